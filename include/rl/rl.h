@@ -1,0 +1,13 @@
+/* rl.h: everything public in renderlab. */
+#ifndef RL_H
+#define RL_H
+#include "rl/rl_common.h"
+#include "rl/rl_math.h"
+#include "rl/rl_rng.h"
+#include "rl/rl_image.h"
+#include "rl/rl_timer.h"
+#include "rl/rl_camera.h"
+#include "rl/rl_scene.h"
+#include "rl/rl_raster.h"
+#include "rl/rl_render.h"
+#endif

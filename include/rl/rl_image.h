@@ -1,0 +1,78 @@
+/* rl_image.h: the frame every renderer writes, and textures.
+ *
+ * An rl_image is a float RGBA colour buffer (linear, premultiplied alpha not
+ * assumed) with optional per-pixel layers: depth (eye-space distance along
+ * the view axis, +INFINITY where nothing was hit) and IDs (object ID and
+ * triangle ID, RL_ID_NONE where nothing was hit). Pixel (0,0) is top-left;
+ * rows are stored top to bottom.
+ *
+ * Output: PNG (8-bit sRGB, via libpng) and OpenEXR (half RGBA, via OpenEXR).
+ * Input: PNG, JPEG and the other formats stb_image reads, for textures.
+ * Limits: width and height in 1..RL_IMAGE_MAX_SIZE; anything larger is refused
+ * with RL_ERR_LIMIT before allocating. */
+#ifndef RL_IMAGE_H
+#define RL_IMAGE_H
+
+#include <stdint.h>
+#include "rl/rl_common.h"
+#include "rl/rl_math.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+#define RL_IMAGE_MAX_SIZE 16384
+#define RL_ID_NONE 0xFFFFFFFFu
+
+typedef enum rl_image_layers {
+    RL_LAYER_COLOR = 1 << 0,
+    RL_LAYER_DEPTH = 1 << 1,
+    RL_LAYER_ID    = 1 << 2,   /* object_id and triangle_id */
+} rl_image_layers;
+
+typedef struct rl_image {
+    int width, height;
+    unsigned layers;          /* rl_image_layers present */
+    rl_vec4 *color;           /* width*height, or NULL */
+    float *depth;             /* width*height, or NULL */
+    uint32_t *object_id;      /* width*height, or NULL */
+    uint32_t *triangle_id;    /* width*height, or NULL */
+} rl_image;
+
+/* Allocates an image with the given layers, cleared (see rl_image_clear). */
+RL_API rl_status rl_image_create(int width, int height, unsigned layers, rl_image **out);
+RL_API void rl_image_release(rl_image *img);      /* NULL is a no-op */
+/* Colour to (0,0,0,0), depth to +INFINITY, IDs to RL_ID_NONE. */
+RL_API void rl_image_clear(rl_image *img);
+RL_API void rl_image_fill(rl_image *img, rl_vec4 color);
+static inline rl_vec4 *rl_image_pixel(rl_image *img, int x, int y) { return &img->color[(size_t)y * img->width + x]; }
+
+/* Writes colour by extension: ".png" (8-bit sRGB, alpha kept) or ".exr"
+ * (half float linear RGBA). RL_ERR_UNSUPPORTED for other extensions,
+ * RL_ERR_IO when the file cannot be written. */
+RL_API rl_status rl_image_write(const rl_image *img, const char *path);
+RL_API rl_status rl_image_write_png(const rl_image *img, const char *path);
+RL_API rl_status rl_image_write_exr(const rl_image *img, const char *path);
+/* Reads a PNG (8/16-bit) or EXR into a colour-only image, linear values
+ * (PNG is decoded from sRGB). For round trips and tests. */
+RL_API rl_status rl_image_read(const char *path, rl_image **out);
+
+/* Textures: linear RGBA float texels, bilinear lookup with repeat wrapping. */
+typedef struct rl_texture {
+    int width, height;
+    rl_vec4 *texels;          /* row 0 = top of the picture */
+    char *path;               /* where it came from, or NULL */
+} rl_texture;
+
+/* Loads PNG/JPEG/BMP/TGA via stb_image; sRGB colour converted to linear. */
+RL_API rl_status rl_texture_load(const char *path, rl_texture **out);
+/* Creates a texture from texels (copied). */
+RL_API rl_status rl_texture_create(int width, int height, const rl_vec4 *texels, rl_texture **out);
+RL_API void rl_texture_release(rl_texture *tex);
+/* uv (0,0) is the bottom-left of the picture (OpenGL convention), repeat wrap. */
+RL_API rl_vec4 rl_texture_sample(const rl_texture *tex, rl_vec2 uv);
+
+#ifdef __cplusplus
+}
+#endif
+#endif

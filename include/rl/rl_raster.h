@@ -1,0 +1,110 @@
+/* rl_raster.h: the software rasterizer, renderlab's reference "hardware" path.
+ *
+ * Triangles are transformed by a view-projection, clipped against the near
+ * plane (and a guard band, so that fixed-point setup never overflows),
+ * rasterized with edge functions in 8-bit sub-pixel fixed point and the
+ * top-left fill rule (a pixel is covered when its centre is inside, shared
+ * edges are drawn exactly once), depth-tested on the eye-space depth
+ * recovered from the screen-linear 1/w (perspective-correct), and written to
+ * the layers of an rl_image that the batch asks for: colour, depth, IDs.
+ * Colours and uvs are interpolated perspective-correctly.
+ *
+ * Multithreaded (OpenMP): the screen is split into horizontal bands, each
+ * band owned by one thread, so results are deterministic and need no locks.
+ * Points are drawn as screen-aligned squares of a given pixel size.
+ * rl_raster_query() counts the pixels of a batch that would pass the depth
+ * test without writing anything: an occlusion query.
+ *
+ * Lighting is not done here: callers pass per-vertex (Gouraud) or per-face
+ * (flat) colours, optionally modulated by a texture; see src/render/raster.c. */
+#ifndef RL_RASTER_H
+#define RL_RASTER_H
+
+#include "rl/rl_camera.h"
+#include "rl/rl_common.h"
+#include "rl/rl_image.h"
+#include "rl/rl_math.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+typedef struct rl_raster rl_raster;
+
+typedef struct rl_raster_desc {         /* zero = default */
+    int threads;                        /* 0 -> omp_get_max_threads() */
+} rl_raster_desc;
+
+typedef enum rl_raster_flags {
+    RL_RASTER_CULL_BACK     = 1 << 0,   /* drop triangles facing away (CCW = front) */
+    RL_RASTER_NO_DEPTH_TEST = 1 << 1,   /* draw regardless of depth (still writes depth) */
+    RL_RASTER_NO_COLOR      = 1 << 2,   /* do not write colour */
+    RL_RASTER_NO_DEPTH      = 1 << 3,   /* do not write depth */
+    RL_RASTER_NO_ID         = 1 << 4,   /* do not write IDs */
+} rl_raster_flags;
+
+/* Counters accumulated by draws (add, never reset by the rasterizer). */
+typedef struct rl_raster_counters {
+    uint64_t triangles_in;        /* submitted */
+    uint64_t triangles_drawn;     /* after culling and clipping, setup done */
+    uint64_t pixels_written;      /* fragments that passed the depth test */
+    uint64_t points_drawn;
+} rl_raster_counters;
+
+/* A triangle batch. positions are world space (transformed by the current
+ * view-projection). Colour source, first non-NULL wins: colors (per vertex,
+ * Gouraud), face_colors (per triangle, flat), otherwise color. With uvs and a
+ * texture (the per-triangle texture_index into textures, or texture), the
+ * colour is multiplied by the texel. IDs: triangle_ids[i] or
+ * first_triangle_id + i; object_ids[i] or object_id. */
+typedef struct rl_raster_batch {
+    uint32_t num_vertices;
+    const rl_vec3 *positions;
+    const rl_vec4 *colors;
+    const rl_vec4 *face_colors;
+    rl_vec4 color;
+    const rl_vec2 *uvs;
+    const rl_texture *texture;
+    const uint32_t *triangle_texture;     /* per triangle index or RL_ID_NONE */
+    rl_texture *const *textures;
+    uint32_t num_triangles;
+    const uint32_t *indices;              /* 3 per triangle */
+    const uint32_t *triangle_ids;
+    uint32_t first_triangle_id;
+    const uint32_t *object_ids;
+    uint32_t object_id;
+    unsigned flags;                       /* rl_raster_flags */
+} rl_raster_batch;
+
+typedef struct rl_raster_points {
+    uint32_t count;
+    const rl_vec3 *positions;             /* world space */
+    const rl_vec4 *colors;                /* per point, or NULL: color */
+    rl_vec4 color;
+    const float *sizes_px;                /* per point side length, or NULL: size_px */
+    float size_px;
+    const uint32_t *object_ids;
+    uint32_t object_id;
+    unsigned flags;
+} rl_raster_points;
+
+RL_API rl_status rl_raster_create(const rl_raster_desc *desc, rl_raster **out);
+RL_API void rl_raster_release(rl_raster *r);
+/* Sets the render target and view-projection. The target's width/height
+ * define the viewport. RL_ERR_INVALID_ARG for a NULL target. */
+RL_API rl_status rl_raster_set_target(rl_raster *r, rl_image *target,
+                                      const rl_mat4 *view, const rl_mat4 *projection);
+/* Convenience: view and projection from a camera (near/far from the camera,
+ * or rl_camera_clip_range() over bounds when its z_near is 0). */
+RL_API rl_status rl_raster_set_camera(rl_raster *r, rl_image *target, const rl_camera *cam,
+                                      rl_aabb scene_bounds);
+RL_API rl_status rl_raster_draw(rl_raster *r, const rl_raster_batch *batch, rl_raster_counters *c);
+RL_API rl_status rl_raster_draw_points(rl_raster *r, const rl_raster_points *pts, rl_raster_counters *c);
+/* Occlusion query: number of pixels of the batch's triangles that would pass
+ * the depth test (strictly nearer than the stored depth). Writes nothing. */
+RL_API rl_status rl_raster_query(rl_raster *r, const rl_raster_batch *batch, uint64_t *visible_pixels);
+
+#ifdef __cplusplus
+}
+#endif
+#endif

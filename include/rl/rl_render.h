@@ -1,0 +1,84 @@
+/* rl_render.h: the pluggable renderer interface.
+ *
+ * Every algorithm in renderlab (raster, and later whitted, vt, pt, surfels,
+ * chc++) is an rl_renderer created by name from one registry, configured with
+ * validated key/value options, and run as
+ *     render(scene, camera, image, stats)
+ * so that the evaluator can time and compare any of them. Options are typed
+ * (int, float, bool, enum, string) and checked on rl_renderer_set(); unknown
+ * keys and malformed values fail with RL_ERR_INVALID_ARG and a message that
+ * lists what is accepted. */
+#ifndef RL_RENDER_H
+#define RL_RENDER_H
+
+#include "rl/rl_camera.h"
+#include "rl/rl_common.h"
+#include "rl/rl_image.h"
+#include "rl/rl_scene.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+typedef enum rl_ray_type {
+    RL_RAY_PRIMARY = 0,
+    RL_RAY_SHADOW,
+    RL_RAY_REFLECTION,
+    RL_RAY_REFRACTION,
+    RL_RAY_DIFFUSE,
+    RL_RAY_TYPE_COUNT
+} rl_ray_type;
+RL_API const char *rl_ray_type_name(rl_ray_type type);
+
+typedef struct rl_render_stats {
+    double time_ms;                       /* wall time of render() */
+    uint64_t rays[RL_RAY_TYPE_COUNT];     /* traced rays by type */
+    uint64_t triangles_rasterized;        /* triangles set up by a rasterizer */
+    uint64_t pixels_written;              /* fragments/pixels written */
+    uint64_t samples;                     /* shading samples (e.g. spp * pixels) */
+} rl_render_stats;
+
+typedef enum rl_option_type {
+    RL_OPT_INT, RL_OPT_FLOAT, RL_OPT_BOOL, RL_OPT_ENUM, RL_OPT_STRING
+} rl_option_type;
+
+typedef struct rl_option_info {
+    const char *key;
+    rl_option_type type;
+    const char *default_value;
+    const char *help;
+    double min, max;                      /* RL_OPT_INT / RL_OPT_FLOAT range */
+    const char *const *choices;           /* RL_OPT_ENUM: NULL-terminated */
+} rl_option_info;
+
+typedef struct rl_renderer rl_renderer;
+
+typedef struct rl_renderer_info {
+    const char *name;
+    const char *description;
+    const char *reference;                /* paper, or "" */
+} rl_renderer_info;
+
+RL_API const rl_renderer_info *rl_renderer_list(size_t *count);
+/* RL_ERR_NOT_FOUND for an unknown name (the message lists the known ones). */
+RL_API rl_status rl_renderer_create(const char *name, rl_renderer **out);
+RL_API void rl_renderer_release(rl_renderer *r);
+RL_API const char *rl_renderer_name(const rl_renderer *r);
+RL_API const rl_option_info *rl_renderer_options(const rl_renderer *r, size_t *count);
+/* Validates and stores one option. key may carry the renderer's name as a
+ * prefix ("raster.shading"). */
+RL_API rl_status rl_renderer_set(rl_renderer *r, const char *key, const char *value);
+/* Current value as text (the default if never set); NULL for unknown keys. */
+RL_API const char *rl_renderer_get(const rl_renderer *r, const char *key);
+/* Optional progress callback for long renders. */
+RL_API void rl_renderer_set_progress(rl_renderer *r, rl_progress_fn fn, void *user);
+/* Renders the committed scene from cam into image, which must match the
+ * camera's resolved resolution and have at least RL_LAYER_COLOR. stats may
+ * be NULL; otherwise it is overwritten. */
+RL_API rl_status rl_renderer_render(rl_renderer *r, const rl_scene *scene, const rl_camera *cam,
+                                    rl_image *image, rl_render_stats *stats);
+
+#ifdef __cplusplus
+}
+#endif
+#endif

@@ -1,0 +1,229 @@
+/* rl_scene.h: the shared scene model.
+ *
+ * A scene is a graph of nodes (transform, optional mesh instance, optional
+ * material override, free string attributes) over shared meshes, materials,
+ * textures, lights and cameras. rl_scene_commit() flattens it into
+ * world-space triangle arrays with stable IDs:
+ *   - object ID   = index of a mesh-carrying node in depth-first order
+ *                   (children in insertion order), one per instance;
+ *   - triangle ID = index into the flattened triangle array; an object's
+ *                   triangles are contiguous, in mesh order.
+ * The same scene description therefore always yields the same IDs.
+ * A committed scene is immutable; accelerators and renderers borrow it.
+ *
+ * Bad geometry: rl_scene_add_mesh() drops triangles that reference a NaN/Inf
+ * vertex or have zero area, counts them in rl_scene_stats and logs one warning
+ * per mesh. Indices out of range are an error. Committing a scene without
+ * triangles fails with RL_ERR_EMPTY_SCENE. */
+#ifndef RL_SCENE_H
+#define RL_SCENE_H
+
+#include "rl/rl_camera.h"
+#include "rl/rl_common.h"
+#include "rl/rl_image.h"
+#include "rl/rl_math.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+#define RL_NONE 0xFFFFFFFFu          /* "no index" for meshes, materials, textures */
+#define RL_NODE_ROOT 0u              /* every scene has a root node */
+#define RL_SCENE_MAX_TRIANGLES (1u << 30)
+
+/* Phong material with the ray-tracing coefficients of Ullmann 2003, Sec. 3.1
+ * (eq. 3.1-3.4): local Phong term + k_r * reflected + k_t * transmitted. */
+typedef struct rl_material {
+    char name[64];
+    rl_vec3 diffuse;          /* k_d, linear RGB */
+    rl_vec3 specular;         /* k_s */
+    float shininess;          /* Phong exponent n */
+    float reflectivity;       /* k_r in [0,1] */
+    float transmissivity;     /* k_t in [0,1] */
+    float ior;                /* index of refraction, >= 1 */
+    rl_vec3 emission;         /* emitted radiance */
+    uint32_t diffuse_texture; /* scene texture index or RL_NONE */
+} rl_material;
+
+/* Grey diffuse (0.8), no specular, shininess 32, ior 1.5, no texture. */
+RL_API rl_material rl_material_default(void);
+/* RL_ERR_INVALID_ARG for negative or non-finite coefficients, k_r + k_t > 1,
+ * ior < 1. */
+RL_API rl_status rl_material_validate(const rl_material *m);
+
+typedef enum rl_light_type {
+    RL_LIGHT_POINT = 0,
+    RL_LIGHT_SPOT,
+    RL_LIGHT_DIRECTIONAL,
+    RL_LIGHT_QUAD,
+    RL_LIGHT_TYPE_COUNT
+} rl_light_type;
+
+/* Point and spot lights fall off with 1/d^2; intensity scales color.
+ * Directional: irradiance color*intensity from direction -direction.
+ * Quad: emitted radiance color*intensity from the parallelogram
+ * position + s*edge_u + t*edge_v (s,t in [0,1]), on the side of
+ * cross(edge_u, edge_v). */
+typedef struct rl_light {
+    rl_light_type type;
+    rl_vec3 color;
+    float intensity;
+    rl_vec3 position;         /* point, spot; quad corner */
+    rl_vec3 direction;        /* spot, directional: the direction light travels */
+    float spot_inner_deg;     /* full intensity inside this half angle */
+    float spot_outer_deg;     /* zero outside this half angle */
+    rl_vec3 edge_u, edge_v;   /* quad */
+} rl_light;
+
+RL_API const char *rl_light_type_name(rl_light_type type);
+RL_API rl_status rl_light_validate(const rl_light *l);
+
+/* Mesh input. Data is copied. normals == NULL: area-weighted smooth normals
+ * are computed; uvs == NULL: all (0,0). */
+typedef struct rl_mesh_desc {
+    const char *name;
+    uint32_t num_vertices;
+    const rl_vec3 *positions;
+    const rl_vec3 *normals;
+    const rl_vec2 *uvs;
+    uint32_t num_triangles;
+    const uint32_t *indices;           /* 3 per triangle */
+    const uint32_t *triangle_materials;/* per triangle, or NULL: use material */
+    uint32_t material;                 /* scene material index */
+} rl_mesh_desc;
+
+typedef struct rl_scene rl_scene;
+
+RL_API rl_status rl_scene_create(rl_scene **out);
+RL_API void rl_scene_release(rl_scene *scene);         /* NULL is a no-op */
+RL_API rl_status rl_scene_set_name(rl_scene *scene, const char *name);
+RL_API const char *rl_scene_name(const rl_scene *scene);
+/* Folder that relative asset paths are resolved against ("" = cwd). */
+RL_API rl_status rl_scene_set_base_dir(rl_scene *scene, const char *dir);
+RL_API const char *rl_scene_base_dir(const rl_scene *scene);
+
+/* Building (only before commit; afterwards RL_ERR_INVALID_ARG). */
+RL_API rl_status rl_scene_add_material(rl_scene *scene, const rl_material *m, uint32_t *id);
+/* Index of the material with this name, or RL_NONE. */
+RL_API uint32_t rl_scene_find_material(const rl_scene *scene, const char *name);
+/* Takes ownership of tex on success. */
+RL_API rl_status rl_scene_add_texture(rl_scene *scene, rl_texture *tex, uint32_t *id);
+/* Loads a texture file (relative to the base dir), sharing repeated paths. */
+RL_API rl_status rl_scene_load_texture(rl_scene *scene, const char *path, uint32_t *id);
+RL_API rl_status rl_scene_add_mesh(rl_scene *scene, const rl_mesh_desc *desc, uint32_t *mesh_id);
+RL_API rl_status rl_scene_add_light(rl_scene *scene, const rl_light *light);
+RL_API rl_status rl_scene_add_camera(rl_scene *scene, const char *name, const rl_camera *cam);
+/* Takes ownership of path on success; replaces any previous path. */
+RL_API rl_status rl_scene_set_camera_path(rl_scene *scene, rl_camera_path *path);
+
+/* Scene graph. transform == NULL: identity. node ids are dense, root = 0. */
+RL_API rl_status rl_scene_add_node(rl_scene *scene, uint32_t parent, const char *name,
+                                   const rl_mat4 *transform, uint32_t *node_id);
+RL_API rl_status rl_scene_node_set_mesh(rl_scene *scene, uint32_t node, uint32_t mesh);
+/* Replaces the materials of this node's mesh and of its descendants' meshes,
+ * unless a descendant sets its own override. */
+RL_API rl_status rl_scene_node_set_material(rl_scene *scene, uint32_t node, uint32_t material);
+/* Free per-node attributes (e.g. "vt" = "true"); value NULL removes. */
+RL_API rl_status rl_scene_node_set_attr(rl_scene *scene, uint32_t node, const char *key,
+                                        const char *value);
+RL_API const char *rl_scene_node_attr(const rl_scene *scene, uint32_t node, const char *key);
+RL_API uint32_t rl_scene_node_count(const rl_scene *scene);
+RL_API const char *rl_scene_node_name(const rl_scene *scene, uint32_t node);
+RL_API uint32_t rl_scene_node_parent(const rl_scene *scene, uint32_t node); /* RL_NONE for root */
+/* First node with this name in id order, or RL_NONE. */
+RL_API uint32_t rl_scene_find_node(const rl_scene *scene, const char *name);
+
+/* Flattens and validates. RL_ERR_EMPTY_SCENE without triangles. */
+RL_API rl_status rl_scene_commit(rl_scene *scene);
+RL_API bool rl_scene_is_committed(const rl_scene *scene);
+
+/* One flattened mesh instance. */
+typedef struct rl_object {
+    const char *name;          /* node name */
+    uint32_t node, mesh;
+    uint32_t first_triangle, num_triangles;
+    uint32_t first_vertex, num_vertices;
+    rl_aabb bounds;            /* world space */
+    rl_mat4 world;             /* node's local-to-world transform */
+} rl_object;
+
+/* Read-only view of a committed scene; valid until the scene is released. */
+typedef struct rl_scene_data {
+    uint32_t num_vertices;
+    const rl_vec3 *positions;           /* world space */
+    const rl_vec3 *normals;             /* world space, unit */
+    const rl_vec2 *uvs;                 /* never NULL */
+    uint32_t num_triangles;
+    const uint32_t *indices;            /* 3 per triangle, into the vertex arrays */
+    const uint32_t *triangle_object;    /* object ID per triangle */
+    const uint32_t *triangle_material;  /* material index per triangle */
+    uint32_t num_objects;
+    const rl_object *objects;
+    uint32_t num_materials;
+    const rl_material *materials;
+    uint32_t num_textures;
+    rl_texture *const *textures;
+    uint32_t num_lights;
+    const rl_light *lights;
+    uint32_t num_cameras;
+    const rl_camera *cameras;
+    const char *const *camera_names;
+    const rl_camera_path *camera_path;  /* or NULL */
+    rl_aabb bounds;
+} rl_scene_data;
+
+/* NULL (with RL_ERR_NOT_COMMITTED recorded) unless committed. */
+RL_API const rl_scene_data *rl_scene_get_data(const rl_scene *scene);
+
+/* The named camera, the first camera (name NULL), or a camera framing the
+ * bounds when the scene has none. RL_ERR_NOT_FOUND for an unknown name. */
+RL_API rl_status rl_scene_get_camera(const rl_scene *scene, const char *name, rl_camera *out);
+
+typedef struct rl_scene_stats {
+    uint32_t nodes, meshes, objects, materials, textures, lights, cameras;
+    uint64_t mesh_triangles;       /* unique triangles in meshes */
+    uint64_t triangles, vertices;  /* after instancing (committed scenes) */
+    uint64_t emissive_triangles;
+    uint64_t dropped_degenerate;   /* zero-area triangles dropped */
+    uint64_t dropped_nonfinite;    /* triangles with NaN/Inf vertices dropped */
+    size_t memory_bytes;           /* flattened arrays + meshes */
+    rl_aabb bounds;
+} rl_scene_stats;
+RL_API void rl_scene_get_stats(const rl_scene *scene, rl_scene_stats *out);
+
+/* Procedural meshes ("generators"), shared by built-in and JSON scenes.
+ * params: "key=value" pairs separated by commas or NULL; unknown keys are
+ * RL_ERR_INVALID_ARG. Generators: box, quad, sphere, cylinder, teapot
+ * (Utah teapot from its Bezier patches). See docs/scene-format.md. */
+RL_API rl_status rl_scene_add_generated(rl_scene *scene, const char *generator,
+                                        const char *params, uint32_t material,
+                                        uint32_t *mesh_id);
+RL_API const char *const *rl_generator_names(size_t *count);
+
+/* Built-in scenes: cornell, cornell-teapot, spheres, city. params as above
+ * (e.g. "triangles=70000" for cornell-teapot, "blocks=8" for city). The
+ * returned scene is committed. */
+typedef struct rl_builtin_info {
+    const char *name;
+    const char *description;
+    const char *params;        /* documented parameters with defaults */
+} rl_builtin_info;
+RL_API const rl_builtin_info *rl_builtin_scenes(size_t *count);
+RL_API rl_status rl_scene_create_builtin(const char *name, const char *params, rl_scene **out);
+
+/* Loading. rl_scene_load() accepts a built-in name, a .json scene file or
+ * any mesh file Assimp reads (OBJ, PLY, STL, glTF/GLB, DAE, 3DS, FBX, ...);
+ * for a bare mesh file it adds a default light and camera. Returns a
+ * committed scene. Errors name the file, and for JSON the line and column. */
+RL_API rl_status rl_scene_load(const char *source, const char *params, rl_scene **out);
+RL_API rl_status rl_scene_load_json(const char *path, rl_scene **out);   /* committed */
+/* Imports a mesh file with Assimp under parent: its node hierarchy,
+ * meshes (triangulated; quads and n-gons split), materials and textures
+ * (paths relative to the file). *root_node receives the imported root. */
+RL_API rl_status rl_scene_import(rl_scene *scene, const char *path, uint32_t parent,
+                                 uint32_t *root_node);
+
+#ifdef __cplusplus
+}
+#endif
+#endif

@@ -1,0 +1,37 @@
+#!/usr/bin/env bash
+# Installs the Debian packages renderlab needs, and only those that are missing.
+# Idempotent: with everything present it touches nothing and asks no network.
+set -euo pipefail
+
+PACKAGES=(
+  build-essential cmake pkg-config
+  libpng-dev          # PNG output
+  libopenexr-dev      # EXR output
+  libstb-dev          # PNG/JPEG texture input (stb_image)
+  libcjson-dev        # scene and result files
+  libassimp-dev       # OBJ, PLY, STL, glTF, DAE, 3DS, FBX import
+  libcmocka-dev       # unit tests
+)
+
+missing=()
+for p in "${PACKAGES[@]}"; do
+  if ! dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed"; then
+    missing+=("$p")
+  fi
+done
+
+if [ ${#missing[@]} -eq 0 ]; then
+  echo "deps: all ${#PACKAGES[@]} packages present"
+  exit 0
+fi
+
+SUDO=""
+if [ "$(id -u)" -ne 0 ]; then
+  if command -v sudo >/dev/null 2>&1; then SUDO="sudo"; else
+    echo "deps: missing ${missing[*]} and not root (no sudo available)" >&2; exit 1
+  fi
+fi
+echo "deps: installing ${missing[*]}"
+export DEBIAN_FRONTEND=noninteractive
+$SUDO apt-get update -qq
+$SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}"

@@ -1,0 +1,37 @@
+/* renderer.h: how an algorithm plugs into the rl_renderer interface.
+ *
+ * A renderer provides one rl_renderer_class: its name, its option table and
+ * three functions. The generic layer (renderer.c) validates and stores option
+ * values as text; an implementation reads them typed with rl_renderer_opt_*.
+ * All classes are listed once, in registry.c. */
+#ifndef RL_RENDER_RENDERER_H
+#define RL_RENDER_RENDERER_H
+
+#include "rl/rl_render.h"
+
+typedef struct rl_renderer_class {
+    rl_renderer_info info;
+    const rl_option_info *options;
+    size_t num_options;
+    /* Allocates the implementation's state (may set *state = NULL). */
+    rl_status (*create)(void **state);
+    /* Renders; stats is zeroed by the caller, time_ms is filled by the caller. */
+    rl_status (*render)(rl_renderer *r, void *state, const rl_scene *scene,
+                        const rl_camera *cam, rl_image *image, rl_render_stats *stats);
+    void (*release)(void *state);
+} rl_renderer_class;
+
+/* registry.c */
+extern const rl_renderer_class *const rl_renderer_classes[];
+extern const size_t rl_renderer_class_count;
+
+/* Typed option reads for implementations (values were validated on set). */
+long long rl_renderer_opt_int(const rl_renderer *r, const char *key);
+double rl_renderer_opt_float(const rl_renderer *r, const char *key);
+bool rl_renderer_opt_bool(const rl_renderer *r, const char *key);
+int rl_renderer_opt_enum(const rl_renderer *r, const char *key);   /* choice index */
+const char *rl_renderer_opt_string(const rl_renderer *r, const char *key);
+/* Progress for implementations: false means cancel. */
+bool rl_renderer_progress(const rl_renderer *r, double done);
+
+#endif

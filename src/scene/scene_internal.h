@@ -1,0 +1,64 @@
+/* scene_internal.h: the rl_scene struct, shared by the files of src/scene. */
+#ifndef RL_SCENE_INTERNAL_H
+#define RL_SCENE_INTERNAL_H
+
+#include "rl/rl_scene.h"
+
+typedef struct rl_attr { char *key, *value; } rl_attr;
+
+typedef struct rl_node {
+    char *name;
+    uint32_t parent;           /* RL_NONE for root */
+    rl_mat4 local;             /* local -> parent */
+    uint32_t mesh;             /* RL_NONE if none */
+    uint32_t material;         /* override or RL_NONE */
+    uint32_t first_child, next_sibling, last_child; /* RL_NONE-terminated lists */
+    rl_attr *attrs;
+    uint32_t num_attrs;
+} rl_node;
+
+typedef struct rl_mesh {
+    char *name;
+    uint32_t num_vertices, num_triangles;
+    rl_vec3 *positions, *normals;
+    rl_vec2 *uvs;
+    uint32_t *indices;
+    uint32_t *materials;       /* per triangle */
+} rl_mesh;
+
+struct rl_scene {
+    char *name;
+    char *base_dir;
+    bool committed;
+
+    rl_node *nodes;       uint32_t num_nodes, cap_nodes;
+    rl_mesh *meshes;      uint32_t num_meshes, cap_meshes;
+    rl_material *materials; uint32_t num_materials, cap_materials;
+    rl_texture **textures; uint32_t num_textures, cap_textures;
+    rl_light *lights;     uint32_t num_lights, cap_lights;
+    rl_camera *cameras;   char **camera_names; uint32_t num_cameras, cap_cameras;
+    rl_camera_path *camera_path;
+
+    uint64_t dropped_degenerate, dropped_nonfinite;
+
+    /* Flattened by commit. */
+    rl_scene_data data;
+    rl_vec3 *flat_positions, *flat_normals;
+    rl_vec2 *flat_uvs;
+    uint32_t *flat_indices, *flat_tri_object, *flat_tri_material;
+    rl_object *flat_objects;
+};
+
+/* Returns RL_ERR_INVALID_ARG with a message if the scene is committed. */
+rl_status rl_scene_check_mutable(const rl_scene *scene, const char *what);
+
+/* Area-weighted smooth vertex normals; vertices without area get +z. */
+void rl_mesh_compute_normals(uint32_t num_vertices, const rl_vec3 *positions,
+                             uint32_t num_triangles, const uint32_t *indices, rl_vec3 *normals);
+
+/* Joins base_dir and a relative path into out (absolute paths are kept). */
+void rl_path_join(const char *base_dir, const char *path, char *out, size_t out_size);
+/* Directory part of path ("" if none) into out. */
+void rl_path_dirname(const char *path, char *out, size_t out_size);
+
+#endif
