@@ -30,7 +30,7 @@ check: deps
 	    ctest --output-on-failure -j $(JOBS) -E '^bench/'
 
 demo: deps build
-	@bash scripts/demo.sh $(BUILD)/rl out/demo
+	@$(BUILD)/rl demo --out out/demo
 
 clean:
 	rm -rf $(BUILD) $(BUILD_SAN) out
