@@ -104,7 +104,8 @@ void *rl_realloc_array(void *p, size_t count, size_t size)
         rl_error(RL_ERR_OUT_OF_MEMORY, "allocation of %zu x %zu bytes overflows", count, size);
         return NULL;
     }
-    void *q = realloc(p, count * size ? count * size : 1);
+    size_t bytes = count * size;
+    void *q = realloc(p, bytes ? bytes : 1);
     if (!q)
         rl_error(RL_ERR_OUT_OF_MEMORY, "out of memory allocating %zu x %zu bytes", count, size);
     return q;

@@ -1,0 +1,141 @@
+/* image.c: rl_image allocation, clearing and format dispatch by extension.
+ * Sizes are checked against RL_IMAGE_MAX_SIZE before anything is allocated,
+ * so a corrupt header or a typo on the command line cannot ask for 64 GiB. */
+#include "rl/rl_image.h"
+
+#include <ctype.h>
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "core/error.h"
+#include "core/image_internal.h"
+
+rl_status rl_image_check_size(const char *what, long long width, long long height)
+{
+    if (width < 1 || height < 1 || width > RL_IMAGE_MAX_SIZE || height > RL_IMAGE_MAX_SIZE)
+        return rl_error(RL_ERR_LIMIT, "%s: size %lldx%lld outside 1..%d per side", what,
+                        width, height, RL_IMAGE_MAX_SIZE);
+    return RL_OK;
+}
+
+rl_status rl_image_create(int width, int height, unsigned layers, rl_image **out)
+{
+    if (!out)
+        return rl_error(RL_ERR_INVALID_ARG, "rl_image_create: out is NULL");
+    rl_status st = rl_image_check_size("rl_image_create", width, height);
+    if (st != RL_OK)
+        return st;
+    if (layers & ~(unsigned)(RL_LAYER_COLOR | RL_LAYER_DEPTH | RL_LAYER_ID))
+        return rl_error(RL_ERR_INVALID_ARG, "rl_image_create: unknown layer bits 0x%x", layers);
+    size_t n = (size_t)width * (size_t)height;
+    rl_image *img = rl_calloc(1, sizeof *img);
+    if (!img)
+        return RL_ERR_OUT_OF_MEMORY;
+    img->width = width;
+    img->height = height;
+    img->layers = layers;
+    bool ok = true;
+    if (layers & RL_LAYER_COLOR)
+        ok = ok && (img->color = rl_calloc(n, sizeof *img->color)) != NULL;
+    if (layers & RL_LAYER_DEPTH)
+        ok = ok && (img->depth = rl_calloc(n, sizeof *img->depth)) != NULL;
+    if (layers & RL_LAYER_ID) {
+        ok = ok && (img->object_id = rl_calloc(n, sizeof *img->object_id)) != NULL;
+        ok = ok && (img->triangle_id = rl_calloc(n, sizeof *img->triangle_id)) != NULL;
+    }
+    if (!ok) {
+        rl_image_release(img);
+        return RL_ERR_OUT_OF_MEMORY;
+    }
+    rl_image_clear(img);
+    *out = img;
+    return RL_OK;
+}
+
+void rl_image_release(rl_image *img)
+{
+    if (!img)
+        return;
+    free(img->color);
+    free(img->depth);
+    free(img->object_id);
+    free(img->triangle_id);
+    free(img);
+}
+
+void rl_image_clear(rl_image *img)
+{
+    if (!img)
+        return;
+    size_t n = (size_t)img->width * (size_t)img->height;
+    if (img->color)
+        memset(img->color, 0, n * sizeof *img->color);
+    for (size_t i = 0; img->depth && i < n; ++i)
+        img->depth[i] = INFINITY;
+    for (size_t i = 0; img->object_id && i < n; ++i)
+        img->object_id[i] = RL_ID_NONE;
+    for (size_t i = 0; img->triangle_id && i < n; ++i)
+        img->triangle_id[i] = RL_ID_NONE;
+}
+
+void rl_image_fill(rl_image *img, rl_vec4 color)
+{
+    if (!img || !img->color)
+        return;
+    size_t n = (size_t)img->width * (size_t)img->height;
+    for (size_t i = 0; i < n; ++i)
+        img->color[i] = color;
+}
+
+/* Case-insensitive "does path end in ext" (ext includes the dot). */
+static bool has_extension(const char *path, const char *ext)
+{
+    size_t lp = strlen(path), le = strlen(ext);
+    if (lp < le)
+        return false;
+    for (size_t i = 0; i < le; ++i)
+        if (tolower((unsigned char)path[lp - le + i]) != ext[i])
+            return false;
+    return true;
+}
+
+static const char *extension_of(const char *path)
+{
+    const char *slash = strrchr(path, '/');
+    const char *dot = strrchr(path, '.');
+    return dot && (!slash || dot > slash) ? dot : "";
+}
+
+rl_status rl_image_check_writable(const rl_image *img, const char *who, const char *path)
+{
+    if (!img || !path)
+        return rl_error(RL_ERR_INVALID_ARG, "%s: image or path is NULL", who);
+    if (!img->color)
+        return rl_error(RL_ERR_INVALID_ARG, "%s: %s: image has no colour layer", who, path);
+    return rl_image_check_size(path, img->width, img->height);
+}
+
+rl_status rl_image_write(const rl_image *img, const char *path)
+{
+    if (!img || !path)
+        return rl_error(RL_ERR_INVALID_ARG, "rl_image_write: image or path is NULL");
+    if (has_extension(path, ".png"))
+        return rl_image_write_png(img, path);
+    if (has_extension(path, ".exr"))
+        return rl_image_write_exr(img, path);
+    const char *ext = extension_of(path);
+    return rl_error(RL_ERR_UNSUPPORTED,
+                    "%s: unsupported image extension \"%s\" (accepted: .png, .exr)", path,
+                    *ext ? ext : "(none)");
+}
+
+rl_status rl_image_read(const char *path, rl_image **out)
+{
+    if (!path || !out)
+        return rl_error(RL_ERR_INVALID_ARG, "rl_image_read: path or out is NULL");
+    if (has_extension(path, ".exr"))
+        return rl_image_read_exr(path, out);
+    /* Anything else is sniffed by libpng, which names what it found. */
+    return rl_image_read_png(path, out);
+}

@@ -1,0 +1,143 @@
+/* texture.c: image textures for shading. Decoding is stb_image's (PNG, JPEG,
+ * BMP, TGA, ...); 8- and 16-bit colour is converted from sRGB to linear with
+ * the exact curve (stbi_loadf would apply a plain 2.2 gamma), alpha is kept
+ * linear. Texels are stored top row first like the picture; sampling flips v
+ * so that uv (0,0) is the bottom-left (OpenGL convention), with bilinear
+ * filtering between texel centres and repeat wrapping. */
+#include "rl/rl_image.h"
+
+#include <errno.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include <stb/stb_image.h>
+
+#include "core/error.h"
+
+#define TEXTURE_MAX_SIZE 16384
+
+static rl_status check_texture_size(const char *what, long long w, long long h)
+{
+    if (w < 1 || h < 1 || w > TEXTURE_MAX_SIZE || h > TEXTURE_MAX_SIZE)
+        return rl_error(RL_ERR_LIMIT, "%s: texture size %lldx%lld outside 1..%d per side", what,
+                        w, h, TEXTURE_MAX_SIZE);
+    return RL_OK;
+}
+
+/* Allocates the texture and its texel array; path may be NULL. */
+static rl_status texture_alloc(int w, int h, const char *path, rl_texture **out)
+{
+    rl_texture *tex = rl_calloc(1, sizeof *tex);
+    if (!tex)
+        return RL_ERR_OUT_OF_MEMORY;
+    tex->width = w;
+    tex->height = h;
+    tex->texels = rl_calloc((size_t)w * (size_t)h, sizeof *tex->texels);
+    if (tex->texels && path)
+        tex->path = rl_strdup(path);
+    if (!tex->texels || (path && !tex->path)) {
+        rl_texture_release(tex);
+        return RL_ERR_OUT_OF_MEMORY;
+    }
+    *out = tex;
+    return RL_OK;
+}
+
+rl_status rl_texture_load(const char *path, rl_texture **out)
+{
+    if (!path || !out)
+        return rl_error(RL_ERR_INVALID_ARG, "rl_texture_load: path or out is NULL");
+    FILE *f = fopen(path, "rb");
+    if (!f)
+        return rl_error(RL_ERR_IO, "%s: cannot open: %s", path, strerror(errno));
+    /* Read the header only, so absurd sizes are refused before decoding. */
+    int w = 0, h = 0, comp = 0;
+    if (!stbi_info_from_file(f, &w, &h, &comp)) {
+        fclose(f);
+        return rl_error(RL_ERR_PARSE, "%s: cannot decode image: %s", path, stbi_failure_reason());
+    }
+    rl_status st = check_texture_size(path, w, h);
+    if (st != RL_OK) {
+        fclose(f);
+        return st;
+    }
+    bool wide = stbi_is_16_bit_from_file(f);
+    void *data = wide ? (void *)stbi_load_from_file_16(f, &w, &h, &comp, 4)
+                      : (void *)stbi_load_from_file(f, &w, &h, &comp, 4);
+    fclose(f);
+    if (!data)
+        return rl_error(RL_ERR_PARSE, "%s: cannot decode image: %s", path, stbi_failure_reason());
+    rl_texture *tex = NULL;
+    if ((st = texture_alloc(w, h, path, &tex)) != RL_OK) {
+        stbi_image_free(data);
+        return st;
+    }
+    const float scale = wide ? 1.0f / 65535.0f : 1.0f / 255.0f;
+    for (size_t i = 0; i < (size_t)w * h; ++i) {
+        float v[4];
+        for (int c = 0; c < 4; ++c)
+            v[c] = scale * (wide ? (float)((const stbi_us *)data)[4 * i + c]
+                                 : (float)((const stbi_uc *)data)[4 * i + c]);
+        tex->texels[i] = rl_v4(rl_srgb_to_linear(v[0]), rl_srgb_to_linear(v[1]),
+                               rl_srgb_to_linear(v[2]), v[3]);
+    }
+    stbi_image_free(data);
+    *out = tex;
+    return RL_OK;
+}
+
+rl_status rl_texture_create(int width, int height, const rl_vec4 *texels, rl_texture **out)
+{
+    if (!texels || !out)
+        return rl_error(RL_ERR_INVALID_ARG, "rl_texture_create: texels or out is NULL");
+    rl_status st = check_texture_size("rl_texture_create", width, height);
+    if (st != RL_OK)
+        return st;
+    rl_texture *tex = NULL;
+    if ((st = texture_alloc(width, height, NULL, &tex)) != RL_OK)
+        return st;
+    memcpy(tex->texels, texels, (size_t)width * (size_t)height * sizeof *texels);
+    *out = tex;
+    return RL_OK;
+}
+
+void rl_texture_release(rl_texture *tex)
+{
+    if (!tex)
+        return;
+    free(tex->texels);
+    free(tex->path);
+    free(tex);
+}
+
+/* Integer index i wrapped into [0, n). */
+static int wrap(long long i, int n)
+{
+    long long r = i % n;
+    return (int)(r < 0 ? r + n : r);
+}
+
+rl_vec4 rl_texture_sample(const rl_texture *tex, rl_vec2 uv)
+{
+    float u = uv.x, v = uv.y;
+    /* Reduce to [0,1) first: keeps huge or NaN coordinates in integer range. */
+    u = isfinite(u) ? u - floorf(u) : 0.0f;
+    v = isfinite(v) ? v - floorf(v) : 0.0f;
+    /* Texel centres sit at half-integers; v = 0 is the bottom of the picture. */
+    float fx = u * (float)tex->width - 0.5f;
+    float fy = (1.0f - v) * (float)tex->height - 0.5f;
+    float x0f = floorf(fx), y0f = floorf(fy);
+    float tx = fx - x0f, ty = fy - y0f;
+    int x0 = wrap((long long)x0f, tex->width), x1 = wrap((long long)x0f + 1, tex->width);
+    int y0 = wrap((long long)y0f, tex->height), y1 = wrap((long long)y0f + 1, tex->height);
+    const rl_vec4 *row0 = tex->texels + (size_t)y0 * tex->width;
+    const rl_vec4 *row1 = tex->texels + (size_t)y1 * tex->width;
+    float w00 = (1 - tx) * (1 - ty), w10 = tx * (1 - ty), w01 = (1 - tx) * ty, w11 = tx * ty;
+    rl_vec4 a = row0[x0], b = row0[x1], c = row1[x0], d = row1[x1];
+    return rl_v4(w00 * a.x + w10 * b.x + w01 * c.x + w11 * d.x,
+                 w00 * a.y + w10 * b.y + w01 * c.y + w11 * d.y,
+                 w00 * a.z + w10 * b.z + w01 * c.z + w11 * d.z,
+                 w00 * a.w + w10 * b.w + w01 * c.w + w11 * d.w);
+}
