@@ -19,6 +19,10 @@ typedef struct rl_renderer_class {
     rl_status (*render)(rl_renderer *r, void *state, const rl_scene *scene,
                         const rl_camera *cam, rl_image *image, rl_render_stats *stats);
     void (*release)(void *state);
+    /* Optional extra check of a value that already passed the type check
+     * (e.g. a colour in a string option); NULL: none. Records and returns
+     * RL_ERR_INVALID_ARG for a bad value. */
+    rl_status (*check)(const char *key, const char *value);
 } rl_renderer_class;
 
 /* registry.c */
@@ -31,6 +35,11 @@ double rl_renderer_opt_float(const rl_renderer *r, const char *key);
 bool rl_renderer_opt_bool(const rl_renderer *r, const char *key);
 int rl_renderer_opt_enum(const rl_renderer *r, const char *key);   /* choice index */
 const char *rl_renderer_opt_string(const rl_renderer *r, const char *key);
+/* Colours in string options: "r,g,b" or a single grey value, finite and >= 0.
+ * rl_renderer_parse_color() only parses (no error recorded); the option read
+ * returns black for a value that does not parse. */
+bool rl_renderer_parse_color(const char *text, rl_vec3 *out);
+rl_vec3 rl_renderer_opt_color(const rl_renderer *r, const char *key);
 /* Progress for implementations: false means cancel. */
 bool rl_renderer_progress(const rl_renderer *r, double done);
 

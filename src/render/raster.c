@@ -1,0 +1,411 @@
+/* raster.c: renderer "raster", software rasterization with local Phong
+ * lighting; the reference for the hardware path of the thesis renderers
+ * (Ullmann 2003, Sec. 3.5 uses OpenGL Gouraud shading for the same role).
+ *
+ * Lighting is the local part of the Phong model of Ullmann 2003, Sec. 3.1
+ * (eq. 3.1 without the k_r/k_t terms): emission + ambient * k_d +
+ * sum over lights of E * (k_d max(0, n.l) + k_s max(0, r.v)^n). It is
+ * evaluated per vertex and interpolated by src/raster (gouraud, textured) or
+ * once per triangle at its centroid with the geometric normal (flat).
+ * No shadows: a rasterizer has no visibility between surface and light.
+ *
+ * Options (defaults): shading = textured (flat | gouraud | textured),
+ * cull = false, ambient = 0.05, background = "0,0,0", threads = 0 (all).
+ *
+ * Deviations, on purpose:
+ *  - two-sided lighting: the normal is flipped towards the viewer, so open
+ *    meshes and meshes with inconsistent winding look the same from both
+ *    sides (OpenGL's GL_LIGHT_MODEL_TWO_SIDE);
+ *  - quad lights are approximated by a point light at their centre with
+ *    intensity * area * max(0, cos at the light);
+ *  - textured: the rasterizer multiplies the whole interpolated colour by
+ *    the texel, so the texture modulates specular and emission too, not only
+ *    k_d as in the ray tracers. Fine for matte textured scenes, which is
+ *    what textures are used for here; splitting into two passes would need
+ *    additive blending that src/raster does not have. */
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#ifdef _OPENMP
+#include <omp.h>
+#endif
+
+#include "core/error.h"
+#include "render/renderer.h"
+#include "rl/rl_raster.h"
+
+enum { SHADING_FLAT = 0, SHADING_GOURAUD, SHADING_TEXTURED };
+static const char *const shading_choices[] = { "flat", "gouraud", "textured", NULL };
+
+static const rl_option_info raster_options[] = {
+    { "shading", RL_OPT_ENUM, "textured",
+      "flat: per triangle; gouraud: per vertex; textured: gouraud times the diffuse texture",
+      0, 0, shading_choices },
+    { "cull", RL_OPT_BOOL, "false", "drop back faces (counter-clockwise = front)", 0, 0, NULL },
+    { "ambient", RL_OPT_FLOAT, "0.05", "ambient light, multiplied by k_d", 0, 1, NULL },
+    { "background", RL_OPT_STRING, "0,0,0", "colour where nothing is hit: \"r,g,b\" or one grey value",
+      0, 0, NULL },
+    { "threads", RL_OPT_INT, "0", "OpenMP threads for lighting and rasterization (0 = all)", 0, 1024, NULL },
+};
+
+/* What every lighting evaluation needs; read-only, shared by all threads. */
+typedef struct shade_ctx {
+    const rl_scene_data *data;
+    rl_vec3 eye;
+    float ambient;
+} shade_ctx;
+
+static float smoothstep(float e0, float e1, float x)
+{
+    float t = rl_clampf((x - e0) / (e1 - e0), 0.0f, 1.0f);
+    return t * t * (3.0f - 2.0f * t);
+}
+
+/* Irradiance-like scale E of light L at p and the unit direction l towards
+ * it; returns false where the light does not reach p. */
+static bool light_at(const rl_light *L, rl_vec3 p, rl_vec3 *E, rl_vec3 *l)
+{
+    rl_vec3 power = rl_scale(L->color, L->intensity);
+    if (L->type == RL_LIGHT_DIRECTIONAL) {
+        *l = rl_normalize(rl_neg(L->direction));
+        *E = power;
+        return rl_length2(*l) > 0.0f;
+    }
+
+    rl_vec3 pos = L->position;
+    if (L->type == RL_LIGHT_QUAD) {
+        rl_vec3 normal = rl_cross(L->edge_u, L->edge_v);
+        float area = rl_length(normal);
+        pos = rl_add(pos, rl_scale(rl_add(L->edge_u, L->edge_v), 0.5f));
+        rl_vec3 to_p = rl_normalize(rl_sub(p, pos));
+        /* Emitting side only, and foreshortened like a small area light. */
+        float cos_light = area > 0.0f ? rl_dot(rl_scale(normal, 1.0f / area), to_p) : 0.0f;
+        power = rl_scale(power, area * rl_maxf(0.0f, cos_light));
+    }
+    rl_vec3 to_light = rl_sub(pos, p);
+    float d2 = rl_length2(to_light);
+    if (!(d2 > 0.0f))
+        return false;
+    *l = rl_scale(to_light, 1.0f / sqrtf(d2));
+    float falloff = 1.0f / d2;
+    if (L->type == RL_LIGHT_SPOT) {
+        float cos_axis = rl_dot(rl_neg(*l), rl_normalize(L->direction));
+        float cos_outer = cosf(rl_radians(L->spot_outer_deg));
+        float cos_inner = cosf(rl_radians(L->spot_inner_deg));
+        /* A hard cone when inner >= outer: smoothstep would divide by <= 0. */
+        falloff *= cos_inner > cos_outer ? smoothstep(cos_outer, cos_inner, cos_axis)
+                                         : (cos_axis >= cos_outer ? 1.0f : 0.0f);
+    }
+    *E = rl_scale(power, falloff);
+    return falloff > 0.0f;
+}
+
+/* Local Phong colour at p with shading normal n (Ullmann 2003, eq. 3.1
+ * without the recursive terms). */
+static rl_vec4 phong(const shade_ctx *ctx, const rl_material *m, rl_vec3 p, rl_vec3 n)
+{
+    rl_vec3 v = rl_normalize(rl_sub(ctx->eye, p));
+    if (rl_dot(n, v) < 0.0f)
+        n = rl_neg(n);                        /* two-sided lighting */
+    rl_vec3 c = rl_add(m->emission, rl_scale(m->diffuse, ctx->ambient));
+    bool specular = rl_vmax_comp(m->specular) > 0.0f;
+    for (uint32_t i = 0; i < ctx->data->num_lights; ++i) {
+        rl_vec3 E, l;
+        if (!light_at(&ctx->data->lights[i], p, &E, &l))
+            continue;
+        float n_dot_l = rl_dot(n, l);
+        if (n_dot_l <= 0.0f)
+            continue;
+        rl_vec3 term = rl_scale(m->diffuse, n_dot_l);
+        if (specular) {
+            rl_vec3 r = rl_sub(rl_scale(n, 2.0f * n_dot_l), l);   /* l mirrored about n */
+            float r_dot_v = rl_maxf(0.0f, rl_dot(r, v));
+            term = rl_add(term, rl_scale(m->specular, powf(r_dot_v, m->shininess)));
+        }
+        c = rl_add(c, rl_mul(term, E));
+    }
+    return rl_v4_from3(c, 1.0f);
+}
+
+/* Per-frame buffers; everything is NULL unless the shading mode needs it. */
+typedef struct frame_buffers {
+    uint32_t *object_material;   /* per object: shared material or RL_NONE */
+    uint32_t *vertex_material;   /* per vertex of single-material objects */
+    rl_vec4 *vertex_colors;      /* gouraud/textured, single-material objects */
+    rl_vec4 *face_colors;        /* flat */
+    /* Objects mixing materials: one vertex per triangle corner, indexed by
+     * 3 * global triangle index, because a shared vertex would need one
+     * colour per material. */
+    rl_vec3 *corner_positions;
+    rl_vec2 *corner_uvs;
+    rl_vec4 *corner_colors;
+    uint32_t *triangle_texture;  /* per triangle, textured mode */
+    uint32_t *indices;           /* scratch: one object's local indices */
+    float *depth;                /* when the image has no depth layer */
+} frame_buffers;
+
+static void free_buffers(frame_buffers *b)
+{
+    free(b->object_material);
+    free(b->vertex_material);
+    free(b->vertex_colors);
+    free(b->face_colors);
+    free(b->corner_positions);
+    free(b->corner_uvs);
+    free(b->corner_colors);
+    free(b->triangle_texture);
+    free(b->indices);
+    free(b->depth);
+}
+
+static uint32_t texture_of(const rl_scene_data *d, uint32_t material)
+{
+    uint32_t t = d->materials[material].diffuse_texture;
+    return t < d->num_textures ? t : RL_ID_NONE;
+}
+
+/* Allocates what the mode needs and finds each object's shared material. */
+static rl_status prepare(const rl_scene_data *d, int shading, frame_buffers *b, bool *any_mixed)
+{
+    uint32_t max_tris = 0;
+    *any_mixed = false;
+    b->object_material = rl_calloc(d->num_objects ? d->num_objects : 1, sizeof *b->object_material);
+    if (!b->object_material)
+        return RL_ERR_OUT_OF_MEMORY;
+    for (uint32_t o = 0; o < d->num_objects; ++o) {
+        const rl_object *obj = &d->objects[o];
+        uint32_t m = obj->num_triangles ? d->triangle_material[obj->first_triangle] : RL_NONE;
+        for (uint32_t t = 1; t < obj->num_triangles && m != RL_NONE; ++t)
+            if (d->triangle_material[obj->first_triangle + t] != m)
+                m = RL_NONE;
+        b->object_material[o] = m;
+        *any_mixed |= obj->num_triangles > 0 && m == RL_NONE;
+        if (obj->num_triangles > max_tris)
+            max_tris = obj->num_triangles;
+    }
+    b->indices = rl_calloc((size_t)max_tris * 3 + 1, sizeof *b->indices);
+    if (!b->indices)
+        return RL_ERR_OUT_OF_MEMORY;
+
+    if (shading == SHADING_FLAT) {
+        b->face_colors = rl_calloc((size_t)d->num_triangles + 1, sizeof *b->face_colors);
+        return b->face_colors ? RL_OK : RL_ERR_OUT_OF_MEMORY;
+    }
+
+    size_t nv = (size_t)d->num_vertices + 1;
+    b->vertex_material = rl_calloc(nv, sizeof *b->vertex_material);
+    b->vertex_colors = rl_calloc(nv, sizeof *b->vertex_colors);
+    if (!b->vertex_material || !b->vertex_colors)
+        return RL_ERR_OUT_OF_MEMORY;
+    for (uint32_t v = 0; v < d->num_vertices; ++v)
+        b->vertex_material[v] = RL_NONE;
+    for (uint32_t o = 0; o < d->num_objects; ++o) {
+        const rl_object *obj = &d->objects[o];
+        for (uint32_t v = 0; v < obj->num_vertices; ++v)
+            b->vertex_material[obj->first_vertex + v] = b->object_material[o];
+    }
+    if (!*any_mixed)
+        return RL_OK;
+    size_t corners = (size_t)d->num_triangles * 3;
+    b->corner_positions = rl_calloc(corners, sizeof *b->corner_positions);
+    b->corner_uvs = rl_calloc(corners, sizeof *b->corner_uvs);
+    b->corner_colors = rl_calloc(corners, sizeof *b->corner_colors);
+    b->triangle_texture = rl_calloc(d->num_triangles, sizeof *b->triangle_texture);
+    if (!b->corner_positions || !b->corner_uvs || !b->corner_colors || !b->triangle_texture)
+        return RL_ERR_OUT_OF_MEMORY;
+    return RL_OK;
+}
+
+/* Lights vertices, corners or faces in parallel; every result depends only
+ * on its own element, so the output does not depend on the thread count. */
+static void light_scene(const shade_ctx *ctx, int shading, int threads, frame_buffers *b)
+{
+    const rl_scene_data *d = ctx->data;
+    const int64_t nt = d->num_triangles, nv = d->num_vertices;
+
+    if (shading == SHADING_FLAT) {
+#pragma omp parallel for num_threads(threads) schedule(static)
+        for (int64_t t = 0; t < nt; ++t) {
+            const uint32_t *tri = &d->indices[3 * t];
+            rl_vec3 p0 = d->positions[tri[0]], p1 = d->positions[tri[1]], p2 = d->positions[tri[2]];
+            rl_vec3 centroid = rl_scale(rl_add(rl_add(p0, p1), p2), 1.0f / 3.0f);
+            rl_vec3 n = rl_normalize(rl_cross(rl_sub(p1, p0), rl_sub(p2, p0)));
+            b->face_colors[t] = phong(ctx, &d->materials[d->triangle_material[t]], centroid, n);
+        }
+        return;
+    }
+
+#pragma omp parallel for num_threads(threads) schedule(static)
+    for (int64_t v = 0; v < nv; ++v) {
+        uint32_t m = b->vertex_material[v];
+        if (m != RL_NONE)
+            b->vertex_colors[v] = phong(ctx, &d->materials[m], d->positions[v], d->normals[v]);
+    }
+    if (!b->corner_colors)
+        return;
+#pragma omp parallel for num_threads(threads) schedule(static)
+    for (int64_t t = 0; t < nt; ++t) {
+        if (b->object_material[d->triangle_object[t]] != RL_NONE)
+            continue;
+        uint32_t m = d->triangle_material[t];
+        for (int k = 0; k < 3; ++k) {
+            uint32_t vi = d->indices[3 * t + k];
+            b->corner_positions[3 * t + k] = d->positions[vi];
+            b->corner_uvs[3 * t + k] = d->uvs[vi];
+            b->corner_colors[3 * t + k] = phong(ctx, &d->materials[m], d->positions[vi], d->normals[vi]);
+        }
+        b->triangle_texture[t] = shading == SHADING_TEXTURED ? texture_of(d, m) : RL_ID_NONE;
+    }
+}
+
+/* One batch per object: object IDs come from the batch, triangle IDs are the
+ * scene's global (flattened) triangle indices. */
+static rl_status draw_object(rl_raster *ras, const rl_scene_data *d, uint32_t o, int shading,
+                             unsigned flags, frame_buffers *b, rl_raster_counters *counters)
+{
+    const rl_object *obj = &d->objects[o];
+    if (obj->num_triangles == 0)
+        return RL_OK;
+    rl_raster_batch batch;
+    memset(&batch, 0, sizeof batch);
+    batch.num_triangles = obj->num_triangles;
+    batch.first_triangle_id = obj->first_triangle;
+    batch.object_id = o;
+    batch.flags = flags;
+    batch.indices = b->indices;
+
+    uint32_t m = b->object_material[o];
+    if (shading != SHADING_FLAT && m == RL_NONE) {
+        size_t first = (size_t)obj->first_triangle * 3;
+        batch.num_vertices = obj->num_triangles * 3;
+        batch.positions = b->corner_positions + first;
+        batch.colors = b->corner_colors + first;
+        for (uint32_t i = 0; i < batch.num_vertices; ++i)
+            b->indices[i] = i;
+        if (shading == SHADING_TEXTURED) {
+            batch.uvs = b->corner_uvs + first;
+            batch.triangle_texture = b->triangle_texture + obj->first_triangle;
+            batch.textures = d->textures;
+        }
+        return rl_raster_draw(ras, &batch, counters);
+    }
+
+    /* Scene indices are global; the batch sees only this object's vertices. */
+    const uint32_t *tri = d->indices + (size_t)obj->first_triangle * 3;
+    for (uint32_t i = 0; i < obj->num_triangles * 3; ++i) {
+        uint32_t local = tri[i] - obj->first_vertex;
+        if (tri[i] < obj->first_vertex || local >= obj->num_vertices)
+            return rl_error(RL_ERR_INTERNAL, "raster: object %u has a vertex index outside its range", o);
+        b->indices[i] = local;
+    }
+    batch.num_vertices = obj->num_vertices;
+    batch.positions = d->positions + obj->first_vertex;
+    if (shading == SHADING_FLAT) {
+        batch.face_colors = b->face_colors + obj->first_triangle;
+    } else {
+        batch.colors = b->vertex_colors + obj->first_vertex;
+        uint32_t tex = shading == SHADING_TEXTURED ? texture_of(d, m) : RL_ID_NONE;
+        if (tex != RL_ID_NONE) {
+            batch.uvs = d->uvs + obj->first_vertex;
+            batch.texture = d->textures[tex];
+        }
+    }
+    return rl_raster_draw(ras, &batch, counters);
+}
+
+static rl_status raster_check(const char *key, const char *value)
+{
+    rl_vec3 c;
+    if (strcmp(key, "background") == 0 && !rl_renderer_parse_color(value, &c))
+        return rl_error(RL_ERR_INVALID_ARG,
+                        "raster: option background=\"%s\" is not a colour (\"r,g,b\" or one value, >= 0)",
+                        value);
+    return RL_OK;
+}
+
+static rl_status raster_render(rl_renderer *r, void *state, const rl_scene *scene,
+                               const rl_camera *cam, rl_image *image, rl_render_stats *stats)
+{
+    (void)state;
+    const rl_scene_data *d = rl_scene_get_data(scene);
+    if (!d)
+        return RL_ERR_NOT_COMMITTED;
+    int shading = rl_renderer_opt_enum(r, "shading");
+    int threads = (int)rl_renderer_opt_int(r, "threads");
+#ifdef _OPENMP
+    int lighting_threads = threads > 0 ? threads : omp_get_max_threads();
+#else
+    int lighting_threads = 1;
+#endif
+    shade_ctx ctx = { d, cam->eye, (float)rl_renderer_opt_float(r, "ambient") };
+    unsigned flags = rl_renderer_opt_bool(r, "cull") ? RL_RASTER_CULL_BACK : 0u;
+
+    frame_buffers b;
+    memset(&b, 0, sizeof b);
+    bool any_mixed;
+    rl_status st = prepare(d, shading, &b, &any_mixed);
+    if (st != RL_OK) {
+        free_buffers(&b);
+        return st;
+    }
+
+    /* The rasterizer depth-tests against the target's depth layer; borrow a
+     * private one when the caller did not ask for depth. */
+    rl_image target = *image;
+    size_t num_pixels = (size_t)image->width * (size_t)image->height;
+    if (!(target.layers & RL_LAYER_DEPTH) || !target.depth) {
+        b.depth = rl_calloc(num_pixels, sizeof *b.depth);
+        if (!b.depth) {
+            free_buffers(&b);
+            return RL_ERR_OUT_OF_MEMORY;
+        }
+        target.depth = b.depth;
+        target.layers |= RL_LAYER_DEPTH;
+    }
+    if (!(target.layers & RL_LAYER_ID) || !target.object_id || !target.triangle_id)
+        flags |= RL_RASTER_NO_ID;
+
+    light_scene(&ctx, shading, lighting_threads, &b);
+
+    rl_raster *ras = NULL;
+    st = rl_raster_create(&(rl_raster_desc){ .threads = threads }, &ras);
+    if (st == RL_OK)
+        st = rl_raster_set_camera(ras, &target, cam, d->bounds);
+    if (st == RL_OK) {
+        rl_vec3 bg = rl_renderer_opt_color(r, "background");
+        rl_image_clear(&target);
+        rl_image_fill(&target, rl_v4_from3(bg, 1.0f));
+    }
+
+    rl_raster_counters counters;
+    memset(&counters, 0, sizeof counters);
+    /* Report progress about a hundred times, not once per object. */
+    uint32_t step = d->num_objects / 100 + 1;
+    for (uint32_t o = 0; st == RL_OK && o < d->num_objects; ++o) {
+        st = draw_object(ras, d, o, shading, flags, &b, &counters);
+        if (st == RL_OK && (o + 1) % step == 0 &&
+            !rl_renderer_progress(r, (double)(o + 1) / d->num_objects))
+            st = rl_error(RL_ERR_CANCELLED, "raster: cancelled by the progress callback");
+    }
+    rl_raster_release(ras);
+    free_buffers(&b);
+    if (st != RL_OK)
+        return st;
+
+    stats->triangles_rasterized = counters.triangles_drawn;
+    stats->pixels_written = counters.pixels_written;
+    stats->samples = num_pixels;
+    return RL_OK;
+}
+
+const rl_renderer_class rl_raster_renderer_class = {
+    .info = { "raster", "Software rasterization with local Phong lighting; the hardware-path reference",
+              "Ullmann 2003, Sec. 3.1 (Phong model), Sec. 3.5 (hardware path)" },
+    .options = raster_options,
+    .num_options = sizeof raster_options / sizeof raster_options[0],
+    .create = NULL,
+    .render = raster_render,
+    .release = NULL,
+    .check = raster_check,
+};

@@ -1,0 +1,386 @@
+/* renderer.c: the generic rl_renderer layer shared by every algorithm.
+ *
+ * Creates renderers by name from the registry (registry.c), keeps option
+ * values as validated text (so that get() returns exactly what was set and a
+ * renderer's options can be listed and reproduced in reports), and wraps the
+ * class's render() with the checks every algorithm needs: committed scene,
+ * valid camera, an image that matches the camera, zeroed and timed stats. */
+#include "render/renderer.h"
+
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "core/error.h"
+#include "core/params.h"
+#include "rl/rl_timer.h"
+
+struct rl_renderer {
+    const rl_renderer_class *cls;
+    void *state;
+    char **values;              /* one per option, always non-NULL */
+    rl_progress_fn progress;
+    void *progress_user;
+};
+
+/* Renderer names in messages ("raster, whitted, ..."): enough room for a
+ * few dozen algorithms; longer lists are cut, which only shortens a message. */
+#define NAME_LIST_SIZE 512
+
+static void append(char *buf, size_t size, const char *text)
+{
+    size_t used = strlen(buf);
+    if (used + 1 < size)
+        snprintf(buf + used, size - used, "%s", text);
+}
+
+const char *rl_ray_type_name(rl_ray_type type)
+{
+    static const char *const names[RL_RAY_TYPE_COUNT] = {
+        "primary", "shadow", "reflection", "refraction", "diffuse"
+    };
+    return (unsigned)type < RL_RAY_TYPE_COUNT ? names[type] : "unknown";
+}
+
+const rl_renderer_info *rl_renderer_list(size_t *count)
+{
+    /* The infos live inside the classes; the public list wants them
+     * contiguous, so copy once. Guarded because two threads may list at once. */
+    enum { MAX_CLASSES = 64 };
+    static rl_renderer_info infos[MAX_CLASSES];
+    static size_t num_infos;
+    static bool built;
+    size_t n;
+#pragma omp critical(rl_renderer_list)
+    {
+        if (!built) {
+            num_infos = rl_renderer_class_count < MAX_CLASSES ? rl_renderer_class_count : MAX_CLASSES;
+            for (size_t i = 0; i < num_infos; ++i)
+                infos[i] = rl_renderer_classes[i]->info;
+            built = true;
+        }
+        n = num_infos;
+    }
+    if (count)
+        *count = n;
+    return infos;
+}
+
+static const rl_renderer_class *find_class(const char *name)
+{
+    for (size_t i = 0; i < rl_renderer_class_count; ++i)
+        if (strcmp(rl_renderer_classes[i]->info.name, name) == 0)
+            return rl_renderer_classes[i];
+    return NULL;
+}
+
+static void free_values(char **values, size_t n)
+{
+    if (!values)
+        return;
+    for (size_t i = 0; i < n; ++i)
+        free(values[i]);
+    free(values);
+}
+
+rl_status rl_renderer_create(const char *name, rl_renderer **out)
+{
+    if (!name || !out)
+        return rl_error(RL_ERR_INVALID_ARG, "rl_renderer_create: name and out must not be NULL");
+    const rl_renderer_class *cls = find_class(name);
+    if (!cls) {
+        char names[NAME_LIST_SIZE] = "";
+        for (size_t i = 0; i < rl_renderer_class_count; ++i) {
+            if (i)
+                append(names, sizeof names, ", ");
+            append(names, sizeof names, rl_renderer_classes[i]->info.name);
+        }
+        return rl_error(RL_ERR_NOT_FOUND, "unknown algorithm \"%s\" (available: %s)", name, names);
+    }
+
+    rl_renderer *r = rl_calloc(1, sizeof *r);
+    if (!r)
+        return RL_ERR_OUT_OF_MEMORY;
+    r->cls = cls;
+    r->values = rl_calloc(cls->num_options ? cls->num_options : 1, sizeof *r->values);
+    if (!r->values) {
+        free(r);
+        return RL_ERR_OUT_OF_MEMORY;
+    }
+    for (size_t i = 0; i < cls->num_options; ++i) {
+        const char *def = cls->options[i].default_value;
+        r->values[i] = rl_strdup(def ? def : "");
+        if (!r->values[i]) {
+            free_values(r->values, cls->num_options);
+            free(r);
+            return RL_ERR_OUT_OF_MEMORY;
+        }
+    }
+    if (cls->create) {
+        rl_status st = cls->create(&r->state);
+        if (st != RL_OK) {
+            free_values(r->values, cls->num_options);
+            free(r);
+            return st;
+        }
+    }
+    *out = r;
+    return RL_OK;
+}
+
+void rl_renderer_release(rl_renderer *r)
+{
+    if (!r)
+        return;
+    if (r->cls->release)
+        r->cls->release(r->state);
+    free_values(r->values, r->cls->num_options);
+    free(r);
+}
+
+const char *rl_renderer_name(const rl_renderer *r) { return r ? r->cls->info.name : NULL; }
+
+const rl_option_info *rl_renderer_options(const rl_renderer *r, size_t *count)
+{
+    if (count)
+        *count = r ? r->cls->num_options : 0;
+    return r ? r->cls->options : NULL;
+}
+
+/* Index of key (optionally "<name>.key") in the option table, or -1. */
+static long find_option(const rl_renderer *r, const char *key)
+{
+    const char *name = r->cls->info.name;
+    size_t name_len = strlen(name);
+    if (strncmp(key, name, name_len) == 0 && key[name_len] == '.')
+        key += name_len + 1;
+    for (size_t i = 0; i < r->cls->num_options; ++i)
+        if (strcmp(r->cls->options[i].key, key) == 0)
+            return (long)i;
+    return -1;
+}
+
+static bool parse_bool(const char *s, bool *out)
+{
+    static const char *const yes[] = { "true", "1", "yes", "on" };
+    static const char *const no[] = { "false", "0", "no", "off" };
+    for (int i = 0; i < 4; ++i) {
+        if (strcmp(s, yes[i]) == 0) { *out = true; return true; }
+        if (strcmp(s, no[i]) == 0) { *out = false; return true; }
+    }
+    return false;
+}
+
+static int enum_index(const rl_option_info *o, const char *s)
+{
+    for (int i = 0; o->choices && o->choices[i]; ++i)
+        if (strcmp(o->choices[i], s) == 0)
+            return i;
+    return -1;
+}
+
+/* Checks value against the option's type; records a message on failure. */
+static rl_status validate(const rl_renderer *r, const rl_option_info *o, const char *value)
+{
+    const char *name = r->cls->info.name;
+    switch (o->type) {
+    case RL_OPT_INT: {
+        long long v;
+        if (!rl_parse_int(value, &v))
+            return rl_error(RL_ERR_INVALID_ARG, "%s: option %s=\"%s\" is not an integer",
+                            name, o->key, value);
+        if ((double)v < o->min || (double)v > o->max)
+            return rl_error(RL_ERR_INVALID_ARG, "%s: option %s=%s is outside [%.17g, %.17g]",
+                            name, o->key, value, o->min, o->max);
+        return RL_OK;
+    }
+    case RL_OPT_FLOAT: {
+        double v;
+        if (!rl_parse_float(value, &v))
+            return rl_error(RL_ERR_INVALID_ARG, "%s: option %s=\"%s\" is not a finite number",
+                            name, o->key, value);
+        if (v < o->min || v > o->max)
+            return rl_error(RL_ERR_INVALID_ARG, "%s: option %s=%s is outside [%g, %g]",
+                            name, o->key, value, o->min, o->max);
+        return RL_OK;
+    }
+    case RL_OPT_BOOL: {
+        bool b;
+        if (!parse_bool(value, &b))
+            return rl_error(RL_ERR_INVALID_ARG,
+                            "%s: option %s=\"%s\" is not a boolean (true/false, 1/0, yes/no, on/off)",
+                            name, o->key, value);
+        return RL_OK;
+    }
+    case RL_OPT_ENUM: {
+        if (enum_index(o, value) >= 0)
+            return RL_OK;
+        char list[NAME_LIST_SIZE] = "";
+        for (int i = 0; o->choices && o->choices[i]; ++i) {
+            if (i)
+                append(list, sizeof list, ", ");
+            append(list, sizeof list, o->choices[i]);
+        }
+        return rl_error(RL_ERR_INVALID_ARG, "%s: option %s=\"%s\" is not one of %s",
+                        name, o->key, value, list);
+    }
+    case RL_OPT_STRING:
+        return RL_OK;
+    }
+    return rl_error(RL_ERR_INTERNAL, "%s: option %s has an unknown type", name, o->key);
+}
+
+rl_status rl_renderer_set(rl_renderer *r, const char *key, const char *value)
+{
+    if (!r || !key || !value)
+        return rl_error(RL_ERR_INVALID_ARG, "rl_renderer_set: renderer, key and value must not be NULL");
+    long i = find_option(r, key);
+    if (i < 0) {
+        char keys[NAME_LIST_SIZE] = "";
+        for (size_t k = 0; k < r->cls->num_options; ++k) {
+            if (k)
+                append(keys, sizeof keys, ", ");
+            append(keys, sizeof keys, r->cls->options[k].key);
+        }
+        return rl_error(RL_ERR_INVALID_ARG, "%s: unknown option \"%s\" (options: %s)",
+                        r->cls->info.name, key, keys);
+    }
+    const rl_option_info *o = &r->cls->options[i];
+    rl_status st = validate(r, o, value);
+    if (st == RL_OK && r->cls->check)
+        st = r->cls->check(o->key, value);
+    if (st != RL_OK)
+        return st;
+    char *copy = rl_strdup(value);
+    if (!copy)
+        return RL_ERR_OUT_OF_MEMORY;
+    free(r->values[i]);
+    r->values[i] = copy;
+    return RL_OK;
+}
+
+const char *rl_renderer_get(const rl_renderer *r, const char *key)
+{
+    if (!r || !key)
+        return NULL;
+    long i = find_option(r, key);
+    return i < 0 ? NULL : r->values[i];
+}
+
+void rl_renderer_set_progress(rl_renderer *r, rl_progress_fn fn, void *user)
+{
+    if (!r)
+        return;
+    r->progress = fn;
+    r->progress_user = user;
+}
+
+bool rl_renderer_progress(const rl_renderer *r, double done)
+{
+    return !r->progress || r->progress(r->progress_user, done);
+}
+
+/* Typed reads. Values were validated on set and defaults are trusted, so a
+ * failed parse here means a wrong key in an implementation: return zero. */
+long long rl_renderer_opt_int(const rl_renderer *r, const char *key)
+{
+    const char *s = rl_renderer_get(r, key);
+    long long v = 0;
+    return s && rl_parse_int(s, &v) ? v : 0;
+}
+
+double rl_renderer_opt_float(const rl_renderer *r, const char *key)
+{
+    const char *s = rl_renderer_get(r, key);
+    double v = 0.0;
+    return s && rl_parse_float(s, &v) ? v : 0.0;
+}
+
+bool rl_renderer_opt_bool(const rl_renderer *r, const char *key)
+{
+    const char *s = rl_renderer_get(r, key);
+    bool v = false;
+    return s && parse_bool(s, &v) ? v : false;
+}
+
+int rl_renderer_opt_enum(const rl_renderer *r, const char *key)
+{
+    long i = r && key ? find_option(r, key) : -1;
+    if (i < 0)
+        return 0;
+    int idx = enum_index(&r->cls->options[i], r->values[i]);
+    return idx < 0 ? 0 : idx;
+}
+
+const char *rl_renderer_opt_string(const rl_renderer *r, const char *key)
+{
+    const char *s = rl_renderer_get(r, key);
+    return s ? s : "";
+}
+
+bool rl_renderer_parse_color(const char *text, rl_vec3 *out)
+{
+    /* "r,g,b" or one grey value; strtod per component, nothing else allowed. */
+    float c[3];
+    int n = 0;
+    const char *p = text;
+    if (!text)
+        return false;
+    for (;;) {
+        char *end;
+        double v = strtod(p, &end);
+        if (end == p || !(v >= 0.0) || v > 3.4e38 || n == 3)
+            return false;
+        c[n++] = (float)v;
+        while (*end == ' ')
+            ++end;
+        if (*end == '\0')
+            break;
+        if (*end != ',')
+            return false;
+        p = end + 1;
+    }
+    if (n == 2)
+        return false;
+    *out = n == 1 ? rl_v3s(c[0]) : rl_v3(c[0], c[1], c[2]);
+    return true;
+}
+
+rl_vec3 rl_renderer_opt_color(const rl_renderer *r, const char *key)
+{
+    rl_vec3 c = rl_v3s(0.0f);
+    rl_renderer_parse_color(rl_renderer_get(r, key), &c);
+    return c;
+}
+
+rl_status rl_renderer_render(rl_renderer *r, const rl_scene *scene, const rl_camera *cam,
+                             rl_image *image, rl_render_stats *stats)
+{
+    if (!r || !scene || !cam || !image)
+        return rl_error(RL_ERR_INVALID_ARG,
+                        "rl_renderer_render: renderer, scene, camera and image must not be NULL");
+    const char *name = r->cls->info.name;
+    if (!rl_scene_is_committed(scene))
+        return rl_error(RL_ERR_NOT_COMMITTED, "%s: the scene must be committed before rendering", name);
+    rl_camera resolved = rl_camera_resolve(cam);
+    rl_status st = rl_camera_validate(&resolved);
+    if (st != RL_OK)
+        return st;
+    if (!(image->layers & RL_LAYER_COLOR) || !image->color)
+        return rl_error(RL_ERR_INVALID_ARG, "%s: the image has no colour layer", name);
+    if (image->width != resolved.width || image->height != resolved.height)
+        return rl_error(RL_ERR_INVALID_ARG, "%s: image is %dx%d but the camera renders %dx%d",
+                        name, image->width, image->height, resolved.width, resolved.height);
+
+    rl_render_stats local;
+    memset(&local, 0, sizeof local);
+    rl_timer timer;
+    rl_timer_start(&timer);
+    st = r->cls->render(r, r->state, scene, &resolved, image, &local);
+    local.time_ms = rl_timer_ms(&timer);
+    if (st != RL_OK)
+        return st;
+    if (stats)
+        *stats = local;
+    return RL_OK;
+}
