@@ -1,0 +1,39 @@
+/* cli_scene.c: turns a SCENE argument ("name[:k=v,...]", a .json scene or a
+ * mesh file) into a loaded, committed scene. */
+#include "cli.h"
+
+#include <stdlib.h>
+#include <string.h>
+
+static bool is_builtin(const char *name)
+{
+    size_t count = 0;
+    const rl_builtin_info *list = rl_builtin_scenes(&count);
+    for (size_t i = 0; i < count; i++)
+        if (strcmp(list[i].name, name) == 0)
+            return true;
+    return false;
+}
+
+int rl_cli_load_scene(const char *arg, rl_scene **out)
+{
+    char *source = NULL, *params = NULL;
+    if (!rl_cli_split_source(arg, &source, &params))
+        return rl_cli_fail(RL_CLI_FAIL, "out of memory");
+    rl_clear_error();
+    rl_status st = rl_scene_load(source, params, out);
+    int rc = RL_CLI_OK;
+    if (st != RL_OK) {
+        /* The loader's message names the file (and line:col for JSON); only
+         * add the argument when it would otherwise be missing. */
+        const char *msg = rl_last_error();
+        bool named = msg && strstr(msg, source) != NULL;
+        /* A bad parameter of a built-in was typed on the command line: that
+         * is usage (2), whereas a bad value inside a file is input (1). */
+        int code = st == RL_ERR_INVALID_ARG && is_builtin(source) ? RL_CLI_USAGE : RL_CLI_FAIL;
+        rc = rl_cli_fail_status(code, st, named ? NULL : arg);
+    }
+    free(source);
+    free(params);
+    return rc;
+}

@@ -1,0 +1,107 @@
+/* cli_stats.c: scene and render statistics as JSON and as a summary line,
+ * shared by `rl info --json`, `rl render --stats-json` and `rl demo`. */
+#include "cli.h"
+
+#include <cjson/cJSON.h>
+#include <stdlib.h>
+
+static cJSON *vec3_json(rl_vec3 v)
+{
+    const double xyz[3] = { v.x, v.y, v.z };
+    return cJSON_CreateDoubleArray(xyz, 3);
+}
+
+/* cJSON stores numbers as double: exact for counts below 2^53. */
+static void add_count(cJSON *obj, const char *key, uint64_t value)
+{
+    cJSON_AddNumberToObject(obj, key, (double)value);
+}
+
+cJSON *rl_cli_scene_stats_json(const rl_scene *scene)
+{
+    rl_scene_stats st;
+    rl_scene_get_stats(scene, &st);
+    cJSON *obj = cJSON_CreateObject();
+    if (!obj)
+        return NULL;
+    cJSON_AddStringToObject(obj, "name", rl_scene_name(scene) ? rl_scene_name(scene) : "");
+    add_count(obj, "nodes", st.nodes);
+    add_count(obj, "meshes", st.meshes);
+    add_count(obj, "objects", st.objects);
+    add_count(obj, "mesh_triangles", st.mesh_triangles);
+    add_count(obj, "triangles", st.triangles);
+    add_count(obj, "vertices", st.vertices);
+    add_count(obj, "emissive_triangles", st.emissive_triangles);
+    add_count(obj, "materials", st.materials);
+    add_count(obj, "textures", st.textures);
+    add_count(obj, "lights", st.lights);
+    add_count(obj, "cameras", st.cameras);
+    add_count(obj, "memory_bytes", st.memory_bytes);
+    add_count(obj, "dropped_degenerate", st.dropped_degenerate);
+    add_count(obj, "dropped_nonfinite", st.dropped_nonfinite);
+    cJSON *bounds = cJSON_AddObjectToObject(obj, "bounds");
+    if (bounds) {
+        cJSON_AddItemToObject(bounds, "min", vec3_json(st.bounds.min));
+        cJSON_AddItemToObject(bounds, "max", vec3_json(st.bounds.max));
+    }
+    cJSON *names = cJSON_AddArrayToObject(obj, "camera_names");
+    const rl_scene_data *data = rl_scene_is_committed(scene) ? rl_scene_get_data(scene) : NULL;
+    if (names && data)
+        for (uint32_t i = 0; i < data->num_cameras; i++)
+            cJSON_AddItemToArray(names, cJSON_CreateString(
+                                            data->camera_names && data->camera_names[i]
+                                                ? data->camera_names[i] : ""));
+    return obj;
+}
+
+cJSON *rl_cli_render_stats_json(const rl_render_stats *stats)
+{
+    cJSON *obj = cJSON_CreateObject();
+    if (!obj)
+        return NULL;
+    cJSON_AddNumberToObject(obj, "time_ms", stats->time_ms);
+    cJSON *rays = cJSON_AddObjectToObject(obj, "rays");
+    uint64_t total = 0;
+    for (int t = 0; t < RL_RAY_TYPE_COUNT; t++) {
+        if (rays)
+            add_count(rays, rl_ray_type_name((rl_ray_type)t), stats->rays[t]);
+        total += stats->rays[t];
+    }
+    add_count(obj, "rays_total", total);
+    add_count(obj, "triangles_rasterized", stats->triangles_rasterized);
+    add_count(obj, "pixels_written", stats->pixels_written);
+    add_count(obj, "samples", stats->samples);
+    return obj;
+}
+
+bool rl_cli_write_json(const cJSON *item, const char *path)
+{
+    char *text = cJSON_Print(item);
+    if (!text) {
+        rl_cli_fail(RL_CLI_FAIL, "%s: out of memory while formatting JSON", path);
+        return false;
+    }
+    FILE *f = fopen(path, "w");
+    bool ok = f && fputs(text, f) >= 0 && fputc('\n', f) != EOF;
+    if (f && fclose(f) != 0)
+        ok = false;
+    free(text);
+    if (!ok)
+        rl_cli_fail(RL_CLI_FAIL, "%s: cannot write", path);
+    return ok;
+}
+
+void rl_cli_print_summary(FILE *out, const char *algo, const char *scene, int width,
+                          int height, const rl_render_stats *stats)
+{
+    fprintf(out, "%s %dx%d %s: %.1f ms, %llu triangles rasterized, %llu pixels written", algo,
+            width, height, scene, stats->time_ms,
+            (unsigned long long)stats->triangles_rasterized,
+            (unsigned long long)stats->pixels_written);
+    /* Ray counts only for the algorithms that trace any. */
+    for (int t = 0; t < RL_RAY_TYPE_COUNT; t++)
+        if (stats->rays[t])
+            fprintf(out, ", %llu %s rays", (unsigned long long)stats->rays[t],
+                    rl_ray_type_name((rl_ray_type)t));
+    fputc('\n', out);
+}

@@ -1,0 +1,242 @@
+/* cli_util.c: argument parsing, error lines and path checks shared by the
+ * subcommands of `rl`. */
+#define _POSIX_C_SOURCE 200809L
+#include "cli.h"
+
+#include <ctype.h>
+#include <errno.h>
+#include <math.h>
+#include <stdarg.h>
+#include <stdlib.h>
+#include <string.h>
+#include <strings.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include "core/params.h"
+
+int rl_cli_fail(int code, const char *fmt, ...)
+{
+    char line[1200];
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(line, sizeof line, fmt, ap);
+    va_end(ap);
+    /* One line, always: a multi-line library message would break scripts
+     * that read the first line of stderr. */
+    for (char *c = line; *c; c++)
+        if (*c == '\n' || *c == '\r')
+            *c = ' ';
+    fprintf(stderr, "rl: error: %s\n", line);
+    return code;
+}
+
+int rl_cli_fail_status(int code, rl_status status, const char *what)
+{
+    const char *msg = rl_last_error();
+    if (!msg || !*msg)
+        msg = rl_status_string(status);
+    /* Library messages usually name the file or item already. */
+    if (what && *what && !strstr(msg, what))
+        return rl_cli_fail(code, "%s: %s", what, msg);
+    return rl_cli_fail(code, "%s", msg);
+}
+
+bool rl_cli_is_help(const char *arg)
+{
+    return strcmp(arg, "-h") == 0 || strcmp(arg, "--help") == 0;
+}
+
+int rl_cli_take_value(int argc, char **argv, int *i, const char *name, const char **value)
+{
+    const char *arg = argv[*i];
+    size_t n = strlen(name);
+    if (strncmp(arg, name, n) != 0)
+        return 0;
+    if (arg[n] == '=') {
+        *value = arg + n + 1;
+        return 1;
+    }
+    if (arg[n] != '\0')
+        return 0;
+    if (*i + 1 >= argc) {
+        rl_cli_fail(RL_CLI_USAGE, "%s needs a value (see --help)", name);
+        return -1;
+    }
+    *i += 1;
+    *value = argv[*i];
+    return 1;
+}
+
+int rl_cli_unknown_arg(const char *command, const char *arg)
+{
+    if (arg[0] == '-')
+        return rl_cli_fail(RL_CLI_USAGE, "%s: unknown option '%s' (see rl %s --help)", command,
+                           arg, command);
+    return rl_cli_fail(RL_CLI_USAGE, "%s: unexpected argument '%s' (see rl %s --help)", command,
+                       arg, command);
+}
+
+bool rl_cli_parse_size(const char *text, int *width, int *height)
+{
+    const char *x = strpbrk(text, "xX");
+    long long w = 0, h = 0;
+    bool ok = x != NULL;
+    if (ok) {
+        char wtext[32];
+        size_t n = (size_t)(x - text);
+        ok = n > 0 && n < sizeof wtext;
+        if (ok) {
+            memcpy(wtext, text, n);
+            wtext[n] = '\0';
+            ok = rl_parse_int(wtext, &w) && rl_parse_int(x + 1, &h);
+        }
+    }
+    if (!ok) {
+        rl_cli_fail(RL_CLI_USAGE, "--size: expected WIDTHxHEIGHT such as 1280x720, got '%s'",
+                    text);
+        return false;
+    }
+    /* Refuse before anything is allocated: 20000x20000 RGBA float is 6 GB. */
+    if (w < 1 || h < 1 || w > RL_IMAGE_MAX_SIZE || h > RL_IMAGE_MAX_SIZE) {
+        rl_cli_fail(RL_CLI_USAGE, "--size: %lldx%lld is outside 1..%d per side", w, h,
+                    RL_IMAGE_MAX_SIZE);
+        return false;
+    }
+    *width = (int)w;
+    *height = (int)h;
+    return true;
+}
+
+bool rl_cli_parse_vec3(const char *option, const char *text, rl_vec3 *out)
+{
+    double v[3];
+    const char *p = text;
+    for (int k = 0; k < 3; k++) {
+        const char *end = strchr(p, ',');
+        size_t n = end ? (size_t)(end - p) : strlen(p);
+        char part[64];
+        bool last = k == 2;
+        if (n == 0 || n >= sizeof part || (last != (end == NULL))) {
+            rl_cli_fail(RL_CLI_USAGE, "%s: expected x,y,z such as 0,1,5, got '%s'", option, text);
+            return false;
+        }
+        memcpy(part, p, n);
+        part[n] = '\0';
+        if (!rl_parse_float(part, &v[k])) {
+            rl_cli_fail(RL_CLI_USAGE, "%s: '%s' is not a finite number (in '%s')", option, part,
+                        text);
+            return false;
+        }
+        p = end ? end + 1 : p + n;
+    }
+    *out = rl_v3((float)v[0], (float)v[1], (float)v[2]);
+    return true;
+}
+
+bool rl_cli_has_extension(const char *path, const char *const *extensions)
+{
+    size_t n = strlen(path);
+    for (const char *const *e = extensions; *e; e++) {
+        size_t m = strlen(*e);
+        if (n > m && strcasecmp(path + n - m, *e) == 0)
+            return true;
+    }
+    return false;
+}
+
+/* Folder part of path ("." when there is none); malloc'd. */
+static char *folder_of(const char *path)
+{
+    const char *slash = strrchr(path, '/');
+    if (!slash)
+        return strdup(".");
+    if (slash == path)
+        return strdup("/");
+    size_t n = (size_t)(slash - path);
+    char *dir = malloc(n + 1);
+    if (dir) {
+        memcpy(dir, path, n);
+        dir[n] = '\0';
+    }
+    return dir;
+}
+
+bool rl_cli_check_writable(const char *path)
+{
+    char *dir = folder_of(path);
+    if (!dir) {
+        rl_cli_fail(RL_CLI_FAIL, "out of memory");
+        return false;
+    }
+    struct stat st;
+    bool ok = false;
+    if (stat(dir, &st) != 0)
+        rl_cli_fail(RL_CLI_FAIL, "%s: cannot write: folder '%s' does not exist", path, dir);
+    else if (!S_ISDIR(st.st_mode))
+        rl_cli_fail(RL_CLI_FAIL, "%s: cannot write: '%s' is not a folder", path, dir);
+    else if (access(dir, W_OK) != 0)
+        rl_cli_fail(RL_CLI_FAIL, "%s: cannot write: folder '%s' is not writable", path, dir);
+    else if (stat(path, &st) == 0 && S_ISDIR(st.st_mode))
+        rl_cli_fail(RL_CLI_FAIL, "%s: cannot write: it is a folder", path);
+    else
+        ok = true;
+    free(dir);
+    return ok;
+}
+
+bool rl_cli_make_dirs(const char *dir)
+{
+    char *copy = strdup(dir);
+    if (!copy) {
+        rl_cli_fail(RL_CLI_FAIL, "out of memory");
+        return false;
+    }
+    bool ok = true;
+    /* Create each prefix in turn; existing folders are fine. */
+    for (char *p = copy + 1; ok; p++) {
+        bool end = *p == '\0';
+        if (*p == '/' || end) {
+            char saved = *p;
+            *p = '\0';
+            struct stat st;
+            if (mkdir(copy, 0777) != 0 && errno != EEXIST) {
+                rl_cli_fail(RL_CLI_FAIL, "%s: cannot create folder: %s", copy, strerror(errno));
+                ok = false;
+            } else if (stat(copy, &st) != 0 || !S_ISDIR(st.st_mode)) {
+                rl_cli_fail(RL_CLI_FAIL, "%s: exists and is not a folder", copy);
+                ok = false;
+            }
+            *p = saved;
+        }
+        if (end)
+            break;
+    }
+    free(copy);
+    return ok;
+}
+
+bool rl_cli_split_source(const char *arg, char **source, char **params)
+{
+    struct stat st;
+    const char *colon = strrchr(arg, ':');
+    *params = NULL;
+    /* "cornell-teapot:triangles=70000": parameters always contain '=', and a
+     * real file whose name happens to contain ':' wins. */
+    if (colon && strchr(colon, '=') && stat(arg, &st) != 0) {
+        size_t n = (size_t)(colon - arg);
+        *source = malloc(n + 1);
+        *params = strdup(colon + 1);
+        if (!*source || !*params) {
+            free(*source);
+            free(*params);
+            *source = *params = NULL;
+            return false;
+        }
+        memcpy(*source, arg, n);
+        (*source)[n] = '\0';
+        return true;
+    }
+    *source = strdup(arg);
+    return *source != NULL;
+}

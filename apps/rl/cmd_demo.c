@@ -1,0 +1,279 @@
+/* cmd_demo.c: `rl demo`: every built-in scene with every renderer, one PNG
+ * each, plus DIR/report.json (machine, date, scene and render statistics per
+ * image) and DIR/index.html (the same, as a page). `make demo` runs it.
+ *
+ * A failing scene or renderer does not stop the demo: it is reported as one
+ * error line, listed in the report, and the exit code becomes 1. */
+#define _POSIX_C_SOURCE 200809L
+#include "cli.h"
+
+#include <cjson/cJSON.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/utsname.h>
+#include <time.h>
+#include <unistd.h>
+
+static const char demo_help[] =
+    "usage: rl demo [--out DIR] [--size WxH] [--scenes a,b] [--algos a,b]\n"
+    "\n"
+    "Renders every built-in scene (rl scenes) with every renderer (rl algos)\n"
+    "and writes DIR/<scene>-<algo>.png, DIR/report.json (machine, date and, per\n"
+    "image, scene and render statistics) and DIR/index.html (the images and\n"
+    "their statistics on one page). Prints one line per image.\n"
+    "\n"
+    "options:\n"
+    "  --out DIR       output folder, created if missing; default out/demo\n"
+    "  --size WxH      resolution of every image; default 640x480\n"
+    "  --scenes a,b    only these built-in scenes (default parameters)\n"
+    "  --algos a,b     only these renderers\n"
+    "\n"
+    "example:\n"
+    "  rl demo --out out/demo\n"
+    "  rl demo --out /tmp/quick --size 160x120 --scenes cornell,spheres\n";
+
+typedef struct demo_args {
+    const char *out, *scenes, *algos;
+    int width, height;
+} demo_args;
+
+/* True when name is an item of the comma-separated list (NULL = all). */
+static bool in_list(const char *list, const char *name)
+{
+    if (!list)
+        return true;
+    size_t n = strlen(name);
+    for (const char *p = list; *p;) {
+        const char *end = strchr(p, ',');
+        size_t m = end ? (size_t)(end - p) : strlen(p);
+        if (m == n && strncmp(p, name, n) == 0)
+            return true;
+        p = end ? end + 1 : p + m;
+    }
+    return false;
+}
+
+/* Every item of list must be a known name: a typo should not silently
+ * produce an empty demo. */
+static bool check_list(const char *option, const char *list, const char *const *names,
+                       size_t count)
+{
+    for (const char *p = list; *p;) {
+        const char *end = strchr(p, ',');
+        size_t m = end ? (size_t)(end - p) : strlen(p);
+        bool known = false;
+        for (size_t i = 0; i < count && !known; i++)
+            known = strlen(names[i]) == m && strncmp(names[i], p, m) == 0;
+        if (!known) {
+            rl_cli_fail(RL_CLI_USAGE, "%s: unknown name '%.*s'", option, (int)m, p);
+            return false;
+        }
+        p = end ? end + 1 : p + m;
+    }
+    return true;
+}
+
+static int parse_args(int argc, char **argv, demo_args *a)
+{
+    for (int i = 1; i < argc; i++) {
+        const char *v = NULL;
+        int m;
+        if (rl_cli_is_help(argv[i])) {
+            fputs(demo_help, stdout);
+            return -1;
+        }
+        if ((m = rl_cli_take_value(argc, argv, &i, "--out", &v)) > 0)
+            a->out = v;
+        else if (m == 0 && (m = rl_cli_take_value(argc, argv, &i, "--scenes", &v)) > 0)
+            a->scenes = v;
+        else if (m == 0 && (m = rl_cli_take_value(argc, argv, &i, "--algos", &v)) > 0)
+            a->algos = v;
+        else if (m == 0 && (m = rl_cli_take_value(argc, argv, &i, "--size", &v)) > 0) {
+            if (!rl_cli_parse_size(v, &a->width, &a->height))
+                return RL_CLI_USAGE;
+        } else if (m == 0)
+            return rl_cli_unknown_arg("demo", argv[i]);
+        if (m < 0)
+            return RL_CLI_USAGE;
+    }
+    size_t ns = 0, nr = 0;
+    const rl_builtin_info *scenes = rl_builtin_scenes(&ns);
+    const rl_renderer_info *algos = rl_renderer_list(&nr);
+    const char **names = calloc(ns + nr + 1, sizeof *names);
+    if (!names)
+        return rl_cli_fail(RL_CLI_FAIL, "out of memory");
+    for (size_t i = 0; i < ns; i++)
+        names[i] = scenes[i].name;
+    for (size_t i = 0; i < nr; i++)
+        names[ns + i] = algos[i].name;
+    bool ok = (!a->scenes || check_list("--scenes", a->scenes, names, ns)) &&
+              (!a->algos || check_list("--algos", a->algos, names + ns, nr));
+    free(names);
+    return ok ? RL_CLI_OK : RL_CLI_USAGE;
+}
+
+static cJSON *machine_json(void)
+{
+    cJSON *m = cJSON_CreateObject();
+    struct utsname u;
+    if (m && uname(&u) == 0) {
+        char text[5 * sizeof u.sysname + 8];
+        snprintf(text, sizeof text, "%s %s %s %s %s", u.sysname, u.nodename, u.release,
+                 u.version, u.machine);
+        cJSON_AddStringToObject(m, "uname", text);
+    }
+    if (m)
+        cJSON_AddNumberToObject(m, "nproc", (double)sysconf(_SC_NPROCESSORS_ONLN));
+    return m;
+}
+
+static void add_failure(cJSON *failures, const char *scene, const char *algo)
+{
+    cJSON *f = cJSON_CreateObject();
+    if (!f)
+        return;
+    cJSON_AddStringToObject(f, "scene", scene);
+    cJSON_AddStringToObject(f, "algorithm", algo ? algo : "");
+    cJSON_AddStringToObject(f, "error", *rl_last_error() ? rl_last_error() : "failed");
+    cJSON_AddItemToArray(failures, f);
+}
+
+/* Renders scene with one renderer into DIR/<scene>-<algo>.png and appends
+ * the entry to images; returns false (error printed) on failure. */
+static bool render_one(const demo_args *a, const char *scene_name, const rl_scene *scene,
+                       const rl_camera *cam, const char *algo, cJSON *images)
+{
+    char file[512], path[4096];
+    snprintf(file, sizeof file, "%s-%s.png", scene_name, algo);
+    if ((size_t)snprintf(path, sizeof path, "%s/%s", a->out, file) >= sizeof path) {
+        rl_cli_fail(RL_CLI_FAIL, "%s: output path too long", a->out);
+        return false;
+    }
+    rl_renderer *r = NULL;
+    rl_image *img = NULL;
+    rl_progress *progress = NULL;
+    rl_render_stats stats = { 0 };
+    rl_clear_error();
+    rl_status st = rl_renderer_create(algo, &r);
+    if (st == RL_OK)
+        st = rl_image_create(cam->width, cam->height, RL_LAYER_COLOR, &img);
+    if (st == RL_OK) {
+        char label[600];
+        snprintf(label, sizeof label, "%s %s", algo, scene_name);
+        if (rl_log_get_level() >= RL_LOG_INFO && rl_progress_create(label, stderr, &progress) == RL_OK)
+            rl_renderer_set_progress(r, rl_progress_update, progress);
+        st = rl_renderer_render(r, scene, cam, img, &stats);
+        rl_renderer_set_progress(r, NULL, NULL);
+        rl_progress_finish(progress);
+    }
+    if (st == RL_OK)
+        st = rl_image_write(img, path);
+    bool ok = st == RL_OK;
+    if (ok) {
+        rl_cli_print_summary(stdout, algo, scene_name, cam->width, cam->height, &stats);
+        fflush(stdout);
+        cJSON *e = cJSON_CreateObject();
+        if (e) {
+            cJSON_AddStringToObject(e, "scene", scene_name);
+            cJSON_AddStringToObject(e, "algorithm", algo);
+            cJSON_AddStringToObject(e, "file", file);
+            cJSON_AddNumberToObject(e, "width", cam->width);
+            cJSON_AddNumberToObject(e, "height", cam->height);
+            cJSON *ss = rl_cli_scene_stats_json(scene);
+            cJSON *rs = rl_cli_render_stats_json(&stats);
+            if (ss)
+                cJSON_AddItemToObject(e, "scene_stats", ss);
+            if (rs)
+                cJSON_AddItemToObject(e, "render_stats", rs);
+            cJSON_AddItemToArray(images, e);
+        }
+    } else {
+        char what[600];
+        snprintf(what, sizeof what, "%s with %s", scene_name, algo);
+        rl_cli_fail_status(RL_CLI_FAIL, st, what);
+    }
+    rl_image_release(img);
+    rl_renderer_release(r);
+    return ok;
+}
+
+static int run_demo(const demo_args *a, cJSON *report)
+{
+    cJSON *images = cJSON_AddArrayToObject(report, "images");
+    cJSON *failures = cJSON_AddArrayToObject(report, "failures");
+    if (!images || !failures)
+        return rl_cli_fail(RL_CLI_FAIL, "out of memory");
+    size_t ns = 0, nr = 0;
+    const rl_builtin_info *scenes = rl_builtin_scenes(&ns);
+    const rl_renderer_info *algos = rl_renderer_list(&nr);
+    int rc = RL_CLI_OK;
+    for (size_t s = 0; s < ns; s++) {
+        const char *name = scenes[s].name;
+        if (!in_list(a->scenes, name))
+            continue;
+        rl_scene *scene = NULL;
+        rl_camera cam;
+        rl_clear_error();
+        rl_status st = rl_scene_create_builtin(name, NULL, &scene);
+        if (st == RL_OK)
+            st = rl_scene_get_camera(scene, NULL, &cam);
+        if (st != RL_OK) {
+            rl_cli_fail_status(RL_CLI_FAIL, st, name);
+            add_failure(failures, name, NULL);
+            rl_scene_release(scene);
+            rc = RL_CLI_FAIL;
+            continue;
+        }
+        /* Same size for every image so the grid compares like with like. */
+        cam.width = a->width;
+        cam.height = a->height;
+        for (size_t k = 0; k < nr; k++) {
+            if (!in_list(a->algos, algos[k].name))
+                continue;
+            if (!render_one(a, name, scene, &cam, algos[k].name, images)) {
+                add_failure(failures, name, algos[k].name);
+                rc = RL_CLI_FAIL;
+            }
+        }
+        rl_scene_release(scene);
+    }
+    return rc;
+}
+
+int rl_cli_demo(int argc, char **argv)
+{
+    demo_args a = { .out = "out/demo", .width = 640, .height = 480 };
+    int rc = parse_args(argc, argv, &a);
+    if (rc != RL_CLI_OK)
+        return rc < 0 ? RL_CLI_OK : rc;
+    char probe[4096];
+    if ((size_t)snprintf(probe, sizeof probe, "%s/report.json", a.out) >= sizeof probe)
+        return rl_cli_fail(RL_CLI_USAGE, "--out: path too long");
+    if (!rl_cli_make_dirs(a.out) || !rl_cli_check_writable(probe))
+        return RL_CLI_FAIL;
+
+    cJSON *report = cJSON_CreateObject();
+    if (!report)
+        return rl_cli_fail(RL_CLI_FAIL, "out of memory");
+    char date[64];
+    time_t now = time(NULL);
+    struct tm tm;
+    strftime(date, sizeof date, "%Y-%m-%d %H:%M:%S UTC", gmtime_r(&now, &tm));
+    cJSON_AddStringToObject(report, "renderlab", RL_CLI_VERSION);
+    cJSON_AddStringToObject(report, "date", date);
+    cJSON *machine = machine_json();
+    if (machine)
+        cJSON_AddItemToObject(report, "machine", machine);
+    cJSON_AddNumberToObject(report, "width", a.width);
+    cJSON_AddNumberToObject(report, "height", a.height);
+
+    rc = run_demo(&a, report);
+    char html[4096];
+    snprintf(html, sizeof html, "%s/index.html", a.out);
+    if (!rl_cli_write_json(report, probe) || !rl_cli_write_demo_html(report, html))
+        rc = RL_CLI_FAIL;
+    else
+        printf("report: %s, %s\n", probe, html);
+    cJSON_Delete(report);
+    return rc;
+}

@@ -1,0 +1,105 @@
+/* cmd_list.c: `rl scenes` and `rl algos`: what the library offers, read from
+ * its registries (rl_builtin_scenes, rl_renderer_list) so the lists never
+ * drift from the code. */
+#include "cli.h"
+
+static const char *option_type_name(rl_option_type t)
+{
+    switch (t) {
+    case RL_OPT_INT: return "int";
+    case RL_OPT_FLOAT: return "float";
+    case RL_OPT_BOOL: return "bool";
+    case RL_OPT_ENUM: return "enum";
+    case RL_OPT_STRING: return "string";
+    }
+    return "?";
+}
+
+/* Takes only --help; anything else is a usage error. */
+static int no_arguments(int argc, char **argv, const char *help)
+{
+    for (int i = 1; i < argc; i++) {
+        if (rl_cli_is_help(argv[i])) {
+            fputs(help, stdout);
+            return -1;
+        }
+        return rl_cli_unknown_arg(argv[0], argv[i]);
+    }
+    return RL_CLI_OK;
+}
+
+int rl_cli_scenes(int argc, char **argv)
+{
+    int rc = no_arguments(argc, argv,
+                          "usage: rl scenes\n"
+                          "\n"
+                          "Lists the built-in scenes with their description and parameters.\n"
+                          "Parameters follow the scene name after a colon wherever a scene\n"
+                          "is expected.\n"
+                          "\n"
+                          "example:\n"
+                          "  rl scenes\n"
+                          "  rl render cornell-teapot:triangles=70000 --out teapot.png\n");
+    if (rc != RL_CLI_OK)
+        return rc < 0 ? RL_CLI_OK : rc;
+    size_t count = 0;
+    const rl_builtin_info *scenes = rl_builtin_scenes(&count);
+    for (size_t i = 0; i < count; i++) {
+        printf("%-16s %s\n", scenes[i].name, scenes[i].description ? scenes[i].description : "");
+        if (scenes[i].params && *scenes[i].params)
+            printf("%-16s parameters: %s\n", "", scenes[i].params);
+    }
+    return RL_CLI_OK;
+}
+
+static void print_option(const rl_option_info *o)
+{
+    printf("    %-22s %-6s default %-10s %s", o->key, option_type_name(o->type),
+           o->default_value ? o->default_value : "\"\"", o->help ? o->help : "");
+    if ((o->type == RL_OPT_INT || o->type == RL_OPT_FLOAT) && o->max > o->min)
+        printf(" [%g..%g]", o->min, o->max);
+    if (o->type == RL_OPT_ENUM && o->choices) {
+        printf(" {");
+        for (const char *const *c = o->choices; *c; c++)
+            printf("%s%s", c == o->choices ? "" : ", ", *c);
+        printf("}");
+    }
+    putchar('\n');
+}
+
+int rl_cli_algos(int argc, char **argv)
+{
+    int rc = no_arguments(argc, argv,
+                          "usage: rl algos   (alias: rl renderers)\n"
+                          "\n"
+                          "Lists the renderers with their description, paper reference and\n"
+                          "options (key, type, default, help). Set options on the command line\n"
+                          "with --set key=value; the key may carry the renderer's name.\n"
+                          "\n"
+                          "example:\n"
+                          "  rl algos\n"
+                          "  rl render cornell --algo raster --set raster.shading=flat "
+                          "--out flat.png\n");
+    if (rc != RL_CLI_OK)
+        return rc < 0 ? RL_CLI_OK : rc;
+    size_t count = 0;
+    const rl_renderer_info *list = rl_renderer_list(&count);
+    for (size_t i = 0; i < count; i++) {
+        printf("%s: %s\n", list[i].name, list[i].description ? list[i].description : "");
+        if (list[i].reference && *list[i].reference)
+            printf("  reference: %s\n", list[i].reference);
+        rl_renderer *r = NULL;
+        rl_clear_error();
+        if (rl_renderer_create(list[i].name, &r) != RL_OK)
+            return rl_cli_fail_status(RL_CLI_FAIL, rl_last_status(), list[i].name);
+        size_t num_options = 0;
+        const rl_option_info *options = rl_renderer_options(r, &num_options);
+        printf("  options:%s\n", num_options ? "" : " none");
+        for (size_t k = 0; k < num_options; k++)
+            print_option(&options[k]);
+        rl_renderer_release(r);
+        if (i + 1 < count)
+            putchar('\n');
+    }
+    return RL_CLI_OK;
+}

@@ -1,0 +1,101 @@
+/* main.c: entry point of `rl`: global flags, log output, subcommand dispatch.
+ *
+ * Global flags may stand before or after the subcommand (`rl -q render ...`
+ * and `rl render ... -q` mean the same), so they are taken out of argv first
+ * and the subcommand sees only its own arguments. */
+#include "cli.h"
+
+#include <string.h>
+
+typedef struct command {
+    const char *name;
+    int (*run)(int argc, char **argv);
+    const char *summary;
+} command;
+
+static const command commands[] = {
+    { "scenes", rl_cli_scenes, "list the built-in scenes and their parameters" },
+    { "algos", rl_cli_algos, "list the renderers, their papers and options (alias: renderers)" },
+    { "renderers", rl_cli_algos, NULL },
+    { "info", rl_cli_info, "print statistics and cameras of a scene" },
+    { "render", rl_cli_render, "render a scene to PNG or EXR" },
+    { "demo", rl_cli_demo, "render every built-in scene with every renderer + HTML report" },
+};
+
+static void print_usage(FILE *out)
+{
+    fprintf(out,
+            "usage: rl [-v|-q] <command> [options]\n"
+            "\n"
+            "renderlab " RL_CLI_VERSION ": a laboratory of rendering algorithms.\n"
+            "\n"
+            "commands:\n");
+    for (size_t i = 0; i < sizeof commands / sizeof commands[0]; i++)
+        if (commands[i].summary)
+            fprintf(out, "  %-10s %s\n", commands[i].name, commands[i].summary);
+    fprintf(out,
+            "  %-10s show this text (also: rl --help); rl <command> --help for details\n"
+            "\n"
+            "global flags (before or after the command):\n"
+            "  -v, --verbose   debug log\n"
+            "  -q, --quiet     errors only\n"
+            "  --version       print the version\n"
+            "\n"
+            "example:\n"
+            "  rl render cornell --algo raster --size 640x480 --out cornell.png\n",
+            "help");
+}
+
+/* Log lines of the library go to stderr as "rl: warning: ...". */
+static void log_to_stderr(void *user, rl_log_level level, const char *message)
+{
+    (void)user;
+    fprintf(stderr, "rl: %s: %s\n", rl_log_level_name(level), message);
+}
+
+int main(int argc, char **argv)
+{
+    rl_log_level level = RL_LOG_INFO;
+    int n = 0;
+    /* Take out global flags wherever they are; keep everything else in order. */
+    for (int i = 1; i < argc; i++) {
+        const char *a = argv[i];
+        if (strcmp(a, "-v") == 0 || strcmp(a, "--verbose") == 0)
+            level = RL_LOG_DEBUG;
+        else if (strcmp(a, "-q") == 0 || strcmp(a, "--quiet") == 0)
+            level = RL_LOG_ERROR;
+        else
+            argv[n++] = argv[i];
+    }
+    argv[n] = NULL;
+    rl_log_set_level(level);
+    rl_log_set_callback(log_to_stderr, NULL);
+
+    if (n == 0)
+        return rl_cli_fail(RL_CLI_USAGE, "no command given (commands: scenes, algos, info, "
+                                         "render, demo; see rl --help)");
+    const char *name = argv[0];
+    if (strcmp(name, "help") == 0 && n > 1) {
+        /* "rl help render" is "rl render --help". */
+        static char help_flag[] = "--help";
+        char *help_argv[] = { argv[1], help_flag, NULL };
+        for (size_t i = 0; i < sizeof commands / sizeof commands[0]; i++)
+            if (strcmp(argv[1], commands[i].name) == 0)
+                return commands[i].run(2, help_argv);
+        return rl_cli_fail(RL_CLI_USAGE, "unknown command '%s' (see rl --help)", argv[1]);
+    }
+    if (rl_cli_is_help(name) || strcmp(name, "help") == 0) {
+        print_usage(stdout);
+        return RL_CLI_OK;
+    }
+    if (strcmp(name, "--version") == 0) {
+        printf("rl (renderlab) %s\n", RL_CLI_VERSION);
+        return RL_CLI_OK;
+    }
+    for (size_t i = 0; i < sizeof commands / sizeof commands[0]; i++)
+        if (strcmp(name, commands[i].name) == 0)
+            return commands[i].run(n, argv);
+    if (name[0] == '-')
+        return rl_cli_fail(RL_CLI_USAGE, "unknown option '%s' (see rl --help)", name);
+    return rl_cli_fail(RL_CLI_USAGE, "unknown command '%s' (see rl --help)", name);
+}

@@ -1,0 +1,90 @@
+#!/usr/bin/env bash
+# test_cli_bad_input.sh: broken scene files and outputs fail with exit 1 and
+# exactly one "rl: error:" line that says what went wrong; non-finite
+# vertices are dropped with a warning instead.
+# Run as: bash test_cli_bad_input.sh <rl-binary> <scratch-dir>
+set -u
+RL=$1
+TMP=$2
+rm -rf "$TMP"
+mkdir -p "$TMP"
+
+fail() { echo "FAIL: $*" >&2; exit 1; }
+expect_exit() {
+    local want=$1; shift
+    "$@" >"$TMP/out" 2>"$TMP/err"
+    local got=$?
+    [ "$got" -eq "$want" ] || fail "'$*' exited $got, expected $want; stderr: $(head -c 400 "$TMP/err")"
+}
+# expect_error CODE TEXT CMD...: exit CODE, one error line, containing TEXT.
+expect_error() {
+    local code=$1 text=$2; shift 2
+    expect_exit "$code" "$@"
+    [ "$(grep -c '^rl: error: ' "$TMP/err")" -eq 1 ] || fail "'$*' should print one error line, got: $(cat "$TMP/err")"
+    grep '^rl: error: ' "$TMP/err" | grep -q -- "$text" || fail "'$*': error line lacks '$text': $(cat "$TMP/err")"
+}
+OUT="$TMP/x.png"
+
+# Missing file: the error names it.
+expect_error 1 "no-such-scene.obj" "$RL" render "$TMP/no-such-scene.obj" --size 32x24 --out "$OUT"
+expect_error 1 "no-such-scene.json" "$RL" info "$TMP/no-such-scene.json"
+expect_error 1 "" "$RL" render no-such-builtin --size 32x24 --out "$OUT"
+
+# Truncated OBJ: stops in the middle of the vertex list, no faces left.
+printf 'v 0 0 0\nv 1 0 0\nv 0 1' >"$TMP/truncated.obj"
+expect_error 1 "" "$RL" render "$TMP/truncated.obj" --size 32x24 --out "$OUT"
+
+# PLY whose header promises more vertices than the body has.
+cat >"$TMP/short.ply" <<'PLY'
+ply
+format ascii 1.0
+element vertex 4
+property float x
+property float y
+property float z
+element face 2
+property list uchar int vertex_indices
+end_header
+0 0 0
+1 0 0
+3 0 1 2
+3 0 2 3
+PLY
+expect_error 1 "" "$RL" render "$TMP/short.ply" --size 32x24 --out "$OUT"
+
+# glTF cut off in the middle.
+printf '{"asset":{"version":"2.0"},"meshes":[{"primitives":[{"attributes":{"POSITION":0' >"$TMP/corrupt.gltf"
+expect_error 1 "" "$RL" render "$TMP/corrupt.gltf" --size 32x24 --out "$OUT"
+
+# JSON scene with a syntax error on line 3: file:line in the message.
+printf '{\n  "name": "broken",\n  "lights": [ , ]\n}\n' >"$TMP/syntax.json"
+expect_error 1 "syntax.json:3" "$RL" render "$TMP/syntax.json" --size 32x24 --out "$OUT"
+
+# JSON scene with an unknown key: named, with its position.
+printf '{\n  "name": "typo",\n  "no_such_key_xyz": 1\n}\n' >"$TMP/unknown.json"
+expect_error 1 "no_such_key_xyz" "$RL" render "$TMP/unknown.json" --size 32x24 --out "$OUT"
+grep -q 'unknown.json:3' "$TMP/err" || fail "unknown key error lacks file:line: $(cat "$TMP/err")"
+
+# Empty JSON scene: nothing to render.
+printf '{}\n' >"$TMP/empty.json"
+expect_error 1 "" "$RL" render "$TMP/empty.json" --size 32x24 --out "$OUT"
+expect_error 1 "" "$RL" info "$TMP/empty.json"
+[ ! -e "$OUT" ] || fail "a failed render still wrote $OUT"
+
+# OBJ with a NaN vertex: that triangle is dropped with a warning, the other renders.
+printf 'v 0 0 0\nv 1 0 0\nv 0 1 0\nv nan 0 0\nf 1 2 3\nf 1 2 4\n' >"$TMP/nan.obj"
+expect_exit 0 "$RL" render "$TMP/nan.obj" --size 32x24 --out "$TMP/nan.png"
+[ -s "$TMP/nan.png" ] || fail "nan.obj did not render"
+grep -q '^rl: warning: ' "$TMP/err" || fail "no warning about the dropped triangle: $(cat "$TMP/err")"
+expect_exit 0 "$RL" info "$TMP/nan.obj" --json
+grep -q '"dropped_nonfinite":[[:space:]]*1,' "$TMP/out" || fail "info does not count the dropped triangle: $(cat "$TMP/out")"
+
+# Outputs: unwritable folder (exit 1, before rendering), unknown format (exit 2).
+expect_error 1 "/nonexistent/x.png" "$RL" render cornell --size 32x24 --out /nonexistent/x.png
+expect_error 1 "/nonexistent/d.exr" "$RL" render cornell --size 32x24 --out "$OUT" --depth-out /nonexistent/d.exr
+expect_error 2 "x.bmp" "$RL" render cornell --size 32x24 --out "$TMP/x.bmp"
+[ ! -e "$TMP/x.bmp" ] || fail "x.bmp was written"
+
+# Unknown camera.
+expect_error 1 "no-such-camera" "$RL" render cornell --size 32x24 --camera no-such-camera --out "$OUT"
+echo "ok"

@@ -1,0 +1,52 @@
+#!/usr/bin/env bash
+# test_cli_demo.sh: rl demo writes one PNG per scene x renderer, report.json
+# and index.html. Restricted to the small scenes to stay quick under ASan;
+# `make demo` renders them all.
+# Run as: bash test_cli_demo.sh <rl-binary> <scratch-dir>
+set -u
+RL=$1
+TMP=$2
+rm -rf "$TMP"
+mkdir -p "$TMP"
+
+fail() { echo "FAIL: $*" >&2; exit 1; }
+DIR="$TMP/demo/nested"   # does not exist yet: rl demo creates it
+SCENES="cornell,cornell-teapot,spheres"
+
+"$RL" demo --out "$DIR" --size 64x48 --scenes "$SCENES" >"$TMP/out" 2>"$TMP/err" ||
+    fail "rl demo exited $?: $(head -c 400 "$TMP/err")"
+[ -s "$DIR/index.html" ] || fail "index.html missing"
+[ -s "$DIR/report.json" ] || fail "report.json missing"
+
+algos=$("$RL" algos | grep -E '^[a-z+]+: ' | cut -d: -f1)
+[ -n "$algos" ] || fail "rl algos listed no renderer"
+n=0
+for s in ${SCENES//,/ }; do
+    for a in $algos; do
+        f="$DIR/$s-$a.png"
+        [ -s "$f" ] || fail "$f missing"
+        [ "$(od -An -tx1 -N8 "$f" | tr -d ' \n')" = "89504e470d0a1a0a" ] || fail "$f is not a PNG"
+        grep -q "src=\"$s-$a.png\"" "$DIR/index.html" || fail "index.html does not show $s-$a.png"
+        grep -q "\"$s-$a.png\"" "$DIR/report.json" || fail "report.json does not list $s-$a.png"
+        n=$((n + 1))
+    done
+done
+# One line per image (plus the closing "report:" line), no other PNGs.
+[ "$(grep -c ' ms, ' "$TMP/out")" -eq "$n" ] || fail "expected $n image lines: $(cat "$TMP/out")"
+[ "$(ls "$DIR"/*.png | wc -l)" -eq "$n" ] || fail "expected exactly $n PNGs in $DIR"
+[ ! -e "$DIR/city-raster.png" ] || fail "--scenes did not restrict the demo"
+if command -v python3 >/dev/null 2>&1; then
+    python3 - "$DIR/report.json" "$n" <<'PY' || fail "report.json is not the expected JSON"
+import json, sys
+r = json.load(open(sys.argv[1]))
+assert len(r["images"]) == int(sys.argv[2]), len(r["images"])
+for e in r["images"]:
+    assert {"scene", "algorithm", "file", "scene_stats", "render_stats"} <= e.keys(), e.keys()
+    assert e["render_stats"]["time_ms"] >= 0
+    assert e["scene_stats"]["triangles"] > 0
+assert r["machine"]["nproc"] >= 1 and r["date"]
+assert r["failures"] == []
+PY
+fi
+grep -q "processors" "$DIR/index.html" || fail "index.html lacks the machine"
+echo "ok"

@@ -1,0 +1,109 @@
+#!/usr/bin/env bash
+# test_cli_render.sh: rl render writes what it promises (PNG/EXR at the
+# requested size, depth and ID layers, a stats file), accepts renderer
+# options, and rl info reports the Cornell box's 36 triangles.
+# Run as: bash test_cli_render.sh <rl-binary> <scratch-dir>
+set -u
+RL=$1
+TMP=$2
+rm -rf "$TMP"
+mkdir -p "$TMP"
+
+fail() { echo "FAIL: $*" >&2; exit 1; }
+run_ok() {
+    "$@" >"$TMP/out" 2>"$TMP/err" || fail "'$*' exited $?; stderr: $(head -c 400 "$TMP/err")"
+}
+expect_in() { grep -q -- "$2" "$1" || fail "$1 lacks '$2': $(head -c 400 "$1")"; }
+# png_size FILE: "WIDTHxHEIGHT" from the IHDR chunk (big-endian at bytes 16..23).
+png_size() {
+    local magic w h
+    magic=$(od -An -tx1 -N8 "$1" | tr -d ' \n')
+    [ "$magic" = "89504e470d0a1a0a" ] || { echo "not-a-png"; return; }
+    w=$(od -An -tu1 -j16 -N4 "$1" | awk '{print $1*16777216+$2*65536+$3*256+$4}')
+    h=$(od -An -tu1 -j20 -N4 "$1" | awk '{print $1*16777216+$2*65536+$3*256+$4}')
+    echo "${w}x${h}"
+}
+expect_png() {
+    [ -s "$1" ] || fail "$1 was not written"
+    [ "$(png_size "$1")" = "$2" ] || fail "$1 is $(png_size "$1"), expected $2"
+}
+
+# PNG at the requested size, with the one-line summary on stdout.
+run_ok "$RL" render cornell --algo raster --size 64x48 --out "$TMP/c.png"
+expect_png "$TMP/c.png" 64x48
+[ "$(wc -l <"$TMP/out")" -eq 1 ] || fail "summary should be one line: $(cat "$TMP/out")"
+expect_in "$TMP/out" "raster"
+expect_in "$TMP/out" "64x48"
+expect_in "$TMP/out" " ms"
+expect_in "$TMP/out" "triangles rasterized"
+
+# The default algorithm is raster; = syntax works too.
+run_ok "$RL" render cornell --size=32x24 --out="$TMP/eq.png"
+expect_png "$TMP/eq.png" 32x24
+expect_in "$TMP/out" "^raster"
+
+# EXR: magic number 76 2f 31 01.
+run_ok "$RL" render cornell --size 64x48 --out "$TMP/c.exr"
+[ "$(od -An -tx1 -N4 "$TMP/c.exr" | tr -d ' \n')" = "762f3101" ] || fail "c.exr is not OpenEXR"
+
+# Renderer options, with and without the renderer's prefix.
+run_ok "$RL" render cornell --size 64x48 --set raster.shading=flat --out "$TMP/flat.png"
+expect_png "$TMP/flat.png" 64x48
+run_ok "$RL" render cornell --size 64x48 --set shading=flat --out "$TMP/flat2.png"
+cmp -s "$TMP/flat.png" "$TMP/flat2.png" || fail "raster.shading=flat and shading=flat differ"
+
+# Camera overrides and global flags after the subcommand.
+run_ok "$RL" render cornell --size 40x30 --eye 0,1,4 --target 0,1,0 --up 0,1,0 --fov 50 --out "$TMP/cam.png" -q
+expect_png "$TMP/cam.png" 40x30
+cmp -s "$TMP/cam.png" "$TMP/c.png" && fail "camera overrides had no effect"
+
+# Stats file, depth and ID layers.
+run_ok "$RL" render cornell --size 64x48 --out "$TMP/s.png" --stats-json "$TMP/stats.json" \
+    --depth-out "$TMP/depth.exr" --id-out "$TMP/ids.png"
+expect_in "$TMP/stats.json" '"time_ms"'
+expect_in "$TMP/stats.json" '"pixels_written"'
+[ "$(od -An -tx1 -N4 "$TMP/depth.exr" | tr -d ' \n')" = "762f3101" ] || fail "depth.exr is not OpenEXR"
+expect_png "$TMP/ids.png" 64x48
+run_ok "$RL" render cornell --size 64x48 --out "$TMP/s2.png" --depth-out "$TMP/depth.png"
+expect_png "$TMP/depth.png" 64x48
+if command -v python3 >/dev/null 2>&1; then
+    python3 -c 'import json,sys; d=json.load(sys.stdin); assert d["time_ms"] >= 0' <"$TMP/stats.json" ||
+        fail "stats.json is not valid JSON with time_ms"
+fi
+
+# A built-in with parameters.
+run_ok "$RL" render cornell-teapot:triangles=2000 --size 32x24 --out "$TMP/teapot.png"
+expect_png "$TMP/teapot.png" 32x24
+
+# Size comes from the scene's camera, else 1280x720; --camera picks by name.
+cat >"$TMP/box.json" <<'JSON'
+{
+  "lights": [ { "type": "point", "position": [0, 3, 3], "intensity": 10 } ],
+  "cameras": [
+    { "name": "front", "eye": [0, 0, 4], "target": [0, 0, 0], "size": [48, 32] },
+    { "name": "side", "eye": [4, 1, 0], "target": [0, 0, 0], "size": [30, 20] }
+  ],
+  "objects": [ { "generator": "box" } ]
+}
+JSON
+run_ok "$RL" render "$TMP/box.json" --out "$TMP/box.png"
+expect_png "$TMP/box.png" 48x32
+run_ok "$RL" render "$TMP/box.json" --camera side --out "$TMP/side.png"
+expect_png "$TMP/side.png" 30x20
+run_ok "$RL" render "$TMP/box.json" --camera side --size 20x10 --out "$TMP/side2.png"
+expect_png "$TMP/side2.png" 20x10
+printf 'v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n' >"$TMP/tri.obj"
+run_ok "$RL" render "$TMP/tri.obj" --out "$TMP/tri.png"
+expect_png "$TMP/tri.png" 1280x720
+
+# rl info: text and JSON.
+run_ok "$RL" info cornell
+grep -Eq '^triangles +36$' "$TMP/out" || fail "rl info cornell should show 36 triangles: $(cat "$TMP/out")"
+expect_in "$TMP/out" "cameras"
+run_ok "$RL" info cornell --json
+expect_in "$TMP/out" '"triangles":[[:space:]]*36,'
+if command -v python3 >/dev/null 2>&1; then
+    python3 -c 'import json,sys; d=json.load(sys.stdin); assert d["triangles"] == 36' <"$TMP/out" ||
+        fail "rl info cornell --json is not valid JSON with 36 triangles"
+fi
+echo "ok"
