@@ -15,8 +15,10 @@
 
 #include "rl/rl.h"
 
-/* Keep in sync with project(renderlab VERSION ...) in CMakeLists.txt. */
-#define RL_CLI_VERSION "0.1.0"
+/* The version comes from project() in CMakeLists.txt. */
+#ifndef RL_CLI_VERSION
+#error "RL_CLI_VERSION must be defined by the build"
+#endif
 
 enum { RL_CLI_OK = 0, RL_CLI_FAIL = 1, RL_CLI_USAGE = 2 };
 
