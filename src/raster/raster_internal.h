@@ -118,14 +118,14 @@ static inline int rl_raster_num_bands(int height)
     return (height + RL_RASTER_BAND_ROWS - 1) / RL_RASTER_BAND_ROWS;
 }
 
-/* raster.c: grows a scratch array to hold count items; false on failure
+/* rasterizer.c: grows a scratch array to hold count items; false on failure
  * (no error recorded: callers inside parallel regions report afterwards). */
 bool rl_raster_reserve(void **array, size_t *cap, size_t count, size_t item_size);
-/* raster.c: makes sure r->chunks holds count chunks. */
+/* rasterizer.c: makes sure r->chunks holds count chunks. */
 rl_status rl_raster_reserve_chunks(rl_raster *r, int count);
-/* raster.c: threads to use for this draw. */
+/* rasterizer.c: threads to use for this draw. */
 int rl_raster_thread_count(const rl_raster *r);
-/* raster.c: the layers a draw with these flags touches. */
+/* rasterizer.c: the layers a draw with these flags touches. */
 rl_raster_target rl_raster_target_for(const rl_raster *r, unsigned flags, bool query);
 
 /* raster_setup.c: culls, clips and sets up triangles [first, first+count) of

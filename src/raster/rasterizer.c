@@ -1,4 +1,4 @@
-/* raster.c: the rasterizer object: creation, render target and matrices, and
+/* rasterizer.c: the rasterizer object: creation, render target and matrices, and
  * the scratch buffers that are reused across draws (many small draws per
  * frame must not pay for allocation). The pipeline is in raster_draw.c. */
 #include <math.h>

@@ -35,6 +35,7 @@ struct rl_scene {
     rl_mesh *meshes;      uint32_t num_meshes, cap_meshes;
     rl_material *materials; uint32_t num_materials, cap_materials;
     rl_texture **textures; uint32_t num_textures, cap_textures;
+    char **texture_paths;  /* resolved file path per texture or NULL (sharing) */
     rl_light *lights;     uint32_t num_lights, cap_lights;
     rl_camera *cameras;   char **camera_names; uint32_t num_cameras, cap_cameras;
     rl_camera_path *camera_path;
@@ -47,10 +48,16 @@ struct rl_scene {
     rl_vec2 *flat_uvs;
     uint32_t *flat_indices, *flat_tri_object, *flat_tri_material;
     rl_object *flat_objects;
+    uint64_t emissive_triangles;  /* counted by commit */
 };
 
 /* Returns RL_ERR_INVALID_ARG with a message if the scene is committed. */
 rl_status rl_scene_check_mutable(const rl_scene *scene, const char *what);
+
+/* Makes room for `need` elements in *array (capacity *cap, elements of
+ * elem_size bytes), growing geometrically. RL_ERR_OUT_OF_MEMORY or
+ * RL_ERR_LIMIT past 2^31 elements; *array is untouched on failure. */
+rl_status rl_scene_reserve(void **array, uint32_t *cap, uint32_t need, size_t elem_size);
 
 /* Area-weighted smooth vertex normals; vertices without area get +z. */
 void rl_mesh_compute_normals(uint32_t num_vertices, const rl_vec3 *positions,
