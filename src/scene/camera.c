@@ -1,0 +1,169 @@
+/* camera.c: perspective pinhole camera: defaults, validation, the ray frame,
+ * OpenGL-style view/projection matrices built from that same frame (so that
+ * rasterizers and ray tracers agree pixel for pixel), clip ranges and a
+ * default camera that frames a bounding box. */
+#include "rl/rl_camera.h"
+#include "rl/rl_image.h"
+#include "core/error.h"
+
+rl_camera rl_camera_resolve(const rl_camera *cam)
+{
+    rl_camera c = { 0 };
+    if (cam)
+        c = *cam;
+    if (c.up.x == 0.0f && c.up.y == 0.0f && c.up.z == 0.0f)
+        c.up = rl_v3(0.0f, 1.0f, 0.0f);
+    if (c.fov_deg == 0.0f)
+        c.fov_deg = RL_CAMERA_DEFAULT_FOV_DEG;
+    if (c.width == 0)
+        c.width = RL_CAMERA_DEFAULT_WIDTH;
+    if (c.height == 0)
+        c.height = RL_CAMERA_DEFAULT_HEIGHT;
+    return c;
+}
+
+rl_status rl_camera_validate(const rl_camera *cam)
+{
+    if (!cam)
+        return rl_error(RL_ERR_INVALID_ARG, "camera: NULL");
+    rl_camera c = rl_camera_resolve(cam);
+    if (!rl_vfinite(c.eye) || !rl_vfinite(c.target) || !rl_vfinite(c.up) || !isfinite(c.fov_deg) ||
+        !isfinite(c.z_near) || !isfinite(c.z_far))
+        return rl_error(RL_ERR_INVALID_ARG, "camera: non-finite value");
+    rl_vec3 dir = rl_sub(c.target, c.eye);
+    float dist = rl_length(dir);
+    float scale = rl_maxf(rl_vmax_comp(rl_vmax(c.eye, rl_neg(c.eye))),
+                          rl_vmax_comp(rl_vmax(c.target, rl_neg(c.target))));
+    /* Relative to the coordinates: below that, eye and target round together. */
+    if (!(dist > 1e-6f * rl_maxf(scale, 1e-30f)) || !(rl_length2(dir) > 0.0f))
+        return rl_error(RL_ERR_INVALID_ARG, "camera: eye and target coincide");
+    float sin_up = rl_length(rl_cross(dir, c.up)) / (dist * rl_length(c.up));
+    if (!(sin_up > 1e-6f))
+        return rl_error(RL_ERR_INVALID_ARG, "camera: up is parallel to the view direction");
+    if (!(c.fov_deg > 0.0f && c.fov_deg < 180.0f))
+        return rl_error(RL_ERR_INVALID_ARG, "camera: fov %g outside (0,180) degrees",
+                        (double)c.fov_deg);
+    if (c.width < 1 || c.height < 1 || c.width > RL_IMAGE_MAX_SIZE || c.height > RL_IMAGE_MAX_SIZE)
+        return rl_error(RL_ERR_LIMIT, "camera: resolution %dx%d outside 1..%d", c.width, c.height,
+                        RL_IMAGE_MAX_SIZE);
+    if (c.z_near < 0.0f || c.z_far < 0.0f || (c.z_near > 0.0f && c.z_far > 0.0f && c.z_near >= c.z_far))
+        return rl_error(RL_ERR_INVALID_ARG, "camera: need 0 < z_near (%g) < z_far (%g) or zeros",
+                        (double)c.z_near, (double)c.z_far);
+    return RL_OK;
+}
+
+rl_camera_frame rl_camera_frame_make(const rl_camera *cam)
+{
+    rl_camera c = rl_camera_resolve(cam);
+    rl_camera_frame f;
+    f.eye = c.eye;
+    f.w = rl_normalize(rl_sub(c.eye, c.target));
+    f.u = rl_normalize(rl_cross(c.up, f.w));
+    f.v = rl_cross(f.w, f.u);
+    f.tan_half_fov_y = tanf(rl_radians(c.fov_deg) * 0.5f);
+    f.width = c.width;
+    f.height = c.height;
+    f.aspect = (float)c.width / (float)c.height;
+    return f;
+}
+
+rl_ray rl_camera_frame_ray(const rl_camera_frame *f, float px, float py)
+{
+    /* Image plane at distance 1: x right, y up, pixel rows run downwards. */
+    float sx = (2.0f * px / (float)f->width - 1.0f) * f->tan_half_fov_y * f->aspect;
+    float sy = (1.0f - 2.0f * py / (float)f->height) * f->tan_half_fov_y;
+    rl_vec3 d = rl_sub(rl_add(rl_scale(f->u, sx), rl_scale(f->v, sy)), f->w);
+    rl_ray r;
+    r.o = f->eye;
+    r.d = rl_normalize(d);
+    r.t_min = 0.0f;
+    r.t_max = INFINITY;
+    return r;
+}
+
+rl_mat4 rl_camera_view(const rl_camera *cam)
+{
+    rl_camera_frame f = rl_camera_frame_make(cam);
+    rl_vec3 rows[3] = { f.u, f.v, f.w };
+    rl_mat4 m = rl_mat4_identity();
+    for (int r = 0; r < 3; ++r) {
+        m.m[r][0] = rows[r].x;
+        m.m[r][1] = rows[r].y;
+        m.m[r][2] = rows[r].z;
+        m.m[r][3] = -rl_dot(rows[r], f.eye);
+    }
+    return m;
+}
+
+rl_mat4 rl_camera_projection(const rl_camera *cam, float z_near, float z_far)
+{
+    rl_camera c = rl_camera_resolve(cam);
+    return rl_mat4_perspective(rl_radians(c.fov_deg), (float)c.width / (float)c.height, z_near, z_far);
+}
+
+void rl_camera_clip_range(const rl_camera *cam, rl_aabb bounds, float *z_near, float *z_far)
+{
+    rl_camera c = rl_camera_resolve(cam);
+    rl_camera_frame f = rl_camera_frame_make(&c);
+    float lo = INFINITY, hi = -INFINITY;
+    if (!rl_aabb_is_empty(bounds) && rl_vfinite(bounds.min) && rl_vfinite(bounds.max)) {
+        for (int k = 0; k < 8; ++k) {
+            rl_vec3 p = rl_v3(k & 1 ? bounds.max.x : bounds.min.x, k & 2 ? bounds.max.y : bounds.min.y,
+                              k & 4 ? bounds.max.z : bounds.min.z);
+            float depth = -rl_dot(rl_sub(p, f.eye), f.w);
+            lo = rl_minf(lo, depth);
+            hi = rl_maxf(hi, depth);
+        }
+    }
+    float far_d, near_d;
+    if (!(hi > 0.0f)) {
+        /* Nothing in front of the camera: any sane range will do. */
+        far_d = 1000.0f;
+        near_d = 0.01f;
+    } else {
+        /* Enlarged so that the farthest corner is not clipped by rounding. */
+        far_d = hi * 1.01f + 1e-6f;
+        /* Depth precision: a 24-bit buffer loses everything beyond far/near ~ 1e5. */
+        near_d = rl_maxf(lo * 0.99f, far_d * 1e-5f);
+    }
+    if (c.z_far > 0.0f)
+        far_d = c.z_far;
+    if (c.z_near > 0.0f)
+        near_d = c.z_near;
+    if (near_d >= far_d)
+        near_d = far_d * 1e-5f;
+    if (z_near)
+        *z_near = near_d;
+    if (z_far)
+        *z_far = far_d;
+}
+
+rl_camera rl_camera_frame_bounds(rl_aabb bounds, int width, int height)
+{
+    rl_camera c = { 0 };
+    c.width = width > 0 ? width : RL_CAMERA_DEFAULT_WIDTH;
+    c.height = height > 0 ? height : RL_CAMERA_DEFAULT_HEIGHT;
+    c.fov_deg = RL_CAMERA_DEFAULT_FOV_DEG;
+    c.up = rl_v3(0.0f, 1.0f, 0.0f);
+    rl_vec3 centre = rl_v3s(0.0f);
+    float radius = 1.0f;
+    if (!rl_aabb_is_empty(bounds) && rl_vfinite(bounds.min) && rl_vfinite(bounds.max)) {
+        centre = rl_aabb_center(bounds);
+        /* In double: the squared diagonal of a huge box overflows float. */
+        rl_vec3 e = rl_aabb_extent(bounds);
+        radius = (float)(0.5 * sqrt((double)e.x * e.x + (double)e.y * e.y + (double)e.z * e.z));
+        if (!(radius > 0.0f))
+            radius = 1.0f;
+    }
+    /* The bounding sphere fits a cone of half angle theta at distance
+     * r / sin(theta); theta is the narrower of the vertical and horizontal
+     * half fields of view. */
+    float tan_y = tanf(rl_radians(c.fov_deg) * 0.5f);
+    float tan_x = tan_y * (float)c.width / (float)c.height;
+    float half = atanf(rl_minf(tan_x, tan_y));
+    float dist = radius / sinf(half) * 1.05f;
+    rl_vec3 dir = rl_normalize(rl_v3(0.4f, 0.3f, 1.0f));
+    c.target = centre;
+    c.eye = rl_madd(centre, dir, dist);
+    return c;
+}
