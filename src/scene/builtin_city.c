@@ -157,6 +157,8 @@ static void wall(rl_meshbuf *b, const city_materials *m, uint32_t material, wall
 static int bay_openings(opening *o, int n, float start, float bay, float half_width, float y0,
                         float y1)
 {
+    if (n > MAX_UNITS) /* lots never exceed MAX_UNITS bays (see lots()); keeps o[] in bounds */
+        n = MAX_UNITS;
     for (int i = 0; i < n; ++i) {
         float c = start + ((float)i + 0.5f) * bay;
         o[i] = (opening){ c - half_width, c + half_width, y0, y1, true };
