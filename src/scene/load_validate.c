@@ -1,0 +1,370 @@
+/* load_validate.c: our own sanity checks on mesh files, run before Assimp.
+ *
+ * Assimp's readers are forgiving: the OBJ reader skips lines it does not
+ * understand (including binary garbage) and the PLY reader fills in a body
+ * that ends before the header's element counts are reached. Both hide
+ * truncated or corrupted files, so we check what is cheap to check:
+ *   - OBJ is a text format: control bytes mean corruption.
+ *   - PLY (Turk 1994 format description): the header lists every element
+ *     with its count and properties; the body must provide all of them, as
+ *     whitespace-separated tokens (ascii) or fixed-size binary values with
+ *     counted lists (binary_little_endian / binary_big_endian). Faces need
+ *     at least 3 corners (Assimp's triangulation asserts otherwise) and
+ *     indices below the vertex count. */
+#include <errno.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "core/error.h"
+#include "scene/load_internal.h"
+
+#define PLY_MAX_ELEMENTS 16
+#define PLY_MAX_PROPERTIES 64
+
+static bool has_ext(const char *path, const char *ext)
+{
+    size_t n = strlen(path), e = strlen(ext);
+    if (n < e)
+        return false;
+    for (size_t i = 0; i < e; ++i) {
+        char c = path[n - e + i];
+        if (c >= 'A' && c <= 'Z')
+            c = (char)(c - 'A' + 'a');
+        if (c != ext[i])
+            return false;
+    }
+    return true;
+}
+
+static rl_status read_all(const char *path, char **data, size_t *size)
+{
+    FILE *f = fopen(path, "rb");
+    if (!f)
+        return rl_error(RL_ERR_IO, "%s: cannot open: %s", path, strerror(errno));
+    char *buf = NULL;
+    size_t len = 0, cap = 0;
+    for (;;) {
+        if (len == cap) {
+            cap = cap ? cap * 2 : 65536;
+            char *nb = rl_realloc_array(buf, cap + 1, 1);
+            if (!nb) {
+                free(buf);
+                fclose(f);
+                return RL_ERR_OUT_OF_MEMORY;
+            }
+            buf = nb;
+        }
+        size_t got = fread(buf + len, 1, cap - len, f);
+        len += got;
+        if (got == 0)
+            break;
+    }
+    bool failed = ferror(f) != 0;
+    fclose(f);
+    if (failed) {
+        free(buf);
+        return rl_error(RL_ERR_IO, "%s: read error", path);
+    }
+    buf[len] = '\0';
+    *data = buf;
+    *size = len;
+    return RL_OK;
+}
+
+static rl_status check_obj(const char *path, const char *data, size_t size)
+{
+    for (size_t i = 0; i < size; ++i) {
+        unsigned char c = (unsigned char)data[i];
+        /* Tabs, line breaks, vertical tab and form feed are whitespace. */
+        if ((c < 0x20 && !(c >= 0x09 && c <= 0x0D)) || c == 0x7F)
+            return rl_error(RL_ERR_PARSE, "%s: byte %zu: binary data in a text OBJ file", path,
+                            i);
+    }
+    return RL_OK;
+}
+
+typedef struct ply_property {
+    int size;        /* bytes of a scalar value, or of each list item */
+    int count_size;  /* bytes of the list count, 0 for scalars */
+    bool is_signed, is_float;   /* of the (item) type */
+    bool face_indices;          /* "vertex_indices" of "face": checked */
+} ply_property;
+
+typedef struct ply_element {
+    char name[32];
+    unsigned long long count;
+    ply_property props[PLY_MAX_PROPERTIES];
+    int num_props;
+} ply_element;
+
+static bool type_signed(const char *t)
+{
+    return strcmp(t, "char") == 0 || strcmp(t, "int8") == 0 || strcmp(t, "short") == 0 ||
+           strcmp(t, "int16") == 0 || strcmp(t, "int") == 0 || strcmp(t, "int32") == 0;
+}
+
+static bool type_float(const char *t) { return t[0] == 'f' || t[0] == 'd'; }
+
+static int type_size(const char *t)
+{
+    static const struct { const char *name; int size; } types[] = {
+        { "char", 1 },   { "int8", 1 },   { "uchar", 1 },  { "uint8", 1 },
+        { "short", 2 },  { "int16", 2 },  { "ushort", 2 }, { "uint16", 2 },
+        { "int", 4 },    { "int32", 4 },  { "uint", 4 },   { "uint32", 4 },
+        { "float", 4 },  { "float32", 4 }, { "double", 8 }, { "float64", 8 },
+    };
+    for (size_t i = 0; i < sizeof types / sizeof types[0]; ++i)
+        if (strcmp(t, types[i].name) == 0)
+            return types[i].size;
+    return 0;
+}
+
+/* Reads the next header line into line (NUL-terminated, without '\r'). */
+static bool next_line(const char *data, size_t size, size_t *pos, char *line, size_t cap)
+{
+    if (*pos >= size)
+        return false;
+    size_t n = 0;
+    while (*pos < size && data[*pos] != '\n') {
+        if (data[*pos] != '\r' && n + 1 < cap)
+            line[n++] = data[*pos];
+        ++*pos;
+    }
+    if (*pos < size)
+        ++*pos;   /* the '\n' */
+    line[n] = '\0';
+    return true;
+}
+
+static unsigned long long read_uint(const unsigned char *p, int size, bool big_endian)
+{
+    unsigned long long v = 0;
+    for (int i = 0; i < size; ++i)
+        v |= (unsigned long long)p[big_endian ? size - 1 - i : i] << (8 * i);
+    return v;
+}
+
+static bool is_space(char c) { return c == ' ' || (c >= '\t' && c <= '\r'); }
+
+/* Skips one whitespace-separated token (at least one byte, so that every
+ * call makes progress); false at the end of the data. */
+static bool skip_token(const char *data, size_t size, size_t *pos, const char **tok)
+{
+    while (*pos < size && is_space(data[*pos]))
+        ++*pos;
+    if (*pos >= size)
+        return false;
+    *tok = data + *pos;
+    while (*pos < size && !is_space(data[*pos]))
+        ++*pos;
+    return true;
+}
+
+/* The whole token [tok, end) is one number (strtod stops at NUL bytes, so
+ * binary junk inside a token fails too). */
+static bool is_number(const char *tok, const char *end)
+{
+    char *stop;
+    (void)strtod(tok, &stop);
+    return stop == end;
+}
+
+static rl_status not_a_number(const char *path, const ply_element *e, unsigned long long i)
+{
+    return rl_error(RL_ERR_PARSE, "%s: PLY \"%s\" element %llu holds something that is not a "
+                    "number", path, e->name, i);
+}
+
+static rl_status ply_body_short(const char *path, const ply_element *e, unsigned long long i)
+{
+    return rl_error(RL_ERR_PARSE, "%s: PLY body ends after %llu of %llu \"%s\" elements", path,
+                    i, e->count, e->name);
+}
+
+/* Assimp's triangulation asserts on faces with fewer than 3 corners. */
+static rl_status check_face_size(const char *path, const ply_property *p, unsigned long long face,
+                                 unsigned long long n)
+{
+    if (p->face_indices && n < 3)
+        return rl_error(RL_ERR_PARSE, "%s: PLY face %llu has %llu corners (at least 3 needed)",
+                        path, face, n);
+    return RL_OK;
+}
+
+static rl_status bad_index(const char *path, unsigned long long face, const char *index)
+{
+    return rl_error(RL_ERR_PARSE, "%s: PLY face %llu uses vertex %.20s, out of range", path,
+                    face, index);
+}
+
+static rl_status check_ply(const char *path, const char *data, size_t size)
+{
+    char line[512];
+    size_t pos = 0;
+    if (!next_line(data, size, &pos, line, sizeof line) || strcmp(line, "ply") != 0)
+        return rl_error(RL_ERR_PARSE, "%s: not a PLY file (first line is not \"ply\")", path);
+
+    ply_element elems[PLY_MAX_ELEMENTS];
+    int num_elems = 0, format = -1;   /* 0 ascii, 1 little, 2 big endian */
+    for (;;) {
+        if (!next_line(data, size, &pos, line, sizeof line))
+            return rl_error(RL_ERR_PARSE, "%s: PLY header has no end_header", path);
+        /* Assimp's PLY reader can loop forever on odd header bytes. */
+        for (const char *ch = line; *ch; ++ch)
+            if ((unsigned char)*ch < 0x20 && *ch != '\t')
+                return rl_error(RL_ERR_PARSE, "%s: control byte in the PLY header", path);
+        char word[32] = "", a[32] = "", b[32] = "", c[32] = "", d[32] = "";
+        int words = sscanf(line, "%31s %31s %31s %31s %31s", word, a, b, c, d);
+        if (words < 1)
+            continue;
+        if (strcmp(word, "end_header") == 0) {
+            if (words != 1)
+                return rl_error(RL_ERR_PARSE, "%s: junk after PLY end_header", path);
+            break;
+        }
+        if (strcmp(word, "format") == 0) {
+            format = strcmp(a, "ascii") == 0                  ? 0
+                     : strcmp(a, "binary_little_endian") == 0 ? 1
+                     : strcmp(a, "binary_big_endian") == 0    ? 2 : -1;
+            if (format < 0)
+                return rl_error(RL_ERR_PARSE, "%s: unknown PLY format \"%s\"", path, a);
+        } else if (strcmp(word, "element") == 0) {
+            if (num_elems == PLY_MAX_ELEMENTS)
+                return rl_error(RL_ERR_PARSE, "%s: more than %d PLY elements", path,
+                                PLY_MAX_ELEMENTS);
+            ply_element *e = &elems[num_elems++];
+            memset(e, 0, sizeof *e);
+            snprintf(e->name, sizeof e->name, "%s", a);
+            char *end = NULL;
+            e->count = strtoull(b, &end, 10);
+            if (b[0] == '\0' || b[0] == '-' || *end != '\0')
+                return rl_error(RL_ERR_PARSE, "%s: PLY element \"%s\" has a bad count \"%s\"",
+                                path, a, b);
+        } else if (strcmp(word, "property") == 0) {
+            if (num_elems == 0)
+                return rl_error(RL_ERR_PARSE, "%s: PLY property before any element", path);
+            ply_element *e = &elems[num_elems - 1];
+            if (e->num_props == PLY_MAX_PROPERTIES)
+                return rl_error(RL_ERR_PARSE, "%s: too many PLY properties", path);
+            ply_property *p = &e->props[e->num_props++];
+            bool list = strcmp(a, "list") == 0;
+            p->count_size = list ? type_size(b) : 0;
+            const char *item_type = list ? c : a, *prop_name = list ? d : b;
+            p->size = type_size(item_type);
+            p->is_signed = type_signed(item_type);
+            p->is_float = type_float(item_type);
+            p->face_indices = list && strcmp(e->name, "face") == 0 &&
+                              (strcmp(prop_name, "vertex_indices") == 0 ||
+                               strcmp(prop_name, "vertex_index") == 0);
+            if (p->size == 0 || (list && p->count_size == 0))
+                return rl_error(RL_ERR_PARSE, "%s: unknown PLY property type in \"%s\"", path,
+                                line);
+        } else if (strcmp(word, "comment") != 0 && strcmp(word, "obj_info") != 0) {
+            return rl_error(RL_ERR_PARSE, "%s: unexpected PLY header line \"%s\"", path, line);
+        }
+    }
+    if (format < 0)
+        return rl_error(RL_ERR_PARSE, "%s: PLY header has no format line", path);
+
+    unsigned long long vertices = 0;
+    for (int k = 0; k < num_elems; ++k)
+        if (strcmp(elems[k].name, "vertex") == 0)
+            vertices = elems[k].count;
+    const unsigned char *bytes = (const unsigned char *)data;
+    rl_status st;
+    for (int k = 0; k < num_elems; ++k) {
+        const ply_element *e = &elems[k];
+        if (e->num_props == 0)
+            continue;
+        for (unsigned long long i = 0; i < e->count; ++i) {
+            for (int j = 0; j < e->num_props; ++j) {
+                const ply_property *p = &e->props[j];
+                if (format == 0) {
+                    const char *tok;
+                    if (!skip_token(data, size, &pos, &tok))
+                        return ply_body_short(path, e, i);
+                    if (!is_number(tok, data + pos))
+                        return not_a_number(path, e, i);
+                    if (p->count_size == 0)
+                        continue;
+                    char *end;
+                    unsigned long long n = strtoull(tok, &end, 10);
+                    if (tok[0] == '-' || end == tok)
+                        return rl_error(RL_ERR_PARSE, "%s: bad PLY list length in \"%s\"",
+                                        path, e->name);
+                    if ((st = check_face_size(path, p, i, n)) != RL_OK)
+                        return st;
+                    for (unsigned long long m = 0; m < n; ++m) {
+                        if (!skip_token(data, size, &pos, &tok))
+                            return ply_body_short(path, e, i);
+                        if (!is_number(tok, data + pos))
+                            return not_a_number(path, e, i);
+                        if (p->face_indices && !p->is_float) {
+                            long long idx = strtoll(tok, &end, 10);
+                            if (end == tok || idx < 0 || (unsigned long long)idx >= vertices)
+                                return bad_index(path, i, tok);
+                        }
+                    }
+                } else if (p->count_size == 0) {
+                    if (size - pos < (size_t)p->size)
+                        return ply_body_short(path, e, i);
+                    pos += (size_t)p->size;
+                } else {
+                    if (size - pos < (size_t)p->count_size)
+                        return ply_body_short(path, e, i);
+                    unsigned long long n = read_uint(bytes + pos, p->count_size, format == 2);
+                    pos += (size_t)p->count_size;
+                    if (n > (size - pos) / (size_t)p->size)
+                        return ply_body_short(path, e, i);
+                    if ((st = check_face_size(path, p, i, n)) != RL_OK)
+                        return st;
+                    for (unsigned long long m = 0; p->face_indices && !p->is_float && m < n; ++m) {
+                        unsigned long long idx = read_uint(bytes + pos + m * (size_t)p->size,
+                                                           p->size, format == 2);
+                        /* A negative signed index has its top bit set. */
+                        bool negative = p->is_signed && (idx >> (8 * p->size - 1)) & 1u;
+                        if (negative || idx >= vertices) {
+                            char text[32];
+                            snprintf(text, sizeof text, "%s%llu", negative ? "negative " : "",
+                                     negative ? 0ull : idx);
+                            return bad_index(path, i, text);
+                        }
+                    }
+                    pos += (size_t)(n * (unsigned long long)p->size);
+                }
+            }
+        }
+    }
+    return RL_OK;
+}
+
+/* Assimp picks its reader by content when the extension's reader declines,
+ * so a PLY body in a ".gltf" file still reaches the PLY reader: sniff the
+ * magic as well as the extension. */
+static bool starts_like_ply(const char *path)
+{
+    char head[5] = "";
+    FILE *f = fopen(path, "rb");
+    if (!f)
+        return false;
+    size_t n = fread(head, 1, 4, f);
+    fclose(f);
+    return n == 4 && memcmp(head, "ply", 3) == 0 && (head[3] == '\n' || head[3] == '\r');
+}
+
+rl_status rl_check_mesh_file(const char *path)
+{
+    bool ply = has_ext(path, ".ply") || starts_like_ply(path);
+    bool obj = !ply && has_ext(path, ".obj");
+    if (!obj && !ply)
+        return RL_OK;
+    char *data = NULL;
+    size_t size = 0;
+    rl_status st = read_all(path, &data, &size);
+    if (st != RL_OK)
+        return st;
+    st = obj ? check_obj(path, data, size) : check_ply(path, data, size);
+    free(data);
+    return st;
+}
