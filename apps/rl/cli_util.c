@@ -14,6 +14,7 @@
 #include <unistd.h>
 
 #include "core/params.h"
+#include "core/path.h"
 
 int rl_cli_fail(int code, const char *fmt, ...)
 {
@@ -136,12 +137,10 @@ bool rl_cli_parse_vec3(const char *option, const char *text, rl_vec3 *out)
 
 bool rl_cli_has_extension(const char *path, const char *const *extensions)
 {
-    size_t n = strlen(path);
-    for (const char *const *e = extensions; *e; e++) {
-        size_t m = strlen(*e);
-        if (n > m && strcasecmp(path + n - m, *e) == 0)
+    /* A bare ".png" names no file. */
+    for (const char *const *e = extensions; *e; e++)
+        if (strlen(path) > strlen(*e) && rl_path_has_ext(path, *e))
             return true;
-    }
     return false;
 }
 

@@ -3,12 +3,12 @@
  * so a corrupt header or a typo on the command line cannot ask for 64 GiB. */
 #include "rl/rl_image.h"
 
-#include <ctype.h>
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
 #include "core/error.h"
+#include "core/path.h"
 #include "core/image_internal.h"
 
 rl_status rl_image_check_size(const char *what, long long width, long long height)
@@ -88,18 +88,6 @@ void rl_image_fill(rl_image *img, rl_vec4 color)
         img->color[i] = color;
 }
 
-/* Case-insensitive "does path end in ext" (ext includes the dot). */
-static bool has_extension(const char *path, const char *ext)
-{
-    size_t lp = strlen(path), le = strlen(ext);
-    if (lp < le)
-        return false;
-    for (size_t i = 0; i < le; ++i)
-        if (tolower((unsigned char)path[lp - le + i]) != ext[i])
-            return false;
-    return true;
-}
-
 static const char *extension_of(const char *path)
 {
     const char *slash = strrchr(path, '/');
@@ -120,9 +108,9 @@ rl_status rl_image_write(const rl_image *img, const char *path)
 {
     if (!img || !path)
         return rl_error(RL_ERR_INVALID_ARG, "rl_image_write: image or path is NULL");
-    if (has_extension(path, ".png"))
+    if (rl_path_has_ext(path, ".png"))
         return rl_image_write_png(img, path);
-    if (has_extension(path, ".exr"))
+    if (rl_path_has_ext(path, ".exr"))
         return rl_image_write_exr(img, path);
     const char *ext = extension_of(path);
     return rl_error(RL_ERR_UNSUPPORTED,
@@ -134,7 +122,7 @@ rl_status rl_image_read(const char *path, rl_image **out)
 {
     if (!path || !out)
         return rl_error(RL_ERR_INVALID_ARG, "rl_image_read: path or out is NULL");
-    if (has_extension(path, ".exr"))
+    if (rl_path_has_ext(path, ".exr"))
         return rl_image_read_exr(path, out);
     /* Anything else is sniffed by libpng, which names what it found. */
     return rl_image_read_png(path, out);

@@ -199,7 +199,7 @@ static void compute_bounds(rl_scene *s)
     s->emissive_triangles = emissive;
 }
 
-static void discard_flat(rl_scene *s)
+void rl_scene_free_flat(rl_scene *s)
 {
     free(s->flat_positions);
     free(s->flat_normals);
@@ -225,7 +225,7 @@ rl_status rl_scene_commit(rl_scene *scene)
     uint64_t tris = 0, verts = 0;
     rl_status st = build_objects(scene, &setup, &tris, &verts);
     if (st != RL_OK) {
-        discard_flat(scene);
+        rl_scene_free_flat(scene);
         return rl_error(st, "scene \"%s\": out of memory flattening the graph", scene->name);
     }
     if (tris == 0)
@@ -237,7 +237,7 @@ rl_status rl_scene_commit(rl_scene *scene)
                       RL_SCENE_MAX_TRIANGLES);
     if (st != RL_OK) {
         free(setup);
-        discard_flat(scene);
+        rl_scene_free_flat(scene);
         return st;
     }
     rl_scene_data *d = &scene->data;
@@ -252,7 +252,7 @@ rl_status rl_scene_commit(rl_scene *scene)
     if (!scene->flat_positions || !scene->flat_normals || !scene->flat_uvs ||
         !scene->flat_indices || !scene->flat_tri_object || !scene->flat_tri_material) {
         free(setup);
-        discard_flat(scene);
+        rl_scene_free_flat(scene);
         return rl_error(RL_ERR_OUT_OF_MEMORY, "scene \"%s\": out of memory for %llu triangles",
                         scene->name, (unsigned long long)tris);
     }

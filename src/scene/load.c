@@ -15,21 +15,6 @@
 
 #define PATH_MAX_LEN 4096
 
-static bool has_ext(const char *path, const char *ext)
-{
-    size_t n = strlen(path), e = strlen(ext);
-    if (n < e)
-        return false;
-    for (size_t i = 0; i < e; ++i) {
-        char c = path[n - e + i];
-        if (c >= 'A' && c <= 'Z')
-            c = (char)(c - 'A' + 'a');
-        if (c != ext[i])
-            return false;
-    }
-    return true;
-}
-
 static bool is_regular_file(const char *path)
 {
     FILE *f = fopen(path, "rb");
@@ -169,7 +154,7 @@ RL_API rl_status rl_scene_load(const char *source, const char *params, rl_scene 
             return rl_error(RL_ERR_INVALID_ARG,
                             "%s: scene parameters (\"%s\") apply only to built-in scenes",
                             source, params);
-        if (has_ext(source, ".json"))
+        if (rl_path_has_ext(source, ".json"))
             return rl_scene_load_json(source, out);
         return load_mesh_file(source, out);
     }

@@ -17,25 +17,11 @@
 #include <string.h>
 
 #include "core/error.h"
+#include "core/path.h"
 #include "scene/load_internal.h"
 
 #define PLY_MAX_ELEMENTS 16
 #define PLY_MAX_PROPERTIES 64
-
-static bool has_ext(const char *path, const char *ext)
-{
-    size_t n = strlen(path), e = strlen(ext);
-    if (n < e)
-        return false;
-    for (size_t i = 0; i < e; ++i) {
-        char c = path[n - e + i];
-        if (c >= 'A' && c <= 'Z')
-            c = (char)(c - 'A' + 'a');
-        if (c != ext[i])
-            return false;
-    }
-    return true;
-}
 
 static rl_status read_all(const char *path, char **data, size_t *size)
 {
@@ -355,8 +341,8 @@ static bool starts_like_ply(const char *path)
 
 rl_status rl_check_mesh_file(const char *path)
 {
-    bool ply = has_ext(path, ".ply") || starts_like_ply(path);
-    bool obj = !ply && has_ext(path, ".obj");
+    bool ply = rl_path_has_ext(path, ".ply") || starts_like_ply(path);
+    bool obj = !ply && rl_path_has_ext(path, ".obj");
     if (!obj && !ply)
         return RL_OK;
     char *data = NULL;

@@ -58,17 +58,6 @@ rl_status rl_scene_create(rl_scene **out)
     return RL_OK;
 }
 
-static void free_flat(rl_scene *s)
-{
-    free(s->flat_positions);
-    free(s->flat_normals);
-    free(s->flat_uvs);
-    free(s->flat_indices);
-    free(s->flat_tri_object);
-    free(s->flat_tri_material);
-    free(s->flat_objects);
-}
-
 void rl_scene_release(rl_scene *scene)
 {
     if (!scene)
@@ -106,7 +95,7 @@ void rl_scene_release(rl_scene *scene)
     free(scene->cameras);
     free(scene->camera_names);
     rl_camera_path_release(scene->camera_path);
-    free_flat(scene);
+    rl_scene_free_flat(scene);
     free(scene->name);
     free(scene->base_dir);
     free(scene);

@@ -2,6 +2,7 @@
 #ifndef RL_SCENE_INTERNAL_H
 #define RL_SCENE_INTERNAL_H
 
+#include "core/path.h"
 #include "rl/rl_scene.h"
 
 typedef struct rl_attr { char *key, *value; } rl_attr;
@@ -51,6 +52,9 @@ struct rl_scene {
     uint64_t emissive_triangles;  /* counted by commit */
 };
 
+/* Frees the arrays made by commit and clears scene->data (commit.c). */
+void rl_scene_free_flat(rl_scene *scene);
+
 /* Returns RL_ERR_INVALID_ARG with a message if the scene is committed. */
 rl_status rl_scene_check_mutable(const rl_scene *scene, const char *what);
 
@@ -63,9 +67,5 @@ rl_status rl_scene_reserve(void **array, uint32_t *cap, uint32_t need, size_t el
 void rl_mesh_compute_normals(uint32_t num_vertices, const rl_vec3 *positions,
                              uint32_t num_triangles, const uint32_t *indices, rl_vec3 *normals);
 
-/* Joins base_dir and a relative path into out (absolute paths are kept). */
-void rl_path_join(const char *base_dir, const char *path, char *out, size_t out_size);
-/* Directory part of path ("" if none) into out. */
-void rl_path_dirname(const char *path, char *out, size_t out_size);
 
 #endif

@@ -1,6 +1,6 @@
-/* path.c: joining and splitting file paths for scene assets (POSIX '/'
- * separators; a Windows drive prefix "C:" also counts as absolute). */
-#include "scene/scene_internal.h"
+/* path.c: joining and splitting file paths for scene assets and outputs
+ * (POSIX '/' separators; a Windows drive prefix "C:" also counts as absolute). */
+#include "core/path.h"
 
 #include <stdio.h>
 #include <string.h>
@@ -47,4 +47,19 @@ void rl_path_dirname(const char *path, char *out, size_t out_size)
         len = out_size - 1;
     memcpy(out, path, len);
     out[len] = '\0';
+}
+
+bool rl_path_has_ext(const char *path, const char *ext)
+{
+    size_t n = strlen(path), e = strlen(ext);
+    if (n < e)
+        return false;
+    for (size_t i = 0; i < e; ++i) {
+        char c = path[n - e + i];
+        if (c >= 'A' && c <= 'Z')
+            c = (char)(c - 'A' + 'a');
+        if (c != ext[i])
+            return false;
+    }
+    return true;
 }
