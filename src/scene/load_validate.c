@@ -4,7 +4,8 @@
  * understand (including binary garbage) and the PLY reader fills in a body
  * that ends before the header's element counts are reached. Both hide
  * truncated or corrupted files, so we check what is cheap to check:
- *   - OBJ is a text format: control bytes mean corruption.
+ *   - OBJ is a text format: control bytes mean corruption, and a face
+ *     needs at least 3 corners (a cut-off last line has fewer).
  *   - PLY (Turk 1994 format description): the header lists every element
  *     with its count and properties; the body must provide all of them, as
  *     whitespace-separated tokens (ascii) or fixed-size binary values with
@@ -58,6 +59,24 @@ static rl_status read_all(const char *path, char **data, size_t *size)
     return RL_OK;
 }
 
+static bool obj_space(char c) { return c == ' ' || c == '\t' || c == '\r'; }
+
+/* Corners of the face statement starting at line (just after "f"). */
+static int obj_face_corners(const char *p, const char *end)
+{
+    int corners = 0;
+    while (p < end && *p != '\n') {
+        while (p < end && obj_space(*p))
+            ++p;
+        if (p >= end || *p == '\n' || *p == '#')
+            break;
+        ++corners;
+        while (p < end && !obj_space(*p) && *p != '\n')
+            ++p;
+    }
+    return corners;
+}
+
 static rl_status check_obj(const char *path, const char *data, size_t size)
 {
     for (size_t i = 0; i < size; ++i) {
@@ -66,6 +85,26 @@ static rl_status check_obj(const char *path, const char *data, size_t size)
         if ((c < 0x20 && !(c >= 0x09 && c <= 0x0D)) || c == 0x7F)
             return rl_error(RL_ERR_PARSE, "%s: byte %zu: binary data in a text OBJ file", path,
                             i);
+    }
+    /* A file cut inside a face statement leaves a face with one or two
+     * corners, which Assimp turns into a point or line and then rejects with
+     * an internal validation message; name the line instead. */
+    const char *end = data + size;
+    size_t line = 1;
+    for (const char *p = data; p < end; ++line) {
+        const char *q = p;
+        while (q < end && obj_space(*q))
+            ++q;
+        if (q + 1 < end && q[0] == 'f' && obj_space(q[1])) {
+            int corners = obj_face_corners(q + 1, end);
+            if (corners < 3)
+                return rl_error(RL_ERR_PARSE,
+                                "%s:%zu: face with %d corner%s, at least 3 expected "
+                                "(truncated file?)",
+                                path, line, corners, corners == 1 ? "" : "s");
+        }
+        const char *nl = memchr(p, '\n', (size_t)(end - p));
+        p = nl ? nl + 1 : end;
     }
     return RL_OK;
 }

@@ -449,6 +449,8 @@ static void test_truncated_obj_is_a_parse_error(void **state)
     expect_parse_error(write_text(dir, "cut_face.obj",
                                   "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nf 1 2 3\nf 1 3", path,
                                   sizeof path));
+    /* ... and the message points at the cut line. */
+    assert_non_null(strstr(rl_last_error(), "cut_face.obj:6: face with 2 corners"));
     /* Cut in the vertex list: faces refer to vertices that never came. */
     expect_parse_error(write_text(dir, "cut_vertices.obj", "v 0 0 0\nv 1 0 0\nf 1 2 3\n",
                                   path, sizeof path));
