@@ -10,6 +10,7 @@ PACKAGES=(
   libstb-dev          # PNG/JPEG texture input (stb_image)
   libcjson-dev        # scene and result files
   libassimp-dev       # OBJ, PLY, STL, glTF, DAE, 3DS, FBX import
+  libembree-dev       # Embree 3: reference accelerator and benchmark anchor
   libcmocka-dev       # unit tests
 )
 

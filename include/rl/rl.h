@@ -10,4 +10,6 @@
 #include "rl/rl_scene.h"
 #include "rl/rl_raster.h"
 #include "rl/rl_render.h"
+#include "rl/rl_accel.h"
+#include "rl/rl_trace.h"
 #endif

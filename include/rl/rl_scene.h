@@ -96,6 +96,9 @@ typedef struct rl_scene rl_scene;
 
 RL_API rl_status rl_scene_create(rl_scene **out);
 RL_API void rl_scene_release(rl_scene *scene);         /* NULL is a no-op */
+/* A number unique to this scene within the process (never reused), so that
+ * caches keyed on a scene survive a new scene at a recycled address. */
+RL_API uint64_t rl_scene_uid(const rl_scene *scene);
 RL_API rl_status rl_scene_set_name(rl_scene *scene, const char *name);
 RL_API const char *rl_scene_name(const rl_scene *scene);
 /* Folder that relative asset paths are resolved against ("" = cwd). */

@@ -40,6 +40,10 @@ rl_status rl_scene_check_mutable(const rl_scene *scene, const char *what)
     return RL_OK;
 }
 
+static _Atomic uint64_t next_uid = 1;
+
+uint64_t rl_scene_uid(const rl_scene *scene) { return scene ? scene->uid : 0; }
+
 rl_status rl_scene_create(rl_scene **out)
 {
     if (!out)
@@ -47,6 +51,7 @@ rl_status rl_scene_create(rl_scene **out)
     rl_scene *s = rl_calloc(1, sizeof *s);
     if (!s)
         return RL_ERR_OUT_OF_MEMORY;
+    s->uid = next_uid++;
     s->name = rl_strdup("scene");
     s->base_dir = rl_strdup("");
     uint32_t root;

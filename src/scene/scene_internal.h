@@ -28,6 +28,7 @@ typedef struct rl_mesh {
 } rl_mesh;
 
 struct rl_scene {
+    uint64_t uid;            /* see rl_scene_uid() */
     char *name;
     char *base_dir;
     bool committed;

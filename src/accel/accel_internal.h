@@ -1,0 +1,43 @@
+/* accel_internal.h: how an acceleration structure plugs into rl_accel.
+ *
+ * accel.c holds the generic layer (argument checks, NaN rays, stats, timing);
+ * each kind provides one rl_accel_class with build/intersect/occluded/free on
+ * its own state. Queries get rays that already passed the validity check
+ * (finite origin/direction, non-zero direction, t_min <= t_max). */
+#ifndef RL_ACCEL_INTERNAL_H
+#define RL_ACCEL_INTERNAL_H
+
+#include "rl/rl_accel.h"
+
+typedef struct rl_accel_class {
+    const char *name;
+    /* Builds from the scene's flattened triangles; fills stats fields it
+     * knows (memory, nodes, grid_res, ...). build_ms is measured by accel.c. */
+    rl_status (*build)(const rl_scene_data *data, const rl_accel_desc *desc, void **state,
+                       rl_accel_stats *stats);
+    bool (*intersect)(const void *state, rl_ray *ray, rl_hit *hit);
+    bool (*occluded)(const void *state, const rl_ray *ray);
+    void (*release)(void *state);
+} rl_accel_class;
+
+extern const rl_accel_class rl_accel_bvh_class;
+extern const rl_accel_class rl_accel_grid_class;
+extern const rl_accel_class rl_accel_brute_class;
+#ifdef RL_HAVE_EMBREE
+extern const rl_accel_class rl_accel_embree_class;
+#endif
+
+/* The precomputed watertight ray/triangle test (Woop, Benthin, Wald 2013),
+ * shared by every kind of ours so that they agree bit for bit on a hit. */
+typedef struct rl_ray_watertight {
+    int kx, ky, kz;           /* axis permutation: kz = largest |d| */
+    float sx, sy, sz;         /* shear constants */
+    rl_vec3 o;
+} rl_ray_watertight;
+
+void rl_ray_watertight_setup(const rl_ray *ray, rl_ray_watertight *w);
+/* True for a hit with t in (t_min, t_max); fills *t, *u, *v. Backfaces hit too. */
+bool rl_triangle_intersect_watertight(const rl_ray_watertight *w, rl_vec3 p0, rl_vec3 p1, rl_vec3 p2,
+                                      float t_min, float t_max, float *t, float *u, float *v);
+
+#endif
