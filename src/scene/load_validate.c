@@ -286,7 +286,9 @@ static rl_status check_ply(const char *path, const char *data, size_t size)
                 return rl_error(RL_ERR_PARSE, "%s: unknown PLY property type in \"%s\"", path,
                                 line);
         } else if (strcmp(word, "comment") != 0 && strcmp(word, "obj_info") != 0) {
-            return rl_error(RL_ERR_PARSE, "%s: unexpected PLY header line \"%s\"", path, line);
+            /* Real exporters write free text without "comment" (Blender 2.4x:
+             * "Created by Blender3D ..."); Assimp skips such lines, so do we. */
+            rl_warn("%s: ignoring unknown PLY header line \"%s\"", path, line);
         }
     }
     if (format < 0)

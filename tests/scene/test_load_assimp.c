@@ -191,6 +191,24 @@ static void test_ascii_ply_loads_with_its_quad_split(void **state)
     rl_scene_release(s);
 }
 
+static void test_ply_header_free_text_line_is_skipped_like_assimp_does(void **state)
+{
+    (void)state;
+    char dir[1100], path[1200];
+    dir_for("ply", dir, sizeof dir);
+    /* Blender 2.4x wrote this line without the "comment" keyword. */
+    write_text(dir, "blender24.ply",
+               "ply\nformat ascii 1.0\nCreated by Blender3D 247 - www.blender.org, source file: \n"
+               "element vertex 3\nproperty float x\nproperty float y\nproperty float z\n"
+               "element face 1\nproperty list uchar int vertex_indices\nend_header\n"
+               "0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n",
+               path, sizeof path);
+    rl_scene *s = NULL;
+    assert_int_equal(import_committed(path, &s), RL_OK);
+    assert_int_equal(rl_scene_get_data(s)->num_triangles, 1);
+    rl_scene_release(s);
+}
+
 static void put_f32(unsigned char **p, float f)
 {
     memcpy(*p, &f, 4);   /* STL is little-endian, as is every machine we run on */
@@ -580,6 +598,7 @@ int main(void)
         cmocka_unit_test(test_obj_quad_and_pentagon_split_into_five_triangles),
         cmocka_unit_test(test_obj_material_and_texture_resolve_relative_to_the_obj),
         cmocka_unit_test(test_ascii_ply_loads_with_its_quad_split),
+        cmocka_unit_test(test_ply_header_free_text_line_is_skipped_like_assimp_does),
         cmocka_unit_test(test_binary_stl_loads),
         cmocka_unit_test(test_gltf_triangle_keeps_its_node_hierarchy_and_transforms),
         cmocka_unit_test(test_gltf_embedded_png_texture_is_decoded),
