@@ -76,6 +76,23 @@ static void assert_vec3_near(rl_vec3 a, rl_vec3 b, float eps)
     assert_true(fabsf(a.z - b.z) <= eps);
 }
 
+static void test_scene_uids_are_never_reused(void **state)
+{
+    (void)state;
+    rl_scene *a = new_scene(0);
+    uint64_t first = rl_scene_uid(a);
+    assert_true(first != 0);
+    rl_scene_release(a);
+    /* A new scene may get the released one's address, never its uid. */
+    rl_scene *b = new_scene(0);
+    rl_scene *c = new_scene(0);
+    assert_true(rl_scene_uid(b) != first);
+    assert_true(rl_scene_uid(c) != rl_scene_uid(b));
+    assert_int_equal(rl_scene_uid(NULL), 0);
+    rl_scene_release(b);
+    rl_scene_release(c);
+}
+
 static void test_new_scene_has_only_a_root_node(void **state)
 {
     (void)state;
@@ -698,6 +715,7 @@ int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_new_scene_has_only_a_root_node),
+        cmocka_unit_test(test_scene_uids_are_never_reused),
         cmocka_unit_test(test_one_mesh_in_three_nodes_gives_three_objects_in_depth_first_order),
         cmocka_unit_test(test_material_override_is_inherited_until_a_descendant_sets_its_own),
         cmocka_unit_test(test_node_attributes_can_be_set_replaced_and_removed),
