@@ -1,0 +1,229 @@
+/* accel.c: the generic acceleration-structure layer behind rl_accel.h.
+ *
+ * Like Embree's API: create borrows a committed scene and checks the desc,
+ * commit builds (timed here, so every kind reports build_ms the same way),
+ * queries are thread-safe and cannot fail. Rays that no structure could
+ * answer meaningfully (NaN/Inf origin, direction or t_min, zero direction,
+ * NaN t_max, t_min > t_max) are turned away here, so the per-kind classes
+ * (accel_internal.h) never see them. Every kind of ours breaks ties the same
+ * way: among hits at equal t, the lowest triangle ID wins. */
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "accel/accel_internal.h"
+#include "core/error.h"
+#include "rl/rl_timer.h"
+
+struct rl_accel {
+    const rl_scene *scene;
+    const rl_scene_data *data;
+    rl_accel_desc desc;
+    const rl_accel_class *cls;
+    void *state;
+    bool committed;
+    rl_accel_stats stats;
+};
+
+static const char *const kind_names[RL_ACCEL_KIND_COUNT] = {
+    [RL_ACCEL_BVH] = "bvh",
+    [RL_ACCEL_GRID] = "grid",
+    [RL_ACCEL_EMBREE] = "embree",
+    [RL_ACCEL_BRUTE] = "brute",
+};
+
+const char *rl_accel_kind_name(rl_accel_kind kind)
+{
+    if ((int)kind < 0 || kind >= RL_ACCEL_KIND_COUNT)
+        return "unknown";
+    return kind_names[kind];
+}
+
+rl_status rl_accel_kind_parse(const char *name, rl_accel_kind *out)
+{
+    if (!name || !out)
+        return rl_error(RL_ERR_INVALID_ARG, "rl_accel_kind_parse: NULL argument");
+    for (int k = 0; k < RL_ACCEL_KIND_COUNT; ++k)
+        if (strcmp(name, kind_names[k]) == 0) {
+            *out = (rl_accel_kind)k;
+            return RL_OK;
+        }
+    return rl_error(RL_ERR_NOT_FOUND, "accel: unknown kind \"%s\" (known: bvh, grid, embree, brute)",
+                    name);
+}
+
+bool rl_accel_kind_available(rl_accel_kind kind)
+{
+    switch (kind) {
+    case RL_ACCEL_BVH:
+    case RL_ACCEL_GRID:
+    case RL_ACCEL_BRUTE:
+        return true;
+    case RL_ACCEL_EMBREE:
+#ifdef RL_HAVE_EMBREE
+        return true;
+#else
+        return false;
+#endif
+    default:
+        return false;
+    }
+}
+
+static const rl_accel_class *class_of(rl_accel_kind kind)
+{
+    switch (kind) {
+    case RL_ACCEL_BVH: return &rl_accel_bvh_class;
+    case RL_ACCEL_GRID: return &rl_accel_grid_class;
+    case RL_ACCEL_BRUTE: return &rl_accel_brute_class;
+#ifdef RL_HAVE_EMBREE
+    case RL_ACCEL_EMBREE: return &rl_accel_embree_class;
+#endif
+    default: return NULL;
+    }
+}
+
+static rl_status check_desc(const rl_accel_desc *d)
+{
+    if ((int)d->kind < 0 || d->kind >= RL_ACCEL_KIND_COUNT)
+        return rl_error(RL_ERR_INVALID_ARG, "accel: kind %d out of range", (int)d->kind);
+    if (d->threads < 0)
+        return rl_error(RL_ERR_INVALID_ARG, "accel: threads %d < 0", d->threads);
+    if (d->bvh_leaf_size < 0 || d->bvh_leaf_size > 64)
+        return rl_error(RL_ERR_INVALID_ARG, "accel: bvh_leaf_size %d not in 0..64", d->bvh_leaf_size);
+    if (d->bvh_bins != 0 && (d->bvh_bins < 2 || d->bvh_bins > 256))
+        return rl_error(RL_ERR_INVALID_ARG, "accel: bvh_bins %d not 0 or in 2..256", d->bvh_bins);
+    if (!isfinite(d->grid_lambda) || d->grid_lambda < 0.0f)
+        return rl_error(RL_ERR_INVALID_ARG, "accel: grid_lambda %g must be finite and >= 0",
+                        (double)d->grid_lambda);
+    for (int a = 0; a < 3; ++a)
+        if (d->grid_res[a] < 0 || d->grid_res[a] > 4096)
+            return rl_error(RL_ERR_INVALID_ARG, "accel: grid_res[%d] = %d not in 0..4096", a,
+                            d->grid_res[a]);
+    return RL_OK;
+}
+
+rl_status rl_accel_create(const rl_scene *scene, const rl_accel_desc *desc, rl_accel **out)
+{
+    if (!scene || !out)
+        return rl_error(RL_ERR_INVALID_ARG, "rl_accel_create: NULL scene or out");
+    rl_accel_desc d = desc ? *desc : (rl_accel_desc){ 0 };
+    rl_status s = check_desc(&d);
+    if (s)
+        return s;
+    if (!rl_accel_kind_available(d.kind))
+        return rl_error(RL_ERR_UNSUPPORTED, "accel: kind \"%s\" is not in this build",
+                        rl_accel_kind_name(d.kind));
+    if (!rl_scene_is_committed(scene))
+        return rl_error(RL_ERR_NOT_COMMITTED, "accel: the scene must be committed first");
+    const rl_scene_data *data = rl_scene_get_data(scene);
+    if (!data)
+        return rl_error(RL_ERR_NOT_COMMITTED, "accel: the scene has no committed data");
+    rl_accel *a = rl_calloc(1, sizeof *a);
+    if (!a)
+        return RL_ERR_OUT_OF_MEMORY;
+    a->scene = scene;
+    a->data = data;
+    a->desc = d;
+    a->cls = class_of(d.kind);
+    a->stats.kind = d.kind;
+    *out = a;
+    return RL_OK;
+}
+
+rl_status rl_accel_commit(rl_accel *accel)
+{
+    if (!accel)
+        return rl_error(RL_ERR_INVALID_ARG, "rl_accel_commit: accel is NULL");
+    if (accel->committed)
+        return RL_OK;
+    rl_accel_stats st = { .kind = accel->desc.kind };
+    void *state = NULL;
+    rl_timer timer;
+    rl_timer_start(&timer);
+    rl_status s = accel->cls->build(accel->data, &accel->desc, &state, &st);
+    if (s)
+        return s;
+    st.build_ms = rl_timer_ms(&timer);
+    st.kind = accel->desc.kind;
+    st.num_triangles = accel->data->num_triangles;
+    st.bytes_per_triangle = st.num_triangles ? (double)st.memory_bytes / (double)st.num_triangles : 0.0;
+    accel->state = state;
+    accel->stats = st;
+    accel->committed = true;
+    return RL_OK;
+}
+
+void rl_accel_release(rl_accel *accel)
+{
+    if (!accel)
+        return;
+    if (accel->committed && accel->cls->release)
+        accel->cls->release(accel->state);
+    free(accel);
+}
+
+void rl_accel_get_stats(const rl_accel *accel, rl_accel_stats *out)
+{
+    if (!out)
+        return;
+    if (!accel) {
+        memset(out, 0, sizeof *out);
+        return;
+    }
+    *out = accel->stats;
+}
+
+const rl_scene *rl_accel_scene(const rl_accel *accel) { return accel ? accel->scene : NULL; }
+
+/* The contract's invalid rays. Written with positive tests so that any NaN
+ * fails them: "!(t_min <= t_max)" also catches a NaN t_max. */
+static bool ray_is_valid(const rl_ray *r)
+{
+    if (!rl_vfinite(r->o) || !rl_vfinite(r->d) || !isfinite(r->t_min))
+        return false;
+    if (r->d.x == 0.0f && r->d.y == 0.0f && r->d.z == 0.0f)
+        return false;
+    return r->t_min <= r->t_max;
+}
+
+bool rl_accel_intersect(const rl_accel *accel, rl_ray *ray, rl_hit *hit)
+{
+    if (!ray || !hit)
+        return false;
+    hit->triangle = RL_ID_NONE;
+    hit->object = RL_ID_NONE;
+    if (!accel || !accel->committed || !ray_is_valid(ray))
+        return false;
+    rl_hit h = { .triangle = RL_ID_NONE, .object = RL_ID_NONE };
+    rl_ray r = *ray;
+    if (!accel->cls->intersect(accel->state, &r, &h))
+        return false;
+    h.object = accel->data->triangle_object[h.triangle];
+    ray->t_max = h.t;
+    *hit = h;
+    return true;
+}
+
+bool rl_accel_occluded(const rl_accel *accel, const rl_ray *ray)
+{
+    if (!accel || !ray || !accel->committed || !ray_is_valid(ray))
+        return false;
+    return accel->cls->occluded(accel->state, ray);
+}
+
+void rl_accel_intersect_n(const rl_accel *accel, rl_ray *rays, rl_hit *hits, size_t n)
+{
+    if (!rays || !hits)
+        return;
+    for (size_t i = 0; i < n; ++i)
+        rl_accel_intersect(accel, &rays[i], &hits[i]);
+}
+
+void rl_accel_occluded_n(const rl_accel *accel, const rl_ray *rays, bool *occluded, size_t n)
+{
+    if (!rays || !occluded)
+        return;
+    for (size_t i = 0; i < n; ++i)
+        occluded[i] = rl_accel_occluded(accel, &rays[i]);
+}

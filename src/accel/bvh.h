@@ -1,0 +1,80 @@
+/* bvh.h: the BVH shared by its builder (bvh_build.c), the wide collapse
+ * (bvh_wide.c), the traversal (bvh_wide_traverse.c) and its rl_accel class
+ * (bvh.c).
+ *
+ * Layout for cache-friendly traversal: the binary build tree has 32-byte
+ * nodes in one array, the two children of an inner node adjacent (index,
+ * index + 1); the wide tree has 32 bytes per child (whole cache lines); the
+ * leaves' triangles are copied in leaf order into one array of vertex
+ * triples that keep their scene triangle ID. */
+#ifndef RL_ACCEL_BVH_H
+#define RL_ACCEL_BVH_H
+
+#include <stdint.h>
+
+#include "accel/accel_internal.h"
+
+/* Above this depth the builder only halves (object median), so that the
+ * traversal stack can never overflow: binary depth <= 48 + 31 = 79, and a
+ * wide node pushes at most 3 entries per level. */
+#define RL_BVH_SAH_MAX_DEPTH 48
+#define RL_BVH_MAX_DEPTH 96
+/* Children per wide node: 8 where AVX tests them in one go, else 4 (SSE). */
+#if defined(__AVX__)
+#define RL_BVH_WIDTH 8
+#else
+#define RL_BVH_WIDTH 4
+#endif
+#define RL_BVH_WIDE_STACK ((RL_BVH_WIDTH - 1) * RL_BVH_MAX_DEPTH)
+/* SAH leaves may hold up to this many triangles when no split pays off. */
+#define RL_BVH_MAX_LEAF 16
+
+typedef struct rl_bvh_node {
+    float min[3];
+    uint32_t index;           /* inner: first child; leaf: first triangle */
+    float max[3];
+    uint16_t count;           /* triangles in a leaf; 0 for an inner node */
+    uint16_t axis;            /* inner: split axis, orders the children */
+} rl_bvh_node;
+
+typedef struct rl_bvh_tri {
+    rl_vec3 p0, p1, p2;
+    uint32_t id;              /* scene triangle ID */
+} rl_bvh_tri;
+
+/* Wide node collapsed from the binary tree (bvh_wide.c), bounds as
+ * structure of arrays so that one SIMD slab test covers all children.
+ * Unused slots have inverted bounds (min +inf, max -inf): never hit. */
+typedef struct rl_bvh_wide_node {
+    float bmin[3][RL_BVH_WIDTH];     /* [axis][child] */
+    float bmax[3][RL_BVH_WIDTH];
+    uint32_t child[RL_BVH_WIDTH];    /* inner: wide node index; leaf: first triangle */
+    uint8_t count[RL_BVH_WIDTH];     /* leaf: triangles (> 0); inner: 0 */
+    uint8_t pad[3 * RL_BVH_WIDTH];   /* 32 bytes per child: whole cache lines */
+} rl_bvh_wide_node;
+_Static_assert(sizeof(rl_bvh_wide_node) == 32 * RL_BVH_WIDTH, "wide node fills whole cache lines");
+
+typedef struct rl_bvh {
+    rl_bvh_node *nodes;       /* binary tree, NULL once widened and dropped */
+    uint32_t num_nodes;
+    rl_bvh_wide_node *wide;       /* wide tree the traversal uses, or NULL */
+    uint32_t num_wide;
+    rl_bvh_tri *tris;
+    uint32_t num_tris;
+} rl_bvh;
+
+/* Binned SAH build (Wald 2007); fills nodes, leaves, max_depth, sah_cost and
+ * memory_bytes of *stats. RL_ERR_OUT_OF_MEMORY, RL_ERR_CANCELLED; *bvh is
+ * untouched on failure. */
+rl_status rl_bvh_build(const rl_scene_data *data, const rl_accel_desc *desc, rl_bvh *bvh,
+                       rl_accel_stats *stats);
+void rl_bvh_free(rl_bvh *bvh);
+/* Collapses the binary tree into bvh->wide (deterministic: largest-area
+ * child opened first). RL_ERR_OUT_OF_MEMORY. */
+rl_status rl_bvh_widen(rl_bvh *bvh);
+
+/* Traversal of the wide tree (bvh_wide_traverse.c). */
+bool rl_bvh_wide_intersect(const rl_bvh *bvh, rl_ray *ray, rl_hit *hit);
+bool rl_bvh_wide_occluded(const rl_bvh *bvh, const rl_ray *ray);
+
+#endif

@@ -1,0 +1,270 @@
+/* bvh_wide_traverse.c: ordered traversal of the wide BVH (bvh_wide.c).
+ *
+ * One slab test (Kay & Kajiya 1986) covers all of a node's children: AVX
+ * (8 lanes), SSE (4 lanes at a time) or a scalar loop over the same IEEE
+ * operations, so all paths agree bit for bit. The per-axis near/far plane is chosen
+ * once per ray by the direction's sign (Williams et al. 2005, "An Efficient
+ * and Robust Ray-Box Intersection Algorithm"). A zero direction component
+ * gives 1/d = ±inf; an origin exactly on that slab's plane then yields
+ * 0·inf = NaN, which the max/min skip (MAXPS/MINPS and our ternaries keep
+ * the second operand on NaN), so the slab counts as "inside" and no NaN
+ * reaches the result. Boxes get a 2^-15 relative slack so that rounding in
+ * the slab test never culls a box whose triangle the watertight test hits
+ * (the BVH must agree with brute force exactly; cf. Ize 2013, "Robust BVH
+ * Ray Traversal"). Hit children are sorted by entry distance, the nearest
+ * is visited next and the others are pushed with their distance, so that a
+ * pop can skip boxes beyond the shortened t_max. Closest hit follows the
+ * tie rule of accel.c (equal t: lowest triangle ID). */
+#include <math.h>
+
+#if defined(__SSE2__)
+#include <immintrin.h>
+#endif
+
+#include "accel/bvh.h"
+#include "accel/watertight.h"
+
+#define SLACK_LO (1.0f - 0x1p-15f)
+#define SLACK_HI (1.0f + 0x1p-15f)
+
+typedef struct ray_pre {
+    float o[3], inv[3];
+    int neg[3];
+} ray_pre;
+
+typedef struct entry {
+    uint32_t ref;             /* wide node, or first triangle of a leaf */
+    uint32_t count;           /* leaf triangles; 0: inner node */
+    float dist;               /* entry distance of its box */
+} entry;
+
+static inline void ray_pre_setup(const rl_ray *r, ray_pre *p)
+{
+    const float d[3] = { r->d.x, r->d.y, r->d.z };
+    p->o[0] = r->o.x;
+    p->o[1] = r->o.y;
+    p->o[2] = r->o.z;
+    for (int a = 0; a < 3; ++a) {
+        p->inv[a] = 1.0f / d[a];
+        p->neg[a] = signbit(d[a]) ? 1 : 0;
+    }
+}
+
+/* Entry distances of the children; returns the mask of hit lanes. */
+static inline int box_n(const rl_bvh_wide_node *n, const ray_pre *r, float t_min, float t_max, float dist[RL_BVH_WIDTH])
+{
+#if defined(__AVX__) && RL_BVH_WIDTH == 8
+    __m256 lo = _mm256_set1_ps(t_min), hi = _mm256_set1_ps(t_max);
+    for (int a = 0; a < 3; ++a) {
+        __m256 o = _mm256_set1_ps(r->o[a]), inv = _mm256_set1_ps(r->inv[a]);
+        __m256 near = _mm256_loadu_ps(r->neg[a] ? n->bmax[a] : n->bmin[a]);
+        __m256 far = _mm256_loadu_ps(r->neg[a] ? n->bmin[a] : n->bmax[a]);
+        lo = _mm256_max_ps(_mm256_mul_ps(_mm256_sub_ps(near, o), inv), lo);
+        hi = _mm256_min_ps(_mm256_mul_ps(_mm256_sub_ps(far, o), inv), hi);
+    }
+    _mm256_storeu_ps(dist, lo);
+    return _mm256_movemask_ps(_mm256_cmp_ps(_mm256_mul_ps(lo, _mm256_set1_ps(SLACK_LO)),
+                                            _mm256_mul_ps(hi, _mm256_set1_ps(SLACK_HI)), _CMP_LE_OQ));
+#elif defined(__SSE2__)
+    int mask = 0;
+    for (int c = 0; c < RL_BVH_WIDTH; c += 4) {
+        __m128 lo = _mm_set1_ps(t_min), hi = _mm_set1_ps(t_max);
+        for (int a = 0; a < 3; ++a) {
+            __m128 o = _mm_set1_ps(r->o[a]), inv = _mm_set1_ps(r->inv[a]);
+            __m128 near = _mm_loadu_ps((r->neg[a] ? n->bmax[a] : n->bmin[a]) + c);
+            __m128 far = _mm_loadu_ps((r->neg[a] ? n->bmin[a] : n->bmax[a]) + c);
+            lo = _mm_max_ps(_mm_mul_ps(_mm_sub_ps(near, o), inv), lo);
+            hi = _mm_min_ps(_mm_mul_ps(_mm_sub_ps(far, o), inv), hi);
+        }
+        _mm_storeu_ps(dist + c, lo);
+        mask |= _mm_movemask_ps(_mm_cmple_ps(_mm_mul_ps(lo, _mm_set1_ps(SLACK_LO)),
+                                             _mm_mul_ps(hi, _mm_set1_ps(SLACK_HI)))) << c;
+    }
+    return mask;
+#else
+    int mask = 0;
+    for (int i = 0; i < RL_BVH_WIDTH; ++i) {
+        float lo = t_min, hi = t_max;
+        for (int a = 0; a < 3; ++a) {
+            float near = r->neg[a] ? n->bmax[a][i] : n->bmin[a][i];
+            float far = r->neg[a] ? n->bmin[a][i] : n->bmax[a][i];
+            float tn = (near - r->o[a]) * r->inv[a];
+            float tf = (far - r->o[a]) * r->inv[a];
+            lo = tn > lo ? tn : lo;
+            hi = tf < hi ? tf : hi;
+        }
+        dist[i] = lo;
+        if (lo * SLACK_LO <= hi * SLACK_HI)
+            mask |= 1 << i;
+    }
+    return mask;
+#endif
+}
+
+/* Incoherent rays are bound by memory latency: start fetching every child
+ * we will visit (node: all its cache lines; leaf: its triangles' first lines). */
+static inline void prefetch_child(const rl_bvh *bvh, entry e)
+{
+#if defined(__GNUC__)
+    if (e.count == 0) {
+        const char *p = (const char *)&bvh->wide[e.ref];
+        for (size_t line = 0; line < sizeof(rl_bvh_wide_node); line += 64)
+            __builtin_prefetch(p + line);
+    } else {
+        const char *p = (const char *)&bvh->tris[e.ref];
+        __builtin_prefetch(p);
+        __builtin_prefetch(p + 64);
+        if (e.count > 2)
+            __builtin_prefetch(p + 128);
+    }
+#else
+    (void)bvh;
+    (void)e;
+#endif
+}
+
+/* Pushes the hit children of n farthest first and returns the nearest in
+ * *next; false when none is hit. */
+static inline bool visit(const rl_bvh *bvh, const rl_bvh_wide_node *n, const ray_pre *r, float t_min, float t_max,
+                         entry *stack, int *sp, entry *next)
+{
+    float dist[RL_BVH_WIDTH];
+    int mask = box_n(n, r, t_min, t_max, dist);
+    if (!mask)
+        return false;
+    entry hit[RL_BVH_WIDTH];
+    int k = 0;
+    for (int i = 0; i < RL_BVH_WIDTH; ++i) {
+        if (!(mask & (1 << i)))
+            continue;
+        entry e = { n->child[i], n->count[i], dist[i] };
+        prefetch_child(bvh, e);
+        int j = k++;
+        while (j > 0 && hit[j - 1].dist < e.dist) {   /* descending; stable */
+            hit[j] = hit[j - 1];
+            --j;
+        }
+        hit[j] = e;
+    }
+    for (int i = 0; i < k - 1; ++i)
+        stack[(*sp)++] = hit[i];
+    *next = hit[k - 1];
+    return true;
+}
+
+/* The closest hit so far, with the tie rule of accel.c (equal t: lowest
+ * ID): t_test lets equal t through to the ID comparison. */
+typedef struct closest {
+    float t, t_test, u, v;
+    uint32_t id;
+} closest;
+
+RL_WT_INLINE void leaf_closest_k(const rl_bvh_tri *tri, uint32_t count, const rl_ray_watertight *w, int kx, int ky,
+                                 int kz, float t_min, closest *c)
+{
+    for (uint32_t i = 0; i < count; ++i) {
+        float t, u, v;
+        if (!rl_watertight_hit_k(w, kx, ky, kz, tri[i].p0, tri[i].p1, tri[i].p2, t_min, c->t_test, &t, &u, &v))
+            continue;
+        if (t < c->t || tri[i].id < c->id) {
+            *c = (closest){ t, nextafterf(t, INFINITY), u, v, tri[i].id };
+        }
+    }
+}
+
+RL_WT_INLINE bool leaf_any_k(const rl_bvh_tri *tri, uint32_t count, const rl_ray_watertight *w, int kx, int ky,
+                             int kz, float t_min, float t_max)
+{
+    for (uint32_t i = 0; i < count; ++i) {
+        float t, u, v;
+        if (rl_watertight_hit_k(w, kx, ky, kz, tri[i].p0, tri[i].p1, tri[i].p2, t_min, t_max, &t, &u, &v))
+            return true;
+    }
+    return false;
+}
+
+/* One loop per axis permutation (kz, then kx; ky follows), so that the
+ * vertex components are picked at compile time. */
+static void leaf_closest(const rl_bvh_tri *tri, uint32_t count, const rl_ray_watertight *w, float t_min,
+                         closest *c)
+{
+    switch (w->kz * 3 + w->kx) {
+    case 0 * 3 + 1: leaf_closest_k(tri, count, w, 1, 2, 0, t_min, c); break;
+    case 0 * 3 + 2: leaf_closest_k(tri, count, w, 2, 1, 0, t_min, c); break;
+    case 1 * 3 + 2: leaf_closest_k(tri, count, w, 2, 0, 1, t_min, c); break;
+    case 1 * 3 + 0: leaf_closest_k(tri, count, w, 0, 2, 1, t_min, c); break;
+    case 2 * 3 + 0: leaf_closest_k(tri, count, w, 0, 1, 2, t_min, c); break;
+    default: leaf_closest_k(tri, count, w, 1, 0, 2, t_min, c); break;
+    }
+}
+
+static bool leaf_any(const rl_bvh_tri *tri, uint32_t count, const rl_ray_watertight *w, float t_min, float t_max)
+{
+    switch (w->kz * 3 + w->kx) {
+    case 0 * 3 + 1: return leaf_any_k(tri, count, w, 1, 2, 0, t_min, t_max);
+    case 0 * 3 + 2: return leaf_any_k(tri, count, w, 2, 1, 0, t_min, t_max);
+    case 1 * 3 + 2: return leaf_any_k(tri, count, w, 2, 0, 1, t_min, t_max);
+    case 1 * 3 + 0: return leaf_any_k(tri, count, w, 0, 2, 1, t_min, t_max);
+    case 2 * 3 + 0: return leaf_any_k(tri, count, w, 0, 1, 2, t_min, t_max);
+    default: return leaf_any_k(tri, count, w, 1, 0, 2, t_min, t_max);
+    }
+}
+
+bool rl_bvh_wide_intersect(const rl_bvh *bvh, rl_ray *ray, rl_hit *hit)
+{
+    ray_pre p;
+    ray_pre_setup(ray, &p);
+    rl_ray_watertight w;
+    rl_ray_watertight_setup(ray, &w);
+    const float t_min = ray->t_min;
+    closest c = { ray->t_max, ray->t_max, 0.0f, 0.0f, RL_ID_NONE };
+    entry stack[RL_BVH_WIDE_STACK];
+    int sp = 0;
+    entry cur = { 0, 0, t_min };
+    for (;;) {
+        if (cur.count == 0) {
+            if (visit(bvh, &bvh->wide[cur.ref], &p, t_min, c.t, stack, &sp, &cur))
+                continue;
+        } else {
+            leaf_closest(&bvh->tris[cur.ref], cur.count, &w, t_min, &c);
+        }
+        /* Pop, skipping boxes that now start beyond the closest hit. */
+        for (;;) {
+            if (sp == 0)
+                goto finished;
+            cur = stack[--sp];
+            if (cur.dist * SLACK_LO <= c.t * SLACK_HI)
+                break;
+        }
+    }
+finished:
+    if (c.id == RL_ID_NONE)
+        return false;
+    ray->t_max = c.t;
+    *hit = (rl_hit){ .t = c.t, .u = c.u, .v = c.v, .triangle = c.id, .object = hit->object };
+    return true;
+}
+
+bool rl_bvh_wide_occluded(const rl_bvh *bvh, const rl_ray *ray)
+{
+    ray_pre p;
+    ray_pre_setup(ray, &p);
+    rl_ray_watertight w;
+    rl_ray_watertight_setup(ray, &w);
+    const float t_min = ray->t_min, t_max = ray->t_max;
+    entry stack[RL_BVH_WIDE_STACK];
+    int sp = 0;
+    entry cur = { 0, 0, t_min };
+    for (;;) {
+        if (cur.count == 0) {
+            if (visit(bvh, &bvh->wide[cur.ref], &p, t_min, t_max, stack, &sp, &cur))
+                continue;
+        } else {
+            if (leaf_any(&bvh->tris[cur.ref], cur.count, &w, t_min, t_max))
+                return true;   /* any hit will do */
+        }
+        if (sp == 0)
+            return false;
+        cur = stack[--sp];
+    }
+}
