@@ -30,7 +30,8 @@ extern "C" {
 
 typedef struct rl_ray_tree_node {
     uint8_t type;             /* rl_ray_type */
-    uint8_t depth;            /* recursion depth, 0 = primary */
+    uint8_t depth;            /* recursion depth, 0 = primary; a shadow
+                               * feeler is one deeper than the ray it lights */
     uint32_t object;          /* hit object, RL_ID_NONE for a miss; for a
                                * shadow ray the occluder, RL_ID_NONE if the
                                * light is visible */
@@ -46,9 +47,10 @@ typedef struct rl_ray_tree {
 RL_API bool rl_ray_tree_equal(const rl_ray_tree *a, const rl_ray_tree *b);
 
 typedef struct rl_tracer_desc {           /* zero = default */
-    int max_depth;            /* reflection/refraction recursion; 0 -> 5 */
+    int max_depth;            /* reflection/refraction recursion; 0 -> 5,
+                               * < 0 -> none (local term only); at most 64 */
     int area_samples;         /* shadow samples per quad light, n x n grid
-                               * jittered; 0 -> 4 (16 samples) */
+                               * jittered; 0 -> 4 (16 samples); at most 32 */
     float ambient;            /* ambient term × k_d; 0 -> 0.05, < 0 -> none */
     rl_vec3 background;       /* radiance of rays that leave the scene */
     bool no_shadows;          /* skip shadow feelers (all lights visible) */

@@ -23,6 +23,8 @@ struct rl_renderer {
     void *progress_user;
 };
 
+void *rl_renderer_state(const rl_renderer *r) { return r ? r->state : NULL; }
+
 /* Renderer names in messages ("raster, whitted, ..."): enough room for a
  * few dozen algorithms; longer lists are cut, which only shortens a message. */
 #define NAME_LIST_SIZE 512

@@ -40,6 +40,9 @@ const char *rl_renderer_opt_string(const rl_renderer *r, const char *key);
  * returns black for a value that does not parse. */
 bool rl_renderer_parse_color(const char *text, rl_vec3 *out);
 rl_vec3 rl_renderer_opt_color(const rl_renderer *r, const char *key);
+/* The implementation's state made by its class's create(), for accessors
+ * of a renderer's own (e.g. rl_whitted_pixel_tree). */
+void *rl_renderer_state(const rl_renderer *r);
 /* Progress for implementations: false means cancel. */
 bool rl_renderer_progress(const rl_renderer *r, double done);
 

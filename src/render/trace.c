@@ -1,0 +1,286 @@
+/* trace.c: the exact recursive ray tracer of rl_trace.h (Whitted 1980) with
+ * the coefficient model of Ullmann 2003, Sec. 3.1, eq. 3.1-3.4:
+ *     L = local Phong with shadow feelers (trace_shade.c)
+ *       + k_r L(r_r),   r_r = r_p - 2 (r_p.n) n                  (eq. 3.3)
+ *       + k_t L(r_t),   r_t by Snell with eta = eta_1/eta_2       (eq. 3.4)
+ * recursively up to max_depth, or until the product of the coefficients
+ * along the path drops below 1e-3 (it could not change the 8-bit result).
+ *
+ * Choices where the thesis leaves freedom:
+ *  - the hit point is rebuilt from the barycentrics, p = (1-u-v)p0 + u p1 +
+ *    v p2, so that rl_tracer_shade() on a vertex (u, v at a corner) shades
+ *    exactly that vertex, and trace and shade agree bit for bit;
+ *  - two-sided shading: the interpolated normal is flipped towards the
+ *    incoming ray, as the raster renderer does for the viewer;
+ *  - refraction enters when the geometric normal faces the ray (eta =
+ *    1/ior) and leaves otherwise (eta = ior); total internal reflection adds
+ *    k_t to the reflection coefficient;
+ *  - self-intersection: secondary rays start offset along the geometric
+ *    normal by eps = 1e-5 times the scene's size (largest absolute bound
+ *    coordinate or diagonal), i.e. ~100 float ulps at that scale: enough for
+ *    the barycentric point's rounding, far below any feature of our scenes.
+ *
+ * Ray tree (rl_trace.h): every ray actually traced gets one node, in the
+ * order traced: a ray, then its shadow feelers (light order; a quad light
+ * contributes one node per jittered sample traced), then its reflection
+ * subtree, then its refraction subtree. Misses record RL_ID_NONE; a shadow
+ * node names the closest occluder and sits one level below the ray whose hit
+ * it lights, as that hit's reflection and refraction do. */
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "core/error.h"
+#include "render/trace_internal.h"
+
+#define MIN_WEIGHT 1e-3f
+#define MAX_DEPTH_LIMIT 64        /* recursion depth and rl_ray_tree_node.depth */
+#define MAX_AREA_SAMPLES 32       /* 32 x 32 = 1024 feelers per quad light */
+#define EPS_SCALE 1e-5f
+
+bool rl_ray_tree_equal(const rl_ray_tree *a, const rl_ray_tree *b)
+{
+    if (!a || !b)
+        return a == b;
+    if (a->count != b->count || a->truncated != b->truncated)
+        return false;
+    /* Field by field: the node struct has padding bytes memcmp would see. */
+    for (uint32_t i = 0; i < a->count && i < RL_RAY_TREE_MAX; ++i) {
+        const rl_ray_tree_node *x = &a->nodes[i], *y = &b->nodes[i];
+        if (x->type != y->type || x->depth != y->depth || x->object != y->object || x->light != y->light)
+            return false;
+    }
+    return true;
+}
+
+uint32_t rl_trace_tree_push(rl_trace_ctx *ctx, rl_ray_type type, int depth, uint32_t object,
+                            uint32_t light)
+{
+    rl_ray_tree *tree = ctx->tree;
+    if (!tree)
+        return RL_ID_NONE;
+    if (tree->count >= RL_RAY_TREE_MAX) {
+        tree->truncated = true;
+        return RL_ID_NONE;
+    }
+    rl_ray_tree_node *n = &tree->nodes[tree->count];
+    n->type = (uint8_t)type;
+    n->depth = (uint8_t)depth;
+    n->object = object;
+    n->light = light;
+    return tree->count++;
+}
+
+static float scene_scale(rl_aabb b)
+{
+    if (rl_aabb_is_empty(b) || !rl_vfinite(b.min) || !rl_vfinite(b.max))
+        return 1.0f;
+    float coord = rl_maxf(rl_vmax_comp(rl_vmax(b.min, rl_neg(b.min))), rl_vmax_comp(rl_vmax(b.max, rl_neg(b.max))));
+    float s = rl_maxf(coord, rl_length(rl_aabb_extent(b)));
+    return s > 0.0f ? s : 1.0f;
+}
+
+rl_status rl_tracer_create(const rl_accel *accel, const rl_tracer_desc *desc, rl_tracer **out)
+{
+    if (!accel || !out)
+        return rl_error(RL_ERR_INVALID_ARG, "rl_tracer_create: accel and out must not be NULL");
+    rl_tracer_desc d;
+    memset(&d, 0, sizeof d);
+    if (desc)
+        d = *desc;
+    if (d.max_depth > MAX_DEPTH_LIMIT)
+        return rl_error(RL_ERR_INVALID_ARG, "tracer: max_depth %d exceeds %d", d.max_depth, MAX_DEPTH_LIMIT);
+    if (d.area_samples < 0 || d.area_samples > MAX_AREA_SAMPLES)
+        return rl_error(RL_ERR_INVALID_ARG, "tracer: area_samples %d outside 0..%d", d.area_samples,
+                        MAX_AREA_SAMPLES);
+    if (!isfinite(d.ambient))
+        return rl_error(RL_ERR_INVALID_ARG, "tracer: ambient is not finite");
+    if (!rl_vfinite(d.background) || d.background.x < 0.0f || d.background.y < 0.0f ||
+        d.background.z < 0.0f)
+        return rl_error(RL_ERR_INVALID_ARG, "tracer: background must be finite and >= 0");
+    const rl_scene *scene = rl_accel_scene(accel);
+    const rl_scene_data *data = scene ? rl_scene_get_data(scene) : NULL;
+    if (!data)
+        return rl_error(RL_ERR_NOT_COMMITTED, "tracer: the accel's scene is not committed");
+
+    rl_tracer *t = rl_calloc(1, sizeof *t);
+    if (!t)
+        return RL_ERR_OUT_OF_MEMORY;
+    t->accel = accel;
+    t->data = data;
+    t->max_depth = d.max_depth == 0 ? 5 : (d.max_depth < 0 ? 0 : d.max_depth);
+    t->area_samples = d.area_samples == 0 ? 4 : d.area_samples;
+    t->ambient = d.ambient == 0.0f ? 0.05f : rl_maxf(d.ambient, 0.0f);
+    t->background = d.background;
+    t->shadows = !d.no_shadows;
+    t->seed = d.seed;
+    t->eps = EPS_SCALE * scene_scale(data->bounds);
+    *out = t;
+    return RL_OK;
+}
+
+void rl_tracer_release(rl_tracer *tracer)
+{
+    free(tracer);
+}
+
+rl_vec3 rl_trace_offset(const rl_tracer *tracer, const rl_trace_surface *s, rl_vec3 dir)
+{
+    float side = rl_dot(dir, s->ng) >= 0.0f ? 1.0f : -1.0f;
+    return rl_madd(s->p, s->ng, side * tracer->eps);
+}
+
+/* Fills the surface at hit for a ray travelling along unit d; false for a
+ * hit that names no triangle of the scene. */
+static bool surface_at(const rl_tracer *tr, const rl_hit *hit, rl_vec3 d, rl_trace_surface *s)
+{
+    const rl_scene_data *data = tr->data;
+    if (hit->triangle >= data->num_triangles)
+        return false;
+    const uint32_t *tri = &data->indices[3 * (size_t)hit->triangle];
+    float u = hit->u, v = hit->v, w = 1.0f - u - v;
+    rl_vec3 p0 = data->positions[tri[0]], p1 = data->positions[tri[1]], p2 = data->positions[tri[2]];
+    s->p = rl_add(rl_add(rl_scale(p0, w), rl_scale(p1, u)), rl_scale(p2, v));
+    s->v = rl_neg(d);
+
+    rl_vec3 ng = rl_normalize(rl_cross(rl_sub(p1, p0), rl_sub(p2, p0)));
+    rl_vec3 ns = rl_add(rl_add(rl_scale(data->normals[tri[0]], w), rl_scale(data->normals[tri[1]], u)),
+                        rl_scale(data->normals[tri[2]], v));
+    ns = rl_normalize(ns);
+    if (!(rl_length2(ns) > 0.0f) || !rl_vfinite(ns))
+        ns = ng;
+    s->front = rl_dot(ng, s->v) > 0.0f;
+    s->ng = s->front ? ng : rl_neg(ng);
+    s->ns = rl_dot(ns, s->v) < 0.0f ? rl_neg(ns) : ns;
+
+    s->m = &data->materials[data->triangle_material[hit->triangle]];
+    s->kd = s->m->diffuse;
+    uint32_t tex = s->m->diffuse_texture;
+    if (tex < data->num_textures && data->textures[tex]) {
+        rl_vec2 t0 = data->uvs[tri[0]], t1 = data->uvs[tri[1]], t2 = data->uvs[tri[2]];
+        rl_vec2 uv = rl_v2(w * t0.x + u * t1.x + v * t2.x, w * t0.y + u * t1.y + v * t2.y);
+        rl_vec4 texel = rl_texture_sample(data->textures[tex], uv);
+        s->kd = rl_mul(s->kd, rl_v3(texel.x, texel.y, texel.z));
+    }
+    return true;
+}
+
+static rl_vec3 trace_ray(rl_trace_ctx *ctx, rl_ray ray, rl_ray_type type, int depth, float weight);
+
+/* Radiance leaving the surface at hit back along ray (eq. 3.1-3.4). */
+static rl_vec3 shade_hit(rl_trace_ctx *ctx, const rl_ray *ray, const rl_hit *hit, int depth, float weight)
+{
+    const rl_tracer *tr = ctx->tracer;
+    rl_vec3 d = rl_normalize(ray->d);
+    rl_trace_surface s;
+    if (!surface_at(tr, hit, d, &s))
+        return tr->background;
+    rl_vec3 color = rl_trace_local(ctx, &s, depth);
+    if (depth >= tr->max_depth)
+        return color;
+
+    float k_r = s.m->reflectivity, k_t = s.m->transmissivity;
+    rl_vec3 refracted = rl_v3s(0.0f);
+    if (k_t > 0.0f) {
+        /* Entering when the geometric normal faced the ray (eq. 3.4 with
+         * eta_1/eta_2 = 1/ior), leaving into air otherwise. */
+        bool entering = s.front;
+        float ior = s.m->ior >= 1.0f ? s.m->ior : 1.0f;
+        float eta = entering ? 1.0f / ior : ior;
+        if (!rl_refract(d, s.ns, eta, &refracted)) {
+            k_r += k_t;               /* total internal reflection */
+            k_t = 0.0f;
+        }
+    }
+    if (k_r > 0.0f && weight * k_r >= MIN_WEIGHT) {
+        rl_vec3 dir = rl_reflect(d, s.ns);
+        rl_ray r = { rl_trace_offset(tr, &s, dir), 0.0f, dir, INFINITY };
+        color = rl_add(color, rl_scale(trace_ray(ctx, r, RL_RAY_REFLECTION, depth + 1, weight * k_r), k_r));
+    }
+    if (k_t > 0.0f && weight * k_t >= MIN_WEIGHT) {
+        rl_vec3 dir = rl_normalize(refracted);
+        rl_ray r = { rl_trace_offset(tr, &s, dir), 0.0f, dir, INFINITY };
+        color = rl_add(color, rl_scale(trace_ray(ctx, r, RL_RAY_REFRACTION, depth + 1, weight * k_t), k_t));
+    }
+    return color;
+}
+
+static rl_vec3 trace_ray(rl_trace_ctx *ctx, rl_ray ray, rl_ray_type type, int depth, float weight)
+{
+    ctx->rays[type]++;
+    uint32_t node = rl_trace_tree_push(ctx, type, depth, RL_ID_NONE, RL_ID_NONE);
+    rl_hit hit = { INFINITY, 0.0f, 0.0f, RL_ID_NONE, RL_ID_NONE };
+    if (!rl_accel_intersect(ctx->tracer->accel, &ray, &hit))
+        return ctx->tracer->background;
+    if (node != RL_ID_NONE)
+        ctx->tree->nodes[node].object = hit.object;
+    return shade_hit(ctx, &ray, &hit, depth, weight);
+}
+
+/* Shared start of trace and shade: result zeroed, tree emptied, jitter
+ * seeded from (tracer seed, sample_id) so a sample repeats exactly. */
+static void begin(const rl_tracer *tracer, uint64_t sample_id, rl_trace_result *out, rl_ray_tree *tree,
+                  rl_trace_ctx *ctx)
+{
+    memset(out, 0, sizeof *out);
+    out->hit = (rl_hit){ INFINITY, 0.0f, 0.0f, RL_ID_NONE, RL_ID_NONE };
+    if (tree) {
+        tree->count = 0;
+        tree->truncated = false;
+    }
+    ctx->tracer = tracer;
+    ctx->rays = out->rays;
+    ctx->tree = tree;
+    rl_rng_seed(&ctx->rng, rl_hash64(tracer->seed ^ rl_hash64(sample_id)), sample_id);
+}
+
+static rl_ray_type valid_type(rl_ray_type type)
+{
+    return (unsigned)type < RL_RAY_TYPE_COUNT ? type : RL_RAY_PRIMARY;
+}
+
+void rl_tracer_trace(const rl_tracer *tracer, const rl_ray *ray, rl_ray_type type, uint64_t sample_id,
+                     rl_trace_result *out, rl_ray_tree *tree)
+{
+    if (!tracer || !ray || !out)
+        return;
+    rl_trace_ctx ctx;
+    begin(tracer, sample_id, out, tree, &ctx);
+    type = valid_type(type);
+    ctx.rays[type]++;
+    uint32_t node = rl_trace_tree_push(&ctx, type, 0, RL_ID_NONE, RL_ID_NONE);
+    rl_ray r = *ray;
+    rl_hit hit = out->hit;
+    if (!rl_accel_intersect(tracer->accel, &r, &hit)) {
+        out->color = tracer->background;
+        return;
+    }
+    if (node != RL_ID_NONE)
+        tree->nodes[node].object = hit.object;
+    out->hit = hit;
+    out->color = shade_hit(&ctx, &r, &hit, 0, 1.0f);
+}
+
+void rl_tracer_shade(const rl_tracer *tracer, const rl_ray *ray, const rl_hit *hit, rl_ray_type type,
+                     uint64_t sample_id, rl_trace_result *out, rl_ray_tree *tree)
+{
+    if (!tracer || !ray || !hit || !out)
+        return;
+    rl_trace_ctx ctx;
+    begin(tracer, sample_id, out, tree, &ctx);
+    type = valid_type(type);
+    ctx.rays[type]++;
+    /* A hit naming no triangle, or a ray with no usable direction, is a miss:
+     * there is no surface (or no viewer direction) to shade. */
+    bool usable = hit->triangle < tracer->data->num_triangles && rl_vfinite(ray->d) &&
+                  rl_length2(ray->d) > 0.0f;
+    uint32_t object = usable ? tracer->data->triangle_object[hit->triangle] : RL_ID_NONE;
+    rl_trace_tree_push(&ctx, type, 0, object, RL_ID_NONE);
+    if (!usable) {
+        out->color = tracer->background;
+        return;
+    }
+    out->hit = *hit;
+    out->hit.object = object;
+    out->color = shade_hit(&ctx, ray, &out->hit, 0, 1.0f);
+}

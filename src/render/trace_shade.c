@@ -1,0 +1,151 @@
+/* trace_shade.c: the local term of the Whitted tracer, Phong with hard
+ * shadows (Ullmann 2003, Sec. 3.1: shadow feeler r_s = p_l - v_i, eq. 3.2):
+ *     emission + ambient k_d + sum over lights, visible:
+ *                                E (k_d max(0, n.l) + k_s max(0, r.v)^n)
+ * with the same light model as the raster renderer (raster.c), so that both
+ * agree on unshadowed diffuse scenes:
+ *  - point and spot: E = colour intensity / d^2, the spot cone fading with
+ *    a smoothstep between the outer and inner half angles;
+ *  - directional: E = colour intensity from -direction, feeler unbounded;
+ *  - quad: an n x n grid of jittered points, each a small emitter of
+ *    radiance colour intensity and area A/n^2 seen under cos_light, i.e.
+ *    E_j = L A cos_light / (n^2 d^2). (raster.c approximates the same with
+ *    one point at the centre.)
+ * A feeler is traced only where it could change the result: the light
+ * reaches the point (inside the cone, on the emitting side) and lies above
+ * the shading normal. Transmissive occluders block like opaque ones: hard
+ * shadows, as the thesis' ray tracer. With a ray tree the feeler asks for the
+ * closest occluder (rl_accel_intersect) so the node names a well-defined
+ * object; without one the cheaper any-hit query (rl_accel_occluded) does. */
+#include <math.h>
+
+#include "render/trace_internal.h"
+
+#define SHADOW_T_SHRINK 1e-4f     /* stop feelers short of the light itself */
+
+static float smoothstep(float e0, float e1, float x)
+{
+    float t = rl_clampf((x - e0) / (e1 - e0), 0.0f, 1.0f);
+    return t * t * (3.0f - 2.0f * t);
+}
+
+/* Point/spot/directional: E, unit l towards the light and the feeler
+ * length (INFINITY for directional); false where the light cannot reach p. */
+static bool delta_light(const rl_light *L, rl_vec3 p, rl_vec3 *E, rl_vec3 *l, float *dist)
+{
+    rl_vec3 power = rl_scale(L->color, L->intensity);
+    if (L->type == RL_LIGHT_DIRECTIONAL) {
+        *l = rl_normalize(rl_neg(L->direction));
+        *E = power;
+        *dist = INFINITY;
+        return rl_length2(*l) > 0.0f;
+    }
+    rl_vec3 to_light = rl_sub(L->position, p);
+    float d2 = rl_length2(to_light);
+    if (!(d2 > 0.0f))
+        return false;
+    *dist = sqrtf(d2);
+    *l = rl_scale(to_light, 1.0f / *dist);
+    float falloff = 1.0f / d2;
+    if (L->type == RL_LIGHT_SPOT) {
+        float cos_axis = rl_dot(rl_neg(*l), rl_normalize(L->direction));
+        float cos_outer = cosf(rl_radians(L->spot_outer_deg));
+        float cos_inner = cosf(rl_radians(L->spot_inner_deg));
+        /* A hard cone when inner >= outer: smoothstep would divide by <= 0. */
+        falloff *= cos_inner > cos_outer ? smoothstep(cos_outer, cos_inner, cos_axis)
+                                         : (cos_axis >= cos_outer ? 1.0f : 0.0f);
+    }
+    *E = rl_scale(power, falloff);
+    return falloff > 0.0f;
+}
+
+/* Phong BRDF-times-cosine part for unit l; zero below the shading normal. */
+static rl_vec3 phong(const rl_trace_surface *s, rl_vec3 l, float n_dot_l)
+{
+    rl_vec3 term = rl_scale(s->kd, n_dot_l);
+    if (rl_vmax_comp(s->m->specular) > 0.0f) {
+        rl_vec3 r = rl_sub(rl_scale(s->ns, 2.0f * n_dot_l), l);   /* l mirrored about n */
+        float r_dot_v = rl_maxf(0.0f, rl_dot(r, s->v));
+        term = rl_add(term, rl_scale(s->m->specular, powf(r_dot_v, s->m->shininess)));
+    }
+    return term;
+}
+
+/* Traces one feeler from s towards unit l over dist; true if the light is
+ * visible. Records the shadow ray and its node (occluder or RL_ID_NONE),
+ * one level below the ray whose hit it lights, like a reflection would be. */
+static bool feeler(rl_trace_ctx *ctx, const rl_trace_surface *s, rl_vec3 l, float dist, int depth,
+                   uint32_t light)
+{
+    const rl_tracer *tr = ctx->tracer;
+    if (!tr->shadows)
+        return true;
+    ctx->rays[RL_RAY_SHADOW]++;
+    rl_ray ray = { rl_trace_offset(tr, s, l), 0.0f, l, isinf(dist) ? INFINITY : dist * (1.0f - SHADOW_T_SHRINK) };
+    if (!ctx->tree)
+        return !rl_accel_occluded(tr->accel, &ray);
+    rl_hit hit = { INFINITY, 0.0f, 0.0f, RL_ID_NONE, RL_ID_NONE };
+    bool blocked = rl_accel_intersect(tr->accel, &ray, &hit);
+    rl_trace_tree_push(ctx, RL_RAY_SHADOW, depth + 1, blocked ? hit.object : RL_ID_NONE, light);
+    return !blocked;
+}
+
+/* Quad light (n x n jittered grid): summed E_j * phong of the visible samples. */
+static rl_vec3 quad_light(rl_trace_ctx *ctx, const rl_trace_surface *s, const rl_light *L, int depth,
+                          uint32_t index)
+{
+    rl_vec3 sum = rl_v3s(0.0f);
+    rl_vec3 normal = rl_cross(L->edge_u, L->edge_v);
+    float area = rl_length(normal);
+    if (!(area > 0.0f))
+        return sum;
+    normal = rl_scale(normal, 1.0f / area);
+    int n = ctx->tracer->area_samples;
+    rl_vec3 radiance = rl_scale(L->color, L->intensity * area / (float)(n * n));
+    for (int j = 0; j < n; ++j) {
+        for (int i = 0; i < n; ++i) {
+            /* Draw both numbers first so the sequence does not depend on
+             * which samples are skipped. */
+            float xi_u = rl_rng_float(&ctx->rng), xi_v = rl_rng_float(&ctx->rng);
+            rl_vec3 q = rl_add(L->position, rl_add(rl_scale(L->edge_u, ((float)i + xi_u) / (float)n),
+                                                   rl_scale(L->edge_v, ((float)j + xi_v) / (float)n)));
+            rl_vec3 to_light = rl_sub(q, s->p);
+            float d2 = rl_length2(to_light);
+            if (!(d2 > 0.0f))
+                continue;
+            float dist = sqrtf(d2);
+            rl_vec3 l = rl_scale(to_light, 1.0f / dist);
+            float cos_light = -rl_dot(normal, l);
+            float n_dot_l = rl_dot(s->ns, l);
+            if (cos_light <= 0.0f || n_dot_l <= 0.0f)
+                continue;
+            if (!feeler(ctx, s, l, dist, depth, index))
+                continue;
+            rl_vec3 E = rl_scale(radiance, cos_light / d2);
+            sum = rl_add(sum, rl_mul(phong(s, l, n_dot_l), E));
+        }
+    }
+    return sum;
+}
+
+rl_vec3 rl_trace_local(rl_trace_ctx *ctx, const rl_trace_surface *s, int depth)
+{
+    const rl_scene_data *data = ctx->tracer->data;
+    rl_vec3 c = rl_add(s->m->emission, rl_scale(s->kd, ctx->tracer->ambient));
+    for (uint32_t i = 0; i < data->num_lights; ++i) {
+        const rl_light *L = &data->lights[i];
+        if (L->type == RL_LIGHT_QUAD) {
+            c = rl_add(c, quad_light(ctx, s, L, depth, i));
+            continue;
+        }
+        rl_vec3 E, l;
+        float dist;
+        if (!delta_light(L, s->p, &E, &l, &dist))
+            continue;
+        float n_dot_l = rl_dot(s->ns, l);
+        if (n_dot_l <= 0.0f || !feeler(ctx, s, l, dist, depth, i))
+            continue;
+        c = rl_add(c, rl_mul(phong(s, l, n_dot_l), E));
+    }
+    return c;
+}
