@@ -94,10 +94,11 @@ bool rl_cli_write_json(const cJSON *item, const char *path)
 void rl_cli_print_summary(FILE *out, const char *algo, const char *scene, int width,
                           int height, const rl_render_stats *stats)
 {
-    fprintf(out, "%s %dx%d %s: %.1f ms, %llu triangles rasterized, %llu pixels written", algo,
-            width, height, scene, stats->time_ms,
-            (unsigned long long)stats->triangles_rasterized,
-            (unsigned long long)stats->pixels_written);
+    fprintf(out, "%s %dx%d %s: %.1f ms", algo, width, height, scene, stats->time_ms);
+    /* Rasterization counts only for the algorithms that rasterize. */
+    if (stats->triangles_rasterized)
+        fprintf(out, ", %llu triangles rasterized", (unsigned long long)stats->triangles_rasterized);
+    fprintf(out, ", %llu pixels written", (unsigned long long)stats->pixels_written);
     /* Ray counts only for the algorithms that trace any. */
     for (int t = 0; t < RL_RAY_TYPE_COUNT; t++)
         if (stats->rays[t])

@@ -59,9 +59,10 @@ static void put_cell(FILE *f, const cJSON *e)
     put_escaped(f, str(e, "file"));
     fputs("\" alt=\"", f);
     put_escaped(f, str(e, "file"));
-    fprintf(f, "\"></a><br>%.1f ms &middot; %.0f triangles rasterized &middot; "
-               "%.0f pixels written",
-            num(rs, "time_ms"), num(rs, "triangles_rasterized"), num(rs, "pixels_written"));
+    fprintf(f, "\"></a><br>%.1f ms", num(rs, "time_ms"));
+    if (num(rs, "triangles_rasterized") > 0)
+        fprintf(f, " &middot; %.0f triangles rasterized", num(rs, "triangles_rasterized"));
+    fprintf(f, " &middot; %.0f pixels written", num(rs, "pixels_written"));
     if (num(rs, "rays_total") > 0)
         fprintf(f, " &middot; %.0f rays", num(rs, "rays_total"));
     double lights = num(ss, "lights");

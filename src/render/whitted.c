@@ -317,7 +317,8 @@ static rl_status whitted_render(rl_renderer *r, void *state, const rl_scene *sce
         for (int k = 0; k < RL_RAY_TYPE_COUNT; ++k)
             stats->rays[k] += tile_rays[t][k];
     free(tile_rays);
-    stats->samples = (uint64_t)image->width * (uint64_t)image->height * (uint64_t)(f.ss * f.ss);
+    stats->pixels_written = (uint64_t)image->width * (uint64_t)image->height;
+    stats->samples = stats->pixels_written * (uint64_t)(f.ss * f.ss);
     return RL_OK;
 }
 

@@ -126,6 +126,7 @@ static void test_supersampling_traces_ss_squared_primary_rays_per_pixel(void **s
     assert_int_equal(st1.rays[RL_RAY_PRIMARY], 24 * 24);
     assert_int_equal(st2.rays[RL_RAY_PRIMARY], 4 * 24 * 24);
     assert_int_equal(st2.samples, 4 * 24 * 24);
+    assert_int_equal(st2.pixels_written, 24 * 24);
     assert_true(st2.rays[RL_RAY_SHADOW] > 3 * st1.rays[RL_RAY_SHADOW]);
     /* Antialiased, not a copy: some silhouette pixel changes colour. */
     assert_memory_not_equal(a->color, b->color, (size_t)24 * 24 * sizeof *a->color);
