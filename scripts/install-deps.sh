@@ -12,6 +12,7 @@ PACKAGES=(
   libassimp-dev       # OBJ, PLY, STL, glTF, DAE, 3DS, FBX import
   libembree-dev       # Embree 3: reference accelerator and benchmark anchor
   libcmocka-dev       # unit tests
+  assimp-testmodels   # real meshes for rl bench rays
 )
 
 missing=()

@@ -20,6 +20,7 @@ static const command commands[] = {
     { "info", rl_cli_info, "print statistics and cameras of a scene" },
     { "render", rl_cli_render, "render a scene to PNG or EXR" },
     { "demo", rl_cli_demo, "render every built-in scene with every renderer + HTML report" },
+    { "bench", rl_cli_bench, "time the accelerators on standard ray workloads (bench rays)" },
 };
 
 static void print_usage(FILE *out)
@@ -73,7 +74,7 @@ int main(int argc, char **argv)
 
     if (n == 0)
         return rl_cli_fail(RL_CLI_USAGE, "no command given (commands: scenes, algos, info, "
-                                         "render, demo; see rl --help)");
+                                         "render, demo, bench; see rl --help)");
     const char *name = argv[0];
     if (strcmp(name, "help") == 0 && n > 1) {
         /* "rl help render" is "rl render --help". */

@@ -1,0 +1,228 @@
+/* bench_report.c: the JSON record of one `rl bench rays` run.
+ *
+ * A benchmark figure means little without the machine it ran on and the
+ * ratio to a reference measured in the same run (machines, loads and
+ * compilers change), so the record carries uname, the CPU model, the core
+ * and thread counts, the date, the renderlab version and every parameter,
+ * then per scene, accelerator and workload: rays, hits, seconds, Mrays/s and
+ * the ratio to Embree. Unknown values are JSON null, never made up. */
+#define _POSIX_C_SOURCE 200809L
+#include "bench_rays.h"
+#include "cli.h"
+
+#include <cjson/cJSON.h>
+#include <math.h>
+#include <omp.h>
+#include <string.h>
+#include <sys/utsname.h>
+#include <time.h>
+
+/* "model name : AMD EPYC ..." from /proc/cpuinfo; "unknown" elsewhere. */
+static void cpu_model(char *out, size_t size)
+{
+    snprintf(out, size, "unknown");
+    FILE *f = fopen("/proc/cpuinfo", "r");
+    if (!f)
+        return;
+    char line[512];
+    while (fgets(line, sizeof line, f)) {
+        const char *colon = strchr(line, ':');
+        if (strncmp(line, "model name", 10) == 0 && colon) {
+            colon++;
+            while (*colon == ' ' || *colon == '\t')
+                colon++;
+            snprintf(out, size, "%s", colon);
+            out[strcspn(out, "\r\n")] = '\0';
+            break;
+        }
+    }
+    fclose(f);
+}
+
+/* Adds a number, or null for NaN (JSON has no NaN). */
+static void add_number(cJSON *obj, const char *key, double value)
+{
+    if (isfinite(value))
+        cJSON_AddNumberToObject(obj, key, value);
+    else
+        cJSON_AddNullToObject(obj, key);
+}
+
+/* "0.52 0.58 0.59" from /proc/loadavg: other work on the machine skews
+ * the figures, so the record says how busy it was. */
+static void load_average(char *out, size_t size)
+{
+    snprintf(out, size, "unknown");
+    FILE *f = fopen("/proc/loadavg", "r");
+    if (!f)
+        return;
+    double l1, l5, l15;
+    if (fscanf(f, "%lf %lf %lf", &l1, &l5, &l15) == 3)
+        snprintf(out, size, "%.2f %.2f %.2f", l1, l5, l15);
+    fclose(f);
+}
+
+static cJSON *machine_json(int threads)
+{
+    cJSON *m = cJSON_CreateObject();
+    if (!m)
+        return NULL;
+    struct utsname u;
+    char text[sizeof u.sysname + sizeof u.release + sizeof u.version + sizeof u.machine + 8];
+    if (uname(&u) == 0) {
+        snprintf(text, sizeof text, "%s %s %s %s", u.sysname, u.release, u.version, u.machine);
+        cJSON_AddStringToObject(m, "uname", text);
+    } else {
+        cJSON_AddNullToObject(m, "uname");
+    }
+    char cpu[256];
+    cpu_model(cpu, sizeof cpu);
+    cJSON_AddStringToObject(m, "cpu", cpu);
+    cJSON_AddNumberToObject(m, "nproc", omp_get_num_procs());
+    cJSON_AddNumberToObject(m, "threads", threads);
+    char load[64];
+    load_average(load, sizeof load);
+    cJSON_AddStringToObject(m, "loadavg_at_end", load);
+    return m;
+}
+
+static cJSON *params_json(const rl_bench_params *p)
+{
+    cJSON *o = cJSON_CreateObject();
+    if (!o)
+        return NULL;
+    char size[32];
+    snprintf(size, sizeof size, "%dx%d", p->width, p->height);
+    cJSON_AddStringToObject(o, "size", size);
+    if (p->rays > 0)
+        cJSON_AddNumberToObject(o, "rays", (double)p->rays);
+    else
+        cJSON_AddNullToObject(o, "rays");
+    cJSON_AddNumberToObject(o, "threads", p->threads);
+    cJSON_AddBoolToObject(o, "quick", p->quick);
+    cJSON_AddNumberToObject(o, "min_runs", p->min_runs);
+    cJSON_AddNumberToObject(o, "max_runs", p->max_runs);
+    cJSON_AddNumberToObject(o, "min_total_s", p->min_total_s);
+    cJSON_AddNumberToObject(o, "seed", (double)p->seed);
+    cJSON_AddStringToObject(o, "tile_order", "8x8 tiles, scanline");
+    cJSON_AddStringToObject(o, "timing", "per workload: a warm-up pass per accel, then timed "
+                                         "passes interleaved across accels, at least min_runs "
+                                         "and min_total_s per accel (at most max_runs); seconds: "
+                                         "fastest pass, wall clock; cpu_seconds: least CPU time "
+                                         "of the tracing threads");
+    return o;
+}
+
+static cJSON *stats_json(const rl_accel_stats *s)
+{
+    cJSON *o = cJSON_CreateObject();
+    if (!o)
+        return NULL;
+    cJSON_AddNumberToObject(o, "build_ms", s->build_ms);
+    cJSON_AddNumberToObject(o, "memory_bytes", (double)s->memory_bytes);
+    cJSON_AddNumberToObject(o, "bytes_per_triangle", s->bytes_per_triangle);
+    if (s->kind == RL_ACCEL_BVH) {
+        cJSON_AddNumberToObject(o, "nodes", s->nodes);
+        cJSON_AddNumberToObject(o, "leaves", s->leaves);
+        cJSON_AddNumberToObject(o, "max_depth", s->max_depth);
+        cJSON_AddNumberToObject(o, "sah_cost", s->sah_cost);
+    } else if (s->kind == RL_ACCEL_GRID) {
+        cJSON_AddItemToObject(o, "grid_res", cJSON_CreateIntArray(s->grid_res, 3));
+        cJSON_AddNumberToObject(o, "grid_references", (double)s->grid_references);
+    }
+    return o;
+}
+
+static cJSON *accel_json(const rl_bench_scene_result *sc, const rl_bench_accel_result *a)
+{
+    cJSON *o = cJSON_CreateObject();
+    if (!o)
+        return NULL;
+    cJSON_AddStringToObject(o, "accel", rl_accel_kind_name(a->kind));
+    cJSON_AddStringToObject(o, "status", a->status);
+    if (strcmp(a->status, "ok") != 0) {
+        cJSON_AddStringToObject(o, "reason", a->reason);
+        return o;
+    }
+    cJSON_AddItemToObject(o, "build", stats_json(&a->stats));
+    cJSON *work = cJSON_AddObjectToObject(o, "workloads");
+    for (int w = 0; work && w < RL_BENCH_WORKLOADS; w++) {
+        const rl_bench_timing *t = &a->timing[w];
+        cJSON *wj = cJSON_AddObjectToObject(work, rl_bench_workload_name(w));
+        if (!wj)
+            break;
+        cJSON_AddNumberToObject(wj, "rays", (double)sc->rays[w]);
+        cJSON_AddNumberToObject(wj, "hits", (double)t->hits);
+        add_number(wj, "seconds", sc->rays[w] ? t->best_s : NAN);
+        cJSON_AddNumberToObject(wj, "runs", t->runs);
+        add_number(wj, "mrays_per_s", a->mrays_per_s[w]);
+        add_number(wj, "ratio_to_embree", a->ratio_to_embree[w]);
+        add_number(wj, "cpu_seconds", sc->rays[w] ? t->best_cpu_s : NAN);
+        add_number(wj, "mrays_per_cpu_s", a->mrays_per_cpu_s[w]);
+        add_number(wj, "cpu_ratio_to_embree", a->cpu_ratio_to_embree[w]);
+        cJSON_AddBoolToObject(wj, "hits_agree", sc->hits_agree[w]);
+        cJSON_AddBoolToObject(wj, "deterministic", t->deterministic);
+    }
+    return o;
+}
+
+static cJSON *scene_json(const rl_bench_scene_result *sc)
+{
+    cJSON *o = cJSON_CreateObject();
+    if (!o)
+        return NULL;
+    cJSON_AddStringToObject(o, "scene", sc->arg);
+    cJSON_AddStringToObject(o, "name", sc->label);
+    cJSON_AddStringToObject(o, "status", sc->status);
+    if (strcmp(sc->status, "ok") != 0) {
+        cJSON_AddStringToObject(o, "reason", sc->reason);
+        return o;
+    }
+    cJSON_AddNumberToObject(o, "triangles", (double)sc->triangles);
+    char size[32];
+    snprintf(size, sizeof size, "%dx%d", sc->width, sc->height);
+    cJSON_AddStringToObject(o, "size", size);
+    cJSON *rays = cJSON_AddObjectToObject(o, "rays");
+    bool agree = true;
+    for (int w = 0; rays && w < RL_BENCH_WORKLOADS; w++) {
+        cJSON_AddNumberToObject(rays, rl_bench_workload_name(w), (double)sc->rays[w]);
+        agree = agree && sc->hits_agree[w];
+    }
+    cJSON_AddBoolToObject(o, "hits_agree", agree);
+    cJSON *accels = cJSON_AddArrayToObject(o, "accels");
+    for (int i = 0; accels && i < sc->num_accels; i++)
+        cJSON_AddItemToArray(accels, accel_json(sc, &sc->accels[i]));
+    return o;
+}
+
+cJSON *rl_bench_report_json(const rl_bench_params *params, const rl_bench_scene_result *scenes,
+                            int num_scenes, int hit_mismatches)
+{
+    cJSON *root = cJSON_CreateObject();
+    if (!root)
+        return NULL;
+    cJSON_AddStringToObject(root, "benchmark", "rays");
+    cJSON_AddStringToObject(root, "renderlab_version", RL_CLI_VERSION);
+    char date[32];
+    time_t now = time(NULL);
+    struct tm utc;
+    if (gmtime_r(&now, &utc) && strftime(date, sizeof date, "%Y-%m-%dT%H:%M:%SZ", &utc))
+        cJSON_AddStringToObject(root, "date", date);
+    else
+        cJSON_AddNullToObject(root, "date");
+    cJSON_AddBoolToObject(root, "embree", rl_accel_kind_available(RL_ACCEL_EMBREE));
+    cJSON_AddItemToObject(root, "machine", machine_json(params->threads));
+    cJSON_AddItemToObject(root, "parameters", params_json(params));
+    cJSON_AddNumberToObject(root, "hit_mismatches", hit_mismatches);
+    cJSON *list = cJSON_AddArrayToObject(root, "scenes");
+    for (int i = 0; list && i < num_scenes; i++)
+        cJSON_AddItemToArray(list, scene_json(&scenes[i]));
+    /* cJSON drops items it could not allocate silently; a record with holes
+     * must not pass for a complete one. */
+    if (!list || !cJSON_GetObjectItem(root, "machine") || !cJSON_GetObjectItem(root, "parameters")
+        || cJSON_GetArraySize(list) != num_scenes) {
+        cJSON_Delete(root);
+        return NULL;
+    }
+    return root;
+}
