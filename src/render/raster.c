@@ -32,6 +32,7 @@
 #endif
 
 #include "core/error.h"
+#include "render/light_eval.h"
 #include "render/renderer.h"
 #include "rl/rl_raster.h"
 
@@ -56,49 +57,27 @@ typedef struct shade_ctx {
     float ambient;
 } shade_ctx;
 
-static float smoothstep(float e0, float e1, float x)
-{
-    float t = rl_clampf((x - e0) / (e1 - e0), 0.0f, 1.0f);
-    return t * t * (3.0f - 2.0f * t);
-}
-
 /* Irradiance-like scale E of light L at p and the unit direction l towards
  * it; returns false where the light does not reach p. */
 static bool light_at(const rl_light *L, rl_vec3 p, rl_vec3 *E, rl_vec3 *l)
 {
-    rl_vec3 power = rl_scale(L->color, L->intensity);
-    if (L->type == RL_LIGHT_DIRECTIONAL) {
-        *l = rl_normalize(rl_neg(L->direction));
-        *E = power;
-        return rl_length2(*l) > 0.0f;
-    }
-
-    rl_vec3 pos = L->position;
-    if (L->type == RL_LIGHT_QUAD) {
-        rl_vec3 normal = rl_cross(L->edge_u, L->edge_v);
-        float area = rl_length(normal);
-        pos = rl_add(pos, rl_scale(rl_add(L->edge_u, L->edge_v), 0.5f));
-        rl_vec3 to_p = rl_normalize(rl_sub(p, pos));
-        /* Emitting side only, and foreshortened like a small area light. */
-        float cos_light = area > 0.0f ? rl_dot(rl_scale(normal, 1.0f / area), to_p) : 0.0f;
-        power = rl_scale(power, area * rl_maxf(0.0f, cos_light));
-    }
+    float dist;
+    if (L->type != RL_LIGHT_QUAD)
+        return rl_light_eval_delta(L, p, E, l, &dist);
+    /* A quad light as one point at its centre, emitting side only and
+     * foreshortened like a small area light: power·area·cos_light / d². */
+    rl_vec3 normal = rl_cross(L->edge_u, L->edge_v);
+    float area = rl_length(normal);
+    rl_vec3 pos = rl_add(L->position, rl_scale(rl_add(L->edge_u, L->edge_v), 0.5f));
     rl_vec3 to_light = rl_sub(pos, p);
     float d2 = rl_length2(to_light);
-    if (!(d2 > 0.0f))
+    if (!(d2 > 0.0f) || !(area > 0.0f))
         return false;
     *l = rl_scale(to_light, 1.0f / sqrtf(d2));
-    float falloff = 1.0f / d2;
-    if (L->type == RL_LIGHT_SPOT) {
-        float cos_axis = rl_dot(rl_neg(*l), rl_normalize(L->direction));
-        float cos_outer = cosf(rl_radians(L->spot_outer_deg));
-        float cos_inner = cosf(rl_radians(L->spot_inner_deg));
-        /* A hard cone when inner >= outer: smoothstep would divide by <= 0. */
-        falloff *= cos_inner > cos_outer ? smoothstep(cos_outer, cos_inner, cos_axis)
-                                         : (cos_axis >= cos_outer ? 1.0f : 0.0f);
-    }
-    *E = rl_scale(power, falloff);
-    return falloff > 0.0f;
+    float cos_light = rl_dot(rl_scale(normal, 1.0f / area), rl_neg(*l));
+    rl_vec3 power = rl_scale(rl_scale(L->color, L->intensity), area * rl_maxf(0.0f, cos_light));
+    *E = rl_scale(power, 1.0f / d2);
+    return cos_light > 0.0f;
 }
 
 /* Local Phong colour at p with shading normal n (Ullmann 2003, eq. 3.1

@@ -19,45 +19,10 @@
  * object; without one the cheaper any-hit query (rl_accel_occluded) does. */
 #include <math.h>
 
+#include "render/light_eval.h"
 #include "render/trace_internal.h"
 
 #define SHADOW_T_SHRINK 1e-4f     /* stop feelers short of the light itself */
-
-static float smoothstep(float e0, float e1, float x)
-{
-    float t = rl_clampf((x - e0) / (e1 - e0), 0.0f, 1.0f);
-    return t * t * (3.0f - 2.0f * t);
-}
-
-/* Point/spot/directional: E, unit l towards the light and the feeler
- * length (INFINITY for directional); false where the light cannot reach p. */
-static bool delta_light(const rl_light *L, rl_vec3 p, rl_vec3 *E, rl_vec3 *l, float *dist)
-{
-    rl_vec3 power = rl_scale(L->color, L->intensity);
-    if (L->type == RL_LIGHT_DIRECTIONAL) {
-        *l = rl_normalize(rl_neg(L->direction));
-        *E = power;
-        *dist = INFINITY;
-        return rl_length2(*l) > 0.0f;
-    }
-    rl_vec3 to_light = rl_sub(L->position, p);
-    float d2 = rl_length2(to_light);
-    if (!(d2 > 0.0f))
-        return false;
-    *dist = sqrtf(d2);
-    *l = rl_scale(to_light, 1.0f / *dist);
-    float falloff = 1.0f / d2;
-    if (L->type == RL_LIGHT_SPOT) {
-        float cos_axis = rl_dot(rl_neg(*l), rl_normalize(L->direction));
-        float cos_outer = cosf(rl_radians(L->spot_outer_deg));
-        float cos_inner = cosf(rl_radians(L->spot_inner_deg));
-        /* A hard cone when inner >= outer: smoothstep would divide by <= 0. */
-        falloff *= cos_inner > cos_outer ? smoothstep(cos_outer, cos_inner, cos_axis)
-                                         : (cos_axis >= cos_outer ? 1.0f : 0.0f);
-    }
-    *E = rl_scale(power, falloff);
-    return falloff > 0.0f;
-}
 
 /* Phong BRDF-times-cosine part for unit l; zero below the shading normal. */
 static rl_vec3 phong(const rl_trace_surface *s, rl_vec3 l, float n_dot_l)
@@ -140,7 +105,7 @@ rl_vec3 rl_trace_local(rl_trace_ctx *ctx, const rl_trace_surface *s, int depth)
         }
         rl_vec3 E, l;
         float dist;
-        if (!delta_light(L, s->p, &E, &l, &dist))
+        if (!rl_light_eval_delta(L, s->p, &E, &l, &dist))
             continue;
         float n_dot_l = rl_dot(s->ns, l);
         if (n_dot_l <= 0.0f || !feeler(ctx, s, l, dist, depth, i))
