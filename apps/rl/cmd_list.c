@@ -11,6 +11,7 @@ static const char *option_type_name(rl_option_type t)
     case RL_OPT_BOOL: return "bool";
     case RL_OPT_ENUM: return "enum";
     case RL_OPT_STRING: return "string";
+    case RL_OPT_COLOR: return "color";
     }
     return "?";
 }

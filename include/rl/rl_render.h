@@ -5,7 +5,7 @@
  * validated key/value options, and run as
  *     render(scene, camera, image, stats)
  * so that the evaluator can time and compare any of them. Options are typed
- * (int, float, bool, enum, string) and checked on rl_renderer_set(); unknown
+ * (int, float, bool, enum, string, colour) and checked on rl_renderer_set(); unknown
  * keys and malformed values fail with RL_ERR_INVALID_ARG and a message that
  * lists what is accepted. */
 #ifndef RL_RENDER_H
@@ -39,7 +39,8 @@ typedef struct rl_render_stats {
 } rl_render_stats;
 
 typedef enum rl_option_type {
-    RL_OPT_INT, RL_OPT_FLOAT, RL_OPT_BOOL, RL_OPT_ENUM, RL_OPT_STRING
+    RL_OPT_INT, RL_OPT_FLOAT, RL_OPT_BOOL, RL_OPT_ENUM, RL_OPT_STRING,
+    RL_OPT_COLOR                          /* "r,g,b" or one grey value, finite, >= 0 */
 } rl_option_type;
 
 typedef struct rl_option_info {

@@ -228,6 +228,14 @@ static rl_status validate(const rl_renderer *r, const rl_option_info *o, const c
     }
     case RL_OPT_STRING:
         return RL_OK;
+    case RL_OPT_COLOR: {
+        rl_vec3 c;
+        if (rl_renderer_parse_color(value, &c))
+            return RL_OK;
+        return rl_error(RL_ERR_INVALID_ARG,
+                        "%s: option %s=\"%s\" is not a colour (\"r,g,b\" or one value, >= 0)",
+                        name, o->key, value);
+    }
     }
     return rl_error(RL_ERR_INTERNAL, "%s: option %s has an unknown type", name, o->key);
 }

@@ -35,7 +35,7 @@ double rl_renderer_opt_float(const rl_renderer *r, const char *key);
 bool rl_renderer_opt_bool(const rl_renderer *r, const char *key);
 int rl_renderer_opt_enum(const rl_renderer *r, const char *key);   /* choice index */
 const char *rl_renderer_opt_string(const rl_renderer *r, const char *key);
-/* Colours in string options: "r,g,b" or a single grey value, finite and >= 0.
+/* RL_OPT_COLOR values: "r,g,b" or a single grey value, finite and >= 0.
  * rl_renderer_parse_color() only parses (no error recorded); the option read
  * returns black for a value that does not parse. */
 bool rl_renderer_parse_color(const char *text, rl_vec3 *out);

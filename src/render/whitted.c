@@ -47,7 +47,7 @@ static const rl_option_info whitted_options[] = {
     { "area_samples", RL_OPT_INT, "4", "n x n jittered shadow feelers per quad light", 1, 32, NULL },
     { "shadows", RL_OPT_BOOL, "true", "trace shadow feelers (false: every light is visible)", 0, 0, NULL },
     { "ambient", RL_OPT_FLOAT, "0.05", "ambient light, multiplied by k_d", 0, 1, NULL },
-    { "background", RL_OPT_STRING, "0,0,0", "radiance of rays that leave the scene: \"r,g,b\" or one grey value",
+    { "background", RL_OPT_COLOR, "0,0,0", "radiance of rays that leave the scene: \"r,g,b\" or one grey value",
       0, 0, NULL },
     { "threads", RL_OPT_INT, "0", "OpenMP threads (0 = all)", 0, 1024, NULL },
     { "ray_trees", RL_OPT_BOOL, "false", "keep every pixel's centre-sample ray tree (for tests and Vertex Tracing)",
@@ -96,11 +96,6 @@ rl_status rl_whitted_pixel_tree(const rl_renderer *r, int x, int y, rl_ray_tree 
 
 static rl_status whitted_check(const char *key, const char *value)
 {
-    rl_vec3 c;
-    if (strcmp(key, "background") == 0 && !rl_renderer_parse_color(value, &c))
-        return rl_error(RL_ERR_INVALID_ARG,
-                        "whitted: option background=\"%s\" is not a colour (\"r,g,b\" or one value, >= 0)",
-                        value);
     if (strcmp(key, "accel") == 0 && strcmp(value, "embree") == 0 &&
         !rl_accel_kind_available(RL_ACCEL_EMBREE))
         return rl_error(RL_ERR_INVALID_ARG,
