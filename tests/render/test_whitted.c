@@ -304,6 +304,26 @@ static bool cancel_midway(void *user, double done)
     return done < 0.5;
 }
 
+static void test_a_view_of_nothing_renders_the_background(void **state)
+{
+    (void)state;
+    rl_camera cam;
+    rl_scene *s = cornell(&cam);
+    /* Turn round: the box is behind the eye, nothing is in view. */
+    cam.target = rl_add(cam.eye, rl_sub(cam.eye, cam.target));
+    rl_render_stats st;
+    rl_image *img = render("whitted", s, &cam, (const char *const[]){ "background", "0.25,0.5,0.75", NULL }, &st);
+    for (int i = 0; i < SIZE * SIZE; ++i) {
+        assert_true(img->color[i].x == 0.25f && img->color[i].y == 0.5f && img->color[i].z == 0.75f);
+        assert_int_equal(img->object_id[i], RL_ID_NONE);
+        assert_true(isinf(img->depth[i]));
+    }
+    assert_int_equal(st.rays[RL_RAY_PRIMARY], SIZE * SIZE);
+    assert_int_equal(st.rays[RL_RAY_SHADOW] + st.rays[RL_RAY_REFLECTION] + st.rays[RL_RAY_REFRACTION], 0);
+    rl_image_release(img);
+    rl_scene_release(s);
+}
+
 static void test_progress_callback_can_cancel_the_frame(void **state)
 {
     (void)state;
@@ -333,6 +353,7 @@ int main(void)
         cmocka_unit_test(test_max_depth_zero_traces_no_secondary_rays),
         cmocka_unit_test(test_pixel_trees_are_kept_on_request_and_match_the_ids),
         cmocka_unit_test(test_cached_accel_follows_scene_and_kind_changes),
+        cmocka_unit_test(test_a_view_of_nothing_renders_the_background),
         cmocka_unit_test(test_progress_callback_can_cancel_the_frame),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
