@@ -40,7 +40,7 @@ typedef enum rl_accel_kind {
 typedef struct rl_accel_desc {                      /* zero = default */
     rl_accel_kind kind;
     int threads;              /* build threads; 0 -> all */
-    int bvh_leaf_size;        /* max triangles per leaf; 0 -> 4 */
+    int bvh_leaf_size;        /* max triangles per leaf; 0 -> 2 */
     int bvh_bins;             /* SAH bins per axis; 0 -> 16 */
     float grid_lambda;        /* grid density λ: cells per axis ≈ λ·∛N scaled to
                                * the box's aspect; 0 -> 2 */

@@ -1,11 +1,11 @@
 /* bvh.c: RL_ACCEL_BVH, the binned SAH BVH behind the rl_accel interface.
  *
- * Build: bvh_build.c (binary, Wald 2007), collapsed to 4 wide by
- * bvh_wide.c; traversal: bvh_wide_traverse.c; watertight triangle test:
- * watertight.h (Woop et al. 2013). The wide tree measured about 2x the
- * binary traversal's throughput on incoherent rays (city, teapot), so the
- * binary tree is only build scaffolding. This file adapts them to
- * rl_accel_class. */
+ * Build: bvh_build.c (binary, Wald 2007), collapsed to RL_BVH_WIDTH (8
+ * with AVX, else 4) wide by bvh_wide.c; traversal: bvh_wide_traverse.c;
+ * watertight triangle test: watertight.h (Woop et al. 2013). The wide
+ * tree measured about 2x the binary traversal's throughput on incoherent
+ * rays (city, teapot), so the binary tree is only build scaffolding. This
+ * file adapts them to rl_accel_class. */
 #include <stdlib.h>
 
 #include "accel/bvh.h"

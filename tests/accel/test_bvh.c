@@ -14,6 +14,7 @@
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
+#include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -230,11 +231,14 @@ static bool box_contains_point(const rl_bvh_node *n, rl_vec3 p)
 }
 
 /* The wide collapse: every wide node is reached once, every binary leaf
- * appears once with its triangle range, unused lanes are inverted boxes. */
+ * appears once with its triangle range, unused lanes are inverted boxes,
+ * and the nodes start on a cache line. */
 static void assert_wide_tree_holds_the_same_leaves(rl_bvh *bvh, uint32_t leaves)
 {
     assert_int_equal(rl_bvh_widen(bvh), RL_OK);
     assert_true(bvh->num_wide >= 1 && bvh->num_wide <= bvh->num_nodes / 2 + 1);
+    /* Cache-line aligned: a node touches exactly sizeof / 64 lines. */
+    assert_int_equal((uintptr_t)bvh->wide % 64, 0);
     uint32_t *reached = calloc(bvh->num_wide, sizeof *reached);
     uint32_t *covered = calloc(bvh->num_tris, sizeof *covered);
     assert_true(reached && covered);
