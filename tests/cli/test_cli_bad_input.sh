@@ -4,25 +4,8 @@
 # vertices are dropped with a warning instead.
 # Run as: bash test_cli_bad_input.sh <rl-binary> <scratch-dir>
 set -u
-RL=$1
-TMP=$2
-rm -rf "$TMP"
-mkdir -p "$TMP"
+. "$(dirname "${BASH_SOURCE[0]}")/lib.bash"
 
-fail() { echo "FAIL: $*" >&2; exit 1; }
-expect_exit() {
-    local want=$1; shift
-    "$@" >"$TMP/out" 2>"$TMP/err"
-    local got=$?
-    [ "$got" -eq "$want" ] || fail "'$*' exited $got, expected $want; stderr: $(head -c 400 "$TMP/err")"
-}
-# expect_error CODE TEXT CMD...: exit CODE, one error line, containing TEXT.
-expect_error() {
-    local code=$1 text=$2; shift 2
-    expect_exit "$code" "$@"
-    [ "$(grep -c '^rl: error: ' "$TMP/err")" -eq 1 ] || fail "'$*' should print one error line, got: $(cat "$TMP/err")"
-    grep '^rl: error: ' "$TMP/err" | grep -q -- "$text" || fail "'$*': error line lacks '$text': $(cat "$TMP/err")"
-}
 OUT="$TMP/x.png"
 
 # Missing file: the error names it.

@@ -6,23 +6,8 @@
 # output 1. Keeps the benchmark from rotting; it measures nothing.
 # Run as: bash test_cli_bench.sh <rl-binary> <scratch-dir>
 set -u
-RL=$1
-TMP=$2
-rm -rf "$TMP"
-mkdir -p "$TMP"
+. "$(dirname "${BASH_SOURCE[0]}")/lib.bash"
 
-fail() { echo "FAIL: $*" >&2; exit 1; }
-expect_exit() {
-    local want=$1; shift
-    "$@" >"$TMP/out" 2>"$TMP/err"
-    local got=$?
-    [ "$got" -eq "$want" ] || fail "'$*' exited $got, expected $want; stderr: $(head -c 400 "$TMP/err")"
-}
-expect_usage_error() {
-    expect_exit 2 "$@"
-    [ "$(grep -c '^rl: error: ' "$TMP/err")" -eq 1 ] || fail "'$*' should print one error line, got: $(cat "$TMP/err")"
-}
-expect_in() { grep -q -- "$2" "$1" || fail "$1 lacks '$2': $(head -c 400 "$1")"; }
 have_python() { command -v python3 >/dev/null 2>&1 && python3 -c 'import json' 2>/dev/null; }
 
 # The quick run: table on stdout, JSON where --out says.

@@ -4,12 +4,8 @@
 # `make demo` renders them all.
 # Run as: bash test_cli_demo.sh <rl-binary> <scratch-dir>
 set -u
-RL=$1
-TMP=$2
-rm -rf "$TMP"
-mkdir -p "$TMP"
+. "$(dirname "${BASH_SOURCE[0]}")/lib.bash"
 
-fail() { echo "FAIL: $*" >&2; exit 1; }
 DIR="$TMP/demo/nested"   # does not exist yet: rl demo creates it
 SCENES="cornell,cornell-teapot,spheres"
 

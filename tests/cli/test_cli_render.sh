@@ -4,16 +4,8 @@
 # options, and rl info reports the Cornell box's 36 triangles.
 # Run as: bash test_cli_render.sh <rl-binary> <scratch-dir>
 set -u
-RL=$1
-TMP=$2
-rm -rf "$TMP"
-mkdir -p "$TMP"
+. "$(dirname "${BASH_SOURCE[0]}")/lib.bash"
 
-fail() { echo "FAIL: $*" >&2; exit 1; }
-run_ok() {
-    "$@" >"$TMP/out" 2>"$TMP/err" || fail "'$*' exited $?; stderr: $(head -c 400 "$TMP/err")"
-}
-expect_in() { grep -q -- "$2" "$1" || fail "$1 lacks '$2': $(head -c 400 "$1")"; }
 # png_size FILE: "WIDTHxHEIGHT" from the IHDR chunk (big-endian at bytes 16..23).
 png_size() {
     local magic w h

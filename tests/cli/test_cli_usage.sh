@@ -3,24 +3,7 @@
 # for every kind of bad usage (rl's exit codes are part of its interface).
 # Run as: bash test_cli_usage.sh <rl-binary> <scratch-dir>
 set -u
-RL=$1
-TMP=$2
-mkdir -p "$TMP"
-
-fail() { echo "FAIL: $*" >&2; exit 1; }
-# expect_exit CODE CMD...: runs CMD, keeps its stdout/stderr, checks the code.
-expect_exit() {
-    local want=$1; shift
-    "$@" >"$TMP/out" 2>"$TMP/err"
-    local got=$?
-    [ "$got" -eq "$want" ] || fail "'$*' exited $got, expected $want; stderr: $(head -c 400 "$TMP/err")"
-}
-# expect_usage_error CMD...: exit 2 and exactly one "rl: error:" line.
-expect_usage_error() {
-    expect_exit 2 "$@"
-    [ "$(grep -c '^rl: error: ' "$TMP/err")" -eq 1 ] || fail "'$*' should print one error line, got: $(cat "$TMP/err")"
-}
-expect_in() { grep -q -- "$2" "$1" || fail "$1 lacks '$2': $(head -c 400 "$1")"; }
+. "$(dirname "${BASH_SOURCE[0]}")/lib.bash"
 
 # Help: top level and every subcommand print usage, options and an example.
 for h in --help -h help; do

@@ -1,0 +1,34 @@
+# lib.bash: what every CLI integration script shares (sourced, not a test:
+# ctest runs only tests/cli/*.sh). Scripts run as: bash script.sh <rl> <dir>;
+# this sets RL and a fresh scratch directory TMP.
+RL=$1
+TMP=$2
+rm -rf "$TMP"
+mkdir -p "$TMP"
+
+fail() { echo "FAIL: $*" >&2; exit 1; }
+# run_ok CMD...: runs CMD, keeps its stdout/stderr in $TMP/out, $TMP/err.
+run_ok() {
+    "$@" >"$TMP/out" 2>"$TMP/err" || fail "'$*' exited $?; stderr: $(head -c 400 "$TMP/err")"
+}
+# expect_exit CODE CMD...: runs CMD, keeps its stdout/stderr, checks the code.
+expect_exit() {
+    local want=$1; shift
+    "$@" >"$TMP/out" 2>"$TMP/err"
+    local got=$?
+    [ "$got" -eq "$want" ] || fail "'$*' exited $got, expected $want; stderr: $(head -c 400 "$TMP/err")"
+}
+# expect_error CODE TEXT CMD...: exit CODE, one "rl: error:" line, containing TEXT.
+expect_error() {
+    local code=$1 text=$2; shift 2
+    expect_exit "$code" "$@"
+    [ "$(grep -c '^rl: error: ' "$TMP/err")" -eq 1 ] || fail "'$*' should print one error line, got: $(cat "$TMP/err")"
+    grep '^rl: error: ' "$TMP/err" | grep -q -- "$text" || fail "'$*': error line lacks '$text': $(cat "$TMP/err")"
+}
+# expect_usage_error CMD...: exit 2 and exactly one "rl: error:" line.
+expect_usage_error() {
+    expect_exit 2 "$@"
+    [ "$(grep -c '^rl: error: ' "$TMP/err")" -eq 1 ] || fail "'$*' should print one error line, got: $(cat "$TMP/err")"
+}
+# expect_in FILE TEXT: FILE contains TEXT.
+expect_in() { grep -q -- "$2" "$1" || fail "$1 lacks '$2': $(head -c 400 "$1")"; }
