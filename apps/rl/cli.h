@@ -75,6 +75,8 @@ bool rl_cli_split_source(const char *arg, char **source, char **params);
 /* Loads "name[:k=v,...]" / a .json scene / a mesh file with rl_scene_load.
  * Returns RL_CLI_OK, or RL_CLI_FAIL with the error printed. */
 int rl_cli_load_scene(const char *arg, rl_scene **out);
+/* True when name is one of the built-in scenes (rl scenes). */
+bool rl_cli_is_builtin(const char *name);
 
 /* Scene statistics and render statistics as JSON objects (for --json,
  * --stats-json and the demo report); NULL when out of memory. */

@@ -5,7 +5,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-static bool is_builtin(const char *name)
+bool rl_cli_is_builtin(const char *name)
 {
     size_t count = 0;
     const rl_builtin_info *list = rl_builtin_scenes(&count);
@@ -30,7 +30,7 @@ int rl_cli_load_scene(const char *arg, rl_scene **out)
         bool named = msg && strstr(msg, source) != NULL;
         /* A bad parameter of a built-in was typed on the command line: that
          * is usage (2), whereas a bad value inside a file is input (1). */
-        int code = st == RL_ERR_INVALID_ARG && is_builtin(source) ? RL_CLI_USAGE : RL_CLI_FAIL;
+        int code = st == RL_ERR_INVALID_ARG && rl_cli_is_builtin(source) ? RL_CLI_USAGE : RL_CLI_FAIL;
         rc = rl_cli_fail_status(code, st, named ? NULL : arg);
     }
     free(source);

@@ -273,16 +273,6 @@ static void scene_label(const char *arg, char *out, size_t size)
     snprintf(out, size, "%s", slash && slash[1] ? slash + 1 : arg);
 }
 
-static bool is_builtin(const char *name)
-{
-    size_t count = 0;
-    const rl_builtin_info *list = rl_builtin_scenes(&count);
-    for (size_t i = 0; i < count; i++)
-        if (strcmp(list[i].name, name) == 0)
-            return true;
-    return false;
-}
-
 /* Loads every scene up front, so that a typo in the last one does not cost
  * the minutes spent on the first. A missing file becomes a skipped scene. */
 static int load_scenes(const bench_args *a, rl_scene **scenes, rl_bench_scene_result *results)
@@ -297,7 +287,7 @@ static int load_scenes(const bench_args *a, rl_scene **scenes, rl_bench_scene_re
             return rl_cli_fail(RL_CLI_FAIL, "out of memory");
         struct stat st;
         bool looks_like_file = strchr(source, '/') || strchr(source, '.');
-        bool missing = !is_builtin(source) && looks_like_file && stat(source, &st) != 0;
+        bool missing = !rl_cli_is_builtin(source) && looks_like_file && stat(source, &st) != 0;
         free(source);
         free(params);
         if (missing) {
