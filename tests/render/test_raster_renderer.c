@@ -13,8 +13,9 @@
 
 #include "rl/rl_render.h"
 #include "rl/rl_scene.h"
+#include "render/render_fixtures.h"
 
-#define ALL_LAYERS (RL_LAYER_COLOR | RL_LAYER_DEPTH | RL_LAYER_ID)
+#define ALL_LAYERS FX_ALL_LAYERS
 
 /* Möller & Trumbore 1997: distance along r to triangle (a,b,c), or INFINITY. */
 static float intersect_triangle(const rl_ray *r, rl_vec3 a, rl_vec3 b, rl_vec3 c)
@@ -53,49 +54,13 @@ static uint32_t brute_force_hit(const rl_scene_data *d, const rl_ray *r, float *
     return best;
 }
 
-static rl_image *render(rl_scene *s, const rl_camera *cam, unsigned layers, const char *const *opts,
-                        rl_render_stats *stats)
-{
-    rl_renderer *r = NULL;
-    rl_image *img = NULL;
-    assert_int_equal(rl_renderer_create("raster", &r), RL_OK);
-    for (size_t i = 0; opts && opts[i]; i += 2)
-        assert_int_equal(rl_renderer_set(r, opts[i], opts[i + 1]), RL_OK);
-    assert_int_equal(rl_image_create(cam->width, cam->height, layers, &img), RL_OK);
-    assert_int_equal(rl_renderer_render(r, s, cam, img, stats), RL_OK);
-    rl_renderer_release(r);
-    return img;
-}
-
-static void assert_images_identical(const rl_image *a, const rl_image *b)
-{
-    size_t n = (size_t)a->width * a->height;
-    assert_int_equal(a->layers, b->layers);
-    assert_memory_equal(a->color, b->color, n * sizeof *a->color);
-    if (a->depth)
-        assert_memory_equal(a->depth, b->depth, n * sizeof *a->depth);
-    if (a->object_id) {
-        assert_memory_equal(a->object_id, b->object_id, n * sizeof *a->object_id);
-        assert_memory_equal(a->triangle_id, b->triangle_id, n * sizeof *a->triangle_id);
-    }
-}
-
-static rl_scene *cornell(rl_camera *cam)
-{
-    rl_scene *s = NULL;
-    assert_int_equal(rl_scene_create_builtin("cornell", NULL, &s), RL_OK);
-    assert_int_equal(rl_scene_get_camera(s, NULL, cam), RL_OK);
-    cam->width = cam->height = 64;
-    return s;
-}
-
 static void test_cornell_ids_and_depth_agree_with_brute_force_ray_casting(void **state)
 {
     (void)state;
     rl_camera cam;
-    rl_scene *s = cornell(&cam);
+    rl_scene *s = fx_cornell(&cam, 64);
     const rl_scene_data *d = rl_scene_get_data(s);
-    rl_image *img = render(s, &cam, ALL_LAYERS, NULL, NULL);
+    rl_image *img = fx_render("raster", s, &cam, ALL_LAYERS, NULL, NULL);
     rl_camera resolved = rl_camera_resolve(&cam);
     rl_camera_frame f = rl_camera_frame_make(&resolved);
 
@@ -232,7 +197,7 @@ static void test_quad_under_point_light_matches_analytic_phong_at_centre_vertex(
     (void)state;
     rl_scene *s = lit_quad();
     rl_camera cam = top_camera(3.0f);
-    rl_image *img = render(s, &cam, ALL_LAYERS, NULL, NULL);
+    rl_image *img = fx_render("raster", s, &cam, ALL_LAYERS, NULL, NULL);
 
     /* At the centre n = l = v = r = +y: E = I / h^2, n.l = r.v = 1. */
     float E = light_intensity / (light_height * light_height);
@@ -267,7 +232,7 @@ static void test_directional_and_spot_lights_match_analytic_values(void **state)
     rl_light sun = { .type = RL_LIGHT_DIRECTIONAL, .color = { 1, 1, 1 }, .intensity = 0.5f,
                      .direction = { 0, -1, 0 } };
     rl_scene *s = quad_with_light(&sun);
-    rl_image *img = render(s, &cam, ALL_LAYERS, NULL, NULL);
+    rl_image *img = fx_render("raster", s, &cam, ALL_LAYERS, NULL, NULL);
     float expected = (quad_kd.x + quad_ks.x) * 0.5f + ambient;
     assert_float_equal(rl_image_pixel(img, 32, 32)->x, expected, 0.02f * expected);
     /* Away from the centre the specular lobe fades but the diffuse part stays. */
@@ -282,7 +247,7 @@ static void test_directional_and_spot_lights_match_analytic_values(void **state)
                       .position = { 0, light_height, 0 }, .direction = { 0, -1, 0 },
                       .spot_inner_deg = 10.0f, .spot_outer_deg = 20.0f };
     s = quad_with_light(&spot);
-    img = render(s, &cam, ALL_LAYERS, NULL, NULL);
+    img = fx_render("raster", s, &cam, ALL_LAYERS, NULL, NULL);
     float E = light_intensity / (light_height * light_height);
     expected = (quad_kd.x + quad_ks.x) * E + ambient;
     assert_float_equal(rl_image_pixel(img, 32, 32)->x, expected, 0.02f * expected);
@@ -298,8 +263,8 @@ static void test_back_face_culling_hides_the_quad_from_below(void **state)
     rl_camera below = top_camera(-3.0f);
     rl_render_stats culled, kept;
     const char *const cull[] = { "cull", "true", NULL };
-    rl_image *a = render(s, &below, ALL_LAYERS, cull, &culled);
-    rl_image *b = render(s, &below, ALL_LAYERS, NULL, &kept);
+    rl_image *a = fx_render("raster", s, &below, ALL_LAYERS, cull, &culled);
+    rl_image *b = fx_render("raster", s, &below, ALL_LAYERS, NULL, &kept);
     assert_int_equal(culled.pixels_written, 0);
     assert_true(kept.pixels_written > 0);
     /* Two-sided lighting: from below the quad is lit as if its normal faced us,
@@ -358,8 +323,8 @@ static void test_flat_and_gouraud_differ_on_a_sphere_but_cover_the_same_pixels(v
     rl_camera cam = { .eye = { 0, 0, 4 }, .target = { 0, 0, 0 }, .width = 48, .height = 48 };
     const char *const flat[] = { "shading", "flat", NULL };
     const char *const gouraud[] = { "shading", "gouraud", NULL };
-    rl_image *a = render(s, &cam, ALL_LAYERS, flat, NULL);
-    rl_image *b = render(s, &cam, ALL_LAYERS, gouraud, NULL);
+    rl_image *a = fx_render("raster", s, &cam, ALL_LAYERS, flat, NULL);
+    rl_image *b = fx_render("raster", s, &cam, ALL_LAYERS, gouraud, NULL);
     size_t n = 48 * 48, covered = 0, differing = 0;
     assert_memory_equal(a->object_id, b->object_id, n * sizeof *a->object_id);
     for (size_t p = 0; p < n; ++p) {
@@ -430,8 +395,8 @@ static void test_an_object_mixing_materials_renders_like_its_parts_split_by_mate
     const char *const modes[] = { "flat", "gouraud", "textured" };
     for (int i = 0; i < 3; ++i) {
         const char *const opts[] = { "shading", modes[i], NULL };
-        rl_image *a = render(mixed, &cam, ALL_LAYERS, opts, NULL);
-        rl_image *b = render(split, &cam, ALL_LAYERS, opts, NULL);
+        rl_image *a = fx_render("raster", mixed, &cam, ALL_LAYERS, opts, NULL);
+        rl_image *b = fx_render("raster", split, &cam, ALL_LAYERS, opts, NULL);
         assert_memory_equal(a->color, b->color, 65 * 65 * sizeof *a->color);
         assert_memory_equal(a->depth, b->depth, 65 * 65 * sizeof *a->depth);
         /* Left half red, right half green. */
@@ -453,8 +418,8 @@ static void test_textured_shading_multiplies_gouraud_by_the_texel(void **state)
         rl_scene *s = two_material_grid(splits[k]);
         rl_camera cam = top_camera(3.0f);
         const char *const gouraud[] = { "shading", "gouraud", NULL };
-        rl_image *a = render(s, &cam, ALL_LAYERS, gouraud, NULL);
-        rl_image *b = render(s, &cam, ALL_LAYERS, NULL, NULL);      /* default: textured */
+        rl_image *a = fx_render("raster", s, &cam, ALL_LAYERS, gouraud, NULL);
+        rl_image *b = fx_render("raster", s, &cam, ALL_LAYERS, NULL, NULL);      /* default: textured */
         int checked = 0;
         for (int y = 0; y < 65; ++y)
             for (int x = 0; x < 65; ++x) {
@@ -483,10 +448,10 @@ static void test_stats_count_triangles_pixels_and_samples(void **state)
 {
     (void)state;
     rl_camera cam;
-    rl_scene *s = cornell(&cam);
+    rl_scene *s = fx_cornell(&cam, 64);
     rl_render_stats st;
     memset(&st, 0xff, sizeof st);
-    rl_image *img = render(s, &cam, ALL_LAYERS, NULL, &st);
+    rl_image *img = fx_render("raster", s, &cam, ALL_LAYERS, NULL, &st);
     assert_true(st.triangles_rasterized > 0);
     assert_true(st.pixels_written >= 64 * 64 / 2);
     assert_int_equal(st.samples, 64 * 64);
@@ -501,16 +466,16 @@ static void test_renders_are_deterministic_and_independent_of_thread_count(void 
 {
     (void)state;
     rl_camera cam;
-    rl_scene *s = cornell(&cam);
+    rl_scene *s = fx_cornell(&cam, 64);
     const char *const one[] = { "threads", "1", NULL };
     const char *const two[] = { "threads", "2", NULL };
-    rl_image *a = render(s, &cam, ALL_LAYERS, NULL, NULL);
-    rl_image *b = render(s, &cam, ALL_LAYERS, NULL, NULL);
-    rl_image *c = render(s, &cam, ALL_LAYERS, one, NULL);
-    rl_image *d = render(s, &cam, ALL_LAYERS, two, NULL);
-    assert_images_identical(a, b);
-    assert_images_identical(c, d);
-    assert_images_identical(a, c);
+    rl_image *a = fx_render("raster", s, &cam, ALL_LAYERS, NULL, NULL);
+    rl_image *b = fx_render("raster", s, &cam, ALL_LAYERS, NULL, NULL);
+    rl_image *c = fx_render("raster", s, &cam, ALL_LAYERS, one, NULL);
+    rl_image *d = fx_render("raster", s, &cam, ALL_LAYERS, two, NULL);
+    fx_assert_images_identical(a, b);
+    fx_assert_images_identical(c, d);
+    fx_assert_images_identical(a, c);
     rl_image_release(a);
     rl_image_release(b);
     rl_image_release(c);
@@ -522,10 +487,10 @@ static void test_colour_does_not_depend_on_the_layers_asked_for(void **state)
 {
     (void)state;
     rl_camera cam;
-    rl_scene *s = cornell(&cam);
+    rl_scene *s = fx_cornell(&cam, 64);
     const char *const bg[] = { "background", "0.25,0.5,0.75", NULL };
-    rl_image *full = render(s, &cam, ALL_LAYERS, bg, NULL);
-    rl_image *color = render(s, &cam, RL_LAYER_COLOR, bg, NULL);
+    rl_image *full = fx_render("raster", s, &cam, ALL_LAYERS, bg, NULL);
+    rl_image *color = fx_render("raster", s, &cam, RL_LAYER_COLOR, bg, NULL);
     assert_memory_equal(full->color, color->color, 64 * 64 * sizeof *full->color);
     for (size_t p = 0; p < 64 * 64; ++p)
         if (full->object_id[p] == RL_ID_NONE)

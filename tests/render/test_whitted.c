@@ -16,58 +16,15 @@
 #include "rl/rl_accel.h"
 #include "rl/rl_render.h"
 #include "rl/rl_scene.h"
+#include "render/render_fixtures.h"
 
-#define ALL_LAYERS (RL_LAYER_COLOR | RL_LAYER_DEPTH | RL_LAYER_ID)
+#define ALL_LAYERS FX_ALL_LAYERS
 #define SIZE 48
-
-static rl_renderer *make(const char *name, const char *const *opts)
-{
-    rl_renderer *r = NULL;
-    assert_int_equal(rl_renderer_create(name, &r), RL_OK);
-    for (size_t i = 0; opts && opts[i]; i += 2)
-        assert_int_equal(rl_renderer_set(r, opts[i], opts[i + 1]), RL_OK);
-    return r;
-}
-
-static rl_image *render_with(rl_renderer *r, const rl_scene *s, const rl_camera *cam, rl_render_stats *stats)
-{
-    rl_image *img = NULL;
-    assert_int_equal(rl_image_create(cam->width, cam->height, ALL_LAYERS, &img), RL_OK);
-    assert_int_equal(rl_renderer_render(r, s, cam, img, stats), RL_OK);
-    return img;
-}
-
-static rl_image *render(const char *name, const rl_scene *s, const rl_camera *cam, const char *const *opts,
-                        rl_render_stats *stats)
-{
-    rl_renderer *r = make(name, opts);
-    rl_image *img = render_with(r, s, cam, stats);
-    rl_renderer_release(r);
-    return img;
-}
-
-static void assert_images_identical(const rl_image *a, const rl_image *b)
-{
-    size_t n = (size_t)a->width * a->height;
-    assert_memory_equal(a->color, b->color, n * sizeof *a->color);
-    assert_memory_equal(a->depth, b->depth, n * sizeof *a->depth);
-    assert_memory_equal(a->object_id, b->object_id, n * sizeof *a->object_id);
-    assert_memory_equal(a->triangle_id, b->triangle_id, n * sizeof *a->triangle_id);
-}
-
-static rl_scene *cornell(rl_camera *cam)
-{
-    rl_scene *s = NULL;
-    assert_int_equal(rl_scene_create_builtin("cornell", NULL, &s), RL_OK);
-    assert_int_equal(rl_scene_get_camera(s, NULL, cam), RL_OK);
-    cam->width = cam->height = SIZE;
-    return s;
-}
 
 static void test_whitted_is_registered_and_refuses_bad_options(void **state)
 {
     (void)state;
-    rl_renderer *r = make("whitted", NULL);
+    rl_renderer *r = fx_make("whitted", NULL);
     assert_string_equal(rl_renderer_get(r, "accel"), "bvh");
     assert_int_equal(rl_renderer_set(r, "accel", "octree"), RL_ERR_INVALID_ARG);
     assert_int_equal(rl_renderer_set(r, "ss", "0"), RL_ERR_INVALID_ARG);
@@ -87,11 +44,13 @@ static void test_cornell_is_identical_with_bvh_and_brute_force(void **state)
 {
     (void)state;
     rl_camera cam;
-    rl_scene *s = cornell(&cam);
+    rl_scene *s = fx_cornell(&cam, SIZE);
     rl_render_stats st_bvh, st_brute;
-    rl_image *bvh = render("whitted", s, &cam, (const char *const[]){ "accel", "bvh", NULL }, &st_bvh);
-    rl_image *brute = render("whitted", s, &cam, (const char *const[]){ "accel", "brute", NULL }, &st_brute);
-    assert_images_identical(bvh, brute);
+    rl_image *bvh = fx_render("whitted", s, &cam, ALL_LAYERS,
+                              (const char *const[]){ "accel", "bvh", NULL }, &st_bvh);
+    rl_image *brute = fx_render("whitted", s, &cam, ALL_LAYERS,
+                                (const char *const[]){ "accel", "brute", NULL }, &st_brute);
+    fx_assert_images_identical(bvh, brute);
     assert_memory_equal(st_bvh.rays, st_brute.rays, sizeof st_bvh.rays);
     assert_int_equal(st_bvh.rays[RL_RAY_PRIMARY], SIZE * SIZE);
     assert_true(st_bvh.rays[RL_RAY_SHADOW] > 0);
@@ -105,10 +64,12 @@ static void test_image_does_not_depend_on_the_thread_count(void **state)
 {
     (void)state;
     rl_camera cam;
-    rl_scene *s = cornell(&cam);
-    rl_image *one = render("whitted", s, &cam, (const char *const[]){ "threads", "1", NULL }, NULL);
-    rl_image *two = render("whitted", s, &cam, (const char *const[]){ "threads", "2", NULL }, NULL);
-    assert_images_identical(one, two);
+    rl_scene *s = fx_cornell(&cam, SIZE);
+    rl_image *one = fx_render("whitted", s, &cam, ALL_LAYERS,
+                              (const char *const[]){ "threads", "1", NULL }, NULL);
+    rl_image *two = fx_render("whitted", s, &cam, ALL_LAYERS,
+                              (const char *const[]){ "threads", "2", NULL }, NULL);
+    fx_assert_images_identical(one, two);
     rl_image_release(one);
     rl_image_release(two);
     rl_scene_release(s);
@@ -118,11 +79,13 @@ static void test_supersampling_traces_ss_squared_primary_rays_per_pixel(void **s
 {
     (void)state;
     rl_camera cam;
-    rl_scene *s = cornell(&cam);
+    rl_scene *s = fx_cornell(&cam, SIZE);
     cam.width = cam.height = 24;
     rl_render_stats st1, st2;
-    rl_image *a = render("whitted", s, &cam, (const char *const[]){ "ss", "1", NULL }, &st1);
-    rl_image *b = render("whitted", s, &cam, (const char *const[]){ "ss", "2", NULL }, &st2);
+    rl_image *a = fx_render("whitted", s, &cam, ALL_LAYERS,
+                            (const char *const[]){ "ss", "1", NULL }, &st1);
+    rl_image *b = fx_render("whitted", s, &cam, ALL_LAYERS,
+                            (const char *const[]){ "ss", "2", NULL }, &st2);
     assert_int_equal(st1.rays[RL_RAY_PRIMARY], 24 * 24);
     assert_int_equal(st2.rays[RL_RAY_PRIMARY], 4 * 24 * 24);
     assert_int_equal(st2.samples, 4 * 24 * 24);
@@ -139,9 +102,9 @@ static void test_depth_and_ids_agree_with_the_raster_renderer(void **state)
 {
     (void)state;
     rl_camera cam;
-    rl_scene *s = cornell(&cam);
-    rl_image *ras = render("raster", s, &cam, NULL, NULL);
-    rl_image *wt = render("whitted", s, &cam, NULL, NULL);
+    rl_scene *s = fx_cornell(&cam, SIZE);
+    rl_image *ras = fx_render("raster", s, &cam, ALL_LAYERS, NULL, NULL);
+    rl_image *wt = fx_render("whitted", s, &cam, ALL_LAYERS, NULL, NULL);
     int n = SIZE * SIZE, same = 0, hits = 0;
     for (int p = 0; p < n; ++p) {
         if (wt->object_id[p] != ras->object_id[p])
@@ -203,9 +166,11 @@ static void test_unshadowed_diffuse_floor_matches_gouraud_raster(void **state)
     (void)state;
     rl_camera cam;
     rl_scene *s = lit_floor(&cam);
-    rl_image *ras = render("raster", s, &cam, (const char *const[]){ "shading", "gouraud", NULL }, NULL);
-    rl_image *wt = render("whitted", s, &cam,
-                          (const char *const[]){ "shadows", "false", "max_depth", "0", NULL }, NULL);
+    rl_image *ras = fx_render("raster", s, &cam, ALL_LAYERS,
+                              (const char *const[]){ "shading", "gouraud", NULL },
+                              NULL);
+    rl_image *wt = fx_render("whitted", s, &cam, ALL_LAYERS,
+                             (const char *const[]){ "shadows", "false", "max_depth", "0", NULL }, NULL);
     double sum_abs = 0.0, sum = 0.0;
     int compared = 0;
     for (int p = 0; p < SIZE * SIZE; ++p) {
@@ -231,8 +196,9 @@ static void test_max_depth_zero_traces_no_secondary_rays(void **state)
     assert_int_equal(rl_scene_get_camera(s, NULL, &cam), RL_OK);
     cam.width = cam.height = 16;
     rl_render_stats flat, deep;
-    rl_image *a = render("whitted", s, &cam, (const char *const[]){ "max_depth", "0", NULL }, &flat);
-    rl_image *b = render("whitted", s, &cam, NULL, &deep);
+    rl_image *a = fx_render("whitted", s, &cam, ALL_LAYERS,
+                            (const char *const[]){ "max_depth", "0", NULL }, &flat);
+    rl_image *b = fx_render("whitted", s, &cam, ALL_LAYERS, NULL, &deep);
     assert_int_equal(flat.rays[RL_RAY_REFLECTION] + flat.rays[RL_RAY_REFRACTION], 0);
     assert_true(deep.rays[RL_RAY_REFLECTION] > 0);
     assert_true(deep.rays[RL_RAY_REFRACTION] > 0);
@@ -245,16 +211,16 @@ static void test_pixel_trees_are_kept_on_request_and_match_the_ids(void **state)
 {
     (void)state;
     rl_camera cam;
-    rl_scene *s = cornell(&cam);
+    rl_scene *s = fx_cornell(&cam, SIZE);
     cam.width = cam.height = 16;
     rl_ray_tree tree;
-    rl_renderer *r = make("whitted", NULL);
+    rl_renderer *r = fx_make("whitted", NULL);
     assert_int_equal(rl_whitted_pixel_tree(r, 0, 0, &tree), RL_ERR_NOT_FOUND);
-    rl_image *plain = render_with(r, s, &cam, NULL);
+    rl_image *plain = fx_render_with(r, s, &cam, ALL_LAYERS, NULL);
     assert_int_equal(rl_whitted_pixel_tree(r, 0, 0, &tree), RL_ERR_NOT_FOUND);
     assert_int_equal(rl_renderer_set(r, "ray_trees", "true"), RL_OK);
-    rl_image *img = render_with(r, s, &cam, NULL);
-    assert_images_identical(plain, img);        /* keeping trees changes nothing */
+    rl_image *img = fx_render_with(r, s, &cam, ALL_LAYERS, NULL);
+    fx_assert_images_identical(plain, img);        /* keeping trees changes nothing */
     for (int y = 0; y < 16; ++y)
         for (int x = 0; x < 16; ++x) {
             assert_int_equal(rl_whitted_pixel_tree(r, x, y, &tree), RL_OK);
@@ -264,7 +230,7 @@ static void test_pixel_trees_are_kept_on_request_and_match_the_ids(void **state)
         }
     assert_int_equal(rl_whitted_pixel_tree(r, 16, 0, &tree), RL_ERR_INVALID_ARG);
     assert_int_equal(rl_whitted_pixel_tree(NULL, 0, 0, &tree), RL_ERR_INVALID_ARG);
-    rl_renderer *ras = make("raster", NULL);
+    rl_renderer *ras = fx_make("raster", NULL);
     assert_int_equal(rl_whitted_pixel_tree(ras, 0, 0, &tree), RL_ERR_INVALID_ARG);
     rl_renderer_release(ras);
     rl_image_release(plain);
@@ -278,16 +244,16 @@ static void test_cached_accel_follows_scene_and_kind_changes(void **state)
 {
     (void)state;
     rl_camera cam_c, cam_f;
-    rl_scene *box = cornell(&cam_c);
+    rl_scene *box = fx_cornell(&cam_c, SIZE);
     rl_scene *floor = lit_floor(&cam_f);
-    rl_renderer *r = make("whitted", NULL);
-    rl_image *a = render_with(r, box, &cam_c, NULL);
-    rl_image *b = render_with(r, floor, &cam_f, NULL);
+    rl_renderer *r = fx_make("whitted", NULL);
+    rl_image *a = fx_render_with(r, box, &cam_c, ALL_LAYERS, NULL);
+    rl_image *b = fx_render_with(r, floor, &cam_f, ALL_LAYERS, NULL);
     assert_int_equal(rl_renderer_set(r, "accel", "grid"), RL_OK);
-    rl_image *c = render_with(r, box, &cam_c, NULL);
-    rl_image *fresh_b = render("whitted", floor, &cam_f, NULL, NULL);
-    assert_images_identical(a, c);
-    assert_images_identical(b, fresh_b);
+    rl_image *c = fx_render_with(r, box, &cam_c, ALL_LAYERS, NULL);
+    rl_image *fresh_b = fx_render("whitted", floor, &cam_f, ALL_LAYERS, NULL, NULL);
+    fx_assert_images_identical(a, c);
+    fx_assert_images_identical(b, fresh_b);
     rl_image_release(a);
     rl_image_release(b);
     rl_image_release(c);
@@ -308,11 +274,12 @@ static void test_a_view_of_nothing_renders_the_background(void **state)
 {
     (void)state;
     rl_camera cam;
-    rl_scene *s = cornell(&cam);
+    rl_scene *s = fx_cornell(&cam, SIZE);
     /* Turn round: the box is behind the eye, nothing is in view. */
     cam.target = rl_add(cam.eye, rl_sub(cam.eye, cam.target));
     rl_render_stats st;
-    rl_image *img = render("whitted", s, &cam, (const char *const[]){ "background", "0.25,0.5,0.75", NULL }, &st);
+    rl_image *img = fx_render("whitted", s, &cam, ALL_LAYERS,
+                              (const char *const[]){ "background", "0.25,0.5,0.75", NULL }, &st);
     for (int i = 0; i < SIZE * SIZE; ++i) {
         assert_true(img->color[i].x == 0.25f && img->color[i].y == 0.5f && img->color[i].z == 0.75f);
         assert_int_equal(img->object_id[i], RL_ID_NONE);
@@ -328,8 +295,8 @@ static void test_progress_callback_can_cancel_the_frame(void **state)
 {
     (void)state;
     rl_camera cam;
-    rl_scene *s = cornell(&cam);
-    rl_renderer *r = make("whitted", NULL);
+    rl_scene *s = fx_cornell(&cam, SIZE);
+    rl_renderer *r = fx_make("whitted", NULL);
     int calls = 0;
     rl_renderer_set_progress(r, cancel_midway, &calls);
     rl_image *img = NULL;
