@@ -32,6 +32,11 @@ static rl_status bvh_build(const rl_scene_data *data, const rl_accel_desc *desc,
     stats->memory_bytes -= (size_t)bvh->num_nodes * sizeof *bvh->nodes;
     free(bvh->nodes);
     bvh->nodes = NULL;
+    /* Leaves are tested from their SoA blocks; the AoS copy was scaffolding too. */
+    stats->memory_bytes += (size_t)bvh->num_blocks * sizeof *bvh->blocks;
+    stats->memory_bytes -= (size_t)bvh->num_tris * sizeof *bvh->tris;
+    free(bvh->tris);
+    bvh->tris = NULL;
     *state = bvh;
     return RL_OK;
 }

@@ -42,13 +42,24 @@ typedef struct rl_bvh_tri {
     uint32_t id;              /* scene triangle ID */
 } rl_bvh_tri;
 
+/* A leaf's triangles as structure of arrays, RL_BVH_LANES per block, so
+ * that one SIMD watertight test covers a block (bvh_leaf_simd.h; as
+ * Embree's Triangle4). A leaf of n triangles owns ceil(n / LANES)
+ * consecutive blocks; unused lanes are all-NaN: NaN fails every
+ * comparison, so such a lane never hits. */
+#define RL_BVH_LANES 4
+typedef struct rl_bvh_block {
+    float p[3][3][RL_BVH_LANES];     /* [vertex][axis][lane] */
+    uint32_t id[RL_BVH_LANES];       /* scene triangle ID; RL_ID_NONE in padding */
+} rl_bvh_block;
+
 /* Wide node collapsed from the binary tree (bvh_wide.c), bounds as
  * structure of arrays so that one SIMD slab test covers all children.
  * Unused slots have inverted bounds (min +inf, max -inf): never hit. */
 typedef struct rl_bvh_wide_node {
     float bmin[3][RL_BVH_WIDTH];     /* [axis][child] */
     float bmax[3][RL_BVH_WIDTH];
-    uint32_t child[RL_BVH_WIDTH];    /* inner: wide node index; leaf: first triangle */
+    uint32_t child[RL_BVH_WIDTH];    /* inner: wide node index; leaf: first block */
     uint8_t count[RL_BVH_WIDTH];     /* leaf: triangles (> 0); inner: 0 */
     uint8_t pad[3 * RL_BVH_WIDTH];   /* 32 bytes per child: whole cache lines */
 } rl_bvh_wide_node;
@@ -61,6 +72,8 @@ typedef struct rl_bvh {
     uint32_t num_wide;
     rl_bvh_tri *tris;
     uint32_t num_tris;
+    rl_bvh_block *blocks;         /* leaves in SoA blocks (rl_bvh_widen) */
+    uint32_t num_blocks;
 } rl_bvh;
 
 /* Binned SAH build (Wald 2007); fills nodes, leaves, max_depth, sah_cost and
@@ -70,7 +83,8 @@ rl_status rl_bvh_build(const rl_scene_data *data, const rl_accel_desc *desc, rl_
                        rl_accel_stats *stats);
 void rl_bvh_free(rl_bvh *bvh);
 /* Collapses the binary tree into bvh->wide (deterministic: largest-area
- * child opened first). RL_ERR_OUT_OF_MEMORY. */
+ * child opened first) and packs the leaves into bvh->blocks, in leaf order.
+ * RL_ERR_OUT_OF_MEMORY. */
 rl_status rl_bvh_widen(rl_bvh *bvh);
 
 /* Traversal of the wide tree (bvh_wide_traverse.c). */

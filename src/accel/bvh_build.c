@@ -10,6 +10,9 @@
  * traversal is cheap next to our watertight test; the 1:2 ratio and the
  * default leaf size 2 (instead of 1:1 and 4) measured +15-25 % on
  * incoherent rays (rl bench rays, diffuse; cornell-teapot 70k and city).
+ * With the SIMD leaf test (4 triangles per block, bvh_wide_traverse.c),
+ * costing leaves per block and default leaf sizes 3-4 were tried: Wuson
+ * gained a little, city lost (shadow -10 %), so the costs stay per triangle.
  * Termination: N <= desc bvh_leaf_size (default 2) is always a leaf; larger
  * nodes become a leaf when the best split does not beat the leaf cost
  * C_isect·N, up to RL_BVH_MAX_LEAF triangles (so a leaf may exceed
@@ -346,6 +349,8 @@ rl_status rl_bvh_build(const rl_scene_data *data, const rl_accel_desc *desc, rl_
     bvh->num_nodes = stats->nodes;
     bvh->wide = NULL;
     bvh->num_wide = 0;
+    bvh->blocks = NULL;
+    bvh->num_blocks = 0;
     bvh->tris = tris;
     bvh->num_tris = N;
     tris = NULL;
@@ -366,5 +371,6 @@ void rl_bvh_free(rl_bvh *bvh)
     free(bvh->nodes);
     free(bvh->wide);
     free(bvh->tris);
+    free(bvh->blocks);
     memset(bvh, 0, sizeof *bvh);
 }

@@ -6,7 +6,8 @@
  * children, the inner child with the largest surface area is replaced by
  * its own two children until the node is full or only leaves are left. The
  * binary tree's leaves and triangle order are kept, so the wide tree holds
- * exactly the same leaves. One wide node costs one SIMD slab test instead
+ * exactly the same leaves (each packed into SoA blocks of RL_BVH_LANES
+ * triangles for the SIMD leaf test). One wide node costs one SIMD slab test instead
  * of up to WIDTH - 1 binary ones, and divides the depth. Serial and depth-first,
  * hence deterministic. */
 #include <stdlib.h>
@@ -17,9 +18,42 @@
 
 typedef struct widener {
     const rl_bvh_node *bin;
+    const rl_bvh_tri *tris;
     rl_bvh_wide_node *wide;
     uint32_t count;
+    rl_bvh_block *blocks;
+    uint32_t num_blocks;
 } widener;
+
+static uint32_t leaf_blocks(uint32_t count)
+{
+    return (count + RL_BVH_LANES - 1) / RL_BVH_LANES;
+}
+
+/* Packs a leaf's triangles into the next blocks; returns the first. */
+static uint32_t pack_leaf(widener *w, uint32_t first, uint32_t count)
+{
+    uint32_t start = w->num_blocks;
+    for (uint32_t i = 0; i < count; i += RL_BVH_LANES) {
+        rl_bvh_block *b = &w->blocks[w->num_blocks++];
+        for (uint32_t l = 0; l < RL_BVH_LANES; ++l) {
+            if (i + l >= count) {   /* padding: NaN fails every comparison */
+                for (int k = 0; k < 3; ++k)
+                    for (int a = 0; a < 3; ++a)
+                        b->p[k][a][l] = NAN;
+                b->id[l] = RL_ID_NONE;
+                continue;
+            }
+            const rl_bvh_tri *t = &w->tris[first + i + l];
+            const rl_vec3 p[3] = { t->p0, t->p1, t->p2 };
+            for (int k = 0; k < 3; ++k)
+                for (int a = 0; a < 3; ++a)
+                    b->p[k][a][l] = rl_vget(p[k], a);
+            b->id[l] = t->id;
+        }
+    }
+    return start;
+}
 
 static float node_area(const rl_bvh_node *n)
 {
@@ -71,7 +105,7 @@ static void widen_node(widener *w, uint32_t slot, uint32_t b)
             node->bmax[a][i] = k->max[a];
         }
         if (k->count > 0) {
-            node->child[i] = k->index;
+            node->child[i] = pack_leaf(w, k->index, k->count);
             node->count[i] = (uint8_t)k->count;
         } else {
             child_slot[i] = w->count++;
@@ -97,7 +131,15 @@ rl_status rl_bvh_widen(rl_bvh *bvh)
     rl_bvh_wide_node *wide = alloc_wide(bound);
     if (!wide)
         return rl_error(RL_ERR_OUT_OF_MEMORY, "accel bvh: out of memory for %u wide nodes", (unsigned)bound);
-    widener w = { bvh->nodes, wide, 1 };
+    uint32_t num_blocks = 0;
+    for (uint32_t i = 0; i < bvh->num_nodes; ++i)
+        num_blocks += leaf_blocks(bvh->nodes[i].count);
+    rl_bvh_block *blocks = aligned_alloc(64, ((size_t)num_blocks * sizeof *blocks + 63) / 64 * 64);
+    if (!blocks) {
+        free(wide);
+        return rl_error(RL_ERR_OUT_OF_MEMORY, "accel bvh: out of memory for %u leaf blocks", (unsigned)num_blocks);
+    }
+    widener w = { bvh->nodes, bvh->tris, wide, 1, blocks, 0 };
     widen_node(&w, 0, 0);
     /* Shrink by copying: realloc would not keep the alignment. */
     rl_bvh_wide_node *shrunk = w.count < bound ? alloc_wide(w.count) : NULL;
@@ -109,5 +151,8 @@ rl_status rl_bvh_widen(rl_bvh *bvh)
     free(bvh->wide);
     bvh->wide = wide;
     bvh->num_wide = w.count;
+    free(bvh->blocks);
+    bvh->blocks = blocks;
+    bvh->num_blocks = w.num_blocks;
     return RL_OK;
 }

@@ -13,8 +13,10 @@
  * (the BVH must agree with brute force exactly; cf. Ize 2013, "Robust BVH
  * Ray Traversal"). Hit children are sorted by entry distance, the nearest
  * is visited next and the others are pushed with their distance, so that a
- * pop can skip boxes beyond the shortened t_max. Closest hit follows the
- * tie rule of accel.c (equal t: lowest triangle ID). */
+ * pop can skip boxes beyond the shortened t_max. Leaves test their
+ * triangles RL_BVH_LANES at a time (SoA blocks, bvh.h), with exactly the
+ * scalar test's operations, as Embree's Triangle4 does. Closest hit follows
+ * the tie rule of accel.c (equal t: lowest triangle ID). */
 #include <math.h>
 
 #if defined(__SSE2__)
@@ -33,7 +35,7 @@ typedef struct ray_pre {
 } ray_pre;
 
 typedef struct entry {
-    uint32_t ref;             /* wide node, or first triangle of a leaf */
+    uint32_t ref;             /* wide node, or first block of a leaf */
     uint32_t count;           /* leaf triangles; 0: inner node */
     float dist;               /* entry distance of its box */
 } entry;
@@ -111,11 +113,12 @@ static inline void prefetch_child(const rl_bvh *bvh, entry e)
         for (size_t line = 0; line < sizeof(rl_bvh_wide_node); line += 64)
             __builtin_prefetch(p + line);
     } else {
-        const char *p = (const char *)&bvh->tris[e.ref];
-        __builtin_prefetch(p);
-        __builtin_prefetch(p + 64);
-        if (e.count > 2)
-            __builtin_prefetch(p + 128);
+        /* The leaf's blocks: the first two lines, then one per 64 bytes. */
+        const char *p = (const char *)&bvh->blocks[e.ref];
+        size_t bytes = (e.count + RL_BVH_LANES - 1) / RL_BVH_LANES * sizeof(rl_bvh_block);
+        for (size_t off = 0; off < bytes; off += 64)
+            __builtin_prefetch(p + off);
+        __builtin_prefetch(p + bytes - 1);
     }
 #else
     (void)bvh;
@@ -159,25 +162,127 @@ typedef struct closest {
     uint32_t id;
 } closest;
 
-RL_WT_INLINE void leaf_closest_k(const rl_bvh_tri *tri, uint32_t count, const rl_ray_watertight *w, int kx, int ky,
-                                 int kz, float t_min, closest *c)
+/* Lane l of a block as the scalar test's vertices. */
+static inline void block_lane(const rl_bvh_block *b, int l, rl_vec3 p[3])
 {
-    for (uint32_t i = 0; i < count; ++i) {
-        float t, u, v;
-        if (!rl_watertight_hit_k(w, kx, ky, kz, tri[i].p0, tri[i].p1, tri[i].p2, t_min, c->t_test, &t, &u, &v))
-            continue;
-        if (t < c->t || tri[i].id < c->id) {
-            *c = (closest){ t, nextafterf(t, INFINITY), u, v, tri[i].id };
+    for (int k = 0; k < 3; ++k)
+        p[k] = (rl_vec3){ b->p[k][0][l], b->p[k][1][l], b->p[k][2][l] };
+}
+
+/* The watertight test (watertight.h) on all lanes of a block at once: the
+ * same IEEE operations in the same order (no FMA: C11 mode contracts
+ * nothing, and we use no FMA intrinsics), so each lane's t, u, v are
+ * bit-identical to the scalar test's. Lanes whose edge functions hit
+ * exactly 0 need the scalar test's double recompute: they go to *fallback
+ * and out of the returned hit mask. Padding lanes are NaN and fail. */
+RL_WT_INLINE int block_hit_k(const rl_bvh_block *b, const rl_ray_watertight *w, int kx, int ky, int kz,
+                             float t_min, float t_max, float t[RL_BVH_LANES], float u[RL_BVH_LANES],
+                             float v[RL_BVH_LANES], int *fallback)
+{
+#if defined(__SSE2__) && RL_BVH_LANES == 4
+    const __m128 zero = _mm_setzero_ps(), sign = _mm_set1_ps(-0.0f);
+    const __m128 ox = _mm_set1_ps(RL_WT_COMP(w->o, kx)), oy = _mm_set1_ps(RL_WT_COMP(w->o, ky));
+    const __m128 oz = _mm_set1_ps(RL_WT_COMP(w->o, kz));
+    const __m128 sx = _mm_set1_ps(w->sx), sy = _mm_set1_ps(w->sy), sz = _mm_set1_ps(w->sz);
+    __m128 Az = _mm_sub_ps(_mm_load_ps(b->p[0][kz]), oz);
+    __m128 Bz = _mm_sub_ps(_mm_load_ps(b->p[1][kz]), oz);
+    __m128 Cz = _mm_sub_ps(_mm_load_ps(b->p[2][kz]), oz);
+    __m128 Ax = _mm_sub_ps(_mm_sub_ps(_mm_load_ps(b->p[0][kx]), ox), _mm_mul_ps(sx, Az));
+    __m128 Ay = _mm_sub_ps(_mm_sub_ps(_mm_load_ps(b->p[0][ky]), oy), _mm_mul_ps(sy, Az));
+    __m128 Bx = _mm_sub_ps(_mm_sub_ps(_mm_load_ps(b->p[1][kx]), ox), _mm_mul_ps(sx, Bz));
+    __m128 By = _mm_sub_ps(_mm_sub_ps(_mm_load_ps(b->p[1][ky]), oy), _mm_mul_ps(sy, Bz));
+    __m128 Cx = _mm_sub_ps(_mm_sub_ps(_mm_load_ps(b->p[2][kx]), ox), _mm_mul_ps(sx, Cz));
+    __m128 Cy = _mm_sub_ps(_mm_sub_ps(_mm_load_ps(b->p[2][ky]), oy), _mm_mul_ps(sy, Cz));
+    __m128 U = _mm_sub_ps(_mm_mul_ps(Cx, By), _mm_mul_ps(Cy, Bx));
+    __m128 V = _mm_sub_ps(_mm_mul_ps(Ax, Cy), _mm_mul_ps(Ay, Cx));
+    __m128 W = _mm_sub_ps(_mm_mul_ps(Bx, Ay), _mm_mul_ps(By, Ax));
+    *fallback = _mm_movemask_ps(
+        _mm_or_ps(_mm_or_ps(_mm_cmpeq_ps(U, zero), _mm_cmpeq_ps(V, zero)), _mm_cmpeq_ps(W, zero)));
+    __m128 neg = _mm_or_ps(_mm_or_ps(_mm_cmplt_ps(U, zero), _mm_cmplt_ps(V, zero)), _mm_cmplt_ps(W, zero));
+    __m128 pos = _mm_or_ps(_mm_or_ps(_mm_cmpgt_ps(U, zero), _mm_cmpgt_ps(V, zero)), _mm_cmpgt_ps(W, zero));
+    __m128 det = _mm_add_ps(_mm_add_ps(U, V), W);
+    /* cmpneq is unordered like C's !(det == 0): a NaN lane fails later. */
+    __m128 ok = _mm_andnot_ps(_mm_and_ps(neg, pos), _mm_cmpneq_ps(det, zero));
+    if (!_mm_movemask_ps(ok))
+        return 0;
+    Az = _mm_mul_ps(Az, sz);
+    Bz = _mm_mul_ps(Bz, sz);
+    Cz = _mm_mul_ps(Cz, sz);
+    __m128 T = _mm_add_ps(_mm_add_ps(_mm_mul_ps(U, Az), _mm_mul_ps(V, Bz)), _mm_mul_ps(W, Cz));
+    __m128 det_abs = _mm_andnot_ps(sign, det);
+    __m128 T_abs = _mm_xor_ps(T, _mm_and_ps(_mm_cmplt_ps(det, zero), sign));   /* det < 0 ? -T : T */
+    if (t_min >= 0.0f)
+        ok = _mm_andnot_ps(_mm_cmple_ps(T_abs, zero), ok);
+    __m128 bound = _mm_mul_ps(_mm_mul_ps(_mm_set1_ps(t_max), det_abs), _mm_set1_ps(1.0f + 0x1p-16f));
+    ok = _mm_andnot_ps(_mm_and_ps(_mm_cmpgt_ps(bound, _mm_set1_ps(0x1p-100f)), _mm_cmpgt_ps(T_abs, bound)), ok);
+    __m128 th = _mm_div_ps(T, det);
+    ok = _mm_and_ps(ok, _mm_and_ps(_mm_cmpgt_ps(th, _mm_set1_ps(t_min)), _mm_cmplt_ps(th, _mm_set1_ps(t_max))));
+    int mask = _mm_movemask_ps(ok) & ~*fallback;
+    if (mask) {
+        _mm_storeu_ps(t, th);
+        _mm_storeu_ps(u, _mm_div_ps(V, det));
+        _mm_storeu_ps(v, _mm_div_ps(W, det));
+    }
+    return mask;
+#else
+    /* No SSE: the scalar test lane by lane (it does its own fallback). */
+    int mask = 0;
+    *fallback = 0;
+    for (int l = 0; l < RL_BVH_LANES; ++l) {
+        rl_vec3 p[3];
+        block_lane(b, l, p);
+        if (rl_watertight_hit_k(w, kx, ky, kz, p[0], p[1], p[2], t_min, t_max, &t[l], &u[l], &v[l]))
+            mask |= 1 << l;
+    }
+    return mask;
+#endif
+}
+
+/* block_hit_k plus the scalar test (with its double recompute) on the
+ * fallback lanes. */
+RL_WT_INLINE int block_hits_k(const rl_bvh_block *b, const rl_ray_watertight *w, int kx, int ky, int kz,
+                              float t_min, float t_max, float t[RL_BVH_LANES], float u[RL_BVH_LANES],
+                              float v[RL_BVH_LANES])
+{
+    int fallback;
+    int mask = block_hit_k(b, w, kx, ky, kz, t_min, t_max, t, u, v, &fallback);
+    if (fallback) {
+        for (int l = 0; l < RL_BVH_LANES; ++l) {
+            rl_vec3 p[3];
+            if (!(fallback & (1 << l)))
+                continue;
+            block_lane(b, l, p);
+            if (rl_watertight_hit_k(w, kx, ky, kz, p[0], p[1], p[2], t_min, t_max, &t[l], &u[l], &v[l]))
+                mask |= 1 << l;
+        }
+    }
+    return mask;
+}
+
+/* All lanes of a block are tested against the same t_max, so a lane beyond
+ * an earlier lane's hit can come back: t < t_test filters it. Acceptance
+ * depends on t alone (watertight.c), so this equals testing one by one. */
+RL_WT_INLINE void leaf_closest_k(const rl_bvh_block *blk, uint32_t count, const rl_ray_watertight *w, int kx,
+                                 int ky, int kz, float t_min, closest *c)
+{
+    for (uint32_t i = 0; i < count; i += RL_BVH_LANES, ++blk) {
+        float t[RL_BVH_LANES], u[RL_BVH_LANES], v[RL_BVH_LANES];
+        int mask = block_hits_k(blk, w, kx, ky, kz, t_min, c->t_test, t, u, v);
+        for (int l = 0; mask; ++l, mask >>= 1) {
+            if (!(mask & 1) || !(t[l] < c->t_test))
+                continue;
+            if (t[l] < c->t || blk->id[l] < c->id)
+                *c = (closest){ t[l], nextafterf(t[l], INFINITY), u[l], v[l], blk->id[l] };
         }
     }
 }
 
-RL_WT_INLINE bool leaf_any_k(const rl_bvh_tri *tri, uint32_t count, const rl_ray_watertight *w, int kx, int ky,
-                             int kz, float t_min, float t_max)
+RL_WT_INLINE bool leaf_any_k(const rl_bvh_block *blk, uint32_t count, const rl_ray_watertight *w, int kx,
+                             int ky, int kz, float t_min, float t_max)
 {
-    for (uint32_t i = 0; i < count; ++i) {
-        float t, u, v;
-        if (rl_watertight_hit_k(w, kx, ky, kz, tri[i].p0, tri[i].p1, tri[i].p2, t_min, t_max, &t, &u, &v))
+    for (uint32_t i = 0; i < count; i += RL_BVH_LANES, ++blk) {
+        float t[RL_BVH_LANES], u[RL_BVH_LANES], v[RL_BVH_LANES];
+        if (block_hits_k(blk, w, kx, ky, kz, t_min, t_max, t, u, v))
             return true;
     }
     return false;
@@ -185,7 +290,7 @@ RL_WT_INLINE bool leaf_any_k(const rl_bvh_tri *tri, uint32_t count, const rl_ray
 
 /* One loop per axis permutation (kz, then kx; ky follows), so that the
  * vertex components are picked at compile time. */
-static void leaf_closest(const rl_bvh_tri *tri, uint32_t count, const rl_ray_watertight *w, float t_min,
+static void leaf_closest(const rl_bvh_block *tri, uint32_t count, const rl_ray_watertight *w, float t_min,
                          closest *c)
 {
     switch (w->kz * 3 + w->kx) {
@@ -198,7 +303,7 @@ static void leaf_closest(const rl_bvh_tri *tri, uint32_t count, const rl_ray_wat
     }
 }
 
-static bool leaf_any(const rl_bvh_tri *tri, uint32_t count, const rl_ray_watertight *w, float t_min, float t_max)
+static bool leaf_any(const rl_bvh_block *tri, uint32_t count, const rl_ray_watertight *w, float t_min, float t_max)
 {
     switch (w->kz * 3 + w->kx) {
     case 0 * 3 + 1: return leaf_any_k(tri, count, w, 1, 2, 0, t_min, t_max);
@@ -226,7 +331,7 @@ bool rl_bvh_wide_intersect(const rl_bvh *bvh, rl_ray *ray, rl_hit *hit)
             if (visit(bvh, &bvh->wide[cur.ref], &p, t_min, c.t, stack, &sp, &cur))
                 continue;
         } else {
-            leaf_closest(&bvh->tris[cur.ref], cur.count, &w, t_min, &c);
+            leaf_closest(&bvh->blocks[cur.ref], cur.count, &w, t_min, &c);
         }
         /* Pop, skipping boxes that now start beyond the closest hit. */
         for (;;) {
@@ -260,7 +365,7 @@ bool rl_bvh_wide_occluded(const rl_bvh *bvh, const rl_ray *ray)
             if (visit(bvh, &bvh->wide[cur.ref], &p, t_min, t_max, stack, &sp, &cur))
                 continue;
         } else {
-            if (leaf_any(&bvh->tris[cur.ref], cur.count, &w, t_min, t_max))
+            if (leaf_any(&bvh->blocks[cur.ref], cur.count, &w, t_min, t_max))
                 return true;   /* any hit will do */
         }
         if (sp == 0)

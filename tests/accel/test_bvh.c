@@ -231,17 +231,20 @@ static bool box_contains_point(const rl_bvh_node *n, rl_vec3 p)
 }
 
 /* The wide collapse: every wide node is reached once, every binary leaf
- * appears once with its triangle range, unused lanes are inverted boxes,
- * and the nodes start on a cache line. */
-static void assert_wide_tree_holds_the_same_leaves(rl_bvh *bvh, uint32_t leaves)
+ * appears once, packed into its own SoA blocks that hold each triangle once
+ * (bit-exact vertices, NaN padding that never hits), unused lanes are
+ * inverted boxes, and the nodes start on a cache line. */
+static void assert_wide_tree_holds_the_same_leaves(rl_bvh *bvh, const rl_scene_data *d, uint32_t leaves)
 {
     assert_int_equal(rl_bvh_widen(bvh), RL_OK);
     assert_true(bvh->num_wide >= 1 && bvh->num_wide <= bvh->num_nodes / 2 + 1);
     /* Cache-line aligned: a node touches exactly sizeof / 64 lines. */
     assert_int_equal((uintptr_t)bvh->wide % 64, 0);
+    assert_int_equal((uintptr_t)bvh->blocks % 16, 0);   /* aligned SIMD loads */
     uint32_t *reached = calloc(bvh->num_wide, sizeof *reached);
     uint32_t *covered = calloc(bvh->num_tris, sizeof *covered);
-    assert_true(reached && covered);
+    uint32_t *block_used = calloc(bvh->num_blocks, sizeof *block_used);
+    assert_true(reached && covered && block_used);
     reached[0] = 1;
     uint32_t wide_leaves = 0;
     for (uint32_t i = 0; i < bvh->num_wide; ++i) {
@@ -259,9 +262,29 @@ static void assert_wide_tree_holds_the_same_leaves(rl_bvh *bvh, uint32_t leaves)
                 continue;
             }
             ++wide_leaves;
-            for (uint32_t t = n->child[c]; t < n->child[c] + n->count[c]; ++t) {
-                ++covered[t];
-                assert_true(bvh->tris[t].p0.x >= n->bmin[0][c] && bvh->tris[t].p0.x <= n->bmax[0][c]);
+            for (uint32_t t = 0; t < n->count[c]; ++t) {
+                uint32_t b = n->child[c] + t / RL_BVH_LANES, l = t % RL_BVH_LANES;
+                assert_true(b < bvh->num_blocks);
+                if (l == 0)
+                    ++block_used[b];
+                const rl_bvh_block *blk = &bvh->blocks[b];
+                uint32_t id = blk->id[l];
+                assert_true(id < bvh->num_tris);
+                ++covered[id];
+                const uint32_t *idx = d->indices + 3 * (size_t)id;
+                for (int k = 0; k < 3; ++k) {
+                    rl_vec3 p = d->positions[idx[k]];
+                    assert_memory_equal(&blk->p[k][0][l], &p.x, sizeof p.x);
+                    assert_memory_equal(&blk->p[k][1][l], &p.y, sizeof p.y);
+                    assert_memory_equal(&blk->p[k][2][l], &p.z, sizeof p.z);
+                }
+                assert_true(blk->p[0][0][l] >= n->bmin[0][c] && blk->p[0][0][l] <= n->bmax[0][c]);
+            }
+            /* Padding after the last triangle: NaN, no ID. */
+            for (uint32_t t = n->count[c]; t % RL_BVH_LANES != 0; ++t) {
+                const rl_bvh_block *blk = &bvh->blocks[n->child[c] + t / RL_BVH_LANES];
+                assert_int_equal(blk->id[t % RL_BVH_LANES], RL_ID_NONE);
+                assert_true(isnan(blk->p[1][2][t % RL_BVH_LANES]));
             }
         }
         assert_true(used >= 1);
@@ -270,9 +293,12 @@ static void assert_wide_tree_holds_the_same_leaves(rl_bvh *bvh, uint32_t leaves)
         assert_int_equal(reached[i], 1);
     for (uint32_t t = 0; t < bvh->num_tris; ++t)
         assert_int_equal(covered[t], 1);
+    for (uint32_t b = 0; b < bvh->num_blocks; ++b)
+        assert_int_equal(block_used[b], 1);
     assert_int_equal(wide_leaves, leaves);
     free(reached);
     free(covered);
+    free(block_used);
 }
 
 /* Structure: every node's box holds its children / triangles, every scene
@@ -322,7 +348,7 @@ static void test_bvh_structure_is_consistent_and_stats_are_sane(void **state)
         assert_int_equal(st.memory_bytes, (size_t)bvh.num_nodes * 32 + (size_t)bvh.num_tris * sizeof(rl_bvh_tri));
         if (leaf_sizes[k] == 1)   /* SAH leaves need more than one triangle */
             assert_true(leaves >= d->num_triangles / RL_BVH_MAX_LEAF);
-        assert_wide_tree_holds_the_same_leaves(&bvh, leaves);
+        assert_wide_tree_holds_the_same_leaves(&bvh, d, leaves);
         rl_bvh_free(&bvh);
     }
     rl_accel *a = make_accel(s, (rl_accel_desc){ .kind = RL_ACCEL_BVH });
@@ -465,6 +491,69 @@ static void test_rays_at_shared_edges_and_vertices_never_escape(void **state)
     assert_sphere_is_watertight(RL_ACCEL_BVH, 32, 64);
 }
 
+/* Bit-identical closest hit and occlusion of two accels on one ray. */
+static void assert_same_hit(const rl_accel *ref, const rl_accel *test, rl_ray r)
+{
+    rl_ray a = r, b = r;
+    rl_hit ha, hb;
+    bool ga = rl_accel_intersect(ref, &a, &ha), gb = rl_accel_intersect(test, &b, &hb);
+    assert_true(ga == gb);
+    assert_true(rl_accel_occluded(test, &r) == ga);
+    if (ga)
+        assert_true(ha.triangle == hb.triangle && ha.t == hb.t && ha.u == hb.u && ha.v == hb.v);
+}
+
+/* The SIMD leaf test hands lanes with an edge function of exactly 0 to the
+ * scalar test (double recompute): rays straight down at the vertices and
+ * edge midpoints of an integer grid (every edge function through them is
+ * exactly 0), and at the sphere's vertices, must give the brute-force hit
+ * bit for bit. */
+static void test_bvh_agrees_with_brute_force_at_vertices_and_edges(void **state)
+{
+    (void)state;
+    enum { N = 12 };
+    rl_vec3 pos[(N + 1) * (N + 1)];
+    uint32_t idx[6 * N * N], *t = idx;
+    for (uint32_t j = 0; j <= N; ++j)
+        for (uint32_t i = 0; i <= N; ++i)
+            pos[j * (N + 1) + i] = rl_v3((float)i, (float)j, (float)((i * 7 + j * 3) % 5) * 0.25f);
+    for (uint32_t j = 0; j < N; ++j)
+        for (uint32_t i = 0; i < N; ++i) {
+            uint32_t a = j * (N + 1) + i;
+            *t++ = a; *t++ = a + 1; *t++ = a + N + 1;
+            *t++ = a + 1; *t++ = a + N + 2; *t++ = a + N + 1;
+        }
+    rl_scene *s = mesh_scene(pos, (N + 1) * (N + 1), idx, 2 * N * N);
+    rl_accel *brute = make_accel(s, (rl_accel_desc){ .kind = RL_ACCEL_BRUTE });
+    rl_accel *bvh = make_accel(s, (rl_accel_desc){ .kind = RL_ACCEL_BVH });
+    for (uint32_t j = 0; j <= 2 * N; ++j)
+        for (uint32_t i = 0; i <= 2 * N; ++i) {
+            rl_vec3 o = rl_v3(0.5f * (float)i, 0.5f * (float)j, 5.0f);
+            assert_same_hit(brute, bvh, (rl_ray){ .o = o, .d = rl_v3(0, 0, -1), .t_max = INFINITY });
+            assert_same_hit(brute, bvh, (rl_ray){ .o = o, .d = rl_v3(0, 0, -2), .t_max = 3.0f });
+        }
+    rl_accel_release(bvh);
+    rl_accel_release(brute);
+    rl_scene_release(s);
+
+    rl_vec3 *sp;
+    uint32_t *sidx, nv, nt;
+    uv_sphere(8, 16, &sp, &nv, &sidx, &nt);
+    s = mesh_scene(sp, nv, sidx, nt);
+    brute = make_accel(s, (rl_accel_desc){ .kind = RL_ACCEL_BRUTE });
+    bvh = make_accel(s, (rl_accel_desc){ .kind = RL_ACCEL_BVH });
+    for (uint32_t v = 0; v < nv; ++v) {
+        assert_same_hit(brute, bvh, (rl_ray){ .o = rl_v3(0, 0, 0), .d = sp[v], .t_max = INFINITY });
+        assert_same_hit(brute, bvh, (rl_ray){ .o = rl_scale(sp[v], 3.0f), .d = rl_scale(sp[v], -1.0f),
+                                              .t_max = INFINITY });
+    }
+    rl_accel_release(bvh);
+    rl_accel_release(brute);
+    rl_scene_release(s);
+    free(sp);
+    free(sidx);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -477,6 +566,7 @@ int main(void)
         cmocka_unit_test(test_bvh_structure_is_consistent_and_stats_are_sane),
         cmocka_unit_test(test_bvh_breaks_ties_by_lowest_triangle_id),
         cmocka_unit_test(test_rays_at_shared_edges_and_vertices_never_escape),
+        cmocka_unit_test(test_bvh_agrees_with_brute_force_at_vertices_and_edges),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
