@@ -5,8 +5,9 @@
  * Layout for cache-friendly traversal: the binary build tree has 32-byte
  * nodes in one array, the two children of an inner node adjacent (index,
  * index + 1); the wide tree has 32 bytes per child (whole cache lines); the
- * leaves' triangles are copied in leaf order into one array of vertex
- * triples that keep their scene triangle ID. */
+ * build copies the leaves' triangles in leaf order into an array of vertex
+ * triples (tris), which the widening packs into SoA blocks (blocks) and
+ * bvh.c then frees: traversal reads only the wide nodes and the blocks. */
 #ifndef RL_ACCEL_BVH_H
 #define RL_ACCEL_BVH_H
 
@@ -43,7 +44,7 @@ typedef struct rl_bvh_tri {
 } rl_bvh_tri;
 
 /* A leaf's triangles as structure of arrays, RL_BVH_LANES per block, so
- * that one SIMD watertight test covers a block (bvh_leaf_simd.h; as
+ * that one SIMD watertight test covers a block (bvh_wide_traverse.c; as
  * Embree's Triangle4). A leaf of n triangles owns ceil(n / LANES)
  * consecutive blocks; unused lanes are all-NaN: NaN fails every
  * comparison, so such a lane never hits. */
@@ -70,7 +71,7 @@ typedef struct rl_bvh {
     uint32_t num_nodes;
     rl_bvh_wide_node *wide;       /* wide tree the traversal uses, or NULL */
     uint32_t num_wide;
-    rl_bvh_tri *tris;
+    rl_bvh_tri *tris;             /* leaf order; NULL once packed and dropped */
     uint32_t num_tris;
     rl_bvh_block *blocks;         /* leaves in SoA blocks (rl_bvh_widen) */
     uint32_t num_blocks;
