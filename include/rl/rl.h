@@ -12,4 +12,5 @@
 #include "rl/rl_render.h"
 #include "rl/rl_accel.h"
 #include "rl/rl_trace.h"
+#include "rl/rl_metrics.h"
 #endif
