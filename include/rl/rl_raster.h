@@ -41,7 +41,24 @@ typedef enum rl_raster_flags {
     RL_RASTER_NO_COLOR      = 1 << 2,   /* do not write colour */
     RL_RASTER_NO_DEPTH      = 1 << 3,   /* do not write depth */
     RL_RASTER_NO_ID         = 1 << 4,   /* do not write IDs */
+    /* Multi-pass rendering (Ullmann 2003, Sec. 3.5.4): a later pass over the
+     * same geometry adds its colour to the target where its depth equals
+     * the stored depth (bit-identical setup gives bit-identical depth). */
+    RL_RASTER_DEPTH_EQUAL   = 1 << 5,   /* pass when depth == stored (instead of <) */
+    RL_RASTER_BLEND_ADD     = 1 << 6,   /* colour += fragment (alpha kept) instead of = */
 } rl_raster_flags;
+
+/* One term of a multi-textured draw (Ullmann 2003, Sec. 3.5.5): per-vertex
+ * colour times a texture looked up at per-vertex uvs, both interpolated
+ * perspective-correctly. A triangle whose texture is RL_ID_NONE (or a layer
+ * without textures/uvs) uses the colour alone. */
+#define RL_RASTER_MAX_LAYERS 4
+typedef struct rl_raster_layer {
+    const rl_vec4 *colors;                /* per vertex, required */
+    const rl_vec2 *uvs;                   /* per vertex, or NULL: untextured */
+    const uint32_t *triangle_texture;     /* per triangle index into textures, or NULL */
+    rl_texture *const *textures;
+} rl_raster_layer;
 
 /* Counters accumulated by draws (add, never reset by the rasterizer). */
 typedef struct rl_raster_counters {
@@ -52,7 +69,9 @@ typedef struct rl_raster_counters {
 } rl_raster_counters;
 
 /* A triangle batch. positions are world space (transformed by the current
- * view-projection). Colour source, first non-NULL wins: colors (per vertex,
+ * view-projection). Colour source, first non-NULL wins: layers (num_layers >
+ * 0: the fragment is the sum over layers of colour x texel, alpha = layer 0's
+ * alpha), colors (per vertex,
  * Gouraud), face_colors (per triangle, flat), otherwise color. With uvs and a
  * texture (the per-triangle texture_index into textures, or texture), the
  * colour is multiplied by the texel. IDs: triangle_ids[i] or
@@ -74,6 +93,8 @@ typedef struct rl_raster_batch {
     const uint32_t *object_ids;
     uint32_t object_id;
     unsigned flags;                       /* rl_raster_flags */
+    uint32_t num_layers;                  /* 0..RL_RASTER_MAX_LAYERS */
+    const rl_raster_layer *layers;
 } rl_raster_batch;
 
 typedef struct rl_raster_points {
@@ -101,7 +122,8 @@ RL_API rl_status rl_raster_set_camera(rl_raster *r, rl_image *target, const rl_c
 RL_API rl_status rl_raster_draw(rl_raster *r, const rl_raster_batch *batch, rl_raster_counters *c);
 RL_API rl_status rl_raster_draw_points(rl_raster *r, const rl_raster_points *pts, rl_raster_counters *c);
 /* Occlusion query: number of pixels of the batch's triangles that would pass
- * the depth test (strictly nearer than the stored depth). Writes nothing. */
+ * the depth test (strictly nearer than the stored depth, or equal to it with
+ * RL_RASTER_DEPTH_EQUAL). Writes nothing. */
 RL_API rl_status rl_raster_query(rl_raster *r, const rl_raster_batch *batch, uint64_t *visible_pixels);
 
 #ifdef __cplusplus

@@ -6,7 +6,11 @@
  * An occlusion query counts what a draw with RL_RASTER_NO_DEPTH would write:
  * like a GPU query with depth writes off, fragments of the batch do not
  * occlude each other. For a batch without self-overlap that equals the
- * pixels_written of a normal draw. */
+ * pixels_written of a normal draw.
+ *
+ * A layered batch (num_layers > 0) is validated here once, so that the fill
+ * can read layer colours without checks; its prims get side records (see
+ * rl_raster_prim_src) and the fill reads the layers from the batch. */
 #include <omp.h>
 
 #include "core/error.h"
@@ -23,6 +27,15 @@ static rl_status check_batch(const rl_raster *r, const rl_raster_batch *b, const
         return rl_error(RL_ERR_INVALID_ARG, "%s: NULL argument", fn);
     if (!r->target)
         return rl_error(RL_ERR_INVALID_ARG, "%s: no render target set", fn);
+    if (b->num_layers > RL_RASTER_MAX_LAYERS)
+        return rl_error(RL_ERR_INVALID_ARG, "%s: %u layers (at most %d)", fn, b->num_layers,
+                        RL_RASTER_MAX_LAYERS);
+    if (b->num_layers > 0 && !b->layers)
+        return rl_error(RL_ERR_INVALID_ARG, "%s: %u layers but layers is NULL", fn,
+                        b->num_layers);
+    for (uint32_t i = 0; i < b->num_layers; ++i)
+        if (!b->layers[i].colors)
+            return rl_error(RL_ERR_INVALID_ARG, "%s: layer %u has no colors", fn, i);
     if (b->num_triangles == 0)
         return RL_OK;
     if (!b->indices || !b->positions)
@@ -77,8 +90,11 @@ static uint64_t fill_band(const rl_raster *r, const rl_raster_target *t, int num
     uint64_t passed = 0;
     for (int c = 0; c < num_chunks; ++c) {
         const rl_raster_chunk *ch = &r->chunks[c];
-        for (uint32_t k = ch->bins.off[band]; k < ch->bins.off[band + 1]; ++k)
-            passed += rl_raster_fill_prim(t, &ch->prims[ch->bins.idx[k]], row0, row1);
+        for (uint32_t k = ch->bins.off[band]; k < ch->bins.off[band + 1]; ++k) {
+            const uint32_t i = ch->bins.idx[k];
+            passed += rl_raster_fill_prim(t, &ch->prims[i], t->layered ? &ch->srcs[i] : NULL,
+                                          row0, row1);
+        }
     }
     return passed;
 }
@@ -129,7 +145,9 @@ static rl_status run(rl_raster *r, const rl_raster_batch *b, bool query, uint64_
                      uint64_t *drawn_out)
 {
     const int threads = rl_raster_thread_count(r);
-    const rl_raster_target t = rl_raster_target_for(r, b->flags, query);
+    rl_raster_target t = rl_raster_target_for(r, b->flags, query);
+    if (b->num_layers > 0 && t.color)
+        t.layered = b;
     const int num_bands = rl_raster_num_bands(t.height);
     rl_status st = transform(r, b->positions, b->num_vertices, threads);
     if (st != RL_OK)

@@ -49,6 +49,18 @@ typedef struct rl_raster_prim {
     int gouraud;
 } rl_raster_prim;
 
+/* Side record of a prim, kept only for layered draws (num_layers > 0), one
+ * per prim at the same index: layers read their attributes from the batch
+ * instead of the prim, so that up to RL_RASTER_MAX_LAYERS colours and uvs
+ * per vertex do not bloat every prim of every other draw. bw[k] holds the
+ * barycentrics of prim vertex k in the source triangle (a clipped fan
+ * vertex lies inside it) over w, so that b_j = sum_k l_k bw[k]_j / (1/w) is
+ * perspective-correct like every other attribute. */
+typedef struct rl_raster_prim_src {
+    rl_vec3 bw[3];
+    uint32_t triangle;            /* index into the batch */
+} rl_raster_prim_src;
+
 /* A point's screen square, already clipped to the viewport. */
 typedef struct rl_raster_point {
     int32_t y0, y1;
@@ -72,6 +84,8 @@ typedef struct rl_raster_bins {
 typedef struct rl_raster_chunk {
     rl_raster_prim *prims;
     size_t num_prims, prim_cap;
+    rl_raster_prim_src *srcs;     /* layered draws only, parallel to prims */
+    size_t src_cap;
     rl_raster_bins bins;
     uint64_t triangles_drawn;
     bool failed;                  /* allocation failed inside a parallel region */
@@ -82,6 +96,9 @@ typedef struct rl_raster_chunk {
 typedef struct rl_raster_target {
     int width, height;
     bool perspective;             /* depth = 1 / (1/w), else (depth/w) / (1/w) */
+    bool depth_equal;             /* RL_RASTER_DEPTH_EQUAL: pass on ==, not < */
+    bool blend_add;               /* RL_RASTER_BLEND_ADD: rgb += fragment */
+    const rl_raster_batch *layered;   /* non-NULL: colour from its layers */
     const float *depth_test;
     float *depth;
     rl_vec4 *color;
@@ -129,8 +146,9 @@ int rl_raster_thread_count(const rl_raster *r);
 rl_raster_target rl_raster_target_for(const rl_raster *r, unsigned flags, bool query);
 
 /* raster_setup.c: culls, clips and sets up triangles [first, first+count) of
- * the batch into chunk (appending, in order); r->clip holds the transformed
- * vertices. Returns false on allocation failure. */
+ * the batch into chunk (appending, in order; for a layered batch also
+ * chunk->srcs); r->clip holds the transformed vertices. Returns false on
+ * allocation failure. */
 bool rl_raster_setup(const rl_raster *r, const rl_raster_batch *b, uint32_t first,
                      uint32_t count, rl_raster_chunk *chunk);
 
@@ -140,9 +158,10 @@ bool rl_raster_bin(rl_raster_bins *bins, const void *items, size_t count, size_t
                    int num_bands);
 
 /* raster_fill.c: rasterizes p within rows [row0, row1); returns the number
- * of fragments that passed the depth test. */
+ * of fragments that passed the depth test. src is p's side record when
+ * t->layered is set, else ignored (may be NULL). */
 uint64_t rl_raster_fill_prim(const rl_raster_target *t, const rl_raster_prim *p,
-                             int row0, int row1);
+                             const rl_raster_prim_src *src, int row0, int row1);
 uint64_t rl_raster_fill_point(const rl_raster_target *t, const rl_raster_point *p,
                               int row0, int row1);
 

@@ -11,7 +11,12 @@
  * Fill rule: top-left, as in Direct3D 10 (pixel centres at +0.5; a centre on
  * a top or left edge is inside). With the triangle ordered so that twice its
  * area is positive in y-down pixel space, an edge a->b is "top" when it is
- * horizontal with dx > 0 and "left" when dy < 0. */
+ * horizontal with dx > 0 and "left" when dy < 0.
+ *
+ * Layered draws (rl_raster_layer) carry each polygon vertex's barycentrics in
+ * its source triangle through clipping and store them, over w, in a side
+ * record next to the prim (rl_raster_prim_src); the layers' colours and uvs
+ * are then read from the batch at fill time. */
 #include <math.h>
 
 #include "raster/raster_internal.h"
@@ -22,6 +27,7 @@ typedef struct cvert {
     rl_vec4 c;
     rl_vec2 uv;
     float d;
+    rl_vec3 b;                    /* barycentrics in the source triangle */
 } cvert;
 
 /* Outcode bits: planes that clip (distance < 0 is outside) and the viewport
@@ -68,6 +74,8 @@ static cvert lerp_vert(const cvert *a, const cvert *b, float t)
                 rl_lerpf(a->c.z, b->c.z, t), rl_lerpf(a->c.w, b->c.w, t));
     v.uv = rl_v2(rl_lerpf(a->uv.x, b->uv.x, t), rl_lerpf(a->uv.y, b->uv.y, t));
     v.d = rl_lerpf(a->d, b->d, t);
+    v.b = rl_v3(rl_lerpf(a->b.x, b->b.x, t), rl_lerpf(a->b.y, b->b.y, t),
+                rl_lerpf(a->b.z, b->b.z, t));
     return v;
 }
 
@@ -117,9 +125,10 @@ typedef struct svert {
     float iw, dw;
     rl_vec4 cw;
     rl_vec2 uvw;
+    rl_vec3 bw;                   /* source barycentrics / w */
 } svert;
 
-static bool project(const cvert *v, int width, int height, svert *s)
+static bool project(const cvert *v, int width, int height, bool layered, svert *s)
 {
     if (!(v->p.w > 0.0f))
         return false;
@@ -141,6 +150,8 @@ static bool project(const cvert *v, int width, int height, svert *s)
     s->dw = v->d * iw;
     s->cw = rl_v4(v->c.x * iw, v->c.y * iw, v->c.z * iw, v->c.w * iw);
     s->uvw = rl_v2(v->uv.x * iw, v->uv.y * iw);
+    if (layered)
+        s->bw = rl_v3(v->b.x * iw, v->b.y * iw, v->b.z * iw);
     return true;
 }
 
@@ -152,10 +163,12 @@ static int32_t fill_bias(const svert *a, const svert *b)
     return top_left ? 0 : -1;
 }
 
-/* Sets up triangle (a, b, c) into *p; false when it is degenerate, culled,
- * or its bounding box holds no pixel centre of the viewport. */
+/* Sets up triangle (a, b, c) into *p (and, when src is not NULL, the
+ * source barycentrics into *src in p's vertex order); false when it is
+ * degenerate, culled, or its bounding box holds no pixel centre of the
+ * viewport. */
 static bool setup_tri(const svert *a, const svert *b, const svert *c, bool cull_back,
-                      int width, int height, rl_raster_prim *p)
+                      int width, int height, rl_raster_prim *p, rl_raster_prim_src *src)
 {
     int64_t area2 = ((int64_t)b->x - a->x) * ((int64_t)c->y - a->y) -
                     ((int64_t)b->y - a->y) * ((int64_t)c->x - a->x);
@@ -220,6 +233,9 @@ static bool setup_tri(const svert *a, const svert *b, const svert *c, bool cull_
         p->uvw[k] = v[k]->uvw;
         p->bias[k] = fill_bias(v[(k + 1) % 3], v[(k + 2) % 3]);
     }
+    if (src)
+        for (int k = 0; k < 3; ++k)
+            src->bw[k] = v[k]->bw;
     return true;
 }
 
@@ -234,6 +250,7 @@ bool rl_raster_setup(const rl_raster *r, const rl_raster_batch *b, uint32_t firs
     const int width = r->target->width, height = r->target->height;
     const float gx = r->guard_x, gy = r->guard_y;
     const bool cull_back = (b->flags & RL_RASTER_CULL_BACK) != 0;
+    const bool layered = b->num_layers > 0;
     for (uint32_t t = first; t < first + count; ++t) {
         const uint32_t *tri = &b->indices[3 * (size_t)t];
         cvert poly[MAX_POLY];
@@ -251,7 +268,7 @@ bool rl_raster_setup(const rl_raster *r, const rl_raster_batch *b, uint32_t firs
             continue;
 
         const rl_texture *tex = NULL;
-        if (b->uvs) {
+        if (b->uvs && !layered) {
             if (b->triangle_texture && b->textures) {
                 uint32_t ti = b->triangle_texture[t];
                 tex = ti == RL_ID_NONE ? NULL : b->textures[ti];
@@ -263,6 +280,7 @@ bool rl_raster_setup(const rl_raster *r, const rl_raster_batch *b, uint32_t firs
             poly[k].c = b->colors ? b->colors[tri[k]] : rl_v4(0, 0, 0, 0);
             poly[k].uv = tex ? b->uvs[tri[k]] : rl_v2(0, 0);
             poly[k].d = r->perspective ? 0.0f : r->eye_depth[tri[k]];
+            poly[k].b = rl_v3(k == 0 ? 1.0f : 0.0f, k == 1 ? 1.0f : 0.0f, k == 2 ? 1.0f : 0.0f);
         }
         int n = 3;
         if (oc_or & CLIP_PLANES)
@@ -272,7 +290,7 @@ bool rl_raster_setup(const rl_raster *r, const rl_raster_batch *b, uint32_t firs
         svert sv[MAX_POLY];
         bool ok = true;
         for (int k = 0; k < n && ok; ++k)
-            ok = project(&poly[k], width, height, &sv[k]);
+            ok = project(&poly[k], width, height, layered, &sv[k]);
         if (!ok)
             continue;
 
@@ -288,9 +306,17 @@ bool rl_raster_setup(const rl_raster *r, const rl_raster_batch *b, uint32_t firs
                 !rl_raster_reserve((void **)&chunk->prims, &chunk->prim_cap, chunk->num_prims + 1,
                                    sizeof *chunk->prims))
                 return false;
+            rl_raster_prim_src *src = NULL;
+            if (layered) {
+                if (!rl_raster_reserve((void **)&chunk->srcs, &chunk->src_cap,
+                                       chunk->num_prims + 1, sizeof *chunk->srcs))
+                    return false;
+                src = &chunk->srcs[chunk->num_prims];
+                src->triangle = t;
+            }
             rl_raster_prim *p = &chunk->prims[chunk->num_prims];
             *p = proto;
-            if (setup_tri(&sv[0], &sv[k], &sv[k + 1], cull_back, width, height, p)) {
+            if (setup_tri(&sv[0], &sv[k], &sv[k + 1], cull_back, width, height, p, src)) {
                 chunk->num_prims++;
                 drawn = true;
             }

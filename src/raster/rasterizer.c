@@ -31,6 +31,7 @@ void rl_raster_release(rl_raster *r)
         return;
     for (int i = 0; i < r->chunk_cap; ++i) {
         free(r->chunks[i].prims);
+        free(r->chunks[i].srcs);
         free(r->chunks[i].bins.off);
         free(r->chunks[i].bins.idx);
     }
@@ -134,7 +135,9 @@ rl_raster_target rl_raster_target_for(const rl_raster *r, unsigned flags, bool q
 {
     rl_image *img = r->target;
     rl_raster_target t = { .width = img->width, .height = img->height,
-                           .perspective = r->perspective };
+                           .perspective = r->perspective,
+                           .depth_equal = (flags & RL_RASTER_DEPTH_EQUAL) != 0,
+                           .blend_add = (flags & RL_RASTER_BLEND_ADD) != 0 };
     if (!(flags & RL_RASTER_NO_DEPTH_TEST))
         t.depth_test = img->depth;
     if (query)

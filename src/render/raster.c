@@ -21,8 +21,16 @@
  *  - textured: the rasterizer multiplies the whole interpolated colour by
  *    the texel, so the texture modulates specular and emission too, not only
  *    k_d as in the ray tracers. Fine for matte textured scenes, which is
- *    what textures are used for here; splitting into two passes would need
- *    additive blending that src/raster does not have. */
+ *    what textures are used for here. src/raster could now split it (two
+ *    layers, or a second RL_RASTER_DEPTH_EQUAL | RL_RASTER_BLEND_ADD pass,
+ *    Ullmann 2003, Sec. 3.5.4-3.5.5); not done, so that "raster" images stay
+ *    comparable with earlier runs.
+ *
+ * The scene drawing itself (lighting + one batch per object) is
+ * rl_raster_draw_scene (raster_scene.h), shared with the hybrid renderers:
+ * an object mask selects what to draw, and with RL_RASTER_NO_COLOR nothing
+ * is lit at all (the ID/Z pre-pass of Vertex Tracing). raster_render() only
+ * sets up the target, clears it and calls it for every object. */
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -33,10 +41,11 @@
 
 #include "core/error.h"
 #include "render/light_eval.h"
+#include "render/raster_scene.h"
 #include "render/renderer.h"
 #include "rl/rl_raster.h"
 
-enum { SHADING_FLAT = 0, SHADING_GOURAUD, SHADING_TEXTURED };
+/* Option order = rl_raster_shading order. */
 static const char *const shading_choices[] = { "flat", "gouraud", "textured", NULL };
 
 static const rl_option_info raster_options[] = {
@@ -107,7 +116,7 @@ static rl_vec4 phong(const shade_ctx *ctx, const rl_material *m, rl_vec3 p, rl_v
     return rl_v4_from3(c, 1.0f);
 }
 
-/* Per-frame buffers; everything is NULL unless the shading mode needs it. */
+/* Per-draw buffers; everything is NULL unless the shading mode needs it. */
 typedef struct frame_buffers {
     uint32_t *object_material;   /* per object: shared material or RL_NONE */
     uint32_t *vertex_material;   /* per vertex of single-material objects */
@@ -121,7 +130,6 @@ typedef struct frame_buffers {
     rl_vec4 *corner_colors;
     uint32_t *triangle_texture;  /* per triangle, textured mode */
     uint32_t *indices;           /* scratch: one object's local indices */
-    float *depth;                /* when the image has no depth layer */
 } frame_buffers;
 
 static void free_buffers(frame_buffers *b)
@@ -135,7 +143,6 @@ static void free_buffers(frame_buffers *b)
     free(b->corner_colors);
     free(b->triangle_texture);
     free(b->indices);
-    free(b->depth);
 }
 
 static uint32_t texture_of(const rl_scene_data *d, uint32_t material)
@@ -144,11 +151,19 @@ static uint32_t texture_of(const rl_scene_data *d, uint32_t material)
     return t < d->num_textures ? t : RL_ID_NONE;
 }
 
-/* Allocates what the mode needs and finds each object's shared material. */
-static rl_status prepare(const rl_scene_data *d, int shading, frame_buffers *b, bool *any_mixed)
+static bool selected(const uint8_t *mask, uint32_t object)
+{
+    return !mask || mask[object];
+}
+
+/* Allocates what the mode needs and finds each object's shared material.
+ * Unlit draws need only the index scratch; unselected objects get no
+ * lighting (their vertices keep material RL_NONE). */
+static rl_status prepare(const rl_scene_data *d, rl_raster_shading shading, bool lit,
+                         const uint8_t *mask, frame_buffers *b)
 {
     uint32_t max_tris = 0;
-    *any_mixed = false;
+    bool any_mixed = false;
     b->object_material = rl_calloc(d->num_objects ? d->num_objects : 1, sizeof *b->object_material);
     if (!b->object_material)
         return RL_ERR_OUT_OF_MEMORY;
@@ -159,15 +174,17 @@ static rl_status prepare(const rl_scene_data *d, int shading, frame_buffers *b, 
             if (d->triangle_material[obj->first_triangle + t] != m)
                 m = RL_NONE;
         b->object_material[o] = m;
-        *any_mixed |= obj->num_triangles > 0 && m == RL_NONE;
+        any_mixed |= obj->num_triangles > 0 && m == RL_NONE && selected(mask, o);
         if (obj->num_triangles > max_tris)
             max_tris = obj->num_triangles;
     }
     b->indices = rl_calloc((size_t)max_tris * 3 + 1, sizeof *b->indices);
     if (!b->indices)
         return RL_ERR_OUT_OF_MEMORY;
+    if (!lit)
+        return RL_OK;
 
-    if (shading == SHADING_FLAT) {
+    if (shading == RL_SHADING_FLAT) {
         b->face_colors = rl_calloc((size_t)d->num_triangles + 1, sizeof *b->face_colors);
         return b->face_colors ? RL_OK : RL_ERR_OUT_OF_MEMORY;
     }
@@ -181,10 +198,12 @@ static rl_status prepare(const rl_scene_data *d, int shading, frame_buffers *b, 
         b->vertex_material[v] = RL_NONE;
     for (uint32_t o = 0; o < d->num_objects; ++o) {
         const rl_object *obj = &d->objects[o];
+        if (!selected(mask, o))
+            continue;
         for (uint32_t v = 0; v < obj->num_vertices; ++v)
             b->vertex_material[obj->first_vertex + v] = b->object_material[o];
     }
-    if (!*any_mixed)
+    if (!any_mixed)
         return RL_OK;
     size_t corners = (size_t)d->num_triangles * 3;
     b->corner_positions = rl_calloc(corners, sizeof *b->corner_positions);
@@ -196,16 +215,20 @@ static rl_status prepare(const rl_scene_data *d, int shading, frame_buffers *b, 
     return RL_OK;
 }
 
-/* Lights vertices, corners or faces in parallel; every result depends only
- * on its own element, so the output does not depend on the thread count. */
-static void light_scene(const shade_ctx *ctx, int shading, int threads, frame_buffers *b)
+/* Lights the vertices, corners or faces of the selected objects in
+ * parallel; every result depends only on its own element, so the output
+ * does not depend on the thread count. */
+static void light_scene(const shade_ctx *ctx, rl_raster_shading shading, int threads,
+                        const uint8_t *mask, frame_buffers *b)
 {
     const rl_scene_data *d = ctx->data;
     const int64_t nt = d->num_triangles, nv = d->num_vertices;
 
-    if (shading == SHADING_FLAT) {
+    if (shading == RL_SHADING_FLAT) {
 #pragma omp parallel for num_threads(threads) schedule(static)
         for (int64_t t = 0; t < nt; ++t) {
+            if (!selected(mask, d->triangle_object[t]))
+                continue;
             const uint32_t *tri = &d->indices[3 * t];
             rl_vec3 p0 = d->positions[tri[0]], p1 = d->positions[tri[1]], p2 = d->positions[tri[2]];
             rl_vec3 centroid = rl_scale(rl_add(rl_add(p0, p1), p2), 1.0f / 3.0f);
@@ -225,7 +248,8 @@ static void light_scene(const shade_ctx *ctx, int shading, int threads, frame_bu
         return;
 #pragma omp parallel for num_threads(threads) schedule(static)
     for (int64_t t = 0; t < nt; ++t) {
-        if (b->object_material[d->triangle_object[t]] != RL_NONE)
+        uint32_t o = d->triangle_object[t];
+        if (b->object_material[o] != RL_NONE || !selected(mask, o))
             continue;
         uint32_t m = d->triangle_material[t];
         for (int k = 0; k < 3; ++k) {
@@ -234,14 +258,17 @@ static void light_scene(const shade_ctx *ctx, int shading, int threads, frame_bu
             b->corner_uvs[3 * t + k] = d->uvs[vi];
             b->corner_colors[3 * t + k] = phong(ctx, &d->materials[m], d->positions[vi], d->normals[vi]);
         }
-        b->triangle_texture[t] = shading == SHADING_TEXTURED ? texture_of(d, m) : RL_ID_NONE;
+        b->triangle_texture[t] = shading == RL_SHADING_TEXTURED ? texture_of(d, m) : RL_ID_NONE;
     }
 }
 
 /* One batch per object: object IDs come from the batch, triangle IDs are the
- * scene's global (flattened) triangle indices. */
-static rl_status draw_object(rl_raster *ras, const rl_scene_data *d, uint32_t o, int shading,
-                             unsigned flags, frame_buffers *b, rl_raster_counters *counters)
+ * scene's global (flattened) triangle indices. Unlit draws take the
+ * object's own vertices even for mixed materials: the corner copies hold
+ * the same positions, so depth and IDs are bit-identical either way. */
+static rl_status draw_object(rl_raster *ras, const rl_scene_data *d, uint32_t o,
+                             rl_raster_shading shading, bool lit, unsigned flags,
+                             frame_buffers *b, rl_raster_counters *counters)
 {
     const rl_object *obj = &d->objects[o];
     if (obj->num_triangles == 0)
@@ -255,14 +282,14 @@ static rl_status draw_object(rl_raster *ras, const rl_scene_data *d, uint32_t o,
     batch.indices = b->indices;
 
     uint32_t m = b->object_material[o];
-    if (shading != SHADING_FLAT && m == RL_NONE) {
+    if (lit && shading != RL_SHADING_FLAT && m == RL_NONE) {
         size_t first = (size_t)obj->first_triangle * 3;
         batch.num_vertices = obj->num_triangles * 3;
         batch.positions = b->corner_positions + first;
         batch.colors = b->corner_colors + first;
         for (uint32_t i = 0; i < batch.num_vertices; ++i)
             b->indices[i] = i;
-        if (shading == SHADING_TEXTURED) {
+        if (shading == RL_SHADING_TEXTURED) {
             batch.uvs = b->corner_uvs + first;
             batch.triangle_texture = b->triangle_texture + obj->first_triangle;
             batch.textures = d->textures;
@@ -280,17 +307,72 @@ static rl_status draw_object(rl_raster *ras, const rl_scene_data *d, uint32_t o,
     }
     batch.num_vertices = obj->num_vertices;
     batch.positions = d->positions + obj->first_vertex;
-    if (shading == SHADING_FLAT) {
+    if (!lit)
+        return rl_raster_draw(ras, &batch, counters);
+    if (shading == RL_SHADING_FLAT) {
         batch.face_colors = b->face_colors + obj->first_triangle;
     } else {
         batch.colors = b->vertex_colors + obj->first_vertex;
-        uint32_t tex = shading == SHADING_TEXTURED ? texture_of(d, m) : RL_ID_NONE;
+        uint32_t tex = shading == RL_SHADING_TEXTURED ? texture_of(d, m) : RL_ID_NONE;
         if (tex != RL_ID_NONE) {
             batch.uvs = d->uvs + obj->first_vertex;
             batch.texture = d->textures[tex];
         }
     }
     return rl_raster_draw(ras, &batch, counters);
+}
+
+rl_status rl_raster_draw_scene(rl_raster *ras, const rl_scene_data *d, rl_vec3 eye,
+                               const rl_raster_scene_desc *desc, rl_raster_counters *c,
+                               bool (*progress)(void *user, double done), void *user)
+{
+    if (!ras || !d)
+        return rl_error(RL_ERR_INVALID_ARG, "rl_raster_draw_scene: NULL argument");
+    rl_raster_scene_desc opt;
+    memset(&opt, 0, sizeof opt);
+    if (desc)
+        opt = *desc;
+    if (opt.shading != RL_SHADING_FLAT && opt.shading != RL_SHADING_GOURAUD &&
+        opt.shading != RL_SHADING_TEXTURED)
+        return rl_error(RL_ERR_INVALID_ARG, "rl_raster_draw_scene: unknown shading %d",
+                        (int)opt.shading);
+    if (opt.threads < 0)
+        return rl_error(RL_ERR_INVALID_ARG, "rl_raster_draw_scene: threads %d < 0", opt.threads);
+    const bool lit = !(opt.flags & RL_RASTER_NO_COLOR);
+
+    frame_buffers b;
+    memset(&b, 0, sizeof b);
+    rl_status st = prepare(d, opt.shading, lit, opt.object_mask, &b);
+    if (st != RL_OK) {
+        free_buffers(&b);
+        return rl_error(st, "rl_raster_draw_scene: buffers for %u triangles", d->num_triangles);
+    }
+    if (lit) {
+#ifdef _OPENMP
+        int lighting_threads = opt.threads > 0 ? opt.threads : omp_get_max_threads();
+#else
+        int lighting_threads = 1;
+#endif
+        shade_ctx ctx = { d, eye, opt.ambient };
+        light_scene(&ctx, opt.shading, lighting_threads, opt.object_mask, &b);
+    }
+
+    /* Report progress about a hundred times, not once per object. */
+    uint32_t step = d->num_objects / 100 + 1;
+    for (uint32_t o = 0; st == RL_OK && o < d->num_objects; ++o) {
+        if (selected(opt.object_mask, o))
+            st = draw_object(ras, d, o, opt.shading, lit, opt.flags, &b, c);
+        if (st == RL_OK && progress && (o + 1) % step == 0 &&
+            !progress(user, (double)(o + 1) / d->num_objects))
+            st = rl_error(RL_ERR_CANCELLED, "raster: cancelled by the progress callback");
+    }
+    free_buffers(&b);
+    return st;
+}
+
+static bool renderer_progress(void *user, double done)
+{
+    return rl_renderer_progress((const rl_renderer *)user, done);
 }
 
 static rl_status raster_render(rl_renderer *r, void *state, const rl_scene *scene,
@@ -300,45 +382,30 @@ static rl_status raster_render(rl_renderer *r, void *state, const rl_scene *scen
     const rl_scene_data *d = rl_scene_get_data(scene);
     if (!d)
         return RL_ERR_NOT_COMMITTED;
-    int shading = rl_renderer_opt_enum(r, "shading");
-    int threads = (int)rl_renderer_opt_int(r, "threads");
-#ifdef _OPENMP
-    int lighting_threads = threads > 0 ? threads : omp_get_max_threads();
-#else
-    int lighting_threads = 1;
-#endif
-    shade_ctx ctx = { d, cam->eye, (float)rl_renderer_opt_float(r, "ambient") };
-    unsigned flags = rl_renderer_opt_bool(r, "cull") ? RL_RASTER_CULL_BACK : 0u;
-
-    frame_buffers b;
-    memset(&b, 0, sizeof b);
-    bool any_mixed;
-    rl_status st = prepare(d, shading, &b, &any_mixed);
-    if (st != RL_OK) {
-        free_buffers(&b);
-        return st;
-    }
+    rl_raster_scene_desc desc = {
+        .shading = (rl_raster_shading)rl_renderer_opt_enum(r, "shading"),
+        .ambient = (float)rl_renderer_opt_float(r, "ambient"),
+        .threads = (int)rl_renderer_opt_int(r, "threads"),
+        .flags = rl_renderer_opt_bool(r, "cull") ? RL_RASTER_CULL_BACK : 0u,
+    };
 
     /* The rasterizer depth-tests against the target's depth layer; borrow a
      * private one when the caller did not ask for depth. */
     rl_image target = *image;
     size_t num_pixels = (size_t)image->width * (size_t)image->height;
+    float *own_depth = NULL;
     if (!(target.layers & RL_LAYER_DEPTH) || !target.depth) {
-        b.depth = rl_calloc(num_pixels, sizeof *b.depth);
-        if (!b.depth) {
-            free_buffers(&b);
+        own_depth = rl_calloc(num_pixels, sizeof *own_depth);
+        if (!own_depth)
             return RL_ERR_OUT_OF_MEMORY;
-        }
-        target.depth = b.depth;
+        target.depth = own_depth;
         target.layers |= RL_LAYER_DEPTH;
     }
     if (!(target.layers & RL_LAYER_ID) || !target.object_id || !target.triangle_id)
-        flags |= RL_RASTER_NO_ID;
-
-    light_scene(&ctx, shading, lighting_threads, &b);
+        desc.flags |= RL_RASTER_NO_ID;
 
     rl_raster *ras = NULL;
-    st = rl_raster_create(&(rl_raster_desc){ .threads = threads }, &ras);
+    rl_status st = rl_raster_create(&(rl_raster_desc){ .threads = desc.threads }, &ras);
     if (st == RL_OK)
         st = rl_raster_set_camera(ras, &target, cam, d->bounds);
     if (st == RL_OK) {
@@ -346,19 +413,12 @@ static rl_status raster_render(rl_renderer *r, void *state, const rl_scene *scen
         rl_image_clear(&target);
         rl_image_fill(&target, rl_v4_from3(bg, 1.0f));
     }
-
     rl_raster_counters counters;
     memset(&counters, 0, sizeof counters);
-    /* Report progress about a hundred times, not once per object. */
-    uint32_t step = d->num_objects / 100 + 1;
-    for (uint32_t o = 0; st == RL_OK && o < d->num_objects; ++o) {
-        st = draw_object(ras, d, o, shading, flags, &b, &counters);
-        if (st == RL_OK && (o + 1) % step == 0 &&
-            !rl_renderer_progress(r, (double)(o + 1) / d->num_objects))
-            st = rl_error(RL_ERR_CANCELLED, "raster: cancelled by the progress callback");
-    }
+    if (st == RL_OK)
+        st = rl_raster_draw_scene(ras, d, cam->eye, &desc, &counters, renderer_progress, r);
     rl_raster_release(ras);
-    free_buffers(&b);
+    free(own_depth);
     if (st != RL_OK)
         return st;
 

@@ -1,0 +1,41 @@
+/* raster_scene.h: the "raster" renderer's way of drawing a committed scene,
+ * shared with the hybrid renderers. Vertex Tracing (Ullmann 2003, Sec. 3.5)
+ * draws its ID/Z pre-pass and its non-VT objects through exactly this code,
+ * so that "rasterized" means the same thing in every renderer.
+ *
+ * Lighting is raster.c's local Phong model (see there); it is evaluated only
+ * when the draw writes colour. */
+#ifndef RL_RENDER_RASTER_SCENE_H
+#define RL_RENDER_RASTER_SCENE_H
+
+#include "rl/rl_raster.h"
+#include "rl/rl_scene.h"
+
+typedef enum rl_raster_shading {
+    RL_SHADING_FLAT = 0,      /* per triangle, geometric normal at the centroid */
+    RL_SHADING_GOURAUD,       /* per vertex, interpolated */
+    RL_SHADING_TEXTURED,      /* gouraud times the diffuse texture */
+} rl_raster_shading;
+
+typedef struct rl_raster_scene_desc {
+    rl_raster_shading shading;
+    float ambient;            /* times k_d */
+    int threads;              /* for lighting; 0 = all */
+    unsigned flags;           /* rl_raster_flags added to every batch; with
+                               * RL_RASTER_NO_COLOR no lighting is computed */
+    const uint8_t *object_mask;   /* per object, nonzero = draw; NULL = all */
+} rl_raster_scene_desc;
+
+/* Draws the objects of d selected by the mask into the rasterizer's current
+ * target (set with rl_raster_set_target/set_camera; it must have a depth
+ * layer), one batch per object: object IDs are object indices, triangle IDs
+ * the scene's global triangle indices. eye is the viewer position for
+ * specular lighting and two-sided normals. Counters accumulate into c
+ * (may be NULL). progress (may be NULL) is called with the fraction of
+ * objects done about a hundred times; returning false cancels with
+ * RL_ERR_CANCELLED. */
+rl_status rl_raster_draw_scene(rl_raster *ras, const rl_scene_data *d, rl_vec3 eye,
+                               const rl_raster_scene_desc *desc, rl_raster_counters *c,
+                               bool (*progress)(void *user, double done), void *user);
+
+#endif

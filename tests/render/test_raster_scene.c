@@ -1,0 +1,257 @@
+/* test_raster_scene.c: rl_raster_draw_scene, the "raster" renderer's scene
+ * drawing shared with the hybrid renderers (Ullmann 2003, Sec. 3.5: ID/Z
+ * pre-pass and non-VT objects). Oracles: the renderer itself (bitwise), a
+ * full draw (what a mask keeps), a lit draw (what an unlit one writes). */
+#include <math.h>
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include <cmocka.h>
+
+#include "render/raster_scene.h"
+#include "rl/rl_raster.h"
+#include "rl/rl_render.h"
+#include "rl/rl_scene.h"
+#include "render/render_fixtures.h"
+
+#define SIZE 48
+
+static void add_quad(rl_scene *s, float x0, float y0, float x1, float y1, float z,
+                     const uint32_t *triangle_materials, uint32_t material)
+{
+    const rl_vec3 pos[4] = { { x0, y0, z }, { x1, y0, z }, { x1, y1, z }, { x0, y1, z } };
+    const rl_vec3 nrm[4] = { { 0, 0, 1 }, { 0, 0, 1 }, { 0, 0, 1 }, { 0, 0, 1 } };
+    const rl_vec2 uv[4] = { { 0, 0 }, { 1, 0 }, { 1, 1 }, { 0, 1 } };
+    const uint32_t idx[6] = { 0, 1, 2, 0, 2, 3 };
+    rl_mesh_desc md = { .name = "quad", .num_vertices = 4, .positions = pos, .normals = nrm,
+                        .uvs = uv, .num_triangles = 2, .indices = idx,
+                        .triangle_materials = triangle_materials, .material = material };
+    uint32_t mesh, node;
+    assert_int_equal(rl_scene_add_mesh(s, &md, &mesh), RL_OK);
+    assert_int_equal(rl_scene_add_node(s, RL_NODE_ROOT, "quad", NULL, &node), RL_OK);
+    assert_int_equal(rl_scene_node_set_mesh(s, node, mesh), RL_OK);
+}
+
+/* Three overlapping quads facing +z: object 0 at the back mixes a textured
+ * and a plain material, objects 1 and 2 are single-material and nearer. */
+static rl_scene *stack_scene(rl_camera *cam)
+{
+    rl_scene *s = NULL;
+    assert_int_equal(rl_scene_create(&s), RL_OK);
+    const rl_vec4 texels[4] = { { 1, 0.5f, 0.25f, 1 }, { 0.25f, 1, 0.5f, 1 },
+                                { 0.5f, 0.25f, 1, 1 }, { 1, 1, 1, 1 } };
+    rl_texture *tex = NULL;
+    uint32_t tex_id, red, green, blue;
+    assert_int_equal(rl_texture_create(2, 2, texels, &tex), RL_OK);
+    assert_int_equal(rl_scene_add_texture(s, tex, &tex_id), RL_OK);
+    rl_material m = rl_material_default();
+    m.diffuse = rl_v3(0.8f, 0.2f, 0.2f);
+    m.diffuse_texture = tex_id;
+    assert_int_equal(rl_scene_add_material(s, &m, &red), RL_OK);
+    m = rl_material_default();
+    m.diffuse = rl_v3(0.2f, 0.8f, 0.2f);
+    m.specular = rl_v3s(0.4f);
+    assert_int_equal(rl_scene_add_material(s, &m, &green), RL_OK);
+    m = rl_material_default();
+    m.diffuse = rl_v3(0.2f, 0.2f, 0.8f);
+    assert_int_equal(rl_scene_add_material(s, &m, &blue), RL_OK);
+    const uint32_t mixed[2] = { red, green };
+    add_quad(s, -1.0f, -1.0f, 1.0f, 1.0f, -1.0f, mixed, red);
+    add_quad(s, -0.6f, -0.2f, 0.3f, 0.7f, -0.5f, NULL, blue);
+    add_quad(s, 0.0f, -0.8f, 0.8f, 0.1f, 0.0f, NULL, green);
+    rl_light l = { .type = RL_LIGHT_POINT, .color = { 1, 1, 1 }, .intensity = 3.0f,
+                   .position = { 0.3f, 0.5f, 2.0f } };
+    assert_int_equal(rl_scene_add_light(s, &l), RL_OK);
+    assert_int_equal(rl_scene_commit(s), RL_OK);
+    *cam = (rl_camera){ .eye = { 0.1f, 0.05f, 3.0f }, .target = { 0, 0, -1 }, .up = { 0, 1, 0 },
+                        .fov_deg = 45.0f, .width = SIZE, .height = SIZE };
+    return s;
+}
+
+typedef struct drawn {
+    rl_image *img;
+    rl_raster_counters counters;
+} drawn;
+
+/* A fresh image (colour filled with fill) drawn into with draw_scene. */
+static drawn draw_scene(const rl_scene *s, const rl_camera *cam, const rl_raster_scene_desc *desc,
+                        rl_vec4 fill)
+{
+    const rl_scene_data *d = rl_scene_get_data(s);
+    drawn out = { NULL, { 0 } };
+    assert_int_equal(rl_image_create(cam->width, cam->height, FX_ALL_LAYERS, &out.img), RL_OK);
+    rl_image_fill(out.img, fill);
+    rl_raster *ras = NULL;
+    assert_int_equal(rl_raster_create(NULL, &ras), RL_OK);
+    assert_int_equal(rl_raster_set_camera(ras, out.img, cam, d->bounds), RL_OK);
+    assert_int_equal(rl_raster_draw_scene(ras, d, cam->eye, desc, &out.counters, NULL, NULL),
+                     RL_OK);
+    rl_raster_release(ras);
+    return out;
+}
+
+static size_t pixels_of(const rl_image *img, uint32_t object)
+{
+    size_t n = 0;
+    for (size_t i = 0; i < (size_t)img->width * img->height; ++i)
+        n += img->object_id[i] == object;
+    return n;
+}
+
+static void test_mask_draws_only_the_selected_objects(void **state)
+{
+    (void)state;
+    rl_camera cam;
+    rl_scene *s = stack_scene(&cam);
+    rl_raster_scene_desc desc = { .shading = RL_SHADING_TEXTURED, .ambient = 0.05f };
+    drawn all = draw_scene(s, &cam, &desc, rl_v4(0, 0, 0, 1));
+    for (uint32_t o = 0; o < 3; ++o)
+        assert_true(pixels_of(all.img, o) > 50);
+
+    const uint8_t mask[3] = { 1, 0, 1 };
+    desc.object_mask = mask;
+    drawn some = draw_scene(s, &cam, &desc, rl_v4(0, 0, 0, 1));
+    const size_t n = (size_t)SIZE * SIZE;
+    for (size_t i = 0; i < n; ++i) {
+        uint32_t id = some.img->object_id[i];
+        assert_true(id == 0 || id == 2 || id == RL_ID_NONE);
+        /* Where a selected object was in front, it still is, and looks the
+         * same: lighting of an object does not depend on the others. */
+        if (all.img->object_id[i] == 0 || all.img->object_id[i] == 2) {
+            assert_int_equal(id, all.img->object_id[i]);
+            assert_memory_equal(&some.img->color[i], &all.img->color[i], sizeof(rl_vec4));
+            assert_memory_equal(&some.img->depth[i], &all.img->depth[i], sizeof(float));
+        }
+    }
+    /* Object 1 hid part of object 0: that part shows now. */
+    assert_true(pixels_of(some.img, 0) > pixels_of(all.img, 0));
+    assert_int_equal(pixels_of(some.img, 1), 0);
+    assert_int_equal(some.counters.triangles_in, 4);
+    assert_int_equal(all.counters.triangles_in, 6);
+
+    const uint8_t none[3] = { 0, 0, 0 };
+    desc.object_mask = none;
+    drawn nothing = draw_scene(s, &cam, &desc, rl_v4(0, 0, 0, 1));
+    assert_int_equal(nothing.counters.pixels_written, 0);
+    assert_int_equal(pixels_of(nothing.img, RL_ID_NONE), n);
+    rl_image_release(all.img);
+    rl_image_release(some.img);
+    rl_image_release(nothing.img);
+    rl_scene_release(s);
+}
+
+static void test_no_color_writes_depth_and_ids_of_a_lit_draw_and_leaves_colour_alone(void **state)
+{
+    (void)state;
+    rl_camera cam;
+    rl_scene *s = stack_scene(&cam);
+    const rl_vec4 sentinel = { 0.25f, 0.5f, 0.75f, 0.125f };
+    const rl_raster_shading modes[3] = { RL_SHADING_FLAT, RL_SHADING_GOURAUD,
+                                         RL_SHADING_TEXTURED };
+    const size_t n = (size_t)SIZE * SIZE;
+    for (int k = 0; k < 3; ++k) {
+        rl_raster_scene_desc desc = { .shading = modes[k], .ambient = 0.1f };
+        drawn lit = draw_scene(s, &cam, &desc, sentinel);
+        desc.flags = RL_RASTER_NO_COLOR;
+        drawn ids = draw_scene(s, &cam, &desc, sentinel);
+        for (size_t i = 0; i < n; ++i)
+            assert_memory_equal(&ids.img->color[i], &sentinel, sizeof sentinel);
+        /* Bitwise, also for the object mixing materials, which the lit draw
+         * sends through per-corner copies of its vertices. */
+        assert_memory_equal(ids.img->depth, lit.img->depth, n * sizeof(float));
+        assert_memory_equal(ids.img->object_id, lit.img->object_id, n * sizeof(uint32_t));
+        assert_memory_equal(ids.img->triangle_id, lit.img->triangle_id, n * sizeof(uint32_t));
+        assert_int_equal(ids.counters.pixels_written, lit.counters.pixels_written);
+        assert_true(pixels_of(ids.img, RL_ID_NONE) < n);
+        rl_image_release(lit.img);
+        rl_image_release(ids.img);
+    }
+    rl_scene_release(s);
+}
+
+static void test_raster_renderer_output_equals_drawing_the_whole_scene(void **state)
+{
+    (void)state;
+    rl_camera cam;
+    rl_scene *s = stack_scene(&cam);
+    const char *const modes[3] = { "flat", "gouraud", "textured" };
+    for (int k = 0; k < 3; ++k) {
+        const char *const opts[] = { "shading", modes[k], "ambient", "0.2", "cull", "true",
+                                     "background", "0.1,0.2,0.3", NULL };
+        rl_render_stats stats;
+        memset(&stats, 0, sizeof stats);
+        rl_image *rendered = fx_render("raster", s, &cam, FX_ALL_LAYERS, opts, &stats);
+        rl_raster_scene_desc desc = { .shading = (rl_raster_shading)k, .ambient = 0.2f,
+                                      .flags = RL_RASTER_CULL_BACK };
+        drawn direct = draw_scene(s, &cam, &desc, rl_v4(0.1f, 0.2f, 0.3f, 1.0f));
+        fx_assert_images_identical(rendered, direct.img);
+        assert_int_equal(stats.pixels_written, direct.counters.pixels_written);
+        assert_int_equal(stats.triangles_rasterized, direct.counters.triangles_drawn);
+        rl_image_release(rendered);
+        rl_image_release(direct.img);
+    }
+    rl_scene_release(s);
+}
+
+typedef struct progress_log {
+    int calls;
+    double last;
+    int cancel_after;    /* 0: never */
+} progress_log;
+
+static bool log_progress(void *user, double done)
+{
+    progress_log *log = user;
+    assert_true(done > log->last && done <= 1.0);
+    log->last = done;
+    return ++log->calls != log->cancel_after;
+}
+
+static void test_progress_reaches_one_and_can_cancel(void **state)
+{
+    (void)state;
+    rl_camera cam;
+    rl_scene *s = stack_scene(&cam);
+    const rl_scene_data *d = rl_scene_get_data(s);
+    rl_image *img = NULL;
+    assert_int_equal(rl_image_create(SIZE, SIZE, FX_ALL_LAYERS, &img), RL_OK);
+    rl_raster *ras = NULL;
+    assert_int_equal(rl_raster_create(NULL, &ras), RL_OK);
+    assert_int_equal(rl_raster_set_camera(ras, img, &cam, d->bounds), RL_OK);
+    rl_raster_scene_desc desc = { .shading = RL_SHADING_GOURAUD };
+
+    progress_log log = { 0, 0.0, 0 };
+    assert_int_equal(rl_raster_draw_scene(ras, d, cam.eye, &desc, NULL, log_progress, &log),
+                     RL_OK);
+    assert_int_equal(log.calls, 3);
+    assert_true(log.last == 1.0);
+
+    log = (progress_log){ 0, 0.0, 1 };
+    assert_int_equal(rl_raster_draw_scene(ras, d, cam.eye, &desc, NULL, log_progress, &log),
+                     RL_ERR_CANCELLED);
+    assert_int_equal(log.calls, 1);
+
+    desc.shading = (rl_raster_shading)7;
+    assert_int_equal(rl_raster_draw_scene(ras, d, cam.eye, &desc, NULL, NULL, NULL),
+                     RL_ERR_INVALID_ARG);
+    assert_int_equal(rl_raster_draw_scene(NULL, d, cam.eye, NULL, NULL, NULL, NULL),
+                     RL_ERR_INVALID_ARG);
+    rl_raster_release(ras);
+    rl_image_release(img);
+    rl_scene_release(s);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_mask_draws_only_the_selected_objects),
+        cmocka_unit_test(test_no_color_writes_depth_and_ids_of_a_lit_draw_and_leaves_colour_alone),
+        cmocka_unit_test(test_raster_renderer_output_equals_drawing_the_whole_scene),
+        cmocka_unit_test(test_progress_reaches_one_and_can_cancel),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
