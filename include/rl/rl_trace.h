@@ -45,6 +45,10 @@ typedef struct rl_ray_tree {
 } rl_ray_tree;
 
 RL_API bool rl_ray_tree_equal(const rl_ray_tree *a, const rl_ray_tree *b);
+/* 64-bit hash of the nodes (type, depth, object, light) and the truncation
+ * flag: equal trees hash equally; Vertex Tracing stores only this per vertex
+ * and compares hashes (a false "equal" has probability ~2^-64). */
+RL_API uint64_t rl_ray_tree_hash(const rl_ray_tree *tree);
 
 typedef struct rl_tracer_desc {           /* zero = default */
     int max_depth;            /* reflection/refraction recursion; 0 -> 5,
@@ -80,6 +84,80 @@ RL_API void rl_tracer_trace(const rl_tracer *tracer, const rl_ray *ray, rl_ray_t
 RL_API void rl_tracer_shade(const rl_tracer *tracer, const rl_ray *ray, const rl_hit *hit,
                             rl_ray_type type, uint64_t sample_id, rl_trace_result *out,
                             rl_ray_tree *tree);
+
+/* ---- Vertex Tracing samples (Ullmann 2003, Sec. 3.1, 3.4.5, 3.5.3) ---- */
+
+/* A surface point given explicitly instead of by a ray hit: a vertex of a
+ * refined VT mesh. Position and shading normal come from the refinement
+ * (eq. 3.7, 3.8), not from the triangle, which supplies only the geometric
+ * normal, the material and the object. */
+typedef struct rl_trace_point {
+    rl_vec3 p;                /* world position */
+    rl_vec3 n;                /* shading normal (need not be unit) */
+    rl_vec2 uv;               /* texture coordinates */
+    uint32_t triangle;        /* scene triangle the point lies on */
+} rl_trace_point;
+
+/* One deferred-texture term (Sec. 3.5.3): what the rasterizer multiplies by
+ * a texel. The term's radiance is diffuse * texel(uv) + rest, or
+ * diffuse + rest when texture is RL_NONE. Weights (k_r, k_t) are folded in. */
+typedef struct rl_trace_layer {
+    rl_vec3 diffuse;          /* k_d (untextured) times the light it receives */
+    rl_vec3 rest;             /* everything not modulated by the texture:
+                               * emission, specular, and for the reflection
+                               * and refraction terms the deeper recursion
+                               * (C_comb, eq. 3.21) and misses (background) */
+    uint32_t texture;         /* scene texture index, or RL_NONE */
+    rl_vec2 uv;
+} rl_trace_layer;
+
+enum { RL_TRACE_LAYER_PRIMARY = 0, RL_TRACE_LAYER_REFLECTION, RL_TRACE_LAYER_REFRACTION,
+       RL_TRACE_LAYER_COUNT };
+
+/* Depth-0 shadow-feeler results of one point, for temporal coherence
+ * (Sec. 3.4.5): the occluding object of each feeler the point traced, in the
+ * order traced (RL_ID_NONE: light visible; RL_ID_NONE - 1: blocked by an
+ * object not named, because the feeler was traced without a ray tree and
+ * used the any-hit query). Valid while lights and geometry stay and the
+ * point is seen from the same side (front). A cache holding RL_ID_NONE - 1
+ * is not replayed into a ray tree (the tree would not be exact): the
+ * feelers are traced again. cache_in and cache_out may be the same struct. */
+#define RL_TRACE_FEELER_CACHE_MAX 64
+typedef struct rl_trace_feelers {
+    uint32_t count;           /* 0..RL_TRACE_FEELER_CACHE_MAX */
+    bool front;               /* the viewer was on the side the point's shading
+                               * normal points to: that side (the normal
+                               * flipped towards the viewer) decides which
+                               * feelers are shot. With a degenerate shading
+                               * normal, the geometric normal's side. */
+    bool complete;            /* all feelers fitted (count <= MAX) */
+    uint32_t occluder[RL_TRACE_FEELER_CACHE_MAX];
+} rl_trace_feelers;
+
+typedef struct rl_trace_sample {
+    rl_vec3 color;            /* radiance towards the eye, textures applied:
+                               * equals rl_tracer_shade() of the same point */
+    rl_vec3 flat;             /* the same with every deferred texture taken
+                               * as white: what refinement criteria compare */
+    rl_trace_layer layers[RL_TRACE_LAYER_COUNT];
+    uint64_t rays[RL_RAY_TYPE_COUNT];  /* rays traced (cached feelers excluded;
+                                        * the eye ray counts as one primary) */
+    uint32_t feelers_reused;  /* depth-0 feelers answered from the cache */
+} rl_trace_sample;
+
+/* Shades the point as seen from eye (the primary ray eye -> p, eq. 3.1, is
+ * not traced: its hit is the point). The reflection and refraction terms of
+ * the first recursion level are returned as deferred-texture layers; deeper
+ * levels are sampled with their textures, as the thesis does. sample_id
+ * seeds the area-light jitter. cache_in (may be NULL) answers depth-0
+ * feelers when it matches (same front side, complete); cache_out (may be
+ * NULL) receives this point's depth-0 feelers. tree may be NULL. A point
+ * whose triangle is out of range or whose eye ray has no direction shades
+ * as a miss (background). Thread-safe. */
+RL_API void rl_tracer_shade_point(const rl_tracer *tracer, rl_vec3 eye, const rl_trace_point *pt,
+                                  uint64_t sample_id, const rl_trace_feelers *cache_in,
+                                  rl_trace_feelers *cache_out, rl_trace_sample *out,
+                                  rl_ray_tree *tree);
 
 #ifdef __cplusplus
 }

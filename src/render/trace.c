@@ -25,7 +25,11 @@
  * contributes one node per jittered sample traced), then its reflection
  * subtree, then its refraction subtree. Misses record RL_ID_NONE; a shadow
  * node names the closest occluder and sits one level below the ray whose hit
- * it lights, as that hit's reflection and refraction do. */
+ * it lights, as that hit's reflection and refraction do.
+ *
+ * The local term comes back split (k_d irr + rest, trace_shade.c) so that
+ * trace_point.c can defer the texture lookup of a hit (Sec. 3.5.3); here the
+ * two are recombined at once with the textured k_d. */
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -51,6 +55,23 @@ bool rl_ray_tree_equal(const rl_ray_tree *a, const rl_ray_tree *b)
             return false;
     }
     return true;
+}
+
+/* Chains the splitmix64 finaliser over the fields rl_ray_tree_equal()
+ * compares (never the padding), one 64-bit word at a time: each step is a
+ * bijection of the running state, so trees differing in one word differ in
+ * the hash except with probability ~2^-64. */
+uint64_t rl_ray_tree_hash(const rl_ray_tree *tree)
+{
+    if (!tree)
+        return 0;
+    uint64_t h = rl_hash64(0x52544852ull ^ ((uint64_t)tree->count << 1) ^ (tree->truncated ? 1u : 0u));
+    for (uint32_t i = 0; i < tree->count && i < RL_RAY_TREE_MAX; ++i) {
+        const rl_ray_tree_node *n = &tree->nodes[i];
+        h = rl_hash64(h ^ (((uint64_t)n->object << 32) | n->light));
+        h = rl_hash64(h ^ ((uint64_t)n->type | ((uint64_t)n->depth << 8)));
+    }
+    return h;
 }
 
 uint32_t rl_trace_tree_push(rl_trace_ctx *ctx, rl_ray_type type, int depth, uint32_t object,
@@ -130,6 +151,34 @@ rl_vec3 rl_trace_offset(const rl_tracer *tracer, const rl_trace_surface *s, rl_v
     return rl_madd(s->p, s->ng, side * tracer->eps);
 }
 
+void rl_trace_surface_finish(const rl_tracer *tr, uint32_t tri_index, rl_vec3 ns, rl_vec2 uv, rl_vec3 v,
+                             rl_trace_surface *s)
+{
+    const rl_scene_data *data = tr->data;
+    const uint32_t *tri = &data->indices[3 * (size_t)tri_index];
+    rl_vec3 p0 = data->positions[tri[0]], p1 = data->positions[tri[1]], p2 = data->positions[tri[2]];
+    s->v = v;
+    rl_vec3 ng = rl_normalize(rl_cross(rl_sub(p1, p0), rl_sub(p2, p0)));
+    ns = rl_normalize(ns);
+    if (!(rl_length2(ns) > 0.0f) || !rl_vfinite(ns))
+        ns = ng;
+    s->front = rl_dot(ng, v) > 0.0f;
+    s->ns_front = !(rl_dot(ns, v) < 0.0f);
+    s->ng = s->front ? ng : rl_neg(ng);
+    s->ns = s->ns_front ? ns : rl_neg(ns);
+
+    s->m = &data->materials[data->triangle_material[tri_index]];
+    s->kd = s->m->diffuse;
+    s->uv = uv;
+    s->texture = RL_NONE;
+    uint32_t tex = s->m->diffuse_texture;
+    if (tex < data->num_textures && data->textures[tex]) {
+        s->texture = tex;
+        rl_vec4 texel = rl_texture_sample(data->textures[tex], uv);
+        s->kd = rl_mul(s->kd, rl_v3(texel.x, texel.y, texel.z));
+    }
+}
+
 /* Fills the surface at hit for a ray travelling along unit d; false for a
  * hit that names no triangle of the scene. */
 static bool surface_at(const rl_tracer *tr, const rl_hit *hit, rl_vec3 d, rl_trace_surface *s)
@@ -141,97 +190,121 @@ static bool surface_at(const rl_tracer *tr, const rl_hit *hit, rl_vec3 d, rl_tra
     float u = hit->u, v = hit->v, w = 1.0f - u - v;
     rl_vec3 p0 = data->positions[tri[0]], p1 = data->positions[tri[1]], p2 = data->positions[tri[2]];
     s->p = rl_add(rl_add(rl_scale(p0, w), rl_scale(p1, u)), rl_scale(p2, v));
-    s->v = rl_neg(d);
-
-    rl_vec3 ng = rl_normalize(rl_cross(rl_sub(p1, p0), rl_sub(p2, p0)));
     rl_vec3 ns = rl_add(rl_add(rl_scale(data->normals[tri[0]], w), rl_scale(data->normals[tri[1]], u)),
                         rl_scale(data->normals[tri[2]], v));
-    ns = rl_normalize(ns);
-    if (!(rl_length2(ns) > 0.0f) || !rl_vfinite(ns))
-        ns = ng;
-    s->front = rl_dot(ng, s->v) > 0.0f;
-    s->ng = s->front ? ng : rl_neg(ng);
-    s->ns = rl_dot(ns, s->v) < 0.0f ? rl_neg(ns) : ns;
-
-    s->m = &data->materials[data->triangle_material[hit->triangle]];
-    s->kd = s->m->diffuse;
-    uint32_t tex = s->m->diffuse_texture;
-    if (tex < data->num_textures && data->textures[tex]) {
-        rl_vec2 t0 = data->uvs[tri[0]], t1 = data->uvs[tri[1]], t2 = data->uvs[tri[2]];
-        rl_vec2 uv = rl_v2(w * t0.x + u * t1.x + v * t2.x, w * t0.y + u * t1.y + v * t2.y);
-        rl_vec4 texel = rl_texture_sample(data->textures[tex], uv);
-        s->kd = rl_mul(s->kd, rl_v3(texel.x, texel.y, texel.z));
-    }
+    rl_vec2 t0 = data->uvs[tri[0]], t1 = data->uvs[tri[1]], t2 = data->uvs[tri[2]];
+    rl_vec2 uv = rl_v2(w * t0.x + u * t1.x + v * t2.x, w * t0.y + u * t1.y + v * t2.y);
+    rl_trace_surface_finish(tr, hit->triangle, ns, uv, rl_neg(d), s);
     return true;
 }
 
-static rl_vec3 trace_ray(rl_trace_ctx *ctx, rl_ray ray, rl_ray_type type, int depth, float weight);
-
-/* Radiance leaving the surface at hit back along ray (eq. 3.1-3.4). */
-static rl_vec3 shade_hit(rl_trace_ctx *ctx, const rl_ray *ray, const rl_hit *hit, int depth, float weight)
+int rl_trace_secondary_rays(const rl_tracer *tr, const rl_trace_surface *s, rl_vec3 d, float weight,
+                            rl_trace_secondary out[2])
 {
-    const rl_tracer *tr = ctx->tracer;
-    rl_vec3 d = rl_normalize(ray->d);
-    rl_trace_surface s;
-    if (!surface_at(tr, hit, d, &s))
-        return tr->background;
-    rl_vec3 color = rl_trace_local(ctx, &s, depth);
-    if (depth >= tr->max_depth)
-        return color;
-
-    float k_r = s.m->reflectivity, k_t = s.m->transmissivity;
+    float k_r = s->m->reflectivity, k_t = s->m->transmissivity;
     rl_vec3 refracted = rl_v3s(0.0f);
     if (k_t > 0.0f) {
         /* Entering when the geometric normal faced the ray (eq. 3.4 with
          * eta_1/eta_2 = 1/ior), leaving into air otherwise. */
-        bool entering = s.front;
-        float ior = s.m->ior >= 1.0f ? s.m->ior : 1.0f;
-        float eta = entering ? 1.0f / ior : ior;
-        if (!rl_refract(d, s.ns, eta, &refracted)) {
+        float ior = s->m->ior >= 1.0f ? s->m->ior : 1.0f;
+        float eta = s->front ? 1.0f / ior : ior;
+        if (!rl_refract(d, s->ns, eta, &refracted)) {
             k_r += k_t;               /* total internal reflection */
             k_t = 0.0f;
         }
     }
+    int n = 0;
     if (k_r > 0.0f && weight * k_r >= MIN_WEIGHT) {
-        rl_vec3 dir = rl_reflect(d, s.ns);
-        rl_ray r = { rl_trace_offset(tr, &s, dir), 0.0f, dir, INFINITY };
-        color = rl_add(color, rl_scale(trace_ray(ctx, r, RL_RAY_REFLECTION, depth + 1, weight * k_r), k_r));
+        rl_vec3 dir = rl_reflect(d, s->ns);
+        out[n++] = (rl_trace_secondary){ { rl_trace_offset(tr, s, dir), 0.0f, dir, INFINITY },
+                                         RL_RAY_REFLECTION, k_r };
     }
     if (k_t > 0.0f && weight * k_t >= MIN_WEIGHT) {
         rl_vec3 dir = rl_normalize(refracted);
-        rl_ray r = { rl_trace_offset(tr, &s, dir), 0.0f, dir, INFINITY };
-        color = rl_add(color, rl_scale(trace_ray(ctx, r, RL_RAY_REFRACTION, depth + 1, weight * k_t), k_t));
+        out[n++] = (rl_trace_secondary){ { rl_trace_offset(tr, s, dir), 0.0f, dir, INFINITY },
+                                         RL_RAY_REFRACTION, k_t };
     }
+    return n;
+}
+
+/* Radiance leaving s back along unit d (eq. 3.1-3.4), local term then the
+ * weighted reflection and refraction; layer (may be NULL) gets it split as
+ * rl_trace_ray() documents. */
+static rl_vec3 shade_surface(rl_trace_ctx *ctx, const rl_trace_surface *s, rl_vec3 d, int depth, float weight,
+                             rl_trace_layer *layer)
+{
+    const rl_tracer *tr = ctx->tracer;
+    rl_trace_local local = rl_trace_local_term(ctx, s, depth);
+    rl_vec3 color = rl_add(rl_mul(s->kd, local.irr), local.rest);
+    rl_vec3 rest = local.rest;
+    if (depth < tr->max_depth) {
+        rl_trace_secondary sec[2];
+        int n = rl_trace_secondary_rays(tr, s, d, weight, sec);
+        for (int i = 0; i < n; ++i) {
+            rl_vec3 c = rl_trace_ray(ctx, sec[i].ray, sec[i].type, depth + 1, weight * sec[i].k, NULL);
+            c = rl_scale(c, sec[i].k);
+            color = rl_add(color, c);
+            rest = rl_add(rest, c);
+        }
+    }
+    if (layer)
+        *layer = (rl_trace_layer){ rl_mul(s->m->diffuse, local.irr), rest, s->texture, s->uv };
     return color;
 }
 
-static rl_vec3 trace_ray(rl_trace_ctx *ctx, rl_ray ray, rl_ray_type type, int depth, float weight)
+static rl_vec3 miss(const rl_tracer *tr, rl_trace_layer *layer)
+{
+    if (layer)
+        *layer = (rl_trace_layer){ rl_v3s(0.0f), tr->background, RL_NONE, rl_v2(0.0f, 0.0f) };
+    return tr->background;
+}
+
+/* Radiance leaving the surface at hit back along ray. */
+static rl_vec3 shade_hit(rl_trace_ctx *ctx, const rl_ray *ray, const rl_hit *hit, int depth, float weight,
+                         rl_trace_layer *layer)
+{
+    rl_vec3 d = rl_normalize(ray->d);
+    rl_trace_surface s;
+    if (!surface_at(ctx->tracer, hit, d, &s))
+        return miss(ctx->tracer, layer);
+    return shade_surface(ctx, &s, d, depth, weight, layer);
+}
+
+rl_vec3 rl_trace_ray(rl_trace_ctx *ctx, rl_ray ray, rl_ray_type type, int depth, float weight,
+                     rl_trace_layer *layer)
 {
     ctx->rays[type]++;
     uint32_t node = rl_trace_tree_push(ctx, type, depth, RL_ID_NONE, RL_ID_NONE);
     rl_hit hit = { INFINITY, 0.0f, 0.0f, RL_ID_NONE, RL_ID_NONE };
     if (!rl_accel_intersect(ctx->tracer->accel, &ray, &hit))
-        return ctx->tracer->background;
+        return miss(ctx->tracer, layer);
     if (node != RL_ID_NONE)
         ctx->tree->nodes[node].object = hit.object;
-    return shade_hit(ctx, &ray, &hit, depth, weight);
+    return shade_hit(ctx, &ray, &hit, depth, weight, layer);
 }
 
-/* Shared start of trace and shade: result zeroed, tree emptied, jitter
- * seeded from (tracer seed, sample_id) so a sample repeats exactly. */
+void rl_trace_begin(const rl_tracer *tracer, uint64_t sample_id, uint64_t *rays, rl_ray_tree *tree,
+                    rl_trace_ctx *ctx)
+{
+    memset(rays, 0, RL_RAY_TYPE_COUNT * sizeof *rays);
+    if (tree) {
+        tree->count = 0;
+        tree->truncated = false;
+    }
+    memset(ctx, 0, sizeof *ctx);
+    ctx->tracer = tracer;
+    ctx->rays = rays;
+    ctx->tree = tree;
+    rl_rng_seed(&ctx->rng, rl_hash64(tracer->seed ^ rl_hash64(sample_id)), sample_id);
+}
+
+/* Shared start of trace and shade: result zeroed, then rl_trace_begin. */
 static void begin(const rl_tracer *tracer, uint64_t sample_id, rl_trace_result *out, rl_ray_tree *tree,
                   rl_trace_ctx *ctx)
 {
     memset(out, 0, sizeof *out);
     out->hit = (rl_hit){ INFINITY, 0.0f, 0.0f, RL_ID_NONE, RL_ID_NONE };
-    if (tree) {
-        tree->count = 0;
-        tree->truncated = false;
-    }
-    ctx->tracer = tracer;
-    ctx->rays = out->rays;
-    ctx->tree = tree;
-    rl_rng_seed(&ctx->rng, rl_hash64(tracer->seed ^ rl_hash64(sample_id)), sample_id);
+    rl_trace_begin(tracer, sample_id, out->rays, tree, ctx);
 }
 
 static rl_ray_type valid_type(rl_ray_type type)
@@ -258,7 +331,7 @@ void rl_tracer_trace(const rl_tracer *tracer, const rl_ray *ray, rl_ray_type typ
     if (node != RL_ID_NONE)
         tree->nodes[node].object = hit.object;
     out->hit = hit;
-    out->color = shade_hit(&ctx, &r, &hit, 0, 1.0f);
+    out->color = shade_hit(&ctx, &r, &hit, 0, 1.0f, NULL);
 }
 
 void rl_tracer_shade(const rl_tracer *tracer, const rl_ray *ray, const rl_hit *hit, rl_ray_type type,
@@ -282,5 +355,5 @@ void rl_tracer_shade(const rl_tracer *tracer, const rl_ray *ray, const rl_hit *h
     }
     out->hit = *hit;
     out->hit.object = object;
-    out->color = shade_hit(&ctx, ray, &out->hit, 0, 1.0f);
+    out->color = shade_hit(&ctx, ray, &out->hit, 0, 1.0f, NULL);
 }

@@ -1,13 +1,19 @@
-/* trace_internal.h: what the two halves of the Whitted tracer share.
+/* trace_internal.h: what the parts of the Whitted tracer share.
  *
  * trace.c owns the tracer, the recursion (reflection/refraction) and the ray
  * tree; trace_shade.c owns the local Phong term with its shadow feelers
- * (Ullmann 2003, eq. 3.2). Both record rays through one per-sample context. */
+ * (Ullmann 2003, eq. 3.2) and the feeler cache (Sec. 3.4.5); trace_point.c
+ * shades explicit surface points for Vertex Tracing with deferred textures
+ * (Sec. 3.5.3). All record rays through one per-sample context. */
 #ifndef RL_RENDER_TRACE_INTERNAL_H
 #define RL_RENDER_TRACE_INTERNAL_H
 
 #include "rl/rl_rng.h"
 #include "rl/rl_trace.h"
+
+/* rl_trace_feelers.occluder: blocked, found by an any-hit query that does
+ * not name the occluder (documented in rl_trace.h). */
+#define RL_TRACE_OCCLUDER_UNKNOWN (RL_ID_NONE - 1u)
 
 struct rl_tracer {
     const rl_accel *accel;
@@ -21,13 +27,23 @@ struct rl_tracer {
     float eps;                /* secondary-ray origin offset, see trace.c */
 };
 
-/* State of one traced sample: counters, tree and the area-light jitter. */
+/* State of one traced sample: counters, tree, the area-light jitter and the
+ * depth-0 feeler cache (both cache pointers NULL outside trace_point.c). */
 typedef struct rl_trace_ctx {
     const rl_tracer *tracer;
     rl_rng rng;
     uint64_t *rays;           /* rl_trace_result.rays */
     rl_ray_tree *tree;        /* or NULL */
+    const rl_trace_feelers *cache_in;  /* replayed depth-0 feelers, or NULL */
+    rl_trace_feelers *cache_out;       /* recorded depth-0 feelers, or NULL */
+    uint32_t feelers;         /* depth-0 feelers met so far */
+    uint32_t reused;          /* of those, answered from cache_in */
 } rl_trace_ctx;
+
+/* Zeroes rays (RL_RAY_TYPE_COUNT counters), empties the tree and seeds the
+ * jitter from (tracer seed, sample_id) so that a sample repeats exactly. */
+void rl_trace_begin(const rl_tracer *tracer, uint64_t sample_id, uint64_t *rays, rl_ray_tree *tree,
+                    rl_trace_ctx *ctx);
 
 /* Appends a node (or sets the truncation flag); returns its index or
  * RL_ID_NONE when no node was written. */
@@ -41,14 +57,47 @@ typedef struct rl_trace_surface {
     rl_vec3 ns;               /* interpolated shading normal, flipped likewise */
     rl_vec3 v;                /* unit direction back along the ray */
     bool front;               /* the unflipped geometric normal faced the ray */
+    bool ns_front;            /* the unflipped shading normal faced the ray */
     rl_vec3 kd;               /* k_d times the diffuse texture */
+    uint32_t texture;         /* the material's valid diffuse texture or RL_NONE */
+    rl_vec2 uv;               /* texture coordinates at p */
     const rl_material *m;
 } rl_trace_surface;
 
-/* Local term: emission + ambient k_d + sum over visible lights of
- * E (k_d max(0, n.l) + k_s max(0, r.v)^n), tracing one shadow feeler per
- * light sample (trace_shade.c). */
-rl_vec3 rl_trace_local(rl_trace_ctx *ctx, const rl_trace_surface *s, int depth);
+/* Completes s on scene triangle tri at s->p with raw shading normal ns (any
+ * length; degenerate -> geometric normal), texture coordinates uv, seen
+ * along unit v: flips the normals towards v and applies the texture to k_d.
+ * tri must be in range. */
+void rl_trace_surface_finish(const rl_tracer *tr, uint32_t tri, rl_vec3 ns, rl_vec2 uv, rl_vec3 v,
+                             rl_trace_surface *s);
+
+/* Local term split for deferred texturing (Sec. 3.5.3): local = kd * irr +
+ * rest, where irr = ambient + sum over visible lights of E max(0, n.l)
+ * (the light k_d modulates) and rest = emission + sum E k_s max(0, r.v)^n.
+ * Traces one shadow feeler per light sample (trace_shade.c). */
+typedef struct rl_trace_local {
+    rl_vec3 irr;
+    rl_vec3 rest;
+} rl_trace_local;
+rl_trace_local rl_trace_local_term(rl_trace_ctx *ctx, const rl_trace_surface *s, int depth);
+
+/* The reflection and refraction rays leaving s (eq. 3.3, 3.4) for a ray
+ * along unit d, in tracing order, with their coefficients after total
+ * internal reflection and the path-weight cut-off. Returns how many (0-2). */
+typedef struct rl_trace_secondary {
+    rl_ray ray;
+    rl_ray_type type;
+    float k;                  /* k_r or k_t */
+} rl_trace_secondary;
+int rl_trace_secondary_rays(const rl_tracer *tr, const rl_trace_surface *s, rl_vec3 d, float weight,
+                            rl_trace_secondary out[2]);
+
+/* Traces ray (counted and recorded as type at depth) and returns the
+ * radiance it brings back, recursively. layer (may be NULL) receives the
+ * same radiance split at the first hit: diffuse = untextured k_d * irr, rest
+ * = everything else, texture/uv of the hit; a miss has rest = background. */
+rl_vec3 rl_trace_ray(rl_trace_ctx *ctx, rl_ray ray, rl_ray_type type, int depth, float weight,
+                     rl_trace_layer *layer);
 
 /* Origin of a secondary ray leaving s in direction dir: offset along the
  * geometric normal to the side dir leaves on, so the ray cannot hit the

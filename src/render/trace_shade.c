@@ -16,7 +16,19 @@
  * the shading normal. Transmissive occluders block like opaque ones: hard
  * shadows, as the thesis' ray tracer. With a ray tree the feeler asks for the
  * closest occluder (rl_accel_intersect) so the node names a well-defined
- * object; without one the cheaper any-hit query (rl_accel_occluded) does. */
+ * object; without one the cheaper any-hit query (rl_accel_occluded) does.
+ *
+ * The sum is returned in two parts for deferred texturing (Ullmann 2003,
+ * Sec. 3.5.3): irr, the light k_d modulates (ambient included), and rest,
+ * emission plus specular; the caller forms k_d irr + rest, with k_d
+ * textured or not.
+ *
+ * Feeler cache (Sec. 3.4.5): the thesis keeps the shadow-feeler results of
+ * primary vertices for the next frame while the lights stay. We cache the
+ * depth-0 feelers of one point in tracing order and replay them instead of
+ * tracing. The area-light jitter is drawn before the feeler either way, so a
+ * replayed sample consumes the generator exactly like a traced one and the
+ * results stay bit-identical. */
 #include <math.h>
 
 #include "render/light_eval.h"
@@ -24,53 +36,72 @@
 
 #define SHADOW_T_SHRINK 1e-4f     /* stop feelers short of the light itself */
 
-/* Phong BRDF-times-cosine part for unit l; zero below the shading normal. */
-static rl_vec3 phong(const rl_trace_surface *s, rl_vec3 l, float n_dot_l)
+/* Adds one visible light sample of irradiance E from unit l to the parts:
+ * the cosine-weighted E to irr, the Phong highlight (k_s max(0, r.v)^n E)
+ * to rest. */
+static void add_light(rl_trace_local *acc, const rl_trace_surface *s, rl_vec3 l, float n_dot_l, rl_vec3 E)
 {
-    rl_vec3 term = rl_scale(s->kd, n_dot_l);
+    acc->irr = rl_add(acc->irr, rl_scale(E, n_dot_l));
     if (rl_vmax_comp(s->m->specular) > 0.0f) {
         rl_vec3 r = rl_sub(rl_scale(s->ns, 2.0f * n_dot_l), l);   /* l mirrored about n */
         float r_dot_v = rl_maxf(0.0f, rl_dot(r, s->v));
-        term = rl_add(term, rl_scale(s->m->specular, powf(r_dot_v, s->m->shininess)));
+        acc->rest = rl_add(acc->rest, rl_mul(rl_scale(s->m->specular, powf(r_dot_v, s->m->shininess)), E));
     }
-    return term;
 }
 
-/* Traces one feeler from s towards unit l over dist; true if the light is
- * visible. Records the shadow ray and its node (occluder or RL_ID_NONE),
- * one level below the ray whose hit it lights, like a reflection would be. */
-static bool feeler(rl_trace_ctx *ctx, const rl_trace_surface *s, rl_vec3 l, float dist, int depth,
-                   uint32_t light)
+/* Occluder of a feeler by tracing it; RL_ID_NONE if the light is visible. */
+static uint32_t trace_feeler(rl_trace_ctx *ctx, const rl_trace_surface *s, rl_vec3 l, float dist)
 {
     const rl_tracer *tr = ctx->tracer;
-    if (!tr->shadows)
-        return true;
     ctx->rays[RL_RAY_SHADOW]++;
     rl_ray ray = { rl_trace_offset(tr, s, l), 0.0f, l, isinf(dist) ? INFINITY : dist * (1.0f - SHADOW_T_SHRINK) };
     if (!ctx->tree)
-        return !rl_accel_occluded(tr->accel, &ray);
+        return rl_accel_occluded(tr->accel, &ray) ? RL_TRACE_OCCLUDER_UNKNOWN : RL_ID_NONE;
     rl_hit hit = { INFINITY, 0.0f, 0.0f, RL_ID_NONE, RL_ID_NONE };
-    bool blocked = rl_accel_intersect(tr->accel, &ray, &hit);
-    rl_trace_tree_push(ctx, RL_RAY_SHADOW, depth + 1, blocked ? hit.object : RL_ID_NONE, light);
-    return !blocked;
+    return rl_accel_intersect(tr->accel, &ray, &hit) ? hit.object : RL_ID_NONE;
 }
 
-/* Quad light (n x n jittered grid): summed E_j * phong of the visible samples. */
-static rl_vec3 quad_light(rl_trace_ctx *ctx, const rl_trace_surface *s, const rl_light *L, int depth,
-                          uint32_t index)
+/* One feeler from s towards unit l over dist; true if the light is visible.
+ * Records the shadow ray and its node (occluder or RL_ID_NONE), one level
+ * below the ray whose hit it lights, like a reflection would be. Depth-0
+ * feelers are answered from and recorded into the cache. */
+static bool feeler(rl_trace_ctx *ctx, const rl_trace_surface *s, rl_vec3 l, float dist, int depth,
+                   uint32_t light)
 {
-    rl_vec3 sum = rl_v3s(0.0f);
+    if (!ctx->tracer->shadows)
+        return true;
+    uint32_t occluder;
+    if (depth == 0 && ctx->cache_in && ctx->feelers < ctx->cache_in->count) {
+        occluder = ctx->cache_in->occluder[ctx->feelers];
+        ctx->reused++;
+    } else {
+        occluder = trace_feeler(ctx, s, l, dist);
+    }
+    rl_trace_tree_push(ctx, RL_RAY_SHADOW, depth + 1, occluder, light);
+    if (depth == 0) {
+        if (ctx->cache_out && ctx->feelers < RL_TRACE_FEELER_CACHE_MAX)
+            ctx->cache_out->occluder[ctx->feelers] = occluder;
+        ctx->feelers++;
+    }
+    return occluder == RL_ID_NONE;
+}
+
+/* Quad light (n x n jittered grid): the visible samples E_j into acc. */
+static void quad_light(rl_trace_ctx *ctx, rl_trace_local *acc, const rl_trace_surface *s, const rl_light *L,
+                       int depth, uint32_t index)
+{
     rl_vec3 normal = rl_cross(L->edge_u, L->edge_v);
     float area = rl_length(normal);
     if (!(area > 0.0f))
-        return sum;
+        return;
     normal = rl_scale(normal, 1.0f / area);
     int n = ctx->tracer->area_samples;
     rl_vec3 radiance = rl_scale(L->color, L->intensity * area / (float)(n * n));
     for (int j = 0; j < n; ++j) {
         for (int i = 0; i < n; ++i) {
             /* Draw both numbers first so the sequence does not depend on
-             * which samples are skipped. */
+             * which samples are skipped, nor on whether the feeler is
+             * traced or replayed from the cache. */
             float xi_u = rl_rng_float(&ctx->rng), xi_v = rl_rng_float(&ctx->rng);
             rl_vec3 q = rl_add(L->position, rl_add(rl_scale(L->edge_u, ((float)i + xi_u) / (float)n),
                                                    rl_scale(L->edge_v, ((float)j + xi_v) / (float)n)));
@@ -86,21 +117,19 @@ static rl_vec3 quad_light(rl_trace_ctx *ctx, const rl_trace_surface *s, const rl
                 continue;
             if (!feeler(ctx, s, l, dist, depth, index))
                 continue;
-            rl_vec3 E = rl_scale(radiance, cos_light / d2);
-            sum = rl_add(sum, rl_mul(phong(s, l, n_dot_l), E));
+            add_light(acc, s, l, n_dot_l, rl_scale(radiance, cos_light / d2));
         }
     }
-    return sum;
 }
 
-rl_vec3 rl_trace_local(rl_trace_ctx *ctx, const rl_trace_surface *s, int depth)
+rl_trace_local rl_trace_local_term(rl_trace_ctx *ctx, const rl_trace_surface *s, int depth)
 {
     const rl_scene_data *data = ctx->tracer->data;
-    rl_vec3 c = rl_add(s->m->emission, rl_scale(s->kd, ctx->tracer->ambient));
+    rl_trace_local acc = { rl_v3s(ctx->tracer->ambient), s->m->emission };
     for (uint32_t i = 0; i < data->num_lights; ++i) {
         const rl_light *L = &data->lights[i];
         if (L->type == RL_LIGHT_QUAD) {
-            c = rl_add(c, quad_light(ctx, s, L, depth, i));
+            quad_light(ctx, &acc, s, L, depth, i);
             continue;
         }
         rl_vec3 E, l;
@@ -110,7 +139,7 @@ rl_vec3 rl_trace_local(rl_trace_ctx *ctx, const rl_trace_surface *s, int depth)
         float n_dot_l = rl_dot(s->ns, l);
         if (n_dot_l <= 0.0f || !feeler(ctx, s, l, dist, depth, i))
             continue;
-        c = rl_add(c, rl_mul(phong(s, l, n_dot_l), E));
+        add_light(&acc, s, l, n_dot_l, E);
     }
-    return c;
+    return acc;
 }
