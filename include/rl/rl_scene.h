@@ -203,7 +203,8 @@ RL_API rl_status rl_scene_add_generated(rl_scene *scene, const char *generator,
                                         uint32_t *mesh_id);
 RL_API const char *const *rl_generator_names(size_t *count);
 
-/* Built-in scenes: cornell, cornell-teapot, spheres, city. params as above
+/* Built-in scenes: cornell, cornell-teapot, spheres, city, table, cluster
+ * (rl scenes lists them with their parameters). params as above
  * (e.g. "triangles=70000" for cornell-teapot, "blocks=8" for city). The
  * returned scene is committed. */
 typedef struct rl_builtin_info {

@@ -31,9 +31,25 @@ static const rl_builtin_info infos[] = {
       "blocks=6 (per side, 1..64), seed=1, floors_min=2, floors_max=16 (1..200), "
       "detail=2 (0 boxes with slabs, 1 + windows, 2 + interior walls), "
       "block_size=64 (m, 24..512), street_width=16 (m, 4..200), furniture=true" },
+    { "table",
+      "the table scene of Ullmann 2003, Sec. 5.1: checkered table top, blue mirroring "
+      "cup and red glass (the VT objects, node attribute vt=true), fork, teapot, plate, "
+      "book, table lamp with a point light in its shade; cameras default and overview",
+      "detail=1 (tessellation multiplier, 0.25..8; about 20000 triangles at 1), "
+      "checks=8 (tablecloth checkers across the table, 1..256), fill=0.15 (dim fill "
+      "light from behind the camera, 0..1; 0 = the thesis' single lamp light)" },
+    { "cluster",
+      "vehicle instrument cluster of Ullmann 2003, Sec. 5.4: speedometer and tachometer "
+      "dials with printed textures, needles, warning lights behind a curved reflecting "
+      "and refracting cover glass (the only VT object), steering wheel; cameras driver, "
+      "lateral, zoom and a 4 s head-movement camera path",
+      "speed=80 (km/h, 0..240), rpm=3 (x1000/min, 0..8), tex=1024 (dial texture size, "
+      "64..4096), glass_segments=48 (cover glass columns, 4..1024), detail=1 "
+      "(tessellation multiplier, 0.25..8)" },
 };
 static const rl_builtin_build_fn builders[] = {
     rl_builtin_cornell, rl_builtin_cornell_teapot, rl_builtin_spheres, rl_builtin_city,
+    rl_builtin_table, rl_builtin_cluster,
 };
 #define NUM_BUILTINS (sizeof infos / sizeof infos[0])
 _Static_assert(sizeof builders / sizeof builders[0] == NUM_BUILTINS, "one builder per scene");
@@ -56,7 +72,7 @@ rl_status rl_scene_create_builtin(const char *name, const char *params, rl_scene
     if (!build)
         return rl_error(RL_ERR_NOT_FOUND,
                         "unknown built-in scene \"%s\" (built-ins: cornell, cornell-teapot, "
-                        "spheres, city)", name);
+                        "spheres, city, table, cluster)", name);
     rl_params p;
     rl_status s = rl_params_parse(params, &p);
     if (s)

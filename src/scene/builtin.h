@@ -16,6 +16,8 @@ rl_status rl_builtin_cornell(rl_scene *scene, rl_params *params);
 rl_status rl_builtin_cornell_teapot(rl_scene *scene, rl_params *params);
 rl_status rl_builtin_spheres(rl_scene *scene, rl_params *params);
 rl_status rl_builtin_city(rl_scene *scene, rl_params *params);
+rl_status rl_builtin_table(rl_scene *scene, rl_params *params);
+rl_status rl_builtin_cluster(rl_scene *scene, rl_params *params);
 
 /* Adds a material with the given name, diffuse colour and otherwise the
  * defaults of rl_material_default(); *id receives its index. */
