@@ -27,6 +27,7 @@
 #endif
 
 #include "core/error.h"
+#include "render/accel_cache.h"
 #include "render/renderer.h"
 #include "render/whitted.h"
 #include "rl/rl_accel.h"
@@ -55,9 +56,7 @@ static const rl_option_info whitted_options[] = {
 };
 
 typedef struct whitted_state {
-    rl_accel *accel;             /* cached between frames */
-    uint64_t scene_uid;
-    rl_accel_kind kind;
+    rl_accel_cache accel;        /* kept between frames */
     rl_ray_tree *trees;          /* last frame's trees, or NULL */
     int tree_width, tree_height;
 } whitted_state;
@@ -76,7 +75,7 @@ static void whitted_release(void *state)
     whitted_state *s = state;
     if (!s)
         return;
-    rl_accel_release(s->accel);
+    rl_accel_cache_release(&s->accel);
     free(s->trees);
     free(s);
 }
@@ -110,30 +109,6 @@ static bool build_progress(void *user, double done)
 #pragma omp critical(rl_whitted_progress)
     go_on = rl_renderer_progress(user, BUILD_SHARE * done);
     return go_on;
-}
-
-/* Reuses the cached accel when it was built for this scene and kind. */
-static rl_status ensure_accel(rl_renderer *r, whitted_state *s, const rl_scene *scene, rl_accel_kind kind,
-                              int threads)
-{
-    uint64_t uid = rl_scene_uid(scene);
-    if (s->accel && s->scene_uid == uid && s->kind == kind)
-        return RL_OK;
-    rl_accel_release(s->accel);
-    s->accel = NULL;
-    rl_accel *a = NULL;
-    rl_accel_desc desc = { .kind = kind, .threads = threads, .progress = build_progress, .user = r };
-    rl_status st = rl_accel_create(scene, &desc, &a);
-    if (st == RL_OK)
-        st = rl_accel_commit(a);
-    if (st != RL_OK) {
-        rl_accel_release(a);
-        return st;
-    }
-    s->accel = a;
-    s->scene_uid = uid;
-    s->kind = kind;
-    return RL_OK;
 }
 
 /* Everything a tile needs; read-only but for its own pixels and counters. */
@@ -253,16 +228,13 @@ static rl_status whitted_render(rl_renderer *r, void *state, const rl_scene *sce
     rl_status st = rl_accel_kind_parse(accel_choices[rl_renderer_opt_enum(r, "accel")], &kind);
     if (st != RL_OK)
         return st;
-    if (!rl_accel_kind_available(kind))
-        return rl_error(RL_ERR_UNSUPPORTED, "whitted: accel=%s is not available in this build",
-                        rl_accel_kind_name(kind));
     int threads = (int)rl_renderer_opt_int(r, "threads");
 #ifdef _OPENMP
     int num_threads = threads > 0 ? threads : omp_get_max_threads();
 #else
     int num_threads = 1;
 #endif
-    if ((st = ensure_accel(r, s, scene, kind, threads)) != RL_OK)
+    if ((st = rl_accel_cache_get(&s->accel, "whitted", scene, kind, threads, build_progress, r)) != RL_OK)
         return st;
     if ((st = prepare_trees(s, rl_renderer_opt_bool(r, "ray_trees"), image->width, image->height)) != RL_OK)
         return st;
@@ -282,7 +254,7 @@ static rl_status whitted_render(rl_renderer *r, void *state, const rl_scene *sce
     int64_t num_tiles = (int64_t)tiles_x * tiles_y;
     rl_tracer *tracer = NULL;
     uint64_t (*tile_rays)[RL_RAY_TYPE_COUNT] = NULL;
-    st = rl_tracer_create(s->accel, &desc, &tracer);
+    st = rl_tracer_create(s->accel.accel, &desc, &tracer);
     if (st == RL_OK && !(tile_rays = rl_calloc((size_t)num_tiles, sizeof *tile_rays)))
         st = RL_ERR_OUT_OF_MEMORY;
     if (st != RL_OK) {
