@@ -1,0 +1,82 @@
+/* rl_vt.h: what the Vertex Tracing renderer "vt" (Ullmann 2003) reports
+ * beyond the common rl_renderer interface: per-frame statistics for the
+ * Ch. 5 measurements, the refined mesh, and progressive updates.
+ *
+ * Vertex Tracing in one paragraph: the visible vertices of the VT objects'
+ * meshes are ray traced directly (the primary ray hits the vertex, eq. 3.1);
+ * the edges between them, longest first, are split at their midpoints
+ * wherever the two ends' samples differ by the chosen criteria (RGB, HSV,
+ * ray tree) until a minimum projected length; over-compressed triangles are
+ * split too (forced refinement); the radiance is reconstructed by Gouraud
+ * interpolation of the vertex samples through the rasterizer, together with
+ * the rasterized non-VT objects (hybrid rendering). See src/render/vt.c for
+ * the options and the section of the thesis each one follows. */
+#ifndef RL_VT_H
+#define RL_VT_H
+
+#include "rl/rl_common.h"
+#include "rl/rl_image.h"
+#include "rl/rl_render.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+#define RL_VT_MAX_THREADS 64
+
+typedef struct rl_vt_stats {
+    uint32_t vt_objects;               /* objects vertex traced */
+    uint64_t primary_vertices;         /* of the VT meshes, after welding */
+    uint64_t primary_faces;
+    uint64_t visible_primary_faces;    /* passed the ID-buffer test (Sec. 3.4.1) */
+    uint64_t vertices_sampled;         /* vertices that cast rays this frame */
+    uint64_t vertices_generated;       /* new vertices made by refinement */
+    uint64_t splits_rgb, splits_hsv, splits_tree;  /* an edge may fire several */
+    uint64_t splits_forced;            /* forced refinement (Sec. 3.3.2) */
+    uint64_t edges_tested;             /* criterion tests */
+    uint64_t edges_culled_z;           /* new edges dropped by the z test */
+    uint64_t edges_culled_viewport;    /* new edges dropped by the viewport test */
+    uint64_t faces_drawn;              /* VT faces rasterized in the final image */
+    uint64_t feelers_reused;           /* shadow feelers answered by temporal coherence */
+    uint32_t stages;                   /* refinement stages run */
+    double time_visibility_ms;         /* ID/Z pre-pass and face flags */
+    double time_sampling_ms;           /* ray tracing of vertices (wall) */
+    double time_refine_ms;             /* criteria, splits, edge list (serial) */
+    double time_draw_ms;               /* reconstruction (non-VT objects + VT faces) */
+    double time_preview_ms;            /* from the start until the preview (the
+                                        * primary vertices only) was drawn */
+    uint32_t threads;
+    uint64_t thread_rays[RL_VT_MAX_THREADS];   /* rays traced per thread (Fig. 5.15b) */
+    double thread_busy_ms[RL_VT_MAX_THREADS];  /* sampling time per thread */
+} rl_vt_stats;
+
+/* Statistics of the last frame rendered by r. RL_ERR_INVALID_ARG when r is
+ * not a "vt" renderer or has rendered nothing yet. */
+RL_API rl_status rl_vt_get_stats(const rl_renderer *r, rl_vt_stats *out);
+
+/* One vertex of the refined mesh of the last frame, in screen space. */
+typedef struct rl_vt_vertex_info {
+    float x, y;                        /* pixels, y down */
+    uint16_t stage;                    /* 0 = primary */
+    uint8_t sampled;                   /* cast rays */
+    uint8_t reason;                    /* why it exists: 0 primary, else the
+                                        * bits 1 rgb, 2 hsv, 4 tree, 8 forced */
+} rl_vt_vertex_info;
+
+/* The vertices and the leaf faces (3 vertex indices each) of the last frame.
+ * The arrays stay valid until the next render or release. */
+RL_API rl_status rl_vt_get_mesh(const rl_renderer *r, const rl_vt_vertex_info **vertices,
+                                size_t *num_vertices, const uint32_t **faces, size_t *num_faces);
+
+/* Progressive display (Sec. 3.5.1): called with the current image after the
+ * preview (stage 0) and after every k-th refinement stage (option
+ * update_every), drawn by overdraw or redraw (option progressive), and once
+ * more with final = true. Returning false stops the refinement there (the
+ * image is then the last update). fn NULL removes the callback. */
+typedef bool (*rl_vt_update_fn)(void *user, const rl_image *image, uint32_t stage, bool final);
+RL_API rl_status rl_vt_set_update_callback(rl_renderer *r, rl_vt_update_fn fn, void *user);
+
+#ifdef __cplusplus
+}
+#endif
+#endif

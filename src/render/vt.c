@@ -1,0 +1,563 @@
+/* vt.c: renderer "vt", Vertex Tracing (Ullmann 2003, Ch. 3-4): adaptive
+ * progressive ray tracing in object space, hybrid with rasterization.
+ *
+ * A frame (Fig. 3.17): the ID-buffer pre-pass flags the visible faces of the
+ * VT objects (Sec. 3.4.1); their vertices are ray traced straight from the
+ * eye (eq. 3.1, no primary intersection test) with shadow feelers and
+ * recursive reflection and refraction (eq. 3.2-3.4) through the exact tracer
+ * (rl_trace.h); edges are refined longest first while the chosen criteria
+ * find the samples at their ends too different (Sec. 3.3.1), with forced
+ * refinement (Sec. 3.3.2), the z-buffer and viewport tests on new edges
+ * (Sec. 3.4.2-3.4.3), down to a minimum projected length; the result is
+ * drawn by Gouraud interpolation with deferred textures (Sec. 3.5) over the
+ * rasterized non-VT objects. Sampling runs in parallel (Sec. 4.4, see
+ * vt_sample.c); refinement stages are described in vt_refine.c.
+ *
+ * VT objects (Sec. 3.5): option `objects`:
+ *   auto   nodes with the attribute vt (inherited by descendants; "true"/
+ *          "false"), or, when no node has it, every object with a
+ *          reflective or refractive material (the thesis' choice);
+ *   all / none, or a comma-separated list of node names (with descendants).
+ *
+ * Temporal coherence (Sec. 3.4.5): the depth-0 shadow feelers of every
+ * sampled vertex are kept by vertex key and replayed in the next frame while
+ * the scene and the light settings stay the same. The thesis does this for
+ * the primary vertices; our keys also identify refined vertices (an edge's
+ * midpoint has the same key whatever the order of splits), so they are
+ * reused too. Everything view-dependent is traced anew. Replay is exact:
+ * a frame with coherence is bit-identical to one without.
+ *
+ * Collision detection (Sec. 3.4.4, the thesis' OOB hierarchy for ray-object
+ * intersection) is the accel option: any rl_accel, BVH by default. */
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#ifdef _OPENMP
+#include <omp.h>
+#endif
+
+#include "core/error.h"
+#include "render/accel_cache.h"
+#include "render/renderer.h"
+#include "render/vt_run.h"
+#include "rl/rl_timer.h"
+#include "rl/rl_vt.h"
+
+static const char *const accel_choices[] = { "bvh", "grid", "embree", "brute", NULL };
+static const char *const criteria_choices[] = { "rgb", "hsv", "tree", "tree+rgb", "tree+hsv", NULL };
+static const char *const texture_choices[] = { "multitexture", "multipass", "sampled", NULL };
+static const char *const progressive_choices[] = { "none", "overdraw", "redraw", NULL };
+static const char *const shading_choices[] = { "flat", "gouraud", "textured", NULL };
+static const char *const overlay_choices[] = { "none", "wire", "samples", NULL };
+
+static const rl_option_info vt_options[] = {
+    { "objects", RL_OPT_STRING, "auto",
+      "VT objects: auto (attribute vt, else reflective/refractive objects), all, none, or node names a,b,c",
+      0, 0, NULL },
+    { "criteria", RL_OPT_ENUM, "tree+hsv", "subdivision criteria (Sec. 3.3.1), combined with OR",
+      0, 0, criteria_choices },
+    { "eps_rgb", RL_OPT_FLOAT, "0.1", "RGB: L1 distance of display values (0..3) that splits an edge", 0, 3, NULL },
+    { "eps_h", RL_OPT_FLOAT, "0.05", "HSV: hue difference (fraction of the circle) that splits", 0, 0.5, NULL },
+    { "eps_s", RL_OPT_FLOAT, "0.1", "HSV: saturation difference that splits", 0, 1, NULL },
+    { "eps_v", RL_OPT_FLOAT, "0.05", "HSV: value difference that splits", 0, 1, NULL },
+    { "min_edge", RL_OPT_FLOAT, "1", "minimum projected edge length in pixels: shorter edges are not split",
+      0.25, 1e6, NULL },
+    { "forced", RL_OPT_BOOL, "true", "forced refinement of compressed triangles (Sec. 3.3.2)", 0, 0, NULL },
+    { "eps_z", RL_OPT_FLOAT, "0.98", "forced refinement threshold on xi = c / (a + b)", 0.5, 1, NULL },
+    { "id_test", RL_OPT_BOOL, "true", "ID-buffer visibility pre-pass (Sec. 3.4.1; false: all faces)", 0, 0, NULL },
+    { "z_test", RL_OPT_BOOL, "true", "z-buffer test of new edges (Sec. 3.4.2)", 0, 0, NULL },
+    { "clip_test", RL_OPT_BOOL, "true", "viewport test of new edges (Sec. 3.4.3)", 0, 0, NULL },
+    { "textures", RL_OPT_ENUM, "multitexture",
+      "deferred textures: multitexture (eq. 3.20, one pass), multipass (eq. 3.22), sampled (no deferral)",
+      0, 0, texture_choices },
+    { "progressive", RL_OPT_ENUM, "none", "intermediate images for the update callback (Sec. 3.5.1)",
+      0, 0, progressive_choices },
+    { "update_every", RL_OPT_INT, "1", "k: refinement stages between progressive updates", 1, 1000000, NULL },
+    { "overdraw_f", RL_OPT_FLOAT, "0.0001", "f of eq. 3.14: overdraw offset per stage towards the eye",
+      0, 0.01, NULL },
+    { "coherence", RL_OPT_BOOL, "true", "reuse shadow feelers between frames (Sec. 3.4.5)", 0, 0, NULL },
+    { "max_vertices", RL_OPT_INT, "16000000", "refinement stops when the mesh has this many vertices",
+      100, 1000000000, NULL },
+    { "overlay", RL_OPT_ENUM, "none", "draw the refined mesh (wire) or samples by reason over the image",
+      0, 0, overlay_choices },
+    { "shading", RL_OPT_ENUM, "textured", "shading of the rasterized non-VT objects", 0, 0, shading_choices },
+    { "accel", RL_OPT_ENUM, "bvh", "acceleration structure for the rays (embree only in builds with Embree)",
+      0, 0, accel_choices },
+    { "max_depth", RL_OPT_INT, "5", "reflection/refraction recursion depth (0: local shading only)", 0, 64, NULL },
+    { "area_samples", RL_OPT_INT, "4", "n x n jittered shadow feelers per quad light", 1, 32, NULL },
+    { "shadows", RL_OPT_BOOL, "true", "trace shadow feelers (false: every light is visible)", 0, 0, NULL },
+    { "ambient", RL_OPT_FLOAT, "0.05", "ambient light, multiplied by k_d", 0, 1, NULL },
+    { "background", RL_OPT_COLOR, "0,0,0", "radiance of rays that leave the scene: \"r,g,b\" or one grey value",
+      0, 0, NULL },
+    { "threads", RL_OPT_INT, "0", "OpenMP threads (0 = all)", 0, 1024, NULL },
+};
+
+typedef struct vt_state {
+    rl_accel_cache accel;
+    /* the VT meshes, kept while the scene and the object selection stay */
+    uint64_t mesh_scene;
+    char *mesh_objects;
+    uint8_t *object_vt, *object_raster;
+    uint32_t *tri_face;
+    vt_mesh mesh;
+    bool mesh_valid;
+    vt_heap heap;
+    /* temporal coherence */
+    vt_feeler_map feelers;
+    uint64_t feelers_scene;
+    uint64_t feelers_signature;
+    /* the last frame */
+    bool have_frame;
+    rl_vt_stats stats;
+    rl_vt_vertex_info *vinfo;
+    uint32_t *finfo;
+    size_t num_vinfo, num_finfo;
+    rl_vt_update_fn update;
+    void *update_user;
+} vt_state;
+
+static rl_status vt_create(void **state)
+{
+    vt_state *s = rl_calloc(1, sizeof *s);
+    if (!s)
+        return RL_ERR_OUT_OF_MEMORY;
+    *state = s;
+    return RL_OK;
+}
+
+static void vt_release(void *state)
+{
+    vt_state *s = state;
+    if (!s)
+        return;
+    rl_accel_cache_release(&s->accel);
+    free(s->mesh_objects);
+    free(s->object_vt);
+    free(s->object_raster);
+    free(s->tri_face);
+    vt_mesh_free(&s->mesh);
+    vt_heap_free(&s->heap);
+    vt_feeler_map_free(&s->feelers);
+    free(s->vinfo);
+    free(s->finfo);
+    free(s);
+}
+
+static rl_status vt_check(const char *key, const char *value)
+{
+    if (strcmp(key, "accel") == 0 && strcmp(value, "embree") == 0 && !rl_accel_kind_available(RL_ACCEL_EMBREE))
+        return rl_error(RL_ERR_INVALID_ARG, "vt: accel=embree is not available in this build (configure with -DRL_EMBREE=ON)");
+    if (strcmp(key, "objects") == 0 && value[0] == '\0')
+        return rl_error(RL_ERR_INVALID_ARG, "vt: objects must be auto, all, none or a list of node names");
+    return RL_OK;
+}
+
+/* ------------------------------------------------------- VT objects -- */
+
+/* The vt attribute of node or its nearest ancestor that has one: 1 true,
+ * 0 false, -1 none. */
+static int vt_attr(const rl_scene *scene, uint32_t node)
+{
+    for (uint32_t n = node; n != RL_NONE; n = rl_scene_node_parent(scene, n)) {
+        const char *a = rl_scene_node_attr(scene, n, "vt");
+        if (a)
+            return strcmp(a, "true") == 0 || strcmp(a, "1") == 0 || strcmp(a, "yes") == 0;
+    }
+    return -1;
+}
+
+static bool under(const rl_scene *scene, uint32_t node, uint32_t ancestor)
+{
+    for (uint32_t n = node; n != RL_NONE; n = rl_scene_node_parent(scene, n))
+        if (n == ancestor)
+            return true;
+    return false;
+}
+
+static rl_status select_objects(const rl_scene *scene, const rl_scene_data *d, const char *spec, uint8_t *vt)
+{
+    memset(vt, 0, d->num_objects);
+    if (strcmp(spec, "none") == 0)
+        return RL_OK;
+    if (strcmp(spec, "all") == 0) {
+        memset(vt, 1, d->num_objects);
+        return RL_OK;
+    }
+    if (strcmp(spec, "auto") == 0) {
+        bool any_attr = false;
+        for (uint32_t o = 0; o < d->num_objects; ++o) {
+            int a = vt_attr(scene, d->objects[o].node);
+            any_attr |= a >= 0;
+            vt[o] = a > 0;
+        }
+        if (any_attr)
+            return RL_OK;
+        /* Sec. 3.5: specular objects are the VT objects. */
+        for (uint32_t o = 0; o < d->num_objects; ++o) {
+            const rl_object *obj = &d->objects[o];
+            for (uint32_t t = obj->first_triangle; t < obj->first_triangle + obj->num_triangles && !vt[o]; ++t) {
+                const rl_material *m = &d->materials[d->triangle_material[t]];
+                vt[o] = m->reflectivity > 0.0f || m->transmissivity > 0.0f;
+            }
+        }
+        return RL_OK;
+    }
+    /* A list of node names, each with its subtree. */
+    const char *p = spec;
+    while (*p) {
+        const char *end = strchr(p, ',');
+        size_t len = end ? (size_t)(end - p) : strlen(p);
+        char name[256];
+        if (len == 0 || len >= sizeof name)
+            return rl_error(RL_ERR_INVALID_ARG, "vt: objects: empty or overlong node name in \"%s\"", spec);
+        memcpy(name, p, len);
+        name[len] = '\0';
+        uint32_t node = rl_scene_find_node(scene, name);
+        if (node == RL_NONE)
+            return rl_error(RL_ERR_NOT_FOUND, "vt: objects: no node named \"%s\" in scene \"%s\"", name,
+                            rl_scene_name(scene));
+        for (uint32_t o = 0; o < d->num_objects; ++o)
+            if (under(scene, d->objects[o].node, node))
+                vt[o] = 1;
+        p = end ? end + 1 : p + len;
+    }
+    return RL_OK;
+}
+
+/* Rebuilds the VT meshes when the scene or the selection changed. */
+static rl_status ensure_mesh(vt_state *s, const rl_scene *scene, const rl_scene_data *d, const char *spec)
+{
+    uint64_t uid = rl_scene_uid(scene);
+    if (s->mesh_valid && s->mesh_scene == uid && s->mesh_objects && strcmp(s->mesh_objects, spec) == 0)
+        return RL_OK;
+    s->mesh_valid = false;
+    free(s->object_vt);
+    free(s->object_raster);
+    free(s->tri_face);
+    free(s->mesh_objects);
+    s->object_raster = s->object_vt = NULL;
+    s->tri_face = NULL;
+    s->mesh_objects = NULL;
+    vt_mesh_free(&s->mesh);
+    size_t no = d->num_objects ? d->num_objects : 1;
+    s->object_vt = rl_calloc(no, 1);
+    s->object_raster = rl_calloc(no, 1);
+    s->tri_face = rl_realloc_array(NULL, d->num_triangles ? d->num_triangles : 1, sizeof *s->tri_face);
+    size_t len = strlen(spec);
+    s->mesh_objects = malloc(len + 1);
+    if (!s->object_vt || !s->object_raster || !s->tri_face || !s->mesh_objects)
+        return RL_ERR_OUT_OF_MEMORY;
+    memcpy(s->mesh_objects, spec, len + 1);
+    rl_status st = select_objects(scene, d, spec, s->object_vt);
+    if (st == RL_OK)
+        st = vt_mesh_build(&s->mesh, d, s->object_vt);
+    if (st != RL_OK)
+        return st;
+    for (uint32_t o = 0; o < d->num_objects; ++o)
+        s->object_raster[o] = !s->object_vt[o];
+    for (uint32_t t = 0; t < d->num_triangles; ++t)
+        s->tri_face[t] = VT_NONE;
+    for (uint32_t f = 0; f < s->mesh.num_primary_faces; ++f)
+        s->tri_face[s->mesh.faces[f].triangle] = f;
+    s->mesh_scene = uid;
+    s->mesh_valid = true;
+    return RL_OK;
+}
+
+/* ------------------------------------------------------------- frame -- */
+
+static bool build_progress(void *user, double done)
+{
+    bool go_on;
+#pragma omp critical(rl_vt_progress)
+    go_on = rl_renderer_progress(user, 0.05 * done);
+    return go_on;
+}
+
+static void read_settings(rl_renderer *r, vt_settings *set)
+{
+    memset(set, 0, sizeof *set);
+    vt_criteria_parse(criteria_choices[rl_renderer_opt_enum(r, "criteria")], &set->criteria.bits);
+    set->criteria.eps_rgb = (float)rl_renderer_opt_float(r, "eps_rgb");
+    set->criteria.eps_h = (float)rl_renderer_opt_float(r, "eps_h");
+    set->criteria.eps_s = (float)rl_renderer_opt_float(r, "eps_s");
+    set->criteria.eps_v = (float)rl_renderer_opt_float(r, "eps_v");
+    set->min_edge = (float)rl_renderer_opt_float(r, "min_edge");
+    set->forced = rl_renderer_opt_bool(r, "forced");
+    set->eps_z = (float)rl_renderer_opt_float(r, "eps_z");
+    set->id_test = rl_renderer_opt_bool(r, "id_test");
+    set->z_test = rl_renderer_opt_bool(r, "z_test");
+    set->clip_test = rl_renderer_opt_bool(r, "clip_test");
+    set->textures = rl_renderer_opt_enum(r, "textures");
+    set->progressive = rl_renderer_opt_enum(r, "progressive");
+    set->update_every = (int)rl_renderer_opt_int(r, "update_every");
+    set->overdraw_f = (float)rl_renderer_opt_float(r, "overdraw_f");
+    set->coherence = rl_renderer_opt_bool(r, "coherence");
+    set->max_vertices = (uint32_t)rl_renderer_opt_int(r, "max_vertices");
+    int threads = (int)rl_renderer_opt_int(r, "threads");
+#ifdef _OPENMP
+    set->threads = threads > 0 ? threads : omp_get_max_threads();
+#else
+    (void)threads;
+    set->threads = 1;
+#endif
+    if (set->threads > RL_VT_MAX_THREADS)
+        set->threads = RL_VT_MAX_THREADS;
+    set->shading = (rl_raster_shading)rl_renderer_opt_enum(r, "shading");
+    set->ambient = (float)rl_renderer_opt_float(r, "ambient");
+    set->background = rl_renderer_opt_color(r, "background");
+    set->overlay = rl_renderer_opt_enum(r, "overlay");
+}
+
+/* What the cached feelers depend on besides the scene. */
+static uint64_t feeler_signature(const rl_tracer_desc *desc)
+{
+    return ((uint64_t)(unsigned)desc->area_samples << 8) ^ (desc->no_shadows ? 1u : 0u) ^ (desc->seed << 20);
+}
+
+/* Keeps this frame's feelers for the next one. */
+static rl_status keep_feelers(vt_state *s, const vt_run *run)
+{
+    const vt_mesh *m = run->mesh;
+    size_t n = 0;
+    for (uint32_t v = 0; v < m->num_verts; ++v)
+        n += m->verts[v].state == VT_SAMPLED;
+    uint64_t *keys = rl_realloc_array(NULL, n ? n : 1, sizeof *keys);
+    rl_trace_feelers *vals = rl_realloc_array(NULL, n ? n : 1, sizeof *vals);
+    rl_status st = keys && vals ? RL_OK : RL_ERR_OUT_OF_MEMORY;
+    if (st == RL_OK) {
+        size_t i = 0;
+        for (uint32_t v = 0; v < m->num_verts; ++v) {
+            if (m->verts[v].state != VT_SAMPLED)
+                continue;
+            keys[i] = m->verts[v].key;
+            vals[i++] = run->feelers[v];
+        }
+        st = vt_feeler_map_rebuild(&s->feelers, keys, vals, n);
+    }
+    free(keys);
+    free(vals);
+    return st;
+}
+
+/* Copies the refined mesh out for rl_vt_get_mesh. */
+static rl_status keep_mesh(vt_state *s, const vt_run *run)
+{
+    const vt_mesh *m = run->mesh;
+    size_t faces = 0;
+    for (uint32_t f = 0; f < m->num_faces; ++f)
+        faces += m->faces[f].leaf;
+    rl_vt_vertex_info *vi = rl_realloc_array(s->vinfo, m->num_verts ? m->num_verts : 1, sizeof *vi);
+    if (!vi)
+        return RL_ERR_OUT_OF_MEMORY;
+    s->vinfo = vi;
+    uint32_t *fi = rl_realloc_array(s->finfo, faces ? 3 * faces : 1, sizeof *fi);
+    if (!fi)
+        return RL_ERR_OUT_OF_MEMORY;
+    s->finfo = fi;
+    for (uint32_t v = 0; v < m->num_verts; ++v) {
+        const vt_vertex *x = &m->verts[v];
+        vi[v] = (rl_vt_vertex_info){ x->sx, x->sy, x->stage, x->state == VT_SAMPLED,
+                                     v < run->per_vertex_cap ? run->reason[v] : 0 };
+    }
+    size_t k = 0;
+    for (uint32_t f = 0; f < m->num_faces; ++f) {
+        if (!m->faces[f].leaf)
+            continue;
+        for (int j = 0; j < 3; ++j)
+            fi[k++] = m->faces[f].v[j];
+    }
+    s->num_vinfo = m->num_verts;
+    s->num_finfo = faces;
+    return RL_OK;
+}
+
+static rl_status vt_render(rl_renderer *r, void *state, const rl_scene *scene, const rl_camera *cam_in,
+                           rl_image *image, rl_render_stats *stats)
+{
+    vt_state *s = state;
+    const rl_scene_data *d = rl_scene_get_data(scene);
+    if (!d)
+        return RL_ERR_NOT_COMMITTED;
+    rl_status st = rl_camera_validate(cam_in);
+    if (st != RL_OK)
+        return st;
+    rl_camera cam = rl_camera_resolve(cam_in);
+    vt_settings set;
+    read_settings(r, &set);
+    s->have_frame = false;
+
+    rl_accel_kind kind;
+    if ((st = rl_accel_kind_parse(accel_choices[rl_renderer_opt_enum(r, "accel")], &kind)) != RL_OK)
+        return st;
+    if ((st = rl_accel_cache_get(&s->accel, "vt", scene, kind, set.threads, build_progress, r)) != RL_OK)
+        return st;
+    if ((st = ensure_mesh(s, scene, d, rl_renderer_opt_string(r, "objects"))) != RL_OK)
+        return st;
+
+    int max_depth = (int)rl_renderer_opt_int(r, "max_depth");
+    float ambient = (float)rl_renderer_opt_float(r, "ambient");
+    rl_tracer_desc desc = {
+        .max_depth = max_depth > 0 ? max_depth : -1,
+        .area_samples = (int)rl_renderer_opt_int(r, "area_samples"),
+        .ambient = ambient > 0.0f ? ambient : -1.0f,
+        .background = set.background,
+        .no_shadows = !rl_renderer_opt_bool(r, "shadows"),
+        .seed = 0,
+    };
+    rl_tracer *tracer = NULL;
+    if ((st = rl_tracer_create(s->accel.accel, &desc, &tracer)) != RL_OK)
+        return st;
+    uint64_t signature = feeler_signature(&desc);
+    if (!set.coherence || s->feelers_scene != rl_scene_uid(scene) || s->feelers_signature != signature) {
+        vt_feeler_map_free(&s->feelers);
+        s->feelers_scene = rl_scene_uid(scene);
+        s->feelers_signature = signature;
+    }
+
+    vt_mesh_reset(&s->mesh);
+    vt_heap_clear(&s->heap);
+    vt_run run;
+    memset(&run, 0, sizeof run);
+    run.t_start_ms = rl_time_s() * 1000.0;
+    run.set = &set;
+    run.data = d;
+    run.tracer = tracer;
+    run.mesh = &s->mesh;
+    run.heap = &s->heap;
+    run.object_vt = s->object_vt;
+    run.object_raster = s->object_raster;
+    run.tri_face = s->tri_face;
+    run.want_tree = (set.criteria.bits & VT_CRIT_TREE) != 0;
+    run.cache = set.coherence && s->feelers.count ? &s->feelers : NULL;
+    run.renderer = r;
+    run.update = s->update;
+    run.update_user = s->update_user;
+    run.image = image;
+    run.camera = &cam;
+
+    float z_near = cam.z_near, z_far = cam.z_far;
+    if (!(z_near > 0.0f))
+        rl_camera_clip_range(&cam, d->bounds, &z_near, &z_far);
+    run.view_m = rl_camera_view(&cam);
+    run.proj_m = rl_camera_projection(&cam, z_near, z_far);
+    run.view = (vt_view){
+        .view_proj = rl_mat4_mul(&run.proj_m, &run.view_m),
+        .eye = cam.eye,
+        .forward = rl_normalize(rl_sub(cam.target, cam.eye)),
+        .width = image->width,
+        .height = image->height,
+        .z_near = z_near,
+        .depth = NULL,
+        .depth_tolerance = 1e-3f,
+    };
+    run.stats.threads = (uint32_t)set.threads;
+    run.stats.primary_vertices = s->mesh.num_primary_verts;
+    run.stats.primary_faces = s->mesh.num_primary_faces;
+    for (uint32_t o = 0; o < d->num_objects; ++o)
+        run.stats.vt_objects += s->object_vt[o];
+
+    rl_image *depth_ids = NULL;
+    st = vt_run_reserve(&run);
+    if (st == RL_OK)
+        st = rl_image_create(image->width, image->height, RL_LAYER_DEPTH | RL_LAYER_ID, &depth_ids);
+    double t0 = rl_time_s() * 1000.0;
+    if (st == RL_OK)
+        st = vt_prepass(&run, depth_ids);
+    run.stats.time_visibility_ms = rl_time_s() * 1000.0 - t0;
+    if (st == RL_OK)
+        st = vt_refine(&run);
+    rl_tracer_release(tracer);
+    if (st == RL_OK) {
+        double td = rl_time_s() * 1000.0;
+        if (!vt_update(&run, run.stats.stages, true) && run.failed)
+            st = RL_ERR_OUT_OF_MEMORY;
+        run.stats.time_draw_ms = rl_time_s() * 1000.0 - td;
+    }
+    if (st == RL_OK && set.coherence)
+        st = keep_feelers(s, &run);
+    if (st == RL_OK)
+        st = keep_mesh(s, &run);
+    rl_image_release(depth_ids);
+    vt_run_free_blocks(&run);
+    free(run.reason);
+    free(run.feelers);
+    free(run.scratch_depth);
+    if (st != RL_OK)
+        return st;
+
+    for (int t = 0; t < set.threads && t < RL_VT_MAX_THREADS; ++t) {
+        run.stats.thread_rays[t] = run.tally[t].rays;
+        run.stats.thread_busy_ms[t] = run.tally[t].busy_ms;
+        run.stats.feelers_reused += run.tally[t].feelers_reused;
+    }
+    s->stats = run.stats;
+    s->have_frame = true;
+    for (int k = 0; k < RL_RAY_TYPE_COUNT; ++k)
+        stats->rays[k] = run.rays[k];
+    stats->triangles_rasterized = run.counters.triangles_drawn;
+    stats->pixels_written = run.counters.pixels_written;
+    stats->samples = run.stats.vertices_sampled;
+    if (run.cancelled)
+        return rl_error(RL_ERR_CANCELLED, "vt: cancelled by the progress callback");
+    return RL_OK;
+}
+
+/* ---------------------------------------------------------- accessors -- */
+
+static vt_state *vt_of(const rl_renderer *r, const char *fn)
+{
+    if (!r || strcmp(rl_renderer_name(r), "vt") != 0) {
+        rl_error(RL_ERR_INVALID_ARG, "%s: needs a \"vt\" renderer", fn);
+        return NULL;
+    }
+    return rl_renderer_state(r);
+}
+
+rl_status rl_vt_get_stats(const rl_renderer *r, rl_vt_stats *out)
+{
+    vt_state *s = vt_of(r, "rl_vt_get_stats");
+    if (!s || !out)
+        return rl_error(RL_ERR_INVALID_ARG, "rl_vt_get_stats: needs a \"vt\" renderer and out");
+    if (!s->have_frame)
+        return rl_error(RL_ERR_INVALID_ARG, "rl_vt_get_stats: no frame rendered yet");
+    *out = s->stats;
+    return RL_OK;
+}
+
+rl_status rl_vt_get_mesh(const rl_renderer *r, const rl_vt_vertex_info **vertices, size_t *num_vertices,
+                         const uint32_t **faces, size_t *num_faces)
+{
+    vt_state *s = vt_of(r, "rl_vt_get_mesh");
+    if (!s || !vertices || !num_vertices || !faces || !num_faces)
+        return rl_error(RL_ERR_INVALID_ARG, "rl_vt_get_mesh: needs a \"vt\" renderer and outputs");
+    if (!s->have_frame)
+        return rl_error(RL_ERR_INVALID_ARG, "rl_vt_get_mesh: no frame rendered yet");
+    *vertices = s->vinfo;
+    *num_vertices = s->num_vinfo;
+    *faces = s->finfo;
+    *num_faces = s->num_finfo;
+    return RL_OK;
+}
+
+rl_status rl_vt_set_update_callback(rl_renderer *r, rl_vt_update_fn fn, void *user)
+{
+    vt_state *s = vt_of(r, "rl_vt_set_update_callback");
+    if (!s)
+        return RL_ERR_INVALID_ARG;
+    s->update = fn;
+    s->update_user = user;
+    return RL_OK;
+}
+
+const rl_renderer_class rl_vt_renderer_class = {
+    .info = { "vt", "Vertex Tracing: adaptive progressive ray tracing in object space, hybrid with rasterization",
+              "Ullmann 2003, Ch. 3-4" },
+    .options = vt_options,
+    .num_options = sizeof vt_options / sizeof vt_options[0],
+    .create = vt_create,
+    .render = vt_render,
+    .release = vt_release,
+    .check = vt_check,
+};

@@ -1,0 +1,340 @@
+/* vt_draw.c: reconstruction of the radiance function (Ullmann 2003,
+ * Sec. 3.5) through the software rasterizer: the second pass of Fig. 3.17.
+ *
+ * The non-VT objects are drawn by the raster renderer's own code (hybrid
+ * rendering), then the leaf faces of the refined VT meshes with their
+ * vertex samples interpolated by Gouraud shading. Textures are not part of
+ * the samples (Sec. 3.5.3): each vertex carries, per term (the surface
+ * itself, its reflection, its refraction), the light that a texel would
+ * multiply and the texture coordinates where it would be looked up, and
+ * the rasterizer does the lookup per pixel:
+ *   multitexture (Sec. 3.5.5): one pass with four layers, the exact form of
+ *       eq. 3.20 in our material model (a texture scales k_d only):
+ *       D_prim T_prim + (R_prim + R_refl + R_trans) + D_refl T_refl + D_trans T_trans;
+ *   multipass (Sec. 3.5.4): eq. 3.22 in three passes added with blending,
+ *       each (C + C_comb) times its texture, the thesis' approximation;
+ *   sampled: the textured radiance at the vertices, interpolated (what
+ *       happens without deferred textures; for comparison).
+ * A face whose three vertices see different reflected (or refracted)
+ * textures is an "undefined face" (Fig. 3.21): for that term its vertices'
+ * looked-up radiance is interpolated instead.
+ *
+ * Progressive display (Sec. 3.5.1): redraw rebuilds the image; overdraw
+ * draws only the faces of the stages since the last update on top of it,
+ * each vertex moved towards the eye by eq. 3.16,
+ *     v_k = v - (v - p_a) f k,
+ * so that children win the depth test against their parents. */
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "core/error.h"
+#include "render/vt_run.h"
+
+#define NUM_LAYERS 4
+
+typedef struct corner_buf {
+    size_t faces;
+    rl_vec3 *pos;
+    rl_vec4 *col[NUM_LAYERS];
+    rl_vec2 *uv[NUM_LAYERS];
+    uint32_t *tex[NUM_LAYERS];    /* per face */
+    uint32_t *idx;
+    uint32_t *tri_ids, *obj_ids;  /* per face */
+} corner_buf;
+
+static void free_corners(corner_buf *b)
+{
+    free(b->pos);
+    for (int l = 0; l < NUM_LAYERS; ++l) {
+        free(b->col[l]);
+        free(b->uv[l]);
+        free(b->tex[l]);
+    }
+    free(b->idx);
+    free(b->tri_ids);
+    free(b->obj_ids);
+    memset(b, 0, sizeof *b);
+}
+
+static bool alloc_corners(corner_buf *b, size_t faces)
+{
+    memset(b, 0, sizeof *b);
+    b->faces = faces;
+    size_t n = faces ? faces * 3 : 1;
+    bool ok = (b->pos = rl_realloc_array(NULL, n, sizeof *b->pos)) && (b->idx = rl_realloc_array(NULL, n, sizeof *b->idx)) &&
+              (b->tri_ids = rl_realloc_array(NULL, n / 3 + 1, sizeof *b->tri_ids)) &&
+              (b->obj_ids = rl_realloc_array(NULL, n / 3 + 1, sizeof *b->obj_ids));
+    for (int l = 0; ok && l < NUM_LAYERS; ++l)
+        ok = (b->col[l] = rl_realloc_array(NULL, n, sizeof *b->col[l])) &&
+             (b->uv[l] = rl_realloc_array(NULL, n, sizeof *b->uv[l])) &&
+             (b->tex[l] = rl_realloc_array(NULL, n / 3 + 1, sizeof *b->tex[l]));
+    if (!ok)
+        free_corners(b);
+    return ok;
+}
+
+static const rl_texture *texture_at(const rl_scene_data *d, uint32_t tex)
+{
+    return tex < d->num_textures ? d->textures[tex] : NULL;
+}
+
+/* Radiance of one deferred term looked up at the vertex (undefined faces). */
+static rl_vec3 looked_up(const rl_scene_data *d, const rl_trace_layer *L)
+{
+    const rl_texture *t = texture_at(d, L->texture);
+    if (!t)
+        return rl_add(L->diffuse, L->rest);
+    rl_vec4 texel = rl_texture_sample(t, L->uv);
+    return rl_add(rl_mul(L->diffuse, rl_v3(texel.x, texel.y, texel.z)), L->rest);
+}
+
+static rl_vec4 c4(rl_vec3 c)
+{
+    return rl_v4_from3(c, 1.0f);
+}
+
+/* The texture of the term `layer` on the face when all three vertices see
+ * the same one ("defined face", Fig. 3.20), else RL_NONE. */
+static uint32_t defined_texture(const rl_scene_data *d, const vt_vertex *v[3], int layer)
+{
+    uint32_t t = v[0]->layers[layer].texture;
+    if (!texture_at(d, t))
+        return RL_NONE;
+    return v[1]->layers[layer].texture == t && v[2]->layers[layer].texture == t ? t : RL_NONE;
+}
+
+static uint32_t face_texture(const rl_scene_data *d, const vt_face *f)
+{
+    uint32_t tex = d->materials[d->triangle_material[f->triangle]].diffuse_texture;
+    return texture_at(d, tex) ? tex : RL_NONE;
+}
+
+/* Fills face slot i (three corners) for the texture mode. */
+static void fill_face(const vt_run *run, corner_buf *b, size_t i, const vt_face *f, bool offset)
+{
+    const rl_scene_data *d = run->data;
+    const vt_vertex *v[3];
+    for (int k = 0; k < 3; ++k)
+        v[k] = &run->mesh->verts[f->v[k]];
+    float shift = offset ? run->set->overdraw_f * (float)f->stage : 0.0f;
+    uint32_t tex0 = face_texture(d, f);
+    uint32_t tex_refl = defined_texture(d, v, RL_TRACE_LAYER_REFLECTION);
+    uint32_t tex_refr = defined_texture(d, v, RL_TRACE_LAYER_REFRACTION);
+    b->tri_ids[i] = f->triangle;
+    b->obj_ids[i] = f->object;
+    int mode = run->set->textures;
+    b->tex[0][i] = mode == VT_TEX_SAMPLED ? RL_NONE : tex0;
+    b->tex[1][i] = RL_NONE;
+    b->tex[2][i] = mode == VT_TEX_SAMPLED ? RL_NONE : tex_refl;
+    b->tex[3][i] = mode == VT_TEX_SAMPLED ? RL_NONE : tex_refr;
+    for (int k = 0; k < 3; ++k) {
+        size_t c = 3 * i + (size_t)k;
+        const vt_vertex *x = v[k];
+        /* eq. 3.16 */
+        b->pos[c] = shift > 0.0f ? rl_sub(x->p, rl_scale(rl_sub(x->p, run->view.eye), shift)) : x->p;
+        b->idx[c] = (uint32_t)c;
+        const rl_trace_layer *L = x->layers;
+        for (int l = 0; l < NUM_LAYERS; ++l)
+            b->uv[l][c] = rl_v2(0.0f, 0.0f);
+        if (mode == VT_TEX_SAMPLED) {
+            b->col[0][c] = c4(x->color);
+            continue;
+        }
+        b->uv[0][c] = x->uv;
+        b->uv[2][c] = L[RL_TRACE_LAYER_REFLECTION].uv;
+        b->uv[3][c] = L[RL_TRACE_LAYER_REFRACTION].uv;
+        rl_vec3 refl = tex_refl != RL_NONE ? L[RL_TRACE_LAYER_REFLECTION].diffuse
+                                           : looked_up(d, &L[RL_TRACE_LAYER_REFLECTION]);
+        rl_vec3 refr = tex_refr != RL_NONE ? L[RL_TRACE_LAYER_REFRACTION].diffuse
+                                           : looked_up(d, &L[RL_TRACE_LAYER_REFRACTION]);
+        if (mode == VT_TEX_MULTITEXTURE) {
+            /* eq. 3.20: only the diffuse parts are modulated. */
+            rl_vec3 rest = L[RL_TRACE_LAYER_PRIMARY].rest;
+            if (tex_refl != RL_NONE)
+                rest = rl_add(rest, L[RL_TRACE_LAYER_REFLECTION].rest);
+            if (tex_refr != RL_NONE)
+                rest = rl_add(rest, L[RL_TRACE_LAYER_REFRACTION].rest);
+            b->col[0][c] = c4(L[RL_TRACE_LAYER_PRIMARY].diffuse);
+            b->col[1][c] = c4(rest);
+            b->col[2][c] = c4(refl);
+            b->col[3][c] = c4(refr);
+        } else {
+            /* eq. 3.22: (C + C_comb) x texture per pass. */
+            b->col[0][c] = c4(rl_add(L[RL_TRACE_LAYER_PRIMARY].diffuse, L[RL_TRACE_LAYER_PRIMARY].rest));
+            b->col[2][c] = c4(tex_refl != RL_NONE ? rl_add(refl, L[RL_TRACE_LAYER_REFLECTION].rest) : refl);
+            b->col[3][c] = c4(tex_refr != RL_NONE ? rl_add(refr, L[RL_TRACE_LAYER_REFRACTION].rest) : refr);
+        }
+    }
+}
+
+static bool drawable(const vt_mesh *m, const vt_face *f)
+{
+    return m->verts[f->v[0]].state == VT_SAMPLED && m->verts[f->v[1]].state == VT_SAMPLED &&
+           m->verts[f->v[2]].state == VT_SAMPLED;
+}
+
+static rl_status draw_faces(vt_run *run, rl_raster *ras, bool only_new, unsigned id_flags)
+{
+    const vt_mesh *m = run->mesh;
+    size_t count = 0;
+    for (uint32_t f = 0; f < m->num_faces; ++f) {
+        const vt_face *face = &m->faces[f];
+        bool take = only_new ? face->stage > run->drawn_stage : face->leaf;
+        count += take && drawable(m, face);
+    }
+    if (!count)
+        return RL_OK;
+    corner_buf b;
+    if (!alloc_corners(&b, count))
+        return RL_ERR_OUT_OF_MEMORY;
+    size_t i = 0;
+    for (uint32_t f = 0; f < m->num_faces; ++f) {
+        const vt_face *face = &m->faces[f];
+        bool take = only_new ? face->stage > run->drawn_stage : face->leaf;
+        if (take && drawable(m, face))
+            fill_face(run, &b, i++, face, run->set->progressive == VT_PROG_OVERDRAW);
+    }
+    if (!only_new)
+        run->stats.faces_drawn = count;
+
+    rl_raster_batch batch;
+    memset(&batch, 0, sizeof batch);
+    batch.num_vertices = (uint32_t)(count * 3);
+    batch.positions = b.pos;
+    batch.num_triangles = (uint32_t)count;
+    batch.indices = b.idx;
+    batch.triangle_ids = b.tri_ids;
+    batch.object_ids = b.obj_ids;
+    batch.flags = id_flags;
+    rl_raster_layer layers[NUM_LAYERS];
+    for (int l = 0; l < NUM_LAYERS; ++l)
+        layers[l] = (rl_raster_layer){ b.col[l], b.uv[l], b.tex[l], run->data->textures };
+    rl_status st;
+    if (run->set->textures == VT_TEX_SAMPLED) {
+        batch.colors = b.col[0];
+        st = rl_raster_draw(ras, &batch, &run->counters);
+    } else if (run->set->textures == VT_TEX_MULTITEXTURE) {
+        batch.num_layers = NUM_LAYERS;
+        batch.layers = layers;
+        st = rl_raster_draw(ras, &batch, &run->counters);
+    } else {
+        /* Sec. 3.5.4: pass 1 writes, passes 2 and 3 add where the same
+         * faces are in front (depth equal). */
+        batch.num_layers = 1;
+        batch.layers = &layers[0];
+        st = rl_raster_draw(ras, &batch, &run->counters);
+        for (int l = 2; st == RL_OK && l < NUM_LAYERS; ++l) {
+            batch.layers = &layers[l];
+            batch.flags = RL_RASTER_DEPTH_EQUAL | RL_RASTER_BLEND_ADD | RL_RASTER_NO_DEPTH | RL_RASTER_NO_ID;
+            st = rl_raster_draw(ras, &batch, &run->counters);
+        }
+    }
+    free_corners(&b);
+    return st;
+}
+
+rl_status vt_draw(vt_run *run, bool only_new)
+{
+    rl_image target = *run->image;
+    size_t n = (size_t)target.width * (size_t)target.height;
+    if (!(target.layers & RL_LAYER_DEPTH) || !target.depth) {
+        if (!run->scratch_depth && !(run->scratch_depth = rl_realloc_array(NULL, n, sizeof(float))))
+            return RL_ERR_OUT_OF_MEMORY;
+        target.depth = run->scratch_depth;
+        target.layers |= RL_LAYER_DEPTH;
+    }
+    unsigned id_flags = (target.layers & RL_LAYER_ID) && target.object_id && target.triangle_id ? 0u : RL_RASTER_NO_ID;
+    if (only_new && !run->drawn)
+        only_new = false;
+    rl_raster *ras = NULL;
+    rl_status st = rl_raster_create(&(rl_raster_desc){ .threads = run->set->threads }, &ras);
+    if (st == RL_OK)
+        st = rl_raster_set_target(ras, &target, &run->view_m, &run->proj_m);
+    if (st == RL_OK && !only_new) {
+        /* Fig. 3.17, second pass: clear, the non-VT objects, then the faces. */
+        rl_image_clear(&target);
+        rl_image_fill(&target, rl_v4_from3(run->set->background, 1.0f));
+        rl_raster_scene_desc desc = { .shading = run->set->shading, .ambient = run->set->ambient,
+                                      .threads = run->set->threads, .flags = id_flags,
+                                      .object_mask = run->object_raster };
+        st = rl_raster_draw_scene(ras, run->data, run->view.eye, &desc, &run->counters, NULL, NULL);
+    }
+    if (st == RL_OK)
+        st = draw_faces(run, ras, only_new, id_flags);
+    rl_raster_release(ras);
+    if (st == RL_OK)
+        run->drawn = true;
+    return st;
+}
+
+/* ------------------------------------------------------------- overlay -- */
+
+static void plot(rl_image *img, int x, int y, rl_vec4 c)
+{
+    if (x >= 0 && y >= 0 && x < img->width && y < img->height)
+        img->color[(size_t)y * img->width + x] = c;
+}
+
+/* Bresenham-free DDA: enough for a diagnostic wireframe. */
+static void line(rl_image *img, float x0, float y0, float x1, float y1, rl_vec4 c)
+{
+    float dx = x1 - x0, dy = y1 - y0;
+    float steps = fmaxf(fabsf(dx), fabsf(dy));
+    if (!(steps < 1e5f))
+        return;
+    int n = (int)ceilf(steps);
+    for (int i = 0; i <= n; ++i) {
+        float t = n ? (float)i / (float)n : 0.0f;
+        plot(img, (int)floorf(x0 + t * dx), (int)floorf(y0 + t * dy), c);
+    }
+}
+
+void vt_draw_overlay(vt_run *run)
+{
+    const vt_mesh *m = run->mesh;
+    rl_image *img = run->image;
+    if (run->set->overlay == VT_OVERLAY_WIRE) {
+        rl_vec4 c = rl_v4(0.9f, 0.9f, 0.9f, 1.0f);
+        for (uint32_t f = 0; f < m->num_faces; ++f) {
+            const vt_face *face = &m->faces[f];
+            if (!face->leaf || !drawable(m, face) || !face->visible)
+                continue;
+            for (int k = 0; k < 3; ++k) {
+                const vt_vertex *a = &m->verts[face->v[k]], *b = &m->verts[face->v[(k + 1) % 3]];
+                if (a->cw > 0.0f && b->cw > 0.0f)
+                    line(img, a->sx, a->sy, b->sx, b->sy, c);
+            }
+        }
+    } else if (run->set->overlay == VT_OVERLAY_SAMPLES) {
+        /* Fig. 5.2c-d: red for discontinuities (ray tree), yellow for
+         * non-linearities (intensity), blue for forced refinement, grey for
+         * the initial pattern. */
+        for (uint32_t v = 0; v < m->num_verts; ++v) {
+            const vt_vertex *x = &m->verts[v];
+            if (x->state != VT_SAMPLED || !(x->cw > 0.0f))
+                continue;
+            uint8_t r = v < run->per_vertex_cap ? run->reason[v] : 0;
+            rl_vec4 c = (r & VT_REASON_TREE) ? rl_v4(1.0f, 0.1f, 0.1f, 1.0f)
+                      : (r & (VT_REASON_RGB | VT_REASON_HSV)) ? rl_v4(1.0f, 0.9f, 0.1f, 1.0f)
+                      : (r & VT_REASON_FORCED) ? rl_v4(0.2f, 0.5f, 1.0f, 1.0f)
+                      : rl_v4(0.6f, 0.6f, 0.6f, 1.0f);
+            plot(img, (int)floorf(x->sx), (int)floorf(x->sy), c);
+        }
+    }
+}
+
+bool vt_update(vt_run *run, uint32_t stage, bool final)
+{
+    bool overdraw = run->set->progressive == VT_PROG_OVERDRAW;
+    if (!final || !run->drawn || !overdraw || stage != run->drawn_stage) {
+        if (vt_draw(run, overdraw && run->drawn) != RL_OK) {
+            run->failed = true;
+            return false;
+        }
+        run->drawn_stage = stage;
+    }
+    if (final)
+        vt_draw_overlay(run);
+    return run->update ? run->update(run->update_user, run->image, stage, final) : true;
+}

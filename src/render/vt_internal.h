@@ -1,0 +1,223 @@
+/* vt_internal.h: the parts of Vertex Tracing (Ullmann 2003, Ch. 3-4) and
+ * the contracts between them.
+ *
+ *   vt_mesh.c       the refinement mesh in object space: vertices, edges
+ *                   with their left/right faces, faces; edge-based
+ *                   subdivision (Sec. 3.3, Fig. 3.5) and the compression
+ *                   factor xi of forced refinement (Sec. 3.3.2).
+ *   vt_criteria.c   the subdivision criteria (Sec. 3.3.1): RGB L1, HSV,
+ *                   ray tree, and their combinations.
+ *   vt_visibility.c projection to the screen, the z-buffer test of a vertex
+ *                   (Sec. 3.4.2) and the modified Cohen-Sutherland viewport
+ *                   test of an edge (Sec. 3.4.3).
+ *   vt_heap.c       the edge list sorted by projected length (Sec. 3.3,
+ *                   Fig. 3.4), longest first.
+ *   vt_refine.c     the refinement stages and the parallel sampling (Ch. 4).
+ *   vt_draw.c       reconstruction through the rasterizer (Sec. 3.5).
+ *   vt.c            the renderer "vt": options, frames, temporal coherence.
+ *
+ * Everything here is single-threaded unless said otherwise; vt_refine.c
+ * runs the vertex sampling in parallel, never the mesh updates. */
+#ifndef RL_RENDER_VT_INTERNAL_H
+#define RL_RENDER_VT_INTERNAL_H
+
+#include <stdbool.h>
+#include <stdint.h>
+
+#include "rl/rl_math.h"
+#include "rl/rl_scene.h"
+#include "rl/rl_trace.h"
+
+#define VT_NONE 0xFFFFFFFFu
+
+/* ---------------------------------------------------------------- mesh -- */
+
+enum vt_vertex_state {
+    VT_UNSAMPLED = 0,         /* no rays yet */
+    VT_QUEUED,                /* waiting for the sampling of this stage */
+    VT_SAMPLED,               /* sample fields valid */
+};
+
+typedef struct vt_vertex {
+    rl_vec3 p;                /* world position (eq. 3.7: edge midpoint) */
+    rl_vec3 n;                /* unit shading normal (eq. 3.8) */
+    rl_vec2 uv;               /* interpolated like p */
+    uint32_t triangle;        /* scene triangle the vertex lies on */
+    uint32_t object;          /* scene object */
+    uint64_t key;             /* identity across frames: see vt_vertex_key */
+    /* screen, filled by vt_project_vertex */
+    float sx, sy;             /* pixel coordinates (x right, y down, pixel
+                               * centres at +0.5); 0 when cw <= 0 */
+    float depth;              /* eye depth along the view axis */
+    float cw;                 /* clip w; <= 0: behind the eye */
+    uint8_t state;            /* vt_vertex_state */
+    uint8_t visible;          /* z-buffer test passed (Sec. 3.4.2) */
+    uint16_t stage;           /* refinement stage that created it (0 = primary) */
+    /* sample (state == VT_SAMPLED) */
+    rl_vec3 color;            /* radiance, textures applied */
+    rl_vec3 flat;             /* radiance with deferred textures white */
+    rl_trace_layer layers[RL_TRACE_LAYER_COUNT];
+    uint64_t tree_hash;       /* rl_ray_tree_hash of its ray tree */
+} vt_vertex;
+
+typedef struct vt_edge {
+    uint32_t v[2];            /* end vertices */
+    uint32_t face[2];         /* adjacent faces, VT_NONE on a boundary:
+                               * face[0] has v[0] -> v[1] counter-clockwise
+                               * (it created the edge), face[1] the other
+                               * (v[1] -> v[0] when consistently wound);
+                               * sub-edges keep the direction and slots */
+    uint32_t mid;             /* midpoint vertex once split, else VT_NONE */
+    uint32_t child[2];        /* sub-edges (v[0],mid) and (mid,v[1]) once split */
+    float length;             /* projected length in pixels (vt_edge_length) */
+    uint8_t queued;           /* currently in the edge list */
+    uint8_t forced;           /* split by forced refinement */
+} vt_edge;
+
+typedef struct vt_face {
+    uint32_t v[3];            /* counter-clockwise, as the source triangle */
+    uint32_t e[3];            /* e[i] joins v[(i+1)%3] and v[(i+2)%3] (opposite v[i]) */
+    uint32_t triangle;        /* source scene triangle */
+    uint32_t object;
+    uint32_t parent;          /* VT_NONE for a primary face */
+    uint16_t stage;           /* stage that created it (overdraw offset k, Sec. 3.5.1) */
+    uint8_t leaf;             /* not split (drawn) */
+    uint8_t visible;          /* its primary ancestor passed the ID-buffer test */
+} vt_face;
+
+typedef struct vt_mesh {
+    vt_vertex *verts;  uint32_t num_verts, cap_verts;
+    vt_edge *edges;    uint32_t num_edges, cap_edges;
+    vt_face *faces;    uint32_t num_faces, cap_faces;
+    uint32_t num_primary_verts, num_primary_edges, num_primary_faces;
+} vt_mesh;
+
+/* Builds the primary mesh of the VT objects (object_mask[o] != 0) of a
+ * committed scene: one face per scene triangle, vertices welded within an
+ * object when position, normal and uv are all equal (loaders often repeat
+ * them), edges shared by exactly two faces get both as neighbours; an edge
+ * with more than two faces (non-manifold) is kept once per extra face as a
+ * boundary edge. Primary vertex keys are vt_vertex_key_primary(object,
+ * index of the welded vertex within the object). Faces are visible = 0,
+ * leaf = 1, stage 0. RL_ERR_OUT_OF_MEMORY, or RL_ERR_LIMIT past 2^31
+ * elements. */
+rl_status vt_mesh_build(vt_mesh *m, const rl_scene_data *d, const uint8_t *object_mask);
+void vt_mesh_free(vt_mesh *m);
+/* Drops everything but the primary elements and resets their refinement
+ * state (edges unsplit and unqueued, faces leaf and invisible, vertices
+ * unsampled): the start of a new camera frame. Keeps the allocations. */
+void vt_mesh_reset(vt_mesh *m);
+
+uint64_t vt_vertex_key_primary(uint32_t object, uint32_t index);
+/* Symmetric in a and b: the midpoint of an edge has the same key whichever
+ * way round or in whichever order the edge was split. */
+uint64_t vt_vertex_key_mid(uint64_t a, uint64_t b);
+
+/* Splits edge e at its midpoint (Sec. 3.3, Fig. 3.5): new vertex v' =
+ * (v_i + v_j)/2 (eq. 3.7), n' = normalize(n_i + n_j) (eq. 3.8; n_i if the
+ * sum vanishes), uv averaged, triangle/object from the edge's first
+ * adjacent face, key vt_vertex_key_mid, stage as given, state UNSAMPLED.
+ * Each adjacent leaf face (a, b, c) with the edge (a, b) opposite c becomes
+ * two leaf children (a, v', c) and (v', b, c), joined by a new edge (v', c);
+ * the parent stops being a leaf; the children inherit its visible flag and
+ * get the given stage. Edge e gets mid and child[] set. The faces' old edges
+ * get their face references moved to the children. Returns the new vertex
+ * index, or VT_NONE when out of memory (the mesh is unchanged then) or when
+ * e is already split (returns its mid then, no change).
+ * new_edges receives up to 4 edge indices: the two sub-edges, then the new
+ * inner edges; new_faces up to 4 face indices; counts through the pointers.
+ * Pointers into the mesh arrays are invalidated (they may grow). */
+uint32_t vt_mesh_split(vt_mesh *m, uint32_t e, uint16_t stage, uint32_t new_edges[4],
+                       uint32_t *num_new_edges, uint32_t new_faces[4], uint32_t *num_new_faces);
+
+/* Compression factor of face f with the side opposite vertex slot i as base
+ * (Sec. 3.3.2): xi = |base| / (|side 1| + |side 2|), from the projected
+ * pixel coordinates of the vertices. 0 when both other sides have zero
+ * length. */
+float vt_face_xi(const vt_mesh *m, uint32_t f, int i);
+/* xi of the face's longest side: 1 means zero area, where refinement stops. */
+float vt_face_xi_max(const vt_mesh *m, uint32_t f);
+
+/* ------------------------------------------------------------ criteria -- */
+
+enum vt_criterion_bits {
+    VT_CRIT_RGB  = 1 << 0,    /* L1 of the two colours > eps_rgb (eq. 3.11) */
+    VT_CRIT_HSV  = 1 << 1,    /* |dH| > eps_h or |dS| > eps_s or |dV| > eps_v */
+    VT_CRIT_TREE = 1 << 2,    /* the ray trees differ */
+};
+
+typedef struct vt_criteria {
+    unsigned bits;            /* vt_criterion_bits, OR-combined: split if any fires */
+    float eps_rgb;            /* on display values: sRGB-encoded, clamped to [0,1] */
+    float eps_h;              /* hue difference as a fraction of the circle, [0, 0.5] */
+    float eps_s, eps_v;       /* in [0, 1] */
+} vt_criteria;
+
+/* Parses "rgb", "hsv", "tree", "tree+rgb", "tree+hsv" (also "rgb+tree",
+ * "hsv+tree", and "rgb+hsv"); false for anything else. */
+bool vt_criteria_parse(const char *text, unsigned *bits);
+/* The criteria that fire for the samples a and b (both VT_SAMPLED), as
+ * vt_criterion_bits; 0 = interpolation along the edge is acceptable.
+ * Colours compared are the vertices' flat colours (deferred textures left
+ * out, Sec. 3.5.3). HSV: hue is ignored when either saturation is below
+ * 1e-3 (it is undefined for greys); the hue difference wraps around. */
+unsigned vt_criteria_test(const vt_criteria *c, const vt_vertex *a, const vt_vertex *b);
+/* sRGB display value of one linear channel, clamped to [0, 1]. */
+float vt_display(float linear);
+/* HSV of a display-space colour: h in [0, 1), s, v in [0, 1]. */
+void vt_rgb_to_hsv(rl_vec3 rgb, float *h, float *s, float *v);
+
+/* ---------------------------------------------------------- visibility -- */
+
+/* The camera as the refinement sees it. */
+typedef struct vt_view {
+    rl_mat4 view_proj;        /* projection * view, as rl_raster_set_camera uses */
+    rl_vec3 eye;
+    rl_vec3 forward;          /* unit view axis */
+    int width, height;
+    float z_near;             /* clip w below this is behind the near plane */
+    const float *depth;       /* z-buffer of the pre-pass (eye depth per pixel,
+                               * +INFINITY where empty), width*height */
+    float depth_tolerance;    /* relative, for the z test; e.g. 1e-3 */
+} vt_view;
+
+/* Fills sx, sy, depth and cw of vertex v. */
+void vt_project_vertex(const vt_view *view, vt_vertex *v);
+/* Z-buffer test (Sec. 3.4.2): the vertex is in front of the near plane, on
+ * the screen, and not behind the stored depth at any of the (up to) four
+ * pixel centres around its projection: depth <= stored * (1 + tolerance).
+ * Taking the farthest of the four keeps vertices on silhouettes and on the
+ * VT surface itself (which is in the z-buffer) visible. */
+bool vt_vertex_visible(const vt_view *view, const vt_vertex *v);
+/* Viewport test (Sec. 3.4.3): Cohen-Sutherland outcodes of both ends in
+ * clip space (left, right, bottom, top, near); trivially visible when one
+ * end is inside, trivially hidden when both share an outside bit, otherwise
+ * the edge is clipped plane by plane only until one of the two decisions
+ * can be made (the thesis' modification: no full clip). */
+bool vt_edge_in_viewport(const vt_view *view, const vt_vertex *a, const vt_vertex *b);
+/* Projected length in pixels of the edge (both ends projected); for an edge
+ * crossing the near plane, the length of its part in front of the near
+ * plane, clipped there. */
+float vt_edge_length(const vt_view *view, const vt_vertex *a, const vt_vertex *b);
+
+/* ---------------------------------------------------------- edge list -- */
+
+/* Max-heap of edge indices by length; ties broken by the smaller edge index
+ * first, so the order is fully deterministic. (The thesis uses a binary tree
+ * with a linked list through it, Fig. 4.10; a heap has the same O(log n)
+ * insertion and gives the longest edge in O(1).) */
+typedef struct vt_heap {
+    uint32_t *items;
+    float *keys;
+    uint32_t count, cap;
+} vt_heap;
+
+rl_status vt_heap_push(vt_heap *h, uint32_t edge, float length);
+/* false when empty. */
+bool vt_heap_pop(vt_heap *h, uint32_t *edge, float *length);
+/* Length of the top element; -INFINITY when empty. */
+float vt_heap_top(const vt_heap *h);
+void vt_heap_clear(vt_heap *h);
+void vt_heap_free(vt_heap *h);
+
+#endif

@@ -1,0 +1,372 @@
+/* vt_refine.c: the refinement of Vertex Tracing (Ullmann 2003, Sec. 3.3,
+ * 3.4, 4.4): the ID-buffer pre-pass, the edge list sorted by projected
+ * length, the subdivision criteria, forced refinement, and the stages that
+ * alternate refinement with parallel sampling.
+ *
+ * Stages. The thesis processes the sorted edge list one edge at a time,
+ * longest first, and lets secondary threads sample ahead (Sec. 4.4.2). We
+ * keep "longest first" at the granularity of one octave: a stage takes every
+ * edge within a factor two of the longest one (all of them were sampled in
+ * earlier stages), tests them in length order, splits where a criterion
+ * fires and hands the new vertices to the samplers at once; the stage ends
+ * when they are all sampled. Sub-edges are at most about half as long, so
+ * they land in a later stage, exactly as in the sequential order; only the
+ * new inner edges (e_L, e_R of Fig. 3.5) may be longer and are then simply
+ * tested first in the next stage. The result does not depend on the number
+ * of threads, and the stage is the natural unit of the progressive display
+ * (Sec. 3.5.1: "after k refinement stages"). */
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#ifdef _OPENMP
+#include <omp.h>
+#endif
+
+#include "core/error.h"
+#include "render/renderer.h"
+#include "render/vt_run.h"
+#include "rl/rl_timer.h"
+
+#define BAND 0.5f                  /* a stage: lengths within [top * BAND, top] */
+/* xi at or above: zero area, stop (Sec. 3.3.2). For a sliver of base c and
+ * height h, xi ~ 1 - 2 h^2 / c^2: 1e-3 is a height of a few hundredths of a
+ * pixel on a pixel-long base, which float rounding can otherwise keep
+ * "refining" forever (the thesis' endless recursion when A -> 0). */
+#define XI_FLAT (1.0f - 1e-3f)
+
+static double now_ms(void)
+{
+    return rl_time_s() * 1000.0;
+}
+
+/* ------------------------------------------------------------ pre-pass -- */
+
+rl_status vt_prepass(vt_run *run, rl_image *depth_ids)
+{
+    const vt_settings *set = run->set;
+    vt_mesh *m = run->mesh;
+    rl_raster *ras = NULL;
+    rl_status st = rl_raster_create(&(rl_raster_desc){ .threads = set->threads }, &ras);
+    if (st == RL_OK)
+        st = rl_raster_set_target(ras, depth_ids, &run->view_m, &run->proj_m);
+    if (st == RL_OK) {
+        /* Sec. 3.5, Fig. 3.17, first pass: the whole scene into the ID and
+         * Z buffers. Every triangle keeps its own ID, so the non-VT objects
+         * need no special colour 0: their IDs simply name no VT face. */
+        rl_image_clear(depth_ids);
+        rl_raster_scene_desc desc = { .shading = RL_SHADING_FLAT, .threads = set->threads,
+                                      .flags = RL_RASTER_NO_COLOR };
+        rl_raster_counters c;
+        memset(&c, 0, sizeof c);
+        st = rl_raster_draw_scene(ras, run->data, run->view.eye, &desc, &c, NULL, NULL);
+    }
+    rl_raster_release(ras);
+    if (st != RL_OK)
+        return st;
+
+    /* Fig. 3.11: every pixel flags the face it shows. */
+    size_t n = (size_t)depth_ids->width * (size_t)depth_ids->height;
+    if (set->id_test) {
+        for (size_t i = 0; i < n; ++i) {
+            uint32_t tri = depth_ids->triangle_id[i];
+            if (tri < run->data->num_triangles && run->tri_face[tri] != VT_NONE)
+                m->faces[run->tri_face[tri]].visible = 1;
+        }
+    } else {
+        for (uint32_t f = 0; f < m->num_primary_faces; ++f)
+            m->faces[f].visible = 1;
+    }
+    for (uint32_t f = 0; f < m->num_primary_faces; ++f)
+        run->stats.visible_primary_faces += m->faces[f].visible;
+
+    run->view.depth = depth_ids->depth;
+    for (uint32_t v = 0; v < m->num_primary_verts; ++v) {
+        vt_vertex *vx = &m->verts[v];
+        vt_project_vertex(&run->view, vx);
+        vx->visible = set->z_test ? (uint8_t)vt_vertex_visible(&run->view, vx) : 1;
+    }
+    return RL_OK;
+}
+
+/* ---------------------------------------------------------- refinement -- */
+
+typedef struct refine_ctx {
+    vt_run *run;
+    uint32_t *batch;    uint32_t batch_count, batch_cap;
+    uint32_t *forced;   uint32_t forced_count, forced_cap;
+    double refine_ms;   /* primary thread in refinement code */
+    double update_ms;   /* primary thread in progressive updates */
+} refine_ctx;
+
+static bool grow(uint32_t **array, uint32_t *cap, uint32_t need)
+{
+    if (need <= *cap)
+        return true;
+    uint32_t n = *cap ? *cap * 2 : 1024;
+    while (n < need)
+        n *= 2;
+    uint32_t *p = rl_realloc_array(*array, n, sizeof *p);
+    if (!p)
+        return false;
+    *array = p;
+    *cap = n;
+    return true;
+}
+
+/* An edge enters the edge list (Fig. 3.4) if it is long enough to be split
+ * and visible: on screen (Sec. 3.4.3) and, unless it is primary (the ID
+ * buffer already decided those, Fig. 3.12), with at least one end passing
+ * the z test (Sec. 3.4.2, Fig. 3.14). Its ends are queued for sampling so
+ * that the criterion can be evaluated when the edge comes up. */
+static void consider_edge(refine_ctx *ctx, uint32_t e, bool primary)
+{
+    vt_run *run = ctx->run;
+    const vt_settings *set = run->set;
+    vt_mesh *m = run->mesh;
+    vt_edge *ed = &m->edges[e];
+    const vt_vertex *a = &m->verts[ed->v[0]], *b = &m->verts[ed->v[1]];
+    ed->length = vt_edge_length(&run->view, a, b);
+    if (!(ed->length > set->min_edge) || ed->mid != VT_NONE || ed->queued)
+        return;
+    if (!primary && set->z_test && !a->visible && !b->visible) {
+        run->stats.edges_culled_z++;
+        return;
+    }
+    if (set->clip_test && !vt_edge_in_viewport(&run->view, a, b)) {
+        run->stats.edges_culled_viewport++;
+        return;
+    }
+    uint32_t v0 = ed->v[0], v1 = ed->v[1];
+    float length = ed->length;
+    vt_sample_queue(run, v0);
+    vt_sample_queue(run, v1);
+    if (vt_heap_push(run->heap, e, length) != RL_OK) {
+        run->failed = true;
+        return;
+    }
+    m->edges[e].queued = 1;
+}
+
+/* Forced refinement (Sec. 3.3.2, Fig. 3.10): in each new sub-face the side
+ * opposite the new vertex is the base; a compression xi = base / (sum of
+ * the other two) above eps_Z forces the base to be split, unless it is at
+ * the minimum length or the face has no area (xi = 1). */
+static void check_forced(refine_ctx *ctx, uint32_t f, uint32_t mid)
+{
+    vt_run *run = ctx->run;
+    vt_mesh *m = run->mesh;
+    const vt_face *face = &m->faces[f];
+    int slot = face->v[0] == mid ? 0 : face->v[1] == mid ? 1 : face->v[2] == mid ? 2 : -1;
+    if (slot < 0 || !face->visible)
+        return;
+    uint32_t base = face->e[slot];
+    const vt_edge *be = &m->edges[base];
+    if (be->mid != VT_NONE)
+        return;
+    if (!(vt_face_xi(m, f, slot) > run->set->eps_z) || !(vt_face_xi_max(m, f) < XI_FLAT))
+        return;
+    if (!grow(&ctx->forced, &ctx->forced_cap, ctx->forced_count + 1)) {
+        run->failed = true;
+        return;
+    }
+    ctx->forced[ctx->forced_count++] = base;
+}
+
+static bool budget_left(const vt_run *run)
+{
+    return run->mesh->num_verts < run->set->max_vertices;
+}
+
+/* Splits edge e (Sec. 3.3, eq. 3.7-3.8, Fig. 3.5): the new vertex is
+ * projected, z-tested and queued; the new edges are considered for the
+ * edge list; the new faces are checked for forced refinement. */
+static void split_edge(refine_ctx *ctx, uint32_t e, uint8_t reason, uint16_t stage)
+{
+    vt_run *run = ctx->run;
+    vt_mesh *m = run->mesh;
+    uint32_t new_edges[4], new_faces[4], ne = 0, nf = 0;
+    uint32_t mid = vt_mesh_split(m, e, stage, new_edges, &ne, new_faces, &nf);
+    if (mid == VT_NONE || vt_run_reserve(run) != RL_OK) {
+        run->failed = true;
+        return;
+    }
+    run->reason[mid] = reason;
+    vt_vertex *v = &m->verts[mid];
+    vt_project_vertex(&run->view, v);
+    v->visible = run->set->z_test ? (uint8_t)vt_vertex_visible(&run->view, v) : 1;
+    run->stats.vertices_generated++;
+    if (reason & VT_REASON_FORCED)
+        run->stats.splits_forced++;
+    vt_sample_queue(run, mid);
+    for (uint32_t i = 0; i < ne; ++i)
+        consider_edge(ctx, new_edges[i], false);
+    if (run->set->forced)
+        for (uint32_t i = 0; i < nf; ++i)
+            check_forced(ctx, new_faces[i], mid);
+}
+
+/* Splits the bases collected by check_forced, and the bases their splits
+ * force in turn, down to the minimum length. */
+static void run_forced(refine_ctx *ctx, uint16_t stage)
+{
+    vt_run *run = ctx->run;
+    const vt_settings *set = run->set;
+    while (ctx->forced_count && !run->failed && budget_left(run)) {
+        uint32_t e = ctx->forced[--ctx->forced_count];
+        vt_mesh *m = run->mesh;
+        vt_edge *ed = &m->edges[e];
+        if (ed->mid != VT_NONE)
+            continue;
+        const vt_vertex *a = &m->verts[ed->v[0]], *b = &m->verts[ed->v[1]];
+        ed->length = vt_edge_length(&run->view, a, b);
+        if (!(ed->length > set->min_edge))
+            continue;
+        /* Hidden bases are not worth rays: the same tests as the edge list. */
+        if ((set->z_test && !a->visible && !b->visible) ||
+            (set->clip_test && !vt_edge_in_viewport(&run->view, a, b)))
+            continue;
+        m->edges[e].forced = 1;
+        split_edge(ctx, e, VT_REASON_FORCED, stage);
+    }
+    ctx->forced_count = 0;
+}
+
+/* Sec. 3.3.2: refining where no adjacent face has projected area cannot
+ * help and need not stop (the endless recursion of A -> 0). */
+static bool has_area(const vt_mesh *m, const vt_edge *ed)
+{
+    for (int k = 0; k < 2; ++k)
+        if (ed->face[k] != VT_NONE && vt_face_xi_max(m, ed->face[k]) < XI_FLAT)
+            return true;
+    return false;
+}
+
+static uint8_t reason_of(unsigned bits)
+{
+    return (uint8_t)(((bits & VT_CRIT_RGB) ? VT_REASON_RGB : 0) | ((bits & VT_CRIT_HSV) ? VT_REASON_HSV : 0) |
+                     ((bits & VT_CRIT_TREE) ? VT_REASON_TREE : 0));
+}
+
+/* One stage: the edges of the top octave, tested longest first. */
+static void run_stage(refine_ctx *ctx, uint16_t stage)
+{
+    vt_run *run = ctx->run;
+    vt_mesh *m = run->mesh;
+    float band = vt_heap_top(run->heap) * BAND;
+    ctx->batch_count = 0;
+    uint32_t e;
+    float length;
+    while (vt_heap_top(run->heap) >= band && vt_heap_pop(run->heap, &e, &length)) {
+        if (!grow(&ctx->batch, &ctx->batch_cap, ctx->batch_count + 1)) {
+            run->failed = true;
+            return;
+        }
+        m->edges[e].queued = 0;
+        ctx->batch[ctx->batch_count++] = e;
+    }
+    for (uint32_t i = 0; i < ctx->batch_count && !run->failed; ++i) {
+        if (!budget_left(run))
+            break;
+        vt_edge *ed = &m->edges[ctx->batch[i]];
+        if (ed->mid != VT_NONE)
+            continue;                       /* split meanwhile by forced refinement */
+        const vt_vertex *a = &m->verts[ed->v[0]], *b = &m->verts[ed->v[1]];
+        if (a->state != VT_SAMPLED || b->state != VT_SAMPLED)
+            continue;                       /* cannot happen: queued when pushed */
+        if (!has_area(m, ed))
+            continue;
+        unsigned bits = vt_criteria_test(&run->set->criteria, a, b);
+        run->stats.edges_tested++;
+        if (!bits)
+            continue;
+        run->stats.splits_rgb += (bits & VT_CRIT_RGB) != 0;
+        run->stats.splits_hsv += (bits & VT_CRIT_HSV) != 0;
+        run->stats.splits_tree += (bits & VT_CRIT_TREE) != 0;
+        split_edge(ctx, ctx->batch[i], reason_of(bits), stage);
+        run_forced(ctx, stage);
+    }
+}
+
+/* Progress of an adaptive process has no known total; the longest edge
+ * left, on a log scale between the first stage and the minimum length,
+ * is a fair guess. */
+static double progress_of(float top, float first, float min_edge)
+{
+    if (!(top > min_edge) || !(first > min_edge))
+        return 1.0;
+    double done = log((double)first / (double)top) / log((double)first / (double)min_edge);
+    return done < 0.0 ? 0.0 : done > 1.0 ? 1.0 : done;
+}
+
+static void refine_all(refine_ctx *ctx)
+{
+    vt_run *run = ctx->run;
+    vt_mesh *m = run->mesh;
+    double t0 = now_ms();
+
+    /* Fig. 3.12: the edges of every visible primary face; their vertices
+     * are ray traced (stage 0, the initial sample pattern of Sec. 3.2). */
+    for (uint32_t e = 0; e < m->num_primary_edges && !run->failed; ++e) {
+        const vt_edge *ed = &m->edges[e];
+        bool vis = (ed->face[0] != VT_NONE && m->faces[ed->face[0]].visible) ||
+                   (ed->face[1] != VT_NONE && m->faces[ed->face[1]].visible);
+        if (!vis)
+            continue;
+        vt_sample_queue(run, ed->v[0]);
+        vt_sample_queue(run, ed->v[1]);
+        consider_edge(ctx, e, true);
+    }
+    ctx->refine_ms += now_ms() - t0;
+    vt_sample_flush(run);
+
+    double tu = now_ms();
+    if (run->update && !run->failed && !vt_update(run, 0, false))
+        run->stopped = true;
+    ctx->update_ms += now_ms() - tu;
+    run->stats.time_preview_ms = now_ms() - run->t_start_ms;
+
+    float first = vt_heap_top(run->heap);
+    uint16_t stage = 0;
+    while (!run->failed && !run->stopped && run->heap->count && budget_left(run)) {
+        if (stage == UINT16_MAX)
+            break;
+        ++stage;
+        float top = vt_heap_top(run->heap);
+        double ts = now_ms();
+        run_stage(ctx, stage);
+        ctx->refine_ms += now_ms() - ts;
+        vt_sample_flush(run);
+        run->stats.stages = stage;
+        if (!rl_renderer_progress(run->renderer, progress_of(top, first, run->set->min_edge))) {
+            run->stopped = run->cancelled = true;
+            break;
+        }
+        tu = now_ms();
+        if (run->update && run->set->progressive != VT_PROG_NONE &&
+            stage % (uint16_t)run->set->update_every == 0 && !vt_update(run, stage, false))
+            run->stopped = true;
+        ctx->update_ms += now_ms() - tu;
+    }
+    vt_sample_flush(run);
+}
+
+rl_status vt_refine(vt_run *run)
+{
+    refine_ctx ctx;
+    memset(&ctx, 0, sizeof ctx);
+    ctx.run = run;
+    double t0 = now_ms();
+#pragma omp parallel num_threads(run->set->threads)
+#pragma omp single
+    refine_all(&ctx);
+    double wall = now_ms() - t0;
+    free(ctx.batch);
+    free(ctx.forced);
+    run->stats.time_refine_ms = ctx.refine_ms;
+    run->stats.time_sampling_ms = wall - ctx.refine_ms - ctx.update_ms;
+    if (run->failed)
+        return rl_error(RL_ERR_OUT_OF_MEMORY, "vt: out of memory while refining (%u vertices)",
+                        run->mesh->num_verts);
+    return RL_OK;
+}

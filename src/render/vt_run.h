@@ -1,0 +1,167 @@
+/* vt_run.h: one Vertex Tracing frame as vt.c, vt_refine.c, vt_sample.c and
+ * vt_draw.c share it (the building blocks are in vt_internal.h).
+ *
+ * Threads (Ullmann 2003, Ch. 4.4): one thread, the primary thread in the
+ * thesis' words, owns the mesh and the edge list and does all refinement;
+ * the vertices it creates are handed out in blocks as OpenMP tasks that the
+ * other (secondary) threads sample while it goes on refining. A block owns
+ * copies of everything its rays need and its results, so sampling never
+ * reads the mesh the primary thread is growing. A refinement stage ends
+ * when all its blocks are sampled (the sequential dependency Sampling_k ->
+ * Refinement_k -> Sampling_k+1 of Sec. 4.2). Every vertex's sample depends
+ * only on the vertex, so the image is the same for any number of threads. */
+#ifndef RL_RENDER_VT_RUN_H
+#define RL_RENDER_VT_RUN_H
+
+#include "render/raster_scene.h"
+#include "render/vt_internal.h"
+#include "rl/rl_raster.h"
+#include "rl/rl_vt.h"
+
+enum { VT_TEX_MULTITEXTURE = 0, VT_TEX_MULTIPASS, VT_TEX_SAMPLED };
+enum { VT_PROG_NONE = 0, VT_PROG_OVERDRAW, VT_PROG_REDRAW };
+enum { VT_OVERLAY_NONE = 0, VT_OVERLAY_WIRE, VT_OVERLAY_SAMPLES };
+
+/* Why a vertex exists (rl_vt_vertex_info.reason). */
+enum { VT_REASON_RGB = 1, VT_REASON_HSV = 2, VT_REASON_TREE = 4, VT_REASON_FORCED = 8 };
+
+/* The options of one frame, validated and resolved (vt.c). */
+typedef struct vt_settings {
+    vt_criteria criteria;
+    float min_edge;           /* px: edges this short or shorter are not split */
+    bool forced;              /* forced refinement (Sec. 3.3.2) */
+    float eps_z;              /* its threshold on xi */
+    bool id_test, z_test, clip_test;   /* Sec. 3.4.1-3.4.3 */
+    int textures;             /* VT_TEX_* (Sec. 3.5.3-3.5.5) */
+    int progressive;          /* VT_PROG_* (Sec. 3.5.1) */
+    int update_every;         /* k */
+    float overdraw_f;         /* f of eq. 3.14 */
+    bool coherence;           /* temporal coherence (Sec. 3.4.5) */
+    uint32_t max_vertices;    /* refinement stops growing the mesh here */
+    int threads;              /* resolved, >= 1 */
+    rl_raster_shading shading;/* of the non-VT objects */
+    float ambient;
+    rl_vec3 background;
+    int overlay;              /* VT_OVERLAY_* */
+} vt_settings;
+
+/* Temporal coherence: depth-0 shadow feelers by vertex key, from the last
+ * frame. Open addressing; read-only while a frame samples. */
+typedef struct vt_feeler_map {
+    uint64_t *keys;           /* 0 = empty slot (keys are never 0, see vt_key_nonzero) */
+    rl_trace_feelers *values;
+    size_t cap, count;        /* cap a power of two */
+} vt_feeler_map;
+
+const rl_trace_feelers *vt_feeler_map_find(const vt_feeler_map *m, uint64_t key);
+/* Replaces the map's contents with the entries (keys[i], values[i]). */
+rl_status vt_feeler_map_rebuild(vt_feeler_map *m, const uint64_t *keys, const rl_trace_feelers *values,
+                                size_t count);
+void vt_feeler_map_free(vt_feeler_map *m);
+static inline uint64_t vt_key_nonzero(uint64_t key) { return key ? key : 0x9E3779B97F4A7C15ull; }
+
+#define VT_BLOCK 32
+
+/* A block of vertices to sample: inputs copied from the mesh by the primary
+ * thread, outputs read back by it after the stage's taskwait. */
+typedef struct vt_block {
+    uint32_t count;
+    uint32_t vertex[VT_BLOCK];
+    rl_trace_point point[VT_BLOCK];
+    uint64_t key[VT_BLOCK];
+    const rl_trace_feelers *cache_in[VT_BLOCK];
+    rl_trace_sample out[VT_BLOCK];
+    uint64_t tree_hash[VT_BLOCK];
+    rl_trace_feelers feelers[VT_BLOCK];
+    struct vt_block *next;
+} vt_block;
+
+/* Per-thread tallies (indexed by omp_get_thread_num, padded apart). */
+typedef struct vt_thread_tally {
+    uint64_t rays;
+    uint64_t feelers_reused;
+    double busy_ms;
+    char pad[40];
+} vt_thread_tally;
+
+typedef struct vt_run {
+    const vt_settings *set;
+    const rl_scene_data *data;
+    const rl_tracer *tracer;
+    vt_mesh *mesh;
+    vt_heap *heap;
+    vt_view view;
+    uint8_t *object_vt;       /* per object: vertex traced */
+    const uint8_t *object_raster; /* per object: rasterized (not VT) */
+    const uint32_t *tri_face; /* scene triangle -> primary face, VT_NONE */
+    rl_mat4 view_m, proj_m;   /* the rasterizer's matrices for this camera */
+    /* per vertex, grown by the primary thread alongside mesh->verts */
+    uint8_t *reason;
+    rl_trace_feelers *feelers;/* coherence only: this frame's feelers */
+    uint32_t per_vertex_cap;
+    bool want_tree;           /* the ray-tree criterion is on */
+    /* temporal coherence */
+    const vt_feeler_map *cache;   /* or NULL */
+    /* sampling */
+    vt_block *pending;        /* blocks spawned this stage, to read back */
+    vt_block *filling;        /* block the primary thread is filling */
+    vt_block *free_blocks;
+    uint64_t rays[RL_RAY_TYPE_COUNT];  /* summed by the primary thread */
+    vt_thread_tally tally[RL_VT_MAX_THREADS];
+    bool failed;              /* out of memory inside the parallel region */
+    /* progress and updates */
+    rl_renderer *renderer;
+    rl_vt_update_fn update;
+    void *update_user;
+    rl_image *image;          /* the frame's target */
+    const rl_camera *camera;
+    bool stopped;             /* update callback or progress asked to stop */
+    bool cancelled;           /* ... and it was the progress callback */
+    uint32_t drawn_stage;     /* overdraw: faces of stages <= this are drawn */
+    bool drawn;               /* the image holds a frame (overdraw may add to it) */
+    float *scratch_depth;     /* when the image has no depth layer */
+    rl_raster_counters counters;  /* reconstruction draws */
+    /* statistics */
+    double t_start_ms;        /* rl_time_s() * 1000 at the frame's start */
+    rl_vt_stats stats;
+} vt_run;
+
+/* vt_sample.c ------------------------------------------------------------ */
+/* Marks vertex v queued and adds it to the block being filled; a full block
+ * is spawned as a task. Call from the primary thread inside the parallel
+ * region (or outside it: then the block is sampled at vt_sample_flush). */
+void vt_sample_queue(vt_run *run, uint32_t v);
+/* Spawns the partly filled block, waits for all blocks of this stage and
+ * copies their results into the mesh (state VT_SAMPLED). */
+void vt_sample_flush(vt_run *run);
+/* Makes room for per-vertex arrays up to mesh->num_verts. */
+rl_status vt_run_reserve(vt_run *run);
+void vt_run_free_blocks(vt_run *run);
+
+/* vt_refine.c ------------------------------------------------------------ */
+/* The ID-buffer pre-pass (Sec. 3.4.1, Fig. 3.12, 3.17): rasterizes the scene
+ * into depth and IDs, flags the visible primary faces, projects the primary
+ * vertices, z-tests them. depth_ids is a scratch image with depth and IDs. */
+rl_status vt_prepass(vt_run *run, rl_image *depth_ids);
+/* Fills the edge list with the edges of visible primary faces and queues
+ * their vertices; then all refinement stages until the list is empty, the
+ * vertex budget is spent or an update/progress callback stops it. Runs the
+ * parallel region. */
+rl_status vt_refine(vt_run *run);
+
+/* vt_draw.c -------------------------------------------------------------- */
+/* Draws the frame into run->image: background, the non-VT objects through
+ * the raster renderer's code, then the VT leaf faces whose vertices are all
+ * sampled, by Gouraud interpolation with deferred textures (Sec. 3.5).
+ * only_new: overdraw (Sec. 3.5.1): draw just the faces of stages after
+ * run->drawn_stage onto the existing image, offset towards the eye by
+ * eq. 3.16. Counts VT faces in run->stats.faces_drawn (full draws). */
+rl_status vt_draw(vt_run *run, bool only_new);
+/* Paints the refined mesh (wire) or its vertices coloured by reason
+ * (samples) over the image, like Fig. 5.1e and 5.2c-d. */
+void vt_draw_overlay(vt_run *run);
+/* Called after the preview and every k-th stage: draws and hands the image
+ * to the update callback. Returns false when the callback asked to stop. */
+bool vt_update(vt_run *run, uint32_t stage, bool final);
+
+#endif

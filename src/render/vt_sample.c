@@ -1,0 +1,238 @@
+/* vt_sample.c: sampling the vertices of Vertex Tracing in parallel
+ * (Ullmann 2003, Sec. 4.4, Fig. 4.11-4.12), and the feeler map of temporal
+ * coherence (Sec. 3.4.5).
+ *
+ * The thesis' primary thread refines and its secondary threads walk the
+ * sorted edge list sampling vertices that are not yet sampled, with
+ * InProgress/Sampled flags per vertex. Here the primary thread packs the
+ * vertices it creates into blocks of VT_BLOCK and spawns each full block as
+ * an OpenMP task; idle threads take tasks from the runtime's queue, and the
+ * primary thread helps at the end of a stage (taskwait). The flags become
+ * the vertex state (QUEUED, SAMPLED) and the queue replaces the walk over
+ * the list: no locks of our own, and no thread ever skips over sampled
+ * entries. A block carries copies of its inputs, so the primary thread may
+ * grow (reallocate) the mesh while blocks are being sampled.
+ *
+ * The area-light jitter of a vertex is seeded from its key, which is the
+ * same in every frame and on every thread: a vertex's sample never depends
+ * on who traced it or when, which is what lets temporal coherence reuse
+ * feelers exactly. */
+#include <stdlib.h>
+#include <string.h>
+
+#ifdef _OPENMP
+#include <omp.h>
+#endif
+
+#include "core/error.h"
+#include "render/vt_run.h"
+#include "rl/rl_rng.h"
+#include "rl/rl_timer.h"
+
+/* ---------------------------------------------------------- feeler map -- */
+
+static size_t slot_of(uint64_t key, size_t cap)
+{
+    return (size_t)(rl_hash64(key) & (uint64_t)(cap - 1));
+}
+
+const rl_trace_feelers *vt_feeler_map_find(const vt_feeler_map *m, uint64_t key)
+{
+    if (!m || !m->cap)
+        return NULL;
+    key = vt_key_nonzero(key);
+    for (size_t i = slot_of(key, m->cap);; i = (i + 1) & (m->cap - 1)) {
+        if (m->keys[i] == key)
+            return &m->values[i];
+        if (m->keys[i] == 0)
+            return NULL;
+    }
+}
+
+rl_status vt_feeler_map_rebuild(vt_feeler_map *m, const uint64_t *keys, const rl_trace_feelers *values,
+                                size_t count)
+{
+    size_t cap = 64;
+    while (cap < 2 * count)                 /* load factor <= 1/2 */
+        cap *= 2;
+    if (cap != m->cap) {
+        uint64_t *k = rl_calloc(cap, sizeof *k);
+        rl_trace_feelers *v = rl_realloc_array(NULL, cap, sizeof *v);
+        if (!k || !v) {
+            free(k);
+            free(v);
+            return RL_ERR_OUT_OF_MEMORY;
+        }
+        vt_feeler_map_free(m);
+        m->keys = k;
+        m->values = v;
+        m->cap = cap;
+    } else {
+        memset(m->keys, 0, cap * sizeof *m->keys);
+    }
+    m->count = 0;
+    for (size_t n = 0; n < count; ++n) {
+        uint64_t key = vt_key_nonzero(keys[n]);
+        size_t i = slot_of(key, cap);
+        while (m->keys[i] != 0 && m->keys[i] != key)
+            i = (i + 1) & (cap - 1);
+        if (m->keys[i] == 0)
+            m->count++;
+        m->keys[i] = key;
+        m->values[i] = values[n];
+    }
+    return RL_OK;
+}
+
+void vt_feeler_map_free(vt_feeler_map *m)
+{
+    free(m->keys);
+    free(m->values);
+    memset(m, 0, sizeof *m);
+}
+
+/* ------------------------------------------------------------ sampling -- */
+
+rl_status vt_run_reserve(vt_run *run)
+{
+    uint32_t need = run->mesh->num_verts;
+    if (need <= run->per_vertex_cap)
+        return RL_OK;
+    uint32_t cap = run->per_vertex_cap ? run->per_vertex_cap : 1024;
+    while (cap < need)
+        cap = cap > UINT32_MAX / 2 ? need : cap * 2;
+    uint8_t *reason = rl_realloc_array(run->reason, cap, sizeof *reason);
+    if (!reason)
+        return RL_ERR_OUT_OF_MEMORY;
+    run->reason = reason;
+    if (run->set->coherence) {
+        rl_trace_feelers *f = rl_realloc_array(run->feelers, cap, sizeof *f);
+        if (!f)
+            return RL_ERR_OUT_OF_MEMORY;
+        run->feelers = f;
+    }
+    memset(run->reason + run->per_vertex_cap, 0, cap - run->per_vertex_cap);
+    run->per_vertex_cap = cap;
+    return RL_OK;
+}
+
+static int thread_index(void)
+{
+#ifdef _OPENMP
+    int t = omp_get_thread_num();
+    return t < RL_VT_MAX_THREADS ? t : RL_VT_MAX_THREADS - 1;
+#else
+    return 0;
+#endif
+}
+
+/* The work unit of Ch. 4: a set of vertices in, their samples out, nothing
+ * shared. A master-worker (MPI) version would send exactly this. */
+static void sample_block(vt_run *run, vt_block *b)
+{
+    double t0 = (rl_time_s() * 1000.0);
+    vt_thread_tally *tally = &run->tally[thread_index()];
+    rl_ray_tree tree;
+    for (uint32_t i = 0; i < b->count; ++i) {
+        rl_tracer_shade_point(run->tracer, run->view.eye, &b->point[i], b->key[i], b->cache_in[i],
+                              run->set->coherence ? &b->feelers[i] : NULL, &b->out[i],
+                              run->want_tree ? &tree : NULL);
+        b->tree_hash[i] = run->want_tree ? rl_ray_tree_hash(&tree) : 0;
+        for (int k = 0; k < RL_RAY_TYPE_COUNT; ++k)
+            tally->rays += b->out[i].rays[k];
+        tally->feelers_reused += b->out[i].feelers_reused;
+    }
+    tally->busy_ms += (rl_time_s() * 1000.0) - t0;
+}
+
+static vt_block *take_block(vt_run *run)
+{
+    vt_block *b = run->free_blocks;
+    if (b)
+        run->free_blocks = b->next;
+    else if (!(b = malloc(sizeof *b)))
+        return NULL;
+    b->count = 0;
+    b->next = NULL;
+    return b;
+}
+
+static void spawn(vt_run *run, vt_block *b)
+{
+    b->next = run->pending;
+    run->pending = b;
+#pragma omp task firstprivate(b) shared(run)
+    sample_block(run, b);
+}
+
+void vt_sample_queue(vt_run *run, uint32_t v)
+{
+    vt_vertex *vx = &run->mesh->verts[v];
+    if (vx->state != VT_UNSAMPLED)
+        return;
+    if (!run->filling && !(run->filling = take_block(run))) {
+        run->failed = true;
+        return;
+    }
+    vx->state = VT_QUEUED;
+    vt_block *b = run->filling;
+    uint32_t i = b->count++;
+    b->vertex[i] = v;
+    b->point[i] = (rl_trace_point){ vx->p, vx->n, vx->uv, vx->triangle };
+    b->key[i] = vx->key;
+    b->cache_in[i] = run->cache ? vt_feeler_map_find(run->cache, vx->key) : NULL;
+    if (b->count == VT_BLOCK) {
+        run->filling = NULL;
+        spawn(run, b);
+    }
+}
+
+void vt_sample_flush(vt_run *run)
+{
+    if (run->filling) {
+        vt_block *b = run->filling;
+        run->filling = NULL;
+        if (b->count)
+            spawn(run, b);
+        else {
+            b->next = run->free_blocks;
+            run->free_blocks = b;
+        }
+    }
+#pragma omp taskwait
+    vt_mesh *m = run->mesh;
+    while (run->pending) {
+        vt_block *b = run->pending;
+        run->pending = b->next;
+        for (uint32_t i = 0; i < b->count; ++i) {
+            vt_vertex *v = &m->verts[b->vertex[i]];
+            const rl_trace_sample *s = &b->out[i];
+            v->color = s->color;
+            /* Without deferred textures the criteria see them too. */
+            v->flat = run->set->textures == VT_TEX_SAMPLED ? s->color : s->flat;
+            memcpy(v->layers, s->layers, sizeof v->layers);
+            v->tree_hash = b->tree_hash[i];
+            v->state = VT_SAMPLED;
+            for (int k = 0; k < RL_RAY_TYPE_COUNT; ++k)
+                run->rays[k] += s->rays[k];
+            run->stats.vertices_sampled++;
+            if (run->set->coherence && b->vertex[i] < run->per_vertex_cap)
+                run->feelers[b->vertex[i]] = b->feelers[i];
+        }
+        b->next = run->free_blocks;
+        run->free_blocks = b;
+    }
+}
+
+void vt_run_free_blocks(vt_run *run)
+{
+    vt_block *lists[3] = { run->pending, run->filling, run->free_blocks };
+    for (int l = 0; l < 3; ++l) {
+        while (lists[l]) {
+            vt_block *next = lists[l]->next;
+            free(lists[l]);
+            lists[l] = next;
+        }
+    }
+    run->pending = run->filling = run->free_blocks = NULL;
+}

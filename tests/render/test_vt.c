@@ -1,0 +1,496 @@
+/* test_vt.c: the Vertex Tracing renderer "vt" (Ullmann 2003, Ch. 3-4) as a
+ * whole: refinement behaviour on constructed scenes, visibility, forced
+ * refinement, convergence to the Whitted image, determinism, temporal
+ * coherence, progressive updates and bad options. The building blocks have
+ * their own tests (test_vt_mesh.c, test_vt_criteria.c, test_vt_visibility.c). */
+#include <math.h>
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include <cmocka.h>
+
+#include "render/render_fixtures.h"
+#include "rl/rl_metrics.h"
+#include "rl/rl_vt.h"
+
+/* ------------------------------------------------------------ scenes -- */
+
+static uint32_t add_material(rl_scene *s, const char *name, rl_vec3 kd, float kr, float kt)
+{
+    rl_material m = rl_material_default();
+    snprintf(m.name, sizeof m.name, "%s", name);
+    m.diffuse = kd;
+    m.reflectivity = kr;
+    m.transmissivity = kt;
+    uint32_t id;
+    assert_int_equal(rl_scene_add_material(s, &m, &id), RL_OK);
+    return id;
+}
+
+static uint32_t add_object(rl_scene *s, const char *name, const char *gen, const char *params, uint32_t mat,
+                           rl_mat4 xf, bool vt)
+{
+    uint32_t mesh, node;
+    assert_int_equal(rl_scene_add_generated(s, gen, params, mat, &mesh), RL_OK);
+    assert_int_equal(rl_scene_add_node(s, RL_NODE_ROOT, name, &xf, &node), RL_OK);
+    assert_int_equal(rl_scene_node_set_mesh(s, node, mesh), RL_OK);
+    assert_int_equal(rl_scene_node_set_attr(s, node, "vt", vt ? "true" : "false"), RL_OK);
+    return node;
+}
+
+static rl_camera look(rl_vec3 eye, rl_vec3 target, int size)
+{
+    rl_camera c;
+    memset(&c, 0, sizeof c);
+    c.eye = eye;
+    c.target = target;
+    c.up = rl_v3(0.0f, 1.0f, 0.0f);
+    c.fov_deg = 45.0f;
+    c.width = c.height = size;
+    return c;
+}
+
+/* An n x n grid of quads over [-h, h]^2 at y = 0, facing +y: a tessellated
+ * floor, because Vertex Tracing starts from the mesh's vertices and cannot
+ * see a feature that lies inside one triangle (Sec. 3.3.2). */
+static uint32_t add_grid(rl_scene *s, const char *name, int n, float h, uint32_t mat, bool vt)
+{
+    size_t nv = (size_t)(n + 1) * (n + 1);
+    rl_vec3 *pos = calloc(nv, sizeof *pos);
+    rl_vec2 *uv = calloc(nv, sizeof *uv);
+    uint32_t *idx = calloc((size_t)n * n * 6, sizeof *idx);
+    for (int j = 0; j <= n; ++j)
+        for (int i = 0; i <= n; ++i) {
+            pos[j * (n + 1) + i] = rl_v3(-h + 2.0f * h * (float)i / (float)n, 0.0f, -h + 2.0f * h * (float)j / (float)n);
+            uv[j * (n + 1) + i] = rl_v2((float)i / (float)n, (float)j / (float)n);
+        }
+    size_t k = 0;
+    for (int j = 0; j < n; ++j)
+        for (int i = 0; i < n; ++i) {
+            uint32_t a = (uint32_t)(j * (n + 1) + i), b = a + 1, c = a + (uint32_t)(n + 1), d = c + 1;
+            /* counter-clockwise seen from +y */
+            idx[k++] = a; idx[k++] = c; idx[k++] = b;
+            idx[k++] = b; idx[k++] = c; idx[k++] = d;
+        }
+    rl_mesh_desc md = { .name = name, .num_vertices = (uint32_t)nv, .positions = pos, .uvs = uv,
+                        .num_triangles = (uint32_t)(n * n * 2), .indices = idx, .material = mat };
+    uint32_t mesh, node;
+    assert_int_equal(rl_scene_add_mesh(s, &md, &mesh), RL_OK);
+    assert_int_equal(rl_scene_add_node(s, RL_NODE_ROOT, name, NULL, &node), RL_OK);
+    assert_int_equal(rl_scene_node_set_mesh(s, node, mesh), RL_OK);
+    assert_int_equal(rl_scene_node_set_attr(s, node, "vt", vt ? "true" : "false"), RL_OK);
+    free(pos);
+    free(uv);
+    free(idx);
+    return node;
+}
+
+/* A 4 x 4 m diffuse floor (VT, 8 x 8 quads) at y = 0. With occluder: a 1 m box hovering
+ * above it (not VT) and a point light above, casting a sharp shadow; without:
+ * a directional light from straight above, so the floor's radiance is
+ * constant. */
+static rl_scene *floor_scene(bool occluder)
+{
+    rl_scene *s = NULL;
+    assert_int_equal(rl_scene_create(&s), RL_OK);
+    uint32_t grey = add_material(s, "grey", rl_v3(0.7f, 0.7f, 0.7f), 0.0f, 0.0f);
+    add_grid(s, "floor", 8, 2.0f, grey, true);
+    rl_light l;
+    memset(&l, 0, sizeof l);
+    l.color = rl_v3(1.0f, 1.0f, 1.0f);
+    if (occluder) {
+        add_object(s, "box", "box", "size=1", grey, rl_mat4_translate(rl_v3(0.3f, 1.2f, 0.2f)), false);
+        l.type = RL_LIGHT_POINT;
+        l.position = rl_v3(0.0f, 4.0f, 0.0f);
+        l.intensity = 16.0f;
+    } else {
+        l.type = RL_LIGHT_DIRECTIONAL;
+        l.direction = rl_v3(0.0f, -1.0f, 0.0f);
+        l.intensity = 1.0f;
+    }
+    assert_int_equal(rl_scene_add_light(s, &l), RL_OK);
+    assert_int_equal(rl_scene_commit(s), RL_OK);
+    return s;
+}
+
+static rl_renderer *make_vt(const char *const *opts)
+{
+    return fx_make("vt", opts);
+}
+
+static rl_vt_stats render_stats(rl_renderer *r, const rl_scene *s, const rl_camera *cam, rl_image **keep)
+{
+    rl_render_stats rs;
+    rl_image *img = fx_render_with(r, s, cam, FX_ALL_LAYERS, &rs);
+    rl_vt_stats st;
+    assert_int_equal(rl_vt_get_stats(r, &st), RL_OK);
+    if (getenv("VT_DEBUG"))
+        print_message("vt: prim v %llu f %llu visf %llu sampled %llu gen %llu tested %llu rgb %llu hsv %llu tree %llu forced %llu cz %llu cv %llu stages %u faces %llu\n",
+                      (unsigned long long)st.primary_vertices, (unsigned long long)st.primary_faces,
+                      (unsigned long long)st.visible_primary_faces, (unsigned long long)st.vertices_sampled,
+                      (unsigned long long)st.vertices_generated, (unsigned long long)st.edges_tested,
+                      (unsigned long long)st.splits_rgb, (unsigned long long)st.splits_hsv,
+                      (unsigned long long)st.splits_tree, (unsigned long long)st.splits_forced,
+                      (unsigned long long)st.edges_culled_z, (unsigned long long)st.edges_culled_viewport,
+                      st.stages, (unsigned long long)st.faces_drawn);
+    if (keep)
+        *keep = img;
+    else
+        rl_image_release(img);
+    return st;
+}
+
+/* ------------------------------------------------------------- tests -- */
+
+/* Sec. 3.3: without variation nothing is refined. */
+static void flat_quad_is_not_refined(void **state)
+{
+    (void)state;
+    rl_scene *s = floor_scene(false);
+    rl_camera cam = look(rl_v3(0.0f, 3.0f, 4.0f), rl_v3(0.0f, 0.0f, 0.0f), 96);
+    for (int c = 0; c < 5; ++c) {
+        static const char *const crit[] = { "rgb", "hsv", "tree", "tree+rgb", "tree+hsv" };
+        const char *opts[] = { "criteria", crit[c], "min_edge", "1", NULL };
+        rl_renderer *r = make_vt(opts);
+        rl_vt_stats st = render_stats(r, s, &cam, NULL);
+        assert_int_equal(st.vt_objects, 1);
+        assert_true(st.visible_primary_faces >= 1);
+        assert_int_equal(st.vertices_generated, 0);
+        assert_true(st.vertices_sampled <= st.primary_vertices);   /* a corner may be off screen */
+        rl_renderer_release(r);
+    }
+    rl_scene_release(s);
+}
+
+/* Sec. 3.3.1 (ray tree) and 3.3.2: a sharp shadow is refined down to the
+ * minimum edge length along its boundary, and only there. */
+static void shadow_boundary_refined_only_there(void **state)
+{
+    (void)state;
+    rl_scene *s = floor_scene(true);
+    int size = 160;
+    rl_camera cam = look(rl_v3(0.0f, 5.0f, 3.0f), rl_v3(0.0f, 0.0f, 0.0f), size);
+    float min_edge = 2.0f;
+    const char *opts[] = { "criteria", "tree", "min_edge", "2", NULL };
+    rl_renderer *r = make_vt(opts);
+    rl_vt_stats st = render_stats(r, s, &cam, NULL);
+    assert_true(st.vertices_generated > 50);
+    assert_true(st.splits_tree > 0);
+    const rl_vt_vertex_info *v;
+    const uint32_t *f;
+    size_t nv, nf;
+    assert_int_equal(rl_vt_get_mesh(r, &v, &nv, &f, &nf), RL_OK);
+
+    /* The boundary from the exact renderer: floor pixels whose shadow state
+     * differs from a floor neighbour's. */
+    const char *wopts[] = { "max_depth", "0", NULL };
+    rl_image *ref = fx_render("whitted", s, &cam, FX_ALL_LAYERS, wopts, NULL);
+    uint32_t floor_obj = 0;
+    uint8_t *boundary = calloc((size_t)size * size, 1);
+    int nb = 0;
+    for (int y = 1; y < size - 1; ++y) {
+        for (int x = 1; x < size - 1; ++x) {
+            size_t i = (size_t)y * size + x;
+            if (ref->object_id[i] != floor_obj || ref->object_id[i + 1] != floor_obj ||
+                ref->object_id[i + size] != floor_obj)
+                continue;
+            float a = ref->color[i].y, b = ref->color[i + 1].y, c = ref->color[i + size].y;
+            if (fabsf(a - b) > 0.2f * fmaxf(a, b) || fabsf(a - c) > 0.2f * fmaxf(a, c)) {
+                boundary[i] = 1;
+                nb++;
+            }
+        }
+    }
+    assert_true(nb > 40);
+    /* Every boundary pixel has a vertex within a few minimum lengths. */
+    int covered = 0;
+    for (int y = 0; y < size; ++y) {
+        for (int x = 0; x < size; ++x) {
+            if (!boundary[(size_t)y * size + x])
+                continue;
+            float best = INFINITY;
+            for (size_t k = 0; k < nv; ++k) {
+                float dx = v[k].x - ((float)x + 0.5f), dy = v[k].y - ((float)y + 0.5f);
+                best = fminf(best, dx * dx + dy * dy);
+            }
+            covered += sqrtf(best) <= 2.5f * min_edge;
+        }
+    }
+    assert_true(covered >= nb * 95 / 100);
+    /* Small faces occur only near the boundary. */
+    int small = 0, far_small = 0;
+    for (size_t k = 0; k < nf; ++k) {
+        const rl_vt_vertex_info *a = &v[f[3 * k]], *b = &v[f[3 * k + 1]], *c = &v[f[3 * k + 2]];
+        float e = fmaxf(fmaxf(hypotf(a->x - b->x, a->y - b->y), hypotf(b->x - c->x, b->y - c->y)),
+                        hypotf(c->x - a->x, c->y - a->y));
+        if (e > 2.0f * min_edge || !a->sampled || !b->sampled || !c->sampled)
+            continue;
+        small++;
+        float cx = (a->x + b->x + c->x) / 3.0f, cy = (a->y + b->y + c->y) / 3.0f;
+        float best = INFINITY;
+        for (int y = 0; y < size; ++y)
+            for (int x = 0; x < size; ++x)
+                if (boundary[(size_t)y * size + x])
+                    best = fminf(best, hypotf(cx - ((float)x + 0.5f), cy - ((float)y + 0.5f)));
+        far_small += best > 8.0f * min_edge;
+    }
+    assert_true(small > 20);
+    assert_true(far_small <= small / 50);
+    free(boundary);
+    rl_image_release(ref);
+    rl_renderer_release(r);
+    rl_scene_release(s);
+}
+
+/* Sec. 3.3.2: forced refinement happens, and never on faces without
+ * projected area (xi = 1): here the floor is seen exactly edge-on. */
+static void forced_refinement_stops_at_zero_area(void **state)
+{
+    (void)state;
+    rl_scene *s = floor_scene(true);
+    const char *opts[] = { "criteria", "tree", "min_edge", "2", "eps_z", "0.5", "id_test", "false",
+                           "z_test", "false", NULL };
+    rl_renderer *r = make_vt(opts);
+    rl_camera slanted = look(rl_v3(0.0f, 5.0f, 3.0f), rl_v3(0.0f, 0.0f, 0.0f), 96);
+    rl_vt_stats st = render_stats(r, s, &slanted, NULL);
+    assert_true(st.splits_forced > 0);
+    rl_camera edge_on = look(rl_v3(0.0f, 0.0f, 6.0f), rl_v3(0.0f, 0.0f, 0.0f), 96);
+    st = render_stats(r, s, &edge_on, NULL);
+    /* The shadow crosses the line and the trees differ, but no face has
+     * projected area: nothing is refined, forced or otherwise. */
+    assert_int_equal(st.splits_forced, 0);
+    assert_int_equal(st.vertices_generated, 0);
+    rl_renderer_release(r);
+    rl_scene_release(s);
+}
+
+/* Sec. 3.4.1: a VT object behind an opaque wall casts no rays at all. */
+static void hidden_vertices_cast_no_rays(void **state)
+{
+    (void)state;
+    for (int hidden = 0; hidden < 2; ++hidden) {
+        rl_scene *s = NULL;
+        assert_int_equal(rl_scene_create(&s), RL_OK);
+        uint32_t mirror = add_material(s, "mirror", rl_v3(0.2f, 0.2f, 0.2f), 0.8f, 0.0f);
+        uint32_t grey = add_material(s, "grey", rl_v3(0.6f, 0.6f, 0.6f), 0.0f, 0.0f);
+        add_object(s, "ball", "sphere", "radius=0.5,segments=24,rings=12", mirror, rl_mat4_identity(), true);
+        rl_mat4 rot = rl_mat4_rotate(rl_v3(1.0f, 0.0f, 0.0f), 1.5707963f);
+        rl_mat4 mv = rl_mat4_translate(rl_v3(0.0f, 0.0f, hidden ? 1.5f : -3.0f));
+        rl_mat4 wall = rl_mat4_mul(&mv, &rot);   /* the quad's +y normal turned to +z */
+        add_object(s, "wall", "quad", "sx=6,sz=6", grey, wall, false);
+        rl_light l = { .type = RL_LIGHT_POINT, .color = rl_v3(1, 1, 1), .intensity = 10.0f,
+                       .position = rl_v3(0.0f, 3.0f, 4.0f) };
+        assert_int_equal(rl_scene_add_light(s, &l), RL_OK);
+        assert_int_equal(rl_scene_commit(s), RL_OK);
+        rl_camera cam = look(rl_v3(0.0f, 0.0f, 4.0f), rl_v3(0.0f, 0.0f, 0.0f), 64);
+        rl_renderer *r = make_vt(NULL);
+        rl_render_stats rs;
+        rl_image *img = fx_render_with(r, s, &cam, FX_ALL_LAYERS, &rs);
+        rl_vt_stats st;
+        assert_int_equal(rl_vt_get_stats(r, &st), RL_OK);
+        if (getenv("VT_DEBUG"))
+            print_message("hidden %d: prim %llu faces %llu visf %llu sampled %llu\n", hidden,
+                          (unsigned long long)st.primary_vertices, (unsigned long long)st.primary_faces,
+                          (unsigned long long)st.visible_primary_faces, (unsigned long long)st.vertices_sampled);
+        uint64_t rays = 0;
+        for (int k = 0; k < RL_RAY_TYPE_COUNT; ++k)
+            rays += rs.rays[k];
+        if (hidden) {
+            assert_int_equal(st.visible_primary_faces, 0);
+            assert_int_equal(st.vertices_sampled, 0);
+            assert_int_equal(rays, 0);
+        } else {
+            assert_true(st.vertices_sampled > 0);
+            assert_true(rays > 0);
+            assert_true(st.visible_primary_faces < st.primary_faces / 2 + 24);   /* the back half is hidden */
+        }
+        rl_image_release(img);
+        rl_renderer_release(r);
+        rl_scene_release(s);
+    }
+}
+
+/* Ch. 5 (Fig. 5.1): with a minimum edge length of one pixel, Vertex Tracing
+ * of every object reproduces the exact ray tracer's image. The scene is
+ * tessellated finely enough for its vertices to be a sample pattern
+ * (Sec. 3.2): a 32 x 32 floor and three spheres, mirror, glass and matte,
+ * under a point light (hard shadows). */
+static void converges_to_whitted(void **state)
+{
+    (void)state;
+    rl_scene *s = NULL;
+    assert_int_equal(rl_scene_create(&s), RL_OK);
+    uint32_t grey = add_material(s, "grey", rl_v3(0.7f, 0.7f, 0.7f), 0.0f, 0.0f);
+    uint32_t mirror = add_material(s, "mirror", rl_v3(0.1f, 0.1f, 0.1f), 0.8f, 0.0f);
+    uint32_t glass = add_material(s, "glass", rl_v3(0.05f, 0.05f, 0.05f), 0.1f, 0.85f);
+    uint32_t red = add_material(s, "red", rl_v3(0.8f, 0.2f, 0.15f), 0.0f, 0.0f);
+    add_grid(s, "floor", 32, 3.0f, grey, true);
+    const char *ball = "radius=0.5,segments=32,rings=16";
+    add_object(s, "mirror", "sphere", ball, mirror, rl_mat4_translate(rl_v3(-1.2f, 0.5f, 0.0f)), true);
+    add_object(s, "glass", "sphere", ball, glass, rl_mat4_translate(rl_v3(0.0f, 0.5f, 0.3f)), true);
+    add_object(s, "red", "sphere", ball, red, rl_mat4_translate(rl_v3(1.2f, 0.5f, 0.0f)), true);
+    rl_light l = { .type = RL_LIGHT_POINT, .color = rl_v3(1, 1, 1), .intensity = 20.0f,
+                   .position = rl_v3(1.0f, 4.0f, 2.0f) };
+    assert_int_equal(rl_scene_add_light(s, &l), RL_OK);
+    assert_int_equal(rl_scene_commit(s), RL_OK);
+    rl_camera cam = look(rl_v3(0.0f, 2.0f, 4.5f), rl_v3(0.0f, 0.3f, 0.0f), 160);
+    const char *vopts[] = { "min_edge", "1", "criteria", "tree+rgb", "eps_rgb", "0.03", NULL };
+    rl_image *vt = fx_render("vt", s, &cam, FX_ALL_LAYERS, vopts, NULL);
+    rl_image *ref = fx_render("whitted", s, &cam, FX_ALL_LAYERS, NULL, NULL);
+    rl_image_metrics m;
+    assert_int_equal(rl_image_compare(vt, ref, NULL, &m), RL_OK);
+    print_message("vt vs whitted: ssim %.4f rmse %.4f\n", m.ssim, m.rmse);
+    assert_true(m.ssim >= 0.99);
+    rl_image_release(vt);
+    rl_image_release(ref);
+    rl_scene_release(s);
+}
+
+/* Ch. 4: the image does not depend on the number of threads; Sec. 3.4.5:
+ * nor on temporal coherence, which must replay feelers exactly. */
+static void deterministic_and_coherent(void **state)
+{
+    (void)state;
+    rl_scene *s = floor_scene(true);
+    rl_camera a = look(rl_v3(0.0f, 5.0f, 3.0f), rl_v3(0.0f, 0.0f, 0.0f), 96);
+    rl_camera b = look(rl_v3(0.4f, 4.8f, 3.2f), rl_v3(0.0f, 0.0f, 0.0f), 96);
+    const char *one[] = { "threads", "1", "coherence", "false", NULL };
+    const char *two[] = { "threads", "2", "coherence", "true", NULL };
+    rl_renderer *r1 = make_vt(one), *r2 = make_vt(two);
+    rl_image *i1 = NULL, *i2 = NULL;
+    render_stats(r1, s, &a, &i1);
+    render_stats(r2, s, &a, &i2);
+    fx_assert_images_identical(i1, i2);
+    rl_image_release(i1);
+    rl_image_release(i2);
+    /* Second frame from a nearby camera: r2 reuses feelers. */
+    rl_vt_stats s1 = render_stats(r1, s, &b, &i1);
+    rl_vt_stats s2 = render_stats(r2, s, &b, &i2);
+    fx_assert_images_identical(i1, i2);
+    assert_int_equal(s1.feelers_reused, 0);
+    assert_true(s2.feelers_reused > 0);
+    assert_int_equal(s1.vertices_sampled, s2.vertices_sampled);
+    rl_image_release(i1);
+    rl_image_release(i2);
+    rl_renderer_release(r1);
+    rl_renderer_release(r2);
+    rl_scene_release(s);
+}
+
+typedef struct updates {
+    int calls, finals;
+    uint32_t last_stage;
+    int stop_after;
+} updates;
+
+static bool on_update(void *user, const rl_image *img, uint32_t stage, bool final)
+{
+    updates *u = user;
+    assert_non_null(img);
+    u->calls++;
+    u->finals += final;
+    u->last_stage = stage;
+    return u->stop_after <= 0 || u->calls < u->stop_after;
+}
+
+/* Sec. 3.5.1: a preview first, updates every k stages, stop on request. */
+static void progressive_updates(void **state)
+{
+    (void)state;
+    rl_scene *s = floor_scene(true);
+    rl_camera cam = look(rl_v3(0.0f, 5.0f, 3.0f), rl_v3(0.0f, 0.0f, 0.0f), 96);
+    const char *modes[] = { "overdraw", "redraw" };
+    for (int m = 0; m < 2; ++m) {
+        const char *opts[] = { "progressive", modes[m], "update_every", "1", "criteria", "tree", NULL };
+        rl_renderer *r = make_vt(opts);
+        updates u = { 0, 0, 0, 0 };
+        assert_int_equal(rl_vt_set_update_callback(r, on_update, &u), RL_OK);
+        rl_vt_stats st = render_stats(r, s, &cam, NULL);
+        assert_int_equal(u.finals, 1);
+        assert_int_equal(u.calls, (int)st.stages + 2);   /* preview, each stage, final */
+        assert_true(st.time_preview_ms > 0.0);
+        /* Stop after the preview: no refinement. */
+        updates stop = { 0, 0, 0, 1 };
+        assert_int_equal(rl_vt_set_update_callback(r, on_update, &stop), RL_OK);
+        st = render_stats(r, s, &cam, NULL);
+        assert_int_equal(st.stages, 0);
+        assert_int_equal(st.vertices_generated, 0);
+        rl_renderer_release(r);
+    }
+    rl_scene_release(s);
+}
+
+/* A camera that sees nothing renders the background and traces nothing. */
+static void nothing_in_view(void **state)
+{
+    (void)state;
+    rl_scene *s = floor_scene(true);
+    rl_camera cam = look(rl_v3(0.0f, 2.0f, 0.0f), rl_v3(0.0f, 10.0f, 0.1f), 32);
+    const char *opts[] = { "background", "0.25", NULL };
+    rl_renderer *r = make_vt(opts);
+    rl_image *img = NULL;
+    rl_vt_stats st = render_stats(r, s, &cam, &img);
+    assert_int_equal(st.vertices_sampled, 0);
+    for (size_t i = 0; i < 32 * 32; ++i)
+        assert_float_equal(img->color[i].x, 0.25f, 1e-6f);
+    rl_image_release(img);
+    rl_renderer_release(r);
+    rl_scene_release(s);
+}
+
+/* Invalid thresholds and lengths are refused with a message naming them. */
+static void bad_options(void **state)
+{
+    (void)state;
+    rl_renderer *r = make_vt(NULL);
+    static const char *const bad[][2] = {
+        { "eps_rgb", "-1" }, { "eps_h", "0.7" }, { "eps_s", "nan" }, { "eps_v", "-0.1" },
+        { "min_edge", "-2" }, { "min_edge", "0" }, { "eps_z", "1.5" }, { "criteria", "colour" },
+        { "objects", "" }, { "update_every", "0" }, { "max_vertices", "-5" },
+    };
+    for (size_t i = 0; i < sizeof bad / sizeof bad[0]; ++i) {
+        rl_clear_error();
+        assert_int_equal(rl_renderer_set(r, bad[i][0], bad[i][1]), RL_ERR_INVALID_ARG);
+        assert_non_null(strstr(rl_last_error(), bad[i][0]));
+    }
+    rl_vt_stats st;
+    assert_int_equal(rl_vt_get_stats(r, &st), RL_ERR_INVALID_ARG);   /* no frame yet */
+    /* An unknown node name fails at render time with the name. */
+    assert_int_equal(rl_renderer_set(r, "objects", "no_such_node"), RL_OK);
+    rl_scene *s = floor_scene(false);
+    rl_camera cam = look(rl_v3(0.0f, 3.0f, 4.0f), rl_v3(0.0f, 0.0f, 0.0f), 16);
+    rl_image *img = NULL;
+    assert_int_equal(rl_image_create(16, 16, RL_LAYER_COLOR, &img), RL_OK);
+    rl_clear_error();
+    assert_int_equal(rl_renderer_render(r, s, &cam, img, NULL), RL_ERR_NOT_FOUND);
+    assert_non_null(strstr(rl_last_error(), "no_such_node"));
+    rl_image_release(img);
+    rl_scene_release(s);
+    rl_renderer_release(r);
+    /* Accessors refuse other renderers. */
+    rl_renderer *w = fx_make("whitted", NULL);
+    rl_clear_error();
+    assert_int_equal(rl_vt_get_stats(w, &st), RL_ERR_INVALID_ARG);
+    rl_renderer_release(w);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(flat_quad_is_not_refined),
+        cmocka_unit_test(shadow_boundary_refined_only_there),
+        cmocka_unit_test(forced_refinement_stops_at_zero_area),
+        cmocka_unit_test(hidden_vertices_cast_no_rays),
+        cmocka_unit_test(converges_to_whitted),
+        cmocka_unit_test(deterministic_and_coherent),
+        cmocka_unit_test(progressive_updates),
+        cmocka_unit_test(nothing_in_view),
+        cmocka_unit_test(bad_options),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}

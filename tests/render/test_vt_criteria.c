@@ -1,0 +1,203 @@
+/* test_vt_criteria.c: the subdivision criteria of Vertex Tracing
+ * (vt_criteria.c; Ullmann 2003, Sec. 3.3.1): sRGB display values against
+ * the closed form, HSV of the primaries and a mixed colour, and each
+ * criterion firing just above its threshold and not just below it, with the
+ * hue wrapping round the circle and ignored for greys. */
+#include <math.h>
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <string.h>
+
+#include <cmocka.h>
+
+#include "render/vt_internal.h"
+
+/* Linear value whose display value is d (inverse sRGB transfer). */
+static float linear_of(float d)
+{
+    return d <= 0.04045f ? d / 12.92f : powf((d + 0.055f) / 1.055f, 2.4f);
+}
+
+static vt_vertex sample_display(float r, float g, float b)
+{
+    vt_vertex v;
+    memset(&v, 0, sizeof v);
+    v.state = VT_SAMPLED;
+    v.flat = rl_v3(linear_of(r), linear_of(g), linear_of(b));
+    v.color = v.flat;
+    return v;
+}
+
+static void test_display_is_clamped_srgb(void **state)
+{
+    (void)state;
+    assert_float_equal(vt_display(0.0f), 0.0f, 0.0f);
+    assert_float_equal(vt_display(-3.0f), 0.0f, 0.0f);
+    assert_float_equal(vt_display(NAN), 0.0f, 0.0f);
+    assert_float_equal(vt_display(1.0f), 1.0f, 1e-6f);
+    assert_float_equal(vt_display(7.5f), 1.0f, 0.0f);
+    assert_float_equal(vt_display(INFINITY), 1.0f, 0.0f);
+    /* the linear toe and the power segment meet at 0.0031308 */
+    assert_float_equal(vt_display(0.002f), 12.92f * 0.002f, 1e-7f);
+    assert_float_equal(vt_display(0.0031308f), 0.04045f, 1e-5f);
+    assert_float_equal(vt_display(0.5f), 0.735357f, 1e-5f);
+    assert_float_equal(vt_display(0.18f), 0.461356f, 1e-5f);
+    for (int i = 0; i <= 100; ++i) {
+        float d = (float)i / 100.0f;
+        assert_float_equal(vt_display(linear_of(d)), d, 2e-6f);
+    }
+}
+
+static void check_hsv(rl_vec3 rgb, float h, float s, float v)
+{
+    float hh, ss, vv;
+    vt_rgb_to_hsv(rgb, &hh, &ss, &vv);
+    assert_float_equal(hh, h, 1e-6f);
+    assert_float_equal(ss, s, 1e-6f);
+    assert_float_equal(vv, v, 1e-6f);
+}
+
+static void test_hsv_of_primaries_and_greys(void **state)
+{
+    (void)state;
+    check_hsv(rl_v3(1, 0, 0), 0.0f, 1.0f, 1.0f);
+    check_hsv(rl_v3(1, 1, 0), 1.0f / 6.0f, 1.0f, 1.0f);
+    check_hsv(rl_v3(0, 0.5f, 0), 1.0f / 3.0f, 1.0f, 0.5f);
+    check_hsv(rl_v3(0, 1, 1), 0.5f, 1.0f, 1.0f);
+    check_hsv(rl_v3(0, 0, 1), 2.0f / 3.0f, 1.0f, 1.0f);
+    check_hsv(rl_v3(1, 0, 1), 5.0f / 6.0f, 1.0f, 1.0f);
+    check_hsv(rl_v3(1, 0, 0.3f), 0.95f, 1.0f, 1.0f);
+    check_hsv(rl_v3(0.5f, 0.25f, 0.0f), 1.0f / 12.0f, 1.0f, 0.5f);
+    check_hsv(rl_v3(0.8f, 0.4f, 0.4f), 0.0f, 0.5f, 0.8f);
+    check_hsv(rl_v3(0.3f, 0.3f, 0.3f), 0.0f, 0.0f, 0.3f);
+    check_hsv(rl_v3(0, 0, 0), 0.0f, 0.0f, 0.0f);
+    /* h stays in [0, 1) just below red */
+    float h, s, v;
+    vt_rgb_to_hsv(rl_v3(1.0f, 0.0f, 1e-7f), &h, &s, &v);
+    assert_true(h >= 0.0f && h < 1.0f);
+}
+
+static void test_parse_accepts_the_documented_names_only(void **state)
+{
+    (void)state;
+    static const struct { const char *text; unsigned bits; } ok[] = {
+        { "rgb", VT_CRIT_RGB },
+        { "hsv", VT_CRIT_HSV },
+        { "tree", VT_CRIT_TREE },
+        { "tree+rgb", VT_CRIT_TREE | VT_CRIT_RGB },
+        { "rgb+tree", VT_CRIT_TREE | VT_CRIT_RGB },
+        { "tree+hsv", VT_CRIT_TREE | VT_CRIT_HSV },
+        { "hsv+tree", VT_CRIT_TREE | VT_CRIT_HSV },
+        { "rgb+hsv", VT_CRIT_RGB | VT_CRIT_HSV },
+    };
+    for (size_t i = 0; i < sizeof ok / sizeof ok[0]; ++i) {
+        unsigned bits = 0;
+        assert_true(vt_criteria_parse(ok[i].text, &bits));
+        assert_int_equal(bits, ok[i].bits);
+    }
+    static const char *const bad[] = { "", "RGB", "rgb+", "+rgb", "tree+tree", "rgb hsv",
+                                       "rgb+hsv+tree", "l1", "rgbx" };
+    for (size_t i = 0; i < sizeof bad / sizeof bad[0]; ++i) {
+        unsigned bits = 12345;
+        assert_false(vt_criteria_parse(bad[i], &bits));
+        assert_int_equal(bits, 12345);
+    }
+    unsigned bits;
+    assert_false(vt_criteria_parse(NULL, &bits));
+}
+
+static void test_rgb_fires_on_l1_of_display_values(void **state)
+{
+    (void)state;
+    vt_vertex a = sample_display(0.5f, 0.5f, 0.5f);
+    vt_vertex b = sample_display(0.6f, 0.45f, 0.5f);      /* L1 = 0.15 */
+    vt_criteria c = { .bits = VT_CRIT_RGB, .eps_rgb = 0.149f };
+    assert_int_equal(vt_criteria_test(&c, &a, &b), VT_CRIT_RGB);
+    assert_int_equal(vt_criteria_test(&c, &b, &a), VT_CRIT_RGB);
+    c.eps_rgb = 0.151f;
+    assert_int_equal(vt_criteria_test(&c, &a, &b), 0);
+    /* overexposure clamps: 2 and 50 are both white */
+    vt_vertex w1 = sample_display(1, 1, 1), w2 = sample_display(1, 1, 1);
+    w1.flat = rl_v3s(2.0f);
+    w2.flat = rl_v3s(50.0f);
+    c.eps_rgb = 0.0f;
+    assert_int_equal(vt_criteria_test(&c, &w1, &w2), 0);
+    /* only the flat (untextured) radiance counts, Sec. 3.5.3 */
+    vt_vertex t1 = sample_display(0.2f, 0.2f, 0.2f), t2 = t1;
+    t1.color = rl_v3(1, 0, 0);
+    t2.color = rl_v3(0, 0, 1);
+    assert_int_equal(vt_criteria_test(&c, &t1, &t2), 0);
+}
+
+static void test_hsv_hue_wraps_and_is_ignored_for_greys(void **state)
+{
+    (void)state;
+    /* hues 0.95 and 0.05: 0.1 apart across red, same S and V */
+    vt_vertex a = sample_display(1.0f, 0.0f, 0.3f), b = sample_display(1.0f, 0.3f, 0.0f);
+    vt_criteria c = { .bits = VT_CRIT_HSV, .eps_h = 0.11f, .eps_s = 0.01f, .eps_v = 0.01f };
+    assert_int_equal(vt_criteria_test(&c, &a, &b), 0);
+    c.eps_h = 0.09f;
+    assert_int_equal(vt_criteria_test(&c, &a, &b), VT_CRIT_HSV);
+
+    /* nearly grey: hues far apart but saturation below 1e-3 */
+    vt_vertex g1 = sample_display(0.5f, 0.5f, 0.5f), g2 = sample_display(0.5f, 0.5f, 0.5f);
+    g1.flat.x *= 1.0004f;                 /* reddish */
+    g2.flat.z *= 1.0004f;                 /* bluish */
+    float h1, s1, v1, h2, s2, v2;
+    vt_rgb_to_hsv(rl_v3(vt_display(g1.flat.x), vt_display(g1.flat.y), vt_display(g1.flat.z)),
+                  &h1, &s1, &v1);
+    vt_rgb_to_hsv(rl_v3(vt_display(g2.flat.x), vt_display(g2.flat.y), vt_display(g2.flat.z)),
+                  &h2, &s2, &v2);
+    assert_true(s1 > 0.0f && s1 < 1e-3f);
+    assert_true(fabsf(h1 - h2) > 0.3f);
+    c.eps_h = 0.01f;
+    assert_int_equal(vt_criteria_test(&c, &g1, &g2), 0);
+
+    /* saturation and value on their own */
+    vt_vertex p = sample_display(0.8f, 0.4f, 0.4f), q = sample_display(0.8f, 0.6f, 0.6f);
+    c = (vt_criteria){ .bits = VT_CRIT_HSV, .eps_h = 0.5f, .eps_s = 0.2f, .eps_v = 1.0f };
+    assert_int_equal(vt_criteria_test(&c, &p, &q), VT_CRIT_HSV);   /* dS = 0.25 */
+    c.eps_s = 0.3f;
+    assert_int_equal(vt_criteria_test(&c, &p, &q), 0);
+    vt_vertex r = sample_display(0.6f, 0.3f, 0.3f);                /* dV = 0.2 */
+    c = (vt_criteria){ .bits = VT_CRIT_HSV, .eps_h = 0.5f, .eps_s = 1.0f, .eps_v = 0.19f };
+    assert_int_equal(vt_criteria_test(&c, &p, &r), VT_CRIT_HSV);
+    c.eps_v = 0.21f;
+    assert_int_equal(vt_criteria_test(&c, &p, &r), 0);
+}
+
+static void test_tree_and_combinations_report_what_fired(void **state)
+{
+    (void)state;
+    vt_vertex a = sample_display(0.5f, 0.5f, 0.5f), b = sample_display(0.9f, 0.5f, 0.5f);
+    a.tree_hash = 0x1111;
+    b.tree_hash = 0x1111;
+    vt_criteria c = { .bits = VT_CRIT_TREE, .eps_rgb = 0.1f, .eps_h = 0.5f, .eps_s = 1.0f,
+                      .eps_v = 1.0f };
+    assert_int_equal(vt_criteria_test(&c, &a, &b), 0);        /* colours differ, trees don't */
+    b.tree_hash = 0x2222;
+    assert_int_equal(vt_criteria_test(&c, &a, &b), VT_CRIT_TREE);
+    c.bits = VT_CRIT_TREE | VT_CRIT_RGB;
+    assert_int_equal(vt_criteria_test(&c, &a, &b), VT_CRIT_TREE | VT_CRIT_RGB);
+    c.bits = VT_CRIT_RGB | VT_CRIT_HSV;
+    assert_int_equal(vt_criteria_test(&c, &a, &b), VT_CRIT_RGB);
+    c.eps_v = 0.1f;
+    assert_int_equal(vt_criteria_test(&c, &a, &b), VT_CRIT_RGB | VT_CRIT_HSV);
+    c.bits = 0;
+    assert_int_equal(vt_criteria_test(&c, &a, &b), 0);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_display_is_clamped_srgb),
+        cmocka_unit_test(test_hsv_of_primaries_and_greys),
+        cmocka_unit_test(test_parse_accepts_the_documented_names_only),
+        cmocka_unit_test(test_rgb_fires_on_l1_of_display_values),
+        cmocka_unit_test(test_hsv_hue_wraps_and_is_ignored_for_greys),
+        cmocka_unit_test(test_tree_and_combinations_report_what_fired),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}

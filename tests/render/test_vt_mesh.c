@@ -1,0 +1,813 @@
+/* test_vt_mesh.c: the Vertex Tracing refinement mesh (vt_mesh.c): welding
+ * and edge pairing on meshes built in code, the exact shape of one split
+ * (Ullmann 2003, Fig. 3.5), and a full consistency check (adjacency both
+ * ways, orientation, areas, no T-junctions, Euler characteristic of a closed
+ * mesh) after thousands of random splits on a grid, a closed cube and a
+ * committed UV sphere. Reset must give back the freshly built mesh. */
+#include <math.h>
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include <cmocka.h>
+
+#include "render/vt_internal.h"
+
+/* ------------------------------------------------------- scene builders -- */
+
+/* Hand-made rl_scene_data: owns its arrays. */
+typedef struct toy {
+    rl_scene_data d;
+    rl_vec3 *p, *n;
+    rl_vec2 *uv;
+    uint32_t *idx, *tri_obj;
+    rl_object *obj;
+    uint32_t nv, nt, no;
+} toy;
+
+static void toy_init(toy *t, uint32_t max_v, uint32_t max_t, uint32_t max_o)
+{
+    memset(t, 0, sizeof *t);
+    t->p = calloc(max_v, sizeof *t->p);
+    t->n = calloc(max_v, sizeof *t->n);
+    t->uv = calloc(max_v, sizeof *t->uv);
+    t->idx = calloc(3 * (size_t)max_t, sizeof *t->idx);
+    t->tri_obj = calloc(max_t, sizeof *t->tri_obj);
+    t->obj = calloc(max_o, sizeof *t->obj);
+    assert_non_null(t->p);
+    assert_non_null(t->n);
+    assert_non_null(t->uv);
+    assert_non_null(t->idx);
+    assert_non_null(t->tri_obj);
+    assert_non_null(t->obj);
+}
+
+static void toy_free(toy *t)
+{
+    free(t->p);
+    free(t->n);
+    free(t->uv);
+    free(t->idx);
+    free(t->tri_obj);
+    free(t->obj);
+}
+
+static void toy_begin_object(toy *t)
+{
+    t->obj[t->no].first_triangle = t->nt;
+    t->obj[t->no].first_vertex = t->nv;
+    t->no++;
+}
+
+static uint32_t toy_vertex(toy *t, rl_vec3 p, rl_vec3 n, rl_vec2 uv)
+{
+    t->p[t->nv] = p;
+    t->n[t->nv] = n;
+    t->uv[t->nv] = uv;
+    t->obj[t->no - 1].num_vertices++;
+    return t->nv++;
+}
+
+static void toy_triangle(toy *t, uint32_t a, uint32_t b, uint32_t c)
+{
+    t->idx[3 * t->nt] = a;
+    t->idx[3 * t->nt + 1] = b;
+    t->idx[3 * t->nt + 2] = c;
+    t->tri_obj[t->nt] = t->no - 1;
+    t->obj[t->no - 1].num_triangles++;
+    t->nt++;
+}
+
+static const rl_scene_data *toy_data(toy *t)
+{
+    t->d.num_vertices = t->nv;
+    t->d.positions = t->p;
+    t->d.normals = t->n;
+    t->d.uvs = t->uv;
+    t->d.num_triangles = t->nt;
+    t->d.indices = t->idx;
+    t->d.triangle_object = t->tri_obj;
+    t->d.num_objects = t->no;
+    t->d.objects = t->obj;
+    return &t->d;
+}
+
+/* n x n quads in the z = 0 plane, counter-clockwise seen from +z. */
+static void toy_grid(toy *t, uint32_t n)
+{
+    toy_init(t, (n + 1) * (n + 1), 2 * n * n, 1);
+    toy_begin_object(t);
+    for (uint32_t j = 0; j <= n; ++j)
+        for (uint32_t i = 0; i <= n; ++i)
+            toy_vertex(t, rl_v3((float)i, (float)j, 0.0f), rl_v3(0, 0, 1),
+                       rl_v2((float)i / (float)n, (float)j / (float)n));
+    for (uint32_t j = 0; j < n; ++j)
+        for (uint32_t i = 0; i < n; ++i) {
+            uint32_t a = j * (n + 1) + i, b = a + 1, c = a + n + 2, d = a + n + 1;
+            toy_triangle(t, a, b, c);
+            toy_triangle(t, a, c, d);
+        }
+}
+
+/* A unit cube as a loader delivers it: every triangle with its own three
+ * vertices, which weld to the 8 corners (smooth normals, uv 0). Outward
+ * facing, counter-clockwise. */
+static void toy_cube_soup(toy *t)
+{
+    static const int quads[6][4] = {
+        { 0, 2, 3, 1 }, { 4, 5, 7, 6 }, { 0, 1, 5, 4 },
+        { 2, 6, 7, 3 }, { 0, 4, 6, 2 }, { 1, 3, 7, 5 },
+    };
+    toy_init(t, 36, 12, 1);
+    toy_begin_object(t);
+    for (int q = 0; q < 6; ++q) {
+        const int tri[2][3] = { { quads[q][0], quads[q][1], quads[q][2] },
+                                { quads[q][0], quads[q][2], quads[q][3] } };
+        for (int k = 0; k < 2; ++k) {
+            uint32_t v[3];
+            for (int c = 0; c < 3; ++c) {
+                int corner = tri[k][c];
+                rl_vec3 p = rl_v3((float)(corner & 1), (float)((corner >> 1) & 1),
+                                  (float)((corner >> 2) & 1));
+                rl_vec3 n = rl_normalize(rl_sub(p, rl_v3s(0.5f)));
+                v[c] = toy_vertex(t, p, n, rl_v2(0, 0));
+            }
+            toy_triangle(t, v[0], v[1], v[2]);
+        }
+    }
+}
+
+/* --------------------------------------------------- consistency check -- */
+
+static rl_vec3 face_cross(const vt_mesh *m, uint32_t f)
+{
+    const vt_face *fc = &m->faces[f];
+    rl_vec3 a = m->verts[fc->v[0]].p, b = m->verts[fc->v[1]].p, c = m->verts[fc->v[2]].p;
+    return rl_cross(rl_sub(b, a), rl_sub(c, a));
+}
+
+/* In double from the float positions: children of a sliver must add up to
+ * their parent beyond float rounding. */
+static double face_area(const vt_mesh *m, uint32_t f)
+{
+    const vt_face *fc = &m->faces[f];
+    double p[3][3];
+    for (int k = 0; k < 3; ++k) {
+        rl_vec3 v = m->verts[fc->v[k]].p;
+        p[k][0] = v.x;
+        p[k][1] = v.y;
+        p[k][2] = v.z;
+    }
+    double u[3], w[3];
+    for (int i = 0; i < 3; ++i) {
+        u[i] = p[1][i] - p[0][i];
+        w[i] = p[2][i] - p[0][i];
+    }
+    double cx = u[1] * w[2] - u[2] * w[1], cy = u[2] * w[0] - u[0] * w[2];
+    double cz = u[0] * w[1] - u[1] * w[0];
+    return 0.5 * sqrt(cx * cx + cy * cy + cz * cz);
+}
+
+static bool face_has_edge_ccw(const vt_face *f, uint32_t a, uint32_t b)
+{
+    for (int i = 0; i < 3; ++i)
+        if (f->v[i] == a && f->v[(i + 1) % 3] == b)
+            return true;
+    return false;
+}
+
+/* Every invariant of the refinement mesh (the input is consistently wound,
+ * so the orientation convention is checked strictly). closed: every live
+ * edge must have two faces and V - E + F = 2. */
+static void check_mesh(const vt_mesh *m, bool closed)
+{
+    uint32_t split_edges = 0, live_edges = 0, leaf_faces = 0;
+    double *child_area = calloc(m->num_faces, sizeof *child_area);
+    uint32_t *child_count = calloc(m->num_faces, sizeof *child_count);
+    assert_non_null(child_area);
+    assert_non_null(child_count);
+
+    for (uint32_t f = 0; f < m->num_faces; ++f) {
+        const vt_face *fc = &m->faces[f];
+        assert_true((f < m->num_primary_faces) == (fc->parent == VT_NONE));
+        if (fc->parent != VT_NONE) {
+            assert_true(fc->parent < f);
+            assert_false(m->faces[fc->parent].leaf);
+            child_area[fc->parent] += face_area(m, f);
+            child_count[fc->parent]++;
+            /* same orientation as the parent */
+            assert_true(rl_dot(face_cross(m, f), face_cross(m, fc->parent)) > 0.0f);
+            assert_int_equal(fc->triangle, m->faces[fc->parent].triangle);
+            assert_int_equal(fc->object, m->faces[fc->parent].object);
+        }
+        if (!fc->leaf)
+            continue;
+        leaf_faces++;
+        for (int i = 0; i < 3; ++i) {
+            assert_true(fc->v[i] < m->num_verts);
+            assert_true(fc->e[i] < m->num_edges);
+            const vt_edge *e = &m->edges[fc->e[i]];
+            /* a leaf face's edges are unsplit, join the right corners and
+             * reference the face back */
+            assert_int_equal(e->mid, VT_NONE);
+            uint32_t a = fc->v[(i + 1) % 3], b = fc->v[(i + 2) % 3];
+            assert_true((e->v[0] == a && e->v[1] == b) || (e->v[0] == b && e->v[1] == a));
+            assert_true(e->face[0] == f || e->face[1] == f);
+        }
+    }
+    for (uint32_t f = 0; f < m->num_faces; ++f) {
+        if (m->faces[f].leaf) {
+            assert_int_equal(child_count[f], 0);
+            continue;
+        }
+        assert_int_equal(child_count[f], 2);
+        double a = face_area(m, f);
+        if (!(fabs(child_area[f] - a) <= 1e-4 * a + 1e-12))
+            fail_msg("face %u: area %g, children %g", f, a, child_area[f]);
+    }
+
+    for (uint32_t ei = 0; ei < m->num_edges; ++ei) {
+        const vt_edge *e = &m->edges[ei];
+        assert_true(e->v[0] < m->num_verts && e->v[1] < m->num_verts);
+        assert_true(e->v[0] != e->v[1]);
+        if (e->mid != VT_NONE) {
+            split_edges++;
+            const vt_edge *c0 = &m->edges[e->child[0]], *c1 = &m->edges[e->child[1]];
+            assert_int_equal(c0->v[0], e->v[0]);
+            assert_int_equal(c0->v[1], e->mid);
+            assert_int_equal(c1->v[0], e->mid);
+            assert_int_equal(c1->v[1], e->v[1]);
+            rl_vec3 want = rl_scale(rl_add(m->verts[e->v[0]].p, m->verts[e->v[1]].p), 0.5f);
+            assert_float_equal(m->verts[e->mid].p.x, want.x, 1e-6);
+            assert_float_equal(m->verts[e->mid].p.y, want.y, 1e-6);
+            assert_float_equal(m->verts[e->mid].p.z, want.z, 1e-6);
+            /* no T-junction: every face beside a split edge was split too */
+            for (int s = 0; s < 2; ++s)
+                if (e->face[s] != VT_NONE)
+                    assert_false(m->faces[e->face[s]].leaf);
+            continue;
+        }
+        assert_int_equal(e->child[0], VT_NONE);
+        live_edges++;
+        assert_true(e->face[0] != VT_NONE);
+        if (closed)
+            assert_true(e->face[1] != VT_NONE);
+        for (int s = 0; s < 2; ++s) {
+            if (e->face[s] == VT_NONE)
+                continue;
+            const vt_face *fc = &m->faces[e->face[s]];
+            assert_true(fc->leaf);
+            assert_true(fc->e[0] == ei || fc->e[1] == ei || fc->e[2] == ei);
+            /* face[0] runs v[0] -> v[1], face[1] the other way round */
+            if (s == 0)
+                assert_true(face_has_edge_ccw(fc, e->v[0], e->v[1]));
+            else
+                assert_true(face_has_edge_ccw(fc, e->v[1], e->v[0]));
+        }
+        assert_true(e->face[0] != e->face[1]);
+    }
+    assert_int_equal(m->num_verts, m->num_primary_verts + split_edges);
+    if (closed)
+        assert_int_equal((int64_t)m->num_verts - live_edges + leaf_faces, 2);
+
+    double primary = 0.0, leaves = 0.0;
+    for (uint32_t f = 0; f < m->num_faces; ++f) {
+        if (f < m->num_primary_faces)
+            primary += face_area(m, f);
+        if (m->faces[f].leaf)
+            leaves += face_area(m, f);
+    }
+    assert_true(fabs(primary - leaves) <= 1e-5 * primary);
+    free(child_area);
+    free(child_count);
+}
+
+static uint64_t rng_next(uint64_t *s)
+{
+    *s ^= *s << 13;
+    *s ^= *s >> 7;
+    *s ^= *s << 17;
+    return *s;
+}
+
+/* Splits count random unsplit edges, checking each split's report and the
+ * whole mesh every check_every splits. */
+static void random_splits(vt_mesh *m, int count, uint64_t seed, bool closed, int check_every)
+{
+    for (int i = 0; i < count; ++i) {
+        uint32_t e;
+        do
+            e = (uint32_t)(rng_next(&seed) % m->num_edges);
+        while (m->edges[e].mid != VT_NONE);
+        int sides = (m->edges[e].face[0] != VT_NONE) + (m->edges[e].face[1] != VT_NONE);
+        uint32_t a = m->edges[e].v[0], b = m->edges[e].v[1];
+        uint32_t verts = m->num_verts, faces = m->num_faces;
+        uint32_t ne[4], nf[4], num_e = 99, num_f = 99;
+        uint32_t mid = vt_mesh_split(m, e, (uint16_t)(1 + i % 7), ne, &num_e, nf, &num_f);
+        assert_int_equal(mid, verts);
+        assert_int_equal(m->num_verts, verts + 1);
+        assert_int_equal(num_e, 2 + (uint32_t)sides);
+        assert_int_equal(num_f, 2 * (uint32_t)sides);
+        assert_int_equal(m->num_faces, faces + 2 * (uint32_t)sides);
+        assert_int_equal(ne[0], m->edges[e].child[0]);
+        assert_int_equal(ne[1], m->edges[e].child[1]);
+        for (uint32_t k = 0; k < num_f; ++k) {
+            assert_true(m->faces[nf[k]].leaf);
+            assert_int_equal(m->faces[nf[k]].stage, 1 + i % 7);
+        }
+        assert_true(m->verts[mid].key == vt_vertex_key_mid(m->verts[a].key, m->verts[b].key));
+        assert_int_equal(m->verts[mid].state, VT_UNSAMPLED);
+        if ((i + 1) % check_every == 0)
+            check_mesh(m, closed);
+    }
+    check_mesh(m, closed);
+}
+
+/* -------------------------------------------------------------- tests -- */
+
+static void test_grid_builds_shared_edges(void **state)
+{
+    (void)state;
+    toy t;
+    toy_grid(&t, 10);
+    uint8_t mask[1] = { 1 };
+    vt_mesh m = { 0 };
+    assert_int_equal(vt_mesh_build(&m, toy_data(&t), mask), RL_OK);
+    assert_int_equal(m.num_verts, 121);
+    assert_int_equal(m.num_faces, 200);
+    /* 10 x 11 horizontal + 11 x 10 vertical + 100 diagonals */
+    assert_int_equal(m.num_edges, 320);
+    assert_int_equal(m.num_primary_verts, 121);
+    assert_int_equal(m.num_primary_edges, 320);
+    assert_int_equal(m.num_primary_faces, 200);
+    uint32_t boundary = 0;
+    for (uint32_t e = 0; e < m.num_edges; ++e)
+        boundary += m.edges[e].face[1] == VT_NONE;
+    assert_int_equal(boundary, 40);
+    for (uint32_t f = 0; f < m.num_faces; ++f) {
+        assert_int_equal(m.faces[f].triangle, f);
+        assert_int_equal(m.faces[f].leaf, 1);
+        assert_int_equal(m.faces[f].visible, 0);
+        assert_int_equal(m.faces[f].stage, 0);
+        for (int i = 0; i < 3; ++i) {
+            rl_vec3 want = t.p[t.idx[3 * f + (uint32_t)i]];
+            assert_memory_equal(&m.verts[m.faces[f].v[i]].p, &want, sizeof want);
+        }
+    }
+    for (uint32_t v = 0; v < m.num_verts; ++v)
+        assert_true(m.verts[v].key == vt_vertex_key_primary(0, v));
+    check_mesh(&m, false);
+    vt_mesh_free(&m);
+    toy_free(&t);
+}
+
+static void test_cube_soup_welds_into_a_closed_mesh(void **state)
+{
+    (void)state;
+    toy t;
+    toy_cube_soup(&t);
+    uint8_t mask[1] = { 1 };
+    vt_mesh m = { 0 };
+    assert_int_equal(vt_mesh_build(&m, toy_data(&t), mask), RL_OK);
+    assert_int_equal(m.num_verts, 8);
+    assert_int_equal(m.num_edges, 18);
+    assert_int_equal(m.num_faces, 12);
+    /* keys number the welded vertices in order of first use */
+    for (uint32_t v = 0; v < 8; ++v)
+        assert_true(m.verts[v].key == vt_vertex_key_primary(0, v));
+    assert_int_equal(m.verts[0].triangle, 0);
+    check_mesh(&m, true);
+    vt_mesh_free(&m);
+    toy_free(&t);
+}
+
+static void test_weld_needs_equal_normal_and_uv(void **state)
+{
+    (void)state;
+    /* Two triangles sharing positions a, b but with a different uv at b: a
+     * texture seam is a boundary, not a shared edge. */
+    toy t;
+    toy_init(&t, 6, 2, 1);
+    toy_begin_object(&t);
+    rl_vec3 n = rl_v3(0, 0, 1);
+    uint32_t a = toy_vertex(&t, rl_v3(0, 0, 0), n, rl_v2(0, 0));
+    uint32_t b = toy_vertex(&t, rl_v3(1, 0, 0), n, rl_v2(1, 0));
+    uint32_t c = toy_vertex(&t, rl_v3(0, 1, 0), n, rl_v2(0, 1));
+    uint32_t a2 = toy_vertex(&t, rl_v3(0, 0, 0), n, rl_v2(0, 0));
+    uint32_t b2 = toy_vertex(&t, rl_v3(1, 0, 0), n, rl_v2(0.5f, 0));
+    uint32_t d = toy_vertex(&t, rl_v3(0, -1, 0), n, rl_v2(0, -1));
+    toy_triangle(&t, a, c, b);
+    toy_triangle(&t, a2, b2, d);
+    uint8_t mask[1] = { 1 };
+    vt_mesh m = { 0 };
+    assert_int_equal(vt_mesh_build(&m, toy_data(&t), mask), RL_OK);
+    assert_int_equal(m.num_verts, 5);    /* a2 welds to a, b2 does not */
+    assert_int_equal(m.num_edges, 6);
+    vt_mesh_free(&m);
+
+    t.uv[b2] = rl_v2(1, 0);
+    assert_int_equal(vt_mesh_build(&m, toy_data(&t), mask), RL_OK);
+    assert_int_equal(m.num_verts, 4);
+    assert_int_equal(m.num_edges, 5);
+    check_mesh(&m, false);
+
+    t.n[b2] = rl_normalize(rl_v3(0, 0.1f, 1));
+    assert_int_equal(vt_mesh_build(&m, toy_data(&t), mask), RL_OK);
+    assert_int_equal(m.num_verts, 5);
+    vt_mesh_free(&m);
+    toy_free(&t);
+}
+
+static void test_objects_are_masked_and_never_welded_together(void **state)
+{
+    (void)state;
+    toy t;
+    toy_init(&t, 9, 3, 3);
+    rl_vec3 n = rl_v3(0, 0, 1);
+    for (uint32_t o = 0; o < 3; ++o) {
+        toy_begin_object(&t);
+        uint32_t a = toy_vertex(&t, rl_v3(0, 0, 0), n, rl_v2(0, 0));
+        uint32_t b = toy_vertex(&t, rl_v3(1, 0, 0), n, rl_v2(0, 0));
+        uint32_t c = toy_vertex(&t, rl_v3(0, 1, 0), n, rl_v2(0, 0));
+        toy_triangle(&t, a, b, c);
+    }
+    vt_mesh m = { 0 };
+    uint8_t all[3] = { 1, 1, 1 };
+    assert_int_equal(vt_mesh_build(&m, toy_data(&t), all), RL_OK);
+    assert_int_equal(m.num_verts, 9);
+    assert_int_equal(m.num_edges, 9);
+    assert_int_equal(m.num_faces, 3);
+
+    uint8_t some[3] = { 0, 0, 1 };
+    assert_int_equal(vt_mesh_build(&m, toy_data(&t), some), RL_OK);
+    assert_int_equal(m.num_verts, 3);
+    assert_int_equal(m.num_faces, 1);
+    assert_int_equal(m.faces[0].object, 2);
+    assert_int_equal(m.faces[0].triangle, 2);
+    assert_int_equal(m.verts[0].object, 2);
+    assert_true(m.verts[1].key == vt_vertex_key_primary(2, 1));
+
+    uint8_t none[3] = { 0, 0, 0 };
+    assert_int_equal(vt_mesh_build(&m, toy_data(&t), none), RL_OK);
+    assert_int_equal(m.num_verts, 0);
+    assert_int_equal(m.num_edges, 0);
+    assert_int_equal(m.num_faces, 0);
+    vt_mesh_reset(&m);
+    vt_mesh_free(&m);
+
+    rl_scene_data empty;
+    memset(&empty, 0, sizeof empty);
+    assert_int_equal(vt_mesh_build(&m, &empty, NULL), RL_OK);
+    assert_int_equal(m.num_faces, 0);
+    assert_int_equal(vt_mesh_build(NULL, &empty, NULL), RL_ERR_INVALID_ARG);
+    vt_mesh_free(&m);
+    toy_free(&t);
+}
+
+static void test_non_manifold_edge_gets_boundary_copies(void **state)
+{
+    (void)state;
+    /* Four fins on the edge (a, b). */
+    toy t;
+    toy_init(&t, 6, 4, 1);
+    toy_begin_object(&t);
+    rl_vec3 n = rl_v3(0, 0, 1);
+    uint32_t a = toy_vertex(&t, rl_v3(0, 0, 0), n, rl_v2(0, 0));
+    uint32_t b = toy_vertex(&t, rl_v3(1, 0, 0), n, rl_v2(0, 0));
+    uint32_t c = toy_vertex(&t, rl_v3(0, 1, 0), n, rl_v2(0, 0));
+    uint32_t d = toy_vertex(&t, rl_v3(0, -1, 0), n, rl_v2(0, 0));
+    uint32_t e = toy_vertex(&t, rl_v3(0, 0, 1), n, rl_v2(0, 0));
+    uint32_t g = toy_vertex(&t, rl_v3(0, 0, -1), n, rl_v2(0, 0));
+    toy_triangle(&t, a, b, c);
+    toy_triangle(&t, b, a, d);
+    toy_triangle(&t, a, b, e);
+    toy_triangle(&t, b, a, g);
+    uint8_t mask[1] = { 1 };
+    vt_mesh m = { 0 };
+    assert_int_equal(vt_mesh_build(&m, toy_data(&t), mask), RL_OK);
+    /* (a,b) shared once, then two copies; 8 outer sides */
+    assert_int_equal(m.num_edges, 11);
+    uint32_t ab_shared = 0, ab_single = 0;
+    for (uint32_t i = 0; i < m.num_edges; ++i) {
+        const vt_edge *ed = &m.edges[i];
+        bool is_ab = (ed->v[0] == 0 && ed->v[1] == 1) || (ed->v[0] == 1 && ed->v[1] == 0);
+        if (!is_ab)
+            continue;
+        if (ed->face[1] != VT_NONE)
+            ab_shared++;
+        else
+            ab_single++;
+    }
+    assert_int_equal(ab_shared, 1);
+    assert_int_equal(ab_single, 2);
+    check_mesh(&m, false);
+    random_splits(&m, 60, 99, false, 1);
+    vt_mesh_free(&m);
+    toy_free(&t);
+}
+
+static void test_split_of_one_edge_follows_fig_3_5(void **state)
+{
+    (void)state;
+    /* Two triangles (0,1,2) and (1,0,3) sharing the edge 0-1. */
+    toy t;
+    toy_init(&t, 4, 2, 1);
+    toy_begin_object(&t);
+    toy_vertex(&t, rl_v3(0, 0, 0), rl_v3(1, 0, 0), rl_v2(0, 0));
+    toy_vertex(&t, rl_v3(2, 0, 0), rl_v3(0, 1, 0), rl_v2(1, 0.5f));
+    toy_vertex(&t, rl_v3(1, 1, 0), rl_v3(0, 0, 1), rl_v2(0, 1));
+    toy_vertex(&t, rl_v3(1, -1, 0), rl_v3(0, 0, 1), rl_v2(1, 1));
+    toy_triangle(&t, 0, 1, 2);
+    toy_triangle(&t, 1, 0, 3);
+    uint8_t mask[1] = { 1 };
+    vt_mesh m = { 0 };
+    assert_int_equal(vt_mesh_build(&m, toy_data(&t), mask), RL_OK);
+    m.faces[1].visible = 1;
+    uint32_t e = m.faces[0].e[2];         /* opposite vertex 2: 0 -> 1 */
+    assert_int_equal(m.edges[e].v[0], 0);
+    assert_int_equal(m.edges[e].v[1], 1);
+    assert_int_equal(m.edges[e].face[0], 0);
+    assert_int_equal(m.edges[e].face[1], 1);
+
+    uint32_t ne[4], nf[4], num_e, num_f;
+    uint32_t v = vt_mesh_split(&m, e, 3, ne, &num_e, nf, &num_f);
+    assert_int_equal(v, 4);
+    const vt_vertex *mv = &m.verts[v];
+    assert_float_equal(mv->p.x, 1.0f, 0.0f);
+    assert_float_equal(mv->p.y, 0.0f, 0.0f);
+    /* eq. 3.8: normalize((1,0,0) + (0,1,0)) */
+    assert_float_equal(mv->n.x, sqrtf(0.5f), 1e-6f);
+    assert_float_equal(mv->n.y, sqrtf(0.5f), 1e-6f);
+    assert_float_equal(mv->n.z, 0.0f, 0.0f);
+    assert_float_equal(mv->uv.x, 0.5f, 0.0f);
+    assert_float_equal(mv->uv.y, 0.25f, 0.0f);
+    assert_int_equal(mv->stage, 3);
+    assert_int_equal(mv->triangle, 0);
+    assert_true(mv->key == vt_vertex_key_mid(m.verts[0].key, m.verts[1].key));
+
+    assert_int_equal(num_e, 4);
+    assert_int_equal(num_f, 4);
+    assert_int_equal(m.edges[e].mid, 4);
+    assert_false(m.faces[0].leaf);
+    assert_false(m.faces[1].leaf);
+    /* (a, b, c) = (0, 1, 2): children (0, v', 2) and (v', 1, 2) */
+    const vt_face *f1 = &m.faces[nf[0]], *f2 = &m.faces[nf[1]];
+    assert_int_equal(f1->v[0], 0);
+    assert_int_equal(f1->v[1], 4);
+    assert_int_equal(f1->v[2], 2);
+    assert_int_equal(f2->v[0], 4);
+    assert_int_equal(f2->v[1], 1);
+    assert_int_equal(f2->v[2], 2);
+    assert_int_equal(f1->parent, 0);
+    assert_int_equal(f1->stage, 3);
+    assert_int_equal(f1->visible, 0);
+    /* the other side (1, 0, 3) split on (1, 0): (1, v', 3) and (v', 0, 3),
+     * and they inherit its visible flag */
+    const vt_face *f3 = &m.faces[nf[2]], *f4 = &m.faces[nf[3]];
+    assert_int_equal(f3->v[0], 1);
+    assert_int_equal(f3->v[1], 4);
+    assert_int_equal(f3->v[2], 3);
+    assert_int_equal(f4->v[0], 4);
+    assert_int_equal(f4->v[1], 0);
+    assert_int_equal(f4->v[2], 3);
+    assert_int_equal(f3->visible, 1);
+    assert_int_equal(f4->parent, 1);
+    /* inner edges v' -> c */
+    assert_int_equal(m.edges[ne[2]].v[0], 4);
+    assert_int_equal(m.edges[ne[2]].v[1], 2);
+    assert_int_equal(m.edges[ne[3]].v[0], 4);
+    assert_int_equal(m.edges[ne[3]].v[1], 3);
+    check_mesh(&m, false);
+
+    /* splitting it again changes nothing */
+    uint32_t faces = m.num_faces, edges = m.num_edges;
+    assert_int_equal(vt_mesh_split(&m, e, 5, ne, &num_e, nf, &num_f), 4);
+    assert_int_equal(num_e, 0);
+    assert_int_equal(num_f, 0);
+    assert_int_equal(m.num_faces, faces);
+    assert_int_equal(m.num_edges, edges);
+
+    /* a boundary edge splits one face: 3 edges, 2 faces */
+    uint32_t outer = f1->e[1];            /* (2, 0) */
+    assert_int_equal(m.edges[outer].face[1], VT_NONE);
+    v = vt_mesh_split(&m, outer, 4, ne, &num_e, nf, &num_f);
+    assert_int_equal(v, 5);
+    assert_int_equal(num_e, 3);
+    assert_int_equal(num_f, 2);
+    check_mesh(&m, false);
+    vt_mesh_free(&m);
+    toy_free(&t);
+}
+
+static void test_midpoint_normal_falls_back_when_normals_cancel(void **state)
+{
+    (void)state;
+    toy t;
+    toy_init(&t, 3, 1, 1);
+    toy_begin_object(&t);
+    toy_vertex(&t, rl_v3(0, 0, 0), rl_v3(0, 0, 1), rl_v2(0, 0));
+    toy_vertex(&t, rl_v3(1, 0, 0), rl_v3(0, 0, -1), rl_v2(0, 0));
+    toy_vertex(&t, rl_v3(0, 1, 0), rl_v3(0, 0, 1), rl_v2(0, 0));
+    toy_triangle(&t, 0, 1, 2);
+    uint8_t mask[1] = { 1 };
+    vt_mesh m = { 0 };
+    assert_int_equal(vt_mesh_build(&m, toy_data(&t), mask), RL_OK);
+    uint32_t ne[4], nf[4], num_e, num_f;
+    uint32_t v = vt_mesh_split(&m, m.faces[0].e[2], 1, ne, &num_e, nf, &num_f);
+    assert_float_equal(m.verts[v].n.z, 1.0f, 0.0f);
+    vt_mesh_free(&m);
+    toy_free(&t);
+}
+
+static void test_random_splits_keep_grid_consistent(void **state)
+{
+    (void)state;
+    toy t;
+    toy_grid(&t, 10);
+    uint8_t mask[1] = { 1 };
+    vt_mesh m = { 0 };
+    assert_int_equal(vt_mesh_build(&m, toy_data(&t), mask), RL_OK);
+    random_splits(&m, 2000, 0x1234567u, false, 97);
+    vt_mesh_free(&m);
+    toy_free(&t);
+}
+
+static void test_random_splits_keep_cube_closed(void **state)
+{
+    (void)state;
+    toy t;
+    toy_cube_soup(&t);
+    uint8_t mask[1] = { 1 };
+    vt_mesh m = { 0 };
+    assert_int_equal(vt_mesh_build(&m, toy_data(&t), mask), RL_OK);
+    random_splits(&m, 2000, 0xabcdefu, true, 101);
+    vt_mesh_free(&m);
+    toy_free(&t);
+}
+
+static void test_random_splits_on_committed_sphere(void **state)
+{
+    (void)state;
+    rl_scene *s = NULL;
+    assert_int_equal(rl_scene_create(&s), RL_OK);
+    rl_material mat = rl_material_default();
+    uint32_t mat_id, mesh, node;
+    assert_int_equal(rl_scene_add_material(s, &mat, &mat_id), RL_OK);
+    assert_int_equal(rl_scene_add_generated(s, "sphere", "segments=16,rings=8", mat_id, &mesh),
+                     RL_OK);
+    for (int i = 0; i < 2; ++i) {
+        assert_int_equal(rl_scene_add_node(s, RL_NODE_ROOT, "ball", NULL, &node), RL_OK);
+        assert_int_equal(rl_scene_node_set_mesh(s, node, mesh), RL_OK);
+    }
+    assert_int_equal(rl_scene_commit(s), RL_OK);
+    const rl_scene_data *d = rl_scene_get_data(s);
+    assert_non_null(d);
+    assert_int_equal(d->num_objects, 2);
+    uint8_t mask[2] = { 1, 1 };
+    vt_mesh m = { 0 };
+    assert_int_equal(vt_mesh_build(&m, d, mask), RL_OK);
+    assert_int_equal(m.num_faces, d->num_triangles);
+    assert_true(m.num_verts <= d->num_vertices);
+    /* Per instance, the uv seam (7 edges on either side) and the poles (one
+     * vertex per segment, so both sides of the 2 x 16 pole triangles) stay
+     * open; the seam's pole edges are counted twice by that: 14 + 64 - 2. */
+    uint32_t shared = 0;
+    for (uint32_t e = 0; e < m.num_edges; ++e)
+        shared += m.edges[e].face[1] != VT_NONE;
+    assert_int_equal(m.num_edges - shared, 2 * (14 + 64 - 2));
+    check_mesh(&m, false);
+    random_splits(&m, 2000, 0x5eed, false, 250);
+    vt_mesh_free(&m);
+    rl_scene_release(s);
+}
+
+static void test_reset_restores_the_primary_mesh(void **state)
+{
+    (void)state;
+    toy t;
+    toy_grid(&t, 6);
+    uint8_t mask[1] = { 1 };
+    vt_mesh fresh = { 0 }, m = { 0 };
+    assert_int_equal(vt_mesh_build(&fresh, toy_data(&t), mask), RL_OK);
+    assert_int_equal(vt_mesh_build(&m, toy_data(&t), mask), RL_OK);
+    for (int round = 0; round < 3; ++round) {
+        for (uint32_t f = 0; f < m.num_faces; ++f)
+            m.faces[f].visible = 1;
+        for (uint32_t v = 0; v < m.num_verts; ++v)
+            m.verts[v].state = VT_SAMPLED;
+        for (uint32_t e = 0; e < m.num_edges; ++e)
+            m.edges[e].queued = 1;
+        random_splits(&m, 500, 77 + (uint64_t)round, false, 1000);
+        uint32_t cap = m.cap_faces;
+        vt_mesh_reset(&m);
+        assert_int_equal(m.cap_faces, cap);
+        assert_int_equal(m.num_verts, fresh.num_verts);
+        assert_int_equal(m.num_edges, fresh.num_edges);
+        assert_int_equal(m.num_faces, fresh.num_faces);
+        for (uint32_t e = 0; e < m.num_edges; ++e) {
+            const vt_edge *a = &m.edges[e], *b = &fresh.edges[e];
+            assert_int_equal(a->v[0], b->v[0]);
+            assert_int_equal(a->v[1], b->v[1]);
+            assert_int_equal(a->face[0], b->face[0]);
+            assert_int_equal(a->face[1], b->face[1]);
+            assert_int_equal(a->mid, VT_NONE);
+            assert_int_equal(a->child[0], VT_NONE);
+            assert_int_equal(a->child[1], VT_NONE);
+            assert_int_equal(a->queued, 0);
+            assert_int_equal(a->forced, 0);
+        }
+        for (uint32_t f = 0; f < m.num_faces; ++f) {
+            assert_memory_equal(m.faces[f].v, fresh.faces[f].v, sizeof m.faces[f].v);
+            assert_memory_equal(m.faces[f].e, fresh.faces[f].e, sizeof m.faces[f].e);
+            assert_int_equal(m.faces[f].leaf, 1);
+            assert_int_equal(m.faces[f].visible, 0);
+        }
+        for (uint32_t v = 0; v < m.num_verts; ++v) {
+            assert_int_equal(m.verts[v].state, VT_UNSAMPLED);
+            assert_true(m.verts[v].key == fresh.verts[v].key);
+        }
+        check_mesh(&m, false);
+    }
+    vt_mesh_free(&m);
+    vt_mesh_free(&fresh);
+    toy_free(&t);
+}
+
+static int cmp_u64(const void *a, const void *b)
+{
+    uint64_t x = *(const uint64_t *)a, y = *(const uint64_t *)b;
+    return (x > y) - (x < y);
+}
+
+static void test_keys_are_distinct_and_mid_is_symmetric(void **state)
+{
+    (void)state;
+    enum { OBJECTS = 40, INDICES = 500 };
+    uint64_t *keys = malloc(sizeof *keys * OBJECTS * INDICES);
+    assert_non_null(keys);
+    size_t n = 0;
+    for (uint32_t o = 0; o < OBJECTS; ++o)
+        for (uint32_t i = 0; i < INDICES; ++i)
+            keys[n++] = vt_vertex_key_primary(o, i);
+    qsort(keys, n, sizeof *keys, cmp_u64);
+    for (size_t i = 1; i < n; ++i)
+        assert_true(keys[i - 1] != keys[i]);
+    uint64_t a = vt_vertex_key_primary(0, 0), b = vt_vertex_key_primary(0, 1);
+    assert_true(a != b);
+    assert_true(vt_vertex_key_primary(1, 0) != vt_vertex_key_primary(0, 1));
+    assert_true(vt_vertex_key_mid(a, b) == vt_vertex_key_mid(b, a));
+    assert_true(vt_vertex_key_mid(a, b) != a && vt_vertex_key_mid(a, b) != b);
+    uint64_t ab = vt_vertex_key_mid(a, b);
+    assert_true(vt_vertex_key_mid(a, ab) != vt_vertex_key_mid(b, ab));
+    assert_true(vt_vertex_key_mid(a, a) != vt_vertex_key_mid(b, b));
+    free(keys);
+}
+
+static void test_xi_is_base_over_the_other_two_sides(void **state)
+{
+    (void)state;
+    vt_vertex v[3];
+    memset(v, 0, sizeof v);
+    /* 3-4-5 right triangle in pixels */
+    v[0].sx = 0; v[0].sy = 0;
+    v[1].sx = 3; v[1].sy = 0;
+    v[2].sx = 0; v[2].sy = 4;
+    vt_face f;
+    memset(&f, 0, sizeof f);
+    f.v[0] = 0; f.v[1] = 1; f.v[2] = 2;
+    vt_mesh m = { .verts = v, .num_verts = 3, .faces = &f, .num_faces = 1 };
+    assert_float_equal(vt_face_xi(&m, 0, 0), 5.0f / 7.0f, 1e-6f);
+    assert_float_equal(vt_face_xi(&m, 0, 1), 4.0f / 8.0f, 1e-6f);
+    assert_float_equal(vt_face_xi(&m, 0, 2), 3.0f / 9.0f, 1e-6f);
+    assert_float_equal(vt_face_xi_max(&m, 0), 5.0f / 7.0f, 1e-6f);
+    /* collinear: no area, xi = 1 */
+    v[2].sx = 6; v[2].sy = 0;
+    assert_float_equal(vt_face_xi_max(&m, 0), 1.0f, 1e-6f);
+    /* all in one point: 0 by definition */
+    v[1].sx = v[2].sx = 0;
+    assert_float_equal(vt_face_xi(&m, 0, 0), 0.0f, 0.0f);
+    assert_float_equal(vt_face_xi_max(&m, 0), 0.0f, 0.0f);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_grid_builds_shared_edges),
+        cmocka_unit_test(test_cube_soup_welds_into_a_closed_mesh),
+        cmocka_unit_test(test_weld_needs_equal_normal_and_uv),
+        cmocka_unit_test(test_objects_are_masked_and_never_welded_together),
+        cmocka_unit_test(test_non_manifold_edge_gets_boundary_copies),
+        cmocka_unit_test(test_split_of_one_edge_follows_fig_3_5),
+        cmocka_unit_test(test_midpoint_normal_falls_back_when_normals_cancel),
+        cmocka_unit_test(test_random_splits_keep_grid_consistent),
+        cmocka_unit_test(test_random_splits_keep_cube_closed),
+        cmocka_unit_test(test_random_splits_on_committed_sphere),
+        cmocka_unit_test(test_reset_restores_the_primary_mesh),
+        cmocka_unit_test(test_keys_are_distinct_and_mid_is_symmetric),
+        cmocka_unit_test(test_xi_is_base_over_the_other_two_sides),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
