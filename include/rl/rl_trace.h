@@ -59,6 +59,12 @@ typedef struct rl_tracer_desc {           /* zero = default */
     rl_vec3 background;       /* radiance of rays that leave the scene */
     bool no_shadows;          /* skip shadow feelers (all lights visible) */
     uint64_t seed;            /* area-light jitter */
+    /* Ray trees record only whether a shadow feeler was blocked (occluder
+     * RL_ID_NONE - 1 for any occluder), not by which object, so feelers keep
+     * the cheaper any-hit query even when a tree is kept. Enough for the
+     * ray-tree criterion of Vertex Tracing, whose shadow nodes say whether
+     * the light is visible (Ullmann 2003, Sec. 3.3.1, Fig. 3.7). */
+    bool tree_shadow_any_hit;
 } rl_tracer_desc;
 
 typedef struct rl_tracer rl_tracer;

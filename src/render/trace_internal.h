@@ -23,6 +23,7 @@ struct rl_tracer {
     float ambient;            /* resolved: 0 = none */
     rl_vec3 background;
     bool shadows;
+    bool tree_shadow_any_hit; /* see rl_tracer_desc */
     uint64_t seed;
     float eps;                /* secondary-ray origin offset, see trace.c */
 };

@@ -104,7 +104,7 @@ void rl_tracer_shade_point(const rl_tracer *tracer, rl_vec3 eye, const rl_trace_
     /* Replay from a copy: cache_in may be cache_out, which the feelers
      * overwrite as they go. */
     rl_trace_feelers replay;
-    if (cache_in && cache_matches(cache_in, s.ns_front, tree != NULL)) {
+    if (cache_in && cache_matches(cache_in, s.ns_front, tree != NULL && !tracer->tree_shadow_any_hit)) {
         replay = *cache_in;
         ctx.cache_in = &replay;
     }

@@ -55,7 +55,7 @@ static uint32_t trace_feeler(rl_trace_ctx *ctx, const rl_trace_surface *s, rl_ve
     const rl_tracer *tr = ctx->tracer;
     ctx->rays[RL_RAY_SHADOW]++;
     rl_ray ray = { rl_trace_offset(tr, s, l), 0.0f, l, isinf(dist) ? INFINITY : dist * (1.0f - SHADOW_T_SHRINK) };
-    if (!ctx->tree)
+    if (!ctx->tree || tr->tree_shadow_any_hit)
         return rl_accel_occluded(tr->accel, &ray) ? RL_TRACE_OCCLUDER_UNKNOWN : RL_ID_NONE;
     rl_hit hit = { INFINITY, 0.0f, 0.0f, RL_ID_NONE, RL_ID_NONE };
     return rl_accel_intersect(tr->accel, &ray, &hit) ? hit.object : RL_ID_NONE;

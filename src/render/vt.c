@@ -405,6 +405,7 @@ static rl_status vt_render(rl_renderer *r, void *state, const rl_scene *scene, c
         .background = set.background,
         .no_shadows = !rl_renderer_opt_bool(r, "shadows"),
         .seed = 0,
+        .tree_shadow_any_hit = true,
     };
     rl_tracer *tracer = NULL;
     if ((st = rl_tracer_create(s->accel.accel, &desc, &tracer)) != RL_OK)

@@ -162,6 +162,30 @@ static rl_status add_materials(table *t)
     return s;
 }
 
+/* The top surface as an nx x nz grid: Vertex Tracing samples a surface at
+ * its vertices first (Ullmann 2003, Sec. 3.2), so a table top made of two
+ * triangles would start from four samples and miss every shadow lying
+ * inside them (Sec. 3.3.2). Counter-clockwise seen from +y; uv 0..rx, 0..rz
+ * along +x and -z like rl_meshbuf_quad. */
+static void top_grid(rl_meshbuf *b, float x, float z, float y, float rx, float rz, int nx, int nz)
+{
+    uint32_t first = 0;
+    for (int j = 0; j <= nz; ++j)
+        for (int i = 0; i <= nx; ++i) {
+            float u = (float)i / (float)nx, v = (float)j / (float)nz;
+            uint32_t id = rl_meshbuf_vertex(b, rl_v3(-x + 2.0f * x * u, y, z - 2.0f * z * v), rl_v3(0.0f, 1.0f, 0.0f),
+                                            rl_v2(rx * u, rz * v));
+            if (i == 0 && j == 0)
+                first = id;
+        }
+    for (int j = 0; j < nz; ++j)
+        for (int i = 0; i < nx; ++i) {
+            uint32_t a = first + (uint32_t)(j * (nx + 1) + i), c = a + 1, d = a + (uint32_t)(nx + 1), e = d + 1;
+            rl_meshbuf_triangle(b, a, c, e);
+            rl_meshbuf_triangle(b, a, e, d);
+        }
+}
+
 /* Room and table: floor, back wall, checkered top (VT object), legs. */
 static rl_status add_furniture(table *t)
 {
@@ -184,7 +208,9 @@ static rl_status add_furniture(table *t)
     float rx = TABLE_W / (2.0f * cell), rz = TABLE_D / (2.0f * cell), ry = TABLE_T / (2.0f * cell);
     rl_meshbuf_init(&b);
     b.material = t->m.cloth;
-    rl_meshbuf_quad(&b, rl_v3(-x, y1, z), rl_v3(x, y1, z), rl_v3(x, y1, -z), rl_v3(-x, y1, -z), rl_v2(rx, rz));
+    int grid = (int)(48.0f * t->detail + 0.5f);
+    grid = grid < 4 ? 4 : grid;
+    top_grid(&b, x, z, y1, rx, rz, grid, (int)((float)grid * TABLE_D / TABLE_W + 0.5f));
     rl_meshbuf_quad(&b, rl_v3(-x, y0, -z), rl_v3(x, y0, -z), rl_v3(x, y0, z), rl_v3(-x, y0, z), rl_v2(rx, rz));
     rl_meshbuf_quad(&b, rl_v3(-x, y0, z), rl_v3(x, y0, z), rl_v3(x, y1, z), rl_v3(-x, y1, z), rl_v2(rx, ry));
     rl_meshbuf_quad(&b, rl_v3(x, y0, -z), rl_v3(-x, y0, -z), rl_v3(-x, y1, -z), rl_v3(x, y1, -z), rl_v2(rx, ry));
