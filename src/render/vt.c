@@ -40,11 +40,11 @@
 #include "core/error.h"
 #include "render/accel_cache.h"
 #include "render/renderer.h"
+#include "render/tracer_options.h"
 #include "render/vt_run.h"
 #include "rl/rl_timer.h"
 #include "rl/rl_vt.h"
 
-static const char *const accel_choices[] = { "bvh", "grid", "embree", "brute", NULL };
 static const char *const criteria_choices[] = { "rgb", "hsv", "tree", "tree+rgb", "tree+hsv", NULL };
 static const char *const texture_choices[] = { "multitexture", "multipass", "sampled", NULL };
 static const char *const progressive_choices[] = { "none", "overdraw", "redraw", NULL };
@@ -82,15 +82,7 @@ static const rl_option_info vt_options[] = {
     { "overlay", RL_OPT_ENUM, "none", "draw the refined mesh (wire) or samples by reason over the image",
       0, 0, overlay_choices },
     { "shading", RL_OPT_ENUM, "textured", "shading of the rasterized non-VT objects", 0, 0, shading_choices },
-    { "accel", RL_OPT_ENUM, "bvh", "acceleration structure for the rays (embree only in builds with Embree)",
-      0, 0, accel_choices },
-    { "max_depth", RL_OPT_INT, "5", "reflection/refraction recursion depth (0: local shading only)", 0, 64, NULL },
-    { "area_samples", RL_OPT_INT, "4", "n x n jittered shadow feelers per quad light", 1, 32, NULL },
-    { "shadows", RL_OPT_BOOL, "true", "trace shadow feelers (false: every light is visible)", 0, 0, NULL },
-    { "ambient", RL_OPT_FLOAT, "0.05", "ambient light, multiplied by k_d", 0, 1, NULL },
-    { "background", RL_OPT_COLOR, "0,0,0", "radiance of rays that leave the scene: \"r,g,b\" or one grey value",
-      0, 0, NULL },
-    { "threads", RL_OPT_INT, "0", "OpenMP threads (0 = all)", 0, 1024, NULL },
+    RL_TRACER_OPTION_ROWS,
 };
 
 typedef struct vt_state {
@@ -146,11 +138,9 @@ static void vt_release(void *state)
 
 static rl_status vt_check(const char *key, const char *value)
 {
-    if (strcmp(key, "accel") == 0 && strcmp(value, "embree") == 0 && !rl_accel_kind_available(RL_ACCEL_EMBREE))
-        return rl_error(RL_ERR_INVALID_ARG, "vt: accel=embree is not available in this build (configure with -DRL_EMBREE=ON)");
     if (strcmp(key, "objects") == 0 && value[0] == '\0')
         return rl_error(RL_ERR_INVALID_ARG, "vt: objects must be auto, all, none or a list of node names");
-    return RL_OK;
+    return rl_tracer_options_check("vt", key, value);
 }
 
 /* ------------------------------------------------------- VT objects -- */
@@ -389,24 +379,15 @@ static rl_status vt_render(rl_renderer *r, void *state, const rl_scene *scene, c
     s->have_frame = false;
 
     rl_accel_kind kind;
-    if ((st = rl_accel_kind_parse(accel_choices[rl_renderer_opt_enum(r, "accel")], &kind)) != RL_OK)
+    rl_tracer_desc desc;
+    if ((st = rl_tracer_options_read(r, &desc, &kind)) != RL_OK)
         return st;
+    desc.tree_shadow_any_hit = true;      /* shadow nodes say lit or blocked (Sec. 3.3.1) */
     if ((st = rl_accel_cache_get(&s->accel, "vt", scene, kind, set.threads, build_progress, r)) != RL_OK)
         return st;
     if ((st = ensure_mesh(s, scene, d, rl_renderer_opt_string(r, "objects"))) != RL_OK)
         return st;
 
-    int max_depth = (int)rl_renderer_opt_int(r, "max_depth");
-    float ambient = (float)rl_renderer_opt_float(r, "ambient");
-    rl_tracer_desc desc = {
-        .max_depth = max_depth > 0 ? max_depth : -1,
-        .area_samples = (int)rl_renderer_opt_int(r, "area_samples"),
-        .ambient = ambient > 0.0f ? ambient : -1.0f,
-        .background = set.background,
-        .no_shadows = !rl_renderer_opt_bool(r, "shadows"),
-        .seed = 0,
-        .tree_shadow_any_hit = true,
-    };
     rl_tracer *tracer = NULL;
     if ((st = rl_tracer_create(s->accel.accel, &desc, &tracer)) != RL_OK)
         return st;

@@ -29,6 +29,7 @@
 #include "core/error.h"
 #include "render/accel_cache.h"
 #include "render/renderer.h"
+#include "render/tracer_options.h"
 #include "render/whitted.h"
 #include "rl/rl_accel.h"
 #include "rl/rl_trace.h"
@@ -37,20 +38,9 @@
 #define MAX_TREE_BYTES ((size_t)256 << 20)   /* ray_trees: ~776 bytes per pixel */
 #define BUILD_SHARE 0.1                      /* progress share of the accel build */
 
-static const char *const accel_choices[] = { "bvh", "grid", "embree", "brute", NULL };
-
 static const rl_option_info whitted_options[] = {
-    { "accel", RL_OPT_ENUM, "bvh", "acceleration structure (embree only in builds with Embree)",
-      0, 0, accel_choices },
-    { "max_depth", RL_OPT_INT, "5", "reflection/refraction recursion depth (0: local shading only)",
-      0, 64, NULL },
+    RL_TRACER_OPTION_ROWS,
     { "ss", RL_OPT_INT, "1", "n x n samples per pixel at the stratum centres", 1, 16, NULL },
-    { "area_samples", RL_OPT_INT, "4", "n x n jittered shadow feelers per quad light", 1, 32, NULL },
-    { "shadows", RL_OPT_BOOL, "true", "trace shadow feelers (false: every light is visible)", 0, 0, NULL },
-    { "ambient", RL_OPT_FLOAT, "0.05", "ambient light, multiplied by k_d", 0, 1, NULL },
-    { "background", RL_OPT_COLOR, "0,0,0", "radiance of rays that leave the scene: \"r,g,b\" or one grey value",
-      0, 0, NULL },
-    { "threads", RL_OPT_INT, "0", "OpenMP threads (0 = all)", 0, 1024, NULL },
     { "ray_trees", RL_OPT_BOOL, "false", "keep every pixel's centre-sample ray tree (for tests and Vertex Tracing)",
       0, 0, NULL },
 };
@@ -95,11 +85,7 @@ rl_status rl_whitted_pixel_tree(const rl_renderer *r, int x, int y, rl_ray_tree 
 
 static rl_status whitted_check(const char *key, const char *value)
 {
-    if (strcmp(key, "accel") == 0 && strcmp(value, "embree") == 0 &&
-        !rl_accel_kind_available(RL_ACCEL_EMBREE))
-        return rl_error(RL_ERR_INVALID_ARG,
-                        "whitted: accel=embree is not available in this build (configure with -DRL_EMBREE=ON)");
-    return RL_OK;
+    return rl_tracer_options_check("whitted", key, value);
 }
 
 /* The accel build reports the first BUILD_SHARE of the frame's progress. */
@@ -225,7 +211,8 @@ static rl_status whitted_render(rl_renderer *r, void *state, const rl_scene *sce
     if (!rl_scene_get_data(scene))
         return RL_ERR_NOT_COMMITTED;
     rl_accel_kind kind;
-    rl_status st = rl_accel_kind_parse(accel_choices[rl_renderer_opt_enum(r, "accel")], &kind);
+    rl_tracer_desc desc;
+    rl_status st = rl_tracer_options_read(r, &desc, &kind);
     if (st != RL_OK)
         return st;
     int threads = (int)rl_renderer_opt_int(r, "threads");
@@ -239,17 +226,6 @@ static rl_status whitted_render(rl_renderer *r, void *state, const rl_scene *sce
     if ((st = prepare_trees(s, rl_renderer_opt_bool(r, "ray_trees"), image->width, image->height)) != RL_OK)
         return st;
 
-    /* Option zeros mean "none" here but "default" in the tracer's desc. */
-    int max_depth = (int)rl_renderer_opt_int(r, "max_depth");
-    float ambient = (float)rl_renderer_opt_float(r, "ambient");
-    rl_tracer_desc desc = {
-        .max_depth = max_depth > 0 ? max_depth : -1,
-        .area_samples = (int)rl_renderer_opt_int(r, "area_samples"),
-        .ambient = ambient > 0.0f ? ambient : -1.0f,
-        .background = rl_renderer_opt_color(r, "background"),
-        .no_shadows = !rl_renderer_opt_bool(r, "shadows"),
-        .seed = 0,
-    };
     int tiles_x = (image->width + TILE - 1) / TILE, tiles_y = (image->height + TILE - 1) / TILE;
     int64_t num_tiles = (int64_t)tiles_x * tiles_y;
     rl_tracer *tracer = NULL;
