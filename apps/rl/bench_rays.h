@@ -90,6 +90,10 @@ typedef struct rl_bench_params {
     uint64_t seed;
 } rl_bench_params;
 
+/* uname, CPU model, nproc, threads and the load average: the machine a
+ * record was measured on (also used by `rl bench vt`); NULL when out of memory. */
+struct cJSON *rl_bench_machine_json(int threads);
+
 /* The whole run as one JSON object: machine, date, version, parameters,
  * per scene/accel/workload rays, hits, seconds, Mrays/s, ratio to Embree.
  * NULL when out of memory. */

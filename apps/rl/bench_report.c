@@ -62,7 +62,7 @@ static void load_average(char *out, size_t size)
     fclose(f);
 }
 
-static cJSON *machine_json(int threads)
+cJSON *rl_bench_machine_json(int threads)
 {
     cJSON *m = cJSON_CreateObject();
     if (!m)
@@ -211,7 +211,7 @@ cJSON *rl_bench_report_json(const rl_bench_params *params, const rl_bench_scene_
     else
         cJSON_AddNullToObject(root, "date");
     cJSON_AddBoolToObject(root, "embree", rl_accel_kind_available(RL_ACCEL_EMBREE));
-    cJSON_AddItemToObject(root, "machine", machine_json(params->threads));
+    cJSON_AddItemToObject(root, "machine", rl_bench_machine_json(params->threads));
     cJSON_AddItemToObject(root, "parameters", params_json(params));
     cJSON_AddNumberToObject(root, "hit_mismatches", hit_mismatches);
     cJSON *list = cJSON_AddArrayToObject(root, "scenes");

@@ -1,5 +1,6 @@
 /* cmd_bench.c: `rl bench rays`: ray throughput of every accelerator on the
  * same standard workloads (bench_rays.h), as a table and a JSON record.
+ * `rl bench vt` (Vertex Tracing vs Whitted) lives in bench_vt.c.
  *
  * The benchmark doubles as a smoke test: every accelerator traces exactly the
  * same rays, so their hit counts per workload must agree; a mismatch is
@@ -10,6 +11,7 @@
  * so the default list works without the Assimp test models. */
 #define _POSIX_C_SOURCE 200809L
 #include "bench_rays.h"
+#include "bench_vt.h"
 #include "cli.h"
 
 #include <cjson/cJSON.h>
@@ -24,6 +26,7 @@
 
 static const char bench_help[] =
     "usage: rl bench rays [options]\n"
+    "       rl bench vt [options]   Vertex Tracing vs Whitted (see rl bench vt --help)\n"
     "\n"
     "Times ray queries of each accelerator on three workloads generated once\n"
     "per scene and shared by all accelerators:\n"
@@ -177,13 +180,15 @@ static bool parse_count(const char *option, const char *text, long long max, lon
 static int parse_args(int argc, char **argv, bench_args *a)
 {
     if (argc < 2)
-        return rl_cli_fail(RL_CLI_USAGE, "bench: missing benchmark (try: rl bench rays)");
+        return rl_cli_fail(RL_CLI_USAGE,
+                           "bench: missing benchmark (try: rl bench rays, rl bench vt)");
     if (rl_cli_is_help(argv[1])) {
         fputs(bench_help, stdout);
         return -1;
     }
     if (strcmp(argv[1], "rays") != 0)
-        return rl_cli_fail(RL_CLI_USAGE, "bench: unknown benchmark '%s' (known: rays)", argv[1]);
+        return rl_cli_fail(RL_CLI_USAGE, "bench: unknown benchmark '%s' (known: rays, vt)",
+                           argv[1]);
     bool has_scenes = false, has_accels = false;
     for (int i = 2; i < argc; i++) {
         const char *v = NULL;
@@ -620,6 +625,8 @@ static int run(bench_args *a)
 
 int rl_cli_bench(int argc, char **argv)
 {
+    if (argc >= 2 && strcmp(argv[1], "vt") == 0)
+        return rl_bench_vt(argc, argv);
     bench_args a;
     memset(&a, 0, sizeof a);
     int rc = parse_args(argc, argv, &a);

@@ -1,0 +1,1435 @@
+/* bench_vt.c: `rl bench vt`: the measurements of Ullmann 2003, Ch. 5
+ * (Sec. 5.1-5.3) for the renderer "vt", each against the renderer "whitted"
+ * of the same run with the same tracer options (max_depth, area_samples,
+ * shadows, threads), as tables on stdout and one JSON record:
+ *   criteria    Fig. 5.5/5.6: vertices and splits per refinement criterion
+ *   resolution  Fig. 5.10-5.12: rays, samples and time vs resolution, preview
+ *   quality     min_edge sweep: the fastest setting with SSIM >= 0.95 and its
+ *               time relative to Whitted (our target: <= 0.1)
+ *   threads     Fig. 5.9/5.15: speed-up, rays per thread, time split
+ *   visibility  Fig. 5.13: the ID, Z and clipping tests switched off in turn
+ *   animation   Sec. 3.4.5: the `cluster` camera path with and without
+ *               temporal coherence, which must give identical images
+ * The static sections use the built-in scene `table` (Sec. 5.1) with its
+ * default camera.
+ *
+ * Quality: SSIM, RMSE and PSNR (rl_metrics.h) of the VT image against the
+ * Whitted image, over the VT-object pixels and over the whole frame. The VT
+ * pixels are those whose object ID in Whitted's ID layer is a VT object. The
+ * vt renderer does not export its object set, so the bench derives it by the
+ * rule its option objects=auto documents: an object is a VT object when the
+ * attribute vt of its node, or of the nearest ancestor that has one, says
+ * true; when no node has the attribute, the objects with a reflective or
+ * refractive material are (Sec. 3.5).
+ *
+ * Timing: per configuration one warm-up render (it builds and caches the
+ * accelerator and the VT meshes, which a frame of an interactive session
+ * does not pay), then the fastest of 2 renders (--quick: 1). Static frames
+ * run with coherence=false: a repeated frame would otherwise reuse its own
+ * shadow feelers. Temporal coherence is measured in the animation section,
+ * where each frame is rendered once, for the same reason. */
+#define _POSIX_C_SOURCE 200809L
+#include "bench_vt.h"
+
+#include "bench_rays.h"
+#include "cli.h"
+
+#include <cjson/cJSON.h>
+#include <math.h>
+#include <omp.h>
+#include <stdarg.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+
+#include "core/params.h"
+#include "rl/rl_metrics.h"
+#include "rl/rl_vt.h"
+
+static const char bench_vt_help[] =
+    "usage: rl bench vt [options]\n"
+    "\n"
+    "Measures Vertex Tracing (renderer vt, Ullmann 2003) as in the thesis, Ch. 5,\n"
+    "always against the Whitted ray tracer of the same run with the same tracer\n"
+    "options, and writes a table and JSON. Sections:\n"
+    "  criteria    table scene: vertices, splits, rays, time and SSIM/RMSE/PSNR\n"
+    "              per criterion rgb, hsv, tree, tree+rgb, tree+hsv (Fig. 5.5/5.6)\n"
+    "  resolution  512, 1024, 2048 square: rays and samples as % of Whitted's,\n"
+    "              time and preview time (Fig. 5.10-5.12)\n"
+    "  quality     min_edge 1..8: fastest setting with SSIM >= 0.95 on the VT pixels\n"
+    "  threads     1, 2, 4, ... threads: speed-up, rays per thread, load imbalance,\n"
+    "              time split (Fig. 5.9, 5.15)\n"
+    "  visibility  ID/Z/clip tests on and off (Fig. 5.13)\n"
+    "  animation   cluster scene camera path with and without temporal coherence\n"
+    "\n"
+    "options:\n"
+    "  --size WxH        static sections (not resolution); default 1024x1024\n"
+    "  --anim-size WxH   animation frames; default 640x480\n"
+    "  --frames N        animation frames along the path; default 60\n"
+    "  --threads N       threads of both renderers and the largest count of the\n"
+    "                    threads section; default all cores\n"
+    "  --only LIST       comma-separated subset of the sections above\n"
+    "  --out FILE.json   default bench/results/vt-YYYYMMDD-HHMMSS.json\n"
+    "  --quick           tiny run: 128x128, resolutions 64 and 128, threads 1 and 2,\n"
+    "                    3 frames, one timed render\n"
+    "\n"
+    "Timing: one warm-up render per configuration, then the fastest of 2.\n"
+    "SSIM etc. are measured over the VT-object pixels and over the whole frame.\n"
+    "\n"
+    "example:\n"
+    "  rl bench vt --only criteria,quality --size 512x512\n";
+
+enum { SEC_CRITERIA, SEC_RESOLUTION, SEC_QUALITY, SEC_THREADS, SEC_VISIBILITY, SEC_ANIMATION,
+       SEC_COUNT };
+static const char *const section_names[SEC_COUNT] = { "criteria", "resolution", "quality",
+                                                      "threads", "visibility", "animation" };
+
+/* Tracer options set on both renderers (their defaults, set explicitly so
+ * that a changed default cannot make the comparison unfair). */
+#define TRACE_MAX_DEPTH "5"
+#define TRACE_AREA_SAMPLES "4"
+#define TRACE_SHADOWS "true"
+
+#define MAX_FRAMES 100000
+#define SSIM_GOAL 0.95          /* "equal quality" for the min_edge sweep */
+#define TIME_RATIO_GOAL 0.1     /* VT time / Whitted time at equal quality */
+#define MAX_REFS 16
+
+/* Ullmann 2003, Fig. 5.5/5.6: generated vertices on the table scene. */
+static const struct {
+    const char *name;
+    double thesis_generated;
+} criteria[] = {
+    { "rgb", 23220 }, { "hsv", 23058 }, { "tree", 22470 }, { "tree+rgb", 28535 },
+    { "tree+hsv", 28037 },
+};
+
+typedef struct bvt_args {
+    int width, height, anim_width, anim_height;
+    long long frames, threads;     /* threads 0 = all */
+    bool has_size, has_anim_size, has_frames, quick;
+    unsigned sections;             /* bit per SEC_ */
+    const char *out;
+} bvt_args;
+
+/* A Whitted frame, the reference of every comparison at its size. */
+typedef struct ref_frame {
+    int width, height, threads;
+    rl_image *image;               /* colour and IDs */
+    uint8_t *mask;                 /* VT-object pixels */
+    uint64_t mask_pixels;
+    rl_render_stats stats;         /* of the fastest timed render */
+} ref_frame;
+
+typedef struct bvt {
+    const bvt_args *a;
+    int threads;                   /* both renderers, static sections */
+    int max_threads;               /* largest count of the threads section */
+    int runs;                      /* timed renders after the warm-up */
+    rl_scene *table, *cluster;
+    uint8_t *table_vt, *cluster_vt;        /* per object: a VT object */
+    rl_camera table_cam;
+    ref_frame refs[MAX_REFS];
+    int num_refs;
+    char reason[256];              /* why a section failed, when not the library's */
+} bvt;
+
+/* The fastest timed render of a configuration. */
+typedef struct timed_frame {
+    rl_render_stats stats;
+    rl_vt_stats vt;                /* vt renderers only */
+} timed_frame;
+
+typedef struct quality {
+    rl_image_metrics vt_px, full;  /* VT-object pixels, whole frame */
+} quality;
+
+/* ------------------------------------------------------------ output -- */
+
+/* "bench vt: criteria rgb 1024x1024: ..." on stderr, one per measurement. */
+static void note(const char *fmt, ...)
+#if defined(__GNUC__)
+    __attribute__((format(printf, 1, 2)))
+#endif
+    ;
+static void note(const char *fmt, ...)
+{
+    if (rl_log_get_level() < RL_LOG_INFO)
+        return;
+    va_list ap;
+    va_start(ap, fmt);
+    fputs("bench vt: ", stderr);
+    vfprintf(stderr, fmt, ap);
+    fputc('\n', stderr);
+    va_end(ap);
+}
+
+/* JSON has no NaN or infinity: unknown values are null. */
+static void add_num(cJSON *o, const char *key, double value)
+{
+    if (isfinite(value))
+        cJSON_AddNumberToObject(o, key, value);
+    else
+        cJSON_AddNullToObject(o, key);
+}
+
+static uint64_t rays_total(const rl_render_stats *s)
+{
+    uint64_t n = 0;
+    for (int k = 0; k < RL_RAY_TYPE_COUNT; k++)
+        n += s->rays[k];
+    return n;
+}
+
+static cJSON *rays_json(const rl_render_stats *s)
+{
+    cJSON *o = cJSON_CreateObject();
+    for (int k = 0; o && k < RL_RAY_TYPE_COUNT; k++)
+        cJSON_AddNumberToObject(o, rl_ray_type_name((rl_ray_type)k), (double)s->rays[k]);
+    if (o)
+        cJSON_AddNumberToObject(o, "total", (double)rays_total(s));
+    return o;
+}
+
+static cJSON *metrics_json(const rl_image_metrics *m)
+{
+    cJSON *o = cJSON_CreateObject();
+    if (!o)
+        return NULL;
+    add_num(o, "ssim", m->ssim);
+    add_num(o, "rmse", m->rmse);
+    add_num(o, "psnr", m->psnr);    /* null when the images are equal */
+    add_num(o, "max_abs", m->max_abs);
+    cJSON_AddNumberToObject(o, "pixels", (double)m->pixels);
+    return o;
+}
+
+static cJSON *quality_json(const quality *q)
+{
+    cJSON *o = cJSON_CreateObject();
+    if (!o)
+        return NULL;
+    cJSON_AddItemToObject(o, "vt_pixels", metrics_json(&q->vt_px));
+    cJSON_AddItemToObject(o, "full", metrics_json(&q->full));
+    return o;
+}
+
+static cJSON *vt_stats_json(const rl_vt_stats *s)
+{
+    cJSON *o = cJSON_CreateObject();
+    if (!o)
+        return NULL;
+    const struct {
+        const char *key;
+        uint64_t value;
+    } counts[] = {
+        { "vt_objects", s->vt_objects },
+        { "primary_vertices", s->primary_vertices },
+        { "primary_faces", s->primary_faces },
+        { "visible_primary_faces", s->visible_primary_faces },
+        { "vertices_sampled", s->vertices_sampled },
+        { "vertices_generated", s->vertices_generated },
+        { "splits_rgb", s->splits_rgb },
+        { "splits_hsv", s->splits_hsv },
+        { "splits_tree", s->splits_tree },
+        { "splits_forced", s->splits_forced },
+        { "edges_tested", s->edges_tested },
+        { "edges_culled_z", s->edges_culled_z },
+        { "edges_culled_viewport", s->edges_culled_viewport },
+        { "faces_drawn", s->faces_drawn },
+        { "feelers_reused", s->feelers_reused },
+        { "stages", s->stages },
+        { "threads", s->threads },
+    };
+    for (size_t i = 0; i < sizeof counts / sizeof counts[0]; i++)
+        cJSON_AddNumberToObject(o, counts[i].key, (double)counts[i].value);
+    add_num(o, "time_visibility_ms", s->time_visibility_ms);
+    add_num(o, "time_sampling_ms", s->time_sampling_ms);
+    add_num(o, "time_refine_ms", s->time_refine_ms);
+    add_num(o, "time_draw_ms", s->time_draw_ms);
+    add_num(o, "time_preview_ms", s->time_preview_ms);
+    return o;
+}
+
+/* Whitted's figures of a reference frame. */
+static cJSON *ref_json(const ref_frame *ref)
+{
+    cJSON *o = cJSON_CreateObject();
+    if (!o)
+        return NULL;
+    add_num(o, "time_ms", ref->stats.time_ms);
+    cJSON_AddItemToObject(o, "rays", rays_json(&ref->stats));
+    cJSON_AddNumberToObject(o, "vt_pixels", (double)ref->mask_pixels);
+    return o;
+}
+
+/* A failure the bench itself finds; returns st. */
+static rl_status bench_error(bvt *b, rl_status st, const char *fmt, ...)
+#if defined(__GNUC__)
+    __attribute__((format(printf, 3, 4)))
+#endif
+    ;
+static rl_status bench_error(bvt *b, rl_status st, const char *fmt, ...)
+{
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(b->reason, sizeof b->reason, fmt, ap);
+    va_end(ap);
+    return st;
+}
+
+static double ratio(double a, double b)
+{
+    return b != 0.0 ? a / b : NAN;
+}
+
+/* ------------------------------------------------------- VT objects -- */
+
+/* The attribute vt of node or its nearest ancestor that has one: 1 true,
+ * 0 false, -1 none (the rule of the vt renderer's objects=auto). */
+static int vt_attribute(const rl_scene *scene, uint32_t node)
+{
+    for (uint32_t n = node; n != RL_NONE; n = rl_scene_node_parent(scene, n)) {
+        const char *v = rl_scene_node_attr(scene, n, "vt");
+        if (v)
+            return strcmp(v, "true") == 0 || strcmp(v, "1") == 0 || strcmp(v, "yes") == 0;
+    }
+    return -1;
+}
+
+/* One byte per object: 1 for a VT object. NULL when out of memory. */
+static uint8_t *vt_objects(const rl_scene *scene)
+{
+    const rl_scene_data *d = rl_scene_get_data(scene);
+    uint8_t *vt = calloc(d->num_objects ? d->num_objects : 1, 1);
+    if (!vt)
+        return NULL;
+    bool any = false;
+    for (uint32_t o = 0; o < d->num_objects; o++) {
+        int a = vt_attribute(scene, d->objects[o].node);
+        any = any || a >= 0;
+        vt[o] = a > 0;
+    }
+    if (any)
+        return vt;
+    /* Sec. 3.5: without attributes, the specular objects are traced. */
+    for (uint32_t o = 0; o < d->num_objects; o++) {
+        const rl_object *obj = &d->objects[o];
+        for (uint32_t t = obj->first_triangle; t < obj->first_triangle + obj->num_triangles; t++) {
+            const rl_material *m = &d->materials[d->triangle_material[t]];
+            if (m->reflectivity > 0.0f || m->transmissivity > 0.0f) {
+                vt[o] = 1;
+                break;
+            }
+        }
+    }
+    return vt;
+}
+
+/* mask[i] = 1 where Whitted saw a VT object; returns the count. */
+static uint64_t fill_mask(const rl_image *ref, const uint8_t *object_vt, uint32_t num_objects,
+                          uint8_t *mask)
+{
+    uint64_t n = 0;
+    size_t pixels = (size_t)ref->width * (size_t)ref->height;
+    for (size_t i = 0; i < pixels; i++) {
+        uint32_t id = ref->object_id[i];
+        mask[i] = id != RL_ID_NONE && id < num_objects && object_vt[id];
+        n += mask[i];
+    }
+    return n;
+}
+
+/* --------------------------------------------------------- rendering -- */
+
+static rl_status make_renderer(const char *name, int threads, rl_renderer **out)
+{
+    rl_renderer *r = NULL;
+    rl_status st = rl_renderer_create(name, &r);
+    char t[16];
+    snprintf(t, sizeof t, "%d", threads);
+    const char *const keys[] = { "max_depth", "area_samples", "shadows", "threads" };
+    const char *const values[] = { TRACE_MAX_DEPTH, TRACE_AREA_SAMPLES, TRACE_SHADOWS, t };
+    for (size_t i = 0; st == RL_OK && i < sizeof keys / sizeof keys[0]; i++)
+        st = rl_renderer_set(r, keys[i], values[i]);
+    if (st == RL_OK && strcmp(name, "vt") == 0)
+        st = rl_renderer_set(r, "coherence", "false");
+    if (st != RL_OK) {
+        rl_renderer_release(r);
+        r = NULL;
+    }
+    *out = r;
+    return st;
+}
+
+static rl_status set_int(rl_renderer *r, const char *key, double value)
+{
+    char text[32];
+    snprintf(text, sizeof text, "%g", value);
+    return rl_renderer_set(r, key, text);
+}
+
+static rl_camera sized(const rl_camera *cam, int width, int height)
+{
+    rl_camera c = *cam;
+    c.width = width;
+    c.height = height;
+    return c;
+}
+
+/* One warm-up render, then the fastest of runs; img holds the last frame
+ * (all frames of a configuration are the same: nothing is random). */
+static rl_status render_timed(rl_renderer *r, const rl_scene *scene, const rl_camera *cam,
+                              rl_image *img, int runs, timed_frame *out)
+{
+    bool vt = strcmp(rl_renderer_name(r), "vt") == 0;
+    rl_render_stats stats;
+    rl_clear_error();
+    rl_status st = rl_renderer_render(r, scene, cam, img, &stats);
+    memset(out, 0, sizeof *out);
+    out->stats.time_ms = INFINITY;
+    for (int i = 0; st == RL_OK && i < runs; i++) {
+        st = rl_renderer_render(r, scene, cam, img, &stats);
+        if (st == RL_OK && stats.time_ms < out->stats.time_ms) {
+            out->stats = stats;
+            if (vt)
+                st = rl_vt_get_stats(r, &out->vt);
+        }
+    }
+    return st;
+}
+
+/* The Whitted frame at width x height with threads, rendered on first use. */
+static rl_status reference(bvt *b, int width, int height, int threads, ref_frame **out)
+{
+    for (int i = 0; i < b->num_refs; i++) {
+        ref_frame *f = &b->refs[i];
+        if (f->width == width && f->height == height && f->threads == threads) {
+            *out = f;
+            return RL_OK;
+        }
+    }
+    if (b->num_refs == MAX_REFS)      /* never with the fixed section lists */
+        return bench_error(b, RL_ERR_LIMIT, "more than %d reference frames", MAX_REFS);
+    ref_frame *f = &b->refs[b->num_refs];
+    memset(f, 0, sizeof *f);
+    rl_renderer *r = NULL;
+    rl_camera cam = sized(&b->table_cam, width, height);
+    timed_frame t;
+    rl_status st = make_renderer("whitted", threads, &r);
+    if (st == RL_OK)
+        st = rl_image_create(width, height, RL_LAYER_COLOR | RL_LAYER_ID, &f->image);
+    if (st == RL_OK && !(f->mask = malloc((size_t)width * (size_t)height)))
+        st = RL_ERR_OUT_OF_MEMORY;
+    if (st == RL_OK)
+        st = render_timed(r, b->table, &cam, f->image, b->runs, &t);
+    rl_renderer_release(r);
+    if (st != RL_OK) {
+        rl_image_release(f->image);
+        free(f->mask);
+        return st;
+    }
+    f->width = width;
+    f->height = height;
+    f->threads = threads;
+    f->stats = t.stats;
+    f->mask_pixels = fill_mask(f->image, b->table_vt, rl_scene_get_data(b->table)->num_objects,
+                               f->mask);
+    b->num_refs++;
+    note("whitted %dx%d, %d threads: %.1f ms, %llu rays, %llu VT pixels", width, height, threads,
+         t.stats.time_ms, (unsigned long long)rays_total(&t.stats),
+         (unsigned long long)f->mask_pixels);
+    *out = f;
+    return RL_OK;
+}
+
+static void nan_metrics(rl_image_metrics *m)
+{
+    *m = (rl_image_metrics){ .rmse = NAN, .psnr = NAN, .ssim = NAN, .max_abs = NAN };
+}
+
+/* img against the reference, over the VT pixels (when there are any) and
+ * over the whole frame. */
+static rl_status compare(const rl_image *img, const rl_image *ref, const uint8_t *mask,
+                         uint64_t mask_pixels, quality *q)
+{
+    nan_metrics(&q->vt_px);
+    rl_status st = rl_image_compare(img, ref, &(rl_metric_options){ 0 }, &q->full);
+    if (st == RL_OK && mask_pixels)
+        st = rl_image_compare(img, ref, &(rl_metric_options){ .mask = mask }, &q->vt_px);
+    return st;
+}
+
+/* ---------------------------------------------------------- criteria -- */
+
+/* Fig. 5.5/5.6: the same frame refined by each criterion. */
+static rl_status sec_criteria(bvt *b, cJSON *sec)
+{
+    int w = b->a->width, h = b->a->height;
+    ref_frame *ref = NULL;
+    rl_status st = reference(b, w, h, b->threads, &ref);
+    if (st != RL_OK)
+        return st;
+    cJSON_AddStringToObject(sec, "scene", "table");
+    char size[32];
+    snprintf(size, sizeof size, "%dx%d", w, h);
+    cJSON_AddStringToObject(sec, "size", size);
+    cJSON_AddItemToObject(sec, "whitted", ref_json(ref));
+    cJSON *rows = cJSON_AddArrayToObject(sec, "runs");
+
+    rl_renderer *r = NULL;
+    rl_image *img = NULL;
+    rl_camera cam = sized(&b->table_cam, w, h);
+    st = make_renderer("vt", b->threads, &r);
+    if (st == RL_OK)
+        st = rl_image_create(w, h, RL_LAYER_COLOR, &img);
+
+    printf("\ncriteria (Fig. 5.5/5.6): table %s, whitted %.1f ms, %llu rays, %llu VT pixels\n",
+           size, ref->stats.time_ms, (unsigned long long)rays_total(&ref->stats),
+           (unsigned long long)ref->mask_pixels);
+    printf("%-9s %9s %9s %9s %8s %8s %8s %7s %8s %10s %9s  %6s %7s %6s  %6s %7s\n", "criteria",
+           "sampled", "generated", "thesis", "rgb", "hsv", "tree", "forced", "faces", "rays",
+           "ms", "ssimVT", "rmseVT", "psnrVT", "ssim", "rmse");
+    for (size_t c = 0; st == RL_OK && c < sizeof criteria / sizeof criteria[0]; c++) {
+        timed_frame t;
+        quality q;
+        const rl_vt_vertex_info *verts;
+        const uint32_t *faces;
+        size_t num_verts = 0, num_faces = 0;
+        rl_clear_error();
+        st = rl_renderer_set(r, "criteria", criteria[c].name);
+        if (st == RL_OK)
+            st = render_timed(r, b->table, &cam, img, b->runs, &t);
+        if (st == RL_OK)
+            st = rl_vt_get_mesh(r, &verts, &num_verts, &faces, &num_faces);
+        if (st == RL_OK)
+            st = compare(img, ref->image, ref->mask, ref->mask_pixels, &q);
+        if (st != RL_OK)
+            break;
+        cJSON *row = cJSON_CreateObject();
+        cJSON_AddItemToArray(rows, row);
+        cJSON_AddStringToObject(row, "criteria", criteria[c].name);
+        cJSON_AddNumberToObject(row, "vertices_sampled", (double)t.vt.vertices_sampled);
+        cJSON_AddNumberToObject(row, "vertices_generated", (double)t.vt.vertices_generated);
+        cJSON_AddNumberToObject(row, "thesis_vertices_generated", criteria[c].thesis_generated);
+        cJSON *splits = cJSON_AddObjectToObject(row, "splits");
+        cJSON_AddNumberToObject(splits, "rgb", (double)t.vt.splits_rgb);
+        cJSON_AddNumberToObject(splits, "hsv", (double)t.vt.splits_hsv);
+        cJSON_AddNumberToObject(splits, "tree", (double)t.vt.splits_tree);
+        cJSON_AddNumberToObject(splits, "forced", (double)t.vt.splits_forced);
+        cJSON_AddNumberToObject(row, "faces", (double)num_faces);
+        cJSON_AddNumberToObject(row, "mesh_vertices", (double)num_verts);
+        cJSON_AddItemToObject(row, "rays", rays_json(&t.stats));
+        add_num(row, "time_ms", t.stats.time_ms);
+        add_num(row, "time_ratio_to_whitted", ratio(t.stats.time_ms, ref->stats.time_ms));
+        cJSON_AddItemToObject(row, "quality", quality_json(&q));
+        cJSON_AddItemToObject(row, "vt_stats", vt_stats_json(&t.vt));
+        printf("%-9s %9llu %9llu %9.0f %8llu %8llu %8llu %7llu %8zu %10llu %9.1f  %6.3f %7.4f "
+               "%6.2f  %6.3f %7.4f\n",
+               criteria[c].name, (unsigned long long)t.vt.vertices_sampled,
+               (unsigned long long)t.vt.vertices_generated, criteria[c].thesis_generated,
+               (unsigned long long)t.vt.splits_rgb, (unsigned long long)t.vt.splits_hsv,
+               (unsigned long long)t.vt.splits_tree, (unsigned long long)t.vt.splits_forced,
+               num_faces, (unsigned long long)rays_total(&t.stats), t.stats.time_ms, q.vt_px.ssim,
+               q.vt_px.rmse, q.vt_px.psnr, q.full.ssim, q.full.rmse);
+        fflush(stdout);
+        note("criteria %s %s: %.1f ms, %llu vertices generated, SSIM %.3f (VT pixels)",
+             criteria[c].name, size, t.stats.time_ms, (unsigned long long)t.vt.vertices_generated,
+             q.vt_px.ssim);
+    }
+    rl_image_release(img);
+    rl_renderer_release(r);
+    return st;
+}
+
+/* -------------------------------------------------------- resolution -- */
+
+static bool count_update(void *user, const rl_image *image, uint32_t stage, bool final)
+{
+    (void)image;
+    (void)stage;
+    (void)final;
+    ++*(int *)user;
+    return true;
+}
+
+/* Fig. 5.10-5.12: default criteria at growing square resolutions. */
+static rl_status sec_resolution(bvt *b, cJSON *sec)
+{
+    static const int full_sizes[] = { 512, 1024, 2048 }, quick_sizes[] = { 64, 128 };
+    const int *sizes = b->a->quick ? quick_sizes : full_sizes;
+    int num_sizes = b->a->quick ? 2 : 3;
+    cJSON_AddStringToObject(sec, "scene", "table");
+    cJSON *rows = cJSON_AddArrayToObject(sec, "runs");
+    printf("\nresolution (Fig. 5.10-5.12): table, default criteria; %% of Whitted's rays and "
+           "of the pixels\n");
+    printf("%-9s %10s %10s %6s %9s %6s %6s  %6s %7s %9s %9s %6s %10s\n", "size", "VT rays",
+           "Whitted", "rays%", "samples", "smpl%", "growth", "ssimVT", "rmseVT", "VT ms",
+           "Whitted ms", "VT/W", "preview ms");
+    rl_status st = RL_OK;
+    double prev_samples = NAN;
+    bool within_5 = true, sublinear = true;
+    for (int i = 0; st == RL_OK && i < num_sizes; i++) {
+        int n = sizes[i];
+        ref_frame *ref = NULL;
+        rl_renderer *r = NULL;
+        rl_image *img = NULL;
+        rl_camera cam = sized(&b->table_cam, n, n);
+        timed_frame t;
+        rl_vt_stats preview;
+        quality q;
+        int updates = 0;
+        st = reference(b, n, n, b->threads, &ref);
+        if (st == RL_OK)
+            st = make_renderer("vt", b->threads, &r);
+        if (st == RL_OK)
+            st = rl_image_create(n, n, RL_LAYER_COLOR, &img);
+        if (st == RL_OK)
+            st = render_timed(r, b->table, &cam, img, b->runs, &t);
+        if (st == RL_OK)
+            st = compare(img, ref->image, ref->mask, ref->mask_pixels, &q);
+        /* One more frame with an update callback, so that the preview of
+         * Sec. 3.5.1 (the primary vertices only) is really drawn; its time
+         * is not part of the timed frames. */
+        if (st == RL_OK)
+            st = rl_vt_set_update_callback(r, count_update, &updates);
+        if (st == RL_OK)
+            st = rl_renderer_render(r, b->table, &cam, img, NULL);
+        if (st == RL_OK)
+            st = rl_vt_get_stats(r, &preview);
+        rl_image_release(img);
+        rl_renderer_release(r);
+        if (st != RL_OK)
+            break;
+        double pixels = (double)n * n;
+        double vt_rays = (double)rays_total(&t.stats), wh_rays = (double)rays_total(&ref->stats);
+        double samples = (double)t.vt.vertices_sampled;
+        double growth = ratio(samples, prev_samples);
+        double pixel_growth = i ? pixels / ((double)sizes[i - 1] * sizes[i - 1]) : NAN;
+        within_5 = within_5 && samples <= 0.05 * pixels;
+        if (i)
+            sublinear = sublinear && growth < pixel_growth;
+        prev_samples = samples;
+        cJSON *row = cJSON_CreateObject();
+        cJSON_AddItemToArray(rows, row);
+        char size[32];
+        snprintf(size, sizeof size, "%dx%d", n, n);
+        cJSON_AddStringToObject(row, "size", size);
+        cJSON_AddNumberToObject(row, "pixels", pixels);
+        cJSON_AddItemToObject(row, "vt_rays", rays_json(&t.stats));
+        cJSON_AddItemToObject(row, "whitted_rays", rays_json(&ref->stats));
+        add_num(row, "rays_percent_of_whitted", 100.0 * ratio(vt_rays, wh_rays));
+        cJSON_AddNumberToObject(row, "vertices_sampled", samples);
+        add_num(row, "samples_percent_of_pixels", 100.0 * samples / pixels);
+        add_num(row, "samples_growth", growth);
+        add_num(row, "pixel_growth", pixel_growth);
+        cJSON_AddItemToObject(row, "quality", quality_json(&q));
+        add_num(row, "vt_time_ms", t.stats.time_ms);
+        add_num(row, "whitted_time_ms", ref->stats.time_ms);
+        add_num(row, "time_ratio_to_whitted", ratio(t.stats.time_ms, ref->stats.time_ms));
+        add_num(row, "preview_ms", preview.time_preview_ms);
+        cJSON_AddNumberToObject(row, "preview_updates", updates);
+        cJSON_AddItemToObject(row, "vt_stats", vt_stats_json(&t.vt));
+        printf("%-9s %10.0f %10.0f %6.2f %9.0f %6.2f %6.2f  %6.3f %7.4f %9.1f %9.1f %6.3f %10.1f\n",
+               size, vt_rays, wh_rays, 100.0 * ratio(vt_rays, wh_rays), samples,
+               100.0 * samples / pixels, growth, q.vt_px.ssim, q.vt_px.rmse, t.stats.time_ms,
+               ref->stats.time_ms, ratio(t.stats.time_ms, ref->stats.time_ms),
+               preview.time_preview_ms);
+        fflush(stdout);
+        note("resolution %s: %.1f ms (whitted %.1f ms), %.0f samples, preview %.1f ms", size,
+             t.stats.time_ms, ref->stats.time_ms, samples, preview.time_preview_ms);
+    }
+    if (st == RL_OK) {
+        cJSON_AddBoolToObject(sec, "samples_within_5_percent", within_5);
+        cJSON_AddBoolToObject(sec, "samples_sublinear", sublinear);
+        printf("samples <= 5%% of the pixels (thesis): %s; sub-linear growth: %s\n",
+               within_5 ? "yes" : "no", sublinear ? "yes" : "no");
+    }
+    return st;
+}
+
+/* ----------------------------------------------------------- quality -- */
+
+/* The min_edge sweep: how fast is VT at Whitted's quality? */
+static rl_status sec_quality(bvt *b, cJSON *sec)
+{
+    static const double min_edges[] = { 1, 2, 3, 4, 6, 8 };
+    int w = b->a->width, h = b->a->height;
+    ref_frame *ref = NULL;
+    rl_status st = reference(b, w, h, b->threads, &ref);
+    if (st != RL_OK)
+        return st;
+    char size[32];
+    snprintf(size, sizeof size, "%dx%d", w, h);
+    cJSON_AddStringToObject(sec, "scene", "table");
+    cJSON_AddStringToObject(sec, "size", size);
+    cJSON_AddItemToObject(sec, "whitted", ref_json(ref));
+    add_num(sec, "ssim_goal", SSIM_GOAL);
+    add_num(sec, "time_ratio_goal", TIME_RATIO_GOAL);
+    cJSON *rows = cJSON_AddArrayToObject(sec, "runs");
+
+    rl_renderer *r = NULL;
+    rl_image *img = NULL;
+    rl_camera cam = sized(&b->table_cam, w, h);
+    st = make_renderer("vt", b->threads, &r);
+    if (st == RL_OK)
+        st = rl_image_create(w, h, RL_LAYER_COLOR, &img);
+    printf("\nquality: min_edge sweep, table %s, default criteria, whitted %.1f ms\n", size,
+           ref->stats.time_ms);
+    printf("%-8s %9s %6s %9s %10s  %6s %7s  %6s\n", "min_edge", "VT ms", "VT/W", "sampled", "rays",
+           "ssimVT", "rmseVT", "ssim");
+    int best = -1;
+    double best_ms = INFINITY, best_ssim = NAN;
+    for (size_t i = 0; st == RL_OK && i < sizeof min_edges / sizeof min_edges[0]; i++) {
+        timed_frame t;
+        quality q;
+        rl_clear_error();
+        st = set_int(r, "min_edge", min_edges[i]);
+        if (st == RL_OK)
+            st = render_timed(r, b->table, &cam, img, b->runs, &t);
+        if (st == RL_OK)
+            st = compare(img, ref->image, ref->mask, ref->mask_pixels, &q);
+        if (st != RL_OK)
+            break;
+        if (q.vt_px.ssim >= SSIM_GOAL && t.stats.time_ms < best_ms) {
+            best = (int)i;
+            best_ms = t.stats.time_ms;
+            best_ssim = q.vt_px.ssim;
+        }
+        cJSON *row = cJSON_CreateObject();
+        cJSON_AddItemToArray(rows, row);
+        cJSON_AddNumberToObject(row, "min_edge", min_edges[i]);
+        add_num(row, "time_ms", t.stats.time_ms);
+        add_num(row, "time_ratio_to_whitted", ratio(t.stats.time_ms, ref->stats.time_ms));
+        cJSON_AddNumberToObject(row, "vertices_sampled", (double)t.vt.vertices_sampled);
+        cJSON_AddItemToObject(row, "rays", rays_json(&t.stats));
+        cJSON_AddItemToObject(row, "quality", quality_json(&q));
+        printf("%-8g %9.1f %6.3f %9llu %10llu  %6.3f %7.4f  %6.3f\n", min_edges[i],
+               t.stats.time_ms, ratio(t.stats.time_ms, ref->stats.time_ms),
+               (unsigned long long)t.vt.vertices_sampled, (unsigned long long)rays_total(&t.stats),
+               q.vt_px.ssim, q.vt_px.rmse, q.full.ssim);
+        fflush(stdout);
+        note("quality min_edge=%g %s: %.1f ms, SSIM %.3f (VT pixels)", min_edges[i], size,
+             t.stats.time_ms, q.vt_px.ssim);
+    }
+    rl_image_release(img);
+    rl_renderer_release(r);
+    if (st != RL_OK)
+        return st;
+    double best_ratio = best >= 0 ? ratio(best_ms, ref->stats.time_ms) : NAN;
+    bool met = best >= 0 && best_ratio <= TIME_RATIO_GOAL;
+    if (best >= 0) {
+        cJSON *o = cJSON_AddObjectToObject(sec, "best");
+        cJSON_AddNumberToObject(o, "min_edge", min_edges[best]);
+        add_num(o, "time_ms", best_ms);
+        add_num(o, "ssim_vt_pixels", best_ssim);
+        add_num(o, "time_ratio_to_whitted", best_ratio);
+        printf("fastest with SSIM >= %.2f: min_edge=%g, %.1f ms = %.3f x Whitted: "
+               "target <= %.1f %s\n", SSIM_GOAL, min_edges[best], best_ms, best_ratio,
+               TIME_RATIO_GOAL, met ? "met" : "not met");
+    } else {
+        cJSON_AddNullToObject(sec, "best");
+        printf("no setting reached SSIM >= %.2f on the VT pixels: target not met\n", SSIM_GOAL);
+    }
+    cJSON_AddBoolToObject(sec, "met", met);
+    return RL_OK;
+}
+
+/* ----------------------------------------------------------- threads -- */
+
+/* Fig. 5.15 (and the time split of Fig. 5.9): 1, 2, 4, ... threads. */
+static rl_status sec_threads(bvt *b, cJSON *sec)
+{
+    int counts[16], num = 0;
+    for (int n = 1; n < b->max_threads && num < 15; n *= 2)
+        counts[num++] = n;
+    counts[num++] = b->max_threads;
+    int w = b->a->width, h = b->a->height;
+    char size[32];
+    snprintf(size, sizeof size, "%dx%d", w, h);
+    cJSON_AddStringToObject(sec, "scene", "table");
+    cJSON_AddStringToObject(sec, "size", size);
+    cJSON *rows = cJSON_AddArrayToObject(sec, "runs");
+    printf("\nthreads (Fig. 5.9, 5.15): table %s; VT time split in ms; imbalance = (max - min) / "
+           "mean of the rays per thread\n", size);
+    printf("%-7s %9s %7s %10s %7s %9s  %8s %8s %8s %8s  %s\n", "threads", "VT ms", "speedup",
+           "Whitted ms", "speedup", "imbalance", "visib.", "sampling", "refine", "draw",
+           "rays per thread");
+    rl_status st = RL_OK;
+    double vt_one = NAN, wh_one = NAN;
+    for (int i = 0; st == RL_OK && i < num; i++) {
+        int n = counts[i];
+        ref_frame *ref = NULL;
+        rl_renderer *r = NULL;
+        rl_image *img = NULL;
+        rl_camera cam = sized(&b->table_cam, w, h);
+        timed_frame t;
+        st = reference(b, w, h, n, &ref);
+        if (st == RL_OK)
+            st = make_renderer("vt", n, &r);
+        if (st == RL_OK)
+            st = rl_image_create(w, h, RL_LAYER_COLOR, &img);
+        if (st == RL_OK)
+            st = render_timed(r, b->table, &cam, img, b->runs, &t);
+        rl_image_release(img);
+        rl_renderer_release(r);
+        if (st != RL_OK)
+            break;
+        if (i == 0) {
+            vt_one = t.stats.time_ms;
+            wh_one = ref->stats.time_ms;
+        }
+        uint32_t used = t.vt.threads < RL_VT_MAX_THREADS ? t.vt.threads : RL_VT_MAX_THREADS;
+        double lo = INFINITY, hi = 0.0, sum = 0.0;
+        for (uint32_t k = 0; k < used; k++) {
+            double x = (double)t.vt.thread_rays[k];
+            lo = x < lo ? x : lo;
+            hi = x > hi ? x : hi;
+            sum += x;
+        }
+        double imbalance = used && sum > 0.0 ? (hi - lo) / (sum / used) : NAN;
+        cJSON *row = cJSON_CreateObject();
+        cJSON_AddItemToArray(rows, row);
+        cJSON_AddNumberToObject(row, "threads", n);
+        add_num(row, "vt_time_ms", t.stats.time_ms);
+        add_num(row, "vt_speedup", ratio(vt_one, t.stats.time_ms));
+        add_num(row, "whitted_time_ms", ref->stats.time_ms);
+        add_num(row, "whitted_speedup", ratio(wh_one, ref->stats.time_ms));
+        add_num(row, "time_ratio_to_whitted", ratio(t.stats.time_ms, ref->stats.time_ms));
+        cJSON *rays = cJSON_AddArrayToObject(row, "thread_rays");
+        cJSON *busy = cJSON_AddArrayToObject(row, "thread_busy_ms");
+        for (uint32_t k = 0; k < used; k++) {
+            cJSON_AddItemToArray(rays, cJSON_CreateNumber((double)t.vt.thread_rays[k]));
+            cJSON_AddItemToArray(busy, cJSON_CreateNumber(t.vt.thread_busy_ms[k]));
+        }
+        add_num(row, "load_imbalance", imbalance);
+        cJSON *split = cJSON_AddObjectToObject(row, "time_split_ms");
+        add_num(split, "visibility", t.vt.time_visibility_ms);
+        add_num(split, "sampling", t.vt.time_sampling_ms);
+        add_num(split, "refine", t.vt.time_refine_ms);
+        add_num(split, "draw", t.vt.time_draw_ms);
+        add_num(split, "other", t.stats.time_ms - t.vt.time_visibility_ms - t.vt.time_sampling_ms
+                                    - t.vt.time_refine_ms - t.vt.time_draw_ms);
+        cJSON_AddItemToObject(row, "vt_rays", rays_json(&t.stats));
+        printf("%-7d %9.1f %7.2f %10.1f %7.2f %9.3f  %8.1f %8.1f %8.1f %8.1f  ", n, t.stats.time_ms,
+               ratio(vt_one, t.stats.time_ms), ref->stats.time_ms,
+               ratio(wh_one, ref->stats.time_ms), imbalance, t.vt.time_visibility_ms,
+               t.vt.time_sampling_ms, t.vt.time_refine_ms, t.vt.time_draw_ms);
+        for (uint32_t k = 0; k < used && k < 8; k++)
+            printf("%s%llu", k ? " " : "", (unsigned long long)t.vt.thread_rays[k]);
+        printf("%s\n", used > 8 ? " ..." : "");
+        fflush(stdout);
+        note("threads %d %s: VT %.1f ms, whitted %.1f ms, imbalance %.3f", n, size,
+             t.stats.time_ms, ref->stats.time_ms, imbalance);
+    }
+    return st;
+}
+
+/* -------------------------------------------------------- visibility -- */
+
+/* Fig. 5.13: the visibility tests switched off one after the other. */
+static rl_status sec_visibility(bvt *b, cJSON *sec)
+{
+    static const struct {
+        const char *name, *id, *z, *clip;
+    } configs[] = {
+        { "ID+Z+C", "true", "true", "true" },
+        { "ID+Z", "true", "true", "false" },
+        { "ID", "true", "false", "false" },
+        { "none", "false", "false", "false" },
+    };
+    int w = b->a->width, h = b->a->height;
+    ref_frame *ref = NULL;
+    rl_status st = reference(b, w, h, b->threads, &ref);
+    if (st != RL_OK)
+        return st;
+    char size[32];
+    snprintf(size, sizeof size, "%dx%d", w, h);
+    cJSON_AddStringToObject(sec, "scene", "table");
+    cJSON_AddStringToObject(sec, "size", size);
+    cJSON *rows = cJSON_AddArrayToObject(sec, "runs");
+    rl_renderer *r = NULL;
+    rl_image *img = NULL;
+    rl_camera cam = sized(&b->table_cam, w, h);
+    st = make_renderer("vt", b->threads, &r);
+    if (st == RL_OK)
+        st = rl_image_create(w, h, RL_LAYER_COLOR, &img);
+    printf("\nvisibility tests (Fig. 5.13): table %s, ID buffer, Z buffer, viewport clipping\n",
+           size);
+    printf("%-7s %9s %9s %9s %9s %9s %10s  %6s\n", "tests", "VT ms", "sampled", "vis.faces",
+           "culled Z", "culled C", "rays", "ssimVT");
+    for (size_t i = 0; st == RL_OK && i < sizeof configs / sizeof configs[0]; i++) {
+        timed_frame t;
+        quality q;
+        rl_clear_error();
+        st = rl_renderer_set(r, "id_test", configs[i].id);
+        if (st == RL_OK)
+            st = rl_renderer_set(r, "z_test", configs[i].z);
+        if (st == RL_OK)
+            st = rl_renderer_set(r, "clip_test", configs[i].clip);
+        if (st == RL_OK)
+            st = render_timed(r, b->table, &cam, img, b->runs, &t);
+        if (st == RL_OK)
+            st = compare(img, ref->image, ref->mask, ref->mask_pixels, &q);
+        if (st != RL_OK)
+            break;
+        cJSON *row = cJSON_CreateObject();
+        cJSON_AddItemToArray(rows, row);
+        cJSON_AddStringToObject(row, "tests", configs[i].name);
+        cJSON_AddBoolToObject(row, "id_test", configs[i].id[0] == 't');
+        cJSON_AddBoolToObject(row, "z_test", configs[i].z[0] == 't');
+        cJSON_AddBoolToObject(row, "clip_test", configs[i].clip[0] == 't');
+        add_num(row, "time_ms", t.stats.time_ms);
+        cJSON_AddNumberToObject(row, "vertices_sampled", (double)t.vt.vertices_sampled);
+        cJSON_AddNumberToObject(row, "visible_primary_faces", (double)t.vt.visible_primary_faces);
+        cJSON_AddNumberToObject(row, "edges_culled_z", (double)t.vt.edges_culled_z);
+        cJSON_AddNumberToObject(row, "edges_culled_viewport", (double)t.vt.edges_culled_viewport);
+        cJSON_AddItemToObject(row, "rays", rays_json(&t.stats));
+        cJSON_AddItemToObject(row, "quality", quality_json(&q));
+        printf("%-7s %9.1f %9llu %9llu %9llu %9llu %10llu  %6.3f\n", configs[i].name,
+               t.stats.time_ms, (unsigned long long)t.vt.vertices_sampled,
+               (unsigned long long)t.vt.visible_primary_faces,
+               (unsigned long long)t.vt.edges_culled_z,
+               (unsigned long long)t.vt.edges_culled_viewport,
+               (unsigned long long)rays_total(&t.stats), q.vt_px.ssim);
+        fflush(stdout);
+        note("visibility %s %s: %.1f ms, %llu vertices sampled", configs[i].name, size,
+             t.stats.time_ms, (unsigned long long)t.vt.vertices_sampled);
+    }
+    rl_image_release(img);
+    rl_renderer_release(r);
+    return st;
+}
+
+/* --------------------------------------------------------- animation -- */
+
+typedef struct series {
+    double sum, lo, hi;
+    int n;
+} series;
+
+static void series_add(series *s, double x)
+{
+    if (!isfinite(x))
+        return;
+    s->lo = s->n && s->lo < x ? s->lo : x;
+    s->hi = s->n && s->hi > x ? s->hi : x;
+    s->sum += x;
+    s->n++;
+}
+
+static cJSON *series_json(const series *s)
+{
+    cJSON *o = cJSON_CreateObject();
+    if (!o)
+        return NULL;
+    add_num(o, "mean", s->n ? s->sum / s->n : NAN);
+    add_num(o, "min", s->n ? s->lo : NAN);
+    add_num(o, "max", s->n ? s->hi : NAN);
+    return o;
+}
+
+static double series_mean(const series *s)
+{
+    return s->n ? s->sum / s->n : NAN;
+}
+
+/* The renderers of the animation: Whitted, VT with and without coherence. */
+typedef struct anim {
+    rl_renderer *whitted, *coherent, *plain;
+    rl_image *ref, *a, *b;
+    uint8_t *mask;
+} anim;
+
+static void anim_free(anim *x)
+{
+    rl_renderer_release(x->whitted);
+    rl_renderer_release(x->coherent);
+    rl_renderer_release(x->plain);
+    rl_image_release(x->ref);
+    rl_image_release(x->a);
+    rl_image_release(x->b);
+    free(x->mask);
+}
+
+
+/* What one frame of the path gave. */
+typedef struct anim_result {
+    rl_render_stats whitted, coherent, plain;
+    rl_vt_stats vt;                /* of the coherent renderer */
+    quality q;
+    uint64_t vt_pixels;
+    bool identical;
+} anim_result;
+
+/* One frame of the path for the three renderers. */
+static rl_status anim_frame(bvt *b, anim *x, const rl_camera *cam, anim_result *res)
+{
+    const rl_scene_data *d = rl_scene_get_data(b->cluster);
+    rl_clear_error();
+    rl_status st = rl_renderer_render(x->whitted, b->cluster, cam, x->ref, &res->whitted);
+    if (st == RL_OK)
+        st = rl_renderer_render(x->coherent, b->cluster, cam, x->a, &res->coherent);
+    if (st == RL_OK)
+        st = rl_vt_get_stats(x->coherent, &res->vt);
+    if (st == RL_OK)
+        st = rl_renderer_render(x->plain, b->cluster, cam, x->b, &res->plain);
+    if (st == RL_OK) {
+        res->vt_pixels = fill_mask(x->ref, b->cluster_vt, d->num_objects, x->mask);
+        st = compare(x->a, x->ref, x->mask, res->vt_pixels, &res->q);
+    }
+    if (st != RL_OK)
+        return st;
+    /* Sec. 3.4.5: replaying the feelers must not change a single bit. */
+    size_t bytes = (size_t)x->a->width * (size_t)x->a->height * sizeof *x->a->color;
+    res->identical = memcmp(x->a->color, x->b->color, bytes) == 0;
+    return RL_OK;
+}
+
+static cJSON *anim_json(uint32_t frame, const anim_result *r)
+{
+    cJSON *row = cJSON_CreateObject();
+    if (!row)
+        return NULL;
+    cJSON_AddNumberToObject(row, "frame", frame);
+    add_num(row, "vt_coherent_ms", r->coherent.time_ms);
+    add_num(row, "vt_plain_ms", r->plain.time_ms);
+    add_num(row, "whitted_ms", r->whitted.time_ms);
+    add_num(row, "ssim_vt_pixels", r->q.vt_px.ssim);
+    add_num(row, "rmse_vt_pixels", r->q.vt_px.rmse);
+    add_num(row, "ssim_full", r->q.full.ssim);
+    cJSON_AddNumberToObject(row, "vt_pixels", (double)r->vt_pixels);
+    cJSON_AddNumberToObject(row, "feelers_reused", (double)r->vt.feelers_reused);
+    cJSON_AddNumberToObject(row, "vertices_sampled", (double)r->vt.vertices_sampled);
+    cJSON_AddNumberToObject(row, "vt_rays", (double)rays_total(&r->coherent));
+    cJSON_AddNumberToObject(row, "vt_plain_rays", (double)rays_total(&r->plain));
+    cJSON_AddNumberToObject(row, "whitted_rays", (double)rays_total(&r->whitted));
+    cJSON_AddBoolToObject(row, "identical", r->identical);
+    return row;
+}
+
+/* Sec. 3.4.5 on the cluster's camera path: each VT renderer renders the
+ * whole path in order (two renderers: one keeps the feelers between frames,
+ * the other does not), interleaved frame by frame with Whitted, so that
+ * every frame has its reference and load changes hit all three alike. */
+static rl_status sec_animation(bvt *b, cJSON *sec)
+{
+    const rl_camera_path *path = rl_scene_get_data(b->cluster)->camera_path;
+    if (!path)
+        return bench_error(b, RL_ERR_NOT_FOUND, "scene cluster has no camera path");
+    int w = b->a->anim_width, h = b->a->anim_height;
+    uint32_t n = (uint32_t)b->a->frames;
+    char size[32];
+    snprintf(size, sizeof size, "%dx%d", w, h);
+    cJSON_AddStringToObject(sec, "scene", "cluster");
+    cJSON_AddStringToObject(sec, "size", size);
+    cJSON_AddNumberToObject(sec, "frames", n);
+    add_num(sec, "path_duration_s", rl_camera_path_duration(path));
+    cJSON *rows = cJSON_AddArrayToObject(sec, "per_frame");
+
+    anim x;
+    memset(&x, 0, sizeof x);
+    rl_camera first = rl_camera_path_frame(path, 0, n);
+    first = sized(&first, w, h);
+    rl_clear_error();
+    rl_status st = make_renderer("whitted", b->threads, &x.whitted);
+    if (st == RL_OK)
+        st = make_renderer("vt", b->threads, &x.coherent);
+    if (st == RL_OK)
+        st = make_renderer("vt", b->threads, &x.plain);
+    if (st == RL_OK)
+        st = rl_image_create(w, h, RL_LAYER_COLOR | RL_LAYER_ID, &x.ref);
+    if (st == RL_OK)
+        st = rl_image_create(w, h, RL_LAYER_COLOR, &x.a);
+    if (st == RL_OK)
+        st = rl_image_create(w, h, RL_LAYER_COLOR, &x.b);
+    if (st == RL_OK && !(x.mask = malloc((size_t)w * (size_t)h)))
+        st = RL_ERR_OUT_OF_MEMORY;
+    /* Warm-up (accelerators, meshes), still without coherence, so that the
+     * first frame of the path finds no feelers of its own. */
+    if (st == RL_OK)
+        st = rl_renderer_render(x.whitted, b->cluster, &first, x.ref, NULL);
+    if (st == RL_OK)
+        st = rl_renderer_render(x.coherent, b->cluster, &first, x.a, NULL);
+    if (st == RL_OK)
+        st = rl_renderer_render(x.plain, b->cluster, &first, x.b, NULL);
+    if (st == RL_OK)
+        st = rl_renderer_set(x.coherent, "coherence", "true");
+
+    series acc[4];      /* coherent ms, plain ms, Whitted ms, SSIM */
+    memset(acc, 0, sizeof acc);
+    uint64_t reused = 0;
+    bool identical = true;
+    for (uint32_t i = 0; st == RL_OK && i < n; i++) {
+        rl_camera cam = rl_camera_path_frame(path, i, n);
+        cam = sized(&cam, w, h);
+        anim_result res;
+        st = anim_frame(b, &x, &cam, &res);
+        if (st != RL_OK)
+            break;
+        cJSON_AddItemToArray(rows, anim_json(i, &res));
+        identical = identical && res.identical;
+        reused += res.vt.feelers_reused;
+        series_add(&acc[0], res.coherent.time_ms);
+        series_add(&acc[1], res.plain.time_ms);
+        series_add(&acc[2], res.whitted.time_ms);
+        series_add(&acc[3], res.q.vt_px.ssim);
+        note("animation frame %u/%u %s: VT %.1f ms coherent, %.1f ms plain, whitted %.1f ms, "
+             "SSIM %.3f, %llu feelers reused, %s",
+             i + 1, n, size, res.coherent.time_ms, res.plain.time_ms, res.whitted.time_ms,
+             res.q.vt_px.ssim, (unsigned long long)res.vt.feelers_reused,
+             res.identical ? "identical" : "DIFFERENT");
+    }
+    anim_free(&x);
+    if (st != RL_OK)
+        return st;
+    cJSON *sum = cJSON_AddObjectToObject(sec, "summary");
+    cJSON_AddItemToObject(sum, "vt_coherent_ms", series_json(&acc[0]));
+    cJSON_AddItemToObject(sum, "vt_plain_ms", series_json(&acc[1]));
+    cJSON_AddItemToObject(sum, "whitted_ms", series_json(&acc[2]));
+    cJSON_AddItemToObject(sum, "ssim_vt_pixels", series_json(&acc[3]));
+    cJSON_AddNumberToObject(sum, "feelers_reused", (double)reused);
+    add_num(sum, "coherence_speedup", ratio(series_mean(&acc[1]), series_mean(&acc[0])));
+    add_num(sum, "time_ratio_to_whitted", ratio(series_mean(&acc[0]), series_mean(&acc[2])));
+    cJSON_AddBoolToObject(sec, "identical", identical);
+    printf("\nanimation (Sec. 3.4.5): cluster, %u frames of the camera path at %s\n", n, size);
+    printf("%-14s %9s %9s %9s\n", "", "mean", "min", "max");
+    const char *labels[4] = { "VT coherent ms", "VT plain ms", "Whitted ms", "SSIM VT px" };
+    for (int k = 0; k < 4; k++)
+        printf("%-14s %9.3f %9.3f %9.3f\n", labels[k], series_mean(&acc[k]),
+               acc[k].n ? acc[k].lo : NAN, acc[k].n ? acc[k].hi : NAN);
+    printf("feelers reused %llu; coherence speed-up %.3f; VT/Whitted %.3f; coherent and plain "
+           "images %s\n",
+           (unsigned long long)reused, ratio(series_mean(&acc[1]), series_mean(&acc[0])),
+           ratio(series_mean(&acc[0]), series_mean(&acc[2])),
+           identical ? "identical" : "DIFFER");
+    fflush(stdout);
+    return RL_OK;
+}
+
+/* ------------------------------------------------------- the command -- */
+
+static bool parse_count(const char *option, const char *text, long long max, long long *out)
+{
+    long long v;
+    if (!rl_parse_int(text, &v) || v < 1 || v > max) {
+        rl_cli_fail(RL_CLI_USAGE, "%s: expected a whole number in 1..%lld, got '%s'", option, max,
+                    text);
+        return false;
+    }
+    *out = v;
+    return true;
+}
+
+static bool parse_only(const char *text, unsigned *sections)
+{
+    *sections = 0;
+    const char *p = text;
+    for (;;) {
+        size_t n = strcspn(p, ",");
+        int found = -1;
+        for (int k = 0; k < SEC_COUNT; k++)
+            if (n == strlen(section_names[k]) && strncmp(p, section_names[k], n) == 0)
+                found = k;
+        if (found < 0) {
+            rl_cli_fail(RL_CLI_USAGE, "--only: expected sections among criteria, resolution, "
+                                      "quality, threads, visibility, animation, got '%s'", text);
+            return false;
+        }
+        *sections |= 1u << found;
+        if (p[n] == '\0')
+            return true;
+        p += n + 1;
+    }
+}
+
+/* Returns RL_CLI_OK, an exit code, or -1 when --help was printed. */
+static int parse_args(int argc, char **argv, bvt_args *a)
+{
+    a->sections = (1u << SEC_COUNT) - 1;
+    for (int i = 2; i < argc; i++) {
+        const char *v = NULL;
+        int m;
+        if (rl_cli_is_help(argv[i])) {
+            fputs(bench_vt_help, stdout);
+            return -1;
+        }
+#define VALUE(name) ((m = rl_cli_take_value(argc, argv, &i, name, &v)) != 0)
+        if (strcmp(argv[i], "--quick") == 0) {
+            a->quick = true;
+        } else if (VALUE("--size")) {
+            if (m < 0 || !rl_cli_parse_size(v, &a->width, &a->height))
+                return RL_CLI_USAGE;
+            a->has_size = true;
+        } else if (VALUE("--anim-size")) {
+            if (m < 0 || !rl_cli_parse_size(v, &a->anim_width, &a->anim_height))
+                return RL_CLI_USAGE;
+            a->has_anim_size = true;
+        } else if (VALUE("--frames")) {
+            if (m < 0 || !parse_count("--frames", v, MAX_FRAMES, &a->frames))
+                return RL_CLI_USAGE;
+            a->has_frames = true;
+        } else if (VALUE("--threads")) {
+            if (m < 0 || !parse_count("--threads", v, RL_VT_MAX_THREADS, &a->threads))
+                return RL_CLI_USAGE;
+        } else if (VALUE("--only")) {
+            if (m < 0 || !parse_only(v, &a->sections))
+                return RL_CLI_USAGE;
+        } else if (VALUE("--out")) {
+            if (m < 0)
+                return RL_CLI_USAGE;
+            a->out = v;
+        } else {
+            return rl_cli_unknown_arg("bench vt", argv[i]);
+        }
+#undef VALUE
+    }
+    if (a->out && !rl_cli_has_extension(a->out, (const char *const[]){ ".json", NULL }))
+        return rl_cli_fail(RL_CLI_USAGE, "--out: '%s' should end in .json", a->out);
+    /* Defaults; --quick changes only what was not given. The thesis
+     * measured the table scene at 1024x1024 (Sec. 5.1). */
+    if (!a->has_size)
+        a->width = a->height = a->quick ? 128 : 1024;
+    if (!a->has_anim_size) {
+        a->anim_width = a->quick ? 128 : 640;
+        a->anim_height = a->quick ? 128 : 480;
+    }
+    if (!a->has_frames)
+        a->frames = a->quick ? 3 : 60;
+    return RL_CLI_OK;
+}
+
+/* bench/results/vt-YYYYMMDD-HHMMSS.json (UTC), creating the folder. */
+static bool default_out(char *path, size_t size)
+{
+    time_t now = time(NULL);
+    struct tm utc;
+    char stamp[32];
+    if (!gmtime_r(&now, &utc) || !strftime(stamp, sizeof stamp, "%Y%m%d-%H%M%S", &utc))
+        snprintf(stamp, sizeof stamp, "%lld", (long long)now);
+    snprintf(path, size, "bench/results/vt-%s.json", stamp);
+    return rl_cli_make_dirs("bench/results");
+}
+
+static bool wants(const bvt_args *a, int section)
+{
+    return (a->sections >> section) & 1u;
+}
+
+/* Loads a built-in scene and its VT object set. */
+static int load(const char *name, rl_scene **scene, uint8_t **object_vt)
+{
+    int rc = rl_cli_load_scene(name, scene);
+    if (rc != RL_CLI_OK)
+        return rc;
+    if (!(*object_vt = vt_objects(*scene)))
+        return rl_cli_fail(RL_CLI_FAIL, "out of memory");
+    return RL_CLI_OK;
+}
+
+/* Every vt option with the value the sections start from. */
+static cJSON *vt_options_json(int threads)
+{
+    rl_renderer *r = NULL;
+    if (make_renderer("vt", threads, &r) != RL_OK)
+        return NULL;
+    cJSON *o = cJSON_CreateObject();
+    size_t count = 0;
+    const rl_option_info *opts = rl_renderer_options(r, &count);
+    for (size_t i = 0; o && i < count; i++)
+        cJSON_AddStringToObject(o, opts[i].key, rl_renderer_get(r, opts[i].key));
+    rl_renderer_release(r);
+    return o;
+}
+
+static cJSON *params_json(const bvt *b)
+{
+    const bvt_args *a = b->a;
+    cJSON *o = cJSON_CreateObject();
+    if (!o)
+        return NULL;
+    char text[64];
+    snprintf(text, sizeof text, "%dx%d", a->width, a->height);
+    cJSON_AddStringToObject(o, "size", text);
+    snprintf(text, sizeof text, "%dx%d", a->anim_width, a->anim_height);
+    cJSON_AddStringToObject(o, "anim_size", text);
+    cJSON_AddNumberToObject(o, "frames", (double)a->frames);
+    cJSON_AddNumberToObject(o, "threads", b->threads);
+    cJSON_AddNumberToObject(o, "max_threads", b->max_threads);
+    cJSON_AddBoolToObject(o, "quick", a->quick);
+    cJSON *only = cJSON_AddArrayToObject(o, "sections");
+    for (int k = 0; only && k < SEC_COUNT; k++)
+        if (wants(a, k))
+            cJSON_AddItemToArray(only, cJSON_CreateString(section_names[k]));
+    cJSON_AddNumberToObject(o, "warmup_renders", 1);
+    cJSON_AddNumberToObject(o, "timed_renders", b->runs);
+    cJSON *tracer = cJSON_AddObjectToObject(o, "tracer");
+    cJSON_AddNumberToObject(tracer, "max_depth", atoi(TRACE_MAX_DEPTH));
+    cJSON_AddNumberToObject(tracer, "area_samples", atoi(TRACE_AREA_SAMPLES));
+    cJSON_AddBoolToObject(tracer, "shadows", strcmp(TRACE_SHADOWS, "true") == 0);
+    cJSON_AddItemToObject(o, "vt_options", vt_options_json(b->threads));
+    cJSON_AddStringToObject(o, "timing",
+                            "wall time of rl_renderer_render; per configuration one warm-up "
+                            "render, then the fastest of timed_renders; static sections with "
+                            "coherence=false; animation frames rendered once each");
+    cJSON_AddStringToObject(o, "vt_pixels",
+                            "pixels whose object in Whitted's ID layer is a VT object: node or "
+                            "nearest ancestor with attribute vt=true, else (no vt attribute in "
+                            "the scene) reflective or refractive objects");
+    cJSON_AddStringToObject(o, "metrics",
+                            "rl_image_compare: sRGB, SSIM on luma (Wang et al. 2004)");
+    return o;
+}
+
+/* Figures of Ullmann 2003, Ch. 5, for the reader of the record. */
+static cJSON *thesis_json(void)
+{
+    cJSON *o = cJSON_CreateObject();
+    if (!o)
+        return NULL;
+    cJSON *gen = cJSON_AddObjectToObject(o, "vertices_generated");
+    for (size_t c = 0; gen && c < sizeof criteria / sizeof criteria[0]; c++)
+        cJSON_AddNumberToObject(gen, criteria[c].name, criteria[c].thesis_generated);
+    cJSON_AddNumberToObject(o, "samples_percent_of_pixels_at_most", 5);
+    cJSON *factor = cJSON_AddArrayToObject(o, "whitted_over_vt_time_factor");
+    cJSON_AddItemToArray(factor, cJSON_CreateNumber(6.8));
+    cJSON_AddItemToArray(factor, cJSON_CreateNumber(86));
+    cJSON_AddNumberToObject(o, "speedup_two_cpus", 1.6);
+    cJSON_AddStringToObject(o, "source", "Ullmann 2003, Fig. 5.5, 5.6, Sec. 3.2, Fig. 5.10, 5.15");
+    return o;
+}
+
+static cJSON *report_root(const bvt *b)
+{
+    cJSON *root = cJSON_CreateObject();
+    if (!root)
+        return NULL;
+    cJSON_AddStringToObject(root, "benchmark", "vt");
+    cJSON_AddStringToObject(root, "renderlab_version", RL_CLI_VERSION);
+    char date[32];
+    time_t now = time(NULL);
+    struct tm utc;
+    if (gmtime_r(&now, &utc) && strftime(date, sizeof date, "%Y-%m-%dT%H:%M:%SZ", &utc))
+        cJSON_AddStringToObject(root, "date", date);
+    else
+        cJSON_AddNullToObject(root, "date");
+    cJSON_AddItemToObject(root, "machine", rl_bench_machine_json(b->threads));
+    cJSON_AddItemToObject(root, "parameters", params_json(b));
+    cJSON_AddItemToObject(root, "thesis", thesis_json());
+    return root;
+}
+
+typedef rl_status (*section_fn)(bvt *b, cJSON *sec);
+
+static int run(bvt *b)
+{
+    const bvt_args *a = b->a;
+    char out[256];
+    if (a->out)
+        snprintf(out, sizeof out, "%s", a->out);
+    if (a->out ? !rl_cli_check_writable(out) : !default_out(out, sizeof out))
+        return RL_CLI_FAIL;
+    /* The renderers first: the record is worthless without them. */
+    const char *const names[] = { "vt", "whitted" };
+    for (int i = 0; i < 2; i++) {
+        rl_renderer *r = NULL;
+        rl_clear_error();
+        rl_status st = rl_renderer_create(names[i], &r);
+        rl_renderer_release(r);
+        if (st != RL_OK)
+            return rl_cli_fail_status(RL_CLI_FAIL, st, "bench vt");
+    }
+    bool static_sections = false;
+    for (int k = 0; k < SEC_ANIMATION; k++)
+        static_sections = static_sections || wants(a, k);
+    int rc = RL_CLI_OK;
+    if (static_sections && (rc = load("table", &b->table, &b->table_vt)) != RL_CLI_OK)
+        return rc;
+    if (static_sections) {
+        rl_clear_error();
+        rl_status st = rl_scene_get_camera(b->table, NULL, &b->table_cam);
+        if (st != RL_OK)
+            return rl_cli_fail_status(RL_CLI_FAIL, st, "bench vt: table camera");
+    }
+    if (wants(a, SEC_ANIMATION) && (rc = load("cluster", &b->cluster, &b->cluster_vt)) != RL_CLI_OK)
+        return rc;
+
+    cJSON *root = report_root(b);
+    if (!root)
+        return rl_cli_fail(RL_CLI_FAIL, "out of memory");
+    static const section_fn fns[SEC_COUNT] = { sec_criteria, sec_resolution, sec_quality,
+                                               sec_threads, sec_visibility, sec_animation };
+    printf("rl bench vt: Vertex Tracing vs Whitted, %d threads, max_depth %s, area_samples %s, "
+           "shadows %s\n", b->threads, TRACE_MAX_DEPTH, TRACE_AREA_SAMPLES, TRACE_SHADOWS);
+    char failed[512] = "";
+    for (int k = 0; k < SEC_COUNT; k++) {
+        if (!wants(a, k))
+            continue;
+        cJSON *sec = cJSON_AddObjectToObject(root, section_names[k]);
+        if (!sec) {
+            rc = rl_cli_fail(RL_CLI_FAIL, "out of memory");
+            break;
+        }
+        b->reason[0] = '\0';
+        rl_clear_error();
+        rl_status st = fns[k](b, sec);
+        if (st == RL_OK) {
+            cJSON_AddStringToObject(sec, "status", "ok");
+            continue;
+        }
+        /* The other sections may still work: record why and go on. */
+        const char *why = b->reason[0] ? b->reason : rl_last_error();
+        if (!why || !*why)
+            why = rl_status_string(st);
+        cJSON_AddStringToObject(sec, "status", "failed");
+        cJSON_AddStringToObject(sec, "reason", why);
+        printf("\n%s: failed: %s\n", section_names[k], why);
+        if (!failed[0])
+            snprintf(failed, sizeof failed, "%s (%s)", section_names[k], why);
+    }
+    /* Again for the load average after the run: how busy the machine was. */
+    cJSON *machine = rl_bench_machine_json(b->threads);
+    if (machine && !cJSON_ReplaceItemInObjectCaseSensitive(root, "machine", machine))
+        cJSON_Delete(machine);
+    if (rc == RL_CLI_OK) {
+        if (!cJSON_GetObjectItem(root, "machine") || !cJSON_GetObjectItem(root, "parameters"))
+            rc = rl_cli_fail(RL_CLI_FAIL, "out of memory");
+        else if (!rl_cli_write_json(root, out))
+            rc = RL_CLI_FAIL;
+        else
+            note("wrote %s", out);
+    }
+    cJSON_Delete(root);
+    if (rc == RL_CLI_OK && failed[0])
+        rc = rl_cli_fail(RL_CLI_FAIL, "bench vt: section %s failed", failed);
+    return rc;
+}
+
+int rl_bench_vt(int argc, char **argv)
+{
+    bvt_args a;
+    memset(&a, 0, sizeof a);
+    int rc = parse_args(argc, argv, &a);
+    if (rc != RL_CLI_OK)
+        return rc < 0 ? RL_CLI_OK : rc;
+    bvt b;
+    memset(&b, 0, sizeof b);
+    b.a = &a;
+    b.threads = a.threads ? (int)a.threads : omp_get_max_threads();
+    b.threads = b.threads < RL_VT_MAX_THREADS ? b.threads : RL_VT_MAX_THREADS;
+    b.max_threads = a.threads ? (int)a.threads : omp_get_num_procs();
+    b.max_threads = b.max_threads < RL_VT_MAX_THREADS ? b.max_threads : RL_VT_MAX_THREADS;
+    if (a.quick && !a.threads)
+        b.max_threads = 2;      /* threads 1 and 2 */
+    b.runs = a.quick ? 1 : 2;
+    rc = run(&b);
+    for (int i = 0; i < b.num_refs; i++) {
+        rl_image_release(b.refs[i].image);
+        free(b.refs[i].mask);
+    }
+    rl_scene_release(b.table);
+    rl_scene_release(b.cluster);
+    free(b.table_vt);
+    free(b.cluster_vt);
+    return rc;
+}

@@ -1,0 +1,148 @@
+#!/usr/bin/env bash
+# test_cli_bench_vt.sh: `rl bench vt --quick` runs every section of the Vertex
+# Tracing benchmark (Ullmann 2003, Ch. 5) against Whitted and writes a
+# complete JSON record with sane values; bad usage exits 2, an unwritable
+# output 1. Keeps the benchmark from rotting; it measures nothing.
+# Run as: bash test_cli_bench_vt.sh <rl-binary> <scratch-dir>
+set -u
+. "$(dirname "${BASH_SOURCE[0]}")/lib.bash"
+
+have_python() { command -v python3 >/dev/null 2>&1 && python3 -c 'import json' 2>/dev/null; }
+
+# Bad usage first (cheap): exit 2 with one error line, before anything runs.
+expect_usage_error "$RL" bench vt --frames 0 --out "$TMP/x.json"
+expect_usage_error "$RL" bench vt --frames ten --out "$TMP/x.json"
+expect_usage_error "$RL" bench vt --size 0x0 --out "$TMP/x.json"
+expect_usage_error "$RL" bench vt --anim-size 64 --out "$TMP/x.json"
+expect_usage_error "$RL" bench vt --threads 0 --out "$TMP/x.json"
+expect_usage_error "$RL" bench vt --only criteria,nosuch --out "$TMP/x.json"
+expect_usage_error "$RL" bench vt --only "" --out "$TMP/x.json"
+expect_usage_error "$RL" bench vt --quick --out "$TMP/x.txt"
+expect_usage_error "$RL" bench vt --frobnicate
+expect_usage_error "$RL" bench vt --size
+[ -e "$TMP/x.json" ] && fail "a failed run wrote x.json"
+
+# Output folder that does not exist: exit 1, checked before the run.
+expect_exit 1 "$RL" bench vt --quick --out "$TMP/no/such/dir/vt.json"
+expect_in "$TMP/err" "rl: error: "
+
+# Help, and the bench dispatcher knows vt.
+expect_exit 0 "$RL" bench vt --help
+for o in --size --anim-size --frames --threads --only --out --quick criteria animation; do
+    expect_in "$TMP/out" "$o"
+done
+expect_error 2 "known: rays, vt" "$RL" bench nosuch
+
+# The quick run: every section, a table on stdout, JSON where --out says.
+expect_exit 0 "$RL" bench vt --quick --out "$TMP/vt.json"
+[ -s "$TMP/vt.json" ] || fail "vt.json was not written"
+for s in criteria resolution quality threads visibility animation tree+hsv min_edge; do
+    expect_in "$TMP/out" "$s"
+done
+expect_in "$TMP/err" "bench vt: wrote"
+
+if have_python; then
+    python3 - "$TMP/vt.json" <<'PY' || fail "vt.json does not hold a complete, sane record"
+import json, math, sys
+r = json.load(open(sys.argv[1]))
+for k in ("benchmark", "renderlab_version", "date", "machine", "parameters", "thesis"):
+    assert k in r, "missing key " + k
+assert r["benchmark"] == "vt"
+for k in ("uname", "cpu", "nproc", "threads"):
+    assert k in r["machine"], "machine lacks " + k
+p = r["parameters"]
+assert p["quick"] is True and p["size"] == "128x128" and p["frames"] == 3, p
+assert p["tracer"] == {"max_depth": 5, "area_samples": 4, "shadows": True}, p["tracer"]
+
+def ssim_ok(x):
+    return x is None or -1.0 <= x <= 1.0
+
+def quality_ok(q):
+    for part in ("vt_pixels", "full"):
+        assert ssim_ok(q[part]["ssim"]), q
+        assert q[part]["rmse"] is None or 0.0 <= q[part]["rmse"] <= 1.0, q
+    # The table's VT objects are in view: the VT pixels are measured.
+    assert q["vt_pixels"]["pixels"] > 0 and q["vt_pixels"]["ssim"] is not None, q
+
+for name in ("criteria", "resolution", "quality", "threads", "visibility", "animation"):
+    assert name in r, "missing section " + name
+    assert r[name]["status"] == "ok", "%s: %s" % (name, r[name].get("reason"))
+
+c = r["criteria"]
+assert [x["criteria"] for x in c["runs"]] == ["rgb", "hsv", "tree", "tree+rgb", "tree+hsv"]
+assert c["whitted"]["rays"]["total"] > 0 and c["whitted"]["time_ms"] > 0
+for x in c["runs"]:
+    assert x["rays"]["total"] > 0 and x["time_ms"] > 0 and x["faces"] > 0, x
+    assert x["vertices_sampled"] > 0 and x["thesis_vertices_generated"] > 20000, x
+    quality_ok(x["quality"])
+
+res = r["resolution"]["runs"]
+assert [x["size"] for x in res] == ["64x64", "128x128"], res
+for x in res:
+    assert x["vt_rays"]["total"] > 0 and x["whitted_rays"]["total"] > 0
+    assert x["rays_percent_of_whitted"] > 0 and x["samples_percent_of_pixels"] > 0
+    assert x["vt_time_ms"] > 0 and x["whitted_time_ms"] > 0
+    assert x["preview_ms"] is not None and x["preview_ms"] >= 0, x
+    assert x["preview_updates"] >= 1, "the update callback saw the preview"
+    quality_ok(x["quality"])
+
+q = r["quality"]
+assert [x["min_edge"] for x in q["runs"]] == [1, 2, 3, 4, 6, 8]
+for x in q["runs"]:
+    assert x["time_ms"] > 0 and x["rays"]["total"] > 0
+    quality_ok(x["quality"])
+assert isinstance(q["met"], bool)
+if q["best"] is not None:
+    assert q["best"]["ssim_vt_pixels"] >= 0.95
+    assert min(x["time_ms"] for x in q["runs"] if x["quality"]["vt_pixels"]["ssim"] >= 0.95) \
+        == q["best"]["time_ms"]
+
+t = r["threads"]["runs"]
+assert [x["threads"] for x in t] == [1, 2], t
+for x in t:
+    assert len(x["thread_rays"]) == x["threads"] and sum(x["thread_rays"]) > 0, x
+    assert x["vt_time_ms"] > 0 and x["whitted_time_ms"] > 0
+    assert x["load_imbalance"] is None or x["load_imbalance"] >= 0
+    for k in ("visibility", "sampling", "refine", "draw"):
+        assert x["time_split_ms"][k] >= 0, x
+assert t[0]["vt_speedup"] == 1 and t[0]["load_imbalance"] == 0
+
+v = r["visibility"]["runs"]
+assert [x["tests"] for x in v] == ["ID+Z+C", "ID+Z", "ID", "none"]
+for x in v:
+    assert x["time_ms"] > 0 and x["vertices_sampled"] > 0
+# Without the ID buffer every face counts as visible.
+assert v[3]["visible_primary_faces"] >= v[0]["visible_primary_faces"]
+
+a = r["animation"]
+assert a["scene"] == "cluster" and a["frames"] == 3 and len(a["per_frame"]) == 3
+for x in a["per_frame"]:
+    assert x["vt_coherent_ms"] > 0 and x["vt_plain_ms"] > 0 and x["whitted_ms"] > 0
+    assert ssim_ok(x["ssim_vt_pixels"]) and x["vt_rays"] > 0 and x["whitted_rays"] > 0
+# The first frame has no previous frame to reuse feelers from.
+assert a["per_frame"][0]["feelers_reused"] == 0
+# Sec. 3.4.5: reusing the feelers is exact.
+assert a["identical"] is True and all(x["identical"] for x in a["per_frame"])
+for k in ("vt_coherent_ms", "vt_plain_ms", "whitted_ms"):
+    s = a["summary"][k]
+    assert 0 < s["min"] <= s["mean"] <= s["max"], (k, s)
+PY
+else
+    for k in '"benchmark"' '"machine"' '"parameters"' '"criteria"' '"resolution"' '"quality"' \
+             '"threads"' '"visibility"' '"animation"' '"identical": true' '"ssim"'; do
+        expect_in "$TMP/vt.json" "$k"
+    done
+fi
+
+# --only runs the named sections and nothing else.
+expect_exit 0 "$RL" bench vt --quick --only visibility --size 32x32 -q --out "$TMP/o.json"
+if have_python; then
+    python3 - "$TMP/o.json" <<'PY' || fail "o.json is wrong"
+import json, sys
+r = json.load(open(sys.argv[1]))
+assert r["parameters"]["sections"] == ["visibility"], r["parameters"]
+assert "visibility" in r and "criteria" not in r and "animation" not in r
+assert r["visibility"]["size"] == "32x32" and r["visibility"]["status"] == "ok"
+PY
+fi
+echo "ok"
