@@ -93,6 +93,9 @@ typedef struct rl_bench_params {
 /* uname, CPU model, nproc, threads and the load average: the machine a
  * record was measured on (also used by `rl bench vt`); NULL when out of memory. */
 struct cJSON *rl_bench_machine_json(int threads);
+/* The head of every benchmark record: benchmark name, renderlab version, UTC
+ * date and the machine; NULL when out of memory. */
+struct cJSON *rl_bench_record_json(const char *benchmark, int threads);
 
 /* The whole run as one JSON object: machine, date, version, parameters,
  * per scene/accel/workload rays, hits, seconds, Mrays/s, ratio to Embree.

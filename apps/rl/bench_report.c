@@ -195,13 +195,12 @@ static cJSON *scene_json(const rl_bench_scene_result *sc)
     return o;
 }
 
-cJSON *rl_bench_report_json(const rl_bench_params *params, const rl_bench_scene_result *scenes,
-                            int num_scenes, int hit_mismatches)
+cJSON *rl_bench_record_json(const char *benchmark, int threads)
 {
     cJSON *root = cJSON_CreateObject();
     if (!root)
         return NULL;
-    cJSON_AddStringToObject(root, "benchmark", "rays");
+    cJSON_AddStringToObject(root, "benchmark", benchmark);
     cJSON_AddStringToObject(root, "renderlab_version", RL_CLI_VERSION);
     char date[32];
     time_t now = time(NULL);
@@ -210,8 +209,17 @@ cJSON *rl_bench_report_json(const rl_bench_params *params, const rl_bench_scene_
         cJSON_AddStringToObject(root, "date", date);
     else
         cJSON_AddNullToObject(root, "date");
+    cJSON_AddItemToObject(root, "machine", rl_bench_machine_json(threads));
+    return root;
+}
+
+cJSON *rl_bench_report_json(const rl_bench_params *params, const rl_bench_scene_result *scenes,
+                            int num_scenes, int hit_mismatches)
+{
+    cJSON *root = rl_bench_record_json("rays", params->threads);
+    if (!root)
+        return NULL;
     cJSON_AddBoolToObject(root, "embree", rl_accel_kind_available(RL_ACCEL_EMBREE));
-    cJSON_AddItemToObject(root, "machine", rl_bench_machine_json(params->threads));
     cJSON_AddItemToObject(root, "parameters", params_json(params));
     cJSON_AddNumberToObject(root, "hit_mismatches", hit_mismatches);
     cJSON *list = cJSON_AddArrayToObject(root, "scenes");

@@ -1301,19 +1301,9 @@ static cJSON *thesis_json(void)
 
 static cJSON *report_root(const bvt *b)
 {
-    cJSON *root = cJSON_CreateObject();
+    cJSON *root = rl_bench_record_json("vt", b->threads);
     if (!root)
         return NULL;
-    cJSON_AddStringToObject(root, "benchmark", "vt");
-    cJSON_AddStringToObject(root, "renderlab_version", RL_CLI_VERSION);
-    char date[32];
-    time_t now = time(NULL);
-    struct tm utc;
-    if (gmtime_r(&now, &utc) && strftime(date, sizeof date, "%Y-%m-%dT%H:%M:%SZ", &utc))
-        cJSON_AddStringToObject(root, "date", date);
-    else
-        cJSON_AddNullToObject(root, "date");
-    cJSON_AddItemToObject(root, "machine", rl_bench_machine_json(b->threads));
     cJSON_AddItemToObject(root, "parameters", params_json(b));
     cJSON_AddItemToObject(root, "thesis", thesis_json());
     return root;
