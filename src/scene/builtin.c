@@ -6,6 +6,7 @@
 #include "scene/builtin.h"
 
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 
 #include "core/error.h"
@@ -110,5 +111,40 @@ rl_status rl_builtin_instance(rl_scene *scene, uint32_t parent, const char *name
     if (!s && kind) s = rl_scene_node_set_attr(scene, n, "kind", kind);
     if (!s && node)
         *node = n;
+    return s;
+}
+
+rl_material rl_builtin_phong(const char *name, rl_vec3 kd, float ks, float shininess)
+{
+    rl_material m = rl_material_default();
+    snprintf(m.name, sizeof m.name, "%s", name);
+    m.diffuse = kd;
+    m.specular = rl_v3s(ks);
+    m.shininess = shininess;
+    return m;
+}
+
+rl_status rl_builtin_texture(rl_scene *scene, int width, int height, const rl_vec4 *texels,
+                             uint32_t *id)
+{
+    rl_texture *tex = NULL;
+    rl_status s = rl_texture_create(width, height, texels, &tex);
+    if (!s && (s = rl_scene_add_texture(scene, tex, id)))
+        rl_texture_release(tex);   /* ownership passes only on success */
+    return s;
+}
+
+rl_status rl_builtin_checker(rl_scene *scene, int cell_texels, rl_vec4 even, rl_vec4 odd,
+                             uint32_t *id)
+{
+    const int n = 2 * cell_texels;
+    rl_vec4 *texels = rl_alloc((size_t)n * (size_t)n * sizeof *texels);
+    if (!texels)
+        return RL_ERR_OUT_OF_MEMORY;
+    for (int y = 0; y < n; ++y)
+        for (int x = 0; x < n; ++x)
+            texels[y * n + x] = ((x / cell_texels) + (y / cell_texels)) & 1 ? odd : even;
+    rl_status s = rl_builtin_texture(scene, n, n, texels, id);
+    free(texels);
     return s;
 }

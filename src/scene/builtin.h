@@ -23,6 +23,19 @@ rl_status rl_builtin_cluster(rl_scene *scene, rl_params *params);
  * defaults of rl_material_default(); *id receives its index. */
 rl_status rl_builtin_material(rl_scene *scene, const char *name, rl_vec3 diffuse,
                               uint32_t *id);
+/* Phong material: diffuse kd, grey specular ks, shininess; the rest as
+ * rl_material_default(). */
+rl_material rl_builtin_phong(const char *name, rl_vec3 kd, float ks, float shininess);
+/* Adds a width x height texture made from texels (copied); *id receives
+ * its index. */
+rl_status rl_builtin_texture(rl_scene *scene, int width, int height, const rl_vec4 *texels,
+                             uint32_t *id);
+/* A two-colour checkerboard of 2 x 2 cells, each cell_texels wide (whole
+ * texel blocks, so bilinear lookup only blurs the cell borders); a surface
+ * repeats it. odd colours the cells with odd x + y. */
+rl_status rl_builtin_checker(rl_scene *scene, int cell_texels, rl_vec4 even, rl_vec4 odd,
+                             uint32_t *id);
+
 /* Adds a node under parent with a mesh, an optional "kind" attribute and a
  * transform (NULL: identity); *node (may be NULL) receives its id. */
 rl_status rl_builtin_instance(rl_scene *scene, uint32_t parent, const char *name,

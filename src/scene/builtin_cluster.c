@@ -164,27 +164,15 @@ static rl_status add_dial_texture(rl_scene *scene, int n, const dial_scale *sc, 
     if (!texels)
         return rl_error(RL_ERR_OUT_OF_MEMORY, "cluster: no memory for a %d x %d dial texture", n, n);
     paint_dial(texels, n, sc);
-    rl_texture *tex = NULL;
-    rl_status s = rl_texture_create(n, n, texels, &tex);
+    rl_status s = rl_builtin_texture(scene, n, n, texels, id);
     free(texels);
-    if (!s && (s = rl_scene_add_texture(scene, tex, id)))
-        rl_texture_release(tex);   /* ownership passes only on success */
     return s;
 }
 
-static rl_material phong(const char *name, rl_vec3 kd, float ks, float shininess)
-{
-    rl_material m = rl_material_default();
-    snprintf(m.name, sizeof m.name, "%s", name);
-    m.diffuse = kd;
-    m.specular = rl_v3s(ks);
-    m.shininess = shininess;
-    return m;
-}
 
 static rl_material emitter(const char *name, rl_vec3 radiance)
 {
-    rl_material m = phong(name, rl_v3s(0.0f), 0.0f, 1.0f);
+    rl_material m = rl_builtin_phong(name, rl_v3s(0.0f), 0.0f, 1.0f);
     m.emission = radiance;
     return m;
 }
@@ -197,30 +185,30 @@ static rl_status add_materials(cluster *c)
     if (!s) s = add_dial_texture(c->scene, n, &rpm_scale, &rpm_tex);
     if (s)
         return s;
-    rl_material dial_speed = phong("dial_speed", rl_v3s(1.0f), 0.05f, 10.0f);
+    rl_material dial_speed = rl_builtin_phong("dial_speed", rl_v3s(1.0f), 0.05f, 10.0f);
     dial_speed.diffuse_texture = speed_tex;
     rl_material dial_rpm = dial_speed;
     snprintf(dial_rpm.name, sizeof dial_rpm.name, "dial_rpm");
     dial_rpm.diffuse_texture = rpm_tex;
     /* Needles glow faintly, as lit needles do. */
-    rl_material needle = phong("needle", rl_v3(0.80f, 0.05f, 0.02f), 0.4f, 40.0f);
+    rl_material needle = rl_builtin_phong("needle", rl_v3(0.80f, 0.05f, 0.02f), 0.4f, 40.0f);
     needle.emission = rl_v3(0.25f, 0.02f, 0.0f);
-    rl_material chrome = phong("chrome", rl_v3s(0.15f), 0.8f, 150.0f);
+    rl_material chrome = rl_builtin_phong("chrome", rl_v3s(0.15f), 0.8f, 150.0f);
     chrome.reflectivity = 0.5f;
-    rl_material glass = phong("cover_glass", rl_v3s(0.01f), 0.25f, 400.0f);
+    rl_material glass = rl_builtin_phong("cover_glass", rl_v3s(0.01f), 0.25f, 400.0f);
     glass.reflectivity = 0.09f;
     glass.transmissivity = 0.85f;
     glass.ior = 1.5f;
     const struct { rl_material m; uint32_t *id; } list[] = {
-        { phong("plastic", rl_v3(0.05f, 0.05f, 0.055f), 0.15f, 20.0f), &c->m.plastic },
-        { phong("dashboard", rl_v3(0.09f, 0.09f, 0.10f), 0.1f, 15.0f), &c->m.dash },
+        { rl_builtin_phong("plastic", rl_v3(0.05f, 0.05f, 0.055f), 0.15f, 20.0f), &c->m.plastic },
+        { rl_builtin_phong("dashboard", rl_v3(0.09f, 0.09f, 0.10f), 0.1f, 15.0f), &c->m.dash },
         { dial_speed, &c->m.dial_speed },
         { dial_rpm, &c->m.dial_rpm },
         { needle, &c->m.needle },
         { chrome, &c->m.chrome },
-        { phong("hub", rl_v3s(0.06f), 0.5f, 60.0f), &c->m.hub },
+        { rl_builtin_phong("hub", rl_v3s(0.06f), 0.5f, 60.0f), &c->m.hub },
         { glass, &c->m.glass },
-        { phong("wheel", rl_v3(0.05f, 0.045f, 0.04f), 0.25f, 15.0f), &c->m.wheel },
+        { rl_builtin_phong("wheel", rl_v3(0.05f, 0.045f, 0.04f), 0.25f, 15.0f), &c->m.wheel },
         { emitter("sky", rl_v3(0.8f * SKY_RADIANCE, 0.875f * SKY_RADIANCE, SKY_RADIANCE)), &c->m.sky },
         { emitter("warn_green", rl_v3(0.1f, 1.6f, 0.2f)), &c->m.warn[0] },
         { emitter("warn_amber", rl_v3(1.8f, 0.9f, 0.05f)), &c->m.warn[1] },

@@ -17,25 +17,11 @@
 #define SPACING 1.4f                   /* centre distance between spheres */
 #define CHECK_TEXELS 8                 /* texels per checker cell */
 
-/* Two-colour checkerboard with 2x2 cells; the floor repeats it. Cells are
- * whole texel blocks so bilinear lookup only blurs the cell borders. */
+/* Two-colour checkerboard with 2x2 cells; the floor repeats it. */
 static rl_status add_checker_texture(rl_scene *scene, uint32_t *id)
 {
-    const int n = 2 * CHECK_TEXELS;
-    rl_vec4 *texels = rl_alloc((size_t)n * n * sizeof *texels);
-    if (!texels)
-        return RL_ERR_OUT_OF_MEMORY;
-    for (int y = 0; y < n; ++y)
-        for (int x = 0; x < n; ++x) {
-            bool dark = ((x / CHECK_TEXELS) + (y / CHECK_TEXELS)) & 1;
-            texels[y * n + x] = dark ? rl_v4(0.10f, 0.10f, 0.12f, 1.0f) : rl_v4(0.85f, 0.85f, 0.80f, 1.0f);
-        }
-    rl_texture *tex = NULL;
-    rl_status s = rl_texture_create(n, n, texels, &tex);
-    free(texels);
-    if (!s && (s = rl_scene_add_texture(scene, tex, id)))
-        rl_texture_release(tex);   /* ownership passes only on success */
-    return s;
+    return rl_builtin_checker(scene, CHECK_TEXELS, rl_v4(0.85f, 0.85f, 0.80f, 1.0f),
+                              rl_v4(0.10f, 0.10f, 0.12f, 1.0f), id);
 }
 
 static rl_status add_materials(rl_scene *scene, uint32_t ids[4], uint32_t floor_texture,

@@ -92,32 +92,10 @@ static rl_status add_vt_part(table *t, rl_meshbuf *b, const char *name, const ch
 /* Red and white tablecloth, 2 x 2 cells per repeat. */
 static rl_status add_cloth_texture(rl_scene *scene, uint32_t *id)
 {
-    const int n = 2 * CHECK_TEXELS;
-    rl_vec4 *texels = rl_alloc((size_t)n * n * sizeof *texels);
-    if (!texels)
-        return RL_ERR_OUT_OF_MEMORY;
-    for (int y = 0; y < n; ++y)
-        for (int x = 0; x < n; ++x) {
-            bool red = ((x / CHECK_TEXELS) + (y / CHECK_TEXELS)) & 1;
-            texels[y * n + x] = red ? rl_v4(0.60f, 0.06f, 0.05f, 1.0f) : rl_v4(0.85f, 0.84f, 0.80f, 1.0f);
-        }
-    rl_texture *tex = NULL;
-    rl_status s = rl_texture_create(n, n, texels, &tex);
-    free(texels);
-    if (!s && (s = rl_scene_add_texture(scene, tex, id)))
-        rl_texture_release(tex);   /* ownership passes only on success */
-    return s;
+    return rl_builtin_checker(scene, CHECK_TEXELS, rl_v4(0.85f, 0.84f, 0.80f, 1.0f),
+                              rl_v4(0.60f, 0.06f, 0.05f, 1.0f), id);
 }
 
-static rl_material phong(const char *name, rl_vec3 kd, float ks, float shininess)
-{
-    rl_material m = rl_material_default();
-    snprintf(m.name, sizeof m.name, "%s", name);
-    m.diffuse = kd;
-    m.specular = rl_v3s(ks);
-    m.shininess = shininess;
-    return m;
-}
 
 static rl_status add_materials(table *t)
 {
@@ -125,37 +103,37 @@ static rl_status add_materials(table *t)
     rl_status s = add_cloth_texture(t->scene, &cloth_tex);
     if (s)
         return s;
-    rl_material cloth = phong("tablecloth", rl_v3s(1.0f), 0.2f, 40.0f);
+    rl_material cloth = rl_builtin_phong("tablecloth", rl_v3s(1.0f), 0.2f, 40.0f);
     cloth.diffuse_texture = cloth_tex;     /* k_d modulated by the checkers */
     cloth.reflectivity = 0.2f;
-    rl_material cup = phong("cup_blue", rl_v3(0.04f, 0.10f, 0.42f), 0.8f, 120.0f);
+    rl_material cup = rl_builtin_phong("cup_blue", rl_v3(0.04f, 0.10f, 0.42f), 0.8f, 120.0f);
     cup.reflectivity = 0.6f;
     /* The tracer does not tint transmitted light, so the red comes from a
      * strong diffuse term next to k_t. */
-    rl_material glass = phong("glass_red", rl_v3(0.30f, 0.02f, 0.02f), 0.9f, 200.0f);
+    rl_material glass = rl_builtin_phong("glass_red", rl_v3(0.30f, 0.02f, 0.02f), 0.9f, 200.0f);
     glass.reflectivity = 0.1f;
     glass.transmissivity = 0.7f;
     glass.ior = 1.5f;
-    rl_material metal = phong("metal", rl_v3s(0.25f), 0.7f, 80.0f);
+    rl_material metal = rl_builtin_phong("metal", rl_v3s(0.25f), 0.7f, 80.0f);
     metal.reflectivity = 0.3f;
     const struct { rl_material m; uint32_t *id; } list[] = {
         { cloth, &t->m.cloth },
-        { phong("wood", rl_v3(0.42f, 0.26f, 0.14f), 0.1f, 20.0f), &t->m.wood },
-        { phong("floor", rl_v3(0.45f, 0.40f, 0.34f), 0.0f, 1.0f), &t->m.floor },
-        { phong("wall", rl_v3(0.70f, 0.70f, 0.64f), 0.0f, 1.0f), &t->m.wall },
+        { rl_builtin_phong("wood", rl_v3(0.42f, 0.26f, 0.14f), 0.1f, 20.0f), &t->m.wood },
+        { rl_builtin_phong("floor", rl_v3(0.45f, 0.40f, 0.34f), 0.0f, 1.0f), &t->m.floor },
+        { rl_builtin_phong("wall", rl_v3(0.70f, 0.70f, 0.64f), 0.0f, 1.0f), &t->m.wall },
         { cup, &t->m.cup },
         { glass, &t->m.glass },
         { metal, &t->m.metal },
-        { phong("teapot", rl_v3(0.72f, 0.70f, 0.62f), 0.0f, 1.0f), &t->m.teapot },
-        { phong("lamp", rl_v3s(0.12f), 0.6f, 60.0f), &t->m.lamp },
-        { phong("shade", rl_v3(0.85f, 0.78f, 0.55f), 0.0f, 1.0f), &t->m.shade },
+        { rl_builtin_phong("teapot", rl_v3(0.72f, 0.70f, 0.62f), 0.0f, 1.0f), &t->m.teapot },
+        { rl_builtin_phong("lamp", rl_v3s(0.12f), 0.6f, 60.0f), &t->m.lamp },
+        { rl_builtin_phong("shade", rl_v3(0.85f, 0.78f, 0.55f), 0.0f, 1.0f), &t->m.shade },
         /* A few centimetres from the bulb the inside gets ~30x the table's
          * irradiance; a dark lining keeps its mirror image in the table and
          * the cup a highlight rather than a white blot. */
-        { phong("shade_inner", rl_v3(0.06f, 0.055f, 0.04f), 0.0f, 1.0f), &t->m.shade_inner },
-        { phong("plate", rl_v3s(0.7f), 0.3f, 90.0f), &t->m.plate },
-        { phong("book", rl_v3(0.15f, 0.35f, 0.18f), 0.1f, 20.0f), &t->m.book },
-        { phong("pages", rl_v3(0.86f, 0.84f, 0.76f), 0.0f, 1.0f), &t->m.pages },
+        { rl_builtin_phong("shade_inner", rl_v3(0.06f, 0.055f, 0.04f), 0.0f, 1.0f), &t->m.shade_inner },
+        { rl_builtin_phong("plate", rl_v3s(0.7f), 0.3f, 90.0f), &t->m.plate },
+        { rl_builtin_phong("book", rl_v3(0.15f, 0.35f, 0.18f), 0.1f, 20.0f), &t->m.book },
+        { rl_builtin_phong("pages", rl_v3(0.86f, 0.84f, 0.76f), 0.0f, 1.0f), &t->m.pages },
     };
     for (size_t i = 0; i < sizeof list / sizeof list[0] && !s; ++i)
         s = rl_scene_add_material(t->scene, &list[i].m, list[i].id);
