@@ -13,4 +13,6 @@
 #include "rl/rl_accel.h"
 #include "rl/rl_trace.h"
 #include "rl/rl_metrics.h"
+#include "rl/rl_filter.h"
+#include "rl/rl_shadowmap.h"
 #endif

@@ -197,14 +197,15 @@ RL_API void rl_scene_get_stats(const rl_scene *scene, rl_scene_stats *out);
 /* Procedural meshes ("generators"), shared by built-in and JSON scenes.
  * params: "key=value" pairs separated by commas or NULL; unknown keys are
  * RL_ERR_INVALID_ARG. Generators: box, quad, sphere, cylinder, teapot
- * (Utah teapot from its Bezier patches). See docs/scene-format.md. */
+ * (Utah teapot from its Bezier patches), blob (a closed, lumpy genus-0 mesh
+ * with an exact even triangle count). See docs/scene-format.md. */
 RL_API rl_status rl_scene_add_generated(rl_scene *scene, const char *generator,
                                         const char *params, uint32_t material,
                                         uint32_t *mesh_id);
 RL_API const char *const *rl_generator_names(size_t *count);
 
-/* Built-in scenes: cornell, cornell-teapot, spheres, city, table, cluster
- * (rl scenes lists them with their parameters). params as above
+/* Built-in scenes: cornell, cornell-teapot, spheres, city, table, cluster,
+ * ls-open, ls-cornell (rl scenes lists them with their parameters). params as above
  * (e.g. "triangles=70000" for cornell-teapot, "blocks=8" for city). The
  * returned scene is committed. */
 typedef struct rl_builtin_info {

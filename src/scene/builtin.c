@@ -47,10 +47,23 @@ static const rl_builtin_info infos[] = {
       "speed=80 (km/h, 0..240), rpm=3 (x1000/min, 0..8), tex=1024 (dial texture size, "
       "64..4096), glass_segments=48 (cover glass columns, 4..1024), detail=1 "
       "(tessellation multiplier, 0.25..8)" },
+    { "ls-open",
+      "Schröder 2017, Sec. 9.3, scenes 1-3: one object (90 % diffuse, 10 % specular, "
+      "shininess 50) on a floor under three quad lights; object + 8 triangles; "
+      "max path length 2 (root attribute max_path_length); camera 1280x720",
+      "model=teapot (teapot: 15704 triangles; bunny: closed blob of 69450, the thesis' "
+      "69451 being odd; dragon: closed blob of 871306), triangles=N (teapot: closest patch "
+      "grid, 1..4000000; bunny/dragon: exactly N, even, 4..16000000)" },
+    { "ls-cornell",
+      "Schröder 2017, Sec. 9.3, scenes 4-7: Cornell box (5 walls, ceiling quad light: 12 "
+      "triangles) with a diffuse and a mirror cuboid (36 triangles) or one model (+12); "
+      "max path length 3 (root attribute max_path_length); camera 1280x720",
+      "model=boxes (or teapot, bunny, dragon as in ls-open), triangles=N (models only, "
+      "as in ls-open)" },
 };
 static const rl_builtin_build_fn builders[] = {
     rl_builtin_cornell, rl_builtin_cornell_teapot, rl_builtin_spheres, rl_builtin_city,
-    rl_builtin_table, rl_builtin_cluster,
+    rl_builtin_table, rl_builtin_cluster, rl_builtin_ls_open, rl_builtin_ls_cornell,
 };
 #define NUM_BUILTINS (sizeof infos / sizeof infos[0])
 _Static_assert(sizeof builders / sizeof builders[0] == NUM_BUILTINS, "one builder per scene");
@@ -73,7 +86,7 @@ rl_status rl_scene_create_builtin(const char *name, const char *params, rl_scene
     if (!build)
         return rl_error(RL_ERR_NOT_FOUND,
                         "unknown built-in scene \"%s\" (built-ins: cornell, cornell-teapot, "
-                        "spheres, city, table, cluster)", name);
+                        "spheres, city, table, cluster, ls-open, ls-cornell)", name);
     rl_params p;
     rl_status s = rl_params_parse(params, &p);
     if (s)

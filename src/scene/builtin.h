@@ -18,6 +18,13 @@ rl_status rl_builtin_spheres(rl_scene *scene, rl_params *params);
 rl_status rl_builtin_city(rl_scene *scene, rl_params *params);
 rl_status rl_builtin_table(rl_scene *scene, rl_params *params);
 rl_status rl_builtin_cluster(rl_scene *scene, rl_params *params);
+/* The test scenes of Schröder 2017, Sec. 9.3 (builtin_linespace.c). */
+rl_status rl_builtin_ls_open(rl_scene *scene, rl_params *params);
+rl_status rl_builtin_ls_cornell(rl_scene *scene, rl_params *params);
+/* Triangle counts of the bunny and dragon stand-ins (closed blobs): the
+ * thesis' 69,451 is odd, impossible for a closed mesh, hence 69,450. */
+#define RL_LS_BUNNY_TRIANGLES 69450u
+#define RL_LS_DRAGON_TRIANGLES 871306u
 
 /* Adds a material with the given name, diffuse colour and otherwise the
  * defaults of rl_material_default(); *id receives its index. */

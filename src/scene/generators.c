@@ -28,8 +28,14 @@
  * |           |          |         |               | Schröder 2017's teapot (13 x 19 per patch) |
  * |           | size     | 1       | (0, 1e6]      | height; stands on y = 0 around the y axis, |
  * |           |          |         |               | spout towards +x, width about 2.04 * size  |
+ * | blob      | triangles| 20000   | even, [4, 16e6]| exactly this many triangles; closed,      |
+ * |           |          |         |               | genus 0, outward (blob.c); odd is an error |
+ * |           | seed     | 1       | [0, 2^53]     | lump placement                             |
+ * |           | scale    | 1       | (0, 1e6]      | radius of the sphere before the lumps      |
+ * |           | lumps    | 6       | [0, 64]       | smooth bumps and dents                     |
  *
- * The teapot is Newell's 32-patch Utah teapot (teapot.c). */
+ * The teapot is Newell's 32-patch Utah teapot (teapot.c). The blob
+ * (blob.c) stands in for the bunny and dragon of Schröder 2017, Sec. 9.3. */
 #include "scene/generators.h"
 
 #include <stdlib.h>
@@ -37,6 +43,7 @@
 
 #include "core/error.h"
 #include "core/params.h"
+#include "scene/blob.h"
 
 #define GEN_MAX_SIZE 1e6
 
@@ -236,6 +243,23 @@ static rl_status build_teapot(rl_meshbuf *b, rl_params *p)
     return s;
 }
 
+static rl_status build_blob(rl_meshbuf *b, rl_params *p)
+{
+    long long triangles = RL_BLOB_DEFAULT_TRIANGLES, seed = 1, lumps = 6;
+    double scale = 1.0;
+    rl_status s = rl_params_int(p, "blob", "triangles", RL_BLOB_MIN_TRIANGLES,
+                                RL_BLOB_MAX_TRIANGLES, &triangles);
+    if (!s) s = rl_params_int(p, "blob", "seed", 0, 1ll << 53, &seed);
+    if (!s) s = rl_params_float(p, "blob", "scale", 1e-30, GEN_MAX_SIZE, &scale);
+    if (!s) s = rl_params_int(p, "blob", "lumps", 0, RL_BLOB_MAX_LUMPS, &lumps);
+    if (!s) s = rl_params_check_unused(p, "blob", "triangles, seed, scale, lumps");
+    if (!s)
+        s = rl_gen_blob(b, &(rl_blob_desc){ .triangles = (uint32_t)triangles,
+                                            .seed = (uint64_t)seed, .scale = (float)scale,
+                                            .lumps = (int)lumps });
+    return s;
+}
+
 typedef struct generator {
     const char *name;
     rl_status (*build)(rl_meshbuf *b, rl_params *p);
@@ -247,11 +271,12 @@ static const generator generators[] = {
     { "sphere", build_sphere },
     { "cylinder", build_cylinder },
     { "teapot", build_teapot },
+    { "blob", build_blob },
 };
 #define NUM_GENERATORS (sizeof generators / sizeof generators[0])
 
 static const char *const generator_names[NUM_GENERATORS + 1] = {
-    "box", "quad", "sphere", "cylinder", "teapot", NULL
+    "box", "quad", "sphere", "cylinder", "teapot", "blob", NULL
 };
 
 const char *const *rl_generator_names(size_t *count)
@@ -273,7 +298,7 @@ rl_status rl_scene_add_generated(rl_scene *scene, const char *generator_name,
             g = &generators[i];
     if (!g)
         return rl_error(RL_ERR_NOT_FOUND, "unknown generator \"%s\" (known: box, quad, "
-                                          "sphere, cylinder, teapot)", generator_name);
+                                          "sphere, cylinder, teapot, blob)", generator_name);
     rl_params p;
     rl_status s = rl_params_parse(params, &p);
     if (s)

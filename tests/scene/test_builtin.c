@@ -31,7 +31,8 @@ static void test_builtin_list_names_every_scene(void **state)
     (void)state;
     size_t n = 0;
     const rl_builtin_info *info = rl_builtin_scenes(&n);
-    const char *expected[] = { "cornell", "cornell-teapot", "spheres", "city", "table", "cluster" };
+    const char *expected[] = { "cornell", "cornell-teapot", "spheres", "city", "table", "cluster",
+                               "ls-open", "ls-cornell" };
     assert_int_equal(n, sizeof expected / sizeof expected[0]);
     for (size_t i = 0; i < n; ++i) {
         assert_string_equal(info[i].name, expected[i]);

@@ -154,9 +154,10 @@ static void test_generators_reject_bad_parameters(void **state)
 
     size_t n = 0;
     const char *const *names = rl_generator_names(&n);
-    assert_int_equal(n, 5);
+    assert_int_equal(n, 6);
     assert_string_equal(names[4], "teapot");
-    assert_null(names[5]);
+    assert_string_equal(names[5], "blob");
+    assert_null(names[6]);
 }
 
 static void test_teapot_data_matches_the_published_set(void **state)
