@@ -32,6 +32,7 @@
 #include "bench_vt.h"
 
 #include "bench_rays.h"
+#include "bench_util.h"
 #include "cli.h"
 
 #include <cjson/cJSON.h>
@@ -147,62 +148,12 @@ typedef struct quality {
 /* ------------------------------------------------------------ output -- */
 
 /* "bench vt: criteria rgb 1024x1024: ..." on stderr, one per measurement. */
-static void note(const char *fmt, ...)
-#if defined(__GNUC__)
-    __attribute__((format(printf, 1, 2)))
-#endif
-    ;
-static void note(const char *fmt, ...)
-{
-    if (rl_log_get_level() < RL_LOG_INFO)
-        return;
-    va_list ap;
-    va_start(ap, fmt);
-    fputs("bench vt: ", stderr);
-    vfprintf(stderr, fmt, ap);
-    fputc('\n', stderr);
-    va_end(ap);
-}
-
-/* JSON has no NaN or infinity: unknown values are null. */
-static void add_num(cJSON *o, const char *key, double value)
-{
-    if (isfinite(value))
-        cJSON_AddNumberToObject(o, key, value);
-    else
-        cJSON_AddNullToObject(o, key);
-}
-
-static uint64_t rays_total(const rl_render_stats *s)
-{
-    uint64_t n = 0;
-    for (int k = 0; k < RL_RAY_TYPE_COUNT; k++)
-        n += s->rays[k];
-    return n;
-}
-
-static cJSON *rays_json(const rl_render_stats *s)
-{
-    cJSON *o = cJSON_CreateObject();
-    for (int k = 0; o && k < RL_RAY_TYPE_COUNT; k++)
-        cJSON_AddNumberToObject(o, rl_ray_type_name((rl_ray_type)k), (double)s->rays[k]);
-    if (o)
-        cJSON_AddNumberToObject(o, "total", (double)rays_total(s));
-    return o;
-}
-
-static cJSON *metrics_json(const rl_image_metrics *m)
-{
-    cJSON *o = cJSON_CreateObject();
-    if (!o)
-        return NULL;
-    add_num(o, "ssim", m->ssim);
-    add_num(o, "rmse", m->rmse);
-    add_num(o, "psnr", m->psnr);    /* null when the images are equal */
-    add_num(o, "max_abs", m->max_abs);
-    cJSON_AddNumberToObject(o, "pixels", (double)m->pixels);
-    return o;
-}
+#define note(...) rl_bench_note("vt", __VA_ARGS__)
+#define add_num rl_bench_add_num
+#define rays_total rl_bench_rays_total
+#define rays_json rl_bench_rays_json
+#define metrics_json rl_bench_metrics_json
+#define ratio rl_bench_ratio
 
 static cJSON *quality_json(const quality *q)
 {
@@ -276,11 +227,6 @@ static rl_status bench_error(bvt *b, rl_status st, const char *fmt, ...)
     vsnprintf(b->reason, sizeof b->reason, fmt, ap);
     va_end(ap);
     return st;
-}
-
-static double ratio(double a, double b)
-{
-    return b != 0.0 ? a / b : NAN;
 }
 
 /* ------------------------------------------------------- VT objects -- */
@@ -463,8 +409,9 @@ static rl_status compare(const rl_image *img, const rl_image *ref, const uint8_t
 /* ---------------------------------------------------------- criteria -- */
 
 /* Fig. 5.5/5.6: the same frame refined by each criterion. */
-static rl_status sec_criteria(bvt *b, cJSON *sec)
+static rl_status sec_criteria(void *ctx, cJSON *sec)
 {
+    bvt *b = ctx;
     int w = b->a->width, h = b->a->height;
     ref_frame *ref = NULL;
     rl_status st = reference(b, w, h, b->threads, &ref);
@@ -554,8 +501,9 @@ static bool count_update(void *user, const rl_image *image, uint32_t stage, bool
 }
 
 /* Fig. 5.10-5.12: default criteria at growing square resolutions. */
-static rl_status sec_resolution(bvt *b, cJSON *sec)
+static rl_status sec_resolution(void *ctx, cJSON *sec)
 {
+    bvt *b = ctx;
     static const int full_sizes[] = { 512, 1024, 2048 }, quick_sizes[] = { 64, 128 };
     const int *sizes = b->a->quick ? quick_sizes : full_sizes;
     int num_sizes = b->a->quick ? 2 : 3;
@@ -651,8 +599,9 @@ static rl_status sec_resolution(bvt *b, cJSON *sec)
 /* ----------------------------------------------------------- quality -- */
 
 /* The min_edge sweep: how fast is VT at Whitted's quality? */
-static rl_status sec_quality(bvt *b, cJSON *sec)
+static rl_status sec_quality(void *ctx, cJSON *sec)
 {
+    bvt *b = ctx;
     static const double min_edges[] = { 1, 2, 3, 4, 6, 8 };
     int w = b->a->width, h = b->a->height;
     ref_frame *ref = NULL;
@@ -738,8 +687,9 @@ static rl_status sec_quality(bvt *b, cJSON *sec)
 /* ----------------------------------------------------------- threads -- */
 
 /* Fig. 5.15 (and the time split of Fig. 5.9): 1, 2, 4, ... threads. */
-static rl_status sec_threads(bvt *b, cJSON *sec)
+static rl_status sec_threads(void *ctx, cJSON *sec)
 {
+    bvt *b = ctx;
     int counts[16], num = 0;
     for (int n = 1; n < b->max_threads && num < 15; n *= 2)
         counts[num++] = n;
@@ -828,8 +778,9 @@ static rl_status sec_threads(bvt *b, cJSON *sec)
 /* -------------------------------------------------------- visibility -- */
 
 /* Fig. 5.13: the visibility tests switched off one after the other. */
-static rl_status sec_visibility(bvt *b, cJSON *sec)
+static rl_status sec_visibility(void *ctx, cJSON *sec)
 {
+    bvt *b = ctx;
     static const struct {
         const char *name, *id, *z, *clip;
     } configs[] = {
@@ -1012,8 +963,9 @@ static cJSON *anim_json(uint32_t frame, const anim_result *r)
  * whole path in order (two renderers: one keeps the feelers between frames,
  * the other does not), interleaved frame by frame with Whitted, so that
  * every frame has its reference and load changes hit all three alike. */
-static rl_status sec_animation(bvt *b, cJSON *sec)
+static rl_status sec_animation(void *ctx, cJSON *sec)
 {
+    bvt *b = ctx;
     const rl_camera_path *path = rl_scene_get_data(b->cluster)->camera_path;
     if (!path)
         return bench_error(b, RL_ERR_NOT_FOUND, "scene cluster has no camera path");
@@ -1109,40 +1061,6 @@ static rl_status sec_animation(bvt *b, cJSON *sec)
 
 /* ------------------------------------------------------- the command -- */
 
-static bool parse_count(const char *option, const char *text, long long max, long long *out)
-{
-    long long v;
-    if (!rl_parse_int(text, &v) || v < 1 || v > max) {
-        rl_cli_fail(RL_CLI_USAGE, "%s: expected a whole number in 1..%lld, got '%s'", option, max,
-                    text);
-        return false;
-    }
-    *out = v;
-    return true;
-}
-
-static bool parse_only(const char *text, unsigned *sections)
-{
-    *sections = 0;
-    const char *p = text;
-    for (;;) {
-        size_t n = strcspn(p, ",");
-        int found = -1;
-        for (int k = 0; k < SEC_COUNT; k++)
-            if (n == strlen(section_names[k]) && strncmp(p, section_names[k], n) == 0)
-                found = k;
-        if (found < 0) {
-            rl_cli_fail(RL_CLI_USAGE, "--only: expected sections among criteria, resolution, "
-                                      "quality, threads, visibility, animation, got '%s'", text);
-            return false;
-        }
-        *sections |= 1u << found;
-        if (p[n] == '\0')
-            return true;
-        p += n + 1;
-    }
-}
-
 /* Returns RL_CLI_OK, an exit code, or -1 when --help was printed. */
 static int parse_args(int argc, char **argv, bvt_args *a)
 {
@@ -1166,14 +1084,14 @@ static int parse_args(int argc, char **argv, bvt_args *a)
                 return RL_CLI_USAGE;
             a->has_anim_size = true;
         } else if (VALUE("--frames")) {
-            if (m < 0 || !parse_count("--frames", v, MAX_FRAMES, &a->frames))
+            if (m < 0 || !rl_bench_parse_count("--frames", v, MAX_FRAMES, &a->frames))
                 return RL_CLI_USAGE;
             a->has_frames = true;
         } else if (VALUE("--threads")) {
-            if (m < 0 || !parse_count("--threads", v, RL_VT_MAX_THREADS, &a->threads))
+            if (m < 0 || !rl_bench_parse_count("--threads", v, RL_VT_MAX_THREADS, &a->threads))
                 return RL_CLI_USAGE;
         } else if (VALUE("--only")) {
-            if (m < 0 || !parse_only(v, &a->sections))
+            if (m < 0 || !rl_bench_parse_sections(v, section_names, SEC_COUNT, &a->sections))
                 return RL_CLI_USAGE;
         } else if (VALUE("--out")) {
             if (m < 0)
@@ -1197,18 +1115,6 @@ static int parse_args(int argc, char **argv, bvt_args *a)
     if (!a->has_frames)
         a->frames = a->quick ? 3 : 60;
     return RL_CLI_OK;
-}
-
-/* bench/results/vt-YYYYMMDD-HHMMSS.json (UTC), creating the folder. */
-static bool default_out(char *path, size_t size)
-{
-    time_t now = time(NULL);
-    struct tm utc;
-    char stamp[32];
-    if (!gmtime_r(&now, &utc) || !strftime(stamp, sizeof stamp, "%Y%m%d-%H%M%S", &utc))
-        snprintf(stamp, sizeof stamp, "%lld", (long long)now);
-    snprintf(path, size, "bench/results/vt-%s.json", stamp);
-    return rl_cli_make_dirs("bench/results");
 }
 
 static bool wants(const bvt_args *a, int section)
@@ -1309,15 +1215,13 @@ static cJSON *report_root(const bvt *b)
     return root;
 }
 
-typedef rl_status (*section_fn)(bvt *b, cJSON *sec);
-
 static int run(bvt *b)
 {
     const bvt_args *a = b->a;
     char out[256];
     if (a->out)
         snprintf(out, sizeof out, "%s", a->out);
-    if (a->out ? !rl_cli_check_writable(out) : !default_out(out, sizeof out))
+    if (a->out ? !rl_cli_check_writable(out) : !rl_bench_default_out("vt", out, sizeof out))
         return RL_CLI_FAIL;
     /* The renderers first: the record is worthless without them. */
     const char *const names[] = { "vt", "whitted" };
@@ -1347,51 +1251,14 @@ static int run(bvt *b)
     cJSON *root = report_root(b);
     if (!root)
         return rl_cli_fail(RL_CLI_FAIL, "out of memory");
-    static const section_fn fns[SEC_COUNT] = { sec_criteria, sec_resolution, sec_quality,
-                                               sec_threads, sec_visibility, sec_animation };
+    static const rl_bench_section_fn fns[SEC_COUNT] = { sec_criteria, sec_resolution,
+                                                        sec_quality, sec_threads,
+                                                        sec_visibility, sec_animation };
     printf("rl bench vt: Vertex Tracing vs Whitted, %d threads, max_depth %s, area_samples %s, "
            "shadows %s\n", b->threads, TRACE_MAX_DEPTH, TRACE_AREA_SAMPLES, TRACE_SHADOWS);
-    char failed[512] = "";
-    for (int k = 0; k < SEC_COUNT; k++) {
-        if (!wants(a, k))
-            continue;
-        cJSON *sec = cJSON_AddObjectToObject(root, section_names[k]);
-        if (!sec) {
-            rc = rl_cli_fail(RL_CLI_FAIL, "out of memory");
-            break;
-        }
-        b->reason[0] = '\0';
-        rl_clear_error();
-        rl_status st = fns[k](b, sec);
-        if (st == RL_OK) {
-            cJSON_AddStringToObject(sec, "status", "ok");
-            continue;
-        }
-        /* The other sections may still work: record why and go on. */
-        const char *why = b->reason[0] ? b->reason : rl_last_error();
-        if (!why || !*why)
-            why = rl_status_string(st);
-        cJSON_AddStringToObject(sec, "status", "failed");
-        cJSON_AddStringToObject(sec, "reason", why);
-        printf("\n%s: failed: %s\n", section_names[k], why);
-        if (!failed[0])
-            snprintf(failed, sizeof failed, "%s (%s)", section_names[k], why);
-    }
-    /* Again for the load average after the run: how busy the machine was. */
-    cJSON *machine = rl_bench_machine_json(b->threads);
-    if (machine && !cJSON_ReplaceItemInObjectCaseSensitive(root, "machine", machine))
-        cJSON_Delete(machine);
-    if (rc == RL_CLI_OK) {
-        if (!cJSON_GetObjectItem(root, "machine") || !cJSON_GetObjectItem(root, "parameters"))
-            rc = rl_cli_fail(RL_CLI_FAIL, "out of memory");
-        else if (!rl_cli_write_json(root, out))
-            rc = RL_CLI_FAIL;
-        else
-            note("wrote %s", out);
-    }
+    rc = rl_bench_run_sections("vt", root, section_names, fns, SEC_COUNT, a->sections, b,
+                               b->reason, b->threads, out);
     cJSON_Delete(root);
-    if (rc == RL_CLI_OK && failed[0])
-        rc = rl_cli_fail(RL_CLI_FAIL, "bench vt: section %s failed", failed);
     return rc;
 }
 

@@ -11,6 +11,7 @@
  * so the default list works without the Assimp test models. */
 #define _POSIX_C_SOURCE 200809L
 #include "bench_rays.h"
+#include "bench_util.h"
 #include "bench_vt.h"
 #include "cli.h"
 
@@ -20,7 +21,6 @@
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
-#include <time.h>
 
 #include "core/params.h"
 
@@ -549,24 +549,12 @@ static void print_scene(const rl_bench_scene_result *sc)
     fflush(stdout);
 }
 
-/* bench/results/rays-YYYYMMDD-HHMMSS.json (UTC), creating the folder. */
-static bool default_out(char *path, size_t size)
-{
-    time_t now = time(NULL);
-    struct tm utc;
-    char stamp[32];
-    if (!gmtime_r(&now, &utc) || !strftime(stamp, sizeof stamp, "%Y%m%d-%H%M%S", &utc))
-        snprintf(stamp, sizeof stamp, "%lld", (long long)now);
-    snprintf(path, size, "bench/results/rays-%s.json", stamp);
-    return rl_cli_make_dirs("bench/results");
-}
-
 static int run(bench_args *a)
 {
     char out[256];
     if (a->out)
         snprintf(out, sizeof out, "%s", a->out);
-    if (a->out ? !rl_cli_check_writable(out) : !default_out(out, sizeof out))
+    if (a->out ? !rl_cli_check_writable(out) : !rl_bench_default_out("rays", out, sizeof out))
         return RL_CLI_FAIL;
 
     rl_bench_params p = {

@@ -1,0 +1,169 @@
+/* bench_util.c: see bench_util.h. */
+#define _POSIX_C_SOURCE 200809L
+#include "bench_util.h"
+
+#include "bench_rays.h"
+#include "cli.h"
+
+#include <cjson/cJSON.h>
+#include <math.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <string.h>
+#include <time.h>
+
+#include "core/params.h"
+
+void rl_bench_note(const char *bench, const char *fmt, ...)
+{
+    if (rl_log_get_level() < RL_LOG_INFO)
+        return;
+    va_list ap;
+    va_start(ap, fmt);
+    fprintf(stderr, "bench %s: ", bench);
+    vfprintf(stderr, fmt, ap);
+    fputc('\n', stderr);
+    va_end(ap);
+}
+
+void rl_bench_add_num(cJSON *o, const char *key, double value)
+{
+    if (isfinite(value))
+        cJSON_AddNumberToObject(o, key, value);
+    else
+        cJSON_AddNullToObject(o, key);
+}
+
+uint64_t rl_bench_rays_total(const rl_render_stats *s)
+{
+    uint64_t n = 0;
+    for (int k = 0; k < RL_RAY_TYPE_COUNT; k++)
+        n += s->rays[k];
+    return n;
+}
+
+cJSON *rl_bench_rays_json(const rl_render_stats *s)
+{
+    cJSON *o = cJSON_CreateObject();
+    for (int k = 0; o && k < RL_RAY_TYPE_COUNT; k++)
+        cJSON_AddNumberToObject(o, rl_ray_type_name((rl_ray_type)k), (double)s->rays[k]);
+    if (o)
+        cJSON_AddNumberToObject(o, "total", (double)rl_bench_rays_total(s));
+    return o;
+}
+
+cJSON *rl_bench_metrics_json(const rl_image_metrics *m)
+{
+    cJSON *o = cJSON_CreateObject();
+    if (!o)
+        return NULL;
+    rl_bench_add_num(o, "ssim", m->ssim);
+    rl_bench_add_num(o, "rmse", m->rmse);
+    rl_bench_add_num(o, "psnr", m->psnr);    /* null when the images are equal */
+    rl_bench_add_num(o, "max_abs", m->max_abs);
+    cJSON_AddNumberToObject(o, "pixels", (double)m->pixels);
+    return o;
+}
+
+double rl_bench_ratio(double a, double b)
+{
+    return b != 0.0 ? a / b : NAN;
+}
+
+bool rl_bench_parse_count(const char *option, const char *text, long long max, long long *out)
+{
+    long long v;
+    if (!rl_parse_int(text, &v) || v < 1 || v > max) {
+        rl_cli_fail(RL_CLI_USAGE, "%s: expected a whole number in 1..%lld, got '%s'", option, max,
+                    text);
+        return false;
+    }
+    *out = v;
+    return true;
+}
+
+bool rl_bench_parse_sections(const char *text, const char *const *names, int count,
+                             unsigned *sections)
+{
+    *sections = 0;
+    const char *p = text;
+    for (;;) {
+        size_t n = strcspn(p, ",");
+        int found = -1;
+        for (int k = 0; k < count; k++)
+            if (n == strlen(names[k]) && strncmp(p, names[k], n) == 0)
+                found = k;
+        if (found < 0) {
+            char list[256] = "";
+            for (int k = 0; k < count; k++) {
+                size_t len = strlen(list);
+                snprintf(list + len, sizeof list - len, "%s%s", k ? ", " : "", names[k]);
+            }
+            rl_cli_fail(RL_CLI_USAGE, "--only: expected sections among %s, got '%s'", list, text);
+            return false;
+        }
+        *sections |= 1u << found;
+        if (p[n] == '\0')
+            return true;
+        p += n + 1;
+    }
+}
+
+bool rl_bench_default_out(const char *prefix, char *path, size_t size)
+{
+    time_t now = time(NULL);
+    struct tm utc;
+    char stamp[32];
+    if (!gmtime_r(&now, &utc) || !strftime(stamp, sizeof stamp, "%Y%m%d-%H%M%S", &utc))
+        snprintf(stamp, sizeof stamp, "%lld", (long long)now);
+    snprintf(path, size, "bench/results/%s-%s.json", prefix, stamp);
+    return rl_cli_make_dirs("bench/results");
+}
+
+int rl_bench_run_sections(const char *bench, cJSON *root, const char *const *names,
+                          const rl_bench_section_fn *fns, int count, unsigned wanted, void *ctx,
+                          char *reason, int threads, const char *out)
+{
+    int rc = RL_CLI_OK;
+    char failed[512] = "";
+    for (int k = 0; k < count; k++) {
+        if (!((wanted >> k) & 1u))
+            continue;
+        cJSON *sec = cJSON_AddObjectToObject(root, names[k]);
+        if (!sec) {
+            rc = rl_cli_fail(RL_CLI_FAIL, "out of memory");
+            break;
+        }
+        reason[0] = '\0';
+        rl_clear_error();
+        rl_status st = fns[k](ctx, sec);
+        if (st == RL_OK) {
+            cJSON_AddStringToObject(sec, "status", "ok");
+            continue;
+        }
+        /* The other sections may still work: record why and go on. */
+        const char *why = reason[0] ? reason : rl_last_error();
+        if (!why || !*why)
+            why = rl_status_string(st);
+        cJSON_AddStringToObject(sec, "status", "failed");
+        cJSON_AddStringToObject(sec, "reason", why);
+        printf("\n%s: failed: %s\n", names[k], why);
+        if (!failed[0])
+            snprintf(failed, sizeof failed, "%s (%s)", names[k], why);
+    }
+    /* Again for the load average after the run: how busy the machine was. */
+    cJSON *machine = rl_bench_machine_json(threads);
+    if (machine && !cJSON_ReplaceItemInObjectCaseSensitive(root, "machine", machine))
+        cJSON_Delete(machine);
+    if (rc == RL_CLI_OK) {
+        if (!cJSON_GetObjectItem(root, "machine") || !cJSON_GetObjectItem(root, "parameters"))
+            rc = rl_cli_fail(RL_CLI_FAIL, "out of memory");
+        else if (!rl_cli_write_json(root, out))
+            rc = RL_CLI_FAIL;
+        else
+            rl_bench_note(bench, "wrote %s", out);
+    }
+    if (rc == RL_CLI_OK && failed[0])
+        rc = rl_cli_fail(RL_CLI_FAIL, "bench %s: section %s failed", bench, failed);
+    return rc;
+}
