@@ -52,7 +52,12 @@ static inline void ray_pre_setup(const rl_ray *r, ray_pre *p)
     }
 }
 
-/* Entry distances of the children; returns the mask of hit lanes. */
+/* Entry distances of the children; returns the mask of hit lanes. The
+ * interval [lo, hi] is widened by a relative 2^-15 so that rounding never
+ * loses a flat box (a wall: lo == hi). Scaling by (1 -+ eps) widens it only
+ * for lo, hi >= 0, which holds whenever t_min >= 0 (else lo >= 0 > hi and
+ * the box is rejected anyway); a range reaching back (t_min < 0) takes the
+ * sign-safe form. */
 static inline int box_n(const rl_bvh_wide_node *n, const ray_pre *r, float t_min, float t_max, float dist[RL_BVH_WIDTH])
 {
 #if defined(__AVX__) && RL_BVH_WIDTH == 8
@@ -65,6 +70,14 @@ static inline int box_n(const rl_bvh_wide_node *n, const ray_pre *r, float t_min
         hi = _mm256_min_ps(_mm256_mul_ps(_mm256_sub_ps(far, o), inv), hi);
     }
     _mm256_storeu_ps(dist, lo);
+    if (t_min < 0.0f) {
+        /* The slack must widen the interval whatever the signs (below). */
+        const __m256 abs = _mm256_castsi256_ps(_mm256_set1_epi32(0x7fffffff));
+        const __m256 eps = _mm256_set1_ps(0x1p-15f);
+        lo = _mm256_sub_ps(lo, _mm256_mul_ps(_mm256_and_ps(lo, abs), eps));
+        hi = _mm256_add_ps(hi, _mm256_mul_ps(_mm256_and_ps(hi, abs), eps));
+        return _mm256_movemask_ps(_mm256_cmp_ps(lo, hi, _CMP_LE_OQ));
+    }
     return _mm256_movemask_ps(_mm256_cmp_ps(_mm256_mul_ps(lo, _mm256_set1_ps(SLACK_LO)),
                                             _mm256_mul_ps(hi, _mm256_set1_ps(SLACK_HI)), _CMP_LE_OQ));
 #elif defined(__SSE2__)
@@ -79,6 +92,14 @@ static inline int box_n(const rl_bvh_wide_node *n, const ray_pre *r, float t_min
             hi = _mm_min_ps(_mm_mul_ps(_mm_sub_ps(far, o), inv), hi);
         }
         _mm_storeu_ps(dist + c, lo);
+        if (t_min < 0.0f) {
+            const __m128 abs = _mm_castsi128_ps(_mm_set1_epi32(0x7fffffff));
+            const __m128 eps = _mm_set1_ps(0x1p-15f);
+            lo = _mm_sub_ps(lo, _mm_mul_ps(_mm_and_ps(lo, abs), eps));
+            hi = _mm_add_ps(hi, _mm_mul_ps(_mm_and_ps(hi, abs), eps));
+            mask |= _mm_movemask_ps(_mm_cmple_ps(lo, hi)) << c;
+            continue;
+        }
         mask |= _mm_movemask_ps(_mm_cmple_ps(_mm_mul_ps(lo, _mm_set1_ps(SLACK_LO)),
                                              _mm_mul_ps(hi, _mm_set1_ps(SLACK_HI)))) << c;
     }
@@ -96,7 +117,7 @@ static inline int box_n(const rl_bvh_wide_node *n, const ray_pre *r, float t_min
             hi = tf < hi ? tf : hi;
         }
         dist[i] = lo;
-        if (lo * SLACK_LO <= hi * SLACK_HI)
+        if (lo - fabsf(lo) * 0x1p-15f <= hi + fabsf(hi) * 0x1p-15f)
             mask |= 1 << i;
     }
     return mask;
@@ -338,7 +359,8 @@ bool rl_bvh_wide_intersect(const rl_bvh *bvh, rl_ray *ray, rl_hit *hit)
             if (sp == 0)
                 goto finished;
             cur = stack[--sp];
-            if (cur.dist * SLACK_LO <= c.t * SLACK_HI)
+            /* The same relative slack as box_n, sign-safe (t may be < 0). */
+            if (cur.dist - fabsf(cur.dist) * 0x1p-15f <= c.t + fabsf(c.t) * 0x1p-15f)
                 break;
         }
     }

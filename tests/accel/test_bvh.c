@@ -503,6 +503,43 @@ static void assert_same_hit(const rl_accel *ref, const rl_accel *test, rl_ray r)
         assert_true(ha.triangle == hb.triangle && ha.t == hb.t && ha.u == hb.u && ha.v == hb.v);
 }
 
+/* Ranges that reach behind the origin (t_min < 0) are valid queries: the
+ * BVH must find hits at negative t like brute force. Its box test once
+ * widened [lo, hi] by scaling, which narrows a flat box (a wall, lo == hi)
+ * behind the origin and lost it. Segments of random length around random
+ * points inside the Cornell box. */
+static void test_bvh_finds_hits_at_negative_t(void **state)
+{
+    (void)state;
+    rl_scene *s = builtin("cornell", NULL);
+    rl_accel *brute = make_accel(s, (rl_accel_desc){ .kind = RL_ACCEL_BRUTE });
+    rl_accel *bvh = make_accel(s, (rl_accel_desc){ .kind = RL_ACCEL_BVH });
+    /* The reported case first. */
+    assert_same_hit(brute, bvh, (rl_ray){ .o = { 0.453212291f, 0.00355176348f, 0.170753002f },
+                                          .d = { 0.492434859f, 0.471887469f, -0.233506441f },
+                                          .t_min = -0.0992674f, .t_max = 0.0492569f });
+    ray_gen g = ray_gen_make(s, 11);
+    rl_vec3 lo = g.bounds.min, ext = rl_aabb_extent(g.bounds);
+    uint32_t behind = 0;
+    for (uint32_t i = 0; i < 20000; ++i) {
+        rl_rng *rng = &g.rng;
+        rl_vec3 o = rl_v3(lo.x + ext.x * rl_rng_float(rng), lo.y + ext.y * rl_rng_float(rng),
+                          lo.z + ext.z * rl_rng_float(rng));
+        float len = fmaxf(ext.x, fmaxf(ext.y, ext.z)) * rl_rng_float(rng);
+        rl_ray r = { .o = o, .d = random_direction(rng), .t_min = -len * rl_rng_float(rng),
+                     .t_max = len };
+        rl_ray a = r;
+        rl_hit h;
+        if (rl_accel_intersect(brute, &a, &h) && h.t < 0.0f)
+            ++behind;
+        assert_same_hit(brute, bvh, r);
+    }
+    assert_true(behind > 1000);
+    rl_accel_release(bvh);
+    rl_accel_release(brute);
+    rl_scene_release(s);
+}
+
 /* The SIMD leaf test hands lanes with an edge function of exactly 0 to the
  * scalar test (double recompute): rays straight down at the vertices and
  * edge midpoints of an integer grid (every edge function through them is
@@ -562,6 +599,7 @@ int main(void)
         cmocka_unit_test(test_bvh_agrees_with_brute_force_on_cornell_teapot),
         cmocka_unit_test(test_bvh_agrees_with_brute_force_on_city),
         cmocka_unit_test(test_bvh_occluded_agrees_with_intersect_on_random_segments),
+        cmocka_unit_test(test_bvh_finds_hits_at_negative_t),
         cmocka_unit_test(test_bvh_build_is_identical_with_one_and_two_threads),
         cmocka_unit_test(test_bvh_structure_is_consistent_and_stats_are_sane),
         cmocka_unit_test(test_bvh_breaks_ties_by_lowest_triangle_id),
