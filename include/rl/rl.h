@@ -11,6 +11,7 @@
 #include "rl/rl_raster.h"
 #include "rl/rl_render.h"
 #include "rl/rl_accel.h"
+#include "rl/rl_linespace.h"
 #include "rl/rl_trace.h"
 #include "rl/rl_metrics.h"
 #include "rl/rl_filter.h"

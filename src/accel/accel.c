@@ -227,3 +227,10 @@ void rl_accel_occluded_n(const rl_accel *accel, const rl_ray *rays, bool *occlud
     for (size_t i = 0; i < n; ++i)
         occluded[i] = rl_accel_occluded(accel, &rays[i]);
 }
+
+const struct rl_grid *rl_accel_grid_state(const rl_accel *a)
+{
+    if (!a || !a->committed || a->desc.kind != RL_ACCEL_GRID)
+        return NULL;
+    return a->state;
+}

@@ -27,6 +27,11 @@ extern const rl_accel_class rl_accel_brute_class;
 extern const rl_accel_class rl_accel_embree_class;
 #endif
 
+/* The grid of a committed RL_ACCEL_GRID accel (the Line Space builds on
+ * it, rl_linespace.h); NULL for any other kind or an uncommitted accel. */
+struct rl_grid;
+const struct rl_grid *rl_accel_grid_state(const rl_accel *a);
+
 /* The precomputed watertight ray/triangle test (Woop, Benthin, Wald 2013),
  * shared by every kind of ours so that they agree bit for bit on a hit. */
 typedef struct rl_ray_watertight {

@@ -1,0 +1,201 @@
+/* rl_linespace.h: the Line Space (Keul, Müller, Lemke 2016) as built and
+ * used by Schröder 2017, Ch. 4 and 7, on the CPU.
+ *
+ * A Line Space lives inside each voxel of a uniform grid (the grid of
+ * RL_ACCEL_GRID, Sec. 6.1). Each of the voxel's 6 faces is split into N x N
+ * patches; a shaft joins two patches on different faces. Of the 36·N^4
+ * ordered patch pairs, 15·N^4 are unique and relevant (a pair and its
+ * reverse are one shaft; pairs on one face hold nothing), Sec. 4.2. A ray
+ * crossing a voxel enters through one patch and leaves through another, so
+ * it lies inside exactly that shaft, and only what the shaft holds can
+ * stop it there.
+ *
+ * Payloads, each with its own queries (Sec. 7.1-7.4):
+ *   CANDIDATES  the triangles overlapping the shaft, ordered along the
+ *               shaft ("front" first, the thesis' front/back buffers).
+ *               Fixed: k slots per shaft, the k/2 front-most and k/2
+ *               back-most (Alg. 3); a fuller shaft loses triangles and the
+ *               query may miss them (the thesis' artefacts). Dynamic: a
+ *               counting pass and a prefix sum size each shaft's list
+ *               exactly (proposed in Sec. 7.1.1, built here), so queries
+ *               are exact: the same hit as the BVH.
+ *   PNMT        position, normal, material and texcoord of the front-most
+ *               and back-most surface in the shaft, 8 half floats each
+ *               (16 per shaft), n_z rebuilt from its sign (eq. 9).
+ *               Queries return that stored surface: no triangle test.
+ *   PREILLUM    the front and back surfaces' colour under direct light
+ *               (shadow feelers to every light), from a caller-supplied
+ *               shading function. Queries return a colour.
+ *
+ * Index mapping (explicit, tested bijective over the 15·N^4 shafts):
+ *   faces      0 -x, 1 +x, 2 -y, 3 +y, 4 -z, 5 +z;
+ *   patch      p = i + N·j on a face, (i, j) the patch's cell along the
+ *              face's two other axes in increasing axis order
+ *              (face ±x: (y, z); ±y: (x, z); ±z: (x, y));
+ *   face pair  (a, b) with a < b, numbered 0..14 in lexicographic order
+ *              ((0,1)=0, (0,2)=1, ..., (4,5)=14);
+ *   shaft      pair·N^4 + p_a·N^2 + p_b.
+ *   A ray going from face a to face b (a < b) runs the shaft "forward";
+ *   from b to a "backward" (it meets the back list first).
+ *
+ * Data layout (flat arrays, close to the thesis' textures, so that a GPU
+ * version can upload them unchanged; see rl_linespace_data):
+ *   voxel_slot[cell]  per grid cell, the index of its Line Space block, or
+ *                     RL_NONE for a voxel without triangles (an empty voxel
+ *                     needs no shafts: every ray crosses it freely);
+ *   shaft s of block b has global index g = b·15·N^4 + s;
+ *   fixed lists:   cand[g·k .. g·k + k-1], front half then back half,
+ *                  RL_NONE padded;
+ *   dynamic lists: cand[start[g] .. start[g+1]-1], ordered front to back;
+ *   pnmt[g·16 .. g·16 + 15] (uint16 half floats), front record then back:
+ *                  position (voxel-relative, in [0,1]^3 of the voxel box:
+ *                  our change, it keeps half-float precision independent
+ *                  of the scene's size), normal x, y, material ID + 1 with
+ *                  the sign of n_z, texcoord u, v; an empty shaft has
+ *                  material field 0;
+ *   preillum[g·8 .. g·8 + 7] (half floats), front RGBA then back RGBA.
+ *
+ * Lifecycle as rl_accel: create (borrowing a committed RL_ACCEL_GRID accel,
+ * which must outlive the Line Space), optionally set the shading function,
+ * commit (builds), then thread-safe queries that cannot fail. */
+#ifndef RL_LINESPACE_H
+#define RL_LINESPACE_H
+
+#include "rl/rl_accel.h"
+#include "rl/rl_common.h"
+#include "rl/rl_math.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+#define RL_LS_DEFAULT_N 5      /* Schröder 2017, Sec. 9.2: N = 5 in all tests */
+#define RL_LS_MAX_N 16
+#define RL_LS_DEFAULT_K 8      /* fixed slots per shaft (not stated in the thesis) */
+#define RL_LS_MAX_K 256
+#define RL_LS_FACE_PAIRS 15
+
+typedef enum rl_ls_payload {
+    RL_LS_CANDIDATES = 1u << 0,
+    RL_LS_PNMT       = 1u << 1,
+    RL_LS_PREILLUM   = 1u << 2
+} rl_ls_payload;
+
+typedef struct rl_linespace rl_linespace;       /* opaque */
+
+typedef struct rl_linespace_desc {              /* zero = default */
+    int n;                    /* patches per face side; 0 -> RL_LS_DEFAULT_N */
+    int k;                    /* fixed candidate slots per shaft (even);
+                               * 0 -> RL_LS_DEFAULT_K; unused when dynamic */
+    bool dynamic;             /* exact per-shaft lists (prefix sums) */
+    unsigned payloads;        /* rl_ls_payload bits; 0 -> RL_LS_CANDIDATES */
+    int threads;              /* build threads; 0 -> all */
+    rl_progress_fn progress;  /* may be NULL; false cancels the build */
+    void *user;
+} rl_linespace_desc;
+
+/* A surface point as a PNMT record holds it, or as an exact hit yields it. */
+typedef struct rl_ls_surface {
+    float t;                  /* along the query ray */
+    rl_vec3 p;                /* world position */
+    rl_vec3 n;                /* unit shading normal */
+    rl_vec2 uv;
+    uint32_t material;        /* scene material index */
+} rl_ls_surface;
+
+/* Direct light leaving surface s towards -dir (dir: the direction the ray
+ * travels when it reaches s), for PREILLUM. Called from build threads. */
+typedef rl_vec3 (*rl_ls_shade_fn)(void *user, const rl_ls_surface *s, rl_vec3 dir);
+
+typedef struct rl_linespace_stats {
+    int n, k;
+    bool dynamic;
+    unsigned payloads;
+    int grid_res[3];
+    uint32_t voxels, filled_voxels;    /* grid cells; cells with a block */
+    uint64_t shafts;                   /* filled_voxels · 15·N^4 */
+    uint64_t empty_shafts;             /* no triangle overlaps the shaft */
+    uint64_t candidates;               /* stored candidate references */
+    uint32_t max_candidates;           /* in one shaft, before truncation */
+    double mean_candidates;            /* per non-empty shaft, before truncation */
+    uint64_t truncated_shafts;         /* fixed lists that lost triangles */
+    double build_ms;                   /* all payloads, without the grid */
+    double candidates_ms, pnmt_ms, preillum_ms;
+    size_t memory_bytes;               /* all arrays */
+} rl_linespace_stats;
+
+/* RL_ERR_INVALID_ARG: NULL, an accel that is not RL_ACCEL_GRID or not
+ * committed, n outside 1..RL_LS_MAX_N, k odd or outside 2..RL_LS_MAX_K,
+ * unknown payload bits. */
+RL_API rl_status rl_linespace_create(const rl_accel *grid, const rl_linespace_desc *desc,
+                                     rl_linespace **out);
+/* Required before commit when PREILLUM is requested (else RL_ERR_INVALID_ARG
+ * at commit). */
+RL_API rl_status rl_linespace_set_shader(rl_linespace *ls, rl_ls_shade_fn fn, void *user);
+/* Builds; RL_ERR_OUT_OF_MEMORY, RL_ERR_LIMIT (more than 2^32-1 shafts or
+ * candidates), RL_ERR_CANCELLED. A second commit is a no-op. */
+RL_API rl_status rl_linespace_commit(rl_linespace *ls);
+RL_API void rl_linespace_release(rl_linespace *ls);       /* NULL is a no-op */
+RL_API void rl_linespace_get_stats(const rl_linespace *ls, rl_linespace_stats *out);
+RL_API const rl_accel *rl_linespace_grid(const rl_linespace *ls);
+
+/* ---- index mapping (pure functions) ---- */
+static inline uint32_t rl_ls_shafts_per_voxel(int n) { return 15u * (uint32_t)(n * n) * (uint32_t)(n * n); }
+/* Shaft index for patches pa on face fa and pb on face fb (fa != fb, either
+ * order); *forward (may be NULL) says whether fa < fb. RL_NONE if fa == fb. */
+RL_API uint32_t rl_ls_shaft_index(int n, int fa, int pa, int fb, int pb, bool *forward);
+/* Inverse: the faces (fa < fb) and patches of shaft s < 15·N^4. */
+RL_API void rl_ls_shaft_decode(int n, uint32_t s, int *fa, int *pa, int *fb, int *pb);
+/* The shaft a line crosses in a voxel, from its entry and exit points on
+ * the voxel box (as the query does); RL_NONE when both lie on one face. */
+RL_API uint32_t rl_ls_shaft_of_segment(int n, rl_aabb voxel, rl_vec3 entry, rl_vec3 exit,
+                                       bool *forward);
+
+/* ---- queries (committed Line Space; thread-safe; bad rays miss) ----
+ * All walk the grid's voxels front to back with the 3D-DDA and consult
+ * each filled voxel's shaft for the ray. */
+
+/* CANDIDATES: closest hit among the shaft candidates, as rl_accel_intersect
+ * (shortens ray->t_max on a hit). Exact with dynamic lists; with fixed
+ * lists a truncated shaft may miss. */
+RL_API bool rl_linespace_intersect(const rl_linespace *ls, rl_ray *ray, rl_hit *hit);
+RL_API bool rl_linespace_occluded(const rl_linespace *ls, const rl_ray *ray);
+/* PNMT: the first stored surface along the ray within (t_min, t_max),
+ * without a triangle test; its t is the stored point projected on the ray. */
+RL_API bool rl_linespace_pnmt_intersect(const rl_linespace *ls, const rl_ray *ray,
+                                        rl_ls_surface *s);
+/* PNMT shadow test: whether a stored surface lies within (t_min, t_max). */
+RL_API bool rl_linespace_pnmt_occluded(const rl_linespace *ls, const rl_ray *ray);
+/* PREILLUM: the stored colour of the first surface along the ray; *t as
+ * for PNMT (may be NULL). False (colour untouched) if none. */
+RL_API bool rl_linespace_preillum(const rl_linespace *ls, const rl_ray *ray, rl_vec3 *color,
+                                  float *t);
+
+/* ---- raw arrays, for a GPU upload and for tests ---- */
+typedef struct rl_linespace_data {
+    int n, k;
+    bool dynamic;
+    uint32_t shafts_per_voxel;         /* 15·N^4 */
+    uint32_t num_cells, num_blocks;
+    const uint32_t *voxel_slot;        /* num_cells entries */
+    const uint32_t *cand;              /* candidate triangle IDs */
+    const uint32_t *cand_start;        /* dynamic: num_blocks·S + 1 entries; else NULL */
+    uint64_t num_cand;
+    const uint16_t *pnmt;              /* or NULL */
+    const uint16_t *preillum;          /* or NULL */
+} rl_linespace_data;
+RL_API void rl_linespace_get_data(const rl_linespace *ls, rl_linespace_data *out);
+
+/* ---- save and load (Schröder 2017, Sec. 13.3) ----
+ * A versioned little-endian file with a checksum over its contents and a
+ * fingerprint of the scene's triangles and the grid (resolution, bounds).
+ * Load refuses (RL_ERR_PARSE: corrupt/truncated/wrong version; RL_ERR_INVALID_ARG:
+ * another scene or grid) with a message saying which. A loaded Line Space
+ * is committed and answers queries bit-identically to the saved one. */
+RL_API rl_status rl_linespace_save(const rl_linespace *ls, const char *path);
+RL_API rl_status rl_linespace_load(const rl_accel *grid, const char *path, rl_linespace **out);
+
+#ifdef __cplusplus
+}
+#endif
+#endif

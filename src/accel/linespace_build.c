@@ -1,0 +1,706 @@
+/* linespace_build.c: generating the Line Space payloads per filled voxel
+ * (Schröder 2017, Sec. 7.1, Alg. 3; dynamic lists as proposed in Sec. 7.1.1;
+ * PREILLUM Sec. 7.3; PNMT Sec. 7.4).
+ *
+ * Per voxel (a grid cell with at least one triangle; OpenMP over voxels,
+ * dynamic schedule): every triangle of the cell is clipped to the voxel and
+ * rl_ls_enumerate (linespace_shaft.c) lists the shafts it may overlap, with
+ * its position along each shaft. A counting sort groups the entries by
+ * shaft; each shaft's list is then sorted front to back by the midpoint ray
+ * (Alg. 3), ties by triangle ID. From the sorted list:
+ *   fixed k:  the k/2 front-most (front order) and the k/2 back-most (back
+ *             to front), RL_NONE padded; a shaft with more than k
+ *             candidates counts as truncated (Sec. 7.1.1's "holes");
+ *   dynamic:  counting pass, prefix sum, fill pass (Sec. 7.1.1). In contrast
+ *             to the proposal, the counting pass keeps each voxel's lists in
+ *             a temporary block and the fill pass copies them to their
+ *             prefix-sum offsets instead of clipping everything again: twice
+ *             the list memory for a moment, half the build time. The prefix
+ *             sum is two-level: offsets inside each block during the pass,
+ *             then the blocks' bases, added per block in parallel;
+ *   PNMT:     the front record is the first triangle the shaft's midpoint
+ *             ray hits, the back record the first the reversed ray hits
+ *             (Sec. 7.4). If the midpoint ray hits none of the shaft's
+ *             candidates (they only graze the shaft), we store the point of
+ *             the front-most (back-most) candidate closest to the axis point
+ *             at that candidate's key: a shaft with geometry then never
+ *             reads as empty;
+ *   PREILLUM: the same two surfaces, coloured by the caller's shading
+ *             function (Sec. 7.3), alpha 1 (0: no surface).
+ * Output depends only on the voxel, so it is the same for any number of
+ * threads. */
+#include <math.h>
+#include <stdatomic.h>
+#include <stdlib.h>
+#include <string.h>
+
+#ifdef _OPENMP
+#include <omp.h>
+#endif
+#ifdef __F16C__
+#include <immintrin.h>
+#endif
+
+#include "accel/linespace_internal.h"
+#include "core/error.h"
+#include "core/half.h"
+#include "rl/rl_timer.h"
+
+/* What the records need of one triangle of the voxel, gathered once per
+ * voxel: entries carry the triangle's local index in the cell's (sorted)
+ * list, so a shaft's record reads this instead of the scene's index,
+ * normal, uv and vertex arrays and the cell-unit conversion per shaft. */
+typedef struct tri_info {
+    double v[3][3];               /* vertices in cell units */
+    rl_vec3 n[3];                 /* vertex normals */
+    rl_vec2 uv[3];
+    float mat1;                   /* material ID + 1, as the record stores it */
+    uint32_t id;                  /* scene triangle ID */
+} tri_info;
+
+/* Per-thread workspace, allocated once per thread (no allocation inside
+ * the per-triangle loops; the entry buffers grow between triangles). */
+typedef struct workspace {
+    rl_ls_entry *entries, *sorted;
+    size_t capacity;
+    uint32_t *offset;             /* S + 1 */
+    rl_ls_entry *back;            /* k entries, for the back half */
+    double *scratch;
+    int *iscratch;
+    tri_info *tris;               /* the voxel's triangles, by local index */
+    size_t tri_capacity;
+    double pnmt_s, preillum_s;     /* ms spent on the PNMT / PREILLUM records */
+} workspace;
+
+static bool ws_init(workspace *w, uint32_t S, int n, int k)
+{
+    memset(w, 0, sizeof *w);
+    w->offset = malloc(((size_t)S + 1) * sizeof *w->offset);
+    w->back = malloc((size_t)(k > 0 ? k : 1) * sizeof *w->back);
+    w->scratch = malloc((size_t)12 * (size_t)(n * n) * sizeof *w->scratch);
+    w->iscratch = malloc((size_t)4 * (size_t)(n * n) * sizeof *w->iscratch);
+    return w->offset && w->back && w->scratch && w->iscratch;
+}
+
+static void ws_free(workspace *w)
+{
+    free(w->entries);
+    free(w->sorted);
+    free(w->offset);
+    free(w->back);
+    free(w->scratch);
+    free(w->iscratch);
+    free(w->tris);
+}
+
+static bool ws_reserve(workspace *w, size_t need)
+{
+    if (need <= w->capacity)
+        return true;
+    size_t cap = w->capacity ? w->capacity : 4096;
+    while (cap < need)
+        cap *= 2;
+    rl_ls_entry *a = realloc(w->entries, cap * sizeof *a);
+    if (!a)
+        return false;
+    w->entries = a;
+    rl_ls_entry *b = realloc(w->sorted, cap * sizeof *b);
+    if (!b)
+        return false;
+    w->sorted = b;
+    w->capacity = cap;
+    return true;
+}
+
+static bool ws_reserve_tris(workspace *w, size_t need)
+{
+    if (need <= w->tri_capacity)
+        return true;
+    size_t cap = w->tri_capacity ? w->tri_capacity : 256;
+    while (cap < need)
+        cap *= 2;
+    tri_info *t = realloc(w->tris, cap * sizeof *t);
+    if (!t)
+        return false;
+    w->tris = t;
+    w->tri_capacity = cap;
+    return true;
+}
+
+static inline bool front_less(const rl_ls_entry *a, const rl_ls_entry *b)
+{
+    return a->key_front < b->key_front || (a->key_front == b->key_front && a->tri < b->tri);
+}
+
+static inline bool back_less(const rl_ls_entry *a, const rl_ls_entry *b)
+{
+    return a->key_back > b->key_back || (a->key_back == b->key_back && a->tri < b->tri);
+}
+
+static void insertion_sort(rl_ls_entry *e, uint32_t m, bool back);
+
+/* Bottom-up merge sort through tmp (m entries); no allocation. */
+static void merge_sort(rl_ls_entry *e, uint32_t m, rl_ls_entry *tmp)
+{
+    const uint32_t run = 16;
+    for (uint32_t i = 0; i < m; i += run)
+        insertion_sort(e + i, m - i < run ? m - i : run, false);
+    rl_ls_entry *src = e, *dst = tmp;
+    for (uint32_t width = run; width < m; width *= 2) {
+        for (uint32_t i = 0; i < m; i += 2 * width) {
+            uint32_t mid = i + width < m ? i + width : m, end = i + 2 * width < m ? i + 2 * width : m;
+            uint32_t a = i, b = mid, o = i;
+            while (a < mid && b < end)
+                dst[o++] = front_less(&src[b], &src[a]) ? src[b++] : src[a++];
+            while (a < mid)
+                dst[o++] = src[a++];
+            while (b < end)
+                dst[o++] = src[b++];
+        }
+        rl_ls_entry *t = src;
+        src = dst;
+        dst = t;
+    }
+    if (src != e)
+        memcpy(e, src, m * sizeof *e);
+}
+
+static void sort_entries(rl_ls_entry *e, uint32_t m, bool back)
+{
+    insertion_sort(e, m, back);
+}
+
+static void insertion_sort(rl_ls_entry *e, uint32_t m, bool back)
+{
+    for (uint32_t i = 1; i < m; ++i) {
+        rl_ls_entry x = e[i];
+        uint32_t j = i;
+        for (; j > 0 && (back ? back_less(&x, &e[j - 1]) : front_less(&x, &e[j - 1])); --j)
+            e[j] = e[j - 1];
+        e[j] = x;
+    }
+}
+
+void rl_ls_surface_at(const rl_linespace *ls, uint32_t tri, float u, float v, rl_ls_surface *s)
+{
+    const rl_scene_data *d = ls->data;
+    const uint32_t *idx = d->indices + 3 * (size_t)tri;
+    float w = 1.0f - u - v;
+    const rl_vec3 *p = ls->grid->tri_verts + 3 * (size_t)tri;
+    s->p = rl_add(rl_add(rl_scale(p[0], w), rl_scale(p[1], u)), rl_scale(p[2], v));
+    rl_vec3 n = rl_add(rl_add(rl_scale(d->normals[idx[0]], w), rl_scale(d->normals[idx[1]], u)),
+                       rl_scale(d->normals[idx[2]], v));
+    float len = rl_length(n);
+    if (!(len > 0.0f)) {
+        n = rl_cross(rl_sub(p[1], p[0]), rl_sub(p[2], p[0]));
+        len = rl_length(n);
+    }
+    s->n = len > 0.0f ? rl_scale(n, 1.0f / len) : rl_v3(0.0f, 0.0f, 1.0f);
+    rl_vec2 a = d->uvs[idx[0]], b = d->uvs[idx[1]], c = d->uvs[idx[2]];
+    s->uv = rl_v2(a.x * w + b.x * u + c.x * v, a.y * w + b.y * u + c.y * v);
+    s->material = d->triangle_material[tri];
+}
+
+/* The barycentrics a record stores for shaft entry e: the midpoint ray's
+ * hit, or (no hit) those of the point closest to the axis at the entry's
+ * key. */
+static void record_bary(const double v[3][3], const double a[3], const double b[3],
+                        const rl_ls_entry *e, bool front, double *u, double *w)
+{
+    *u = e->u;
+    *w = e->w;
+    if (!(e->shaft & RL_LS_ENTRY_HIT)) {
+        double key = front ? e->key_front : e->key_back;
+        key = key < 0.0 ? 0.0 : (key > 1.0 ? 1.0 : key);
+        double q[3] = { a[0] + (b[0] - a[0]) * key, a[1] + (b[1] - a[1]) * key,
+                        a[2] + (b[2] - a[2]) * key };
+        rl_ls_closest_point(v, q, u, w);
+    }
+}
+
+/* The stored point in cell units, clamped to the voxel. */
+static inline void record_unit(const double v[3][3], double u, double w, double unit[3])
+{
+    for (int k = 0; k < 3; ++k) {
+        double x = (1.0 - u - w) * v[0][k] + u * v[1][k] + w * v[2][k];
+        unit[k] = x < 0.0 ? 0.0 : (x > 1.0 ? 1.0 : x);
+    }
+}
+
+/* 8 floats to half floats, as rl_half_from_float does one by one: with
+ * F16C one instruction (round to nearest even, the same rounding, overflow
+ * and subnormals); a NaN takes the scalar path, which drops its payload. */
+static inline void halves8(uint16_t *r, const float f[8])
+{
+#ifdef __F16C__
+    __m256 x = _mm256_loadu_ps(f);
+    if (!_mm256_movemask_ps(_mm256_cmp_ps(x, x, _CMP_UNORD_Q))) {
+        _mm_storeu_si128((__m128i *)(void *)r, _mm256_cvtps_ph(x, _MM_FROUND_TO_NEAREST_INT));
+        return;
+    }
+#endif
+    for (int i = 0; i < 8; ++i)
+        r[i] = rl_half_from_float(f[i]);
+}
+
+/* One PNMT record (Sec. 7.4, eq. 9: n_z's sign rides on the material ID +
+ * 1) at barycentrics (u, w) of triangle t. The normal and uv use the same
+ * float operations as rl_ls_surface_at, from the cached vertex data. */
+static void pnmt_record(const rl_linespace *ls, const tri_info *t, double u, double w, uint16_t *r)
+{
+    float fu = (float)u, fv = (float)w, fw = 1.0f - fu - fv;
+    rl_vec3 n = rl_add(rl_add(rl_scale(t->n[0], fw), rl_scale(t->n[1], fu)), rl_scale(t->n[2], fv));
+    float len = rl_length(n);
+    if (!(len > 0.0f)) {
+        const rl_vec3 *p = ls->grid->tri_verts + 3 * (size_t)t->id;
+        n = rl_cross(rl_sub(p[1], p[0]), rl_sub(p[2], p[0]));
+        len = rl_length(n);
+    }
+    n = len > 0.0f ? rl_scale(n, 1.0f / len) : rl_v3(0.0f, 0.0f, 1.0f);
+    double unit[3];
+    record_unit(t->v, u, w, unit);
+    float f[8];
+    f[RL_LS_PNMT_PX] = (float)unit[0];
+    f[RL_LS_PNMT_PY] = (float)unit[1];
+    f[RL_LS_PNMT_PZ] = (float)unit[2];
+    f[RL_LS_PNMT_NX] = n.x;
+    f[RL_LS_PNMT_NY] = n.y;
+    f[RL_LS_PNMT_MAT] = n.z < 0.0f ? -t->mat1 : t->mat1;
+    f[RL_LS_PNMT_U] = t->uv[0].x * fw + t->uv[1].x * fu + t->uv[2].x * fv;
+    f[RL_LS_PNMT_V] = t->uv[0].y * fw + t->uv[1].y * fu + t->uv[2].y * fv;
+    halves8(r, f);
+}
+
+/* Front and back picks of a list sorted front to back: the first midpoint
+ * ray hit in front order; the hit with the largest parameter (lowest ID on
+ * ties); without hits the front-most and back-most candidates. */
+static inline void pick_records(const rl_ls_entry *list, uint32_t m, const rl_ls_entry **ef_out,
+                                const rl_ls_entry **eb_out)
+{
+    const rl_ls_entry *ef = NULL, *eb = NULL;
+    for (uint32_t i = 0; i < m; ++i)
+        if (list[i].shaft & RL_LS_ENTRY_HIT) {
+            if (!ef)
+                ef = &list[i];
+            if (!eb || list[i].key_back > eb->key_back)
+                eb = &list[i];
+        }
+    if (!ef) {
+        ef = eb = &list[0];
+        for (uint32_t i = 1; i < m; ++i)
+            if (back_less(&list[i], eb))
+                eb = &list[i];
+    }
+    *ef_out = ef;
+    *eb_out = eb;
+}
+
+/* The PNMT record of shaft s (global index gidx) from its list sorted front
+ * to back; a, b: the patch centres (midpoint ray) in cell units. */
+static void shaft_pnmt(const rl_linespace *ls, const tri_info *tris, const rl_ls_entry *list,
+                       uint32_t m, uint64_t gidx, const double a[3], const double b[3])
+{
+    uint16_t *pn = ls->pnmt + gidx * 16;
+    if (m == 0) {
+        memset(pn, 0, 16 * sizeof *pn);
+        return;
+    }
+    const rl_ls_entry *ef, *eb;
+    pick_records(list, m, &ef, &eb);
+    double u, w;
+    const tri_info *t = &tris[ef->tri];
+    record_bary(t->v, a, b, ef, true, &u, &w);
+    pnmt_record(ls, t, u, w, pn);
+    /* One triangle hit by the midpoint ray both ways: the same record. */
+    if (ef == eb && (ef->shaft & RL_LS_ENTRY_HIT)) {
+        memcpy(pn + RL_LS_PNMT_RECORD, pn, RL_LS_PNMT_RECORD * sizeof *pn);
+        return;
+    }
+    t = &tris[eb->tri];
+    record_bary(t->v, a, b, eb, false, &u, &w);
+    pnmt_record(ls, t, u, w, pn + RL_LS_PNMT_RECORD);
+}
+
+/* The PREILLUM record of shaft s, as shaft_pnmt. */
+static void shaft_preillum(const rl_linespace *ls, const tri_info *tris, const rl_ls_entry *list,
+                           uint32_t m, uint64_t gidx, const double a[3], const double bb[3],
+                           const double lo[3], const double ext[3])
+{
+    uint16_t *pi = ls->preillum + gidx * 8;
+    if (m == 0) {
+        memset(pi, 0, 8 * sizeof *pi);
+        return;
+    }
+    const rl_ls_entry *pick[2];
+    pick_records(list, m, &pick[0], &pick[1]);
+    for (int side = 0; side < 2; ++side) {
+        const tri_info *t = &tris[pick[side]->tri];
+        double u, w;
+        record_bary(t->v, a, bb, pick[side], side == 0, &u, &w);
+        rl_ls_surface surf;
+        rl_ls_surface_at(ls, t->id, (float)u, (float)w, &surf);
+        /* Sec. 7.3: shaded for the direction the ray travels when it
+         * reaches the surface. */
+        rl_vec3 wa = rl_v3((float)(lo[0] + a[0] * ext[0]), (float)(lo[1] + a[1] * ext[1]),
+                           (float)(lo[2] + a[2] * ext[2]));
+        rl_vec3 wb = rl_v3((float)(lo[0] + bb[0] * ext[0]), (float)(lo[1] + bb[1] * ext[1]),
+                           (float)(lo[2] + bb[2] * ext[2]));
+        rl_vec3 dir = rl_normalize(side == 0 ? rl_sub(wb, wa) : rl_sub(wa, wb));
+        surf.t = rl_length(rl_sub(surf.p, side == 0 ? wa : wb));
+        rl_vec3 c = ls->shade(ls->shade_user, &surf, dir);
+        uint16_t *q = pi + side * 4;
+        q[0] = rl_half_from_float(c.x);
+        q[1] = rl_half_from_float(c.y);
+        q[2] = rl_half_from_float(c.z);
+        q[3] = rl_half_from_float(1.0f);
+    }
+}
+
+typedef struct voxel_stats {
+    uint64_t empty, stored, truncated, sum;
+    uint32_t max;
+} voxel_stats;
+
+/* Builds block b (grid cell `cell`). Dynamic lists: the block's lists go
+ * to *dyn_block, cand_start[b·S + s] gets shaft s's offset inside the block
+ * and *dyn_count the block's total (rl_ls_build adds the block's base).
+ * Returns false on out of memory. */
+static bool build_voxel(rl_linespace *ls, const rl_ls_geometry *geo, workspace *w, uint32_t b,
+                        uint32_t cell, uint32_t **dyn_block, uint64_t *dyn_count, voxel_stats *vs)
+{
+    const rl_grid *g = ls->grid;
+    const rl_scene_data *d = ls->data;
+    const uint32_t S = ls->shafts_per_voxel;
+    const int k = ls->k;
+    int xyz[3];
+    rl_grid_cell_coords(g, cell, xyz);
+    rl_aabb box = rl_grid_cell_bounds(g, xyz[0], xyz[1], xyz[2]);
+    double lo[3], ext[3], inv_ext[3];
+    for (int a = 0; a < 3; ++a) {
+        lo[a] = rl_vget(box.min, a);
+        ext[a] = (double)rl_vget(box.max, a) - lo[a];
+        inv_ext[a] = 1.0 / ext[a];
+    }
+    /* Alg. 3's loops, turned around: per triangle, the shafts it overlaps.
+     * Entries carry the triangle's index in the cell's list, which is sorted
+     * by ID, so ties by local index are ties by ID. */
+    const uint32_t first = g->cell_start[cell], ntri = g->cell_start[cell + 1] - first;
+    const uint32_t *ids = g->cell_tris + first;
+    if (!ws_reserve_tris(w, ntri))
+        return false;
+    const bool records = ls->pnmt || ls->preillum;
+    size_t nent = 0;
+    for (uint32_t j = 0; j < ntri; ++j) {
+        uint32_t id = ids[j];
+        if (!ws_reserve(w, nent + S))
+            return false;
+        tri_info *ti = &w->tris[j];
+        const rl_vec3 *p = g->tri_verts + 3 * (size_t)id;
+        double pu[3][3];
+        for (int i = 0; i < 3; ++i)
+            for (int a = 0; a < 3; ++a)
+                ti->v[i][a] = pu[i][a] = ((double)rl_vget(p[i], a) - lo[a]) * inv_ext[a];
+        ti->id = id;
+        if (records) {
+            const uint32_t *idx = d->indices + 3 * (size_t)id;
+            for (int i = 0; i < 3; ++i) {
+                ti->n[i] = d->normals[idx[i]];
+                ti->uv[i] = d->uvs[idx[i]];
+            }
+            ti->mat1 = (float)d->triangle_material[id] + 1.0f;
+        }
+        rl_ls_tri t;
+        if (!rl_ls_tri_setup(&t, pu))
+            continue;
+        nent += rl_ls_enumerate(geo, &t, j, w->entries + nent, w->scratch, w->iscratch);
+    }
+    /* Counting sort by shaft. */
+    uint32_t *off = w->offset;
+    memset(off, 0, ((size_t)S + 1) * sizeof *off);
+    for (size_t i = 0; i < nent; ++i)
+        ++off[(w->entries[i].shaft & ~RL_LS_ENTRY_HIT) + 1];
+    for (uint32_t s = 0; s < S; ++s)
+        off[s + 1] += off[s];
+    for (size_t i = 0; i < nent; ++i) {
+        uint32_t s = w->entries[i].shaft & ~RL_LS_ENTRY_HIT;
+        w->sorted[off[s]++] = w->entries[i];
+    }
+    for (uint32_t s = S; s > 0; --s)
+        off[s] = off[s - 1];
+    off[0] = 0;
+
+    uint32_t *dyn = NULL;
+    bool want_cand = (ls->payloads & RL_LS_CANDIDATES) != 0;
+    if (want_cand && ls->dynamic) {
+        dyn = malloc((nent ? nent : 1) * sizeof *dyn);
+        if (!dyn)
+            return false;
+        *dyn_block = dyn;
+        *dyn_count = nent;
+        memcpy(ls->cand_start + (uint64_t)b * S, off, (size_t)S * sizeof *off);
+    }
+    for (uint32_t s = 0; s < S; ++s) {
+        rl_ls_entry *list = w->sorted + off[s];
+        uint32_t m = off[s + 1] - off[s];
+        uint64_t gidx = (uint64_t)b * S + s;
+        if (m > 16)
+            merge_sort(list, m, w->entries);   /* free after the scatter */
+        else if (m > 1)
+            insertion_sort(list, m, false);
+        if (m == 0)
+            ++vs->empty;
+        vs->sum += m;
+        if (m > vs->max)
+            vs->max = m;
+        if (!want_cand)
+            continue;
+        if (ls->dynamic) {
+            for (uint32_t i = 0; i < m; ++i)
+                dyn[off[s] + i] = ids[list[i].tri];
+            vs->stored += m;
+            continue;
+        }
+        uint32_t *slot = ls->cand + gidx * (uint64_t)k;
+        uint32_t half = (uint32_t)k / 2, nf = m < half ? m : half;
+        for (uint32_t i = 0; i < half; ++i)
+            slot[i] = i < nf ? ids[list[i].tri] : RL_NONE;
+        /* Alg. 3: the back buffer holds the k/2 back-most, back to front. */
+        uint32_t cnt = 0;
+        for (uint32_t i = 0; i < m; ++i) {
+            if (cnt < half) {
+                w->back[cnt++] = list[i];
+                sort_entries(w->back, cnt, true);
+            } else if (back_less(&list[i], &w->back[half - 1])) {
+                w->back[half - 1] = list[i];
+                sort_entries(w->back, half, true);
+            }
+        }
+        for (uint32_t i = 0; i < half; ++i)
+            slot[half + i] = i < nf ? ids[w->back[i].tri] : RL_NONE;
+        vs->stored += 2 * (uint64_t)nf;
+        if (m > (uint32_t)k)
+            ++vs->truncated;
+    }
+    /* PNMT and PREILLUM in separate passes over the sorted lists (still in
+     * cache), so that each gets its own time. */
+    for (int payload = 0; payload < 2; ++payload) {
+        bool pnmt = payload == 0;
+        if (pnmt ? !ls->pnmt : !ls->preillum)
+            continue;
+        rl_timer timer;
+        rl_timer_start(&timer);
+        /* Shafts in index order: face pair, then patch A, then patch B. */
+        const int np = ls->n * ls->n;
+        uint32_t s = 0;
+        for (int pair = 0; pair < RL_LS_FACE_PAIRS; ++pair) {
+            int fa, fb;
+            rl_ls_pair_faces(pair, &fa, &fb);
+            for (int pa = 0; pa < np; ++pa) {
+                const float *ca = geo->patch_center + ((size_t)fa * (size_t)np + (size_t)pa) * 3;
+                double a[3] = { ca[0], ca[1], ca[2] };
+                for (int pb = 0; pb < np; ++pb, ++s) {
+                    const float *cb = geo->patch_center + ((size_t)fb * (size_t)np + (size_t)pb) * 3;
+                    double bb[3] = { cb[0], cb[1], cb[2] };
+                    const rl_ls_entry *list = w->sorted + off[s];
+                    uint32_t m = off[s + 1] - off[s];
+                    uint64_t gidx = (uint64_t)b * S + s;
+                    if (pnmt)
+                        shaft_pnmt(ls, w->tris, list, m, gidx, a, bb);
+                    else
+                        shaft_preillum(ls, w->tris, list, m, gidx, a, bb, lo, ext);
+                }
+            }
+        }
+        *(pnmt ? &w->pnmt_s : &w->preillum_s) += rl_timer_ms(&timer);
+    }
+    return true;
+}
+
+void rl_ls_free_arrays(rl_linespace *ls)
+{
+    free(ls->voxel_slot);
+    free(ls->cand);
+    free(ls->cand_start);
+    free(ls->pnmt);
+    free(ls->preillum);
+    ls->voxel_slot = ls->cand = ls->cand_start = NULL;
+    ls->pnmt = ls->preillum = NULL;
+}
+
+rl_status rl_ls_build(rl_linespace *ls)
+{
+    rl_timer total;
+    rl_timer_start(&total);
+    const rl_grid *g = ls->grid;
+    const uint32_t S = ls->shafts_per_voxel;
+    ls->num_cells = g->num_cells;
+    ls->voxel_slot = malloc((size_t)g->num_cells * sizeof *ls->voxel_slot);
+    if (!ls->voxel_slot)
+        return rl_error(RL_ERR_OUT_OF_MEMORY, "linespace: out of memory for %u voxel slots",
+                        g->num_cells);
+    uint32_t blocks = 0;
+    for (uint32_t c = 0; c < g->num_cells; ++c)
+        ls->voxel_slot[c] = g->cell_start[c + 1] > g->cell_start[c] ? blocks++ : RL_NONE;
+    ls->num_blocks = blocks;
+    uint64_t shafts = (uint64_t)blocks * S;
+    if (shafts > UINT32_MAX - 1u)
+        return rl_error(RL_ERR_LIMIT,
+                        "linespace: %u filled voxels x %u shafts = %llu shafts exceed 2^32-1", blocks,
+                        S, (unsigned long long)shafts);
+    uint32_t *cells = malloc((size_t)(blocks ? blocks : 1) * sizeof *cells);
+    uint32_t **dyn = NULL;
+    uint64_t *dyn_count = NULL;
+    bool want_cand = (ls->payloads & RL_LS_CANDIDATES) != 0;
+    if (!cells)
+        return rl_error(RL_ERR_OUT_OF_MEMORY, "linespace: out of memory");
+    for (uint32_t c = 0; c < g->num_cells; ++c)
+        if (ls->voxel_slot[c] != RL_NONE)
+            cells[ls->voxel_slot[c]] = c;
+    rl_status st = RL_OK;
+    if (want_cand && ls->dynamic) {
+        /* Every entry is written by the build: no zero fill needed. */
+        ls->cand_start = malloc(((size_t)shafts + 1) * sizeof *ls->cand_start);
+        dyn = calloc((size_t)(blocks ? blocks : 1), sizeof *dyn);
+        dyn_count = calloc((size_t)(blocks ? blocks : 1), sizeof *dyn_count);
+        if (!ls->cand_start || !dyn || !dyn_count)
+            st = RL_ERR_OUT_OF_MEMORY;
+    } else if (want_cand) {
+        ls->cand = malloc((size_t)(shafts ? shafts : 1) * (size_t)ls->k * sizeof *ls->cand);
+        ls->num_cand = shafts * (uint64_t)ls->k;
+        if (!ls->cand)
+            st = RL_ERR_OUT_OF_MEMORY;
+    }
+    if (!st && (ls->payloads & RL_LS_PNMT) &&
+        !(ls->pnmt = malloc((size_t)(shafts ? shafts : 1) * 16 * sizeof *ls->pnmt)))
+        st = RL_ERR_OUT_OF_MEMORY;
+    if (!st && (ls->payloads & RL_LS_PREILLUM) &&
+        !(ls->preillum = malloc((size_t)(shafts ? shafts : 1) * 8 * sizeof *ls->preillum)))
+        st = RL_ERR_OUT_OF_MEMORY;
+    rl_ls_geometry geo = { 0 };
+    if (!st)
+        st = rl_ls_geometry_init(&geo, ls->n);
+    if (st) {
+        free(cells);
+        free(dyn);
+        free(dyn_count);
+        return rl_error(RL_ERR_OUT_OF_MEMORY, "linespace: out of memory for %llu shafts",
+                        (unsigned long long)shafts);
+    }
+    int threads = ls->threads;
+#ifdef _OPENMP
+    if (threads <= 0)
+        threads = omp_get_max_threads();
+#else
+    threads = 1;
+#endif
+    atomic_int failed = 0;        /* 1: out of memory, 2: cancelled */
+    atomic_uint done = 0;
+    voxel_stats total_vs = { 0 };
+    double pnmt_s = 0.0, preillum_s = 0.0;
+    rl_timer pass;
+    rl_timer_start(&pass);
+    #pragma omp parallel num_threads(threads)
+    {
+        workspace w;
+        voxel_stats vs = { 0 };
+        if (!ws_init(&w, S, ls->n, ls->k))
+            atomic_store(&failed, 1);
+        #pragma omp for schedule(dynamic, 1)
+        for (long bi = 0; bi < (long)blocks; ++bi) {
+            if (atomic_load(&failed))
+                continue;
+            if (!build_voxel(ls, &geo, &w, (uint32_t)bi, cells[bi], dyn ? &dyn[bi] : NULL,
+                             dyn ? &dyn_count[bi] : NULL, &vs)) {
+                atomic_store(&failed, 1);
+                continue;
+            }
+            unsigned d = atomic_fetch_add(&done, 1u) + 1u;
+            bool main_thread = true;
+#ifdef _OPENMP
+            main_thread = omp_get_thread_num() == 0;
+#endif
+            if (ls->progress && main_thread && !ls->progress(ls->user, 0.95 * d / (double)blocks))
+                atomic_store(&failed, 2);
+        }
+        #pragma omp critical(rl_ls_stats)
+        {
+            total_vs.empty += vs.empty;
+            total_vs.stored += vs.stored;
+            total_vs.truncated += vs.truncated;
+            total_vs.sum += vs.sum;
+            if (vs.max > total_vs.max)
+                total_vs.max = vs.max;
+            pnmt_s += w.pnmt_s;
+            preillum_s += w.preillum_s;
+        }
+        ws_free(&w);
+    }
+    double pass_ms = rl_timer_ms(&pass);
+    int fail = atomic_load(&failed);
+    if (!fail && dyn) {
+        /* Sec. 7.1.1's prefix sum, in two levels: the pass left each
+         * shaft's offset inside its block, so only the blocks' totals are
+         * summed here and each block's offsets are shifted by its base in
+         * parallel, while its lists are copied into place. */
+        uint64_t sum = 0;
+        for (uint32_t bi = 0; bi < blocks; ++bi) {
+            uint64_t c = dyn_count[bi];
+            dyn_count[bi] = sum;
+            sum += c;
+        }
+        if (sum > UINT32_MAX)
+            fail = 3;
+        if (!fail) {
+            ls->num_cand = sum;
+            ls->cand_start[shafts] = (uint32_t)sum;
+            ls->cand = malloc((size_t)(sum ? sum : 1) * sizeof *ls->cand);
+            if (!ls->cand)
+                fail = 1;
+        }
+        if (!fail) {
+            #pragma omp parallel for num_threads(threads) schedule(dynamic, 16)
+            for (long bi = 0; bi < (long)blocks; ++bi) {
+                uint32_t base = (uint32_t)dyn_count[bi];
+                uint32_t *cs = ls->cand_start + (uint64_t)bi * S;
+                for (uint32_t s = 0; s < S; ++s)
+                    cs[s] += base;
+                uint64_t last = bi + 1 < (long)blocks ? dyn_count[bi + 1] : sum;
+                memcpy(ls->cand + base, dyn[bi], (size_t)(last - base) * sizeof *ls->cand);
+                free(dyn[bi]);
+                dyn[bi] = NULL;
+            }
+        }
+    }
+    if (dyn)
+        for (uint32_t bi = 0; bi < blocks; ++bi)
+            free(dyn[bi]);
+    free(dyn);
+    free(dyn_count);
+    free(cells);
+    rl_ls_geometry_free(&geo);
+    if (fail == 1)
+        return rl_error(RL_ERR_OUT_OF_MEMORY, "linespace: out of memory during the build");
+    if (fail == 2)
+        return rl_error(RL_ERR_CANCELLED, "linespace: build cancelled");
+    if (fail == 3)
+        return rl_error(RL_ERR_LIMIT, "linespace: more than 2^32-1 candidates");
+    if (ls->progress)
+        ls->progress(ls->user, 1.0);
+    rl_linespace_stats *st2 = &ls->stats;
+    st2->filled_voxels = blocks;
+    st2->shafts = shafts;
+    st2->empty_shafts = total_vs.empty;
+    st2->candidates = total_vs.stored;
+    st2->max_candidates = total_vs.max;
+    st2->mean_candidates =
+        shafts > total_vs.empty ? (double)total_vs.sum / (double)(shafts - total_vs.empty) : 0.0;
+    st2->truncated_shafts = total_vs.truncated;
+    st2->build_ms = rl_timer_ms(&total);
+    /* The payloads share one pass over the voxels: split its wall time by
+     * the threads' time shares. */
+    double thread_ms = pass_ms * threads;
+    st2->pnmt_ms = thread_ms > 0.0 ? pass_ms * (pnmt_s / thread_ms) : 0.0;
+    st2->preillum_ms = thread_ms > 0.0 ? pass_ms * (preillum_s / thread_ms) : 0.0;
+    st2->candidates_ms = st2->build_ms - st2->pnmt_ms - st2->preillum_ms;
+    return RL_OK;
+}

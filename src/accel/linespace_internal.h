@@ -1,0 +1,130 @@
+/* linespace_internal.h: the Line Space object and the pieces its files share
+ * (rl_linespace.h documents the public contract and the array layout).
+ *
+ *   linespace.c        create / commit / release / stats / raw arrays
+ *   linespace_shaft.c  index mapping, per-build shaft geometry in cell units,
+ *                      the conservative triangle/shaft overlap enumeration
+ *   linespace_build.c  per-voxel candidate lists (fixed k and dynamic with a
+ *                      prefix sum), PNMT and PREILLUM records
+ *   linespace_query.c  the 3D-DDA walk and the per-shaft queries
+ *   linespace_io.c     save / load
+ *
+ * Geometry is handled in "cell units": a voxel is the unit cube [0,1]^3 in
+ * them, so one table of shaft geometry serves every voxel of the grid (all
+ * cells have the same size, grid.h). */
+#ifndef RL_ACCEL_LINESPACE_INTERNAL_H
+#define RL_ACCEL_LINESPACE_INTERNAL_H
+
+#include "accel/grid.h"
+#include "rl/rl_linespace.h"
+
+/* Growth of shafts and of the voxel a triangle is clipped to, in cell units:
+ * covers the grid's own cell growth (CELL_GROW_REL 1e-4 in grid_build.c) and
+ * the rounding of the query's entry/exit points, so that the overlap test
+ * stays conservative (a shaft never misses a triangle its lines can hit). */
+#define RL_LS_EPS 3e-4
+
+/* One PNMT record: 8 half floats (Schröder 2017, Sec. 7.4, Fig. 15). */
+enum { RL_LS_PNMT_PX, RL_LS_PNMT_PY, RL_LS_PNMT_PZ, RL_LS_PNMT_NX, RL_LS_PNMT_NY,
+       RL_LS_PNMT_MAT, RL_LS_PNMT_U, RL_LS_PNMT_V, RL_LS_PNMT_RECORD };
+
+struct rl_linespace {
+    const rl_accel *accel;
+    const rl_grid *grid;
+    const rl_scene_data *data;
+    int n, k, threads;
+    bool dynamic;
+    unsigned payloads;
+    rl_progress_fn progress;
+    void *user;
+    rl_ls_shade_fn shade;
+    void *shade_user;
+    bool committed;
+    uint32_t shafts_per_voxel;    /* S = 15·N^4 */
+    uint32_t num_cells, num_blocks;
+    uint32_t *voxel_slot;         /* num_cells */
+    uint32_t *cand;               /* fixed: blocks·S·k; dynamic: num_cand */
+    uint32_t *cand_start;         /* dynamic: blocks·S + 1 */
+    uint64_t num_cand;            /* entries of cand */
+    uint16_t *pnmt;               /* blocks·S·16 */
+    uint16_t *preillum;           /* blocks·S·8 */
+    rl_linespace_stats stats;
+};
+
+/* ---- shaft geometry (linespace_shaft.c) ---- */
+
+/* Face f's plane axis and the two in-face axes in increasing order. */
+static inline int rl_ls_face_axis(int f) { return f >> 1; }
+static inline void rl_ls_face_uv(int f, int *u, int *v)
+{
+    int a = f >> 1;
+    *u = a == 0 ? 1 : 0;
+    *v = a == 2 ? 1 : 2;
+}
+/* Face pair number of (a, b), a < b: lexicographic, (0,1) = 0 .. (4,5) = 14. */
+int rl_ls_pair_index(int a, int b);
+void rl_ls_pair_faces(int pair, int *a, int *b);
+
+/* Per-build tables in cell units. */
+typedef struct rl_ls_geometry {
+    int n;
+    uint32_t shafts;              /* S */
+    float *patch_center;          /* 6·N^2 x 3: centre of patch p on face f at [(f·N^2 + p)·3] */
+} rl_ls_geometry;
+
+rl_status rl_ls_geometry_init(rl_ls_geometry *g, int n);
+void rl_ls_geometry_free(rl_ls_geometry *g);
+
+/* A triangle in cell units, clipped to the voxel grown by RL_LS_EPS. */
+typedef struct rl_ls_tri {
+    double v[3][3];               /* the whole triangle */
+    double poly[9][3];            /* the clipped polygon */
+    int npoly;
+    double lo[3], hi[3];          /* the polygon's box */
+    double normal[3], d;          /* plane: normal·x = d (unnormalised) */
+} rl_ls_tri;
+
+/* Clips triangle (p0, p1, p2), already in cell units, to the grown voxel;
+ * false if nothing is left. */
+bool rl_ls_tri_setup(rl_ls_tri *t, const double p[3][3]);
+
+/* One shaft a triangle overlaps, with its ordering along the shaft
+ * (Schröder 2017, Alg. 3): key_front/key_back are the midpoint ray's
+ * parameter (0 at patch A's centre, 1 at B's) of the hit, or for a triangle
+ * the midpoint ray misses, the smallest / largest projection of the clipped
+ * polygon on the shaft axis. */
+typedef struct rl_ls_entry {
+    uint32_t shaft;               /* bit 31: the midpoint ray hits the triangle */
+    uint32_t tri;                 /* tri_id as given to rl_ls_enumerate: the build
+                                   * passes the index in the cell's sorted list */
+    float key_front, key_back;
+    float u, w;                   /* barycentrics of the midpoint ray's hit */
+} rl_ls_entry;
+#define RL_LS_ENTRY_HIT 0x80000000u
+
+/* Appends one entry per shaft that may overlap the triangle (conservative:
+ * never misses one) to out, which has room for S entries; returns the
+ * number appended. scratch: 6·N^2·2 doubles + 4·N^2 ints. */
+/* rl_ls_shaft_of_segment on points already in cell units. */
+uint32_t rl_ls_shaft_of_unit(int n, const double entry[3], const double exit[3], bool *forward);
+
+uint32_t rl_ls_enumerate(const rl_ls_geometry *g, const rl_ls_tri *t, uint32_t tri_id,
+                         rl_ls_entry *out, double *scratch, int *iscratch);
+
+/* Midpoint ray parameter and barycentrics where the segment a->b meets the
+ * triangle (cell units); false if it does not (within a small tolerance). */
+bool rl_ls_segment_hit(const double a[3], const double b[3], const double v[3][3], double *s,
+                       double *u, double *w);
+/* Barycentrics (u, w) of the triangle's point closest to q (cell units). */
+void rl_ls_closest_point(const double v[3][3], const double q[3], double *u, double *w);
+
+/* The surface at barycentrics (u, v) of triangle tri (p = (1-u-v)·p0 +
+ * u·p1 + v·p2): position, interpolated unit normal, uv, material. */
+void rl_ls_surface_at(const rl_linespace *ls, uint32_t tri, float u, float v, rl_ls_surface *s);
+
+/* ---- build and queries ---- */
+rl_status rl_ls_build(rl_linespace *ls);
+size_t rl_ls_memory_bytes(const rl_linespace *ls);
+void rl_ls_free_arrays(rl_linespace *ls);
+
+#endif

@@ -1,0 +1,388 @@
+/* linespace_query.c: Line Space traversal (Schröder 2017, Sec. 7.2-7.4).
+ *
+ * Every query walks the grid's voxels front to back with the 3D-DDA of
+ * grid.h. In a filled voxel it extends the ray's line to the voxel box (also
+ * when the origin lies inside), takes the entry and exit points and from
+ * them the shaft and the direction (Sec. 4.3); points are computed in double
+ * in cell units, so their rounding stays far below the shafts' growth
+ * RL_LS_EPS.
+ *
+ * CANDIDATES. As grid.c, with the shaft's list in place of the cell's: each
+ * candidate is tested with the shared watertight test against the whole ray,
+ * the closest hit is kept (ties to the lower ID), and the walk stops at the
+ * first voxel whose exit lies beyond the best hit by grid.c's relative
+ * margin. The shaft holds every triangle that the line's piece inside the
+ * voxel can meet (linespace_shaft.c is conservative), so with dynamic lists
+ * the result is the grid's, and the BVH's. Fixed lists: all k slots are
+ * tested (front half first), so only shafts with more than k candidates can
+ * lose a hit; the thesis tests one half only. A voxel where entry and exit
+ * lie on one face (grazing, a line in a face plane) or where the line misses
+ * the box by rounding uses the voxel's full grid list (always exact).
+ *
+ * PNMT. The stored surface of the ray's shaft and direction (forward: the
+ * front record, backward: the back record), at t = the stored point's
+ * projection on the ray, accepted inside (t_min, t_max). In contrast to the
+ * thesis, which skips the ray's origin voxel (Sec. 12.1, "Voxel-Offset")
+ * against self-intersection, the origin voxel is answered exactly: the
+ * closest hit among its triangles (the dynamic shaft list, or the grid list)
+ * within the voxel's t-interval; only the voxels after it use records.
+ *
+ * PREILLUM. The stored colour of the first surface; t from the PNMT record
+ * when PNMT is built too, else the middle of the ray's interval in that
+ * voxel. No shading happens at query time, so the origin voxel cannot be
+ * answered exactly: there a record counts only beyond t_min plus a tenth of
+ * the voxel's diagonal (in ray parameter), which keeps the surface the ray
+ * starts from out; otherwise the walk goes on. */
+#include <math.h>
+#include <string.h>
+
+#include "accel/linespace_internal.h"
+#include "accel/watertight.h"
+#include "core/half.h"
+
+#define MAILBOX_SIZE 16
+#define T_SLACK_REL 1e-6f          /* as grid.c: walk vs triangle-test rounding */
+#define ORIGIN_MARGIN_REL 0.1f     /* PREILLUM, origin voxel: of the voxel diagonal */
+
+static bool ray_is_valid(const rl_ray *r)
+{
+    if (!rl_vfinite(r->o) || !rl_vfinite(r->d) || !isfinite(r->t_min))
+        return false;
+    if (r->d.x == 0.0f && r->d.y == 0.0f && r->d.z == 0.0f)
+        return false;
+    return r->t_min <= r->t_max;
+}
+
+static bool usable(const rl_linespace *ls, const rl_ray *ray)
+{
+    return ls && ray && ls->committed && ray_is_valid(ray);
+}
+
+/* The shaft of the ray's line in the voxel at cell coordinates xyz (Sec.
+ * 4.3), RL_NONE if the entry and exit share a face or the line misses the
+ * box by rounding. */
+static uint32_t shaft_of_ray(const rl_linespace *ls, const int xyz[3], const rl_ray *r, bool *forward)
+{
+    rl_aabb box = rl_grid_cell_bounds(ls->grid, xyz[0], xyz[1], xyz[2]);
+    double o[3], d[3], tn = -INFINITY, tf = INFINITY;
+    for (int a = 0; a < 3; ++a) {
+        double lo = rl_vget(box.min, a), ext = (double)rl_vget(box.max, a) - lo;
+        o[a] = ((double)rl_vget(r->o, a) - lo) / ext;
+        d[a] = (double)rl_vget(r->d, a) / ext;
+        if (d[a] == 0.0) {
+            if (o[a] < 0.0 || o[a] > 1.0)
+                return RL_NONE;
+            continue;
+        }
+        double t0 = -o[a] / d[a], t1 = (1.0 - o[a]) / d[a];
+        if (t0 > t1) {
+            double s = t0; t0 = t1; t1 = s;
+        }
+        tn = t0 > tn ? t0 : tn;
+        tf = t1 < tf ? t1 : tf;
+    }
+    if (!(tn <= tf) || !isfinite(tn) || !isfinite(tf))
+        return RL_NONE;
+    double entry[3], exit[3];
+    for (int a = 0; a < 3; ++a) {
+        entry[a] = o[a] + d[a] * tn;
+        exit[a] = o[a] + d[a] * tf;
+    }
+    return rl_ls_shaft_of_unit(ls->n, entry, exit, forward);
+}
+
+/* The triangle list to test in a filled voxel: the shaft's candidates, or
+ * the voxel's grid list (no candidates stored, or no shaft). */
+typedef struct tri_list {
+    const uint32_t *ids;
+    uint32_t count;
+} tri_list;
+
+static tri_list grid_list(const rl_grid *g, uint32_t cell)
+{
+    tri_list l = { g->cell_tris + g->cell_start[cell], g->cell_start[cell + 1] - g->cell_start[cell] };
+    return l;
+}
+
+static tri_list candidates(const rl_linespace *ls, uint32_t cell, uint32_t block, uint32_t shaft,
+                           bool exact_only)
+{
+    if (shaft == RL_NONE || !(ls->payloads & RL_LS_CANDIDATES) || (exact_only && !ls->dynamic))
+        return grid_list(ls->grid, cell);
+    uint64_t g = (uint64_t)block * ls->shafts_per_voxel + shaft;
+    tri_list l;
+    if (ls->dynamic) {
+        l.ids = ls->cand + ls->cand_start[g];
+        l.count = ls->cand_start[g + 1] - ls->cand_start[g];
+    } else {
+        l.ids = ls->cand + g * (uint64_t)ls->k;
+        l.count = (uint32_t)ls->k;
+    }
+    return l;
+}
+
+typedef struct closest {
+    uint32_t id;
+    float t, u, v;
+} closest;
+
+/* Tests a list (RL_NONE slots skipped) against the whole ray within
+ * (t_min, limit); keeps the closest, ties to the lower ID (grid.c). */
+static void test_list(const rl_linespace *ls, const rl_ray_watertight *w, const rl_ray *ray, tri_list l,
+                      uint32_t *mailbox, closest *best, float *limit)
+{
+    const rl_vec3 *verts = ls->grid->tri_verts;
+    for (uint32_t j = 0; j < l.count; ++j) {
+        uint32_t id = l.ids[j];
+        if (id == RL_NONE)
+            continue;
+        uint32_t *box = &mailbox[id & (MAILBOX_SIZE - 1)];
+        if (*box == id)
+            continue;
+        *box = id;
+        const rl_vec3 *v = verts + 3 * (size_t)id;
+        float t, u, vv;
+        if (!rl_watertight_hit(w, v[0], v[1], v[2], ray->t_min, *limit, &t, &u, &vv))
+            continue;
+        if (best->id == RL_NONE || t < best->t || (t == best->t && id < best->id)) {
+            best->id = id;
+            best->t = t;
+            best->u = u;
+            best->v = vv;
+            *limit = nextafterf(t, INFINITY);
+        }
+    }
+}
+
+static bool any_hit(const rl_linespace *ls, const rl_ray_watertight *w, const rl_ray *ray, tri_list l,
+                    uint32_t *mailbox, float t_max)
+{
+    const rl_vec3 *verts = ls->grid->tri_verts;
+    for (uint32_t j = 0; j < l.count; ++j) {
+        uint32_t id = l.ids[j];
+        if (id == RL_NONE)
+            continue;
+        uint32_t *box = &mailbox[id & (MAILBOX_SIZE - 1)];
+        if (*box == id)
+            continue;
+        *box = id;
+        const rl_vec3 *v = verts + 3 * (size_t)id;
+        float t, u, vv;
+        if (rl_watertight_hit(w, v[0], v[1], v[2], ray->t_min, t_max, &t, &u, &vv))
+            return true;
+    }
+    return false;
+}
+
+bool rl_linespace_intersect(const rl_linespace *ls, rl_ray *ray, rl_hit *hit)
+{
+    if (!ray || !hit)
+        return false;
+    hit->triangle = RL_ID_NONE;
+    hit->object = RL_ID_NONE;
+    if (!usable(ls, ray))
+        return false;
+    rl_grid_dda it;
+    if (!rl_grid_dda_begin(ls->grid, ray, &it))
+        return false;
+    rl_ray_watertight w;
+    rl_ray_watertight_setup(ray, &w);
+    uint32_t mailbox[MAILBOX_SIZE];
+    memset(mailbox, 0xff, sizeof mailbox);
+    closest best = { RL_NONE, ray->t_max, 0.0f, 0.0f };
+    float limit = ray->t_max;
+    uint32_t cell;
+    float t0, t1;
+    while (rl_grid_dda_next(&it, &cell, &t0, &t1)) {
+        uint32_t block = ls->voxel_slot[cell];
+        if (block != RL_NONE) {
+            bool fwd;
+            uint32_t shaft = shaft_of_ray(ls, it.current, ray, &fwd);
+            test_list(ls, &w, ray, candidates(ls, cell, block, shaft, false), mailbox, &best, &limit);
+        }
+        if (best.id != RL_NONE && best.t <= t1 - T_SLACK_REL * fabsf(t1))
+            break;
+    }
+    if (best.id == RL_NONE)
+        return false;
+    ray->t_max = best.t;
+    hit->t = best.t;
+    hit->u = best.u;
+    hit->v = best.v;
+    hit->triangle = best.id;
+    hit->object = ls->data->triangle_object[best.id];
+    return true;
+}
+
+bool rl_linespace_occluded(const rl_linespace *ls, const rl_ray *ray)
+{
+    if (!usable(ls, ray))
+        return false;
+    rl_grid_dda it;
+    if (!rl_grid_dda_begin(ls->grid, ray, &it))
+        return false;
+    rl_ray_watertight w;
+    rl_ray_watertight_setup(ray, &w);
+    uint32_t mailbox[MAILBOX_SIZE];
+    memset(mailbox, 0xff, sizeof mailbox);
+    uint32_t cell;
+    float t0, t1;
+    while (rl_grid_dda_next(&it, &cell, &t0, &t1)) {
+        uint32_t block = ls->voxel_slot[cell];
+        if (block == RL_NONE)
+            continue;
+        bool fwd;
+        uint32_t shaft = shaft_of_ray(ls, it.current, ray, &fwd);
+        if (any_hit(ls, &w, ray, candidates(ls, cell, block, shaft, false), mailbox, ray->t_max))
+            return true;
+    }
+    return false;
+}
+
+/* Sec. 7.4, eq. 9: a PNMT record back to a surface; false if empty. */
+static bool decode_pnmt(const rl_linespace *ls, const int xyz[3], const uint16_t *r, rl_ls_surface *s)
+{
+    float m = rl_half_to_float(r[RL_LS_PNMT_MAT]);
+    if (m == 0.0f)
+        return false;
+    rl_aabb box = rl_grid_cell_bounds(ls->grid, xyz[0], xyz[1], xyz[2]);
+    rl_vec3 ext = rl_sub(box.max, box.min);
+    s->p = rl_v3(box.min.x + rl_half_to_float(r[RL_LS_PNMT_PX]) * ext.x,
+                 box.min.y + rl_half_to_float(r[RL_LS_PNMT_PY]) * ext.y,
+                 box.min.z + rl_half_to_float(r[RL_LS_PNMT_PZ]) * ext.z);
+    float nx = rl_half_to_float(r[RL_LS_PNMT_NX]), ny = rl_half_to_float(r[RL_LS_PNMT_NY]);
+    float nz = sqrtf(rl_maxf(0.0f, 1.0f - nx * nx - ny * ny));
+    s->n = rl_v3(nx, ny, m < 0.0f ? -nz : nz);
+    s->material = (uint32_t)(fabsf(m) - 1.0f + 0.5f);
+    s->uv = rl_v2(rl_half_to_float(r[RL_LS_PNMT_U]), rl_half_to_float(r[RL_LS_PNMT_V]));
+    return true;
+}
+
+static float project_t(const rl_ray *ray, rl_vec3 p)
+{
+    return rl_dot(rl_sub(p, ray->o), ray->d) / rl_dot(ray->d, ray->d);
+}
+
+/* The exact closest hit among the origin voxel's triangles within its
+ * t-interval (PNMT's origin-voxel rule); fills *s. */
+static bool origin_hit(const rl_linespace *ls, const rl_ray *ray, uint32_t cell, uint32_t block,
+                       uint32_t shaft, float t1, rl_ls_surface *s)
+{
+    rl_ray_watertight w;
+    rl_ray_watertight_setup(ray, &w);
+    uint32_t mailbox[MAILBOX_SIZE];
+    memset(mailbox, 0xff, sizeof mailbox);
+    float limit = rl_minf(ray->t_max, t1 + T_SLACK_REL * fabsf(t1));
+    closest best = { RL_NONE, limit, 0.0f, 0.0f };
+    test_list(ls, &w, ray, candidates(ls, cell, block, shaft, true), mailbox, &best, &limit);
+    if (best.id == RL_NONE)
+        return false;
+    if (s) {
+        rl_ls_surface_at(ls, best.id, best.u, best.v, s);
+        s->t = best.t;
+    }
+    return true;
+}
+
+static bool origin_inside(const rl_linespace *ls, const rl_ray *ray)
+{
+    return rl_aabb_contains(ls->grid->bounds, rl_ray_at(ray, ray->t_min));
+}
+
+static bool pnmt_walk(const rl_linespace *ls, const rl_ray *ray, rl_ls_surface *out)
+{
+    if (!usable(ls, ray) || !ls->pnmt)
+        return false;
+    rl_grid_dda it;
+    if (!rl_grid_dda_begin(ls->grid, ray, &it))
+        return false;
+    bool first = origin_inside(ls, ray);
+    uint32_t cell;
+    float t0, t1;
+    while (rl_grid_dda_next(&it, &cell, &t0, &t1)) {
+        bool origin = first;
+        first = false;
+        uint32_t block = ls->voxel_slot[cell];
+        if (block == RL_NONE)
+            continue;
+        bool fwd = true;
+        uint32_t shaft = shaft_of_ray(ls, it.current, ray, &fwd);
+        if (origin || shaft == RL_NONE) {
+            /* Origin voxel (our change to Sec. 12.1) and grazing lines: exact. */
+            if (origin_hit(ls, ray, cell, block, shaft, t1, out))
+                return true;
+            continue;
+        }
+        const uint16_t *rec = ls->pnmt + ((uint64_t)block * ls->shafts_per_voxel + shaft) * 16 +
+                              (fwd ? 0 : RL_LS_PNMT_RECORD);
+        rl_ls_surface s;
+        if (!decode_pnmt(ls, it.current, rec, &s))
+            continue;
+        s.t = project_t(ray, s.p);
+        if (s.t > ray->t_min && s.t < ray->t_max) {
+            if (out)
+                *out = s;
+            return true;
+        }
+    }
+    return false;
+}
+
+bool rl_linespace_pnmt_intersect(const rl_linespace *ls, const rl_ray *ray, rl_ls_surface *s)
+{
+    rl_ls_surface tmp;
+    if (!s)
+        return false;
+    if (!pnmt_walk(ls, ray, &tmp))
+        return false;
+    *s = tmp;
+    return true;
+}
+
+bool rl_linespace_pnmt_occluded(const rl_linespace *ls, const rl_ray *ray)
+{
+    return pnmt_walk(ls, ray, NULL);
+}
+
+bool rl_linespace_preillum(const rl_linespace *ls, const rl_ray *ray, rl_vec3 *color, float *t_out)
+{
+    if (!usable(ls, ray) || !ls->preillum || !color)
+        return false;
+    rl_grid_dda it;
+    if (!rl_grid_dda_begin(ls->grid, ray, &it))
+        return false;
+    bool first = origin_inside(ls, ray);
+    float dlen = rl_length(ray->d);
+    float margin = ORIGIN_MARGIN_REL * rl_length(ls->grid->cell_size) / dlen;
+    uint32_t cell;
+    float t0, t1;
+    while (rl_grid_dda_next(&it, &cell, &t0, &t1)) {
+        bool origin = first;
+        first = false;
+        uint32_t block = ls->voxel_slot[cell];
+        if (block == RL_NONE)
+            continue;
+        bool fwd = true;
+        uint32_t shaft = shaft_of_ray(ls, it.current, ray, &fwd);
+        if (shaft == RL_NONE)
+            continue;
+        uint64_t g = (uint64_t)block * ls->shafts_per_voxel + shaft;
+        const uint16_t *c = ls->preillum + g * 8 + (fwd ? 0 : 4);
+        if (rl_half_to_float(c[3]) == 0.0f)
+            continue;
+        float t = 0.5f * (t0 + t1);
+        if (ls->pnmt) {
+            rl_ls_surface s;
+            if (decode_pnmt(ls, it.current, ls->pnmt + g * 16 + (fwd ? 0 : RL_LS_PNMT_RECORD), &s))
+                t = project_t(ray, s.p);
+        }
+        float lo = origin ? ray->t_min + margin : ray->t_min;
+        if (!(t > lo && t < ray->t_max))
+            continue;
+        *color = rl_v3(rl_half_to_float(c[0]), rl_half_to_float(c[1]), rl_half_to_float(c[2]));
+        if (t_out)
+            *t_out = t;
+        return true;
+    }
+    return false;
+}
