@@ -1,0 +1,666 @@
+/* pathtrace.c: renderer "pt", the GPU path tracer of Schröder 2017 (Ch. 6,
+ * 8) on the CPU: progressive path tracing with next-event estimation,
+ * Russian roulette and Phong importance sampling, with selectable ray
+ * backends (BVH, grid, Embree, Line Space candidates / PNMT /
+ * pre-illumination, shadow maps) for the shadow and the secondary rays.
+ *
+ * Options (defaults; the thesis' values in brackets):
+ *   spp = 1            paths per pixel and frame
+ *   max_depth = -1     surface interactions after the camera hit [2 open
+ *                      scenes, 3 Cornell box]; 0 = direct light only;
+ *                      -1 = the scene's root attribute max_path_length
+ *                      (ls-open, ls-cornell carry the thesis' value), else 3
+ *   rr = true, rr_depth = 2    Russian roulette from that bounce on
+ *   rng = hybrid       lcg | tausworthe | hybrid (Sec. 5.3) [hybrid]
+ *   seed = 0
+ *   shadow = bvh       bvh | grid | embree | ls-candidates | ls-preillum |
+ *                      ls-pnmt | shadowmap
+ *   diffuse = bvh      bvh | grid | embree | ls-candidates | ls-preillum | ls-pnmt
+ *   primary = trace    trace (jittered camera rays through the BVH) |
+ *                      raster (G-buffer from the rasterizer, Sec. 8.1: no
+ *                      jitter, so edges alias as the thesis notes)
+ *   checkerboard = false       Sec. 8.5
+ *   accumulate = true          Sec. 6.5, eq. 8
+ *   filter = none, filter_fade = 16    Sec. 8.2
+ *   grid_res = 0 (grid heuristic), ls_n = 5 [5], ls_k = 8, ls_dynamic = true
+ *   shadowmap_size = 1024 [1024], light_samples = 1, threads = 0 (all)
+ *
+ * A frame (Sec. 5.1, Fig. 8): build what the backends need (once per
+ * scene, pathtrace_backend.c); on a reset fill the G-buffer; then for each
+ * of the spp samples a primary pass (jittered camera rays, or the
+ * rasterized G-buffer once per frame) and a path pass (pathtrace_path.c),
+ * both over 16 x 16 tiles handed out dynamically to OpenMP threads.
+ *
+ * Accumulation (Sec. 6.5, eq. 8): C_{s+1} = s/(s+1) C_s + 1/(s+1) C_trace.
+ * We keep the per-pixel sum in double and its sample count and divide,
+ * which is eq. 8 without its rounding drift; the count is per pixel because
+ * checkerboard rendering (Sec. 8.5) renders the pixels with (x + y + frame)
+ * even in one frame and the others in the next; in the first frame after a
+ * reset the missing pixels are the mean of their rendered 4-neighbours.
+ * The accumulation restarts when the camera, the scene (rl_scene_uid), the
+ * image size or any option changes, on rl_pt_reset(), and every frame with
+ * accumulate = false.
+ *
+ * Random numbers (Sec. 5.3): one GPU-style generator state per pixel (the
+ * thesis' state texture), seeded on reset from PCG32 (seed, pixel) and
+ * advanced across frames. Every pixel's result depends only on its own
+ * state, so images do not depend on the thread count.
+ *
+ * Filter (Sec. 8.2): the filtered accumulated image is blended in with the
+ * weight 1 / (1 + spp / filter_fade), spp the mean samples per pixel so far:
+ * "the filter's influence decreases as the samples grow"; filter_fade = 0
+ * keeps the full filter. The G-buffer guides the filter.
+ *
+ * Depth and ID layers come from the G-buffer (pixel centres). */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#ifdef _OPENMP
+#include <omp.h>
+#endif
+
+#include "core/error.h"
+#include "core/params.h"
+#include "render/pathtrace_internal.h"
+#include "render/renderer.h"
+#include "rl/rl_pt.h"
+#include "rl/rl_timer.h"
+
+#define TILE 16
+#define BUILD_SHARE 0.1
+
+static const char *const rng_choices[] = { "lcg", "tausworthe", "hybrid", NULL };
+/* Order = rl_pt_backend. */
+static const char *const shadow_choices[] = { "bvh", "grid", "embree", "ls-candidates", "ls-preillum", "ls-pnmt",
+                                              "shadowmap", NULL };
+static const char *const diffuse_choices[] = { "bvh", "grid", "embree", "ls-candidates", "ls-preillum", "ls-pnmt",
+                                               NULL };
+static const char *const primary_choices[] = { "trace", "raster", NULL };
+/* Order = rl_filter_kind. */
+static const char *const filter_choices[] = { "none", "gauss", "bilateral", "aniso", "kuwahara", NULL };
+
+static const rl_option_info pt_options[] = {
+    { "spp", RL_OPT_INT, "1", "paths per pixel and frame", 1, 65536, NULL },
+    { "max_depth", RL_OPT_INT, "-1",
+      "surface interactions after the camera hit (0: direct light only; thesis: 2 open scenes, 3 Cornell box; "
+      "-1: the scene's root attribute max_path_length, else 3)",
+      -1, 1024, NULL },
+    { "rr", RL_OPT_BOOL, "true", "Russian roulette on the path length (Sec. 3.2.4)", 0, 0, NULL },
+    { "rr_depth", RL_OPT_INT, "2", "bounce from which Russian roulette may end a path", 0, 1024, NULL },
+    { "rng", RL_OPT_ENUM, "hybrid", "per-pixel random numbers (Sec. 5.3): lcg, tausworthe or their hybrid",
+      0, 0, rng_choices },
+    { "seed", RL_OPT_INT, "0", "seed of the per-pixel generator states", 0, 9007199254740991.0, NULL },
+    { "shadow", RL_OPT_ENUM, "bvh", "shadow test: exact accelerator, Line Space payload or shadow maps",
+      0, 0, shadow_choices },
+    { "diffuse", RL_OPT_ENUM, "bvh", "secondary rays: exact accelerator or Line Space payload",
+      0, 0, diffuse_choices },
+    { "primary", RL_OPT_ENUM, "trace",
+      "primary visibility: trace (jittered rays, BVH) or raster (G-buffer, Sec. 8.1)", 0, 0, primary_choices },
+    { "checkerboard", RL_OPT_BOOL, "false", "render alternate halves of the pixels per frame (Sec. 8.5)",
+      0, 0, NULL },
+    { "accumulate", RL_OPT_BOOL, "true", "progressive accumulation across frames (Sec. 6.5, eq. 8)", 0, 0, NULL },
+    { "filter", RL_OPT_ENUM, "none", "noise filter on the accumulated image (Sec. 8.2)", 0, 0, filter_choices },
+    { "filter_fade", RL_OPT_FLOAT, "16",
+      "filter weight 1/(1 + spp/filter_fade) with spp the samples so far; 0 = never fade", 0, 1e9, NULL },
+    { "grid_res", RL_OPT_INT, "0", "voxels per axis of the grid and the Line Space (0 = grid heuristic)",
+      0, 1024, NULL },
+    { "ls_n", RL_OPT_INT, "5", "Line Space patches per voxel face side (Sec. 9.2: 5)", 1, RL_LS_MAX_N, NULL },
+    { "ls_k", RL_OPT_INT, "8", "Line Space fixed candidate slots per shaft (even)", 2, RL_LS_MAX_K, NULL },
+    { "ls_dynamic", RL_OPT_BOOL, "true", "exact per-shaft candidate lists (prefix sums, Sec. 7.1.1)", 0, 0, NULL },
+    { "shadowmap_size", RL_OPT_INT, "1024", "texels per shadow-map face side (Sec. 8.6)", 16, 16384, NULL },
+    { "light_samples", RL_OPT_INT, "1", "shadow rays per quad light and vertex", 1, 1024, NULL },
+    { "threads", RL_OPT_INT, "0", "OpenMP threads (0 = all)", 0, 1024, NULL },
+};
+#define NUM_OPTIONS (sizeof pt_options / sizeof pt_options[0])
+
+typedef struct pt_state {
+    pt_backends b;
+    /* the accumulation and what it depends on */
+    bool valid, force_reset;
+    uint64_t scene_uid;
+    rl_camera cam;
+    int width, height;
+    char *signature;
+    double *accum;                /* 3 per pixel: summed radiance */
+    uint32_t *count;              /* samples per pixel */
+    rl_rng_gpu *rng;              /* per pixel */
+    rl_gbuffer *gbuf;
+    uint64_t frames, total_samples;
+    /* per-frame scratch */
+    rl_hit *hits;
+    rl_vec3 *dirs;
+    /* the last frame */
+    bool have_frame;
+    rl_pt_stats stats;
+} pt_state;
+
+static rl_status pt_create(void **state)
+{
+    pt_state *s = rl_calloc(1, sizeof *s);
+    if (!s)
+        return RL_ERR_OUT_OF_MEMORY;
+    *state = s;
+    return RL_OK;
+}
+
+static void free_frame(pt_state *s)
+{
+    free(s->accum);
+    free(s->count);
+    free(s->rng);
+    free(s->hits);
+    free(s->dirs);
+    rl_gbuffer_release(s->gbuf);
+    s->accum = NULL;
+    s->count = NULL;
+    s->rng = NULL;
+    s->hits = NULL;
+    s->dirs = NULL;
+    s->gbuf = NULL;
+    s->valid = false;
+}
+
+static void pt_release(void *state)
+{
+    pt_state *s = state;
+    if (!s)
+        return;
+    rl_pt_backends_release(&s->b);
+    free_frame(s);
+    free(s->signature);
+    free(s);
+}
+
+/* The thesis' path length stored with a scene (Sec. 9.3; the built-ins
+ * ls-open and ls-cornell set it on their root node), else 3. */
+static int scene_max_depth(const rl_scene *scene)
+{
+    const char *v = rl_scene_node_attr(scene, 0, "max_path_length");
+    long long n;
+    return v && rl_parse_int(v, &n) && n >= 0 && n <= 1024 ? (int)n : 3;
+}
+
+static rl_status pt_check(const char *key, const char *value)
+{
+    if (strcmp(key, "shadow") == 0 || strcmp(key, "diffuse") == 0) {
+        bool shadow = key[0] == 's';
+        for (int k = 0; k < RL_PT_BACKEND_COUNT; ++k) {
+            if (strcmp(value, rl_pt_backend_name((rl_pt_backend)k)) != 0)
+                continue;
+            if (!rl_pt_backend_available((rl_pt_backend)k, shadow))
+                return rl_error(RL_ERR_INVALID_ARG, "pt: %s=%s is not available in this build%s", key, value,
+                                k == RL_PT_BACKEND_EMBREE ? " (configure with -DRL_EMBREE=ON)" : "");
+        }
+        return RL_OK;
+    }
+    if (strcmp(key, "ls_k") == 0 && atoi(value) % 2 != 0)
+        return rl_error(RL_ERR_INVALID_ARG, "pt: ls_k=%s must be even (front and back halves, Alg. 3)", value);
+    return RL_OK;
+}
+
+static void read_settings(const rl_renderer *r, pt_settings *set)
+{
+    memset(set, 0, sizeof *set);
+    set->spp = (int)rl_renderer_opt_int(r, "spp");
+    set->max_depth = (int)rl_renderer_opt_int(r, "max_depth");
+    set->rr = rl_renderer_opt_bool(r, "rr");
+    set->rr_depth = (int)rl_renderer_opt_int(r, "rr_depth");
+    set->rng = (rl_rng_gpu_kind)rl_renderer_opt_enum(r, "rng");
+    set->seed = (uint64_t)rl_renderer_opt_int(r, "seed");
+    set->shadow = (rl_pt_backend)rl_renderer_opt_enum(r, "shadow");
+    set->diffuse = (rl_pt_backend)rl_renderer_opt_enum(r, "diffuse");
+    set->primary = (pt_primary)rl_renderer_opt_enum(r, "primary");
+    set->checkerboard = rl_renderer_opt_bool(r, "checkerboard");
+    set->accumulate = rl_renderer_opt_bool(r, "accumulate");
+    set->filter = (rl_filter_kind)rl_renderer_opt_enum(r, "filter");
+    set->filter_fade = rl_renderer_opt_float(r, "filter_fade");
+    set->grid_res = (int)rl_renderer_opt_int(r, "grid_res");
+    set->ls_n = (int)rl_renderer_opt_int(r, "ls_n");
+    set->ls_k = (int)rl_renderer_opt_int(r, "ls_k");
+    set->ls_dynamic = rl_renderer_opt_bool(r, "ls_dynamic");
+    set->shadowmap_size = (int)rl_renderer_opt_int(r, "shadowmap_size");
+    set->light_samples = (int)rl_renderer_opt_int(r, "light_samples");
+    int threads = (int)rl_renderer_opt_int(r, "threads");
+#ifdef _OPENMP
+    set->threads = threads > 0 ? threads : omp_get_max_threads();
+#else
+    (void)threads;
+    set->threads = 1;
+#endif
+}
+
+/* All option values as one string: any change restarts the accumulation. */
+static char *option_signature(const rl_renderer *r)
+{
+    size_t len = 1;
+    for (size_t i = 0; i < NUM_OPTIONS; ++i)
+        len += strlen(pt_options[i].key) + strlen(rl_renderer_get(r, pt_options[i].key)) + 2;
+    char *sig = rl_alloc(len);
+    if (!sig)
+        return NULL;
+    sig[0] = '\0';
+    size_t used = 0;
+    for (size_t i = 0; i < NUM_OPTIONS; ++i)
+        used += (size_t)snprintf(sig + used, len - used, "%s=%s;", pt_options[i].key,
+                                 rl_renderer_get(r, pt_options[i].key));
+    return sig;
+}
+
+static bool same_camera(const rl_camera *a, const rl_camera *b)
+{
+    return memcmp(&a->eye, &b->eye, sizeof a->eye) == 0 && memcmp(&a->target, &b->target, sizeof a->target) == 0 &&
+           memcmp(&a->up, &b->up, sizeof a->up) == 0 && a->fov_deg == b->fov_deg && a->width == b->width &&
+           a->height == b->height && a->z_near == b->z_near && a->z_far == b->z_far;
+}
+
+/* Starts a new accumulation: buffers, generator states, G-buffer. */
+static rl_status reset(pt_state *s, const rl_scene *scene, const rl_camera *cam, const pt_settings *set,
+                       char *signature)
+{
+    int w = cam->width, h = cam->height;
+    size_t n = (size_t)w * (size_t)h;
+    if (!s->accum || s->width != w || s->height != h) {
+        free_frame(s);
+        s->accum = rl_calloc(3 * n, sizeof *s->accum);
+        s->count = rl_calloc(n, sizeof *s->count);
+        s->rng = rl_calloc(n, sizeof *s->rng);
+        s->hits = rl_calloc(n, sizeof *s->hits);
+        s->dirs = rl_calloc(n, sizeof *s->dirs);
+        rl_status st = s->accum && s->count && s->rng && s->hits && s->dirs ? RL_OK : RL_ERR_OUT_OF_MEMORY;
+        if (st == RL_OK)
+            st = rl_gbuffer_create(w, h, &s->gbuf);
+        if (st != RL_OK) {
+            free_frame(s);
+            free(signature);
+            return st;
+        }
+    }
+    memset(s->accum, 0, 3 * n * sizeof *s->accum);
+    memset(s->count, 0, n * sizeof *s->count);
+    /* Sec. 5.3.3: the state texture is filled once from the CPU generator. */
+    for (size_t i = 0; i < n; ++i)
+        rl_rng_gpu_seed(&s->rng[i], set->rng, set->seed, i);
+    free(s->signature);
+    s->signature = signature;
+    s->scene_uid = rl_scene_uid(scene);
+    s->cam = *cam;
+    s->width = w;
+    s->height = h;
+    s->frames = 0;
+    s->total_samples = 0;
+    s->valid = true;
+    s->force_reset = false;
+    return RL_OK;
+}
+
+/* Everything a tile needs; read-only but for its pixels and counters. */
+typedef struct frame {
+    pt_state *s;
+    const pt_settings *set;
+    pt_ctx ctx;
+    rl_camera_frame cam;
+    rl_vec3 eye;
+    int width, height, tiles_x;
+    uint64_t parity;
+} frame;
+
+static bool active(const frame *f, int x, int y)
+{
+    return !f->set->checkerboard || (((uint64_t)(x + y) + f->parity) & 1u) == 0;
+}
+
+static void tile_bounds(const frame *f, int64_t t, int *x0, int *y0, int *x1, int *y1)
+{
+    *x0 = (int)(t % f->tiles_x) * TILE;
+    *y0 = (int)(t / f->tiles_x) * TILE;
+    *x1 = *x0 + TILE < f->width ? *x0 + TILE : f->width;
+    *y1 = *y0 + TILE < f->height ? *y0 + TILE : f->height;
+}
+
+/* Primary pass of one sample (trace mode): jittered camera rays, Sec. 8.1's
+ * "jittering of the primary rays". */
+static void primary_tile(const frame *f, int64_t t, pt_counters *c)
+{
+    int x0, y0, x1, y1;
+    tile_bounds(f, t, &x0, &y0, &x1, &y1);
+    for (int y = y0; y < y1; ++y) {
+        for (int x = x0; x < x1; ++x) {
+            if (!active(f, x, y))
+                continue;
+            size_t i = (size_t)y * f->width + x;
+            rl_rng_gpu *rng = &f->s->rng[i];
+            float jx = rl_rng_gpu_float(rng), jy = rl_rng_gpu_float(rng);
+            rl_ray ray = rl_camera_frame_ray(&f->cam, (float)x + jx, (float)y + jy);
+            rl_hit hit = { INFINITY, 0.0f, 0.0f, RL_ID_NONE, RL_ID_NONE };
+            c->rays[RL_RAY_PRIMARY]++;
+            c->trace_q[RL_PT_BACKEND_BVH]++;
+            rl_accel_intersect(f->s->b.exact[RL_ACCEL_BVH], &ray, &hit);
+            f->s->hits[i] = hit;
+            f->s->dirs[i] = ray.d;
+        }
+    }
+}
+
+/* The first vertex of pixel i: the traced hit or the G-buffer's surface. */
+static bool first_vertex(const frame *f, size_t i, pt_surface *s)
+{
+    const rl_scene_data *d = f->ctx.data;
+    if (f->set->primary == PT_PRIMARY_TRACE)
+        return rl_pt_surface_at_hit(d, &f->s->hits[i], f->eye, f->s->dirs[i], s);
+    const rl_gbuffer *g = f->s->gbuf;
+    uint32_t tri = g->triangle[i];
+    if (tri >= d->num_triangles)
+        return false;
+    rl_vec3 v = rl_normalize(rl_sub(f->eye, g->position[i]));
+    rl_pt_surface_finish(d, tri, g->position[i], g->normal[i], g->uv[i], v, s);
+    return true;
+}
+
+static void path_tile(const frame *f, int64_t t, pt_counters *c)
+{
+    int x0, y0, x1, y1;
+    tile_bounds(f, t, &x0, &y0, &x1, &y1);
+    for (int y = y0; y < y1; ++y) {
+        for (int x = x0; x < x1; ++x) {
+            if (!active(f, x, y))
+                continue;
+            size_t i = (size_t)y * f->width + x;
+            pt_surface first;
+            if (!first_vertex(f, i, &first))
+                continue;             /* background: black */
+            rl_vec3 L = rl_pt_trace_path(&f->ctx, &first, &f->s->rng[i], c);
+            /* A NaN or infinity would poison the pixel's mean for good. */
+            if (!rl_vfinite(L))
+                continue;
+            f->s->accum[3 * i + 0] += L.x;
+            f->s->accum[3 * i + 1] += L.y;
+            f->s->accum[3 * i + 2] += L.z;
+        }
+    }
+}
+
+static void add_counters(pt_counters *to, const pt_counters *from)
+{
+    for (int k = 0; k < RL_RAY_TYPE_COUNT; ++k)
+        to->rays[k] += from->rays[k];
+    for (int k = 0; k < RL_PT_BACKEND_COUNT; ++k) {
+        to->shadow_q[k] += from->shadow_q[k];
+        to->trace_q[k] += from->trace_q[k];
+    }
+    to->preillum_ends += from->preillum_ends;
+}
+
+/* One pass over all tiles; tile counters keep adding. */
+static void run_pass(const frame *f, int threads, int64_t num_tiles, pt_counters *tile_c, bool primary)
+{
+#pragma omp parallel for num_threads(threads) schedule(dynamic, 1)
+    for (int64_t t = 0; t < num_tiles; ++t) {
+        if (primary)
+            primary_tile(f, t, &tile_c[t]);
+        else
+            path_tile(f, t, &tile_c[t]);
+    }
+}
+
+/* The accumulated mean into the image; checkerboard holes (first frame
+ * after a reset) from the rendered 4-neighbours (Sec. 8.5, Fig. 17). */
+static void resolve(const pt_state *s, rl_image *image)
+{
+    int w = s->width, h = s->height;
+#pragma omp parallel for schedule(static)
+    for (int y = 0; y < h; ++y) {
+        for (int x = 0; x < w; ++x) {
+            size_t i = (size_t)y * w + x;
+            double c[3] = { 0.0, 0.0, 0.0 };
+            if (s->count[i] > 0) {
+                for (int k = 0; k < 3; ++k)
+                    c[k] = s->accum[3 * i + k] / s->count[i];
+            } else {
+                static const int dx[4] = { -1, 1, 0, 0 }, dy[4] = { 0, 0, -1, 1 };
+                int n = 0;
+                for (int j = 0; j < 4; ++j) {
+                    int nx = x + dx[j], ny = y + dy[j];
+                    if (nx < 0 || ny < 0 || nx >= w || ny >= h)
+                        continue;
+                    size_t q = (size_t)ny * w + nx;
+                    if (s->count[q] == 0)
+                        continue;
+                    for (int k = 0; k < 3; ++k)
+                        c[k] += s->accum[3 * q + k] / s->count[q];
+                    ++n;
+                }
+                for (int k = 0; k < 3 && n > 0; ++k)
+                    c[k] /= n;
+            }
+            image->color[i] = rl_v4((float)c[0], (float)c[1], (float)c[2], 1.0f);
+        }
+    }
+}
+
+/* Sec. 8.2: filter, faded out as the samples grow. */
+static rl_status apply_filter(const pt_state *s, const pt_settings *set, rl_image *image, float *weight)
+{
+    double spp = (double)s->total_samples / ((double)s->width * s->height);
+    float w = set->filter_fade > 0.0 ? (float)(1.0 / (1.0 + spp / set->filter_fade)) : 1.0f;
+    *weight = w;
+    rl_image *in = NULL, *out = NULL;
+    rl_status st = rl_image_create(s->width, s->height, RL_LAYER_COLOR, &in);
+    if (st == RL_OK)
+        st = rl_image_create(s->width, s->height, RL_LAYER_COLOR, &out);
+    if (st == RL_OK) {
+        size_t n = (size_t)s->width * s->height;
+        memcpy(in->color, image->color, n * sizeof *in->color);
+        st = rl_filter_apply(&(rl_filter_desc){ .kind = set->filter }, in, s->gbuf, out);
+        for (size_t i = 0; st == RL_OK && i < n; ++i) {
+            rl_vec4 a = in->color[i], b = out->color[i];
+            image->color[i] = rl_v4(a.x + w * (b.x - a.x), a.y + w * (b.y - a.y), a.z + w * (b.z - a.z), 1.0f);
+        }
+    }
+    rl_image_release(in);
+    rl_image_release(out);
+    return st;
+}
+
+static void write_layers(const pt_state *s, rl_image *image)
+{
+    size_t n = (size_t)s->width * s->height;
+    const rl_gbuffer *g = s->gbuf;
+    if ((image->layers & RL_LAYER_DEPTH) && image->depth)
+        memcpy(image->depth, g->depth, n * sizeof *image->depth);
+    if ((image->layers & RL_LAYER_ID) && image->object_id && image->triangle_id) {
+        memcpy(image->object_id, g->object, n * sizeof *image->object_id);
+        memcpy(image->triangle_id, g->triangle, n * sizeof *image->triangle_id);
+    }
+}
+
+static rl_status cancelled(pt_state *s)
+{
+    s->force_reset = true;        /* a half-accumulated frame is no frame */
+    return rl_error(RL_ERR_CANCELLED, "pt: cancelled by the progress callback");
+}
+
+static rl_status pt_render(rl_renderer *r, void *state, const rl_scene *scene, const rl_camera *cam,
+                           rl_image *image, rl_render_stats *stats)
+{
+    pt_state *s = state;
+    const rl_scene_data *d = rl_scene_get_data(scene);
+    if (!d)
+        return RL_ERR_NOT_COMMITTED;
+    rl_timer total;
+    rl_timer_start(&total);
+    pt_settings set;
+    read_settings(r, &set);
+    s->have_frame = false;
+    rl_pt_stats ps;
+    memset(&ps, 0, sizeof ps);
+
+    double built_ms = 0.0;
+    rl_status st = rl_pt_backends_prepare(&s->b, scene, &set, set.threads, &built_ms);
+    if (st != RL_OK)
+        return st;
+    ps.time_build_ms = built_ms;
+    if (!rl_renderer_progress(r, BUILD_SHARE))
+        return cancelled(s);
+
+    char *sig = option_signature(r);
+    if (!sig)
+        return RL_ERR_OUT_OF_MEMORY;
+    bool need_reset = s->force_reset || !s->valid || !set.accumulate || s->scene_uid != rl_scene_uid(scene) ||
+                      s->width != cam->width || s->height != cam->height || !same_camera(&s->cam, cam) ||
+                      strcmp(s->signature, sig) != 0;
+    if (need_reset) {
+        if ((st = reset(s, scene, cam, &set, sig)) != RL_OK)
+            return st;
+    } else {
+        free(sig);
+    }
+    ps.reset = need_reset;
+
+    /* Primary visibility that does not change while accumulating: the
+     * traced G-buffer once per reset; the rasterized one every frame, as
+     * the thesis' extra render pass (Sec. 8.1). */
+    rl_timer timer;
+    rl_timer_start(&timer);
+    if (set.primary == PT_PRIMARY_RASTER) {
+        st = rl_gbuffer_raster(s->gbuf, scene, cam);
+    } else if (need_reset) {
+        st = rl_gbuffer_trace(s->gbuf, s->b.exact[RL_ACCEL_BVH], cam);
+        ps.gbuffer_rays = (uint64_t)cam->width * cam->height;
+    }
+    if (st != RL_OK) {
+        s->force_reset = true;
+        return st;
+    }
+    ps.time_primary_ms = rl_timer_ms(&timer);
+
+    frame f = {
+        .s = s,
+        .set = &set,
+        .ctx = { .data = d, .b = &s->b, .shadow = set.shadow, .diffuse = set.diffuse,
+                 .max_depth = set.max_depth >= 0 ? set.max_depth : scene_max_depth(scene),
+                 .rr_depth = set.rr_depth, .light_samples = set.light_samples, .rr = set.rr },
+        .cam = rl_camera_frame_make(cam),
+        .eye = cam->eye,
+        .width = cam->width,
+        .height = cam->height,
+        .tiles_x = (cam->width + TILE - 1) / TILE,
+        .parity = s->frames & 1u,
+    };
+    int64_t num_tiles = (int64_t)f.tiles_x * ((cam->height + TILE - 1) / TILE);
+    pt_counters *tile_c = rl_calloc((size_t)num_tiles, sizeof *tile_c);
+    if (!tile_c)
+        return RL_ERR_OUT_OF_MEMORY;
+    for (int k = 0; k < set.spp; ++k) {
+        if (set.primary == PT_PRIMARY_TRACE) {
+            rl_timer_start(&timer);
+            run_pass(&f, set.threads, num_tiles, tile_c, true);
+            ps.time_primary_ms += rl_timer_ms(&timer);
+        }
+        rl_timer_start(&timer);
+        run_pass(&f, set.threads, num_tiles, tile_c, false);
+        ps.time_paths_ms += rl_timer_ms(&timer);
+        if (!rl_renderer_progress(r, BUILD_SHARE + (1.0 - BUILD_SHARE) * (k + 1) / set.spp)) {
+            free(tile_c);
+            return cancelled(s);
+        }
+    }
+    pt_counters sum;
+    memset(&sum, 0, sizeof sum);
+    for (int64_t t = 0; t < num_tiles; ++t)
+        add_counters(&sum, &tile_c[t]);
+    free(tile_c);
+
+    uint64_t traced = 0;
+    for (int y = 0; y < cam->height; ++y)
+        for (int x = 0; x < cam->width; ++x)
+            if (active(&f, x, y)) {
+                s->count[(size_t)y * cam->width + x] += (uint32_t)set.spp;
+                ++traced;
+            }
+    s->frames++;
+    s->total_samples += traced * (uint64_t)set.spp;
+
+    resolve(s, image);
+    if (set.filter != RL_FILTER_NONE) {
+        rl_timer_start(&timer);
+        st = apply_filter(s, &set, image, &ps.filter_weight);
+        ps.time_filter_ms = rl_timer_ms(&timer);
+        if (st != RL_OK)
+            return st;
+    }
+    write_layers(s, image);
+
+    for (int k = 0; k < RL_RAY_TYPE_COUNT; ++k)
+        stats->rays[k] = ps.rays[k] = sum.rays[k];
+    memcpy(ps.shadow_queries, sum.shadow_q, sizeof ps.shadow_queries);
+    memcpy(ps.trace_queries, sum.trace_q, sizeof ps.trace_queries);
+    ps.preillum_ends = sum.preillum_ends;
+    stats->pixels_written = (uint64_t)cam->width * cam->height;
+    stats->samples = ps.samples = traced * (uint64_t)set.spp;
+    ps.frames = s->frames;
+    ps.spp = (double)s->total_samples / ((double)cam->width * cam->height);
+    ps.spp_frame = (uint32_t)set.spp;
+    ps.pixels_traced = traced;
+    uint64_t rays = 0;
+    for (int k = 0; k < RL_RAY_TYPE_COUNT; ++k)
+        rays += ps.rays[k];
+    double ray_ms = ps.time_primary_ms + ps.time_paths_ms;
+    ps.mrays_per_s = ray_ms > 0.0 ? (double)rays / (ray_ms * 1e3) : 0.0;
+    ps.build_bvh_ms = s->b.exact[RL_ACCEL_BVH] ? s->b.exact_ms[RL_ACCEL_BVH] : 0.0;
+    ps.build_grid_ms = s->b.exact[RL_ACCEL_GRID] ? s->b.exact_ms[RL_ACCEL_GRID] : 0.0;
+    ps.build_embree_ms = s->b.exact[RL_ACCEL_EMBREE] ? s->b.exact_ms[RL_ACCEL_EMBREE] : 0.0;
+    ps.build_linespace_ms = s->b.ls ? s->b.ls_ms : 0.0;
+    ps.build_shadowmap_ms = s->b.sm ? s->b.sm_ms : 0.0;
+    ps.rng = set.rng;
+    ps.time_total_ms = rl_timer_ms(&total);
+    s->stats = ps;
+    s->have_frame = true;
+    return RL_OK;
+}
+
+/* The state of r if it is a "pt" renderer, else NULL. */
+static pt_state *pt_of(const rl_renderer *r)
+{
+    if (!r || strcmp(rl_renderer_name(r), "pt") != 0)
+        return NULL;
+    return rl_renderer_state(r);
+}
+
+rl_status rl_pt_get_stats(const rl_renderer *r, rl_pt_stats *out)
+{
+    pt_state *s = pt_of(r);
+    if (!s || !out)
+        return rl_error(RL_ERR_INVALID_ARG, "rl_pt_get_stats: needs a \"pt\" renderer and out");
+    if (!s->have_frame)
+        return rl_error(RL_ERR_INVALID_ARG, "rl_pt_get_stats: no frame rendered yet");
+    *out = s->stats;
+    return RL_OK;
+}
+
+rl_status rl_pt_reset(rl_renderer *r)
+{
+    pt_state *s = pt_of(r);
+    if (!s)
+        return rl_error(RL_ERR_INVALID_ARG, "rl_pt_reset: needs a \"pt\" renderer");
+    s->force_reset = true;
+    return RL_OK;
+}
+
+const rl_gbuffer *rl_pt_gbuffer(const rl_renderer *r)
+{
+    pt_state *s = pt_of(r);
+    return s && s->have_frame ? s->gbuf : NULL;
+}
+
+const rl_renderer_class rl_pt_renderer_class = {
+    .info = { "pt", "Progressive path tracing with NEE, Russian roulette and Phong sampling; Line Space backends",
+              "Schröder 2017" },
+    .options = pt_options,
+    .num_options = NUM_OPTIONS,
+    .create = pt_create,
+    .render = pt_render,
+    .release = pt_release,
+    .check = pt_check,
+};

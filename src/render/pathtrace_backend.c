@@ -1,0 +1,269 @@
+/* pathtrace_backend.c: the structures behind the path tracer's backends
+ * (Schröder 2017, Sec. 5.1, Diagram 3): an exact accelerator per exact
+ * backend in use (BVH, grid, Embree), the grid plus its Line Space for the
+ * ls-* backends (one Line Space with the union of the payloads the shadow
+ * and diffuse backends ask for, on the grid of grid_res), and the shadow
+ * maps. Each is built lazily, the first time a frame needs it, and kept
+ * until the scene (rl_scene_uid) or its own parameters change, so that
+ * switching backends back and forth costs nothing.
+ *
+ * Also here: the quad-light cover of emissive triangles used by the
+ * emission rule (pathtrace_path.c). */
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "core/error.h"
+#include "render/pathtrace_internal.h"
+#include "rl/rl_timer.h"
+
+#define EPS_SCALE 1e-5f           /* ray origin offset, as trace.c */
+
+const char *rl_pt_backend_name(rl_pt_backend backend)
+{
+    static const char *const names[RL_PT_BACKEND_COUNT] = {
+        "bvh", "grid", "embree", "ls-candidates", "ls-preillum", "ls-pnmt", "shadowmap"
+    };
+    return (unsigned)backend < RL_PT_BACKEND_COUNT ? names[backend] : "unknown";
+}
+
+static bool is_exact(rl_pt_backend k)
+{
+    return k == RL_PT_BACKEND_BVH || k == RL_PT_BACKEND_GRID || k == RL_PT_BACKEND_EMBREE;
+}
+
+bool rl_pt_backend_available(rl_pt_backend backend, bool shadow)
+{
+    if (backend == RL_PT_BACKEND_EMBREE)
+        return rl_accel_kind_available(RL_ACCEL_EMBREE);
+    if (backend == RL_PT_BACKEND_SHADOWMAP)
+        return shadow;
+    return (unsigned)backend < RL_PT_BACKEND_COUNT;
+}
+
+/* The Line Space on the grid with the payloads the backends need, and pt's
+ * shading function for the pre-illuminated colours (Sec. 7.3). */
+static rl_status ls_build(const rl_accel *grid, const rl_linespace_desc *desc, rl_ls_shade_fn shade,
+                          void *user, rl_linespace **out, double *build_ms)
+{
+    rl_linespace *ls = NULL;
+    *out = NULL;
+    rl_status st = rl_linespace_create(grid, desc, &ls);
+    if (st == RL_OK && (desc->payloads & RL_LS_PREILLUM))
+        st = rl_linespace_set_shader(ls, shade, user);
+    if (st == RL_OK)
+        st = rl_linespace_commit(ls);
+    if (st != RL_OK) {
+        rl_linespace_release(ls);
+        return st;
+    }
+    rl_linespace_stats stats;
+    rl_linespace_get_stats(ls, &stats);
+    *build_ms = stats.build_ms;
+    *out = ls;
+    return RL_OK;
+}
+
+/* Shadow maps of every light (Sec. 8.6). */
+static rl_status sm_build(const rl_scene *scene, int size, rl_shadowmap **out, double *build_ms)
+{
+    rl_shadowmap_desc desc = { .size = size };
+    rl_status st = rl_shadowmap_create(scene, &desc, out);
+    if (st != RL_OK)
+        return st;
+    *build_ms = rl_shadowmap_build_ms(*out);
+    return RL_OK;
+}
+
+static float scene_scale(rl_aabb b)
+{
+    if (rl_aabb_is_empty(b) || !rl_vfinite(b.min) || !rl_vfinite(b.max))
+        return 1.0f;
+    float coord = rl_maxf(rl_vmax_comp(rl_vmax(b.min, rl_neg(b.min))), rl_vmax_comp(rl_vmax(b.max, rl_neg(b.max))));
+    float s = rl_maxf(coord, rl_length(rl_aabb_extent(b)));
+    return s > 0.0f ? s : 1.0f;
+}
+
+uint32_t rl_pt_cover_point(const rl_scene_data *d, rl_vec3 p, float tol)
+{
+    for (uint32_t i = 0; i < d->num_lights; ++i) {
+        const rl_light *L = &d->lights[i];
+        if (L->type != RL_LIGHT_QUAD)
+            continue;
+        rl_vec3 n = rl_cross(L->edge_u, L->edge_v);
+        float area = rl_length(n);
+        if (!(area > 0.0f))
+            continue;
+        rl_vec3 r = rl_sub(p, L->position);
+        if (fabsf(rl_dot(r, n)) / area > tol)
+            continue;
+        /* (s, t) of p in the parallelogram: solve the 2x2 normal equations
+         * of r = s edge_u + t edge_v. */
+        float uu = rl_dot(L->edge_u, L->edge_u), uv = rl_dot(L->edge_u, L->edge_v);
+        float vv = rl_dot(L->edge_v, L->edge_v), ru = rl_dot(r, L->edge_u), rv = rl_dot(r, L->edge_v);
+        float det = uu * vv - uv * uv;
+        if (!(det > 0.0f))
+            continue;
+        float s = (ru * vv - rv * uv) / det, t = (rv * uu - ru * uv) / det;
+        float ts = tol / sqrtf(uu), tt = tol / sqrtf(vv);
+        if (s >= -ts && s <= 1.0f + ts && t >= -tt && t <= 1.0f + tt)
+            return i;
+    }
+    return RL_NONE;
+}
+
+/* Per emissive triangle: the quad light covering all three corners. */
+static rl_status build_cover(pt_backends *b, const rl_scene_data *d)
+{
+    free(b->tri_cover);
+    b->tri_cover = rl_calloc(d->num_triangles ? d->num_triangles : 1, sizeof *b->tri_cover);
+    if (!b->tri_cover)
+        return RL_ERR_OUT_OF_MEMORY;
+    float tol = 10.0f * b->eps;
+    for (uint32_t t = 0; t < d->num_triangles; ++t) {
+        b->tri_cover[t] = RL_NONE;
+        if (!(rl_vmax_comp(d->materials[d->triangle_material[t]].emission) > 0.0f))
+            continue;
+        const uint32_t *idx = &d->indices[3 * (size_t)t];
+        uint32_t c0 = rl_pt_cover_point(d, d->positions[idx[0]], tol);
+        if (c0 != RL_NONE && rl_pt_cover_point(d, d->positions[idx[1]], tol) == c0 &&
+            rl_pt_cover_point(d, d->positions[idx[2]], tol) == c0)
+            b->tri_cover[t] = c0;
+    }
+    return RL_OK;
+}
+
+void rl_pt_backends_release(pt_backends *b)
+{
+    rl_linespace_release(b->ls);          /* before the grid it borrows */
+    for (int k = 0; k < 3; ++k)
+        rl_accel_release(b->exact[k]);
+    rl_shadowmap_release(b->sm);
+    free(b->tri_cover);
+    memset(b, 0, sizeof *b);
+}
+
+static rl_status build_exact(pt_backends *b, const rl_scene *scene, rl_accel_kind kind, int grid_res,
+                             int threads, double *built_ms)
+{
+    if (b->exact[kind] && (kind != RL_ACCEL_GRID || b->grid_res == grid_res))
+        return RL_OK;
+    if (kind == RL_ACCEL_GRID) {
+        rl_linespace_release(b->ls);      /* it lives on the old grid */
+        b->ls = NULL;
+        b->ls_ms = 0.0;
+    }
+    rl_accel_release(b->exact[kind]);
+    b->exact[kind] = NULL;
+    if (!rl_accel_kind_available(kind))
+        return rl_error(RL_ERR_UNSUPPORTED, "pt: %s is not available in this build", rl_accel_kind_name(kind));
+    rl_accel_desc desc = { .kind = kind, .threads = threads };
+    if (kind == RL_ACCEL_GRID && grid_res > 0)
+        desc.grid_res[0] = desc.grid_res[1] = desc.grid_res[2] = grid_res;
+    rl_accel *a = NULL;
+    rl_timer timer;
+    rl_timer_start(&timer);
+    rl_status st = rl_accel_create(scene, &desc, &a);
+    if (st == RL_OK)
+        st = rl_accel_commit(a);
+    if (st != RL_OK) {
+        rl_accel_release(a);
+        return st;
+    }
+    b->exact[kind] = a;
+    b->exact_ms[kind] = rl_timer_ms(&timer);
+    *built_ms += b->exact_ms[kind];
+    if (kind == RL_ACCEL_GRID)
+        b->grid_res = grid_res;
+    return RL_OK;
+}
+
+static unsigned payload_of(rl_pt_backend k)
+{
+    switch (k) {
+    case RL_PT_BACKEND_LS_CANDIDATES: return RL_LS_CANDIDATES;
+    case RL_PT_BACKEND_LS_PNMT: return RL_LS_PNMT;
+    case RL_PT_BACKEND_LS_PREILLUM: return RL_LS_PREILLUM;
+    default: return 0;
+    }
+}
+
+rl_status rl_pt_backends_prepare(pt_backends *b, const rl_scene *scene, const pt_settings *set, int threads,
+                                 double *built_ms)
+{
+    *built_ms = 0.0;
+    const rl_scene_data *d = rl_scene_get_data(scene);
+    if (!d)
+        return RL_ERR_NOT_COMMITTED;
+    uint64_t uid = rl_scene_uid(scene);
+    rl_status st;
+    if (b->scene_uid != uid || !b->tri_cover) {
+        rl_pt_backends_release(b);
+        b->scene_uid = uid;
+        b->data = d;
+        b->eps = EPS_SCALE * scene_scale(d->bounds);
+        if ((st = build_cover(b, d)) != RL_OK)
+            return st;
+    }
+    rl_pt_backend kinds[2] = { set->shadow, set->diffuse };
+    for (int i = 0; i < 2; ++i) {
+        if (!rl_pt_backend_available(kinds[i], i == 0))
+            return rl_error(RL_ERR_UNSUPPORTED, "pt: %s=%s is not available in this build", i == 0 ? "shadow" : "diffuse",
+                            rl_pt_backend_name(kinds[i]));
+    }
+    /* Primary rays and the traced G-buffer use the BVH (Sec. 6.4.1 traces
+     * them like any ray; the thesis' choice of structure is ours here). */
+    if (set->primary == PT_PRIMARY_TRACE && (st = build_exact(b, scene, RL_ACCEL_BVH, 0, threads, built_ms)))
+        return st;
+    for (int i = 0; i < 2; ++i)
+        if (is_exact(kinds[i]) &&
+            (st = build_exact(b, scene, (rl_accel_kind)kinds[i], set->grid_res, threads, built_ms)))
+            return st;
+
+    unsigned payloads = payload_of(set->shadow) | payload_of(set->diffuse);
+    if (payloads) {
+        /* The Line Space lives in the grid's voxels (Sec. 4.2, 6.1). */
+        if ((st = build_exact(b, scene, RL_ACCEL_GRID, set->grid_res, threads, built_ms)))
+            return st;
+        bool same = b->ls && b->ls_n == set->ls_n && b->ls_k == set->ls_k && b->ls_dynamic == set->ls_dynamic &&
+                    (b->ls_payloads & payloads) == payloads;
+        if (!same) {
+            rl_linespace_release(b->ls);
+            b->ls = NULL;
+            rl_linespace_desc desc = { .n = set->ls_n, .k = set->ls_k, .dynamic = set->ls_dynamic,
+                                       .payloads = payloads, .threads = threads };
+            double ms = 0.0;
+            st = ls_build(b->exact[RL_ACCEL_GRID], &desc, rl_pt_preillum_shade, b, &b->ls, &ms);
+            if (st != RL_OK)
+                return st;
+            b->ls_n = set->ls_n;
+            b->ls_k = set->ls_k;
+            b->ls_dynamic = set->ls_dynamic;
+            b->ls_payloads = payloads;
+            b->ls_ms = ms;
+            *built_ms += ms;
+            /* The stored surfaces of the voxel a ray starts in include the
+             * surface it leaves: the thesis skips them by a voxel offset
+             * (Sec. 12.1-12.2, Fig. 19/21: "Voxel-Offset ... gegen
+             * Selbstbeleuchtung"); one voxel diagonal leaves that voxel. */
+            rl_accel_stats gs;
+            rl_accel_get_stats(b->exact[RL_ACCEL_GRID], &gs);
+            rl_vec3 ext = rl_aabb_extent(d->bounds);
+            rl_vec3 voxel = rl_v3(ext.x / (float)(gs.grid_res[0] > 0 ? gs.grid_res[0] : 1),
+                                  ext.y / (float)(gs.grid_res[1] > 0 ? gs.grid_res[1] : 1),
+                                  ext.z / (float)(gs.grid_res[2] > 0 ? gs.grid_res[2] : 1));
+            b->ls_offset = rl_length(voxel);
+        }
+    }
+    if (set->shadow == RL_PT_BACKEND_SHADOWMAP && (!b->sm || b->sm_size != set->shadowmap_size)) {
+        rl_shadowmap_release(b->sm);
+        b->sm = NULL;
+        double ms = 0.0;
+        if ((st = sm_build(scene, set->shadowmap_size, &b->sm, &ms)) != RL_OK)
+            return st;
+        b->sm_size = set->shadowmap_size;
+        b->sm_ms = ms;
+        *built_ms += ms;
+    }
+    return RL_OK;
+}

@@ -1,0 +1,145 @@
+/* pathtrace_internal.h: what the parts of the path tracer "pt" share
+ * (Schröder 2017, Ch. 6 and 8).
+ *
+ * pathtrace.c          the renderer: options, frame loop, accumulation
+ *                      (Sec. 6.5), checkerboard (Sec. 8.5), filter (Sec. 8.2)
+ * pathtrace_path.c     one camera path (Sec. 3.3, 6.4): Trace, Shade (NEE),
+ *                      emission rule, Russian roulette; the pre-illumination
+ *                      shader for the Line Space (Sec. 7.4)
+ * pathtrace_bsdf.c     importance sampling of the modified Phong BRDF
+ *                      (Sec. 6.4.3; Lafortune & Willems 1994)
+ * pathtrace_backend.c  the acceleration structures the backends need (BVH,
+ *                      grid, Embree, Line Space, shadow maps), built lazily
+ *                      and kept between frames; query routing */
+#ifndef RL_RENDER_PATHTRACE_INTERNAL_H
+#define RL_RENDER_PATHTRACE_INTERNAL_H
+
+#include "rl/rl_accel.h"
+#include "rl/rl_filter.h"
+#include "rl/rl_gbuffer.h"
+#include "rl/rl_linespace.h"
+#include "rl/rl_pt.h"
+#include "rl/rl_rng.h"
+#include "rl/rl_scene.h"
+#include "rl/rl_shadowmap.h"
+
+/* ------------------------------------------------------------ settings -- */
+
+typedef enum pt_primary { PT_PRIMARY_TRACE = 0, PT_PRIMARY_RASTER } pt_primary;
+
+typedef struct pt_settings {
+    int spp, max_depth, rr_depth, light_samples, threads;
+    bool rr, checkerboard, accumulate, ls_dynamic;
+    rl_rng_gpu_kind rng;
+    uint64_t seed;
+    rl_pt_backend shadow, diffuse;
+    pt_primary primary;
+    rl_filter_kind filter;
+    double filter_fade;
+    int grid_res, ls_n, ls_k, shadowmap_size;
+} pt_settings;
+
+/* ------------------------------------------------------------ backends -- */
+
+/* Everything built for one scene, kept between frames (Sec. 5.1: "built
+ * once and reused; only a new scene rebuilds them"). */
+typedef struct pt_backends {
+    uint64_t scene_uid;
+    const rl_scene_data *data;
+    rl_accel *exact[3];            /* by rl_accel_kind: BVH, GRID, EMBREE */
+    double exact_ms[3];
+    int grid_res;                  /* the option the grid was built with */
+    rl_linespace *ls;
+    int ls_n, ls_k;
+    bool ls_dynamic;
+    unsigned ls_payloads;
+    double ls_ms;
+    float ls_offset;               /* PNMT / preillum queries start one voxel
+                                    * diagonal away (Sec. 12.1-12.2: "Voxel-Offset") */
+    rl_shadowmap *sm;
+    int sm_size;
+    double sm_ms;
+    uint32_t *tri_cover;           /* per triangle: covering quad light or RL_NONE */
+    float eps;                     /* ray origin offset */
+} pt_backends;
+
+/* Makes sure the structures that set's backends and primary mode need exist
+ * for scene (building what is missing or stale); *built_ms gets the time
+ * spent building. RL_ERR_UNSUPPORTED names a backend missing in this build. */
+rl_status rl_pt_backends_prepare(pt_backends *b, const rl_scene *scene, const pt_settings *set,
+                                 int threads, double *built_ms);
+void rl_pt_backends_release(pt_backends *b);
+/* The quad light whose parallelogram contains p (within tol of its plane
+ * and of its edges), or RL_NONE: the emission rule of pathtrace_path.c. */
+uint32_t rl_pt_cover_point(const rl_scene_data *d, rl_vec3 p, float tol);
+/* Whether backend can be used in this build (Embree is optional) for shadow
+ * tests (shadow = true: all) or secondary rays (not shadow maps). */
+bool rl_pt_backend_available(rl_pt_backend backend, bool shadow);
+
+/* --------------------------------------------------------------- paths -- */
+
+/* Per-tile counters, summed in tile order after a pass. */
+typedef struct pt_counters {
+    uint64_t rays[RL_RAY_TYPE_COUNT];
+    uint64_t shadow_q[RL_PT_BACKEND_COUNT];
+    uint64_t trace_q[RL_PT_BACKEND_COUNT];
+    uint64_t preillum_ends;
+} pt_counters;
+
+/* What a path needs; read-only during a pass. */
+typedef struct pt_ctx {
+    const rl_scene_data *data;
+    const pt_backends *b;
+    rl_pt_backend shadow, diffuse;
+    int max_depth, rr_depth, light_samples;
+    bool rr;
+} pt_ctx;
+
+/* A surface point being shaded. Normals are unit and face the side the
+ * ray came from; tri is RL_ID_NONE for a Line Space PNMT record. */
+typedef struct pt_surface {
+    rl_vec3 p;
+    rl_vec3 ng;               /* geometric normal (PNMT: the stored normal) */
+    rl_vec3 ns;               /* shading normal */
+    rl_vec3 v;                /* unit direction back along the incoming ray */
+    bool front;               /* the unflipped geometric normal faced the ray */
+    rl_vec3 kd;               /* k_d times the diffuse texture */
+    rl_vec2 uv;
+    const rl_material *m;
+    uint32_t tri;
+} pt_surface;
+
+/* Surface on triangle tri at p with raw shading normal ns and texture
+ * coordinates uv, seen along unit v. tri must be in range. */
+void rl_pt_surface_finish(const rl_scene_data *d, uint32_t tri, rl_vec3 p, rl_vec3 ns, rl_vec2 uv, rl_vec3 v,
+                          pt_surface *s);
+/* Surface at an exact hit of a ray along unit dir; false if the hit names
+ * no triangle. */
+bool rl_pt_surface_at_hit(const rl_scene_data *d, const rl_hit *hit, rl_vec3 o, rl_vec3 dir, pt_surface *s);
+
+/* Radiance arriving along the camera path whose first vertex is s
+ * (Sec. 6.4: Trace, Shade, Phong sampling, until max_depth or roulette). */
+rl_vec3 rl_pt_trace_path(const pt_ctx *ctx, const pt_surface *first, rl_rng_gpu *rng, pt_counters *c);
+
+/* Closest surface along ray through backend `backend` (exact kinds, Line
+ * Space candidates, PNMT), counted as `type`. False on a miss. */
+bool rl_pt_closest(const pt_ctx *ctx, rl_pt_backend backend, rl_ray *ray, pt_surface *s, pt_counters *c);
+
+/* rl_ls_shade_fn for PREILLUM (user = the pt_backends): the direct light
+ * leaving a stored surface, with exact shadow rays through the grid. */
+rl_vec3 rl_pt_preillum_shade(void *user, const rl_ls_surface *s, rl_vec3 dir);
+
+/* -------------------------------------------------------------- BSDF ---- */
+
+/* Modified Phong BRDF (Lafortune & Willems 1994) at s for the outgoing
+ * direction s->v: f(wi) without the cosine. */
+rl_vec3 rl_pt_phong_eval(const pt_surface *s, rl_vec3 wi);
+/* Importance samples wi from the lobe mixture (diffuse cosine lobe or
+ * cos^n lobe around the mirror direction, chosen by their reflectances);
+ * *weight = f cos / pdf with the mixture pdf. False when the sample points
+ * below the surface or the material reflects nothing. */
+bool rl_pt_phong_sample(const pt_surface *s, float u_lobe, float u1, float u2, rl_vec3 *wi, rl_vec3 *weight);
+/* The mixture pdf of rl_pt_phong_sample in solid angle (for tests). */
+float rl_pt_phong_pdf(const pt_surface *s, rl_vec3 wi);
+
+#endif

@@ -1,0 +1,365 @@
+/* pathtrace_path.c: one camera path of the path tracer "pt" (Schröder 2017,
+ * Sec. 3.3 and 6.4): Trace finds the next surface through the chosen
+ * backend; at the surface Russian roulette over the material's coefficients
+ * picks the mirror ray (k_r), the refracted ray (k_t, Snell without Fresnel
+ * as in trace.c) or the Phong BRDF (the rest); only in the BRDF case does
+ * Shade gather the lights with shadow rays (next-event estimation) and the
+ * Phong sampling (pathtrace_bsdf.c) choose the next direction. The path
+ * ends on a miss (background black), after max_depth interactions behind
+ * the camera hit, or by Russian roulette on the throughput.
+ *
+ * Shade (Sec. 6.4.2, 6.3): per light and BRDF vertex
+ *  - point / spot / directional: one hard shadow ray, f E cos(theta_R) with
+ *    E from light_eval.h (colour intensity / d^2, spot cone);
+ *  - quad: light_samples points uniform on the parallelogram, each
+ *    f L_e A cos(theta_E) cos(theta_R) / (d^2 light_samples): for a
+ *    Lambertian f = k_d / pi this is eq. 7 times the surface colour.
+ *
+ * Emission rule (no double counting): an emissive surface adds its
+ * emission when the path reached it from the camera or by a mirror or
+ * refraction event. After a BRDF bounce it adds it only if NEE does not
+ * also sample it: a surface is "covered" when it lies in a quad light's
+ * plane and inside its parallelogram (pathtrace_backend.c; the builtin
+ * cornell box has such an emissive quad mesh with an RL_LIGHT_QUAD on it).
+ * Covered surfaces emit on the quad's emitting side only, as the quad light
+ * does; uncovered ones emit on both sides on every hit (as trace.c).
+ *
+ * Russian roulette (Sec. 3.2.4): from the rr_depth-th bounce on, a path
+ * survives with q = min(1, max throughput component) and its throughput is
+ * divided by q: unbiased.
+ *
+ * Line Space backends: ls-pnmt returns a stored surface (position, normal,
+ * material, uv; no triangle) which is shaded like a hit; ls-preillum
+ * returns the stored direct light of the first surface along a secondary
+ * ray, which is added with the throughput and ends the path (Sec. 7.4).
+ * Both start one voxel diagonal away from the surface a ray leaves (the
+ * thesis' voxel offset against self-illumination, Sec. 12.1-12.2, Fig. 19, 21):
+ * occluders closer than that are missed, as the thesis reports.
+ *
+ * Random numbers come from the pixel's GPU-style generator only, in an
+ * order that does not depend on which shadow rays are traced, so exact
+ * backends give the same image. */
+#include <math.h>
+#include <string.h>
+
+#include "render/light_eval.h"
+#include "render/pathtrace_internal.h"
+
+#define SHADOW_T_SHRINK 1e-4f     /* stop feelers short of the light itself */
+#define PREILLUM_QUAD_SAMPLES 16  /* points per quad light for a stored value */
+
+static rl_vec3 offset_origin(const pt_ctx *ctx, const pt_surface *s, rl_vec3 dir)
+{
+    float side = rl_dot(dir, s->ng) >= 0.0f ? 1.0f : -1.0f;
+    return rl_madd(s->p, s->ng, side * ctx->b->eps);
+}
+
+static rl_vec3 textured_kd(const rl_scene_data *d, const rl_material *m, rl_vec2 uv)
+{
+    rl_vec3 kd = m->diffuse;
+    uint32_t tex = m->diffuse_texture;
+    if (tex < d->num_textures && d->textures[tex]) {
+        rl_vec4 texel = rl_texture_sample(d->textures[tex], uv);
+        kd = rl_mul(kd, rl_v3(texel.x, texel.y, texel.z));
+    }
+    return kd;
+}
+
+void rl_pt_surface_finish(const rl_scene_data *d, uint32_t tri, rl_vec3 p, rl_vec3 ns, rl_vec2 uv, rl_vec3 v,
+                          pt_surface *s)
+{
+    const uint32_t *idx = &d->indices[3 * (size_t)tri];
+    rl_vec3 p0 = d->positions[idx[0]], p1 = d->positions[idx[1]], p2 = d->positions[idx[2]];
+    rl_vec3 ng = rl_normalize(rl_cross(rl_sub(p1, p0), rl_sub(p2, p0)));
+    ns = rl_normalize(ns);
+    if (!(rl_length2(ns) > 0.0f) || !rl_vfinite(ns))
+        ns = ng;
+    s->p = p;
+    s->v = v;
+    s->front = rl_dot(ng, v) > 0.0f;
+    s->ng = s->front ? ng : rl_neg(ng);
+    s->ns = rl_dot(ns, v) < 0.0f ? rl_neg(ns) : ns;
+    s->m = &d->materials[d->triangle_material[tri]];
+    s->uv = uv;
+    s->kd = textured_kd(d, s->m, uv);
+    s->tri = tri;
+}
+
+bool rl_pt_surface_at_hit(const rl_scene_data *d, const rl_hit *hit, rl_vec3 o, rl_vec3 dir, pt_surface *s)
+{
+    (void)o;
+    if (hit->triangle >= d->num_triangles)
+        return false;
+    const uint32_t *idx = &d->indices[3 * (size_t)hit->triangle];
+    float u = hit->u, v = hit->v, w = 1.0f - u - v;
+    /* The point from the barycentrics, as trace.c, so every exact backend
+     * that reports the same (triangle, u, v) shades the same point. */
+    rl_vec3 p = rl_add(rl_add(rl_scale(d->positions[idx[0]], w), rl_scale(d->positions[idx[1]], u)),
+                       rl_scale(d->positions[idx[2]], v));
+    rl_vec3 ns = rl_add(rl_add(rl_scale(d->normals[idx[0]], w), rl_scale(d->normals[idx[1]], u)),
+                        rl_scale(d->normals[idx[2]], v));
+    rl_vec2 t0 = d->uvs[idx[0]], t1 = d->uvs[idx[1]], t2 = d->uvs[idx[2]];
+    rl_vec2 uv = rl_v2(w * t0.x + u * t1.x + v * t2.x, w * t0.y + u * t1.y + v * t2.y);
+    rl_pt_surface_finish(d, hit->triangle, p, ns, uv, rl_neg(rl_normalize(dir)), s);
+    return true;
+}
+
+/* A PNMT record (Sec. 7.2) as a surface: only the stored shading normal is
+ * known, so it serves as the geometric one too. */
+static bool surface_of_record(const rl_scene_data *d, const rl_ls_surface *r, rl_vec3 v, pt_surface *s)
+{
+    if (r->material >= d->num_materials || !rl_vfinite(r->p))
+        return false;
+    rl_vec3 n = rl_normalize(r->n);
+    if (!(rl_length2(n) > 0.0f) || !rl_vfinite(n))
+        n = v;
+    bool faces = rl_dot(n, v) >= 0.0f;
+    s->p = r->p;
+    s->v = v;
+    s->front = faces;
+    s->ns = s->ng = faces ? n : rl_neg(n);
+    s->m = &d->materials[r->material];
+    s->uv = r->uv;
+    s->kd = textured_kd(d, s->m, r->uv);
+    s->tri = RL_ID_NONE;
+    return true;
+}
+
+bool rl_pt_closest(const pt_ctx *ctx, rl_pt_backend backend, rl_ray *ray, pt_surface *s, pt_counters *c)
+{
+    const pt_backends *b = ctx->b;
+    c->trace_q[backend]++;
+    rl_hit hit = { INFINITY, 0.0f, 0.0f, RL_ID_NONE, RL_ID_NONE };
+    switch (backend) {
+    case RL_PT_BACKEND_BVH:
+    case RL_PT_BACKEND_GRID:
+    case RL_PT_BACKEND_EMBREE:
+        if (!rl_accel_intersect(b->exact[backend], ray, &hit))
+            return false;
+        return rl_pt_surface_at_hit(ctx->data, &hit, ray->o, ray->d, s);
+    case RL_PT_BACKEND_LS_CANDIDATES:
+        if (!rl_linespace_intersect(b->ls, ray, &hit))
+            return false;
+        return rl_pt_surface_at_hit(ctx->data, &hit, ray->o, ray->d, s);
+    case RL_PT_BACKEND_LS_PNMT: {
+        rl_ls_surface rec;
+        ray->t_min = rl_maxf(ray->t_min, b->ls_offset);
+        if (!rl_linespace_pnmt_intersect(b->ls, ray, &rec))
+            return false;
+        return surface_of_record(ctx->data, &rec, rl_neg(rl_normalize(ray->d)), s);
+    }
+    default:
+        return false;             /* preillum and shadow maps find no surface */
+    }
+}
+
+/* Shadow test from s towards unit l over dist (light index for the shadow
+ * maps); true if the light is visible. ju, jv: the shadow-map jitter. */
+static bool visible(const pt_ctx *ctx, const pt_surface *s, rl_vec3 l, float dist, uint32_t light, float ju,
+                    float jv, pt_counters *c)
+{
+    const pt_backends *b = ctx->b;
+    rl_pt_backend k = ctx->shadow;
+    c->shadow_q[k]++;
+    if (k == RL_PT_BACKEND_SHADOWMAP)
+        return rl_shadowmap_visible(b->sm, light, s->p, s->ng, ju, jv);
+    c->rays[RL_RAY_SHADOW]++;
+    rl_ray ray = { offset_origin(ctx, s, l), 0.0f, l, isinf(dist) ? INFINITY : dist * (1.0f - SHADOW_T_SHRINK) };
+    switch (k) {
+    case RL_PT_BACKEND_BVH:
+    case RL_PT_BACKEND_GRID:
+    case RL_PT_BACKEND_EMBREE:
+        return !rl_accel_occluded(b->exact[k], &ray);
+    case RL_PT_BACKEND_LS_CANDIDATES:
+        return !rl_linespace_occluded(b->ls, &ray);
+    case RL_PT_BACKEND_LS_PNMT:
+        /* Voxel offset at both ends: the light's own voxel holds the lamp
+         * and what it is mounted on, which no stored point can tell apart
+         * from an occluder (pathtrace_backend.c). */
+        ray.t_min = b->ls_offset;
+        ray.t_max -= b->ls_offset;
+        return !(ray.t_min < ray.t_max && rl_linespace_pnmt_occluded(b->ls, &ray));
+    case RL_PT_BACKEND_LS_PREILLUM: {
+        /* The pre-illuminated Line Space knows the first stored surface
+         * along the ray and its distance: occluded if one lies before the
+         * light. */
+        rl_vec3 col;
+        float t = INFINITY;
+        ray.t_min = b->ls_offset;
+        ray.t_max -= b->ls_offset;
+        return !(ray.t_min < ray.t_max && rl_linespace_preillum(b->ls, &ray, &col, &t) && t < ray.t_max);
+    }
+    default:
+        return true;
+    }
+}
+
+/* Shade (Sec. 6.4.2): the light of all lights reflected at s towards s->v. */
+static rl_vec3 direct_light(const pt_ctx *ctx, const pt_surface *s, rl_rng_gpu *rng, pt_counters *c)
+{
+    const rl_scene_data *d = ctx->data;
+    bool jitter = ctx->shadow == RL_PT_BACKEND_SHADOWMAP;
+    rl_vec3 sum = rl_v3s(0.0f);
+    for (uint32_t i = 0; i < d->num_lights; ++i) {
+        const rl_light *L = &d->lights[i];
+        if (L->type == RL_LIGHT_QUAD) {
+            rl_vec3 nq = rl_cross(L->edge_u, L->edge_v);
+            float area = rl_length(nq);
+            if (!(area > 0.0f))
+                continue;
+            nq = rl_scale(nq, 1.0f / area);
+            int n = ctx->light_samples;
+            rl_vec3 le = rl_scale(L->color, L->intensity * area / (float)n);
+            for (int k = 0; k < n; ++k) {
+                /* Sec. 6.3: a random point P_rnd on the light. Both numbers
+                 * are drawn before any test, so the sequence does not
+                 * depend on the outcome. */
+                float xu = rl_rng_gpu_float(rng), xv = rl_rng_gpu_float(rng);
+                float ju = jitter ? rl_rng_gpu_float(rng) : 0.0f, jv = jitter ? rl_rng_gpu_float(rng) : 0.0f;
+                rl_vec3 q = rl_add(L->position, rl_add(rl_scale(L->edge_u, xu), rl_scale(L->edge_v, xv)));
+                rl_vec3 to = rl_sub(q, s->p);
+                float d2 = rl_length2(to);
+                if (!(d2 > 0.0f))
+                    continue;
+                float dist = sqrtf(d2);
+                rl_vec3 l = rl_scale(to, 1.0f / dist);
+                float cos_e = -rl_dot(nq, l), cos_r = rl_dot(s->ns, l);
+                if (cos_e <= 0.0f || cos_r <= 0.0f || !visible(ctx, s, l, dist, i, ju, jv, c))
+                    continue;
+                rl_vec3 f = rl_pt_phong_eval(s, l);
+                sum = rl_add(sum, rl_mul(f, rl_scale(le, cos_e * cos_r / d2)));   /* eq. 7 */
+            }
+            continue;
+        }
+        float ju = jitter ? rl_rng_gpu_float(rng) : 0.0f, jv = jitter ? rl_rng_gpu_float(rng) : 0.0f;
+        rl_vec3 E, l;
+        float dist;
+        if (!rl_light_eval_delta(L, s->p, &E, &l, &dist))
+            continue;
+        float cos_r = rl_dot(s->ns, l);
+        if (cos_r <= 0.0f || !visible(ctx, s, l, dist, i, ju, jv, c))
+            continue;
+        sum = rl_add(sum, rl_mul(rl_pt_phong_eval(s, l), rl_scale(E, cos_r)));
+    }
+    return sum;
+}
+
+/* The emission rule (see the top of the file). */
+static rl_vec3 emitted(const pt_ctx *ctx, const pt_surface *s, bool after_brdf)
+{
+    rl_vec3 e = s->m->emission;
+    if (!(rl_vmax_comp(e) > 0.0f))
+        return rl_v3s(0.0f);
+    const pt_backends *b = ctx->b;
+    uint32_t cover = s->tri != RL_ID_NONE ? b->tri_cover[s->tri] : rl_pt_cover_point(ctx->data, s->p, 10.0f * b->eps);
+    if (cover == RL_NONE)
+        return e;
+    const rl_light *L = &ctx->data->lights[cover];
+    bool emitting_side = rl_dot(s->v, rl_cross(L->edge_u, L->edge_v)) > 0.0f;
+    return emitting_side && !after_brdf ? e : rl_v3s(0.0f);
+}
+
+rl_vec3 rl_pt_trace_path(const pt_ctx *ctx, const pt_surface *first, rl_rng_gpu *rng, pt_counters *c)
+{
+    rl_vec3 radiance = rl_v3s(0.0f), T = rl_v3s(1.0f);
+    pt_surface s = *first;
+    bool after_brdf = false;
+    for (int depth = 0;; ++depth) {
+        radiance = rl_add(radiance, rl_mul(T, emitted(ctx, &s, after_brdf)));
+
+        /* Sec. 6.4.1: Russian roulette over reflect / refract / diffuse,
+         * each chosen with its coefficient, so the weight stays 1. */
+        float k_r = s.m->reflectivity, k_t = s.m->transmissivity;
+        float u_event = rl_rng_gpu_float(rng);
+        rl_vec3 dir;
+        rl_ray_type type;
+        if (u_event < k_r + k_t) {
+            if (depth >= ctx->max_depth)
+                break;
+            rl_vec3 d = rl_neg(s.v);
+            type = RL_RAY_REFLECTION;
+            dir = rl_reflect(d, s.ns);
+            if (u_event >= k_r) {
+                /* Entering when the geometric normal faced the ray, as
+                 * trace.c; total internal reflection mirrors instead. */
+                float ior = s.m->ior >= 1.0f ? s.m->ior : 1.0f;
+                rl_vec3 t;
+                if (rl_refract(d, s.ns, s.front ? 1.0f / ior : ior, &t)) {
+                    dir = rl_normalize(t);
+                    type = RL_RAY_REFRACTION;
+                }
+            }
+            after_brdf = false;
+        } else {
+            radiance = rl_add(radiance, rl_mul(T, direct_light(ctx, &s, rng, c)));
+            if (depth >= ctx->max_depth)
+                break;
+            float u0 = rl_rng_gpu_float(rng), u1 = rl_rng_gpu_float(rng), u2 = rl_rng_gpu_float(rng);
+            rl_vec3 w;
+            if (!rl_pt_phong_sample(&s, u0, u1, u2, &dir, &w))
+                break;
+            T = rl_mul(T, w);
+            type = RL_RAY_DIFFUSE;
+            after_brdf = true;
+        }
+
+        /* Sec. 3.3: Russian roulette on the path length. */
+        if (ctx->rr && depth >= ctx->rr_depth) {
+            float q = rl_minf(1.0f, rl_vmax_comp(T));
+            float xi = rl_rng_gpu_float(rng);
+            if (!(xi < q))
+                break;
+            T = rl_scale(T, 1.0f / q);
+        }
+        if (!(rl_vmax_comp(T) > 0.0f))
+            break;
+
+        rl_ray ray = { offset_origin(ctx, &s, dir), 0.0f, dir, INFINITY };
+        c->rays[type]++;
+        if (ctx->diffuse == RL_PT_BACKEND_LS_PREILLUM) {
+            rl_vec3 col;
+            ray.t_min = ctx->b->ls_offset;
+            c->trace_q[RL_PT_BACKEND_LS_PREILLUM]++;
+            if (rl_linespace_preillum(ctx->b->ls, &ray, &col, NULL)) {
+                radiance = rl_add(radiance, rl_mul(T, col));
+                c->preillum_ends++;
+            }
+            break;
+        }
+        pt_surface next;
+        if (!rl_pt_closest(ctx, ctx->diffuse, &ray, &next, c))
+            break;
+        s = next;
+    }
+    return radiance;
+}
+
+static uint32_t float_bits(float f)
+{
+    uint32_t u;
+    memcpy(&u, &f, sizeof u);
+    return u;
+}
+
+rl_vec3 rl_pt_preillum_shade(void *user, const rl_ls_surface *rec, rl_vec3 dir)
+{
+    const pt_backends *b = user;
+    pt_ctx ctx = { .data = b->data, .b = b, .shadow = RL_PT_BACKEND_GRID, .diffuse = RL_PT_BACKEND_GRID,
+                   .light_samples = PREILLUM_QUAD_SAMPLES };
+    pt_surface s;
+    if (!surface_of_record(b->data, rec, rl_neg(rl_normalize(dir)), &s))
+        return rl_v3s(0.0f);
+    /* Seeded from the record itself: the stored value does not depend on
+     * the build's thread schedule. */
+    uint64_t key = rl_hash64(((uint64_t)float_bits(s.p.x) << 32) ^ float_bits(s.p.y));
+    key = rl_hash64(key ^ ((uint64_t)float_bits(s.p.z) << 32) ^ float_bits(dir.x + 2.0f * dir.y + 4.0f * dir.z));
+    rl_rng_gpu rng;
+    rl_rng_gpu_seed(&rng, RL_RNG_GPU_HYBRID, key, 0);
+    pt_counters c;
+    memset(&c, 0, sizeof c);
+    /* What a path arriving by a BRDF bounce would gather here: uncovered
+     * emission, and the direct light of the BRDF event (probability
+     * 1 - k_r - k_t). */
+    float brdf = rl_maxf(0.0f, 1.0f - s.m->reflectivity - s.m->transmissivity);
+    return rl_add(emitted(&ctx, &s, true), rl_scale(direct_light(&ctx, &s, &rng, &c), brdf));
+}
