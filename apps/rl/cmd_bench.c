@@ -10,6 +10,7 @@
  * mesh file that does not exist is skipped with the reason, not a failure,
  * so the default list works without the Assimp test models. */
 #define _POSIX_C_SOURCE 200809L
+#include "bench_pt.h"
 #include "bench_rays.h"
 #include "bench_util.h"
 #include "bench_vt.h"
@@ -27,6 +28,7 @@
 static const char bench_help[] =
     "usage: rl bench rays [options]\n"
     "       rl bench vt [options]   Vertex Tracing vs Whitted (see rl bench vt --help)\n"
+    "       rl bench pt [options]   Line Space path tracing (see rl bench pt --help)\n"
     "\n"
     "Times ray queries of each accelerator on three workloads generated once\n"
     "per scene and shared by all accelerators:\n"
@@ -187,7 +189,7 @@ static int parse_args(int argc, char **argv, bench_args *a)
         return -1;
     }
     if (strcmp(argv[1], "rays") != 0)
-        return rl_cli_fail(RL_CLI_USAGE, "bench: unknown benchmark '%s' (known: rays, vt)",
+        return rl_cli_fail(RL_CLI_USAGE, "bench: unknown benchmark '%s' (known: rays, vt, pt)",
                            argv[1]);
     bool has_scenes = false, has_accels = false;
     for (int i = 2; i < argc; i++) {
@@ -615,6 +617,8 @@ int rl_cli_bench(int argc, char **argv)
 {
     if (argc >= 2 && strcmp(argv[1], "vt") == 0)
         return rl_bench_vt(argc, argv);
+    if (argc >= 2 && strcmp(argv[1], "pt") == 0)
+        return rl_bench_pt(argc, argv);
     bench_args a;
     memset(&a, 0, sizeof a);
     int rc = parse_args(argc, argv, &a);

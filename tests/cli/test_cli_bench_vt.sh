@@ -31,7 +31,7 @@ expect_exit 0 "$RL" bench vt --help
 for o in --size --anim-size --frames --threads --only --out --quick criteria animation; do
     expect_in "$TMP/out" "$o"
 done
-expect_error 2 "known: rays, vt" "$RL" bench nosuch
+expect_error 2 "known: rays, vt, pt" "$RL" bench nosuch
 
 # The quick run: every section, a table on stdout, JSON where --out says.
 expect_exit 0 "$RL" bench vt --quick --out "$TMP/vt.json"

@@ -1,0 +1,994 @@
+/* bench_pt.c: `rl bench pt`: the measurements of Schröder 2017, Ch. 10-12,
+ * for the path tracer "pt" and the Line Space, as tables on stdout and one
+ * JSON record:
+ *   generation    Table 1: grid and Line Space build times (and memory,
+ *                 fill) for the thesis' scene / voxel resolution / N rows
+ *   scenes        Diagram 1: frame time and Mrays/s at 1280x720, 1 spp,
+ *                 all secondary and shadow rays through the grid vs the
+ *                 PNMT Line Space (and our BVH), for the 7 scenes of Sec. 9.3
+ *   diffuse       Diagram 2: Cornell box with the bunny-sized model, diffuse
+ *                 rays through each structure, shadows by shadow maps
+ *   shadow        Diagram 3: the same scene, shadow rays through each
+ *                 structure (and shadow maps), diffuse rays by the PNMT LS
+ *   error         RMSE and SSIM of every variant against a converged BVH
+ *                 reference at equal sample counts, and the time each needs
+ *                 to reach the RMSE the BVH reaches at 4, 16, 64 spp
+ *   accumulation  RMSE against total samples, and what each filter of
+ *                 Sec. 8.2 does to RMSE and SSIM at 1, 4 and 16 spp
+ *
+ * Timing: per configuration one warm-up render (it builds and caches the
+ * grid, Line Space and shadow maps, which the thesis also builds once per
+ * scene, Fig. 8), then the fastest of 2 renders (--quick: 1), with
+ * accumulate=false so that each render is one frame of spp samples.
+ * Mrays/s counts every ray of the frame (primary, shadow, diffuse,
+ * reflection, refraction; a shadow-map lookup counts as a shadow ray, as
+ * the thesis counts it in Diagram 3). */
+#define _POSIX_C_SOURCE 200809L
+#include "bench_pt.h"
+
+#include "bench_rays.h"
+#include "bench_util.h"
+#include "cli.h"
+
+#include <cjson/cJSON.h>
+#include <math.h>
+#include <omp.h>
+#include <stdarg.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+#include "rl/rl_linespace.h"
+#include "rl/rl_metrics.h"
+
+#define note(...) rl_bench_note("pt", __VA_ARGS__)
+
+static const char bench_pt_help[] =
+    "usage: rl bench pt [options]\n"
+    "\n"
+    "Measures the path tracer (renderer pt) and the Line Space as in Schroeder 2017,\n"
+    "Ch. 10-12, and writes a table and JSON. Sections:\n"
+    "  generation    grid and Line Space build time, memory and fill for the rows\n"
+    "                of the thesis' Table 1 (Cornell box with boxes/teapot/bunny/dragon)\n"
+    "  scenes        frame time and Mrays/s, all rays through the grid vs the PNMT\n"
+    "                Line Space vs our BVH, for the 7 scenes of Sec. 9.3 (Diagram 1)\n"
+    "  diffuse       Cornell box + bunny: diffuse rays through grid, LS candidates,\n"
+    "                PNMT, pre-illuminated, BVH; shadows by shadow maps (Diagram 2)\n"
+    "  shadow        the same for shadow rays, plus shadow maps (Diagram 3)\n"
+    "  error         RMSE/SSIM of each variant against a converged BVH reference\n"
+    "                at equal spp, and time to reach the BVH's RMSE at 4/16/64 spp\n"
+    "  accumulation  RMSE against total samples; each filter's RMSE/SSIM\n"
+    "\n"
+    "options:\n"
+    "  --size WxH        frame sections; default 1280x720 (the thesis)\n"
+    "  --error-size WxH  error and accumulation sections; default 320x180\n"
+    "  --ref-spp N       samples of the BVH reference; default 1024\n"
+    "  --spp-max N       samples accumulated per variant in the error section; default 64\n"
+    "  --max-memory GB   skip Line Spaces estimated to need more; default 60% of RAM\n"
+    "  --threads N       threads; default all cores\n"
+    "  --only LIST       comma-separated subset of the sections above\n"
+    "  --out FILE.json   default bench/results/pt-YYYYMMDD-HHMMSS.json\n"
+    "  --quick           tiny run: Cornell box only, 128x72 frames, 64x36 error\n"
+    "                    images, 64 reference spp, 8 spp per variant, one timed render\n"
+    "\n"
+    "example:\n"
+    "  rl bench pt --only generation,shadow\n";
+
+enum { SEC_GENERATION, SEC_SCENES, SEC_DIFFUSE, SEC_SHADOW, SEC_ERROR, SEC_ACCUMULATION,
+       SEC_COUNT };
+static const char *const section_names[SEC_COUNT] = { "generation", "scenes", "diffuse",
+                                                      "shadow", "error", "accumulation" };
+
+/* Schröder 2017, Table 1: generation times in ms on a GeForce GTX 1080. */
+static const struct gen_row {
+    const char *scene;        /* built-in with parameters */
+    int thesis_scene;         /* numbering of Sec. 9.3 */
+    int res, n;
+    double thesis_grid_ms, thesis_ls_ms;
+    bool quick;
+} gen_rows[] = {
+    { "ls-cornell:model=boxes", 4, 8, 4, 43, 154, true },
+    { "ls-cornell:model=boxes", 4, 8, 5, 43, 269, true },
+    { "ls-cornell:model=teapot", 5, 8, 5, 58, 644, false },
+    { "ls-cornell:model=teapot", 5, 32, 5, 47, 1795, false },
+    { "ls-cornell:model=bunny", 6, 8, 5, 51, 3915, false },
+    { "ls-cornell:model=bunny", 6, 64, 5, 71, 10081, false },
+    { "ls-cornell:model=dragon", 7, 8, 5, 95, 94393, false },
+    { "ls-cornell:model=dragon", 7, 72, 5, 88, 53675, false },
+};
+
+/* Sec. 9.3: the seven scenes, with the Line Space voxel resolution we use
+ * for each (the thesis tuned it per scene and names these in Table 1). */
+static const struct scene_row {
+    const char *scene;
+    int thesis_scene;
+    int max_depth;            /* the thesis' maximum path length */
+    int ls_res;
+    bool quick;
+} scene_rows[] = {
+    { "ls-open:model=teapot", 1, 2, 32, false },
+    { "ls-open:model=bunny", 2, 2, 64, false },
+    { "ls-open:model=dragon", 3, 2, 72, false },
+    { "ls-cornell:model=boxes", 4, 3, 8, true },
+    { "ls-cornell:model=teapot", 5, 3, 32, false },
+    { "ls-cornell:model=bunny", 6, 3, 64, false },
+    { "ls-cornell:model=dragon", 7, 3, 72, false },
+};
+
+#define MAX_SCENES 8
+#define RUNS 2
+#define PT_SEED "1"
+#define REF_SEED "90210"
+
+typedef struct bpt_args {
+    int width, height, err_width, err_height;
+    long long ref_spp, spp_max, threads;
+    double max_memory_gb;
+    bool has_size, has_err_size, has_ref_spp, has_spp_max, quick;
+    unsigned sections;
+    const char *out;
+} bpt_args;
+
+typedef struct bpt {
+    const bpt_args *a;
+    int threads, runs;
+    double max_memory_bytes;
+    struct { char name[64]; rl_scene *scene; } scenes[MAX_SCENES];
+    int num_scenes;
+    rl_image *reference;           /* error/accumulation reference, when made */
+    double reference_ms;
+    char reason[256];
+} bpt;
+
+/* One configuration of the path tracer. */
+typedef struct pt_config {
+    const char *label;
+    const char *shadow, *diffuse;
+    const char *filter;            /* NULL: none */
+    int grid_res;                  /* 0: the grid heuristic */
+    int max_depth;                 /* 0: the renderer's default */
+    int spp;
+    bool accumulate;
+    const char *seed;
+} pt_config;
+
+static rl_status fail(bpt *b, rl_status st, const char *fmt, ...)
+#if defined(__GNUC__)
+    __attribute__((format(printf, 3, 4)))
+#endif
+    ;
+static rl_status fail(bpt *b, rl_status st, const char *fmt, ...)
+{
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(b->reason, sizeof b->reason, fmt, ap);
+    va_end(ap);
+    return st;
+}
+
+/* A built-in scene with parameters, loaded once. */
+static rl_status scene_get(bpt *b, const char *name, rl_scene **out)
+{
+    for (int i = 0; i < b->num_scenes; i++)
+        if (strcmp(b->scenes[i].name, name) == 0) {
+            *out = b->scenes[i].scene;
+            return RL_OK;
+        }
+    if (b->num_scenes == MAX_SCENES) {
+        /* Keep memory bounded: the dragon scenes are large. */
+        rl_scene_release(b->scenes[0].scene);
+        memmove(&b->scenes[0], &b->scenes[1], sizeof b->scenes[0] * (MAX_SCENES - 1));
+        b->num_scenes--;
+    }
+    char *source = NULL, *params = NULL;
+    if (!rl_cli_split_source(name, &source, &params))
+        return fail(b, RL_ERR_OUT_OF_MEMORY, "out of memory");
+    note("loading %s", name);
+    rl_scene *s = NULL;
+    rl_status st = rl_scene_create_builtin(source, params, &s);
+    free(source);
+    free(params);
+    if (st != RL_OK)
+        return st;
+    snprintf(b->scenes[b->num_scenes].name, sizeof b->scenes[0].name, "%s", name);
+    b->scenes[b->num_scenes++].scene = s;
+    *out = s;
+    return RL_OK;
+}
+
+static rl_status set_num(rl_renderer *r, const char *key, long long value)
+{
+    char text[32];
+    snprintf(text, sizeof text, "%lld", value);
+    return rl_renderer_set(r, key, text);
+}
+
+static rl_status make_pt(const bpt *b, const pt_config *c, rl_renderer **out)
+{
+    rl_renderer *r = NULL;
+    rl_status st = rl_renderer_create("pt", &r);
+    if (st == RL_OK) st = set_num(r, "threads", b->threads);
+    if (st == RL_OK) st = rl_renderer_set(r, "seed", c->seed ? c->seed : PT_SEED);
+    if (st == RL_OK) st = rl_renderer_set(r, "shadow", c->shadow);
+    if (st == RL_OK) st = rl_renderer_set(r, "diffuse", c->diffuse);
+    if (st == RL_OK) st = rl_renderer_set(r, "filter", c->filter ? c->filter : "none");
+    if (st == RL_OK && c->filter) st = rl_renderer_set(r, "filter_fade", "0");
+    if (st == RL_OK) st = set_num(r, "grid_res", c->grid_res);
+    if (st == RL_OK && c->max_depth) st = set_num(r, "max_depth", c->max_depth);
+    if (st == RL_OK) st = set_num(r, "spp", c->spp ? c->spp : 1);
+    if (st == RL_OK) st = rl_renderer_set(r, "accumulate", c->accumulate ? "true" : "false");
+    if (st != RL_OK) {
+        rl_renderer_release(r);
+        r = NULL;
+    }
+    *out = r;
+    return st;
+}
+
+static rl_camera scene_camera(const rl_scene *scene, int width, int height)
+{
+    rl_camera cam;
+    if (rl_scene_get_camera(scene, NULL, &cam) != RL_OK)
+        cam = rl_camera_frame_bounds(rl_scene_get_data(scene)->bounds, width, height);
+    cam.width = width;
+    cam.height = height;
+    return cam;
+}
+
+/* One warm-up frame (builds what the configuration needs), then the
+ * fastest of b->runs frames. */
+static rl_status frame_timed(const bpt *b, const pt_config *c, const rl_scene *scene, int width,
+                             int height, rl_render_stats *best, double *warmup_ms)
+{
+    rl_renderer *r = NULL;
+    rl_image *img = NULL;
+    rl_camera cam = scene_camera(scene, width, height);
+    rl_status st = make_pt(b, c, &r);
+    if (st == RL_OK)
+        st = rl_image_create(width, height, RL_LAYER_COLOR, &img);
+    rl_render_stats s;
+    if (st == RL_OK)
+        st = rl_renderer_render(r, scene, &cam, img, &s);
+    *warmup_ms = st == RL_OK ? s.time_ms : NAN;
+    memset(best, 0, sizeof *best);
+    best->time_ms = INFINITY;
+    for (int i = 0; st == RL_OK && i < b->runs; i++)
+        if ((st = rl_renderer_render(r, scene, &cam, img, &s)) == RL_OK && s.time_ms < best->time_ms)
+            *best = s;
+    rl_image_release(img);
+    rl_renderer_release(r);
+    return st;
+}
+
+static double mrays(const rl_render_stats *s)
+{
+    return s->time_ms > 0.0 ? (double)rl_bench_rays_total(s) / (s->time_ms * 1e3) : NAN;
+}
+
+/* ------------------------------------------------------- memory guard -- */
+
+/* An upper bound of a Line Space's size before building it: the cells a
+ * triangle's box overlaps are at least the cells that hold it, and each
+ * such cell gets 15·N^4 shafts of a list offset and a PNMT record (16 half
+ * floats). The grid tiles the scene's box (plus a tiny pad). */
+static double ls_bytes_upper(const rl_scene *scene, int res, int n)
+{
+    const rl_scene_data *d = rl_scene_get_data(scene);
+    size_t cells = (size_t)res * res * res;
+    uint8_t *filled = calloc(cells, 1);
+    if (!filled)
+        return INFINITY;
+    rl_vec3 lo = d->bounds.min, hi = d->bounds.max;
+    float ext[3] = { hi.x - lo.x, hi.y - lo.y, hi.z - lo.z };
+    float mn[3] = { lo.x, lo.y, lo.z };
+    for (uint32_t t = 0; t < d->num_triangles; t++) {
+        int c0[3], c1[3];
+        for (int a = 0; a < 3; a++) {
+            float tmin = INFINITY, tmax = -INFINITY;
+            for (int v = 0; v < 3; v++) {
+                rl_vec3 p = d->positions[d->indices[3 * t + v]];
+                float x = a == 0 ? p.x : a == 1 ? p.y : p.z;
+                tmin = fminf(tmin, x);
+                tmax = fmaxf(tmax, x);
+            }
+            float s = ext[a] > 0.0f ? (float)res / ext[a] : 0.0f;
+            c0[a] = (int)floorf((tmin - mn[a]) * s);
+            c1[a] = (int)floorf((tmax - mn[a]) * s);
+            c0[a] = c0[a] < 0 ? 0 : c0[a] >= res ? res - 1 : c0[a];
+            c1[a] = c1[a] < 0 ? 0 : c1[a] >= res ? res - 1 : c1[a];
+        }
+        for (int z = c0[2]; z <= c1[2]; z++)
+            for (int y = c0[1]; y <= c1[1]; y++)
+                for (int x = c0[0]; x <= c1[0]; x++)
+                    filled[(size_t)x + (size_t)res * ((size_t)y + (size_t)res * (size_t)z)] = 1;
+    }
+    size_t count = 0;
+    for (size_t i = 0; i < cells; i++)
+        count += filled[i];
+    free(filled);
+    return (double)count * rl_ls_shafts_per_voxel(n) * (4.0 + 32.0);
+}
+
+/* The largest resolution <= res (halving) whose Line Space fits the limit. */
+static int ls_res_that_fits(const bpt *b, const rl_scene *scene, int res, int n)
+{
+    while (res > 1 && ls_bytes_upper(scene, res, n) > b->max_memory_bytes)
+        res /= 2;
+    return res;
+}
+
+/* -------------------------------------------------------- generation -- */
+
+static rl_status sec_generation(void *ctx, cJSON *sec)
+{
+    bpt *b = ctx;
+    cJSON *rows = cJSON_AddArrayToObject(sec, "rows");
+    if (!rows)
+        return RL_ERR_OUT_OF_MEMORY;
+    printf("\ngeneration (Table 1; thesis: GTX 1080, candidates + PNMT on the GPU; ours: dynamic "
+           "candidate lists + PNMT, %d threads)\n", b->threads);
+    printf("%-26s %4s %2s %10s %10s %10s %10s %7s %9s %8s %10s\n", "scene", "res", "N",
+           "grid ms", "thesis", "LS ms", "thesis", "x GPU", "LS MiB", "empty %", "cand/shaft");
+    bool any_failed = false;
+    for (size_t i = 0; i < sizeof gen_rows / sizeof gen_rows[0]; i++) {
+        const struct gen_row *g = &gen_rows[i];
+        if (b->a->quick && !g->quick)
+            continue;
+        cJSON *row = cJSON_CreateObject();
+        if (!row)
+            return RL_ERR_OUT_OF_MEMORY;
+        cJSON_AddItemToArray(rows, row);
+        cJSON_AddStringToObject(row, "scene", g->scene);
+        cJSON_AddNumberToObject(row, "thesis_scene", g->thesis_scene);
+        cJSON_AddNumberToObject(row, "voxel_res", g->res);
+        cJSON_AddNumberToObject(row, "n", g->n);
+        cJSON_AddNumberToObject(row, "thesis_grid_ms", g->thesis_grid_ms);
+        cJSON_AddNumberToObject(row, "thesis_ls_ms", g->thesis_ls_ms);
+        rl_scene *scene = NULL;
+        rl_clear_error();
+        rl_status st = scene_get(b, g->scene, &scene);
+        double need = st == RL_OK ? ls_bytes_upper(scene, g->res, g->n) : NAN;
+        if (st == RL_OK && need > b->max_memory_bytes) {
+            char why[160];
+            snprintf(why, sizeof why, "skipped: the Line Space may need up to %.1f GiB, the limit "
+                     "is %.1f GiB (--max-memory)", need / 1073741824.0,
+                     b->max_memory_bytes / 1073741824.0);
+            cJSON_AddStringToObject(row, "status", why);
+            printf("%-26s %4d %2d  %s\n", g->scene, g->res, g->n, why);
+            continue;
+        }
+        rl_accel *grid = NULL;
+        rl_linespace *ls = NULL;
+        rl_accel_desc ad = { .kind = RL_ACCEL_GRID, .threads = b->threads,
+                             .grid_res = { g->res, g->res, g->res } };
+        if (st == RL_OK) st = rl_accel_create(scene, &ad, &grid);
+        if (st == RL_OK) st = rl_accel_commit(grid);
+        rl_linespace_desc ld = { .n = g->n, .dynamic = true,
+                                 .payloads = RL_LS_CANDIDATES | RL_LS_PNMT, .threads = b->threads };
+        if (st == RL_OK) st = rl_linespace_create(grid, &ld, &ls);
+        if (st == RL_OK) st = rl_linespace_commit(ls);
+        if (st != RL_OK) {
+            const char *why = rl_last_error() && *rl_last_error() ? rl_last_error()
+                                                                   : rl_status_string(st);
+            cJSON_AddStringToObject(row, "status", why);
+            printf("%-26s %4d %2d  failed: %s\n", g->scene, g->res, g->n, why);
+            any_failed = true;
+        } else {
+            rl_accel_stats gs;
+            rl_linespace_stats ls_s;
+            rl_accel_get_stats(grid, &gs);
+            rl_linespace_get_stats(ls, &ls_s);
+            double empty = ls_s.shafts ? 100.0 * (double)ls_s.empty_shafts / (double)ls_s.shafts
+                                       : NAN;
+            cJSON_AddStringToObject(row, "status", "ok");
+            cJSON_AddNumberToObject(row, "triangles", gs.num_triangles);
+            rl_bench_add_num(row, "grid_ms", gs.build_ms);
+            rl_bench_add_num(row, "ls_ms", ls_s.build_ms);
+            rl_bench_add_num(row, "ls_candidates_ms", ls_s.candidates_ms);
+            rl_bench_add_num(row, "ls_pnmt_ms", ls_s.pnmt_ms);
+            rl_bench_add_num(row, "thesis_over_ours_ls", rl_bench_ratio(g->thesis_ls_ms, ls_s.build_ms));
+            cJSON_AddNumberToObject(row, "grid_bytes", (double)gs.memory_bytes);
+            cJSON_AddNumberToObject(row, "ls_bytes", (double)ls_s.memory_bytes);
+            cJSON_AddNumberToObject(row, "filled_voxels", ls_s.filled_voxels);
+            cJSON_AddNumberToObject(row, "shafts", (double)ls_s.shafts);
+            cJSON_AddNumberToObject(row, "empty_shafts", (double)ls_s.empty_shafts);
+            cJSON_AddNumberToObject(row, "candidates", (double)ls_s.candidates);
+            cJSON_AddNumberToObject(row, "max_candidates", ls_s.max_candidates);
+            rl_bench_add_num(row, "mean_candidates", ls_s.mean_candidates);
+            printf("%-26s %4d %2d %10.1f %10.0f %10.1f %10.0f %7.2f %9.1f %8.1f %10.2f\n",
+                   g->scene, g->res, g->n, gs.build_ms, g->thesis_grid_ms, ls_s.build_ms,
+                   g->thesis_ls_ms, rl_bench_ratio(g->thesis_ls_ms, ls_s.build_ms),
+                   (double)ls_s.memory_bytes / 1048576.0, empty, ls_s.mean_candidates);
+            note("generation %s %d^3 N=%d: grid %.1f ms, LS %.1f ms", g->scene, g->res, g->n,
+                 gs.build_ms, ls_s.build_ms);
+        }
+        fflush(stdout);
+        rl_linespace_release(ls);
+        rl_accel_release(grid);
+    }
+    if (any_failed)
+        return fail(b, RL_ERR_INTERNAL, "a Line Space build failed (see the rows)");
+    return RL_OK;
+}
+
+/* ------------------------------------------------------------ frames -- */
+
+static cJSON *frame_json(const pt_config *c, const rl_render_stats *s, double warmup_ms)
+{
+    cJSON *o = cJSON_CreateObject();
+    if (!o)
+        return NULL;
+    cJSON_AddStringToObject(o, "label", c->label);
+    cJSON_AddStringToObject(o, "shadow", c->shadow);
+    cJSON_AddStringToObject(o, "diffuse", c->diffuse);
+    cJSON_AddNumberToObject(o, "grid_res", c->grid_res);
+    rl_bench_add_num(o, "frame_ms", s->time_ms);
+    rl_bench_add_num(o, "fps", s->time_ms > 0.0 ? 1e3 / s->time_ms : NAN);
+    rl_bench_add_num(o, "mrays_per_s", mrays(s));
+    rl_bench_add_num(o, "warmup_ms", warmup_ms);
+    cJSON_AddItemToObject(o, "rays", rl_bench_rays_json(s));
+    return o;
+}
+
+/* Renders each configuration on one scene and prints a row per config
+ * with its speed relative to configuration `base`. */
+static rl_status frame_table(bpt *b, const char *scene_name, const pt_config *configs, int count,
+                             int base, cJSON *out)
+{
+    rl_scene *scene = NULL;
+    rl_status st = scene_get(b, scene_name, &scene);
+    if (st != RL_OK)
+        return st;
+    rl_render_stats stats[16];
+    double warm[16];
+    for (int i = 0; i < count && i < 16; i++) {
+        rl_clear_error();
+        if ((st = frame_timed(b, &configs[i], scene, b->a->width, b->a->height, &stats[i],
+                              &warm[i])) != RL_OK)
+            return st;
+        note("%s %s (shadow %s, diffuse %s): %.1f ms, %.1f Mrays/s", scene_name, configs[i].label,
+             configs[i].shadow, configs[i].diffuse, stats[i].time_ms, mrays(&stats[i]));
+    }
+    printf("%-16s %-14s %-14s %5s %10s %8s %9s %10s %9s\n", "config", "shadow", "diffuse", "res",
+           "frame ms", "fps", "Mrays/s", "warmup ms", "x base");
+    for (int i = 0; i < count && i < 16; i++) {
+        double x = rl_bench_ratio(stats[base].time_ms, stats[i].time_ms);
+        printf("%-16s %-14s %-14s %5d %10.1f %8.2f %9.2f %10.1f %9.2f\n", configs[i].label,
+               configs[i].shadow, configs[i].diffuse, configs[i].grid_res, stats[i].time_ms,
+               1e3 / stats[i].time_ms, mrays(&stats[i]), warm[i], x);
+        cJSON *row = frame_json(&configs[i], &stats[i], warm[i]);
+        if (!row)
+            return RL_ERR_OUT_OF_MEMORY;
+        rl_bench_add_num(row, "speedup_vs_base", x);
+        cJSON_AddItemToArray(out, row);
+    }
+    fflush(stdout);
+    return RL_OK;
+}
+
+static rl_status sec_scenes(void *ctx, cJSON *sec)
+{
+    bpt *b = ctx;
+    cJSON *rows = cJSON_AddArrayToObject(sec, "scenes");
+    if (!rows)
+        return RL_ERR_OUT_OF_MEMORY;
+    printf("\nscenes (Diagram 1: %dx%d, 1 spp, all secondary and shadow rays through one "
+           "structure; x base = speed-up over the grid)\n", b->a->width, b->a->height);
+    for (size_t i = 0; i < sizeof scene_rows / sizeof scene_rows[0]; i++) {
+        const struct scene_row *sr = &scene_rows[i];
+        if (b->a->quick && !sr->quick)
+            continue;
+        rl_scene *scene = NULL;
+        rl_status st = scene_get(b, sr->scene, &scene);
+        if (st != RL_OK)
+            return st;
+        int res = ls_res_that_fits(b, scene, sr->ls_res, RL_LS_DEFAULT_N);
+        pt_config configs[] = {
+            { .label = "grid", .shadow = "grid", .diffuse = "grid", .max_depth = sr->max_depth },
+            { .label = "ls-pnmt", .shadow = "ls-pnmt", .diffuse = "ls-pnmt", .grid_res = res,
+              .max_depth = sr->max_depth },
+            { .label = "ls-candidates", .shadow = "ls-candidates", .diffuse = "ls-candidates",
+              .grid_res = res, .max_depth = sr->max_depth },
+            { .label = "bvh", .shadow = "bvh", .diffuse = "bvh", .max_depth = sr->max_depth },
+        };
+        printf("\n%s (thesis scene %d, max path length %d, LS voxels %d^3%s)\n", sr->scene,
+               sr->thesis_scene, sr->max_depth, res,
+               res < sr->ls_res ? ", reduced to fit --max-memory" : "");
+        cJSON *entry = cJSON_CreateObject();
+        if (!entry)
+            return RL_ERR_OUT_OF_MEMORY;
+        cJSON_AddItemToArray(rows, entry);
+        cJSON_AddStringToObject(entry, "scene", sr->scene);
+        cJSON_AddNumberToObject(entry, "thesis_scene", sr->thesis_scene);
+        cJSON_AddNumberToObject(entry, "max_depth", sr->max_depth);
+        cJSON_AddNumberToObject(entry, "ls_voxel_res", res);
+        cJSON_AddNumberToObject(entry, "ls_voxel_res_wanted", sr->ls_res);
+        cJSON *frames = cJSON_AddArrayToObject(entry, "frames");
+        if (!frames)
+            return RL_ERR_OUT_OF_MEMORY;
+        if ((st = frame_table(b, sr->scene, configs, 4, 0, frames)) != RL_OK)
+            return st;
+    }
+    return RL_OK;
+}
+
+/* The scene of Diagrams 2 and 3 (the Cornell box with the bunny). */
+static const char *diagram_scene(const bpt *b)
+{
+    return b->a->quick ? "ls-cornell:model=boxes" : "ls-cornell:model=bunny";
+}
+
+static int diagram_res(bpt *b, const char *name)
+{
+    rl_scene *scene = NULL;
+    if (scene_get(b, name, &scene) != RL_OK)
+        return 8;
+    return ls_res_that_fits(b, scene, b->a->quick ? 8 : 64, RL_LS_DEFAULT_N);
+}
+
+static rl_status sec_diffuse(void *ctx, cJSON *sec)
+{
+    bpt *b = ctx;
+    const char *name = diagram_scene(b);
+    int res = diagram_res(b, name);
+    pt_config configs[] = {
+        { .label = "grid", .shadow = "shadowmap", .diffuse = "grid" },
+        { .label = "ls-candidates", .shadow = "shadowmap", .diffuse = "ls-candidates", .grid_res = res },
+        { .label = "ls-pnmt", .shadow = "shadowmap", .diffuse = "ls-pnmt", .grid_res = res },
+        { .label = "ls-preillum", .shadow = "shadowmap", .diffuse = "ls-preillum", .grid_res = res },
+        { .label = "bvh", .shadow = "shadowmap", .diffuse = "bvh" },
+    };
+    printf("\ndiffuse (Diagram 2: %s, %dx%d, 1 spp, shadows by shadow maps, LS voxels %d^3; "
+           "x base = speed-up over the grid; thesis: PNMT > 20x the grid)\n", name, b->a->width,
+           b->a->height, res);
+    cJSON_AddStringToObject(sec, "scene", name);
+    cJSON_AddNumberToObject(sec, "ls_voxel_res", res);
+    cJSON *frames = cJSON_AddArrayToObject(sec, "frames");
+    return frames ? frame_table(b, name, configs, 5, 0, frames) : RL_ERR_OUT_OF_MEMORY;
+}
+
+static rl_status sec_shadow(void *ctx, cJSON *sec)
+{
+    bpt *b = ctx;
+    const char *name = diagram_scene(b);
+    int res = diagram_res(b, name);
+    pt_config configs[] = {
+        { .label = "grid", .shadow = "grid", .diffuse = "ls-pnmt", .grid_res = res },
+        { .label = "ls-candidates", .shadow = "ls-candidates", .diffuse = "ls-pnmt", .grid_res = res },
+        { .label = "ls-pnmt", .shadow = "ls-pnmt", .diffuse = "ls-pnmt", .grid_res = res },
+        { .label = "ls-preillum", .shadow = "ls-preillum", .diffuse = "ls-pnmt", .grid_res = res },
+        { .label = "shadowmap", .shadow = "shadowmap", .diffuse = "ls-pnmt", .grid_res = res },
+        { .label = "bvh", .shadow = "bvh", .diffuse = "ls-pnmt", .grid_res = res },
+    };
+    printf("\nshadow (Diagram 3: %s, %dx%d, 1 spp, diffuse rays by the PNMT LS, voxels %d^3; "
+           "x base = speed-up over the grid; thesis: PNMT ~10x the grid, shadow maps faster still)\n",
+           name, b->a->width, b->a->height, res);
+    cJSON_AddStringToObject(sec, "scene", name);
+    cJSON_AddNumberToObject(sec, "ls_voxel_res", res);
+    cJSON *frames = cJSON_AddArrayToObject(sec, "frames");
+    return frames ? frame_table(b, name, configs, 6, 0, frames) : RL_ERR_OUT_OF_MEMORY;
+}
+
+/* ------------------------------------------------ error and accumulation -- */
+
+/* The converged BVH image of the diagram scene at the error size. */
+static rl_status reference(bpt *b, const rl_scene *scene, const rl_camera *cam)
+{
+    if (b->reference)
+        return RL_OK;
+    int per_frame = 16;
+    pt_config c = { .label = "reference", .shadow = "bvh", .diffuse = "bvh", .spp = per_frame,
+                    .accumulate = true, .seed = REF_SEED };
+    rl_renderer *r = NULL;
+    rl_status st = make_pt(b, &c, &r);
+    if (st == RL_OK)
+        st = rl_image_create(cam->width, cam->height, RL_LAYER_COLOR, &b->reference);
+    b->reference_ms = 0.0;
+    long long frames = (b->a->ref_spp + per_frame - 1) / per_frame;
+    for (long long f = 0; st == RL_OK && f < frames; f++) {
+        rl_render_stats s;
+        st = rl_renderer_render(r, scene, cam, b->reference, &s);
+        b->reference_ms += s.time_ms;
+    }
+    rl_renderer_release(r);
+    if (st != RL_OK) {
+        rl_image_release(b->reference);
+        b->reference = NULL;
+        return st;
+    }
+    note("reference: %lld spp in %.0f ms", frames * per_frame, b->reference_ms);
+    return RL_OK;
+}
+
+typedef struct curve_point {
+    long long spp;
+    double time_ms;            /* accumulated frame time */
+    rl_image_metrics m;
+} curve_point;
+
+#define MAX_POINTS 24
+
+/* Accumulates 1 spp per frame up to spp_max, measuring at powers of two
+ * (and at the checkpoints given, when not NULL). */
+static rl_status accumulate_curve(bpt *b, const pt_config *c, const rl_scene *scene,
+                                  const rl_camera *cam, long long spp_max, curve_point *pts,
+                                  int *num)
+{
+    rl_renderer *r = NULL;
+    rl_image *img = NULL;
+    pt_config cc = *c;
+    cc.spp = 1;
+    cc.accumulate = true;
+    rl_status st = make_pt(b, &cc, &r);
+    if (st == RL_OK)
+        st = rl_image_create(cam->width, cam->height, RL_LAYER_COLOR, &img);
+    /* A warm-up frame builds the structures; changing the seed afterwards
+     * restarts the accumulation (any option change does), so the curve
+     * holds frame time only. */
+    rl_render_stats s0;
+    if (st == RL_OK) st = rl_renderer_set(r, "seed", "7");
+    if (st == RL_OK) st = rl_renderer_render(r, scene, cam, img, &s0);
+    if (st == RL_OK) st = rl_renderer_set(r, "seed", cc.seed ? cc.seed : PT_SEED);
+    double t = 0.0;
+    *num = 0;
+    for (long long spp = 1; st == RL_OK && spp <= spp_max; spp++) {
+        rl_render_stats s;
+        if ((st = rl_renderer_render(r, scene, cam, img, &s)) != RL_OK)
+            break;
+        t += s.time_ms;
+        if ((spp & (spp - 1)) == 0 && *num < MAX_POINTS) {
+            curve_point *p = &pts[(*num)++];
+            p->spp = spp;
+            p->time_ms = t;
+            st = rl_image_compare(img, b->reference, &(rl_metric_options){ 0 }, &p->m);
+        }
+    }
+    rl_image_release(img);
+    rl_renderer_release(r);
+    return st;
+}
+
+static cJSON *curve_json(const curve_point *pts, int num)
+{
+    cJSON *a = cJSON_CreateArray();
+    for (int i = 0; a && i < num; i++) {
+        cJSON *p = cJSON_CreateObject();
+        if (!p)
+            break;
+        cJSON_AddNumberToObject(p, "spp", (double)pts[i].spp);
+        rl_bench_add_num(p, "time_ms", pts[i].time_ms);
+        rl_bench_add_num(p, "rmse", pts[i].m.rmse);
+        rl_bench_add_num(p, "ssim", pts[i].m.ssim);
+        cJSON_AddItemToArray(a, p);
+    }
+    return a;
+}
+
+/* Accumulated time at the first checkpoint whose RMSE is at most target. */
+static double time_to_rmse(const curve_point *pts, int num, double target)
+{
+    for (int i = 0; i < num; i++)
+        if (pts[i].m.rmse <= target)
+            return pts[i].time_ms;
+    return NAN;
+}
+
+static rl_status error_setup(bpt *b, const rl_scene **scene, rl_camera *cam)
+{
+    rl_scene *s = NULL;
+    rl_status st = scene_get(b, diagram_scene(b), &s);
+    if (st != RL_OK)
+        return st;
+    *scene = s;
+    *cam = scene_camera(s, b->a->err_width, b->a->err_height);
+    return reference(b, s, cam);
+}
+
+static rl_status sec_error(void *ctx, cJSON *sec)
+{
+    bpt *b = ctx;
+    const rl_scene *scene = NULL;
+    rl_camera cam;
+    rl_status st = error_setup(b, &scene, &cam);
+    if (st != RL_OK)
+        return st;
+    int res = diagram_res(b, diagram_scene(b));
+    const pt_config configs[] = {
+        { .label = "bvh", .shadow = "bvh", .diffuse = "bvh" },
+        { .label = "grid", .shadow = "grid", .diffuse = "grid" },
+        { .label = "ls-candidates", .shadow = "ls-candidates", .diffuse = "ls-candidates", .grid_res = res },
+        { .label = "ls-pnmt", .shadow = "ls-pnmt", .diffuse = "ls-pnmt", .grid_res = res },
+        { .label = "ls-preillum", .shadow = "ls-preillum", .diffuse = "ls-preillum", .grid_res = res },
+        { .label = "shadowmap", .shadow = "shadowmap", .diffuse = "bvh" },
+    };
+    enum { NUM = sizeof configs / sizeof configs[0] };
+    curve_point pts[NUM][MAX_POINTS];
+    int num[NUM];
+    for (int i = 0; i < NUM; i++) {
+        rl_clear_error();
+        if ((st = accumulate_curve(b, &configs[i], scene, &cam, b->a->spp_max, pts[i], &num[i])) != RL_OK)
+            return st;
+        note("error %s: %lld spp, RMSE %.4f", configs[i].label, pts[i][num[i] - 1].spp,
+             pts[i][num[i] - 1].m.rmse);
+    }
+    /* Targets: the BVH's RMSE at 4, 16 and 64 spp (as far as measured). */
+    double targets[3];
+    long long target_spp[3] = { 4, 16, 64 };
+    for (int k = 0; k < 3; k++) {
+        targets[k] = NAN;
+        for (int p = 0; p < num[0]; p++)
+            if (pts[0][p].spp == target_spp[k])
+                targets[k] = pts[0][p].m.rmse;
+    }
+    printf("\nerror (%s, %dx%d, against %lld spp of the BVH; equal spp = %lld; time to the "
+           "BVH's RMSE at 4/16/64 spp, '-' = never within %lld spp)\n", diagram_scene(b),
+           cam.width, cam.height, b->a->ref_spp, b->a->spp_max, b->a->spp_max);
+    printf("%-14s %9s %8s %11s %11s %11s %11s\n", "variant", "RMSE", "SSIM", "ms/spp", "t(4) ms",
+           "t(16) ms", "t(64) ms");
+    cJSON_AddStringToObject(sec, "scene", diagram_scene(b));
+    cJSON_AddNumberToObject(sec, "reference_spp", (double)b->a->ref_spp);
+    rl_bench_add_num(sec, "reference_ms", b->reference_ms);
+    cJSON *vars = cJSON_AddArrayToObject(sec, "variants");
+    if (!vars)
+        return RL_ERR_OUT_OF_MEMORY;
+    for (int i = 0; i < NUM; i++) {
+        const curve_point *last = &pts[i][num[i] - 1];
+        double tt[3];
+        for (int k = 0; k < 3; k++)
+            tt[k] = isfinite(targets[k]) ? time_to_rmse(pts[i], num[i], targets[k]) : NAN;
+        printf("%-14s %9.4f %8.4f %11.2f", configs[i].label, last->m.rmse, last->m.ssim,
+               last->time_ms / (double)last->spp);
+        for (int k = 0; k < 3; k++) {
+            if (isfinite(tt[k]))
+                printf(" %11.1f", tt[k]);
+            else
+                printf(" %11s", "-");
+        }
+        printf("\n");
+        cJSON *v = cJSON_CreateObject();
+        if (!v)
+            return RL_ERR_OUT_OF_MEMORY;
+        cJSON_AddItemToArray(vars, v);
+        cJSON_AddStringToObject(v, "label", configs[i].label);
+        cJSON_AddStringToObject(v, "shadow", configs[i].shadow);
+        cJSON_AddStringToObject(v, "diffuse", configs[i].diffuse);
+        cJSON_AddNumberToObject(v, "grid_res", configs[i].grid_res);
+        cJSON_AddItemToObject(v, "curve", curve_json(pts[i], num[i]));
+        cJSON *ttj = cJSON_AddObjectToObject(v, "time_to_bvh_rmse_ms");
+        for (int k = 0; ttj && k < 3; k++) {
+            char key[16];
+            snprintf(key, sizeof key, "spp%lld", target_spp[k]);
+            rl_bench_add_num(ttj, key, tt[k]);
+        }
+    }
+    fflush(stdout);
+    return RL_OK;
+}
+
+static rl_status sec_accumulation(void *ctx, cJSON *sec)
+{
+    bpt *b = ctx;
+    const rl_scene *scene = NULL;
+    rl_camera cam;
+    rl_status st = error_setup(b, &scene, &cam);
+    if (st != RL_OK)
+        return st;
+    /* Convergence of the exact path tracer. */
+    curve_point pts[MAX_POINTS];
+    int num = 0;
+    pt_config base = { .label = "bvh", .shadow = "bvh", .diffuse = "bvh" };
+    if ((st = accumulate_curve(b, &base, scene, &cam, b->a->spp_max, pts, &num)) != RL_OK)
+        return st;
+    printf("\naccumulation (%s, %dx%d, BVH, eq. 8): RMSE against total samples\n",
+           diagram_scene(b), cam.width, cam.height);
+    printf("%8s %10s %9s %8s\n", "spp", "time ms", "RMSE", "SSIM");
+    for (int i = 0; i < num; i++)
+        printf("%8lld %10.1f %9.4f %8.4f\n", pts[i].spp, pts[i].time_ms, pts[i].m.rmse,
+               pts[i].m.ssim);
+    cJSON_AddStringToObject(sec, "scene", diagram_scene(b));
+    cJSON_AddItemToObject(sec, "convergence", curve_json(pts, num));
+    /* Filters of Sec. 8.2 at full strength (filter_fade 0). */
+    static const char *const filters[] = { "none", "gauss", "bilateral", "aniso", "kuwahara" };
+    long long max_spp = b->a->spp_max < 16 ? b->a->spp_max : 16;
+    printf("\nfilters (Sec. 8.2, full strength): RMSE / SSIM at 1, 4, 16 spp\n");
+    printf("%-10s", "filter");
+    for (long long s = 1; s <= max_spp; s *= 4)
+        printf(" %8lld spp RMSE %7s", s, "SSIM");
+    printf("\n");
+    cJSON *fl = cJSON_AddArrayToObject(sec, "filters");
+    if (!fl)
+        return RL_ERR_OUT_OF_MEMORY;
+    for (size_t f = 0; f < sizeof filters / sizeof filters[0]; f++) {
+        pt_config c = base;
+        c.label = filters[f];
+        c.filter = strcmp(filters[f], "none") ? filters[f] : NULL;
+        curve_point fp[MAX_POINTS];
+        int fn = 0;
+        rl_clear_error();
+        if ((st = accumulate_curve(b, &c, scene, &cam, max_spp, fp, &fn)) != RL_OK)
+            return st;
+        printf("%-10s", filters[f]);
+        cJSON *o = cJSON_CreateObject();
+        if (!o)
+            return RL_ERR_OUT_OF_MEMORY;
+        cJSON_AddItemToArray(fl, o);
+        cJSON_AddStringToObject(o, "filter", filters[f]);
+        cJSON *pj = cJSON_AddArrayToObject(o, "points");
+        for (int i = 0; i < fn; i++) {
+            if (fp[i].spp != 1 && fp[i].spp != 4 && fp[i].spp != 16)
+                continue;
+            printf(" %17.4f %7.4f", fp[i].m.rmse, fp[i].m.ssim);
+            cJSON *p = cJSON_CreateObject();
+            if (!p || !pj)
+                return RL_ERR_OUT_OF_MEMORY;
+            cJSON_AddNumberToObject(p, "spp", (double)fp[i].spp);
+            rl_bench_add_num(p, "rmse", fp[i].m.rmse);
+            rl_bench_add_num(p, "ssim", fp[i].m.ssim);
+            rl_bench_add_num(p, "time_ms", fp[i].time_ms);
+            cJSON_AddItemToArray(pj, p);
+        }
+        printf("\n");
+    }
+    fflush(stdout);
+    return RL_OK;
+}
+
+/* ------------------------------------------------------- the command -- */
+
+/* Returns RL_CLI_OK, an exit code, or -1 when --help was printed. */
+static int parse_args(int argc, char **argv, bpt_args *a)
+{
+    a->sections = (1u << SEC_COUNT) - 1;
+    for (int i = 2; i < argc; i++) {
+        const char *v = NULL;
+        int m;
+        if (rl_cli_is_help(argv[i])) {
+            fputs(bench_pt_help, stdout);
+            return -1;
+        }
+#define VALUE(name) ((m = rl_cli_take_value(argc, argv, &i, name, &v)) != 0)
+        if (strcmp(argv[i], "--quick") == 0) {
+            a->quick = true;
+        } else if (VALUE("--size")) {
+            if (m < 0 || !rl_cli_parse_size(v, &a->width, &a->height))
+                return RL_CLI_USAGE;
+            a->has_size = true;
+        } else if (VALUE("--error-size")) {
+            if (m < 0 || !rl_cli_parse_size(v, &a->err_width, &a->err_height))
+                return RL_CLI_USAGE;
+            a->has_err_size = true;
+        } else if (VALUE("--ref-spp")) {
+            if (m < 0 || !rl_bench_parse_count("--ref-spp", v, 1 << 20, &a->ref_spp))
+                return RL_CLI_USAGE;
+            a->has_ref_spp = true;
+        } else if (VALUE("--spp-max")) {
+            if (m < 0 || !rl_bench_parse_count("--spp-max", v, 1 << 16, &a->spp_max))
+                return RL_CLI_USAGE;
+            a->has_spp_max = true;
+        } else if (VALUE("--max-memory")) {
+            long long gb;
+            if (m < 0 || !rl_bench_parse_count("--max-memory", v, 1 << 16, &gb))
+                return RL_CLI_USAGE;
+            a->max_memory_gb = (double)gb;
+        } else if (VALUE("--threads")) {
+            if (m < 0 || !rl_bench_parse_count("--threads", v, 1024, &a->threads))
+                return RL_CLI_USAGE;
+        } else if (VALUE("--only")) {
+            if (m < 0 || !rl_bench_parse_sections(v, section_names, SEC_COUNT, &a->sections))
+                return RL_CLI_USAGE;
+        } else if (VALUE("--out")) {
+            if (m < 0)
+                return RL_CLI_USAGE;
+            a->out = v;
+        } else {
+            return rl_cli_unknown_arg("bench pt", argv[i]);
+        }
+#undef VALUE
+    }
+    if (a->out && !rl_cli_has_extension(a->out, (const char *const[]){ ".json", NULL }))
+        return rl_cli_fail(RL_CLI_USAGE, "--out: '%s' should end in .json", a->out);
+    if (!a->has_size) {
+        a->width = a->quick ? 128 : 1280;      /* Sec. 9.2: 1280x720 */
+        a->height = a->quick ? 72 : 720;
+    }
+    if (!a->has_err_size) {
+        a->err_width = a->quick ? 64 : 320;
+        a->err_height = a->quick ? 36 : 180;
+    }
+    if (!a->has_ref_spp)
+        a->ref_spp = a->quick ? 64 : 1024;
+    if (!a->has_spp_max)
+        a->spp_max = a->quick ? 8 : 64;
+    return RL_CLI_OK;
+}
+
+static cJSON *params_json(const bpt *b)
+{
+    const bpt_args *a = b->a;
+    cJSON *o = cJSON_CreateObject();
+    if (!o)
+        return NULL;
+    char text[64];
+    snprintf(text, sizeof text, "%dx%d", a->width, a->height);
+    cJSON_AddStringToObject(o, "size", text);
+    snprintf(text, sizeof text, "%dx%d", a->err_width, a->err_height);
+    cJSON_AddStringToObject(o, "error_size", text);
+    cJSON_AddNumberToObject(o, "reference_spp", (double)a->ref_spp);
+    cJSON_AddNumberToObject(o, "spp_max", (double)a->spp_max);
+    cJSON_AddNumberToObject(o, "threads", b->threads);
+    cJSON_AddNumberToObject(o, "max_memory_bytes", b->max_memory_bytes);
+    cJSON_AddNumberToObject(o, "ls_n", RL_LS_DEFAULT_N);
+    cJSON_AddBoolToObject(o, "quick", a->quick);
+    cJSON_AddNumberToObject(o, "warmup_renders", 1);
+    cJSON_AddNumberToObject(o, "timed_renders", b->runs);
+    cJSON_AddStringToObject(o, "seed", PT_SEED);
+    cJSON_AddStringToObject(o, "timing",
+                            "wall time of rl_renderer_render; per configuration one warm-up "
+                            "render (builds grid/Line Space/shadow maps), then the fastest of "
+                            "timed_renders with accumulate=false");
+    cJSON_AddStringToObject(o, "metrics", "rl_image_compare: sRGB, SSIM on luma");
+    return o;
+}
+
+static cJSON *thesis_json(void)
+{
+    cJSON *o = cJSON_CreateObject();
+    if (!o)
+        return NULL;
+    cJSON_AddStringToObject(o, "machine", "Intel Core i7-6800K, NVIDIA GeForce GTX 1080 (GPU "
+                                          "compute shaders)");
+    cJSON_AddStringToObject(o, "resolution", "1280x720");
+    cJSON_AddNumberToObject(o, "ls_n", 5);
+    cJSON_AddStringToObject(o, "diffuse_pnmt_vs_grid", "more than 20x (Diagram 2)");
+    cJSON_AddStringToObject(o, "shadow_pnmt_vs_grid", "about 10x (Diagram 3)");
+    cJSON_AddStringToObject(o, "source", "Schroeder 2017, Table 1, Diagrams 1-3, Sec. 9-12");
+    return o;
+}
+
+static double physical_memory(void)
+{
+    long pages = sysconf(_SC_PHYS_PAGES), page = sysconf(_SC_PAGE_SIZE);
+    return pages > 0 && page > 0 ? (double)pages * (double)page : 8.0 * 1073741824.0;
+}
+
+int rl_bench_pt(int argc, char **argv)
+{
+    bpt_args a;
+    memset(&a, 0, sizeof a);
+    int rc = parse_args(argc, argv, &a);
+    if (rc != RL_CLI_OK)
+        return rc < 0 ? RL_CLI_OK : rc;
+    bpt b;
+    memset(&b, 0, sizeof b);
+    b.a = &a;
+    b.threads = a.threads ? (int)a.threads : omp_get_max_threads();
+    b.runs = a.quick ? 1 : RUNS;
+    b.max_memory_bytes = a.max_memory_gb > 0.0 ? a.max_memory_gb * 1073741824.0
+                                               : 0.6 * physical_memory();
+    char out[256];
+    if (a.out)
+        snprintf(out, sizeof out, "%s", a.out);
+    if (a.out ? !rl_cli_check_writable(out) : !rl_bench_default_out("pt", out, sizeof out))
+        return RL_CLI_FAIL;
+    rl_renderer *probe = NULL;
+    rl_clear_error();
+    rl_status st = rl_renderer_create("pt", &probe);
+    rl_renderer_release(probe);
+    if (st != RL_OK)
+        return rl_cli_fail_status(RL_CLI_FAIL, st, "bench pt");
+    cJSON *root = rl_bench_record_json("pt", b.threads);
+    if (!root)
+        return rl_cli_fail(RL_CLI_FAIL, "out of memory");
+    cJSON_AddItemToObject(root, "parameters", params_json(&b));
+    cJSON_AddItemToObject(root, "thesis", thesis_json());
+    static const rl_bench_section_fn fns[SEC_COUNT] = { sec_generation, sec_scenes, sec_diffuse,
+                                                        sec_shadow, sec_error, sec_accumulation };
+    printf("rl bench pt: Line Space path tracing (Schroeder 2017), %d threads\n", b.threads);
+    rc = rl_bench_run_sections("pt", root, section_names, fns, SEC_COUNT, a.sections, &b,
+                               b.reason, b.threads, out);
+    cJSON_Delete(root);
+    for (int i = 0; i < b.num_scenes; i++)
+        rl_scene_release(b.scenes[i].scene);
+    rl_image_release(b.reference);
+    return rc;
+}

@@ -1,0 +1,109 @@
+#!/usr/bin/env bash
+# test_cli_bench_pt.sh: `rl bench pt --quick` runs every section of the Line
+# Space path-tracing benchmark (Schröder 2017, Table 1, Diagrams 1-3) and
+# writes a complete JSON record with sane values; bad usage exits 2, an
+# unwritable output 1. Keeps the benchmark from rotting; it measures nothing.
+# Run as: bash test_cli_bench_pt.sh <rl-binary> <scratch-dir>
+set -u
+. "$(dirname "${BASH_SOURCE[0]}")/lib.bash"
+
+have_python() { command -v python3 >/dev/null 2>&1 && python3 -c 'import json' 2>/dev/null; }
+
+expect_usage_error "$RL" bench pt --ref-spp 0 --out "$TMP/x.json"
+expect_usage_error "$RL" bench pt --spp-max many --out "$TMP/x.json"
+expect_usage_error "$RL" bench pt --size 0x0 --out "$TMP/x.json"
+expect_usage_error "$RL" bench pt --error-size 64 --out "$TMP/x.json"
+expect_usage_error "$RL" bench pt --only scenes,nosuch --out "$TMP/x.json"
+expect_usage_error "$RL" bench pt --quick --out "$TMP/x.txt"
+expect_usage_error "$RL" bench pt --frobnicate
+[ -e "$TMP/x.json" ] && fail "a failed run wrote x.json"
+
+expect_exit 1 "$RL" bench pt --quick --out "$TMP/no/such/dir/pt.json"
+expect_in "$TMP/err" "rl: error: "
+
+expect_exit 0 "$RL" bench pt --help
+for o in --size --error-size --ref-spp --spp-max --max-memory --only --out --quick generation \
+         accumulation; do
+    expect_in "$TMP/out" "$o"
+done
+
+expect_exit 0 "$RL" bench pt --quick --out "$TMP/pt.json"
+[ -s "$TMP/pt.json" ] || fail "pt.json was not written"
+for s in generation scenes diffuse shadow error accumulation ls-pnmt shadowmap kuwahara; do
+    expect_in "$TMP/out" "$s"
+done
+expect_in "$TMP/err" "bench pt: wrote"
+
+if have_python; then
+    python3 - "$TMP/pt.json" <<'PY' || fail "pt.json does not hold a complete, sane record"
+import json, sys
+r = json.load(open(sys.argv[1]))
+assert r["benchmark"] == "pt"
+for k in ("renderlab_version", "date", "machine", "parameters", "thesis"):
+    assert k in r, "missing key " + k
+p = r["parameters"]
+assert p["quick"] is True and p["size"] == "128x72" and p["error_size"] == "64x36", p
+for name in ("generation", "scenes", "diffuse", "shadow", "error", "accumulation"):
+    assert r[name]["status"] == "ok", "%s: %s" % (name, r[name].get("reason"))
+
+g = r["generation"]["rows"]
+assert [(x["voxel_res"], x["n"]) for x in g] == [(8, 4), (8, 5)], g
+for x in g:
+    assert x["status"] == "ok" and x["triangles"] == 36, x
+    assert x["ls_ms"] > 0 and x["grid_ms"] >= 0 and x["ls_bytes"] > 0, x
+    assert x["shafts"] == x["filled_voxels"] * 15 * x["n"] ** 4, x
+    assert 0 <= x["empty_shafts"] <= x["shafts"], x
+
+def frames_ok(frames, labels):
+    assert [f["label"] for f in frames] == labels, frames
+    for f in frames:
+        assert f["frame_ms"] > 0 and f["mrays_per_s"] > 0 and f["rays"]["total"] > 0, f
+    assert frames[0]["speedup_vs_base"] == 1, frames[0]
+
+sc = r["scenes"]["scenes"]
+assert [x["scene"] for x in sc] == ["ls-cornell:model=boxes"], sc
+frames_ok(sc[0]["frames"], ["grid", "ls-pnmt", "ls-candidates", "bvh"])
+frames_ok(r["diffuse"]["frames"], ["grid", "ls-candidates", "ls-pnmt", "ls-preillum", "bvh"])
+frames_ok(r["shadow"]["frames"],
+          ["grid", "ls-candidates", "ls-pnmt", "ls-preillum", "shadowmap", "bvh"])
+
+e = r["error"]
+assert e["reference_spp"] == 64
+labels = [v["label"] for v in e["variants"]]
+assert labels == ["bvh", "grid", "ls-candidates", "ls-pnmt", "ls-preillum", "shadowmap"], labels
+for v in e["variants"]:
+    c = v["curve"]
+    assert [x["spp"] for x in c] == [1, 2, 4, 8], c
+    for x in c:
+        assert 0 <= x["rmse"] <= 1 and -1 <= x["ssim"] <= 1 and x["time_ms"] > 0, x
+    assert all(c[i]["time_ms"] <= c[i + 1]["time_ms"] for i in range(len(c) - 1))
+# The exact variants trace the same paths (up to hits on shared edges,
+# where structures may pick either triangle): nearly the same error.
+by = {v["label"]: v["curve"] for v in e["variants"]}
+for other in ("grid", "ls-candidates"):
+    for a, b in zip(by["bvh"], by[other]):
+        assert abs(a["rmse"] - b["rmse"]) <= 0.02 * a["rmse"] + 1e-6, (other, a, b)
+# More samples, less error (exact path tracer, same seed).
+assert by["bvh"][-1]["rmse"] < by["bvh"][0]["rmse"]
+
+a = r["accumulation"]
+assert [x["spp"] for x in a["convergence"]] == [1, 2, 4, 8]
+assert [f["filter"] for f in a["filters"]] == ["none", "gauss", "bilateral", "aniso", "kuwahara"]
+for f in a["filters"]:
+    assert [x["spp"] for x in f["points"]] == [1, 4], f
+# At 1 spp an edge-preserving filter lowers the error of the noisy image
+# (plain Gauss need not: on a 64x36 image it blurs the edges as much).
+none1 = a["filters"][0]["points"][0]["rmse"]
+assert a["filters"][2]["points"][0]["rmse"] < none1, a["filters"]
+PY
+fi
+
+expect_exit 0 "$RL" bench pt --quick --only generation -q --out "$TMP/o.json"
+if have_python; then
+    python3 - "$TMP/o.json" <<'PY' || fail "o.json is wrong"
+import json, sys
+r = json.load(open(sys.argv[1]))
+assert "generation" in r and "scenes" not in r and "error" not in r
+PY
+fi
+echo "ok"
