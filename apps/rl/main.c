@@ -20,7 +20,7 @@ static const command commands[] = {
     { "info", rl_cli_info, "print statistics and cameras of a scene" },
     { "render", rl_cli_render, "render a scene to PNG or EXR" },
     { "demo", rl_cli_demo, "render every built-in scene with every renderer + HTML report" },
-    { "bench", rl_cli_bench, "time the accelerators on standard ray workloads (bench rays)" },
+    { "bench", rl_cli_bench, "benchmarks: bench rays (accelerators), bench vt (Vertex Tracing), bench pt (Line Space path tracing)" },
 };
 
 static void print_usage(FILE *out)
