@@ -36,6 +36,7 @@ typedef struct rl_render_stats {
     uint64_t triangles_rasterized;        /* triangles set up by a rasterizer */
     uint64_t pixels_written;              /* fragments/pixels written */
     uint64_t samples;                     /* shading samples (e.g. spp * pixels) */
+    uint64_t occlusion_queries;           /* rasterizer occlusion queries issued */
 } rl_render_stats;
 
 typedef enum rl_option_type {
@@ -71,6 +72,12 @@ RL_API const rl_option_info *rl_renderer_options(const rl_renderer *r, size_t *c
 RL_API rl_status rl_renderer_set(rl_renderer *r, const char *key, const char *value);
 /* Current value as text (the default if never set); NULL for unknown keys. */
 RL_API const char *rl_renderer_get(const rl_renderer *r, const char *key);
+/* Forgets what the renderer carried over from earlier frames (temporal
+ * coherence, accumulated samples, culling state) but keeps what it built
+ * for the scene (acceleration structures, Line Spaces, shadow maps): the
+ * next frame is rendered as if it were the first from its camera. This is
+ * the "unconditioned" state of Jähn 2015, Sec. 4.2.3. NULL is a no-op. */
+RL_API void rl_renderer_reset(rl_renderer *r);
 /* Optional progress callback for long renders. */
 RL_API void rl_renderer_set_progress(rl_renderer *r, rl_progress_fn fn, void *user);
 /* Renders the committed scene from cam into image, which must match the

@@ -162,6 +162,14 @@ static void free_frame(pt_state *s)
     s->valid = false;
 }
 
+/* The accumulation restarts; the grid, Line Space and shadow maps stay. */
+static void pt_reset_state(void *state)
+{
+    pt_state *s = state;
+    if (s)
+        s->force_reset = true;
+}
+
 static void pt_release(void *state)
 {
     pt_state *s = state;
@@ -663,4 +671,5 @@ const rl_renderer_class rl_pt_renderer_class = {
     .render = pt_render,
     .release = pt_release,
     .check = pt_check,
+    .reset = pt_reset_state,
 };

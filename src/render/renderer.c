@@ -7,12 +7,11 @@
  * valid camera, an image that matches the camera, zeroed and timed stats. */
 #include "render/renderer.h"
 
-#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
 #include "core/error.h"
-#include "core/params.h"
+#include "core/options.h"
 #include "rl/rl_timer.h"
 
 struct rl_renderer {
@@ -24,17 +23,6 @@ struct rl_renderer {
 };
 
 void *rl_renderer_state(const rl_renderer *r) { return r ? r->state : NULL; }
-
-/* Renderer names in messages ("raster, whitted, ..."): enough room for a
- * few dozen algorithms; longer lists are cut, which only shortens a message. */
-#define NAME_LIST_SIZE 512
-
-static void append(char *buf, size_t size, const char *text)
-{
-    size_t used = strlen(buf);
-    if (used + 1 < size)
-        snprintf(buf + used, size - used, "%s", text);
-}
 
 const char *rl_ray_type_name(rl_ray_type type)
 {
@@ -91,11 +79,11 @@ rl_status rl_renderer_create(const char *name, rl_renderer **out)
         return rl_error(RL_ERR_INVALID_ARG, "rl_renderer_create: name and out must not be NULL");
     const rl_renderer_class *cls = find_class(name);
     if (!cls) {
-        char names[NAME_LIST_SIZE] = "";
+        char names[RL_OPTION_LIST_SIZE] = "";
         for (size_t i = 0; i < rl_renderer_class_count; ++i) {
             if (i)
-                append(names, sizeof names, ", ");
-            append(names, sizeof names, rl_renderer_classes[i]->info.name);
+                rl_option_append(names, sizeof names, ", ");
+            rl_option_append(names, sizeof names, rl_renderer_classes[i]->info.name);
         }
         return rl_error(RL_ERR_NOT_FOUND, "unknown algorithm \"%s\" (available: %s)", name, names);
     }
@@ -152,92 +140,7 @@ const rl_option_info *rl_renderer_options(const rl_renderer *r, size_t *count)
 /* Index of key (optionally "<name>.key") in the option table, or -1. */
 static long find_option(const rl_renderer *r, const char *key)
 {
-    const char *name = r->cls->info.name;
-    size_t name_len = strlen(name);
-    if (strncmp(key, name, name_len) == 0 && key[name_len] == '.')
-        key += name_len + 1;
-    for (size_t i = 0; i < r->cls->num_options; ++i)
-        if (strcmp(r->cls->options[i].key, key) == 0)
-            return (long)i;
-    return -1;
-}
-
-static bool parse_bool(const char *s, bool *out)
-{
-    static const char *const yes[] = { "true", "1", "yes", "on" };
-    static const char *const no[] = { "false", "0", "no", "off" };
-    for (int i = 0; i < 4; ++i) {
-        if (strcmp(s, yes[i]) == 0) { *out = true; return true; }
-        if (strcmp(s, no[i]) == 0) { *out = false; return true; }
-    }
-    return false;
-}
-
-static int enum_index(const rl_option_info *o, const char *s)
-{
-    for (int i = 0; o->choices && o->choices[i]; ++i)
-        if (strcmp(o->choices[i], s) == 0)
-            return i;
-    return -1;
-}
-
-/* Checks value against the option's type; records a message on failure. */
-static rl_status validate(const rl_renderer *r, const rl_option_info *o, const char *value)
-{
-    const char *name = r->cls->info.name;
-    switch (o->type) {
-    case RL_OPT_INT: {
-        long long v;
-        if (!rl_parse_int(value, &v))
-            return rl_error(RL_ERR_INVALID_ARG, "%s: option %s=\"%s\" is not an integer",
-                            name, o->key, value);
-        if ((double)v < o->min || (double)v > o->max)
-            return rl_error(RL_ERR_INVALID_ARG, "%s: option %s=%s is outside [%.17g, %.17g]",
-                            name, o->key, value, o->min, o->max);
-        return RL_OK;
-    }
-    case RL_OPT_FLOAT: {
-        double v;
-        if (!rl_parse_float(value, &v))
-            return rl_error(RL_ERR_INVALID_ARG, "%s: option %s=\"%s\" is not a finite number",
-                            name, o->key, value);
-        if (v < o->min || v > o->max)
-            return rl_error(RL_ERR_INVALID_ARG, "%s: option %s=%s is outside [%g, %g]",
-                            name, o->key, value, o->min, o->max);
-        return RL_OK;
-    }
-    case RL_OPT_BOOL: {
-        bool b;
-        if (!parse_bool(value, &b))
-            return rl_error(RL_ERR_INVALID_ARG,
-                            "%s: option %s=\"%s\" is not a boolean (true/false, 1/0, yes/no, on/off)",
-                            name, o->key, value);
-        return RL_OK;
-    }
-    case RL_OPT_ENUM: {
-        if (enum_index(o, value) >= 0)
-            return RL_OK;
-        char list[NAME_LIST_SIZE] = "";
-        for (int i = 0; o->choices && o->choices[i]; ++i) {
-            if (i)
-                append(list, sizeof list, ", ");
-            append(list, sizeof list, o->choices[i]);
-        }
-        return rl_error(RL_ERR_INVALID_ARG, "%s: option %s=\"%s\" is not one of %s",
-                        name, o->key, value, list);
-    }
-    case RL_OPT_STRING:
-        return RL_OK;
-    case RL_OPT_COLOR: {
-        rl_vec3 c;
-        if (rl_renderer_parse_color(value, &c))
-            return RL_OK;
-        return rl_error(RL_ERR_INVALID_ARG,
-                        "%s: option %s=\"%s\" is not a colour (\"r,g,b\" or one value, >= 0)",
-                        name, o->key, value);
-    }
-    }
-    return rl_error(RL_ERR_INTERNAL, "%s: option %s has an unknown type", name, o->key);
+    return rl_option_find(r->cls->options, r->cls->num_options, r->cls->info.name, key);
 }
 
 rl_status rl_renderer_set(rl_renderer *r, const char *key, const char *value)
@@ -245,18 +148,10 @@ rl_status rl_renderer_set(rl_renderer *r, const char *key, const char *value)
     if (!r || !key || !value)
         return rl_error(RL_ERR_INVALID_ARG, "rl_renderer_set: renderer, key and value must not be NULL");
     long i = find_option(r, key);
-    if (i < 0) {
-        char keys[NAME_LIST_SIZE] = "";
-        for (size_t k = 0; k < r->cls->num_options; ++k) {
-            if (k)
-                append(keys, sizeof keys, ", ");
-            append(keys, sizeof keys, r->cls->options[k].key);
-        }
-        return rl_error(RL_ERR_INVALID_ARG, "%s: unknown option \"%s\" (options: %s)",
-                        r->cls->info.name, key, keys);
-    }
+    if (i < 0)
+        return rl_option_unknown(r->cls->options, r->cls->num_options, r->cls->info.name, key);
     const rl_option_info *o = &r->cls->options[i];
-    rl_status st = validate(r, o, value);
+    rl_status st = rl_option_validate(o, value, r->cls->info.name);
     if (st == RL_OK && r->cls->check)
         st = r->cls->check(o->key, value);
     if (st != RL_OK)
@@ -267,6 +162,12 @@ rl_status rl_renderer_set(rl_renderer *r, const char *key, const char *value)
     free(r->values[i]);
     r->values[i] = copy;
     return RL_OK;
+}
+
+void rl_renderer_reset(rl_renderer *r)
+{
+    if (r && r->cls->reset)
+        r->cls->reset(r->state);
 }
 
 const char *rl_renderer_get(const rl_renderer *r, const char *key)
@@ -294,23 +195,17 @@ bool rl_renderer_progress(const rl_renderer *r, double done)
  * failed parse here means a wrong key in an implementation: return zero. */
 long long rl_renderer_opt_int(const rl_renderer *r, const char *key)
 {
-    const char *s = rl_renderer_get(r, key);
-    long long v = 0;
-    return s && rl_parse_int(s, &v) ? v : 0;
+    return rl_option_read_int(rl_renderer_get(r, key));
 }
 
 double rl_renderer_opt_float(const rl_renderer *r, const char *key)
 {
-    const char *s = rl_renderer_get(r, key);
-    double v = 0.0;
-    return s && rl_parse_float(s, &v) ? v : 0.0;
+    return rl_option_read_float(rl_renderer_get(r, key));
 }
 
 bool rl_renderer_opt_bool(const rl_renderer *r, const char *key)
 {
-    const char *s = rl_renderer_get(r, key);
-    bool v = false;
-    return s && parse_bool(s, &v) ? v : false;
+    return rl_option_read_bool(rl_renderer_get(r, key));
 }
 
 int rl_renderer_opt_enum(const rl_renderer *r, const char *key)
@@ -318,8 +213,7 @@ int rl_renderer_opt_enum(const rl_renderer *r, const char *key)
     long i = r && key ? find_option(r, key) : -1;
     if (i < 0)
         return 0;
-    int idx = enum_index(&r->cls->options[i], r->values[i]);
-    return idx < 0 ? 0 : idx;
+    return rl_option_read_enum(&r->cls->options[i], r->values[i]);
 }
 
 const char *rl_renderer_opt_string(const rl_renderer *r, const char *key)
@@ -330,36 +224,13 @@ const char *rl_renderer_opt_string(const rl_renderer *r, const char *key)
 
 bool rl_renderer_parse_color(const char *text, rl_vec3 *out)
 {
-    /* "r,g,b" or one grey value; strtod per component, nothing else allowed. */
-    float c[3];
-    int n = 0;
-    const char *p = text;
-    if (!text)
-        return false;
-    for (;;) {
-        char *end;
-        double v = strtod(p, &end);
-        if (end == p || !(v >= 0.0) || v > 3.4e38 || n == 3)
-            return false;
-        c[n++] = (float)v;
-        while (*end == ' ')
-            ++end;
-        if (*end == '\0')
-            break;
-        if (*end != ',')
-            return false;
-        p = end + 1;
-    }
-    if (n == 2)
-        return false;
-    *out = n == 1 ? rl_v3s(c[0]) : rl_v3(c[0], c[1], c[2]);
-    return true;
+    return rl_option_parse_color(text, out);
 }
 
 rl_vec3 rl_renderer_opt_color(const rl_renderer *r, const char *key)
 {
     rl_vec3 c = rl_v3s(0.0f);
-    rl_renderer_parse_color(rl_renderer_get(r, key), &c);
+    rl_option_parse_color(rl_renderer_get(r, key), &c);
     return c;
 }
 

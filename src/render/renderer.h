@@ -23,6 +23,9 @@ typedef struct rl_renderer_class {
      * (e.g. a colour in a string option); NULL: none. Records and returns
      * RL_ERR_INVALID_ARG for a bad value. */
     rl_status (*check)(const char *key, const char *value);
+    /* Optional: forget frame-to-frame state, keep per-scene preprocessing
+     * (rl_renderer_reset); NULL: the renderer keeps none. */
+    void (*reset)(void *state);
 } rl_renderer_class;
 
 /* registry.c */

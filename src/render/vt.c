@@ -118,6 +118,15 @@ static rl_status vt_create(void **state)
     return RL_OK;
 }
 
+/* Temporal coherence (Sec. 3.4.5) is the only state a frame leaves for the
+ * next one; the BVH is per scene and stays. */
+static void vt_reset(void *state)
+{
+    vt_state *s = state;
+    if (s)
+        vt_feeler_map_free(&s->feelers);
+}
+
 static void vt_release(void *state)
 {
     vt_state *s = state;
@@ -542,4 +551,5 @@ const rl_renderer_class rl_vt_renderer_class = {
     .render = vt_render,
     .release = vt_release,
     .check = vt_check,
+    .reset = vt_reset,
 };

@@ -343,6 +343,12 @@ static void test_accumulation_converges_and_reset_repeats(void **state)
     assert_int_equal(rl_pt_reset(r), RL_OK);
     assert_int_equal(rl_renderer_render(r, s, &cam, img, NULL), RL_OK);
     assert_memory_equal(img->color, first->color, 16 * 16 * sizeof *img->color);
+    /* The generic rl_renderer_reset (Jähn 2015's unconditioned state) does
+     * the same. */
+    assert_int_equal(rl_renderer_render(r, s, &cam, img, NULL), RL_OK);
+    rl_renderer_reset(r);
+    assert_int_equal(rl_renderer_render(r, s, &cam, img, NULL), RL_OK);
+    assert_memory_equal(img->color, first->color, 16 * 16 * sizeof *img->color);
     /* So does any option change, and a camera change. */
     assert_int_equal(rl_renderer_render(r, s, &cam, img, NULL), RL_OK);
     assert_int_equal(rl_renderer_set(r, "light_samples", "2"), RL_OK);

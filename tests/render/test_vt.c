@@ -377,6 +377,12 @@ static void deterministic_and_coherent(void **state)
     assert_int_equal(s1.vertices_sampled, s2.vertices_sampled);
     rl_image_release(i1);
     rl_image_release(i2);
+    /* rl_renderer_reset forgets the feelers (the unconditioned state of
+     * Jähn 2015, Sec. 4.2.3): the next frame reuses none, same image. */
+    rl_renderer_reset(r2);
+    s2 = render_stats(r2, s, &a, &i2);
+    assert_int_equal(s2.feelers_reused, 0);
+    rl_image_release(i2);
     rl_renderer_release(r1);
     rl_renderer_release(r2);
     rl_scene_release(s);
