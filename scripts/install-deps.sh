@@ -12,6 +12,8 @@ PACKAGES=(
   libassimp-dev       # OBJ, PLY, STL, glTF, DAE, 3DS, FBX import
   libembree-dev       # Embree 3: reference accelerator and benchmark anchor
   libcmocka-dev       # unit tests
+  libcairo2-dev       # plots in evaluation reports (SVG, PNG)
+  fonts-dejavu-core   # a font for plot labels
   assimp-testmodels   # real meshes for rl bench rays
 )
 
