@@ -15,7 +15,22 @@
  * image (and inside the mask). Windows are truncated at the borders (the
  * weights renormalised), so every pixel is a window centre. A mask selects
  * window centres only: each window still reads all its pixels, masked or
- * not. Outputs stay untouched on failure. */
+ * not.
+ *
+ * Hierarchical (multi-scale) SSIM, ssim_levels = L in 2..5: the
+ * multi-scale SSIM of Wang, Simoncelli & Bovik 2003 over a Gaussian pyramid
+ * (Burt 1981: the separable kernel [1 4 6 4 1] / 16, truncated and
+ * renormalised at the borders, then every second pixel, so a level of n
+ * pixels has ceil(n / 2)). Contrast x structure is averaged at every level,
+ * the full SSIM (with luminance) at the coarsest; the means are combined as
+ * a product with the 2003 paper's exponents (0.0448, 0.2856, 0.3001,
+ * 0.2363, 0.1333; the first L renormalised to sum to 1), negative means
+ * taken as 0. rl_image_compare() then reports it in `ssim`; RMSE, PSNR and
+ * max_abs stay single-scale. Masks and the per-pixel map are single-scale
+ * only (RL_ERR_INVALID_ARG with L > 1). Jähn 2015, Sec. 4.2.5 uses it to
+ * emphasise large-area errors.
+ *
+ * Outputs stay untouched on failure. */
 #ifndef RL_METRICS_H
 #define RL_METRICS_H
 
@@ -30,6 +45,7 @@ typedef struct rl_metric_options {    /* zero = default */
     const uint8_t *mask;              /* width*height, nonzero = counted; NULL = all */
     bool linear;                      /* compare linear values instead of sRGB */
     bool ssim_rgb;                    /* SSIM per channel, averaged (default: luma) */
+    int ssim_levels;                  /* 0 or 1: single-scale SSIM; 2..5: multi-scale */
 } rl_metric_options;
 
 typedef struct rl_image_metrics {
@@ -41,12 +57,15 @@ typedef struct rl_image_metrics {
 } rl_image_metrics;
 
 /* RL_ERR_INVALID_ARG for NULL or size-mismatched images, missing colour
- * layers, or a mask that selects no pixel. */
+ * layers, a mask that selects no pixel, ssim_levels outside 0..5 or a mask
+ * with ssim_levels > 1. With ssim_levels > 1, `ssim` is the multi-scale
+ * SSIM. */
 RL_API rl_status rl_image_compare(const rl_image *test, const rl_image *reference,
                                   const rl_metric_options *opt, rl_image_metrics *out);
 
 /* The per-pixel SSIM map (width*height floats, 0 outside the mask), for
- * difference pictures; out must hold width*height values. */
+ * difference pictures; out must hold width*height values. Single-scale
+ * only: RL_ERR_INVALID_ARG for ssim_levels > 1. */
 RL_API rl_status rl_image_ssim_map(const rl_image *test, const rl_image *reference,
                                    const rl_metric_options *opt, float *out);
 

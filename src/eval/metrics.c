@@ -20,6 +20,26 @@
  * masked or not, so the masked SSIM is a plain sub-average of the full SSIM
  * map and does not depend on where the mask edge cuts a window.
  *
+ * Multi-scale SSIM (options.ssim_levels = L > 1) follows Wang, Simoncelli &
+ * Bovik 2003, "Multi-scale structural similarity for image quality
+ * assessment", Asilomar, Eq. (7): contrast x structure, c_j s_j = (2
+ * sigma_xy + C2) / (sigma_x^2 + sigma_y^2 + C2), averaged over the window
+ * centres of every level j < L, and the full SSIM (luminance included) of
+ * the coarsest level, combined as prod_j mean(c_j s_j)^beta_j times
+ * mean(SSIM_L)^beta_L with the paper's exponents for five levels (0.0448,
+ * 0.2856, 0.3001, 0.2363, 0.1333), the first L of them renormalised to sum
+ * to one. A negative mean (anti-correlated images) is taken as 0 before
+ * the fractional power, where the paper leaves it undefined. As in the
+ * paper's reference code the luminance term enters as the coarsest level's
+ * mean SSIM rather than a separate mean of l. The levels are a Gaussian
+ * pyramid after Burt 1981 (the thesis' [Bur81]; Burt & Adelson 1983):
+ * level j+1 is level j convolved with the separable 5-tap generating kernel
+ * [1 4 6 4 1] / 16 (a = 0.375) and subsampled at even pixels, so a level of
+ * n pixels gives ceil(n / 2); at the borders the kernel is truncated and
+ * renormalised, like the SSIM window. Each level's SSIM uses the same 11x11
+ * window and constants as the single-scale SSIM. Jähn 2015, Sec. 4.2.5 uses
+ * this hierarchical filtering to emphasise large-area errors.
+ *
  * Work is split into bands of rows, one per OpenMP iteration; each band
  * filters its rows plus a RADIUS-row halo, so no full-size intermediate is
  * kept and the result does not depend on the thread count (sums are reduced
@@ -119,6 +139,7 @@ typedef struct ssim_job {
     float *map;                 /* map[i] += map_scale * SSIM, or NULL */
     float map_scale;
     double *row_sum;            /* row_sum[y] += sum of masked SSIM in row y, or NULL */
+    double *row_cs;             /* row_cs[y] += sum of c*s (Wang 2003) in row y, or NULL */
     double *scratch;            /* threads * scratch_per_thread doubles */
     size_t scratch_per_thread;
 } ssim_job;
@@ -178,6 +199,14 @@ static double ssim_from_moments(double mx, double my, double exx, double eyy, do
     return num / den;
 }
 
+/* Contrast x structure of Wang, Simoncelli & Bovik 2003, Eq. (3)-(4) with
+ * C3 = C2 / 2 merged; symmetric, so identical inputs give exactly 1. */
+static double cs_from_moments(double mx, double my, double exx, double eyy, double exy)
+{
+    double sxx = exx - mx * mx, syy = eyy - my * my, sxy = exy - mx * my;
+    return (2.0 * sxy + SSIM_C2) / (sxx + syy + SSIM_C2);
+}
+
 static void ssim_band(const ssim_job *job, int b0, int b1, double *scratch)
 {
     const int w = job->width, h = job->height;
@@ -224,18 +253,23 @@ static void ssim_band(const ssim_job *job, int b0, int b1, double *scratch)
         }
         const double norm = job->row_inv[i];
         const size_t row = (size_t)i * ws;
-        double sum = 0.0;
+        double sum = 0.0, sum_cs = 0.0;
         for (int j = 0; j < w; ++j) {
             if (job->mask && !job->mask[row + (size_t)j])
                 continue;
             double v = ssim_from_moments(acc[0][j] * norm, acc[1][j] * norm, acc[2][j] * norm,
                                          acc[3][j] * norm, acc[4][j] * norm);
             sum += v;
+            if (job->row_cs)
+                sum_cs += cs_from_moments(acc[0][j] * norm, acc[1][j] * norm, acc[2][j] * norm,
+                                          acc[3][j] * norm, acc[4][j] * norm);
             if (job->map)
                 job->map[row + (size_t)j] += job->map_scale * (float)v;
         }
         if (job->row_sum)
             job->row_sum[i] += sum;
+        if (job->row_cs)
+            job->row_cs[i] += sum_cs;
     }
 }
 
@@ -388,6 +422,160 @@ static void ctx_run(compare_ctx *c)
     }
 }
 
+/* ---- multi-scale SSIM (Wang, Simoncelli & Bovik 2003) ----------------- */
+
+enum { MS_MAX_LEVELS = 5, PYR_RADIUS = 2 };
+/* Wang 2003, Sec. 3.2: beta_j = gamma_j = alpha_5 for five scales */
+static const double ms_weights[MS_MAX_LEVELS] = { 0.0448, 0.2856, 0.3001, 0.2363, 0.1333 };
+/* Burt 1981 generating kernel with a = 0.375: [1 4 6 4 1] / 16 */
+static const double pyr_kernel[2 * PYR_RADIUS + 1] = { 1.0, 4.0, 6.0, 4.0, 1.0 };
+
+/* One REDUCE step along a line of n samples with stride `step`: dst gets
+ * (n + 1) / 2 samples with stride dst_step, the kernel truncated and
+ * renormalised at the ends. */
+static void reduce_line(const double *src, int n, size_t step, double *dst, size_t dst_step)
+{
+    for (int i = 0; 2 * i < n; ++i) {
+        double s = 0.0, wsum = 0.0;
+        for (int t = -PYR_RADIUS; t <= PYR_RADIUS; ++t) {
+            int k = 2 * i + t;
+            if (k < 0 || k >= n)
+                continue;
+            s += pyr_kernel[PYR_RADIUS + t] * src[(size_t)k * step];
+            wsum += pyr_kernel[PYR_RADIUS + t];
+        }
+        dst[(size_t)i * dst_step] = s / wsum;
+    }
+}
+
+/* src (w x h) -> dst ((w+1)/2 x (h+1)/2), through tmp ((w+1)/2 x h). */
+static void reduce_plane(const double *src, int w, int h, double *tmp, double *dst)
+{
+    const int w2 = (w + 1) / 2;
+    for (int r = 0; r < h; ++r)
+        reduce_line(src + (size_t)r * (size_t)w, w, 1, tmp + (size_t)r * (size_t)w2, 1);
+    for (int col = 0; col < w2; ++col)
+        reduce_line(tmp + col, h, (size_t)w2, dst + col, (size_t)w2);
+}
+
+/* Buffers of the coarser levels: two ping-pong pairs of planes and the
+ * horizontal-pass scratch. */
+typedef struct pyramid {
+    double *levels[2];          /* x then y, each (w+1)/2 * (h+1)/2, per parity */
+    double *tmp;
+    double *row_ssim, *row_cs;  /* height rows */
+} pyramid;
+
+static void pyramid_free(pyramid *py)
+{
+    free(py->levels[0]);
+    free(py->levels[1]);
+    free(py->tmp);
+    free(py->row_ssim);
+    free(py->row_cs);
+}
+
+static rl_status pyramid_init(pyramid *py, int w, int h)
+{
+    memset(py, 0, sizeof *py);
+    const size_t n1 = (size_t)((w + 1) / 2) * (size_t)((h + 1) / 2);
+    py->levels[0] = rl_calloc(2 * n1, sizeof(double));
+    py->levels[1] = rl_calloc(2 * n1, sizeof(double));
+    py->tmp = rl_calloc((size_t)((w + 1) / 2) * (size_t)h, sizeof(double));
+    py->row_ssim = rl_calloc((size_t)h, sizeof(double));
+    py->row_cs = rl_calloc((size_t)h, sizeof(double));
+    if (!py->levels[0] || !py->levels[1] || !py->tmp || !py->row_ssim || !py->row_cs) {
+        pyramid_free(py);
+        return RL_ERR_OUT_OF_MEMORY;
+    }
+    return RL_OK;
+}
+
+/* Multi-scale SSIM of the current planes (no mask: rejected earlier). */
+static double ms_ssim(compare_ctx *c, pyramid *py, int levels)
+{
+    ssim_job *job = &c->job;
+    const int w0 = job->width, h0 = job->height;
+    const double *x = c->planes, *y = c->planes + (size_t)w0 * (size_t)h0;
+    double wsum = 0.0;
+    for (int j = 0; j < levels; ++j)
+        wsum += ms_weights[j];
+    int w = w0, h = h0;
+    double result = 1.0;
+    for (int j = 0; j < levels; ++j) {
+        job->x = x;
+        job->y = y;
+        job->width = w;
+        job->height = h;
+        truncated_norms(job->g, w, job->col_inv);
+        truncated_norms(job->g, h, job->row_inv);
+        memset(py->row_ssim, 0, (size_t)h * sizeof(double));
+        memset(py->row_cs, 0, (size_t)h * sizeof(double));
+        job->row_sum = py->row_ssim;
+        job->row_cs = py->row_cs;
+        ssim_run(job, c->threads);
+        double sum = 0.0;
+        const double *rows = j == levels - 1 ? py->row_ssim : py->row_cs;
+        for (int r = 0; r < h; ++r)
+            sum += rows[r];
+        double mean = sum / ((double)w * (double)h);
+        /* Wang 2003, Eq. (7): c*s at every scale, luminance at the coarsest */
+        result *= pow(mean > 0.0 ? mean : 0.0, ms_weights[j] / wsum);
+        if (j + 1 < levels) {
+            const int w2 = (w + 1) / 2, h2 = (h + 1) / 2;
+            double *nx = py->levels[j % 2], *ny = nx + (size_t)w2 * (size_t)h2;
+            reduce_plane(x, w, h, py->tmp, nx);
+            reduce_plane(y, w, h, py->tmp, ny);
+            x = nx;
+            y = ny;
+            w = w2;
+            h = h2;
+        }
+    }
+    /* back to the full-size planes for the next channel */
+    job->x = c->planes;
+    job->y = c->planes + (size_t)w0 * (size_t)h0;
+    job->width = w0;
+    job->height = h0;
+    job->row_sum = NULL;
+    job->row_cs = NULL;
+    truncated_norms(job->g, w0, job->col_inv);
+    truncated_norms(job->g, h0, job->row_inv);
+    return result;
+}
+
+/* Mean multi-scale SSIM over luma or the three channels. */
+static double ctx_run_ms(compare_ctx *c, pyramid *py)
+{
+    if (!c->opt.ssim_rgb) {
+        fill_planes(c, CH_LUMA);
+        return ms_ssim(c, py, c->opt.ssim_levels);
+    }
+    double sum = 0.0;
+    for (int ch = CH_R; ch <= CH_B; ++ch) {
+        fill_planes(c, (channel)ch);
+        sum += ms_ssim(c, py, c->opt.ssim_levels);
+    }
+    return sum / 3.0;
+}
+
+static rl_status check_levels(const char *fn, const rl_metric_options *opt, bool map)
+{
+    if (!opt)
+        return RL_OK;
+    if (opt->ssim_levels < 0 || opt->ssim_levels > MS_MAX_LEVELS)
+        return rl_error(RL_ERR_INVALID_ARG, "%s: ssim_levels %d outside [0, %d]", fn,
+                        opt->ssim_levels, MS_MAX_LEVELS);
+    if (opt->ssim_levels > 1 && opt->mask)
+        return rl_error(RL_ERR_INVALID_ARG,
+                        "%s: a mask is not supported with ssim_levels > 1 (the coarser levels "
+                        "have no mask)", fn);
+    if (opt->ssim_levels > 1 && map)
+        return rl_error(RL_ERR_INVALID_ARG,
+                        "%s: the SSIM map is single-scale; ssim_levels must be 0 or 1", fn);
+    return RL_OK;
+}
+
 /* ---- public API ------------------------------------------------------- */
 
 rl_status rl_image_compare(const rl_image *test, const rl_image *reference,
@@ -395,19 +583,33 @@ rl_status rl_image_compare(const rl_image *test, const rl_image *reference,
 {
     if (!out)
         return rl_error(RL_ERR_INVALID_ARG, "rl_image_compare: out is NULL");
+    rl_status st = check_levels("rl_image_compare", opt, false);
+    if (st != RL_OK)
+        return st;
     compare_ctx c;
     uint64_t pixels = 0;
-    rl_status st = ctx_init(&c, "rl_image_compare", test, reference, opt, true, &pixels);
+    st = ctx_init(&c, "rl_image_compare", test, reference, opt, true, &pixels);
     if (st != RL_OK)
         return st;
     const int h = test->height;
+    const bool multi = c.opt.ssim_levels > 1;
     double *row_ssim = rl_calloc((size_t)h, sizeof(double));
-    if (!row_ssim) {
+    pyramid py;
+    memset(&py, 0, sizeof py);
+    if (row_ssim && multi)
+        st = pyramid_init(&py, test->width, h);
+    if (!row_ssim || st != RL_OK) {
+        free(row_ssim);
         ctx_free(&c);
         return RL_ERR_OUT_OF_MEMORY;
     }
-    c.job.row_sum = row_ssim;
-    ctx_run(&c);
+    double ms = 0.0;
+    if (multi) {
+        ms = ctx_run_ms(&c, &py);
+    } else {
+        c.job.row_sum = row_ssim;
+        ctx_run(&c);
+    }
 
     double sq = 0.0, max_abs = 0.0, ssim = 0.0;
     for (int i = 0; i < h; ++i) {
@@ -419,10 +621,11 @@ rl_status rl_image_compare(const rl_image *test, const rl_image *reference,
     const double mse = sq / (3.0 * count);          /* over R, G and B */
     out->rmse = sqrt(mse);
     out->psnr = mse > 0.0 ? 10.0 * log10(1.0 / mse) : INFINITY;
-    out->ssim = ssim / (count * (c.opt.ssim_rgb ? 3.0 : 1.0));
+    out->ssim = multi ? ms : ssim / (count * (c.opt.ssim_rgb ? 3.0 : 1.0));
     out->max_abs = max_abs;
     out->pixels = pixels;
     free(row_ssim);
+    pyramid_free(&py);
     ctx_free(&c);
     return RL_OK;
 }
@@ -432,9 +635,12 @@ rl_status rl_image_ssim_map(const rl_image *test, const rl_image *reference,
 {
     if (!out)
         return rl_error(RL_ERR_INVALID_ARG, "rl_image_ssim_map: out is NULL");
+    rl_status st = check_levels("rl_image_ssim_map", opt, true);
+    if (st != RL_OK)
+        return st;
     compare_ctx c;
     uint64_t pixels = 0;
-    rl_status st = ctx_init(&c, "rl_image_ssim_map", test, reference, opt, false, &pixels);
+    st = ctx_init(&c, "rl_image_ssim_map", test, reference, opt, false, &pixels);
     if (st != RL_OK)
         return st;
     memset(out, 0, (size_t)test->width * (size_t)test->height * sizeof *out);

@@ -187,6 +187,108 @@ static double library_pixel(const rl_image *t, const rl_image *r, const rl_metri
     return m.ssim;
 }
 
+/* ---- multi-scale oracle (Wang, Simoncelli & Bovik 2003) ---------------- */
+
+/* Mean SSIM and mean contrast x structure of all windows of one level,
+ * from the same direct window sums as oracle_window. */
+static void oracle_level_means(const oracle_planes *p, double *ssim, double *cs)
+{
+    double sum_ssim = 0.0, sum_cs = 0.0;
+    for (int py = 0; py < p->h; ++py)
+        for (int px = 0; px < p->w; ++px) {
+            double wsum = 0.0, mx = 0.0, my = 0.0;
+            for (int dy = -5; dy <= 5; ++dy)
+                for (int dx = -5; dx <= 5; ++dx) {
+                    int x = px + dx, y = py + dy;
+                    if (x < 0 || y < 0 || x >= p->w || y >= p->h)
+                        continue;
+                    double g = exp(-(double)(dx * dx + dy * dy) / (2.0 * 1.5 * 1.5));
+                    wsum += g;
+                    mx += g * p->t[y * p->w + x];
+                    my += g * p->r[y * p->w + x];
+                }
+            mx /= wsum;
+            my /= wsum;
+            double sxx = 0.0, syy = 0.0, sxy = 0.0;
+            for (int dy = -5; dy <= 5; ++dy)
+                for (int dx = -5; dx <= 5; ++dx) {
+                    int x = px + dx, y = py + dy;
+                    if (x < 0 || y < 0 || x >= p->w || y >= p->h)
+                        continue;
+                    double g = exp(-(double)(dx * dx + dy * dy) / (2.0 * 1.5 * 1.5)) / wsum;
+                    double a = p->t[y * p->w + x] - mx, b = p->r[y * p->w + x] - my;
+                    sxx += g * a * a;
+                    syy += g * b * b;
+                    sxy += g * a * b;
+                }
+            double l = (2.0 * mx * my + C1) / (mx * mx + my * my + C1);
+            double c = (2.0 * sxy + C2) / (sxx + syy + C2);
+            sum_ssim += l * c;
+            sum_cs += c;
+        }
+    *ssim = sum_ssim / (p->w * p->h);
+    *cs = sum_cs / (p->w * p->h);
+}
+
+/* Burt 1981 REDUCE in 2D, straight from the definition: the 5x5 weights
+ * w(m) w(n) with w = [1 4 6 4 1] / 16 over the taps inside the image,
+ * divided by their sum, at every even pixel. */
+static double *oracle_reduce(const double *src, int w, int h)
+{
+    static const double k[5] = { 1, 4, 6, 4, 1 };
+    const int w2 = (w + 1) / 2, h2 = (h + 1) / 2;
+    double *dst = malloc((size_t)w2 * (size_t)h2 * sizeof(double));
+    assert_non_null(dst);
+    for (int i = 0; i < h2; ++i)
+        for (int j = 0; j < w2; ++j) {
+            double s = 0.0, wsum = 0.0;
+            for (int m = -2; m <= 2; ++m)
+                for (int n = -2; n <= 2; ++n) {
+                    int y = 2 * i + m, x = 2 * j + n;
+                    if (x < 0 || y < 0 || x >= w || y >= h)
+                        continue;
+                    s += k[m + 2] * k[n + 2] * src[y * w + x];
+                    wsum += k[m + 2] * k[n + 2];
+                }
+            dst[i * w2 + j] = s / wsum;
+        }
+    return dst;
+}
+
+/* Eq. (7) of Wang et al. 2003 with their five exponents, the first
+ * `levels` renormalised; luma or RGB averaged. */
+static double oracle_ms_ssim(const rl_image *t, const rl_image *r, const rl_metric_options *o,
+                             int levels)
+{
+    static const double beta[5] = { 0.0448, 0.2856, 0.3001, 0.2363, 0.1333 };
+    double bsum = 0.0;
+    for (int j = 0; j < levels; ++j)
+        bsum += beta[j];
+    const int first = o->ssim_rgb ? 0 : 3, last = o->ssim_rgb ? 2 : 3;
+    double total = 0.0;
+    for (int c = first; c <= last; ++c) {
+        oracle_planes p = oracle_planes_make(t, r, c, o->linear);
+        double ms = 1.0;
+        for (int j = 0; j < levels; ++j) {
+            double ssim, cs;
+            oracle_level_means(&p, &ssim, &cs);
+            double v = j == levels - 1 ? ssim : cs;
+            ms *= pow(v > 0.0 ? v : 0.0, beta[j] / bsum);
+            if (j + 1 < levels) {
+                double *nt = oracle_reduce(p.t, p.w, p.h), *nr = oracle_reduce(p.r, p.w, p.h);
+                oracle_planes_free(&p);
+                p.t = nt;
+                p.r = nr;
+                p.w = (p.w + 1) / 2;
+                p.h = (p.h + 1) / 2;
+            }
+        }
+        oracle_planes_free(&p);
+        total += ms;
+    }
+    return total / (last - first + 1);
+}
+
 /* ---- cases ------------------------------------------------------------- */
 
 static void test_identical_images_give_ssim_one_and_zero_error(void **state)
@@ -409,6 +511,140 @@ static void test_mask_averages_only_selected_window_centres(void **state)
     rl_image_release(ref);
 }
 
+/* A checkerboard x = m + d s and y = m + a d s (s = (-1)^(i+j)): in a full
+ * 11x11 window with Gaussian weights g_t (sigma 1.5), the weighted mean of
+ * s is s0 e with e = (sum g_t (-1)^t / sum g_t)^2 and s0 the centre's sign,
+ * and s^2 = 1, so by hand
+ *   mu_x = m + d s0 e,  mu_y = m + a d s0 e,
+ *   sigma_x^2 = d^2 (1 - e^2),  sigma_y^2 = a^2 d^2 (1 - e^2),
+ *   sigma_xy = a d^2 (1 - e^2),
+ * and SSIM = l * cs with l = (2 mu_x mu_y + C1) / (mu_x^2 + mu_y^2 + C1),
+ * cs = (2 a d^2 (1 - e^2) + C2) / ((1 + a^2) d^2 (1 - e^2) + C2)
+ * (Wang et al. 2004, Eq. (13)). Checked at every centre whose window lies
+ * inside the image. */
+static void test_checkerboard_contrast_matches_the_closed_form_in_full_windows(void **state)
+{
+    (void)state;
+    const int w = 29, h = 24;
+    const double m = 0.5, d = 0.25, a = 0.5;    /* all values exact in float */
+    rl_image *x = make_image(w, h), *y = make_image(w, h);
+    for (int i = 0; i < h; ++i)
+        for (int j = 0; j < w; ++j) {
+            double sgn = (i + j) % 2 ? -1.0 : 1.0;
+            float vx = (float)(m + d * sgn), vy = (float)(m + a * d * sgn);
+            *rl_image_pixel(x, j, i) = rl_v4(vx, vx, vx, 1);
+            *rl_image_pixel(y, j, i) = rl_v4(vy, vy, vy, 1);
+        }
+    double alt = 0.0, sum = 0.0;
+    for (int t = -5; t <= 5; ++t) {
+        double g = exp(-(double)(t * t) / (2.0 * 1.5 * 1.5));
+        alt += (t % 2 ? -1.0 : 1.0) * g;
+        sum += g;
+    }
+    const double e = (alt / sum) * (alt / sum);
+    const double var = d * d * (1.0 - e * e);
+    const double cs = (2.0 * a * var + C2) / ((1.0 + a * a) * var + C2);
+    float *map = malloc((size_t)w * (size_t)h * sizeof *map);
+    assert_non_null(map);
+    assert_int_equal(rl_image_ssim_map(x, y, &(rl_metric_options){ .linear = true }, map), RL_OK);
+    int checked = 0;
+    for (int i = 5; i < h - 5; ++i)
+        for (int j = 5; j < w - 5; ++j) {
+            double s0 = (i + j) % 2 ? -1.0 : 1.0;
+            double mx = m + d * s0 * e, my = m + a * d * s0 * e;
+            double l = (2.0 * mx * my + C1) / (mx * mx + my * my + C1);
+            assert_near(map[i * w + j], l * cs, 2e-7);
+            ++checked;
+        }
+    assert_int_equal(checked, (w - 10) * (h - 10));
+    free(map);
+    rl_image_release(x);
+    rl_image_release(y);
+}
+
+static void test_multiscale_ssim_of_constant_images_is_the_coarsest_luminance(void **state)
+{
+    (void)state;
+    /* No structure at any level: every c*s is 1, so Eq. (7) of Wang et al.
+     * 2003 leaves l^(beta_L / sum beta) of the coarsest level, and a
+     * constant stays constant through the normalised pyramid filter. */
+    const double a = 0.25, b = 0.75;
+    rl_image *ta = make_image(23, 17), *tb = make_image(23, 17);
+    rl_image_fill(ta, rl_v4((float)a, (float)a, (float)a, 1));
+    rl_image_fill(tb, rl_v4((float)b, (float)b, (float)b, 1));
+    const double l = (2 * a * b + C1) / (a * a + b * b + C1);
+    const double beta[5] = { 0.0448, 0.2856, 0.3001, 0.2363, 0.1333 };
+    double bsum = 0.0;
+    for (int levels = 1; levels <= 5; ++levels) {
+        bsum += beta[levels - 1];
+        rl_image_metrics m;
+        rl_metric_options o = { .linear = true, .ssim_levels = levels };
+        assert_int_equal(rl_image_compare(ta, tb, &o, &m), RL_OK);
+        double want = levels == 1 ? l : pow(l, beta[levels - 1] / bsum);
+        assert_near(m.ssim, want, 1e-12);
+        assert_near(m.rmse, fabs(a - b), 1e-12);    /* the errors stay single-scale */
+    }
+    rl_image_release(ta);
+    rl_image_release(tb);
+}
+
+static void test_multiscale_ssim_agrees_with_the_direct_pyramid(void **state)
+{
+    (void)state;
+    rl_image *t = make_pattern(41, 35, 11u);
+    rl_image *ref = make_distorted(t, 12u);
+    rl_image *same = make_image(41, 35);
+    memcpy(same->color, t->color, 41 * 35 * sizeof *t->color);
+    const rl_metric_options base[] = { { 0 }, { .linear = true }, { .ssim_rgb = true } };
+    for (size_t i = 0; i < sizeof base / sizeof base[0]; ++i)
+        for (int levels = 2; levels <= 5; ++levels) {
+            rl_metric_options o = base[i];
+            o.ssim_levels = levels;
+            rl_image_metrics m;
+            assert_int_equal(rl_image_compare(t, ref, &o, &m), RL_OK);
+            assert_near(m.ssim, oracle_ms_ssim(t, ref, &o, levels), 1e-9);
+            assert_true(m.ssim > 0.0 && m.ssim < 1.0);
+            assert_int_equal(rl_image_compare(t, same, &o, &m), RL_OK);
+            assert_true(m.ssim == 1.0);     /* identical: exactly one */
+        }
+    /* levels 0 and 1 are the single-scale SSIM, bit for bit */
+    rl_image_metrics m0, m1;
+    assert_int_equal(rl_image_compare(t, ref, NULL, &m0), RL_OK);
+    assert_int_equal(rl_image_compare(t, ref, &(rl_metric_options){ .ssim_levels = 1 }, &m1),
+                     RL_OK);
+    assert_true(m0.ssim == m1.ssim);
+    rl_image_release(t);
+    rl_image_release(ref);
+    rl_image_release(same);
+}
+
+static void test_multiscale_options_are_checked(void **state)
+{
+    (void)state;
+    rl_image *a = make_pattern(8, 6, 1u), *b = make_pattern(8, 6, 2u);
+    uint8_t mask[48];
+    memset(mask, 1, sizeof mask);
+    rl_image_metrics m = { .ssim = 42.0 };
+    float map[48] = { 7.0f };
+    assert_int_equal(rl_image_compare(a, b, &(rl_metric_options){ .ssim_levels = -1 }, &m),
+                     RL_ERR_INVALID_ARG);
+    assert_int_equal(rl_image_compare(a, b, &(rl_metric_options){ .ssim_levels = 6 }, &m),
+                     RL_ERR_INVALID_ARG);
+    assert_int_equal(rl_image_compare(a, b, &(rl_metric_options){ .ssim_levels = 3, .mask = mask },
+                                      &m),
+                     RL_ERR_INVALID_ARG);
+    assert_true(m.ssim == 42.0);
+    assert_int_equal(rl_image_ssim_map(a, b, &(rl_metric_options){ .ssim_levels = 2 }, map),
+                     RL_ERR_INVALID_ARG);
+    assert_true(map[0] == 7.0f);
+    /* a level of one pixel is still a valid SSIM window */
+    assert_int_equal(rl_image_compare(a, b, &(rl_metric_options){ .ssim_levels = 5 }, &m), RL_OK);
+    assert_true(m.ssim <= 1.0);
+    rl_clear_error();
+    rl_image_release(a);
+    rl_image_release(b);
+}
+
 static void test_bad_arguments_are_invalid_and_leave_outputs_alone(void **state)
 {
     (void)state;
@@ -492,6 +728,10 @@ int main(void)
         cmocka_unit_test(test_result_does_not_depend_on_thread_count),
         cmocka_unit_test(test_rmse_and_max_abs_follow_their_definitions),
         cmocka_unit_test(test_mask_averages_only_selected_window_centres),
+        cmocka_unit_test(test_checkerboard_contrast_matches_the_closed_form_in_full_windows),
+        cmocka_unit_test(test_multiscale_ssim_of_constant_images_is_the_coarsest_luminance),
+        cmocka_unit_test(test_multiscale_ssim_agrees_with_the_direct_pyramid),
+        cmocka_unit_test(test_multiscale_options_are_checked),
         cmocka_unit_test(test_bad_arguments_are_invalid_and_leave_outputs_alone),
         cmocka_unit_test(test_difference_is_black_where_equal),
     };
