@@ -16,4 +16,8 @@
 #include "rl/rl_metrics.h"
 #include "rl/rl_filter.h"
 #include "rl/rl_shadowmap.h"
+#include "rl/rl_property.h"
+#include "rl/rl_sampling.h"
+#include "rl/rl_stats.h"
+#include "rl/rl_plot.h"
 #endif
