@@ -33,6 +33,8 @@ int rl_cli_info(int argc, char **argv);
 int rl_cli_render(int argc, char **argv);
 int rl_cli_demo(int argc, char **argv);
 int rl_cli_bench(int argc, char **argv);
+int rl_cli_eval(int argc, char **argv);
+int rl_cli_compare(int argc, char **argv);
 
 /* Prints "rl: error: <message>" and returns code. */
 int rl_cli_fail(int code, const char *fmt, ...)

@@ -12,6 +12,7 @@
 #define _POSIX_C_SOURCE 200809L
 #include "bench_pt.h"
 #include "bench_rays.h"
+#include "bench_sampling.h"
 #include "bench_util.h"
 #include "bench_vt.h"
 #include "cli.h"
@@ -29,6 +30,7 @@ static const char bench_help[] =
     "usage: rl bench rays [options]\n"
     "       rl bench vt [options]   Vertex Tracing vs Whitted (see rl bench vt --help)\n"
     "       rl bench pt [options]   Line Space path tracing (see rl bench pt --help)\n"
+    "       rl bench sampling [options]  property sampling, Jaehn 2015 Sec. 5.7\n"
     "\n"
     "Times ray queries of each accelerator on three workloads generated once\n"
     "per scene and shared by all accelerators:\n"
@@ -619,6 +621,8 @@ int rl_cli_bench(int argc, char **argv)
         return rl_bench_vt(argc, argv);
     if (argc >= 2 && strcmp(argv[1], "pt") == 0)
         return rl_bench_pt(argc, argv);
+    if (argc >= 2 && strcmp(argv[1], "sampling") == 0)
+        return rl_bench_sampling(argc, argv);
     bench_args a;
     memset(&a, 0, sizeof a);
     int rc = parse_args(argc, argv, &a);

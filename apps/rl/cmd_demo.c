@@ -2,6 +2,10 @@
  * each, plus DIR/report.json (machine, date, scene and render statistics per
  * image) and DIR/index.html (the same, as a page). `make demo` runs it.
  *
+ * Then a small `rl compare` (Jähn 2015's evaluation: every renderer at the
+ * same adaptively sampled positions) of the first demo scene, or `table`
+ * by default, into DIR/compare/, linked from the page.
+ *
  * A failing scene or renderer does not stop the demo: it is reported as one
  * error line, listed in the report, and the exit code becomes 1. */
 #define _POSIX_C_SOURCE 200809L
@@ -20,13 +24,16 @@ static const char demo_help[] =
     "Renders every built-in scene (rl scenes) with every renderer (rl algos)\n"
     "and writes DIR/<scene>-<algo>.png, DIR/report.json (machine, date and, per\n"
     "image, scene and render statistics) and DIR/index.html (the images and\n"
-    "their statistics on one page). Prints one line per image.\n"
+    "their statistics on one page). Prints one line per image. Then compares\n"
+    "the renderers over a small sampled region of one scene (rl compare) into\n"
+    "DIR/compare/report.html.\n"
     "\n"
     "options:\n"
     "  --out DIR       output folder, created if missing; default out/demo\n"
     "  --size WxH      resolution of every image; default 640x480\n"
     "  --scenes a,b    only these built-in scenes (default parameters)\n"
     "  --algos a,b     only these renderers\n"
+    "  --no-compare    skip the comparison\n"
     "\n"
     "example:\n"
     "  rl demo --out out/demo\n"
@@ -35,6 +42,7 @@ static const char demo_help[] =
 typedef struct demo_args {
     const char *out, *scenes, *algos;
     int width, height;
+    bool no_compare;
 } demo_args;
 
 /* True when name is an item of the comma-separated list (NULL = all). */
@@ -81,6 +89,10 @@ static int parse_args(int argc, char **argv, demo_args *a)
         if (rl_cli_is_help(argv[i])) {
             fputs(demo_help, stdout);
             return -1;
+        }
+        if (strcmp(argv[i], "--no-compare") == 0) {
+            a->no_compare = true;
+            continue;
         }
         if ((m = rl_cli_take_value(argc, argv, &i, "--out", &v)) > 0)
             a->out = v;
@@ -240,6 +252,31 @@ static int run_demo(const demo_args *a, cJSON *report)
     return rc;
 }
 
+/* The small comparison: every demo renderer at the same 24 positions of
+ * one scene, tiny images, one timed render per direction. */
+static int run_compare(const demo_args *a)
+{
+    char scene[256] = "table", algos[1024] = "", out[4096];
+    if (a->scenes) {
+        const char *end = strchr(a->scenes, ',');
+        snprintf(scene, sizeof scene, "%.*s", end ? (int)(end - a->scenes) : (int)strlen(a->scenes),
+                 a->scenes);
+    }
+    size_t nr = 0;
+    const rl_renderer_info *info = rl_renderer_list(&nr);
+    for (size_t k = 0; k < nr; k++)
+        if (in_list(a->algos, info[k].name)) {
+            size_t len = strlen(algos);
+            snprintf(algos + len, sizeof algos - len, "%s%s", len ? "," : "", info[k].name);
+        }
+    if (!*algos)
+        return RL_CLI_OK;
+    snprintf(out, sizeof out, "%s/compare", a->out);
+    char *argv[] = { "compare", scene, "--algos", algos, "--size", "48x48", "--samples", "24",
+                     "--repeats", "1", "--resolution", "32", "--out", out, NULL };
+    return rl_cli_compare((int)(sizeof argv / sizeof argv[0]) - 1, argv);
+}
+
 int rl_cli_demo(int argc, char **argv)
 {
     demo_args a = { .out = "out/demo", .width = 640, .height = 480 };
@@ -268,6 +305,13 @@ int rl_cli_demo(int argc, char **argv)
     cJSON_AddNumberToObject(report, "height", a.height);
 
     rc = run_demo(&a, report);
+    if (!a.no_compare) {
+        int crc = run_compare(&a);
+        if (crc == RL_CLI_OK)
+            cJSON_AddStringToObject(report, "compare", "compare/report.html");
+        else
+            rc = RL_CLI_FAIL;
+    }
     char html[4096];
     snprintf(html, sizeof html, "%s/index.html", a.out);
     if (!rl_cli_write_json(report, probe) || !rl_cli_write_demo_html(report, html))

@@ -4,22 +4,10 @@
  * numbers. Self-contained: inline CSS, no scripts, no external resources;
  * the images are the PNGs next to the page. */
 #include "cli.h"
+#include "html.h"
 
 #include <cjson/cJSON.h>
 #include <string.h>
-
-static void put_escaped(FILE *f, const char *s)
-{
-    for (; s && *s; s++) {
-        switch (*s) {
-        case '<': fputs("&lt;", f); break;
-        case '>': fputs("&gt;", f); break;
-        case '&': fputs("&amp;", f); break;
-        case '"': fputs("&quot;", f); break;
-        default: fputc(*s, f);
-        }
-    }
-}
 
 static const char *str(const cJSON *obj, const char *key)
 {
@@ -54,11 +42,11 @@ static void put_cell(FILE *f, const cJSON *e)
     const cJSON *rs = cJSON_GetObjectItemCaseSensitive(e, "render_stats");
     const cJSON *ss = cJSON_GetObjectItemCaseSensitive(e, "scene_stats");
     fputs("<td><a href=\"", f);
-    put_escaped(f, str(e, "file"));
+    rl_html_put_escaped(f, str(e, "file"));
     fputs("\"><img src=\"", f);
-    put_escaped(f, str(e, "file"));
+    rl_html_put_escaped(f, str(e, "file"));
     fputs("\" alt=\"", f);
-    put_escaped(f, str(e, "file"));
+    rl_html_put_escaped(f, str(e, "file"));
     fprintf(f, "\"></a><br>%.1f ms", num(rs, "time_ms"));
     if (num(rs, "triangles_rasterized") > 0)
         fprintf(f, " &middot; %.0f triangles rasterized", num(rs, "triangles_rasterized"));
@@ -93,17 +81,17 @@ bool rl_cli_write_demo_html(const cJSON *report, const char *path)
           ".s{color:#666}\n</style></head><body>\n<h1>renderlab demo</h1>\n<p>",
           f);
     fputs("renderlab ", f);
-    put_escaped(f, str(report, "renderlab"));
+    rl_html_put_escaped(f, str(report, "renderlab"));
     fputs(" &middot; ", f);
-    put_escaped(f, str(report, "date"));
+    rl_html_put_escaped(f, str(report, "date"));
     fprintf(f, " &middot; %.0fx%.0f<br>machine: ", num(report, "width"), num(report, "height"));
-    put_escaped(f, str(machine, "uname"));
+    rl_html_put_escaped(f, str(machine, "uname"));
     fprintf(f, " &middot; %.0f processors</p>\n", num(machine, "nproc"));
 
     fputs("<table>\n<tr><th>scene</th>", f);
     for (int k = 0; k < num_algos; k++) {
         fputs("<th>", f);
-        put_escaped(f, algos[k]);
+        rl_html_put_escaped(f, algos[k]);
         fputs("</th>", f);
     }
     fputs("</tr>\n", f);
@@ -118,7 +106,7 @@ bool rl_cli_write_demo_html(const cJSON *report, const char *path)
             if (row)
                 fputs("</tr>\n", f);
             fputs("<tr><th>", f);
-            put_escaped(f, scene);
+            rl_html_put_escaped(f, scene);
             fputs("</th>", f);
             row = scene;
             col = 0;
@@ -137,14 +125,20 @@ bool rl_cli_write_demo_html(const cJSON *report, const char *path)
         fputs("<h2>failures</h2>\n<ul>\n", f);
         cJSON_ArrayForEach(e, failures) {
             fputs("<li>", f);
-            put_escaped(f, str(e, "scene"));
+            rl_html_put_escaped(f, str(e, "scene"));
             fputs(" ", f);
-            put_escaped(f, str(e, "algorithm"));
+            rl_html_put_escaped(f, str(e, "algorithm"));
             fputs(": ", f);
-            put_escaped(f, str(e, "error"));
+            rl_html_put_escaped(f, str(e, "error"));
             fputs("</li>\n", f);
         }
         fputs("</ul>\n", f);
+    }
+    if (*str(report, "compare")) {
+        fputs("<p>The renderers compared over a sampled region of the scene (time, rays, "
+              "triangles, image quality; Jähn 2015): <a href=\"", f);
+        rl_html_put_escaped(f, str(report, "compare"));
+        fputs("\">comparison report</a>.</p>\n", f);
     }
     fputs("<p class=\"s\">Data: <a href=\"report.json\">report.json</a></p>\n"
           "</body></html>\n", f);

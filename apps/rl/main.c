@@ -20,7 +20,9 @@ static const command commands[] = {
     { "info", rl_cli_info, "print statistics and cameras of a scene" },
     { "render", rl_cli_render, "render a scene to PNG or EXR" },
     { "demo", rl_cli_demo, "render every built-in scene with every renderer + HTML report" },
-    { "bench", rl_cli_bench, "benchmarks: bench rays (accelerators), bench vt (Vertex Tracing), bench pt (Line Space path tracing)" },
+    { "eval", rl_cli_eval, "approximate a position-dependent property over a region (heat map, statistics)" },
+    { "compare", rl_cli_compare, "compare renderers over a sampled region: time, operations, image quality" },
+    { "bench", rl_cli_bench, "benchmarks: bench rays (accelerators), bench vt (Vertex Tracing), bench pt (Line Space path tracing), bench sampling (property approximation)" },
 };
 
 static void print_usage(FILE *out)
@@ -74,7 +76,7 @@ int main(int argc, char **argv)
 
     if (n == 0)
         return rl_cli_fail(RL_CLI_USAGE, "no command given (commands: scenes, algos, info, "
-                                         "render, demo, bench; see rl --help)");
+                                         "render, demo, eval, compare, bench; see rl --help)");
     const char *name = argv[0];
     if (strcmp(name, "help") == 0 && n > 1) {
         /* "rl help render" is "rl render --help". */

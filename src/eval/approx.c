@@ -48,6 +48,8 @@ void rl_approx_release(rl_approx *a)
     free(a->nodes);
     free(a->leaves);
     free(a->leaf_sets);
+    free(a->leaf_first);
+    free(a->leaf_samples);
     free(a->sample_pos);
     free(a->sample_value);
     free(a->sample_sets);
@@ -397,6 +399,74 @@ rl_status rl_approx_finish(rl_approx *a, uint32_t *const *lists, const uint32_t 
     free(g.stamp);
     free(g.out);
     free(g.stack);
+    return rl_approx_index_samples(a);
+}
+
+/* Calls fn(a, leaf, sample, user) for every leaf whose closed box holds
+ * the sample, descending only into children that hold it. */
+static void for_leaves_holding(const rl_approx *a, uint32_t sample, uint32_t *stack,
+                               void (*fn)(rl_approx *, uint32_t, uint32_t), rl_approx *w)
+{
+    uint32_t top = 0;
+    rl_vec3 p = a->sample_pos[sample];
+    if (a->node_count == 0 || !rl_box_holds(a->nodes[0].box, p))
+        return;
+    stack[top++] = 0;
+    while (top) {
+        const rl_approx_node *nd = &a->nodes[stack[--top]];
+        if (nd->kind == RL_NODE_LEAF) {
+            fn(w, nd->leaf, sample);
+            continue;
+        }
+        for (uint32_t c = 0; c < rl_approx_child_count(a, nd); ++c)
+            if (rl_box_holds(a->nodes[nd->first_child + c].box, p))
+                stack[top++] = nd->first_child + c;
+    }
+}
+
+static void count_sample(rl_approx *a, uint32_t leaf, uint32_t sample)
+{
+    (void)sample;
+    a->leaf_first[leaf + 1]++;
+}
+
+static void place_sample(rl_approx *a, uint32_t leaf, uint32_t sample)
+{
+    /* leaf_first[leaf] is used as the fill cursor, restored afterwards */
+    a->leaf_samples[a->leaf_first[leaf]++] = sample;
+}
+
+rl_status rl_approx_index_samples(rl_approx *a)
+{
+    free(a->leaf_first);
+    free(a->leaf_samples);
+    a->leaf_samples = NULL;
+    a->leaf_first = rl_calloc((size_t)a->leaf_count + 1, sizeof *a->leaf_first);
+    /* The deepest path holds at most one node per level; the stack needs
+     * room for all children of every node on it. */
+    uint32_t *stack = rl_calloc((size_t)a->node_count + 1, sizeof *stack);
+    if (!a->leaf_first || !stack) {
+        free(stack);
+        return RL_ERR_OUT_OF_MEMORY;
+    }
+    for (uint32_t s = 0; s < a->sample_count; ++s)
+        for_leaves_holding(a, s, stack, count_sample, a);
+    for (uint32_t i = 0; i < a->leaf_count; ++i)
+        a->leaf_first[i + 1] += a->leaf_first[i];
+    size_t total = a->leaf_first[a->leaf_count];
+    a->leaf_samples = rl_calloc(total ? total : 1, sizeof *a->leaf_samples);
+    if (!a->leaf_samples) {
+        free(stack);
+        return RL_ERR_OUT_OF_MEMORY;
+    }
+    for (uint32_t s = 0; s < a->sample_count; ++s)
+        for_leaves_holding(a, s, stack, place_sample, a);
+    /* The cursors now stand at each leaf's end, which is the next leaf's
+     * start: shift back by one leaf. */
+    for (uint32_t i = a->leaf_count; i > 0; --i)
+        a->leaf_first[i] = a->leaf_first[i - 1];
+    a->leaf_first[0] = 0;
+    free(stack);
     return RL_OK;
 }
 
@@ -518,9 +588,25 @@ rl_status rl_approx_query(const rl_approx *a, rl_vec3 pos, double *value, uint32
     if (node == RL_APPROX_NONE)
         return rl_error(RL_ERR_NOT_FOUND, "rl_approx_query: (%g, %g, %g) is outside the sampled region",
                         (double)pos.x, (double)pos.y, (double)pos.z);
-    const rl_approx_region *r = &a->leaves[a->nodes[node].leaf];
+    uint32_t leaf = a->nodes[node].leaf;
+    const rl_approx_region *r = &a->leaves[leaf];
     double v = r->value;
-    if (r->linear) {
+    if (!r->linear && a->desc.interpolation == RL_INTERP_NEAREST && a->leaf_first &&
+        a->leaf_first[leaf + 1] > a->leaf_first[leaf]) {
+        /* The nearest sample of the leaf (rl_sampling.h: the Voronoi
+         * alternative); ties go to the lower sample index. */
+        double best = INFINITY;
+        for (uint32_t k = a->leaf_first[leaf]; k < a->leaf_first[leaf + 1]; ++k) {
+            uint32_t s = a->leaf_samples[k];
+            double dx = (double)a->sample_pos[s].x - pos.x, dz = (double)a->sample_pos[s].z - pos.z;
+            double dy = a->dims == 3 ? (double)a->sample_pos[s].y - pos.y : 0.0;
+            double d2 = dx * dx + dy * dy + dz * dz;
+            if (d2 < best) {
+                best = d2;
+                v = a->sample_value[s];
+            }
+        }
+    } else if (r->linear) {
         v = r->offset;
         for (int k = 0; k < rl_approx_axis_count(a->dims); ++k) {
             int ax = rl_approx_axis(a->dims, k);

@@ -116,7 +116,9 @@ static cJSON *save_desc(const rl_sampling_desc *d)
               add(o, "candidates", cJSON_CreateNumber(d->candidates)) &&
               add(o, "combine", cJSON_CreateString(combine_names[d->combine])) &&
               add(o, "seed", cJSON_CreateString(seed)) && add(o, "workers", cJSON_CreateNumber(d->workers)) &&
-              add(o, "linear", cJSON_CreateBool(d->linear));
+              add(o, "linear", cJSON_CreateBool(d->linear)) &&
+              add(o, "interpolation", cJSON_CreateString(d->interpolation == RL_INTERP_REGION
+                                                             ? "region" : "nearest"));
     if (!ok) {
         cJSON_Delete(o);
         return NULL;
@@ -347,7 +349,8 @@ static rl_status load_desc(const loader *l, const cJSON *o, int dims, rl_samplin
 {
     static const char *const keys[] = { "method", "positions", "max_samples", "max_seconds", "min_side",
                                         "samples_base", "samples_per_meter", "candidates", "grid_res",
-                                        "combine", "seed", "workers", "linear", NULL };
+                                        "combine", "seed", "workers", "linear", "interpolation",
+                                        NULL };
     rl_status st = rl_json_check_keys(l->doc, o, "\"desc\"", keys);
     cJSON *c = NULL;
     int e = 0;
@@ -405,6 +408,12 @@ static rl_status load_desc(const loader *l, const cJSON *o, int dims, rl_samplin
         if (!cJSON_IsBool(c))
             return rl_json_error(l->doc, c, "\"linear\": expected true or false");
         d->linear = cJSON_IsTrue(c);
+    }
+    if (st == RL_OK && (st = member(l, o, "interpolation", "\"desc\"", &c)) == RL_OK) {
+        const char *s = cJSON_IsString(c) ? c->valuestring : "";
+        if (strcmp(s, "nearest") != 0 && strcmp(s, "region") != 0)
+            return rl_json_error(l->doc, c, "\"interpolation\": expected \"nearest\" or \"region\"");
+        d->interpolation = strcmp(s, "region") == 0 ? RL_INTERP_REGION : RL_INTERP_NEAREST;
     }
     return st;
 }
@@ -680,6 +689,9 @@ static rl_status load(const loader *l, const cJSON *root, rl_approx **out)
                 a->leaves[a->nodes[i].leaf].box = a->nodes[i].box;
                 a->leaves[a->nodes[i].leaf].depth = a->nodes[i].depth;
             }
+        st = rl_approx_index_samples(a);
+    }
+    if (st == RL_OK) {
         *out = a;
         return RL_OK;
     }

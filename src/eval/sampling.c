@@ -64,8 +64,9 @@ static rl_status resolve(rl_property *p, const rl_sampling_desc *in, rl_sampling
     }
     d->region = r;
     if ((unsigned)d->method > RL_SAMPLING_GRID || (unsigned)d->positions > RL_POSITIONS_GRID ||
-        (unsigned)d->combine > RL_COMBINE_MIN)
-        return rl_error(RL_ERR_INVALID_ARG, "rl_sample_property: unknown method, positions or combine");
+        (unsigned)d->combine > RL_COMBINE_MIN || (unsigned)d->interpolation > RL_INTERP_REGION)
+        return rl_error(RL_ERR_INVALID_ARG,
+                        "rl_sample_property: unknown method, positions, combine or interpolation");
     if (isnan(d->max_seconds) || d->max_seconds < 0.0)
         return rl_error(RL_ERR_INVALID_ARG, "rl_sample_property: max_seconds %g (expected >= 0)",
                         d->max_seconds);

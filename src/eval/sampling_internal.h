@@ -46,6 +46,10 @@ struct rl_approx {
     uint32_t leaf_count;
     uint64_t *leaf_sets;       /* leaf_count * set_words */
 
+    /* Per leaf, the samples in its closed box (CSR: leaf_first[i] ..
+     * leaf_first[i + 1] index leaf_samples); for nearest-sample queries. */
+    uint32_t *leaf_first, *leaf_samples;
+
     rl_vec3 *sample_pos;
     double *sample_value;
     uint64_t *sample_sets;     /* sample_count * set_words */
@@ -121,6 +125,9 @@ rl_status rl_approx_finish(rl_approx *a, uint32_t *const *lists, const uint32_t 
 /* Numbers leaves depth first (sets node.leaf, leaf_count; allocates
  * leaves[] and leaf_sets[] zeroed). Used by finish and by the loader. */
 rl_status rl_approx_number_leaves(rl_approx *a);
+/* Builds leaf_first/leaf_samples from the tree and the samples (closed
+ * boxes). Called by finish and by the loader. */
+rl_status rl_approx_index_samples(rl_approx *a);
 /* Leaf node containing p (closed boxes, the lower child on a boundary);
  * RL_APPROX_NONE outside the root box. For 2-D, p.y is ignored. */
 uint32_t rl_approx_find_leaf(const rl_approx *a, rl_vec3 p);

@@ -614,7 +614,9 @@ static void test_query_on_a_boundary_picks_the_smaller_index(void **state)
     (void)state;
     fn_prop fp = { .f = f_x };
     rl_property *p = make_property(&fp, 1, 0);
-    rl_approx *a = one_split(p, 2, box2(0, 0, 4, 1), 6);
+    rl_approx *a = sample(p, (rl_sampling_desc){ .region = box2(0, 0, 4, 1), .dims = 2, .max_samples = 6,
+                                                 .samples_base = 3.5f, .samples_per_meter = 0.01f,
+                                                 .min_side = 0.01f, .interpolation = RL_INTERP_REGION });
     double v;
     uint32_t leaf = 99;
     assert_int_equal(rl_approx_query(a, (rl_vec3){ 2.0f, -7.0f, 0.5f }, &v, &leaf), RL_OK);
@@ -623,6 +625,24 @@ static void test_query_on_a_boundary_picks_the_smaller_index(void **state)
     assert_int_equal(rl_approx_query(a, (rl_vec3){ 2.0001f, 0, 0.5f }, &v, &leaf), RL_OK);
     assert_int_equal(leaf, 1);
     assert_near(v, 3.0, 1e-12);
+    rl_approx_release(a);
+    /* The default, nearest sample of the leaf: on the boundary the corners
+     * at x = 2 (f = 2) are nearest; inside the left leaf near x = 0, 0. */
+    a = one_split(p, 2, box2(0, 0, 4, 1), 6);
+    assert_int_equal(rl_approx_query(a, (rl_vec3){ 2.0f, 0, 0.5f }, &v, &leaf), RL_OK);
+    assert_int_equal(leaf, 0);
+    assert_near(v, 2.0, 1e-12);
+    assert_int_equal(rl_approx_query(a, (rl_vec3){ 0.2f, 0, 0.1f }, &v, &leaf), RL_OK);
+    assert_near(v, 0.0, 1e-12);
+    assert_near(region(a, 0).value, 1.0, 1e-12); /* region values are unchanged */
+    /* Every sample answers its own position exactly. */
+    for (uint32_t i = 0; i < rl_approx_sample_count(a); ++i) {
+        rl_vec3 sp;
+        double sv;
+        assert_int_equal(rl_approx_sample(a, i, &sp, &sv), RL_OK);
+        assert_int_equal(rl_approx_query(a, sp, &v, NULL), RL_OK);
+        assert_near(v, sv, 1e-12);
+    }
     assert_int_equal(rl_approx_query(a, (rl_vec3){ 4.5f, 0, 0.5f }, &v, &leaf), RL_ERR_NOT_FOUND);
     assert_int_equal(rl_approx_query(a, (rl_vec3){ NAN, 0, 0.5f }, &v, &leaf), RL_ERR_NOT_FOUND);
     rl_clear_error();

@@ -1,0 +1,560 @@
+/* cmd_compare.c: `rl compare SCENE --algos A,B,...`: every given renderer
+ * measured over the same adaptively sampled region (Jähn 2015, Ch. 4-5),
+ * instead of along one hand-picked camera path:
+ *   time      rendering time, max over 6 directions of the median of
+ *             --repeats renders (Def. 6, unconditioned);
+ *   rays      traced rays and
+ *   triangles rasterized triangles (Sec. 4.2.4, max over the directions);
+ *   quality   SSIM against --reference, min over the directions (Def. 7).
+ * The sample positions are chosen once, by adaptive sampling of pixel
+ * visibility (the property whose structure most others follow, Sec. 5.7),
+ * and every renderer is measured at exactly those positions, so the
+ * comparisons are paired. Writes DIR/compare.json and DIR/report.html with
+ * side-by-side heat maps (shared colour range per metric) and violin plots.
+ * Renderers come from the registry by name, so a new renderer needs no
+ * change here. */
+#define _POSIX_C_SOURCE 200809L
+#include "bench_util.h"
+#include "cli.h"
+#include "eval_common.h"
+
+#include <cjson/cJSON.h>
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+static const char compare_help_head[] =
+    "usage: rl compare SCENE --algos A[:k=v,...],B,... [options]\n"
+    "\n"
+    "Measures every renderer at the same positions, chosen by adaptive sampling\n"
+    "of pixel visibility over a region of the scene, and writes DIR/compare.json\n"
+    "and DIR/report.html: heat maps side by side, violin plots and weighted\n"
+    "statistics of rendering time, traced rays, rasterized triangles and SSIM\n"
+    "against the reference.\n"
+    "\n"
+    "options:\n"
+    "  --algos LIST        renderers (rl algos), each optionally with options:\n"
+    "                      pt:shadow=ls-pnmt,diffuse=ls-pnmt,whitted (a k=v item\n"
+    "                      after a comma continues the previous renderer's options)\n"
+    "  --reference A[:k=v] the exact reference for quality; default whitted\n"
+    "  --metrics LIST      time, rays, triangles, quality; default all\n"
+    "  --size WxH          image per direction; default 128x128\n"
+    "  --fov DEG           field of view per direction; default 120 (Sec. 4.2.3)\n"
+    "  --repeats N         renders per direction for time (median); default 3\n"
+    "  --resolution N      cube-face resolution of the visibility that places\n"
+    "                      the samples; default 128\n"
+    "  --out DIR           output folder; default out/compare\n"
+    "\n";
+static const char compare_help_tail[] =
+    "\n"
+    "example:\n"
+    "  rl compare cornell --algos raster,whitted,vt,pt:spp=1 --samples 64 --out out/cmp\n";
+
+#define MAX_ALGOS 16
+enum { M_TIME, M_RAYS, M_TRIANGLES, M_QUALITY, M_COUNT };
+static const char *const metric_names[M_COUNT] = { "time", "rays", "triangles", "quality" };
+static const char *const metric_titles[M_COUNT] = {
+    "Rendering time (Def. 6)", "Traced rays (Sec. 4.2.4)", "Rasterized triangles (Sec. 4.2.4)",
+    "Image quality against the reference (Def. 7)"
+};
+
+typedef struct algo_spec {
+    char *label;          /* as given: "pt:shadow=ls-pnmt" */
+    char *name;           /* "pt" */
+    char *options;        /* "shadow=ls-pnmt" or NULL */
+} algo_spec;
+
+typedef struct compare_args {
+    const char *scene, *out;
+    algo_spec algos[MAX_ALGOS];
+    int num_algos;
+    algo_spec reference;
+    unsigned metrics;
+    int width, height;
+    double fov_deg;
+    long long repeats, resolution;
+    rl_eval_sampling sampling;
+} compare_args;
+
+static void free_spec(algo_spec *s)
+{
+    free(s->label);
+    free(s->name);
+    free(s->options);
+    memset(s, 0, sizeof *s);
+}
+
+static void free_args(compare_args *a)
+{
+    for (int i = 0; i < a->num_algos; i++)
+        free_spec(&a->algos[i]);
+    free_spec(&a->reference);
+}
+
+static bool known_renderer(const char *name)
+{
+    size_t n = 0;
+    const rl_renderer_info *info = rl_renderer_list(&n);
+    for (size_t i = 0; i < n; i++)
+        if (strcmp(info[i].name, name) == 0)
+            return true;
+    return false;
+}
+
+/* Splits "name[:k=v,...]" into a spec; checks the renderer and its options
+ * by creating it once. */
+static bool make_spec(const char *text, algo_spec *s)
+{
+    s->label = strdup(text);
+    const char *colon = strchr(text, ':');
+    s->name = colon ? strndup(text, (size_t)(colon - text)) : strdup(text);
+    s->options = colon && colon[1] ? strdup(colon + 1) : NULL;
+    if (!s->label || !s->name || (colon && colon[1] && !s->options)) {
+        rl_cli_fail(RL_CLI_FAIL, "out of memory");
+        return false;
+    }
+    rl_renderer *r = NULL;
+    rl_status st = rl_renderer_create(s->name, &r);
+    if (st != RL_OK || !known_renderer(s->name)) {
+        rl_renderer_release(r);
+        rl_cli_fail_status(RL_CLI_USAGE, st, "--algos");
+        return false;
+    }
+    /* The options are checked here, not after minutes of sampling. */
+    char *opts = s->options ? strdup(s->options) : NULL, *save = NULL;
+    for (char *kv = opts ? strtok_r(opts, ",", &save) : NULL; kv && st == RL_OK;
+         kv = strtok_r(NULL, ",", &save)) {
+        char *eq = strchr(kv, '=');
+        if (!eq) {
+            rl_cli_fail(RL_CLI_USAGE, "%s: expected key=value, got '%s'", s->label, kv);
+            st = RL_ERR_INVALID_ARG;
+            break;
+        }
+        *eq = '\0';
+        if ((st = rl_renderer_set(r, kv, eq + 1)) != RL_OK)
+            rl_cli_fail_status(RL_CLI_USAGE, st, s->label);
+    }
+    free(opts);
+    rl_renderer_release(r);
+    return st == RL_OK;
+}
+
+static bool parse_algos(const char *list, compare_args *a)
+{
+    char *copy = strdup(list);
+    if (!copy) {
+        rl_cli_fail(RL_CLI_FAIL, "out of memory");
+        return false;
+    }
+    char item[1024] = "";
+    bool ok = true;
+    char *save = NULL;
+    for (char *tok = strtok_r(copy, ",", &save); ok; tok = strtok_r(NULL, ",", &save)) {
+        /* A k=v item (no ':' before its '=') continues the options of the
+         * item before it; "pt:spp=1" starts a new renderer. */
+        const char *eq = tok ? strchr(tok, '=') : NULL, *colon = tok ? strchr(tok, ':') : NULL;
+        if (eq && (!colon || colon > eq) && *item) {
+            size_t len = strlen(item);
+            snprintf(item + len, sizeof item - len, "%s%s", strchr(item, ':') ? "," : ":", tok);
+            continue;
+        }
+        if (*item) {
+            if (a->num_algos == MAX_ALGOS) {
+                rl_cli_fail(RL_CLI_USAGE, "--algos: at most %d renderers", MAX_ALGOS);
+                ok = false;
+                break;
+            }
+            ok = make_spec(item, &a->algos[a->num_algos++]);
+        }
+        if (!tok)
+            break;
+        snprintf(item, sizeof item, "%s", tok);
+    }
+    free(copy);
+    if (ok && a->num_algos == 0) {
+        rl_cli_fail(RL_CLI_USAGE, "--algos: no renderer given");
+        ok = false;
+    }
+    return ok;
+}
+
+static int parse_args(int argc, char **argv, compare_args *a)
+{
+    rl_eval_sampling_init(&a->sampling);
+    a->sampling.desc.max_samples = 64;
+    a->out = "out/compare";
+    a->metrics = (1u << M_COUNT) - 1;
+    a->width = a->height = 128;
+    a->fov_deg = 120.0;
+    a->repeats = 3;
+    a->resolution = 128;
+    const char *algos = NULL, *reference = "whitted";
+    for (int i = 1; i < argc; i++) {
+        const char *v = NULL;
+        int m;
+        if (rl_cli_is_help(argv[i])) {
+            fputs(compare_help_head, stdout);
+            fputs(rl_eval_sampling_help, stdout);
+            fputs(compare_help_tail, stdout);
+            return -1;
+        }
+        if ((m = rl_eval_sampling_arg(argc, argv, &i, &a->sampling)) != 0) {
+            if (m < 0)
+                return RL_CLI_USAGE;
+            continue;
+        }
+#define VALUE(name) (m == 0 && (m = rl_cli_take_value(argc, argv, &i, name, &v)) > 0)
+        m = 0;
+        if (VALUE("--algos"))
+            algos = v;
+        else if (VALUE("--reference"))
+            reference = v;
+        else if (VALUE("--out"))
+            a->out = v;
+        else if (VALUE("--metrics")) {
+            if (!rl_bench_parse_sections(v, metric_names, M_COUNT, &a->metrics))
+                return RL_CLI_USAGE;
+        } else if (VALUE("--size")) {
+            if (!rl_cli_parse_size(v, &a->width, &a->height))
+                return RL_CLI_USAGE;
+        } else if (VALUE("--fov")) {
+            char *end = NULL;
+            a->fov_deg = strtod(v, &end);
+            if (!*v || *end || !(a->fov_deg > 0.0 && a->fov_deg < 180.0))
+                return rl_cli_fail(RL_CLI_USAGE, "--fov: expected degrees in (0, 180), got '%s'", v);
+        } else if (VALUE("--repeats")) {
+            if (!rl_bench_parse_count("--repeats", v, 1000, &a->repeats))
+                return RL_CLI_USAGE;
+        } else if (VALUE("--resolution")) {
+            if (!rl_bench_parse_count("--resolution", v, 4096, &a->resolution))
+                return RL_CLI_USAGE;
+        } else if (m == 0 && argv[i][0] != '-' && !a->scene)
+            a->scene = argv[i];
+        else if (m == 0)
+            return rl_cli_unknown_arg("compare", argv[i]);
+#undef VALUE
+        if (m < 0)
+            return RL_CLI_USAGE;
+    }
+    if (!a->scene)
+        return rl_cli_fail(RL_CLI_USAGE, "compare: no scene given (see rl compare --help)");
+    if (!algos)
+        return rl_cli_fail(RL_CLI_USAGE, "compare: no --algos given (see rl algos)");
+    if (!parse_algos(algos, a) || !make_spec(reference, &a->reference))
+        return RL_CLI_USAGE;
+    return RL_CLI_OK;
+}
+
+/* The property of metric m for renderer s (NULL with the error printed). */
+static rl_property *metric_property(const compare_args *a, int m, const algo_spec *s)
+{
+    rl_property *p = NULL;
+    char num[32];
+    rl_status st = rl_property_create(m == M_TIME ? "time" : m == M_QUALITY ? "quality" : "ops", &p);
+#define SET(k, v) if (st == RL_OK) st = rl_property_set(p, k, v)
+    SET("renderer", s->name);
+    if (s->options)
+        SET("renderer_options", s->options);
+    snprintf(num, sizeof num, "%d", a->width);
+    SET("width", num);
+    snprintf(num, sizeof num, "%d", a->height);
+    SET("height", num);
+    snprintf(num, sizeof num, "%g", a->fov_deg);
+    SET("fov_deg", num);
+    if (m == M_TIME) {
+        snprintf(num, sizeof num, "%lld", a->repeats);
+        SET("repeats", num);
+    } else if (m == M_RAYS || m == M_TRIANGLES) {
+        SET("counter", m == M_RAYS ? "rays" : "triangles");
+    } else if (m == M_QUALITY) {
+        SET("reference", a->reference.name);
+        if (a->reference.options)
+            SET("reference_options", a->reference.options);
+    }
+#undef SET
+    if (st != RL_OK) {
+        rl_cli_fail_status(RL_CLI_USAGE, st, s->label);
+        rl_property_release(p);
+        return NULL;
+    }
+    return p;
+}
+
+typedef struct measured {
+    rl_approx *approx;   /* the driver's tree with this renderer's values */
+    rl_stats stats;
+    bool ok;
+    char error[256];
+} measured;
+
+static bool sampling_progress(void *user, double done) { return rl_progress_update(user, done); }
+
+static void put_metric_section(rl_html *h, const compare_args *a, int m, measured (*res)[M_COUNT],
+                               const rl_image *top, float height)
+{
+    /* Renderers that never do this operation (a rasterizer traces no ray)
+     * are left out of its plots rather than shown as a flat zero. */
+    int shown[MAX_ALGOS], ns = 0;
+    double lo = INFINITY, hi = -INFINITY;
+    for (int i = 0; i < a->num_algos; i++) {
+        if (!res[i][m].ok)
+            continue;
+        if ((m == M_RAYS || m == M_TRIANGLES) && res[i][m].stats.max <= 0.0)
+            continue;
+        shown[ns++] = i;
+        lo = fmin(lo, res[i][m].stats.min);
+        hi = fmax(hi, res[i][m].stats.max);
+    }
+    rl_html_heading(h, 2, metric_titles[m]);
+    if (ns == 0) {
+        rl_html_para(h, "No renderer has values for this metric.");
+        return;
+    }
+    static const char *const head[] = { "renderer", "min", "25 %", "median", "75 %", "max", "mean" };
+    rl_html_table_begin(h, head, 7);
+    for (int k = 0; k < ns; k++) {
+        char cells[7][32];
+        const char *row[7];
+        rl_eval_stats_cells(&res[shown[k]][m].stats, cells);
+        snprintf(cells[0], sizeof cells[0], "%.31s", a->algos[shown[k]].label);
+        for (int c = 0; c < 7; c++)
+            row[c] = cells[c];
+        rl_html_table_row(h, row, 7);
+    }
+    rl_html_table_end(h);
+    /* One violin per renderer on a shared axis, then the heat maps side by
+     * side with one colour range, so colours compare across renderers. */
+    rl_plot_series series[MAX_ALGOS];
+    double *vals[MAX_ALGOS] = { 0 }, *wts[MAX_ALGOS] = { 0 };
+    size_t cnt[MAX_ALGOS] = { 0 };
+    for (int k = 0; k < ns; k++) {
+        rl_eval_leaf_series(res[shown[k]][m].approx, &vals[k], &wts[k], &cnt[k]);
+        series[k] = (rl_plot_series){ a->algos[shown[k]].label, vals[k], wts[k], cnt[k] };
+    }
+    char *violin = NULL;
+    rl_plot_style vs = { .width = 140 + 110 * ns, .height = 420, .title = metric_names[m],
+                         .y_label = rl_approx_unit(res[shown[0]][m].approx) };
+    if (rl_plot_violin(series, (size_t)ns, &vs, &(rl_plot_output){ .svg = &violin }) != RL_OK)
+        violin = NULL;
+    rl_html_svg(h, violin, "Area/volume-weighted distributions over the region, one violin "
+                           "per renderer, with box plots inside.");
+    free(violin);
+    rl_html_row_begin(h);
+    bool reverse = m != M_QUALITY;   /* dark = expensive or bad */
+    for (int k = 0; k < ns; k++) {
+        char *svg = rl_eval_heatmap_svg(res[shown[k]][m].approx, height, top,
+                                        a->algos[shown[k]].label, lo, hi > lo ? hi : lo + 1e-9,
+                                        reverse, NULL);
+        rl_html_svg(h, svg, NULL);
+        free(svg);
+        free(vals[k]);
+        free(wts[k]);
+    }
+    rl_html_row_end(h);
+}
+
+static cJSON *result_json(const compare_args *a, const rl_scene *scene, const rl_approx *driver,
+                          measured (*res)[M_COUNT])
+{
+    cJSON *root = cJSON_CreateObject();
+    if (!root)
+        return NULL;
+    cJSON_AddStringToObject(root, "renderlab", RL_CLI_VERSION);
+    cJSON_AddStringToObject(root, "scene", a->scene);
+    cJSON_AddItemToObject(root, "scene_stats", rl_cli_scene_stats_json(scene));
+    cJSON_AddItemToObject(root, "sampling", rl_eval_desc_json(&a->sampling.desc));
+    cJSON_AddNumberToObject(root, "samples", rl_approx_sample_count(driver));
+    cJSON_AddNumberToObject(root, "regions", rl_approx_region_count(driver));
+    cJSON_AddStringToObject(root, "reference", a->reference.label);
+    cJSON_AddNumberToObject(root, "width", a->width);
+    cJSON_AddNumberToObject(root, "height", a->height);
+    cJSON_AddNumberToObject(root, "fov_deg", a->fov_deg);
+    cJSON_AddNumberToObject(root, "repeats", (double)a->repeats);
+    cJSON *algos = cJSON_AddArrayToObject(root, "renderers");
+    for (int i = 0; i < a->num_algos; i++) {
+        cJSON *o = cJSON_CreateObject();
+        cJSON_AddStringToObject(o, "renderer", a->algos[i].label);
+        for (int m = 0; m < M_COUNT; m++) {
+            if (!(a->metrics & (1u << m)))
+                continue;
+            if (res[i][m].ok) {
+                cJSON *s = rl_eval_stats_json(&res[i][m].stats);
+                cJSON_AddStringToObject(s, "unit", rl_approx_unit(res[i][m].approx));
+                cJSON_AddItemToObject(o, metric_names[m], s);
+            } else {
+                cJSON *s = cJSON_AddObjectToObject(o, metric_names[m]);
+                cJSON_AddStringToObject(s, "error", res[i][m].error);
+            }
+        }
+        cJSON_AddItemToArray(algos, o);
+    }
+    return root;
+}
+
+int rl_cli_compare(int argc, char **argv)
+{
+    compare_args a = { 0 };
+    int rc = parse_args(argc, argv, &a);
+    if (rc != RL_CLI_OK) {
+        free_args(&a);
+        return rc < 0 ? RL_CLI_OK : rc;
+    }
+    char report[4096], json_path[4096];
+    snprintf(report, sizeof report, "%s/report.html", a.out);
+    snprintf(json_path, sizeof json_path, "%s/compare.json", a.out);
+    rl_scene *scene = NULL;
+    rl_property *vis = NULL;
+    rl_approx *driver = NULL;
+    rl_vec3 *pos = NULL;
+    rl_image *top = NULL;
+    measured (*res)[M_COUNT] = calloc(MAX_ALGOS, sizeof *res);
+    if (!res) {
+        rc = rl_cli_fail(RL_CLI_FAIL, "out of memory");
+        goto done;
+    }
+    /* Everything a typo can break is checked before the long part. */
+    for (int i = 0; i < a.num_algos; i++)
+        for (int m = 0; m < M_COUNT; m++) {
+            rl_property *p = (a.metrics & (1u << m)) ? metric_property(&a, m, &a.algos[i]) : NULL;
+            if ((a.metrics & (1u << m)) && !p) {
+                rc = RL_CLI_USAGE;
+                goto done;
+            }
+            rl_property_release(p);
+        }
+    if (!rl_cli_make_dirs(a.out) || !rl_cli_check_writable(report)) {
+        rc = RL_CLI_FAIL;
+        goto done;
+    }
+    if ((rc = rl_cli_load_scene(a.scene, &scene)) != RL_CLI_OK)
+        goto done;
+    if (!rl_eval_sampling_finish(&a.sampling, scene)) {
+        rc = RL_CLI_USAGE;
+        goto done;
+    }
+    char num[32];
+    snprintf(num, sizeof num, "%lld", a.resolution);
+    rl_status st = rl_property_create("visibility", &vis);
+    if (st == RL_OK)
+        st = rl_property_set(vis, "resolution", num);
+    if (st == RL_OK)
+        st = rl_property_commit(vis, scene, a.sampling.desc.workers);
+    rl_progress *progress = NULL;
+    if (st == RL_OK && rl_log_get_level() >= RL_LOG_INFO)
+        rl_progress_create("placing samples", stderr, &progress);
+    a.sampling.desc.progress = progress ? sampling_progress : NULL;
+    a.sampling.desc.progress_user = progress;
+    if (st == RL_OK)
+        st = rl_sample_property(vis, &a.sampling.desc, &driver);
+    if (progress)
+        rl_progress_finish(progress);
+    a.sampling.desc.progress = NULL;
+    if (st != RL_OK) {
+        rc = rl_cli_fail_status(RL_CLI_FAIL, st, "sampling");
+        goto done;
+    }
+    uint32_t ns = rl_approx_sample_count(driver);
+    pos = malloc(ns * sizeof *pos);
+    if (!pos) {
+        rc = rl_cli_fail(RL_CLI_FAIL, "out of memory");
+        goto done;
+    }
+    for (uint32_t k = 0; k < ns; k++) {
+        double v;
+        rl_approx_sample(driver, k, &pos[k], &v);
+    }
+    int failures = 0;
+    for (int i = 0; i < a.num_algos; i++) {
+        for (int m = 0; m < M_COUNT; m++) {
+            if (!(a.metrics & (1u << m)))
+                continue;
+            measured *r = &res[i][m];
+            rl_property *p = metric_property(&a, m, &a.algos[i]);
+            double *values = NULL, *v2 = NULL, *w2 = NULL;
+            size_t n2 = 0;
+            char label[300];
+            snprintf(label, sizeof label, "%s %s", a.algos[i].label, metric_names[m]);
+            rl_clear_error();
+            st = p ? rl_property_commit(p, scene, a.sampling.desc.workers) : RL_ERR_INVALID_ARG;
+            if (st == RL_OK)
+                st = rl_eval_measure(p, pos, ns, &values, label);
+            if (st == RL_OK)
+                st = rl_approx_with_values(driver, values, metric_names[m], rl_property_unit(p),
+                                           &r->approx);
+            if (st == RL_OK && !rl_eval_leaf_series(r->approx, &v2, &w2, &n2))
+                st = RL_ERR_OUT_OF_MEMORY;
+            if (st == RL_OK)
+                st = rl_stats_compute(v2, w2, n2, &r->stats);
+            r->ok = st == RL_OK;
+            if (!r->ok) {
+                snprintf(r->error, sizeof r->error, "%s",
+                         *rl_last_error() ? rl_last_error() : rl_status_string(st));
+                fprintf(stderr, "rl: warning: %s: %s\n", label, r->error);
+                failures++;
+            } else if (rl_log_get_level() >= RL_LOG_INFO) {
+                fprintf(stderr, "%s: mean %.4g %s, median %.4g, max %.4g\n", label, r->stats.mean,
+                        rl_property_unit(p), r->stats.q[2], r->stats.max);
+            }
+            free(values);
+            free(v2);
+            free(w2);
+            rl_property_release(p);
+        }
+    }
+    cJSON *root = result_json(&a, scene, driver, res);
+    bool ok = root && rl_cli_write_json(root, json_path);
+    cJSON_Delete(root);
+    if (!ok) {
+        rc = RL_CLI_FAIL;
+        goto done;
+    }
+    char title[256];
+    snprintf(title, sizeof title, "rl compare: %s", a.scene);
+    rl_html *h = rl_html_begin(report, title);
+    if (!h) {
+        rc = RL_CLI_FAIL;
+        goto done;
+    }
+    const rl_sampling_desc *d = &a.sampling.desc;
+    rl_aabb b = rl_approx_bounds(driver);
+    top = rl_eval_top_view(scene, b, d->height, 512);
+    rl_html_para(h, "%d renderers measured at the same %u positions (%s, %s sampling of pixel "
+                 "visibility at %lld² per cube face, %u regions). Per position: 6 directions, "
+                 "%dx%d pixels, %g° field of view; time is the maximum over the directions of "
+                 "the median of %lld renders; quality is SSIM against %s, the minimum over the "
+                 "directions (Jähn 2015, Ch. 4). Statistics are weighted by region %s.",
+                 a.num_algos, ns, d->dims == 2 ? "a 2-D slice" : "a 3-D region",
+                 d->method == RL_SAMPLING_GRID ? "grid" : "adaptive", a.resolution,
+                 rl_approx_region_count(driver), a.width, a.height, a.fov_deg, a.repeats,
+                 a.reference.label, d->dims == 2 ? "area" : "volume");
+    char *vis_svg = rl_eval_heatmap_svg(driver, d->height, top, "visible objects", 0, 0, false, NULL);
+    rl_html_svg(h, vis_svg, "Where the samples are: the visibility approximation that placed "
+                            "them (adaptive sampling refines where visibility changes).");
+    free(vis_svg);
+    for (int m = 0; m < M_COUNT; m++)
+        if (a.metrics & (1u << m))
+            put_metric_section(h, &a, m, res, top, d->height);
+    rl_html_para(h, "Data: compare.json.");
+    if (!rl_html_end(h, report)) {
+        rc = RL_CLI_FAIL;
+        goto done;
+    }
+    printf("compared %d renderers at %u positions of %s; wrote %s, %s\n", a.num_algos, ns, a.scene,
+           json_path, report);
+    rc = failures ? rl_cli_fail(RL_CLI_FAIL, "%d measurement%s failed (see the warnings)", failures,
+                                failures == 1 ? "" : "s")
+                  : RL_CLI_OK;
+done:
+    if (res)
+        for (int i = 0; i < MAX_ALGOS; i++)
+            for (int m = 0; m < M_COUNT; m++)
+                rl_approx_release(res[i][m].approx);
+    free(res);
+    free(pos);
+    rl_image_release(top);
+    rl_approx_release(driver);
+    rl_property_release(vis);
+    rl_scene_release(scene);
+    free_args(&a);
+    return rc;
+}

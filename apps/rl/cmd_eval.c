@@ -1,0 +1,434 @@
+/* cmd_eval.c: `rl eval SCENE --property NAME`: a position-dependent property
+ * (Jähn 2015, Ch. 4) approximated over a 2-D slice or a 3-D region by
+ * adaptive or grid sampling (Ch. 5), evaluated as in Sec. 5.6: region
+ * statistics weighted by area/volume, a heat map over the scene's top view,
+ * a violin plot and a histogram of the region values, and, with
+ * --validate N, the error at N uniform random positions (Sec. 5.7) with a
+ * correlation plot. Writes DIR/approx.json (the approximation, loadable with
+ * rl_approx_load_json), DIR/eval.json (the numbers) and a self-contained
+ * HTML report. */
+#define _POSIX_C_SOURCE 200809L
+#include "bench_util.h"
+#include "cli.h"
+#include "eval_common.h"
+
+#include <cjson/cJSON.h>
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+static const char eval_help_head[] =
+    "usage: rl eval SCENE --property NAME [options]\n"
+    "       rl eval --list      the properties and their options\n"
+    "\n"
+    "Approximates a position-dependent property over a region of the scene\n"
+    "and writes DIR/approx.json, DIR/eval.json and an HTML report with a heat\n"
+    "map, a violin plot and a histogram of the area-weighted region values.\n"
+    "\n"
+    "options:\n"
+    "  --property NAME     visibility, time, ops or quality (see --list)\n"
+    "  --set KEY=VALUE     property option, repeatable (e.g. resolution=256,\n"
+    "                      renderer=whitted, renderer_options=max_depth=2)\n"
+    "  --validate N        also measure at N uniform random positions and report\n"
+    "                      the absolute error of the approximation there\n"
+    "  --out DIR           output folder, created if missing; default out/eval\n"
+    "  --report FILE.html  default DIR/report.html\n"
+    "\n";
+static const char eval_help_tail[] =
+    "\n"
+    "example:\n"
+    "  rl eval city --property visibility --set resolution=256 --height 1.7 \\\n"
+    "     --samples 512 --validate 200 --out out/eval-city\n";
+
+#define MAX_SETS 64
+
+typedef struct eval_args {
+    const char *scene, *property, *out, *report;
+    const char *sets[MAX_SETS];
+    int num_sets;
+    long long validate;
+    bool list;
+    rl_eval_sampling sampling;
+} eval_args;
+
+static void print_help(void)
+{
+    fputs(eval_help_head, stdout);
+    fputs(rl_eval_sampling_help, stdout);
+    fputs(eval_help_tail, stdout);
+}
+
+static int print_list(void)
+{
+    size_t n = 0;
+    const rl_property_info *info = rl_property_list(&n);
+    for (size_t i = 0; i < n; i++) {
+        printf("%s: %s%s%s%s\n", info[i].name, info[i].description,
+               *info[i].reference ? " (" : "", info[i].reference, *info[i].reference ? ")" : "");
+        rl_property *p = NULL;
+        if (rl_property_create(info[i].name, &p) != RL_OK)
+            continue;
+        size_t no = 0;
+        const rl_option_info *o = rl_property_options(p, &no);
+        for (size_t k = 0; k < no; k++)
+            printf("  %-20s %s (default %s)\n", o[k].key, o[k].help, o[k].default_value);
+        rl_property_release(p);
+    }
+    return RL_CLI_OK;
+}
+
+static int parse_args(int argc, char **argv, eval_args *a)
+{
+    rl_eval_sampling_init(&a->sampling);
+    a->out = "out/eval";
+    for (int i = 1; i < argc; i++) {
+        const char *v = NULL;
+        int m;
+        if (rl_cli_is_help(argv[i])) {
+            print_help();
+            return -1;
+        }
+        if (strcmp(argv[i], "--list") == 0) {
+            a->list = true;
+            continue;
+        }
+        if ((m = rl_eval_sampling_arg(argc, argv, &i, &a->sampling)) != 0) {
+            if (m < 0)
+                return RL_CLI_USAGE;
+            continue;
+        }
+        if ((m = rl_cli_take_value(argc, argv, &i, "--property", &v)) > 0)
+            a->property = v;
+        else if (m == 0 && (m = rl_cli_take_value(argc, argv, &i, "--out", &v)) > 0)
+            a->out = v;
+        else if (m == 0 && (m = rl_cli_take_value(argc, argv, &i, "--report", &v)) > 0)
+            a->report = v;
+        else if (m == 0 && (m = rl_cli_take_value(argc, argv, &i, "--set", &v)) > 0) {
+            if (a->num_sets == MAX_SETS)
+                return rl_cli_fail(RL_CLI_USAGE, "--set: at most %d options", MAX_SETS);
+            a->sets[a->num_sets++] = v;
+        } else if (m == 0 && (m = rl_cli_take_value(argc, argv, &i, "--validate", &v)) > 0) {
+            if (!rl_bench_parse_count("--validate", v, 1 << 20, &a->validate))
+                return RL_CLI_USAGE;
+        } else if (m == 0 && argv[i][0] != '-' && !a->scene)
+            a->scene = argv[i];
+        else if (m == 0)
+            return rl_cli_unknown_arg("eval", argv[i]);
+        if (m < 0)
+            return RL_CLI_USAGE;
+    }
+    if (a->list)
+        return RL_CLI_OK;
+    if (!a->scene)
+        return rl_cli_fail(RL_CLI_USAGE, "eval: no scene given (see rl eval --help)");
+    if (!a->property)
+        return rl_cli_fail(RL_CLI_USAGE, "eval: no --property given (see rl eval --list)");
+    static const char *const html[] = { ".html", ".htm", NULL };
+    if (a->report && !rl_cli_has_extension(a->report, html))
+        return rl_cli_fail(RL_CLI_USAGE, "--report: expected a .html file, got '%s'", a->report);
+    return RL_CLI_OK;
+}
+
+/* The property with its --set options applied; usage errors are exit 2. */
+static int make_property(const eval_args *a, rl_property **out)
+{
+    rl_status st = rl_property_create(a->property, out);
+    if (st != RL_OK)
+        return rl_cli_fail_status(RL_CLI_USAGE, st, "--property");
+    for (int k = 0; k < a->num_sets; k++) {
+        const char *eq = strchr(a->sets[k], '=');
+        char key[128];
+        if (!eq || eq == a->sets[k] || (size_t)(eq - a->sets[k]) >= sizeof key) {
+            rl_property_release(*out);
+            *out = NULL;
+            return rl_cli_fail(RL_CLI_USAGE, "--set: expected KEY=VALUE, got '%s'", a->sets[k]);
+        }
+        memcpy(key, a->sets[k], (size_t)(eq - a->sets[k]));
+        key[eq - a->sets[k]] = '\0';
+        st = rl_property_set(*out, key, eq + 1);
+        if (st != RL_OK) {
+            rl_property_release(*out);
+            *out = NULL;
+            return rl_cli_fail_status(RL_CLI_USAGE, st, "--set");
+        }
+    }
+    return RL_CLI_OK;
+}
+
+static bool sampling_progress(void *user, double done)
+{
+    return rl_progress_update(user, done);
+}
+
+typedef struct eval_result {
+    rl_stats stats;
+    bool validated;
+    rl_stats error;
+    double correlation;
+    double *measured, *approximated;
+    size_t num_validated;
+} eval_result;
+
+static int validate(const eval_args *a, rl_property *p, const rl_approx *ap, eval_result *r)
+{
+    size_t n = (size_t)a->validate;
+    rl_vec3 *pos = rl_eval_random_positions(ap, n, a->sampling.desc.seed + 0x9e3779b9ULL);
+    double *approx = malloc(n * sizeof *approx), *err = malloc(n * sizeof *err);
+    if (!pos || !approx || !err) {
+        free(pos);
+        free(approx);
+        free(err);
+        return rl_cli_fail(RL_CLI_FAIL, "out of memory");
+    }
+    double *measured = NULL;
+    rl_status st = rl_eval_measure(p, pos, n, &measured, "validation");
+    for (size_t i = 0; st == RL_OK && i < n; i++) {
+        st = rl_approx_query(ap, pos[i], &approx[i], NULL);
+        err[i] = fabs(approx[i] - measured[i]);
+    }
+    if (st == RL_OK)
+        st = rl_stats_compute(err, NULL, n, &r->error);
+    r->correlation = NAN;
+    if (st == RL_OK && n >= 2 && rl_stats_correlation(measured, approx, n, &r->correlation) != RL_OK)
+        rl_clear_error();    /* a constant property has no correlation */
+    free(pos);
+    free(err);
+    if (st != RL_OK) {
+        free(measured);
+        free(approx);
+        return rl_cli_fail_status(RL_CLI_FAIL, st, "validation");
+    }
+    r->validated = true;
+    r->measured = measured;
+    r->approximated = approx;
+    r->num_validated = n;
+    return RL_CLI_OK;
+}
+
+static cJSON *result_json(const eval_args *a, const rl_scene *scene, const rl_property *p,
+                          const rl_approx *ap, const eval_result *r)
+{
+    cJSON *root = cJSON_CreateObject();
+    if (!root)
+        return NULL;
+    cJSON_AddStringToObject(root, "renderlab", RL_CLI_VERSION);
+    cJSON_AddStringToObject(root, "scene", a->scene);
+    cJSON_AddItemToObject(root, "scene_stats", rl_cli_scene_stats_json(scene));
+    cJSON *prop = cJSON_AddObjectToObject(root, "property");
+    cJSON_AddStringToObject(prop, "name", rl_property_name(p));
+    cJSON_AddStringToObject(prop, "unit", rl_property_unit(p));
+    cJSON *opts = cJSON_AddObjectToObject(prop, "options");
+    size_t no = 0;
+    const rl_option_info *o = rl_property_options(p, &no);
+    for (size_t k = 0; k < no; k++)
+        cJSON_AddStringToObject(opts, o[k].key, rl_property_get(p, o[k].key));
+    cJSON_AddItemToObject(root, "sampling", rl_eval_desc_json(&a->sampling.desc));
+    cJSON_AddNumberToObject(root, "samples", rl_approx_sample_count(ap));
+    cJSON_AddNumberToObject(root, "regions", rl_approx_region_count(ap));
+    rl_bench_add_num(root, "seconds", rl_approx_seconds(ap));
+    rl_bench_add_num(root, "samples_per_second", rl_approx_sample_count(ap) / rl_approx_seconds(ap));
+    rl_bench_add_num(root, "measure", rl_approx_measure(ap));
+    cJSON_AddStringToObject(root, "measure_unit", rl_approx_dims(ap) == 2 ? "m^2" : "m^3");
+    cJSON_AddItemToObject(root, "region_stats", rl_eval_stats_json(&r->stats));
+    if (r->validated) {
+        cJSON *v = cJSON_AddObjectToObject(root, "validation");
+        cJSON_AddNumberToObject(v, "points", (double)r->num_validated);
+        cJSON_AddItemToObject(v, "abs_error", rl_eval_stats_json(&r->error));
+        rl_bench_add_num(v, "correlation", r->correlation);
+    }
+    return root;
+}
+
+static void stats_table(rl_html *h, const char *name, const rl_stats *s)
+{
+    static const char *const head[] = { "", "min", "25 %", "median", "75 %", "max", "mean" };
+    char cells[7][32];
+    const char *row[7];
+    rl_eval_stats_cells(s, cells);
+    snprintf(cells[0], sizeof cells[0], "%s", name);
+    for (int k = 0; k < 7; k++)
+        row[k] = cells[k];
+    rl_html_table_begin(h, head, 7);
+    rl_html_table_row(h, row, 7);
+    rl_html_table_end(h);
+}
+
+static int write_report(const eval_args *a, const char *path, const rl_scene *scene,
+                        const rl_property *p, const rl_approx *ap, const eval_result *r)
+{
+    char title[256];
+    snprintf(title, sizeof title, "rl eval: %s on %s", rl_property_name(p), a->scene);
+    rl_html *h = rl_html_begin(path, title);
+    if (!h)
+        return RL_CLI_FAIL;
+    const rl_sampling_desc *d = &a->sampling.desc;
+    rl_aabb b = rl_approx_bounds(ap);
+    char where[256];
+    if (d->dims == 2)
+        snprintf(where, sizeof where, "the slice y = %g m over x %g..%g, z %g..%g (%.4g m²)",
+                 d->height, b.min.x, b.max.x, b.min.z, b.max.z, rl_approx_measure(ap));
+    else
+        snprintf(where, sizeof where, "the region %g,%g,%g .. %g,%g,%g (%.4g m³)", b.min.x,
+                 b.min.y, b.min.z, b.max.x, b.max.y, b.max.z, rl_approx_measure(ap));
+    rl_html_para(h, "Property %s [%s] approximated over %s by %s sampling%s%s: %u samples, %u "
+                 "regions, %.1f s (%.1f samples/s). Region values are weighted by their %s "
+                 "(Jähn 2015, Sec. 5.6.2).",
+                 rl_property_name(p), rl_property_unit(p), where,
+                 d->method == RL_SAMPLING_GRID ? "regular grid" : "adaptive",
+                 d->method == RL_SAMPLING_GRID ? "" : ", positions ",
+                 d->method == RL_SAMPLING_GRID ? "" : rl_eval_positions_name(d->positions),
+                 rl_approx_sample_count(ap), rl_approx_region_count(ap), rl_approx_seconds(ap),
+                 rl_approx_sample_count(ap) / rl_approx_seconds(ap),
+                 d->dims == 2 ? "area" : "volume");
+    rl_html_heading(h, 2, "Distribution");
+    stats_table(h, rl_property_unit(p), &r->stats);
+
+    double *values = NULL, *weights = NULL;
+    size_t n = 0;
+    rl_eval_leaf_series(ap, &values, &weights, &n);
+    rl_image *top = rl_eval_top_view(scene, b, d->height, 512);
+    bool reverse = false;
+    char png[4096];
+    snprintf(png, sizeof png, "%s/heatmap.png", a->out);
+    char *heat = rl_eval_heatmap_svg(ap, d->height, top, rl_property_name(p), 0, 0, reverse, png);
+    rl_plot_series series = { .name = rl_property_unit(p), .values = values, .weights = weights,
+                              .count = n };
+    char *violin = NULL, *hist = NULL, *corr = NULL;
+    rl_plot_style vs = { .width = 320, .height = 420, .title = "region values",
+                         .y_label = rl_property_unit(p) };
+    rl_plot_style hs = { .width = 480, .height = 420, .title = "histogram",
+                         .x_label = rl_property_unit(p), .y_label = "share of the region" };
+    if (values && rl_plot_violin(&series, 1, &vs, &(rl_plot_output){ .svg = &violin }) != RL_OK)
+        violin = NULL;
+    if (values && rl_plot_histogram(&series, 1, 0, &hs, &(rl_plot_output){ .svg = &hist }) != RL_OK)
+        hist = NULL;
+    rl_html_row_begin(h);
+    if (heat)
+        rl_html_svg(h, heat, d->dims == 2 ? "Heat map of the regions over the scene's top "
+                                            "view; dots are the sample positions."
+                                          : "The regions cut by the plane y = --height.");
+    rl_html_svg(h, violin, "Violin plot (weighted kernel density) with the box plot inside.");
+    rl_html_svg(h, hist, "Histogram of the region values, weighted by area/volume.");
+    rl_html_row_end(h);
+    if (r->validated) {
+        rl_html_heading(h, 2, "Validation");
+        rl_html_para(h, "The property measured at %zu uniform random positions against the "
+                     "approximation there (Jähn 2015, Sec. 5.7): absolute error below; Pearson "
+                     "r = %.4f.", r->num_validated, r->correlation);
+        stats_table(h, "|error|", &r->error);
+        rl_plot_style cs = { .width = 440, .height = 420, .title = "measured vs approximated",
+                             .x_label = "measured", .y_label = "approximated" };
+        if (rl_plot_correlation(r->measured, r->approximated, r->num_validated, &cs,
+                                &(rl_plot_output){ .svg = &corr }) == RL_OK)
+            rl_html_svg(h, corr, NULL);
+        else
+            rl_clear_error();
+    }
+    rl_html_para(h, "Data: approx.json (the approximation), eval.json (these numbers), "
+                    "heatmap.png (the heat map for papers).");
+    free(heat);
+    free(violin);
+    free(hist);
+    free(corr);
+    free(values);
+    free(weights);
+    rl_image_release(top);
+    rl_clear_error();
+    return rl_html_end(h, path) ? RL_CLI_OK : RL_CLI_FAIL;
+}
+
+int rl_cli_eval(int argc, char **argv)
+{
+    eval_args a = { 0 };
+    int rc = parse_args(argc, argv, &a);
+    if (rc != RL_CLI_OK)
+        return rc < 0 ? RL_CLI_OK : rc;
+    if (a.list)
+        return print_list();
+    rl_property *p = NULL;
+    if ((rc = make_property(&a, &p)) != RL_CLI_OK)
+        return rc;
+    char report[4096], json_path[4096], approx_path[4096];
+    snprintf(report, sizeof report, "%s", a.report ? a.report : "");
+    if (!a.report)
+        snprintf(report, sizeof report, "%s/report.html", a.out);
+    snprintf(json_path, sizeof json_path, "%s/eval.json", a.out);
+    snprintf(approx_path, sizeof approx_path, "%s/approx.json", a.out);
+    rl_scene *scene = NULL;
+    rl_approx *ap = NULL;
+    eval_result r = { 0 };
+    if (!rl_cli_make_dirs(a.out) || !rl_cli_check_writable(report)) {
+        rc = RL_CLI_FAIL;
+        goto done;
+    }
+    if ((rc = rl_cli_load_scene(a.scene, &scene)) != RL_CLI_OK)
+        goto done;
+    if (!rl_eval_sampling_finish(&a.sampling, scene)) {
+        rc = RL_CLI_USAGE;
+        goto done;
+    }
+    rl_status st = rl_property_commit(p, scene, a.sampling.desc.workers);
+    if (st != RL_OK) {
+        rc = rl_cli_fail_status(st == RL_ERR_INVALID_ARG ? RL_CLI_USAGE : RL_CLI_FAIL, st,
+                                "property");
+        goto done;
+    }
+    rl_progress *progress = NULL;
+    if (rl_log_get_level() >= RL_LOG_INFO)
+        rl_progress_create("sampling", stderr, &progress);
+    a.sampling.desc.progress = progress ? sampling_progress : NULL;
+    a.sampling.desc.progress_user = progress;
+    st = rl_sample_property(p, &a.sampling.desc, &ap);
+    if (progress)
+        rl_progress_finish(progress);
+    a.sampling.desc.progress = NULL;
+    if (st != RL_OK) {
+        rc = rl_cli_fail_status(RL_CLI_FAIL, st, "sampling");
+        goto done;
+    }
+    double *values = NULL, *weights = NULL;
+    size_t n = 0;
+    if (!rl_eval_leaf_series(ap, &values, &weights, &n)) {
+        rc = rl_cli_fail(RL_CLI_FAIL, "out of memory");
+        goto done;
+    }
+    st = rl_stats_compute(values, weights, n, &r.stats);
+    free(values);
+    free(weights);
+    if (st != RL_OK) {
+        rc = rl_cli_fail_status(RL_CLI_FAIL, st, "statistics");
+        goto done;
+    }
+    if (a.validate > 0 && (rc = validate(&a, p, ap, &r)) != RL_CLI_OK)
+        goto done;
+    st = rl_approx_save_json(ap, approx_path);
+    if (st != RL_OK) {
+        rc = rl_cli_fail_status(RL_CLI_FAIL, st, approx_path);
+        goto done;
+    }
+    cJSON *root = result_json(&a, scene, p, ap, &r);
+    bool ok = root && rl_cli_write_json(root, json_path);
+    cJSON_Delete(root);
+    if (!ok) {
+        rc = RL_CLI_FAIL;
+        goto done;
+    }
+    if ((rc = write_report(&a, report, scene, p, ap, &r)) != RL_CLI_OK)
+        goto done;
+    printf("%s on %s: %u samples, %u regions in %.1f s; %s mean %.4g, median %.4g, min %.4g, "
+           "max %.4g",
+           rl_property_name(p), a.scene, rl_approx_sample_count(ap), rl_approx_region_count(ap),
+           rl_approx_seconds(ap), rl_property_unit(p), r.stats.mean, r.stats.q[2], r.stats.min,
+           r.stats.max);
+    if (r.validated)
+        printf("; validation at %zu points: mean |error| %.4g, median %.4g", r.num_validated,
+               r.error.mean, r.error.q[2]);
+    printf("\nwrote %s, %s, %s\n", approx_path, json_path, report);
+done:
+    free(r.measured);
+    free(r.approximated);
+    rl_approx_release(ap);
+    rl_property_release(p);
+    rl_scene_release(scene);
+    return rc;
+}

@@ -1,0 +1,452 @@
+/* eval_common.c: see eval_common.h. */
+#include "eval_common.h"
+
+#include <cjson/cJSON.h>
+#include <math.h>
+#include <omp.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "bench_util.h"
+#include "cli.h"
+
+const char rl_eval_sampling_help[] =
+    "sampling (Jähn 2015, Ch. 5):\n"
+    "  --dims 2|3          2: the horizontal slice y = --height (default);\n"
+    "                      3: the whole region\n"
+    "  --region x0,y0,z0,x1,y1,z1   default: the scene's bounds\n"
+    "  --height H          slice height; default the middle of the region's y\n"
+    "  --method M          adaptive (Alg. 5.3, default) or grid (Alg. 5.2)\n"
+    "  --positions P       bn-corners (default), bn, random or grid: how an\n"
+    "                      adaptive region chooses its samples (Sec. 5.4.2)\n"
+    "  --samples N         sample budget; default 256\n"
+    "  --seconds S         time budget (stops at whichever comes first)\n"
+    "  --min-side M        smallest region side; default 1 m, or 1/64 of the\n"
+    "                      region's longest side when that is smaller\n"
+    "  --samples-base N    samples per new region, constant part; default 5\n"
+    "  --samples-per-meter F  samples per metre of region diameter; default 0.05\n"
+    "  --combine C         region value: mean (default), max or min\n"
+    "  --interp I          point queries: nearest (the nearest sample in the\n"
+    "                      region, default) or region (its combined value, the\n"
+    "                      thesis); see docs/evaluation.md\n"
+    "  --linear            fit a linear function per region instead\n"
+    "  --seed N            default 1\n"
+    "  --workers N         parallel evaluations; default all threads\n";
+
+static const char *const positions_names[] = { "bn-corners", "bn", "random", "grid" };
+static const char *const method_names[] = { "adaptive", "grid" };
+static const char *const combine_names[] = { "mean", "max", "min" };
+static const char *const interp_names[] = { "nearest", "region" };
+
+const char *rl_eval_positions_name(rl_position_variant v)
+{
+    return (unsigned)v < 4 ? positions_names[v] : "?";
+}
+
+void rl_eval_sampling_init(rl_eval_sampling *s)
+{
+    memset(s, 0, sizeof *s);
+    s->desc.dims = 2;
+    s->desc.max_samples = 256;
+    s->desc.seed = 1;
+}
+
+static int pick(const char *option, const char *v, const char *const *names, int n)
+{
+    for (int k = 0; k < n; k++)
+        if (strcmp(v, names[k]) == 0)
+            return k;
+    char list[256] = "";
+    for (int k = 0; k < n; k++) {
+        strcat(list, k ? ", " : "");
+        strcat(list, names[k]);
+    }
+    rl_cli_fail(RL_CLI_USAGE, "%s: unknown value '%s' (one of %s)", option, v, list);
+    return -1;
+}
+
+static bool parse_number(const char *option, const char *v, double lo, double hi, double *out)
+{
+    char *end = NULL;
+    double x = strtod(v, &end);
+    if (!*v || *end || !isfinite(x) || x < lo || x > hi) {
+        rl_cli_fail(RL_CLI_USAGE, "%s: expected a number in [%g, %g], got '%s'", option, lo, hi, v);
+        return false;
+    }
+    *out = x;
+    return true;
+}
+
+static bool parse_region(const char *v, rl_aabb *box)
+{
+    float c[6];
+    char *end = NULL;
+    const char *p = v;
+    for (int k = 0; k < 6; k++) {
+        double x = strtod(p, &end);
+        if (end == p || !isfinite(x) || (k < 5 && *end != ',') || (k == 5 && *end)) {
+            rl_cli_fail(RL_CLI_USAGE, "--region: expected x0,y0,z0,x1,y1,z1, got '%s'", v);
+            return false;
+        }
+        c[k] = (float)x;
+        p = end + 1;
+    }
+    if (!(c[0] <= c[3] && c[1] <= c[4] && c[2] <= c[5])) {
+        rl_cli_fail(RL_CLI_USAGE, "--region: the second corner must not be below the first ('%s')", v);
+        return false;
+    }
+    box->min = (rl_vec3){ c[0], c[1], c[2] };
+    box->max = (rl_vec3){ c[3], c[4], c[5] };
+    return true;
+}
+
+int rl_eval_sampling_arg(int argc, char **argv, int *i, rl_eval_sampling *s)
+{
+    const char *v = NULL;
+    int m;
+    double x;
+    rl_sampling_desc *d = &s->desc;
+#define TAKE(name) ((m = rl_cli_take_value(argc, argv, i, name, &v)) != 0)
+    if (strcmp(argv[*i], "--linear") == 0) {
+        d->linear = true;
+        return 1;
+    }
+    if (TAKE("--dims")) {
+        if (m < 0)
+            return -1;
+        if (strcmp(v, "2") != 0 && strcmp(v, "3") != 0) {
+            rl_cli_fail(RL_CLI_USAGE, "--dims: 2 or 3, got '%s'", v);
+            return -1;
+        }
+        d->dims = v[0] - '0';
+    } else if (TAKE("--region")) {
+        if (m < 0 || !parse_region(v, &d->region))
+            return -1;
+        s->has_region = true;
+    } else if (TAKE("--height")) {
+        if (m < 0 || !parse_number("--height", v, -1e9, 1e9, &x))
+            return -1;
+        d->height = (float)x;
+        s->has_height = true;
+    } else if (TAKE("--method")) {
+        int k = m < 0 ? -1 : pick("--method", v, method_names, 2);
+        if (k < 0)
+            return -1;
+        d->method = (rl_sampling_method)k;
+    } else if (TAKE("--positions")) {
+        int k = m < 0 ? -1 : pick("--positions", v, positions_names, 4);
+        if (k < 0)
+            return -1;
+        d->positions = (rl_position_variant)k;
+    } else if (TAKE("--interp")) {
+        int k = m < 0 ? -1 : pick("--interp", v, interp_names, 2);
+        if (k < 0)
+            return -1;
+        d->interpolation = (rl_interpolation)k;
+    } else if (TAKE("--combine")) {
+        int k = m < 0 ? -1 : pick("--combine", v, combine_names, 3);
+        if (k < 0)
+            return -1;
+        d->combine = (rl_combine)k;
+    } else if (TAKE("--samples")) {
+        long long n;
+        if (m < 0 || !rl_bench_parse_count("--samples", v, 1 << 24, &n))
+            return -1;
+        d->max_samples = (uint32_t)n;
+    } else if (TAKE("--seconds")) {
+        if (m < 0 || !parse_number("--seconds", v, 1e-3, 1e7, &x))
+            return -1;
+        d->max_seconds = x;
+    } else if (TAKE("--min-side")) {
+        if (m < 0 || !parse_number("--min-side", v, 1e-6, 1e9, &x))
+            return -1;
+        d->min_side = (float)x;
+        s->has_min_side = true;
+    } else if (TAKE("--samples-base")) {
+        if (m < 0 || !parse_number("--samples-base", v, 1, 1e6, &x))
+            return -1;
+        d->samples_base = (float)x;
+    } else if (TAKE("--samples-per-meter")) {
+        if (m < 0 || !parse_number("--samples-per-meter", v, 1e-9, 1e6, &x))
+            return -1;
+        d->samples_per_meter = (float)x;
+    } else if (TAKE("--seed")) {
+        long long n;
+        if (m < 0 || !rl_bench_parse_count("--seed", v, 1LL << 62, &n))
+            return -1;
+        d->seed = (uint64_t)n;
+    } else if (TAKE("--workers")) {
+        long long n;
+        if (m < 0 || !rl_bench_parse_count("--workers", v, 1024, &n))
+            return -1;
+        d->workers = (int)n;
+    } else
+        return 0;
+#undef TAKE
+    return 1;
+}
+
+bool rl_eval_sampling_finish(rl_eval_sampling *s, const rl_scene *scene)
+{
+    rl_sampling_desc *d = &s->desc;
+    const rl_scene_data *sd = rl_scene_get_data(scene);
+    rl_aabb b = sd->bounds;
+    if (!s->has_region)
+        d->region = b;
+    else if (d->region.max.x < b.min.x || d->region.min.x > b.max.x ||
+             d->region.max.z < b.min.z || d->region.min.z > b.max.z ||
+             (d->dims == 3 && (d->region.max.y < b.min.y || d->region.min.y > b.max.y))) {
+        rl_cli_fail(RL_CLI_USAGE, "--region does not overlap the scene (bounds %g,%g,%g .. %g,%g,%g)",
+                    b.min.x, b.min.y, b.min.z, b.max.x, b.max.y, b.max.z);
+        return false;
+    }
+    if (!s->has_height)
+        d->height = 0.5f * (d->region.min.y + d->region.max.y);
+    else if (d->dims == 2 && (d->height < b.min.y || d->height > b.max.y)) {
+        rl_cli_fail(RL_CLI_USAGE, "--height %g is outside the scene's y range [%g, %g]", d->height,
+                    b.min.y, b.max.y);
+        return false;
+    }
+    if (!s->has_min_side) {
+        float ex = d->region.max.x - d->region.min.x, ez = d->region.max.z - d->region.min.z;
+        float ey = d->dims == 3 ? d->region.max.y - d->region.min.y : 0.0f;
+        float longest = fmaxf(ex, fmaxf(ey, ez));
+        d->min_side = fminf(1.0f, longest / 64.0f);
+        if (!(d->min_side > 0.0f))
+            d->min_side = 1.0f;
+    }
+    return true;
+}
+
+rl_image *rl_eval_top_view(const rl_scene *scene, rl_aabb region, float height, int width)
+{
+    float ex = region.max.x - region.min.x, ez = region.max.z - region.min.z;
+    if (!(ex > 0.0f) || !(ez > 0.0f) || width < 16)
+        return NULL;
+    int h = (int)lrintf((float)width * ez / ex);
+    if (h < 16 || h > 4 * width)
+        return NULL;
+    const rl_scene_data *sd = rl_scene_get_data(scene);
+    /* Far above, with a narrow field of view: nearly orthographic, and exact
+     * at the slice height. Up = -z puts +x to the right of the image. */
+    float top = fmaxf(sd->bounds.max.y, height);
+    float dist = (top - height) + 20.0f * fmaxf(ex, ez);
+    rl_camera cam = {
+        .eye = { region.min.x + 0.5f * ex, height + dist, region.min.z + 0.5f * ez },
+        .target = { region.min.x + 0.5f * ex, height, region.min.z + 0.5f * ez },
+        .up = { 0.0f, 0.0f, -1.0f },
+        .fov_deg = 2.0f * atanf(0.5f * ez / dist) * 57.29578f,
+        .width = width,
+        .height = h,
+    };
+    rl_renderer *r = NULL;
+    rl_image *img = NULL;
+    if (rl_renderer_create("raster", &r) != RL_OK ||
+        rl_image_create(width, h, RL_LAYER_COLOR | RL_LAYER_DEPTH | RL_LAYER_ID, &img) != RL_OK ||
+        rl_renderer_render(r, scene, &cam, img, NULL) != RL_OK) {
+        rl_image_release(img);
+        img = NULL;
+    }
+    rl_renderer_release(r);
+    rl_clear_error();
+    return img;
+}
+
+bool rl_eval_leaf_series(const rl_approx *a, double **values, double **weights, size_t *n)
+{
+    uint32_t count = rl_approx_region_count(a);
+    double *v = malloc((count ? count : 1) * sizeof *v);
+    double *w = malloc((count ? count : 1) * sizeof *w);
+    if (!v || !w) {
+        free(v);
+        free(w);
+        return false;
+    }
+    int dims = rl_approx_dims(a);
+    for (uint32_t i = 0; i < count; i++) {
+        rl_approx_region r;
+        rl_approx_get_region(a, i, &r);
+        double dx = r.box.max.x - r.box.min.x, dy = r.box.max.y - r.box.min.y;
+        double dz = r.box.max.z - r.box.min.z;
+        v[i] = r.value;
+        w[i] = dims == 2 ? dx * dz : dx * dy * dz;
+    }
+    *values = v;
+    *weights = w;
+    *n = count;
+    return true;
+}
+
+char *rl_eval_heatmap_svg(const rl_approx *a, float height, const rl_image *top,
+                          const char *title, double vmin, double vmax, bool reverse,
+                          const char *png_path)
+{
+    uint32_t count = rl_approx_region_count(a), samples = rl_approx_sample_count(a);
+    rl_plot_cell *cells = malloc((count ? count : 1) * sizeof *cells);
+    double *points = malloc(2 * (samples ? samples : 1) * sizeof *points);
+    char *svg = NULL;
+    if (!cells || !points) {
+        free(cells);
+        free(points);
+        rl_cli_fail(RL_CLI_FAIL, "out of memory");
+        return NULL;
+    }
+    int dims = rl_approx_dims(a);
+    size_t n = 0, np = 0;
+    for (uint32_t i = 0; i < count; i++) {
+        rl_approx_region r;
+        rl_approx_get_region(a, i, &r);
+        if (dims == 3 && (height < r.box.min.y || height > r.box.max.y))
+            continue;
+        cells[n++] = (rl_plot_cell){ r.box.min.x, -r.box.max.z, r.box.max.x, -r.box.min.z, r.value };
+    }
+    rl_aabb b = rl_approx_bounds(a);
+    for (uint32_t i = 0; i < samples; i++) {
+        rl_vec3 p;
+        double v;
+        rl_approx_sample(a, i, &p, &v);
+        /* 3-D: only the samples near the cut, else the map is a cloud. */
+        if (dims == 3 && fabsf(p.y - height) > 0.05f * (b.max.y - b.min.y))
+            continue;
+        points[2 * np] = p.x;
+        points[2 * np + 1] = -p.z;
+        np++;
+    }
+    char x_label[] = "x (m)", y_label[] = "-z (m)";
+    rl_plot_heatmap h = {
+        .cells = cells, .count = n,
+        .x0 = b.min.x, .y0 = -b.max.z, .x1 = b.max.x, .y1 = -b.min.z,
+        .vmin = vmin, .vmax = vmax, .reverse = reverse, .borders = true,
+        .unit = rl_approx_unit(a), .overlay = top, .points = points, .num_points = np,
+    };
+    rl_plot_style style = { .width = 560, .height = 0, .title = title,
+                            .x_label = x_label, .y_label = y_label };
+    /* Keep the map's aspect: plot area about 440 points wide. */
+    double ex = b.max.x - b.min.x, ez = b.max.z - b.min.z;
+    style.height = ex > 0 ? (int)fmin(900.0, fmax(240.0, 440.0 * ez / ex + 110.0)) : 480;
+    rl_status st = n ? rl_plot_heatmap_draw(&h, &style, &(rl_plot_output){ .svg = &svg })
+                     : RL_ERR_INVALID_ARG;
+    if (st == RL_OK && png_path)
+        st = rl_plot_heatmap_draw(&h, &style, &(rl_plot_output){ .path = png_path });
+    if (st != RL_OK) {
+        rl_cli_fail_status(RL_CLI_FAIL, st, "heat map");
+        free(svg);
+        svg = NULL;
+    }
+    free(cells);
+    free(points);
+    return svg;
+}
+
+rl_vec3 *rl_eval_random_positions(const rl_approx *a, size_t count, uint64_t seed)
+{
+    rl_vec3 *pos = malloc((count ? count : 1) * sizeof *pos);
+    if (!pos)
+        return NULL;
+    rl_aabb b = rl_approx_bounds(a);
+    rl_rng rng;
+    rl_rng_seed(&rng, seed, 0x5eed);
+    for (size_t i = 0; i < count; i++) {
+        float u = rl_rng_float(&rng), v = rl_rng_float(&rng), w = rl_rng_float(&rng);
+        pos[i] = (rl_vec3){ b.min.x + u * (b.max.x - b.min.x),
+                            rl_approx_dims(a) == 2 ? b.min.y : b.min.y + v * (b.max.y - b.min.y),
+                            b.min.z + w * (b.max.z - b.min.z) };
+    }
+    return pos;
+}
+
+rl_status rl_eval_measure(rl_property *p, const rl_vec3 *pos, size_t count, double **values,
+                          const char *progress_label)
+{
+    double *v = malloc((count ? count : 1) * sizeof *v);
+    if (!v)
+        return RL_ERR_OUT_OF_MEMORY;
+    rl_progress *progress = NULL;
+    if (progress_label && rl_log_get_level() >= RL_LOG_INFO)
+        rl_progress_create(progress_label, stderr, &progress);
+    int workers = rl_property_workers(p);
+    if (rl_property_get_flags(p) & RL_PROPERTY_EXCLUSIVE)
+        workers = 1;
+    rl_status st = RL_OK;
+    size_t done = 0;
+#pragma omp parallel for num_threads(workers) schedule(dynamic, 1)
+    for (size_t i = 0; i < count; i++) {
+        rl_status s;
+        #pragma omp atomic read
+        s = st;
+        if (s != RL_OK)
+            continue;
+        rl_property_sample sample = { 0 };
+        s = rl_property_evaluate(p, omp_get_thread_num(), pos[i], &sample);
+        v[i] = sample.value;
+        if (s != RL_OK) {
+            #pragma omp critical(rl_eval_measure_status)
+            if (st == RL_OK)
+                st = s;
+        }
+        #pragma omp critical(rl_eval_measure_progress)
+        {
+            done++;
+            if (progress)
+                rl_progress_update(progress, (double)done / (double)count);
+        }
+    }
+    if (progress)
+        rl_progress_finish(progress);
+    if (st != RL_OK) {
+        free(v);
+        return st;
+    }
+    *values = v;
+    return RL_OK;
+}
+
+cJSON *rl_eval_stats_json(const rl_stats *s)
+{
+    cJSON *o = cJSON_CreateObject();
+    if (!o)
+        return NULL;
+    rl_bench_add_num(o, "min", s->min);
+    rl_bench_add_num(o, "q25", s->q[1]);
+    rl_bench_add_num(o, "median", s->q[2]);
+    rl_bench_add_num(o, "q75", s->q[3]);
+    rl_bench_add_num(o, "max", s->max);
+    rl_bench_add_num(o, "mean", s->mean);
+    rl_bench_add_num(o, "stddev", s->stddev);
+    rl_bench_add_num(o, "weight", s->total_weight);
+    rl_bench_add_num(o, "count", (double)s->count);
+    return o;
+}
+
+cJSON *rl_eval_desc_json(const rl_sampling_desc *d)
+{
+    cJSON *o = cJSON_CreateObject();
+    if (!o)
+        return NULL;
+    cJSON_AddNumberToObject(o, "dims", d->dims);
+    cJSON *r = cJSON_AddArrayToObject(o, "region");
+    const float c[6] = { d->region.min.x, d->region.min.y, d->region.min.z,
+                         d->region.max.x, d->region.max.y, d->region.max.z };
+    for (int k = 0; k < 6 && r; k++)
+        cJSON_AddItemToArray(r, cJSON_CreateNumber(c[k]));
+    if (d->dims == 2)
+        cJSON_AddNumberToObject(o, "height", d->height);
+    cJSON_AddStringToObject(o, "method", method_names[d->method]);
+    if (d->method == RL_SAMPLING_ADAPTIVE)
+        cJSON_AddStringToObject(o, "positions", rl_eval_positions_name(d->positions));
+    cJSON_AddNumberToObject(o, "max_samples", d->max_samples);
+    rl_bench_add_num(o, "max_seconds", d->max_seconds);
+    cJSON_AddNumberToObject(o, "min_side", d->min_side);
+    cJSON_AddStringToObject(o, "combine", combine_names[d->combine]);
+    cJSON_AddBoolToObject(o, "linear", d->linear);
+    cJSON_AddStringToObject(o, "interpolation", interp_names[d->interpolation]);
+    cJSON_AddNumberToObject(o, "seed", (double)d->seed);
+    return o;
+}
+
+void rl_eval_stats_cells(const rl_stats *s, char buf[7][32])
+{
+    const double v[6] = { s->min, s->q[1], s->q[2], s->q[3], s->max, s->mean };
+    for (int k = 0; k < 6; k++)
+        snprintf(buf[k + 1], 32, "%.4g", v[k]);
+}

@@ -1,0 +1,105 @@
+#!/usr/bin/env bash
+# test_cli_eval.sh: `rl eval` (a property approximated over a region, Jähn
+# 2015 Ch. 4-5), `rl compare` (renderers at the same sampled positions) and
+# `rl bench sampling --quick` write complete, sane outputs; bad input gets
+# one clear error line and exit 2 (usage) or 1 (input/output).
+# Run as: bash test_cli_eval.sh <rl-binary> <scratch-dir>
+set -u
+. "$(dirname "${BASH_SOURCE[0]}")/lib.bash"
+
+have_python() { command -v python3 >/dev/null 2>&1 && python3 -c 'import json' 2>/dev/null; }
+
+# --- bad usage: nothing is sampled, nothing is written ---
+expect_usage_error "$RL" eval cornell --out "$TMP/e"
+expect_error 2 "no scene" "$RL" eval --property visibility
+expect_error 2 "nosuch" "$RL" eval cornell --property nosuch --out "$TMP/e"
+expect_error 2 "resolution" "$RL" eval cornell --property visibility --set resolution=0 --out "$TMP/e"
+expect_error 2 "frob" "$RL" eval cornell --property visibility --set frob=1 --out "$TMP/e"
+expect_usage_error "$RL" eval cornell --property visibility --samples 0 --out "$TMP/e"
+expect_usage_error "$RL" eval cornell --property visibility --dims 4 --out "$TMP/e"
+expect_usage_error "$RL" eval cornell --property visibility --region 1,1,1,0,0,0 --out "$TMP/e"
+expect_usage_error "$RL" eval cornell --property visibility --region 100,100,100,200,200,200 --out "$TMP/e"
+expect_usage_error "$RL" eval cornell --property visibility --height 1e6 --out "$TMP/e"
+expect_usage_error "$RL" eval cornell --property visibility --positions fancy --out "$TMP/e"
+expect_usage_error "$RL" eval cornell --property visibility --report "$TMP/e/r.txt"
+expect_usage_error "$RL" eval cornell --property time --set renderer=nosuch --out "$TMP/e"
+[ -e "$TMP/e/approx.json" ] && fail "a failed eval wrote approx.json"
+expect_exit 1 "$RL" eval no-such-scene.json --property visibility --out "$TMP/e"
+expect_exit 0 "$RL" eval --list
+for p in visibility time ops quality resolution renderer metric; do expect_in "$TMP/out" "$p"; done
+expect_exit 0 "$RL" eval --help
+for o in --property --set --validate --dims --region --height --positions --interp --samples; do
+    expect_in "$TMP/out" "$o"
+done
+
+# --- a 2-D visibility approximation with validation ---
+run_ok "$RL" eval cornell --property visibility --set resolution=32 --samples 48 --validate 20 \
+    --out "$TMP/vis"
+for f in approx.json eval.json report.html heatmap.png; do
+    [ -s "$TMP/vis/$f" ] || fail "eval did not write $f"
+done
+expect_in "$TMP/out" "48 samples"
+expect_in "$TMP/vis/report.html" "<svg"
+grep -q "<script" "$TMP/vis/report.html" && fail "the report must not need scripts"
+grep -Eq '(src|href)="https?:' "$TMP/vis/report.html" && fail "the report must be self-contained"
+if have_python; then
+    python3 - "$TMP/vis/eval.json" "$TMP/vis/approx.json" <<'PY' || fail "eval.json/approx.json are not sane"
+import json, sys
+e = json.load(open(sys.argv[1]))
+a = json.load(open(sys.argv[2]))
+assert e["property"]["name"] == "visibility" and e["samples"] == 48, e
+s = e["region_stats"]
+assert 0 < s["min"] <= s["median"] <= s["max"] <= 8, s      # cornell has 8 objects
+assert e["validation"]["points"] == 20 and e["validation"]["abs_error"]["mean"] >= 0
+assert a["format"] == "renderlab-approx" and len(a["samples"]) == 48
+PY
+fi
+
+# 3-D, grid method, an image-quality property of two renderers
+run_ok "$RL" eval cornell --property quality --set renderer=raster --set reference=whitted \
+    --set width=24 --set height=24 --dims 3 --method grid --samples 8 --out "$TMP/q"
+expect_in "$TMP/out" "SSIM"
+
+# --- rl compare ---
+expect_usage_error "$RL" compare cornell --out "$TMP/c"
+expect_error 2 "nosuch" "$RL" compare cornell --algos raster,nosuch --out "$TMP/c"
+expect_usage_error "$RL" compare cornell --algos raster --metrics time,speed --out "$TMP/c"
+expect_usage_error "$RL" compare cornell --algos raster:frob=1 --out "$TMP/c"
+run_ok "$RL" compare cornell --algos raster,whitted:max_depth=2,pt:spp=1,max_depth=2 --size 24x24 \
+    --samples 12 --repeats 1 --resolution 16 --out "$TMP/c"
+[ -s "$TMP/c/report.html" ] && [ -s "$TMP/c/compare.json" ] || fail "compare outputs missing"
+if have_python; then
+    python3 - "$TMP/c/compare.json" <<'PY' || fail "compare.json is not sane"
+import json, sys
+c = json.load(open(sys.argv[1]))
+names = [r["renderer"] for r in c["renderers"]]
+assert names == ["raster", "whitted:max_depth=2", "pt:spp=1,max_depth=2"], names
+for r in c["renderers"]:
+    assert r["time"]["min"] > 0, r
+    assert 0 <= r["quality"]["max"] <= 1.0 + 1e-9, r
+raster, whitted, pt = c["renderers"]
+assert raster["rays"]["max"] == 0 and raster["triangles"]["min"] > 0
+assert whitted["rays"]["min"] > 0 and whitted["quality"]["min"] > 0.999   # whitted is the reference
+PY
+fi
+
+# --- rl bench sampling ---
+expect_usage_error "$RL" bench sampling --only nosuch --out "$TMP/b.json"
+expect_usage_error "$RL" bench sampling --samples 0 --out "$TMP/b.json"
+run_ok "$RL" bench sampling --quick --out "$TMP/b.json"
+for s in variants convergence throughput bn-corners; do expect_in "$TMP/out" "$s"; done
+if have_python; then
+    python3 - "$TMP/b.json" <<'PY' || fail "bench sampling JSON is not complete"
+import json, sys
+r = json.load(open(sys.argv[1]))
+for s in ("variants", "convergence", "throughput"):
+    assert r[s]["status"] == "ok", (s, r[s])
+assert r["variants"]["cases_total"] == 8 and len(r["variants"]["cases"]) == 8
+for c in r["variants"]["cases"]:
+    for v in ("grid", "random", "bn", "bn-corners", "bnc-region"):
+        assert c[v]["abs_error"]["mean"] >= 0, c
+assert r["throughput"]["rows"][0]["samples_per_second"] > 0
+assert "machine" in r
+PY
+fi
+echo "ok"
