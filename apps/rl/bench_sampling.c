@@ -136,12 +136,7 @@ static rl_status errors(const rl_approx *ap, const rl_vec3 *pos, const double *m
     double *e = malloc(n * sizeof *e);
     if (!e)
         return RL_ERR_OUT_OF_MEMORY;
-    rl_status st = RL_OK;
-    for (size_t i = 0; st == RL_OK && i < n; i++) {
-        double v = 0.0;
-        st = rl_approx_query(ap, pos[i], &v, NULL);
-        e[i] = fabs(v - measured[i]);
-    }
+    rl_status st = rl_eval_errors(ap, pos, measured, n, NULL, e);
     if (st == RL_OK)
         st = rl_stats_compute(e, NULL, n, out);
     free(e);

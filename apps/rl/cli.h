@@ -55,6 +55,12 @@ int rl_cli_take_value(int argc, char **argv, int *i, const char *name, const cha
 /* Error for an unrecognised argument of a subcommand; returns RL_CLI_USAGE. */
 int rl_cli_unknown_arg(const char *command, const char *arg);
 
+/* Splits "KEY=VALUE" into key (a NUL-terminated copy, at most key_size - 1
+ * characters) and *value (pointing into text). Prints "<what>: expected
+ * KEY=VALUE, got '...'" or "<what>: key too long in '...'" and returns
+ * false otherwise. For --set options of renderers and properties. */
+bool rl_cli_split_option(const char *what, const char *text, char *key, size_t key_size,
+                         const char **value);
 /* "WxH" with both sides in 1..RL_IMAGE_MAX_SIZE; prints the error itself. */
 bool rl_cli_parse_size(const char *text, int *width, int *height);
 /* "x,y,z" of finite floats; prints the error itself (option names the flag). */

@@ -43,6 +43,25 @@ int rl_cli_fail_status(int code, rl_status status, const char *what)
     return rl_cli_fail(code, "%s", msg);
 }
 
+bool rl_cli_split_option(const char *what, const char *text, char *key, size_t key_size,
+                         const char **value)
+{
+    const char *eq = strchr(text, '=');
+    if (!eq || eq == text) {
+        rl_cli_fail(RL_CLI_USAGE, "%s: expected KEY=VALUE, got '%s'", what, text);
+        return false;
+    }
+    size_t n = (size_t)(eq - text);
+    if (n >= key_size) {
+        rl_cli_fail(RL_CLI_USAGE, "%s: key too long in '%s'", what, text);
+        return false;
+    }
+    memcpy(key, text, n);
+    key[n] = '\0';
+    *value = eq + 1;
+    return true;
+}
+
 bool rl_cli_is_help(const char *arg)
 {
     return strcmp(arg, "-h") == 0 || strcmp(arg, "--help") == 0;

@@ -91,16 +91,6 @@ static void free_args(compare_args *a)
     free_spec(&a->reference);
 }
 
-static bool known_renderer(const char *name)
-{
-    size_t n = 0;
-    const rl_renderer_info *info = rl_renderer_list(&n);
-    for (size_t i = 0; i < n; i++)
-        if (strcmp(info[i].name, name) == 0)
-            return true;
-    return false;
-}
-
 /* Splits "name[:k=v,...]" into a spec; checks the renderer and its options
  * by creating it once. */
 static bool make_spec(const char *text, algo_spec *s)
@@ -115,7 +105,7 @@ static bool make_spec(const char *text, algo_spec *s)
     }
     rl_renderer *r = NULL;
     rl_status st = rl_renderer_create(s->name, &r);
-    if (st != RL_OK || !known_renderer(s->name)) {
+    if (st != RL_OK) {
         rl_renderer_release(r);
         rl_cli_fail_status(RL_CLI_USAGE, st, "--algos");
         return false;
@@ -124,14 +114,13 @@ static bool make_spec(const char *text, algo_spec *s)
     char *opts = s->options ? strdup(s->options) : NULL, *save = NULL;
     for (char *kv = opts ? strtok_r(opts, ",", &save) : NULL; kv && st == RL_OK;
          kv = strtok_r(NULL, ",", &save)) {
-        char *eq = strchr(kv, '=');
-        if (!eq) {
-            rl_cli_fail(RL_CLI_USAGE, "%s: expected key=value, got '%s'", s->label, kv);
+        char key[128];
+        const char *value = NULL;
+        if (!rl_cli_split_option(s->label, kv, key, sizeof key, &value)) {
             st = RL_ERR_INVALID_ARG;
             break;
         }
-        *eq = '\0';
-        if ((st = rl_renderer_set(r, kv, eq + 1)) != RL_OK)
+        if ((st = rl_renderer_set(r, key, value)) != RL_OK)
             rl_cli_fail_status(RL_CLI_USAGE, st, s->label);
     }
     free(opts);
@@ -287,8 +276,6 @@ typedef struct measured {
     char error[256];
 } measured;
 
-static bool sampling_progress(void *user, double done) { return rl_progress_update(user, done); }
-
 static void put_metric_section(rl_html *h, const compare_args *a, int m, measured (*res)[M_COUNT],
                                const rl_image *top, float height)
 {
@@ -442,7 +429,7 @@ int rl_cli_compare(int argc, char **argv)
     rl_progress *progress = NULL;
     if (st == RL_OK && rl_log_get_level() >= RL_LOG_INFO)
         rl_progress_create("placing samples", stderr, &progress);
-    a.sampling.desc.progress = progress ? sampling_progress : NULL;
+    a.sampling.desc.progress = progress ? rl_progress_update : NULL;
     a.sampling.desc.progress_user = progress;
     if (st == RL_OK)
         st = rl_sample_property(vis, &a.sampling.desc, &driver);

@@ -136,16 +136,14 @@ static int make_property(const eval_args *a, rl_property **out)
     if (st != RL_OK)
         return rl_cli_fail_status(RL_CLI_USAGE, st, "--property");
     for (int k = 0; k < a->num_sets; k++) {
-        const char *eq = strchr(a->sets[k], '=');
         char key[128];
-        if (!eq || eq == a->sets[k] || (size_t)(eq - a->sets[k]) >= sizeof key) {
+        const char *value = NULL;
+        if (!rl_cli_split_option("--set", a->sets[k], key, sizeof key, &value)) {
             rl_property_release(*out);
             *out = NULL;
-            return rl_cli_fail(RL_CLI_USAGE, "--set: expected KEY=VALUE, got '%s'", a->sets[k]);
+            return RL_CLI_USAGE;
         }
-        memcpy(key, a->sets[k], (size_t)(eq - a->sets[k]));
-        key[eq - a->sets[k]] = '\0';
-        st = rl_property_set(*out, key, eq + 1);
+        st = rl_property_set(*out, key, value);
         if (st != RL_OK) {
             rl_property_release(*out);
             *out = NULL;
@@ -153,11 +151,6 @@ static int make_property(const eval_args *a, rl_property **out)
         }
     }
     return RL_CLI_OK;
-}
-
-static bool sampling_progress(void *user, double done)
-{
-    return rl_progress_update(user, done);
 }
 
 typedef struct eval_result {
@@ -182,10 +175,8 @@ static int validate(const eval_args *a, rl_property *p, const rl_approx *ap, eva
     }
     double *measured = NULL;
     rl_status st = rl_eval_measure(p, pos, n, &measured, "validation");
-    for (size_t i = 0; st == RL_OK && i < n; i++) {
-        st = rl_approx_query(ap, pos[i], &approx[i], NULL);
-        err[i] = fabs(approx[i] - measured[i]);
-    }
+    if (st == RL_OK)
+        st = rl_eval_errors(ap, pos, measured, n, approx, err);
     if (st == RL_OK)
         st = rl_stats_compute(err, NULL, n, &r->error);
     r->correlation = NAN;
@@ -376,7 +367,7 @@ int rl_cli_eval(int argc, char **argv)
     rl_progress *progress = NULL;
     if (rl_log_get_level() >= RL_LOG_INFO)
         rl_progress_create("sampling", stderr, &progress);
-    a.sampling.desc.progress = progress ? sampling_progress : NULL;
+    a.sampling.desc.progress = progress ? rl_progress_update : NULL;
     a.sampling.desc.progress_user = progress;
     st = rl_sample_property(p, &a.sampling.desc, &ap);
     if (progress)

@@ -139,15 +139,12 @@ static int create_renderer(const render_args *a, rl_renderer **out)
     if (st != RL_OK)
         return rl_cli_fail_status(RL_CLI_USAGE, st, NULL);
     for (int k = 0; k < a->num_sets; k++) {
-        const char *eq = strchr(a->sets[k], '=');
-        size_t n = (size_t)(eq - a->sets[k]);
         char key[128];
-        if (n >= sizeof key)
-            return rl_cli_fail(RL_CLI_USAGE, "--set: key too long in '%s'", a->sets[k]);
-        memcpy(key, a->sets[k], n);
-        key[n] = '\0';
+        const char *value = NULL;
+        if (!rl_cli_split_option("--set", a->sets[k], key, sizeof key, &value))
+            return RL_CLI_USAGE;
         rl_clear_error();
-        st = rl_renderer_set(*out, key, eq + 1);
+        st = rl_renderer_set(*out, key, value);
         if (st != RL_OK)
             return rl_cli_fail_status(RL_CLI_USAGE, st, "--set");
     }

@@ -401,6 +401,21 @@ rl_status rl_eval_measure(rl_property *p, const rl_vec3 *pos, size_t count, doub
     return RL_OK;
 }
 
+rl_status rl_eval_errors(const rl_approx *a, const rl_vec3 *pos, const double *measured,
+                         size_t count, double *approx, double *err)
+{
+    for (size_t i = 0; i < count; i++) {
+        double v = 0.0;
+        rl_status st = rl_approx_query(a, pos[i], &v, NULL);
+        if (st != RL_OK)
+            return st;
+        if (approx)
+            approx[i] = v;
+        err[i] = fabs(v - measured[i]);
+    }
+    return RL_OK;
+}
+
 cJSON *rl_eval_stats_json(const rl_stats *s)
 {
     cJSON *o = cJSON_CreateObject();

@@ -60,6 +60,11 @@ rl_vec3 *rl_eval_random_positions(const rl_approx *a, size_t count, uint64_t see
 rl_status rl_eval_measure(rl_property *p, const rl_vec3 *pos, size_t count, double **values,
                           const char *progress_label);
 
+/* The approximation at every position (into approx, may be NULL) and its
+ * absolute error against measured (into err): the validation of Sec. 5.7. */
+rl_status rl_eval_errors(const rl_approx *a, const rl_vec3 *pos, const double *measured,
+                         size_t count, double *approx, double *err);
+
 struct cJSON *rl_eval_stats_json(const rl_stats *s);
 struct cJSON *rl_eval_desc_json(const rl_sampling_desc *d);
 const char *rl_eval_positions_name(rl_position_variant v);
