@@ -322,51 +322,155 @@ static rl_status draw_object(rl_raster *ras, const rl_scene_data *d, uint32_t o,
     return rl_raster_draw(ras, &batch, counters);
 }
 
+/* The drawer: buffers prepared once, objects lit on first draw. */
+struct rl_scene_drawer {
+    const rl_scene_data *data;
+    rl_raster_scene_desc opt;
+    bool lit;                    /* the draws write colour */
+    shade_ctx ctx;
+    int threads;
+    uint8_t *object_lit;         /* per object: lighting done */
+    frame_buffers b;
+};
+
+static rl_status check_desc(const rl_raster_scene_desc *opt, const char *fn)
+{
+    if (opt->shading != RL_SHADING_FLAT && opt->shading != RL_SHADING_GOURAUD &&
+        opt->shading != RL_SHADING_TEXTURED)
+        return rl_error(RL_ERR_INVALID_ARG, "%s: unknown shading %d", fn, (int)opt->shading);
+    if (opt->threads < 0)
+        return rl_error(RL_ERR_INVALID_ARG, "%s: threads %d < 0", fn, opt->threads);
+    return RL_OK;
+}
+
+void rl_scene_drawer_release(rl_scene_drawer *dr)
+{
+    if (!dr)
+        return;
+    free_buffers(&dr->b);
+    free(dr->object_lit);
+    free(dr);
+}
+
+rl_status rl_scene_drawer_create(const rl_scene_data *d, rl_vec3 eye, const rl_raster_scene_desc *desc,
+                                 rl_scene_drawer **out)
+{
+    if (!d || !out)
+        return rl_error(RL_ERR_INVALID_ARG, "rl_scene_drawer_create: NULL argument");
+    *out = NULL;
+    rl_scene_drawer *dr = rl_calloc(1, sizeof *dr);
+    if (!dr)
+        return RL_ERR_OUT_OF_MEMORY;
+    dr->data = d;
+    if (desc)
+        dr->opt = *desc;
+    rl_status st = check_desc(&dr->opt, "rl_scene_drawer_create");
+    if (st != RL_OK) {
+        free(dr);
+        return st;
+    }
+    dr->lit = !(dr->opt.flags & RL_RASTER_NO_COLOR);
+#ifdef _OPENMP
+    dr->threads = dr->opt.threads > 0 ? dr->opt.threads : omp_get_max_threads();
+#else
+    dr->threads = 1;
+#endif
+    dr->ctx = (shade_ctx){ d, eye, dr->opt.ambient };
+    dr->object_lit = rl_calloc(d->num_objects ? d->num_objects : 1, 1);
+    st = dr->object_lit ? prepare(d, dr->opt.shading, dr->lit, dr->opt.object_mask, &dr->b)
+                        : RL_ERR_OUT_OF_MEMORY;
+    if (st != RL_OK) {
+        rl_scene_drawer_release(dr);
+        return rl_error(st, "rl_scene_drawer_create: buffers for %u triangles", d->num_triangles);
+    }
+    *out = dr;
+    return RL_OK;
+}
+
+/* Lights one object's vertices, corners or faces (what light_scene does
+ * for all of them), in parallel only when it is big enough to pay. */
+static void light_object(rl_scene_drawer *dr, uint32_t o)
+{
+    const rl_scene_data *d = dr->data;
+    const rl_object *obj = &d->objects[o];
+    frame_buffers *b = &dr->b;
+    const shade_ctx *ctx = &dr->ctx;
+    const int threads = obj->num_vertices > 4096 ? dr->threads : 1;
+    const int64_t t0 = obj->first_triangle, t1 = t0 + obj->num_triangles;
+    if (dr->opt.shading == RL_SHADING_FLAT) {
+#pragma omp parallel for num_threads(threads) schedule(static)
+        for (int64_t t = t0; t < t1; ++t) {
+            const uint32_t *tri = &d->indices[3 * t];
+            rl_vec3 p0 = d->positions[tri[0]], p1 = d->positions[tri[1]], p2 = d->positions[tri[2]];
+            rl_vec3 centroid = rl_scale(rl_add(rl_add(p0, p1), p2), 1.0f / 3.0f);
+            rl_vec3 n = rl_normalize(rl_cross(rl_sub(p1, p0), rl_sub(p2, p0)));
+            b->face_colors[t] = phong(ctx, &d->materials[d->triangle_material[t]], centroid, n);
+        }
+        return;
+    }
+    uint32_t m = b->object_material[o];
+    if (m != RL_NONE) {
+        const int64_t v0 = obj->first_vertex, v1 = v0 + obj->num_vertices;
+#pragma omp parallel for num_threads(threads) schedule(static)
+        for (int64_t v = v0; v < v1; ++v)
+            b->vertex_colors[v] = phong(ctx, &d->materials[m], d->positions[v], d->normals[v]);
+        return;
+    }
+#pragma omp parallel for num_threads(threads) schedule(static)
+    for (int64_t t = t0; t < t1; ++t) {
+        uint32_t tm = d->triangle_material[t];
+        for (int k = 0; k < 3; ++k) {
+            uint32_t vi = d->indices[3 * t + k];
+            b->corner_positions[3 * t + k] = d->positions[vi];
+            b->corner_uvs[3 * t + k] = d->uvs[vi];
+            b->corner_colors[3 * t + k] = phong(ctx, &d->materials[tm], d->positions[vi], d->normals[vi]);
+        }
+        b->triangle_texture[t] = dr->opt.shading == RL_SHADING_TEXTURED ? texture_of(d, tm) : RL_ID_NONE;
+    }
+}
+
+rl_status rl_scene_drawer_draw(rl_scene_drawer *dr, rl_raster *ras, uint32_t object, rl_raster_counters *c)
+{
+    if (!dr || !ras)
+        return rl_error(RL_ERR_INVALID_ARG, "rl_scene_drawer_draw: NULL argument");
+    if (object >= dr->data->num_objects)
+        return rl_error(RL_ERR_INVALID_ARG, "rl_scene_drawer_draw: object %u of %u", object,
+                        dr->data->num_objects);
+    if (!selected(dr->opt.object_mask, object))
+        return RL_OK;
+    if (dr->lit && !dr->object_lit[object]) {
+        light_object(dr, object);
+        dr->object_lit[object] = 1;
+    }
+    return draw_object(ras, dr->data, object, dr->opt.shading, dr->lit, dr->opt.flags, &dr->b, c);
+}
+
 rl_status rl_raster_draw_scene(rl_raster *ras, const rl_scene_data *d, rl_vec3 eye,
                                const rl_raster_scene_desc *desc, rl_raster_counters *c,
                                bool (*progress)(void *user, double done), void *user)
 {
     if (!ras || !d)
         return rl_error(RL_ERR_INVALID_ARG, "rl_raster_draw_scene: NULL argument");
-    rl_raster_scene_desc opt;
-    memset(&opt, 0, sizeof opt);
-    if (desc)
-        opt = *desc;
-    if (opt.shading != RL_SHADING_FLAT && opt.shading != RL_SHADING_GOURAUD &&
-        opt.shading != RL_SHADING_TEXTURED)
-        return rl_error(RL_ERR_INVALID_ARG, "rl_raster_draw_scene: unknown shading %d",
-                        (int)opt.shading);
-    if (opt.threads < 0)
-        return rl_error(RL_ERR_INVALID_ARG, "rl_raster_draw_scene: threads %d < 0", opt.threads);
-    const bool lit = !(opt.flags & RL_RASTER_NO_COLOR);
-
-    frame_buffers b;
-    memset(&b, 0, sizeof b);
-    rl_status st = prepare(d, opt.shading, lit, opt.object_mask, &b);
-    if (st != RL_OK) {
-        free_buffers(&b);
-        return rl_error(st, "rl_raster_draw_scene: buffers for %u triangles", d->num_triangles);
-    }
-    if (lit) {
-#ifdef _OPENMP
-        int lighting_threads = opt.threads > 0 ? opt.threads : omp_get_max_threads();
-#else
-        int lighting_threads = 1;
-#endif
-        shade_ctx ctx = { d, eye, opt.ambient };
-        light_scene(&ctx, opt.shading, lighting_threads, opt.object_mask, &b);
+    rl_scene_drawer *dr = NULL;
+    rl_status st = rl_scene_drawer_create(d, eye, desc, &dr);
+    if (st != RL_OK)
+        return st;
+    /* Everything selected gets drawn: light it all in one parallel pass
+     * (one object at a time would serialise the many small ones). */
+    if (dr->lit) {
+        light_scene(&dr->ctx, dr->opt.shading, dr->threads, dr->opt.object_mask, &dr->b);
+        memset(dr->object_lit, 1, d->num_objects ? d->num_objects : 1);
     }
 
     /* Report progress about a hundred times, not once per object. */
     uint32_t step = d->num_objects / 100 + 1;
     for (uint32_t o = 0; st == RL_OK && o < d->num_objects; ++o) {
-        if (selected(opt.object_mask, o))
-            st = draw_object(ras, d, o, opt.shading, lit, opt.flags, &b, c);
+        st = rl_scene_drawer_draw(dr, ras, o, c);
         if (st == RL_OK && progress && (o + 1) % step == 0 &&
             !progress(user, (double)(o + 1) / d->num_objects))
             st = rl_error(RL_ERR_CANCELLED, "raster: cancelled by the progress callback");
     }
-    free_buffers(&b);
+    rl_scene_drawer_release(dr);
     return st;
 }
 

@@ -38,4 +38,18 @@ rl_status rl_raster_draw_scene(rl_raster *ras, const rl_scene_data *d, rl_vec3 e
                                const rl_raster_scene_desc *desc, rl_raster_counters *c,
                                bool (*progress)(void *user, double done), void *user);
 
+/* The same drawing one object at a time, for renderers that decide per
+ * object what to draw and in which order (occlusion culling, level of
+ * detail): buffers are prepared once per frame, and an object is lit when
+ * it is first drawn, so culled objects cost no lighting. Drawing every
+ * selected object in index order gives exactly rl_raster_draw_scene's
+ * image. The drawer borrows d and desc->object_mask. */
+typedef struct rl_scene_drawer rl_scene_drawer;
+rl_status rl_scene_drawer_create(const rl_scene_data *d, rl_vec3 eye, const rl_raster_scene_desc *desc,
+                                 rl_scene_drawer **out);
+/* Draws object (an index < d->num_objects; unselected objects are skipped)
+ * into the rasterizer's current target. */
+rl_status rl_scene_drawer_draw(rl_scene_drawer *dr, rl_raster *ras, uint32_t object, rl_raster_counters *c);
+void rl_scene_drawer_release(rl_scene_drawer *dr);    /* NULL is a no-op */
+
 #endif
