@@ -20,5 +20,6 @@
 #include "rl/rl_sampling.h"
 #include "rl/rl_stats.h"
 #include "rl/rl_plot.h"
+#include "rl/rl_octree.h"
 #include "rl/rl_surfels.h"
 #endif
