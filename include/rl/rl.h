@@ -21,5 +21,6 @@
 #include "rl/rl_stats.h"
 #include "rl/rl_plot.h"
 #include "rl/rl_octree.h"
+#include "rl/rl_culling.h"
 #include "rl/rl_surfels.h"
 #endif

@@ -9,11 +9,13 @@ extern const rl_renderer_class rl_raster_renderer_class;     /* raster.c */
 extern const rl_renderer_class rl_whitted_renderer_class;    /* whitted.c */
 extern const rl_renderer_class rl_vt_renderer_class;         /* vt.c */
 extern const rl_renderer_class rl_pt_renderer_class;         /* pathtrace.c */
+extern const rl_renderer_class rl_chcpp_renderer_class;      /* chcpp.c */
 
 const rl_renderer_class *const rl_renderer_classes[] = {
     &rl_raster_renderer_class,
     &rl_whitted_renderer_class,
     &rl_vt_renderer_class,
     &rl_pt_renderer_class,
+    &rl_chcpp_renderer_class,
 };
 const size_t rl_renderer_class_count = sizeof rl_renderer_classes / sizeof rl_renderer_classes[0];

@@ -1,0 +1,525 @@
+/* chcpp.c: renderer "chcpp", CHC++ occlusion culling (Mattausch, Bittner &
+ * Wimmer 2008, "CHC++: Coherent Hierarchical Culling Revisited"), the
+ * conservative reference of Jähn 2015 (Sec. 2.1.2, 7.3-7.5), over the
+ * loose octree of rl_octree.h and the rasterizer's occlusion queries.
+ *
+ * Per frame the octree is traversed front to back (a priority queue on the
+ * eye-box distance). Temporal coherence, as in CHC/CHC++:
+ *  - a node visible in the previous frame is traversed at once: its
+ *    objects are drawn, its children queued. A node holding objects is
+ *    queried only every n_av frames (option assumed_visible), at a random
+ *    offset so that the queries of many nodes do not fall due together;
+ *    otherwise it is assumed visible;
+ *  - a node that was invisible (or not reached) in the previous frame goes
+ *    to the I-queue; when `batch` nodes have gathered, or the traversal
+ *    queue runs dry, they are queried as multi-queries: consecutive nodes
+ *    are grouped while the value |M| / C(M) grows, with the expected cost
+ *    C(M) = 1 + (1 - prod p_k) |M| (a failed multi-query costs one query
+ *    per node again) and the probability that a node invisible for i
+ *    frames stays invisible p(i) = 0.99 - 0.7 exp(-i) (CHC++, Sec. 4.2).
+ *    A node found visible is drawn and its children queued;
+ *  - visibility is pulled up: a visible node makes all its ancestors
+ *    visible; inner nodes are reset before their subtree reports.
+ * Tighter bounds (CHC++, Sec. 4.4): a node is queried with the tight box
+ * of its subtree's objects (rl_octree_node.bounds), or with the objects'
+ * own boxes where they are few (<= 8) and their surface is smaller; the
+ * classic loose box with tight = false. Query boxes are grown by a
+ * relative 1e-3 and nodes whose box reaches the near plane are never
+ * queried, so culling stays conservative: the image equals "raster"'s
+ * wherever no two surfaces fight for the same depth (coplanar overlaps are
+ * resolved by drawing order, here front to back, there by object index).
+ *
+ * Deviation, on purpose: our queries are synchronous (the software
+ * rasterizer answers at once), so there is no latency to hide: a query is
+ * evaluated against the depth buffer as it is when the query is issued,
+ * exactly the GPU semantics, and its result is used right away. The
+ * V-queue of CHC++ (deferring the queries of previously visible nodes to
+ * fill waiting time) therefore has nothing to fill; those queries are
+ * issued just before the node's objects are drawn, as in the original CHC,
+ * which also keeps a node's own geometry from hiding its box. Batching of
+ * the I-queue keeps its purpose: later queries see more occluders, and
+ * multi-queries save query fill.
+ *
+ * Options: the raster renderer's (shading, cull, ambient, background,
+ * threads) plus max_depth 5 (Jähn 2015, Sec. 7.3), looseness 2.0, batch 50,
+ * assumed_visible 10, multiquery true, tight true, seed 1. The defaults for
+ * batch and assumed_visible are ours, in the range the CHC++ paper
+ * explores. */
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "core/error.h"
+#include "render/culling.h"
+#include "render/raster_scene.h"
+#include "render/renderer.h"
+#include "rl/rl_timer.h"
+
+static const char *const shading_choices[] = { "flat", "gouraud", "textured", NULL };
+
+static const rl_option_info chcpp_options[] = {
+    { "shading", RL_OPT_ENUM, "textured", "flat | gouraud | textured, as raster", 0, 0, shading_choices },
+    { "cull", RL_OPT_BOOL, "false", "drop back faces (counter-clockwise = front)", 0, 0, NULL },
+    { "ambient", RL_OPT_FLOAT, "0.05", "ambient light, multiplied by k_d", 0, 1, NULL },
+    { "background", RL_OPT_COLOR, "0,0,0", "colour where nothing is drawn", 0, 0, NULL },
+    { "threads", RL_OPT_INT, "0", "OpenMP threads of the rasterizer (0 = all)", 0, 1024, NULL },
+    { "max_depth", RL_OPT_INT, "5", "maximum depth of the loose octree (0: all objects in the root)", 0,
+      RL_OCTREE_MAX_DEPTH, NULL },
+    { "looseness", RL_OPT_FLOAT, "2", "loose octree enlargement factor k", 1, 8, NULL },
+    { "batch", RL_OPT_INT, "50", "previously invisible nodes gathered before they are queried", 1, 100000,
+      NULL },
+    { "assumed_visible", RL_OPT_INT, "10", "a visible node is queried again about every n frames", 1, 100000,
+      NULL },
+    { "multiquery", RL_OPT_BOOL, "true", "query batched invisible nodes together (CHC++ Sec. 4.2)", 0, 0,
+      NULL },
+    { "tight", RL_OPT_BOOL, "true", "query the tight bounds of a node's objects, not its loose box", 0, 0,
+      NULL },
+    { "seed", RL_OPT_INT, "1", "seed of the random query offsets", 0, 4294967295.0, NULL },
+};
+
+typedef struct node_state {
+    uint64_t last_visited;        /* frame; 0 = never */
+    uint64_t next_query;          /* frame when a visible node is queried again */
+    uint32_t invisible_frames;    /* consecutive frames found invisible */
+    uint8_t visible;
+} node_state;
+
+typedef struct heap_item {
+    float dist;
+    uint32_t node;
+} heap_item;
+
+typedef struct chcpp_state {
+    rl_culling_head head;         /* first: rl_culling_get_stats */
+    rl_octree_cache oc;
+    node_state *ns;
+    uint32_t num_ns;
+    uint64_t frame;
+    heap_item *heap;
+    uint32_t heap_n, heap_cap;
+    uint32_t *iqueue;
+    uint32_t iq_n, iq_cap;
+    rl_box_query query;
+} chcpp_state;
+
+/* One frame's working set. */
+typedef struct frame_ctx {
+    chcpp_state *s;
+    const rl_scene_data *d;
+    const rl_octree_node *nodes;
+    const uint32_t *objects;
+    rl_raster *ras;
+    rl_scene_drawer *drawer;
+    rl_cull_view view;
+    rl_raster_counters counters;
+    bool tight, multiquery;
+    uint32_t batch, n_av;
+    uint64_t seed;
+} frame_ctx;
+
+static rl_status chcpp_create(void **state)
+{
+    chcpp_state *s = rl_calloc(1, sizeof *s);
+    if (!s)
+        return RL_ERR_OUT_OF_MEMORY;
+    *state = s;
+    return RL_OK;
+}
+
+static void chcpp_release(void *state)
+{
+    chcpp_state *s = state;
+    if (!s)
+        return;
+    rl_octree_cache_release(&s->oc);
+    rl_box_query_free(&s->query);
+    free(s->ns);
+    free(s->heap);
+    free(s->iqueue);
+    free(s);
+}
+
+static void chcpp_reset(void *state)
+{
+    chcpp_state *s = state;
+    if (s && s->ns)
+        memset(s->ns, 0, (size_t)s->num_ns * sizeof *s->ns);
+}
+
+/* --- the traversal queue: a binary min-heap on distance, ties by node --- */
+
+static bool heap_less(heap_item a, heap_item b)
+{
+    return a.dist < b.dist || (a.dist == b.dist && a.node < b.node);
+}
+
+static rl_status heap_push(chcpp_state *s, heap_item it)
+{
+    if (s->heap_n == s->heap_cap) {
+        uint32_t cap = s->heap_cap ? 2 * s->heap_cap : 256;
+        heap_item *h = realloc(s->heap, (size_t)cap * sizeof *h);
+        if (!h)
+            return RL_ERR_OUT_OF_MEMORY;
+        s->heap = h;
+        s->heap_cap = cap;
+    }
+    uint32_t i = s->heap_n++;
+    while (i > 0 && heap_less(it, s->heap[(i - 1) / 2])) {
+        s->heap[i] = s->heap[(i - 1) / 2];
+        i = (i - 1) / 2;
+    }
+    s->heap[i] = it;
+    return RL_OK;
+}
+
+static heap_item heap_pop(chcpp_state *s)
+{
+    heap_item top = s->heap[0], last = s->heap[--s->heap_n];
+    uint32_t i = 0, n = s->heap_n;
+    for (;;) {
+        uint32_t c = 2 * i + 1;
+        if (c >= n)
+            break;
+        if (c + 1 < n && heap_less(s->heap[c + 1], s->heap[c]))
+            ++c;
+        if (!heap_less(s->heap[c], last))
+            break;
+        s->heap[i] = s->heap[c];
+        i = c;
+    }
+    if (n > 0)
+        s->heap[i] = last;
+    return top;
+}
+
+/* --- CHC++ --- */
+
+/* CHC++, Sec. 4.2: probability that a node invisible for i frames stays so. */
+static double p_stay_invisible(uint32_t i)
+{
+    return 0.99 - 0.7 * exp(-(double)i);
+}
+
+static uint64_t mix64(uint64_t x)
+{
+    x ^= x >> 33;
+    x *= 0xff51afd7ed558ccdULL;
+    x ^= x >> 33;
+    x *= 0xc4ceb9fe1a85ec53ULL;
+    x ^= x >> 33;
+    return x;
+}
+
+static void pull_up(frame_ctx *f, uint32_t n)
+{
+    while (n != RL_NONE && !f->s->ns[n].visible) {
+        f->s->ns[n].visible = 1;
+        n = f->nodes[n].parent;
+    }
+}
+
+/* The next frame at which a visible node is queried again: n_av frames on,
+ * minus a random part so that nodes spread over the frames. */
+static void schedule_query(frame_ctx *f, uint32_t n)
+{
+    uint64_t r = mix64(f->seed ^ ((uint64_t)n << 32) ^ f->s->frame);
+    f->s->ns[n].next_query = f->s->frame + 1 + r % f->n_av;
+}
+
+/* Draws the node's own objects and queues its children. */
+static rl_status traverse(frame_ctx *f, uint32_t n)
+{
+    const rl_octree_node *node = &f->nodes[n];
+    rl_status st = RL_OK;
+    for (uint32_t k = 0; k < node->num_objects && st == RL_OK; ++k) {
+        uint32_t o = f->objects[node->first_object + k];
+        st = rl_scene_drawer_draw(f->drawer, f->ras, o, &f->counters);
+        f->s->head.stats.objects_drawn++;
+        f->s->head.stats.triangles_drawn += f->d->objects[o].num_triangles;
+    }
+    for (uint32_t c = 0; c < node->num_children && st == RL_OK; ++c) {
+        uint32_t ch = node->first_child + c;
+        st = heap_push(f->s, (heap_item){ rl_cull_box_distance(f->view.eye, f->nodes[ch].bounds), ch });
+    }
+    return st;
+}
+
+/* Collects the boxes of the objects below n into the query while there
+ * are at most `room` of them; false when there are more. */
+static bool object_boxes(frame_ctx *f, uint32_t n, uint32_t *room, double *area)
+{
+    const rl_octree_node *node = &f->nodes[n];
+    if (node->num_objects > *room)
+        return false;
+    *room -= node->num_objects;
+    for (uint32_t k = 0; k < node->num_objects; ++k)
+        *area += rl_aabb_area(f->d->objects[f->objects[node->first_object + k]].bounds);
+    for (uint32_t c = 0; c < node->num_children; ++c)
+        if (!object_boxes(f, node->first_child + c, room, area))
+            return false;
+    return true;
+}
+
+static rl_status add_object_boxes(frame_ctx *f, uint32_t n)
+{
+    const rl_octree_node *node = &f->nodes[n];
+    rl_status st = RL_OK;
+    for (uint32_t k = 0; k < node->num_objects && st == RL_OK; ++k)
+        st = rl_box_query_add(&f->s->query, f->d->objects[f->objects[node->first_object + k]].bounds, 1e-3f);
+    for (uint32_t c = 0; c < node->num_children && st == RL_OK; ++c)
+        st = add_object_boxes(f, node->first_child + c);
+    return st;
+}
+
+/* Adds node n's query geometry (tighter bounds, CHC++ Sec. 4.4). */
+static rl_status add_node_boxes(frame_ctx *f, uint32_t n)
+{
+    const rl_octree_node *node = &f->nodes[n];
+    if (!f->tight)
+        return rl_box_query_add(&f->s->query, node->loose, 1e-3f);
+    uint32_t room = 8;
+    double area = 0.0;
+    if (node->subtree_objects > 1 && object_boxes(f, n, &room, &area) && area < rl_aabb_area(node->bounds))
+        return add_object_boxes(f, n);
+    return rl_box_query_add(&f->s->query, node->bounds, 1e-3f);
+}
+
+/* One occlusion query over the nodes list[0..count). */
+static rl_status query_nodes(frame_ctx *f, const uint32_t *list, uint32_t count, bool *visible)
+{
+    rl_box_query_reset(&f->s->query);
+    rl_status st = RL_OK;
+    for (uint32_t i = 0; i < count && st == RL_OK; ++i)
+        st = add_node_boxes(f, list[i]);
+    uint64_t pixels = 0;
+    if (st == RL_OK)
+        st = rl_box_query_run(&f->s->query, f->ras, &pixels, NULL);
+    f->s->head.stats.queries++;
+    f->s->head.stats.query_boxes += f->s->query.boxes;
+    if (count > 1)
+        f->s->head.stats.multiqueries++;
+    *visible = pixels > 0;
+    return st;
+}
+
+/* A previously invisible node found visible (or invisible) by its query. */
+static rl_status resolve(frame_ctx *f, uint32_t n, bool visible)
+{
+    node_state *ns = &f->s->ns[n];
+    if (!visible) {
+        ns->visible = 0;
+        ns->invisible_frames++;
+        f->s->head.stats.nodes_occluded++;
+        return RL_OK;
+    }
+    ns->invisible_frames = 0;
+    pull_up(f, n);
+    schedule_query(f, n);
+    return traverse(f, n);
+}
+
+/* Queries the I-queue: multi-queries grouped by the CHC++ cost model, a
+ * failed one node by node. */
+static rl_status flush_iqueue(frame_ctx *f)
+{
+    chcpp_state *s = f->s;
+    rl_status st = RL_OK;
+    uint32_t i = 0;
+    while (i < s->iq_n && st == RL_OK) {
+        uint32_t m = 1;
+        if (f->multiquery) {
+            double p_all = p_stay_invisible(s->ns[s->iqueue[i]].invisible_frames);
+            double best = 1.0 / (1.0 + (1.0 - p_all));
+            while (i + m < s->iq_n) {
+                double p = p_all * p_stay_invisible(s->ns[s->iqueue[i + m]].invisible_frames);
+                double value = (double)(m + 1) / (1.0 + (1.0 - p) * (double)(m + 1));
+                if (!(value > best))
+                    break;
+                best = value;
+                p_all = p;
+                ++m;
+            }
+        }
+        bool visible = false;
+        st = query_nodes(f, s->iqueue + i, m, &visible);
+        if (st == RL_OK && m > 1 && visible) {
+            s->head.stats.multiqueries_failed++;
+            for (uint32_t k = 0; k < m && st == RL_OK; ++k) {
+                bool v = false;
+                st = query_nodes(f, s->iqueue + i + k, 1, &v);
+                if (st == RL_OK)
+                    st = resolve(f, s->iqueue[i + k], v);
+            }
+        } else {
+            for (uint32_t k = 0; k < m && st == RL_OK; ++k)
+                st = resolve(f, s->iqueue[i + k], visible);
+        }
+        i += m;
+    }
+    s->iq_n = 0;
+    return st;
+}
+
+static rl_status iqueue_push(chcpp_state *s, uint32_t n)
+{
+    if (s->iq_n == s->iq_cap) {
+        uint32_t cap = s->iq_cap ? 2 * s->iq_cap : 256;
+        uint32_t *q = realloc(s->iqueue, (size_t)cap * sizeof *q);
+        if (!q)
+            return RL_ERR_OUT_OF_MEMORY;
+        s->iqueue = q;
+        s->iq_cap = cap;
+    }
+    s->iqueue[s->iq_n++] = n;
+    return RL_OK;
+}
+
+/* The CHC++ main loop over one frame. */
+static rl_status chcpp_frame(frame_ctx *f)
+{
+    chcpp_state *s = f->s;
+    rl_culling_stats *stats = &s->head.stats;
+    rl_status st = heap_push(s, (heap_item){ rl_cull_box_distance(f->view.eye, f->nodes[0].bounds), 0 });
+    while (st == RL_OK && (s->heap_n > 0 || s->iq_n > 0)) {
+        if (s->heap_n == 0) {
+            st = flush_iqueue(f);   /* may queue the children of visible nodes */
+            continue;
+        }
+        uint32_t n = heap_pop(s).node;
+        const rl_octree_node *node = &f->nodes[n];
+        node_state *ns = &s->ns[n];
+        stats->nodes_visited++;
+        bool was_visible = ns->visible && ns->last_visited + 1 == s->frame;
+        ns->last_visited = s->frame;
+        if (!rl_cull_box_in_frustum(&f->view, node->bounds)) {
+            ns->visible = 0;
+            stats->nodes_frustum_culled++;
+            continue;
+        }
+        if (rl_cull_box_near_eye(&f->view, f->tight ? node->bounds : node->loose)) {
+            /* No query can be trusted where the near plane cuts the box. */
+            ns->visible = 0;
+            if (node->num_objects)
+                pull_up(f, n);
+            st = traverse(f, n);
+            continue;
+        }
+        if (!was_visible) {
+            st = iqueue_push(s, n);
+            if (st == RL_OK && s->iq_n >= f->batch)
+                st = flush_iqueue(f);
+            continue;
+        }
+        /* Previously visible: reset, then let the node's own query (when
+         * due) or its subtree pull the visibility up again. */
+        ns->visible = 0;
+        if (node->num_objects) {
+            if (s->frame >= ns->next_query) {
+                bool v = false;
+                st = query_nodes(f, &n, 1, &v);
+                schedule_query(f, n);
+                if (v)
+                    pull_up(f, n);
+                else
+                    ns->invisible_frames++;
+            } else {
+                pull_up(f, n);
+            }
+        }
+        if (st == RL_OK)
+            st = traverse(f, n);
+    }
+    s->heap_n = 0;
+    s->iq_n = 0;
+    return st;
+}
+
+static rl_status chcpp_render(rl_renderer *r, void *state, const rl_scene *scene, const rl_camera *cam,
+                              rl_image *image, rl_render_stats *stats)
+{
+    chcpp_state *s = state;
+    const rl_scene_data *d = rl_scene_get_data(scene);
+    if (!d)
+        return RL_ERR_NOT_COMMITTED;
+    memset(&s->head.stats, 0, sizeof s->head.stats);
+    s->head.have_frame = false;
+
+    rl_timer t0;
+    rl_timer_start(&t0);
+    int depth = (int)rl_renderer_opt_int(r, "max_depth");
+    rl_octree_desc od = { .max_depth = depth ? depth : RL_OCTREE_DEPTH_ZERO,
+                          .looseness = (float)rl_renderer_opt_float(r, "looseness") };
+    bool rebuilt = false;
+    rl_status st = rl_octree_cache_get(&s->oc, scene, &od, &rebuilt);
+    if (st != RL_OK)
+        return st;
+    uint32_t nn;
+    const rl_octree_node *nodes = rl_octree_nodes(s->oc.tree, &nn);
+    if (rebuilt || s->num_ns != nn) {
+        free(s->ns);
+        s->ns = rl_calloc(nn, sizeof *s->ns);
+        s->num_ns = s->ns ? nn : 0;
+        if (!s->ns)
+            return RL_ERR_OUT_OF_MEMORY;
+        s->head.stats.preprocess_ms = rl_timer_ms(&t0);
+    }
+    s->head.stats.octree_nodes = nn;
+    s->head.stats.octree_depth = rl_octree_depth(s->oc.tree);
+
+    rl_raster_scene_desc desc = {
+        .shading = (rl_raster_shading)rl_renderer_opt_enum(r, "shading"),
+        .ambient = (float)rl_renderer_opt_float(r, "ambient"),
+        .threads = (int)rl_renderer_opt_int(r, "threads"),
+        .flags = rl_renderer_opt_bool(r, "cull") ? RL_RASTER_CULL_BACK : 0u,
+    };
+    rl_cull_target target;
+    st = rl_cull_target_begin(image, rl_renderer_opt_color(r, "background"), &target);
+    if (st != RL_OK)
+        return st;
+    desc.flags |= target.flags;
+
+    frame_ctx f;
+    memset(&f, 0, sizeof f);
+    f.s = s;
+    f.d = d;
+    f.nodes = nodes;
+    f.objects = rl_octree_objects(s->oc.tree, NULL);
+    f.tight = rl_renderer_opt_bool(r, "tight");
+    f.multiquery = rl_renderer_opt_bool(r, "multiquery");
+    f.batch = (uint32_t)rl_renderer_opt_int(r, "batch");
+    f.n_av = (uint32_t)rl_renderer_opt_int(r, "assumed_visible");
+    f.seed = (uint64_t)rl_renderer_opt_int(r, "seed");
+    rl_cull_view_make(cam, d->bounds, &f.view);
+    st = rl_raster_create(&(rl_raster_desc){ .threads = desc.threads }, &f.ras);
+    if (st == RL_OK)
+        st = rl_raster_set_target(f.ras, &target.image, &f.view.view, &f.view.proj);
+    if (st == RL_OK)
+        st = rl_scene_drawer_create(d, f.view.eye, &desc, &f.drawer);
+    if (st == RL_OK) {
+        s->frame++;
+        st = chcpp_frame(&f);
+    }
+    rl_scene_drawer_release(f.drawer);
+    rl_raster_release(f.ras);
+    rl_cull_target_end(&target);
+    if (st != RL_OK)
+        return st;
+    stats->triangles_rasterized = f.counters.triangles_drawn;
+    stats->pixels_written = f.counters.pixels_written;
+    stats->samples = (uint64_t)image->width * image->height;
+    stats->occlusion_queries = s->head.stats.queries;
+    s->head.have_frame = true;
+    return RL_OK;
+}
+
+const rl_renderer_class rl_chcpp_renderer_class = {
+    .info = { "chcpp", "CHC++ occlusion culling over a loose octree; the same image as raster",
+              "Mattausch, Bittner & Wimmer 2008; Jähn 2015, Sec. 2.1.2, 7.3" },
+    .options = chcpp_options,
+    .num_options = sizeof chcpp_options / sizeof chcpp_options[0],
+    .create = chcpp_create,
+    .render = chcpp_render,
+    .release = chcpp_release,
+    .check = NULL,
+    .reset = chcpp_reset,
+};

@@ -1,0 +1,208 @@
+/* culling.c: see culling.h. */
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "core/error.h"
+#include "render/culling.h"
+#include "render/renderer.h"
+
+void rl_cull_view_make(const rl_camera *cam, rl_aabb scene_bounds, rl_cull_view *v)
+{
+    memset(v, 0, sizeof *v);
+    v->cam = rl_camera_resolve(cam);
+    v->eye = v->cam.eye;
+    float z_near = v->cam.z_near, z_far = v->cam.z_far;
+    if (!(z_near > 0.0f))
+        rl_camera_clip_range(&v->cam, scene_bounds, &z_near, &z_far);
+    v->z_near = z_near;
+    v->z_far = z_far;
+    v->view = rl_camera_view(&v->cam);
+    v->proj = rl_camera_projection(&v->cam, z_near, z_far);
+    v->view_proj = rl_mat4_mul(&v->proj, &v->view);
+
+    /* Gribb & Hartmann 2001: the clip planes are sums and differences of
+     * the rows of the view-projection (column vectors, -w <= x,y,z <= w). */
+    const float(*m)[4] = v->view_proj.m;
+    for (int i = 0; i < 6; ++i) {
+        int row = i / 2;
+        float s = (i & 1) ? -1.0f : 1.0f;
+        rl_vec4 p = { m[3][0] + s * m[row][0], m[3][1] + s * m[row][1], m[3][2] + s * m[row][2],
+                      m[3][3] + s * m[row][3] };
+        float len = sqrtf(p.x * p.x + p.y * p.y + p.z * p.z);
+        if (len > 0.0f)
+            p = (rl_vec4){ p.x / len, p.y / len, p.z / len, p.w / len };
+        v->planes[i] = p;
+    }
+    float ty = tanf(0.5f * rl_radians(v->cam.fov_deg));
+    float tx = ty * (float)v->cam.width / (float)v->cam.height;
+    v->near_radius = z_near * sqrtf(1.0f + tx * tx + ty * ty);
+    v->focal_px = 0.5f * (float)v->cam.height / ty;
+}
+
+bool rl_cull_box_in_frustum(const rl_cull_view *v, rl_aabb b)
+{
+    for (int i = 0; i < 6; ++i) {
+        const rl_vec4 p = v->planes[i];
+        /* The box corner farthest along the plane normal. */
+        rl_vec3 c = { p.x >= 0.0f ? b.max.x : b.min.x, p.y >= 0.0f ? b.max.y : b.min.y,
+                      p.z >= 0.0f ? b.max.z : b.min.z };
+        float dist = p.x * c.x + p.y * c.y + p.z * c.z + p.w;
+        /* A small slack: a box touching a plane is kept. */
+        if (dist < -1e-5f * (fabsf(p.w) + 1.0f))
+            return false;
+    }
+    return true;
+}
+
+float rl_cull_box_distance(rl_vec3 eye, rl_aabb b)
+{
+    float dx = rl_maxf(rl_maxf(b.min.x - eye.x, 0.0f), eye.x - b.max.x);
+    float dy = rl_maxf(rl_maxf(b.min.y - eye.y, 0.0f), eye.y - b.max.y);
+    float dz = rl_maxf(rl_maxf(b.min.z - eye.z, 0.0f), eye.z - b.max.z);
+    return sqrtf(dx * dx + dy * dy + dz * dz);
+}
+
+bool rl_cull_box_near_eye(const rl_cull_view *v, rl_aabb b)
+{
+    return rl_cull_box_distance(v->eye, b) <= 2.0f * v->near_radius;
+}
+
+double rl_cull_projected_area(const rl_cull_view *v, rl_aabb b)
+{
+    rl_vec3 e = rl_aabb_extent(b);
+    double r = 0.5 * sqrt((double)e.x * e.x + (double)e.y * e.y + (double)e.z * e.z);
+    rl_vec3 c = rl_aabb_center(b);
+    double d = rl_length(rl_sub(c, v->eye));
+    if (d <= r)   /* around the eye: the whole screen */
+        return (double)v->cam.width * v->cam.height;
+    /* Radius on screen of a sphere at distance d (its silhouette cone). */
+    double rp = (double)v->focal_px * r / sqrt(d * d - r * r);
+    double a = (double)RL_PI * rp * rp;
+    return a > 1.0 ? a : 1.0;
+}
+
+void rl_box_query_reset(rl_box_query *q)
+{
+    q->boxes = 0;
+}
+
+rl_status rl_box_query_add(rl_box_query *q, rl_aabb b, float margin)
+{
+    if (q->boxes == q->cap_boxes) {
+        size_t cap = q->cap_boxes ? 2 * q->cap_boxes : 64;
+        rl_vec3 *p = realloc(q->positions, cap * 8 * sizeof *p);
+        if (!p)
+            return RL_ERR_OUT_OF_MEMORY;
+        q->positions = p;
+        uint32_t *ix = realloc(q->indices, cap * 36 * sizeof *ix);
+        if (!ix)
+            return RL_ERR_OUT_OF_MEMORY;
+        q->indices = ix;
+        q->cap_boxes = cap;
+    }
+    rl_vec3 e = rl_aabb_extent(b);
+    float grow = margin * rl_maxf(rl_maxf(e.x, e.y), e.z) + 1e-6f;
+    b.min = rl_sub(b.min, rl_v3s(grow));
+    b.max = rl_add(b.max, rl_v3s(grow));
+    rl_vec3 *p = q->positions + (size_t)q->boxes * 8;
+    for (int i = 0; i < 8; ++i)
+        p[i] = rl_v3((i & 1) ? b.max.x : b.min.x, (i & 2) ? b.max.y : b.min.y, (i & 4) ? b.max.z : b.min.z);
+    /* Counter-clockwise seen from outside, so that back faces can be culled. */
+    static const uint32_t faces[36] = { 0, 2, 1, 1, 2, 3, 4, 5, 6, 5, 7, 6, 0, 1, 4, 1, 5, 4,
+                                        2, 6, 3, 3, 6, 7, 0, 4, 2, 2, 4, 6, 1, 3, 5, 3, 7, 5 };
+    uint32_t *ix = q->indices + (size_t)q->boxes * 36;
+    for (int i = 0; i < 36; ++i)
+        ix[i] = q->boxes * 8 + faces[i];
+    q->boxes++;
+    return RL_OK;
+}
+
+rl_status rl_box_query_run(rl_box_query *q, rl_raster *ras, uint64_t *pixels, rl_raster_counters *c)
+{
+    *pixels = 0;
+    if (q->boxes == 0)
+        return RL_OK;
+    rl_raster_batch batch;
+    memset(&batch, 0, sizeof batch);
+    batch.num_vertices = q->boxes * 8;
+    batch.positions = q->positions;
+    batch.num_triangles = q->boxes * 12;
+    batch.indices = q->indices;
+    batch.flags = RL_RASTER_CULL_BACK;
+    if (c)
+        c->triangles_in += batch.num_triangles;
+    return rl_raster_query(ras, &batch, pixels);
+}
+
+void rl_box_query_free(rl_box_query *q)
+{
+    free(q->positions);
+    free(q->indices);
+    memset(q, 0, sizeof *q);
+}
+
+rl_status rl_cull_target_begin(rl_image *image, rl_vec3 background, rl_cull_target *t)
+{
+    memset(t, 0, sizeof *t);
+    t->image = *image;
+    size_t num_pixels = (size_t)image->width * (size_t)image->height;
+    if (!(t->image.layers & RL_LAYER_DEPTH) || !t->image.depth) {
+        t->own_depth = rl_calloc(num_pixels ? num_pixels : 1, sizeof *t->own_depth);
+        if (!t->own_depth)
+            return RL_ERR_OUT_OF_MEMORY;
+        t->image.depth = t->own_depth;
+        t->image.layers |= RL_LAYER_DEPTH;
+    }
+    if (!(t->image.layers & RL_LAYER_ID) || !t->image.object_id || !t->image.triangle_id)
+        t->flags |= RL_RASTER_NO_ID;
+    rl_image_clear(&t->image);
+    rl_image_fill(&t->image, rl_v4_from3(background, 1.0f));
+    return RL_OK;
+}
+
+void rl_cull_target_end(rl_cull_target *t)
+{
+    free(t->own_depth);
+    t->own_depth = NULL;
+}
+
+rl_status rl_octree_cache_get(rl_octree_cache *c, const rl_scene *scene, const rl_octree_desc *desc,
+                              bool *rebuilt)
+{
+    *rebuilt = false;
+    uint64_t uid = rl_scene_uid(scene);
+    if (c->tree && c->scene_uid == uid && memcmp(&c->desc, desc, sizeof *desc) == 0)
+        return RL_OK;
+    rl_octree_release(c->tree);
+    c->tree = NULL;
+    rl_status st = rl_octree_build(scene, desc, &c->tree);
+    if (st != RL_OK)
+        return st;
+    c->scene_uid = uid;
+    c->desc = *desc;
+    *rebuilt = true;
+    return RL_OK;
+}
+
+void rl_octree_cache_release(rl_octree_cache *c)
+{
+    rl_octree_release(c->tree);
+    memset(c, 0, sizeof *c);
+}
+
+rl_status rl_culling_get_stats(const rl_renderer *r, rl_culling_stats *out)
+{
+    static const char *const names[] = { "chcpp", "svs", "visset", "surfels" };
+    bool known = false;
+    for (size_t i = 0; r && i < sizeof names / sizeof names[0]; ++i)
+        known |= strcmp(rl_renderer_name(r), names[i]) == 0;
+    if (!known || !out)
+        return rl_error(RL_ERR_INVALID_ARG,
+                        "rl_culling_get_stats: needs a chcpp, svs, visset or surfels renderer and out");
+    const rl_culling_head *h = rl_renderer_state(r);
+    if (!h || !h->have_frame)
+        return rl_error(RL_ERR_INVALID_ARG, "rl_culling_get_stats: no frame rendered yet");
+    *out = h->stats;
+    return RL_OK;
+}

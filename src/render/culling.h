@@ -1,0 +1,83 @@
+/* culling.h: what the visibility-culling and level-of-detail renderers
+ * (chcpp.c, svs.c, surfels.c) share: the view of one frame with its
+ * frustum, bounding-box occlusion queries through the rasterizer, the
+ * render target with a private depth layer, and a loose octree kept
+ * between frames. */
+#ifndef RL_RENDER_CULLING_H
+#define RL_RENDER_CULLING_H
+
+#include "rl/rl_culling.h"
+#include "rl/rl_octree.h"
+#include "rl/rl_raster.h"
+#include "rl/rl_scene.h"
+
+/* One frame's camera, exactly as rl_raster_set_camera() sets it up. */
+typedef struct rl_cull_view {
+    rl_camera cam;                /* resolved */
+    rl_vec3 eye;
+    float z_near, z_far;
+    rl_mat4 view, proj, view_proj;
+    rl_vec4 planes[6];            /* inward: dot(n, p) + d >= 0 inside */
+    float near_radius;            /* eye to the near plane's corners */
+    float focal_px;               /* pixels per unit at depth 1 (vertical) */
+} rl_cull_view;
+
+void rl_cull_view_make(const rl_camera *cam, rl_aabb scene_bounds, rl_cull_view *v);
+/* False only where the box is certainly outside the frustum. */
+bool rl_cull_box_in_frustum(const rl_cull_view *v, rl_aabb b);
+/* True where a box query could be wrong because the near plane cuts the
+ * box's front (the eye is inside the box grown by near_radius). */
+bool rl_cull_box_near_eye(const rl_cull_view *v, rl_aabb b);
+/* Distance from the eye to the box (0 inside): the front-to-back key. */
+float rl_cull_box_distance(rl_vec3 eye, rl_aabb b);
+/* Projected area in pixels of the box's bounding sphere (Jähn 2015,
+ * Sec. 6.2 "projizierte Größe"), at least 1 for a box around the eye. */
+double rl_cull_projected_area(const rl_cull_view *v, rl_aabb b);
+
+/* Several boxes as one occlusion query (a multi-query, Mattausch et al.
+ * 2008): front faces only, each box grown by a relative margin so that
+ * the geometry it bounds can never poke through its faces by rounding. */
+typedef struct rl_box_query {
+    rl_vec3 *positions;
+    uint32_t *indices;
+    uint32_t boxes;
+    size_t cap_boxes;
+} rl_box_query;
+
+void rl_box_query_reset(rl_box_query *q);
+rl_status rl_box_query_add(rl_box_query *q, rl_aabb b, float margin);
+/* Visible pixels of all boxes added since the last reset (0 boxes: 0). */
+rl_status rl_box_query_run(rl_box_query *q, rl_raster *ras, uint64_t *pixels, rl_raster_counters *c);
+void rl_box_query_free(rl_box_query *q);
+
+/* The caller's image as the rasterizer's target, with a private depth
+ * layer if the caller asked for none, cleared to the background. */
+typedef struct rl_cull_target {
+    rl_image image;
+    float *own_depth;
+    unsigned flags;               /* RL_RASTER_NO_ID when the caller has no ID layer */
+} rl_cull_target;
+
+rl_status rl_cull_target_begin(rl_image *image, rl_vec3 background, rl_cull_target *t);
+void rl_cull_target_end(rl_cull_target *t);
+
+/* A loose octree rebuilt only when the scene or its parameters change. */
+typedef struct rl_octree_cache {
+    rl_octree *tree;
+    uint64_t scene_uid;
+    rl_octree_desc desc;
+} rl_octree_cache;
+
+/* *rebuilt tells whether per-node state must be reset. */
+rl_status rl_octree_cache_get(rl_octree_cache *c, const rl_scene *scene, const rl_octree_desc *desc,
+                              bool *rebuilt);
+void rl_octree_cache_release(rl_octree_cache *c);
+
+/* Every culling renderer's state starts with this, so that
+ * rl_culling_get_stats() can read any of them. */
+typedef struct rl_culling_head {
+    rl_culling_stats stats;
+    bool have_frame;
+} rl_culling_head;
+
+#endif
