@@ -5,7 +5,10 @@
 #define RL_TESTS_RENDER_FIXTURES_H
 
 #include "rl/rl_render.h"
+#include "rl/rl_rng.h"
 #include "rl/rl_scene.h"
+
+#include <stdlib.h>
 
 #define FX_ALL_LAYERS (RL_LAYER_COLOR | RL_LAYER_DEPTH | RL_LAYER_ID)
 
@@ -61,6 +64,80 @@ static inline rl_scene *fx_cornell(rl_camera *cam, int size)
     assert_int_equal(rl_scene_create_builtin("cornell", NULL, &s), RL_OK);
     assert_int_equal(rl_scene_get_camera(s, NULL, cam), RL_OK);
     cam->width = cam->height = size;
+    return s;
+}
+
+static inline void fx_add_box(rl_scene *s, uint32_t mat, rl_vec3 lo, rl_vec3 hi, uint32_t subdiv)
+{
+    /* A box whose faces are split into subdiv x subdiv quads, so that it
+     * has enough triangles for culling to matter. */
+    uint32_t n = subdiv + 1, nv = 6 * n * n, nt = 6 * subdiv * subdiv * 2;
+    rl_vec3 *p = malloc(nv * sizeof *p);
+    uint32_t *idx = malloc(nt * 3 * sizeof *idx);
+    uint32_t v = 0, t = 0;
+    for (int face = 0; face < 6; ++face) {
+        int axis = face / 2, u = (axis + 1) % 3, w = (axis + 2) % 3;
+        bool hi_side = face & 1;
+        uint32_t base = v;
+        for (uint32_t i = 0; i < n; ++i)
+            for (uint32_t j = 0; j < n; ++j) {
+                float c[3];
+                float lo3[3] = { lo.x, lo.y, lo.z }, hi3[3] = { hi.x, hi.y, hi.z };
+                c[axis] = hi_side ? hi3[axis] : lo3[axis];
+                c[u] = lo3[u] + (hi3[u] - lo3[u]) * (float)i / (float)subdiv;
+                c[w] = lo3[w] + (hi3[w] - lo3[w]) * (float)j / (float)subdiv;
+                p[v++] = rl_v3(c[0], c[1], c[2]);
+            }
+        for (uint32_t i = 0; i < subdiv; ++i)
+            for (uint32_t j = 0; j < subdiv; ++j) {
+                uint32_t a = base + i * n + j, b = a + n, c = a + 1, d = b + 1;
+                uint32_t q[6] = { a, b, c, c, b, d };
+                if (!hi_side) {
+                    q[1] = c, q[2] = b, q[4] = d, q[5] = b;
+                }
+                for (int k = 0; k < 6; ++k)
+                    idx[t++] = q[k];
+            }
+    }
+    uint32_t mesh, node;
+    rl_mesh_desc md = { .name = "box", .num_vertices = nv, .positions = p, .num_triangles = nt,
+                        .indices = idx, .material = mat };
+    assert_int_equal(rl_scene_add_mesh(s, &md, &mesh), RL_OK);
+    assert_int_equal(rl_scene_add_node(s, RL_NODE_ROOT, "box", NULL, &node), RL_OK);
+    assert_int_equal(rl_scene_node_set_mesh(s, node, mesh), RL_OK);
+    free(p);
+    free(idx);
+}
+
+/* The culling tests' city: a 12 x 12 grid of buildings of random heights on a ground slab, every
+ * coordinate jittered so that no two faces share a plane. */
+static inline rl_scene *fx_box_city(void)
+{
+    rl_scene *s = NULL;
+    assert_int_equal(rl_scene_create(&s), RL_OK);
+    rl_rng rng;
+    rl_rng_seed(&rng, 7, 1);
+    uint32_t mats[4];
+    for (int i = 0; i < 4; ++i) {
+        rl_material m = rl_material_default();
+        m.diffuse = rl_v3(0.3f + 0.15f * (float)i, 0.5f, 0.8f - 0.15f * (float)i);
+        m.specular = rl_v3s(0.2f);
+        assert_int_equal(rl_scene_add_material(s, &m, &mats[i]), RL_OK);
+    }
+    fx_add_box(s, mats[0], rl_v3(-5.013f, -1.0f, -5.021f), rl_v3(125.017f, -0.0031f, 125.011f), 8);
+    for (int i = 0; i < 12; ++i)
+        for (int j = 0; j < 12; ++j) {
+            float x = 10.0f * (float)i + 1.0f + 0.37f * rl_rng_float(&rng);
+            float z = 10.0f * (float)j + 1.0f + 0.41f * rl_rng_float(&rng);
+            float h = 4.0f + 30.0f * rl_rng_float(&rng);
+            float w = 6.0f + 1.5f * rl_rng_float(&rng);
+            fx_add_box(s, mats[(i + j) % 4], rl_v3(x, 0.0013f * (float)(i * 12 + j + 1), z),
+                    rl_v3(x + w, h, z + w + 0.1f * rl_rng_float(&rng)), 4);
+        }
+    rl_light l = { .type = RL_LIGHT_DIRECTIONAL, .color = rl_v3s(1.0f), .intensity = 1.0f,
+                   .direction = rl_normalize(rl_v3(-0.3f, -1.0f, -0.5f)) };
+    assert_int_equal(rl_scene_add_light(s, &l), RL_OK);
+    assert_int_equal(rl_scene_commit(s), RL_OK);
     return s;
 }
 
