@@ -13,6 +13,7 @@
 #include "bench_pt.h"
 #include "bench_rays.h"
 #include "bench_sampling.h"
+#include "bench_surfels.h"
 #include "bench_util.h"
 #include "bench_vt.h"
 #include "cli.h"
@@ -31,6 +32,7 @@ static const char bench_help[] =
     "       rl bench vt [options]   Vertex Tracing vs Whitted (see rl bench vt --help)\n"
     "       rl bench pt [options]   Line Space path tracing (see rl bench pt --help)\n"
     "       rl bench sampling [options]  property sampling, Jaehn 2015 Sec. 5.7\n"
+    "       rl bench surfels [options]   Progressive Blue Surfels, Jaehn 2015 Table 6.1\n"
     "\n"
     "Times ray queries of each accelerator on three workloads generated once\n"
     "per scene and shared by all accelerators:\n"
@@ -191,7 +193,8 @@ static int parse_args(int argc, char **argv, bench_args *a)
         return -1;
     }
     if (strcmp(argv[1], "rays") != 0)
-        return rl_cli_fail(RL_CLI_USAGE, "bench: unknown benchmark '%s' (known: rays, vt, pt)",
+        return rl_cli_fail(RL_CLI_USAGE, "bench: unknown benchmark '%s' (known: rays, vt, pt, "
+                           "sampling, surfels)",
                            argv[1]);
     bool has_scenes = false, has_accels = false;
     for (int i = 2; i < argc; i++) {
@@ -623,6 +626,8 @@ int rl_cli_bench(int argc, char **argv)
         return rl_bench_pt(argc, argv);
     if (argc >= 2 && strcmp(argv[1], "sampling") == 0)
         return rl_bench_sampling(argc, argv);
+    if (argc >= 2 && strcmp(argv[1], "surfels") == 0)
+        return rl_bench_surfels(argc, argv);
     bench_args a;
     memset(&a, 0, sizeof a);
     int rc = parse_args(argc, argv, &a);

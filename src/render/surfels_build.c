@@ -74,7 +74,9 @@
 #define SURFEL_MAX_NEIGHBOURS 1024u
 #define SURFEL_MAX_THREADS 4096
 #define SURFEL_VIEWS 8
-#define SURFEL_PARALLEL_SAMPLE 512     /* distance queries of a sample this big run in parallel */
+/* Distance queries of a sample this big run in parallel; smaller ones do not
+ * pay for a parallel region per sample (on a busy machine they lose). */
+#define SURFEL_PARALLEL_SAMPLE 4096
 
 /* Share of the progress bar per step. */
 #define PROGRESS_ATLAS 0.35
