@@ -11,6 +11,7 @@ extern const rl_renderer_class rl_vt_renderer_class;         /* vt.c */
 extern const rl_renderer_class rl_pt_renderer_class;         /* pathtrace.c */
 extern const rl_renderer_class rl_chcpp_renderer_class;      /* chcpp.c */
 extern const rl_renderer_class rl_svs_renderer_class;        /* svs.c */
+extern const rl_renderer_class rl_visset_renderer_class;     /* visset.c */
 
 const rl_renderer_class *const rl_renderer_classes[] = {
     &rl_raster_renderer_class,
@@ -19,5 +20,6 @@ const rl_renderer_class *const rl_renderer_classes[] = {
     &rl_pt_renderer_class,
     &rl_chcpp_renderer_class,
     &rl_svs_renderer_class,
+    &rl_visset_renderer_class,
 };
 const size_t rl_renderer_class_count = sizeof rl_renderer_classes / sizeof rl_renderer_classes[0];

@@ -28,7 +28,10 @@ static inline rl_image *fx_render_with(rl_renderer *r, const rl_scene *s, const 
 {
     rl_image *img = NULL;
     assert_int_equal(rl_image_create(cam->width, cam->height, layers, &img), RL_OK);
-    assert_int_equal(rl_renderer_render(r, s, cam, img, stats), RL_OK);
+    rl_status st = rl_renderer_render(r, s, cam, img, stats);
+    if (st != RL_OK)
+        print_error("%s: %s\n", rl_renderer_name(r), rl_last_error());
+    assert_int_equal(st, RL_OK);
     return img;
 }
 

@@ -1,0 +1,360 @@
+/* visset.c: renderer "visset", visibility as a position-dependent property
+ * (Jähn 2015, Sec. 7.6): the set of visible objects, approximated over a
+ * region by adaptive sampling (Ch. 5, the visibility property of Sec.
+ * 4.2.2), is queried at the viewer's position and only that set is drawn.
+ *
+ * The approximation comes from a file written by `rl eval --property
+ * visibility` (option approx = its approx.json), or is sampled on the
+ * first frame over the scene's bounds (a 2-D slice at `height` above the
+ * scene's floor, or the 3-D bounds) with `samples` samples of `resolution`²
+ * pixels per cube face. Where the viewer is outside the sampled region the
+ * renderer draws everything in the frustum (and counts it), so it never
+ * shows an empty image for want of data.
+ *
+ * Budgeted variant (Sec. 7.6 after Eikel, Jähn & Fischer 2010): with
+ * budget > 0 the objects of the set are drawn in decreasing estimated
+ * impact, their visible pixels at the centre of the region they come from,
+ * as long as the triangles drawn stay within the budget; an object that
+ * would exceed it is skipped and smaller ones still get their turn, so the
+ * budget is never exceeded. The impact estimate at the region centre is
+ * ours: the thesis' property stores pixels per object and sample.
+ *
+ * Frustum culling applies to each object of the set. Approximate: an
+ * object that no sample of the region saw is missing (Fig. 7.11). */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "core/error.h"
+#include "render/culling.h"
+#include "render/raster_scene.h"
+#include "render/renderer.h"
+#include "rl/rl_property.h"
+#include "rl/rl_sampling.h"
+#include "rl/rl_timer.h"
+
+static const char *const shading_choices[] = { "flat", "gouraud", "textured", NULL };
+
+static const rl_option_info visset_options[] = {
+    { "shading", RL_OPT_ENUM, "textured", "flat | gouraud | textured, as raster", 0, 0, shading_choices },
+    { "cull", RL_OPT_BOOL, "false", "drop back faces (counter-clockwise = front)", 0, 0, NULL },
+    { "ambient", RL_OPT_FLOAT, "0.05", "ambient light, multiplied by k_d", 0, 1, NULL },
+    { "background", RL_OPT_COLOR, "0,0,0", "colour where nothing is drawn", 0, 0, NULL },
+    { "threads", RL_OPT_INT, "0", "OpenMP threads (0 = all)", 0, 1024, NULL },
+    { "approx", RL_OPT_STRING, "", "approx.json of the visibility property (rl eval); empty: sample it here",
+      0, 0, NULL },
+    { "samples", RL_OPT_INT, "256", "samples when sampling here", 1, 1 << 20, NULL },
+    { "dims", RL_OPT_INT, "2", "2: a horizontal slice at `height`; 3: the scene's bounds", 2, 3, NULL },
+    { "height", RL_OPT_FLOAT, "1.7", "slice height above the scene's lowest point (dims 2)", -1e6, 1e6, NULL },
+    { "resolution", RL_OPT_INT, "128", "pixels per cube face of each visibility sample", 8, 4096, NULL },
+    { "seed", RL_OPT_INT, "1", "sampling seed", 0, 4294967295.0, NULL },
+    { "budget", RL_OPT_INT, "0", "triangles per frame, highest impact first (0: no budget)", 0, 4294967295.0,
+      NULL },
+};
+
+typedef struct visset_key {
+    char approx[512];
+    uint32_t samples, resolution;
+    int dims;
+    float height;
+    uint64_t seed, scene_uid;
+    bool ranked;                  /* impact ranking built (budget mode) */
+} visset_key;
+
+typedef struct visset_state {
+    rl_culling_head head;         /* first: rl_culling_get_stats */
+    visset_key key;
+    rl_approx *approx;
+    /* budget mode: per leaf region its set ordered by impact */
+    uint64_t *rank_offset;
+    uint32_t *rank_objects;
+    uint32_t *stamp;
+    uint32_t frame;
+    uint32_t frames_outside;      /* viewer outside the sampled region */
+} visset_state;
+
+static rl_status visset_create(void **state)
+{
+    visset_state *s = rl_calloc(1, sizeof *s);
+    if (!s)
+        return RL_ERR_OUT_OF_MEMORY;
+    *state = s;
+    return RL_OK;
+}
+
+static void drop(visset_state *s)
+{
+    rl_approx_release(s->approx);
+    free(s->rank_offset);
+    free(s->rank_objects);
+    free(s->stamp);
+    s->approx = NULL;
+    s->rank_offset = NULL;
+    s->rank_objects = NULL;
+    s->stamp = NULL;
+}
+
+static void visset_release(void *state)
+{
+    visset_state *s = state;
+    if (!s)
+        return;
+    drop(s);
+    free(s);
+}
+
+static rl_status make_property(const rl_scene *scene, const visset_key *k, int threads, rl_property **out)
+{
+    rl_property *p = NULL;
+    char res[32];
+    snprintf(res, sizeof res, "%u", k->resolution);
+    rl_status st = rl_property_create("visibility", &p);
+    if (st == RL_OK)
+        st = rl_property_set(p, "resolution", res);
+    if (st == RL_OK)
+        st = rl_property_commit(p, scene, threads > 0 ? threads : 0);
+    if (st != RL_OK) {
+        rl_property_release(p);
+        return st;
+    }
+    *out = p;
+    return RL_OK;
+}
+
+typedef struct ranked {
+    uint32_t object, pixels;
+} ranked;
+
+static int by_impact(const void *a, const void *b)
+{
+    const ranked *x = a, *y = b;
+    if (x->pixels != y->pixels)
+        return x->pixels > y->pixels ? -1 : 1;
+    return x->object < y->object ? -1 : x->object > y->object;
+}
+
+/* Budget mode: each leaf's set ordered by visible pixels at its centre. */
+static rl_status build_ranking(visset_state *s, const visset_key *k, const rl_scene *scene,
+                               const rl_scene_data *d, int threads)
+{
+    rl_property *p = NULL;
+    rl_status st = make_property(scene, k, threads, &p);
+    if (st != RL_OK)
+        return st;
+    uint32_t nr = rl_approx_region_count(s->approx);
+    uint32_t *pixels = rl_calloc(d->num_objects, sizeof *pixels);
+    ranked *tmp = rl_calloc(d->num_objects, sizeof *tmp);
+    s->rank_offset = rl_calloc((size_t)nr + 1, sizeof *s->rank_offset);
+    size_t total = 0;
+    for (uint32_t i = 0; i < nr; ++i) {
+        const uint64_t *set = rl_approx_region_set(s->approx, i);
+        for (uint32_t o = 0; set && o < d->num_objects; ++o)
+            total += (set[o / 64] >> (o % 64)) & 1u;
+    }
+    s->rank_objects = rl_calloc(total + 1, sizeof *s->rank_objects);
+    if (!pixels || !tmp || !s->rank_offset || !s->rank_objects)
+        st = RL_ERR_OUT_OF_MEMORY;
+    size_t at = 0;
+    for (uint32_t i = 0; i < nr && st == RL_OK; ++i) {
+        rl_approx_region reg;
+        st = rl_approx_get_region(s->approx, i, &reg);
+        if (st == RL_OK)
+            st = rl_property_object_pixels(p, 0, rl_aabb_center(reg.box), pixels);
+        const uint64_t *set = rl_approx_region_set(s->approx, i);
+        uint32_t n = 0;
+        for (uint32_t o = 0; st == RL_OK && set && o < d->num_objects; ++o)
+            if ((set[o / 64] >> (o % 64)) & 1u)
+                tmp[n++] = (ranked){ o, pixels[o] };
+        qsort(tmp, n, sizeof *tmp, by_impact);
+        s->rank_offset[i] = at;
+        for (uint32_t k = 0; k < n; ++k)
+            s->rank_objects[at++] = tmp[k].object;
+    }
+    if (st == RL_OK)
+        s->rank_offset[nr] = at;
+    free(pixels);
+    free(tmp);
+    rl_property_release(p);
+    return st;
+}
+
+static rl_status prepare(visset_state *s, rl_renderer *r, const rl_scene *scene, const rl_scene_data *d,
+                         bool budget, int threads)
+{
+    visset_key k;
+    memset(&k, 0, sizeof k);
+    const char *path = rl_renderer_opt_string(r, "approx");
+    if (strlen(path) >= sizeof k.approx)
+        return rl_error(RL_ERR_INVALID_ARG, "visset: approx path longer than %zu characters",
+                        sizeof k.approx - 1);
+    strcpy(k.approx, path);
+    k.samples = (uint32_t)rl_renderer_opt_int(r, "samples");
+    k.resolution = (uint32_t)rl_renderer_opt_int(r, "resolution");
+    k.dims = (int)rl_renderer_opt_int(r, "dims");
+    k.height = (float)rl_renderer_opt_float(r, "height");
+    k.seed = (uint64_t)rl_renderer_opt_int(r, "seed");
+    k.scene_uid = rl_scene_uid(scene);
+    k.ranked = s->key.ranked;
+    if (s->approx && memcmp(&k, &s->key, sizeof k) == 0 && (!budget || s->key.ranked))
+        return RL_OK;
+
+    rl_timer t0;
+    rl_timer_start(&t0);
+    bool same_sets = s->approx && memcmp(&k, &s->key, sizeof k) == 0;
+    rl_status st = RL_OK;
+    if (!same_sets) {
+        drop(s);
+        k.ranked = false;
+        s->stamp = rl_calloc(d->num_objects, sizeof *s->stamp);
+        if (!s->stamp)
+            return RL_ERR_OUT_OF_MEMORY;
+        s->frame = 0;
+        if (k.approx[0]) {
+            st = rl_approx_load_json(k.approx, &s->approx);
+        } else {
+            rl_property *p = NULL;
+            st = make_property(scene, &k, threads, &p);
+            rl_sampling_desc sd = { .region = d->bounds, .dims = k.dims, .max_samples = k.samples,
+                                    .seed = k.seed };
+            sd.height = d->bounds.min.y + k.height;
+            if (st == RL_OK)
+                st = rl_sample_property(p, &sd, &s->approx);
+            rl_property_release(p);
+        }
+        if (st == RL_OK && rl_approx_set_size(s->approx) != d->num_objects)
+            st = rl_error(RL_ERR_INVALID_ARG,
+                          "visset: the approximation holds sets of %u objects, the scene has %u (is it the "
+                          "visibility property of this scene?)",
+                          rl_approx_set_size(s->approx), d->num_objects);
+        if (st != RL_OK) {
+            drop(s);
+            return st;
+        }
+    }
+    if (budget) {
+        st = build_ranking(s, &k, scene, d, threads);
+        if (st != RL_OK) {
+            drop(s);
+            return st;
+        }
+        k.ranked = true;
+    }
+    s->key = k;
+    s->head.stats.preprocess_ms = rl_timer_ms(&t0);
+    return RL_OK;
+}
+
+typedef struct visset_frame {
+    visset_state *s;
+    const rl_scene_data *d;
+    rl_raster *ras;
+    rl_scene_drawer *drawer;
+    rl_cull_view view;
+    rl_raster_counters counters;
+    uint64_t budget;
+} visset_frame;
+
+/* Draws object o unless culled, drawn already or beyond the budget. */
+static rl_status draw_object(visset_frame *f, uint32_t o)
+{
+    visset_state *s = f->s;
+    const rl_object *obj = &f->d->objects[o];
+    if (s->stamp[o] == s->frame || !rl_cull_box_in_frustum(&f->view, obj->bounds))
+        return RL_OK;
+    if (f->budget && s->head.stats.triangles_drawn + obj->num_triangles > f->budget)
+        return RL_OK;
+    s->stamp[o] = s->frame;
+    s->head.stats.objects_drawn++;
+    s->head.stats.triangles_drawn += obj->num_triangles;
+    return rl_scene_drawer_draw(f->drawer, f->ras, o, &f->counters);
+}
+
+static rl_status visset_render(rl_renderer *r, void *state, const rl_scene *scene, const rl_camera *cam,
+                               rl_image *image, rl_render_stats *stats)
+{
+    visset_state *s = state;
+    const rl_scene_data *d = rl_scene_get_data(scene);
+    if (!d)
+        return RL_ERR_NOT_COMMITTED;
+    memset(&s->head.stats, 0, sizeof s->head.stats);
+    s->head.have_frame = false;
+    const int threads = (int)rl_renderer_opt_int(r, "threads");
+    const uint64_t budget = (uint64_t)rl_renderer_opt_int(r, "budget");
+    rl_status st = prepare(s, r, scene, d, budget > 0, threads);
+    if (st != RL_OK)
+        return st;
+
+    rl_raster_scene_desc desc = {
+        .shading = (rl_raster_shading)rl_renderer_opt_enum(r, "shading"),
+        .ambient = (float)rl_renderer_opt_float(r, "ambient"),
+        .threads = threads,
+        .flags = rl_renderer_opt_bool(r, "cull") ? RL_RASTER_CULL_BACK : 0u,
+    };
+    rl_cull_target target;
+    st = rl_cull_target_begin(image, rl_renderer_opt_color(r, "background"), &target);
+    if (st != RL_OK)
+        return st;
+    desc.flags |= target.flags;
+    visset_frame f;
+    memset(&f, 0, sizeof f);
+    f.s = s;
+    f.d = d;
+    f.budget = budget;
+    rl_cull_view_make(cam, d->bounds, &f.view);
+    st = rl_raster_create(&(rl_raster_desc){ .threads = threads }, &f.ras);
+    if (st == RL_OK)
+        st = rl_raster_set_target(f.ras, &target.image, &f.view.view, &f.view.proj);
+    if (st == RL_OK)
+        st = rl_scene_drawer_create(d, f.view.eye, &desc, &f.drawer);
+    if (st == RL_OK && ++s->frame == 0) {
+        memset(s->stamp, 0, d->num_objects * sizeof *s->stamp);
+        s->frame = 1;
+    }
+    /* Inside the sampled region (2-D: its x-z extent)? Checked here so that
+     * a viewer outside raises no error. */
+    rl_aabb rb = rl_approx_bounds(s->approx);
+    rl_vec3 e = f.view.eye;
+    bool inside = e.x >= rb.min.x && e.x <= rb.max.x && e.z >= rb.min.z && e.z <= rb.max.z &&
+                  (rl_approx_dims(s->approx) == 2 || (e.y >= rb.min.y && e.y <= rb.max.y));
+    double ignored;
+    uint32_t region = 0;
+    if (st == RL_OK && inside)
+        st = rl_approx_query(s->approx, e, &ignored, &region);
+    if (st == RL_OK && !inside) {
+        s->frames_outside++;
+        for (uint32_t o = 0; o < d->num_objects && st == RL_OK; ++o)
+            st = draw_object(&f, o);
+    } else if (st == RL_OK && budget) {
+        for (uint64_t a = s->rank_offset[region]; a < s->rank_offset[region + 1] && st == RL_OK; ++a)
+            st = draw_object(&f, s->rank_objects[a]);
+    } else if (st == RL_OK) {
+        const uint64_t *set = rl_approx_region_set(s->approx, region);
+        for (uint32_t o = 0; set && o < d->num_objects && st == RL_OK; ++o)
+            if ((set[o / 64] >> (o % 64)) & 1u)
+                st = draw_object(&f, o);
+    }
+    rl_scene_drawer_release(f.drawer);
+    rl_raster_release(f.ras);
+    rl_cull_target_end(&target);
+    if (st != RL_OK)
+        return st;
+    stats->triangles_rasterized = f.counters.triangles_drawn;
+    stats->pixels_written = f.counters.pixels_written;
+    stats->samples = (uint64_t)image->width * image->height;
+    s->head.have_frame = true;
+    return RL_OK;
+}
+
+const rl_renderer_class rl_visset_renderer_class = {
+    .info = { "visset", "Draws the set of visible objects stored in a sampled visibility property "
+                        "(approximate; optional triangle budget)",
+              "Jähn 2015, Sec. 7.6; Eikel, Jähn & Fischer 2010" },
+    .options = visset_options,
+    .num_options = sizeof visset_options / sizeof visset_options[0],
+    .create = visset_create,
+    .render = visset_render,
+    .release = visset_release,
+    .check = NULL,
+    .reset = NULL,
+};

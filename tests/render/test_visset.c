@@ -1,0 +1,133 @@
+/* test_visset.c: the global-visibility renderer of Jähn 2015, Sec. 7.6
+ * ("visset") draws the sampled set of visible objects: at street level a
+ * fraction of the triangles at good quality; a budget is never exceeded;
+ * an approximation saved by the evaluator gives the same frames; outside
+ * the sampled region it draws everything (= raster). */
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include <cmocka.h>
+
+#include "render_fixtures.h"
+#include "rl/rl.h"
+
+static const char *const good[] = { "samples", "256", "resolution", "64", NULL };
+static const char *const coarse[] = { "samples", "48", "resolution", "48", NULL };
+
+static rl_camera street(float t)
+{
+    rl_camera c = { .eye = rl_v3(9.5f, 1.7f, 3.0f + 5.0f * t), .target = rl_v3(12.0f + 2.0f * t, 1.5f, 70.0f),
+                    .fov_deg = 60.0f, .width = 128, .height = 96 };
+    return c;
+}
+
+static void test_visset_draws_the_sampled_set(void **state)
+{
+    (void)state;
+    rl_scene *s = fx_box_city();
+    rl_renderer *vis = fx_make("visset", good);
+    double ssim_sum = 0.0;
+    for (int i = 0; i < 4; ++i) {
+        rl_camera cam = street((float)i);
+        rl_render_stats full, st;
+        rl_image *ref = fx_render("raster", s, &cam, RL_LAYER_COLOR, NULL, &full);
+        rl_image *img = fx_render_with(vis, s, &cam, RL_LAYER_COLOR, &st);
+        assert_true(st.triangles_rasterized * 2 < full.triangles_rasterized);
+        rl_image_metrics m;
+        assert_int_equal(rl_image_compare(img, ref, NULL, &m), RL_OK);
+        ssim_sum += m.ssim;
+        rl_image_release(img);
+        rl_image_release(ref);
+    }
+    assert_true(ssim_sum / 4.0 > 0.95);   /* measured 0.986 */
+
+    /* Budgets: never exceeded, and a bigger budget draws at least as much. */
+    uint64_t prev = 0;
+    for (int b = 0; b < 3; ++b) {
+        static const char *const budgets[] = { "300", "3000", "30000" };
+        rl_renderer *rb = fx_make("visset", good);
+        assert_int_equal(rl_renderer_set(rb, "budget", budgets[b]), RL_OK);
+        rl_camera cam = street(1.0f);
+        rl_image *img = fx_render_with(rb, s, &cam, RL_LAYER_COLOR, NULL);
+        rl_culling_stats cs;
+        assert_int_equal(rl_culling_get_stats(rb, &cs), RL_OK);
+        assert_true(cs.triangles_drawn <= (uint64_t)atoll(budgets[b]));
+        assert_true(cs.triangles_drawn >= prev);
+        prev = cs.triangles_drawn;
+        rl_image_release(img);
+        rl_renderer_release(rb);
+    }
+    assert_true(prev > 0);
+
+    /* Outside the slice's x-z extent: everything, as raster. */
+    rl_camera out = { .eye = rl_v3(-40, 30, -40), .target = rl_v3(60, 0, 60), .width = 96, .height = 72 };
+    rl_image *ref = fx_render("raster", s, &out, FX_ALL_LAYERS, NULL, NULL);
+    rl_image *img = fx_render_with(vis, s, &out, FX_ALL_LAYERS, NULL);
+    fx_assert_images_identical(img, ref);
+    rl_image_release(img);
+    rl_image_release(ref);
+    rl_renderer_release(vis);
+    rl_scene_release(s);
+}
+
+static void test_visset_reads_the_evaluators_approximation(void **state)
+{
+    (void)state;
+    rl_scene *s = fx_box_city();
+    const rl_scene_data *d = rl_scene_get_data(s);
+    rl_property *p = NULL;
+    assert_int_equal(rl_property_create("visibility", &p), RL_OK);
+    assert_int_equal(rl_property_set(p, "resolution", "48"), RL_OK);
+    assert_int_equal(rl_property_commit(p, s, 0), RL_OK);
+    rl_sampling_desc sd = { .region = d->bounds, .dims = 2, .height = d->bounds.min.y + 1.7f,
+                            .max_samples = 48, .seed = 1 };
+    rl_approx *a = NULL;
+    assert_int_equal(rl_sample_property(p, &sd, &a), RL_OK);
+    const char *dir = getenv("RL_TEST_TMP");
+    char path[1024];
+    snprintf(path, sizeof path, "%s/visset_approx.json", dir ? dir : ".");
+    assert_int_equal(rl_approx_save_json(a, path), RL_OK);
+    rl_approx_release(a);
+    rl_property_release(p);
+
+    rl_renderer *own = fx_make("visset", coarse);
+    rl_renderer *file = fx_make("visset", (const char *const[]){ "approx", path, NULL });
+    for (int i = 0; i < 3; ++i) {
+        rl_camera cam = street((float)i);
+        rl_image *x = fx_render_with(own, s, &cam, FX_ALL_LAYERS, NULL);
+        rl_image *y = fx_render_with(file, s, &cam, FX_ALL_LAYERS, NULL);
+        fx_assert_images_identical(x, y);
+        rl_image_release(x);
+        rl_image_release(y);
+    }
+    rl_renderer_release(file);
+    rl_renderer_release(own);
+
+    /* The same file for another scene, and a missing file, are refused. */
+    rl_scene *other = NULL;
+    assert_int_equal(rl_scene_create_builtin("cornell", "", &other), RL_OK);
+    rl_renderer *bad = fx_make("visset", (const char *const[]){ "approx", path, NULL });
+    rl_camera cam = { .eye = rl_v3(0, 1, 3), .target = rl_v3(0, 1, 0), .width = 32, .height = 32 };
+    rl_image *img = NULL;
+    assert_int_equal(rl_image_create(32, 32, RL_LAYER_COLOR, &img), RL_OK);
+    assert_int_equal(rl_renderer_render(bad, other, &cam, img, NULL), RL_ERR_INVALID_ARG);
+    assert_int_equal(rl_renderer_set(bad, "approx", "/nonexistent/approx.json"), RL_OK);
+    assert_int_not_equal(rl_renderer_render(bad, other, &cam, img, NULL), RL_OK);
+    rl_image_release(img);
+    rl_renderer_release(bad);
+    rl_scene_release(other);
+    rl_scene_release(s);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_visset_draws_the_sampled_set),
+        cmocka_unit_test(test_visset_reads_the_evaluators_approximation),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
