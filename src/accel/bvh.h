@@ -83,8 +83,8 @@ typedef struct rl_bvh {
 rl_status rl_bvh_build(const rl_scene_data *data, const rl_accel_desc *desc, rl_bvh *bvh,
                        rl_accel_stats *stats);
 void rl_bvh_free(rl_bvh *bvh);
-/* Collapses the binary tree into bvh->wide (deterministic: largest-area
- * child opened first) and packs the leaves into bvh->blocks, in leaf order.
+/* Collapses the binary tree into bvh->wide (deterministic: the cut of least
+ * SAH cost, bvh_wide.c) and packs the leaves into bvh->blocks, in leaf order.
  * RL_ERR_OUT_OF_MEMORY. */
 rl_status rl_bvh_widen(rl_bvh *bvh);
 
