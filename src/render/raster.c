@@ -116,6 +116,24 @@ static rl_vec4 phong(const shade_ctx *ctx, const rl_material *m, rl_vec3 p, rl_v
     return rl_v4_from3(c, 1.0f);
 }
 
+rl_vec3 rl_raster_light_diffuse(const rl_scene_data *d, rl_vec3 p, rl_vec3 n, rl_vec3 kd, float ambient,
+                                rl_vec3 eye)
+{
+    rl_vec3 v = rl_sub(eye, p);
+    if (rl_dot(n, v) < 0.0f)
+        n = rl_neg(n);                        /* two-sided, as phong() */
+    rl_vec3 c = rl_scale(kd, ambient);
+    for (uint32_t i = 0; i < d->num_lights; ++i) {
+        rl_vec3 E, l;
+        if (!light_at(&d->lights[i], p, &E, &l))
+            continue;
+        float n_dot_l = rl_dot(n, l);
+        if (n_dot_l > 0.0f)
+            c = rl_add(c, rl_mul(rl_scale(kd, n_dot_l), E));
+    }
+    return c;
+}
+
 /* Per-draw buffers; everything is NULL unless the shading mode needs it. */
 typedef struct frame_buffers {
     uint32_t *object_material;   /* per object: shared material or RL_NONE */

@@ -38,6 +38,13 @@ rl_status rl_raster_draw_scene(rl_raster *ras, const rl_scene_data *d, rl_vec3 e
                                const rl_raster_scene_desc *desc, rl_raster_counters *c,
                                bool (*progress)(void *user, double done), void *user);
 
+/* raster's lighting of a diffuse point (the ambient and diffuse terms of
+ * its Phong model, two-sided, quad lights as points): for primitives
+ * without a mesh material, such as surfels, lit like the meshes they
+ * replace. */
+rl_vec3 rl_raster_light_diffuse(const rl_scene_data *d, rl_vec3 p, rl_vec3 n, rl_vec3 kd, float ambient,
+                                rl_vec3 eye);
+
 /* The same drawing one object at a time, for renderers that decide per
  * object what to draw and in which order (occlusion culling, level of
  * detail): buffers are prepared once per frame, and an object is lit when

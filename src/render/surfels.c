@@ -1,0 +1,413 @@
+/* surfels.c: renderer "surfels", Progressive Blue Surfels (Jähn 2015,
+ * Ch. 6): distant parts of the scene are drawn as prefixes of their surfel
+ * sequences instead of their meshes.
+ *
+ * Preprocessing (Sec. 6.1.2): every node of the loose octree (rl_octree.h)
+ * whose subtree holds more than `min_triangles` triangles gets a surfel
+ * representation of all the objects below it (rl_surfels_build, Sec.
+ * 6.1.1), so a whole distant district of a city becomes one node.
+ *
+ * Rendering (Sec. 6.2), from the root, with A the projected size of a
+ * node's bounding box (the area of its screen rectangle, in pixels):
+ *  - outside the frustum: skipped;
+ *  - A > max_size², or no surfels: its objects are drawn and its children
+ *    visited;
+ *  - A <= min_size²: a prefix of n = A · coverage · overdraw surfels is
+ *    drawn and the subtree is not visited; when n exceeds the sequence,
+ *    all are drawn and the point size grows by sqrt(n / count) (the
+ *    projected area per surfel, as a side length);
+ *  - in between: the prefix and the point size are scaled linearly by
+ *    t = (max² - A) / (max² - min²) (0 at the maximum, 1 at the minimum)
+ *    and the node's objects and children are drawn as well, so that
+ *    switching levels does not pop.
+ * Each surfel is a square point of side point_size · relative size ·
+ * cos(normal, view direction) pixels (at least 1), hidden when it faces
+ * away (Sec. 6.2.1), lit like the meshes by raster's diffuse model at its
+ * unlit colour (its 20 bytes hold no specular term).
+ *
+ * Options (thesis defaults, Sec. 6.3): min_size 100, max_size 200 (sides
+ * of the projected size in pixels), overdraw 4, point_size 7, count 40000,
+ * resolution 1024, start_sample 160; min_triangles (default = count, "of
+ * the order of the surfel count"), max_depth 5, seed 1; plus raster's
+ * shading options for the meshes. */
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#ifdef _OPENMP
+#include <omp.h>
+#endif
+
+#include "core/error.h"
+#include "render/culling.h"
+#include "render/raster_scene.h"
+#include "render/renderer.h"
+#include "rl/rl_surfels.h"
+#include "rl/rl_timer.h"
+
+static const char *const shading_choices[] = { "flat", "gouraud", "textured", NULL };
+
+static const rl_option_info surfels_options[] = {
+    { "shading", RL_OPT_ENUM, "textured", "meshes: flat | gouraud | textured, as raster", 0, 0, shading_choices },
+    { "cull", RL_OPT_BOOL, "false", "drop back faces of meshes", 0, 0, NULL },
+    { "ambient", RL_OPT_FLOAT, "0.05", "ambient light, multiplied by k_d", 0, 1, NULL },
+    { "background", RL_OPT_COLOR, "0,0,0", "colour where nothing is drawn", 0, 0, NULL },
+    { "threads", RL_OPT_INT, "0", "OpenMP threads (0 = all)", 0, 1024, NULL },
+    { "min_size", RL_OPT_FLOAT, "100", "below this projected side (px) a node is surfels only", 0, 1e6, NULL },
+    { "max_size", RL_OPT_FLOAT, "200", "above this projected side (px) a node is its meshes only", 0, 1e6, NULL },
+    { "overdraw", RL_OPT_FLOAT, "4", "surfels per covered pixel", 0.01, 1000, NULL },
+    { "point_size", RL_OPT_FLOAT, "7", "base point size in pixels", 0.1, 256, NULL },
+    { "count", RL_OPT_INT, "40000", "surfels per node", 1, 1 << 24, NULL },
+    { "resolution", RL_OPT_INT, "1024", "pixels per side of each of the 8 views", 8, 16384, NULL },
+    { "start_sample", RL_OPT_INT, "160", "candidates per sample of the progressive sampling", 1, 1000000, NULL },
+    { "min_triangles", RL_OPT_INT, "0", "nodes with more triangles get surfels (0: = count)", 0, 4294967295.0,
+      NULL },
+    { "max_depth", RL_OPT_INT, "5", "maximum depth of the loose octree", 0, RL_OCTREE_MAX_DEPTH, NULL },
+    { "seed", RL_OPT_INT, "1", "seed of the surfel sampling", 0, 4294967295.0, NULL },
+};
+
+typedef struct surfels_params {
+    rl_octree_desc od;
+    uint32_t count, resolution, start_sample, min_triangles;
+    uint64_t seed, scene_uid;
+} surfels_params;
+
+typedef struct surfels_state {
+    rl_culling_head head;         /* first: rl_culling_get_stats */
+    rl_octree_cache oc;
+    surfels_params params;
+    bool built;
+    rl_surfel_set *sets;          /* per octree node; count 0 = none */
+    uint32_t num_sets;
+    /* per frame: the points to draw */
+    rl_vec3 *pos;
+    rl_vec4 *col;
+    float *size;
+    size_t cap;
+} surfels_state;
+
+static rl_status surfels_create(void **state)
+{
+    surfels_state *s = rl_calloc(1, sizeof *s);
+    if (!s)
+        return RL_ERR_OUT_OF_MEMORY;
+    *state = s;
+    return RL_OK;
+}
+
+static void drop_sets(surfels_state *s)
+{
+    for (uint32_t i = 0; i < s->num_sets; ++i)
+        rl_surfel_set_free(&s->sets[i]);
+    free(s->sets);
+    s->sets = NULL;
+    s->num_sets = 0;
+    s->built = false;
+}
+
+static void surfels_release(void *state)
+{
+    surfels_state *s = state;
+    if (!s)
+        return;
+    drop_sets(s);
+    rl_octree_cache_release(&s->oc);
+    free(s->pos);
+    free(s->col);
+    free(s->size);
+    free(s);
+}
+
+static void collect_objects(const rl_octree_node *nodes, const uint32_t *objects, uint32_t n, uint32_t *out,
+                            uint32_t *count)
+{
+    const rl_octree_node *node = &nodes[n];
+    for (uint32_t k = 0; k < node->num_objects; ++k)
+        out[(*count)++] = objects[node->first_object + k];
+    for (uint32_t c = 0; c < node->num_children; ++c)
+        collect_objects(nodes, objects, node->first_child + c, out, count);
+}
+
+/* Sec. 6.1.2: surfels for every node with enough geometry below it. */
+static rl_status build_sets(surfels_state *s, rl_renderer *r, const rl_scene *scene, int threads)
+{
+    const rl_scene_data *d = rl_scene_get_data(scene);
+    uint32_t nn;
+    const rl_octree_node *nodes = rl_octree_nodes(s->oc.tree, &nn);
+    const uint32_t *objects = rl_octree_objects(s->oc.tree, NULL);
+    s->sets = rl_calloc(nn, sizeof *s->sets);
+    uint32_t *list = rl_calloc((size_t)d->num_objects + 1, sizeof *list);
+    rl_status st = s->sets && list ? RL_OK : RL_ERR_OUT_OF_MEMORY;
+    if (st == RL_OK)
+        s->num_sets = nn;
+    uint32_t todo = 0, done = 0;
+    for (uint32_t n = 0; n < nn; ++n)
+        todo += nodes[n].subtree_triangles > s->params.min_triangles;
+    for (uint32_t n = 0; n < nn && st == RL_OK; ++n) {
+        if (nodes[n].subtree_triangles <= s->params.min_triangles)
+            continue;
+        uint32_t count = 0;
+        collect_objects(nodes, objects, n, list, &count);
+        rl_surfel_desc desc = { .resolution = s->params.resolution, .count = s->params.count,
+                                .start_sample = s->params.start_sample, .seed = s->params.seed + n,
+                                .threads = threads };
+        st = rl_surfels_build(scene, list, count, &desc, &s->sets[n]);
+        if (st == RL_OK && !rl_renderer_progress(r, (double)++done / (double)(todo ? todo : 1)))
+            st = rl_error(RL_ERR_CANCELLED, "surfels: cancelled by the progress callback");
+    }
+    free(list);
+    return st;
+}
+
+typedef struct surfels_frame {
+    surfels_state *s;
+    const rl_scene_data *d;
+    const rl_octree_node *nodes;
+    const uint32_t *objects;
+    rl_raster *ras;
+    rl_scene_drawer *drawer;
+    rl_cull_view view;
+    rl_raster_counters counters;
+    float min2, max2, overdraw, point_size, ambient;
+    int threads;
+} surfels_frame;
+
+/* Projected size of a box: the area of its screen rectangle in pixels;
+ * INFINITY when it reaches behind the near plane. */
+static double projected_size(const rl_cull_view *v, rl_aabb b)
+{
+    double x0 = INFINITY, y0 = INFINITY, x1 = -INFINITY, y1 = -INFINITY;
+    for (int i = 0; i < 8; ++i) {
+        rl_vec3 p = rl_v3((i & 1) ? b.max.x : b.min.x, (i & 2) ? b.max.y : b.min.y, (i & 4) ? b.max.z : b.min.z);
+        rl_vec4 c = rl_mat4_mul_vec4(&v->view_proj, rl_v4_from3(p, 1.0f));
+        if (!(c.w > v->z_near * 0.5f))
+            return INFINITY;
+        double x = ((double)c.x / c.w + 1.0) * 0.5 * v->cam.width;
+        double y = (1.0 - (double)c.y / c.w) * 0.5 * v->cam.height;
+        x0 = x < x0 ? x : x0;
+        x1 = x > x1 ? x : x1;
+        y0 = y < y0 ? y : y0;
+        y1 = y > y1 ? y : y1;
+    }
+    return (x1 - x0) * (y1 - y0);
+}
+
+static rl_status reserve(surfels_state *s, size_t n)
+{
+    if (n <= s->cap)
+        return RL_OK;
+    size_t cap = s->cap ? s->cap : 4096;
+    while (cap < n)
+        cap *= 2;
+    rl_vec3 *p = realloc(s->pos, cap * sizeof *p);
+    if (p)
+        s->pos = p;
+    rl_vec4 *c = realloc(s->col, cap * sizeof *c);
+    if (c)
+        s->col = c;
+    float *z = realloc(s->size, cap * sizeof *z);
+    if (z)
+        s->size = z;
+    if (!p || !c || !z)
+        return RL_ERR_OUT_OF_MEMORY;
+    s->cap = cap;
+    return RL_OK;
+}
+
+/* Sec. 6.2.1: the first n surfels of set, point size `base` px. */
+static rl_status draw_prefix(surfels_frame *f, const rl_surfel_set *set, uint32_t n, float base)
+{
+    surfels_state *s = f->s;
+    rl_status st = reserve(s, n);
+    if (st != RL_OK)
+        return st;
+    const rl_vec3 eye = f->view.eye;
+    uint32_t kept = 0;
+    /* Light and size in parallel, then compact the front-facing points in
+     * order, so the result does not depend on the thread count. */
+#pragma omp parallel for num_threads(n > 8192 ? f->threads : 1) schedule(static)
+    for (int64_t i = 0; i < (int64_t)n; ++i) {
+        const rl_surfel *sf = &set->surfels[i];
+        rl_vec3 p = rl_v3(sf->position[0], sf->position[1], sf->position[2]);
+        rl_vec3 nrm = rl_surfel_normal(sf);
+        rl_vec3 to_eye = rl_sub(eye, p);
+        float len = rl_length(to_eye);
+        float cosv = len > 0.0f ? rl_dot(nrm, to_eye) / len : 1.0f;
+        s->pos[i] = p;
+        if (!(cosv > 0.0f)) {
+            s->size[i] = 0.0f;   /* faces away: hidden */
+            continue;
+        }
+        s->size[i] = rl_maxf(1.0f, base * rl_surfel_size(sf) * cosv);
+        rl_vec3 c = rl_raster_light_diffuse(f->d, p, nrm, rl_surfel_color(sf), f->ambient, eye);
+        s->col[i] = rl_v4_from3(c, 1.0f);
+    }
+    for (uint32_t i = 0; i < n; ++i) {
+        if (s->size[i] == 0.0f)
+            continue;
+        s->pos[kept] = s->pos[i];
+        s->col[kept] = s->col[i];
+        s->size[kept] = s->size[i];
+        ++kept;
+    }
+    rl_raster_points pts = { .count = kept, .positions = s->pos, .colors = s->col, .sizes_px = s->size,
+                             .object_id = RL_ID_NONE };
+    s->head.stats.points_drawn += kept;
+    rl_raster_counters c;
+    memset(&c, 0, sizeof c);
+    st = rl_raster_draw_points(f->ras, &pts, &c);
+    f->counters.pixels_written += c.pixels_written;
+    f->counters.points_drawn += c.points_drawn;
+    return st;
+}
+
+static rl_status draw_node(surfels_frame *f, uint32_t n)
+{
+    surfels_state *s = f->s;
+    const rl_octree_node *node = &f->nodes[n];
+    s->head.stats.nodes_visited++;
+    if (!rl_cull_box_in_frustum(&f->view, node->bounds)) {
+        s->head.stats.nodes_frustum_culled++;
+        return RL_OK;
+    }
+    const rl_surfel_set *set = n < s->num_sets ? &s->sets[n] : NULL;
+    double a = projected_size(&f->view, node->bounds);
+    rl_status st = RL_OK;
+    if (set && set->count > 0 && a <= f->max2) {
+        /* Sec. 6.2: prefix length and point size from the projected size. */
+        double want = a * set->coverage * f->overdraw;
+        double t = a <= f->min2 ? 1.0 : (f->max2 - a) / (f->max2 - f->min2);
+        double grow = want > set->count ? sqrt(want / set->count) : 1.0;
+        double len = t * (want < set->count ? want : set->count);
+        uint32_t m = (uint32_t)ceil(len);
+        if (m > set->count)
+            m = set->count;
+        if (m > 0)
+            st = draw_prefix(f, set, m, (float)(t * f->point_size * grow));
+        s->head.stats.surfel_nodes++;
+        if (st != RL_OK || a <= f->min2)
+            return st;
+    }
+    for (uint32_t k = 0; k < node->num_objects && st == RL_OK; ++k) {
+        uint32_t o = f->objects[node->first_object + k];
+        if (!rl_cull_box_in_frustum(&f->view, f->d->objects[o].bounds))
+            continue;
+        s->head.stats.objects_drawn++;
+        s->head.stats.triangles_drawn += f->d->objects[o].num_triangles;
+        st = rl_scene_drawer_draw(f->drawer, f->ras, o, &f->counters);
+    }
+    for (uint32_t c = 0; c < node->num_children && st == RL_OK; ++c)
+        st = draw_node(f, node->first_child + c);
+    return st;
+}
+
+static rl_status surfels_render(rl_renderer *r, void *state, const rl_scene *scene, const rl_camera *cam,
+                                rl_image *image, rl_render_stats *stats)
+{
+    surfels_state *s = state;
+    const rl_scene_data *d = rl_scene_get_data(scene);
+    if (!d)
+        return RL_ERR_NOT_COMMITTED;
+    memset(&s->head.stats, 0, sizeof s->head.stats);
+    s->head.have_frame = false;
+    const int threads = (int)rl_renderer_opt_int(r, "threads");
+    float min_size = (float)rl_renderer_opt_float(r, "min_size");
+    float max_size = (float)rl_renderer_opt_float(r, "max_size");
+    if (!(max_size >= min_size))
+        return rl_error(RL_ERR_INVALID_ARG, "surfels: max_size %g is below min_size %g", (double)max_size,
+                        (double)min_size);
+
+    surfels_params p;
+    memset(&p, 0, sizeof p);
+    int depth = (int)rl_renderer_opt_int(r, "max_depth");
+    p.od = (rl_octree_desc){ .max_depth = depth ? depth : RL_OCTREE_DEPTH_ZERO };
+    p.count = (uint32_t)rl_renderer_opt_int(r, "count");
+    p.resolution = (uint32_t)rl_renderer_opt_int(r, "resolution");
+    p.start_sample = (uint32_t)rl_renderer_opt_int(r, "start_sample");
+    p.min_triangles = (uint32_t)rl_renderer_opt_int(r, "min_triangles");
+    if (p.min_triangles == 0)
+        p.min_triangles = p.count;
+    p.seed = (uint64_t)rl_renderer_opt_int(r, "seed");
+    p.scene_uid = rl_scene_uid(scene);
+
+    rl_timer t0;
+    rl_timer_start(&t0);
+    bool rebuilt = false;
+    rl_status st = rl_octree_cache_get(&s->oc, scene, &p.od, &rebuilt);
+    if (st != RL_OK)
+        return st;
+    if (rebuilt || !s->built || memcmp(&p, &s->params, sizeof p) != 0) {
+        drop_sets(s);
+        s->params = p;
+        st = build_sets(s, r, scene, threads);
+        if (st != RL_OK) {
+            drop_sets(s);
+            return st;
+        }
+        s->built = true;
+        s->head.stats.preprocess_ms = rl_timer_ms(&t0);
+    }
+    uint32_t nn;
+    const rl_octree_node *nodes = rl_octree_nodes(s->oc.tree, &nn);
+    s->head.stats.octree_nodes = nn;
+    s->head.stats.octree_depth = rl_octree_depth(s->oc.tree);
+
+    rl_raster_scene_desc desc = {
+        .shading = (rl_raster_shading)rl_renderer_opt_enum(r, "shading"),
+        .ambient = (float)rl_renderer_opt_float(r, "ambient"),
+        .threads = threads,
+        .flags = rl_renderer_opt_bool(r, "cull") ? RL_RASTER_CULL_BACK : 0u,
+    };
+    rl_cull_target target;
+    st = rl_cull_target_begin(image, rl_renderer_opt_color(r, "background"), &target);
+    if (st != RL_OK)
+        return st;
+    desc.flags |= target.flags;
+    surfels_frame f;
+    memset(&f, 0, sizeof f);
+    f.s = s;
+    f.d = d;
+    f.nodes = nodes;
+    f.objects = rl_octree_objects(s->oc.tree, NULL);
+    f.min2 = min_size * min_size;
+    f.max2 = max_size * max_size;
+    f.overdraw = (float)rl_renderer_opt_float(r, "overdraw");
+    f.point_size = (float)rl_renderer_opt_float(r, "point_size");
+    f.ambient = desc.ambient;
+#ifdef _OPENMP
+    f.threads = threads > 0 ? threads : omp_get_max_threads();
+#else
+    f.threads = 1;
+#endif
+    rl_cull_view_make(cam, d->bounds, &f.view);
+    st = rl_raster_create(&(rl_raster_desc){ .threads = threads }, &f.ras);
+    if (st == RL_OK)
+        st = rl_raster_set_target(f.ras, &target.image, &f.view.view, &f.view.proj);
+    if (st == RL_OK)
+        st = rl_scene_drawer_create(d, f.view.eye, &desc, &f.drawer);
+    if (st == RL_OK)
+        st = draw_node(&f, 0);
+    rl_scene_drawer_release(f.drawer);
+    rl_raster_release(f.ras);
+    rl_cull_target_end(&target);
+    if (st != RL_OK)
+        return st;
+    stats->triangles_rasterized = f.counters.triangles_drawn;
+    stats->pixels_written = f.counters.pixels_written;
+    stats->samples = (uint64_t)image->width * image->height;
+    s->head.have_frame = true;
+    return RL_OK;
+}
+
+const rl_renderer_class rl_surfels_renderer_class = {
+    .info = { "surfels", "Progressive Blue Surfels: distant octree nodes as prefixes of blue-noise surfel "
+                         "sequences (approximate level of detail)",
+              "Jähn 2015, Ch. 6" },
+    .options = surfels_options,
+    .num_options = sizeof surfels_options / sizeof surfels_options[0],
+    .create = surfels_create,
+    .render = surfels_render,
+    .release = surfels_release,
+    .check = NULL,
+    .reset = NULL,
+};

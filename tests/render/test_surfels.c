@@ -1,0 +1,121 @@
+/* test_surfels.c: the Progressive Blue Surfels renderer (Jähn 2015, Sec.
+ * 6.2) on the box city: never approximating gives raster's image; far away
+ * the city becomes points only, at a measured quality; in between both are
+ * drawn; the same options give the same image; bad sizes are refused. */
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include <cmocka.h>
+
+#include "render_fixtures.h"
+#include "rl/rl.h"
+
+/* Small surfel sets so that the preprocessing stays fast under ASan. */
+#define SMALL "count", "3000", "resolution", "128", "min_triangles", "2000"
+
+static rl_camera far_camera(float dist)
+{
+    rl_camera c = { .eye = rl_v3(60.0f - dist, 0.8f * dist, 60.0f - dist), .target = rl_v3(60, 5, 60),
+                    .fov_deg = 40.0f, .width = 160, .height = 120 };
+    return c;
+}
+
+static void test_surfels_without_approximation_equal_raster(void **state)
+{
+    (void)state;
+    rl_scene *s = fx_box_city();
+    rl_camera cam = far_camera(150.0f);
+    rl_render_stats a, b;
+    rl_image *ref = fx_render("raster", s, &cam, FX_ALL_LAYERS, NULL, &a);
+    rl_image *img = fx_render("surfels", s, &cam, FX_ALL_LAYERS,
+                              (const char *const[]){ SMALL, "min_size", "0", "max_size", "0", NULL }, &b);
+    fx_assert_images_identical(ref, img);
+    rl_image_release(ref);
+    rl_image_release(img);
+    rl_scene_release(s);
+}
+
+static void test_surfels_replace_distant_geometry(void **state)
+{
+    (void)state;
+    rl_scene *s = fx_box_city();
+    rl_camera cam = far_camera(260.0f);
+    rl_render_stats full, st;
+    rl_image *ref = fx_render("raster", s, &cam, RL_LAYER_COLOR, NULL, &full);
+
+    /* Everything below 400 px a side: the whole city as points. */
+    rl_renderer *r = fx_make("surfels", (const char *const[]){ SMALL, "min_size", "400", "max_size", "800", NULL });
+    rl_image *img = fx_render_with(r, s, &cam, RL_LAYER_COLOR, &st);
+    rl_culling_stats cs;
+    assert_int_equal(rl_culling_get_stats(r, &cs), RL_OK);
+    assert_int_equal(st.triangles_rasterized, 0);
+    assert_true(cs.points_drawn > 500);
+    assert_true(cs.surfel_nodes >= 1);
+    assert_true(cs.preprocess_ms > 0.0);
+    rl_image_metrics m;
+    assert_int_equal(rl_image_compare(img, ref, NULL, &m), RL_OK);
+    print_message("points only: %llu points, SSIM %.3f\n", (unsigned long long)cs.points_drawn, m.ssim);
+    assert_true(m.ssim > 0.6);
+    /* The next frame reuses the surfels. */
+    rl_image *again = fx_render_with(r, s, &cam, RL_LAYER_COLOR, &st);
+    assert_int_equal(rl_culling_get_stats(r, &cs), RL_OK);
+    assert_true(cs.preprocess_ms == 0.0);
+    fx_assert_images_identical(img, again);
+    rl_image_release(again);
+    rl_image_release(img);
+    rl_renderer_release(r);
+
+    /* Closer: the blend zone. A fresh renderer with the same seed draws
+     * the same points, with any thread count. */
+    rl_image_release(ref);
+    cam = far_camera(110.0f);
+    ref = fx_render("raster", s, &cam, RL_LAYER_COLOR, NULL, &full);
+    rl_image *one = fx_render("surfels", s, &cam, RL_LAYER_COLOR,
+                              (const char *const[]){ SMALL, "min_size", "60", "max_size", "120", "threads", "1", NULL },
+                              &st);
+    rl_render_stats st2;
+    rl_image *two = fx_render("surfels", s, &cam, RL_LAYER_COLOR,
+                              (const char *const[]){ SMALL, "min_size", "60", "max_size", "120", "threads", "2", NULL },
+                              &st2);
+    fx_assert_images_identical(one, two);
+    /* The blend zone: meshes and points together, fewer triangles. */
+    assert_true(st.triangles_rasterized > 0 && st.triangles_rasterized < full.triangles_rasterized);
+    assert_int_equal(rl_image_compare(one, ref, NULL, &m), RL_OK);
+    print_message("blended: %llu of %llu triangles, SSIM %.3f\n", (unsigned long long)st.triangles_rasterized,
+                  (unsigned long long)full.triangles_rasterized, m.ssim);
+    assert_true(m.ssim > 0.8);
+    rl_image_release(one);
+    rl_image_release(two);
+    rl_image_release(ref);
+    rl_scene_release(s);
+}
+
+static void test_surfels_refuse_bad_options(void **state)
+{
+    (void)state;
+    rl_scene *s = fx_box_city();
+    rl_renderer *r = fx_make("surfels", (const char *const[]){ "min_size", "300", "max_size", "200", NULL });
+    rl_camera cam = far_camera(100.0f);
+    rl_image *img = NULL;
+    assert_int_equal(rl_image_create(cam.width, cam.height, RL_LAYER_COLOR, &img), RL_OK);
+    assert_int_equal(rl_renderer_render(r, s, &cam, img, NULL), RL_ERR_INVALID_ARG);
+    assert_int_equal(rl_renderer_set(r, "overdraw", "0"), RL_ERR_INVALID_ARG);
+    assert_int_equal(rl_renderer_set(r, "count", "0"), RL_ERR_INVALID_ARG);
+    rl_image_release(img);
+    rl_renderer_release(r);
+    rl_scene_release(s);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_surfels_without_approximation_equal_raster),
+        cmocka_unit_test(test_surfels_replace_distant_geometry),
+        cmocka_unit_test(test_surfels_refuse_bad_options),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
