@@ -13,6 +13,7 @@
 #include "bench_pt.h"
 #include "bench_rays.h"
 #include "bench_sampling.h"
+#include "bench_culling.h"
 #include "bench_surfels.h"
 #include "bench_util.h"
 #include "bench_vt.h"
@@ -33,6 +34,7 @@ static const char bench_help[] =
     "       rl bench pt [options]   Line Space path tracing (see rl bench pt --help)\n"
     "       rl bench sampling [options]  property sampling, Jaehn 2015 Sec. 5.7\n"
     "       rl bench surfels [options]   Progressive Blue Surfels, Jaehn 2015 Table 6.1\n"
+    "       rl bench culling [options]   CHC++, SVS, visible sets: Jaehn 2015 Ch. 7\n"
     "\n"
     "Times ray queries of each accelerator on three workloads generated once\n"
     "per scene and shared by all accelerators:\n"
@@ -194,7 +196,7 @@ static int parse_args(int argc, char **argv, bench_args *a)
     }
     if (strcmp(argv[1], "rays") != 0)
         return rl_cli_fail(RL_CLI_USAGE, "bench: unknown benchmark '%s' (known: rays, vt, pt, "
-                           "sampling, surfels)",
+                           "sampling, surfels, culling)",
                            argv[1]);
     bool has_scenes = false, has_accels = false;
     for (int i = 2; i < argc; i++) {
@@ -628,6 +630,8 @@ int rl_cli_bench(int argc, char **argv)
         return rl_bench_sampling(argc, argv);
     if (argc >= 2 && strcmp(argv[1], "surfels") == 0)
         return rl_bench_surfels(argc, argv);
+    if (argc >= 2 && strcmp(argv[1], "culling") == 0)
+        return rl_bench_culling(argc, argv);
     bench_args a;
     memset(&a, 0, sizeof a);
     int rc = parse_args(argc, argv, &a);

@@ -22,7 +22,7 @@ static const command commands[] = {
     { "demo", rl_cli_demo, "render every built-in scene with every renderer + HTML report" },
     { "eval", rl_cli_eval, "approximate a position-dependent property over a region (heat map, statistics)" },
     { "compare", rl_cli_compare, "compare renderers over a sampled region: time, operations, image quality" },
-    { "bench", rl_cli_bench, "benchmarks: bench rays (accelerators), bench vt (Vertex Tracing), bench pt (Line Space path tracing), bench sampling (property approximation), bench surfels (Progressive Blue Surfels)" },
+    { "bench", rl_cli_bench, "benchmarks: bench rays (accelerators), bench vt (Vertex Tracing), bench pt (Line Space path tracing), bench sampling (property approximation), bench surfels (Progressive Blue Surfels), bench culling (CHC++, SVS, visible sets)" },
 };
 
 static void print_usage(FILE *out)

@@ -1,0 +1,634 @@
+/* bench_culling.c: `rl bench culling`, the applications of Jähn 2015,
+ * Ch. 7 for the culling renderers, each measured with the evaluator
+ * (position-dependent properties over a sampled region) and printed beside
+ * the thesis' figures:
+ *   depth   Sec. 7.3: the conditioned rendering time of chcpp for octree
+ *           depths 0..--max-depth, each approximated by adaptive sampling
+ *           of a 3-D region (the scene's bounds, 20 % higher); the depth
+ *           with the lowest area-weighted mean (the thesis: 5, 9.9 ms);
+ *   svs     Sec. 7.4: over a 2-D slice, at the positions of the sampled
+ *           "polygons in visible objects" (the visibility property,
+ *           measure polygons; the lower bound of any object-based
+ *           conservative method), the conditioned time and the rasterized
+ *           triangles of chcpp and svs, and svs' image quality (SSIM, worst
+ *           of 6 directions) against raster (the conservative image). The
+ *           thesis: mean 18 ms (svs) vs 55 ms (chcpp), 7.1 M vs 15 M
+ *           polygons;
+ *   select  Sec. 7.5: at --select-positions random positions of the slice,
+ *           each with a random view direction, one frame of chcpp and of
+ *           svs (median of 3 after 3 unmeasured frames); runtime selection
+ *           takes chcpp where the sampled polygons in visible objects fall
+ *           below their --select-quantile, else svs. Mean time of each and
+ *           of the selection, over all positions and over the
+ *           high-occlusion ones (the thesis: 7 ms -> 3 ms there);
+ *   visset  Sec. 7.6: the sampled visible sets of the svs section as a
+ *           renderer (visset, from the saved approx.json): memory of the
+ *           sets (the thesis: 31 MB), its time (max; the thesis 14 ms) and
+ *           its image quality (min) at the same positions, and the
+ *           budgeted variant (--budget triangles).
+ * The reports of the same measurements as heat maps and violins come from
+ * `rl compare` (docs/culling.md gives the commands). */
+#define _POSIX_C_SOURCE 200809L
+#include "bench_culling.h"
+
+#include "bench_rays.h"
+#include "bench_util.h"
+#include "cli.h"
+#include "eval_common.h"
+
+#include <cjson/cJSON.h>
+#include <math.h>
+#include <omp.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#define note(...) (fflush(stdout), rl_bench_note("culling", __VA_ARGS__))
+
+static const char bench_culling_help[] =
+    "usage: rl bench culling [options]\n"
+    "\n"
+    "The Jaehn 2015 Ch. 7 applications of the culling renderers, measured as\n"
+    "position-dependent properties (see docs/culling.md). Sections:\n"
+    "  depth    Sec. 7.3: chcpp time per octree depth over a 3-D region\n"
+    "  svs      Sec. 7.4: chcpp vs svs over a 2-D slice: time, triangles,\n"
+    "           polygons in visible objects, svs quality\n"
+    "  select   Sec. 7.5: runtime selection of chcpp or svs per position\n"
+    "  visset   Sec. 7.6: the sampled visible sets as a renderer, with budget\n"
+    "\n"
+    "options:\n"
+    "  --scene S            default city:blocks=4\n"
+    "  --only LIST          sections, comma-separated; default all\n"
+    "  --samples N          samples per approximation; default 96\n"
+    "  --max-depth N        depth section: depths 0..N; default 8\n"
+    "  --size N             image side per direction; default 128\n"
+    "  --height H           slice height above the scene's floor; default 10\n"
+    "  --resolution N       cube-face side of the visibility property; default 128\n"
+    "  --select-positions N default 100\n"
+    "  --select-quantile Q  high occlusion below this quantile; default 0.25\n"
+    "  --budget N           triangles of the budgeted visset; default: a quarter\n"
+    "                       of chcpp's mean\n"
+    "  --threads N          default all\n"
+    "  --seed N             default 1\n"
+    "  --out FILE.json      default bench/results/culling-YYYYMMDD-HHMMSS.json\n"
+    "  --quick              tiny run: cornell-sized box city, few samples\n"
+    "\n"
+    "example:\n"
+    "  rl bench culling --only depth,svs --samples 256\n";
+
+enum { SEC_DEPTH, SEC_SVS, SEC_SELECT, SEC_VISSET, SEC_COUNT };
+static const char *const section_names[SEC_COUNT] = { "depth", "svs", "select", "visset" };
+
+typedef struct bc_args {
+    const char *scene, *out;
+    long long samples, max_depth, size, resolution, select_positions, budget, threads, seed;
+    double height, select_quantile;
+    unsigned sections;
+    bool quick;
+} bc_args;
+
+typedef struct bc_ctx {
+    bc_args *a;
+    rl_scene *scene;
+    const rl_scene_data *d;
+    char dir[1024];               /* for the saved approximation */
+    /* svs section's positions and values, reused by select and visset */
+    rl_approx *driver;
+    rl_vec3 *pos;
+    uint32_t npos;
+    double chcpp_triangles_mean;
+    char reason[512];
+} bc_ctx;
+
+/* A property with options {key, value, ..., NULL}, committed. */
+static rl_status make_property(bc_ctx *c, const char *name, const char *const *kv, rl_property **out)
+{
+    rl_property *p = NULL;
+    rl_status st = rl_property_create(name, &p);
+    for (size_t i = 0; st == RL_OK && kv && kv[i]; i += 2)
+        st = rl_property_set(p, kv[i], kv[i + 1]);
+    if (st == RL_OK)
+        st = rl_property_commit(p, c->scene, (int)c->a->threads);
+    if (st != RL_OK) {
+        rl_property_release(p);
+        return st;
+    }
+    *out = p;
+    return RL_OK;
+}
+
+/* Area- (volume-) weighted statistics of values given at the driver's
+ * samples, through the driver's regions. */
+static rl_status region_stats(const rl_approx *driver, const double *values, rl_stats *out)
+{
+    rl_approx *a = NULL;
+    rl_status st = rl_approx_with_values(driver, values, "v", "", &a);
+    double *v = NULL, *w = NULL;
+    size_t n = 0;
+    if (st == RL_OK && !rl_eval_leaf_series(a, &v, &w, &n))
+        st = RL_ERR_OUT_OF_MEMORY;
+    if (st == RL_OK)
+        st = rl_stats_compute(v, w, n, out);
+    free(v);
+    free(w);
+    rl_approx_release(a);
+    return st;
+}
+
+static cJSON *stats_json(const rl_stats *s)
+{
+    return rl_eval_stats_json(s);
+}
+
+/* The time property's options for one renderer. */
+#define TIME_KV(renderer, options)                                                                     \
+    (const char *const[]) { "renderer", renderer, "renderer_options", options, "width", size, "height", size, \
+                            "repeats", "3", "conditioned", "true", "condition_frames", "3", NULL }
+
+/* --- Sec. 7.3 --- */
+static rl_status sec_depth(void *ctx, cJSON *sec)
+{
+    bc_ctx *c = ctx;
+    char size[32];
+    snprintf(size, sizeof size, "%lld", c->a->size);
+    rl_aabb region = c->d->bounds;
+    region.max.y += 0.2f * (region.max.y - region.min.y);
+    printf("\nSec. 7.3: conditioned chcpp time (ms) per maximum octree depth, %lld samples each, 3-D region\n",
+           c->a->samples);
+    printf("%5s %7s %9s %9s %9s %9s %9s\n", "depth", "nodes", "mean", "q25", "median", "q75", "max");
+    cJSON *rows = cJSON_AddArrayToObject(sec, "depths");
+    int best = -1;
+    double best_mean = INFINITY;
+    for (int depth = 0; depth <= (int)c->a->max_depth; ++depth) {
+        char opts[64];
+        snprintf(opts, sizeof opts, "max_depth=%d", depth);
+        rl_property *p = NULL;
+        rl_status st = make_property(c, "time", TIME_KV("chcpp", opts), &p);
+        rl_sampling_desc sd = { .region = region, .dims = 3, .max_samples = (uint32_t)c->a->samples,
+                                .seed = (uint64_t)c->a->seed };
+        rl_approx *a = NULL;
+        if (st == RL_OK)
+            st = rl_sample_property(p, &sd, &a);
+        rl_property_release(p);
+        double *v = NULL, *w = NULL;
+        size_t n = 0;
+        rl_stats s;
+        if (st == RL_OK && !rl_eval_leaf_series(a, &v, &w, &n))
+            st = RL_ERR_OUT_OF_MEMORY;
+        if (st == RL_OK)
+            st = rl_stats_compute(v, w, n, &s);
+        free(v);
+        free(w);
+        rl_approx_release(a);
+        if (st != RL_OK)
+            return st;
+        rl_octree *t = NULL;
+        uint32_t nodes = 0;
+        if (rl_octree_build(c->scene, &(rl_octree_desc){ .max_depth = depth ? depth : RL_OCTREE_DEPTH_ZERO },
+                            &t) == RL_OK)
+            rl_octree_nodes(t, &nodes);
+        rl_octree_release(t);
+        printf("%5d %7u %9.2f %9.2f %9.2f %9.2f %9.2f\n", depth, nodes, s.mean, s.q[1], s.q[2], s.q[3], s.max);
+        cJSON *o = cJSON_CreateObject();
+        cJSON_AddNumberToObject(o, "max_depth", depth);
+        cJSON_AddNumberToObject(o, "octree_nodes", nodes);
+        cJSON_AddItemToObject(o, "time_ms", stats_json(&s));
+        cJSON_AddItemToArray(rows, o);
+        if (s.mean < best_mean) {
+            best_mean = s.mean;
+            best = depth;
+        }
+    }
+    printf("best depth %d, mean %.2f ms (thesis, Power Plant: depth 5, 9.9 ms)\n", best, best_mean);
+    cJSON_AddNumberToObject(sec, "best_depth", best);
+    rl_bench_add_num(sec, "best_mean_ms", best_mean);
+    cJSON_AddNumberToObject(sec, "thesis_best_depth", 5);
+    cJSON_AddNumberToObject(sec, "thesis_best_mean_ms", 9.9);
+    return RL_OK;
+}
+
+/* --- the shared slice of Sec. 7.4-7.6 --- */
+static rl_status ensure_driver(bc_ctx *c)
+{
+    if (c->driver)
+        return RL_OK;
+    char res[32];
+    snprintf(res, sizeof res, "%lld", c->a->resolution);
+    rl_property *vis = NULL;
+    rl_status st = make_property(c, "visibility", (const char *const[]){ "resolution", res, "measure", "polygons",
+                                                                         NULL },
+                                 &vis);
+    rl_sampling_desc sd = { .region = c->d->bounds, .dims = 2,
+                            .height = c->d->bounds.min.y + (float)c->a->height,
+                            .max_samples = (uint32_t)c->a->samples, .seed = (uint64_t)c->a->seed };
+    if (st == RL_OK) {
+        note("sampling polygons in visible objects (%lld samples)", c->a->samples);
+        st = rl_sample_property(vis, &sd, &c->driver);
+    }
+    rl_property_release(vis);
+    if (st != RL_OK)
+        return st;
+    c->npos = rl_approx_sample_count(c->driver);
+    c->pos = malloc((c->npos ? c->npos : 1) * sizeof *c->pos);
+    if (!c->pos)
+        return RL_ERR_OUT_OF_MEMORY;
+    for (uint32_t k = 0; k < c->npos; ++k)
+        rl_approx_sample(c->driver, k, &c->pos[k], NULL);
+    return RL_OK;
+}
+
+/* Measures property name/kv at the driver's positions into stats. */
+static rl_status measure_at_driver(bc_ctx *c, const char *label, const char *name, const char *const *kv,
+                                   rl_stats *s)
+{
+    rl_property *p = NULL;
+    rl_status st = make_property(c, name, kv, &p);
+    double *values = NULL;
+    if (st == RL_OK)
+        st = rl_eval_measure(p, c->pos, c->npos, &values, label);
+    if (st == RL_OK)
+        st = region_stats(c->driver, values, s);
+    free(values);
+    rl_property_release(p);
+    return st;
+}
+
+static void table_row(const char *what, const rl_stats *s, const char *thesis)
+{
+    printf("%-36s %11.4g %11.4g %11.4g %11.4g  %s\n", what, s->mean, s->min, s->q[2], s->max, thesis);
+}
+
+/* --- Sec. 7.4 --- */
+static rl_status sec_svs(void *ctx, cJSON *sec)
+{
+    bc_ctx *c = ctx;
+    rl_status st = ensure_driver(c);
+    if (st != RL_OK)
+        return st;
+    char size[32];
+    snprintf(size, sizeof size, "%lld", c->a->size);
+    rl_stats vis, t_chc, t_svs, tri_chc, tri_svs, q_svs;
+    double *dv = NULL, *dw = NULL;
+    size_t dn = 0;
+    if (!rl_eval_leaf_series(c->driver, &dv, &dw, &dn))
+        return RL_ERR_OUT_OF_MEMORY;
+    st = rl_stats_compute(dv, dw, dn, &vis);
+    free(dv);
+    free(dw);
+    const char *const tri_kv_chc[] = { "renderer", "chcpp", "width", size, "height", size, "counter", "triangles",
+                                       NULL };
+    const char *const tri_kv_svs[] = { "renderer", "svs", "width", size, "height", size, "counter", "triangles",
+                                       NULL };
+    const char *const q_kv[] = { "renderer", "svs", "reference", "raster", "width", size, "height", size, NULL };
+    if (st == RL_OK)
+        st = measure_at_driver(c, "chcpp time", "time", TIME_KV("chcpp", ""), &t_chc);
+    if (st == RL_OK)
+        st = measure_at_driver(c, "svs time", "time", TIME_KV("svs", ""), &t_svs);
+    if (st == RL_OK)
+        st = measure_at_driver(c, "chcpp triangles", "ops", tri_kv_chc, &tri_chc);
+    if (st == RL_OK)
+        st = measure_at_driver(c, "svs triangles", "ops", tri_kv_svs, &tri_svs);
+    if (st == RL_OK)
+        st = measure_at_driver(c, "svs quality", "quality", q_kv, &q_svs);
+    if (st != RL_OK)
+        return st;
+    c->chcpp_triangles_mean = tri_chc.mean;
+    printf("\nSec. 7.4: chcpp vs svs over the slice y = floor + %g, %u positions (area-weighted)\n", c->a->height,
+           c->npos);
+    printf("%-36s %11s %11s %11s %11s  %s\n", "property", "mean", "min", "median", "max", "thesis (mean)");
+    table_row("polygons in visible objects", &vis, "-");
+    table_row("chcpp time (ms, conditioned)", &t_chc, "55 ms");
+    table_row("svs time (ms, conditioned)", &t_svs, "18 ms");
+    table_row("chcpp triangles (max of 6 dirs)", &tri_chc, "15 M");
+    table_row("svs triangles (max of 6 dirs)", &tri_svs, "7.1 M");
+    table_row("svs SSIM vs raster (min of 6 dirs)", &q_svs, "not measured");
+    printf("svs / chcpp: time %.2f (thesis 0.33), triangles %.2f (thesis 0.47)\n",
+           rl_bench_ratio(t_svs.mean, t_chc.mean), rl_bench_ratio(tri_svs.mean, tri_chc.mean));
+    cJSON_AddNumberToObject(sec, "positions", c->npos);
+    cJSON_AddItemToObject(sec, "visible_polygons", stats_json(&vis));
+    cJSON_AddItemToObject(sec, "chcpp_time_ms", stats_json(&t_chc));
+    cJSON_AddItemToObject(sec, "svs_time_ms", stats_json(&t_svs));
+    cJSON_AddItemToObject(sec, "chcpp_triangles", stats_json(&tri_chc));
+    cJSON_AddItemToObject(sec, "svs_triangles", stats_json(&tri_svs));
+    cJSON_AddItemToObject(sec, "svs_ssim", stats_json(&q_svs));
+    rl_bench_add_num(sec, "time_ratio_svs_chcpp", rl_bench_ratio(t_svs.mean, t_chc.mean));
+    rl_bench_add_num(sec, "triangle_ratio_svs_chcpp", rl_bench_ratio(tri_svs.mean, tri_chc.mean));
+    return RL_OK;
+}
+
+/* --- Sec. 7.5 --- */
+
+/* Median of 3 measured frames after 3 unmeasured ones (conditioned). */
+static rl_status frame_ms(rl_renderer *r, const rl_scene *scene, const rl_camera *cam, rl_image *img, double *ms)
+{
+    double t[3];
+    rl_render_stats st;
+    for (int i = 0; i < 6; ++i) {
+        rl_status s = rl_renderer_render(r, scene, cam, img, &st);
+        if (s != RL_OK)
+            return s;
+        if (i >= 3)
+            t[i - 3] = st.time_ms;
+    }
+    double lo = fmin(t[0], fmin(t[1], t[2])), hi = fmax(t[0], fmax(t[1], t[2]));
+    *ms = t[0] + t[1] + t[2] - lo - hi;
+    return RL_OK;
+}
+
+static rl_status sec_select(void *ctx, cJSON *sec)
+{
+    bc_ctx *c = ctx;
+    rl_status st = ensure_driver(c);
+    if (st != RL_OK)
+        return st;
+    /* The threshold: a quantile of the sampled polygons in visible objects. */
+    double *dv = NULL, *dw = NULL, threshold = 0.0;
+    size_t dn = 0;
+    if (!rl_eval_leaf_series(c->driver, &dv, &dw, &dn))
+        return RL_ERR_OUT_OF_MEMORY;
+    st = rl_stats_quantiles(dv, dw, dn, &c->a->select_quantile, 1, &threshold);
+    free(dv);
+    free(dw);
+    if (st != RL_OK)
+        return st;
+    const size_t n = (size_t)c->a->select_positions;
+    rl_vec3 *pos = rl_eval_random_positions(c->driver, n, (uint64_t)c->a->seed + 75);
+    rl_renderer *chc = NULL, *svs = NULL;
+    rl_image *img = NULL;
+    if (!pos)
+        return RL_ERR_OUT_OF_MEMORY;
+    char th[32];
+    snprintf(th, sizeof th, "%lld", c->a->threads);
+    st = rl_renderer_create("chcpp", &chc);
+    if (st == RL_OK)
+        st = rl_renderer_create("svs", &svs);
+    if (st == RL_OK)
+        st = rl_renderer_set(chc, "threads", th);
+    if (st == RL_OK)
+        st = rl_renderer_set(svs, "threads", th);
+    if (st == RL_OK)
+        st = rl_image_create((int)c->a->size, (int)c->a->size, RL_LAYER_COLOR, &img);
+    rl_rng rng;
+    rl_rng_seed(&rng, (uint64_t)c->a->seed, 0x75);
+    double sum_c = 0, sum_s = 0, sum_sel = 0, hc = 0, hs = 0, hsel = 0;
+    size_t high = 0;
+    note("select: %zu random positions and directions", n);
+    for (size_t i = 0; i < n && st == RL_OK; ++i) {
+        /* Sec. 7.5: a random direction, so that the view is not averaged away. */
+        float yaw = 2.0f * RL_PI * rl_rng_float(&rng), pitch = rl_radians(40.0f * (rl_rng_float(&rng) - 0.5f));
+        rl_vec3 dir = rl_v3(cosf(pitch) * cosf(yaw), sinf(pitch), cosf(pitch) * sinf(yaw));
+        rl_camera cam = { .eye = pos[i], .target = rl_add(pos[i], dir), .fov_deg = 60.0f,
+                          .width = (int)c->a->size, .height = (int)c->a->size };
+        double vp = 0.0, tc = 0.0, ts = 0.0;
+        st = rl_approx_query(c->driver, pos[i], &vp, NULL);
+        if (st == RL_OK)
+            st = frame_ms(chc, c->scene, &cam, img, &tc);
+        if (st == RL_OK)
+            st = frame_ms(svs, c->scene, &cam, img, &ts);
+        bool occluded = vp < threshold;
+        double sel = occluded ? tc : ts;
+        sum_c += tc;
+        sum_s += ts;
+        sum_sel += sel;
+        if (occluded) {
+            ++high;
+            hc += tc;
+            hs += ts;
+            hsel += sel;
+        }
+    }
+    rl_image_release(img);
+    rl_renderer_release(chc);
+    rl_renderer_release(svs);
+    free(pos);
+    if (st != RL_OK)
+        return st;
+    printf("\nSec. 7.5: runtime selection (chcpp where polygons in visible objects < %.4g, the %.2f quantile; "
+           "else svs)\n", threshold, c->a->select_quantile);
+    printf("%-32s %10s %10s %10s\n", "mean frame time (ms)", "chcpp", "svs", "selected");
+    printf("%-32s %10.3f %10.3f %10.3f\n", "all positions", sum_c / (double)n, sum_s / (double)n,
+           sum_sel / (double)n);
+    if (high)
+        printf("%-32s %10.3f %10.3f %10.3f  (%zu positions; thesis: svs 7 ms -> 3 ms)\n", "high occlusion",
+               hc / (double)high, hs / (double)high, hsel / (double)high, high);
+    bool beats = sum_sel <= sum_c && sum_sel <= sum_s;
+    printf("selection beats both on mean time: %s\n", beats ? "yes" : "NO");
+    cJSON_AddNumberToObject(sec, "positions", (double)n);
+    rl_bench_add_num(sec, "threshold_visible_polygons", threshold);
+    cJSON_AddNumberToObject(sec, "quantile", c->a->select_quantile);
+    rl_bench_add_num(sec, "chcpp_mean_ms", sum_c / (double)n);
+    rl_bench_add_num(sec, "svs_mean_ms", sum_s / (double)n);
+    rl_bench_add_num(sec, "selected_mean_ms", sum_sel / (double)n);
+    cJSON_AddNumberToObject(sec, "high_occlusion_positions", (double)high);
+    rl_bench_add_num(sec, "high_chcpp_mean_ms", high ? hc / (double)high : NAN);
+    rl_bench_add_num(sec, "high_svs_mean_ms", high ? hs / (double)high : NAN);
+    rl_bench_add_num(sec, "high_selected_mean_ms", high ? hsel / (double)high : NAN);
+    cJSON_AddBoolToObject(sec, "selection_beats_both", beats);
+    return RL_OK;
+}
+
+/* --- Sec. 7.6 --- */
+static rl_status sec_visset(void *ctx, cJSON *sec)
+{
+    bc_ctx *c = ctx;
+    rl_status st = ensure_driver(c);
+    if (st != RL_OK)
+        return st;
+    char path[1200], opts[1400], size[32];
+    snprintf(path, sizeof path, "%s/culling-visset-approx.json", c->dir);
+    if (strchr(path, ',')) {
+        snprintf(c->reason, sizeof c->reason, "the output folder contains a comma (renderer options cannot hold it)");
+        return RL_ERR_INVALID_ARG;
+    }
+    st = rl_approx_save_json(c->driver, path);
+    if (st != RL_OK)
+        return st;
+    snprintf(size, sizeof size, "%lld", c->a->size);
+    /* The sets' memory: one bit per object for every leaf and every sample. */
+    double words = (double)((rl_approx_set_size(c->driver) + 63) / 64);
+    double bytes = 8.0 * words * (rl_approx_region_count(c->driver) + rl_approx_sample_count(c->driver));
+    long long budget = c->a->budget;
+    if (budget <= 0)
+        budget = c->chcpp_triangles_mean > 0 ? (long long)(c->chcpp_triangles_mean / 4) : 10000;
+    char budget_opts[1500];
+    snprintf(opts, sizeof opts, "approx=%s", path);
+    snprintf(budget_opts, sizeof budget_opts, "approx=%s,budget=%lld", path, budget);
+    rl_stats t_v, q_v, t_b, q_b;
+    const char *const q_kv[] = { "renderer", "visset", "renderer_options", opts, "reference", "raster",
+                                 "width", size, "height", size, NULL };
+    const char *const qb_kv[] = { "renderer", "visset", "renderer_options", budget_opts, "reference", "raster",
+                                  "width", size, "height", size, NULL };
+    st = measure_at_driver(c, "visset time", "time", TIME_KV("visset", opts), &t_v);
+    if (st == RL_OK)
+        st = measure_at_driver(c, "visset quality", "quality", q_kv, &q_v);
+    if (st == RL_OK)
+        st = measure_at_driver(c, "visset budget time", "time", TIME_KV("visset", budget_opts), &t_b);
+    if (st == RL_OK)
+        st = measure_at_driver(c, "visset budget quality", "quality", qb_kv, &q_b);
+    if (st != RL_OK)
+        return st;
+    printf("\nSec. 7.6: the sampled visible sets as a renderer (%u leaves, %u samples; sets %.2f MB, thesis 31 MB "
+           "for 4096 samples)\n", rl_approx_region_count(c->driver), rl_approx_sample_count(c->driver), bytes / 1e6);
+    printf("%-36s %11s %11s %11s %11s  %s\n", "property", "mean", "min", "median", "max", "thesis");
+    table_row("visset time (ms)", &t_v, "max 14 ms");
+    table_row("visset SSIM vs raster", &q_v, "min: massive errors");
+    char what[64];
+    snprintf(what, sizeof what, "budget %lld: time (ms)", budget);
+    table_row(what, &t_b, "-");
+    snprintf(what, sizeof what, "budget %lld: SSIM vs raster", budget);
+    table_row(what, &q_b, "-");
+    rl_bench_add_num(sec, "set_bytes", bytes);
+    cJSON_AddNumberToObject(sec, "thesis_set_bytes", 31e6);
+    cJSON_AddItemToObject(sec, "time_ms", stats_json(&t_v));
+    cJSON_AddItemToObject(sec, "ssim", stats_json(&q_v));
+    cJSON_AddNumberToObject(sec, "budget_triangles", (double)budget);
+    cJSON_AddItemToObject(sec, "budget_time_ms", stats_json(&t_b));
+    cJSON_AddItemToObject(sec, "budget_ssim", stats_json(&q_b));
+    return RL_OK;
+}
+
+static bool parse_real(const char *option, const char *text, double lo, double hi, double *out)
+{
+    char *end = NULL;
+    double x = strtod(text, &end);
+    if (!*text || *end || !isfinite(x) || x < lo || x > hi) {
+        rl_cli_fail(RL_CLI_USAGE, "%s: expected a number in [%g, %g], got '%s'", option, lo, hi, text);
+        return false;
+    }
+    *out = x;
+    return true;
+}
+
+static int parse_args(int argc, char **argv, bc_args *a)
+{
+    a->sections = (1u << SEC_COUNT) - 1;
+    a->seed = 1;
+    a->select_quantile = 0.25;
+    a->height = 10.0;
+    bool has_samples = false, has_depth = false, has_size = false, has_res = false, has_sel = false;
+    for (int i = 2; i < argc; i++) {
+        const char *v = NULL;
+        int m;
+        if (rl_cli_is_help(argv[i])) {
+            fputs(bench_culling_help, stdout);
+            return -1;
+        }
+#define VALUE(name) ((m = rl_cli_take_value(argc, argv, &i, name, &v)) != 0)
+#define COUNT(name, max, field, flag)                                                                 \
+    if (VALUE(name)) {                                                                                \
+        if (m < 0 || !rl_bench_parse_count(name, v, max, &a->field))                                  \
+            return RL_CLI_USAGE;                                                                      \
+        flag;                                                                                         \
+        continue;                                                                                     \
+    }
+        if (strcmp(argv[i], "--quick") == 0) {
+            a->quick = true;
+            continue;
+        }
+        COUNT("--samples", 1 << 20, samples, has_samples = true)
+        COUNT("--size", 4096, size, has_size = true)
+        COUNT("--resolution", 4096, resolution, has_res = true)
+        COUNT("--select-positions", 1 << 20, select_positions, has_sel = true)
+        COUNT("--budget", 1LL << 40, budget, (void)0)
+        COUNT("--threads", 1024, threads, (void)0)
+        COUNT("--seed", 1LL << 62, seed, (void)0)
+        if (VALUE("--max-depth")) {
+            char *end = NULL;
+            if (m < 0)
+                return RL_CLI_USAGE;
+            a->max_depth = strtoll(v, &end, 10);
+            if (!*v || *end || a->max_depth < 0 || a->max_depth > RL_OCTREE_MAX_DEPTH)
+                return rl_cli_fail(RL_CLI_USAGE, "--max-depth: expected 0..%d, got '%s'", RL_OCTREE_MAX_DEPTH, v);
+            has_depth = true;
+        } else if (VALUE("--height")) {
+            if (m < 0 || !parse_real("--height", v, -1e6, 1e6, &a->height))
+                return RL_CLI_USAGE;
+        } else if (VALUE("--select-quantile")) {
+            if (m < 0 || !parse_real("--select-quantile", v, 1e-6, 1.0 - 1e-6, &a->select_quantile))
+                return RL_CLI_USAGE;
+        } else if (VALUE("--only")) {
+            if (m < 0 || !rl_bench_parse_sections(v, section_names, SEC_COUNT, &a->sections))
+                return RL_CLI_USAGE;
+        } else if (VALUE("--scene")) {
+            if (m < 0)
+                return RL_CLI_USAGE;
+            a->scene = v;
+        } else if (VALUE("--out")) {
+            if (m < 0)
+                return RL_CLI_USAGE;
+            a->out = v;
+        } else {
+            return rl_cli_unknown_arg("bench culling", argv[i]);
+        }
+#undef COUNT
+#undef VALUE
+    }
+    if (a->out && !rl_cli_has_extension(a->out, (const char *const[]){ ".json", NULL }))
+        return rl_cli_fail(RL_CLI_USAGE, "--out: '%s' should end in .json", a->out);
+    if (!a->scene)
+        a->scene = a->quick ? "city:blocks=1" : "city:blocks=4";
+    if (!has_samples)
+        a->samples = a->quick ? 6 : 96;
+    if (!has_depth)
+        a->max_depth = a->quick ? 2 : 8;
+    if (!has_size)
+        a->size = a->quick ? 32 : 128;
+    if (!has_res)
+        a->resolution = a->quick ? 32 : 128;
+    if (!has_sel)
+        a->select_positions = a->quick ? 4 : 100;
+    return RL_CLI_OK;
+}
+
+int rl_bench_culling(int argc, char **argv)
+{
+    bc_args a = { 0 };
+    int rc = parse_args(argc, argv, &a);
+    if (rc != RL_CLI_OK)
+        return rc < 0 ? RL_CLI_OK : rc;
+    char out_buf[1024];
+    const char *out = a.out;
+    if (!out) {
+        if (!rl_bench_default_out("culling", out_buf, sizeof out_buf))
+            return RL_CLI_FAIL;
+        out = out_buf;
+    }
+    if (!rl_cli_check_writable(out))
+        return RL_CLI_FAIL;
+    bc_ctx c = { .a = &a };
+    snprintf(c.dir, sizeof c.dir, "%s", out);
+    char *slash = strrchr(c.dir, '/');
+    if (slash)
+        *slash = '\0';
+    else
+        snprintf(c.dir, sizeof c.dir, ".");
+    if ((rc = rl_cli_load_scene(a.scene, &c.scene)) != RL_CLI_OK)
+        return rc;
+    c.d = rl_scene_get_data(c.scene);
+    int threads = a.threads > 0 ? (int)a.threads : omp_get_max_threads();
+    cJSON *root = rl_bench_record_json("culling", threads);
+    if (!root) {
+        rl_scene_release(c.scene);
+        return rl_cli_fail(RL_CLI_FAIL, "out of memory");
+    }
+    cJSON *params = cJSON_AddObjectToObject(root, "parameters");
+    cJSON_AddStringToObject(params, "scene", a.scene);
+    cJSON_AddItemToObject(params, "scene_stats", rl_cli_scene_stats_json(c.scene));
+    cJSON_AddNumberToObject(params, "samples", (double)a.samples);
+    cJSON_AddNumberToObject(params, "max_depth", (double)a.max_depth);
+    cJSON_AddNumberToObject(params, "size", (double)a.size);
+    cJSON_AddNumberToObject(params, "height", a.height);
+    cJSON_AddNumberToObject(params, "resolution", (double)a.resolution);
+    cJSON_AddNumberToObject(params, "select_positions", (double)a.select_positions);
+    cJSON_AddNumberToObject(params, "select_quantile", a.select_quantile);
+    cJSON_AddNumberToObject(params, "seed", (double)a.seed);
+    cJSON_AddBoolToObject(params, "quick", a.quick);
+    static const rl_bench_section_fn fns[SEC_COUNT] = { sec_depth, sec_svs, sec_select, sec_visset };
+    rc = rl_bench_run_sections("culling", root, section_names, fns, SEC_COUNT, a.sections, &c, c.reason, threads,
+                               out);
+    cJSON_Delete(root);
+    rl_approx_release(c.driver);
+    free(c.pos);
+    rl_scene_release(c.scene);
+    return rc;
+}

@@ -1,0 +1,70 @@
+#!/usr/bin/env bash
+# test_cli_bench_culling.sh: `rl bench culling --quick` runs the Jaehn 2015
+# Ch. 7 applications (octree depth for CHC++, SVS vs CHC++, runtime
+# selection, visible sets as a renderer) on a tiny city and writes a
+# complete JSON record with sane values; --only picks sections; bad usage
+# exits 2. Keeps the benchmark from rotting; it measures nothing.
+# Run as: bash test_cli_bench_culling.sh <rl-binary> <scratch-dir>
+set -u
+. "$(dirname "${BASH_SOURCE[0]}")/lib.bash"
+
+have_python() { command -v python3 >/dev/null 2>&1 && python3 -c 'import json' 2>/dev/null; }
+
+expect_usage_error "$RL" bench culling --samples 0 --out "$TMP/x.json"
+expect_usage_error "$RL" bench culling --max-depth 21 --out "$TMP/x.json"
+expect_usage_error "$RL" bench culling --select-quantile 1.5 --out "$TMP/x.json"
+expect_usage_error "$RL" bench culling --only depth,nosuch --out "$TMP/x.json"
+expect_usage_error "$RL" bench culling --quick --out "$TMP/x.txt"
+expect_usage_error "$RL" bench culling --frobnicate
+[ -e "$TMP/x.json" ] && fail "a failed run wrote x.json"
+expect_exit 1 "$RL" bench culling --quick --out "$TMP/no/such/dir/c.json"
+
+expect_exit 0 "$RL" bench culling --help
+for o in --scene --only --samples --max-depth --size --height --resolution --select-positions \
+         --select-quantile --budget --threads --seed --out --quick; do
+    expect_in "$TMP/out" "$o"
+done
+expect_exit 0 "$RL" bench --help
+expect_in "$TMP/out" "rl bench culling"
+
+expect_exit 0 "$RL" bench culling --quick --out "$TMP/c.json"
+[ -s "$TMP/c.json" ] || fail "c.json was not written"
+[ -s "$TMP/culling-visset-approx.json" ] || fail "the visible sets were not saved"
+for s in "Sec. 7.3" "best depth" "Sec. 7.4" "svs / chcpp" "Sec. 7.5" "selection beats both" \
+         "Sec. 7.6" "budget"; do
+    expect_in "$TMP/out" "$s"
+done
+
+if have_python; then
+    python3 - "$TMP/c.json" <<'PY' || fail "c.json does not hold a complete, sane record"
+import json, sys
+r = json.load(open(sys.argv[1]))
+assert r["benchmark"] == "culling"
+for k in ("machine", "parameters", "depth", "svs", "select", "visset"):
+    assert k in r, "missing " + k
+for k in ("depth", "svs", "select", "visset"):
+    assert r[k]["status"] == "ok", (k, r[k])
+d = r["depth"]["depths"]
+assert [x["max_depth"] for x in d] == [0, 1, 2], d
+assert d[0]["octree_nodes"] == 1 and d[2]["octree_nodes"] > d[1]["octree_nodes"] > 1, d
+assert 0 <= r["depth"]["best_depth"] <= 2
+s = r["svs"]
+assert s["positions"] >= 1 and s["chcpp_time_ms"]["mean"] > 0 and s["svs_time_ms"]["mean"] > 0, s
+assert 0 < s["svs_ssim"]["mean"] <= 1, s
+sel = r["select"]
+assert sel["positions"] == 4 and sel["selected_mean_ms"] > 0, sel
+assert min(sel["chcpp_mean_ms"], sel["svs_mean_ms"]) <= sel["selected_mean_ms"] <= max(sel["chcpp_mean_ms"], sel["svs_mean_ms"]) + 1e-9, sel
+v = r["visset"]
+assert v["set_bytes"] > 0 and v["budget_triangles"] > 0 and 0 < v["ssim"]["min"] <= 1, v
+PY
+fi
+
+expect_exit 0 "$RL" bench culling --quick --only depth --max-depth 1 -q --out "$TMP/d.json"
+if have_python; then
+    python3 - "$TMP/d.json" <<'PY' || fail "d.json is wrong"
+import json, sys
+r = json.load(open(sys.argv[1]))
+assert len(r["depth"]["depths"]) == 2 and "svs" not in r, r.keys()
+PY
+fi
+echo "ok"
