@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # test_cli_bench_culling.sh: `rl bench culling --quick` runs the Jaehn 2015
-# Ch. 7 applications (octree depth for CHC++, SVS vs CHC++, runtime
+# Ch. 7 applications (surfels per projected size, octree depth for CHC++, SVS vs CHC++, runtime
 # selection, visible sets as a renderer) on a tiny city and writes a
 # complete JSON record with sane values; --only picks sections; bad usage
 # exits 2. Keeps the benchmark from rotting; it measures nothing.
@@ -21,7 +21,7 @@ expect_exit 1 "$RL" bench culling --quick --out "$TMP/no/such/dir/c.json"
 
 expect_exit 0 "$RL" bench culling --help
 for o in --scene --only --samples --max-depth --size --height --resolution --select-positions \
-         --select-quantile --budget --threads --seed --out --quick; do
+         --select-quantile --surfels --budget --threads --seed --out --quick; do
     expect_in "$TMP/out" "$o"
 done
 expect_exit 0 "$RL" bench --help
@@ -30,7 +30,7 @@ expect_in "$TMP/out" "rl bench culling"
 expect_exit 0 "$RL" bench culling --quick --out "$TMP/c.json"
 [ -s "$TMP/c.json" ] || fail "c.json was not written"
 [ -s "$TMP/culling-visset-approx.json" ] || fail "the visible sets were not saved"
-for s in "Sec. 7.3" "best depth" "Sec. 7.4" "svs / chcpp" "Sec. 7.5" "selection beats both" \
+for s in "Sec. 7.2" "[300,400]" "Sec. 7.3" "best depth" "Sec. 7.4" "svs / chcpp" "Sec. 7.5" "selection beats both" \
          "Sec. 7.6" "budget"; do
     expect_in "$TMP/out" "$s"
 done
@@ -40,10 +40,14 @@ if have_python; then
 import json, sys
 r = json.load(open(sys.argv[1]))
 assert r["benchmark"] == "culling"
-for k in ("machine", "parameters", "depth", "svs", "select", "visset"):
+for k in ("machine", "parameters", "surfels", "depth", "svs", "select", "visset"):
     assert k in r, "missing " + k
-for k in ("depth", "svs", "select", "visset"):
+for k in ("surfels", "depth", "svs", "select", "visset"):
     assert r[k]["status"] == "ok", (k, r[k])
+sf = r["surfels"]["ranges"]
+assert [(x["min_size"], x["max_size"]) for x in sf] == [(50, 100), (100, 200), (200, 300), (300, 400)], sf
+for x in sf:
+    assert x["time_ms"]["mean"] > 0 and 0 < x["hssim"]["min"] <= 1, x
 d = r["depth"]["depths"]
 assert [x["max_depth"] for x in d] == [0, 1, 2], d
 assert d[0]["octree_nodes"] == 1 and d[2]["octree_nodes"] > d[1]["octree_nodes"] > 1, d
