@@ -69,6 +69,8 @@ cJSON *rl_cli_render_stats_json(const rl_render_stats *stats)
     }
     add_count(obj, "rays_total", total);
     add_count(obj, "triangles_rasterized", stats->triangles_rasterized);
+    add_count(obj, "points_drawn", stats->points_drawn);
+    add_count(obj, "occlusion_queries", stats->occlusion_queries);
     add_count(obj, "pixels_written", stats->pixels_written);
     add_count(obj, "samples", stats->samples);
     return obj;
@@ -98,6 +100,10 @@ void rl_cli_print_summary(FILE *out, const char *algo, const char *scene, int wi
     /* Rasterization counts only for the algorithms that rasterize. */
     if (stats->triangles_rasterized)
         fprintf(out, ", %llu triangles rasterized", (unsigned long long)stats->triangles_rasterized);
+    if (stats->points_drawn)
+        fprintf(out, ", %llu points", (unsigned long long)stats->points_drawn);
+    if (stats->occlusion_queries)
+        fprintf(out, ", %llu occlusion queries", (unsigned long long)stats->occlusion_queries);
     fprintf(out, ", %llu pixels written", (unsigned long long)stats->pixels_written);
     /* Ray counts only for the algorithms that trace any. */
     for (int t = 0; t < RL_RAY_TYPE_COUNT; t++)

@@ -55,7 +55,8 @@
  *   ops         An operation count of a renderer (Sec. 4.2.4): `counter` =
  *               triangles (rasterized), rays (all types), primary_rays,
  *               shadow_rays, secondary_rays (reflection + refraction +
- *               diffuse), pixels, samples or occlusion_queries, reduced over
+ *               diffuse), pixels, samples, occlusion_queries, points or
+ *               primitives (triangles + points), reduced over
  *               the directions by `reduce` = max (default) or sum;
  *               direction[i] holds the count of direction i. Options as
  *               for time, minus repeats/conditioning; the worker's

@@ -37,6 +37,7 @@ typedef struct rl_render_stats {
     uint64_t pixels_written;              /* fragments/pixels written */
     uint64_t samples;                     /* shading samples (e.g. spp * pixels) */
     uint64_t occlusion_queries;           /* rasterizer occlusion queries issued */
+    uint64_t points_drawn;                /* point primitives rasterized (surfels) */
 } rl_render_stats;
 
 typedef enum rl_option_type {

@@ -86,10 +86,10 @@ static const rl_option_info time_options[] = {
 
 static const char *const counter_choices[] = {
     "triangles", "rays", "primary_rays", "shadow_rays", "secondary_rays",
-    "pixels", "samples", "occlusion_queries", NULL
+    "pixels", "samples", "occlusion_queries", "points", "primitives", NULL
 };
 enum { CNT_TRIANGLES = 0, CNT_RAYS, CNT_PRIMARY, CNT_SHADOW, CNT_SECONDARY, CNT_PIXELS,
-       CNT_SAMPLES, CNT_QUERIES };
+       CNT_SAMPLES, CNT_QUERIES, CNT_POINTS, CNT_PRIMITIVES };
 static const char *const reduce_choices[] = { "max", "sum", NULL };
 enum { REDUCE_MAX = 0, REDUCE_SUM };
 
@@ -97,7 +97,8 @@ static const rl_option_info ops_options[] = {
     RENDER_OPTION_ROWS,
     { "counter", RL_OPT_ENUM, "triangles",
       "triangles (rasterized), rays (all), primary_rays, shadow_rays, secondary_rays "
-      "(reflection + refraction + diffuse), pixels (written), samples, occlusion_queries",
+      "(reflection + refraction + diffuse), pixels (written), samples, occlusion_queries, points "
+      "(drawn), primitives (triangles + points)",
       0, 0, counter_choices },
     { "reduce", RL_OPT_ENUM, "max", "over the six directions: max or sum", 0, 0, reduce_choices },
 };
@@ -378,6 +379,8 @@ static double read_counter(int counter, const rl_render_stats *st)
     case CNT_PIXELS: return (double)st->pixels_written;
     case CNT_SAMPLES: return (double)st->samples;
     case CNT_QUERIES: return (double)st->occlusion_queries;
+    case CNT_POINTS: return (double)st->points_drawn;
+    case CNT_PRIMITIVES: return (double)(st->triangles_rasterized + st->points_drawn);
     }
     return NAN;
 }

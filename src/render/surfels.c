@@ -393,6 +393,7 @@ static rl_status surfels_render(rl_renderer *r, void *state, const rl_scene *sce
     if (st != RL_OK)
         return st;
     stats->triangles_rasterized = f.counters.triangles_drawn;
+    stats->points_drawn = f.counters.points_drawn;
     stats->pixels_written = f.counters.pixels_written;
     stats->samples = (uint64_t)image->width * image->height;
     s->head.have_frame = true;

@@ -54,6 +54,7 @@ static void test_surfels_replace_distant_geometry(void **state)
     assert_int_equal(rl_culling_get_stats(r, &cs), RL_OK);
     assert_int_equal(st.triangles_rasterized, 0);
     assert_true(cs.points_drawn > 500);
+    assert_true(st.points_drawn > 0 && st.points_drawn <= cs.points_drawn);   /* rl_render_stats too */
     assert_true(cs.surfel_nodes >= 1);
     assert_true(cs.preprocess_ms > 0.0);
     rl_image_metrics m;
