@@ -55,14 +55,8 @@
 #include "render/renderer.h"
 #include "rl/rl_timer.h"
 
-static const char *const shading_choices[] = { "flat", "gouraud", "textured", NULL };
-
 static const rl_option_info chcpp_options[] = {
-    { "shading", RL_OPT_ENUM, "textured", "flat | gouraud | textured, as raster", 0, 0, shading_choices },
-    { "cull", RL_OPT_BOOL, "false", "drop back faces (counter-clockwise = front)", 0, 0, NULL },
-    { "ambient", RL_OPT_FLOAT, "0.05", "ambient light, multiplied by k_d", 0, 1, NULL },
-    { "background", RL_OPT_COLOR, "0,0,0", "colour where nothing is drawn", 0, 0, NULL },
-    { "threads", RL_OPT_INT, "0", "OpenMP threads of the rasterizer (0 = all)", 0, 1024, NULL },
+    RL_CULL_RASTER_OPTIONS,
     { "max_depth", RL_OPT_INT, "5", "maximum depth of the loose octree (0: all objects in the root)", 0,
       RL_OCTREE_MAX_DEPTH, NULL },
     { "looseness", RL_OPT_FLOAT, "2", "loose octree enlargement factor k", 1, 8, NULL },
@@ -108,10 +102,7 @@ typedef struct frame_ctx {
     const rl_scene_data *d;
     const rl_octree_node *nodes;
     const uint32_t *objects;
-    rl_raster *ras;
-    rl_scene_drawer *drawer;
-    rl_cull_view view;
-    rl_raster_counters counters;
+    rl_cull_frame cf;
     bool tight, multiquery;
     uint32_t batch, n_av;
     uint64_t seed;
@@ -233,13 +224,13 @@ static rl_status traverse(frame_ctx *f, uint32_t n)
     rl_status st = RL_OK;
     for (uint32_t k = 0; k < node->num_objects && st == RL_OK; ++k) {
         uint32_t o = f->objects[node->first_object + k];
-        st = rl_scene_drawer_draw(f->drawer, f->ras, o, &f->counters);
+        st = rl_scene_drawer_draw(f->cf.drawer, f->cf.ras, o, &f->cf.counters);
         f->s->head.stats.objects_drawn++;
         f->s->head.stats.triangles_drawn += f->d->objects[o].num_triangles;
     }
     for (uint32_t c = 0; c < node->num_children && st == RL_OK; ++c) {
         uint32_t ch = node->first_child + c;
-        st = heap_push(f->s, (heap_item){ rl_cull_box_distance(f->view.eye, f->nodes[ch].bounds), ch });
+        st = heap_push(f->s, (heap_item){ rl_cull_box_distance(f->cf.view.eye, f->nodes[ch].bounds), ch });
     }
     return st;
 }
@@ -293,7 +284,7 @@ static rl_status query_nodes(frame_ctx *f, const uint32_t *list, uint32_t count,
         st = add_node_boxes(f, list[i]);
     uint64_t pixels = 0;
     if (st == RL_OK)
-        st = rl_box_query_run(&f->s->query, f->ras, &pixels, NULL);
+        st = rl_box_query_run(&f->s->query, f->cf.ras, &pixels, NULL);
     f->s->head.stats.queries++;
     f->s->head.stats.query_boxes += f->s->query.boxes;
     if (count > 1)
@@ -379,7 +370,7 @@ static rl_status chcpp_frame(frame_ctx *f)
 {
     chcpp_state *s = f->s;
     rl_culling_stats *stats = &s->head.stats;
-    rl_status st = heap_push(s, (heap_item){ rl_cull_box_distance(f->view.eye, f->nodes[0].bounds), 0 });
+    rl_status st = heap_push(s, (heap_item){ rl_cull_box_distance(f->cf.view.eye, f->nodes[0].bounds), 0 });
     while (st == RL_OK && (s->heap_n > 0 || s->iq_n > 0)) {
         if (s->heap_n == 0) {
             st = flush_iqueue(f);   /* may queue the children of visible nodes */
@@ -391,12 +382,12 @@ static rl_status chcpp_frame(frame_ctx *f)
         stats->nodes_visited++;
         bool was_visible = ns->visible && ns->last_visited + 1 == s->frame;
         ns->last_visited = s->frame;
-        if (!rl_cull_box_in_frustum(&f->view, node->bounds)) {
+        if (!rl_cull_box_in_frustum(&f->cf.view, node->bounds)) {
             ns->visible = 0;
             stats->nodes_frustum_culled++;
             continue;
         }
-        if (rl_cull_box_near_eye(&f->view, f->tight ? node->bounds : node->loose)) {
+        if (rl_cull_box_near_eye(&f->cf.view, f->tight ? node->bounds : node->loose)) {
             /* No query can be trusted where the near plane cuts the box. */
             ns->visible = 0;
             if (node->num_objects)
@@ -466,18 +457,6 @@ static rl_status chcpp_render(rl_renderer *r, void *state, const rl_scene *scene
     s->head.stats.octree_nodes = nn;
     s->head.stats.octree_depth = rl_octree_depth(s->oc.tree);
 
-    rl_raster_scene_desc desc = {
-        .shading = (rl_raster_shading)rl_renderer_opt_enum(r, "shading"),
-        .ambient = (float)rl_renderer_opt_float(r, "ambient"),
-        .threads = (int)rl_renderer_opt_int(r, "threads"),
-        .flags = rl_renderer_opt_bool(r, "cull") ? RL_RASTER_CULL_BACK : 0u,
-    };
-    rl_cull_target target;
-    st = rl_cull_target_begin(image, rl_renderer_opt_color(r, "background"), &target);
-    if (st != RL_OK)
-        return st;
-    desc.flags |= target.flags;
-
     frame_ctx f;
     memset(&f, 0, sizeof f);
     f.s = s;
@@ -489,24 +468,13 @@ static rl_status chcpp_render(rl_renderer *r, void *state, const rl_scene *scene
     f.batch = (uint32_t)rl_renderer_opt_int(r, "batch");
     f.n_av = (uint32_t)rl_renderer_opt_int(r, "assumed_visible");
     f.seed = (uint64_t)rl_renderer_opt_int(r, "seed");
-    rl_cull_view_make(cam, d->bounds, &f.view);
-    st = rl_raster_create(&(rl_raster_desc){ .threads = desc.threads }, &f.ras);
-    if (st == RL_OK)
-        st = rl_raster_set_target(f.ras, &target.image, &f.view.view, &f.view.proj);
-    if (st == RL_OK)
-        st = rl_scene_drawer_create(d, f.view.eye, &desc, &f.drawer);
-    if (st == RL_OK) {
-        s->frame++;
-        st = chcpp_frame(&f);
-    }
-    rl_scene_drawer_release(f.drawer);
-    rl_raster_release(f.ras);
-    rl_cull_target_end(&target);
+    st = rl_cull_frame_begin(r, d, cam, image, &f.cf);
     if (st != RL_OK)
         return st;
-    stats->triangles_rasterized = f.counters.triangles_drawn;
-    stats->pixels_written = f.counters.pixels_written;
-    stats->samples = (uint64_t)image->width * image->height;
+    s->frame++;
+    st = rl_cull_frame_end(&f.cf, chcpp_frame(&f), image, stats);
+    if (st != RL_OK)
+        return st;
     stats->occlusion_queries = s->head.stats.queries;
     s->head.have_frame = true;
     return RL_OK;

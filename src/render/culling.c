@@ -4,6 +4,9 @@
 #include <string.h>
 
 #include "core/error.h"
+#ifdef _OPENMP
+#include <omp.h>
+#endif
 #include "render/culling.h"
 #include "render/renderer.h"
 
@@ -205,4 +208,54 @@ rl_status rl_culling_get_stats(const rl_renderer *r, rl_culling_stats *out)
         return rl_error(RL_ERR_INVALID_ARG, "rl_culling_get_stats: no frame rendered yet");
     *out = h->stats;
     return RL_OK;
+}
+
+const char *const rl_cull_shading_choices[] = { "flat", "gouraud", "textured", NULL };
+
+rl_status rl_cull_frame_begin(rl_renderer *r, const rl_scene_data *d, const rl_camera *cam, rl_image *image,
+                              rl_cull_frame *f)
+{
+    memset(f, 0, sizeof *f);
+    f->threads_opt = (int)rl_renderer_opt_int(r, "threads");
+#ifdef _OPENMP
+    f->threads = f->threads_opt > 0 ? f->threads_opt : omp_get_max_threads();
+#else
+    f->threads = 1;
+#endif
+    f->ambient = (float)rl_renderer_opt_float(r, "ambient");
+    rl_raster_scene_desc desc = {
+        .shading = (rl_raster_shading)rl_renderer_opt_enum(r, "shading"),
+        .ambient = f->ambient,
+        .threads = f->threads_opt,
+        .flags = rl_renderer_opt_bool(r, "cull") ? RL_RASTER_CULL_BACK : 0u,
+    };
+    rl_status st = rl_cull_target_begin(image, rl_renderer_opt_color(r, "background"), &f->target);
+    if (st != RL_OK)
+        return st;
+    desc.flags |= f->target.flags;
+    rl_cull_view_make(cam, d->bounds, &f->view);
+    st = rl_raster_create(&(rl_raster_desc){ .threads = f->threads_opt }, &f->ras);
+    if (st == RL_OK)
+        st = rl_raster_set_target(f->ras, &f->target.image, &f->view.view, &f->view.proj);
+    if (st == RL_OK)
+        st = rl_scene_drawer_create(d, f->view.eye, &desc, &f->drawer);
+    if (st != RL_OK)
+        rl_cull_frame_end(f, st, image, NULL);
+    return st;
+}
+
+rl_status rl_cull_frame_end(rl_cull_frame *f, rl_status st, const rl_image *image, rl_render_stats *stats)
+{
+    rl_scene_drawer_release(f->drawer);
+    rl_raster_release(f->ras);
+    rl_cull_target_end(&f->target);
+    f->drawer = NULL;
+    f->ras = NULL;
+    if (st == RL_OK && stats) {
+        stats->triangles_rasterized = f->counters.triangles_drawn;
+        stats->points_drawn = f->counters.points_drawn;
+        stats->pixels_written = f->counters.pixels_written;
+        stats->samples = (uint64_t)image->width * image->height;
+    }
+    return st;
 }

@@ -6,6 +6,7 @@
 #ifndef RL_RENDER_CULLING_H
 #define RL_RENDER_CULLING_H
 
+#include "render/raster_scene.h"
 #include "rl/rl_culling.h"
 #include "rl/rl_octree.h"
 #include "rl/rl_raster.h"
@@ -72,6 +73,37 @@ typedef struct rl_octree_cache {
 rl_status rl_octree_cache_get(rl_octree_cache *c, const rl_scene *scene, const rl_octree_desc *desc,
                               bool *rebuilt);
 void rl_octree_cache_release(rl_octree_cache *c);
+
+/* The option rows every culling renderer shares with raster (its mesh
+ * drawing), first in its table; rl_cull_frame_begin() reads them. */
+extern const char *const rl_cull_shading_choices[];
+#define RL_CULL_RASTER_OPTIONS                                                                          \
+    { "shading", RL_OPT_ENUM, "textured", "meshes: flat | gouraud | textured, as raster", 0, 0,          \
+      rl_cull_shading_choices },                                                                        \
+    { "cull", RL_OPT_BOOL, "false", "drop back faces (counter-clockwise = front)", 0, 0, NULL },        \
+    { "ambient", RL_OPT_FLOAT, "0.05", "ambient light, multiplied by k_d", 0, 1, NULL },                \
+    { "background", RL_OPT_COLOR, "0,0,0", "colour where nothing is drawn", 0, 0, NULL },              \
+    { "threads", RL_OPT_INT, "0", "OpenMP threads (0 = all)", 0, 1024, NULL }
+
+/* One frame of a culling renderer: the caller's image as target, the view,
+ * a rasterizer on it and a drawer for the objects, from the shared
+ * options. */
+typedef struct rl_cull_frame {
+    rl_cull_target target;
+    rl_cull_view view;
+    rl_raster *ras;
+    rl_scene_drawer *drawer;
+    rl_raster_counters counters;
+    int threads_opt;              /* the option: 0 = all */
+    int threads;                  /* resolved, >= 1 */
+    float ambient;
+} rl_cull_frame;
+
+rl_status rl_cull_frame_begin(rl_renderer *r, const rl_scene_data *d, const rl_camera *cam, rl_image *image,
+                              rl_cull_frame *f);
+/* Releases what begin made; with st == RL_OK fills stats (triangles,
+ * points, pixels written, samples). Returns st. */
+rl_status rl_cull_frame_end(rl_cull_frame *f, rl_status st, const rl_image *image, rl_render_stats *stats);
 
 /* Every culling renderer's state starts with this, so that
  * rl_culling_get_stats() can read any of them. */

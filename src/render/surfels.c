@@ -34,10 +34,6 @@
 #include <stdlib.h>
 #include <string.h>
 
-#ifdef _OPENMP
-#include <omp.h>
-#endif
-
 #include "core/error.h"
 #include "render/culling.h"
 #include "render/raster_scene.h"
@@ -45,14 +41,8 @@
 #include "rl/rl_surfels.h"
 #include "rl/rl_timer.h"
 
-static const char *const shading_choices[] = { "flat", "gouraud", "textured", NULL };
-
 static const rl_option_info surfels_options[] = {
-    { "shading", RL_OPT_ENUM, "textured", "meshes: flat | gouraud | textured, as raster", 0, 0, shading_choices },
-    { "cull", RL_OPT_BOOL, "false", "drop back faces of meshes", 0, 0, NULL },
-    { "ambient", RL_OPT_FLOAT, "0.05", "ambient light, multiplied by k_d", 0, 1, NULL },
-    { "background", RL_OPT_COLOR, "0,0,0", "colour where nothing is drawn", 0, 0, NULL },
-    { "threads", RL_OPT_INT, "0", "OpenMP threads (0 = all)", 0, 1024, NULL },
+    RL_CULL_RASTER_OPTIONS,
     { "min_size", RL_OPT_FLOAT, "100", "below this projected side (px) a node is surfels only", 0, 1e6, NULL },
     { "max_size", RL_OPT_FLOAT, "200", "above this projected side (px) a node is its meshes only", 0, 1e6, NULL },
     { "overdraw", RL_OPT_FLOAT, "4", "surfels per covered pixel", 0.01, 1000, NULL },
@@ -164,12 +154,8 @@ typedef struct surfels_frame {
     const rl_scene_data *d;
     const rl_octree_node *nodes;
     const uint32_t *objects;
-    rl_raster *ras;
-    rl_scene_drawer *drawer;
-    rl_cull_view view;
-    rl_raster_counters counters;
-    float min2, max2, overdraw, point_size, ambient;
-    int threads;
+    rl_cull_frame cf;
+    float min2, max2, overdraw, point_size;
 } surfels_frame;
 
 /* Projected size of a box: the area of its screen rectangle in pixels;
@@ -221,11 +207,11 @@ static rl_status draw_prefix(surfels_frame *f, const rl_surfel_set *set, uint32_
     rl_status st = reserve(s, n);
     if (st != RL_OK)
         return st;
-    const rl_vec3 eye = f->view.eye;
+    const rl_vec3 eye = f->cf.view.eye;
     uint32_t kept = 0;
     /* Light and size in parallel, then compact the front-facing points in
      * order, so the result does not depend on the thread count. */
-#pragma omp parallel for num_threads(n > 8192 ? f->threads : 1) schedule(static)
+#pragma omp parallel for num_threads(n > 8192 ? f->cf.threads : 1) schedule(static)
     for (int64_t i = 0; i < (int64_t)n; ++i) {
         const rl_surfel *sf = &set->surfels[i];
         rl_vec3 p = rl_v3(sf->position[0], sf->position[1], sf->position[2]);
@@ -239,7 +225,7 @@ static rl_status draw_prefix(surfels_frame *f, const rl_surfel_set *set, uint32_
             continue;
         }
         s->size[i] = rl_maxf(1.0f, base * rl_surfel_size(sf) * cosv);
-        rl_vec3 c = rl_raster_light_diffuse(f->d, p, nrm, rl_surfel_color(sf), f->ambient, eye);
+        rl_vec3 c = rl_raster_light_diffuse(f->d, p, nrm, rl_surfel_color(sf), f->cf.ambient, eye);
         s->col[i] = rl_v4_from3(c, 1.0f);
     }
     for (uint32_t i = 0; i < n; ++i) {
@@ -255,9 +241,9 @@ static rl_status draw_prefix(surfels_frame *f, const rl_surfel_set *set, uint32_
     s->head.stats.points_drawn += kept;
     rl_raster_counters c;
     memset(&c, 0, sizeof c);
-    st = rl_raster_draw_points(f->ras, &pts, &c);
-    f->counters.pixels_written += c.pixels_written;
-    f->counters.points_drawn += c.points_drawn;
+    st = rl_raster_draw_points(f->cf.ras, &pts, &c);
+    f->cf.counters.pixels_written += c.pixels_written;
+    f->cf.counters.points_drawn += c.points_drawn;
     return st;
 }
 
@@ -266,12 +252,12 @@ static rl_status draw_node(surfels_frame *f, uint32_t n)
     surfels_state *s = f->s;
     const rl_octree_node *node = &f->nodes[n];
     s->head.stats.nodes_visited++;
-    if (!rl_cull_box_in_frustum(&f->view, node->bounds)) {
+    if (!rl_cull_box_in_frustum(&f->cf.view, node->bounds)) {
         s->head.stats.nodes_frustum_culled++;
         return RL_OK;
     }
     const rl_surfel_set *set = n < s->num_sets ? &s->sets[n] : NULL;
-    double a = projected_size(&f->view, node->bounds);
+    double a = projected_size(&f->cf.view, node->bounds);
     rl_status st = RL_OK;
     if (set && set->count > 0 && a <= f->max2) {
         /* Sec. 6.2: prefix length and point size from the projected size. */
@@ -290,11 +276,11 @@ static rl_status draw_node(surfels_frame *f, uint32_t n)
     }
     for (uint32_t k = 0; k < node->num_objects && st == RL_OK; ++k) {
         uint32_t o = f->objects[node->first_object + k];
-        if (!rl_cull_box_in_frustum(&f->view, f->d->objects[o].bounds))
+        if (!rl_cull_box_in_frustum(&f->cf.view, f->d->objects[o].bounds))
             continue;
         s->head.stats.objects_drawn++;
         s->head.stats.triangles_drawn += f->d->objects[o].num_triangles;
-        st = rl_scene_drawer_draw(f->drawer, f->ras, o, &f->counters);
+        st = rl_scene_drawer_draw(f->cf.drawer, f->cf.ras, o, &f->cf.counters);
     }
     for (uint32_t c = 0; c < node->num_children && st == RL_OK; ++c)
         st = draw_node(f, node->first_child + c);
@@ -352,17 +338,6 @@ static rl_status surfels_render(rl_renderer *r, void *state, const rl_scene *sce
     s->head.stats.octree_nodes = nn;
     s->head.stats.octree_depth = rl_octree_depth(s->oc.tree);
 
-    rl_raster_scene_desc desc = {
-        .shading = (rl_raster_shading)rl_renderer_opt_enum(r, "shading"),
-        .ambient = (float)rl_renderer_opt_float(r, "ambient"),
-        .threads = threads,
-        .flags = rl_renderer_opt_bool(r, "cull") ? RL_RASTER_CULL_BACK : 0u,
-    };
-    rl_cull_target target;
-    st = rl_cull_target_begin(image, rl_renderer_opt_color(r, "background"), &target);
-    if (st != RL_OK)
-        return st;
-    desc.flags |= target.flags;
     surfels_frame f;
     memset(&f, 0, sizeof f);
     f.s = s;
@@ -373,29 +348,12 @@ static rl_status surfels_render(rl_renderer *r, void *state, const rl_scene *sce
     f.max2 = max_size * max_size;
     f.overdraw = (float)rl_renderer_opt_float(r, "overdraw");
     f.point_size = (float)rl_renderer_opt_float(r, "point_size");
-    f.ambient = desc.ambient;
-#ifdef _OPENMP
-    f.threads = threads > 0 ? threads : omp_get_max_threads();
-#else
-    f.threads = 1;
-#endif
-    rl_cull_view_make(cam, d->bounds, &f.view);
-    st = rl_raster_create(&(rl_raster_desc){ .threads = threads }, &f.ras);
-    if (st == RL_OK)
-        st = rl_raster_set_target(f.ras, &target.image, &f.view.view, &f.view.proj);
-    if (st == RL_OK)
-        st = rl_scene_drawer_create(d, f.view.eye, &desc, &f.drawer);
-    if (st == RL_OK)
-        st = draw_node(&f, 0);
-    rl_scene_drawer_release(f.drawer);
-    rl_raster_release(f.ras);
-    rl_cull_target_end(&target);
+    st = rl_cull_frame_begin(r, d, cam, image, &f.cf);
     if (st != RL_OK)
         return st;
-    stats->triangles_rasterized = f.counters.triangles_drawn;
-    stats->points_drawn = f.counters.points_drawn;
-    stats->pixels_written = f.counters.pixels_written;
-    stats->samples = (uint64_t)image->width * image->height;
+    st = rl_cull_frame_end(&f.cf, draw_node(&f, 0), image, stats);
+    if (st != RL_OK)
+        return st;
     s->head.have_frame = true;
     return RL_OK;
 }

@@ -48,14 +48,8 @@
 #include "render/renderer.h"
 #include "rl/rl_timer.h"
 
-static const char *const shading_choices[] = { "flat", "gouraud", "textured", NULL };
-
 static const rl_option_info svs_options[] = {
-    { "shading", RL_OPT_ENUM, "textured", "flat | gouraud | textured, as raster", 0, 0, shading_choices },
-    { "cull", RL_OPT_BOOL, "false", "drop back faces (counter-clockwise = front)", 0, 0, NULL },
-    { "ambient", RL_OPT_FLOAT, "0.05", "ambient light, multiplied by k_d", 0, 1, NULL },
-    { "background", RL_OPT_COLOR, "0,0,0", "colour where nothing is drawn", 0, 0, NULL },
-    { "threads", RL_OPT_INT, "0", "OpenMP threads (0 = all)", 0, 1024, NULL },
+    RL_CULL_RASTER_OPTIONS,
     { "max_depth", RL_OPT_INT, "5", "maximum depth of the loose octree (0: all objects in the root)", 0,
       RL_OCTREE_MAX_DEPTH, NULL },
     { "looseness", RL_OPT_FLOAT, "2", "loose octree enlargement factor k", 1, 8, NULL },
@@ -411,10 +405,7 @@ typedef struct svs_frame {
     const rl_scene_data *d;
     const rl_octree_node *nodes;
     const uint32_t *objects;
-    rl_raster *ras;
-    rl_scene_drawer *drawer;
-    rl_cull_view view;
-    rl_raster_counters counters;
+    rl_cull_frame cf;
     uint32_t neighbours;
     float distance;
 } svs_frame;
@@ -425,11 +416,11 @@ static rl_status draw_object(svs_frame *f, uint32_t o)
     if (s->stamp[o] == s->frame)
         return RL_OK;
     s->stamp[o] = s->frame;
-    if (!rl_cull_box_in_frustum(&f->view, f->d->objects[o].bounds))
+    if (!rl_cull_box_in_frustum(&f->cf.view, f->d->objects[o].bounds))
         return RL_OK;
     s->head.stats.objects_drawn++;
     s->head.stats.triangles_drawn += f->d->objects[o].num_triangles;
-    return rl_scene_drawer_draw(f->drawer, f->ras, o, &f->counters);
+    return rl_scene_drawer_draw(f->cf.drawer, f->cf.ras, o, &f->cf.counters);
 }
 
 static rl_status draw_node(svs_frame *f, uint32_t n)
@@ -437,14 +428,14 @@ static rl_status draw_node(svs_frame *f, uint32_t n)
     svs_state *s = f->s;
     const rl_octree_node *node = &f->nodes[n];
     s->head.stats.nodes_visited++;
-    if (!rl_cull_box_in_frustum(&f->view, node->bounds)) {
+    if (!rl_cull_box_in_frustum(&f->cf.view, node->bounds)) {
         s->head.stats.nodes_frustum_culled++;
         return RL_OK;
     }
     rl_vec3 c;
     float r;
     sphere_of(node->bounds, &c, &r);
-    rl_vec3 to_eye = rl_sub(f->view.eye, c);
+    rl_vec3 to_eye = rl_sub(f->cf.view.eye, c);
     float dist = rl_length(to_eye);
     rl_status st = RL_OK;
     if (dist > f->distance * r) {
@@ -525,17 +516,6 @@ static rl_status svs_render(rl_renderer *r, void *state, const rl_scene *scene, 
     s->head.stats.octree_nodes = nn;
     s->head.stats.octree_depth = rl_octree_depth(s->oc.tree);
 
-    rl_raster_scene_desc desc = {
-        .shading = (rl_raster_shading)rl_renderer_opt_enum(r, "shading"),
-        .ambient = (float)rl_renderer_opt_float(r, "ambient"),
-        .threads = threads,
-        .flags = rl_renderer_opt_bool(r, "cull") ? RL_RASTER_CULL_BACK : 0u,
-    };
-    rl_cull_target target;
-    st = rl_cull_target_begin(image, rl_renderer_opt_color(r, "background"), &target);
-    if (st != RL_OK)
-        return st;
-    desc.flags |= target.flags;
     svs_frame f;
     memset(&f, 0, sizeof f);
     f.s = s;
@@ -546,27 +526,16 @@ static rl_status svs_render(rl_renderer *r, void *state, const rl_scene *scene, 
     f.distance = (float)rl_renderer_opt_float(r, "distance");
     if (f.neighbours > s->num_dirs)
         f.neighbours = s->num_dirs;
-    rl_cull_view_make(cam, d->bounds, &f.view);
-    st = rl_raster_create(&(rl_raster_desc){ .threads = threads }, &f.ras);
-    if (st == RL_OK)
-        st = rl_raster_set_target(f.ras, &target.image, &f.view.view, &f.view.proj);
-    if (st == RL_OK)
-        st = rl_scene_drawer_create(d, f.view.eye, &desc, &f.drawer);
-    if (st == RL_OK) {
-        if (++s->frame == 0) {
-            memset(s->stamp, 0, d->num_objects * sizeof *s->stamp);
-            s->frame = 1;
-        }
-        st = draw_node(&f, 0);
-    }
-    rl_scene_drawer_release(f.drawer);
-    rl_raster_release(f.ras);
-    rl_cull_target_end(&target);
+    st = rl_cull_frame_begin(r, d, cam, image, &f.cf);
     if (st != RL_OK)
         return st;
-    stats->triangles_rasterized = f.counters.triangles_drawn;
-    stats->pixels_written = f.counters.pixels_written;
-    stats->samples = (uint64_t)image->width * image->height;
+    if (++s->frame == 0) {
+        memset(s->stamp, 0, d->num_objects * sizeof *s->stamp);
+        s->frame = 1;
+    }
+    st = rl_cull_frame_end(&f.cf, draw_node(&f, 0), image, stats);
+    if (st != RL_OK)
+        return st;
     s->head.have_frame = true;
     return RL_OK;
 }

@@ -34,14 +34,8 @@
 #include "rl/rl_sampling.h"
 #include "rl/rl_timer.h"
 
-static const char *const shading_choices[] = { "flat", "gouraud", "textured", NULL };
-
 static const rl_option_info visset_options[] = {
-    { "shading", RL_OPT_ENUM, "textured", "flat | gouraud | textured, as raster", 0, 0, shading_choices },
-    { "cull", RL_OPT_BOOL, "false", "drop back faces (counter-clockwise = front)", 0, 0, NULL },
-    { "ambient", RL_OPT_FLOAT, "0.05", "ambient light, multiplied by k_d", 0, 1, NULL },
-    { "background", RL_OPT_COLOR, "0,0,0", "colour where nothing is drawn", 0, 0, NULL },
-    { "threads", RL_OPT_INT, "0", "OpenMP threads (0 = all)", 0, 1024, NULL },
+    RL_CULL_RASTER_OPTIONS,
     { "approx", RL_OPT_STRING, "", "approx.json of the visibility property (rl eval); empty: sample it here",
       0, 0, NULL },
     { "samples", RL_OPT_INT, "256", "samples when sampling here", 1, 1 << 20, NULL },
@@ -248,10 +242,7 @@ static rl_status prepare(visset_state *s, rl_renderer *r, const rl_scene *scene,
 typedef struct visset_frame {
     visset_state *s;
     const rl_scene_data *d;
-    rl_raster *ras;
-    rl_scene_drawer *drawer;
-    rl_cull_view view;
-    rl_raster_counters counters;
+    rl_cull_frame cf;
     uint64_t budget;
 } visset_frame;
 
@@ -260,14 +251,14 @@ static rl_status draw_object(visset_frame *f, uint32_t o)
 {
     visset_state *s = f->s;
     const rl_object *obj = &f->d->objects[o];
-    if (s->stamp[o] == s->frame || !rl_cull_box_in_frustum(&f->view, obj->bounds))
+    if (s->stamp[o] == s->frame || !rl_cull_box_in_frustum(&f->cf.view, obj->bounds))
         return RL_OK;
     if (f->budget && s->head.stats.triangles_drawn + obj->num_triangles > f->budget)
         return RL_OK;
     s->stamp[o] = s->frame;
     s->head.stats.objects_drawn++;
     s->head.stats.triangles_drawn += obj->num_triangles;
-    return rl_scene_drawer_draw(f->drawer, f->ras, o, &f->counters);
+    return rl_scene_drawer_draw(f->cf.drawer, f->cf.ras, o, &f->cf.counters);
 }
 
 static rl_status visset_render(rl_renderer *r, void *state, const rl_scene *scene, const rl_camera *cam,
@@ -285,36 +276,22 @@ static rl_status visset_render(rl_renderer *r, void *state, const rl_scene *scen
     if (st != RL_OK)
         return st;
 
-    rl_raster_scene_desc desc = {
-        .shading = (rl_raster_shading)rl_renderer_opt_enum(r, "shading"),
-        .ambient = (float)rl_renderer_opt_float(r, "ambient"),
-        .threads = threads,
-        .flags = rl_renderer_opt_bool(r, "cull") ? RL_RASTER_CULL_BACK : 0u,
-    };
-    rl_cull_target target;
-    st = rl_cull_target_begin(image, rl_renderer_opt_color(r, "background"), &target);
-    if (st != RL_OK)
-        return st;
-    desc.flags |= target.flags;
     visset_frame f;
     memset(&f, 0, sizeof f);
     f.s = s;
     f.d = d;
     f.budget = budget;
-    rl_cull_view_make(cam, d->bounds, &f.view);
-    st = rl_raster_create(&(rl_raster_desc){ .threads = threads }, &f.ras);
-    if (st == RL_OK)
-        st = rl_raster_set_target(f.ras, &target.image, &f.view.view, &f.view.proj);
-    if (st == RL_OK)
-        st = rl_scene_drawer_create(d, f.view.eye, &desc, &f.drawer);
-    if (st == RL_OK && ++s->frame == 0) {
+    st = rl_cull_frame_begin(r, d, cam, image, &f.cf);
+    if (st != RL_OK)
+        return st;
+    if (++s->frame == 0) {
         memset(s->stamp, 0, d->num_objects * sizeof *s->stamp);
         s->frame = 1;
     }
     /* Inside the sampled region (2-D: its x-z extent)? Checked here so that
      * a viewer outside raises no error. */
     rl_aabb rb = rl_approx_bounds(s->approx);
-    rl_vec3 e = f.view.eye;
+    rl_vec3 e = f.cf.view.eye;
     bool inside = e.x >= rb.min.x && e.x <= rb.max.x && e.z >= rb.min.z && e.z <= rb.max.z &&
                   (rl_approx_dims(s->approx) == 2 || (e.y >= rb.min.y && e.y <= rb.max.y));
     double ignored;
@@ -334,14 +311,9 @@ static rl_status visset_render(rl_renderer *r, void *state, const rl_scene *scen
             if ((set[o / 64] >> (o % 64)) & 1u)
                 st = draw_object(&f, o);
     }
-    rl_scene_drawer_release(f.drawer);
-    rl_raster_release(f.ras);
-    rl_cull_target_end(&target);
+    st = rl_cull_frame_end(&f.cf, st, image, stats);
     if (st != RL_OK)
         return st;
-    stats->triangles_rasterized = f.counters.triangles_drawn;
-    stats->pixels_written = f.counters.pixels_written;
-    stats->samples = (uint64_t)image->width * image->height;
     s->head.have_frame = true;
     return RL_OK;
 }
