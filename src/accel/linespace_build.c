@@ -637,6 +637,12 @@ rl_status rl_ls_build(rl_linespace *ls)
     }
     double pass_ms = rl_timer_ms(&pass);
     int fail = atomic_load(&failed);
+    /* Only the main thread reports inside the pass, and under dynamic
+     * scheduling it may have built no block at all (a busy machine, few
+     * blocks): report the pass's end once more, so that a cancel is never
+     * missed. */
+    if (!fail && ls->progress && !ls->progress(ls->user, 0.95))
+        fail = 2;
     if (!fail && dyn) {
         /* Sec. 7.1.1's prefix sum, in two levels: the pass left each
          * shaft's offset inside its block, so only the blocks' totals are
