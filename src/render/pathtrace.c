@@ -111,6 +111,8 @@ static const rl_option_info pt_options[] = {
     { "ls_dynamic", RL_OPT_BOOL, "true", "exact per-shaft candidate lists (prefix sums, Sec. 7.1.1)", 0, 0, NULL },
     { "shadowmap_size", RL_OPT_INT, "1024", "texels per shadow-map face side (Sec. 8.6)", 16, 16384, NULL },
     { "light_samples", RL_OPT_INT, "1", "shadow rays per quad light and vertex", 1, 1024, NULL },
+    { "background", RL_OPT_COLOR, "0,0,0",
+      "radiance arriving from every direction where a ray leaves the scene (a uniform environment)", 0, 0, NULL },
     { "threads", RL_OPT_INT, "0", "OpenMP threads (0 = all)", 0, 1024, NULL },
 };
 #define NUM_OPTIONS (sizeof pt_options / sizeof pt_options[0])
@@ -230,6 +232,7 @@ static void read_settings(const rl_renderer *r, pt_settings *set)
     set->ls_dynamic = rl_renderer_opt_bool(r, "ls_dynamic");
     set->shadowmap_size = (int)rl_renderer_opt_int(r, "shadowmap_size");
     set->light_samples = (int)rl_renderer_opt_int(r, "light_samples");
+    set->background = rl_renderer_opt_color(r, "background");
     int threads = (int)rl_renderer_opt_int(r, "threads");
 #ifdef _OPENMP
     set->threads = threads > 0 ? threads : omp_get_max_threads();
@@ -376,9 +379,9 @@ static void path_tile(const frame *f, int64_t t, pt_counters *c)
                 continue;
             size_t i = (size_t)y * f->width + x;
             pt_surface first;
-            if (!first_vertex(f, i, &first))
-                continue;             /* background: black */
-            rl_vec3 L = rl_pt_trace_path(&f->ctx, &first, &f->s->rng[i], c);
+            rl_vec3 L = f->ctx.background;   /* a camera ray that leaves the scene */
+            if (first_vertex(f, i, &first))
+                L = rl_pt_trace_path(&f->ctx, &first, &f->s->rng[i], c);
             /* A NaN or infinity would poison the pixel's mean for good. */
             if (!rl_vfinite(L))
                 continue;
@@ -548,7 +551,8 @@ static rl_status pt_render(rl_renderer *r, void *state, const rl_scene *scene, c
         .set = &set,
         .ctx = { .data = d, .b = &s->b, .shadow = set.shadow, .diffuse = set.diffuse,
                  .max_depth = set.max_depth >= 0 ? set.max_depth : scene_max_depth(scene),
-                 .rr_depth = set.rr_depth, .light_samples = set.light_samples, .rr = set.rr },
+                 .rr_depth = set.rr_depth, .light_samples = set.light_samples, .rr = set.rr,
+                 .background = set.background },
         .cam = rl_camera_frame_make(cam),
         .eye = cam->eye,
         .width = cam->width,

@@ -37,6 +37,7 @@ typedef struct pt_settings {
     rl_filter_kind filter;
     double filter_fade;
     int grid_res, ls_n, ls_k, shadowmap_size;
+    rl_vec3 background;            /* environment radiance of escaping rays */
 } pt_settings;
 
 /* ------------------------------------------------------------ backends -- */
@@ -93,6 +94,7 @@ typedef struct pt_ctx {
     rl_pt_backend shadow, diffuse;
     int max_depth, rr_depth, light_samples;
     bool rr;
+    rl_vec3 background;            /* radiance of rays that leave the scene */
 } pt_ctx;
 
 /* A surface point being shaded. Normals are unit and face the side the

@@ -5,8 +5,10 @@
  * as in trace.c) or the Phong BRDF (the rest); only in the BRDF case does
  * Shade gather the lights with shadow rays (next-event estimation) and the
  * Phong sampling (pathtrace_bsdf.c) choose the next direction. The path
- * ends on a miss (background black), after max_depth interactions behind
- * the camera hit, or by Russian roulette on the throughput.
+ * ends on a miss, where it gathers the option background as the radiance
+ * of a uniform environment (black by default; no light samples it, so
+ * counting it on every escape is unbiased), after max_depth interactions
+ * behind the camera hit, or by Russian roulette on the throughput.
  *
  * Shade (Sec. 6.4.2, 6.3): per light and BRDF vertex
  *  - point / spot / directional: one hard shadow ray, f E cos(theta_R) with
@@ -323,12 +325,16 @@ rl_vec3 rl_pt_trace_path(const pt_ctx *ctx, const pt_surface *first, rl_rng_gpu 
             if (rl_linespace_preillum(ctx->b->ls, &ray, &col, NULL)) {
                 radiance = rl_add(radiance, rl_mul(T, col));
                 c->preillum_ends++;
+            } else {
+                radiance = rl_add(radiance, rl_mul(T, ctx->background));
             }
             break;
         }
         pt_surface next;
-        if (!rl_pt_closest(ctx, ctx->diffuse, &ray, &next, c))
+        if (!rl_pt_closest(ctx, ctx->diffuse, &ray, &next, c)) {
+            radiance = rl_add(radiance, rl_mul(T, ctx->background));
             break;
+        }
         s = next;
     }
     return radiance;

@@ -224,6 +224,79 @@ static void test_lambertian_floor_under_point_light_matches_closed_form(void **s
     rl_scene_release(s);
 }
 
+/* A uniform environment of radiance E (option background) over a
+ * Lambertian floor without lights: every bounce leaves the open scene, so
+ * every path carries exactly k_d E (f cos / pdf = k_d for cosine sampling),
+ * and the camera rays that miss carry E. */
+static void test_uniform_environment_lights_a_lambertian_floor(void **state)
+{
+    (void)state;
+    rl_vec3 kd = rl_v3(0.7f, 0.5f, 0.3f), E = rl_v3(0.8f, 1.0f, 1.25f);
+    rl_scene *s = floor_scene(kd, NULL, false);
+    rl_camera cam = { .eye = rl_v3(0.0f, 1.0f, 3.0f), .target = rl_v3(0.0f, 0.0f, 0.0f), .fov_deg = 60.0f,
+                      .width = SIZE, .height = SIZE };
+    const char *const depths[] = { "1", "3" };
+    for (int k = 0; k < 2; ++k) {
+        rl_renderer *r = fx_make("pt", (const char *const[]){ "primary", "raster", "max_depth", depths[k],
+                                                              "background", "0.8,1,1.25", NULL });
+        rl_image *img = fx_render_with(r, s, &cam, FX_ALL_LAYERS, NULL);
+        const rl_gbuffer *g = rl_pt_gbuffer(r);
+        int hits = 0, misses = 0;
+        for (int i = 0; i < SIZE * SIZE; ++i) {
+            rl_vec3 want = g->object[i] == RL_ID_NONE ? E : rl_mul(kd, E);
+            hits += g->object[i] != RL_ID_NONE;
+            misses += g->object[i] == RL_ID_NONE;
+            assert_float_equal(img->color[i].x, want.x, 1e-5f);
+            assert_float_equal(img->color[i].y, want.y, 1e-5f);
+            assert_float_equal(img->color[i].z, want.z, 1e-5f);
+        }
+        assert_true(hits > 0 && misses > 0);
+        rl_image_release(img);
+        rl_renderer_release(r);
+    }
+    /* The default background is black. */
+    rl_image *img = fx_render("pt", s, &cam, RL_LAYER_COLOR, (const char *const[]){ "max_depth", "3", NULL }, NULL);
+    assert_float_equal(mean_color(img).x, 0.0f, 0.0f);
+    rl_image_release(img);
+    rl_scene_release(s);
+}
+
+static bool cancel_after_build(void *user, double done)
+{
+    int *calls = user;
+    ++*calls;
+    return done <= 0.5;   /* the build share passes, the first sample cancels */
+}
+
+/* A cancel by the progress callback stops the frame with RL_ERR_CANCELLED
+ * and leaves no half-accumulated frame behind: the next frame equals the
+ * first frame of a fresh renderer. */
+static void test_progress_callback_cancels_and_leaves_no_partial_frame(void **state)
+{
+    (void)state;
+    rl_light light = { .type = RL_LIGHT_POINT, .color = rl_v3s(1.0f), .intensity = 3.0f,
+                       .position = rl_v3(0.3f, 1.5f, 0.2f) };
+    rl_scene *s = floor_scene(rl_v3s(0.5f), &light, false);
+    rl_camera cam = { .eye = rl_v3(0.0f, 3.0f, 3.0f), .target = rl_v3(0.0f, 0.0f, 0.0f), .width = SIZE,
+                      .height = SIZE };
+    const char *const opts[] = { "spp", "4", "max_depth", "3", NULL };
+    rl_renderer *r = fx_make("pt", opts);
+    int calls = 0;
+    rl_renderer_set_progress(r, cancel_after_build, &calls);
+    rl_image *img = NULL;
+    assert_int_equal(rl_image_create(SIZE, SIZE, RL_LAYER_COLOR, &img), RL_OK);
+    assert_int_equal(rl_renderer_render(r, s, &cam, img, NULL), RL_ERR_CANCELLED);
+    assert_true(calls >= 2);
+    rl_renderer_set_progress(r, NULL, NULL);
+    assert_int_equal(rl_renderer_render(r, s, &cam, img, NULL), RL_OK);
+    rl_image *fresh = fx_render("pt", s, &cam, RL_LAYER_COLOR, opts, NULL);
+    fx_assert_images_identical(img, fresh);
+    rl_image_release(fresh);
+    rl_image_release(img);
+    rl_renderer_release(r);
+    rl_scene_release(s);
+}
+
 /* The emission rule: the same lamp as a quad light over its emissive mesh
  * (NEE, the mesh covered) and as the bare emissive mesh (found by BRDF
  * sampling only) must light the floor alike: no double counting, no gap. */
@@ -540,6 +613,8 @@ int main(void)
         cmocka_unit_test(test_max_depth_default_comes_from_the_scene),
         cmocka_unit_test(test_white_furnace_converges_to_e_over_one_minus_albedo),
         cmocka_unit_test(test_lambertian_floor_under_point_light_matches_closed_form),
+        cmocka_unit_test(test_uniform_environment_lights_a_lambertian_floor),
+        cmocka_unit_test(test_progress_callback_cancels_and_leaves_no_partial_frame),
         cmocka_unit_test(test_nee_on_covered_emitter_matches_hitting_the_bare_emitter),
         cmocka_unit_test(test_exact_backends_give_the_same_image),
         cmocka_unit_test(test_image_does_not_depend_on_the_thread_count),
