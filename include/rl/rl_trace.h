@@ -65,6 +65,13 @@ typedef struct rl_tracer_desc {           /* zero = default */
      * ray-tree criterion of Vertex Tracing, whose shadow nodes say whether
      * the light is visible (Ullmann 2003, Sec. 3.3.1, Fig. 3.7). */
     bool tree_shadow_any_hit;
+    /* Deferred textures (the layers of rl_tracer_shade_point) pass through
+     * untextured reflecting or refracting surfaces to the first textured
+     * surface along the strongest of their secondary rays, so that a
+     * texture behind a glass shell (two surfaces) is still looked up per
+     * fragment. Our extension of Ullmann 2003, Sec. 3.5.3, which stops at
+     * the first surface. The recombined colour is unchanged. */
+    bool defer_through;
 } rl_tracer_desc;
 
 typedef struct rl_tracer rl_tracer;

@@ -135,6 +135,7 @@ rl_status rl_tracer_create(const rl_accel *accel, const rl_tracer_desc *desc, rl
     t->background = d.background;
     t->shadows = !d.no_shadows;
     t->tree_shadow_any_hit = d.tree_shadow_any_hit;
+    t->defer_through = d.defer_through;
     t->seed = d.seed;
     t->eps = EPS_SCALE * scene_scale(data->bounds);
     *out = t;
@@ -238,15 +239,43 @@ static rl_vec3 shade_surface(rl_trace_ctx *ctx, const rl_trace_surface *s, rl_ve
     rl_trace_local local = rl_trace_local_term(ctx, s, depth);
     rl_vec3 color = rl_add(rl_mul(s->kd, local.irr), local.rest);
     rl_vec3 rest = local.rest;
-    if (depth < tr->max_depth) {
-        rl_trace_secondary sec[2];
-        int n = rl_trace_secondary_rays(tr, s, d, weight, sec);
+    rl_trace_secondary sec[2];
+    int n = depth < tr->max_depth ? rl_trace_secondary_rays(tr, s, d, weight, sec) : 0;
+    if (layer && tr->defer_through && s->texture == RL_NONE && n > 0) {
+        /* Deferral through an untextured surface (rl_tracer_desc): its own
+         * terms need no texel and go to rest; the strongest secondary ray
+         * that ends on a textured surface hands its layer on, scaled by its
+         * coefficient; the other ray is looked up here. */
+        rl_trace_layer sub[2];
+        int pick = -1;
+        float best = 0.0f;
         for (int i = 0; i < n; ++i) {
-            rl_vec3 c = rl_trace_ray(ctx, sec[i].ray, sec[i].type, depth + 1, weight * sec[i].k, NULL);
-            c = rl_scale(c, sec[i].k);
-            color = rl_add(color, c);
-            rest = rl_add(rest, c);
+            rl_vec3 c = rl_trace_ray(ctx, sec[i].ray, sec[i].type, depth + 1, weight * sec[i].k, &sub[i]);
+            color = rl_add(color, rl_scale(c, sec[i].k));
+            float strength = sec[i].k * rl_vmax_comp(sub[i].diffuse);
+            if (sub[i].texture != RL_NONE && (pick < 0 || strength > best)) {
+                pick = i;
+                best = strength;
+            }
         }
+        rest = rl_add(rest, rl_mul(s->m->diffuse, local.irr));
+        for (int i = 0; i < n; ++i)
+            if (i != pick)
+                rest = rl_add(rest, rl_scale(rl_trace_layer_color(tr->data, &sub[i]), sec[i].k));
+        if (pick < 0) {
+            *layer = (rl_trace_layer){ rl_v3s(0.0f), rest, RL_NONE, s->uv };
+        } else {
+            *layer = (rl_trace_layer){ rl_scale(sub[pick].diffuse, sec[pick].k),
+                                       rl_add(rest, rl_scale(sub[pick].rest, sec[pick].k)), sub[pick].texture,
+                                       sub[pick].uv };
+        }
+        return color;
+    }
+    for (int i = 0; i < n; ++i) {
+        rl_vec3 c = rl_trace_ray(ctx, sec[i].ray, sec[i].type, depth + 1, weight * sec[i].k, NULL);
+        c = rl_scale(c, sec[i].k);
+        color = rl_add(color, c);
+        rest = rl_add(rest, c);
     }
     if (layer)
         *layer = (rl_trace_layer){ rl_mul(s->m->diffuse, local.irr), rest, s->texture, s->uv };

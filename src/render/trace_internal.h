@@ -24,6 +24,7 @@ struct rl_tracer {
     rl_vec3 background;
     bool shadows;
     bool tree_shadow_any_hit; /* see rl_tracer_desc */
+    bool defer_through;       /* see rl_tracer_desc */
     uint64_t seed;
     float eps;                /* secondary-ray origin offset, see trace.c */
 };
@@ -99,6 +100,10 @@ int rl_trace_secondary_rays(const rl_tracer *tr, const rl_trace_surface *s, rl_v
  * = everything else, texture/uv of the hit; a miss has rest = background. */
 rl_vec3 rl_trace_ray(rl_trace_ctx *ctx, rl_ray ray, rl_ray_type type, int depth, float weight,
                      rl_trace_layer *layer);
+
+/* A deferred layer's radiance with its texel looked up (diffuse * texel +
+ * rest; no texel when untextured). */
+rl_vec3 rl_trace_layer_color(const rl_scene_data *data, const rl_trace_layer *layer);
 
 /* Origin of a secondary ray leaving s in direction dir: offset along the
  * geometric normal to the side dir leaves on, so the ray cannot hit the

@@ -37,9 +37,7 @@ static bool cache_matches(const rl_trace_feelers *c, bool front, bool with_tree)
     return true;
 }
 
-/* A layer's radiance with its texel (diffuse * texel + rest; no texel when
- * untextured). */
-static rl_vec3 layer_color(const rl_scene_data *data, const rl_trace_layer *layer)
+rl_vec3 rl_trace_layer_color(const rl_scene_data *data, const rl_trace_layer *layer)
 {
     rl_vec3 diffuse = layer->diffuse;
     if (layer->texture != RL_NONE && layer->texture < data->num_textures && data->textures[layer->texture]) {
@@ -119,7 +117,7 @@ void rl_tracer_shade_point(const rl_tracer *tracer, rl_vec3 eye, const rl_trace_
 
     for (int i = 0; i < RL_TRACE_LAYER_COUNT; ++i) {
         const rl_trace_layer *layer = &out->layers[i];
-        out->color = rl_add(out->color, layer_color(data, layer));
+        out->color = rl_add(out->color, rl_trace_layer_color(data, layer));
         out->flat = rl_add(out->flat, rl_add(layer->diffuse, layer->rest));
     }
 }

@@ -71,6 +71,9 @@ static const rl_option_info vt_options[] = {
     { "textures", RL_OPT_ENUM, "multitexture",
       "deferred textures: multitexture (eq. 3.20, one pass), multipass (eq. 3.22), sampled (no deferral)",
       0, 0, texture_choices },
+    { "defer_through", RL_OPT_BOOL, "true",
+      "deferred textures pass through untextured glass and mirrors to the textured surface behind (ours; "
+      "false: the thesis, first surface only)", 0, 0, NULL },
     { "progressive", RL_OPT_ENUM, "none", "intermediate images for the update callback (Sec. 3.5.1)",
       0, 0, progressive_choices },
     { "update_every", RL_OPT_INT, "1", "k: refinement stages between progressive updates", 1, 1000000, NULL },
@@ -392,6 +395,7 @@ static rl_status vt_render(rl_renderer *r, void *state, const rl_scene *scene, c
     if ((st = rl_tracer_options_read(r, &desc, &kind)) != RL_OK)
         return st;
     desc.tree_shadow_any_hit = true;      /* shadow nodes say lit or blocked (Sec. 3.3.1) */
+    desc.defer_through = rl_renderer_opt_bool(r, "defer_through");
     if ((st = rl_accel_cache_get(&s->accel, "vt", scene, kind, set.threads, build_progress, r)) != RL_OK)
         return st;
     if ((st = ensure_mesh(s, scene, d, rl_renderer_opt_string(r, "objects"))) != RL_OK)

@@ -282,6 +282,72 @@ static void test_mirror_layer_defers_the_floor_texture_at_the_reflected_uv(void 
     release(&f);
 }
 
+/* A layer recombined by hand: diffuse x texel + rest. */
+static rl_vec3 layer_sum(const rl_scene_data *d, const rl_trace_layer *l)
+{
+    rl_vec3 texel = rl_v3s(1.0f);
+    if (l->texture != RL_NONE) {
+        rl_vec4 t4 = rl_texture_sample(d->textures[l->texture], l->uv);
+        texel = rl_v3(t4.x, t4.y, t4.z);
+    }
+    return rl_add(rl_mul(l->diffuse, texel), l->rest);
+}
+
+/* A checkered floor y = 0 under a glass shell: two clear panes y = 1 and
+ * y = 0.9 (k_t 0.9, ior 1, so rays go straight). The refraction layer of a
+ * point on the upper pane defers the floor's texture through the lower,
+ * untextured pane (rl_tracer_desc.defer_through), at the uv of the floor
+ * point on the straight line from the eye; without it the layer stops at
+ * the pane (the thesis). Either way every vertex recombines to the colour
+ * rl_tracer_shade gives. */
+static void shell(fixture *f, bool defer_through)
+{
+    assert_int_equal(rl_scene_create(&f->scene), RL_OK);
+    rl_material floor = plain(rl_v3(0.8f, 0.8f, 0.8f));
+    floor.diffuse_texture = add_checker(f->scene);
+    rl_material glass = plain(rl_v3s(0.05f));
+    glass.transmissivity = 0.9f;
+    glass.ior = 1.0f;
+    add_grid(f->scene, rl_v3(-2, 0, 2), rl_v3(4, 0, 0), rl_v3(0, 0, -4), 0.0f, add_material(f->scene, floor));
+    uint32_t g = add_material(f->scene, glass);
+    add_grid(f->scene, rl_v3(-2, 1.0f, 2), rl_v3(4, 0, 0), rl_v3(0, 0, -4), 0.0f, g);
+    add_grid(f->scene, rl_v3(-2, 0.9f, 2), rl_v3(4, 0, 0), rl_v3(0, 0, -4), 0.0f, g);
+    add_point_light(f->scene, rl_v3(0.5f, 4.0f, 0.5f), 10.0f);
+    finish(f, &(rl_tracer_desc){ .no_shadows = true, .defer_through = defer_through });
+}
+
+static void test_deferred_textures_pass_through_an_untextured_glass_shell(void **state)
+{
+    (void)state;
+    const rl_vec3 eye = rl_v3(0.2f, 3.0f, 0.3f);
+    int textured[2];
+    for (int k = 0; k < 2; ++k) {
+        fixture f = { 0 };
+        shell(&f, k == 1);
+        const rl_object *upper = &f.data->objects[1];
+        rl_trace_point pt = { rl_v3(0.0f, 1.0f, 0.0f), rl_v3(0, 1, 0), rl_v2(1.0f, 1.0f), upper->first_triangle };
+        rl_trace_sample s;
+        rl_tracer_shade_point(f.tracer, eye, &pt, 9, NULL, NULL, &s, NULL);
+        const rl_trace_layer *refr = &s.layers[RL_TRACE_LAYER_REFRACTION];
+        if (k == 1) {
+            /* The floor point (-0.1, 0, -0.15): uv = 2 ((x + 2) / 4, (2 - z) / 4). */
+            assert_int_equal(refr->texture, 0);
+            assert_close(refr->uv.x, 0.95f, 1e-4f);
+            assert_close(refr->uv.y, 1.075f, 1e-4f);
+            assert_true(refr->diffuse.x > 0.0f);
+        } else {
+            assert_int_equal(refr->texture, RL_NONE);
+        }
+        assert_color_close(rl_add(rl_add(layer_sum(f.data, &s.layers[0]),
+                                         layer_sum(f.data, &s.layers[1])),
+                                  layer_sum(f.data, refr)),
+                           s.color, 1e-5f);
+        textured[k] = assert_vertices_match_shade(&f, eye, 77);
+        release(&f);
+    }
+    assert_true(textured[1] > textured[0]);
+}
+
 /* Glass pane z = 0 (front +z); from below it (inside the glass) at 60°
  * from the normal, sin 60° * 1.5 > 1: total internal reflection folds k_t
  * into the reflection. From above at the same angle the ray refracts. */
@@ -556,6 +622,7 @@ int main(void)
         cmocka_unit_test(test_a_vertex_shaded_as_a_point_equals_shading_its_hit),
         cmocka_unit_test(test_flat_equals_color_exactly_without_textures),
         cmocka_unit_test(test_mirror_layer_defers_the_floor_texture_at_the_reflected_uv),
+        cmocka_unit_test(test_deferred_textures_pass_through_an_untextured_glass_shell),
         cmocka_unit_test(test_total_internal_reflection_folds_refraction_into_the_mirror_layer),
         cmocka_unit_test(test_replayed_feelers_are_bit_identical_and_save_shadow_rays),
         cmocka_unit_test(test_a_cache_from_the_other_side_or_incomplete_is_not_used),
