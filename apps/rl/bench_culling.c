@@ -39,6 +39,7 @@
 #define _POSIX_C_SOURCE 200809L
 #include "bench_culling.h"
 
+#include "bench_args.h"
 #include "bench_rays.h"
 #include "bench_util.h"
 #include "cli.h"
@@ -603,18 +604,20 @@ static rl_status sec_visset(void *ctx, cJSON *sec)
     return RL_OK;
 }
 
-static bool parse_real(const char *option, const char *text, double lo, double hi, double *out)
+/* --max-depth: 0 is a valid depth, so not a count. */
+static bool take_max_depth(void *a, const char *v)
 {
     char *end = NULL;
-    double x = strtod(text, &end);
-    if (!*text || *end || !isfinite(x) || x < lo || x > hi) {
-        rl_cli_fail(RL_CLI_USAGE, "%s: expected a number in [%g, %g], got '%s'", option, lo, hi, text);
+    long long d = strtoll(v, &end, 10);
+    if (!*v || *end || d < 0 || d > RL_OCTREE_MAX_DEPTH) {
+        rl_cli_fail(RL_CLI_USAGE, "--max-depth: expected 0..%d, got '%s'", RL_OCTREE_MAX_DEPTH, v);
         return false;
     }
-    *out = x;
+    ((bc_args *)a)->max_depth = d;
     return true;
 }
 
+/* Returns RL_CLI_OK, an exit code, or RL_BENCH_HELP_SHOWN. */
 static int parse_args(int argc, char **argv, bc_args *a)
 {
     a->sections = (1u << SEC_COUNT) - 1;
@@ -622,66 +625,27 @@ static int parse_args(int argc, char **argv, bc_args *a)
     a->select_quantile = 0.25;
     a->height = 10.0;
     bool has_samples = false, has_depth = false, has_size = false, has_res = false, has_sel = false;
-    for (int i = 2; i < argc; i++) {
-        const char *v = NULL;
-        int m;
-        if (rl_cli_is_help(argv[i])) {
-            fputs(bench_culling_help, stdout);
-            return -1;
-        }
-#define VALUE(name) ((m = rl_cli_take_value(argc, argv, &i, name, &v)) != 0)
-#define COUNT(name, max, field, flag)                                                                 \
-    if (VALUE(name)) {                                                                                \
-        if (m < 0 || !rl_bench_parse_count(name, v, max, &a->field))                                  \
-            return RL_CLI_USAGE;                                                                      \
-        flag;                                                                                         \
-        continue;                                                                                     \
-    }
-        if (strcmp(argv[i], "--quick") == 0) {
-            a->quick = true;
-            continue;
-        }
-        COUNT("--samples", 1 << 20, samples, has_samples = true)
-        COUNT("--size", 4096, size, has_size = true)
-        COUNT("--resolution", 4096, resolution, has_res = true)
-        COUNT("--select-positions", 1 << 20, select_positions, has_sel = true)
-        COUNT("--budget", 1LL << 40, budget, (void)0)
-        COUNT("--surfels", 1 << 24, surfels, (void)0)
-        COUNT("--threads", 1024, threads, (void)0)
-        COUNT("--seed", 1LL << 62, seed, (void)0)
-        if (VALUE("--max-depth")) {
-            char *end = NULL;
-            if (m < 0)
-                return RL_CLI_USAGE;
-            a->max_depth = strtoll(v, &end, 10);
-            if (!*v || *end || a->max_depth < 0 || a->max_depth > RL_OCTREE_MAX_DEPTH)
-                return rl_cli_fail(RL_CLI_USAGE, "--max-depth: expected 0..%d, got '%s'", RL_OCTREE_MAX_DEPTH, v);
-            has_depth = true;
-        } else if (VALUE("--height")) {
-            if (m < 0 || !parse_real("--height", v, -1e6, 1e6, &a->height))
-                return RL_CLI_USAGE;
-        } else if (VALUE("--select-quantile")) {
-            if (m < 0 || !parse_real("--select-quantile", v, 1e-6, 1.0 - 1e-6, &a->select_quantile))
-                return RL_CLI_USAGE;
-        } else if (VALUE("--only")) {
-            if (m < 0 || !rl_bench_parse_sections(v, section_names, SEC_COUNT, &a->sections))
-                return RL_CLI_USAGE;
-        } else if (VALUE("--scene")) {
-            if (m < 0)
-                return RL_CLI_USAGE;
-            a->scene = v;
-        } else if (VALUE("--out")) {
-            if (m < 0)
-                return RL_CLI_USAGE;
-            a->out = v;
-        } else {
-            return rl_cli_unknown_arg("bench culling", argv[i]);
-        }
-#undef COUNT
-#undef VALUE
-    }
-    if (a->out && !rl_cli_has_extension(a->out, (const char *const[]){ ".json", NULL }))
-        return rl_cli_fail(RL_CLI_USAGE, "--out: '%s' should end in .json", a->out);
+    const rl_bench_opt rows[] = {
+        RL_BENCH_FLAG("--quick", &a->quick),
+        RL_BENCH_COUNT("--samples", 1 << 20, &a->samples, &has_samples),
+        RL_BENCH_COUNT("--size", 4096, &a->size, &has_size),
+        RL_BENCH_COUNT("--resolution", 4096, &a->resolution, &has_res),
+        RL_BENCH_COUNT("--select-positions", 1 << 20, &a->select_positions, &has_sel),
+        RL_BENCH_COUNT("--budget", 1LL << 40, &a->budget, NULL),
+        RL_BENCH_COUNT("--surfels", 1 << 24, &a->surfels, NULL),
+        RL_BENCH_COUNT("--threads", 1024, &a->threads, NULL),
+        RL_BENCH_COUNT("--seed", 1LL << 62, &a->seed, NULL),
+        RL_BENCH_CUSTOM("--max-depth", take_max_depth, a, &has_depth),
+        RL_BENCH_REAL("--height", -1e6, 1e6, &a->height, NULL),
+        RL_BENCH_REAL("--select-quantile", 1e-6, 1.0 - 1e-6, &a->select_quantile, NULL),
+        RL_BENCH_SECTIONS(section_names, SEC_COUNT, &a->sections),
+        RL_BENCH_STRING("--scene", &a->scene),
+        RL_BENCH_OUT(&a->out),
+    };
+    int rc = rl_bench_parse_args(argc, argv, "bench culling", bench_culling_help, rows,
+                                 (int)(sizeof rows / sizeof rows[0]));
+    if (rc != RL_CLI_OK)
+        return rc;
     if (!a->scene)
         a->scene = a->quick ? "city:blocks=1" : "city";
     if (!has_samples)
@@ -704,7 +668,7 @@ int rl_bench_culling(int argc, char **argv)
     bc_args a = { 0 };
     int rc = parse_args(argc, argv, &a);
     if (rc != RL_CLI_OK)
-        return rc < 0 ? RL_CLI_OK : rc;
+        return rc == RL_BENCH_HELP_SHOWN ? RL_CLI_OK : rc;
     char out_buf[1024];
     const char *out = a.out;
     if (!out) {

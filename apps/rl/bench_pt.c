@@ -26,6 +26,7 @@
 #define _POSIX_C_SOURCE 200809L
 #include "bench_pt.h"
 
+#include "bench_args.h"
 #include "bench_rays.h"
 #include "bench_util.h"
 #include "cli.h"
@@ -123,7 +124,7 @@ static const struct scene_row {
 typedef struct bpt_args {
     int width, height, err_width, err_height;
     long long ref_spp, spp_max, threads;
-    double max_memory_gb;
+    long long max_memory_gb;       /* 0: 60% of physical memory */
     bool has_size, has_err_size, has_ref_spp, has_spp_max, quick;
     unsigned sections;
     const char *out;
@@ -835,58 +836,25 @@ static rl_status sec_accumulation(void *ctx, cJSON *sec)
 
 /* ------------------------------------------------------- the command -- */
 
-/* Returns RL_CLI_OK, an exit code, or -1 when --help was printed. */
+/* Returns RL_CLI_OK, an exit code, or RL_BENCH_HELP_SHOWN. */
 static int parse_args(int argc, char **argv, bpt_args *a)
 {
     a->sections = (1u << SEC_COUNT) - 1;
-    for (int i = 2; i < argc; i++) {
-        const char *v = NULL;
-        int m;
-        if (rl_cli_is_help(argv[i])) {
-            fputs(bench_pt_help, stdout);
-            return -1;
-        }
-#define VALUE(name) ((m = rl_cli_take_value(argc, argv, &i, name, &v)) != 0)
-        if (strcmp(argv[i], "--quick") == 0) {
-            a->quick = true;
-        } else if (VALUE("--size")) {
-            if (m < 0 || !rl_cli_parse_size(v, &a->width, &a->height))
-                return RL_CLI_USAGE;
-            a->has_size = true;
-        } else if (VALUE("--error-size")) {
-            if (m < 0 || !rl_cli_parse_size(v, &a->err_width, &a->err_height))
-                return RL_CLI_USAGE;
-            a->has_err_size = true;
-        } else if (VALUE("--ref-spp")) {
-            if (m < 0 || !rl_bench_parse_count("--ref-spp", v, 1 << 20, &a->ref_spp))
-                return RL_CLI_USAGE;
-            a->has_ref_spp = true;
-        } else if (VALUE("--spp-max")) {
-            if (m < 0 || !rl_bench_parse_count("--spp-max", v, 1 << 16, &a->spp_max))
-                return RL_CLI_USAGE;
-            a->has_spp_max = true;
-        } else if (VALUE("--max-memory")) {
-            long long gb;
-            if (m < 0 || !rl_bench_parse_count("--max-memory", v, 1 << 16, &gb))
-                return RL_CLI_USAGE;
-            a->max_memory_gb = (double)gb;
-        } else if (VALUE("--threads")) {
-            if (m < 0 || !rl_bench_parse_count("--threads", v, 1024, &a->threads))
-                return RL_CLI_USAGE;
-        } else if (VALUE("--only")) {
-            if (m < 0 || !rl_bench_parse_sections(v, section_names, SEC_COUNT, &a->sections))
-                return RL_CLI_USAGE;
-        } else if (VALUE("--out")) {
-            if (m < 0)
-                return RL_CLI_USAGE;
-            a->out = v;
-        } else {
-            return rl_cli_unknown_arg("bench pt", argv[i]);
-        }
-#undef VALUE
-    }
-    if (a->out && !rl_cli_has_extension(a->out, (const char *const[]){ ".json", NULL }))
-        return rl_cli_fail(RL_CLI_USAGE, "--out: '%s' should end in .json", a->out);
+    const rl_bench_opt rows[] = {
+        RL_BENCH_FLAG("--quick", &a->quick),
+        RL_BENCH_SIZE("--size", &a->width, &a->height, &a->has_size),
+        RL_BENCH_SIZE("--error-size", &a->err_width, &a->err_height, &a->has_err_size),
+        RL_BENCH_COUNT("--ref-spp", 1 << 20, &a->ref_spp, &a->has_ref_spp),
+        RL_BENCH_COUNT("--spp-max", 1 << 16, &a->spp_max, &a->has_spp_max),
+        RL_BENCH_COUNT("--max-memory", 1 << 16, &a->max_memory_gb, NULL),
+        RL_BENCH_COUNT("--threads", 1024, &a->threads, NULL),
+        RL_BENCH_SECTIONS(section_names, SEC_COUNT, &a->sections),
+        RL_BENCH_OUT(&a->out),
+    };
+    int rc = rl_bench_parse_args(argc, argv, "bench pt", bench_pt_help, rows,
+                                 (int)(sizeof rows / sizeof rows[0]));
+    if (rc != RL_CLI_OK)
+        return rc;
     if (!a->has_size) {
         a->width = a->quick ? 128 : 1280;      /* Sec. 9.2: 1280x720 */
         a->height = a->quick ? 72 : 720;
@@ -957,13 +925,13 @@ int rl_bench_pt(int argc, char **argv)
     memset(&a, 0, sizeof a);
     int rc = parse_args(argc, argv, &a);
     if (rc != RL_CLI_OK)
-        return rc < 0 ? RL_CLI_OK : rc;
+        return rc == RL_BENCH_HELP_SHOWN ? RL_CLI_OK : rc;
     bpt b;
     memset(&b, 0, sizeof b);
     b.a = &a;
     b.threads = a.threads ? (int)a.threads : omp_get_max_threads();
     b.runs = a.quick ? 1 : RUNS;
-    b.max_memory_bytes = a.max_memory_gb > 0.0 ? a.max_memory_gb * 1073741824.0
+    b.max_memory_bytes = a.max_memory_gb > 0 ? (double)a.max_memory_gb * 1073741824.0
                                                : 0.6 * physical_memory();
     char out[256];
     if (a.out)

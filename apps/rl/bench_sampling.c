@@ -22,6 +22,7 @@
 #define _POSIX_C_SOURCE 200809L
 #include "bench_sampling.h"
 
+#include "bench_args.h"
 #include "bench_rays.h"
 #include "bench_util.h"
 #include "cli.h"
@@ -346,61 +347,33 @@ static bool parse_counts(const char *text, bs_args *a)
     return a->num_counts > 0;
 }
 
+static bool take_counts(void *a, const char *text)
+{
+    return parse_counts(text, a);
+}
+
+/* Returns RL_CLI_OK, an exit code, or RL_BENCH_HELP_SHOWN. */
 static int parse_args(int argc, char **argv, bs_args *a)
 {
     a->sections = (1u << SEC_COUNT) - 1;
     a->height = 1.7;
     bool has_res = false, has_val = false, has_counts = false;
-    for (int i = 2; i < argc; i++) {
-        const char *v = NULL;
-        int m;
-        if (rl_cli_is_help(argv[i])) {
-            fputs(bench_sampling_help, stdout);
-            return -1;
-        }
-#define VALUE(name) ((m = rl_cli_take_value(argc, argv, &i, name, &v)) != 0)
-        if (strcmp(argv[i], "--quick") == 0) {
-            a->quick = true;
-        } else if (VALUE("--scene")) {
-            if (m < 0)
-                return RL_CLI_USAGE;
-            a->scene = v;
-        } else if (VALUE("--resolution")) {
-            if (m < 0 || !rl_bench_parse_count("--resolution", v, 4096, &a->resolution))
-                return RL_CLI_USAGE;
-            has_res = true;
-        } else if (VALUE("--validation")) {
-            if (m < 0 || !rl_bench_parse_count("--validation", v, 1 << 20, &a->validation))
-                return RL_CLI_USAGE;
-            has_val = true;
-        } else if (VALUE("--height")) {
-            char *end = NULL;
-            if (m < 0)
-                return RL_CLI_USAGE;
-            a->height = strtod(v, &end);
-            if (!*v || *end || !isfinite(a->height) || a->height < 0.0)
-                return rl_cli_fail(RL_CLI_USAGE, "--height: expected metres >= 0, got '%s'", v);
-        } else if (VALUE("--samples")) {
-            if (m < 0 || !parse_counts(v, a))
-                return RL_CLI_USAGE;
-            has_counts = true;
-        } else if (VALUE("--threads")) {
-            if (m < 0 || !rl_bench_parse_count("--threads", v, 1024, &a->threads))
-                return RL_CLI_USAGE;
-        } else if (VALUE("--only")) {
-            if (m < 0 || !rl_bench_parse_sections(v, section_names, SEC_COUNT, &a->sections))
-                return RL_CLI_USAGE;
-        } else if (VALUE("--out")) {
-            if (m < 0)
-                return RL_CLI_USAGE;
-            a->out = v;
-        } else {
-            return rl_cli_unknown_arg("bench sampling", argv[i]);
-        }
-#undef VALUE
-    }
-    if (a->out && !rl_cli_has_extension(a->out, (const char *const[]){ ".json", NULL }))
-        return rl_cli_fail(RL_CLI_USAGE, "--out: '%s' should end in .json", a->out);
+    const rl_bench_opt rows[] = {
+        RL_BENCH_FLAG("--quick", &a->quick),
+        RL_BENCH_STRING("--scene", &a->scene),
+        RL_BENCH_COUNT("--resolution", 4096, &a->resolution, &has_res),
+        RL_BENCH_COUNT("--validation", 1 << 20, &a->validation, &has_val),
+        { .name = "--height", .kind = RL_BENCH_OPT_REAL, .real = &a->height, .lo = 0.0,
+          .hi = INFINITY, .expect = "metres >= 0" },
+        RL_BENCH_CUSTOM("--samples", take_counts, a, &has_counts),
+        RL_BENCH_COUNT("--threads", 1024, &a->threads, NULL),
+        RL_BENCH_SECTIONS(section_names, SEC_COUNT, &a->sections),
+        RL_BENCH_OUT(&a->out),
+    };
+    int rc = rl_bench_parse_args(argc, argv, "bench sampling", bench_sampling_help, rows,
+                                 (int)(sizeof rows / sizeof rows[0]));
+    if (rc != RL_CLI_OK)
+        return rc;
     if (!a->scene)
         a->scene = a->quick ? "cornell" : "city:blocks=3";
     if (!has_res)
@@ -420,7 +393,7 @@ int rl_bench_sampling(int argc, char **argv)
     bs_args a = { 0 };
     int rc = parse_args(argc, argv, &a);
     if (rc != RL_CLI_OK)
-        return rc < 0 ? RL_CLI_OK : rc;
+        return rc == RL_BENCH_HELP_SHOWN ? RL_CLI_OK : rc;
     char out_buf[512];
     const char *out = a.out;
     if (!out) {

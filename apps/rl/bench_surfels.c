@@ -22,6 +22,7 @@
 #define _POSIX_C_SOURCE 200809L
 #include "bench_surfels.h"
 
+#include "bench_args.h"
 #include "bench_rays.h"
 #include "bench_util.h"
 #include "cli.h"
@@ -303,62 +304,34 @@ static bool parse_variants(const char *text, unsigned *bits)
     }
 }
 
+static bool take_variants(void *a, const char *text)
+{
+    return parse_variants(text, &((bsf_args *)a)->variants);
+}
+
+/* Returns RL_CLI_OK, an exit code, or RL_BENCH_HELP_SHOWN. */
 static int parse_args(int argc, char **argv, bsf_args *a)
 {
     a->variants = (1u << V_COUNT) - 1;
     a->seed = 1;
     a->max_seconds = 120.0;
     bool has_res = false, has_count = false, has_max = false;
-    for (int i = 2; i < argc; i++) {
-        const char *v = NULL;
-        int m;
-        if (rl_cli_is_help(argv[i])) {
-            fputs(bench_surfels_help, stdout);
-            return -1;
-        }
-#define VALUE(name) ((m = rl_cli_take_value(argc, argv, &i, name, &v)) != 0)
-        if (strcmp(argv[i], "--quick") == 0) {
-            a->quick = true;
-        } else if (VALUE("--scene")) {
-            if (m < 0)
-                return RL_CLI_USAGE;
-            a->scene = v;
-        } else if (VALUE("--resolution")) {
-            if (m < 0 || !rl_bench_parse_count("--resolution", v, 16384, &a->resolution))
-                return RL_CLI_USAGE;
-            has_res = true;
-        } else if (VALUE("--count")) {
-            if (m < 0 || !rl_bench_parse_count("--count", v, 1 << 26, &a->count))
-                return RL_CLI_USAGE;
-            has_count = true;
-        } else if (VALUE("--variants")) {
-            if (m < 0 || !parse_variants(v, &a->variants))
-                return RL_CLI_USAGE;
-        } else if (VALUE("--max-seconds")) {
-            char *end = NULL;
-            if (m < 0)
-                return RL_CLI_USAGE;
-            a->max_seconds = strtod(v, &end);
-            if (!*v || *end || !isfinite(a->max_seconds) || a->max_seconds <= 0.0)
-                return rl_cli_fail(RL_CLI_USAGE, "--max-seconds: expected seconds > 0, got '%s'", v);
-            has_max = true;
-        } else if (VALUE("--seed")) {
-            if (m < 0 || !rl_bench_parse_count("--seed", v, 1LL << 62, &a->seed))
-                return RL_CLI_USAGE;
-        } else if (VALUE("--threads")) {
-            if (m < 0 || !rl_bench_parse_count("--threads", v, 1024, &a->threads))
-                return RL_CLI_USAGE;
-        } else if (VALUE("--out")) {
-            if (m < 0)
-                return RL_CLI_USAGE;
-            a->out = v;
-        } else {
-            return rl_cli_unknown_arg("bench surfels", argv[i]);
-        }
-#undef VALUE
-    }
-    if (a->out && !rl_cli_has_extension(a->out, (const char *const[]){ ".json", NULL }))
-        return rl_cli_fail(RL_CLI_USAGE, "--out: '%s' should end in .json", a->out);
+    const rl_bench_opt rows[] = {
+        RL_BENCH_FLAG("--quick", &a->quick),
+        RL_BENCH_STRING("--scene", &a->scene),
+        RL_BENCH_COUNT("--resolution", 16384, &a->resolution, &has_res),
+        RL_BENCH_COUNT("--count", 1 << 26, &a->count, &has_count),
+        RL_BENCH_CUSTOM("--variants", take_variants, a, NULL),
+        { .name = "--max-seconds", .kind = RL_BENCH_OPT_REAL, .real = &a->max_seconds,
+          .lo = 0.0, .lo_open = true, .hi = INFINITY, .expect = "seconds > 0", .set = &has_max },
+        RL_BENCH_COUNT("--seed", 1LL << 62, &a->seed, NULL),
+        RL_BENCH_COUNT("--threads", 1024, &a->threads, NULL),
+        RL_BENCH_OUT(&a->out),
+    };
+    int rc = rl_bench_parse_args(argc, argv, "bench surfels", bench_surfels_help, rows,
+                                 (int)(sizeof rows / sizeof rows[0]));
+    if (rc != RL_CLI_OK)
+        return rc;
     if (!a->scene)
         a->scene = a->quick ? "cornell" : "city";
     if (!has_res)
@@ -375,7 +348,7 @@ int rl_bench_surfels(int argc, char **argv)
     bsf_args a = { 0 };
     int rc = parse_args(argc, argv, &a);
     if (rc != RL_CLI_OK)
-        return rc < 0 ? RL_CLI_OK : rc;
+        return rc == RL_BENCH_HELP_SHOWN ? RL_CLI_OK : rc;
     char out_buf[512];
     const char *out = a.out;
     if (!out) {

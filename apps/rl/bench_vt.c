@@ -31,6 +31,7 @@
 #define _POSIX_C_SOURCE 200809L
 #include "bench_vt.h"
 
+#include "bench_args.h"
 #include "bench_rays.h"
 #include "bench_util.h"
 #include "cli.h"
@@ -1061,49 +1062,23 @@ static rl_status sec_animation(void *ctx, cJSON *sec)
 
 /* ------------------------------------------------------- the command -- */
 
-/* Returns RL_CLI_OK, an exit code, or -1 when --help was printed. */
+/* Returns RL_CLI_OK, an exit code, or RL_BENCH_HELP_SHOWN. */
 static int parse_args(int argc, char **argv, bvt_args *a)
 {
     a->sections = (1u << SEC_COUNT) - 1;
-    for (int i = 2; i < argc; i++) {
-        const char *v = NULL;
-        int m;
-        if (rl_cli_is_help(argv[i])) {
-            fputs(bench_vt_help, stdout);
-            return -1;
-        }
-#define VALUE(name) ((m = rl_cli_take_value(argc, argv, &i, name, &v)) != 0)
-        if (strcmp(argv[i], "--quick") == 0) {
-            a->quick = true;
-        } else if (VALUE("--size")) {
-            if (m < 0 || !rl_cli_parse_size(v, &a->width, &a->height))
-                return RL_CLI_USAGE;
-            a->has_size = true;
-        } else if (VALUE("--anim-size")) {
-            if (m < 0 || !rl_cli_parse_size(v, &a->anim_width, &a->anim_height))
-                return RL_CLI_USAGE;
-            a->has_anim_size = true;
-        } else if (VALUE("--frames")) {
-            if (m < 0 || !rl_bench_parse_count("--frames", v, MAX_FRAMES, &a->frames))
-                return RL_CLI_USAGE;
-            a->has_frames = true;
-        } else if (VALUE("--threads")) {
-            if (m < 0 || !rl_bench_parse_count("--threads", v, RL_VT_MAX_THREADS, &a->threads))
-                return RL_CLI_USAGE;
-        } else if (VALUE("--only")) {
-            if (m < 0 || !rl_bench_parse_sections(v, section_names, SEC_COUNT, &a->sections))
-                return RL_CLI_USAGE;
-        } else if (VALUE("--out")) {
-            if (m < 0)
-                return RL_CLI_USAGE;
-            a->out = v;
-        } else {
-            return rl_cli_unknown_arg("bench vt", argv[i]);
-        }
-#undef VALUE
-    }
-    if (a->out && !rl_cli_has_extension(a->out, (const char *const[]){ ".json", NULL }))
-        return rl_cli_fail(RL_CLI_USAGE, "--out: '%s' should end in .json", a->out);
+    const rl_bench_opt rows[] = {
+        RL_BENCH_FLAG("--quick", &a->quick),
+        RL_BENCH_SIZE("--size", &a->width, &a->height, &a->has_size),
+        RL_BENCH_SIZE("--anim-size", &a->anim_width, &a->anim_height, &a->has_anim_size),
+        RL_BENCH_COUNT("--frames", MAX_FRAMES, &a->frames, &a->has_frames),
+        RL_BENCH_COUNT("--threads", RL_VT_MAX_THREADS, &a->threads, NULL),
+        RL_BENCH_SECTIONS(section_names, SEC_COUNT, &a->sections),
+        RL_BENCH_OUT(&a->out),
+    };
+    int rc = rl_bench_parse_args(argc, argv, "bench vt", bench_vt_help, rows,
+                                 (int)(sizeof rows / sizeof rows[0]));
+    if (rc != RL_CLI_OK)
+        return rc;
     /* Defaults; --quick changes only what was not given. The thesis
      * measured the table scene at 1024x1024 (Sec. 5.1). */
     if (!a->has_size)
@@ -1268,7 +1243,7 @@ int rl_bench_vt(int argc, char **argv)
     memset(&a, 0, sizeof a);
     int rc = parse_args(argc, argv, &a);
     if (rc != RL_CLI_OK)
-        return rc < 0 ? RL_CLI_OK : rc;
+        return rc == RL_BENCH_HELP_SHOWN ? RL_CLI_OK : rc;
     bvt b;
     memset(&b, 0, sizeof b);
     b.a = &a;

@@ -10,6 +10,7 @@
  * mesh file that does not exist is skipped with the reason, not a failure,
  * so the default list works without the Assimp test models. */
 #define _POSIX_C_SOURCE 200809L
+#include "bench_args.h"
 #include "bench_pt.h"
 #include "bench_rays.h"
 #include "bench_sampling.h"
@@ -172,19 +173,17 @@ static bool parse_accels(const char *text, bench_args *a)
     }
 }
 
-static bool parse_count(const char *option, const char *text, long long max, long long *out)
+static bool take_scenes(void *a, const char *text)
 {
-    long long v;
-    if (!rl_parse_int(text, &v) || v < 1 || v > max) {
-        rl_cli_fail(RL_CLI_USAGE, "%s: expected a whole number in 1..%lld, got '%s'", option, max,
-                    text);
-        return false;
-    }
-    *out = v;
-    return true;
+    return parse_scenes(text, a);
 }
 
-/* Returns RL_CLI_OK, an exit code, or -1 when --help was printed. */
+static bool take_accels(void *a, const char *text)
+{
+    return parse_accels(text, a);
+}
+
+/* Returns RL_CLI_OK, an exit code, or RL_BENCH_HELP_SHOWN. */
 static int parse_args(int argc, char **argv, bench_args *a)
 {
     if (argc < 2)
@@ -192,52 +191,26 @@ static int parse_args(int argc, char **argv, bench_args *a)
                            "bench: missing benchmark (try: rl bench rays, rl bench vt)");
     if (rl_cli_is_help(argv[1])) {
         fputs(bench_help, stdout);
-        return -1;
+        return RL_BENCH_HELP_SHOWN;
     }
     if (strcmp(argv[1], "rays") != 0)
         return rl_cli_fail(RL_CLI_USAGE, "bench: unknown benchmark '%s' (known: rays, vt, pt, "
                            "sampling, surfels, culling)",
                            argv[1]);
     bool has_scenes = false, has_accels = false;
-    for (int i = 2; i < argc; i++) {
-        const char *v = NULL;
-        int m;
-        if (rl_cli_is_help(argv[i])) {
-            fputs(bench_help, stdout);
-            return -1;
-        }
-#define VALUE(name) ((m = rl_cli_take_value(argc, argv, &i, name, &v)) != 0)
-        if (strcmp(argv[i], "--quick") == 0) {
-            a->quick = true;
-        } else if (VALUE("--scenes")) {
-            if (m < 0 || !parse_scenes(v, a))
-                return RL_CLI_USAGE;
-            has_scenes = true;
-        } else if (VALUE("--accels")) {
-            if (m < 0 || !parse_accels(v, a))
-                return RL_CLI_USAGE;
-            has_accels = true;
-        } else if (VALUE("--size")) {
-            if (m < 0 || !rl_cli_parse_size(v, &a->width, &a->height))
-                return RL_CLI_USAGE;
-            a->has_size = true;
-        } else if (VALUE("--rays")) {
-            if (m < 0 || !parse_count("--rays", v, MAX_RAYS, &a->rays))
-                return RL_CLI_USAGE;
-        } else if (VALUE("--threads")) {
-            if (m < 0 || !parse_count("--threads", v, 4096, &a->threads))
-                return RL_CLI_USAGE;
-        } else if (VALUE("--out")) {
-            if (m < 0)
-                return RL_CLI_USAGE;
-            a->out = v;
-        } else {
-            return rl_cli_unknown_arg("bench rays", argv[i]);
-        }
-#undef VALUE
-    }
-    if (a->out && !rl_cli_has_extension(a->out, (const char *const[]){ ".json", NULL }))
-        return rl_cli_fail(RL_CLI_USAGE, "--out: '%s' should end in .json", a->out);
+    const rl_bench_opt rows[] = {
+        RL_BENCH_FLAG("--quick", &a->quick),
+        RL_BENCH_CUSTOM("--scenes", take_scenes, a, &has_scenes),
+        RL_BENCH_CUSTOM("--accels", take_accels, a, &has_accels),
+        RL_BENCH_SIZE("--size", &a->width, &a->height, &a->has_size),
+        RL_BENCH_COUNT("--rays", MAX_RAYS, &a->rays, NULL),
+        RL_BENCH_COUNT("--threads", 4096, &a->threads, NULL),
+        RL_BENCH_OUT(&a->out),
+    };
+    int rc = rl_bench_parse_args(argc, argv, "bench rays", bench_help, rows,
+                                 (int)(sizeof rows / sizeof rows[0]));
+    if (rc != RL_CLI_OK)
+        return rc;
 
     /* Defaults; --quick only changes what was not given explicitly. */
     if (!has_scenes) {
@@ -638,5 +611,5 @@ int rl_cli_bench(int argc, char **argv)
     if (rc == RL_CLI_OK)
         rc = run(&a);
     free_args(&a);
-    return rc < 0 ? RL_CLI_OK : rc;
+    return rc == RL_BENCH_HELP_SHOWN ? RL_CLI_OK : rc;
 }
