@@ -57,7 +57,9 @@ assert s["positions"] >= 1 and s["chcpp_time_ms"]["mean"] > 0 and s["svs_time_ms
 assert 0 < s["svs_ssim"]["mean"] <= 1, s
 sel = r["select"]
 assert sel["positions"] == 4 and sel["selected_mean_ms"] > 0, sel
-assert min(sel["chcpp_mean_ms"], sel["svs_mean_ms"]) <= sel["selected_mean_ms"] <= max(sel["chcpp_mean_ms"], sel["svs_mean_ms"]) + 1e-9, sel
+# The selection picks per position, so its mean may be below both (that is
+# its point) or, with a poor predictor, above both: only sanity here.
+assert sel["chcpp_mean_ms"] > 0 and sel["svs_mean_ms"] > 0 and isinstance(sel["selection_beats_both"], bool), sel
 v = r["visset"]
 assert v["set_bytes"] > 0 and v["budget_triangles"] > 0 and 0 < v["ssim"]["min"] <= 1, v
 PY
