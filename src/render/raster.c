@@ -233,6 +233,32 @@ static rl_status prepare(const rl_scene_data *d, rl_raster_shading shading, bool
     return RL_OK;
 }
 
+/* Flat shading of triangle t: the geometric normal at its centroid. */
+static void light_face(const shade_ctx *ctx, frame_buffers *b, int64_t t)
+{
+    const rl_scene_data *d = ctx->data;
+    const uint32_t *tri = &d->indices[3 * t];
+    rl_vec3 p0 = d->positions[tri[0]], p1 = d->positions[tri[1]], p2 = d->positions[tri[2]];
+    rl_vec3 centroid = rl_scale(rl_add(rl_add(p0, p1), p2), 1.0f / 3.0f);
+    rl_vec3 n = rl_normalize(rl_cross(rl_sub(p1, p0), rl_sub(p2, p0)));
+    b->face_colors[t] = phong(ctx, &d->materials[d->triangle_material[t]], centroid, n);
+}
+
+/* The corner copies of triangle t of a mixed-material object, lit with
+ * the triangle's own material. */
+static void light_corners(const shade_ctx *ctx, rl_raster_shading shading, frame_buffers *b, int64_t t)
+{
+    const rl_scene_data *d = ctx->data;
+    uint32_t m = d->triangle_material[t];
+    for (int k = 0; k < 3; ++k) {
+        uint32_t vi = d->indices[3 * t + k];
+        b->corner_positions[3 * t + k] = d->positions[vi];
+        b->corner_uvs[3 * t + k] = d->uvs[vi];
+        b->corner_colors[3 * t + k] = phong(ctx, &d->materials[m], d->positions[vi], d->normals[vi]);
+    }
+    b->triangle_texture[t] = shading == RL_SHADING_TEXTURED ? texture_of(d, m) : RL_ID_NONE;
+}
+
 /* Lights the vertices, corners or faces of the selected objects in
  * parallel; every result depends only on its own element, so the output
  * does not depend on the thread count. */
@@ -244,15 +270,9 @@ static void light_scene(const shade_ctx *ctx, rl_raster_shading shading, int thr
 
     if (shading == RL_SHADING_FLAT) {
 #pragma omp parallel for num_threads(threads) schedule(static)
-        for (int64_t t = 0; t < nt; ++t) {
-            if (!selected(mask, d->triangle_object[t]))
-                continue;
-            const uint32_t *tri = &d->indices[3 * t];
-            rl_vec3 p0 = d->positions[tri[0]], p1 = d->positions[tri[1]], p2 = d->positions[tri[2]];
-            rl_vec3 centroid = rl_scale(rl_add(rl_add(p0, p1), p2), 1.0f / 3.0f);
-            rl_vec3 n = rl_normalize(rl_cross(rl_sub(p1, p0), rl_sub(p2, p0)));
-            b->face_colors[t] = phong(ctx, &d->materials[d->triangle_material[t]], centroid, n);
-        }
+        for (int64_t t = 0; t < nt; ++t)
+            if (selected(mask, d->triangle_object[t]))
+                light_face(ctx, b, t);
         return;
     }
 
@@ -267,16 +287,8 @@ static void light_scene(const shade_ctx *ctx, rl_raster_shading shading, int thr
 #pragma omp parallel for num_threads(threads) schedule(static)
     for (int64_t t = 0; t < nt; ++t) {
         uint32_t o = d->triangle_object[t];
-        if (b->object_material[o] != RL_NONE || !selected(mask, o))
-            continue;
-        uint32_t m = d->triangle_material[t];
-        for (int k = 0; k < 3; ++k) {
-            uint32_t vi = d->indices[3 * t + k];
-            b->corner_positions[3 * t + k] = d->positions[vi];
-            b->corner_uvs[3 * t + k] = d->uvs[vi];
-            b->corner_colors[3 * t + k] = phong(ctx, &d->materials[m], d->positions[vi], d->normals[vi]);
-        }
-        b->triangle_texture[t] = shading == RL_SHADING_TEXTURED ? texture_of(d, m) : RL_ID_NONE;
+        if (b->object_material[o] == RL_NONE && selected(mask, o))
+            light_corners(ctx, shading, b, t);
     }
 }
 
@@ -417,13 +429,8 @@ static void light_object(rl_scene_drawer *dr, uint32_t o)
     const int64_t t0 = obj->first_triangle, t1 = t0 + obj->num_triangles;
     if (dr->opt.shading == RL_SHADING_FLAT) {
 #pragma omp parallel for num_threads(threads) schedule(static)
-        for (int64_t t = t0; t < t1; ++t) {
-            const uint32_t *tri = &d->indices[3 * t];
-            rl_vec3 p0 = d->positions[tri[0]], p1 = d->positions[tri[1]], p2 = d->positions[tri[2]];
-            rl_vec3 centroid = rl_scale(rl_add(rl_add(p0, p1), p2), 1.0f / 3.0f);
-            rl_vec3 n = rl_normalize(rl_cross(rl_sub(p1, p0), rl_sub(p2, p0)));
-            b->face_colors[t] = phong(ctx, &d->materials[d->triangle_material[t]], centroid, n);
-        }
+        for (int64_t t = t0; t < t1; ++t)
+            light_face(ctx, b, t);
         return;
     }
     uint32_t m = b->object_material[o];
@@ -435,16 +442,8 @@ static void light_object(rl_scene_drawer *dr, uint32_t o)
         return;
     }
 #pragma omp parallel for num_threads(threads) schedule(static)
-    for (int64_t t = t0; t < t1; ++t) {
-        uint32_t tm = d->triangle_material[t];
-        for (int k = 0; k < 3; ++k) {
-            uint32_t vi = d->indices[3 * t + k];
-            b->corner_positions[3 * t + k] = d->positions[vi];
-            b->corner_uvs[3 * t + k] = d->uvs[vi];
-            b->corner_colors[3 * t + k] = phong(ctx, &d->materials[tm], d->positions[vi], d->normals[vi]);
-        }
-        b->triangle_texture[t] = dr->opt.shading == RL_SHADING_TEXTURED ? texture_of(d, tm) : RL_ID_NONE;
-    }
+    for (int64_t t = t0; t < t1; ++t)
+        light_corners(ctx, dr->opt.shading, b, t);
 }
 
 rl_status rl_scene_drawer_draw(rl_scene_drawer *dr, rl_raster *ras, uint32_t object, rl_raster_counters *c)
