@@ -163,6 +163,10 @@ RL_API bool rl_mat4_invert(const rl_mat4 *a, rl_mat4 *out);
 RL_API rl_mat4 rl_mat4_look_at(rl_vec3 eye, rl_vec3 target, rl_vec3 up);
 /* OpenGL-style perspective projection: clip w = -z_eye, NDC z in [-1,1]. */
 RL_API rl_mat4 rl_mat4_perspective(float fov_y_rad, float aspect, float z_near, float z_far);
+/* Centred orthographic projection (glOrtho with symmetric bounds): eye x in
+ * [-half_width, half_width], y likewise, z_eye = -z_near .. -z_far to NDC
+ * -1 .. +1, clip w = 1. */
+RL_API rl_mat4 rl_mat4_orthographic(float half_width, float half_height, float z_near, float z_far);
 RL_API rl_vec4 rl_mat4_mul_vec4(const rl_mat4 *a, rl_vec4 v);
 RL_API rl_vec3 rl_mat4_mul_point(const rl_mat4 *a, rl_vec3 p);       /* w = 1, no divide */
 RL_API rl_vec3 rl_mat4_mul_dir(const rl_mat4 *a, rl_vec3 d);         /* w = 0 */

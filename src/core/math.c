@@ -152,6 +152,20 @@ rl_mat4 rl_mat4_perspective(float fov_y_rad, float aspect, float z_near, float z
     return r;
 }
 
+rl_mat4 rl_mat4_orthographic(float half_width, float half_height, float z_near, float z_far)
+{
+    /* glOrtho, centred: x, y in [-half, half] and z_eye = -near .. -far map
+     * to NDC -1 .. +1; w stays 1 (the rasterizer then interpolates eye depth
+     * affinely). */
+    rl_mat4 r = { { { 0 } } };
+    r.m[0][0] = 1.0f / half_width;
+    r.m[1][1] = 1.0f / half_height;
+    r.m[2][2] = -2.0f / (z_far - z_near);
+    r.m[2][3] = -(z_far + z_near) / (z_far - z_near);
+    r.m[3][3] = 1.0f;
+    return r;
+}
+
 rl_vec4 rl_mat4_mul_vec4(const rl_mat4 *a, rl_vec4 v)
 {
     const float (*m)[4] = a->m;

@@ -40,7 +40,6 @@ void rl_cull_view_make(const rl_camera *cam, rl_aabb scene_bounds, rl_cull_view 
     float ty = tanf(0.5f * rl_radians(v->cam.fov_deg));
     float tx = ty * (float)v->cam.width / (float)v->cam.height;
     v->near_radius = z_near * sqrtf(1.0f + tx * tx + ty * ty);
-    v->focal_px = 0.5f * (float)v->cam.height / ty;
 }
 
 bool rl_cull_box_in_frustum(const rl_cull_view *v, rl_aabb b)
@@ -69,20 +68,6 @@ float rl_cull_box_distance(rl_vec3 eye, rl_aabb b)
 bool rl_cull_box_near_eye(const rl_cull_view *v, rl_aabb b)
 {
     return rl_cull_box_distance(v->eye, b) <= 2.0f * v->near_radius;
-}
-
-double rl_cull_projected_area(const rl_cull_view *v, rl_aabb b)
-{
-    rl_vec3 e = rl_aabb_extent(b);
-    double r = 0.5 * sqrt((double)e.x * e.x + (double)e.y * e.y + (double)e.z * e.z);
-    rl_vec3 c = rl_aabb_center(b);
-    double d = rl_length(rl_sub(c, v->eye));
-    if (d <= r)   /* around the eye: the whole screen */
-        return (double)v->cam.width * v->cam.height;
-    /* Radius on screen of a sphere at distance d (its silhouette cone). */
-    double rp = (double)v->focal_px * r / sqrt(d * d - r * r);
-    double a = (double)RL_PI * rp * rp;
-    return a > 1.0 ? a : 1.0;
 }
 
 void rl_box_query_reset(rl_box_query *q)

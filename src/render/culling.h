@@ -20,7 +20,6 @@ typedef struct rl_cull_view {
     rl_mat4 view, proj, view_proj;
     rl_vec4 planes[6];            /* inward: dot(n, p) + d >= 0 inside */
     float near_radius;            /* eye to the near plane's corners */
-    float focal_px;               /* pixels per unit at depth 1 (vertical) */
 } rl_cull_view;
 
 void rl_cull_view_make(const rl_camera *cam, rl_aabb scene_bounds, rl_cull_view *v);
@@ -31,9 +30,6 @@ bool rl_cull_box_in_frustum(const rl_cull_view *v, rl_aabb b);
 bool rl_cull_box_near_eye(const rl_cull_view *v, rl_aabb b);
 /* Distance from the eye to the box (0 inside): the front-to-back key. */
 float rl_cull_box_distance(rl_vec3 eye, rl_aabb b);
-/* Projected area in pixels of the box's bounding sphere (Jähn 2015,
- * Sec. 6.2 "projizierte Größe"), at least 1 for a box around the eye. */
-double rl_cull_projected_area(const rl_cull_view *v, rl_aabb b);
 
 /* Several boxes as one occlusion query (a multi-query, Mattausch et al.
  * 2008): front faces only, each box grown by a relative margin so that

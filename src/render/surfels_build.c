@@ -169,14 +169,8 @@ static void view_matrices(const view *v, rl_mat4 *vm, rl_mat4 *pm)
         vm->m[r][2] = rows[r].z;
         vm->m[r][3] = -rl_dot(rows[r], v->eye);
     }
-    /* glOrtho over the sphere: it spans depths [R, 3R] from the eye. */
-    float n = 0.5f * v->half, f = 3.5f * v->half;
-    memset(pm, 0, sizeof *pm);
-    pm->m[0][0] = 1.0f / v->half;
-    pm->m[1][1] = 1.0f / v->half;
-    pm->m[2][2] = -2.0f / (f - n);
-    pm->m[2][3] = -(f + n) / (f - n);
-    pm->m[3][3] = 1.0f;
+    /* Over the sphere: it spans depths [R, 3R] from the eye. */
+    *pm = rl_mat4_orthographic(v->half, v->half, 0.5f * v->half, 3.5f * v->half);
 }
 
 /* The candidate of pixel (x, y) of view v, which shows triangle t at depth. */

@@ -203,13 +203,7 @@ static void ortho_view(rl_vec3 c, float r, rl_vec3 dir, rl_mat4 *view, rl_mat4 *
     rl_vec3 eye = rl_add(c, rl_scale(dir, 2.0f * r));
     rl_vec3 up = fabsf(dir.y) > 0.99f ? rl_v3(1, 0, 0) : rl_v3(0, 1, 0);
     *view = rl_mat4_look_at(eye, c, up);
-    float n = 0.5f * r, f = 3.5f * r;
-    memset(proj, 0, sizeof *proj);
-    proj->m[0][0] = 1.0f / r;
-    proj->m[1][1] = 1.0f / r;
-    proj->m[2][2] = -2.0f / (f - n);
-    proj->m[2][3] = -(f + n) / (f - n);
-    proj->m[3][3] = 1.0f;
+    *proj = rl_mat4_orthographic(r, r, 0.5f * r, 3.5f * r);   /* the sphere spans depths [r, 3r] */
 }
 
 typedef struct svs_worker {

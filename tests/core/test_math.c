@@ -119,6 +119,21 @@ static void test_perspective_maps_frustum_corners_to_ndc(void **state)
     assert_vec3_near(d, rl_v3(-1, -1, -1), 1e-4);
 }
 
+static void test_orthographic_maps_the_box_to_ndc_with_w_one(void **state)
+{
+    (void)state;
+    rl_mat4 p = rl_mat4_orthographic(2.0f, 0.5f, 1.0f, 9.0f);
+    float w;
+    rl_vec3 a = project(&p, rl_v3(2.0f, 0.5f, -1.0f), &w);
+    assert_near(w, 1, 0);                          /* affine: clip w = 1 */
+    assert_vec3_near(a, rl_v3(1, 1, -1), 1e-6);
+    rl_vec3 b = project(&p, rl_v3(-2.0f, -0.5f, -9.0f), &w);
+    assert_near(w, 1, 0);
+    assert_vec3_near(b, rl_v3(-1, -1, 1), 1e-6);
+    rl_vec3 c = project(&p, rl_v3(1.0f, 0.25f, -5.0f), &w);
+    assert_vec3_near(c, rl_v3(0.5f, 0.5f, 0), 1e-6);
+}
+
 static void test_normals_transform_with_inverse_transpose(void **state)
 {
     (void)state;
@@ -263,6 +278,7 @@ int main(void)
         cmocka_unit_test(test_rotation_is_right_handed),
         cmocka_unit_test(test_look_at_maps_target_onto_negative_z),
         cmocka_unit_test(test_perspective_maps_frustum_corners_to_ndc),
+        cmocka_unit_test(test_orthographic_maps_the_box_to_ndc_with_w_one),
         cmocka_unit_test(test_normals_transform_with_inverse_transpose),
         cmocka_unit_test(test_aabb_transform_matches_transformed_corners),
         cmocka_unit_test(test_onb_is_orthonormal_and_right_handed),
