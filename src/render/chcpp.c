@@ -53,6 +53,7 @@
 #include "render/culling.h"
 #include "render/raster_scene.h"
 #include "render/renderer.h"
+#include "rl/rl_rng.h"
 #include "rl/rl_timer.h"
 
 static const rl_option_info chcpp_options[] = {
@@ -191,16 +192,6 @@ static double p_stay_invisible(uint32_t i)
     return 0.99 - 0.7 * exp(-(double)i);
 }
 
-static uint64_t mix64(uint64_t x)
-{
-    x ^= x >> 33;
-    x *= 0xff51afd7ed558ccdULL;
-    x ^= x >> 33;
-    x *= 0xc4ceb9fe1a85ec53ULL;
-    x ^= x >> 33;
-    return x;
-}
-
 static void pull_up(frame_ctx *f, uint32_t n)
 {
     while (n != RL_NONE && !f->s->ns[n].visible) {
@@ -213,7 +204,7 @@ static void pull_up(frame_ctx *f, uint32_t n)
  * minus a random part so that nodes spread over the frames. */
 static void schedule_query(frame_ctx *f, uint32_t n)
 {
-    uint64_t r = mix64(f->seed ^ ((uint64_t)n << 32) ^ f->s->frame);
+    uint64_t r = rl_hash64(f->seed ^ ((uint64_t)n << 32) ^ f->s->frame);
     f->s->ns[n].next_query = f->s->frame + 1 + r % f->n_av;
 }
 
