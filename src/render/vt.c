@@ -64,7 +64,7 @@ static const rl_option_info vt_options[] = {
     { "min_edge", RL_OPT_FLOAT, "1", "minimum projected edge length in pixels: shorter edges are not split",
       0.25, 1e6, NULL },
     { "forced", RL_OPT_BOOL, "true", "forced refinement of compressed triangles (Sec. 3.3.2)", 0, 0, NULL },
-    { "eps_z", RL_OPT_FLOAT, "0.98", "forced refinement threshold on xi = c / (a + b)", 0.5, 1, NULL },
+    { "eps_z", RL_OPT_FLOAT, "0.999", "forced refinement threshold on xi = c / (a + b)", 0.5, 1, NULL },
     { "id_test", RL_OPT_BOOL, "true", "ID-buffer visibility pre-pass (Sec. 3.4.1; false: all faces)", 0, 0, NULL },
     { "z_test", RL_OPT_BOOL, "true", "z-buffer test of new edges (Sec. 3.4.2)", 0, 0, NULL },
     { "clip_test", RL_OPT_BOOL, "true", "viewport test of new edges (Sec. 3.4.3)", 0, 0, NULL },

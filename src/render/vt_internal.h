@@ -135,8 +135,11 @@ uint32_t vt_mesh_split(vt_mesh *m, uint32_t e, uint16_t stage, uint32_t new_edge
  * pixel coordinates of the vertices. 0 when both other sides have zero
  * length. */
 float vt_face_xi(const vt_mesh *m, uint32_t f, int i);
-/* xi of the face's longest side: 1 means zero area, where refinement stops. */
-float vt_face_xi_max(const vt_mesh *m, uint32_t f);
+/* Projected height of the face over its longest side, in pixels: the
+ * measure of "no area" (Sec. 3.3.2, A -> 0) that does not depend on the
+ * face's length, unlike xi (a 100-pixel sliver 2 pixels wide has xi
+ * 0.9996). */
+float vt_face_height_px(const vt_mesh *m, uint32_t f);
 
 /* ------------------------------------------------------------ criteria -- */
 

@@ -464,16 +464,13 @@ float vt_face_xi(const vt_mesh *m, uint32_t f, int i)
     return a + b > 0.0 ? (float)(c / (a + b)) : 0.0f;
 }
 
-float vt_face_xi_max(const vt_mesh *m, uint32_t f)
+float vt_face_height_px(const vt_mesh *m, uint32_t f)
 {
     const uint32_t *v = m->faces[f].v;
-    double side[3];
-    for (int i = 0; i < 3; ++i)
-        side[i] = side_px(m, v[(i + 1) % 3], v[(i + 2) % 3]);
-    int c = 0;
-    for (int i = 1; i < 3; ++i)
-        if (side[i] > side[c])
-            c = i;
-    double rest = side[(c + 1) % 3] + side[(c + 2) % 3];
-    return rest > 0.0 ? (float)(side[c] / rest) : 0.0f;
+    const vt_vertex *a = &m->verts[v[0]], *b = &m->verts[v[1]], *c = &m->verts[v[2]];
+    double ux = (double)b->sx - a->sx, uy = (double)b->sy - a->sy;
+    double wx = (double)c->sx - a->sx, wy = (double)c->sy - a->sy;
+    double twice_area = fabs(ux * wy - uy * wx);
+    double longest = fmax(side_px(m, v[0], v[1]), fmax(side_px(m, v[1], v[2]), side_px(m, v[2], v[0])));
+    return longest > 0.0 ? (float)(twice_area / longest) : 0.0f;
 }

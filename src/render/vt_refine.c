@@ -29,11 +29,14 @@
 #include "rl/rl_timer.h"
 
 #define BAND 0.5f                  /* a stage: lengths within [top * BAND, top] */
-/* xi at or above: zero area, stop (Sec. 3.3.2). For a sliver of base c and
- * height h, xi ~ 1 - 2 h^2 / c^2: 1e-3 is a height of a few hundredths of a
- * pixel on a pixel-long base, which float rounding can otherwise keep
- * "refining" forever (the thesis' endless recursion when A -> 0). */
-#define XI_FLAT (1.0f - 1e-3f)
+/* A face lower than this over its longest side has no area (Sec. 3.3.2:
+ * xi = 1, A -> 0) and is not refined: float rounding can otherwise keep a
+ * sliver "refining" forever (the thesis' endless recursion). The measure is
+ * the height in pixels, not xi itself: xi ~ 1 - 2 h^2 / c^2 for a sliver of
+ * base c and height h, so any threshold on xi calls long slivers a few
+ * pixels wide flat, and their long edges would never be split again (they
+ * showed as streaks along the walls of the cups). */
+#define FLAT_HEIGHT_PX 0.05f
 
 static double now_ms(void)
 {
@@ -164,7 +167,7 @@ static void check_forced(refine_ctx *ctx, uint32_t f, uint32_t mid)
     const vt_edge *be = &m->edges[base];
     if (be->mid != VT_NONE)
         return;
-    if (!(vt_face_xi(m, f, slot) > run->set->eps_z) || !(vt_face_xi_max(m, f) < XI_FLAT))
+    if (!(vt_face_xi(m, f, slot) > run->set->eps_z) || !(vt_face_height_px(m, f) > FLAT_HEIGHT_PX))
         return;
     if (!grow(&ctx->forced, &ctx->forced_cap, ctx->forced_count + 1)) {
         run->failed = true;
@@ -237,7 +240,7 @@ static void run_forced(refine_ctx *ctx, uint16_t stage)
 static bool has_area(const vt_mesh *m, const vt_edge *ed)
 {
     for (int k = 0; k < 2; ++k)
-        if (ed->face[k] != VT_NONE && vt_face_xi_max(m, ed->face[k]) < XI_FLAT)
+        if (ed->face[k] != VT_NONE && vt_face_height_px(m, ed->face[k]) > FLAT_HEIGHT_PX)
             return true;
     return false;
 }

@@ -766,7 +766,7 @@ static void test_keys_are_distinct_and_mid_is_symmetric(void **state)
     free(keys);
 }
 
-static void test_xi_is_base_over_the_other_two_sides(void **state)
+static void test_xi_and_height_of_a_face(void **state)
 {
     (void)state;
     vt_vertex v[3];
@@ -782,14 +782,22 @@ static void test_xi_is_base_over_the_other_two_sides(void **state)
     assert_float_equal(vt_face_xi(&m, 0, 0), 5.0f / 7.0f, 1e-6f);
     assert_float_equal(vt_face_xi(&m, 0, 1), 4.0f / 8.0f, 1e-6f);
     assert_float_equal(vt_face_xi(&m, 0, 2), 3.0f / 9.0f, 1e-6f);
-    assert_float_equal(vt_face_xi_max(&m, 0), 5.0f / 7.0f, 1e-6f);
-    /* collinear: no area, xi = 1 */
+    /* height over the longest side: 2 * area / 5 */
+    assert_float_equal(vt_face_height_px(&m, 0), 12.0f / 5.0f, 1e-6f);
+    /* a long sliver 2 pixels high: xi = 200 / (2 sqrt(100^2 + 2^2)) is
+     * 0.9998, "flat" by any threshold on xi; its height says otherwise */
+    v[1].sx = 200; v[1].sy = 0;
+    v[2].sx = 100; v[2].sy = 2;
+    assert_true(vt_face_xi(&m, 0, 2) > 0.999f);
+    assert_float_equal(vt_face_height_px(&m, 0), 2.0f, 1e-5f);
+    /* collinear: no area, xi = 1, height 0 */
     v[2].sx = 6; v[2].sy = 0;
-    assert_float_equal(vt_face_xi_max(&m, 0), 1.0f, 1e-6f);
+    assert_float_equal(vt_face_xi(&m, 0, 2), 1.0f, 1e-6f);
+    assert_float_equal(vt_face_height_px(&m, 0), 0.0f, 0.0f);
     /* all in one point: 0 by definition */
     v[1].sx = v[2].sx = 0;
     assert_float_equal(vt_face_xi(&m, 0, 0), 0.0f, 0.0f);
-    assert_float_equal(vt_face_xi_max(&m, 0), 0.0f, 0.0f);
+    assert_float_equal(vt_face_height_px(&m, 0), 0.0f, 0.0f);
 }
 
 int main(void)
@@ -807,7 +815,7 @@ int main(void)
         cmocka_unit_test(test_random_splits_on_committed_sphere),
         cmocka_unit_test(test_reset_restores_the_primary_mesh),
         cmocka_unit_test(test_keys_are_distinct_and_mid_is_symmetric),
-        cmocka_unit_test(test_xi_is_base_over_the_other_two_sides),
+        cmocka_unit_test(test_xi_and_height_of_a_face),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
