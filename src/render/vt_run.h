@@ -134,6 +134,9 @@ void vt_sample_queue(vt_run *run, uint32_t v);
 /* Spawns the partly filled block, waits for all blocks of this stage and
  * copies their results into the mesh (state VT_SAMPLED). */
 void vt_sample_flush(vt_run *run);
+/* Time the calling thread has spent sampling blocks so far (ms): the
+ * refinement subtracts what its thread sampled inside its own intervals. */
+double vt_sample_busy_ms(const vt_run *run);
 /* Makes room for per-vertex arrays up to mesh->num_verts. */
 rl_status vt_run_reserve(vt_run *run);
 void vt_run_free_blocks(vt_run *run);

@@ -145,6 +145,11 @@ static void sample_block(vt_run *run, vt_block *b)
     tally->busy_ms += (rl_time_s() * 1000.0) - t0;
 }
 
+double vt_sample_busy_ms(const vt_run *run)
+{
+    return run->tally[thread_index()].busy_ms;
+}
+
 static vt_block *take_block(vt_run *run)
 {
     vt_block *b = run->free_blocks;

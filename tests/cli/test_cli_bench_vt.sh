@@ -87,7 +87,14 @@ for x in res:
     quality_ok(x["quality"])
 
 q = r["quality"]
-assert [x["min_edge"] for x in q["runs"]] == [1, 2, 3, 4, 6, 8]
+edges = [1, 2, 3, 4, 6, 8, 12, 16, 24, 32]
+for crit in ("tree+hsv", "hsv"):
+    rows = [x for x in q["runs"] if x["criteria"] == crit]
+    assert rows and [x["min_edge"] for x in rows] == edges[:len(rows)], (crit, rows)
+    # the sweep of a criterion ends after two misses in a row, or at the end
+    miss = [x["quality"]["vt_pixels"]["ssim"] < 0.95 for x in rows]
+    assert len(rows) == len(edges) or miss[-2:] == [True, True], (crit, miss)
+    assert not any(miss[i] and miss[i + 1] for i in range(len(miss) - 2)), (crit, miss)
 for x in q["runs"]:
     assert x["time_ms"] > 0 and x["rays"]["total"] > 0
     quality_ok(x["quality"])
