@@ -460,7 +460,8 @@ static rl_status vt_render(rl_renderer *r, void *state, const rl_scene *scene, c
     double t0 = rl_time_s() * 1000.0;
     if (st == RL_OK)
         st = vt_prepass(&run, depth_ids);
-    run.stats.time_visibility_ms = rl_time_s() * 1000.0 - t0;
+    /* The rasterized half drawn inside the pre-pass counts as drawing. */
+    run.stats.time_visibility_ms = rl_time_s() * 1000.0 - t0 - run.stats.time_draw_ms;
     if (st == RL_OK)
         st = vt_refine(&run);
     rl_tracer_release(tracer);
@@ -468,7 +469,7 @@ static rl_status vt_render(rl_renderer *r, void *state, const rl_scene *scene, c
         double td = rl_time_s() * 1000.0;
         if (!vt_update(&run, run.stats.stages, true) && run.failed)
             st = RL_ERR_OUT_OF_MEMORY;
-        run.stats.time_draw_ms = rl_time_s() * 1000.0 - td;
+        run.stats.time_draw_ms += rl_time_s() * 1000.0 - td;
     }
     if (st == RL_OK && set.coherence)
         st = keep_feelers(s, &run);
@@ -479,6 +480,7 @@ static rl_status vt_render(rl_renderer *r, void *state, const rl_scene *scene, c
     free(run.reason);
     free(run.feelers);
     free(run.scratch_depth);
+    vt_draw_free_base(&run);
     if (st != RL_OK)
         return st;
 

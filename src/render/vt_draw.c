@@ -30,6 +30,7 @@
 
 #include "core/error.h"
 #include "render/vt_run.h"
+#include "rl/rl_timer.h"
 
 #define NUM_LAYERS 4
 
@@ -234,34 +235,118 @@ static rl_status draw_faces(vt_run *run, rl_raster *ras, bool only_new, unsigned
     return st;
 }
 
-rl_status vt_draw(vt_run *run, bool only_new)
+rl_status vt_draw_target(vt_run *run, rl_image *target)
 {
-    rl_image target = *run->image;
-    size_t n = (size_t)target.width * (size_t)target.height;
-    if (!(target.layers & RL_LAYER_DEPTH) || !target.depth) {
+    *target = *run->image;
+    size_t n = (size_t)target->width * (size_t)target->height;
+    if (!(target->layers & RL_LAYER_DEPTH) || !target->depth) {
         if (!run->scratch_depth && !(run->scratch_depth = rl_realloc_array(NULL, n, sizeof(float))))
             return RL_ERR_OUT_OF_MEMORY;
-        target.depth = run->scratch_depth;
-        target.layers |= RL_LAYER_DEPTH;
+        target->depth = run->scratch_depth;
+        target->layers |= RL_LAYER_DEPTH;
     }
-    unsigned id_flags = (target.layers & RL_LAYER_ID) && target.object_id && target.triangle_id ? 0u : RL_RASTER_NO_ID;
-    if (only_new && !run->drawn)
-        only_new = false;
+    return RL_OK;
+}
+
+static unsigned id_flags_of(const rl_image *target)
+{
+    return (target->layers & RL_LAYER_ID) && target->object_id && target->triangle_id ? 0u
+                                                                                    : RL_RASTER_NO_ID;
+}
+
+static rl_status open_raster(vt_run *run, rl_image *target, rl_raster **out)
+{
+    rl_status st = rl_raster_create(&(rl_raster_desc){ .threads = run->set->threads }, out);
+    if (st == RL_OK && (st = rl_raster_set_target(*out, target, &run->view_m, &run->proj_m)) != RL_OK) {
+        rl_raster_release(*out);
+        *out = NULL;
+    }
+    return st;
+}
+
+/* Copies n items between the frame and the kept base, when both exist. */
+static void copy_layer(void *dst, const void *src, size_t n, size_t size)
+{
+    if (dst && src)
+        memcpy(dst, src, n * size);
+}
+
+rl_status vt_draw_base(vt_run *run)
+{
+    double t0 = rl_time_s() * 1000.0;
+    rl_image target;
+    rl_status st = vt_draw_target(run, &target);
     rl_raster *ras = NULL;
-    rl_status st = rl_raster_create(&(rl_raster_desc){ .threads = run->set->threads }, &ras);
     if (st == RL_OK)
-        st = rl_raster_set_target(ras, &target, &run->view_m, &run->proj_m);
-    if (st == RL_OK && !only_new) {
-        /* Fig. 3.17, second pass: clear, the non-VT objects, then the faces. */
+        st = open_raster(run, &target, &ras);
+    if (st == RL_OK) {
+        /* Fig. 3.17, second pass, its rasterized half: clear, the non-VT
+         * objects. Drawn once: the pre-pass adds the VT objects to a copy
+         * of this depth, the VT faces go on top of it. */
         rl_image_clear(&target);
         rl_image_fill(&target, rl_v4_from3(run->set->background, 1.0f));
         rl_raster_scene_desc desc = { .shading = run->set->shading, .ambient = run->set->ambient,
-                                      .threads = run->set->threads, .flags = id_flags,
+                                      .threads = run->set->threads, .flags = id_flags_of(&target),
                                       .object_mask = run->object_raster };
         st = rl_raster_draw_scene(ras, run->data, run->view.eye, &desc, &run->counters, NULL, NULL);
     }
+    rl_raster_release(ras);
+    size_t n = (size_t)target.width * (size_t)target.height;
+    if (st == RL_OK && run->update) {
+        bool ids = !(id_flags_of(&target) & RL_RASTER_NO_ID);
+        run->base_color = rl_realloc_array(NULL, n, sizeof *run->base_color);
+        run->base_depth = rl_realloc_array(NULL, n, sizeof *run->base_depth);
+        if (ids) {
+            run->base_object_id = rl_realloc_array(NULL, n, sizeof *run->base_object_id);
+            run->base_triangle_id = rl_realloc_array(NULL, n, sizeof *run->base_triangle_id);
+        }
+        if (!run->base_color || !run->base_depth || (ids && (!run->base_object_id || !run->base_triangle_id)))
+            st = RL_ERR_OUT_OF_MEMORY;
+        else {
+            copy_layer(run->base_color, target.color, n, sizeof *target.color);
+            copy_layer(run->base_depth, target.depth, n, sizeof *target.depth);
+            copy_layer(run->base_object_id, ids ? target.object_id : NULL, n, sizeof(uint32_t));
+            copy_layer(run->base_triangle_id, ids ? target.triangle_id : NULL, n, sizeof(uint32_t));
+        }
+    }
+    run->stats.time_draw_ms += rl_time_s() * 1000.0 - t0;
+    return st;
+}
+
+void vt_draw_free_base(vt_run *run)
+{
+    free(run->base_color);
+    free(run->base_depth);
+    free(run->base_object_id);
+    free(run->base_triangle_id);
+    run->base_color = NULL;
+    run->base_depth = NULL;
+    run->base_object_id = run->base_triangle_id = NULL;
+}
+
+rl_status vt_draw(vt_run *run, bool only_new)
+{
+    rl_image target;
+    rl_status st = vt_draw_target(run, &target);
+    if (st != RL_OK)
+        return st;
+    if (only_new && !run->drawn)
+        only_new = false;
+    if (!only_new && run->drawn) {
+        /* A full redraw starts again from the rasterized half. */
+        if (!run->base_color || !run->base_depth)
+            return rl_error(RL_ERR_INTERNAL, "vt: redraw without the kept rasterized image");
+        size_t n = (size_t)target.width * (size_t)target.height;
+        bool ids = !(id_flags_of(&target) & RL_RASTER_NO_ID);
+        copy_layer(target.color, run->base_color, n, sizeof *target.color);
+        copy_layer(target.depth, run->base_depth, n, sizeof *target.depth);
+        copy_layer(ids ? target.object_id : NULL, run->base_object_id, n, sizeof(uint32_t));
+        copy_layer(ids ? target.triangle_id : NULL, run->base_triangle_id, n, sizeof(uint32_t));
+    }
+    rl_raster *ras = NULL;
+    st = open_raster(run, &target, &ras);
     if (st == RL_OK)
-        st = draw_faces(run, ras, only_new, id_flags);
+        st = draw_faces(run, ras, only_new, id_flags_of(&target));
     rl_raster_release(ras);
     if (st == RL_OK)
         run->drawn = true;

@@ -49,17 +49,26 @@ rl_status vt_prepass(vt_run *run, rl_image *depth_ids)
 {
     const vt_settings *set = run->set;
     vt_mesh *m = run->mesh;
+    rl_image frame;
+    rl_status st = vt_draw_base(run);
+    if (st == RL_OK)
+        st = vt_draw_target(run, &frame);
     rl_raster *ras = NULL;
-    rl_status st = rl_raster_create(&(rl_raster_desc){ .threads = set->threads }, &ras);
+    if (st == RL_OK)
+        st = rl_raster_create(&(rl_raster_desc){ .threads = set->threads }, &ras);
     if (st == RL_OK)
         st = rl_raster_set_target(ras, depth_ids, &run->view_m, &run->proj_m);
     if (st == RL_OK) {
         /* Sec. 3.5, Fig. 3.17, first pass: the whole scene into the ID and
-         * Z buffers. Every triangle keeps its own ID, so the non-VT objects
-         * need no special colour 0: their IDs simply name no VT face. */
+         * Z buffers. The rasterized objects are in the frame's depth
+         * already (vt_draw_base); the VT objects go on top of a copy of
+         * it. Every triangle keeps its own ID, so the non-VT objects need
+         * no special colour 0: their pixels name no VT face. */
         rl_image_clear(depth_ids);
+        memcpy(depth_ids->depth, frame.depth,
+               (size_t)frame.width * (size_t)frame.height * sizeof *frame.depth);
         rl_raster_scene_desc desc = { .shading = RL_SHADING_FLAT, .threads = set->threads,
-                                      .flags = RL_RASTER_NO_COLOR };
+                                      .flags = RL_RASTER_NO_COLOR, .object_mask = run->object_vt };
         rl_raster_counters c;
         memset(&c, 0, sizeof c);
         st = rl_raster_draw_scene(ras, run->data, run->view.eye, &desc, &c, NULL, NULL);

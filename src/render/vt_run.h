@@ -120,6 +120,11 @@ typedef struct vt_run {
     uint32_t drawn_stage;     /* overdraw: faces of stages <= this are drawn */
     bool drawn;               /* the image holds a frame (overdraw may add to it) */
     float *scratch_depth;     /* when the image has no depth layer */
+    /* the rasterized half of the frame (vt_draw_base), kept for redraws
+     * when an update callback may ask for more than one full draw */
+    rl_vec4 *base_color;
+    float *base_depth;
+    uint32_t *base_object_id, *base_triangle_id;
     rl_raster_counters counters;  /* reconstruction draws */
     /* statistics */
     double t_start_ms;        /* rl_time_s() * 1000 at the frame's start */
@@ -142,9 +147,11 @@ rl_status vt_run_reserve(vt_run *run);
 void vt_run_free_blocks(vt_run *run);
 
 /* vt_refine.c ------------------------------------------------------------ */
-/* The ID-buffer pre-pass (Sec. 3.4.1, Fig. 3.12, 3.17): rasterizes the scene
- * into depth and IDs, flags the visible primary faces, projects the primary
- * vertices, z-tests them. depth_ids is a scratch image with depth and IDs. */
+/* The ID-buffer pre-pass (Sec. 3.4.1, Fig. 3.12, 3.17): draws the
+ * rasterized half of the frame (vt_draw_base), then the VT objects into a
+ * copy of its depth with IDs, flags the visible primary faces, projects the
+ * primary vertices, z-tests them. depth_ids is a scratch image with depth
+ * and IDs. */
 rl_status vt_prepass(vt_run *run, rl_image *depth_ids);
 /* Fills the edge list with the edges of visible primary faces and queues
  * their vertices; then all refinement stages until the list is empty, the
@@ -153,9 +160,21 @@ rl_status vt_prepass(vt_run *run, rl_image *depth_ids);
 rl_status vt_refine(vt_run *run);
 
 /* vt_draw.c -------------------------------------------------------------- */
-/* Draws the frame into run->image: background, the non-VT objects through
- * the raster renderer's code, then the VT leaf faces whose vertices are all
- * sampled, by Gouraud interpolation with deferred textures (Sec. 3.5).
+/* Fig. 3.17, the rasterized half of the frame, drawn once per frame before
+ * the ID pre-pass: background and the non-VT objects through the raster
+ * renderer's code, into run->image (colour, depth, IDs). The pre-pass
+ * starts from its depth; with an update callback a copy is kept, from
+ * which every later full draw starts. Adds its time to stats.time_draw_ms. */
+rl_status vt_draw_base(vt_run *run);
+/* Frees the copy kept by vt_draw_base. */
+void vt_draw_free_base(vt_run *run);
+/* The frame's target: run->image, with the scratch depth layer when the
+ * image has none (the rasterizer needs one). */
+rl_status vt_draw_target(vt_run *run, rl_image *target);
+/* Draws the frame into run->image: the rasterized half (vt_draw_base's,
+ * restored after an earlier full draw), then the VT leaf faces whose
+ * vertices are all sampled, by Gouraud interpolation with deferred
+ * textures (Sec. 3.5).
  * only_new: overdraw (Sec. 3.5.1): draw just the faces of stages after
  * run->drawn_stage onto the existing image, offset towards the eye by
  * eq. 3.16. Counts VT faces in run->stats.faces_drawn (full draws). */
