@@ -601,16 +601,46 @@ static rl_status sec_resolution(void *ctx, cJSON *sec)
 
 /* ----------------------------------------------------------- quality -- */
 
+/* Whitted's time for ref once more, now: the quality section compares
+ * against the faster of this and the reference's own time, so that a slow
+ * moment of a shared machine at the section's start cannot flatter VT. */
+static rl_status retime_reference(bvt *b, const ref_frame *ref, double *ms)
+{
+    rl_renderer *r = NULL;
+    rl_image *img = NULL;
+    rl_camera cam = sized(&b->table_cam, ref->width, ref->height);
+    timed_frame t;
+    rl_status st = make_renderer("whitted", ref->threads, &r);
+    if (st == RL_OK)
+        st = rl_image_create(ref->width, ref->height, RL_LAYER_COLOR, &img);
+    if (st == RL_OK)
+        st = render_timed(r, b->table, &cam, img, b->runs, &t);
+    rl_image_release(img);
+    rl_renderer_release(r);
+    if (st == RL_OK)
+        *ms = t.stats.time_ms;
+    return st;
+}
+
 /* The min_edge sweep: how fast is VT at Whitted's quality? For the default
  * criteria and for HSV alone (the cheapest criterion of Fig. 5.5), min_edge
  * grows until two settings in a row miss the SSIM goal: a coarser mesh is
  * faster, so the fastest setting that meets the goal is the last one
- * before quality drops below it. */
+ * before quality drops below it. Whitted is timed at the section's start
+ * and end, and the faster time is the reference of every ratio. */
+typedef struct quality_row {
+    const char *criteria;
+    double min_edge;
+    timed_frame t;
+    quality q;
+} quality_row;
+
 static rl_status sec_quality(void *ctx, cJSON *sec)
 {
     bvt *b = ctx;
     static const char *const crits[] = { "tree+hsv", "hsv" };
     static const double min_edges[] = { 1, 2, 3, 4, 6, 8, 12, 16, 24, 32 };
+    enum { NUM_CRITS = sizeof crits / sizeof crits[0], NUM_EDGES = sizeof min_edges / sizeof min_edges[0] };
     int w = b->a->width, h = b->a->height;
     ref_frame *ref = NULL;
     rl_status st = reference(b, w, h, b->threads, &ref);
@@ -623,77 +653,86 @@ static rl_status sec_quality(void *ctx, cJSON *sec)
     cJSON_AddItemToObject(sec, "whitted", ref_json(ref));
     add_num(sec, "ssim_goal", SSIM_GOAL);
     add_num(sec, "time_ratio_goal", TIME_RATIO_GOAL);
-    cJSON *rows = cJSON_AddArrayToObject(sec, "runs");
 
+    quality_row rows[NUM_CRITS * NUM_EDGES];
+    int n = 0;
     rl_renderer *r = NULL;
     rl_image *img = NULL;
     rl_camera cam = sized(&b->table_cam, w, h);
     st = make_renderer("vt", b->threads, &r);
     if (st == RL_OK)
         st = rl_image_create(w, h, RL_LAYER_COLOR, &img);
-    printf("\nquality: min_edge sweep, table %s, whitted %.1f ms\n", size, ref->stats.time_ms);
-    printf("%-9s %-8s %9s %6s %9s %10s  %6s %7s  %6s\n", "criteria", "min_edge", "VT ms", "VT/W",
-           "sampled", "rays", "ssimVT", "rmseVT", "ssim");
-    const char *best_crit = NULL;
-    double best_edge = NAN, best_ms = INFINITY, best_ssim = NAN;
-    for (size_t c = 0; st == RL_OK && c < sizeof crits / sizeof crits[0]; c++) {
+    for (int c = 0; st == RL_OK && c < NUM_CRITS; c++) {
         rl_clear_error();
         st = rl_renderer_set(r, "criteria", crits[c]);
         int misses = 0;
-        for (size_t i = 0; st == RL_OK && misses < 2 && i < sizeof min_edges / sizeof min_edges[0]; i++) {
-            timed_frame t;
-            quality q;
+        for (int i = 0; st == RL_OK && misses < 2 && i < NUM_EDGES; i++) {
+            quality_row *row = &rows[n];
+            row->criteria = crits[c];
+            row->min_edge = min_edges[i];
             rl_clear_error();
             st = set_int(r, "min_edge", min_edges[i]);
             if (st == RL_OK)
-                st = render_timed(r, b->table, &cam, img, b->runs, &t);
+                st = render_timed(r, b->table, &cam, img, b->runs, &row->t);
             if (st == RL_OK)
-                st = compare(img, ref->image, ref->mask, ref->mask_pixels, &q);
+                st = compare(img, ref->image, ref->mask, ref->mask_pixels, &row->q);
             if (st != RL_OK)
                 break;
-            bool meets = q.vt_px.ssim >= SSIM_GOAL;
-            misses = meets ? 0 : misses + 1;
-            if (meets && t.stats.time_ms < best_ms) {
-                best_crit = crits[c];
-                best_edge = min_edges[i];
-                best_ms = t.stats.time_ms;
-                best_ssim = q.vt_px.ssim;
-            }
-            cJSON *row = cJSON_CreateObject();
-            cJSON_AddItemToArray(rows, row);
-            cJSON_AddStringToObject(row, "criteria", crits[c]);
-            cJSON_AddNumberToObject(row, "min_edge", min_edges[i]);
-            add_num(row, "time_ms", t.stats.time_ms);
-            add_num(row, "time_ratio_to_whitted", ratio(t.stats.time_ms, ref->stats.time_ms));
-            cJSON_AddNumberToObject(row, "vertices_sampled", (double)t.vt.vertices_sampled);
-            cJSON_AddItemToObject(row, "rays", rays_json(&t.stats));
-            cJSON_AddItemToObject(row, "quality", quality_json(&q));
-            printf("%-9s %-8g %9.1f %6.3f %9llu %10llu  %6.3f %7.4f  %6.3f\n", crits[c],
-                   min_edges[i], t.stats.time_ms, ratio(t.stats.time_ms, ref->stats.time_ms),
-                   (unsigned long long)t.vt.vertices_sampled,
-                   (unsigned long long)rays_total(&t.stats), q.vt_px.ssim, q.vt_px.rmse,
-                   q.full.ssim);
-            fflush(stdout);
+            misses = row->q.vt_px.ssim >= SSIM_GOAL ? 0 : misses + 1;
+            n++;
             note("quality %s min_edge=%g %s: %.1f ms, SSIM %.3f (VT pixels)", crits[c],
-                 min_edges[i], size, t.stats.time_ms, q.vt_px.ssim);
+                 min_edges[i], size, row->t.stats.time_ms, row->q.vt_px.ssim);
         }
     }
     rl_image_release(img);
     rl_renderer_release(r);
+    double again = NAN;
+    if (st == RL_OK)
+        st = retime_reference(b, ref, &again);
     if (st != RL_OK)
         return st;
-    double best_ratio = best_crit ? ratio(best_ms, ref->stats.time_ms) : NAN;
-    bool met = best_crit && best_ratio <= TIME_RATIO_GOAL;
-    if (best_crit) {
+    double whitted_ms = again < ref->stats.time_ms ? again : ref->stats.time_ms;
+    add_num(sec, "whitted_time_ms_end", again);
+    add_num(sec, "whitted_time_ms", whitted_ms);
+
+    printf("\nquality: min_edge sweep, table %s, whitted %.1f ms (faster of %.1f at the start and "
+           "%.1f at the end)\n", size, whitted_ms, ref->stats.time_ms, again);
+    printf("%-9s %-8s %9s %6s %9s %10s  %6s %7s  %6s\n", "criteria", "min_edge", "VT ms", "VT/W",
+           "sampled", "rays", "ssimVT", "rmseVT", "ssim");
+    cJSON *runs = cJSON_AddArrayToObject(sec, "runs");
+    const quality_row *best = NULL;
+    for (int i = 0; i < n; i++) {
+        const quality_row *row = &rows[i];
+        double ms = row->t.stats.time_ms;
+        if (row->q.vt_px.ssim >= SSIM_GOAL && (!best || ms < best->t.stats.time_ms))
+            best = row;
+        cJSON *o = cJSON_CreateObject();
+        cJSON_AddItemToArray(runs, o);
+        cJSON_AddStringToObject(o, "criteria", row->criteria);
+        cJSON_AddNumberToObject(o, "min_edge", row->min_edge);
+        add_num(o, "time_ms", ms);
+        add_num(o, "time_ratio_to_whitted", ratio(ms, whitted_ms));
+        cJSON_AddNumberToObject(o, "vertices_sampled", (double)row->t.vt.vertices_sampled);
+        cJSON_AddItemToObject(o, "rays", rays_json(&row->t.stats));
+        cJSON_AddItemToObject(o, "quality", quality_json(&row->q));
+        printf("%-9s %-8g %9.1f %6.3f %9llu %10llu  %6.3f %7.4f  %6.3f\n", row->criteria,
+               row->min_edge, ms, ratio(ms, whitted_ms),
+               (unsigned long long)row->t.vt.vertices_sampled,
+               (unsigned long long)rays_total(&row->t.stats), row->q.vt_px.ssim, row->q.vt_px.rmse,
+               row->q.full.ssim);
+    }
+    double best_ratio = best ? ratio(best->t.stats.time_ms, whitted_ms) : NAN;
+    bool met = best && best_ratio <= TIME_RATIO_GOAL;
+    if (best) {
         cJSON *o = cJSON_AddObjectToObject(sec, "best");
-        cJSON_AddStringToObject(o, "criteria", best_crit);
-        cJSON_AddNumberToObject(o, "min_edge", best_edge);
-        add_num(o, "time_ms", best_ms);
-        add_num(o, "ssim_vt_pixels", best_ssim);
+        cJSON_AddStringToObject(o, "criteria", best->criteria);
+        cJSON_AddNumberToObject(o, "min_edge", best->min_edge);
+        add_num(o, "time_ms", best->t.stats.time_ms);
+        add_num(o, "ssim_vt_pixels", best->q.vt_px.ssim);
         add_num(o, "time_ratio_to_whitted", best_ratio);
         printf("fastest with SSIM >= %.2f: %s, min_edge=%g, %.1f ms = %.3f x Whitted: "
-               "target <= %.1f %s\n", SSIM_GOAL, best_crit, best_edge, best_ms, best_ratio,
-               TIME_RATIO_GOAL, met ? "met" : "not met");
+               "target <= %.1f %s\n", SSIM_GOAL, best->criteria, best->min_edge,
+               best->t.stats.time_ms, best_ratio, TIME_RATIO_GOAL, met ? "met" : "not met");
     } else {
         cJSON_AddNullToObject(sec, "best");
         printf("no setting reached SSIM >= %.2f on the VT pixels: target not met\n", SSIM_GOAL);
