@@ -44,8 +44,9 @@ static const char bench_sampling_help[] =
     "objects over 6 cube faces) as in Jaehn 2015, Sec. 5.7. Sections:\n"
     "  variants      2-D/3-D x tight/doubled region x 256/1024/4096 samples x\n"
     "                grid, adaptive random, blue noise, blue noise with corners\n"
-    "                (nearest-sample queries), and blue noise with corners with\n"
-    "                the thesis' region-value queries (bnc-region):\n"
+    "                (our defaults: nearest-sample queries, density-over-range\n"
+    "                splits), and blue noise with corners as in the thesis\n"
+    "                (region-value queries, diameter in q: bnc-region):\n"
     "                absolute error at 2000 random validation points (Fig. 5.5)\n"
     "  convergence   quantiles and mean against the sample count, 100..3200\n"
     "                (Table 5.1), 3-D tight region\n"
@@ -58,6 +59,9 @@ static const char bench_sampling_help[] =
     "  --height H        2-D slice height above the scene's floor; default 1.7 m\n"
     "  --samples A,B,..  sample counts of the variants section; default 256,1024,4096\n"
     "  --validation N    random validation points per region; default 2000\n"
+    "  --quality-size Q  measure (default) or diameter (the thesis): the size in\n"
+    "                    q = n / (size * range) of the adaptive variants other\n"
+    "                    than bnc-region (always the thesis')\n"
     "  --threads N       workers; default all\n"
     "  --only A,B        sections: variants, convergence, throughput\n"
     "  --out FILE.json   default bench/results/sampling-YYYYMMDD-HHMMSS.json\n"
@@ -77,6 +81,7 @@ typedef struct bs_args {
     const char *scene, *out;
     long long resolution, validation, threads;
     double height;
+    rl_quality_size quality_size;     /* of the adaptive variants but bnc-region */
     long long counts[MAX_COUNTS];
     int num_counts;
     unsigned sections;
@@ -92,18 +97,20 @@ typedef struct bs_ctx {
 } bs_ctx;
 
 /* Variant k: 0 grid, then adaptive with random, blue noise, corners (all
- * answering queries with the nearest sample of the region, our default),
- * and last blue noise with corners answering with the region's value, as
- * the thesis does (rl_sampling.h: the deviation). */
+ * with our defaults: queries answered by the nearest sample, regions
+ * chosen by density over range), and last blue noise with corners as the
+ * thesis has it: the region's value answers queries, q uses the diameter
+ * (rl_sampling.h: the deviations). */
 static const char *const variant_names[NUM_VARIANTS] = { "grid", "random", "bn", "bn-corners",
                                                          "bnc-region" };
 
-static void variant_desc(int k, rl_sampling_desc *d)
+static void variant_desc(const bs_args *a, int k, rl_sampling_desc *d)
 {
     d->method = k == 0 ? RL_SAMPLING_GRID : RL_SAMPLING_ADAPTIVE;
     d->positions = k == 1 ? RL_POSITIONS_RANDOM
                  : k == 2 ? RL_POSITIONS_BLUE_NOISE : RL_POSITIONS_BLUE_NOISE_CORNERS;
     d->interpolation = k == 4 ? RL_INTERP_REGION : RL_INTERP_NEAREST;
+    d->quality_size = k == 4 ? RL_QUALITY_DIAMETER : a->quality_size;
 }
 
 static rl_aabb region_of(const bs_ctx *c, bool doubled)
@@ -127,6 +134,7 @@ static rl_sampling_desc base_desc(const bs_ctx *c, int dims, bool doubled)
     d.min_side = fminf(1.0f, fmaxf(ex, fmaxf(ey, ez)) / 64.0f);
     d.seed = 1;
     d.workers = (int)c->a->threads;
+    d.quality_size = c->a->quality_size;
     return d;
 }
 
@@ -189,7 +197,7 @@ static rl_status sec_variants(void *ctx, cJSON *sec)
                 double mean_err[NUM_VARIANTS];
                 for (int k = 0; k < NUM_VARIANTS && st == RL_OK; k++) {
                     rl_sampling_desc dk = d;
-                    variant_desc(k, &dk);
+                    variant_desc(c->a, k, &dk);
                     dk.max_samples = (uint32_t)c->a->counts[ci];
                     rl_approx *ap = NULL;
                     double t0 = rl_time_s();
@@ -352,6 +360,17 @@ static bool take_counts(void *a, const char *text)
     return parse_counts(text, a);
 }
 
+static bool take_quality_size(void *ctx, const char *text)
+{
+    bs_args *a = ctx;
+    if (strcmp(text, "measure") != 0 && strcmp(text, "diameter") != 0) {
+        rl_cli_fail(RL_CLI_USAGE, "--quality-size: expected measure or diameter, got '%s'", text);
+        return false;
+    }
+    a->quality_size = strcmp(text, "diameter") == 0 ? RL_QUALITY_DIAMETER : RL_QUALITY_MEASURE;
+    return true;
+}
+
 /* Returns RL_CLI_OK, an exit code, or RL_BENCH_HELP_SHOWN. */
 static int parse_args(int argc, char **argv, bs_args *a)
 {
@@ -366,6 +385,7 @@ static int parse_args(int argc, char **argv, bs_args *a)
         { .name = "--height", .kind = RL_BENCH_OPT_REAL, .real = &a->height, .lo = 0.0,
           .hi = INFINITY, .expect = "metres >= 0" },
         RL_BENCH_CUSTOM("--samples", take_counts, a, &has_counts),
+        RL_BENCH_CUSTOM("--quality-size", take_quality_size, a, NULL),
         RL_BENCH_COUNT("--threads", 1024, &a->threads, NULL),
         RL_BENCH_SECTIONS(section_names, SEC_COUNT, &a->sections),
         RL_BENCH_OUT(&a->out),
@@ -430,6 +450,8 @@ int rl_bench_sampling(int argc, char **argv)
     cJSON_AddStringToObject(params, "property", "visibility (objects)");
     cJSON_AddNumberToObject(params, "resolution", (double)a.resolution);
     cJSON_AddNumberToObject(params, "validation_points", (double)a.validation);
+    cJSON_AddStringToObject(params, "quality_size",
+                            a.quality_size == RL_QUALITY_DIAMETER ? "diameter" : "measure");
     cJSON_AddNumberToObject(params, "height_above_floor", a.height);
     cJSON *thesis = cJSON_AddObjectToObject(root, "thesis");
     cJSON_AddStringToObject(thesis, "scene", "Power Plant, 1171 objects, 22 ms per sample at 1024^2");

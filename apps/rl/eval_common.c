@@ -26,8 +26,11 @@ const char rl_eval_sampling_help[] =
     "  --samples-base N    samples per new region, constant part; default 5\n"
     "  --samples-per-meter F  samples per metre of region diameter; default 0.05\n"
     "  --combine C         region value: mean (default), max or min\n"
-    "  --interp I          point queries: nearest (the nearest sample in the\n"
-    "                      region, default) or region (its combined value, the\n"
+    "  --interp I          point queries: nearest (the nearest sample, default)\n"
+    "                      or region (the region's combined value, the thesis);\n"
+    "                      see docs/evaluation.md\n"
+    "  --quality-size Q    size in the split priority q = n / (size * range):\n"
+    "                      measure (area or volume, default) or diameter (the\n"
     "                      thesis); see docs/evaluation.md\n"
     "  --linear            fit a linear function per region instead\n"
     "  --seed N            default 1\n"
@@ -37,6 +40,7 @@ static const char *const positions_names[] = { "bn-corners", "bn", "random", "gr
 static const char *const method_names[] = { "adaptive", "grid" };
 static const char *const combine_names[] = { "mean", "max", "min" };
 static const char *const interp_names[] = { "nearest", "region" };
+static const char *const quality_size_names[] = { "measure", "diameter" };
 
 const char *rl_eval_positions_name(rl_position_variant v)
 {
@@ -143,6 +147,11 @@ int rl_eval_sampling_arg(int argc, char **argv, int *i, rl_eval_sampling *s)
         if (k < 0)
             return -1;
         d->interpolation = (rl_interpolation)k;
+    } else if (TAKE("--quality-size")) {
+        int k = m < 0 ? -1 : pick("--quality-size", v, quality_size_names, 2);
+        if (k < 0)
+            return -1;
+        d->quality_size = (rl_quality_size)k;
     } else if (TAKE("--combine")) {
         int k = m < 0 ? -1 : pick("--combine", v, combine_names, 3);
         if (k < 0)
@@ -455,6 +464,8 @@ cJSON *rl_eval_desc_json(const rl_sampling_desc *d)
     cJSON_AddStringToObject(o, "combine", combine_names[d->combine]);
     cJSON_AddBoolToObject(o, "linear", d->linear);
     cJSON_AddStringToObject(o, "interpolation", interp_names[d->interpolation]);
+    if (d->method == RL_SAMPLING_ADAPTIVE)
+        cJSON_AddStringToObject(o, "quality_size", quality_size_names[d->quality_size]);
     cJSON_AddNumberToObject(o, "seed", (double)d->seed);
     return o;
 }

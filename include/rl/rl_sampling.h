@@ -93,12 +93,21 @@
  * shared corners on walls included) is a poor guess inside it wherever the
  * property jumps; this is why the thesis found the grid better in one case
  * of Sec. 5.7. By default a query returns the value of the nearest sample
- * in the leaf instead (RL_INTERP_NEAREST; the Voronoi regions of the
- * samples, the dual of the thesis' Delaunay alternative in Alg. 5.3,
- * line 21), so adaptive sampling keeps every sample's resolution where it
- * placed them densely. Region values, statistics and heat maps are
- * unchanged; RL_INTERP_REGION gives the thesis' queries. For the grid
- * method both agree (one sample per cell). Measured in `rl bench sampling`.
+ * instead (RL_INTERP_NEAREST; the Voronoi regions of the samples, the dual
+ * of the thesis' Delaunay alternative in Alg. 5.3, line 21), found across
+ * leaf borders by a branch-and-bound search of the region tree, so adaptive
+ * sampling keeps every sample's resolution where it placed them densely.
+ * Region values, statistics and heat maps are unchanged; RL_INTERP_REGION
+ * gives the thesis' queries. For the grid method both agree (one sample per
+ * cell, at its centre). Measured in `rl bench sampling`.
+ *
+ * The quality rule, a second deviation: the thesis splits the region of
+ * lowest q = n / (diameter * (max - min)). Halving a 2-D region's sides
+ * quarters its area but only halves its diameter, so q favours small
+ * regions that vary, and the rest of the domain stays sparse. With
+ * RL_QUALITY_MEASURE (default) the size is the area or volume: q is the
+ * sample density over the value range. RL_QUALITY_DIAMETER is the thesis.
+ * Measured in `rl bench sampling` (bench/README.md).
  *
  * Failure: RL_ERR_INVALID_ARG for a NULL argument, a bad region (not
  * finite, empty, or inverted; for 2-D only x and z are checked, and height
@@ -147,12 +156,24 @@ typedef enum rl_combine {
 
 /* What a point query returns inside a leaf. */
 typedef enum rl_interpolation {
-    /* The value of the nearest sample held by the leaf (its closed box):
-     * every sample keeps its own resolution. Our default, see below. */
+    /* The value of the nearest sample (of all samples, across leaf
+     * borders): every sample keeps its own resolution. Our default, see
+     * below. */
     RL_INTERP_NEAREST = 0,
     /* The leaf's combined value (Alg. 5.3, lines 23-25): the thesis. */
     RL_INTERP_REGION,
 } rl_interpolation;
+
+/* The size in the quality q = n / (size * (max - min)) that picks the
+ * region to split next (Alg. 5.3, line 9). */
+typedef enum rl_quality_size {
+    /* The region's area (2-D) or volume (3-D): q is then the sample
+     * density over the value range, and a split raises it by the same
+     * factor everywhere. Our default, see below. */
+    RL_QUALITY_MEASURE = 0,
+    /* The region's diameter (Sec. 5.4.2): the thesis. */
+    RL_QUALITY_DIAMETER,
+} rl_quality_size;
 
 typedef struct rl_sampling_desc {          /* zero = default */
     rl_aabb region;                        /* required */
@@ -179,6 +200,7 @@ typedef struct rl_sampling_desc {          /* zero = default */
                                               then use the fit (overrides
                                               interpolation) */
     rl_interpolation interpolation;        /* point queries; default nearest */
+    rl_quality_size quality_size;          /* adaptive; default measure */
     uint64_t seed;
     int workers;                           /* 0 -> rl_property_workers(p) */
     rl_progress_fn progress;               /* done = samples / max_samples */

@@ -387,7 +387,8 @@ rl_status rl_approx_finish(rl_approx *a, uint32_t *const *lists, const uint32_t 
             list = g.out;
         }
         combine_samples(a, list, n, combine, r, set);
-        r->quality = rl_sampling_quality(counts[i], rl_box_diameter(r->box), r->min, r->max);
+        r->quality = rl_sampling_quality(counts[i], rl_sampling_size(a->dims, a->desc.quality_size, r->box),
+                                         r->min, r->max);
         if (!linear)
             continue;
         fit_linear(a, list, n, r);
@@ -580,6 +581,82 @@ const uint64_t *rl_approx_sample_set(const rl_approx *a, uint32_t i)
     return a->sample_sets + (size_t)i * a->set_words;
 }
 
+/* ----------------------------------------------------- nearest sample -- */
+
+typedef struct nearest {
+    double d2;
+    uint32_t sample;
+} nearest;
+
+static double dist2_to_sample(const rl_approx *a, uint32_t s, rl_vec3 pos)
+{
+    double dx = (double)a->sample_pos[s].x - pos.x, dz = (double)a->sample_pos[s].z - pos.z;
+    double dy = a->dims == 3 ? (double)a->sample_pos[s].y - pos.y : 0.0;
+    return dx * dx + dy * dy + dz * dz;
+}
+
+static void scan_leaf(const rl_approx *a, uint32_t leaf, rl_vec3 pos, nearest *best)
+{
+    for (uint32_t k = a->leaf_first[leaf]; k < a->leaf_first[leaf + 1]; ++k) {
+        uint32_t s = a->leaf_samples[k];
+        double d2 = dist2_to_sample(a, s, pos);
+        if (d2 < best->d2 || (d2 == best->d2 && s < best->sample)) {
+            best->d2 = d2;
+            best->sample = s;
+        }
+    }
+}
+
+/* Squared distance from pos to the box over the active axes. */
+static double box_dist2(const rl_approx *a, rl_aabb b, rl_vec3 pos)
+{
+    double d2 = 0.0;
+    for (int k = 0; k < rl_approx_axis_count(a->dims); ++k) {
+        int ax = rl_approx_axis(a->dims, k);
+        double x = rl_v3_get(pos, ax), lo = rl_v3_get(b.min, ax), hi = rl_v3_get(b.max, ax);
+        double d = x < lo ? lo - x : x > hi ? x - hi : 0.0;
+        d2 += d * d;
+    }
+    return d2;
+}
+
+/* Branch and bound over the region tree, nearer children first; a box
+ * farther than the best sample so far cannot hold a nearer one (boxes are
+ * closed and hold every sample inside them). skip_leaf was scanned. */
+static void nearest_in(const rl_approx *a, uint32_t node, rl_vec3 pos, uint32_t skip_leaf, nearest *best)
+{
+    const rl_approx_node *n = &a->nodes[node];
+    if (n->kind == RL_NODE_LEAF) {
+        if (n->leaf != skip_leaf)
+            scan_leaf(a, n->leaf, pos, best);
+        return;
+    }
+    uint32_t count = rl_approx_child_count(a, n);
+    uint32_t order[8];
+    double dist[8];
+    if (count > 8) {                     /* a grid node inside a tree: plain order */
+        for (uint32_t c = 0; c < count; ++c)
+            if (box_dist2(a, a->nodes[n->first_child + c].box, pos) <= best->d2)
+                nearest_in(a, n->first_child + c, pos, skip_leaf, best);
+        return;
+    }
+    for (uint32_t c = 0; c < count; ++c) {
+        double d = box_dist2(a, a->nodes[n->first_child + c].box, pos);
+        uint32_t i = c;
+        for (; i > 0 && dist[i - 1] > d; --i) {
+            dist[i] = dist[i - 1];
+            order[i] = order[i - 1];
+        }
+        dist[i] = d;
+        order[i] = c;
+    }
+    for (uint32_t i = 0; i < count; ++i) {
+        if (dist[i] > best->d2)
+            break;
+        nearest_in(a, n->first_child + order[i], pos, skip_leaf, best);
+    }
+}
+
 rl_status rl_approx_query(const rl_approx *a, rl_vec3 pos, double *value, uint32_t *region)
 {
     if (!a || !value)
@@ -591,21 +668,20 @@ rl_status rl_approx_query(const rl_approx *a, rl_vec3 pos, double *value, uint32
     uint32_t leaf = a->nodes[node].leaf;
     const rl_approx_region *r = &a->leaves[leaf];
     double v = r->value;
-    if (!r->linear && a->desc.interpolation == RL_INTERP_NEAREST && a->leaf_first &&
-        a->leaf_first[leaf + 1] > a->leaf_first[leaf]) {
-        /* The nearest sample of the leaf (rl_sampling.h: the Voronoi
+    if (!r->linear && a->desc.interpolation == RL_INTERP_NEAREST && a->leaf_first && a->sample_count) {
+        /* The nearest sample of all (rl_sampling.h: the Voronoi
          * alternative); ties go to the lower sample index. */
-        double best = INFINITY;
-        for (uint32_t k = a->leaf_first[leaf]; k < a->leaf_first[leaf + 1]; ++k) {
-            uint32_t s = a->leaf_samples[k];
-            double dx = (double)a->sample_pos[s].x - pos.x, dz = (double)a->sample_pos[s].z - pos.z;
-            double dy = a->dims == 3 ? (double)a->sample_pos[s].y - pos.y : 0.0;
-            double d2 = dx * dx + dy * dy + dz * dz;
-            if (d2 < best) {
-                best = d2;
-                v = a->sample_value[s];
-            }
+        nearest best = { INFINITY, RL_APPROX_NONE };
+        if (a->nodes[0].kind == RL_NODE_GRID) {
+            /* One sample per cell, at its centre: a lattice's Voronoi
+             * cells are its grid cells, no search needed. */
+            scan_leaf(a, leaf, pos, &best);
+        } else {
+            scan_leaf(a, leaf, pos, &best);     /* a good first bound */
+            nearest_in(a, 0, pos, leaf, &best);
         }
+        if (best.sample != RL_APPROX_NONE)
+            v = a->sample_value[best.sample];
     } else if (r->linear) {
         v = r->offset;
         for (int k = 0; k < rl_approx_axis_count(a->dims); ++k) {

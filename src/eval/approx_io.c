@@ -118,7 +118,9 @@ static cJSON *save_desc(const rl_sampling_desc *d)
               add(o, "seed", cJSON_CreateString(seed)) && add(o, "workers", cJSON_CreateNumber(d->workers)) &&
               add(o, "linear", cJSON_CreateBool(d->linear)) &&
               add(o, "interpolation", cJSON_CreateString(d->interpolation == RL_INTERP_REGION
-                                                             ? "region" : "nearest"));
+                                                             ? "region" : "nearest")) &&
+              add(o, "quality_size", cJSON_CreateString(d->quality_size == RL_QUALITY_DIAMETER
+                                                            ? "diameter" : "measure"));
     if (!ok) {
         cJSON_Delete(o);
         return NULL;
@@ -350,7 +352,7 @@ static rl_status load_desc(const loader *l, const cJSON *o, int dims, rl_samplin
     static const char *const keys[] = { "method", "positions", "max_samples", "max_seconds", "min_side",
                                         "samples_base", "samples_per_meter", "candidates", "grid_res",
                                         "combine", "seed", "workers", "linear", "interpolation",
-                                        NULL };
+                                        "quality_size", NULL };
     rl_status st = rl_json_check_keys(l->doc, o, "\"desc\"", keys);
     cJSON *c = NULL;
     int e = 0;
@@ -414,6 +416,15 @@ static rl_status load_desc(const loader *l, const cJSON *o, int dims, rl_samplin
         if (strcmp(s, "nearest") != 0 && strcmp(s, "region") != 0)
             return rl_json_error(l->doc, c, "\"interpolation\": expected \"nearest\" or \"region\"");
         d->interpolation = strcmp(s, "region") == 0 ? RL_INTERP_REGION : RL_INTERP_NEAREST;
+    }
+    /* Files written before the option existed were made with the diameter. */
+    d->quality_size = RL_QUALITY_DIAMETER;
+    c = cJSON_GetObjectItemCaseSensitive(o, "quality_size");
+    if (st == RL_OK && c) {
+        const char *s = cJSON_IsString(c) ? c->valuestring : "";
+        if (strcmp(s, "measure") != 0 && strcmp(s, "diameter") != 0)
+            return rl_json_error(l->doc, c, "\"quality_size\": expected \"measure\" or \"diameter\"");
+        d->quality_size = strcmp(s, "diameter") == 0 ? RL_QUALITY_DIAMETER : RL_QUALITY_MEASURE;
     }
     return st;
 }

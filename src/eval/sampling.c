@@ -64,9 +64,10 @@ static rl_status resolve(rl_property *p, const rl_sampling_desc *in, rl_sampling
     }
     d->region = r;
     if ((unsigned)d->method > RL_SAMPLING_GRID || (unsigned)d->positions > RL_POSITIONS_GRID ||
-        (unsigned)d->combine > RL_COMBINE_MIN || (unsigned)d->interpolation > RL_INTERP_REGION)
+        (unsigned)d->combine > RL_COMBINE_MIN || (unsigned)d->interpolation > RL_INTERP_REGION ||
+        (unsigned)d->quality_size > RL_QUALITY_DIAMETER)
         return rl_error(RL_ERR_INVALID_ARG,
-                        "rl_sample_property: unknown method, positions, combine or interpolation");
+                        "rl_sample_property: unknown method, positions, combine, interpolation or quality size");
     if (isnan(d->max_seconds) || d->max_seconds < 0.0)
         return rl_error(RL_ERR_INVALID_ARG, "rl_sample_property: max_seconds %g (expected >= 0)",
                         d->max_seconds);
@@ -492,7 +493,8 @@ static rl_status push_region(adaptive *ad, uint32_t node)
     node_state *st = &ad->ns[node];
     if (!st->splittable)
         return RL_OK;
-    double q = rl_sampling_quality(ad->s.lists[node].n, rl_box_diameter(a->nodes[node].box), st->vmin, st->vmax);
+    double size = rl_sampling_size(a->dims, ad->s.d.quality_size, a->nodes[node].box);
+    double q = rl_sampling_quality(ad->s.lists[node].n, size, st->vmin, st->vmax);
     if (!queue_push(&ad->q, (queue_entry){ q, node, ++st->version }))
         return RL_ERR_OUT_OF_MEMORY;
     return RL_OK;

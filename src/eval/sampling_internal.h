@@ -81,15 +81,25 @@ static inline double rl_box_diameter(rl_aabb b)
     double x = (double)b.max.x - b.min.x, y = (double)b.max.y - b.min.y, z = (double)b.max.z - b.min.z;
     return sqrt(x * x + y * y + z * z);
 }
-/* q = n / (diameter * (max - min)) (Sec. 5.4.2); no samples: 0, flat: +inf. */
-static inline double rl_sampling_quality(uint32_t n, double diameter, double min, double max)
+/* q = n / (size * (max - min)) (Sec. 5.4.2: size = diameter); no samples:
+ * 0, flat: +inf. */
+static inline double rl_sampling_quality(uint32_t n, double size, double min, double max)
 {
     if (n == 0)
         return 0.0;
     double range = max - min;
     if (!(range > 0.0))
         return INFINITY;
-    return (double)n / (diameter * range);
+    return (double)n / (size * range);
+}
+/* The size in q (rl_quality_size): the box's diameter, or its area (2-D,
+ * x and z) or volume (3-D). */
+static inline double rl_sampling_size(int dims, rl_quality_size kind, rl_aabb b)
+{
+    if (kind == RL_QUALITY_DIAMETER)
+        return rl_box_diameter(b);
+    double x = (double)b.max.x - b.min.x, y = (double)b.max.y - b.min.y, z = (double)b.max.z - b.min.z;
+    return dims == 2 ? x * z : x * y * z;
 }
 /* The split coordinate of [lo, hi]: always computed this way, so that
  * neighbouring regions share bit-identical corners (Sec. 5.4.2, corners). */

@@ -135,6 +135,12 @@ static double f_const(rl_vec3 p)
     (void)p;
     return 1.0;
 }
+/* 1 inside a circle of radius 5 around (8, 8), a closed step curve, on a
+ * gentle slope (no region is flat). */
+static double f_circle(rl_vec3 p)
+{
+    return ((p.x - 8.0f) * (p.x - 8.0f) + (p.z - 8.0f) * (p.z - 8.0f) < 25.0f) + 0.05 * p.x;
+}
 static double f_wave(rl_vec3 p) { return sin(p.x) * cos(0.7 * p.z) + 0.1 * p.y; }
 
 /* ---- splits ------------------------------------------------------------- */
@@ -650,6 +656,84 @@ static void test_query_on_a_boundary_picks_the_smaller_index(void **state)
     rl_property_release(p);
 }
 
+/* Nearest-sample queries answer with the nearest sample of all, also when
+ * it lies in another leaf (the Voronoi regions of the samples): checked
+ * against brute force on adaptive trees in 2-D and 3-D, at points near
+ * leaf borders too. */
+static void test_nearest_query_is_the_nearest_of_all_samples(void **state)
+{
+    (void)state;
+    fn_prop fp = { .f = f_wave };
+    rl_property *p = make_property(&fp, 2, 0);
+    for (int dims = 2; dims <= 3; ++dims) {
+        rl_aabb box = dims == 2 ? box2(-6, -4, 7, 5) : box3(-6, -1, -4, 7, 3, 5);
+        rl_approx *a = sample(p, (rl_sampling_desc){ .region = box, .dims = dims, .max_samples = 300,
+                                                     .min_side = 0.2f, .seed = 5 });
+        uint32_t n = rl_approx_sample_count(a), other_leaf = 0;
+        rl_rng rng;
+        rl_rng_seed(&rng, 11, 3);
+        for (int q = 0; q < 2000; ++q) {
+            rl_vec3 x = { box.min.x + (box.max.x - box.min.x) * rl_rng_float(&rng),
+                          dims == 2 ? 0.0f : box.min.y + (box.max.y - box.min.y) * rl_rng_float(&rng),
+                          box.min.z + (box.max.z - box.min.z) * rl_rng_float(&rng) };
+            double best = INFINITY, want = NAN;
+            rl_vec3 at = x;
+            for (uint32_t i = 0; i < n; ++i) {
+                rl_vec3 sp;
+                double sv;
+                assert_int_equal(rl_approx_sample(a, i, &sp, &sv), RL_OK);
+                double dx = sp.x - x.x, dy = dims == 3 ? sp.y - x.y : 0.0, dz = sp.z - x.z;
+                double d2 = dx * dx + dy * dy + dz * dz;
+                if (d2 < best) {
+                    best = d2;
+                    want = sv;
+                    at = sp;
+                }
+            }
+            double v;
+            uint32_t leaf;
+            assert_int_equal(rl_approx_query(a, x, &v, &leaf), RL_OK);
+            assert_near(v, want, 0.0);
+            rl_approx_region r = region(a, leaf);
+            other_leaf += !holds(r.box, at);
+        }
+        /* the case the global search exists for does occur */
+        print_message("dims %d: %u of 2000 nearest samples lie outside the leaf\n", dims, other_leaf);
+        assert_true(other_leaf > (dims == 2 ? 20u : 0u));
+        rl_approx_release(a);
+    }
+    rl_property_release(p);
+}
+
+/* The quality rule: with the diameter (the thesis) the regions along a
+ * step keep being split while the flat rest stays coarse; with the area
+ * (our default) a split raises q by the same factor everywhere, so the
+ * refinement along the step stops earlier and the coarsest region is
+ * smaller. */
+static void test_quality_size_spreads_the_refinement(void **state)
+{
+    (void)state;
+    fn_prop fp = { .f = f_circle };
+    rl_property *p = make_property(&fp, 1, 0);
+    double largest[2] = { 0, 0 }, smallest[2] = { INFINITY, INFINITY };
+    for (int k = 0; k < 2; ++k) {
+        rl_approx *a = sample(p, (rl_sampling_desc){ .region = box2(0, 0, 16, 16), .dims = 2, .max_samples = 400,
+                                                     .min_side = 0.05f, .quality_size = (rl_quality_size)k });
+        for (uint32_t i = 0; i < rl_approx_region_count(a); ++i) {
+            rl_approx_region r = region(a, i);
+            double area = ((double)r.box.max.x - r.box.min.x) * ((double)r.box.max.z - r.box.min.z);
+            largest[k] = fmax(largest[k], area);
+            smallest[k] = fmin(smallest[k], area);
+        }
+        rl_approx_release(a);
+    }
+    print_message("largest / smallest region: measure %g / %g, diameter %g / %g\n", largest[0], smallest[0],
+                  largest[1], smallest[1]);
+    assert_true(largest[RL_QUALITY_MEASURE] < largest[RL_QUALITY_DIAMETER]);
+    assert_true(smallest[RL_QUALITY_MEASURE] > smallest[RL_QUALITY_DIAMETER]);
+    rl_property_release(p);
+}
+
 /* ---- combine and sets ---------------------------------------------------- */
 
 static void test_combine_takes_mean_max_or_min(void **state)
@@ -938,6 +1022,8 @@ int main(void)
         cmocka_unit_test(test_exclusive_properties_are_evaluated_serially),
         cmocka_unit_test(test_grid_method_samples_each_cell_centre_once),
         cmocka_unit_test(test_query_on_a_boundary_picks_the_smaller_index),
+        cmocka_unit_test(test_nearest_query_is_the_nearest_of_all_samples),
+        cmocka_unit_test(test_quality_size_spreads_the_refinement),
         cmocka_unit_test(test_combine_takes_mean_max_or_min),
         cmocka_unit_test(test_leaf_sets_are_unions_of_their_samples_sets),
         cmocka_unit_test(test_blue_noise_keeps_samples_farther_apart_than_random),
