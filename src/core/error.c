@@ -111,6 +111,34 @@ void *rl_realloc_array(void *p, size_t count, size_t size)
     return q;
 }
 
+bool rl_reserve(void **array, size_t *cap, size_t count, size_t item_size, size_t first)
+{
+    if (count <= *cap)
+        return true;
+    size_t n = *cap ? *cap : (first ? first : 1);
+    while (n < count)
+        n = n > SIZE_MAX / 2 ? count : n * 2;
+    void *p = rl_realloc_array(*array, n, item_size);
+    if (!p)
+        return false;
+    *array = p;
+    *cap = n;
+    return true;
+}
+
+bool rl_reserve_u32(void **array, uint32_t *cap, uint64_t count, size_t item_size, uint32_t first)
+{
+    if (count > UINT32_MAX) {
+        rl_error(RL_ERR_OUT_OF_MEMORY, "more than 2^32 elements of %zu bytes", item_size);
+        return false;
+    }
+    size_t c = *cap;
+    if (!rl_reserve(array, &c, (size_t)count, item_size, first))
+        return false;
+    *cap = c > UINT32_MAX ? UINT32_MAX : (uint32_t)c;
+    return true;
+}
+
 char *rl_strdup(const char *s)
 {
     size_t n = strlen(s) + 1;

@@ -24,6 +24,12 @@ void rl_log(rl_log_level level, const char *fmt, ...) RL_PRINTF(2, 3);
 void *rl_alloc(size_t size);                       /* malloc */
 void *rl_calloc(size_t count, size_t size);        /* calloc, overflow-checked */
 void *rl_realloc_array(void *p, size_t count, size_t size); /* overflow-checked */
+/* Grow-by-doubling: makes *array (of item_size elements, capacity *cap) hold
+ * at least count of them, starting at `first` when empty. Leaves both
+ * untouched and returns false when out of memory (the error is set). The
+ * _u32 form is for capacities kept in 32 bits; false also above UINT32_MAX. */
+bool rl_reserve(void **array, size_t *cap, size_t count, size_t item_size, size_t first);
+bool rl_reserve_u32(void **array, uint32_t *cap, uint64_t count, size_t item_size, uint32_t first);
 char *rl_strdup(const char *s);
 
 #endif

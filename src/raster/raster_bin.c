@@ -4,6 +4,7 @@
  * band later walks its list front to back, which is what makes the threaded
  * result identical to the serial one. Items spanning several bands appear in
  * each of them; items with no rows (culled points) in none. */
+#include "core/error.h"
 #include "raster/raster_internal.h"
 
 static const rl_raster_rows *rows_at(const void *items, size_t i, size_t stride)
@@ -14,8 +15,8 @@ static const rl_raster_rows *rows_at(const void *items, size_t i, size_t stride)
 bool rl_raster_bin(rl_raster_bins *bins, const void *items, size_t count, size_t stride,
                    int num_bands)
 {
-    if (!rl_raster_reserve((void **)&bins->off, &bins->off_cap, (size_t)num_bands + 1,
-                           sizeof *bins->off))
+    if (!rl_reserve((void **)&bins->off, &bins->off_cap, (size_t)num_bands + 1,
+                           sizeof *bins->off, 64))
         return false;
     uint32_t *off = bins->off;
     for (int b = 0; b <= num_bands; ++b)
@@ -35,7 +36,7 @@ bool rl_raster_bin(rl_raster_bins *bins, const void *items, size_t count, size_t
         return false;
     for (int b = 0; b < num_bands; ++b)
         off[b + 1] += off[b];
-    if (!rl_raster_reserve((void **)&bins->idx, &bins->idx_cap, total, sizeof *bins->idx))
+    if (!rl_reserve((void **)&bins->idx, &bins->idx_cap, total, sizeof *bins->idx, 64))
         return false;
     /* Fill, advancing off[b] as a cursor; afterwards off[b] is the end of
      * band b, i.e. the start of band b + 1: shift back by one. */

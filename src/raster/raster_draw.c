@@ -65,10 +65,10 @@ static inline void transform_vertex(const rl_raster *r, const rl_vec3 *positions
 
 static rl_status transform(rl_raster *r, const rl_vec3 *positions, uint32_t n, int threads)
 {
-    if (!rl_raster_reserve((void **)&r->clip, &r->vert_cap, n, sizeof *r->clip))
+    if (!rl_reserve((void **)&r->clip, &r->vert_cap, n, sizeof *r->clip, 64))
         return rl_error(RL_ERR_OUT_OF_MEMORY, "rl_raster: %u vertices", n);
     if (!r->perspective &&
-        !rl_raster_reserve((void **)&r->eye_depth, &r->eye_depth_cap, n, sizeof *r->eye_depth))
+        !rl_reserve((void **)&r->eye_depth, &r->eye_depth_cap, n, sizeof *r->eye_depth, 64))
         return rl_error(RL_ERR_OUT_OF_MEMORY, "rl_raster: %u vertices", n);
     rl_vec4 *clip = r->clip;
     float *eye_depth = r->perspective ? NULL : r->eye_depth;

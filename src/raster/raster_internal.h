@@ -135,9 +135,6 @@ static inline int rl_raster_num_bands(int height)
     return (height + RL_RASTER_BAND_ROWS - 1) / RL_RASTER_BAND_ROWS;
 }
 
-/* rasterizer.c: grows a scratch array to hold count items; false on failure
- * (no error recorded: callers inside parallel regions report afterwards). */
-bool rl_raster_reserve(void **array, size_t *cap, size_t count, size_t item_size);
 /* rasterizer.c: makes sure r->chunks holds count chunks. */
 rl_status rl_raster_reserve_chunks(rl_raster *r, int count);
 /* rasterizer.c: threads to use for this draw. */

@@ -69,7 +69,7 @@ rl_status rl_raster_draw_points(rl_raster *r, const rl_raster_points *pts, rl_ra
     rl_status st = rl_raster_reserve_chunks(r, 1);
     if (st != RL_OK)
         return st;
-    if (!rl_raster_reserve((void **)&r->points, &r->point_cap, n, sizeof *r->points))
+    if (!rl_reserve((void **)&r->points, &r->point_cap, n, sizeof *r->points, 64))
         return rl_error(RL_ERR_OUT_OF_MEMORY, "rl_raster_draw_points: %u points", n);
     const bool parallel = n >= PARALLEL_POINTS && threads > 1;
     uint64_t drawn = 0;

@@ -95,23 +95,6 @@ rl_status rl_raster_set_camera(rl_raster *r, rl_image *target, const rl_camera *
     return rl_raster_set_target(r, target, &view, &proj);
 }
 
-bool rl_raster_reserve(void **array, size_t *cap, size_t count, size_t item_size)
-{
-    if (count <= *cap)
-        return true;
-    size_t n = *cap ? *cap : 64;
-    while (n < count)
-        n *= 2;
-    if (n > SIZE_MAX / item_size)
-        return false;
-    void *p = realloc(*array, n * item_size);
-    if (!p)
-        return false;
-    *array = p;
-    *cap = n;
-    return true;
-}
-
 rl_status rl_raster_reserve_chunks(rl_raster *r, int count)
 {
     if (count <= r->chunk_cap)

@@ -147,14 +147,8 @@ static bool heap_less(heap_item a, heap_item b)
 
 static rl_status heap_push(chcpp_state *s, heap_item it)
 {
-    if (s->heap_n == s->heap_cap) {
-        uint32_t cap = s->heap_cap ? 2 * s->heap_cap : 256;
-        heap_item *h = realloc(s->heap, (size_t)cap * sizeof *h);
-        if (!h)
-            return RL_ERR_OUT_OF_MEMORY;
-        s->heap = h;
-        s->heap_cap = cap;
-    }
+    if (!rl_reserve_u32((void **)&s->heap, &s->heap_cap, (uint64_t)s->heap_n + 1, sizeof *s->heap, 256))
+        return RL_ERR_OUT_OF_MEMORY;
     uint32_t i = s->heap_n++;
     while (i > 0 && heap_less(it, s->heap[(i - 1) / 2])) {
         s->heap[i] = s->heap[(i - 1) / 2];
@@ -344,14 +338,8 @@ static rl_status flush_iqueue(frame_ctx *f)
 
 static rl_status iqueue_push(chcpp_state *s, uint32_t n)
 {
-    if (s->iq_n == s->iq_cap) {
-        uint32_t cap = s->iq_cap ? 2 * s->iq_cap : 256;
-        uint32_t *q = realloc(s->iqueue, (size_t)cap * sizeof *q);
-        if (!q)
-            return RL_ERR_OUT_OF_MEMORY;
-        s->iqueue = q;
-        s->iq_cap = cap;
-    }
+    if (!rl_reserve_u32((void **)&s->iqueue, &s->iq_cap, (uint64_t)s->iq_n + 1, sizeof *s->iqueue, 256))
+        return RL_ERR_OUT_OF_MEMORY;
     s->iqueue[s->iq_n++] = n;
     return RL_OK;
 }

@@ -112,21 +112,6 @@ typedef struct refine_ctx {
     double update_ms;   /* primary thread in progressive updates */
 } refine_ctx;
 
-static bool grow(uint32_t **array, uint32_t *cap, uint32_t need)
-{
-    if (need <= *cap)
-        return true;
-    uint32_t n = *cap ? *cap * 2 : 1024;
-    while (n < need)
-        n *= 2;
-    uint32_t *p = rl_realloc_array(*array, n, sizeof *p);
-    if (!p)
-        return false;
-    *array = p;
-    *cap = n;
-    return true;
-}
-
 /* An edge enters the edge list (Fig. 3.4) if it is long enough to be split
  * and visible: on screen (Sec. 3.4.3) and, unless it is primary (the ID
  * buffer already decided those, Fig. 3.12), with at least one end passing
@@ -179,7 +164,7 @@ static void check_forced(refine_ctx *ctx, uint32_t f, uint32_t mid)
         return;
     if (!(vt_face_xi(m, f, slot) > run->set->eps_z) || !(vt_face_height_px(m, f) > FLAT_HEIGHT_PX))
         return;
-    if (!grow(&ctx->forced, &ctx->forced_cap, ctx->forced_count + 1)) {
+    if (!rl_reserve_u32((void **)&ctx->forced, &ctx->forced_cap, (uint64_t)ctx->forced_count + 1, sizeof *ctx->forced, 1024)) {
         run->failed = true;
         return;
     }
@@ -271,7 +256,7 @@ static void run_stage(refine_ctx *ctx, uint16_t stage)
     uint32_t e;
     float length;
     while (vt_heap_top(run->heap) >= band && vt_heap_pop(run->heap, &e, &length)) {
-        if (!grow(&ctx->batch, &ctx->batch_cap, ctx->batch_count + 1)) {
+        if (!rl_reserve_u32((void **)&ctx->batch, &ctx->batch_cap, (uint64_t)ctx->batch_count + 1, sizeof *ctx->batch, 1024)) {
             run->failed = true;
             return;
         }

@@ -69,17 +69,8 @@ static int child_index(rl_aabb cell, rl_aabb b)
 
 static rl_status grow_nodes(rl_octree *t, uint32_t extra)
 {
-    if (t->num_nodes + extra <= t->cap_nodes)
-        return RL_OK;
-    uint32_t cap = t->cap_nodes ? t->cap_nodes : 64;
-    while (cap < t->num_nodes + extra)
-        cap *= 2;
-    rl_octree_node *n = realloc(t->nodes, (size_t)cap * sizeof *n);
-    if (!n)
-        return RL_ERR_OUT_OF_MEMORY;
-    t->nodes = n;
-    t->cap_nodes = cap;
-    return RL_OK;
+    return rl_reserve_u32((void **)&t->nodes, &t->cap_nodes, (uint64_t)t->num_nodes + extra, sizeof *t->nodes, 64)
+               ? RL_OK : RL_ERR_OUT_OF_MEMORY;
 }
 
 /* Fills node `slot` (already allocated, cell/loose/parent/depth set) from

@@ -1,0 +1,68 @@
+/* test_alloc.c: the grow-by-doubling helpers shared by the rasterizer, the
+ * octree, CHC++ and Vertex Tracing (rl_reserve, rl_reserve_u32). */
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <cmocka.h>
+
+#include <stdlib.h>
+#include <string.h>
+
+#include "core/error.h"
+
+static void test_reserve_doubles_from_first_and_keeps_contents(void **state)
+{
+    (void)state;
+    int *a = NULL;
+    size_t cap = 0;
+    assert_true(rl_reserve((void **)&a, &cap, 0, sizeof *a, 8));
+    assert_null(a);                         /* nothing needed, nothing allocated */
+    assert_true(rl_reserve((void **)&a, &cap, 3, sizeof *a, 8));
+    assert_int_equal(cap, 8);
+    for (int i = 0; i < 8; ++i)
+        a[i] = i * i;
+    assert_true(rl_reserve((void **)&a, &cap, 8, sizeof *a, 8));
+    assert_int_equal(cap, 8);               /* enough already */
+    assert_true(rl_reserve((void **)&a, &cap, 9, sizeof *a, 8));
+    assert_int_equal(cap, 16);
+    assert_true(rl_reserve((void **)&a, &cap, 100, sizeof *a, 8));
+    assert_int_equal(cap, 128);
+    for (int i = 0; i < 8; ++i)
+        assert_int_equal(a[i], i * i);
+    free(a);
+}
+
+static void test_reserve_fails_cleanly_on_overflow(void **state)
+{
+    (void)state;
+    double *a = NULL;
+    size_t cap = 0;
+    assert_true(rl_reserve((void **)&a, &cap, 4, sizeof *a, 4));
+    double *before = a;
+    rl_clear_error();
+    assert_false(rl_reserve((void **)&a, &cap, SIZE_MAX / 2, sizeof *a, 4));
+    assert_ptr_equal(a, before);            /* untouched on failure */
+    assert_int_equal(cap, 4);
+    assert_int_equal(rl_last_status(), RL_ERR_OUT_OF_MEMORY);
+    free(a);
+
+    uint32_t *b = NULL;
+    uint32_t cap32 = 0;
+    assert_true(rl_reserve_u32((void **)&b, &cap32, 5, sizeof *b, 4));
+    assert_int_equal(cap32, 8);
+    rl_clear_error();
+    assert_false(rl_reserve_u32((void **)&b, &cap32, (uint64_t)UINT32_MAX + 1, sizeof *b, 4));
+    assert_int_equal(cap32, 8);
+    assert_int_equal(rl_last_status(), RL_ERR_OUT_OF_MEMORY);
+    free(b);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_reserve_doubles_from_first_and_keeps_contents),
+        cmocka_unit_test(test_reserve_fails_cleanly_on_overflow),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
