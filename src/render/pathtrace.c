@@ -450,6 +450,9 @@ static void resolve(const pt_state *s, rl_image *image)
     }
 }
 
+/* sigma_r (bilateral) and kappa (anisotropic diffusion) at 1 spp. */
+#define PT_FILTER_RANGE_1SPP 0.8f
+
 /* Sec. 8.2: filter, faded out as the samples grow. */
 static rl_status apply_filter(const pt_state *s, const pt_settings *set, rl_image *image, float *weight)
 {
@@ -463,7 +466,18 @@ static rl_status apply_filter(const pt_state *s, const pt_settings *set, rl_imag
     if (st == RL_OK) {
         size_t n = (size_t)s->width * s->height;
         memcpy(in->color, image->color, n * sizeof *in->color);
-        st = rl_filter_apply(&(rl_filter_desc){ .kind = set->filter }, in, s->gbuf, out);
+        /* The colour scales of the edge-stopping filters follow the noise,
+         * which falls as the samples grow; the library's fixed 0.1 takes
+         * 1-spp noise for edges and barely filters. Swept against
+         * converged references on cornell and ls-open at 1, 4 and 16 spp
+         * (160x120, G-buffer guided): sigma_r = 0.8 spp^-3/4 stays within
+         * 3 % of the best bilateral RMSE and kappa = 0.8 / spp within 14 %
+         * of the best diffusion, where 0.1 was up to 2.3x the best. */
+        double n_spp = spp > 1.0 ? spp : 1.0;
+        rl_filter_desc fd = { .kind = set->filter,
+                              .sigma_r = PT_FILTER_RANGE_1SPP * (float)pow(n_spp, -0.75),
+                              .kappa = PT_FILTER_RANGE_1SPP / (float)n_spp };
+        st = rl_filter_apply(&fd, in, s->gbuf, out);
         for (size_t i = 0; st == RL_OK && i < n; ++i) {
             rl_vec4 a = in->color[i], b = out->color[i];
             image->color[i] = rl_v4(a.x + w * (b.x - a.x), a.y + w * (b.y - a.y), a.z + w * (b.z - a.z), 1.0f);
