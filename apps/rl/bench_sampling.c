@@ -362,13 +362,7 @@ static bool take_counts(void *a, const char *text)
 
 static bool take_quality_size(void *ctx, const char *text)
 {
-    bs_args *a = ctx;
-    if (strcmp(text, "measure") != 0 && strcmp(text, "diameter") != 0) {
-        rl_cli_fail(RL_CLI_USAGE, "--quality-size: expected measure or diameter, got '%s'", text);
-        return false;
-    }
-    a->quality_size = strcmp(text, "diameter") == 0 ? RL_QUALITY_DIAMETER : RL_QUALITY_MEASURE;
-    return true;
+    return rl_eval_parse_quality_size("--quality-size", text, &((bs_args *)ctx)->quality_size);
 }
 
 /* Returns RL_CLI_OK, an exit code, or RL_BENCH_HELP_SHOWN. */
@@ -450,8 +444,7 @@ int rl_bench_sampling(int argc, char **argv)
     cJSON_AddStringToObject(params, "property", "visibility (objects)");
     cJSON_AddNumberToObject(params, "resolution", (double)a.resolution);
     cJSON_AddNumberToObject(params, "validation_points", (double)a.validation);
-    cJSON_AddStringToObject(params, "quality_size",
-                            a.quality_size == RL_QUALITY_DIAMETER ? "diameter" : "measure");
+    cJSON_AddStringToObject(params, "quality_size", rl_eval_quality_size_name(a.quality_size));
     cJSON_AddNumberToObject(params, "height_above_floor", a.height);
     cJSON *thesis = cJSON_AddObjectToObject(root, "thesis");
     cJSON_AddStringToObject(thesis, "scene", "Power Plant, 1171 objects, 22 ms per sample at 1024^2");

@@ -349,6 +349,18 @@ static rl_status render_timed(rl_renderer *r, const rl_scene *scene, const rl_ca
 }
 
 /* The Whitted frame at width x height with threads, rendered on first use. */
+/* Whitted on the table at img's size: warm-up, then the fastest timed run. */
+static rl_status time_whitted(bvt *b, int threads, rl_image *img, timed_frame *t)
+{
+    rl_renderer *r = NULL;
+    rl_camera cam = sized(&b->table_cam, img->width, img->height);
+    rl_status st = make_renderer("whitted", threads, &r);
+    if (st == RL_OK)
+        st = render_timed(r, b->table, &cam, img, b->runs, t);
+    rl_renderer_release(r);
+    return st;
+}
+
 static rl_status reference(bvt *b, int width, int height, int threads, ref_frame **out)
 {
     for (int i = 0; i < b->num_refs; i++) {
@@ -362,17 +374,12 @@ static rl_status reference(bvt *b, int width, int height, int threads, ref_frame
         return bench_error(b, RL_ERR_LIMIT, "more than %d reference frames", MAX_REFS);
     ref_frame *f = &b->refs[b->num_refs];
     memset(f, 0, sizeof *f);
-    rl_renderer *r = NULL;
-    rl_camera cam = sized(&b->table_cam, width, height);
     timed_frame t;
-    rl_status st = make_renderer("whitted", threads, &r);
-    if (st == RL_OK)
-        st = rl_image_create(width, height, RL_LAYER_COLOR | RL_LAYER_ID, &f->image);
+    rl_status st = rl_image_create(width, height, RL_LAYER_COLOR | RL_LAYER_ID, &f->image);
     if (st == RL_OK && !(f->mask = malloc((size_t)width * (size_t)height)))
         st = RL_ERR_OUT_OF_MEMORY;
     if (st == RL_OK)
-        st = render_timed(r, b->table, &cam, f->image, b->runs, &t);
-    rl_renderer_release(r);
+        st = time_whitted(b, threads, f->image, &t);
     if (st != RL_OK) {
         rl_image_release(f->image);
         free(f->mask);
@@ -606,17 +613,12 @@ static rl_status sec_resolution(void *ctx, cJSON *sec)
  * moment of a shared machine at the section's start cannot flatter VT. */
 static rl_status retime_reference(bvt *b, const ref_frame *ref, double *ms)
 {
-    rl_renderer *r = NULL;
     rl_image *img = NULL;
-    rl_camera cam = sized(&b->table_cam, ref->width, ref->height);
     timed_frame t;
-    rl_status st = make_renderer("whitted", ref->threads, &r);
+    rl_status st = rl_image_create(ref->width, ref->height, RL_LAYER_COLOR, &img);
     if (st == RL_OK)
-        st = rl_image_create(ref->width, ref->height, RL_LAYER_COLOR, &img);
-    if (st == RL_OK)
-        st = render_timed(r, b->table, &cam, img, b->runs, &t);
+        st = time_whitted(b, ref->threads, img, &t);
     rl_image_release(img);
-    rl_renderer_release(r);
     if (st == RL_OK)
         *ms = t.stats.time_ms;
     return st;

@@ -69,6 +69,20 @@ static int pick(const char *option, const char *v, const char *const *names, int
     return -1;
 }
 
+const char *rl_eval_quality_size_name(rl_quality_size q)
+{
+    return (unsigned)q < 2 ? quality_size_names[q] : "?";
+}
+
+bool rl_eval_parse_quality_size(const char *option, const char *text, rl_quality_size *out)
+{
+    int k = pick(option, text, quality_size_names, 2);
+    if (k < 0)
+        return false;
+    *out = (rl_quality_size)k;
+    return true;
+}
+
 static bool parse_number(const char *option, const char *v, double lo, double hi, double *out)
 {
     char *end = NULL;
@@ -148,10 +162,8 @@ int rl_eval_sampling_arg(int argc, char **argv, int *i, rl_eval_sampling *s)
             return -1;
         d->interpolation = (rl_interpolation)k;
     } else if (TAKE("--quality-size")) {
-        int k = m < 0 ? -1 : pick("--quality-size", v, quality_size_names, 2);
-        if (k < 0)
+        if (m < 0 || !rl_eval_parse_quality_size("--quality-size", v, &d->quality_size))
             return -1;
-        d->quality_size = (rl_quality_size)k;
     } else if (TAKE("--combine")) {
         int k = m < 0 ? -1 : pick("--combine", v, combine_names, 3);
         if (k < 0)
@@ -465,7 +477,7 @@ cJSON *rl_eval_desc_json(const rl_sampling_desc *d)
     cJSON_AddBoolToObject(o, "linear", d->linear);
     cJSON_AddStringToObject(o, "interpolation", interp_names[d->interpolation]);
     if (d->method == RL_SAMPLING_ADAPTIVE)
-        cJSON_AddStringToObject(o, "quality_size", quality_size_names[d->quality_size]);
+        cJSON_AddStringToObject(o, "quality_size", rl_eval_quality_size_name(d->quality_size));
     cJSON_AddNumberToObject(o, "seed", (double)d->seed);
     return o;
 }

@@ -68,6 +68,11 @@ rl_status rl_eval_errors(const rl_approx *a, const rl_vec3 *pos, const double *m
 struct cJSON *rl_eval_stats_json(const rl_stats *s);
 struct cJSON *rl_eval_desc_json(const rl_sampling_desc *d);
 const char *rl_eval_positions_name(rl_position_variant v);
+/* "measure" or "diameter" (rl_quality_size), for options and records. */
+const char *rl_eval_quality_size_name(rl_quality_size q);
+/* Parses the value of `option` as a quality size; false after printing a
+ * usage error. */
+bool rl_eval_parse_quality_size(const char *option, const char *text, rl_quality_size *out);
 /* Five-number summary plus mean as table cells (formatted into buf). */
 void rl_eval_stats_cells(const rl_stats *s, char buf[7][32]);
 

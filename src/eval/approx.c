@@ -672,14 +672,11 @@ rl_status rl_approx_query(const rl_approx *a, rl_vec3 pos, double *value, uint32
         /* The nearest sample of all (rl_sampling.h: the Voronoi
          * alternative); ties go to the lower sample index. */
         nearest best = { INFINITY, RL_APPROX_NONE };
-        if (a->nodes[0].kind == RL_NODE_GRID) {
-            /* One sample per cell, at its centre: a lattice's Voronoi
-             * cells are its grid cells, no search needed. */
-            scan_leaf(a, leaf, pos, &best);
-        } else {
-            scan_leaf(a, leaf, pos, &best);     /* a good first bound */
+        scan_leaf(a, leaf, pos, &best);         /* a good first bound */
+        /* The grid method has one sample per cell, at its centre: a
+         * lattice's Voronoi cells are its grid cells, no search needed. */
+        if (a->nodes[0].kind != RL_NODE_GRID)
             nearest_in(a, 0, pos, leaf, &best);
-        }
         if (best.sample != RL_APPROX_NONE)
             v = a->sample_value[best.sample];
     } else if (r->linear) {

@@ -15,8 +15,7 @@ static const rl_raster_rows *rows_at(const void *items, size_t i, size_t stride)
 bool rl_raster_bin(rl_raster_bins *bins, const void *items, size_t count, size_t stride,
                    int num_bands)
 {
-    if (!rl_reserve((void **)&bins->off, &bins->off_cap, (size_t)num_bands + 1,
-                           sizeof *bins->off, 64))
+    if (!rl_reserve((void **)&bins->off, &bins->off_cap, (size_t)num_bands + 1, sizeof *bins->off, 64))
         return false;
     uint32_t *off = bins->off;
     for (int b = 0; b <= num_bands; ++b)

@@ -305,12 +305,12 @@ bool rl_raster_setup(const rl_raster *r, const rl_raster_batch *b, uint32_t firs
         for (int k = 1; k + 1 < n; ++k) {
             if (chunk->num_prims == chunk->prim_cap &&
                 !rl_reserve((void **)&chunk->prims, &chunk->prim_cap, chunk->num_prims + 1,
-                                   sizeof *chunk->prims, 64))
+                            sizeof *chunk->prims, 64))
                 return false;
             rl_raster_prim_src *src = NULL;
             if (layered) {
-                if (!rl_reserve((void **)&chunk->srcs, &chunk->src_cap,
-                                       chunk->num_prims + 1, sizeof *chunk->srcs, 64))
+                if (!rl_reserve((void **)&chunk->srcs, &chunk->src_cap, chunk->num_prims + 1,
+                                sizeof *chunk->srcs, 64))
                     return false;
                 src = &chunk->srcs[chunk->num_prims];
                 src->triangle = t;

@@ -271,6 +271,20 @@ static void copy_layer(void *dst, const void *src, size_t n, size_t size)
         memcpy(dst, src, n * size);
 }
 
+/* The frame's layers into the kept base (save) or back (restore); IDs only
+ * when the frame has them. */
+static void copy_base(vt_run *run, const rl_image *target, bool save)
+{
+    size_t n = (size_t)target->width * (size_t)target->height;
+    bool ids = !(id_flags_of(target) & RL_RASTER_NO_ID);
+    void *frame[4] = { target->color, target->depth, ids ? target->object_id : NULL,
+                       ids ? target->triangle_id : NULL };
+    void *base[4] = { run->base_color, run->base_depth, run->base_object_id, run->base_triangle_id };
+    const size_t size[4] = { sizeof *target->color, sizeof *target->depth, sizeof(uint32_t), sizeof(uint32_t) };
+    for (int k = 0; k < 4; ++k)
+        copy_layer(save ? base[k] : frame[k], save ? frame[k] : base[k], n, size[k]);
+}
+
 rl_status vt_draw_base(vt_run *run)
 {
     double t0 = rl_time_s() * 1000.0;
@@ -302,12 +316,8 @@ rl_status vt_draw_base(vt_run *run)
         }
         if (!run->base_color || !run->base_depth || (ids && (!run->base_object_id || !run->base_triangle_id)))
             st = RL_ERR_OUT_OF_MEMORY;
-        else {
-            copy_layer(run->base_color, target.color, n, sizeof *target.color);
-            copy_layer(run->base_depth, target.depth, n, sizeof *target.depth);
-            copy_layer(run->base_object_id, ids ? target.object_id : NULL, n, sizeof(uint32_t));
-            copy_layer(run->base_triangle_id, ids ? target.triangle_id : NULL, n, sizeof(uint32_t));
-        }
+        else
+            copy_base(run, &target, true);
     }
     run->stats.time_draw_ms += rl_time_s() * 1000.0 - t0;
     return st;
@@ -336,12 +346,7 @@ rl_status vt_draw(vt_run *run, bool only_new)
         /* A full redraw starts again from the rasterized half. */
         if (!run->base_color || !run->base_depth)
             return rl_error(RL_ERR_INTERNAL, "vt: redraw without the kept rasterized image");
-        size_t n = (size_t)target.width * (size_t)target.height;
-        bool ids = !(id_flags_of(&target) & RL_RASTER_NO_ID);
-        copy_layer(target.color, run->base_color, n, sizeof *target.color);
-        copy_layer(target.depth, run->base_depth, n, sizeof *target.depth);
-        copy_layer(ids ? target.object_id : NULL, run->base_object_id, n, sizeof(uint32_t));
-        copy_layer(ids ? target.triangle_id : NULL, run->base_triangle_id, n, sizeof(uint32_t));
+        copy_base(run, &target, false);
     }
     rl_raster *ras = NULL;
     st = open_raster(run, &target, &ras);

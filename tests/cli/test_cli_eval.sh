@@ -15,6 +15,7 @@ expect_error 2 "no scene" "$RL" eval --property visibility
 expect_error 2 "nosuch" "$RL" eval cornell --property nosuch --out "$TMP/e"
 expect_error 2 "resolution" "$RL" eval cornell --property visibility --set resolution=0 --out "$TMP/e"
 expect_error 2 "frob" "$RL" eval cornell --property visibility --set frob=1 --out "$TMP/e"
+expect_error 2 "one of measure, diameter" "$RL" eval cornell --property visibility --quality-size area --out "$TMP/e"
 expect_usage_error "$RL" eval cornell --property visibility --samples 0 --out "$TMP/e"
 expect_usage_error "$RL" eval cornell --property visibility --dims 4 --out "$TMP/e"
 expect_usage_error "$RL" eval cornell --property visibility --region 1,1,1,0,0,0 --out "$TMP/e"
@@ -86,6 +87,7 @@ fi
 # --- rl bench sampling ---
 expect_usage_error "$RL" bench sampling --only nosuch --out "$TMP/b.json"
 expect_usage_error "$RL" bench sampling --samples 0 --out "$TMP/b.json"
+expect_error 2 "one of measure, diameter" "$RL" bench sampling --quality-size area --out "$TMP/b.json"
 run_ok "$RL" bench sampling --quick --out "$TMP/b.json"
 for s in variants convergence throughput bn-corners; do expect_in "$TMP/out" "$s"; done
 if have_python; then
