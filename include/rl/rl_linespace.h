@@ -170,6 +170,24 @@ RL_API bool rl_linespace_pnmt_occluded(const rl_linespace *ls, const rl_ray *ray
  * for PNMT (may be NULL). False (colour untouched) if none. */
 RL_API bool rl_linespace_preillum(const rl_linespace *ls, const rl_ray *ray, rl_vec3 *color,
                                   float *t);
+/* PREILLUM shadow test: whether rl_linespace_preillum finds a surface (the
+ * same answer, without loading the colours). */
+RL_API bool rl_linespace_preillum_occluded(const rl_linespace *ls, const rl_ray *ray);
+
+/* What the PNMT and PREILLUM queries do in the voxel that holds the ray's
+ * point at t_min (the voxel it starts in), where a stored surface is most
+ * often the one the ray leaves:
+ *   RL_LS_ORIGIN_EXACT    PNMT: the closest hit among the voxel's triangles;
+ *                         PREILLUM: records only beyond a tenth of the voxel
+ *                         diagonal (the default, for rays from a surface);
+ *   RL_LS_ORIGIN_RECORDS  records as in every other voxel, for callers that
+ *                         move t_min past the voxel of their surface
+ *                         themselves (the thesis' voxel offset, Sec. 12.1).
+ * A query policy, not build data (a loaded Line Space starts EXACT); not to
+ * be changed while queries run. RL_ERR_INVALID_ARG for NULL or an unknown
+ * rule. */
+typedef enum rl_ls_origin { RL_LS_ORIGIN_EXACT = 0, RL_LS_ORIGIN_RECORDS } rl_ls_origin;
+RL_API rl_status rl_linespace_set_origin(rl_linespace *ls, rl_ls_origin origin);
 
 /* ---- raw arrays, for a GPU upload and for tests ---- */
 typedef struct rl_linespace_data {

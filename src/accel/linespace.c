@@ -69,6 +69,16 @@ rl_status rl_linespace_set_shader(rl_linespace *ls, rl_ls_shade_fn fn, void *use
     return RL_OK;
 }
 
+rl_status rl_linespace_set_origin(rl_linespace *ls, rl_ls_origin origin)
+{
+    if (!ls)
+        return rl_error(RL_ERR_INVALID_ARG, "rl_linespace_set_origin: NULL linespace");
+    if (origin != RL_LS_ORIGIN_EXACT && origin != RL_LS_ORIGIN_RECORDS)
+        return rl_error(RL_ERR_INVALID_ARG, "rl_linespace_set_origin: unknown rule %d", (int)origin);
+    ls->origin = origin;
+    return RL_OK;
+}
+
 size_t rl_ls_memory_bytes(const rl_linespace *ls)
 {
     uint64_t shafts = (uint64_t)ls->num_blocks * ls->shafts_per_voxel;
@@ -81,7 +91,43 @@ size_t rl_ls_memory_bytes(const rl_linespace *ls)
         bytes += (size_t)shafts * 16 * sizeof(uint16_t);
     if (ls->preillum)
         bytes += (size_t)shafts * 8 * sizeof(uint16_t);
+    if (ls->occupied)
+        bytes += (size_t)ls->num_blocks * ls->occ_words * sizeof(uint64_t);
     return bytes;
+}
+
+bool rl_ls_occupancy_alloc(rl_linespace *ls)
+{
+    ls->occ_words = (ls->shafts_per_voxel + 63u) / 64u;
+    size_t words = (size_t)ls->num_blocks * ls->occ_words;
+    ls->occupied = calloc(words ? words : 1, sizeof *ls->occupied);
+    return ls->occupied != NULL;
+}
+
+/* Any payload tells: a shaft with triangles has a non-empty dynamic list, a
+ * first fixed slot (the front half fills first), a PNMT material (ID + 1,
+ * never 0) and a PREILLUM alpha of 1. */
+static bool shaft_has_triangles(const rl_linespace *ls, uint64_t g)
+{
+    if (ls->pnmt)
+        return ls->pnmt[g * 16 + RL_LS_PNMT_MAT] != 0;
+    if (ls->preillum)
+        return ls->preillum[g * 8 + 3] != 0;
+    if (ls->dynamic)
+        return ls->cand_start[g + 1] > ls->cand_start[g];
+    return ls->cand[g * (uint64_t)ls->k] != RL_NONE;
+}
+
+void rl_ls_occupancy_from_payloads(rl_linespace *ls)
+{
+    const uint32_t S = ls->shafts_per_voxel;
+    #pragma omp parallel for schedule(static)
+    for (long b = 0; b < (long)ls->num_blocks; ++b) {
+        uint64_t *w = ls->occupied + (uint64_t)b * ls->occ_words;
+        for (uint32_t s = 0; s < S; ++s)
+            if (shaft_has_triangles(ls, (uint64_t)b * S + s))
+                w[s >> 6] |= 1ull << (s & 63u);
+    }
 }
 
 rl_status rl_linespace_commit(rl_linespace *ls)

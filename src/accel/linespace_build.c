@@ -449,6 +449,8 @@ static bool build_voxel(rl_linespace *ls, const rl_ls_geometry *geo, workspace *
             insertion_sort(list, m, false);
         if (m == 0)
             ++vs->empty;
+        else
+            ls->occupied[(uint64_t)b * ls->occ_words + (s >> 6)] |= 1ull << (s & 63u);
         vs->sum += m;
         if (m > vs->max)
             vs->max = m;
@@ -523,8 +525,10 @@ void rl_ls_free_arrays(rl_linespace *ls)
     free(ls->cand_start);
     free(ls->pnmt);
     free(ls->preillum);
+    free(ls->occupied);
     ls->voxel_slot = ls->cand = ls->cand_start = NULL;
     ls->pnmt = ls->preillum = NULL;
+    ls->occupied = NULL;
 }
 
 rl_status rl_ls_build(rl_linespace *ls)
@@ -575,6 +579,8 @@ rl_status rl_ls_build(rl_linespace *ls)
         st = RL_ERR_OUT_OF_MEMORY;
     if (!st && (ls->payloads & RL_LS_PREILLUM) &&
         !(ls->preillum = malloc((size_t)(shafts ? shafts : 1) * 8 * sizeof *ls->preillum)))
+        st = RL_ERR_OUT_OF_MEMORY;
+    if (!st && !rl_ls_occupancy_alloc(ls))
         st = RL_ERR_OUT_OF_MEMORY;
     rl_ls_geometry geo = { 0 };
     if (!st)

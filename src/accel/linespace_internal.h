@@ -40,6 +40,7 @@ struct rl_linespace {
     rl_ls_shade_fn shade;
     void *shade_user;
     bool committed;
+    rl_ls_origin origin;          /* query rule in the start voxel */
     uint32_t shafts_per_voxel;    /* S = 15·N^4 */
     uint32_t num_cells, num_blocks;
     uint32_t *voxel_slot;         /* num_cells */
@@ -48,8 +49,19 @@ struct rl_linespace {
     uint64_t num_cand;            /* entries of cand */
     uint16_t *pnmt;               /* blocks·S·16 */
     uint16_t *preillum;           /* blocks·S·8 */
+    /* One bit per shaft, set if any triangle overlaps it (its list is not
+     * empty; it has PNMT and PREILLUM records). Derived data, not saved:
+     * 15·N^4 bits per voxel are 1/256 of the PNMT records, so the walk
+     * skips empty shafts in cache instead of loading a record from memory. */
+    uint64_t *occupied;           /* blocks·occ_words */
+    uint32_t occ_words;           /* per block: ceil(S / 64) */
     rl_linespace_stats stats;
 };
+
+static inline bool rl_ls_shaft_occupied(const rl_linespace *ls, uint32_t block, uint32_t shaft)
+{
+    return (ls->occupied[(uint64_t)block * ls->occ_words + (shaft >> 6)] >> (shaft & 63u)) & 1u;
+}
 
 /* ---- shaft geometry (linespace_shaft.c) ---- */
 
@@ -124,6 +136,10 @@ void rl_ls_surface_at(const rl_linespace *ls, uint32_t tri, float u, float v, rl
 
 /* ---- build and queries ---- */
 rl_status rl_ls_build(rl_linespace *ls);
+/* Allocates ls->occupied (zeroed); false when out of memory. */
+bool rl_ls_occupancy_alloc(rl_linespace *ls);
+/* Sets every bit from the payload arrays (after a load). */
+void rl_ls_occupancy_from_payloads(rl_linespace *ls);
 size_t rl_ls_memory_bytes(const rl_linespace *ls);
 void rl_ls_free_arrays(rl_linespace *ls);
 

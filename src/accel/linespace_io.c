@@ -374,6 +374,11 @@ rl_status rl_linespace_load(const rl_accel *grid, const char *path, rl_linespace
     st = check_contents(ls, path);
     if (st)
         goto done;
+    if (!rl_ls_occupancy_alloc(ls)) {
+        st = rl_error(RL_ERR_OUT_OF_MEMORY, "%s: out of memory", path);
+        goto done;
+    }
+    rl_ls_occupancy_from_payloads(ls);
     rl_linespace_stats *t = &ls->stats;
     t->filled_voxels = h.num_blocks;
     t->shafts = shafts;

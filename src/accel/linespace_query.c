@@ -32,7 +32,17 @@
  * voxel. No shading happens at query time, so the origin voxel cannot be
  * answered exactly: there a record counts only beyond t_min plus a tenth of
  * the voxel's diagonal (in ray parameter), which keeps the surface the ray
- * starts from out; otherwise the walk goes on. */
+ * starts from out; otherwise the walk goes on.
+ *
+ * RL_LS_ORIGIN_RECORDS drops both origin-voxel rules (the caller offsets
+ * t_min, as the thesis does).
+ *
+ * EMPTY SHAFTS. Every walk checks the shaft's occupancy bit first: a shaft
+ * no triangle overlaps has no candidates and no records, and its bit sits in
+ * a small array that stays in cache, where a record costs a load from
+ * memory. Shadow tests (PNMT, PREILLUM) also skip decoding a filled shaft's
+ * record when the whole voxel lies inside the ray's interval, since the
+ * stored point lies in its voxel. Answers are the same as without both. */
 #include <math.h>
 #include <string.h>
 
@@ -58,23 +68,37 @@ static bool usable(const rl_linespace *ls, const rl_ray *ray)
     return ls && ray && ls->committed && ray_is_valid(ray);
 }
 
-/* The shaft of the ray's line in the voxel at cell coordinates xyz (Sec.
- * 4.3), RL_NONE if the entry and exit share a face or the line misses the
- * box by rounding. */
-static uint32_t shaft_of_ray(const rl_linespace *ls, const int xyz[3], const rl_ray *r, bool *forward)
+/* The ray's line in cell units of the whole grid (cell xyz is the unit
+ * cube at xyz), set up once per query so that each voxel costs no
+ * division. */
+typedef struct cell_line {
+    double o[3], d[3], inv[3];
+} cell_line;
+
+static void cell_line_setup(const rl_linespace *ls, const rl_ray *r, cell_line *l)
 {
-    rl_aabb box = rl_grid_cell_bounds(ls->grid, xyz[0], xyz[1], xyz[2]);
-    double o[3], d[3], tn = -INFINITY, tf = INFINITY;
     for (int a = 0; a < 3; ++a) {
-        double lo = rl_vget(box.min, a), ext = (double)rl_vget(box.max, a) - lo;
-        o[a] = ((double)rl_vget(r->o, a) - lo) / ext;
-        d[a] = (double)rl_vget(r->d, a) / ext;
-        if (d[a] == 0.0) {
+        double size = rl_vget(ls->grid->cell_size, a);
+        l->o[a] = ((double)rl_vget(r->o, a) - rl_vget(ls->grid->bounds.min, a)) / size;
+        l->d[a] = (double)rl_vget(r->d, a) / size;
+        l->inv[a] = l->d[a] != 0.0 ? 1.0 / l->d[a] : 0.0;
+    }
+}
+
+/* The shaft of the line in the voxel at cell coordinates xyz (Sec. 4.3),
+ * RL_NONE if the entry and exit share a face or the line misses the box by
+ * rounding. */
+static uint32_t shaft_of_ray(const rl_linespace *ls, const int xyz[3], const cell_line *l, bool *forward)
+{
+    double o[3], tn = -INFINITY, tf = INFINITY;
+    for (int a = 0; a < 3; ++a) {
+        o[a] = l->o[a] - (double)xyz[a];
+        if (l->d[a] == 0.0) {
             if (o[a] < 0.0 || o[a] > 1.0)
                 return RL_NONE;
             continue;
         }
-        double t0 = -o[a] / d[a], t1 = (1.0 - o[a]) / d[a];
+        double t0 = -o[a] * l->inv[a], t1 = (1.0 - o[a]) * l->inv[a];
         if (t0 > t1) {
             double s = t0; t0 = t1; t1 = s;
         }
@@ -85,8 +109,8 @@ static uint32_t shaft_of_ray(const rl_linespace *ls, const int xyz[3], const rl_
         return RL_NONE;
     double entry[3], exit[3];
     for (int a = 0; a < 3; ++a) {
-        entry[a] = o[a] + d[a] * tn;
-        exit[a] = o[a] + d[a] * tf;
+        entry[a] = o[a] + l->d[a] * tn;
+        exit[a] = o[a] + l->d[a] * tf;
     }
     return rl_ls_shaft_of_unit(ls->n, entry, exit, forward);
 }
@@ -185,6 +209,8 @@ bool rl_linespace_intersect(const rl_linespace *ls, rl_ray *ray, rl_hit *hit)
     rl_grid_dda it;
     if (!rl_grid_dda_begin(ls->grid, ray, &it))
         return false;
+    cell_line line;
+    cell_line_setup(ls, ray, &line);
     rl_ray_watertight w;
     rl_ray_watertight_setup(ray, &w);
     uint32_t mailbox[MAILBOX_SIZE];
@@ -197,8 +223,9 @@ bool rl_linespace_intersect(const rl_linespace *ls, rl_ray *ray, rl_hit *hit)
         uint32_t block = ls->voxel_slot[cell];
         if (block != RL_NONE) {
             bool fwd;
-            uint32_t shaft = shaft_of_ray(ls, it.current, ray, &fwd);
-            test_list(ls, &w, ray, candidates(ls, cell, block, shaft, false), mailbox, &best, &limit);
+            uint32_t shaft = shaft_of_ray(ls, it.current, &line, &fwd);
+            if (shaft == RL_NONE || rl_ls_shaft_occupied(ls, block, shaft))
+                test_list(ls, &w, ray, candidates(ls, cell, block, shaft, false), mailbox, &best, &limit);
         }
         if (best.id != RL_NONE && best.t <= t1 - T_SLACK_REL * fabsf(t1))
             break;
@@ -221,6 +248,8 @@ bool rl_linespace_occluded(const rl_linespace *ls, const rl_ray *ray)
     rl_grid_dda it;
     if (!rl_grid_dda_begin(ls->grid, ray, &it))
         return false;
+    cell_line line;
+    cell_line_setup(ls, ray, &line);
     rl_ray_watertight w;
     rl_ray_watertight_setup(ray, &w);
     uint32_t mailbox[MAILBOX_SIZE];
@@ -232,7 +261,9 @@ bool rl_linespace_occluded(const rl_linespace *ls, const rl_ray *ray)
         if (block == RL_NONE)
             continue;
         bool fwd;
-        uint32_t shaft = shaft_of_ray(ls, it.current, ray, &fwd);
+        uint32_t shaft = shaft_of_ray(ls, it.current, &line, &fwd);
+        if (shaft != RL_NONE && !rl_ls_shaft_occupied(ls, block, shaft))
+            continue;
         if (any_hit(ls, &w, ray, candidates(ls, cell, block, shaft, false), mailbox, ray->t_max))
             return true;
     }
@@ -284,9 +315,24 @@ static bool origin_hit(const rl_linespace *ls, const rl_ray *ray, uint32_t cell,
     return true;
 }
 
+/* Whether every point of voxel xyz projects on the ray strictly inside
+ * (lo, t_max): a stored point (clamped to its voxel, linespace_build.c)
+ * then needs no decoding for a shadow test. The centre's projection +- the
+ * half diagonal over |d| bounds every point's; the slack covers rounding,
+ * so the answer is always the one the record gives. */
+static bool voxel_within(const rl_linespace *ls, const int xyz[3], const rl_ray *ray, float lo)
+{
+    rl_aabb box = rl_grid_cell_bounds(ls->grid, xyz[0], xyz[1], xyz[2]);
+    float tc = project_t(ray, rl_scale(rl_add(box.min, box.max), 0.5f));
+    float r = 0.5f * rl_length(ls->grid->cell_size) / rl_length(ray->d);
+    float slack = 1e-4f * r + 1e-6f * fabsf(tc);
+    return tc - r - slack > lo && tc + r + slack < ray->t_max;
+}
+
+/* Whether the first voxel walked gets the start-voxel rule. */
 static bool origin_inside(const rl_linespace *ls, const rl_ray *ray)
 {
-    return rl_aabb_contains(ls->grid->bounds, rl_ray_at(ray, ray->t_min));
+    return ls->origin == RL_LS_ORIGIN_EXACT && rl_aabb_contains(ls->grid->bounds, rl_ray_at(ray, ray->t_min));
 }
 
 static bool pnmt_walk(const rl_linespace *ls, const rl_ray *ray, rl_ls_surface *out)
@@ -296,6 +342,8 @@ static bool pnmt_walk(const rl_linespace *ls, const rl_ray *ray, rl_ls_surface *
     rl_grid_dda it;
     if (!rl_grid_dda_begin(ls->grid, ray, &it))
         return false;
+    cell_line line;
+    cell_line_setup(ls, ray, &line);
     bool first = origin_inside(ls, ray);
     uint32_t cell;
     float t0, t1;
@@ -306,13 +354,17 @@ static bool pnmt_walk(const rl_linespace *ls, const rl_ray *ray, rl_ls_surface *
         if (block == RL_NONE)
             continue;
         bool fwd = true;
-        uint32_t shaft = shaft_of_ray(ls, it.current, ray, &fwd);
+        uint32_t shaft = shaft_of_ray(ls, it.current, &line, &fwd);
+        if (shaft != RL_NONE && !rl_ls_shaft_occupied(ls, block, shaft))
+            continue;             /* no triangle in the shaft: no record either */
         if (origin || shaft == RL_NONE) {
             /* Origin voxel (our change to Sec. 12.1) and grazing lines: exact. */
             if (origin_hit(ls, ray, cell, block, shaft, t1, out))
                 return true;
             continue;
         }
+        if (!out && voxel_within(ls, it.current, ray, ray->t_min))
+            return true;          /* the record lies in the voxel: inside (t_min, t_max) */
         const uint16_t *rec = ls->pnmt + ((uint64_t)block * ls->shafts_per_voxel + shaft) * 16 +
                               (fwd ? 0 : RL_LS_PNMT_RECORD);
         rl_ls_surface s;
@@ -344,13 +396,17 @@ bool rl_linespace_pnmt_occluded(const rl_linespace *ls, const rl_ray *ray)
     return pnmt_walk(ls, ray, NULL);
 }
 
-bool rl_linespace_preillum(const rl_linespace *ls, const rl_ray *ray, rl_vec3 *color, float *t_out)
+/* PREILLUM walk; color NULL: a shadow test, which needs no record where a
+ * filled shaft's surface must lie inside the ray's interval. */
+static bool preillum_walk(const rl_linespace *ls, const rl_ray *ray, rl_vec3 *color, float *t_out)
 {
-    if (!usable(ls, ray) || !ls->preillum || !color)
+    if (!usable(ls, ray) || !ls->preillum)
         return false;
     rl_grid_dda it;
     if (!rl_grid_dda_begin(ls->grid, ray, &it))
         return false;
+    cell_line line;
+    cell_line_setup(ls, ray, &line);
     bool first = origin_inside(ls, ray);
     float dlen = rl_length(ray->d);
     float margin = ORIGIN_MARGIN_REL * rl_length(ls->grid->cell_size) / dlen;
@@ -363,26 +419,38 @@ bool rl_linespace_preillum(const rl_linespace *ls, const rl_ray *ray, rl_vec3 *c
         if (block == RL_NONE)
             continue;
         bool fwd = true;
-        uint32_t shaft = shaft_of_ray(ls, it.current, ray, &fwd);
-        if (shaft == RL_NONE)
+        uint32_t shaft = shaft_of_ray(ls, it.current, &line, &fwd);
+        if (shaft == RL_NONE || !rl_ls_shaft_occupied(ls, block, shaft))
             continue;
+        float lo = origin ? ray->t_min + margin : ray->t_min;
         uint64_t g = (uint64_t)block * ls->shafts_per_voxel + shaft;
-        const uint16_t *c = ls->preillum + g * 8 + (fwd ? 0 : 4);
-        if (rl_half_to_float(c[3]) == 0.0f)
-            continue;
         float t = 0.5f * (t0 + t1);
         if (ls->pnmt) {
+            if (!color && voxel_within(ls, it.current, ray, lo))
+                return true;
             rl_ls_surface s;
             if (decode_pnmt(ls, it.current, ls->pnmt + g * 16 + (fwd ? 0 : RL_LS_PNMT_RECORD), &s))
                 t = project_t(ray, s.p);
         }
-        float lo = origin ? ray->t_min + margin : ray->t_min;
         if (!(t > lo && t < ray->t_max))
             continue;
-        *color = rl_v3(rl_half_to_float(c[0]), rl_half_to_float(c[1]), rl_half_to_float(c[2]));
+        if (color) {
+            const uint16_t *c = ls->preillum + g * 8 + (fwd ? 0 : 4);
+            *color = rl_v3(rl_half_to_float(c[0]), rl_half_to_float(c[1]), rl_half_to_float(c[2]));
+        }
         if (t_out)
             *t_out = t;
         return true;
     }
     return false;
+}
+
+bool rl_linespace_preillum(const rl_linespace *ls, const rl_ray *ray, rl_vec3 *color, float *t_out)
+{
+    return color && preillum_walk(ls, ray, color, t_out);
+}
+
+bool rl_linespace_preillum_occluded(const rl_linespace *ls, const rl_ray *ray)
+{
+    return preillum_walk(ls, ray, NULL, NULL);
 }

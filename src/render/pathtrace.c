@@ -22,7 +22,8 @@
  *   checkerboard = false       Sec. 8.5
  *   accumulate = true          Sec. 6.5, eq. 8
  *   filter = none, filter_fade = 16    Sec. 8.2
- *   grid_res = 0 (grid heuristic), ls_n = 5 [5], ls_k = 8, ls_dynamic = true
+ *   grid_res = 0 (grid heuristic), ls_n = 5 [5], ls_k = 8, ls_dynamic = true,
+ *   ls_origin = offset [offset]
  *   shadowmap_size = 1024 [1024], light_samples = 1, threads = 0 (all)
  *
  * A frame (Sec. 5.1, Fig. 8): build what the backends need (once per
@@ -77,6 +78,7 @@ static const char *const shadow_choices[] = { "bvh", "grid", "embree", "ls-candi
                                               "shadowmap", NULL };
 static const char *const diffuse_choices[] = { "bvh", "grid", "embree", "ls-candidates", "ls-preillum", "ls-pnmt",
                                                NULL };
+static const char *const ls_origin_choices[] = { "offset", "exact", NULL };
 static const char *const primary_choices[] = { "trace", "raster", NULL };
 /* Order = rl_filter_kind. */
 static const char *const filter_choices[] = { "none", "gauss", "bilateral", "aniso", "kuwahara", NULL };
@@ -108,6 +110,9 @@ static const rl_option_info pt_options[] = {
       0, 1024, NULL },
     { "ls_n", RL_OPT_INT, "5", "Line Space patches per voxel face side (Sec. 9.2: 5)", 1, RL_LS_MAX_N, NULL },
     { "ls_k", RL_OPT_INT, "8", "Line Space fixed candidate slots per shaft (even)", 2, RL_LS_MAX_K, NULL },
+    { "ls_origin", RL_OPT_ENUM, "offset",
+      "PNMT/preillum rays: offset (start one voxel diagonal away, Sec. 12.1) or exact (start at the "
+      "surface; the start voxel's triangles answer PNMT rays exactly)", 0, 0, ls_origin_choices },
     { "ls_dynamic", RL_OPT_BOOL, "true", "exact per-shaft candidate lists (prefix sums, Sec. 7.1.1)", 0, 0, NULL },
     { "shadowmap_size", RL_OPT_INT, "1024", "texels per shadow-map face side (Sec. 8.6)", 16, 16384, NULL },
     { "light_samples", RL_OPT_INT, "1", "shadow rays per quad light and vertex", 1, 1024, NULL },
@@ -230,6 +235,7 @@ static void read_settings(const rl_renderer *r, pt_settings *set)
     set->ls_n = (int)rl_renderer_opt_int(r, "ls_n");
     set->ls_k = (int)rl_renderer_opt_int(r, "ls_k");
     set->ls_dynamic = rl_renderer_opt_bool(r, "ls_dynamic");
+    set->ls_origin_exact = rl_renderer_opt_enum(r, "ls_origin") == 1;
     set->shadowmap_size = (int)rl_renderer_opt_int(r, "shadowmap_size");
     set->light_samples = (int)rl_renderer_opt_int(r, "light_samples");
     set->background = rl_renderer_opt_color(r, "background");

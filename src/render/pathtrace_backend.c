@@ -225,6 +225,9 @@ rl_status rl_pt_backends_prepare(pt_backends *b, const rl_scene *scene, const pt
         /* The Line Space lives in the grid's voxels (Sec. 4.2, 6.1). */
         if ((st = build_exact(b, scene, RL_ACCEL_GRID, set->grid_res, threads, built_ms)))
             return st;
+        /* The pre-illuminated colours' shadow rays go through the BVH. */
+        if ((payloads & RL_LS_PREILLUM) && (st = build_exact(b, scene, RL_ACCEL_BVH, 0, threads, built_ms)))
+            return st;
         bool same = b->ls && b->ls_n == set->ls_n && b->ls_k == set->ls_k && b->ls_dynamic == set->ls_dynamic &&
                     (b->ls_payloads & payloads) == payloads;
         if (!same) {
@@ -254,6 +257,10 @@ rl_status rl_pt_backends_prepare(pt_backends *b, const rl_scene *scene, const pt
                                   ext.z / (float)(gs.grid_res[2] > 0 ? gs.grid_res[2] : 1));
             b->ls_offset = rl_length(voxel);
         }
+        /* A query rule, no rebuild: with the offset the start voxel is
+         * already past the surface, so records answer there too. */
+        rl_linespace_set_origin(b->ls, set->ls_origin_exact ? RL_LS_ORIGIN_EXACT : RL_LS_ORIGIN_RECORDS);
+        b->ls_start = set->ls_origin_exact ? 0.0f : b->ls_offset;
     }
     if (set->shadow == RL_PT_BACKEND_SHADOWMAP && (!b->sm || b->sm_size != set->shadowmap_size)) {
         rl_shadowmap_release(b->sm);

@@ -30,6 +30,7 @@ typedef enum pt_primary { PT_PRIMARY_TRACE = 0, PT_PRIMARY_RASTER } pt_primary;
 typedef struct pt_settings {
     int spp, max_depth, rr_depth, light_samples, threads;
     bool rr, checkerboard, accumulate, ls_dynamic;
+    bool ls_origin_exact;          /* ls_origin=exact, else the voxel offset */
     rl_rng_gpu_kind rng;
     uint64_t seed;
     rl_pt_backend shadow, diffuse;
@@ -55,8 +56,9 @@ typedef struct pt_backends {
     bool ls_dynamic;
     unsigned ls_payloads;
     double ls_ms;
-    float ls_offset;               /* PNMT / preillum queries start one voxel
-                                    * diagonal away (Sec. 12.1-12.2: "Voxel-Offset") */
+    float ls_offset;               /* one voxel diagonal (Sec. 12.1-12.2: "Voxel-Offset") */
+    float ls_start;                /* where PNMT / preillum rays start: ls_offset,
+                                    * or 0 with ls_origin=exact */
     rl_shadowmap *sm;
     int sm_size;
     double sm_ms;

@@ -145,7 +145,7 @@ bool rl_pt_closest(const pt_ctx *ctx, rl_pt_backend backend, rl_ray *ray, pt_sur
         return rl_pt_surface_at_hit(ctx->data, &hit, ray->o, ray->d, s);
     case RL_PT_BACKEND_LS_PNMT: {
         rl_ls_surface rec;
-        ray->t_min = rl_maxf(ray->t_min, b->ls_offset);
+        ray->t_min = rl_maxf(ray->t_min, b->ls_start);
         if (!rl_linespace_pnmt_intersect(b->ls, ray, &rec))
             return false;
         return surface_of_record(ctx->data, &rec, rl_neg(rl_normalize(ray->d)), s);
@@ -175,21 +175,20 @@ static bool visible(const pt_ctx *ctx, const pt_surface *s, rl_vec3 l, float dis
     case RL_PT_BACKEND_LS_CANDIDATES:
         return !rl_linespace_occluded(b->ls, &ray);
     case RL_PT_BACKEND_LS_PNMT:
-        /* Voxel offset at both ends: the light's own voxel holds the lamp
+        /* Voxel offset at the light's end always (its voxel holds the lamp
          * and what it is mounted on, which no stored point can tell apart
-         * from an occluder (pathtrace_backend.c). */
-        ray.t_min = b->ls_offset;
+         * from an occluder), at the surface's with ls_origin=offset
+         * (pathtrace_backend.c). */
+        ray.t_min = rl_maxf(ray.t_min, b->ls_start);
         ray.t_max -= b->ls_offset;
         return !(ray.t_min < ray.t_max && rl_linespace_pnmt_occluded(b->ls, &ray));
     case RL_PT_BACKEND_LS_PREILLUM: {
         /* The pre-illuminated Line Space knows the first stored surface
          * along the ray and its distance: occluded if one lies before the
          * light. */
-        rl_vec3 col;
-        float t = INFINITY;
-        ray.t_min = b->ls_offset;
+        ray.t_min = rl_maxf(ray.t_min, b->ls_start);
         ray.t_max -= b->ls_offset;
-        return !(ray.t_min < ray.t_max && rl_linespace_preillum(b->ls, &ray, &col, &t) && t < ray.t_max);
+        return !(ray.t_min < ray.t_max && rl_linespace_preillum_occluded(b->ls, &ray));
     }
     default:
         return true;
@@ -320,7 +319,7 @@ rl_vec3 rl_pt_trace_path(const pt_ctx *ctx, const pt_surface *first, rl_rng_gpu 
         c->rays[type]++;
         if (ctx->diffuse == RL_PT_BACKEND_LS_PREILLUM) {
             rl_vec3 col;
-            ray.t_min = ctx->b->ls_offset;
+            ray.t_min = rl_maxf(ray.t_min, ctx->b->ls_start);
             c->trace_q[RL_PT_BACKEND_LS_PREILLUM]++;
             if (rl_linespace_preillum(ctx->b->ls, &ray, &col, NULL)) {
                 radiance = rl_add(radiance, rl_mul(T, col));
@@ -350,7 +349,11 @@ static uint32_t float_bits(float f)
 rl_vec3 rl_pt_preillum_shade(void *user, const rl_ls_surface *rec, rl_vec3 dir)
 {
     const pt_backends *b = user;
-    pt_ctx ctx = { .data = b->data, .b = b, .shadow = RL_PT_BACKEND_GRID, .diffuse = RL_PT_BACKEND_GRID,
+    /* Exact shadow rays through the BVH, which the backends build first
+     * for this (pathtrace_backend.c): the fastest exact structure here, and
+     * the build's cost is almost all shadow rays. */
+    rl_pt_backend exact = b->exact[RL_ACCEL_BVH] ? RL_PT_BACKEND_BVH : RL_PT_BACKEND_GRID;
+    pt_ctx ctx = { .data = b->data, .b = b, .shadow = exact, .diffuse = exact,
                    .light_samples = PREILLUM_QUAD_SAMPLES };
     pt_surface s;
     if (!surface_of_record(b->data, rec, rl_neg(rl_normalize(dir)), &s))

@@ -453,6 +453,168 @@ static void test_linespace_pnmt_records_decode_to_unit_normals_in_the_voxel(void
     rl_scene_release(s);
 }
 
+/* The occupancy bits the build sets (one per shaft with triangles) agree
+ * with what every payload says and with the bits a loaded Line Space
+ * derives from its payloads. */
+static void check_occupancy(rl_linespace *ls)
+{
+    const uint32_t S = ls->shafts_per_voxel;
+    uint64_t set = 0, shafts = (uint64_t)ls->num_blocks * S;
+    for (uint64_t g = 0; g < shafts; ++g) {
+        bool bit = rl_ls_shaft_occupied(ls, (uint32_t)(g / S), (uint32_t)(g % S));
+        set += bit;
+        if (ls->dynamic && ls->cand_start)
+            assert_int_equal(bit, ls->cand_start[g + 1] > ls->cand_start[g]);
+        if (!ls->dynamic && ls->cand)
+            assert_int_equal(bit, ls->cand[g * (uint64_t)ls->k] != RL_NONE);
+        if (ls->pnmt)
+            assert_int_equal(bit, rl_half_to_float(ls->pnmt[g * 16 + RL_LS_PNMT_MAT]) != 0.0f);
+        if (ls->preillum)
+            assert_int_equal(bit, rl_half_to_float(ls->preillum[g * 8 + 3]) != 0.0f);
+    }
+    assert_int_equal(set, shafts - ls->stats.empty_shafts);
+    size_t words = (size_t)ls->num_blocks * ls->occ_words;
+    uint64_t *built = malloc(words * sizeof *built);
+    assert_non_null(built);
+    memcpy(built, ls->occupied, words * sizeof *built);
+    memset(ls->occupied, 0, words * sizeof *built);
+    rl_ls_occupancy_from_payloads(ls);
+    assert_memory_equal(built, ls->occupied, words * sizeof *built);
+    free(built);
+}
+
+static void test_linespace_occupancy_bits_match_every_payload(void **state)
+{
+    (void)state;
+    rl_scene *s = builtin("cornell-teapot", "triangles=2000");
+    rl_accel *grid = accel_of(s, (rl_accel_desc){ .kind = RL_ACCEL_GRID, .grid_res = { 6, 6, 6 } });
+    rl_linespace *all = ls_of(grid,
+                              (rl_linespace_desc){ .n = 3, .dynamic = true,
+                                                   .payloads = RL_LS_CANDIDATES | RL_LS_PNMT | RL_LS_PREILLUM },
+                              shade_by_normal);
+    rl_linespace *fixed = ls_of(grid, (rl_linespace_desc){ .n = 3, .k = 4 }, NULL);
+    rl_linespace *pre = ls_of(grid, (rl_linespace_desc){ .n = 3, .payloads = RL_LS_PREILLUM }, shade_by_normal);
+    check_occupancy(all);
+    check_occupancy(fixed);
+    check_occupancy(pre);
+    assert_true(all->stats.empty_shafts > 0 && all->stats.empty_shafts < all->stats.shafts);
+    rl_linespace_release(pre);
+    rl_linespace_release(fixed);
+    rl_linespace_release(all);
+    rl_accel_release(grid);
+    rl_scene_release(s);
+}
+
+/* The shadow tests' shortcuts (no record decoded where a filled shaft's
+ * voxel lies inside the ray's interval) give the answers of the full
+ * queries, in both origin rules. */
+static void test_linespace_shadow_tests_equal_the_full_queries(void **state)
+{
+    (void)state;
+    rl_scene *s = builtin("cornell-teapot", "triangles=2000");
+    const rl_scene_data *d = rl_scene_get_data(s);
+    rl_accel *grid = accel_of(s, (rl_accel_desc){ .kind = RL_ACCEL_GRID, .grid_res = { 8, 8, 8 } });
+    rl_linespace *ls = ls_of(grid,
+                             (rl_linespace_desc){ .n = 3, .dynamic = true,
+                                                  .payloads = RL_LS_PNMT | RL_LS_PREILLUM },
+                             shade_by_normal);
+    rl_linespace *pre = ls_of(grid, (rl_linespace_desc){ .n = 3, .payloads = RL_LS_PREILLUM }, shade_by_normal);
+    rl_rng r;
+    rl_rng_seed(&r, 5, 9);
+    int n = 20000 / RAYS_SCALE, occluded = 0;
+    for (int rule = 0; rule < 2; ++rule) {
+        rl_ls_origin o = rule ? RL_LS_ORIGIN_RECORDS : RL_LS_ORIGIN_EXACT;
+        assert_int_equal(rl_linespace_set_origin(ls, o), RL_OK);
+        assert_int_equal(rl_linespace_set_origin(pre, o), RL_OK);
+        for (int i = 0; i < n; ++i) {
+            rl_ray ray = random_ray(&r, d);
+            if (i % 2)
+                ray.t_max = uniform(&r, 0.1f, 1.0f);   /* segments, as shadow rays */
+            rl_ls_surface sf;
+            rl_vec3 c;
+            bool p = rl_linespace_pnmt_occluded(ls, &ray);
+            assert_int_equal(p, rl_linespace_pnmt_intersect(ls, &ray, &sf));
+            assert_int_equal(rl_linespace_preillum_occluded(ls, &ray), rl_linespace_preillum(ls, &ray, &c, NULL));
+            assert_int_equal(rl_linespace_preillum_occluded(pre, &ray), rl_linespace_preillum(pre, &ray, &c, NULL));
+            occluded += p;
+        }
+    }
+    assert_true(occluded > n / 4 && occluded < 2 * n - n / 4);
+    assert_int_equal(rl_linespace_set_origin(ls, (rl_ls_origin)7), RL_ERR_INVALID_ARG);
+    assert_int_equal(rl_linespace_set_origin(NULL, RL_LS_ORIGIN_EXACT), RL_ERR_INVALID_ARG);
+    rl_linespace_release(pre);
+    rl_linespace_release(ls);
+    rl_accel_release(grid);
+    rl_scene_release(s);
+}
+
+/* The origin rules differ only in the voxel a ray starts in: rays from
+ * outside the grid get the same answers; a hit inside the start voxel is
+ * exact under EXACT (that voxel's triangles answer) and, under RECORDS, is
+ * mostly a stored point instead. */
+static void test_linespace_origin_rules_differ_only_in_the_start_voxel(void **state)
+{
+    (void)state;
+    rl_scene *s = builtin("cornell-teapot", "triangles=2000");
+    const rl_scene_data *d = rl_scene_get_data(s);
+    rl_accel *bvh = accel_of(s, (rl_accel_desc){ .kind = RL_ACCEL_BVH });
+    rl_accel *grid = accel_of(s, (rl_accel_desc){ .kind = RL_ACCEL_GRID, .grid_res = { 8, 8, 8 } });
+    const rl_grid *g = rl_accel_grid_state(grid);
+    rl_linespace *ls = ls_of(grid, (rl_linespace_desc){ .n = 3, .dynamic = true, .payloads = RL_LS_PNMT }, NULL);
+    rl_rng r;
+    rl_rng_seed(&r, 3, 4);
+    float scale = rl_vmax_comp(rl_aabb_extent(d->bounds));
+    int n = 40000 / RAYS_SCALE, outside = 0, in_start = 0, exact_same = 0, records_same = 0;
+    for (int i = 0; i < n; ++i) {
+        rl_ray ray = random_ray(&r, d);
+        rl_ls_surface a, b;
+        assert_int_equal(rl_linespace_set_origin(ls, RL_LS_ORIGIN_EXACT), RL_OK);
+        bool ha = rl_linespace_pnmt_intersect(ls, &ray, &a);
+        assert_int_equal(rl_linespace_set_origin(ls, RL_LS_ORIGIN_RECORDS), RL_OK);
+        bool hb = rl_linespace_pnmt_intersect(ls, &ray, &b);
+        rl_vec3 start = rl_ray_at(&ray, ray.t_min);
+        if (!rl_aabb_contains(d->bounds, start)) {
+            ++outside;
+            assert_int_equal(ha, hb);
+            if (ha)
+                assert_true(a.t == b.t && a.material == b.material);
+            continue;
+        }
+        /* The exact hit, if it lies well inside the start voxel. */
+        rl_ray full = ray;
+        rl_hit h;
+        if (ray.t_min < 0.0f || !rl_accel_intersect(bvh, &full, &h))
+            continue;
+        int c[3];
+        rl_grid_cell_of(g, start, c);
+        rl_aabb box = rl_grid_cell_bounds(g, c[0], c[1], c[2]);
+        float t_exit = INFINITY;
+        for (int k = 0; k < 3; ++k) {
+            float dk = rl_vget(ray.d, k);
+            if (dk != 0.0f) {
+                float t = ((dk > 0.0f ? rl_vget(box.max, k) : rl_vget(box.min, k)) - rl_vget(ray.o, k)) / dk;
+                t_exit = rl_minf(t_exit, t);
+            }
+        }
+        if (!(h.t < t_exit - 1e-3f * scale / rl_length(ray.d)))
+            continue;
+        ++in_start;
+        float tol = 1e-5f * scale / rl_length(ray.d);
+        exact_same += ha && fabsf(a.t - h.t) <= tol;
+        records_same += hb && fabsf(b.t - h.t) <= tol;
+    }
+    print_message("origin rules: %d rays from outside agree; of %d exact hits in the start voxel, EXACT "
+                  "gives %d, RECORDS %d\n", outside, in_start, exact_same, records_same);
+    assert_true(outside > n / 10);
+    assert_true(in_start > n / 100);
+    assert_int_equal(exact_same, in_start);
+    assert_true(records_same < in_start / 2);
+    rl_linespace_release(ls);
+    rl_accel_release(grid);
+    rl_accel_release(bvh);
+    rl_scene_release(s);
+}
+
 /* ---- build ------------------------------------------------------------ */
 
 static void test_linespace_build_is_identical_with_1_and_2_threads(void **state)
@@ -568,6 +730,9 @@ int main(void)
         cmocka_unit_test(test_linespace_fixed_lists_report_truncation_and_return_only_true_hits),
         cmocka_unit_test(test_linespace_pnmt_and_preillum_occlusion_agree_at_the_measured_rate),
         cmocka_unit_test(test_linespace_pnmt_records_decode_to_unit_normals_in_the_voxel),
+        cmocka_unit_test(test_linespace_occupancy_bits_match_every_payload),
+        cmocka_unit_test(test_linespace_shadow_tests_equal_the_full_queries),
+        cmocka_unit_test(test_linespace_origin_rules_differ_only_in_the_start_voxel),
         cmocka_unit_test(test_linespace_build_is_identical_with_1_and_2_threads),
         cmocka_unit_test(test_linespace_rejects_bad_arguments),
     };

@@ -86,6 +86,7 @@ static void test_approximate_backends_stay_close_to_the_exact_image(void **state
     const char *const cases[][4] = {
         { "diffuse", "ls-pnmt", "ls_n", "3" },
         { "shadow", "ls-pnmt", "ls_n", "3" },
+        { "diffuse", "ls-pnmt", "ls_origin", "exact" },
         { "diffuse", "ls-preillum", "ls_n", "3" },
         { "shadow", "ls-preillum", "ls_n", "3" },
         { "shadow", "ls-candidates", "ls_dynamic", "false" },
