@@ -7,9 +7,12 @@
  *                 all secondary and shadow rays through the grid vs the
  *                 PNMT Line Space (and our BVH), for the 7 scenes of Sec. 9.3
  *   diffuse       Diagram 2: Cornell box with the bunny-sized model, diffuse
- *                 rays through each structure, shadows by shadow maps
+ *                 rays through each structure, shadows by shadow maps; each
+ *                 Line Space variant at voxels 8^3..64^3 and its best
+ *                 (the thesis tuned the resolution per structure), and a
+ *                 frame without diffuse rays as the floor of the rays' share
  *   shadow        Diagram 3: the same scene, shadow rays through each
- *                 structure (and shadow maps), diffuse rays by the PNMT LS
+ *                 structure (and shadow maps), diffuse rays by the BVH
  *   error         RMSE and SSIM of every variant against a converged BVH
  *                 reference at equal sample counts, and the time each needs
  *                 to reach the RMSE the BVH reaches at 4, 16, 64 spp
@@ -53,11 +56,14 @@ static const char bench_pt_help[] =
     "                of the thesis' Table 1 (Cornell box with boxes/teapot/bunny/dragon)\n"
     "  scenes        frame time and Mrays/s, all rays through the grid vs the PNMT\n"
     "                Line Space vs our BVH, for the 7 scenes of Sec. 9.3 (Diagram 1)\n"
-    "  diffuse       Cornell box + bunny: diffuse rays through grid, LS candidates,\n"
-    "                PNMT, pre-illuminated, BVH; shadows by shadow maps (Diagram 2)\n"
-    "  shadow        the same for shadow rays, plus shadow maps (Diagram 3)\n"
-    "  error         RMSE/SSIM of each variant against a converged BVH reference\n"
-    "                at equal spp, and time to reach the BVH's RMSE at 4/16/64 spp\n"
+    "  diffuse       Cornell box + bunny: diffuse rays through grid, BVH, and each\n"
+    "                Line Space variant (candidates, PNMT, pre-illuminated) at voxels\n"
+    "                8^3..64^3, best per variant; shadows by shadow maps (Diagram 2)\n"
+    "  shadow        the same for shadow rays, plus shadow maps; diffuse rays by\n"
+    "                the BVH (Diagram 3)\n"
+    "  error         RMSE/SSIM of each variant (PNMT and pre-illuminated at every\n"
+    "                voxel resolution) against a converged BVH reference at equal\n"
+    "                spp, and time to reach the BVH's RMSE at 4/16/64 spp\n"
     "  accumulation  RMSE against total samples; each filter's RMSE/SSIM\n"
     "\n"
     "options:\n"
@@ -148,6 +154,8 @@ typedef struct pt_config {
     const char *filter;            /* NULL: none */
     int grid_res;                  /* 0: the grid heuristic */
     int max_depth;                 /* 0: the renderer's default */
+    bool direct_only;              /* max_depth 0: no secondary rays */
+    const char *ls_origin;         /* NULL: the renderer's default (offset) */
     int spp;
     bool accumulate;
     const char *seed;
@@ -216,6 +224,8 @@ static rl_status make_pt(const bpt *b, const pt_config *c, rl_renderer **out)
     if (st == RL_OK && c->filter) st = rl_renderer_set(r, "filter_fade", "0");
     if (st == RL_OK) st = set_num(r, "grid_res", c->grid_res);
     if (st == RL_OK && c->max_depth) st = set_num(r, "max_depth", c->max_depth);
+    if (st == RL_OK && c->direct_only) st = set_num(r, "max_depth", 0);
+    if (st == RL_OK && c->ls_origin) st = rl_renderer_set(r, "ls_origin", c->ls_origin);
     if (st == RL_OK) st = set_num(r, "spp", c->spp ? c->spp : 1);
     if (st == RL_OK) st = rl_renderer_set(r, "accumulate", c->accumulate ? "true" : "false");
     if (st != RL_OK) {
@@ -431,18 +441,24 @@ static cJSON *frame_json(const pt_config *c, const rl_render_stats *s, double wa
     return o;
 }
 
+#define MAX_CONFIGS 16
+
 /* Renders each configuration on one scene and prints a row per config
- * with its speed relative to configuration `base`. */
+ * with its speed relative to configuration `base`. With floor >= 0 (a
+ * configuration without the rays under test), also the speed-up of the
+ * rest of the frame, (base - floor) / (config - floor): the rays' own
+ * share, which the frame's fixed cost (primary rays, shading) hides. */
 static rl_status frame_table(bpt *b, const char *scene_name, const pt_config *configs, int count,
-                             int base, cJSON *out)
+                             int base, int floor, cJSON *out, rl_render_stats *stats)
 {
     rl_scene *scene = NULL;
     rl_status st = scene_get(b, scene_name, &scene);
     if (st != RL_OK)
         return st;
-    rl_render_stats stats[16];
-    double warm[16];
-    for (int i = 0; i < count && i < 16; i++) {
+    if (count > MAX_CONFIGS)
+        return fail(b, RL_ERR_LIMIT, "bench pt: %d configurations > %d", count, MAX_CONFIGS);
+    double warm[MAX_CONFIGS];
+    for (int i = 0; i < count; i++) {
         rl_clear_error();
         if ((st = frame_timed(b, &configs[i], scene, b->a->width, b->a->height, &stats[i],
                               &warm[i])) != RL_OK)
@@ -450,17 +466,26 @@ static rl_status frame_table(bpt *b, const char *scene_name, const pt_config *co
         note("%s %s (shadow %s, diffuse %s): %.1f ms, %.1f Mrays/s", scene_name, configs[i].label,
              configs[i].shadow, configs[i].diffuse, stats[i].time_ms, mrays(&stats[i]));
     }
-    printf("%-16s %-14s %-14s %5s %10s %8s %9s %10s %9s\n", "config", "shadow", "diffuse", "res",
-           "frame ms", "fps", "Mrays/s", "warmup ms", "x base");
-    for (int i = 0; i < count && i < 16; i++) {
+    printf("%-18s %-14s %-14s %5s %10s %8s %9s %10s %9s%s\n", "config", "shadow", "diffuse", "res",
+           "frame ms", "fps", "Mrays/s", "warmup ms", "x base", floor >= 0 ? " x base (rays)" : "");
+    for (int i = 0; i < count; i++) {
         double x = rl_bench_ratio(stats[base].time_ms, stats[i].time_ms);
-        printf("%-16s %-14s %-14s %5d %10.1f %8.2f %9.2f %10.1f %9.2f\n", configs[i].label,
+        double xr = floor >= 0 && i != floor
+                        ? rl_bench_ratio(stats[base].time_ms - stats[floor].time_ms,
+                                         stats[i].time_ms - stats[floor].time_ms)
+                        : NAN;
+        printf("%-18s %-14s %-14s %5d %10.1f %8.2f %9.2f %10.1f %9.2f", configs[i].label,
                configs[i].shadow, configs[i].diffuse, configs[i].grid_res, stats[i].time_ms,
                1e3 / stats[i].time_ms, mrays(&stats[i]), warm[i], x);
+        if (floor >= 0 && isfinite(xr))
+            printf(" %14.2f", xr);
+        printf("\n");
         cJSON *row = frame_json(&configs[i], &stats[i], warm[i]);
         if (!row)
             return RL_ERR_OUT_OF_MEMORY;
         rl_bench_add_num(row, "speedup_vs_base", x);
+        if (floor >= 0)
+            rl_bench_add_num(row, "rays_speedup_vs_base", xr);
         cJSON_AddItemToArray(out, row);
     }
     fflush(stdout);
@@ -507,7 +532,8 @@ static rl_status sec_scenes(void *ctx, cJSON *sec)
         cJSON *frames = cJSON_AddArrayToObject(entry, "frames");
         if (!frames)
             return RL_ERR_OUT_OF_MEMORY;
-        if ((st = frame_table(b, sr->scene, configs, 4, 0, frames)) != RL_OK)
+        rl_render_stats stats[4];
+        if ((st = frame_table(b, sr->scene, configs, 4, 0, -1, frames, stats)) != RL_OK)
             return st;
     }
     return RL_OK;
@@ -519,55 +545,142 @@ static const char *diagram_scene(const bpt *b)
     return b->a->quick ? "ls-cornell:model=boxes" : "ls-cornell:model=bunny";
 }
 
-static int diagram_res(bpt *b, const char *name)
+/* The Line Space voxel resolutions the diagram and error sections sweep
+ * (the thesis picked the best resolution per structure, Sec. 11.1); those
+ * estimated above --max-memory are left out. Returns how many. */
+static int sweep_res(bpt *b, const char *name, int res[4])
 {
+    static const int full[] = { 8, 16, 32, 64 }, quick[] = { 4, 8 };
+    const int *list = b->a->quick ? quick : full;
+    int count = b->a->quick ? 2 : 4, n = 0;
     rl_scene *scene = NULL;
     if (scene_get(b, name, &scene) != RL_OK)
-        return 8;
-    return ls_res_that_fits(b, scene, b->a->quick ? 8 : 64, RL_LS_DEFAULT_N);
+        return 0;
+    for (int i = 0; i < count; i++) {
+        if (ls_bytes_upper(scene, list[i], RL_LS_DEFAULT_N) <= b->max_memory_bytes)
+            res[n++] = list[i];
+        else
+            note("LS voxels %d^3 skipped: estimated above --max-memory", list[i]);
+    }
+    return n;
+}
+
+/* The resolution in the middle of the sweep, for variants measured once. */
+static int middle_res(bpt *b, const char *name)
+{
+    int res[4], n = sweep_res(b, name, res);
+    return n ? res[(n - 1) / 2] : 4;
+}
+
+static const char *const ls_variants[3] = { "ls-candidates", "ls-pnmt", "ls-preillum" };
+
+/* Appends one configuration per Line Space variant and resolution; labels
+ * "variant@res" live in labels[]. */
+static int add_sweep(pt_config *configs, int count, char labels[][32], const int *res, int nres,
+                     bool shadow)
+{
+    for (int v = 0; v < 3; v++)
+        for (int i = 0; i < nres && count < MAX_CONFIGS; i++, count++) {
+            snprintf(labels[count], 32, "%s@%d", ls_variants[v], res[i]);
+            pt_config c = { .label = labels[count], .grid_res = res[i],
+                            .shadow = shadow ? ls_variants[v] : "shadowmap",
+                            .diffuse = shadow ? "bvh" : ls_variants[v] };
+            configs[count] = c;
+        }
+    return count;
+}
+
+/* Per Line Space variant, the fastest resolution of the sweep, against
+ * the grid (config 0) and the BVH (config 1); with floor >= 0 also the
+ * rays' own share (see frame_table). */
+static void sweep_best(const pt_config *configs, const rl_render_stats *stats, int first, int count,
+                       int floor, bool shadow, cJSON *sec)
+{
+    cJSON *best = cJSON_AddObjectToObject(sec, "best");
+    printf("best resolution per variant:\n");
+    for (int v = 0; v < 3; v++) {
+        int bi = -1;
+        for (int i = first; i < count; i++)
+            if (strcmp(shadow ? configs[i].shadow : configs[i].diffuse, ls_variants[v]) == 0 &&
+                (bi < 0 || stats[i].time_ms < stats[bi].time_ms))
+                bi = i;
+        if (bi < 0)
+            continue;
+        double xg = rl_bench_ratio(stats[0].time_ms, stats[bi].time_ms);
+        double xb = rl_bench_ratio(stats[1].time_ms, stats[bi].time_ms);
+        double xr = floor >= 0 ? rl_bench_ratio(stats[0].time_ms - stats[floor].time_ms,
+                                                stats[bi].time_ms - stats[floor].time_ms)
+                               : NAN;
+        printf("  %-14s %3d^3  %8.1f ms  %5.2fx the grid  %5.2fx the BVH", ls_variants[v],
+               configs[bi].grid_res, stats[bi].time_ms, xg, xb);
+        if (isfinite(xr))
+            printf("  rays alone %5.2fx the grid", xr);
+        printf("\n");
+        cJSON *o = best ? cJSON_AddObjectToObject(best, ls_variants[v]) : NULL;
+        if (!o)
+            continue;
+        cJSON_AddNumberToObject(o, "grid_res", configs[bi].grid_res);
+        rl_bench_add_num(o, "frame_ms", stats[bi].time_ms);
+        rl_bench_add_num(o, "speedup_vs_grid", xg);
+        rl_bench_add_num(o, "speedup_vs_bvh", xb);
+        if (floor >= 0)
+            rl_bench_add_num(o, "rays_speedup_vs_grid", xr);
+    }
+    fflush(stdout);
 }
 
 static rl_status sec_diffuse(void *ctx, cJSON *sec)
 {
     bpt *b = ctx;
     const char *name = diagram_scene(b);
-    int res = diagram_res(b, name);
-    pt_config configs[] = {
+    int res[4], nres = sweep_res(b, name, res);
+    pt_config configs[MAX_CONFIGS] = {
         { .label = "grid", .shadow = "shadowmap", .diffuse = "grid" },
-        { .label = "ls-candidates", .shadow = "shadowmap", .diffuse = "ls-candidates", .grid_res = res },
-        { .label = "ls-pnmt", .shadow = "shadowmap", .diffuse = "ls-pnmt", .grid_res = res },
-        { .label = "ls-preillum", .shadow = "shadowmap", .diffuse = "ls-preillum", .grid_res = res },
         { .label = "bvh", .shadow = "shadowmap", .diffuse = "bvh" },
+        { .label = "no diffuse rays", .shadow = "shadowmap", .diffuse = "bvh", .direct_only = true },
     };
-    printf("\ndiffuse (Diagram 2: %s, %dx%d, 1 spp, shadows by shadow maps, LS voxels %d^3; "
-           "x base = speed-up over the grid; thesis: PNMT > 20x the grid)\n", name, b->a->width,
-           b->a->height, res);
+    char labels[MAX_CONFIGS][32];
+    int count = add_sweep(configs, 3, labels, res, nres, false);
+    printf("\ndiffuse (Diagram 2: %s, %dx%d, 1 spp, shadows by shadow maps, each Line Space variant "
+           "at voxels %d^3..%d^3; x base = speed-up over the grid, (rays): of the frame without "
+           "the direct-light-only floor; thesis: PNMT > 20x the grid)\n", name, b->a->width,
+           b->a->height, nres ? res[0] : 0, nres ? res[nres - 1] : 0);
     cJSON_AddStringToObject(sec, "scene", name);
-    cJSON_AddNumberToObject(sec, "ls_voxel_res", res);
     cJSON *frames = cJSON_AddArrayToObject(sec, "frames");
-    return frames ? frame_table(b, name, configs, 5, 0, frames) : RL_ERR_OUT_OF_MEMORY;
+    if (!frames)
+        return RL_ERR_OUT_OF_MEMORY;
+    rl_render_stats stats[MAX_CONFIGS];
+    rl_status st = frame_table(b, name, configs, count, 0, 2, frames, stats);
+    if (st == RL_OK)
+        sweep_best(configs, stats, 3, count, 2, false, sec);
+    return st;
 }
 
 static rl_status sec_shadow(void *ctx, cJSON *sec)
 {
     bpt *b = ctx;
     const char *name = diagram_scene(b);
-    int res = diagram_res(b, name);
-    pt_config configs[] = {
-        { .label = "grid", .shadow = "grid", .diffuse = "ls-pnmt", .grid_res = res },
-        { .label = "ls-candidates", .shadow = "ls-candidates", .diffuse = "ls-pnmt", .grid_res = res },
-        { .label = "ls-pnmt", .shadow = "ls-pnmt", .diffuse = "ls-pnmt", .grid_res = res },
-        { .label = "ls-preillum", .shadow = "ls-preillum", .diffuse = "ls-pnmt", .grid_res = res },
-        { .label = "shadowmap", .shadow = "shadowmap", .diffuse = "ls-pnmt", .grid_res = res },
-        { .label = "bvh", .shadow = "bvh", .diffuse = "ls-pnmt", .grid_res = res },
+    int res[4], nres = sweep_res(b, name, res);
+    pt_config configs[MAX_CONFIGS] = {
+        { .label = "grid", .shadow = "grid", .diffuse = "bvh" },
+        { .label = "bvh", .shadow = "bvh", .diffuse = "bvh" },
+        { .label = "shadowmap", .shadow = "shadowmap", .diffuse = "bvh" },
     };
-    printf("\nshadow (Diagram 3: %s, %dx%d, 1 spp, diffuse rays by the PNMT LS, voxels %d^3; "
-           "x base = speed-up over the grid; thesis: PNMT ~10x the grid, shadow maps faster still)\n",
-           name, b->a->width, b->a->height, res);
+    char labels[MAX_CONFIGS][32];
+    int count = add_sweep(configs, 3, labels, res, nres, true);
+    printf("\nshadow (Diagram 3: %s, %dx%d, 1 spp, diffuse rays by the BVH, each Line Space variant "
+           "at voxels %d^3..%d^3; x base = speed-up over the grid; thesis: PNMT ~10x the grid, "
+           "shadow maps faster still)\n", name, b->a->width, b->a->height, nres ? res[0] : 0,
+           nres ? res[nres - 1] : 0);
     cJSON_AddStringToObject(sec, "scene", name);
-    cJSON_AddNumberToObject(sec, "ls_voxel_res", res);
     cJSON *frames = cJSON_AddArrayToObject(sec, "frames");
-    return frames ? frame_table(b, name, configs, 6, 0, frames) : RL_ERR_OUT_OF_MEMORY;
+    if (!frames)
+        return RL_ERR_OUT_OF_MEMORY;
+    rl_render_stats stats[MAX_CONFIGS];
+    rl_status st = frame_table(b, name, configs, count, 0, -1, frames, stats);
+    if (st == RL_OK)
+        sweep_best(configs, stats, 3, count, -1, true, sec);
+    return st;
 }
 
 /* ------------------------------------------------ error and accumulation -- */
@@ -693,18 +806,33 @@ static rl_status sec_error(void *ctx, cJSON *sec)
     rl_status st = error_setup(b, &scene, &cam);
     if (st != RL_OK)
         return st;
-    int res = diagram_res(b, diagram_scene(b));
-    const pt_config configs[] = {
+    int res[4], nres = sweep_res(b, diagram_scene(b), res), mid = middle_res(b, diagram_scene(b));
+    /* The exact variants once (candidates: the BVH's image), the
+     * approximate ones at every resolution of the sweep. */
+    pt_config configs[MAX_CONFIGS] = {
         { .label = "bvh", .shadow = "bvh", .diffuse = "bvh" },
         { .label = "grid", .shadow = "grid", .diffuse = "grid" },
-        { .label = "ls-candidates", .shadow = "ls-candidates", .diffuse = "ls-candidates", .grid_res = res },
-        { .label = "ls-pnmt", .shadow = "ls-pnmt", .diffuse = "ls-pnmt", .grid_res = res },
-        { .label = "ls-preillum", .shadow = "ls-preillum", .diffuse = "ls-preillum", .grid_res = res },
         { .label = "shadowmap", .shadow = "shadowmap", .diffuse = "bvh" },
     };
-    enum { NUM = sizeof configs / sizeof configs[0] };
-    curve_point pts[NUM][MAX_POINTS];
-    int num[NUM];
+    char labels[MAX_CONFIGS][32];
+    int count = 3;
+    snprintf(labels[count], 32, "ls-candidates@%d", mid);
+    configs[count] = (pt_config){ .label = labels[count], .shadow = "ls-candidates",
+                                  .diffuse = "ls-candidates", .grid_res = mid };
+    count++;
+    for (int v = 1; v < 3; v++)
+        for (int i = 0; i < nres && count < MAX_CONFIGS - 1; i++, count++) {
+            snprintf(labels[count], 32, "%s@%d", ls_variants[v], res[i]);
+            configs[count] = (pt_config){ .label = labels[count], .shadow = ls_variants[v],
+                                          .diffuse = ls_variants[v], .grid_res = res[i] };
+        }
+    snprintf(labels[count], 32, "ls-pnmt@%d exact", mid);
+    configs[count] = (pt_config){ .label = labels[count], .shadow = "ls-pnmt", .diffuse = "ls-pnmt",
+                                  .grid_res = mid, .ls_origin = "exact" };
+    count++;
+    const int NUM = count;
+    curve_point pts[MAX_CONFIGS][MAX_POINTS];
+    int num[MAX_CONFIGS];
     for (int i = 0; i < NUM; i++) {
         rl_clear_error();
         if ((st = accumulate_curve(b, &configs[i], scene, &cam, b->a->spp_max, pts[i], &num[i])) != RL_OK)
@@ -724,7 +852,7 @@ static rl_status sec_error(void *ctx, cJSON *sec)
     printf("\nerror (%s, %dx%d, against %lld spp of the BVH; equal spp = %lld; time to the "
            "BVH's RMSE at 4/16/64 spp, '-' = never within %lld spp)\n", diagram_scene(b),
            cam.width, cam.height, b->a->ref_spp, b->a->spp_max, b->a->spp_max);
-    printf("%-14s %9s %8s %11s %11s %11s %11s\n", "variant", "RMSE", "SSIM", "ms/spp", "t(4) ms",
+    printf("%-18s %9s %8s %11s %11s %11s %11s\n", "variant", "RMSE", "SSIM", "ms/spp", "t(4) ms",
            "t(16) ms", "t(64) ms");
     cJSON_AddStringToObject(sec, "scene", diagram_scene(b));
     cJSON_AddNumberToObject(sec, "reference_spp", (double)b->a->ref_spp);
@@ -737,7 +865,7 @@ static rl_status sec_error(void *ctx, cJSON *sec)
         double tt[3];
         for (int k = 0; k < 3; k++)
             tt[k] = isfinite(targets[k]) ? time_to_rmse(pts[i], num[i], targets[k]) : NAN;
-        printf("%-14s %9.4f %8.4f %11.2f", configs[i].label, last->m.rmse, last->m.ssim,
+        printf("%-18s %9.4f %8.4f %11.2f", configs[i].label, last->m.rmse, last->m.ssim,
                last->time_ms / (double)last->spp);
         for (int k = 0; k < 3; k++) {
             if (isfinite(tt[k]))
@@ -754,6 +882,7 @@ static rl_status sec_error(void *ctx, cJSON *sec)
         cJSON_AddStringToObject(v, "shadow", configs[i].shadow);
         cJSON_AddStringToObject(v, "diffuse", configs[i].diffuse);
         cJSON_AddNumberToObject(v, "grid_res", configs[i].grid_res);
+        cJSON_AddStringToObject(v, "ls_origin", configs[i].ls_origin ? configs[i].ls_origin : "offset");
         cJSON_AddItemToObject(v, "curve", curve_json(pts[i], num[i]));
         cJSON *ttj = cJSON_AddObjectToObject(v, "time_to_bvh_rmse_ms");
         for (int k = 0; ttj && k < 3; k++) {

@@ -63,14 +63,27 @@ def frames_ok(frames, labels):
 sc = r["scenes"]["scenes"]
 assert [x["scene"] for x in sc] == ["ls-cornell:model=boxes"], sc
 frames_ok(sc[0]["frames"], ["grid", "ls-pnmt", "ls-candidates", "bvh"])
-frames_ok(r["diffuse"]["frames"], ["grid", "ls-candidates", "ls-pnmt", "ls-preillum", "bvh"])
-frames_ok(r["shadow"]["frames"],
-          ["grid", "ls-candidates", "ls-pnmt", "ls-preillum", "shadowmap", "bvh"])
+# Diagrams 2-3: every Line Space variant at each voxel resolution of the
+# quick sweep (4^3, 8^3), and the fastest per variant.
+sweep = ["%s@%d" % (v, n) for v in ("ls-candidates", "ls-pnmt", "ls-preillum") for n in (4, 8)]
+frames_ok(r["diffuse"]["frames"], ["grid", "bvh", "no diffuse rays"] + sweep)
+frames_ok(r["shadow"]["frames"], ["grid", "bvh", "shadowmap"] + sweep)
+for sec in ("diffuse", "shadow"):
+    best = r[sec]["best"]
+    assert sorted(best) == ["ls-candidates", "ls-pnmt", "ls-preillum"], best
+    for v, o in best.items():
+        times = [f["frame_ms"] for f in r[sec]["frames"] if f["label"].startswith(v + "@")]
+        assert o["grid_res"] in (4, 8) and o["frame_ms"] == min(times), (sec, v, o, times)
+d = {f["label"]: f for f in r["diffuse"]["frames"]}
+assert d["no diffuse rays"]["rays"].get("diffuse", 0) == 0, d["no diffuse rays"]["rays"]
+assert "rays_speedup_vs_base" in d["ls-pnmt@4"]
 
 e = r["error"]
 assert e["reference_spp"] == 64
 labels = [v["label"] for v in e["variants"]]
-assert labels == ["bvh", "grid", "ls-candidates", "ls-pnmt", "ls-preillum", "shadowmap"], labels
+assert labels == ["bvh", "grid", "shadowmap", "ls-candidates@4", "ls-pnmt@4", "ls-pnmt@8",
+                  "ls-preillum@4", "ls-preillum@8", "ls-pnmt@4 exact"], labels
+assert [v["ls_origin"] for v in e["variants"]] == ["offset"] * 8 + ["exact"]
 for v in e["variants"]:
     c = v["curve"]
     assert [x["spp"] for x in c] == [1, 2, 4, 8], c
@@ -80,7 +93,7 @@ for v in e["variants"]:
 # The exact variants trace the same paths (up to hits on shared edges,
 # where structures may pick either triangle): nearly the same error.
 by = {v["label"]: v["curve"] for v in e["variants"]}
-for other in ("grid", "ls-candidates"):
+for other in ("grid", "ls-candidates@4"):
     for a, b in zip(by["bvh"], by[other]):
         assert abs(a["rmse"] - b["rmse"]) <= 0.02 * a["rmse"] + 1e-6, (other, a, b)
 # More samples, less error (exact path tracer, same seed).
