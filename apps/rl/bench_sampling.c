@@ -62,6 +62,10 @@ static const char bench_sampling_help[] =
     "  --quality-size Q  measure (default) or diameter (the thesis): the size in\n"
     "                    q = n / (size * range) of the adaptive variants other\n"
     "                    than bnc-region (always the thesis')\n"
+    "  --samples-base B, --samples-per-meter M\n"
+    "                    samples of a new region, B + M * diameter, of the adaptive\n"
+    "                    variants other than bnc-region; default 5 and 0.05/m\n"
+    "                    (the thesis, Sec. 5.4.2)\n"
     "  --threads N       workers; default all\n"
     "  --only A,B        sections: variants, convergence, throughput\n"
     "  --out FILE.json   default bench/results/sampling-YYYYMMDD-HHMMSS.json\n"
@@ -82,6 +86,7 @@ typedef struct bs_args {
     long long resolution, validation, threads;
     double height;
     rl_quality_size quality_size;     /* of the adaptive variants but bnc-region */
+    double samples_base, samples_per_meter;   /* the same; 0: the defaults (Sec. 5.4.2) */
     long long counts[MAX_COUNTS];
     int num_counts;
     unsigned sections;
@@ -111,6 +116,8 @@ static void variant_desc(const bs_args *a, int k, rl_sampling_desc *d)
                  : k == 2 ? RL_POSITIONS_BLUE_NOISE : RL_POSITIONS_BLUE_NOISE_CORNERS;
     d->interpolation = k == 4 ? RL_INTERP_REGION : RL_INTERP_NEAREST;
     d->quality_size = k == 4 ? RL_QUALITY_DIAMETER : a->quality_size;
+    d->samples_base = k == 4 ? 0.0f : (float)a->samples_base;
+    d->samples_per_meter = k == 4 ? 0.0f : (float)a->samples_per_meter;
 }
 
 static rl_aabb region_of(const bs_ctx *c, bool doubled)
@@ -135,6 +142,8 @@ static rl_sampling_desc base_desc(const bs_ctx *c, int dims, bool doubled)
     d.seed = 1;
     d.workers = (int)c->a->threads;
     d.quality_size = c->a->quality_size;
+    d.samples_base = (float)c->a->samples_base;
+    d.samples_per_meter = (float)c->a->samples_per_meter;
     return d;
 }
 
@@ -380,6 +389,8 @@ static int parse_args(int argc, char **argv, bs_args *a)
           .hi = INFINITY, .expect = "metres >= 0" },
         RL_BENCH_CUSTOM("--samples", take_counts, a, &has_counts),
         RL_BENCH_CUSTOM("--quality-size", take_quality_size, a, NULL),
+        RL_BENCH_REAL("--samples-base", 1.0, 1e6, &a->samples_base, NULL),
+        RL_BENCH_REAL("--samples-per-meter", 1e-9, 1e6, &a->samples_per_meter, NULL),
         RL_BENCH_COUNT("--threads", 1024, &a->threads, NULL),
         RL_BENCH_SECTIONS(section_names, SEC_COUNT, &a->sections),
         RL_BENCH_OUT(&a->out),
@@ -445,6 +456,8 @@ int rl_bench_sampling(int argc, char **argv)
     cJSON_AddNumberToObject(params, "resolution", (double)a.resolution);
     cJSON_AddNumberToObject(params, "validation_points", (double)a.validation);
     cJSON_AddStringToObject(params, "quality_size", rl_eval_quality_size_name(a.quality_size));
+    cJSON_AddNumberToObject(params, "samples_base", a.samples_base > 0.0 ? a.samples_base : 5.0);
+    cJSON_AddNumberToObject(params, "samples_per_meter", a.samples_per_meter > 0.0 ? a.samples_per_meter : 0.05);
     cJSON_AddNumberToObject(params, "height_above_floor", a.height);
     cJSON *thesis = cJSON_AddObjectToObject(root, "thesis");
     cJSON_AddStringToObject(thesis, "scene", "Power Plant, 1171 objects, 22 ms per sample at 1024^2");

@@ -88,6 +88,8 @@ fi
 expect_usage_error "$RL" bench sampling --only nosuch --out "$TMP/b.json"
 expect_usage_error "$RL" bench sampling --samples 0 --out "$TMP/b.json"
 expect_error 2 "one of measure, diameter" "$RL" bench sampling --quality-size area --out "$TMP/b.json"
+expect_error 2 "expected a number" "$RL" bench sampling --samples-base 0 --out "$TMP/b.json"
+expect_error 2 "expected a number" "$RL" bench sampling --samples-per-meter nan --out "$TMP/b.json"
 run_ok "$RL" bench sampling --quick --out "$TMP/b.json"
 for s in variants convergence throughput bn-corners; do expect_in "$TMP/out" "$s"; done
 if have_python; then
@@ -102,6 +104,7 @@ for c in r["variants"]["cases"]:
         assert c[v]["abs_error"]["mean"] >= 0, c
 assert r["throughput"]["rows"][0]["samples_per_second"] > 0
 assert "machine" in r
+assert r["parameters"]["samples_base"] == 5 and r["parameters"]["samples_per_meter"] == 0.05
 PY
 fi
 echo "ok"
