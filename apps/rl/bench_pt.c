@@ -565,26 +565,25 @@ static int sweep_res(bpt *b, const char *name, int res[4])
     return n;
 }
 
-/* The resolution in the middle of the sweep, for variants measured once. */
-static int middle_res(bpt *b, const char *name)
-{
-    int res[4], n = sweep_res(b, name, res);
-    return n ? res[(n - 1) / 2] : 4;
-}
-
 static const char *const ls_variants[3] = { "ls-candidates", "ls-pnmt", "ls-preillum" };
 
-/* Appends one configuration per Line Space variant and resolution; labels
- * "variant@res" live in labels[]. */
-static int add_sweep(pt_config *configs, int count, char labels[][32], const int *res, int nres,
-                     bool shadow)
+/* Which rays a sweep configuration routes through the variant under test:
+ * diffuse rays (shadows by shadow maps), shadow rays (diffuse rays by the
+ * BVH), or both. */
+typedef enum sweep_rays { SWEEP_DIFFUSE, SWEEP_SHADOW, SWEEP_BOTH } sweep_rays;
+
+/* Appends one configuration per Line Space variant from `first` on and per
+ * resolution, up to cap configurations; labels "variant@res" live in
+ * labels[]. */
+static int add_sweep(pt_config *configs, int count, int cap, char labels[][32], int first,
+                     const int *res, int nres, sweep_rays rays)
 {
-    for (int v = 0; v < 3; v++)
-        for (int i = 0; i < nres && count < MAX_CONFIGS; i++, count++) {
+    for (int v = first; v < 3; v++)
+        for (int i = 0; i < nres && count < cap; i++, count++) {
             snprintf(labels[count], 32, "%s@%d", ls_variants[v], res[i]);
             pt_config c = { .label = labels[count], .grid_res = res[i],
-                            .shadow = shadow ? ls_variants[v] : "shadowmap",
-                            .diffuse = shadow ? "bvh" : ls_variants[v] };
+                            .shadow = rays == SWEEP_DIFFUSE ? "shadowmap" : ls_variants[v],
+                            .diffuse = rays == SWEEP_SHADOW ? "bvh" : ls_variants[v] };
             configs[count] = c;
         }
     return count;
@@ -594,14 +593,14 @@ static int add_sweep(pt_config *configs, int count, char labels[][32], const int
  * the grid (config 0) and the BVH (config 1); with floor >= 0 also the
  * rays' own share (see frame_table). */
 static void sweep_best(const pt_config *configs, const rl_render_stats *stats, int first, int count,
-                       int floor, bool shadow, cJSON *sec)
+                       int floor, sweep_rays rays, cJSON *sec)
 {
     cJSON *best = cJSON_AddObjectToObject(sec, "best");
     printf("best resolution per variant:\n");
     for (int v = 0; v < 3; v++) {
         int bi = -1;
         for (int i = first; i < count; i++)
-            if (strcmp(shadow ? configs[i].shadow : configs[i].diffuse, ls_variants[v]) == 0 &&
+            if (strcmp(rays == SWEEP_SHADOW ? configs[i].shadow : configs[i].diffuse, ls_variants[v]) == 0 &&
                 (bi < 0 || stats[i].time_ms < stats[bi].time_ms))
                 bi = i;
         if (bi < 0)
@@ -640,7 +639,7 @@ static rl_status sec_diffuse(void *ctx, cJSON *sec)
         { .label = "no diffuse rays", .shadow = "shadowmap", .diffuse = "bvh", .direct_only = true },
     };
     char labels[MAX_CONFIGS][32];
-    int count = add_sweep(configs, 3, labels, res, nres, false);
+    int count = add_sweep(configs, 3, MAX_CONFIGS, labels, 0, res, nres, SWEEP_DIFFUSE);
     printf("\ndiffuse (Diagram 2: %s, %dx%d, 1 spp, shadows by shadow maps, each Line Space variant "
            "at voxels %d^3..%d^3; x base = speed-up over the grid, (rays): of the frame without "
            "the direct-light-only floor; thesis: PNMT > 20x the grid)\n", name, b->a->width,
@@ -652,7 +651,7 @@ static rl_status sec_diffuse(void *ctx, cJSON *sec)
     rl_render_stats stats[MAX_CONFIGS];
     rl_status st = frame_table(b, name, configs, count, 0, 2, frames, stats);
     if (st == RL_OK)
-        sweep_best(configs, stats, 3, count, 2, false, sec);
+        sweep_best(configs, stats, 3, count, 2, SWEEP_DIFFUSE, sec);
     return st;
 }
 
@@ -667,7 +666,7 @@ static rl_status sec_shadow(void *ctx, cJSON *sec)
         { .label = "shadowmap", .shadow = "shadowmap", .diffuse = "bvh" },
     };
     char labels[MAX_CONFIGS][32];
-    int count = add_sweep(configs, 3, labels, res, nres, true);
+    int count = add_sweep(configs, 3, MAX_CONFIGS, labels, 0, res, nres, SWEEP_SHADOW);
     printf("\nshadow (Diagram 3: %s, %dx%d, 1 spp, diffuse rays by the BVH, each Line Space variant "
            "at voxels %d^3..%d^3; x base = speed-up over the grid; thesis: PNMT ~10x the grid, "
            "shadow maps faster still)\n", name, b->a->width, b->a->height, nres ? res[0] : 0,
@@ -679,7 +678,7 @@ static rl_status sec_shadow(void *ctx, cJSON *sec)
     rl_render_stats stats[MAX_CONFIGS];
     rl_status st = frame_table(b, name, configs, count, 0, -1, frames, stats);
     if (st == RL_OK)
-        sweep_best(configs, stats, 3, count, -1, true, sec);
+        sweep_best(configs, stats, 3, count, -1, SWEEP_SHADOW, sec);
     return st;
 }
 
@@ -806,7 +805,8 @@ static rl_status sec_error(void *ctx, cJSON *sec)
     rl_status st = error_setup(b, &scene, &cam);
     if (st != RL_OK)
         return st;
-    int res[4], nres = sweep_res(b, diagram_scene(b), res), mid = middle_res(b, diagram_scene(b));
+    int res[4], nres = sweep_res(b, diagram_scene(b), res);
+    int mid = nres ? res[(nres - 1) / 2] : 4;     /* for the variants measured once */
     /* The exact variants once (candidates: the BVH's image), the
      * approximate ones at every resolution of the sweep. */
     pt_config configs[MAX_CONFIGS] = {
@@ -820,12 +820,7 @@ static rl_status sec_error(void *ctx, cJSON *sec)
     configs[count] = (pt_config){ .label = labels[count], .shadow = "ls-candidates",
                                   .diffuse = "ls-candidates", .grid_res = mid };
     count++;
-    for (int v = 1; v < 3; v++)
-        for (int i = 0; i < nres && count < MAX_CONFIGS - 1; i++, count++) {
-            snprintf(labels[count], 32, "%s@%d", ls_variants[v], res[i]);
-            configs[count] = (pt_config){ .label = labels[count], .shadow = ls_variants[v],
-                                          .diffuse = ls_variants[v], .grid_res = res[i] };
-        }
+    count = add_sweep(configs, count, MAX_CONFIGS - 1, labels, 1, res, nres, SWEEP_BOTH);
     snprintf(labels[count], 32, "ls-pnmt@%d exact", mid);
     configs[count] = (pt_config){ .label = labels[count], .shadow = "ls-pnmt", .diffuse = "ls-pnmt",
                                   .grid_res = mid, .ls_origin = "exact" };

@@ -122,12 +122,10 @@ void rl_ls_occupancy_from_payloads(rl_linespace *ls)
 {
     const uint32_t S = ls->shafts_per_voxel;
     #pragma omp parallel for schedule(static)
-    for (long b = 0; b < (long)ls->num_blocks; ++b) {
-        uint64_t *w = ls->occupied + (uint64_t)b * ls->occ_words;
+    for (long b = 0; b < (long)ls->num_blocks; ++b)
         for (uint32_t s = 0; s < S; ++s)
             if (shaft_has_triangles(ls, (uint64_t)b * S + s))
-                w[s >> 6] |= 1ull << (s & 63u);
-    }
+                rl_ls_shaft_mark(ls, (uint32_t)b, s);
 }
 
 rl_status rl_linespace_commit(rl_linespace *ls)

@@ -450,7 +450,7 @@ static bool build_voxel(rl_linespace *ls, const rl_ls_geometry *geo, workspace *
         if (m == 0)
             ++vs->empty;
         else
-            ls->occupied[(uint64_t)b * ls->occ_words + (s >> 6)] |= 1ull << (s & 63u);
+            rl_ls_shaft_mark(ls, b, s);
         vs->sum += m;
         if (m > vs->max)
             vs->max = m;

@@ -62,6 +62,11 @@ static inline bool rl_ls_shaft_occupied(const rl_linespace *ls, uint32_t block, 
 {
     return (ls->occupied[(uint64_t)block * ls->occ_words + (shaft >> 6)] >> (shaft & 63u)) & 1u;
 }
+/* Sets the bit (each block's words belong to one build thread). */
+static inline void rl_ls_shaft_mark(rl_linespace *ls, uint32_t block, uint32_t shaft)
+{
+    ls->occupied[(uint64_t)block * ls->occ_words + (shaft >> 6)] |= 1ull << (shaft & 63u);
+}
 
 /* ---- shaft geometry (linespace_shaft.c) ---- */
 

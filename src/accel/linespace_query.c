@@ -315,16 +315,22 @@ static bool origin_hit(const rl_linespace *ls, const rl_ray *ray, uint32_t cell,
     return true;
 }
 
+/* Half a voxel diagonal in the ray's parameter: how far a point of a voxel
+ * can project from the voxel centre's projection. Once per query. */
+static float half_diagonal_t(const rl_linespace *ls, const rl_ray *ray)
+{
+    return 0.5f * rl_length(ls->grid->cell_size) / rl_length(ray->d);
+}
+
 /* Whether every point of voxel xyz projects on the ray strictly inside
  * (lo, t_max): a stored point (clamped to its voxel, linespace_build.c)
- * then needs no decoding for a shadow test. The centre's projection +- the
- * half diagonal over |d| bounds every point's; the slack covers rounding,
- * so the answer is always the one the record gives. */
-static bool voxel_within(const rl_linespace *ls, const int xyz[3], const rl_ray *ray, float lo)
+ * then needs no decoding for a shadow test. The centre's projection +- r
+ * (half_diagonal_t) bounds every point's; the slack covers rounding, so
+ * the answer is always the one the record gives. */
+static bool voxel_within(const rl_linespace *ls, const int xyz[3], const rl_ray *ray, float lo, float r)
 {
     rl_aabb box = rl_grid_cell_bounds(ls->grid, xyz[0], xyz[1], xyz[2]);
     float tc = project_t(ray, rl_scale(rl_add(box.min, box.max), 0.5f));
-    float r = 0.5f * rl_length(ls->grid->cell_size) / rl_length(ray->d);
     float slack = 1e-4f * r + 1e-6f * fabsf(tc);
     return tc - r - slack > lo && tc + r + slack < ray->t_max;
 }
@@ -345,6 +351,7 @@ static bool pnmt_walk(const rl_linespace *ls, const rl_ray *ray, rl_ls_surface *
     cell_line line;
     cell_line_setup(ls, ray, &line);
     bool first = origin_inside(ls, ray);
+    float r = out ? 0.0f : half_diagonal_t(ls, ray);
     uint32_t cell;
     float t0, t1;
     while (rl_grid_dda_next(&it, &cell, &t0, &t1)) {
@@ -363,7 +370,7 @@ static bool pnmt_walk(const rl_linespace *ls, const rl_ray *ray, rl_ls_surface *
                 return true;
             continue;
         }
-        if (!out && voxel_within(ls, it.current, ray, ray->t_min))
+        if (!out && voxel_within(ls, it.current, ray, ray->t_min, r))
             return true;          /* the record lies in the voxel: inside (t_min, t_max) */
         const uint16_t *rec = ls->pnmt + ((uint64_t)block * ls->shafts_per_voxel + shaft) * 16 +
                               (fwd ? 0 : RL_LS_PNMT_RECORD);
@@ -408,8 +415,8 @@ static bool preillum_walk(const rl_linespace *ls, const rl_ray *ray, rl_vec3 *co
     cell_line line;
     cell_line_setup(ls, ray, &line);
     bool first = origin_inside(ls, ray);
-    float dlen = rl_length(ray->d);
-    float margin = ORIGIN_MARGIN_REL * rl_length(ls->grid->cell_size) / dlen;
+    float margin = ORIGIN_MARGIN_REL * rl_length(ls->grid->cell_size) / rl_length(ray->d);
+    float r = color ? 0.0f : half_diagonal_t(ls, ray);
     uint32_t cell;
     float t0, t1;
     while (rl_grid_dda_next(&it, &cell, &t0, &t1)) {
@@ -426,7 +433,7 @@ static bool preillum_walk(const rl_linespace *ls, const rl_ray *ray, rl_vec3 *co
         uint64_t g = (uint64_t)block * ls->shafts_per_voxel + shaft;
         float t = 0.5f * (t0 + t1);
         if (ls->pnmt) {
-            if (!color && voxel_within(ls, it.current, ray, lo))
+            if (!color && voxel_within(ls, it.current, ray, lo, r))
                 return true;
             rl_ls_surface s;
             if (decode_pnmt(ls, it.current, ls->pnmt + g * 16 + (fwd ? 0 : RL_LS_PNMT_RECORD), &s))
