@@ -107,4 +107,19 @@ assert "machine" in r
 assert r["parameters"]["samples_base"] == 5 and r["parameters"]["samples_per_meter"] == 0.05
 PY
 fi
+# --samples-base reaches the adaptive variants but not the grid or the
+# thesis' bnc-region.
+run_ok "$RL" bench sampling --quick --only variants --samples-base 12 --out "$TMP/b12.json"
+if have_python; then
+    python3 - "$TMP/b.json" "$TMP/b12.json" <<'PY' || fail "--samples-base is not applied as documented"
+import json, sys
+a, b = (json.load(open(f)) for f in sys.argv[1:3])
+assert b["parameters"]["samples_base"] == 12
+ca, cb = a["variants"]["cases"], b["variants"]["cases"]
+err = lambda c, v: c[v]["abs_error"]["mean"]
+for x, y in zip(ca, cb):
+    assert err(x, "grid") == err(y, "grid") and err(x, "bnc-region") == err(y, "bnc-region"), (x, y)
+assert any(err(x, "bn-corners") != err(y, "bn-corners") for x, y in zip(ca, cb))
+PY
+fi
 echo "ok"
