@@ -15,6 +15,7 @@
 #include <stb/stb_image.h>
 
 #include "core/error.h"
+#include "core/texture_sample.h"
 
 #define TEXTURE_MAX_SIZE 16384
 
@@ -112,32 +113,7 @@ void rl_texture_release(rl_texture *tex)
     free(tex);
 }
 
-/* Integer index i wrapped into [0, n). */
-static int wrap(long long i, int n)
-{
-    long long r = i % n;
-    return (int)(r < 0 ? r + n : r);
-}
-
 rl_vec4 rl_texture_sample(const rl_texture *tex, rl_vec2 uv)
 {
-    float u = uv.x, v = uv.y;
-    /* Reduce to [0,1) first: keeps huge or NaN coordinates in integer range. */
-    u = isfinite(u) ? u - floorf(u) : 0.0f;
-    v = isfinite(v) ? v - floorf(v) : 0.0f;
-    /* Texel centres sit at half-integers; v = 0 is the bottom of the picture. */
-    float fx = u * (float)tex->width - 0.5f;
-    float fy = (1.0f - v) * (float)tex->height - 0.5f;
-    float x0f = floorf(fx), y0f = floorf(fy);
-    float tx = fx - x0f, ty = fy - y0f;
-    int x0 = wrap((long long)x0f, tex->width), x1 = wrap((long long)x0f + 1, tex->width);
-    int y0 = wrap((long long)y0f, tex->height), y1 = wrap((long long)y0f + 1, tex->height);
-    const rl_vec4 *row0 = tex->texels + (size_t)y0 * tex->width;
-    const rl_vec4 *row1 = tex->texels + (size_t)y1 * tex->width;
-    float w00 = (1 - tx) * (1 - ty), w10 = tx * (1 - ty), w01 = (1 - tx) * ty, w11 = tx * ty;
-    rl_vec4 a = row0[x0], b = row0[x1], c = row1[x0], d = row1[x1];
-    return rl_v4(w00 * a.x + w10 * b.x + w01 * c.x + w11 * d.x,
-                 w00 * a.y + w10 * b.y + w01 * c.y + w11 * d.y,
-                 w00 * a.z + w10 * b.z + w01 * c.z + w11 * d.z,
-                 w00 * a.w + w10 * b.w + w01 * c.w + w11 * d.w);
+    return rl_texture_sample_inline(tex, uv);
 }

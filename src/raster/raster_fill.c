@@ -23,6 +23,9 @@
  *    contraction in ISO C mode), so its fragments get bit-identical depth;
  *    a different, nearer triangle wrote a different depth there, and equal
  *    depth from another triangle is as rare as an exact tie. */
+#include <math.h>
+
+#include "core/texture_sample.h"
 #include "raster/raster_internal.h"
 
 static inline rl_vec4 mul4(rl_vec4 a, rl_vec4 b)
@@ -45,48 +48,109 @@ shade(const rl_raster_prim *p, double l0, double l1, double l2, double inv_iw)
         const rl_vec2 *t = p->uvw;
         rl_vec2 uv = rl_v2((float)((l0 * t[0].x + l1 * t[1].x + l2 * t[2].x) * inv_iw),
                            (float)((l0 * t[0].y + l1 * t[1].y + l2 * t[2].y) * inv_iw));
-        c = mul4(c, rl_texture_sample(p->tex, uv));
+        c = mul4(c, rl_texture_sample_inline(p->tex, uv));
     }
     return c;
 }
 
-/* Ullmann 2003, Sec. 3.5.5: sum over layers of colour x texel, both read
- * from the batch at the source triangle's perspective-correct barycentrics;
- * alpha is layer 0's (interpolated, not modulated). */
-static rl_vec4 shade_layers(const rl_raster_batch *b, const rl_raster_prim_src *src, double l0,
-                            double l1, double l2, double inv_iw)
+/* A layered prim's layers, read from the batch once per fill call instead of
+ * once per fragment: the untextured layers summed per source vertex (their
+ * sum interpolates like each of them), the textured ones kept apart. */
+typedef struct layer_terms {
+    rl_vec4 plain[3];             /* rgb: untextured layers; w: layer 0's alpha */
+    int num_tex;
+    rl_vec4 col[RL_RASTER_MAX_LAYERS][3];
+    rl_vec2 uv[RL_RASTER_MAX_LAYERS][3];
+    const rl_texture *tex[RL_RASTER_MAX_LAYERS];
+} layer_terms;
+
+static void gather_layers(const rl_raster_batch *b, const rl_raster_prim_src *src, layer_terms *t)
 {
-    const rl_vec3 *bw = src->bw;
-    const double b0 = (l0 * bw[0].x + l1 * bw[1].x + l2 * bw[2].x) * inv_iw;
-    const double b1 = (l0 * bw[0].y + l1 * bw[1].y + l2 * bw[2].y) * inv_iw;
-    const double b2 = (l0 * bw[0].z + l1 * bw[1].z + l2 * bw[2].z) * inv_iw;
     const uint32_t *tri = &b->indices[3 * (size_t)src->triangle];
-    const uint32_t i0 = tri[0], i1 = tri[1], i2 = tri[2];
-    double sum_r = 0.0, sum_g = 0.0, sum_b = 0.0;
-    float alpha = 0.0f;
+    for (int k = 0; k < 3; ++k)
+        t->plain[k] = rl_v4(0.0f, 0.0f, 0.0f, b->layers[0].colors[tri[k]].w);
+    t->num_tex = 0;
     for (uint32_t i = 0; i < b->num_layers; ++i) {
         const rl_raster_layer *layer = &b->layers[i];
-        const rl_vec4 *c = layer->colors;
-        rl_vec4 col = rl_v4((float)(b0 * c[i0].x + b1 * c[i1].x + b2 * c[i2].x),
-                            (float)(b0 * c[i0].y + b1 * c[i1].y + b2 * c[i2].y),
-                            (float)(b0 * c[i0].z + b1 * c[i1].z + b2 * c[i2].z),
-                            (float)(b0 * c[i0].w + b1 * c[i1].w + b2 * c[i2].w));
-        if (i == 0)
-            alpha = col.w;
+        const rl_texture *tex = NULL;
         if (layer->uvs && layer->textures && layer->triangle_texture) {
             uint32_t ti = layer->triangle_texture[src->triangle];
-            if (ti != RL_ID_NONE) {
-                const rl_vec2 *uv = layer->uvs;
-                rl_vec2 at = rl_v2((float)(b0 * uv[i0].x + b1 * uv[i1].x + b2 * uv[i2].x),
-                                   (float)(b0 * uv[i0].y + b1 * uv[i1].y + b2 * uv[i2].y));
-                col = mul4(col, rl_texture_sample(layer->textures[ti], at));
+            if (ti != RL_ID_NONE)
+                tex = layer->textures[ti];
+        }
+        for (int k = 0; k < 3; ++k) {
+            rl_vec4 c = layer->colors[tri[k]];
+            if (tex) {
+                t->col[t->num_tex][k] = c;
+                t->uv[t->num_tex][k] = layer->uvs[tri[k]];
+            } else {
+                t->plain[k].x += c.x;
+                t->plain[k].y += c.y;
+                t->plain[k].z += c.z;
             }
         }
-        sum_r += col.x;
-        sum_g += col.y;
-        sum_b += col.z;
+        if (tex)
+            t->tex[t->num_tex++] = tex;
     }
-    return rl_v4((float)sum_r, (float)sum_g, (float)sum_b, alpha);
+}
+
+/* Ullmann 2003, Sec. 3.5.5: sum over layers of colour x texel, both
+ * interpolated at the source triangle's perspective-correct barycentrics;
+ * alpha is layer 0's (interpolated, not modulated). */
+static inline __attribute__((always_inline)) rl_vec4
+shade_layers(const layer_terms *t, const rl_raster_prim_src *src, double l0, double l1, double l2,
+             double inv_iw)
+{
+    const rl_vec3 *bw = src->bw;
+    const float b0 = (float)((l0 * bw[0].x + l1 * bw[1].x + l2 * bw[2].x) * inv_iw);
+    const float b1 = (float)((l0 * bw[0].y + l1 * bw[1].y + l2 * bw[2].y) * inv_iw);
+    const float b2 = (float)((l0 * bw[0].z + l1 * bw[1].z + l2 * bw[2].z) * inv_iw);
+    const rl_vec4 *q = t->plain;
+    rl_vec4 sum = rl_v4(b0 * q[0].x + b1 * q[1].x + b2 * q[2].x,
+                        b0 * q[0].y + b1 * q[1].y + b2 * q[2].y,
+                        b0 * q[0].z + b1 * q[1].z + b2 * q[2].z,
+                        b0 * q[0].w + b1 * q[1].w + b2 * q[2].w);
+    for (int i = 0; i < t->num_tex; ++i) {
+        const rl_vec4 *c = t->col[i];
+        const rl_vec2 *uv = t->uv[i];
+        rl_vec4 texel = rl_texture_sample_inline(
+            t->tex[i], rl_v2(b0 * uv[0].x + b1 * uv[1].x + b2 * uv[2].x,
+                             b0 * uv[0].y + b1 * uv[1].y + b2 * uv[2].y));
+        sum.x += (b0 * c[0].x + b1 * c[1].x + b2 * c[2].x) * texel.x;
+        sum.y += (b0 * c[0].y + b1 * c[1].y + b2 * c[2].y) * texel.y;
+        sum.z += (b0 * c[0].z + b1 * c[1].z + b2 * c[2].z) * texel.z;
+    }
+    return sum;
+}
+
+/* Columns [*lo, *hi) of a row that may hold covered pixels: edge k is
+ * e_k(x) = e[k] - dy[k] s (x - x0), so each edge with dy != 0 bounds x on
+ * one side. Worked out in double, whose rounding (edge values reach 2^58)
+ * moves a bound by far less than a pixel; one pixel of margin on each side
+ * keeps the span a superset of the covered pixels, and the exact int64 test
+ * per pixel still decides. Returns false when a horizontal edge leaves the
+ * row empty. */
+static inline bool row_span(const int64_t e[3], const int64_t dy[3], int64_t s, int x0, int x1,
+                            int *lo, int *hi)
+{
+    double l = x0, h = x1;
+    for (int k = 0; k < 3; ++k) {
+        if (dy[k] == 0) {
+            if (e[k] < 0)
+                return false;
+            continue;
+        }
+        const double xk = x0 + (double)e[k] / (double)(dy[k] * s);
+        if (dy[k] > 0)
+            h = xk + 2.0 < h ? xk + 2.0 : h;    /* e_k falls with x: x <= xk */
+        else
+            l = xk - 1.0 > l ? xk - 1.0 : l;    /* e_k rises with x: x >= xk */
+    }
+    if (!(l < h))
+        return false;
+    *lo = (int)ceil(l) > x0 ? (int)ceil(l) : x0;
+    *hi = (int)floor(h) < x1 ? (int)floor(h) : x1;
+    return *lo < *hi;
 }
 
 /* The pixel loop, compiled twice: plain (the common single pass, kept as
@@ -98,6 +162,8 @@ fill_prim(const rl_raster_target *t, const rl_raster_prim *p, const rl_raster_pr
           int row0, int row1, const bool multi)
 {
     const int y0 = p->y0 > row0 ? p->y0 : row0, y1 = p->y1 < row1 ? p->y1 : row1;
+    if (y0 >= y1)
+        return 0;
     const int64_t s = RL_RASTER_SUBPIXEL, half = RL_RASTER_SUBPIXEL / 2;
     /* Edge k runs from vertex k+1 to k+2 and is positive on the inside. */
     int64_t dx[3], dy[3], row_e[3];
@@ -110,46 +176,55 @@ fill_prim(const rl_raster_target *t, const rl_raster_prim *p, const rl_raster_pr
     }
     const bool write_color = t->color != NULL;
     const bool depth_equal = multi && t->depth_equal;
+    const bool layered = multi && t->layered && write_color;
+    layer_terms terms;
+    if (layered)
+        gather_layers(t->layered, src, &terms);
     uint64_t passed = 0;
     for (int y = y0; y < y1; ++y) {
-        int64_t e0 = row_e[0], e1 = row_e[1], e2 = row_e[2];
-        const double cy = y + 0.5;
-        const double r0 = p->ly[0] * cy + p->l0[0], r1 = p->ly[1] * cy + p->l0[1],
-                     r2 = p->ly[2] * cy + p->l0[2];
-        size_t pix = (size_t)y * (size_t)t->width + (size_t)p->x0;
-        for (int x = p->x0; x < p->x1; ++x, ++pix) {
-            if ((e0 | e1 | e2) >= 0) {
-                const double cx = x + 0.5;
-                double l0 = p->lx[0] * cx + r0, l1 = p->lx[1] * cx + r1, l2 = p->lx[2] * cx + r2;
-                double iw = l0 * p->iw[0] + l1 * p->iw[1] + l2 * p->iw[2];
-                double inv_iw = 1.0 / iw;
-                double z = t->perspective ? inv_iw
-                                          : (l0 * p->dw[0] + l1 * p->dw[1] + l2 * p->dw[2]) * inv_iw;
-                float zf = (float)z;
-                if (!t->depth_test ||
-                    (depth_equal ? zf == t->depth_test[pix] : zf < t->depth_test[pix])) {
-                    ++passed;
-                    if (t->depth)
-                        t->depth[pix] = zf;
-                    if (write_color) {
-                        rl_vec4 c = multi && t->layered
-                                        ? shade_layers(t->layered, src, l0, l1, l2, inv_iw)
-                                        : shade(p, l0, l1, l2, inv_iw);
-                        if (multi && t->blend_add) {
-                            rl_vec4 dst = t->color[pix];
-                            c = rl_v4(dst.x + c.x, dst.y + c.y, dst.z + c.z, dst.w);
+        int xs, xe;
+        if (row_span(row_e, dy, s, p->x0, p->x1, &xs, &xe)) {
+            const int64_t skip = xs - p->x0;
+            int64_t e0 = row_e[0] - dy[0] * s * skip, e1 = row_e[1] - dy[1] * s * skip,
+                    e2 = row_e[2] - dy[2] * s * skip;
+            const double cy = y + 0.5;
+            const double r0 = p->ly[0] * cy + p->l0[0], r1 = p->ly[1] * cy + p->l0[1],
+                         r2 = p->ly[2] * cy + p->l0[2];
+            size_t pix = (size_t)y * (size_t)t->width + (size_t)xs;
+            for (int x = xs; x < xe; ++x, ++pix) {
+                if ((e0 | e1 | e2) >= 0) {
+                    const double cx = x + 0.5;
+                    double l0 = p->lx[0] * cx + r0, l1 = p->lx[1] * cx + r1, l2 = p->lx[2] * cx + r2;
+                    double iw = l0 * p->iw[0] + l1 * p->iw[1] + l2 * p->iw[2];
+                    double inv_iw = 1.0 / iw;
+                    double z = t->perspective
+                                   ? inv_iw
+                                   : (l0 * p->dw[0] + l1 * p->dw[1] + l2 * p->dw[2]) * inv_iw;
+                    float zf = (float)z;
+                    if (!t->depth_test ||
+                        (depth_equal ? zf == t->depth_test[pix] : zf < t->depth_test[pix])) {
+                        ++passed;
+                        if (t->depth)
+                            t->depth[pix] = zf;
+                        if (write_color) {
+                            rl_vec4 c = layered ? shade_layers(&terms, src, l0, l1, l2, inv_iw)
+                                                : shade(p, l0, l1, l2, inv_iw);
+                            if (multi && t->blend_add) {
+                                rl_vec4 dst = t->color[pix];
+                                c = rl_v4(dst.x + c.x, dst.y + c.y, dst.z + c.z, dst.w);
+                            }
+                            t->color[pix] = c;
                         }
-                        t->color[pix] = c;
+                        if (t->object_id)
+                            t->object_id[pix] = p->object_id;
+                        if (t->triangle_id)
+                            t->triangle_id[pix] = p->triangle_id;
                     }
-                    if (t->object_id)
-                        t->object_id[pix] = p->object_id;
-                    if (t->triangle_id)
-                        t->triangle_id[pix] = p->triangle_id;
                 }
+                e0 -= dy[0] * s;
+                e1 -= dy[1] * s;
+                e2 -= dy[2] * s;
             }
-            e0 -= dy[0] * s;
-            e1 -= dy[1] * s;
-            e2 -= dy[2] * s;
         }
         row_e[0] += dx[0] * s;
         row_e[1] += dx[1] * s;
