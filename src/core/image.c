@@ -64,28 +64,41 @@ void rl_image_release(rl_image *img)
     free(img);
 }
 
+/* Frames are cleared and filled once per render, at up to 16 MB of colour
+ * each: in parallel above this many pixels (a nested call, inside another
+ * parallel region, runs on its own thread). */
+#define PARALLEL_PIXELS (1 << 16)
+
 void rl_image_clear(rl_image *img)
 {
     if (!img)
         return;
-    size_t n = (size_t)img->width * (size_t)img->height;
-    if (img->color)
-        memset(img->color, 0, n * sizeof *img->color);
-    for (size_t i = 0; img->depth && i < n; ++i)
-        img->depth[i] = INFINITY;
-    for (size_t i = 0; img->object_id && i < n; ++i)
-        img->object_id[i] = RL_ID_NONE;
-    for (size_t i = 0; img->triangle_id && i < n; ++i)
-        img->triangle_id[i] = RL_ID_NONE;
+    const int64_t n = (int64_t)img->width * (int64_t)img->height;
+    rl_vec4 *color = img->color;
+    float *depth = img->depth;
+    uint32_t *object_id = img->object_id, *triangle_id = img->triangle_id;
+    #pragma omp parallel for schedule(static) if (n >= PARALLEL_PIXELS)
+    for (int64_t i = 0; i < n; ++i) {
+        if (color)
+            color[i] = rl_v4(0.0f, 0.0f, 0.0f, 0.0f);
+        if (depth)
+            depth[i] = INFINITY;
+        if (object_id)
+            object_id[i] = RL_ID_NONE;
+        if (triangle_id)
+            triangle_id[i] = RL_ID_NONE;
+    }
 }
 
 void rl_image_fill(rl_image *img, rl_vec4 color)
 {
     if (!img || !img->color)
         return;
-    size_t n = (size_t)img->width * (size_t)img->height;
-    for (size_t i = 0; i < n; ++i)
-        img->color[i] = color;
+    const int64_t n = (int64_t)img->width * (int64_t)img->height;
+    rl_vec4 *c = img->color;
+    #pragma omp parallel for schedule(static) if (n >= PARALLEL_PIXELS)
+    for (int64_t i = 0; i < n; ++i)
+        c[i] = color;
 }
 
 static const char *extension_of(const char *path)

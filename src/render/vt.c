@@ -110,6 +110,14 @@ typedef struct vt_state {
     size_t num_vinfo, num_finfo;
     rl_vt_update_fn update;
     void *update_user;
+    /* frame buffers kept across frames, so that a frame does not fault in
+     * fresh pages (a 1024² frame touches tens of MB) */
+    rl_raster *ras;
+    int ras_threads;
+    rl_image *depth_ids;      /* the pre-pass' depth and IDs */
+    float *scratch_depth;     /* the frame's depth when the image has none */
+    size_t scratch_pixels;
+    vt_corners corners;
 } vt_state;
 
 static rl_status vt_create(void **state)
@@ -145,7 +153,42 @@ static void vt_release(void *state)
     vt_feeler_map_free(&s->feelers);
     free(s->vinfo);
     free(s->finfo);
+    rl_raster_release(s->ras);
+    rl_image_release(s->depth_ids);
+    free(s->scratch_depth);
+    vt_corners_free(&s->corners);
     free(s);
+}
+
+/* The kept rasterizer, pre-pass image and scratch depth (for an image
+ * without a depth layer), (re)made when the thread count or the frame size
+ * changed. */
+static rl_status frame_buffers(vt_state *s, int threads, const rl_image *image)
+{
+    const int width = image->width, height = image->height;
+    const size_t n = (size_t)width * (size_t)height;
+    if ((!(image->layers & RL_LAYER_DEPTH) || !image->depth) && s->scratch_pixels != n) {
+        free(s->scratch_depth);
+        s->scratch_pixels = 0;
+        if (!(s->scratch_depth = rl_realloc_array(NULL, n, sizeof *s->scratch_depth)))
+            return rl_error(RL_ERR_OUT_OF_MEMORY, "vt: depth of %dx%d pixels", width, height);
+        s->scratch_pixels = n;
+    }
+    rl_status st;
+    if (!s->ras || s->ras_threads != threads) {
+        rl_raster_release(s->ras);
+        s->ras = NULL;
+        if ((st = rl_raster_create(&(rl_raster_desc){ .threads = threads }, &s->ras)) != RL_OK)
+            return st;
+        s->ras_threads = threads;
+    }
+    if (!s->depth_ids || s->depth_ids->width != width || s->depth_ids->height != height) {
+        rl_image_release(s->depth_ids);
+        s->depth_ids = NULL;
+        if ((st = rl_image_create(width, height, RL_LAYER_DEPTH | RL_LAYER_ID, &s->depth_ids)) != RL_OK)
+            return st;
+    }
+    return RL_OK;
 }
 
 static rl_status vt_check(const char *key, const char *value)
@@ -453,10 +496,13 @@ static rl_status vt_render(rl_renderer *r, void *state, const rl_scene *scene, c
     for (uint32_t o = 0; o < d->num_objects; ++o)
         run.stats.vt_objects += s->object_vt[o];
 
-    rl_image *depth_ids = NULL;
     st = vt_run_reserve(&run);
     if (st == RL_OK)
-        st = rl_image_create(image->width, image->height, RL_LAYER_DEPTH | RL_LAYER_ID, &depth_ids);
+        st = frame_buffers(s, set.threads, image);
+    rl_image *depth_ids = s->depth_ids;
+    run.ras = s->ras;
+    run.corners = &s->corners;
+    run.scratch_depth = s->scratch_depth;
     double t0 = rl_time_s() * 1000.0;
     if (st == RL_OK)
         st = vt_prepass(&run, depth_ids);
@@ -475,11 +521,9 @@ static rl_status vt_render(rl_renderer *r, void *state, const rl_scene *scene, c
         st = keep_feelers(s, &run);
     if (st == RL_OK)
         st = keep_mesh(s, &run);
-    rl_image_release(depth_ids);
     vt_run_free_blocks(&run);
     free(run.reason);
     free(run.feelers);
-    free(run.scratch_depth);
     vt_draw_free_base(&run);
     if (st != RL_OK)
         return st;

@@ -32,19 +32,9 @@
 #include "render/vt_run.h"
 #include "rl/rl_timer.h"
 
-#define NUM_LAYERS 4
+#define NUM_LAYERS VT_NUM_LAYERS
 
-typedef struct corner_buf {
-    size_t faces;
-    rl_vec3 *pos;
-    rl_vec4 *col[NUM_LAYERS];
-    rl_vec2 *uv[NUM_LAYERS];
-    uint32_t *tex[NUM_LAYERS];    /* per face */
-    uint32_t *idx;
-    uint32_t *tri_ids, *obj_ids;  /* per face */
-} corner_buf;
-
-static void free_corners(corner_buf *b)
+void vt_corners_free(vt_corners *b)
 {
     free(b->pos);
     for (int l = 0; l < NUM_LAYERS; ++l) {
@@ -55,23 +45,33 @@ static void free_corners(corner_buf *b)
     free(b->idx);
     free(b->tri_ids);
     free(b->obj_ids);
+    free(b->faces);
     memset(b, 0, sizeof *b);
 }
 
-static bool alloc_corners(corner_buf *b, size_t faces)
+/* Room for `faces` faces: grows by doubling, never shrinks. */
+static bool reserve_corners(vt_corners *b, size_t faces)
 {
-    memset(b, 0, sizeof *b);
-    b->faces = faces;
-    size_t n = faces ? faces * 3 : 1;
-    bool ok = (b->pos = rl_realloc_array(NULL, n, sizeof *b->pos)) && (b->idx = rl_realloc_array(NULL, n, sizeof *b->idx)) &&
-              (b->tri_ids = rl_realloc_array(NULL, n / 3 + 1, sizeof *b->tri_ids)) &&
-              (b->obj_ids = rl_realloc_array(NULL, n / 3 + 1, sizeof *b->obj_ids));
+    if (faces <= b->cap)
+        return true;
+    size_t cap = b->cap ? b->cap : 1024;
+    while (cap < faces)
+        cap *= 2;
+    vt_corners_free(b);
+    size_t n = cap * 3;
+    bool ok = (b->pos = rl_realloc_array(NULL, n, sizeof *b->pos)) &&
+              (b->idx = rl_realloc_array(NULL, n, sizeof *b->idx)) &&
+              (b->tri_ids = rl_realloc_array(NULL, cap, sizeof *b->tri_ids)) &&
+              (b->obj_ids = rl_realloc_array(NULL, cap, sizeof *b->obj_ids)) &&
+              (b->faces = rl_realloc_array(NULL, cap, sizeof *b->faces));
     for (int l = 0; ok && l < NUM_LAYERS; ++l)
         ok = (b->col[l] = rl_realloc_array(NULL, n, sizeof *b->col[l])) &&
              (b->uv[l] = rl_realloc_array(NULL, n, sizeof *b->uv[l])) &&
-             (b->tex[l] = rl_realloc_array(NULL, n / 3 + 1, sizeof *b->tex[l]));
+             (b->tex[l] = rl_realloc_array(NULL, cap, sizeof *b->tex[l]));
     if (!ok)
-        free_corners(b);
+        vt_corners_free(b);
+    else
+        b->cap = cap;
     return ok;
 }
 
@@ -112,7 +112,7 @@ static uint32_t face_texture(const rl_scene_data *d, const vt_face *f)
 }
 
 /* Fills face slot i (three corners) for the texture mode. */
-static void fill_face(const vt_run *run, corner_buf *b, size_t i, const vt_face *f, bool offset)
+static void fill_face(const vt_run *run, vt_corners *b, size_t i, const vt_face *f, bool offset)
 {
     const rl_scene_data *d = run->data;
     const vt_vertex *v[3];
@@ -175,45 +175,51 @@ static bool drawable(const vt_mesh *m, const vt_face *f)
            m->verts[f->v[2]].state == VT_SAMPLED;
 }
 
+static bool taken(const vt_run *run, const vt_face *face, bool only_new)
+{
+    return (only_new ? face->stage > run->drawn_stage : face->leaf) && drawable(run->mesh, face);
+}
+
 static rl_status draw_faces(vt_run *run, rl_raster *ras, bool only_new, unsigned id_flags)
 {
     const vt_mesh *m = run->mesh;
     size_t count = 0;
-    for (uint32_t f = 0; f < m->num_faces; ++f) {
-        const vt_face *face = &m->faces[f];
-        bool take = only_new ? face->stage > run->drawn_stage : face->leaf;
-        count += take && drawable(m, face);
-    }
+    for (uint32_t f = 0; f < m->num_faces; ++f)
+        count += taken(run, &m->faces[f], only_new);
     if (!count)
         return RL_OK;
-    corner_buf b;
-    if (!alloc_corners(&b, count))
+    vt_corners *b = run->corners;
+    if (!reserve_corners(b, count))
         return RL_ERR_OUT_OF_MEMORY;
     size_t i = 0;
-    for (uint32_t f = 0; f < m->num_faces; ++f) {
-        const vt_face *face = &m->faces[f];
-        bool take = only_new ? face->stage > run->drawn_stage : face->leaf;
-        if (take && drawable(m, face))
-            fill_face(run, &b, i++, face, run->set->progressive == VT_PROG_OVERDRAW);
-    }
+    for (uint32_t f = 0; f < m->num_faces; ++f)
+        if (taken(run, &m->faces[f], only_new))
+            b->faces[i++] = f;
+    /* Each slot depends only on its face: any thread count gives the same
+     * batch. */
+    const bool offset = run->set->progressive == VT_PROG_OVERDRAW;
+    const int threads = count >= 4096 ? run->set->threads : 1;
+    #pragma omp parallel for num_threads(threads) schedule(static)
+    for (int64_t k = 0; k < (int64_t)count; ++k)
+        fill_face(run, b, (size_t)k, &m->faces[b->faces[k]], offset);
     if (!only_new)
         run->stats.faces_drawn = count;
 
     rl_raster_batch batch;
     memset(&batch, 0, sizeof batch);
     batch.num_vertices = (uint32_t)(count * 3);
-    batch.positions = b.pos;
+    batch.positions = b->pos;
     batch.num_triangles = (uint32_t)count;
-    batch.indices = b.idx;
-    batch.triangle_ids = b.tri_ids;
-    batch.object_ids = b.obj_ids;
+    batch.indices = b->idx;
+    batch.triangle_ids = b->tri_ids;
+    batch.object_ids = b->obj_ids;
     batch.flags = id_flags;
     rl_raster_layer layers[NUM_LAYERS];
     for (int l = 0; l < NUM_LAYERS; ++l)
-        layers[l] = (rl_raster_layer){ b.col[l], b.uv[l], b.tex[l], run->data->textures };
+        layers[l] = (rl_raster_layer){ b->col[l], b->uv[l], b->tex[l], run->data->textures };
     rl_status st;
     if (run->set->textures == VT_TEX_SAMPLED) {
-        batch.colors = b.col[0];
+        batch.colors = b->col[0];
         st = rl_raster_draw(ras, &batch, &run->counters);
     } else if (run->set->textures == VT_TEX_MULTITEXTURE) {
         batch.num_layers = NUM_LAYERS;
@@ -231,17 +237,15 @@ static rl_status draw_faces(vt_run *run, rl_raster *ras, bool only_new, unsigned
             st = rl_raster_draw(ras, &batch, &run->counters);
         }
     }
-    free_corners(&b);
     return st;
 }
 
 rl_status vt_draw_target(vt_run *run, rl_image *target)
 {
     *target = *run->image;
-    size_t n = (size_t)target->width * (size_t)target->height;
     if (!(target->layers & RL_LAYER_DEPTH) || !target->depth) {
-        if (!run->scratch_depth && !(run->scratch_depth = rl_realloc_array(NULL, n, sizeof(float))))
-            return RL_ERR_OUT_OF_MEMORY;
+        if (!run->scratch_depth)
+            return rl_error(RL_ERR_INTERNAL, "vt: no scratch depth for an image without depth");
         target->depth = run->scratch_depth;
         target->layers |= RL_LAYER_DEPTH;
     }
@@ -254,13 +258,13 @@ static unsigned id_flags_of(const rl_image *target)
                                                                                     : RL_RASTER_NO_ID;
 }
 
+/* The frame's rasterizer (kept by the renderer), aimed at target. */
 static rl_status open_raster(vt_run *run, rl_image *target, rl_raster **out)
 {
-    rl_status st = rl_raster_create(&(rl_raster_desc){ .threads = run->set->threads }, out);
-    if (st == RL_OK && (st = rl_raster_set_target(*out, target, &run->view_m, &run->proj_m)) != RL_OK) {
-        rl_raster_release(*out);
-        *out = NULL;
-    }
+    *out = NULL;
+    rl_status st = rl_raster_set_target(run->ras, target, &run->view_m, &run->proj_m);
+    if (st == RL_OK)
+        *out = run->ras;
     return st;
 }
 
@@ -304,7 +308,6 @@ rl_status vt_draw_base(vt_run *run)
                                       .object_mask = run->object_raster };
         st = rl_raster_draw_scene(ras, run->data, run->view.eye, &desc, &run->counters, NULL, NULL);
     }
-    rl_raster_release(ras);
     size_t n = (size_t)target.width * (size_t)target.height;
     if (st == RL_OK && run->update) {
         bool ids = !(id_flags_of(&target) & RL_RASTER_NO_ID);
@@ -352,7 +355,6 @@ rl_status vt_draw(vt_run *run, bool only_new)
     st = open_raster(run, &target, &ras);
     if (st == RL_OK)
         st = draw_faces(run, ras, only_new, id_flags_of(&target));
-    rl_raster_release(ras);
     if (st == RL_OK)
         run->drawn = true;
     return st;

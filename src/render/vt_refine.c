@@ -53,9 +53,7 @@ rl_status vt_prepass(vt_run *run, rl_image *depth_ids)
     rl_status st = vt_draw_base(run);
     if (st == RL_OK)
         st = vt_draw_target(run, &frame);
-    rl_raster *ras = NULL;
-    if (st == RL_OK)
-        st = rl_raster_create(&(rl_raster_desc){ .threads = set->threads }, &ras);
+    rl_raster *ras = run->ras;
     if (st == RL_OK)
         st = rl_raster_set_target(ras, depth_ids, &run->view_m, &run->proj_m);
     if (st == RL_OK) {
@@ -73,7 +71,6 @@ rl_status vt_prepass(vt_run *run, rl_image *depth_ids)
         memset(&c, 0, sizeof c);
         st = rl_raster_draw_scene(ras, run->data, run->view.eye, &desc, &c, NULL, NULL);
     }
-    rl_raster_release(ras);
     if (st != RL_OK)
         return st;
 

@@ -84,6 +84,22 @@ typedef struct vt_thread_tally {
     char pad[40];
 } vt_thread_tally;
 
+/* The VT leaf faces as a layered raster batch (vt_draw.c): three corners
+ * per face, four layers (Sec. 3.5.5). Kept by the renderer across frames
+ * and only grown, so that a frame does not fault in fresh pages. */
+#define VT_NUM_LAYERS 4
+typedef struct vt_corners {
+    size_t cap;               /* faces the arrays hold */
+    rl_vec3 *pos;
+    rl_vec4 *col[VT_NUM_LAYERS];
+    rl_vec2 *uv[VT_NUM_LAYERS];
+    uint32_t *tex[VT_NUM_LAYERS];    /* per face */
+    uint32_t *idx;
+    uint32_t *tri_ids, *obj_ids;     /* per face */
+    uint32_t *faces;          /* mesh face of each slot */
+} vt_corners;
+void vt_corners_free(vt_corners *b);
+
 typedef struct vt_run {
     const vt_settings *set;
     const rl_scene_data *data;
@@ -120,6 +136,9 @@ typedef struct vt_run {
     uint32_t drawn_stage;     /* overdraw: faces of stages <= this are drawn */
     bool drawn;               /* the image holds a frame (overdraw may add to it) */
     float *scratch_depth;     /* when the image has no depth layer */
+    /* kept by the renderer across frames (vt_state) */
+    rl_raster *ras;           /* every draw of the frame; its scratch stays */
+    vt_corners *corners;
     /* the rasterized half of the frame (vt_draw_base), kept for redraws
      * when an update callback may ask for more than one full draw */
     rl_vec4 *base_color;
