@@ -123,35 +123,52 @@ shade_layers(const layer_terms *t, const rl_raster_prim_src *src, double l0, dou
     return sum;
 }
 
-/* Columns [*lo, *hi) of a row that may hold covered pixels: edge k is
- * e_k(x) = e[k] - dy[k] s (x - x0), so each edge with dy != 0 bounds x on
- * one side. Worked out in double, whose rounding (edge values reach 2^58)
- * moves a bound by far less than a pixel; one pixel of margin on each side
- * keeps the span a superset of the covered pixels, and the exact int64 test
- * per pixel still decides. Returns false when a horizontal edge leaves the
- * row empty. */
-static inline bool row_span(const int64_t e[3], const int64_t dy[3], int64_t s, int x0, int x1,
-                            int *lo, int *hi)
+/* Whether pixel x of the row is inside all three edges: edge k is
+ * e_k(x) = e[k] - dy[k] s (x - x0), exact in int64. */
+static inline bool covered(const int64_t e[3], const int64_t dy_s[3], int x0, int x)
+{
+    const int64_t dx = x - x0;
+    return ((e[0] - dy_s[0] * dx) | (e[1] - dy_s[1] * dx) | (e[2] - dy_s[2] * dx)) >= 0;
+}
+
+/* The covered columns [*lo, *hi) of a row. A row of a triangle covers one
+ * interval (the intersection of three half-lines), and each edge with
+ * dy != 0 bounds it on one side, at x0 + e[k] / (dy[k] s). The bounds are
+ * estimated in double with the reciprocal inv[k] = 1 / (dy[k] s) taken once
+ * per prim (edge values reach 2^58, so the estimate may be off by a
+ * fraction of a pixel), widened by a pixel, then trimmed with the exact
+ * int64 test: the pixel loop needs no edge test at all. Returns false for
+ * an empty row. */
+static inline bool row_span(const int64_t e[3], const int64_t dy_s[3], const double inv[3], int x0,
+                            int x1, int *lo, int *hi)
 {
     double l = x0, h = x1;
     for (int k = 0; k < 3; ++k) {
-        if (dy[k] == 0) {
+        if (dy_s[k] == 0) {
             if (e[k] < 0)
                 return false;
             continue;
         }
-        const double xk = x0 + (double)e[k] / (double)(dy[k] * s);
-        if (dy[k] > 0)
+        const double xk = x0 + (double)e[k] * inv[k];
+        if (dy_s[k] > 0)
             h = xk + 2.0 < h ? xk + 2.0 : h;    /* e_k falls with x: x <= xk */
         else
             l = xk - 1.0 > l ? xk - 1.0 : l;    /* e_k rises with x: x >= xk */
     }
     if (!(l < h))
         return false;
-    *lo = (int)ceil(l) > x0 ? (int)ceil(l) : x0;
-    *hi = (int)floor(h) < x1 ? (int)floor(h) : x1;
-    return *lo < *hi;
+    int a = (int)ceil(l) > x0 ? (int)ceil(l) : x0;
+    int b = (int)floor(h) < x1 ? (int)floor(h) : x1;
+    while (a < b && !covered(e, dy_s, x0, a))
+        ++a;
+    while (b > a && !covered(e, dy_s, x0, b - 1))
+        --b;
+    *lo = a;
+    *hi = b;
+    return a < b;
 }
+
+#define SPAN_ROWS RL_RASTER_BAND_ROWS
 
 /* The pixel loop, compiled twice: plain (the common single pass, kept as
  * lean as before multi-pass existed) and multi (DEPTH_EQUAL, BLEND_ADD,
@@ -166,69 +183,79 @@ fill_prim(const rl_raster_target *t, const rl_raster_prim *p, const rl_raster_pr
         return 0;
     const int64_t s = RL_RASTER_SUBPIXEL, half = RL_RASTER_SUBPIXEL / 2;
     /* Edge k runs from vertex k+1 to k+2 and is positive on the inside. */
-    int64_t dx[3], dy[3], row_e[3];
+    int64_t dx[3], dy[3], dy_s[3], row_e[3];
+    double inv[3];
     const int64_t px0 = p->x0 * s + half, py0 = y0 * s + half;
     for (int k = 0; k < 3; ++k) {
         int a = (k + 1) % 3, b = (k + 2) % 3;
         dx[k] = (int64_t)p->vx[b] - p->vx[a];
         dy[k] = (int64_t)p->vy[b] - p->vy[a];
         row_e[k] = dx[k] * (py0 - p->vy[a]) - dy[k] * (px0 - p->vx[a]) + p->bias[k];
+        dy_s[k] = dy[k] * s;
+        inv[k] = dy[k] ? 1.0 / (double)dy_s[k] : 0.0;
     }
     const bool write_color = t->color != NULL;
     const bool depth_equal = multi && t->depth_equal;
     const bool layered = multi && t->layered && write_color;
     layer_terms terms;
-    if (layered)
+    if (layered) {
         gather_layers(t->layered, src, &terms);
+    } else {
+        /* Never read; set so that no compiler thinks it might be. */
+        terms.num_tex = 0;
+        terms.plain[0] = terms.plain[1] = terms.plain[2] = rl_v4(0.0f, 0.0f, 0.0f, 0.0f);
+    }
     uint64_t passed = 0;
-    for (int y = y0; y < y1; ++y) {
-        int xs, xe;
-        if (row_span(row_e, dy, s, p->x0, p->x1, &xs, &xe)) {
-            const int64_t skip = xs - p->x0;
-            int64_t e0 = row_e[0] - dy[0] * s * skip, e1 = row_e[1] - dy[1] * s * skip,
-                    e2 = row_e[2] - dy[2] * s * skip;
+    /* Exact spans first, a block of rows at a time: the pixel loop then
+     * tests no edges and keeps no edge values in registers. */
+    int span_lo[SPAN_ROWS], span_hi[SPAN_ROWS];
+    for (int yb = y0; yb < y1; yb += SPAN_ROWS) {
+        const int yb1 = y1 - yb < SPAN_ROWS ? y1 : yb + SPAN_ROWS;
+        for (int y = yb; y < yb1; ++y) {
+            if (!row_span(row_e, dy_s, inv, p->x0, p->x1, &span_lo[y - yb], &span_hi[y - yb]))
+                span_lo[y - yb] = span_hi[y - yb] = 0;
+            row_e[0] += dx[0] * s;
+            row_e[1] += dx[1] * s;
+            row_e[2] += dx[2] * s;
+        }
+        for (int y = yb; y < yb1; ++y) {
+            const int xs = span_lo[y - yb], xe = span_hi[y - yb];
+            if (xs >= xe)
+                continue;
             const double cy = y + 0.5;
             const double r0 = p->ly[0] * cy + p->l0[0], r1 = p->ly[1] * cy + p->l0[1],
                          r2 = p->ly[2] * cy + p->l0[2];
             size_t pix = (size_t)y * (size_t)t->width + (size_t)xs;
             for (int x = xs; x < xe; ++x, ++pix) {
-                if ((e0 | e1 | e2) >= 0) {
-                    const double cx = x + 0.5;
-                    double l0 = p->lx[0] * cx + r0, l1 = p->lx[1] * cx + r1, l2 = p->lx[2] * cx + r2;
-                    double iw = l0 * p->iw[0] + l1 * p->iw[1] + l2 * p->iw[2];
-                    double inv_iw = 1.0 / iw;
-                    double z = t->perspective
-                                   ? inv_iw
-                                   : (l0 * p->dw[0] + l1 * p->dw[1] + l2 * p->dw[2]) * inv_iw;
-                    float zf = (float)z;
-                    if (!t->depth_test ||
-                        (depth_equal ? zf == t->depth_test[pix] : zf < t->depth_test[pix])) {
-                        ++passed;
-                        if (t->depth)
-                            t->depth[pix] = zf;
-                        if (write_color) {
-                            rl_vec4 c = layered ? shade_layers(&terms, src, l0, l1, l2, inv_iw)
-                                                : shade(p, l0, l1, l2, inv_iw);
-                            if (multi && t->blend_add) {
-                                rl_vec4 dst = t->color[pix];
-                                c = rl_v4(dst.x + c.x, dst.y + c.y, dst.z + c.z, dst.w);
-                            }
-                            t->color[pix] = c;
-                        }
-                        if (t->object_id)
-                            t->object_id[pix] = p->object_id;
-                        if (t->triangle_id)
-                            t->triangle_id[pix] = p->triangle_id;
+                const double cx = x + 0.5;
+                double l0 = p->lx[0] * cx + r0, l1 = p->lx[1] * cx + r1,
+                       l2 = p->lx[2] * cx + r2;
+                double iw = l0 * p->iw[0] + l1 * p->iw[1] + l2 * p->iw[2];
+                double inv_iw = 1.0 / iw;
+                double z = t->perspective ? inv_iw
+                                          : (l0 * p->dw[0] + l1 * p->dw[1] + l2 * p->dw[2]) * inv_iw;
+                float zf = (float)z;
+                if (t->depth_test &&
+                    !(depth_equal ? zf == t->depth_test[pix] : zf < t->depth_test[pix]))
+                    continue;
+                ++passed;
+                if (t->depth)
+                    t->depth[pix] = zf;
+                if (write_color) {
+                    rl_vec4 c = layered ? shade_layers(&terms, src, l0, l1, l2, inv_iw)
+                                        : shade(p, l0, l1, l2, inv_iw);
+                    if (multi && t->blend_add) {
+                        rl_vec4 dst = t->color[pix];
+                        c = rl_v4(dst.x + c.x, dst.y + c.y, dst.z + c.z, dst.w);
                     }
+                    t->color[pix] = c;
                 }
-                e0 -= dy[0] * s;
-                e1 -= dy[1] * s;
-                e2 -= dy[2] * s;
+                if (t->object_id)
+                    t->object_id[pix] = p->object_id;
+                if (t->triangle_id)
+                    t->triangle_id[pix] = p->triangle_id;
             }
         }
-        row_e[0] += dx[0] * s;
-        row_e[1] += dx[1] * s;
-        row_e[2] += dx[2] * s;
     }
     return passed;
 }

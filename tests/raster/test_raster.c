@@ -264,6 +264,52 @@ static void test_random_fans_cover_their_polygon_without_gaps_or_overlaps(void *
     }
 }
 
+/* Rows are filled over spans bounded in floating point and trimmed by the
+ * exact edge test (raster_fill.c): long slivers, shallow or steep, up to
+ * far off screen, must still cover every pixel well inside them and none
+ * well outside. */
+static void test_long_slivers_cover_exactly_their_pixels(void **state)
+{
+    (void)state;
+    uint64_t seed = 777;
+    int inside_total = 0;
+    for (int k = 0; k < 200; ++k) {
+        /* A long edge from one far point to another across the image, and
+         * an apex 0.2..4 px off its middle. */
+        double a[2], b[2], c[2];
+        double reach = k % 4 == 0 ? 4000.0 : 40.0;
+        double ang = 2 * RL_PI * frand(&seed);
+        double mx = 8 + 48 * frand(&seed), my = 8 + 48 * frand(&seed);
+        double ux = cos(ang), uy = sin(ang), h = 0.2 + 3.8 * frand(&seed);
+        a[0] = mx - reach * ux; a[1] = my - reach * uy;
+        b[0] = mx + reach * ux; b[1] = my + reach * uy;
+        c[0] = mx - h * uy;     c[1] = my + h * ux;
+        const double *v[3] = { a, b, c };
+        rl_vec3 pos[3];
+        double seen[3][2];
+        for (int i = 0; i < 3; ++i) {
+            pos[i] = pix((float)v[i][0], (float)v[i][1], 1);
+            seen[i][0] = (pos[i].x + 1.0) * (W / 2);   /* what the rasterizer sees */
+            seen[i][1] = (1.0 - pos[i].y) * (H / 2);
+        }
+        int counts[W * H];
+        coverage_counts(pos, 3, tri012, 1, counts);
+        for (int y = 0; y < H; ++y) {
+            for (int x = 0; x < W; ++x) {
+                double q[2] = { x + 0.5, y + 0.5 };
+                double m = inside_margin(seen[0], seen[1], seen[2], q);
+                if (m > 1e-2) {
+                    assert_int_equal(counts[y * W + x], 1);
+                    ++inside_total;
+                } else if (m < -1e-2) {
+                    assert_int_equal(counts[y * W + x], 0);
+                }
+            }
+        }
+    }
+    assert_true(inside_total > 2000);
+}
+
 /* ---- (c) depth ---------------------------------------------------------- */
 
 static void test_nearer_triangle_wins_regardless_of_draw_order(void **state)
@@ -859,6 +905,7 @@ int main(void)
         cmocka_unit_test(test_rectangle_includes_top_left_edges_and_excludes_bottom_right),
         cmocka_unit_test(test_two_triangles_sharing_a_diagonal_cover_a_square_exactly_once),
         cmocka_unit_test(test_random_fans_cover_their_polygon_without_gaps_or_overlaps),
+        cmocka_unit_test(test_long_slivers_cover_exactly_their_pixels),
         cmocka_unit_test(test_nearer_triangle_wins_regardless_of_draw_order),
         cmocka_unit_test(test_depth_is_the_perspective_correct_eye_depth_of_the_plane),
         cmocka_unit_test(test_orthographic_depth_is_the_interpolated_eye_depth),
