@@ -44,6 +44,8 @@ RL_API rl_status rl_image_create(int width, int height, unsigned layers, rl_imag
 RL_API void rl_image_release(rl_image *img);      /* NULL is a no-op */
 /* Colour to (0,0,0,0), depth to +INFINITY, IDs to RL_ID_NONE. */
 RL_API void rl_image_clear(rl_image *img);
+/* rl_image_clear with the colour set to color (a background), in one pass. */
+RL_API void rl_image_clear_to(rl_image *img, rl_vec4 color);
 RL_API void rl_image_fill(rl_image *img, rl_vec4 color);
 static inline rl_vec4 *rl_image_pixel(rl_image *img, int x, int y) { return &img->color[(size_t)y * img->width + x]; }
 

@@ -69,7 +69,7 @@ void rl_image_release(rl_image *img)
  * parallel region, runs on its own thread). */
 #define PARALLEL_PIXELS (1 << 16)
 
-void rl_image_clear(rl_image *img)
+void rl_image_clear_to(rl_image *img, rl_vec4 background)
 {
     if (!img)
         return;
@@ -80,7 +80,7 @@ void rl_image_clear(rl_image *img)
     #pragma omp parallel for schedule(static) if (n >= PARALLEL_PIXELS)
     for (int64_t i = 0; i < n; ++i) {
         if (color)
-            color[i] = rl_v4(0.0f, 0.0f, 0.0f, 0.0f);
+            color[i] = background;
         if (depth)
             depth[i] = INFINITY;
         if (object_id)
@@ -88,6 +88,11 @@ void rl_image_clear(rl_image *img)
         if (triangle_id)
             triangle_id[i] = RL_ID_NONE;
     }
+}
+
+void rl_image_clear(rl_image *img)
+{
+    rl_image_clear_to(img, rl_v4(0.0f, 0.0f, 0.0f, 0.0f));
 }
 
 void rl_image_fill(rl_image *img, rl_vec4 color)

@@ -531,8 +531,7 @@ static rl_status raster_render(rl_renderer *r, void *state, const rl_scene *scen
         st = rl_raster_set_camera(ras, &target, cam, d->bounds);
     if (st == RL_OK) {
         rl_vec3 bg = rl_renderer_opt_color(r, "background");
-        rl_image_clear(&target);
-        rl_image_fill(&target, rl_v4_from3(bg, 1.0f));
+        rl_image_clear_to(&target, rl_v4_from3(bg, 1.0f));
     }
     rl_raster_counters counters;
     memset(&counters, 0, sizeof counters);

@@ -301,8 +301,7 @@ rl_status vt_draw_base(vt_run *run)
         /* Fig. 3.17, second pass, its rasterized half: clear, the non-VT
          * objects. Drawn once: the pre-pass adds the VT objects to a copy
          * of this depth, the VT faces go on top of it. */
-        rl_image_clear(&target);
-        rl_image_fill(&target, rl_v4_from3(run->set->background, 1.0f));
+        rl_image_clear_to(&target, rl_v4_from3(run->set->background, 1.0f));
         rl_raster_scene_desc desc = { .shading = run->set->shading, .ambient = run->set->ambient,
                                       .threads = run->set->threads, .flags = id_flags_of(&target),
                                       .object_mask = run->object_raster };

@@ -62,7 +62,9 @@ rl_status vt_prepass(vt_run *run, rl_image *depth_ids)
          * already (vt_draw_base); the VT objects go on top of a copy of
          * it. Every triangle keeps its own ID, so the non-VT objects need
          * no special colour 0: their pixels name no VT face. */
-        rl_image_clear(depth_ids);
+        rl_image ids = *depth_ids;
+        ids.depth = NULL;         /* overwritten by the copy below */
+        rl_image_clear(&ids);
         memcpy(depth_ids->depth, frame.depth,
                (size_t)frame.width * (size_t)frame.height * sizeof *frame.depth);
         rl_raster_scene_desc desc = { .shading = RL_SHADING_FLAT, .threads = set->threads,

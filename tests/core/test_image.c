@@ -42,6 +42,16 @@ static void test_create_clears_every_layer(void **state)
     }
     rl_image_fill(img, rl_v4(1, 2, 3, 4));
     assert_true(rl_image_pixel(img, 2, 1)->z == 3);
+    img->depth[4] = 1.0f;
+    img->object_id[4] = img->triangle_id[5] = 7;
+    rl_image_clear_to(img, rl_v4(0.5f, 0.25f, 0.125f, 1.0f));
+    for (int i = 0; i < 6; ++i) {
+        assert_true(img->color[i].x == 0.5f && img->color[i].y == 0.25f &&
+                    img->color[i].z == 0.125f && img->color[i].w == 1.0f);
+        assert_true(isinf(img->depth[i]) && img->depth[i] > 0);
+        assert_int_equal(img->object_id[i], RL_ID_NONE);
+        assert_int_equal(img->triangle_id[i], RL_ID_NONE);
+    }
     rl_image_release(img);
     rl_image_release(NULL);
 }
