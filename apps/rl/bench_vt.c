@@ -641,7 +641,7 @@ static rl_status sec_quality(void *ctx, cJSON *sec)
 {
     bvt *b = ctx;
     static const char *const crits[] = { "tree+hsv", "hsv" };
-    static const double min_edges[] = { 1, 2, 3, 4, 6, 8, 12, 16, 24, 32 };
+    static const double min_edges[] = { 1, 2, 3, 4, 6, 8, 10, 12, 14, 16, 20, 24, 28, 32 };
     enum { NUM_CRITS = sizeof crits / sizeof crits[0], NUM_EDGES = sizeof min_edges / sizeof min_edges[0] };
     int w = b->a->width, h = b->a->height;
     ref_frame *ref = NULL;
