@@ -428,6 +428,41 @@ static void deterministic_and_coherent(void **state)
     rl_scene_release(s);
 }
 
+/* A renderer keeps its rasterizer, pre-pass image and face batch across
+ * frames: a frame of another size, thread count or set of layers must come
+ * out exactly as from a fresh renderer. */
+static void kept_buffers_follow_size_threads_and_layers(void **state)
+{
+    (void)state;
+    rl_scene *s = floor_scene(true);
+    rl_camera big = look(rl_v3(0.0f, 5.0f, 3.0f), rl_v3(0.0f, 0.0f, 0.0f), 96);
+    rl_camera small = big;
+    small.width = 72;
+    small.height = 40;
+    const char *two[] = { "threads", "2", "coherence", "false", NULL };
+    rl_renderer *kept = make_vt(two);
+    const struct { const rl_camera *cam; const char *threads; unsigned layers; } frames[] = {
+        { &big, "2", FX_ALL_LAYERS },
+        { &small, "2", FX_ALL_LAYERS },
+        { &small, "1", RL_LAYER_COLOR },   /* no depth: the renderer's scratch depth */
+        { &big, "1", RL_LAYER_COLOR },
+        { &big, "2", FX_ALL_LAYERS },
+    };
+    for (size_t k = 0; k < sizeof frames / sizeof frames[0]; ++k) {
+        assert_int_equal(rl_renderer_set(kept, "threads", frames[k].threads), RL_OK);
+        rl_image *a = fx_render_with(kept, s, frames[k].cam, frames[k].layers, NULL);
+        const char *fresh_opts[] = { "threads", frames[k].threads, "coherence", "false", NULL };
+        rl_renderer *fresh = make_vt(fresh_opts);
+        rl_image *b = fx_render_with(fresh, s, frames[k].cam, frames[k].layers, NULL);
+        fx_assert_images_identical(a, b);
+        rl_image_release(a);
+        rl_image_release(b);
+        rl_renderer_release(fresh);
+    }
+    rl_renderer_release(kept);
+    rl_scene_release(s);
+}
+
 typedef struct updates {
     int calls, finals;
     uint32_t last_stage;
@@ -551,6 +586,7 @@ int main(void)
         cmocka_unit_test(hidden_vertices_cast_no_rays),
         cmocka_unit_test(converges_to_whitted),
         cmocka_unit_test(deterministic_and_coherent),
+        cmocka_unit_test(kept_buffers_follow_size_threads_and_layers),
         cmocka_unit_test(progressive_updates),
         cmocka_unit_test(nothing_in_view),
         cmocka_unit_test(bad_options),
