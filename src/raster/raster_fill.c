@@ -150,10 +150,9 @@ static inline vf vfloor(vf x)
     return r;
 }
 
-static inline vf vcvt_f(vd x)
-{
-    return __builtin_convertvector(x, vf);
-}
+/* double lanes to float lanes (a macro: a 32-byte vector argument would
+ * change the ABI of builds without AVX, which warn about it). */
+#define vcvt_f(x) __builtin_convertvector((x), vf)
 
 /* l0 a0 + l1 a1 + l2 a2, times inv_iw when it is given: one interpolated
  * attribute for four lanes, in double like the scalar code. */
