@@ -111,13 +111,21 @@ void *rl_realloc_array(void *p, size_t count, size_t size)
     return q;
 }
 
+size_t rl_grow_capacity(size_t cap, size_t count, size_t first)
+{
+    if (count <= cap)
+        return cap;
+    size_t n = cap ? cap : (first ? first : 1);
+    while (n < count)
+        n = n > SIZE_MAX / 2 ? count : n * 2;
+    return n;
+}
+
 bool rl_reserve(void **array, size_t *cap, size_t count, size_t item_size, size_t first)
 {
     if (count <= *cap)
         return true;
-    size_t n = *cap ? *cap : (first ? first : 1);
-    while (n < count)
-        n = n > SIZE_MAX / 2 ? count : n * 2;
+    size_t n = rl_grow_capacity(*cap, count, first);
     void *p = rl_realloc_array(*array, n, item_size);
     if (!p)
         return false;

@@ -29,6 +29,10 @@ void *rl_realloc_array(void *p, size_t count, size_t size); /* overflow-checked 
  * untouched and returns false when out of memory (the error is set). The
  * _u32 form is for capacities kept in 32 bits; false also above UINT32_MAX. */
 bool rl_reserve(void **array, size_t *cap, size_t count, size_t item_size, size_t first);
+/* The capacity rl_reserve grows cap to for count items: cap itself when it
+ * is enough, else doubled from cap (or `first` when cap is 0). For several
+ * arrays kept under one capacity. */
+size_t rl_grow_capacity(size_t cap, size_t count, size_t first);
 bool rl_reserve_u32(void **array, uint32_t *cap, uint64_t count, size_t item_size, uint32_t first);
 char *rl_strdup(const char *s);
 

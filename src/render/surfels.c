@@ -182,16 +182,14 @@ static rl_status reserve(surfels_state *s, size_t n)
 {
     if (n <= s->cap)
         return RL_OK;
-    size_t cap = s->cap ? s->cap : 4096;
-    while (cap < n)
-        cap *= 2;
-    rl_vec3 *p = realloc(s->pos, cap * sizeof *p);
+    size_t cap = rl_grow_capacity(s->cap, n, 4096);
+    rl_vec3 *p = rl_realloc_array(s->pos, cap, sizeof *p);
     if (p)
         s->pos = p;
-    rl_vec4 *c = realloc(s->col, cap * sizeof *c);
+    rl_vec4 *c = rl_realloc_array(s->col, cap, sizeof *c);
     if (c)
         s->col = c;
-    float *z = realloc(s->size, cap * sizeof *z);
+    float *z = rl_realloc_array(s->size, cap, sizeof *z);
     if (z)
         s->size = z;
     if (!p || !c || !z)

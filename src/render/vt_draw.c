@@ -54,9 +54,7 @@ static bool reserve_corners(vt_corners *b, size_t faces)
 {
     if (faces <= b->cap)
         return true;
-    size_t cap = b->cap ? b->cap : 1024;
-    while (cap < faces)
-        cap *= 2;
+    size_t cap = rl_grow_capacity(b->cap, faces, 1024);
     vt_corners_free(b);
     size_t n = cap * 3;
     bool ok = (b->pos = rl_realloc_array(NULL, n, sizeof *b->pos)) &&

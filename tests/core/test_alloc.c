@@ -1,5 +1,6 @@
 /* test_alloc.c: the grow-by-doubling helpers shared by the rasterizer, the
- * octree, CHC++ and Vertex Tracing (rl_reserve, rl_reserve_u32). */
+ * octree, CHC++, surfels and Vertex Tracing (rl_reserve, rl_reserve_u32,
+ * rl_grow_capacity). */
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
@@ -33,6 +34,28 @@ static void test_reserve_doubles_from_first_and_keeps_contents(void **state)
     free(a);
 }
 
+static void test_grow_capacity_is_what_reserve_allocates(void **state)
+{
+    (void)state;
+    assert_int_equal(rl_grow_capacity(0, 0, 8), 0);
+    assert_int_equal(rl_grow_capacity(0, 3, 8), 8);
+    assert_int_equal(rl_grow_capacity(0, 3, 0), 4);     /* from 1 */
+    assert_int_equal(rl_grow_capacity(8, 8, 8), 8);
+    assert_int_equal(rl_grow_capacity(8, 9, 8), 16);
+    assert_int_equal(rl_grow_capacity(8, 100, 8), 128);
+    assert_int_equal(rl_grow_capacity(SIZE_MAX / 2 + 2, SIZE_MAX, 1), SIZE_MAX);
+    for (size_t need = 1; need < 300; need += 7) {
+        int *a = NULL;
+        size_t cap = 5;
+        size_t expect = rl_grow_capacity(cap, need, 4);
+        cap = 0;
+        assert_true(rl_reserve((void **)&a, &cap, 5, sizeof *a, 5));
+        assert_true(rl_reserve((void **)&a, &cap, need, sizeof *a, 4));
+        assert_int_equal(cap, expect);
+        free(a);
+    }
+}
+
 static void test_reserve_fails_cleanly_on_overflow(void **state)
 {
     (void)state;
@@ -62,6 +85,7 @@ int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_reserve_doubles_from_first_and_keeps_contents),
+        cmocka_unit_test(test_grow_capacity_is_what_reserve_allocates),
         cmocka_unit_test(test_reserve_fails_cleanly_on_overflow),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
