@@ -207,6 +207,34 @@ tex_fetch(const rl_texture *tex, const tex4 *a, int j)
                  w00 * A.w + w10 * B.w + w01 * C.w + w11 * D.w);
 }
 
+/* Four colours channel by channel (structure of arrays), and the
+ * transposes to and from the pixels' rl_vec4. */
+typedef struct col4 {
+    vf r, g, b, a;
+} col4;
+
+static inline col4 to_lanes(const rl_vec4 v[LANES])
+{
+    return (col4){ (vf){ v[0].x, v[1].x, v[2].x, v[3].x }, (vf){ v[0].y, v[1].y, v[2].y, v[3].y },
+                   (vf){ v[0].z, v[1].z, v[2].z, v[3].z }, (vf){ v[0].w, v[1].w, v[2].w, v[3].w } };
+}
+
+static inline void from_lanes(col4 c, rl_vec4 out[LANES])
+{
+    for (int j = 0; j < LANES; ++j)
+        out[j] = rl_v4(c.r[j], c.g[j], c.b[j], c.a[j]);
+}
+
+/* The four lanes' texels of one lookup, channel by channel. */
+static inline __attribute__((always_inline)) col4 tex_lanes(const rl_texture *tex, vf u, vf v)
+{
+    const tex4 a = tex_address(tex, u, v);
+    rl_vec4 texel[LANES];
+    for (int j = 0; j < LANES; ++j)
+        texel[j] = tex_fetch(tex, &a, j);
+    return to_lanes(texel);
+}
+
 /* shade() for four lanes. */
 static inline __attribute__((always_inline)) void
 shade4(const rl_raster_prim *p, const frag4 *f, rl_vec4 out[LANES])
@@ -240,23 +268,18 @@ shade_layers4(const layer_terms *t, const rl_raster_prim_src *src, const frag4 *
     const vf b1 = interp(f, bw[0].y, bw[1].y, bw[2].y);
     const vf b2 = interp(f, bw[0].z, bw[1].z, bw[2].z);
     const rl_vec4 *q = t->plain;
-    for (int j = 0; j < LANES; ++j)
-        out[j] = rl_v4(b0[j] * q[0].x + b1[j] * q[1].x + b2[j] * q[2].x,
-                       b0[j] * q[0].y + b1[j] * q[1].y + b2[j] * q[2].y,
-                       b0[j] * q[0].z + b1[j] * q[1].z + b2[j] * q[2].z,
-                       b0[j] * q[0].w + b1[j] * q[1].w + b2[j] * q[2].w);
+    col4 sum = { b0 * q[0].x + b1 * q[1].x + b2 * q[2].x, b0 * q[0].y + b1 * q[1].y + b2 * q[2].y,
+                 b0 * q[0].z + b1 * q[1].z + b2 * q[2].z, b0 * q[0].w + b1 * q[1].w + b2 * q[2].w };
     for (int i = 0; i < t->num_tex; ++i) {
         const rl_vec4 *c = t->col[i];
         const rl_vec2 *uv = t->uv[i];
-        const tex4 a = tex_address(t->tex[i], b0 * uv[0].x + b1 * uv[1].x + b2 * uv[2].x,
-                                   b0 * uv[0].y + b1 * uv[1].y + b2 * uv[2].y);
-        for (int j = 0; j < LANES; ++j) {
-            const rl_vec4 texel = tex_fetch(t->tex[i], &a, j);
-            out[j].x += (b0[j] * c[0].x + b1[j] * c[1].x + b2[j] * c[2].x) * texel.x;
-            out[j].y += (b0[j] * c[0].y + b1[j] * c[1].y + b2[j] * c[2].y) * texel.y;
-            out[j].z += (b0[j] * c[0].z + b1[j] * c[1].z + b2[j] * c[2].z) * texel.z;
-        }
+        const col4 x = tex_lanes(t->tex[i], b0 * uv[0].x + b1 * uv[1].x + b2 * uv[2].x,
+                                 b0 * uv[0].y + b1 * uv[1].y + b2 * uv[2].y);
+        sum.r += (b0 * c[0].x + b1 * c[1].x + b2 * c[2].x) * x.r;
+        sum.g += (b0 * c[0].y + b1 * c[1].y + b2 * c[2].y) * x.g;
+        sum.b += (b0 * c[0].z + b1 * c[1].z + b2 * c[2].z) * x.b;
     }
+    from_lanes(sum, out);
 }
 
 /* The lanes of value where pass is set replace those at dst (4 bytes each). */
