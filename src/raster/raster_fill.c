@@ -2,7 +2,8 @@
  *
  * Edge functions (Pineda 1988, "A parallel algorithm for polygon
  * rasterization") are evaluated exactly in int64 on 24.8 fixed-point
- * vertices and stepped incrementally; they decide coverage. Barycentrics
+ * vertices; they decide coverage, one covered span per row (row_span), so
+ * the pixel loop itself tests no edges. Barycentrics
  * come from the unsnapped vertices (see rl_raster_prim). 1/w and
  * attribute/w are linear in screen space, so depth = 1 / (1/w) and
  * colour = (colour/w) / (1/w) are perspective-correct (Heckbert & Moreton
@@ -130,8 +131,9 @@ shade_layers(const layer_terms *t, const rl_raster_prim_src *src, double l0, dou
  * whatever the build targets). Each lane performs the same operations in
  * the same order (ISO C mode allows no FMA contraction), so every fragment
  * gets the same bits as from the scalar loop, which still does the tails.
- * Per lane stay only the texel fetches and the colour arithmetic, which is
- * four channels wide already. */
+ * Per lane stay the texel fetches and, for single-layer prims, the colour
+ * arithmetic (four channels wide already); layered fragments are summed
+ * channel by channel. */
 #define LANES 4
 typedef double vd __attribute__((vector_size(8 * LANES)));
 typedef float vf __attribute__((vector_size(4 * LANES)));
@@ -154,8 +156,8 @@ static inline vf vfloor(vf x)
  * change the ABI of builds without AVX, which warn about it). */
 #define vcvt_f(x) __builtin_convertvector((x), vf)
 
-/* l0 a0 + l1 a1 + l2 a2, times inv_iw when it is given: one interpolated
- * attribute for four lanes, in double like the scalar code. */
+/* (l0 a0 + l1 a1 + l2 a2) / (1/w): one perspective-correct attribute for
+ * four lanes, in double like the scalar code. */
 static inline vf interp(const frag4 *f, float a0, float a1, float a2)
 {
     return vcvt_f((f->l0 * (double)a0 + f->l1 * (double)a1 + f->l2 * (double)a2) * f->inv_iw);
