@@ -13,6 +13,21 @@
 
 #include "rl/rl_image.h"
 
+/* The bilinear blend of texels (x0, y0), (x1, y0), (x0, y1), (x1, y1) with
+ * weights w00, w10, w01, w11 (indices already wrapped). */
+static inline __attribute__((always_inline)) rl_vec4
+rl_texture_blend(const rl_texture *tex, int x0, int x1, int y0, int y1, float w00, float w10,
+                 float w01, float w11)
+{
+    const rl_vec4 *row0 = tex->texels + (size_t)y0 * (size_t)tex->width;
+    const rl_vec4 *row1 = tex->texels + (size_t)y1 * (size_t)tex->width;
+    rl_vec4 a = row0[x0], b = row0[x1], c = row1[x0], d = row1[x1];
+    return rl_v4(w00 * a.x + w10 * b.x + w01 * c.x + w11 * d.x,
+                 w00 * a.y + w10 * b.y + w01 * c.y + w11 * d.y,
+                 w00 * a.z + w10 * b.z + w01 * c.z + w11 * d.z,
+                 w00 * a.w + w10 * b.w + w01 * c.w + w11 * d.w);
+}
+
 static inline __attribute__((always_inline)) rl_vec4
 rl_texture_sample_inline(const rl_texture *tex, rl_vec2 uv)
 {
@@ -32,14 +47,8 @@ rl_texture_sample_inline(const rl_texture *tex, rl_vec2 uv)
     y0 += y0 < 0 ? h : 0;
     x1 -= x1 >= w ? w : 0;
     y1 -= y1 >= h ? h : 0;
-    const rl_vec4 *row0 = tex->texels + (size_t)y0 * (size_t)w;
-    const rl_vec4 *row1 = tex->texels + (size_t)y1 * (size_t)w;
-    float w00 = (1 - tx) * (1 - ty), w10 = tx * (1 - ty), w01 = (1 - tx) * ty, w11 = tx * ty;
-    rl_vec4 a = row0[x0], b = row0[x1], c = row1[x0], d = row1[x1];
-    return rl_v4(w00 * a.x + w10 * b.x + w01 * c.x + w11 * d.x,
-                 w00 * a.y + w10 * b.y + w01 * c.y + w11 * d.y,
-                 w00 * a.z + w10 * b.z + w01 * c.z + w11 * d.z,
-                 w00 * a.w + w10 * b.w + w01 * c.w + w11 * d.w);
+    return rl_texture_blend(tex, x0, x1, y0, y1, (1 - tx) * (1 - ty), tx * (1 - ty),
+                            (1 - tx) * ty, tx * ty);
 }
 
 #endif

@@ -199,14 +199,8 @@ static inline tex4 tex_address(const rl_texture *tex, vf u, vf v)
 static inline __attribute__((always_inline)) rl_vec4
 tex_fetch(const rl_texture *tex, const tex4 *a, int j)
 {
-    const rl_vec4 *row0 = tex->texels + (size_t)a->y0[j] * (size_t)tex->width;
-    const rl_vec4 *row1 = tex->texels + (size_t)a->y1[j] * (size_t)tex->width;
-    const float w00 = a->w00[j], w10 = a->w10[j], w01 = a->w01[j], w11 = a->w11[j];
-    rl_vec4 A = row0[a->x0[j]], B = row0[a->x1[j]], C = row1[a->x0[j]], D = row1[a->x1[j]];
-    return rl_v4(w00 * A.x + w10 * B.x + w01 * C.x + w11 * D.x,
-                 w00 * A.y + w10 * B.y + w01 * C.y + w11 * D.y,
-                 w00 * A.z + w10 * B.z + w01 * C.z + w11 * D.z,
-                 w00 * A.w + w10 * B.w + w01 * C.w + w11 * D.w);
+    return rl_texture_blend(tex, a->x0[j], a->x1[j], a->y0[j], a->y1[j], a->w00[j], a->w10[j],
+                            a->w01[j], a->w11[j]);
 }
 
 /* Four colours channel by channel (structure of arrays), and the
@@ -243,10 +237,9 @@ shade4(const rl_raster_prim *p, const frag4 *f, rl_vec4 out[LANES])
 {
     if (p->gouraud) {
         const rl_vec4 *a = p->cw;
-        const vf r = interp(f, a[0].x, a[1].x, a[2].x), g = interp(f, a[0].y, a[1].y, a[2].y);
-        const vf b = interp(f, a[0].z, a[1].z, a[2].z), al = interp(f, a[0].w, a[1].w, a[2].w);
-        for (int j = 0; j < LANES; ++j)
-            out[j] = rl_v4(r[j], g[j], b[j], al[j]);
+        from_lanes((col4){ interp(f, a[0].x, a[1].x, a[2].x), interp(f, a[0].y, a[1].y, a[2].y),
+                           interp(f, a[0].z, a[1].z, a[2].z), interp(f, a[0].w, a[1].w, a[2].w) },
+                   out);
     } else {
         for (int j = 0; j < LANES; ++j)
             out[j] = p->color;

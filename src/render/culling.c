@@ -144,8 +144,7 @@ rl_status rl_cull_target_begin(rl_image *image, rl_vec3 background, rl_cull_targ
     }
     if (!(t->image.layers & RL_LAYER_ID) || !t->image.object_id || !t->image.triangle_id)
         t->flags |= RL_RASTER_NO_ID;
-    rl_image_clear(&t->image);
-    rl_image_fill(&t->image, rl_v4_from3(background, 1.0f));
+    rl_image_clear_to(&t->image, rl_v4_from3(background, 1.0f));
     return RL_OK;
 }
 
