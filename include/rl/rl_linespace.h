@@ -43,17 +43,24 @@
  *   voxel_slot[cell]  per grid cell, the index of its Line Space block, or
  *                     RL_NONE for a voxel without triangles (an empty voxel
  *                     needs no shafts: every ray crosses it freely);
- *   shaft s of block b has global index g = b·15·N^4 + s;
- *   fixed lists:   cand[g·k .. g·k + k-1], front half then back half,
+ *   occupied[b·W + s/64] bit s%64 (W = ceil(15·N^4 / 64) words per
+ *                  block): whether any triangle overlaps shaft s of block
+ *                  b. Only occupied shafts have lists and records, stored
+ *                  at the shaft's rank among all occupied shafts,
+ *                  r = rank[b·W + s/64] + popcount(occupied[b·W + s/64] &
+ *                  ((1 << s%64) - 1)), with rank[w] the occupied shafts
+ *                  before word w (our change: the thesis stores every
+ *                  shaft; about half are empty, so this halves the
+ *                  memory);
+ *   fixed lists:   cand[r·k .. r·k + k-1], front half then back half,
  *                  RL_NONE padded;
- *   dynamic lists: cand[start[g] .. start[g+1]-1], ordered front to back;
- *   pnmt[g·16 .. g·16 + 15] (uint16 half floats), front record then back:
+ *   dynamic lists: cand[start[r] .. start[r+1]-1], ordered front to back;
+ *   pnmt[r·16 .. r·16 + 15] (uint16 half floats), front record then back:
  *                  position (voxel-relative, in [0,1]^3 of the voxel box:
  *                  our change, it keeps half-float precision independent
  *                  of the scene's size), normal x, y, material ID + 1 with
- *                  the sign of n_z, texcoord u, v; an empty shaft has
- *                  material field 0;
- *   preillum[g·8 .. g·8 + 7] (half floats), front RGBA then back RGBA.
+ *                  the sign of n_z, texcoord u, v;
+ *   preillum[r·8 .. r·8 + 7] (half floats), front RGBA then back RGBA.
  *
  * Lifecycle as rl_accel: create (borrowing a committed RL_ACCEL_GRID accel,
  * which must outlive the Line Space), optionally set the shading function,
@@ -197,10 +204,14 @@ typedef struct rl_linespace_data {
     uint32_t num_cells, num_blocks;
     const uint32_t *voxel_slot;        /* num_cells entries */
     const uint32_t *cand;              /* candidate triangle IDs */
-    const uint32_t *cand_start;        /* dynamic: num_blocks·S + 1 entries; else NULL */
+    const uint32_t *cand_start;        /* dynamic: num_occupied + 1 entries; else NULL */
     uint64_t num_cand;
-    const uint16_t *pnmt;              /* or NULL */
-    const uint16_t *preillum;          /* or NULL */
+    const uint16_t *pnmt;              /* num_occupied records, or NULL */
+    const uint16_t *preillum;          /* num_occupied records, or NULL */
+    uint32_t occ_words;                /* W: occupancy words per block */
+    uint64_t num_occupied;             /* shafts with triangles */
+    const uint64_t *occupied;          /* num_blocks·W words */
+    const uint32_t *rank;              /* num_blocks·W entries */
 } rl_linespace_data;
 RL_API void rl_linespace_get_data(const rl_linespace *ls, rl_linespace_data *out);
 

@@ -81,18 +81,18 @@ rl_status rl_linespace_set_origin(rl_linespace *ls, rl_ls_origin origin)
 
 size_t rl_ls_memory_bytes(const rl_linespace *ls)
 {
-    uint64_t shafts = (uint64_t)ls->num_blocks * ls->shafts_per_voxel;
+    uint64_t occ = ls->num_occupied;
     size_t bytes = (size_t)ls->num_cells * sizeof(uint32_t);
     if (ls->cand)
         bytes += (size_t)ls->num_cand * sizeof(uint32_t);
     if (ls->cand_start)
-        bytes += (size_t)(shafts + 1) * sizeof(uint32_t);
+        bytes += (size_t)(occ + 1) * sizeof(uint32_t);
     if (ls->pnmt)
-        bytes += (size_t)shafts * 16 * sizeof(uint16_t);
+        bytes += (size_t)occ * 16 * sizeof(uint16_t);
     if (ls->preillum)
-        bytes += (size_t)shafts * 8 * sizeof(uint16_t);
+        bytes += (size_t)occ * 8 * sizeof(uint16_t);
     if (ls->occupied)
-        bytes += (size_t)ls->num_blocks * ls->occ_words * sizeof(uint64_t);
+        bytes += (size_t)ls->num_blocks * ls->occ_words * (sizeof(uint64_t) + sizeof(uint32_t));
     return bytes;
 }
 
@@ -101,31 +101,19 @@ bool rl_ls_occupancy_alloc(rl_linespace *ls)
     ls->occ_words = (ls->shafts_per_voxel + 63u) / 64u;
     size_t words = (size_t)ls->num_blocks * ls->occ_words;
     ls->occupied = calloc(words ? words : 1, sizeof *ls->occupied);
-    return ls->occupied != NULL;
+    ls->rank = malloc((words ? words : 1) * sizeof *ls->rank);
+    return ls->occupied && ls->rank;
 }
 
-/* Any payload tells: a shaft with triangles has a non-empty dynamic list, a
- * first fixed slot (the front half fills first), a PNMT material (ID + 1,
- * never 0) and a PREILLUM alpha of 1. */
-static bool shaft_has_triangles(const rl_linespace *ls, uint64_t g)
+void rl_ls_rank_from_bits(rl_linespace *ls)
 {
-    if (ls->pnmt)
-        return ls->pnmt[g * 16 + RL_LS_PNMT_MAT] != 0;
-    if (ls->preillum)
-        return ls->preillum[g * 8 + 3] != 0;
-    if (ls->dynamic)
-        return ls->cand_start[g + 1] > ls->cand_start[g];
-    return ls->cand[g * (uint64_t)ls->k] != RL_NONE;
-}
-
-void rl_ls_occupancy_from_payloads(rl_linespace *ls)
-{
-    const uint32_t S = ls->shafts_per_voxel;
-    #pragma omp parallel for schedule(static)
-    for (long b = 0; b < (long)ls->num_blocks; ++b)
-        for (uint32_t s = 0; s < S; ++s)
-            if (shaft_has_triangles(ls, (uint64_t)b * S + s))
-                rl_ls_shaft_mark(ls, (uint32_t)b, s);
+    size_t words = (size_t)ls->num_blocks * ls->occ_words;
+    uint64_t sum = 0;
+    for (size_t i = 0; i < words; ++i) {
+        ls->rank[i] = (uint32_t)sum;
+        sum += (uint64_t)__builtin_popcountll(ls->occupied[i]);
+    }
+    ls->num_occupied = sum;
 }
 
 rl_status rl_linespace_commit(rl_linespace *ls)
@@ -187,4 +175,8 @@ void rl_linespace_get_data(const rl_linespace *ls, rl_linespace_data *out)
     out->num_cand = ls->num_cand;
     out->pnmt = ls->pnmt;
     out->preillum = ls->preillum;
+    out->occ_words = ls->occ_words;
+    out->num_occupied = ls->num_occupied;
+    out->occupied = ls->occupied;
+    out->rank = ls->rank;
 }

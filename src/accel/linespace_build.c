@@ -2,8 +2,8 @@
  * (Schröder 2017, Sec. 7.1, Alg. 3; dynamic lists as proposed in Sec. 7.1.1;
  * PREILLUM Sec. 7.3; PNMT Sec. 7.4).
  *
- * Per voxel (a grid cell with at least one triangle; OpenMP over voxels,
- * dynamic schedule): every triangle of the cell is clipped to the voxel and
+ * Per voxel (a grid cell with at least one triangle; OpenMP threads claim
+ * voxels in order): every triangle of the cell is clipped to the voxel and
  * rl_ls_enumerate (linespace_shaft.c) lists the shafts it may overlap, with
  * its position along each shaft. A counting sort groups the entries by
  * shaft; each shaft's list is then sorted front to back by the midpoint ray
@@ -16,8 +16,7 @@
  *             a temporary block and the fill pass copies them to their
  *             prefix-sum offsets instead of clipping everything again: twice
  *             the list memory for a moment, half the build time. The prefix
- *             sum is two-level: offsets inside each block during the pass,
- *             then the blocks' bases, added per block in parallel;
+ *             sum over the blocks runs during the pass (rank_chain);
  *   PNMT:     the front record is the first triangle the shaft's midpoint
  *             ray hits, the back record the first the reversed ray hits
  *             (Sec. 7.4). If the midpoint ray hits none of the shaft's
@@ -26,10 +25,17 @@
  *             at that candidate's key: a shaft with geometry then never
  *             reads as empty;
  *   PREILLUM: the same two surfaces, coloured by the caller's shading
- *             function (Sec. 7.3), alpha 1 (0: no surface).
- * Output depends only on the voxel, so it is the same for any number of
- * threads. */
+ *             function (Sec. 7.3), alpha 1.
+ * Only occupied shafts (a non-empty list) get lists and records, at their
+ * rank among all occupied shafts (rl_linespace.h): a block's records start
+ * at the sum of the occupied shafts of the blocks before it, which a chain
+ * of published counts provides during the pass (rank_chain below). The
+ * arrays are allocated for every shaft and shrunk at the end; the pages
+ * never written are never faulted in. Positions depend only on the
+ * voxels, so the output is the same for any number of threads. */
+#define _POSIX_C_SOURCE 200809L
 #include <math.h>
+#include <sched.h>
 #include <stdatomic.h>
 #include <stdlib.h>
 #include <string.h>
@@ -58,6 +64,21 @@ typedef struct tri_info {
     uint32_t id;                  /* scene triangle ID */
 } tri_info;
 
+/* A block whose records wait in a thread's staging area for its base
+ * (rank_chain below). */
+typedef struct staged_block {
+    uint32_t block, count;
+    size_t at;                    /* first staged record */
+} staged_block;
+
+typedef struct staging {
+    uint32_t *start, *fixed;      /* as rec_dst, `capacity` records each */
+    uint16_t *pnmt, *preillum;
+    size_t capacity, used;
+    staged_block *pending;
+    size_t npending, pending_cap;
+} staging;
+
 /* Per-thread workspace, allocated once per thread (no allocation inside
  * the per-triangle loops; the entry buffers grow between triangles). */
 typedef struct workspace {
@@ -70,6 +91,10 @@ typedef struct workspace {
     tri_info *tris;               /* the voxel's triangles, by local index */
     size_t tri_capacity;
     double pnmt_s, preillum_s;     /* ms spent on the PNMT / PREILLUM records */
+    /* The block between build_lists and write_records. */
+    uint32_t cell, occupied;
+    double lo[3], ext[3];         /* the voxel's box */
+    staging stage;
 } workspace;
 
 static bool ws_init(workspace *w, uint32_t S, int n, int k)
@@ -91,6 +116,11 @@ static void ws_free(workspace *w)
     free(w->scratch);
     free(w->iscratch);
     free(w->tris);
+    free(w->stage.start);
+    free(w->stage.fixed);
+    free(w->stage.pnmt);
+    free(w->stage.preillum);
+    free(w->stage.pending);
 }
 
 static bool ws_reserve(workspace *w, size_t need)
@@ -295,16 +325,12 @@ static inline void pick_records(const rl_ls_entry *list, uint32_t m, const rl_ls
     *eb_out = eb;
 }
 
-/* The PNMT record of shaft s (global index gidx) from its list sorted front
- * to back; a, b: the patch centres (midpoint ray) in cell units. */
+/* The PNMT record of an occupied shaft (pn: 16 halves) from its list of m
+ * >= 1 entries sorted front to back; a, b: the patch centres (midpoint ray)
+ * in cell units. */
 static void shaft_pnmt(const rl_linespace *ls, const tri_info *tris, const rl_ls_entry *list,
-                       uint32_t m, uint64_t gidx, const double a[3], const double b[3])
+                       uint32_t m, uint16_t *pn, const double a[3], const double b[3])
 {
-    uint16_t *pn = ls->pnmt + gidx * 16;
-    if (m == 0) {
-        memset(pn, 0, 16 * sizeof *pn);
-        return;
-    }
     const rl_ls_entry *ef, *eb;
     pick_records(list, m, &ef, &eb);
     double u, w;
@@ -321,16 +347,11 @@ static void shaft_pnmt(const rl_linespace *ls, const tri_info *tris, const rl_ls
     pnmt_record(ls, t, u, w, pn + RL_LS_PNMT_RECORD);
 }
 
-/* The PREILLUM record of shaft s, as shaft_pnmt. */
+/* The PREILLUM record (pi: 8 halves) of an occupied shaft, as shaft_pnmt. */
 static void shaft_preillum(const rl_linespace *ls, const tri_info *tris, const rl_ls_entry *list,
-                           uint32_t m, uint64_t gidx, const double a[3], const double bb[3],
+                           uint32_t m, uint16_t *pi, const double a[3], const double bb[3],
                            const double lo[3], const double ext[3])
 {
-    uint16_t *pi = ls->preillum + gidx * 8;
-    if (m == 0) {
-        memset(pi, 0, 8 * sizeof *pi);
-        return;
-    }
     const rl_ls_entry *pick[2];
     pick_records(list, m, &pick[0], &pick[1]);
     for (int side = 0; side < 2; ++side) {
@@ -361,25 +382,25 @@ typedef struct voxel_stats {
     uint32_t max;
 } voxel_stats;
 
-/* Builds block b (grid cell `cell`). Dynamic lists: the block's lists go
- * to *dyn_block, cand_start[b·S + s] gets shaft s's offset inside the block
- * and *dyn_count the block's total (rl_ls_build adds the block's base).
- * Returns false on out of memory. */
-static bool build_voxel(rl_linespace *ls, const rl_ls_geometry *geo, workspace *w, uint32_t b,
+/* Step 1 of a block (grid cell `cell`): the sorted list of every shaft in
+ * w->sorted / w->offset and the block's occupancy bits; w->occupied gets
+ * the number of occupied shafts. Dynamic lists: the block's lists go to
+ * *dyn_block (rl_ls_build copies them into place) and *dyn_count gets their
+ * total. Returns false on out of memory. */
+static bool build_lists(rl_linespace *ls, const rl_ls_geometry *geo, workspace *w, uint32_t b,
                         uint32_t cell, uint32_t **dyn_block, uint64_t *dyn_count, voxel_stats *vs)
 {
     const rl_grid *g = ls->grid;
     const rl_scene_data *d = ls->data;
     const uint32_t S = ls->shafts_per_voxel;
-    const int k = ls->k;
     int xyz[3];
     rl_grid_cell_coords(g, cell, xyz);
     rl_aabb box = rl_grid_cell_bounds(g, xyz[0], xyz[1], xyz[2]);
-    double lo[3], ext[3], inv_ext[3];
+    double inv_ext[3];
     for (int a = 0; a < 3; ++a) {
-        lo[a] = rl_vget(box.min, a);
-        ext[a] = (double)rl_vget(box.max, a) - lo[a];
-        inv_ext[a] = 1.0 / ext[a];
+        w->lo[a] = rl_vget(box.min, a);
+        w->ext[a] = (double)rl_vget(box.max, a) - w->lo[a];
+        inv_ext[a] = 1.0 / w->ext[a];
     }
     /* Alg. 3's loops, turned around: per triangle, the shafts it overlaps.
      * Entries carry the triangle's index in the cell's list, which is sorted
@@ -399,7 +420,7 @@ static bool build_voxel(rl_linespace *ls, const rl_ls_geometry *geo, workspace *
         double pu[3][3];
         for (int i = 0; i < 3; ++i)
             for (int a = 0; a < 3; ++a)
-                ti->v[i][a] = pu[i][a] = ((double)rl_vget(p[i], a) - lo[a]) * inv_ext[a];
+                ti->v[i][a] = pu[i][a] = ((double)rl_vget(p[i], a) - w->lo[a]) * inv_ext[a];
         ti->id = id;
         if (records) {
             const uint32_t *idx = d->indices + 3 * (size_t)id;
@@ -430,70 +451,102 @@ static bool build_voxel(rl_linespace *ls, const rl_ls_geometry *geo, workspace *
     off[0] = 0;
 
     uint32_t *dyn = NULL;
-    bool want_cand = (ls->payloads & RL_LS_CANDIDATES) != 0;
-    if (want_cand && ls->dynamic) {
+    if ((ls->payloads & RL_LS_CANDIDATES) && ls->dynamic) {
         dyn = malloc((nent ? nent : 1) * sizeof *dyn);
         if (!dyn)
             return false;
         *dyn_block = dyn;
         *dyn_count = nent;
-        memcpy(ls->cand_start + (uint64_t)b * S, off, (size_t)S * sizeof *off);
     }
+    uint32_t occupied = 0;
     for (uint32_t s = 0; s < S; ++s) {
         rl_ls_entry *list = w->sorted + off[s];
         uint32_t m = off[s + 1] - off[s];
-        uint64_t gidx = (uint64_t)b * S + s;
         if (m > 16)
             merge_sort(list, m, w->entries);   /* free after the scatter */
         else if (m > 1)
             insertion_sort(list, m, false);
-        if (m == 0)
+        if (m == 0) {
             ++vs->empty;
-        else
-            rl_ls_shaft_mark(ls, b, s);
+            continue;
+        }
+        rl_ls_shaft_mark(ls, b, s);
+        ++occupied;
         vs->sum += m;
         if (m > vs->max)
             vs->max = m;
-        if (!want_cand)
-            continue;
-        if (ls->dynamic) {
+        if (dyn) {
             for (uint32_t i = 0; i < m; ++i)
                 dyn[off[s] + i] = ids[list[i].tri];
             vs->stored += m;
-            continue;
         }
-        uint32_t *slot = ls->cand + gidx * (uint64_t)k;
-        uint32_t half = (uint32_t)k / 2, nf = m < half ? m : half;
-        for (uint32_t i = 0; i < half; ++i)
-            slot[i] = i < nf ? ids[list[i].tri] : RL_NONE;
-        /* Alg. 3: the back buffer holds the k/2 back-most, back to front. */
-        uint32_t cnt = 0;
-        for (uint32_t i = 0; i < m; ++i) {
-            if (cnt < half) {
-                w->back[cnt++] = list[i];
-                sort_entries(w->back, cnt, true);
-            } else if (back_less(&list[i], &w->back[half - 1])) {
-                w->back[half - 1] = list[i];
-                sort_entries(w->back, half, true);
+    }
+    w->occupied = occupied;
+    return true;
+}
+
+/* Where step 2 writes a block's per-shaft data: the final arrays at the
+ * block's rank (its base known), or the thread's staging area. */
+typedef struct rec_dst {
+    uint32_t *start;              /* dynamic: start[j] = start_base + offset in the block */
+    uint32_t start_base;
+    uint32_t *fixed;              /* fixed lists, k per occupied shaft */
+    uint16_t *pnmt, *preillum;
+} rec_dst;
+
+/* Step 2 of a block: the lists and records of its occupied shafts, in
+ * shaft order, from step 1's sorted lists. */
+static void write_records(const rl_linespace *ls, const rl_ls_geometry *geo, workspace *w,
+                          const rec_dst *dst, voxel_stats *vs)
+{
+    const uint32_t S = ls->shafts_per_voxel;
+    const uint32_t *off = w->offset;
+    const uint32_t *ids = ls->grid->cell_tris + ls->grid->cell_start[w->cell];
+    if (dst->start || dst->fixed) {
+        const int k = ls->k;
+        uint32_t j = 0;
+        for (uint32_t s = 0; s < S; ++s) {
+            uint32_t m = off[s + 1] - off[s];
+            if (m == 0)
+                continue;
+            if (dst->start) {
+                dst->start[j++] = dst->start_base + off[s];
+                continue;
             }
+            const rl_ls_entry *list = w->sorted + off[s];
+            uint32_t *slot = dst->fixed + (size_t)j++ * (size_t)k;
+            uint32_t half = (uint32_t)k / 2, nf = m < half ? m : half;
+            for (uint32_t i = 0; i < half; ++i)
+                slot[i] = i < nf ? ids[list[i].tri] : RL_NONE;
+            /* Alg. 3: the back buffer holds the k/2 back-most, back to front. */
+            uint32_t cnt = 0;
+            for (uint32_t i = 0; i < m; ++i) {
+                if (cnt < half) {
+                    w->back[cnt++] = list[i];
+                    sort_entries(w->back, cnt, true);
+                } else if (back_less(&list[i], &w->back[half - 1])) {
+                    w->back[half - 1] = list[i];
+                    sort_entries(w->back, half, true);
+                }
+            }
+            for (uint32_t i = 0; i < half; ++i)
+                slot[half + i] = i < nf ? ids[w->back[i].tri] : RL_NONE;
+            vs->stored += 2 * (uint64_t)nf;
+            if (m > (uint32_t)k)
+                ++vs->truncated;
         }
-        for (uint32_t i = 0; i < half; ++i)
-            slot[half + i] = i < nf ? ids[w->back[i].tri] : RL_NONE;
-        vs->stored += 2 * (uint64_t)nf;
-        if (m > (uint32_t)k)
-            ++vs->truncated;
     }
     /* PNMT and PREILLUM in separate passes over the sorted lists (still in
      * cache), so that each gets its own time. */
     for (int payload = 0; payload < 2; ++payload) {
         bool pnmt = payload == 0;
-        if (pnmt ? !ls->pnmt : !ls->preillum)
+        if (pnmt ? !dst->pnmt : !dst->preillum)
             continue;
         rl_timer timer;
         rl_timer_start(&timer);
         /* Shafts in index order: face pair, then patch A, then patch B. */
         const int np = ls->n * ls->n;
-        uint32_t s = 0;
+        uint32_t s = 0, j = 0;
         for (int pair = 0; pair < RL_LS_FACE_PAIRS; ++pair) {
             int fa, fb;
             rl_ls_pair_faces(pair, &fa, &fb);
@@ -501,21 +554,153 @@ static bool build_voxel(rl_linespace *ls, const rl_ls_geometry *geo, workspace *
                 const float *ca = geo->patch_center + ((size_t)fa * (size_t)np + (size_t)pa) * 3;
                 double a[3] = { ca[0], ca[1], ca[2] };
                 for (int pb = 0; pb < np; ++pb, ++s) {
+                    uint32_t m = off[s + 1] - off[s];
+                    if (m == 0)
+                        continue;
                     const float *cb = geo->patch_center + ((size_t)fb * (size_t)np + (size_t)pb) * 3;
                     double bb[3] = { cb[0], cb[1], cb[2] };
                     const rl_ls_entry *list = w->sorted + off[s];
-                    uint32_t m = off[s + 1] - off[s];
-                    uint64_t gidx = (uint64_t)b * S + s;
                     if (pnmt)
-                        shaft_pnmt(ls, w->tris, list, m, gidx, a, bb);
+                        shaft_pnmt(ls, w->tris, list, m, dst->pnmt + (size_t)j * 16, a, bb);
                     else
-                        shaft_preillum(ls, w->tris, list, m, gidx, a, bb, lo, ext);
+                        shaft_preillum(ls, w->tris, list, m, dst->preillum + (size_t)j * 8, a, bb,
+                                       w->lo, w->ext);
+                    ++j;
                 }
             }
         }
         *(pnmt ? &w->pnmt_s : &w->preillum_s) += rl_timer_ms(&timer);
     }
+}
+
+/* The ranks of the blocks' occupied shafts. Blocks are built in parallel
+ * and in any order, but a block's records go to the rank of its first
+ * occupied shaft, the sum over all blocks before it. Each block publishes
+ * its counts after step 1; the frontier F is the number of leading blocks
+ * whose counts are all known, so base[b] is final for b <= F. A block
+ * behind the frontier is written straight into place; one ahead of it is
+ * staged by its thread and copied once its base is known (no thread ever
+ * waits for another inside the pass). */
+typedef struct rank_chain {
+    uint32_t blocks;
+    uint32_t *occ;                /* per block: occupied shafts */
+    uint64_t *cand;               /* per block: dynamic candidates */
+    unsigned char *known;
+    uint64_t *base_occ, *base_cand;   /* blocks + 1 */
+    atomic_uint frontier;
+} rank_chain;
+
+static uint32_t chain_publish(rank_chain *c, uint32_t b, uint32_t occ, uint64_t cand)
+{
+    uint32_t f;
+    #pragma omp critical(rl_ls_chain)
+    {
+        c->occ[b] = occ;
+        c->cand[b] = cand;
+        c->known[b] = 1;
+        f = atomic_load_explicit(&c->frontier, memory_order_relaxed);
+        while (f < c->blocks && c->known[f]) {
+            c->base_occ[f + 1] = c->base_occ[f] + c->occ[f];
+            c->base_cand[f + 1] = c->base_cand[f] + c->cand[f];
+            ++f;
+        }
+        atomic_store_explicit(&c->frontier, f, memory_order_release);
+    }
+    return f;
+}
+
+static void final_dst(const rl_linespace *ls, const rank_chain *c, uint32_t b, rec_dst *d)
+{
+    uint64_t r = c->base_occ[b];
+    d->start = ls->dynamic && ls->cand_start ? ls->cand_start + r : NULL;
+    d->start_base = (uint32_t)c->base_cand[b];
+    d->fixed = !ls->dynamic && ls->cand ? ls->cand + r * (uint64_t)ls->k : NULL;
+    d->pnmt = ls->pnmt ? ls->pnmt + r * 16 : NULL;
+    d->preillum = ls->preillum ? ls->preillum + r * 8 : NULL;
+}
+
+/* The rank of each occupancy word of block b. */
+static void write_rank(rl_linespace *ls, uint32_t b, uint64_t base)
+{
+    uint64_t at = (uint64_t)b * ls->occ_words;
+    for (uint32_t i = 0; i < ls->occ_words; ++i) {
+        ls->rank[at + i] = (uint32_t)base;
+        base += (uint64_t)__builtin_popcountll(ls->occupied[at + i]);
+    }
+}
+
+/* realloc of *p to count items; false (and *p kept) when out of memory. */
+#define grow(p, count, size) grow_to((void **)(p), (count), (size))
+static bool grow_to(void **p, size_t count, size_t size)
+{
+    void *q = rl_realloc_array(*p, count, size);
+    if (!q)
+        return false;
+    *p = q;
     return true;
+}
+
+/* Room for `count` more staged records; false when out of memory. */
+static bool stage_reserve(const rl_linespace *ls, staging *st, size_t count)
+{
+    size_t cap = rl_grow_capacity(st->capacity, st->used + count, 1024);
+    if (cap == st->capacity)
+        return true;
+    if (ls->dynamic && ls->cand_start && !grow(&st->start, cap, sizeof *st->start))
+        return false;
+    if (!ls->dynamic && ls->cand && !grow(&st->fixed, cap * (size_t)ls->k, sizeof *st->fixed))
+        return false;
+    if (ls->pnmt && !grow(&st->pnmt, cap * 16, sizeof *st->pnmt))
+        return false;
+    if (ls->preillum && !grow(&st->preillum, cap * 8, sizeof *st->preillum))
+        return false;
+    st->capacity = cap;
+    return true;
+}
+
+static bool stage_block(const rl_linespace *ls, staging *st, uint32_t b, uint32_t count, rec_dst *d)
+{
+    if (!stage_reserve(ls, st, count) ||
+        !rl_reserve((void **)&st->pending, &st->pending_cap, st->npending + 1, sizeof *st->pending, 16))
+        return false;
+    size_t at = st->used;
+    st->pending[st->npending++] = (staged_block){ b, count, at };
+    st->used += count;
+    d->start = st->start ? st->start + at : NULL;
+    d->start_base = 0;
+    d->fixed = st->fixed ? st->fixed + at * (size_t)ls->k : NULL;
+    d->pnmt = st->pnmt ? st->pnmt + at * 16 : NULL;
+    d->preillum = st->preillum ? st->preillum + at * 8 : NULL;
+    return true;
+}
+
+/* Copies the staged blocks whose base is known into place. */
+static void stage_flush(rl_linespace *ls, staging *st, const rank_chain *c)
+{
+    uint32_t f = atomic_load_explicit(&c->frontier, memory_order_acquire);
+    uint32_t kept = 0;
+    for (uint32_t i = 0; i < st->npending; ++i) {
+        staged_block p = st->pending[i];
+        if (p.block > f) {
+            st->pending[kept++] = p;
+            continue;
+        }
+        rec_dst d;
+        final_dst(ls, c, p.block, &d);
+        if (d.start)
+            for (uint32_t j = 0; j < p.count; ++j)
+                d.start[j] = d.start_base + st->start[p.at + j];
+        if (d.fixed)
+            memcpy(d.fixed, st->fixed + p.at * (size_t)ls->k, (size_t)p.count * (size_t)ls->k * sizeof *d.fixed);
+        if (d.pnmt)
+            memcpy(d.pnmt, st->pnmt + p.at * 16, (size_t)p.count * 16 * sizeof *d.pnmt);
+        if (d.preillum)
+            memcpy(d.preillum, st->preillum + p.at * 8, (size_t)p.count * 8 * sizeof *d.preillum);
+        write_rank(ls, p.block, c->base_occ[p.block]);
+    }
+    st->npending = kept;
+    if (kept == 0)
+        st->used = 0;
 }
 
 void rl_ls_free_arrays(rl_linespace *ls)
@@ -526,9 +711,30 @@ void rl_ls_free_arrays(rl_linespace *ls)
     free(ls->pnmt);
     free(ls->preillum);
     free(ls->occupied);
-    ls->voxel_slot = ls->cand = ls->cand_start = NULL;
+    free(ls->rank);
+    ls->voxel_slot = ls->cand = ls->cand_start = ls->rank = NULL;
     ls->pnmt = ls->preillum = NULL;
     ls->occupied = NULL;
+}
+
+/* Shrinks an array allocated for every shaft to the occupied ones (the
+ * untouched tail was never faulted in; realloc gives it back). */
+static void shrink(void **p, uint64_t count, size_t size)
+{
+    if (!*p)
+        return;
+    void *q = realloc(*p, (size_t)(count ? count : 1) * size);
+    if (q)
+        *p = q;
+}
+
+static void chain_free(rank_chain *c)
+{
+    free(c->occ);
+    free(c->cand);
+    free(c->known);
+    free(c->base_occ);
+    free(c->base_cand);
 }
 
 rl_status rl_ls_build(rl_linespace *ls)
@@ -560,19 +766,32 @@ rl_status rl_ls_build(rl_linespace *ls)
     for (uint32_t c = 0; c < g->num_cells; ++c)
         if (ls->voxel_slot[c] != RL_NONE)
             cells[ls->voxel_slot[c]] = c;
-    rl_status st = RL_OK;
-    if (want_cand && ls->dynamic) {
-        /* Every entry is written by the build: no zero fill needed. */
-        ls->cand_start = malloc(((size_t)shafts + 1) * sizeof *ls->cand_start);
-        dyn = calloc((size_t)(blocks ? blocks : 1), sizeof *dyn);
-        dyn_count = calloc((size_t)(blocks ? blocks : 1), sizeof *dyn_count);
-        if (!ls->cand_start || !dyn || !dyn_count)
-            st = RL_ERR_OUT_OF_MEMORY;
-    } else if (want_cand) {
-        ls->cand = malloc((size_t)(shafts ? shafts : 1) * (size_t)ls->k * sizeof *ls->cand);
-        ls->num_cand = shafts * (uint64_t)ls->k;
-        if (!ls->cand)
-            st = RL_ERR_OUT_OF_MEMORY;
+    /* Per-shaft arrays are sized for every shaft and shrunk to the occupied
+     * ones afterwards: only the pages written are ever faulted in. */
+    size_t nb = (size_t)(blocks ? blocks : 1);
+    rank_chain chain = { .blocks = blocks };
+    chain.occ = malloc(nb * sizeof *chain.occ);
+    chain.cand = malloc(nb * sizeof *chain.cand);
+    chain.known = calloc(nb, 1);
+    chain.base_occ = malloc((nb + 1) * sizeof *chain.base_occ);
+    chain.base_cand = malloc((nb + 1) * sizeof *chain.base_cand);
+    atomic_init(&chain.frontier, 0u);
+    rl_status st = chain.occ && chain.cand && chain.known && chain.base_occ && chain.base_cand
+                       ? RL_OK
+                       : RL_ERR_OUT_OF_MEMORY;
+    if (!st) {
+        chain.base_occ[0] = chain.base_cand[0] = 0;
+        if (want_cand && ls->dynamic) {
+            ls->cand_start = malloc(((size_t)shafts + 1) * sizeof *ls->cand_start);
+            dyn = calloc(nb, sizeof *dyn);
+            dyn_count = calloc(nb, sizeof *dyn_count);
+            if (!ls->cand_start || !dyn || !dyn_count)
+                st = RL_ERR_OUT_OF_MEMORY;
+        } else if (want_cand) {
+            ls->cand = malloc((size_t)(shafts ? shafts : 1) * (size_t)ls->k * sizeof *ls->cand);
+            if (!ls->cand)
+                st = RL_ERR_OUT_OF_MEMORY;
+        }
     }
     if (!st && (ls->payloads & RL_LS_PNMT) &&
         !(ls->pnmt = malloc((size_t)(shafts ? shafts : 1) * 16 * sizeof *ls->pnmt)))
@@ -589,6 +808,7 @@ rl_status rl_ls_build(rl_linespace *ls)
         free(cells);
         free(dyn);
         free(dyn_count);
+        chain_free(&chain);
         return rl_error(RL_ERR_OUT_OF_MEMORY, "linespace: out of memory for %llu shafts",
                         (unsigned long long)shafts);
     }
@@ -600,7 +820,7 @@ rl_status rl_ls_build(rl_linespace *ls)
     threads = 1;
 #endif
     atomic_int failed = 0;        /* 1: out of memory, 2: cancelled */
-    atomic_uint done = 0;
+    atomic_uint next = 0, done = 0;
     voxel_stats total_vs = { 0 };
     double pnmt_s = 0.0, preillum_s = 0.0;
     rl_timer pass;
@@ -611,22 +831,47 @@ rl_status rl_ls_build(rl_linespace *ls)
         voxel_stats vs = { 0 };
         if (!ws_init(&w, S, ls->n, ls->k))
             atomic_store(&failed, 1);
-        #pragma omp for schedule(dynamic, 1)
-        for (long bi = 0; bi < (long)blocks; ++bi) {
-            if (atomic_load(&failed))
-                continue;
-            if (!build_voxel(ls, &geo, &w, (uint32_t)bi, cells[bi], dyn ? &dyn[bi] : NULL,
+        bool main_thread = true;
+#ifdef _OPENMP
+        main_thread = omp_get_thread_num() == 0;
+#endif
+        /* Blocks are claimed in increasing order, so the frontier always
+         * advances: every claimed block publishes its counts right after
+         * step 1, without waiting. */
+        for (;;) {
+            uint32_t bi = atomic_fetch_add(&next, 1u);
+            if (bi >= blocks || atomic_load(&failed))
+                break;
+            w.cell = cells[bi];
+            if (!build_lists(ls, &geo, &w, bi, cells[bi], dyn ? &dyn[bi] : NULL,
                              dyn ? &dyn_count[bi] : NULL, &vs)) {
                 atomic_store(&failed, 1);
-                continue;
+                break;
             }
+            uint32_t f = chain_publish(&chain, bi, w.occupied, dyn ? dyn_count[bi] : 0);
+            rec_dst dst;
+            bool placed = bi <= f;
+            if (placed)
+                final_dst(ls, &chain, bi, &dst);
+            else if (!stage_block(ls, &w.stage, bi, w.occupied, &dst)) {
+                atomic_store(&failed, 1);
+                break;
+            }
+            write_records(ls, &geo, &w, &dst, &vs);
+            if (placed)
+                write_rank(ls, bi, chain.base_occ[bi]);
+            if (w.stage.npending)
+                stage_flush(ls, &w.stage, &chain);
             unsigned d = atomic_fetch_add(&done, 1u) + 1u;
-            bool main_thread = true;
-#ifdef _OPENMP
-            main_thread = omp_get_thread_num() == 0;
-#endif
             if (ls->progress && main_thread && !ls->progress(ls->user, 0.95 * d / (double)blocks))
                 atomic_store(&failed, 2);
+        }
+        /* The staged blocks wait only for blocks other threads have
+         * already claimed. */
+        while (w.stage.npending && !atomic_load(&failed)) {
+            stage_flush(ls, &w.stage, &chain);
+            if (w.stage.npending)
+                sched_yield();
         }
         #pragma omp critical(rl_ls_stats)
         {
@@ -649,22 +894,17 @@ rl_status rl_ls_build(rl_linespace *ls)
      * missed. */
     if (!fail && ls->progress && !ls->progress(ls->user, 0.95))
         fail = 2;
+    uint64_t occupied = fail ? 0 : chain.base_occ[blocks];
     if (!fail && dyn) {
-        /* Sec. 7.1.1's prefix sum, in two levels: the pass left each
-         * shaft's offset inside its block, so only the blocks' totals are
-         * summed here and each block's offsets are shifted by its base in
-         * parallel, while its lists are copied into place. */
-        uint64_t sum = 0;
-        for (uint32_t bi = 0; bi < blocks; ++bi) {
-            uint64_t c = dyn_count[bi];
-            dyn_count[bi] = sum;
-            sum += c;
-        }
+        /* Sec. 7.1.1's prefix sum: the chain has summed the blocks' list
+         * lengths and the offsets are already global; the lists are copied
+         * into place in parallel. */
+        uint64_t sum = chain.base_cand[blocks];
         if (sum > UINT32_MAX)
             fail = 3;
         if (!fail) {
             ls->num_cand = sum;
-            ls->cand_start[shafts] = (uint32_t)sum;
+            ls->cand_start[occupied] = (uint32_t)sum;
             ls->cand = malloc((size_t)(sum ? sum : 1) * sizeof *ls->cand);
             if (!ls->cand)
                 fail = 1;
@@ -672,15 +912,20 @@ rl_status rl_ls_build(rl_linespace *ls)
         if (!fail) {
             #pragma omp parallel for num_threads(threads) schedule(dynamic, 16)
             for (long bi = 0; bi < (long)blocks; ++bi) {
-                uint32_t base = (uint32_t)dyn_count[bi];
-                uint32_t *cs = ls->cand_start + (uint64_t)bi * S;
-                for (uint32_t s = 0; s < S; ++s)
-                    cs[s] += base;
-                uint64_t last = bi + 1 < (long)blocks ? dyn_count[bi + 1] : sum;
-                memcpy(ls->cand + base, dyn[bi], (size_t)(last - base) * sizeof *ls->cand);
+                memcpy(ls->cand + chain.base_cand[bi], dyn[bi], (size_t)dyn_count[bi] * sizeof *ls->cand);
                 free(dyn[bi]);
                 dyn[bi] = NULL;
             }
+        }
+    }
+    if (!fail) {
+        ls->num_occupied = occupied;
+        shrink((void **)&ls->cand_start, ls->cand_start ? occupied + 1 : 0, sizeof *ls->cand_start);
+        shrink((void **)&ls->pnmt, occupied * 16, sizeof *ls->pnmt);
+        shrink((void **)&ls->preillum, occupied * 8, sizeof *ls->preillum);
+        if (want_cand && !ls->dynamic) {
+            ls->num_cand = occupied * (uint64_t)ls->k;
+            shrink((void **)&ls->cand, ls->num_cand, sizeof *ls->cand);
         }
     }
     if (dyn)
@@ -689,6 +934,7 @@ rl_status rl_ls_build(rl_linespace *ls)
     free(dyn);
     free(dyn_count);
     free(cells);
+    chain_free(&chain);
     rl_ls_geometry_free(&geo);
     if (fail == 1)
         return rl_error(RL_ERR_OUT_OF_MEMORY, "linespace: out of memory during the build");

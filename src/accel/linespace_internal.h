@@ -44,17 +44,24 @@ struct rl_linespace {
     uint32_t shafts_per_voxel;    /* S = 15·N^4 */
     uint32_t num_cells, num_blocks;
     uint32_t *voxel_slot;         /* num_cells */
-    uint32_t *cand;               /* fixed: blocks·S·k; dynamic: num_cand */
-    uint32_t *cand_start;         /* dynamic: blocks·S + 1 */
+    /* Per-shaft data exists for occupied shafts only (a shaft any triangle
+     * overlaps), at the shaft's rank r among them (rl_ls_shaft_rank):
+     * about half the shafts are empty at high voxel resolutions, and their
+     * records were most of the memory (and of the build's first-touch
+     * page faults). rl_linespace.h documents the layout. */
+    uint32_t *cand;               /* fixed: num_occupied·k; dynamic: num_cand */
+    uint32_t *cand_start;         /* dynamic: num_occupied + 1 */
     uint64_t num_cand;            /* entries of cand */
-    uint16_t *pnmt;               /* blocks·S·16 */
-    uint16_t *preillum;           /* blocks·S·8 */
-    /* One bit per shaft, set if any triangle overlaps it (its list is not
-     * empty; it has PNMT and PREILLUM records). Derived data, not saved:
-     * 15·N^4 bits per voxel are 1/256 of the PNMT records, so the walk
-     * skips empty shafts in cache instead of loading a record from memory. */
+    uint16_t *pnmt;               /* num_occupied·16 */
+    uint16_t *preillum;           /* num_occupied·8 */
+    /* One bit per shaft, set if any triangle overlaps it; rank[w]: the
+     * occupied shafts before word w (over all blocks). 15·N^4 bits per
+     * voxel are 1/256 of the PNMT records, so the walk skips empty shafts
+     * in cache and finds a record with one popcount. */
     uint64_t *occupied;           /* blocks·occ_words */
+    uint32_t *rank;               /* blocks·occ_words */
     uint32_t occ_words;           /* per block: ceil(S / 64) */
+    uint64_t num_occupied;
     rl_linespace_stats stats;
 };
 
@@ -66,6 +73,13 @@ static inline bool rl_ls_shaft_occupied(const rl_linespace *ls, uint32_t block, 
 static inline void rl_ls_shaft_mark(rl_linespace *ls, uint32_t block, uint32_t shaft)
 {
     ls->occupied[(uint64_t)block * ls->occ_words + (shaft >> 6)] |= 1ull << (shaft & 63u);
+}
+/* Index of an occupied shaft's records: its rank among occupied shafts. */
+static inline uint64_t rl_ls_shaft_rank(const rl_linespace *ls, uint32_t block, uint32_t shaft)
+{
+    uint64_t w = (uint64_t)block * ls->occ_words + (shaft >> 6);
+    uint64_t below = ls->occupied[w] & ((1ull << (shaft & 63u)) - 1u);
+    return (uint64_t)ls->rank[w] + (uint64_t)__builtin_popcountll(below);
 }
 
 /* ---- shaft geometry (linespace_shaft.c) ---- */
@@ -141,10 +155,10 @@ void rl_ls_surface_at(const rl_linespace *ls, uint32_t tri, float u, float v, rl
 
 /* ---- build and queries ---- */
 rl_status rl_ls_build(rl_linespace *ls);
-/* Allocates ls->occupied (zeroed); false when out of memory. */
+/* Allocates ls->occupied (zeroed) and ls->rank; false when out of memory. */
 bool rl_ls_occupancy_alloc(rl_linespace *ls);
-/* Sets every bit from the payload arrays (after a load). */
-void rl_ls_occupancy_from_payloads(rl_linespace *ls);
+/* Fills ls->rank from the bits and sets num_occupied (after a load). */
+void rl_ls_rank_from_bits(rl_linespace *ls);
 size_t rl_ls_memory_bytes(const rl_linespace *ls);
 void rl_ls_free_arrays(rl_linespace *ls);
 

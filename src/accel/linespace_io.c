@@ -2,19 +2,23 @@
  * Sec. 13.3 suggests storing it instead of rebuilding).
  *
  * File (little-endian; refused on a big-endian host):
- *   header   "RLLS", u32 version (1), i32 n, i32 k, u32 dynamic, u32 payloads,
+ *   header   "RLLS", u32 version (2), i32 n, i32 k, u32 dynamic, u32 payloads,
  *            i32 res[3], f32 bounds min[3] max[3], u32 num_triangles,
  *            u64 scene fingerprint, u32 num_cells, u32 num_blocks,
  *            u64 num_cand, u64 empty_shafts, u64 candidates,
  *            u64 truncated_shafts, u32 max_candidates, f64 mean_candidates
- *   arrays   voxel_slot, cand (if CANDIDATES), cand_start (dynamic),
- *            pnmt (if PNMT), preillum (if PREILLUM), as in rl_linespace.h
+ *   arrays   voxel_slot, occupied (u64 words), cand (if CANDIDATES),
+ *            cand_start (dynamic), pnmt (if PNMT), preillum (if PREILLUM),
+ *            as in rl_linespace.h; the ranks are derived on load. Version
+ *            1 stored records for every shaft, empty ones included; such
+ *            files are refused (rebuild and save again).
  *   u64      checksum over all bytes before it
  * The fingerprint folds the triangle count and every vertex coordinate's
  * bits through rl_hash64. Load checks the header's sizes against the file's
  * length before allocating anything, then the checksum (RL_ERR_PARSE), then
  * that the file belongs to the given grid and scene (RL_ERR_INVALID_ARG),
- * then the arrays' contents (indices in range, monotone offsets). */
+ * then the arrays' contents (occupancy bits against the header's count,
+ * indices in range, monotone offsets). */
 #define _POSIX_C_SOURCE 200809L
 #include <errno.h>
 #include <stdio.h>
@@ -27,7 +31,7 @@
 #include "rl/rl_rng.h"
 
 #define LS_MAGIC "RLLS"
-#define LS_VERSION 1u
+#define LS_VERSION 2u
 #define HEADER_BYTES 128
 
 static bool little_endian(void)
@@ -140,28 +144,30 @@ static bool decode(const unsigned char *b, header *h)
 
 /* The arrays of a Line Space with header h, in file order. */
 typedef struct array_sizes {
-    uint64_t slot, cand, start, pnmt, preillum;   /* elements */
+    uint64_t slot, occ, cand, start, pnmt, preillum;   /* elements */
 } array_sizes;
 
+/* h->empty_shafts <= the shafts (checked before). */
 static array_sizes sizes_of(const header *h)
 {
-    uint64_t shafts = (uint64_t)h->num_blocks * rl_ls_shafts_per_voxel(h->n);
-    array_sizes s = { h->num_cells, 0, 0, 0, 0 };
+    uint32_t S = rl_ls_shafts_per_voxel(h->n);
+    uint64_t occupied = (uint64_t)h->num_blocks * S - h->empty_shafts;
+    array_sizes s = { h->num_cells, (uint64_t)h->num_blocks * ((S + 63u) / 64u), 0, 0, 0, 0 };
     if (h->payloads & RL_LS_CANDIDATES) {
         s.cand = h->num_cand;
         if (h->dynamic)
-            s.start = shafts + 1;
+            s.start = occupied + 1;
     }
     if (h->payloads & RL_LS_PNMT)
-        s.pnmt = shafts * 16;
+        s.pnmt = occupied * 16;
     if (h->payloads & RL_LS_PREILLUM)
-        s.preillum = shafts * 8;
+        s.preillum = occupied * 8;
     return s;
 }
 
 static uint64_t file_bytes(array_sizes s)
 {
-    return HEADER_BYTES + 4 * (s.slot + s.cand + s.start) + 2 * (s.pnmt + s.preillum) + 8;
+    return HEADER_BYTES + 4 * (s.slot + s.cand + s.start) + 8 * s.occ + 2 * (s.pnmt + s.preillum) + 8;
 }
 
 static bool write_hashed(FILE *f, const void *p, size_t n, uint64_t *h)
@@ -202,6 +208,7 @@ rl_status rl_linespace_save(const rl_linespace *ls, const char *path)
     uint64_t sum = 0;
     bool ok = write_hashed(f, buf, HEADER_BYTES, &sum) &&
               write_hashed(f, ls->voxel_slot, 4 * s.slot, &sum) &&
+              write_hashed(f, ls->occupied, 8 * s.occ, &sum) &&
               write_hashed(f, ls->cand, 4 * s.cand, &sum) &&
               write_hashed(f, ls->cand_start, 4 * s.start, &sum) &&
               write_hashed(f, ls->pnmt, 2 * s.pnmt, &sum) &&
@@ -237,11 +244,25 @@ static rl_status check_contents(const rl_linespace *ls, const char *path)
     if (next != ls->num_blocks)
         return rl_error(RL_ERR_PARSE, "%s: %u blocks, the grid has %u filled voxels", path,
                         ls->num_blocks, next);
-    uint64_t shafts = (uint64_t)ls->num_blocks * ls->shafts_per_voxel;
+    /* Bits past the last shaft of a block are never set. */
+    const uint32_t S = ls->shafts_per_voxel, W = ls->occ_words;
+    const uint64_t pad = S % 64u ? ~0ull << (S % 64u) : 0;
+    uint64_t set = 0;
+    for (uint64_t b = 0; b < ls->num_blocks; ++b) {
+        if (ls->occupied[b * W + W - 1] & pad)
+            return rl_error(RL_ERR_PARSE, "%s: occupancy bits past the last shaft of block %llu", path,
+                            (unsigned long long)b);
+        for (uint32_t i = 0; i < W; ++i)
+            set += (uint64_t)__builtin_popcountll(ls->occupied[b * W + i]);
+    }
+    if (set != ls->num_occupied)
+        return rl_error(RL_ERR_PARSE, "%s: %llu occupied shafts, the header says %llu", path,
+                        (unsigned long long)set, (unsigned long long)ls->num_occupied);
+    uint64_t occupied = ls->num_occupied;
     if (ls->cand_start) {
-        if (ls->cand_start[0] != 0 || ls->cand_start[shafts] != ls->num_cand)
+        if (ls->cand_start[0] != 0 || ls->cand_start[occupied] != ls->num_cand)
             return rl_error(RL_ERR_PARSE, "%s: candidate offsets do not span the list", path);
-        for (uint64_t i = 0; i < shafts; ++i)
+        for (uint64_t i = 0; i < occupied; ++i)
             if (ls->cand_start[i + 1] < ls->cand_start[i])
                 return rl_error(RL_ERR_PARSE, "%s: candidate offsets decrease at shaft %llu", path,
                                 (unsigned long long)i);
@@ -286,8 +307,10 @@ rl_status rl_linespace_load(const rl_accel *grid, const char *path, rl_linespace
         goto done;
     }
     uint64_t shafts = (uint64_t)h.num_blocks * rl_ls_shafts_per_voxel(h.n);
-    if (shafts > UINT32_MAX - 1u || h.num_cand > (uint64_t)UINT32_MAX * RL_LS_MAX_K ||
-        ((h.payloads & RL_LS_CANDIDATES) && !h.dynamic && h.num_cand != shafts * (uint64_t)h.k) ||
+    if (shafts > UINT32_MAX - 1u || h.empty_shafts > shafts ||
+        h.num_cand > (uint64_t)UINT32_MAX * RL_LS_MAX_K ||
+        ((h.payloads & RL_LS_CANDIDATES) && !h.dynamic &&
+         h.num_cand != (shafts - h.empty_shafts) * (uint64_t)h.k) ||
         ((h.payloads & RL_LS_CANDIDATES) && h.dynamic && h.num_cand > UINT32_MAX)) {
         st = rl_error(RL_ERR_PARSE, "%s: corrupt header (array sizes)", path);
         goto done;
@@ -313,11 +336,13 @@ rl_status rl_linespace_load(const rl_accel *grid, const char *path, rl_linespace
         goto done;
     }
     ls->voxel_slot = malloc((size_t)(s.slot ? s.slot : 1) * 4);
+    ls->occupied = malloc((size_t)(s.occ ? s.occ : 1) * 8);
+    ls->rank = malloc((size_t)(s.occ ? s.occ : 1) * 4);
     ls->cand = s.cand ? malloc((size_t)s.cand * 4) : NULL;
     ls->cand_start = s.start ? malloc((size_t)s.start * 4) : NULL;
     ls->pnmt = s.pnmt ? malloc((size_t)s.pnmt * 2) : NULL;
     ls->preillum = s.preillum ? malloc((size_t)s.preillum * 2) : NULL;
-    if (!ls->voxel_slot || (s.cand && !ls->cand) || (s.start && !ls->cand_start) ||
+    if (!ls->voxel_slot || !ls->occupied || !ls->rank || (s.cand && !ls->cand) || (s.start && !ls->cand_start) ||
         (s.pnmt && !ls->pnmt) || (s.preillum && !ls->preillum)) {
         st = rl_error(RL_ERR_OUT_OF_MEMORY, "%s: out of memory for %llu bytes", path,
                       (unsigned long long)file_bytes(s));
@@ -325,6 +350,7 @@ rl_status rl_linespace_load(const rl_accel *grid, const char *path, rl_linespace
     }
     uint64_t sum = hash_bytes(0, buf, HEADER_BYTES), stored = 0;
     bool ok = read_hashed(f, ls->voxel_slot, 4 * s.slot, &sum) &&
+              read_hashed(f, ls->occupied, 8 * s.occ, &sum) &&
               read_hashed(f, ls->cand, 4 * s.cand, &sum) &&
               read_hashed(f, ls->cand_start, 4 * s.start, &sum) &&
               read_hashed(f, ls->pnmt, 2 * s.pnmt, &sum) &&
@@ -367,18 +393,18 @@ rl_status rl_linespace_load(const rl_accel *grid, const char *path, rl_linespace
     fresh->cand_start = ls->cand_start;
     fresh->pnmt = ls->pnmt;
     fresh->preillum = ls->preillum;
+    fresh->occupied = ls->occupied;
+    fresh->rank = ls->rank;
     free(ls);
     ls = fresh;
     ls->num_blocks = h.num_blocks;
+    ls->occ_words = (ls->shafts_per_voxel + 63u) / 64u;
+    ls->num_occupied = shafts - h.empty_shafts;
     ls->num_cand = (h.payloads & RL_LS_CANDIDATES) ? h.num_cand : 0;
     st = check_contents(ls, path);
     if (st)
         goto done;
-    if (!rl_ls_occupancy_alloc(ls)) {
-        st = rl_error(RL_ERR_OUT_OF_MEMORY, "%s: out of memory", path);
-        goto done;
-    }
-    rl_ls_occupancy_from_payloads(ls);
+    rl_ls_rank_from_bits(ls);
     rl_linespace_stats *t = &ls->stats;
     t->filled_voxels = h.num_blocks;
     t->shafts = shafts;

@@ -133,13 +133,13 @@ static tri_list candidates(const rl_linespace *ls, uint32_t cell, uint32_t block
 {
     if (shaft == RL_NONE || !(ls->payloads & RL_LS_CANDIDATES) || (exact_only && !ls->dynamic))
         return grid_list(ls->grid, cell);
-    uint64_t g = (uint64_t)block * ls->shafts_per_voxel + shaft;
+    uint64_t r = rl_ls_shaft_rank(ls, block, shaft);   /* an occupied shaft: the callers check */
     tri_list l;
     if (ls->dynamic) {
-        l.ids = ls->cand + ls->cand_start[g];
-        l.count = ls->cand_start[g + 1] - ls->cand_start[g];
+        l.ids = ls->cand + ls->cand_start[r];
+        l.count = ls->cand_start[r + 1] - ls->cand_start[r];
     } else {
-        l.ids = ls->cand + g * (uint64_t)ls->k;
+        l.ids = ls->cand + r * (uint64_t)ls->k;
         l.count = (uint32_t)ls->k;
     }
     return l;
@@ -372,7 +372,7 @@ static bool pnmt_walk(const rl_linespace *ls, const rl_ray *ray, rl_ls_surface *
         }
         if (!out && voxel_within(ls, it.current, ray, ray->t_min, r))
             return true;          /* the record lies in the voxel: inside (t_min, t_max) */
-        const uint16_t *rec = ls->pnmt + ((uint64_t)block * ls->shafts_per_voxel + shaft) * 16 +
+        const uint16_t *rec = ls->pnmt + rl_ls_shaft_rank(ls, block, shaft) * 16 +
                               (fwd ? 0 : RL_LS_PNMT_RECORD);
         rl_ls_surface s;
         if (!decode_pnmt(ls, it.current, rec, &s))
@@ -430,7 +430,7 @@ static bool preillum_walk(const rl_linespace *ls, const rl_ray *ray, rl_vec3 *co
         if (shaft == RL_NONE || !rl_ls_shaft_occupied(ls, block, shaft))
             continue;
         float lo = origin ? ray->t_min + margin : ray->t_min;
-        uint64_t g = (uint64_t)block * ls->shafts_per_voxel + shaft;
+        uint64_t g = rl_ls_shaft_rank(ls, block, shaft);
         float t = 0.5f * (t0 + t1);
         if (ls->pnmt) {
             if (!color && voxel_within(ls, it.current, ray, lo, r))
