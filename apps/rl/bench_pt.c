@@ -280,8 +280,9 @@ static double mrays(const rl_render_stats *s)
 
 /* An upper bound of a Line Space's size before building it: the cells a
  * triangle's box overlaps are at least the cells that hold it, and each
- * such cell gets 15·N^4 shafts of a list offset and a PNMT record (16 half
- * floats). The grid tiles the scene's box (plus a tiny pad). */
+ * such cell gets at most 15·N^4 occupied shafts of a list offset and a
+ * PNMT record (16 half floats). The grid tiles the scene's box (plus a tiny
+ * pad). */
 static double ls_bytes_upper(const rl_scene *scene, int res, int n)
 {
     const rl_scene_data *d = rl_scene_get_data(scene);
