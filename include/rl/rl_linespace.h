@@ -43,13 +43,13 @@
  *   voxel_slot[cell]  per grid cell, the index of its Line Space block, or
  *                     RL_NONE for a voxel without triangles (an empty voxel
  *                     needs no shafts: every ray crosses it freely);
- *   occupied[b·W + s/64] bit s%64 (W = ceil(15·N^4 / 64) words per
- *                  block): whether any triangle overlaps shaft s of block
- *                  b. Only occupied shafts have lists and records, stored
- *                  at the shaft's rank among all occupied shafts,
- *                  r = rank[b·W + s/64] + popcount(occupied[b·W + s/64] &
- *                  ((1 << s%64) - 1)), with rank[w] the occupied shafts
- *                  before word w (our change: the thesis stores every
+ *   occupancy[2w], w = b·W + s/64, bit s%64 (W = ceil(15·N^4 / 64)
+ *                  words per block): whether any triangle overlaps shaft
+ *                  s of block b; occupancy[2w + 1]: the occupied shafts
+ *                  before word w. Only occupied shafts have lists and
+ *                  records, stored at the shaft's rank among all occupied
+ *                  shafts, r = occupancy[2w + 1] + popcount(occupancy[2w] &
+ *                  ((1 << s%64) - 1)) (our change: the thesis stores every
  *                  shaft; about half are empty, so this halves the
  *                  memory);
  *   fixed lists:   cand[r·k .. r·k + k-1], front half then back half,
@@ -210,8 +210,7 @@ typedef struct rl_linespace_data {
     const uint16_t *preillum;          /* num_occupied records, or NULL */
     uint32_t occ_words;                /* W: occupancy words per block */
     uint64_t num_occupied;             /* shafts with triangles */
-    const uint64_t *occupied;          /* num_blocks·W words */
-    const uint32_t *rank;              /* num_blocks·W entries */
+    const uint64_t *occupancy;         /* 2·num_blocks·W words: bits, rank */
 } rl_linespace_data;
 RL_API void rl_linespace_get_data(const rl_linespace *ls, rl_linespace_data *out);
 

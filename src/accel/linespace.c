@@ -92,7 +92,7 @@ size_t rl_ls_memory_bytes(const rl_linespace *ls)
     if (ls->preillum)
         bytes += (size_t)occ * 8 * sizeof(uint16_t);
     if (ls->occupied)
-        bytes += (size_t)ls->num_blocks * ls->occ_words * (sizeof(uint64_t) + sizeof(uint32_t));
+        bytes += (size_t)ls->num_blocks * ls->occ_words * 2 * sizeof(uint64_t);
     return bytes;
 }
 
@@ -100,20 +100,8 @@ bool rl_ls_occupancy_alloc(rl_linespace *ls)
 {
     ls->occ_words = (ls->shafts_per_voxel + 63u) / 64u;
     size_t words = (size_t)ls->num_blocks * ls->occ_words;
-    ls->occupied = calloc(words ? words : 1, sizeof *ls->occupied);
-    ls->rank = malloc((words ? words : 1) * sizeof *ls->rank);
-    return ls->occupied && ls->rank;
-}
-
-void rl_ls_rank_from_bits(rl_linespace *ls)
-{
-    size_t words = (size_t)ls->num_blocks * ls->occ_words;
-    uint64_t sum = 0;
-    for (size_t i = 0; i < words; ++i) {
-        ls->rank[i] = (uint32_t)sum;
-        sum += (uint64_t)__builtin_popcountll(ls->occupied[i]);
-    }
-    ls->num_occupied = sum;
+    ls->occupied = calloc(words ? 2 * words : 2, sizeof *ls->occupied);
+    return ls->occupied != NULL;
 }
 
 rl_status rl_linespace_commit(rl_linespace *ls)
@@ -177,6 +165,5 @@ void rl_linespace_get_data(const rl_linespace *ls, rl_linespace_data *out)
     out->preillum = ls->preillum;
     out->occ_words = ls->occ_words;
     out->num_occupied = ls->num_occupied;
-    out->occupied = ls->occupied;
-    out->rank = ls->rank;
+    out->occupancy = ls->occupied;
 }

@@ -622,10 +622,10 @@ static void final_dst(const rl_linespace *ls, const rank_chain *c, uint32_t b, r
 /* The rank of each occupancy word of block b. */
 static void write_rank(rl_linespace *ls, uint32_t b, uint64_t base)
 {
-    uint64_t at = (uint64_t)b * ls->occ_words;
+    uint64_t *w = ls->occupied + 2 * (uint64_t)b * ls->occ_words;
     for (uint32_t i = 0; i < ls->occ_words; ++i) {
-        ls->rank[at + i] = (uint32_t)base;
-        base += (uint64_t)__builtin_popcountll(ls->occupied[at + i]);
+        w[2 * i + 1] = base;
+        base += (uint64_t)__builtin_popcountll(w[2 * i]);
     }
 }
 
@@ -711,8 +711,7 @@ void rl_ls_free_arrays(rl_linespace *ls)
     free(ls->pnmt);
     free(ls->preillum);
     free(ls->occupied);
-    free(ls->rank);
-    ls->voxel_slot = ls->cand = ls->cand_start = ls->rank = NULL;
+    ls->voxel_slot = ls->cand = ls->cand_start = NULL;
     ls->pnmt = ls->preillum = NULL;
     ls->occupied = NULL;
 }

@@ -54,32 +54,36 @@ struct rl_linespace {
     uint64_t num_cand;            /* entries of cand */
     uint16_t *pnmt;               /* num_occupied·16 */
     uint16_t *preillum;           /* num_occupied·8 */
-    /* One bit per shaft, set if any triangle overlaps it; rank[w]: the
-     * occupied shafts before word w (over all blocks). 15·N^4 bits per
-     * voxel are 1/256 of the PNMT records, so the walk skips empty shafts
-     * in cache and finds a record with one popcount. */
-    uint64_t *occupied;           /* blocks·occ_words */
-    uint32_t *rank;               /* blocks·occ_words */
+    /* Two words per 64 shafts: [2w] one bit per shaft, set if any
+     * triangle overlaps it; [2w+1] the occupied shafts before word w (over
+     * all blocks), its rank. Interleaved, so the walk's bit test and the
+     * rank of a record share a cache line; 2 bits per shaft are 1/128 of
+     * the PNMT records, so empty shafts are skipped in cache and a record
+     * is found with one popcount. */
+    uint64_t *occupied;           /* 2·blocks·occ_words */
     uint32_t occ_words;           /* per block: ceil(S / 64) */
     uint64_t num_occupied;
     rl_linespace_stats stats;
 };
 
+static inline uint64_t rl_ls_occ_word(const rl_linespace *ls, uint32_t block, uint32_t shaft)
+{
+    return 2 * ((uint64_t)block * ls->occ_words + (shaft >> 6));
+}
 static inline bool rl_ls_shaft_occupied(const rl_linespace *ls, uint32_t block, uint32_t shaft)
 {
-    return (ls->occupied[(uint64_t)block * ls->occ_words + (shaft >> 6)] >> (shaft & 63u)) & 1u;
+    return (ls->occupied[rl_ls_occ_word(ls, block, shaft)] >> (shaft & 63u)) & 1u;
 }
 /* Sets the bit (each block's words belong to one build thread). */
 static inline void rl_ls_shaft_mark(rl_linespace *ls, uint32_t block, uint32_t shaft)
 {
-    ls->occupied[(uint64_t)block * ls->occ_words + (shaft >> 6)] |= 1ull << (shaft & 63u);
+    ls->occupied[rl_ls_occ_word(ls, block, shaft)] |= 1ull << (shaft & 63u);
 }
 /* Index of an occupied shaft's records: its rank among occupied shafts. */
 static inline uint64_t rl_ls_shaft_rank(const rl_linespace *ls, uint32_t block, uint32_t shaft)
 {
-    uint64_t w = (uint64_t)block * ls->occ_words + (shaft >> 6);
-    uint64_t below = ls->occupied[w] & ((1ull << (shaft & 63u)) - 1u);
-    return (uint64_t)ls->rank[w] + (uint64_t)__builtin_popcountll(below);
+    const uint64_t *w = ls->occupied + rl_ls_occ_word(ls, block, shaft);
+    return w[1] + (uint64_t)__builtin_popcountll(w[0] & ((1ull << (shaft & 63u)) - 1u));
 }
 
 /* ---- shaft geometry (linespace_shaft.c) ---- */
@@ -155,10 +159,8 @@ void rl_ls_surface_at(const rl_linespace *ls, uint32_t tri, float u, float v, rl
 
 /* ---- build and queries ---- */
 rl_status rl_ls_build(rl_linespace *ls);
-/* Allocates ls->occupied (zeroed) and ls->rank; false when out of memory. */
+/* Allocates ls->occupied (zeroed); false when out of memory. */
 bool rl_ls_occupancy_alloc(rl_linespace *ls);
-/* Fills ls->rank from the bits and sets num_occupied (after a load). */
-void rl_ls_rank_from_bits(rl_linespace *ls);
 size_t rl_ls_memory_bytes(const rl_linespace *ls);
 void rl_ls_free_arrays(rl_linespace *ls);
 

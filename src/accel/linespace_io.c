@@ -7,9 +7,10 @@
  *            u64 scene fingerprint, u32 num_cells, u32 num_blocks,
  *            u64 num_cand, u64 empty_shafts, u64 candidates,
  *            u64 truncated_shafts, u32 max_candidates, f64 mean_candidates
- *   arrays   voxel_slot, occupied (u64 words), cand (if CANDIDATES),
- *            cand_start (dynamic), pnmt (if PNMT), preillum (if PREILLUM),
- *            as in rl_linespace.h; the ranks are derived on load. Version
+ *   arrays   voxel_slot, occupancy (u64 pairs: bits, rank), cand (if
+ *            CANDIDATES), cand_start (dynamic), pnmt (if PNMT), preillum
+ *            (if PREILLUM), as in rl_linespace.h; the ranks are checked
+ *            against the bits on load. Version
  *            1 stored records for every shaft, empty ones included; such
  *            files are refused (rebuild and save again).
  *   u64      checksum over all bytes before it
@@ -152,7 +153,7 @@ static array_sizes sizes_of(const header *h)
 {
     uint32_t S = rl_ls_shafts_per_voxel(h->n);
     uint64_t occupied = (uint64_t)h->num_blocks * S - h->empty_shafts;
-    array_sizes s = { h->num_cells, (uint64_t)h->num_blocks * ((S + 63u) / 64u), 0, 0, 0, 0 };
+    array_sizes s = { h->num_cells, 2 * (uint64_t)h->num_blocks * ((S + 63u) / 64u), 0, 0, 0, 0 };
     if (h->payloads & RL_LS_CANDIDATES) {
         s.cand = h->num_cand;
         if (h->dynamic)
@@ -249,11 +250,16 @@ static rl_status check_contents(const rl_linespace *ls, const char *path)
     const uint64_t pad = S % 64u ? ~0ull << (S % 64u) : 0;
     uint64_t set = 0;
     for (uint64_t b = 0; b < ls->num_blocks; ++b) {
-        if (ls->occupied[b * W + W - 1] & pad)
+        const uint64_t *w = ls->occupied + 2 * b * W;
+        if (w[2 * (W - 1)] & pad)
             return rl_error(RL_ERR_PARSE, "%s: occupancy bits past the last shaft of block %llu", path,
                             (unsigned long long)b);
-        for (uint32_t i = 0; i < W; ++i)
-            set += (uint64_t)__builtin_popcountll(ls->occupied[b * W + i]);
+        for (uint32_t i = 0; i < W; ++i) {
+            if (w[2 * i + 1] != set)
+                return rl_error(RL_ERR_PARSE, "%s: shaft ranks do not count the occupancy bits (block %llu)",
+                                path, (unsigned long long)b);
+            set += (uint64_t)__builtin_popcountll(w[2 * i]);
+        }
     }
     if (set != ls->num_occupied)
         return rl_error(RL_ERR_PARSE, "%s: %llu occupied shafts, the header says %llu", path,
@@ -337,12 +343,11 @@ rl_status rl_linespace_load(const rl_accel *grid, const char *path, rl_linespace
     }
     ls->voxel_slot = malloc((size_t)(s.slot ? s.slot : 1) * 4);
     ls->occupied = malloc((size_t)(s.occ ? s.occ : 1) * 8);
-    ls->rank = malloc((size_t)(s.occ ? s.occ : 1) * 4);
     ls->cand = s.cand ? malloc((size_t)s.cand * 4) : NULL;
     ls->cand_start = s.start ? malloc((size_t)s.start * 4) : NULL;
     ls->pnmt = s.pnmt ? malloc((size_t)s.pnmt * 2) : NULL;
     ls->preillum = s.preillum ? malloc((size_t)s.preillum * 2) : NULL;
-    if (!ls->voxel_slot || !ls->occupied || !ls->rank || (s.cand && !ls->cand) || (s.start && !ls->cand_start) ||
+    if (!ls->voxel_slot || !ls->occupied || (s.cand && !ls->cand) || (s.start && !ls->cand_start) ||
         (s.pnmt && !ls->pnmt) || (s.preillum && !ls->preillum)) {
         st = rl_error(RL_ERR_OUT_OF_MEMORY, "%s: out of memory for %llu bytes", path,
                       (unsigned long long)file_bytes(s));
@@ -394,7 +399,6 @@ rl_status rl_linespace_load(const rl_accel *grid, const char *path, rl_linespace
     fresh->pnmt = ls->pnmt;
     fresh->preillum = ls->preillum;
     fresh->occupied = ls->occupied;
-    fresh->rank = ls->rank;
     free(ls);
     ls = fresh;
     ls->num_blocks = h.num_blocks;
@@ -404,7 +408,6 @@ rl_status rl_linespace_load(const rl_accel *grid, const char *path, rl_linespace
     st = check_contents(ls, path);
     if (st)
         goto done;
-    rl_ls_rank_from_bits(ls);
     rl_linespace_stats *t = &ls->stats;
     t->filled_voxels = h.num_blocks;
     t->shafts = shafts;
