@@ -118,6 +118,7 @@ typedef struct vt_state {
     float *scratch_depth;     /* the frame's depth when the image has none */
     size_t scratch_pixels;
     vt_corners corners;
+    vt_base base;             /* progressive frames' copy of the rasterized half */
 } vt_state;
 
 static rl_status vt_create(void **state)
@@ -157,6 +158,7 @@ static void vt_release(void *state)
     rl_image_release(s->depth_ids);
     free(s->scratch_depth);
     vt_corners_free(&s->corners);
+    vt_base_free(&s->base);
     free(s);
 }
 
@@ -503,6 +505,7 @@ static rl_status vt_render(rl_renderer *r, void *state, const rl_scene *scene, c
     run.ras = s->ras;
     run.corners = &s->corners;
     run.scratch_depth = s->scratch_depth;
+    run.base = &s->base;
     double t0 = rl_time_s() * 1000.0;
     if (st == RL_OK)
         st = vt_prepass(&run, depth_ids);
@@ -524,7 +527,6 @@ static rl_status vt_render(rl_renderer *r, void *state, const rl_scene *scene, c
     vt_run_free_blocks(&run);
     free(run.reason);
     free(run.feelers);
-    vt_draw_free_base(&run);
     if (st != RL_OK)
         return st;
 

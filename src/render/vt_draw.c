@@ -281,7 +281,7 @@ static void copy_base(vt_run *run, const rl_image *target, bool save)
     bool ids = !(id_flags_of(target) & RL_RASTER_NO_ID);
     void *frame[4] = { target->color, target->depth, ids ? target->object_id : NULL,
                        ids ? target->triangle_id : NULL };
-    void *base[4] = { run->base_color, run->base_depth, run->base_object_id, run->base_triangle_id };
+    void *base[4] = { run->base->color, run->base->depth, run->base->object_id, run->base->triangle_id };
     const size_t size[4] = { sizeof *target->color, sizeof *target->depth, sizeof(uint32_t), sizeof(uint32_t) };
     for (int k = 0; k < 4; ++k)
         copy_layer(save ? base[k] : frame[k], save ? frame[k] : base[k], n, size[k]);
@@ -308,30 +308,28 @@ rl_status vt_draw_base(vt_run *run)
     size_t n = (size_t)target.width * (size_t)target.height;
     if (st == RL_OK && run->update) {
         bool ids = !(id_flags_of(&target) & RL_RASTER_NO_ID);
-        run->base_color = rl_realloc_array(NULL, n, sizeof *run->base_color);
-        run->base_depth = rl_realloc_array(NULL, n, sizeof *run->base_depth);
-        if (ids) {
-            run->base_object_id = rl_realloc_array(NULL, n, sizeof *run->base_object_id);
-            run->base_triangle_id = rl_realloc_array(NULL, n, sizeof *run->base_triangle_id);
-        }
-        if (!run->base_color || !run->base_depth || (ids && (!run->base_object_id || !run->base_triangle_id)))
+        vt_base *b = run->base;
+        if (!rl_reserve((void **)&b->color, &b->color_cap, n, sizeof *b->color, n) ||
+            !rl_reserve((void **)&b->depth, &b->depth_cap, n, sizeof *b->depth, n) ||
+            (ids && (!rl_reserve((void **)&b->object_id, &b->object_id_cap, n, sizeof *b->object_id, n) ||
+                     !rl_reserve((void **)&b->triangle_id, &b->triangle_id_cap, n, sizeof *b->triangle_id, n))))
             st = RL_ERR_OUT_OF_MEMORY;
-        else
+        else {
             copy_base(run, &target, true);
+            run->have_base = true;
+        }
     }
     run->stats.time_draw_ms += rl_time_s() * 1000.0 - t0;
     return st;
 }
 
-void vt_draw_free_base(vt_run *run)
+void vt_base_free(vt_base *b)
 {
-    free(run->base_color);
-    free(run->base_depth);
-    free(run->base_object_id);
-    free(run->base_triangle_id);
-    run->base_color = NULL;
-    run->base_depth = NULL;
-    run->base_object_id = run->base_triangle_id = NULL;
+    free(b->color);
+    free(b->depth);
+    free(b->object_id);
+    free(b->triangle_id);
+    memset(b, 0, sizeof *b);
 }
 
 rl_status vt_draw(vt_run *run, bool only_new)
@@ -344,7 +342,7 @@ rl_status vt_draw(vt_run *run, bool only_new)
         only_new = false;
     if (!only_new && run->drawn) {
         /* A full redraw starts again from the rasterized half. */
-        if (!run->base_color || !run->base_depth)
+        if (!run->have_base)
             return rl_error(RL_ERR_INTERNAL, "vt: redraw without the kept rasterized image");
         copy_base(run, &target, false);
     }

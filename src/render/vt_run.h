@@ -100,6 +100,17 @@ typedef struct vt_corners {
 } vt_corners;
 void vt_corners_free(vt_corners *b);
 
+/* The rasterized half of a frame (vt_draw_base), copied aside for redraws
+ * when an update callback may ask for more than one full draw. The
+ * buffers are kept by the renderer across frames (vt_state), so that a
+ * progressive frame does not allocate and fault them in again. */
+typedef struct vt_base {
+    rl_vec4 *color;
+    float *depth;
+    uint32_t *object_id, *triangle_id;
+    size_t color_cap, depth_cap, object_id_cap, triangle_id_cap;   /* pixels */
+} vt_base;
+
 typedef struct vt_run {
     const vt_settings *set;
     const rl_scene_data *data;
@@ -139,11 +150,8 @@ typedef struct vt_run {
     /* kept by the renderer across frames (vt_state) */
     rl_raster *ras;           /* every draw of the frame; its scratch stays */
     vt_corners *corners;
-    /* the rasterized half of the frame (vt_draw_base), kept for redraws
-     * when an update callback may ask for more than one full draw */
-    rl_vec4 *base_color;
-    float *base_depth;
-    uint32_t *base_object_id, *base_triangle_id;
+    vt_base *base;            /* the rasterized half of the frame */
+    bool have_base;           /* base holds this frame's */
     rl_raster_counters counters;  /* reconstruction draws */
     /* statistics */
     double t_start_ms;        /* rl_time_s() * 1000 at the frame's start */
@@ -185,8 +193,8 @@ rl_status vt_refine(vt_run *run);
  * starts from its depth; with an update callback a copy is kept, from
  * which every later full draw starts. Adds its time to stats.time_draw_ms. */
 rl_status vt_draw_base(vt_run *run);
-/* Frees the copy kept by vt_draw_base. */
-void vt_draw_free_base(vt_run *run);
+/* Frees the buffers of a kept base. */
+void vt_base_free(vt_base *b);
 /* The frame's target: run->image, with the scratch depth layer when the
  * image has none (the rasterizer needs one). */
 rl_status vt_draw_target(vt_run *run, rl_image *target);

@@ -508,6 +508,19 @@ static void progressive_updates(void **state)
             assert_memory_equal(progressive->object_id, plain->object_id, n * sizeof *plain->object_id);
             rl_image_release(progressive);
             rl_image_release(plain);
+            /* The copy of the rasterized half is kept across frames: a
+             * larger and then a smaller frame still equal plain ones. */
+            for (int size = 128; size >= 64; size -= 64) {
+                rl_camera c2 = look(rl_v3(0.5f, 4.0f, 3.5f), rl_v3(0.0f, 0.0f, 0.0f), size);
+                progressive = plain = NULL;
+                render_stats(r, s, &c2, &progressive);
+                render_stats(p, s, &c2, &plain);
+                n = (size_t)size * (size_t)size;
+                assert_memory_equal(progressive->color, plain->color, n * sizeof *plain->color);
+                assert_memory_equal(progressive->depth, plain->depth, n * sizeof *plain->depth);
+                rl_image_release(progressive);
+                rl_image_release(plain);
+            }
             rl_renderer_release(p);
             u = (updates){ 0, 0, 0, 0 };
         }
