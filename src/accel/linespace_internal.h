@@ -137,17 +137,19 @@ typedef struct rl_ls_entry {
 } rl_ls_entry;
 #define RL_LS_ENTRY_HIT 0x80000000u
 
-/* Appends one entry per shaft that may overlap the triangle (conservative:
- * never misses one) to out, which has room for S entries; returns the
- * number appended. scratch: 6·N^2·2 doubles + 4·N^2 ints. */
 /* rl_ls_shaft_of_segment on points already in cell units. */
 uint32_t rl_ls_shaft_of_unit(int n, const double entry[3], const double exit[3], bool *forward);
 
+/* Appends one entry per shaft that may overlap the triangle (conservative:
+ * never misses one) to out, which has room for S entries; returns the
+ * number appended. scratch: 6·N^2·5 doubles + 4·N^2 ints. */
 uint32_t rl_ls_enumerate(const rl_ls_geometry *g, const rl_ls_tri *t, uint32_t tri_id,
                          rl_ls_entry *out, double *scratch, int *iscratch);
 
 /* Midpoint ray parameter and barycentrics where the segment a->b meets the
- * triangle (cell units); false if it does not (within a small tolerance). */
+ * triangle (cell units); false if it does not (within a small tolerance).
+ * The build finds the same hits from per-patch values (rl_ls_enumerate);
+ * this Möller-Trumbore test is their reference in the tests. */
 bool rl_ls_segment_hit(const double a[3], const double b[3], const double v[3][3], double *s,
                        double *u, double *w);
 /* Barycentrics (u, w) of the triangle's point closest to q (cell units). */

@@ -370,23 +370,56 @@ static inline void apply_bound(double x, signed char kind, double *lo, double *h
         *hi = -INFINITY;
 }
 
-static inline void emit(const rl_ls_geometry *g, const rl_ls_tri *t, const double e1[3],
-                        const double e2[3], uint32_t tri_id, int fa, int pa, int fb, int pb,
-                        uint32_t base, const double *pl_lo, const double *pl_hi, rl_ls_entry *out,
-                        uint32_t *count)
+/* Per-patch values of one triangle, computed once per triangle so that a
+ * shaft's midpoint ray costs a division and a few multiply-adds instead of
+ * a Möller-Trumbore test: for patch centre c (cell units),
+ *   lo, hi  the support of the triangle's plane over the patch (signed
+ *           distances of its nearest and farthest corner, unit normal);
+ *   d       the signed distance of c itself;
+ *   u, w    the barycentrics of c's projection onto the plane.
+ * The barycentrics are affine in the point and constant along the normal,
+ * so the midpoint ray a->b meets the plane at s = d_a / (d_a - d_b) with
+ * barycentrics (1-s)·u_a + s·u_b and (1-s)·w_a + s·w_b: the same hit as the
+ * ray/triangle test up to rounding, with its tolerances. */
+typedef struct patch_planes {
+    double *lo, *hi, *d, *u, *w;  /* 6·N^2 each, by f·N^2 + p */
+} patch_planes;
+
+static inline bool midpoint_hit(const patch_planes *pp, int ia, int ib, double *s, double *u,
+                                double *w)
+{
+    double da = pp->d[ia], den = da - pp->d[ib];
+    if (!(fabs(den) > 1e-300))
+        return false;   /* parallel to the plane, or no plane */
+    double ss = da / den;
+    if (ss < -1e-3 || ss > 1.0 + 1e-3)
+        return false;
+    double uu = pp->u[ia] + (pp->u[ib] - pp->u[ia]) * ss;
+    if (uu < -1e-9 || uu > 1.0 + 1e-9)
+        return false;
+    double ww = pp->w[ia] + (pp->w[ib] - pp->w[ia]) * ss;
+    if (ww < -1e-9 || uu + ww > 1.0 + 1e-9)
+        return false;
+    *s = ss;
+    *u = uu;
+    *w = ww;
+    return true;
+}
+
+static inline void emit(const rl_ls_geometry *g, const rl_ls_tri *t, const patch_planes *pp,
+                        uint32_t tri_id, int fa, int pa, int fb, int pb, uint32_t base,
+                        rl_ls_entry *out, uint32_t *count)
 {
     int n = g->n, np = n * n;
     /* Schröder 2017, Alg. 3: the triangle's plane against both patches. */
     int ia = fa * np + pa, ib = fb * np + pb;
-    if (MIN2(pl_lo[ia], pl_lo[ib]) > RL_LS_EPS || MAX2(pl_hi[ia], pl_hi[ib]) < -RL_LS_EPS)
+    if (MIN2(pp->lo[ia], pp->lo[ib]) > RL_LS_EPS || MAX2(pp->hi[ia], pp->hi[ib]) < -RL_LS_EPS)
         return;
-    const float *ca = g->patch_center + (size_t)ia * 3, *cb = g->patch_center + (size_t)ib * 3;
-    double a[3] = { ca[0], ca[1], ca[2] }, b[3] = { cb[0], cb[1], cb[2] };
     rl_ls_entry *e = &out[(*count)++];
     e->shaft = base + (uint32_t)pa * (uint32_t)np + (uint32_t)pb;
     e->tri = tri_id;
     double s, u, w;
-    if (segment_hit_edges(a, b, t->v[0], e1, e2, &s, &u, &w)) {
+    if (midpoint_hit(pp, ia, ib, &s, &u, &w)) {
         /* Alg. 3: ordered by the midpoint ray's hit. */
         e->key_front = e->key_back = (float)s;
         e->u = (float)u;
@@ -396,7 +429,9 @@ static inline void emit(const rl_ls_geometry *g, const rl_ls_tri *t, const doubl
     }
     /* Our stand-in for a triangle the midpoint ray misses: its clipped
      * part's extent along the shaft axis. */
-    double ax[3] = { b[0] - a[0], b[1] - a[1], b[2] - a[2] };
+    const float *ca = g->patch_center + (size_t)ia * 3, *cb = g->patch_center + (size_t)ib * 3;
+    double a[3] = { ca[0], ca[1], ca[2] };
+    double ax[3] = { cb[0] - a[0], cb[1] - a[1], cb[2] - a[2] };
     double inv = 1.0 / (ax[0] * ax[0] + ax[1] * ax[1] + ax[2] * ax[2]);
     double lo = INFINITY, hi = -INFINITY;
     for (int i = 0; i < t->npoly; ++i) {
@@ -420,18 +455,40 @@ uint32_t rl_ls_enumerate(const rl_ls_geometry *g, const rl_ls_tri *t, uint32_t t
         e1[k] = t->v[1][k] - t->v[0][k];
         e2[k] = t->v[2][k] - t->v[0][k];
     }
-    /* Support of the triangle's plane (signed distance) over every patch. */
-    double *pl_lo = scratch, *pl_hi = scratch + 6 * np;
-    const double *nn = t->normal;
+    /* Gradients of the barycentrics: u(x) = (x - v0)·(e2 x m)/|m|^2 and
+     * w(x) = (x - v0)·(m x e1)/|m|^2 with m = e1 x e2 (1 at v1, resp. v2,
+     * 0 at the other two vertices, constant along m). */
+    double m[3] = { e1[1] * e2[2] - e1[2] * e2[1], e1[2] * e2[0] - e1[0] * e2[2],
+                    e1[0] * e2[1] - e1[1] * e2[0] };
+    double mm = m[0] * m[0] + m[1] * m[1] + m[2] * m[2];
+    double gu[3] = { 0.0, 0.0, 0.0 }, gw[3] = { 0.0, 0.0, 0.0 };
+    if (mm > 0.0 && isfinite(mm)) {
+        double im = 1.0 / mm;
+        gu[0] = (e2[1] * m[2] - e2[2] * m[1]) * im;
+        gu[1] = (e2[2] * m[0] - e2[0] * m[2]) * im;
+        gu[2] = (e2[0] * m[1] - e2[1] * m[0]) * im;
+        gw[0] = (m[1] * e1[2] - m[2] * e1[1]) * im;
+        gw[1] = (m[2] * e1[0] - m[0] * e1[2]) * im;
+        gw[2] = (m[0] * e1[1] - m[1] * e1[0]) * im;
+    }
+    /* The plane's support, distance and barycentrics over every patch. */
+    const int nf = 6 * np;
+    patch_planes pp = { scratch, scratch + nf, scratch + 2 * nf, scratch + 3 * nf, scratch + 4 * nf };
+    const double *nn = t->normal, *v0 = t->v[0];
     for (int f = 0; f < 6; ++f) {
         int u, v;
         rl_ls_face_uv(f, &u, &v);
         double ext = h * (fabs(nn[u]) + fabs(nn[v]));
         for (int p = 0; p < np; ++p) {
             const float *c = g->patch_center + ((size_t)f * (size_t)np + (size_t)p) * 3;
+            double x[3] = { c[0] - v0[0], c[1] - v0[1], c[2] - v0[2] };
             double d = nn[0] * c[0] + nn[1] * c[1] + nn[2] * c[2] - t->d;
-            pl_lo[f * np + p] = d - ext;
-            pl_hi[f * np + p] = d + ext;
+            int i = f * np + p;
+            pp.lo[i] = d - ext;
+            pp.hi[i] = d + ext;
+            pp.d[i] = d;
+            pp.u[i] = x[0] * gu[0] + x[1] * gu[1] + x[2] * gu[2];
+            pp.w[i] = x[0] * gw[0] + x[1] * gw[1] + x[2] * gw[2];
         }
     }
     int *list_u = iscratch, *list_v = iscratch + 2 * np;
@@ -469,7 +526,7 @@ uint32_t rl_ls_enumerate(const rl_ls_geometry *g, const rl_ls_tri *t, uint32_t t
                     for (int y = 0; y < nu[1]; ++y) {
                         int pa = list_u[2 * x] + n * list_v[2 * y];
                         int pb = list_u[2 * x + 1] + n * list_v[2 * y + 1];
-                        emit(g, t, e1, e2, tri_id, fa, pa, fb, pb, base, pl_lo, pl_hi, out, &count);
+                        emit(g, t, &pp, tri_id, fa, pa, fb, pb, base, out, &count);
                     }
                 continue;
             }
@@ -531,7 +588,7 @@ uint32_t rl_ls_enumerate(const rl_ls_geometry *g, const rl_ls_tri *t, uint32_t t
                                 continue;
                             int pa = cb < r ? iq + n * ir : ir + n * iq;
                             int pb = ca < r ? jp + n * jr : jr + n * jp;
-                            emit(g, t, e1, e2, tri_id, fa, pa, fb, pb, base, pl_lo, pl_hi, out, &count);
+                            emit(g, t, &pp, tri_id, fa, pa, fb, pb, base, out, &count);
                         }
                 }
         }

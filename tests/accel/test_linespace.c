@@ -1,6 +1,7 @@
 /* test_linespace.c: the Line Space (src/accel/linespace*.c, Schröder 2017):
  * index mapping, half floats, candidate lists against the BVH, fixed lists,
  * PNMT/PREILLUM agreement rates, determinism, bad arguments. */
+#include <math.h>
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
@@ -213,6 +214,87 @@ static void test_linespace_shaft_of_segment_agrees_with_the_mapping(void **state
             assert_int_equal(rl_ls_shaft_of_segment(n, box, a, on_face(&r, box, n, fa, ib, jb), NULL),
                              RL_NONE);
         }
+}
+
+/* The build orders a shaft's entries by where its midpoint ray meets the
+ * triangle, found from per-patch plane distances and barycentrics instead of
+ * a ray/triangle test per shaft; both must name the same hits. Fails when
+ * the precomputed barycentric gradients or the interpolation go wrong. */
+static void test_linespace_enumerated_hits_equal_the_ray_triangle_test(void **state)
+{
+    (void)state;
+    rl_rng r;
+    rl_rng_seed(&r, 11, 3);
+    const int ns[] = { 1, 3, 6 };
+    uint64_t hits = 0, agree = 0, misses_checked = 0;
+    for (size_t ni = 0; ni < sizeof ns / sizeof ns[0]; ++ni) {
+        int n = ns[ni];
+        rl_ls_geometry g;
+        assert_int_equal(rl_ls_geometry_init(&g, n), RL_OK);
+        rl_ls_entry *out = malloc(g.shafts * sizeof *out);
+        double *scratch = malloc((size_t)30 * (size_t)(n * n) * sizeof *scratch);
+        int *iscratch = malloc((size_t)4 * (size_t)(n * n) * sizeof *iscratch);
+        unsigned char *listed = malloc(g.shafts);
+        assert_true(out && scratch && iscratch && listed);
+        for (int it = 0; it < 60; ++it) {
+            /* Triangles inside, across and much larger than the voxel. */
+            double spread = it % 3 == 0 ? 0.5 : it % 3 == 1 ? 1.5 : 6.0;
+            double p[3][3];
+            for (int i = 0; i < 3; ++i)
+                for (int k = 0; k < 3; ++k)
+                    p[i][k] = 0.5 + spread * (2.0 * rl_rng_float(&r) - 1.0);
+            rl_ls_tri t;
+            if (!rl_ls_tri_setup(&t, p))
+                continue;
+            uint32_t count = rl_ls_enumerate(&g, &t, 7u, out, scratch, iscratch);
+            memset(listed, 0, g.shafts);
+            for (uint32_t e = 0; e < count; ++e) {
+                uint32_t shaft = out[e].shaft & ~RL_LS_ENTRY_HIT;
+                assert_true(shaft < g.shafts);
+                assert_int_equal(out[e].tri, 7u);
+                listed[shaft] = 1;
+                int fa, pa, fb, pb;
+                rl_ls_shaft_decode(n, shaft, &fa, &pa, &fb, &pb);
+                const float *ca = g.patch_center + ((size_t)fa * (size_t)(n * n) + (size_t)pa) * 3;
+                const float *cb = g.patch_center + ((size_t)fb * (size_t)(n * n) + (size_t)pb) * 3;
+                double a[3] = { ca[0], ca[1], ca[2] }, b[3] = { cb[0], cb[1], cb[2] };
+                double s, u, w;
+                bool ref = rl_ls_segment_hit(a, b, t.v, &s, &u, &w);
+                bool got = (out[e].shaft & RL_LS_ENTRY_HIT) != 0;
+                if (!got && !ref)
+                    continue;
+                ++hits;
+                /* Rays grazing an edge may fall either side of the tolerance. */
+                if (got == ref && fabs(s - out[e].key_front) < 1e-5 &&
+                    fabs(u - out[e].u) < 1e-5 && fabs(w - out[e].w) < 1e-5)
+                    ++agree;
+            }
+            /* A midpoint ray that hits the triangle lies in a listed shaft. */
+            for (uint32_t sh = 0; sh < g.shafts; sh += 1 + sh % 5) {
+                if (listed[sh])
+                    continue;
+                int fa, pa, fb, pb;
+                rl_ls_shaft_decode(n, sh, &fa, &pa, &fb, &pb);
+                const float *ca = g.patch_center + ((size_t)fa * (size_t)(n * n) + (size_t)pa) * 3;
+                const float *cb = g.patch_center + ((size_t)fb * (size_t)(n * n) + (size_t)pb) * 3;
+                double a[3] = { ca[0], ca[1], ca[2] }, b[3] = { cb[0], cb[1], cb[2] };
+                double s, u, w;
+                if (rl_ls_segment_hit(a, b, t.v, &s, &u, &w))
+                    assert_true(s < 1e-3 || s > 1.0 - 1e-3 || u < 1e-6 || w < 1e-6 ||
+                                u + w > 1.0 - 1e-6);
+                ++misses_checked;
+            }
+        }
+        free(listed);
+        free(iscratch);
+        free(scratch);
+        free(out);
+        rl_ls_geometry_free(&g);
+    }
+    assert_true(hits > 1000 && misses_checked > 1000);
+    if ((double)agree < 0.999 * (double)hits)
+        fail_msg("%llu of %llu midpoint hits agree with the ray/triangle test",
+                 (unsigned long long)agree, (unsigned long long)hits);
 }
 
 /* ---- half floats ----------------------------------------------------- */
@@ -739,6 +821,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_linespace_index_mapping_is_a_bijection_for_n_1_to_6),
         cmocka_unit_test(test_linespace_shaft_of_segment_agrees_with_the_mapping),
+        cmocka_unit_test(test_linespace_enumerated_hits_equal_the_ray_triangle_test),
         cmocka_unit_test(test_half_conversion_rounds_to_nearest_even_and_round_trips),
         cmocka_unit_test(test_linespace_dynamic_candidates_equal_the_bvh_on_cornell_teapot),
         cmocka_unit_test(test_linespace_dynamic_candidates_equal_the_bvh_on_cornell),
