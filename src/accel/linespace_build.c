@@ -102,7 +102,7 @@ static bool ws_init(workspace *w, uint32_t S, int n, int k)
     memset(w, 0, sizeof *w);
     w->offset = malloc(((size_t)S + 1) * sizeof *w->offset);
     w->back = malloc((size_t)(k > 0 ? k : 1) * sizeof *w->back);
-    w->scratch = malloc((size_t)30 * (size_t)(n * n) * sizeof *w->scratch);
+    w->scratch = malloc(RL_LS_ENUM_SCRATCH(n) * sizeof *w->scratch);
     w->iscratch = malloc((size_t)4 * (size_t)(n * n) * sizeof *w->iscratch);
     return w->offset && w->back && w->scratch && w->iscratch;
 }

@@ -142,7 +142,9 @@ uint32_t rl_ls_shaft_of_unit(int n, const double entry[3], const double exit[3],
 
 /* Appends one entry per shaft that may overlap the triangle (conservative:
  * never misses one) to out, which has room for S entries; returns the
- * number appended. scratch: 6·N^2·5 doubles + 4·N^2 ints. */
+ * number appended. scratch: RL_LS_ENUM_SCRATCH(N) doubles (6·N^2 for
+ * each of five per-patch values) + 4·N^2 ints. */
+#define RL_LS_ENUM_SCRATCH(n) ((size_t)30 * (size_t)(n) * (size_t)(n))
 uint32_t rl_ls_enumerate(const rl_ls_geometry *g, const rl_ls_tri *t, uint32_t tri_id,
                          rl_ls_entry *out, double *scratch, int *iscratch);
 

@@ -216,6 +216,19 @@ static void test_linespace_shaft_of_segment_agrees_with_the_mapping(void **state
         }
 }
 
+/* The Möller-Trumbore hit of shaft's midpoint ray (patch centre to patch
+ * centre) with triangle t. */
+static bool reference_hit(const rl_ls_geometry *g, uint32_t shaft, const rl_ls_tri *t, double *s,
+                          double *u, double *w)
+{
+    int fa, pa, fb, pb, np = g->n * g->n;
+    rl_ls_shaft_decode(g->n, shaft, &fa, &pa, &fb, &pb);
+    const float *ca = g->patch_center + ((size_t)fa * (size_t)np + (size_t)pa) * 3;
+    const float *cb = g->patch_center + ((size_t)fb * (size_t)np + (size_t)pb) * 3;
+    double a[3] = { ca[0], ca[1], ca[2] }, b[3] = { cb[0], cb[1], cb[2] };
+    return rl_ls_segment_hit(a, b, t->v, s, u, w);
+}
+
 /* The build orders a shaft's entries by where its midpoint ray meets the
  * triangle, found from per-patch plane distances and barycentrics instead of
  * a ray/triangle test per shaft; both must name the same hits. Fails when
@@ -232,7 +245,7 @@ static void test_linespace_enumerated_hits_equal_the_ray_triangle_test(void **st
         rl_ls_geometry g;
         assert_int_equal(rl_ls_geometry_init(&g, n), RL_OK);
         rl_ls_entry *out = malloc(g.shafts * sizeof *out);
-        double *scratch = malloc((size_t)30 * (size_t)(n * n) * sizeof *scratch);
+        double *scratch = malloc(RL_LS_ENUM_SCRATCH(n) * sizeof *scratch);
         int *iscratch = malloc((size_t)4 * (size_t)(n * n) * sizeof *iscratch);
         unsigned char *listed = malloc(g.shafts);
         assert_true(out && scratch && iscratch && listed);
@@ -253,13 +266,8 @@ static void test_linespace_enumerated_hits_equal_the_ray_triangle_test(void **st
                 assert_true(shaft < g.shafts);
                 assert_int_equal(out[e].tri, 7u);
                 listed[shaft] = 1;
-                int fa, pa, fb, pb;
-                rl_ls_shaft_decode(n, shaft, &fa, &pa, &fb, &pb);
-                const float *ca = g.patch_center + ((size_t)fa * (size_t)(n * n) + (size_t)pa) * 3;
-                const float *cb = g.patch_center + ((size_t)fb * (size_t)(n * n) + (size_t)pb) * 3;
-                double a[3] = { ca[0], ca[1], ca[2] }, b[3] = { cb[0], cb[1], cb[2] };
                 double s, u, w;
-                bool ref = rl_ls_segment_hit(a, b, t.v, &s, &u, &w);
+                bool ref = reference_hit(&g, shaft, &t, &s, &u, &w);
                 bool got = (out[e].shaft & RL_LS_ENTRY_HIT) != 0;
                 if (!got && !ref)
                     continue;
@@ -273,13 +281,8 @@ static void test_linespace_enumerated_hits_equal_the_ray_triangle_test(void **st
             for (uint32_t sh = 0; sh < g.shafts; sh += 1 + sh % 5) {
                 if (listed[sh])
                     continue;
-                int fa, pa, fb, pb;
-                rl_ls_shaft_decode(n, sh, &fa, &pa, &fb, &pb);
-                const float *ca = g.patch_center + ((size_t)fa * (size_t)(n * n) + (size_t)pa) * 3;
-                const float *cb = g.patch_center + ((size_t)fb * (size_t)(n * n) + (size_t)pb) * 3;
-                double a[3] = { ca[0], ca[1], ca[2] }, b[3] = { cb[0], cb[1], cb[2] };
                 double s, u, w;
-                if (rl_ls_segment_hit(a, b, t.v, &s, &u, &w))
+                if (reference_hit(&g, sh, &t, &s, &u, &w))
                     assert_true(s < 1e-3 || s > 1.0 - 1e-3 || u < 1e-6 || w < 1e-6 ||
                                 u + w > 1.0 - 1e-6);
                 ++misses_checked;
