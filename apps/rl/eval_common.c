@@ -32,6 +32,8 @@ const char rl_eval_sampling_help[] =
     "  --quality-size Q    size in the split priority q = n / (size * range):\n"
     "                      measure (area or volume, default) or diameter (the\n"
     "                      thesis); see docs/evaluation.md\n"
+    "  --grid-shift        grid method: one random offset for every cell's\n"
+    "                      sample instead of the cell centres (--seed)\n"
     "  --linear            fit a linear function per region instead\n"
     "  --seed N            default 1\n"
     "  --workers N         parallel evaluations; default all threads\n";
@@ -127,6 +129,10 @@ int rl_eval_sampling_arg(int argc, char **argv, int *i, rl_eval_sampling *s)
 #define TAKE(name) ((m = rl_cli_take_value(argc, argv, i, name, &v)) != 0)
     if (strcmp(argv[*i], "--linear") == 0) {
         d->linear = true;
+        return 1;
+    }
+    if (strcmp(argv[*i], "--grid-shift") == 0) {
+        d->grid_shift = true;
         return 1;
     }
     if (TAKE("--dims")) {
@@ -478,6 +484,8 @@ cJSON *rl_eval_desc_json(const rl_sampling_desc *d)
     cJSON_AddStringToObject(o, "interpolation", interp_names[d->interpolation]);
     if (d->method == RL_SAMPLING_ADAPTIVE)
         cJSON_AddStringToObject(o, "quality_size", rl_eval_quality_size_name(d->quality_size));
+    else
+        cJSON_AddBoolToObject(o, "grid_shift", d->grid_shift);
     cJSON_AddNumberToObject(o, "seed", (double)d->seed);
     return o;
 }

@@ -201,6 +201,11 @@ typedef struct rl_sampling_desc {          /* zero = default */
                                               interpolation) */
     rl_interpolation interpolation;        /* point queries; default nearest */
     rl_quality_size quality_size;          /* adaptive; default measure */
+    bool grid_shift;                       /* grid method: every cell's sample at
+                                              one seeded random offset from its
+                                              cell's corner, the same in all
+                                              cells (a randomly shifted lattice);
+                                              default the cell centres (Alg. 5.2) */
     uint64_t seed;
     int workers;                           /* 0 -> rl_property_workers(p) */
     rl_progress_fn progress;               /* done = samples / max_samples */

@@ -120,7 +120,8 @@ static cJSON *save_desc(const rl_sampling_desc *d)
               add(o, "interpolation", cJSON_CreateString(d->interpolation == RL_INTERP_REGION
                                                              ? "region" : "nearest")) &&
               add(o, "quality_size", cJSON_CreateString(d->quality_size == RL_QUALITY_DIAMETER
-                                                            ? "diameter" : "measure"));
+                                                            ? "diameter" : "measure")) &&
+              add(o, "grid_shift", cJSON_CreateBool(d->grid_shift));
     if (!ok) {
         cJSON_Delete(o);
         return NULL;
@@ -352,7 +353,7 @@ static rl_status load_desc(const loader *l, const cJSON *o, int dims, rl_samplin
     static const char *const keys[] = { "method", "positions", "max_samples", "max_seconds", "min_side",
                                         "samples_base", "samples_per_meter", "candidates", "grid_res",
                                         "combine", "seed", "workers", "linear", "interpolation",
-                                        "quality_size", NULL };
+                                        "quality_size", "grid_shift", NULL };
     rl_status st = rl_json_check_keys(l->doc, o, "\"desc\"", keys);
     cJSON *c = NULL;
     int e = 0;
@@ -425,6 +426,13 @@ static rl_status load_desc(const loader *l, const cJSON *o, int dims, rl_samplin
         if (strcmp(s, "measure") != 0 && strcmp(s, "diameter") != 0)
             return rl_json_error(l->doc, c, "\"quality_size\": expected \"measure\" or \"diameter\"");
         d->quality_size = strcmp(s, "diameter") == 0 ? RL_QUALITY_DIAMETER : RL_QUALITY_MEASURE;
+    }
+    /* Optional too: older files have centred grids. */
+    c = cJSON_GetObjectItemCaseSensitive(o, "grid_shift");
+    if (st == RL_OK && c) {
+        if (!cJSON_IsBool(c))
+            return rl_json_error(l->doc, c, "\"grid_shift\": expected true or false");
+        d->grid_shift = cJSON_IsTrue(c);
     }
     return st;
 }

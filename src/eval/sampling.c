@@ -303,10 +303,28 @@ static rl_status run_grid(rl_property *p, const rl_sampling_desc *d, int workers
     rl_vec3 *pos = rl_calloc(cells, sizeof *pos);
     batch b = { 0 };
     rl_status st = counts && lists && ids && pos ? RL_OK : RL_ERR_OUT_OF_MEMORY;
+    /* Alg. 5.2: the cell centres; or one random offset for every cell (a
+     * shifted lattice, Cranley & Patterson 1976), which keeps the lattice's
+     * even cover but not its fixed alignment with the scene. */
+    float shift[3] = { 0.0f, 0.0f, 0.0f };
+    if (d->grid_shift) {
+        rl_rng rng;
+        rl_rng_seed(&rng, d->seed, 0x9a1d5f7u);
+        for (int ax = 0; ax < 3; ++ax)
+            shift[ax] = rl_rng_float(&rng);
+    }
     for (uint32_t c = 0; c < cells && st == RL_OK; ++c) {
         rl_aabb box = a->nodes[1 + c].box;
-        pos[c] = (rl_vec3){ rl_split_mid(box.min.x, box.max.x), rl_split_mid(box.min.y, box.max.y),
-                            rl_split_mid(box.min.z, box.max.z) };
+        if (!d->grid_shift) {
+            pos[c] = (rl_vec3){ rl_split_mid(box.min.x, box.max.x), rl_split_mid(box.min.y, box.max.y),
+                                rl_split_mid(box.min.z, box.max.z) };
+            continue;
+        }
+        for (int ax = 0; ax < 3; ++ax) {
+            float lo = rl_v3_get(box.min, ax), hi = rl_v3_get(box.max, ax);
+            float x = lo + (hi - lo) * shift[ax];
+            rl_v3_set(&pos[c], ax, x < hi ? x : hi);
+        }
     }
     /* Batches of a few positions per worker keep the time budget and the
      * progress callback responsive. */

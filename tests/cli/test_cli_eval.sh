@@ -56,6 +56,18 @@ assert a["format"] == "renderlab-approx" and len(a["samples"]) == 48
 PY
 fi
 
+# A shifted grid: the flag reaches the sampler and both records.
+run_ok "$RL" eval cornell --property visibility --set resolution=16 --method grid --grid-shift \
+    --samples 16 --seed 4 --out "$TMP/shift"
+if have_python; then
+    python3 - "$TMP/shift/eval.json" "$TMP/shift/approx.json" <<'PY' || fail "--grid-shift is not applied"
+import json, sys
+e = json.load(open(sys.argv[1]))
+a = json.load(open(sys.argv[2]))
+assert a["desc"]["grid_shift"] is True and e["sampling"]["grid_shift"] is True, (a["desc"], e["sampling"])
+PY
+fi
+
 # 3-D, grid method, an image-quality property of two renderers
 run_ok "$RL" eval cornell --property quality --set renderer=raster --set reference=whitted \
     --set width=24 --set height=24 --dims 3 --method grid --samples 8 --out "$TMP/q"
@@ -90,6 +102,7 @@ expect_usage_error "$RL" bench sampling --samples 0 --out "$TMP/b.json"
 expect_error 2 "one of measure, diameter" "$RL" bench sampling --quality-size area --out "$TMP/b.json"
 expect_error 2 "expected a number" "$RL" bench sampling --samples-base 0 --out "$TMP/b.json"
 expect_error 2 "expected a number" "$RL" bench sampling --samples-per-meter nan --out "$TMP/b.json"
+expect_usage_error "$RL" bench sampling --repeats 0 --out "$TMP/b.json"
 run_ok "$RL" bench sampling --quick --out "$TMP/b.json"
 for s in variants convergence throughput bn-corners; do expect_in "$TMP/out" "$s"; done
 if have_python; then
@@ -100,8 +113,9 @@ for s in ("variants", "convergence", "throughput"):
     assert r[s]["status"] == "ok", (s, r[s])
 assert r["variants"]["cases_total"] == 8 and len(r["variants"]["cases"]) == 8
 for c in r["variants"]["cases"]:
-    for v in ("grid", "random", "bn", "bn-corners", "bnc-region"):
+    for v in ("grid", "grid~", "random", "bn", "bn-corners", "bnc-region"):
         assert c[v]["abs_error"]["mean"] >= 0, c
+        assert c[v]["mean_abs_error"] == c[v]["abs_error"]["mean"], c
 assert r["throughput"]["rows"][0]["samples_per_second"] > 0
 assert "machine" in r
 assert r["parameters"]["samples_base"] == 5 and r["parameters"]["samples_per_meter"] == 0.05
@@ -120,6 +134,28 @@ err = lambda c, v: c[v]["abs_error"]["mean"]
 for x, y in zip(ca, cb):
     assert err(x, "grid") == err(y, "grid") and err(x, "bnc-region") == err(y, "bnc-region"), (x, y)
 assert any(err(x, "bn-corners") != err(y, "bn-corners") for x, y in zip(ca, cb))
+PY
+fi
+# --repeats: the target's pair (grid~, bn-corners) over seeds 1..R, their
+# mean compared; seed 1 is the run without repeats, the rest untouched.
+run_ok "$RL" bench sampling --quick --only variants --repeats 3 --out "$TMP/b3.json"
+if have_python; then
+    python3 - "$TMP/b.json" "$TMP/b3.json" <<'PY' || fail "--repeats is not applied as documented"
+import json, sys
+a, b = (json.load(open(f)) for f in sys.argv[1:3])
+assert b["parameters"]["repeats"] == 3
+for x, y in zip(a["variants"]["cases"], b["variants"]["cases"]):
+    for v in ("grid", "grid~", "random", "bn", "bn-corners", "bnc-region"):
+        seeds = y[v]["mean_abs_error_per_seed"]
+        assert len(seeds) == (3 if v in ("grid~", "bn-corners") else 1), (v, y)
+        assert seeds[0] == x[v]["abs_error"]["mean"], (v, x, y)
+        assert abs(y[v]["mean_abs_error"] - sum(seeds) / len(seeds)) < 1e-12, (v, y)
+    m, g, s = (y[v]["mean_abs_error"] for v in ("bn-corners", "grid", "grid~"))
+    assert y["adaptive_no_worse_than_grid"] == (m <= g), y
+    assert y["adaptive_no_worse_than_shifted_grid"] == (m <= s), y
+r = b["variants"]
+assert r["cases_met"] == sum(c["adaptive_no_worse_than_grid"] for c in r["cases"])
+assert r["cases_met_shifted_grid"] == sum(c["adaptive_no_worse_than_shifted_grid"] for c in r["cases"])
 PY
 fi
 echo "ok"

@@ -159,6 +159,8 @@ static void test_round_trip_answers_every_query_identically(void **state)
         { .region = { { 0, 0, 0 }, { 10, 3, 10 } }, .method = RL_SAMPLING_GRID, .max_samples = 200 },
         { .region = { { 0, 0, 0 }, { 10, 0, 10 } }, .dims = 2, .method = RL_SAMPLING_GRID, .grid_res = { 7, 0, 3 },
           .linear = true },
+        { .region = { { 0, 0, 0 }, { 10, 3, 10 } }, .method = RL_SAMPLING_GRID, .max_samples = 64,
+          .grid_shift = true, .seed = 11 },
     };
     for (size_t i = 0; i < sizeof descs / sizeof descs[0]; ++i) {
         rl_approx *a = NULL;
@@ -295,6 +297,10 @@ static void edit_seed(cJSON *r)
 {
     cJSON_ReplaceItemInObject(cJSON_GetObjectItem(r, "desc"), "seed", cJSON_CreateNumber(5));
 }
+static void edit_grid_shift(cJSON *r)
+{
+    cJSON_ReplaceItemInObject(cJSON_GetObjectItem(r, "desc"), "grid_shift", cJSON_CreateString("yes"));
+}
 static void edit_grid(cJSON *r)
 {
     cJSON *node = cJSON_GetArrayItem(cJSON_GetObjectItem(r, "nodes"), 0);
@@ -343,6 +349,7 @@ static void test_broken_files_are_refused(void **state)
     expect_edit_refused(good, broken, edit_sample_float, "samples");
     expect_edit_refused(good, broken, edit_desc, "positions");
     expect_edit_refused(good, broken, edit_seed, "seed");
+    expect_edit_refused(good, broken, edit_grid_shift, "grid_shift");
     expect_edit_refused(good, broken, edit_grid, "nodes");
 
     char missing[1024];

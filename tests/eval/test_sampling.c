@@ -615,6 +615,71 @@ static void test_grid_method_samples_each_cell_centre_once(void **state)
     rl_property_release(p);
 }
 
+/* grid_shift: every cell's sample at the same seeded offset from its cell's
+ * corner (not the centre), inside the cell; the same seed, the same
+ * lattice; another seed, another offset. */
+static void test_shifted_grid_moves_every_sample_by_one_offset(void **state)
+{
+    (void)state;
+    fn_prop fp = { .f = f_wave };
+    rl_property *p = make_property(&fp, 2, 0);
+    rl_sampling_desc d = { .region = box3(0, 0, 0, 4, 2, 1), .method = RL_SAMPLING_GRID, .max_samples = 64,
+                           .grid_shift = true, .seed = 7 };
+    rl_approx *a = sample(p, d), *same = sample(p, d);
+    d.seed = 8;
+    rl_approx *other = sample(p, d);
+    assert_int_equal(rl_approx_region_count(a), 64);
+    assert_int_equal(rl_approx_sample_count(a), 64);
+    double off[3] = { 0 }, off_other[3] = { 0 };
+    for (uint32_t i = 0; i < 64; ++i) {
+        rl_approx_region r = region(a, i);
+        assert_int_equal(r.samples, 1);
+        rl_vec3 s, t, o;
+        double v;
+        assert_int_equal(rl_approx_sample(a, i, &s, &v), RL_OK);
+        assert_int_equal(rl_approx_sample(same, i, &t, NULL), RL_OK);
+        assert_int_equal(rl_approx_sample(other, i, &o, NULL), RL_OK);
+        assert_memory_equal(&s, &t, sizeof s);
+        assert_true(holds(r.box, s));
+        assert_near(v, f_wave(s), 0.0);
+        assert_near(r.value, v, 0.0);
+        /* The offset in cell units (cells of 0.5 m), the same in all cells. */
+        double rel[3] = { (s.x - r.box.min.x) / 0.5, (s.y - r.box.min.y) / 0.5, (s.z - r.box.min.z) / 0.5 };
+        double rel_o[3] = { (o.x - r.box.min.x) / 0.5, (o.y - r.box.min.y) / 0.5, (o.z - r.box.min.z) / 0.5 };
+        for (int k = 0; k < 3; ++k) {
+            if (i == 0) {
+                off[k] = rel[k];
+                off_other[k] = rel_o[k];
+            }
+            assert_near(rel[k], off[k], 1e-5);
+            assert_near(rel_o[k], off_other[k], 1e-5);
+            assert_true(rel[k] >= 0.0 && rel[k] <= 1.0);
+        }
+        /* Queries inside the cell answer with its sample. */
+        double q;
+        assert_int_equal(rl_approx_query(a, (rl_vec3){ r.box.min.x + 0.25f, r.box.min.y + 0.25f,
+                                                        r.box.min.z + 0.25f }, &q, NULL), RL_OK);
+        assert_near(q, v, 0.0);
+    }
+    assert_true(fabs(off[0] - 0.5) + fabs(off[1] - 0.5) + fabs(off[2] - 0.5) > 1e-3);
+    assert_true(fabs(off[0] - off_other[0]) + fabs(off[1] - off_other[1]) + fabs(off[2] - off_other[2]) > 1e-3);
+    rl_approx_release(a);
+    rl_approx_release(same);
+    rl_approx_release(other);
+
+    /* 2-D: the slice's height stays exact. */
+    a = sample(p, (rl_sampling_desc){ .region = box2(0, 0, 3, 1), .dims = 2, .height = 1.25f,
+                                      .method = RL_SAMPLING_GRID, .max_samples = 12, .grid_shift = true,
+                                      .seed = 3 });
+    for (uint32_t i = 0; i < rl_approx_sample_count(a); ++i) {
+        rl_vec3 s;
+        assert_int_equal(rl_approx_sample(a, i, &s, NULL), RL_OK);
+        assert_true(s.y == 1.25f);
+    }
+    rl_approx_release(a);
+    rl_property_release(p);
+}
+
 static void test_query_on_a_boundary_picks_the_smaller_index(void **state)
 {
     (void)state;
@@ -1021,6 +1086,7 @@ int main(void)
         cmocka_unit_test(test_results_are_identical_for_any_worker_count_and_seed),
         cmocka_unit_test(test_exclusive_properties_are_evaluated_serially),
         cmocka_unit_test(test_grid_method_samples_each_cell_centre_once),
+        cmocka_unit_test(test_shifted_grid_moves_every_sample_by_one_offset),
         cmocka_unit_test(test_query_on_a_boundary_picks_the_smaller_index),
         cmocka_unit_test(test_nearest_query_is_the_nearest_of_all_samples),
         cmocka_unit_test(test_quality_size_spreads_the_refinement),
