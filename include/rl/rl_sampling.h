@@ -11,6 +11,14 @@
  *   RL_SAMPLING_GRID      Regular sampling (Sec. 5.3, Alg. 5.2): the region
  *                         cut into res.x x res.y x res.z equal boxes, one
  *                         sample at each centre; the reference method.
+ *                         With grid_shift (ours) every sample sits at the
+ *                         same random offset (from the seed) inside its
+ *                         box instead: a randomly shifted lattice, which
+ *                         keeps the even cover but not the one alignment
+ *                         of the centred lattice with the scene (on a
+ *                         regular scene such as `city` that alignment
+ *                         moves the grid's error by up to 40 % between
+ *                         neighbouring sample counts; bench/README.md).
  *   RL_SAMPLING_ADAPTIVE  Adaptive sampling (Sec. 5.4, Alg. 5.3, default):
  *                         a priority queue of regions ordered by quality
  *                             q = n / (diameter * (max - min))
@@ -98,8 +106,10 @@
  * leaf borders by a branch-and-bound search of the region tree, so adaptive
  * sampling keeps every sample's resolution where it placed them densely.
  * Region values, statistics and heat maps are unchanged; RL_INTERP_REGION
- * gives the thesis' queries. For the grid method both agree (one sample per
- * cell, at its centre). Measured in `rl bench sampling`.
+ * gives the thesis' queries. For the centred grid both agree (one sample
+ * per cell, at its centre); for a shifted grid a nearest-sample query near
+ * a cell's border may answer with the neighbour's sample, i.e. the shifted
+ * lattice's own Voronoi cells. Measured in `rl bench sampling`.
  *
  * The quality rule, a second deviation: the thesis splits the region of
  * lowest q = n / (diameter * (max - min)). Halving a 2-D region's sides

@@ -124,6 +124,7 @@ static void chcpp_release(void *state)
     if (!s)
         return;
     rl_octree_cache_release(&s->oc);
+    rl_cull_keep_release(&s->head.keep);
     rl_box_query_free(&s->query);
     free(s->ns);
     free(s->heap);
@@ -447,7 +448,7 @@ static rl_status chcpp_render(rl_renderer *r, void *state, const rl_scene *scene
     f.batch = (uint32_t)rl_renderer_opt_int(r, "batch");
     f.n_av = (uint32_t)rl_renderer_opt_int(r, "assumed_visible");
     f.seed = (uint64_t)rl_renderer_opt_int(r, "seed");
-    st = rl_cull_frame_begin(r, d, cam, image, &f.cf);
+    st = rl_cull_frame_begin(r, scene, &s->head.keep, cam, image, &f.cf);
     if (st != RL_OK)
         return st;
     s->frame++;

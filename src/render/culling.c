@@ -196,9 +196,23 @@ rl_status rl_culling_get_stats(const rl_renderer *r, rl_culling_stats *out)
 
 const char *const rl_cull_shading_choices[] = { "flat", "gouraud", "textured", NULL };
 
-rl_status rl_cull_frame_begin(rl_renderer *r, const rl_scene_data *d, const rl_camera *cam, rl_image *image,
-                              rl_cull_frame *f)
+void rl_cull_keep_release(rl_cull_keep *k)
 {
+    rl_scene_drawer_release(k->drawer);
+    rl_raster_release(k->ras);
+    memset(k, 0, sizeof *k);
+}
+
+static bool same_drawing(const rl_raster_scene_desc *a, const rl_raster_scene_desc *b)
+{
+    return a->shading == b->shading && a->ambient == b->ambient && a->threads == b->threads &&
+           a->flags == b->flags && a->object_mask == b->object_mask;
+}
+
+rl_status rl_cull_frame_begin(rl_renderer *r, const rl_scene *scene, rl_cull_keep *keep, const rl_camera *cam,
+                              rl_image *image, rl_cull_frame *f)
+{
+    const rl_scene_data *d = rl_scene_get_data(scene);
     memset(f, 0, sizeof *f);
     f->threads_opt = (int)rl_renderer_opt_int(r, "threads");
 #ifdef _OPENMP
@@ -218,11 +232,24 @@ rl_status rl_cull_frame_begin(rl_renderer *r, const rl_scene_data *d, const rl_c
         return st;
     desc.flags |= f->target.flags;
     rl_cull_view_make(cam, d->bounds, &f->view);
-    st = rl_raster_create(&(rl_raster_desc){ .threads = f->threads_opt }, &f->ras);
+    if (keep->ras && keep->drawer && keep->scene_uid == rl_scene_uid(scene) && same_drawing(&keep->desc, &desc)) {
+        rl_scene_drawer_new_frame(keep->drawer, f->view.eye);
+    } else {
+        rl_cull_keep_release(keep);
+        st = rl_raster_create(&(rl_raster_desc){ .threads = f->threads_opt }, &keep->ras);
+        if (st == RL_OK)
+            st = rl_scene_drawer_create(d, f->view.eye, &desc, &keep->drawer);
+        if (st == RL_OK) {
+            keep->scene_uid = rl_scene_uid(scene);
+            keep->desc = desc;
+        } else {
+            rl_cull_keep_release(keep);
+        }
+    }
+    f->ras = keep->ras;
+    f->drawer = keep->drawer;
     if (st == RL_OK)
         st = rl_raster_set_target(f->ras, &f->target.image, &f->view.view, &f->view.proj);
-    if (st == RL_OK)
-        st = rl_scene_drawer_create(d, f->view.eye, &desc, &f->drawer);
     if (st != RL_OK)
         rl_cull_frame_end(f, st, image, NULL);
     return st;
@@ -230,8 +257,6 @@ rl_status rl_cull_frame_begin(rl_renderer *r, const rl_scene_data *d, const rl_c
 
 rl_status rl_cull_frame_end(rl_cull_frame *f, rl_status st, const rl_image *image, rl_render_stats *stats)
 {
-    rl_scene_drawer_release(f->drawer);
-    rl_raster_release(f->ras);
     rl_cull_target_end(&f->target);
     f->drawer = NULL;
     f->ras = NULL;

@@ -446,6 +446,12 @@ static void light_object(rl_scene_drawer *dr, uint32_t o)
         light_corners(ctx, dr->opt.shading, b, t);
 }
 
+void rl_scene_drawer_new_frame(rl_scene_drawer *dr, rl_vec3 eye)
+{
+    dr->ctx.eye = eye;
+    memset(dr->object_lit, 0, dr->data->num_objects ? dr->data->num_objects : 1);
+}
+
 rl_status rl_scene_drawer_draw(rl_scene_drawer *dr, rl_raster *ras, uint32_t object, rl_raster_counters *c)
 {
     if (!dr || !ras)

@@ -54,6 +54,12 @@ rl_vec3 rl_raster_light_diffuse(const rl_scene_data *d, rl_vec3 p, rl_vec3 n, rl
 typedef struct rl_scene_drawer rl_scene_drawer;
 rl_status rl_scene_drawer_create(const rl_scene_data *d, rl_vec3 eye, const rl_raster_scene_desc *desc,
                                  rl_scene_drawer **out);
+/* Starts another frame with a drawer made for the same scene and desc: the
+ * viewer moves to eye, and every object is lit again when it is first drawn.
+ * The buffers (per vertex and corner of the whole scene) are made once, so
+ * a renderer that keeps its drawer does not allocate and fault in the
+ * whole scene's buffers every frame for the few objects it draws. */
+void rl_scene_drawer_new_frame(rl_scene_drawer *dr, rl_vec3 eye);
 /* Draws object (an index < d->num_objects; unselected objects are skipped)
  * into the rasterizer's current target. */
 rl_status rl_scene_drawer_draw(rl_scene_drawer *dr, rl_raster *ras, uint32_t object, rl_raster_counters *c);

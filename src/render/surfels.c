@@ -102,6 +102,7 @@ static void surfels_release(void *state)
         return;
     drop_sets(s);
     rl_octree_cache_release(&s->oc);
+    rl_cull_keep_release(&s->head.keep);
     free(s->pos);
     free(s->col);
     free(s->size);
@@ -346,7 +347,7 @@ static rl_status surfels_render(rl_renderer *r, void *state, const rl_scene *sce
     f.max2 = max_size * max_size;
     f.overdraw = (float)rl_renderer_opt_float(r, "overdraw");
     f.point_size = (float)rl_renderer_opt_float(r, "point_size");
-    st = rl_cull_frame_begin(r, d, cam, image, &f.cf);
+    st = rl_cull_frame_begin(r, scene, &s->head.keep, cam, image, &f.cf);
     if (st != RL_OK)
         return st;
     st = rl_cull_frame_end(&f.cf, draw_node(&f, 0), image, stats);

@@ -111,6 +111,7 @@ static void svs_release(void *state)
         return;
     drop_sets(s);
     rl_octree_cache_release(&s->oc);
+    rl_cull_keep_release(&s->head.keep);
     free(s);
 }
 
@@ -520,7 +521,7 @@ static rl_status svs_render(rl_renderer *r, void *state, const rl_scene *scene, 
     f.distance = (float)rl_renderer_opt_float(r, "distance");
     if (f.neighbours > s->num_dirs)
         f.neighbours = s->num_dirs;
-    st = rl_cull_frame_begin(r, d, cam, image, &f.cf);
+    st = rl_cull_frame_begin(r, scene, &s->head.keep, cam, image, &f.cf);
     if (st != RL_OK)
         return st;
     if (++s->frame == 0) {

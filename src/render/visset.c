@@ -95,6 +95,7 @@ static void visset_release(void *state)
     if (!s)
         return;
     drop(s);
+    rl_cull_keep_release(&s->head.keep);
     free(s);
 }
 
@@ -281,7 +282,7 @@ static rl_status visset_render(rl_renderer *r, void *state, const rl_scene *scen
     f.s = s;
     f.d = d;
     f.budget = budget;
-    st = rl_cull_frame_begin(r, d, cam, image, &f.cf);
+    st = rl_cull_frame_begin(r, scene, &s->head.keep, cam, image, &f.cf);
     if (st != RL_OK)
         return st;
     if (++s->frame == 0) {

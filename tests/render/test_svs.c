@@ -95,6 +95,43 @@ static void test_svs_never_draws_a_sealed_object(void **state)
     rl_scene_release(s);
 }
 
+/* The rasterizer and drawer kept between frames (culling.c, shared by
+ * chcpp, svs, visset and surfels) follow the viewer, the drawing options,
+ * the image's layers and the scene: every frame equals a fresh renderer's.
+ * Fails when the drawer keeps the lighting of the previous viewer (the
+ * materials have a specular term) or outlives its scene or options. */
+static void test_kept_drawer_follows_view_options_layers_and_scene(void **state)
+{
+    (void)state;
+    rl_scene *s = fx_box_city(), *other = fx_box_city();
+    rl_camera a = far_camera(), b = far_camera();
+    b.eye = rl_v3(180.0f, 70.0f, -90.0f);
+    rl_renderer *r = fx_make("svs", (const char *const[]){ "max_depth", "3", NULL });
+    const char *const opts[] = { "max_depth", "3", NULL };
+    const char *const flat[] = { "max_depth", "3", "shading", "flat", NULL };
+    rl_image *first = fx_render_with(r, s, &a, FX_ALL_LAYERS, NULL);
+    rl_image_release(first);
+    struct {
+        const rl_scene *scene;
+        const char *shading;
+        unsigned layers;
+    } steps[] = { { s, "textured", FX_ALL_LAYERS }, { s, "flat", FX_ALL_LAYERS },
+                  { s, "flat", RL_LAYER_COLOR }, { other, "flat", RL_LAYER_COLOR } };
+    for (size_t i = 0; i < sizeof steps / sizeof steps[0]; ++i) {
+        assert_int_equal(rl_renderer_set(r, "shading", steps[i].shading), RL_OK);
+        const rl_camera *cam = i % 2 ? &a : &b;
+        rl_image *kept = fx_render_with(r, steps[i].scene, cam, steps[i].layers, NULL);
+        rl_image *fresh = fx_render("svs", steps[i].scene, cam, steps[i].layers,
+                                    strcmp(steps[i].shading, "flat") == 0 ? flat : opts, NULL);
+        fx_assert_images_identical(kept, fresh);
+        rl_image_release(kept);
+        rl_image_release(fresh);
+    }
+    rl_renderer_release(r);
+    rl_scene_release(other);
+    rl_scene_release(s);
+}
+
 static void test_svs_refuses_bad_options(void **state)
 {
     (void)state;
@@ -111,6 +148,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_svs_draws_less_at_high_quality_from_far),
         cmocka_unit_test(test_svs_never_draws_a_sealed_object),
+        cmocka_unit_test(test_kept_drawer_follows_view_options_layers_and_scene),
         cmocka_unit_test(test_svs_refuses_bad_options),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
