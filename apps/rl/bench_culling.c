@@ -77,6 +77,9 @@ static const char bench_culling_help[] =
     "  --max-depth N        depth section: depths 0..N; default 8\n"
     "  --size N             image side per direction; default 128\n"
     "  --height H           slice height above the scene's floor; default 10\n"
+    "  --extent F           the slice of svs/select/visset spans F times the\n"
+    "                       scene's width and depth around its centre (2: the\n"
+    "                       city seen from outside too); default 1\n"
     "  --resolution N       cube-face side of the visibility property; default 128\n"
     "  --select-positions N default 100\n"
     "  --select-quantile Q  high occlusion below this quantile; default 0.25\n"
@@ -97,7 +100,7 @@ static const char *const section_names[SEC_COUNT] = { "surfels", "depth", "svs",
 typedef struct bc_args {
     const char *scene, *out;
     long long samples, max_depth, size, resolution, select_positions, budget, threads, seed, surfels;
-    double height, select_quantile;
+    double height, select_quantile, extent;
     unsigned sections;
     bool quick;
 } bc_args;
@@ -343,7 +346,16 @@ static rl_status ensure_driver(bc_ctx *c)
     rl_status st = make_property(c, "visibility", (const char *const[]){ "resolution", res, "measure", "polygons",
                                                                          NULL },
                                  &vis);
-    rl_sampling_desc sd = { .region = c->d->bounds, .dims = 2,
+    /* --extent: the scene's x/z extent scaled about its centre. */
+    rl_aabb slice = c->d->bounds;
+    float cx = 0.5f * (slice.min.x + slice.max.x), cz = 0.5f * (slice.min.z + slice.max.z);
+    float hx = 0.5f * (float)c->a->extent * (slice.max.x - slice.min.x);
+    float hz = 0.5f * (float)c->a->extent * (slice.max.z - slice.min.z);
+    slice.min.x = cx - hx;
+    slice.max.x = cx + hx;
+    slice.min.z = cz - hz;
+    slice.max.z = cz + hz;
+    rl_sampling_desc sd = { .region = slice, .dims = 2,
                             .height = c->d->bounds.min.y + (float)c->a->height,
                             .max_samples = (uint32_t)c->a->samples, .seed = (uint64_t)c->a->seed };
     if (st == RL_OK) {
@@ -436,8 +448,8 @@ static rl_status sec_svs(void *ctx, cJSON *sec)
     if (st != RL_OK)
         return st;
     c->chcpp_triangles_mean = tri_chc.mean;
-    printf("\nSec. 7.4: chcpp vs svs over the slice y = floor + %g, %u positions (area-weighted)\n", c->a->height,
-           c->npos);
+    printf("\nSec. 7.4: chcpp vs svs over the slice y = floor + %g (%g x the scene's width), %u positions "
+           "(area-weighted)\n", c->a->height, c->a->extent, c->npos);
     printf("%-36s %11s %11s %11s %11s  %s\n", "property", "mean", "min", "median", "max", "thesis (mean)");
     table_row("polygons in visible objects", &vis, "-");
     table_row("chcpp time (ms, conditioned)", &t_chc, "55 ms");
@@ -679,6 +691,7 @@ static int parse_args(int argc, char **argv, bc_args *a)
     a->seed = 1;
     a->select_quantile = 0.25;
     a->height = 10.0;
+    a->extent = 1.0;
     bool has_samples = false, has_depth = false, has_size = false, has_res = false, has_sel = false;
     const rl_bench_opt rows[] = {
         RL_BENCH_FLAG("--quick", &a->quick),
@@ -692,6 +705,7 @@ static int parse_args(int argc, char **argv, bc_args *a)
         RL_BENCH_COUNT("--seed", 1LL << 62, &a->seed, NULL),
         RL_BENCH_CUSTOM("--max-depth", take_max_depth, a, &has_depth),
         RL_BENCH_REAL("--height", -1e6, 1e6, &a->height, NULL),
+        RL_BENCH_REAL("--extent", 0.01, 100.0, &a->extent, NULL),
         RL_BENCH_REAL("--select-quantile", 1e-6, 1.0 - 1e-6, &a->select_quantile, NULL),
         RL_BENCH_SECTIONS(section_names, SEC_COUNT, &a->sections),
         RL_BENCH_STRING("--scene", &a->scene),
@@ -756,6 +770,7 @@ int rl_bench_culling(int argc, char **argv)
     cJSON_AddNumberToObject(params, "max_depth", (double)a.max_depth);
     cJSON_AddNumberToObject(params, "size", (double)a.size);
     cJSON_AddNumberToObject(params, "height", a.height);
+    cJSON_AddNumberToObject(params, "extent", a.extent);
     cJSON_AddNumberToObject(params, "resolution", (double)a.resolution);
     cJSON_AddNumberToObject(params, "select_positions", (double)a.select_positions);
     cJSON_AddNumberToObject(params, "select_quantile", a.select_quantile);

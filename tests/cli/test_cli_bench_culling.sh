@@ -13,6 +13,7 @@ have_python() { command -v python3 >/dev/null 2>&1 && python3 -c 'import json' 2
 expect_usage_error "$RL" bench culling --samples 0 --out "$TMP/x.json"
 expect_usage_error "$RL" bench culling --max-depth 21 --out "$TMP/x.json"
 expect_usage_error "$RL" bench culling --select-quantile 1.5 --out "$TMP/x.json"
+expect_usage_error "$RL" bench culling --extent 0 --out "$TMP/x.json"
 expect_usage_error "$RL" bench culling --only depth,nosuch --out "$TMP/x.json"
 expect_usage_error "$RL" bench culling --quick --out "$TMP/x.txt"
 expect_usage_error "$RL" bench culling --frobnicate
@@ -20,7 +21,7 @@ expect_usage_error "$RL" bench culling --frobnicate
 expect_exit 1 "$RL" bench culling --quick --out "$TMP/no/such/dir/c.json"
 
 expect_exit 0 "$RL" bench culling --help
-for o in --scene --only --samples --max-depth --size --height --resolution --select-positions \
+for o in --scene --only --samples --max-depth --size --height --extent --resolution --select-positions \
          --select-quantile --surfels --budget --threads --seed --out --quick; do
     expect_in "$TMP/out" "$o"
 done
@@ -62,6 +63,18 @@ assert sel["positions"] == 4 and sel["selected_mean_ms"] > 0, sel
 assert sel["chcpp_mean_ms"] > 0 and sel["svs_mean_ms"] > 0 and isinstance(sel["selection_beats_both"], bool), sel
 v = r["visset"]
 assert v["set_bytes"] > 0 and v["budget_triangles"] > 0 and 0 < v["ssim"]["min"] <= 1, v
+PY
+fi
+
+# --extent widens the slice of Sec. 7.4-7.6 about the scene's centre: the
+# positions there see the scene from outside.
+expect_exit 0 "$RL" bench culling --quick --only svs --extent 3 --out "$TMP/e.json"
+if have_python; then
+    python3 - "$TMP/c.json" "$TMP/e.json" <<'PY' || fail "--extent is not applied"
+import json, sys
+a, b = (json.load(open(f)) for f in sys.argv[1:3])
+assert a["parameters"]["extent"] == 1 and b["parameters"]["extent"] == 3
+assert a["svs"]["visible_polygons"]["mean"] != b["svs"]["visible_polygons"]["mean"], (a["svs"], b["svs"])
 PY
 fi
 
