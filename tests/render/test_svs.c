@@ -106,9 +106,10 @@ static void test_kept_drawer_follows_view_options_layers_and_scene(void **state)
     rl_scene *s = fx_box_city(), *other = fx_box_city();
     rl_camera a = far_camera(), b = far_camera();
     b.eye = rl_v3(180.0f, 70.0f, -90.0f);
-    rl_renderer *r = fx_make("svs", (const char *const[]){ "max_depth", "3", NULL });
-    const char *const opts[] = { "max_depth", "3", NULL };
-    const char *const flat[] = { "max_depth", "3", "shading", "flat", NULL };
+    /* Coarse sets (12 directions, 32² renders): this is about the drawer. */
+    const char *const opts[] = { "max_depth", "3", "levels", "0", "resolution", "32", NULL };
+    const char *const flat[] = { "max_depth", "3", "levels", "0", "resolution", "32", "shading", "flat", NULL };
+    rl_renderer *r = fx_make("svs", opts);
     rl_image *first = fx_render_with(r, s, &a, FX_ALL_LAYERS, NULL);
     rl_image_release(first);
     struct {
