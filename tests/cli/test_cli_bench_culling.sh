@@ -61,6 +61,13 @@ assert sel["positions"] == 4 and sel["selected_mean_ms"] > 0, sel
 # The selection picks per position, so its mean may be below both (that is
 # its point) or, with a poor predictor, above both: only sanity here.
 assert sel["chcpp_mean_ms"] > 0 and sel["svs_mean_ms"] > 0 and isinstance(sel["selection_beats_both"], bool), sel
+# With the svs section's sampled times: the selection judged on the time
+# property itself, between the two renderers' means or below both.
+assert sel["property_chcpp_mean_ms"] > 0 and sel["property_svs_mean_ms"] > 0, sel
+lo = min(sel["property_chcpp_mean_ms"], sel["property_svs_mean_ms"])
+hi = max(sel["property_chcpp_mean_ms"], sel["property_svs_mean_ms"])
+assert 0 < sel["property_time_selected_mean_ms"] and 0 <= sel["property_time_selected_chcpp"] <= 4, sel
+assert sel["property_time_selection_beats_both"] == (sel["property_time_selected_mean_ms"] < lo), sel
 v = r["visset"]
 assert v["set_bytes"] > 0 and v["budget_triangles"] > 0 and 0 < v["ssim"]["min"] <= 1, v
 PY
