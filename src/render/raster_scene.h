@@ -47,8 +47,9 @@ rl_vec3 rl_raster_light_diffuse(const rl_scene_data *d, rl_vec3 p, rl_vec3 n, rl
 
 /* The same drawing one object at a time, for renderers that decide per
  * object what to draw and in which order (occlusion culling, level of
- * detail): buffers are prepared once per frame, and an object is lit when
- * it is first drawn, so culled objects cost no lighting. Drawing every
+ * detail): buffers are prepared once per drawer (rl_scene_drawer_new_frame
+ * reuses them for the next frame), and an object is lit when it is first
+ * drawn in a frame, so culled objects cost no lighting. Drawing every
  * selected object in index order gives exactly rl_raster_draw_scene's
  * image. The drawer borrows d and desc->object_mask. */
 typedef struct rl_scene_drawer rl_scene_drawer;
