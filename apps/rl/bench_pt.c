@@ -72,6 +72,8 @@ static const char bench_pt_help[] =
     "  --ref-spp N       samples of the BVH reference; default 1024\n"
     "  --spp-max N       samples accumulated per variant in the error section; default 64\n"
     "  --max-memory GB   skip Line Spaces estimated to need more; default 60% of RAM\n"
+    "  --small-pages     generation: build without transparent huge pages\n"
+    "                    (rl_linespace_desc.small_pages), for an A/B of the page size\n"
     "  --threads N       threads; default all cores\n"
     "  --only LIST       comma-separated subset of the sections above\n"
     "  --out FILE.json   default bench/results/pt-YYYYMMDD-HHMMSS.json\n"
@@ -131,7 +133,7 @@ typedef struct bpt_args {
     int width, height, err_width, err_height;
     long long ref_spp, spp_max, threads;
     long long max_memory_gb;       /* 0: 60% of physical memory */
-    bool has_size, has_err_size, has_ref_spp, has_spp_max, quick;
+    bool has_size, has_err_size, has_ref_spp, has_spp_max, quick, small_pages;
     unsigned sections;
     const char *out;
 } bpt_args;
@@ -375,7 +377,7 @@ static rl_status sec_generation(void *ctx, cJSON *sec)
                              .grid_res = { g->res, g->res, g->res } };
         if (st == RL_OK) st = rl_accel_create(scene, &ad, &grid);
         if (st == RL_OK) st = rl_accel_commit(grid);
-        rl_linespace_desc ld = { .n = g->n, .dynamic = true,
+        rl_linespace_desc ld = { .n = g->n, .dynamic = true, .small_pages = b->a->small_pages,
                                  .payloads = RL_LS_CANDIDATES | RL_LS_PNMT, .threads = b->threads };
         if (st == RL_OK) st = rl_linespace_create(grid, &ld, &ls);
         if (st == RL_OK) st = rl_linespace_commit(ls);
@@ -967,6 +969,7 @@ static int parse_args(int argc, char **argv, bpt_args *a)
     a->sections = (1u << SEC_COUNT) - 1;
     const rl_bench_opt rows[] = {
         RL_BENCH_FLAG("--quick", &a->quick),
+        RL_BENCH_FLAG("--small-pages", &a->small_pages),
         RL_BENCH_SIZE("--size", &a->width, &a->height, &a->has_size),
         RL_BENCH_SIZE("--error-size", &a->err_width, &a->err_height, &a->has_err_size),
         RL_BENCH_COUNT("--ref-spp", 1 << 20, &a->ref_spp, &a->has_ref_spp),
@@ -1012,6 +1015,7 @@ static cJSON *params_json(const bpt *b)
     cJSON_AddNumberToObject(o, "max_memory_bytes", b->max_memory_bytes);
     cJSON_AddNumberToObject(o, "ls_n", RL_LS_DEFAULT_N);
     cJSON_AddBoolToObject(o, "quick", a->quick);
+    cJSON_AddBoolToObject(o, "ls_huge_pages", !a->small_pages);
     cJSON_AddNumberToObject(o, "warmup_renders", 1);
     cJSON_AddNumberToObject(o, "timed_renders", b->runs);
     cJSON_AddStringToObject(o, "seed", PT_SEED);

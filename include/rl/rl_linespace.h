@@ -64,7 +64,17 @@
  *
  * Lifecycle as rl_accel: create (borrowing a committed RL_ACCEL_GRID accel,
  * which must outlive the Line Space), optionally set the shading function,
- * commit (builds), then thread-safe queries that cannot fail. */
+ * commit (builds), then thread-safe queries that cannot fail.
+ *
+ * Memory pages: the arrays of 4 MiB or more (and the build's temporary
+ * lists) are 2 MiB-aligned and advised for transparent huge pages on Linux
+ * (madvise MADV_HUGEPAGE; a no-op where the kernel has them off). A build
+ * writes gigabytes once, and first-touch faults of 4 KiB pages were 35-50 %
+ * of it on our 2-core VM; with huge pages teapot 32^3 built in 1.5-2.7 s
+ * instead of 3.5-3.8 s (docs/line-space.md). On a machine whose kernel
+ * compacts memory on every huge fault this can be slower (seen on another
+ * VM of ours): desc.small_pages keeps plain malloc. Loaded Line Spaces
+ * always ask for huge pages. */
 #ifndef RL_LINESPACE_H
 #define RL_LINESPACE_H
 
@@ -97,6 +107,8 @@ typedef struct rl_linespace_desc {              /* zero = default */
     bool dynamic;             /* exact per-shaft lists (prefix sums) */
     unsigned payloads;        /* rl_ls_payload bits; 0 -> RL_LS_CANDIDATES */
     int threads;              /* build threads; 0 -> all */
+    bool small_pages;         /* don't advise the arrays for transparent
+                               * huge pages (see above) */
     rl_progress_fn progress;  /* may be NULL; false cancels the build */
     void *user;
 } rl_linespace_desc;

@@ -42,6 +42,7 @@ rl_status rl_linespace_create(const rl_accel *grid, const rl_linespace_desc *des
     ls->n = n;
     ls->k = k;
     ls->dynamic = d.dynamic;
+    ls->huge_pages = !d.small_pages;
     ls->payloads = payloads;
     ls->threads = d.threads;
     ls->progress = d.progress;

@@ -48,6 +48,7 @@
 #endif
 
 #include "accel/linespace_internal.h"
+#include "core/bigalloc.h"
 #include "core/error.h"
 #include "core/half.h"
 #include "rl/rl_timer.h"
@@ -377,6 +378,51 @@ static void shaft_preillum(const rl_linespace *ls, const tri_info *tris, const r
     }
 }
 
+/* One thread's store for the dynamic lists of its blocks until they are
+ * copied into place: chunks of RL_LS_ARENA_CHUNK entries or more (on huge
+ * pages, rl_big_alloc) instead of one malloc per block, whose fresh pages
+ * cost a 4 KiB fault each; the lists are 4 bytes per candidate, as much
+ * as the final array. */
+#define RL_LS_ARENA_CHUNK ((size_t)4 << 20)
+
+typedef struct list_arena {
+    uint32_t **chunk;
+    size_t count, cap;
+    size_t used, size;            /* entries of the last chunk */
+} list_arena;
+
+/* Room for n contiguous entries, or NULL when out of memory. */
+static uint32_t *arena_take(list_arena *a, size_t n, bool huge)
+{
+    if (a->count == 0 || a->size - a->used < n) {
+        if (a->count == a->cap) {
+            size_t cap = a->cap ? 2 * a->cap : 16;
+            uint32_t **c = realloc(a->chunk, cap * sizeof *c);
+            if (!c)
+                return NULL;
+            a->chunk = c;
+            a->cap = cap;
+        }
+        size_t size = n > RL_LS_ARENA_CHUNK ? n : RL_LS_ARENA_CHUNK;
+        uint32_t *c = rl_big_alloc(size * sizeof *c, huge);
+        if (!c)
+            return NULL;
+        a->chunk[a->count++] = c;
+        a->size = size;
+        a->used = 0;
+    }
+    uint32_t *p = a->chunk[a->count - 1] + a->used;
+    a->used += n;
+    return p;
+}
+
+static void arena_free(list_arena *a)
+{
+    for (size_t i = 0; i < a->count; ++i)
+        free(a->chunk[i]);
+    free(a->chunk);
+}
+
 typedef struct voxel_stats {
     uint64_t empty, stored, truncated, sum;
     uint32_t max;
@@ -385,10 +431,11 @@ typedef struct voxel_stats {
 /* Step 1 of a block (grid cell `cell`): the sorted list of every shaft in
  * w->sorted / w->offset and the block's occupancy bits; w->occupied gets
  * the number of occupied shafts. Dynamic lists: the block's lists go to
- * *dyn_block (rl_ls_build copies them into place) and *dyn_count gets their
- * total. Returns false on out of memory. */
+ * *dyn_block in the thread's arena (rl_ls_build copies them into place)
+ * and *dyn_count gets their total. Returns false on out of memory. */
 static bool build_lists(rl_linespace *ls, const rl_ls_geometry *geo, workspace *w, uint32_t b,
-                        uint32_t cell, uint32_t **dyn_block, uint64_t *dyn_count, voxel_stats *vs)
+                        uint32_t cell, list_arena *arena, uint32_t **dyn_block, uint64_t *dyn_count,
+                        voxel_stats *vs)
 {
     const rl_grid *g = ls->grid;
     const rl_scene_data *d = ls->data;
@@ -452,7 +499,7 @@ static bool build_lists(rl_linespace *ls, const rl_ls_geometry *geo, workspace *
 
     uint32_t *dyn = NULL;
     if ((ls->payloads & RL_LS_CANDIDATES) && ls->dynamic) {
-        dyn = malloc((nent ? nent : 1) * sizeof *dyn);
+        dyn = arena_take(arena, nent ? nent : 1, ls->huge_pages);
         if (!dyn)
             return false;
         *dyn_block = dyn;
@@ -781,22 +828,24 @@ rl_status rl_ls_build(rl_linespace *ls)
     if (!st) {
         chain.base_occ[0] = chain.base_cand[0] = 0;
         if (want_cand && ls->dynamic) {
-            ls->cand_start = malloc(((size_t)shafts + 1) * sizeof *ls->cand_start);
+            ls->cand_start = rl_big_alloc(((size_t)shafts + 1) * sizeof *ls->cand_start, ls->huge_pages);
             dyn = calloc(nb, sizeof *dyn);
             dyn_count = calloc(nb, sizeof *dyn_count);
             if (!ls->cand_start || !dyn || !dyn_count)
                 st = RL_ERR_OUT_OF_MEMORY;
         } else if (want_cand) {
-            ls->cand = malloc((size_t)(shafts ? shafts : 1) * (size_t)ls->k * sizeof *ls->cand);
+            ls->cand = rl_big_alloc((size_t)(shafts ? shafts : 1) * (size_t)ls->k * sizeof *ls->cand,
+                                    ls->huge_pages);
             if (!ls->cand)
                 st = RL_ERR_OUT_OF_MEMORY;
         }
     }
     if (!st && (ls->payloads & RL_LS_PNMT) &&
-        !(ls->pnmt = malloc((size_t)(shafts ? shafts : 1) * 16 * sizeof *ls->pnmt)))
+        !(ls->pnmt = rl_big_alloc((size_t)(shafts ? shafts : 1) * 16 * sizeof *ls->pnmt, ls->huge_pages)))
         st = RL_ERR_OUT_OF_MEMORY;
     if (!st && (ls->payloads & RL_LS_PREILLUM) &&
-        !(ls->preillum = malloc((size_t)(shafts ? shafts : 1) * 8 * sizeof *ls->preillum)))
+        !(ls->preillum = rl_big_alloc((size_t)(shafts ? shafts : 1) * 8 * sizeof *ls->preillum,
+                                       ls->huge_pages)))
         st = RL_ERR_OUT_OF_MEMORY;
     if (!st && !rl_ls_occupancy_alloc(ls))
         st = RL_ERR_OUT_OF_MEMORY;
@@ -818,6 +867,15 @@ rl_status rl_ls_build(rl_linespace *ls)
 #else
     threads = 1;
 #endif
+    list_arena *arenas = dyn ? calloc((size_t)threads, sizeof *arenas) : NULL;
+    if (dyn && !arenas) {
+        free(cells);
+        free(dyn);
+        free(dyn_count);
+        chain_free(&chain);
+        rl_ls_geometry_free(&geo);
+        return rl_error(RL_ERR_OUT_OF_MEMORY, "linespace: out of memory");
+    }
     atomic_int failed = 0;        /* 1: out of memory, 2: cancelled */
     atomic_uint next = 0, done = 0;
     voxel_stats total_vs = { 0 };
@@ -831,8 +889,11 @@ rl_status rl_ls_build(rl_linespace *ls)
         if (!ws_init(&w, S, ls->n, ls->k))
             atomic_store(&failed, 1);
         bool main_thread = true;
+        list_arena *arena = arenas;
 #ifdef _OPENMP
         main_thread = omp_get_thread_num() == 0;
+        if (arenas)
+            arena += omp_get_thread_num();
 #endif
         /* Blocks are claimed in increasing order, so the frontier always
          * advances: every claimed block publishes its counts right after
@@ -842,7 +903,7 @@ rl_status rl_ls_build(rl_linespace *ls)
             if (bi >= blocks || atomic_load(&failed))
                 break;
             w.cell = cells[bi];
-            if (!build_lists(ls, &geo, &w, bi, cells[bi], dyn ? &dyn[bi] : NULL,
+            if (!build_lists(ls, &geo, &w, bi, cells[bi], arena, dyn ? &dyn[bi] : NULL,
                              dyn ? &dyn_count[bi] : NULL, &vs)) {
                 atomic_store(&failed, 1);
                 break;
@@ -904,17 +965,14 @@ rl_status rl_ls_build(rl_linespace *ls)
         if (!fail) {
             ls->num_cand = sum;
             ls->cand_start[occupied] = (uint32_t)sum;
-            ls->cand = malloc((size_t)(sum ? sum : 1) * sizeof *ls->cand);
+            ls->cand = rl_big_alloc((size_t)(sum ? sum : 1) * sizeof *ls->cand, ls->huge_pages);
             if (!ls->cand)
                 fail = 1;
         }
         if (!fail) {
             #pragma omp parallel for num_threads(threads) schedule(dynamic, 16)
-            for (long bi = 0; bi < (long)blocks; ++bi) {
+            for (long bi = 0; bi < (long)blocks; ++bi)
                 memcpy(ls->cand + chain.base_cand[bi], dyn[bi], (size_t)dyn_count[bi] * sizeof *ls->cand);
-                free(dyn[bi]);
-                dyn[bi] = NULL;
-            }
         }
     }
     if (!fail) {
@@ -927,9 +985,10 @@ rl_status rl_ls_build(rl_linespace *ls)
             shrink((void **)&ls->cand, ls->num_cand, sizeof *ls->cand);
         }
     }
-    if (dyn)
-        for (uint32_t bi = 0; bi < blocks; ++bi)
-            free(dyn[bi]);
+    if (arenas)
+        for (int t = 0; t < threads; ++t)
+            arena_free(&arenas[t]);
+    free(arenas);
     free(dyn);
     free(dyn_count);
     free(cells);

@@ -34,6 +34,7 @@ struct rl_linespace {
     const rl_scene_data *data;
     int n, k, threads;
     bool dynamic;
+    bool huge_pages;              /* arrays on transparent huge pages */
     unsigned payloads;
     rl_progress_fn progress;
     void *user;

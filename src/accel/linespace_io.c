@@ -28,6 +28,7 @@
 
 #include "accel/accel_internal.h"
 #include "accel/linespace_internal.h"
+#include "core/bigalloc.h"
 #include "core/error.h"
 #include "rl/rl_rng.h"
 
@@ -343,10 +344,10 @@ rl_status rl_linespace_load(const rl_accel *grid, const char *path, rl_linespace
     }
     ls->voxel_slot = malloc((size_t)(s.slot ? s.slot : 1) * 4);
     ls->occupied = malloc((size_t)(s.occ ? s.occ : 1) * 8);
-    ls->cand = s.cand ? malloc((size_t)s.cand * 4) : NULL;
-    ls->cand_start = s.start ? malloc((size_t)s.start * 4) : NULL;
-    ls->pnmt = s.pnmt ? malloc((size_t)s.pnmt * 2) : NULL;
-    ls->preillum = s.preillum ? malloc((size_t)s.preillum * 2) : NULL;
+    ls->cand = s.cand ? rl_big_alloc((size_t)s.cand * 4, true) : NULL;
+    ls->cand_start = s.start ? rl_big_alloc((size_t)s.start * 4, true) : NULL;
+    ls->pnmt = s.pnmt ? rl_big_alloc((size_t)s.pnmt * 2, true) : NULL;
+    ls->preillum = s.preillum ? rl_big_alloc((size_t)s.preillum * 2, true) : NULL;
     if (!ls->voxel_slot || !ls->occupied || (s.cand && !ls->cand) || (s.start && !ls->cand_start) ||
         (s.pnmt && !ls->pnmt) || (s.preillum && !ls->preillum)) {
         st = rl_error(RL_ERR_OUT_OF_MEMORY, "%s: out of memory for %llu bytes", path,

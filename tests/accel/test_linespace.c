@@ -713,7 +713,7 @@ static void test_linespace_origin_rules_differ_only_in_the_start_voxel(void **st
 
 /* ---- build ------------------------------------------------------------ */
 
-static void test_linespace_build_is_identical_with_1_2_and_7_threads(void **state)
+static void test_linespace_build_is_identical_with_1_2_and_7_threads_and_either_page_size(void **state)
 {
     (void)state;
     rl_scene *s = builtin("cornell-teapot", "triangles=2000");
@@ -723,8 +723,11 @@ static void test_linespace_build_is_identical_with_1_2_and_7_threads(void **stat
                                 .threads = 1 };
         rl_linespace *a = ls_of(grid, d, NULL);
         /* 7 threads on this 2-core machine: blocks finish far out of order,
-         * so many are staged before their rank is known. */
+         * so many are staged before their rank is known. The second build
+         * also keeps plain malloc (the first has its arrays and the dynamic
+         * lists' arena on huge pages). */
         d.threads = dyn ? 7 : 2;
+        d.small_pages = true;
         rl_linespace *b = ls_of(grid, d, NULL);
         rl_linespace_data da, db;
         rl_linespace_get_data(a, &da);
@@ -834,7 +837,7 @@ int main(void)
         cmocka_unit_test(test_linespace_occupancy_bits_match_every_payload),
         cmocka_unit_test(test_linespace_shadow_tests_equal_the_full_queries),
         cmocka_unit_test(test_linespace_origin_rules_differ_only_in_the_start_voxel),
-        cmocka_unit_test(test_linespace_build_is_identical_with_1_2_and_7_threads),
+        cmocka_unit_test(test_linespace_build_is_identical_with_1_2_and_7_threads_and_either_page_size),
         cmocka_unit_test(test_linespace_rejects_bad_arguments),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

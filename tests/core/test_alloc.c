@@ -1,6 +1,6 @@
 /* test_alloc.c: the grow-by-doubling helpers shared by the rasterizer, the
  * octree, CHC++, surfels and Vertex Tracing (rl_reserve, rl_reserve_u32,
- * rl_grow_capacity). */
+ * rl_grow_capacity), and rl_big_alloc for the Line Space's arrays. */
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
@@ -10,6 +10,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "core/bigalloc.h"
 #include "core/error.h"
 
 static void test_reserve_doubles_from_first_and_keeps_contents(void **state)
@@ -81,12 +82,44 @@ static void test_reserve_fails_cleanly_on_overflow(void **state)
     free(b);
 }
 
+static void test_big_alloc_aligns_large_huge_arrays_and_works_with_realloc_and_free(void **state)
+{
+    (void)state;
+    /* Small or plain: malloc, any alignment, usable. */
+    unsigned char *small = rl_big_alloc(100, true), *plain = rl_big_alloc(RL_BIG_ALLOC_MIN, false);
+    assert_non_null(small);
+    assert_non_null(plain);
+    memset(small, 1, 100);
+    memset(plain, 2, RL_BIG_ALLOC_MIN);
+    free(small);
+    free(plain);
+    /* Large with huge pages: 2 MiB-aligned on Linux, every byte usable
+     * (the size is not a multiple of 2 MiB), and realloc keeps the data
+     * when the Line Space shrinks an array to its occupied shafts. */
+    size_t n = RL_BIG_ALLOC_MIN + 12345;
+    uint32_t *a = rl_big_alloc(n * sizeof *a, true);
+    assert_non_null(a);
+#if defined(__linux__)
+    assert_int_equal((uintptr_t)a % ((uintptr_t)2 << 20), 0);
+#endif
+    for (size_t i = 0; i < n; ++i)
+        a[i] = (uint32_t)(i * 2654435761u);
+    uint32_t *b = realloc(a, 1000 * sizeof *b);
+    assert_non_null(b);
+    for (size_t i = 0; i < 1000; ++i)
+        assert_int_equal(b[i], (uint32_t)(i * 2654435761u));
+    free(b);
+    /* A size that overflows when rounded to whole huge pages. */
+    assert_null(rl_big_alloc(SIZE_MAX - 5, true));
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_reserve_doubles_from_first_and_keeps_contents),
         cmocka_unit_test(test_grow_capacity_is_what_reserve_allocates),
         cmocka_unit_test(test_reserve_fails_cleanly_on_overflow),
+        cmocka_unit_test(test_big_alloc_aligns_large_huge_arrays_and_works_with_realloc_and_free),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -1,0 +1,31 @@
+/* bigalloc.c: large arrays on transparent huge pages (see bigalloc.h). */
+#define _DEFAULT_SOURCE
+#include "core/bigalloc.h"
+
+#include <stdlib.h>
+#if defined(__linux__)
+#include <sys/mman.h>
+#endif
+
+#define HUGE_PAGE ((size_t)2 << 20)
+
+void *rl_big_alloc(size_t bytes, bool huge)
+{
+    if (!huge || bytes < RL_BIG_ALLOC_MIN)
+        return malloc(bytes ? bytes : 1);
+#if defined(__linux__) && defined(MADV_HUGEPAGE)
+    /* Whole huge pages: the advice covers the array's last page too. */
+    size_t rounded = (bytes + HUGE_PAGE - 1) & ~(HUGE_PAGE - 1);
+    if (rounded < bytes)
+        return NULL;
+    void *p = NULL;
+    if (posix_memalign(&p, HUGE_PAGE, rounded) != 0)
+        return NULL;
+    /* Advice only: a kernel without THP (or with it off) keeps 4 KiB
+     * pages, and the array works the same. */
+    (void)madvise(p, rounded, MADV_HUGEPAGE);
+    return p;
+#else
+    return malloc(bytes);
+#endif
+}
