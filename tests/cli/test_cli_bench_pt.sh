@@ -22,8 +22,8 @@ expect_exit 1 "$RL" bench pt --quick --out "$TMP/no/such/dir/pt.json"
 expect_in "$TMP/err" "rl: error: "
 
 expect_exit 0 "$RL" bench pt --help
-for o in --size --error-size --ref-spp --spp-max --max-memory --only --out --quick generation \
-         accumulation; do
+for o in --size --error-size --ref-spp --spp-max --max-memory --builds --small-pages --only --out \
+         --quick generation accumulation; do
     expect_in "$TMP/out" "$o"
 done
 
@@ -51,6 +51,7 @@ assert [(x["voxel_res"], x["n"]) for x in g] == [(8, 4), (8, 5)], g
 for x in g:
     assert x["status"] == "ok" and x["triangles"] == 36, x
     assert x["ls_ms"] > 0 and x["grid_ms"] >= 0 and x["ls_bytes"] > 0, x
+    assert x["ls_ms_runs"] == [x["ls_ms"]], x          # --quick: one build
     assert x["shafts"] == x["filled_voxels"] * 15 * x["n"] ** 4, x
     assert 0 <= x["empty_shafts"] <= x["shafts"], x
 
@@ -111,12 +112,20 @@ assert a["filters"][2]["points"][0]["rmse"] < none1, a["filters"]
 PY
 fi
 
-expect_exit 0 "$RL" bench pt --quick --only generation -q --out "$TMP/o.json"
+expect_exit 0 "$RL" bench pt --quick --only generation --builds 3 --small-pages -q --out "$TMP/o.json"
 if have_python; then
     python3 - "$TMP/o.json" <<'PY' || fail "o.json is wrong"
 import json, sys
 r = json.load(open(sys.argv[1]))
 assert "generation" in r and "scenes" not in r and "error" not in r
+p = r["parameters"]
+assert p["ls_builds"] == 3 and p["ls_huge_pages"] is False, p
+for x in r["generation"]["rows"]:
+    runs = x["ls_ms_runs"]
+    assert len(runs) == 3 and all(t > 0 for t in runs) and x["ls_ms"] == min(runs), x
 PY
 fi
+expect_exit 2 "$RL" bench pt --quick --builds 0
+expect_in "$TMP/err" "--builds"
+expect_exit 2 "$RL" bench pt --quick --builds 101
 echo "ok"
