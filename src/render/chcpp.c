@@ -124,7 +124,7 @@ static void chcpp_release(void *state)
     if (!s)
         return;
     rl_octree_cache_release(&s->oc);
-    rl_cull_keep_release(&s->head.keep);
+    rl_drawer_keep_release(&s->head.keep);
     rl_box_query_free(&s->query);
     free(s->ns);
     free(s->heap);

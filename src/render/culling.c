@@ -196,20 +196,7 @@ rl_status rl_culling_get_stats(const rl_renderer *r, rl_culling_stats *out)
 
 const char *const rl_cull_shading_choices[] = { "flat", "gouraud", "textured", NULL };
 
-void rl_cull_keep_release(rl_cull_keep *k)
-{
-    rl_scene_drawer_release(k->drawer);
-    rl_raster_release(k->ras);
-    memset(k, 0, sizeof *k);
-}
-
-static bool same_drawing(const rl_raster_scene_desc *a, const rl_raster_scene_desc *b)
-{
-    return a->shading == b->shading && a->ambient == b->ambient && a->threads == b->threads &&
-           a->flags == b->flags && a->object_mask == b->object_mask;
-}
-
-rl_status rl_cull_frame_begin(rl_renderer *r, const rl_scene *scene, rl_cull_keep *keep, const rl_camera *cam,
+rl_status rl_cull_frame_begin(rl_renderer *r, const rl_scene *scene, rl_drawer_keep *keep, const rl_camera *cam,
                               rl_image *image, rl_cull_frame *f)
 {
     const rl_scene_data *d = rl_scene_get_data(scene);
@@ -232,20 +219,7 @@ rl_status rl_cull_frame_begin(rl_renderer *r, const rl_scene *scene, rl_cull_kee
         return st;
     desc.flags |= f->target.flags;
     rl_cull_view_make(cam, d->bounds, &f->view);
-    if (keep->ras && keep->drawer && keep->scene_uid == rl_scene_uid(scene) && same_drawing(&keep->desc, &desc)) {
-        rl_scene_drawer_new_frame(keep->drawer, f->view.eye);
-    } else {
-        rl_cull_keep_release(keep);
-        st = rl_raster_create(&(rl_raster_desc){ .threads = f->threads_opt }, &keep->ras);
-        if (st == RL_OK)
-            st = rl_scene_drawer_create(d, f->view.eye, &desc, &keep->drawer);
-        if (st == RL_OK) {
-            keep->scene_uid = rl_scene_uid(scene);
-            keep->desc = desc;
-        } else {
-            rl_cull_keep_release(keep);
-        }
-    }
+    st = rl_drawer_keep_acquire(keep, scene, &desc, f->view.eye);
     f->ras = keep->ras;
     f->drawer = keep->drawer;
     if (st == RL_OK)

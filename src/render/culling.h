@@ -81,19 +81,6 @@ extern const char *const rl_cull_shading_choices[];
     { "background", RL_OPT_COLOR, "0,0,0", "colour where nothing is drawn", 0, 0, NULL },              \
     { "threads", RL_OPT_INT, "0", "OpenMP threads (0 = all)", 0, 1024, NULL }
 
-/* What a culling renderer keeps between frames: its rasterizer and its
- * drawer, whose per-vertex and per-corner buffers span the whole scene.
- * Made afresh every frame they cost more than drawing the culled set
- * (allocating and faulting in about 200 MB on `city`). Remade when the
- * scene or the drawing options change. */
-typedef struct rl_cull_keep {
-    rl_raster *ras;
-    rl_scene_drawer *drawer;
-    uint64_t scene_uid;
-    rl_raster_scene_desc desc;
-} rl_cull_keep;
-void rl_cull_keep_release(rl_cull_keep *k);
-
 /* One frame of a culling renderer: the caller's image as target, the view,
  * a rasterizer on it and a drawer for the objects, from the shared
  * options (the rasterizer and drawer are the renderer's kept ones). */
@@ -108,7 +95,7 @@ typedef struct rl_cull_frame {
     float ambient;
 } rl_cull_frame;
 
-rl_status rl_cull_frame_begin(rl_renderer *r, const rl_scene *scene, rl_cull_keep *keep, const rl_camera *cam,
+rl_status rl_cull_frame_begin(rl_renderer *r, const rl_scene *scene, rl_drawer_keep *keep, const rl_camera *cam,
                               rl_image *image, rl_cull_frame *f);
 /* Releases what begin made (not the kept rasterizer and drawer); with st
  * == RL_OK fills stats (triangles, points, pixels written, samples).
@@ -120,7 +107,7 @@ rl_status rl_cull_frame_end(rl_cull_frame *f, rl_status st, const rl_image *imag
 typedef struct rl_culling_head {
     rl_culling_stats stats;
     bool have_frame;
-    rl_cull_keep keep;            /* released by the renderer's release */
+    rl_drawer_keep keep;          /* released by the renderer's release */
 } rl_culling_head;
 
 #endif

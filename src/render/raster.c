@@ -30,7 +30,9 @@
  * rl_raster_draw_scene (raster_scene.h), shared with the hybrid renderers:
  * an object mask selects what to draw, and with RL_RASTER_NO_COLOR nothing
  * is lit at all (the ID/Z pre-pass of Vertex Tracing). raster_render() only
- * sets up the target, clears it and calls it for every object. */
+ * sets up the target, clears it and draws every object with the drawer it
+ * keeps between frames (rl_drawer_keep): the buffers for the whole scene
+ * are made once, the lighting is redone every frame. */
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -468,6 +470,30 @@ rl_status rl_scene_drawer_draw(rl_scene_drawer *dr, rl_raster *ras, uint32_t obj
     return draw_object(ras, dr->data, object, dr->opt.shading, dr->lit, dr->opt.flags, &dr->b, c);
 }
 
+rl_status rl_scene_drawer_draw_all(rl_scene_drawer *dr, rl_raster *ras, rl_raster_counters *c,
+                                   bool (*progress)(void *user, double done), void *user)
+{
+    if (!dr || !ras)
+        return rl_error(RL_ERR_INVALID_ARG, "rl_scene_drawer_draw_all: NULL argument");
+    const rl_scene_data *d = dr->data;
+    /* Everything selected gets drawn: light it all in one parallel pass
+     * (one object at a time would serialise the many small ones). */
+    if (dr->lit) {
+        light_scene(&dr->ctx, dr->opt.shading, dr->threads, dr->opt.object_mask, &dr->b);
+        memset(dr->object_lit, 1, d->num_objects ? d->num_objects : 1);
+    }
+    /* Report progress about a hundred times, not once per object. */
+    rl_status st = RL_OK;
+    uint32_t step = d->num_objects / 100 + 1;
+    for (uint32_t o = 0; st == RL_OK && o < d->num_objects; ++o) {
+        st = rl_scene_drawer_draw(dr, ras, o, c);
+        if (st == RL_OK && progress && (o + 1) % step == 0 &&
+            !progress(user, (double)(o + 1) / d->num_objects))
+            st = rl_error(RL_ERR_CANCELLED, "raster: cancelled by the progress callback");
+    }
+    return st;
+}
+
 rl_status rl_raster_draw_scene(rl_raster *ras, const rl_scene_data *d, rl_vec3 eye,
                                const rl_raster_scene_desc *desc, rl_raster_counters *c,
                                bool (*progress)(void *user, double done), void *user)
@@ -476,25 +502,50 @@ rl_status rl_raster_draw_scene(rl_raster *ras, const rl_scene_data *d, rl_vec3 e
         return rl_error(RL_ERR_INVALID_ARG, "rl_raster_draw_scene: NULL argument");
     rl_scene_drawer *dr = NULL;
     rl_status st = rl_scene_drawer_create(d, eye, desc, &dr);
-    if (st != RL_OK)
-        return st;
-    /* Everything selected gets drawn: light it all in one parallel pass
-     * (one object at a time would serialise the many small ones). */
-    if (dr->lit) {
-        light_scene(&dr->ctx, dr->opt.shading, dr->threads, dr->opt.object_mask, &dr->b);
-        memset(dr->object_lit, 1, d->num_objects ? d->num_objects : 1);
-    }
-
-    /* Report progress about a hundred times, not once per object. */
-    uint32_t step = d->num_objects / 100 + 1;
-    for (uint32_t o = 0; st == RL_OK && o < d->num_objects; ++o) {
-        st = rl_scene_drawer_draw(dr, ras, o, c);
-        if (st == RL_OK && progress && (o + 1) % step == 0 &&
-            !progress(user, (double)(o + 1) / d->num_objects))
-            st = rl_error(RL_ERR_CANCELLED, "raster: cancelled by the progress callback");
-    }
+    if (st == RL_OK)
+        st = rl_scene_drawer_draw_all(dr, ras, c, progress, user);
     rl_scene_drawer_release(dr);
     return st;
+}
+
+static bool same_drawing(const rl_raster_scene_desc *a, const rl_raster_scene_desc *b)
+{
+    return a->shading == b->shading && a->ambient == b->ambient && a->threads == b->threads &&
+           a->flags == b->flags && a->object_mask == b->object_mask;
+}
+
+rl_status rl_drawer_keep_acquire(rl_drawer_keep *k, const rl_scene *scene, const rl_raster_scene_desc *desc,
+                                 rl_vec3 eye)
+{
+    if (!k || !scene || !desc)
+        return rl_error(RL_ERR_INVALID_ARG, "rl_drawer_keep_acquire: NULL argument");
+    if (k->ras && k->drawer && k->scene_uid == rl_scene_uid(scene) && same_drawing(&k->desc, desc)) {
+        rl_scene_drawer_new_frame(k->drawer, eye);
+        return RL_OK;
+    }
+    rl_drawer_keep_release(k);
+    const rl_scene_data *d = rl_scene_get_data(scene);
+    if (!d)
+        return rl_error(RL_ERR_NOT_COMMITTED, "rl_drawer_keep_acquire: the scene is not committed");
+    rl_status st = rl_raster_create(&(rl_raster_desc){ .threads = desc->threads }, &k->ras);
+    if (st == RL_OK)
+        st = rl_scene_drawer_create(d, eye, desc, &k->drawer);
+    if (st == RL_OK) {
+        k->scene_uid = rl_scene_uid(scene);
+        k->desc = *desc;
+    } else {
+        rl_drawer_keep_release(k);
+    }
+    return st;
+}
+
+void rl_drawer_keep_release(rl_drawer_keep *k)
+{
+    if (!k)
+        return;
+    rl_scene_drawer_release(k->drawer);
+    rl_raster_release(k->ras);
+    memset(k, 0, sizeof *k);
 }
 
 static bool renderer_progress(void *user, double done)
@@ -502,10 +553,32 @@ static bool renderer_progress(void *user, double done)
     return rl_renderer_progress((const rl_renderer *)user, done);
 }
 
+/* The renderer's state: its rasterizer and drawer, kept between frames
+ * (the drawer's buffers span the whole scene). Every frame still lights
+ * every object, as plain rasterization does. */
+typedef struct raster_state {
+    rl_drawer_keep keep;
+} raster_state;
+
+static rl_status raster_create(void **state)
+{
+    *state = rl_calloc(1, sizeof(raster_state));
+    return *state ? RL_OK : RL_ERR_OUT_OF_MEMORY;
+}
+
+static void raster_release(void *state)
+{
+    raster_state *s = state;
+    if (!s)
+        return;
+    rl_drawer_keep_release(&s->keep);
+    free(s);
+}
+
 static rl_status raster_render(rl_renderer *r, void *state, const rl_scene *scene,
                                const rl_camera *cam, rl_image *image, rl_render_stats *stats)
 {
-    (void)state;
+    raster_state *s = state;
     const rl_scene_data *d = rl_scene_get_data(scene);
     if (!d)
         return RL_ERR_NOT_COMMITTED;
@@ -531,10 +604,9 @@ static rl_status raster_render(rl_renderer *r, void *state, const rl_scene *scen
     if (!(target.layers & RL_LAYER_ID) || !target.object_id || !target.triangle_id)
         desc.flags |= RL_RASTER_NO_ID;
 
-    rl_raster *ras = NULL;
-    rl_status st = rl_raster_create(&(rl_raster_desc){ .threads = desc.threads }, &ras);
+    rl_status st = rl_drawer_keep_acquire(&s->keep, scene, &desc, cam->eye);
     if (st == RL_OK)
-        st = rl_raster_set_camera(ras, &target, cam, d->bounds);
+        st = rl_raster_set_camera(s->keep.ras, &target, cam, d->bounds);
     if (st == RL_OK) {
         rl_vec3 bg = rl_renderer_opt_color(r, "background");
         rl_image_clear_to(&target, rl_v4_from3(bg, 1.0f));
@@ -542,8 +614,7 @@ static rl_status raster_render(rl_renderer *r, void *state, const rl_scene *scen
     rl_raster_counters counters;
     memset(&counters, 0, sizeof counters);
     if (st == RL_OK)
-        st = rl_raster_draw_scene(ras, d, cam->eye, &desc, &counters, renderer_progress, r);
-    rl_raster_release(ras);
+        st = rl_scene_drawer_draw_all(s->keep.drawer, s->keep.ras, &counters, renderer_progress, r);
     free(own_depth);
     if (st != RL_OK)
         return st;
@@ -559,8 +630,8 @@ const rl_renderer_class rl_raster_renderer_class = {
               "Ullmann 2003, Sec. 3.1 (Phong model), Sec. 3.5 (hardware path)" },
     .options = raster_options,
     .num_options = sizeof raster_options / sizeof raster_options[0],
-    .create = NULL,
+    .create = raster_create,
     .render = raster_render,
-    .release = NULL,
+    .release = raster_release,
     .check = NULL,
 };

@@ -102,7 +102,7 @@ static void surfels_release(void *state)
         return;
     drop_sets(s);
     rl_octree_cache_release(&s->oc);
-    rl_cull_keep_release(&s->head.keep);
+    rl_drawer_keep_release(&s->head.keep);
     free(s->pos);
     free(s->col);
     free(s->size);

@@ -111,7 +111,7 @@ static void svs_release(void *state)
         return;
     drop_sets(s);
     rl_octree_cache_release(&s->oc);
-    rl_cull_keep_release(&s->head.keep);
+    rl_drawer_keep_release(&s->head.keep);
     free(s);
 }
 

@@ -95,7 +95,7 @@ static void visset_release(void *state)
     if (!s)
         return;
     drop(s);
-    rl_cull_keep_release(&s->head.keep);
+    rl_drawer_keep_release(&s->head.keep);
     free(s);
 }
 

@@ -500,10 +500,52 @@ static void test_colour_does_not_depend_on_the_layers_asked_for(void **state)
     rl_scene_release(s);
 }
 
+/* The renderer keeps its rasterizer and drawer between frames
+ * (rl_drawer_keep): every frame must equal a fresh renderer's across view,
+ * shading, layer, thread and scene changes. A drawer kept across a
+ * shading change keeps the wrong buffers (flat colours are per face); one
+ * kept across scenes lights the other scene's vertices. */
+static void test_a_kept_renderer_follows_view_shading_layers_threads_and_scene(void **state)
+{
+    (void)state;
+    rl_camera a, b;
+    rl_scene *s = fx_cornell(&a, 48), *mixed = two_material_grid(false);
+    b = a;
+    b.eye = rl_add(a.eye, rl_v3(0.3f, 0.2f, -0.4f));
+    rl_camera top = top_camera(3.0f);
+    top.width = top.height = 48;
+    rl_renderer *r = fx_make("raster", NULL);
+    rl_image *first = fx_render_with(r, s, &a, ALL_LAYERS, NULL);
+    rl_image_release(first);
+    struct {
+        const rl_scene *scene;
+        const rl_camera *cam;
+        const char *shading, *threads;
+        unsigned layers;
+    } steps[] = { { s, &b, "textured", "0", ALL_LAYERS },   { s, &a, "flat", "0", ALL_LAYERS },
+                  { s, &b, "gouraud", "0", RL_LAYER_COLOR }, { s, &a, "gouraud", "1", ALL_LAYERS },
+                  { mixed, &top, "textured", "1", ALL_LAYERS }, { mixed, &top, "flat", "2", ALL_LAYERS },
+                  { s, &a, "textured", "2", ALL_LAYERS } };
+    for (size_t i = 0; i < sizeof steps / sizeof steps[0]; ++i) {
+        assert_int_equal(rl_renderer_set(r, "shading", steps[i].shading), RL_OK);
+        assert_int_equal(rl_renderer_set(r, "threads", steps[i].threads), RL_OK);
+        rl_image *kept = fx_render_with(r, steps[i].scene, steps[i].cam, steps[i].layers, NULL);
+        const char *const opts[] = { "shading", steps[i].shading, "threads", steps[i].threads, NULL };
+        rl_image *fresh = fx_render("raster", steps[i].scene, steps[i].cam, steps[i].layers, opts, NULL);
+        fx_assert_images_identical(kept, fresh);
+        rl_image_release(kept);
+        rl_image_release(fresh);
+    }
+    rl_renderer_release(r);
+    rl_scene_release(mixed);
+    rl_scene_release(s);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_cornell_ids_and_depth_agree_with_brute_force_ray_casting),
+        cmocka_unit_test(test_a_kept_renderer_follows_view_shading_layers_threads_and_scene),
         cmocka_unit_test(test_quad_under_point_light_matches_analytic_phong_at_centre_vertex),
         cmocka_unit_test(test_directional_and_spot_lights_match_analytic_values),
         cmocka_unit_test(test_back_face_culling_hides_the_quad_from_below),
