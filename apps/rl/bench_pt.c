@@ -60,7 +60,8 @@ static const char bench_pt_help[] =
     "                Line Space variant (candidates, PNMT, pre-illuminated) at voxels\n"
     "                8^3..64^3, best per variant; shadows by shadow maps (Diagram 2)\n"
     "  shadow        the same for shadow rays, plus shadow maps; diffuse rays by\n"
-    "                the BVH (Diagram 3)\n"
+    "                the BVH (Diagram 3); then the frame's shadow rays alone through\n"
+    "                the BVH, the grid and each Line Space (Mrays/s, occluded counts)\n"
     "  error         RMSE/SSIM of each variant (PNMT and pre-illuminated at every\n"
     "                voxel resolution) against a converged BVH reference at equal\n"
     "                spp, and time to reach the BVH's RMSE at 4/16/64 spp\n"
@@ -681,6 +682,215 @@ static rl_status sec_diffuse(void *ctx, cJSON *sec)
     return st;
 }
 
+/* Diagram 3's shadow rays alone, without the rest of the frame: one ray
+ * per pixel from the primary hit (by the BVH) to a random point of the
+ * first light, the same rays through every structure, the fastest of
+ * b->runs passes each. PNMT answers rays under the renderer's rule (a
+ * voxel diagonal cut off at both ends, pathtrace_path.c), so the BVH is
+ * timed on those rays too, for a like-for-like ratio; the candidate Line
+ * Space is exact and answers the full rays. Pre-illuminated shadow tests
+ * walk like PNMT and need a shading function, so they are not repeated. */
+typedef enum ray_structure { RS_BVH, RS_GRID, RS_LS_CAND, RS_LS_PNMT } ray_structure;
+
+static double occluded_pass(const bpt *b, ray_structure k, const rl_accel *acc, const rl_linespace *ls,
+                            const rl_ray *rays, size_t n, uint64_t *occluded)
+{
+    double best = INFINITY;
+    for (int r = 0; r < b->runs; r++) {
+        uint64_t occ = 0;
+        double t0 = omp_get_wtime();
+        #pragma omp parallel for num_threads(b->threads) schedule(dynamic, 1024) reduction(+ : occ)
+        for (long i = 0; i < (long)n; i++) {
+            bool hit = k == RS_LS_CAND   ? rl_linespace_occluded(ls, &rays[i])
+                       : k == RS_LS_PNMT ? rl_linespace_pnmt_occluded(ls, &rays[i])
+                                         : rl_accel_occluded(acc, &rays[i]);
+            occ += hit;
+        }
+        double ms = (omp_get_wtime() - t0) * 1e3;
+        best = ms < best ? ms : best;
+        *occluded = occ;
+    }
+    return best;
+}
+
+static cJSON *pass_json(cJSON *parent, const char *name, double ms, size_t rays, uint64_t occluded)
+{
+    cJSON *o = cJSON_AddObjectToObject(parent, name);
+    if (!o)
+        return NULL;
+    rl_bench_add_num(o, "ms", ms);
+    rl_bench_add_num(o, "mrays_per_s", ms > 0.0 ? (double)rays / (ms * 1e3) : NAN);
+    cJSON_AddNumberToObject(o, "rays", (double)rays);
+    cJSON_AddNumberToObject(o, "occluded", (double)occluded);
+    return o;
+}
+
+static rl_status shadow_rays(const bpt *b, const rl_scene *scene, rl_ray **out, size_t *count)
+{
+    const rl_scene_data *d = rl_scene_get_data(scene);
+    *out = NULL;
+    *count = 0;
+    if (d->num_lights == 0)
+        return RL_OK;
+    rl_accel *bvh = NULL;
+    rl_status st = rl_accel_create(scene, &(rl_accel_desc){ .kind = RL_ACCEL_BVH, .threads = b->threads }, &bvh);
+    if (st == RL_OK)
+        st = rl_accel_commit(bvh);
+    rl_camera cam = scene_camera(scene, b->a->width, b->a->height);
+    rl_camera_frame f = rl_camera_frame_make(&cam);
+    size_t cap = (size_t)cam.width * (size_t)cam.height;
+    rl_ray *rays = st == RL_OK ? malloc(cap * sizeof *rays) : NULL;
+    if (st == RL_OK && !rays)
+        st = RL_ERR_OUT_OF_MEMORY;
+    const rl_light *L = &d->lights[0];
+    rl_vec3 ext = rl_sub(d->bounds.max, d->bounds.min);
+    float eps = 1e-4f * rl_maxf(1.0f, rl_maxf(ext.x, rl_maxf(ext.y, ext.z)));
+    size_t n = 0;
+    for (int y = 0; st == RL_OK && y < cam.height; y++)
+        for (int x = 0; x < cam.width; x++) {
+            rl_ray pr = rl_camera_frame_ray(&f, (float)x + 0.5f, (float)y + 0.5f);
+            rl_hit h;
+            if (!rl_accel_intersect(bvh, &pr, &h))
+                continue;
+            rl_vec3 p = rl_ray_at(&pr, h.t), q = L->position;
+            if (L->type == RL_LIGHT_QUAD) {
+                rl_rng rng;
+                rl_rng_seed(&rng, 1, (uint64_t)y * (uint64_t)cam.width + (uint64_t)x);
+                float u = rl_rng_float(&rng), v = rl_rng_float(&rng);
+                q = rl_add(L->position, rl_add(rl_scale(L->edge_u, u), rl_scale(L->edge_v, v)));
+            }
+            rl_vec3 dir = L->type == RL_LIGHT_DIRECTIONAL ? rl_scale(L->direction, -1.0f) : rl_sub(q, p);
+            float dist = L->type == RL_LIGHT_DIRECTIONAL ? INFINITY : rl_length(dir);
+            if (!(dist > 2.0f * eps))
+                continue;
+            dir = rl_normalize(dir);
+            /* As the renderer: no ray where the light is behind the surface
+             * (seen from the camera) or the surface behind a quad light. */
+            const uint32_t *tri = d->indices + 3 * (size_t)h.triangle;
+            rl_vec3 ng = rl_cross(rl_sub(d->positions[tri[1]], d->positions[tri[0]]),
+                                  rl_sub(d->positions[tri[2]], d->positions[tri[0]]));
+            if (rl_dot(ng, pr.d) > 0.0f)
+                ng = rl_scale(ng, -1.0f);
+            if (!(rl_dot(ng, dir) > 0.0f))
+                continue;
+            if (L->type == RL_LIGHT_QUAD && !(rl_dot(rl_cross(L->edge_u, L->edge_v), dir) < 0.0f))
+                continue;
+            rays[n++] = (rl_ray){ rl_madd(p, rl_normalize(ng), eps), 0.0f, dir,
+                                  isinf(dist) ? INFINITY : dist * (1.0f - 1e-4f) };
+        }
+    rl_accel_release(bvh);
+    if (st != RL_OK) {
+        free(rays);
+        return st;
+    }
+    *out = rays;
+    *count = n;
+    return RL_OK;
+}
+
+static rl_status shadow_rays_alone(bpt *b, const char *name, const int *res, int nres, cJSON *sec)
+{
+    rl_scene *scene = NULL;
+    rl_status st = scene_get(b, name, &scene);
+    rl_ray *rays = NULL, *cut = NULL;
+    size_t n = 0;
+    if (st == RL_OK)
+        st = shadow_rays(b, scene, &rays, &n);
+    if (st != RL_OK || n == 0) {
+        free(rays);
+        return st;
+    }
+    cJSON *o = cJSON_AddObjectToObject(sec, "rays_alone");
+    cJSON *lsj = o ? cJSON_AddArrayToObject(o, "line_spaces") : NULL;
+    if (!lsj) {
+        free(rays);
+        return RL_ERR_OUT_OF_MEMORY;
+    }
+    cJSON_AddStringToObject(o, "rays_are", "one per pixel: primary hit (BVH) to a random point of the "
+                                           "first light; PNMT and bvh_same_rays: a voxel diagonal cut "
+                                           "off at both ends (the renderer's rule)");
+    printf("shadow rays alone (%zu rays, the frame's first bounce; fastest of %d passes; Mrays/s, "
+           "occluded):\n", n, b->runs);
+    rl_accel *acc[2] = { NULL, NULL };
+    static const char *const acc_names[2] = { "bvh", "grid" };
+    double acc_ms[2] = { NAN, NAN };
+    for (int k = 0; k < 2 && st == RL_OK; k++) {
+        st = rl_accel_create(scene, &(rl_accel_desc){ .kind = k ? RL_ACCEL_GRID : RL_ACCEL_BVH,
+                                                      .threads = b->threads }, &acc[k]);
+        if (st == RL_OK)
+            st = rl_accel_commit(acc[k]);
+        uint64_t occ = 0;
+        if (st == RL_OK) {
+            acc_ms[k] = occluded_pass(b, k ? RS_GRID : RS_BVH, acc[k], NULL, rays, n, &occ);
+            pass_json(o, acc_names[k], acc_ms[k], n, occ);
+            printf("  %-22s %8.1f ms %8.2f Mrays/s %9llu\n", acc_names[k], acc_ms[k],
+                   (double)n / (acc_ms[k] * 1e3), (unsigned long long)occ);
+        }
+    }
+    cut = st == RL_OK ? malloc(n * sizeof *cut) : NULL;
+    if (st == RL_OK && !cut)
+        st = RL_ERR_OUT_OF_MEMORY;
+    const rl_scene_data *d = rl_scene_get_data(scene);
+    for (int i = 0; st == RL_OK && i < nres; i++) {
+        rl_accel *grid = NULL;
+        rl_linespace *ls = NULL;
+        st = rl_accel_create(scene, &(rl_accel_desc){ .kind = RL_ACCEL_GRID, .threads = b->threads,
+                                                      .grid_res = { res[i], res[i], res[i] } }, &grid);
+        if (st == RL_OK)
+            st = rl_accel_commit(grid);
+        rl_linespace_desc ld = { .dynamic = true, .payloads = RL_LS_CANDIDATES | RL_LS_PNMT,
+                                 .threads = b->threads };
+        if (st == RL_OK)
+            st = rl_linespace_create(grid, &ld, &ls);
+        if (st == RL_OK)
+            st = rl_linespace_commit(ls);
+        if (st == RL_OK)
+            st = rl_linespace_set_origin(ls, RL_LS_ORIGIN_RECORDS);
+        if (st == RL_OK) {
+            /* The renderer's PNMT rule (pathtrace_backend.c: ls_offset). */
+            float diag = rl_length(rl_scale(rl_sub(d->bounds.max, d->bounds.min), 1.0f / (float)res[i]));
+            size_t m = 0;
+            for (size_t r = 0; r < n; r++) {
+                rl_ray c = rays[r];
+                c.t_min = rl_maxf(c.t_min, diag);
+                c.t_max -= diag;
+                if (c.t_min < c.t_max)
+                    cut[m++] = c;
+            }
+            uint64_t occ_c = 0, occ_p = 0, occ_b = 0;
+            double ms_c = occluded_pass(b, RS_LS_CAND, NULL, ls, rays, n, &occ_c);
+            double ms_p = occluded_pass(b, RS_LS_PNMT, NULL, ls, cut, m, &occ_p);
+            double ms_b = occluded_pass(b, RS_BVH, acc[0], NULL, cut, m, &occ_b);
+            cJSON *e = cJSON_CreateObject();
+            cJSON_AddItemToArray(lsj, e);
+            cJSON_AddNumberToObject(e, "voxel_res", res[i]);
+            pass_json(e, "candidates", ms_c, n, occ_c);
+            pass_json(e, "pnmt", ms_p, m, occ_p);
+            pass_json(e, "bvh_same_rays", ms_b, m, occ_b);
+            rl_bench_add_num(e, "candidates_speedup_vs_bvh", rl_bench_ratio(acc_ms[0], ms_c));
+            rl_bench_add_num(e, "candidates_speedup_vs_grid", rl_bench_ratio(acc_ms[1], ms_c));
+            rl_bench_add_num(e, "pnmt_speedup_vs_bvh", rl_bench_ratio(ms_b, ms_p));
+            char label[32];
+            snprintf(label, sizeof label, "ls-candidates@%d", res[i]);
+            printf("  %-22s %8.1f ms %8.2f Mrays/s %9llu  %5.2fx the BVH, %5.2fx the grid\n",
+                   label, ms_c, (double)n / (ms_c * 1e3), (unsigned long long)occ_c,
+                   rl_bench_ratio(acc_ms[0], ms_c), rl_bench_ratio(acc_ms[1], ms_c));
+            printf("  ls-pnmt@%-14d %8.1f ms %8.2f Mrays/s %9llu  %5.2fx the BVH on the same %zu rays "
+                   "(%.1f ms, %llu occluded)\n", res[i], ms_p, (double)m / (ms_p * 1e3),
+                   (unsigned long long)occ_p, rl_bench_ratio(ms_b, ms_p), m, ms_b,
+                   (unsigned long long)occ_b);
+            fflush(stdout);
+        }
+        rl_linespace_release(ls);
+        rl_accel_release(grid);
+    }
+    rl_accel_release(acc[0]);
+    rl_accel_release(acc[1]);
+    free(rays);
+    free(cut);
+    return st;
+}
+
 static rl_status sec_shadow(void *ctx, cJSON *sec)
 {
     bpt *b = ctx;
@@ -705,6 +915,8 @@ static rl_status sec_shadow(void *ctx, cJSON *sec)
     rl_status st = frame_table(b, name, configs, count, 0, -1, frames, stats);
     if (st == RL_OK)
         sweep_best(configs, stats, 3, count, -1, SWEEP_SHADOW, sec);
+    if (st == RL_OK)
+        st = shadow_rays_alone(b, name, res, nres, sec);
     return st;
 }
 

@@ -75,6 +75,18 @@ for sec in ("diffuse", "shadow"):
     for v, o in best.items():
         times = [f["frame_ms"] for f in r[sec]["frames"] if f["label"].startswith(v + "@")]
         assert o["grid_res"] in (4, 8) and o["frame_ms"] == min(times), (sec, v, o, times)
+# Shadow rays alone: the exact structures agree on every ray (the
+# candidate Line Space is exact); PNMT and the BVH share the cut rays.
+ra = r["shadow"]["rays_alone"]
+n = ra["bvh"]["rays"]
+assert n > 0 and ra["grid"]["rays"] == n and ra["bvh"]["ms"] > 0, ra
+assert abs(ra["grid"]["occluded"] - ra["bvh"]["occluded"]) <= max(2, n // 500), ra
+assert [x["voxel_res"] for x in ra["line_spaces"]] == [4, 8], ra
+for x in ra["line_spaces"]:
+    assert x["candidates"]["rays"] == n, x
+    assert abs(x["candidates"]["occluded"] - ra["bvh"]["occluded"]) <= max(2, n // 500), x
+    assert 0 < x["pnmt"]["rays"] == x["bvh_same_rays"]["rays"] <= n, x
+    assert x["pnmt"]["ms"] > 0 and x["pnmt_speedup_vs_bvh"] > 0, x
 d = {f["label"]: f for f in r["diffuse"]["frames"]}
 assert d["no diffuse rays"]["rays"].get("diffuse", 0) == 0, d["no diffuse rays"]["rays"]
 assert "rays_speedup_vs_base" in d["ls-pnmt@4"]
