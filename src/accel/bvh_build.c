@@ -35,6 +35,7 @@
 #include <omp.h>
 
 #include "accel/bvh.h"
+#include "core/bigalloc.h"
 #include "core/error.h"
 
 #define C_TRAV 0.5f
@@ -231,7 +232,7 @@ typedef struct frame {
  * SAH cost = Σ_inner C_trav·A/A_root + Σ_leaf C_isect·N·A/A_root. */
 static rl_status compact(const builder *b, uint32_t count, rl_bvh_node **out, rl_accel_stats *stats)
 {
-    rl_bvh_node *dense = rl_alloc((size_t)count * sizeof *dense);
+    rl_bvh_node *dense = rl_big_array(count, sizeof *dense, false);
     frame *stack = rl_alloc(((size_t)RL_BVH_SAH_MAX_DEPTH + 64) * 2 * sizeof *stack);
     if (!dense || !stack) {
         free(dense);
@@ -290,11 +291,11 @@ rl_status rl_bvh_build(const rl_scene_data *data, const rl_accel_desc *desc, rl_
     atomic_init(&b.cancelled, false);
     atomic_init(&b.nodes, 0);
     atomic_init(&b.done, 0);
-    rl_aabb *tri_bounds = rl_alloc((size_t)N * sizeof *tri_bounds);
-    rl_vec3 *centroids = rl_alloc((size_t)N * sizeof *centroids);
-    uint32_t *ref = rl_alloc((size_t)N * sizeof *ref);
-    rl_bvh_node *sparse = rl_alloc(((size_t)2 * N - 1) * sizeof *sparse);
-    rl_bvh_tri *tris = rl_alloc((size_t)N * sizeof *tris);
+    rl_aabb *tri_bounds = rl_big_array(N, sizeof *tri_bounds, false);
+    rl_vec3 *centroids = rl_big_array(N, sizeof *centroids, false);
+    uint32_t *ref = rl_big_array(N, sizeof *ref, false);
+    rl_bvh_node *sparse = rl_big_array((size_t)2 * N - 1, sizeof *sparse, false);
+    rl_bvh_tri *tris = rl_big_array(N, sizeof *tris, false);
     rl_bvh_node *nodes = NULL;
     rl_status st = RL_OK;
     if (!tri_bounds || !centroids || !ref || !sparse || !tris) {

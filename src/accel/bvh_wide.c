@@ -20,6 +20,7 @@
 #include <string.h>
 
 #include "accel/bvh.h"
+#include "core/bigalloc.h"
 #include "core/error.h"
 
 typedef struct widener {
@@ -178,11 +179,17 @@ static void widen_node(widener *w, uint32_t slot, uint32_t b)
             widen_node(w, child_slot[i], kids[i]);
 }
 
-/* Wide nodes on cache-line boundaries: malloc aligns large blocks to 16
- * bytes only, so a 256-byte node would touch 5 lines instead of 4. */
+/* Cache-line aligned arrays: malloc aligns large blocks to 16 bytes only,
+ * so a 256-byte node would touch 5 lines instead of 4. Large ones come on
+ * huge pages (rl_big_alloc, 2 MiB-aligned); bytes is a multiple of 64. */
+static void *alloc_lines(size_t bytes)
+{
+    return bytes >= RL_BIG_ALLOC_MIN ? rl_big_alloc(bytes, true) : aligned_alloc(64, bytes ? bytes : 64);
+}
+
 static rl_bvh_wide_node *alloc_wide(uint32_t count)
 {
-    return aligned_alloc(64, (size_t)count * sizeof(rl_bvh_wide_node));   /* a multiple of 64 */
+    return alloc_lines((size_t)count * sizeof(rl_bvh_wide_node));   /* a multiple of 64 */
 }
 
 rl_status rl_bvh_widen(rl_bvh *bvh)
@@ -195,13 +202,13 @@ rl_status rl_bvh_widen(rl_bvh *bvh)
     uint32_t num_blocks = 0;
     for (uint32_t i = 0; i < bvh->num_nodes; ++i)
         num_blocks += leaf_blocks(bvh->nodes[i].count);
-    rl_bvh_block *blocks = aligned_alloc(64, ((size_t)num_blocks * sizeof *blocks + 63) / 64 * 64);
+    rl_bvh_block *blocks = alloc_lines(((size_t)num_blocks * sizeof *blocks + 63) / 64 * 64);
     if (!blocks) {
         free(wide);
         return rl_error(RL_ERR_OUT_OF_MEMORY, "accel bvh: out of memory for %u leaf blocks", (unsigned)num_blocks);
     }
-    float *cost = malloc((size_t)bvh->num_nodes * RL_BVH_WIDTH * sizeof *cost);
-    uint8_t *split = malloc((size_t)bvh->num_nodes * RL_BVH_WIDTH);
+    float *cost = rl_big_alloc((size_t)bvh->num_nodes * RL_BVH_WIDTH * sizeof *cost, true);
+    uint8_t *split = rl_big_alloc((size_t)bvh->num_nodes * RL_BVH_WIDTH, true);
     if (!cost || !split) {
         free(cost);
         free(split);

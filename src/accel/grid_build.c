@@ -25,6 +25,7 @@
 #endif
 
 #include "accel/grid.h"
+#include "core/bigalloc.h"
 #include "core/error.h"
 
 #define CELL_GROW_REL 1e-4
@@ -299,7 +300,7 @@ rl_status rl_grid_build(const rl_scene_data *data, const rl_accel_desc *desc, rl
     rl_status s = RL_OK;
     uint32_t *cursor = NULL;
     g->num_triangles = data->num_triangles;
-    g->tri_verts = rl_calloc(3 * (size_t)g->num_triangles + 1, sizeof *g->tri_verts);
+    g->tri_verts = rl_big_array(3 * (size_t)g->num_triangles + 1, sizeof *g->tri_verts, true);
     if (!g->tri_verts) {
         s = RL_ERR_OUT_OF_MEMORY;
         goto fail;
@@ -317,7 +318,7 @@ rl_status rl_grid_build(const rl_scene_data *data, const rl_accel_desc *desc, rl
     }
 
     /* Pass 1: references per cell, counted into cell_start[0..num_cells-1]. */
-    g->cell_start = rl_calloc((size_t)g->num_cells + 1, sizeof *g->cell_start);
+    g->cell_start = rl_big_array((size_t)g->num_cells + 1, sizeof *g->cell_start, true);
     if (!g->cell_start) {
         s = RL_ERR_OUT_OF_MEMORY;
         goto fail;
@@ -348,8 +349,8 @@ rl_status rl_grid_build(const rl_scene_data *data, const rl_accel_desc *desc, rl
 
     /* Pass 2: scatter, then sort each cell so the lists do not depend on
      * the thread schedule. */
-    g->cell_tris = rl_calloc((size_t)total + 1, sizeof *g->cell_tris);
-    cursor = rl_alloc((size_t)g->num_cells * sizeof *cursor);
+    g->cell_tris = rl_big_array((size_t)total + 1, sizeof *g->cell_tris, true);
+    cursor = rl_big_array(g->num_cells, sizeof *cursor, false);
     if (!g->cell_tris || !cursor) {
         s = RL_ERR_OUT_OF_MEMORY;
         goto fail;

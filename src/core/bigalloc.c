@@ -1,8 +1,11 @@
 /* bigalloc.c: large arrays on transparent huge pages (see bigalloc.h). */
 #define _DEFAULT_SOURCE
 #include "core/bigalloc.h"
+#include "core/error.h"
 
+#include <stdint.h>
 #include <stdlib.h>
+#include <string.h>
 #if defined(__linux__)
 #include <sys/mman.h>
 #endif
@@ -28,4 +31,21 @@ void *rl_big_alloc(size_t bytes, bool huge)
 #else
     return malloc(bytes);
 #endif
+}
+
+void *rl_big_array(size_t count, size_t size, bool zero)
+{
+    if (size && count > SIZE_MAX / size) {
+        rl_error(RL_ERR_OUT_OF_MEMORY, "allocation of %zu x %zu bytes overflows", count, size);
+        return NULL;
+    }
+    size_t bytes = count * size;
+    void *p = rl_big_alloc(bytes, true);
+    if (!p) {
+        rl_error(RL_ERR_OUT_OF_MEMORY, "out of memory allocating %zu x %zu bytes", count, size);
+        return NULL;
+    }
+    if (zero)
+        memset(p, 0, bytes ? bytes : 1);
+    return p;
 }

@@ -20,4 +20,11 @@
  * on the 2-core VM of 2026-12-03 (docs/line-space.md). */
 void *rl_big_alloc(size_t bytes, bool huge);
 
+/* An array of count items of size bytes through rl_big_alloc(huge = true),
+ * overflow-checked, zero-filled when `zero`; sets RL_ERR_OUT_OF_MEMORY
+ * with a message on failure (as rl_alloc). For the acceleration
+ * structures' build arrays: a BVH over `city` (1.4 M triangles) built in
+ * 0.8-0.9 s with huge pages against 1.65 s without on the same VM. */
+void *rl_big_array(size_t count, size_t size, bool zero);
+
 #endif

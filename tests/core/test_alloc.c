@@ -113,6 +113,23 @@ static void test_big_alloc_aligns_large_huge_arrays_and_works_with_realloc_and_f
     assert_null(rl_big_alloc(SIZE_MAX - 5, true));
 }
 
+static void test_big_array_zero_fills_and_reports_overflow(void **state)
+{
+    (void)state;
+    size_t n = RL_BIG_ALLOC_MIN / sizeof(uint64_t) + 3;
+    uint64_t *a = rl_big_array(n, sizeof *a, true);
+    assert_non_null(a);
+    for (size_t i = 0; i < n; ++i)
+        assert_true(a[i] == 0);
+    free(a);
+    uint8_t *b = rl_big_array(10, 1, false);    /* small: plain malloc */
+    assert_non_null(b);
+    free(b);
+    rl_clear_error();
+    assert_null(rl_big_array(SIZE_MAX / 2, 4, false));
+    assert_int_equal(rl_last_status(), RL_ERR_OUT_OF_MEMORY);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -120,6 +137,7 @@ int main(void)
         cmocka_unit_test(test_grow_capacity_is_what_reserve_allocates),
         cmocka_unit_test(test_reserve_fails_cleanly_on_overflow),
         cmocka_unit_test(test_big_alloc_aligns_large_huge_arrays_and_works_with_realloc_and_free),
+        cmocka_unit_test(test_big_array_zero_fills_and_reports_overflow),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
