@@ -725,17 +725,15 @@ static cJSON *pass_json(cJSON *parent, const char *name, double ms, size_t rays,
     return o;
 }
 
-static rl_status shadow_rays(const bpt *b, const rl_scene *scene, rl_ray **out, size_t *count)
+static rl_status shadow_rays(const bpt *b, const rl_scene *scene, const rl_accel *bvh, rl_ray **out,
+                             size_t *count)
 {
     const rl_scene_data *d = rl_scene_get_data(scene);
     *out = NULL;
     *count = 0;
     if (d->num_lights == 0)
         return RL_OK;
-    rl_accel *bvh = NULL;
-    rl_status st = rl_accel_create(scene, &(rl_accel_desc){ .kind = RL_ACCEL_BVH, .threads = b->threads }, &bvh);
-    if (st == RL_OK)
-        st = rl_accel_commit(bvh);
+    rl_status st = RL_OK;
     rl_camera cam = scene_camera(scene, b->a->width, b->a->height);
     rl_camera_frame f = rl_camera_frame_make(&cam);
     size_t cap = (size_t)cam.width * (size_t)cam.height;
@@ -778,7 +776,6 @@ static rl_status shadow_rays(const bpt *b, const rl_scene *scene, rl_ray **out, 
             rays[n++] = (rl_ray){ rl_madd(p, rl_normalize(ng), eps), 0.0f, dir,
                                   isinf(dist) ? INFINITY : dist * (1.0f - 1e-4f) };
         }
-    rl_accel_release(bvh);
     if (st != RL_OK) {
         free(rays);
         return st;
@@ -794,38 +791,36 @@ static rl_status shadow_rays_alone(bpt *b, const char *name, const int *res, int
     rl_status st = scene_get(b, name, &scene);
     rl_ray *rays = NULL, *cut = NULL;
     size_t n = 0;
-    if (st == RL_OK)
-        st = shadow_rays(b, scene, &rays, &n);
-    if (st != RL_OK || n == 0) {
-        free(rays);
-        return st;
+    rl_accel *acc[2] = { NULL, NULL };
+    static const char *const acc_names[2] = { "bvh", "grid" };
+    for (int k = 0; k < 2 && st == RL_OK; k++) {
+        st = rl_accel_create(scene, &(rl_accel_desc){ .kind = k ? RL_ACCEL_GRID : RL_ACCEL_BVH,
+                                                      .threads = b->threads }, &acc[k]);
+        if (st == RL_OK)
+            st = rl_accel_commit(acc[k]);
     }
-    cJSON *o = cJSON_AddObjectToObject(sec, "rays_alone");
+    if (st == RL_OK)
+        st = shadow_rays(b, scene, acc[0], &rays, &n);
+    cJSON *o = st == RL_OK && n ? cJSON_AddObjectToObject(sec, "rays_alone") : NULL;
     cJSON *lsj = o ? cJSON_AddArrayToObject(o, "line_spaces") : NULL;
-    if (!lsj) {
+    if (st != RL_OK || n == 0 || !lsj) {
+        rl_accel_release(acc[0]);
+        rl_accel_release(acc[1]);
         free(rays);
-        return RL_ERR_OUT_OF_MEMORY;
+        return st != RL_OK || n == 0 ? st : RL_ERR_OUT_OF_MEMORY;
     }
     cJSON_AddStringToObject(o, "rays_are", "one per pixel: primary hit (BVH) to a random point of the "
                                            "first light; PNMT and bvh_same_rays: a voxel diagonal cut "
                                            "off at both ends (the renderer's rule)");
     printf("shadow rays alone (%zu rays, the frame's first bounce; fastest of %d passes; Mrays/s, "
            "occluded):\n", n, b->runs);
-    rl_accel *acc[2] = { NULL, NULL };
-    static const char *const acc_names[2] = { "bvh", "grid" };
     double acc_ms[2] = { NAN, NAN };
-    for (int k = 0; k < 2 && st == RL_OK; k++) {
-        st = rl_accel_create(scene, &(rl_accel_desc){ .kind = k ? RL_ACCEL_GRID : RL_ACCEL_BVH,
-                                                      .threads = b->threads }, &acc[k]);
-        if (st == RL_OK)
-            st = rl_accel_commit(acc[k]);
+    for (int k = 0; k < 2; k++) {
         uint64_t occ = 0;
-        if (st == RL_OK) {
-            acc_ms[k] = occluded_pass(b, k ? RS_GRID : RS_BVH, acc[k], NULL, rays, n, &occ);
-            pass_json(o, acc_names[k], acc_ms[k], n, occ);
-            printf("  %-22s %8.1f ms %8.2f Mrays/s %9llu\n", acc_names[k], acc_ms[k],
-                   (double)n / (acc_ms[k] * 1e3), (unsigned long long)occ);
-        }
+        acc_ms[k] = occluded_pass(b, k ? RS_GRID : RS_BVH, acc[k], NULL, rays, n, &occ);
+        pass_json(o, acc_names[k], acc_ms[k], n, occ);
+        printf("  %-22s %8.1f ms %8.2f Mrays/s %9llu\n", acc_names[k], acc_ms[k],
+               (double)n / (acc_ms[k] * 1e3), (unsigned long long)occ);
     }
     cut = st == RL_OK ? malloc(n * sizeof *cut) : NULL;
     if (st == RL_OK && !cut)
