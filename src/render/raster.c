@@ -420,14 +420,16 @@ rl_status rl_scene_drawer_create(const rl_scene_data *d, rl_vec3 eye, const rl_r
 }
 
 /* Lights one object's vertices, corners or faces (what light_scene does
- * for all of them), in parallel only when it is big enough to pay. */
-static void light_object(rl_scene_drawer *dr, uint32_t o)
+ * for all of them), with up to `threads` threads when it is big enough to
+ * pay. */
+static void light_object(rl_scene_drawer *dr, uint32_t o, int threads)
 {
     const rl_scene_data *d = dr->data;
     const rl_object *obj = &d->objects[o];
     frame_buffers *b = &dr->b;
     const shade_ctx *ctx = &dr->ctx;
-    const int threads = obj->num_vertices > 4096 ? dr->threads : 1;
+    if (obj->num_vertices <= 4096)
+        threads = 1;
     const int64_t t0 = obj->first_triangle, t1 = t0 + obj->num_triangles;
     if (dr->opt.shading == RL_SHADING_FLAT) {
 #pragma omp parallel for num_threads(threads) schedule(static)
@@ -454,6 +456,30 @@ void rl_scene_drawer_new_frame(rl_scene_drawer *dr, rl_vec3 eye)
     memset(dr->object_lit, 0, dr->data->num_objects ? dr->data->num_objects : 1);
 }
 
+void rl_scene_drawer_light(rl_scene_drawer *dr, const uint32_t *objects, uint32_t count)
+{
+    if (!dr || !dr->lit || !objects)
+        return;
+    /* Each object once: 2 marks one queued in this call. */
+    uint32_t n = 0;
+    uint32_t *todo = calloc(count ? count : 1, sizeof *todo);
+    if (!todo)
+        return;                   /* the draws light them one by one */
+    for (uint32_t i = 0; i < count; ++i) {
+        uint32_t o = objects[i];
+        if (o < dr->data->num_objects && selected(dr->opt.object_mask, o) && !dr->object_lit[o]) {
+            dr->object_lit[o] = 2;
+            todo[n++] = o;
+        }
+    }
+#pragma omp parallel for num_threads(dr->threads) schedule(dynamic, 1)
+    for (int64_t i = 0; i < (int64_t)n; ++i)
+        light_object(dr, todo[i], 1);
+    for (uint32_t i = 0; i < n; ++i)
+        dr->object_lit[todo[i]] = 1;
+    free(todo);
+}
+
 rl_status rl_scene_drawer_draw(rl_scene_drawer *dr, rl_raster *ras, uint32_t object, rl_raster_counters *c)
 {
     if (!dr || !ras)
@@ -464,7 +490,7 @@ rl_status rl_scene_drawer_draw(rl_scene_drawer *dr, rl_raster *ras, uint32_t obj
     if (!selected(dr->opt.object_mask, object))
         return RL_OK;
     if (dr->lit && !dr->object_lit[object]) {
-        light_object(dr, object);
+        light_object(dr, object, dr->threads);
         dr->object_lit[object] = 1;
     }
     return draw_object(ras, dr->data, object, dr->opt.shading, dr->lit, dr->opt.flags, &dr->b, c);

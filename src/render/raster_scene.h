@@ -61,6 +61,13 @@ rl_status rl_scene_drawer_create(const rl_scene_data *d, rl_vec3 eye, const rl_r
  * a renderer that keeps its drawer does not allocate and fault in the
  * whole scene's buffers every frame for the few objects it draws. */
 void rl_scene_drawer_new_frame(rl_scene_drawer *dr, rl_vec3 eye);
+/* Lights the listed objects that are selected and not yet lit this frame,
+ * in one parallel pass over the objects, for a renderer that knows what it
+ * will draw before it draws: most objects are too small to light in
+ * parallel one by one, so that would leave all threads but one idle. The
+ * images do not change (lighting is per object). Out of memory: nothing
+ * is done and the draws light the objects themselves. */
+void rl_scene_drawer_light(rl_scene_drawer *dr, const uint32_t *objects, uint32_t count);
 /* Draws object (an index < d->num_objects; unselected objects are skipped)
  * into the rasterizer's current target. */
 rl_status rl_scene_drawer_draw(rl_scene_drawer *dr, rl_raster *ras, uint32_t object, rl_raster_counters *c);

@@ -74,7 +74,21 @@ typedef struct surfels_state {
     rl_vec4 *col;
     float *size;
     size_t cap;
+    /* per frame: what the traversal decided to draw, in order, and the
+     * meshes among it (lit in one parallel pass before drawing) */
+    struct draw_cmd *cmds;
+    size_t num_cmds, cmds_cap;
+    uint32_t *lit;
+    size_t lit_cap;
 } surfels_state;
+
+/* One step of a frame: a mesh object, or a prefix of m surfels of an
+ * octree node's set at a point size. */
+typedef struct draw_cmd {
+    uint32_t index;               /* object, or octree node for points */
+    uint32_t m;                   /* points: the prefix length; 0: an object */
+    float point_size;
+} draw_cmd;
 
 static rl_status surfels_create(void **state)
 {
@@ -106,6 +120,8 @@ static void surfels_release(void *state)
     free(s->pos);
     free(s->col);
     free(s->size);
+    free(s->cmds);
+    free(s->lit);
     free(s);
 }
 
@@ -246,6 +262,16 @@ static rl_status draw_prefix(surfels_frame *f, const rl_surfel_set *set, uint32_
     return st;
 }
 
+static rl_status push_cmd(surfels_state *s, draw_cmd c)
+{
+    if (!rl_reserve((void **)&s->cmds, &s->cmds_cap, s->num_cmds + 1, sizeof *s->cmds, 256))
+        return RL_ERR_OUT_OF_MEMORY;
+    s->cmds[s->num_cmds++] = c;
+    return RL_OK;
+}
+
+/* Sec. 6.2's traversal: decides what to draw and appends it to s->cmds
+ * (drawn by draw_cmds). */
 static rl_status draw_node(surfels_frame *f, uint32_t n)
 {
     surfels_state *s = f->s;
@@ -268,7 +294,7 @@ static rl_status draw_node(surfels_frame *f, uint32_t n)
         if (m > set->count)
             m = set->count;
         if (m > 0)
-            st = draw_prefix(f, set, m, (float)(t * f->point_size * grow));
+            st = push_cmd(s, (draw_cmd){ n, m, (float)(t * f->point_size * grow) });
         s->head.stats.surfel_nodes++;
         if (st != RL_OK || a <= f->min2)
             return st;
@@ -279,10 +305,32 @@ static rl_status draw_node(surfels_frame *f, uint32_t n)
             continue;
         s->head.stats.objects_drawn++;
         s->head.stats.triangles_drawn += f->d->objects[o].num_triangles;
-        st = rl_scene_drawer_draw(f->cf.drawer, f->cf.ras, o, &f->cf.counters);
+        st = push_cmd(s, (draw_cmd){ o, 0, 0.0f });
     }
     for (uint32_t c = 0; c < node->num_children && st == RL_OK; ++c)
         st = draw_node(f, node->first_child + c);
+    return st;
+}
+
+/* Draws the traversal's steps in order, after lighting all its meshes in
+ * one parallel pass (one at a time, most are too small to light in
+ * parallel, and the other threads would wait). */
+static rl_status draw_cmds(surfels_frame *f)
+{
+    surfels_state *s = f->s;
+    size_t k = 0;
+    if (!rl_reserve((void **)&s->lit, &s->lit_cap, s->num_cmds, sizeof *s->lit, 256))
+        return RL_ERR_OUT_OF_MEMORY;
+    for (size_t i = 0; i < s->num_cmds; ++i)
+        if (s->cmds[i].m == 0)
+            s->lit[k++] = s->cmds[i].index;
+    rl_scene_drawer_light(f->cf.drawer, s->lit, (uint32_t)k);
+    rl_status st = RL_OK;
+    for (size_t i = 0; i < s->num_cmds && st == RL_OK; ++i) {
+        const draw_cmd *c = &s->cmds[i];
+        st = c->m ? draw_prefix(f, &s->sets[c->index], c->m, c->point_size)
+                  : rl_scene_drawer_draw(f->cf.drawer, f->cf.ras, c->index, &f->cf.counters);
+    }
     return st;
 }
 
@@ -350,7 +398,11 @@ static rl_status surfels_render(rl_renderer *r, void *state, const rl_scene *sce
     st = rl_cull_frame_begin(r, scene, &s->head.keep, cam, image, &f.cf);
     if (st != RL_OK)
         return st;
-    st = rl_cull_frame_end(&f.cf, draw_node(&f, 0), image, stats);
+    s->num_cmds = 0;
+    st = draw_node(&f, 0);
+    if (st == RL_OK)
+        st = draw_cmds(&f);
+    st = rl_cull_frame_end(&f.cf, st, image, stats);
     if (st != RL_OK)
         return st;
     s->head.have_frame = true;
