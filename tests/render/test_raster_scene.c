@@ -197,6 +197,61 @@ static void test_raster_renderer_output_equals_drawing_the_whole_scene(void **st
     rl_scene_release(s);
 }
 
+/* A drawer whose objects were lit ahead in one parallel pass
+ * (rl_scene_drawer_light, as surfels does) draws what
+ * rl_raster_draw_scene draws, also in its next frame from another eye;
+ * duplicates, unselected and out-of-range objects in the list are
+ * ignored. */
+static void test_lighting_ahead_draws_the_same_image(void **state)
+{
+    (void)state;
+    rl_camera cam, moved;
+    rl_scene *s = stack_scene(&cam);
+    const rl_scene_data *d = rl_scene_get_data(s);
+    moved = cam;
+    moved.eye = rl_add(cam.eye, rl_v3(0.4f, 0.3f, 0.2f));
+    uint8_t *mask = calloc(d->num_objects, 1);
+    assert_non_null(mask);
+    for (uint32_t o = 0; o < d->num_objects; ++o)
+        mask[o] = o != 1;
+    uint32_t *list = calloc(2 * (size_t)d->num_objects + 1, sizeof *list);
+    assert_non_null(list);
+    uint32_t n = 0;
+    for (uint32_t o = d->num_objects; o-- > 0;)
+        list[n++] = o;                    /* reversed: lighting order is free */
+    for (uint32_t o = 0; o < d->num_objects; ++o)
+        list[n++] = o;                    /* each twice */
+    list[n++] = d->num_objects + 7;       /* out of range */
+    for (int k = 0; k < 3; ++k) {
+        rl_raster_scene_desc desc = { .shading = (rl_raster_shading)k, .ambient = 0.1f, .object_mask = mask };
+        rl_scene_drawer *dr = NULL;
+        assert_int_equal(rl_scene_drawer_create(d, cam.eye, &desc, &dr), RL_OK);
+        for (int frame = 0; frame < 2; ++frame) {
+            const rl_camera *c = frame ? &moved : &cam;
+            if (frame)
+                rl_scene_drawer_new_frame(dr, c->eye);
+            rl_image *img = NULL;
+            assert_int_equal(rl_image_create(c->width, c->height, FX_ALL_LAYERS, &img), RL_OK);
+            rl_image_fill(img, rl_v4(0.0f, 0.0f, 0.0f, 1.0f));
+            rl_raster *ras = NULL;
+            assert_int_equal(rl_raster_create(NULL, &ras), RL_OK);
+            assert_int_equal(rl_raster_set_camera(ras, img, c, d->bounds), RL_OK);
+            rl_scene_drawer_light(dr, list, n);
+            for (uint32_t o = 0; o < d->num_objects; ++o)
+                assert_int_equal(rl_scene_drawer_draw(dr, ras, o, NULL), RL_OK);
+            drawn direct = draw_scene(s, c, &desc, rl_v4(0.0f, 0.0f, 0.0f, 1.0f));
+            fx_assert_images_identical(img, direct.img);
+            rl_image_release(direct.img);
+            rl_raster_release(ras);
+            rl_image_release(img);
+        }
+        rl_scene_drawer_release(dr);
+    }
+    free(list);
+    free(mask);
+    rl_scene_release(s);
+}
+
 typedef struct progress_log {
     int calls;
     double last;
@@ -251,6 +306,7 @@ int main(void)
         cmocka_unit_test(test_mask_draws_only_the_selected_objects),
         cmocka_unit_test(test_no_color_writes_depth_and_ids_of_a_lit_draw_and_leaves_colour_alone),
         cmocka_unit_test(test_raster_renderer_output_equals_drawing_the_whole_scene),
+        cmocka_unit_test(test_lighting_ahead_draws_the_same_image),
         cmocka_unit_test(test_progress_reaches_one_and_can_cancel),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
