@@ -849,17 +849,6 @@ rl_status rl_ls_build(rl_linespace *ls)
         st = RL_ERR_OUT_OF_MEMORY;
     if (!st && !rl_ls_occupancy_alloc(ls))
         st = RL_ERR_OUT_OF_MEMORY;
-    rl_ls_geometry geo = { 0 };
-    if (!st)
-        st = rl_ls_geometry_init(&geo, ls->n);
-    if (st) {
-        free(cells);
-        free(dyn);
-        free(dyn_count);
-        chain_free(&chain);
-        return rl_error(RL_ERR_OUT_OF_MEMORY, "linespace: out of memory for %llu shafts",
-                        (unsigned long long)shafts);
-    }
     int threads = ls->threads;
 #ifdef _OPENMP
     if (threads <= 0)
@@ -867,14 +856,20 @@ rl_status rl_ls_build(rl_linespace *ls)
 #else
     threads = 1;
 #endif
-    list_arena *arenas = dyn ? calloc((size_t)threads, sizeof *arenas) : NULL;
-    if (dyn && !arenas) {
+    list_arena *arenas = NULL;
+    if (!st && dyn && !(arenas = calloc((size_t)threads, sizeof *arenas)))
+        st = RL_ERR_OUT_OF_MEMORY;
+    rl_ls_geometry geo = { 0 };
+    if (!st)
+        st = rl_ls_geometry_init(&geo, ls->n);
+    if (st) {
         free(cells);
         free(dyn);
         free(dyn_count);
+        free(arenas);
         chain_free(&chain);
-        rl_ls_geometry_free(&geo);
-        return rl_error(RL_ERR_OUT_OF_MEMORY, "linespace: out of memory");
+        return rl_error(RL_ERR_OUT_OF_MEMORY, "linespace: out of memory for %llu shafts",
+                        (unsigned long long)shafts);
     }
     atomic_int failed = 0;        /* 1: out of memory, 2: cancelled */
     atomic_uint next = 0, done = 0;

@@ -362,6 +362,7 @@ struct rl_scene_drawer {
     shade_ctx ctx;
     int threads;
     uint8_t *object_lit;         /* per object: lighting done */
+    uint32_t *todo;              /* scratch of rl_scene_drawer_light, one per object */
     frame_buffers b;
 };
 
@@ -381,6 +382,7 @@ void rl_scene_drawer_release(rl_scene_drawer *dr)
         return;
     free_buffers(&dr->b);
     free(dr->object_lit);
+    free(dr->todo);
     free(dr);
 }
 
@@ -409,8 +411,9 @@ rl_status rl_scene_drawer_create(const rl_scene_data *d, rl_vec3 eye, const rl_r
 #endif
     dr->ctx = (shade_ctx){ d, eye, dr->opt.ambient };
     dr->object_lit = rl_calloc(d->num_objects ? d->num_objects : 1, 1);
-    st = dr->object_lit ? prepare(d, dr->opt.shading, dr->lit, dr->opt.object_mask, &dr->b)
-                        : RL_ERR_OUT_OF_MEMORY;
+    dr->todo = dr->lit ? rl_calloc(d->num_objects ? d->num_objects : 1, sizeof *dr->todo) : NULL;
+    bool have = dr->object_lit && (dr->todo || !dr->lit);
+    st = have ? prepare(d, dr->opt.shading, dr->lit, dr->opt.object_mask, &dr->b) : RL_ERR_OUT_OF_MEMORY;
     if (st != RL_OK) {
         rl_scene_drawer_release(dr);
         return rl_error(st, "rl_scene_drawer_create: buffers for %u triangles", d->num_triangles);
@@ -460,11 +463,9 @@ void rl_scene_drawer_light(rl_scene_drawer *dr, const uint32_t *objects, uint32_
 {
     if (!dr || !dr->lit || !objects)
         return;
-    /* Each object once: 2 marks one queued in this call. */
-    uint32_t n = 0;
-    uint32_t *todo = calloc(count ? count : 1, sizeof *todo);
-    if (!todo)
-        return;                   /* the draws light them one by one */
+    /* Each object once (2 marks one queued in this call), so at most
+     * num_objects of them. */
+    uint32_t n = 0, *todo = dr->todo;
     for (uint32_t i = 0; i < count; ++i) {
         uint32_t o = objects[i];
         if (o < dr->data->num_objects && selected(dr->opt.object_mask, o) && !dr->object_lit[o]) {
@@ -477,7 +478,6 @@ void rl_scene_drawer_light(rl_scene_drawer *dr, const uint32_t *objects, uint32_
         light_object(dr, todo[i], 1);
     for (uint32_t i = 0; i < n; ++i)
         dr->object_lit[todo[i]] = 1;
-    free(todo);
 }
 
 rl_status rl_scene_drawer_draw(rl_scene_drawer *dr, rl_raster *ras, uint32_t object, rl_raster_counters *c)

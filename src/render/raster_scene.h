@@ -65,8 +65,7 @@ void rl_scene_drawer_new_frame(rl_scene_drawer *dr, rl_vec3 eye);
  * in one parallel pass over the objects, for a renderer that knows what it
  * will draw before it draws: most objects are too small to light in
  * parallel one by one, so that would leave all threads but one idle. The
- * images do not change (lighting is per object). Out of memory: nothing
- * is done and the draws light the objects themselves. */
+ * images do not change (lighting is per object). */
 void rl_scene_drawer_light(rl_scene_drawer *dr, const uint32_t *objects, uint32_t count);
 /* Draws object (an index < d->num_objects; unselected objects are skipped)
  * into the rasterizer's current target. */
