@@ -57,7 +57,8 @@ static const char bench_pt_help[] =
     "  scenes        frame time and Mrays/s, all rays through the grid vs the PNMT\n"
     "                Line Space vs our BVH, for the 7 scenes of Sec. 9.3 (Diagram 1)\n"
     "  diffuse       Cornell box + bunny: diffuse rays through grid, BVH, and each\n"
-    "                Line Space variant (candidates, PNMT, pre-illuminated) at voxels\n"
+    "                Line Space variant (exact and fixed-k candidates, PNMT,\n"
+    "                pre-illuminated) at voxels\n"
     "                8^3..64^3, best per variant; shadows by shadow maps (Diagram 2)\n"
     "  shadow        the same for shadow rays, plus shadow maps; diffuse rays by\n"
     "                the BVH (Diagram 3); then the frame's shadow rays alone through\n"
@@ -74,6 +75,8 @@ static const char bench_pt_help[] =
     "  --spp-max N       samples accumulated per variant in the error section; default 64\n"
     "  --max-memory GB   skip Line Spaces estimated to need more; default 60% of RAM\n"
     "  --builds N        generation: the fastest of N builds per row; default 3 (quick: 1)\n"
+    "  --fixed-k K       generation: also build fixed lists of K (even; default 8), for\n"
+    "                    the cost of the dynamic lists (time, memory, truncated shafts)\n"
     "  --small-pages     generation: build without transparent huge pages\n"
     "                    (rl_linespace_desc.small_pages), for an A/B of the page size\n"
     "  --threads N       threads; default all cores\n"
@@ -136,7 +139,8 @@ typedef struct bpt_args {
     long long ref_spp, spp_max, threads;
     long long max_memory_gb;       /* 0: 60% of physical memory */
     long long builds;              /* generation: fastest of this many builds */
-    bool has_size, has_err_size, has_ref_spp, has_spp_max, has_builds, quick, small_pages;
+    long long fixed_k;             /* generation: fixed lists of k for the cost of dynamic ones */
+    bool has_size, has_err_size, has_ref_spp, has_spp_max, has_builds, has_fixed_k, quick, small_pages;
     unsigned sections;
     const char *out;
 } bpt_args;
@@ -161,6 +165,7 @@ typedef struct pt_config {
     int max_depth;                 /* 0: the renderer's default */
     bool direct_only;              /* max_depth 0: no secondary rays */
     const char *ls_origin;         /* NULL: the renderer's default (offset) */
+    bool ls_fixed;                 /* the thesis' fixed lists of k = 8 (ls_dynamic=false) */
     int spp;
     bool accumulate;
     const char *seed;
@@ -231,6 +236,7 @@ static rl_status make_pt(const bpt *b, const pt_config *c, rl_renderer **out)
     if (st == RL_OK && c->max_depth) st = set_num(r, "max_depth", c->max_depth);
     if (st == RL_OK && c->direct_only) st = set_num(r, "max_depth", 0);
     if (st == RL_OK && c->ls_origin) st = rl_renderer_set(r, "ls_origin", c->ls_origin);
+    if (st == RL_OK && c->ls_fixed) st = rl_renderer_set(r, "ls_dynamic", "false");
     if (st == RL_OK) st = set_num(r, "spp", c->spp ? c->spp : 1);
     if (st == RL_OK) st = rl_renderer_set(r, "accumulate", c->accumulate ? "true" : "false");
     if (st != RL_OK) {
@@ -336,6 +342,89 @@ static int ls_res_that_fits(const bpt *b, const rl_scene *scene, int res, int n)
 
 /* -------------------------------------------------------- generation -- */
 
+/* The fastest of --builds fresh builds of desc (a build's first touch of
+ * gigabytes varies with the VM's memory state by up to 1.5x); every build
+ * time goes to runs. */
+static rl_status fastest_build(const bpt *b, const rl_accel *grid, const rl_linespace_desc *desc,
+                               cJSON *runs, rl_linespace **out)
+{
+    *out = NULL;
+    double best_ms = INFINITY;
+    for (long long r = 0; r < b->a->builds; r++) {
+        rl_linespace *next = NULL;
+        rl_status st = rl_linespace_create(grid, desc, &next);
+        if (st == RL_OK) st = rl_linespace_commit(next);
+        if (st != RL_OK) {
+            rl_linespace_release(next);
+            rl_linespace_release(*out);
+            *out = NULL;
+            return st;
+        }
+        rl_linespace_stats ns;
+        rl_linespace_get_stats(next, &ns);
+        cJSON_AddItemToArray(runs, cJSON_CreateNumber(ns.build_ms));
+        if (ns.build_ms < best_ms) {
+            best_ms = ns.build_ms;
+            rl_linespace_release(*out);
+            *out = next;
+        } else {
+            rl_linespace_release(next);
+        }
+    }
+    return RL_OK;
+}
+
+/* The cost of dynamic allocation (Sec. 7.1.1 proposes it, we build it):
+ * the same row with the thesis' fixed lists of k candidates, built as
+ * often, against the dynamic build `dyn`: time, memory and the shafts the
+ * fixed lists truncate. Its size is known from dyn's occupied shafts. */
+static rl_status fixed_row(const bpt *b, const struct gen_row *g, const rl_accel *grid,
+                           const rl_linespace *dyn, cJSON *row)
+{
+    rl_linespace_stats ds;
+    rl_linespace_get_stats(dyn, &ds);
+    int k = (int)b->a->fixed_k;
+    cJSON *o = cJSON_AddObjectToObject(row, "fixed");
+    if (!o)
+        return RL_ERR_OUT_OF_MEMORY;
+    cJSON_AddNumberToObject(o, "k", k);
+    double occupied = (double)(ds.shafts - ds.empty_shafts);
+    double need = (double)ds.memory_bytes - 4.0 * (double)ds.candidates - 4.0 * (occupied + 1.0) +
+                  4.0 * k * occupied;
+    if (need > b->max_memory_bytes) {
+        char why[160];
+        snprintf(why, sizeof why, "skipped: fixed lists of %d need %.1f GiB, the limit is %.1f GiB "
+                 "(--max-memory)", k, need / 1073741824.0, b->max_memory_bytes / 1073741824.0);
+        cJSON_AddStringToObject(o, "status", why);
+        printf("%-26s %4d %2d  fixed k=%d %s\n", g->scene, g->res, g->n, k, why);
+        return RL_OK;
+    }
+    rl_linespace_desc fd = { .n = g->n, .k = k, .dynamic = false, .small_pages = b->a->small_pages,
+                             .payloads = RL_LS_CANDIDATES | RL_LS_PNMT, .threads = b->threads };
+    rl_linespace *ls = NULL;
+    rl_status st = fastest_build(b, grid, &fd, cJSON_AddArrayToObject(o, "ms_runs"), &ls);
+    if (st != RL_OK)
+        return st;
+    rl_linespace_stats fs;
+    rl_linespace_get_stats(ls, &fs);
+    rl_linespace_release(ls);
+    double trunc = occupied > 0.0 ? 100.0 * (double)fs.truncated_shafts / occupied : 0.0;
+    cJSON_AddStringToObject(o, "status", "ok");
+    rl_bench_add_num(o, "ms", fs.build_ms);
+    cJSON_AddNumberToObject(o, "bytes", (double)fs.memory_bytes);
+    cJSON_AddNumberToObject(o, "candidates", (double)fs.candidates);
+    cJSON_AddNumberToObject(o, "truncated_shafts", (double)fs.truncated_shafts);
+    rl_bench_add_num(o, "truncated_pct_of_occupied", trunc);
+    rl_bench_add_num(o, "dynamic_over_fixed_ms", rl_bench_ratio(ds.build_ms, fs.build_ms));
+    rl_bench_add_num(o, "dynamic_over_fixed_bytes", rl_bench_ratio((double)ds.memory_bytes,
+                                                                   (double)fs.memory_bytes));
+    printf("%-26s %4d %2d  fixed k=%d: %.1f ms (dynamic / fixed %.2f), %.1f MiB (dynamic / fixed "
+           "%.2f), %.1f %% of occupied shafts truncated\n", g->scene, g->res, g->n, k, fs.build_ms,
+           rl_bench_ratio(ds.build_ms, fs.build_ms), (double)fs.memory_bytes / 1048576.0,
+           rl_bench_ratio((double)ds.memory_bytes, (double)fs.memory_bytes), trunc);
+    return RL_OK;
+}
+
 static rl_status sec_generation(void *ctx, cJSON *sec)
 {
     bpt *b = ctx;
@@ -382,29 +471,8 @@ static rl_status sec_generation(void *ctx, cJSON *sec)
         if (st == RL_OK) st = rl_accel_commit(grid);
         rl_linespace_desc ld = { .n = g->n, .dynamic = true, .small_pages = b->a->small_pages,
                                  .payloads = RL_LS_CANDIDATES | RL_LS_PNMT, .threads = b->threads };
-        /* The fastest of --builds fresh builds: a build's first touch of
-         * gigabytes varies with the VM's memory state by up to 1.5x. */
-        cJSON *runs = cJSON_AddArrayToObject(row, "ls_ms_runs");
-        double best_ms = INFINITY;
-        for (long long r = 0; st == RL_OK && r < b->a->builds; r++) {
-            rl_linespace *next = NULL;
-            st = rl_linespace_create(grid, &ld, &next);
-            if (st == RL_OK) st = rl_linespace_commit(next);
-            if (st != RL_OK) {
-                rl_linespace_release(next);
-                break;
-            }
-            rl_linespace_stats ns;
-            rl_linespace_get_stats(next, &ns);
-            cJSON_AddItemToArray(runs, cJSON_CreateNumber(ns.build_ms));
-            if (ns.build_ms < best_ms) {
-                best_ms = ns.build_ms;
-                rl_linespace_release(ls);
-                ls = next;
-            } else {
-                rl_linespace_release(next);
-            }
-        }
+        if (st == RL_OK)
+            st = fastest_build(b, grid, &ld, cJSON_AddArrayToObject(row, "ls_ms_runs"), &ls);
         if (st != RL_OK) {
             const char *why = rl_last_error() && *rl_last_error() ? rl_last_error()
                                                                    : rl_status_string(st);
@@ -439,6 +507,12 @@ static rl_status sec_generation(void *ctx, cJSON *sec)
                    (double)ls_s.memory_bytes / 1048576.0, empty, ls_s.mean_candidates);
             note("generation %s %d^3 N=%d: grid %.1f ms, LS %.1f ms", g->scene, g->res, g->n,
                  gs.build_ms, ls_s.build_ms);
+            fflush(stdout);
+            if ((st = fixed_row(b, g, grid, ls, row)) != RL_OK) {
+                const char *why = rl_last_error() && *rl_last_error() ? rl_last_error() : rl_status_string(st);
+                printf("%-26s %4d %2d  fixed lists failed: %s\n", g->scene, g->res, g->n, why);
+                any_failed = true;
+            }
         }
         fflush(stdout);
         rl_linespace_release(ls);
@@ -460,6 +534,7 @@ static cJSON *frame_json(const pt_config *c, const rl_render_stats *s, double wa
     cJSON_AddStringToObject(o, "shadow", c->shadow);
     cJSON_AddStringToObject(o, "diffuse", c->diffuse);
     cJSON_AddNumberToObject(o, "grid_res", c->grid_res);
+    cJSON_AddBoolToObject(o, "ls_fixed_lists", c->ls_fixed);
     rl_bench_add_num(o, "frame_ms", s->time_ms);
     rl_bench_add_num(o, "fps", s->time_ms > 0.0 ? 1e3 / s->time_ms : NAN);
     rl_bench_add_num(o, "mrays_per_s", mrays(s));
@@ -468,7 +543,7 @@ static cJSON *frame_json(const pt_config *c, const rl_render_stats *s, double wa
     return o;
 }
 
-#define MAX_CONFIGS 16
+#define MAX_CONFIGS 24
 
 /* Renders each configuration on one scene and prints a row per config
  * with its speed relative to configuration `base`. With floor >= 0 (a
@@ -592,7 +667,20 @@ static int sweep_res(bpt *b, const char *name, int res[4])
     return n;
 }
 
-static const char *const ls_variants[3] = { "ls-candidates", "ls-pnmt", "ls-preillum" };
+/* The Line Space variants under test: the label, the backend and whether
+ * its candidate lists are the thesis' fixed ones (k = 8, the renderer's
+ * default) instead of our exact dynamic lists. */
+static const struct ls_variant {
+    const char *label, *backend;
+    bool fixed;
+} ls_variants[] = {
+    { "ls-candidates", "ls-candidates", false },
+    { "ls-fixed-k8", "ls-candidates", true },
+    { "ls-pnmt", "ls-pnmt", false },
+    { "ls-preillum", "ls-preillum", false },
+};
+#define NUM_LS_VARIANTS ((int)(sizeof ls_variants / sizeof ls_variants[0]))
+#define LS_FIRST_APPROX 2      /* ls_variants[2..]: the approximate ones */
 
 /* Which rays a sweep configuration routes through the variant under test:
  * diffuse rays (shadows by shadow maps), shadow rays (diffuse rays by the
@@ -605,12 +693,12 @@ typedef enum sweep_rays { SWEEP_DIFFUSE, SWEEP_SHADOW, SWEEP_BOTH } sweep_rays;
 static int add_sweep(pt_config *configs, int count, int cap, char labels[][32], int first,
                      const int *res, int nres, sweep_rays rays)
 {
-    for (int v = first; v < 3; v++)
+    for (int v = first; v < NUM_LS_VARIANTS; v++)
         for (int i = 0; i < nres && count < cap; i++, count++) {
-            snprintf(labels[count], 32, "%s@%d", ls_variants[v], res[i]);
-            pt_config c = { .label = labels[count], .grid_res = res[i],
-                            .shadow = rays == SWEEP_DIFFUSE ? "shadowmap" : ls_variants[v],
-                            .diffuse = rays == SWEEP_SHADOW ? "bvh" : ls_variants[v] };
+            snprintf(labels[count], 32, "%s@%d", ls_variants[v].label, res[i]);
+            pt_config c = { .label = labels[count], .grid_res = res[i], .ls_fixed = ls_variants[v].fixed,
+                            .shadow = rays == SWEEP_DIFFUSE ? "shadowmap" : ls_variants[v].backend,
+                            .diffuse = rays == SWEEP_SHADOW ? "bvh" : ls_variants[v].backend };
             configs[count] = c;
         }
     return count;
@@ -624,11 +712,11 @@ static void sweep_best(const pt_config *configs, const rl_render_stats *stats, i
 {
     cJSON *best = cJSON_AddObjectToObject(sec, "best");
     printf("best resolution per variant:\n");
-    for (int v = 0; v < 3; v++) {
+    for (int v = 0; v < NUM_LS_VARIANTS; v++) {
         int bi = -1;
         for (int i = first; i < count; i++)
-            if (strcmp(rays == SWEEP_SHADOW ? configs[i].shadow : configs[i].diffuse, ls_variants[v]) == 0 &&
-                (bi < 0 || stats[i].time_ms < stats[bi].time_ms))
+            if (strcmp(rays == SWEEP_SHADOW ? configs[i].shadow : configs[i].diffuse, ls_variants[v].backend) == 0 &&
+                configs[i].ls_fixed == ls_variants[v].fixed && (bi < 0 || stats[i].time_ms < stats[bi].time_ms))
                 bi = i;
         if (bi < 0)
             continue;
@@ -637,12 +725,12 @@ static void sweep_best(const pt_config *configs, const rl_render_stats *stats, i
         double xr = floor >= 0 ? rl_bench_ratio(stats[0].time_ms - stats[floor].time_ms,
                                                 stats[bi].time_ms - stats[floor].time_ms)
                                : NAN;
-        printf("  %-14s %3d^3  %8.1f ms  %5.2fx the grid  %5.2fx the BVH", ls_variants[v],
+        printf("  %-14s %3d^3  %8.1f ms  %5.2fx the grid  %5.2fx the BVH", ls_variants[v].label,
                configs[bi].grid_res, stats[bi].time_ms, xg, xb);
         if (isfinite(xr))
             printf("  rays alone %5.2fx the grid", xr);
         printf("\n");
-        cJSON *o = best ? cJSON_AddObjectToObject(best, ls_variants[v]) : NULL;
+        cJSON *o = best ? cJSON_AddObjectToObject(best, ls_variants[v].label) : NULL;
         if (!o)
             continue;
         cJSON_AddNumberToObject(o, "grid_res", configs[bi].grid_res);
@@ -1049,11 +1137,13 @@ static rl_status sec_error(void *ctx, cJSON *sec)
     };
     char labels[MAX_CONFIGS][32];
     int count = 3;
-    snprintf(labels[count], 32, "ls-candidates@%d", mid);
-    configs[count] = (pt_config){ .label = labels[count], .shadow = "ls-candidates",
-                                  .diffuse = "ls-candidates", .grid_res = mid };
-    count++;
-    count = add_sweep(configs, count, MAX_CONFIGS - 1, labels, 1, res, nres, SWEEP_BOTH);
+    for (int v = 0; v < LS_FIRST_APPROX; v++, count++) {
+        snprintf(labels[count], 32, "%s@%d", ls_variants[v].label, mid);
+        configs[count] = (pt_config){ .label = labels[count], .shadow = ls_variants[v].backend,
+                                      .diffuse = ls_variants[v].backend, .grid_res = mid,
+                                      .ls_fixed = ls_variants[v].fixed };
+    }
+    count = add_sweep(configs, count, MAX_CONFIGS - 1, labels, LS_FIRST_APPROX, res, nres, SWEEP_BOTH);
     snprintf(labels[count], 32, "ls-pnmt@%d exact", mid);
     configs[count] = (pt_config){ .label = labels[count], .shadow = "ls-pnmt", .diffuse = "ls-pnmt",
                                   .grid_res = mid, .ls_origin = "exact" };
@@ -1111,6 +1201,7 @@ static rl_status sec_error(void *ctx, cJSON *sec)
         cJSON_AddStringToObject(v, "diffuse", configs[i].diffuse);
         cJSON_AddNumberToObject(v, "grid_res", configs[i].grid_res);
         cJSON_AddStringToObject(v, "ls_origin", configs[i].ls_origin ? configs[i].ls_origin : "offset");
+        cJSON_AddBoolToObject(v, "ls_fixed_lists", configs[i].ls_fixed);
         cJSON_AddItemToObject(v, "curve", curve_json(pts[i], num[i]));
         cJSON *ttj = cJSON_AddObjectToObject(v, "time_to_bvh_rmse_ms");
         for (int k = 0; ttj && k < 3; k++) {
@@ -1201,6 +1292,7 @@ static int parse_args(int argc, char **argv, bpt_args *a)
         RL_BENCH_FLAG("--quick", &a->quick),
         RL_BENCH_FLAG("--small-pages", &a->small_pages),
         RL_BENCH_COUNT("--builds", 100, &a->builds, &a->has_builds),
+        RL_BENCH_COUNT("--fixed-k", RL_LS_MAX_K, &a->fixed_k, &a->has_fixed_k),
         RL_BENCH_SIZE("--size", &a->width, &a->height, &a->has_size),
         RL_BENCH_SIZE("--error-size", &a->err_width, &a->err_height, &a->has_err_size),
         RL_BENCH_COUNT("--ref-spp", 1 << 20, &a->ref_spp, &a->has_ref_spp),
@@ -1228,6 +1320,11 @@ static int parse_args(int argc, char **argv, bpt_args *a)
         a->spp_max = a->quick ? 8 : 64;
     if (!a->has_builds)
         a->builds = a->quick ? 1 : 3;
+    if (!a->has_fixed_k)
+        a->fixed_k = 8;
+    if (a->fixed_k % 2 != 0)
+        return rl_cli_fail(RL_CLI_USAGE, "--fixed-k: %lld is odd (front and back halves of k/2, Alg. 3)",
+                           a->fixed_k);
     return RL_CLI_OK;
 }
 
@@ -1250,6 +1347,7 @@ static cJSON *params_json(const bpt *b)
     cJSON_AddBoolToObject(o, "quick", a->quick);
     cJSON_AddBoolToObject(o, "ls_huge_pages", !a->small_pages);
     cJSON_AddNumberToObject(o, "ls_builds", (double)a->builds);
+    cJSON_AddNumberToObject(o, "ls_fixed_k", (double)a->fixed_k);
     cJSON_AddNumberToObject(o, "warmup_renders", 1);
     cJSON_AddNumberToObject(o, "timed_renders", b->runs);
     cJSON_AddStringToObject(o, "seed", PT_SEED);

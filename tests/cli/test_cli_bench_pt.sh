@@ -16,13 +16,14 @@ expect_usage_error "$RL" bench pt --error-size 64 --out "$TMP/x.json"
 expect_usage_error "$RL" bench pt --only scenes,nosuch --out "$TMP/x.json"
 expect_usage_error "$RL" bench pt --quick --out "$TMP/x.txt"
 expect_usage_error "$RL" bench pt --frobnicate
+expect_usage_error "$RL" bench pt --fixed-k 7 --out "$TMP/x.json"
 [ -e "$TMP/x.json" ] && fail "a failed run wrote x.json"
 
 expect_exit 1 "$RL" bench pt --quick --out "$TMP/no/such/dir/pt.json"
 expect_in "$TMP/err" "rl: error: "
 
 expect_exit 0 "$RL" bench pt --help
-for o in --size --error-size --ref-spp --spp-max --max-memory --builds --small-pages --only --out \
+for o in --size --error-size --ref-spp --spp-max --max-memory --builds --fixed-k --small-pages --only --out \
          --quick generation accumulation; do
     expect_in "$TMP/out" "$o"
 done
@@ -54,6 +55,14 @@ for x in g:
     assert x["ls_ms_runs"] == [x["ls_ms"]], x          # --quick: one build
     assert x["shafts"] == x["filled_voxels"] * 15 * x["n"] ** 4, x
     assert 0 <= x["empty_shafts"] <= x["shafts"], x
+    # The cost of dynamic lists: the same row with fixed lists of k = 8
+    # (k slots per occupied shaft: the front and the back half).
+    f = x["fixed"]
+    assert f["status"] == "ok" and f["k"] == 8 and f["ms_runs"] == [f["ms"]], f
+    assert f["ms"] > 0 and f["bytes"] > 0 and f["dynamic_over_fixed_ms"] > 0, f
+    occupied = x["shafts"] - x["empty_shafts"]
+    assert 0 <= f["truncated_shafts"] <= occupied, f
+    assert 0 < f["candidates"] <= 8 * occupied, f
 
 def frames_ok(frames, labels):
     assert [f["label"] for f in frames] == labels, frames
@@ -66,12 +75,13 @@ assert [x["scene"] for x in sc] == ["ls-cornell:model=boxes"], sc
 frames_ok(sc[0]["frames"], ["grid", "ls-pnmt", "ls-candidates", "bvh"])
 # Diagrams 2-3: every Line Space variant at each voxel resolution of the
 # quick sweep (4^3, 8^3), and the fastest per variant.
-sweep = ["%s@%d" % (v, n) for v in ("ls-candidates", "ls-pnmt", "ls-preillum") for n in (4, 8)]
+variants = ("ls-candidates", "ls-fixed-k8", "ls-pnmt", "ls-preillum")
+sweep = ["%s@%d" % (v, n) for v in variants for n in (4, 8)]
 frames_ok(r["diffuse"]["frames"], ["grid", "bvh", "no diffuse rays"] + sweep)
 frames_ok(r["shadow"]["frames"], ["grid", "bvh", "shadowmap"] + sweep)
 for sec in ("diffuse", "shadow"):
     best = r[sec]["best"]
-    assert sorted(best) == ["ls-candidates", "ls-pnmt", "ls-preillum"], best
+    assert sorted(best) == sorted(variants), best
     for v, o in best.items():
         times = [f["frame_ms"] for f in r[sec]["frames"] if f["label"].startswith(v + "@")]
         assert o["grid_res"] in (4, 8) and o["frame_ms"] == min(times), (sec, v, o, times)
@@ -94,9 +104,10 @@ assert "rays_speedup_vs_base" in d["ls-pnmt@4"]
 e = r["error"]
 assert e["reference_spp"] == 64
 labels = [v["label"] for v in e["variants"]]
-assert labels == ["bvh", "grid", "shadowmap", "ls-candidates@4", "ls-pnmt@4", "ls-pnmt@8",
-                  "ls-preillum@4", "ls-preillum@8", "ls-pnmt@4 exact"], labels
-assert [v["ls_origin"] for v in e["variants"]] == ["offset"] * 8 + ["exact"]
+assert labels == ["bvh", "grid", "shadowmap", "ls-candidates@4", "ls-fixed-k8@4", "ls-pnmt@4",
+                  "ls-pnmt@8", "ls-preillum@4", "ls-preillum@8", "ls-pnmt@4 exact"], labels
+assert [v["ls_origin"] for v in e["variants"]] == ["offset"] * 9 + ["exact"]
+assert [v["ls_fixed_lists"] for v in e["variants"]] == [False] * 4 + [True] + [False] * 5
 for v in e["variants"]:
     c = v["curve"]
     assert [x["spp"] for x in c] == [1, 2, 4, 8], c
