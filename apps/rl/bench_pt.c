@@ -376,13 +376,14 @@ static rl_status fastest_build(const bpt *b, const rl_accel *grid, const rl_line
 
 /* The cost of dynamic allocation (Sec. 7.1.1 proposes it, we build it):
  * the same row with the thesis' fixed lists of k candidates, built as
- * often, against the dynamic build `dyn`: time, memory and the shafts the
- * fixed lists truncate. Its size is known from dyn's occupied shafts. */
+ * often, against the dynamic build's stats `dyn`: time, memory and the
+ * shafts the fixed lists truncate. Its size is known from dyn's occupied
+ * shafts; the dynamic Line Space must be released before (both of the
+ * dragon-sized model at 72³ do not fit in 24 GB). */
 static rl_status fixed_row(const bpt *b, const struct gen_row *g, const rl_accel *grid,
-                           const rl_linespace *dyn, cJSON *row)
+                           const rl_linespace_stats *dyn, cJSON *row)
 {
-    rl_linespace_stats ds;
-    rl_linespace_get_stats(dyn, &ds);
+    const rl_linespace_stats ds = *dyn;
     int k = (int)b->a->fixed_k;
     cJSON *o = cJSON_AddObjectToObject(row, "fixed");
     if (!o)
@@ -508,7 +509,9 @@ static rl_status sec_generation(void *ctx, cJSON *sec)
             note("generation %s %d^3 N=%d: grid %.1f ms, LS %.1f ms", g->scene, g->res, g->n,
                  gs.build_ms, ls_s.build_ms);
             fflush(stdout);
-            if ((st = fixed_row(b, g, grid, ls, row)) != RL_OK) {
+            rl_linespace_release(ls);
+            ls = NULL;
+            if ((st = fixed_row(b, g, grid, &ls_s, row)) != RL_OK) {
                 const char *why = rl_last_error() && *rl_last_error() ? rl_last_error() : rl_status_string(st);
                 printf("%-26s %4d %2d  fixed lists failed: %s\n", g->scene, g->res, g->n, why);
                 any_failed = true;

@@ -23,7 +23,7 @@
  *   accumulate = true          Sec. 6.5, eq. 8
  *   filter = none, filter_fade = 16    Sec. 8.2
  *   grid_res = 0 (grid heuristic), ls_n = 5 [5], ls_k = 8, ls_dynamic = true,
- *   ls_origin = offset [offset]
+ *   ls_origin = offset [offset], ls_file = "" (Line Space cache, Sec. 13.3)
  *   shadowmap_size = 1024 [1024], light_samples = 1, threads = 0 (all)
  *
  * A frame (Sec. 5.1, Fig. 8): build what the backends need (once per
@@ -114,6 +114,9 @@ static const rl_option_info pt_options[] = {
       "PNMT/preillum rays: offset (start one voxel diagonal away, Sec. 12.1) or exact (start at the "
       "surface; the start voxel's triangles answer PNMT rays exactly)", 0, 0, ls_origin_choices },
     { "ls_dynamic", RL_OPT_BOOL, "true", "exact per-shaft candidate lists (prefix sums, Sec. 7.1.1)", 0, 0, NULL },
+    { "ls_file", RL_OPT_STRING, "",
+      "Line Space cache (Sec. 13.3): loaded if the file exists (it must match the scene, grid and "
+      "ls_* options), else built and saved there; empty = build in memory only", 0, 0, NULL },
     { "shadowmap_size", RL_OPT_INT, "1024", "texels per shadow-map face side (Sec. 8.6)", 16, 16384, NULL },
     { "light_samples", RL_OPT_INT, "1", "shadow rays per quad light and vertex", 1, 1024, NULL },
     { "background", RL_OPT_COLOR, "0,0,0",
@@ -236,6 +239,7 @@ static void read_settings(const rl_renderer *r, pt_settings *set)
     set->ls_k = (int)rl_renderer_opt_int(r, "ls_k");
     set->ls_dynamic = rl_renderer_opt_bool(r, "ls_dynamic");
     set->ls_origin_exact = rl_renderer_opt_enum(r, "ls_origin") == 1;
+    set->ls_file = rl_renderer_opt_string(r, "ls_file");
     set->shadowmap_size = (int)rl_renderer_opt_int(r, "shadowmap_size");
     set->light_samples = (int)rl_renderer_opt_int(r, "light_samples");
     set->background = rl_renderer_opt_color(r, "background");

@@ -10,6 +10,7 @@
  * Also here: the quad-light cover of emissive triangles used by the
  * emission rule (pathtrace_path.c). */
 #include <math.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -60,6 +61,75 @@ static rl_status ls_build(const rl_accel *grid, const rl_linespace_desc *desc, r
     rl_linespace_stats stats;
     rl_linespace_get_stats(ls, &stats);
     *build_ms = stats.build_ms;
+    *out = ls;
+    return RL_OK;
+}
+
+/* "N=5, dynamic lists, candidates+pnmt" for ls_cached's message. */
+static void ls_describe(char *buf, size_t size, int n, bool dynamic, int k, unsigned payloads)
+{
+    int len = dynamic ? snprintf(buf, size, "N=%d, dynamic lists, payloads", n)
+                      : snprintf(buf, size, "N=%d, fixed lists of k=%d, payloads", n, k);
+    const char *names[3] = { "candidates", "pnmt", "preillum" };
+    const unsigned bits[3] = { RL_LS_CANDIDATES, RL_LS_PNMT, RL_LS_PREILLUM };
+    char sep = ' ';
+    for (int i = 0; i < 3 && len > 0 && (size_t)len < size; ++i)
+        if (payloads & bits[i]) {
+            len += snprintf(buf + len, size - (size_t)len, "%c%s", sep, names[i]);
+            sep = '+';
+        }
+}
+
+static bool file_exists(const char *path)
+{
+    FILE *f = fopen(path, "rb");
+    if (f)
+        fclose(f);
+    return f != NULL;
+}
+
+/* The Line Space of desc through the cache file `path` (Sec. 13.3 of the
+ * thesis proposes keeping it instead of rebuilding): loaded when the file
+ * exists, which must then match the grid and the scene (rl_linespace_load
+ * checks) and desc (checked here: same N, list kind and k, and at least
+ * the payloads asked for); otherwise built and saved there. Pre-illuminated
+ * colours depend on the lights and materials, which the file's
+ * fingerprint does not cover, so they are refused rather than risked.
+ * *ms: the build or the load time. */
+static rl_status ls_cached(const rl_accel *grid, const rl_linespace_desc *desc, const char *path,
+                           rl_linespace **out, double *ms)
+{
+    *out = NULL;
+    if (desc->payloads & RL_LS_PREILLUM)
+        return rl_error(RL_ERR_INVALID_ARG, "pt: ls_file keeps geometry only (candidates, PNMT); the "
+                        "pre-illuminated colours depend on lights and materials and are rebuilt: leave "
+                        "ls_file empty with ls-preillum");
+    if (!file_exists(path)) {
+        rl_status st = ls_build(grid, desc, NULL, NULL, out, ms);
+        if (st == RL_OK && (st = rl_linespace_save(*out, path)) != RL_OK) {
+            rl_linespace_release(*out);
+            *out = NULL;
+        }
+        return st;
+    }
+    rl_timer t;
+    rl_timer_start(&t);
+    rl_linespace *ls = NULL;
+    rl_status st = rl_linespace_load(grid, path, &ls);
+    if (st != RL_OK)
+        return st;                        /* the loader's message names the file and the cause */
+    *ms = rl_timer_ms(&t);
+    rl_linespace_stats s;
+    rl_linespace_get_stats(ls, &s);
+    if (s.n != desc->n || s.dynamic != desc->dynamic || (!s.dynamic && s.k != desc->k) ||
+        (s.payloads & desc->payloads) != desc->payloads) {
+        rl_linespace_release(ls);
+        char have[96], need[96];
+        ls_describe(have, sizeof have, s.n, s.dynamic, s.k, s.payloads);
+        ls_describe(need, sizeof need, desc->n, desc->dynamic, desc->k, desc->payloads);
+        return rl_error(RL_ERR_INVALID_ARG, "pt: ls_file %s holds a Line Space with %s; these options need %s: "
+                        "delete the file or name another", path, have, need);
+    }
     *out = ls;
     return RL_OK;
 }
@@ -136,6 +206,7 @@ static rl_status build_cover(pt_backends *b, const rl_scene_data *d)
 void rl_pt_backends_release(pt_backends *b)
 {
     rl_linespace_release(b->ls);          /* before the grid it borrows */
+    free(b->ls_file);
     for (int k = 0; k < 3; ++k)
         rl_accel_release(b->exact[k]);
     rl_shadowmap_release(b->sm);
@@ -152,6 +223,8 @@ static rl_status build_exact(pt_backends *b, const rl_scene *scene, rl_accel_kin
         rl_linespace_release(b->ls);      /* it lives on the old grid */
         b->ls = NULL;
         b->ls_ms = 0.0;
+        free(b->ls_file);
+        b->ls_file = NULL;
     }
     rl_accel_release(b->exact[kind]);
     b->exact[kind] = NULL;
@@ -228,17 +301,29 @@ rl_status rl_pt_backends_prepare(pt_backends *b, const rl_scene *scene, const pt
         /* The pre-illuminated colours' shadow rays go through the BVH. */
         if ((payloads & RL_LS_PREILLUM) && (st = build_exact(b, scene, RL_ACCEL_BVH, 0, threads, built_ms)))
             return st;
+        const char *file = set->ls_file && *set->ls_file ? set->ls_file : NULL;
         bool same = b->ls && b->ls_n == set->ls_n && b->ls_k == set->ls_k && b->ls_dynamic == set->ls_dynamic &&
-                    (b->ls_payloads & payloads) == payloads;
+                    (b->ls_payloads & payloads) == payloads &&
+                    (file ? b->ls_file && strcmp(b->ls_file, file) == 0 : !b->ls_file);
         if (!same) {
             rl_linespace_release(b->ls);
             b->ls = NULL;
+            free(b->ls_file);
+            b->ls_file = NULL;
             rl_linespace_desc desc = { .n = set->ls_n, .k = set->ls_k, .dynamic = set->ls_dynamic,
                                        .payloads = payloads, .threads = threads };
             double ms = 0.0;
-            st = ls_build(b->exact[RL_ACCEL_GRID], &desc, rl_pt_preillum_shade, b, &b->ls, &ms);
-            if (st != RL_OK)
+            if (file)
+                st = ls_cached(b->exact[RL_ACCEL_GRID], &desc, file, &b->ls, &ms);
+            else
+                st = ls_build(b->exact[RL_ACCEL_GRID], &desc, rl_pt_preillum_shade, b, &b->ls, &ms);
+            if (st == RL_OK && file && !(b->ls_file = rl_strdup(file)))
+                st = RL_ERR_OUT_OF_MEMORY;
+            if (st != RL_OK) {
+                rl_linespace_release(b->ls);
+                b->ls = NULL;
                 return st;
+            }
             b->ls_n = set->ls_n;
             b->ls_k = set->ls_k;
             b->ls_dynamic = set->ls_dynamic;

@@ -38,6 +38,7 @@ typedef struct pt_settings {
     rl_filter_kind filter;
     double filter_fade;
     int grid_res, ls_n, ls_k, shadowmap_size;
+    const char *ls_file;           /* Line Space cache file; "" none (valid for one frame) */
     rl_vec3 background;            /* environment radiance of escaping rays */
 } pt_settings;
 
@@ -55,7 +56,8 @@ typedef struct pt_backends {
     int ls_n, ls_k;
     bool ls_dynamic;
     unsigned ls_payloads;
-    double ls_ms;
+    char *ls_file;                 /* the cache file the Line Space came from or went to; NULL none */
+    double ls_ms;                  /* its build, or load, time */
     float ls_offset;               /* one voxel diagonal (Sec. 12.1-12.2: "Voxel-Offset") */
     float ls_start;                /* where PNMT / preillum rays start: ls_offset,
                                     * or 0 with ls_origin=exact */

@@ -539,6 +539,172 @@ static void test_linespace_pnmt_records_decode_to_unit_normals_in_the_voxel(void
     rl_scene_release(s);
 }
 
+/* The triangles the point p lies on (within tol of the plane, inside
+ * with a barycentric margin), up to max; their count. */
+static int triangles_at(const rl_scene_data *d, rl_vec3 p, float tol, float margin, uint32_t *out, float (*bary)[2],
+                        int max)
+{
+    int n = 0;
+    for (uint32_t t = 0; t < d->num_triangles && n < max; ++t) {
+        const uint32_t *i = d->indices + 3 * (size_t)t;
+        rl_vec3 a = d->positions[i[0]], e1 = rl_sub(d->positions[i[1]], a), e2 = rl_sub(d->positions[i[2]], a);
+        rl_vec3 nn = rl_cross(e1, e2);
+        float len = rl_length(nn);
+        if (!(len > 0.0f))
+            continue;
+        rl_vec3 q = rl_sub(p, a);
+        if (fabsf(rl_dot(q, nn)) / len > tol)
+            continue;
+        /* Barycentrics of q in (e1, e2) by the normal equations. */
+        float d11 = rl_dot(e1, e1), d12 = rl_dot(e1, e2), d22 = rl_dot(e2, e2);
+        float q1 = rl_dot(q, e1), q2 = rl_dot(q, e2), det = d11 * d22 - d12 * d12;
+        float u = (d22 * q1 - d12 * q2) / det, v = (d11 * q2 - d12 * q1) / det;
+        if (u < -margin || v < -margin || u + v > 1.0f + margin)
+            continue;
+        out[n] = t;
+        bary[n][0] = u;
+        bary[n][1] = v;
+        ++n;
+    }
+    return n;
+}
+
+/* Sec. 7.4, eq. 9: a PNMT record keeps n_x, n_y and the sign of n_z (on
+ * the material field); n_z is rebuilt from them. A surface a query returns
+ * lies on the triangle its record was made from, so its rebuilt normal
+ * must be that triangle's interpolated normal there (rl_ls_surface_at,
+ * which the build uses too), up to half-float rounding, with n_z of the
+ * right sign. Points on an edge between faces of different normals are
+ * skipped (either face may have made them). The rotated boxes of `cornell`
+ * and its walls face every direction, +z and -z included. */
+static void test_linespace_pnmt_normals_rebuild_n_z_with_its_sign(void **state)
+{
+    (void)state;
+    rl_scene *s = builtin("cornell", NULL);
+    const rl_scene_data *d = rl_scene_get_data(s);
+    rl_accel *grid = accel_of(s, (rl_accel_desc){ .kind = RL_ACCEL_GRID, .grid_res = { 8, 8, 8 } });
+    rl_linespace *ls = ls_of(grid, (rl_linespace_desc){ .dynamic = true, .payloads = RL_LS_PNMT }, NULL);
+    float tol = 2e-4f * rl_vmax_comp(rl_aabb_extent(d->bounds));
+    rl_rng r;
+    rl_rng_seed(&r, 77, 1);
+    int n = 40000 / RAYS_SCALE, checked = 0, edges = 0, off = 0, plus_z = 0, minus_z = 0;
+    float worst = 1.0f;
+    for (int i = 0; i < n; ++i) {
+        rl_ray ray = { .o = random_in(&r, d->bounds), .d = random_dir(&r), .t_min = 0.0f, .t_max = INFINITY };
+        rl_ls_surface sf;
+        if (!rl_linespace_pnmt_intersect(ls, &ray, &sf))
+            continue;
+        uint32_t tris[8];
+        float bary[8][2];
+        int m = triangles_at(d, sf.p, tol, 1e-3f, tris, bary, 8);
+        if (m == 0) {
+            ++off;
+            continue;
+        }
+        rl_ls_surface on[8];
+        rl_ls_surface_at(ls, tris[0], bary[0][0], bary[0][1], &on[0]);
+        /* Near an edge (10x the tolerances) a face of another normal may
+         * have made the record, its point rounded onto this face. */
+        uint32_t near[8];
+        float nb[8][2];
+        int mn = triangles_at(d, sf.p, 10.0f * tol, 1e-2f, near, nb, 8);
+        bool unique = true;
+        for (int j = 0; j < mn; ++j) {
+            rl_ls_surface o;
+            rl_ls_surface_at(ls, near[j], nb[j][0], nb[j][1], &o);
+            unique &= rl_dot(o.n, on[0].n) > 0.999f;
+        }
+        if (!unique) {
+            ++edges;
+            continue;
+        }
+        ++checked;
+        assert_int_equal(sf.material, on[0].material);
+        float c = rl_dot(sf.n, on[0].n);
+        worst = c < worst ? c : worst;
+        if (fabsf(on[0].n.z) > 0.05f) {
+            /* The sign of n_z, which the record keeps only as the sign of
+             * its material field. */
+            assert_true((sf.n.z > 0.0f) == (on[0].n.z > 0.0f));
+            plus_z += on[0].n.z > 0.0f;
+            minus_z += on[0].n.z < 0.0f;
+        }
+    }
+    print_message("PNMT normals: %d surfaces checked, %d on edges and %d off every triangle skipped (n_z > 0: "
+                  "%d, < 0: %d); worst cos to the surface's normal %.5f\n", checked, edges, off, plus_z, minus_z,
+                  worst);
+    assert_true(checked > n / 2);
+    assert_true(off < checked / 50);      /* clamped to the voxel, or not on a surface */
+    assert_true(plus_z > 100 && minus_z > 100);
+    assert_true(worst > 0.998f);
+    rl_linespace_release(ls);
+    rl_accel_release(grid);
+    rl_scene_release(s);
+}
+
+/* Alg. 3's fixed lists: k/2 slots for the front-most candidates in front
+ * order, then k/2 for the back-most. Against the exact dynamic list of the
+ * same shaft (sorted front to back): the front half is its prefix, the
+ * back half holds distinct members of it, and a shaft with at most k/2
+ * candidates has all of them in both halves (padded with RL_NONE). */
+static void test_linespace_fixed_lists_hold_the_front_prefix_and_back_members_of_the_exact_list(void **state)
+{
+    (void)state;
+    rl_scene *s = builtin("cornell-teapot", "triangles=3000");
+    rl_accel *grid = accel_of(s, (rl_accel_desc){ .kind = RL_ACCEL_GRID, .grid_res = { 6, 6, 6 } });
+    const int k = 6, half = k / 2;
+    rl_linespace *dyn = ls_of(grid, (rl_linespace_desc){ .n = 3, .dynamic = true }, NULL);
+    rl_linespace *fix = ls_of(grid, (rl_linespace_desc){ .n = 3, .k = k }, NULL);
+    rl_linespace_data dd, fd;
+    rl_linespace_get_data(dyn, &dd);
+    rl_linespace_get_data(fix, &fd);
+    assert_int_equal(dd.num_occupied, fd.num_occupied);   /* the same shafts are occupied */
+    assert_memory_equal(dd.occupancy, fd.occupancy, 2 * (size_t)dd.num_blocks * dd.occ_words * sizeof(uint64_t));
+    uint64_t full = 0, truncated = 0;
+    for (uint64_t q = 0; q < dd.num_occupied; ++q) {
+        const uint32_t *list = dd.cand + dd.cand_start[q], *slots = fd.cand + q * (uint64_t)k;
+        uint32_t m = dd.cand_start[q + 1] - dd.cand_start[q];
+        assert_true(m >= 1);
+        uint32_t shown = m < (uint32_t)half ? m : (uint32_t)half;
+        for (uint32_t i = 0; i < (uint32_t)half; ++i)
+            assert_int_equal(slots[i], i < shown ? list[i] : RL_NONE);
+        for (uint32_t i = 0; i < (uint32_t)half; ++i) {
+            uint32_t id = slots[half + i];
+            if (i >= shown) {
+                assert_int_equal(id, RL_NONE);
+                continue;
+            }
+            bool member = false;
+            for (uint32_t j = 0; j < m; ++j)
+                member |= list[j] == id;
+            assert_true(member);
+            for (uint32_t j = 0; j < i; ++j)
+                assert_int_not_equal(slots[half + j], id);
+        }
+        if (m <= (uint32_t)half) {
+            /* All of them in the back half too (as a set). */
+            for (uint32_t j = 0; j < m; ++j) {
+                bool found = false;
+                for (int i = 0; i < half; ++i)
+                    found |= slots[half + i] == list[j];
+                assert_true(found);
+            }
+            ++full;
+        }
+        truncated += m > (uint32_t)k;
+    }
+    rl_linespace_stats fs;
+    rl_linespace_get_stats(fix, &fs);
+    assert_int_equal(fs.truncated_shafts, truncated);
+    print_message("fixed k=%d against dynamic: %llu of %llu occupied shafts fit a half, %llu truncated\n", k,
+                  (unsigned long long)full, (unsigned long long)dd.num_occupied, (unsigned long long)truncated);
+    assert_true(full > 0 && truncated > 0);
+    rl_linespace_release(fix);
+    rl_linespace_release(dyn);
+    rl_accel_release(grid);
+    rl_scene_release(s);
+}
+
 /* The occupancy bits the build sets (one per shaft with triangles) count
  * the empty shafts of the stats, every occupied shaft has a non-empty
  * payload at its rank (and there is no payload beyond them), and each
@@ -834,6 +1000,8 @@ int main(void)
         cmocka_unit_test(test_linespace_fixed_lists_report_truncation_and_return_only_true_hits),
         cmocka_unit_test(test_linespace_pnmt_and_preillum_occlusion_agree_at_the_measured_rate),
         cmocka_unit_test(test_linespace_pnmt_records_decode_to_unit_normals_in_the_voxel),
+        cmocka_unit_test(test_linespace_pnmt_normals_rebuild_n_z_with_its_sign),
+        cmocka_unit_test(test_linespace_fixed_lists_hold_the_front_prefix_and_back_members_of_the_exact_list),
         cmocka_unit_test(test_linespace_occupancy_bits_match_every_payload),
         cmocka_unit_test(test_linespace_shadow_tests_equal_the_full_queries),
         cmocka_unit_test(test_linespace_origin_rules_differ_only_in_the_start_voxel),

@@ -9,6 +9,7 @@
 #include <stdarg.h>
 #include <stddef.h>
 #include <stdint.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -106,10 +107,22 @@ static void test_approximate_backends_stay_close_to_the_exact_image(void **state
         assert_float_equal(m, m_ref, 0.2 * m_ref);
         rl_pt_stats st;
         assert_int_equal(rl_pt_get_stats(r, &st), RL_OK);
-        if (strcmp(cases[c][1], "shadowmap") == 0) {
-            assert_true(st.shadow_queries[RL_PT_BACKEND_SHADOWMAP] > 0);
+        /* The option routed the rays: the chosen structure answered that
+         * kind of query, and the other kind went elsewhere (the default,
+         * the BVH). */
+        int be = -1;
+        for (int k = 0; k < RL_PT_BACKEND_COUNT; ++k)
+            if (strcmp(rl_pt_backend_name((rl_pt_backend)k), cases[c][1]) == 0)
+                be = k;
+        assert_true(be >= 0 && be != RL_PT_BACKEND_BVH);
+        bool shadow = strcmp(cases[c][0], "shadow") == 0;
+        assert_true((shadow ? st.shadow_queries[be] : st.trace_queries[be]) > 0);
+        assert_int_equal(shadow ? st.trace_queries[be] : st.shadow_queries[be], 0);
+        assert_true((shadow ? st.trace_queries[RL_PT_BACKEND_BVH] : st.shadow_queries[RL_PT_BACKEND_BVH]) > 0);
+        if (be == RL_PT_BACKEND_SHADOWMAP)
             assert_true(st.build_shadowmap_ms > 0.0);
-        }
+        if (be == RL_PT_BACKEND_LS_CANDIDATES || be == RL_PT_BACKEND_LS_PNMT || be == RL_PT_BACKEND_LS_PREILLUM)
+            assert_true(st.build_linespace_ms > 0.0);
         if (strcmp(cases[c][0], "diffuse") == 0 && strcmp(cases[c][1], "ls-preillum") == 0)
             assert_true(st.preillum_ends > 0);
         rl_image_release(img);
@@ -117,6 +130,67 @@ static void test_approximate_backends_stay_close_to_the_exact_image(void **state
     }
     rl_image_release(ref);
     rl_scene_release(s);
+}
+
+static rl_status render_status(rl_renderer *r, const rl_scene *s, const rl_camera *cam)
+{
+    rl_image *img = NULL;
+    assert_int_equal(rl_image_create(cam->width, cam->height, RL_LAYER_COLOR, &img), RL_OK);
+    rl_clear_error();                     /* the message kept is the first one */
+    rl_status st = rl_renderer_render(r, s, cam, img, NULL);
+    rl_image_release(img);
+    return st;
+}
+
+/* ls_file (the thesis' Sec. 13.3: keep the Line Space instead of
+ * rebuilding it): the first renderer builds and saves it, a second one
+ * loads it and renders the same image; a file made with other ls_*
+ * options, another grid or holding no pre-illuminated colours is refused
+ * with a message, never used. */
+static void test_ls_file_saves_then_loads_the_same_line_space(void **state)
+{
+    (void)state;
+    rl_camera cam;
+    rl_scene *s = fx_cornell(&cam, SIZE);
+    const char *dir = getenv("RL_TEST_TMP");
+    char path[1024];
+    snprintf(path, sizeof path, "%s/pt_ls_file.rlls", dir ? dir : "/tmp");
+    remove(path);
+    const char *const opts[] = { "spp", "4", "shadow", "ls-pnmt", "diffuse", "ls-candidates", "ls_n", "3",
+                                 "grid_res", "6", "ls_file", path, NULL };
+    rl_renderer *first = fx_make("pt", opts);
+    rl_image *a = fx_render_with(first, s, &cam, RL_LAYER_COLOR, NULL);
+    FILE *f = fopen(path, "rb");
+    assert_non_null(f);
+    fclose(f);
+    rl_renderer *second = fx_make("pt", opts);
+    rl_image *b = fx_render_with(second, s, &cam, RL_LAYER_COLOR, NULL);
+    fx_assert_images_identical(a, b);
+    rl_pt_stats st;
+    assert_int_equal(rl_pt_get_stats(second, &st), RL_OK);
+    assert_true(st.shadow_queries[RL_PT_BACKEND_LS_PNMT] > 0 && st.trace_queries[RL_PT_BACKEND_LS_CANDIDATES] > 0);
+
+    /* Other options than the file's: refused, and the file is kept. */
+    assert_int_equal(rl_renderer_set(second, "ls_n", "4"), RL_OK);
+    assert_int_equal(render_status(second, s, &cam), RL_ERR_INVALID_ARG);
+    assert_non_null(strstr(rl_last_error(), "N=3"));
+    assert_int_equal(rl_renderer_set(second, "ls_n", "3"), RL_OK);
+    assert_int_equal(rl_renderer_set(second, "grid_res", "5"), RL_OK);
+    assert_int_equal(render_status(second, s, &cam), RL_ERR_INVALID_ARG);   /* another grid */
+    assert_int_equal(rl_renderer_set(second, "grid_res", "6"), RL_OK);
+    assert_int_equal(rl_renderer_set(second, "diffuse", "ls-preillum"), RL_OK);
+    assert_int_equal(render_status(second, s, &cam), RL_ERR_INVALID_ARG);
+    assert_non_null(strstr(rl_last_error(), "ls-preillum"));
+    /* Back to the file's options: it loads again. */
+    assert_int_equal(rl_renderer_set(second, "diffuse", "ls-candidates"), RL_OK);
+    assert_int_equal(render_status(second, s, &cam), RL_OK);
+
+    rl_image_release(b);
+    rl_image_release(a);
+    rl_renderer_release(second);
+    rl_renderer_release(first);
+    rl_scene_release(s);
+    remove(path);
 }
 
 /* Sec. 8.2: the filtered image enters with weight 1 / (1 + spp / fade). */
@@ -178,6 +252,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_dynamic_line_space_candidates_reproduce_the_bvh_image),
         cmocka_unit_test(test_approximate_backends_stay_close_to_the_exact_image),
+        cmocka_unit_test(test_ls_file_saves_then_loads_the_same_line_space),
         cmocka_unit_test(test_filter_is_applied_and_fades_with_the_samples),
         cmocka_unit_test(test_edge_stopping_filters_remove_most_of_the_1spp_noise),
     };
