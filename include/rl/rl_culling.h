@@ -1,5 +1,5 @@
 /* rl_culling.h: statistics of the visibility-culling renderers (chcpp,
- * svs, visset) and of the level-of-detail renderer surfels, for the last
+ * svs, visset, select) and of the level-of-detail renderer surfels, for the last
  * frame they rendered. The generic rl_render_stats carry the triangles
  * rasterized and the occlusion queries; these add what the algorithms
  * decide per node. */
@@ -27,6 +27,8 @@ typedef struct rl_culling_stats {
     uint64_t points_drawn;            /* surfels */
     uint32_t surfel_nodes;            /* nodes drawn (partly) as surfels */
     double preprocess_ms;             /* building what the frame needed first (octree, surfels, visibility) */
+    uint32_t selected;                /* select: 1 = its first, 2 = its second renderer drew the frame
+                                       * (the other fields are that renderer's); 0 for the others */
 } rl_culling_stats;
 
 /* RL_ERR_INVALID_ARG when r is not one of these renderers or has rendered

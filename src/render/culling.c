@@ -180,13 +180,13 @@ void rl_octree_cache_release(rl_octree_cache *c)
 
 rl_status rl_culling_get_stats(const rl_renderer *r, rl_culling_stats *out)
 {
-    static const char *const names[] = { "chcpp", "svs", "visset", "surfels" };
+    static const char *const names[] = { "chcpp", "svs", "visset", "surfels", "select" };
     bool known = false;
     for (size_t i = 0; r && i < sizeof names / sizeof names[0]; ++i)
         known |= strcmp(rl_renderer_name(r), names[i]) == 0;
     if (!known || !out)
         return rl_error(RL_ERR_INVALID_ARG,
-                        "rl_culling_get_stats: needs a chcpp, svs, visset or surfels renderer and out");
+                        "rl_culling_get_stats: needs a chcpp, svs, visset, surfels or select renderer and out");
     const rl_culling_head *h = rl_renderer_state(r);
     if (!h || !h->have_frame)
         return rl_error(RL_ERR_INVALID_ARG, "rl_culling_get_stats: no frame rendered yet");

@@ -13,6 +13,7 @@ extern const rl_renderer_class rl_chcpp_renderer_class;      /* chcpp.c */
 extern const rl_renderer_class rl_svs_renderer_class;        /* svs.c */
 extern const rl_renderer_class rl_visset_renderer_class;     /* visset.c */
 extern const rl_renderer_class rl_surfels_renderer_class;    /* surfels.c */
+extern const rl_renderer_class rl_select_renderer_class;     /* select.c */
 
 const rl_renderer_class *const rl_renderer_classes[] = {
     &rl_raster_renderer_class,
@@ -23,5 +24,6 @@ const rl_renderer_class *const rl_renderer_classes[] = {
     &rl_svs_renderer_class,
     &rl_visset_renderer_class,
     &rl_surfels_renderer_class,
+    &rl_select_renderer_class,
 };
 const size_t rl_renderer_class_count = sizeof rl_renderer_classes / sizeof rl_renderer_classes[0];

@@ -1,0 +1,308 @@
+/* select.c: renderer "select", the runtime selection of a culling method
+ * per position (Jähn 2015, Sec. 7.5): two renderers (default chcpp and
+ * svs) and a sampled position-dependent property that predicts, at the
+ * viewer's position, which of them to use for the frame.
+ *
+ * Rules:
+ *   time       (default) the renderer whose sampled time property is lower
+ *              there: the thesis' "hardware-dependent" variant, which needs
+ *              the time of both measured on the target machine. The two
+ *              approximations come from `rl eval --property time` (options
+ *              first_time, second_time = their approx.json), or are sampled
+ *              on the first frame over the scene (a 2-D slice at `height`
+ *              above the floor, or the 3-D bounds) with `samples` samples
+ *              of `resolution`² pixels per direction, conditioned.
+ *   threshold  the thesis' rule: `first` where the sampled property in
+ *              `property` (an approx.json, e.g. the polygons in visible
+ *              objects, `rl eval --property visibility --set
+ *              measure=polygons`) is below `threshold`, else `second`.
+ * Where the viewer is outside a sampled region, `first` draws (the
+ * conservative choice with the defaults).
+ *
+ * The chosen renderer draws the whole frame with the shared raster options
+ * forwarded; both are kept between frames, so CHC++ keeps its temporal
+ * coherence across frames that SVS drew. rl_culling_get_stats returns the
+ * drawing renderer's statistics with `selected` set. */
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "core/error.h"
+#include "render/culling.h"
+#include "render/renderer.h"
+#include "rl/rl_property.h"
+#include "rl/rl_sampling.h"
+#include "rl/rl_timer.h"
+
+#define NAME_MAX_LEN 64
+#define PATH_MAX_LEN 512
+
+static const char *const rule_choices[] = { "time", "threshold", NULL };
+enum { RULE_TIME, RULE_THRESHOLD };
+
+/* The options forwarded to both renderers (RL_CULL_RASTER_OPTIONS). */
+static const char *const forwarded[] = { "shading", "cull", "ambient", "background", "threads" };
+
+static const rl_option_info select_options[] = {
+    RL_CULL_RASTER_OPTIONS,
+    { "first", RL_OPT_STRING, "chcpp", "renderer drawn where the rule picks it, and outside the sampled region",
+      0, 0, NULL },
+    { "second", RL_OPT_STRING, "svs", "the other renderer", 0, 0, NULL },
+    { "rule", RL_OPT_ENUM, "time",
+      "time: the one with the lower sampled time property; threshold: first where `property` < threshold",
+      0, 0, rule_choices },
+    { "first_time", RL_OPT_STRING, "", "rule=time: approx.json of first's time property (rl eval); empty: sampled here",
+      0, 0, NULL },
+    { "second_time", RL_OPT_STRING, "", "rule=time: approx.json of second's time property; empty: sampled here",
+      0, 0, NULL },
+    { "property", RL_OPT_STRING, "", "rule=threshold: approx.json of a scalar property (required)", 0, 0, NULL },
+    { "threshold", RL_OPT_FLOAT, "0", "rule=threshold: first where the property is below this", -1e300, 1e300, NULL },
+    { "samples", RL_OPT_INT, "16", "samples per time property when sampled here", 1, 1 << 20, NULL },
+    { "dims", RL_OPT_INT, "2", "sampled here: 2 = a horizontal slice at `height`, 3 = the scene's bounds", 2, 3,
+      NULL },
+    { "height", RL_OPT_FLOAT, "1.7", "slice height above the scene's lowest point (dims 2)", -1e6, 1e6, NULL },
+    { "resolution", RL_OPT_INT, "64", "sampled here: pixels per side of each of the 6 directions", 8, 4096, NULL },
+    { "seed", RL_OPT_INT, "1", "sampling seed", 0, 4294967295.0, NULL },
+};
+
+typedef struct select_key {
+    char names[2][NAME_MAX_LEN];
+    int rule;
+    char paths[2][PATH_MAX_LEN];  /* time: first_time, second_time; threshold: property, "" */
+    uint32_t samples, resolution;
+    int dims;
+    float height;
+    uint64_t seed, scene_uid;
+} select_key;
+
+typedef struct select_state {
+    rl_culling_head head;         /* first: rl_culling_get_stats */
+    select_key key;
+    bool prepared;
+    rl_renderer *child[2];
+    char child_name[2][NAME_MAX_LEN];
+    rl_approx *approx[2];         /* time: both; threshold: [0] */
+} select_state;
+
+static rl_status select_create(void **state)
+{
+    select_state *s = rl_calloc(1, sizeof *s);
+    if (!s)
+        return RL_ERR_OUT_OF_MEMORY;
+    *state = s;
+    return RL_OK;
+}
+
+static void drop_approx(select_state *s)
+{
+    for (int i = 0; i < 2; ++i) {
+        rl_approx_release(s->approx[i]);
+        s->approx[i] = NULL;
+    }
+    s->prepared = false;
+}
+
+static void select_release(void *state)
+{
+    select_state *s = state;
+    if (!s)
+        return;
+    drop_approx(s);
+    for (int i = 0; i < 2; ++i)
+        rl_renderer_release(s->child[i]);
+    free(s);
+}
+
+static void select_reset(void *state)
+{
+    select_state *s = state;
+    for (int i = 0; i < 2; ++i)
+        if (s->child[i])
+            rl_renderer_reset(s->child[i]);
+}
+
+static rl_status copy_text(char *dst, size_t size, const char *src, const char *what)
+{
+    if (strlen(src) >= size)
+        return rl_error(RL_ERR_INVALID_ARG, "select: %s longer than %zu characters", what, size - 1);
+    strcpy(dst, src);
+    return RL_OK;
+}
+
+/* The two renderers, created when their names change; the shared raster
+ * options forwarded every frame. */
+static rl_status prepare_children(select_state *s, rl_renderer *r)
+{
+    const char *keys[2] = { "first", "second" };
+    for (int i = 0; i < 2; ++i) {
+        const char *name = rl_renderer_opt_string(r, keys[i]);
+        if (strcmp(name, "select") == 0)
+            return rl_error(RL_ERR_INVALID_ARG, "select: %s=select would select itself", keys[i]);
+        if (!s->child[i] || strcmp(s->child_name[i], name) != 0) {
+            rl_renderer_release(s->child[i]);
+            s->child[i] = NULL;
+            s->child_name[i][0] = '\0';
+            rl_status st = copy_text(s->child_name[i], sizeof s->child_name[i], name, keys[i]);
+            if (st == RL_OK)
+                st = rl_renderer_create(name, &s->child[i]);   /* names an unknown renderer */
+            if (st != RL_OK) {
+                s->child_name[i][0] = '\0';
+                return st;
+            }
+        }
+        /* Culling renderers have them all; another renderer must too. */
+        for (size_t k = 0; k < sizeof forwarded / sizeof forwarded[0]; ++k) {
+            rl_status st = rl_renderer_set(s->child[i], forwarded[k], rl_renderer_get(r, forwarded[k]));
+            if (st != RL_OK)
+                return st;
+        }
+    }
+    return RL_OK;
+}
+
+/* Sec. 4.2.3: the conditioned time property of renderer `name`, sampled
+ * over the scene as visset samples visibility. */
+static rl_status sample_time(const rl_scene *scene, const rl_scene_data *d, const select_key *k, const char *name,
+                             rl_approx **out)
+{
+    rl_property *p = NULL;
+    char res[32];
+    snprintf(res, sizeof res, "%u", k->resolution);
+    rl_status st = rl_property_create("time", &p);
+    if (st == RL_OK) st = rl_property_set(p, "renderer", name);
+    if (st == RL_OK) st = rl_property_set(p, "width", res);
+    if (st == RL_OK) st = rl_property_set(p, "height", res);
+    if (st == RL_OK) st = rl_property_set(p, "repeats", "3");
+    if (st == RL_OK) st = rl_property_set(p, "conditioned", "true");
+    if (st == RL_OK) st = rl_property_commit(p, scene, 0);
+    rl_sampling_desc sd = { .region = d->bounds, .dims = k->dims, .max_samples = k->samples, .seed = k->seed };
+    sd.height = d->bounds.min.y + k->height;
+    if (st == RL_OK)
+        st = rl_sample_property(p, &sd, out);
+    rl_property_release(p);
+    return st;
+}
+
+
+/* The approximations the rule reads, loaded or sampled when the options
+ * or the scene change. */
+static rl_status prepare(select_state *s, rl_renderer *r, const rl_scene *scene, const rl_scene_data *d)
+{
+    select_key k;
+    memset(&k, 0, sizeof k);
+    rl_status st = RL_OK;
+    memcpy(k.names, s->child_name, sizeof k.names);
+    k.rule = rl_renderer_opt_enum(r, "rule");
+    if (k.rule == RULE_TIME) {
+        st = copy_text(k.paths[0], PATH_MAX_LEN, rl_renderer_opt_string(r, "first_time"), "first_time");
+        if (st == RL_OK)
+            st = copy_text(k.paths[1], PATH_MAX_LEN, rl_renderer_opt_string(r, "second_time"), "second_time");
+    } else {
+        st = copy_text(k.paths[0], PATH_MAX_LEN, rl_renderer_opt_string(r, "property"), "property");
+        if (st == RL_OK && !k.paths[0][0])
+            st = rl_error(RL_ERR_INVALID_ARG, "select: rule=threshold needs property=FILE (approx.json of "
+                                              "rl eval, e.g. --property visibility --set measure=polygons)");
+    }
+    if (st != RL_OK)
+        return st;
+    k.samples = (uint32_t)rl_renderer_opt_int(r, "samples");
+    k.resolution = (uint32_t)rl_renderer_opt_int(r, "resolution");
+    k.dims = (int)rl_renderer_opt_int(r, "dims");
+    k.height = (float)rl_renderer_opt_float(r, "height");
+    k.seed = (uint64_t)rl_renderer_opt_int(r, "seed");
+    k.scene_uid = rl_scene_uid(scene);
+    if (s->prepared && memcmp(&k, &s->key, sizeof k) == 0)
+        return RL_OK;
+
+    drop_approx(s);
+    rl_timer t;
+    rl_timer_start(&t);
+    if (k.rule == RULE_THRESHOLD) {
+        st = rl_approx_load_json(k.paths[0], &s->approx[0]);   /* its message names the file */
+    } else {
+        for (int i = 0; i < 2 && st == RL_OK; ++i)
+            st = k.paths[i][0] ? rl_approx_load_json(k.paths[i], &s->approx[i])
+                               : sample_time(scene, d, &k, k.names[i], &s->approx[i]);
+        /* A time read from a file must be a time (of any renderer: the
+         * file does not say which). */
+        for (int i = 0; i < 2 && st == RL_OK; ++i)
+            if (k.paths[i][0] && strcmp(rl_approx_property(s->approx[i]), "time") != 0)
+                st = rl_error(RL_ERR_INVALID_ARG, "select: %s holds the property '%s', not time", k.paths[i],
+                              rl_approx_property(s->approx[i]));
+    }
+    if (st != RL_OK) {
+        drop_approx(s);
+        return st;
+    }
+    s->key = k;
+    s->prepared = true;
+    s->head.stats.preprocess_ms = rl_timer_ms(&t);
+    return RL_OK;
+}
+
+/* The approximation's value at the eye; false outside its region (2-D:
+ * its x-z extent). */
+static bool value_at(const rl_approx *a, rl_vec3 eye, double *value)
+{
+    rl_aabb b = rl_approx_bounds(a);
+    bool inside = eye.x >= b.min.x && eye.x <= b.max.x && eye.z >= b.min.z && eye.z <= b.max.z &&
+                  (rl_approx_dims(a) == 2 || (eye.y >= b.min.y && eye.y <= b.max.y));
+    return inside && rl_approx_query(a, eye, value, NULL) == RL_OK;
+}
+
+static rl_status select_render(rl_renderer *r, void *state, const rl_scene *scene, const rl_camera *cam,
+                               rl_image *image, rl_render_stats *stats)
+{
+    select_state *s = state;
+    const rl_scene_data *d = rl_scene_get_data(scene);
+    if (!d)
+        return RL_ERR_NOT_COMMITTED;
+    s->head.have_frame = false;
+    double pre = s->head.stats.preprocess_ms;
+    memset(&s->head.stats, 0, sizeof s->head.stats);
+    s->head.stats.preprocess_ms = pre;
+    rl_status st = prepare_children(s, r);
+    if (st == RL_OK) {
+        bool again = s->prepared;
+        st = prepare(s, r, scene, d);
+        if (again && s->prepared)
+            s->head.stats.preprocess_ms = 0.0;    /* nothing prepared this frame */
+    }
+    if (st != RL_OK)
+        return st;
+
+    int pick = 0;
+    double v0, v1;
+    if (s->key.rule == RULE_THRESHOLD) {
+        if (value_at(s->approx[0], cam->eye, &v0))
+            pick = v0 < rl_renderer_opt_float(r, "threshold") ? 0 : 1;
+    } else if (value_at(s->approx[0], cam->eye, &v0) && value_at(s->approx[1], cam->eye, &v1)) {
+        pick = v1 < v0 ? 1 : 0;
+    }
+    double pre_ms = s->head.stats.preprocess_ms;
+    st = rl_renderer_render(s->child[pick], scene, cam, image, stats);
+    if (st != RL_OK)
+        return st;
+    rl_culling_stats cs;
+    if (rl_culling_get_stats(s->child[pick], &cs) == RL_OK)
+        s->head.stats = cs;
+    else
+        rl_clear_error();                 /* not a culling renderer: its rl_render_stats only */
+    s->head.stats.preprocess_ms += pre_ms;
+    s->head.stats.selected = (uint32_t)pick + 1;
+    s->head.have_frame = true;
+    return RL_OK;
+}
+
+const rl_renderer_class rl_select_renderer_class = {
+    .info = { "select", "Runtime selection per position of one of two culling renderers (default chcpp or "
+                        "svs) from sampled properties",
+              "Jähn 2015, Sec. 7.5" },
+    .options = select_options,
+    .num_options = sizeof select_options / sizeof select_options[0],
+    .create = select_create,
+    .render = select_render,
+    .release = select_release,
+    .check = NULL,
+    .reset = select_reset,
+};
