@@ -642,6 +642,78 @@ static void test_linespace_pnmt_normals_rebuild_n_z_with_its_sign(void **state)
     rl_scene_release(s);
 }
 
+/* Sec. 7.4 / Alg. 3: a shaft's front PNMT record is the first surface its
+ * midpoint ray (patch centre A to patch centre B, A on the lower face)
+ * hits, the back record the first the reversed ray hits. Any triangle the
+ * segment A-B meets lies in the shaft, so the BVH's closest hits on the
+ * segment, both ways, must be where the records say (up to half-float
+ * rounding of the voxel-relative position). Shafts whose midpoint ray
+ * meets nothing (the records then take the nearest candidate, our
+ * fallback) or only at an end point are skipped. */
+static void test_linespace_pnmt_records_are_the_midpoint_rays_first_hits(void **state)
+{
+    (void)state;
+    rl_scene *s = builtin("cornell-teapot", "triangles=2000");
+    rl_accel *bvh = accel_of(s, (rl_accel_desc){ .kind = RL_ACCEL_BVH });
+    rl_accel *grid = accel_of(s, (rl_accel_desc){ .kind = RL_ACCEL_GRID, .grid_res = { 4, 4, 4 } });
+    rl_linespace *ls = ls_of(grid, (rl_linespace_desc){ .n = 3, .dynamic = true, .payloads = RL_LS_PNMT }, NULL);
+    const rl_grid *g = ls->grid;
+    const int n = ls->n;
+    uint64_t compared = 0, agree = 0, skipped = 0;
+    for (int z = 0; z < g->res[2]; ++z)
+        for (int y = 0; y < g->res[1]; ++y)
+            for (int x = 0; x < g->res[0]; ++x) {
+                uint32_t block = ls->voxel_slot[rl_grid_cell_index(g, x, y, z)];
+                if (block == RL_NONE)
+                    continue;
+                rl_aabb box = rl_grid_cell_bounds(g, x, y, z);
+                rl_vec3 ext = rl_aabb_extent(box);
+                for (uint32_t sh = 0; sh < ls->shafts_per_voxel; ++sh) {
+                    if (!rl_ls_shaft_occupied(ls, block, sh))
+                        continue;
+                    int f[2], p[2];
+                    rl_ls_shaft_decode(n, sh, &f[0], &p[0], &f[1], &p[1]);
+                    rl_vec3 end[2];
+                    for (int e = 0; e < 2; ++e) {
+                        int u, v;
+                        rl_ls_face_uv(f[e], &u, &v);
+                        float c[3];
+                        c[f[e] >> 1] = (float)(f[e] & 1);
+                        c[u] = ((float)(p[e] % n) + 0.5f) / (float)n;
+                        c[v] = ((float)(p[e] / n) + 0.5f) / (float)n;
+                        end[e] = rl_add(box.min, rl_mul(rl_v3(c[0], c[1], c[2]), ext));
+                    }
+                    const uint16_t *rec = ls->pnmt + rl_ls_shaft_rank(ls, block, sh) * 16;
+                    for (int side = 0; side < 2; ++side) {
+                        rl_vec3 a = end[side], b = end[1 - side];
+                        rl_ray ray = { .o = a, .d = rl_sub(b, a), .t_min = 0.0f, .t_max = 1.0f };
+                        rl_hit h;
+                        if (!rl_accel_intersect(bvh, &ray, &h) || h.t < 1e-3f || h.t > 1.0f - 1e-3f) {
+                            ++skipped;
+                            continue;
+                        }
+                        rl_vec3 hit = rl_ray_at(&ray, h.t);
+                        const uint16_t *r = rec + side * RL_LS_PNMT_RECORD;
+                        rl_vec3 stored = rl_add(box.min, rl_mul(rl_v3(rl_half_to_float(r[RL_LS_PNMT_PX]),
+                                                                      rl_half_to_float(r[RL_LS_PNMT_PY]),
+                                                                      rl_half_to_float(r[RL_LS_PNMT_PZ])),
+                                                                ext));
+                        ++compared;
+                        agree += rl_length(rl_sub(stored, hit)) <= 2e-3f * rl_length(ext);
+                    }
+                }
+            }
+    print_message("PNMT records against the midpoint rays' first hits: %llu of %llu agree (%llu sides "
+                  "without an inner hit skipped)\n", (unsigned long long)agree, (unsigned long long)compared,
+                  (unsigned long long)skipped);
+    assert_true(compared > 5000);
+    assert_true(agree == compared);
+    rl_linespace_release(ls);
+    rl_accel_release(grid);
+    rl_accel_release(bvh);
+    rl_scene_release(s);
+}
+
 /* Alg. 3's fixed lists: k/2 slots for the front-most candidates in front
  * order, then k/2 for the back-most. Against the exact dynamic list of the
  * same shaft (sorted front to back): the front half is its prefix, the
@@ -1001,6 +1073,7 @@ int main(void)
         cmocka_unit_test(test_linespace_pnmt_and_preillum_occlusion_agree_at_the_measured_rate),
         cmocka_unit_test(test_linespace_pnmt_records_decode_to_unit_normals_in_the_voxel),
         cmocka_unit_test(test_linespace_pnmt_normals_rebuild_n_z_with_its_sign),
+        cmocka_unit_test(test_linespace_pnmt_records_are_the_midpoint_rays_first_hits),
         cmocka_unit_test(test_linespace_fixed_lists_hold_the_front_prefix_and_back_members_of_the_exact_list),
         cmocka_unit_test(test_linespace_occupancy_bits_match_every_payload),
         cmocka_unit_test(test_linespace_shadow_tests_equal_the_full_queries),
