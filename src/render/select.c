@@ -11,7 +11,8 @@
  *              first_time, second_time = their approx.json), or are sampled
  *              on the first frame over the scene (a 2-D slice at `height`
  *              above the floor, or the 3-D bounds) with `samples` samples
- *              of `resolution`² pixels per direction, conditioned.
+ *              of `resolution`² pixels per direction, conditioned by 2
+ *              frames and measured once (coarse: a first look).
  *   threshold  the thesis' rule: `first` where the sampled property in
  *              `property` (an approx.json, e.g. the polygons in visible
  *              objects, `rl eval --property visibility --set
@@ -57,11 +58,11 @@ static const rl_option_info select_options[] = {
       0, 0, NULL },
     { "property", RL_OPT_STRING, "", "rule=threshold: approx.json of a scalar property (required)", 0, 0, NULL },
     { "threshold", RL_OPT_FLOAT, "0", "rule=threshold: first where the property is below this", -1e300, 1e300, NULL },
-    { "samples", RL_OPT_INT, "16", "samples per time property when sampled here", 1, 1 << 20, NULL },
+    { "samples", RL_OPT_INT, "8", "samples per time property when sampled here (a coarse default: give files from rl eval for a real selection)", 1, 1 << 20, NULL },
     { "dims", RL_OPT_INT, "2", "sampled here: 2 = a horizontal slice at `height`, 3 = the scene's bounds", 2, 3,
       NULL },
     { "height", RL_OPT_FLOAT, "1.7", "slice height above the scene's lowest point (dims 2)", -1e6, 1e6, NULL },
-    { "resolution", RL_OPT_INT, "64", "sampled here: pixels per side of each of the 6 directions", 8, 4096, NULL },
+    { "resolution", RL_OPT_INT, "32", "sampled here: pixels per side of each of the 6 directions", 8, 4096, NULL },
     { "seed", RL_OPT_INT, "1", "sampling seed", 0, 4294967295.0, NULL },
 };
 
@@ -172,8 +173,11 @@ static rl_status sample_time(const rl_scene *scene, const rl_scene_data *d, cons
     if (st == RL_OK) st = rl_property_set(p, "renderer", name);
     if (st == RL_OK) st = rl_property_set(p, "width", res);
     if (st == RL_OK) st = rl_property_set(p, "height", res);
-    if (st == RL_OK) st = rl_property_set(p, "repeats", "3");
+    /* Coarse and quick (a default for a first look; rl eval's files are
+     * the real measurement): 2 unmeasured frames, then 1 measured. */
+    if (st == RL_OK) st = rl_property_set(p, "repeats", "1");
     if (st == RL_OK) st = rl_property_set(p, "conditioned", "true");
+    if (st == RL_OK) st = rl_property_set(p, "condition_frames", "2");
     if (st == RL_OK) st = rl_property_commit(p, scene, 0);
     rl_sampling_desc sd = { .region = d->bounds, .dims = k->dims, .max_samples = k->samples, .seed = k->seed };
     sd.height = d->bounds.min.y + k->height;
