@@ -60,7 +60,8 @@ typedef struct rl_pt_stats {
     double time_build_ms;         /* structures built during this frame */
     double time_total_ms;         /* the whole render() call */
     /* Build times of the structures in use, whenever they were built
-     * (they are kept between frames); 0 for one not in use. */
+     * (they are kept between frames); 0 for one not in use. With ls_file
+     * the Line Space's is its load time when the file was loaded. */
     double build_bvh_ms, build_grid_ms, build_embree_ms, build_linespace_ms, build_shadowmap_ms;
     rl_rng_gpu_kind rng;
     float filter_weight;          /* weight of the filtered image in the output */

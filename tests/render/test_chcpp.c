@@ -116,6 +116,56 @@ static void test_chcpp_culls_at_street_level(void **state)
     rl_scene_release(s);
 }
 
+/* Sums of a street walk's culling statistics (frames after the first). */
+typedef struct walk_sums {
+    uint64_t queries, multiqueries, occluded, triangles;
+} walk_sums;
+
+static walk_sums street_walk(const rl_scene *s, const char *const *opts)
+{
+    rl_renderer *chc = fx_make("chcpp", opts);
+    walk_sums w = { 0 };
+    for (int f = 0; f < 12; ++f) {
+        rl_camera cam = street_camera(0.5f * (float)f);
+        rl_image *img = fx_render_with(chc, s, &cam, RL_LAYER_COLOR, NULL);
+        rl_culling_stats cs;
+        assert_int_equal(rl_culling_get_stats(chc, &cs), RL_OK);
+        if (f > 0) {
+            w.queries += cs.queries;
+            w.multiqueries += cs.multiqueries;
+            w.occluded += cs.nodes_occluded;
+            w.triangles += cs.triangles_drawn;
+        }
+        rl_image_release(img);
+    }
+    rl_renderer_release(chc);
+    return w;
+}
+
+/* CHC++'s additions are in use and do what they are for (Mattausch et al.
+ * 2008, Sec. 4): multi-queries answer batches of previously invisible
+ * nodes with fewer queries, and the tight bounds of a node's objects find
+ * at least as much occluded as its loose box. */
+static void test_chcpp_multiqueries_and_tight_bounds_are_used(void **state)
+{
+    (void)state;
+    rl_scene *s = fx_box_city();
+    walk_sums def = street_walk(s, NULL);
+    walk_sums single = street_walk(s, (const char *const[]){ "multiquery", "false", NULL });
+    walk_sums loose = street_walk(s, (const char *const[]){ "tight", "false", NULL });
+    print_message("street walk: default %llu queries (%llu multi), %llu occluded, %llu triangles; without "
+                  "multi-queries %llu queries; loose boxes %llu occluded, %llu triangles\n",
+                  (unsigned long long)def.queries, (unsigned long long)def.multiqueries,
+                  (unsigned long long)def.occluded, (unsigned long long)def.triangles,
+                  (unsigned long long)single.queries, (unsigned long long)loose.occluded,
+                  (unsigned long long)loose.triangles);
+    assert_true(def.multiqueries > 0);
+    assert_int_equal(single.multiqueries, 0);
+    assert_true(single.queries > def.queries);
+    assert_true(loose.triangles >= def.triangles);
+    rl_scene_release(s);
+}
+
 static void test_chcpp_refuses_bad_options(void **state)
 {
     (void)state;
@@ -138,6 +188,7 @@ int main(void)
         cmocka_unit_test(test_chcpp_equals_raster_on_random_walks),
         cmocka_unit_test(test_chcpp_variants_stay_conservative),
         cmocka_unit_test(test_chcpp_culls_at_street_level),
+        cmocka_unit_test(test_chcpp_multiqueries_and_tight_bounds_are_used),
         cmocka_unit_test(test_chcpp_refuses_bad_options),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
