@@ -242,3 +242,10 @@ rl_status rl_cull_frame_end(rl_cull_frame *f, rl_status st, const rl_image *imag
     }
     return st;
 }
+
+bool rl_cull_approx_covers(const rl_approx *a, rl_vec3 eye)
+{
+    rl_aabb b = rl_approx_bounds(a);
+    return eye.x >= b.min.x && eye.x <= b.max.x && eye.z >= b.min.z && eye.z <= b.max.z &&
+           (rl_approx_dims(a) == 2 || (eye.y >= b.min.y && eye.y <= b.max.y));
+}

@@ -10,6 +10,7 @@
 #include "rl/rl_culling.h"
 #include "rl/rl_octree.h"
 #include "rl/rl_raster.h"
+#include "rl/rl_sampling.h"
 #include "rl/rl_scene.h"
 
 /* One frame's camera, exactly as rl_raster_set_camera() sets it up. */
@@ -109,5 +110,10 @@ typedef struct rl_culling_head {
     bool have_frame;
     rl_drawer_keep keep;          /* released by the renderer's release */
 } rl_culling_head;
+
+/* Whether a sampled approximation (visset's sets, select's properties)
+ * covers the viewer at eye: inside its bounds, for a 2-D slice inside its
+ * x-z extent at any height. Renderers fall back to a default outside. */
+bool rl_cull_approx_covers(const rl_approx *a, rl_vec3 eye);
 
 #endif

@@ -244,14 +244,10 @@ static rl_status prepare(select_state *s, rl_renderer *r, const rl_scene *scene,
     return RL_OK;
 }
 
-/* The approximation's value at the eye; false outside its region (2-D:
- * its x-z extent). */
+/* The approximation's value at the eye; false outside its region. */
 static bool value_at(const rl_approx *a, rl_vec3 eye, double *value)
 {
-    rl_aabb b = rl_approx_bounds(a);
-    bool inside = eye.x >= b.min.x && eye.x <= b.max.x && eye.z >= b.min.z && eye.z <= b.max.z &&
-                  (rl_approx_dims(a) == 2 || (eye.y >= b.min.y && eye.y <= b.max.y));
-    return inside && rl_approx_query(a, eye, value, NULL) == RL_OK;
+    return rl_cull_approx_covers(a, eye) && rl_approx_query(a, eye, value, NULL) == RL_OK;
 }
 
 static rl_status select_render(rl_renderer *r, void *state, const rl_scene *scene, const rl_camera *cam,

@@ -291,10 +291,8 @@ static rl_status visset_render(rl_renderer *r, void *state, const rl_scene *scen
     }
     /* Inside the sampled region (2-D: its x-z extent)? Checked here so that
      * a viewer outside raises no error. */
-    rl_aabb rb = rl_approx_bounds(s->approx);
     rl_vec3 e = f.cf.view.eye;
-    bool inside = e.x >= rb.min.x && e.x <= rb.max.x && e.z >= rb.min.z && e.z <= rb.max.z &&
-                  (rl_approx_dims(s->approx) == 2 || (e.y >= rb.min.y && e.y <= rb.max.y));
+    bool inside = rl_cull_approx_covers(s->approx, e);
     double ignored;
     uint32_t region = 0;
     if (st == RL_OK && inside)
