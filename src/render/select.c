@@ -258,16 +258,10 @@ static rl_status select_render(rl_renderer *r, void *state, const rl_scene *scen
     if (!d)
         return RL_ERR_NOT_COMMITTED;
     s->head.have_frame = false;
-    double pre = s->head.stats.preprocess_ms;
-    memset(&s->head.stats, 0, sizeof s->head.stats);
-    s->head.stats.preprocess_ms = pre;
+    memset(&s->head.stats, 0, sizeof s->head.stats);   /* prepare() times what it loads or samples */
     rl_status st = prepare_children(s, r);
-    if (st == RL_OK) {
-        bool again = s->prepared;
+    if (st == RL_OK)
         st = prepare(s, r, scene, d);
-        if (again && s->prepared)
-            s->head.stats.preprocess_ms = 0.0;    /* nothing prepared this frame */
-    }
     if (st != RL_OK)
         return st;
 
