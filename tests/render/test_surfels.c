@@ -95,6 +95,43 @@ static void test_surfels_replace_distant_geometry(void **state)
     rl_scene_release(s);
 }
 
+/* Points drawn (front-facing points of the prefix) by a surfels-only
+ * frame of the whole city from `dist`, on a small image so that no prefix
+ * reaches the set's 3000 surfels. */
+static uint64_t points_at(const rl_scene *s, float dist, const char *overdraw)
+{
+    rl_camera cam = far_camera(dist);
+    cam.width = 64;
+    cam.height = 48;
+    rl_renderer *r = fx_make("surfels", (const char *const[]){ SMALL, "min_size", "400", "max_size", "800",
+                                                               "overdraw", overdraw, NULL });
+    rl_image *img = fx_render_with(r, s, &cam, RL_LAYER_COLOR, NULL);
+    rl_culling_stats cs;
+    assert_int_equal(rl_culling_get_stats(r, &cs), RL_OK);
+    rl_image_release(img);
+    rl_renderer_release(r);
+    return cs.points_drawn;
+}
+
+/* Sec. 6.2: the prefix length is projected size x coverage x overdraw,
+ * so the points drawn grow linearly with the overdraw factor and fall
+ * with the square of the distance (the city's projected box, nearly
+ * 1/d^2 this far away). Counted are the front-facing points of the
+ * prefix, a nearly constant share of a blue-noise prefix. */
+static void test_surfel_prefix_follows_projected_size_and_overdraw(void **state)
+{
+    (void)state;
+    rl_scene *s = fx_box_city();
+    double p1 = (double)points_at(s, 150.0f, "1"), p2 = (double)points_at(s, 150.0f, "2");
+    double far = (double)points_at(s, 300.0f, "2");
+    print_message("surfel prefixes: overdraw 1: %.0f points, 2: %.0f (x%.3f); twice as far: %.0f (x%.3f)\n", p1,
+                  p2, p2 / p1, far, far / p2);
+    assert_true(p1 > 200.0);
+    assert_float_equal(p2 / p1, 2.0, 0.2);
+    assert_float_equal(far / p2, 0.25, 0.05);
+    rl_scene_release(s);
+}
+
 static void test_surfels_refuse_bad_options(void **state)
 {
     (void)state;
@@ -116,6 +153,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_surfels_without_approximation_equal_raster),
         cmocka_unit_test(test_surfels_replace_distant_geometry),
+        cmocka_unit_test(test_surfel_prefix_follows_projected_size_and_overdraw),
         cmocka_unit_test(test_surfels_refuse_bad_options),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
