@@ -161,8 +161,9 @@ static rl_status prepare_children(select_state *s, rl_renderer *r)
     return RL_OK;
 }
 
-/* Sec. 4.2.3: the conditioned time property of renderer `name`, sampled
- * over the scene as visset samples visibility. */
+/* Sec. 4.2.3: the conditioned time property of renderer `name` (with its
+ * default options; the forwarded raster options change little of its
+ * time), sampled over the scene as visset samples visibility. */
 static rl_status sample_time(const rl_scene *scene, const rl_scene_data *d, const select_key *k, const char *name,
                              rl_approx **out)
 {
