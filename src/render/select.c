@@ -131,7 +131,7 @@ static rl_status copy_text(char *dst, size_t size, const char *src, const char *
 }
 
 /* The two renderers, created when their names change; the shared raster
- * options forwarded every frame. */
+ * options forwarded whenever they differ. */
 static rl_status prepare_children(select_state *s, rl_renderer *r)
 {
     const char *keys[2] = { "first", "second" };
@@ -151,9 +151,13 @@ static rl_status prepare_children(select_state *s, rl_renderer *r)
                 return st;
             }
         }
-        /* Culling renderers have them all; another renderer must too. */
+        /* Culling renderers have them all; another renderer must too.
+         * Set only when changed: no copies on every frame. */
         for (size_t k = 0; k < sizeof forwarded / sizeof forwarded[0]; ++k) {
-            rl_status st = rl_renderer_set(s->child[i], forwarded[k], rl_renderer_get(r, forwarded[k]));
+            const char *want = rl_renderer_get(r, forwarded[k]), *have = rl_renderer_get(s->child[i], forwarded[k]);
+            if (have && strcmp(have, want) == 0)
+                continue;
+            rl_status st = rl_renderer_set(s->child[i], forwarded[k], want);
             if (st != RL_OK)
                 return st;
         }

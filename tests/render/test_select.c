@@ -109,6 +109,33 @@ static void test_select_draws_with_the_renderer_the_sampled_times_pick(void **st
     rl_scene_release(s);
 }
 
+/* The shared raster options reach the drawing renderer, also when they
+ * change between frames. */
+static void test_select_forwards_the_raster_options(void **state)
+{
+    (void)state;
+    rl_scene *s = fx_box_city();
+    char a[1024], b[1024];
+    save_approx(s, "time", step_time, "select_fwd_first.json", a, sizeof a);
+    save_approx(s, "time", flat_time, "select_fwd_second.json", b, sizeof b);
+    rl_renderer *sel = fx_make("select", (const char *const[]){ "first_time", a, "second_time", b, "shading", "flat",
+                                                                 "background", "0.2,0.3,0.4", NULL });
+    rl_camera cam = at_x(20.0f);
+    const char *const flat[] = { "shading", "flat", "background", "0.2,0.3,0.4", NULL };
+    const char *const gouraud[] = { "shading", "gouraud", "background", "0.2,0.3,0.4", NULL };
+    for (int f = 0; f < 2; ++f) {
+        if (f == 1)
+            assert_int_equal(rl_renderer_set(sel, "shading", "gouraud"), RL_OK);
+        rl_image *img = fx_render_with(sel, s, &cam, FX_ALL_LAYERS, NULL);
+        rl_image *ref = fx_render("chcpp", s, &cam, FX_ALL_LAYERS, f == 0 ? flat : gouraud, NULL);
+        fx_assert_images_identical(img, ref);
+        rl_image_release(ref);
+        rl_image_release(img);
+    }
+    rl_renderer_release(sel);
+    rl_scene_release(s);
+}
+
 /* The thesis' rule: first where the property is below the threshold. */
 static void test_select_threshold_rule(void **state)
 {
@@ -184,6 +211,7 @@ int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_select_draws_with_the_renderer_the_sampled_times_pick),
+        cmocka_unit_test(test_select_forwards_the_raster_options),
         cmocka_unit_test(test_select_threshold_rule),
         cmocka_unit_test(test_select_refuses_bad_inputs_with_a_message),
         cmocka_unit_test(test_select_samples_the_times_itself),
