@@ -38,6 +38,7 @@
 #include "render/culling.h"
 #include "render/raster_scene.h"
 #include "render/renderer.h"
+#include "render/surfels_internal.h"
 #include "rl/rl_surfels.h"
 #include "rl/rl_timer.h"
 
@@ -172,7 +173,7 @@ typedef struct surfels_frame {
     const rl_octree_node *nodes;
     const uint32_t *objects;
     rl_cull_frame cf;
-    float min2, max2, overdraw, point_size;
+    float min_size, max_size, overdraw, point_size;
 } surfels_frame;
 
 /* Projected size of a box: the area of its screen rectangle in pixels;
@@ -235,11 +236,9 @@ static rl_status draw_prefix(surfels_frame *f, const rl_surfel_set *set, uint32_
         float len = rl_length(to_eye);
         float cosv = len > 0.0f ? rl_dot(nrm, to_eye) / len : 1.0f;
         s->pos[i] = p;
-        if (!(cosv > 0.0f)) {
-            s->size[i] = 0.0f;   /* faces away: hidden */
-            continue;
-        }
-        s->size[i] = rl_maxf(1.0f, base * rl_surfel_size(sf) * cosv);
+        s->size[i] = rl_surfel_point_side(base, rl_surfel_size(sf), cosv);
+        if (s->size[i] == 0.0f)
+            continue;            /* faces away: hidden */
         rl_vec3 c = rl_raster_light_diffuse(f->d, p, nrm, rl_surfel_color(sf), f->cf.ambient, eye);
         s->col[i] = rl_v4_from3(c, 1.0f);
     }
@@ -284,19 +283,14 @@ static rl_status draw_node(surfels_frame *f, uint32_t n)
     const rl_surfel_set *set = n < s->num_sets ? &s->sets[n] : NULL;
     double a = projected_size(&f->cf.view, node->bounds);
     rl_status st = RL_OK;
-    if (set && set->count > 0 && a <= f->max2) {
-        /* Sec. 6.2: prefix length and point size from the projected size. */
-        double want = a * set->coverage * f->overdraw;
-        double t = a <= f->min2 ? 1.0 : (f->max2 - a) / (f->max2 - f->min2);
-        double grow = want > set->count ? sqrt(want / set->count) : 1.0;
-        double len = t * (want < set->count ? want : set->count);
-        uint32_t m = (uint32_t)ceil(len);
-        if (m > set->count)
-            m = set->count;
-        if (m > 0)
-            st = push_cmd(s, (draw_cmd){ n, m, (float)(t * f->point_size * grow) });
-        s->head.stats.surfel_nodes++;
-        if (st != RL_OK || a <= f->min2)
+    if (set && set->count > 0) {
+        rl_surfel_lod lod = rl_surfels_node_lod(a, set->coverage, set->count, f->min_size, f->max_size,
+                                                f->overdraw, f->point_size);
+        if (lod.prefix > 0)
+            st = push_cmd(s, (draw_cmd){ n, lod.prefix, lod.point_size });
+        if (a <= (double)f->max_size * f->max_size)
+            s->head.stats.surfel_nodes++;
+        if (st != RL_OK || !lod.descend)
             return st;
     }
     for (uint32_t k = 0; k < node->num_objects && st == RL_OK; ++k) {
@@ -391,8 +385,8 @@ static rl_status surfels_render(rl_renderer *r, void *state, const rl_scene *sce
     f.d = d;
     f.nodes = nodes;
     f.objects = rl_octree_objects(s->oc.tree, NULL);
-    f.min2 = min_size * min_size;
-    f.max2 = max_size * max_size;
+    f.min_size = min_size;
+    f.max_size = max_size;
     f.overdraw = (float)rl_renderer_opt_float(r, "overdraw");
     f.point_size = (float)rl_renderer_opt_float(r, "point_size");
     st = rl_cull_frame_begin(r, scene, &s->head.keep, cam, image, &f.cf);

@@ -1,6 +1,7 @@
 /* surfels_internal.h: the spatial helpers of the Progressive Blue Surfels
  * preprocessing (Jähn 2015, Sec. 6.1.1; rl_surfels.h), shared by
- * surfels_build.c, its test and `rl bench surfels`.
+ * surfels_build.c, its test and `rl bench surfels`, and the renderer's
+ * level-of-detail rule (Sec. 6.2, surfels_lod.c).
  *
  * rl_surfel_grid is a uniform grid over a box whose cells are hashed into a
  * power-of-two bucket table, with one singly linked list of point indices
@@ -13,6 +14,7 @@
 #ifndef RL_RENDER_SURFELS_INTERNAL_H
 #define RL_RENDER_SURFELS_INTERNAL_H
 
+#include <stdbool.h>
 #include <stdint.h>
 
 #include "rl/rl_surfels.h"
@@ -48,5 +50,28 @@ void rl_surfel_grid_free(rl_surfel_grid *g);
  * both 0). Deterministic for any thread count. threads 0 = all. */
 rl_status rl_surfels_prefix_spacing(const rl_surfel *s, uint32_t m, int threads, double *min_dist,
                                     double *mean_dist);
+
+/* Sec. 6.2: what a frame draws of an octree node with `count` surfels
+ * whose bounding box projects to `area` pixels (the area of its screen
+ * rectangle), for the renderer's options min_size/max_size (sides in
+ * pixels), overdraw and point_size:
+ *   area > max_size^2 (or count 0): no surfels, descend (meshes);
+ *   area <= min_size^2: a prefix of area * coverage * overdraw surfels at
+ *     point_size, no descent; when that exceeds count, all count surfels
+ *     at point_size * sqrt(area * coverage * overdraw / count);
+ *   in between: prefix and point size of the case above times
+ *     t = (max^2 - area) / (max^2 - min^2), and descend as well.
+ * The prefix is rounded up and never exceeds count. */
+typedef struct rl_surfel_lod {
+    uint32_t prefix;              /* surfels to draw (0: none) */
+    float point_size;             /* the node's point size in pixels */
+    bool descend;                 /* draw the node's meshes and children too */
+} rl_surfel_lod;
+rl_surfel_lod rl_surfels_node_lod(double area, double coverage, uint32_t count, float min_size,
+                                  float max_size, float overdraw, float point_size);
+/* Sec. 6.2.1: a surfel's side in pixels, point_size * relative_size *
+ * cos_view and at least 1, or 0 (hidden) when cos_view <= 0 (it faces
+ * away from the viewer) or is NaN. */
+float rl_surfel_point_side(float point_size, float relative_size, float cos_view);
 
 #endif

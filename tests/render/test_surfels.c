@@ -1,7 +1,9 @@
 /* test_surfels.c: the Progressive Blue Surfels renderer (Jähn 2015, Sec.
  * 6.2) on the box city: never approximating gives raster's image; far away
  * the city becomes points only, at a measured quality; in between both are
- * drawn; the same options give the same image; bad sizes are refused. */
+ * drawn; the same options give the same image; the prefix and point-size
+ * rule matches hand-computed values; bad sizes are refused. */
+#include <math.h>
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
@@ -11,6 +13,7 @@
 
 #include <cmocka.h>
 
+#include "render/surfels_internal.h"
 #include "render_fixtures.h"
 #include "rl/rl.h"
 
@@ -132,6 +135,56 @@ static void test_surfel_prefix_follows_projected_size_and_overdraw(void **state)
     rl_scene_release(s);
 }
 
+/* Sec. 6.2's rule with the thesis' defaults (min 100 px, max 200 px,
+ * overdraw 4, point size 7) on a node of 40,000 surfels covering half its
+ * box, against values computed by hand. */
+static void test_surfel_lod_rule_by_hand(void **state)
+{
+    (void)state;
+    const uint32_t count = 40000;
+    /* 50^2 px: surfels only, 2500 * 0.5 * 4 = 5000 of them at size 7. */
+    rl_surfel_lod l = rl_surfels_node_lod(2500.0, 0.5, count, 100.0f, 200.0f, 4.0f, 7.0f);
+    assert_int_equal(l.prefix, 5000);
+    assert_float_equal(l.point_size, 7.0f, 1e-6f);
+    assert_false(l.descend);
+    /* 100^2 px exactly: still surfels only, 20,000 of them. */
+    l = rl_surfels_node_lod(10000.0, 0.5, count, 100.0f, 200.0f, 4.0f, 7.0f);
+    assert_int_equal(l.prefix, 20000);
+    assert_false(l.descend);
+    /* Coverage 1 at 150^2 px: 90,000 wanted of 40,000, so all of them at
+     * 7 * sqrt(90000 / 40000) = 10.5 px at the minimum size; here t =
+     * (40000 - 22500) / (40000 - 10000) = 7/12: ceil(40000 * 7/12) =
+     * 23,334 surfels at 10.5 * 7/12 = 6.125 px, and the meshes too. */
+    l = rl_surfels_node_lod(22500.0, 1.0, count, 100.0f, 200.0f, 4.0f, 7.0f);
+    assert_int_equal(l.prefix, 23334);
+    assert_float_equal(l.point_size, 6.125f, 1e-4f);
+    assert_true(l.descend);
+    /* All of a small node at 80^2 px: 25,600 wanted of 10,000, size 7 * 1.6. */
+    l = rl_surfels_node_lod(6400.0, 1.0, 10000, 100.0f, 200.0f, 4.0f, 7.0f);
+    assert_int_equal(l.prefix, 10000);
+    assert_float_equal(l.point_size, 11.2f, 1e-4f);
+    /* At the maximum size the blend reaches zero; above it, meshes only. */
+    l = rl_surfels_node_lod(40000.0, 0.5, count, 100.0f, 200.0f, 4.0f, 7.0f);
+    assert_int_equal(l.prefix, 0);
+    assert_float_equal(l.point_size, 0.0f, 1e-6f);
+    assert_true(l.descend);
+    l = rl_surfels_node_lod(40001.0, 0.5, count, 100.0f, 200.0f, 4.0f, 7.0f);
+    assert_int_equal(l.prefix, 0);
+    assert_true(l.descend);
+    /* Reaching behind the near plane (projected size +inf): meshes. */
+    l = rl_surfels_node_lod(INFINITY, 0.5, count, 100.0f, 200.0f, 4.0f, 7.0f);
+    assert_int_equal(l.prefix, 0);
+    assert_true(l.descend);
+    /* Sec. 6.2.1: a point's side is 7 x relative size x cosine, at least
+     * one pixel; points facing away are hidden. */
+    assert_float_equal(rl_surfel_point_side(7.0f, 1.0f, 1.0f), 7.0f, 1e-6f);
+    assert_float_equal(rl_surfel_point_side(7.0f, 0.5f, 0.5f), 1.75f, 1e-6f);
+    assert_float_equal(rl_surfel_point_side(7.0f, 0.1f, 0.5f), 1.0f, 1e-6f);
+    assert_float_equal(rl_surfel_point_side(7.0f, 1.0f, 0.0f), 0.0f, 1e-6f);
+    assert_float_equal(rl_surfel_point_side(7.0f, 1.0f, -0.3f), 0.0f, 1e-6f);
+    assert_float_equal(rl_surfel_point_side(7.0f, 1.0f, NAN), 0.0f, 1e-6f);
+}
+
 static void test_surfels_refuse_bad_options(void **state)
 {
     (void)state;
@@ -154,6 +207,7 @@ int main(void)
         cmocka_unit_test(test_surfels_without_approximation_equal_raster),
         cmocka_unit_test(test_surfels_replace_distant_geometry),
         cmocka_unit_test(test_surfel_prefix_follows_projected_size_and_overdraw),
+        cmocka_unit_test(test_surfel_lod_rule_by_hand),
         cmocka_unit_test(test_surfels_refuse_bad_options),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
