@@ -17,7 +17,7 @@ const char rl_eval_sampling_help[] =
     "  --region x0,y0,z0,x1,y1,z1   default: the scene's bounds\n"
     "  --height H          slice height; default the middle of the region's y\n"
     "  --method M          adaptive (Alg. 5.3, default) or grid (Alg. 5.2)\n"
-    "  --positions P       bn-corners (default), bn, random or grid: how an\n"
+    "  --positions P       bn (default), bn-corners, random or grid: how an\n"
     "                      adaptive region chooses its samples (Sec. 5.4.2)\n"
     "  --samples N         sample budget; default 256\n"
     "  --seconds S         time budget (stops at whichever comes first)\n"
@@ -26,9 +26,11 @@ const char rl_eval_sampling_help[] =
     "  --samples-base N    samples per new region, constant part; default 5\n"
     "  --samples-per-meter F  samples per metre of region diameter; default 0.05\n"
     "  --combine C         region value: mean (default), max or min\n"
-    "  --interp I          point queries: nearest (the nearest sample, default)\n"
-    "                      or region (the region's combined value, the thesis);\n"
-    "                      see docs/evaluation.md\n"
+    "  --interp I          point queries: idw (inverse distance weighting of\n"
+    "                      the nearest samples, default), nearest (the nearest\n"
+    "                      sample) or region (the region's combined value, the\n"
+    "                      thesis); see docs/evaluation.md\n"
+    "  --idw-neighbors K   samples weighted by an idw query; default 4\n"
     "  --quality-size Q    size in the split priority q = n / (size * range):\n"
     "                      measure (area or volume, default) or diameter (the\n"
     "                      thesis); see docs/evaluation.md\n"
@@ -38,10 +40,10 @@ const char rl_eval_sampling_help[] =
     "  --seed N            default 1\n"
     "  --workers N         parallel evaluations; default all threads\n";
 
-static const char *const positions_names[] = { "bn-corners", "bn", "random", "grid" };
+static const char *const positions_names[] = { "bn", "bn-corners", "random", "grid" };
 static const char *const method_names[] = { "adaptive", "grid" };
 static const char *const combine_names[] = { "mean", "max", "min" };
-static const char *const interp_names[] = { "nearest", "region" };
+static const char *const interp_names[] = { "idw", "nearest", "region" };
 static const char *const quality_size_names[] = { "measure", "diameter" };
 
 const char *rl_eval_positions_name(rl_position_variant v)
@@ -163,7 +165,7 @@ int rl_eval_sampling_arg(int argc, char **argv, int *i, rl_eval_sampling *s)
             return -1;
         d->positions = (rl_position_variant)k;
     } else if (TAKE("--interp")) {
-        int k = m < 0 ? -1 : pick("--interp", v, interp_names, 2);
+        int k = m < 0 ? -1 : pick("--interp", v, interp_names, 3);
         if (k < 0)
             return -1;
         d->interpolation = (rl_interpolation)k;
@@ -189,6 +191,11 @@ int rl_eval_sampling_arg(int argc, char **argv, int *i, rl_eval_sampling *s)
             return -1;
         d->min_side = (float)x;
         s->has_min_side = true;
+    } else if (TAKE("--idw-neighbors")) {
+        long long n;
+        if (m < 0 || !rl_bench_parse_count("--idw-neighbors", v, RL_SAMPLING_MAX_IDW_NEIGHBORS, &n))
+            return -1;
+        d->idw_neighbors = (uint32_t)n;
     } else if (TAKE("--samples-base")) {
         if (m < 0 || !parse_number("--samples-base", v, 1, 1e6, &x))
             return -1;
@@ -482,6 +489,9 @@ cJSON *rl_eval_desc_json(const rl_sampling_desc *d)
     cJSON_AddStringToObject(o, "combine", combine_names[d->combine]);
     cJSON_AddBoolToObject(o, "linear", d->linear);
     cJSON_AddStringToObject(o, "interpolation", interp_names[d->interpolation]);
+    if (d->interpolation == RL_INTERP_IDW && !d->linear)
+        cJSON_AddNumberToObject(o, "idw_neighbors",
+                                d->idw_neighbors ? d->idw_neighbors : RL_SAMPLING_DEFAULT_IDW_NEIGHBORS);
     if (d->method == RL_SAMPLING_ADAPTIVE)
         cJSON_AddStringToObject(o, "quality_size", rl_eval_quality_size_name(d->quality_size));
     else

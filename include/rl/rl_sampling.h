@@ -47,9 +47,10 @@
  *   RL_POSITIONS_BLUE_NOISE         best of `candidates` (200) uniform
  *                                   candidates by distance to the nearest
  *                                   sample taken so far anywhere (McCool &
- *                                   Fiume 1992);
+ *                                   Fiume 1992; default, see below);
  *   RL_POSITIONS_BLUE_NOISE_CORNERS the region's corners first (when not
- *                                   yet sampled), then blue noise (default);
+ *                                   yet sampled), then blue noise (the
+ *                                   thesis' choice for region values);
  *   RL_POSITIONS_GRID               the cell centres of the smallest k^d
  *                                   lattice with k^d >= count, all of them
  *                                   (within the budget).
@@ -100,16 +101,29 @@
  * regular grid (one sample each), and the mean of a region's samples (its
  * shared corners on walls included) is a poor guess inside it wherever the
  * property jumps; this is why the thesis found the grid better in one case
- * of Sec. 5.7. By default a query returns the value of the nearest sample
- * instead (RL_INTERP_NEAREST; the Voronoi regions of the samples, the dual
- * of the thesis' Delaunay alternative in Alg. 5.3, line 21), found across
- * leaf borders by a branch-and-bound search of the region tree, so adaptive
- * sampling keeps every sample's resolution where it placed them densely.
- * Region values, statistics and heat maps are unchanged; RL_INTERP_REGION
- * gives the thesis' queries. For the centred grid both agree (one sample
- * per cell, at its centre); for a shifted grid a nearest-sample query near
- * a cell's border may answer with the neighbour's sample, i.e. the shifted
- * lattice's own Voronoi cells. Measured in `rl bench sampling`.
+ * of Sec. 5.7. By default a query weights the idw_neighbors (4) nearest
+ * samples of all by their inverse squared distance (RL_INTERP_IDW,
+ * Shepard's interpolation, a scattered-data alternative to the thesis'
+ * Delaunay interpolation in Alg. 5.3, line 21); a query on a sample
+ * returns that sample's value, and every answer lies within the range of
+ * the samples. RL_INTERP_NEAREST returns the value of the nearest sample
+ * (the samples' Voronoi regions). Both search across leaf borders by
+ * branch and bound over the region tree (rings of cells on a grid), so
+ * adaptive sampling keeps every sample's resolution where it placed them
+ * densely. Region values, statistics and heat maps are unchanged;
+ * RL_INTERP_REGION gives the thesis' queries. For the centred grid the
+ * nearest sample is the cell's own (its centre), the thesis' query; for a
+ * shifted grid a nearest-sample query near a cell's border may answer with
+ * the neighbour's sample, i.e. the shifted lattice's own Voronoi cells.
+ * Measured in `rl bench sampling` (bench/README.md): on `city` the weighting
+ * lowers the error of every sampler in nearly every case, the grid's too.
+ *
+ * Positions, a further deviation: blue noise without the corners is the
+ * default. A region's corners serve the thesis' region values (its mean
+ * then spans the whole box); queries that interpolate the nearest samples
+ * do not need them, and the corners on the sampled domain's own boundary
+ * cover only a half, quarter or eighth of the area an inner sample covers.
+ * Measured in `rl bench sampling` (bench/README.md).
  *
  * The quality rule, a second deviation: the thesis splits the region of
  * lowest q = n / (diameter * (max - min)). Halving a 2-D region's sides
@@ -145,6 +159,9 @@ extern "C" {
  * candidates per sample. */
 #define RL_SAMPLING_MAX_SAMPLES    (1u << 24)
 #define RL_SAMPLING_MAX_CANDIDATES (1u << 16)
+/* Neighbours of an inverse-distance-weighted query: the default and the cap. */
+#define RL_SAMPLING_DEFAULT_IDW_NEIGHBORS 4
+#define RL_SAMPLING_MAX_IDW_NEIGHBORS 32
 
 typedef enum rl_sampling_method {
     RL_SAMPLING_ADAPTIVE = 0,
@@ -152,8 +169,8 @@ typedef enum rl_sampling_method {
 } rl_sampling_method;
 
 typedef enum rl_position_variant {
-    RL_POSITIONS_BLUE_NOISE_CORNERS = 0,
-    RL_POSITIONS_BLUE_NOISE,
+    RL_POSITIONS_BLUE_NOISE = 0,
+    RL_POSITIONS_BLUE_NOISE_CORNERS,
     RL_POSITIONS_RANDOM,
     RL_POSITIONS_GRID,
 } rl_position_variant;
@@ -166,10 +183,13 @@ typedef enum rl_combine {
 
 /* What a point query returns inside a leaf. */
 typedef enum rl_interpolation {
-    /* The value of the nearest sample (of all samples, across leaf
-     * borders): every sample keeps its own resolution. Our default, see
+    /* Shepard's inverse distance weighting (power 2) of the idw_neighbors
+     * (4) nearest samples of all, across leaf borders. Our default, see
      * below. */
-    RL_INTERP_NEAREST = 0,
+    RL_INTERP_IDW = 0,
+    /* The value of the nearest sample (of all samples, across leaf
+     * borders): every sample keeps its own resolution. */
+    RL_INTERP_NEAREST,
     /* The leaf's combined value (Alg. 5.3, lines 23-25): the thesis. */
     RL_INTERP_REGION,
 } rl_interpolation;
@@ -209,7 +229,9 @@ typedef struct rl_sampling_desc {          /* zero = default */
     bool linear;                           /* also fit a gradient per leaf; queries
                                               then use the fit (overrides
                                               interpolation) */
-    rl_interpolation interpolation;        /* point queries; default nearest */
+    rl_interpolation interpolation;        /* point queries; default idw */
+    uint32_t idw_neighbors;                /* RL_INTERP_IDW: 0 -> 4;
+                                              <= RL_SAMPLING_MAX_IDW_NEIGHBORS */
     rl_quality_size quality_size;          /* adaptive; default measure */
     bool grid_shift;                       /* grid method: every cell's sample at
                                               one seeded random offset from its
@@ -275,14 +297,21 @@ RL_API const uint64_t *rl_approx_sample_set(const rl_approx *a, uint32_t i);
 RL_API rl_status rl_approx_with_values(const rl_approx *a, const double *values,
                                        const char *property, const char *unit, rl_approx **out);
 
-/* Point query: the value of the leaf containing pos (its linear fit at pos
- * when it has one; for 2-D, pos.y is ignored) and, when region is non-NULL,
- * the leaf's index. Leaves are numbered depth first, children in the order
+/* Point query: the approximation's value at pos as desc.interpolation
+ * says (idw, nearest sample or the leaf's value; the leaf's linear fit at
+ * pos when it has one; for 2-D, pos.y is ignored) and, when region is
+ * non-NULL, the index of the leaf containing pos. Leaves are numbered depth first, children in the order
  * x before y before z, low before high; on a boundary the leaf with the
  * smaller index wins. RL_ERR_NOT_FOUND outside the (closed) bounds or for a
  * non-finite pos; RL_ERR_INVALID_ARG for NULL a or value. */
 RL_API rl_status rl_approx_query(const rl_approx *a, rl_vec3 pos, double *value, uint32_t *region);
 
+/* Changes how rl_approx_query() answers (the samples and regions stay):
+ * e.g. the same approximation queried by nearest sample and by inverse
+ * distance weighting. idw_neighbors 0 -> 4. RL_ERR_INVALID_ARG for NULL or
+ * an unknown value, RL_ERR_LIMIT above RL_SAMPLING_MAX_IDW_NEIGHBORS. */
+RL_API rl_status rl_approx_set_interpolation(rl_approx *a, rl_interpolation interpolation,
+                                             uint32_t idw_neighbors);
 /* JSON with the desc, the tree, the leaves (with sets as index lists) and
  * the samples; load gives an approximation that answers every query
  * identically. RL_ERR_IO, RL_ERR_PARSE (with the offending key) on load. */

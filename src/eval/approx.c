@@ -581,12 +581,35 @@ const uint64_t *rl_approx_sample_set(const rl_approx *a, uint32_t i)
     return a->sample_sets + (size_t)i * a->set_words;
 }
 
-/* ----------------------------------------------------- nearest sample -- */
+/* ------------------------------------------------- nearest samples -- */
 
-typedef struct nearest {
-    double d2;
-    uint32_t sample;
-} nearest;
+/* The k nearest samples so far, nearest first; ties by sample index, so
+ * that answers do not depend on the search order. A sample on a shared
+ * border is in several leaves and is kept once. */
+typedef struct knn {
+    uint32_t k, n;
+    double d2[RL_SAMPLING_MAX_IDW_NEIGHBORS];
+    uint32_t sample[RL_SAMPLING_MAX_IDW_NEIGHBORS];
+} knn;
+
+/* Squared distance of the k-th nearest so far: nothing farther can enter. */
+static double knn_bound(const knn *b) { return b->n < b->k ? INFINITY : b->d2[b->n - 1]; }
+
+static void knn_offer(knn *b, uint32_t s, double d2)
+{
+    if (b->n == b->k && (d2 > b->d2[b->n - 1] || (d2 == b->d2[b->n - 1] && s > b->sample[b->n - 1])))
+        return;
+    for (uint32_t i = 0; i < b->n; ++i)
+        if (b->sample[i] == s)
+            return;
+    uint32_t i = b->n < b->k ? b->n++ : b->n - 1;
+    for (; i > 0 && (b->d2[i - 1] > d2 || (b->d2[i - 1] == d2 && b->sample[i - 1] > s)); --i) {
+        b->d2[i] = b->d2[i - 1];
+        b->sample[i] = b->sample[i - 1];
+    }
+    b->d2[i] = d2;
+    b->sample[i] = s;
+}
 
 static double dist2_to_sample(const rl_approx *a, uint32_t s, rl_vec3 pos)
 {
@@ -595,15 +618,11 @@ static double dist2_to_sample(const rl_approx *a, uint32_t s, rl_vec3 pos)
     return dx * dx + dy * dy + dz * dz;
 }
 
-static void scan_leaf(const rl_approx *a, uint32_t leaf, rl_vec3 pos, nearest *best)
+static void scan_leaf(const rl_approx *a, uint32_t leaf, rl_vec3 pos, knn *best)
 {
     for (uint32_t k = a->leaf_first[leaf]; k < a->leaf_first[leaf + 1]; ++k) {
         uint32_t s = a->leaf_samples[k];
-        double d2 = dist2_to_sample(a, s, pos);
-        if (d2 < best->d2 || (d2 == best->d2 && s < best->sample)) {
-            best->d2 = d2;
-            best->sample = s;
-        }
+        knn_offer(best, s, dist2_to_sample(a, s, pos));
     }
 }
 
@@ -620,10 +639,60 @@ static double box_dist2(const rl_approx *a, rl_aabb b, rl_vec3 pos)
     return d2;
 }
 
+static void knn_in(const rl_approx *a, uint32_t node, rl_vec3 pos, uint32_t skip_leaf, knn *best);
+
+/* The cells of a grid node in rings of growing Chebyshev distance around
+ * the cell that holds pos (clamped into the grid): a cell r rings away is
+ * at least (r - 1) cell sides away, so the search stops at the first ring
+ * beyond the k-th best distance, or when a ring leaves the grid. */
+static void knn_in_grid(const rl_approx *a, const rl_approx_node *n, rl_vec3 pos, uint32_t skip_leaf,
+                        knn *best)
+{
+    int c[3] = { 0, 0, 0 }, res[3] = { 1, 1, 1 };
+    double side = INFINITY;
+    for (int k = 0; k < rl_approx_axis_count(a->dims); ++k) {
+        int ax = rl_approx_axis(a->dims, k);
+        double lo = rl_v3_get(n->box.min, ax), hi = rl_v3_get(n->box.max, ax);
+        res[ax] = n->res[ax];
+        double t = floor(((double)rl_v3_get(pos, ax) - lo) / (hi - lo) * res[ax]);
+        c[ax] = t < 0.0 ? 0 : t > res[ax] - 1 ? res[ax] - 1 : (int)t;
+        double sd = (hi - lo) / res[ax];
+        side = sd < side ? sd : side;
+    }
+    side *= 0.999;   /* the cells' float edges are not exactly equal */
+    for (int r = 0;; ++r) {
+        if (r >= 2) {
+            double lb = (r - 1) * side;
+            if (lb * lb > knn_bound(best))
+                return;
+        }
+        bool inside = false;
+        int lo[3], hi[3];
+        for (int ax = 0; ax < 3; ++ax) {
+            lo[ax] = c[ax] - r < 0 ? 0 : c[ax] - r;
+            hi[ax] = c[ax] + r > res[ax] - 1 ? res[ax] - 1 : c[ax] + r;
+            inside |= res[ax] > 1 && (c[ax] - r >= 0 || c[ax] + r <= res[ax] - 1);
+        }
+        if (!inside && r > 0)
+            return;
+        for (int z = lo[2]; z <= hi[2]; ++z)
+            for (int y = lo[1]; y <= hi[1]; ++y)
+                for (int x = lo[0]; x <= hi[0]; ++x) {
+                    int dx = abs(x - c[0]), dy = abs(y - c[1]), dz = abs(z - c[2]);
+                    int cheb = dx > dy ? dx : dy;
+                    if ((cheb > dz ? cheb : dz) != r)
+                        continue;
+                    uint32_t i = (uint32_t)x + (uint32_t)res[0] * ((uint32_t)y + (uint32_t)res[1] * (uint32_t)z);
+                    if (box_dist2(a, a->nodes[n->first_child + i].box, pos) <= knn_bound(best))
+                        knn_in(a, n->first_child + i, pos, skip_leaf, best);
+                }
+    }
+}
+
 /* Branch and bound over the region tree, nearer children first; a box
- * farther than the best sample so far cannot hold a nearer one (boxes are
- * closed and hold every sample inside them). skip_leaf was scanned. */
-static void nearest_in(const rl_approx *a, uint32_t node, rl_vec3 pos, uint32_t skip_leaf, nearest *best)
+ * farther than the k-th best sample so far cannot hold a nearer one (boxes
+ * are closed and hold every sample inside them). skip_leaf was scanned. */
+static void knn_in(const rl_approx *a, uint32_t node, rl_vec3 pos, uint32_t skip_leaf, knn *best)
 {
     const rl_approx_node *n = &a->nodes[node];
     if (n->kind == RL_NODE_LEAF) {
@@ -631,15 +700,13 @@ static void nearest_in(const rl_approx *a, uint32_t node, rl_vec3 pos, uint32_t 
             scan_leaf(a, n->leaf, pos, best);
         return;
     }
+    if (n->kind == RL_NODE_GRID) {
+        knn_in_grid(a, n, pos, skip_leaf, best);
+        return;
+    }
     uint32_t count = rl_approx_child_count(a, n);
     uint32_t order[8];
     double dist[8];
-    if (count > 8) {                     /* a grid node inside a tree: plain order */
-        for (uint32_t c = 0; c < count; ++c)
-            if (box_dist2(a, a->nodes[n->first_child + c].box, pos) <= best->d2)
-                nearest_in(a, n->first_child + c, pos, skip_leaf, best);
-        return;
-    }
     for (uint32_t c = 0; c < count; ++c) {
         double d = box_dist2(a, a->nodes[n->first_child + c].box, pos);
         uint32_t i = c;
@@ -651,10 +718,38 @@ static void nearest_in(const rl_approx *a, uint32_t node, rl_vec3 pos, uint32_t 
         order[i] = c;
     }
     for (uint32_t i = 0; i < count; ++i) {
-        if (dist[i] > best->d2)
+        if (dist[i] > knn_bound(best))
             break;
-        nearest_in(a, n->first_child + order[i], pos, skip_leaf, best);
+        knn_in(a, n->first_child + order[i], pos, skip_leaf, best);
     }
+}
+
+/* The k nearest samples of all, across leaf borders. */
+static void find_knn(const rl_approx *a, uint32_t leaf, rl_vec3 pos, uint32_t k, knn *best)
+{
+    best->k = k;
+    best->n = 0;
+    scan_leaf(a, leaf, pos, best);         /* a good first bound */
+    /* The grid method has one sample per cell, at its centre: a lattice's
+     * Voronoi cells are its grid cells, so the nearest one is the cell's. */
+    if (k == 1 && a->nodes[0].kind == RL_NODE_GRID && !a->desc.grid_shift)
+        return;
+    knn_in(a, 0, pos, leaf, best);
+}
+
+/* Shepard's inverse distance weighting (power 2) of the k nearest samples;
+ * a query on a sample returns that sample's value. */
+static double idw_value(const rl_approx *a, const knn *b)
+{
+    if (b->d2[0] == 0.0 || b->n == 1)
+        return a->sample_value[b->sample[0]];
+    double ws = 0.0, vs = 0.0;
+    for (uint32_t i = 0; i < b->n; ++i) {
+        double w = 1.0 / b->d2[i];
+        ws += w;
+        vs += w * a->sample_value[b->sample[i]];
+    }
+    return vs / ws;
 }
 
 rl_status rl_approx_query(const rl_approx *a, rl_vec3 pos, double *value, uint32_t *region)
@@ -668,17 +763,17 @@ rl_status rl_approx_query(const rl_approx *a, rl_vec3 pos, double *value, uint32
     uint32_t leaf = a->nodes[node].leaf;
     const rl_approx_region *r = &a->leaves[leaf];
     double v = r->value;
-    if (!r->linear && a->desc.interpolation == RL_INTERP_NEAREST && a->leaf_first && a->sample_count) {
-        /* The nearest sample of all (rl_sampling.h: the Voronoi
-         * alternative); ties go to the lower sample index. */
-        nearest best = { INFINITY, RL_APPROX_NONE };
-        scan_leaf(a, leaf, pos, &best);         /* a good first bound */
-        /* The grid method has one sample per cell, at its centre: a
-         * lattice's Voronoi cells are its grid cells, no search needed. */
-        if (a->nodes[0].kind != RL_NODE_GRID)
-            nearest_in(a, 0, pos, leaf, &best);
-        if (best.sample != RL_APPROX_NONE)
-            v = a->sample_value[best.sample];
+    rl_interpolation in = a->desc.interpolation;
+    if (!r->linear && in != RL_INTERP_REGION && a->leaf_first && a->sample_count) {
+        /* The nearest sample (rl_sampling.h: the Voronoi alternative), or
+         * Shepard's weighting of the nearest few. */
+        knn best;
+        uint32_t k = a->desc.idw_neighbors;
+        k = in == RL_INTERP_NEAREST ? 1u : k == 0 ? RL_SAMPLING_DEFAULT_IDW_NEIGHBORS
+                                      : k > RL_SAMPLING_MAX_IDW_NEIGHBORS ? RL_SAMPLING_MAX_IDW_NEIGHBORS : k;
+        find_knn(a, leaf, pos, k, &best);
+        if (best.n > 0)
+            v = in == RL_INTERP_NEAREST ? a->sample_value[best.sample[0]] : idw_value(a, &best);
     } else if (r->linear) {
         v = r->offset;
         for (int k = 0; k < rl_approx_axis_count(a->dims); ++k) {
@@ -690,6 +785,21 @@ rl_status rl_approx_query(const rl_approx *a, rl_vec3 pos, double *value, uint32
     *value = v;
     if (region)
         *region = a->nodes[node].leaf;
+    return RL_OK;
+}
+
+rl_status rl_approx_set_interpolation(rl_approx *a, rl_interpolation interpolation, uint32_t idw_neighbors)
+{
+    if (!a)
+        return rl_error(RL_ERR_INVALID_ARG, "rl_approx_set_interpolation: approximation is NULL");
+    if ((unsigned)interpolation > RL_INTERP_REGION)
+        return rl_error(RL_ERR_INVALID_ARG, "rl_approx_set_interpolation: unknown interpolation %d",
+                        (int)interpolation);
+    if (idw_neighbors > RL_SAMPLING_MAX_IDW_NEIGHBORS)
+        return rl_error(RL_ERR_LIMIT, "rl_approx_set_interpolation: %u neighbours, at most %d", idw_neighbors,
+                        RL_SAMPLING_MAX_IDW_NEIGHBORS);
+    a->desc.interpolation = interpolation;
+    a->desc.idw_neighbors = idw_neighbors ? idw_neighbors : RL_SAMPLING_DEFAULT_IDW_NEIGHBORS;
     return RL_OK;
 }
 

@@ -34,7 +34,8 @@
 #define MAX_SET_SIZE (1u << 26)
 
 static const char *const method_names[] = { "adaptive", "grid", NULL };
-static const char *const position_names[] = { "blue_noise_corners", "blue_noise", "random", "lattice", NULL };
+static const char *const interpolation_names[] = { "idw", "nearest", "region", NULL };
+static const char *const position_names[] = { "blue_noise", "blue_noise_corners", "random", "lattice", NULL };
 static const char *const combine_names[] = { "mean", "max", "min", NULL };
 
 /* ---- saving ---- */
@@ -117,8 +118,8 @@ static cJSON *save_desc(const rl_sampling_desc *d)
               add(o, "combine", cJSON_CreateString(combine_names[d->combine])) &&
               add(o, "seed", cJSON_CreateString(seed)) && add(o, "workers", cJSON_CreateNumber(d->workers)) &&
               add(o, "linear", cJSON_CreateBool(d->linear)) &&
-              add(o, "interpolation", cJSON_CreateString(d->interpolation == RL_INTERP_REGION
-                                                             ? "region" : "nearest")) &&
+              add(o, "interpolation", cJSON_CreateString(interpolation_names[d->interpolation])) &&
+              add(o, "idw_neighbors", cJSON_CreateNumber(d->idw_neighbors)) &&
               add(o, "quality_size", cJSON_CreateString(d->quality_size == RL_QUALITY_DIAMETER
                                                             ? "diameter" : "measure")) &&
               add(o, "grid_shift", cJSON_CreateBool(d->grid_shift));
@@ -278,14 +279,18 @@ static rl_status get_finite(const loader *l, const cJSON *item, const char *key,
     return st;
 }
 
-/* A float stored as a double must come back as the same float. */
+/* A float stored as a double must come back as the same float. Tools that
+ * re-print the file may shorten the number to 15 digits (cJSON does), which
+ * moves it by far less than 1e-12 of itself but no longer hits the float
+ * exactly; such a number still names one float. A value like 0.1 (1.5e-9
+ * from the nearest float) was not written by us and is refused. */
 static rl_status get_float(const loader *l, const cJSON *item, const char *key, float *out)
 {
     double v = 0.0;
     rl_status st = get_finite(l, item, key, &v);
     if (st != RL_OK)
         return st;
-    if (fabs(v) > 3.4e38 || (double)(float)v != v)
+    if (fabs(v) > 3.4e38 || fabs((double)(float)v - v) > 1e-12 * fabs(v))
         return rl_json_error(l->doc, item, "\"%s\": %.17g is not a single-precision number", key, v);
     *out = (float)v;
     return RL_OK;
@@ -353,7 +358,7 @@ static rl_status load_desc(const loader *l, const cJSON *o, int dims, rl_samplin
     static const char *const keys[] = { "method", "positions", "max_samples", "max_seconds", "min_side",
                                         "samples_base", "samples_per_meter", "candidates", "grid_res",
                                         "combine", "seed", "workers", "linear", "interpolation",
-                                        "quality_size", "grid_shift", NULL };
+                                        "idw_neighbors", "quality_size", "grid_shift", NULL };
     rl_status st = rl_json_check_keys(l->doc, o, "\"desc\"", keys);
     cJSON *c = NULL;
     int e = 0;
@@ -412,11 +417,16 @@ static rl_status load_desc(const loader *l, const cJSON *o, int dims, rl_samplin
             return rl_json_error(l->doc, c, "\"linear\": expected true or false");
         d->linear = cJSON_IsTrue(c);
     }
-    if (st == RL_OK && (st = member(l, o, "interpolation", "\"desc\"", &c)) == RL_OK) {
-        const char *s = cJSON_IsString(c) ? c->valuestring : "";
-        if (strcmp(s, "nearest") != 0 && strcmp(s, "region") != 0)
-            return rl_json_error(l->doc, c, "\"interpolation\": expected \"nearest\" or \"region\"");
-        d->interpolation = strcmp(s, "region") == 0 ? RL_INTERP_REGION : RL_INTERP_NEAREST;
+    if (st == RL_OK && (st = member(l, o, "interpolation", "\"desc\"", &c)) == RL_OK &&
+        (st = get_enum(l, c, "interpolation", interpolation_names, &e)) == RL_OK)
+        d->interpolation = (rl_interpolation)e;
+    /* Files written before the option existed have no neighbour count. */
+    d->idw_neighbors = RL_SAMPLING_DEFAULT_IDW_NEIGHBORS;
+    c = cJSON_GetObjectItemCaseSensitive(o, "idw_neighbors");
+    if (st == RL_OK && c && (st = get_uint(l, c, "idw_neighbors", RL_SAMPLING_MAX_IDW_NEIGHBORS, &u)) == RL_OK) {
+        if (u == 0)
+            return rl_json_error(l->doc, c, "\"idw_neighbors\": expected 1 to %d", RL_SAMPLING_MAX_IDW_NEIGHBORS);
+        d->idw_neighbors = (uint32_t)u;
     }
     /* Files written before the option existed were made with the diameter. */
     d->quality_size = RL_QUALITY_DIAMETER;

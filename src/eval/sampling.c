@@ -97,6 +97,11 @@ static rl_status resolve(rl_property *p, const rl_sampling_desc *in, rl_sampling
         d->samples_per_meter = DEFAULT_SAMPLES_PER_METER;
     if (d->candidates == 0)
         d->candidates = DEFAULT_CANDIDATES;
+    if (d->idw_neighbors > RL_SAMPLING_MAX_IDW_NEIGHBORS)
+        return rl_error(RL_ERR_LIMIT, "rl_sample_property: idw_neighbors %u (at most %d)", d->idw_neighbors,
+                        RL_SAMPLING_MAX_IDW_NEIGHBORS);
+    if (d->idw_neighbors == 0)
+        d->idw_neighbors = RL_SAMPLING_DEFAULT_IDW_NEIGHBORS;
 
     int committed = rl_property_workers(p);
     if (committed < 1)

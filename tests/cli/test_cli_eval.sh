@@ -22,6 +22,9 @@ expect_usage_error "$RL" eval cornell --property visibility --region 1,1,1,0,0,0
 expect_usage_error "$RL" eval cornell --property visibility --region 100,100,100,200,200,200 --out "$TMP/e"
 expect_usage_error "$RL" eval cornell --property visibility --height 1e6 --out "$TMP/e"
 expect_usage_error "$RL" eval cornell --property visibility --positions fancy --out "$TMP/e"
+expect_usage_error "$RL" eval cornell --property visibility --interp cubic --out "$TMP/e"
+expect_usage_error "$RL" eval cornell --property visibility --idw-neighbors 0 --out "$TMP/e"
+expect_usage_error "$RL" eval cornell --property visibility --idw-neighbors 33 --out "$TMP/e"
 expect_usage_error "$RL" eval cornell --property visibility --report "$TMP/e/r.txt"
 expect_usage_error "$RL" eval cornell --property time --set renderer=nosuch --out "$TMP/e"
 [ -e "$TMP/e/approx.json" ] && fail "a failed eval wrote approx.json"
@@ -29,7 +32,7 @@ expect_exit 1 "$RL" eval no-such-scene.json --property visibility --out "$TMP/e"
 expect_exit 0 "$RL" eval --list
 for p in visibility time ops quality resolution renderer metric; do expect_in "$TMP/out" "$p"; done
 expect_exit 0 "$RL" eval --help
-for o in --property --set --validate --dims --region --height --positions --interp --samples; do
+for o in --property --set --validate --dims --region --height --positions --interp --idw-neighbors --samples; do
     expect_in "$TMP/out" "$o"
 done
 
@@ -65,6 +68,30 @@ import json, sys
 e = json.load(open(sys.argv[1]))
 a = json.load(open(sys.argv[2]))
 assert a["desc"]["grid_shift"] is True and e["sampling"]["grid_shift"] is True, (a["desc"], e["sampling"])
+PY
+fi
+
+# Queries: idw with 4 neighbours by default, the count and the other
+# interpolations reach the sampler and both records.
+if have_python; then
+    python3 - "$TMP/vis/eval.json" "$TMP/vis/approx.json" <<'PY' || fail "the default queries are not idw"
+import json, sys
+e = json.load(open(sys.argv[1]))
+a = json.load(open(sys.argv[2]))
+assert a["desc"]["interpolation"] == "idw" and a["desc"]["idw_neighbors"] == 4, a["desc"]
+assert e["sampling"]["interpolation"] == "idw" and e["sampling"]["idw_neighbors"] == 4, e["sampling"]
+PY
+fi
+run_ok "$RL" eval cornell --property visibility --set resolution=16 --samples 16 --idw-neighbors 7 \
+    --validate 8 --out "$TMP/idw7"
+run_ok "$RL" eval cornell --property visibility --set resolution=16 --samples 16 --interp nearest \
+    --validate 8 --out "$TMP/near"
+if have_python; then
+    python3 - "$TMP/idw7/approx.json" "$TMP/near/approx.json" <<'PY' || fail "--idw-neighbors/--interp are not applied"
+import json, sys
+a, b = (json.load(open(f)) for f in sys.argv[1:3])
+assert a["desc"]["interpolation"] == "idw" and a["desc"]["idw_neighbors"] == 7, a["desc"]
+assert b["desc"]["interpolation"] == "nearest", b["desc"]
 PY
 fi
 
@@ -104,7 +131,7 @@ expect_error 2 "expected a number" "$RL" bench sampling --samples-base 0 --out "
 expect_error 2 "expected a number" "$RL" bench sampling --samples-per-meter nan --out "$TMP/b.json"
 expect_usage_error "$RL" bench sampling --repeats 0 --out "$TMP/b.json"
 run_ok "$RL" bench sampling --quick --out "$TMP/b.json"
-for s in variants convergence throughput bn-corners; do expect_in "$TMP/out" "$s"; done
+for s in variants convergence throughput grid-idw bn-corners; do expect_in "$TMP/out" "$s"; done
 if have_python; then
     python3 - "$TMP/b.json" <<'PY' || fail "bench sampling JSON is not complete"
 import json, sys
@@ -113,7 +140,7 @@ for s in ("variants", "convergence", "throughput"):
     assert r[s]["status"] == "ok", (s, r[s])
 assert r["variants"]["cases_total"] == 8 and len(r["variants"]["cases"]) == 8
 for c in r["variants"]["cases"]:
-    for v in ("grid", "grid~", "random", "bn", "bn-corners", "bnc-region"):
+    for v in ("grid", "grid-idw", "grid~", "random", "bn", "bn-corners", "bnc-region"):
         assert c[v]["abs_error"]["mean"] >= 0, c
         assert c[v]["mean_abs_error"] == c[v]["abs_error"]["mean"], c
 assert r["throughput"]["rows"][0]["samples_per_second"] > 0
@@ -136,7 +163,7 @@ for x, y in zip(ca, cb):
 assert any(err(x, "bn-corners") != err(y, "bn-corners") for x, y in zip(ca, cb))
 PY
 fi
-# --repeats: the target's pair (grid~, bn-corners) over seeds 1..R, their
+# --repeats: grid~, bn (the target) and bn-corners over seeds 1..R, their
 # mean compared; seed 1 is the run without repeats, the rest untouched.
 run_ok "$RL" bench sampling --quick --only variants --repeats 3 --out "$TMP/b3.json"
 if have_python; then
@@ -145,16 +172,20 @@ import json, sys
 a, b = (json.load(open(f)) for f in sys.argv[1:3])
 assert b["parameters"]["repeats"] == 3
 for x, y in zip(a["variants"]["cases"], b["variants"]["cases"]):
-    for v in ("grid", "grid~", "random", "bn", "bn-corners", "bnc-region"):
+    for v in ("grid", "grid-idw", "grid~", "random", "bn", "bn-corners", "bnc-region"):
         seeds = y[v]["mean_abs_error_per_seed"]
-        assert len(seeds) == (3 if v in ("grid~", "bn-corners") else 1), (v, y)
+        assert len(seeds) == (3 if v in ("grid~", "bn", "bn-corners") else 1), (v, y)
         assert seeds[0] == x[v]["abs_error"]["mean"], (v, x, y)
         assert abs(y[v]["mean_abs_error"] - sum(seeds) / len(seeds)) < 1e-12, (v, y)
-    m, g, s = (y[v]["mean_abs_error"] for v in ("bn-corners", "grid", "grid~"))
-    assert y["adaptive_no_worse_than_grid"] == (m <= g), y
+    m, g, gi, s = (y[v]["mean_abs_error"] for v in ("bn", "grid", "grid-idw", "grid~"))
+    assert y["adaptive_no_worse_than_grid"] == (m <= min(g, gi)), y
+    assert y["adaptive_no_worse_than_thesis_grid"] == (m <= g), y
     assert y["adaptive_no_worse_than_shifted_grid"] == (m <= s), y
+    # grid-idw queries the grid's own samples: the same count, the same time
+    assert y["grid-idw"]["samples_taken"] == y["grid"]["samples_taken"], y
 r = b["variants"]
 assert r["cases_met"] == sum(c["adaptive_no_worse_than_grid"] for c in r["cases"])
+assert r["cases_met_thesis_grid"] == sum(c["adaptive_no_worse_than_thesis_grid"] for c in r["cases"])
 assert r["cases_met_shifted_grid"] == sum(c["adaptive_no_worse_than_shifted_grid"] for c in r["cases"])
 PY
 fi

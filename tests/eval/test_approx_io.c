@@ -334,6 +334,33 @@ static void test_broken_files_are_refused(void **state)
     expect_load(broken, RL_ERR_PARSE);
     free(text);
 
+    /* Re-printed by cJSON (numbers shortened to 15 digits where that comes
+     * within its epsilon): still the same approximation. */
+    text = read_text(good, &len);
+    cJSON *root = cJSON_Parse(text);
+    free(text);
+    assert_non_null(root);
+    char *reprinted = cJSON_Print(root);
+    cJSON_Delete(root);
+    write_text(broken, reprinted, strlen(reprinted));
+    cJSON_free(reprinted);
+    rl_approx *again = NULL;
+    if (rl_approx_load_json(broken, &again) != RL_OK)
+        fail_msg("re-printed file: %s", rl_last_error());
+    /* The same float positions; values within cJSON's rounding. */
+    assert_int_equal(rl_approx_sample_count(again), rl_approx_sample_count(a));
+    for (uint32_t i = 0; i < rl_approx_sample_count(a); ++i) {
+        rl_vec3 pa, pb;
+        double va, vb;
+        assert_int_equal(rl_approx_sample(a, i, &pa, &va), RL_OK);
+        assert_int_equal(rl_approx_sample(again, i, &pb, &vb), RL_OK);
+        assert_memory_equal(&pa, &pb, sizeof pa);
+        assert_float_equal(va, vb, 1e-12 * (1.0 + fabs(va)));
+        assert_int_equal(rl_approx_query(again, pa, &vb, NULL), RL_OK);
+        assert_float_equal(va, vb, 1e-12 * (1.0 + fabs(va)));
+    }
+    rl_approx_release(again);
+
     expect_edit_refused(good, broken, edit_version, "version");
     expect_edit_refused(good, broken, edit_format, "format");
     expect_edit_refused(good, broken, edit_unknown_key, "bounce");

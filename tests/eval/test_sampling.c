@@ -150,6 +150,7 @@ static double f_wave(rl_vec3 p) { return sin(p.x) * cos(0.7 * p.z) + 0.1 * p.y; 
 static rl_approx *one_split(rl_property *p, int dims, rl_aabb region, uint32_t budget)
 {
     return sample(p, (rl_sampling_desc){ .region = region, .dims = dims, .max_samples = budget,
+                                          .positions = RL_POSITIONS_BLUE_NOISE_CORNERS,
                                           .samples_base = dims == 2 ? 3.5f : 7.5f, .samples_per_meter = 0.01f,
                                           .min_side = 0.01f });
 }
@@ -236,7 +237,8 @@ static void test_step_property_gives_hand_counted_regions_and_shared_samples(voi
     fn_prop fp = { .f = f_step };
     rl_property *p = make_property(&fp, 2, 0);
     rl_sampling_desc d = { .region = box2(0, 0, 8, 8), .dims = 2, .max_samples = 18, .samples_base = 3.5f,
-                           .samples_per_meter = 0.01f, .min_side = 2.0f };
+                           .samples_per_meter = 0.01f, .min_side = 2.0f,
+                           .positions = RL_POSITIONS_BLUE_NOISE_CORNERS };
     rl_approx *a = sample(p, d);
     assert_int_equal(atomic_load(&fp.calls), 18);
     assert_int_equal(rl_approx_sample_count(a), 18);
@@ -344,7 +346,7 @@ static void test_linear_property_is_fitted_with_near_zero_error(void **state)
     fn_prop fp2 = { .f = f_linear };
     rl_property *p2 = make_property(&fp2, 1, 0);
     rl_aabb b2 = box2(-3, 1, 5, 4);
-    for (int v = RL_POSITIONS_BLUE_NOISE_CORNERS; v <= RL_POSITIONS_GRID; ++v) {
+    for (int v = RL_POSITIONS_BLUE_NOISE; v <= RL_POSITIONS_GRID; ++v) {
         a = sample(p2, (rl_sampling_desc){ .region = b2, .dims = 2, .height = 1.5f, .max_samples = 200,
                                            .min_side = 0.05f, .positions = (rl_position_variant)v,
                                            .linear = true, .seed = 3 });
@@ -382,7 +384,7 @@ static void test_sample_budget_is_spent_exactly(void **state)
     fn_prop fp = { .f = f_wave };
     rl_property *p = make_property(&fp, 3, 0);
     uint32_t budgets[] = { 1, 7, 37, 100, 333 };
-    for (int v = RL_POSITIONS_BLUE_NOISE_CORNERS; v <= RL_POSITIONS_GRID; ++v)
+    for (int v = RL_POSITIONS_BLUE_NOISE; v <= RL_POSITIONS_GRID; ++v)
         for (size_t i = 0; i < sizeof budgets / sizeof budgets[0]; ++i)
             for (int dims = 2; dims <= 3; ++dims) {
                 atomic_store(&fp.calls, 0);
@@ -513,7 +515,7 @@ static void test_results_are_identical_for_any_worker_count_and_seed(void **stat
     (void)state;
     fn_prop fp = { .f = f_wave };
     rl_property *p = make_property(&fp, 4, 0);
-    for (int v = RL_POSITIONS_BLUE_NOISE_CORNERS; v <= RL_POSITIONS_GRID; ++v) {
+    for (int v = RL_POSITIONS_BLUE_NOISE; v <= RL_POSITIONS_GRID; ++v) {
         rl_sampling_desc d = { .region = box3(-5, 0, -5, 5, 3, 5), .max_samples = 700, .min_side = 0.2f,
                                .positions = (rl_position_variant)v, .seed = 42, .workers = 1 };
         rl_approx *one = sample(p, d);
@@ -565,7 +567,7 @@ static void test_grid_method_samples_each_cell_centre_once(void **state)
     rl_property *p = make_property(&fp, 2, 0);
     /* 4 x 2 x 1 with 64 samples: cubes of 0.5, 8 x 4 x 2. */
     rl_approx *a = sample(p, (rl_sampling_desc){ .region = box3(0, 0, 0, 4, 2, 1), .method = RL_SAMPLING_GRID,
-                                                  .max_samples = 64 });
+                                                  .max_samples = 64, .interpolation = RL_INTERP_NEAREST });
     assert_int_equal(atomic_load(&fp.calls), 64);
     assert_int_equal(rl_approx_region_count(a), 64);
     assert_int_equal(rl_approx_sample_count(a), 64);
@@ -655,10 +657,9 @@ static void test_shifted_grid_moves_every_sample_by_one_offset(void **state)
             assert_near(rel_o[k], off_other[k], 1e-5);
             assert_true(rel[k] >= 0.0 && rel[k] <= 1.0);
         }
-        /* Queries inside the cell answer with its sample. */
+        /* A query on the sample answers with it (also by default, idw). */
         double q;
-        assert_int_equal(rl_approx_query(a, (rl_vec3){ r.box.min.x + 0.25f, r.box.min.y + 0.25f,
-                                                        r.box.min.z + 0.25f }, &q, NULL), RL_OK);
+        assert_int_equal(rl_approx_query(a, s, &q, NULL), RL_OK);
         assert_near(q, v, 0.0);
     }
     assert_true(fabs(off[0] - 0.5) + fabs(off[1] - 0.5) + fabs(off[2] - 0.5) > 1e-3);
@@ -687,7 +688,8 @@ static void test_query_on_a_boundary_picks_the_smaller_index(void **state)
     rl_property *p = make_property(&fp, 1, 0);
     rl_approx *a = sample(p, (rl_sampling_desc){ .region = box2(0, 0, 4, 1), .dims = 2, .max_samples = 6,
                                                  .samples_base = 3.5f, .samples_per_meter = 0.01f,
-                                                 .min_side = 0.01f, .interpolation = RL_INTERP_REGION });
+                                                 .min_side = 0.01f, .interpolation = RL_INTERP_REGION,
+                                                 .positions = RL_POSITIONS_BLUE_NOISE_CORNERS });
     double v;
     uint32_t leaf = 99;
     assert_int_equal(rl_approx_query(a, (rl_vec3){ 2.0f, -7.0f, 0.5f }, &v, &leaf), RL_OK);
@@ -697,9 +699,10 @@ static void test_query_on_a_boundary_picks_the_smaller_index(void **state)
     assert_int_equal(leaf, 1);
     assert_near(v, 3.0, 1e-12);
     rl_approx_release(a);
-    /* The default, nearest sample of the leaf: on the boundary the corners
-     * at x = 2 (f = 2) are nearest; inside the left leaf near x = 0, 0. */
+    /* The nearest sample: on the boundary the corners at x = 2 (f = 2)
+     * are nearest; inside the left leaf near x = 0, 0. */
     a = one_split(p, 2, box2(0, 0, 4, 1), 6);
+    assert_int_equal(rl_approx_set_interpolation(a, RL_INTERP_NEAREST, 0), RL_OK);
     assert_int_equal(rl_approx_query(a, (rl_vec3){ 2.0f, 0, 0.5f }, &v, &leaf), RL_OK);
     assert_int_equal(leaf, 0);
     assert_near(v, 2.0, 1e-12);
@@ -733,7 +736,8 @@ static void test_nearest_query_is_the_nearest_of_all_samples(void **state)
     for (int dims = 2; dims <= 3; ++dims) {
         rl_aabb box = dims == 2 ? box2(-6, -4, 7, 5) : box3(-6, -1, -4, 7, 3, 5);
         rl_approx *a = sample(p, (rl_sampling_desc){ .region = box, .dims = dims, .max_samples = 300,
-                                                     .min_side = 0.2f, .seed = 5 });
+                                                     .min_side = 0.2f, .seed = 5,
+                                                     .interpolation = RL_INTERP_NEAREST });
         uint32_t n = rl_approx_sample_count(a), other_leaf = 0;
         rl_rng rng;
         rl_rng_seed(&rng, 11, 3);
@@ -770,6 +774,111 @@ static void test_nearest_query_is_the_nearest_of_all_samples(void **state)
     rl_property_release(p);
 }
 
+/* Brute-force Shepard weighting (power 2) of the k nearest samples of a,
+ * ties by sample index; a query on a sample gives that sample. */
+static double brute_idw(const rl_approx *a, rl_vec3 x, int dims, uint32_t k)
+{
+    uint32_t n = rl_approx_sample_count(a), idx[RL_SAMPLING_MAX_IDW_NEIGHBORS];
+    double d2s[RL_SAMPLING_MAX_IDW_NEIGHBORS] = { 0 }, vals[RL_SAMPLING_MAX_IDW_NEIGHBORS] = { 0 };
+    uint32_t have = 0;
+    assert_true(n > 0);
+    for (uint32_t i = 0; i < n; ++i) {
+        rl_vec3 sp;
+        double sv;
+        assert_int_equal(rl_approx_sample(a, i, &sp, &sv), RL_OK);
+        double dx = (double)sp.x - x.x, dy = dims == 3 ? (double)sp.y - x.y : 0.0, dz = (double)sp.z - x.z;
+        double d2 = dx * dx + dy * dy + dz * dz;
+        if (have == k && d2 >= d2s[k - 1])
+            continue;
+        uint32_t j = have < k ? have++ : k - 1;
+        for (; j > 0 && d2s[j - 1] > d2; --j) {
+            d2s[j] = d2s[j - 1];
+            vals[j] = vals[j - 1];
+            idx[j] = idx[j - 1];
+        }
+        d2s[j] = d2;
+        vals[j] = sv;
+        idx[j] = i;
+    }
+    if (d2s[0] == 0.0 || have == 1)
+        return vals[0];
+    double ws = 0.0, vs = 0.0;
+    for (uint32_t j = 0; j < have; ++j) {
+        ws += 1.0 / d2s[j];
+        vs += vals[j] / d2s[j];
+    }
+    return vs / ws;
+}
+
+/* The default queries weight the idw_neighbors nearest samples of all by
+ * inverse squared distance (Shepard): checked against brute force on
+ * adaptive trees in 2-D and 3-D and on centred and shifted grids (whose
+ * search walks rings of cells), for 1, 4 (the default) and 9 neighbours;
+ * every sample answers its own position exactly, and the answers lie
+ * within the range of the samples. */
+static void test_idw_query_weights_the_nearest_samples(void **state)
+{
+    (void)state;
+    fn_prop fp = { .f = f_wave };
+    rl_property *p = make_property(&fp, 2, 0);
+    for (int c = 0; c < 8; ++c) {
+        int dims = c % 2 ? 3 : 2;
+        rl_aabb box = dims == 2 ? box2(-6, -4, 7, 5) : box3(-6, -1, -4, 7, 3, 5);
+        rl_sampling_desc d = { .region = box, .dims = dims, .max_samples = 300, .min_side = 0.2f, .seed = 5 };
+        d.method = c / 2 == 0 ? RL_SAMPLING_ADAPTIVE : RL_SAMPLING_GRID;
+        d.grid_shift = c / 2 == 2;
+        d.idw_neighbors = c / 2 == 3 ? 9 : 0;
+        rl_approx *a = sample(p, d);
+        uint32_t k = c / 2 == 3 ? 9 : 4;
+        double lo = INFINITY, hi = -INFINITY;
+        for (uint32_t i = 0; i < rl_approx_sample_count(a); ++i) {
+            rl_vec3 sp;
+            double sv, v;
+            assert_int_equal(rl_approx_sample(a, i, &sp, &sv), RL_OK);
+            assert_int_equal(rl_approx_query(a, sp, &v, NULL), RL_OK);
+            assert_near(v, sv, 0.0);
+            lo = sv < lo ? sv : lo;
+            hi = sv > hi ? sv : hi;
+        }
+        rl_rng rng;
+        rl_rng_seed(&rng, 12, (uint64_t)c);
+        for (int q = 0; q < 1000; ++q) {
+            rl_vec3 x = { box.min.x + (box.max.x - box.min.x) * rl_rng_float(&rng),
+                          dims == 2 ? 0.0f : box.min.y + (box.max.y - box.min.y) * rl_rng_float(&rng),
+                          box.min.z + (box.max.z - box.min.z) * rl_rng_float(&rng) };
+            double v, want = brute_idw(a, x, dims, k);
+            assert_int_equal(rl_approx_query(a, x, &v, NULL), RL_OK);
+            assert_near(v, want, 1e-9 * (1.0 + fabs(want)));
+            assert_true(v >= lo - 1e-9 && v <= hi + 1e-9);
+            if (c == 0 && q < 200) {   /* the same approximation, one neighbour: the nearest sample */
+                assert_int_equal(rl_approx_set_interpolation(a, RL_INTERP_IDW, 1), RL_OK);
+                assert_int_equal(rl_approx_query(a, x, &v, NULL), RL_OK);
+                assert_near(v, brute_idw(a, x, dims, 1), 0.0);
+                assert_int_equal(rl_approx_set_interpolation(a, RL_INTERP_IDW, 0), RL_OK);
+            }
+        }
+        rl_approx_release(a);
+    }
+    /* Refusals. */
+    rl_approx *a = sample(p, (rl_sampling_desc){ .region = box2(0, 0, 1, 1), .dims = 2, .max_samples = 8 });
+    rl_clear_error();
+    assert_int_equal(rl_approx_set_interpolation(a, (rl_interpolation)7, 0), RL_ERR_INVALID_ARG);
+    assert_int_equal(rl_approx_set_interpolation(a, RL_INTERP_IDW, RL_SAMPLING_MAX_IDW_NEIGHBORS + 1),
+                     RL_ERR_LIMIT);
+    assert_int_equal(rl_approx_set_interpolation(NULL, RL_INTERP_IDW, 0), RL_ERR_INVALID_ARG);
+    rl_approx_release(a);
+    rl_approx *none = NULL;
+    rl_clear_error();
+    assert_int_equal(rl_sample_property(p, &(rl_sampling_desc){ .region = box2(0, 0, 1, 1), .dims = 2,
+                                                                .idw_neighbors = RL_SAMPLING_MAX_IDW_NEIGHBORS + 1 },
+                                        &none),
+                     RL_ERR_LIMIT);
+    assert_non_null(strstr(rl_last_error(), "idw_neighbors"));
+    assert_null(none);
+    rl_clear_error();
+    rl_property_release(p);
+}
+
 /* The quality rule: with the diameter (the thesis) the regions along a
  * step keep being split while the flat rest stays coarse; with the area
  * (our default) a split raises q by the same factor everywhere, so the
@@ -783,6 +892,7 @@ static void test_quality_size_spreads_the_refinement(void **state)
     double largest[2] = { 0, 0 }, smallest[2] = { INFINITY, INFINITY };
     for (int k = 0; k < 2; ++k) {
         rl_approx *a = sample(p, (rl_sampling_desc){ .region = box2(0, 0, 16, 16), .dims = 2, .max_samples = 400,
+                                                     .positions = RL_POSITIONS_BLUE_NOISE_CORNERS,
                                                      .min_side = 0.05f, .quality_size = (rl_quality_size)k });
         for (uint32_t i = 0; i < rl_approx_region_count(a); ++i) {
             rl_approx_region r = region(a, i);
@@ -1089,6 +1199,7 @@ int main(void)
         cmocka_unit_test(test_shifted_grid_moves_every_sample_by_one_offset),
         cmocka_unit_test(test_query_on_a_boundary_picks_the_smaller_index),
         cmocka_unit_test(test_nearest_query_is_the_nearest_of_all_samples),
+        cmocka_unit_test(test_idw_query_weights_the_nearest_samples),
         cmocka_unit_test(test_quality_size_spreads_the_refinement),
         cmocka_unit_test(test_combine_takes_mean_max_or_min),
         cmocka_unit_test(test_leaf_sets_are_unions_of_their_samples_sets),
