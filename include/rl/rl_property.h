@@ -43,7 +43,10 @@
  *               directions. Unconditioned (default): the renderer is
  *               reset (rl_renderer_reset) before every measured frame, so
  *               no state of earlier frames is reused, while what it built
- *               for the scene (BVH, Line Space) is kept; conditioned: the worker's renderer is kept and
+ *               for the scene (BVH, Line Space) is kept; each worker's
+ *               renderer draws one unmeasured frame before its first
+ *               measured one, so that building for the scene is never
+ *               timed. Conditioned: the worker's renderer is kept and
  *               up to `condition_frames` (default 10) unmeasured frames
  *               come first, stopping after the first frame that is not 2 %
  *               faster than the one before. Options: renderer (default
@@ -64,9 +67,11 @@
  *               thread per renderer when several workers are committed.
  *   quality     Image quality of a renderer against a reference renderer
  *               (Sec. 4.2.5, Def. 7): per direction both render; `metric` =
- *               ssim (default), hssim (hierarchical SSIM over a Gaussian
- *               pyramid, see rl_metrics.h), psnr, or rmse; the minimum over
- *               the directions for ssim/hssim/psnr, the maximum for rmse.
+ *               hssim (default: hierarchical SSIM over a Gaussian pyramid,
+ *               as the thesis, see rl_metrics.h), ssim, psnr (dB, capped
+ *               at RL_PROPERTY_PSNR_MAX for equal images, so that
+ *               statistics stay finite) or rmse; the minimum over the
+ *               directions for ssim/hssim/psnr, the maximum for rmse.
  *               Flagged RL_PROPERTY_HIGHER_IS_BETTER except for rmse.
  *               Options: renderer, renderer_options, reference (default
  *               raster), reference_options, width, height, fov_deg,
@@ -104,6 +109,10 @@ extern "C" {
 #endif
 
 typedef struct rl_property rl_property;
+
+/* The quality property's PSNR of equal images (otherwise +inf), dB: above
+ * any real difference of 8-bit images (one level in every pixel: 48 dB). */
+#define RL_PROPERTY_PSNR_MAX 100.0
 
 typedef enum rl_property_flags {
     /* Timing: evaluate on one worker at a time, never concurrently. */

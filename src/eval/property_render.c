@@ -89,7 +89,9 @@ static const char *const counter_choices[] = {
     "pixels", "samples", "occlusion_queries", "points", "primitives", NULL
 };
 enum { CNT_TRIANGLES = 0, CNT_RAYS, CNT_PRIMARY, CNT_SHADOW, CNT_SECONDARY, CNT_PIXELS,
-       CNT_SAMPLES, CNT_QUERIES, CNT_POINTS, CNT_PRIMITIVES };
+       CNT_SAMPLES, CNT_QUERIES, CNT_POINTS, CNT_PRIMITIVES, CNT_COUNT };
+_Static_assert(sizeof counter_choices / sizeof counter_choices[0] == CNT_COUNT + 1,
+               "one name per counter");
 static const char *const reduce_choices[] = { "max", "sum", NULL };
 enum { REDUCE_MAX = 0, REDUCE_SUM };
 
@@ -112,8 +114,9 @@ static const rl_option_info quality_options[] = {
       NULL },
     { "reference_options", RL_OPT_STRING, "", "\"key=value,...\" options of the reference", 0,
       0, NULL },
-    { "metric", RL_OPT_ENUM, "ssim",
-      "ssim, hssim (multi-scale SSIM, Burt pyramid), psnr (dB) or rmse", 0, 0, metric_choices },
+    { "metric", RL_OPT_ENUM, "hssim",
+      "ssim, hssim (multi-scale SSIM, Burt pyramid), psnr (dB, at most 100: equal images) or rmse",
+      0, 0, metric_choices },
     { "hssim_levels", RL_OPT_INT, "5", "pyramid levels of hssim (Wang et al. 2003 use 5)", 2, 5,
       NULL },
 };
@@ -151,6 +154,7 @@ typedef struct renderer_recipe {
 typedef struct rp_worker {
     rl_renderer *r, *ref;
     rl_image *img, *ref_img;
+    bool built;                 /* time: the renderer has built for the scene */
 } rp_worker;
 
 typedef struct rp_state {
@@ -331,6 +335,18 @@ static rl_status time_evaluate(rl_property *p, void *state, int worker, rl_vec3 
     rp_worker *w = &s->w[worker];
     double *times = s->times + (size_t)worker * (size_t)s->repeats;
     double value = 0.0;
+    if (!w->built) {
+        /* What a renderer builds for the scene on its first frame (a BVH, a
+         * Line Space, surfels, sampled properties) is preprocessing, not the
+         * time of a frame at this position: one unmeasured frame first, then
+         * reset, which keeps the build (rl_renderer_reset). */
+        rl_camera cam = direction_camera(s, pos, 0);
+        rl_status st = rl_renderer_render(w->r, s->scene, &cam, w->img, NULL);
+        if (st != RL_OK)
+            return st;
+        rl_renderer_reset(w->r);
+        w->built = true;
+    }
     for (int i = 0; i < 6; ++i) {
         rl_camera cam = direction_camera(s, pos, i);
         rl_status st = RL_OK;
@@ -427,7 +443,8 @@ static rl_status quality_evaluate(rl_property *p, void *state, int worker, rl_ve
             st = rl_image_compare(w->img, w->ref_img, &mo, &m);
         if (st != RL_OK)
             return st;
-        double v = s->metric == METRIC_PSNR ? m.psnr : s->metric == METRIC_RMSE ? m.rmse : m.ssim;
+        double v = s->metric == METRIC_PSNR ? fmin(m.psnr, RL_PROPERTY_PSNR_MAX)
+                 : s->metric == METRIC_RMSE ? m.rmse : m.ssim;
         out->direction[i] = v;
         /* Def. 7: the worst direction, i.e. min of a quality, max of an error */
         value = error_metric ? (v > value ? v : value) : (v < value ? v : value);
@@ -470,8 +487,12 @@ static unsigned time_flags(const rl_property *p)
 
 static const char *ops_unit(const rl_property *p)
 {
-    static const char *const units[] = { "triangles", "rays", "rays", "rays", "rays",
-                                         "pixels", "samples", "queries" };
+    static const char *const units[CNT_COUNT] = {
+        [CNT_TRIANGLES] = "triangles", [CNT_RAYS] = "rays", [CNT_PRIMARY] = "rays",
+        [CNT_SHADOW] = "rays", [CNT_SECONDARY] = "rays", [CNT_PIXELS] = "pixels",
+        [CNT_SAMPLES] = "samples", [CNT_QUERIES] = "queries", [CNT_POINTS] = "points",
+        [CNT_PRIMITIVES] = "primitives" };
+    _Static_assert(sizeof units / sizeof units[0] == CNT_COUNT, "one unit per counter");
     return units[rl_property_opt_enum(p, "counter")];
 }
 
