@@ -3,9 +3,11 @@
  * instead of along one hand-picked camera path:
  *   time      rendering time, max over 6 directions of the median of
  *             --repeats renders (Def. 6, unconditioned);
- *   rays      traced rays and
- *   triangles rasterized triangles (Sec. 4.2.4, max over the directions);
- *   quality   SSIM against --reference, min over the directions (Def. 7).
+ *   rays      traced rays,
+ *   triangles rasterized triangles and
+ *   queries   occlusion queries (Sec. 4.2.4, max over the directions);
+ *   quality   hierarchical SSIM (or --quality-metric) against --reference,
+ *             min over the directions (Def. 7).
  * The sample positions are chosen once, by adaptive sampling of pixel
  * visibility (the property whose structure most others follow, Sec. 5.7),
  * and every renderer is measured at exactly those positions, so the
@@ -29,15 +31,19 @@ static const char compare_help_head[] =
     "Measures every renderer at the same positions, chosen by adaptive sampling\n"
     "of pixel visibility over a region of the scene, and writes DIR/compare.json\n"
     "and DIR/report.html: heat maps side by side, violin plots and weighted\n"
-    "statistics of rendering time, traced rays, rasterized triangles and SSIM\n"
-    "against the reference.\n"
+    "statistics of rendering time, traced rays, rasterized triangles, occlusion\n"
+    "queries and image quality against the reference.\n"
     "\n"
     "options:\n"
     "  --algos LIST        renderers (rl algos), each optionally with options:\n"
     "                      pt:shadow=ls-pnmt,diffuse=ls-pnmt,whitted (a k=v item\n"
-    "                      after a comma continues the previous renderer's options)\n"
+    "                      after a comma continues the previous renderer's options);\n"
+    "                      a bare value sets every option that offers it:\n"
+    "                      pt:ls-pnmt is pt:shadow=ls-pnmt,diffuse=ls-pnmt\n"
     "  --reference A[:k=v] the exact reference for quality; default whitted\n"
-    "  --metrics LIST      time, rays, triangles, quality; default all\n"
+    "  --quality-metric M  hssim (default: hierarchical SSIM, Jaehn 2015, Sec.\n"
+    "                      4.2.5), ssim, psnr (dB, at most 100) or rmse\n"
+    "  --metrics LIST      time, rays, triangles, queries, quality; default all\n"
     "  --size WxH          image per direction; default 128x128\n"
     "  --fov DEG           field of view per direction; default 120 (Sec. 4.2.3)\n"
     "  --repeats N         renders per direction for time (median); default 3\n"
@@ -48,20 +54,25 @@ static const char compare_help_head[] =
 static const char compare_help_tail[] =
     "\n"
     "example:\n"
-    "  rl compare cornell --algos raster,whitted,vt,pt:spp=1 --samples 64 --out out/cmp\n";
+    "  rl compare cornell --algos raster,whitted,vt,pt:ls-pnmt --samples 64 --out out/cmp\n";
 
 #define MAX_ALGOS 16
-enum { M_TIME, M_RAYS, M_TRIANGLES, M_QUALITY, M_COUNT };
-static const char *const metric_names[M_COUNT] = { "time", "rays", "triangles", "quality" };
+enum { M_TIME, M_RAYS, M_TRIANGLES, M_QUERIES, M_QUALITY, M_COUNT };
+static const char *const metric_names[M_COUNT] = { "time", "rays", "triangles", "queries", "quality" };
 static const char *const metric_titles[M_COUNT] = {
     "Rendering time (Def. 6)", "Traced rays (Sec. 4.2.4)", "Rasterized triangles (Sec. 4.2.4)",
-    "Image quality against the reference (Def. 7)"
+    "Occlusion queries (Sec. 4.2.4)", "Image quality against the reference (Def. 7)"
 };
+/* The quality property's metrics; the report names them. */
+static const char *const quality_metrics[] = { "hssim", "ssim", "psnr", "rmse", NULL };
+static const char *const quality_metric_titles[] = { "hierarchical SSIM", "SSIM", "PSNR", "RMSE" };
+/* An operation count: a renderer that never does it is left out of its plots. */
+static bool is_count(int m) { return m == M_RAYS || m == M_TRIANGLES || m == M_QUERIES; }
 
 typedef struct algo_spec {
     char *label;          /* as given: "pt:shadow=ls-pnmt" */
     char *name;           /* "pt" */
-    char *options;        /* "shadow=ls-pnmt" or NULL */
+    char *options;        /* "shadow=ls-pnmt" (bare values expanded) or NULL */
 } algo_spec;
 
 typedef struct compare_args {
@@ -69,6 +80,7 @@ typedef struct compare_args {
     algo_spec algos[MAX_ALGOS];
     int num_algos;
     algo_spec reference;
+    int quality_metric;   /* index into quality_metrics */
     unsigned metrics;
     int width, height;
     double fov_deg;
@@ -91,15 +103,56 @@ static void free_args(compare_args *a)
     free_spec(&a->reference);
 }
 
+/* Appends "key=value" to the growing option string *out (comma-separated). */
+static bool append_option(char **out, size_t *len, const char *key, const char *value)
+{
+    size_t add = strlen(key) + strlen(value) + 2;
+    char *grown = realloc(*out, *len + add + 1);
+    if (!grown)
+        return false;
+    *out = grown;
+    *len += (size_t)sprintf(grown + *len, "%s%s=%s", *len ? "," : "", key, value);
+    return true;
+}
+
+/* A bare VALUE (no '=') stands for every enum option of the renderer that
+ * offers it: pt:ls-pnmt is pt:shadow=ls-pnmt,diffuse=ls-pnmt, the thesis'
+ * name of the variant. Found by the renderer's own option table, so later
+ * renderers get the shorthand too. RL_ERR_INVALID_ARG with a message when
+ * no option offers the value. */
+static rl_status expand_bare_value(const rl_renderer *r, const char *label, const char *value,
+                                   char **out, size_t *len)
+{
+    size_t count = 0;
+    const rl_option_info *opts = rl_renderer_options(r, &count);
+    int found = 0;
+    for (size_t i = 0; i < count; i++) {
+        if (opts[i].type != RL_OPT_ENUM || !opts[i].choices)
+            continue;
+        for (const char *const *c = opts[i].choices; *c; c++) {
+            if (strcmp(*c, value) != 0)
+                continue;
+            if (!append_option(out, len, opts[i].key, value))
+                return RL_ERR_OUT_OF_MEMORY;
+            found++;
+        }
+    }
+    if (!found) {
+        rl_cli_fail(RL_CLI_USAGE, "%s: '%s' is neither KEY=VALUE nor a value of one of the renderer's "
+                    "options (see rl algos)", label, value);
+        return RL_ERR_INVALID_ARG;
+    }
+    return RL_OK;
+}
+
 /* Splits "name[:k=v,...]" into a spec; checks the renderer and its options
- * by creating it once. */
+ * by creating it once, and expands bare values (expand_bare_value). */
 static bool make_spec(const char *text, algo_spec *s)
 {
     s->label = strdup(text);
     const char *colon = strchr(text, ':');
     s->name = colon ? strndup(text, (size_t)(colon - text)) : strdup(text);
-    s->options = colon && colon[1] ? strdup(colon + 1) : NULL;
-    if (!s->label || !s->name || (colon && colon[1] && !s->options)) {
+    if (!s->label || !s->name) {
         rl_cli_fail(RL_CLI_FAIL, "out of memory");
         return false;
     }
@@ -111,20 +164,43 @@ static bool make_spec(const char *text, algo_spec *s)
         return false;
     }
     /* The options are checked here, not after minutes of sampling. */
-    char *opts = s->options ? strdup(s->options) : NULL, *save = NULL;
+    char *opts = colon && colon[1] ? strdup(colon + 1) : NULL, *save = NULL, *expanded = NULL;
+    size_t len = 0;
+    if (colon && colon[1] && !opts)
+        st = RL_ERR_OUT_OF_MEMORY;
     for (char *kv = opts ? strtok_r(opts, ",", &save) : NULL; kv && st == RL_OK;
          kv = strtok_r(NULL, ",", &save)) {
+        const char *eq = strchr(kv, '=');
+        if (!eq) {
+            st = expand_bare_value(r, s->label, kv, &expanded, &len);
+            continue;
+        }
         char key[128];
         const char *value = NULL;
         if (!rl_cli_split_option(s->label, kv, key, sizeof key, &value)) {
             st = RL_ERR_INVALID_ARG;
             break;
         }
-        if ((st = rl_renderer_set(r, key, value)) != RL_OK)
+        if (!append_option(&expanded, &len, key, value))
+            st = RL_ERR_OUT_OF_MEMORY;
+    }
+    /* Set in order, so that a later item wins as everywhere else. */
+    char *copy = st == RL_OK && expanded ? strdup(expanded) : NULL;
+    for (char *kv = copy ? strtok_r(copy, ",", &save) : NULL; kv && st == RL_OK;
+         kv = strtok_r(NULL, ",", &save)) {
+        char *eq = strchr(kv, '=');
+        *eq = '\0';
+        if ((st = rl_renderer_set(r, kv, eq + 1)) != RL_OK)
             rl_cli_fail_status(RL_CLI_USAGE, st, s->label);
     }
+    if (st == RL_ERR_OUT_OF_MEMORY || (st == RL_OK && expanded && !copy)) {
+        rl_cli_fail(RL_CLI_FAIL, "out of memory");
+        st = RL_ERR_OUT_OF_MEMORY;
+    }
+    free(copy);
     free(opts);
     rl_renderer_release(r);
+    s->options = expanded;
     return st == RL_OK;
 }
 
@@ -198,6 +274,15 @@ static int parse_args(int argc, char **argv, compare_args *a)
             algos = v;
         else if (VALUE("--reference"))
             reference = v;
+        else if (VALUE("--quality-metric")) {
+            int k = 0;
+            while (quality_metrics[k] && strcmp(quality_metrics[k], v) != 0)
+                k++;
+            if (!quality_metrics[k])
+                return rl_cli_fail(RL_CLI_USAGE, "--quality-metric: expected hssim, ssim, psnr or rmse, "
+                                   "got '%s'", v);
+            a->quality_metric = k;
+        }
         else if (VALUE("--out"))
             a->out = v;
         else if (VALUE("--metrics")) {
@@ -253,9 +338,10 @@ static rl_property *metric_property(const compare_args *a, int m, const algo_spe
     if (m == M_TIME) {
         snprintf(num, sizeof num, "%lld", a->repeats);
         SET("repeats", num);
-    } else if (m == M_RAYS || m == M_TRIANGLES) {
-        SET("counter", m == M_RAYS ? "rays" : "triangles");
+    } else if (is_count(m)) {
+        SET("counter", m == M_RAYS ? "rays" : m == M_TRIANGLES ? "triangles" : "occlusion_queries");
     } else if (m == M_QUALITY) {
+        SET("metric", quality_metrics[a->quality_metric]);
         SET("reference", a->reference.name);
         if (a->reference.options)
             SET("reference_options", a->reference.options);
@@ -286,7 +372,7 @@ static void put_metric_section(rl_html *h, const compare_args *a, int m, measure
     for (int i = 0; i < a->num_algos; i++) {
         if (!res[i][m].ok)
             continue;
-        if ((m == M_RAYS || m == M_TRIANGLES) && res[i][m].stats.max <= 0.0)
+        if (is_count(m) && res[i][m].stats.max <= 0.0)
             continue;
         shown[ns++] = i;
         lo = fmin(lo, res[i][m].stats.min);
@@ -327,7 +413,8 @@ static void put_metric_section(rl_html *h, const compare_args *a, int m, measure
                            "per renderer, with box plots inside.");
     free(violin);
     rl_html_row_begin(h);
-    bool reverse = m != M_QUALITY;   /* dark = expensive or bad */
+    /* dark = expensive or bad; of the quality metrics only rmse is an error */
+    bool reverse = m != M_QUALITY || strcmp(quality_metrics[a->quality_metric], "rmse") == 0;
     for (int k = 0; k < ns; k++) {
         char *svg = rl_eval_heatmap_svg(res[shown[k]][m].approx, height, top,
                                         a->algos[shown[k]].label, lo, hi > lo ? hi : lo + 1e-9,
@@ -353,6 +440,7 @@ static cJSON *result_json(const compare_args *a, const rl_scene *scene, const rl
     cJSON_AddNumberToObject(root, "samples", rl_approx_sample_count(driver));
     cJSON_AddNumberToObject(root, "regions", rl_approx_region_count(driver));
     cJSON_AddStringToObject(root, "reference", a->reference.label);
+    cJSON_AddStringToObject(root, "quality_metric", quality_metrics[a->quality_metric]);
     cJSON_AddNumberToObject(root, "width", a->width);
     cJSON_AddNumberToObject(root, "height", a->height);
     cJSON_AddNumberToObject(root, "fov_deg", a->fov_deg);
@@ -508,12 +596,14 @@ int rl_cli_compare(int argc, char **argv)
     rl_html_para(h, "%d renderers measured at the same %u positions (%s, %s sampling of pixel "
                  "visibility at %lld² per cube face, %u regions). Per position: 6 directions, "
                  "%dx%d pixels, %g° field of view; time is the maximum over the directions of "
-                 "the median of %lld renders; quality is SSIM against %s, the minimum over the "
+                 "the median of %lld renders; quality is %s against %s, the %s over the "
                  "directions (Jähn 2015, Ch. 4). Statistics are weighted by region %s.",
                  a.num_algos, ns, d->dims == 2 ? "a 2-D slice" : "a 3-D region",
                  d->method == RL_SAMPLING_GRID ? "grid" : "adaptive", a.resolution,
                  rl_approx_region_count(driver), a.width, a.height, a.fov_deg, a.repeats,
-                 a.reference.label, d->dims == 2 ? "area" : "volume");
+                 quality_metric_titles[a.quality_metric], a.reference.label,
+                 strcmp(quality_metrics[a.quality_metric], "rmse") == 0 ? "maximum" : "minimum",
+                 d->dims == 2 ? "area" : "volume");
     char *vis_svg = rl_eval_heatmap_svg(driver, d->height, top, "visible objects", 0, 0, false, NULL);
     rl_html_svg(h, vis_svg, "Where the samples are: the visibility approximation that placed "
                             "them (adaptive sampling refines where visibility changes).");

@@ -29,6 +29,12 @@ static const char eval_help_head[] =
     "  --property NAME     visibility, time, ops or quality (see --list)\n"
     "  --set KEY=VALUE     property option, repeatable (e.g. resolution=256,\n"
     "                      renderer=whitted, renderer_options=max_depth=2)\n"
+    "  --property2 NAME    sample a combined property (Jaehn 2015, Sec. 4.2.6):\n"
+    "                      --property OP NAME, e.g. the time of one renderer\n"
+    "                      minus another's\n"
+    "  --op OP             of the combined property: minus (default), ratio,\n"
+    "                      min or max\n"
+    "  --set2 KEY=VALUE    option of --property2, repeatable\n"
     "  --validate N        also measure at N uniform random positions and report\n"
     "                      the absolute error of the approximation there\n"
     "  --out DIR           output folder, created if missing; default out/eval\n"
@@ -38,14 +44,24 @@ static const char eval_help_tail[] =
     "\n"
     "example:\n"
     "  rl eval city --property visibility --set resolution=256 --height 1.7 \\\n"
-    "     --samples 512 --validate 200 --out out/eval-city\n";
+    "     --samples 512 --validate 200 --out out/eval-city\n"
+    "  rl eval table --property time --set renderer=vt --property2 time \\\n"
+    "     --set2 renderer=raster --dims 3 --samples 128 --out out/vt-minus-raster\n";
 
 #define MAX_SETS 64
+
+/* --op names, in rl_property_op order. */
+static const char *const combine_ops[] = { "minus", "ratio", "min", "max", NULL };
 
 typedef struct eval_args {
     const char *scene, *property, *out, *report;
     const char *sets[MAX_SETS];
     int num_sets;
+    const char *second;          /* --property2, or NULL */
+    const char *op;              /* --op, or NULL */
+    int combine_op;              /* rl_property_op */
+    const char *sets2[MAX_SETS];
+    int num_sets2;
     long long validate;
     bool list;
     rl_eval_sampling sampling;
@@ -107,6 +123,20 @@ static int parse_args(int argc, char **argv, eval_args *a)
             if (a->num_sets == MAX_SETS)
                 return rl_cli_fail(RL_CLI_USAGE, "--set: at most %d options", MAX_SETS);
             a->sets[a->num_sets++] = v;
+        } else if (m == 0 && (m = rl_cli_take_value(argc, argv, &i, "--set2", &v)) > 0) {
+            if (a->num_sets2 == MAX_SETS)
+                return rl_cli_fail(RL_CLI_USAGE, "--set2: at most %d options", MAX_SETS);
+            a->sets2[a->num_sets2++] = v;
+        } else if (m == 0 && (m = rl_cli_take_value(argc, argv, &i, "--property2", &v)) > 0) {
+            a->second = v;
+        } else if (m == 0 && (m = rl_cli_take_value(argc, argv, &i, "--op", &v)) > 0) {
+            int k = 0;
+            while (combine_ops[k] && strcmp(combine_ops[k], v) != 0)
+                k++;
+            if (!combine_ops[k])
+                return rl_cli_fail(RL_CLI_USAGE, "--op: expected minus, ratio, min or max, got '%s'", v);
+            a->combine_op = k;
+            a->op = v;
         } else if (m == 0 && (m = rl_cli_take_value(argc, argv, &i, "--validate", &v)) > 0) {
             if (!rl_bench_parse_count("--validate", v, 1 << 20, &a->validate))
                 return RL_CLI_USAGE;
@@ -123,22 +153,25 @@ static int parse_args(int argc, char **argv, eval_args *a)
         return rl_cli_fail(RL_CLI_USAGE, "eval: no scene given (see rl eval --help)");
     if (!a->property)
         return rl_cli_fail(RL_CLI_USAGE, "eval: no --property given (see rl eval --list)");
+    if ((a->num_sets2 || a->op) && !a->second)
+        return rl_cli_fail(RL_CLI_USAGE, "%s: only with --property2", a->op ? "--op" : "--set2");
     static const char *const html[] = { ".html", ".htm", NULL };
     if (a->report && !rl_cli_has_extension(a->report, html))
         return rl_cli_fail(RL_CLI_USAGE, "--report: expected a .html file, got '%s'", a->report);
     return RL_CLI_OK;
 }
 
-/* The property with its --set options applied; usage errors are exit 2. */
-static int make_property(const eval_args *a, rl_property **out)
+/* Property `name` with the options `sets` applied; usage errors are exit 2. */
+static int make_one(const char *name, const char *flag, const char *set_flag, const char *const *sets,
+                    int num_sets, rl_property **out)
 {
-    rl_status st = rl_property_create(a->property, out);
+    rl_status st = rl_property_create(name, out);
     if (st != RL_OK)
-        return rl_cli_fail_status(RL_CLI_USAGE, st, "--property");
-    for (int k = 0; k < a->num_sets; k++) {
+        return rl_cli_fail_status(RL_CLI_USAGE, st, flag);
+    for (int k = 0; k < num_sets; k++) {
         char key[128];
         const char *value = NULL;
-        if (!rl_cli_split_option("--set", a->sets[k], key, sizeof key, &value)) {
+        if (!rl_cli_split_option(set_flag, sets[k], key, sizeof key, &value)) {
             rl_property_release(*out);
             *out = NULL;
             return RL_CLI_USAGE;
@@ -147,10 +180,46 @@ static int make_property(const eval_args *a, rl_property **out)
         if (st != RL_OK) {
             rl_property_release(*out);
             *out = NULL;
-            return rl_cli_fail_status(RL_CLI_USAGE, st, "--set");
+            return rl_cli_fail_status(RL_CLI_USAGE, st, set_flag);
         }
     }
     return RL_CLI_OK;
+}
+
+/* The property to sample: --property with --set, or with --property2 the
+ * combined property of it and the second one (Sec. 4.2.6). *first and
+ * *second point at the parts (*second NULL without --combine), owned by
+ * *out, for the record of their options. */
+static int make_property(const eval_args *a, rl_property **out, rl_property **first, rl_property **second)
+{
+    rl_property *p = NULL, *q = NULL;
+    int rc = make_one(a->property, "--property", "--set", a->sets, a->num_sets, &p);
+    if (rc == RL_CLI_OK && a->second)
+        rc = make_one(a->second, "--property2", "--set2", a->sets2, a->num_sets2, &q);
+    if (rc != RL_CLI_OK) {
+        rl_property_release(p);
+        return rc;
+    }
+    *first = p;
+    *second = q;
+    if (!q) {
+        *out = p;
+        return RL_CLI_OK;
+    }
+    rl_status st = rl_property_create_combined((rl_property_op)a->combine_op, p, q, out);
+    if (st != RL_OK)   /* p and q are released by the call */
+        return rl_cli_fail_status(RL_CLI_USAGE, st, "--property2");
+    return RL_CLI_OK;
+}
+
+static cJSON *options_json(const rl_property *p)
+{
+    cJSON *opts = cJSON_CreateObject();
+    size_t no = 0;
+    const rl_option_info *o = rl_property_options(p, &no);
+    for (size_t k = 0; opts && k < no; k++)
+        cJSON_AddStringToObject(opts, o[k].key, rl_property_get(p, o[k].key));
+    return opts;
 }
 
 typedef struct eval_result {
@@ -197,7 +266,8 @@ static int validate(const eval_args *a, rl_property *p, const rl_approx *ap, eva
 }
 
 static cJSON *result_json(const eval_args *a, const rl_scene *scene, const rl_property *p,
-                          const rl_approx *ap, const eval_result *r)
+                          const rl_property *first, const rl_property *second, const rl_approx *ap,
+                          const eval_result *r)
 {
     cJSON *root = cJSON_CreateObject();
     if (!root)
@@ -208,11 +278,14 @@ static cJSON *result_json(const eval_args *a, const rl_scene *scene, const rl_pr
     cJSON *prop = cJSON_AddObjectToObject(root, "property");
     cJSON_AddStringToObject(prop, "name", rl_property_name(p));
     cJSON_AddStringToObject(prop, "unit", rl_property_unit(p));
-    cJSON *opts = cJSON_AddObjectToObject(prop, "options");
-    size_t no = 0;
-    const rl_option_info *o = rl_property_options(p, &no);
-    for (size_t k = 0; k < no; k++)
-        cJSON_AddStringToObject(opts, o[k].key, rl_property_get(p, o[k].key));
+    cJSON_AddItemToObject(prop, "options", options_json(first));
+    if (second) {
+        cJSON_AddStringToObject(prop, "op", combine_ops[a->combine_op]);
+        cJSON *o2 = cJSON_AddObjectToObject(prop, "second");
+        cJSON_AddStringToObject(o2, "name", rl_property_name(second));
+        cJSON_AddStringToObject(o2, "unit", rl_property_unit(second));
+        cJSON_AddItemToObject(o2, "options", options_json(second));
+    }
     cJSON_AddItemToObject(root, "sampling", rl_eval_desc_json(&a->sampling.desc));
     cJSON_AddNumberToObject(root, "samples", rl_approx_sample_count(ap));
     cJSON_AddNumberToObject(root, "regions", rl_approx_region_count(ap));
@@ -336,8 +409,8 @@ int rl_cli_eval(int argc, char **argv)
         return rc < 0 ? RL_CLI_OK : rc;
     if (a.list)
         return print_list();
-    rl_property *p = NULL;
-    if ((rc = make_property(&a, &p)) != RL_CLI_OK)
+    rl_property *p = NULL, *first = NULL, *second = NULL;
+    if ((rc = make_property(&a, &p, &first, &second)) != RL_CLI_OK)
         return rc;
     char report[4096], json_path[4096], approx_path[4096];
     snprintf(report, sizeof report, "%s", a.report ? a.report : "");
@@ -397,7 +470,7 @@ int rl_cli_eval(int argc, char **argv)
         rc = rl_cli_fail_status(RL_CLI_FAIL, st, approx_path);
         goto done;
     }
-    cJSON *root = result_json(&a, scene, p, ap, &r);
+    cJSON *root = result_json(&a, scene, p, first, second, ap, &r);
     bool ok = root && rl_cli_write_json(root, json_path);
     cJSON_Delete(root);
     if (!ok) {

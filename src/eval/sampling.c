@@ -6,11 +6,13 @@
  * as close to cubes as possible.
  *
  * Adaptive sampling (Sec. 5.4, Alg. 5.3) with the thesis' parameters
- * (Sec. 5.4.2): the region of lowest quality q = n / (diameter * (max -
- * min)) is split (in 2 along its longest side when longest / shortest >
- * sqrt(2), else into 4 or 8), no side below min_side (1 m); each new region
- * gets 5 + 0.05 / m * diameter samples, blue noise with corners by default;
- * stop on the sample budget (default) or the time budget.
+ * (Sec. 5.4.2): the region of lowest quality q = n / (size * (max - min))
+ * is split (in 2 along its longest side when longest / shortest > sqrt(2),
+ * else into 4 or 8), no side below min_side (1 m); each new region gets
+ * 5 + 0.05 / m * diameter samples; stop on the sample budget (default) or
+ * the time budget. Two defaults deviate (rl_sampling.h): size is the
+ * region's area or volume (the thesis: its diameter), and positions are
+ * blue noise without the corners the thesis takes first.
  *
  * Parallel sampling (Sec. 5.5, Alg. 5.4): the new positions of all regions
  * of one split form a batch evaluated by the property's workers with

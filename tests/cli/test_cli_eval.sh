@@ -27,6 +27,11 @@ expect_usage_error "$RL" eval cornell --property visibility --idw-neighbors 0 --
 expect_usage_error "$RL" eval cornell --property visibility --idw-neighbors 33 --out "$TMP/e"
 expect_usage_error "$RL" eval cornell --property visibility --report "$TMP/e/r.txt"
 expect_usage_error "$RL" eval cornell --property time --set renderer=nosuch --out "$TMP/e"
+expect_error 2 "expected minus, ratio" "$RL" eval cornell --property time --property2 time --op plus --out "$TMP/e"
+expect_error 2 "only with --property2" "$RL" eval cornell --property time --set2 renderer=raster --out "$TMP/e"
+expect_error 2 "only with --property2" "$RL" eval cornell --property time --op ratio --out "$TMP/e"
+expect_error 2 "nosuch" "$RL" eval cornell --property time --property2 nosuch --out "$TMP/e"
+expect_error 2 "frob" "$RL" eval cornell --property time --property2 time --set2 frob=1 --out "$TMP/e"
 [ -e "$TMP/e/approx.json" ] && fail "a failed eval wrote approx.json"
 expect_exit 1 "$RL" eval no-such-scene.json --property visibility --out "$TMP/e"
 expect_exit 0 "$RL" eval --list
@@ -44,6 +49,13 @@ for f in approx.json eval.json report.html heatmap.png; do
 done
 expect_in "$TMP/out" "48 samples"
 expect_in "$TMP/vis/report.html" "<svg"
+# Sec. 5.6's plots: heat map, violin with box plot, histogram; with
+# --validate the correlation of measured and approximated values.
+for caption in "Heat map of the regions" "Violin plot" "Histogram of the region values" \
+        "Pearson r"; do
+    expect_in "$TMP/vis/report.html" "$caption"
+done
+[ "$(grep -o '<svg' "$TMP/vis/report.html" | wc -l)" -ge 4 ] || fail "the eval report lacks plots"
 grep -q "<script" "$TMP/vis/report.html" && fail "the report must not need scripts"
 grep -Eq '(src|href)="https?:' "$TMP/vis/report.html" && fail "the report must be self-contained"
 if have_python; then
@@ -99,26 +111,68 @@ fi
 run_ok "$RL" eval cornell --property quality --set renderer=raster --set reference=whitted \
     --set width=24 --set height=24 --dims 3 --method grid --samples 8 --out "$TMP/q"
 expect_in "$TMP/out" "SSIM"
+# PSNR of a renderer against itself: equal images everywhere, capped at 100 dB
+# so that statistics and plots stay finite (+inf once failed the whole run).
+run_ok "$RL" eval cornell --property quality --set renderer=raster --set reference=raster \
+    --set metric=psnr --set width=16 --set height=16 --samples 8 --out "$TMP/psnr"
+expect_in "$TMP/out" "dB mean 100"
+
+# A combined property (Sec. 4.2.6): the op and both parts reach the record,
+# and its value is the difference of the parts at the same positions.
+run_ok "$RL" eval cornell --property ops --set renderer=whitted --set counter=rays --set width=16 \
+    --set height=16 --property2 ops --set2 renderer=whitted --set2 counter=shadow_rays \
+    --set2 width=16 --set2 height=16 --samples 8 --method grid --out "$TMP/comb"
+run_ok "$RL" eval cornell --property ops --set renderer=whitted --set counter=rays --set width=16 \
+    --set height=16 --samples 8 --method grid --out "$TMP/comb-a"
+run_ok "$RL" eval cornell --property ops --set renderer=whitted --set counter=shadow_rays --set width=16 \
+    --set height=16 --samples 8 --method grid --out "$TMP/comb-b"
+if have_python; then
+    python3 - "$TMP/comb" "$TMP/comb-a" "$TMP/comb-b" <<'PY' || fail "--property2 is not applied"
+import json, sys
+e = json.load(open(sys.argv[1] + "/eval.json"))
+p = e["property"]
+assert p["name"] == "difference(ops, ops)" and p["op"] == "minus", p
+assert p["options"]["counter"] == "rays" and p["second"]["options"]["counter"] == "shadow_rays", p
+c, a, b = (json.load(open(d + "/approx.json"))["samples"] for d in sys.argv[1:4])
+assert len(c) == len(a) == len(b) == 8
+for sc, sa, sb in zip(c, a, b):   # [x, y, z, value]
+    assert sc[:3] == sa[:3] == sb[:3], (sc, sa, sb)
+    assert sc[3] == sa[3] - sb[3] and sb[3] > 0, (sc, sa, sb)
+PY
+fi
 
 # --- rl compare ---
 expect_usage_error "$RL" compare cornell --out "$TMP/c"
 expect_error 2 "nosuch" "$RL" compare cornell --algos raster,nosuch --out "$TMP/c"
 expect_usage_error "$RL" compare cornell --algos raster --metrics time,speed --out "$TMP/c"
 expect_usage_error "$RL" compare cornell --algos raster:frob=1 --out "$TMP/c"
-run_ok "$RL" compare cornell --algos raster,whitted:max_depth=2,pt:spp=1,max_depth=2 --size 24x24 \
-    --samples 12 --repeats 1 --resolution 16 --out "$TMP/c"
+expect_error 2 "neither KEY=VALUE nor a value" "$RL" compare cornell --algos pt:ls-nosuch --out "$TMP/c"
+expect_error 2 "quality-metric" "$RL" compare cornell --algos raster --quality-metric mse --out "$TMP/c"
+# pt:ls-pnmt: the issue's own spelling, a bare value for every option
+# offering it (shadow and diffuse rays by the PNMT Line Space).
+run_ok "$RL" compare cornell --algos raster,whitted:max_depth=2,pt:spp=1,max_depth=2,pt:ls-pnmt,chcpp \
+    --size 24x24 --samples 12 --repeats 1 --resolution 16 --out "$TMP/c"
 [ -s "$TMP/c/report.html" ] && [ -s "$TMP/c/compare.json" ] || fail "compare outputs missing"
+# A violin plot per metric and heat maps side by side (one per renderer
+# that does the operation), besides the visibility that placed the samples.
+for title in "Rendering time" "Traced rays" "Rasterized triangles" "Occlusion queries" "Image quality"; do
+    expect_in "$TMP/c/report.html" "$title"
+done
+[ "$(grep -o '<svg' "$TMP/c/report.html" | wc -l)" -ge 20 ] || fail "the compare report lacks plots"
 if have_python; then
     python3 - "$TMP/c/compare.json" <<'PY' || fail "compare.json is not sane"
 import json, sys
 c = json.load(open(sys.argv[1]))
 names = [r["renderer"] for r in c["renderers"]]
-assert names == ["raster", "whitted:max_depth=2", "pt:spp=1,max_depth=2"], names
+assert names == ["raster", "whitted:max_depth=2", "pt:spp=1,max_depth=2", "pt:ls-pnmt", "chcpp"], names
+assert c["quality_metric"] == "hssim", c["quality_metric"]       # the thesis' SSIM
 for r in c["renderers"]:
     assert r["time"]["min"] > 0, r
     assert 0 <= r["quality"]["max"] <= 1.0 + 1e-9, r
-raster, whitted, pt = c["renderers"]
+raster, whitted, pt, ls, chcpp = c["renderers"]
 assert raster["rays"]["max"] == 0 and raster["triangles"]["min"] > 0
+assert raster["queries"]["max"] == 0 and chcpp["queries"]["min"] > 0     # CHC++'s occlusion queries
+assert ls["rays"]["min"] > 0
 assert whitted["rays"]["min"] > 0 and whitted["quality"]["min"] > 0.999   # whitted is the reference
 PY
 fi
