@@ -64,4 +64,29 @@ void *rl_property_impl(const rl_property *p);
 rl_status rl_property_visibility_pixels(rl_property *p, void *state, int worker, rl_vec3 pos,
                                         uint32_t *pixels_per_object);
 
+/* property_render.c: the time property's rule (Jähn 2015, Sec. 4.2.3, Def.
+ * 6) on frames from callbacks, so that tests can script frame times. */
+typedef struct rl_time_frames {
+    /* Renders direction (0..5) once; *ms its time. */
+    rl_status (*render)(void *ctx, int direction, double *ms);
+    void (*reset)(void *ctx);               /* rl_renderer_reset */
+    void *ctx;
+} rl_time_frames;
+
+typedef struct rl_time_rule {
+    int repeats;                /* measured frames per direction, >= 1 */
+    bool conditioned;
+    int condition_frames;       /* conditioned: at most this many unmeasured frames */
+} rl_time_rule;
+
+/* One sample: unless *built, an unmeasured frame of direction 0, a reset,
+ * and *built = true (the build for the scene is not a frame's time); then
+ * per direction, conditioned: unmeasured frames until one is not 2 % faster
+ * than the one before (at most condition_frames), unconditioned: a reset
+ * before every measured frame; the median of `repeats` measured frames.
+ * direction[i] gets the medians, *value their maximum. scratch holds
+ * `repeats` doubles. */
+rl_status rl_time_measure(const rl_time_frames *f, const rl_time_rule *rule, bool *built,
+                          double *scratch, double direction[6], double *value);
+
 #endif

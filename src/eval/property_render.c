@@ -317,62 +317,77 @@ static double median(double *v, int n)
     return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
 }
 
-static rl_status timed_render(rl_renderer *r, const rl_scene *scene, const rl_camera *cam,
-                              rl_image *img, double *ms)
+rl_status rl_time_measure(const rl_time_frames *f, const rl_time_rule *rule, bool *built,
+                          double *scratch, double direction[6], double *value)
 {
+    double ms = 0.0;
+    if (!*built) {
+        /* What a renderer builds for the scene on its first frame (a BVH, a
+         * Line Space, surfels, sampled properties) is preprocessing, not the
+         * time of a frame at this position: one unmeasured frame first, then
+         * reset, which keeps the build (rl_renderer_reset). */
+        rl_status st = f->render(f->ctx, 0, &ms);
+        if (st != RL_OK)
+            return st;
+        f->reset(f->ctx);
+        *built = true;
+    }
+    double v = 0.0;
+    for (int i = 0; i < 6; ++i) {
+        rl_status st = RL_OK;
+        if (rule->conditioned) {
+            /* condition until a frame is not 2 % faster than its predecessor */
+            double prev = INFINITY;
+            for (int k = 0; st == RL_OK && k < rule->condition_frames; ++k) {
+                st = f->render(f->ctx, i, &ms);
+                if (!(ms < 0.98 * prev))
+                    break;
+                prev = ms;
+            }
+        }
+        for (int k = 0; st == RL_OK && k < rule->repeats; ++k) {
+            if (!rule->conditioned)
+                f->reset(f->ctx);   /* unconditioned: no earlier frame survives */
+            st = f->render(f->ctx, i, &scratch[k]);
+        }
+        if (st != RL_OK)
+            return st;
+        direction[i] = median(scratch, rule->repeats);
+        v = direction[i] > v ? direction[i] : v;
+    }
+    *value = v;
+    return RL_OK;
+}
+
+typedef struct time_ctx {
+    rp_state *s;
+    rp_worker *w;
+    rl_vec3 pos;
+} time_ctx;
+
+static rl_status time_render(void *ctx, int direction, double *ms)
+{
+    time_ctx *c = ctx;
+    rl_camera cam = direction_camera(c->s, c->pos, direction);
     rl_timer t;
     rl_timer_start(&t);
-    rl_status st = rl_renderer_render(r, scene, cam, img, NULL);
+    rl_status st = rl_renderer_render(c->w->r, c->s->scene, &cam, c->w->img, NULL);
     *ms = rl_timer_ms(&t);
     return st;
 }
+
+static void time_reset(void *ctx) { rl_renderer_reset(((time_ctx *)ctx)->w->r); }
 
 static rl_status time_evaluate(rl_property *p, void *state, int worker, rl_vec3 pos,
                                rl_property_result *out)
 {
     (void)p;
     rp_state *s = state;
-    rp_worker *w = &s->w[worker];
-    double *times = s->times + (size_t)worker * (size_t)s->repeats;
-    double value = 0.0;
-    if (!w->built) {
-        /* What a renderer builds for the scene on its first frame (a BVH, a
-         * Line Space, surfels, sampled properties) is preprocessing, not the
-         * time of a frame at this position: one unmeasured frame first, then
-         * reset, which keeps the build (rl_renderer_reset). */
-        rl_camera cam = direction_camera(s, pos, 0);
-        rl_status st = rl_renderer_render(w->r, s->scene, &cam, w->img, NULL);
-        if (st != RL_OK)
-            return st;
-        rl_renderer_reset(w->r);
-        w->built = true;
-    }
-    for (int i = 0; i < 6; ++i) {
-        rl_camera cam = direction_camera(s, pos, i);
-        rl_status st = RL_OK;
-        if (s->conditioned) {
-            /* condition until a frame is not 2 % faster than its predecessor */
-            double prev = INFINITY;
-            for (int k = 0; st == RL_OK && k < s->condition_frames; ++k) {
-                double ms = 0.0;
-                st = timed_render(w->r, s->scene, &cam, w->img, &ms);
-                if (!(ms < 0.98 * prev))
-                    break;
-                prev = ms;
-            }
-        }
-        for (int k = 0; st == RL_OK && k < s->repeats; ++k) {
-            if (!s->conditioned)
-                rl_renderer_reset(w->r);   /* unconditioned: no earlier frame survives */
-            st = timed_render(w->r, s->scene, &cam, w->img, &times[k]);
-        }
-        if (st != RL_OK)
-            return st;
-        out->direction[i] = median(times, s->repeats);
-        value = out->direction[i] > value ? out->direction[i] : value;
-    }
-    out->value = value;
-    return RL_OK;
+    time_ctx c = { s, &s->w[worker], pos };
+    rl_time_frames f = { time_render, time_reset, &c };
+    rl_time_rule rule = { s->repeats, s->conditioned, s->condition_frames };
+    return rl_time_measure(&f, &rule, &c.w->built, s->times + (size_t)worker * (size_t)s->repeats,
+                           out->direction, &out->value);
 }
 
 /* ---- ops (Sec. 4.2.4) -------------------------------------------------- */

@@ -13,6 +13,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "eval/property_internal.h"
 #include "rl/rl.h"
 #include "rl/rl_property.h"
 
@@ -227,6 +228,121 @@ static void test_out_of_range_options_are_invalid(void **state)
 }
 
 /* ---- time (Sec. 4.2.3) ------------------------------------------------- */
+
+/* Scripted frames for rl_time_measure: each render takes the next time of
+ * the script and logs its direction; resets are logged as -1. */
+typedef struct script {
+    const double *times;
+    int n, next;
+    int log[256], logged;
+    int fail_at;                /* render call that fails, or -1 */
+} script;
+
+static rl_status script_render(void *ctx, int direction, double *ms)
+{
+    script *s = ctx;
+    assert_true(s->next < s->n);
+    if (s->next == s->fail_at)
+        return RL_ERR_INVALID_ARG;
+    *ms = s->times[s->next++];
+    s->log[s->logged++] = direction;
+    return RL_OK;
+}
+
+static void script_reset(void *ctx)
+{
+    script *s = ctx;
+    s->log[s->logged++] = -1;
+}
+
+static int log_count(const script *s, int what)
+{
+    int n = 0;
+    for (int i = 0; i < s->logged; ++i)
+        n += s->log[i] == what;
+    return n;
+}
+
+/* Def. 6, unconditioned: the median of the repeats per direction, the
+ * maximum over directions, a reset before every measured frame; the first
+ * sample of a worker renders once unmeasured (the scene's build). */
+static void test_time_rule_unconditioned_takes_medians_resets_and_skips_the_build(void **state)
+{
+    (void)state;
+    double times[1 + 18 + 18];
+    times[0] = 1000.0;                                   /* the build: never counted */
+    for (int i = 0; i < 6; ++i) {
+        times[1 + 3 * i] = 10.0 * i + 100.0;             /* an outlier first */
+        times[2 + 3 * i] = 10.0 * i + 1.0;
+        times[3 + 3 * i] = 10.0 * i + 3.0;               /* the median, last */
+        for (int k = 0; k < 3; ++k)
+            times[19 + 3 * i + k] = 7.0;
+    }
+    script sc = { .times = times, .n = 37, .fail_at = -1 };
+    rl_time_frames f = { script_render, script_reset, &sc };
+    rl_time_rule rule = { .repeats = 3 };
+    bool built = false;
+    double scratch[3], dir[6], value = 0.0;
+    assert_int_equal(rl_time_measure(&f, &rule, &built, scratch, dir, &value), RL_OK);
+    assert_true(built);
+    for (int i = 0; i < 6; ++i)
+        assert_true(dir[i] == 10.0 * i + 3.0);
+    assert_true(value == 53.0);
+    /* render(0) reset, then (reset render) x 3 per direction */
+    assert_int_equal(sc.logged, 2 + 6 * 3 * 2);
+    assert_int_equal(sc.log[0], 0);
+    assert_int_equal(sc.log[1], -1);
+    for (int i = 0; i < 6; ++i)
+        for (int k = 0; k < 3; ++k) {
+            assert_int_equal(sc.log[2 + 6 * i + 2 * k], -1);
+            assert_int_equal(sc.log[3 + 6 * i + 2 * k], i);
+        }
+    /* The next sample of the same worker: no build frame. */
+    sc.logged = 0;
+    assert_int_equal(rl_time_measure(&f, &rule, &built, scratch, dir, &value), RL_OK);
+    assert_int_equal(sc.logged, 6 * 3 * 2);
+    assert_true(value == 7.0);
+}
+
+/* Def. 6, conditioned: unmeasured frames until one is not 2 % faster than
+ * the one before, at most condition_frames of them, no resets. */
+static void test_time_rule_conditioned_stops_at_two_percent_or_the_frame_limit(void **state)
+{
+    (void)state;
+    double times[64];
+    int n = 0;
+    /* direction 0: 100, 50, 30, 29.5 (1.7 % faster: the last unmeasured), measured 20 */
+    const double d0[] = { 100.0, 50.0, 30.0, 29.5, 20.0 };
+    for (int k = 0; k < 5; ++k)
+        times[n++] = d0[k];
+    /* direction 1: always 10 % faster: the limit of 4 frames, measured 40 */
+    for (int k = 0; k < 4; ++k)
+        times[n++] = 100.0 * pow(0.9, k);
+    times[n++] = 40.0;
+    /* directions 2-5: 5, 5 (not faster), measured 7 */
+    for (int i = 2; i < 6; ++i) {
+        times[n++] = 5.0;
+        times[n++] = 5.0;
+        times[n++] = 7.0;
+    }
+    script sc = { .times = times, .n = n, .fail_at = -1 };
+    rl_time_frames f = { script_render, script_reset, &sc };
+    rl_time_rule rule = { .repeats = 1, .conditioned = true, .condition_frames = 4 };
+    bool built = true;
+    double scratch[1], dir[6], value = 0.0;
+    assert_int_equal(rl_time_measure(&f, &rule, &built, scratch, dir, &value), RL_OK);
+    assert_int_equal(sc.next, n);                       /* every scripted frame, no more */
+    assert_int_equal(log_count(&sc, -1), 0);
+    assert_int_equal(log_count(&sc, 0), 5);
+    assert_int_equal(log_count(&sc, 1), 5);
+    assert_true(dir[0] == 20.0 && dir[1] == 40.0 && dir[2] == 7.0 && dir[5] == 7.0);
+    assert_true(value == 40.0);
+
+    /* A failing frame's status comes back. */
+    sc = (script){ .times = times, .n = n, .fail_at = 2 };
+    f.ctx = &sc;
+    assert_int_equal(rl_time_measure(&f, &rule, &built, scratch, dir, &value), RL_ERR_INVALID_ARG);
+}
 
 static void test_time_is_positive_exclusive_and_the_max_over_directions(void **state)
 {
@@ -626,6 +742,8 @@ int main(void)
         cmocka_unit_test(test_evaluate_needs_a_commit_a_worker_and_a_finite_position),
         cmocka_unit_test(test_commit_needs_a_committed_non_empty_scene),
         cmocka_unit_test(test_out_of_range_options_are_invalid),
+        cmocka_unit_test(test_time_rule_unconditioned_takes_medians_resets_and_skips_the_build),
+        cmocka_unit_test(test_time_rule_conditioned_stops_at_two_percent_or_the_frame_limit),
         cmocka_unit_test(test_time_is_positive_exclusive_and_the_max_over_directions),
         cmocka_unit_test(test_time_rejects_unknown_renderers_and_bad_renderer_options),
         cmocka_unit_test(test_ops_counts_the_triangles_the_rasterizer_draws),
