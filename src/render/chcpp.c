@@ -56,6 +56,10 @@
 #include "rl/rl_rng.h"
 #include "rl/rl_timer.h"
 
+/* Query boxes grow by this share of their longest side, so that rounding
+ * never lets the bounded geometry poke through their faces. */
+#define QUERY_MARGIN 1e-3f
+
 static const rl_option_info chcpp_options[] = {
     RL_CULL_RASTER_OPTIONS,
     { "max_depth", RL_OPT_INT, "5", "maximum depth of the loose octree (0: all objects in the root)", 0,
@@ -242,7 +246,7 @@ static rl_status add_object_boxes(frame_ctx *f, uint32_t n)
     const rl_octree_node *node = &f->nodes[n];
     rl_status st = RL_OK;
     for (uint32_t k = 0; k < node->num_objects && st == RL_OK; ++k)
-        st = rl_box_query_add(&f->s->query, f->d->objects[f->objects[node->first_object + k]].bounds, 1e-3f);
+        st = rl_box_query_add(&f->s->query, f->d->objects[f->objects[node->first_object + k]].bounds, QUERY_MARGIN);
     for (uint32_t c = 0; c < node->num_children && st == RL_OK; ++c)
         st = add_object_boxes(f, node->first_child + c);
     return st;
@@ -253,12 +257,12 @@ static rl_status add_node_boxes(frame_ctx *f, uint32_t n)
 {
     const rl_octree_node *node = &f->nodes[n];
     if (!f->tight)
-        return rl_box_query_add(&f->s->query, node->loose, 1e-3f);
+        return rl_box_query_add(&f->s->query, node->loose, QUERY_MARGIN);
     uint32_t room = 8;
     double area = 0.0;
     if (node->subtree_objects > 1 && object_boxes(f, n, &room, &area) && area < rl_aabb_area(node->bounds))
         return add_object_boxes(f, n);
-    return rl_box_query_add(&f->s->query, node->bounds, 1e-3f);
+    return rl_box_query_add(&f->s->query, node->bounds, QUERY_MARGIN);
 }
 
 /* One occlusion query over the nodes list[0..count). */
@@ -367,8 +371,12 @@ static rl_status chcpp_frame(frame_ctx *f)
             stats->nodes_frustum_culled++;
             continue;
         }
-        if (rl_cull_box_near_eye(&f->cf.view, f->tight ? node->bounds : node->loose)) {
-            /* No query can be trusted where the near plane cuts the box. */
+        /* The grown box a query draws: it holds the node's object boxes
+         * grown likewise (each no larger than the node's bounds). */
+        if (rl_cull_box_near_eye(&f->cf.view,
+                                 rl_box_query_bounds(f->tight ? node->bounds : node->loose, QUERY_MARGIN))) {
+            /* No query can be trusted where the near plane cuts the box, or
+             * where the eye is inside it (only back faces face the eye). */
             ns->visible = 0;
             if (node->num_objects)
                 pull_up(f, n);

@@ -75,6 +75,13 @@ void rl_box_query_reset(rl_box_query *q)
     q->boxes = 0;
 }
 
+rl_aabb rl_box_query_bounds(rl_aabb b, float margin)
+{
+    rl_vec3 e = rl_aabb_extent(b);
+    float grow = margin * rl_maxf(rl_maxf(e.x, e.y), e.z) + 1e-6f;
+    return (rl_aabb){ rl_sub(b.min, rl_v3s(grow)), rl_add(b.max, rl_v3s(grow)) };
+}
+
 rl_status rl_box_query_add(rl_box_query *q, rl_aabb b, float margin)
 {
     if (q->boxes == q->cap_boxes) {
@@ -89,10 +96,7 @@ rl_status rl_box_query_add(rl_box_query *q, rl_aabb b, float margin)
         q->indices = ix;
         q->cap_boxes = cap;
     }
-    rl_vec3 e = rl_aabb_extent(b);
-    float grow = margin * rl_maxf(rl_maxf(e.x, e.y), e.z) + 1e-6f;
-    b.min = rl_sub(b.min, rl_v3s(grow));
-    b.max = rl_add(b.max, rl_v3s(grow));
+    b = rl_box_query_bounds(b, margin);
     rl_vec3 *p = q->positions + (size_t)q->boxes * 8;
     for (int i = 0; i < 8; ++i)
         p[i] = rl_v3((i & 1) ? b.max.x : b.min.x, (i & 2) ? b.max.y : b.min.y, (i & 4) ? b.max.z : b.min.z);

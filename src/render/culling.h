@@ -43,6 +43,10 @@ typedef struct rl_box_query {
 } rl_box_query;
 
 void rl_box_query_reset(rl_box_query *q);
+/* The box a query draws for b: grown by margin times its longest side (plus
+ * 1e-6). Near-eye tests must use it, not b: an eye outside b but inside
+ * the grown box sees only its back faces, which count no pixel. */
+rl_aabb rl_box_query_bounds(rl_aabb b, float margin);
 rl_status rl_box_query_add(rl_box_query *q, rl_aabb b, float margin);
 /* Visible pixels of all boxes added since the last reset (0 boxes: 0). */
 rl_status rl_box_query_run(rl_box_query *q, rl_raster *ras, uint64_t *pixels, rl_raster_counters *c);
