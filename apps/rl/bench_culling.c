@@ -435,8 +435,10 @@ static rl_status sec_svs(void *ctx, cJSON *sec)
                                        NULL };
     const char *const tri_kv_svs[] = { "renderer", "svs", "renderer_options", svs_options(c), "width", size,
                                        "height", size, "counter", "triangles", NULL };
+    /* Single-scale SSIM, as every record of this section so far (the
+     * quality property's default is hierarchical SSIM since 2026-12-04). */
     const char *const q_kv[] = { "renderer", "svs", "renderer_options", svs_options(c), "reference", "raster",
-                                 "width", size, "height", size, NULL };
+                                 "metric", "ssim", "width", size, "height", size, NULL };
     if (st == RL_OK)
         st = measure_at_driver_keep(c, "chcpp time", "time", TIME_KV("chcpp", ""), &t_chc, &c->time_chcpp);
     if (st == RL_OK)
@@ -689,10 +691,11 @@ static rl_status sec_visset(void *ctx, cJSON *sec)
     snprintf(opts, sizeof opts, "approx=%s", path);
     snprintf(budget_opts, sizeof budget_opts, "approx=%s,budget=%lld", path, budget);
     rl_stats t_v, q_v, t_b, q_b;
+    /* Single-scale SSIM, as the records so far (see sec_svs). */
     const char *const q_kv[] = { "renderer", "visset", "renderer_options", opts, "reference", "raster",
-                                 "width", size, "height", size, NULL };
+                                 "metric", "ssim", "width", size, "height", size, NULL };
     const char *const qb_kv[] = { "renderer", "visset", "renderer_options", budget_opts, "reference", "raster",
-                                  "width", size, "height", size, NULL };
+                                  "metric", "ssim", "width", size, "height", size, NULL };
     st = measure_at_driver(c, "visset time", "time", TIME_KV("visset", opts), &t_v);
     if (st == RL_OK)
         st = measure_at_driver(c, "visset quality", "quality", q_kv, &q_v);
