@@ -89,7 +89,22 @@ static uint32_t check_invariants(const rl_scene *scene, const rl_octree *t)
         }
         if (n->num_children == 0) {
             assert_int_equal(n->first_child, RL_NONE);
-            /* A leaf above max depth holds at most leaf_objects, or objects that fit no child. */
+            /* A leaf above max depth holds at most leaf_objects, or only
+             * objects that fit no child: the loose box of the octant
+             * holding an object's centre does not hold the object. */
+            if ((int)n->depth < desc.max_depth && n->num_objects > desc.leaf_objects) {
+                for (uint32_t k = 0; k < n->num_objects; ++k) {
+                    rl_aabb ob = d->objects[objects[n->first_object + k]].bounds;
+                    rl_vec3 oc = rl_aabb_center(ob);
+                    rl_aabb oct = n->cell;
+                    if (oc.x >= c.x) oct.min.x = c.x; else oct.max.x = c.x;
+                    if (oc.y >= c.y) oct.min.y = c.y; else oct.max.y = c.y;
+                    if (oc.z >= c.z) oct.min.z = c.z; else oct.max.z = c.z;
+                    rl_vec3 oh = rl_scale(rl_aabb_extent(oct), 0.5f * desc.looseness);
+                    rl_vec3 occ = rl_aabb_center(oct);
+                    assert_false(inside((rl_aabb){ rl_sub(occ, oh), rl_add(occ, oh) }, ob));
+                }
+            }
         } else {
             assert_true(n->num_children <= 8);
             for (uint32_t j = 0; j < n->num_children; ++j) {
