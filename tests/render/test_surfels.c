@@ -63,7 +63,7 @@ static void test_surfels_replace_distant_geometry(void **state)
     rl_image_metrics m;
     assert_int_equal(rl_image_compare(img, ref, NULL, &m), RL_OK);
     print_message("points only: %llu points, SSIM %.3f\n", (unsigned long long)cs.points_drawn, m.ssim);
-    assert_true(m.ssim > 0.6);
+    assert_true(m.ssim > 0.85);   /* 0.909 measured; deterministic with the seed */
     /* The next frame reuses the surfels. */
     rl_image *again = fx_render_with(r, s, &cam, RL_LAYER_COLOR, &st);
     assert_int_equal(rl_culling_get_stats(r, &cs), RL_OK);
