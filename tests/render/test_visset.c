@@ -130,11 +130,80 @@ static void test_visset_reads_the_evaluators_approximation(void **state)
     rl_scene_release(s);
 }
 
+/* The budgeted variant draws in decreasing impact (visible pixels at the
+ * region's centre): three boxes of 12 triangles each, added smallest
+ * first, one region sampled at its centre; a budget of one box draws the
+ * biggest, of two the two biggest. */
+static bool has_object(const rl_image *img, uint32_t id)
+{
+    for (int k = 0; k < img->width * img->height; ++k)
+        if (img->object_id[k] == id)
+            return true;
+    return false;
+}
+
+static void test_visset_budget_draws_the_highest_impact_first(void **state)
+{
+    (void)state;
+    rl_scene *s = NULL;
+    assert_int_equal(rl_scene_create(&s), RL_OK);
+    rl_material m = rl_material_default();
+    uint32_t mat;
+    assert_int_equal(rl_scene_add_material(s, &m, &mat), RL_OK);
+    fx_add_box(s, mat, rl_v3(9, 1, 6), rl_v3(9.5f, 1.5f, 6.5f), 1);       /* small, far */
+    fx_add_box(s, mat, rl_v3(6, 0, 0.5f), rl_v3(7, 2, 2.5f), 1);          /* medium */
+    fx_add_box(s, mat, rl_v3(3, -3, -4), rl_v3(4, 5, -0.5f), 1);          /* big, near */
+    rl_light l = { .type = RL_LIGHT_DIRECTIONAL, .color = rl_v3s(1.0f), .intensity = 1.0f,
+                   .direction = rl_normalize(rl_v3(1, -1, 0.2f)) };
+    assert_int_equal(rl_scene_add_light(s, &l), RL_OK);
+    assert_int_equal(rl_scene_commit(s), RL_OK);
+    const rl_scene_data *d = rl_scene_get_data(s);
+    assert_int_equal(d->num_objects, 3);
+    uint32_t small = 0, medium = 0, big = 0;     /* object ids by their bounds */
+    for (uint32_t o = 0; o < 3; ++o) {
+        float x = d->objects[o].bounds.min.x;
+        *(x > 8 ? &small : x > 5 ? &medium : &big) = o;
+    }
+
+    rl_property *p = NULL;
+    assert_int_equal(rl_property_create("visibility", &p), RL_OK);
+    assert_int_equal(rl_property_set(p, "resolution", "64"), RL_OK);
+    assert_int_equal(rl_property_commit(p, s, 1), RL_OK);
+    rl_sampling_desc sd = { .region = { { -1, 0, -1 }, { 1, 2, 1 } }, .dims = 2, .height = 1.0f,
+                            .method = RL_SAMPLING_GRID, .grid_res = { 1, 1, 1 }, .seed = 1 };
+    rl_approx *a = NULL;
+    assert_int_equal(rl_sample_property(p, &sd, &a), RL_OK);
+    const char *dir = getenv("RL_TEST_TMP");
+    char path[1024];
+    snprintf(path, sizeof path, "%s/visset_impact.json", dir ? dir : "/tmp");
+    assert_int_equal(rl_approx_save_json(a, path), RL_OK);
+    rl_approx_release(a);
+    rl_property_release(p);
+
+    rl_camera cam = { .eye = rl_v3(0.3f, 1.0f, -0.2f), .target = rl_v3(5, 1, 0), .fov_deg = 110.0f,
+                      .width = 96, .height = 72 };
+    rl_image *ref = fx_render("raster", s, &cam, FX_ALL_LAYERS, NULL, NULL);
+    assert_true(has_object(ref, small) && has_object(ref, medium) && has_object(ref, big));
+    rl_image_release(ref);
+    static const char *const budgets[] = { "12", "24", "36" };
+    for (int b = 0; b < 3; ++b) {
+        rl_renderer *r = fx_make("visset", (const char *const[]){ "approx", path, "budget", budgets[b], NULL });
+        rl_image *img = fx_render_with(r, s, &cam, FX_ALL_LAYERS, NULL);
+        assert_true(has_object(img, big));
+        assert_true(has_object(img, medium) == (b >= 1));
+        assert_true(has_object(img, small) == (b >= 2));
+        rl_image_release(img);
+        rl_renderer_release(r);
+    }
+    rl_scene_release(s);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_visset_draws_the_sampled_set),
         cmocka_unit_test(test_visset_reads_the_evaluators_approximation),
+        cmocka_unit_test(test_visset_budget_draws_the_highest_impact_first),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
