@@ -17,7 +17,8 @@ typedef struct rl_culling_stats {
     uint32_t octree_nodes, octree_depth;
     uint32_t nodes_visited;           /* taken from the traversal queue */
     uint32_t nodes_frustum_culled;
-    uint32_t nodes_occluded;          /* found invisible by a query */
+    uint32_t nodes_occluded;          /* chcpp: found invisible by a query; svs: drawn from
+                                       * their stored sets (whose hidden objects are skipped) */
     uint32_t objects_drawn;
     uint64_t triangles_drawn;         /* of objects (queries not included) */
     uint64_t queries;                 /* occlusion queries issued (a multi-query counts once) */

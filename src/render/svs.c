@@ -19,7 +19,9 @@
  * frustum is skipped; a node whose sphere does not contain the viewer is
  * drawn as the union of the sets of the `neighbours` (3) sample
  * directions nearest to the direction from the sphere's centre to the
- * viewer (the corners of the spherical triangle around it), each object
+ * viewer (usually the corners of the spherical triangle around it; near
+ * an edge of the triangle a vertex beyond the edge can be nearer than the
+ * opposite corner, a choice that needs no triangle search), each object
  * once and only if its box is in the frustum; a node around the viewer
  * draws its own objects and recurses. Approximate on purpose: between the
  * samples, and for viewers close to a sphere, where a perspective view
