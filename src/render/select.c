@@ -22,8 +22,12 @@
  *
  * The chosen renderer draws the whole frame with the shared raster options
  * forwarded; both are kept between frames, so CHC++ keeps its temporal
- * coherence across frames that SVS drew. rl_culling_get_stats returns the
- * drawing renderer's statistics with `selected` set. */
+ * coherence across frames that SVS drew. The first frame for a scene also
+ * lets the renderer not chosen draw once (into the same image, overwritten
+ * after), so that both build for the scene (SVS' sets, CHC++'s octree) in
+ * that frame's preprocessing and a later switch costs a frame, not a
+ * build. rl_culling_get_stats returns the drawing renderer's statistics
+ * with `selected` set. */
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -82,6 +86,7 @@ typedef struct select_state {
     bool prepared;
     rl_renderer *child[2];
     char child_name[2][NAME_MAX_LEN];
+    uint64_t built_uid[2];        /* scene the child has drawn once for (0: none) */
     rl_approx *approx[2];         /* time: both; threshold: [0] */
 } select_state;
 
@@ -143,6 +148,7 @@ static rl_status prepare_children(select_state *s, rl_renderer *r)
             rl_renderer_release(s->child[i]);
             s->child[i] = NULL;
             s->child_name[i][0] = '\0';
+            s->built_uid[i] = 0;
             rl_status st = copy_text(s->child_name[i], sizeof s->child_name[i], name, keys[i]);
             if (st == RL_OK)
                 st = rl_renderer_create(name, &s->child[i]);   /* names an unknown renderer */
@@ -279,9 +285,21 @@ static rl_status select_render(rl_renderer *r, void *state, const rl_scene *scen
         pick = v1 < v0 ? 1 : 0;
     }
     double pre_ms = s->head.stats.preprocess_ms;
+    uint64_t uid = rl_scene_uid(scene);
+    if (s->built_uid[1 - pick] != uid) {
+        /* The other one builds for the scene now, as preprocessing. */
+        rl_timer t;
+        rl_timer_start(&t);
+        st = rl_renderer_render(s->child[1 - pick], scene, cam, image, NULL);
+        if (st != RL_OK)
+            return st;
+        s->built_uid[1 - pick] = uid;
+        pre_ms += rl_timer_ms(&t);
+    }
     st = rl_renderer_render(s->child[pick], scene, cam, image, stats);
     if (st != RL_OK)
         return st;
+    s->built_uid[pick] = uid;
     rl_culling_stats cs;
     if (rl_culling_get_stats(s->child[pick], &cs) == RL_OK)
         s->head.stats = cs;

@@ -177,6 +177,30 @@ assert whitted["rays"]["min"] > 0 and whitted["quality"]["min"] > 0.999   # whit
 PY
 fi
 
+# The Ch. 7 recipes of docs/culling.md in miniature: Sec. 7.5, the times of
+# chcpp and svs sampled by rl eval, then select reading them beside both;
+# Sec. 7.6, the visible sets sampled by rl eval, then drawn by visset.
+run_ok "$RL" eval cornell --property time --set renderer=chcpp --set conditioned=true --set width=24 \
+    --set height=24 --samples 8 --out "$TMP/t-chcpp"
+run_ok "$RL" eval cornell --property time --set renderer=svs --set renderer_options=resolution=32 \
+    --set conditioned=true --set width=24 --set height=24 --samples 8 --out "$TMP/t-svs"
+run_ok "$RL" compare cornell --algos chcpp,svs:resolution=32,select:first_time="$TMP/t-chcpp/approx.json",second_time="$TMP/t-svs/approx.json" \
+    --metrics time,triangles --size 24x24 --samples 8 --repeats 1 --resolution 16 --out "$TMP/select"
+run_ok "$RL" eval cornell --property visibility --set resolution=16 --samples 16 --out "$TMP/vis16"
+run_ok "$RL" compare cornell --algos visset:approx="$TMP/vis16/approx.json",chcpp --reference raster \
+    --size 24x24 --samples 8 --repeats 1 --resolution 16 --out "$TMP/visset"
+if have_python; then
+    python3 - "$TMP/select/compare.json" "$TMP/visset/compare.json" <<'PY' || fail "the Ch. 7 recipes are not sane"
+import json, sys
+sel = json.load(open(sys.argv[1]))["renderers"]
+assert [r["renderer"].split(":")[0] for r in sel] == ["chcpp", "svs", "select"], sel
+assert all(r["time"]["min"] > 0 and r["triangles"]["min"] > 0 for r in sel), sel
+vis = json.load(open(sys.argv[2]))["renderers"]
+assert vis[1]["quality"]["min"] == 1.0, vis[1]          # chcpp is conservative
+assert 0 < vis[0]["quality"]["min"] <= 1.0 and vis[0]["triangles"]["min"] > 0, vis
+PY
+fi
+
 # --- rl bench sampling ---
 expect_usage_error "$RL" bench sampling --only nosuch --out "$TMP/b.json"
 expect_usage_error "$RL" bench sampling --samples 0 --out "$TMP/b.json"
