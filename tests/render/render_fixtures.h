@@ -112,6 +112,17 @@ static inline void fx_add_box(rl_scene *s, uint32_t mat, rl_vec3 lo, rl_vec3 hi,
     free(idx);
 }
 
+/* An empty scene with one default material (its index in *mat), for
+ * tests that place their own boxes. */
+static inline rl_scene *fx_scene_with_material(uint32_t *mat)
+{
+    rl_scene *s = NULL;
+    assert_int_equal(rl_scene_create(&s), RL_OK);
+    rl_material m = rl_material_default();
+    assert_int_equal(rl_scene_add_material(s, &m, mat), RL_OK);
+    return s;
+}
+
 /* The culling tests' city: a 12 x 12 grid of buildings of random heights on a ground slab, every
  * coordinate jittered so that no two faces share a plane. */
 static inline rl_scene *fx_box_city(void)

@@ -93,11 +93,8 @@ static void test_chcpp_variants_stay_conservative(void **state)
 static void test_chcpp_is_conservative_for_viewers_at_a_wall(void **state)
 {
     (void)state;
-    rl_scene *s = NULL;
-    assert_int_equal(rl_scene_create(&s), RL_OK);
-    rl_material m = rl_material_default();
     uint32_t mat;
-    assert_int_equal(rl_scene_add_material(s, &m, &mat), RL_OK);
+    rl_scene *s = fx_scene_with_material(&mat);
     fx_add_box(s, mat, rl_v3(0, 0, 0), rl_v3(100, 20, 100), 1);
     fx_add_box(s, mat, rl_v3(-200, 0, -200), rl_v3(-199, 1, -199), 1);
     rl_light l = { .type = RL_LIGHT_DIRECTIONAL, .color = rl_v3s(1.0f), .intensity = 1.0f,

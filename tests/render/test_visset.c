@@ -145,11 +145,8 @@ static bool has_object(const rl_image *img, uint32_t id)
 static void test_visset_budget_draws_the_highest_impact_first(void **state)
 {
     (void)state;
-    rl_scene *s = NULL;
-    assert_int_equal(rl_scene_create(&s), RL_OK);
-    rl_material m = rl_material_default();
     uint32_t mat;
-    assert_int_equal(rl_scene_add_material(s, &m, &mat), RL_OK);
+    rl_scene *s = fx_scene_with_material(&mat);
     fx_add_box(s, mat, rl_v3(9, 1, 6), rl_v3(9.5f, 1.5f, 6.5f), 1);       /* small, far */
     fx_add_box(s, mat, rl_v3(6, 0, 0.5f), rl_v3(7, 2, 2.5f), 1);          /* medium */
     fx_add_box(s, mat, rl_v3(3, -3, -4), rl_v3(4, 5, -0.5f), 1);          /* big, near */
