@@ -75,7 +75,9 @@ typedef struct rl_raster_counters {
  * Gouraud), face_colors (per triangle, flat), otherwise color. With uvs and a
  * texture (the per-triangle texture_index into textures, or texture), the
  * colour is multiplied by the texel. IDs: triangle_ids[i] or
- * first_triangle_id + i; object_ids[i] or object_id. */
+ * first_triangle_id + i; object_ids[i] or object_id. With lazy set, colors
+ * need not be filled before the draw (see rl_raster_lazy_colors). */
+typedef struct rl_raster_lazy_colors rl_raster_lazy_colors;
 typedef struct rl_raster_batch {
     uint32_t num_vertices;
     const rl_vec3 *positions;
@@ -95,7 +97,28 @@ typedef struct rl_raster_batch {
     unsigned flags;                       /* rl_raster_flags */
     uint32_t num_layers;                  /* 0..RL_RASTER_MAX_LAYERS */
     const rl_raster_layer *layers;
+    const rl_raster_lazy_colors *lazy;    /* NULL: colors are filled already */
 } rl_raster_batch;
+
+/* Vertex colours computed on demand. A GPU runs its vertex shader on every
+ * vertex submitted; in a large scene most of them belong to triangles that
+ * the trivial reject, back-face culling or the pixel-centre test drop
+ * (Jaehn 2015, Sec. 7.4: SVS submits ~20x the triangles it draws). With
+ * lazy colours, setup asks for colors[v] only for the vertices of triangles
+ * that survive, by calling shade(user, v), which must write colors[v] as a
+ * pure function of v (so the image equals that of filling colors first).
+ * stamps (one per vertex, owned by the caller, zeroed once) remember across
+ * draws which vertices are shaded for the current value of frame: each is
+ * shaded at most once per frame, by one thread, even when parallel setup
+ * chunks share it. A new lighting (another eye, say) takes a new frame
+ * value, 1 <= frame < 2^31. Batches without per-vertex colors or with layers
+ * ignore lazy. */
+struct rl_raster_lazy_colors {
+    void (*shade)(void *user, uint32_t vertex);
+    void *user;
+    uint32_t *stamps;                     /* accessed atomically */
+    uint32_t frame;
+};
 
 typedef struct rl_raster_points {
     uint32_t count;
@@ -121,6 +144,12 @@ RL_API rl_status rl_raster_set_camera(rl_raster *r, rl_image *target, const rl_c
                                       rl_aabb scene_bounds);
 RL_API rl_status rl_raster_draw(rl_raster *r, const rl_raster_batch *batch, rl_raster_counters *c);
 RL_API rl_status rl_raster_draw_points(rl_raster *r, const rl_raster_points *pts, rl_raster_counters *c);
+/* True when nothing inside box (world space) can be drawn in the current
+ * view: the box lies entirely beyond the near plane or a side of the
+ * viewport. Conservative (a margin covers rounding), so skipping the
+ * triangles of such a box never changes an image; false without a target
+ * and for empty or non-finite boxes. */
+RL_API bool rl_raster_box_outside(const rl_raster *r, rl_aabb box);
 /* Occlusion query: number of pixels of the batch's triangles that would pass
  * the depth test (strictly nearer than the stored depth, or equal to it with
  * RL_RASTER_DEPTH_EQUAL). Writes nothing. */

@@ -36,6 +36,10 @@ static rl_status check_batch(const rl_raster *r, const rl_raster_batch *b, const
     for (uint32_t i = 0; i < b->num_layers; ++i)
         if (!b->layers[i].colors)
             return rl_error(RL_ERR_INVALID_ARG, "%s: layer %u has no colors", fn, i);
+    if (b->lazy && (!b->lazy->shade || !b->lazy->stamps || b->lazy->frame < 1 ||
+                    b->lazy->frame >= (1u << 31)))
+        return rl_error(RL_ERR_INVALID_ARG, "%s: lazy colours need shade, stamps and 1 <= frame < 2^31 "
+                        "(frame %u)", fn, b->lazy->frame);
     if (b->num_triangles == 0)
         return RL_OK;
     if (!b->indices || !b->positions)

@@ -119,6 +119,33 @@ static int32_t clamp_i32(int64_t v, int32_t lo, int32_t hi)
     return v < lo ? lo : (v > hi ? hi : (int32_t)v);
 }
 
+/* Twice the signed area of the snapped triangle, exact. */
+static inline int64_t twice_area(int32_t ax, int32_t ay, int32_t bx, int32_t by, int32_t cx, int32_t cy)
+{
+    return ((int64_t)bx - ax) * ((int64_t)cy - ay) - ((int64_t)by - ay) * ((int64_t)cx - ax);
+}
+
+/* The pixels [x0, x1) x [y0, y1) of the viewport whose centres lie in the
+ * bounding box of the snapped vertices; false when there are none. */
+static inline bool pixel_box(const int32_t xs[3], const int32_t ys[3], int width, int height,
+                             int32_t *x0, int32_t *x1, int32_t *y0, int32_t *y1)
+{
+    int64_t min_x = xs[0], max_x = xs[0], min_y = ys[0], max_y = ys[0];
+    for (int k = 1; k < 3; ++k) {
+        min_x = xs[k] < min_x ? xs[k] : min_x;
+        max_x = xs[k] > max_x ? xs[k] : max_x;
+        min_y = ys[k] < min_y ? ys[k] : min_y;
+        max_y = ys[k] > max_y ? ys[k] : max_y;
+    }
+    /* Pixel x is a candidate when its centre x*256 + 128 lies in [min, max]. */
+    const int64_t half = RL_RASTER_SUBPIXEL / 2;
+    *x0 = clamp_i32(-floor_div(-(min_x - half), RL_RASTER_SUBPIXEL), 0, width);
+    *x1 = clamp_i32(floor_div(max_x - half, RL_RASTER_SUBPIXEL) + 1, 0, width);
+    *y0 = clamp_i32(-floor_div(-(min_y - half), RL_RASTER_SUBPIXEL), 0, height);
+    *y1 = clamp_i32(floor_div(max_y - half, RL_RASTER_SUBPIXEL) + 1, 0, height);
+    return *x0 < *x1 && *y0 < *y1;
+}
+
 /* A projected polygon vertex. */
 typedef struct svert {
     int32_t x, y;                 /* snapped */
@@ -129,24 +156,34 @@ typedef struct svert {
     rl_vec3 bw;                   /* source barycentrics / w */
 } svert;
 
-static bool project(const cvert *v, int width, int height, bool layered, svert *s)
+/* The snapped pixel position of clip-space p, and the exact one in fx, fy;
+ * false where it cannot be projected (w <= 0, or beyond the guard band). */
+static inline bool snap(rl_vec4 p, int width, int height, int32_t *x, int32_t *y, double *fx,
+                        double *fy)
 {
-    if (!(v->p.w > 0.0f))
+    if (!(p.w > 0.0f))
         return false;
-    double inv_w = 1.0 / v->p.w;
-    double x_pix = (v->p.x * inv_w + 1.0) * 0.5 * width;
-    double y_pix = (1.0 - v->p.y * inv_w) * 0.5 * height;
+    double inv_w = 1.0 / p.w;
+    double x_pix = (p.x * inv_w + 1.0) * 0.5 * width;
+    double y_pix = (1.0 - p.y * inv_w) * 0.5 * height;
     /* Cannot trigger after guard-band clipping except through rounding; it
      * keeps the fixed-point bound a hard guarantee. */
     if (!(fabs(x_pix) < 2.0 * RL_RASTER_GUARD_PX) || !(fabs(y_pix) < 2.0 * RL_RASTER_GUARD_PX))
         return false;
-    s->fx = x_pix;
-    s->fy = y_pix;
+    *fx = x_pix;
+    *fy = y_pix;
     /* Round half up; any rule works as long as a shared vertex always snaps
      * the same way, which a pure function of its position guarantees. */
-    s->x = (int32_t)floor(x_pix * RL_RASTER_SUBPIXEL + 0.5);
-    s->y = (int32_t)floor(y_pix * RL_RASTER_SUBPIXEL + 0.5);
-    float iw = (float)inv_w;
+    *x = (int32_t)floor(x_pix * RL_RASTER_SUBPIXEL + 0.5);
+    *y = (int32_t)floor(y_pix * RL_RASTER_SUBPIXEL + 0.5);
+    return true;
+}
+
+static bool project(const cvert *v, int width, int height, bool layered, svert *s)
+{
+    if (!snap(v->p, width, height, &s->x, &s->y, &s->fx, &s->fy))
+        return false;
+    float iw = (float)(1.0 / v->p.w);
     s->iw = iw;
     s->dw = v->d * iw;
     s->cw = rl_v4(v->c.x * iw, v->c.y * iw, v->c.z * iw, v->c.w * iw);
@@ -171,8 +208,7 @@ static int32_t fill_bias(const svert *a, const svert *b)
 static bool setup_tri(const svert *a, const svert *b, const svert *c, bool cull_back,
                       int width, int height, rl_raster_prim *p, rl_raster_prim_src *src)
 {
-    int64_t area2 = ((int64_t)b->x - a->x) * ((int64_t)c->y - a->y) -
-                    ((int64_t)b->y - a->y) * ((int64_t)c->x - a->x);
+    int64_t area2 = twice_area(a->x, a->y, b->x, b->y, c->x, c->y);
     if (area2 == 0)
         return false;
     /* Counter-clockwise as seen by the camera (y up) is clockwise in y-down
@@ -185,20 +221,8 @@ static bool setup_tri(const svert *a, const svert *b, const svert *c, bool cull_
         v[2] = b;
         area2 = -area2;
     }
-    int64_t min_x = v[0]->x, max_x = v[0]->x, min_y = v[0]->y, max_y = v[0]->y;
-    for (int k = 1; k < 3; ++k) {
-        min_x = v[k]->x < min_x ? v[k]->x : min_x;
-        max_x = v[k]->x > max_x ? v[k]->x : max_x;
-        min_y = v[k]->y < min_y ? v[k]->y : min_y;
-        max_y = v[k]->y > max_y ? v[k]->y : max_y;
-    }
-    /* Pixel x is a candidate when its centre x*256 + 128 lies in [min, max]. */
-    const int64_t half = RL_RASTER_SUBPIXEL / 2;
-    p->x0 = clamp_i32(-floor_div(-(min_x - half), RL_RASTER_SUBPIXEL), 0, width);
-    p->x1 = clamp_i32(floor_div(max_x - half, RL_RASTER_SUBPIXEL) + 1, 0, width);
-    p->y0 = clamp_i32(-floor_div(-(min_y - half), RL_RASTER_SUBPIXEL), 0, height);
-    p->y1 = clamp_i32(floor_div(max_y - half, RL_RASTER_SUBPIXEL) + 1, 0, height);
-    if (p->x0 >= p->x1 || p->y0 >= p->y1)
+    const int32_t xs[3] = { v[0]->x, v[1]->x, v[2]->x }, ys[3] = { v[0]->y, v[1]->y, v[2]->y };
+    if (!pixel_box(xs, ys, width, height, &p->x0, &p->x1, &p->y0, &p->y1))
         return false;
     /* Barycentric planes from the exact positions; where snapping changed
      * the triangle too much (nearly degenerate), from the snapped ones. */
@@ -245,6 +269,50 @@ static bool vec4_finite(rl_vec4 v)
     return isfinite(v.x) && isfinite(v.y) && isfinite(v.z) && isfinite(v.w);
 }
 
+/* Whether unclipped triangle (a, b, c) can reach setup_tri and pass it: the
+ * same tests on the same snapped corners (project, the area's sign, the
+ * pixel box), before a single attribute is read. Most triangles of a large
+ * scene fail here, being back-facing or too small to cover a pixel centre,
+ * and skip all attribute work; the answer is setup_tri's by construction
+ * (the same pure functions of the same positions), which keeps every image
+ * bit-identical. */
+static bool may_cover(rl_vec4 a, rl_vec4 b, rl_vec4 c, bool cull_back, int width, int height)
+{
+    int32_t xs[3], ys[3];
+    double fx, fy;
+    if (!snap(a, width, height, &xs[0], &ys[0], &fx, &fy) ||
+        !snap(b, width, height, &xs[1], &ys[1], &fx, &fy) ||
+        !snap(c, width, height, &xs[2], &ys[2], &fx, &fy))
+        return false;
+    int64_t area2 = twice_area(xs[0], ys[0], xs[1], ys[1], xs[2], ys[2]);
+    if (area2 == 0 || (area2 > 0 && cull_back))
+        return false;
+    int32_t x0, x1, y0, y1;
+    return pixel_box(xs, ys, width, height, &x0, &x1, &y0, &y1);
+}
+
+/* Colour of vertex v of a batch with lazy colours (rl_raster_lazy_colors):
+ * stamps[v] == 2 frame means shaded this frame, 2 frame - 1 that a thread
+ * is shading it now; whoever moves it to "busy" shades, everyone else waits
+ * for "done" (a rare, short wait: parallel chunks share few vertices). */
+static rl_vec4 lazy_color(const rl_raster_batch *b, uint32_t v)
+{
+    const rl_raster_lazy_colors *lz = b->lazy;
+    const uint32_t done = 2 * lz->frame, busy = done - 1;
+    uint32_t s = __atomic_load_n(&lz->stamps[v], __ATOMIC_ACQUIRE);
+    if (s != done) {
+        if (s != busy && __atomic_compare_exchange_n(&lz->stamps[v], &s, busy, false, __ATOMIC_ACQUIRE,
+                                                     __ATOMIC_ACQUIRE)) {
+            lz->shade(lz->user, v);
+            __atomic_store_n(&lz->stamps[v], done, __ATOMIC_RELEASE);
+        } else {
+            while (__atomic_load_n(&lz->stamps[v], __ATOMIC_ACQUIRE) != done)
+                ;
+        }
+    }
+    return b->colors[v];
+}
+
 bool rl_raster_setup(const rl_raster *r, const rl_raster_batch *b, uint32_t first,
                      uint32_t count, rl_raster_chunk *chunk)
 {
@@ -252,6 +320,7 @@ bool rl_raster_setup(const rl_raster *r, const rl_raster_batch *b, uint32_t firs
     const float gx = r->guard_x, gy = r->guard_y;
     const bool cull_back = (b->flags & RL_RASTER_CULL_BACK) != 0;
     const bool layered = b->num_layers > 0;
+    const bool lazy = b->lazy && b->colors && !layered;
     for (uint32_t t = first; t < first + count; ++t) {
         const uint32_t *tri = &b->indices[3 * (size_t)t];
         cvert poly[MAX_POLY];
@@ -267,6 +336,9 @@ bool rl_raster_setup(const rl_raster *r, const rl_raster_batch *b, uint32_t firs
         /* Non-finite positions are skipped silently (rl_raster.h). */
         if (!finite || oc_and != 0)
             continue;
+        if (!(oc_or & CLIP_PLANES) &&
+            !may_cover(poly[0].p, poly[1].p, poly[2].p, cull_back, width, height))
+            continue;
 
         const rl_texture *tex = NULL;
         if (b->uvs && !layered) {
@@ -278,7 +350,8 @@ bool rl_raster_setup(const rl_raster *r, const rl_raster_batch *b, uint32_t firs
             }
         }
         for (int k = 0; k < 3; ++k) {
-            poly[k].c = b->colors ? b->colors[tri[k]] : rl_v4(0, 0, 0, 0);
+            poly[k].c = !b->colors ? rl_v4(0, 0, 0, 0)
+                        : lazy ? lazy_color(b, tri[k]) : b->colors[tri[k]];
             poly[k].uv = tex ? b->uvs[tri[k]] : rl_v2(0, 0);
             poly[k].d = r->perspective ? 0.0f : r->eye_depth[tri[k]];
             poly[k].b = rl_v3(k == 0 ? 1.0f : 0.0f, k == 1 ? 1.0f : 0.0f, k == 2 ? 1.0f : 0.0f);

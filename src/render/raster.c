@@ -32,7 +32,12 @@
  * is lit at all (the ID/Z pre-pass of Vertex Tracing). raster_render() only
  * sets up the target, clears it and draws every object with the drawer it
  * keeps between frames (rl_drawer_keep): the buffers for the whole scene
- * are made once, the lighting is redone every frame. */
+ * are made once, the lighting is redone every frame. An object whose box
+ * lies outside the view is neither lit nor drawn (rl_raster_box_outside:
+ * the rasterizer would drop all of its triangles), and in gouraud and
+ * textured shading a vertex is lit only when the rasterizer keeps a
+ * triangle that uses it (rl_raster_lazy_colors); both leave the image as it
+ * was and save most of the work of a frame in a large scene. */
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -232,6 +237,21 @@ static rl_status prepare(const rl_scene_data *d, rl_raster_shading shading, bool
     b->triangle_texture = rl_calloc(d->num_triangles, sizeof *b->triangle_texture);
     if (!b->corner_positions || !b->corner_uvs || !b->corner_colors || !b->triangle_texture)
         return RL_ERR_OUT_OF_MEMORY;
+    /* What does not depend on the eye, once: positions, uvs, textures. */
+    for (uint32_t o = 0; o < d->num_objects; ++o) {
+        const rl_object *obj = &d->objects[o];
+        if (b->object_material[o] != RL_NONE || !selected(mask, o))
+            continue;
+        for (size_t t = obj->first_triangle; t < (size_t)obj->first_triangle + obj->num_triangles; ++t) {
+            uint32_t m = d->triangle_material[t];
+            for (int k = 0; k < 3; ++k) {
+                uint32_t vi = d->indices[3 * t + k];
+                b->corner_positions[3 * t + k] = d->positions[vi];
+                b->corner_uvs[3 * t + k] = d->uvs[vi];
+            }
+            b->triangle_texture[t] = shading == RL_SHADING_TEXTURED ? texture_of(d, m) : RL_ID_NONE;
+        }
+    }
     return RL_OK;
 }
 
@@ -246,52 +266,13 @@ static void light_face(const shade_ctx *ctx, frame_buffers *b, int64_t t)
     b->face_colors[t] = phong(ctx, &d->materials[d->triangle_material[t]], centroid, n);
 }
 
-/* The corner copies of triangle t of a mixed-material object, lit with
- * the triangle's own material. */
-static void light_corners(const shade_ctx *ctx, rl_raster_shading shading, frame_buffers *b, int64_t t)
+/* Corner c (3 t + k) of triangle t of a mixed-material object, lit with
+ * the triangle's own material (prepare() made its position and uv). */
+static void light_corner(const shade_ctx *ctx, frame_buffers *b, size_t c)
 {
     const rl_scene_data *d = ctx->data;
-    uint32_t m = d->triangle_material[t];
-    for (int k = 0; k < 3; ++k) {
-        uint32_t vi = d->indices[3 * t + k];
-        b->corner_positions[3 * t + k] = d->positions[vi];
-        b->corner_uvs[3 * t + k] = d->uvs[vi];
-        b->corner_colors[3 * t + k] = phong(ctx, &d->materials[m], d->positions[vi], d->normals[vi]);
-    }
-    b->triangle_texture[t] = shading == RL_SHADING_TEXTURED ? texture_of(d, m) : RL_ID_NONE;
-}
-
-/* Lights the vertices, corners or faces of the selected objects in
- * parallel; every result depends only on its own element, so the output
- * does not depend on the thread count. */
-static void light_scene(const shade_ctx *ctx, rl_raster_shading shading, int threads,
-                        const uint8_t *mask, frame_buffers *b)
-{
-    const rl_scene_data *d = ctx->data;
-    const int64_t nt = d->num_triangles, nv = d->num_vertices;
-
-    if (shading == RL_SHADING_FLAT) {
-#pragma omp parallel for num_threads(threads) schedule(static)
-        for (int64_t t = 0; t < nt; ++t)
-            if (selected(mask, d->triangle_object[t]))
-                light_face(ctx, b, t);
-        return;
-    }
-
-#pragma omp parallel for num_threads(threads) schedule(static)
-    for (int64_t v = 0; v < nv; ++v) {
-        uint32_t m = b->vertex_material[v];
-        if (m != RL_NONE)
-            b->vertex_colors[v] = phong(ctx, &d->materials[m], d->positions[v], d->normals[v]);
-    }
-    if (!b->corner_colors)
-        return;
-#pragma omp parallel for num_threads(threads) schedule(static)
-    for (int64_t t = 0; t < nt; ++t) {
-        uint32_t o = d->triangle_object[t];
-        if (b->object_material[o] == RL_NONE && selected(mask, o))
-            light_corners(ctx, shading, b, t);
-    }
+    uint32_t vi = d->indices[c];
+    b->corner_colors[c] = phong(ctx, &d->materials[d->triangle_material[c / 3]], d->positions[vi], d->normals[vi]);
 }
 
 /* One batch per object: object IDs come from the batch, triangle IDs are the
@@ -300,7 +281,8 @@ static void light_scene(const shade_ctx *ctx, rl_raster_shading shading, int thr
  * the same positions, so depth and IDs are bit-identical either way. */
 static rl_status draw_object(rl_raster *ras, const rl_scene_data *d, uint32_t o,
                              rl_raster_shading shading, bool lit, unsigned flags,
-                             frame_buffers *b, rl_raster_counters *counters)
+                             frame_buffers *b, const rl_raster_lazy_colors *lazy,
+                             rl_raster_counters *counters)
 {
     const rl_object *obj = &d->objects[o];
     if (obj->num_triangles == 0)
@@ -319,6 +301,7 @@ static rl_status draw_object(rl_raster *ras, const rl_scene_data *d, uint32_t o,
         batch.num_vertices = obj->num_triangles * 3;
         batch.positions = b->corner_positions + first;
         batch.colors = b->corner_colors + first;
+        batch.lazy = lazy;
         for (uint32_t i = 0; i < batch.num_vertices; ++i)
             b->indices[i] = i;
         if (shading == RL_SHADING_TEXTURED) {
@@ -345,6 +328,7 @@ static rl_status draw_object(rl_raster *ras, const rl_scene_data *d, uint32_t o,
         batch.face_colors = b->face_colors + obj->first_triangle;
     } else {
         batch.colors = b->vertex_colors + obj->first_vertex;
+        batch.lazy = lazy;
         uint32_t tex = shading == RL_SHADING_TEXTURED ? texture_of(d, m) : RL_ID_NONE;
         if (tex != RL_ID_NONE) {
             batch.uvs = d->uvs + obj->first_vertex;
@@ -363,6 +347,13 @@ struct rl_scene_drawer {
     int threads;
     uint8_t *object_lit;         /* per object: lighting done */
     uint32_t *todo;              /* scratch of rl_scene_drawer_light, one per object */
+    uint32_t *in_view;           /* scratch of rl_scene_drawer_draw_all, one per object */
+    /* Lazy lighting (rl_raster_lazy_colors) of single-material objects in
+     * gouraud/textured mode: a stamp per scene vertex, and the value of
+     * this frame's lighting. */
+    uint32_t *stamps;            /* per vertex (single-material objects) */
+    uint32_t *corner_stamps;     /* per corner (mixed objects), if any */
+    uint32_t frame;
     frame_buffers b;
 };
 
@@ -383,6 +374,9 @@ void rl_scene_drawer_release(rl_scene_drawer *dr)
     free_buffers(&dr->b);
     free(dr->object_lit);
     free(dr->todo);
+    free(dr->in_view);
+    free(dr->stamps);
+    free(dr->corner_stamps);
     free(dr);
 }
 
@@ -412,8 +406,16 @@ rl_status rl_scene_drawer_create(const rl_scene_data *d, rl_vec3 eye, const rl_r
     dr->ctx = (shade_ctx){ d, eye, dr->opt.ambient };
     dr->object_lit = rl_calloc(d->num_objects ? d->num_objects : 1, 1);
     dr->todo = dr->lit ? rl_calloc(d->num_objects ? d->num_objects : 1, sizeof *dr->todo) : NULL;
-    bool have = dr->object_lit && (dr->todo || !dr->lit);
+    dr->in_view = dr->lit ? rl_calloc(d->num_objects ? d->num_objects : 1, sizeof *dr->in_view) : NULL;
+    bool lazy = dr->lit && dr->opt.shading != RL_SHADING_FLAT;
+    dr->stamps = lazy ? rl_calloc((size_t)d->num_vertices + 1, sizeof *dr->stamps) : NULL;
+    dr->frame = 1;
+    bool have = dr->object_lit && ((dr->todo && dr->in_view) || !dr->lit) && (dr->stamps || !lazy);
     st = have ? prepare(d, dr->opt.shading, dr->lit, dr->opt.object_mask, &dr->b) : RL_ERR_OUT_OF_MEMORY;
+    if (st == RL_OK && lazy && dr->b.corner_colors) {
+        dr->corner_stamps = rl_calloc((size_t)d->num_triangles * 3, sizeof *dr->corner_stamps);
+        st = dr->corner_stamps ? RL_OK : RL_ERR_OUT_OF_MEMORY;
+    }
     if (st != RL_OK) {
         rl_scene_drawer_release(dr);
         return rl_error(st, "rl_scene_drawer_create: buffers for %u triangles", d->num_triangles);
@@ -422,16 +424,19 @@ rl_status rl_scene_drawer_create(const rl_scene_data *d, rl_vec3 eye, const rl_r
     return RL_OK;
 }
 
-/* Lights one object's vertices, corners or faces (what light_scene does
- * for all of them), with up to `threads` threads when it is big enough to
- * pay. */
+/* Objects with more vertices are lit with several threads. */
+#define BIG_OBJECT_VERTICES 4096
+
+/* Lights one object's vertices, corners or faces, with up to `threads`
+ * threads when it is big enough to pay. Every result depends only on its
+ * own element, so the output does not depend on the thread count. */
 static void light_object(rl_scene_drawer *dr, uint32_t o, int threads)
 {
     const rl_scene_data *d = dr->data;
     const rl_object *obj = &d->objects[o];
     frame_buffers *b = &dr->b;
     const shade_ctx *ctx = &dr->ctx;
-    if (obj->num_vertices <= 4096)
+    if (obj->num_vertices <= BIG_OBJECT_VERTICES)
         threads = 1;
     const int64_t t0 = obj->first_triangle, t1 = t0 + obj->num_triangles;
     if (dr->opt.shading == RL_SHADING_FLAT) {
@@ -449,14 +454,51 @@ static void light_object(rl_scene_drawer *dr, uint32_t o, int threads)
         return;
     }
 #pragma omp parallel for num_threads(threads) schedule(static)
-    for (int64_t t = t0; t < t1; ++t)
-        light_corners(ctx, dr->opt.shading, b, t);
+    for (int64_t c = 3 * t0; c < 3 * t1; ++c)
+        light_corner(ctx, b, (size_t)c);
 }
 
 void rl_scene_drawer_new_frame(rl_scene_drawer *dr, rl_vec3 eye)
 {
     dr->ctx.eye = eye;
     memset(dr->object_lit, 0, dr->data->num_objects ? dr->data->num_objects : 1);
+    /* Every stamp is now out of date; after 2^31 - 2 frames start over. */
+    if (++dr->frame >= (1u << 31)) {
+        if (dr->stamps)
+            memset(dr->stamps, 0, ((size_t)dr->data->num_vertices + 1) * sizeof *dr->stamps);
+        if (dr->corner_stamps)
+            memset(dr->corner_stamps, 0, (size_t)dr->data->num_triangles * 3 * sizeof *dr->corner_stamps);
+        dr->frame = 1;
+    }
+}
+
+/* Objects whose vertices (or corners) are lit on demand while drawn. */
+static bool lit_lazily(const rl_scene_drawer *dr, uint32_t o)
+{
+    return dr->stamps && (dr->b.object_material[o] != RL_NONE || dr->corner_stamps);
+}
+
+/* rl_raster_lazy_colors' shade for vertex v of a single-material object,
+ * as light_object would light it; user is the object's lazy_object. */
+typedef struct lazy_object {
+    rl_scene_drawer *dr;
+    uint32_t first;              /* first vertex, or first corner */
+    const rl_material *material; /* NULL: mixed, corners */
+} lazy_object;
+
+static void shade_vertex(void *user, uint32_t v)
+{
+    const lazy_object *u = user;
+    const rl_scene_data *d = u->dr->data;
+    const uint32_t g = u->first + v;
+    u->dr->b.vertex_colors[g] = phong(&u->dr->ctx, u->material, d->positions[g], d->normals[g]);
+}
+
+/* The same for corner v of a mixed-material object. */
+static void shade_corner(void *user, uint32_t v)
+{
+    const lazy_object *u = user;
+    light_corner(&u->dr->ctx, &u->dr->b, (size_t)u->first + v);
 }
 
 void rl_scene_drawer_light(rl_scene_drawer *dr, const uint32_t *objects, uint32_t count)
@@ -468,15 +510,28 @@ void rl_scene_drawer_light(rl_scene_drawer *dr, const uint32_t *objects, uint32_
     uint32_t n = 0, *todo = dr->todo;
     for (uint32_t i = 0; i < count; ++i) {
         uint32_t o = objects[i];
-        if (o < dr->data->num_objects && selected(dr->opt.object_mask, o) && !dr->object_lit[o]) {
+        if (o < dr->data->num_objects && selected(dr->opt.object_mask, o) && !dr->object_lit[o] &&
+            !lit_lazily(dr, o)) {
             dr->object_lit[o] = 2;
             todo[n++] = o;
         }
     }
+    /* Big objects one at a time with every thread (light_object decides),
+     * the many small ones side by side. */
+    uint32_t small = 0;
+    for (uint32_t i = 0; i < n; ++i) {
+        uint32_t o = todo[i];
+        if (dr->data->objects[o].num_vertices > BIG_OBJECT_VERTICES) {
+            light_object(dr, o, dr->threads);
+            dr->object_lit[o] = 1;
+        } else {
+            todo[small++] = o;
+        }
+    }
 #pragma omp parallel for num_threads(dr->threads) schedule(dynamic, 1)
-    for (int64_t i = 0; i < (int64_t)n; ++i)
+    for (int64_t i = 0; i < (int64_t)small; ++i)
         light_object(dr, todo[i], 1);
-    for (uint32_t i = 0; i < n; ++i)
+    for (uint32_t i = 0; i < small; ++i)
         dr->object_lit[todo[i]] = 1;
 }
 
@@ -489,11 +544,32 @@ rl_status rl_scene_drawer_draw(rl_scene_drawer *dr, rl_raster *ras, uint32_t obj
                         dr->data->num_objects);
     if (!selected(dr->opt.object_mask, object))
         return RL_OK;
+    /* Entirely outside the view: every triangle would fail the trivial
+     * reject, so neither light nor transform it (the image is the same). */
+    const rl_object *obj = &dr->data->objects[object];
+    if (rl_raster_box_outside(ras, obj->bounds)) {
+        if (c)
+            c->triangles_in += obj->num_triangles;
+        return RL_OK;
+    }
+    if (dr->lit && lit_lazily(dr, object)) {
+        const uint32_t m = dr->b.object_material[object];
+        lazy_object user = { dr, obj->first_vertex, NULL };
+        rl_raster_lazy_colors lazy = { shade_vertex, &user, dr->stamps + obj->first_vertex, dr->frame };
+        if (m != RL_NONE) {
+            user.material = &dr->data->materials[m];
+        } else {
+            user.first = obj->first_triangle * 3;
+            lazy.shade = shade_corner;
+            lazy.stamps = dr->corner_stamps + user.first;
+        }
+        return draw_object(ras, dr->data, object, dr->opt.shading, dr->lit, dr->opt.flags, &dr->b, &lazy, c);
+    }
     if (dr->lit && !dr->object_lit[object]) {
         light_object(dr, object, dr->threads);
         dr->object_lit[object] = 1;
     }
-    return draw_object(ras, dr->data, object, dr->opt.shading, dr->lit, dr->opt.flags, &dr->b, c);
+    return draw_object(ras, dr->data, object, dr->opt.shading, dr->lit, dr->opt.flags, &dr->b, NULL, c);
 }
 
 rl_status rl_scene_drawer_draw_all(rl_scene_drawer *dr, rl_raster *ras, rl_raster_counters *c,
@@ -502,11 +578,15 @@ rl_status rl_scene_drawer_draw_all(rl_scene_drawer *dr, rl_raster *ras, rl_raste
     if (!dr || !ras)
         return rl_error(RL_ERR_INVALID_ARG, "rl_scene_drawer_draw_all: NULL argument");
     const rl_scene_data *d = dr->data;
-    /* Everything selected gets drawn: light it all in one parallel pass
-     * (one object at a time would serialise the many small ones). */
+    /* Light what can be seen in one pass before drawing (one object at a
+     * time would serialise the many small ones); objects outside the view
+     * are skipped by rl_scene_drawer_draw and need no lighting. */
     if (dr->lit) {
-        light_scene(&dr->ctx, dr->opt.shading, dr->threads, dr->opt.object_mask, &dr->b);
-        memset(dr->object_lit, 1, d->num_objects ? d->num_objects : 1);
+        uint32_t n = 0;
+        for (uint32_t o = 0; o < d->num_objects; ++o)
+            if (selected(dr->opt.object_mask, o) && !rl_raster_box_outside(ras, d->objects[o].bounds))
+                dr->in_view[n++] = o;
+        rl_scene_drawer_light(dr, dr->in_view, n);
     }
     /* Report progress about a hundred times, not once per object. */
     rl_status st = RL_OK;

@@ -49,7 +49,10 @@ rl_vec3 rl_raster_light_diffuse(const rl_scene_data *d, rl_vec3 p, rl_vec3 n, rl
  * object what to draw and in which order (occlusion culling, level of
  * detail): buffers are prepared once per drawer (rl_scene_drawer_new_frame
  * reuses them for the next frame), and an object is lit when it is first
- * drawn in a frame, so culled objects cost no lighting. Drawing every
+ * drawn in a frame, so culled objects cost no lighting; in gouraud and
+ * textured shading only the vertices of its triangles that the rasterizer
+ * keeps are lit (rl_raster_lazy_colors), and an object whose box is
+ * outside the view is skipped whole (rl_raster_box_outside). Drawing every
  * selected object in index order gives exactly rl_raster_draw_scene's
  * image. The drawer borrows d and desc->object_mask. */
 typedef struct rl_scene_drawer rl_scene_drawer;
@@ -65,7 +68,8 @@ void rl_scene_drawer_new_frame(rl_scene_drawer *dr, rl_vec3 eye);
  * in one parallel pass over the objects, for a renderer that knows what it
  * will draw before it draws: most objects are too small to light in
  * parallel one by one, so that would leave all threads but one idle. The
- * images do not change (lighting is per object). */
+ * images do not change (lighting is per object). Objects lit lazily (all
+ * of them in gouraud and textured shading) are left to the draw. */
 void rl_scene_drawer_light(rl_scene_drawer *dr, const uint32_t *objects, uint32_t count);
 /* Draws object (an index < d->num_objects; unselected objects are skipped)
  * into the rasterizer's current target. */
