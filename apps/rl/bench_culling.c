@@ -46,6 +46,7 @@
 
 #include "bench_args.h"
 #include "bench_rays.h"
+#include "bench_resume.h"
 #include "bench_util.h"
 #include "cli.h"
 #include "eval_common.h"
@@ -91,16 +92,25 @@ static const char bench_culling_help[] =
     "  --threads N          default all\n"
     "  --seed N             default 1\n"
     "  --out FILE.json      default bench/results/culling-YYYYMMDD-HHMMSS.json\n"
+    "  --resume DIR         keep the sampled slice of svs/select/visset and\n"
+    "                       every value measured at its positions in DIR (saved\n"
+    "                       every 32 positions): the same command continues a\n"
+    "                       run that stopped; DIR must be new or made by a run\n"
+    "                       with the same options\n"
     "  --quick              tiny run: cornell-sized box city, few samples\n"
     "\n"
     "example:\n"
-    "  rl bench culling --only depth,svs --samples 256\n";
+    "  rl bench culling --only depth,svs --samples 256\n"
+    "  rl bench culling --scene city:blocks=12 --only svs --samples 4096 --resume out/svs4096\n";
 
 enum { SEC_SURFELS, SEC_DEPTH, SEC_SVS, SEC_SELECT, SEC_VISSET, SEC_COUNT };
 static const char *const section_names[SEC_COUNT] = { "surfels", "depth", "svs", "select", "visset" };
 
+/* Positions measured between two saves of a --resume run. */
+#define RESUME_BLOCK 32
+
 typedef struct bc_args {
-    const char *scene, *out;
+    const char *scene, *out, *resume;
     long long samples, max_depth, size, resolution, select_positions, budget, threads, seed, surfels;
     double height, select_quantile, extent;
     unsigned sections;
@@ -118,6 +128,7 @@ typedef struct bc_ctx {
     uint32_t npos;
     double chcpp_triangles_mean;
     rl_approx *time_chcpp, *time_svs;   /* the svs section's sampled times, for select */
+    rl_bench_resume *resume;      /* --resume: NULL without */
     const char *frames;           /* measured and conditioning frames of the time property */
     char reason[512];
 } bc_ctx;
@@ -338,6 +349,8 @@ static rl_status sec_depth(void *ctx, cJSON *sec)
 }
 
 /* --- the shared slice of Sec. 7.4-7.6 --- */
+static rl_status driver_positions(bc_ctx *c);
+
 static rl_status ensure_driver(bc_ctx *c)
 {
     if (c->driver)
@@ -360,19 +373,85 @@ static rl_status ensure_driver(bc_ctx *c)
     rl_sampling_desc sd = { .region = slice, .dims = 2,
                             .height = c->d->bounds.min.y + (float)c->a->height,
                             .max_samples = (uint32_t)c->a->samples, .seed = (uint64_t)c->a->seed };
+    const char *saved = c->resume ? rl_bench_resume_path(c->resume, "slice.json") : NULL;
+    FILE *f = saved ? fopen(saved, "r") : NULL;
+    if (f) {
+        /* --resume: the slice of an earlier run with the same options. */
+        fclose(f);
+        note("polygons in visible objects: the slice sampled before (%s)", saved);
+        rl_property_release(vis);
+        return rl_approx_load_json(saved, &c->driver) == RL_OK ? driver_positions(c) : RL_ERR_IO;
+    }
     if (st == RL_OK) {
         note("sampling polygons in visible objects (%lld samples)", c->a->samples);
         st = rl_sample_property(vis, &sd, &c->driver);
     }
     rl_property_release(vis);
+    if (st == RL_OK && c->resume && rl_approx_save_json(c->driver, rl_bench_resume_path(c->resume, "slice.json")) !=
+                                        RL_OK)
+        st = RL_ERR_IO;
     if (st != RL_OK)
         return st;
+    return driver_positions(c);
+}
+
+/* c->pos and c->npos from the driver's samples. */
+static rl_status driver_positions(bc_ctx *c)
+{
     c->npos = rl_approx_sample_count(c->driver);
     c->pos = malloc((c->npos ? c->npos : 1) * sizeof *c->pos);
     if (!c->pos)
         return RL_ERR_OUT_OF_MEMORY;
     for (uint32_t k = 0; k < c->npos; ++k)
         rl_approx_sample(c->driver, k, &c->pos[k], NULL);
+    return RL_OK;
+}
+
+/* --resume: p at the driver's positions, continuing the series saved under
+ * label and saving it every RESUME_BLOCK positions. */
+static rl_status measure_resumable(bc_ctx *c, rl_property *p, const char *label, double **values)
+{
+    char name[128];
+    size_t k = 0;
+    for (const char *q = label; *q && k + 6 < sizeof name; ++q)
+        name[k++] = (*q >= 'a' && *q <= 'z') || (*q >= '0' && *q <= '9') ? *q : '-';
+    snprintf(name + k, sizeof name - k, ".json");
+    double *v = NULL;
+    size_t done = 0;
+    if (!rl_bench_resume_load(c->resume, name, &v, &done))
+        return RL_ERR_IO;
+    if (done > c->npos) {
+        free(v);
+        note("%s holds %zu values for %u positions", rl_bench_resume_path(c->resume, name), done, c->npos);
+        return RL_ERR_IO;
+    }
+    double *all = realloc(v, (c->npos ? c->npos : 1) * sizeof *all);
+    if (!all) {
+        free(v);
+        return RL_ERR_OUT_OF_MEMORY;
+    }
+    if (done > 0)
+        note("%s: %zu of %u positions measured before", label, done, c->npos);
+    rl_status st = RL_OK;
+    while (st == RL_OK && done < c->npos) {
+        size_t n = c->npos - done < RESUME_BLOCK ? c->npos - done : RESUME_BLOCK;
+        double *block = NULL;
+        char what[160];
+        snprintf(what, sizeof what, "%s (%zu-%zu of %u)", label, done + 1, done + n, c->npos);
+        st = rl_eval_measure(p, c->pos + done, n, &block, what);
+        if (st == RL_OK) {
+            memcpy(all + done, block, n * sizeof *block);
+            done += n;
+            if (!rl_bench_resume_save(c->resume, name, all, done))
+                st = RL_ERR_IO;
+        }
+        free(block);
+    }
+    if (st != RL_OK) {
+        free(all);
+        return st;
+    }
+    *values = all;
     return RL_OK;
 }
 
@@ -385,7 +464,7 @@ static rl_status measure_at_driver_keep(bc_ctx *c, const char *label, const char
     rl_status st = make_property(c, name, kv, &p);
     double *values = NULL;
     if (st == RL_OK)
-        st = rl_eval_measure(p, c->pos, c->npos, &values, label);
+        st = c->resume ? measure_resumable(c, p, label, &values) : rl_eval_measure(p, c->pos, c->npos, &values, label);
     if (st == RL_OK)
         st = region_stats(c->driver, values, s);
     if (st == RL_OK && keep)
@@ -763,6 +842,7 @@ static int parse_args(int argc, char **argv, bc_args *a)
         RL_BENCH_REAL("--select-quantile", 1e-6, 1.0 - 1e-6, &a->select_quantile, NULL),
         RL_BENCH_SECTIONS(section_names, SEC_COUNT, &a->sections),
         RL_BENCH_STRING("--scene", &a->scene),
+        RL_BENCH_STRING("--resume", &a->resume),
         RL_BENCH_OUT(&a->out),
     };
     int rc = rl_bench_parse_args(argc, argv, "bench culling", bench_culling_help, rows,
@@ -812,6 +892,19 @@ int rl_bench_culling(int argc, char **argv)
         return rc;
     c.d = rl_scene_get_data(c.scene);
     int threads = a.threads > 0 ? (int)a.threads : omp_get_max_threads();
+    if (a.resume) {
+        /* Everything that changes the slice or a value measured on it. */
+        char key[1024];
+        snprintf(key, sizeof key,
+                 "rl bench culling: scene=%s samples=%lld size=%lld resolution=%lld height=%.17g extent=%.17g "
+                 "seed=%lld budget=%lld threads=%d quick=%d\n",
+                 a.scene, a.samples, a.size, a.resolution, a.height, a.extent, a.seed, a.budget, threads,
+                 (int)a.quick);
+        if (!rl_bench_resume_open(a.resume, key, &c.resume)) {
+            rl_scene_release(c.scene);
+            return RL_CLI_FAIL;
+        }
+    }
     cJSON *root = rl_bench_record_json("culling", threads);
     if (!root) {
         rl_scene_release(c.scene);
@@ -839,6 +932,7 @@ int rl_bench_culling(int argc, char **argv)
     rl_approx_release(c.time_chcpp);
     rl_approx_release(c.time_svs);
     free(c.pos);
+    rl_bench_resume_close(c.resume);
     rl_scene_release(c.scene);
     return rc;
 }

@@ -22,7 +22,7 @@ expect_exit 1 "$RL" bench culling --quick --out "$TMP/no/such/dir/c.json"
 
 expect_exit 0 "$RL" bench culling --help
 for o in --scene --only --samples --max-depth --size --height --extent --resolution --select-positions \
-         --select-quantile --surfels --budget --threads --seed --out --quick; do
+         --select-quantile --surfels --budget --threads --seed --out --resume --quick; do
     expect_in "$TMP/out" "$o"
 done
 expect_exit 0 "$RL" bench --help
@@ -84,6 +84,36 @@ assert a["parameters"]["extent"] == 1 and b["parameters"]["extent"] == 3
 assert a["svs"]["visible_polygons"]["mean"] != b["svs"]["visible_polygons"]["mean"], (a["svs"], b["svs"])
 PY
 fi
+
+# --resume: the slice and every series measured on it are kept; a run that
+# stopped (here: series cut short or lost, as a kill would leave them)
+# continues with the same command and ends with the same values.
+expect_exit 0 "$RL" bench culling --quick --only svs --resume "$TMP/res" --out "$TMP/r1.json"
+for f in key.txt slice.json chcpp-time.json svs-time.json chcpp-triangles.json svs-triangles.json svs-quality.json; do
+    [ -s "$TMP/res/$f" ] || fail "--resume did not keep $f"
+done
+cp "$TMP/res/svs-triangles.json" "$TMP/tri-full.json"
+echo '{"values": [1234.5]}' >"$TMP/res/svs-triangles.json"
+rm "$TMP/res/svs-quality.json"
+expect_exit 0 "$RL" bench culling --quick --only svs --resume "$TMP/res" --out "$TMP/r2.json"
+expect_in "$TMP/err" "the slice sampled before"
+expect_in "$TMP/err" "svs triangles: 1 of"
+cmp -s "$TMP/res/svs-triangles.json" "$TMP/tri-full.json" && fail "the cut series was measured anew, not continued"
+if have_python; then
+    python3 - "$TMP/r1.json" "$TMP/r2.json" "$TMP/res/svs-triangles.json" "$TMP/tri-full.json" <<'PY' || fail "a resumed run differs"
+import json, sys
+a, b = (json.load(open(f))["svs"] for f in sys.argv[1:3])
+cut, full = (json.load(open(f))["values"] for f in sys.argv[3:5])
+assert a["positions"] == b["positions"] and a["visible_polygons"] == b["visible_polygons"], (a, b)
+assert a["chcpp_triangles"] == b["chcpp_triangles"] and a["svs_ssim"] == b["svs_ssim"], (a, b)
+# the kept first value, then the rest measured as before
+assert len(cut) == len(full) and cut[0] == 1234.5 and cut[1:] == full[1:], (cut, full)
+PY
+fi
+expect_error 1 "other options" "$RL" bench culling --quick --only svs --seed 2 --resume "$TMP/res" --out "$TMP/r3.json"
+echo 'not json' >"$TMP/res/svs-quality.json"
+expect_exit 1 "$RL" bench culling --quick --only svs --resume "$TMP/res" --out "$TMP/r4.json"
+expect_in "$TMP/err" "not a saved series"
 
 expect_exit 0 "$RL" bench culling --quick --only depth --max-depth 1 -q --out "$TMP/d.json"
 if have_python; then

@@ -1,0 +1,175 @@
+/* bench_resume.c: see bench_resume.h. */
+#define _POSIX_C_SOURCE 200809L
+#include "bench_resume.h"
+
+#include "cli.h"
+
+#include <cjson/cJSON.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+struct rl_bench_resume {
+    char dir[1024];
+    char path[1280];
+};
+
+/* The whole file, NUL-terminated and malloc'd; NULL if it cannot be read
+ * (*missing tells a file that is not there from one that fails). */
+static char *slurp(const char *path, bool *missing)
+{
+    *missing = false;
+    FILE *f = fopen(path, "rb");
+    if (!f) {
+        *missing = true;
+        return NULL;
+    }
+    char *text = NULL;
+    size_t len = 0, cap = 0;
+    for (;;) {
+        if (len + 4096 + 1 > cap) {
+            cap = cap ? 2 * cap : 8192;
+            char *t = realloc(text, cap);
+            if (!t) {
+                free(text);
+                fclose(f);
+                return NULL;
+            }
+            text = t;
+        }
+        size_t n = fread(text + len, 1, 4096, f);
+        len += n;
+        if (n < 4096)
+            break;
+    }
+    bool ok = !ferror(f);
+    fclose(f);
+    if (!ok) {
+        free(text);
+        return NULL;
+    }
+    text[len] = '\0';
+    return text;
+}
+
+/* Writes text to path through path.tmp and a rename. */
+static bool write_atomic(const char *path, const char *text)
+{
+    char tmp[1400];
+    snprintf(tmp, sizeof tmp, "%s.tmp", path);
+    FILE *f = fopen(tmp, "w");
+    bool ok = f && fputs(text, f) >= 0;
+    if (f && fclose(f) != 0)
+        ok = false;
+    if (ok && rename(tmp, path) != 0)
+        ok = false;
+    if (!ok)
+        rl_cli_fail(RL_CLI_FAIL, "%s: cannot write", path);
+    return ok;
+}
+
+bool rl_bench_resume_open(const char *dir, const char *key, rl_bench_resume **out)
+{
+    *out = NULL;
+    if (strlen(dir) >= sizeof((rl_bench_resume *)0)->dir) {
+        rl_cli_fail(RL_CLI_FAIL, "%s: path too long", dir);
+        return false;
+    }
+    if (!rl_cli_make_dirs(dir))
+        return false;
+    rl_bench_resume *r = calloc(1, sizeof *r);
+    if (!r) {
+        rl_cli_fail(RL_CLI_FAIL, "out of memory");
+        return false;
+    }
+    snprintf(r->dir, sizeof r->dir, "%s", dir);
+    const char *key_path = rl_bench_resume_path(r, "key.txt");
+    bool missing = false;
+    char *have = slurp(key_path, &missing);
+    bool ok;
+    if (have) {
+        ok = strcmp(have, key) == 0;
+        if (!ok)
+            rl_cli_fail(RL_CLI_FAIL, "%s holds a run with other options (%.*s), not this one (%.*s); use another "
+                        "folder or the same options", dir, (int)strcspn(have, "\n"), have,
+                        (int)strcspn(key, "\n"), key);
+    } else if (missing) {
+        ok = write_atomic(key_path, key);
+    } else {
+        ok = false;
+        rl_cli_fail(RL_CLI_FAIL, "%s: cannot read", key_path);
+    }
+    free(have);
+    if (!ok) {
+        free(r);
+        return false;
+    }
+    *out = r;
+    return true;
+}
+
+void rl_bench_resume_close(rl_bench_resume *r)
+{
+    free(r);
+}
+
+const char *rl_bench_resume_path(rl_bench_resume *r, const char *name)
+{
+    snprintf(r->path, sizeof r->path, "%s/%s", r->dir, name);
+    return r->path;
+}
+
+bool rl_bench_resume_load(rl_bench_resume *r, const char *name, double **values, size_t *count)
+{
+    *values = NULL;
+    *count = 0;
+    const char *path = rl_bench_resume_path(r, name);
+    bool missing = false;
+    char *text = slurp(path, &missing);
+    if (!text) {
+        if (!missing)
+            rl_cli_fail(RL_CLI_FAIL, "%s: cannot read", path);
+        return missing;
+    }
+    cJSON *root = cJSON_Parse(text);
+    free(text);
+    const cJSON *arr = cJSON_GetObjectItemCaseSensitive(root, "values");
+    int n = cJSON_IsArray(arr) ? cJSON_GetArraySize(arr) : -1;
+    double *v = n >= 0 ? malloc((size_t)(n > 0 ? n : 1) * sizeof *v) : NULL;
+    bool ok = v != NULL;
+    for (int i = 0; ok && i < n; ++i) {
+        const cJSON *x = cJSON_GetArrayItem(arr, i);
+        ok = cJSON_IsNumber(x) && isfinite(x->valuedouble);
+        if (ok)
+            v[i] = x->valuedouble;
+    }
+    cJSON_Delete(root);
+    if (!ok) {
+        free(v);
+        rl_cli_fail(RL_CLI_FAIL, "%s: not a saved series ({\"values\": [numbers]}); delete it to measure again",
+                    rl_bench_resume_path(r, name));
+        return false;
+    }
+    *values = v;
+    *count = (size_t)n;
+    return true;
+}
+
+bool rl_bench_resume_save(rl_bench_resume *r, const char *name, const double *values, size_t count)
+{
+    cJSON *root = cJSON_CreateObject();
+    cJSON *arr = root ? cJSON_AddArrayToObject(root, "values") : NULL;
+    bool ok = arr != NULL;
+    for (size_t i = 0; ok && i < count; ++i)
+        ok = cJSON_AddItemToArray(arr, cJSON_CreateNumber(values[i]));
+    char *text = ok ? cJSON_Print(root) : NULL;
+    cJSON_Delete(root);
+    if (!text) {
+        rl_cli_fail(RL_CLI_FAIL, "out of memory while saving %s", name);
+        return false;
+    }
+    ok = write_atomic(rl_bench_resume_path(r, name), text);
+    free(text);
+    return ok;
+}

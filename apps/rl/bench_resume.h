@@ -1,0 +1,31 @@
+/* bench_resume.h: a folder in which a long benchmark keeps what it has
+ * measured so far, so that a run that stops (a machine lent for a few
+ * hours, a crash) can be continued by the same command instead of being
+ * started over.
+ *
+ * The folder holds key.txt, the options of the run that made it: only a
+ * run with the same key may continue there. Named value series are saved
+ * after every block (written to a temporary file and renamed, so that a
+ * run killed while saving leaves the previous block intact); other files
+ * (a saved approximation) go to rl_bench_resume_path(). */
+#ifndef RL_APP_BENCH_RESUME_H
+#define RL_APP_BENCH_RESUME_H
+
+#include <stdbool.h>
+#include <stddef.h>
+
+typedef struct rl_bench_resume rl_bench_resume;
+
+/* Opens dir (made if missing) for a run described by key. Fails, with the
+ * error printed, when dir belongs to a run with another key. */
+bool rl_bench_resume_open(const char *dir, const char *key, rl_bench_resume **out);
+void rl_bench_resume_close(rl_bench_resume *r);      /* NULL is a no-op */
+/* dir/name, valid until the next call. */
+const char *rl_bench_resume_path(rl_bench_resume *r, const char *name);
+/* The series saved under name: *values malloc'd (NULL and 0 when none was
+ * saved). False, with the error printed, for an unreadable file. */
+bool rl_bench_resume_load(rl_bench_resume *r, const char *name, double **values, size_t *count);
+/* Saves count values under name, replacing what was there. */
+bool rl_bench_resume_save(rl_bench_resume *r, const char *name, const double *values, size_t count);
+
+#endif
