@@ -39,6 +39,13 @@
  *
  * ops: one frame per direction with the worker's renderer; `counter` from
  * rl_render_stats, reduced by `reduce` = max (default, like time) or sum.
+ * The renderer is reset before each direction (rl_renderer_reset keeps
+ * what it built for the scene), so that a renderer with temporal coherence
+ * (chcpp, vt) counts what it does at this position, not what the previous
+ * position left it: until 2026-12-04 chcpp's count depended on the order
+ * in which the workers took the positions. Conditioning, as for time, is
+ * not offered: CHC++ re-queries a visible node only every assumed_visible
+ * frames, so a count does not settle when it first repeats.
  *
  * quality: per direction one frame of the renderer and one of the
  * reference, compared by rl_image_compare() on sRGB luma: ssim (Wang et
@@ -426,6 +433,7 @@ static rl_status ops_evaluate(rl_property *p, void *state, int worker, rl_vec3 p
     for (int i = 0; i < 6; ++i) {
         rl_camera cam = direction_camera(s, pos, i);
         rl_render_stats stats;
+        rl_renderer_reset(w->r);        /* nothing of an earlier frame survives */
         rl_status st = rl_renderer_render(w->r, s->scene, &cam, w->img, &stats);
         if (st != RL_OK)
             return st;

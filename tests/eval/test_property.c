@@ -489,6 +489,32 @@ static void test_ops_counts_whitted_rays(void **state)
     rl_scene_release(s);
 }
 
+/* CHC++ keeps what was visible in the last frame (temporal coherence), so
+ * one frame at a position counts partly what the previous position left;
+ * the ops property must count the position itself, independent of where
+ * the renderer was before. */
+static void test_ops_of_a_coherent_renderer_do_not_depend_on_the_previous_position(void **state)
+{
+    (void)state;
+    rl_scene *s = NULL;
+    assert_int_equal(rl_scene_create_builtin("city", "blocks=1", &s), RL_OK);
+    const rl_scene_data *d = rl_scene_get_data(s);
+    rl_vec3 lo = d->bounds.min, hi = d->bounds.max;
+    rl_vec3 a = rl_v3(lo.x + 0.3f * (hi.x - lo.x), lo.y + 2.0f, lo.z + 0.3f * (hi.z - lo.z));
+    rl_vec3 b = rl_v3(lo.x + 0.5f * (hi.x - lo.x), hi.y + 20.0f, lo.z + 0.5f * (hi.z - lo.z));
+    const char *const opts[] = { "renderer", "chcpp", "counter", "triangles", "width", "32", "height", "32",
+                                 NULL };
+    rl_property *p = make("ops", opts, s, 1);
+    rl_property_sample first = evaluate_at(p, a);
+    rl_property_sample other = evaluate_at(p, b);
+    rl_property_sample again = evaluate_at(p, a);
+    assert_true(other.value != first.value);          /* b sees another city */
+    for (int i = 0; i < 6; ++i)
+        assert_true(again.direction[i] == first.direction[i]);
+    rl_property_release(p);
+    rl_scene_release(s);
+}
+
 /* ---- quality (Sec. 4.2.5) ---------------------------------------------- */
 
 static void test_quality_of_the_reference_against_itself_is_perfect(void **state)
@@ -749,6 +775,7 @@ int main(void)
         cmocka_unit_test(test_ops_counts_the_triangles_the_rasterizer_draws),
         cmocka_unit_test(test_every_ops_counter_has_its_unit),
         cmocka_unit_test(test_ops_counts_whitted_rays),
+        cmocka_unit_test(test_ops_of_a_coherent_renderer_do_not_depend_on_the_previous_position),
         cmocka_unit_test(test_quality_of_the_reference_against_itself_is_perfect),
         cmocka_unit_test(test_quality_of_unshadowed_raster_against_whitted_is_below_one),
         cmocka_unit_test(test_custom_property_calls_back_and_checks_its_arguments),
