@@ -15,6 +15,7 @@
 
 #include <cmocka.h>
 
+#include "raster/raster_fixtures.h"
 #include "rl/rl_raster.h"
 
 #define W 64
@@ -22,22 +23,6 @@
 #define ALL_LAYERS (RL_LAYER_COLOR | RL_LAYER_DEPTH | RL_LAYER_ID)
 
 /* ---- helpers ------------------------------------------------------------ */
-
-static rl_mat4 identity(void)
-{
-    rl_mat4 m = { { { 1, 0, 0, 0 }, { 0, 1, 0, 0 }, { 0, 0, 1, 0 }, { 0, 0, 0, 1 } } };
-    return m;
-}
-
-/* OpenGL perspective, 90 degrees vertical, square aspect. */
-static rl_mat4 perspective90(float n, float f)
-{
-    rl_mat4 m = { { { 1, 0, 0, 0 },
-                    { 0, 1, 0, 0 },
-                    { 0, 0, (f + n) / (n - f), 2 * f * n / (n - f) },
-                    { 0, 0, -1, 0 } } };
-    return m;
-}
 
 /* Pixel-space point for the identity setup: (px, py) in pixels, eye depth d. */
 static rl_vec3 pix(float px, float py, float d)

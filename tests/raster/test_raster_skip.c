@@ -14,26 +14,11 @@
 
 #include <cmocka.h>
 
+#include "raster/raster_fixtures.h"
 #include "rl/rl_raster.h"
 
 #define W 64
 #define H 64
-
-static rl_mat4 identity(void)
-{
-    rl_mat4 m = { { { 1, 0, 0, 0 }, { 0, 1, 0, 0 }, { 0, 0, 1, 0 }, { 0, 0, 0, 1 } } };
-    return m;
-}
-
-/* OpenGL perspective, 90 degrees vertical, square aspect. */
-static rl_mat4 perspective90(float n, float f)
-{
-    rl_mat4 m = { { { 1, 0, 0, 0 },
-                    { 0, 1, 0, 0 },
-                    { 0, 0, (f + n) / (n - f), 2 * f * n / (n - f) },
-                    { 0, 0, -1, 0 } } };
-    return m;
-}
 
 typedef struct fixture {
     rl_raster *r;
