@@ -347,10 +347,10 @@ struct rl_scene_drawer {
     int threads;
     uint8_t *object_lit;         /* per object: lighting done */
     uint32_t *todo;              /* scratch of rl_scene_drawer_light, one per object */
-    uint32_t *in_view;           /* scratch of rl_scene_drawer_draw_all, one per object */
-    /* Lazy lighting (rl_raster_lazy_colors) of single-material objects in
-     * gouraud/textured mode: a stamp per scene vertex, and the value of
-     * this frame's lighting. */
+    uint32_t *in_view;           /* scratch of rl_scene_drawer_draw_all (flat shading) */
+    /* Lazy lighting (rl_raster_lazy_colors) in gouraud/textured mode: a
+     * stamp per scene vertex and per corner of mixed-material objects, and
+     * the value of this frame's lighting. */
     uint32_t *stamps;            /* per vertex (single-material objects) */
     uint32_t *corner_stamps;     /* per corner (mixed objects), if any */
     uint32_t frame;
@@ -406,11 +406,12 @@ rl_status rl_scene_drawer_create(const rl_scene_data *d, rl_vec3 eye, const rl_r
     dr->ctx = (shade_ctx){ d, eye, dr->opt.ambient };
     dr->object_lit = rl_calloc(d->num_objects ? d->num_objects : 1, 1);
     dr->todo = dr->lit ? rl_calloc(d->num_objects ? d->num_objects : 1, sizeof *dr->todo) : NULL;
-    dr->in_view = dr->lit ? rl_calloc(d->num_objects ? d->num_objects : 1, sizeof *dr->in_view) : NULL;
     bool lazy = dr->lit && dr->opt.shading != RL_SHADING_FLAT;
+    bool eager = dr->lit && !lazy;
+    dr->in_view = eager ? rl_calloc(d->num_objects ? d->num_objects : 1, sizeof *dr->in_view) : NULL;
     dr->stamps = lazy ? rl_calloc((size_t)d->num_vertices + 1, sizeof *dr->stamps) : NULL;
     dr->frame = 1;
-    bool have = dr->object_lit && ((dr->todo && dr->in_view) || !dr->lit) && (dr->stamps || !lazy);
+    bool have = dr->object_lit && (dr->todo || !dr->lit) && (dr->in_view || !eager) && (dr->stamps || !lazy);
     st = have ? prepare(d, dr->opt.shading, dr->lit, dr->opt.object_mask, &dr->b) : RL_ERR_OUT_OF_MEMORY;
     if (st == RL_OK && lazy && dr->b.corner_colors) {
         dr->corner_stamps = rl_calloc((size_t)d->num_triangles * 3, sizeof *dr->corner_stamps);
@@ -578,10 +579,11 @@ rl_status rl_scene_drawer_draw_all(rl_scene_drawer *dr, rl_raster *ras, rl_raste
     if (!dr || !ras)
         return rl_error(RL_ERR_INVALID_ARG, "rl_scene_drawer_draw_all: NULL argument");
     const rl_scene_data *d = dr->data;
-    /* Light what can be seen in one pass before drawing (one object at a
-     * time would serialise the many small ones); objects outside the view
-     * are skipped by rl_scene_drawer_draw and need no lighting. */
-    if (dr->lit) {
+    /* Flat shading lights eagerly: what can be seen, in one pass before
+     * drawing (one object at a time would serialise the many small ones);
+     * objects outside the view are skipped by rl_scene_drawer_draw and need
+     * no lighting. Lazily lit objects light themselves while drawn. */
+    if (dr->in_view) {
         uint32_t n = 0;
         for (uint32_t o = 0; o < d->num_objects; ++o)
             if (selected(dr->opt.object_mask, o) && !rl_raster_box_outside(ras, d->objects[o].bounds))
