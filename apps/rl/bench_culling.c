@@ -349,12 +349,31 @@ static rl_status sec_depth(void *ctx, cJSON *sec)
 }
 
 /* --- the shared slice of Sec. 7.4-7.6 --- */
-static rl_status driver_positions(bc_ctx *c);
+/* c->pos and c->npos from the driver's samples. */
+static rl_status driver_positions(bc_ctx *c)
+{
+    c->npos = rl_approx_sample_count(c->driver);
+    c->pos = malloc((c->npos ? c->npos : 1) * sizeof *c->pos);
+    if (!c->pos)
+        return RL_ERR_OUT_OF_MEMORY;
+    for (uint32_t k = 0; k < c->npos; ++k)
+        rl_approx_sample(c->driver, k, &c->pos[k], NULL);
+    return RL_OK;
+}
 
 static rl_status ensure_driver(bc_ctx *c)
 {
     if (c->driver)
         return RL_OK;
+    const char *saved = c->resume ? rl_bench_resume_path(c->resume, "slice.json") : NULL;
+    FILE *f = saved ? fopen(saved, "r") : NULL;
+    if (f) {
+        /* --resume: the slice of an earlier run with the same options. */
+        fclose(f);
+        note("polygons in visible objects: the slice sampled before (%s)", saved);
+        rl_status st = rl_approx_load_json(saved, &c->driver);
+        return st == RL_OK ? driver_positions(c) : st;
+    }
     char res[32];
     snprintf(res, sizeof res, "%lld", c->a->resolution);
     rl_property *vis = NULL;
@@ -373,15 +392,6 @@ static rl_status ensure_driver(bc_ctx *c)
     rl_sampling_desc sd = { .region = slice, .dims = 2,
                             .height = c->d->bounds.min.y + (float)c->a->height,
                             .max_samples = (uint32_t)c->a->samples, .seed = (uint64_t)c->a->seed };
-    const char *saved = c->resume ? rl_bench_resume_path(c->resume, "slice.json") : NULL;
-    FILE *f = saved ? fopen(saved, "r") : NULL;
-    if (f) {
-        /* --resume: the slice of an earlier run with the same options. */
-        fclose(f);
-        note("polygons in visible objects: the slice sampled before (%s)", saved);
-        rl_property_release(vis);
-        return rl_approx_load_json(saved, &c->driver) == RL_OK ? driver_positions(c) : RL_ERR_IO;
-    }
     if (st == RL_OK) {
         note("sampling polygons in visible objects (%lld samples)", c->a->samples);
         st = rl_sample_property(vis, &sd, &c->driver);
@@ -393,18 +403,6 @@ static rl_status ensure_driver(bc_ctx *c)
     if (st != RL_OK)
         return st;
     return driver_positions(c);
-}
-
-/* c->pos and c->npos from the driver's samples. */
-static rl_status driver_positions(bc_ctx *c)
-{
-    c->npos = rl_approx_sample_count(c->driver);
-    c->pos = malloc((c->npos ? c->npos : 1) * sizeof *c->pos);
-    if (!c->pos)
-        return RL_ERR_OUT_OF_MEMORY;
-    for (uint32_t k = 0; k < c->npos; ++k)
-        rl_approx_sample(c->driver, k, &c->pos[k], NULL);
-    return RL_OK;
 }
 
 /* --resume: p at the driver's positions, continuing the series saved under
