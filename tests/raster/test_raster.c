@@ -57,17 +57,6 @@ static void unmake(fixture *f)
     rl_image_release(f->img);
 }
 
-static rl_raster_batch tris(const rl_vec3 *pos, uint32_t nv, const uint32_t *idx, uint32_t nt)
-{
-    rl_raster_batch b = { 0 };
-    b.positions = pos;
-    b.num_vertices = nv;
-    b.indices = idx;
-    b.num_triangles = nt;
-    b.color = rl_v4(1, 1, 1, 1);
-    return b;
-}
-
 static const uint32_t tri012[3] = { 0, 1, 2 };
 static const uint32_t quad_idx[6] = { 0, 1, 2, 0, 2, 3 };
 

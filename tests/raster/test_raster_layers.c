@@ -66,13 +66,7 @@ static const rl_vec3 *square(void)
 
 static rl_raster_batch quad(const rl_vec3 *pos)
 {
-    rl_raster_batch b = { 0 };
-    b.positions = pos;
-    b.num_vertices = 4;
-    b.indices = quad_idx;
-    b.num_triangles = 2;
-    b.color = rl_v4(1, 1, 1, 1);
-    return b;
+    return tris(pos, 4, quad_idx, 2);
 }
 
 static uint64_t draw(fixture *f, rl_raster_batch b)
@@ -150,11 +144,7 @@ static void test_layer_colours_interpolate_like_gouraud(void **state)
     for (int k = 0; k < 3; ++k)
         sum[k] = rl_v4(ca[k].x + cb[k].x, ca[k].y + cb[k].y, ca[k].z + cb[k].z, ca[k].w);
     const uint32_t idx[3] = { 0, 1, 2 };
-    rl_raster_batch b = { 0 };
-    b.positions = p;
-    b.num_vertices = 3;
-    b.indices = idx;
-    b.num_triangles = 1;
+    rl_raster_batch b = tris(p, 3, idx, 1);
     rl_raster_layer layers[2] = { { .colors = ca }, { .colors = cb } };
     b.num_layers = 2;
     b.layers = layers;

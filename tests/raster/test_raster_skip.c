@@ -105,11 +105,7 @@ static void free_soup(soup *s)
 static void draw_soup(fixture *f, const soup *s, const rl_vec4 *colors, const rl_raster_lazy_colors *lazy,
                       unsigned flags)
 {
-    rl_raster_batch b = { 0 };
-    b.positions = s->pos;
-    b.num_vertices = s->nv;
-    b.indices = s->idx;
-    b.num_triangles = s->nt;
+    rl_raster_batch b = tris(s->pos, s->nv, s->idx, s->nt);
     b.colors = colors;
     b.lazy = lazy;
     b.flags = flags;
@@ -184,11 +180,7 @@ static void test_lazy_colours_shade_only_vertices_of_drawn_triangles_once_per_fr
     uint32_t calls[15] = { 0 }, stamps[15] = { 0 };
     shader sh = { colors, calls };
     rl_raster_lazy_colors lz = { shade, &sh, stamps, 1 };
-    rl_raster_batch b = { 0 };
-    b.positions = pos;
-    b.num_vertices = 15;
-    b.indices = idx;
-    b.num_triangles = 5;
+    rl_raster_batch b = tris(pos, 15, idx, 5);
     b.colors = colors;
     b.lazy = &lz;
     b.flags = RL_RASTER_CULL_BACK;
@@ -219,11 +211,7 @@ static void test_lazy_colours_with_bad_parameters_are_rejected(void **state)
     uint32_t idx[3] = { 0, 1, 2 }, calls[3] = { 0 }, stamps[3] = { 0 };
     rl_vec4 colors[3];
     shader sh = { colors, calls };
-    rl_raster_batch b = { 0 };
-    b.positions = pos;
-    b.num_vertices = 3;
-    b.indices = idx;
-    b.num_triangles = 1;
+    rl_raster_batch b = tris(pos, 3, idx, 1);
     b.colors = colors;
     const rl_raster_lazy_colors bad[] = {
         { shade, &sh, stamps, 0 },              /* frame 0 is every stamp's start */
@@ -303,12 +291,7 @@ static void test_triangles_in_a_box_outside_draw_nothing(void **state)
                            fminf(fmaxf(pos[k].z, z0), z1));
             idx[k] = (uint32_t)(lcg(&seed) % 24);
         }
-        rl_raster_batch b = { 0 };
-        b.positions = pos;
-        b.num_vertices = 24;
-        b.indices = idx;
-        b.num_triangles = 8;
-        b.color = rl_v4(1, 1, 1, 1);
+        rl_raster_batch b = tris(pos, 24, idx, 8);
         rl_raster_counters c = { 0 };
         rl_image_clear(f.img);
         assert_int_equal(rl_raster_draw(f.r, &b, &c), RL_OK);
