@@ -94,7 +94,8 @@ static const char bench_culling_help[] =
     "  --out FILE.json      default bench/results/culling-YYYYMMDD-HHMMSS.json\n"
     "  --resume DIR         keep the sampled slice of svs/select/visset and\n"
     "                       every value measured at its positions in DIR (saved\n"
-    "                       every 32 positions): the same command continues a\n"
+    "                       every 32 positions), and each depth's sampling of\n"
+    "                       the depth section: the same command continues a\n"
     "                       run that stopped; DIR must be new or made by a run\n"
     "                       with the same options\n"
     "  --quick              tiny run: cornell-sized box city, few samples\n"
@@ -287,6 +288,39 @@ static rl_status sec_surfels(void *ctx, cJSON *sec)
 }
 
 /* --- Sec. 7.3 --- */
+/* The time of chcpp with options opts sampled over region; with --resume,
+ * the approximation of one depth is kept in DIR/depth-N.json, so a stopped
+ * run continues with the next depth (one depth is the unit: the adaptive
+ * sampling itself cannot be resumed). */
+static rl_status depth_sampled(bc_ctx *c, int depth, const rl_aabb *region, const char *opts, const char *size,
+                               rl_approx **out)
+{
+    char name[32];
+    snprintf(name, sizeof name, "depth-%d.json", depth);
+    const char *saved = c->resume ? rl_bench_resume_path(c->resume, name) : NULL;
+    FILE *f = saved ? fopen(saved, "r") : NULL;
+    if (f) {
+        fclose(f);
+        note("depth %d: sampled before (%s)", depth, saved);
+        return rl_approx_load_json(saved, out);
+    }
+    rl_property *p = NULL;
+    rl_status st = make_property(c, "time", TIME_KV("chcpp", opts), &p);
+    rl_sampling_desc sd = { .region = *region, .dims = 3, .max_samples = (uint32_t)c->a->samples,
+                            .seed = (uint64_t)c->a->seed };
+    if (st == RL_OK) {
+        note("depth %d: sampling chcpp's time (%lld samples)", depth, c->a->samples);
+        st = rl_sample_property(p, &sd, out);
+    }
+    rl_property_release(p);
+    if (st == RL_OK && c->resume && rl_approx_save_json(*out, rl_bench_resume_path(c->resume, name)) != RL_OK) {
+        rl_approx_release(*out);
+        *out = NULL;
+        st = RL_ERR_IO;
+    }
+    return st;
+}
+
 static rl_status sec_depth(void *ctx, cJSON *sec)
 {
     bc_ctx *c = ctx;
@@ -303,14 +337,8 @@ static rl_status sec_depth(void *ctx, cJSON *sec)
     for (int depth = 0; depth <= (int)c->a->max_depth; ++depth) {
         char opts[64];
         snprintf(opts, sizeof opts, "max_depth=%d", depth);
-        rl_property *p = NULL;
-        rl_status st = make_property(c, "time", TIME_KV("chcpp", opts), &p);
-        rl_sampling_desc sd = { .region = region, .dims = 3, .max_samples = (uint32_t)c->a->samples,
-                                .seed = (uint64_t)c->a->seed };
         rl_approx *a = NULL;
-        if (st == RL_OK)
-            st = rl_sample_property(p, &sd, &a);
-        rl_property_release(p);
+        rl_status st = depth_sampled(c, depth, &region, opts, size, &a);
         double *v = NULL, *w = NULL;
         size_t n = 0;
         rl_stats s;

@@ -123,4 +123,26 @@ r = json.load(open(sys.argv[1]))
 assert len(r["depth"]["depths"]) == 2 and "svs" not in r, r.keys()
 PY
 fi
+
+# --resume in the depth section: each depth's sampling is kept, a longer run
+# continues after the depths done (their noisy times come back unchanged),
+# and a damaged depth file is an error, not a silent resample.
+expect_exit 0 "$RL" bench culling --quick --only depth --max-depth 1 --resume "$TMP/dres" --out "$TMP/d1.json"
+for f in depth-0.json depth-1.json; do
+    [ -s "$TMP/dres/$f" ] || fail "--resume did not keep $f"
+done
+expect_exit 0 "$RL" bench culling --quick --only depth --max-depth 2 --resume "$TMP/dres" --out "$TMP/d2.json"
+expect_in "$TMP/err" "depth 0: sampled before"
+expect_in "$TMP/err" "depth 1: sampled before"
+[ -s "$TMP/dres/depth-2.json" ] || fail "--resume did not keep depth-2.json"
+if have_python; then
+    python3 - "$TMP/d1.json" "$TMP/d2.json" <<'PY' || fail "a resumed depth run differs"
+import json, sys
+a, b = (json.load(open(f))["depth"]["depths"] for f in sys.argv[1:3])
+assert len(a) == 2 and len(b) == 3, (a, b)
+assert a == b[:2], (a, b[:2])
+PY
+fi
+echo 'not json' >"$TMP/dres/depth-1.json"
+expect_exit 1 "$RL" bench culling --quick --only depth --max-depth 1 --resume "$TMP/dres" --out "$TMP/d3.json"
 echo "ok"
