@@ -313,7 +313,7 @@ static rl_status depth_sampled(bc_ctx *c, int depth, const rl_aabb *region, cons
         st = rl_sample_property(p, &sd, out);
     }
     rl_property_release(p);
-    if (st == RL_OK && c->resume && rl_approx_save_json(*out, rl_bench_resume_path(c->resume, name)) != RL_OK) {
+    if (st == RL_OK && c->resume && !rl_bench_resume_save_approx(c->resume, name, *out)) {
         rl_approx_release(*out);
         *out = NULL;
         st = RL_ERR_IO;
@@ -425,8 +425,7 @@ static rl_status ensure_driver(bc_ctx *c)
         st = rl_sample_property(vis, &sd, &c->driver);
     }
     rl_property_release(vis);
-    if (st == RL_OK && c->resume && rl_approx_save_json(c->driver, rl_bench_resume_path(c->resume, "slice.json")) !=
-                                        RL_OK)
+    if (st == RL_OK && c->resume && !rl_bench_resume_save_approx(c->resume, "slice.json", c->driver))
         st = RL_ERR_IO;
     if (st != RL_OK)
         return st;

@@ -173,3 +173,17 @@ bool rl_bench_resume_save(rl_bench_resume *r, const char *name, const double *va
     free(text);
     return ok;
 }
+
+bool rl_bench_resume_save_approx(rl_bench_resume *r, const char *name, const rl_approx *a)
+{
+    char path[1280], tmp[1400];
+    snprintf(path, sizeof path, "%s", rl_bench_resume_path(r, name));
+    snprintf(tmp, sizeof tmp, "%s.tmp", path);
+    if (rl_approx_save_json(a, tmp) != RL_OK)
+        return false;
+    if (rename(tmp, path) != 0) {
+        rl_cli_fail(RL_CLI_FAIL, "%s: cannot write", path);
+        return false;
+    }
+    return true;
+}

@@ -11,6 +11,8 @@
 #ifndef RL_APP_BENCH_RESUME_H
 #define RL_APP_BENCH_RESUME_H
 
+#include "rl/rl_sampling.h"
+
 #include <stdbool.h>
 #include <stddef.h>
 
@@ -27,5 +29,10 @@ const char *rl_bench_resume_path(rl_bench_resume *r, const char *name);
 bool rl_bench_resume_load(rl_bench_resume *r, const char *name, double **values, size_t *count);
 /* Saves count values under name, replacing what was there. */
 bool rl_bench_resume_save(rl_bench_resume *r, const char *name, const double *values, size_t count);
+/* Saves a sampled approximation under name, also through a temporary file
+ * and a rename: a run killed while saving leaves no half file that the
+ * next run would fail to load. False on failure (the library's error, or
+ * one printed). */
+bool rl_bench_resume_save_approx(rl_bench_resume *r, const char *name, const rl_approx *a);
 
 #endif

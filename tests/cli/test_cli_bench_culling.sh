@@ -135,6 +135,7 @@ expect_exit 0 "$RL" bench culling --quick --only depth --max-depth 2 --resume "$
 expect_in "$TMP/err" "depth 0: sampled before"
 expect_in "$TMP/err" "depth 1: sampled before"
 [ -s "$TMP/dres/depth-2.json" ] || fail "--resume did not keep depth-2.json"
+ls "$TMP/dres" "$TMP/res" | grep -q '\.tmp$' && fail "a temporary file was left behind"
 if have_python; then
     python3 - "$TMP/d1.json" "$TMP/d2.json" <<'PY' || fail "a resumed depth run differs"
 import json, sys
