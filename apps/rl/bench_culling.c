@@ -297,15 +297,15 @@ static rl_status depth_sampled(bc_ctx *c, int depth, const rl_aabb *region, cons
 {
     char name[32];
     snprintf(name, sizeof name, "depth-%d.json", depth);
-    const char *saved = c->resume ? rl_bench_resume_path(c->resume, name) : NULL;
-    FILE *f = saved ? fopen(saved, "r") : NULL;
-    if (f) {
-        fclose(f);
-        note("depth %d: sampled before (%s)", depth, saved);
-        return rl_approx_load_json(saved, out);
+    *out = NULL;
+    rl_status st = c->resume ? rl_bench_resume_load_approx(c->resume, name, out) : RL_OK;
+    if (st != RL_OK || *out) {
+        if (*out)
+            note("depth %d: sampled before (%s)", depth, rl_bench_resume_path(c->resume, name));
+        return st;
     }
     rl_property *p = NULL;
-    rl_status st = make_property(c, "time", TIME_KV("chcpp", opts), &p);
+    st = make_property(c, "time", TIME_KV("chcpp", opts), &p);
     rl_sampling_desc sd = { .region = *region, .dims = 3, .max_samples = (uint32_t)c->a->samples,
                             .seed = (uint64_t)c->a->seed };
     if (st == RL_OK) {
@@ -393,19 +393,19 @@ static rl_status ensure_driver(bc_ctx *c)
 {
     if (c->driver)
         return RL_OK;
-    const char *saved = c->resume ? rl_bench_resume_path(c->resume, "slice.json") : NULL;
-    FILE *f = saved ? fopen(saved, "r") : NULL;
-    if (f) {
-        /* --resume: the slice of an earlier run with the same options. */
-        fclose(f);
-        note("polygons in visible objects: the slice sampled before (%s)", saved);
-        rl_status st = rl_approx_load_json(saved, &c->driver);
-        return st == RL_OK ? driver_positions(c) : st;
+    /* --resume: the slice of an earlier run with the same options. */
+    rl_status st = c->resume ? rl_bench_resume_load_approx(c->resume, "slice.json", &c->driver) : RL_OK;
+    if (st != RL_OK)
+        return st;
+    if (c->driver) {
+        note("polygons in visible objects: the slice sampled before (%s)",
+             rl_bench_resume_path(c->resume, "slice.json"));
+        return driver_positions(c);
     }
     char res[32];
     snprintf(res, sizeof res, "%lld", c->a->resolution);
     rl_property *vis = NULL;
-    rl_status st = make_property(c, "visibility", (const char *const[]){ "resolution", res, "measure", "polygons",
+    st = make_property(c, "visibility", (const char *const[]){ "resolution", res, "measure", "polygons",
                                                                          NULL },
                                  &vis);
     /* --extent: the scene's x/z extent scaled about its centre. */

@@ -187,3 +187,14 @@ bool rl_bench_resume_save_approx(rl_bench_resume *r, const char *name, const rl_
     }
     return true;
 }
+
+rl_status rl_bench_resume_load_approx(rl_bench_resume *r, const char *name, rl_approx **out)
+{
+    *out = NULL;
+    const char *path = rl_bench_resume_path(r, name);
+    FILE *f = fopen(path, "r");
+    if (!f)
+        return RL_OK;
+    fclose(f);
+    return rl_approx_load_json(path, out);
+}

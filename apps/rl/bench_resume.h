@@ -34,5 +34,9 @@ bool rl_bench_resume_save(rl_bench_resume *r, const char *name, const double *va
  * next run would fail to load. False on failure (the library's error, or
  * one printed). */
 bool rl_bench_resume_save_approx(rl_bench_resume *r, const char *name, const rl_approx *a);
+/* The approximation saved under name: RL_OK with *out NULL when none was
+ * saved; the library's status and message (RL_ERR_IO, RL_ERR_PARSE) for a
+ * file that cannot be loaded, which a run must not silently sample over. */
+rl_status rl_bench_resume_load_approx(rl_bench_resume *r, const char *name, rl_approx **out);
 
 #endif

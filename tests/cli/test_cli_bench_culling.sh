@@ -114,6 +114,10 @@ expect_error 1 "other options" "$RL" bench culling --quick --only svs --seed 2 -
 echo 'not json' >"$TMP/res/svs-quality.json"
 expect_exit 1 "$RL" bench culling --quick --only svs --resume "$TMP/res" --out "$TMP/r4.json"
 expect_in "$TMP/err" "not a saved series"
+echo '{"dims": 2' >"$TMP/res/slice.json"
+expect_exit 1 "$RL" bench culling --quick --only svs --resume "$TMP/res" --out "$TMP/r5.json"
+expect_in "$TMP/err" "slice.json:2:1"
+grep -q "sampling polygons" "$TMP/err" && fail "a damaged slice was sampled over"
 
 expect_exit 0 "$RL" bench culling --quick --only depth --max-depth 1 -q --out "$TMP/d.json"
 if have_python; then
