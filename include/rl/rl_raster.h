@@ -143,6 +143,13 @@ RL_API rl_status rl_raster_set_target(rl_raster *r, rl_image *target,
 RL_API rl_status rl_raster_set_camera(rl_raster *r, rl_image *target, const rl_camera *cam,
                                       rl_aabb scene_bounds);
 RL_API rl_status rl_raster_draw(rl_raster *r, const rl_raster_batch *batch, rl_raster_counters *c);
+/* Draws count batches in order: image, IDs and counters are exactly those of
+ * count rl_raster_draw calls, but runs of small batches (a scene of many
+ * small objects) are set up and filled on all threads together, where one
+ * draw each would run on one. Every batch is checked first: an invalid one
+ * (its index in the message) fails the call before anything is drawn. */
+RL_API rl_status rl_raster_draw_many(rl_raster *r, const rl_raster_batch *batches, uint32_t count,
+                                     rl_raster_counters *c);
 RL_API rl_status rl_raster_draw_points(rl_raster *r, const rl_raster_points *pts, rl_raster_counters *c);
 /* True when nothing inside box (world space) can be drawn in the current
  * view: the box lies entirely beyond the near plane or a side of the

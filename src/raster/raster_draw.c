@@ -10,8 +10,17 @@
  *
  * A layered batch (num_layers > 0) is validated here once, so that the fill
  * can read layer colours without checks; its prims get side records (see
- * rl_raster_prim_src) and the fill reads the layers from the batch. */
+ * rl_raster_prim_src) and the fill reads the layers from the batch.
+ *
+ * rl_raster_draw_many groups consecutive small batches: one draw of a few
+ * hundred triangles is too small to split, so a scene of many small objects
+ * drawn one by one would run on one thread. A group is cut into contiguous
+ * runs of batches, one per thread, each transformed and set up into its own
+ * chunk; the bands then walk the chunks in order, so every pixel still sees
+ * the triangles in submission order, as the draws one by one would. */
 #include <omp.h>
+#include <stdarg.h>
+#include <stdio.h>
 
 #include "core/error.h"
 #include "raster/raster_internal.h"
@@ -21,39 +30,60 @@
 #define PARALLEL_TRIANGLES 2048
 #define PARALLEL_PIXELS 16384
 
-static rl_status check_batch(const rl_raster *r, const rl_raster_batch *b, const char *fn)
+/* A group of rl_raster_draw_many holds at most this many vertices (bounded
+ * scratch), and batches of at least PARALLEL_TRIANGLES are drawn alone: their
+ * own setup already runs on every thread. */
+#define GROUP_VERTICES (1u << 18)
+
+/* Writes a batch's problem to msg; every problem is an invalid argument. */
+static rl_status RL_PRINTF(3, 4) problem(char *msg, size_t size, const char *fmt, ...)
+{
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(msg, size, fmt, ap);
+    va_end(ap);
+    return RL_ERR_INVALID_ARG;
+}
+
+/* Why batch b cannot be drawn, as status and message (no function name, so
+ * that each caller can say where), or RL_OK. Messages are formatted only on
+ * failure: rl_raster_draw_many checks thousands of batches per frame. */
+static rl_status batch_problem(const rl_raster *r, const rl_raster_batch *b, char *msg, size_t size)
 {
     if (!r || !b)
-        return rl_error(RL_ERR_INVALID_ARG, "%s: NULL argument", fn);
+        return problem(msg, size, "NULL argument");
     if (!r->target)
-        return rl_error(RL_ERR_INVALID_ARG, "%s: no render target set", fn);
+        return problem(msg, size, "no render target set");
     if (b->num_layers > RL_RASTER_MAX_LAYERS)
-        return rl_error(RL_ERR_INVALID_ARG, "%s: %u layers (at most %d)", fn, b->num_layers,
-                        RL_RASTER_MAX_LAYERS);
+        return problem(msg, size, "%u layers (at most %d)", b->num_layers, RL_RASTER_MAX_LAYERS);
     if (b->num_layers > 0 && !b->layers)
-        return rl_error(RL_ERR_INVALID_ARG, "%s: %u layers but layers is NULL", fn,
-                        b->num_layers);
+        return problem(msg, size, "%u layers but layers is NULL", b->num_layers);
     for (uint32_t i = 0; i < b->num_layers; ++i)
         if (!b->layers[i].colors)
-            return rl_error(RL_ERR_INVALID_ARG, "%s: layer %u has no colors", fn, i);
+            return problem(msg, size, "layer %u has no colors", i);
     if (b->lazy && (!b->lazy->shade || !b->lazy->stamps || b->lazy->frame < 1 ||
                     b->lazy->frame >= (1u << 31)))
-        return rl_error(RL_ERR_INVALID_ARG, "%s: lazy colours need shade, stamps and 1 <= frame < 2^31 "
-                        "(frame %u)", fn, b->lazy->frame);
+        return problem(msg, size, "lazy colours need shade, stamps and 1 <= frame < 2^31 (frame %u)",
+                       b->lazy->frame);
     if (b->num_triangles == 0)
         return RL_OK;
     if (!b->indices || !b->positions)
-        return rl_error(RL_ERR_INVALID_ARG, "%s: %u triangles without indices or positions",
-                        fn, b->num_triangles);
+        return problem(msg, size, "%u triangles without indices or positions", b->num_triangles);
     /* One pass, OR-free max: cheap next to the setup that follows. */
     const size_t n = 3 * (size_t)b->num_triangles;
     uint32_t max_index = 0;
     for (size_t i = 0; i < n; ++i)
         max_index = b->indices[i] > max_index ? b->indices[i] : max_index;
     if (max_index >= b->num_vertices)
-        return rl_error(RL_ERR_INVALID_ARG, "%s: index %u out of range (%u vertices)", fn,
-                        max_index, b->num_vertices);
+        return problem(msg, size, "index %u out of range (%u vertices)", max_index, b->num_vertices);
     return RL_OK;
+}
+
+static rl_status check_batch(const rl_raster *r, const rl_raster_batch *b, const char *fn)
+{
+    char msg[160];
+    rl_status st = batch_problem(r, b, msg, sizeof msg);
+    return st == RL_OK ? RL_OK : rl_error(st, "%s: %s", fn, msg);
 }
 
 static inline void transform_vertex(const rl_raster *r, const rl_vec3 *positions, uint32_t i,
@@ -67,13 +97,22 @@ static inline void transform_vertex(const rl_raster *r, const rl_vec3 *positions
     }
 }
 
-static rl_status transform(rl_raster *r, const rl_vec3 *positions, uint32_t n, int threads)
+/* Makes r->clip (and r->eye_depth for affine projections) hold n vertices. */
+static rl_status reserve_vertices(rl_raster *r, size_t n)
 {
     if (!rl_reserve((void **)&r->clip, &r->vert_cap, n, sizeof *r->clip, 64))
-        return rl_error(RL_ERR_OUT_OF_MEMORY, "rl_raster: %u vertices", n);
+        return rl_error(RL_ERR_OUT_OF_MEMORY, "rl_raster: %zu vertices", n);
     if (!r->perspective &&
         !rl_reserve((void **)&r->eye_depth, &r->eye_depth_cap, n, sizeof *r->eye_depth, 64))
-        return rl_error(RL_ERR_OUT_OF_MEMORY, "rl_raster: %u vertices", n);
+        return rl_error(RL_ERR_OUT_OF_MEMORY, "rl_raster: %zu vertices", n);
+    return RL_OK;
+}
+
+static rl_status transform(rl_raster *r, const rl_vec3 *positions, uint32_t n, int threads)
+{
+    rl_status st = reserve_vertices(r, n);
+    if (st != RL_OK)
+        return st;
     rl_vec4 *clip = r->clip;
     float *eye_depth = r->perspective ? NULL : r->eye_depth;
     if (n < PARALLEL_VERTICES || threads < 2) {
@@ -140,7 +179,7 @@ static void setup_chunk(rl_raster *r, const rl_raster_batch *b, uint32_t first, 
     uint32_t hi = (uint32_t)((uint64_t)slab * (uint64_t)(c + 1) / (uint64_t)num_chunks);
     ch->num_prims = 0;
     ch->triangles_drawn = 0;
-    ch->failed = !rl_raster_setup(r, b, first + lo, hi - lo, ch) ||
+    ch->failed = !rl_raster_setup(r, b, r->clip, r->eye_depth, first + lo, hi - lo, ch) ||
                  !rl_raster_bin(&ch->bins, ch->prims, ch->num_prims, sizeof *ch->prims, num_bands);
 }
 
@@ -182,6 +221,81 @@ static rl_status run(rl_raster *r, const rl_raster_batch *b, bool query, uint64_
     return RL_OK;
 }
 
+/* Transforms and sets up the batches of chunk c of a group (c->group_lo ..
+ * group_hi), each into its own part of r->clip. */
+static void setup_group_chunk(rl_raster *r, const rl_raster_batch *batches, int c, int num_bands)
+{
+    rl_raster_chunk *ch = &r->chunks[c];
+    ch->num_prims = 0;
+    ch->triangles_drawn = 0;
+    ch->failed = false;
+    for (uint32_t k = ch->group_lo; k < ch->group_hi && !ch->failed; ++k) {
+        const rl_raster_batch *b = &batches[k];
+        rl_vec4 *clip = r->clip + r->group_vertex[k];
+        float *eye_depth = r->perspective ? NULL : r->eye_depth + r->group_vertex[k];
+        for (uint32_t i = 0; i < b->num_vertices; ++i)
+            transform_vertex(r, b->positions, i, clip, eye_depth);
+        ch->failed = !rl_raster_setup(r, b, clip, eye_depth, 0, b->num_triangles, ch);
+    }
+    ch->failed = ch->failed || !rl_raster_bin(&ch->bins, ch->prims, ch->num_prims, sizeof *ch->prims, num_bands);
+}
+
+/* Draws batches[0 .. count) (none layered, all with the same flags, together
+ * fewer than RL_RASTER_SLAB triangles and GROUP_VERTICES vertices) as one
+ * draw: runs of whole batches of about equal triangle counts, one per
+ * thread, filled in order. */
+static rl_status run_group(rl_raster *r, const rl_raster_batch *batches, uint32_t count, uint32_t triangles,
+                           size_t vertices, uint64_t *passed_out, uint64_t *drawn_out)
+{
+    const int threads = rl_raster_thread_count(r);
+    rl_raster_target t = rl_raster_target_for(r, batches[0].flags, false);
+    const int num_bands = rl_raster_num_bands(t.height);
+    rl_status st = reserve_vertices(r, vertices);
+    if (st != RL_OK)
+        return st;
+    if (!rl_reserve((void **)&r->group_vertex, &r->group_cap, count, sizeof *r->group_vertex, 64))
+        return rl_error(RL_ERR_OUT_OF_MEMORY, "rl_raster_draw_many: %u batches", count);
+    int num_chunks = triangles >= PARALLEL_TRIANGLES ? threads : 1;
+    if ((uint32_t)num_chunks > count)
+        num_chunks = (int)count;
+    if ((st = rl_raster_reserve_chunks(r, num_chunks)) != RL_OK)
+        return st;
+    /* Chunk c starts with the first batch that begins at or after
+     * triangles * c / num_chunks. */
+    size_t v = 0;
+    uint64_t before = 0;
+    int c = 0;
+    r->chunks[0].group_lo = 0;
+    for (uint32_t k = 0; k < count; ++k) {
+        while (c + 1 < num_chunks && before * (uint64_t)num_chunks >= (uint64_t)triangles * (uint64_t)(c + 1)) {
+            r->chunks[c].group_hi = k;
+            r->chunks[++c].group_lo = k;
+        }
+        r->group_vertex[k] = v;
+        v += batches[k].num_vertices;
+        before += batches[k].num_triangles;
+    }
+    r->chunks[c].group_hi = count;
+    while (++c < num_chunks)
+        r->chunks[c].group_lo = r->chunks[c].group_hi = count;
+    if (num_chunks == 1) {
+        setup_group_chunk(r, batches, 0, num_bands);
+    } else {
+        #pragma omp parallel for num_threads(num_chunks) schedule(static, 1)
+        for (int k = 0; k < num_chunks; ++k)
+            setup_group_chunk(r, batches, k, num_bands);
+    }
+    uint64_t drawn = 0;
+    for (int k = 0; k < num_chunks; ++k) {
+        if (r->chunks[k].failed)
+            return rl_error(RL_ERR_OUT_OF_MEMORY, "rl_raster_draw_many: setup of %u triangles", triangles);
+        drawn += r->chunks[k].triangles_drawn;
+    }
+    *passed_out = fill_bands(r, &t, num_chunks, threads);
+    *drawn_out = drawn;
+    return RL_OK;
+}
+
 rl_status rl_raster_draw(rl_raster *r, const rl_raster_batch *batch, rl_raster_counters *c)
 {
     rl_status st = check_batch(r, batch, "rl_raster_draw");
@@ -209,5 +323,62 @@ rl_status rl_raster_query(rl_raster *r, const rl_raster_batch *batch, uint64_t *
     if (batch->num_triangles > 0 && (st = run(r, batch, true, &passed, &drawn)) != RL_OK)
         return st;
     *visible_pixels = passed;
+    return RL_OK;
+}
+
+/* Small enough to share a group with its neighbours. */
+static bool groupable(const rl_raster_batch *b)
+{
+    return b->num_layers == 0 && b->num_triangles < PARALLEL_TRIANGLES && b->num_vertices <= GROUP_VERTICES;
+}
+
+rl_status rl_raster_draw_many(rl_raster *r, const rl_raster_batch *batches, uint32_t count,
+                              rl_raster_counters *c)
+{
+    if (!r || (!batches && count > 0))
+        return rl_error(RL_ERR_INVALID_ARG, "rl_raster_draw_many: NULL argument");
+    for (uint32_t k = 0; k < count; ++k) {
+        char msg[160];
+        rl_status st = batch_problem(r, &batches[k], msg, sizeof msg);
+        if (st != RL_OK)
+            return rl_error(st, "rl_raster_draw_many: batch %u of %u: %s", k, count, msg);
+    }
+    rl_raster_counters sum = { 0 };
+    for (uint32_t k = 0; k < count;) {
+        const rl_raster_batch *b = &batches[k];
+        uint64_t passed = 0, drawn = 0;
+        uint32_t n = 1;
+        rl_status st = RL_OK;
+        if (!groupable(b)) {
+            if (b->num_triangles > 0)
+                st = run(r, b, false, &passed, &drawn);
+        } else {
+            uint32_t triangles = b->num_triangles;
+            size_t vertices = b->num_vertices;
+            for (; k + n < count; ++n) {
+                const rl_raster_batch *next = &batches[k + n];
+                if (!groupable(next) || next->flags != b->flags ||
+                    triangles + next->num_triangles > RL_RASTER_SLAB ||
+                    vertices + next->num_vertices > GROUP_VERTICES)
+                    break;
+                triangles += next->num_triangles;
+                vertices += next->num_vertices;
+            }
+            if (triangles > 0)
+                st = run_group(r, b, n, triangles, vertices, &passed, &drawn);
+        }
+        if (st != RL_OK)
+            return st;
+        for (uint32_t i = 0; i < n; ++i)
+            sum.triangles_in += batches[k + i].num_triangles;
+        sum.triangles_drawn += drawn;
+        sum.pixels_written += passed;
+        k += n;
+    }
+    if (c) {
+        c->triangles_in += sum.triangles_in;
+        c->triangles_drawn += sum.triangles_drawn;
+        c->pixels_written += sum.pixels_written;
+    }
     return RL_OK;
 }

@@ -88,6 +88,7 @@ typedef struct rl_raster_chunk {
     size_t src_cap;
     rl_raster_bins bins;
     uint64_t triangles_drawn;
+    uint32_t group_lo, group_hi;  /* rl_raster_draw_many: this chunk's batches */
     bool failed;                  /* allocation failed inside a parallel region */
 } rl_raster_chunk;
 
@@ -116,6 +117,8 @@ struct rl_raster {
     rl_vec4 *clip;                /* clip-space vertices */
     float *eye_depth;             /* per vertex, affine projections only */
     size_t vert_cap, eye_depth_cap;
+    size_t *group_vertex;         /* rl_raster_draw_many: each batch's first clip vertex */
+    size_t group_cap;
     rl_raster_chunk *chunks;
     int chunk_cap;
     rl_raster_point *points;
@@ -144,10 +147,11 @@ rl_raster_target rl_raster_target_for(const rl_raster *r, unsigned flags, bool q
 
 /* raster_setup.c: culls, clips and sets up triangles [first, first+count) of
  * the batch into chunk (appending, in order; for a layered batch also
- * chunk->srcs); r->clip holds the transformed vertices. Returns false on
- * allocation failure. */
-bool rl_raster_setup(const rl_raster *r, const rl_raster_batch *b, uint32_t first,
-                     uint32_t count, rl_raster_chunk *chunk);
+ * chunk->srcs); clip holds the batch's transformed vertices and eye_depth
+ * their eye depths (affine projections only). Returns false on allocation
+ * failure. */
+bool rl_raster_setup(const rl_raster *r, const rl_raster_batch *b, const rl_vec4 *clip,
+                     const float *eye_depth, uint32_t first, uint32_t count, rl_raster_chunk *chunk);
 
 /* raster_bin.c: sorts items (each starting with rl_raster_rows, stride bytes
  * apart) into bands of RL_RASTER_BAND_ROWS rows, keeping their order. */

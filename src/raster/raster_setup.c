@@ -313,8 +313,8 @@ static rl_vec4 lazy_color(const rl_raster_batch *b, uint32_t v)
     return b->colors[v];
 }
 
-bool rl_raster_setup(const rl_raster *r, const rl_raster_batch *b, uint32_t first,
-                     uint32_t count, rl_raster_chunk *chunk)
+bool rl_raster_setup(const rl_raster *r, const rl_raster_batch *b, const rl_vec4 *clip,
+                     const float *eye_depth, uint32_t first, uint32_t count, rl_raster_chunk *chunk)
 {
     const int width = r->target->width, height = r->target->height;
     const float gx = r->guard_x, gy = r->guard_y;
@@ -327,7 +327,7 @@ bool rl_raster_setup(const rl_raster *r, const rl_raster_batch *b, uint32_t firs
         unsigned oc_and = ~0u, oc_or = 0;
         bool finite = true;
         for (int k = 0; k < 3; ++k) {
-            poly[k].p = r->clip[tri[k]];
+            poly[k].p = clip[tri[k]];
             finite = finite && vec4_finite(poly[k].p);
             unsigned oc = outcode(poly[k].p, gx, gy);
             oc_and &= oc;
@@ -353,7 +353,7 @@ bool rl_raster_setup(const rl_raster *r, const rl_raster_batch *b, uint32_t firs
             poly[k].c = !b->colors ? rl_v4(0, 0, 0, 0)
                         : lazy ? lazy_color(b, tri[k]) : b->colors[tri[k]];
             poly[k].uv = tex ? b->uvs[tri[k]] : rl_v2(0, 0);
-            poly[k].d = r->perspective ? 0.0f : r->eye_depth[tri[k]];
+            poly[k].d = r->perspective ? 0.0f : eye_depth[tri[k]];
             poly[k].b = rl_v3(k == 0 ? 1.0f : 0.0f, k == 1 ? 1.0f : 0.0f, k == 2 ? 1.0f : 0.0f);
         }
         int n = 3;

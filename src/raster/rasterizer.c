@@ -38,6 +38,7 @@ void rl_raster_release(rl_raster *r)
     free(r->chunks);
     free(r->clip);
     free(r->eye_depth);
+    free(r->group_vertex);
     free(r->points);
     free(r);
 }

@@ -211,12 +211,11 @@ static void schedule_query(frame_ctx *f, uint32_t n)
 static rl_status traverse(frame_ctx *f, uint32_t n)
 {
     const rl_octree_node *node = &f->nodes[n];
-    rl_status st = RL_OK;
+    const uint32_t *objects = f->objects + node->first_object;
+    rl_status st = rl_scene_drawer_draw_list(f->cf.drawer, f->cf.ras, objects, node->num_objects, &f->cf.counters);
     for (uint32_t k = 0; k < node->num_objects && st == RL_OK; ++k) {
-        uint32_t o = f->objects[node->first_object + k];
-        st = rl_scene_drawer_draw(f->cf.drawer, f->cf.ras, o, &f->cf.counters);
         f->s->head.stats.objects_drawn++;
-        f->s->head.stats.triangles_drawn += f->d->objects[o].num_triangles;
+        f->s->head.stats.triangles_drawn += f->d->objects[objects[k]].num_triangles;
     }
     for (uint32_t c = 0; c < node->num_children && st == RL_OK; ++c) {
         uint32_t ch = node->first_child + c;

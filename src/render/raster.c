@@ -154,7 +154,13 @@ typedef struct frame_buffers {
     rl_vec2 *corner_uvs;
     rl_vec4 *corner_colors;
     uint32_t *triangle_texture;  /* per triangle, textured mode */
-    uint32_t *indices;           /* scratch: one object's local indices */
+    /* Per scene corner (3 per triangle): the batch index of the corner in
+     * its object's batch, the object-local vertex (or, for objects drawn
+     * by corners, the local corner), made when the object is first drawn:
+     * batches of a list must all be ready before rl_raster_draw_many, and
+     * calloc leaves the pages of objects never drawn untouched. */
+    uint32_t *local;
+    uint8_t *local_ready;        /* per object */
 } frame_buffers;
 
 static void free_buffers(frame_buffers *b)
@@ -167,7 +173,8 @@ static void free_buffers(frame_buffers *b)
     free(b->corner_uvs);
     free(b->corner_colors);
     free(b->triangle_texture);
-    free(b->indices);
+    free(b->local);
+    free(b->local_ready);
 }
 
 static uint32_t texture_of(const rl_scene_data *d, uint32_t material)
@@ -187,7 +194,6 @@ static bool selected(const uint8_t *mask, uint32_t object)
 static rl_status prepare(const rl_scene_data *d, rl_raster_shading shading, bool lit,
                          const uint8_t *mask, frame_buffers *b)
 {
-    uint32_t max_tris = 0;
     bool any_mixed = false;
     b->object_material = rl_calloc(d->num_objects ? d->num_objects : 1, sizeof *b->object_material);
     if (!b->object_material)
@@ -200,11 +206,10 @@ static rl_status prepare(const rl_scene_data *d, rl_raster_shading shading, bool
                 m = RL_NONE;
         b->object_material[o] = m;
         any_mixed |= obj->num_triangles > 0 && m == RL_NONE && selected(mask, o);
-        if (obj->num_triangles > max_tris)
-            max_tris = obj->num_triangles;
     }
-    b->indices = rl_calloc((size_t)max_tris * 3 + 1, sizeof *b->indices);
-    if (!b->indices)
+    b->local = rl_calloc((size_t)d->num_triangles * 3 + 1, sizeof *b->local);
+    b->local_ready = rl_calloc(d->num_objects ? d->num_objects : 1, 1);
+    if (!b->local || !b->local_ready)
         return RL_ERR_OUT_OF_MEMORY;
     if (!lit)
         return RL_OK;
@@ -275,67 +280,83 @@ static void light_corner(const shade_ctx *ctx, frame_buffers *b, size_t c)
     b->corner_colors[c] = phong(ctx, &d->materials[d->triangle_material[c / 3]], d->positions[vi], d->normals[vi]);
 }
 
+/* Object o's batch indices (b->local), made on its first draw: the
+ * identity over its corners when it is drawn by corners, else its triangles'
+ * scene indices made local to its vertices. */
+static rl_status object_indices(const rl_scene_data *d, frame_buffers *b, uint32_t o, bool corners)
+{
+    if (b->local_ready[o])
+        return RL_OK;
+    const rl_object *obj = &d->objects[o];
+    const size_t first = (size_t)obj->first_triangle * 3, n = (size_t)obj->num_triangles * 3;
+    uint32_t *local = b->local + first;
+    if (corners) {
+        for (size_t i = 0; i < n; ++i)
+            local[i] = (uint32_t)i;
+    } else {
+        /* Scene indices are global; the batch sees only this object's vertices. */
+        const uint32_t *tri = d->indices + first;
+        for (size_t i = 0; i < n; ++i) {
+            local[i] = tri[i] - obj->first_vertex;
+            if (tri[i] < obj->first_vertex || local[i] >= obj->num_vertices)
+                return rl_error(RL_ERR_INTERNAL, "raster: object %u has a vertex index outside its range", o);
+        }
+    }
+    b->local_ready[o] = 1;
+    return RL_OK;
+}
+
 /* One batch per object: object IDs come from the batch, triangle IDs are the
  * scene's global (flattened) triangle indices. Unlit draws take the
  * object's own vertices even for mixed materials: the corner copies hold
- * the same positions, so depth and IDs are bit-identical either way. */
-static rl_status draw_object(rl_raster *ras, const rl_scene_data *d, uint32_t o,
-                             rl_raster_shading shading, bool lit, unsigned flags,
-                             frame_buffers *b, const rl_raster_lazy_colors *lazy,
-                             rl_raster_counters *counters)
+ * the same positions, so depth and IDs are bit-identical either way. lazy
+ * (NULL: colours filled already) must outlive the draw of the batch. */
+static rl_status object_batch(const rl_scene_data *d, uint32_t o, rl_raster_shading shading, bool lit,
+                              unsigned flags, frame_buffers *b, const rl_raster_lazy_colors *lazy,
+                              rl_raster_batch *batch)
 {
     const rl_object *obj = &d->objects[o];
-    if (obj->num_triangles == 0)
-        return RL_OK;
-    rl_raster_batch batch;
-    memset(&batch, 0, sizeof batch);
-    batch.num_triangles = obj->num_triangles;
-    batch.first_triangle_id = obj->first_triangle;
-    batch.object_id = o;
-    batch.flags = flags;
-    batch.indices = b->indices;
+    memset(batch, 0, sizeof *batch);
+    batch->num_triangles = obj->num_triangles;
+    batch->first_triangle_id = obj->first_triangle;
+    batch->object_id = o;
+    batch->flags = flags;
+    batch->indices = b->local + (size_t)obj->first_triangle * 3;
 
     uint32_t m = b->object_material[o];
-    if (lit && shading != RL_SHADING_FLAT && m == RL_NONE) {
+    const bool corners = lit && shading != RL_SHADING_FLAT && m == RL_NONE;
+    rl_status st = object_indices(d, b, o, corners);
+    if (st != RL_OK)
+        return st;
+    if (corners) {
         size_t first = (size_t)obj->first_triangle * 3;
-        batch.num_vertices = obj->num_triangles * 3;
-        batch.positions = b->corner_positions + first;
-        batch.colors = b->corner_colors + first;
-        batch.lazy = lazy;
-        for (uint32_t i = 0; i < batch.num_vertices; ++i)
-            b->indices[i] = i;
+        batch->num_vertices = obj->num_triangles * 3;
+        batch->positions = b->corner_positions + first;
+        batch->colors = b->corner_colors + first;
+        batch->lazy = lazy;
         if (shading == RL_SHADING_TEXTURED) {
-            batch.uvs = b->corner_uvs + first;
-            batch.triangle_texture = b->triangle_texture + obj->first_triangle;
-            batch.textures = d->textures;
+            batch->uvs = b->corner_uvs + first;
+            batch->triangle_texture = b->triangle_texture + obj->first_triangle;
+            batch->textures = d->textures;
         }
-        return rl_raster_draw(ras, &batch, counters);
+        return RL_OK;
     }
-
-    /* Scene indices are global; the batch sees only this object's vertices. */
-    const uint32_t *tri = d->indices + (size_t)obj->first_triangle * 3;
-    for (uint32_t i = 0; i < obj->num_triangles * 3; ++i) {
-        uint32_t local = tri[i] - obj->first_vertex;
-        if (tri[i] < obj->first_vertex || local >= obj->num_vertices)
-            return rl_error(RL_ERR_INTERNAL, "raster: object %u has a vertex index outside its range", o);
-        b->indices[i] = local;
-    }
-    batch.num_vertices = obj->num_vertices;
-    batch.positions = d->positions + obj->first_vertex;
+    batch->num_vertices = obj->num_vertices;
+    batch->positions = d->positions + obj->first_vertex;
     if (!lit)
-        return rl_raster_draw(ras, &batch, counters);
+        return RL_OK;
     if (shading == RL_SHADING_FLAT) {
-        batch.face_colors = b->face_colors + obj->first_triangle;
+        batch->face_colors = b->face_colors + obj->first_triangle;
     } else {
-        batch.colors = b->vertex_colors + obj->first_vertex;
-        batch.lazy = lazy;
+        batch->colors = b->vertex_colors + obj->first_vertex;
+        batch->lazy = lazy;
         uint32_t tex = shading == RL_SHADING_TEXTURED ? texture_of(d, m) : RL_ID_NONE;
         if (tex != RL_ID_NONE) {
-            batch.uvs = d->uvs + obj->first_vertex;
-            batch.texture = d->textures[tex];
+            batch->uvs = d->uvs + obj->first_vertex;
+            batch->texture = d->textures[tex];
         }
     }
-    return rl_raster_draw(ras, &batch, counters);
+    return RL_OK;
 }
 
 /* The drawer: buffers prepared once, objects lit on first draw. */
@@ -347,7 +368,6 @@ struct rl_scene_drawer {
     int threads;
     uint8_t *object_lit;         /* per object: lighting done */
     uint32_t *todo;              /* scratch of rl_scene_drawer_light, one per object */
-    uint32_t *in_view;           /* scratch of rl_scene_drawer_draw_all (flat shading) */
     /* Lazy lighting (rl_raster_lazy_colors) in gouraud/textured mode: a
      * stamp per scene vertex and per corner of mixed-material objects, and
      * the value of this frame's lighting. */
@@ -355,6 +375,12 @@ struct rl_scene_drawer {
     uint32_t *corner_stamps;     /* per corner (mixed objects), if any */
     uint32_t frame;
     frame_buffers b;
+    /* Scratch of a list draw (rl_scene_drawer_draw_list): the objects to
+     * draw, their batches and their lazy colours, list_cap of each. */
+    uint32_t *list;
+    rl_raster_batch *batches;
+    struct lazy_slot *lazies;
+    size_t list_cap;
 };
 
 static rl_status check_desc(const rl_raster_scene_desc *opt, const char *fn)
@@ -374,9 +400,11 @@ void rl_scene_drawer_release(rl_scene_drawer *dr)
     free_buffers(&dr->b);
     free(dr->object_lit);
     free(dr->todo);
-    free(dr->in_view);
     free(dr->stamps);
     free(dr->corner_stamps);
+    free(dr->list);
+    free(dr->batches);
+    free(dr->lazies);
     free(dr);
 }
 
@@ -407,11 +435,9 @@ rl_status rl_scene_drawer_create(const rl_scene_data *d, rl_vec3 eye, const rl_r
     dr->object_lit = rl_calloc(d->num_objects ? d->num_objects : 1, 1);
     dr->todo = dr->lit ? rl_calloc(d->num_objects ? d->num_objects : 1, sizeof *dr->todo) : NULL;
     bool lazy = dr->lit && dr->opt.shading != RL_SHADING_FLAT;
-    bool eager = dr->lit && !lazy;
-    dr->in_view = eager ? rl_calloc(d->num_objects ? d->num_objects : 1, sizeof *dr->in_view) : NULL;
     dr->stamps = lazy ? rl_calloc((size_t)d->num_vertices + 1, sizeof *dr->stamps) : NULL;
     dr->frame = 1;
-    bool have = dr->object_lit && (dr->todo || !dr->lit) && (dr->in_view || !eager) && (dr->stamps || !lazy);
+    bool have = dr->object_lit && (dr->todo || !dr->lit) && (dr->stamps || !lazy);
     st = have ? prepare(d, dr->opt.shading, dr->lit, dr->opt.object_mask, &dr->b) : RL_ERR_OUT_OF_MEMORY;
     if (st == RL_OK && lazy && dr->b.corner_colors) {
         dr->corner_stamps = rl_calloc((size_t)d->num_triangles * 3, sizeof *dr->corner_stamps);
@@ -529,48 +555,118 @@ void rl_scene_drawer_light(rl_scene_drawer *dr, const uint32_t *objects, uint32_
             todo[small++] = o;
         }
     }
+    if (small == 1) {
+        light_object(dr, todo[0], 1);   /* one object (chcpp's draws): no parallel region */
+    } else {
 #pragma omp parallel for num_threads(dr->threads) schedule(dynamic, 1)
-    for (int64_t i = 0; i < (int64_t)small; ++i)
-        light_object(dr, todo[i], 1);
+        for (int64_t i = 0; i < (int64_t)small; ++i)
+            light_object(dr, todo[i], 1);
+    }
     for (uint32_t i = 0; i < small; ++i)
         dr->object_lit[todo[i]] = 1;
 }
 
+/* A batch's lazy colours, kept until the list it belongs to is drawn. */
+typedef struct lazy_slot {
+    rl_raster_lazy_colors colors;
+    lazy_object user;
+} lazy_slot;
+
+/* The lazy colours of object o, in slot; NULL when o is lit eagerly. */
+static const rl_raster_lazy_colors *object_lazy(rl_scene_drawer *dr, uint32_t o, lazy_slot *slot)
+{
+    if (!dr->lit || !lit_lazily(dr, o))
+        return NULL;
+    const rl_object *obj = &dr->data->objects[o];
+    const uint32_t m = dr->b.object_material[o];
+    slot->user = (lazy_object){ dr, obj->first_vertex, NULL };
+    slot->colors = (rl_raster_lazy_colors){ shade_vertex, &slot->user, dr->stamps + obj->first_vertex, dr->frame };
+    if (m != RL_NONE) {
+        slot->user.material = &dr->data->materials[m];
+    } else {
+        slot->user.first = obj->first_triangle * 3;
+        slot->colors.shade = shade_corner;
+        slot->colors.stamps = dr->corner_stamps + slot->user.first;
+    }
+    return &slot->colors;
+}
+
+static rl_status reserve_list(rl_scene_drawer *dr, size_t count)
+{
+    if (count <= dr->list_cap)
+        return RL_OK;
+    size_t cap = rl_grow_capacity(dr->list_cap, count, 64);
+    uint32_t *list = rl_realloc_array(dr->list, cap, sizeof *list);
+    if (list)
+        dr->list = list;
+    rl_raster_batch *batches = rl_realloc_array(dr->batches, cap, sizeof *batches);
+    if (batches)
+        dr->batches = batches;
+    lazy_slot *lazies = rl_realloc_array(dr->lazies, cap, sizeof *lazies);
+    if (lazies)
+        dr->lazies = lazies;
+    if (!list || !batches || !lazies)
+        return rl_error(RL_ERR_OUT_OF_MEMORY, "rl_scene_drawer: a list of %zu objects", count);
+    dr->list_cap = cap;
+    return RL_OK;
+}
+
+/* Draws objects[0 .. count) (NULL: first, first + 1, ...) in order, as one
+ * rl_raster_draw_many, so that many small objects are drawn on all threads
+ * together. fn names the caller in errors. */
+static rl_status draw_objects(rl_scene_drawer *dr, rl_raster *ras, const uint32_t *objects, uint32_t first,
+                              uint32_t count, rl_raster_counters *c, const char *fn)
+{
+    if (!dr || !ras || (!objects && count > 0 && first + (uint64_t)count > dr->data->num_objects))
+        return rl_error(RL_ERR_INVALID_ARG, "%s: NULL argument or objects out of range", fn);
+    const rl_scene_data *d = dr->data;
+    rl_status st = reserve_list(dr, count);
+    if (st != RL_OK)
+        return st;
+    /* What is drawn: selected objects with triangles whose box is not
+     * entirely outside the view (every triangle of those would fail the
+     * trivial reject, so neither light nor transform them: the image is
+     * the same); the others only count as submitted. */
+    uint32_t n = 0;
+    uint64_t skipped = 0;
+    for (uint32_t i = 0; i < count; ++i) {
+        const uint32_t o = objects ? objects[i] : first + i;
+        if (o >= d->num_objects)
+            return rl_error(RL_ERR_INVALID_ARG, "%s: object %u of %u", fn, o, d->num_objects);
+        if (!selected(dr->opt.object_mask, o) || d->objects[o].num_triangles == 0)
+            continue;
+        if (rl_raster_box_outside(ras, d->objects[o].bounds))
+            skipped += d->objects[o].num_triangles;
+        else
+            dr->list[n++] = o;
+    }
+    /* Eager lighting (flat shading) in one parallel pass over the list. */
+    rl_scene_drawer_light(dr, dr->list, n);
+    for (uint32_t i = 0; i < n && st == RL_OK; ++i) {
+        const uint32_t o = dr->list[i];
+        st = object_batch(d, o, dr->opt.shading, dr->lit, dr->opt.flags, &dr->b,
+                          object_lazy(dr, o, &dr->lazies[i]), &dr->batches[i]);
+    }
+    if (st == RL_OK)
+        st = rl_raster_draw_many(ras, dr->batches, n, c);
+    if (st == RL_OK && c)
+        c->triangles_in += skipped;
+    return st;
+}
+
 rl_status rl_scene_drawer_draw(rl_scene_drawer *dr, rl_raster *ras, uint32_t object, rl_raster_counters *c)
 {
-    if (!dr || !ras)
+    if (!dr)
         return rl_error(RL_ERR_INVALID_ARG, "rl_scene_drawer_draw: NULL argument");
-    if (object >= dr->data->num_objects)
-        return rl_error(RL_ERR_INVALID_ARG, "rl_scene_drawer_draw: object %u of %u", object,
-                        dr->data->num_objects);
-    if (!selected(dr->opt.object_mask, object))
-        return RL_OK;
-    /* Entirely outside the view: every triangle would fail the trivial
-     * reject, so neither light nor transform it (the image is the same). */
-    const rl_object *obj = &dr->data->objects[object];
-    if (rl_raster_box_outside(ras, obj->bounds)) {
-        if (c)
-            c->triangles_in += obj->num_triangles;
-        return RL_OK;
-    }
-    if (dr->lit && lit_lazily(dr, object)) {
-        const uint32_t m = dr->b.object_material[object];
-        lazy_object user = { dr, obj->first_vertex, NULL };
-        rl_raster_lazy_colors lazy = { shade_vertex, &user, dr->stamps + obj->first_vertex, dr->frame };
-        if (m != RL_NONE) {
-            user.material = &dr->data->materials[m];
-        } else {
-            user.first = obj->first_triangle * 3;
-            lazy.shade = shade_corner;
-            lazy.stamps = dr->corner_stamps + user.first;
-        }
-        return draw_object(ras, dr->data, object, dr->opt.shading, dr->lit, dr->opt.flags, &dr->b, &lazy, c);
-    }
-    if (dr->lit && !dr->object_lit[object]) {
-        light_object(dr, object, dr->threads);
-        dr->object_lit[object] = 1;
-    }
-    return draw_object(ras, dr->data, object, dr->opt.shading, dr->lit, dr->opt.flags, &dr->b, NULL, c);
+    return draw_objects(dr, ras, &object, 0, 1, c, "rl_scene_drawer_draw");
+}
+
+rl_status rl_scene_drawer_draw_list(rl_scene_drawer *dr, rl_raster *ras, const uint32_t *objects, uint32_t count,
+                                    rl_raster_counters *c)
+{
+    if (!dr || (!objects && count > 0))
+        return rl_error(RL_ERR_INVALID_ARG, "rl_scene_drawer_draw_list: NULL argument");
+    return draw_objects(dr, ras, objects, 0, count, c, "rl_scene_drawer_draw_list");
 }
 
 rl_status rl_scene_drawer_draw_all(rl_scene_drawer *dr, rl_raster *ras, rl_raster_counters *c,
@@ -578,25 +674,17 @@ rl_status rl_scene_drawer_draw_all(rl_scene_drawer *dr, rl_raster *ras, rl_raste
 {
     if (!dr || !ras)
         return rl_error(RL_ERR_INVALID_ARG, "rl_scene_drawer_draw_all: NULL argument");
-    const rl_scene_data *d = dr->data;
-    /* Flat shading lights eagerly: what can be seen, in one pass before
-     * drawing (one object at a time would serialise the many small ones);
-     * objects outside the view are skipped by rl_scene_drawer_draw and need
-     * no lighting. Lazily lit objects light themselves while drawn. */
-    if (dr->in_view) {
-        uint32_t n = 0;
-        for (uint32_t o = 0; o < d->num_objects; ++o)
-            if (selected(dr->opt.object_mask, o) && !rl_raster_box_outside(ras, d->objects[o].bounds))
-                dr->in_view[n++] = o;
-        rl_scene_drawer_light(dr, dr->in_view, n);
-    }
-    /* Report progress about a hundred times, not once per object. */
+    const uint32_t total = dr->data->num_objects;
+    /* Progress about a hundred times, in lists long enough to keep every
+     * thread busy. */
+    uint32_t step = total / 100 + 1;
+    if (step < 1024)
+        step = 1024;
     rl_status st = RL_OK;
-    uint32_t step = d->num_objects / 100 + 1;
-    for (uint32_t o = 0; st == RL_OK && o < d->num_objects; ++o) {
-        st = rl_scene_drawer_draw(dr, ras, o, c);
-        if (st == RL_OK && progress && (o + 1) % step == 0 &&
-            !progress(user, (double)(o + 1) / d->num_objects))
+    for (uint32_t o = 0; st == RL_OK && o < total; o += step) {
+        uint32_t n = total - o < step ? total - o : step;
+        st = draw_objects(dr, ras, NULL, o, n, c, "rl_scene_drawer_draw_all");
+        if (st == RL_OK && progress && !progress(user, (double)(o + n) / total))
             st = rl_error(RL_ERR_CANCELLED, "raster: cancelled by the progress callback");
     }
     return st;

@@ -74,9 +74,16 @@ void rl_scene_drawer_light(rl_scene_drawer *dr, const uint32_t *objects, uint32_
 /* Draws object (an index < d->num_objects; unselected objects are skipped)
  * into the rasterizer's current target. */
 rl_status rl_scene_drawer_draw(rl_scene_drawer *dr, rl_raster *ras, uint32_t object, rl_raster_counters *c);
+/* Draws the listed objects in list order, exactly as one rl_scene_drawer_draw
+ * each would, but as one rl_raster_draw_many: a renderer that knows its set
+ * before drawing it (SVS, a stored visible set) gets its many small objects
+ * drawn on all threads, where one draw each would run on one. */
+rl_status rl_scene_drawer_draw_list(rl_scene_drawer *dr, rl_raster *ras, const uint32_t *objects, uint32_t count,
+                                    rl_raster_counters *c);
 void rl_scene_drawer_release(rl_scene_drawer *dr);    /* NULL is a no-op */
-/* Lights every selected object in one parallel pass and draws them all in
- * index order: rl_raster_draw_scene with a drawer of one's own. */
+/* Draws every selected object in index order (lists of many objects, see
+ * rl_scene_drawer_draw_list): rl_raster_draw_scene with a drawer of one's
+ * own. */
 rl_status rl_scene_drawer_draw_all(rl_scene_drawer *dr, rl_raster *ras, rl_raster_counters *c,
                                    bool (*progress)(void *user, double done), void *user);
 

@@ -319,11 +319,22 @@ static rl_status draw_cmds(surfels_frame *f)
         if (s->cmds[i].m == 0)
             s->lit[k++] = s->cmds[i].index;
     rl_scene_drawer_light(f->cf.drawer, s->lit, (uint32_t)k);
+    /* Each run of meshes between surfel prefixes is one list, drawn on all
+     * threads together (s->lit holds the runs' objects in order). */
     rl_status st = RL_OK;
-    for (size_t i = 0; i < s->num_cmds && st == RL_OK; ++i) {
+    size_t run = 0;
+    for (size_t i = 0; i < s->num_cmds && st == RL_OK;) {
         const draw_cmd *c = &s->cmds[i];
-        st = c->m ? draw_prefix(f, &s->sets[c->index], c->m, c->point_size)
-                  : rl_scene_drawer_draw(f->cf.drawer, f->cf.ras, c->index, &f->cf.counters);
+        if (c->m) {
+            st = draw_prefix(f, &s->sets[c->index], c->m, c->point_size);
+            ++i;
+            continue;
+        }
+        size_t n = 0;
+        for (; i < s->num_cmds && s->cmds[i].m == 0; ++i)
+            ++n;
+        st = rl_scene_drawer_draw_list(f->cf.drawer, f->cf.ras, s->lit + run, (uint32_t)n, &f->cf.counters);
+        run += n;
     }
     return st;
 }

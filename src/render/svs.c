@@ -82,6 +82,10 @@ typedef struct svs_state {
     uint32_t *set_objects;
     uint32_t *stamp;              /* per object: frame it was drawn in */
     uint32_t frame;
+    /* This frame's objects, in the order the traversal found them: drawn
+     * as one list (rl_scene_drawer_draw_list), on all threads. */
+    uint32_t *draw;
+    uint32_t num_draw;
 } svs_state;
 
 static rl_status svs_create(void **state)
@@ -99,10 +103,12 @@ static void drop_sets(svs_state *s)
     free(s->set_offset);
     free(s->set_objects);
     free(s->stamp);
+    free(s->draw);
     s->dirs = NULL;
     s->set_offset = NULL;
     s->set_objects = NULL;
     s->stamp = NULL;
+    s->draw = NULL;
     s->built = false;
 }
 
@@ -264,8 +270,8 @@ static rl_status sample_set(const svs_state *s, const rl_scene_data *d, const rl
     ortho_view(c, r, s->dirs[k], &view, &proj);
     rl_image_clear(w->img);
     rl_status st = rl_raster_set_target(w->ras, w->img, &view, &proj);
-    for (uint32_t i = 0; i < nc && st == RL_OK; ++i)
-        st = rl_scene_drawer_draw(w->drawer, w->ras, w->cand[i], NULL);
+    if (st == RL_OK)
+        st = rl_scene_drawer_draw_list(w->drawer, w->ras, w->cand, nc, NULL);
     if (st != RL_OK)
         return st;
     if (++w->tick == 0) {
@@ -299,7 +305,8 @@ static rl_status build_sets(svs_state *s, const rl_scene *scene, int threads)
     uint32_t **sets = rl_calloc((size_t)nn * D, sizeof *sets);
     uint32_t *sizes = rl_calloc((size_t)nn * D, sizeof *sizes);
     s->stamp = rl_calloc(d->num_objects, sizeof *s->stamp);
-    if (!sets || !sizes || !s->stamp) {
+    s->draw = rl_calloc(d->num_objects ? d->num_objects : 1, sizeof *s->draw);
+    if (!sets || !sizes || !s->stamp || !s->draw) {
         free(sets);
         free(sizes);
         return RL_ERR_OUT_OF_MEMORY;
@@ -417,7 +424,8 @@ static rl_status draw_object(svs_frame *f, uint32_t o)
         return RL_OK;
     s->head.stats.objects_drawn++;
     s->head.stats.triangles_drawn += f->d->objects[o].num_triangles;
-    return rl_scene_drawer_draw(f->cf.drawer, f->cf.ras, o, &f->cf.counters);
+    s->draw[s->num_draw++] = o;       /* once per frame (the stamp) */
+    return RL_OK;
 }
 
 static rl_status draw_node(svs_frame *f, uint32_t n)
@@ -530,7 +538,11 @@ static rl_status svs_render(rl_renderer *r, void *state, const rl_scene *scene, 
         memset(s->stamp, 0, d->num_objects * sizeof *s->stamp);
         s->frame = 1;
     }
-    st = rl_cull_frame_end(&f.cf, draw_node(&f, 0), image, stats);
+    s->num_draw = 0;
+    st = draw_node(&f, 0);
+    if (st == RL_OK)
+        st = rl_scene_drawer_draw_list(f.cf.drawer, f.cf.ras, s->draw, s->num_draw, &f.cf.counters);
+    st = rl_cull_frame_end(&f.cf, st, image, stats);
     if (st != RL_OK)
         return st;
     s->head.have_frame = true;

@@ -66,6 +66,10 @@ typedef struct visset_state {
     uint32_t *stamp;
     uint32_t frame;
     uint32_t frames_outside;      /* viewer outside the sampled region */
+    /* This frame's objects in drawing order, drawn as one list
+     * (rl_scene_drawer_draw_list), on all threads. */
+    uint32_t *draw;
+    uint32_t num_draw;
 } visset_state;
 
 static rl_status visset_create(void **state)
@@ -83,10 +87,12 @@ static void drop(visset_state *s)
     free(s->rank_offset);
     free(s->rank_objects);
     free(s->stamp);
+    free(s->draw);
     s->approx = NULL;
     s->rank_offset = NULL;
     s->rank_objects = NULL;
     s->stamp = NULL;
+    s->draw = NULL;
 }
 
 static void visset_release(void *state)
@@ -202,7 +208,8 @@ static rl_status prepare(visset_state *s, rl_renderer *r, const rl_scene *scene,
         drop(s);
         k.ranked = false;
         s->stamp = rl_calloc(d->num_objects, sizeof *s->stamp);
-        if (!s->stamp)
+        s->draw = rl_calloc(d->num_objects ? d->num_objects : 1, sizeof *s->draw);
+        if (!s->stamp || !s->draw)
             return RL_ERR_OUT_OF_MEMORY;
         s->frame = 0;
         if (k.approx[0]) {
@@ -259,7 +266,8 @@ static rl_status draw_object(visset_frame *f, uint32_t o)
     s->stamp[o] = s->frame;
     s->head.stats.objects_drawn++;
     s->head.stats.triangles_drawn += obj->num_triangles;
-    return rl_scene_drawer_draw(f->cf.drawer, f->cf.ras, o, &f->cf.counters);
+    s->draw[s->num_draw++] = o;       /* once per frame (the stamp) */
+    return RL_OK;
 }
 
 static rl_status visset_render(rl_renderer *r, void *state, const rl_scene *scene, const rl_camera *cam,
@@ -289,6 +297,7 @@ static rl_status visset_render(rl_renderer *r, void *state, const rl_scene *scen
         memset(s->stamp, 0, d->num_objects * sizeof *s->stamp);
         s->frame = 1;
     }
+    s->num_draw = 0;
     /* Inside the sampled region (2-D: its x-z extent)? Checked here so that
      * a viewer outside raises no error. */
     rl_vec3 e = f.cf.view.eye;
@@ -310,6 +319,8 @@ static rl_status visset_render(rl_renderer *r, void *state, const rl_scene *scen
             if ((set[o / 64] >> (o % 64)) & 1u)
                 st = draw_object(&f, o);
     }
+    if (st == RL_OK)
+        st = rl_scene_drawer_draw_list(f.cf.drawer, f.cf.ras, s->draw, s->num_draw, &f.cf.counters);
     st = rl_cull_frame_end(&f.cf, st, image, stats);
     if (st != RL_OK)
         return st;
