@@ -555,9 +555,11 @@ void rl_scene_drawer_light(rl_scene_drawer *dr, const uint32_t *objects, uint32_
             todo[small++] = o;
         }
     }
+    /* Every list draw comes here, mostly with nothing (or one object) to
+     * light: no parallel region then, which would cost more than it does. */
     if (small == 1) {
-        light_object(dr, todo[0], 1);   /* one object (chcpp's draws): no parallel region */
-    } else {
+        light_object(dr, todo[0], 1);
+    } else if (small > 1) {
 #pragma omp parallel for num_threads(dr->threads) schedule(dynamic, 1)
         for (int64_t i = 0; i < (int64_t)small; ++i)
             light_object(dr, todo[i], 1);
