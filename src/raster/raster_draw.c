@@ -221,6 +221,13 @@ static rl_status run(rl_raster *r, const rl_raster_batch *b, bool query, uint64_
     return RL_OK;
 }
 
+/* The vertices a batch needs in a group's scratch: none without triangles
+ * (such a batch may even come without positions). */
+static inline size_t group_vertices(const rl_raster_batch *b)
+{
+    return b->num_triangles ? b->num_vertices : 0;
+}
+
 /* Transforms and sets up the batches of chunk c of a group (c->group_lo ..
  * group_hi), each into its own part of r->clip. */
 static void setup_group_chunk(rl_raster *r, const rl_raster_batch *batches, int c, int num_bands)
@@ -231,6 +238,8 @@ static void setup_group_chunk(rl_raster *r, const rl_raster_batch *batches, int 
     ch->failed = false;
     for (uint32_t k = ch->group_lo; k < ch->group_hi && !ch->failed; ++k) {
         const rl_raster_batch *b = &batches[k];
+        if (b->num_triangles == 0)
+            continue;
         rl_vec4 *clip = r->clip + r->group_vertex[k];
         float *eye_depth = r->perspective ? NULL : r->eye_depth + r->group_vertex[k];
         for (uint32_t i = 0; i < b->num_vertices; ++i)
@@ -272,7 +281,7 @@ static rl_status run_group(rl_raster *r, const rl_raster_batch *batches, uint32_
             r->chunks[++c].group_lo = k;
         }
         r->group_vertex[k] = v;
-        v += batches[k].num_vertices;
+        v += group_vertices(&batches[k]);
         before += batches[k].num_triangles;
     }
     r->chunks[c].group_hi = count;
@@ -329,7 +338,7 @@ rl_status rl_raster_query(rl_raster *r, const rl_raster_batch *batch, uint64_t *
 /* Small enough to share a group with its neighbours. */
 static bool groupable(const rl_raster_batch *b)
 {
-    return b->num_layers == 0 && b->num_triangles < PARALLEL_TRIANGLES && b->num_vertices <= GROUP_VERTICES;
+    return b->num_layers == 0 && b->num_triangles < PARALLEL_TRIANGLES && group_vertices(b) <= GROUP_VERTICES;
 }
 
 rl_status rl_raster_draw_many(rl_raster *r, const rl_raster_batch *batches, uint32_t count,
@@ -354,15 +363,15 @@ rl_status rl_raster_draw_many(rl_raster *r, const rl_raster_batch *batches, uint
                 st = run(r, b, false, &passed, &drawn);
         } else {
             uint32_t triangles = b->num_triangles;
-            size_t vertices = b->num_vertices;
+            size_t vertices = group_vertices(b);
             for (; k + n < count; ++n) {
                 const rl_raster_batch *next = &batches[k + n];
                 if (!groupable(next) || next->flags != b->flags ||
                     triangles + next->num_triangles > RL_RASTER_SLAB ||
-                    vertices + next->num_vertices > GROUP_VERTICES)
+                    vertices + group_vertices(next) > GROUP_VERTICES)
                     break;
                 triangles += next->num_triangles;
-                vertices += next->num_vertices;
+                vertices += group_vertices(next);
             }
             if (triangles > 0)
                 st = run_group(r, b, n, triangles, vertices, &passed, &drawn);

@@ -134,6 +134,13 @@ static void make_scene(scene *sc)
             b->num_layers = 1;
             b->layers = &sc->layer;
         }
+        if (k == 19) {
+            /* Empty, with vertices but no positions or indices: nothing to
+             * transform. */
+            b->positions = NULL;
+            b->indices = NULL;
+            b->num_vertices = 5;
+        }
         v0 += nv;
         i0 += 3 * (size_t)nt[k];
     }
