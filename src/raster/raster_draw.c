@@ -356,13 +356,12 @@ rl_status rl_raster_draw_many(rl_raster *r, const rl_raster_batch *batches, uint
     for (uint32_t k = 0; k < count;) {
         const rl_raster_batch *b = &batches[k];
         uint64_t passed = 0, drawn = 0;
-        uint32_t n = 1;
+        uint32_t n = 1, triangles = b->num_triangles;   /* of the n batches drawn now */
         rl_status st = RL_OK;
         if (!groupable(b)) {
-            if (b->num_triangles > 0)
+            if (triangles > 0)
                 st = run(r, b, false, &passed, &drawn);
         } else {
-            uint32_t triangles = b->num_triangles;
             size_t vertices = group_vertices(b);
             for (; k + n < count; ++n) {
                 const rl_raster_batch *next = &batches[k + n];
@@ -378,8 +377,7 @@ rl_status rl_raster_draw_many(rl_raster *r, const rl_raster_batch *batches, uint
         }
         if (st != RL_OK)
             return st;
-        for (uint32_t i = 0; i < n; ++i)
-            sum.triangles_in += batches[k + i].num_triangles;
+        sum.triangles_in += triangles;
         sum.triangles_drawn += drawn;
         sum.pixels_written += passed;
         k += n;

@@ -154,11 +154,12 @@ typedef struct frame_buffers {
     rl_vec2 *corner_uvs;
     rl_vec4 *corner_colors;
     uint32_t *triangle_texture;  /* per triangle, textured mode */
-    /* Per scene corner (3 per triangle): the batch index of the corner in
-     * its object's batch, the object-local vertex (or, for objects drawn
-     * by corners, the local corner), made when the object is first drawn:
-     * batches of a list must all be ready before rl_raster_draw_many, and
-     * calloc leaves the pages of objects never drawn untouched. */
+    /* Per scene corner (3 per triangle): the index its object's batch
+     * uses for it, the object-local vertex (or, for objects drawn by
+     * corners, the local corner). Made when the object is first drawn and
+     * kept: the batches of a list must all be ready before
+     * rl_raster_draw_many, and calloc leaves the pages of objects never
+     * drawn untouched. */
     uint32_t *local;
     uint8_t *local_ready;        /* per object */
 } frame_buffers;
