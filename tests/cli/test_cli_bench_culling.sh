@@ -22,7 +22,7 @@ expect_exit 1 "$RL" bench culling --quick --out "$TMP/no/such/dir/c.json"
 
 expect_exit 0 "$RL" bench culling --help
 for o in --scene --only --samples --max-depth --size --height --extent --resolution --select-positions \
-         --select-quantile --surfels --budget --threads --seed --out --resume --quick; do
+         --select-quantile --visset-positions --surfels --budget --threads --seed --out --resume --quick; do
     expect_in "$TMP/out" "$o"
 done
 expect_exit 0 "$RL" bench --help
@@ -69,7 +69,11 @@ hi = max(sel["property_chcpp_mean_ms"], sel["property_svs_mean_ms"])
 assert 0 < sel["property_time_selected_mean_ms"] and 0 <= sel["property_time_selected_chcpp"] <= 4, sel
 assert sel["property_time_selection_beats_both"] == (sel["property_time_selected_mean_ms"] < lo), sel
 v = r["visset"]
-assert v["set_bytes"] > 0 and v["budget_triangles"] > 0 and 0 < v["ssim"]["min"] <= 1, v
+assert v["set_bytes"] > 0 and v["budget_triangles"] > 0 and 0 < v["hssim"]["min"] <= 1, v
+assert v["positions"] == 4 and 0 <= v["hssim_below_0_9"] <= 4 and len(v["worst_position"]) == 3, v
+assert v["budget_time_ms"]["mean"] > 0 and 0 < v["budget_hssim"]["max"] <= 1, v
+# the svs section ran before, so visset is compared with its sampled time
+assert v["svs_sampled_time_mean_ms"] > 0, v
 PY
 fi
 
@@ -110,6 +114,17 @@ assert a["chcpp_triangles"] == b["chcpp_triangles"] and a["svs_ssim"] == b["svs_
 assert len(cut) == len(full) and cut[0] == 1234.5 and cut[1:] == full[1:], (cut, full)
 PY
 fi
+# visset's series are named by their positions and budget (whose default
+# depends on whether the svs section ran), so a later run with the other
+# budget does not continue them.
+expect_exit 0 "$RL" bench culling --quick --only visset --resume "$TMP/res" --out "$TMP/v1.json"
+for f in visset-time-at-4-random-positions.json visset-budget-10000-quality-at-4-random-positions.json; do
+    [ -s "$TMP/res/$f" ] || fail "--resume did not keep $f"
+done
+expect_exit 0 "$RL" bench culling --quick --only svs,visset --resume "$TMP/res" --out "$TMP/v2.json"
+expect_in "$TMP/err" "visset time at 4 random positions: 4 of 4 positions measured before"
+ls "$TMP/res" | grep -q "visset-budget-10000-time" || fail "the budget of 10000 lost its series"
+ls "$TMP/res" | grep -v 10000 | grep -q "visset-budget-.*-time-at-4" || fail "the svs section's budget was not measured anew"
 expect_error 1 "other options" "$RL" bench culling --quick --only svs --seed 2 --resume "$TMP/res" --out "$TMP/r3.json"
 echo 'not json' >"$TMP/res/svs-quality.json"
 expect_exit 1 "$RL" bench culling --quick --only svs --resume "$TMP/res" --out "$TMP/r4.json"
