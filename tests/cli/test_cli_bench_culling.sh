@@ -14,6 +14,7 @@ expect_usage_error "$RL" bench culling --samples 0 --out "$TMP/x.json"
 expect_usage_error "$RL" bench culling --max-depth 21 --out "$TMP/x.json"
 expect_usage_error "$RL" bench culling --select-quantile 1.5 --out "$TMP/x.json"
 expect_usage_error "$RL" bench culling --extent 0 --out "$TMP/x.json"
+expect_usage_error "$RL" bench culling --visset-positions 0 --out "$TMP/x.json"
 expect_usage_error "$RL" bench culling --only depth,nosuch --out "$TMP/x.json"
 expect_usage_error "$RL" bench culling --quick --out "$TMP/x.txt"
 expect_usage_error "$RL" bench culling --frobnicate
