@@ -33,7 +33,6 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "render/surfels_internal.h"
 #include "rl/rl_surfels.h"
 
 #define note(...) (fflush(stdout), rl_bench_note("surfels", __VA_ARGS__))

@@ -12,7 +12,7 @@
 #include <string.h>
 #include <time.h>
 
-#include "core/params.h"
+#include "rl/rl_options.h"
 
 void rl_bench_note(const char *bench, const char *fmt, ...)
 {

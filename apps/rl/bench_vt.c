@@ -44,7 +44,7 @@
 #include <string.h>
 #include <time.h>
 
-#include "core/params.h"
+#include "rl/rl_options.h"
 #include "rl/rl_metrics.h"
 #include "rl/rl_vt.h"
 

@@ -13,8 +13,8 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
-#include "core/params.h"
-#include "core/path.h"
+#include "rl/rl_options.h"
+#include "rl/rl_path.h"
 
 int rl_cli_fail(int code, const char *fmt, ...)
 {

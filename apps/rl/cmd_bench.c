@@ -27,7 +27,7 @@
 #include <string.h>
 #include <sys/stat.h>
 
-#include "core/params.h"
+#include "rl/rl_options.h"
 
 static const char bench_help[] =
     "usage: rl bench rays [options]\n"

@@ -11,7 +11,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "core/params.h"
+#include "rl/rl_options.h"
 
 static const char render_help[] =
     "usage: rl render SCENE --out FILE.png|FILE.exr [options]\n"

@@ -2,6 +2,8 @@
 #ifndef RL_H
 #define RL_H
 #include "rl/rl_common.h"
+#include "rl/rl_options.h"
+#include "rl/rl_path.h"
 #include "rl/rl_math.h"
 #include "rl/rl_rng.h"
 #include "rl/rl_image.h"
@@ -13,8 +15,11 @@
 #include "rl/rl_accel.h"
 #include "rl/rl_linespace.h"
 #include "rl/rl_trace.h"
-#include "rl/rl_metrics.h"
+#include "rl/rl_gbuffer.h"
 #include "rl/rl_filter.h"
+#include "rl/rl_pt.h"
+#include "rl/rl_vt.h"
+#include "rl/rl_metrics.h"
 #include "rl/rl_shadowmap.h"
 #include "rl/rl_property.h"
 #include "rl/rl_sampling.h"

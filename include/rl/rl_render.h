@@ -14,6 +14,7 @@
 #include "rl/rl_camera.h"
 #include "rl/rl_common.h"
 #include "rl/rl_image.h"
+#include "rl/rl_options.h"
 #include "rl/rl_scene.h"
 
 #ifdef __cplusplus
@@ -40,19 +41,6 @@ typedef struct rl_render_stats {
     uint64_t points_drawn;                /* point primitives rasterized (surfels) */
 } rl_render_stats;
 
-typedef enum rl_option_type {
-    RL_OPT_INT, RL_OPT_FLOAT, RL_OPT_BOOL, RL_OPT_ENUM, RL_OPT_STRING,
-    RL_OPT_COLOR                          /* "r,g,b" or one grey value, finite, >= 0 */
-} rl_option_type;
-
-typedef struct rl_option_info {
-    const char *key;
-    rl_option_type type;
-    const char *default_value;
-    const char *help;
-    double min, max;                      /* RL_OPT_INT / RL_OPT_FLOAT range */
-    const char *const *choices;           /* RL_OPT_ENUM: NULL-terminated */
-} rl_option_info;
 
 typedef struct rl_renderer rl_renderer;
 

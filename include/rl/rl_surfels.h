@@ -82,6 +82,13 @@ RL_API rl_status rl_surfels_build(const rl_scene *scene, const uint32_t *objects
                                   const rl_surfel_desc *desc, rl_surfel_set *out);
 RL_API void rl_surfel_set_free(rl_surfel_set *set);    /* NULL is a no-op; zeroes *set */
 
+/* Nearest-neighbour distances within the prefix [0, m) of a sequence (the
+ * measure of Jähn 2015, Sec. 6.4): their minimum and mean (m >= 2, else
+ * both 0, as for s == NULL). Deterministic for any thread count. threads
+ * 0 = all. RL_ERR_INVALID_ARG for NULL outputs; RL_ERR_OUT_OF_MEMORY. */
+RL_API rl_status rl_surfels_prefix_spacing(const rl_surfel *s, uint32_t m, int threads, double *min_dist,
+                                           double *mean_dist);
+
 /* Decoders for the packed fields. */
 RL_API rl_vec3 rl_surfel_normal(const rl_surfel *s);
 RL_API rl_vec3 rl_surfel_color(const rl_surfel *s);

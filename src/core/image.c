@@ -8,7 +8,7 @@
 #include <string.h>
 
 #include "core/error.h"
-#include "core/path.h"
+#include "rl/rl_path.h"
 #include "core/image_internal.h"
 
 rl_status rl_image_check_size(const char *what, long long width, long long height)

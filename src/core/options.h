@@ -1,4 +1,4 @@
-/* options.h: typed option tables (rl_option_info, rl_render.h) checked and
+/* options.h: typed option tables (rl_option_info, rl_options.h) checked and
  * read as text, shared by everything configured with key/value options:
  * renderers (src/render/renderer.c) and position-dependent properties
  * (src/eval/property.c). One definition, so that "threads=x" fails with the
@@ -10,7 +10,8 @@
 #ifndef RL_CORE_OPTIONS_H
 #define RL_CORE_OPTIONS_H
 
-#include "rl/rl_render.h"   /* rl_option_info */
+#include "rl/rl_math.h"
+#include "rl/rl_options.h"
 
 /* Message lists ("raster, whitted, ..."): enough room for a few dozen
  * names; longer lists are cut, which only shortens a message. */

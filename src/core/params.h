@@ -7,7 +7,7 @@
 #ifndef RL_CORE_PARAMS_H
 #define RL_CORE_PARAMS_H
 
-#include "rl/rl_common.h"
+#include "rl/rl_options.h"   /* rl_parse_int, rl_parse_float */
 
 typedef struct rl_param { char *key, *value; bool used; } rl_param;
 typedef struct rl_params { rl_param *items; uint32_t count; } rl_params;
@@ -37,9 +37,5 @@ rl_status rl_params_enum(rl_params *p, const char *context, const char *key,
 /* RL_ERR_INVALID_ARG naming the first unused key and listing `accepted`
  * (a human-readable list such as "triangles, seed"). */
 rl_status rl_params_check_unused(const rl_params *p, const char *context, const char *accepted);
-
-/* Strict string -> number conversions (whole string, finite). */
-bool rl_parse_int(const char *s, long long *out);
-bool rl_parse_float(const char *s, double *out);
 
 #endif

@@ -1,6 +1,6 @@
 /* path.c: joining and splitting file paths for scene assets and outputs
  * (POSIX '/' separators; a Windows drive prefix "C:" also counts as absolute). */
-#include "core/path.h"
+#include "rl/rl_path.h"
 
 #include <stdio.h>
 #include <string.h>

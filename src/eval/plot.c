@@ -26,7 +26,7 @@
 #include <string.h>
 
 #include "core/error.h"
-#include "core/path.h"
+#include "rl/rl_path.h"
 
 #define FONT_FAMILY "DejaVu Sans"
 #define CAP_HEIGHT 0.73      /* DejaVu Sans cap height in em */

@@ -201,6 +201,8 @@ void rl_surfel_grid_free(rl_surfel_grid *g)
 rl_status rl_surfels_prefix_spacing(const rl_surfel *s, uint32_t m, int threads, double *min_dist,
                                     double *mean_dist)
 {
+    if (!min_dist || !mean_dist)
+        return rl_error(RL_ERR_INVALID_ARG, "rl_surfels_prefix_spacing: min_dist and mean_dist must not be NULL");
     *min_dist = 0.0;
     *mean_dist = 0.0;
     if (!s || m < 2)

@@ -45,11 +45,6 @@ uint32_t rl_surfel_grid_knn(const rl_surfel_grid *g, const rl_vec3 *points, rl_v
 float rl_surfel_grid_nearest2(const rl_surfel_grid *g, const rl_vec3 *points, rl_vec3 p);
 void rl_surfel_grid_free(rl_surfel_grid *g);
 
-/* Nearest-neighbour distances within the prefix [0, m) of a sequence (the
- * measure of Jähn 2015, Sec. 6.4): their minimum and mean (m >= 2, else
- * both 0). Deterministic for any thread count. threads 0 = all. */
-rl_status rl_surfels_prefix_spacing(const rl_surfel *s, uint32_t m, int threads, double *min_dist,
-                                    double *mean_dist);
 
 /* Sec. 6.2: what a frame draws of an octree node with `count` surfels
  * whose bounding box projects to `area` pixels (the area of its screen

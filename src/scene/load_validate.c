@@ -18,7 +18,7 @@
 #include <string.h>
 
 #include "core/error.h"
-#include "core/path.h"
+#include "rl/rl_path.h"
 #include "scene/load_internal.h"
 
 #define PLY_MAX_ELEMENTS 16

@@ -2,7 +2,7 @@
 #ifndef RL_SCENE_INTERNAL_H
 #define RL_SCENE_INTERNAL_H
 
-#include "core/path.h"
+#include "rl/rl_path.h"
 #include "rl/rl_scene.h"
 
 typedef struct rl_attr { char *key, *value; } rl_attr;
