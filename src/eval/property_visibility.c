@@ -38,7 +38,7 @@
 
 #include "core/error.h"
 #include "eval/property_internal.h"
-#include "render/raster_scene.h"
+#include "raster/scene_drawer.h"
 #include "rl/rl_raster.h"
 
 static const char *const measure_choices[] = { "objects", "polygons", "pixels", NULL };

@@ -6,7 +6,7 @@
 #ifndef RL_RENDER_CULLING_H
 #define RL_RENDER_CULLING_H
 
-#include "render/raster_scene.h"
+#include "raster/scene_drawer.h"
 #include "rl/rl_culling.h"
 #include "rl/rl_octree.h"
 #include "rl/rl_raster.h"

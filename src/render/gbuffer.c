@@ -16,7 +16,7 @@
 #include <string.h>
 
 #include "core/error.h"
-#include "render/raster_scene.h"
+#include "raster/scene_drawer.h"
 #include "rl/rl_gbuffer.h"
 #include "rl/rl_image.h"
 #include "rl/rl_raster.h"

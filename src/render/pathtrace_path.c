@@ -44,7 +44,7 @@
 #include <math.h>
 #include <string.h>
 
-#include "render/light_eval.h"
+#include "scene/light_eval.h"
 #include "render/pathtrace_internal.h"
 
 #define SHADOW_T_SHRINK 1e-4f     /* stop feelers short of the light itself */

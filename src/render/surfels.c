@@ -36,7 +36,7 @@
 
 #include "core/error.h"
 #include "render/culling.h"
-#include "render/raster_scene.h"
+#include "raster/scene_drawer.h"
 #include "render/renderer.h"
 #include "render/surfels_internal.h"
 #include "rl/rl_surfels.h"

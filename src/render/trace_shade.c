@@ -31,7 +31,7 @@
  * results stay bit-identical. */
 #include <math.h>
 
-#include "render/light_eval.h"
+#include "scene/light_eval.h"
 #include "render/trace_internal.h"
 
 #define SHADOW_T_SHRINK 1e-4f     /* stop feelers short of the light itself */

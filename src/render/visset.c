@@ -28,7 +28,7 @@
 
 #include "core/error.h"
 #include "render/culling.h"
-#include "render/raster_scene.h"
+#include "raster/scene_drawer.h"
 #include "render/renderer.h"
 #include "rl/rl_property.h"
 #include "rl/rl_sampling.h"

@@ -13,7 +13,7 @@
 #ifndef RL_RENDER_VT_RUN_H
 #define RL_RENDER_VT_RUN_H
 
-#include "render/raster_scene.h"
+#include "raster/scene_drawer.h"
 #include "render/vt_internal.h"
 #include "rl/rl_raster.h"
 #include "rl/rl_vt.h"

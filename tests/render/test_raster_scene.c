@@ -12,7 +12,7 @@
 
 #include <cmocka.h>
 
-#include "render/raster_scene.h"
+#include "raster/scene_drawer.h"
 #include "rl/rl_raster.h"
 #include "rl/rl_render.h"
 #include "rl/rl_scene.h"

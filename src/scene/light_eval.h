@@ -1,7 +1,7 @@
 /* light_eval.h: how much a light sends towards a surface point, shared by
  * the renderers so that raster and whitted light a scene identically. */
-#ifndef RL_RENDER_LIGHT_EVAL_H
-#define RL_RENDER_LIGHT_EVAL_H
+#ifndef RL_SCENE_LIGHT_EVAL_H
+#define RL_SCENE_LIGHT_EVAL_H
 
 #include "rl/rl_scene.h"
 

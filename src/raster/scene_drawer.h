@@ -1,12 +1,14 @@
-/* raster_scene.h: the "raster" renderer's way of drawing a committed scene,
- * shared with the hybrid renderers. Vertex Tracing (Ullmann 2003, Sec. 3.5)
- * draws its ID/Z pre-pass and its non-VT objects through exactly this code,
- * so that "rasterized" means the same thing in every renderer.
+/* scene_drawer.h: the software rasterizer's way of drawing a committed
+ * scene (scene_drawer.c), shared by every renderer that rasterizes: the
+ * "raster" renderer, Vertex Tracing (Ullmann 2003, Sec. 3.5: its ID/Z
+ * pre-pass and its non-VT objects), the culling and level-of-detail
+ * renderers and the visibility property, so that "rasterized" means the
+ * same thing in every renderer.
  *
- * Lighting is raster.c's local Phong model (see there); it is evaluated only
- * when the draw writes colour. */
-#ifndef RL_RENDER_RASTER_SCENE_H
-#define RL_RENDER_RASTER_SCENE_H
+ * Lighting is the local Phong model described in scene_drawer.c; it is
+ * evaluated only when the draw writes colour. */
+#ifndef RL_RASTER_SCENE_DRAWER_H
+#define RL_RASTER_SCENE_DRAWER_H
 
 #include "rl/rl_raster.h"
 #include "rl/rl_scene.h"

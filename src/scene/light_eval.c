@@ -2,7 +2,7 @@
  * light_eval.h). */
 #include <math.h>
 
-#include "render/light_eval.h"
+#include "scene/light_eval.h"
 
 static float smoothstep(float e0, float e1, float x)
 {
