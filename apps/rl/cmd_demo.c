@@ -168,6 +168,8 @@ static bool render_one(const demo_args *a, const char *scene_name, const rl_scen
     rl_clear_error();
     rl_status st = rl_renderer_create(algo, &r);
     if (st == RL_OK)
+        st = rl_renderer_prepare_inputs(r, scene);   /* visset, select: sampled here */
+    if (st == RL_OK)
         st = rl_image_create(cam->width, cam->height, RL_LAYER_COLOR, &img);
     if (st == RL_OK) {
         char label[600];

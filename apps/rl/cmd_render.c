@@ -231,6 +231,13 @@ static int render_frame(const render_args *a)
     if (rc == RL_CLI_OK)
         rc = choose_camera(a, scene, &cam);
     if (rc == RL_CLI_OK) {
+        /* visset and select: their sampled properties, before the frame. */
+        rl_clear_error();
+        rl_status st = rl_renderer_prepare_inputs(renderer, scene);
+        if (st != RL_OK)
+            rc = rl_cli_fail_status(RL_CLI_FAIL, st, "render");
+    }
+    if (rc == RL_CLI_OK) {
         unsigned layers = RL_LAYER_COLOR | (a->depth_out ? RL_LAYER_DEPTH : 0u) |
                           (a->id_out ? RL_LAYER_ID : 0u);
         rl_clear_error();

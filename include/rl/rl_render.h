@@ -67,6 +67,48 @@ RL_API const char *rl_renderer_get(const rl_renderer *r, const char *key);
  * next frame is rendered as if it were the first from its camera. This is
  * the "unconditioned" state of Jähn 2015, Sec. 4.2.3. NULL is a no-op. */
 RL_API void rl_renderer_reset(rl_renderer *r);
+/* Inputs measured elsewhere. A renderer that draws from a measured
+ * position-dependent property (visset: the sets of visible objects of
+ * Jähn 2015, Sec. 7.6; select: a time or another scalar per position,
+ * Sec. 7.5) reads it through this lookup and never samples or loads it
+ * itself: renderers sit below the evaluation layer. The caller builds the
+ * lookup, usually from a sampled approximation: rl_renderer_prepare_inputs()
+ * (rl_sampling.h) loads or samples what the renderer's options ask for and
+ * hands it in, and the CLI calls it for every renderer it creates. A test
+ * or an application may hand in a lookup of its own. */
+typedef struct rl_position_lookup {
+    void *user;
+    const char *property;         /* what was measured ("visibility", "time", ...) */
+    uint32_t set_size;            /* bits of each region's set (one per object); 0: no sets */
+    uint32_t num_regions;
+    double prepare_ms;            /* loading or sampling it: reported as the renderer's preprocessing */
+    /* False where p lies outside what the lookup covers (a 2-D slice covers
+     * its x-z extent at any height); else the value at p and its region. */
+    bool (*query)(void *user, rl_vec3 p, double *value, uint32_t *region);
+    /* Region i's set (set_size bits, 64 per word, object o in bit o % 64 of
+     * word o / 64); NULL where there is none. */
+    const uint64_t *(*region_set)(void *user, uint32_t region);
+    rl_vec3 (*region_center)(void *user, uint32_t region);
+    /* Optional (NULL: not offered): the visible pixels of each of the
+     * set_size objects seen from p, into pixels. */
+    rl_status (*object_pixels)(void *user, rl_vec3 p, uint32_t *pixels);
+    void (*release)(void *user);  /* frees user; may be NULL */
+} rl_position_lookup;
+
+/* The lookup inputs ("slots") of r, named after the option that names
+ * their file (visset: "approx"; select: "first_time", "second_time",
+ * "property"); count 0 for renderers that read none. */
+RL_API const char *const *rl_renderer_input_slots(const rl_renderer *r, size_t *count);
+/* Hands lookup to r's slot (NULL clears it); on success r owns lookup->user
+ * and calls lookup->release when the slot is replaced or r released; on
+ * failure the caller still owns it. key (may be NULL) is kept for
+ * rl_renderer_input_key: whoever prepares inputs says what they were made
+ * from, so that it can skip work that is already done. RL_ERR_INVALID_ARG
+ * for an unknown slot or a lookup without query. */
+RL_API rl_status rl_renderer_set_input(rl_renderer *r, const char *slot, const rl_position_lookup *lookup,
+                                       const char *key);
+/* The key given with the slot's lookup; NULL when the slot is empty. */
+RL_API const char *rl_renderer_input_key(const rl_renderer *r, const char *slot);
 /* Optional progress callback for long renders. */
 RL_API void rl_renderer_set_progress(rl_renderer *r, rl_progress_fn fn, void *user);
 /* Renders the committed scene from cam into image, which must match the

@@ -315,6 +315,21 @@ RL_API rl_status rl_approx_set_interpolation(rl_approx *a, rl_interpolation inte
 /* JSON with the desc, the tree, the leaves (with sets as index lists) and
  * the samples; load gives an approximation that answers every query
  * identically. RL_ERR_IO, RL_ERR_PARSE (with the offending key) on load. */
+/* A renderer input (rl_position_lookup, rl_render.h) over a, which it
+ * takes over: a is released with the lookup (its release). Regions are
+ * a's leaves; a point outside a's bounds (a 2-D slice: outside its x-z
+ * extent, at any height) is not covered. No object pixels offered. On
+ * failure a stays the caller's. */
+RL_API rl_status rl_approx_lookup(rl_approx *a, rl_position_lookup *out);
+/* Gives r the measured inputs its options ask for (rl_renderer_input_slots):
+ * visset's visible sets and select's times or threshold property, loaded
+ * from the approx.json files its options name or sampled over the scene as
+ * they describe (visset.c, select.c). Work done before for the same
+ * options and scene is skipped, so it may be called before every frame;
+ * renderers without inputs return RL_OK at once. Errors: those of loading
+ * or sampling; RL_ERR_NOT_COMMITTED. */
+RL_API rl_status rl_renderer_prepare_inputs(rl_renderer *r, const rl_scene *scene);
+
 RL_API rl_status rl_approx_save_json(const rl_approx *a, const char *path);
 RL_API rl_status rl_approx_load_json(const char *path, rl_approx **out);
 

@@ -64,6 +64,7 @@
 #include "core/params.h"
 #include "eval/property_internal.h"
 #include "rl/rl_metrics.h"
+#include "rl/rl_sampling.h"
 #include "rl/rl_timer.h"
 
 /* ---- options ----------------------------------------------------------- */
@@ -218,6 +219,9 @@ static rl_status make_renderer(const rp_state *s, const renderer_recipe *rc, con
             rl_error(st, "%s: option %s: \"%s=%s\" rejected by %s", s->who, key,
                      rc->params.items[i].key, rc->params.items[i].value, rc->name);
     }
+    /* What visset and select draw from (their sampled properties). */
+    if (st == RL_OK)
+        st = rl_renderer_prepare_inputs(r, s->scene);
     if (st != RL_OK) {
         rl_renderer_release(r);
         return st;

@@ -182,19 +182,30 @@ void rl_octree_cache_release(rl_octree_cache *c)
     memset(c, 0, sizeof *c);
 }
 
-rl_status rl_culling_get_stats(const rl_renderer *r, rl_culling_stats *out)
+static bool is_culling_renderer(const rl_renderer *r)
 {
     static const char *const names[] = { "chcpp", "svs", "visset", "surfels", "select" };
-    bool known = false;
     for (size_t i = 0; r && i < sizeof names / sizeof names[0]; ++i)
-        known |= strcmp(rl_renderer_name(r), names[i]) == 0;
-    if (!known || !out)
+        if (strcmp(rl_renderer_name(r), names[i]) == 0)
+            return true;
+    return false;
+}
+
+const rl_culling_stats *rl_cull_stats_of(const rl_renderer *r)
+{
+    const rl_culling_head *h = is_culling_renderer(r) ? rl_renderer_state(r) : NULL;
+    return h && h->have_frame ? &h->stats : NULL;
+}
+
+rl_status rl_culling_get_stats(const rl_renderer *r, rl_culling_stats *out)
+{
+    if (!is_culling_renderer(r) || !out)
         return rl_error(RL_ERR_INVALID_ARG,
                         "rl_culling_get_stats: needs a chcpp, svs, visset, surfels or select renderer and out");
-    const rl_culling_head *h = rl_renderer_state(r);
-    if (!h || !h->have_frame)
+    const rl_culling_stats *stats = rl_cull_stats_of(r);
+    if (!stats)
         return rl_error(RL_ERR_INVALID_ARG, "rl_culling_get_stats: no frame rendered yet");
-    *out = h->stats;
+    *out = *stats;
     return RL_OK;
 }
 
@@ -245,11 +256,4 @@ rl_status rl_cull_frame_end(rl_cull_frame *f, rl_status st, const rl_image *imag
         stats->samples = (uint64_t)image->width * image->height;
     }
     return st;
-}
-
-bool rl_cull_approx_covers(const rl_approx *a, rl_vec3 eye)
-{
-    rl_aabb b = rl_approx_bounds(a);
-    return eye.x >= b.min.x && eye.x <= b.max.x && eye.z >= b.min.z && eye.z <= b.max.z &&
-           (rl_approx_dims(a) == 2 || (eye.y >= b.min.y && eye.y <= b.max.y));
 }

@@ -10,7 +10,6 @@
 #include "rl/rl_culling.h"
 #include "rl/rl_octree.h"
 #include "rl/rl_raster.h"
-#include "rl/rl_sampling.h"
 #include "rl/rl_scene.h"
 
 /* One frame's camera, exactly as rl_raster_set_camera() sets it up. */
@@ -115,9 +114,9 @@ typedef struct rl_culling_head {
     rl_drawer_keep keep;          /* released by the renderer's release */
 } rl_culling_head;
 
-/* Whether a sampled approximation (visset's sets, select's properties)
- * covers the viewer at eye: inside its bounds, for a 2-D slice inside its
- * x-z extent at any height. Renderers fall back to a default outside. */
-bool rl_cull_approx_covers(const rl_approx *a, rl_vec3 eye);
+/* The statistics of r's last frame, or NULL when r is not a culling
+ * renderer or has rendered nothing yet (rl_culling_get_stats without
+ * recording an error). */
+const rl_culling_stats *rl_cull_stats_of(const rl_renderer *r);
 
 #endif

@@ -20,7 +20,24 @@ struct rl_renderer {
     char **values;              /* one per option, always non-NULL */
     rl_progress_fn progress;
     void *progress_user;
+    /* Lookup inputs per slot of the class (rl_renderer_set_input). */
+    struct renderer_input {
+        rl_position_lookup lookup;
+        bool set;
+        char *key;
+        uint64_t generation;
+    } inputs[RL_RENDERER_MAX_INPUTS];
 };
+
+static void clear_input(struct renderer_input *in)
+{
+    if (in->set && in->lookup.release)
+        in->lookup.release(in->lookup.user);
+    free(in->key);
+    in->key = NULL;
+    in->set = false;
+    memset(&in->lookup, 0, sizeof in->lookup);
+}
 
 void *rl_renderer_state(const rl_renderer *r) { return r ? r->state : NULL; }
 
@@ -124,8 +141,77 @@ void rl_renderer_release(rl_renderer *r)
         return;
     if (r->cls->release)
         r->cls->release(r->state);
+    for (size_t i = 0; i < RL_RENDERER_MAX_INPUTS; ++i)
+        clear_input(&r->inputs[i]);
     free_values(r->values, r->cls->num_options);
     free(r);
+}
+
+const char *const *rl_renderer_input_slots(const rl_renderer *r, size_t *count)
+{
+    if (count)
+        *count = r ? r->cls->num_inputs : 0;
+    return r ? r->cls->inputs : NULL;
+}
+
+static long find_input(const rl_renderer *r, const char *slot)
+{
+    for (size_t i = 0; slot && i < r->cls->num_inputs && i < RL_RENDERER_MAX_INPUTS; ++i)
+        if (strcmp(r->cls->inputs[i], slot) == 0)
+            return (long)i;
+    return -1;
+}
+
+rl_status rl_renderer_set_input(rl_renderer *r, const char *slot, const rl_position_lookup *lookup,
+                                const char *key)
+{
+    if (!r || !slot)
+        return rl_error(RL_ERR_INVALID_ARG, "rl_renderer_set_input: renderer and slot must not be NULL");
+    long i = find_input(r, slot);
+    if (i < 0) {
+        if (!r->cls->num_inputs)
+            return rl_error(RL_ERR_INVALID_ARG, "%s: reads no measured inputs (slot \"%s\")", r->cls->info.name,
+                            slot);
+        char names[RL_OPTION_LIST_SIZE] = "";
+        for (size_t k = 0; k < r->cls->num_inputs; ++k) {
+            if (k)
+                rl_option_append(names, sizeof names, ", ");
+            rl_option_append(names, sizeof names, r->cls->inputs[k]);
+        }
+        return rl_error(RL_ERR_INVALID_ARG, "%s: unknown input \"%s\" (inputs: %s)", r->cls->info.name, slot,
+                        names);
+    }
+    if (lookup && !lookup->query)
+        return rl_error(RL_ERR_INVALID_ARG, "%s: input %s: the lookup has no query function", r->cls->info.name,
+                        slot);
+    char *copy = NULL;
+    if (lookup && key && !(copy = rl_strdup(key)))
+        return RL_ERR_OUT_OF_MEMORY;
+    struct renderer_input *in = &r->inputs[i];
+    clear_input(in);
+    if (lookup) {
+        in->lookup = *lookup;
+        in->set = true;
+        in->key = copy;
+    }
+    in->generation++;
+    return RL_OK;
+}
+
+const char *rl_renderer_input_key(const rl_renderer *r, const char *slot)
+{
+    long i = r ? find_input(r, slot) : -1;
+    if (i < 0 || !r->inputs[i].set)
+        return NULL;
+    return r->inputs[i].key ? r->inputs[i].key : "";
+}
+
+const rl_position_lookup *rl_renderer_input(const rl_renderer *r, const char *slot, uint64_t *generation)
+{
+    long i = find_input(r, slot);
+    if (generation)
+        *generation = i < 0 ? 0 : r->inputs[i].generation;
+    return i >= 0 && r->inputs[i].set ? &r->inputs[i].lookup : NULL;
 }
 
 const char *rl_renderer_name(const rl_renderer *r) { return r ? r->cls->info.name : NULL; }

@@ -26,7 +26,13 @@ typedef struct rl_renderer_class {
     /* Optional: forget frame-to-frame state, keep per-scene preprocessing
      * (rl_renderer_reset); NULL: the renderer keeps none. */
     void (*reset)(void *state);
+    /* Optional lookup inputs (rl_renderer_set_input), by slot name. */
+    const char *const *inputs;
+    size_t num_inputs;
 } rl_renderer_class;
+
+/* At most this many input slots per class. */
+#define RL_RENDERER_MAX_INPUTS 4
 
 /* registry.c */
 extern const rl_renderer_class *const rl_renderer_classes[];
@@ -46,6 +52,10 @@ rl_vec3 rl_renderer_opt_color(const rl_renderer *r, const char *key);
 /* The implementation's state made by its class's create(), for accessors
  * of a renderer's own (e.g. rl_whitted_pixel_tree). */
 void *rl_renderer_state(const rl_renderer *r);
+/* The lookup in slot (NULL when none was handed in) and how often the slot
+ * was set, so that a renderer can tell a new lookup from the one it built
+ * its per-region data for. */
+const rl_position_lookup *rl_renderer_input(const rl_renderer *r, const char *slot, uint64_t *generation);
 /* Progress for implementations: false means cancel. */
 bool rl_renderer_progress(const rl_renderer *r, double done);
 

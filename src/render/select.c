@@ -9,16 +9,22 @@
  *              the time of both measured on the target machine. The two
  *              approximations come from `rl eval --property time` (options
  *              first_time, second_time = their approx.json), or are sampled
- *              on the first frame over the scene (a 2-D slice at `height`
- *              above the floor, or the 3-D bounds) with `samples` samples
- *              of `resolution`² pixels per direction, conditioned by 2
- *              frames and measured once (coarse: a first look).
+ *              before the first frame over the scene (a 2-D slice at
+ *              `height` above the floor, or the 3-D bounds) with `samples`
+ *              samples of `resolution`² pixels per direction, conditioned
+ *              by 2 frames and measured once (coarse: a first look).
  *   threshold  the thesis' rule: `first` where the sampled property in
  *              `property` (an approx.json, e.g. the polygons in visible
  *              objects, `rl eval --property visibility --set
  *              measure=polygons`) is below `threshold`, else `second`.
  * Where the viewer is outside a sampled region, `first` draws (the
  * conservative choice with the defaults).
+ *
+ * The renderer reads the approximations through its inputs, named after
+ * those options (rl_position_lookup, rl_render.h), and never samples or
+ * loads them itself: rl_renderer_prepare_inputs() (rl_sampling.h, which the
+ * CLI calls) loads the files or samples the times. Its two renderers get no
+ * inputs, so neither may be one that reads them (visset, select).
  *
  * The chosen renderer draws the whole frame with the shared raster options
  * forwarded; both are kept between frames, so CHC++ keeps its temporal
@@ -28,19 +34,15 @@
  * that frame's preprocessing and a later switch costs a frame, not a
  * build. rl_culling_get_stats returns the drawing renderer's statistics
  * with `selected` set. */
-#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
 #include "core/error.h"
 #include "render/culling.h"
 #include "render/renderer.h"
-#include "rl/rl_property.h"
-#include "rl/rl_sampling.h"
 #include "rl/rl_timer.h"
 
 #define NAME_MAX_LEN 64
-#define PATH_MAX_LEN 512
 
 static const char *const rule_choices[] = { "time", "threshold", NULL };
 enum { RULE_TIME, RULE_THRESHOLD };
@@ -56,39 +58,30 @@ static const rl_option_info select_options[] = {
     { "rule", RL_OPT_ENUM, "time",
       "time: the one with the lower sampled time property; threshold: first where `property` < threshold",
       0, 0, rule_choices },
-    { "first_time", RL_OPT_STRING, "", "rule=time: approx.json of first's time property (rl eval); empty: sampled here",
+    { "first_time", RL_OPT_STRING, "", "rule=time: approx.json of first's time property (rl eval); empty: sampled before the first frame",
       0, 0, NULL },
-    { "second_time", RL_OPT_STRING, "", "rule=time: approx.json of second's time property; empty: sampled here",
+    { "second_time", RL_OPT_STRING, "", "rule=time: approx.json of second's time property; empty: sampled before the first frame",
       0, 0, NULL },
     { "property", RL_OPT_STRING, "", "rule=threshold: approx.json of a scalar property (required)", 0, 0, NULL },
     { "threshold", RL_OPT_FLOAT, "0", "rule=threshold: first where the property is below this", -1e300, 1e300, NULL },
-    { "samples", RL_OPT_INT, "8", "samples per time property when sampled here (a coarse default: give files from rl eval for a real selection)", 1, 1 << 20, NULL },
-    { "dims", RL_OPT_INT, "2", "sampled here: 2 = a horizontal slice at `height`, 3 = the scene's bounds", 2, 3,
+    { "samples", RL_OPT_INT, "8", "samples per time property when sampled before the first frame (a coarse default: give files from rl eval for a real selection)", 1, 1 << 20, NULL },
+    { "dims", RL_OPT_INT, "2", "sampled: 2 = a horizontal slice at `height`, 3 = the scene's bounds", 2, 3,
       NULL },
     { "height", RL_OPT_FLOAT, "1.7", "slice height above the scene's lowest point (dims 2)", -1e6, 1e6, NULL },
-    { "resolution", RL_OPT_INT, "32", "sampled here: pixels per side of each of the 6 directions", 8, 4096, NULL },
+    { "resolution", RL_OPT_INT, "32", "sampled: pixels per side of each of the 6 directions", 8, 4096, NULL },
     { "seed", RL_OPT_INT, "1", "sampling seed", 0, 4294967295.0, NULL },
 };
 
-typedef struct select_key {
-    char names[2][NAME_MAX_LEN];
-    int rule;
-    char paths[2][PATH_MAX_LEN];  /* time: first_time, second_time; threshold: property, "" */
-    uint32_t samples, resolution;
-    int dims;
-    float height;
-    uint64_t seed, scene_uid;
-} select_key;
-
 typedef struct select_state {
     rl_culling_head head;         /* first: rl_culling_get_stats */
-    select_key key;
-    bool prepared;
     rl_renderer *child[2];
     char child_name[2][NAME_MAX_LEN];
     uint64_t built_uid[2];        /* scene the child has drawn once for (0: none) */
-    rl_approx *approx[2];         /* time: both; threshold: [0] */
+    uint64_t generation[2];       /* of the inputs last used: their making is reported once */
 } select_state;
+
+/* rule=time reads both times, rule=threshold the property. */
+static const char *const select_inputs[] = { "first_time", "second_time", "property" };
 
 static rl_status select_create(void **state)
 {
@@ -99,21 +92,11 @@ static rl_status select_create(void **state)
     return RL_OK;
 }
 
-static void drop_approx(select_state *s)
-{
-    for (int i = 0; i < 2; ++i) {
-        rl_approx_release(s->approx[i]);
-        s->approx[i] = NULL;
-    }
-    s->prepared = false;
-}
-
 static void select_release(void *state)
 {
     select_state *s = state;
     if (!s)
         return;
-    drop_approx(s);
     for (int i = 0; i < 2; ++i)
         rl_renderer_release(s->child[i]);
     free(s);
@@ -152,6 +135,11 @@ static rl_status prepare_children(select_state *s, rl_renderer *r)
             rl_status st = copy_text(s->child_name[i], sizeof s->child_name[i], name, keys[i]);
             if (st == RL_OK)
                 st = rl_renderer_create(name, &s->child[i]);   /* names an unknown renderer */
+            size_t inputs = 0;
+            rl_renderer_input_slots(s->child[i], &inputs);
+            if (st == RL_OK && inputs)
+                st = rl_error(RL_ERR_INVALID_ARG, "select: %s=%s reads measured inputs, which select does not "
+                                                  "hand on", keys[i], name);
             if (st != RL_OK) {
                 s->child_name[i][0] = '\0';
                 return st;
@@ -171,94 +159,48 @@ static rl_status prepare_children(select_state *s, rl_renderer *r)
     return RL_OK;
 }
 
-/* Sec. 4.2.3: the conditioned time property of renderer `name` (with its
- * default options; the forwarded raster options change little of its
- * time), sampled over the scene as visset samples visibility. */
-static rl_status sample_time(const rl_scene *scene, const rl_scene_data *d, const select_key *k, const char *name,
-                             rl_approx **out)
+/* The lookups the rule reads: both times (rule=time) or the property
+ * (rule=threshold), checked; their making is reported as preprocessing on
+ * the first frame that uses them. */
+static rl_status prepare(select_state *s, rl_renderer *r, int rule, const rl_position_lookup *l[2])
 {
-    rl_property *p = NULL;
-    char res[32];
-    snprintf(res, sizeof res, "%u", k->resolution);
-    rl_status st = rl_property_create("time", &p);
-    if (st == RL_OK) st = rl_property_set(p, "renderer", name);
-    if (st == RL_OK) st = rl_property_set(p, "width", res);
-    if (st == RL_OK) st = rl_property_set(p, "height", res);
-    /* Coarse and quick (a default for a first look; rl eval's files are
-     * the real measurement): 2 unmeasured frames, then 1 measured. */
-    if (st == RL_OK) st = rl_property_set(p, "repeats", "1");
-    if (st == RL_OK) st = rl_property_set(p, "conditioned", "true");
-    if (st == RL_OK) st = rl_property_set(p, "condition_frames", "2");
-    if (st == RL_OK) st = rl_property_commit(p, scene, 0);
-    rl_sampling_desc sd = { .region = d->bounds, .dims = k->dims, .max_samples = k->samples, .seed = k->seed };
-    sd.height = d->bounds.min.y + k->height;
-    if (st == RL_OK)
-        st = rl_sample_property(p, &sd, out);
-    rl_property_release(p);
-    return st;
-}
-
-
-/* The approximations the rule reads, loaded or sampled when the options
- * or the scene change. */
-static rl_status prepare(select_state *s, rl_renderer *r, const rl_scene *scene, const rl_scene_data *d)
-{
-    select_key k;
-    memset(&k, 0, sizeof k);
-    rl_status st = RL_OK;
-    memcpy(k.names, s->child_name, sizeof k.names);
-    k.rule = rl_renderer_opt_enum(r, "rule");
-    if (k.rule == RULE_TIME) {
-        st = copy_text(k.paths[0], PATH_MAX_LEN, rl_renderer_opt_string(r, "first_time"), "first_time");
-        if (st == RL_OK)
-            st = copy_text(k.paths[1], PATH_MAX_LEN, rl_renderer_opt_string(r, "second_time"), "second_time");
-    } else {
-        st = copy_text(k.paths[0], PATH_MAX_LEN, rl_renderer_opt_string(r, "property"), "property");
-        if (st == RL_OK && !k.paths[0][0])
-            st = rl_error(RL_ERR_INVALID_ARG, "select: rule=threshold needs property=FILE (approx.json of "
-                                              "rl eval, e.g. --property visibility --set measure=polygons)");
-    }
-    if (st != RL_OK)
-        return st;
-    k.samples = (uint32_t)rl_renderer_opt_int(r, "samples");
-    k.resolution = (uint32_t)rl_renderer_opt_int(r, "resolution");
-    k.dims = (int)rl_renderer_opt_int(r, "dims");
-    k.height = (float)rl_renderer_opt_float(r, "height");
-    k.seed = (uint64_t)rl_renderer_opt_int(r, "seed");
-    k.scene_uid = rl_scene_uid(scene);
-    if (s->prepared && memcmp(&k, &s->key, sizeof k) == 0)
-        return RL_OK;
-
-    drop_approx(s);
-    rl_timer t;
-    rl_timer_start(&t);
-    if (k.rule == RULE_THRESHOLD) {
-        st = rl_approx_load_json(k.paths[0], &s->approx[0]);   /* its message names the file */
-    } else {
-        for (int i = 0; i < 2 && st == RL_OK; ++i)
-            st = k.paths[i][0] ? rl_approx_load_json(k.paths[i], &s->approx[i])
-                               : sample_time(scene, d, &k, k.names[i], &s->approx[i]);
+    const char *slots[2] = { "first_time", "second_time" };
+    if (rule == RULE_THRESHOLD)
+        slots[0] = "property", slots[1] = NULL;
+    for (int i = 0; i < 2; ++i) {
+        l[i] = NULL;
+        if (!slots[i])
+            continue;
+        uint64_t generation;
+        l[i] = rl_renderer_input(r, slots[i], &generation);
+        if (!l[i])
+            return rule == RULE_THRESHOLD
+                       ? rl_error(RL_ERR_INVALID_ARG, "select: rule=threshold needs property=FILE (approx.json "
+                                                      "of rl eval, e.g. --property visibility --set "
+                                                      "measure=polygons)")
+                       : rl_error(RL_ERR_INVALID_ARG,
+                                  "select: no %s: load or sample it with rl_renderer_prepare_inputs() "
+                                  "(rl_sampling.h; the rl tool does), or hand a lookup to input \"%s\"",
+                                  slots[i], slots[i]);
         /* A time read from a file must be a time (of any renderer: the
          * file does not say which). */
-        for (int i = 0; i < 2 && st == RL_OK; ++i)
-            if (k.paths[i][0] && strcmp(rl_approx_property(s->approx[i]), "time") != 0)
-                st = rl_error(RL_ERR_INVALID_ARG, "select: %s holds the property '%s', not time", k.paths[i],
-                              rl_approx_property(s->approx[i]));
+        if (rule == RULE_TIME && (!l[i]->property || strcmp(l[i]->property, "time") != 0))
+            return rl_error(RL_ERR_INVALID_ARG, "select: %s holds the property '%s', not time",
+                            rl_renderer_opt_string(r, slots[i])[0] ? rl_renderer_opt_string(r, slots[i]) : slots[i],
+                            l[i]->property ? l[i]->property : "");
+        if (generation != s->generation[i]) {
+            s->head.stats.preprocess_ms += l[i]->prepare_ms;
+            s->generation[i] = generation;
+        }
     }
-    if (st != RL_OK) {
-        drop_approx(s);
-        return st;
-    }
-    s->key = k;
-    s->prepared = true;
-    s->head.stats.preprocess_ms = rl_timer_ms(&t);
     return RL_OK;
 }
 
-/* The approximation's value at the eye; false outside its region. */
-static bool value_at(const rl_approx *a, rl_vec3 eye, double *value)
+/* The lookup's value at the eye; false outside its region. */
+static bool value_at(const rl_position_lookup *l, rl_vec3 eye, double *value)
 {
-    return rl_cull_approx_covers(a, eye) && rl_approx_query(a, eye, value, NULL) == RL_OK;
+    uint32_t region;
+    return l->query(l->user, eye, value, &region);
 }
 
 static rl_status select_render(rl_renderer *r, void *state, const rl_scene *scene, const rl_camera *cam,
@@ -270,18 +212,20 @@ static rl_status select_render(rl_renderer *r, void *state, const rl_scene *scen
         return RL_ERR_NOT_COMMITTED;
     s->head.have_frame = false;
     memset(&s->head.stats, 0, sizeof s->head.stats);   /* prepare() times what it loads or samples */
+    const int rule = rl_renderer_opt_enum(r, "rule");
+    const rl_position_lookup *l[2];
     rl_status st = prepare_children(s, r);
     if (st == RL_OK)
-        st = prepare(s, r, scene, d);
+        st = prepare(s, r, rule, l);
     if (st != RL_OK)
         return st;
 
     int pick = 0;
     double v0, v1;
-    if (s->key.rule == RULE_THRESHOLD) {
-        if (value_at(s->approx[0], cam->eye, &v0))
+    if (rule == RULE_THRESHOLD) {
+        if (value_at(l[0], cam->eye, &v0))
             pick = v0 < rl_renderer_opt_float(r, "threshold") ? 0 : 1;
-    } else if (value_at(s->approx[0], cam->eye, &v0) && value_at(s->approx[1], cam->eye, &v1)) {
+    } else if (value_at(l[0], cam->eye, &v0) && value_at(l[1], cam->eye, &v1)) {
         pick = v1 < v0 ? 1 : 0;
     }
     double pre_ms = s->head.stats.preprocess_ms;
@@ -300,11 +244,10 @@ static rl_status select_render(rl_renderer *r, void *state, const rl_scene *scen
     if (st != RL_OK)
         return st;
     s->built_uid[pick] = uid;
-    rl_culling_stats cs;
-    if (rl_culling_get_stats(s->child[pick], &cs) == RL_OK)
-        s->head.stats = cs;
-    else
-        rl_clear_error();                 /* not a culling renderer: its rl_render_stats only */
+    /* Another renderer than a culling one has its rl_render_stats only. */
+    const rl_culling_stats *cs = rl_cull_stats_of(s->child[pick]);
+    if (cs)
+        s->head.stats = *cs;
     s->head.stats.preprocess_ms += pre_ms;
     s->head.stats.selected = (uint32_t)pick + 1;
     s->head.have_frame = true;
@@ -322,4 +265,6 @@ const rl_renderer_class rl_select_renderer_class = {
     .release = select_release,
     .check = NULL,
     .reset = select_reset,
+    .inputs = select_inputs,
+    .num_inputs = sizeof select_inputs / sizeof select_inputs[0],
 };

@@ -3,13 +3,15 @@
  * region by adaptive sampling (Ch. 5, the visibility property of Sec.
  * 4.2.2), is queried at the viewer's position and only that set is drawn.
  *
- * The approximation comes from a file written by `rl eval --property
- * visibility` (option approx = its approx.json), or is sampled on the
- * first frame over the scene's bounds (a 2-D slice at `height` above the
- * scene's floor, or the 3-D bounds) with `samples` samples of `resolution`²
- * pixels per cube face. Where the viewer is outside the sampled region the
- * renderer draws everything in the frustum (and counts it), so it never
- * shows an empty image for want of data.
+ * The renderer reads the approximation through its input "approx" (a
+ * rl_position_lookup, rl_render.h) and never samples or loads it itself:
+ * rl_renderer_prepare_inputs() (rl_sampling.h, which the CLI calls) loads
+ * the file written by `rl eval --property visibility` (option approx = its
+ * approx.json), or samples it over the scene's bounds (a 2-D slice at
+ * `height` above the scene's floor, or the 3-D bounds) with `samples`
+ * samples of `resolution`² pixels per cube face. Where the viewer is
+ * outside the sampled region the renderer draws everything in the frustum
+ * (and counts it), so it never shows an empty image for want of data.
  *
  * Budgeted variant (Sec. 7.6 after Eikel, Jähn & Fischer 2010): with
  * budget > 0 the objects of the set are drawn in decreasing estimated
@@ -17,12 +19,12 @@
  * as long as the triangles drawn stay within the budget; an object that
  * would exceed it is skipped and smaller ones still get their turn, so the
  * budget is never exceeded. The impact estimate at the region centre is
- * ours: the thesis' property stores pixels per object and sample.
+ * ours (the lookup's object_pixels): the thesis' property stores pixels per
+ * object and sample.
  *
  * Frustum culling applies to each object of the set. Approximate: an
  * object that no sample of the region saw is missing (Fig. 7.11). */
 #include <math.h>
-#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -30,15 +32,13 @@
 #include "render/culling.h"
 #include "raster/scene_drawer.h"
 #include "render/renderer.h"
-#include "rl/rl_property.h"
-#include "rl/rl_sampling.h"
 #include "rl/rl_timer.h"
 
 static const rl_option_info visset_options[] = {
     RL_CULL_RASTER_OPTIONS,
-    { "approx", RL_OPT_STRING, "", "approx.json of the visibility property (rl eval); empty: sample it here",
-      0, 0, NULL },
-    { "samples", RL_OPT_INT, "256", "samples when sampling here", 1, 1 << 20, NULL },
+    { "approx", RL_OPT_STRING, "", "approx.json of the visibility property (rl eval); empty: sampled before the "
+      "first frame", 0, 0, NULL },
+    { "samples", RL_OPT_INT, "256", "samples when sampled before the first frame", 1, 1 << 20, NULL },
     { "dims", RL_OPT_INT, "2", "2: a horizontal slice at `height`; 3: the scene's bounds", 2, 3, NULL },
     { "height", RL_OPT_FLOAT, "1.7", "slice height above the scene's lowest point (dims 2)", -1e6, 1e6, NULL },
     { "resolution", RL_OPT_INT, "128", "pixels per cube face of each visibility sample", 8, 4096, NULL },
@@ -47,19 +47,12 @@ static const rl_option_info visset_options[] = {
       NULL },
 };
 
-typedef struct visset_key {
-    char approx[512];
-    uint32_t samples, resolution;
-    int dims;
-    float height;
-    uint64_t seed, scene_uid;
-    bool ranked;                  /* impact ranking built (budget mode) */
-} visset_key;
-
 typedef struct visset_state {
     rl_culling_head head;         /* first: rl_culling_get_stats */
-    visset_key key;
-    rl_approx *approx;
+    /* What the per-object arrays and the ranking were made for: the
+     * input's generation (rl_renderer_input) and the scene. */
+    uint64_t generation, scene_uid;
+    bool ready, ranked;
     /* budget mode: per leaf region its set ordered by impact */
     uint64_t *rank_offset;
     uint32_t *rank_objects;
@@ -72,6 +65,8 @@ typedef struct visset_state {
     uint32_t num_draw;
 } visset_state;
 
+static const char *const visset_inputs[] = { "approx" };
+
 static rl_status visset_create(void **state)
 {
     visset_state *s = rl_calloc(1, sizeof *s);
@@ -83,16 +78,15 @@ static rl_status visset_create(void **state)
 
 static void drop(visset_state *s)
 {
-    rl_approx_release(s->approx);
     free(s->rank_offset);
     free(s->rank_objects);
     free(s->stamp);
     free(s->draw);
-    s->approx = NULL;
     s->rank_offset = NULL;
     s->rank_objects = NULL;
     s->stamp = NULL;
     s->draw = NULL;
+    s->ready = s->ranked = false;
 }
 
 static void visset_release(void *state)
@@ -103,24 +97,6 @@ static void visset_release(void *state)
     drop(s);
     rl_drawer_keep_release(&s->head.keep);
     free(s);
-}
-
-static rl_status make_property(const rl_scene *scene, const visset_key *k, int threads, rl_property **out)
-{
-    rl_property *p = NULL;
-    char res[32];
-    snprintf(res, sizeof res, "%u", k->resolution);
-    rl_status st = rl_property_create("visibility", &p);
-    if (st == RL_OK)
-        st = rl_property_set(p, "resolution", res);
-    if (st == RL_OK)
-        st = rl_property_commit(p, scene, threads > 0 ? threads : 0);
-    if (st != RL_OK) {
-        rl_property_release(p);
-        return st;
-    }
-    *out = p;
-    return RL_OK;
 }
 
 typedef struct ranked {
@@ -136,20 +112,19 @@ static int by_impact(const void *a, const void *b)
 }
 
 /* Budget mode: each leaf's set ordered by visible pixels at its centre. */
-static rl_status build_ranking(visset_state *s, const visset_key *k, const rl_scene *scene,
-                               const rl_scene_data *d, int threads)
+static rl_status build_ranking(visset_state *s, const rl_position_lookup *l, const rl_scene_data *d)
 {
-    rl_property *p = NULL;
-    rl_status st = make_property(scene, k, threads, &p);
-    if (st != RL_OK)
-        return st;
-    uint32_t nr = rl_approx_region_count(s->approx);
+    if (!l->object_pixels || !l->region_center)
+        return rl_error(RL_ERR_INVALID_ARG, "visset: budget > 0 needs the visible pixels per object, which the "
+                                            "lookup in input \"approx\" does not offer");
+    rl_status st = RL_OK;
+    uint32_t nr = l->num_regions;
     uint32_t *pixels = rl_calloc(d->num_objects, sizeof *pixels);
     ranked *tmp = rl_calloc(d->num_objects, sizeof *tmp);
     s->rank_offset = rl_calloc((size_t)nr + 1, sizeof *s->rank_offset);
     size_t total = 0;
     for (uint32_t i = 0; i < nr; ++i) {
-        const uint64_t *set = rl_approx_region_set(s->approx, i);
+        const uint64_t *set = l->region_set(l->user, i);
         for (uint32_t o = 0; set && o < d->num_objects; ++o)
             total += (set[o / 64] >> (o % 64)) & 1u;
     }
@@ -158,11 +133,8 @@ static rl_status build_ranking(visset_state *s, const visset_key *k, const rl_sc
         st = RL_ERR_OUT_OF_MEMORY;
     size_t at = 0;
     for (uint32_t i = 0; i < nr && st == RL_OK; ++i) {
-        rl_approx_region reg;
-        st = rl_approx_get_region(s->approx, i, &reg);
-        if (st == RL_OK)
-            st = rl_property_object_pixels(p, 0, rl_aabb_center(reg.box), pixels);
-        const uint64_t *set = rl_approx_region_set(s->approx, i);
+        st = l->object_pixels(l->user, l->region_center(l->user, i), pixels);
+        const uint64_t *set = l->region_set(l->user, i);
         uint32_t n = 0;
         for (uint32_t o = 0; st == RL_OK && set && o < d->num_objects; ++o)
             if ((set[o / 64] >> (o % 64)) & 1u)
@@ -176,74 +148,58 @@ static rl_status build_ranking(visset_state *s, const visset_key *k, const rl_sc
         s->rank_offset[nr] = at;
     free(pixels);
     free(tmp);
-    rl_property_release(p);
     return st;
 }
 
+/* The sets of input "approx", checked against the scene, and the
+ * per-object arrays; the ranking too in budget mode. Redone when the input
+ * or the scene changes. */
 static rl_status prepare(visset_state *s, rl_renderer *r, const rl_scene *scene, const rl_scene_data *d,
-                         bool budget, int threads)
+                         bool budget, const rl_position_lookup **out)
 {
-    visset_key k;
-    memset(&k, 0, sizeof k);
-    const char *path = rl_renderer_opt_string(r, "approx");
-    if (strlen(path) >= sizeof k.approx)
-        return rl_error(RL_ERR_INVALID_ARG, "visset: approx path longer than %zu characters",
-                        sizeof k.approx - 1);
-    strcpy(k.approx, path);
-    k.samples = (uint32_t)rl_renderer_opt_int(r, "samples");
-    k.resolution = (uint32_t)rl_renderer_opt_int(r, "resolution");
-    k.dims = (int)rl_renderer_opt_int(r, "dims");
-    k.height = (float)rl_renderer_opt_float(r, "height");
-    k.seed = (uint64_t)rl_renderer_opt_int(r, "seed");
-    k.scene_uid = rl_scene_uid(scene);
-    k.ranked = s->key.ranked;
-    if (s->approx && memcmp(&k, &s->key, sizeof k) == 0 && (!budget || s->key.ranked))
+    uint64_t generation;
+    const rl_position_lookup *l = rl_renderer_input(r, "approx", &generation);
+    if (!l)
+        return rl_error(RL_ERR_INVALID_ARG,
+                        "visset: no visible sets: load or sample them with rl_renderer_prepare_inputs() "
+                        "(rl_sampling.h; the rl tool does), or hand a lookup to input \"approx\"");
+    *out = l;
+    uint64_t uid = rl_scene_uid(scene);
+    bool same_sets = s->ready && s->generation == generation && s->scene_uid == uid;
+    if (same_sets && (!budget || s->ranked))
         return RL_OK;
 
     rl_timer t0;
     rl_timer_start(&t0);
-    bool same_sets = s->approx && memcmp(&k, &s->key, sizeof k) == 0;
-    rl_status st = RL_OK;
+    double input_ms = 0.0;
     if (!same_sets) {
         drop(s);
-        k.ranked = false;
+        if (l->set_size != d->num_objects || !l->region_set)
+            return rl_error(RL_ERR_INVALID_ARG,
+                            "visset: the approximation holds sets of %u objects, the scene has %u (is it the "
+                            "visibility property of this scene?)",
+                            l->set_size, d->num_objects);
         s->stamp = rl_calloc(d->num_objects, sizeof *s->stamp);
         s->draw = rl_calloc(d->num_objects ? d->num_objects : 1, sizeof *s->draw);
-        if (!s->stamp || !s->draw)
-            return RL_ERR_OUT_OF_MEMORY;
-        s->frame = 0;
-        if (k.approx[0]) {
-            st = rl_approx_load_json(k.approx, &s->approx);
-        } else {
-            rl_property *p = NULL;
-            st = make_property(scene, &k, threads, &p);
-            rl_sampling_desc sd = { .region = d->bounds, .dims = k.dims, .max_samples = k.samples,
-                                    .seed = k.seed };
-            sd.height = d->bounds.min.y + k.height;
-            if (st == RL_OK)
-                st = rl_sample_property(p, &sd, &s->approx);
-            rl_property_release(p);
-        }
-        if (st == RL_OK && rl_approx_set_size(s->approx) != d->num_objects)
-            st = rl_error(RL_ERR_INVALID_ARG,
-                          "visset: the approximation holds sets of %u objects, the scene has %u (is it the "
-                          "visibility property of this scene?)",
-                          rl_approx_set_size(s->approx), d->num_objects);
-        if (st != RL_OK) {
+        if (!s->stamp || !s->draw) {
             drop(s);
-            return st;
+            return RL_ERR_OUT_OF_MEMORY;
         }
+        s->frame = 0;
+        s->ready = true;
+        s->generation = generation;
+        s->scene_uid = uid;
+        input_ms = l->prepare_ms;   /* the first frame with these sets reports their making */
     }
     if (budget) {
-        st = build_ranking(s, &k, scene, d, threads);
+        rl_status st = build_ranking(s, l, d);
         if (st != RL_OK) {
             drop(s);
             return st;
         }
-        k.ranked = true;
+        s->ranked = true;
     }
-    s->key = k;
-    s->head.stats.preprocess_ms = rl_timer_ms(&t0);
+    s->head.stats.preprocess_ms = input_ms + rl_timer_ms(&t0);
     return RL_OK;
 }
 
@@ -279,9 +235,9 @@ static rl_status visset_render(rl_renderer *r, void *state, const rl_scene *scen
         return RL_ERR_NOT_COMMITTED;
     memset(&s->head.stats, 0, sizeof s->head.stats);
     s->head.have_frame = false;
-    const int threads = (int)rl_renderer_opt_int(r, "threads");
     const uint64_t budget = (uint64_t)rl_renderer_opt_int(r, "budget");
-    rl_status st = prepare(s, r, scene, d, budget > 0, threads);
+    const rl_position_lookup *l = NULL;
+    rl_status st = prepare(s, r, scene, d, budget > 0, &l);
     if (st != RL_OK)
         return st;
 
@@ -301,11 +257,9 @@ static rl_status visset_render(rl_renderer *r, void *state, const rl_scene *scen
     /* Inside the sampled region (2-D: its x-z extent)? Checked here so that
      * a viewer outside raises no error. */
     rl_vec3 e = f.cf.view.eye;
-    bool inside = rl_cull_approx_covers(s->approx, e);
     double ignored;
     uint32_t region = 0;
-    if (st == RL_OK && inside)
-        st = rl_approx_query(s->approx, e, &ignored, &region);
+    bool inside = l->query(l->user, e, &ignored, &region) && region < l->num_regions;
     if (st == RL_OK && !inside) {
         s->frames_outside++;
         for (uint32_t o = 0; o < d->num_objects && st == RL_OK; ++o)
@@ -314,7 +268,7 @@ static rl_status visset_render(rl_renderer *r, void *state, const rl_scene *scen
         for (uint64_t a = s->rank_offset[region]; a < s->rank_offset[region + 1] && st == RL_OK; ++a)
             st = draw_object(&f, s->rank_objects[a]);
     } else if (st == RL_OK) {
-        const uint64_t *set = rl_approx_region_set(s->approx, region);
+        const uint64_t *set = l->region_set(l->user, region);
         for (uint32_t o = 0; set && o < d->num_objects && st == RL_OK; ++o)
             if ((set[o / 64] >> (o % 64)) & 1u)
                 st = draw_object(&f, o);
@@ -339,4 +293,6 @@ const rl_renderer_class rl_visset_renderer_class = {
     .release = visset_release,
     .check = NULL,
     .reset = NULL,
+    .inputs = visset_inputs,
+    .num_inputs = sizeof visset_inputs / sizeof visset_inputs[0],
 };

@@ -6,6 +6,7 @@
 
 #include "rl/rl_render.h"
 #include "rl/rl_rng.h"
+#include "rl/rl_sampling.h"
 #include "rl/rl_scene.h"
 
 #include <stdlib.h>
@@ -22,13 +23,16 @@ static inline rl_renderer *fx_make(const char *name, const char *const *opts)
     return r;
 }
 
-/* One frame into a new image with the given layers (the camera's size). */
+/* One frame into a new image with the given layers (the camera's size),
+ * after the renderer's measured inputs are prepared as the CLI does. */
 static inline rl_image *fx_render_with(rl_renderer *r, const rl_scene *s, const rl_camera *cam,
                                        unsigned layers, rl_render_stats *stats)
 {
     rl_image *img = NULL;
     assert_int_equal(rl_image_create(cam->width, cam->height, layers, &img), RL_OK);
-    rl_status st = rl_renderer_render(r, s, cam, img, stats);
+    rl_status st = rl_renderer_prepare_inputs(r, s);
+    if (st == RL_OK)
+        st = rl_renderer_render(r, s, cam, img, stats);
     if (st != RL_OK)
         print_error("%s: %s\n", rl_renderer_name(r), rl_last_error());
     assert_int_equal(st, RL_OK);

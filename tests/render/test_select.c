@@ -186,7 +186,9 @@ static rl_status render_status(rl_renderer *r, const rl_scene *s)
     rl_image *img = NULL;
     assert_int_equal(rl_image_create(cam.width, cam.height, RL_LAYER_COLOR, &img), RL_OK);
     rl_clear_error();
-    rl_status st = rl_renderer_render(r, s, &cam, img, NULL);
+    rl_status st = rl_renderer_prepare_inputs(r, s);
+    if (st == RL_OK)
+        st = rl_renderer_render(r, s, &cam, img, NULL);
     rl_image_release(img);
     return st;
 }
@@ -210,13 +212,27 @@ static void test_select_refuses_bad_inputs_with_a_message(void **state)
     expect_refused(s, (const char *const[]){ "rule", "threshold", NULL }, "property=FILE");
     expect_refused(s, (const char *const[]){ "first", "nosuch", NULL }, "nosuch");
     expect_refused(s, (const char *const[]){ "second", "select", NULL }, "itself");
+    expect_refused(s, (const char *const[]){ "first", "visset", NULL }, "measured inputs");
+    /* The renderer refuses it too, when a caller skips the preparation. */
+    rl_renderer *r = fx_make("select", (const char *const[]){ "first", "visset", NULL });
+    rl_camera cam = at_x(20.0f);
+    rl_image *img = NULL;
+    assert_int_equal(rl_image_create(cam.width, cam.height, RL_LAYER_COLOR, &img), RL_OK);
+    rl_clear_error();
+    assert_int_equal(rl_renderer_render(r, s, &cam, img, NULL), RL_ERR_INVALID_ARG);
+    assert_non_null(strstr(rl_last_error(), "measured inputs"));
+    rl_image_release(img);
+    rl_renderer_release(r);
     expect_refused(s, (const char *const[]){ "first_time", "/no/such/approx.json", "second_time", p, NULL },
                    "/no/such/approx.json");
     expect_refused(s, (const char *const[]){ "first_time", p, "second_time", p, NULL }, "not time");
     rl_scene_release(s);
 }
 
-/* Without files the two times are sampled on the first frame and kept. */
+/* Without files the two times are sampled before the first frame
+ * (rl_renderer_prepare_inputs) and kept: preparing again for the same
+ * options and scene does nothing, and the first frame reports the
+ * sampling as preprocessing. */
 static void test_select_samples_the_times_itself(void **state)
 {
     (void)state;
@@ -228,6 +244,12 @@ static void test_select_samples_the_times_itself(void **state)
     assert_int_equal(rl_culling_get_stats(sel, &cs), RL_OK);
     assert_true(cs.selected == 1 || cs.selected == 2);
     assert_true(cs.preprocess_ms > 0.0);
+    const char *key = rl_renderer_input_key(sel, "first_time");
+    assert_non_null(key);
+    char before[1024];
+    snprintf(before, sizeof before, "%s", key);
+    assert_int_equal(rl_renderer_prepare_inputs(sel, s), RL_OK);
+    assert_string_equal(rl_renderer_input_key(sel, "first_time"), before);
     assert_int_equal(rl_renderer_render(sel, s, &cam, img, NULL), RL_OK);
     assert_int_equal(rl_culling_get_stats(sel, &cs), RL_OK);
     assert_true(cs.preprocess_ms == 0.0);   /* sampled once, and the same renderer drew */

@@ -121,9 +121,10 @@ static void test_visset_reads_the_evaluators_approximation(void **state)
     rl_camera cam = { .eye = rl_v3(0, 1, 3), .target = rl_v3(0, 1, 0), .width = 32, .height = 32 };
     rl_image *img = NULL;
     assert_int_equal(rl_image_create(32, 32, RL_LAYER_COLOR, &img), RL_OK);
+    assert_int_equal(rl_renderer_prepare_inputs(bad, other), RL_OK);
     assert_int_equal(rl_renderer_render(bad, other, &cam, img, NULL), RL_ERR_INVALID_ARG);
     assert_int_equal(rl_renderer_set(bad, "approx", "/nonexistent/approx.json"), RL_OK);
-    assert_int_not_equal(rl_renderer_render(bad, other, &cam, img, NULL), RL_OK);
+    assert_int_not_equal(rl_renderer_prepare_inputs(bad, other), RL_OK);
     rl_image_release(img);
     rl_renderer_release(bad);
     rl_scene_release(other);
@@ -142,9 +143,10 @@ static bool has_object(const rl_image *img, uint32_t id)
     return false;
 }
 
-static void test_visset_budget_draws_the_highest_impact_first(void **state)
+/* Three boxes of 12 triangles, small and far, medium, big and near, seen
+ * from the origin looking along +x; their object ids by size. */
+static rl_scene *three_boxes(uint32_t *small_out, uint32_t *medium_out, uint32_t *big_out)
 {
-    (void)state;
     uint32_t mat;
     rl_scene *s = fx_scene_with_material(&mat);
     fx_add_box(s, mat, rl_v3(9, 1, 6), rl_v3(9.5f, 1.5f, 6.5f), 1);       /* small, far */
@@ -156,12 +158,79 @@ static void test_visset_budget_draws_the_highest_impact_first(void **state)
     assert_int_equal(rl_scene_commit(s), RL_OK);
     const rl_scene_data *d = rl_scene_get_data(s);
     assert_int_equal(d->num_objects, 3);
-    uint32_t small = 0, medium = 0, big = 0;     /* object ids by their bounds */
     for (uint32_t o = 0; o < 3; ++o) {
         float x = d->objects[o].bounds.min.x;
-        *(x > 8 ? &small : x > 5 ? &medium : &big) = o;
+        *(x > 8 ? small_out : x > 5 ? medium_out : big_out) = o;
     }
+    return s;
+}
 
+static const rl_camera three_boxes_camera = { .eye = { 0.3f, 1.0f, -0.2f }, .target = { 5, 1, 0 },
+                                              .fov_deg = 110.0f, .width = 96, .height = 72 };
+
+/* A lookup of the test's own: one region everywhere whose set is fixed. */
+static int fixed_released;
+static bool fixed_query(void *user, rl_vec3 p, double *value, uint32_t *region)
+{
+    (void)user, (void)p;
+    *value = 0.0;
+    *region = 0;
+    return true;
+}
+static const uint64_t *fixed_set(void *user, uint32_t region)
+{
+    (void)region;
+    return user;
+}
+static void fixed_release(void *user)
+{
+    (void)user;
+    fixed_released++;
+}
+
+/* The renderer reads its sets only through the lookup (rl_render.h): one
+ * handed in by the caller, with no sampling anywhere, draws exactly its
+ * set; without one the frame is refused with a message that says how to
+ * get one; the renderer releases the lookup it owns. */
+static void test_visset_draws_a_lookup_of_its_own(void **state)
+{
+    (void)state;
+    uint32_t small = 0, medium = 0, big = 0;
+    rl_scene *s = three_boxes(&small, &medium, &big);
+    rl_camera cam = three_boxes_camera;
+    rl_renderer *r = fx_make("visset", NULL);
+    rl_image *img = NULL;
+    assert_int_equal(rl_image_create(cam.width, cam.height, FX_ALL_LAYERS, &img), RL_OK);
+    rl_clear_error();
+    assert_int_equal(rl_renderer_render(r, s, &cam, img, NULL), RL_ERR_INVALID_ARG);
+    assert_non_null(strstr(rl_last_error(), "no visible sets"));
+
+    static uint64_t set[1];
+    set[0] = (1ull << small) | (1ull << big);
+    rl_position_lookup l = { .user = set, .property = "visibility", .set_size = 3, .num_regions = 1,
+                             .query = fixed_query, .region_set = fixed_set, .release = fixed_release };
+    assert_int_equal(rl_renderer_set_input(r, "sets", &l, NULL), RL_ERR_INVALID_ARG);   /* unknown slot */
+    fixed_released = 0;
+    assert_int_equal(rl_renderer_set_input(r, "approx", &l, "mine"), RL_OK);
+    assert_string_equal(rl_renderer_input_key(r, "approx"), "mine");
+    assert_int_equal(rl_renderer_render(r, s, &cam, img, NULL), RL_OK);
+    assert_true(has_object(img, small) && has_object(img, big));
+    assert_false(has_object(img, medium));
+    /* Budgets need pixels per object, which this lookup does not offer. */
+    assert_int_equal(rl_renderer_set(r, "budget", "12"), RL_OK);
+    assert_int_equal(rl_renderer_render(r, s, &cam, img, NULL), RL_ERR_INVALID_ARG);
+    assert_int_equal(fixed_released, 0);
+    rl_renderer_release(r);
+    assert_int_equal(fixed_released, 1);
+    rl_image_release(img);
+    rl_scene_release(s);
+}
+
+static void test_visset_budget_draws_the_highest_impact_first(void **state)
+{
+    (void)state;
+    uint32_t small = 0, medium = 0, big = 0;
+    rl_scene *s = three_boxes(&small, &medium, &big);
     rl_property *p = NULL;
     assert_int_equal(rl_property_create("visibility", &p), RL_OK);
     assert_int_equal(rl_property_set(p, "resolution", "64"), RL_OK);
@@ -177,8 +246,7 @@ static void test_visset_budget_draws_the_highest_impact_first(void **state)
     rl_approx_release(a);
     rl_property_release(p);
 
-    rl_camera cam = { .eye = rl_v3(0.3f, 1.0f, -0.2f), .target = rl_v3(5, 1, 0), .fov_deg = 110.0f,
-                      .width = 96, .height = 72 };
+    rl_camera cam = three_boxes_camera;
     rl_image *ref = fx_render("raster", s, &cam, FX_ALL_LAYERS, NULL, NULL);
     assert_true(has_object(ref, small) && has_object(ref, medium) && has_object(ref, big));
     rl_image_release(ref);
@@ -201,6 +269,7 @@ int main(void)
         cmocka_unit_test(test_visset_draws_the_sampled_set),
         cmocka_unit_test(test_visset_reads_the_evaluators_approximation),
         cmocka_unit_test(test_visset_budget_draws_the_highest_impact_first),
+        cmocka_unit_test(test_visset_draws_a_lookup_of_its_own),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
