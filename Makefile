@@ -27,7 +27,7 @@ check: deps
 	@cd $(BUILD) && ctest --output-on-failure -j $(JOBS)
 	@echo "== ctest: ASan+UBSan Debug ($(BUILD_SAN)) =="
 	@cd $(BUILD_SAN) && ASAN_OPTIONS=detect_leaks=1 UBSAN_OPTIONS=print_stacktrace=1 \
-	    ctest --output-on-failure -j $(JOBS) -E '^bench/'
+	    ctest --output-on-failure -j $(JOBS)
 
 demo: deps build
 	@$(BUILD)/rl demo --out out/demo

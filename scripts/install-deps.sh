@@ -15,6 +15,7 @@ PACKAGES=(
   libcairo2-dev       # plots in evaluation reports (SVG, PNG)
   fonts-dejavu-core   # a font for plot labels
   assimp-testmodels   # real meshes for rl bench rays
+  python3             # the JSON checks of the CLI tests
 )
 
 missing=()

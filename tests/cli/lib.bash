@@ -7,6 +7,8 @@ rm -rf "$TMP"
 mkdir -p "$TMP"
 
 fail() { echo "FAIL: $*" >&2; exit 1; }
+# The JSON checks are Python: never skipped (scripts/install-deps.sh installs it).
+python3 -c 'import json' 2>/dev/null || fail "python3 with its json module is needed by the CLI tests"
 # run_ok CMD...: runs CMD, keeps its stdout/stderr in $TMP/out, $TMP/err.
 run_ok() {
     "$@" >"$TMP/out" 2>"$TMP/err" || fail "'$*' exited $?; stderr: $(head -c 400 "$TMP/err")"

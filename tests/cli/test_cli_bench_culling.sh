@@ -8,8 +8,6 @@
 set -u
 . "$(dirname "${BASH_SOURCE[0]}")/lib.bash"
 
-have_python() { command -v python3 >/dev/null 2>&1 && python3 -c 'import json' 2>/dev/null; }
-
 expect_usage_error "$RL" bench culling --samples 0 --out "$TMP/x.json"
 expect_usage_error "$RL" bench culling --max-depth 21 --out "$TMP/x.json"
 expect_usage_error "$RL" bench culling --select-quantile 1.5 --out "$TMP/x.json"
@@ -37,8 +35,7 @@ for s in "Sec. 7.2" "[300,400]" "Sec. 7.3" "best depth" "Sec. 7.4" "svs / chcpp"
     expect_in "$TMP/out" "$s"
 done
 
-if have_python; then
-    python3 - "$TMP/c.json" <<'PY' || fail "c.json does not hold a complete, sane record"
+python3 - "$TMP/c.json" <<'PY' || fail "c.json does not hold a complete, sane record"
 import json, sys
 r = json.load(open(sys.argv[1]))
 assert r["benchmark"] == "culling"
@@ -76,19 +73,16 @@ assert v["budget_time_ms"]["mean"] > 0 and 0 <= v["budget_hssim"]["min"] <= v["b
 # the svs section ran before, so visset is compared with its sampled time
 assert v["svs_sampled_time_mean_ms"] > 0, v
 PY
-fi
 
 # --extent widens the slice of Sec. 7.4-7.6 about the scene's centre: the
 # positions there see the scene from outside.
 expect_exit 0 "$RL" bench culling --quick --only svs --extent 3 --out "$TMP/e.json"
-if have_python; then
-    python3 - "$TMP/c.json" "$TMP/e.json" <<'PY' || fail "--extent is not applied"
+python3 - "$TMP/c.json" "$TMP/e.json" <<'PY' || fail "--extent is not applied"
 import json, sys
 a, b = (json.load(open(f)) for f in sys.argv[1:3])
 assert a["parameters"]["extent"] == 1 and b["parameters"]["extent"] == 3
 assert a["svs"]["visible_polygons"]["mean"] != b["svs"]["visible_polygons"]["mean"], (a["svs"], b["svs"])
 PY
-fi
 
 # --resume: the slice and every series measured on it are kept; a run that
 # stopped (here: series cut short or lost, as a kill would leave them)
@@ -104,8 +98,7 @@ expect_exit 0 "$RL" bench culling --quick --only svs --resume "$TMP/res" --out "
 expect_in "$TMP/err" "the slice sampled before"
 expect_in "$TMP/err" "svs triangles: 1 of"
 cmp -s "$TMP/res/svs-triangles.json" "$TMP/tri-full.json" && fail "the cut series was measured anew, not continued"
-if have_python; then
-    python3 - "$TMP/r1.json" "$TMP/r2.json" "$TMP/res/svs-triangles.json" "$TMP/tri-full.json" <<'PY' || fail "a resumed run differs"
+python3 - "$TMP/r1.json" "$TMP/r2.json" "$TMP/res/svs-triangles.json" "$TMP/tri-full.json" <<'PY' || fail "a resumed run differs"
 import json, sys
 a, b = (json.load(open(f))["svs"] for f in sys.argv[1:3])
 cut, full = (json.load(open(f))["values"] for f in sys.argv[3:5])
@@ -114,7 +107,6 @@ assert a["chcpp_triangles"] == b["chcpp_triangles"] and a["svs_ssim"] == b["svs_
 # the kept first value, then the rest measured as before
 assert len(cut) == len(full) and cut[0] == 1234.5 and cut[1:] == full[1:], (cut, full)
 PY
-fi
 # visset's series are named by their positions and budget (whose default
 # depends on whether the svs section ran), so a later run with the other
 # budget does not continue them.
@@ -136,13 +128,11 @@ expect_in "$TMP/err" "slice.json:2:1"
 grep -q "sampling polygons" "$TMP/err" && fail "a damaged slice was sampled over"
 
 expect_exit 0 "$RL" bench culling --quick --only depth --max-depth 1 -q --out "$TMP/d.json"
-if have_python; then
-    python3 - "$TMP/d.json" <<'PY' || fail "d.json is wrong"
+python3 - "$TMP/d.json" <<'PY' || fail "d.json is wrong"
 import json, sys
 r = json.load(open(sys.argv[1]))
 assert len(r["depth"]["depths"]) == 2 and "svs" not in r, r.keys()
 PY
-fi
 
 # --resume in the depth section: each depth's sampling is kept, a longer run
 # continues after the depths done (their noisy times come back unchanged),
@@ -156,14 +146,12 @@ expect_in "$TMP/err" "depth 0: sampled before"
 expect_in "$TMP/err" "depth 1: sampled before"
 [ -s "$TMP/dres/depth-2.json" ] || fail "--resume did not keep depth-2.json"
 ls "$TMP/dres" "$TMP/res" | grep -q '\.tmp$' && fail "a temporary file was left behind"
-if have_python; then
-    python3 - "$TMP/d1.json" "$TMP/d2.json" <<'PY' || fail "a resumed depth run differs"
+python3 - "$TMP/d1.json" "$TMP/d2.json" <<'PY' || fail "a resumed depth run differs"
 import json, sys
 a, b = (json.load(open(f))["depth"]["depths"] for f in sys.argv[1:3])
 assert len(a) == 2 and len(b) == 3, (a, b)
 assert a == b[:2], (a, b[:2])
 PY
-fi
 echo 'not json' >"$TMP/dres/depth-1.json"
 expect_exit 1 "$RL" bench culling --quick --only depth --max-depth 1 --resume "$TMP/dres" --out "$TMP/d3.json"
 echo "ok"

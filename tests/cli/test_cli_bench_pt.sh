@@ -7,8 +7,6 @@
 set -u
 . "$(dirname "${BASH_SOURCE[0]}")/lib.bash"
 
-have_python() { command -v python3 >/dev/null 2>&1 && python3 -c 'import json' 2>/dev/null; }
-
 expect_usage_error "$RL" bench pt --ref-spp 0 --out "$TMP/x.json"
 expect_usage_error "$RL" bench pt --spp-max many --out "$TMP/x.json"
 expect_usage_error "$RL" bench pt --size 0x0 --out "$TMP/x.json"
@@ -35,8 +33,7 @@ for s in generation scenes diffuse shadow error accumulation ls-pnmt shadowmap k
 done
 expect_in "$TMP/err" "bench pt: wrote"
 
-if have_python; then
-    python3 - "$TMP/pt.json" <<'PY' || fail "pt.json does not hold a complete, sane record"
+python3 - "$TMP/pt.json" <<'PY' || fail "pt.json does not hold a complete, sane record"
 import json, sys
 r = json.load(open(sys.argv[1]))
 assert r["benchmark"] == "pt"
@@ -133,11 +130,9 @@ for f in a["filters"]:
 none1 = a["filters"][0]["points"][0]["rmse"]
 assert a["filters"][2]["points"][0]["rmse"] < none1, a["filters"]
 PY
-fi
 
 expect_exit 0 "$RL" bench pt --quick --only generation --builds 3 --small-pages -q --out "$TMP/o.json"
-if have_python; then
-    python3 - "$TMP/o.json" <<'PY' || fail "o.json is wrong"
+python3 - "$TMP/o.json" <<'PY' || fail "o.json is wrong"
 import json, sys
 r = json.load(open(sys.argv[1]))
 assert "generation" in r and "scenes" not in r and "error" not in r
@@ -147,7 +142,6 @@ for x in r["generation"]["rows"]:
     runs = x["ls_ms_runs"]
     assert len(runs) == 3 and all(t > 0 for t in runs) and x["ls_ms"] == min(runs), x
 PY
-fi
 expect_exit 2 "$RL" bench pt --quick --builds 0
 expect_in "$TMP/err" "--builds"
 expect_exit 2 "$RL" bench pt --quick --builds 101

@@ -31,8 +31,7 @@ done
 [ "$(grep -c ' ms, ' "$TMP/out")" -eq "$n" ] || fail "expected $n image lines: $(cat "$TMP/out")"
 [ "$(ls "$DIR"/*.png | wc -l)" -eq "$n" ] || fail "expected exactly $n PNGs in $DIR"
 [ ! -e "$DIR/city-raster.png" ] || fail "--scenes did not restrict the demo"
-if command -v python3 >/dev/null 2>&1; then
-    python3 - "$DIR/report.json" "$n" <<'PY' || fail "report.json is not the expected JSON"
+python3 - "$DIR/report.json" "$n" <<'PY' || fail "report.json is not the expected JSON"
 import json, sys
 r = json.load(open(sys.argv[1]))
 assert len(r["images"]) == int(sys.argv[2]), len(r["images"])
@@ -43,6 +42,5 @@ for e in r["images"]:
 assert r["machine"]["nproc"] >= 1 and r["date"]
 assert r["failures"] == []
 PY
-fi
 grep -q "processors" "$DIR/index.html" || fail "index.html lacks the machine"
 echo "ok"

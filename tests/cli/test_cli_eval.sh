@@ -7,8 +7,6 @@
 set -u
 . "$(dirname "${BASH_SOURCE[0]}")/lib.bash"
 
-have_python() { command -v python3 >/dev/null 2>&1 && python3 -c 'import json' 2>/dev/null; }
-
 # --- bad usage: nothing is sampled, nothing is written ---
 expect_usage_error "$RL" eval cornell --out "$TMP/e"
 expect_error 2 "no scene" "$RL" eval --property visibility
@@ -58,8 +56,7 @@ done
 [ "$(grep -o '<svg' "$TMP/vis/report.html" | wc -l)" -ge 4 ] || fail "the eval report lacks plots"
 grep -q "<script" "$TMP/vis/report.html" && fail "the report must not need scripts"
 grep -Eq '(src|href)="https?:' "$TMP/vis/report.html" && fail "the report must be self-contained"
-if have_python; then
-    python3 - "$TMP/vis/eval.json" "$TMP/vis/approx.json" <<'PY' || fail "eval.json/approx.json are not sane"
+python3 - "$TMP/vis/eval.json" "$TMP/vis/approx.json" <<'PY' || fail "eval.json/approx.json are not sane"
 import json, sys
 e = json.load(open(sys.argv[1]))
 a = json.load(open(sys.argv[2]))
@@ -69,43 +66,36 @@ assert 0 < s["min"] <= s["median"] <= s["max"] <= 8, s      # cornell has 8 obje
 assert e["validation"]["points"] == 20 and e["validation"]["abs_error"]["mean"] >= 0
 assert a["format"] == "renderlab-approx" and len(a["samples"]) == 48
 PY
-fi
 
 # A shifted grid: the flag reaches the sampler and both records.
 run_ok "$RL" eval cornell --property visibility --set resolution=16 --method grid --grid-shift \
     --samples 16 --seed 4 --out "$TMP/shift"
-if have_python; then
-    python3 - "$TMP/shift/eval.json" "$TMP/shift/approx.json" <<'PY' || fail "--grid-shift is not applied"
+python3 - "$TMP/shift/eval.json" "$TMP/shift/approx.json" <<'PY' || fail "--grid-shift is not applied"
 import json, sys
 e = json.load(open(sys.argv[1]))
 a = json.load(open(sys.argv[2]))
 assert a["desc"]["grid_shift"] is True and e["sampling"]["grid_shift"] is True, (a["desc"], e["sampling"])
 PY
-fi
 
 # Queries: idw with 4 neighbours by default, the count and the other
 # interpolations reach the sampler and both records.
-if have_python; then
-    python3 - "$TMP/vis/eval.json" "$TMP/vis/approx.json" <<'PY' || fail "the default queries are not idw"
+python3 - "$TMP/vis/eval.json" "$TMP/vis/approx.json" <<'PY' || fail "the default queries are not idw"
 import json, sys
 e = json.load(open(sys.argv[1]))
 a = json.load(open(sys.argv[2]))
 assert a["desc"]["interpolation"] == "idw" and a["desc"]["idw_neighbors"] == 4, a["desc"]
 assert e["sampling"]["interpolation"] == "idw" and e["sampling"]["idw_neighbors"] == 4, e["sampling"]
 PY
-fi
 run_ok "$RL" eval cornell --property visibility --set resolution=16 --samples 16 --idw-neighbors 7 \
     --validate 8 --out "$TMP/idw7"
 run_ok "$RL" eval cornell --property visibility --set resolution=16 --samples 16 --interp nearest \
     --validate 8 --out "$TMP/near"
-if have_python; then
-    python3 - "$TMP/idw7/approx.json" "$TMP/near/approx.json" <<'PY' || fail "--idw-neighbors/--interp are not applied"
+python3 - "$TMP/idw7/approx.json" "$TMP/near/approx.json" <<'PY' || fail "--idw-neighbors/--interp are not applied"
 import json, sys
 a, b = (json.load(open(f)) for f in sys.argv[1:3])
 assert a["desc"]["interpolation"] == "idw" and a["desc"]["idw_neighbors"] == 7, a["desc"]
 assert b["desc"]["interpolation"] == "nearest", b["desc"]
 PY
-fi
 
 # 3-D, grid method, an image-quality property of two renderers
 run_ok "$RL" eval cornell --property quality --set renderer=raster --set reference=whitted \
@@ -126,8 +116,7 @@ run_ok "$RL" eval cornell --property ops --set renderer=whitted --set counter=ra
     --set height=16 --samples 8 --method grid --out "$TMP/comb-a"
 run_ok "$RL" eval cornell --property ops --set renderer=whitted --set counter=shadow_rays --set width=16 \
     --set height=16 --samples 8 --method grid --out "$TMP/comb-b"
-if have_python; then
-    python3 - "$TMP/comb" "$TMP/comb-a" "$TMP/comb-b" <<'PY' || fail "--property2 is not applied"
+python3 - "$TMP/comb" "$TMP/comb-a" "$TMP/comb-b" <<'PY' || fail "--property2 is not applied"
 import json, sys
 e = json.load(open(sys.argv[1] + "/eval.json"))
 p = e["property"]
@@ -139,7 +128,6 @@ for sc, sa, sb in zip(c, a, b):   # [x, y, z, value]
     assert sc[:3] == sa[:3] == sb[:3], (sc, sa, sb)
     assert sc[3] == sa[3] - sb[3] and sb[3] > 0, (sc, sa, sb)
 PY
-fi
 
 # --- rl compare ---
 expect_usage_error "$RL" compare cornell --out "$TMP/c"
@@ -159,8 +147,7 @@ for title in "Rendering time" "Traced rays" "Rasterized triangles" "Occlusion qu
     expect_in "$TMP/c/report.html" "$title"
 done
 [ "$(grep -o '<svg' "$TMP/c/report.html" | wc -l)" -ge 20 ] || fail "the compare report lacks plots"
-if have_python; then
-    python3 - "$TMP/c/compare.json" <<'PY' || fail "compare.json is not sane"
+python3 - "$TMP/c/compare.json" <<'PY' || fail "compare.json is not sane"
 import json, sys
 c = json.load(open(sys.argv[1]))
 names = [r["renderer"] for r in c["renderers"]]
@@ -175,7 +162,6 @@ assert raster["queries"]["max"] == 0 and chcpp["queries"]["min"] > 0     # CHC++
 assert ls["rays"]["min"] > 0
 assert whitted["rays"]["min"] > 0 and whitted["quality"]["min"] > 0.999   # whitted is the reference
 PY
-fi
 
 # The Ch. 7 recipes of docs/culling.md in miniature: Sec. 7.5, the times of
 # chcpp and svs sampled by rl eval, then select reading them beside both;
@@ -189,8 +175,7 @@ run_ok "$RL" compare cornell --algos chcpp,svs:resolution=32,select:first_time="
 run_ok "$RL" eval cornell --property visibility --set resolution=16 --samples 16 --out "$TMP/vis16"
 run_ok "$RL" compare cornell --algos visset:approx="$TMP/vis16/approx.json",chcpp --reference raster \
     --size 24x24 --samples 8 --repeats 1 --resolution 16 --out "$TMP/visset"
-if have_python; then
-    python3 - "$TMP/select/compare.json" "$TMP/visset/compare.json" <<'PY' || fail "the Ch. 7 recipes are not sane"
+python3 - "$TMP/select/compare.json" "$TMP/visset/compare.json" <<'PY' || fail "the Ch. 7 recipes are not sane"
 import json, sys
 sel = json.load(open(sys.argv[1]))["renderers"]
 assert [r["renderer"].split(":")[0] for r in sel] == ["chcpp", "svs", "select"], sel
@@ -199,7 +184,6 @@ vis = json.load(open(sys.argv[2]))["renderers"]
 assert vis[1]["quality"]["min"] == 1.0, vis[1]          # chcpp is conservative
 assert 0 < vis[0]["quality"]["min"] <= 1.0 and vis[0]["triangles"]["min"] > 0, vis
 PY
-fi
 
 # --- rl bench sampling ---
 expect_usage_error "$RL" bench sampling --only nosuch --out "$TMP/b.json"
@@ -210,8 +194,7 @@ expect_error 2 "expected a number" "$RL" bench sampling --samples-per-meter nan 
 expect_usage_error "$RL" bench sampling --repeats 0 --out "$TMP/b.json"
 run_ok "$RL" bench sampling --quick --out "$TMP/b.json"
 for s in variants convergence throughput grid-idw bn-corners; do expect_in "$TMP/out" "$s"; done
-if have_python; then
-    python3 - "$TMP/b.json" <<'PY' || fail "bench sampling JSON is not complete"
+python3 - "$TMP/b.json" <<'PY' || fail "bench sampling JSON is not complete"
 import json, sys
 r = json.load(open(sys.argv[1]))
 for s in ("variants", "convergence", "throughput"):
@@ -225,12 +208,10 @@ assert r["throughput"]["rows"][0]["samples_per_second"] > 0
 assert "machine" in r
 assert r["parameters"]["samples_base"] == 5 and r["parameters"]["samples_per_meter"] == 0.05
 PY
-fi
 # --samples-base reaches the adaptive variants but not the grid or the
 # thesis' bnc-region.
 run_ok "$RL" bench sampling --quick --only variants --samples-base 12 --out "$TMP/b12.json"
-if have_python; then
-    python3 - "$TMP/b.json" "$TMP/b12.json" <<'PY' || fail "--samples-base is not applied as documented"
+python3 - "$TMP/b.json" "$TMP/b12.json" <<'PY' || fail "--samples-base is not applied as documented"
 import json, sys
 a, b = (json.load(open(f)) for f in sys.argv[1:3])
 assert b["parameters"]["samples_base"] == 12
@@ -240,12 +221,10 @@ for x, y in zip(ca, cb):
     assert err(x, "grid") == err(y, "grid") and err(x, "bnc-region") == err(y, "bnc-region"), (x, y)
 assert any(err(x, "bn-corners") != err(y, "bn-corners") for x, y in zip(ca, cb))
 PY
-fi
 # --repeats: grid~, bn (the target) and bn-corners over seeds 1..R, their
 # mean compared; seed 1 is the run without repeats, the rest untouched.
 run_ok "$RL" bench sampling --quick --only variants --repeats 3 --out "$TMP/b3.json"
-if have_python; then
-    python3 - "$TMP/b.json" "$TMP/b3.json" <<'PY' || fail "--repeats is not applied as documented"
+python3 - "$TMP/b.json" "$TMP/b3.json" <<'PY' || fail "--repeats is not applied as documented"
 import json, sys
 a, b = (json.load(open(f)) for f in sys.argv[1:3])
 assert b["parameters"]["repeats"] == 3
@@ -266,5 +245,4 @@ assert r["cases_met"] == sum(c["adaptive_no_worse_than_grid"] for c in r["cases"
 assert r["cases_met_thesis_grid"] == sum(c["adaptive_no_worse_than_thesis_grid"] for c in r["cases"])
 assert r["cases_met_shifted_grid"] == sum(c["adaptive_no_worse_than_shifted_grid"] for c in r["cases"])
 PY
-fi
 echo "ok"
