@@ -8,19 +8,14 @@
  * triangle that spans several cells may thus be hit beyond the current cell;
  * such a hit is kept but the walk goes on, and it stops only at the first
  * cell whose exit lies at or beyond the best hit: every triangle that could
- * be hit closer overlaps a cell visited by then. Ties at equal t go to the lower triangle
- * ID, as in the brute-force reference (accel.c). Re-testing a triangle in a
- * later cell cannot change the result (the bound only shrinks), so the small
- * per-ray mailbox on the stack only saves time. */
+ * be hit closer overlaps a cell visited by then. Each cell's list is tested
+ * by tri_list.h (mailbox, ties to the lower triangle ID). */
 #include <math.h>
 #include <string.h>
 
 #include "accel/accel_internal.h"
 #include "accel/grid.h"
-#include "accel/watertight.h"
-
-/* Direct-mapped per-ray mailbox of recently tested triangle IDs. */
-#define MAILBOX_SIZE 16
+#include "accel/tri_list.h"
 /* Relative rounding allowance on ray parameters: t computed by the walk and
  * t computed by the triangle test differ by a few ulps of the origin's
  * distance (grows with that distance; see grid.h). */
@@ -163,46 +158,28 @@ static bool grid_intersect(const void *state, rl_ray *ray, rl_hit *hit)
         return false;
     rl_ray_watertight w;
     rl_ray_watertight_setup(ray, &w);
-    uint32_t mailbox[MAILBOX_SIZE];
-    memset(mailbox, 0xff, sizeof mailbox);
-    uint32_t best = RL_ID_NONE;
-    float best_t = ray->t_max, best_u = 0.0f, best_v = 0.0f;
-    /* Once there is a hit, test one ulp past its t so that an equal t with
-     * a lower ID (the tie rule) is still reported. */
+    rl_mailbox mailbox;
+    rl_mailbox_init(&mailbox);
+    rl_tri_closest best = { RL_ID_NONE, ray->t_max, 0.0f, 0.0f };
     float limit = ray->t_max;
     uint32_t cell;
     float t_enter, t_exit;
     while (rl_grid_dda_next(&it, &cell, &t_enter, &t_exit)) {
-        for (uint32_t j = g->cell_start[cell], end = g->cell_start[cell + 1]; j < end; ++j) {
-            uint32_t id = g->cell_tris[j];
-            uint32_t *box = &mailbox[id & (MAILBOX_SIZE - 1)];
-            if (*box == id)
-                continue;
-            *box = id;
-            const rl_vec3 *v = g->tri_verts + 3 * (size_t)id;
-            float t, u, vv;
-            if (!rl_watertight_hit(&w, v[0], v[1], v[2], ray->t_min, limit, &t, &u, &vv))
-                continue;
-            if (best == RL_ID_NONE || t < best_t || (t == best_t && id < best)) {
-                best = id;
-                best_t = t;
-                best_u = u;
-                best_v = vv;
-                limit = nextafterf(best_t, INFINITY);
-            }
-        }
+        uint32_t first = g->cell_start[cell];
+        rl_tri_list_closest(g->tri_verts, g->cell_tris + first, g->cell_start[cell + 1] - first, &w, ray->t_min,
+                            &mailbox, &best, &limit);
         /* Done once the best hit lies inside the cells walked so far; the
          * margin hands hits within rounding of the exit to the next cell. */
-        if (best != RL_ID_NONE && best_t <= t_exit - T_SLACK_REL * fabsf(t_exit))
+        if (best.id != RL_ID_NONE && best.t <= t_exit - T_SLACK_REL * fabsf(t_exit))
             break;
     }
-    if (best == RL_ID_NONE)
+    if (best.id == RL_ID_NONE)
         return false;
-    ray->t_max = best_t;
-    hit->t = best_t;
-    hit->u = best_u;
-    hit->v = best_v;
-    hit->triangle = best;
+    ray->t_max = best.t;
+    hit->t = best.t;
+    hit->u = best.u;
+    hit->v = best.v;
+    hit->triangle = best.id;
     return true;
 }
 
@@ -214,22 +191,16 @@ static bool grid_occluded(const void *state, const rl_ray *ray)
         return false;
     rl_ray_watertight w;
     rl_ray_watertight_setup(ray, &w);
-    uint32_t mailbox[MAILBOX_SIZE];
-    memset(mailbox, 0xff, sizeof mailbox);
+    rl_mailbox mailbox;
+    rl_mailbox_init(&mailbox);
     uint32_t cell;
     float t_enter, t_exit;
-    while (rl_grid_dda_next(&it, &cell, &t_enter, &t_exit))
-        for (uint32_t j = g->cell_start[cell], end = g->cell_start[cell + 1]; j < end; ++j) {
-            uint32_t id = g->cell_tris[j];
-            uint32_t *box = &mailbox[id & (MAILBOX_SIZE - 1)];
-            if (*box == id)
-                continue;
-            *box = id;
-            const rl_vec3 *v = g->tri_verts + 3 * (size_t)id;
-            float t, u, vv;
-            if (rl_watertight_hit(&w, v[0], v[1], v[2], ray->t_min, ray->t_max, &t, &u, &vv))
-                return true;
-        }
+    while (rl_grid_dda_next(&it, &cell, &t_enter, &t_exit)) {
+        uint32_t first = g->cell_start[cell];
+        if (rl_tri_list_any(g->tri_verts, g->cell_tris + first, g->cell_start[cell + 1] - first, &w, ray->t_min,
+                            ray->t_max, &mailbox))
+            return true;
+    }
     return false;
 }
 

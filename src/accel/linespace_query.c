@@ -47,10 +47,9 @@
 #include <string.h>
 
 #include "accel/linespace_internal.h"
-#include "accel/watertight.h"
+#include "accel/tri_list.h"
 #include "core/half.h"
 
-#define MAILBOX_SIZE 16
 #define T_SLACK_REL 1e-6f          /* as grid.c: walk vs triangle-test rounding */
 #define ORIGIN_MARGIN_REL 0.1f     /* PREILLUM, origin voxel: of the voxel diagonal */
 
@@ -145,57 +144,17 @@ static tri_list candidates(const rl_linespace *ls, uint32_t cell, uint32_t block
     return l;
 }
 
-typedef struct closest {
-    uint32_t id;
-    float t, u, v;
-} closest;
-
-/* Tests a list (RL_NONE slots skipped) against the whole ray within
- * (t_min, limit); keeps the closest, ties to the lower ID (grid.c). */
+/* A candidate list against the whole ray (tri_list.h). */
 static void test_list(const rl_linespace *ls, const rl_ray_watertight *w, const rl_ray *ray, tri_list l,
-                      uint32_t *mailbox, closest *best, float *limit)
+                      rl_mailbox *mailbox, rl_tri_closest *best, float *limit)
 {
-    const rl_vec3 *verts = ls->grid->tri_verts;
-    for (uint32_t j = 0; j < l.count; ++j) {
-        uint32_t id = l.ids[j];
-        if (id == RL_NONE)
-            continue;
-        uint32_t *box = &mailbox[id & (MAILBOX_SIZE - 1)];
-        if (*box == id)
-            continue;
-        *box = id;
-        const rl_vec3 *v = verts + 3 * (size_t)id;
-        float t, u, vv;
-        if (!rl_watertight_hit(w, v[0], v[1], v[2], ray->t_min, *limit, &t, &u, &vv))
-            continue;
-        if (best->id == RL_NONE || t < best->t || (t == best->t && id < best->id)) {
-            best->id = id;
-            best->t = t;
-            best->u = u;
-            best->v = vv;
-            *limit = nextafterf(t, INFINITY);
-        }
-    }
+    rl_tri_list_closest(ls->grid->tri_verts, l.ids, l.count, w, ray->t_min, mailbox, best, limit);
 }
 
 static bool any_hit(const rl_linespace *ls, const rl_ray_watertight *w, const rl_ray *ray, tri_list l,
-                    uint32_t *mailbox, float t_max)
+                    rl_mailbox *mailbox, float t_max)
 {
-    const rl_vec3 *verts = ls->grid->tri_verts;
-    for (uint32_t j = 0; j < l.count; ++j) {
-        uint32_t id = l.ids[j];
-        if (id == RL_NONE)
-            continue;
-        uint32_t *box = &mailbox[id & (MAILBOX_SIZE - 1)];
-        if (*box == id)
-            continue;
-        *box = id;
-        const rl_vec3 *v = verts + 3 * (size_t)id;
-        float t, u, vv;
-        if (rl_watertight_hit(w, v[0], v[1], v[2], ray->t_min, t_max, &t, &u, &vv))
-            return true;
-    }
-    return false;
+    return rl_tri_list_any(ls->grid->tri_verts, l.ids, l.count, w, ray->t_min, t_max, mailbox);
 }
 
 bool rl_linespace_intersect(const rl_linespace *ls, rl_ray *ray, rl_hit *hit)
@@ -213,9 +172,9 @@ bool rl_linespace_intersect(const rl_linespace *ls, rl_ray *ray, rl_hit *hit)
     cell_line_setup(ls, ray, &line);
     rl_ray_watertight w;
     rl_ray_watertight_setup(ray, &w);
-    uint32_t mailbox[MAILBOX_SIZE];
-    memset(mailbox, 0xff, sizeof mailbox);
-    closest best = { RL_NONE, ray->t_max, 0.0f, 0.0f };
+    rl_mailbox mailbox;
+    rl_mailbox_init(&mailbox);
+    rl_tri_closest best = { RL_NONE, ray->t_max, 0.0f, 0.0f };
     float limit = ray->t_max;
     uint32_t cell;
     float t0, t1;
@@ -225,7 +184,7 @@ bool rl_linespace_intersect(const rl_linespace *ls, rl_ray *ray, rl_hit *hit)
             bool fwd;
             uint32_t shaft = shaft_of_ray(ls, it.current, &line, &fwd);
             if (shaft == RL_NONE || rl_ls_shaft_occupied(ls, block, shaft))
-                test_list(ls, &w, ray, candidates(ls, cell, block, shaft, false), mailbox, &best, &limit);
+                test_list(ls, &w, ray, candidates(ls, cell, block, shaft, false), &mailbox, &best, &limit);
         }
         if (best.id != RL_NONE && best.t <= t1 - T_SLACK_REL * fabsf(t1))
             break;
@@ -252,8 +211,8 @@ bool rl_linespace_occluded(const rl_linespace *ls, const rl_ray *ray)
     cell_line_setup(ls, ray, &line);
     rl_ray_watertight w;
     rl_ray_watertight_setup(ray, &w);
-    uint32_t mailbox[MAILBOX_SIZE];
-    memset(mailbox, 0xff, sizeof mailbox);
+    rl_mailbox mailbox;
+    rl_mailbox_init(&mailbox);
     uint32_t cell;
     float t0, t1;
     while (rl_grid_dda_next(&it, &cell, &t0, &t1)) {
@@ -264,7 +223,7 @@ bool rl_linespace_occluded(const rl_linespace *ls, const rl_ray *ray)
         uint32_t shaft = shaft_of_ray(ls, it.current, &line, &fwd);
         if (shaft != RL_NONE && !rl_ls_shaft_occupied(ls, block, shaft))
             continue;
-        if (any_hit(ls, &w, ray, candidates(ls, cell, block, shaft, false), mailbox, ray->t_max))
+        if (any_hit(ls, &w, ray, candidates(ls, cell, block, shaft, false), &mailbox, ray->t_max))
             return true;
     }
     return false;
@@ -301,11 +260,11 @@ static bool origin_hit(const rl_linespace *ls, const rl_ray *ray, uint32_t cell,
 {
     rl_ray_watertight w;
     rl_ray_watertight_setup(ray, &w);
-    uint32_t mailbox[MAILBOX_SIZE];
-    memset(mailbox, 0xff, sizeof mailbox);
+    rl_mailbox mailbox;
+    rl_mailbox_init(&mailbox);
     float limit = rl_minf(ray->t_max, t1 + T_SLACK_REL * fabsf(t1));
-    closest best = { RL_NONE, limit, 0.0f, 0.0f };
-    test_list(ls, &w, ray, candidates(ls, cell, block, shaft, true), mailbox, &best, &limit);
+    rl_tri_closest best = { RL_NONE, limit, 0.0f, 0.0f };
+    test_list(ls, &w, ray, candidates(ls, cell, block, shaft, true), &mailbox, &best, &limit);
     if (best.id == RL_NONE)
         return false;
     if (s) {
