@@ -3,7 +3,6 @@
 
 #include <cjson/cJSON.h>
 #include <math.h>
-#include <omp.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -398,51 +397,7 @@ rl_status rl_eval_measure(rl_property *p, const rl_vec3 *pos, size_t count, doub
     rl_progress *progress = NULL;
     if (progress_label && rl_log_get_level() >= RL_LOG_INFO)
         rl_progress_create(progress_label, stderr, &progress);
-    int workers = rl_property_workers(p);
-    if (rl_property_get_flags(p) & RL_PROPERTY_EXCLUSIVE)
-        workers = 1;
-    rl_status st = RL_OK;
-    size_t done = 0;
-    if (workers <= 1) {
-        /* One position at a time (always for times), outside any parallel
-         * region: inside one, even of a single thread, the renderer's own
-         * parallel regions are nested, and libgomp starts nested teams far
-         * more slowly: chcpp on `city` (128², 2 threads) took 15.8 instead
-         * of 5.7 ms per frame so, svs 35.8 instead of 30.2. Until 2026-12-05
-         * every time of `rl bench culling` and `rl eval` was measured so
-         * (when renderers drew most objects on one thread, which cost less:
-         * chcpp 7.9 instead of 7.1 ms, svs 54.5 instead of 54.2). */
-        for (size_t i = 0; i < count && st == RL_OK; i++) {
-            rl_property_sample sample = { 0 };
-            st = rl_property_evaluate(p, 0, pos[i], &sample);
-            v[i] = sample.value;
-            if (progress)
-                rl_progress_update(progress, (double)(i + 1) / (double)count);
-        }
-    } else {
-#pragma omp parallel for num_threads(workers) schedule(dynamic, 1)
-        for (size_t i = 0; i < count; i++) {
-            rl_status s;
-#pragma omp atomic read
-            s = st;
-            if (s != RL_OK)
-                continue;
-            rl_property_sample sample = { 0 };
-            s = rl_property_evaluate(p, omp_get_thread_num(), pos[i], &sample);
-            v[i] = sample.value;
-            if (s != RL_OK) {
-#pragma omp critical(rl_eval_measure_status)
-                if (st == RL_OK)
-                    st = s;
-            }
-#pragma omp critical(rl_eval_measure_progress)
-            {
-                done++;
-                if (progress)
-                    rl_progress_update(progress, (double)done / (double)count);
-            }
-        }
-    }
+    rl_status st = rl_property_measure(p, pos, count, v, progress ? rl_progress_update : NULL, progress);
     if (progress)
         rl_progress_finish(progress);
     if (st != RL_OK) {

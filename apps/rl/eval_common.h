@@ -55,8 +55,8 @@ char *rl_eval_heatmap_svg(const rl_approx *a, float height, const rl_image *top,
 /* Uniform random positions in the sampled region (2-D: on the slice),
  * seeded; malloc'd, count entries. */
 rl_vec3 *rl_eval_random_positions(const rl_approx *a, size_t count, uint64_t seed);
-/* Evaluates p at every position with all its workers (serially for an
- * exclusive property); values malloc'd. progress_label may be NULL. */
+/* rl_property_measure into a malloc'd array, with a progress bar named
+ * progress_label (NULL: none). */
 rl_status rl_eval_measure(rl_property *p, const rl_vec3 *pos, size_t count, double **values,
                           const char *progress_label);
 

@@ -261,6 +261,18 @@ typedef struct rl_approx_region {
 
 RL_API rl_status rl_sample_property(rl_property *p, const rl_sampling_desc *desc,
                                     rl_approx **out);
+/* Measures the committed property p at count given positions, values[i]
+ * at pos[i], as rl_sample_property measures its samples: exclusive
+ * properties (times, RL_PROPERTY_EXCLUSIVE) one position at a time on the
+ * calling thread outside any parallel region, the others on the property's
+ * workers; a value does not depend on which worker measured it. progress
+ * (may be NULL) is called on the calling thread with the fraction done;
+ * returning false cancels (RL_ERR_CANCELLED). On failure the status and
+ * message of the first failing position (a worker's message is moved to
+ * the calling thread); values are then partly written. RL_ERR_INVALID_ARG
+ * (NULL arguments), RL_ERR_NOT_COMMITTED. */
+RL_API rl_status rl_property_measure(rl_property *p, const rl_vec3 *pos, size_t count, double *values,
+                                     rl_progress_fn progress, void *user);
 RL_API void rl_approx_release(rl_approx *a);                 /* NULL is a no-op */
 
 RL_API int rl_approx_dims(const rl_approx *a);

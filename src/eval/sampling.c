@@ -163,7 +163,7 @@ static rl_status evaluate_one(rl_property *p, int worker, rl_vec3 pos, double *v
  * lowest failing index seen, with the worker's message moved to this
  * thread. */
 static rl_status evaluate_batch(rl_property *p, int workers, bool exclusive, const rl_vec3 *pos, uint32_t n,
-                                batch *b, size_t words)
+                                double *values, uint64_t *sets, size_t words)
 {
     if (n == 0)
         return RL_OK;
@@ -171,7 +171,7 @@ static rl_status evaluate_batch(rl_property *p, int workers, bool exclusive, con
         /* RL_PROPERTY_EXCLUSIVE (timings): one position at a time, since the
          * property itself uses all threads and concurrency would distort it. */
         for (uint32_t i = 0; i < n; ++i) {
-            rl_status st = evaluate_one(p, 0, pos[i], &b->values[i], words ? b->sets + (size_t)i * words : NULL);
+            rl_status st = evaluate_one(p, 0, pos[i], &values[i], words ? sets + (size_t)i * words : NULL);
             if (st != RL_OK)
                 return st;
         }
@@ -195,7 +195,7 @@ static rl_status evaluate_batch(rl_property *p, int workers, bool exclusive, con
          * ours, cleared so that a failure's message is its own. */
         if (!caller)
             rl_clear_error();
-        rl_status st = evaluate_one(p, worker, pos[i], &b->values[i], words ? b->sets + (size_t)i * words : NULL);
+        rl_status st = evaluate_one(p, worker, pos[i], &values[i], words ? sets + (size_t)i * words : NULL);
         if (st != RL_OK) {
 #pragma omp critical(rl_sampling_fail)
             {
@@ -216,6 +216,31 @@ static rl_status evaluate_batch(rl_property *p, int workers, bool exclusive, con
     if (!message_here)
         rl_error(fail_status, "%s", fail_message[0] ? fail_message : rl_status_string(fail_status));
     return fail_status;
+}
+
+rl_status rl_property_measure(rl_property *p, const rl_vec3 *pos, size_t count, double *values,
+                              rl_progress_fn progress, void *user)
+{
+    if (!p || (count && (!pos || !values)))
+        return rl_error(RL_ERR_INVALID_ARG, "rl_property_measure: property, positions and values must not be NULL");
+    int workers = rl_property_workers(p);
+    if (workers < 1)
+        return rl_error(RL_ERR_NOT_COMMITTED, "rl_property_measure: property \"%s\" is not committed",
+                        rl_property_name(p));
+    bool exclusive = rl_property_get_flags(p) & RL_PROPERTY_EXCLUSIVE;
+    /* Batches of a few positions per worker: progress between them, on the
+     * calling thread; exclusive properties one position at a time. */
+    size_t chunk = exclusive || workers <= 1 ? 1 : (size_t)workers * 8;
+    for (size_t i = 0; i < count;) {
+        uint32_t n = (uint32_t)(count - i < chunk ? count - i : chunk);
+        rl_status st = evaluate_batch(p, workers, exclusive, pos + i, n, values + i, NULL, 0);
+        if (st != RL_OK)
+            return st;
+        i += n;
+        if (progress && !progress(user, (double)i / (double)count))
+            return rl_error(RL_ERR_CANCELLED, "rl_property_measure: cancelled after %zu of %zu positions", i, count);
+    }
+    return RL_OK;
 }
 
 /* ---- regular sampling (Sec. 5.3, Alg. 5.2) ---- */
@@ -341,7 +366,7 @@ static rl_status run_grid(rl_property *p, const rl_sampling_desc *d, int workers
         uint32_t n = cells - c0 < per_batch ? cells - c0 : per_batch;
         st = batch_reserve(&b, n, a->set_words);
         if (st == RL_OK)
-            st = evaluate_batch(p, workers, exclusive, pos + c0, n, &b, a->set_words);
+            st = evaluate_batch(p, workers, exclusive, pos + c0, n, b.values, b.sets, a->set_words);
         for (uint32_t i = 0; i < n && st == RL_OK; ++i) {
             uint32_t s = rl_approx_add_sample(a, pos[c0 + i], b.values[i],
                                               a->set_words ? b.sets + (size_t)i * a->set_words : NULL);
@@ -597,7 +622,8 @@ static rl_status evaluate_pending(adaptive *ad, rl_property *p, int workers, boo
 {
     rl_status st = batch_reserve(&ad->b, ad->s.pending_count, ad->s.a->set_words);
     if (st == RL_OK)
-        st = evaluate_batch(p, workers, exclusive, ad->s.pending, ad->s.pending_count, &ad->b, ad->s.a->set_words);
+        st = evaluate_batch(p, workers, exclusive, ad->s.pending, ad->s.pending_count, ad->b.values, ad->b.sets,
+                            ad->s.a->set_words);
     if (st == RL_OK)
         st = commit_batch(ad);
     return st;

@@ -1180,6 +1180,53 @@ static void test_a_failing_property_fails_the_run(void **state)
     rl_property_release(p);
 }
 
+/* rl_property_measure gives each position its own value for any worker
+ * count, reports progress up to 1 and cancels when asked; failures carry
+ * the failing position's status and a message on the calling thread. */
+static void test_measure_gives_each_position_its_value(void **state)
+{
+    (void)state;
+    enum { N = 100 };
+    rl_vec3 pos[N];
+    for (int i = 0; i < N; ++i)
+        pos[i] = (rl_vec3){ 0.37f * (float)i, 0.11f * (float)(i % 7), 5.0f - 0.05f * (float)i };
+    for (int w = 1; w <= 3; w += 2) {
+        fn_prop fp = { .f = f_wave };
+        rl_property *p = make_property(&fp, w, 0);
+        double v[N];
+        progress_log log = { .cancel_after = 1000000, .monotone = true };
+        assert_int_equal(rl_property_measure(p, pos, N, v, on_progress, &log), RL_OK);
+        for (int i = 0; i < N; ++i)
+            assert_true(v[i] == f_wave(pos[i]));
+        assert_int_equal(atomic_load(&fp.calls), N);
+        assert_true(log.calls >= 1 && log.monotone && log.last == 1.0);
+        progress_log stop = { .cancel_after = 1, .monotone = true };
+        assert_int_equal(rl_property_measure(p, pos, N, v, on_progress, &stop), RL_ERR_CANCELLED);
+        assert_true(atomic_load(&fp.calls) < 2 * N);
+        assert_int_equal(rl_property_measure(p, pos, 0, NULL, NULL, NULL), RL_OK);
+        assert_int_equal(rl_property_measure(p, NULL, N, v, NULL, NULL), RL_ERR_INVALID_ARG);
+        assert_int_equal(rl_property_measure(NULL, pos, N, v, NULL, NULL), RL_ERR_INVALID_ARG);
+        rl_property_release(p);
+    }
+    rl_property *raw = NULL;
+    fn_prop fp = { .f = f_x };
+    rl_property_callbacks cb = { .name = "fn", .evaluate = fn_evaluate };
+    assert_int_equal(rl_property_create_custom(&cb, &fp, &raw), RL_OK);
+    double v[N];
+    assert_int_equal(rl_property_measure(raw, pos, N, v, NULL, NULL), RL_ERR_NOT_COMMITTED);
+    rl_property_release(raw);
+
+    rl_property *bad = NULL;
+    rl_property_callbacks fcb = { .name = "failing", .evaluate = failing_evaluate };
+    assert_int_equal(rl_property_create_custom(&fcb, NULL, &bad), RL_OK);
+    assert_int_equal(rl_property_commit(bad, NULL, 3), RL_OK);
+    rl_clear_error();
+    assert_int_equal(rl_property_measure(bad, pos, N, v, NULL, NULL), RL_ERR_UNSUPPORTED);
+    assert_true(strlen(rl_last_error()) > 0);
+    rl_clear_error();
+    rl_property_release(bad);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -1207,6 +1254,7 @@ int main(void)
         cmocka_unit_test(test_blue_noise_with_corners_stays_fast_at_4096_samples),
         cmocka_unit_test(test_bad_input_is_refused_with_the_documented_status),
         cmocka_unit_test(test_a_failing_property_fails_the_run),
+        cmocka_unit_test(test_measure_gives_each_position_its_value),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
