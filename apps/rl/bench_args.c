@@ -9,15 +9,15 @@
 #include <stdlib.h>
 #include <string.h>
 
-static bool parse_real(const rl_bench_opt *o, const char *text)
+static bool parse_real(const bench_opt *o, const char *text)
 {
     char *end = NULL;
     double x = strtod(text, &end);
     if (!*text || *end || !isfinite(x) || x < o->lo || (o->lo_open && x <= o->lo) || x > o->hi) {
         if (o->expect)
-            rl_cli_fail(RL_CLI_USAGE, "%s: expected %s, got '%s'", o->name, o->expect, text);
+            cli_fail(RL_CLI_USAGE, "%s: expected %s, got '%s'", o->name, o->expect, text);
         else
-            rl_cli_fail(RL_CLI_USAGE, "%s: expected a number in [%g, %g], got '%s'", o->name,
+            cli_fail(RL_CLI_USAGE, "%s: expected a number in [%g, %g], got '%s'", o->name,
                         o->lo, o->hi, text);
         return false;
     }
@@ -26,11 +26,11 @@ static bool parse_real(const rl_bench_opt *o, const char *text)
 }
 
 /* Stores text per the row's kind; false when the error is printed. */
-static bool take(const rl_bench_opt *o, const char *text)
+static bool take(const bench_opt *o, const char *text)
 {
     switch (o->kind) {
     case RL_BENCH_OPT_COUNT:
-        return rl_bench_parse_count(o->name, text, o->max, o->count);
+        return bench_parse_count(o->name, text, o->max, o->count);
     case RL_BENCH_OPT_REAL:
         return parse_real(o, text);
     case RL_BENCH_OPT_STRING:
@@ -38,9 +38,9 @@ static bool take(const rl_bench_opt *o, const char *text)
         *o->string = text;
         return true;
     case RL_BENCH_OPT_SIZE:
-        return rl_cli_parse_size(text, o->width, o->height);
+        return cli_parse_size(text, o->width, o->height);
     case RL_BENCH_OPT_SECTIONS:
-        return rl_bench_parse_sections(text, o->names, o->num_names, o->sections);
+        return bench_parse_sections(text, o->names, o->num_names, o->sections);
     case RL_BENCH_OPT_CUSTOM:
         return o->parse(o->ctx, text);
     case RL_BENCH_OPT_FLAG:
@@ -51,17 +51,17 @@ static bool take(const rl_bench_opt *o, const char *text)
 
 /* The row argv[*i] names: 1 when taken (*i past its value), 0 when no row
  * matches, -1 on a usage error (printed). */
-static int match(int argc, char **argv, int *i, const rl_bench_opt *rows, int count)
+static int match(int argc, char **argv, int *i, const bench_opt *rows, int count)
 {
     for (int r = 0; r < count; r++) {
-        const rl_bench_opt *o = &rows[r];
+        const bench_opt *o = &rows[r];
         if (o->kind == RL_BENCH_OPT_FLAG) {
             if (strcmp(argv[*i], o->name) != 0)
                 continue;
             *o->flag = true;
         } else {
             const char *v = NULL;
-            int m = rl_cli_take_value(argc, argv, i, o->name, &v);
+            int m = cli_take_value(argc, argv, i, o->name, &v);
             if (m == 0)
                 continue;
             if (m < 0 || !take(o, v))
@@ -74,11 +74,11 @@ static int match(int argc, char **argv, int *i, const rl_bench_opt *rows, int co
     return 0;
 }
 
-int rl_bench_parse_args(int argc, char **argv, const char *command, const char *help,
-                        const rl_bench_opt *rows, int count)
+int bench_parse_args(int argc, char **argv, const char *command, const char *help,
+                        const bench_opt *rows, int count)
 {
     for (int i = 2; i < argc; i++) {
-        if (rl_cli_is_help(argv[i])) {
+        if (cli_is_help(argv[i])) {
             fputs(help, stdout);
             return RL_BENCH_HELP_SHOWN;
         }
@@ -86,12 +86,12 @@ int rl_bench_parse_args(int argc, char **argv, const char *command, const char *
         if (m < 0)
             return RL_CLI_USAGE;
         if (m == 0)
-            return rl_cli_unknown_arg(command, argv[i]);
+            return cli_unknown_arg(command, argv[i]);
     }
     for (int r = 0; r < count; r++) {
         const char *out = rows[r].kind == RL_BENCH_OPT_OUT ? *rows[r].string : NULL;
-        if (out && !rl_cli_has_extension(out, (const char *const[]){ ".json", NULL }))
-            return rl_cli_fail(RL_CLI_USAGE, "%s: '%s' should end in .json", rows[r].name, out);
+        if (out && !cli_has_extension(out, (const char *const[]){ ".json", NULL }))
+            return cli_fail(RL_CLI_USAGE, "%s: '%s' should end in .json", rows[r].name, out);
     }
     return RL_CLI_OK;
 }

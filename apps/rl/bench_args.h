@@ -1,10 +1,10 @@
 /* bench_args.h: the option parser every `rl bench` subcommand shares.
  *
  * A subcommand describes its options as a table of rows (name, kind, where
- * the value goes, an optional "was given" flag) and calls rl_bench_parse_args
+ * the value goes, an optional "was given" flag) and calls bench_parse_args
  * once. The parser walks argv from index 2 (argv[0] "bench", argv[1] the
  * benchmark), matches "--name VALUE" and "--name=VALUE" with
- * rl_cli_take_value, and checks each value as it comes, so the first bad
+ * cli_take_value, and checks each value as it comes, so the first bad
  * argument is the one reported. Defaults, including those that depend on
  * --quick, stay with the caller: the parser only writes what was given. */
 #ifndef RL_APP_BENCH_ARGS_H
@@ -12,20 +12,20 @@
 
 #include <stdbool.h>
 
-typedef enum rl_bench_opt_kind {
+typedef enum bench_opt_kind {
     RL_BENCH_OPT_FLAG,      /* no value: *flag = true */
-    RL_BENCH_OPT_COUNT,     /* whole number in 1..max (rl_bench_parse_count) */
+    RL_BENCH_OPT_COUNT,     /* whole number in 1..max (bench_parse_count) */
     RL_BENCH_OPT_REAL,      /* finite number in lo..hi */
     RL_BENCH_OPT_STRING,    /* *string points into argv */
     RL_BENCH_OPT_OUT,       /* like STRING; must end in .json (checked after all options) */
-    RL_BENCH_OPT_SIZE,      /* "WxH" (rl_cli_parse_size) into *width, *height */
-    RL_BENCH_OPT_SECTIONS,  /* --only: names[0..count-1] as bits (rl_bench_parse_sections) */
+    RL_BENCH_OPT_SIZE,      /* "WxH" (cli_parse_size) into *width, *height */
+    RL_BENCH_OPT_SECTIONS,  /* --only: names[0..count-1] as bits (bench_parse_sections) */
     RL_BENCH_OPT_CUSTOM,    /* parse(ctx, value); false when it printed the error */
-} rl_bench_opt_kind;
+} bench_opt_kind;
 
-typedef struct rl_bench_opt {
+typedef struct bench_opt {
     const char *name;               /* "--threads" */
-    rl_bench_opt_kind kind;
+    bench_opt_kind kind;
     bool *set;                      /* optional: true once the option was given */
     /* The destination of the row's kind (one of these). */
     bool *flag;
@@ -48,7 +48,7 @@ typedef struct rl_bench_opt {
     /* CUSTOM */
     bool (*parse)(void *ctx, const char *value);
     void *ctx;
-} rl_bench_opt;
+} bench_opt;
 
 /* Rows for the common kinds; anything else is written out with designated
  * initializers. */
@@ -73,9 +73,9 @@ typedef struct rl_bench_opt {
 
 /* Parses argv[2..argc-1] against rows[0..count-1]. -h/--help prints help to
  * stdout and returns RL_BENCH_HELP_SHOWN; an unknown argument is reported by
- * rl_cli_unknown_arg(command, ...), a missing or bad value with one error
+ * cli_unknown_arg(command, ...), a missing or bad value with one error
  * line; both return RL_CLI_USAGE. Returns RL_CLI_OK otherwise. */
-int rl_bench_parse_args(int argc, char **argv, const char *command, const char *help,
-                        const rl_bench_opt *rows, int count);
+int bench_parse_args(int argc, char **argv, const char *command, const char *help,
+                        const bench_opt *rows, int count);
 
 #endif

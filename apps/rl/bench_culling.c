@@ -60,7 +60,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#define note(...) (fflush(stdout), rl_bench_note("culling", __VA_ARGS__))
+#define note(...) (fflush(stdout), bench_note("culling", __VA_ARGS__))
 
 static const char bench_culling_help[] =
     "usage: rl bench culling [options]\n"
@@ -133,7 +133,7 @@ typedef struct bc_ctx {
     uint32_t npos;
     double chcpp_triangles_mean;
     rl_approx *time_chcpp, *time_svs;   /* the svs section's sampled times, for select */
-    rl_bench_resume *resume;      /* --resume: NULL without */
+    bench_resume *resume;      /* --resume: NULL without */
     const char *frames;           /* measured and conditioning frames of the time property */
     char reason[512];
 } bc_ctx;
@@ -163,7 +163,7 @@ static rl_status region_stats(const rl_approx *driver, const double *values, rl_
     rl_status st = rl_approx_with_values(driver, values, "v", "", &a);
     double *v = NULL, *w = NULL;
     size_t n = 0;
-    if (st == RL_OK && !rl_eval_leaf_series(a, &v, &w, &n))
+    if (st == RL_OK && !eval_leaf_series(a, &v, &w, &n))
         st = RL_ERR_OUT_OF_MEMORY;
     if (st == RL_OK)
         st = rl_stats_compute(v, w, n, out);
@@ -175,7 +175,7 @@ static rl_status region_stats(const rl_approx *driver, const double *values, rl_
 
 static cJSON *stats_json(const rl_stats *s)
 {
-    return rl_eval_stats_json(s);
+    return eval_stats_json(s);
 }
 
 /* The time property's options for one renderer: conditioned (Jähn 2015, Sec.
@@ -240,7 +240,7 @@ static rl_status sec_surfels(void *ctx, cJSON *sec)
             rl_property *pt = NULL;
             st = make_property(c, "time", TIME_KV("surfels", opts[k]), &pt);
             if (st == RL_OK)
-                st = rl_eval_measure(pt, pos, n, &values, "surfels time");
+                st = eval_measure(pt, pos, n, &values, "surfels time");
             if (st == RL_OK)
                 st = region_stats(driver, values, &t);
             free(values);
@@ -253,7 +253,7 @@ static rl_status sec_surfels(void *ctx, cJSON *sec)
         if (st == RL_OK)
             st = make_property(c, "quality", q_kv, &pq);
         if (st == RL_OK)
-            st = rl_eval_measure(pq, pos, n, &values, "surfels quality");
+            st = eval_measure(pq, pos, n, &values, "surfels quality");
         if (st == RL_OK)
             st = region_stats(driver, values, &q);
         free(values);
@@ -265,7 +265,7 @@ static rl_status sec_surfels(void *ctx, cJSON *sec)
         if (st == RL_OK)
             st = make_property(c, "ops", prim_kv, &pp);
         if (st == RL_OK)
-            st = rl_eval_measure(pp, pos, n, &values, "surfels primitives");
+            st = eval_measure(pp, pos, n, &values, "surfels primitives");
         if (st == RL_OK)
             st = region_stats(driver, values, &prim);
         free(values);
@@ -302,10 +302,10 @@ static rl_status depth_sampled(bc_ctx *c, int depth, const rl_aabb *region, cons
     char name[32];
     snprintf(name, sizeof name, "depth-%d.json", depth);
     *out = NULL;
-    rl_status st = c->resume ? rl_bench_resume_load_approx(c->resume, name, out) : RL_OK;
+    rl_status st = c->resume ? bench_resume_load_approx(c->resume, name, out) : RL_OK;
     if (st != RL_OK || *out) {
         if (*out)
-            note("depth %d: sampled before (%s)", depth, rl_bench_resume_path(c->resume, name));
+            note("depth %d: sampled before (%s)", depth, bench_resume_path(c->resume, name));
         return st;
     }
     rl_property *p = NULL;
@@ -317,7 +317,7 @@ static rl_status depth_sampled(bc_ctx *c, int depth, const rl_aabb *region, cons
         st = rl_sample_property(p, &sd, out);
     }
     rl_property_release(p);
-    if (st == RL_OK && c->resume && !rl_bench_resume_save_approx(c->resume, name, *out)) {
+    if (st == RL_OK && c->resume && !bench_resume_save_approx(c->resume, name, *out)) {
         rl_approx_release(*out);
         *out = NULL;
         st = RL_ERR_IO;
@@ -346,7 +346,7 @@ static rl_status sec_depth(void *ctx, cJSON *sec)
         double *v = NULL, *w = NULL;
         size_t n = 0;
         rl_stats s;
-        if (st == RL_OK && !rl_eval_leaf_series(a, &v, &w, &n))
+        if (st == RL_OK && !eval_leaf_series(a, &v, &w, &n))
             st = RL_ERR_OUT_OF_MEMORY;
         if (st == RL_OK)
             st = rl_stats_compute(v, w, n, &s);
@@ -374,7 +374,7 @@ static rl_status sec_depth(void *ctx, cJSON *sec)
     }
     printf("best depth %d, mean %.2f ms (thesis, Power Plant: depth 5, 9.9 ms)\n", best, best_mean);
     cJSON_AddNumberToObject(sec, "best_depth", best);
-    rl_bench_add_num(sec, "best_mean_ms", best_mean);
+    bench_add_num(sec, "best_mean_ms", best_mean);
     cJSON_AddNumberToObject(sec, "thesis_best_depth", 5);
     cJSON_AddNumberToObject(sec, "thesis_best_mean_ms", 9.9);
     return RL_OK;
@@ -398,12 +398,12 @@ static rl_status ensure_driver(bc_ctx *c)
     if (c->driver)
         return RL_OK;
     /* --resume: the slice of an earlier run with the same options. */
-    rl_status st = c->resume ? rl_bench_resume_load_approx(c->resume, "slice.json", &c->driver) : RL_OK;
+    rl_status st = c->resume ? bench_resume_load_approx(c->resume, "slice.json", &c->driver) : RL_OK;
     if (st != RL_OK)
         return st;
     if (c->driver) {
         note("polygons in visible objects: the slice sampled before (%s)",
-             rl_bench_resume_path(c->resume, "slice.json"));
+             bench_resume_path(c->resume, "slice.json"));
         return driver_positions(c);
     }
     char res[32];
@@ -429,7 +429,7 @@ static rl_status ensure_driver(bc_ctx *c)
         st = rl_sample_property(vis, &sd, &c->driver);
     }
     rl_property_release(vis);
-    if (st == RL_OK && c->resume && !rl_bench_resume_save_approx(c->resume, "slice.json", c->driver))
+    if (st == RL_OK && c->resume && !bench_resume_save_approx(c->resume, "slice.json", c->driver))
         st = RL_ERR_IO;
     if (st != RL_OK)
         return st;
@@ -448,11 +448,11 @@ static rl_status measure_resumable(bc_ctx *c, rl_property *p, const char *label,
     snprintf(name + k, sizeof name - k, ".json");
     double *v = NULL;
     size_t done = 0;
-    if (!rl_bench_resume_load(c->resume, name, &v, &done))
+    if (!bench_resume_load(c->resume, name, &v, &done))
         return RL_ERR_IO;
     if (done > npos) {
         free(v);
-        note("%s holds %zu values for %u positions", rl_bench_resume_path(c->resume, name), done, npos);
+        note("%s holds %zu values for %u positions", bench_resume_path(c->resume, name), done, npos);
         return RL_ERR_IO;
     }
     double *all = realloc(v, (npos ? npos : 1) * sizeof *all);
@@ -468,11 +468,11 @@ static rl_status measure_resumable(bc_ctx *c, rl_property *p, const char *label,
         double *block = NULL;
         char what[160];
         snprintf(what, sizeof what, "%s (%zu-%zu of %u)", label, done + 1, done + n, npos);
-        st = rl_eval_measure(p, pos + done, n, &block, what);
+        st = eval_measure(p, pos + done, n, &block, what);
         if (st == RL_OK) {
             memcpy(all + done, block, n * sizeof *block);
             done += n;
-            if (!rl_bench_resume_save(c->resume, name, all, done))
+            if (!bench_resume_save(c->resume, name, all, done))
                 st = RL_ERR_IO;
         }
         free(block);
@@ -494,7 +494,7 @@ static rl_status measure_at(bc_ctx *c, const char *label, const char *name, cons
     rl_status st = make_property(c, name, kv, &p);
     if (st == RL_OK)
         st = c->resume ? measure_resumable(c, p, label, pos, npos, values)
-                       : rl_eval_measure(p, pos, npos, values, label);
+                       : eval_measure(p, pos, npos, values, label);
     rl_property_release(p);
     return st;
 }
@@ -545,7 +545,7 @@ static rl_status sec_svs(void *ctx, cJSON *sec)
     rl_stats vis, t_chc, t_svs, tri_chc, tri_svs, q_svs;
     double *dv = NULL, *dw = NULL;
     size_t dn = 0;
-    if (!rl_eval_leaf_series(c->driver, &dv, &dw, &dn))
+    if (!eval_leaf_series(c->driver, &dv, &dw, &dn))
         return RL_ERR_OUT_OF_MEMORY;
     st = rl_stats_compute(dv, dw, dn, &vis);
     free(dv);
@@ -581,7 +581,7 @@ static rl_status sec_svs(void *ctx, cJSON *sec)
     table_row("svs triangles (max of 6 dirs)", &tri_svs, "7.1 M");
     table_row("svs SSIM vs raster (min of 6 dirs)", &q_svs, "not measured");
     printf("svs / chcpp: time %.2f (thesis 0.33), triangles %.2f (thesis 0.47)\n",
-           rl_bench_ratio(t_svs.mean, t_chc.mean), rl_bench_ratio(tri_svs.mean, tri_chc.mean));
+           bench_ratio(t_svs.mean, t_chc.mean), bench_ratio(tri_svs.mean, tri_chc.mean));
     cJSON_AddNumberToObject(sec, "positions", c->npos);
     cJSON_AddItemToObject(sec, "visible_polygons", stats_json(&vis));
     cJSON_AddItemToObject(sec, "chcpp_time_ms", stats_json(&t_chc));
@@ -589,8 +589,8 @@ static rl_status sec_svs(void *ctx, cJSON *sec)
     cJSON_AddItemToObject(sec, "chcpp_triangles", stats_json(&tri_chc));
     cJSON_AddItemToObject(sec, "svs_triangles", stats_json(&tri_svs));
     cJSON_AddItemToObject(sec, "svs_ssim", stats_json(&q_svs));
-    rl_bench_add_num(sec, "time_ratio_svs_chcpp", rl_bench_ratio(t_svs.mean, t_chc.mean));
-    rl_bench_add_num(sec, "triangle_ratio_svs_chcpp", rl_bench_ratio(tri_svs.mean, tri_chc.mean));
+    bench_add_num(sec, "time_ratio_svs_chcpp", bench_ratio(t_svs.mean, t_chc.mean));
+    bench_add_num(sec, "triangle_ratio_svs_chcpp", bench_ratio(tri_svs.mean, tri_chc.mean));
     return RL_OK;
 }
 
@@ -622,7 +622,7 @@ static rl_status sec_select(void *ctx, cJSON *sec)
     /* The threshold: a quantile of the sampled polygons in visible objects. */
     double *dv = NULL, *dw = NULL, threshold = 0.0;
     size_t dn = 0;
-    if (!rl_eval_leaf_series(c->driver, &dv, &dw, &dn))
+    if (!eval_leaf_series(c->driver, &dv, &dw, &dn))
         return RL_ERR_OUT_OF_MEMORY;
     st = rl_stats_quantiles(dv, dw, dn, &c->a->select_quantile, 1, &threshold);
     free(dv);
@@ -630,7 +630,7 @@ static rl_status sec_select(void *ctx, cJSON *sec)
     if (st != RL_OK)
         return st;
     const size_t n = (size_t)c->a->select_positions;
-    rl_vec3 *pos = rl_eval_random_positions(c->driver, n, (uint64_t)c->a->seed + 75);
+    rl_vec3 *pos = eval_random_positions(c->driver, n, (uint64_t)c->a->seed + 75);
     rl_renderer *chc = NULL, *svs = NULL;
     rl_image *img = NULL;
     /* Per position: the sampled times pick chcpp (the same pick judges
@@ -711,13 +711,13 @@ static rl_status sec_select(void *ctx, cJSON *sec)
         rl_property *tp = NULL;
         st = make_property(c, "time", TIME_KV("chcpp", ""), &tp);
         if (st == RL_OK)
-            st = rl_eval_measure(tp, pos, n, &pc6, "select chcpp time");
+            st = eval_measure(tp, pos, n, &pc6, "select chcpp time");
         rl_property_release(tp);
         tp = NULL;
         if (st == RL_OK)
             st = make_property(c, "time", TIME_KV("svs", svs_options(c)), &tp);
         if (st == RL_OK)
-            st = rl_eval_measure(tp, pos, n, &ps6, "select svs time");
+            st = eval_measure(tp, pos, n, &ps6, "select svs time");
         rl_property_release(tp);
         for (size_t i = 0; i < n && st == RL_OK; ++i) {
             sum_c6 += pc6[i];
@@ -758,25 +758,25 @@ static rl_status sec_select(void *ctx, cJSON *sec)
         printf("selection by sampled time beats both on the time property: %s\n", beats6 ? "yes" : "NO");
     }
     cJSON_AddNumberToObject(sec, "positions", (double)n);
-    rl_bench_add_num(sec, "threshold_visible_polygons", threshold);
+    bench_add_num(sec, "threshold_visible_polygons", threshold);
     cJSON_AddNumberToObject(sec, "quantile", c->a->select_quantile);
-    rl_bench_add_num(sec, "chcpp_mean_ms", sum_c / (double)n);
-    rl_bench_add_num(sec, "svs_mean_ms", sum_s / (double)n);
-    rl_bench_add_num(sec, "selected_mean_ms", sum_sel / (double)n);
+    bench_add_num(sec, "chcpp_mean_ms", sum_c / (double)n);
+    bench_add_num(sec, "svs_mean_ms", sum_s / (double)n);
+    bench_add_num(sec, "selected_mean_ms", sum_sel / (double)n);
     cJSON_AddNumberToObject(sec, "high_occlusion_positions", (double)high);
-    rl_bench_add_num(sec, "high_chcpp_mean_ms", high ? hc / (double)high : NAN);
-    rl_bench_add_num(sec, "high_svs_mean_ms", high ? hs / (double)high : NAN);
-    rl_bench_add_num(sec, "high_selected_mean_ms", high ? hsel / (double)high : NAN);
+    bench_add_num(sec, "high_chcpp_mean_ms", high ? hc / (double)high : NAN);
+    bench_add_num(sec, "high_svs_mean_ms", high ? hs / (double)high : NAN);
+    bench_add_num(sec, "high_selected_mean_ms", high ? hsel / (double)high : NAN);
     cJSON_AddBoolToObject(sec, "selection_beats_both", beats);
     if (timed == n) {
-        rl_bench_add_num(sec, "time_selected_mean_ms", sum_tsel / (double)n);
+        bench_add_num(sec, "time_selected_mean_ms", sum_tsel / (double)n);
         cJSON_AddNumberToObject(sec, "time_selected_chcpp", (double)picked_chcpp);
         cJSON_AddBoolToObject(sec, "time_selection_beats_both", tbeats);
     }
     if (six) {
-        rl_bench_add_num(sec, "property_chcpp_mean_ms", sum_c6 / (double)n);
-        rl_bench_add_num(sec, "property_svs_mean_ms", sum_s6 / (double)n);
-        rl_bench_add_num(sec, "property_time_selected_mean_ms", sum_sel6 / (double)n);
+        bench_add_num(sec, "property_chcpp_mean_ms", sum_c6 / (double)n);
+        bench_add_num(sec, "property_svs_mean_ms", sum_s6 / (double)n);
+        bench_add_num(sec, "property_time_selected_mean_ms", sum_sel6 / (double)n);
         cJSON_AddNumberToObject(sec, "property_time_selected_chcpp", (double)picked_chcpp);
         cJSON_AddBoolToObject(sec, "property_time_selection_beats_both", beats6);
     }
@@ -797,7 +797,7 @@ static rl_status sec_visset(void *ctx, cJSON *sec)
      * 4096 samples that file holds 7.6 MB), else a copy beside --out. */
     char path[1200], opts[1400], size[32];
     if (c->resume)
-        snprintf(path, sizeof path, "%s", rl_bench_resume_path(c->resume, "slice.json"));
+        snprintf(path, sizeof path, "%s", bench_resume_path(c->resume, "slice.json"));
     else
         snprintf(path, sizeof path, "%s/culling-visset-approx.json", c->dir);
     if (strchr(path, ',')) {
@@ -824,7 +824,7 @@ static rl_status sec_visset(void *ctx, cJSON *sec)
      * positions of the slice (their plain mean estimates the area mean),
      * and hierarchical SSIM, the thesis' metric for Fig. 7.11. */
     const uint32_t n = (uint32_t)c->a->visset_positions;
-    rl_vec3 *pos = rl_eval_random_positions(c->driver, n, (uint64_t)c->a->seed + 76);
+    rl_vec3 *pos = eval_random_positions(c->driver, n, (uint64_t)c->a->seed + 76);
     if (!pos)
         return RL_ERR_OUT_OF_MEMORY;
     const char *const q_kv[] = { "renderer", "visset", "renderer_options", opts, "reference", "raster",
@@ -882,7 +882,7 @@ static rl_status sec_visset(void *ctx, cJSON *sec)
         if (svs_ok)
             printf("svs' sampled time at the same positions (Sec. 7.4): mean %.4g ms\n", svs_sum / n);
         cJSON_AddNumberToObject(sec, "positions", n);
-        rl_bench_add_num(sec, "set_bytes", bytes);
+        bench_add_num(sec, "set_bytes", bytes);
         cJSON_AddNumberToObject(sec, "thesis_set_bytes", 31e6);
         cJSON_AddItemToObject(sec, "time_ms", stats_json(&s[0]));
         cJSON_AddItemToObject(sec, "hssim", stats_json(&s[1]));
@@ -890,7 +890,7 @@ static rl_status sec_visset(void *ctx, cJSON *sec)
         const double w[3] = { pos[worst].x, pos[worst].y, pos[worst].z };
         cJSON_AddItemToObject(sec, "worst_position", cJSON_CreateDoubleArray(w, 3));
         if (svs_ok)
-            rl_bench_add_num(sec, "svs_sampled_time_mean_ms", svs_sum / n);
+            bench_add_num(sec, "svs_sampled_time_mean_ms", svs_sum / n);
         cJSON_AddNumberToObject(sec, "budget_triangles", (double)budget);
         cJSON_AddItemToObject(sec, "budget_time_ms", stats_json(&s[2]));
         cJSON_AddItemToObject(sec, "budget_hssim", stats_json(&s[3]));
@@ -907,7 +907,7 @@ static bool take_max_depth(void *a, const char *v)
     char *end = NULL;
     long long d = strtoll(v, &end, 10);
     if (!*v || *end || d < 0 || d > RL_OCTREE_MAX_DEPTH) {
-        rl_cli_fail(RL_CLI_USAGE, "--max-depth: expected 0..%d, got '%s'", RL_OCTREE_MAX_DEPTH, v);
+        cli_fail(RL_CLI_USAGE, "--max-depth: expected 0..%d, got '%s'", RL_OCTREE_MAX_DEPTH, v);
         return false;
     }
     ((bc_args *)a)->max_depth = d;
@@ -923,7 +923,7 @@ static int parse_args(int argc, char **argv, bc_args *a)
     a->height = 10.0;
     a->extent = 1.0;
     bool has_samples = false, has_depth = false, has_size = false, has_res = false, has_sel = false;
-    const rl_bench_opt rows[] = {
+    const bench_opt rows[] = {
         RL_BENCH_FLAG("--quick", &a->quick),
         RL_BENCH_COUNT("--samples", 1 << 20, &a->samples, &has_samples),
         RL_BENCH_COUNT("--size", 4096, &a->size, &has_size),
@@ -943,7 +943,7 @@ static int parse_args(int argc, char **argv, bc_args *a)
         RL_BENCH_STRING("--resume", &a->resume),
         RL_BENCH_OUT(&a->out),
     };
-    int rc = rl_bench_parse_args(argc, argv, "bench culling", bench_culling_help, rows,
+    int rc = bench_parse_args(argc, argv, "bench culling", bench_culling_help, rows,
                                  (int)(sizeof rows / sizeof rows[0]));
     if (rc != RL_CLI_OK)
         return rc;
@@ -966,7 +966,7 @@ static int parse_args(int argc, char **argv, bc_args *a)
     return RL_CLI_OK;
 }
 
-int rl_bench_culling(int argc, char **argv)
+int bench_culling(int argc, char **argv)
 {
     bc_args a = { 0 };
     int rc = parse_args(argc, argv, &a);
@@ -975,11 +975,11 @@ int rl_bench_culling(int argc, char **argv)
     char out_buf[1024];
     const char *out = a.out;
     if (!out) {
-        if (!rl_bench_default_out("culling", out_buf, sizeof out_buf))
+        if (!bench_default_out("culling", out_buf, sizeof out_buf))
             return RL_CLI_FAIL;
         out = out_buf;
     }
-    if (!rl_cli_check_writable(out))
+    if (!cli_check_writable(out))
         return RL_CLI_FAIL;
     bc_ctx c = { .a = &a, .frames = a.quick ? "1" : "3" };
     snprintf(c.dir, sizeof c.dir, "%s", out);
@@ -988,7 +988,7 @@ int rl_bench_culling(int argc, char **argv)
         *slash = '\0';
     else
         snprintf(c.dir, sizeof c.dir, ".");
-    if ((rc = rl_cli_load_scene(a.scene, &c.scene)) != RL_CLI_OK)
+    if ((rc = cli_load_scene(a.scene, &c.scene)) != RL_CLI_OK)
         return rc;
     c.d = rl_scene_get_data(c.scene);
     int threads = a.threads > 0 ? (int)a.threads : omp_get_max_threads();
@@ -1000,19 +1000,19 @@ int rl_bench_culling(int argc, char **argv)
                  "seed=%lld budget=%lld threads=%d quick=%d\n",
                  a.scene, a.samples, a.size, a.resolution, a.height, a.extent, a.seed, a.budget, threads,
                  (int)a.quick);
-        if (!rl_bench_resume_open(a.resume, key, &c.resume)) {
+        if (!bench_resume_open(a.resume, key, &c.resume)) {
             rl_scene_release(c.scene);
             return RL_CLI_FAIL;
         }
     }
-    cJSON *root = rl_bench_record_json("culling", threads);
+    cJSON *root = bench_record_json("culling", threads);
     if (!root) {
         rl_scene_release(c.scene);
-        return rl_cli_fail(RL_CLI_FAIL, "out of memory");
+        return cli_fail(RL_CLI_FAIL, "out of memory");
     }
     cJSON *params = cJSON_AddObjectToObject(root, "parameters");
     cJSON_AddStringToObject(params, "scene", a.scene);
-    cJSON_AddItemToObject(params, "scene_stats", rl_cli_scene_stats_json(c.scene));
+    cJSON_AddItemToObject(params, "scene_stats", cli_scene_stats_json(c.scene));
     cJSON_AddNumberToObject(params, "samples", (double)a.samples);
     cJSON_AddNumberToObject(params, "max_depth", (double)a.max_depth);
     cJSON_AddNumberToObject(params, "size", (double)a.size);
@@ -1025,15 +1025,15 @@ int rl_bench_culling(int argc, char **argv)
     cJSON_AddNumberToObject(params, "seed", (double)a.seed);
     cJSON_AddBoolToObject(params, "quick", a.quick);
     cJSON_AddNumberToObject(params, "surfels", (double)a.surfels);
-    static const rl_bench_section_fn fns[SEC_COUNT] = { sec_surfels, sec_depth, sec_svs, sec_select, sec_visset };
-    rc = rl_bench_run_sections("culling", root, section_names, fns, SEC_COUNT, a.sections, &c, c.reason, threads,
+    static const bench_section_fn fns[SEC_COUNT] = { sec_surfels, sec_depth, sec_svs, sec_select, sec_visset };
+    rc = bench_run_sections("culling", root, section_names, fns, SEC_COUNT, a.sections, &c, c.reason, threads,
                                out);
     cJSON_Delete(root);
     rl_approx_release(c.driver);
     rl_approx_release(c.time_chcpp);
     rl_approx_release(c.time_svs);
     free(c.pos);
-    rl_bench_resume_close(c.resume);
+    bench_resume_close(c.resume);
     rl_scene_release(c.scene);
     return rc;
 }

@@ -4,6 +4,6 @@
 #define RL_APP_BENCH_CULLING_H
 
 /* argv[0] is "bench", argv[1] "culling"; returns an exit code (cli.h). */
-int rl_bench_culling(int argc, char **argv);
+int bench_culling(int argc, char **argv);
 
 #endif

@@ -45,7 +45,7 @@
 #include "rl/rl_linespace.h"
 #include "rl/rl_metrics.h"
 
-#define note(...) rl_bench_note("pt", __VA_ARGS__)
+#define note(...) bench_note("pt", __VA_ARGS__)
 
 static const char bench_pt_help[] =
     "usage: rl bench pt [options]\n"
@@ -200,7 +200,7 @@ static rl_status scene_get(bpt *b, const char *name, rl_scene **out)
         b->num_scenes--;
     }
     char *source = NULL, *params = NULL;
-    if (!rl_cli_split_source(name, &source, &params))
+    if (!cli_split_source(name, &source, &params))
         return fail(b, RL_ERR_OUT_OF_MEMORY, "out of memory");
     note("loading %s", name);
     rl_scene *s = NULL;
@@ -284,7 +284,7 @@ static rl_status frame_timed(const bpt *b, const pt_config *c, const rl_scene *s
 
 static double mrays(const rl_render_stats *s)
 {
-    return s->time_ms > 0.0 ? (double)rl_bench_rays_total(s) / (s->time_ms * 1e3) : NAN;
+    return s->time_ms > 0.0 ? (double)bench_rays_total(s) / (s->time_ms * 1e3) : NAN;
 }
 
 /* ------------------------------------------------------- memory guard -- */
@@ -411,18 +411,18 @@ static rl_status fixed_row(const bpt *b, const struct gen_row *g, const rl_accel
     rl_linespace_release(ls);
     double trunc = occupied > 0.0 ? 100.0 * (double)fs.truncated_shafts / occupied : 0.0;
     cJSON_AddStringToObject(o, "status", "ok");
-    rl_bench_add_num(o, "ms", fs.build_ms);
+    bench_add_num(o, "ms", fs.build_ms);
     cJSON_AddNumberToObject(o, "bytes", (double)fs.memory_bytes);
     cJSON_AddNumberToObject(o, "candidates", (double)fs.candidates);
     cJSON_AddNumberToObject(o, "truncated_shafts", (double)fs.truncated_shafts);
-    rl_bench_add_num(o, "truncated_pct_of_occupied", trunc);
-    rl_bench_add_num(o, "dynamic_over_fixed_ms", rl_bench_ratio(ds.build_ms, fs.build_ms));
-    rl_bench_add_num(o, "dynamic_over_fixed_bytes", rl_bench_ratio((double)ds.memory_bytes,
+    bench_add_num(o, "truncated_pct_of_occupied", trunc);
+    bench_add_num(o, "dynamic_over_fixed_ms", bench_ratio(ds.build_ms, fs.build_ms));
+    bench_add_num(o, "dynamic_over_fixed_bytes", bench_ratio((double)ds.memory_bytes,
                                                                    (double)fs.memory_bytes));
     printf("%-26s %4d %2d  fixed k=%d: %.1f ms (dynamic / fixed %.2f), %.1f MiB (dynamic / fixed "
            "%.2f), %.1f %% of occupied shafts truncated\n", g->scene, g->res, g->n, k, fs.build_ms,
-           rl_bench_ratio(ds.build_ms, fs.build_ms), (double)fs.memory_bytes / 1048576.0,
-           rl_bench_ratio((double)ds.memory_bytes, (double)fs.memory_bytes), trunc);
+           bench_ratio(ds.build_ms, fs.build_ms), (double)fs.memory_bytes / 1048576.0,
+           bench_ratio((double)ds.memory_bytes, (double)fs.memory_bytes), trunc);
     return RL_OK;
 }
 
@@ -489,11 +489,11 @@ static rl_status sec_generation(void *ctx, cJSON *sec)
                                        : NAN;
             cJSON_AddStringToObject(row, "status", "ok");
             cJSON_AddNumberToObject(row, "triangles", gs.num_triangles);
-            rl_bench_add_num(row, "grid_ms", gs.build_ms);
-            rl_bench_add_num(row, "ls_ms", ls_s.build_ms);
-            rl_bench_add_num(row, "ls_candidates_ms", ls_s.candidates_ms);
-            rl_bench_add_num(row, "ls_pnmt_ms", ls_s.pnmt_ms);
-            rl_bench_add_num(row, "thesis_over_ours_ls", rl_bench_ratio(g->thesis_ls_ms, ls_s.build_ms));
+            bench_add_num(row, "grid_ms", gs.build_ms);
+            bench_add_num(row, "ls_ms", ls_s.build_ms);
+            bench_add_num(row, "ls_candidates_ms", ls_s.candidates_ms);
+            bench_add_num(row, "ls_pnmt_ms", ls_s.pnmt_ms);
+            bench_add_num(row, "thesis_over_ours_ls", bench_ratio(g->thesis_ls_ms, ls_s.build_ms));
             cJSON_AddNumberToObject(row, "grid_bytes", (double)gs.memory_bytes);
             cJSON_AddNumberToObject(row, "ls_bytes", (double)ls_s.memory_bytes);
             cJSON_AddNumberToObject(row, "filled_voxels", ls_s.filled_voxels);
@@ -501,10 +501,10 @@ static rl_status sec_generation(void *ctx, cJSON *sec)
             cJSON_AddNumberToObject(row, "empty_shafts", (double)ls_s.empty_shafts);
             cJSON_AddNumberToObject(row, "candidates", (double)ls_s.candidates);
             cJSON_AddNumberToObject(row, "max_candidates", ls_s.max_candidates);
-            rl_bench_add_num(row, "mean_candidates", ls_s.mean_candidates);
+            bench_add_num(row, "mean_candidates", ls_s.mean_candidates);
             printf("%-26s %4d %2d %10.1f %10.0f %10.1f %10.0f %7.2f %9.1f %8.1f %10.2f\n",
                    g->scene, g->res, g->n, gs.build_ms, g->thesis_grid_ms, ls_s.build_ms,
-                   g->thesis_ls_ms, rl_bench_ratio(g->thesis_ls_ms, ls_s.build_ms),
+                   g->thesis_ls_ms, bench_ratio(g->thesis_ls_ms, ls_s.build_ms),
                    (double)ls_s.memory_bytes / 1048576.0, empty, ls_s.mean_candidates);
             note("generation %s %d^3 N=%d: grid %.1f ms, LS %.1f ms", g->scene, g->res, g->n,
                  gs.build_ms, ls_s.build_ms);
@@ -538,11 +538,11 @@ static cJSON *frame_json(const pt_config *c, const rl_render_stats *s, double wa
     cJSON_AddStringToObject(o, "diffuse", c->diffuse);
     cJSON_AddNumberToObject(o, "grid_res", c->grid_res);
     cJSON_AddBoolToObject(o, "ls_fixed_lists", c->ls_fixed);
-    rl_bench_add_num(o, "frame_ms", s->time_ms);
-    rl_bench_add_num(o, "fps", s->time_ms > 0.0 ? 1e3 / s->time_ms : NAN);
-    rl_bench_add_num(o, "mrays_per_s", mrays(s));
-    rl_bench_add_num(o, "warmup_ms", warmup_ms);
-    cJSON_AddItemToObject(o, "rays", rl_bench_rays_json(s));
+    bench_add_num(o, "frame_ms", s->time_ms);
+    bench_add_num(o, "fps", s->time_ms > 0.0 ? 1e3 / s->time_ms : NAN);
+    bench_add_num(o, "mrays_per_s", mrays(s));
+    bench_add_num(o, "warmup_ms", warmup_ms);
+    cJSON_AddItemToObject(o, "rays", bench_rays_json(s));
     return o;
 }
 
@@ -574,9 +574,9 @@ static rl_status frame_table(bpt *b, const char *scene_name, const pt_config *co
     printf("%-18s %-14s %-14s %5s %10s %8s %9s %10s %9s%s\n", "config", "shadow", "diffuse", "res",
            "frame ms", "fps", "Mrays/s", "warmup ms", "x base", floor >= 0 ? " x base (rays)" : "");
     for (int i = 0; i < count; i++) {
-        double x = rl_bench_ratio(stats[base].time_ms, stats[i].time_ms);
+        double x = bench_ratio(stats[base].time_ms, stats[i].time_ms);
         double xr = floor >= 0 && i != floor
-                        ? rl_bench_ratio(stats[base].time_ms - stats[floor].time_ms,
+                        ? bench_ratio(stats[base].time_ms - stats[floor].time_ms,
                                          stats[i].time_ms - stats[floor].time_ms)
                         : NAN;
         printf("%-18s %-14s %-14s %5d %10.1f %8.2f %9.2f %10.1f %9.2f", configs[i].label,
@@ -588,9 +588,9 @@ static rl_status frame_table(bpt *b, const char *scene_name, const pt_config *co
         cJSON *row = frame_json(&configs[i], &stats[i], warm[i]);
         if (!row)
             return RL_ERR_OUT_OF_MEMORY;
-        rl_bench_add_num(row, "speedup_vs_base", x);
+        bench_add_num(row, "speedup_vs_base", x);
         if (floor >= 0)
-            rl_bench_add_num(row, "rays_speedup_vs_base", xr);
+            bench_add_num(row, "rays_speedup_vs_base", xr);
         cJSON_AddItemToArray(out, row);
     }
     fflush(stdout);
@@ -723,9 +723,9 @@ static void sweep_best(const pt_config *configs, const rl_render_stats *stats, i
                 bi = i;
         if (bi < 0)
             continue;
-        double xg = rl_bench_ratio(stats[0].time_ms, stats[bi].time_ms);
-        double xb = rl_bench_ratio(stats[1].time_ms, stats[bi].time_ms);
-        double xr = floor >= 0 ? rl_bench_ratio(stats[0].time_ms - stats[floor].time_ms,
+        double xg = bench_ratio(stats[0].time_ms, stats[bi].time_ms);
+        double xb = bench_ratio(stats[1].time_ms, stats[bi].time_ms);
+        double xr = floor >= 0 ? bench_ratio(stats[0].time_ms - stats[floor].time_ms,
                                                 stats[bi].time_ms - stats[floor].time_ms)
                                : NAN;
         printf("  %-14s %3d^3  %8.1f ms  %5.2fx the grid  %5.2fx the BVH", ls_variants[v].label,
@@ -737,11 +737,11 @@ static void sweep_best(const pt_config *configs, const rl_render_stats *stats, i
         if (!o)
             continue;
         cJSON_AddNumberToObject(o, "grid_res", configs[bi].grid_res);
-        rl_bench_add_num(o, "frame_ms", stats[bi].time_ms);
-        rl_bench_add_num(o, "speedup_vs_grid", xg);
-        rl_bench_add_num(o, "speedup_vs_bvh", xb);
+        bench_add_num(o, "frame_ms", stats[bi].time_ms);
+        bench_add_num(o, "speedup_vs_grid", xg);
+        bench_add_num(o, "speedup_vs_bvh", xb);
         if (floor >= 0)
-            rl_bench_add_num(o, "rays_speedup_vs_grid", xr);
+            bench_add_num(o, "rays_speedup_vs_grid", xr);
     }
     fflush(stdout);
 }
@@ -809,8 +809,8 @@ static cJSON *pass_json(cJSON *parent, const char *name, double ms, size_t rays,
     cJSON *o = cJSON_AddObjectToObject(parent, name);
     if (!o)
         return NULL;
-    rl_bench_add_num(o, "ms", ms);
-    rl_bench_add_num(o, "mrays_per_s", ms > 0.0 ? (double)rays / (ms * 1e3) : NAN);
+    bench_add_num(o, "ms", ms);
+    bench_add_num(o, "mrays_per_s", ms > 0.0 ? (double)rays / (ms * 1e3) : NAN);
     cJSON_AddNumberToObject(o, "rays", (double)rays);
     cJSON_AddNumberToObject(o, "occluded", (double)occluded);
     return o;
@@ -953,17 +953,17 @@ static rl_status shadow_rays_alone(bpt *b, const char *name, const int *res, int
             pass_json(e, "candidates", ms_c, n, occ_c);
             pass_json(e, "pnmt", ms_p, m, occ_p);
             pass_json(e, "bvh_same_rays", ms_b, m, occ_b);
-            rl_bench_add_num(e, "candidates_speedup_vs_bvh", rl_bench_ratio(acc_ms[0], ms_c));
-            rl_bench_add_num(e, "candidates_speedup_vs_grid", rl_bench_ratio(acc_ms[1], ms_c));
-            rl_bench_add_num(e, "pnmt_speedup_vs_bvh", rl_bench_ratio(ms_b, ms_p));
+            bench_add_num(e, "candidates_speedup_vs_bvh", bench_ratio(acc_ms[0], ms_c));
+            bench_add_num(e, "candidates_speedup_vs_grid", bench_ratio(acc_ms[1], ms_c));
+            bench_add_num(e, "pnmt_speedup_vs_bvh", bench_ratio(ms_b, ms_p));
             char label[32];
             snprintf(label, sizeof label, "ls-candidates@%d", res[i]);
             printf("  %-22s %8.1f ms %8.2f Mrays/s %9llu  %5.2fx the BVH, %5.2fx the grid\n",
                    label, ms_c, (double)n / (ms_c * 1e3), (unsigned long long)occ_c,
-                   rl_bench_ratio(acc_ms[0], ms_c), rl_bench_ratio(acc_ms[1], ms_c));
+                   bench_ratio(acc_ms[0], ms_c), bench_ratio(acc_ms[1], ms_c));
             printf("  ls-pnmt@%-14d %8.1f ms %8.2f Mrays/s %9llu  %5.2fx the BVH on the same %zu rays "
                    "(%.1f ms, %llu occluded)\n", res[i], ms_p, (double)m / (ms_p * 1e3),
-                   (unsigned long long)occ_p, rl_bench_ratio(ms_b, ms_p), m, ms_b,
+                   (unsigned long long)occ_p, bench_ratio(ms_b, ms_p), m, ms_b,
                    (unsigned long long)occ_b);
             fflush(stdout);
         }
@@ -1093,9 +1093,9 @@ static cJSON *curve_json(const curve_point *pts, int num)
         if (!p)
             break;
         cJSON_AddNumberToObject(p, "spp", (double)pts[i].spp);
-        rl_bench_add_num(p, "time_ms", pts[i].time_ms);
-        rl_bench_add_num(p, "rmse", pts[i].m.rmse);
-        rl_bench_add_num(p, "ssim", pts[i].m.ssim);
+        bench_add_num(p, "time_ms", pts[i].time_ms);
+        bench_add_num(p, "rmse", pts[i].m.rmse);
+        bench_add_num(p, "ssim", pts[i].m.ssim);
         cJSON_AddItemToArray(a, p);
     }
     return a;
@@ -1177,7 +1177,7 @@ static rl_status sec_error(void *ctx, cJSON *sec)
            "t(16) ms", "t(64) ms");
     cJSON_AddStringToObject(sec, "scene", diagram_scene(b));
     cJSON_AddNumberToObject(sec, "reference_spp", (double)b->a->ref_spp);
-    rl_bench_add_num(sec, "reference_ms", b->reference_ms);
+    bench_add_num(sec, "reference_ms", b->reference_ms);
     cJSON *vars = cJSON_AddArrayToObject(sec, "variants");
     if (!vars)
         return RL_ERR_OUT_OF_MEMORY;
@@ -1210,7 +1210,7 @@ static rl_status sec_error(void *ctx, cJSON *sec)
         for (int k = 0; ttj && k < 3; k++) {
             char key[16];
             snprintf(key, sizeof key, "spp%lld", target_spp[k]);
-            rl_bench_add_num(ttj, key, tt[k]);
+            bench_add_num(ttj, key, tt[k]);
         }
     }
     fflush(stdout);
@@ -1274,9 +1274,9 @@ static rl_status sec_accumulation(void *ctx, cJSON *sec)
             if (!p || !pj)
                 return RL_ERR_OUT_OF_MEMORY;
             cJSON_AddNumberToObject(p, "spp", (double)fp[i].spp);
-            rl_bench_add_num(p, "rmse", fp[i].m.rmse);
-            rl_bench_add_num(p, "ssim", fp[i].m.ssim);
-            rl_bench_add_num(p, "time_ms", fp[i].time_ms);
+            bench_add_num(p, "rmse", fp[i].m.rmse);
+            bench_add_num(p, "ssim", fp[i].m.ssim);
+            bench_add_num(p, "time_ms", fp[i].time_ms);
             cJSON_AddItemToArray(pj, p);
         }
         printf("\n");
@@ -1291,7 +1291,7 @@ static rl_status sec_accumulation(void *ctx, cJSON *sec)
 static int parse_args(int argc, char **argv, bpt_args *a)
 {
     a->sections = (1u << SEC_COUNT) - 1;
-    const rl_bench_opt rows[] = {
+    const bench_opt rows[] = {
         RL_BENCH_FLAG("--quick", &a->quick),
         RL_BENCH_FLAG("--small-pages", &a->small_pages),
         RL_BENCH_COUNT("--builds", 100, &a->builds, &a->has_builds),
@@ -1305,7 +1305,7 @@ static int parse_args(int argc, char **argv, bpt_args *a)
         RL_BENCH_SECTIONS(section_names, SEC_COUNT, &a->sections),
         RL_BENCH_OUT(&a->out),
     };
-    int rc = rl_bench_parse_args(argc, argv, "bench pt", bench_pt_help, rows,
+    int rc = bench_parse_args(argc, argv, "bench pt", bench_pt_help, rows,
                                  (int)(sizeof rows / sizeof rows[0]));
     if (rc != RL_CLI_OK)
         return rc;
@@ -1326,7 +1326,7 @@ static int parse_args(int argc, char **argv, bpt_args *a)
     if (!a->has_fixed_k)
         a->fixed_k = 8;
     if (a->fixed_k % 2 != 0)
-        return rl_cli_fail(RL_CLI_USAGE, "--fixed-k: %lld is odd (front and back halves of k/2, Alg. 3)",
+        return cli_fail(RL_CLI_USAGE, "--fixed-k: %lld is odd (front and back halves of k/2, Alg. 3)",
                            a->fixed_k);
     return RL_CLI_OK;
 }
@@ -1383,7 +1383,7 @@ static double physical_memory(void)
     return pages > 0 && page > 0 ? (double)pages * (double)page : 8.0 * 1073741824.0;
 }
 
-int rl_bench_pt(int argc, char **argv)
+int bench_pt(int argc, char **argv)
 {
     bpt_args a;
     memset(&a, 0, sizeof a);
@@ -1400,23 +1400,23 @@ int rl_bench_pt(int argc, char **argv)
     char out[256];
     if (a.out)
         snprintf(out, sizeof out, "%s", a.out);
-    if (a.out ? !rl_cli_check_writable(out) : !rl_bench_default_out("pt", out, sizeof out))
+    if (a.out ? !cli_check_writable(out) : !bench_default_out("pt", out, sizeof out))
         return RL_CLI_FAIL;
     rl_renderer *probe = NULL;
     rl_clear_error();
     rl_status st = rl_renderer_create("pt", &probe);
     rl_renderer_release(probe);
     if (st != RL_OK)
-        return rl_cli_fail_status(RL_CLI_FAIL, st, "bench pt");
-    cJSON *root = rl_bench_record_json("pt", b.threads);
+        return cli_fail_status(RL_CLI_FAIL, st, "bench pt");
+    cJSON *root = bench_record_json("pt", b.threads);
     if (!root)
-        return rl_cli_fail(RL_CLI_FAIL, "out of memory");
+        return cli_fail(RL_CLI_FAIL, "out of memory");
     cJSON_AddItemToObject(root, "parameters", params_json(&b));
     cJSON_AddItemToObject(root, "thesis", thesis_json());
-    static const rl_bench_section_fn fns[SEC_COUNT] = { sec_generation, sec_scenes, sec_diffuse,
+    static const bench_section_fn fns[SEC_COUNT] = { sec_generation, sec_scenes, sec_diffuse,
                                                         sec_shadow, sec_error, sec_accumulation };
     printf("rl bench pt: Line Space path tracing (Schroeder 2017), %d threads\n", b.threads);
-    rc = rl_bench_run_sections("pt", root, section_names, fns, SEC_COUNT, a.sections, &b,
+    rc = bench_run_sections("pt", root, section_names, fns, SEC_COUNT, a.sections, &b,
                                b.reason, b.threads, out);
     cJSON_Delete(root);
     for (int i = 0; i < b.num_scenes; i++)

@@ -5,6 +5,6 @@
 #define RL_APP_BENCH_PT_H
 
 /* argv[0] is "bench", argv[1] "pt"; returns an exit code (cli.h). */
-int rl_bench_pt(int argc, char **argv);
+int bench_pt(int argc, char **argv);
 
 #endif

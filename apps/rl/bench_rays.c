@@ -21,7 +21,7 @@
 #define TILE 8          /* primary rays: 8x8 pixel tiles in scanline order */
 #define CHUNK 512       /* rays per unit of work handed to a thread */
 
-const char *rl_bench_workload_name(int workload)
+const char *bench_workload_name(int workload)
 {
     static const char *const names[RL_BENCH_WORKLOADS] = { "primary", "shadow", "diffuse" };
     return workload >= 0 && workload < RL_BENCH_WORKLOADS ? names[workload] : "?";
@@ -126,8 +126,8 @@ static void make_primary(const rl_camera *cam, rl_ray *rays, uint32_t *pixel_of)
                 }
 }
 
-bool rl_bench_make_rays(const rl_scene *scene, const rl_camera *cam, const rl_accel *reference,
-                        uint64_t seed, int threads, rl_bench_rays *out)
+bool bench_make_rays(const rl_scene *scene, const rl_camera *cam, const rl_accel *reference,
+                        uint64_t seed, int threads, bench_rays *out)
 {
     const rl_scene_data *data = rl_scene_get_data(scene);
     rl_camera c = rl_camera_resolve(cam);
@@ -184,7 +184,7 @@ bool rl_bench_make_rays(const rl_scene *scene, const rl_camera *cam, const rl_ac
     return ok;
 }
 
-void rl_bench_rays_free(rl_bench_rays *rays)
+void bench_rays_free(bench_rays *rays)
 {
     if (!rays)
         return;
@@ -238,12 +238,12 @@ static uint64_t trace_pass(const rl_accel *accel, const rl_ray *rays, size_t cou
     return hits;
 }
 
-void rl_bench_time_rays(const rl_accel *const *accels, int num_accels, const rl_ray *rays,
+void bench_time_rays(const rl_accel *const *accels, int num_accels, const rl_ray *rays,
                         size_t count, bool any_hit, int threads, int min_runs, int max_runs,
-                        double min_total_s, rl_bench_timing *out)
+                        double min_total_s, bench_timing *out)
 {
     for (int a = 0; a < num_accels; a++) {
-        out[a] = (rl_bench_timing){ .best_s = INFINITY, .best_cpu_s = INFINITY,
+        out[a] = (bench_timing){ .best_s = INFINITY, .best_cpu_s = INFINITY,
                                      .deterministic = true };
         /* The warm-up pass faults in the structure and the rays, fills the
          * caches, and counts the hits. */
@@ -257,7 +257,7 @@ void rl_bench_time_rays(const rl_accel *const *accels, int num_accels, const rl_
     for (bool more = true; more;) {
         more = false;
         for (int a = 0; a < num_accels; a++) {
-            rl_bench_timing *t = &out[a];
+            bench_timing *t = &out[a];
             double spent = total_s ? total_s[a] : INFINITY;
             if (t->runs >= max_runs || (t->runs >= min_runs && spent >= min_total_s))
                 continue;

@@ -22,52 +22,52 @@
 enum { RL_BENCH_PRIMARY = 0, RL_BENCH_SHADOW, RL_BENCH_DIFFUSE, RL_BENCH_WORKLOADS };
 
 /* "primary", "shadow", "diffuse". */
-const char *rl_bench_workload_name(int workload);
+const char *bench_workload_name(int workload);
 
-typedef struct rl_bench_rays {
+typedef struct bench_rays {
     rl_ray *rays[RL_BENCH_WORKLOADS];
     size_t count[RL_BENCH_WORKLOADS];
-} rl_bench_rays;
+} bench_rays;
 
 /* Generates the three workloads for scene, with primary rays of cam (its
  * width x height pixels) and primary hits found with reference (any
  * committed accel of the same scene). seed drives the diffuse directions.
  * Returns false only when out of memory (*out then stays empty). */
-bool rl_bench_make_rays(const rl_scene *scene, const rl_camera *cam, const rl_accel *reference,
-                        uint64_t seed, int threads, rl_bench_rays *out);
-void rl_bench_rays_free(rl_bench_rays *rays);
+bool bench_make_rays(const rl_scene *scene, const rl_camera *cam, const rl_accel *reference,
+                        uint64_t seed, int threads, bench_rays *out);
+void bench_rays_free(bench_rays *rays);
 
-typedef struct rl_bench_timing {
+typedef struct bench_timing {
     uint64_t hits;          /* of the warm-up pass */
     double best_s;          /* fastest timed pass, wall clock */
     double best_cpu_s;      /* least CPU time of the threads over the passes */
     int runs;               /* timed passes */
     bool deterministic;     /* every pass found the same number of hits */
-} rl_bench_timing;
+} bench_timing;
 
 /* Times each of accels on the same rays: one warm-up pass each (which counts
  * the hits), then interleaved timed passes until each has run min_runs
  * times and for min_total_s in all (at most max_runs); out[i] for accels[i].
  * Closest hit (rl_accel_intersect) unless any_hit (rl_accel_occluded). */
-void rl_bench_time_rays(const rl_accel *const *accels, int num_accels, const rl_ray *rays,
+void bench_time_rays(const rl_accel *const *accels, int num_accels, const rl_ray *rays,
                         size_t count, bool any_hit, int threads, int min_runs, int max_runs,
-                        double min_total_s, rl_bench_timing *out);
+                        double min_total_s, bench_timing *out);
 
 /* Results of one accelerator on one scene. */
-typedef struct rl_bench_accel_result {
+typedef struct bench_accel_result {
     rl_accel_kind kind;
     const char *status;                 /* "ok", "unavailable", "failed" */
     char reason[256];                   /* why not "ok" */
     rl_accel_stats stats;
-    rl_bench_timing timing[RL_BENCH_WORKLOADS];
+    bench_timing timing[RL_BENCH_WORKLOADS];
     double mrays_per_s[RL_BENCH_WORKLOADS];       /* wall clock; NAN without rays */
     double ratio_to_embree[RL_BENCH_WORKLOADS];   /* NAN when unknown */
     /* Per CPU second of tracing threads: robust to other load on the machine. */
     double mrays_per_cpu_s[RL_BENCH_WORKLOADS];
     double cpu_ratio_to_embree[RL_BENCH_WORKLOADS];
-} rl_bench_accel_result;
+} bench_accel_result;
 
-typedef struct rl_bench_scene_result {
+typedef struct bench_scene_result {
     const char *arg;                    /* as given to --scenes */
     char label[64];                     /* short name for the table */
     const char *status;                 /* "ok", "skipped", "failed" */
@@ -76,11 +76,11 @@ typedef struct rl_bench_scene_result {
     int width, height;                  /* primary rays */
     size_t rays[RL_BENCH_WORKLOADS];
     bool hits_agree[RL_BENCH_WORKLOADS];
-    rl_bench_accel_result *accels;
+    bench_accel_result *accels;
     int num_accels;
-} rl_bench_scene_result;
+} bench_scene_result;
 
-typedef struct rl_bench_params {
+typedef struct bench_params {
     int width, height;                  /* --size, after --rays */
     long long rays;                     /* --rays, 0 = one per pixel of --size */
     int threads;
@@ -88,20 +88,20 @@ typedef struct rl_bench_params {
     int min_runs, max_runs;
     double min_total_s;
     uint64_t seed;
-} rl_bench_params;
+} bench_params;
 
 /* uname, CPU model, nproc, threads and the load average: the machine a
  * record was measured on (also used by `rl bench vt`); NULL when out of memory. */
-struct cJSON *rl_bench_machine_json(int threads);
+struct cJSON *bench_machine_json(int threads);
 /* The head of every benchmark record: benchmark name, renderlab version, UTC
  * date and the machine; NULL when out of memory. */
-struct cJSON *rl_bench_record_json(const char *benchmark, int threads);
+struct cJSON *bench_record_json(const char *benchmark, int threads);
 
 /* The whole run as one JSON object: machine, date, version, parameters,
  * per scene/accel/workload rays, hits, seconds, Mrays/s, ratio to Embree.
  * NULL when out of memory. */
-struct cJSON *rl_bench_report_json(const rl_bench_params *params,
-                                   const rl_bench_scene_result *scenes, int num_scenes,
+struct cJSON *bench_report_json(const bench_params *params,
+                                   const bench_scene_result *scenes, int num_scenes,
                                    int hit_mismatches);
 
 #endif

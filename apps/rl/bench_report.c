@@ -62,7 +62,7 @@ static void load_average(char *out, size_t size)
     fclose(f);
 }
 
-cJSON *rl_bench_machine_json(int threads)
+cJSON *bench_machine_json(int threads)
 {
     cJSON *m = cJSON_CreateObject();
     if (!m)
@@ -86,7 +86,7 @@ cJSON *rl_bench_machine_json(int threads)
     return m;
 }
 
-static cJSON *params_json(const rl_bench_params *p)
+static cJSON *params_json(const bench_params *p)
 {
     cJSON *o = cJSON_CreateObject();
     if (!o)
@@ -133,7 +133,7 @@ static cJSON *stats_json(const rl_accel_stats *s)
     return o;
 }
 
-static cJSON *accel_json(const rl_bench_scene_result *sc, const rl_bench_accel_result *a)
+static cJSON *accel_json(const bench_scene_result *sc, const bench_accel_result *a)
 {
     cJSON *o = cJSON_CreateObject();
     if (!o)
@@ -147,8 +147,8 @@ static cJSON *accel_json(const rl_bench_scene_result *sc, const rl_bench_accel_r
     cJSON_AddItemToObject(o, "build", stats_json(&a->stats));
     cJSON *work = cJSON_AddObjectToObject(o, "workloads");
     for (int w = 0; work && w < RL_BENCH_WORKLOADS; w++) {
-        const rl_bench_timing *t = &a->timing[w];
-        cJSON *wj = cJSON_AddObjectToObject(work, rl_bench_workload_name(w));
+        const bench_timing *t = &a->timing[w];
+        cJSON *wj = cJSON_AddObjectToObject(work, bench_workload_name(w));
         if (!wj)
             break;
         cJSON_AddNumberToObject(wj, "rays", (double)sc->rays[w]);
@@ -166,7 +166,7 @@ static cJSON *accel_json(const rl_bench_scene_result *sc, const rl_bench_accel_r
     return o;
 }
 
-static cJSON *scene_json(const rl_bench_scene_result *sc)
+static cJSON *scene_json(const bench_scene_result *sc)
 {
     cJSON *o = cJSON_CreateObject();
     if (!o)
@@ -185,7 +185,7 @@ static cJSON *scene_json(const rl_bench_scene_result *sc)
     cJSON *rays = cJSON_AddObjectToObject(o, "rays");
     bool agree = true;
     for (int w = 0; rays && w < RL_BENCH_WORKLOADS; w++) {
-        cJSON_AddNumberToObject(rays, rl_bench_workload_name(w), (double)sc->rays[w]);
+        cJSON_AddNumberToObject(rays, bench_workload_name(w), (double)sc->rays[w]);
         agree = agree && sc->hits_agree[w];
     }
     cJSON_AddBoolToObject(o, "hits_agree", agree);
@@ -195,7 +195,7 @@ static cJSON *scene_json(const rl_bench_scene_result *sc)
     return o;
 }
 
-cJSON *rl_bench_record_json(const char *benchmark, int threads)
+cJSON *bench_record_json(const char *benchmark, int threads)
 {
     cJSON *root = cJSON_CreateObject();
     if (!root)
@@ -209,14 +209,14 @@ cJSON *rl_bench_record_json(const char *benchmark, int threads)
         cJSON_AddStringToObject(root, "date", date);
     else
         cJSON_AddNullToObject(root, "date");
-    cJSON_AddItemToObject(root, "machine", rl_bench_machine_json(threads));
+    cJSON_AddItemToObject(root, "machine", bench_machine_json(threads));
     return root;
 }
 
-cJSON *rl_bench_report_json(const rl_bench_params *params, const rl_bench_scene_result *scenes,
+cJSON *bench_report_json(const bench_params *params, const bench_scene_result *scenes,
                             int num_scenes, int hit_mismatches)
 {
-    cJSON *root = rl_bench_record_json("rays", params->threads);
+    cJSON *root = bench_record_json("rays", params->threads);
     if (!root)
         return NULL;
     cJSON_AddBoolToObject(root, "embree", rl_accel_kind_available(RL_ACCEL_EMBREE));

@@ -10,7 +10,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-struct rl_bench_resume {
+struct bench_resume {
     char dir[1024];
     char path[1280];
 };
@@ -65,40 +65,40 @@ static bool write_atomic(const char *path, const char *text)
     if (ok && rename(tmp, path) != 0)
         ok = false;
     if (!ok)
-        rl_cli_fail(RL_CLI_FAIL, "%s: cannot write", path);
+        cli_fail(RL_CLI_FAIL, "%s: cannot write", path);
     return ok;
 }
 
-bool rl_bench_resume_open(const char *dir, const char *key, rl_bench_resume **out)
+bool bench_resume_open(const char *dir, const char *key, bench_resume **out)
 {
     *out = NULL;
-    if (strlen(dir) >= sizeof((rl_bench_resume *)0)->dir) {
-        rl_cli_fail(RL_CLI_FAIL, "%s: path too long", dir);
+    if (strlen(dir) >= sizeof((bench_resume *)0)->dir) {
+        cli_fail(RL_CLI_FAIL, "%s: path too long", dir);
         return false;
     }
-    if (!rl_cli_make_dirs(dir))
+    if (!cli_make_dirs(dir))
         return false;
-    rl_bench_resume *r = calloc(1, sizeof *r);
+    bench_resume *r = calloc(1, sizeof *r);
     if (!r) {
-        rl_cli_fail(RL_CLI_FAIL, "out of memory");
+        cli_fail(RL_CLI_FAIL, "out of memory");
         return false;
     }
     snprintf(r->dir, sizeof r->dir, "%s", dir);
-    const char *key_path = rl_bench_resume_path(r, "key.txt");
+    const char *key_path = bench_resume_path(r, "key.txt");
     bool missing = false;
     char *have = slurp(key_path, &missing);
     bool ok;
     if (have) {
         ok = strcmp(have, key) == 0;
         if (!ok)
-            rl_cli_fail(RL_CLI_FAIL, "%s holds a run with other options (%.*s), not this one (%.*s); use another "
+            cli_fail(RL_CLI_FAIL, "%s holds a run with other options (%.*s), not this one (%.*s); use another "
                         "folder or the same options", dir, (int)strcspn(have, "\n"), have,
                         (int)strcspn(key, "\n"), key);
     } else if (missing) {
         ok = write_atomic(key_path, key);
     } else {
         ok = false;
-        rl_cli_fail(RL_CLI_FAIL, "%s: cannot read", key_path);
+        cli_fail(RL_CLI_FAIL, "%s: cannot read", key_path);
     }
     free(have);
     if (!ok) {
@@ -109,27 +109,27 @@ bool rl_bench_resume_open(const char *dir, const char *key, rl_bench_resume **ou
     return true;
 }
 
-void rl_bench_resume_close(rl_bench_resume *r)
+void bench_resume_close(bench_resume *r)
 {
     free(r);
 }
 
-const char *rl_bench_resume_path(rl_bench_resume *r, const char *name)
+const char *bench_resume_path(bench_resume *r, const char *name)
 {
     snprintf(r->path, sizeof r->path, "%s/%s", r->dir, name);
     return r->path;
 }
 
-bool rl_bench_resume_load(rl_bench_resume *r, const char *name, double **values, size_t *count)
+bool bench_resume_load(bench_resume *r, const char *name, double **values, size_t *count)
 {
     *values = NULL;
     *count = 0;
-    const char *path = rl_bench_resume_path(r, name);
+    const char *path = bench_resume_path(r, name);
     bool missing = false;
     char *text = slurp(path, &missing);
     if (!text) {
         if (!missing)
-            rl_cli_fail(RL_CLI_FAIL, "%s: cannot read", path);
+            cli_fail(RL_CLI_FAIL, "%s: cannot read", path);
         return missing;
     }
     cJSON *root = cJSON_Parse(text);
@@ -147,8 +147,8 @@ bool rl_bench_resume_load(rl_bench_resume *r, const char *name, double **values,
     cJSON_Delete(root);
     if (!ok) {
         free(v);
-        rl_cli_fail(RL_CLI_FAIL, "%s: not a saved series ({\"values\": [numbers]}); delete it to measure again",
-                    rl_bench_resume_path(r, name));
+        cli_fail(RL_CLI_FAIL, "%s: not a saved series ({\"values\": [numbers]}); delete it to measure again",
+                    bench_resume_path(r, name));
         return false;
     }
     *values = v;
@@ -156,7 +156,7 @@ bool rl_bench_resume_load(rl_bench_resume *r, const char *name, double **values,
     return true;
 }
 
-bool rl_bench_resume_save(rl_bench_resume *r, const char *name, const double *values, size_t count)
+bool bench_resume_save(bench_resume *r, const char *name, const double *values, size_t count)
 {
     cJSON *root = cJSON_CreateObject();
     cJSON *arr = root ? cJSON_AddArrayToObject(root, "values") : NULL;
@@ -166,32 +166,32 @@ bool rl_bench_resume_save(rl_bench_resume *r, const char *name, const double *va
     char *text = ok ? cJSON_Print(root) : NULL;
     cJSON_Delete(root);
     if (!text) {
-        rl_cli_fail(RL_CLI_FAIL, "out of memory while saving %s", name);
+        cli_fail(RL_CLI_FAIL, "out of memory while saving %s", name);
         return false;
     }
-    ok = write_atomic(rl_bench_resume_path(r, name), text);
+    ok = write_atomic(bench_resume_path(r, name), text);
     free(text);
     return ok;
 }
 
-bool rl_bench_resume_save_approx(rl_bench_resume *r, const char *name, const rl_approx *a)
+bool bench_resume_save_approx(bench_resume *r, const char *name, const rl_approx *a)
 {
     char path[1280], tmp[1400];
-    snprintf(path, sizeof path, "%s", rl_bench_resume_path(r, name));
+    snprintf(path, sizeof path, "%s", bench_resume_path(r, name));
     snprintf(tmp, sizeof tmp, "%s.tmp", path);
     if (rl_approx_save_json(a, tmp) != RL_OK)
         return false;
     if (rename(tmp, path) != 0) {
-        rl_cli_fail(RL_CLI_FAIL, "%s: cannot write", path);
+        cli_fail(RL_CLI_FAIL, "%s: cannot write", path);
         return false;
     }
     return true;
 }
 
-rl_status rl_bench_resume_load_approx(rl_bench_resume *r, const char *name, rl_approx **out)
+rl_status bench_resume_load_approx(bench_resume *r, const char *name, rl_approx **out)
 {
     *out = NULL;
-    const char *path = rl_bench_resume_path(r, name);
+    const char *path = bench_resume_path(r, name);
     FILE *f = fopen(path, "r");
     if (!f)
         return RL_OK;

@@ -43,7 +43,7 @@
 #include <string.h>
 
 /* The tables go to stdout, notes to stderr: flush so they do not interleave. */
-#define note(...) (fflush(stdout), rl_bench_note("sampling", __VA_ARGS__))
+#define note(...) (fflush(stdout), bench_note("sampling", __VA_ARGS__))
 
 static const char bench_sampling_help[] =
     "usage: rl bench sampling [options]\n"
@@ -186,7 +186,7 @@ static rl_status errors(const rl_approx *ap, const rl_vec3 *pos, const double *m
     double *e = malloc(n * sizeof *e);
     if (!e)
         return RL_ERR_OUT_OF_MEMORY;
-    rl_status st = rl_eval_errors(ap, pos, measured, n, NULL, e);
+    rl_status st = eval_errors(ap, pos, measured, n, NULL, e);
     if (st == RL_OK)
         st = rl_stats_compute(e, NULL, n, out);
     free(e);
@@ -219,14 +219,14 @@ static rl_status sec_variants(void *ctx, cJSON *sec)
             if (st != RL_OK)
                 return st;
             size_t nv = (size_t)c->a->validation;
-            rl_vec3 *pos = rl_eval_random_positions(shape, nv, 0xba5eULL + (uint64_t)(dims * 2 + doubled));
+            rl_vec3 *pos = eval_random_positions(shape, nv, 0xba5eULL + (uint64_t)(dims * 2 + doubled));
             rl_approx_release(shape);
             double *measured = NULL;
             if (!pos)
                 return RL_ERR_OUT_OF_MEMORY;
             note("%dD %s region: measuring %zu validation points", dims,
                  doubled ? "doubled" : "tight", nv);
-            st = rl_eval_measure(c->vis, pos, nv, &measured, NULL);
+            st = eval_measure(c->vis, pos, nv, &measured, NULL);
             if (st != RL_OK) {
                 free(pos);
                 return st;
@@ -269,8 +269,8 @@ static rl_status sec_variants(void *ctx, cJSON *sec)
                             if (seed == 1) {
                                 cJSON_AddNumberToObject(v, "samples_taken", rl_approx_sample_count(ap));
                                 cJSON_AddNumberToObject(v, "regions", rl_approx_region_count(ap));
-                                rl_bench_add_num(v, "seconds", secs);
-                                cJSON_AddItemToObject(v, "abs_error", rl_eval_stats_json(&es));
+                                bench_add_num(v, "seconds", secs);
+                                cJSON_AddItemToObject(v, "abs_error", eval_stats_json(&es));
                             }
                             cJSON_AddItemToArray(per_seed, cJSON_CreateNumber(es.mean));
                             mean_err[k] += es.mean / seeds;
@@ -283,7 +283,7 @@ static rl_status sec_variants(void *ctx, cJSON *sec)
                         }
                     }
                     if (st == RL_OK) {
-                        rl_bench_add_num(v, "mean_abs_error", mean_err[k]);
+                        bench_add_num(v, "mean_abs_error", mean_err[k]);
                         printf(" %11.3f", mean_err[k]);
                         fflush(stdout);
                     }
@@ -299,18 +299,18 @@ static rl_status sec_variants(void *ctx, cJSON *sec)
                 met_shifted += mean_err[V_TARGET] <= mean_err[V_SHIFTED];
                 total++;
                 cJSON_AddBoolToObject(o, "adaptive_no_worse_than_grid", ok);
-                rl_bench_add_num(o, "adaptive_over_grid", rl_bench_ratio(mean_err[V_TARGET], grid_best));
+                bench_add_num(o, "adaptive_over_grid", bench_ratio(mean_err[V_TARGET], grid_best));
                 cJSON_AddBoolToObject(o, "adaptive_no_worse_than_thesis_grid",
                                       mean_err[V_TARGET] <= mean_err[V_GRID]);
-                rl_bench_add_num(o, "adaptive_over_thesis_grid",
-                                 rl_bench_ratio(mean_err[V_TARGET], mean_err[V_GRID]));
+                bench_add_num(o, "adaptive_over_thesis_grid",
+                                 bench_ratio(mean_err[V_TARGET], mean_err[V_GRID]));
                 cJSON_AddBoolToObject(o, "adaptive_no_worse_than_shifted_grid",
                                       mean_err[V_TARGET] <= mean_err[V_SHIFTED]);
-                rl_bench_add_num(o, "adaptive_over_shifted_grid",
-                                 rl_bench_ratio(mean_err[V_TARGET], mean_err[V_SHIFTED]));
-                printf("  %s (%.2fx) %9.2fx %10.2fx\n", ok ? "yes" : "NO", rl_bench_ratio(mean_err[V_TARGET], grid_best),
-                       rl_bench_ratio(mean_err[V_TARGET], mean_err[V_GRID]),
-                       rl_bench_ratio(mean_err[V_TARGET], mean_err[V_SHIFTED]));
+                bench_add_num(o, "adaptive_over_shifted_grid",
+                                 bench_ratio(mean_err[V_TARGET], mean_err[V_SHIFTED]));
+                printf("  %s (%.2fx) %9.2fx %10.2fx\n", ok ? "yes" : "NO", bench_ratio(mean_err[V_TARGET], grid_best),
+                       bench_ratio(mean_err[V_TARGET], mean_err[V_GRID]),
+                       bench_ratio(mean_err[V_TARGET], mean_err[V_SHIFTED]));
             }
             free(pos);
             free(measured);
@@ -348,14 +348,14 @@ static rl_status sec_convergence(void *ctx, cJSON *sec)
         double *v = NULL, *w = NULL;
         size_t m = 0;
         rl_stats s;
-        if (st == RL_OK && !rl_eval_leaf_series(ap, &v, &w, &m))
+        if (st == RL_OK && !eval_leaf_series(ap, &v, &w, &m))
             st = RL_ERR_OUT_OF_MEMORY;
         if (st == RL_OK)
             st = rl_stats_compute(v, w, m, &s);
         free(v);
         free(w);
         if (st == RL_OK) {
-            cJSON *o = rl_eval_stats_json(&s);
+            cJSON *o = eval_stats_json(&s);
             cJSON_AddNumberToObject(o, "samples", (double)counts[i]);
             cJSON_AddNumberToObject(o, "regions", rl_approx_region_count(ap));
             cJSON_AddItemToArray(rows, o);
@@ -398,11 +398,11 @@ static rl_status sec_throughput(void *ctx, cJSON *sec)
             rl_approx *shape = NULL;
             if (st == RL_OK)
                 st = rl_sample_property(p, &d, &shape);
-            rl_vec3 *pos = st == RL_OK ? rl_eval_random_positions(shape, n, 77) : NULL;
+            rl_vec3 *pos = st == RL_OK ? eval_random_positions(shape, n, 77) : NULL;
             double *vals = NULL;
             double t0 = rl_time_s();
             if (st == RL_OK)
-                st = pos ? rl_eval_measure(p, pos, n, &vals, NULL) : RL_ERR_OUT_OF_MEMORY;
+                st = pos ? eval_measure(p, pos, n, &vals, NULL) : RL_ERR_OUT_OF_MEMORY;
             double secs = rl_time_s() - t0;
             free(vals);
             free(pos);
@@ -416,10 +416,10 @@ static rl_status sec_throughput(void *ctx, cJSON *sec)
             cJSON *o = cJSON_CreateObject();
             cJSON_AddNumberToObject(o, "resolution", (double)resolutions[r]);
             cJSON_AddNumberToObject(o, "workers", w);
-            rl_bench_add_num(o, "samples_per_second", rate);
-            rl_bench_add_num(o, "speedup", rl_bench_ratio(rate, base));
+            bench_add_num(o, "samples_per_second", rate);
+            bench_add_num(o, "speedup", bench_ratio(rate, base));
             cJSON_AddItemToArray(rows, o);
-            printf("%10lld %8d %10.2f %8.2f\n", resolutions[r], w, rate, rl_bench_ratio(rate, base));
+            printf("%10lld %8d %10.2f %8.2f\n", resolutions[r], w, rate, bench_ratio(rate, base));
             if (w == max_workers)
                 break;
         }
@@ -436,7 +436,7 @@ static bool parse_counts(const char *text, bs_args *a)
         long long n = strtoll(p, &end, 10);
         if (end == p || n < 1 || n > (1 << 20) || (*end && *end != ',') ||
             a->num_counts == MAX_COUNTS) {
-            rl_cli_fail(RL_CLI_USAGE, "--samples: expected up to %d counts in 1..%d, got '%s'",
+            cli_fail(RL_CLI_USAGE, "--samples: expected up to %d counts in 1..%d, got '%s'",
                         MAX_COUNTS, 1 << 20, text);
             return false;
         }
@@ -453,7 +453,7 @@ static bool take_counts(void *a, const char *text)
 
 static bool take_quality_size(void *ctx, const char *text)
 {
-    return rl_eval_parse_quality_size("--quality-size", text, &((bs_args *)ctx)->quality_size);
+    return eval_parse_quality_size("--quality-size", text, &((bs_args *)ctx)->quality_size);
 }
 
 /* Returns RL_CLI_OK, an exit code, or RL_BENCH_HELP_SHOWN. */
@@ -462,7 +462,7 @@ static int parse_args(int argc, char **argv, bs_args *a)
     a->sections = (1u << SEC_COUNT) - 1;
     a->height = 1.7;
     bool has_res = false, has_val = false, has_counts = false;
-    const rl_bench_opt rows[] = {
+    const bench_opt rows[] = {
         RL_BENCH_FLAG("--quick", &a->quick),
         RL_BENCH_STRING("--scene", &a->scene),
         RL_BENCH_COUNT("--resolution", 4096, &a->resolution, &has_res),
@@ -478,7 +478,7 @@ static int parse_args(int argc, char **argv, bs_args *a)
         RL_BENCH_SECTIONS(section_names, SEC_COUNT, &a->sections),
         RL_BENCH_OUT(&a->out),
     };
-    int rc = rl_bench_parse_args(argc, argv, "bench sampling", bench_sampling_help, rows,
+    int rc = bench_parse_args(argc, argv, "bench sampling", bench_sampling_help, rows,
                                  (int)(sizeof rows / sizeof rows[0]));
     if (rc != RL_CLI_OK)
         return rc;
@@ -498,7 +498,7 @@ static int parse_args(int argc, char **argv, bs_args *a)
     return RL_CLI_OK;
 }
 
-int rl_bench_sampling(int argc, char **argv)
+int bench_sampling(int argc, char **argv)
 {
     bs_args a = { 0 };
     int rc = parse_args(argc, argv, &a);
@@ -507,14 +507,14 @@ int rl_bench_sampling(int argc, char **argv)
     char out_buf[512];
     const char *out = a.out;
     if (!out) {
-        if (!rl_bench_default_out("sampling", out_buf, sizeof out_buf))
+        if (!bench_default_out("sampling", out_buf, sizeof out_buf))
             return RL_CLI_FAIL;
         out = out_buf;
     }
-    if (!rl_cli_check_writable(out))
+    if (!cli_check_writable(out))
         return RL_CLI_FAIL;
     bs_ctx c = { .a = &a };
-    if ((rc = rl_cli_load_scene(a.scene, &c.scene)) != RL_CLI_OK)
+    if ((rc = cli_load_scene(a.scene, &c.scene)) != RL_CLI_OK)
         return rc;
     c.bounds = rl_scene_get_data(c.scene)->bounds;
     if (a.height > c.bounds.max.y - c.bounds.min.y)
@@ -529,19 +529,19 @@ int rl_bench_sampling(int argc, char **argv)
     if (st != RL_OK) {
         rl_property_release(c.vis);
         rl_scene_release(c.scene);
-        return rl_cli_fail_status(RL_CLI_FAIL, st, "visibility property");
+        return cli_fail_status(RL_CLI_FAIL, st, "visibility property");
     }
     int threads = rl_property_workers(c.vis);
     cJSON *root = cJSON_CreateObject();
-    cJSON_AddItemToObject(root, "machine", rl_bench_machine_json(threads));
+    cJSON_AddItemToObject(root, "machine", bench_machine_json(threads));
     cJSON *params = cJSON_AddObjectToObject(root, "parameters");
     cJSON_AddStringToObject(params, "scene", a.scene);
-    cJSON_AddItemToObject(params, "scene_stats", rl_cli_scene_stats_json(c.scene));
+    cJSON_AddItemToObject(params, "scene_stats", cli_scene_stats_json(c.scene));
     cJSON_AddStringToObject(params, "property", "visibility (objects)");
     cJSON_AddNumberToObject(params, "resolution", (double)a.resolution);
     cJSON_AddNumberToObject(params, "validation_points", (double)a.validation);
     cJSON_AddNumberToObject(params, "repeats", (double)a.repeats);
-    cJSON_AddStringToObject(params, "quality_size", rl_eval_quality_size_name(a.quality_size));
+    cJSON_AddStringToObject(params, "quality_size", eval_quality_size_name(a.quality_size));
     cJSON_AddNumberToObject(params, "samples_base", a.samples_base > 0.0 ? a.samples_base : 5.0);
     cJSON_AddNumberToObject(params, "samples_per_meter", a.samples_per_meter > 0.0 ? a.samples_per_meter : 0.05);
     cJSON_AddNumberToObject(params, "height_above_floor", a.height);
@@ -551,9 +551,9 @@ int rl_bench_sampling(int argc, char **argv)
                                                "region: mean error 12.65 (grid) vs 19.22 (adaptive)");
     printf("rl bench sampling: Jaehn 2015, Sec. 5.7, on %s (%u objects), visibility at %lld^2, "
            "%d workers\n", a.scene, rl_scene_get_data(c.scene)->num_objects, a.resolution, threads);
-    static const rl_bench_section_fn fns[SEC_COUNT] = { sec_variants, sec_convergence,
+    static const bench_section_fn fns[SEC_COUNT] = { sec_variants, sec_convergence,
                                                         sec_throughput };
-    rc = rl_bench_run_sections("sampling", root, section_names, fns, SEC_COUNT, a.sections, &c,
+    rc = bench_run_sections("sampling", root, section_names, fns, SEC_COUNT, a.sections, &c,
                                c.reason, threads, out);
     cJSON_Delete(root);
     rl_property_release(c.vis);

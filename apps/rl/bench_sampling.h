@@ -5,6 +5,6 @@
 #define RL_APP_BENCH_SAMPLING_H
 
 /* argv[0] is "bench", argv[1] "sampling"; returns an exit code (cli.h). */
-int rl_bench_sampling(int argc, char **argv);
+int bench_sampling(int argc, char **argv);
 
 #endif

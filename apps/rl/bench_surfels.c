@@ -35,7 +35,7 @@
 
 #include "rl/rl_surfels.h"
 
-#define note(...) (fflush(stdout), rl_bench_note("surfels", __VA_ARGS__))
+#define note(...) (fflush(stdout), bench_note("surfels", __VA_ARGS__))
 
 static const char bench_surfels_help[] =
     "usage: rl bench surfels [options]\n"
@@ -136,11 +136,11 @@ static double queries(int v, uint32_t count, uint32_t candidates)
 static cJSON *timing_json(const rl_surfel_timing *t)
 {
     cJSON *o = cJSON_CreateObject();
-    rl_bench_add_num(o, "atlas_ms", t->atlas_ms);
-    rl_bench_add_num(o, "candidates_ms", t->candidates_ms);
-    rl_bench_add_num(o, "sampling_ms", t->sampling_ms);
-    rl_bench_add_num(o, "sizes_ms", t->sizes_ms);
-    rl_bench_add_num(o, "total_ms", t->total_ms);
+    bench_add_num(o, "atlas_ms", t->atlas_ms);
+    bench_add_num(o, "candidates_ms", t->candidates_ms);
+    bench_add_num(o, "sampling_ms", t->sampling_ms);
+    bench_add_num(o, "sizes_ms", t->sizes_ms);
+    bench_add_num(o, "total_ms", t->total_ms);
     return o;
 }
 
@@ -158,7 +158,7 @@ static rl_status build(bsf_ctx *c, int v, rl_surfel_set *set)
 
 static void row(const char *label, double ours, double thesis)
 {
-    printf("%-46s %10.1f %10.0f %8.2f\n", label, ours, thesis, rl_bench_ratio(ours, thesis));
+    printf("%-46s %10.1f %10.0f %8.2f\n", label, ours, thesis, bench_ratio(ours, thesis));
 }
 
 static rl_status sec_defaults(void *ctx, cJSON *sec)
@@ -193,10 +193,10 @@ static rl_status sec_defaults(void *ctx, cJSON *sec)
     cJSON_AddItemToObject(sec, "timing", timing_json(t));
     cJSON_AddNumberToObject(sec, "surfels", s->count);
     cJSON_AddNumberToObject(sec, "candidates", s->candidates);
-    rl_bench_add_num(sec, "coverage", s->coverage);
+    bench_add_num(sec, "coverage", s->coverage);
     cJSON_AddNumberToObject(sec, "bytes_per_surfel", (double)sizeof *s->surfels);
     cJSON_AddNumberToObject(sec, "surfel_bytes", (double)bytes);
-    rl_bench_add_num(sec, "ms_per_query", c->ms_per_query);
+    bench_add_num(sec, "ms_per_query", c->ms_per_query);
     cJSON_AddNumberToObject(sec, "target_sampling_ms", TARGET_SAMPLING_MS);
     cJSON_AddBoolToObject(sec, "target_met", met);
     return RL_OK;
@@ -216,8 +216,8 @@ static rl_status quality(bsf_ctx *c, const rl_surfel_set *s, cJSON *out)
             return st;
         cJSON *o = cJSON_CreateObject();
         cJSON_AddNumberToObject(o, "prefix", m);
-        rl_bench_add_num(o, "min_rel", lo / c->diagonal);
-        rl_bench_add_num(o, "mean_rel", mean / c->diagonal);
+        bench_add_num(o, "min_rel", lo / c->diagonal);
+        bench_add_num(o, "mean_rel", mean / c->diagonal);
         cJSON_AddItemToArray(rows, o);
         if (col++ % 2 == 0 || m == s->count)
             printf(" %6u:%.2f/%.2f", m, 1e3 * lo / c->diagonal, 1e3 * mean / c->diagonal);
@@ -244,7 +244,7 @@ static rl_status sec_variants(void *ctx, cJSON *sec)
         double est = c->ms_per_query * queries(v, (uint32_t)c->a->count,
                                                c->defaults.candidates ? c->defaults.candidates
                                                                       : UINT32_MAX);
-        rl_bench_add_num(o, "estimated_ms", c->ms_per_query > 0.0 ? est : NAN);
+        bench_add_num(o, "estimated_ms", c->ms_per_query > 0.0 ? est : NAN);
         if (v != V_PROG_160 && c->ms_per_query > 0.0 && est > 1e3 * c->a->max_seconds) {
             printf("%-12s skipped: estimated %.0f ms > --max-seconds %g\n", variant_names[v], est,
                    c->a->max_seconds);
@@ -260,7 +260,7 @@ static rl_status sec_variants(void *ctx, cJSON *sec)
             s = &own;
         }
         cJSON_AddBoolToObject(o, "skipped", false);
-        rl_bench_add_num(o, "sampling_ms", s->timing.sampling_ms);
+        bench_add_num(o, "sampling_ms", s->timing.sampling_ms);
         cJSON_AddItemToObject(o, "timing", timing_json(&s->timing));
         cJSON_AddNumberToObject(o, "surfels", s->count);
         c->variant_ms[v] = s->timing.sampling_ms;
@@ -292,7 +292,7 @@ static bool parse_variants(const char *text, unsigned *bits)
             if (strlen(variant_names[v]) == n && strncmp(p, variant_names[v], n) == 0)
                 found = v;
         if (found < 0) {
-            rl_cli_fail(RL_CLI_USAGE, "--variants: expected a list of random, prog-160, "
+            cli_fail(RL_CLI_USAGE, "--variants: expected a list of random, prog-160, "
                         "prog-1000, const-160, const-1000, got '%s'", text);
             return false;
         }
@@ -315,7 +315,7 @@ static int parse_args(int argc, char **argv, bsf_args *a)
     a->seed = 1;
     a->max_seconds = 120.0;
     bool has_res = false, has_count = false, has_max = false;
-    const rl_bench_opt rows[] = {
+    const bench_opt rows[] = {
         RL_BENCH_FLAG("--quick", &a->quick),
         RL_BENCH_STRING("--scene", &a->scene),
         RL_BENCH_COUNT("--resolution", 16384, &a->resolution, &has_res),
@@ -327,7 +327,7 @@ static int parse_args(int argc, char **argv, bsf_args *a)
         RL_BENCH_COUNT("--threads", 1024, &a->threads, NULL),
         RL_BENCH_OUT(&a->out),
     };
-    int rc = rl_bench_parse_args(argc, argv, "bench surfels", bench_surfels_help, rows,
+    int rc = bench_parse_args(argc, argv, "bench surfels", bench_surfels_help, rows,
                                  (int)(sizeof rows / sizeof rows[0]));
     if (rc != RL_CLI_OK)
         return rc;
@@ -342,7 +342,7 @@ static int parse_args(int argc, char **argv, bsf_args *a)
     return RL_CLI_OK;
 }
 
-int rl_bench_surfels(int argc, char **argv)
+int bench_surfels(int argc, char **argv)
 {
     bsf_args a = { 0 };
     int rc = parse_args(argc, argv, &a);
@@ -351,26 +351,26 @@ int rl_bench_surfels(int argc, char **argv)
     char out_buf[512];
     const char *out = a.out;
     if (!out) {
-        if (!rl_bench_default_out("surfels", out_buf, sizeof out_buf))
+        if (!bench_default_out("surfels", out_buf, sizeof out_buf))
             return RL_CLI_FAIL;
         out = out_buf;
     }
-    if (!rl_cli_check_writable(out))
+    if (!cli_check_writable(out))
         return RL_CLI_FAIL;
     bsf_ctx c = { .a = &a };
-    if ((rc = rl_cli_load_scene(a.scene, &c.scene)) != RL_CLI_OK)
+    if ((rc = cli_load_scene(a.scene, &c.scene)) != RL_CLI_OK)
         return rc;
     const rl_scene_data *d = rl_scene_get_data(c.scene);
     c.diagonal = rl_length(rl_aabb_extent(d->bounds));
     int threads = a.threads > 0 ? (int)a.threads : omp_get_max_threads();
-    cJSON *root = rl_bench_record_json("surfels", threads);
+    cJSON *root = bench_record_json("surfels", threads);
     if (!root) {
         rl_scene_release(c.scene);
-        return rl_cli_fail(RL_CLI_FAIL, "out of memory");
+        return cli_fail(RL_CLI_FAIL, "out of memory");
     }
     cJSON *params = cJSON_AddObjectToObject(root, "parameters");
     cJSON_AddStringToObject(params, "scene", a.scene);
-    cJSON_AddItemToObject(params, "scene_stats", rl_cli_scene_stats_json(c.scene));
+    cJSON_AddItemToObject(params, "scene_stats", cli_scene_stats_json(c.scene));
     cJSON_AddStringToObject(params, "objects", "all, as one node");
     cJSON_AddNumberToObject(params, "resolution", (double)a.resolution);
     cJSON_AddNumberToObject(params, "count", (double)a.count);
@@ -399,8 +399,8 @@ int rl_bench_surfels(int argc, char **argv)
     printf("rl bench surfels: Jaehn 2015, Table 6.1, on %s (%u objects, %u triangles) as one node: "
            "%lld surfels, %lld^2 per view, %d threads\n", a.scene, d->num_objects, d->num_triangles,
            a.count, a.resolution, threads);
-    static const rl_bench_section_fn fns[SEC_COUNT] = { sec_defaults, sec_variants };
-    rc = rl_bench_run_sections("surfels", root, section_names, fns, SEC_COUNT,
+    static const bench_section_fn fns[SEC_COUNT] = { sec_defaults, sec_variants };
+    rc = bench_run_sections("surfels", root, section_names, fns, SEC_COUNT,
                                (1u << SEC_COUNT) - 1, &c, c.reason, threads, out);
     cJSON_Delete(root);
     rl_surfel_set_free(&c.defaults);

@@ -6,6 +6,6 @@
 #define RL_APP_BENCH_SURFELS_H
 
 /* argv[0] is "bench", argv[1] "surfels"; returns an exit code (cli.h). */
-int rl_bench_surfels(int argc, char **argv);
+int bench_surfels(int argc, char **argv);
 
 #endif

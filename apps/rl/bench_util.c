@@ -14,7 +14,7 @@
 
 #include "rl/rl_options.h"
 
-void rl_bench_note(const char *bench, const char *fmt, ...)
+void bench_note(const char *bench, const char *fmt, ...)
 {
     if (rl_log_get_level() < RL_LOG_INFO)
         return;
@@ -26,7 +26,7 @@ void rl_bench_note(const char *bench, const char *fmt, ...)
     va_end(ap);
 }
 
-void rl_bench_add_num(cJSON *o, const char *key, double value)
+void bench_add_num(cJSON *o, const char *key, double value)
 {
     if (isfinite(value))
         cJSON_AddNumberToObject(o, key, value);
@@ -34,7 +34,7 @@ void rl_bench_add_num(cJSON *o, const char *key, double value)
         cJSON_AddNullToObject(o, key);
 }
 
-uint64_t rl_bench_rays_total(const rl_render_stats *s)
+uint64_t bench_rays_total(const rl_render_stats *s)
 {
     uint64_t n = 0;
     for (int k = 0; k < RL_RAY_TYPE_COUNT; k++)
@@ -42,39 +42,39 @@ uint64_t rl_bench_rays_total(const rl_render_stats *s)
     return n;
 }
 
-cJSON *rl_bench_rays_json(const rl_render_stats *s)
+cJSON *bench_rays_json(const rl_render_stats *s)
 {
     cJSON *o = cJSON_CreateObject();
     for (int k = 0; o && k < RL_RAY_TYPE_COUNT; k++)
         cJSON_AddNumberToObject(o, rl_ray_type_name((rl_ray_type)k), (double)s->rays[k]);
     if (o)
-        cJSON_AddNumberToObject(o, "total", (double)rl_bench_rays_total(s));
+        cJSON_AddNumberToObject(o, "total", (double)bench_rays_total(s));
     return o;
 }
 
-cJSON *rl_bench_metrics_json(const rl_image_metrics *m)
+cJSON *bench_metrics_json(const rl_image_metrics *m)
 {
     cJSON *o = cJSON_CreateObject();
     if (!o)
         return NULL;
-    rl_bench_add_num(o, "ssim", m->ssim);
-    rl_bench_add_num(o, "rmse", m->rmse);
-    rl_bench_add_num(o, "psnr", m->psnr);    /* null when the images are equal */
-    rl_bench_add_num(o, "max_abs", m->max_abs);
+    bench_add_num(o, "ssim", m->ssim);
+    bench_add_num(o, "rmse", m->rmse);
+    bench_add_num(o, "psnr", m->psnr);    /* null when the images are equal */
+    bench_add_num(o, "max_abs", m->max_abs);
     cJSON_AddNumberToObject(o, "pixels", (double)m->pixels);
     return o;
 }
 
-double rl_bench_ratio(double a, double b)
+double bench_ratio(double a, double b)
 {
     return b != 0.0 ? a / b : NAN;
 }
 
-bool rl_bench_parse_count(const char *option, const char *text, long long max, long long *out)
+bool bench_parse_count(const char *option, const char *text, long long max, long long *out)
 {
     long long v;
     if (!rl_parse_int(text, &v) || v < 1 || v > max) {
-        rl_cli_fail(RL_CLI_USAGE, "%s: expected a whole number in 1..%lld, got '%s'", option, max,
+        cli_fail(RL_CLI_USAGE, "%s: expected a whole number in 1..%lld, got '%s'", option, max,
                     text);
         return false;
     }
@@ -82,7 +82,7 @@ bool rl_bench_parse_count(const char *option, const char *text, long long max, l
     return true;
 }
 
-bool rl_bench_parse_sections(const char *text, const char *const *names, int count,
+bool bench_parse_sections(const char *text, const char *const *names, int count,
                              unsigned *sections)
 {
     *sections = 0;
@@ -99,7 +99,7 @@ bool rl_bench_parse_sections(const char *text, const char *const *names, int cou
                 size_t len = strlen(list);
                 snprintf(list + len, sizeof list - len, "%s%s", k ? ", " : "", names[k]);
             }
-            rl_cli_fail(RL_CLI_USAGE, "--only: expected sections among %s, got '%s'", list, text);
+            cli_fail(RL_CLI_USAGE, "--only: expected sections among %s, got '%s'", list, text);
             return false;
         }
         *sections |= 1u << found;
@@ -109,7 +109,7 @@ bool rl_bench_parse_sections(const char *text, const char *const *names, int cou
     }
 }
 
-bool rl_bench_default_out(const char *prefix, char *path, size_t size)
+bool bench_default_out(const char *prefix, char *path, size_t size)
 {
     time_t now = time(NULL);
     struct tm utc;
@@ -117,11 +117,11 @@ bool rl_bench_default_out(const char *prefix, char *path, size_t size)
     if (!gmtime_r(&now, &utc) || !strftime(stamp, sizeof stamp, "%Y%m%d-%H%M%S", &utc))
         snprintf(stamp, sizeof stamp, "%lld", (long long)now);
     snprintf(path, size, "bench/results/%s-%s.json", prefix, stamp);
-    return rl_cli_make_dirs("bench/results");
+    return cli_make_dirs("bench/results");
 }
 
-int rl_bench_run_sections(const char *bench, cJSON *root, const char *const *names,
-                          const rl_bench_section_fn *fns, int count, unsigned wanted, void *ctx,
+int bench_run_sections(const char *bench, cJSON *root, const char *const *names,
+                          const bench_section_fn *fns, int count, unsigned wanted, void *ctx,
                           char *reason, int threads, const char *out)
 {
     int rc = RL_CLI_OK;
@@ -131,7 +131,7 @@ int rl_bench_run_sections(const char *bench, cJSON *root, const char *const *nam
             continue;
         cJSON *sec = cJSON_AddObjectToObject(root, names[k]);
         if (!sec) {
-            rc = rl_cli_fail(RL_CLI_FAIL, "out of memory");
+            rc = cli_fail(RL_CLI_FAIL, "out of memory");
             break;
         }
         reason[0] = '\0';
@@ -152,18 +152,18 @@ int rl_bench_run_sections(const char *bench, cJSON *root, const char *const *nam
             snprintf(failed, sizeof failed, "%s (%s)", names[k], why);
     }
     /* Again for the load average after the run: how busy the machine was. */
-    cJSON *machine = rl_bench_machine_json(threads);
+    cJSON *machine = bench_machine_json(threads);
     if (machine && !cJSON_ReplaceItemInObjectCaseSensitive(root, "machine", machine))
         cJSON_Delete(machine);
     if (rc == RL_CLI_OK) {
         if (!cJSON_GetObjectItem(root, "machine") || !cJSON_GetObjectItem(root, "parameters"))
-            rc = rl_cli_fail(RL_CLI_FAIL, "out of memory");
-        else if (!rl_cli_write_json(root, out))
+            rc = cli_fail(RL_CLI_FAIL, "out of memory");
+        else if (!cli_write_json(root, out))
             rc = RL_CLI_FAIL;
         else
-            rl_bench_note(bench, "wrote %s", out);
+            bench_note(bench, "wrote %s", out);
     }
     if (rc == RL_CLI_OK && failed[0])
-        rc = rl_cli_fail(RL_CLI_FAIL, "bench %s: section %s failed", bench, failed);
+        rc = cli_fail(RL_CLI_FAIL, "bench %s: section %s failed", bench, failed);
     return rc;
 }

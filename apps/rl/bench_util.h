@@ -16,38 +16,38 @@
 struct cJSON;
 
 /* "bench NAME: ..." on stderr when the log level includes info. */
-void rl_bench_note(const char *bench, const char *fmt, ...)
+void bench_note(const char *bench, const char *fmt, ...)
 #if defined(__GNUC__)
     __attribute__((format(printf, 2, 3)))
 #endif
     ;
 /* JSON has no NaN or infinity: unknown values become null. */
-void rl_bench_add_num(struct cJSON *o, const char *key, double value);
-uint64_t rl_bench_rays_total(const rl_render_stats *s);
+void bench_add_num(struct cJSON *o, const char *key, double value);
+uint64_t bench_rays_total(const rl_render_stats *s);
 /* {primary, shadow, ..., total} */
-struct cJSON *rl_bench_rays_json(const rl_render_stats *s);
+struct cJSON *bench_rays_json(const rl_render_stats *s);
 /* {ssim, rmse, psnr, max_abs, pixels} */
-struct cJSON *rl_bench_metrics_json(const rl_image_metrics *m);
-double rl_bench_ratio(double a, double b);          /* NaN when b is 0 */
+struct cJSON *bench_metrics_json(const rl_image_metrics *m);
+double bench_ratio(double a, double b);          /* NaN when b is 0 */
 
 /* A whole number in 1..max for option; prints the usage error. */
-bool rl_bench_parse_count(const char *option, const char *text, long long max, long long *out);
+bool bench_parse_count(const char *option, const char *text, long long max, long long *out);
 /* --only: a comma-separated subset of names[0..count-1] as bits. */
-bool rl_bench_parse_sections(const char *text, const char *const *names, int count,
+bool bench_parse_sections(const char *text, const char *const *names, int count,
                              unsigned *sections);
 /* bench/results/PREFIX-YYYYMMDD-HHMMSS.json (UTC), creating the folder. */
-bool rl_bench_default_out(const char *prefix, char *path, size_t size);
+bool bench_default_out(const char *prefix, char *path, size_t size);
 
 /* One section: fills sec; on failure may write why into the reason buffer
- * given to rl_bench_run_sections (else rl_last_error() is recorded). */
-typedef rl_status (*rl_bench_section_fn)(void *ctx, struct cJSON *sec);
+ * given to bench_run_sections (else rl_last_error() is recorded). */
+typedef rl_status (*bench_section_fn)(void *ctx, struct cJSON *sec);
 /* Runs the sections whose bit is set in `wanted`, in order, each into
  * root[names[k]] with "status": "ok" or "failed" and "reason". reason is
  * cleared before each section. Then refreshes root["machine"] (the load
  * average after the run) and writes root to out. Returns RL_CLI_OK, or
  * RL_CLI_FAIL (printed) when a section failed or the file was not written. */
-int rl_bench_run_sections(const char *bench, struct cJSON *root, const char *const *names,
-                          const rl_bench_section_fn *fns, int count, unsigned wanted, void *ctx,
+int bench_run_sections(const char *bench, struct cJSON *root, const char *const *names,
+                          const bench_section_fn *fns, int count, unsigned wanted, void *ctx,
                           char *reason, int threads, const char *out);
 
 #endif

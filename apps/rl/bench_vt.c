@@ -151,12 +151,12 @@ typedef struct quality {
 /* ------------------------------------------------------------ output -- */
 
 /* "bench vt: criteria rgb 1024x1024: ..." on stderr, one per measurement. */
-#define note(...) rl_bench_note("vt", __VA_ARGS__)
-#define add_num rl_bench_add_num
-#define rays_total rl_bench_rays_total
-#define rays_json rl_bench_rays_json
-#define metrics_json rl_bench_metrics_json
-#define ratio rl_bench_ratio
+#define note(...) bench_note("vt", __VA_ARGS__)
+#define add_num bench_add_num
+#define rays_total bench_rays_total
+#define rays_json bench_rays_json
+#define metrics_json bench_metrics_json
+#define ratio bench_ratio
 
 static cJSON *quality_json(const quality *q)
 {
@@ -1124,7 +1124,7 @@ static rl_status sec_animation(void *ctx, cJSON *sec)
 static int parse_args(int argc, char **argv, bvt_args *a)
 {
     a->sections = (1u << SEC_COUNT) - 1;
-    const rl_bench_opt rows[] = {
+    const bench_opt rows[] = {
         RL_BENCH_FLAG("--quick", &a->quick),
         RL_BENCH_SIZE("--size", &a->width, &a->height, &a->has_size),
         RL_BENCH_SIZE("--anim-size", &a->anim_width, &a->anim_height, &a->has_anim_size),
@@ -1133,7 +1133,7 @@ static int parse_args(int argc, char **argv, bvt_args *a)
         RL_BENCH_SECTIONS(section_names, SEC_COUNT, &a->sections),
         RL_BENCH_OUT(&a->out),
     };
-    int rc = rl_bench_parse_args(argc, argv, "bench vt", bench_vt_help, rows,
+    int rc = bench_parse_args(argc, argv, "bench vt", bench_vt_help, rows,
                                  (int)(sizeof rows / sizeof rows[0]));
     if (rc != RL_CLI_OK)
         return rc;
@@ -1158,11 +1158,11 @@ static bool wants(const bvt_args *a, int section)
 /* Loads a built-in scene and its VT object set. */
 static int load(const char *name, rl_scene **scene, uint8_t **object_vt)
 {
-    int rc = rl_cli_load_scene(name, scene);
+    int rc = cli_load_scene(name, scene);
     if (rc != RL_CLI_OK)
         return rc;
     if (!(*object_vt = vt_objects(*scene)))
-        return rl_cli_fail(RL_CLI_FAIL, "out of memory");
+        return cli_fail(RL_CLI_FAIL, "out of memory");
     return RL_CLI_OK;
 }
 
@@ -1240,7 +1240,7 @@ static cJSON *thesis_json(void)
 
 static cJSON *report_root(const bvt *b)
 {
-    cJSON *root = rl_bench_record_json("vt", b->threads);
+    cJSON *root = bench_record_json("vt", b->threads);
     if (!root)
         return NULL;
     cJSON_AddItemToObject(root, "parameters", params_json(b));
@@ -1254,7 +1254,7 @@ static int run(bvt *b)
     char out[256];
     if (a->out)
         snprintf(out, sizeof out, "%s", a->out);
-    if (a->out ? !rl_cli_check_writable(out) : !rl_bench_default_out("vt", out, sizeof out))
+    if (a->out ? !cli_check_writable(out) : !bench_default_out("vt", out, sizeof out))
         return RL_CLI_FAIL;
     /* The renderers first: the record is worthless without them. */
     const char *const names[] = { "vt", "whitted" };
@@ -1264,7 +1264,7 @@ static int run(bvt *b)
         rl_status st = rl_renderer_create(names[i], &r);
         rl_renderer_release(r);
         if (st != RL_OK)
-            return rl_cli_fail_status(RL_CLI_FAIL, st, "bench vt");
+            return cli_fail_status(RL_CLI_FAIL, st, "bench vt");
     }
     bool static_sections = false;
     for (int k = 0; k < SEC_ANIMATION; k++)
@@ -1276,26 +1276,26 @@ static int run(bvt *b)
         rl_clear_error();
         rl_status st = rl_scene_get_camera(b->table, NULL, &b->table_cam);
         if (st != RL_OK)
-            return rl_cli_fail_status(RL_CLI_FAIL, st, "bench vt: table camera");
+            return cli_fail_status(RL_CLI_FAIL, st, "bench vt: table camera");
     }
     if (wants(a, SEC_ANIMATION) && (rc = load("cluster", &b->cluster, &b->cluster_vt)) != RL_CLI_OK)
         return rc;
 
     cJSON *root = report_root(b);
     if (!root)
-        return rl_cli_fail(RL_CLI_FAIL, "out of memory");
-    static const rl_bench_section_fn fns[SEC_COUNT] = { sec_criteria, sec_resolution,
+        return cli_fail(RL_CLI_FAIL, "out of memory");
+    static const bench_section_fn fns[SEC_COUNT] = { sec_criteria, sec_resolution,
                                                         sec_quality, sec_threads,
                                                         sec_visibility, sec_animation };
     printf("rl bench vt: Vertex Tracing vs Whitted, %d threads, max_depth %s, area_samples %s, "
            "shadows %s\n", b->threads, TRACE_MAX_DEPTH, TRACE_AREA_SAMPLES, TRACE_SHADOWS);
-    rc = rl_bench_run_sections("vt", root, section_names, fns, SEC_COUNT, a->sections, b,
+    rc = bench_run_sections("vt", root, section_names, fns, SEC_COUNT, a->sections, b,
                                b->reason, b->threads, out);
     cJSON_Delete(root);
     return rc;
 }
 
-int rl_bench_vt(int argc, char **argv)
+int bench_vt(int argc, char **argv)
 {
     bvt_args a;
     memset(&a, 0, sizeof a);

@@ -5,6 +5,6 @@
 #define RL_APP_BENCH_VT_H
 
 /* argv[0] is "bench", argv[1] "vt"; returns an exit code (cli.h). */
-int rl_bench_vt(int argc, char **argv);
+int bench_vt(int argc, char **argv);
 
 #endif

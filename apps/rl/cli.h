@@ -27,86 +27,86 @@ enum { RL_CLI_OK = 0, RL_CLI_FAIL = 1, RL_CLI_USAGE = 2 };
 #define RL_CLI_DEFAULT_HEIGHT 720
 
 /* Subcommands: argv[0] is the subcommand name; global flags are removed. */
-int rl_cli_scenes(int argc, char **argv);
-int rl_cli_algos(int argc, char **argv);
-int rl_cli_info(int argc, char **argv);
-int rl_cli_render(int argc, char **argv);
-int rl_cli_demo(int argc, char **argv);
-int rl_cli_bench(int argc, char **argv);
-int rl_cli_eval(int argc, char **argv);
-int rl_cli_compare(int argc, char **argv);
+int cli_scenes(int argc, char **argv);
+int cli_algos(int argc, char **argv);
+int cli_info(int argc, char **argv);
+int cli_render(int argc, char **argv);
+int cli_demo(int argc, char **argv);
+int cli_bench(int argc, char **argv);
+int cli_eval(int argc, char **argv);
+int cli_compare(int argc, char **argv);
 
 /* Prints "rl: error: <message>" and returns code. */
-int rl_cli_fail(int code, const char *fmt, ...)
+int cli_fail(int code, const char *fmt, ...)
 #if defined(__GNUC__)
     __attribute__((format(printf, 2, 3)))
 #endif
     ;
 /* Prints the library's message for a failed call (rl_last_error(), or the
  * status text if the library left none) prefixed by what, and returns code. */
-int rl_cli_fail_status(int code, rl_status status, const char *what);
+int cli_fail_status(int code, rl_status status, const char *what);
 
 /* True for "-h" and "--help". */
-bool rl_cli_is_help(const char *arg);
+bool cli_is_help(const char *arg);
 /* Matches argv[*i] against a value-taking option: "--name VALUE" or
  * "--name=VALUE". Returns 1 and advances *i past the value on a match, 0 if
  * argv[*i] is another argument, -1 (error printed) if the value is missing. */
-int rl_cli_take_value(int argc, char **argv, int *i, const char *name, const char **value);
+int cli_take_value(int argc, char **argv, int *i, const char *name, const char **value);
 /* Error for an unrecognised argument of a subcommand; returns RL_CLI_USAGE. */
-int rl_cli_unknown_arg(const char *command, const char *arg);
+int cli_unknown_arg(const char *command, const char *arg);
 
 /* Splits "KEY=VALUE" into key (a NUL-terminated copy, at most key_size - 1
  * characters) and *value (pointing into text). Prints "<what>: expected
  * KEY=VALUE, got '...'" or "<what>: key too long in '...'" and returns
  * false otherwise. For --set options of renderers and properties. */
-bool rl_cli_split_option(const char *what, const char *text, char *key, size_t key_size,
+bool cli_split_option(const char *what, const char *text, char *key, size_t key_size,
                          const char **value);
 /* "WxH" with both sides in 1..RL_IMAGE_MAX_SIZE; prints the error itself. */
-bool rl_cli_parse_size(const char *text, int *width, int *height);
+bool cli_parse_size(const char *text, int *width, int *height);
 /* "x,y,z" of finite floats; prints the error itself (option names the flag). */
-bool rl_cli_parse_vec3(const char *option, const char *text, rl_vec3 *out);
+bool cli_parse_vec3(const char *option, const char *text, rl_vec3 *out);
 
 /* Extension check before any work: true when path ends in one of the
  * NULL-terminated extensions (".png", ".exr"), case-insensitively. */
-bool rl_cli_has_extension(const char *path, const char *const *extensions);
+bool cli_has_extension(const char *path, const char *const *extensions);
 /* True when the folder that will hold path exists and is writable; prints
  * the error itself. Checked up front so a long render is not wasted. */
-bool rl_cli_check_writable(const char *path);
+bool cli_check_writable(const char *path);
 /* mkdir -p; prints the error itself. */
-bool rl_cli_make_dirs(const char *dir);
+bool cli_make_dirs(const char *dir);
 
 /* Splits "name:k=v,k=v" into a source and built-in parameters. A path that
  * exists as a file is never split. Returns malloc'd copies (params may be
  * NULL); false only when out of memory. */
-bool rl_cli_split_source(const char *arg, char **source, char **params);
+bool cli_split_source(const char *arg, char **source, char **params);
 
 /* Loads "name[:k=v,...]" / a .json scene / a mesh file with rl_scene_load.
  * Returns RL_CLI_OK, or RL_CLI_FAIL with the error printed. */
-int rl_cli_load_scene(const char *arg, rl_scene **out);
+int cli_load_scene(const char *arg, rl_scene **out);
 /* True when name is one of the built-in scenes (rl scenes). */
-bool rl_cli_is_builtin(const char *name);
+bool cli_is_builtin(const char *name);
 
 /* Scene statistics and render statistics as JSON objects (for --json,
  * --stats-json and the demo report); NULL when out of memory. */
 struct cJSON;
-struct cJSON *rl_cli_scene_stats_json(const rl_scene *scene);
-struct cJSON *rl_cli_render_stats_json(const rl_render_stats *stats);
+struct cJSON *cli_scene_stats_json(const rl_scene *scene);
+struct cJSON *cli_render_stats_json(const rl_render_stats *stats);
 /* Serialises item (indented) to path; prints the error itself. */
-bool rl_cli_write_json(const struct cJSON *item, const char *path);
+bool cli_write_json(const struct cJSON *item, const char *path);
 
 /* demo_html.c: DIR/index.html from the demo's report.json object (images
  * referenced by their file names next to it); prints the error itself. */
-bool rl_cli_write_demo_html(const struct cJSON *report, const char *path);
+bool cli_write_demo_html(const struct cJSON *report, const char *path);
 
 /* One line on what a render did: "raster 64x48 cornell: 1.2 ms, ...". */
-void rl_cli_print_summary(FILE *out, const char *algo, const char *scene, int width,
+void cli_print_summary(FILE *out, const char *algo, const char *scene, int width,
                           int height, const rl_render_stats *stats);
 
 /* Extra layers (layers.c). depth: EXR keeps the raw eye-space depth in
  * R,G,B (alpha 0 where nothing was hit), PNG maps it to grey with the
  * nearest surface white and the background black. ids: a PNG with each
  * object ID hashed to a colour, black where nothing was hit. */
-rl_status rl_cli_write_depth(const rl_image *img, const char *path);
-rl_status rl_cli_write_ids(const rl_image *img, const char *path);
+rl_status cli_write_depth(const rl_image *img, const char *path);
+rl_status cli_write_ids(const rl_image *img, const char *path);
 
 #endif

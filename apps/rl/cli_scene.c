@@ -5,7 +5,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-bool rl_cli_is_builtin(const char *name)
+bool cli_is_builtin(const char *name)
 {
     size_t count = 0;
     const rl_builtin_info *list = rl_builtin_scenes(&count);
@@ -15,11 +15,11 @@ bool rl_cli_is_builtin(const char *name)
     return false;
 }
 
-int rl_cli_load_scene(const char *arg, rl_scene **out)
+int cli_load_scene(const char *arg, rl_scene **out)
 {
     char *source = NULL, *params = NULL;
-    if (!rl_cli_split_source(arg, &source, &params))
-        return rl_cli_fail(RL_CLI_FAIL, "out of memory");
+    if (!cli_split_source(arg, &source, &params))
+        return cli_fail(RL_CLI_FAIL, "out of memory");
     rl_clear_error();
     rl_status st = rl_scene_load(source, params, out);
     int rc = RL_CLI_OK;
@@ -30,8 +30,8 @@ int rl_cli_load_scene(const char *arg, rl_scene **out)
         bool named = msg && strstr(msg, source) != NULL;
         /* A bad parameter of a built-in was typed on the command line: that
          * is usage (2), whereas a bad value inside a file is input (1). */
-        int code = st == RL_ERR_INVALID_ARG && rl_cli_is_builtin(source) ? RL_CLI_USAGE : RL_CLI_FAIL;
-        rc = rl_cli_fail_status(code, st, named ? NULL : arg);
+        int code = st == RL_ERR_INVALID_ARG && cli_is_builtin(source) ? RL_CLI_USAGE : RL_CLI_FAIL;
+        rc = cli_fail_status(code, st, named ? NULL : arg);
     }
     free(source);
     free(params);

@@ -17,7 +17,7 @@ static void add_count(cJSON *obj, const char *key, uint64_t value)
     cJSON_AddNumberToObject(obj, key, (double)value);
 }
 
-cJSON *rl_cli_scene_stats_json(const rl_scene *scene)
+cJSON *cli_scene_stats_json(const rl_scene *scene)
 {
     rl_scene_stats st;
     rl_scene_get_stats(scene, &st);
@@ -54,7 +54,7 @@ cJSON *rl_cli_scene_stats_json(const rl_scene *scene)
     return obj;
 }
 
-cJSON *rl_cli_render_stats_json(const rl_render_stats *stats)
+cJSON *cli_render_stats_json(const rl_render_stats *stats)
 {
     cJSON *obj = cJSON_CreateObject();
     if (!obj)
@@ -76,11 +76,11 @@ cJSON *rl_cli_render_stats_json(const rl_render_stats *stats)
     return obj;
 }
 
-bool rl_cli_write_json(const cJSON *item, const char *path)
+bool cli_write_json(const cJSON *item, const char *path)
 {
     char *text = cJSON_Print(item);
     if (!text) {
-        rl_cli_fail(RL_CLI_FAIL, "%s: out of memory while formatting JSON", path);
+        cli_fail(RL_CLI_FAIL, "%s: out of memory while formatting JSON", path);
         return false;
     }
     FILE *f = fopen(path, "w");
@@ -89,11 +89,11 @@ bool rl_cli_write_json(const cJSON *item, const char *path)
         ok = false;
     free(text);
     if (!ok)
-        rl_cli_fail(RL_CLI_FAIL, "%s: cannot write", path);
+        cli_fail(RL_CLI_FAIL, "%s: cannot write", path);
     return ok;
 }
 
-void rl_cli_print_summary(FILE *out, const char *algo, const char *scene, int width,
+void cli_print_summary(FILE *out, const char *algo, const char *scene, int width,
                           int height, const rl_render_stats *stats)
 {
     fprintf(out, "%s %dx%d %s: %.1f ms", algo, width, height, scene, stats->time_ms);

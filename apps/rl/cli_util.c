@@ -16,7 +16,7 @@
 #include "rl/rl_options.h"
 #include "rl/rl_path.h"
 
-int rl_cli_fail(int code, const char *fmt, ...)
+int cli_fail(int code, const char *fmt, ...)
 {
     char line[1200];
     va_list ap;
@@ -32,28 +32,28 @@ int rl_cli_fail(int code, const char *fmt, ...)
     return code;
 }
 
-int rl_cli_fail_status(int code, rl_status status, const char *what)
+int cli_fail_status(int code, rl_status status, const char *what)
 {
     const char *msg = rl_last_error();
     if (!msg || !*msg)
         msg = rl_status_string(status);
     /* Library messages usually name the file or item already. */
     if (what && *what && !strstr(msg, what))
-        return rl_cli_fail(code, "%s: %s", what, msg);
-    return rl_cli_fail(code, "%s", msg);
+        return cli_fail(code, "%s: %s", what, msg);
+    return cli_fail(code, "%s", msg);
 }
 
-bool rl_cli_split_option(const char *what, const char *text, char *key, size_t key_size,
+bool cli_split_option(const char *what, const char *text, char *key, size_t key_size,
                          const char **value)
 {
     const char *eq = strchr(text, '=');
     if (!eq || eq == text) {
-        rl_cli_fail(RL_CLI_USAGE, "%s: expected KEY=VALUE, got '%s'", what, text);
+        cli_fail(RL_CLI_USAGE, "%s: expected KEY=VALUE, got '%s'", what, text);
         return false;
     }
     size_t n = (size_t)(eq - text);
     if (n >= key_size) {
-        rl_cli_fail(RL_CLI_USAGE, "%s: key too long in '%s'", what, text);
+        cli_fail(RL_CLI_USAGE, "%s: key too long in '%s'", what, text);
         return false;
     }
     memcpy(key, text, n);
@@ -62,12 +62,12 @@ bool rl_cli_split_option(const char *what, const char *text, char *key, size_t k
     return true;
 }
 
-bool rl_cli_is_help(const char *arg)
+bool cli_is_help(const char *arg)
 {
     return strcmp(arg, "-h") == 0 || strcmp(arg, "--help") == 0;
 }
 
-int rl_cli_take_value(int argc, char **argv, int *i, const char *name, const char **value)
+int cli_take_value(int argc, char **argv, int *i, const char *name, const char **value)
 {
     const char *arg = argv[*i];
     size_t n = strlen(name);
@@ -80,7 +80,7 @@ int rl_cli_take_value(int argc, char **argv, int *i, const char *name, const cha
     if (arg[n] != '\0')
         return 0;
     if (*i + 1 >= argc) {
-        rl_cli_fail(RL_CLI_USAGE, "%s needs a value (see --help)", name);
+        cli_fail(RL_CLI_USAGE, "%s needs a value (see --help)", name);
         return -1;
     }
     *i += 1;
@@ -88,16 +88,16 @@ int rl_cli_take_value(int argc, char **argv, int *i, const char *name, const cha
     return 1;
 }
 
-int rl_cli_unknown_arg(const char *command, const char *arg)
+int cli_unknown_arg(const char *command, const char *arg)
 {
     if (arg[0] == '-')
-        return rl_cli_fail(RL_CLI_USAGE, "%s: unknown option '%s' (see rl %s --help)", command,
+        return cli_fail(RL_CLI_USAGE, "%s: unknown option '%s' (see rl %s --help)", command,
                            arg, command);
-    return rl_cli_fail(RL_CLI_USAGE, "%s: unexpected argument '%s' (see rl %s --help)", command,
+    return cli_fail(RL_CLI_USAGE, "%s: unexpected argument '%s' (see rl %s --help)", command,
                        arg, command);
 }
 
-bool rl_cli_parse_size(const char *text, int *width, int *height)
+bool cli_parse_size(const char *text, int *width, int *height)
 {
     const char *x = strpbrk(text, "xX");
     long long w = 0, h = 0;
@@ -113,13 +113,13 @@ bool rl_cli_parse_size(const char *text, int *width, int *height)
         }
     }
     if (!ok) {
-        rl_cli_fail(RL_CLI_USAGE, "--size: expected WIDTHxHEIGHT such as 1280x720, got '%s'",
+        cli_fail(RL_CLI_USAGE, "--size: expected WIDTHxHEIGHT such as 1280x720, got '%s'",
                     text);
         return false;
     }
     /* Refuse before anything is allocated: 20000x20000 RGBA float is 6 GB. */
     if (w < 1 || h < 1 || w > RL_IMAGE_MAX_SIZE || h > RL_IMAGE_MAX_SIZE) {
-        rl_cli_fail(RL_CLI_USAGE, "--size: %lldx%lld is outside 1..%d per side", w, h,
+        cli_fail(RL_CLI_USAGE, "--size: %lldx%lld is outside 1..%d per side", w, h,
                     RL_IMAGE_MAX_SIZE);
         return false;
     }
@@ -128,7 +128,7 @@ bool rl_cli_parse_size(const char *text, int *width, int *height)
     return true;
 }
 
-bool rl_cli_parse_vec3(const char *option, const char *text, rl_vec3 *out)
+bool cli_parse_vec3(const char *option, const char *text, rl_vec3 *out)
 {
     double v[3];
     const char *p = text;
@@ -138,13 +138,13 @@ bool rl_cli_parse_vec3(const char *option, const char *text, rl_vec3 *out)
         char part[64];
         bool last = k == 2;
         if (n == 0 || n >= sizeof part || (last != (end == NULL))) {
-            rl_cli_fail(RL_CLI_USAGE, "%s: expected x,y,z such as 0,1,5, got '%s'", option, text);
+            cli_fail(RL_CLI_USAGE, "%s: expected x,y,z such as 0,1,5, got '%s'", option, text);
             return false;
         }
         memcpy(part, p, n);
         part[n] = '\0';
         if (!rl_parse_float(part, &v[k])) {
-            rl_cli_fail(RL_CLI_USAGE, "%s: '%s' is not a finite number (in '%s')", option, part,
+            cli_fail(RL_CLI_USAGE, "%s: '%s' is not a finite number (in '%s')", option, part,
                         text);
             return false;
         }
@@ -154,7 +154,7 @@ bool rl_cli_parse_vec3(const char *option, const char *text, rl_vec3 *out)
     return true;
 }
 
-bool rl_cli_has_extension(const char *path, const char *const *extensions)
+bool cli_has_extension(const char *path, const char *const *extensions)
 {
     /* A bare ".png" names no file. */
     for (const char *const *e = extensions; *e; e++)
@@ -180,34 +180,34 @@ static char *folder_of(const char *path)
     return dir;
 }
 
-bool rl_cli_check_writable(const char *path)
+bool cli_check_writable(const char *path)
 {
     char *dir = folder_of(path);
     if (!dir) {
-        rl_cli_fail(RL_CLI_FAIL, "out of memory");
+        cli_fail(RL_CLI_FAIL, "out of memory");
         return false;
     }
     struct stat st;
     bool ok = false;
     if (stat(dir, &st) != 0)
-        rl_cli_fail(RL_CLI_FAIL, "%s: cannot write: folder '%s' does not exist", path, dir);
+        cli_fail(RL_CLI_FAIL, "%s: cannot write: folder '%s' does not exist", path, dir);
     else if (!S_ISDIR(st.st_mode))
-        rl_cli_fail(RL_CLI_FAIL, "%s: cannot write: '%s' is not a folder", path, dir);
+        cli_fail(RL_CLI_FAIL, "%s: cannot write: '%s' is not a folder", path, dir);
     else if (access(dir, W_OK) != 0)
-        rl_cli_fail(RL_CLI_FAIL, "%s: cannot write: folder '%s' is not writable", path, dir);
+        cli_fail(RL_CLI_FAIL, "%s: cannot write: folder '%s' is not writable", path, dir);
     else if (stat(path, &st) == 0 && S_ISDIR(st.st_mode))
-        rl_cli_fail(RL_CLI_FAIL, "%s: cannot write: it is a folder", path);
+        cli_fail(RL_CLI_FAIL, "%s: cannot write: it is a folder", path);
     else
         ok = true;
     free(dir);
     return ok;
 }
 
-bool rl_cli_make_dirs(const char *dir)
+bool cli_make_dirs(const char *dir)
 {
     char *copy = strdup(dir);
     if (!copy) {
-        rl_cli_fail(RL_CLI_FAIL, "out of memory");
+        cli_fail(RL_CLI_FAIL, "out of memory");
         return false;
     }
     bool ok = true;
@@ -219,10 +219,10 @@ bool rl_cli_make_dirs(const char *dir)
             *p = '\0';
             struct stat st;
             if (mkdir(copy, 0777) != 0 && errno != EEXIST) {
-                rl_cli_fail(RL_CLI_FAIL, "%s: cannot create folder: %s", copy, strerror(errno));
+                cli_fail(RL_CLI_FAIL, "%s: cannot create folder: %s", copy, strerror(errno));
                 ok = false;
             } else if (stat(copy, &st) != 0 || !S_ISDIR(st.st_mode)) {
-                rl_cli_fail(RL_CLI_FAIL, "%s: exists and is not a folder", copy);
+                cli_fail(RL_CLI_FAIL, "%s: exists and is not a folder", copy);
                 ok = false;
             }
             *p = saved;
@@ -234,7 +234,7 @@ bool rl_cli_make_dirs(const char *dir)
     return ok;
 }
 
-bool rl_cli_split_source(const char *arg, char **source, char **params)
+bool cli_split_source(const char *arg, char **source, char **params)
 {
     struct stat st;
     const char *colon = strrchr(arg, ':');

@@ -90,12 +90,12 @@ static void free_args(bench_args *a)
 static bool add_scene(bench_args *a, const char *text, size_t n)
 {
     if (a->num_scenes >= MAX_SCENES) {
-        rl_cli_fail(RL_CLI_USAGE, "--scenes: at most %d scenes", MAX_SCENES);
+        cli_fail(RL_CLI_USAGE, "--scenes: at most %d scenes", MAX_SCENES);
         return false;
     }
     char *s = malloc(n + 1);
     if (!s) {
-        rl_cli_fail(RL_CLI_FAIL, "out of memory");
+        cli_fail(RL_CLI_FAIL, "out of memory");
         return false;
     }
     memcpy(s, text, n);
@@ -111,7 +111,7 @@ static bool continue_scene(bench_args *a, const char *text, size_t n)
     size_t len = strlen(last);
     char *s = realloc(last, len + n + 2);
     if (!s) {
-        rl_cli_fail(RL_CLI_FAIL, "out of memory");
+        cli_fail(RL_CLI_FAIL, "out of memory");
         return false;
     }
     s[len] = ',';
@@ -129,7 +129,7 @@ static bool parse_scenes(const char *text, bench_args *a)
         size_t n = strcspn(p, ",");
         bool param = memchr(p, '=', n) && !memchr(p, ':', n);
         if (n == 0 || (param && a->num_scenes == 0)) {
-            rl_cli_fail(RL_CLI_USAGE, "--scenes: expected NAME[:k=v,...],... such as "
+            cli_fail(RL_CLI_USAGE, "--scenes: expected NAME[:k=v,...],... such as "
                                       "cornell,city:blocks=4, got '%s'", text);
             return false;
         }
@@ -150,7 +150,7 @@ static bool parse_accels(const char *text, bench_args *a)
         char name[32];
         rl_accel_kind kind;
         if (n == 0 || n >= sizeof name) {
-            rl_cli_fail(RL_CLI_USAGE, "--accels: expected names such as bvh,grid,embree, got '%s'",
+            cli_fail(RL_CLI_USAGE, "--accels: expected names such as bvh,grid,embree, got '%s'",
                         text);
             return false;
         }
@@ -159,7 +159,7 @@ static bool parse_accels(const char *text, bench_args *a)
         rl_clear_error();
         rl_status st = rl_accel_kind_parse(name, &kind);
         if (st != RL_OK) {
-            rl_cli_fail_status(RL_CLI_USAGE, st, "--accels");
+            cli_fail_status(RL_CLI_USAGE, st, "--accels");
             return false;
         }
         bool seen = false;      /* a repeated name is measured once */
@@ -187,18 +187,18 @@ static bool take_accels(void *a, const char *text)
 static int parse_args(int argc, char **argv, bench_args *a)
 {
     if (argc < 2)
-        return rl_cli_fail(RL_CLI_USAGE,
+        return cli_fail(RL_CLI_USAGE,
                            "bench: missing benchmark (try: rl bench rays, rl bench vt)");
-    if (rl_cli_is_help(argv[1])) {
+    if (cli_is_help(argv[1])) {
         fputs(bench_help, stdout);
         return RL_BENCH_HELP_SHOWN;
     }
     if (strcmp(argv[1], "rays") != 0)
-        return rl_cli_fail(RL_CLI_USAGE, "bench: unknown benchmark '%s' (known: rays, vt, pt, "
+        return cli_fail(RL_CLI_USAGE, "bench: unknown benchmark '%s' (known: rays, vt, pt, "
                            "sampling, surfels, culling)",
                            argv[1]);
     bool has_scenes = false, has_accels = false;
-    const rl_bench_opt rows[] = {
+    const bench_opt rows[] = {
         RL_BENCH_FLAG("--quick", &a->quick),
         RL_BENCH_CUSTOM("--scenes", take_scenes, a, &has_scenes),
         RL_BENCH_CUSTOM("--accels", take_accels, a, &has_accels),
@@ -207,7 +207,7 @@ static int parse_args(int argc, char **argv, bench_args *a)
         RL_BENCH_COUNT("--threads", 4096, &a->threads, NULL),
         RL_BENCH_OUT(&a->out),
     };
-    int rc = rl_bench_parse_args(argc, argv, "bench rays", bench_help, rows,
+    int rc = bench_parse_args(argc, argv, "bench rays", bench_help, rows,
                                  (int)(sizeof rows / sizeof rows[0]));
     if (rc != RL_CLI_OK)
         return rc;
@@ -246,7 +246,7 @@ static int parse_args(int argc, char **argv, bench_args *a)
         a->height = (int)h;
     }
     if ((long long)a->width * a->height > MAX_RAYS)
-        return rl_cli_fail(RL_CLI_USAGE, "--size: %dx%d is more than %lld primary rays", a->width,
+        return cli_fail(RL_CLI_USAGE, "--size: %dx%d is more than %lld primary rays", a->width,
                            a->height, MAX_RAYS);
     if (a->threads == 0)
         a->threads = omp_get_max_threads();
@@ -262,19 +262,19 @@ static void scene_label(const char *arg, char *out, size_t size)
 
 /* Loads every scene up front, so that a typo in the last one does not cost
  * the minutes spent on the first. A missing file becomes a skipped scene. */
-static int load_scenes(const bench_args *a, rl_scene **scenes, rl_bench_scene_result *results)
+static int load_scenes(const bench_args *a, rl_scene **scenes, bench_scene_result *results)
 {
     for (int i = 0; i < a->num_scenes; i++) {
-        rl_bench_scene_result *r = &results[i];
+        bench_scene_result *r = &results[i];
         r->arg = a->scenes[i];
         r->status = "ok";
         scene_label(r->arg, r->label, sizeof r->label);
         char *source = NULL, *params = NULL;
-        if (!rl_cli_split_source(r->arg, &source, &params))
-            return rl_cli_fail(RL_CLI_FAIL, "out of memory");
+        if (!cli_split_source(r->arg, &source, &params))
+            return cli_fail(RL_CLI_FAIL, "out of memory");
         struct stat st;
         bool looks_like_file = strchr(source, '/') || strchr(source, '.');
-        bool missing = !rl_cli_is_builtin(source) && looks_like_file && stat(source, &st) != 0;
+        bool missing = !cli_is_builtin(source) && looks_like_file && stat(source, &st) != 0;
         free(source);
         free(params);
         if (missing) {
@@ -284,7 +284,7 @@ static int load_scenes(const bench_args *a, rl_scene **scenes, rl_bench_scene_re
                 fprintf(stderr, "rl: warning: bench: skipping %s: no such file\n", r->arg);
             continue;
         }
-        int rc = rl_cli_load_scene(r->arg, &scenes[i]);
+        int rc = cli_load_scene(r->arg, &scenes[i]);
         if (rc != RL_CLI_OK)
             return rc;
         rl_scene_stats stats;
@@ -323,13 +323,13 @@ static void set_reason(char *reason, size_t size, rl_status st)
 }
 
 /* Times every built accelerator on every workload, interleaved
- * (rl_bench_time_rays), and fills Mrays/s. */
-static void measure(rl_accel **built, const rl_bench_rays *rays, const rl_bench_params *p,
-                    rl_bench_scene_result *sc)
+ * (bench_time_rays), and fills Mrays/s. */
+static void measure(rl_accel **built, const bench_rays *rays, const bench_params *p,
+                    bench_scene_result *sc)
 {
     const rl_accel *list[RL_ACCEL_KIND_COUNT];
-    rl_bench_accel_result *which[RL_ACCEL_KIND_COUNT];
-    rl_bench_timing timing[RL_ACCEL_KIND_COUNT];
+    bench_accel_result *which[RL_ACCEL_KIND_COUNT];
+    bench_timing timing[RL_ACCEL_KIND_COUNT];
     int n = 0;
     for (int i = 0; i < sc->num_accels; i++)
         if (built[i]) {
@@ -339,8 +339,8 @@ static void measure(rl_accel **built, const rl_bench_rays *rays, const rl_bench_
     for (int w = 0; w < RL_BENCH_WORKLOADS; w++) {
         if (rays->count[w] == 0 || n == 0)
             continue;
-        progress(sc->label, "tracing", rl_bench_workload_name(w));
-        rl_bench_time_rays(list, n, rays->rays[w], rays->count[w], w == RL_BENCH_SHADOW,
+        progress(sc->label, "tracing", bench_workload_name(w));
+        bench_time_rays(list, n, rays->rays[w], rays->count[w], w == RL_BENCH_SHADOW,
                            p->threads, p->min_runs, p->max_runs, p->min_total_s, timing);
         for (int k = 0; k < n; k++) {
             which[k]->timing[w] = timing[k];
@@ -355,11 +355,11 @@ static void measure(rl_accel **built, const rl_bench_rays *rays, const rl_bench_
 
 /* Ratios to Embree of the same run, and the hit-count check; returns the
  * number of workloads where the accelerators disagree. */
-static int compare(rl_bench_scene_result *sc)
+static int compare(bench_scene_result *sc)
 {
-    const rl_bench_accel_result *embree = NULL, *first = NULL;
+    const bench_accel_result *embree = NULL, *first = NULL;
     for (int i = 0; i < sc->num_accels; i++) {
-        const rl_bench_accel_result *a = &sc->accels[i];
+        const bench_accel_result *a = &sc->accels[i];
         if (strcmp(a->status, "ok") != 0)
             continue;
         first = first ? first : a;
@@ -373,7 +373,7 @@ static int compare(rl_bench_scene_result *sc)
         return 0;
     for (int w = 0; w < RL_BENCH_WORKLOADS; w++) {
         for (int i = 0; i < sc->num_accels; i++) {
-            rl_bench_accel_result *a = &sc->accels[i];
+            bench_accel_result *a = &sc->accels[i];
             if (strcmp(a->status, "ok") != 0)
                 continue;
             if (embree) {
@@ -385,14 +385,14 @@ static int compare(rl_bench_scene_result *sc)
             if (!a->timing[w].deterministic && rl_log_get_level() >= RL_LOG_WARN)
                 fprintf(stderr, "rl: warning: bench: %s %s: %s found different hit counts "
                                 "in different passes\n",
-                        sc->label, rl_bench_workload_name(w), rl_accel_kind_name(a->kind));
+                        sc->label, bench_workload_name(w), rl_accel_kind_name(a->kind));
         }
         if (sc->hits_agree[w])
             continue;
         mismatches++;
         if (rl_log_get_level() >= RL_LOG_WARN) {
             fprintf(stderr, "rl: warning: bench: %s %s: hit counts differ:", sc->label,
-                    rl_bench_workload_name(w));
+                    bench_workload_name(w));
             for (int i = 0; i < sc->num_accels; i++)
                 if (strcmp(sc->accels[i].status, "ok") == 0)
                     fprintf(stderr, " %s %llu", rl_accel_kind_name(sc->accels[i].kind),
@@ -404,8 +404,8 @@ static int compare(rl_bench_scene_result *sc)
 }
 
 /* Runs every accelerator on one scene; false when something failed. */
-static bool run_scene(const rl_scene *scene, const bench_args *a, const rl_bench_params *p,
-                      rl_bench_scene_result *sc)
+static bool run_scene(const rl_scene *scene, const bench_args *a, const bench_params *p,
+                      bench_scene_result *sc)
 {
     rl_camera cam;
     rl_clear_error();
@@ -427,10 +427,10 @@ static bool run_scene(const rl_scene *scene, const bench_args *a, const rl_bench
      * fast to build and trusted: brute force for tiny scenes, else the BVH. */
     rl_accel_kind ref_kind = sc->triangles <= TINY_SCENE ? RL_ACCEL_BRUTE : RL_ACCEL_BVH;
     rl_accel *ref = NULL;
-    rl_bench_rays rays = { { NULL }, { 0 } };
+    bench_rays rays = { { NULL }, { 0 } };
     progress(sc->label, "workloads from primary hits of", rl_accel_kind_name(ref_kind));
     st = build_accel(scene, ref_kind, p->threads, &ref);
-    if (st == RL_OK && !rl_bench_make_rays(scene, &cam, ref, p->seed, p->threads, &rays))
+    if (st == RL_OK && !bench_make_rays(scene, &cam, ref, p->seed, p->threads, &rays))
         st = RL_ERR_OUT_OF_MEMORY;
     if (st != RL_OK) {
         sc->status = "failed";
@@ -445,11 +445,11 @@ static bool run_scene(const rl_scene *scene, const bench_args *a, const rl_bench
     rl_accel *built[RL_ACCEL_KIND_COUNT] = { NULL };
     bool ok = true;
     for (int i = 0; i < sc->num_accels; i++) {
-        rl_bench_accel_result *r = &sc->accels[i];
+        bench_accel_result *r = &sc->accels[i];
         r->kind = a->accels[i];
         r->status = "ok";
         for (int w = 0; w < RL_BENCH_WORKLOADS; w++) {
-            r->timing[w] = (rl_bench_timing){ .deterministic = true };
+            r->timing[w] = (bench_timing){ .deterministic = true };
             r->mrays_per_s[w] = r->ratio_to_embree[w] = NAN;
             r->mrays_per_cpu_s[w] = r->cpu_ratio_to_embree[w] = NAN;
         }
@@ -480,7 +480,7 @@ static bool run_scene(const rl_scene *scene, const bench_args *a, const rl_bench
         if (built[i] != ref)
             rl_accel_release(built[i]);
     rl_accel_release(ref);
-    rl_bench_rays_free(&rays);
+    bench_rays_free(&rays);
     return ok;
 }
 
@@ -494,14 +494,14 @@ static void print_header(void)
            "primary", "shadow", "diffuse", "primary", "shadow", "diffuse");
 }
 
-static void print_scene(const rl_bench_scene_result *sc)
+static void print_scene(const bench_scene_result *sc)
 {
     if (strcmp(sc->status, "ok") != 0) {
         printf("%-30s %s: %s\n", sc->label, sc->status, sc->reason);
         return;
     }
     for (int i = 0; i < sc->num_accels; i++) {
-        const rl_bench_accel_result *r = &sc->accels[i];
+        const bench_accel_result *r = &sc->accels[i];
         printf("%-30s %9llu %-7s", sc->label, (unsigned long long)sc->triangles,
                rl_accel_kind_name(r->kind));
         if (strcmp(r->status, "ok") != 0) {
@@ -536,16 +536,16 @@ static int run(bench_args *a)
     char out[256];
     if (a->out)
         snprintf(out, sizeof out, "%s", a->out);
-    if (a->out ? !rl_cli_check_writable(out) : !rl_bench_default_out("rays", out, sizeof out))
+    if (a->out ? !cli_check_writable(out) : !bench_default_out("rays", out, sizeof out))
         return RL_CLI_FAIL;
 
-    rl_bench_params p = {
+    bench_params p = {
         .width = a->width, .height = a->height, .rays = a->rays, .threads = (int)a->threads,
         .quick = a->quick, .min_runs = a->quick ? 1 : 3, .max_runs = a->quick ? 1 : 100,
         .min_total_s = a->quick ? 0.0 : 0.5, .seed = 1,
     };
     rl_scene *scenes[MAX_SCENES] = { NULL };
-    rl_bench_scene_result results[MAX_SCENES];
+    bench_scene_result results[MAX_SCENES];
     memset(results, 0, sizeof results);
     int rc = load_scenes(a, scenes, results);
     bool ok = true;
@@ -553,14 +553,14 @@ static int run(bench_args *a)
     if (rc == RL_CLI_OK)
         print_header();
     for (int i = 0; rc == RL_CLI_OK && i < a->num_scenes; i++) {
-        rl_bench_scene_result *sc = &results[i];
+        bench_scene_result *sc = &results[i];
         if (!scenes[i]) {
             print_scene(sc);    /* skipped */
             continue;
         }
         sc->accels = calloc((size_t)a->num_accels, sizeof *sc->accels);
         if (!sc->accels) {
-            rc = rl_cli_fail(RL_CLI_FAIL, "out of memory");
+            rc = cli_fail(RL_CLI_FAIL, "out of memory");
             break;
         }
         sc->num_accels = a->num_accels;
@@ -574,10 +574,10 @@ static int run(bench_args *a)
         scenes[i] = NULL;
     }
     if (rc == RL_CLI_OK) {
-        cJSON *report = rl_bench_report_json(&p, results, a->num_scenes, mismatches);
+        cJSON *report = bench_report_json(&p, results, a->num_scenes, mismatches);
         if (!report)
-            rc = rl_cli_fail(RL_CLI_FAIL, "out of memory");
-        else if (!rl_cli_write_json(report, out))
+            rc = cli_fail(RL_CLI_FAIL, "out of memory");
+        else if (!cli_write_json(report, out))
             rc = RL_CLI_FAIL;
         else if (rl_log_get_level() >= RL_LOG_INFO)
             fprintf(stderr, "bench: wrote %s%s\n", out,
@@ -585,7 +585,7 @@ static int run(bench_args *a)
         cJSON_Delete(report);
     }
     if (rc == RL_CLI_OK && !ok)
-        rc = rl_cli_fail(RL_CLI_FAIL, "bench: some scenes or accelerators failed (see table)");
+        rc = cli_fail(RL_CLI_FAIL, "bench: some scenes or accelerators failed (see table)");
     for (int i = 0; i < a->num_scenes; i++) {
         rl_scene_release(scenes[i]);
         free(results[i].accels);
@@ -593,18 +593,18 @@ static int run(bench_args *a)
     return rc;
 }
 
-int rl_cli_bench(int argc, char **argv)
+int cli_bench(int argc, char **argv)
 {
     if (argc >= 2 && strcmp(argv[1], "vt") == 0)
-        return rl_bench_vt(argc, argv);
+        return bench_vt(argc, argv);
     if (argc >= 2 && strcmp(argv[1], "pt") == 0)
-        return rl_bench_pt(argc, argv);
+        return bench_pt(argc, argv);
     if (argc >= 2 && strcmp(argv[1], "sampling") == 0)
-        return rl_bench_sampling(argc, argv);
+        return bench_sampling(argc, argv);
     if (argc >= 2 && strcmp(argv[1], "surfels") == 0)
-        return rl_bench_surfels(argc, argv);
+        return bench_surfels(argc, argv);
     if (argc >= 2 && strcmp(argv[1], "culling") == 0)
-        return rl_bench_culling(argc, argv);
+        return bench_culling(argc, argv);
     bench_args a;
     memset(&a, 0, sizeof a);
     int rc = parse_args(argc, argv, &a);

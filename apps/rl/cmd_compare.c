@@ -85,7 +85,7 @@ typedef struct compare_args {
     int width, height;
     double fov_deg;
     long long repeats, resolution;
-    rl_eval_sampling sampling;
+    eval_sampling sampling;
 } compare_args;
 
 static void free_spec(algo_spec *s)
@@ -138,7 +138,7 @@ static rl_status expand_bare_value(const rl_renderer *r, const char *label, cons
         }
     }
     if (!found) {
-        rl_cli_fail(RL_CLI_USAGE, "%s: '%s' is neither KEY=VALUE nor a value of one of the renderer's "
+        cli_fail(RL_CLI_USAGE, "%s: '%s' is neither KEY=VALUE nor a value of one of the renderer's "
                     "options (see rl algos)", label, value);
         return RL_ERR_INVALID_ARG;
     }
@@ -153,14 +153,14 @@ static bool make_spec(const char *text, algo_spec *s)
     const char *colon = strchr(text, ':');
     s->name = colon ? strndup(text, (size_t)(colon - text)) : strdup(text);
     if (!s->label || !s->name) {
-        rl_cli_fail(RL_CLI_FAIL, "out of memory");
+        cli_fail(RL_CLI_FAIL, "out of memory");
         return false;
     }
     rl_renderer *r = NULL;
     rl_status st = rl_renderer_create(s->name, &r);
     if (st != RL_OK) {
         rl_renderer_release(r);
-        rl_cli_fail_status(RL_CLI_USAGE, st, "--algos");
+        cli_fail_status(RL_CLI_USAGE, st, "--algos");
         return false;
     }
     /* The options are checked here, not after minutes of sampling. */
@@ -177,7 +177,7 @@ static bool make_spec(const char *text, algo_spec *s)
         }
         char key[128];
         const char *value = NULL;
-        if (!rl_cli_split_option(s->label, kv, key, sizeof key, &value)) {
+        if (!cli_split_option(s->label, kv, key, sizeof key, &value)) {
             st = RL_ERR_INVALID_ARG;
             break;
         }
@@ -191,10 +191,10 @@ static bool make_spec(const char *text, algo_spec *s)
         char *eq = strchr(kv, '=');
         *eq = '\0';
         if ((st = rl_renderer_set(r, kv, eq + 1)) != RL_OK)
-            rl_cli_fail_status(RL_CLI_USAGE, st, s->label);
+            cli_fail_status(RL_CLI_USAGE, st, s->label);
     }
     if (st == RL_ERR_OUT_OF_MEMORY || (st == RL_OK && expanded && !copy)) {
-        rl_cli_fail(RL_CLI_FAIL, "out of memory");
+        cli_fail(RL_CLI_FAIL, "out of memory");
         st = RL_ERR_OUT_OF_MEMORY;
     }
     free(copy);
@@ -208,7 +208,7 @@ static bool parse_algos(const char *list, compare_args *a)
 {
     char *copy = strdup(list);
     if (!copy) {
-        rl_cli_fail(RL_CLI_FAIL, "out of memory");
+        cli_fail(RL_CLI_FAIL, "out of memory");
         return false;
     }
     char item[1024] = "";
@@ -225,7 +225,7 @@ static bool parse_algos(const char *list, compare_args *a)
         }
         if (*item) {
             if (a->num_algos == MAX_ALGOS) {
-                rl_cli_fail(RL_CLI_USAGE, "--algos: at most %d renderers", MAX_ALGOS);
+                cli_fail(RL_CLI_USAGE, "--algos: at most %d renderers", MAX_ALGOS);
                 ok = false;
                 break;
             }
@@ -237,7 +237,7 @@ static bool parse_algos(const char *list, compare_args *a)
     }
     free(copy);
     if (ok && a->num_algos == 0) {
-        rl_cli_fail(RL_CLI_USAGE, "--algos: no renderer given");
+        cli_fail(RL_CLI_USAGE, "--algos: no renderer given");
         ok = false;
     }
     return ok;
@@ -245,7 +245,7 @@ static bool parse_algos(const char *list, compare_args *a)
 
 static int parse_args(int argc, char **argv, compare_args *a)
 {
-    rl_eval_sampling_init(&a->sampling);
+    eval_sampling_init(&a->sampling);
     a->sampling.desc.max_samples = 64;
     a->out = "out/compare";
     a->metrics = (1u << M_COUNT) - 1;
@@ -257,18 +257,18 @@ static int parse_args(int argc, char **argv, compare_args *a)
     for (int i = 1; i < argc; i++) {
         const char *v = NULL;
         int m;
-        if (rl_cli_is_help(argv[i])) {
+        if (cli_is_help(argv[i])) {
             fputs(compare_help_head, stdout);
-            fputs(rl_eval_sampling_help, stdout);
+            fputs(eval_sampling_help, stdout);
             fputs(compare_help_tail, stdout);
             return -1;
         }
-        if ((m = rl_eval_sampling_arg(argc, argv, &i, &a->sampling)) != 0) {
+        if ((m = eval_sampling_arg(argc, argv, &i, &a->sampling)) != 0) {
             if (m < 0)
                 return RL_CLI_USAGE;
             continue;
         }
-#define VALUE(name) (m == 0 && (m = rl_cli_take_value(argc, argv, &i, name, &v)) > 0)
+#define VALUE(name) (m == 0 && (m = cli_take_value(argc, argv, &i, name, &v)) > 0)
         m = 0;
         if (VALUE("--algos"))
             algos = v;
@@ -279,41 +279,41 @@ static int parse_args(int argc, char **argv, compare_args *a)
             while (quality_metrics[k] && strcmp(quality_metrics[k], v) != 0)
                 k++;
             if (!quality_metrics[k])
-                return rl_cli_fail(RL_CLI_USAGE, "--quality-metric: expected hssim, ssim, psnr or rmse, "
+                return cli_fail(RL_CLI_USAGE, "--quality-metric: expected hssim, ssim, psnr or rmse, "
                                    "got '%s'", v);
             a->quality_metric = k;
         }
         else if (VALUE("--out"))
             a->out = v;
         else if (VALUE("--metrics")) {
-            if (!rl_bench_parse_sections(v, metric_names, M_COUNT, &a->metrics))
+            if (!bench_parse_sections(v, metric_names, M_COUNT, &a->metrics))
                 return RL_CLI_USAGE;
         } else if (VALUE("--size")) {
-            if (!rl_cli_parse_size(v, &a->width, &a->height))
+            if (!cli_parse_size(v, &a->width, &a->height))
                 return RL_CLI_USAGE;
         } else if (VALUE("--fov")) {
             char *end = NULL;
             a->fov_deg = strtod(v, &end);
             if (!*v || *end || !(a->fov_deg > 0.0 && a->fov_deg < 180.0))
-                return rl_cli_fail(RL_CLI_USAGE, "--fov: expected degrees in (0, 180), got '%s'", v);
+                return cli_fail(RL_CLI_USAGE, "--fov: expected degrees in (0, 180), got '%s'", v);
         } else if (VALUE("--repeats")) {
-            if (!rl_bench_parse_count("--repeats", v, 1000, &a->repeats))
+            if (!bench_parse_count("--repeats", v, 1000, &a->repeats))
                 return RL_CLI_USAGE;
         } else if (VALUE("--resolution")) {
-            if (!rl_bench_parse_count("--resolution", v, 4096, &a->resolution))
+            if (!bench_parse_count("--resolution", v, 4096, &a->resolution))
                 return RL_CLI_USAGE;
         } else if (m == 0 && argv[i][0] != '-' && !a->scene)
             a->scene = argv[i];
         else if (m == 0)
-            return rl_cli_unknown_arg("compare", argv[i]);
+            return cli_unknown_arg("compare", argv[i]);
 #undef VALUE
         if (m < 0)
             return RL_CLI_USAGE;
     }
     if (!a->scene)
-        return rl_cli_fail(RL_CLI_USAGE, "compare: no scene given (see rl compare --help)");
+        return cli_fail(RL_CLI_USAGE, "compare: no scene given (see rl compare --help)");
     if (!algos)
-        return rl_cli_fail(RL_CLI_USAGE, "compare: no --algos given (see rl algos)");
+        return cli_fail(RL_CLI_USAGE, "compare: no --algos given (see rl algos)");
     if (!parse_algos(algos, a) || !make_spec(reference, &a->reference))
         return RL_CLI_USAGE;
     return RL_CLI_OK;
@@ -348,7 +348,7 @@ static rl_property *metric_property(const compare_args *a, int m, const algo_spe
     }
 #undef SET
     if (st != RL_OK) {
-        rl_cli_fail_status(RL_CLI_USAGE, st, s->label);
+        cli_fail_status(RL_CLI_USAGE, st, s->label);
         rl_property_release(p);
         return NULL;
     }
@@ -362,7 +362,7 @@ typedef struct measured {
     char error[256];
 } measured;
 
-static void put_metric_section(rl_html *h, const compare_args *a, int m, measured (*res)[M_COUNT],
+static void put_metric_section(html_doc *h, const compare_args *a, int m, measured (*res)[M_COUNT],
                                const rl_image *top, float height)
 {
     /* Renderers that never do this operation (a rasterizer traces no ray)
@@ -378,30 +378,30 @@ static void put_metric_section(rl_html *h, const compare_args *a, int m, measure
         lo = fmin(lo, res[i][m].stats.min);
         hi = fmax(hi, res[i][m].stats.max);
     }
-    rl_html_heading(h, 2, metric_titles[m]);
+    html_heading(h, 2, metric_titles[m]);
     if (ns == 0) {
-        rl_html_para(h, "No renderer has values for this metric.");
+        html_para(h, "No renderer has values for this metric.");
         return;
     }
     static const char *const head[] = { "renderer", "min", "25 %", "median", "75 %", "max", "mean" };
-    rl_html_table_begin(h, head, 7);
+    html_table_begin(h, head, 7);
     for (int k = 0; k < ns; k++) {
         char cells[7][32];
         const char *row[7];
-        rl_eval_stats_cells(&res[shown[k]][m].stats, cells);
+        eval_stats_cells(&res[shown[k]][m].stats, cells);
         snprintf(cells[0], sizeof cells[0], "%.31s", a->algos[shown[k]].label);
         for (int c = 0; c < 7; c++)
             row[c] = cells[c];
-        rl_html_table_row(h, row, 7);
+        html_table_row(h, row, 7);
     }
-    rl_html_table_end(h);
+    html_table_end(h);
     /* One violin per renderer on a shared axis, then the heat maps side by
      * side with one colour range, so colours compare across renderers. */
     rl_plot_series series[MAX_ALGOS];
     double *vals[MAX_ALGOS] = { 0 }, *wts[MAX_ALGOS] = { 0 };
     size_t cnt[MAX_ALGOS] = { 0 };
     for (int k = 0; k < ns; k++) {
-        rl_eval_leaf_series(res[shown[k]][m].approx, &vals[k], &wts[k], &cnt[k]);
+        eval_leaf_series(res[shown[k]][m].approx, &vals[k], &wts[k], &cnt[k]);
         series[k] = (rl_plot_series){ a->algos[shown[k]].label, vals[k], wts[k], cnt[k] };
     }
     char *violin = NULL;
@@ -409,22 +409,22 @@ static void put_metric_section(rl_html *h, const compare_args *a, int m, measure
                          .y_label = rl_approx_unit(res[shown[0]][m].approx) };
     if (rl_plot_violin(series, (size_t)ns, &vs, &(rl_plot_output){ .svg = &violin }) != RL_OK)
         violin = NULL;
-    rl_html_svg(h, violin, "Area/volume-weighted distributions over the region, one violin "
+    html_svg(h, violin, "Area/volume-weighted distributions over the region, one violin "
                            "per renderer, with box plots inside.");
     free(violin);
-    rl_html_row_begin(h);
+    html_row_begin(h);
     /* dark = expensive or bad; of the quality metrics only rmse is an error */
     bool reverse = m != M_QUALITY || strcmp(quality_metrics[a->quality_metric], "rmse") == 0;
     for (int k = 0; k < ns; k++) {
-        char *svg = rl_eval_heatmap_svg(res[shown[k]][m].approx, height, top,
+        char *svg = eval_heatmap_svg(res[shown[k]][m].approx, height, top,
                                         a->algos[shown[k]].label, lo, hi > lo ? hi : lo + 1e-9,
                                         reverse, NULL);
-        rl_html_svg(h, svg, NULL);
+        html_svg(h, svg, NULL);
         free(svg);
         free(vals[k]);
         free(wts[k]);
     }
-    rl_html_row_end(h);
+    html_row_end(h);
 }
 
 static cJSON *result_json(const compare_args *a, const rl_scene *scene, const rl_approx *driver,
@@ -435,8 +435,8 @@ static cJSON *result_json(const compare_args *a, const rl_scene *scene, const rl
         return NULL;
     cJSON_AddStringToObject(root, "renderlab", RL_CLI_VERSION);
     cJSON_AddStringToObject(root, "scene", a->scene);
-    cJSON_AddItemToObject(root, "scene_stats", rl_cli_scene_stats_json(scene));
-    cJSON_AddItemToObject(root, "sampling", rl_eval_desc_json(&a->sampling.desc));
+    cJSON_AddItemToObject(root, "scene_stats", cli_scene_stats_json(scene));
+    cJSON_AddItemToObject(root, "sampling", eval_desc_json(&a->sampling.desc));
     cJSON_AddNumberToObject(root, "samples", rl_approx_sample_count(driver));
     cJSON_AddNumberToObject(root, "regions", rl_approx_region_count(driver));
     cJSON_AddStringToObject(root, "reference", a->reference.label);
@@ -453,7 +453,7 @@ static cJSON *result_json(const compare_args *a, const rl_scene *scene, const rl
             if (!(a->metrics & (1u << m)))
                 continue;
             if (res[i][m].ok) {
-                cJSON *s = rl_eval_stats_json(&res[i][m].stats);
+                cJSON *s = eval_stats_json(&res[i][m].stats);
                 cJSON_AddStringToObject(s, "unit", rl_approx_unit(res[i][m].approx));
                 cJSON_AddItemToObject(o, metric_names[m], s);
             } else {
@@ -466,7 +466,7 @@ static cJSON *result_json(const compare_args *a, const rl_scene *scene, const rl
     return root;
 }
 
-int rl_cli_compare(int argc, char **argv)
+int cli_compare(int argc, char **argv)
 {
     compare_args a = { 0 };
     int rc = parse_args(argc, argv, &a);
@@ -484,7 +484,7 @@ int rl_cli_compare(int argc, char **argv)
     rl_image *top = NULL;
     measured (*res)[M_COUNT] = calloc(MAX_ALGOS, sizeof *res);
     if (!res) {
-        rc = rl_cli_fail(RL_CLI_FAIL, "out of memory");
+        rc = cli_fail(RL_CLI_FAIL, "out of memory");
         goto done;
     }
     /* Everything a typo can break is checked before the long part. */
@@ -497,13 +497,13 @@ int rl_cli_compare(int argc, char **argv)
             }
             rl_property_release(p);
         }
-    if (!rl_cli_make_dirs(a.out) || !rl_cli_check_writable(report)) {
+    if (!cli_make_dirs(a.out) || !cli_check_writable(report)) {
         rc = RL_CLI_FAIL;
         goto done;
     }
-    if ((rc = rl_cli_load_scene(a.scene, &scene)) != RL_CLI_OK)
+    if ((rc = cli_load_scene(a.scene, &scene)) != RL_CLI_OK)
         goto done;
-    if (!rl_eval_sampling_finish(&a.sampling, scene)) {
+    if (!eval_sampling_finish(&a.sampling, scene)) {
         rc = RL_CLI_USAGE;
         goto done;
     }
@@ -525,13 +525,13 @@ int rl_cli_compare(int argc, char **argv)
         rl_progress_finish(progress);
     a.sampling.desc.progress = NULL;
     if (st != RL_OK) {
-        rc = rl_cli_fail_status(RL_CLI_FAIL, st, "sampling");
+        rc = cli_fail_status(RL_CLI_FAIL, st, "sampling");
         goto done;
     }
     uint32_t ns = rl_approx_sample_count(driver);
     pos = malloc(ns * sizeof *pos);
     if (!pos) {
-        rc = rl_cli_fail(RL_CLI_FAIL, "out of memory");
+        rc = cli_fail(RL_CLI_FAIL, "out of memory");
         goto done;
     }
     for (uint32_t k = 0; k < ns; k++) {
@@ -552,11 +552,11 @@ int rl_cli_compare(int argc, char **argv)
             rl_clear_error();
             st = p ? rl_property_commit(p, scene, a.sampling.desc.workers) : RL_ERR_INVALID_ARG;
             if (st == RL_OK)
-                st = rl_eval_measure(p, pos, ns, &values, label);
+                st = eval_measure(p, pos, ns, &values, label);
             if (st == RL_OK)
                 st = rl_approx_with_values(driver, values, metric_names[m], rl_property_unit(p),
                                            &r->approx);
-            if (st == RL_OK && !rl_eval_leaf_series(r->approx, &v2, &w2, &n2))
+            if (st == RL_OK && !eval_leaf_series(r->approx, &v2, &w2, &n2))
                 st = RL_ERR_OUT_OF_MEMORY;
             if (st == RL_OK)
                 st = rl_stats_compute(v2, w2, n2, &r->stats);
@@ -577,7 +577,7 @@ int rl_cli_compare(int argc, char **argv)
         }
     }
     cJSON *root = result_json(&a, scene, driver, res);
-    bool ok = root && rl_cli_write_json(root, json_path);
+    bool ok = root && cli_write_json(root, json_path);
     cJSON_Delete(root);
     if (!ok) {
         rc = RL_CLI_FAIL;
@@ -585,15 +585,15 @@ int rl_cli_compare(int argc, char **argv)
     }
     char title[256];
     snprintf(title, sizeof title, "rl compare: %s", a.scene);
-    rl_html *h = rl_html_begin(report, title);
+    html_doc *h = html_begin(report, title);
     if (!h) {
         rc = RL_CLI_FAIL;
         goto done;
     }
     const rl_sampling_desc *d = &a.sampling.desc;
     rl_aabb b = rl_approx_bounds(driver);
-    top = rl_eval_top_view(scene, b, d->height, 512);
-    rl_html_para(h, "%d renderers measured at the same %u positions (%s, %s sampling of pixel "
+    top = eval_top_view(scene, b, d->height, 512);
+    html_para(h, "%d renderers measured at the same %u positions (%s, %s sampling of pixel "
                  "visibility at %lld² per cube face, %u regions). Per position: 6 directions, "
                  "%dx%d pixels, %g° field of view; time is the maximum over the directions of "
                  "the median of %lld renders; quality is %s against %s, the %s over the "
@@ -604,21 +604,21 @@ int rl_cli_compare(int argc, char **argv)
                  quality_metric_titles[a.quality_metric], a.reference.label,
                  strcmp(quality_metrics[a.quality_metric], "rmse") == 0 ? "maximum" : "minimum",
                  d->dims == 2 ? "area" : "volume");
-    char *vis_svg = rl_eval_heatmap_svg(driver, d->height, top, "visible objects", 0, 0, false, NULL);
-    rl_html_svg(h, vis_svg, "Where the samples are: the visibility approximation that placed "
+    char *vis_svg = eval_heatmap_svg(driver, d->height, top, "visible objects", 0, 0, false, NULL);
+    html_svg(h, vis_svg, "Where the samples are: the visibility approximation that placed "
                             "them (adaptive sampling refines where visibility changes).");
     free(vis_svg);
     for (int m = 0; m < M_COUNT; m++)
         if (a.metrics & (1u << m))
             put_metric_section(h, &a, m, res, top, d->height);
-    rl_html_para(h, "Data: compare.json.");
-    if (!rl_html_end(h, report)) {
+    html_para(h, "Data: compare.json.");
+    if (!html_end(h, report)) {
         rc = RL_CLI_FAIL;
         goto done;
     }
     printf("compared %d renderers at %u positions of %s; wrote %s, %s\n", a.num_algos, ns, a.scene,
            json_path, report);
-    rc = failures ? rl_cli_fail(RL_CLI_FAIL, "%d measurement%s failed (see the warnings)", failures,
+    rc = failures ? cli_fail(RL_CLI_FAIL, "%d measurement%s failed (see the warnings)", failures,
                                 failures == 1 ? "" : "s")
                   : RL_CLI_OK;
 done:

@@ -73,7 +73,7 @@ static bool check_list(const char *option, const char *list, const char *const *
         for (size_t i = 0; i < count && !known; i++)
             known = strlen(names[i]) == m && strncmp(names[i], p, m) == 0;
         if (!known) {
-            rl_cli_fail(RL_CLI_USAGE, "%s: unknown name '%.*s'", option, (int)m, p);
+            cli_fail(RL_CLI_USAGE, "%s: unknown name '%.*s'", option, (int)m, p);
             return false;
         }
         p = end ? end + 1 : p + m;
@@ -86,7 +86,7 @@ static int parse_args(int argc, char **argv, demo_args *a)
     for (int i = 1; i < argc; i++) {
         const char *v = NULL;
         int m;
-        if (rl_cli_is_help(argv[i])) {
+        if (cli_is_help(argv[i])) {
             fputs(demo_help, stdout);
             return -1;
         }
@@ -94,17 +94,17 @@ static int parse_args(int argc, char **argv, demo_args *a)
             a->no_compare = true;
             continue;
         }
-        if ((m = rl_cli_take_value(argc, argv, &i, "--out", &v)) > 0)
+        if ((m = cli_take_value(argc, argv, &i, "--out", &v)) > 0)
             a->out = v;
-        else if (m == 0 && (m = rl_cli_take_value(argc, argv, &i, "--scenes", &v)) > 0)
+        else if (m == 0 && (m = cli_take_value(argc, argv, &i, "--scenes", &v)) > 0)
             a->scenes = v;
-        else if (m == 0 && (m = rl_cli_take_value(argc, argv, &i, "--algos", &v)) > 0)
+        else if (m == 0 && (m = cli_take_value(argc, argv, &i, "--algos", &v)) > 0)
             a->algos = v;
-        else if (m == 0 && (m = rl_cli_take_value(argc, argv, &i, "--size", &v)) > 0) {
-            if (!rl_cli_parse_size(v, &a->width, &a->height))
+        else if (m == 0 && (m = cli_take_value(argc, argv, &i, "--size", &v)) > 0) {
+            if (!cli_parse_size(v, &a->width, &a->height))
                 return RL_CLI_USAGE;
         } else if (m == 0)
-            return rl_cli_unknown_arg("demo", argv[i]);
+            return cli_unknown_arg("demo", argv[i]);
         if (m < 0)
             return RL_CLI_USAGE;
     }
@@ -113,7 +113,7 @@ static int parse_args(int argc, char **argv, demo_args *a)
     const rl_renderer_info *algos = rl_renderer_list(&nr);
     const char **names = calloc(ns + nr + 1, sizeof *names);
     if (!names)
-        return rl_cli_fail(RL_CLI_FAIL, "out of memory");
+        return cli_fail(RL_CLI_FAIL, "out of memory");
     for (size_t i = 0; i < ns; i++)
         names[i] = scenes[i].name;
     for (size_t i = 0; i < nr; i++)
@@ -158,7 +158,7 @@ static bool render_one(const demo_args *a, const char *scene_name, const rl_scen
     char file[512], path[4096];
     snprintf(file, sizeof file, "%s-%s.png", scene_name, algo);
     if ((size_t)snprintf(path, sizeof path, "%s/%s", a->out, file) >= sizeof path) {
-        rl_cli_fail(RL_CLI_FAIL, "%s: output path too long", a->out);
+        cli_fail(RL_CLI_FAIL, "%s: output path too long", a->out);
         return false;
     }
     rl_renderer *r = NULL;
@@ -184,7 +184,7 @@ static bool render_one(const demo_args *a, const char *scene_name, const rl_scen
         st = rl_image_write(img, path);
     bool ok = st == RL_OK;
     if (ok) {
-        rl_cli_print_summary(stdout, algo, scene_name, cam->width, cam->height, &stats);
+        cli_print_summary(stdout, algo, scene_name, cam->width, cam->height, &stats);
         fflush(stdout);
         cJSON *e = cJSON_CreateObject();
         if (e) {
@@ -193,8 +193,8 @@ static bool render_one(const demo_args *a, const char *scene_name, const rl_scen
             cJSON_AddStringToObject(e, "file", file);
             cJSON_AddNumberToObject(e, "width", cam->width);
             cJSON_AddNumberToObject(e, "height", cam->height);
-            cJSON *ss = rl_cli_scene_stats_json(scene);
-            cJSON *rs = rl_cli_render_stats_json(&stats);
+            cJSON *ss = cli_scene_stats_json(scene);
+            cJSON *rs = cli_render_stats_json(&stats);
             if (ss)
                 cJSON_AddItemToObject(e, "scene_stats", ss);
             if (rs)
@@ -204,7 +204,7 @@ static bool render_one(const demo_args *a, const char *scene_name, const rl_scen
     } else {
         char what[600];
         snprintf(what, sizeof what, "%s with %s", scene_name, algo);
-        rl_cli_fail_status(RL_CLI_FAIL, st, what);
+        cli_fail_status(RL_CLI_FAIL, st, what);
     }
     rl_image_release(img);
     rl_renderer_release(r);
@@ -216,7 +216,7 @@ static int run_demo(const demo_args *a, cJSON *report)
     cJSON *images = cJSON_AddArrayToObject(report, "images");
     cJSON *failures = cJSON_AddArrayToObject(report, "failures");
     if (!images || !failures)
-        return rl_cli_fail(RL_CLI_FAIL, "out of memory");
+        return cli_fail(RL_CLI_FAIL, "out of memory");
     size_t ns = 0, nr = 0;
     const rl_builtin_info *scenes = rl_builtin_scenes(&ns);
     const rl_renderer_info *algos = rl_renderer_list(&nr);
@@ -232,7 +232,7 @@ static int run_demo(const demo_args *a, cJSON *report)
         if (st == RL_OK)
             st = rl_scene_get_camera(scene, NULL, &cam);
         if (st != RL_OK) {
-            rl_cli_fail_status(RL_CLI_FAIL, st, name);
+            cli_fail_status(RL_CLI_FAIL, st, name);
             add_failure(failures, name, NULL);
             rl_scene_release(scene);
             rc = RL_CLI_FAIL;
@@ -276,10 +276,10 @@ static int run_compare(const demo_args *a)
     snprintf(out, sizeof out, "%s/compare", a->out);
     char *argv[] = { "compare", scene, "--algos", algos, "--size", "48x48", "--samples", "24",
                      "--repeats", "1", "--resolution", "32", "--out", out, NULL };
-    return rl_cli_compare((int)(sizeof argv / sizeof argv[0]) - 1, argv);
+    return cli_compare((int)(sizeof argv / sizeof argv[0]) - 1, argv);
 }
 
-int rl_cli_demo(int argc, char **argv)
+int cli_demo(int argc, char **argv)
 {
     demo_args a = { .out = "out/demo", .width = 640, .height = 480 };
     int rc = parse_args(argc, argv, &a);
@@ -287,13 +287,13 @@ int rl_cli_demo(int argc, char **argv)
         return rc < 0 ? RL_CLI_OK : rc;
     char probe[4096];
     if ((size_t)snprintf(probe, sizeof probe, "%s/report.json", a.out) >= sizeof probe)
-        return rl_cli_fail(RL_CLI_USAGE, "--out: path too long");
-    if (!rl_cli_make_dirs(a.out) || !rl_cli_check_writable(probe))
+        return cli_fail(RL_CLI_USAGE, "--out: path too long");
+    if (!cli_make_dirs(a.out) || !cli_check_writable(probe))
         return RL_CLI_FAIL;
 
     cJSON *report = cJSON_CreateObject();
     if (!report)
-        return rl_cli_fail(RL_CLI_FAIL, "out of memory");
+        return cli_fail(RL_CLI_FAIL, "out of memory");
     char date[64];
     time_t now = time(NULL);
     struct tm tm;
@@ -316,7 +316,7 @@ int rl_cli_demo(int argc, char **argv)
     }
     char html[4096];
     snprintf(html, sizeof html, "%s/index.html", a.out);
-    if (!rl_cli_write_json(report, probe) || !rl_cli_write_demo_html(report, html))
+    if (!cli_write_json(report, probe) || !cli_write_demo_html(report, html))
         rc = RL_CLI_FAIL;
     else
         printf("report: %s, %s\n", probe, html);

@@ -64,13 +64,13 @@ typedef struct eval_args {
     int num_sets2;
     long long validate;
     bool list;
-    rl_eval_sampling sampling;
+    eval_sampling sampling;
 } eval_args;
 
 static void print_help(void)
 {
     fputs(eval_help_head, stdout);
-    fputs(rl_eval_sampling_help, stdout);
+    fputs(eval_sampling_help, stdout);
     fputs(eval_help_tail, stdout);
 }
 
@@ -95,12 +95,12 @@ static int print_list(void)
 
 static int parse_args(int argc, char **argv, eval_args *a)
 {
-    rl_eval_sampling_init(&a->sampling);
+    eval_sampling_init(&a->sampling);
     a->out = "out/eval";
     for (int i = 1; i < argc; i++) {
         const char *v = NULL;
         int m;
-        if (rl_cli_is_help(argv[i])) {
+        if (cli_is_help(argv[i])) {
             print_help();
             return -1;
         }
@@ -108,56 +108,56 @@ static int parse_args(int argc, char **argv, eval_args *a)
             a->list = true;
             continue;
         }
-        if ((m = rl_eval_sampling_arg(argc, argv, &i, &a->sampling)) != 0) {
+        if ((m = eval_sampling_arg(argc, argv, &i, &a->sampling)) != 0) {
             if (m < 0)
                 return RL_CLI_USAGE;
             continue;
         }
-        if ((m = rl_cli_take_value(argc, argv, &i, "--property", &v)) > 0)
+        if ((m = cli_take_value(argc, argv, &i, "--property", &v)) > 0)
             a->property = v;
-        else if (m == 0 && (m = rl_cli_take_value(argc, argv, &i, "--out", &v)) > 0)
+        else if (m == 0 && (m = cli_take_value(argc, argv, &i, "--out", &v)) > 0)
             a->out = v;
-        else if (m == 0 && (m = rl_cli_take_value(argc, argv, &i, "--report", &v)) > 0)
+        else if (m == 0 && (m = cli_take_value(argc, argv, &i, "--report", &v)) > 0)
             a->report = v;
-        else if (m == 0 && (m = rl_cli_take_value(argc, argv, &i, "--set", &v)) > 0) {
+        else if (m == 0 && (m = cli_take_value(argc, argv, &i, "--set", &v)) > 0) {
             if (a->num_sets == MAX_SETS)
-                return rl_cli_fail(RL_CLI_USAGE, "--set: at most %d options", MAX_SETS);
+                return cli_fail(RL_CLI_USAGE, "--set: at most %d options", MAX_SETS);
             a->sets[a->num_sets++] = v;
-        } else if (m == 0 && (m = rl_cli_take_value(argc, argv, &i, "--set2", &v)) > 0) {
+        } else if (m == 0 && (m = cli_take_value(argc, argv, &i, "--set2", &v)) > 0) {
             if (a->num_sets2 == MAX_SETS)
-                return rl_cli_fail(RL_CLI_USAGE, "--set2: at most %d options", MAX_SETS);
+                return cli_fail(RL_CLI_USAGE, "--set2: at most %d options", MAX_SETS);
             a->sets2[a->num_sets2++] = v;
-        } else if (m == 0 && (m = rl_cli_take_value(argc, argv, &i, "--property2", &v)) > 0) {
+        } else if (m == 0 && (m = cli_take_value(argc, argv, &i, "--property2", &v)) > 0) {
             a->second = v;
-        } else if (m == 0 && (m = rl_cli_take_value(argc, argv, &i, "--op", &v)) > 0) {
+        } else if (m == 0 && (m = cli_take_value(argc, argv, &i, "--op", &v)) > 0) {
             int k = 0;
             while (combine_ops[k] && strcmp(combine_ops[k], v) != 0)
                 k++;
             if (!combine_ops[k])
-                return rl_cli_fail(RL_CLI_USAGE, "--op: expected minus, ratio, min or max, got '%s'", v);
+                return cli_fail(RL_CLI_USAGE, "--op: expected minus, ratio, min or max, got '%s'", v);
             a->combine_op = k;
             a->op = v;
-        } else if (m == 0 && (m = rl_cli_take_value(argc, argv, &i, "--validate", &v)) > 0) {
-            if (!rl_bench_parse_count("--validate", v, 1 << 20, &a->validate))
+        } else if (m == 0 && (m = cli_take_value(argc, argv, &i, "--validate", &v)) > 0) {
+            if (!bench_parse_count("--validate", v, 1 << 20, &a->validate))
                 return RL_CLI_USAGE;
         } else if (m == 0 && argv[i][0] != '-' && !a->scene)
             a->scene = argv[i];
         else if (m == 0)
-            return rl_cli_unknown_arg("eval", argv[i]);
+            return cli_unknown_arg("eval", argv[i]);
         if (m < 0)
             return RL_CLI_USAGE;
     }
     if (a->list)
         return RL_CLI_OK;
     if (!a->scene)
-        return rl_cli_fail(RL_CLI_USAGE, "eval: no scene given (see rl eval --help)");
+        return cli_fail(RL_CLI_USAGE, "eval: no scene given (see rl eval --help)");
     if (!a->property)
-        return rl_cli_fail(RL_CLI_USAGE, "eval: no --property given (see rl eval --list)");
+        return cli_fail(RL_CLI_USAGE, "eval: no --property given (see rl eval --list)");
     if ((a->num_sets2 || a->op) && !a->second)
-        return rl_cli_fail(RL_CLI_USAGE, "%s: only with --property2", a->op ? "--op" : "--set2");
+        return cli_fail(RL_CLI_USAGE, "%s: only with --property2", a->op ? "--op" : "--set2");
     static const char *const html[] = { ".html", ".htm", NULL };
-    if (a->report && !rl_cli_has_extension(a->report, html))
-        return rl_cli_fail(RL_CLI_USAGE, "--report: expected a .html file, got '%s'", a->report);
+    if (a->report && !cli_has_extension(a->report, html))
+        return cli_fail(RL_CLI_USAGE, "--report: expected a .html file, got '%s'", a->report);
     return RL_CLI_OK;
 }
 
@@ -167,11 +167,11 @@ static int make_one(const char *name, const char *flag, const char *set_flag, co
 {
     rl_status st = rl_property_create(name, out);
     if (st != RL_OK)
-        return rl_cli_fail_status(RL_CLI_USAGE, st, flag);
+        return cli_fail_status(RL_CLI_USAGE, st, flag);
     for (int k = 0; k < num_sets; k++) {
         char key[128];
         const char *value = NULL;
-        if (!rl_cli_split_option(set_flag, sets[k], key, sizeof key, &value)) {
+        if (!cli_split_option(set_flag, sets[k], key, sizeof key, &value)) {
             rl_property_release(*out);
             *out = NULL;
             return RL_CLI_USAGE;
@@ -180,7 +180,7 @@ static int make_one(const char *name, const char *flag, const char *set_flag, co
         if (st != RL_OK) {
             rl_property_release(*out);
             *out = NULL;
-            return rl_cli_fail_status(RL_CLI_USAGE, st, set_flag);
+            return cli_fail_status(RL_CLI_USAGE, st, set_flag);
         }
     }
     return RL_CLI_OK;
@@ -208,7 +208,7 @@ static int make_property(const eval_args *a, rl_property **out, rl_property **fi
     }
     rl_status st = rl_property_create_combined((rl_property_op)a->combine_op, p, q, out);
     if (st != RL_OK)   /* p and q are released by the call */
-        return rl_cli_fail_status(RL_CLI_USAGE, st, "--property2");
+        return cli_fail_status(RL_CLI_USAGE, st, "--property2");
     return RL_CLI_OK;
 }
 
@@ -234,18 +234,18 @@ typedef struct eval_result {
 static int validate(const eval_args *a, rl_property *p, const rl_approx *ap, eval_result *r)
 {
     size_t n = (size_t)a->validate;
-    rl_vec3 *pos = rl_eval_random_positions(ap, n, a->sampling.desc.seed + 0x9e3779b9ULL);
+    rl_vec3 *pos = eval_random_positions(ap, n, a->sampling.desc.seed + 0x9e3779b9ULL);
     double *approx = malloc(n * sizeof *approx), *err = malloc(n * sizeof *err);
     if (!pos || !approx || !err) {
         free(pos);
         free(approx);
         free(err);
-        return rl_cli_fail(RL_CLI_FAIL, "out of memory");
+        return cli_fail(RL_CLI_FAIL, "out of memory");
     }
     double *measured = NULL;
-    rl_status st = rl_eval_measure(p, pos, n, &measured, "validation");
+    rl_status st = eval_measure(p, pos, n, &measured, "validation");
     if (st == RL_OK)
-        st = rl_eval_errors(ap, pos, measured, n, approx, err);
+        st = eval_errors(ap, pos, measured, n, approx, err);
     if (st == RL_OK)
         st = rl_stats_compute(err, NULL, n, &r->error);
     r->correlation = NAN;
@@ -256,7 +256,7 @@ static int validate(const eval_args *a, rl_property *p, const rl_approx *ap, eva
     if (st != RL_OK) {
         free(measured);
         free(approx);
-        return rl_cli_fail_status(RL_CLI_FAIL, st, "validation");
+        return cli_fail_status(RL_CLI_FAIL, st, "validation");
     }
     r->validated = true;
     r->measured = measured;
@@ -274,7 +274,7 @@ static cJSON *result_json(const eval_args *a, const rl_scene *scene, const rl_pr
         return NULL;
     cJSON_AddStringToObject(root, "renderlab", RL_CLI_VERSION);
     cJSON_AddStringToObject(root, "scene", a->scene);
-    cJSON_AddItemToObject(root, "scene_stats", rl_cli_scene_stats_json(scene));
+    cJSON_AddItemToObject(root, "scene_stats", cli_scene_stats_json(scene));
     cJSON *prop = cJSON_AddObjectToObject(root, "property");
     cJSON_AddStringToObject(prop, "name", rl_property_name(p));
     cJSON_AddStringToObject(prop, "unit", rl_property_unit(p));
@@ -286,35 +286,35 @@ static cJSON *result_json(const eval_args *a, const rl_scene *scene, const rl_pr
         cJSON_AddStringToObject(o2, "unit", rl_property_unit(second));
         cJSON_AddItemToObject(o2, "options", options_json(second));
     }
-    cJSON_AddItemToObject(root, "sampling", rl_eval_desc_json(&a->sampling.desc));
+    cJSON_AddItemToObject(root, "sampling", eval_desc_json(&a->sampling.desc));
     cJSON_AddNumberToObject(root, "samples", rl_approx_sample_count(ap));
     cJSON_AddNumberToObject(root, "regions", rl_approx_region_count(ap));
-    rl_bench_add_num(root, "seconds", rl_approx_seconds(ap));
-    rl_bench_add_num(root, "samples_per_second", rl_approx_sample_count(ap) / rl_approx_seconds(ap));
-    rl_bench_add_num(root, "measure", rl_approx_measure(ap));
+    bench_add_num(root, "seconds", rl_approx_seconds(ap));
+    bench_add_num(root, "samples_per_second", rl_approx_sample_count(ap) / rl_approx_seconds(ap));
+    bench_add_num(root, "measure", rl_approx_measure(ap));
     cJSON_AddStringToObject(root, "measure_unit", rl_approx_dims(ap) == 2 ? "m^2" : "m^3");
-    cJSON_AddItemToObject(root, "region_stats", rl_eval_stats_json(&r->stats));
+    cJSON_AddItemToObject(root, "region_stats", eval_stats_json(&r->stats));
     if (r->validated) {
         cJSON *v = cJSON_AddObjectToObject(root, "validation");
         cJSON_AddNumberToObject(v, "points", (double)r->num_validated);
-        cJSON_AddItemToObject(v, "abs_error", rl_eval_stats_json(&r->error));
-        rl_bench_add_num(v, "correlation", r->correlation);
+        cJSON_AddItemToObject(v, "abs_error", eval_stats_json(&r->error));
+        bench_add_num(v, "correlation", r->correlation);
     }
     return root;
 }
 
-static void stats_table(rl_html *h, const char *name, const rl_stats *s)
+static void stats_table(html_doc *h, const char *name, const rl_stats *s)
 {
     static const char *const head[] = { "", "min", "25 %", "median", "75 %", "max", "mean" };
     char cells[7][32];
     const char *row[7];
-    rl_eval_stats_cells(s, cells);
+    eval_stats_cells(s, cells);
     snprintf(cells[0], sizeof cells[0], "%s", name);
     for (int k = 0; k < 7; k++)
         row[k] = cells[k];
-    rl_html_table_begin(h, head, 7);
-    rl_html_table_row(h, row, 7);
-    rl_html_table_end(h);
+    html_table_begin(h, head, 7);
+    html_table_row(h, row, 7);
+    html_table_end(h);
 }
 
 static int write_report(const eval_args *a, const char *path, const rl_scene *scene,
@@ -322,7 +322,7 @@ static int write_report(const eval_args *a, const char *path, const rl_scene *sc
 {
     char title[256];
     snprintf(title, sizeof title, "rl eval: %s on %s", rl_property_name(p), a->scene);
-    rl_html *h = rl_html_begin(path, title);
+    html_doc *h = html_begin(path, title);
     if (!h)
         return RL_CLI_FAIL;
     const rl_sampling_desc *d = &a->sampling.desc;
@@ -334,27 +334,27 @@ static int write_report(const eval_args *a, const char *path, const rl_scene *sc
     else
         snprintf(where, sizeof where, "the region %g,%g,%g .. %g,%g,%g (%.4g m³)", b.min.x,
                  b.min.y, b.min.z, b.max.x, b.max.y, b.max.z, rl_approx_measure(ap));
-    rl_html_para(h, "Property %s [%s] approximated over %s by %s sampling%s%s: %u samples, %u "
+    html_para(h, "Property %s [%s] approximated over %s by %s sampling%s%s: %u samples, %u "
                  "regions, %.1f s (%.1f samples/s). Region values are weighted by their %s "
                  "(Jähn 2015, Sec. 5.6.2).",
                  rl_property_name(p), rl_property_unit(p), where,
                  d->method == RL_SAMPLING_GRID ? "regular grid" : "adaptive",
                  d->method == RL_SAMPLING_GRID ? "" : ", positions ",
-                 d->method == RL_SAMPLING_GRID ? "" : rl_eval_positions_name(d->positions),
+                 d->method == RL_SAMPLING_GRID ? "" : eval_positions_name(d->positions),
                  rl_approx_sample_count(ap), rl_approx_region_count(ap), rl_approx_seconds(ap),
                  rl_approx_sample_count(ap) / rl_approx_seconds(ap),
                  d->dims == 2 ? "area" : "volume");
-    rl_html_heading(h, 2, "Distribution");
+    html_heading(h, 2, "Distribution");
     stats_table(h, rl_property_unit(p), &r->stats);
 
     double *values = NULL, *weights = NULL;
     size_t n = 0;
-    rl_eval_leaf_series(ap, &values, &weights, &n);
-    rl_image *top = rl_eval_top_view(scene, b, d->height, 512);
+    eval_leaf_series(ap, &values, &weights, &n);
+    rl_image *top = eval_top_view(scene, b, d->height, 512);
     bool reverse = false;
     char png[4096];
     snprintf(png, sizeof png, "%s/heatmap.png", a->out);
-    char *heat = rl_eval_heatmap_svg(ap, d->height, top, rl_property_name(p), 0, 0, reverse, png);
+    char *heat = eval_heatmap_svg(ap, d->height, top, rl_property_name(p), 0, 0, reverse, png);
     rl_plot_series series = { .name = rl_property_unit(p), .values = values, .weights = weights,
                               .count = n };
     char *violin = NULL, *hist = NULL, *corr = NULL;
@@ -366,17 +366,17 @@ static int write_report(const eval_args *a, const char *path, const rl_scene *sc
         violin = NULL;
     if (values && rl_plot_histogram(&series, 1, 0, &hs, &(rl_plot_output){ .svg = &hist }) != RL_OK)
         hist = NULL;
-    rl_html_row_begin(h);
+    html_row_begin(h);
     if (heat)
-        rl_html_svg(h, heat, d->dims == 2 ? "Heat map of the regions over the scene's top "
+        html_svg(h, heat, d->dims == 2 ? "Heat map of the regions over the scene's top "
                                             "view; dots are the sample positions."
                                           : "The regions cut by the plane y = --height.");
-    rl_html_svg(h, violin, "Violin plot (weighted kernel density) with the box plot inside.");
-    rl_html_svg(h, hist, "Histogram of the region values, weighted by area/volume.");
-    rl_html_row_end(h);
+    html_svg(h, violin, "Violin plot (weighted kernel density) with the box plot inside.");
+    html_svg(h, hist, "Histogram of the region values, weighted by area/volume.");
+    html_row_end(h);
     if (r->validated) {
-        rl_html_heading(h, 2, "Validation");
-        rl_html_para(h, "The property measured at %zu uniform random positions against the "
+        html_heading(h, 2, "Validation");
+        html_para(h, "The property measured at %zu uniform random positions against the "
                      "approximation there (Jähn 2015, Sec. 5.7): absolute error below; Pearson "
                      "r = %.4f.", r->num_validated, r->correlation);
         stats_table(h, "|error|", &r->error);
@@ -384,11 +384,11 @@ static int write_report(const eval_args *a, const char *path, const rl_scene *sc
                              .x_label = "measured", .y_label = "approximated" };
         if (rl_plot_correlation(r->measured, r->approximated, r->num_validated, &cs,
                                 &(rl_plot_output){ .svg = &corr }) == RL_OK)
-            rl_html_svg(h, corr, NULL);
+            html_svg(h, corr, NULL);
         else
             rl_clear_error();
     }
-    rl_html_para(h, "Data: approx.json (the approximation), eval.json (these numbers), "
+    html_para(h, "Data: approx.json (the approximation), eval.json (these numbers), "
                     "heatmap.png (the heat map for papers).");
     free(heat);
     free(violin);
@@ -398,10 +398,10 @@ static int write_report(const eval_args *a, const char *path, const rl_scene *sc
     free(weights);
     rl_image_release(top);
     rl_clear_error();
-    return rl_html_end(h, path) ? RL_CLI_OK : RL_CLI_FAIL;
+    return html_end(h, path) ? RL_CLI_OK : RL_CLI_FAIL;
 }
 
-int rl_cli_eval(int argc, char **argv)
+int cli_eval(int argc, char **argv)
 {
     eval_args a = { 0 };
     int rc = parse_args(argc, argv, &a);
@@ -421,19 +421,19 @@ int rl_cli_eval(int argc, char **argv)
     rl_scene *scene = NULL;
     rl_approx *ap = NULL;
     eval_result r = { 0 };
-    if (!rl_cli_make_dirs(a.out) || !rl_cli_check_writable(report)) {
+    if (!cli_make_dirs(a.out) || !cli_check_writable(report)) {
         rc = RL_CLI_FAIL;
         goto done;
     }
-    if ((rc = rl_cli_load_scene(a.scene, &scene)) != RL_CLI_OK)
+    if ((rc = cli_load_scene(a.scene, &scene)) != RL_CLI_OK)
         goto done;
-    if (!rl_eval_sampling_finish(&a.sampling, scene)) {
+    if (!eval_sampling_finish(&a.sampling, scene)) {
         rc = RL_CLI_USAGE;
         goto done;
     }
     rl_status st = rl_property_commit(p, scene, a.sampling.desc.workers);
     if (st != RL_OK) {
-        rc = rl_cli_fail_status(st == RL_ERR_INVALID_ARG ? RL_CLI_USAGE : RL_CLI_FAIL, st,
+        rc = cli_fail_status(st == RL_ERR_INVALID_ARG ? RL_CLI_USAGE : RL_CLI_FAIL, st,
                                 "property");
         goto done;
     }
@@ -447,31 +447,31 @@ int rl_cli_eval(int argc, char **argv)
         rl_progress_finish(progress);
     a.sampling.desc.progress = NULL;
     if (st != RL_OK) {
-        rc = rl_cli_fail_status(RL_CLI_FAIL, st, "sampling");
+        rc = cli_fail_status(RL_CLI_FAIL, st, "sampling");
         goto done;
     }
     double *values = NULL, *weights = NULL;
     size_t n = 0;
-    if (!rl_eval_leaf_series(ap, &values, &weights, &n)) {
-        rc = rl_cli_fail(RL_CLI_FAIL, "out of memory");
+    if (!eval_leaf_series(ap, &values, &weights, &n)) {
+        rc = cli_fail(RL_CLI_FAIL, "out of memory");
         goto done;
     }
     st = rl_stats_compute(values, weights, n, &r.stats);
     free(values);
     free(weights);
     if (st != RL_OK) {
-        rc = rl_cli_fail_status(RL_CLI_FAIL, st, "statistics");
+        rc = cli_fail_status(RL_CLI_FAIL, st, "statistics");
         goto done;
     }
     if (a.validate > 0 && (rc = validate(&a, p, ap, &r)) != RL_CLI_OK)
         goto done;
     st = rl_approx_save_json(ap, approx_path);
     if (st != RL_OK) {
-        rc = rl_cli_fail_status(RL_CLI_FAIL, st, approx_path);
+        rc = cli_fail_status(RL_CLI_FAIL, st, approx_path);
         goto done;
     }
     cJSON *root = result_json(&a, scene, p, first, second, ap, &r);
-    bool ok = root && rl_cli_write_json(root, json_path);
+    bool ok = root && cli_write_json(root, json_path);
     cJSON_Delete(root);
     if (!ok) {
         rc = RL_CLI_FAIL;

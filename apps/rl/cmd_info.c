@@ -52,36 +52,36 @@ static void print_text(const rl_scene *scene)
     putchar('\n');
 }
 
-int rl_cli_info(int argc, char **argv)
+int cli_info(int argc, char **argv)
 {
     const char *source = NULL;
     bool json = false;
     for (int i = 1; i < argc; i++) {
-        if (rl_cli_is_help(argv[i])) {
+        if (cli_is_help(argv[i])) {
             fputs(info_help, stdout);
             return RL_CLI_OK;
         }
         if (strcmp(argv[i], "--json") == 0)
             json = true;
         else if (argv[i][0] == '-' || source)
-            return rl_cli_unknown_arg("info", argv[i]);
+            return cli_unknown_arg("info", argv[i]);
         else
             source = argv[i];
     }
     if (!source)
-        return rl_cli_fail(RL_CLI_USAGE, "info: missing SCENE (see rl info --help)");
+        return cli_fail(RL_CLI_USAGE, "info: missing SCENE (see rl info --help)");
 
     rl_scene *scene = NULL;
-    int rc = rl_cli_load_scene(source, &scene);
+    int rc = cli_load_scene(source, &scene);
     if (rc != RL_CLI_OK)
         return rc;
     if (json) {
-        cJSON *obj = rl_cli_scene_stats_json(scene);
+        cJSON *obj = cli_scene_stats_json(scene);
         char *text = obj ? cJSON_Print(obj) : NULL;
         if (text)
             printf("%s\n", text);
         else
-            rc = rl_cli_fail(RL_CLI_FAIL, "out of memory");
+            rc = cli_fail(RL_CLI_FAIL, "out of memory");
         free(text);
         cJSON_Delete(obj);
     } else {

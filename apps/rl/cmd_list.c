@@ -20,16 +20,16 @@ static const char *option_type_name(rl_option_type t)
 static int no_arguments(int argc, char **argv, const char *help)
 {
     for (int i = 1; i < argc; i++) {
-        if (rl_cli_is_help(argv[i])) {
+        if (cli_is_help(argv[i])) {
             fputs(help, stdout);
             return -1;
         }
-        return rl_cli_unknown_arg(argv[0], argv[i]);
+        return cli_unknown_arg(argv[0], argv[i]);
     }
     return RL_CLI_OK;
 }
 
-int rl_cli_scenes(int argc, char **argv)
+int cli_scenes(int argc, char **argv)
 {
     int rc = no_arguments(argc, argv,
                           "usage: rl scenes\n"
@@ -68,7 +68,7 @@ static void print_option(const rl_option_info *o)
     putchar('\n');
 }
 
-int rl_cli_algos(int argc, char **argv)
+int cli_algos(int argc, char **argv)
 {
     int rc = no_arguments(argc, argv,
                           "usage: rl algos   (alias: rl renderers)\n"
@@ -92,7 +92,7 @@ int rl_cli_algos(int argc, char **argv)
         rl_renderer *r = NULL;
         rl_clear_error();
         if (rl_renderer_create(list[i].name, &r) != RL_OK)
-            return rl_cli_fail_status(RL_CLI_FAIL, rl_last_status(), list[i].name);
+            return cli_fail_status(RL_CLI_FAIL, rl_last_status(), list[i].name);
         size_t num_options = 0;
         const rl_option_info *options = rl_renderer_options(r, &num_options);
         printf("  options:%s\n", num_options ? "" : " none");

@@ -57,11 +57,11 @@ static int parse_args(int argc, char **argv, render_args *a)
     for (int i = 1; i < argc; i++) {
         const char *v = NULL;
         int m;
-        if (rl_cli_is_help(argv[i])) {
+        if (cli_is_help(argv[i])) {
             fputs(render_help, stdout);
             return -1;
         }
-#define VALUE(name) ((m = rl_cli_take_value(argc, argv, &i, name, &v)) != 0)
+#define VALUE(name) ((m = cli_take_value(argc, argv, &i, name, &v)) != 0)
         if (VALUE("--out")) a->out = v;
         else if (VALUE("--algo")) a->algo = v;
         else if (VALUE("--camera")) a->camera = v;
@@ -70,30 +70,30 @@ static int parse_args(int argc, char **argv, render_args *a)
         else if (VALUE("--stats-json")) a->stats_json = v;
         else if (VALUE("--set")) a->sets[a->num_sets++] = v;
         else if (VALUE("--size")) {
-            if (m > 0 && !rl_cli_parse_size(v, &a->width, &a->height))
+            if (m > 0 && !cli_parse_size(v, &a->width, &a->height))
                 return RL_CLI_USAGE;
             a->has_size = true;
         } else if (VALUE("--eye")) {
-            if (m > 0 && !rl_cli_parse_vec3("--eye", v, &a->eye))
+            if (m > 0 && !cli_parse_vec3("--eye", v, &a->eye))
                 return RL_CLI_USAGE;
             a->has_eye = true;
         } else if (VALUE("--target")) {
-            if (m > 0 && !rl_cli_parse_vec3("--target", v, &a->target))
+            if (m > 0 && !cli_parse_vec3("--target", v, &a->target))
                 return RL_CLI_USAGE;
             a->has_target = true;
         } else if (VALUE("--up")) {
-            if (m > 0 && !rl_cli_parse_vec3("--up", v, &a->up))
+            if (m > 0 && !cli_parse_vec3("--up", v, &a->up))
                 return RL_CLI_USAGE;
             a->has_up = true;
         } else if (VALUE("--fov")) {
             double fov = 0.0;
             if (m > 0 && (!rl_parse_float(v, &fov) || fov <= 0.0 || fov >= 180.0))
-                return rl_cli_fail(RL_CLI_USAGE, "--fov: expected degrees in (0, 180), got '%s'",
+                return cli_fail(RL_CLI_USAGE, "--fov: expected degrees in (0, 180), got '%s'",
                                    v);
             a->fov_deg = (float)fov;
             a->has_fov = true;
         } else if (argv[i][0] == '-' || a->scene)
-            return rl_cli_unknown_arg("render", argv[i]);
+            return cli_unknown_arg("render", argv[i]);
         else
             a->scene = argv[i];
 #undef VALUE
@@ -101,13 +101,13 @@ static int parse_args(int argc, char **argv, render_args *a)
             return RL_CLI_USAGE; /* missing value, already reported */
     }
     if (!a->scene)
-        return rl_cli_fail(RL_CLI_USAGE, "render: missing SCENE (see rl render --help)");
+        return cli_fail(RL_CLI_USAGE, "render: missing SCENE (see rl render --help)");
     if (!a->out)
-        return rl_cli_fail(RL_CLI_USAGE, "render: missing --out FILE.png|FILE.exr");
+        return cli_fail(RL_CLI_USAGE, "render: missing --out FILE.png|FILE.exr");
     for (int k = 0; k < a->num_sets; k++) {
         const char *eq = strchr(a->sets[k], '=');
         if (!eq || eq == a->sets[k])
-            return rl_cli_fail(RL_CLI_USAGE, "--set: expected KEY=VALUE, got '%s'", a->sets[k]);
+            return cli_fail(RL_CLI_USAGE, "--set: expected KEY=VALUE, got '%s'", a->sets[k]);
     }
     return RL_CLI_OK;
 }
@@ -117,17 +117,17 @@ static int check_outputs(const render_args *a)
 {
     static const char *const image_ext[] = { ".png", ".exr", NULL };
     static const char *const png_ext[] = { ".png", NULL };
-    if (!rl_cli_has_extension(a->out, image_ext))
-        return rl_cli_fail(RL_CLI_USAGE, "%s: unsupported output format (use .png or .exr)",
+    if (!cli_has_extension(a->out, image_ext))
+        return cli_fail(RL_CLI_USAGE, "%s: unsupported output format (use .png or .exr)",
                            a->out);
-    if (a->depth_out && !rl_cli_has_extension(a->depth_out, image_ext))
-        return rl_cli_fail(RL_CLI_USAGE, "%s: unsupported depth format (use .png or .exr)",
+    if (a->depth_out && !cli_has_extension(a->depth_out, image_ext))
+        return cli_fail(RL_CLI_USAGE, "%s: unsupported depth format (use .png or .exr)",
                            a->depth_out);
-    if (a->id_out && !rl_cli_has_extension(a->id_out, png_ext))
-        return rl_cli_fail(RL_CLI_USAGE, "%s: unsupported ID format (use .png)", a->id_out);
+    if (a->id_out && !cli_has_extension(a->id_out, png_ext))
+        return cli_fail(RL_CLI_USAGE, "%s: unsupported ID format (use .png)", a->id_out);
     const char *paths[] = { a->out, a->depth_out, a->id_out, a->stats_json };
     for (size_t k = 0; k < sizeof paths / sizeof paths[0]; k++)
-        if (paths[k] && !rl_cli_check_writable(paths[k]))
+        if (paths[k] && !cli_check_writable(paths[k]))
             return RL_CLI_FAIL;
     return RL_CLI_OK;
 }
@@ -137,16 +137,16 @@ static int create_renderer(const render_args *a, rl_renderer **out)
     rl_clear_error();
     rl_status st = rl_renderer_create(a->algo, out);
     if (st != RL_OK)
-        return rl_cli_fail_status(RL_CLI_USAGE, st, NULL);
+        return cli_fail_status(RL_CLI_USAGE, st, NULL);
     for (int k = 0; k < a->num_sets; k++) {
         char key[128];
         const char *value = NULL;
-        if (!rl_cli_split_option("--set", a->sets[k], key, sizeof key, &value))
+        if (!cli_split_option("--set", a->sets[k], key, sizeof key, &value))
             return RL_CLI_USAGE;
         rl_clear_error();
         st = rl_renderer_set(*out, key, value);
         if (st != RL_OK)
-            return rl_cli_fail_status(RL_CLI_USAGE, st, "--set");
+            return cli_fail_status(RL_CLI_USAGE, st, "--set");
     }
     return RL_CLI_OK;
 }
@@ -157,7 +157,7 @@ static int choose_camera(const render_args *a, const rl_scene *scene, rl_camera 
     rl_clear_error();
     rl_status st = rl_scene_get_camera(scene, a->camera, cam);
     if (st != RL_OK)
-        return rl_cli_fail_status(RL_CLI_FAIL, st, "--camera");
+        return cli_fail_status(RL_CLI_FAIL, st, "--camera");
     const rl_scene_data *data = rl_scene_get_data(scene);
     bool scene_has_cameras = data && data->num_cameras > 0;
     if (a->has_eye) cam->eye = a->eye;
@@ -177,7 +177,7 @@ static int choose_camera(const render_args *a, const rl_scene *scene, rl_camera 
     rl_clear_error();
     st = rl_camera_validate(cam);
     if (st != RL_OK)
-        return rl_cli_fail_status(RL_CLI_USAGE, st, "camera");
+        return cli_fail_status(RL_CLI_USAGE, st, "camera");
     return RL_CLI_OK;
 }
 
@@ -187,13 +187,13 @@ static int write_outputs(const render_args *a, const rl_scene *scene, const rl_i
     rl_clear_error();
     rl_status st = rl_image_write(img, a->out);
     if (st != RL_OK)
-        return rl_cli_fail_status(RL_CLI_FAIL, st, a->out);
-    if (a->depth_out && (st = rl_cli_write_depth(img, a->depth_out)) != RL_OK)
-        return rl_cli_fail_status(RL_CLI_FAIL, st, a->depth_out);
-    if (a->id_out && (st = rl_cli_write_ids(img, a->id_out)) != RL_OK)
-        return rl_cli_fail_status(RL_CLI_FAIL, st, a->id_out);
+        return cli_fail_status(RL_CLI_FAIL, st, a->out);
+    if (a->depth_out && (st = cli_write_depth(img, a->depth_out)) != RL_OK)
+        return cli_fail_status(RL_CLI_FAIL, st, a->depth_out);
+    if (a->id_out && (st = cli_write_ids(img, a->id_out)) != RL_OK)
+        return cli_fail_status(RL_CLI_FAIL, st, a->id_out);
     if (a->stats_json) {
-        cJSON *obj = rl_cli_render_stats_json(stats);
+        cJSON *obj = cli_render_stats_json(stats);
         bool ok = obj != NULL;
         if (ok) {
             cJSON_AddStringToObject(obj, "algorithm", a->algo);
@@ -201,12 +201,12 @@ static int write_outputs(const render_args *a, const rl_scene *scene, const rl_i
             cJSON_AddNumberToObject(obj, "width", img->width);
             cJSON_AddNumberToObject(obj, "height", img->height);
             cJSON_AddStringToObject(obj, "file", a->out);
-            cJSON *scene_stats = rl_cli_scene_stats_json(scene);
+            cJSON *scene_stats = cli_scene_stats_json(scene);
             if (scene_stats)
                 cJSON_AddItemToObject(obj, "scene_stats", scene_stats);
-            ok = rl_cli_write_json(obj, a->stats_json);
+            ok = cli_write_json(obj, a->stats_json);
         } else {
-            rl_cli_fail(RL_CLI_FAIL, "out of memory");
+            cli_fail(RL_CLI_FAIL, "out of memory");
         }
         cJSON_Delete(obj);
         if (!ok)
@@ -227,7 +227,7 @@ static int render_frame(const render_args *a)
     if (rc == RL_CLI_OK)
         rc = create_renderer(a, &renderer);
     if (rc == RL_CLI_OK)
-        rc = rl_cli_load_scene(a->scene, &scene);
+        rc = cli_load_scene(a->scene, &scene);
     if (rc == RL_CLI_OK)
         rc = choose_camera(a, scene, &cam);
     if (rc == RL_CLI_OK) {
@@ -235,7 +235,7 @@ static int render_frame(const render_args *a)
         rl_clear_error();
         rl_status st = rl_renderer_prepare_inputs(renderer, scene);
         if (st != RL_OK)
-            rc = rl_cli_fail_status(RL_CLI_FAIL, st, "render");
+            rc = cli_fail_status(RL_CLI_FAIL, st, "render");
     }
     if (rc == RL_CLI_OK) {
         unsigned layers = RL_LAYER_COLOR | (a->depth_out ? RL_LAYER_DEPTH : 0u) |
@@ -243,7 +243,7 @@ static int render_frame(const render_args *a)
         rl_clear_error();
         rl_status st = rl_image_create(cam.width, cam.height, layers, &img);
         if (st != RL_OK)
-            rc = rl_cli_fail_status(RL_CLI_FAIL, st, "image");
+            rc = cli_fail_status(RL_CLI_FAIL, st, "image");
     }
     if (rc == RL_CLI_OK) {
         /* The bar is chatter: -q silences it with the info log. */
@@ -256,12 +256,12 @@ static int render_frame(const render_args *a)
         rl_renderer_set_progress(renderer, NULL, NULL);
         rl_progress_finish(progress);
         if (st != RL_OK)
-            rc = rl_cli_fail_status(RL_CLI_FAIL, st, "render");
+            rc = cli_fail_status(RL_CLI_FAIL, st, "render");
     }
     if (rc == RL_CLI_OK)
         rc = write_outputs(a, scene, img, &stats);
     if (rc == RL_CLI_OK)
-        rl_cli_print_summary(stdout, rl_renderer_name(renderer), a->scene, cam.width, cam.height,
+        cli_print_summary(stdout, rl_renderer_name(renderer), a->scene, cam.width, cam.height,
                              &stats);
     rl_image_release(img);
     rl_scene_release(scene);
@@ -269,12 +269,12 @@ static int render_frame(const render_args *a)
     return rc;
 }
 
-int rl_cli_render(int argc, char **argv)
+int cli_render(int argc, char **argv)
 {
     render_args a = { .algo = "raster" };
     a.sets = calloc((size_t)argc, sizeof *a.sets);
     if (!a.sets)
-        return rl_cli_fail(RL_CLI_FAIL, "out of memory");
+        return cli_fail(RL_CLI_FAIL, "out of memory");
     int rc = parse_args(argc, argv, &a);
     if (rc == RL_CLI_OK)
         rc = render_frame(&a);

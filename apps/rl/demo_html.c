@@ -42,11 +42,11 @@ static void put_cell(FILE *f, const cJSON *e)
     const cJSON *rs = cJSON_GetObjectItemCaseSensitive(e, "render_stats");
     const cJSON *ss = cJSON_GetObjectItemCaseSensitive(e, "scene_stats");
     fputs("<td><a href=\"", f);
-    rl_html_put_escaped(f, str(e, "file"));
+    html_put_escaped(f, str(e, "file"));
     fputs("\"><img src=\"", f);
-    rl_html_put_escaped(f, str(e, "file"));
+    html_put_escaped(f, str(e, "file"));
     fputs("\" alt=\"", f);
-    rl_html_put_escaped(f, str(e, "file"));
+    html_put_escaped(f, str(e, "file"));
     fprintf(f, "\"></a><br>%.1f ms", num(rs, "time_ms"));
     if (num(rs, "triangles_rasterized") > 0)
         fprintf(f, " &middot; %.0f triangles rasterized", num(rs, "triangles_rasterized"));
@@ -59,11 +59,11 @@ static void put_cell(FILE *f, const cJSON *e)
     fputs("</td>", f);
 }
 
-bool rl_cli_write_demo_html(const cJSON *report, const char *path)
+bool cli_write_demo_html(const cJSON *report, const char *path)
 {
     FILE *f = fopen(path, "w");
     if (!f) {
-        rl_cli_fail(RL_CLI_FAIL, "%s: cannot write", path);
+        cli_fail(RL_CLI_FAIL, "%s: cannot write", path);
         return false;
     }
     const cJSON *images = cJSON_GetObjectItemCaseSensitive(report, "images");
@@ -81,17 +81,17 @@ bool rl_cli_write_demo_html(const cJSON *report, const char *path)
           ".s{color:#666}\n</style></head><body>\n<h1>renderlab demo</h1>\n<p>",
           f);
     fputs("renderlab ", f);
-    rl_html_put_escaped(f, str(report, "renderlab"));
+    html_put_escaped(f, str(report, "renderlab"));
     fputs(" &middot; ", f);
-    rl_html_put_escaped(f, str(report, "date"));
+    html_put_escaped(f, str(report, "date"));
     fprintf(f, " &middot; %.0fx%.0f<br>machine: ", num(report, "width"), num(report, "height"));
-    rl_html_put_escaped(f, str(machine, "uname"));
+    html_put_escaped(f, str(machine, "uname"));
     fprintf(f, " &middot; %.0f processors</p>\n", num(machine, "nproc"));
 
     fputs("<table>\n<tr><th>scene</th>", f);
     for (int k = 0; k < num_algos; k++) {
         fputs("<th>", f);
-        rl_html_put_escaped(f, algos[k]);
+        html_put_escaped(f, algos[k]);
         fputs("</th>", f);
     }
     fputs("</tr>\n", f);
@@ -106,7 +106,7 @@ bool rl_cli_write_demo_html(const cJSON *report, const char *path)
             if (row)
                 fputs("</tr>\n", f);
             fputs("<tr><th>", f);
-            rl_html_put_escaped(f, scene);
+            html_put_escaped(f, scene);
             fputs("</th>", f);
             row = scene;
             col = 0;
@@ -125,11 +125,11 @@ bool rl_cli_write_demo_html(const cJSON *report, const char *path)
         fputs("<h2>failures</h2>\n<ul>\n", f);
         cJSON_ArrayForEach(e, failures) {
             fputs("<li>", f);
-            rl_html_put_escaped(f, str(e, "scene"));
+            html_put_escaped(f, str(e, "scene"));
             fputs(" ", f);
-            rl_html_put_escaped(f, str(e, "algorithm"));
+            html_put_escaped(f, str(e, "algorithm"));
             fputs(": ", f);
-            rl_html_put_escaped(f, str(e, "error"));
+            html_put_escaped(f, str(e, "error"));
             fputs("</li>\n", f);
         }
         fputs("</ul>\n", f);
@@ -137,7 +137,7 @@ bool rl_cli_write_demo_html(const cJSON *report, const char *path)
     if (*str(report, "compare")) {
         fputs("<p>The renderers compared over a sampled region of the scene (time, rays, "
               "triangles, image quality; Jähn 2015): <a href=\"", f);
-        rl_html_put_escaped(f, str(report, "compare"));
+        html_put_escaped(f, str(report, "compare"));
         fputs("\">comparison report</a>.</p>\n", f);
     }
     fputs("<p class=\"s\">Data: <a href=\"report.json\">report.json</a></p>\n"
@@ -146,6 +146,6 @@ bool rl_cli_write_demo_html(const cJSON *report, const char *path)
     if (fclose(f) != 0)
         ok = false;
     if (!ok)
-        rl_cli_fail(RL_CLI_FAIL, "%s: cannot write", path);
+        cli_fail(RL_CLI_FAIL, "%s: cannot write", path);
     return ok;
 }

@@ -9,7 +9,7 @@
 #include "bench_util.h"
 #include "cli.h"
 
-const char rl_eval_sampling_help[] =
+const char eval_sampling_help[] =
     "sampling (Jähn 2015, Ch. 5):\n"
     "  --dims 2|3          2: the horizontal slice y = --height (default);\n"
     "                      3: the whole region\n"
@@ -45,12 +45,12 @@ static const char *const combine_names[] = { "mean", "max", "min" };
 static const char *const interp_names[] = { "idw", "nearest", "region" };
 static const char *const quality_size_names[] = { "measure", "diameter" };
 
-const char *rl_eval_positions_name(rl_position_variant v)
+const char *eval_positions_name(rl_position_variant v)
 {
     return (unsigned)v < 4 ? positions_names[v] : "?";
 }
 
-void rl_eval_sampling_init(rl_eval_sampling *s)
+void eval_sampling_init(eval_sampling *s)
 {
     memset(s, 0, sizeof *s);
     s->desc.dims = 2;
@@ -68,16 +68,16 @@ static int pick(const char *option, const char *v, const char *const *names, int
         strcat(list, k ? ", " : "");
         strcat(list, names[k]);
     }
-    rl_cli_fail(RL_CLI_USAGE, "%s: unknown value '%s' (one of %s)", option, v, list);
+    cli_fail(RL_CLI_USAGE, "%s: unknown value '%s' (one of %s)", option, v, list);
     return -1;
 }
 
-const char *rl_eval_quality_size_name(rl_quality_size q)
+const char *eval_quality_size_name(rl_quality_size q)
 {
     return (unsigned)q < 2 ? quality_size_names[q] : "?";
 }
 
-bool rl_eval_parse_quality_size(const char *option, const char *text, rl_quality_size *out)
+bool eval_parse_quality_size(const char *option, const char *text, rl_quality_size *out)
 {
     int k = pick(option, text, quality_size_names, 2);
     if (k < 0)
@@ -91,7 +91,7 @@ static bool parse_number(const char *option, const char *v, double lo, double hi
     char *end = NULL;
     double x = strtod(v, &end);
     if (!*v || *end || !isfinite(x) || x < lo || x > hi) {
-        rl_cli_fail(RL_CLI_USAGE, "%s: expected a number in [%g, %g], got '%s'", option, lo, hi, v);
+        cli_fail(RL_CLI_USAGE, "%s: expected a number in [%g, %g], got '%s'", option, lo, hi, v);
         return false;
     }
     *out = x;
@@ -106,14 +106,14 @@ static bool parse_region(const char *v, rl_aabb *box)
     for (int k = 0; k < 6; k++) {
         double x = strtod(p, &end);
         if (end == p || !isfinite(x) || (k < 5 && *end != ',') || (k == 5 && *end)) {
-            rl_cli_fail(RL_CLI_USAGE, "--region: expected x0,y0,z0,x1,y1,z1, got '%s'", v);
+            cli_fail(RL_CLI_USAGE, "--region: expected x0,y0,z0,x1,y1,z1, got '%s'", v);
             return false;
         }
         c[k] = (float)x;
         p = end + 1;
     }
     if (!(c[0] <= c[3] && c[1] <= c[4] && c[2] <= c[5])) {
-        rl_cli_fail(RL_CLI_USAGE, "--region: the second corner must not be below the first ('%s')", v);
+        cli_fail(RL_CLI_USAGE, "--region: the second corner must not be below the first ('%s')", v);
         return false;
     }
     box->min = (rl_vec3){ c[0], c[1], c[2] };
@@ -121,13 +121,13 @@ static bool parse_region(const char *v, rl_aabb *box)
     return true;
 }
 
-int rl_eval_sampling_arg(int argc, char **argv, int *i, rl_eval_sampling *s)
+int eval_sampling_arg(int argc, char **argv, int *i, eval_sampling *s)
 {
     const char *v = NULL;
     int m;
     double x;
     rl_sampling_desc *d = &s->desc;
-#define TAKE(name) ((m = rl_cli_take_value(argc, argv, i, name, &v)) != 0)
+#define TAKE(name) ((m = cli_take_value(argc, argv, i, name, &v)) != 0)
     if (strcmp(argv[*i], "--linear") == 0) {
         d->linear = true;
         return 1;
@@ -140,7 +140,7 @@ int rl_eval_sampling_arg(int argc, char **argv, int *i, rl_eval_sampling *s)
         if (m < 0)
             return -1;
         if (strcmp(v, "2") != 0 && strcmp(v, "3") != 0) {
-            rl_cli_fail(RL_CLI_USAGE, "--dims: 2 or 3, got '%s'", v);
+            cli_fail(RL_CLI_USAGE, "--dims: 2 or 3, got '%s'", v);
             return -1;
         }
         d->dims = v[0] - '0';
@@ -169,7 +169,7 @@ int rl_eval_sampling_arg(int argc, char **argv, int *i, rl_eval_sampling *s)
             return -1;
         d->interpolation = (rl_interpolation)k;
     } else if (TAKE("--quality-size")) {
-        if (m < 0 || !rl_eval_parse_quality_size("--quality-size", v, &d->quality_size))
+        if (m < 0 || !eval_parse_quality_size("--quality-size", v, &d->quality_size))
             return -1;
     } else if (TAKE("--combine")) {
         int k = m < 0 ? -1 : pick("--combine", v, combine_names, 3);
@@ -178,7 +178,7 @@ int rl_eval_sampling_arg(int argc, char **argv, int *i, rl_eval_sampling *s)
         d->combine = (rl_combine)k;
     } else if (TAKE("--samples")) {
         long long n;
-        if (m < 0 || !rl_bench_parse_count("--samples", v, 1 << 24, &n))
+        if (m < 0 || !bench_parse_count("--samples", v, 1 << 24, &n))
             return -1;
         d->max_samples = (uint32_t)n;
     } else if (TAKE("--seconds")) {
@@ -192,7 +192,7 @@ int rl_eval_sampling_arg(int argc, char **argv, int *i, rl_eval_sampling *s)
         s->has_min_side = true;
     } else if (TAKE("--idw-neighbors")) {
         long long n;
-        if (m < 0 || !rl_bench_parse_count("--idw-neighbors", v, RL_SAMPLING_MAX_IDW_NEIGHBORS, &n))
+        if (m < 0 || !bench_parse_count("--idw-neighbors", v, RL_SAMPLING_MAX_IDW_NEIGHBORS, &n))
             return -1;
         d->idw_neighbors = (uint32_t)n;
     } else if (TAKE("--samples-base")) {
@@ -205,12 +205,12 @@ int rl_eval_sampling_arg(int argc, char **argv, int *i, rl_eval_sampling *s)
         d->samples_per_meter = (float)x;
     } else if (TAKE("--seed")) {
         long long n;
-        if (m < 0 || !rl_bench_parse_count("--seed", v, 1LL << 62, &n))
+        if (m < 0 || !bench_parse_count("--seed", v, 1LL << 62, &n))
             return -1;
         d->seed = (uint64_t)n;
     } else if (TAKE("--workers")) {
         long long n;
-        if (m < 0 || !rl_bench_parse_count("--workers", v, 1024, &n))
+        if (m < 0 || !bench_parse_count("--workers", v, 1024, &n))
             return -1;
         d->workers = (int)n;
     } else
@@ -219,7 +219,7 @@ int rl_eval_sampling_arg(int argc, char **argv, int *i, rl_eval_sampling *s)
     return 1;
 }
 
-bool rl_eval_sampling_finish(rl_eval_sampling *s, const rl_scene *scene)
+bool eval_sampling_finish(eval_sampling *s, const rl_scene *scene)
 {
     rl_sampling_desc *d = &s->desc;
     const rl_scene_data *sd = rl_scene_get_data(scene);
@@ -229,14 +229,14 @@ bool rl_eval_sampling_finish(rl_eval_sampling *s, const rl_scene *scene)
     else if (d->region.max.x < b.min.x || d->region.min.x > b.max.x ||
              d->region.max.z < b.min.z || d->region.min.z > b.max.z ||
              (d->dims == 3 && (d->region.max.y < b.min.y || d->region.min.y > b.max.y))) {
-        rl_cli_fail(RL_CLI_USAGE, "--region does not overlap the scene (bounds %g,%g,%g .. %g,%g,%g)",
+        cli_fail(RL_CLI_USAGE, "--region does not overlap the scene (bounds %g,%g,%g .. %g,%g,%g)",
                     b.min.x, b.min.y, b.min.z, b.max.x, b.max.y, b.max.z);
         return false;
     }
     if (!s->has_height)
         d->height = 0.5f * (d->region.min.y + d->region.max.y);
     else if (d->dims == 2 && (d->height < b.min.y || d->height > b.max.y)) {
-        rl_cli_fail(RL_CLI_USAGE, "--height %g is outside the scene's y range [%g, %g]", d->height,
+        cli_fail(RL_CLI_USAGE, "--height %g is outside the scene's y range [%g, %g]", d->height,
                     b.min.y, b.max.y);
         return false;
     }
@@ -251,7 +251,7 @@ bool rl_eval_sampling_finish(rl_eval_sampling *s, const rl_scene *scene)
     return true;
 }
 
-rl_image *rl_eval_top_view(const rl_scene *scene, rl_aabb region, float height, int width)
+rl_image *eval_top_view(const rl_scene *scene, rl_aabb region, float height, int width)
 {
     float ex = region.max.x - region.min.x, ez = region.max.z - region.min.z;
     if (!(ex > 0.0f) || !(ez > 0.0f) || width < 16)
@@ -285,7 +285,7 @@ rl_image *rl_eval_top_view(const rl_scene *scene, rl_aabb region, float height, 
     return img;
 }
 
-bool rl_eval_leaf_series(const rl_approx *a, double **values, double **weights, size_t *n)
+bool eval_leaf_series(const rl_approx *a, double **values, double **weights, size_t *n)
 {
     uint32_t count = rl_approx_region_count(a);
     double *v = malloc((count ? count : 1) * sizeof *v);
@@ -310,7 +310,7 @@ bool rl_eval_leaf_series(const rl_approx *a, double **values, double **weights, 
     return true;
 }
 
-char *rl_eval_heatmap_svg(const rl_approx *a, float height, const rl_image *top,
+char *eval_heatmap_svg(const rl_approx *a, float height, const rl_image *top,
                           const char *title, double vmin, double vmax, bool reverse,
                           const char *png_path)
 {
@@ -321,7 +321,7 @@ char *rl_eval_heatmap_svg(const rl_approx *a, float height, const rl_image *top,
     if (!cells || !points) {
         free(cells);
         free(points);
-        rl_cli_fail(RL_CLI_FAIL, "out of memory");
+        cli_fail(RL_CLI_FAIL, "out of memory");
         return NULL;
     }
     int dims = rl_approx_dims(a);
@@ -362,7 +362,7 @@ char *rl_eval_heatmap_svg(const rl_approx *a, float height, const rl_image *top,
     if (st == RL_OK && png_path)
         st = rl_plot_heatmap_draw(&h, &style, &(rl_plot_output){ .path = png_path });
     if (st != RL_OK) {
-        rl_cli_fail_status(RL_CLI_FAIL, st, "heat map");
+        cli_fail_status(RL_CLI_FAIL, st, "heat map");
         free(svg);
         svg = NULL;
     }
@@ -371,7 +371,7 @@ char *rl_eval_heatmap_svg(const rl_approx *a, float height, const rl_image *top,
     return svg;
 }
 
-rl_vec3 *rl_eval_random_positions(const rl_approx *a, size_t count, uint64_t seed)
+rl_vec3 *eval_random_positions(const rl_approx *a, size_t count, uint64_t seed)
 {
     rl_vec3 *pos = malloc((count ? count : 1) * sizeof *pos);
     if (!pos)
@@ -388,7 +388,7 @@ rl_vec3 *rl_eval_random_positions(const rl_approx *a, size_t count, uint64_t see
     return pos;
 }
 
-rl_status rl_eval_measure(rl_property *p, const rl_vec3 *pos, size_t count, double **values,
+rl_status eval_measure(rl_property *p, const rl_vec3 *pos, size_t count, double **values,
                           const char *progress_label)
 {
     double *v = malloc((count ? count : 1) * sizeof *v);
@@ -408,7 +408,7 @@ rl_status rl_eval_measure(rl_property *p, const rl_vec3 *pos, size_t count, doub
     return RL_OK;
 }
 
-rl_status rl_eval_errors(const rl_approx *a, const rl_vec3 *pos, const double *measured,
+rl_status eval_errors(const rl_approx *a, const rl_vec3 *pos, const double *measured,
                          size_t count, double *approx, double *err)
 {
     for (size_t i = 0; i < count; i++) {
@@ -423,24 +423,24 @@ rl_status rl_eval_errors(const rl_approx *a, const rl_vec3 *pos, const double *m
     return RL_OK;
 }
 
-cJSON *rl_eval_stats_json(const rl_stats *s)
+cJSON *eval_stats_json(const rl_stats *s)
 {
     cJSON *o = cJSON_CreateObject();
     if (!o)
         return NULL;
-    rl_bench_add_num(o, "min", s->min);
-    rl_bench_add_num(o, "q25", s->q[1]);
-    rl_bench_add_num(o, "median", s->q[2]);
-    rl_bench_add_num(o, "q75", s->q[3]);
-    rl_bench_add_num(o, "max", s->max);
-    rl_bench_add_num(o, "mean", s->mean);
-    rl_bench_add_num(o, "stddev", s->stddev);
-    rl_bench_add_num(o, "weight", s->total_weight);
-    rl_bench_add_num(o, "count", (double)s->count);
+    bench_add_num(o, "min", s->min);
+    bench_add_num(o, "q25", s->q[1]);
+    bench_add_num(o, "median", s->q[2]);
+    bench_add_num(o, "q75", s->q[3]);
+    bench_add_num(o, "max", s->max);
+    bench_add_num(o, "mean", s->mean);
+    bench_add_num(o, "stddev", s->stddev);
+    bench_add_num(o, "weight", s->total_weight);
+    bench_add_num(o, "count", (double)s->count);
     return o;
 }
 
-cJSON *rl_eval_desc_json(const rl_sampling_desc *d)
+cJSON *eval_desc_json(const rl_sampling_desc *d)
 {
     cJSON *o = cJSON_CreateObject();
     if (!o)
@@ -455,9 +455,9 @@ cJSON *rl_eval_desc_json(const rl_sampling_desc *d)
         cJSON_AddNumberToObject(o, "height", d->height);
     cJSON_AddStringToObject(o, "method", method_names[d->method]);
     if (d->method == RL_SAMPLING_ADAPTIVE)
-        cJSON_AddStringToObject(o, "positions", rl_eval_positions_name(d->positions));
+        cJSON_AddStringToObject(o, "positions", eval_positions_name(d->positions));
     cJSON_AddNumberToObject(o, "max_samples", d->max_samples);
-    rl_bench_add_num(o, "max_seconds", d->max_seconds);
+    bench_add_num(o, "max_seconds", d->max_seconds);
     cJSON_AddNumberToObject(o, "min_side", d->min_side);
     cJSON_AddStringToObject(o, "combine", combine_names[d->combine]);
     cJSON_AddBoolToObject(o, "linear", d->linear);
@@ -466,14 +466,14 @@ cJSON *rl_eval_desc_json(const rl_sampling_desc *d)
         cJSON_AddNumberToObject(o, "idw_neighbors",
                                 d->idw_neighbors ? d->idw_neighbors : RL_SAMPLING_DEFAULT_IDW_NEIGHBORS);
     if (d->method == RL_SAMPLING_ADAPTIVE)
-        cJSON_AddStringToObject(o, "quality_size", rl_eval_quality_size_name(d->quality_size));
+        cJSON_AddStringToObject(o, "quality_size", eval_quality_size_name(d->quality_size));
     else
         cJSON_AddBoolToObject(o, "grid_shift", d->grid_shift);
     cJSON_AddNumberToObject(o, "seed", (double)d->seed);
     return o;
 }
 
-void rl_eval_stats_cells(const rl_stats *s, char buf[7][32])
+void eval_stats_cells(const rl_stats *s, char buf[7][32])
 {
     const double v[6] = { s->min, s->q[1], s->q[2], s->q[3], s->max, s->mean };
     for (int k = 0; k < 6; k++)

@@ -13,67 +13,67 @@
 
 struct cJSON;
 
-typedef struct rl_eval_sampling {
+typedef struct eval_sampling {
     rl_sampling_desc desc;
     bool has_region, has_height, has_min_side;
-} rl_eval_sampling;
+} eval_sampling;
 
 /* The help lines of the shared options. */
-extern const char rl_eval_sampling_help[];
+extern const char eval_sampling_help[];
 
 /* Defaults before parsing: 2-D, 256 samples, blue noise with corners. */
-void rl_eval_sampling_init(rl_eval_sampling *s);
+void eval_sampling_init(eval_sampling *s);
 /* Takes one sampling option at argv[*i]: 1 taken (and *i advanced past its
  * value), 0 not a sampling option, -1 bad value (error printed). */
-int rl_eval_sampling_arg(int argc, char **argv, int *i, rl_eval_sampling *s);
+int eval_sampling_arg(int argc, char **argv, int *i, eval_sampling *s);
 /* Fills what depends on the scene: the region (its bounds), the slice
  * height (the middle of the region's y extent), min_side (1 m, or 1/64 of
  * the longest side when that is smaller, so that small scenes refine).
  * Prints the error and returns false for a region outside the scene or a
  * height outside the region. */
-bool rl_eval_sampling_finish(rl_eval_sampling *s, const rl_scene *scene);
+bool eval_sampling_finish(eval_sampling *s, const rl_scene *scene);
 
 /* A near-orthographic view from high above of the region's x/z extent at
  * the slice height (raster renderer, flat shading), `width` pixels wide;
  * row 0 is the -z side. NULL when it fails (the heat map is then drawn
  * without it). */
-rl_image *rl_eval_top_view(const rl_scene *scene, rl_aabb region, float height, int width);
+rl_image *eval_top_view(const rl_scene *scene, rl_aabb region, float height, int width);
 
 /* Leaf values and their weights (area or volume) of an approximation;
  * malloc'd arrays; false when out of memory. */
-bool rl_eval_leaf_series(const rl_approx *a, double **values, double **weights, size_t *n);
+bool eval_leaf_series(const rl_approx *a, double **values, double **weights, size_t *n);
 
 /* Heat map SVG of the approximation (2-D: every leaf; 3-D: the leaves cut
  * by the plane y = height), x right and -z up, over the top view (may be
  * NULL), with the sample positions. vmin == vmax: the data's range. With
  * png_path the same map is also written there as PNG. NULL (error printed)
  * on failure. */
-char *rl_eval_heatmap_svg(const rl_approx *a, float height, const rl_image *top,
+char *eval_heatmap_svg(const rl_approx *a, float height, const rl_image *top,
                           const char *title, double vmin, double vmax, bool reverse,
                           const char *png_path);
 
 /* Uniform random positions in the sampled region (2-D: on the slice),
  * seeded; malloc'd, count entries. */
-rl_vec3 *rl_eval_random_positions(const rl_approx *a, size_t count, uint64_t seed);
+rl_vec3 *eval_random_positions(const rl_approx *a, size_t count, uint64_t seed);
 /* rl_property_measure into a malloc'd array, with a progress bar named
  * progress_label (NULL: none). */
-rl_status rl_eval_measure(rl_property *p, const rl_vec3 *pos, size_t count, double **values,
+rl_status eval_measure(rl_property *p, const rl_vec3 *pos, size_t count, double **values,
                           const char *progress_label);
 
 /* The approximation at every position (into approx, may be NULL) and its
  * absolute error against measured (into err): the validation of Sec. 5.7. */
-rl_status rl_eval_errors(const rl_approx *a, const rl_vec3 *pos, const double *measured,
+rl_status eval_errors(const rl_approx *a, const rl_vec3 *pos, const double *measured,
                          size_t count, double *approx, double *err);
 
-struct cJSON *rl_eval_stats_json(const rl_stats *s);
-struct cJSON *rl_eval_desc_json(const rl_sampling_desc *d);
-const char *rl_eval_positions_name(rl_position_variant v);
+struct cJSON *eval_stats_json(const rl_stats *s);
+struct cJSON *eval_desc_json(const rl_sampling_desc *d);
+const char *eval_positions_name(rl_position_variant v);
 /* "measure" or "diameter" (rl_quality_size), for options and records. */
-const char *rl_eval_quality_size_name(rl_quality_size q);
+const char *eval_quality_size_name(rl_quality_size q);
 /* Parses the value of `option` as a quality size; false after printing a
  * usage error. */
-bool rl_eval_parse_quality_size(const char *option, const char *text, rl_quality_size *out);
+bool eval_parse_quality_size(const char *option, const char *text, rl_quality_size *out);
 /* Five-number summary plus mean as table cells (formatted into buf). */
-void rl_eval_stats_cells(const rl_stats *s, char buf[7][32]);
+void eval_stats_cells(const rl_stats *s, char buf[7][32]);
 
 #endif

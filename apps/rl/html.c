@@ -7,11 +7,11 @@
 
 #include "cli.h"
 
-struct rl_html {
+struct html_doc {
     FILE *f;
 };
 
-void rl_html_put_escaped(FILE *f, const char *s)
+void html_put_escaped(FILE *f, const char *s)
 {
     for (; s && *s; s++) {
         switch (*s) {
@@ -24,21 +24,21 @@ void rl_html_put_escaped(FILE *f, const char *s)
     }
 }
 
-rl_html *rl_html_begin(const char *path, const char *title)
+html_doc *html_begin(const char *path, const char *title)
 {
-    rl_html *h = calloc(1, sizeof *h);
+    html_doc *h = calloc(1, sizeof *h);
     if (!h) {
-        rl_cli_fail(RL_CLI_FAIL, "out of memory");
+        cli_fail(RL_CLI_FAIL, "out of memory");
         return NULL;
     }
     h->f = fopen(path, "w");
     if (!h->f) {
         free(h);
-        rl_cli_fail(RL_CLI_FAIL, "%s: cannot write", path);
+        cli_fail(RL_CLI_FAIL, "%s: cannot write", path);
         return NULL;
     }
     fputs("<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\">\n<title>", h->f);
-    rl_html_put_escaped(h->f, title);
+    html_put_escaped(h->f, title);
     fputs("</title>\n<style>\n"
           "body{font-family:sans-serif;margin:2em;color:#222;max-width:1400px}\n"
           "h1{font-size:1.5em}h2{font-size:1.2em;margin-top:2em;border-bottom:1px solid #ddd}\n"
@@ -50,21 +50,21 @@ rl_html *rl_html_begin(const char *path, const char *title)
           "figure{margin:0 0 1em 0}figcaption{font-size:.8em;color:#555;max-width:640px}\n"
           "svg{max-width:100%;height:auto}\n.s{color:#666;font-size:.9em}\n"
           "</style></head><body>\n<h1>", h->f);
-    rl_html_put_escaped(h->f, title);
+    html_put_escaped(h->f, title);
     fputs("</h1>\n", h->f);
     return h;
 }
 
-void rl_html_heading(rl_html *h, int level, const char *text)
+void html_heading(html_doc *h, int level, const char *text)
 {
     if (level < 1 || level > 3)
         level = 2;
     fprintf(h->f, "<h%d>", level);
-    rl_html_put_escaped(h->f, text);
+    html_put_escaped(h->f, text);
     fprintf(h->f, "</h%d>\n", level);
 }
 
-void rl_html_para(rl_html *h, const char *fmt, ...)
+void html_para(html_doc *h, const char *fmt, ...)
 {
     char text[2048];
     va_list ap;
@@ -72,51 +72,51 @@ void rl_html_para(rl_html *h, const char *fmt, ...)
     vsnprintf(text, sizeof text, fmt, ap);
     va_end(ap);
     fputs("<p>", h->f);
-    rl_html_put_escaped(h->f, text);
+    html_put_escaped(h->f, text);
     fputs("</p>\n", h->f);
 }
 
-void rl_html_raw(rl_html *h, const char *markup) { fputs(markup, h->f); }
+void html_raw(html_doc *h, const char *markup) { fputs(markup, h->f); }
 
-void rl_html_escaped(rl_html *h, const char *text) { rl_html_put_escaped(h->f, text); }
+void html_escaped(html_doc *h, const char *text) { html_put_escaped(h->f, text); }
 
-void rl_html_svg(rl_html *h, const char *svg, const char *caption)
+void html_svg(html_doc *h, const char *svg, const char *caption)
 {
     fputs("<figure>", h->f);
     if (svg)
         fputs(svg, h->f);
     if (caption && *caption) {
         fputs("<figcaption>", h->f);
-        rl_html_put_escaped(h->f, caption);
+        html_put_escaped(h->f, caption);
         fputs("</figcaption>", h->f);
     }
     fputs("</figure>\n", h->f);
 }
 
-void rl_html_row_begin(rl_html *h) { fputs("<div class=\"row\">\n", h->f); }
-void rl_html_row_end(rl_html *h) { fputs("</div>\n", h->f); }
+void html_row_begin(html_doc *h) { fputs("<div class=\"row\">\n", h->f); }
+void html_row_end(html_doc *h) { fputs("</div>\n", h->f); }
 
-static void put_cells(rl_html *h, const char *tag, const char *const *cells, int n)
+static void put_cells(html_doc *h, const char *tag, const char *const *cells, int n)
 {
     fputs("<tr>", h->f);
     for (int i = 0; i < n; i++) {
         fprintf(h->f, "<%s>", tag);
-        rl_html_put_escaped(h->f, cells[i]);
+        html_put_escaped(h->f, cells[i]);
         fprintf(h->f, "</%s>", tag);
     }
     fputs("</tr>\n", h->f);
 }
 
-void rl_html_table_begin(rl_html *h, const char *const *headers, int n)
+void html_table_begin(html_doc *h, const char *const *headers, int n)
 {
     fputs("<table>\n", h->f);
     put_cells(h, "th", headers, n);
 }
 
-void rl_html_table_row(rl_html *h, const char *const *cells, int n) { put_cells(h, "td", cells, n); }
-void rl_html_table_end(rl_html *h) { fputs("</table>\n", h->f); }
+void html_table_row(html_doc *h, const char *const *cells, int n) { put_cells(h, "td", cells, n); }
+void html_table_end(html_doc *h) { fputs("</table>\n", h->f); }
 
-bool rl_html_end(rl_html *h, const char *path)
+bool html_end(html_doc *h, const char *path)
 {
     fputs("</body></html>\n", h->f);
     bool ok = !ferror(h->f);
@@ -124,6 +124,6 @@ bool rl_html_end(rl_html *h, const char *path)
         ok = false;
     free(h);
     if (!ok)
-        rl_cli_fail(RL_CLI_FAIL, "%s: cannot write", path);
+        cli_fail(RL_CLI_FAIL, "%s: cannot write", path);
     return ok;
 }

@@ -2,43 +2,43 @@
  * compare, bench reports): inline CSS, no scripts, no external resources.
  * Plots come as SVG text from rl_plot_* (which already makes their ids
  * unique per plot, see rl_plot.h) and are inlined. Errors are sticky:
- * check rl_html_end(). */
+ * check html_end(). */
 #ifndef RL_APP_HTML_H
 #define RL_APP_HTML_H
 
 #include <stdbool.h>
 #include <stdio.h>
 
-typedef struct rl_html rl_html;
+typedef struct html_doc html_doc;
 
 /* Opens path and writes the head; prints the error and returns NULL on
  * failure. */
-rl_html *rl_html_begin(const char *path, const char *title);
+html_doc *html_begin(const char *path, const char *title);
 /* Headings h1..h3, escaped. */
-void rl_html_heading(rl_html *h, int level, const char *text);
+void html_heading(html_doc *h, int level, const char *text);
 /* A paragraph of escaped, printf-formatted text. */
-void rl_html_para(rl_html *h, const char *fmt, ...)
+void html_para(html_doc *h, const char *fmt, ...)
 #if defined(__GNUC__)
     __attribute__((format(printf, 2, 3)))
 #endif
     ;
 /* Markup written as is (the caller escapes). */
-void rl_html_raw(rl_html *h, const char *markup);
-void rl_html_escaped(rl_html *h, const char *text);
+void html_raw(html_doc *h, const char *markup);
+void html_escaped(html_doc *h, const char *text);
 /* A figure: the SVG inlined, with an escaped caption (may be NULL). */
-void rl_html_svg(rl_html *h, const char *svg, const char *caption);
-/* Figures side by side until rl_html_row_end. */
-void rl_html_row_begin(rl_html *h);
-void rl_html_row_end(rl_html *h);
+void html_svg(html_doc *h, const char *svg, const char *caption);
+/* Figures side by side until html_row_end. */
+void html_row_begin(html_doc *h);
+void html_row_end(html_doc *h);
 /* A table: header cells, then rows of cells (escaped text). */
-void rl_html_table_begin(rl_html *h, const char *const *headers, int n);
-void rl_html_table_row(rl_html *h, const char *const *cells, int n);
-void rl_html_table_end(rl_html *h);
+void html_table_begin(html_doc *h, const char *const *headers, int n);
+void html_table_row(html_doc *h, const char *const *cells, int n);
+void html_table_end(html_doc *h);
 /* Closes the document and the file; false (error printed) when anything
  * failed to write. Frees h. */
-bool rl_html_end(rl_html *h, const char *path);
+bool html_end(html_doc *h, const char *path);
 
 /* HTML-escapes text into f (shared with the demo page). */
-void rl_html_put_escaped(FILE *f, const char *text);
+void html_put_escaped(FILE *f, const char *text);
 
 #endif

@@ -13,12 +13,12 @@ static float srgb_to_linear(float v)
     return v <= 0.04045f ? v / 12.92f : powf((v + 0.055f) / 1.055f, 2.4f);
 }
 
-rl_status rl_cli_write_depth(const rl_image *img, const char *path)
+rl_status cli_write_depth(const rl_image *img, const char *path)
 {
     if (!img->depth)
         return RL_ERR_INVALID_ARG;
     static const char *const exr[] = { ".exr", NULL };
-    bool raw = rl_cli_has_extension(path, exr);
+    bool raw = cli_has_extension(path, exr);
     size_t n = (size_t)img->width * (size_t)img->height;
     float near = INFINITY, far = -INFINITY;
     for (size_t i = 0; i < n; i++)
@@ -60,7 +60,7 @@ static uint32_t hash_id(uint32_t x)
     return x;
 }
 
-rl_status rl_cli_write_ids(const rl_image *img, const char *path)
+rl_status cli_write_ids(const rl_image *img, const char *path)
 {
     if (!img->object_id)
         return RL_ERR_INVALID_ARG;

@@ -14,15 +14,15 @@ typedef struct command {
 } command;
 
 static const command commands[] = {
-    { "scenes", rl_cli_scenes, "list the built-in scenes and their parameters" },
-    { "algos", rl_cli_algos, "list the renderers, their papers and options (alias: renderers)" },
-    { "renderers", rl_cli_algos, NULL },
-    { "info", rl_cli_info, "print statistics and cameras of a scene" },
-    { "render", rl_cli_render, "render a scene to PNG or EXR" },
-    { "demo", rl_cli_demo, "render every built-in scene with every renderer + HTML report" },
-    { "eval", rl_cli_eval, "approximate a position-dependent property over a region (heat map, statistics)" },
-    { "compare", rl_cli_compare, "compare renderers over a sampled region: time, operations, image quality" },
-    { "bench", rl_cli_bench, "benchmarks: bench rays (accelerators), bench vt (Vertex Tracing), bench pt (Line Space path tracing), bench sampling (property approximation), bench surfels (Progressive Blue Surfels), bench culling (CHC++, SVS, visible sets)" },
+    { "scenes", cli_scenes, "list the built-in scenes and their parameters" },
+    { "algos", cli_algos, "list the renderers, their papers and options (alias: renderers)" },
+    { "renderers", cli_algos, NULL },
+    { "info", cli_info, "print statistics and cameras of a scene" },
+    { "render", cli_render, "render a scene to PNG or EXR" },
+    { "demo", cli_demo, "render every built-in scene with every renderer + HTML report" },
+    { "eval", cli_eval, "approximate a position-dependent property over a region (heat map, statistics)" },
+    { "compare", cli_compare, "compare renderers over a sampled region: time, operations, image quality" },
+    { "bench", cli_bench, "benchmarks: bench rays (accelerators), bench vt (Vertex Tracing), bench pt (Line Space path tracing), bench sampling (property approximation), bench surfels (Progressive Blue Surfels), bench culling (CHC++, SVS, visible sets)" },
 };
 
 static void print_usage(FILE *out)
@@ -75,7 +75,7 @@ int main(int argc, char **argv)
     rl_log_set_callback(log_to_stderr, NULL);
 
     if (n == 0)
-        return rl_cli_fail(RL_CLI_USAGE, "no command given (commands: scenes, algos, info, "
+        return cli_fail(RL_CLI_USAGE, "no command given (commands: scenes, algos, info, "
                                          "render, demo, eval, compare, bench; see rl --help)");
     const char *name = argv[0];
     if (strcmp(name, "help") == 0 && n > 1) {
@@ -85,9 +85,9 @@ int main(int argc, char **argv)
         for (size_t i = 0; i < sizeof commands / sizeof commands[0]; i++)
             if (strcmp(argv[1], commands[i].name) == 0)
                 return commands[i].run(2, help_argv);
-        return rl_cli_fail(RL_CLI_USAGE, "unknown command '%s' (see rl --help)", argv[1]);
+        return cli_fail(RL_CLI_USAGE, "unknown command '%s' (see rl --help)", argv[1]);
     }
-    if (rl_cli_is_help(name) || strcmp(name, "help") == 0) {
+    if (cli_is_help(name) || strcmp(name, "help") == 0) {
         print_usage(stdout);
         return RL_CLI_OK;
     }
@@ -99,6 +99,6 @@ int main(int argc, char **argv)
         if (strcmp(name, commands[i].name) == 0)
             return commands[i].run(n, argv);
     if (name[0] == '-')
-        return rl_cli_fail(RL_CLI_USAGE, "unknown option '%s' (see rl --help)", name);
-    return rl_cli_fail(RL_CLI_USAGE, "unknown command '%s' (see rl --help)", name);
+        return cli_fail(RL_CLI_USAGE, "unknown option '%s' (see rl --help)", name);
+    return cli_fail(RL_CLI_USAGE, "unknown command '%s' (see rl --help)", name);
 }
