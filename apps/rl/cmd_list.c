@@ -16,6 +16,26 @@ static const char *option_type_name(rl_option_type t)
     return "?";
 }
 
+static void print_option(const rl_option_info *o)
+{
+    /* An empty default: "" for text, "-" (none: the help says what then) else. */
+    const char *def = o->default_value && *o->default_value ? o->default_value
+                      : o->type == RL_OPT_STRING             ? "\"\""
+                                                             : "-";
+    printf("    %-22s %-6s default %-10s %s", o->key, option_type_name(o->type), def, o->help ? o->help : "");
+    if (o->type == RL_OPT_INT && o->max > o->min)
+        printf(" [%.0f..%.0f]", o->min, o->max);   /* integers as integers, not 9.0072e+15 */
+    if (o->type == RL_OPT_FLOAT && o->max > o->min)
+        printf(" [%g..%g]", o->min, o->max);
+    if (o->type == RL_OPT_ENUM && o->choices) {
+        printf(" {");
+        for (const char *const *c = o->choices; *c; c++)
+            printf("%s%s", c == o->choices ? "" : ", ", *c);
+        printf("}");
+    }
+    putchar('\n');
+}
+
 /* Takes only --help; anything else is a usage error. */
 static int no_arguments(int argc, char **argv, const char *help)
 {
@@ -34,7 +54,8 @@ int cli_scenes(int argc, char **argv)
     int rc = no_arguments(argc, argv,
                           "usage: rl scenes\n"
                           "\n"
-                          "Lists the built-in scenes with their description and parameters.\n"
+                          "Lists the built-in scenes with their description and parameters\n"
+                          "(key, type, default, help, range), the same tables rl algos prints.\n"
                           "Parameters follow the scene name after a colon wherever a scene\n"
                           "is expected.\n"
                           "\n"
@@ -46,26 +67,14 @@ int cli_scenes(int argc, char **argv)
     size_t count = 0;
     const rl_builtin_info *scenes = rl_builtin_scenes(&count);
     for (size_t i = 0; i < count; i++) {
-        printf("%-16s %s\n", scenes[i].name, scenes[i].description ? scenes[i].description : "");
-        if (scenes[i].params && *scenes[i].params)
-            printf("%-16s parameters: %s\n", "", scenes[i].params);
+        printf("%s: %s\n", scenes[i].name, scenes[i].description ? scenes[i].description : "");
+        printf("  parameters:%s\n", scenes[i].num_options ? "" : " none");
+        for (size_t k = 0; k < scenes[i].num_options; k++)
+            print_option(&scenes[i].options[k]);
+        if (i + 1 < count)
+            putchar('\n');
     }
     return RL_CLI_OK;
-}
-
-static void print_option(const rl_option_info *o)
-{
-    printf("    %-22s %-6s default %-10s %s", o->key, option_type_name(o->type),
-           o->default_value ? o->default_value : "\"\"", o->help ? o->help : "");
-    if ((o->type == RL_OPT_INT || o->type == RL_OPT_FLOAT) && o->max > o->min)
-        printf(" [%g..%g]", o->min, o->max);
-    if (o->type == RL_OPT_ENUM && o->choices) {
-        printf(" {");
-        for (const char *const *c = o->choices; *c; c++)
-            printf("%s%s", c == o->choices ? "" : ", ", *c);
-        printf("}");
-    }
-    putchar('\n');
 }
 
 int cli_algos(int argc, char **argv)

@@ -22,6 +22,7 @@
 #include "rl/rl_common.h"
 #include "rl/rl_image.h"
 #include "rl/rl_math.h"
+#include "rl/rl_options.h"
 
 #ifdef __cplusplus
 extern "C" {
@@ -211,7 +212,8 @@ RL_API const char *const *rl_generator_names(size_t *count);
 typedef struct rl_builtin_info {
     const char *name;
     const char *description;
-    const char *params;        /* documented parameters with defaults */
+    const rl_option_info *options;     /* the parameters: key, type, default, help, range */
+    size_t num_options;
 } rl_builtin_info;
 RL_API const rl_builtin_info *rl_builtin_scenes(size_t *count);
 RL_API rl_status rl_scene_create_builtin(const char *name, const char *params, rl_scene **out);

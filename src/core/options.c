@@ -1,6 +1,5 @@
-/* options.c: validation and typed reads of key/value options (options.h).
- * Moved here from renderer.c unchanged in behaviour and wording, so that
- * properties (src/eval/property.c) validate exactly like renderers. */
+/* options.c: validation, storage and typed reads of key/value options
+ * (options.h), the same for renderers, properties and built-in scenes. */
 #include "core/options.h"
 
 #include <stdio.h>
@@ -35,6 +34,8 @@ long rl_option_find(const rl_option_info *opts, size_t n, const char *prefix, co
 rl_status rl_option_unknown(const rl_option_info *opts, size_t n, const char *context,
                             const char *key)
 {
+    if (n == 0)
+        return rl_error(RL_ERR_INVALID_ARG, "%s: unknown option \"%s\" (it takes none)", context, key);
     char keys[RL_OPTION_LIST_SIZE] = "";
     for (size_t k = 0; k < n; ++k) {
         if (k)
@@ -102,7 +103,7 @@ rl_status rl_option_validate(const rl_option_info *o, const char *value, const c
             return rl_error(RL_ERR_INVALID_ARG, "%s: option %s=\"%s\" is not an integer",
                             name, o->key, value);
         if ((double)v < o->min || (double)v > o->max)
-            return rl_error(RL_ERR_INVALID_ARG, "%s: option %s=%s is outside [%.17g, %.17g]",
+            return rl_error(RL_ERR_INVALID_ARG, "%s: option %s=%s is outside [%.0f, %.0f]",
                             name, o->key, value, o->min, o->max);
         return RL_OK;
     }
@@ -172,4 +173,116 @@ int rl_option_read_enum(const rl_option_info *o, const char *s)
 {
     int idx = o ? rl_option_enum_index(o, s) : -1;
     return idx < 0 ? 0 : idx;
+}
+
+static void free_values(char **values, size_t n)
+{
+    for (size_t i = 0; values && i < n; ++i)
+        free(values[i]);
+    free(values);
+}
+
+rl_status rl_option_store_init(rl_option_store *s, const rl_option_info *options, size_t count,
+                               const char *prefix)
+{
+    memset(s, 0, sizeof *s);
+    char **values = rl_calloc(count ? count : 1, sizeof *values);
+    bool *given = rl_calloc(count ? count : 1, sizeof *given);
+    if (!values || !given) {
+        free(values);
+        free(given);
+        return RL_ERR_OUT_OF_MEMORY;
+    }
+    for (size_t i = 0; i < count; ++i) {
+        const char *def = options[i].default_value;
+        if (!(values[i] = rl_strdup(def ? def : ""))) {
+            free_values(values, count);
+            free(given);
+            return RL_ERR_OUT_OF_MEMORY;
+        }
+    }
+    *s = (rl_option_store){ .options = options, .count = count, .prefix = prefix, .values = values,
+                            .given = given };
+    return RL_OK;
+}
+
+void rl_option_store_free(rl_option_store *s)
+{
+    if (!s)
+        return;
+    free_values(s->values, s->count);
+    free(s->given);
+    memset(s, 0, sizeof *s);
+}
+
+long rl_option_store_find(const rl_option_store *s, const char *key)
+{
+    return s && s->values ? rl_option_find(s->options, s->count, s->prefix, key) : -1;
+}
+
+rl_status rl_option_store_set(rl_option_store *s, const char *key, const char *value, const char *context,
+                              rl_status (*check)(const char *key, const char *value))
+{
+    long i = rl_option_store_find(s, key);
+    if (i < 0)
+        return rl_option_unknown(s->options, s->count, context, key);
+    const rl_option_info *o = &s->options[i];
+    rl_status st = rl_option_validate(o, value, context);
+    if (st == RL_OK && check)
+        st = check(o->key, value);
+    if (st != RL_OK)
+        return st;
+    char *copy = rl_strdup(value);
+    if (!copy)
+        return RL_ERR_OUT_OF_MEMORY;
+    free(s->values[i]);
+    s->values[i] = copy;
+    s->given[i] = true;
+    return RL_OK;
+}
+
+bool rl_option_store_given(const rl_option_store *s, const char *key)
+{
+    long i = rl_option_store_find(s, key);
+    return i >= 0 && s->given[i];
+}
+
+const char *rl_option_store_get(const rl_option_store *s, const char *key)
+{
+    long i = rl_option_store_find(s, key);
+    return i < 0 ? NULL : s->values[i];
+}
+
+long long rl_option_store_int(const rl_option_store *s, const char *key)
+{
+    return rl_option_read_int(rl_option_store_get(s, key));
+}
+
+double rl_option_store_float(const rl_option_store *s, const char *key)
+{
+    return rl_option_read_float(rl_option_store_get(s, key));
+}
+
+bool rl_option_store_bool(const rl_option_store *s, const char *key)
+{
+    return rl_option_read_bool(rl_option_store_get(s, key));
+}
+
+int rl_option_store_enum(const rl_option_store *s, const char *key)
+{
+    long i = rl_option_store_find(s, key);
+    return i < 0 ? 0 : rl_option_read_enum(&s->options[i], s->values[i]);
+}
+
+const char *rl_option_store_string(const rl_option_store *s, const char *key)
+{
+    const char *v = rl_option_store_get(s, key);
+    return v ? v : "";
+}
+
+rl_vec3 rl_option_store_color(const rl_option_store *s, const char *key)
+{
+    rl_vec3 c = rl_v3s(0.0f);
+    rl_option_parse_color(rl_option_store_get(s, key), &c);
+    return c;
 }

@@ -1,12 +1,15 @@
-/* options.h: typed option tables (rl_option_info, rl_options.h) checked and
- * read as text, shared by everything configured with key/value options:
- * renderers (src/render/renderer.c) and position-dependent properties
- * (src/eval/property.c). One definition, so that "threads=x" fails with the
- * same message whoever owns the option.
+/* options.h: the one option store of renderlab. Everything configured with
+ * key=value text describes its options with a table of rl_option_info rows
+ * (rl_options.h) and keeps their values in an rl_option_store: renderers
+ * (src/render/renderer.c), position-dependent properties
+ * (src/eval/property.c) and the built-in scenes (src/scene/builtin.c). One
+ * definition, so that "threads=x" fails with the same message whoever owns
+ * the option, and so that every table prints alike (rl algos, rl scenes).
  *
- * Values are kept as validated text by the owner; the readers here convert
- * text that already passed rl_option_validate() and return zero for text
- * that does not parse (which then means a wrong key in the caller). */
+ * Values are kept as validated text (get() returns exactly what was set, so
+ * that options can be listed and reproduced in reports); the typed reads
+ * convert text that already passed rl_option_validate() and return zero for
+ * a key that is not in the table (which means a wrong key in the caller). */
 #ifndef RL_CORE_OPTIONS_H
 #define RL_CORE_OPTIONS_H
 
@@ -42,5 +45,40 @@ long long rl_option_read_int(const char *s);
 double rl_option_read_float(const char *s);
 bool rl_option_read_bool(const char *s);
 int rl_option_read_enum(const rl_option_info *o, const char *s);   /* 0 if not a choice */
+
+/* A table's values. Zero-initialised it is empty; init fills the
+ * defaults. prefix (may be NULL) is the owner's name: "<prefix>.key" names
+ * the same option as "key". The table and prefix are borrowed. */
+typedef struct rl_option_store {
+    const rl_option_info *options;
+    size_t count;
+    const char *prefix;
+    char **values;                /* one per option, never NULL after init */
+    bool *given;                  /* per option: set since init (not only the default) */
+} rl_option_store;
+
+rl_status rl_option_store_init(rl_option_store *s, const rl_option_info *options, size_t count,
+                               const char *prefix);
+void rl_option_store_free(rl_option_store *s);   /* zeroes *s; NULL is a no-op */
+/* Index of key (with or without the prefix), or -1. */
+long rl_option_store_find(const rl_option_store *s, const char *key);
+/* Validates value against key's row, then with check (may be NULL: an
+ * owner's extra rule), and stores a copy. Messages start with context.
+ * RL_ERR_INVALID_ARG for an unknown key (listing the keys) or a bad value;
+ * the old value stays on failure. */
+rl_status rl_option_store_set(rl_option_store *s, const char *key, const char *value, const char *context,
+                              rl_status (*check)(const char *key, const char *value));
+/* Whether key was set since init: for an owner whose default depends on
+ * other options (a box's sx defaults to its size). */
+bool rl_option_store_given(const rl_option_store *s, const char *key);
+/* The value as text; NULL for an unknown key. */
+const char *rl_option_store_get(const rl_option_store *s, const char *key);
+/* Typed reads (zero, false, "" or black for an unknown key). */
+long long rl_option_store_int(const rl_option_store *s, const char *key);
+double rl_option_store_float(const rl_option_store *s, const char *key);
+bool rl_option_store_bool(const rl_option_store *s, const char *key);
+int rl_option_store_enum(const rl_option_store *s, const char *key);     /* choice index */
+const char *rl_option_store_string(const rl_option_store *s, const char *key);
+rl_vec3 rl_option_store_color(const rl_option_store *s, const char *key);
 
 #endif

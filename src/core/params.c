@@ -1,6 +1,6 @@
-/* params.c: "key=value" lists with typed lookups (params.h). Every lookup
- * marks its key used so that rl_params_check_unused() can turn typos such as
- * "sampels=4" into errors instead of silently rendering with the default. */
+/* params.c: "key=value" lists (params.h) and the strict number parsing of
+ * rl_options.h. Unknown keys become errors where the list meets its option
+ * table (rl_option_store_set), not here. */
 #define _POSIX_C_SOURCE 200809L
 #include "core/params.h"
 
@@ -30,14 +30,13 @@ static rl_status set_owned(rl_params *p, char *key, char *value)
         free(it->value);
         free(key);
         it->value = value;
-        it->used = false;
         return RL_OK;
     }
     rl_param *items = rl_realloc_array(p->items, (size_t)p->count + 1, sizeof *items);
     if (!items)
         return RL_ERR_OUT_OF_MEMORY;
     p->items = items;
-    p->items[p->count++] = (rl_param){ key, value, false };
+    p->items[p->count++] = (rl_param){ key, value };
     return RL_OK;
 }
 
@@ -120,10 +119,7 @@ void rl_params_free(rl_params *p)
 const char *rl_params_get(rl_params *p, const char *key)
 {
     rl_param *it = p && key ? find(p, key) : NULL;
-    if (!it)
-        return NULL;
-    it->used = true;
-    return it->value;
+    return it ? it->value : NULL;
 }
 
 bool rl_parse_int(const char *s, long long *out)
@@ -152,85 +148,4 @@ bool rl_parse_float(const char *s, double *out)
         return false;
     *out = v;
     return true;
-}
-
-static const char *ctx_or(const char *context) { return context ? context : "parameters"; }
-
-rl_status rl_params_int(rl_params *p, const char *context, const char *key,
-                        long long min, long long max, long long *out)
-{
-    const char *s = rl_params_get(p, key);
-    if (!s)
-        return RL_OK;
-    long long v;
-    if (!rl_parse_int(s, &v) || v < min || v > max)
-        return rl_error(RL_ERR_INVALID_ARG, "%s: %s=%s: expected an integer in [%lld, %lld]",
-                        ctx_or(context), key, s, min, max);
-    *out = v;
-    return RL_OK;
-}
-
-rl_status rl_params_float(rl_params *p, const char *context, const char *key,
-                          double min, double max, double *out)
-{
-    const char *s = rl_params_get(p, key);
-    if (!s)
-        return RL_OK;
-    double v;
-    if (!rl_parse_float(s, &v) || v < min || v > max)
-        return rl_error(RL_ERR_INVALID_ARG, "%s: %s=%s: expected a number in [%g, %g]",
-                        ctx_or(context), key, s, min, max);
-    *out = v;
-    return RL_OK;
-}
-
-rl_status rl_params_bool(rl_params *p, const char *context, const char *key, bool *out)
-{
-    const char *s = rl_params_get(p, key);
-    if (!s)
-        return RL_OK;
-    static const char *const yes[] = { "1", "true", "yes", "on" };
-    static const char *const no[] = { "0", "false", "no", "off" };
-    for (int i = 0; i < 4; ++i) {
-        if (strcasecmp(s, yes[i]) == 0) {
-            *out = true;
-            return RL_OK;
-        }
-        if (strcasecmp(s, no[i]) == 0) {
-            *out = false;
-            return RL_OK;
-        }
-    }
-    return rl_error(RL_ERR_INVALID_ARG,
-                    "%s: %s=%s: expected a boolean (1/0, true/false, yes/no, on/off)",
-                    ctx_or(context), key, s);
-}
-
-rl_status rl_params_enum(rl_params *p, const char *context, const char *key,
-                         const char *const *choices, int *out)
-{
-    const char *s = rl_params_get(p, key);
-    if (!s)
-        return RL_OK;
-    for (int i = 0; choices && choices[i]; ++i)
-        if (strcmp(s, choices[i]) == 0) {
-            *out = i;
-            return RL_OK;
-        }
-    char list[512] = "";
-    size_t n = 0;
-    for (int i = 0; choices && choices[i] && n < sizeof list; ++i)
-        n += (size_t)snprintf(list + n, sizeof list - n, "%s%s", i ? ", " : "", choices[i]);
-    return rl_error(RL_ERR_INVALID_ARG, "%s: %s=%s: expected one of: %s", ctx_or(context), key,
-                    s, list);
-}
-
-rl_status rl_params_check_unused(const rl_params *p, const char *context, const char *accepted)
-{
-    for (uint32_t i = 0; p && i < p->count; ++i)
-        if (!p->items[i].used)
-            return rl_error(RL_ERR_INVALID_ARG, "%s: unknown parameter \"%s\" (accepted: %s)",
-                            ctx_or(context), p->items[i].key,
-                            accepted && *accepted ? accepted : "none");
-    return RL_OK;
 }

@@ -30,7 +30,7 @@
 struct rl_property {
     const rl_property_class *cls;
     char *name;
-    char **values;              /* one per option, always non-NULL */
+    rl_option_store options;    /* the class's table and this property's values */
     void *impl;                 /* custom / combined data, or NULL */
     void *state;                /* committed state, or NULL */
     bool committed;
@@ -66,15 +66,6 @@ const rl_property_info *rl_property_list(size_t *count)
     return infos;
 }
 
-static void free_values(char **values, size_t n)
-{
-    if (!values)
-        return;
-    for (size_t i = 0; i < n; ++i)
-        free(values[i]);
-    free(values);
-}
-
 /* A property of class cls with default option values; impl is attached by
  * the caller. */
 static rl_status make(const rl_property_class *cls, const char *name, rl_property **out)
@@ -84,18 +75,12 @@ static rl_status make(const rl_property_class *cls, const char *name, rl_propert
         return RL_ERR_OUT_OF_MEMORY;
     p->cls = cls;
     p->name = rl_strdup(name);
-    p->values = rl_calloc(cls->num_options ? cls->num_options : 1, sizeof *p->values);
-    bool ok = p->name && p->values;
-    for (size_t i = 0; ok && i < cls->num_options; ++i) {
-        const char *def = cls->options[i].default_value;
-        p->values[i] = rl_strdup(def ? def : "");
-        ok = p->values[i] != NULL;
-    }
-    if (!ok) {
-        free_values(p->values, cls->num_options);
+    rl_status st = p->name ? rl_option_store_init(&p->options, cls->options, cls->num_options, cls->info.name)
+                           : RL_ERR_OUT_OF_MEMORY;
+    if (st != RL_OK) {
         free(p->name);
         free(p);
-        return RL_ERR_OUT_OF_MEMORY;
+        return st;
     }
     *out = p;
     return RL_OK;
@@ -137,7 +122,7 @@ void rl_property_release(rl_property *p)
     unbind(p);
     if (p->cls->release_impl)
         p->cls->release_impl(p->impl);
-    free_values(p->values, p->cls->num_options);
+    rl_option_store_free(&p->options);
     free(p->name);
     free(p);
 }
@@ -163,43 +148,21 @@ const rl_option_info *rl_property_options(const rl_property *p, size_t *count)
     return p && p->cls->num_options ? p->cls->options : NULL;
 }
 
-static long find_option(const rl_property *p, const char *key)
-{
-    return rl_option_find(p->cls->options, p->cls->num_options, p->cls->info.name, key);
-}
-
 rl_status rl_property_set(rl_property *p, const char *key, const char *value)
 {
     if (!p || !key || !value)
         return rl_error(RL_ERR_INVALID_ARG,
                         "rl_property_set: property, key and value must not be NULL");
-    long i = find_option(p, key);
-    if (i < 0)
-        return rl_option_unknown(p->cls->options, p->cls->num_options, p->name, key);
-    if (p->committed)
+    if (p->committed && rl_option_store_find(&p->options, key) >= 0)
         return rl_error(RL_ERR_INVALID_ARG,
                         "%s: option %s cannot change after commit (create a new property)",
                         p->name, key);
-    const rl_option_info *o = &p->cls->options[i];
-    rl_status st = rl_option_validate(o, value, p->name);
-    if (st == RL_OK && p->cls->check)
-        st = p->cls->check(o->key, value);
-    if (st != RL_OK)
-        return st;
-    char *copy = rl_strdup(value);
-    if (!copy)
-        return RL_ERR_OUT_OF_MEMORY;
-    free(p->values[i]);
-    p->values[i] = copy;
-    return RL_OK;
+    return rl_option_store_set(&p->options, key, value, p->name, p->cls->check);
 }
 
 const char *rl_property_get(const rl_property *p, const char *key)
 {
-    if (!p || !key)
-        return NULL;
-    long i = find_option(p, key);
-    return i < 0 ? NULL : p->values[i];
+    return p && key ? rl_option_store_get(&p->options, key) : NULL;
 }
 
 const char *rl_property_opt(const rl_property *p, const char *key)
@@ -210,23 +173,22 @@ const char *rl_property_opt(const rl_property *p, const char *key)
 
 long long rl_property_opt_int(const rl_property *p, const char *key)
 {
-    return rl_option_read_int(rl_property_get(p, key));
+    return p ? rl_option_store_int(&p->options, key) : 0;
 }
 
 double rl_property_opt_float(const rl_property *p, const char *key)
 {
-    return rl_option_read_float(rl_property_get(p, key));
+    return p ? rl_option_store_float(&p->options, key) : 0.0;
 }
 
 bool rl_property_opt_bool(const rl_property *p, const char *key)
 {
-    return rl_option_read_bool(rl_property_get(p, key));
+    return p && rl_option_store_bool(&p->options, key);
 }
 
 int rl_property_opt_enum(const rl_property *p, const char *key)
 {
-    long i = p && key ? find_option(p, key) : -1;
-    return i < 0 ? 0 : rl_option_read_enum(&p->cls->options[i], p->values[i]);
+    return p ? rl_option_store_enum(&p->options, key) : 0;
 }
 
 void *rl_property_impl(const rl_property *p) { return p ? p->impl : NULL; }

@@ -17,7 +17,7 @@
 struct rl_renderer {
     const rl_renderer_class *cls;
     void *state;
-    char **values;              /* one per option, always non-NULL */
+    rl_option_store options;    /* the class's table and this renderer's values */
     rl_progress_fn progress;
     void *progress_user;
     /* Lookup inputs per slot of the class (rl_renderer_set_input). */
@@ -81,15 +81,6 @@ static const rl_renderer_class *find_class(const char *name)
     return NULL;
 }
 
-static void free_values(char **values, size_t n)
-{
-    if (!values)
-        return;
-    for (size_t i = 0; i < n; ++i)
-        free(values[i]);
-    free(values);
-}
-
 rl_status rl_renderer_create(const char *name, rl_renderer **out)
 {
     if (!name || !out)
@@ -109,24 +100,15 @@ rl_status rl_renderer_create(const char *name, rl_renderer **out)
     if (!r)
         return RL_ERR_OUT_OF_MEMORY;
     r->cls = cls;
-    r->values = rl_calloc(cls->num_options ? cls->num_options : 1, sizeof *r->values);
-    if (!r->values) {
+    rl_status st = rl_option_store_init(&r->options, cls->options, cls->num_options, cls->info.name);
+    if (st != RL_OK) {
         free(r);
-        return RL_ERR_OUT_OF_MEMORY;
-    }
-    for (size_t i = 0; i < cls->num_options; ++i) {
-        const char *def = cls->options[i].default_value;
-        r->values[i] = rl_strdup(def ? def : "");
-        if (!r->values[i]) {
-            free_values(r->values, cls->num_options);
-            free(r);
-            return RL_ERR_OUT_OF_MEMORY;
-        }
+        return st;
     }
     if (cls->create) {
-        rl_status st = cls->create(&r->state);
+        st = cls->create(&r->state);
         if (st != RL_OK) {
-            free_values(r->values, cls->num_options);
+            rl_option_store_free(&r->options);
             free(r);
             return st;
         }
@@ -143,7 +125,7 @@ void rl_renderer_release(rl_renderer *r)
         r->cls->release(r->state);
     for (size_t i = 0; i < RL_RENDERER_MAX_INPUTS; ++i)
         clear_input(&r->inputs[i]);
-    free_values(r->values, r->cls->num_options);
+    rl_option_store_free(&r->options);
     free(r);
 }
 
@@ -223,31 +205,11 @@ const rl_option_info *rl_renderer_options(const rl_renderer *r, size_t *count)
     return r ? r->cls->options : NULL;
 }
 
-/* Index of key (optionally "<name>.key") in the option table, or -1. */
-static long find_option(const rl_renderer *r, const char *key)
-{
-    return rl_option_find(r->cls->options, r->cls->num_options, r->cls->info.name, key);
-}
-
 rl_status rl_renderer_set(rl_renderer *r, const char *key, const char *value)
 {
     if (!r || !key || !value)
         return rl_error(RL_ERR_INVALID_ARG, "rl_renderer_set: renderer, key and value must not be NULL");
-    long i = find_option(r, key);
-    if (i < 0)
-        return rl_option_unknown(r->cls->options, r->cls->num_options, r->cls->info.name, key);
-    const rl_option_info *o = &r->cls->options[i];
-    rl_status st = rl_option_validate(o, value, r->cls->info.name);
-    if (st == RL_OK && r->cls->check)
-        st = r->cls->check(o->key, value);
-    if (st != RL_OK)
-        return st;
-    char *copy = rl_strdup(value);
-    if (!copy)
-        return RL_ERR_OUT_OF_MEMORY;
-    free(r->values[i]);
-    r->values[i] = copy;
-    return RL_OK;
+    return rl_option_store_set(&r->options, key, value, r->cls->info.name, r->cls->check);
 }
 
 void rl_renderer_reset(rl_renderer *r)
@@ -258,10 +220,7 @@ void rl_renderer_reset(rl_renderer *r)
 
 const char *rl_renderer_get(const rl_renderer *r, const char *key)
 {
-    if (!r || !key)
-        return NULL;
-    long i = find_option(r, key);
-    return i < 0 ? NULL : r->values[i];
+    return r && key ? rl_option_store_get(&r->options, key) : NULL;
 }
 
 void rl_renderer_set_progress(rl_renderer *r, rl_progress_fn fn, void *user)
@@ -277,35 +236,31 @@ bool rl_renderer_progress(const rl_renderer *r, double done)
     return !r->progress || r->progress(r->progress_user, done);
 }
 
-/* Typed reads. Values were validated on set and defaults are trusted, so a
- * failed parse here means a wrong key in an implementation: return zero. */
+/* Typed reads (options.h). Values were validated on set and defaults are
+ * trusted, so a failed parse means a wrong key in an implementation. */
 long long rl_renderer_opt_int(const rl_renderer *r, const char *key)
 {
-    return rl_option_read_int(rl_renderer_get(r, key));
+    return rl_option_store_int(&r->options, key);
 }
 
 double rl_renderer_opt_float(const rl_renderer *r, const char *key)
 {
-    return rl_option_read_float(rl_renderer_get(r, key));
+    return rl_option_store_float(&r->options, key);
 }
 
 bool rl_renderer_opt_bool(const rl_renderer *r, const char *key)
 {
-    return rl_option_read_bool(rl_renderer_get(r, key));
+    return rl_option_store_bool(&r->options, key);
 }
 
 int rl_renderer_opt_enum(const rl_renderer *r, const char *key)
 {
-    long i = r && key ? find_option(r, key) : -1;
-    if (i < 0)
-        return 0;
-    return rl_option_read_enum(&r->cls->options[i], r->values[i]);
+    return rl_option_store_enum(&r->options, key);
 }
 
 const char *rl_renderer_opt_string(const rl_renderer *r, const char *key)
 {
-    const char *s = rl_renderer_get(r, key);
-    return s ? s : "";
+    return rl_option_store_string(&r->options, key);
 }
 
 bool rl_renderer_parse_color(const char *text, rl_vec3 *out)
@@ -315,9 +270,7 @@ bool rl_renderer_parse_color(const char *text, rl_vec3 *out)
 
 rl_vec3 rl_renderer_opt_color(const rl_renderer *r, const char *key)
 {
-    rl_vec3 c = rl_v3s(0.0f);
-    rl_option_parse_color(rl_renderer_get(r, key), &c);
-    return c;
+    return rl_option_store_color(&r->options, key);
 }
 
 rl_status rl_renderer_render(rl_renderer *r, const rl_scene *scene, const rl_camera *cam,

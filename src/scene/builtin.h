@@ -1,26 +1,37 @@
 /* builtin.h: the built-in scenes, one builder per file (builtin_*.c), listed
  * once in builtin.c.
  *
- * A builder reads its parameters, calls rl_params_check_unused() before doing
- * any heavy work, then fills an empty scene through the public API. builtin.c
- * names and commits the scene and releases it on failure. */
+ * A scene is a class: its rl_builtin_info (name, description and the table
+ * of its key=value parameters, the same rl_option_info rows that renderers
+ * use, so rl scenes prints them as rl algos prints options) and a builder.
+ * builtin.c parses and validates the parameters against the table (unknown
+ * keys and out-of-range values fail there, before any work), hands the
+ * builder the values, names and commits the scene and releases it on
+ * failure. A builder checks only what a table cannot say (e.g. a range that
+ * depends on another parameter), then fills an empty scene through the
+ * public API. */
 #ifndef RL_SCENE_BUILTIN_H
 #define RL_SCENE_BUILTIN_H
 
-#include "core/params.h"
+#include "core/options.h"
 #include "rl/rl_scene.h"
 
-typedef rl_status (*rl_builtin_build_fn)(rl_scene *scene, rl_params *params);
+typedef struct rl_builtin_class {
+    rl_builtin_info info;
+    rl_status (*build)(rl_scene *scene, const rl_option_store *params);
+} rl_builtin_class;
 
-rl_status rl_builtin_cornell(rl_scene *scene, rl_params *params);
-rl_status rl_builtin_cornell_teapot(rl_scene *scene, rl_params *params);
-rl_status rl_builtin_spheres(rl_scene *scene, rl_params *params);
-rl_status rl_builtin_city(rl_scene *scene, rl_params *params);
-rl_status rl_builtin_table(rl_scene *scene, rl_params *params);
-rl_status rl_builtin_cluster(rl_scene *scene, rl_params *params);
+#define RL_BUILTIN_OPTIONS(table) (table), sizeof(table) / sizeof((table)[0])
+
+extern const rl_builtin_class rl_builtin_cornell_class;
+extern const rl_builtin_class rl_builtin_cornell_teapot_class;
+extern const rl_builtin_class rl_builtin_spheres_class;
+extern const rl_builtin_class rl_builtin_city_class;
+extern const rl_builtin_class rl_builtin_table_class;
+extern const rl_builtin_class rl_builtin_cluster_class;
 /* The test scenes of Schröder 2017, Sec. 9.3 (builtin_linespace.c). */
-rl_status rl_builtin_ls_open(rl_scene *scene, rl_params *params);
-rl_status rl_builtin_ls_cornell(rl_scene *scene, rl_params *params);
+extern const rl_builtin_class rl_builtin_ls_open_class;
+extern const rl_builtin_class rl_builtin_ls_cornell_class;
 /* Triangle counts of the bunny and dragon stand-ins (closed blobs): the
  * thesis' 69,451 is odd, impossible for a closed mesh, hence 69,450. */
 #define RL_LS_BUNNY_TRIANGLES 69450u

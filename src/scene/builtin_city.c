@@ -484,29 +484,23 @@ static rl_status add_materials(city *cy)
     return s;
 }
 
-static rl_status read_params(rl_params *params, city_params *p)
+static rl_status read_params(const rl_option_store *params, city_params *p)
 {
-    const char *ctx = "city";
-    *p = (city_params){ .blocks = 6, .seed = 1, .floors_min = 2, .floors_max = 16, .detail = 2,
-                        .block_size = 64.0, .street_width = 16.0, .furniture = true };
-    rl_status s = rl_params_int(params, ctx, "blocks", 1, 64, &p->blocks);
-    if (!s) s = rl_params_int(params, ctx, "seed", 0, INT64_MAX, &p->seed);
-    if (!s) s = rl_params_int(params, ctx, "floors_min", 1, 200, &p->floors_min);
-    if (!s) s = rl_params_int(params, ctx, "floors_max", 1, 200, &p->floors_max);
-    if (!s) s = rl_params_int(params, ctx, "detail", 0, 2, &p->detail);
-    if (!s) s = rl_params_float(params, ctx, "block_size", 24.0, 512.0, &p->block_size);
-    if (!s) s = rl_params_float(params, ctx, "street_width", 4.0, 200.0, &p->street_width);
-    if (!s) s = rl_params_bool(params, ctx, "furniture", &p->furniture);
-    if (!s) s = rl_params_check_unused(params, ctx,
-                                       "blocks, seed, floors_min, floors_max, detail, "
-                                       "block_size, street_width, furniture");
-    if (!s && p->floors_min > p->floors_max)
-        s = rl_error(RL_ERR_INVALID_ARG, "city: floors_min (%lld) exceeds floors_max (%lld)",
-                     p->floors_min, p->floors_max);
-    return s;
+    *p = (city_params){ .blocks = rl_option_store_int(params, "blocks"),
+                        .seed = rl_option_store_int(params, "seed"),
+                        .floors_min = rl_option_store_int(params, "floors_min"),
+                        .floors_max = rl_option_store_int(params, "floors_max"),
+                        .detail = rl_option_store_int(params, "detail"),
+                        .block_size = rl_option_store_float(params, "block_size"),
+                        .street_width = rl_option_store_float(params, "street_width"),
+                        .furniture = rl_option_store_bool(params, "furniture") };
+    if (p->floors_min > p->floors_max)
+        return rl_error(RL_ERR_INVALID_ARG, "city: floors_min (%lld) exceeds floors_max (%lld)", p->floors_min,
+                        p->floors_max);
+    return RL_OK;
 }
 
-rl_status rl_builtin_city(rl_scene *scene, rl_params *params)
+static rl_status build_city(rl_scene *scene, const rl_option_store *params)
 {
     city *cy = rl_calloc(1, sizeof *cy);
     if (!cy)
@@ -562,3 +556,22 @@ rl_status rl_builtin_city(rl_scene *scene, rl_params *params)
     free(cy);
     return s;
 }
+
+static const rl_option_info city_options[] = {
+    { "blocks", RL_OPT_INT, "6", "blocks per side", 1, 64, NULL },
+    { "seed", RL_OPT_INT, "1", "random seed of the buildings", 0, 9007199254740992.0, NULL },
+    { "floors_min", RL_OPT_INT, "2", "lowest building, floors", 1, 200, NULL },
+    { "floors_max", RL_OPT_INT, "16", "highest building, floors (>= floors_min)", 1, 200, NULL },
+    { "detail", RL_OPT_INT, "2", "0: boxes with slabs, 1: + windows, 2: + interior walls", 0, 2, NULL },
+    { "block_size", RL_OPT_FLOAT, "64", "block side, m", 24, 512, NULL },
+    { "street_width", RL_OPT_FLOAT, "16", "street width, m", 4, 200, NULL },
+    { "furniture", RL_OPT_BOOL, "true", "street lamps and trees", 0, 0, NULL },
+};
+
+const rl_builtin_class rl_builtin_city_class = {
+    { "city",
+      "procedural city: blocks of buildings with window openings, floor slabs and interior rooms, street lamps "
+      "and trees; for visibility and LOD work",
+      RL_BUILTIN_OPTIONS(city_options) },
+    build_city,
+};

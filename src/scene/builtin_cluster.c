@@ -525,18 +525,15 @@ static rl_status add_cameras(cluster *c)
     return s;
 }
 
-rl_status rl_builtin_cluster(rl_scene *scene, rl_params *params)
+static rl_status build_cluster(rl_scene *scene, const rl_option_store *params)
 {
     cluster c = { .scene = scene,
-                  .p = { .speed = 80.0, .rpm = 3.0, .detail = 1.0, .tex = 1024, .glass_segments = 48 } };
-    const char *ctx = "cluster";
-    rl_status s = rl_params_float(params, ctx, "speed", 0.0, 240.0, &c.p.speed);
-    if (!s) s = rl_params_float(params, ctx, "rpm", 0.0, 8.0, &c.p.rpm);
-    if (!s) s = rl_params_int(params, ctx, "tex", 64, 4096, &c.p.tex);
-    if (!s) s = rl_params_int(params, ctx, "glass_segments", 4, 1024, &c.p.glass_segments);
-    if (!s) s = rl_params_float(params, ctx, "detail", 0.25, 8.0, &c.p.detail);
-    if (!s) s = rl_params_check_unused(params, ctx, "speed, rpm, tex, glass_segments, detail");
-    if (!s) s = add_materials(&c);
+                  .p = { .speed = rl_option_store_float(params, "speed"),
+                         .rpm = rl_option_store_float(params, "rpm"),
+                         .detail = rl_option_store_float(params, "detail"),
+                         .tex = rl_option_store_int(params, "tex"),
+                         .glass_segments = rl_option_store_int(params, "glass_segments") } };
+    rl_status s = add_materials(&c);
     if (s)
         return s;
     c.frame = rl_mat4_rotate(rl_v3(1.0f, 0.0f, 0.0f), rl_radians(-TILT_DEG));
@@ -551,3 +548,20 @@ rl_status rl_builtin_cluster(rl_scene *scene, rl_params *params)
     if (!s) s = add_cameras(&c);
     return s;
 }
+
+static const rl_option_info cluster_options[] = {
+    { "speed", RL_OPT_FLOAT, "80", "speedometer needle, km/h", 0, 240, NULL },
+    { "rpm", RL_OPT_FLOAT, "3", "tachometer needle, x1000/min", 0, 8, NULL },
+    { "tex", RL_OPT_INT, "1024", "dial texture size, texels", 64, 4096, NULL },
+    { "glass_segments", RL_OPT_INT, "48", "cover glass columns", 4, 1024, NULL },
+    { "detail", RL_OPT_FLOAT, "1", "tessellation multiplier", 0.25, 8, NULL },
+};
+
+const rl_builtin_class rl_builtin_cluster_class = {
+    { "cluster",
+      "vehicle instrument cluster of Ullmann 2003, Sec. 5.4: speedometer and tachometer dials with printed "
+      "textures, needles, warning lights behind a curved reflecting and refracting cover glass (the only VT "
+      "object), steering wheel; cameras driver, lateral, zoom and a 4 s head-movement camera path",
+      RL_BUILTIN_OPTIONS(cluster_options) },
+    build_cluster,
+};

@@ -146,10 +146,10 @@ static rl_status add_box(rl_scene *scene)
     return rl_scene_add_camera(scene, "default", &cam);
 }
 
-rl_status rl_builtin_cornell(rl_scene *scene, rl_params *params)
+static rl_status build_cornell(rl_scene *scene, const rl_option_store *params)
 {
-    rl_status s = rl_params_check_unused(params, "cornell", "none");
-    if (!s) s = add_box(scene);
+    (void)params;
+    rl_status s = add_box(scene);
     uint32_t white = rl_scene_find_material(scene, "white");
     uint32_t materials[NUM_MATERIALS] = { white, white, white, white };
     for (size_t i = 0; i < sizeof blocks / sizeof blocks[0] && !s; ++i)
@@ -157,17 +157,12 @@ rl_status rl_builtin_cornell(rl_scene *scene, rl_params *params)
     return s;
 }
 
-rl_status rl_builtin_cornell_teapot(rl_scene *scene, rl_params *params)
+static rl_status build_cornell_teapot(rl_scene *scene, const rl_option_store *params)
 {
-    long long triangles = RL_TEAPOT_DEFAULT_TRIANGLES;
-    double size = 0.2, shininess = 64.0, rotate = -30.0;
-    const char *ctx = "cornell-teapot";
-    rl_status s = rl_params_int(params, ctx, "triangles", 1, RL_TEAPOT_MAX_TRIANGLES, &triangles);
-    if (!s) s = rl_params_float(params, ctx, "size", 0.01, 0.5, &size);
-    if (!s) s = rl_params_float(params, ctx, "shininess", 0.0, 1e4, &shininess);
-    if (!s) s = rl_params_float(params, ctx, "rotate", -360.0, 360.0, &rotate);
-    if (!s) s = rl_params_check_unused(params, ctx, "triangles, size, shininess, rotate");
-    if (!s) s = add_box(scene);
+    long long triangles = rl_option_store_int(params, "triangles");
+    double size = rl_option_store_float(params, "size"), shininess = rl_option_store_float(params, "shininess"),
+           rotate = rl_option_store_float(params, "rotate");
+    rl_status s = add_box(scene);
     if (s)
         return s;
 
@@ -195,3 +190,26 @@ rl_status rl_builtin_cornell_teapot(rl_scene *scene, rl_params *params)
         s = rl_builtin_instance(scene, RL_NODE_ROOT, "teapot", mesh, "teapot", &world, NULL);
     return s;
 }
+
+const rl_builtin_class rl_builtin_cornell_class = {
+    { "cornell",
+      "Cornell box from the Cornell measured data (metres): 5 walls, short and tall block, ceiling quad light; "
+      "36 triangles",
+      NULL, 0 },
+    build_cornell,
+};
+
+_Static_assert(RL_TEAPOT_DEFAULT_TRIANGLES == 15704, "the table's default is the teapot's");
+static const rl_option_info teapot_options[] = {
+    { "triangles", RL_OPT_INT, "15704", "teapot triangles (the closest patch grid is used)", 1,
+      RL_TEAPOT_MAX_TRIANGLES, NULL },
+    { "size", RL_OPT_FLOAT, "0.2", "teapot height, m", 0.01, 0.5, NULL },
+    { "shininess", RL_OPT_FLOAT, "64", "Phong exponent of the teapot", 0, 1e4, NULL },
+    { "rotate", RL_OPT_FLOAT, "-30", "turn about y, degrees", -360, 360, NULL },
+};
+
+const rl_builtin_class rl_builtin_cornell_teapot_class = {
+    { "cornell-teapot", "Cornell box without the blocks, a slightly glossy Utah teapot on the floor",
+      RL_BUILTIN_OPTIONS(teapot_options) },
+    build_cornell_teapot,
+};

@@ -49,23 +49,23 @@ static rl_status add_object_material(rl_scene *scene, uint32_t *id)
     return rl_scene_add_material(scene, &m, id);
 }
 
-/* model= and triangles=, read and checked before any geometry is built.
- * *triangles = 0 means the model's default. */
-static rl_status read_model(rl_params *params, const char *ctx, int *model, long long *triangles)
+/* model= and triangles=, checked before any geometry is built: the table
+ * takes triangles in the widest range, the model narrows it. Without
+ * triangles *triangles stays 0, the model's default. */
+static rl_status read_model(const rl_option_store *params, const char *ctx, int *model, long long *triangles)
 {
-    rl_status s = rl_params_enum(params, ctx, "model", model_names, model);
-    if (s)
-        return s;
-    const char *given = rl_params_get(params, "triangles");
-    if (!given)
-        return RL_OK;
+    *model = rl_option_store_enum(params, "model");
+    if (!rl_option_store_given(params, "triangles"))
+        return RL_OK;   /* *triangles stays 0: the model's default */
+    *triangles = rl_option_store_int(params, "triangles");
     if (*model == MODEL_BOXES)
         return rl_error(RL_ERR_INVALID_ARG, "%s: triangles applies to model=teapot, bunny or "
                         "dragon, not boxes", ctx);
     long long lo = *model == MODEL_TEAPOT ? 1 : RL_BLOB_MIN_TRIANGLES;
     long long hi = *model == MODEL_TEAPOT ? RL_TEAPOT_MAX_TRIANGLES : RL_BLOB_MAX_TRIANGLES;
-    if ((s = rl_params_int(params, ctx, "triangles", lo, hi, triangles)))
-        return s;
+    if (*triangles < lo || *triangles > hi)
+        return rl_error(RL_ERR_INVALID_ARG, "%s: option triangles=%lld is outside [%lld, %lld] for model=%s", ctx,
+                        *triangles, lo, hi, model_names[*model]);
     if (*model != MODEL_TEAPOT && *triangles % 2)
         return rl_error(RL_ERR_INVALID_ARG, "%s: triangles=%lld for model=%s is odd; the model "
                         "is a closed mesh, whose triangle count is even", ctx, *triangles,
@@ -73,7 +73,6 @@ static rl_status read_model(rl_params *params, const char *ctx, int *model, long
     return RL_OK;
 }
 
-/* The model standing on y = 0, centred on the y axis, `height` tall. */
 static rl_status add_model(rl_scene *scene, int model, long long triangles, uint32_t material,
                            float height)
 {
@@ -151,7 +150,7 @@ static rl_status add_camera(rl_scene *scene, rl_vec3 eye, rl_vec3 target, float 
 
 /* ---- ls-open (Sec. 9.3, scenes 1-3) -------------------------------------- */
 
-rl_status rl_builtin_ls_open(rl_scene *scene, rl_params *params)
+static rl_status build_ls_open(rl_scene *scene, const rl_option_store *params)
 {
     const char *ctx = "ls-open";
     int model = MODEL_TEAPOT;
@@ -160,7 +159,6 @@ rl_status rl_builtin_ls_open(rl_scene *scene, rl_params *params)
     if (!s && model == MODEL_BOXES)
         s = rl_error(RL_ERR_INVALID_ARG, "%s: model=boxes belongs to ls-cornell (expected "
                      "teapot, bunny or dragon)", ctx);
-    if (!s) s = rl_params_check_unused(params, ctx, "model, triangles");
     if (s)
         return s;
 
@@ -204,13 +202,12 @@ rl_status rl_builtin_ls_open(rl_scene *scene, rl_params *params)
 
 enum { WALL_WHITE, WALL_RED, WALL_GREEN, NUM_WALL_MATERIALS };
 
-rl_status rl_builtin_ls_cornell(rl_scene *scene, rl_params *params)
+static rl_status build_ls_cornell(rl_scene *scene, const rl_option_store *params)
 {
     const char *ctx = "ls-cornell";
     int model = MODEL_BOXES;
     long long triangles = 0;
     rl_status s = read_model(params, ctx, &model, &triangles);
-    if (!s) s = rl_params_check_unused(params, ctx, "model, triangles");
     if (s)
         return s;
 
@@ -295,3 +292,39 @@ rl_status rl_builtin_ls_cornell(rl_scene *scene, rl_params *params)
     if (!s) s = add_camera(scene, rl_v3(0.0f, 1.0f, 3.9f), rl_v3(0.0f, 1.0f, 0.0f), 40.0f);
     return s;
 }
+
+#define LS_TRIANGLES_OPTION                                                                                     \
+    { "triangles", RL_OPT_INT, "",                                                                              \
+      "model triangles; not given: the model's own (teapot 15704, the closest patch grid to N, 1..4000000; "   \
+      "bunny 69450, dragon 871306, exactly N, even, 4..16000000); not for boxes",                             \
+      1, RL_BLOB_MAX_TRIANGLES, NULL }
+
+static const rl_option_info ls_open_options[] = {
+    { "model", RL_OPT_ENUM, "teapot", "the object: teapot, bunny or dragon (closed blobs standing in for the "
+      "thesis' scans; boxes belongs to ls-cornell)", 0, 0, model_names },
+    LS_TRIANGLES_OPTION,
+};
+
+static const rl_option_info ls_cornell_options[] = {
+    { "model", RL_OPT_ENUM, "boxes", "boxes: a diffuse and a mirror cuboid; or one model as in ls-open", 0, 0,
+      model_names },
+    LS_TRIANGLES_OPTION,
+};
+
+const rl_builtin_class rl_builtin_ls_open_class = {
+    { "ls-open",
+      "Schröder 2017, Sec. 9.3, scenes 1-3: one object (90 % diffuse, 10 % specular, shininess 50) on a floor "
+      "under three quad lights; object + 8 triangles; max path length 2 (root attribute max_path_length); camera "
+      "1280x720",
+      RL_BUILTIN_OPTIONS(ls_open_options) },
+    build_ls_open,
+};
+
+const rl_builtin_class rl_builtin_ls_cornell_class = {
+    { "ls-cornell",
+      "Schröder 2017, Sec. 9.3, scenes 4-7: Cornell box (5 walls, ceiling quad light: 12 triangles) with a "
+      "diffuse and a mirror cuboid (36 triangles) or one model (+12); max path length 3 (root attribute "
+      "max_path_length); camera 1280x720",
+      RL_BUILTIN_OPTIONS(ls_cornell_options) },
+    build_ls_cornell,
+};

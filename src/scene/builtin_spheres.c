@@ -60,17 +60,12 @@ static rl_status add_materials(rl_scene *scene, uint32_t ids[4], uint32_t floor_
     return s;
 }
 
-rl_status rl_builtin_spheres(rl_scene *scene, rl_params *params)
+static rl_status build_spheres(rl_scene *scene, const rl_option_store *params)
 {
-    long long rows = 1, cols = 4, segments = 48, checks = 16;
-    const char *ctx = "spheres";
-    rl_status s = rl_params_int(params, ctx, "rows", 1, 32, &rows);
-    if (!s) s = rl_params_int(params, ctx, "cols", 1, 32, &cols);
-    if (!s) s = rl_params_int(params, ctx, "segments", 8, 1024, &segments);
-    if (!s) s = rl_params_int(params, ctx, "checks", 1, 1024, &checks);
-    if (!s) s = rl_params_check_unused(params, ctx, "rows, cols, segments, checks");
+    long long rows = rl_option_store_int(params, "rows"), cols = rl_option_store_int(params, "cols"),
+              segments = rl_option_store_int(params, "segments"), checks = rl_option_store_int(params, "checks");
     uint32_t texture = RL_NONE, materials[4], floor_material;
-    if (!s) s = add_checker_texture(scene, &texture);
+    rl_status s = add_checker_texture(scene, &texture);
     if (!s) s = add_materials(scene, materials, texture, &floor_material);
     if (s)
         return s;
@@ -136,3 +131,17 @@ rl_status rl_builtin_spheres(rl_scene *scene, rl_params *params)
     };
     return rl_scene_add_camera(scene, "default", &cam);
 }
+
+static const rl_option_info spheres_options[] = {
+    { "rows", RL_OPT_INT, "1", "rows of spheres (materials cycle)", 1, 32, NULL },
+    { "cols", RL_OPT_INT, "4", "spheres per row", 1, 32, NULL },
+    { "segments", RL_OPT_INT, "48", "sphere tessellation", 8, 1024, NULL },
+    { "checks", RL_OPT_INT, "16", "floor checkers per side", 1, 1024, NULL },
+};
+
+const rl_builtin_class rl_builtin_spheres_class = {
+    { "spheres",
+      "mirror, glass, diffuse and glossy spheres on a checkerboard floor; point and directional light",
+      RL_BUILTIN_OPTIONS(spheres_options) },
+    build_spheres,
+};

@@ -42,6 +42,7 @@
 #include <string.h>
 
 #include "core/error.h"
+#include "core/options.h"
 #include "core/params.h"
 #include "scene/blob.h"
 
@@ -176,102 +177,118 @@ static rl_status parse_size(const char *text, rl_vec3 *out)
     return RL_OK;
 }
 
-static rl_status build_box(rl_meshbuf *b, rl_params *p)
+/* Each generator's parameters, one table row per key (the option store of
+ * src/core/options.h; docs/scene-format.md lists them). Sizes lie in
+ * (0, 1e6]: the tables say [1e-30, 1e6]. */
+#define GEN_SIZE(key, def, help) { key, RL_OPT_FLOAT, def, help, 1e-30, GEN_MAX_SIZE, NULL }
+
+static const rl_option_info box_options[] = {
+    { "size", RL_OPT_STRING, "1", "edge length, or three joined by x (\"2x1x0.5\"); centred", 0, 0, NULL },
+    GEN_SIZE("sx", "1", "edge length along x; not given: from size"),
+    GEN_SIZE("sy", "1", "edge length along y; not given: from size"),
+    GEN_SIZE("sz", "1", "edge length along z; not given: from size"),
+};
+
+static rl_status build_box(rl_meshbuf *b, const rl_option_store *p)
 {
     rl_vec3 size = rl_v3s(1.0f);
-    const char *text = rl_params_get(p, "size");
-    rl_status s = text ? parse_size(text, &size) : RL_OK;
-    double sx = size.x, sy = size.y, sz = size.z;
-    if (!s) s = rl_params_float(p, "box", "sx", 1e-30, GEN_MAX_SIZE, &sx);
-    if (!s) s = rl_params_float(p, "box", "sy", 1e-30, GEN_MAX_SIZE, &sy);
-    if (!s) s = rl_params_float(p, "box", "sz", 1e-30, GEN_MAX_SIZE, &sz);
-    if (!s) s = rl_params_check_unused(p, "box", "size, sx, sy, sz");
+    rl_status s = rl_option_store_given(p, "size") ? parse_size(rl_option_store_string(p, "size"), &size) : RL_OK;
+    /* An edge given on its own wins over size. */
+    double e[3] = { size.x, size.y, size.z };
+    const char *keys[3] = { "sx", "sy", "sz" };
+    for (int k = 0; k < 3; ++k)
+        if (rl_option_store_given(p, keys[k]))
+            e[k] = rl_option_store_float(p, keys[k]);
     if (!s)
-        rl_gen_box(b, rl_v3((float)sx, (float)sy, (float)sz));
+        rl_gen_box(b, rl_v3((float)e[0], (float)e[1], (float)e[2]));
     return s;
 }
 
-static rl_status build_quad(rl_meshbuf *b, rl_params *p)
+static const rl_option_info quad_options[] = {
+    GEN_SIZE("sx", "1", "extent along x in the plane y = 0, centred, facing +y"),
+    GEN_SIZE("sz", "1", "extent along z"),
+    { "repeat", RL_OPT_FLOAT, "1", "uv runs 0..repeat", 1e-3, 1e4, NULL },
+};
+
+static rl_status build_quad(rl_meshbuf *b, const rl_option_store *p)
 {
-    double sx = 1.0, sz = 1.0, repeat = 1.0;
-    rl_status s = rl_params_float(p, "quad", "sx", 1e-30, GEN_MAX_SIZE, &sx);
-    if (!s) s = rl_params_float(p, "quad", "sz", 1e-30, GEN_MAX_SIZE, &sz);
-    if (!s) s = rl_params_float(p, "quad", "repeat", 1e-3, 1e4, &repeat);
-    if (!s) s = rl_params_check_unused(p, "quad", "sx, sz, repeat");
-    if (!s)
-        rl_gen_quad(b, (float)sx, (float)sz, (float)repeat);
-    return s;
+    rl_gen_quad(b, (float)rl_option_store_float(p, "sx"), (float)rl_option_store_float(p, "sz"),
+                (float)rl_option_store_float(p, "repeat"));
+    return RL_OK;
 }
 
-static rl_status build_sphere(rl_meshbuf *b, rl_params *p)
+static const rl_option_info sphere_options[] = {
+    GEN_SIZE("radius", "1", "UV sphere centred on the origin"),
+    { "segments", RL_OPT_INT, "32", "divisions around y", 3, 4096, NULL },
+    { "rings", RL_OPT_INT, "16", "divisions pole to pole", 2, 4096, NULL },
+};
+
+static rl_status build_sphere(rl_meshbuf *b, const rl_option_store *p)
 {
-    double radius = 1.0;
-    long long segments = 32, rings = 16;
-    rl_status s = rl_params_float(p, "sphere", "radius", 1e-30, GEN_MAX_SIZE, &radius);
-    if (!s) s = rl_params_int(p, "sphere", "segments", 3, 4096, &segments);
-    if (!s) s = rl_params_int(p, "sphere", "rings", 2, 4096, &rings);
-    if (!s) s = rl_params_check_unused(p, "sphere", "radius, segments, rings");
-    if (!s)
-        rl_gen_sphere(b, (float)radius, (uint32_t)segments, (uint32_t)rings);
-    return s;
+    rl_gen_sphere(b, (float)rl_option_store_float(p, "radius"), (uint32_t)rl_option_store_int(p, "segments"),
+                  (uint32_t)rl_option_store_int(p, "rings"));
+    return RL_OK;
 }
 
-static rl_status build_cylinder(rl_meshbuf *b, rl_params *p)
+static const rl_option_info cylinder_options[] = {
+    GEN_SIZE("radius", "1", "around y, centred"),
+    GEN_SIZE("height", "2", "along y"),
+    { "segments", RL_OPT_INT, "32", "divisions around y", 3, 65536, NULL },
+    { "caps", RL_OPT_BOOL, "true", "close top and bottom", 0, 0, NULL },
+};
+
+static rl_status build_cylinder(rl_meshbuf *b, const rl_option_store *p)
 {
-    double radius = 1.0, height = 2.0;
-    long long segments = 32;
-    bool caps = true;
-    rl_status s = rl_params_float(p, "cylinder", "radius", 1e-30, GEN_MAX_SIZE, &radius);
-    if (!s) s = rl_params_float(p, "cylinder", "height", 1e-30, GEN_MAX_SIZE, &height);
-    if (!s) s = rl_params_int(p, "cylinder", "segments", 3, 65536, &segments);
-    if (!s) s = rl_params_bool(p, "cylinder", "caps", &caps);
-    if (!s) s = rl_params_check_unused(p, "cylinder", "radius, height, segments, caps");
-    if (!s)
-        rl_gen_cylinder(b, (float)radius, (float)height, (uint32_t)segments, caps);
-    return s;
+    rl_gen_cylinder(b, (float)rl_option_store_float(p, "radius"), (float)rl_option_store_float(p, "height"),
+                    (uint32_t)rl_option_store_int(p, "segments"), rl_option_store_bool(p, "caps"));
+    return RL_OK;
 }
 
-static rl_status build_teapot(rl_meshbuf *b, rl_params *p)
+_Static_assert(RL_TEAPOT_DEFAULT_TRIANGLES == 15704, "the table's default is the teapot's");
+static const rl_option_info teapot_options[] = {
+    { "triangles", RL_OPT_INT, "15704", "target count (Utah teapot from its Bezier patches)", 1,
+      RL_TEAPOT_MAX_TRIANGLES, NULL },
+    GEN_SIZE("size", "1", "height; stands on y = 0"),
+};
+
+static rl_status build_teapot(rl_meshbuf *b, const rl_option_store *p)
 {
-    long long triangles = RL_TEAPOT_DEFAULT_TRIANGLES;
-    double size = 1.0;
-    rl_status s = rl_params_int(p, "teapot", "triangles", 1, RL_TEAPOT_MAX_TRIANGLES, &triangles);
-    if (!s) s = rl_params_float(p, "teapot", "size", 1e-30, GEN_MAX_SIZE, &size);
-    if (!s) s = rl_params_check_unused(p, "teapot", "triangles, size");
-    if (!s)
-        rl_gen_teapot(b, (uint32_t)triangles, (float)size);
-    return s;
+    rl_gen_teapot(b, (uint32_t)rl_option_store_int(p, "triangles"), (float)rl_option_store_float(p, "size"));
+    return RL_OK;
 }
 
-static rl_status build_blob(rl_meshbuf *b, rl_params *p)
+_Static_assert(RL_BLOB_DEFAULT_TRIANGLES == 20000, "the table's default is the blob's");
+static const rl_option_info blob_options[] = {
+    { "triangles", RL_OPT_INT, "20000", "exactly this many (even): a closed, genus-0, outward-oriented mesh",
+      RL_BLOB_MIN_TRIANGLES, RL_BLOB_MAX_TRIANGLES, NULL },
+    { "seed", RL_OPT_INT, "1", "lump placement", 0, 9007199254740992.0, NULL },
+    GEN_SIZE("scale", "1", "radius of the sphere before the lumps"),
+    { "lumps", RL_OPT_INT, "6", "smooth bumps and dents", 0, RL_BLOB_MAX_LUMPS, NULL },
+};
+
+static rl_status build_blob(rl_meshbuf *b, const rl_option_store *p)
 {
-    long long triangles = RL_BLOB_DEFAULT_TRIANGLES, seed = 1, lumps = 6;
-    double scale = 1.0;
-    rl_status s = rl_params_int(p, "blob", "triangles", RL_BLOB_MIN_TRIANGLES,
-                                RL_BLOB_MAX_TRIANGLES, &triangles);
-    if (!s) s = rl_params_int(p, "blob", "seed", 0, 1ll << 53, &seed);
-    if (!s) s = rl_params_float(p, "blob", "scale", 1e-30, GEN_MAX_SIZE, &scale);
-    if (!s) s = rl_params_int(p, "blob", "lumps", 0, RL_BLOB_MAX_LUMPS, &lumps);
-    if (!s) s = rl_params_check_unused(p, "blob", "triangles, seed, scale, lumps");
-    if (!s)
-        s = rl_gen_blob(b, &(rl_blob_desc){ .triangles = (uint32_t)triangles,
-                                            .seed = (uint64_t)seed, .scale = (float)scale,
-                                            .lumps = (int)lumps });
-    return s;
+    return rl_gen_blob(b, &(rl_blob_desc){ .triangles = (uint32_t)rl_option_store_int(p, "triangles"),
+                                           .seed = (uint64_t)rl_option_store_int(p, "seed"),
+                                           .scale = (float)rl_option_store_float(p, "scale"),
+                                           .lumps = (int)rl_option_store_int(p, "lumps") });
 }
 
 typedef struct generator {
     const char *name;
-    rl_status (*build)(rl_meshbuf *b, rl_params *p);
+    const rl_option_info *options;
+    size_t num_options;
+    rl_status (*build)(rl_meshbuf *b, const rl_option_store *p);
 } generator;
 
+#define GEN(name, table, build) { name, table, sizeof table / sizeof table[0], build }
 static const generator generators[] = {
-    { "box", build_box },
-    { "quad", build_quad },
-    { "sphere", build_sphere },
-    { "cylinder", build_cylinder },
-    { "teapot", build_teapot },
-    { "blob", build_blob },
+    GEN("box", box_options, build_box),
+    GEN("quad", quad_options, build_quad),
+    GEN("sphere", sphere_options, build_sphere),
+    GEN("cylinder", cylinder_options, build_cylinder),
+    GEN("teapot", teapot_options, build_teapot),
+    GEN("blob", blob_options, build_blob),
 };
 #define NUM_GENERATORS (sizeof generators / sizeof generators[0])
 
@@ -299,17 +316,25 @@ rl_status rl_scene_add_generated(rl_scene *scene, const char *generator_name,
     if (!g)
         return rl_error(RL_ERR_NOT_FOUND, "unknown generator \"%s\" (known: box, quad, "
                                           "sphere, cylinder, teapot, blob)", generator_name);
-    rl_params p;
-    rl_status s = rl_params_parse(params, &p);
+    /* Every key=value checked against the table first; a repeated key
+     * keeps the last value. */
+    rl_params list;
+    rl_status s = rl_params_parse(params, &list);
     if (s)
         return s;
+    rl_option_store p;
+    s = rl_option_store_init(&p, g->options, g->num_options, NULL);
+    for (uint32_t i = 0; s == RL_OK && i < list.count; ++i)
+        s = rl_option_store_set(&p, list.items[i].key, list.items[i].value, g->name, NULL);
+    rl_params_free(&list);
     rl_meshbuf b;
     rl_meshbuf_init(&b);
     b.material = material;
-    s = g->build(&b, &p);
+    if (!s)
+        s = g->build(&b, &p);
     if (!s)
         s = rl_meshbuf_add_to_scene(scene, &b, g->name, mesh_id);
     rl_meshbuf_free(&b);
-    rl_params_free(&p);
+    rl_option_store_free(&p);
     return s;
 }

@@ -27,8 +27,11 @@ expect_in "$TMP/out" "renderlab"
 # Lists come from the library's registries.
 expect_exit 0 "$RL" scenes
 for s in cornell cornell-teapot spheres city; do
-    grep -q "^$s " "$TMP/out" || fail "rl scenes does not list $s"
+    grep -q "^$s: " "$TMP/out" || fail "rl scenes does not list $s"
 done
+# Parameters print like renderer options: type, default, integer ranges.
+expect_in "$TMP/out" "blocks  *int  *default 6 .*\[1\.\.64\]"
+expect_in "$TMP/out" "furniture  *bool  *default true"
 expect_exit 0 "$RL" algos
 expect_in "$TMP/out" "^raster"
 expect_in "$TMP/out" "shading"

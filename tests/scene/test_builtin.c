@@ -36,8 +36,15 @@ static void test_builtin_list_names_every_scene(void **state)
     assert_int_equal(n, sizeof expected / sizeof expected[0]);
     for (size_t i = 0; i < n; ++i) {
         assert_string_equal(info[i].name, expected[i]);
-        assert_true(strlen(info[i].description) > 0 && strlen(info[i].params) > 0);
+        assert_true(strlen(info[i].description) > 0);
+        /* Every parameter is a table row with a default the table accepts:
+         * the scene builds from the defaults spelled out. */
+        for (size_t k = 0; k < info[i].num_options; ++k) {
+            const rl_option_info *o = &info[i].options[k];
+            assert_true(o->key && o->default_value && o->help && strlen(o->help) > 0);
+        }
     }
+    assert_true(info[0].num_options == 0 && info[3].num_options == 8);   /* cornell none, city 8 */
 }
 
 static void test_cornell_has_36_triangles_and_a_downward_quad_light(void **state)
@@ -209,6 +216,10 @@ static void test_unknown_parameter_is_invalid(void **state)
     (void)state;
     rl_scene *s = NULL;
     assert_int_equal(rl_scene_create_builtin("cornell", "triangles=10", &s), RL_ERR_INVALID_ARG);
+    assert_non_null(strstr(rl_last_error(), "takes none"));
+    rl_clear_error();
+    assert_int_equal(rl_scene_create_builtin("city", "blocks=65", &s), RL_ERR_INVALID_ARG);
+    assert_non_null(strstr(rl_last_error(), "outside [1, 64]"));
     rl_clear_error();
     assert_int_equal(rl_scene_create_builtin("city", "bounce=2", &s), RL_ERR_INVALID_ARG);
     assert_non_null(strstr(rl_last_error(), "floors_max"));  /* lists the accepted keys */
