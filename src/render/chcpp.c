@@ -113,27 +113,15 @@ typedef struct frame_ctx {
     uint64_t seed;
 } frame_ctx;
 
-static rl_status chcpp_create(void **state)
-{
-    chcpp_state *s = rl_calloc(1, sizeof *s);
-    if (!s)
-        return RL_ERR_OUT_OF_MEMORY;
-    *state = s;
-    return RL_OK;
-}
-
 static void chcpp_release(void *state)
 {
     chcpp_state *s = state;
-    if (!s)
-        return;
     rl_octree_cache_release(&s->oc);
     rl_drawer_keep_release(&s->head.keep);
     rl_box_query_free(&s->query);
     free(s->ns);
     free(s->heap);
     free(s->iqueue);
-    free(s);
 }
 
 static void chcpp_reset(void *state)
@@ -472,7 +460,7 @@ const rl_renderer_class rl_chcpp_renderer_class = {
               "Mattausch, Bittner & Wimmer 2008; Jähn 2015, Sec. 2.1.2, 7.3" },
     .options = chcpp_options,
     .num_options = sizeof chcpp_options / sizeof chcpp_options[0],
-    .create = chcpp_create,
+    .state_size = sizeof(chcpp_state),
     .render = chcpp_render,
     .release = chcpp_release,
     .check = NULL,

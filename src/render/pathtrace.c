@@ -146,15 +146,6 @@ typedef struct pt_state {
     rl_pt_stats stats;
 } pt_state;
 
-static rl_status pt_create(void **state)
-{
-    pt_state *s = rl_calloc(1, sizeof *s);
-    if (!s)
-        return RL_ERR_OUT_OF_MEMORY;
-    *state = s;
-    return RL_OK;
-}
-
 static void free_frame(pt_state *s)
 {
     free(s->accum);
@@ -183,12 +174,9 @@ static void pt_reset_state(void *state)
 static void pt_release(void *state)
 {
     pt_state *s = state;
-    if (!s)
-        return;
     rl_pt_backends_release(&s->b);
     free_frame(s);
     free(s->signature);
-    free(s);
 }
 
 /* The thesis' path length stored with a scene (Sec. 9.3; the built-ins
@@ -695,7 +683,7 @@ const rl_renderer_class rl_pt_renderer_class = {
               "Schröder 2017" },
     .options = pt_options,
     .num_options = NUM_OPTIONS,
-    .create = pt_create,
+    .state_size = sizeof(pt_state),
     .render = pt_render,
     .release = pt_release,
     .check = pt_check,

@@ -45,19 +45,10 @@ typedef struct raster_state {
     rl_drawer_keep keep;
 } raster_state;
 
-static rl_status raster_create(void **state)
-{
-    *state = rl_calloc(1, sizeof(raster_state));
-    return *state ? RL_OK : RL_ERR_OUT_OF_MEMORY;
-}
-
 static void raster_release(void *state)
 {
     raster_state *s = state;
-    if (!s)
-        return;
     rl_drawer_keep_release(&s->keep);
-    free(s);
 }
 
 static rl_status raster_render(rl_renderer *r, void *state, const rl_scene *scene,
@@ -115,7 +106,7 @@ const rl_renderer_class rl_raster_renderer_class = {
               "Ullmann 2003, Sec. 3.1 (Phong model), Sec. 3.5 (hardware path)" },
     .options = raster_options,
     .num_options = sizeof raster_options / sizeof raster_options[0],
-    .create = raster_create,
+    .state_size = sizeof(raster_state),
     .render = raster_render,
     .release = raster_release,
     .check = NULL,

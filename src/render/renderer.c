@@ -105,13 +105,10 @@ rl_status rl_renderer_create(const char *name, rl_renderer **out)
         free(r);
         return st;
     }
-    if (cls->create) {
-        st = cls->create(&r->state);
-        if (st != RL_OK) {
-            rl_option_store_free(&r->options);
-            free(r);
-            return st;
-        }
+    if (cls->state_size && !(r->state = rl_calloc(1, cls->state_size))) {
+        rl_option_store_free(&r->options);
+        free(r);
+        return RL_ERR_OUT_OF_MEMORY;
     }
     *out = r;
     return RL_OK;
@@ -121,8 +118,9 @@ void rl_renderer_release(rl_renderer *r)
 {
     if (!r)
         return;
-    if (r->cls->release)
+    if (r->cls->release && r->state)
         r->cls->release(r->state);
+    free(r->state);
     for (size_t i = 0; i < RL_RENDERER_MAX_INPUTS; ++i)
         clear_input(&r->inputs[i]);
     rl_option_store_free(&r->options);

@@ -1,7 +1,8 @@
 /* renderer.h: how an algorithm plugs into the rl_renderer interface.
  *
- * A renderer provides one rl_renderer_class: its name, its option table and
- * three functions. The generic layer (renderer.c) validates and stores option
+ * A renderer provides one rl_renderer_class: its name, its option table, the
+ * size of its state and its functions, so that a new renderer is only its
+ * algorithm. The generic layer (renderer.c) validates and stores option
  * values as text; an implementation reads them typed with rl_renderer_opt_*.
  * All classes are listed once, in registry.c. */
 #ifndef RL_RENDER_RENDERER_H
@@ -13,11 +14,13 @@ typedef struct rl_renderer_class {
     rl_renderer_info info;
     const rl_option_info *options;
     size_t num_options;
-    /* Allocates the implementation's state (may set *state = NULL). */
-    rl_status (*create)(void **state);
+    /* Bytes of the implementation's state: the generic layer allocates it
+     * zeroed on create and frees it after release (0: no state). */
+    size_t state_size;
     /* Renders; stats is zeroed by the caller, time_ms is filled by the caller. */
     rl_status (*render)(rl_renderer *r, void *state, const rl_scene *scene,
                         const rl_camera *cam, rl_image *image, rl_render_stats *stats);
+    /* Optional: frees what the state holds, not the state itself. */
     void (*release)(void *state);
     /* Optional extra check of a value that already passed the type check
      * (e.g. a colour in a string option); NULL: none. Records and returns

@@ -83,23 +83,11 @@ typedef struct select_state {
 /* rule=time reads both times, rule=threshold the property. */
 static const char *const select_inputs[] = { "first_time", "second_time", "property" };
 
-static rl_status select_create(void **state)
-{
-    select_state *s = rl_calloc(1, sizeof *s);
-    if (!s)
-        return RL_ERR_OUT_OF_MEMORY;
-    *state = s;
-    return RL_OK;
-}
-
 static void select_release(void *state)
 {
     select_state *s = state;
-    if (!s)
-        return;
     for (int i = 0; i < 2; ++i)
         rl_renderer_release(s->child[i]);
-    free(s);
 }
 
 static void select_reset(void *state)
@@ -260,7 +248,7 @@ const rl_renderer_class rl_select_renderer_class = {
               "Jähn 2015, Sec. 7.5" },
     .options = select_options,
     .num_options = sizeof select_options / sizeof select_options[0],
-    .create = select_create,
+    .state_size = sizeof(select_state),
     .render = select_render,
     .release = select_release,
     .check = NULL,

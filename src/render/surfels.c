@@ -91,15 +91,6 @@ typedef struct draw_cmd {
     float point_size;
 } draw_cmd;
 
-static rl_status surfels_create(void **state)
-{
-    surfels_state *s = rl_calloc(1, sizeof *s);
-    if (!s)
-        return RL_ERR_OUT_OF_MEMORY;
-    *state = s;
-    return RL_OK;
-}
-
 static void drop_sets(surfels_state *s)
 {
     for (uint32_t i = 0; i < s->num_sets; ++i)
@@ -113,8 +104,6 @@ static void drop_sets(surfels_state *s)
 static void surfels_release(void *state)
 {
     surfels_state *s = state;
-    if (!s)
-        return;
     drop_sets(s);
     rl_octree_cache_release(&s->oc);
     rl_drawer_keep_release(&s->head.keep);
@@ -123,7 +112,6 @@ static void surfels_release(void *state)
     free(s->size);
     free(s->cmds);
     free(s->lit);
-    free(s);
 }
 
 static void collect_objects(const rl_octree_node *nodes, const uint32_t *objects, uint32_t n, uint32_t *out,
@@ -420,7 +408,7 @@ const rl_renderer_class rl_surfels_renderer_class = {
               "Jähn 2015, Ch. 6" },
     .options = surfels_options,
     .num_options = sizeof surfels_options / sizeof surfels_options[0],
-    .create = surfels_create,
+    .state_size = sizeof(surfels_state),
     .render = surfels_render,
     .release = surfels_release,
     .check = NULL,

@@ -88,15 +88,6 @@ typedef struct svs_state {
     uint32_t num_draw;
 } svs_state;
 
-static rl_status svs_create(void **state)
-{
-    svs_state *s = rl_calloc(1, sizeof *s);
-    if (!s)
-        return RL_ERR_OUT_OF_MEMORY;
-    *state = s;
-    return RL_OK;
-}
-
 static void drop_sets(svs_state *s)
 {
     free(s->dirs);
@@ -115,12 +106,9 @@ static void drop_sets(svs_state *s)
 static void svs_release(void *state)
 {
     svs_state *s = state;
-    if (!s)
-        return;
     drop_sets(s);
     rl_octree_cache_release(&s->oc);
     rl_drawer_keep_release(&s->head.keep);
-    free(s);
 }
 
 /* --- sample directions: a subdivided icosahedron --- */
@@ -555,7 +543,7 @@ const rl_renderer_class rl_svs_renderer_class = {
               "Eikel, Jähn, Fischer & Meyer auf der Heide 2013; Jähn 2015, Sec. 2.1.1, 7.4" },
     .options = svs_options,
     .num_options = sizeof svs_options / sizeof svs_options[0],
-    .create = svs_create,
+    .state_size = sizeof(svs_state),
     .render = svs_render,
     .release = svs_release,
     .check = NULL,

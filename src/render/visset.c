@@ -67,15 +67,6 @@ typedef struct visset_state {
 
 static const char *const visset_inputs[] = { "approx" };
 
-static rl_status visset_create(void **state)
-{
-    visset_state *s = rl_calloc(1, sizeof *s);
-    if (!s)
-        return RL_ERR_OUT_OF_MEMORY;
-    *state = s;
-    return RL_OK;
-}
-
 static void drop(visset_state *s)
 {
     free(s->rank_offset);
@@ -92,11 +83,8 @@ static void drop(visset_state *s)
 static void visset_release(void *state)
 {
     visset_state *s = state;
-    if (!s)
-        return;
     drop(s);
     rl_drawer_keep_release(&s->head.keep);
-    free(s);
 }
 
 typedef struct ranked {
@@ -288,7 +276,7 @@ const rl_renderer_class rl_visset_renderer_class = {
               "Jähn 2015, Sec. 7.6; Eikel, Jähn & Fischer 2010" },
     .options = visset_options,
     .num_options = sizeof visset_options / sizeof visset_options[0],
-    .create = visset_create,
+    .state_size = sizeof(visset_state),
     .render = visset_render,
     .release = visset_release,
     .check = NULL,

@@ -121,15 +121,6 @@ typedef struct vt_state {
     vt_base base;             /* progressive frames' copy of the rasterized half */
 } vt_state;
 
-static rl_status vt_create(void **state)
-{
-    vt_state *s = rl_calloc(1, sizeof *s);
-    if (!s)
-        return RL_ERR_OUT_OF_MEMORY;
-    *state = s;
-    return RL_OK;
-}
-
 /* Temporal coherence (Sec. 3.4.5) is the only state a frame leaves for the
  * next one; the BVH is per scene and stays. */
 static void vt_reset(void *state)
@@ -142,8 +133,6 @@ static void vt_reset(void *state)
 static void vt_release(void *state)
 {
     vt_state *s = state;
-    if (!s)
-        return;
     rl_accel_cache_release(&s->accel);
     free(s->mesh_objects);
     free(s->object_vt);
@@ -159,7 +148,6 @@ static void vt_release(void *state)
     free(s->scratch_depth);
     vt_corners_free(&s->corners);
     vt_base_free(&s->base);
-    free(s);
 }
 
 /* The kept rasterizer, pre-pass image and scratch depth (for an image
@@ -599,7 +587,7 @@ const rl_renderer_class rl_vt_renderer_class = {
               "Ullmann 2003, Ch. 3-4" },
     .options = vt_options,
     .num_options = sizeof vt_options / sizeof vt_options[0],
-    .create = vt_create,
+    .state_size = sizeof(vt_state),
     .render = vt_render,
     .release = vt_release,
     .check = vt_check,

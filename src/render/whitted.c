@@ -51,23 +51,11 @@ typedef struct whitted_state {
     int tree_width, tree_height;
 } whitted_state;
 
-static rl_status whitted_create(void **state)
-{
-    whitted_state *s = rl_calloc(1, sizeof *s);
-    if (!s)
-        return RL_ERR_OUT_OF_MEMORY;
-    *state = s;
-    return RL_OK;
-}
-
 static void whitted_release(void *state)
 {
     whitted_state *s = state;
-    if (!s)
-        return;
     rl_accel_cache_release(&s->accel);
     free(s->trees);
-    free(s);
 }
 
 rl_status rl_whitted_pixel_tree(const rl_renderer *r, int x, int y, rl_ray_tree *out)
@@ -270,7 +258,7 @@ const rl_renderer_class rl_whitted_renderer_class = {
               "Whitted 1980; coefficient model of Ullmann 2003, Sec. 3.1 (eq. 3.1-3.4)" },
     .options = whitted_options,
     .num_options = sizeof whitted_options / sizeof whitted_options[0],
-    .create = whitted_create,
+    .state_size = sizeof(whitted_state),
     .render = whitted_render,
     .release = whitted_release,
     .check = whitted_check,
