@@ -1,8 +1,9 @@
 /* rl_gbuffer.h: a geometry buffer (Saito & Takahashi 1990), per pixel the
  * first surface seen through the pixel centre.
  *
- * The path tracer fills it with its primary hits, or, in its hybrid mode
- * (Schröder 2017, Sec. 8.1), from rasterized visibility: the rasterizer
+ * The path tracer fills it with its primary hits, or, with primary=raster
+ * (rasterized primary visibility, Schröder 2017, Sec. 8.1; not the hybrid
+ * CPU/GPU path tracing of Sec. 8.4), from rasterized visibility: the rasterizer
  * decides which triangle covers each pixel, and the exact point is the
  * pixel ray's intersection with that triangle (no traversal). The noise
  * filters (rl_filter.h) use it as guidance. Plain arrays, row-major,

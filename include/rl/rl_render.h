@@ -1,8 +1,8 @@
 /* rl_render.h: the pluggable renderer interface.
  *
- * Every algorithm in renderlab (raster, and later whitted, vt, pt, surfels,
- * chc++) is an rl_renderer created by name from one registry, configured with
- * validated key/value options, and run as
+ * Every algorithm in renderlab (raster, whitted, vt, pt, chcpp, svs, visset,
+ * surfels, select; rl_renderer_list) is an rl_renderer created by name from
+ * one registry, configured with validated key/value options, and run as
  *     render(scene, camera, image, stats)
  * so that the evaluator can time and compare any of them. Options are typed
  * (int, float, bool, enum, string, colour) and checked on rl_renderer_set(); unknown

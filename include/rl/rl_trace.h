@@ -1,7 +1,7 @@
 /* rl_trace.h: the exact recursive ray tracer (Whitted 1980) as a library.
  *
- * The renderer "whitted" is built on this, and so will be Vertex Tracing:
- * Ullmann 2003 shoots its vertex rays through exactly this tracer and
+ * The renderers "whitted" and "vt" are built on this: Vertex Tracing
+ * (Ullmann 2003) shoots its vertex rays through exactly this tracer and
  * compares their ray trees (Sec. 3.3.1). Shading follows Ullmann 2003,
  * Sec. 3.1, eq. 3.1-3.4: local Phong with hard shadow feelers to every light
  * (area lights with a fixed sample count), plus k_r times the reflected and

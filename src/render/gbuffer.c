@@ -1,7 +1,7 @@
 /* gbuffer.c: the geometry buffer of rl_gbuffer.h (Saito & Takahashi 1990)
  * as the path tracer uses it (Schröder 2017, Sec. 8.1): per pixel the first
  * surface through the pixel centre, either traced (rl_gbuffer_trace) or
- * from rasterized visibility (rl_gbuffer_raster: the hybrid mode).
+ * from rasterized visibility (rl_gbuffer_raster: pt's primary=raster, Sec. 8.1).
  *
  * The raster path draws the scene's IDs with the shared rasterizer
  * (rl_raster_draw_scene, unlit), then intersects each pixel's centre ray
