@@ -109,7 +109,8 @@ static const rl_option_info pt_options[] = {
     { "grid_res", RL_OPT_INT, "0", "voxels per axis of the grid and the Line Space (0 = grid heuristic)",
       0, 1024, NULL },
     { "ls_n", RL_OPT_INT, "5", "Line Space patches per voxel face side (Sec. 9.2: 5)", 1, RL_LS_MAX_N, NULL },
-    { "ls_k", RL_OPT_INT, "8", "Line Space fixed candidate slots per shaft (even)", 2, RL_LS_MAX_K, NULL },
+    { "ls_k", RL_OPT_INT, "8", "Line Space fixed candidate slots per shaft (even; ls_dynamic=false only)", 2,
+      RL_LS_MAX_K, NULL },
     { "ls_origin", RL_OPT_ENUM, "offset",
       "PNMT/preillum rays: offset (start one voxel diagonal away, Sec. 12.1) or exact (start at the "
       "surface; the start voxel's triangles answer PNMT rays exactly)", 0, 0, ls_origin_choices },
@@ -240,20 +241,30 @@ static void read_settings(const rl_renderer *r, pt_settings *set)
 #endif
 }
 
-/* All option values as one string: any change restarts the accumulation. */
+/* Whether option i can change the image: ls_k sizes the fixed candidate
+ * lists only, so with dynamic lists it has no effect. */
+static bool option_matters(const rl_renderer *r, size_t i)
+{
+    return strcmp(pt_options[i].key, "ls_k") != 0 || !rl_renderer_opt_bool(r, "ls_dynamic");
+}
+
+/* The values of all options that matter as one string: any change restarts
+ * the accumulation. */
 static char *option_signature(const rl_renderer *r)
 {
     size_t len = 1;
     for (size_t i = 0; i < NUM_OPTIONS; ++i)
-        len += strlen(pt_options[i].key) + strlen(rl_renderer_get(r, pt_options[i].key)) + 2;
+        if (option_matters(r, i))
+            len += strlen(pt_options[i].key) + strlen(rl_renderer_get(r, pt_options[i].key)) + 2;
     char *sig = rl_alloc(len);
     if (!sig)
         return NULL;
     sig[0] = '\0';
     size_t used = 0;
     for (size_t i = 0; i < NUM_OPTIONS; ++i)
-        used += (size_t)snprintf(sig + used, len - used, "%s=%s;", pt_options[i].key,
-                                 rl_renderer_get(r, pt_options[i].key));
+        if (option_matters(r, i))
+            used += (size_t)snprintf(sig + used, len - used, "%s=%s;", pt_options[i].key,
+                                     rl_renderer_get(r, pt_options[i].key));
     return sig;
 }
 

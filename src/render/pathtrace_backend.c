@@ -302,7 +302,9 @@ rl_status rl_pt_backends_prepare(pt_backends *b, const rl_scene *scene, const pt
         if ((payloads & RL_LS_PREILLUM) && (st = build_exact(b, scene, RL_ACCEL_BVH, 0, threads, built_ms)))
             return st;
         const char *file = set->ls_file && *set->ls_file ? set->ls_file : NULL;
-        bool same = b->ls && b->ls_n == set->ls_n && b->ls_k == set->ls_k && b->ls_dynamic == set->ls_dynamic &&
+        /* k sizes fixed lists only: dynamic lists ignore it. */
+        bool same = b->ls && b->ls_n == set->ls_n && b->ls_dynamic == set->ls_dynamic &&
+                    (set->ls_dynamic || b->ls_k == set->ls_k) &&
                     (b->ls_payloads & payloads) == payloads &&
                     (file ? b->ls_file && strcmp(b->ls_file, file) == 0 : !b->ls_file);
         if (!same) {

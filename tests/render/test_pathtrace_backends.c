@@ -71,6 +71,23 @@ static void test_dynamic_line_space_candidates_reproduce_the_bvh_image(void **st
     assert_int_equal(rl_renderer_render(r, s, &cam, ls, NULL), RL_OK);
     assert_int_equal(rl_pt_get_stats(r, &st), RL_OK);
     assert_float_equal(st.time_build_ms, 0.0, 0.0);
+    assert_false(st.reset);
+    /* ls_k sizes fixed lists only: with dynamic lists it neither rebuilds
+     * nor restarts the accumulation; with fixed lists it does both. */
+    assert_int_equal(rl_renderer_set(r, "ls_k", "4"), RL_OK);
+    assert_int_equal(rl_renderer_render(r, s, &cam, ls, NULL), RL_OK);
+    assert_int_equal(rl_pt_get_stats(r, &st), RL_OK);
+    assert_false(st.reset);
+    assert_int_equal(st.frames, 3);
+    assert_float_equal(st.time_build_ms, 0.0, 0.0);
+    assert_int_equal(rl_renderer_set(r, "ls_dynamic", "false"), RL_OK);
+    assert_int_equal(rl_renderer_render(r, s, &cam, ls, NULL), RL_OK);
+    assert_int_equal(rl_pt_get_stats(r, &st), RL_OK);
+    assert_true(st.reset && st.time_build_ms > 0.0);
+    assert_int_equal(rl_renderer_set(r, "ls_k", "6"), RL_OK);
+    assert_int_equal(rl_renderer_render(r, s, &cam, ls, NULL), RL_OK);
+    assert_int_equal(rl_pt_get_stats(r, &st), RL_OK);
+    assert_true(st.reset && st.time_build_ms > 0.0);
     rl_image_release(bvh);
     rl_image_release(ls);
     rl_renderer_release(r);
