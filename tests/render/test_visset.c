@@ -47,16 +47,24 @@ static void test_visset_draws_the_sampled_set(void **state)
 
     /* Budgets: never exceeded, counted by the rasterizer (not the
      * renderer's own counter), at several views; a bigger budget draws at
-     * least as much. */
+     * least as much, and the image gets closer to raster's (mean SSIM over
+     * the views; the highest-impact objects come first, so a budget that
+     * drew the wrong ones, or none, would not rise). */
     static const char *const budgets[] = { "300", "3000", "30000" };
+    double budget_ssim[3] = { 0.0, 0.0, 0.0 };
     for (int v = 0; v < 4; ++v) {
         uint64_t prev = 0;
+        rl_camera view = street(0.7f * (float)v);
+        rl_image *full = fx_render("raster", s, &view, RL_LAYER_COLOR, NULL, NULL);
         for (int b = 0; b < 3; ++b) {
             rl_renderer *rb = fx_make("visset", good);
             assert_int_equal(rl_renderer_set(rb, "budget", budgets[b]), RL_OK);
             rl_camera cam = street(0.7f * (float)v);
             rl_render_stats rs;
             rl_image *img = fx_render_with(rb, s, &cam, RL_LAYER_COLOR, &rs);
+            rl_image_metrics bm;
+            assert_int_equal(rl_image_compare(img, full, NULL, &bm), RL_OK);
+            budget_ssim[b] += bm.ssim / 4.0;
             rl_culling_stats cs;
             assert_int_equal(rl_culling_get_stats(rb, &cs), RL_OK);
             assert_true(rs.triangles_rasterized <= (uint64_t)atoll(budgets[b]));
@@ -67,8 +75,13 @@ static void test_visset_draws_the_sampled_set(void **state)
             rl_image_release(img);
             rl_renderer_release(rb);
         }
+        rl_image_release(full);
         assert_true(prev > 0);
     }
+    print_message("visset budget 300 / 3000 / 30000: mean SSIM vs raster %.4f / %.4f / %.4f\n", budget_ssim[0],
+                  budget_ssim[1], budget_ssim[2]);
+    assert_true(budget_ssim[1] >= budget_ssim[0] && budget_ssim[2] >= budget_ssim[1]);
+    assert_true(budget_ssim[2] > budget_ssim[0] + 0.1);
 
     /* Outside the slice's x-z extent: everything, as raster. */
     rl_camera out = { .eye = rl_v3(-40, 30, -40), .target = rl_v3(60, 0, 60), .width = 96, .height = 72 };
