@@ -1,10 +1,11 @@
 # Thin wrapper around CMake; see README.md.
 BUILD      ?= build
 BUILD_SAN  ?= build-asan
+BUILD_FUZZ ?= build-fuzz
 JOBS       ?= $(shell nproc 2>/dev/null || echo 2)
 CMAKE_ARGS ?=
 
-.PHONY: all deps build build-asan check demo clean
+.PHONY: all deps build build-asan build-fuzz fuzz check demo clean
 
 all: build
 
@@ -19,7 +20,26 @@ build-asan:
 	@cmake -S . -B $(BUILD_SAN) -DCMAKE_BUILD_TYPE=Debug -DRL_SANITIZE=ON $(CMAKE_ARGS) >/dev/null
 	@cmake --build $(BUILD_SAN) -j $(JOBS)
 
-# Release tests, then the same tests under ASan+UBSan.
+# The libFuzzer harnesses with clang (instrumented library, ASan+UBSan).
+FUZZ_SCALE   ?= 1
+FUZZ_SECONDS ?= 60
+build-fuzz:
+	@CC=clang CXX=clang++ cmake -S . -B $(BUILD_FUZZ) -DCMAKE_BUILD_TYPE=Debug -DRL_SANITIZE=ON -DRL_FUZZ=ON \
+	    -DRL_TESTS=OFF -DRL_WERROR=OFF -DRL_FUZZ_SCALE=$(FUZZ_SCALE) $(CMAKE_ARGS) >/dev/null
+	@cmake --build $(BUILD_FUZZ) -j $(JOBS)
+
+# A longer campaign: every harness for FUZZ_SECONDS on its corpus, which
+# keeps what it finds (tests/fuzz/corpus/<kind>); crashes go to
+# tests/fuzz/crashes/ as regression inputs.
+fuzz: build-fuzz
+	@mkdir -p tests/fuzz/crashes
+	@$(BUILD_FUZZ)/tests/fuzz/fuzz_load_json -max_total_time=$(FUZZ_SECONDS) -max_len=4096 -timeout=30 \
+	    -artifact_prefix=tests/fuzz/crashes/json- tests/fuzz/corpus/json
+	@ASAN_OPTIONS=detect_leaks=0 $(BUILD_FUZZ)/tests/fuzz/fuzz_load_mesh -max_total_time=$(FUZZ_SECONDS) -max_len=4096 -timeout=30 \
+	    -detect_leaks=0 -artifact_prefix=tests/fuzz/crashes/mesh- tests/fuzz/corpus/mesh
+
+# Release tests, then the same tests under ASan+UBSan, then a short smoke
+# run of every fuzz harness (where clang is installed).
 check: deps
 	@$(MAKE) --no-print-directory build
 	@$(MAKE) --no-print-directory build-asan
@@ -28,9 +48,13 @@ check: deps
 	@echo "== ctest: ASan+UBSan Debug ($(BUILD_SAN)) =="
 	@cd $(BUILD_SAN) && ASAN_OPTIONS=detect_leaks=1 UBSAN_OPTIONS=print_stacktrace=1 \
 	    ctest --output-on-failure -j $(JOBS)
+	@if command -v clang >/dev/null 2>&1; then \
+	    echo "== fuzz smoke: libFuzzer, clang, ASan+UBSan ($(BUILD_FUZZ)) =="; \
+	    $(MAKE) --no-print-directory build-fuzz && cd $(BUILD_FUZZ) && ctest --output-on-failure -j $(JOBS); \
+	else echo "== fuzz smoke: skipped (no clang) =="; fi
 
 demo: deps build
 	@$(BUILD)/rl demo --out out/demo
 
 clean:
-	rm -rf $(BUILD) $(BUILD_SAN) out
+	rm -rf $(BUILD) $(BUILD_SAN) $(BUILD_FUZZ) out

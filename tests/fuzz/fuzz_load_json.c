@@ -1,17 +1,11 @@
 /* fuzz_load_json.c: libFuzzer harness for the JSON scene loader
  * (rl_scene_load_json: cJSON + positions, every key reader, transforms,
- * materials, lights, cameras, camera paths). Not built by CMake.
+ * materials, lights, cameras, camera paths).
  *
- * Build (clang; the library instrumented too):
- *   CC=clang cmake -S . -B build-fuzz -DCMAKE_BUILD_TYPE=Debug -DRL_SANITIZE=ON \
- *       -DRL_TESTS=OFF -DCMAKE_C_FLAGS=-fsanitize=fuzzer-no-link
- *   cmake --build build-fuzz -j2 --target renderlab
- *   clang -g -O1 -fsanitize=fuzzer,address,undefined -Iinclude -Isrc \
- *       tests/fuzz/fuzz_load_json.c build-fuzz/librenderlab.a \
- *       $(pkg-config --libs libpng libcjson assimp OpenEXR stb) -fopenmp -lm -lstdc++ \
- *       -o build-fuzz/fuzz_load_json
- * Run: build-fuzz/fuzz_load_json -max_len=4096 corpus/   (seed corpus/ with
- * the example of docs/scene-format.md).
+ * Built with clang by `make build-fuzz` (RL_FUZZ=ON: the library
+ * instrumented, ASan+UBSan) into build-fuzz/tests/fuzz/; `make check` runs a
+ * short deterministic smoke run on corpus/json (tests/fuzz/smoke.sh), `make
+ * fuzz FUZZ_SECONDS=N` a longer one that keeps what it finds.
  *
  * The loader reads a file, so each input is written to a per-process
  * temporary file first. "file" and "texture" keys may name real files;

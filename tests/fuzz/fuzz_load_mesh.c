@@ -1,16 +1,9 @@
 /* fuzz_load_mesh.c: libFuzzer harness for mesh files through Assimp plus our
  * own checks (load_assimp.c, load_validate.c). The first input byte picks
  * the file extension (obj, ply, stl, gltf, off, dae), the rest is the file.
- * Not built by CMake.
- *
- * Build as described in fuzz_load_json.c, with this file instead:
- *   clang -g -O1 -fsanitize=fuzzer,address,undefined -Iinclude -Isrc \
- *       tests/fuzz/fuzz_load_mesh.c build-fuzz/librenderlab.a \
- *       $(pkg-config --libs libpng libcjson assimp OpenEXR stb) -fopenmp -lm -lstdc++ \
- *       -o build-fuzz/fuzz_load_mesh
- * Run: build-fuzz/fuzz_load_mesh -max_len=4096 -timeout=5 -detect_leaks=0 corpus/
- * (seed corpus/ with the files test_load_assimp writes, each prefixed by its
- * extension byte).
+ * Built and run like fuzz_load_json.c (make build-fuzz, make check's smoke
+ * run on corpus/mesh, whose files start with their extension byte; make
+ * fuzz), with -detect_leaks=0 (see below).
  *
  * Findings inside Assimp 5.2 itself show where our pre-checks need to grow:
  * so far an ai_assert abort on PLY faces with fewer than 3 corners and
