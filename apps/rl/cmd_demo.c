@@ -24,7 +24,9 @@ static const char demo_help[] =
     "Renders every built-in scene (rl scenes) with every renderer (rl algos)\n"
     "and writes DIR/<scene>-<algo>.png, DIR/report.json (machine, date and, per\n"
     "image, scene and render statistics) and DIR/index.html (the images and\n"
-    "their statistics on one page). Prints one line per image. Then compares\n"
+    "their statistics on one page). Prints one line per image. Defaults that\n"
+    "changed on purpose are drawn once more with the old value, and where that\n"
+    "changes an image both are shown side by side (DIR/changes/). Then compares\n"
     "the renderers over a small sampled region of one scene (rl compare) into\n"
     "DIR/compare/report.html.\n"
     "\n"
@@ -151,9 +153,10 @@ static void add_failure(cJSON *failures, const char *scene, const char *algo)
 }
 
 /* Renders scene with one renderer into DIR/<scene>-<algo>.png and appends
- * the entry to images; returns false (error printed) on failure. */
+ * the entry to images; returns false (error printed) on failure. keep (may
+ * be NULL) receives the image. */
 static bool render_one(const demo_args *a, const char *scene_name, const rl_scene *scene,
-                       const rl_camera *cam, const char *algo, cJSON *images)
+                       const rl_camera *cam, const char *algo, cJSON *images, rl_image **keep)
 {
     char file[512], path[4096];
     snprintf(file, sizeof file, "%s-%s.png", scene_name, algo);
@@ -206,16 +209,97 @@ static bool render_one(const demo_args *a, const char *scene_name, const rl_scen
         snprintf(what, sizeof what, "%s with %s", scene_name, algo);
         cli_fail_status(RL_CLI_FAIL, st, what);
     }
-    rl_image_release(img);
+    if (ok && keep)
+        *keep = img;
+    else
+        rl_image_release(img);
     rl_renderer_release(r);
     return ok;
+}
+
+/* Changes of the defaults made on purpose, shown side by side on the page:
+ * the renderer is drawn again with the option at its old value, and where
+ * the images differ both go on the page with their difference. */
+typedef struct demo_change {
+    const char *algo, *key, *old_value, *what;
+} demo_change;
+
+static const demo_change changes[] = {
+    { "whitted", "transmitted_highlight", "false",
+      "Ullmann 2003, eq. 3.17: lights behind a transmissive surface add k_t cos^n of the angle between their "
+      "refracted direction and the viewer's (new); false: classic Phong, as before" },
+    { "vt", "transmitted_highlight", "false",
+      "Ullmann 2003, eq. 3.17, in the vertex samples (as whitted)" },
+};
+
+/* The scene with algo's old default of change c into DIR/changes/, compared
+ * with now (the image of the new default); a change that leaves the image
+ * as it was is not listed. */
+static bool render_change(const demo_args *a, const char *scene_name, const rl_scene *scene, const rl_camera *cam,
+                          const demo_change *c, const rl_image *now, cJSON *list)
+{
+    char file[512], path[4096];
+    snprintf(file, sizeof file, "changes/%s-%s-%s-%s.png", scene_name, c->algo, c->key, c->old_value);
+    if ((size_t)snprintf(path, sizeof path, "%s/%s", a->out, file) >= sizeof path)
+        return cli_fail(RL_CLI_FAIL, "%s: output path too long", a->out), false;
+    rl_renderer *r = NULL;
+    rl_image *img = NULL;
+    rl_render_stats stats = { 0 };
+    rl_image_metrics m = { 0 };
+    rl_clear_error();
+    rl_status st = rl_renderer_create(c->algo, &r);
+    if (st == RL_OK)
+        st = rl_renderer_set(r, c->key, c->old_value);
+    if (st == RL_OK)
+        st = rl_renderer_prepare_inputs(r, scene);
+    if (st == RL_OK)
+        st = rl_image_create(cam->width, cam->height, RL_LAYER_COLOR, &img);
+    if (st == RL_OK)
+        st = rl_renderer_render(r, scene, cam, img, &stats);
+    if (st == RL_OK)
+        st = rl_image_compare(img, now, NULL, &m);
+    bool differs = st == RL_OK && m.max_abs > 0.0;
+    if (differs) {
+        char dir[4096];
+        snprintf(dir, sizeof dir, "%s/changes", a->out);
+        st = cli_make_dirs(dir) ? rl_image_write(img, path) : RL_ERR_IO;
+    }
+    if (st == RL_OK && differs) {
+        printf("changed: %s %s, %s=%s before: RMSE %.4f, SSIM %.4f\n", scene_name, c->algo, c->key, c->old_value,
+               m.rmse, m.ssim);
+        fflush(stdout);
+        cJSON *e = cJSON_CreateObject();
+        if (e) {
+            char now_file[512];
+            snprintf(now_file, sizeof now_file, "%s-%s.png", scene_name, c->algo);
+            cJSON_AddStringToObject(e, "scene", scene_name);
+            cJSON_AddStringToObject(e, "algorithm", c->algo);
+            cJSON_AddStringToObject(e, "option", c->key);
+            cJSON_AddStringToObject(e, "before", c->old_value);
+            cJSON_AddStringToObject(e, "what", c->what);
+            cJSON_AddStringToObject(e, "file_now", now_file);
+            cJSON_AddStringToObject(e, "file_before", file);
+            cJSON_AddNumberToObject(e, "rmse", m.rmse);
+            cJSON_AddNumberToObject(e, "ssim", m.ssim);
+            cJSON_AddNumberToObject(e, "time_ms_before", stats.time_ms);
+            cJSON_AddItemToArray(list, e);
+        }
+    } else if (st != RL_OK) {
+        char what[600];
+        snprintf(what, sizeof what, "%s with %s, %s=%s", scene_name, c->algo, c->key, c->old_value);
+        cli_fail_status(RL_CLI_FAIL, st, what);
+    }
+    rl_image_release(img);
+    rl_renderer_release(r);
+    return st == RL_OK;
 }
 
 static int run_demo(const demo_args *a, cJSON *report)
 {
     cJSON *images = cJSON_AddArrayToObject(report, "images");
     cJSON *failures = cJSON_AddArrayToObject(report, "failures");
-    if (!images || !failures)
+    cJSON *changed = cJSON_AddArrayToObject(report, "changes");
+    if (!images || !failures || !changed)
         return cli_fail(RL_CLI_FAIL, "out of memory");
     size_t ns = 0, nr = 0;
     const rl_builtin_info *scenes = rl_builtin_scenes(&ns);
@@ -244,10 +328,18 @@ static int run_demo(const demo_args *a, cJSON *report)
         for (size_t k = 0; k < nr; k++) {
             if (!in_list(a->algos, algos[k].name))
                 continue;
-            if (!render_one(a, name, scene, &cam, algos[k].name, images)) {
+            rl_image *now = NULL;
+            if (!render_one(a, name, scene, &cam, algos[k].name, images, &now)) {
                 add_failure(failures, name, algos[k].name);
                 rc = RL_CLI_FAIL;
             }
+            for (size_t c = 0; now && c < sizeof changes / sizeof changes[0]; c++)
+                if (strcmp(changes[c].algo, algos[k].name) == 0 &&
+                    !render_change(a, name, scene, &cam, &changes[c], now, changed)) {
+                    add_failure(failures, name, algos[k].name);
+                    rc = RL_CLI_FAIL;
+                }
+            rl_image_release(now);
         }
         rl_scene_release(scene);
     }

@@ -134,6 +134,30 @@ bool cli_write_demo_html(const cJSON *report, const char *path)
         }
         fputs("</ul>\n", f);
     }
+    const cJSON *changes = cJSON_GetObjectItemCaseSensitive(report, "changes");
+    if (cJSON_GetArraySize(changes) > 0) {
+        fputs("<h2>Changed on purpose</h2>\n<p>Defaults that changed, drawn again with the old value "
+              "where that changes the image: now on the left, before on the right.</p>\n<table>\n"
+              "<tr><th>scene, renderer</th><th>now</th><th>before</th><th>difference</th></tr>\n", f);
+        cJSON_ArrayForEach(e, changes) {
+            fputs("<tr><th>", f);
+            html_put_escaped(f, str(e, "scene"));
+            fputs(", ", f);
+            html_put_escaped(f, str(e, "algorithm"));
+            fputs("</th><td><img src=\"", f);
+            html_put_escaped(f, str(e, "file_now"));
+            fputs("\" alt=\"now\"></td><td><img src=\"", f);
+            html_put_escaped(f, str(e, "file_before"));
+            fputs("\" alt=\"before\"></td><td>", f);
+            html_put_escaped(f, str(e, "option"));
+            fputs(" = ", f);
+            html_put_escaped(f, str(e, "before"));
+            fprintf(f, " before<br>RMSE %.4f, SSIM %.4f<br><span class=\"s\">", num(e, "rmse"), num(e, "ssim"));
+            html_put_escaped(f, str(e, "what"));
+            fputs("</span></td></tr>\n", f);
+        }
+        fputs("</table>\n", f);
+    }
     if (*str(report, "compare")) {
         fputs("<p>The renderers compared over a sampled region of the scene (time, rays, "
               "triangles, image quality; Jähn 2015): <a href=\"", f);

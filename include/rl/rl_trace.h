@@ -3,9 +3,11 @@
  * The renderers "whitted" and "vt" are built on this: Vertex Tracing
  * (Ullmann 2003) shoots its vertex rays through exactly this tracer and
  * compares their ray trees (Sec. 3.3.1). Shading follows Ullmann 2003,
- * Sec. 3.1, eq. 3.1-3.4: local Phong with hard shadow feelers to every light
- * (area lights with a fixed sample count), plus k_r times the reflected and
- * k_t times the refracted radiance, recursively up to max_depth.
+ * Sec. 3.1, eq. 3.1-3.4 and Sec. 3.5.2, eq. 3.17-3.19: local Phong with hard
+ * shadow feelers to every light (area lights with a fixed sample count) and
+ * the transmitted highlight of lights behind a transmissive surface, plus
+ * k_r times the reflected and k_t times the refracted radiance, recursively
+ * up to max_depth.
  *
  * A ray tree is the ordered sequence of (ray type, hit object) of every ray
  * spawned while shading one sample, depth-first in the order the tracer
@@ -58,6 +60,10 @@ typedef struct rl_tracer_desc {           /* zero = default */
     float ambient;            /* ambient term × k_d; 0 -> 0.05, < 0 -> none */
     rl_vec3 background;       /* radiance of rays that leave the scene */
     bool no_shadows;          /* skip shadow feelers (all lights visible) */
+    /* Leave out eq. 3.17's transmitted highlight k_t cos^p φ_t (Ullmann
+     * 2003, Sec. 3.5.2), which lights behind a transmissive surface add;
+     * with it off the local term is classic Phong, as before 2026-12-05. */
+    bool no_transmitted_highlight;
     uint64_t seed;            /* area-light jitter */
     /* Ray trees record only whether a shadow feeler was blocked (occluder
      * RL_ID_NONE - 1 for any occluder), not by which object, so feelers keep

@@ -134,6 +134,7 @@ rl_status rl_tracer_create(const rl_accel *accel, const rl_tracer_desc *desc, rl
     t->ambient = d.ambient == 0.0f ? 0.05f : rl_maxf(d.ambient, 0.0f);
     t->background = d.background;
     t->shadows = !d.no_shadows;
+    t->transmitted_highlight = !d.no_transmitted_highlight;
     t->tree_shadow_any_hit = d.tree_shadow_any_hit;
     t->defer_through = d.defer_through;
     t->seed = d.seed;

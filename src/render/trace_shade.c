@@ -1,7 +1,19 @@
 /* trace_shade.c: the local term of the Whitted tracer, Phong with hard
- * shadows (Ullmann 2003, Sec. 3.1: shadow feeler r_s = p_l - v_i, eq. 3.2):
+ * shadows (Ullmann 2003, Sec. 3.1: shadow feeler r_s = p_l - v_i, eq. 3.2)
+ * and the transmitted highlight of eq. 3.17 (Sec. 3.5.2):
  *     emission + ambient k_d + sum over lights, visible:
- *                                E (k_d max(0, n.l) + k_s max(0, r.v)^n)
+ *         in front (n.l > 0):      E (k_d n.l + k_s max(0, r.v)^n)
+ *         behind, k_t > 0:         E k_t max(0, t.v)^n
+ * where t is the light's direction refracted through the surface into the
+ * viewer's side (Snell with the material's ior: leaving the object when the
+ * viewer is outside) and v points to the viewer: the thesis' cos^p φ_t, "φ_t
+ * the angle between the transmitted ray and the view direction", with our
+ * one Phong exponent n as p and the thesis' k_t as its coefficient. A
+ * light is either in front of the surface or behind it, so each light adds
+ * one of the two highlights (Sec. 3.5.2). The feeler to a light behind
+ * leaves from the back side; like every feeler it is blocked by any surface,
+ * also the far side of a closed glass object, so the term shows on thin
+ * transmissive sheets (panes, the cluster's cover glass).
  * with the same light model as the raster renderer (raster.c), so that both
  * agree on unshadowed diffuse scenes:
  *  - point and spot: E = colour intensity / d^2, the spot cone fading with
@@ -47,6 +59,36 @@ static void add_light(rl_trace_local *acc, const rl_trace_surface *s, rl_vec3 l,
         float r_dot_v = rl_maxf(0.0f, rl_dot(r, s->v));
         acc->rest = rl_add(acc->rest, rl_mul(rl_scale(s->m->specular, powf(r_dot_v, s->m->shininess)), E));
     }
+}
+
+/* eq. 3.17: cos φ_t of a light in unit direction l behind the surface
+ * (n.l < 0), or 0 (total internal reflection, or the transmitted light
+ * leaves away from the viewer). */
+static float transmitted_cos(const rl_trace_surface *s, rl_vec3 l)
+{
+    float ior = s->m->ior >= 1.0f ? s->m->ior : 1.0f;
+    /* The light crosses from the far side into the viewer's: out of the
+     * object when the viewer is outside it. */
+    float eta = s->front ? ior : 1.0f / ior;
+    rl_vec3 t;
+    if (!rl_refract(rl_neg(l), rl_neg(s->ns), eta, &t))
+        return 0.0f;
+    float len = rl_length(t);
+    return len > 0.0f ? rl_maxf(0.0f, rl_dot(t, s->v) / len) : 0.0f;
+}
+
+/* Adds the transmitted highlight k_t cos^n φ_t E of a light behind s
+ * (eq. 3.17) to rest. */
+static void add_transmitted(rl_trace_local *acc, const rl_trace_surface *s, float cos_t, rl_vec3 E)
+{
+    acc->rest = rl_add(acc->rest, rl_scale(E, s->m->transmissivity * powf(cos_t, s->m->shininess)));
+}
+
+/* Whether a light behind s could add eq. 3.17's term there: the surface
+ * transmits and the term is on. */
+static bool transmits(const rl_trace_ctx *ctx, const rl_trace_surface *s)
+{
+    return ctx->tracer->transmitted_highlight && s->m->transmissivity > 0.0f;
 }
 
 /* Occluder of a feeler by tracing it; RL_ID_NONE if the light is visible. */
@@ -113,8 +155,15 @@ static void quad_light(rl_trace_ctx *ctx, rl_trace_local *acc, const rl_trace_su
             rl_vec3 l = rl_scale(to_light, 1.0f / dist);
             float cos_light = -rl_dot(normal, l);
             float n_dot_l = rl_dot(s->ns, l);
-            if (cos_light <= 0.0f || n_dot_l <= 0.0f)
+            if (cos_light <= 0.0f)
                 continue;
+            if (n_dot_l <= 0.0f) {
+                /* Behind the surface: eq. 3.17's transmitted highlight. */
+                float cos_t = transmits(ctx, s) ? transmitted_cos(s, l) : 0.0f;
+                if (cos_t > 0.0f && feeler(ctx, s, l, dist, depth, index))
+                    add_transmitted(acc, s, cos_t, rl_scale(radiance, cos_light / d2));
+                continue;
+            }
             if (!feeler(ctx, s, l, dist, depth, index))
                 continue;
             add_light(acc, s, l, n_dot_l, rl_scale(radiance, cos_light / d2));
@@ -137,7 +186,14 @@ rl_trace_local rl_trace_local_term(rl_trace_ctx *ctx, const rl_trace_surface *s,
         if (!rl_light_eval_delta(L, s->p, &E, &l, &dist))
             continue;
         float n_dot_l = rl_dot(s->ns, l);
-        if (n_dot_l <= 0.0f || !feeler(ctx, s, l, dist, depth, i))
+        if (n_dot_l <= 0.0f) {
+            /* Behind the surface: eq. 3.17's transmitted highlight. */
+            float cos_t = transmits(ctx, s) ? transmitted_cos(s, l) : 0.0f;
+            if (cos_t > 0.0f && feeler(ctx, s, l, dist, depth, i))
+                add_transmitted(&acc, s, cos_t, E);
+            continue;
+        }
+        if (!feeler(ctx, s, l, dist, depth, i))
             continue;
         add_light(&acc, s, l, n_dot_l, E);
     }

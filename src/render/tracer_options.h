@@ -21,6 +21,9 @@ extern const char *const rl_tracer_accel_choices[];
     { "area_samples", RL_OPT_INT, "4", "n x n jittered shadow feelers per quad light", 1, 32, NULL }, \
     { "shadows", RL_OPT_BOOL, "true", "trace shadow feelers (false: every light is visible)",        \
       0, 0, NULL },                                                                                   \
+    { "transmitted_highlight", RL_OPT_BOOL, "true",                                                   \
+      "eq. 3.17: lights behind a transmissive surface add k_t cos^n of the angle between their "      \
+      "refracted direction and the viewer's (false: classic Phong)", 0, 0, NULL },                    \
     { "ambient", RL_OPT_FLOAT, "0.05", "ambient light, multiplied by k_d", 0, 1, NULL },             \
     { "background", RL_OPT_COLOR, "0,0,0",                                                            \
       "radiance of rays that leave the scene: \"r,g,b\" or one grey value", 0, 0, NULL },             \

@@ -348,7 +348,8 @@ static void read_settings(rl_renderer *r, vt_settings *set)
 /* What the cached feelers depend on besides the scene. */
 static uint64_t feeler_signature(const rl_tracer_desc *desc)
 {
-    return ((uint64_t)(unsigned)desc->area_samples << 8) ^ (desc->no_shadows ? 1u : 0u) ^ (desc->seed << 20);
+    return ((uint64_t)(unsigned)desc->area_samples << 8) ^ (desc->no_shadows ? 1u : 0u) ^
+           (desc->no_transmitted_highlight ? 2u : 0u) ^ (desc->seed << 20);
 }
 
 /* Keeps this frame's feelers for the next one. */

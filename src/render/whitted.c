@@ -1,12 +1,14 @@
 /* whitted.c: renderer "whitted", recursive ray tracing (Whitted 1980) with
  * the coefficient model of Ullmann 2003, Sec. 3.1 (eq. 3.1-3.4): one primary
- * ray per sample through rl_tracer (trace.c), Phong with hard shadows,
- * k_r reflection and k_t refraction.
+ * ray per sample through rl_tracer (trace.c), Phong with hard shadows and
+ * eq. 3.17's transmitted highlight (Sec. 3.5.2), k_r reflection and k_t
+ * refraction.
  *
  * Options (defaults): accel = bvh (bvh | grid | embree | brute; embree only
  * in a build with Embree), max_depth = 5 (0: local shading only), ss = 1
  * (n x n samples per pixel at the stratum centres, box filtered),
- * area_samples = 4 (n x n per quad light), shadows = true, ambient = 0.05,
+ * area_samples = 4 (n x n per quad light), shadows = true,
+ * transmitted_highlight = true (eq. 3.17), ambient = 0.05,
  * background = "0,0,0", threads = 0 (all), ray_trees = false (keep the ray
  * tree of every pixel's centre sample for rl_whitted_pixel_tree()).
  *

@@ -41,6 +41,16 @@ for e in r["images"]:
     assert e["scene_stats"]["triangles"] > 0
 assert r["machine"]["nproc"] >= 1 and r["date"]
 assert r["failures"] == []
+# Defaults changed on purpose: spheres' glass under whitted shows eq. 3.17's
+# transmitted highlight; each listed pair exists and differs.
+ch = r["changes"]
+assert any(c["scene"] == "spheres" and c["algorithm"] == "whitted" for c in ch), ch
+import os
+for c in ch:
+    assert c["rmse"] > 0 and c["option"] and c["before"], c
+    for k in ("file_now", "file_before"):
+        assert os.path.getsize(os.path.join(os.path.dirname(sys.argv[1]), c[k])) > 0, c
 PY
+grep -q "Changed on purpose" "$DIR/index.html" || fail "index.html lacks the changed defaults"
 grep -q "processors" "$DIR/index.html" || fail "index.html lacks the machine"
 echo "ok"

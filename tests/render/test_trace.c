@@ -213,7 +213,9 @@ static void test_glass_slab_shifts_a_ray_by_the_snell_amount(void **state)
     add_quad(f.scene, rl_v3(-big, -big, -1), rl_v3(-big, big, -1), rl_v3(big, big, -1), rl_v3(big, -big, -1), m_glass);
     add_quad(f.scene, rl_v3(-big, -big, -3), rl_v3(big, -big, -3), rl_v3(big, big, -3), rl_v3(-big, big, -3), m_back);
     add_point_light(f.scene, rl_v3(1.2f, 0.0f, -2.4f), 1.0f);
-    finish(&f, &(rl_tracer_desc){ .ambient = -1.0f });
+    /* Refraction alone: the light behind the slab would add eq. 3.17's
+     * transmitted highlight on both faces (tested on its own below). */
+    finish(&f, &(rl_tracer_desc){ .ambient = -1.0f, .no_transmitted_highlight = true });
 
     const float theta1 = rl_radians(40.0f);
     const float theta2 = asinf(sinf(theta1) / 1.5f);
@@ -509,12 +511,83 @@ static void test_quad_light_traces_n_by_n_feelers_deterministically(void **state
     release(&f);
 }
 
+/* Ullmann 2003, eq. 3.17: a light behind a transmissive pane adds
+ * k_t cos^p φ_t, φ_t between the light's transmitted direction and the
+ * view direction. With ior 1 the light goes on straight: at p on the pane
+ * z = 0, seen from C = (0, 0, 2), lit from L = (0, 0, -1) behind it,
+ *     L_o = k_t I / |p - L|^2 * max(0, dot(norm(p - L), norm(C - p)))^p
+ * (here k_t = 0.5, I = 3, p = the Phong exponent 4).
+ * No diffuse, specular, reflection or ambient, a black background: that is
+ * the whole radiance. Off: nothing. Blocked: nothing. */
+static rl_scene *pane_scene(float ior, bool blocker)
+{
+    rl_scene *s = NULL;
+    assert_int_equal(rl_scene_create(&s), RL_OK);
+    rl_material glass = matte(rl_v3s(0.0f));
+    glass.transmissivity = 0.5f;
+    glass.shininess = 4.0f;
+    glass.ior = ior;
+    uint32_t m = add_material(s, glass);
+    add_quad(s, rl_v3(-2, -2, 0), rl_v3(2, -2, 0), rl_v3(2, 2, 0), rl_v3(-2, 2, 0), m);
+    if (blocker)   /* an opaque card between the pane and the light, facing it */
+        add_quad(s, rl_v3(-0.2f, -0.2f, -0.5f), rl_v3(-0.2f, 0.2f, -0.5f), rl_v3(0.2f, 0.2f, -0.5f),
+                 rl_v3(0.2f, -0.2f, -0.5f), add_material(s, matte(rl_v3s(0.5f))));
+    add_point_light(s, rl_v3(0, 0, -1), 3.0f);
+    return s;
+}
+
+static void test_transmitted_highlight_of_a_light_behind_a_pane_is_eq_3_17(void **state)
+{
+    (void)state;
+    const rl_vec3 eye = rl_v3(0, 0, 2), light = rl_v3(0, 0, -1);
+    const rl_vec3 points[] = { { 0, 0, 0 }, { 0.3f, -0.2f, 0 }, { 0.6f, 0.4f, 0 }, { -0.9f, 0.1f, 0 } };
+    for (int variant = 0; variant < 3; ++variant) {
+        fixture f = { pane_scene(1.0f, variant == 2), NULL, NULL };
+        rl_tracer_desc desc = { .ambient = -1.0f, .no_transmitted_highlight = variant == 1 };
+        finish(&f, &desc);
+        for (size_t i = 0; i < sizeof points / sizeof points[0]; ++i) {
+            rl_vec3 p = points[i];
+            rl_ray ray = ray_from_to(eye, p);
+            rl_trace_result res;
+            rl_tracer_trace(f.tracer, &ray, RL_RAY_PRIMARY, i, &res, NULL);
+            rl_vec3 to_p = rl_sub(p, light);
+            float c = rl_maxf(0.0f, rl_dot(rl_normalize(to_p), rl_normalize(rl_sub(eye, p))));
+            /* The card, halfway to the light, blocks where |p.x|, |p.y| <= 0.4. */
+            bool blocked = variant == 2 && fabsf(p.x) <= 0.4f && fabsf(p.y) <= 0.4f;
+            float want = variant == 1 || blocked ? 0.0f : 0.5f * 3.0f / rl_length2(to_p) * powf(c, 4.0f);
+            if (want > 0.0f)
+                assert_color_close(res.color, rl_v3s(want), 1e-4f);
+            else
+                assert_true(res.color.x == 0.0f && res.color.y == 0.0f && res.color.z == 0.0f);
+        }
+        release(&f);
+    }
+    /* Snell: on the axis the light crosses the pane straight for any ior. */
+    fixture f = { pane_scene(1.5f, false), NULL, NULL };
+    finish(&f, &(rl_tracer_desc){ .ambient = -1.0f });
+    rl_ray axis = ray_from_to(eye, rl_v3(0, 0, 0));
+    rl_trace_result res;
+    rl_tracer_trace(f.tracer, &axis, RL_RAY_PRIMARY, 0, &res, NULL);
+    assert_color_close(res.color, rl_v3s(0.5f * 3.0f), 1e-4f);
+    /* Off the axis the refracted light bends away from the straight line:
+     * leaving glass (eta = 1.5) it leaves the normal, so at p the viewer
+     * sees less of it than with ior 1. */
+    rl_vec3 p = rl_v3(0.3f, 0.0f, 0.0f);
+    rl_ray off = ray_from_to(eye, p);
+    rl_tracer_trace(f.tracer, &off, RL_RAY_PRIMARY, 1, &res, NULL);
+    float straight = 0.5f * 3.0f / rl_length2(rl_sub(p, light)) *
+                     powf(rl_dot(rl_normalize(rl_sub(p, light)), rl_normalize(rl_sub(eye, p))), 4.0f);
+    assert_true(res.color.x > 0.0f && res.color.x < straight);
+    release(&f);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_diffuse_sphere_matches_lambert_under_a_point_light),
         cmocka_unit_test(test_mirror_shows_what_a_direct_ray_to_the_mirrored_point_sees),
         cmocka_unit_test(test_glass_slab_shifts_a_ray_by_the_snell_amount),
+        cmocka_unit_test(test_transmitted_highlight_of_a_light_behind_a_pane_is_eq_3_17),
         cmocka_unit_test(test_ray_counts_and_tree_are_exact_for_two_facing_mirrors),
         cmocka_unit_test(test_tiny_path_weight_stops_the_recursion),
         cmocka_unit_test(test_tree_of_a_deep_mirror_corridor_is_truncated),
