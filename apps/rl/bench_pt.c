@@ -16,6 +16,9 @@
  *   error         RMSE and SSIM of every variant against a converged BVH
  *                 reference at equal sample counts, and the time each needs
  *                 to reach the RMSE the BVH reaches at 4, 16, 64 spp
+ *   specular      Sec. 11.2, 12.3: mirror and refraction rays through the
+ *                 exact grid (specular=exact, the thesis) or the diffuse
+ *                 payload (specular=diffuse), on ls-cornell's mirror cuboid
  *   accumulation  RMSE against total samples, and what each filter of
  *                 Sec. 8.2 does to RMSE and SSIM at 1, 4 and 16 spp
  *
@@ -66,6 +69,8 @@ static const char bench_pt_help[] =
     "  error         RMSE/SSIM of each variant (PNMT and pre-illuminated at every\n"
     "                voxel resolution) against a converged BVH reference at equal\n"
     "                spp, and time to reach the BVH's RMSE at 4/16/64 spp\n"
+    "  specular      mirror/refraction rays through the exact grid (the thesis) or\n"
+    "                the diffuse Line Space payload: RMSE, SSIM, ms/spp on ls-cornell\n"
     "  accumulation  RMSE against total samples; each filter's RMSE/SSIM\n"
     "\n"
     "options:\n"
@@ -88,10 +93,10 @@ static const char bench_pt_help[] =
     "example:\n"
     "  rl bench pt --only generation,shadow\n";
 
-enum { SEC_GENERATION, SEC_SCENES, SEC_DIFFUSE, SEC_SHADOW, SEC_ERROR, SEC_ACCUMULATION,
+enum { SEC_GENERATION, SEC_SCENES, SEC_DIFFUSE, SEC_SHADOW, SEC_ERROR, SEC_SPECULAR, SEC_ACCUMULATION,
        SEC_COUNT };
-static const char *const section_names[SEC_COUNT] = { "generation", "scenes", "diffuse",
-                                                      "shadow", "error", "accumulation" };
+static const char *const section_names[SEC_COUNT] = { "generation", "scenes", "diffuse",  "shadow",
+                                                      "error",      "specular", "accumulation" };
 
 /* Schröder 2017, Table 1: generation times in ms on a GeForce GTX 1080. */
 static const struct gen_row {
@@ -165,6 +170,7 @@ typedef struct pt_config {
     int max_depth;                 /* 0: the renderer's default */
     bool direct_only;              /* max_depth 0: no secondary rays */
     const char *ls_origin;         /* NULL: the renderer's default (offset) */
+    const char *specular;          /* NULL: the renderer's default (exact) */
     bool ls_fixed;                 /* the thesis' fixed lists of k = 8 (ls_dynamic=false) */
     int spp;
     bool accumulate;
@@ -236,6 +242,7 @@ static rl_status make_pt(const bpt *b, const pt_config *c, rl_renderer **out)
     if (st == RL_OK && c->max_depth) st = set_num(r, "max_depth", c->max_depth);
     if (st == RL_OK && c->direct_only) st = set_num(r, "max_depth", 0);
     if (st == RL_OK && c->ls_origin) st = rl_renderer_set(r, "ls_origin", c->ls_origin);
+    if (st == RL_OK && c->specular) st = rl_renderer_set(r, "specular", c->specular);
     if (st == RL_OK && c->ls_fixed) st = rl_renderer_set(r, "ls_dynamic", "false");
     if (st == RL_OK) st = set_num(r, "spp", c->spp ? c->spp : 1);
     if (st == RL_OK) st = rl_renderer_set(r, "accumulate", c->accumulate ? "true" : "false");
@@ -1008,33 +1015,37 @@ static rl_status sec_shadow(void *ctx, cJSON *sec)
 
 /* ------------------------------------------------ error and accumulation -- */
 
-/* The converged BVH image of the diagram scene at the error size. */
-static rl_status reference(bpt *b, const rl_scene *scene, const rl_camera *cam)
+/* A converged BVH image of scene (ref_spp samples) into *out. */
+static rl_status make_reference(bpt *b, const rl_scene *scene, const rl_camera *cam, rl_image **out, double *ms)
 {
-    if (b->reference)
-        return RL_OK;
     int per_frame = 16;
     pt_config c = { .label = "reference", .shadow = "bvh", .diffuse = "bvh", .spp = per_frame,
                     .accumulate = true, .seed = REF_SEED };
     rl_renderer *r = NULL;
     rl_status st = make_pt(b, &c, &r);
     if (st == RL_OK)
-        st = rl_image_create(cam->width, cam->height, RL_LAYER_COLOR, &b->reference);
-    b->reference_ms = 0.0;
+        st = rl_image_create(cam->width, cam->height, RL_LAYER_COLOR, out);
+    *ms = 0.0;
     long long frames = (b->a->ref_spp + per_frame - 1) / per_frame;
     for (long long f = 0; st == RL_OK && f < frames; f++) {
         rl_render_stats s;
-        st = rl_renderer_render(r, scene, cam, b->reference, &s);
-        b->reference_ms += s.time_ms;
+        st = rl_renderer_render(r, scene, cam, *out, &s);
+        *ms += s.time_ms;
     }
     rl_renderer_release(r);
     if (st != RL_OK) {
-        rl_image_release(b->reference);
-        b->reference = NULL;
+        rl_image_release(*out);
+        *out = NULL;
         return st;
     }
-    note("reference: %lld spp in %.0f ms", frames * per_frame, b->reference_ms);
+    note("reference: %lld spp in %.0f ms", frames * per_frame, *ms);
     return RL_OK;
+}
+
+/* The converged BVH image of the diagram scene at the error size. */
+static rl_status reference(bpt *b, const rl_scene *scene, const rl_camera *cam)
+{
+    return b->reference ? RL_OK : make_reference(b, scene, cam, &b->reference, &b->reference_ms);
 }
 
 typedef struct curve_point {
@@ -1047,9 +1058,9 @@ typedef struct curve_point {
 
 /* Accumulates 1 spp per frame up to spp_max, measuring at powers of two
  * (and at the checkpoints given, when not NULL). */
-static rl_status accumulate_curve(bpt *b, const pt_config *c, const rl_scene *scene,
-                                  const rl_camera *cam, long long spp_max, curve_point *pts,
-                                  int *num)
+static rl_status accumulate_curve_against(bpt *b, const pt_config *c, const rl_scene *scene,
+                                          const rl_camera *cam, const rl_image *ref, long long spp_max,
+                                          curve_point *pts, int *num)
 {
     rl_renderer *r = NULL;
     rl_image *img = NULL;
@@ -1077,12 +1088,20 @@ static rl_status accumulate_curve(bpt *b, const pt_config *c, const rl_scene *sc
             curve_point *p = &pts[(*num)++];
             p->spp = spp;
             p->time_ms = t;
-            st = rl_image_compare(img, b->reference, &(rl_metric_options){ 0 }, &p->m);
+            st = rl_image_compare(img, ref, &(rl_metric_options){ 0 }, &p->m);
         }
     }
     rl_image_release(img);
     rl_renderer_release(r);
     return st;
+}
+
+/* Against the diagram scene's reference (error and accumulation sections). */
+static rl_status accumulate_curve(bpt *b, const pt_config *c, const rl_scene *scene,
+                                  const rl_camera *cam, long long spp_max, curve_point *pts,
+                                  int *num)
+{
+    return accumulate_curve_against(b, c, scene, cam, b->reference, spp_max, pts, num);
 }
 
 static cJSON *curve_json(const curve_point *pts, int num)
@@ -1215,6 +1234,67 @@ static rl_status sec_error(void *ctx, cJSON *sec)
     }
     fflush(stdout);
     return RL_OK;
+}
+
+/* Sec. 11.2, 12.3: mirror and refraction rays through the exact grid (the
+ * thesis, specular=exact) or through the diffuse backend's Line Space
+ * payload (specular=diffuse), on the Line Space Cornell box with its
+ * mirror cuboid (the diagram scenes have no mirror). Equal spp, against a
+ * converged BVH image of the same scene. */
+#define SPECULAR_SCENE "ls-cornell"
+static rl_status sec_specular(void *ctx, cJSON *sec)
+{
+    bpt *b = ctx;
+    rl_scene *scene = NULL;
+    rl_status st = scene_get(b, SPECULAR_SCENE, &scene);
+    if (st != RL_OK)
+        return st;
+    rl_camera cam = scene_camera(scene, b->a->err_width, b->a->err_height);
+    rl_image *ref = NULL;
+    double ref_ms = 0.0;
+    if ((st = make_reference(b, scene, &cam, &ref, &ref_ms)) != RL_OK)
+        return st;
+    const pt_config configs[] = {
+        { .label = "bvh", .shadow = "bvh", .diffuse = "bvh" },
+        { .label = "ls-pnmt, specular=exact", .shadow = "bvh", .diffuse = "ls-pnmt", .specular = "exact" },
+        { .label = "ls-pnmt, specular=diffuse", .shadow = "bvh", .diffuse = "ls-pnmt", .specular = "diffuse" },
+        { .label = "ls-preillum, specular=exact", .shadow = "bvh", .diffuse = "ls-preillum", .specular = "exact" },
+        { .label = "ls-preillum, specular=diffuse", .shadow = "bvh", .diffuse = "ls-preillum",
+          .specular = "diffuse" },
+    };
+    enum { N = sizeof configs / sizeof configs[0] };
+    printf("\nspecular rays (%s, %dx%d, %lld spp against %lld spp of the BVH; shadows: bvh)\n", SPECULAR_SCENE,
+           cam.width, cam.height, b->a->spp_max, b->a->ref_spp);
+    printf("%-32s %9s %8s %11s\n", "variant", "RMSE", "SSIM", "ms/spp");
+    cJSON_AddStringToObject(sec, "scene", SPECULAR_SCENE);
+    cJSON_AddNumberToObject(sec, "reference_spp", (double)b->a->ref_spp);
+    cJSON *vars = cJSON_AddArrayToObject(sec, "variants");
+    for (int i = 0; st == RL_OK && vars && i < N; i++) {
+        curve_point pts[MAX_POINTS];
+        int num = 0;
+        rl_clear_error();
+        if ((st = accumulate_curve_against(b, &configs[i], scene, &cam, ref, b->a->spp_max, pts, &num)) != RL_OK)
+            break;
+        const curve_point *last = &pts[num - 1];
+        printf("%-32s %9.4f %8.4f %11.2f\n", configs[i].label, last->m.rmse, last->m.ssim,
+               last->time_ms / (double)last->spp);
+        cJSON *v = cJSON_CreateObject();
+        if (!v) {
+            st = RL_ERR_OUT_OF_MEMORY;
+            break;
+        }
+        cJSON_AddItemToArray(vars, v);
+        cJSON_AddStringToObject(v, "label", configs[i].label);
+        cJSON_AddStringToObject(v, "diffuse", configs[i].diffuse);
+        cJSON_AddStringToObject(v, "specular", configs[i].specular ? configs[i].specular : "exact");
+        bench_add_num(v, "rmse", last->m.rmse);
+        bench_add_num(v, "ssim", last->m.ssim);
+        bench_add_num(v, "ms_per_spp", last->time_ms / (double)last->spp);
+        cJSON_AddItemToObject(v, "curve", curve_json(pts, num));
+    }
+    rl_image_release(ref);
+    fflush(stdout);
+    return st;
 }
 
 static rl_status sec_accumulation(void *ctx, cJSON *sec)
@@ -1413,8 +1493,9 @@ int bench_pt(int argc, char **argv)
         return cli_fail(RL_CLI_FAIL, "out of memory");
     cJSON_AddItemToObject(root, "parameters", params_json(&b));
     cJSON_AddItemToObject(root, "thesis", thesis_json());
-    static const bench_section_fn fns[SEC_COUNT] = { sec_generation, sec_scenes, sec_diffuse,
-                                                        sec_shadow, sec_error, sec_accumulation };
+    static const bench_section_fn fns[SEC_COUNT] = { sec_generation, sec_scenes,   sec_diffuse,
+                                                        sec_shadow,     sec_error,    sec_specular,
+                                                        sec_accumulation };
     printf("rl bench pt: Line Space path tracing (Schroeder 2017), %d threads\n", b.threads);
     rc = bench_run_sections("pt", root, section_names, fns, SEC_COUNT, a.sections, &b,
                                b.reason, b.threads, out);

@@ -16,6 +16,12 @@
  *   shadow = bvh       bvh | grid | embree | ls-candidates | ls-preillum |
  *                      ls-pnmt | shadowmap
  *   diffuse = bvh      bvh | grid | embree | ls-candidates | ls-preillum | ls-pnmt
+ *   specular = exact   mirror and refraction rays: exact (the thesis, Sec.
+ *                      11.2, 12.3: the PNMT Line Space is not accurate enough
+ *                      for them, so they go to the voxel grid it lives in;
+ *                      with an exact diffuse backend, that one) | diffuse
+ *                      (through the diffuse backend, Line Space payloads
+ *                      included: ours before 2026-12-05)
  *   primary = trace    trace (jittered camera rays through the BVH) |
  *                      raster (G-buffer from the rasterizer, Sec. 8.1: no
  *                      jitter, so edges alias as the thesis notes)
@@ -76,6 +82,7 @@ static const char *const rng_choices[] = { "lcg", "tausworthe", "hybrid", NULL }
 /* Order = rl_pt_backend. */
 static const char *const shadow_choices[] = { "bvh", "grid", "embree", "ls-candidates", "ls-preillum", "ls-pnmt",
                                               "shadowmap", NULL };
+static const char *const specular_choices[] = { "exact", "diffuse", NULL };
 static const char *const diffuse_choices[] = { "bvh", "grid", "embree", "ls-candidates", "ls-preillum", "ls-pnmt",
                                                NULL };
 static const char *const ls_origin_choices[] = { "offset", "exact", NULL };
@@ -98,6 +105,9 @@ static const rl_option_info pt_options[] = {
       0, 0, shadow_choices },
     { "diffuse", RL_OPT_ENUM, "bvh", "secondary rays: exact accelerator or Line Space payload",
       0, 0, diffuse_choices },
+    { "specular", RL_OPT_ENUM, "exact",
+      "mirror and refraction rays: exact (the thesis, Sec. 11.2, 12.3: the grid under a Line Space payload, "
+      "else the diffuse backend) or diffuse (the diffuse backend, payloads included)", 0, 0, specular_choices },
     { "primary", RL_OPT_ENUM, "trace",
       "primary visibility: trace (jittered rays, BVH) or raster (G-buffer, Sec. 8.1)", 0, 0, primary_choices },
     { "checkerboard", RL_OPT_BOOL, "false", "render alternate halves of the pixels per frame (Sec. 8.5)",
@@ -218,6 +228,10 @@ static void read_settings(const rl_renderer *r, pt_settings *set)
     set->seed = (uint64_t)rl_renderer_opt_int(r, "seed");
     set->shadow = (rl_pt_backend)rl_renderer_opt_enum(r, "shadow");
     set->diffuse = (rl_pt_backend)rl_renderer_opt_enum(r, "diffuse");
+    /* Sec. 11.2, 12.3: specular rays leave the approximate payloads for the
+     * exact grid the Line Space lives in (always built with a payload). */
+    bool payload = set->diffuse == RL_PT_BACKEND_LS_PNMT || set->diffuse == RL_PT_BACKEND_LS_PREILLUM;
+    set->specular = rl_renderer_opt_enum(r, "specular") == 0 && payload ? RL_PT_BACKEND_GRID : set->diffuse;
     set->primary = (pt_primary)rl_renderer_opt_enum(r, "primary");
     set->checkerboard = rl_renderer_opt_bool(r, "checkerboard");
     set->accumulate = rl_renderer_opt_bool(r, "accumulate");
@@ -572,7 +586,7 @@ static rl_status pt_render(rl_renderer *r, void *state, const rl_scene *scene, c
     frame f = {
         .s = s,
         .set = &set,
-        .ctx = { .data = d, .b = &s->b, .shadow = set.shadow, .diffuse = set.diffuse,
+        .ctx = { .data = d, .b = &s->b, .shadow = set.shadow, .diffuse = set.diffuse, .specular = set.specular,
                  .max_depth = set.max_depth >= 0 ? set.max_depth : scene_max_depth(scene),
                  .rr_depth = set.rr_depth, .light_samples = set.light_samples, .rr = set.rr,
                  .background = set.background },

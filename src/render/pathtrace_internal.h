@@ -34,6 +34,7 @@ typedef struct pt_settings {
     rl_rng_gpu_kind rng;
     uint64_t seed;
     rl_pt_backend shadow, diffuse;
+    rl_pt_backend specular;        /* mirror and refraction rays (option specular) */
     pt_primary primary;
     rl_filter_kind filter;
     double filter_fade;
@@ -96,6 +97,7 @@ typedef struct pt_ctx {
     const rl_scene_data *data;
     const pt_backends *b;
     rl_pt_backend shadow, diffuse;
+    rl_pt_backend specular;        /* mirror and refraction rays */
     int max_depth, rr_depth, light_samples;
     bool rr;
     rl_vec3 background;            /* radiance of rays that leave the scene */

@@ -317,7 +317,10 @@ rl_vec3 rl_pt_trace_path(const pt_ctx *ctx, const pt_surface *first, rl_rng_gpu 
 
         rl_ray ray = { offset_origin(ctx, &s, dir), 0.0f, dir, INFINITY };
         c->rays[type]++;
-        if (ctx->diffuse == RL_PT_BACKEND_LS_PREILLUM) {
+        /* Sec. 11.2, 12.3: mirror and refraction rays may take another
+         * (exact) backend than the diffuse bounces. */
+        rl_pt_backend backend = type == RL_RAY_DIFFUSE ? ctx->diffuse : ctx->specular;
+        if (backend == RL_PT_BACKEND_LS_PREILLUM) {
             rl_vec3 col;
             ray.t_min = rl_maxf(ray.t_min, ctx->b->ls_start);
             c->trace_q[RL_PT_BACKEND_LS_PREILLUM]++;
@@ -330,7 +333,7 @@ rl_vec3 rl_pt_trace_path(const pt_ctx *ctx, const pt_surface *first, rl_rng_gpu 
             break;
         }
         pt_surface next;
-        if (!rl_pt_closest(ctx, ctx->diffuse, &ray, &next, c)) {
+        if (!rl_pt_closest(ctx, backend, &ray, &next, c)) {
             radiance = rl_add(radiance, rl_mul(T, ctx->background));
             break;
         }
@@ -353,7 +356,7 @@ rl_vec3 rl_pt_preillum_shade(void *user, const rl_ls_surface *rec, rl_vec3 dir)
      * for this (pathtrace_backend.c): the fastest exact structure here, and
      * the build's cost is almost all shadow rays. */
     rl_pt_backend exact = b->exact[RL_ACCEL_BVH] ? RL_PT_BACKEND_BVH : RL_PT_BACKEND_GRID;
-    pt_ctx ctx = { .data = b->data, .b = b, .shadow = exact, .diffuse = exact,
+    pt_ctx ctx = { .data = b->data, .b = b, .shadow = exact, .diffuse = exact, .specular = exact,
                    .light_samples = PREILLUM_QUAD_SAMPLES };
     pt_surface s;
     if (!surface_of_record(b->data, rec, rl_neg(rl_normalize(dir)), &s))

@@ -28,7 +28,7 @@ done
 
 expect_exit 0 "$RL" bench pt --quick --out "$TMP/pt.json"
 [ -s "$TMP/pt.json" ] || fail "pt.json was not written"
-for s in generation scenes diffuse shadow error accumulation ls-pnmt shadowmap kuwahara; do
+for s in generation scenes diffuse shadow error specular accumulation ls-pnmt shadowmap kuwahara; do
     expect_in "$TMP/out" "$s"
 done
 expect_in "$TMP/err" "bench pt: wrote"
@@ -41,8 +41,11 @@ for k in ("renderlab_version", "date", "machine", "parameters", "thesis"):
     assert k in r, "missing key " + k
 p = r["parameters"]
 assert p["quick"] is True and p["size"] == "128x72" and p["error_size"] == "64x36", p
-for name in ("generation", "scenes", "diffuse", "shadow", "error", "accumulation"):
+for name in ("generation", "scenes", "diffuse", "shadow", "error", "specular", "accumulation"):
     assert r[name]["status"] == "ok", "%s: %s" % (name, r[name].get("reason"))
+sp = r["specular"]["variants"]
+assert [v["specular"] for v in sp] == ["exact", "exact", "diffuse", "exact", "diffuse"], sp
+assert all(0 <= v["rmse"] < 1 and v["ms_per_spp"] > 0 for v in sp), sp
 
 g = r["generation"]["rows"]
 assert [(x["voxel_res"], x["n"]) for x in g] == [(8, 4), (8, 5)], g
