@@ -8,6 +8,7 @@
 #include "cli.h"
 
 #include <cjson/cJSON.h>
+#include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -37,6 +38,14 @@ static const char render_help[] =
     "  --id-out FILE.png   object IDs in false colour (background black)\n"
     "  --stats-json FILE   render and scene statistics as JSON\n"
     "\n"
+    "camera paths (the scene's \"camera_path\", e.g. cluster's or a JSON scene's):\n"
+    "  --camera-path       render the path's frames instead of one camera; --out\n"
+    "                      (and --depth-out, --id-out) then hold one integer\n"
+    "                      conversion for the frame number: frames/%%04d.png\n"
+    "  --frames N          N frames spread evenly over the path (first and last key)\n"
+    "  --fps F             frames at 1/F s steps from the first key; default 25\n"
+    "                      (--stats-json: one entry per frame)\n"
+    "\n"
     "example:\n"
     "  rl render cornell --algo raster --size 640x480 --out cornell.png \\\n"
     "     --set raster.shading=flat --depth-out depth.exr --stats-json stats.json\n";
@@ -44,12 +53,49 @@ static const char render_help[] =
 typedef struct render_args {
     const char *scene, *algo, *out, *camera, *depth_out, *id_out, *stats_json;
     bool has_size, has_eye, has_target, has_up, has_fov;
+    bool camera_path;           /* --camera-path */
+    long long frames;           /* --frames, 0: from --fps */
+    double fps;                 /* --fps, 0: default */
     int width, height;
     rl_vec3 eye, target, up;
     float fov_deg;
     const char **sets; /* --set values, pointers into argv */
     int num_sets;
 } render_args;
+
+/* Whether name holds exactly one conversion %d, %Nd or %0Nd (N < 10) and no
+ * other %: a frame file pattern that snprintf fills safely. */
+static bool frame_pattern_ok(const char *name)
+{
+    int conversions = 0;
+    for (const char *p = name; *p; ++p) {
+        if (*p != '%')
+            continue;
+        ++p;
+        if (*p == '0')
+            ++p;
+        if (*p >= '1' && *p <= '9')
+            ++p;
+        if (*p != 'd')
+            return false;
+        ++conversions;
+    }
+    return conversions == 1;
+}
+
+/* The file of frame i for a pattern that passed frame_pattern_ok. */
+static bool frame_name(const char *pattern, long long i, char *out, size_t size)
+{
+#if defined(__GNUC__)
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wformat-nonliteral"
+#endif
+    int n = snprintf(out, size, pattern, (int)i);
+#if defined(__GNUC__)
+#pragma GCC diagnostic pop
+#endif
+    return n > 0 && (size_t)n < size;
+}
 
 /* Returns RL_CLI_OK, an exit code, or -1 when --help was printed. */
 static int parse_args(int argc, char **argv, render_args *a)
@@ -69,6 +115,16 @@ static int parse_args(int argc, char **argv, render_args *a)
         else if (VALUE("--id-out")) a->id_out = v;
         else if (VALUE("--stats-json")) a->stats_json = v;
         else if (VALUE("--set")) a->sets[a->num_sets++] = v;
+        else if (strcmp(argv[i], "--camera-path") == 0) {
+            a->camera_path = true;
+            m = 0;
+        } else if (VALUE("--frames")) {
+            if (m > 0 && (!rl_parse_int(v, &a->frames) || a->frames < 1 || a->frames > 1000000))
+                return cli_fail(RL_CLI_USAGE, "--frames: expected a count in [1, 1000000], got '%s'", v);
+        } else if (VALUE("--fps")) {
+            if (m > 0 && (!rl_parse_float(v, &a->fps) || !(a->fps > 0.0) || a->fps > 10000.0))
+                return cli_fail(RL_CLI_USAGE, "--fps: expected frames per second in (0, 10000], got '%s'", v);
+        }
         else if (VALUE("--size")) {
             if (m > 0 && !cli_parse_size(v, &a->width, &a->height))
                 return RL_CLI_USAGE;
@@ -108,6 +164,22 @@ static int parse_args(int argc, char **argv, render_args *a)
         const char *eq = strchr(a->sets[k], '=');
         if (!eq || eq == a->sets[k])
             return cli_fail(RL_CLI_USAGE, "--set: expected KEY=VALUE, got '%s'", a->sets[k]);
+    }
+    if (!a->camera_path && (a->frames || a->fps > 0.0))
+        return cli_fail(RL_CLI_USAGE, "--frames and --fps go with --camera-path");
+    if (a->camera_path) {
+        if (a->frames && a->fps > 0.0)
+            return cli_fail(RL_CLI_USAGE, "--frames and --fps: give one of them");
+        if (a->camera || a->has_eye || a->has_target || a->has_up || a->has_fov)
+            return cli_fail(RL_CLI_USAGE, "--camera-path: the path sets the camera (no --camera, --eye, "
+                                          "--target, --up, --fov)");
+        const char *patterns[] = { a->out, a->depth_out, a->id_out };
+        const char *names[] = { "--out", "--depth-out", "--id-out" };
+        for (int k = 0; k < 3; k++)
+            if (patterns[k] && !frame_pattern_ok(patterns[k]))
+                return cli_fail(RL_CLI_USAGE, "%s %s: with --camera-path the name holds one integer conversion "
+                                              "for the frame number and no other %%, e.g. frames/%%04d.png",
+                                names[k], patterns[k]);
     }
     return RL_CLI_OK;
 }
@@ -269,6 +341,150 @@ static int render_frame(const render_args *a)
     return rc;
 }
 
+/* One frame's entry of the path's stats JSON. */
+static cJSON *frame_json(long long i, double t, const rl_camera *cam, const char *file, const rl_render_stats *stats)
+{
+    cJSON *e = cli_render_stats_json(stats);
+    if (!e)
+        return NULL;
+    cJSON_AddNumberToObject(e, "frame", (double)i);
+    cJSON_AddNumberToObject(e, "time_s", t);
+    cJSON_AddStringToObject(e, "file", file);
+    const rl_vec3 v[2] = { cam->eye, cam->target };
+    const char *keys[2] = { "eye", "target" };
+    for (int k = 0; k < 2; k++) {
+        cJSON *a = cJSON_AddArrayToObject(e, keys[k]);
+        const double c[3] = { v[k].x, v[k].y, v[k].z };
+        for (int j = 0; a && j < 3; j++)
+            cJSON_AddItemToArray(a, cJSON_CreateNumber(c[j]));
+    }
+    cJSON_AddNumberToObject(e, "fov_deg", cam->fov_deg);
+    return e;
+}
+
+/* --camera-path: the scene's path as frames, one renderer kept across them
+ * (so temporal coherence and kept structures carry over, as in a
+ * walkthrough), files named by the --out pattern. */
+static int render_path(const render_args *a)
+{
+    rl_renderer *renderer = NULL;
+    rl_scene *scene = NULL;
+    rl_image *img = NULL;
+    rl_progress *progress = NULL;
+    cJSON *report = NULL, *frames_json = NULL;
+    /* Formats and folders, checked on frame 0's names before any work. */
+    render_args first = *a;
+    char out0[4096], depth0[4096], ids0[4096];
+    if (!frame_name(a->out, 0, out0, sizeof out0) ||
+        (a->depth_out && !frame_name(a->depth_out, 0, depth0, sizeof depth0)) ||
+        (a->id_out && !frame_name(a->id_out, 0, ids0, sizeof ids0)))
+        return cli_fail(RL_CLI_USAGE, "%s: the frame names are too long", a->out);
+    first.out = out0;
+    first.depth_out = a->depth_out ? depth0 : NULL;
+    first.id_out = a->id_out ? ids0 : NULL;
+    int rc = check_outputs(&first);
+    if (rc == RL_CLI_OK)
+        rc = create_renderer(a, &renderer);
+    if (rc == RL_CLI_OK)
+        rc = cli_load_scene(a->scene, &scene);
+    const rl_scene_data *d = scene ? rl_scene_get_data(scene) : NULL;
+    const rl_camera_path *path = d ? d->camera_path : NULL;
+    if (rc == RL_CLI_OK && !path)
+        rc = cli_fail(RL_CLI_USAGE, "%s: the scene has no camera_path (see docs/scene-format.md)", a->scene);
+    rl_camera size;
+    if (rc == RL_CLI_OK)
+        rc = choose_camera(a, scene, &size);      /* the size: --size, the scene camera's, or the default */
+    /* Frames: --frames N spread evenly over the keys, else 1/fps steps. */
+    double duration = path ? rl_camera_path_duration(path) : 0.0, fps = a->fps > 0.0 ? a->fps : 25.0;
+    long long n = a->frames ? a->frames : (long long)floor(duration * fps + 1e-9) + 1;
+    if (rc == RL_CLI_OK && n > 1000000)
+        rc = cli_fail(RL_CLI_USAGE, "--fps %g over %g s makes %lld frames (at most 1000000)", fps, duration, n);
+    if (rc == RL_CLI_OK) {
+        rl_clear_error();
+        rl_status st = rl_renderer_prepare_inputs(renderer, scene);
+        unsigned layers = RL_LAYER_COLOR | (a->depth_out ? RL_LAYER_DEPTH : 0u) | (a->id_out ? RL_LAYER_ID : 0u);
+        if (st == RL_OK)
+            st = rl_image_create(size.width, size.height, layers, &img);
+        if (st != RL_OK)
+            rc = cli_fail_status(RL_CLI_FAIL, st, "render");
+    }
+    if (rc == RL_CLI_OK && a->stats_json) {
+        report = cJSON_CreateObject();
+        if (report) {
+            cJSON_AddStringToObject(report, "algorithm", a->algo);
+            cJSON_AddStringToObject(report, "scene", a->scene);
+            cJSON_AddNumberToObject(report, "width", size.width);
+            cJSON_AddNumberToObject(report, "height", size.height);
+            cJSON_AddNumberToObject(report, "duration_s", duration);
+            cJSON *ss = cli_scene_stats_json(scene);
+            if (ss)
+                cJSON_AddItemToObject(report, "scene_stats", ss);
+            frames_json = cJSON_AddArrayToObject(report, "frames");
+        }
+        if (!frames_json)
+            rc = cli_fail(RL_CLI_FAIL, "out of memory");
+    }
+    if (rc == RL_CLI_OK) {
+        char label[256];
+        snprintf(label, sizeof label, "render %s, %lld frames", a->scene, n);
+        if (rl_log_get_level() >= RL_LOG_INFO)
+            rl_progress_create(label, stderr, &progress);
+    }
+    double total_ms = 0.0, max_ms = 0.0;
+    for (long long i = 0; rc == RL_CLI_OK && i < n; i++) {
+        double t = a->frames ? (n > 1 ? duration * (double)i / (double)(n - 1) : 0.0) : (double)i / fps;
+        rl_camera cam = rl_camera_path_eval(path, rl_camera_path_key(path, 0)->time_s + t);
+        cam.width = size.width;
+        cam.height = size.height;
+        cam = rl_camera_resolve(&cam);
+        rl_render_stats stats = { 0 };
+        render_args fa = *a;
+        char out[4096], depth[4096], ids[4096];
+        bool named = frame_name(a->out, i, out, sizeof out) &&
+                     (!a->depth_out || frame_name(a->depth_out, i, depth, sizeof depth)) &&
+                     (!a->id_out || frame_name(a->id_out, i, ids, sizeof ids));
+        if (!named) {
+            rc = cli_fail(RL_CLI_USAGE, "%s: frame %lld's name is too long", a->out, i);
+            break;
+        }
+        fa.out = out;
+        fa.depth_out = a->depth_out ? depth : NULL;
+        fa.id_out = a->id_out ? ids : NULL;
+        fa.stats_json = NULL;
+        rl_clear_error();
+        rl_status st = rl_renderer_render(renderer, scene, &cam, img, &stats);
+        if (st != RL_OK) {
+            char what[64];
+            snprintf(what, sizeof what, "render, frame %lld", i);
+            rc = cli_fail_status(RL_CLI_FAIL, st, what);
+            break;
+        }
+        rc = write_outputs(&fa, scene, img, &stats);
+        total_ms += stats.time_ms;
+        max_ms = stats.time_ms > max_ms ? stats.time_ms : max_ms;
+        if (rc == RL_CLI_OK && frames_json) {
+            cJSON *e = frame_json(i, t, &cam, out, &stats);
+            if (!e)
+                rc = cli_fail(RL_CLI_FAIL, "out of memory");
+            else
+                cJSON_AddItemToArray(frames_json, e);
+        }
+        if (progress)
+            rl_progress_update(progress, (double)(i + 1) / (double)n);
+    }
+    rl_progress_finish(progress);
+    if (rc == RL_CLI_OK && report && !cli_write_json(report, a->stats_json))
+        rc = RL_CLI_FAIL;
+    if (rc == RL_CLI_OK)
+        printf("%s %dx%d %s: %lld frames of %.3g s, %.1f ms per frame (max %.1f), %s\n", rl_renderer_name(renderer),
+               size.width, size.height, a->scene, n, duration, total_ms / (double)n, max_ms, a->out);
+    cJSON_Delete(report);
+    rl_image_release(img);
+    rl_scene_release(scene);
+    rl_renderer_release(renderer);
+    return rc;
+}
+
 int cli_render(int argc, char **argv)
 {
     render_args a = { .algo = "raster" };
@@ -277,7 +493,7 @@ int cli_render(int argc, char **argv)
         return cli_fail(RL_CLI_FAIL, "out of memory");
     int rc = parse_args(argc, argv, &a);
     if (rc == RL_CLI_OK)
-        rc = render_frame(&a);
+        rc = a.camera_path ? render_path(&a) : render_frame(&a);
     free(a.sets);
     return rc < 0 ? RL_CLI_OK : rc;
 }

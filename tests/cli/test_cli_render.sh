@@ -86,6 +86,45 @@ printf 'v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n' >"$TMP/tri.obj"
 run_ok "$RL" render "$TMP/tri.obj" --out "$TMP/tri.png"
 expect_png "$TMP/tri.png" 1280x720
 
+# Camera paths: the scene's camera_path as frames, named by the --out
+# pattern, any renderer, one stats entry per frame; the path's keys are the
+# first and last frame's cameras.
+cat >"$TMP/walk.json" <<'JSON'
+{ "name": "walk", "base": "cornell",
+  "camera_path": { "keys": [
+    { "time_s": 0, "eye": [0.28, 0.27, -0.8], "target": [0.28, 0.27, 0] },
+    { "time_s": 1, "eye": [0.6, 0.4, -0.6], "target": [0.28, 0.2, 0.28], "fov_deg": 50 } ] } }
+JSON
+mkdir -p "$TMP/frames"
+run_ok "$RL" render "$TMP/walk.json" --camera-path --frames 4 --size 40x30 --algo whitted \
+    --out "$TMP/frames/f%03d.png" --depth-out "$TMP/frames/d%03d.exr" --stats-json "$TMP/walk.json.stats"
+for i in 000 001 002 003; do expect_png "$TMP/frames/f$i.png" 40x30; [ -s "$TMP/frames/d$i.exr" ] || fail "d$i.exr missing"; done
+[ ! -e "$TMP/frames/f004.png" ] || fail "--frames 4 wrote a fifth frame"
+expect_in "$TMP/out" "4 frames"
+python3 - "$TMP/walk.json.stats" "$TMP/frames" <<'PY' || fail "the camera path's stats are wrong"
+import json, sys
+r = json.load(open(sys.argv[1]))
+f = r["frames"]
+assert r["algorithm"] == "whitted" and len(f) == 4 and r["duration_s"] == 1, r
+assert [x["frame"] for x in f] == [0, 1, 2, 3] and abs(f[3]["time_s"] - 1) < 1e-9, f
+assert max(abs(a - b) for a, b in zip(f[0]["eye"], [0.28, 0.27, -0.8])) < 1e-6, f[0]
+assert max(abs(a - b) for a, b in zip(f[3]["eye"], [0.6, 0.4, -0.6])) < 1e-6, f[3]
+assert abs(f[3]["fov_deg"] - 50) < 1e-4 and f[1]["eye"] != f[2]["eye"], f
+assert all(x["time_ms"] >= 0 and x["file"].endswith("f%03d.png" % x["frame"]) for x in f), f
+PY
+# Frames differ along the path; --fps counts frames from the duration.
+cmp -s "$TMP/frames/f000.png" "$TMP/frames/f003.png" && fail "the first and last frame are the same"
+run_ok "$RL" render "$TMP/walk.json" --camera-path --fps 4 --size 16x12 --out "$TMP/frames/g%d.png"
+for i in 0 1 2 3 4; do expect_png "$TMP/frames/g$i.png" 16x12; done
+[ ! -e "$TMP/frames/g5.png" ] || fail "--fps 4 over 1 s wrote more than 5 frames"
+expect_error 2 "no camera_path" "$RL" render cornell --camera-path --out "$TMP/frames/x%d.png"
+expect_error 2 "integer conversion" "$RL" render "$TMP/walk.json" --camera-path --out "$TMP/frames/x.png"
+expect_error 2 "integer conversion" "$RL" render "$TMP/walk.json" --camera-path --out "$TMP/frames/x%s%d.png"
+expect_error 2 "go with --camera-path" "$RL" render "$TMP/walk.json" --frames 3 --out "$TMP/x.png"
+expect_error 2 "one of them" "$RL" render "$TMP/walk.json" --camera-path --frames 3 --fps 2 --out "$TMP/frames/x%d.png"
+expect_error 2 "the path sets the camera" "$RL" render "$TMP/walk.json" --camera-path --eye 0,0,0 \
+    --out "$TMP/frames/x%d.png"
+
 # rl info: text and JSON.
 run_ok "$RL" info cornell
 grep -Eq '^triangles +36$' "$TMP/out" || fail "rl info cornell should show 36 triangles: $(cat "$TMP/out")"
