@@ -783,111 +783,119 @@ static void chain_free(rank_chain *c)
     free(c->base_cand);
 }
 
-rl_status rl_ls_build(rl_linespace *ls)
+/* What one build holds besides the Line Space itself, released together
+ * by build_free(). */
+typedef struct build_ctx {
+    uint32_t blocks;              /* filled voxels */
+    uint64_t shafts;              /* blocks x shafts per voxel */
+    bool want_cand;
+    int threads;
+    uint32_t *cells;              /* block -> grid cell */
+    uint32_t **dyn;               /* dynamic lists per block, or NULL */
+    uint64_t *dyn_count;
+    list_arena *arenas;           /* per thread, with dynamic lists */
+    rank_chain chain;
+    rl_ls_geometry geo;
+} build_ctx;
+
+static void build_free(build_ctx *b)
 {
-    rl_timer total;
-    rl_timer_start(&total);
+    if (b->arenas)
+        for (int t = 0; t < b->threads; ++t)
+            arena_free(&b->arenas[t]);
+    free(b->arenas);
+    free(b->dyn);
+    free(b->dyn_count);
+    free(b->cells);
+    chain_free(&b->chain);
+    rl_ls_geometry_free(&b->geo);
+}
+
+/* The voxel slots (a block per filled voxel), the rank chain and every
+ * per-shaft array, sized for all shafts: they are shrunk to the occupied
+ * ones afterwards, and only the pages written are ever faulted in. */
+static rl_status build_alloc(rl_linespace *ls, build_ctx *b)
+{
     const rl_grid *g = ls->grid;
-    const uint32_t S = ls->shafts_per_voxel;
     ls->num_cells = g->num_cells;
     ls->voxel_slot = malloc((size_t)g->num_cells * sizeof *ls->voxel_slot);
     if (!ls->voxel_slot)
-        return rl_error(RL_ERR_OUT_OF_MEMORY, "linespace: out of memory for %u voxel slots",
-                        g->num_cells);
+        return rl_error(RL_ERR_OUT_OF_MEMORY, "linespace: out of memory for %u voxel slots", g->num_cells);
     uint32_t blocks = 0;
     for (uint32_t c = 0; c < g->num_cells; ++c)
         ls->voxel_slot[c] = g->cell_start[c + 1] > g->cell_start[c] ? blocks++ : RL_NONE;
     ls->num_blocks = blocks;
-    uint64_t shafts = (uint64_t)blocks * S;
-    if (shafts > UINT32_MAX - 1u)
-        return rl_error(RL_ERR_LIMIT,
-                        "linespace: %u filled voxels x %u shafts = %llu shafts exceed 2^32-1", blocks,
-                        S, (unsigned long long)shafts);
-    uint32_t *cells = malloc((size_t)(blocks ? blocks : 1) * sizeof *cells);
-    uint32_t **dyn = NULL;
-    uint64_t *dyn_count = NULL;
-    bool want_cand = (ls->payloads & RL_LS_CANDIDATES) != 0;
-    if (!cells)
-        return rl_error(RL_ERR_OUT_OF_MEMORY, "linespace: out of memory");
-    for (uint32_t c = 0; c < g->num_cells; ++c)
-        if (ls->voxel_slot[c] != RL_NONE)
-            cells[ls->voxel_slot[c]] = c;
-    /* Per-shaft arrays are sized for every shaft and shrunk to the occupied
-     * ones afterwards: only the pages written are ever faulted in. */
-    size_t nb = (size_t)(blocks ? blocks : 1);
-    rank_chain chain = { .blocks = blocks };
-    chain.occ = malloc(nb * sizeof *chain.occ);
-    chain.cand = malloc(nb * sizeof *chain.cand);
-    chain.known = calloc(nb, 1);
-    chain.base_occ = malloc((nb + 1) * sizeof *chain.base_occ);
-    chain.base_cand = malloc((nb + 1) * sizeof *chain.base_cand);
-    atomic_init(&chain.frontier, 0u);
-    rl_status st = chain.occ && chain.cand && chain.known && chain.base_occ && chain.base_cand
-                       ? RL_OK
-                       : RL_ERR_OUT_OF_MEMORY;
-    if (!st) {
-        chain.base_occ[0] = chain.base_cand[0] = 0;
-        if (want_cand && ls->dynamic) {
-            ls->cand_start = rl_big_alloc(((size_t)shafts + 1) * sizeof *ls->cand_start, ls->huge_pages);
-            dyn = calloc(nb, sizeof *dyn);
-            dyn_count = calloc(nb, sizeof *dyn_count);
-            if (!ls->cand_start || !dyn || !dyn_count)
-                st = RL_ERR_OUT_OF_MEMORY;
-        } else if (want_cand) {
-            ls->cand = rl_big_alloc((size_t)(shafts ? shafts : 1) * (size_t)ls->k * sizeof *ls->cand,
-                                    ls->huge_pages);
-            if (!ls->cand)
-                st = RL_ERR_OUT_OF_MEMORY;
-        }
-    }
-    if (!st && (ls->payloads & RL_LS_PNMT) &&
-        !(ls->pnmt = rl_big_alloc((size_t)(shafts ? shafts : 1) * 16 * sizeof *ls->pnmt, ls->huge_pages)))
-        st = RL_ERR_OUT_OF_MEMORY;
-    if (!st && (ls->payloads & RL_LS_PREILLUM) &&
-        !(ls->preillum = rl_big_alloc((size_t)(shafts ? shafts : 1) * 8 * sizeof *ls->preillum,
-                                       ls->huge_pages)))
-        st = RL_ERR_OUT_OF_MEMORY;
-    if (!st && !rl_ls_occupancy_alloc(ls))
-        st = RL_ERR_OUT_OF_MEMORY;
-    int threads = ls->threads;
+    b->blocks = blocks;
+    b->shafts = (uint64_t)blocks * ls->shafts_per_voxel;
+    if (b->shafts > UINT32_MAX - 1u)
+        return rl_error(RL_ERR_LIMIT, "linespace: %u filled voxels x %u shafts = %llu shafts exceed 2^32-1", blocks,
+                        ls->shafts_per_voxel, (unsigned long long)b->shafts);
+    b->want_cand = (ls->payloads & RL_LS_CANDIDATES) != 0;
 #ifdef _OPENMP
-    if (threads <= 0)
-        threads = omp_get_max_threads();
+    b->threads = ls->threads > 0 ? ls->threads : omp_get_max_threads();
 #else
-    threads = 1;
+    b->threads = 1;
 #endif
-    list_arena *arenas = NULL;
-    if (!st && dyn && !(arenas = calloc((size_t)threads, sizeof *arenas)))
-        st = RL_ERR_OUT_OF_MEMORY;
-    rl_ls_geometry geo = { 0 };
-    if (!st)
-        st = rl_ls_geometry_init(&geo, ls->n);
-    if (st) {
-        free(cells);
-        free(dyn);
-        free(dyn_count);
-        free(arenas);
-        chain_free(&chain);
-        return rl_error(RL_ERR_OUT_OF_MEMORY, "linespace: out of memory for %llu shafts",
-                        (unsigned long long)shafts);
+    size_t nb = (size_t)(blocks ? blocks : 1), shafts = (size_t)(b->shafts ? b->shafts : 1);
+    b->cells = malloc(nb * sizeof *b->cells);
+    b->chain = (rank_chain){ .blocks = blocks };
+    b->chain.occ = malloc(nb * sizeof *b->chain.occ);
+    b->chain.cand = malloc(nb * sizeof *b->chain.cand);
+    b->chain.known = calloc(nb, 1);
+    b->chain.base_occ = malloc((nb + 1) * sizeof *b->chain.base_occ);
+    b->chain.base_cand = malloc((nb + 1) * sizeof *b->chain.base_cand);
+    atomic_init(&b->chain.frontier, 0u);
+    bool ok = b->cells && b->chain.occ && b->chain.cand && b->chain.known && b->chain.base_occ &&
+              b->chain.base_cand;
+    if (ok) {
+        for (uint32_t c = 0; c < g->num_cells; ++c)
+            if (ls->voxel_slot[c] != RL_NONE)
+                b->cells[ls->voxel_slot[c]] = c;
+        b->chain.base_occ[0] = b->chain.base_cand[0] = 0;
     }
+    if (ok && b->want_cand && ls->dynamic) {
+        ls->cand_start = rl_big_alloc((shafts + 1) * sizeof *ls->cand_start, ls->huge_pages);
+        b->dyn = calloc(nb, sizeof *b->dyn);
+        b->dyn_count = calloc(nb, sizeof *b->dyn_count);
+        b->arenas = calloc((size_t)b->threads, sizeof *b->arenas);
+        ok = ls->cand_start && b->dyn && b->dyn_count && b->arenas;
+    } else if (ok && b->want_cand) {
+        ok = (ls->cand = rl_big_alloc(shafts * (size_t)ls->k * sizeof *ls->cand, ls->huge_pages)) != NULL;
+    }
+    if (ok && (ls->payloads & RL_LS_PNMT))
+        ok = (ls->pnmt = rl_big_alloc(shafts * 16 * sizeof *ls->pnmt, ls->huge_pages)) != NULL;
+    if (ok && (ls->payloads & RL_LS_PREILLUM))
+        ok = (ls->preillum = rl_big_alloc(shafts * 8 * sizeof *ls->preillum, ls->huge_pages)) != NULL;
+    if (ok)
+        ok = rl_ls_occupancy_alloc(ls);
+    if (ok)
+        ok = rl_ls_geometry_init(&b->geo, ls->n) == RL_OK;
+    return ok ? RL_OK
+              : rl_error(RL_ERR_OUT_OF_MEMORY, "linespace: out of memory for %llu shafts",
+                         (unsigned long long)b->shafts);
+}
+
+/* The pass over the filled voxels (Sec. 7.1, 7.4): per block its shafts'
+ * lists, published to the rank chain, and its records. Returns 0, or 1 (out
+ * of memory) or 2 (cancelled); fills the fill statistics and the threads'
+ * time spent in the payloads. */
+static int build_pass(rl_linespace *ls, build_ctx *b, voxel_stats *total_vs, double *pnmt_s, double *preillum_s)
+{
+    const uint32_t S = ls->shafts_per_voxel, blocks = b->blocks;
+    rank_chain *chain = &b->chain;
     atomic_int failed = 0;        /* 1: out of memory, 2: cancelled */
     atomic_uint next = 0, done = 0;
-    voxel_stats total_vs = { 0 };
-    double pnmt_s = 0.0, preillum_s = 0.0;
-    rl_timer pass;
-    rl_timer_start(&pass);
-    #pragma omp parallel num_threads(threads)
+    #pragma omp parallel num_threads(b->threads)
     {
         workspace w;
         voxel_stats vs = { 0 };
         if (!ws_init(&w, S, ls->n, ls->k))
             atomic_store(&failed, 1);
         bool main_thread = true;
-        list_arena *arena = arenas;
+        list_arena *arena = b->arenas;
 #ifdef _OPENMP
         main_thread = omp_get_thread_num() == 0;
-        if (arenas)
+        if (b->arenas)
             arena += omp_get_thread_num();
 #endif
         /* Blocks are claimed in increasing order, so the frontier always
@@ -897,26 +905,26 @@ rl_status rl_ls_build(rl_linespace *ls)
             uint32_t bi = atomic_fetch_add(&next, 1u);
             if (bi >= blocks || atomic_load(&failed))
                 break;
-            w.cell = cells[bi];
-            if (!build_lists(ls, &geo, &w, bi, cells[bi], arena, dyn ? &dyn[bi] : NULL,
-                             dyn ? &dyn_count[bi] : NULL, &vs)) {
+            w.cell = b->cells[bi];
+            if (!build_lists(ls, &b->geo, &w, bi, b->cells[bi], arena, b->dyn ? &b->dyn[bi] : NULL,
+                             b->dyn ? &b->dyn_count[bi] : NULL, &vs)) {
                 atomic_store(&failed, 1);
                 break;
             }
-            uint32_t f = chain_publish(&chain, bi, w.occupied, dyn ? dyn_count[bi] : 0);
+            uint32_t f = chain_publish(chain, bi, w.occupied, b->dyn ? b->dyn_count[bi] : 0);
             rec_dst dst;
             bool placed = bi <= f;
             if (placed)
-                final_dst(ls, &chain, bi, &dst);
+                final_dst(ls, chain, bi, &dst);
             else if (!stage_block(ls, &w.stage, bi, w.occupied, &dst)) {
                 atomic_store(&failed, 1);
                 break;
             }
-            write_records(ls, &geo, &w, &dst, &vs);
+            write_records(ls, &b->geo, &w, &dst, &vs);
             if (placed)
-                write_rank(ls, bi, chain.base_occ[bi]);
+                write_rank(ls, bi, chain->base_occ[bi]);
             if (w.stage.npending)
-                stage_flush(ls, &w.stage, &chain);
+                stage_flush(ls, &w.stage, chain);
             unsigned d = atomic_fetch_add(&done, 1u) + 1u;
             if (ls->progress && main_thread && !ls->progress(ls->user, 0.95 * d / (double)blocks))
                 atomic_store(&failed, 2);
@@ -924,24 +932,23 @@ rl_status rl_ls_build(rl_linespace *ls)
         /* The staged blocks wait only for blocks other threads have
          * already claimed. */
         while (w.stage.npending && !atomic_load(&failed)) {
-            stage_flush(ls, &w.stage, &chain);
+            stage_flush(ls, &w.stage, chain);
             if (w.stage.npending)
                 sched_yield();
         }
         #pragma omp critical(rl_ls_stats)
         {
-            total_vs.empty += vs.empty;
-            total_vs.stored += vs.stored;
-            total_vs.truncated += vs.truncated;
-            total_vs.sum += vs.sum;
-            if (vs.max > total_vs.max)
-                total_vs.max = vs.max;
-            pnmt_s += w.pnmt_s;
-            preillum_s += w.preillum_s;
+            total_vs->empty += vs.empty;
+            total_vs->stored += vs.stored;
+            total_vs->truncated += vs.truncated;
+            total_vs->sum += vs.sum;
+            if (vs.max > total_vs->max)
+                total_vs->max = vs.max;
+            *pnmt_s += w.pnmt_s;
+            *preillum_s += w.preillum_s;
         }
         ws_free(&w);
     }
-    double pass_ms = rl_timer_ms(&pass);
     int fail = atomic_load(&failed);
     /* Only the main thread reports inside the pass, and under dynamic
      * scheduling it may have built no block at all (a busy machine, few
@@ -949,46 +956,59 @@ rl_status rl_ls_build(rl_linespace *ls)
      * missed. */
     if (!fail && ls->progress && !ls->progress(ls->user, 0.95))
         fail = 2;
-    uint64_t occupied = fail ? 0 : chain.base_occ[blocks];
-    if (!fail && dyn) {
-        /* Sec. 7.1.1's prefix sum: the chain has summed the blocks' list
-         * lengths and the offsets are already global; the lists are copied
-         * into place in parallel. */
-        uint64_t sum = chain.base_cand[blocks];
+    return fail;
+}
+
+/* After the pass: the dynamic lists copied into place (Sec. 7.1.1's prefix
+ * sum: the chain has summed the blocks' list lengths and the offsets are
+ * already global), then every per-shaft array shrunk to the occupied
+ * shafts. Returns 0, 1 (out of memory) or 3 (over 2^32-1 candidates). */
+static int build_gather(rl_linespace *ls, build_ctx *b)
+{
+    uint64_t occupied = b->chain.base_occ[b->blocks];
+    if (b->dyn) {
+        uint64_t sum = b->chain.base_cand[b->blocks];
         if (sum > UINT32_MAX)
-            fail = 3;
-        if (!fail) {
-            ls->num_cand = sum;
-            ls->cand_start[occupied] = (uint32_t)sum;
-            ls->cand = rl_big_alloc((size_t)(sum ? sum : 1) * sizeof *ls->cand, ls->huge_pages);
-            if (!ls->cand)
-                fail = 1;
-        }
-        if (!fail) {
-            #pragma omp parallel for num_threads(threads) schedule(dynamic, 16)
-            for (long bi = 0; bi < (long)blocks; ++bi)
-                memcpy(ls->cand + chain.base_cand[bi], dyn[bi], (size_t)dyn_count[bi] * sizeof *ls->cand);
-        }
+            return 3;
+        ls->num_cand = sum;
+        ls->cand_start[occupied] = (uint32_t)sum;
+        ls->cand = rl_big_alloc((size_t)(sum ? sum : 1) * sizeof *ls->cand, ls->huge_pages);
+        if (!ls->cand)
+            return 1;
+        #pragma omp parallel for num_threads(b->threads) schedule(dynamic, 16)
+        for (long bi = 0; bi < (long)b->blocks; ++bi)
+            memcpy(ls->cand + b->chain.base_cand[bi], b->dyn[bi], (size_t)b->dyn_count[bi] * sizeof *ls->cand);
     }
-    if (!fail) {
-        ls->num_occupied = occupied;
-        shrink((void **)&ls->cand_start, ls->cand_start ? occupied + 1 : 0, sizeof *ls->cand_start);
-        shrink((void **)&ls->pnmt, occupied * 16, sizeof *ls->pnmt);
-        shrink((void **)&ls->preillum, occupied * 8, sizeof *ls->preillum);
-        if (want_cand && !ls->dynamic) {
-            ls->num_cand = occupied * (uint64_t)ls->k;
-            shrink((void **)&ls->cand, ls->num_cand, sizeof *ls->cand);
-        }
+    ls->num_occupied = occupied;
+    shrink((void **)&ls->cand_start, ls->cand_start ? occupied + 1 : 0, sizeof *ls->cand_start);
+    shrink((void **)&ls->pnmt, occupied * 16, sizeof *ls->pnmt);
+    shrink((void **)&ls->preillum, occupied * 8, sizeof *ls->preillum);
+    if (b->want_cand && !ls->dynamic) {
+        ls->num_cand = occupied * (uint64_t)ls->k;
+        shrink((void **)&ls->cand, ls->num_cand, sizeof *ls->cand);
     }
-    if (arenas)
-        for (int t = 0; t < threads; ++t)
-            arena_free(&arenas[t]);
-    free(arenas);
-    free(dyn);
-    free(dyn_count);
-    free(cells);
-    chain_free(&chain);
-    rl_ls_geometry_free(&geo);
+    return 0;
+}
+
+rl_status rl_ls_build(rl_linespace *ls)
+{
+    rl_timer total;
+    rl_timer_start(&total);
+    build_ctx b = { 0 };
+    rl_status st = build_alloc(ls, &b);
+    if (st != RL_OK) {
+        build_free(&b);
+        return st;
+    }
+    voxel_stats vs = { 0 };
+    double pnmt_s = 0.0, preillum_s = 0.0;
+    rl_timer pass;
+    rl_timer_start(&pass);
+    int fail = build_pass(ls, &b, &vs, &pnmt_s, &preillum_s);
+    double pass_ms = rl_timer_ms(&pass);
+    if (!fail)
+        fail = build_gather(ls, &b);
+    build_free(&b);
     if (fail == 1)
         return rl_error(RL_ERR_OUT_OF_MEMORY, "linespace: out of memory during the build");
     if (fail == 2)
@@ -997,21 +1017,20 @@ rl_status rl_ls_build(rl_linespace *ls)
         return rl_error(RL_ERR_LIMIT, "linespace: more than 2^32-1 candidates");
     if (ls->progress)
         ls->progress(ls->user, 1.0);
-    rl_linespace_stats *st2 = &ls->stats;
-    st2->filled_voxels = blocks;
-    st2->shafts = shafts;
-    st2->empty_shafts = total_vs.empty;
-    st2->candidates = total_vs.stored;
-    st2->max_candidates = total_vs.max;
-    st2->mean_candidates =
-        shafts > total_vs.empty ? (double)total_vs.sum / (double)(shafts - total_vs.empty) : 0.0;
-    st2->truncated_shafts = total_vs.truncated;
-    st2->build_ms = rl_timer_ms(&total);
+    rl_linespace_stats *out = &ls->stats;
+    out->filled_voxels = b.blocks;
+    out->shafts = b.shafts;
+    out->empty_shafts = vs.empty;
+    out->candidates = vs.stored;
+    out->max_candidates = vs.max;
+    out->mean_candidates = b.shafts > vs.empty ? (double)vs.sum / (double)(b.shafts - vs.empty) : 0.0;
+    out->truncated_shafts = vs.truncated;
+    out->build_ms = rl_timer_ms(&total);
     /* The payloads share one pass over the voxels: split its wall time by
      * the threads' time shares. */
-    double thread_ms = pass_ms * threads;
-    st2->pnmt_ms = thread_ms > 0.0 ? pass_ms * (pnmt_s / thread_ms) : 0.0;
-    st2->preillum_ms = thread_ms > 0.0 ? pass_ms * (preillum_s / thread_ms) : 0.0;
-    st2->candidates_ms = st2->build_ms - st2->pnmt_ms - st2->preillum_ms;
+    double thread_ms = pass_ms * b.threads;
+    out->pnmt_ms = thread_ms > 0.0 ? pass_ms * (pnmt_s / thread_ms) : 0.0;
+    out->preillum_ms = thread_ms > 0.0 ? pass_ms * (preillum_s / thread_ms) : 0.0;
+    out->candidates_ms = out->build_ms - out->pnmt_ms - out->preillum_ms;
     return RL_OK;
 }
