@@ -972,14 +972,8 @@ int bench_culling(int argc, char **argv)
     int rc = parse_args(argc, argv, &a);
     if (rc != RL_CLI_OK)
         return rc == RL_BENCH_HELP_SHOWN ? RL_CLI_OK : rc;
-    char out_buf[1024];
-    const char *out = a.out;
-    if (!out) {
-        if (!bench_default_out("culling", out_buf, sizeof out_buf))
-            return RL_CLI_FAIL;
-        out = out_buf;
-    }
-    if (!cli_check_writable(out))
+    char out[1024];               /* its folder goes to c.dir, of this size */
+    if (!bench_out_path(a.out, "culling", out, sizeof out))
         return RL_CLI_FAIL;
     bc_ctx c = { .a = &a, .frames = a.quick ? "1" : "3" };
     snprintf(c.dir, sizeof c.dir, "%s", out);

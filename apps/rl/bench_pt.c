@@ -1477,10 +1477,8 @@ int bench_pt(int argc, char **argv)
     b.runs = a.quick ? 1 : RUNS;
     b.max_memory_bytes = a.max_memory_gb > 0 ? (double)a.max_memory_gb * 1073741824.0
                                                : 0.6 * physical_memory();
-    char out[256];
-    if (a.out)
-        snprintf(out, sizeof out, "%s", a.out);
-    if (a.out ? !cli_check_writable(out) : !bench_default_out("pt", out, sizeof out))
+    char out[4096];
+    if (!bench_out_path(a.out, "pt", out, sizeof out))
         return RL_CLI_FAIL;
     rl_renderer *probe = NULL;
     rl_clear_error();

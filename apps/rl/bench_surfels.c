@@ -348,14 +348,8 @@ int bench_surfels(int argc, char **argv)
     int rc = parse_args(argc, argv, &a);
     if (rc != RL_CLI_OK)
         return rc == RL_BENCH_HELP_SHOWN ? RL_CLI_OK : rc;
-    char out_buf[512];
-    const char *out = a.out;
-    if (!out) {
-        if (!bench_default_out("surfels", out_buf, sizeof out_buf))
-            return RL_CLI_FAIL;
-        out = out_buf;
-    }
-    if (!cli_check_writable(out))
+    char out[4096];
+    if (!bench_out_path(a.out, "surfels", out, sizeof out))
         return RL_CLI_FAIL;
     bsf_ctx c = { .a = &a };
     if ((rc = cli_load_scene(a.scene, &c.scene)) != RL_CLI_OK)

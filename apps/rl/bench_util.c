@@ -120,6 +120,17 @@ bool bench_default_out(const char *prefix, char *path, size_t size)
     return cli_make_dirs("bench/results");
 }
 
+bool bench_out_path(const char *given, const char *prefix, char *path, size_t size)
+{
+    if (!given)
+        return bench_default_out(prefix, path, size);
+    if ((size_t)snprintf(path, size, "%s", given) >= size) {
+        cli_fail(RL_CLI_USAGE, "--out: path longer than %zu characters", size - 1);
+        return false;
+    }
+    return cli_check_writable(path);
+}
+
 int bench_run_sections(const char *bench, cJSON *root, const char *const *names,
                           const bench_section_fn *fns, int count, unsigned wanted, void *ctx,
                           char *reason, int threads, const char *out)

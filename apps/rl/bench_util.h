@@ -37,6 +37,10 @@ bool bench_parse_sections(const char *text, const char *const *names, int count,
                              unsigned *sections);
 /* bench/results/PREFIX-YYYYMMDD-HHMMSS.json (UTC), creating the folder. */
 bool bench_default_out(const char *prefix, char *path, size_t size);
+/* Where a benchmark writes its record: --out (given, may be NULL) when its
+ * folder is writable, else the default name above; into path (size bytes).
+ * False (error printed) for a path too long or not writable. */
+bool bench_out_path(const char *given, const char *prefix, char *path, size_t size);
 
 /* One section: fills sec; on failure may write why into the reason buffer
  * given to bench_run_sections (else rl_last_error() is recorded). */

@@ -1251,10 +1251,8 @@ static cJSON *report_root(const bvt *b)
 static int run(bvt *b)
 {
     const bvt_args *a = b->a;
-    char out[256];
-    if (a->out)
-        snprintf(out, sizeof out, "%s", a->out);
-    if (a->out ? !cli_check_writable(out) : !bench_default_out("vt", out, sizeof out))
+    char out[4096];
+    if (!bench_out_path(a->out, "vt", out, sizeof out))
         return RL_CLI_FAIL;
     /* The renderers first: the record is worthless without them. */
     const char *const names[] = { "vt", "whitted" };

@@ -533,10 +533,8 @@ static void print_scene(const bench_scene_result *sc)
 
 static int run(bench_args *a)
 {
-    char out[256];
-    if (a->out)
-        snprintf(out, sizeof out, "%s", a->out);
-    if (a->out ? !cli_check_writable(out) : !bench_default_out("rays", out, sizeof out))
+    char out[4096];
+    if (!bench_out_path(a->out, "rays", out, sizeof out))
         return RL_CLI_FAIL;
 
     bench_params p = {
