@@ -466,104 +466,89 @@ static cJSON *result_json(const compare_args *a, const rl_scene *scene, const rl
     return root;
 }
 
-int cli_compare(int argc, char **argv)
+/* Everything a typo can break, checked before the long part: each metric
+ * property of each renderer can be made. */
+static int check_metrics(const compare_args *a)
 {
-    compare_args a = { 0 };
-    int rc = parse_args(argc, argv, &a);
-    if (rc != RL_CLI_OK) {
-        free_args(&a);
-        return rc < 0 ? RL_CLI_OK : rc;
-    }
-    char report[4096], json_path[4096];
-    snprintf(report, sizeof report, "%s/report.html", a.out);
-    snprintf(json_path, sizeof json_path, "%s/compare.json", a.out);
-    rl_scene *scene = NULL;
-    rl_property *vis = NULL;
-    rl_approx *driver = NULL;
-    rl_vec3 *pos = NULL;
-    rl_image *top = NULL;
-    measured (*res)[M_COUNT] = calloc(MAX_ALGOS, sizeof *res);
-    if (!res) {
-        rc = cli_fail(RL_CLI_FAIL, "out of memory");
-        goto done;
-    }
-    /* Everything a typo can break is checked before the long part. */
-    for (int i = 0; i < a.num_algos; i++)
+    for (int i = 0; i < a->num_algos; i++)
         for (int m = 0; m < M_COUNT; m++) {
-            rl_property *p = (a.metrics & (1u << m)) ? metric_property(&a, m, &a.algos[i]) : NULL;
-            if ((a.metrics & (1u << m)) && !p) {
-                rc = RL_CLI_USAGE;
-                goto done;
-            }
+            if (!(a->metrics & (1u << m)))
+                continue;
+            rl_property *p = metric_property(a, m, &a->algos[i]);
+            if (!p)
+                return RL_CLI_USAGE;
             rl_property_release(p);
         }
-    if (!cli_make_dirs(a.out) || !cli_check_writable(report)) {
-        rc = RL_CLI_FAIL;
-        goto done;
-    }
-    if ((rc = cli_load_scene(a.scene, &scene)) != RL_CLI_OK)
-        goto done;
-    if (!eval_sampling_finish(&a.sampling, scene)) {
-        rc = RL_CLI_USAGE;
-        goto done;
-    }
+    return RL_CLI_OK;
+}
+
+/* The shared positions (Jähn 2015, Ch. 5): adaptive or grid sampling of
+ * pixel visibility places them; every renderer is measured at the same. */
+static int place_samples(compare_args *a, const rl_scene *scene, rl_approx **driver, rl_vec3 **pos,
+                         uint32_t *count)
+{
+    rl_property *vis = NULL;
     char num[32];
-    snprintf(num, sizeof num, "%lld", a.resolution);
+    snprintf(num, sizeof num, "%lld", a->resolution);
     rl_status st = rl_property_create("visibility", &vis);
     if (st == RL_OK)
         st = rl_property_set(vis, "resolution", num);
     if (st == RL_OK)
-        st = rl_property_commit(vis, scene, a.sampling.desc.workers);
+        st = rl_property_commit(vis, scene, a->sampling.desc.workers);
     rl_progress *progress = NULL;
     if (st == RL_OK && rl_log_get_level() >= RL_LOG_INFO)
         rl_progress_create("placing samples", stderr, &progress);
-    a.sampling.desc.progress = progress ? rl_progress_update : NULL;
-    a.sampling.desc.progress_user = progress;
+    a->sampling.desc.progress = progress ? rl_progress_update : NULL;
+    a->sampling.desc.progress_user = progress;
     if (st == RL_OK)
-        st = rl_sample_property(vis, &a.sampling.desc, &driver);
+        st = rl_sample_property(vis, &a->sampling.desc, driver);
     if (progress)
         rl_progress_finish(progress);
-    a.sampling.desc.progress = NULL;
-    if (st != RL_OK) {
-        rc = cli_fail_status(RL_CLI_FAIL, st, "sampling");
-        goto done;
-    }
-    uint32_t ns = rl_approx_sample_count(driver);
-    pos = malloc(ns * sizeof *pos);
-    if (!pos) {
-        rc = cli_fail(RL_CLI_FAIL, "out of memory");
-        goto done;
-    }
+    a->sampling.desc.progress = NULL;
+    rl_property_release(vis);
+    if (st != RL_OK)
+        return cli_fail_status(RL_CLI_FAIL, st, "sampling");
+    uint32_t ns = rl_approx_sample_count(*driver);
+    if (!(*pos = malloc((ns ? ns : 1) * sizeof **pos)))
+        return cli_fail(RL_CLI_FAIL, "out of memory");
     for (uint32_t k = 0; k < ns; k++) {
         double v;
-        rl_approx_sample(driver, k, &pos[k], &v);
+        rl_approx_sample(*driver, k, &(*pos)[k], &v);
     }
+    *count = ns;
+    return RL_CLI_OK;
+}
+
+/* Every metric of every renderer at the positions, as an approximation over
+ * the driver's regions with weighted statistics; a failure is a warning and
+ * counted, the others go on. Returns the number of failures. */
+static int measure_all(const compare_args *a, const rl_scene *scene, const rl_approx *driver, const rl_vec3 *pos,
+                       uint32_t ns, measured (*res)[M_COUNT])
+{
     int failures = 0;
-    for (int i = 0; i < a.num_algos; i++) {
+    for (int i = 0; i < a->num_algos; i++) {
         for (int m = 0; m < M_COUNT; m++) {
-            if (!(a.metrics & (1u << m)))
+            if (!(a->metrics & (1u << m)))
                 continue;
             measured *r = &res[i][m];
-            rl_property *p = metric_property(&a, m, &a.algos[i]);
+            rl_property *p = metric_property(a, m, &a->algos[i]);
             double *values = NULL, *v2 = NULL, *w2 = NULL;
             size_t n2 = 0;
             char label[300];
-            snprintf(label, sizeof label, "%s %s", a.algos[i].label, metric_names[m]);
+            snprintf(label, sizeof label, "%s %s", a->algos[i].label, metric_names[m]);
             rl_clear_error();
-            st = p ? rl_property_commit(p, scene, a.sampling.desc.workers) : RL_ERR_INVALID_ARG;
+            rl_status st = p ? rl_property_commit(p, scene, a->sampling.desc.workers) : RL_ERR_INVALID_ARG;
             if (st == RL_OK)
                 st = eval_measure(p, pos, ns, &values, label);
             if (st == RL_OK)
-                st = rl_approx_with_values(driver, values, metric_names[m], rl_property_unit(p),
-                                           &r->approx);
+                st = rl_approx_with_values(driver, values, metric_names[m], rl_property_unit(p), &r->approx);
             if (st == RL_OK && !eval_leaf_series(r->approx, &v2, &w2, &n2))
                 st = RL_ERR_OUT_OF_MEMORY;
             if (st == RL_OK)
                 st = rl_stats_compute(v2, w2, n2, &r->stats);
             r->ok = st == RL_OK;
             if (!r->ok) {
-                snprintf(r->error, sizeof r->error, "%s",
-                         *rl_last_error() ? rl_last_error() : rl_status_string(st));
+                snprintf(r->error, sizeof r->error, "%s", *rl_last_error() ? rl_last_error() : rl_status_string(st));
                 fprintf(stderr, "rl: warning: %s: %s\n", label, r->error);
                 failures++;
             } else if (rl_log_get_level() >= RL_LOG_INFO) {
@@ -576,61 +561,95 @@ int cli_compare(int argc, char **argv)
             rl_property_release(p);
         }
     }
-    cJSON *root = result_json(&a, scene, driver, res);
+    return failures;
+}
+
+/* compare.json and report.html: the setup, where the samples are, and a
+ * section per metric. */
+static int write_report(const compare_args *a, const rl_scene *scene, const rl_approx *driver, uint32_t ns,
+                        measured (*res)[M_COUNT], const char *report, const char *json_path)
+{
+    cJSON *root = result_json(a, scene, driver, res);
     bool ok = root && cli_write_json(root, json_path);
     cJSON_Delete(root);
-    if (!ok) {
-        rc = RL_CLI_FAIL;
-        goto done;
-    }
+    if (!ok)
+        return RL_CLI_FAIL;
     char title[256];
-    snprintf(title, sizeof title, "rl compare: %s", a.scene);
+    snprintf(title, sizeof title, "rl compare: %s", a->scene);
     html_doc *h = html_begin(report, title);
-    if (!h) {
-        rc = RL_CLI_FAIL;
-        goto done;
-    }
-    const rl_sampling_desc *d = &a.sampling.desc;
+    if (!h)
+        return RL_CLI_FAIL;
+    const rl_sampling_desc *d = &a->sampling.desc;
     rl_aabb b = rl_approx_bounds(driver);
-    top = eval_top_view(scene, b, d->height, 512);
+    rl_image *top = eval_top_view(scene, b, d->height, 512);
     html_para(h, "%d renderers measured at the same %u positions (%s, %s sampling of pixel "
                  "visibility at %lld² per cube face, %u regions). Per position: 6 directions, "
                  "%dx%d pixels, %g° field of view; time is the maximum over the directions of "
                  "the median of %lld renders; quality is %s against %s, the %s over the "
                  "directions (Jähn 2015, Ch. 4). Statistics are weighted by region %s.",
-                 a.num_algos, ns, d->dims == 2 ? "a 2-D slice" : "a 3-D region",
-                 d->method == RL_SAMPLING_GRID ? "grid" : "adaptive", a.resolution,
-                 rl_approx_region_count(driver), a.width, a.height, a.fov_deg, a.repeats,
-                 quality_metric_titles[a.quality_metric], a.reference.label,
-                 strcmp(quality_metrics[a.quality_metric], "rmse") == 0 ? "maximum" : "minimum",
+                 a->num_algos, ns, d->dims == 2 ? "a 2-D slice" : "a 3-D region",
+                 d->method == RL_SAMPLING_GRID ? "grid" : "adaptive", a->resolution,
+                 rl_approx_region_count(driver), a->width, a->height, a->fov_deg, a->repeats,
+                 quality_metric_titles[a->quality_metric], a->reference.label,
+                 strcmp(quality_metrics[a->quality_metric], "rmse") == 0 ? "maximum" : "minimum",
                  d->dims == 2 ? "area" : "volume");
     char *vis_svg = eval_heatmap_svg(driver, d->height, top, "visible objects", 0, 0, false, NULL);
     html_svg(h, vis_svg, "Where the samples are: the visibility approximation that placed "
                             "them (adaptive sampling refines where visibility changes).");
     free(vis_svg);
     for (int m = 0; m < M_COUNT; m++)
-        if (a.metrics & (1u << m))
-            put_metric_section(h, &a, m, res, top, d->height);
+        if (a->metrics & (1u << m))
+            put_metric_section(h, a, m, res, top, d->height);
     html_para(h, "Data: compare.json.");
-    if (!html_end(h, report)) {
-        rc = RL_CLI_FAIL;
-        goto done;
+    rl_image_release(top);
+    return html_end(h, report) ? RL_CLI_OK : RL_CLI_FAIL;
+}
+
+int cli_compare(int argc, char **argv)
+{
+    compare_args a = { 0 };
+    int rc = parse_args(argc, argv, &a);
+    if (rc != RL_CLI_OK) {
+        free_args(&a);
+        return rc < 0 ? RL_CLI_OK : rc;
     }
-    printf("compared %d renderers at %u positions of %s; wrote %s, %s\n", a.num_algos, ns, a.scene,
-           json_path, report);
-    rc = failures ? cli_fail(RL_CLI_FAIL, "%d measurement%s failed (see the warnings)", failures,
-                                failures == 1 ? "" : "s")
-                  : RL_CLI_OK;
-done:
+    char report[4096], json_path[4096];
+    snprintf(report, sizeof report, "%s/report.html", a.out);
+    snprintf(json_path, sizeof json_path, "%s/compare.json", a.out);
+    rl_scene *scene = NULL;
+    rl_approx *driver = NULL;
+    rl_vec3 *pos = NULL;
+    uint32_t ns = 0;
+    measured (*res)[M_COUNT] = calloc(MAX_ALGOS, sizeof *res);
+    if (!res)
+        rc = cli_fail(RL_CLI_FAIL, "out of memory");
+    if (rc == RL_CLI_OK)
+        rc = check_metrics(&a);
+    if (rc == RL_CLI_OK && (!cli_make_dirs(a.out) || !cli_check_writable(report)))
+        rc = RL_CLI_FAIL;
+    if (rc == RL_CLI_OK)
+        rc = cli_load_scene(a.scene, &scene);
+    if (rc == RL_CLI_OK && !eval_sampling_finish(&a.sampling, scene))
+        rc = RL_CLI_USAGE;
+    if (rc == RL_CLI_OK)
+        rc = place_samples(&a, scene, &driver, &pos, &ns);
+    int failures = rc == RL_CLI_OK ? measure_all(&a, scene, driver, pos, ns, res) : 0;
+    if (rc == RL_CLI_OK)
+        rc = write_report(&a, scene, driver, ns, res, report, json_path);
+    if (rc == RL_CLI_OK) {
+        printf("compared %d renderers at %u positions of %s; wrote %s, %s\n", a.num_algos, ns, a.scene, json_path,
+               report);
+        if (failures)
+            rc = cli_fail(RL_CLI_FAIL, "%d measurement%s failed (see the warnings)", failures,
+                          failures == 1 ? "" : "s");
+    }
     if (res)
         for (int i = 0; i < MAX_ALGOS; i++)
             for (int m = 0; m < M_COUNT; m++)
                 rl_approx_release(res[i][m].approx);
     free(res);
     free(pos);
-    rl_image_release(top);
     rl_approx_release(driver);
-    rl_property_release(vis);
     rl_scene_release(scene);
     free_args(&a);
     return rc;
