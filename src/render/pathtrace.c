@@ -529,6 +529,112 @@ static rl_status cancelled(pt_state *s)
     return rl_error(RL_ERR_CANCELLED, "pt: cancelled by the progress callback");
 }
 
+/* What the frame needs before tracing: the backends' structures (built
+ * once per scene), a new accumulation when anything changed, and the
+ * primary visibility that does not change while accumulating (the traced
+ * G-buffer once per reset; the rasterized one every frame, as the thesis'
+ * extra render pass, Sec. 8.1). */
+static rl_status prepare_frame(rl_renderer *r, pt_state *s, const rl_scene *scene, const rl_camera *cam,
+                               const pt_settings *set, rl_pt_stats *ps)
+{
+    double built_ms = 0.0;
+    rl_status st = rl_pt_backends_prepare(&s->b, scene, set, set->threads, &built_ms);
+    if (st != RL_OK)
+        return st;
+    ps->time_build_ms = built_ms;
+    if (!rl_renderer_progress(r, BUILD_SHARE))
+        return cancelled(s);
+
+    char *sig = option_signature(r);
+    if (!sig)
+        return RL_ERR_OUT_OF_MEMORY;
+    bool need_reset = s->force_reset || !s->valid || !set->accumulate || s->scene_uid != rl_scene_uid(scene) ||
+                      s->width != cam->width || s->height != cam->height || !same_camera(&s->cam, cam) ||
+                      strcmp(s->signature, sig) != 0;
+    if (need_reset) {
+        if ((st = reset(s, scene, cam, set, sig)) != RL_OK)
+            return st;
+    } else {
+        free(sig);
+    }
+    ps->reset = need_reset;
+
+    rl_timer timer;
+    rl_timer_start(&timer);
+    if (set->primary == PT_PRIMARY_RASTER) {
+        st = rl_gbuffer_raster(s->gbuf, scene, cam);
+    } else if (need_reset) {
+        st = rl_gbuffer_trace(s->gbuf, s->b.exact[RL_ACCEL_BVH], cam);
+        ps->gbuffer_rays = (uint64_t)cam->width * cam->height;
+    }
+    if (st != RL_OK) {
+        s->force_reset = true;
+        return st;
+    }
+    ps->time_primary_ms = rl_timer_ms(&timer);
+    return RL_OK;
+}
+
+/* The frame's spp passes over the tiles (primary rays, then the paths),
+ * their counters summed into *sum. */
+static rl_status trace_passes(rl_renderer *r, const frame *f, const pt_settings *set, pt_counters *sum,
+                              rl_pt_stats *ps)
+{
+    int64_t num_tiles = (int64_t)f->tiles_x * ((f->height + TILE - 1) / TILE);
+    pt_counters *tile_c = rl_calloc((size_t)num_tiles, sizeof *tile_c);
+    if (!tile_c)
+        return RL_ERR_OUT_OF_MEMORY;
+    rl_timer timer;
+    for (int k = 0; k < set->spp; ++k) {
+        if (set->primary == PT_PRIMARY_TRACE) {
+            rl_timer_start(&timer);
+            run_pass(f, set->threads, num_tiles, tile_c, true);
+            ps->time_primary_ms += rl_timer_ms(&timer);
+        }
+        rl_timer_start(&timer);
+        run_pass(f, set->threads, num_tiles, tile_c, false);
+        ps->time_paths_ms += rl_timer_ms(&timer);
+        if (!rl_renderer_progress(r, BUILD_SHARE + (1.0 - BUILD_SHARE) * (k + 1) / set->spp)) {
+            free(tile_c);
+            return cancelled(f->s);
+        }
+    }
+    memset(sum, 0, sizeof *sum);
+    for (int64_t t = 0; t < num_tiles; ++t)
+        add_counters(sum, &tile_c[t]);
+    free(tile_c);
+    return RL_OK;
+}
+
+/* The frame's statistics (rl_pt_stats and the generic ones). */
+static void finish_stats(pt_state *s, const pt_settings *set, const pt_counters *sum, uint64_t traced,
+                         const rl_camera *cam, const rl_timer *total, rl_render_stats *stats, rl_pt_stats *ps)
+{
+    for (int k = 0; k < RL_RAY_TYPE_COUNT; ++k)
+        stats->rays[k] = ps->rays[k] = sum->rays[k];
+    memcpy(ps->shadow_queries, sum->shadow_q, sizeof ps->shadow_queries);
+    memcpy(ps->trace_queries, sum->trace_q, sizeof ps->trace_queries);
+    ps->preillum_ends = sum->preillum_ends;
+    stats->pixels_written = (uint64_t)cam->width * cam->height;
+    stats->samples = ps->samples = traced * (uint64_t)set->spp;
+    ps->frames = s->frames;
+    ps->spp = (double)s->total_samples / ((double)cam->width * cam->height);
+    ps->spp_frame = (uint32_t)set->spp;
+    ps->pixels_traced = traced;
+    uint64_t rays = 0;
+    for (int k = 0; k < RL_RAY_TYPE_COUNT; ++k)
+        rays += ps->rays[k];
+    double ray_ms = ps->time_primary_ms + ps->time_paths_ms;
+    ps->mrays_per_s = ray_ms > 0.0 ? (double)rays / (ray_ms * 1e3) : 0.0;
+    ps->build_bvh_ms = s->b.exact[RL_ACCEL_BVH] ? s->b.exact_ms[RL_ACCEL_BVH] : 0.0;
+    ps->build_grid_ms = s->b.exact[RL_ACCEL_GRID] ? s->b.exact_ms[RL_ACCEL_GRID] : 0.0;
+    ps->build_embree_ms = s->b.exact[RL_ACCEL_EMBREE] ? s->b.exact_ms[RL_ACCEL_EMBREE] : 0.0;
+    ps->build_linespace_ms = s->b.ls ? s->b.ls_ms : 0.0;
+    ps->build_shadowmap_ms = s->b.sm ? s->b.sm_ms : 0.0;
+    ps->rng = set->rng;
+    ps->time_total_ms = rl_timer_ms(total);
+}
+
 static rl_status pt_render(rl_renderer *r, void *state, const rl_scene *scene, const rl_camera *cam,
                            rl_image *image, rl_render_stats *stats)
 {
@@ -543,45 +649,9 @@ static rl_status pt_render(rl_renderer *r, void *state, const rl_scene *scene, c
     s->have_frame = false;
     rl_pt_stats ps;
     memset(&ps, 0, sizeof ps);
-
-    double built_ms = 0.0;
-    rl_status st = rl_pt_backends_prepare(&s->b, scene, &set, set.threads, &built_ms);
+    rl_status st = prepare_frame(r, s, scene, cam, &set, &ps);
     if (st != RL_OK)
         return st;
-    ps.time_build_ms = built_ms;
-    if (!rl_renderer_progress(r, BUILD_SHARE))
-        return cancelled(s);
-
-    char *sig = option_signature(r);
-    if (!sig)
-        return RL_ERR_OUT_OF_MEMORY;
-    bool need_reset = s->force_reset || !s->valid || !set.accumulate || s->scene_uid != rl_scene_uid(scene) ||
-                      s->width != cam->width || s->height != cam->height || !same_camera(&s->cam, cam) ||
-                      strcmp(s->signature, sig) != 0;
-    if (need_reset) {
-        if ((st = reset(s, scene, cam, &set, sig)) != RL_OK)
-            return st;
-    } else {
-        free(sig);
-    }
-    ps.reset = need_reset;
-
-    /* Primary visibility that does not change while accumulating: the
-     * traced G-buffer once per reset; the rasterized one every frame, as
-     * the thesis' extra render pass (Sec. 8.1). */
-    rl_timer timer;
-    rl_timer_start(&timer);
-    if (set.primary == PT_PRIMARY_RASTER) {
-        st = rl_gbuffer_raster(s->gbuf, scene, cam);
-    } else if (need_reset) {
-        st = rl_gbuffer_trace(s->gbuf, s->b.exact[RL_ACCEL_BVH], cam);
-        ps.gbuffer_rays = (uint64_t)cam->width * cam->height;
-    }
-    if (st != RL_OK) {
-        s->force_reset = true;
-        return st;
-    }
-    ps.time_primary_ms = rl_timer_ms(&timer);
 
     frame f = {
         .s = s,
@@ -597,30 +667,12 @@ static rl_status pt_render(rl_renderer *r, void *state, const rl_scene *scene, c
         .tiles_x = (cam->width + TILE - 1) / TILE,
         .parity = s->frames & 1u,
     };
-    int64_t num_tiles = (int64_t)f.tiles_x * ((cam->height + TILE - 1) / TILE);
-    pt_counters *tile_c = rl_calloc((size_t)num_tiles, sizeof *tile_c);
-    if (!tile_c)
-        return RL_ERR_OUT_OF_MEMORY;
-    for (int k = 0; k < set.spp; ++k) {
-        if (set.primary == PT_PRIMARY_TRACE) {
-            rl_timer_start(&timer);
-            run_pass(&f, set.threads, num_tiles, tile_c, true);
-            ps.time_primary_ms += rl_timer_ms(&timer);
-        }
-        rl_timer_start(&timer);
-        run_pass(&f, set.threads, num_tiles, tile_c, false);
-        ps.time_paths_ms += rl_timer_ms(&timer);
-        if (!rl_renderer_progress(r, BUILD_SHARE + (1.0 - BUILD_SHARE) * (k + 1) / set.spp)) {
-            free(tile_c);
-            return cancelled(s);
-        }
-    }
     pt_counters sum;
-    memset(&sum, 0, sizeof sum);
-    for (int64_t t = 0; t < num_tiles; ++t)
-        add_counters(&sum, &tile_c[t]);
-    free(tile_c);
+    if ((st = trace_passes(r, &f, &set, &sum, &ps)) != RL_OK)
+        return st;
 
+    /* Sec. 6.5, eq. 8: the traced pixels' sample counts (all of them, or
+     * the frame's checkerboard half). */
     uint64_t traced = 0;
     for (int y = 0; y < cam->height; ++y)
         for (int x = 0; x < cam->width; ++x)
@@ -633,6 +685,7 @@ static rl_status pt_render(rl_renderer *r, void *state, const rl_scene *scene, c
 
     resolve(s, image);
     if (set.filter != RL_FILTER_NONE) {
+        rl_timer timer;
         rl_timer_start(&timer);
         st = apply_filter(s, &set, image, &ps.filter_weight);
         ps.time_filter_ms = rl_timer_ms(&timer);
@@ -640,30 +693,7 @@ static rl_status pt_render(rl_renderer *r, void *state, const rl_scene *scene, c
             return st;
     }
     write_layers(s, image);
-
-    for (int k = 0; k < RL_RAY_TYPE_COUNT; ++k)
-        stats->rays[k] = ps.rays[k] = sum.rays[k];
-    memcpy(ps.shadow_queries, sum.shadow_q, sizeof ps.shadow_queries);
-    memcpy(ps.trace_queries, sum.trace_q, sizeof ps.trace_queries);
-    ps.preillum_ends = sum.preillum_ends;
-    stats->pixels_written = (uint64_t)cam->width * cam->height;
-    stats->samples = ps.samples = traced * (uint64_t)set.spp;
-    ps.frames = s->frames;
-    ps.spp = (double)s->total_samples / ((double)cam->width * cam->height);
-    ps.spp_frame = (uint32_t)set.spp;
-    ps.pixels_traced = traced;
-    uint64_t rays = 0;
-    for (int k = 0; k < RL_RAY_TYPE_COUNT; ++k)
-        rays += ps.rays[k];
-    double ray_ms = ps.time_primary_ms + ps.time_paths_ms;
-    ps.mrays_per_s = ray_ms > 0.0 ? (double)rays / (ray_ms * 1e3) : 0.0;
-    ps.build_bvh_ms = s->b.exact[RL_ACCEL_BVH] ? s->b.exact_ms[RL_ACCEL_BVH] : 0.0;
-    ps.build_grid_ms = s->b.exact[RL_ACCEL_GRID] ? s->b.exact_ms[RL_ACCEL_GRID] : 0.0;
-    ps.build_embree_ms = s->b.exact[RL_ACCEL_EMBREE] ? s->b.exact_ms[RL_ACCEL_EMBREE] : 0.0;
-    ps.build_linespace_ms = s->b.ls ? s->b.ls_ms : 0.0;
-    ps.build_shadowmap_ms = s->b.sm ? s->b.sm_ms : 0.0;
-    ps.rng = set.rng;
-    ps.time_total_ms = rl_timer_ms(&total);
+    finish_stats(s, &set, &sum, traced, cam, &total, stats, &ps);
     s->stats = ps;
     s->have_frame = true;
     return RL_OK;
