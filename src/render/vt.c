@@ -409,6 +409,114 @@ static rl_status keep_mesh(vt_state *s, const vt_run *run)
     return RL_OK;
 }
 
+/* The frame's tracer (exact shading, eq. 3.1-3.4, 3.17), the kept
+ * structures made or reused for the scene, and the feeler cache forgotten
+ * when what the feelers depend on changed (Sec. 3.4.5). */
+static rl_status prepare_tracer(rl_renderer *r, vt_state *s, const rl_scene *scene, const rl_scene_data *d,
+                                const vt_settings *set, rl_tracer **tracer)
+{
+    rl_accel_kind kind;
+    rl_tracer_desc desc;
+    rl_status st = rl_tracer_options_read(r, &desc, &kind);
+    if (st != RL_OK)
+        return st;
+    desc.tree_shadow_any_hit = true;      /* shadow nodes say lit or blocked (Sec. 3.3.1) */
+    desc.defer_through = rl_renderer_opt_bool(r, "defer_through");
+    if ((st = rl_accel_cache_get(&s->accel, "vt", scene, kind, set->threads, build_progress, r)) != RL_OK)
+        return st;
+    if ((st = ensure_mesh(s, scene, d, rl_renderer_opt_string(r, "objects"))) != RL_OK)
+        return st;
+    if ((st = rl_tracer_create(s->accel.accel, &desc, tracer)) != RL_OK)
+        return st;
+    uint64_t signature = feeler_signature(&desc);
+    if (!set->coherence || s->feelers_scene != rl_scene_uid(scene) || s->feelers_signature != signature) {
+        vt_feeler_map_free(&s->feelers);
+        s->feelers_scene = rl_scene_uid(scene);
+        s->feelers_signature = signature;
+    }
+    return RL_OK;
+}
+
+/* A frame's run over the kept state: the camera's matrices and the view
+ * the visibility tests use (Sec. 3.4), the state's buffers. */
+static void setup_run(vt_run *run, rl_renderer *r, vt_state *s, const rl_scene_data *d, const vt_settings *set,
+                      rl_tracer *tracer, rl_camera *cam, rl_image *image)
+{
+    memset(run, 0, sizeof *run);
+    run->t_start_ms = rl_time_s() * 1000.0;
+    run->set = set;
+    run->data = d;
+    run->tracer = tracer;
+    run->mesh = &s->mesh;
+    run->heap = &s->heap;
+    run->object_vt = s->object_vt;
+    run->object_raster = s->object_raster;
+    run->tri_face = s->tri_face;
+    run->want_tree = (set->criteria.bits & VT_CRIT_TREE) != 0;
+    run->cache = set->coherence && s->feelers.count ? &s->feelers : NULL;
+    run->renderer = r;
+    run->update = s->update;
+    run->update_user = s->update_user;
+    run->image = image;
+    run->camera = cam;
+
+    float z_near = cam->z_near, z_far = cam->z_far;
+    if (!(z_near > 0.0f))
+        rl_camera_clip_range(cam, d->bounds, &z_near, &z_far);
+    run->view_m = rl_camera_view(cam);
+    run->proj_m = rl_camera_projection(cam, z_near, z_far);
+    run->view = (vt_view){
+        .view_proj = rl_mat4_mul(&run->proj_m, &run->view_m),
+        .eye = cam->eye,
+        .forward = rl_normalize(rl_sub(cam->target, cam->eye)),
+        .width = image->width,
+        .height = image->height,
+        .z_near = z_near,
+        .depth = NULL,
+        .depth_tolerance = 1e-3f,
+    };
+    run->stats.threads = (uint32_t)set->threads;
+    run->stats.primary_vertices = s->mesh.num_primary_verts;
+    run->stats.primary_faces = s->mesh.num_primary_faces;
+    for (uint32_t o = 0; o < d->num_objects; ++o)
+        run->stats.vt_objects += s->object_vt[o];
+}
+
+/* Fig. 3.17: the ID/Z pre-pass with the rasterized half, the refinement
+ * with its sampling, the final draw; then what the next frame keeps
+ * (feelers, the refined mesh). */
+static rl_status run_frame(vt_run *run, vt_state *s, const vt_settings *set, rl_image *image)
+{
+    rl_status st = vt_run_reserve(run);
+    if (st == RL_OK)
+        st = frame_buffers(s, set->threads, image);
+    run->ras = s->ras;
+    run->corners = &s->corners;
+    run->scratch_depth = s->scratch_depth;
+    run->base = &s->base;
+    double t0 = rl_time_s() * 1000.0;
+    if (st == RL_OK)
+        st = vt_prepass(run, s->depth_ids);
+    /* The rasterized half drawn inside the pre-pass counts as drawing. */
+    run->stats.time_visibility_ms = rl_time_s() * 1000.0 - t0 - run->stats.time_draw_ms;
+    if (st == RL_OK)
+        st = vt_refine(run);
+    if (st == RL_OK) {
+        double td = rl_time_s() * 1000.0;
+        if (!vt_update(run, run->stats.stages, true) && run->failed)
+            st = RL_ERR_OUT_OF_MEMORY;
+        run->stats.time_draw_ms += rl_time_s() * 1000.0 - td;
+    }
+    if (st == RL_OK && set->coherence)
+        st = keep_feelers(s, run);
+    if (st == RL_OK)
+        st = keep_mesh(s, run);
+    vt_run_free_blocks(run);
+    free(run->reason);
+    free(run->feelers);
+    return st;
+}
+
 static rl_status vt_render(rl_renderer *r, void *state, const rl_scene *scene, const rl_camera *cam_in,
                            rl_image *image, rl_render_stats *stats)
 {
@@ -424,98 +532,15 @@ static rl_status vt_render(rl_renderer *r, void *state, const rl_scene *scene, c
     read_settings(r, &set);
     s->have_frame = false;
 
-    rl_accel_kind kind;
-    rl_tracer_desc desc;
-    if ((st = rl_tracer_options_read(r, &desc, &kind)) != RL_OK)
-        return st;
-    desc.tree_shadow_any_hit = true;      /* shadow nodes say lit or blocked (Sec. 3.3.1) */
-    desc.defer_through = rl_renderer_opt_bool(r, "defer_through");
-    if ((st = rl_accel_cache_get(&s->accel, "vt", scene, kind, set.threads, build_progress, r)) != RL_OK)
-        return st;
-    if ((st = ensure_mesh(s, scene, d, rl_renderer_opt_string(r, "objects"))) != RL_OK)
-        return st;
-
     rl_tracer *tracer = NULL;
-    if ((st = rl_tracer_create(s->accel.accel, &desc, &tracer)) != RL_OK)
+    if ((st = prepare_tracer(r, s, scene, d, &set, &tracer)) != RL_OK)
         return st;
-    uint64_t signature = feeler_signature(&desc);
-    if (!set.coherence || s->feelers_scene != rl_scene_uid(scene) || s->feelers_signature != signature) {
-        vt_feeler_map_free(&s->feelers);
-        s->feelers_scene = rl_scene_uid(scene);
-        s->feelers_signature = signature;
-    }
-
     vt_mesh_reset(&s->mesh);
     vt_heap_clear(&s->heap);
     vt_run run;
-    memset(&run, 0, sizeof run);
-    run.t_start_ms = rl_time_s() * 1000.0;
-    run.set = &set;
-    run.data = d;
-    run.tracer = tracer;
-    run.mesh = &s->mesh;
-    run.heap = &s->heap;
-    run.object_vt = s->object_vt;
-    run.object_raster = s->object_raster;
-    run.tri_face = s->tri_face;
-    run.want_tree = (set.criteria.bits & VT_CRIT_TREE) != 0;
-    run.cache = set.coherence && s->feelers.count ? &s->feelers : NULL;
-    run.renderer = r;
-    run.update = s->update;
-    run.update_user = s->update_user;
-    run.image = image;
-    run.camera = &cam;
-
-    float z_near = cam.z_near, z_far = cam.z_far;
-    if (!(z_near > 0.0f))
-        rl_camera_clip_range(&cam, d->bounds, &z_near, &z_far);
-    run.view_m = rl_camera_view(&cam);
-    run.proj_m = rl_camera_projection(&cam, z_near, z_far);
-    run.view = (vt_view){
-        .view_proj = rl_mat4_mul(&run.proj_m, &run.view_m),
-        .eye = cam.eye,
-        .forward = rl_normalize(rl_sub(cam.target, cam.eye)),
-        .width = image->width,
-        .height = image->height,
-        .z_near = z_near,
-        .depth = NULL,
-        .depth_tolerance = 1e-3f,
-    };
-    run.stats.threads = (uint32_t)set.threads;
-    run.stats.primary_vertices = s->mesh.num_primary_verts;
-    run.stats.primary_faces = s->mesh.num_primary_faces;
-    for (uint32_t o = 0; o < d->num_objects; ++o)
-        run.stats.vt_objects += s->object_vt[o];
-
-    st = vt_run_reserve(&run);
-    if (st == RL_OK)
-        st = frame_buffers(s, set.threads, image);
-    rl_image *depth_ids = s->depth_ids;
-    run.ras = s->ras;
-    run.corners = &s->corners;
-    run.scratch_depth = s->scratch_depth;
-    run.base = &s->base;
-    double t0 = rl_time_s() * 1000.0;
-    if (st == RL_OK)
-        st = vt_prepass(&run, depth_ids);
-    /* The rasterized half drawn inside the pre-pass counts as drawing. */
-    run.stats.time_visibility_ms = rl_time_s() * 1000.0 - t0 - run.stats.time_draw_ms;
-    if (st == RL_OK)
-        st = vt_refine(&run);
+    setup_run(&run, r, s, d, &set, tracer, &cam, image);
+    st = run_frame(&run, s, &set, image);
     rl_tracer_release(tracer);
-    if (st == RL_OK) {
-        double td = rl_time_s() * 1000.0;
-        if (!vt_update(&run, run.stats.stages, true) && run.failed)
-            st = RL_ERR_OUT_OF_MEMORY;
-        run.stats.time_draw_ms += rl_time_s() * 1000.0 - td;
-    }
-    if (st == RL_OK && set.coherence)
-        st = keep_feelers(s, &run);
-    if (st == RL_OK)
-        st = keep_mesh(s, &run);
-    vt_run_free_blocks(&run);
-    free(run.reason);
-    free(run.feelers);
     if (st != RL_OK)
         return st;
 
