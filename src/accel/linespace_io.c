@@ -281,6 +281,120 @@ static rl_status check_contents(const rl_linespace *ls, const char *path)
     return RL_OK;
 }
 
+/* The header read and checked against itself and the file's length; f is
+ * left at the first array. *shafts: filled voxels x shafts per voxel. */
+static rl_status load_header(FILE *f, const char *path, unsigned char buf[HEADER_BYTES], header *h,
+                             uint64_t *shafts, array_sizes *s)
+{
+    if (fread(buf, 1, HEADER_BYTES, f) != HEADER_BYTES)
+        return rl_error(RL_ERR_PARSE, "%s: truncated header", path);
+    if (!decode(buf, h))
+        return rl_error(RL_ERR_PARSE, "%s: not a Line Space file (magic)", path);
+    if (h->version != LS_VERSION)
+        return rl_error(RL_ERR_PARSE, "%s: version %u, this build reads version %u", path, h->version, LS_VERSION);
+    if (h->n < 1 || h->n > RL_LS_MAX_N || h->k < 2 || h->k > RL_LS_MAX_K || (h->k & 1) || h->dynamic > 1 ||
+        h->payloads == 0 || (h->payloads & ~(unsigned)(RL_LS_CANDIDATES | RL_LS_PNMT | RL_LS_PREILLUM)) ||
+        h->num_blocks > h->num_cells)
+        return rl_error(RL_ERR_PARSE, "%s: corrupt header (n, k, flags or counts)", path);
+    *shafts = (uint64_t)h->num_blocks * rl_ls_shafts_per_voxel(h->n);
+    if (*shafts > UINT32_MAX - 1u || h->empty_shafts > *shafts || h->num_cand > (uint64_t)UINT32_MAX * RL_LS_MAX_K ||
+        ((h->payloads & RL_LS_CANDIDATES) && !h->dynamic &&
+         h->num_cand != (*shafts - h->empty_shafts) * (uint64_t)h->k) ||
+        ((h->payloads & RL_LS_CANDIDATES) && h->dynamic && h->num_cand > UINT32_MAX))
+        return rl_error(RL_ERR_PARSE, "%s: corrupt header (array sizes)", path);
+    *s = sizes_of(h);
+    if (fseeko(f, 0, SEEK_END) != 0)
+        return rl_error(RL_ERR_IO, "%s: cannot seek", path);
+    off_t len = ftello(f);
+    if (len < 0 || (uint64_t)len != file_bytes(*s))
+        return rl_error(RL_ERR_PARSE, "%s: %lld bytes, the header describes %llu (truncated or corrupt)", path,
+                        (long long)len, (unsigned long long)file_bytes(*s));
+    if (fseeko(f, HEADER_BYTES, SEEK_SET) != 0)
+        return rl_error(RL_ERR_IO, "%s: cannot seek", path);
+    return RL_OK;
+}
+
+/* The arrays into ls (allocated here), checked against the stored sum. */
+static rl_status load_arrays(FILE *f, const char *path, const unsigned char buf[HEADER_BYTES], array_sizes s,
+                             rl_linespace *ls)
+{
+    ls->voxel_slot = malloc((size_t)(s.slot ? s.slot : 1) * 4);
+    ls->occupied = malloc((size_t)(s.occ ? s.occ : 1) * 8);
+    ls->cand = s.cand ? rl_big_alloc((size_t)s.cand * 4, true) : NULL;
+    ls->cand_start = s.start ? rl_big_alloc((size_t)s.start * 4, true) : NULL;
+    ls->pnmt = s.pnmt ? rl_big_alloc((size_t)s.pnmt * 2, true) : NULL;
+    ls->preillum = s.preillum ? rl_big_alloc((size_t)s.preillum * 2, true) : NULL;
+    if (!ls->voxel_slot || !ls->occupied || (s.cand && !ls->cand) || (s.start && !ls->cand_start) ||
+        (s.pnmt && !ls->pnmt) || (s.preillum && !ls->preillum))
+        return rl_error(RL_ERR_OUT_OF_MEMORY, "%s: out of memory for %llu bytes", path,
+                        (unsigned long long)file_bytes(s));
+    uint64_t sum = hash_bytes(0, buf, HEADER_BYTES), stored = 0;
+    bool ok = read_hashed(f, ls->voxel_slot, 4 * s.slot, &sum) && read_hashed(f, ls->occupied, 8 * s.occ, &sum) &&
+              read_hashed(f, ls->cand, 4 * s.cand, &sum) && read_hashed(f, ls->cand_start, 4 * s.start, &sum) &&
+              read_hashed(f, ls->pnmt, 2 * s.pnmt, &sum) && read_hashed(f, ls->preillum, 2 * s.preillum, &sum) &&
+              fread(&stored, 1, 8, f) == 8;
+    if (!ok)
+        return rl_error(RL_ERR_PARSE, "%s: truncated", path);
+    if (stored != sum)
+        return rl_error(RL_ERR_PARSE, "%s: checksum mismatch (corrupt file)", path);
+    return RL_OK;
+}
+
+/* An intact file: does it belong to this grid and scene? */
+static rl_status check_grid(const rl_accel *grid, const header *h, const char *path)
+{
+    const rl_grid *g = rl_accel_grid_state(grid);
+    if (!g)
+        return rl_error(RL_ERR_INVALID_ARG, "linespace: needs a committed RL_ACCEL_GRID accel");
+    bool same_grid = h->num_cells == g->num_cells;
+    for (int a = 0; a < 3; ++a)
+        same_grid = same_grid && h->res[a] == g->res[a] && h->bounds[a] == rl_vget(g->bounds.min, a) &&
+                    h->bounds[3 + a] == rl_vget(g->bounds.max, a);
+    if (!same_grid)
+        return rl_error(RL_ERR_INVALID_ARG, "%s: built on another grid (%d x %d x %d cells or bounds differ)", path,
+                        h->res[0], h->res[1], h->res[2]);
+    if (h->num_triangles != g->num_triangles || h->fingerprint != fingerprint(g))
+        return rl_error(RL_ERR_INVALID_ARG, "%s: built for another scene (triangle fingerprint differs)", path);
+    return RL_OK;
+}
+
+/* A Line Space made for grid from the header, taking over the arrays that
+ * were read into tmp (freed), checked and with the file's statistics. */
+static rl_status adopt(const rl_accel *grid, const header *h, uint64_t shafts, rl_linespace *tmp, const char *path,
+                       rl_linespace **out)
+{
+    rl_linespace_desc d = { .n = h->n, .k = h->k, .dynamic = h->dynamic != 0, .payloads = h->payloads };
+    rl_linespace *ls = NULL;
+    rl_status st = rl_linespace_create(grid, &d, &ls);
+    if (st)
+        return st;
+    ls->voxel_slot = tmp->voxel_slot;
+    ls->cand = tmp->cand;
+    ls->cand_start = tmp->cand_start;
+    ls->pnmt = tmp->pnmt;
+    ls->preillum = tmp->preillum;
+    ls->occupied = tmp->occupied;
+    free(tmp);
+    *out = ls;
+    ls->num_blocks = h->num_blocks;
+    ls->occ_words = (ls->shafts_per_voxel + 63u) / 64u;
+    ls->num_occupied = shafts - h->empty_shafts;
+    ls->num_cand = (h->payloads & RL_LS_CANDIDATES) ? h->num_cand : 0;
+    if ((st = check_contents(ls, path)))
+        return st;
+    rl_linespace_stats *t = &ls->stats;
+    t->filled_voxels = h->num_blocks;
+    t->shafts = shafts;
+    t->empty_shafts = h->empty_shafts;
+    t->candidates = h->candidates;
+    t->max_candidates = h->max_candidates;
+    t->mean_candidates = h->mean_candidates;
+    t->truncated_shafts = h->truncated_shafts;
+    t->memory_bytes = rl_ls_memory_bytes(ls);
+    ls->committed = true;
+    return RL_OK;
+}
+
 rl_status rl_linespace_load(const rl_accel *grid, const char *path, rl_linespace **out)
 {
     if (!grid || !path || !out)
@@ -290,140 +404,27 @@ rl_status rl_linespace_load(const rl_accel *grid, const char *path, rl_linespace
     FILE *f = fopen(path, "rb");
     if (!f)
         return rl_error(RL_ERR_IO, "%s: cannot open: %s", path, strerror(errno));
-    rl_linespace *ls = NULL;
-    rl_status st = RL_OK;
     unsigned char buf[HEADER_BYTES];
     header h;
-    if (fread(buf, 1, HEADER_BYTES, f) != HEADER_BYTES) {
-        st = rl_error(RL_ERR_PARSE, "%s: truncated header", path);
-        goto done;
-    }
-    if (!decode(buf, &h)) {
-        st = rl_error(RL_ERR_PARSE, "%s: not a Line Space file (magic)", path);
-        goto done;
-    }
-    if (h.version != LS_VERSION) {
-        st = rl_error(RL_ERR_PARSE, "%s: version %u, this build reads version %u", path, h.version,
-                      LS_VERSION);
-        goto done;
-    }
-    if (h.n < 1 || h.n > RL_LS_MAX_N || h.k < 2 || h.k > RL_LS_MAX_K || (h.k & 1) || h.dynamic > 1 ||
-        h.payloads == 0 || (h.payloads & ~(unsigned)(RL_LS_CANDIDATES | RL_LS_PNMT | RL_LS_PREILLUM)) ||
-        h.num_blocks > h.num_cells) {
-        st = rl_error(RL_ERR_PARSE, "%s: corrupt header (n, k, flags or counts)", path);
-        goto done;
-    }
-    uint64_t shafts = (uint64_t)h.num_blocks * rl_ls_shafts_per_voxel(h.n);
-    if (shafts > UINT32_MAX - 1u || h.empty_shafts > shafts ||
-        h.num_cand > (uint64_t)UINT32_MAX * RL_LS_MAX_K ||
-        ((h.payloads & RL_LS_CANDIDATES) && !h.dynamic &&
-         h.num_cand != (shafts - h.empty_shafts) * (uint64_t)h.k) ||
-        ((h.payloads & RL_LS_CANDIDATES) && h.dynamic && h.num_cand > UINT32_MAX)) {
-        st = rl_error(RL_ERR_PARSE, "%s: corrupt header (array sizes)", path);
-        goto done;
-    }
-    array_sizes s = sizes_of(&h);
-    if (fseeko(f, 0, SEEK_END) != 0) {
-        st = rl_error(RL_ERR_IO, "%s: cannot seek", path);
-        goto done;
-    }
-    off_t len = ftello(f);
-    if (len < 0 || (uint64_t)len != file_bytes(s)) {
-        st = rl_error(RL_ERR_PARSE, "%s: %lld bytes, the header describes %llu (truncated or corrupt)",
-                      path, (long long)len, (unsigned long long)file_bytes(s));
-        goto done;
-    }
-    if (fseeko(f, HEADER_BYTES, SEEK_SET) != 0) {
-        st = rl_error(RL_ERR_IO, "%s: cannot seek", path);
-        goto done;
-    }
-    ls = rl_calloc(1, sizeof *ls);
-    if (!ls) {
+    uint64_t shafts = 0;
+    array_sizes s = { 0 };
+    rl_linespace *ls = NULL;
+    rl_status st = load_header(f, path, buf, &h, &shafts, &s);
+    if (st == RL_OK && !(ls = rl_calloc(1, sizeof *ls)))
         st = RL_ERR_OUT_OF_MEMORY;
-        goto done;
+    if (st == RL_OK)
+        st = load_arrays(f, path, buf, s, ls);
+    if (st == RL_OK)
+        st = check_grid(grid, &h, path);
+    rl_linespace *loaded = NULL;
+    if (st == RL_OK) {
+        st = adopt(grid, &h, shafts, ls, path, &loaded);
+        if (loaded)
+            ls = loaded;       /* tmp was taken over */
     }
-    ls->voxel_slot = malloc((size_t)(s.slot ? s.slot : 1) * 4);
-    ls->occupied = malloc((size_t)(s.occ ? s.occ : 1) * 8);
-    ls->cand = s.cand ? rl_big_alloc((size_t)s.cand * 4, true) : NULL;
-    ls->cand_start = s.start ? rl_big_alloc((size_t)s.start * 4, true) : NULL;
-    ls->pnmt = s.pnmt ? rl_big_alloc((size_t)s.pnmt * 2, true) : NULL;
-    ls->preillum = s.preillum ? rl_big_alloc((size_t)s.preillum * 2, true) : NULL;
-    if (!ls->voxel_slot || !ls->occupied || (s.cand && !ls->cand) || (s.start && !ls->cand_start) ||
-        (s.pnmt && !ls->pnmt) || (s.preillum && !ls->preillum)) {
-        st = rl_error(RL_ERR_OUT_OF_MEMORY, "%s: out of memory for %llu bytes", path,
-                      (unsigned long long)file_bytes(s));
-        goto done;
-    }
-    uint64_t sum = hash_bytes(0, buf, HEADER_BYTES), stored = 0;
-    bool ok = read_hashed(f, ls->voxel_slot, 4 * s.slot, &sum) &&
-              read_hashed(f, ls->occupied, 8 * s.occ, &sum) &&
-              read_hashed(f, ls->cand, 4 * s.cand, &sum) &&
-              read_hashed(f, ls->cand_start, 4 * s.start, &sum) &&
-              read_hashed(f, ls->pnmt, 2 * s.pnmt, &sum) &&
-              read_hashed(f, ls->preillum, 2 * s.preillum, &sum) && fread(&stored, 1, 8, f) == 8;
-    if (!ok) {
-        st = rl_error(RL_ERR_PARSE, "%s: truncated", path);
-        goto done;
-    }
-    if (stored != sum) {
-        st = rl_error(RL_ERR_PARSE, "%s: checksum mismatch (corrupt file)", path);
-        goto done;
-    }
-    /* The file is intact; does it belong to this grid and scene? */
-    const rl_grid *g = rl_accel_grid_state(grid);
-    if (!g) {
-        st = rl_error(RL_ERR_INVALID_ARG, "linespace: needs a committed RL_ACCEL_GRID accel");
-        goto done;
-    }
-    bool same_grid = h.num_cells == g->num_cells;
-    for (int a = 0; a < 3; ++a)
-        same_grid = same_grid && h.res[a] == g->res[a] && h.bounds[a] == rl_vget(g->bounds.min, a) &&
-                    h.bounds[3 + a] == rl_vget(g->bounds.max, a);
-    if (!same_grid) {
-        st = rl_error(RL_ERR_INVALID_ARG, "%s: built on another grid (%d x %d x %d cells or bounds differ)",
-                      path, h.res[0], h.res[1], h.res[2]);
-        goto done;
-    }
-    if (h.num_triangles != g->num_triangles || h.fingerprint != fingerprint(g)) {
-        st = rl_error(RL_ERR_INVALID_ARG, "%s: built for another scene (triangle fingerprint differs)",
-                      path);
-        goto done;
-    }
-    rl_linespace_desc d = { .n = h.n, .k = h.k, .dynamic = h.dynamic != 0, .payloads = h.payloads };
-    rl_linespace *fresh = NULL;
-    st = rl_linespace_create(grid, &d, &fresh);
-    if (st)
-        goto done;
-    fresh->voxel_slot = ls->voxel_slot;
-    fresh->cand = ls->cand;
-    fresh->cand_start = ls->cand_start;
-    fresh->pnmt = ls->pnmt;
-    fresh->preillum = ls->preillum;
-    fresh->occupied = ls->occupied;
-    free(ls);
-    ls = fresh;
-    ls->num_blocks = h.num_blocks;
-    ls->occ_words = (ls->shafts_per_voxel + 63u) / 64u;
-    ls->num_occupied = shafts - h.empty_shafts;
-    ls->num_cand = (h.payloads & RL_LS_CANDIDATES) ? h.num_cand : 0;
-    st = check_contents(ls, path);
-    if (st)
-        goto done;
-    rl_linespace_stats *t = &ls->stats;
-    t->filled_voxels = h.num_blocks;
-    t->shafts = shafts;
-    t->empty_shafts = h.empty_shafts;
-    t->candidates = h.candidates;
-    t->max_candidates = h.max_candidates;
-    t->mean_candidates = h.mean_candidates;
-    t->truncated_shafts = h.truncated_shafts;
-    t->memory_bytes = rl_ls_memory_bytes(ls);
-    ls->committed = true;
-done:
     fclose(f);
     if (st) {
-        if (ls)
-            rl_linespace_release(ls);
+        rl_linespace_release(ls);
         return st;
     }
     *out = ls;
