@@ -142,6 +142,9 @@ RL_API rl_status rl_raster_set_target(rl_raster *r, rl_image *target,
  * or rl_camera_clip_range() over bounds when its z_near is 0). */
 RL_API rl_status rl_raster_set_camera(rl_raster *r, rl_image *target, const rl_camera *cam,
                                       rl_aabb scene_bounds);
+/* Those matrices alone (RL_ERR_INVALID_ARG for a bad camera or clip range). */
+RL_API rl_status rl_raster_camera_matrices(const rl_camera *cam, rl_aabb scene_bounds, rl_mat4 *view,
+                                           rl_mat4 *proj);
 RL_API rl_status rl_raster_draw(rl_raster *r, const rl_raster_batch *batch, rl_raster_counters *c);
 /* Draws count batches in order: image, IDs and counters are exactly those of
  * count rl_raster_draw calls, but runs of small batches (a scene of many

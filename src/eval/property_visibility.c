@@ -38,8 +38,7 @@
 
 #include "core/error.h"
 #include "eval/property_internal.h"
-#include "raster/scene_drawer.h"
-#include "rl/rl_raster.h"
+#include "rl/rl_drawer.h"
 
 static const char *const measure_choices[] = { "objects", "polygons", "pixels", NULL };
 enum { MEASURE_OBJECTS = 0, MEASURE_POLYGONS, MEASURE_PIXELS };
@@ -58,7 +57,7 @@ static const rl_option_info visibility_options[] = {
 };
 
 typedef struct vis_worker {
-    rl_raster *ras;
+    rl_drawer *drawer;          /* IDs only (rl_drawer.h, any backend), kept for every face */
     rl_image *img;              /* depth + IDs, resolution² */
     uint32_t *pixels;           /* per object, this evaluation */
     uint32_t *seen;             /* per object: stamp of the last face that saw it */
@@ -88,7 +87,7 @@ static void visibility_release(void *state)
     if (!s)
         return;
     for (int i = 0; s->w && i < s->workers; ++i) {
-        rl_raster_release(s->w[i].ras);
+        rl_drawer_release(s->w[i].drawer);
         rl_image_release(s->w[i].img);
         free(s->w[i].pixels);
         free(s->w[i].seen);
@@ -122,10 +121,7 @@ static rl_status visibility_commit(rl_property *p, const rl_scene *scene, int wo
     const int threads = s->threads;
     for (int i = 0; st == RL_OK && i < workers; ++i) {
         vis_worker *w = &s->w[i];
-        st = rl_raster_create(&(rl_raster_desc){ .threads = threads }, &w->ras);
-        if (st == RL_OK)
-            st = rl_image_create(s->resolution, s->resolution, RL_LAYER_DEPTH | RL_LAYER_ID,
-                                 &w->img);
+        st = rl_image_create(s->resolution, s->resolution, RL_LAYER_DEPTH | RL_LAYER_ID, &w->img);
         if (st == RL_OK) {
             w->pixels = rl_calloc(d->num_objects, sizeof *w->pixels);
             w->seen = rl_calloc(d->num_objects, sizeof *w->seen);
@@ -133,6 +129,10 @@ static rl_status visibility_commit(rl_property *p, const rl_scene *scene, int wo
             if (!w->pixels || !w->seen || !w->mask)
                 st = RL_ERR_OUT_OF_MEMORY;
         }
+        /* Unlit, so the mask's contents may change from face to face. */
+        const rl_drawer_desc desc = { .flags = RL_RASTER_NO_COLOR, .threads = threads, .object_mask = w->mask };
+        if (st == RL_OK)
+            st = rl_drawer_create(scene, &desc, &w->drawer);
     }
     if (st != RL_OK) {
         visibility_release(s);
@@ -199,11 +199,6 @@ static rl_status count_pixels(vis_state *s, vis_worker *w, rl_vec3 pos, double *
     const size_t n = (size_t)s->resolution * (size_t)s->resolution;
     memset(w->pixels, 0, d->num_objects * sizeof *w->pixels);
     const float z_far = far_plane(d, pos, s->z_near);
-    const rl_raster_scene_desc desc = {
-        .flags = RL_RASTER_NO_COLOR,
-        .threads = s->threads,
-        .object_mask = w->mask,
-    };
     for (int face = 0; face < 6; ++face) {
         rl_vec3 dir, up;
         rl_property_direction(face, &dir, &up);
@@ -215,9 +210,11 @@ static rl_status count_pixels(vis_state *s, vis_worker *w, rl_vec3 pos, double *
         rl_mat4 proj = rl_camera_projection(&cam, s->z_near, z_far);
         frustum_mask(d, pos, dir, up, s->z_near, w->mask);
         rl_image_clear(w->img);
-        rl_status st = rl_raster_set_target(w->ras, w->img, &view, &proj);
+        rl_status st = rl_drawer_begin(w->drawer, w->img, &view, &proj, pos);
         if (st == RL_OK)
-            st = rl_raster_draw_scene(w->ras, d, pos, &desc, NULL, NULL, NULL);
+            st = rl_drawer_draw_all(w->drawer, NULL, NULL, NULL);
+        if (st == RL_OK)
+            st = rl_drawer_end(w->drawer);
         if (st != RL_OK)
             return st;
 

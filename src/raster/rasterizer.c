@@ -76,11 +76,10 @@ rl_status rl_raster_set_target(rl_raster *r, rl_image *target, const rl_mat4 *vi
     return RL_OK;
 }
 
-rl_status rl_raster_set_camera(rl_raster *r, rl_image *target, const rl_camera *cam,
-                               rl_aabb scene_bounds)
+rl_status rl_raster_camera_matrices(const rl_camera *cam, rl_aabb scene_bounds, rl_mat4 *view, rl_mat4 *proj)
 {
-    if (!r || !target || !cam)
-        return rl_error(RL_ERR_INVALID_ARG, "rl_raster_set_camera: NULL argument");
+    if (!cam || !view || !proj)
+        return rl_error(RL_ERR_INVALID_ARG, "rl_raster_camera_matrices: NULL argument");
     rl_status st = rl_camera_validate(cam);
     if (st != RL_OK)
         return st;
@@ -91,9 +90,19 @@ rl_status rl_raster_set_camera(rl_raster *r, rl_image *target, const rl_camera *
     else if (!(z_far > z_near))
         return rl_error(RL_ERR_INVALID_ARG, "rl_raster_set_camera: z_far %g <= z_near %g",
                         (double)z_far, (double)z_near);
-    rl_mat4 view = rl_camera_view(&c);
-    rl_mat4 proj = rl_camera_projection(&c, z_near, z_far);
-    return rl_raster_set_target(r, target, &view, &proj);
+    *view = rl_camera_view(&c);
+    *proj = rl_camera_projection(&c, z_near, z_far);
+    return RL_OK;
+}
+
+rl_status rl_raster_set_camera(rl_raster *r, rl_image *target, const rl_camera *cam,
+                               rl_aabb scene_bounds)
+{
+    if (!r || !target || !cam)
+        return rl_error(RL_ERR_INVALID_ARG, "rl_raster_set_camera: NULL argument");
+    rl_mat4 view, proj;
+    rl_status st = rl_raster_camera_matrices(cam, scene_bounds, &view, &proj);
+    return st == RL_OK ? rl_raster_set_target(r, target, &view, &proj) : st;
 }
 
 rl_status rl_raster_reserve_chunks(rl_raster *r, int count)

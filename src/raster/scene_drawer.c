@@ -344,7 +344,7 @@ static rl_status object_batch(const rl_scene_data *d, uint32_t o, rl_raster_shad
 /* The drawer: buffers prepared once, objects lit on first draw. */
 struct rl_scene_drawer {
     const rl_scene_data *data;
-    rl_raster_scene_desc opt;
+    rl_drawer_desc opt;
     bool lit;                    /* the draws write colour */
     shade_ctx ctx;
     int threads;
@@ -365,7 +365,7 @@ struct rl_scene_drawer {
     size_t list_cap;
 };
 
-static rl_status check_desc(const rl_raster_scene_desc *opt, const char *fn)
+static rl_status check_desc(const rl_drawer_desc *opt, const char *fn)
 {
     if (opt->shading != RL_SHADING_FLAT && opt->shading != RL_SHADING_GOURAUD &&
         opt->shading != RL_SHADING_TEXTURED)
@@ -390,7 +390,7 @@ void rl_scene_drawer_release(rl_scene_drawer *dr)
     free(dr);
 }
 
-rl_status rl_scene_drawer_create(const rl_scene_data *d, rl_vec3 eye, const rl_raster_scene_desc *desc,
+rl_status rl_scene_drawer_create(const rl_scene_data *d, rl_vec3 eye, const rl_drawer_desc *desc,
                                  rl_scene_drawer **out)
 {
     if (!d || !out)
@@ -675,7 +675,7 @@ rl_status rl_scene_drawer_draw_all(rl_scene_drawer *dr, rl_raster *ras, rl_raste
 }
 
 rl_status rl_raster_draw_scene(rl_raster *ras, const rl_scene_data *d, rl_vec3 eye,
-                               const rl_raster_scene_desc *desc, rl_raster_counters *c,
+                               const rl_drawer_desc *desc, rl_raster_counters *c,
                                bool (*progress)(void *user, double done), void *user)
 {
     if (!ras || !d)
@@ -686,44 +686,4 @@ rl_status rl_raster_draw_scene(rl_raster *ras, const rl_scene_data *d, rl_vec3 e
         st = rl_scene_drawer_draw_all(dr, ras, c, progress, user);
     rl_scene_drawer_release(dr);
     return st;
-}
-
-static bool same_drawing(const rl_raster_scene_desc *a, const rl_raster_scene_desc *b)
-{
-    return a->shading == b->shading && a->ambient == b->ambient && a->threads == b->threads &&
-           a->flags == b->flags && a->object_mask == b->object_mask;
-}
-
-rl_status rl_drawer_keep_acquire(rl_drawer_keep *k, const rl_scene *scene, const rl_raster_scene_desc *desc,
-                                 rl_vec3 eye)
-{
-    if (!k || !scene || !desc)
-        return rl_error(RL_ERR_INVALID_ARG, "rl_drawer_keep_acquire: NULL argument");
-    if (k->ras && k->drawer && k->scene_uid == rl_scene_uid(scene) && same_drawing(&k->desc, desc)) {
-        rl_scene_drawer_new_frame(k->drawer, eye);
-        return RL_OK;
-    }
-    rl_drawer_keep_release(k);
-    const rl_scene_data *d = rl_scene_get_data(scene);
-    if (!d)
-        return rl_error(RL_ERR_NOT_COMMITTED, "rl_drawer_keep_acquire: the scene is not committed");
-    rl_status st = rl_raster_create(&(rl_raster_desc){ .threads = desc->threads }, &k->ras);
-    if (st == RL_OK)
-        st = rl_scene_drawer_create(d, eye, desc, &k->drawer);
-    if (st == RL_OK) {
-        k->scene_uid = rl_scene_uid(scene);
-        k->desc = *desc;
-    } else {
-        rl_drawer_keep_release(k);
-    }
-    return st;
-}
-
-void rl_drawer_keep_release(rl_drawer_keep *k)
-{
-    if (!k)
-        return;
-    rl_scene_drawer_release(k->drawer);
-    rl_raster_release(k->ras);
-    memset(k, 0, sizeof *k);
 }

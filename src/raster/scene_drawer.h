@@ -1,32 +1,20 @@
 /* scene_drawer.h: the software rasterizer's way of drawing a committed
- * scene (scene_drawer.c), shared by every renderer that rasterizes: the
- * "raster" renderer, Vertex Tracing (Ullmann 2003, Sec. 3.5: its ID/Z
- * pre-pass and its non-VT objects), the culling and level-of-detail
- * renderers and the visibility property, so that "rasterized" means the
- * same thing in every renderer.
+ * scene (scene_drawer.c), shared by every renderer that rasterizes, so that
+ * "rasterized" means the same thing in all of them. The "raster" renderer,
+ * the culling and level-of-detail renderers and the visibility property
+ * use it through rl_drawer (rl_drawer.h, drawer.c: its software backend);
+ * Vertex Tracing (Ullmann 2003, Sec. 3.5: its ID/Z pre-pass and its non-VT
+ * objects) and pt's rasterized G-buffer call it directly.
  *
  * Lighting is the local Phong model described in scene_drawer.c; it is
  * evaluated only when the draw writes colour. */
 #ifndef RL_RASTER_SCENE_DRAWER_H
 #define RL_RASTER_SCENE_DRAWER_H
 
+#include "rl/rl_drawer.h"
 #include "rl/rl_raster.h"
 #include "rl/rl_scene.h"
 
-typedef enum rl_raster_shading {
-    RL_SHADING_FLAT = 0,      /* per triangle, geometric normal at the centroid */
-    RL_SHADING_GOURAUD,       /* per vertex, interpolated */
-    RL_SHADING_TEXTURED,      /* gouraud times the diffuse texture */
-} rl_raster_shading;
-
-typedef struct rl_raster_scene_desc {
-    rl_raster_shading shading;
-    float ambient;            /* times k_d */
-    int threads;              /* for lighting; 0 = all */
-    unsigned flags;           /* rl_raster_flags added to every batch; with
-                               * RL_RASTER_NO_COLOR no lighting is computed */
-    const uint8_t *object_mask;   /* per object, nonzero = draw; NULL = all */
-} rl_raster_scene_desc;
 
 /* Draws the objects of d selected by the mask into the rasterizer's current
  * target (set with rl_raster_set_target/set_camera; it must have a depth
@@ -37,15 +25,8 @@ typedef struct rl_raster_scene_desc {
  * objects done about a hundred times; returning false cancels with
  * RL_ERR_CANCELLED. */
 rl_status rl_raster_draw_scene(rl_raster *ras, const rl_scene_data *d, rl_vec3 eye,
-                               const rl_raster_scene_desc *desc, rl_raster_counters *c,
+                               const rl_drawer_desc *desc, rl_raster_counters *c,
                                bool (*progress)(void *user, double done), void *user);
-
-/* raster's lighting of a diffuse point (the ambient and diffuse terms of
- * its Phong model, two-sided, quad lights as points): for primitives
- * without a mesh material, such as surfels, lit like the meshes they
- * replace. */
-rl_vec3 rl_raster_light_diffuse(const rl_scene_data *d, rl_vec3 p, rl_vec3 n, rl_vec3 kd, float ambient,
-                                rl_vec3 eye);
 
 /* The same drawing one object at a time, for renderers that decide per
  * object what to draw and in which order (occlusion culling, level of
@@ -58,7 +39,7 @@ rl_vec3 rl_raster_light_diffuse(const rl_scene_data *d, rl_vec3 p, rl_vec3 n, rl
  * selected object in index order gives exactly rl_raster_draw_scene's
  * image. The drawer borrows d and desc->object_mask. */
 typedef struct rl_scene_drawer rl_scene_drawer;
-rl_status rl_scene_drawer_create(const rl_scene_data *d, rl_vec3 eye, const rl_raster_scene_desc *desc,
+rl_status rl_scene_drawer_create(const rl_scene_data *d, rl_vec3 eye, const rl_drawer_desc *desc,
                                  rl_scene_drawer **out);
 /* Starts another frame with a drawer made for the same scene and desc: the
  * viewer moves to eye, and every object is lit again when it is first drawn.
@@ -88,24 +69,5 @@ void rl_scene_drawer_release(rl_scene_drawer *dr);    /* NULL is a no-op */
  * own. */
 rl_status rl_scene_drawer_draw_all(rl_scene_drawer *dr, rl_raster *ras, rl_raster_counters *c,
                                    bool (*progress)(void *user, double done), void *user);
-
-/* What a renderer keeps between frames: a rasterizer and a drawer, whose
- * per-vertex and per-corner buffers span the whole scene. Made afresh
- * every frame they cost more than drawing a culled set, and on a VM as
- * much as lighting the whole scene (allocating and faulting in about
- * 200 MB on `city`). Zero-initialise; released with rl_drawer_keep_release. */
-typedef struct rl_drawer_keep {
-    rl_raster *ras;
-    rl_scene_drawer *drawer;
-    uint64_t scene_uid;
-    rl_raster_scene_desc desc;
-} rl_drawer_keep;
-/* Makes k's rasterizer and drawer ready for a frame of scene drawn with
- * desc from eye: the kept ones (a new frame of the drawer) when the scene
- * (rl_scene_uid) and desc are those they were made for, else new ones.
- * On failure k is released (empty). */
-rl_status rl_drawer_keep_acquire(rl_drawer_keep *k, const rl_scene *scene, const rl_raster_scene_desc *desc,
-                                 rl_vec3 eye);
-void rl_drawer_keep_release(rl_drawer_keep *k);
 
 #endif

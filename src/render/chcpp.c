@@ -51,7 +51,7 @@
 
 #include "core/error.h"
 #include "render/culling.h"
-#include "raster/scene_drawer.h"
+#include "rl/rl_drawer.h"
 #include "render/renderer.h"
 #include "rl/rl_rng.h"
 #include "rl/rl_timer.h"
@@ -117,7 +117,7 @@ static void chcpp_release(void *state)
 {
     chcpp_state *s = state;
     rl_octree_cache_release(&s->oc);
-    rl_drawer_keep_release(&s->head.keep);
+    rl_drawer_release(s->head.drawer);
     rl_box_query_free(&s->query);
     free(s->ns);
     free(s->heap);
@@ -200,7 +200,7 @@ static rl_status traverse(frame_ctx *f, uint32_t n)
 {
     const rl_octree_node *node = &f->nodes[n];
     const uint32_t *objects = f->objects + node->first_object;
-    rl_status st = rl_scene_drawer_draw_list(f->cf.drawer, f->cf.ras, objects, node->num_objects, &f->cf.counters);
+    rl_status st = rl_drawer_draw(f->cf.drawer, objects, node->num_objects, &f->cf.counters);
     for (uint32_t k = 0; k < node->num_objects && st == RL_OK; ++k) {
         f->s->head.stats.objects_drawn++;
         f->s->head.stats.triangles_drawn += f->d->objects[objects[k]].num_triangles;
@@ -261,7 +261,7 @@ static rl_status query_nodes(frame_ctx *f, const uint32_t *list, uint32_t count,
         st = add_node_boxes(f, list[i]);
     uint64_t pixels = 0;
     if (st == RL_OK)
-        st = rl_box_query_run(&f->s->query, f->cf.ras, &pixels, NULL);
+        st = rl_box_query_run(&f->s->query, f->cf.drawer, &pixels, NULL);
     f->s->head.stats.queries++;
     f->s->head.stats.query_boxes += f->s->query.boxes;
     if (count > 1)
@@ -443,7 +443,7 @@ static rl_status chcpp_render(rl_renderer *r, void *state, const rl_scene *scene
     f.batch = (uint32_t)rl_renderer_opt_int(r, "batch");
     f.n_av = (uint32_t)rl_renderer_opt_int(r, "assumed_visible");
     f.seed = (uint64_t)rl_renderer_opt_int(r, "seed");
-    st = rl_cull_frame_begin(r, scene, &s->head.keep, cam, image, &f.cf);
+    st = rl_cull_frame_begin(r, scene, &s->head.drawer, cam, image, &f.cf);
     if (st != RL_OK)
         return st;
     s->frame++;

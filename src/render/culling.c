@@ -110,7 +110,7 @@ rl_status rl_box_query_add(rl_box_query *q, rl_aabb b, float margin)
     return RL_OK;
 }
 
-rl_status rl_box_query_run(rl_box_query *q, rl_raster *ras, uint64_t *pixels, rl_raster_counters *c)
+rl_status rl_box_query_run(rl_box_query *q, rl_drawer *dr, uint64_t *pixels, rl_raster_counters *c)
 {
     *pixels = 0;
     if (q->boxes == 0)
@@ -122,9 +122,7 @@ rl_status rl_box_query_run(rl_box_query *q, rl_raster *ras, uint64_t *pixels, rl
     batch.num_triangles = q->boxes * 12;
     batch.indices = q->indices;
     batch.flags = RL_RASTER_CULL_BACK;
-    if (c)
-        c->triangles_in += batch.num_triangles;
-    return rl_raster_query(ras, &batch, pixels);
+    return rl_drawer_query(dr, &batch, pixels, c);
 }
 
 void rl_box_query_free(rl_box_query *q)
@@ -211,7 +209,7 @@ rl_status rl_culling_get_stats(const rl_renderer *r, rl_culling_stats *out)
 
 const char *const rl_cull_shading_choices[] = { "flat", "gouraud", "textured", NULL };
 
-rl_status rl_cull_frame_begin(rl_renderer *r, const rl_scene *scene, rl_drawer_keep *keep, const rl_camera *cam,
+rl_status rl_cull_frame_begin(rl_renderer *r, const rl_scene *scene, rl_drawer **kept, const rl_camera *cam,
                               rl_image *image, rl_cull_frame *f)
 {
     const rl_scene_data *d = rl_scene_get_data(scene);
@@ -223,7 +221,7 @@ rl_status rl_cull_frame_begin(rl_renderer *r, const rl_scene *scene, rl_drawer_k
     f->threads = 1;
 #endif
     f->ambient = (float)rl_renderer_opt_float(r, "ambient");
-    rl_raster_scene_desc desc = {
+    rl_drawer_desc desc = {
         .shading = (rl_raster_shading)rl_renderer_opt_enum(r, "shading"),
         .ambient = f->ambient,
         .threads = f->threads_opt,
@@ -234,21 +232,30 @@ rl_status rl_cull_frame_begin(rl_renderer *r, const rl_scene *scene, rl_drawer_k
         return st;
     desc.flags |= f->target.flags;
     rl_cull_view_make(cam, d->bounds, &f->view);
-    st = rl_drawer_keep_acquire(keep, scene, &desc, f->view.eye);
-    f->ras = keep->ras;
-    f->drawer = keep->drawer;
+    /* The drawer is kept while the scene and options stay: its buffers
+     * span the whole scene. */
+    if (!rl_drawer_fits(*kept, scene, &desc)) {
+        rl_drawer_release(*kept);
+        *kept = NULL;
+        st = rl_drawer_create(scene, &desc, kept);
+    }
+    f->drawer = *kept;
     if (st == RL_OK)
-        st = rl_raster_set_target(f->ras, &f->target.image, &f->view.view, &f->view.proj);
-    if (st != RL_OK)
-        rl_cull_frame_end(f, st, image, NULL);
+        st = rl_drawer_begin(f->drawer, &f->target.image, &f->view.view, &f->view.proj, f->view.eye);
+    if (st != RL_OK) {
+        rl_cull_target_end(&f->target);
+        f->drawer = NULL;
+    }
     return st;
 }
 
 rl_status rl_cull_frame_end(rl_cull_frame *f, rl_status st, const rl_image *image, rl_render_stats *stats)
 {
+    rl_status end = f->drawer ? rl_drawer_end(f->drawer) : RL_OK;
+    if (st == RL_OK)
+        st = end;
     rl_cull_target_end(&f->target);
     f->drawer = NULL;
-    f->ras = NULL;
     if (st == RL_OK && stats) {
         stats->triangles_rasterized = f->counters.triangles_drawn;
         stats->points_drawn = f->counters.points_drawn;

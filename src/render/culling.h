@@ -6,7 +6,7 @@
 #ifndef RL_RENDER_CULLING_H
 #define RL_RENDER_CULLING_H
 
-#include "raster/scene_drawer.h"
+#include "rl/rl_drawer.h"
 #include "rl/rl_culling.h"
 #include "rl/rl_octree.h"
 #include "rl/rl_raster.h"
@@ -48,7 +48,7 @@ void rl_box_query_reset(rl_box_query *q);
 rl_aabb rl_box_query_bounds(rl_aabb b, float margin);
 rl_status rl_box_query_add(rl_box_query *q, rl_aabb b, float margin);
 /* Visible pixels of all boxes added since the last reset (0 boxes: 0). */
-rl_status rl_box_query_run(rl_box_query *q, rl_raster *ras, uint64_t *pixels, rl_raster_counters *c);
+rl_status rl_box_query_run(rl_box_query *q, rl_drawer *dr, uint64_t *pixels, rl_raster_counters *c);
 void rl_box_query_free(rl_box_query *q);
 
 /* The caller's image as the rasterizer's target, with a private depth
@@ -86,24 +86,23 @@ extern const char *const rl_cull_shading_choices[];
     { "threads", RL_OPT_INT, "0", "OpenMP threads (0 = all)", 0, 1024, NULL }
 
 /* One frame of a culling renderer: the caller's image as target, the view,
- * a rasterizer on it and a drawer for the objects, from the shared
- * options (the rasterizer and drawer are the renderer's kept ones). */
+ * and the renderer's kept drawer (rl_drawer.h, any backend) begun on them,
+ * from the shared options. */
 typedef struct rl_cull_frame {
     rl_cull_target target;
     rl_cull_view view;
-    rl_raster *ras;
-    rl_scene_drawer *drawer;
+    rl_drawer *drawer;            /* the renderer's kept one, begun on the target */
     rl_raster_counters counters;
     int threads_opt;              /* the option: 0 = all */
     int threads;                  /* resolved, >= 1 */
     float ambient;
 } rl_cull_frame;
 
-rl_status rl_cull_frame_begin(rl_renderer *r, const rl_scene *scene, rl_drawer_keep *keep, const rl_camera *cam,
+rl_status rl_cull_frame_begin(rl_renderer *r, const rl_scene *scene, rl_drawer **kept, const rl_camera *cam,
                               rl_image *image, rl_cull_frame *f);
-/* Releases what begin made (not the kept rasterizer and drawer); with st
- * == RL_OK fills stats (triangles, points, pixels written, samples).
- * Returns st. */
+/* Ends the drawer's frame and releases what begin made (not the kept
+ * drawer); with st == RL_OK fills stats (triangles, points, pixels
+ * written, samples). Returns st, or the end's failure. */
 rl_status rl_cull_frame_end(rl_cull_frame *f, rl_status st, const rl_image *image, rl_render_stats *stats);
 
 /* Every culling renderer's state starts with this, so that
@@ -111,7 +110,7 @@ rl_status rl_cull_frame_end(rl_cull_frame *f, rl_status st, const rl_image *imag
 typedef struct rl_culling_head {
     rl_culling_stats stats;
     bool have_frame;
-    rl_drawer_keep keep;          /* released by the renderer's release */
+    rl_drawer *drawer;            /* kept across frames; released by the renderer's release */
 } rl_culling_head;
 
 /* The statistics of r's last frame, or NULL when r is not a culling

@@ -213,7 +213,7 @@ rl_status rl_gbuffer_raster(rl_gbuffer *g, const rl_scene *scene, const rl_camer
         st = rl_raster_set_camera(ras, ids, &c, d->bounds);
     if (st == RL_OK) {
         /* Visibility only: no lighting, as the ID pass of the hybrid renderers. */
-        rl_raster_scene_desc desc = { .flags = RL_RASTER_NO_COLOR };
+        rl_drawer_desc desc = { .flags = RL_RASTER_NO_COLOR };
         st = rl_raster_draw_scene(ras, d, c.eye, &desc, NULL, NULL, NULL);
     }
     rl_raster_release(ras);

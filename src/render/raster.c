@@ -5,9 +5,9 @@
  * The lighting model and its deviations from the thesis are those of the
  * scene drawer (src/raster/scene_drawer.c), which the hybrid and culling
  * renderers share. raster_render() only sets up the target, clears it and
- * draws every object with the drawer it keeps between frames
- * (rl_drawer_keep): the buffers for the whole scene are made once, the
- * lighting is redone every frame.
+ * draws every object with the drawer (rl_drawer.h) it keeps between
+ * frames: the buffers for the whole scene are made once, the lighting is
+ * redone every frame.
  *
  * Options (defaults): shading = textured (flat | gouraud | textured),
  * cull = false, ambient = 0.05, background = "0,0,0", threads = 0 (all). */
@@ -15,7 +15,7 @@
 #include <string.h>
 
 #include "core/error.h"
-#include "raster/scene_drawer.h"
+#include "rl/rl_drawer.h"
 #include "render/renderer.h"
 #include "rl/rl_raster.h"
 
@@ -42,13 +42,13 @@ static bool renderer_progress(void *user, double done)
  * (the drawer's buffers span the whole scene). Every frame still lights
  * every object, as plain rasterization does. */
 typedef struct raster_state {
-    rl_drawer_keep keep;
+    rl_drawer *drawer;
 } raster_state;
 
 static void raster_release(void *state)
 {
     raster_state *s = state;
-    rl_drawer_keep_release(&s->keep);
+    rl_drawer_release(s->drawer);
 }
 
 static rl_status raster_render(rl_renderer *r, void *state, const rl_scene *scene,
@@ -58,7 +58,7 @@ static rl_status raster_render(rl_renderer *r, void *state, const rl_scene *scen
     const rl_scene_data *d = rl_scene_get_data(scene);
     if (!d)
         return RL_ERR_NOT_COMMITTED;
-    rl_raster_scene_desc desc = {
+    rl_drawer_desc desc = {
         .shading = (rl_raster_shading)rl_renderer_opt_enum(r, "shading"),
         .ambient = (float)rl_renderer_opt_float(r, "ambient"),
         .threads = (int)rl_renderer_opt_int(r, "threads"),
@@ -80,9 +80,14 @@ static rl_status raster_render(rl_renderer *r, void *state, const rl_scene *scen
     if (!(target.layers & RL_LAYER_ID) || !target.object_id || !target.triangle_id)
         desc.flags |= RL_RASTER_NO_ID;
 
-    rl_status st = rl_drawer_keep_acquire(&s->keep, scene, &desc, cam->eye);
+    rl_status st = RL_OK;
+    if (!rl_drawer_fits(s->drawer, scene, &desc)) {
+        rl_drawer_release(s->drawer);
+        s->drawer = NULL;
+        st = rl_drawer_create(scene, &desc, &s->drawer);
+    }
     if (st == RL_OK)
-        st = rl_raster_set_camera(s->keep.ras, &target, cam, d->bounds);
+        st = rl_drawer_begin_camera(s->drawer, &target, cam, d->bounds);
     if (st == RL_OK) {
         rl_vec3 bg = rl_renderer_opt_color(r, "background");
         rl_image_clear_to(&target, rl_v4_from3(bg, 1.0f));
@@ -90,7 +95,9 @@ static rl_status raster_render(rl_renderer *r, void *state, const rl_scene *scen
     rl_raster_counters counters;
     memset(&counters, 0, sizeof counters);
     if (st == RL_OK)
-        st = rl_scene_drawer_draw_all(s->keep.drawer, s->keep.ras, &counters, renderer_progress, r);
+        st = rl_drawer_draw_all(s->drawer, &counters, renderer_progress, r);
+    if (st == RL_OK)
+        st = rl_drawer_end(s->drawer);
     free(own_depth);
     if (st != RL_OK)
         return st;

@@ -36,7 +36,7 @@
 
 #include "core/error.h"
 #include "render/culling.h"
-#include "raster/scene_drawer.h"
+#include "rl/rl_drawer.h"
 #include "render/renderer.h"
 #include "render/surfels_internal.h"
 #include "rl/rl_surfels.h"
@@ -106,7 +106,7 @@ static void surfels_release(void *state)
     surfels_state *s = state;
     drop_sets(s);
     rl_octree_cache_release(&s->oc);
-    rl_drawer_keep_release(&s->head.keep);
+    rl_drawer_release(s->head.drawer);
     free(s->pos);
     free(s->col);
     free(s->size);
@@ -243,7 +243,7 @@ static rl_status draw_prefix(surfels_frame *f, const rl_surfel_set *set, uint32_
     s->head.stats.points_drawn += kept;
     rl_raster_counters c;
     memset(&c, 0, sizeof c);
-    st = rl_raster_draw_points(f->cf.ras, &pts, &c);
+    st = rl_drawer_draw_points(f->cf.drawer, &pts, &c);
     f->cf.counters.pixels_written += c.pixels_written;
     f->cf.counters.points_drawn += c.points_drawn;
     return st;
@@ -306,7 +306,7 @@ static rl_status draw_cmds(surfels_frame *f)
     for (size_t i = 0; i < s->num_cmds; ++i)
         if (s->cmds[i].m == 0)
             s->lit[k++] = s->cmds[i].index;
-    rl_scene_drawer_light(f->cf.drawer, s->lit, (uint32_t)k);
+    rl_drawer_light(f->cf.drawer, s->lit, (uint32_t)k);
     /* Each run of meshes between surfel prefixes is one list, drawn on all
      * threads together (s->lit holds the runs' objects in order). */
     rl_status st = RL_OK;
@@ -321,7 +321,7 @@ static rl_status draw_cmds(surfels_frame *f)
         size_t n = 0;
         for (; i < s->num_cmds && s->cmds[i].m == 0; ++i)
             ++n;
-        st = rl_scene_drawer_draw_list(f->cf.drawer, f->cf.ras, s->lit + run, (uint32_t)n, &f->cf.counters);
+        st = rl_drawer_draw(f->cf.drawer, s->lit + run, (uint32_t)n, &f->cf.counters);
         run += n;
     }
     return st;
@@ -388,7 +388,7 @@ static rl_status surfels_render(rl_renderer *r, void *state, const rl_scene *sce
     f.max_size = max_size;
     f.overdraw = (float)rl_renderer_opt_float(r, "overdraw");
     f.point_size = (float)rl_renderer_opt_float(r, "point_size");
-    st = rl_cull_frame_begin(r, scene, &s->head.keep, cam, image, &f.cf);
+    st = rl_cull_frame_begin(r, scene, &s->head.drawer, cam, image, &f.cf);
     if (st != RL_OK)
         return st;
     s->num_cmds = 0;

@@ -46,7 +46,7 @@
 
 #include "core/error.h"
 #include "render/culling.h"
-#include "raster/scene_drawer.h"
+#include "rl/rl_drawer.h"
 #include "render/renderer.h"
 #include "rl/rl_timer.h"
 
@@ -83,7 +83,7 @@ typedef struct svs_state {
     uint32_t *stamp;              /* per object: frame it was drawn in */
     uint32_t frame;
     /* This frame's objects, in the order the traversal found them: drawn
-     * as one list (rl_scene_drawer_draw_list), on all threads. */
+     * as one list (rl_drawer_draw), on all threads. */
     uint32_t *draw;
     uint32_t num_draw;
 } svs_state;
@@ -108,7 +108,7 @@ static void svs_release(void *state)
     svs_state *s = state;
     drop_sets(s);
     rl_octree_cache_release(&s->oc);
-    rl_drawer_keep_release(&s->head.keep);
+    rl_drawer_release(s->head.drawer);
 }
 
 /* --- sample directions: a subdivided icosahedron --- */
@@ -204,9 +204,8 @@ static void ortho_view(rl_vec3 c, float r, rl_vec3 dir, rl_mat4 *view, rl_mat4 *
 }
 
 typedef struct svs_worker {
-    rl_raster *ras;
     rl_image *img;
-    rl_scene_drawer *drawer;
+    rl_drawer *drawer;            /* IDs only, one thread: the workers run in parallel */
     uint32_t *cand;               /* candidate objects */
     uint32_t *stamp;              /* per object: dedupe of candidates and results */
     uint32_t tick;
@@ -257,9 +256,11 @@ static rl_status sample_set(const svs_state *s, const rl_scene_data *d, const rl
     rl_mat4 view, proj;
     ortho_view(c, r, s->dirs[k], &view, &proj);
     rl_image_clear(w->img);
-    rl_status st = rl_raster_set_target(w->ras, w->img, &view, &proj);
+    rl_status st = rl_drawer_begin(w->drawer, w->img, &view, &proj, rl_v3s(0.0f));
     if (st == RL_OK)
-        st = rl_scene_drawer_draw_list(w->drawer, w->ras, w->cand, nc, NULL);
+        st = rl_drawer_draw(w->drawer, w->cand, nc, NULL);
+    if (st == RL_OK)
+        st = rl_drawer_end(w->drawer);
     if (st != RL_OK)
         return st;
     if (++w->tick == 0) {
@@ -307,14 +308,11 @@ static rl_status build_sets(svs_state *s, const rl_scene *scene, int threads)
 #endif
     svs_worker *w = rl_calloc((size_t)nt, sizeof *w);
     st = w ? RL_OK : RL_ERR_OUT_OF_MEMORY;
-    const rl_raster_scene_desc desc = { .flags = RL_RASTER_NO_COLOR, .threads = 1 };
+    const rl_drawer_desc desc = { .flags = RL_RASTER_NO_COLOR, .threads = 1 };
     for (int i = 0; i < nt && st == RL_OK; ++i) {
-        st = rl_raster_create(&(rl_raster_desc){ .threads = 1 }, &w[i].ras);
+        st = rl_image_create(s->params.resolution, s->params.resolution, RL_LAYER_DEPTH | RL_LAYER_ID, &w[i].img);
         if (st == RL_OK)
-            st = rl_image_create(s->params.resolution, s->params.resolution, RL_LAYER_DEPTH | RL_LAYER_ID,
-                                 &w[i].img);
-        if (st == RL_OK)
-            st = rl_scene_drawer_create(d, rl_v3s(0.0f), &desc, &w[i].drawer);
+            st = rl_drawer_create(scene, &desc, &w[i].drawer);
         if (st == RL_OK) {
             w[i].cand = rl_calloc(d->num_objects, sizeof *w[i].cand);
             w[i].stamp = rl_calloc(d->num_objects, sizeof *w[i].stamp);
@@ -356,9 +354,8 @@ static rl_status build_sets(svs_state *s, const rl_scene *scene, int threads)
         st = shared;
     }
     for (int i = 0; i < nt && w; ++i) {
-        rl_raster_release(w[i].ras);
         rl_image_release(w[i].img);
-        rl_scene_drawer_release(w[i].drawer);
+        rl_drawer_release(w[i].drawer);
         free(w[i].cand);
         free(w[i].stamp);
     }
@@ -519,7 +516,7 @@ static rl_status svs_render(rl_renderer *r, void *state, const rl_scene *scene, 
     f.distance = (float)rl_renderer_opt_float(r, "distance");
     if (f.neighbours > s->num_dirs)
         f.neighbours = s->num_dirs;
-    st = rl_cull_frame_begin(r, scene, &s->head.keep, cam, image, &f.cf);
+    st = rl_cull_frame_begin(r, scene, &s->head.drawer, cam, image, &f.cf);
     if (st != RL_OK)
         return st;
     if (++s->frame == 0) {
@@ -529,7 +526,7 @@ static rl_status svs_render(rl_renderer *r, void *state, const rl_scene *scene, 
     s->num_draw = 0;
     st = draw_node(&f, 0);
     if (st == RL_OK)
-        st = rl_scene_drawer_draw_list(f.cf.drawer, f.cf.ras, s->draw, s->num_draw, &f.cf.counters);
+        st = rl_drawer_draw(f.cf.drawer, s->draw, s->num_draw, &f.cf.counters);
     st = rl_cull_frame_end(&f.cf, st, image, stats);
     if (st != RL_OK)
         return st;

@@ -30,7 +30,7 @@
 
 #include "core/error.h"
 #include "render/culling.h"
-#include "raster/scene_drawer.h"
+#include "rl/rl_drawer.h"
 #include "render/renderer.h"
 #include "rl/rl_timer.h"
 
@@ -60,7 +60,7 @@ typedef struct visset_state {
     uint32_t frame;
     uint32_t frames_outside;      /* viewer outside the sampled region */
     /* This frame's objects in drawing order, drawn as one list
-     * (rl_scene_drawer_draw_list), on all threads. */
+     * (rl_drawer_draw), on all threads. */
     uint32_t *draw;
     uint32_t num_draw;
 } visset_state;
@@ -84,7 +84,7 @@ static void visset_release(void *state)
 {
     visset_state *s = state;
     drop(s);
-    rl_drawer_keep_release(&s->head.keep);
+    rl_drawer_release(s->head.drawer);
 }
 
 typedef struct ranked {
@@ -234,7 +234,7 @@ static rl_status visset_render(rl_renderer *r, void *state, const rl_scene *scen
     f.s = s;
     f.d = d;
     f.budget = budget;
-    st = rl_cull_frame_begin(r, scene, &s->head.keep, cam, image, &f.cf);
+    st = rl_cull_frame_begin(r, scene, &s->head.drawer, cam, image, &f.cf);
     if (st != RL_OK)
         return st;
     if (++s->frame == 0) {
@@ -262,7 +262,7 @@ static rl_status visset_render(rl_renderer *r, void *state, const rl_scene *scen
                 st = draw_object(&f, o);
     }
     if (st == RL_OK)
-        st = rl_scene_drawer_draw_list(f.cf.drawer, f.cf.ras, s->draw, s->num_draw, &f.cf.counters);
+        st = rl_drawer_draw(f.cf.drawer, s->draw, s->num_draw, &f.cf.counters);
     st = rl_cull_frame_end(&f.cf, st, image, stats);
     if (st != RL_OK)
         return st;

@@ -300,7 +300,7 @@ rl_status vt_draw_base(vt_run *run)
          * objects. Drawn once: the pre-pass adds the VT objects to a copy
          * of this depth, the VT faces go on top of it. */
         rl_image_clear_to(&target, rl_v4_from3(run->set->background, 1.0f));
-        rl_raster_scene_desc desc = { .shading = run->set->shading, .ambient = run->set->ambient,
+        rl_drawer_desc desc = { .shading = run->set->shading, .ambient = run->set->ambient,
                                       .threads = run->set->threads, .flags = id_flags_of(&target),
                                       .object_mask = run->object_raster };
         st = rl_raster_draw_scene(ras, run->data, run->view.eye, &desc, &run->counters, NULL, NULL);

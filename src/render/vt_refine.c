@@ -67,7 +67,7 @@ rl_status vt_prepass(vt_run *run, rl_image *depth_ids)
         rl_image_clear(&ids);
         memcpy(depth_ids->depth, frame.depth,
                (size_t)frame.width * (size_t)frame.height * sizeof *frame.depth);
-        rl_raster_scene_desc desc = { .shading = RL_SHADING_FLAT, .threads = set->threads,
+        rl_drawer_desc desc = { .shading = RL_SHADING_FLAT, .threads = set->threads,
                                       .flags = RL_RASTER_NO_COLOR, .object_mask = run->object_vt };
         rl_raster_counters c;
         memset(&c, 0, sizeof c);

@@ -13,6 +13,7 @@
 #include <cmocka.h>
 
 #include "raster/scene_drawer.h"
+#include "rl/rl_drawer.h"
 #include "rl/rl_raster.h"
 #include "rl/rl_render.h"
 #include "rl/rl_scene.h"
@@ -78,7 +79,7 @@ typedef struct drawn {
 } drawn;
 
 /* A fresh image (colour filled with fill) drawn into with draw_scene. */
-static drawn draw_scene(const rl_scene *s, const rl_camera *cam, const rl_raster_scene_desc *desc,
+static drawn draw_scene(const rl_scene *s, const rl_camera *cam, const rl_drawer_desc *desc,
                         rl_vec4 fill)
 {
     const rl_scene_data *d = rl_scene_get_data(s);
@@ -107,7 +108,7 @@ static void test_mask_draws_only_the_selected_objects(void **state)
     (void)state;
     rl_camera cam;
     rl_scene *s = stack_scene(&cam);
-    rl_raster_scene_desc desc = { .shading = RL_SHADING_TEXTURED, .ambient = 0.05f };
+    rl_drawer_desc desc = { .shading = RL_SHADING_TEXTURED, .ambient = 0.05f };
     drawn all = draw_scene(s, &cam, &desc, rl_v4(0, 0, 0, 1));
     for (uint32_t o = 0; o < 3; ++o)
         assert_true(pixels_of(all.img, o) > 50);
@@ -154,7 +155,7 @@ static void test_no_color_writes_depth_and_ids_of_a_lit_draw_and_leaves_colour_a
                                          RL_SHADING_TEXTURED };
     const size_t n = (size_t)SIZE * SIZE;
     for (int k = 0; k < 3; ++k) {
-        rl_raster_scene_desc desc = { .shading = modes[k], .ambient = 0.1f };
+        rl_drawer_desc desc = { .shading = modes[k], .ambient = 0.1f };
         drawn lit = draw_scene(s, &cam, &desc, sentinel);
         desc.flags = RL_RASTER_NO_COLOR;
         drawn ids = draw_scene(s, &cam, &desc, sentinel);
@@ -185,7 +186,7 @@ static void test_raster_renderer_output_equals_drawing_the_whole_scene(void **st
         rl_render_stats stats;
         memset(&stats, 0, sizeof stats);
         rl_image *rendered = fx_render("raster", s, &cam, FX_ALL_LAYERS, opts, &stats);
-        rl_raster_scene_desc desc = { .shading = (rl_raster_shading)k, .ambient = 0.2f,
+        rl_drawer_desc desc = { .shading = (rl_raster_shading)k, .ambient = 0.2f,
                                       .flags = RL_RASTER_CULL_BACK };
         drawn direct = draw_scene(s, &cam, &desc, rl_v4(0.1f, 0.2f, 0.3f, 1.0f));
         fx_assert_images_identical(rendered, direct.img);
@@ -223,7 +224,7 @@ static void test_lighting_ahead_draws_the_same_image(void **state)
         list[n++] = o;                    /* each twice */
     list[n++] = d->num_objects + 7;       /* out of range */
     for (int k = 0; k < 3; ++k) {
-        rl_raster_scene_desc desc = { .shading = (rl_raster_shading)k, .ambient = 0.1f, .object_mask = mask };
+        rl_drawer_desc desc = { .shading = (rl_raster_shading)k, .ambient = 0.1f, .object_mask = mask };
         rl_scene_drawer *dr = NULL;
         assert_int_equal(rl_scene_drawer_create(d, cam.eye, &desc, &dr), RL_OK);
         for (int frame = 0; frame < 2; ++frame) {
@@ -265,7 +266,7 @@ static void test_a_list_draws_what_its_objects_draw_one_by_one(void **state)
     uint8_t mask[3] = { 1, 0, 1 };
     const uint32_t list[4] = { 2, 0, 1, 2 };
     for (int k = 0; k < 6; ++k) {
-        rl_raster_scene_desc desc = { .shading = (rl_raster_shading)(k % 3), .ambient = 0.1f,
+        rl_drawer_desc desc = { .shading = (rl_raster_shading)(k % 3), .ambient = 0.1f,
                                       .object_mask = k >= 3 ? mask : NULL };
         rl_scene_drawer *one = NULL, *many = NULL;
         assert_int_equal(rl_scene_drawer_create(d, cam.eye, &desc, &one), RL_OK);
@@ -335,7 +336,7 @@ static void test_progress_reaches_one_and_can_cancel(void **state)
     rl_raster *ras = NULL;
     assert_int_equal(rl_raster_create(NULL, &ras), RL_OK);
     assert_int_equal(rl_raster_set_camera(ras, img, &cam, d->bounds), RL_OK);
-    rl_raster_scene_desc desc = { .shading = RL_SHADING_GOURAUD };
+    rl_drawer_desc desc = { .shading = RL_SHADING_GOURAUD };
 
     progress_log log = { 0, 0.0, 0 };
     assert_int_equal(rl_raster_draw_scene(ras, d, cam.eye, &desc, NULL, log_progress, &log),
@@ -360,6 +361,105 @@ static void test_progress_reaches_one_and_can_cancel(void **state)
     rl_scene_release(s);
 }
 
+/* rl_drawer (rl_drawer.h), the interface the culling renderers and the
+ * visibility property draw through: a kept drawer, begun frame after
+ * frame, draws exactly what rl_raster_draw_scene draws; lists, queries and
+ * points reach the rasterizer; misuse is refused. */
+static void test_the_public_drawer_draws_what_the_scene_drawer_draws(void **state)
+{
+    (void)state;
+    rl_camera cam;
+    rl_scene *s = stack_scene(&cam);
+    const rl_scene_data *d = rl_scene_get_data(s);
+    rl_drawer_desc desc = { .shading = RL_SHADING_GOURAUD, .ambient = 0.05f };
+    rl_drawer *dr = NULL;
+    assert_int_equal(rl_drawer_create(s, &desc, &dr), RL_OK);
+    assert_string_equal(rl_drawer_backend(dr), "software");
+    assert_true(rl_drawer_fits(dr, s, &desc));
+    rl_drawer_desc other = desc;
+    other.ambient = 0.1f;
+    assert_false(rl_drawer_fits(dr, s, &other));
+    rl_image *img = NULL;
+    assert_int_equal(rl_image_create(cam.width, cam.height, FX_ALL_LAYERS, &img), RL_OK);
+    /* Two frames from two eyes with the same drawer: each equals a fresh
+     * draw of the scene (lighting redone for the new eye). */
+    for (int frame = 0; frame < 2; ++frame) {
+        rl_camera c = cam;
+        c.eye.x += 0.3f * (float)frame;
+        drawn want = draw_scene(s, &c, &desc, rl_v4(0, 0, 0, 1));
+        rl_image_clear_to(img, rl_v4(0, 0, 0, 1));
+        rl_raster_counters counters = { 0 };
+        assert_int_equal(rl_drawer_begin_camera(dr, img, &c, d->bounds), RL_OK);
+        assert_int_equal(rl_drawer_draw_all(dr, &counters, NULL, NULL), RL_OK);
+        assert_int_equal(rl_drawer_end(dr), RL_OK);
+        fx_assert_images_identical(img, want.img);
+        assert_int_equal(counters.triangles_drawn, want.counters.triangles_drawn);
+        rl_image_release(want.img);
+    }
+    /* A list in back-to-front order draws the same image as all. */
+    rl_image *listed = NULL;
+    assert_int_equal(rl_image_create(cam.width, cam.height, FX_ALL_LAYERS, &listed), RL_OK);
+    rl_image_clear_to(listed, rl_v4(0, 0, 0, 1));
+    const uint32_t order[3] = { 0, 1, 2 };
+    assert_int_equal(rl_drawer_begin_camera(dr, listed, &cam, d->bounds), RL_OK);
+    rl_drawer_light(dr, order, 3);
+    assert_int_equal(rl_drawer_draw(dr, order, 3, NULL), RL_OK);
+    /* An occlusion query of a quad hidden behind object 1 sees nothing, one
+     * in front of object 0 sees its pixels; neither writes. */
+    const rl_vec3 far[4] = { { -0.4f, 0.0f, -0.7f }, { 0.1f, 0.0f, -0.7f }, { 0.1f, 0.5f, -0.7f },
+                             { -0.4f, 0.5f, -0.7f } };
+    const rl_vec3 near[4] = { { -0.5f, -0.8f, -0.2f }, { -0.3f, -0.8f, -0.2f }, { -0.3f, -0.5f, -0.2f },
+                              { -0.5f, -0.5f, -0.2f } };
+    const uint32_t quad[6] = { 0, 1, 2, 0, 2, 3 };
+    rl_raster_batch box = { .num_vertices = 4, .positions = far, .num_triangles = 2, .indices = quad };
+    uint64_t pixels = 99;
+    rl_raster_counters qc = { 0 };
+    assert_int_equal(rl_drawer_query(dr, &box, &pixels, &qc), RL_OK);
+    assert_int_equal(pixels, 0);
+    assert_int_equal(qc.triangles_in, 2);
+    box.positions = near;
+    assert_int_equal(rl_drawer_query(dr, &box, &pixels, NULL), RL_OK);
+    assert_true(pixels > 10);
+    assert_int_equal(rl_drawer_end(dr), RL_OK);
+    rl_image *all = NULL;
+    assert_int_equal(rl_image_create(cam.width, cam.height, FX_ALL_LAYERS, &all), RL_OK);
+    rl_image_clear_to(all, rl_v4(0, 0, 0, 1));
+    assert_int_equal(rl_drawer_begin_camera(dr, all, &cam, d->bounds), RL_OK);
+    assert_int_equal(rl_drawer_draw_all(dr, NULL, NULL, NULL), RL_OK);
+    /* Points land where they are drawn and count. */
+    const rl_vec3 pos[1] = { { -0.4f, -0.65f, -0.1f } };
+    const rl_vec4 col[1] = { { 1, 1, 0, 1 } };
+    const float size[1] = { 3.0f };
+    rl_raster_points pts = { .count = 1, .positions = pos, .colors = col, .sizes_px = size };
+    rl_raster_counters pc = { 0 };
+    assert_int_equal(rl_drawer_draw_points(dr, &pts, &pc), RL_OK);
+    assert_int_equal(pc.points_drawn, 1);
+    assert_int_equal(rl_drawer_end(dr), RL_OK);
+    size_t yellow = 0;
+    for (size_t i = 0; i < (size_t)cam.width * cam.height; ++i) {
+        yellow += all->color[i].x == 1.0f && all->color[i].y == 1.0f && all->color[i].z == 0.0f;
+        if (listed->color[i].x != all->color[i].x && !(all->color[i].y == 1.0f && all->color[i].z == 0.0f))
+            fail_msg("pixel %zu: the list drew another colour than draw_all", i);
+    }
+    assert_true(yellow >= 4);
+    /* Misuse: no frame begun, a target without depth, NULL arguments. */
+    rl_clear_error();
+    assert_int_equal(rl_drawer_draw(dr, order, 3, NULL), RL_ERR_INVALID_ARG);
+    assert_int_equal(rl_drawer_end(dr), RL_ERR_INVALID_ARG);
+    rl_image *flat = NULL;
+    assert_int_equal(rl_image_create(8, 8, RL_LAYER_COLOR, &flat), RL_OK);
+    assert_int_equal(rl_drawer_begin_camera(dr, flat, &cam, d->bounds), RL_ERR_INVALID_ARG);
+    assert_int_equal(rl_drawer_create(NULL, &desc, &dr), RL_ERR_INVALID_ARG);
+    rl_clear_error();
+    rl_image_release(flat);
+    rl_image_release(all);
+    rl_image_release(listed);
+    rl_image_release(img);
+    rl_drawer_release(dr);
+    rl_drawer_release(NULL);
+    rl_scene_release(s);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -369,6 +469,7 @@ int main(void)
         cmocka_unit_test(test_lighting_ahead_draws_the_same_image),
         cmocka_unit_test(test_a_list_draws_what_its_objects_draw_one_by_one),
         cmocka_unit_test(test_progress_reaches_one_and_can_cancel),
+        cmocka_unit_test(test_the_public_drawer_draws_what_the_scene_drawer_draws),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

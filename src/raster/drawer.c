@@ -1,0 +1,225 @@
+/* drawer.c: rl_drawer (rl_drawer.h) over its backends, and the software
+ * backend: the rasterizer of rasterizer.c with the scene drawer of
+ * scene_drawer.c, whose images every software renderer shares. Every call
+ * checks its arguments once here and dispatches through the backend's
+ * table (drawer_backend.h). */
+#include "raster/drawer_backend.h"
+
+#include <stdlib.h>
+#include <string.h>
+
+#include "core/error.h"
+#include "raster/scene_drawer.h"
+
+struct rl_drawer {
+    const rl_drawer_ops *ops;
+    void *impl;
+    uint64_t scene_uid;
+    rl_drawer_desc desc;
+    bool in_frame;
+};
+
+rl_status rl_drawer_make(const rl_drawer_ops *ops, void *impl, const rl_scene *scene, const rl_drawer_desc *desc,
+                         rl_drawer **out)
+{
+    rl_drawer *dr = rl_calloc(1, sizeof *dr);
+    if (!dr) {
+        ops->release(impl);
+        return RL_ERR_OUT_OF_MEMORY;
+    }
+    *dr = (rl_drawer){ .ops = ops, .impl = impl, .scene_uid = rl_scene_uid(scene) };
+    if (desc)
+        dr->desc = *desc;
+    *out = dr;
+    return RL_OK;
+}
+
+void rl_drawer_release(rl_drawer *dr)
+{
+    if (!dr)
+        return;
+    dr->ops->release(dr->impl);
+    free(dr);
+}
+
+bool rl_drawer_fits(const rl_drawer *dr, const rl_scene *scene, const rl_drawer_desc *desc)
+{
+    static const rl_drawer_desc zero;
+    const rl_drawer_desc *d = desc ? desc : &zero;
+    return dr && scene && dr->scene_uid == rl_scene_uid(scene) && dr->desc.shading == d->shading &&
+           dr->desc.ambient == d->ambient && dr->desc.threads == d->threads && dr->desc.flags == d->flags &&
+           dr->desc.object_mask == d->object_mask;
+}
+
+const char *rl_drawer_backend(const rl_drawer *dr) { return dr ? dr->ops->name : NULL; }
+
+rl_status rl_drawer_begin(rl_drawer *dr, rl_image *target, const rl_mat4 *view, const rl_mat4 *proj,
+                          rl_vec3 eye)
+{
+    if (!dr || !target || !view || !proj)
+        return rl_error(RL_ERR_INVALID_ARG, "rl_drawer_begin: NULL argument");
+    if (!(target->layers & RL_LAYER_DEPTH) || !target->depth)
+        return rl_error(RL_ERR_INVALID_ARG, "rl_drawer_begin: the target has no depth layer");
+    rl_status st = dr->ops->begin(dr->impl, target, view, proj, eye);
+    dr->in_frame = st == RL_OK;
+    return st;
+}
+
+rl_status rl_drawer_begin_camera(rl_drawer *dr, rl_image *target, const rl_camera *cam, rl_aabb scene_bounds)
+{
+    if (!dr || !target || !cam)
+        return rl_error(RL_ERR_INVALID_ARG, "rl_drawer_begin_camera: NULL argument");
+    rl_mat4 view, proj;
+    rl_status st = rl_raster_camera_matrices(cam, scene_bounds, &view, &proj);
+    return st == RL_OK ? rl_drawer_begin(dr, target, &view, &proj, cam->eye) : st;
+}
+
+/* Calls between begin and end only. */
+static rl_status in_frame(const rl_drawer *dr, const char *fn)
+{
+    if (!dr)
+        return rl_error(RL_ERR_INVALID_ARG, "%s: NULL drawer", fn);
+    return dr->in_frame ? RL_OK : rl_error(RL_ERR_INVALID_ARG, "%s: no frame begun (rl_drawer_begin)", fn);
+}
+
+void rl_drawer_light(rl_drawer *dr, const uint32_t *objects, uint32_t count)
+{
+    if (dr && dr->in_frame && (objects || !count))
+        dr->ops->light(dr->impl, objects, count);
+}
+
+rl_status rl_drawer_draw(rl_drawer *dr, const uint32_t *objects, uint32_t count, rl_raster_counters *c)
+{
+    rl_status st = in_frame(dr, "rl_drawer_draw");
+    if (st == RL_OK && count && !objects)
+        st = rl_error(RL_ERR_INVALID_ARG, "rl_drawer_draw: NULL object list");
+    return st == RL_OK ? dr->ops->draw(dr->impl, objects, count, c) : st;
+}
+
+rl_status rl_drawer_draw_all(rl_drawer *dr, rl_raster_counters *c, rl_progress_fn progress, void *user)
+{
+    rl_status st = in_frame(dr, "rl_drawer_draw_all");
+    return st == RL_OK ? dr->ops->draw_all(dr->impl, c, progress, user) : st;
+}
+
+rl_status rl_drawer_query(rl_drawer *dr, const rl_raster_batch *boxes, uint64_t *pixels, rl_raster_counters *c)
+{
+    rl_status st = in_frame(dr, "rl_drawer_query");
+    if (st == RL_OK && (!boxes || !pixels))
+        st = rl_error(RL_ERR_INVALID_ARG, "rl_drawer_query: NULL argument");
+    if (st != RL_OK)
+        return st;
+    if (c)
+        c->triangles_in += boxes->num_triangles;
+    return dr->ops->query(dr->impl, boxes, pixels);
+}
+
+rl_status rl_drawer_draw_points(rl_drawer *dr, const rl_raster_points *points, rl_raster_counters *c)
+{
+    rl_status st = in_frame(dr, "rl_drawer_draw_points");
+    if (st == RL_OK && !points)
+        st = rl_error(RL_ERR_INVALID_ARG, "rl_drawer_draw_points: NULL points");
+    return st == RL_OK ? dr->ops->draw_points(dr->impl, points, c) : st;
+}
+
+rl_status rl_drawer_end(rl_drawer *dr)
+{
+    rl_status st = in_frame(dr, "rl_drawer_end");
+    if (st != RL_OK)
+        return st;
+    dr->in_frame = false;
+    return dr->ops->end(dr->impl);
+}
+
+/* ---- the software backend ---- */
+
+typedef struct software {
+    rl_raster *ras;
+    rl_scene_drawer *drawer;
+} software;
+
+static void sw_release(void *impl)
+{
+    software *sw = impl;
+    if (!sw)
+        return;
+    rl_scene_drawer_release(sw->drawer);
+    rl_raster_release(sw->ras);
+    free(sw);
+}
+
+static rl_status sw_begin(void *impl, rl_image *target, const rl_mat4 *view, const rl_mat4 *proj, rl_vec3 eye)
+{
+    software *sw = impl;
+    rl_scene_drawer_new_frame(sw->drawer, eye);
+    return rl_raster_set_target(sw->ras, target, view, proj);
+}
+
+static void sw_light(void *impl, const uint32_t *objects, uint32_t count)
+{
+    software *sw = impl;
+    rl_scene_drawer_light(sw->drawer, objects, count);
+}
+
+static rl_status sw_draw(void *impl, const uint32_t *objects, uint32_t count, rl_raster_counters *c)
+{
+    software *sw = impl;
+    return rl_scene_drawer_draw_list(sw->drawer, sw->ras, objects, count, c);
+}
+
+static rl_status sw_draw_all(void *impl, rl_raster_counters *c, rl_progress_fn progress, void *user)
+{
+    software *sw = impl;
+    return rl_scene_drawer_draw_all(sw->drawer, sw->ras, c, progress, user);
+}
+
+static rl_status sw_query(void *impl, const rl_raster_batch *boxes, uint64_t *pixels)
+{
+    software *sw = impl;
+    return rl_raster_query(sw->ras, boxes, pixels);
+}
+
+static rl_status sw_draw_points(void *impl, const rl_raster_points *points, rl_raster_counters *c)
+{
+    software *sw = impl;
+    return rl_raster_draw_points(sw->ras, points, c);
+}
+
+static rl_status sw_end(void *impl)
+{
+    (void)impl;     /* drawn into the target already */
+    return RL_OK;
+}
+
+static const rl_drawer_ops software_ops = {
+    .name = "software",
+    .release = sw_release,
+    .begin = sw_begin,
+    .light = sw_light,
+    .draw = sw_draw,
+    .draw_all = sw_draw_all,
+    .query = sw_query,
+    .draw_points = sw_draw_points,
+    .end = sw_end,
+};
+
+rl_status rl_drawer_create(const rl_scene *scene, const rl_drawer_desc *desc, rl_drawer **out)
+{
+    if (!scene || !out)
+        return rl_error(RL_ERR_INVALID_ARG, "rl_drawer_create: NULL argument");
+    *out = NULL;
+    const rl_scene_data *d = rl_scene_get_data(scene);
+    if (!d)
+        return rl_error(RL_ERR_NOT_COMMITTED, "rl_drawer_create: the scene is not committed");
+    software *sw = rl_calloc(1, sizeof *sw);
+    if (!sw)
+        return RL_ERR_OUT_OF_MEMORY;
+    rl_status st = rl_raster_create(&(rl_raster_desc){ .threads = desc ? desc->threads : 0 }, &sw->ras);
+    if (st == RL_OK)
+        st = rl_scene_drawer_create(d, rl_v3s(0.0f), desc, &sw->drawer);
+    if (st != RL_OK) {
+        sw_release(sw);
+        return st;
+    }
+    return rl_drawer_make(&software_ops, sw, scene, desc, out);
+}
