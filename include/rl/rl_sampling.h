@@ -338,8 +338,10 @@ RL_API rl_status rl_approx_lookup(rl_approx *a, rl_position_lookup *out);
  * from the approx.json files its options name or sampled over the scene as
  * they describe (visset.c, select.c). Work done before for the same
  * options and scene is skipped, so it may be called before every frame;
- * renderers without inputs return RL_OK at once. Errors: those of loading
- * or sampling; RL_ERR_NOT_COMMITTED. */
+ * renderers without inputs return RL_OK at once. The inputs borrow scene
+ * (visset's budget measures pixels in it on demand): render r only with
+ * this scene until it is called again for another. Errors: those of
+ * loading or sampling; RL_ERR_NOT_COMMITTED. */
 RL_API rl_status rl_renderer_prepare_inputs(rl_renderer *r, const rl_scene *scene);
 
 RL_API rl_status rl_approx_save_json(const rl_approx *a, const char *path);
