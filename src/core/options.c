@@ -16,7 +16,7 @@ void rl_option_append(char *buf, size_t size, const char *text)
         snprintf(buf + used, size - used, "%s", text);
 }
 
-long rl_option_find(const rl_option_info *opts, size_t n, const char *prefix, const char *key)
+static long rl_option_find(const rl_option_info *opts, size_t n, const char *prefix, const char *key)
 {
     if (!key)
         return -1;
@@ -31,8 +31,7 @@ long rl_option_find(const rl_option_info *opts, size_t n, const char *prefix, co
     return -1;
 }
 
-rl_status rl_option_unknown(const rl_option_info *opts, size_t n, const char *context,
-                            const char *key)
+static rl_status rl_option_unknown(const rl_option_info *opts, size_t n, const char *context, const char *key)
 {
     if (n == 0)
         return rl_error(RL_ERR_INVALID_ARG, "%s: unknown option \"%s\" (it takes none)", context, key);
@@ -46,7 +45,7 @@ rl_status rl_option_unknown(const rl_option_info *opts, size_t n, const char *co
                     keys);
 }
 
-bool rl_option_parse_bool(const char *s, bool *out)
+static bool rl_option_parse_bool(const char *s, bool *out)
 {
     static const char *const yes[] = { "true", "1", "yes", "on" };
     static const char *const no[] = { "false", "0", "no", "off" };
@@ -57,7 +56,7 @@ bool rl_option_parse_bool(const char *s, bool *out)
     return false;
 }
 
-int rl_option_enum_index(const rl_option_info *o, const char *s)
+static int rl_option_enum_index(const rl_option_info *o, const char *s)
 {
     for (int i = 0; s && o->choices && o->choices[i]; ++i)
         if (strcmp(o->choices[i], s) == 0)
@@ -93,7 +92,7 @@ bool rl_option_parse_color(const char *text, rl_vec3 *out)
     return true;
 }
 
-rl_status rl_option_validate(const rl_option_info *o, const char *value, const char *context)
+static rl_status rl_option_validate(const rl_option_info *o, const char *value, const char *context)
 {
     const char *name = context ? context : "";
     switch (o->type) {
@@ -151,25 +150,25 @@ rl_status rl_option_validate(const rl_option_info *o, const char *value, const c
     return rl_error(RL_ERR_INTERNAL, "%s: option %s has an unknown type", name, o->key);
 }
 
-long long rl_option_read_int(const char *s)
+static long long rl_option_read_int(const char *s)
 {
     long long v = 0;
     return s && rl_parse_int(s, &v) ? v : 0;
 }
 
-double rl_option_read_float(const char *s)
+static double rl_option_read_float(const char *s)
 {
     double v = 0.0;
     return s && rl_parse_float(s, &v) ? v : 0.0;
 }
 
-bool rl_option_read_bool(const char *s)
+static bool rl_option_read_bool(const char *s)
 {
     bool v = false;
     return s && rl_option_parse_bool(s, &v) ? v : false;
 }
 
-int rl_option_read_enum(const rl_option_info *o, const char *s)
+static int rl_option_read_enum(const rl_option_info *o, const char *s)
 {
     int idx = o ? rl_option_enum_index(o, s) : -1;
     return idx < 0 ? 0 : idx;

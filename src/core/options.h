@@ -23,28 +23,8 @@
 /* Appends text to the NUL-terminated buf of size bytes, cutting it short
  * when full. */
 void rl_option_append(char *buf, size_t size, const char *text);
-/* Index of key in opts[0..n), or -1; key may carry "<prefix>." in front
- * (prefix may be NULL). */
-long rl_option_find(const rl_option_info *opts, size_t n, const char *prefix, const char *key);
-/* Records and returns RL_ERR_INVALID_ARG "<context>: unknown option
- * \"key\" (options: a, b, ...)". */
-rl_status rl_option_unknown(const rl_option_info *opts, size_t n, const char *context,
-                            const char *key);
-/* Checks value against o's type and range; records a message naming
- * context, key and value and returns RL_ERR_INVALID_ARG on failure. */
-rl_status rl_option_validate(const rl_option_info *o, const char *value, const char *context);
-
-/* Parsers (no error recorded). */
-bool rl_option_parse_bool(const char *s, bool *out);   /* true/false, 1/0, yes/no, on/off */
-int rl_option_enum_index(const rl_option_info *o, const char *s);  /* -1 if not a choice */
-/* "r,g,b" or one grey value, each finite and >= 0. */
+/* "r,g,b" or one grey value, each finite and >= 0 (no error recorded). */
 bool rl_option_parse_color(const char *text, rl_vec3 *out);
-
-/* Readers of validated text (zero / false / black when it does not parse). */
-long long rl_option_read_int(const char *s);
-double rl_option_read_float(const char *s);
-bool rl_option_read_bool(const char *s);
-int rl_option_read_enum(const rl_option_info *o, const char *s);   /* 0 if not a choice */
 
 /* A table's values. Zero-initialised it is empty; init fills the
  * defaults. prefix (may be NULL) is the owner's name: "<prefix>.key" names
