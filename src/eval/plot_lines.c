@@ -16,6 +16,7 @@
 
 #include "core/error.h"
 #include "eval/plot_internal.h"
+#include "eval/stats_internal.h"
 
 enum { MAX_SERIES = 64, MARKERS_UP_TO = 40 };
 
@@ -41,12 +42,11 @@ rl_status rl_plot_correlation(const double *measured, const double *approximated
     rl_status st = rl_plot_check(fn, style, out, 640, 420, &width, &height);
     if (st != RL_OK)
         return st;
-    /* Undefined for constant data; the plot still shows the points. */
+    /* Undefined for constant data; the plot still shows the points. Asked
+     * without recording an error, so that none of the caller's is erased. */
     double r = NAN;
-    if (n >= 2 && rl_stats_correlation(measured, approximated, n, &r) != RL_OK) {
+    if (n >= 2 && rl_stats_pearson(measured, approximated, n, &r) != 0)
         r = NAN;
-        rl_clear_error();
-    }
     rl_plot p;
     st = rl_plot_begin(&p, fn, out, width, height);
     if (st != RL_OK)

@@ -21,6 +21,7 @@
 #include <string.h>
 
 #include "core/error.h"
+#include "eval/stats_internal.h"
 
 typedef struct weighted {
     double v, w;
@@ -245,17 +246,10 @@ rl_status rl_stats_kde(const double *values, const double *weights, size_t n, do
     return RL_OK;
 }
 
-rl_status rl_stats_correlation(const double *x, const double *y, size_t n, double *r)
+int rl_stats_pearson(const double *x, const double *y, size_t n, double *r)
 {
-    const char *fn = "rl_stats_correlation";
-    if (!x || !y || !r)
-        return rl_error(RL_ERR_INVALID_ARG, "%s: x, y or r is NULL", fn);
-    if (n < 2)
-        return rl_error(RL_ERR_INVALID_ARG, "%s: need at least 2 pairs, got %zu", fn, n);
     double mx = 0.0, my = 0.0;
     for (size_t i = 0; i < n; ++i) {
-        if (!isfinite(x[i]) || !isfinite(y[i]))
-            return rl_error(RL_ERR_INVALID_ARG, "%s: pair %zu is not finite", fn, i);
         mx += x[i];
         my += y[i];
     }
@@ -268,9 +262,27 @@ rl_status rl_stats_correlation(const double *x, const double *y, size_t n, doubl
         syy += dy * dy;
         sxy += dx * dy;
     }
-    if (!(sxx > 0.0) || !(syy > 0.0))
-        return rl_error(RL_ERR_INVALID_ARG, "%s: %s is constant", fn, sxx > 0.0 ? "y" : "x");
+    if (!(sxx > 0.0))
+        return 1;
+    if (!(syy > 0.0))
+        return 2;
     /* Rounding can push |r| a hair past 1 for exactly linear data. */
     *r = fmax(-1.0, fmin(1.0, sxy / sqrt(sxx * syy)));
+    return 0;
+}
+
+rl_status rl_stats_correlation(const double *x, const double *y, size_t n, double *r)
+{
+    const char *fn = "rl_stats_correlation";
+    if (!x || !y || !r)
+        return rl_error(RL_ERR_INVALID_ARG, "%s: x, y or r is NULL", fn);
+    if (n < 2)
+        return rl_error(RL_ERR_INVALID_ARG, "%s: need at least 2 pairs, got %zu", fn, n);
+    for (size_t i = 0; i < n; ++i)
+        if (!isfinite(x[i]) || !isfinite(y[i]))
+            return rl_error(RL_ERR_INVALID_ARG, "%s: pair %zu is not finite", fn, i);
+    int constant = rl_stats_pearson(x, y, n, r);
+    if (constant)
+        return rl_error(RL_ERR_INVALID_ARG, "%s: %s is constant", fn, constant == 1 ? "x" : "y");
     return RL_OK;
 }

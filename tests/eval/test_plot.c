@@ -20,6 +20,7 @@
 
 #include "rl/rl_image.h"
 #include "rl/rl_plot.h"
+#include "rl/rl_stats.h"
 #include "rl/rl_rng.h"
 
 #define assert_near(a, b, eps)                                                       \
@@ -495,6 +496,25 @@ static void test_bad_input_writes_nothing(void **state)
     assert_null(svg);
 }
 
+/* Constant data has no correlation; the plot is drawn all the same, and
+ * the caller's earlier error is neither erased nor covered. */
+static void test_constant_correlation_keeps_the_callers_error(void **state)
+{
+    (void)state;
+    rl_clear_error();
+    double r = 0.0;
+    assert_int_equal(rl_stats_correlation(NULL, NULL, 2, &r), RL_ERR_INVALID_ARG);   /* the caller's */
+    char before[256];
+    snprintf(before, sizeof before, "%s", rl_last_error());
+    const double flat[] = { 2, 2, 2, 2 }, rising[] = { 1, 2, 3, 4 };
+    char *svg = NULL;
+    assert_int_equal(rl_plot_correlation(flat, rising, 4, NULL, &(rl_plot_output){ .svg = &svg }), RL_OK);
+    assert_non_null(svg);
+    free(svg);
+    assert_string_equal(rl_last_error(), before);
+    rl_clear_error();
+}
+
 static void test_unwritable_path_is_an_io_error(void **state)
 {
     (void)state;
@@ -534,6 +554,7 @@ int main(void)
         cmocka_unit_test(test_colormap_endpoints_match_published_colours),
         cmocka_unit_test(test_bad_input_writes_nothing),
         cmocka_unit_test(test_unwritable_path_is_an_io_error),
+        cmocka_unit_test(test_constant_correlation_keeps_the_callers_error),
     };
     int failed = cmocka_run_group_tests(tests, NULL, NULL);
     release_font_caches();
