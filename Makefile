@@ -26,7 +26,7 @@ FUZZ_SECONDS ?= 60
 build-fuzz:
 	@CC=clang CXX=clang++ cmake -S . -B $(BUILD_FUZZ) -DCMAKE_BUILD_TYPE=Debug -DRL_SANITIZE=ON -DRL_FUZZ=ON \
 	    -DRL_TESTS=OFF -DRL_WERROR=OFF -DRL_FUZZ_SCALE=$(FUZZ_SCALE) $(CMAKE_ARGS) >/dev/null
-	@cmake --build $(BUILD_FUZZ) -j $(JOBS)
+	@cmake --build $(BUILD_FUZZ) -j $(JOBS) --target fuzz_load_json fuzz_load_mesh
 
 # A longer campaign: every harness for FUZZ_SECONDS on its corpus, which
 # keeps what it finds (tests/fuzz/corpus/<kind>); crashes go to
