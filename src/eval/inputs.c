@@ -192,9 +192,11 @@ static void input_key(char *key, size_t size, const rl_scene *scene, const char 
                  (double)o->height, (unsigned long long)o->seed);
 }
 
-/* Loads path, or samples with make(), and hands the lookup to slot. */
+/* How an input is sampled when no file names it. */
 typedef rl_status (*sample_fn)(const rl_scene *scene, const sample_opts *o, const char *name, rl_approx **out);
 
+/* Loads path, or samples with sample(), and hands the lookup to slot; skips
+ * both when the slot already holds a lookup of the same key. */
 static rl_status set_input(rl_renderer *r, const char *slot, const rl_scene *scene, const char *what,
                            const char *path, const sample_opts *o, sample_fn sample, bool object_pixels)
 {

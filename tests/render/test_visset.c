@@ -118,14 +118,31 @@ static void test_visset_reads_the_evaluators_approximation(void **state)
 
     rl_renderer *own = fx_make("visset", coarse);
     rl_renderer *file = fx_make("visset", (const char *const[]){ "approx", path, NULL });
+    /* The same file handed in by the caller as a lookup (rl_approx_lookup),
+     * without rl_renderer_prepare_inputs: the same frames. */
+    rl_renderer *handed = fx_make("visset", NULL);
+    rl_approx *loaded = NULL;
+    assert_int_equal(rl_approx_load_json(path, &loaded), RL_OK);
+    rl_position_lookup l;
+    assert_int_equal(rl_approx_lookup(loaded, &l), RL_OK);
+    assert_true(l.set_size == d->num_objects && l.num_regions > 0 && !l.object_pixels);
+    assert_int_equal(rl_renderer_set_input(handed, "approx", &l, NULL), RL_OK);
     for (int i = 0; i < 3; ++i) {
         rl_camera cam = street((float)i);
         rl_image *x = fx_render_with(own, s, &cam, FX_ALL_LAYERS, NULL);
         rl_image *y = fx_render_with(file, s, &cam, FX_ALL_LAYERS, NULL);
+        rl_image *z = NULL;
+        assert_int_equal(rl_image_create(cam.width, cam.height, FX_ALL_LAYERS, &z), RL_OK);
+        assert_int_equal(rl_renderer_render(handed, s, &cam, z, NULL), RL_OK);
         fx_assert_images_identical(x, y);
+        fx_assert_images_identical(x, z);
         rl_image_release(x);
         rl_image_release(y);
+        rl_image_release(z);
     }
+    rl_renderer_release(handed);
+    assert_int_equal(rl_approx_lookup(NULL, &l), RL_ERR_INVALID_ARG);
+    rl_clear_error();
     rl_renderer_release(file);
     rl_renderer_release(own);
 
