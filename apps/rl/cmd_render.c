@@ -245,6 +245,13 @@ static int choose_camera(const render_args *a, const rl_scene *scene, rl_camera 
         cam->width = RL_CLI_DEFAULT_WIDTH;
         cam->height = RL_CLI_DEFAULT_HEIGHT;
     }
+    if (!scene_has_cameras && !a->has_eye && !a->has_target && !a->has_up && !a->has_fov) {
+        /* The framing fits the model to the image's aspect ratio, which is
+         * only known now. */
+        rl_camera fit;
+        if (rl_scene_fit_camera(scene, cam->width, cam->height, &fit) == RL_OK)
+            *cam = fit;
+    }
     *cam = rl_camera_resolve(cam);
     rl_clear_error();
     st = rl_camera_validate(cam);

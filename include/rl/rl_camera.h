@@ -53,8 +53,21 @@ RL_API rl_mat4 rl_camera_projection(const rl_camera *cam, float z_near, float z_
  * with z_near = 0: near is clamped to at least far * 1e-5. */
 RL_API void rl_camera_clip_range(const rl_camera *cam, rl_aabb bounds, float *z_near, float *z_far);
 /* A camera looking at bounds from the front-ish diagonal so that the whole
- * box is in view; used when a scene brings no camera. */
+ * box (its bounding sphere) is in view. */
 RL_API rl_camera rl_camera_frame_bounds(rl_aabb bounds, int width, int height);
+/* The default orbit of rl_camera_fit_points: a three-quarter view from the
+ * front (+z), to the right (+x) and above (+y). */
+#define RL_CAMERA_FIT_AZIMUTH_DEG 25.0f
+#define RL_CAMERA_FIT_ELEVATION_DEG 20.0f
+/* A camera that looks at the points from an orbit direction (azimuth about
+ * +y from +z, elevation above the xz plane, in degrees; elevation clamped to
+ * +-89) and is as close as the default field of view allows while every
+ * finite point stays inside the width x height frame, with a 4 % margin.
+ * The tightest framing of a model: the points touch the frame on one axis
+ * and are centred on the other. Non-finite angles take the defaults; no
+ * finite point gives a camera at +z looking at the origin. */
+RL_API rl_camera rl_camera_fit_points(const rl_vec3 *points, size_t count, float azimuth_deg,
+                                      float elevation_deg, int width, int height);
 
 /* Camera paths: keyframes at increasing times, interpolated with centripetal
  * Catmull-Rom on eye and target, linearly on up and fov. Resolution is taken

@@ -179,9 +179,20 @@ typedef struct rl_scene_data {
 /* NULL (with RL_ERR_NOT_COMMITTED recorded) unless committed. */
 RL_API const rl_scene_data *rl_scene_get_data(const rl_scene *scene);
 
-/* The named camera, the first camera (name NULL), or a camera framing the
- * bounds when the scene has none. RL_ERR_NOT_FOUND for an unknown name. */
+/* The named camera, the first camera (name NULL), or, when the scene has
+ * none, rl_scene_fit_camera at the default size. RL_ERR_NOT_FOUND for an
+ * unknown name. */
 RL_API rl_status rl_scene_get_camera(const rl_scene *scene, const char *name, rl_camera *out);
+/* The orbit from which a scene without cameras is framed (degrees, see
+ * rl_camera_fit_points; default RL_CAMERA_FIT_AZIMUTH_DEG/ELEVATION_DEG).
+ * Before commit; RL_ERR_INVALID_ARG for a non-finite azimuth or an
+ * elevation outside -89..89. */
+RL_API rl_status rl_scene_set_default_view(rl_scene *scene, float azimuth_deg, float elevation_deg);
+/* A camera that frames every vertex of the committed scene tightly for a
+ * width x height image from the scene's default view
+ * (rl_camera_fit_points). For a caller that picks the image size after
+ * loading: the fit depends on the aspect ratio. */
+RL_API rl_status rl_scene_fit_camera(const rl_scene *scene, int width, int height, rl_camera *out);
 
 typedef struct rl_scene_stats {
     uint32_t nodes, meshes, objects, materials, textures, lights, cameras;
@@ -220,15 +231,29 @@ RL_API rl_status rl_scene_create_builtin(const char *name, const char *params, r
 
 /* Loading. rl_scene_load() accepts a built-in name, a .json scene file or
  * any mesh file Assimp reads (OBJ, PLY, STL, glTF/GLB, DAE, 3DS, FBX, ...);
- * for a bare mesh file it adds a default light and camera. Returns a
- * committed scene. Errors name the file, and for JSON the line and column. */
+ * for a model file without lights it adds default ones, and one without
+ * cameras is framed by rl_scene_fit_camera. params: a built-in's
+ * parameters or a model file's (rl_model_options), "k=v,k=v" or NULL.
+ * Returns a committed scene. Errors name the file, and for JSON the line
+ * and column. */
 RL_API rl_status rl_scene_load(const char *source, const char *params, rl_scene **out);
+/* The parameters rl_scene_load takes for a model file (cameras=file|off,
+ * lights=file|off|add, headlight, azimuth, elevation). */
+RL_API const rl_option_info *rl_model_options(size_t *count);
 RL_API rl_status rl_scene_load_json(const char *path, rl_scene **out);   /* committed */
 /* Imports a mesh file with Assimp under parent: its node hierarchy,
  * meshes (triangulated; quads and n-gons split), materials and textures
  * (paths relative to the file). *root_node receives the imported root. */
 RL_API rl_status rl_scene_import(rl_scene *scene, const char *path, uint32_t parent,
                                  uint32_t *root_node);
+/* What of a file to take besides its geometry and materials; zero = all. */
+typedef struct rl_scene_import_desc {
+    bool no_cameras;      /* skip the file's cameras */
+    bool no_lights;       /* skip the file's lights */
+} rl_scene_import_desc;
+/* rl_scene_import with a desc (NULL: defaults). */
+RL_API rl_status rl_scene_import_with(rl_scene *scene, const char *path, uint32_t parent,
+                                      const rl_scene_import_desc *desc, uint32_t *root_node);
 
 #ifdef __cplusplus
 }

@@ -138,6 +138,113 @@ void rl_camera_clip_range(const rl_camera *cam, rl_aabb bounds, float *z_near, f
         *z_far = far_d;
 }
 
+/* Tight orbit framing. In the view basis (u right, v up, d forward) a point
+ * (x, y, z) lies between the left and right planes of an eye at (ex, ez)
+ * when ex - tx ez <= x + tx z and ex + tx ez >= x - tx z, tx being the
+ * tangent of the horizontal half angle. With
+ * A = min(x + tx z) and B = max(x - tx z) the farthest-forward eye that keeps
+ * every point inside is ex = (A + B) / 2, ez = (A - B) / (2 tx); the same
+ * for y. The eye takes the smaller (farther back) of the two depths and
+ * stays centred on both axes, so the points touch the frame on one axis
+ * and are centred on the other. */
+rl_camera rl_camera_fit_points(const rl_vec3 *points, size_t count, float azimuth_deg,
+                               float elevation_deg, int width, int height)
+{
+    rl_camera c = { 0 };
+    c.width = width > 0 ? width : RL_CAMERA_DEFAULT_WIDTH;
+    c.height = height > 0 ? height : RL_CAMERA_DEFAULT_HEIGHT;
+    c.fov_deg = RL_CAMERA_DEFAULT_FOV_DEG;
+    float az = rl_radians(isfinite(azimuth_deg) ? azimuth_deg : RL_CAMERA_FIT_AZIMUTH_DEG);
+    /* Straight up or down leaves no up vector; 89 degrees is as steep as the
+     * basis stays well defined. */
+    float el = rl_radians(rl_clampf(isfinite(elevation_deg) ? elevation_deg
+                                                             : RL_CAMERA_FIT_ELEVATION_DEG,
+                                    -89.0f, 89.0f));
+    /* From the target towards the eye: azimuth about +y from +z, elevation
+     * above the xz plane. */
+    rl_vec3 back = rl_v3(sinf(az) * cosf(el), sinf(el), cosf(az) * cosf(el));
+    rl_vec3 d = rl_scale(back, -1.0f);
+    rl_vec3 u = rl_normalize(rl_cross(d, rl_v3(0.0f, 1.0f, 0.0f)));
+    rl_vec3 v = rl_cross(u, d);
+    c.up = rl_v3(0.0f, 1.0f, 0.0f);
+    /* A 4 % margin keeps silhouettes off the image border. */
+    const float fill = 0.96f;
+    float ty = tanf(rl_radians(c.fov_deg) * 0.5f) * fill;
+    float tx = tanf(rl_radians(c.fov_deg) * 0.5f) * (float)c.width / (float)c.height * fill;
+    /* Relative to the first finite point, in double: far-away models lose
+     * no precision, and huge ones do not overflow. */
+    rl_vec3 origin = rl_v3s(0.0f);
+    bool have = false;
+    double A = INFINITY, B = -INFINITY, C = INFINITY, D = -INFINITY, zmin = INFINITY, zmax = -INFINITY;
+    double xlo = INFINITY, xhi = -INFINITY, ylo = INFINITY, yhi = -INFINITY;
+    for (size_t i = 0; i < count; ++i) {
+        if (!rl_vfinite(points[i]))
+            continue;
+        if (!have) {
+            origin = points[i];
+            have = true;
+        }
+        rl_vec3 p = rl_sub(points[i], origin);
+        double x = rl_dot(p, u), y = rl_dot(p, v), z = rl_dot(p, d);
+        A = fmin(A, x + tx * z);
+        B = fmax(B, x - tx * z);
+        C = fmin(C, y + ty * z);
+        D = fmax(D, y - ty * z);
+        zmin = fmin(zmin, z);
+        zmax = fmax(zmax, z);
+        xlo = fmin(xlo, x), xhi = fmax(xhi, x), ylo = fmin(ylo, y), yhi = fmax(yhi, y);
+    }
+    if (!have) {
+        c.target = rl_v3s(0.0f);
+        c.eye = back;
+        return c;
+    }
+    double ezx = (A - B) / (2.0 * tx), ezy = (C - D) / (2.0 * ty);
+    double ez = fmin(ezx, ezy);
+    double ex = 0.5 * (A + B), ey = 0.5 * (C + D);
+    /* A single point, or points on a line along d: step back by their depth
+     * range, or by 1 when there is none. */
+    double depth = zmax - zmin;
+    bool degenerate = !(ez < zmin - 1e-6 * fmax(depth, 1e-30));
+    if (degenerate)
+        ez = zmin - (depth > 0.0 ? depth : 1.0);
+    /* On the axis with room to spare the planes are centred, not the
+     * picture: centre the projected extent instead (the projected offset
+     * (x - e) / (z - ez) falls as e grows, so bisection finds it). */
+    if (!degenerate) {
+        bool slack_x = ezx > ez;
+        /* Every point is in front of the eye, so e at the smallest
+         * coordinate makes every offset >= 0 and e at the largest <= 0. */
+        double lo = slack_x ? xlo : ylo, hi = slack_x ? xhi : yhi;
+        for (int it = 0; it < 40; ++it) {
+            double e = 0.5 * (lo + hi), pmin = INFINITY, pmax = -INFINITY;
+            for (size_t i = 0; i < count; ++i) {
+                if (!rl_vfinite(points[i]))
+                    continue;
+                rl_vec3 p = rl_sub(points[i], origin);
+                double z = rl_dot(p, d), w = slack_x ? rl_dot(p, u) : rl_dot(p, v);
+                double q = (w - e) / (z - ez);
+                pmin = fmin(pmin, q);
+                pmax = fmax(pmax, q);
+            }
+            if (pmin + pmax > 0.0)
+                lo = e;
+            else
+                hi = e;
+        }
+        if (slack_x)
+            ex = 0.5 * (lo + hi);
+        else
+            ey = 0.5 * (lo + hi);
+    }
+    c.eye = rl_add(origin, rl_add(rl_add(rl_scale(u, (float)ex), rl_scale(v, (float)ey)),
+                                  rl_scale(d, (float)ez)));
+    /* The target at the middle of the depth range: orbiting tools rotate
+     * about it. */
+    c.target = rl_add(c.eye, rl_scale(d, (float)(0.5 * (zmin + zmax) - ez)));
+    return c;
+}
+
 rl_camera rl_camera_frame_bounds(rl_aabb bounds, int width, int height)
 {
     rl_camera c = { 0 };

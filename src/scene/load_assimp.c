@@ -23,17 +23,22 @@
  * all of these are found before the scene is touched. Later failures (out of
  * memory, an undecodable texture) can leave nodes behind in the scene, which
  * the caller then releases. */
+#define _POSIX_C_SOURCE 200809L   /* stat, opendir, strcasecmp */
 #include <assimp/cimport.h>
 #include <assimp/material.h>
 #include <assimp/postprocess.h>
 #include <assimp/scene.h>
 #include <assimp/version.h>
+#include <dirent.h>
 #include <errno.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <strings.h>
+#include <sys/stat.h>
 
 #include "core/error.h"
+#include "core/options.h"
 #include "scene/load_internal.h"
 #include "scene/scene_internal.h"
 
@@ -120,13 +125,49 @@ static bool get_float(const struct aiMaterial *mat, const char *key, unsigned ty
     return true;
 }
 
+/* What an import could not map faithfully, counted over the whole file
+ * and reported in one warning (import_notes), not one line per mesh. */
+typedef struct import_notes {
+    unsigned normal_maps, pbr_textures, alpha_modes, invisible;
+    unsigned textures_missing, textures_case;
+    char missing_names[512];    /* the first three missing textures */
+} import_notes;
+
 /* What materials need while they are converted. */
 typedef struct material_ctx {
     rl_scene *scene;
     const char *path, *dir;     /* the model file and its folder */
     const struct aiScene *ai;
     uint32_t *embedded;         /* scene texture id per aiTexture, RL_NONE until used */
+    import_notes notes;
 } material_ctx;
+
+static float luminance(rl_vec3 c) { return 0.2126f * c.x + 0.7152f * c.y + 0.0722f * c.z; }
+
+/* glTF 2.0 metallic-roughness onto the Phong model of rl_material, as close
+ * as one diffuse lobe, one Phong lobe and one mirror allow:
+ * - diffuse: base colour x (1 - metallic) (glTF 2.0 spec, Appendix B: the
+ *   metal has no diffuse lobe);
+ * - specular: the Fresnel reflectance at normal incidence, 0.04 for
+ *   dielectrics and the base colour for metals, blended by metallic;
+ * - shininess: the Phong exponent whose lobe matches the microfacet lobe
+ *   of alpha = roughness^2, n = 2 / alpha^2 - 2 (Walter et al. 2007,
+ *   Sec. 3.3 gives the Beckmann/Phong correspondence), clamped to 1..10^4;
+ * - reflectivity: a metal smoother than roughness 0.2 reflects as a
+ *   mirror; its lobe would be narrower than a pixel at common sizes, which
+ *   the Phong highlight cannot show. Our choice, since Phong has no
+ *   microfacet lobe; pt's microfacet BRDF (issue 37) will replace it. */
+static void map_metal_roughness(rl_material *m, rl_vec3 base, float metallic, float roughness)
+{
+    m->diffuse = rl_scale(base, 1.0f - metallic);
+    m->specular = rl_add(rl_scale(rl_v3s(0.04f), 1.0f - metallic), rl_scale(base, metallic));
+    float alpha = rl_maxf(roughness * roughness, 1e-3f);
+    m->shininess = rl_clampf(2.0f / (alpha * alpha) - 2.0f, 1.0f, 1e4f);
+    if (roughness < 0.2f) {
+        float smooth = 1.0f - roughness / 0.2f;
+        m->reflectivity = rl_clampf(metallic * smooth * luminance(m->specular), 0.0f, 1.0f);
+    }
+}
 
 /* Assimp names embedded textures "*<index>"; some readers use the original
  * file name instead (what aiScene::GetEmbeddedTexture matches in C++). */
@@ -163,6 +204,51 @@ static rl_status load_embedded(material_ctx *c, int index, uint32_t *id)
     return RL_OK;
 }
 
+static bool is_file(const char *path)
+{
+    struct stat st;
+    return stat(path, &st) == 0 && S_ISREG(st.st_mode);
+}
+
+/* The name in dir that equals name ignoring ASCII case, into out. */
+static bool match_nocase(const char *dir, const char *name, char *out, size_t size)
+{
+    DIR *d = opendir(dir[0] ? dir : ".");
+    if (!d)
+        return false;
+    bool found = false;
+    for (struct dirent *e; !found && (e = readdir(d)) != NULL;) {
+        if (strcasecmp(e->d_name, name) != 0)
+            continue;
+        rl_path_join(dir, e->d_name, out, size);
+        found = is_file(out);
+    }
+    closedir(d);
+    return found;
+}
+
+/* Where a texture reference that does not resolve as written may be: the
+ * same path with other letter case (files made on Windows or macOS ask for
+ * TEST.PNG where test.png sits), or only its file name beside the model
+ * (an absolute path from the author's machine, "D:/projects/.../wood.jpg").
+ * Only the model's folder and the reference's own folder are searched, and
+ * each find costs a warning, so that a wrong guess is visible. */
+static bool find_texture_nearby(material_ctx *c, const char *rel, char *out, size_t size)
+{
+    const char *slash = strrchr(rel, '/');
+    const char *name = slash ? slash + 1 : rel;
+    char dir[PATH_MAX_LEN], joined[PATH_MAX_LEN];
+    rl_path_join(c->dir, rel, joined, sizeof joined);
+    rl_path_dirname(joined, dir, sizeof dir);
+    bool found = name[0] && (match_nocase(dir, name, out, size) ||
+                             (strcmp(dir, c->dir) != 0 && match_nocase(c->dir, name, out, size)));
+    if (found) {
+        rl_warn("%s: texture %s not found as written, using %s", c->path, rel, out);
+        c->notes.textures_case++;
+    }
+    return found;
+}
+
 /* Resolves a texture reference of the model file: an embedded texture, or a
  * path against the model's folder, loaded through the scene (which shares
  * repeated paths). A texture file that is missing only costs a warning, as
@@ -184,13 +270,17 @@ static rl_status load_material_texture(material_ctx *c, const char *tex_path, ui
     for (char *ch = rel; *ch; ++ch)
         if (*ch == '\\')
             *ch = '/';
+    if (rel[0] == '\0')
+        return RL_OK;   /* an empty reference: no texture (MD5 writes them) */
     rl_path_join(c->dir, rel, full, sizeof full);
-    FILE *f = fopen(full, "rb");
-    if (!f) {
-        rl_warn("%s: texture %s not found, material left untextured", c->path, full);
+    if (!is_file(full) && !find_texture_nearby(c, rel, full, sizeof full)) {
+        if (c->notes.textures_missing++ < 3)
+            rl_option_append(c->notes.missing_names, sizeof c->notes.missing_names,
+                             c->notes.textures_missing > 1 ? ", " : "");
+        if (c->notes.textures_missing <= 3)
+            rl_option_append(c->notes.missing_names, sizeof c->notes.missing_names, rel);
         return RL_OK;
     }
-    fclose(f);
     /* rl_scene_load_texture resolves relative paths against the scene's base
      * dir; an absolute or cwd-relative path must reach it unchanged, so the
      * base dir is cleared for the call and restored afterwards. */
@@ -216,17 +306,49 @@ static rl_status add_material(material_ctx *c, const struct aiMaterial *mat, uin
     if (aiGetMaterialString(mat, AI_MATKEY_NAME, &name) == aiReturn_SUCCESS)
         snprintf(m.name, sizeof m.name, "%.63s", name.data);
 
-    if (!get_color(mat, AI_MATKEY_COLOR_DIFFUSE, &m.diffuse))
-        get_color(mat, AI_MATKEY_BASE_COLOR, &m.diffuse);   /* glTF metallic-roughness */
-    get_color(mat, AI_MATKEY_COLOR_SPECULAR, &m.specular);
+    rl_vec3 base;
+    float metallic = 0.0f, roughness = 1.0f, f;
+    bool pbr = get_color(mat, AI_MATKEY_BASE_COLOR, &base) &&
+               (get_float(mat, AI_MATKEY_METALLIC_FACTOR, &metallic) |
+                get_float(mat, AI_MATKEY_ROUGHNESS_FACTOR, &roughness));
+    if (pbr) {
+        map_metal_roughness(&m, base, rl_clampf(metallic, 0.0f, 1.0f),
+                            rl_clampf(roughness, 0.0f, 1.0f));
+    } else {
+        if (!get_color(mat, AI_MATKEY_COLOR_DIFFUSE, &m.diffuse))
+            get_color(mat, AI_MATKEY_BASE_COLOR, &m.diffuse);
+        get_color(mat, AI_MATKEY_COLOR_SPECULAR, &m.specular);
+        if (get_float(mat, AI_MATKEY_SHININESS, &f))
+            m.shininess = rl_maxf(f, 0.0f);
+        /* The mirror term is reflectivity x reflective colour (Collada's
+         * <reflective> and <reflectivity>, COLLADA 1.4.1 spec, Ch. 8
+         * "phong"); rl_material has one scalar k_r, so the colour
+         * contributes its luminance. A file without a reflective colour
+         * means a white one. */
+        float reflectivity;
+        if (get_float(mat, AI_MATKEY_REFLECTIVITY, &reflectivity)) {
+            rl_vec3 reflective = rl_v3s(1.0f);
+            get_color(mat, AI_MATKEY_COLOR_REFLECTIVE, &reflective);
+            m.reflectivity = rl_clampf(reflectivity * luminance(reflective), 0.0f, 1.0f);
+        }
+    }
     get_color(mat, AI_MATKEY_COLOR_EMISSIVE, &m.emission);
-    float f;
-    if (get_float(mat, AI_MATKEY_SHININESS, &f))
-        m.shininess = rl_maxf(f, 0.0f);
-    if (get_float(mat, AI_MATKEY_REFLECTIVITY, &f))
-        m.reflectivity = rl_clampf(f, 0.0f, 1.0f);
-    if (get_float(mat, AI_MATKEY_OPACITY, &f))
-        m.transmissivity = rl_clampf(1.0f - f, 0.0f, 1.0f);
+    if (get_float(mat, AI_MATKEY_OPACITY, &f)) {
+        /* Transmission is (1 - opacity) x the transparent colour where the
+         * file gives one (Assimp folds Collada's <transparency> into the
+         * opacity and keeps <transparent> as the colour). */
+        rl_vec3 transparent = rl_v3s(1.0f);
+        get_color(mat, AI_MATKEY_COLOR_TRANSPARENT, &transparent);
+        float kt = rl_clampf((1.0f - f) * luminance(transparent), 0.0f, 1.0f);
+        if (kt >= 1.0f) {
+            /* A surface that lets everything through and reflects nothing
+             * is invisible; in files it is an exporter's inverted
+             * transparency far more often than a wish. */
+            c->notes.invisible++;
+            kt = 0.0f;
+        }
+        m.transmissivity = kt;
+    }
     if (get_float(mat, AI_MATKEY_REFRACTI, &f))
         m.ior = rl_maxf(f, 1.0f);
     /* Ullmann 2003, eq. 3.1: the reflected and transmitted shares must not
@@ -246,6 +368,17 @@ static rl_status add_material(material_ctx *c, const struct aiMaterial *mat, uin
         if (st != RL_OK)
             return st;
     }
+    /* What the material model cannot hold yet is counted, and reported once
+     * per file (import_notes). */
+    c->notes.normal_maps += aiGetMaterialTextureCount(mat, aiTextureType_NORMALS) > 0 ||
+                            aiGetMaterialTextureCount(mat, aiTextureType_HEIGHT) > 0;
+    c->notes.pbr_textures += aiGetMaterialTextureCount(mat, aiTextureType_METALNESS) > 0 ||
+                             aiGetMaterialTextureCount(mat, aiTextureType_DIFFUSE_ROUGHNESS) > 0 ||
+                             aiGetMaterialTextureCount(mat, aiTextureType_UNKNOWN) > 0;
+    struct aiString mode;
+    if (aiGetMaterialString(mat, "$mat.gltf.alphaMode", 0, 0, &mode) == aiReturn_SUCCESS &&
+        strcmp(mode.data, "OPAQUE") != 0)
+        c->notes.alpha_modes++;
     return rl_scene_add_material(c->scene, &m, id);
 }
 
@@ -305,7 +438,28 @@ typedef struct import_ctx {
     const char *path;
     const struct aiScene *ai;
     const uint32_t *mesh_ids;   /* per aiMesh, RL_NONE when it had no triangles */
+    rl_vec3 centre;             /* of the imported geometry, in world space */
 } import_ctx;
+
+/* Centre of the world-space bounds of the nodes from first on (an import
+ * appends its nodes, children after parents). */
+static rl_vec3 imported_centre(const rl_scene *scene, uint32_t first)
+{
+    rl_aabb b = rl_aabb_empty();
+    for (uint32_t n = first; n < scene->num_nodes; ++n) {
+        const rl_node *node = &scene->nodes[n];
+        if (node->mesh == RL_NONE || node->mesh >= scene->num_meshes)
+            continue;
+        rl_mat4 w = scene_node_world(scene, n);
+        const rl_mesh *m = &scene->meshes[node->mesh];
+        for (uint32_t v = 0; v < m->num_vertices; ++v) {
+            rl_vec3 p = rl_mat4_mul_point(&w, m->positions[v]);
+            if (rl_vfinite(p))
+                b = rl_aabb_grow(b, p);
+        }
+    }
+    return rl_aabb_is_empty(b) ? rl_v3s(0.0f) : rl_aabb_center(b);
+}
 
 static rl_status add_node(import_ctx *c, const struct aiNode *an, uint32_t parent,
                           const char *fallback_name, uint32_t *out)
@@ -408,15 +562,29 @@ static rl_status add_cameras(import_ctx *c, const rl_mat4 *parent_world)
         cam.eye = rl_mat4_mul_point(&w, position);
         cam.target = rl_add(cam.eye, rl_normalize(rl_mat4_mul_dir(&w, v3(ac->mLookAt))));
         cam.up = rl_mat4_mul_dir(&w, v3(ac->mUp));
-        /* We want the full vertical angle. */
+        /* We want the full vertical angle. aiCamera documents
+         * mHorizontalFOV as the half horizontal angle, but Assimp 5.2's
+         * importers store the full one: Collada's (the spec's xfov is the
+         * full angle, and a yfov-only camera gets 2 atan(aspect tan(yfov/2))),
+         * FBX's FieldOfView, Blender's, 3DS's, ASE's, LWS's and OpenGEX's.
+         * Checked on the assimp test models: duck.dae's yfov 37.85 comes back
+         * as 54.43 degrees at aspect 1.5, Blender's default camera as 49.13.
+         * The file's aspect (if any) also sets the camera's resolution, so
+         * that the default render shows what the file frames. */
         float aspect = ac->mAspect > 0.0f
                            ? ac->mAspect
                            : (float)RL_CAMERA_DEFAULT_WIDTH / RL_CAMERA_DEFAULT_HEIGHT;
         if (old_gltf)
             cam.fov_deg = rl_degrees(ac->mHorizontalFOV /
                                      (ac->mAspect > 0.0f ? ac->mAspect : 1.0f));
-        else
+        else if (is_gltf(c->path))
             cam.fov_deg = rl_degrees(2.0f * atanf(tanf(ac->mHorizontalFOV) / aspect));
+        else
+            cam.fov_deg = rl_degrees(2.0f * atanf(tanf(0.5f * ac->mHorizontalFOV) / aspect));
+        if (ac->mAspect > 0.0f && ac->mAspect < 16.0f && ac->mAspect > 1.0f / 16.0f) {
+            cam.height = RL_CAMERA_DEFAULT_HEIGHT;
+            cam.width = (int)lroundf(RL_CAMERA_DEFAULT_HEIGHT * ac->mAspect);
+        }
         /* Vetted here: rl_camera_validate would record an error for a camera
          * we merely skip. */
         rl_vec3 view = rl_sub(cam.target, cam.eye);
@@ -442,6 +610,28 @@ static rl_status add_cameras(import_ctx *c, const rl_mat4 *parent_world)
     return RL_OK;
 }
 
+/* Assimp's point and spot lights fall off as 1 / (c + l d + q d^2) with
+ * the file's attenuation; ours fall off as intensity / d^2 (rl_light). The
+ * two agree exactly for a quadratic-only law (intensity 1/q: FBX and Blender
+ * lights with "decay" write q alone, spider.fbx q = 2.2e-7 at distances of
+ * thousands of units, which made its lamp black at intensity 1) and are
+ * matched at the distance d0 from the light to the model's centre
+ * otherwise: intensity = d0^2 / (c + l d0 + q d0^2). No attenuation at all
+ * (0, 0, 0; Blender's default lamp) means a constant law. */
+static float falloff_scale(const struct aiLight *al, float d0)
+{
+    double c = al->mAttenuationConstant, l = al->mAttenuationLinear,
+           q = al->mAttenuationQuadratic;
+    if (!(c >= 0.0 && l >= 0.0 && q >= 0.0) || !isfinite(c + l + q))
+        return 1.0f;
+    if (c == 0.0 && l == 0.0 && q > 0.0)
+        return (float)fmin(1.0 / q, 1e30);
+    if (c == 0.0 && l == 0.0)
+        c = 1.0;
+    double d = d0 > 0.0f && isfinite(d0) ? d0 : 1.0;
+    return (float)fmin(d * d / (c + l * d + q * d * d), 1e30);
+}
+
 static rl_status add_lights(import_ctx *c, const rl_mat4 *parent_world)
 {
     for (unsigned i = 0; i < c->ai->mNumLights; ++i) {
@@ -452,6 +642,8 @@ static rl_status add_lights(import_ctx *c, const rl_mat4 *parent_world)
         l.color = rl_v3(al->mColorDiffuse.r, al->mColorDiffuse.g, al->mColorDiffuse.b);
         l.intensity = 1.0f;
         l.position = rl_mat4_mul_point(&w, v3(al->mPosition));
+        if (al->mType == aiLightSource_POINT || al->mType == aiLightSource_SPOT)
+            l.intensity = falloff_scale(al, rl_length(rl_sub(c->centre, l.position)));
         l.direction = rl_normalize(rl_mat4_mul_dir(&w, v3(al->mDirection)));
         switch (al->mType) {
         case aiLightSource_POINT: l.type = RL_LIGHT_POINT; break;
@@ -485,8 +677,46 @@ static rl_status add_lights(import_ctx *c, const rl_mat4 *parent_world)
     return RL_OK;
 }
 
+/* One warning per file for what was dropped or could not be mapped. */
+static void report_notes(const char *path, const import_notes *n, uint64_t degenerate,
+                         uint64_t nonfinite, unsigned meshes_dropping)
+{
+    char text[1024] = "";
+    char part[600];
+    if (degenerate || nonfinite) {
+        snprintf(part, sizeof part, "; dropped %llu degenerate and %llu non-finite triangles in %u meshes",
+                 (unsigned long long)degenerate, (unsigned long long)nonfinite, meshes_dropping);
+        rl_option_append(text, sizeof text, part);
+    }
+    if (n->textures_missing) {
+        snprintf(part, sizeof part, "; %u textures not found (%s%s)", n->textures_missing,
+                 n->missing_names, n->textures_missing > 3 ? ", ..." : "");
+        rl_option_append(text, sizeof text, part);
+    }
+    if (n->invisible) {
+        snprintf(part, sizeof part, "; %u materials with opacity 0 taken as opaque", n->invisible);
+        rl_option_append(text, sizeof text, part);
+    }
+    if (n->normal_maps) {
+        snprintf(part, sizeof part, "; normal or bump maps ignored (%u materials)", n->normal_maps);
+        rl_option_append(text, sizeof text, part);
+    }
+    if (n->pbr_textures) {
+        snprintf(part, sizeof part, "; metal/roughness textures ignored, factors used (%u materials)",
+                 n->pbr_textures);
+        rl_option_append(text, sizeof text, part);
+    }
+    if (n->alpha_modes) {
+        snprintf(part, sizeof part, "; alpha mask/blend ignored, drawn opaque (%u materials)",
+                 n->alpha_modes);
+        rl_option_append(text, sizeof text, part);
+    }
+    if (text[0])
+        rl_warn("%s: %s", path, text + 2);
+}
+
 static rl_status build(rl_scene *scene, const char *path, const struct aiScene *ai,
-                       uint32_t parent, uint32_t *root_node)
+                       uint32_t parent, const rl_scene_import_desc *desc, uint32_t *root_node)
 {
     char model_dir[PATH_MAX_LEN];
     rl_path_dirname(path, model_dir, sizeof model_dir);
@@ -497,23 +727,35 @@ static rl_status build(rl_scene *scene, const char *path, const struct aiScene *
     rl_status st = material_ids && mesh_ids && embedded ? RL_OK : RL_ERR_OUT_OF_MEMORY;
     for (unsigned i = 0; st == RL_OK && i < ai->mNumTextures; ++i)
         embedded[i] = RL_NONE;
-    material_ctx mc = { scene, path, model_dir, ai, embedded };
+    material_ctx mc = { scene, path, model_dir, ai, embedded, { 0 } };
     for (unsigned i = 0; st == RL_OK && i < ai->mNumMaterials; ++i)
         st = add_material(&mc, ai->mMaterials[i], &material_ids[i]);
-    for (unsigned i = 0; st == RL_OK && i < ai->mNumMeshes; ++i)
+    /* The scene counts what add_mesh drops; the import reports it once. */
+    uint64_t degenerate0 = scene->dropped_degenerate, nonfinite0 = scene->dropped_nonfinite;
+    unsigned meshes_dropping = 0;
+    scene->quiet_mesh_warnings = true;
+    for (unsigned i = 0; st == RL_OK && i < ai->mNumMeshes; ++i) {
+        uint64_t before = scene->dropped_degenerate + scene->dropped_nonfinite;
         st = add_mesh(scene, ai->mMeshes[i], material_ids[ai->mMeshes[i]->mMaterialIndex],
                       &mesh_ids[i]);
+        meshes_dropping += scene->dropped_degenerate + scene->dropped_nonfinite > before;
+    }
+    scene->quiet_mesh_warnings = false;
+    if (st == RL_OK)
+        report_notes(path, &mc.notes, scene->dropped_degenerate - degenerate0,
+                     scene->dropped_nonfinite - nonfinite0, meshes_dropping);
 
     if (st == RL_OK) {
         /* The file stem names the import root when the file leaves it unnamed. */
         const char *base = strrchr(path, '/') ? strrchr(path, '/') + 1 : path;
-        import_ctx c = { scene, path, ai, mesh_ids };
-        uint32_t root = RL_NONE;
+        import_ctx c = { scene, path, ai, mesh_ids, rl_v3s(0.0f) };
+        uint32_t root = RL_NONE, first = scene->num_nodes;
         st = add_node(&c, ai->mRootNode, parent, base, &root);
         rl_mat4 parent_world = scene_node_world(scene, parent);
-        if (st == RL_OK)
+        c.centre = imported_centre(scene, first);
+        if (st == RL_OK && !desc->no_cameras)
             st = add_cameras(&c, &parent_world);
-        if (st == RL_OK)
+        if (st == RL_OK && !desc->no_lights)
             st = add_lights(&c, &parent_world);
         if (st == RL_OK)
             *root_node = root;
@@ -527,8 +769,17 @@ static rl_status build(rl_scene *scene, const char *path, const struct aiScene *
 RL_API rl_status rl_scene_import(rl_scene *scene, const char *path, uint32_t parent,
                                  uint32_t *root_node)
 {
+    return rl_scene_import_with(scene, path, parent, NULL, root_node);
+}
+
+RL_API rl_status rl_scene_import_with(rl_scene *scene, const char *path, uint32_t parent,
+                                      const rl_scene_import_desc *desc, uint32_t *root_node)
+{
     if (!scene || !path || !root_node)
         return rl_error(RL_ERR_INVALID_ARG, "rl_scene_import: NULL argument");
+    rl_scene_import_desc defaults = { 0 };
+    if (!desc)
+        desc = &defaults;
     rl_status st = rl_scene_check_mutable(scene, "rl_scene_import");
     if (st != RL_OK)
         return st;
@@ -545,10 +796,14 @@ RL_API rl_status rl_scene_import(rl_scene *scene, const char *path, uint32_t par
 
     /* No FindInvalidData: it deletes whole meshes over one NaN position,
      * which the scene core handles per triangle. No GenNormals either: the
-     * scene computes area-weighted ones when a mesh has none. */
+     * scene computes area-weighted ones when a mesh has none. GenUVCoords
+     * turns spherical, cylindrical and planar texture projections (LWO,
+     * 3DS) into UVs, and TransformUVCoords applies a texture's UV
+     * transform, since our textures take UVs only. */
     const struct aiScene *ai =
         aiImportFile(path, aiProcess_Triangulate | aiProcess_JoinIdenticalVertices |
-                               aiProcess_SortByPType | aiProcess_ValidateDataStructure);
+                               aiProcess_SortByPType | aiProcess_ValidateDataStructure |
+                               aiProcess_GenUVCoords | aiProcess_TransformUVCoords);
     if (!ai)
         return rl_error(RL_ERR_PARSE, "%s: %s", path, aiGetErrorString());
     if (!ai->mRootNode || (ai->mFlags & AI_SCENE_FLAGS_INCOMPLETE)) {
@@ -557,7 +812,7 @@ RL_API rl_status rl_scene_import(rl_scene *scene, const char *path, uint32_t par
     }
     st = check_scene(path, ai);
     if (st == RL_OK)
-        st = build(scene, path, ai, parent, root_node);
+        st = build(scene, path, ai, parent, desc, root_node);
     aiReleaseImport(ai);
     return st;
 }

@@ -205,7 +205,7 @@ rl_status rl_scene_add_mesh(rl_scene *scene, const rl_mesh_desc *desc, uint32_t 
 
     if (desc->num_triangles == 0)
         rl_warn("mesh \"%s\": has no triangles", name);
-    if (degenerate || nonfinite)
+    if ((degenerate || nonfinite) && !scene->quiet_mesh_warnings)
         rl_warn("mesh \"%s\": dropped %u degenerate and %u non-finite triangles", name, degenerate,
                 nonfinite);
     if (bad_normals)

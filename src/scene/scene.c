@@ -52,6 +52,8 @@ rl_status rl_scene_create(rl_scene **out)
     if (!s)
         return RL_ERR_OUT_OF_MEMORY;
     s->uid = next_uid++;
+    s->view_azimuth_deg = RL_CAMERA_FIT_AZIMUTH_DEG;
+    s->view_elevation_deg = RL_CAMERA_FIT_ELEVATION_DEG;
     s->name = rl_strdup("scene");
     s->base_dir = rl_strdup("");
     uint32_t root;
@@ -305,8 +307,34 @@ rl_status rl_scene_get_camera(const rl_scene *scene, const char *name, rl_camera
         return rl_error(RL_ERR_NOT_COMMITTED,
                         "scene \"%s\": has no camera, and framing its bounds needs a commit",
                         scene->name);
-    *out = rl_camera_frame_bounds(scene->data.bounds, RL_CAMERA_DEFAULT_WIDTH,
-                                  RL_CAMERA_DEFAULT_HEIGHT);
+    return rl_scene_fit_camera(scene, RL_CAMERA_DEFAULT_WIDTH, RL_CAMERA_DEFAULT_HEIGHT, out);
+}
+
+rl_status rl_scene_set_default_view(rl_scene *scene, float azimuth_deg, float elevation_deg)
+{
+    if (!scene)
+        return rl_error(RL_ERR_INVALID_ARG, "rl_scene_set_default_view: NULL scene");
+    rl_status st = rl_scene_check_mutable(scene, "rl_scene_set_default_view");
+    if (st != RL_OK)
+        return st;
+    if (!isfinite(azimuth_deg) || !(elevation_deg >= -89.0f && elevation_deg <= 89.0f))
+        return rl_error(RL_ERR_INVALID_ARG,
+                        "rl_scene_set_default_view: azimuth %g, elevation %g (finite, elevation in -89..89)",
+                        (double)azimuth_deg, (double)elevation_deg);
+    scene->view_azimuth_deg = azimuth_deg;
+    scene->view_elevation_deg = elevation_deg;
+    return RL_OK;
+}
+
+rl_status rl_scene_fit_camera(const rl_scene *scene, int width, int height, rl_camera *out)
+{
+    if (!scene || !out)
+        return rl_error(RL_ERR_INVALID_ARG, "rl_scene_fit_camera: NULL argument");
+    if (!scene->committed)
+        return rl_error(RL_ERR_NOT_COMMITTED, "scene \"%s\": framing its geometry needs a commit",
+                        scene->name);
+    *out = rl_camera_fit_points(scene->data.positions, scene->data.num_vertices,
+                                scene->view_azimuth_deg, scene->view_elevation_deg, width, height);
     return RL_OK;
 }
 

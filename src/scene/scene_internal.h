@@ -43,6 +43,12 @@ struct rl_scene {
     rl_camera_path *camera_path;
 
     uint64_t dropped_degenerate, dropped_nonfinite;
+    /* Set by an import, which reports drops once per file instead of once
+     * per mesh (load_assimp.c). */
+    bool quiet_mesh_warnings;
+    /* The orbit of the camera made for a scene without one
+     * (rl_scene_set_default_view). */
+    float view_azimuth_deg, view_elevation_deg;
 
     /* Flattened by commit. */
     rl_scene_data data;

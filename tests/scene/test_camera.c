@@ -116,6 +116,60 @@ static void test_validate_rejects_degenerate_cameras(void **state)
     rl_clear_error();
 }
 
+/* rl_camera_fit_points: every point inside the frame with the 4 % margin,
+ * and the fit tight: the extreme points touch the margin on one axis and
+ * are centred on the other. */
+static void test_fit_points_is_tight_from_every_orbit(void **state)
+{
+    (void)state;
+    rl_vec3 pts[200];
+    uint32_t seed = 12345;
+    for (int i = 0; i < 200; ++i) {
+        float v[3];
+        for (int k = 0; k < 3; ++k) {
+            seed = seed * 1664525u + 1013904223u;
+            v[k] = (float)(seed >> 8) / 16777216.0f;
+        }
+        /* A long, flat, off-centre cloud. */
+        pts[i] = rl_v3(1000.0f + 40.0f * v[0], -3.0f + 2.0f * v[1], 7.0f + 10.0f * v[2]);
+    }
+    const float orbits[4][2] = { { 25, 20 }, { 0, 0 }, { -120, 60 }, { 200, -45 } };
+    const int sizes[3][2] = { { 640, 480 }, { 100, 400 }, { 800, 200 } };
+    for (int o = 0; o < 4; ++o)
+        for (int sz = 0; sz < 3; ++sz) {
+            rl_camera cam = rl_camera_fit_points(pts, 200, orbits[o][0], orbits[o][1],
+                                                 sizes[sz][0], sizes[sz][1]);
+            assert_int_equal(rl_camera_validate(&cam), RL_OK);
+            rl_camera_frame f = rl_camera_frame_make(&cam);
+            float ty = f.tan_half_fov_y, tx = ty * f.aspect;
+            float xmin = INFINITY, xmax = -INFINITY, ymin = INFINITY, ymax = -INFINITY;
+            for (int i = 0; i < 200; ++i) {
+                rl_vec3 q = rl_sub(pts[i], f.eye);
+                float depth = -rl_dot(q, f.w);
+                assert_true(depth > 0.0f);
+                float x = rl_dot(q, f.u) / (depth * tx), y = rl_dot(q, f.v) / (depth * ty);
+                xmin = fminf(xmin, x), xmax = fmaxf(xmax, x);
+                ymin = fminf(ymin, y), ymax = fmaxf(ymax, y);
+            }
+            /* Inside the 0.96 margin, up to rounding. */
+            assert_true(xmin >= -0.9601f && xmax <= 0.9601f);
+            assert_true(ymin >= -0.9601f && ymax <= 0.9601f);
+            /* Centred on both axes. */
+            assert_true(fabsf(xmin + xmax) < 2e-3f && fabsf(ymin + ymax) < 2e-3f);
+            /* Touching on one. */
+            assert_true(fmaxf(xmax, ymax) > 0.958f);
+        }
+    /* No finite point: a valid camera looking at the origin. */
+    rl_vec3 bad = rl_v3(NAN, 0, 0);
+    rl_camera cam = rl_camera_fit_points(&bad, 1, 25, 20, 64, 64);
+    assert_int_equal(rl_camera_validate(&cam), RL_OK);
+    /* One point: a valid camera in front of it. */
+    rl_vec3 one = rl_v3(5, 5, 5);
+    cam = rl_camera_fit_points(&one, 1, 25, 20, 64, 64);
+    assert_int_equal(rl_camera_validate(&cam), RL_OK);
+    assert_true(rl_length(rl_sub(cam.target, one)) < 1e-4f);
+}
+
 static void test_frame_bounds_sees_all_corners_of_the_box(void **state)
 {
     (void)state;
@@ -256,6 +310,7 @@ int main(void)
         cmocka_unit_test(test_top_left_pixel_ray_points_up_and_left),
         cmocka_unit_test(test_validate_rejects_degenerate_cameras),
         cmocka_unit_test(test_frame_bounds_sees_all_corners_of_the_box),
+        cmocka_unit_test(test_fit_points_is_tight_from_every_orbit),
         cmocka_unit_test(test_clip_range_keeps_near_at_least_far_times_1e_minus_5),
         cmocka_unit_test(test_path_eval_hits_keys_exactly_at_key_times),
         cmocka_unit_test(test_path_eval_is_continuous_and_stays_near_the_keys),

@@ -570,15 +570,25 @@ static void test_get_camera_finds_by_name_first_or_frames_the_bounds(void **stat
     assert_true(out.eye.z == -5.0f);
     rl_scene_release(s);
 
-    /* No camera at all: a camera that frames the committed bounds. */
+    /* No camera at all: the tight fit of the committed vertices from the
+     * scene's default view, at the default size. */
     s = new_scene(1);
     add_node(s, RL_NODE_ROOT, "n", rl_mat4_identity(), add_quad(s, 0));
+    rl_camera framed;
+    assert_int_equal(rl_scene_fit_camera(s, 64, 64, &framed), RL_ERR_NOT_COMMITTED);
+    assert_int_equal(rl_scene_set_default_view(s, 10.0f, 95.0f), RL_ERR_INVALID_ARG);
+    rl_clear_error();
+    assert_int_equal(rl_scene_set_default_view(s, 0.0f, 0.0f), RL_OK);
     assert_int_equal(rl_scene_commit(s), RL_OK);
+    assert_int_equal(rl_scene_set_default_view(s, 0.0f, 0.0f), RL_ERR_INVALID_ARG);
+    rl_clear_error();
     assert_int_equal(rl_scene_get_camera(s, NULL, &out), RL_OK);
-    rl_camera framed = rl_camera_frame_bounds(rl_scene_get_data(s)->bounds, RL_CAMERA_DEFAULT_WIDTH,
-                                              RL_CAMERA_DEFAULT_HEIGHT);
+    assert_int_equal(rl_scene_fit_camera(s, RL_CAMERA_DEFAULT_WIDTH, RL_CAMERA_DEFAULT_HEIGHT,
+                                         &framed), RL_OK);
     assert_memory_equal(&out, &framed, sizeof out);
-    assert_vec3_near(out.target, rl_v3(0.5f, 0.5f, 0.0f), 1e-6f);
+    /* Azimuth 0, elevation 0: straight down -z at the quad in z = 0. */
+    assert_vec3_near(out.target, rl_v3(0.5f, 0.5f, 0.0f), 1e-5f);
+    assert_true(out.eye.z > 0.0f && fabsf(out.eye.x - 0.5f) < 1e-5f);
     rl_scene_release(s);
 }
 
