@@ -2,10 +2,12 @@
 BUILD      ?= build
 BUILD_SAN  ?= build-asan
 BUILD_FUZZ ?= build-fuzz
+BUILD_INSTALL ?= build-install
+PREFIX     ?= /usr/local
 JOBS       ?= $(shell nproc 2>/dev/null || echo 2)
 CMAKE_ARGS ?=
 
-.PHONY: all deps build build-asan build-fuzz fuzz check demo clean
+.PHONY: all deps build build-asan build-fuzz fuzz check demo install clean
 
 all: build
 
@@ -53,8 +55,17 @@ check: deps
 	    $(MAKE) --no-print-directory build-fuzz && cd $(BUILD_FUZZ) && ctest --output-on-failure -j $(JOBS); \
 	else echo "== fuzz smoke: skipped (no clang) =="; fi
 
+# Headers, libraries (shared and static), rl, renderlab.pc and the CMake
+# package under $(DESTDIR)$(PREFIX). Built apart from build/, without
+# -march=native (the result may run elsewhere), the tests and -Werror.
+install:
+	@cmake -S . -B $(BUILD_INSTALL) -DCMAKE_BUILD_TYPE=Release -DCMAKE_INSTALL_PREFIX=$(PREFIX) -DRL_NATIVE=OFF \
+	    -DRL_TESTS=OFF -DRL_EXAMPLES=OFF -DRL_WERROR=OFF $(CMAKE_ARGS) >/dev/null
+	@cmake --build $(BUILD_INSTALL) -j $(JOBS)
+	@DESTDIR=$(DESTDIR) cmake --install $(BUILD_INSTALL)
+
 demo: deps build
 	@$(BUILD)/rl demo --out out/demo
 
 clean:
-	rm -rf $(BUILD) $(BUILD_SAN) $(BUILD_FUZZ) out
+	rm -rf $(BUILD) $(BUILD_SAN) $(BUILD_FUZZ) $(BUILD_INSTALL) out

@@ -36,6 +36,10 @@ int cli_bench(int argc, char **argv);
 int cli_eval(int argc, char **argv);
 int cli_compare(int argc, char **argv);
 
+/* Loads a plugin and runs its rl_plugin_init() (plugin.c); 0, or the exit
+ * code with the error printed. */
+int cli_load_plugin(const char *path);
+
 /* Prints "rl: error: <message>" and returns code. */
 int cli_fail(int code, const char *fmt, ...)
 #if defined(__GNUC__)

@@ -28,7 +28,7 @@ static const command commands[] = {
 static void print_usage(FILE *out)
 {
     fprintf(out,
-            "usage: rl [-v|-q] <command> [options]\n"
+            "usage: rl [-v|-q] [--plugin FILE] <command> [options]\n"
             "\n"
             "renderlab " RL_CLI_VERSION ": a laboratory of rendering algorithms.\n"
             "\n"
@@ -42,6 +42,7 @@ static void print_usage(FILE *out)
             "global flags (before or after the command):\n"
             "  -v, --verbose   debug log\n"
             "  -q, --quiet     errors only\n"
+            "  --plugin FILE   load renderers from a shared object (README, \"Your own renderer\")\n"
             "  --version       print the version\n"
             "\n"
             "example:\n"
@@ -59,7 +60,9 @@ static void log_to_stderr(void *user, rl_log_level level, const char *message)
 int main(int argc, char **argv)
 {
     rl_log_level level = RL_LOG_INFO;
-    int n = 0;
+    enum { MAX_PLUGINS = 8 };
+    const char *plugins[MAX_PLUGINS];
+    int n = 0, num_plugins = 0;
     /* Take out global flags wherever they are; keep everything else in order. */
     for (int i = 1; i < argc; i++) {
         const char *a = argv[i];
@@ -67,12 +70,25 @@ int main(int argc, char **argv)
             level = RL_LOG_DEBUG;
         else if (strcmp(a, "-q") == 0 || strcmp(a, "--quiet") == 0)
             level = RL_LOG_ERROR;
-        else
+        else if (strcmp(a, "--plugin") == 0 || strncmp(a, "--plugin=", 9) == 0) {
+            const char *path = a[8] == '=' ? a + 9 : (i + 1 < argc ? argv[++i] : NULL);
+            if (!path || !*path)
+                return cli_fail(RL_CLI_USAGE, "--plugin needs a file (a shared object defining rl_plugin_init)");
+            if (num_plugins == MAX_PLUGINS)
+                return cli_fail(RL_CLI_USAGE, "at most %d --plugin files", MAX_PLUGINS);
+            plugins[num_plugins++] = path;
+        } else
             argv[n++] = argv[i];
     }
     argv[n] = NULL;
     rl_log_set_level(level);
     rl_log_set_callback(log_to_stderr, NULL);
+    /* Before the subcommand, so that it finds the plugins' renderers by name. */
+    for (int i = 0; i < num_plugins; i++) {
+        int code = cli_load_plugin(plugins[i]);
+        if (code)
+            return code;
+    }
 
     if (n == 0)
         return cli_fail(RL_CLI_USAGE, "no command given (commands: scenes, algos, info, "

@@ -16,7 +16,16 @@
 extern "C" {
 #endif
 
-#define RL_API /* static library; visibility macros arrive with a shared build */
+/* The shared library is built with hidden visibility, so that it exports
+ * exactly the functions declared RL_API here and none of the internal rl_*
+ * helpers of src/ (tests/install/exports.sh checks this). RL_BUILD_LIBRARY
+ * is defined only while compiling renderlab itself; an application sees a
+ * plain declaration, so that its own visibility settings stay its own. */
+#if defined(RL_BUILD_LIBRARY) && (defined(__GNUC__) || defined(__clang__))
+#define RL_API __attribute__((visibility("default")))
+#else
+#define RL_API
+#endif
 
 /* One list of (code, value, message); tests compare codes, people read text. */
 #define RL_STATUS_LIST(X)                                                     \

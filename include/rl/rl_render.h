@@ -7,7 +7,13 @@
  * so that the evaluator can time and compare any of them. Options are typed
  * (int, float, bool, enum, string, colour) and checked on rl_renderer_set(); unknown
  * keys and malformed values fail with RL_ERR_INVALID_ARG and a message that
- * lists what is accepted. */
+ * lists what is accepted.
+ *
+ * Renderers of your own: rl_renderer_register() adds a class described by
+ * an rl_renderer_class_desc to the same registry, after the built-ins. It
+ * is then listed, created by name and measured like any built-in (by the
+ * properties of rl_property.h, by rl_sample_property, by a program's own
+ * comparison): see examples/custom_renderer.c. */
 #ifndef RL_RENDER_H
 #define RL_RENDER_H
 
@@ -116,6 +122,69 @@ RL_API void rl_renderer_set_progress(rl_renderer *r, rl_progress_fn fn, void *us
  * be NULL; otherwise it is overwritten. */
 RL_API rl_status rl_renderer_render(rl_renderer *r, const rl_scene *scene, const rl_camera *cam,
                                     rl_image *image, rl_render_stats *stats);
+
+/* A renderer class written outside the library (rl_renderer_register).
+ * The built-ins are described the same way inside src/render/. */
+typedef struct rl_renderer_class_desc {
+    /* name: required, 1..31 characters of [A-Za-z0-9_-] (it is written
+     * "name:key=value" and "name.key" on command lines), unique among all
+     * renderers. description and reference may be NULL (""). */
+    rl_renderer_info info;
+    /* The option table, typed and checked as for the built-ins (may be NULL
+     * with num_options 0); read the values in render() with
+     * rl_renderer_opt_*. Borrowed, not copied: it must stay valid for as
+     * long as the library is used (a static table, as the built-ins'). */
+    const rl_option_info *options;
+    size_t num_options;
+    /* Bytes of per-renderer state, allocated zeroed by rl_renderer_create()
+     * and freed after release (0: no state, state is NULL). */
+    size_t state_size;
+    /* Required. Called by rl_renderer_render() after its checks: the scene
+     * is committed, cam is resolved and valid, image matches cam's
+     * resolution and has a colour layer; stats is zeroed and its time_ms
+     * filled by the caller. Fill the counters that apply. Record failures
+     * with a status (and, where useful, a message the caller can read: any
+     * failing rl_* call has already recorded one). */
+    rl_status (*render)(rl_renderer *r, void *state, const rl_scene *scene, const rl_camera *cam,
+                        rl_image *image, rl_render_stats *stats);
+    /* Optional: frees what state holds (not state itself). */
+    void (*release)(void *state);
+    /* Optional: forgets frame-to-frame state (rl_renderer_reset). */
+    void (*reset)(void *state);
+    /* Optional: an extra check of a value that already passed its row's
+     * type and range check; return RL_ERR_INVALID_ARG to refuse it. */
+    rl_status (*check)(const char *key, const char *value);
+} rl_renderer_class_desc;
+
+/* At most this many classes can be registered besides the built-ins. */
+#define RL_RENDERER_MAX_REGISTERED 32
+
+/* Adds a renderer class to the registry: from now on rl_renderer_list()
+ * lists it (after the built-ins, in registration order) and
+ * rl_renderer_create() makes it by name, for every caller in the process.
+ * desc and its strings are copied; the option table is borrowed (above).
+ * Classes cannot be removed. Safe to call from any thread; a renderer
+ * created concurrently by the new name may or may not find it.
+ * RL_ERR_INVALID_ARG: NULL desc or render, a missing or malformed name, a
+ * name already taken (built-in or registered), an option row without a key
+ * or whose default does not pass its own check. RL_ERR_LIMIT after
+ * RL_RENDERER_MAX_REGISTERED classes. Nothing is registered on failure. */
+RL_API rl_status rl_renderer_register(const rl_renderer_class_desc *desc);
+
+/* For render() implementations: the current value of an option of r's
+ * table, typed (values were validated when set; defaults when never set).
+ * A key that is not in the table reads as 0, 0.0, false, choice 0, "" or
+ * black: a mistake in the implementation, not in the user's input. */
+RL_API long long rl_renderer_opt_int(const rl_renderer *r, const char *key);
+RL_API double rl_renderer_opt_float(const rl_renderer *r, const char *key);
+RL_API bool rl_renderer_opt_bool(const rl_renderer *r, const char *key);
+RL_API int rl_renderer_opt_enum(const rl_renderer *r, const char *key);   /* choice index */
+RL_API const char *rl_renderer_opt_string(const rl_renderer *r, const char *key);
+RL_API rl_vec3 rl_renderer_opt_color(const rl_renderer *r, const char *key);
+/* For long render() implementations: reports done in [0, 1] to the
+ * callback of rl_renderer_set_progress(); false means the caller cancels
+ * (return RL_ERR_CANCELLED then). True when no callback is set. */
+RL_API bool rl_renderer_progress(const rl_renderer *r, double done);
 
 #ifdef __cplusplus
 }

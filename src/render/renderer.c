@@ -1,6 +1,7 @@
 /* renderer.c: the generic rl_renderer layer shared by every algorithm.
  *
- * Creates renderers by name from the registry (registry.c), keeps option
+ * Creates renderers by name from the registry (registry.c, which also
+ * lists them and registers classes from outside the library), keeps option
  * values as validated text (so that get() returns exactly what was set and a
  * renderer's options can be listed and reproduced in reports), and wraps the
  * class's render() with the checks every algorithm needs: committed scene,
@@ -49,50 +50,14 @@ const char *rl_ray_type_name(rl_ray_type type)
     return (unsigned)type < RL_RAY_TYPE_COUNT ? names[type] : "unknown";
 }
 
-const rl_renderer_info *rl_renderer_list(size_t *count)
-{
-    /* The infos live inside the classes; the public list wants them
-     * contiguous, so copy once. Guarded because two threads may list at once. */
-    enum { MAX_CLASSES = 64 };
-    static rl_renderer_info infos[MAX_CLASSES];
-    static size_t num_infos;
-    static bool built;
-    size_t n;
-#pragma omp critical(rl_renderer_list)
-    {
-        if (!built) {
-            num_infos = rl_renderer_class_count < MAX_CLASSES ? rl_renderer_class_count : MAX_CLASSES;
-            for (size_t i = 0; i < num_infos; ++i)
-                infos[i] = rl_renderer_classes[i]->info;
-            built = true;
-        }
-        n = num_infos;
-    }
-    if (count)
-        *count = n;
-    return infos;
-}
-
-static const rl_renderer_class *find_class(const char *name)
-{
-    for (size_t i = 0; i < rl_renderer_class_count; ++i)
-        if (strcmp(rl_renderer_classes[i]->info.name, name) == 0)
-            return rl_renderer_classes[i];
-    return NULL;
-}
-
 rl_status rl_renderer_create(const char *name, rl_renderer **out)
 {
     if (!name || !out)
         return rl_error(RL_ERR_INVALID_ARG, "rl_renderer_create: name and out must not be NULL");
-    const rl_renderer_class *cls = find_class(name);
+    const rl_renderer_class *cls = rl_renderer_find_class(name);
     if (!cls) {
-        char names[RL_OPTION_LIST_SIZE] = "";
-        for (size_t i = 0; i < rl_renderer_class_count; ++i) {
-            if (i)
-                rl_option_append(names, sizeof names, ", ");
-            rl_option_append(names, sizeof names, rl_renderer_classes[i]->info.name);
-        }
+        char names[RL_OPTION_LIST_SIZE];
+        rl_renderer_class_names(names, sizeof names);
         return rl_error(RL_ERR_NOT_FOUND, "unknown algorithm \"%s\" (available: %s)", name, names);
     }
 
@@ -231,7 +196,7 @@ void rl_renderer_set_progress(rl_renderer *r, rl_progress_fn fn, void *user)
 
 bool rl_renderer_progress(const rl_renderer *r, double done)
 {
-    return !r->progress || r->progress(r->progress_user, done);
+    return !r || !r->progress || r->progress(r->progress_user, done);
 }
 
 /* Typed reads (options.h). Values were validated on set and defaults are

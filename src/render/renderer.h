@@ -4,7 +4,8 @@
  * size of its state and its functions, so that a new renderer is only its
  * algorithm. The generic layer (renderer.c) validates and stores option
  * values as text; an implementation reads them typed with rl_renderer_opt_*.
- * All classes are listed once, in registry.c. */
+ * All built-in classes are listed once, in registry.c; classes from outside
+ * the library join them there through rl_renderer_register(). */
 #ifndef RL_RENDER_RENDERER_H
 #define RL_RENDER_RENDERER_H
 
@@ -37,21 +38,19 @@ typedef struct rl_renderer_class {
 /* At most this many input slots per class. */
 #define RL_RENDERER_MAX_INPUTS 4
 
-/* registry.c */
-extern const rl_renderer_class *const rl_renderer_classes[];
-extern const size_t rl_renderer_class_count;
+/* registry.c: the classes, built-ins first, then those registered with
+ * rl_renderer_register() (rl_render.h). The class of name, or NULL. */
+const rl_renderer_class *rl_renderer_find_class(const char *name);
+/* The names of all classes, ", "-separated, into buf (cut when full): for
+ * the message of an unknown name. */
+void rl_renderer_class_names(char *buf, size_t size);
 
-/* Typed option reads for implementations (values were validated on set). */
-long long rl_renderer_opt_int(const rl_renderer *r, const char *key);
-double rl_renderer_opt_float(const rl_renderer *r, const char *key);
-bool rl_renderer_opt_bool(const rl_renderer *r, const char *key);
-int rl_renderer_opt_enum(const rl_renderer *r, const char *key);   /* choice index */
-const char *rl_renderer_opt_string(const rl_renderer *r, const char *key);
-/* RL_OPT_COLOR values: "r,g,b" or a single grey value, finite and >= 0.
- * rl_renderer_parse_color() only parses (no error recorded); the option read
- * returns black for a value that does not parse. */
+/* The typed option reads rl_renderer_opt_* are public (rl_render.h), for
+ * renderers written outside the library too. RL_OPT_COLOR values: "r,g,b"
+ * or a single grey value, finite and >= 0. rl_renderer_parse_color() only
+ * parses (no error recorded); the option read returns black for a value
+ * that does not parse. */
 bool rl_renderer_parse_color(const char *text, rl_vec3 *out);
-rl_vec3 rl_renderer_opt_color(const rl_renderer *r, const char *key);
 /* The implementation's state made by its class's create(), for accessors
  * of a renderer's own (e.g. rl_whitted_pixel_tree). */
 void *rl_renderer_state(const rl_renderer *r);
@@ -59,7 +58,5 @@ void *rl_renderer_state(const rl_renderer *r);
  * was set, so that a renderer can tell a new lookup from the one it built
  * its per-region data for. */
 const rl_position_lookup *rl_renderer_input(const rl_renderer *r, const char *slot, uint64_t *generation);
-/* Progress for implementations: false means cancel. */
-bool rl_renderer_progress(const rl_renderer *r, double done);
 
 #endif
