@@ -90,6 +90,24 @@ int cli_load_scene(const char *arg, rl_scene **out);
 /* True when name is one of the built-in scenes (rl scenes). */
 bool cli_is_builtin(const char *name);
 
+/* The model-file parameters (rl_model_options) as flags: --file-cameras
+ * file|off, --file-lights file|off|add, --headlight, --orbit AZ,EL. They are
+ * the same as "model.obj:cameras=off,...", collected as key=value text. */
+typedef struct cli_model_flags {
+    char params[256];
+} cli_model_flags;
+#define CLI_MODEL_FLAGS_HELP \
+    "  --file-cameras file|off   use the model file's cameras or frame the model\n" \
+    "  --file-lights file|off|add  the file's lights, the default lights, or both\n" \
+    "  --headlight         a point light at the default view's eye\n" \
+    "  --orbit AZ,EL       the framing camera's orbit in degrees (default 25,20)\n"
+/* 1 when argv[*i] was one of the flags (consumed, *i advanced past its
+ * value), 0 when it is not, -1 after printing a usage error. */
+int cli_take_model_flag(int argc, char **argv, int *i, cli_model_flags *flags);
+/* cli_load_scene with the flags appended to the source's own parameters;
+ * flags on a built-in or JSON scene are a usage error. */
+int cli_load_scene_with(const char *arg, const cli_model_flags *flags, rl_scene **out);
+
 /* Scene statistics and render statistics as JSON objects (for --json,
  * --stats-json and the demo report); NULL when out of memory. */
 struct cJSON;

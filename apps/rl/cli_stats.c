@@ -51,6 +51,41 @@ cJSON *cli_scene_stats_json(const rl_scene *scene)
             cJSON_AddItemToArray(names, cJSON_CreateString(
                                             data->camera_names && data->camera_names[i]
                                                 ? data->camera_names[i] : ""));
+    /* The cameras and lights in full, as rl info prints them. */
+    cJSON *views = cJSON_AddArrayToObject(obj, "camera_list");
+    for (uint32_t i = 0; views && data && i <= data->num_cameras; i++) {
+        rl_camera c;
+        if (i == data->num_cameras && (i > 0 || rl_scene_get_camera(scene, NULL, &c) != RL_OK))
+            break;
+        if (i < data->num_cameras)
+            c = data->cameras[i];
+        c = rl_camera_resolve(&c);
+        cJSON *v = cJSON_CreateObject();
+        if (!v)
+            break;
+        cJSON_AddStringToObject(v, "name", i < data->num_cameras && data->camera_names
+                                               ? data->camera_names[i] : "framed");
+        cJSON_AddItemToObject(v, "eye", vec3_json(c.eye));
+        cJSON_AddItemToObject(v, "target", vec3_json(c.target));
+        cJSON_AddItemToObject(v, "up", vec3_json(c.up));
+        cJSON_AddNumberToObject(v, "fov_deg", c.fov_deg);
+        cJSON_AddNumberToObject(v, "width", c.width);
+        cJSON_AddNumberToObject(v, "height", c.height);
+        cJSON_AddItemToArray(views, v);
+    }
+    cJSON *lights = cJSON_AddArrayToObject(obj, "light_list");
+    for (uint32_t i = 0; lights && data && i < data->num_lights; i++) {
+        const rl_light *l = &data->lights[i];
+        cJSON *v = cJSON_CreateObject();
+        if (!v)
+            break;
+        cJSON_AddStringToObject(v, "type", rl_light_type_name(l->type));
+        cJSON_AddItemToObject(v, "color", vec3_json(l->color));
+        cJSON_AddNumberToObject(v, "intensity", l->intensity);
+        cJSON_AddItemToObject(v, "position", vec3_json(l->position));
+        cJSON_AddItemToObject(v, "direction", vec3_json(l->direction));
+        cJSON_AddItemToArray(lights, v);
+    }
     return obj;
 }
 

@@ -38,6 +38,9 @@ static const char render_help[] =
     "  --id-out FILE.png   object IDs in false colour (background black)\n"
     "  --stats-json FILE   render and scene statistics as JSON\n"
     "\n"
+    "model files (the same as SCENE:cameras=off,lights=add,...; see rl scenes):\n"
+    CLI_MODEL_FLAGS_HELP
+    "\n"
     "camera paths (the scene's \"camera_path\", e.g. cluster's or a JSON scene's):\n"
     "  --camera-path       render the path's frames instead of one camera; --out\n"
     "                      (and --depth-out, --id-out) then hold one integer\n"
@@ -54,6 +57,7 @@ typedef struct render_args {
     const char *scene, *algo, *out, *camera, *depth_out, *id_out, *stats_json;
     bool has_size, has_eye, has_target, has_up, has_fov;
     bool camera_path;           /* --camera-path */
+    cli_model_flags model;      /* --file-cameras, --file-lights, --headlight, --orbit */
     long long frames;           /* --frames, 0: from --fps */
     double fps;                 /* --fps, 0: default */
     int width, height;
@@ -148,6 +152,7 @@ static int parse_args(int argc, char **argv, render_args *a)
                                    v);
             a->fov_deg = (float)fov;
             a->has_fov = true;
+        } else if ((m = cli_take_model_flag(argc, argv, &i, &a->model)) != 0) {
         } else if (argv[i][0] == '-' || a->scene)
             return cli_unknown_arg("render", argv[i]);
         else
@@ -306,7 +311,7 @@ static int render_frame(const render_args *a)
     if (rc == RL_CLI_OK)
         rc = create_renderer(a, &renderer);
     if (rc == RL_CLI_OK)
-        rc = cli_load_scene(a->scene, &scene);
+        rc = cli_load_scene_with(a->scene, &a->model, &scene);
     if (rc == RL_CLI_OK)
         rc = choose_camera(a, scene, &cam);
     if (rc == RL_CLI_OK) {
@@ -393,7 +398,7 @@ static int render_path(const render_args *a)
     if (rc == RL_CLI_OK)
         rc = create_renderer(a, &renderer);
     if (rc == RL_CLI_OK)
-        rc = cli_load_scene(a->scene, &scene);
+        rc = cli_load_scene_with(a->scene, &a->model, &scene);
     const rl_scene_data *d = scene ? rl_scene_get_data(scene) : NULL;
     const rl_camera_path *path = d ? d->camera_path : NULL;
     if (rc == RL_CLI_OK && !path)
