@@ -87,13 +87,16 @@ rl_status rl_renderer_create(const char *name, rl_renderer **out)
         return rl_error(RL_ERR_INVALID_ARG, "rl_renderer_create: name and out must not be NULL");
     const rl_renderer_class *cls = find_class(name);
     if (!cls) {
-        char names[RL_OPTION_LIST_SIZE] = "";
+        char names[RL_OPTION_LIST_SIZE] = "", hint[96];
+        rl_suggestion sg = { 0 };
         for (size_t i = 0; i < rl_renderer_class_count; ++i) {
             if (i)
                 rl_option_append(names, sizeof names, ", ");
             rl_option_append(names, sizeof names, rl_renderer_classes[i]->info.name);
+            rl_suggest(&sg, name, rl_renderer_classes[i]->info.name);
         }
-        return rl_error(RL_ERR_NOT_FOUND, "unknown algorithm \"%s\" (available: %s)", name, names);
+        return rl_error(RL_ERR_NOT_FOUND, "unknown algorithm \"%s\" (%savailable: %s)", name,
+                        rl_option_did_you_mean(&sg, hint, sizeof hint), names);
     }
 
     rl_renderer *r = rl_calloc(1, sizeof *r);
