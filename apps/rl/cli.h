@@ -36,6 +36,10 @@ int cli_bench(int argc, char **argv);
 int cli_eval(int argc, char **argv);
 int cli_compare(int argc, char **argv);
 
+/* One row of an option table (rl algos, rl scenes, rl eval --list): key,
+ * type, default, help, range (integers as integers) or choices. */
+void cli_print_option(FILE *out, const rl_option_info *o);
+
 /* Prints "rl: error: <message>" and returns code. */
 int cli_fail(int code, const char *fmt, ...)
 #if defined(__GNUC__)

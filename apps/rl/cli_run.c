@@ -113,10 +113,12 @@ void cli_build_text(char *out, size_t size)
 #else
     const char *san = "";
 #endif
-#ifdef __VERSION__
-    const char *compiler = __VERSION__;
+#if defined(__clang__)
+    const char *compiler = "clang " __clang_version__;
+#elif defined(__GNUC__)
+    const char *compiler = "GCC " __VERSION__;
 #else
-    const char *compiler = "unknown compiler";
+    const char *compiler = "an unknown compiler";
 #endif
     snprintf(out, size, "renderlab %s, %s%s, %s%s", RL_CLI_VERSION, type, san, compiler,
              rl_accel_kind_available(RL_ACCEL_EMBREE) ? ", Embree" : "");
@@ -143,7 +145,7 @@ static bool load_now(double l[3])
 
 static void warn_if_busy(const cli_load *l, const double load[3], const char *when)
 {
-    if (load[0] > (double)l->threads)
+    if (load[0] > (double)l->threads && rl_log_get_level() >= RL_LOG_WARN)
         fprintf(stderr, "rl: warning: load average %.2f at the %s exceeds the %d threads: other work "
                         "competes for the processors, so times are inflated and noisy\n",
                 load[0], when, l->threads);

@@ -75,7 +75,15 @@ static bool check_list(const char *option, const char *list, const char *const *
         for (size_t i = 0; i < count && !known; i++)
             known = strlen(names[i]) == m && strncmp(names[i], p, m) == 0;
         if (!known) {
-            cli_fail(RL_CLI_USAGE, "%s: unknown name '%.*s'", option, (int)m, p);
+            char typed[256];
+            snprintf(typed, sizeof typed, "%.*s", (int)m, p);
+            rl_suggestion sg = { 0 };
+            for (size_t i = 0; i < count; i++)
+                rl_suggest(&sg, typed, names[i]);
+            if (sg.name)
+                cli_fail(RL_CLI_USAGE, "%s: unknown name '%s' (did you mean '%s'?)", option, typed, sg.name);
+            else
+                cli_fail(RL_CLI_USAGE, "%s: unknown name '%s'", option, typed);
             return false;
         }
         p = end ? end + 1 : p + m;
