@@ -99,7 +99,7 @@ grep -q "rl list" "$TMP/out" && fail "eval --list refers to 'rl list'"
 # bench --help: one line per kind, where the JSON goes, how long.
 run_ok "$RL" bench --help
 for k in rays vt pt sampling surfels culling; do
-    grep -Eq "^  $k +" "$TMP/out" || fail "bench --help lacks $k: $(cat "$TMP/out")"
+    grep -Eq "^  rl bench $k +[a-zA-Z]" "$TMP/out" || fail "bench --help lacks $k: $(cat "$TMP/out")"
 done
 expect_in "$TMP/out" "bench/results/KIND-YYYYMMDD-HHMMSS.json"
 expect_in "$TMP/out" "2 cores"
