@@ -90,11 +90,9 @@ typedef struct bench_params {
     uint64_t seed;
 } bench_params;
 
-/* uname, CPU model, nproc, threads and the load average: the machine a
- * record was measured on (also used by `rl bench vt`); NULL when out of memory. */
-struct cJSON *bench_machine_json(int threads);
 /* The head of every benchmark record: benchmark name, renderlab version, UTC
- * date and the machine; NULL when out of memory. */
+ * date, the command line, the build and the machine (cli_machine_json);
+ * NULL when out of memory. */
 struct cJSON *bench_record_json(const char *benchmark, int threads);
 
 /* The whole run as one JSON object: machine, date, version, parameters,

@@ -2,8 +2,8 @@
  *
  * A benchmark figure means little without the machine it ran on and the
  * ratio to a reference measured in the same run (machines, loads and
- * compilers change), so the record carries uname, the CPU model, the core
- * and thread counts, the date, the renderlab version and every parameter,
+ * compilers change), so the record carries the machine (cli_run.c), the
+ * command line, the build, the date, the renderlab version and every parameter,
  * then per scene, accelerator and workload: rays, hits, seconds, Mrays/s and
  * the ratio to Embree. Unknown values are JSON null, never made up. */
 #define _POSIX_C_SOURCE 200809L
@@ -12,32 +12,8 @@
 
 #include <cjson/cJSON.h>
 #include <math.h>
-#include <omp.h>
 #include <string.h>
-#include <sys/utsname.h>
 #include <time.h>
-
-/* "model name : AMD EPYC ..." from /proc/cpuinfo; "unknown" elsewhere. */
-static void cpu_model(char *out, size_t size)
-{
-    snprintf(out, size, "unknown");
-    FILE *f = fopen("/proc/cpuinfo", "r");
-    if (!f)
-        return;
-    char line[512];
-    while (fgets(line, sizeof line, f)) {
-        const char *colon = strchr(line, ':');
-        if (strncmp(line, "model name", 10) == 0 && colon) {
-            colon++;
-            while (*colon == ' ' || *colon == '\t')
-                colon++;
-            snprintf(out, size, "%s", colon);
-            out[strcspn(out, "\r\n")] = '\0';
-            break;
-        }
-    }
-    fclose(f);
-}
 
 /* Adds a number, or null for NaN (JSON has no NaN). */
 static void add_number(cJSON *obj, const char *key, double value)
@@ -46,44 +22,6 @@ static void add_number(cJSON *obj, const char *key, double value)
         cJSON_AddNumberToObject(obj, key, value);
     else
         cJSON_AddNullToObject(obj, key);
-}
-
-/* "0.52 0.58 0.59" from /proc/loadavg: other work on the machine skews
- * the figures, so the record says how busy it was. */
-static void load_average(char *out, size_t size)
-{
-    snprintf(out, size, "unknown");
-    FILE *f = fopen("/proc/loadavg", "r");
-    if (!f)
-        return;
-    double l1, l5, l15;
-    if (fscanf(f, "%lf %lf %lf", &l1, &l5, &l15) == 3)
-        snprintf(out, size, "%.2f %.2f %.2f", l1, l5, l15);
-    fclose(f);
-}
-
-cJSON *bench_machine_json(int threads)
-{
-    cJSON *m = cJSON_CreateObject();
-    if (!m)
-        return NULL;
-    struct utsname u;
-    char text[sizeof u.sysname + sizeof u.release + sizeof u.version + sizeof u.machine + 8];
-    if (uname(&u) == 0) {
-        snprintf(text, sizeof text, "%s %s %s %s", u.sysname, u.release, u.version, u.machine);
-        cJSON_AddStringToObject(m, "uname", text);
-    } else {
-        cJSON_AddNullToObject(m, "uname");
-    }
-    char cpu[256];
-    cpu_model(cpu, sizeof cpu);
-    cJSON_AddStringToObject(m, "cpu", cpu);
-    cJSON_AddNumberToObject(m, "nproc", omp_get_num_procs());
-    cJSON_AddNumberToObject(m, "threads", threads);
-    char load[64];
-    load_average(load, sizeof load);
-    cJSON_AddStringToObject(m, "loadavg_at_end", load);
-    return m;
 }
 
 static cJSON *params_json(const bench_params *p)
@@ -209,7 +147,11 @@ cJSON *bench_record_json(const char *benchmark, int threads)
         cJSON_AddStringToObject(root, "date", date);
     else
         cJSON_AddNullToObject(root, "date");
-    cJSON_AddItemToObject(root, "machine", bench_machine_json(threads));
+    cJSON_AddStringToObject(root, "command", cli_command_line());
+    char build[512];
+    cli_build_text(build, sizeof build);
+    cJSON_AddStringToObject(root, "build", build);
+    cJSON_AddItemToObject(root, "machine", cli_machine_json(threads));
     return root;
 }
 

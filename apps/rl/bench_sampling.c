@@ -526,8 +526,7 @@ int bench_sampling(int argc, char **argv)
         return cli_fail_status(RL_CLI_FAIL, st, "visibility property");
     }
     int threads = rl_property_workers(c.vis);
-    cJSON *root = cJSON_CreateObject();
-    cJSON_AddItemToObject(root, "machine", bench_machine_json(threads));
+    cJSON *root = bench_record_json("sampling", threads);
     cJSON *params = cJSON_AddObjectToObject(root, "parameters");
     cJSON_AddStringToObject(params, "scene", a.scene);
     cJSON_AddItemToObject(params, "scene_stats", cli_scene_stats_json(c.scene));

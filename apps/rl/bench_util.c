@@ -163,7 +163,7 @@ int bench_run_sections(const char *bench, cJSON *root, const char *const *names,
             snprintf(failed, sizeof failed, "%s (%s)", names[k], why);
     }
     /* Again for the load average after the run: how busy the machine was. */
-    cJSON *machine = bench_machine_json(threads);
+    cJSON *machine = cli_machine_json(threads);
     if (machine && !cJSON_ReplaceItemInObjectCaseSensitive(root, "machine", machine))
         cJSON_Delete(machine);
     if (rc == RL_CLI_OK) {

@@ -39,6 +39,9 @@ int cli_compare(int argc, char **argv);
 /* Loads a plugin and runs its rl_plugin_init() (plugin.c); 0, or the exit
  * code with the error printed. */
 int cli_load_plugin(const char *path);
+/* One row of an option table (rl algos, rl scenes, rl eval --list): key,
+ * type, default, help, range (integers as integers) or choices. */
+void cli_print_option(FILE *out, const rl_option_info *o);
 
 /* Prints "rl: error: <message>" and returns code. */
 int cli_fail(int code, const char *fmt, ...)
@@ -109,10 +112,13 @@ int cli_take_model_flag(int argc, char **argv, int *i, cli_model_flags *flags);
 int cli_load_scene_with(const char *arg, const cli_model_flags *flags, rl_scene **out);
 
 /* Scene statistics and render statistics as JSON objects (for --json,
- * --stats-json and the demo report); NULL when out of memory. */
+ * --stats-json and the demo report); NULL when out of memory. The render
+ * statistics separate preparation from the frame: "prep_ms" is inputs_ms
+ * (rl_renderer_prepare_inputs, timed by the caller) plus stats->prep_ms,
+ * "frame_ms" is time_ms - stats->prep_ms. */
 struct cJSON;
 struct cJSON *cli_scene_stats_json(const rl_scene *scene);
-struct cJSON *cli_render_stats_json(const rl_render_stats *stats);
+struct cJSON *cli_render_stats_json(const rl_render_stats *stats, double inputs_ms);
 /* Serialises item (indented) to path; prints the error itself. */
 bool cli_write_json(const struct cJSON *item, const char *path);
 
@@ -120,9 +126,49 @@ bool cli_write_json(const struct cJSON *item, const char *path);
  * referenced by their file names next to it); prints the error itself. */
 bool cli_write_demo_html(const struct cJSON *report, const char *path);
 
-/* One line on what a render did: "raster 64x48 cornell: 1.2 ms, ...". */
+/* One line on what a render did: "raster 64x48 cornell: prep 0.0 ms,
+ * frame 1.2 ms, ..." (prep and frame as in cli_render_stats_json). */
 void cli_print_summary(FILE *out, const char *algo, const char *scene, int width,
-                          int height, const rl_render_stats *stats);
+                          int height, const rl_render_stats *stats, double inputs_ms);
+
+/* cli_run.c: naming the experiment in every report. main() records the
+ * command line (global flags included) before anything else. */
+void cli_set_command_line(int argc, char **argv);
+const char *cli_command_line(void);
+/* Threads a parallel part uses by default (omp_get_max_threads). */
+int cli_threads(void);
+/* "renderlab 0.1.0, release, GCC 12.2.0, Embree": version, build type,
+ * sanitizer, compiler, optional parts. */
+void cli_build_text(char *out, size_t size);
+/* {uname, cpu, nproc, threads, loadavg_at_end}: the machine of a record. */
+struct cJSON *cli_machine_json(int threads);
+/* {command, build, machine}. */
+struct cJSON *cli_experiment_json(int threads);
+
+/* The load average (getloadavg) at the start and the end of a timed run;
+ * begin and end warn on stderr when the 1-minute load exceeds threads. */
+typedef struct cli_load {
+    double start[3], end[3];          /* 1, 5, 15 minutes */
+    bool known_start, known_end;
+    int threads;
+} cli_load;
+void cli_load_begin(cli_load *l, int threads);
+void cli_load_end(cli_load *l);
+struct cJSON *cli_load_json(const cli_load *l);   /* {start, end, threads, exceeds_threads} */
+void cli_load_text(const cli_load *l, char *out, size_t size);   /* one sentence for reports */
+
+/* "12.3 ms", or "48.2 s" from 10 s on. */
+void cli_format_ms(double ms, char *out, size_t size);
+/* "rl: debug: ..." on stderr under -v (the phase timings), else nothing. */
+void cli_debug(const char *fmt, ...)
+#if defined(__GNUC__)
+    __attribute__((format(printf, 1, 2)))
+#endif
+    ;
+/* "did you mean 'NAME'? " when one of names is a likely typo of typed
+ * (rl_suggest), else ""; written into buf. */
+const char *cli_did_you_mean(const char *typed, const char *const *names, size_t count, char *buf,
+                             size_t size);
 
 /* Extra layers (layers.c). depth: EXR keeps the raw eye-space depth in
  * R,G,B (alpha 0 where nothing was hit), PNG maps it to grey with the

@@ -106,7 +106,16 @@ int cli_load_scene(const char *arg, rl_scene **out)
         /* A bad parameter of a built-in was typed on the command line: that
          * is usage (2), whereas a bad value inside a file is input (1). */
         int code = st == RL_ERR_INVALID_ARG && cli_is_builtin(source) ? RL_CLI_USAGE : RL_CLI_FAIL;
-        rc = cli_fail_status(code, st, named ? NULL : arg);
+        /* Neither a file nor a built-in: perhaps a typo of a built-in. */
+        size_t count = 0;
+        const rl_builtin_info *list = rl_builtin_scenes(&count);
+        rl_suggestion sg = { 0 };
+        for (size_t i = 0; st == RL_ERR_IO && !cli_is_builtin(source) && i < count; i++)
+            rl_suggest(&sg, source, list[i].name);
+        if (sg.name)
+            rc = cli_fail(code, "%s (did you mean '%s'?)", msg && *msg ? msg : rl_status_string(st), sg.name);
+        else
+            rc = cli_fail_status(code, st, named ? NULL : arg);
     }
     free(source);
     free(params);

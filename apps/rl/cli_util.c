@@ -258,3 +258,49 @@ bool cli_split_source(const char *arg, char **source, char **params)
     *source = strdup(arg);
     return *source != NULL;
 }
+
+static const char *option_type_name(rl_option_type t)
+{
+    switch (t) {
+    case RL_OPT_INT: return "int";
+    case RL_OPT_FLOAT: return "float";
+    case RL_OPT_BOOL: return "bool";
+    case RL_OPT_ENUM: return "enum";
+    case RL_OPT_STRING: return "string";
+    case RL_OPT_COLOR: return "color";
+    }
+    return "?";
+}
+
+/* A range bound: whole numbers in full (9007199254740992, not 9.0072e+15),
+ * others and the huge sentinels (1e+300) as %g. */
+static void put_bound(FILE *out, double v)
+{
+    if (v == floor(v) && fabs(v) < 1e16)
+        fprintf(out, "%.0f", v);
+    else
+        fprintf(out, "%g", v);
+}
+
+void cli_print_option(FILE *out, const rl_option_info *o)
+{
+    /* An empty default: "" for text, "-" (none: the help says what then) else. */
+    const char *def = o->default_value && *o->default_value ? o->default_value
+                      : o->type == RL_OPT_STRING             ? "\"\""
+                                                             : "-";
+    fprintf(out, "    %-22s %-6s default %-10s %s", o->key, option_type_name(o->type), def, o->help ? o->help : "");
+    if ((o->type == RL_OPT_INT || o->type == RL_OPT_FLOAT) && o->max > o->min) {
+        fputs(" [", out);
+        put_bound(out, o->min);
+        fputs("..", out);
+        put_bound(out, o->max);
+        fputs("]", out);
+    }
+    if (o->type == RL_OPT_ENUM && o->choices) {
+        fprintf(out, " {");
+        for (const char *const *c = o->choices; *c; c++)
+            fprintf(out, "%s%s", c == o->choices ? "" : ", ", *c);
+        fprintf(out, "}");
+    }
+    fputc('\n', out);
+}

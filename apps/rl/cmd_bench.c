@@ -29,13 +29,39 @@
 
 #include "rl/rl_options.h"
 
+/* rl bench --help: every kind on one line. Durations are the defaults' on
+ * 2 cores (bench/README.md); --quick is the toy run ctest uses. */
+static const char bench_overview[] =
+    "usage: rl bench rays|vt|pt|sampling|surfels|culling [options]\n"
+    "       rl bench KIND --help    the options of one kind\n"
+    "\n"
+    "Timed runs, each writing one JSON record (machine, build, command line,\n"
+    "parameters, results) to --out FILE.json, by default\n"
+    "bench/results/KIND-YYYYMMDD-HHMMSS.json (UTC). --quick: a toy run of\n"
+    "seconds that only checks that nothing rots.\n"
+    "\n"
+    "kinds (what it measures; duration of the defaults on 2 cores, bench/README.md):\n"
+    "  rl bench rays      ray throughput of BVH, grid, Embree: Mrays/s, build,\n"
+    "                     memory (~35 s)\n"
+    "  rl bench vt        Vertex Tracing vs Whitted, Ullmann 2003 Ch. 5: time,\n"
+    "                     rays, SSIM (~8 min)\n"
+    "  rl bench pt        Line Space path tracing, Schroeder 2017 Table 1, Diagrams\n"
+    "                     1-3 (long: Line Spaces of up to 8 GB; choose with --only)\n"
+    "  rl bench sampling  approximation error of sampled visibility, Jaehn 2015\n"
+    "                     Sec. 5.7 (an hour or more; --samples, --repeats shorten it)\n"
+    "  rl bench surfels   Progressive Blue Surfels preprocessing step by step,\n"
+    "                     Jaehn 2015 Table 6.1 (minutes; variants capped by --max-seconds)\n"
+    "  rl bench culling   CHC++, SVS, visible sets, runtime selection, Jaehn 2015\n"
+    "                     Ch. 7 (about an hour on city; choose with --only)\n"
+    "\n"
+    "example:\n"
+    "  rl bench rays --quick --out /tmp/rays.json\n"
+    "  rl bench vt --help\n";
+
+static const char *const bench_kinds[] = { "rays", "vt", "pt", "sampling", "surfels", "culling" };
+
 static const char bench_help[] =
-    "usage: rl bench rays [options]\n"
-    "       rl bench vt [options]   Vertex Tracing vs Whitted (see rl bench vt --help)\n"
-    "       rl bench pt [options]   Line Space path tracing (see rl bench pt --help)\n"
-    "       rl bench sampling [options]  property sampling, Jaehn 2015 Sec. 5.7\n"
-    "       rl bench surfels [options]   Progressive Blue Surfels, Jaehn 2015 Table 6.1\n"
-    "       rl bench culling [options]   CHC++, SVS, visible sets: Jaehn 2015 Ch. 7\n"
+    "usage: rl bench rays [options]      (rl bench --help: every kind)\n"
     "\n"
     "Times ray queries of each accelerator on three workloads generated once\n"
     "per scene and shared by all accelerators:\n"
@@ -188,15 +214,18 @@ static int parse_args(int argc, char **argv, bench_args *a)
 {
     if (argc < 2)
         return cli_fail(RL_CLI_USAGE,
-                           "bench: missing benchmark (try: rl bench rays, rl bench vt)");
+                           "bench: missing benchmark (rays, vt, pt, sampling, surfels, culling; see rl bench --help)");
     if (cli_is_help(argv[1])) {
-        fputs(bench_help, stdout);
+        fputs(bench_overview, stdout);
         return RL_BENCH_HELP_SHOWN;
     }
-    if (strcmp(argv[1], "rays") != 0)
-        return cli_fail(RL_CLI_USAGE, "bench: unknown benchmark '%s' (known: rays, vt, pt, "
+    if (strcmp(argv[1], "rays") != 0) {
+        char hint[96];
+        return cli_fail(RL_CLI_USAGE, "bench: unknown benchmark '%s' (%sknown: rays, vt, pt, "
                            "sampling, surfels, culling)",
-                           argv[1]);
+                           argv[1], cli_did_you_mean(argv[1], bench_kinds, sizeof bench_kinds / sizeof *bench_kinds,
+                                                     hint, sizeof hint));
+    }
     bool has_scenes = false, has_accels = false;
     const bench_opt rows[] = {
         RL_BENCH_FLAG("--quick", &a->quick),

@@ -14,7 +14,9 @@
  * comparisons are paired. Writes DIR/compare.json and DIR/report.html with
  * side-by-side heat maps (shared colour range per metric) and violin plots.
  * Renderers come from the registry by name, so a new renderer needs no
- * change here. */
+ * change here. The report names the experiment (command line, build,
+ * machine, load) and gives each renderer's time a run-to-run spread
+ * (--spread) and its preparation apart. */
 #define _POSIX_C_SOURCE 200809L
 #include "bench_util.h"
 #include "cli.h"
@@ -49,8 +51,7 @@ static const char compare_help_head[] =
     "  --repeats N         renders per direction for time (median); default 3\n"
     "  --resolution N      cube-face resolution of the visibility that places\n"
     "                      the samples; default 128\n"
-    "  --out DIR           output folder; default out/compare\n"
-    "\n";
+    "  --out DIR           output folder; default out/compare\n";
 static const char compare_help_tail[] =
     "\n"
     "example:\n"
@@ -85,7 +86,9 @@ typedef struct compare_args {
     int width, height;
     double fov_deg;
     long long repeats, resolution;
+    int spread_runs;      /* --spread */
     eval_sampling sampling;
+    cli_load load;
 } compare_args;
 
 static void free_spec(algo_spec *s)
@@ -253,17 +256,21 @@ static int parse_args(int argc, char **argv, compare_args *a)
     a->fov_deg = 120.0;
     a->repeats = 3;
     a->resolution = 128;
+    a->spread_runs = EVAL_SPREAD_RUNS;
     const char *algos = NULL, *reference = "whitted";
     for (int i = 1; i < argc; i++) {
         const char *v = NULL;
         int m;
         if (cli_is_help(argv[i])) {
             fputs(compare_help_head, stdout);
+            fputs(eval_spread_help, stdout);
+            fputs("\n", stdout);
             fputs(eval_sampling_help, stdout);
             fputs(compare_help_tail, stdout);
             return -1;
         }
-        if ((m = eval_sampling_arg(argc, argv, &i, &a->sampling)) != 0) {
+        if ((m = eval_sampling_arg(argc, argv, &i, &a->sampling)) != 0 ||
+            (m = eval_spread_arg(argc, argv, &i, &a->spread_runs)) != 0) {
             if (m < 0)
                 return RL_CLI_USAGE;
             continue;
@@ -358,6 +365,8 @@ static rl_property *metric_property(const compare_args *a, int m, const algo_spe
 typedef struct measured {
     rl_approx *approx;   /* the driver's tree with this renderer's values */
     rl_stats stats;
+    double prep_ms;      /* committing the property: the renderer made, its inputs sampled */
+    eval_spread spread;  /* time: the same position measured again */
     bool ok;
     char error[256];
 } measured;
@@ -395,6 +404,15 @@ static void put_metric_section(html_doc *h, const compare_args *a, int m, measur
         html_table_row(h, row, 7);
     }
     html_table_end(h);
+    if (m == M_TIME)
+        for (int k = 0; k < ns; k++) {
+            const measured *r = &res[shown[k]][m];
+            char spread[256], prep[32];
+            eval_spread_text(&r->spread, "ms", spread, sizeof spread);
+            cli_format_ms(r->prep_ms, prep, sizeof prep);
+            html_para(h, "%s: run-to-run spread %s; preparation (prep, not in the times above) %s.",
+                      a->algos[shown[k]].label, spread, prep);
+        }
     /* One violin per renderer on a shared axis, then the heat maps side by
      * side with one colour range, so colours compare across renderers. */
     rl_plot_series series[MAX_ALGOS];
@@ -434,6 +452,8 @@ static cJSON *result_json(const compare_args *a, const rl_scene *scene, const rl
     if (!root)
         return NULL;
     cJSON_AddStringToObject(root, "renderlab", RL_CLI_VERSION);
+    cJSON_AddItemToObject(root, "experiment", cli_experiment_json(a->load.threads));
+    cJSON_AddItemToObject(root, "load", cli_load_json(&a->load));
     cJSON_AddStringToObject(root, "scene", a->scene);
     cJSON_AddItemToObject(root, "scene_stats", cli_scene_stats_json(scene));
     cJSON_AddItemToObject(root, "sampling", eval_desc_json(&a->sampling.desc));
@@ -455,6 +475,9 @@ static cJSON *result_json(const compare_args *a, const rl_scene *scene, const rl
             if (res[i][m].ok) {
                 cJSON *s = eval_stats_json(&res[i][m].stats);
                 cJSON_AddStringToObject(s, "unit", rl_approx_unit(res[i][m].approx));
+                cJSON_AddNumberToObject(s, "prep_ms", res[i][m].prep_ms);
+                if (m == M_TIME)
+                    cJSON_AddItemToObject(s, "spread", eval_spread_json(&res[i][m].spread));
                 cJSON_AddItemToObject(o, metric_names[m], s);
             } else {
                 cJSON *s = cJSON_AddObjectToObject(o, metric_names[m]);
@@ -537,11 +560,20 @@ static int measure_all(const compare_args *a, const rl_scene *scene, const rl_ap
             char label[300];
             snprintf(label, sizeof label, "%s %s", a->algos[i].label, metric_names[m]);
             rl_clear_error();
+            rl_timer phase;
+            rl_timer_start(&phase);
             rl_status st = p ? rl_property_commit(p, scene, a->sampling.desc.workers) : RL_ERR_INVALID_ARG;
-            if (st == RL_OK)
+            r->prep_ms = rl_timer_ms(&phase);
+            if (st == RL_OK) {
+                cli_debug("timing: %s: build %.1f ms", label, r->prep_ms);
+                rl_timer_start(&phase);
                 st = eval_measure(p, pos, ns, &values, label);
+                cli_debug("timing: %s: %u positions %.1f ms", label, ns, rl_timer_ms(&phase));
+            }
             if (st == RL_OK)
                 st = rl_approx_with_values(driver, values, metric_names[m], rl_property_unit(p), &r->approx);
+            if (st == RL_OK && m == M_TIME)
+                st = eval_spread_measure(p, r->approx, a->spread_runs, label, &r->spread);
             if (st == RL_OK && !eval_leaf_series(r->approx, &v2, &w2, &n2))
                 st = RL_ERR_OUT_OF_MEMORY;
             if (st == RL_OK)
@@ -552,8 +584,15 @@ static int measure_all(const compare_args *a, const rl_scene *scene, const rl_ap
                 fprintf(stderr, "rl: warning: %s: %s\n", label, r->error);
                 failures++;
             } else if (rl_log_get_level() >= RL_LOG_INFO) {
-                fprintf(stderr, "%s: mean %.4g %s, median %.4g, max %.4g\n", label, r->stats.mean,
-                        rl_property_unit(p), r->stats.q[2], r->stats.max);
+                fprintf(stderr, "%s: mean %.4g %s, min %.4g, q25 %.4g, median %.4g, q75 %.4g, max %.4g", label,
+                        r->stats.mean, rl_property_unit(p), r->stats.min, r->stats.q[1], r->stats.q[2],
+                        r->stats.q[3], r->stats.max);
+                if (r->spread.runs) {
+                    char spread[256];
+                    eval_spread_text(&r->spread, rl_property_unit(p), spread, sizeof spread);
+                    fprintf(stderr, "; spread: %s", spread);
+                }
+                fputc('\n', stderr);
             }
             free(values);
             free(v2);
@@ -582,17 +621,27 @@ static int write_report(const compare_args *a, const rl_scene *scene, const rl_a
     const rl_sampling_desc *d = &a->sampling.desc;
     rl_aabb b = rl_approx_bounds(driver);
     rl_image *top = eval_top_view(scene, b, d->height, 512);
+    char renders[64];
+    if (a->repeats == 1)
+        snprintf(renders, sizeof renders, "one render");
+    else
+        snprintf(renders, sizeof renders, "the median of %lld renders", a->repeats);
     html_para(h, "%d renderers measured at the same %u positions (%s, %s sampling of pixel "
                  "visibility at %lld² per cube face, %u regions). Per position: 6 directions, "
                  "%dx%d pixels, %g° field of view; time is the maximum over the directions of "
-                 "the median of %lld renders; quality is %s against %s, the %s over the "
+                 "%s, after one unmeasured frame that builds for the scene (its preparation, "
+                 "prep, is reported apart); quality is %s against %s, the %s over the "
                  "directions (Jähn 2015, Ch. 4). Statistics are weighted by region %s.",
                  a->num_algos, ns, d->dims == 2 ? "a 2-D slice" : "a 3-D region",
                  d->method == RL_SAMPLING_GRID ? "grid" : "adaptive", a->resolution,
-                 rl_approx_region_count(driver), a->width, a->height, a->fov_deg, a->repeats,
+                 rl_approx_region_count(driver), a->width, a->height, a->fov_deg, renders,
                  quality_metric_titles[a->quality_metric], a->reference.label,
                  strcmp(quality_metrics[a->quality_metric], "rmse") == 0 ? "maximum" : "minimum",
                  d->dims == 2 ? "area" : "volume");
+    char build[512], load[256];
+    cli_build_text(build, sizeof build);
+    cli_load_text(&a->load, load, sizeof load);
+    html_para(h, "Command: %s. Build: %s. %s.", cli_command_line(), build, load);
     char *vis_svg = eval_heatmap_svg(driver, d->height, top, "visible objects", 0, 0, false, NULL);
     html_svg(h, vis_svg, "Where the samples are: the visibility approximation that placed "
                             "them (adaptive sampling refines where visibility changes).");
@@ -628,12 +677,20 @@ int cli_compare(int argc, char **argv)
     if (rc == RL_CLI_OK && (!cli_make_dirs(a.out) || !cli_check_writable(report)))
         rc = RL_CLI_FAIL;
     if (rc == RL_CLI_OK)
+        cli_load_begin(&a.load, a.sampling.desc.workers > 0 ? a.sampling.desc.workers : cli_threads());
+    rl_timer phase;
+    rl_timer_start(&phase);
+    if (rc == RL_CLI_OK)
         rc = cli_load_scene(a.scene, &scene);
+    if (rc == RL_CLI_OK)
+        cli_debug("timing: load %.1f ms", rl_timer_ms(&phase));
     if (rc == RL_CLI_OK && !eval_sampling_finish(&a.sampling, scene))
         rc = RL_CLI_USAGE;
     if (rc == RL_CLI_OK)
         rc = place_samples(&a, scene, &driver, &pos, &ns);
     int failures = rc == RL_CLI_OK ? measure_all(&a, scene, driver, pos, ns, res) : 0;
+    if (rc == RL_CLI_OK)
+        cli_load_end(&a.load);
     if (rc == RL_CLI_OK)
         rc = write_report(&a, scene, driver, ns, res, report, json_path);
     if (rc == RL_CLI_OK) {

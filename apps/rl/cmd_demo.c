@@ -14,17 +14,17 @@
 #include <cjson/cJSON.h>
 #include <stdlib.h>
 #include <string.h>
-#include <sys/utsname.h>
 #include <time.h>
-#include <unistd.h>
 
 static const char demo_help[] =
     "usage: rl demo [--out DIR] [--size WxH] [--scenes a,b] [--algos a,b]\n"
     "\n"
     "Renders every built-in scene (rl scenes) with every renderer (rl algos)\n"
-    "and writes DIR/<scene>-<algo>.png, DIR/report.json (machine, date and, per\n"
-    "image, scene and render statistics) and DIR/index.html (the images and\n"
-    "their statistics on one page). Prints one line per image. Defaults that\n"
+    "and writes DIR/<scene>-<algo>.png, DIR/report.json (command, build,\n"
+    "machine, date and, per image, scene and render statistics) and\n"
+    "DIR/index.html (the images and their statistics on one page). Prints one\n"
+    "line per image; its times separate the one-time preparation (prep:\n"
+    "sampled inputs, structures built for the scene) from the frame. Defaults that\n"
     "changed on purpose are drawn once more with the old value, and where that\n"
     "changes an image both are shown side by side (DIR/changes/). Then compares\n"
     "the renderers over a small sampled region of one scene (rl compare) into\n"
@@ -75,7 +75,15 @@ static bool check_list(const char *option, const char *list, const char *const *
         for (size_t i = 0; i < count && !known; i++)
             known = strlen(names[i]) == m && strncmp(names[i], p, m) == 0;
         if (!known) {
-            cli_fail(RL_CLI_USAGE, "%s: unknown name '%.*s'", option, (int)m, p);
+            char typed[256];
+            snprintf(typed, sizeof typed, "%.*s", (int)m, p);
+            rl_suggestion sg = { 0 };
+            for (size_t i = 0; i < count; i++)
+                rl_suggest(&sg, typed, names[i]);
+            if (sg.name)
+                cli_fail(RL_CLI_USAGE, "%s: unknown name '%s' (did you mean '%s'?)", option, typed, sg.name);
+            else
+                cli_fail(RL_CLI_USAGE, "%s: unknown name '%s'", option, typed);
             return false;
         }
         p = end ? end + 1 : p + m;
@@ -126,21 +134,6 @@ static int parse_args(int argc, char **argv, demo_args *a)
     return ok ? RL_CLI_OK : RL_CLI_USAGE;
 }
 
-static cJSON *machine_json(void)
-{
-    cJSON *m = cJSON_CreateObject();
-    struct utsname u;
-    if (m && uname(&u) == 0) {
-        char text[5 * sizeof u.sysname + 8];
-        snprintf(text, sizeof text, "%s %s %s %s %s", u.sysname, u.nodename, u.release,
-                 u.version, u.machine);
-        cJSON_AddStringToObject(m, "uname", text);
-    }
-    if (m)
-        cJSON_AddNumberToObject(m, "nproc", (double)sysconf(_SC_NPROCESSORS_ONLN));
-    return m;
-}
-
 static void add_failure(cJSON *failures, const char *scene, const char *algo)
 {
     cJSON *f = cJSON_CreateObject();
@@ -168,10 +161,14 @@ static bool render_one(const demo_args *a, const char *scene_name, const rl_scen
     rl_image *img = NULL;
     rl_progress *progress = NULL;
     rl_render_stats stats = { 0 };
+    rl_timer phase;
+    double inputs_ms = 0.0;
     rl_clear_error();
     rl_status st = rl_renderer_create(algo, &r);
+    rl_timer_start(&phase);
     if (st == RL_OK)
         st = rl_renderer_prepare_inputs(r, scene);   /* visset, select: sampled here */
+    inputs_ms = rl_timer_ms(&phase);
     if (st == RL_OK)
         st = rl_image_create(cam->width, cam->height, RL_LAYER_COLOR, &img);
     if (st == RL_OK) {
@@ -187,7 +184,9 @@ static bool render_one(const demo_args *a, const char *scene_name, const rl_scen
         st = rl_image_write(img, path);
     bool ok = st == RL_OK;
     if (ok) {
-        cli_print_summary(stdout, algo, scene_name, cam->width, cam->height, &stats);
+        cli_debug("timing: %s %s: build %.1f ms (inputs %.1f ms, for the scene %.1f ms), frame %.1f ms", algo,
+                  scene_name, inputs_ms + stats.prep_ms, inputs_ms, stats.prep_ms, stats.time_ms - stats.prep_ms);
+        cli_print_summary(stdout, algo, scene_name, cam->width, cam->height, &stats, inputs_ms);
         fflush(stdout);
         cJSON *e = cJSON_CreateObject();
         if (e) {
@@ -197,7 +196,7 @@ static bool render_one(const demo_args *a, const char *scene_name, const rl_scen
             cJSON_AddNumberToObject(e, "width", cam->width);
             cJSON_AddNumberToObject(e, "height", cam->height);
             cJSON *ss = cli_scene_stats_json(scene);
-            cJSON *rs = cli_render_stats_json(&stats);
+            cJSON *rs = cli_render_stats_json(&stats, inputs_ms);
             if (ss)
                 cJSON_AddItemToObject(e, "scene_stats", ss);
             if (rs)
@@ -311,8 +310,12 @@ static int run_demo(const demo_args *a, cJSON *report)
             continue;
         rl_scene *scene = NULL;
         rl_camera cam;
+        rl_timer phase;
         rl_clear_error();
+        rl_timer_start(&phase);
         rl_status st = rl_scene_create_builtin(name, NULL, &scene);
+        if (st == RL_OK)
+            cli_debug("timing: %s: load %.1f ms", name, rl_timer_ms(&phase));
         if (st == RL_OK)
             st = rl_scene_get_camera(scene, NULL, &cam);
         if (st != RL_OK) {
@@ -392,7 +395,11 @@ int cli_demo(int argc, char **argv)
     strftime(date, sizeof date, "%Y-%m-%d %H:%M:%S UTC", gmtime_r(&now, &tm));
     cJSON_AddStringToObject(report, "renderlab", RL_CLI_VERSION);
     cJSON_AddStringToObject(report, "date", date);
-    cJSON *machine = machine_json();
+    char build[512];
+    cli_build_text(build, sizeof build);
+    cJSON_AddStringToObject(report, "command", cli_command_line());
+    cJSON_AddStringToObject(report, "build", build);
+    cJSON *machine = cli_machine_json(cli_threads());
     if (machine)
         cJSON_AddItemToObject(report, "machine", machine);
     cJSON_AddNumberToObject(report, "width", a.width);

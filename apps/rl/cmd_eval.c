@@ -6,7 +6,9 @@
  * --validate N, the error at N uniform random positions (Sec. 5.7) with a
  * correlation plot. Writes DIR/approx.json (the approximation, loadable with
  * rl_approx_load_json), DIR/eval.json (the numbers) and a self-contained
- * HTML report. */
+ * HTML report. Every report names the experiment (the property with its
+ * renderer and options, the command line, the build, the machine and its
+ * load); a timing also gets its run-to-run spread (--spread). */
 #define _POSIX_C_SOURCE 200809L
 #include "bench_util.h"
 #include "cli.h"
@@ -38,8 +40,7 @@ static const char eval_help_head[] =
     "  --validate N        also measure at N uniform random positions and report\n"
     "                      the absolute error of the approximation there\n"
     "  --out DIR           output folder, created if missing; default out/eval\n"
-    "  --report FILE.html  default DIR/report.html\n"
-    "\n";
+    "  --report FILE.html  default DIR/report.html\n";
 static const char eval_help_tail[] =
     "\n"
     "example:\n"
@@ -63,6 +64,7 @@ typedef struct eval_args {
     const char *sets2[MAX_SETS];
     int num_sets2;
     long long validate;
+    int spread_runs;             /* --spread */
     bool list;
     eval_sampling sampling;
 } eval_args;
@@ -70,6 +72,8 @@ typedef struct eval_args {
 static void print_help(void)
 {
     fputs(eval_help_head, stdout);
+    fputs(eval_spread_help, stdout);
+    fputs("\n", stdout);
     fputs(eval_sampling_help, stdout);
     fputs(eval_help_tail, stdout);
 }
@@ -86,9 +90,12 @@ static int print_list(void)
             continue;
         size_t no = 0;
         const rl_option_info *o = rl_property_options(p, &no);
+        printf("  options (--set KEY=VALUE):%s\n", no ? "" : " none");
         for (size_t k = 0; k < no; k++)
-            printf("  %-20s %s (default %s)\n", o[k].key, o[k].help, o[k].default_value);
+            cli_print_option(stdout, &o[k]);
         rl_property_release(p);
+        if (i + 1 < n)
+            putchar('\n');
     }
     return RL_CLI_OK;
 }
@@ -97,6 +104,7 @@ static int parse_args(int argc, char **argv, eval_args *a)
 {
     eval_sampling_init(&a->sampling);
     a->out = "out/eval";
+    a->spread_runs = EVAL_SPREAD_RUNS;
     for (int i = 1; i < argc; i++) {
         const char *v = NULL;
         int m;
@@ -108,7 +116,8 @@ static int parse_args(int argc, char **argv, eval_args *a)
             a->list = true;
             continue;
         }
-        if ((m = eval_sampling_arg(argc, argv, &i, &a->sampling)) != 0) {
+        if ((m = eval_sampling_arg(argc, argv, &i, &a->sampling)) != 0 ||
+            (m = eval_spread_arg(argc, argv, &i, &a->spread_runs)) != 0) {
             if (m < 0)
                 return RL_CLI_USAGE;
             continue;
@@ -223,6 +232,10 @@ static cJSON *options_json(const rl_property *p)
 }
 
 typedef struct eval_result {
+    char label[1024];            /* eval_property_label, or "a op b" */
+    double prep_ms;              /* rl_property_commit: renderers made, their inputs sampled */
+    eval_spread spread;
+    cli_load load;
     rl_stats stats;
     bool validated;
     rl_stats error;
@@ -273,10 +286,16 @@ static cJSON *result_json(const eval_args *a, const rl_scene *scene, const rl_pr
     if (!root)
         return NULL;
     cJSON_AddStringToObject(root, "renderlab", RL_CLI_VERSION);
+    cJSON_AddItemToObject(root, "experiment", cli_experiment_json(r->load.threads));
+    cJSON_AddItemToObject(root, "load", cli_load_json(&r->load));
     cJSON_AddStringToObject(root, "scene", a->scene);
     cJSON_AddItemToObject(root, "scene_stats", cli_scene_stats_json(scene));
     cJSON *prop = cJSON_AddObjectToObject(root, "property");
     cJSON_AddStringToObject(prop, "name", rl_property_name(p));
+    cJSON_AddStringToObject(prop, "label", r->label);
+    const char *renderer = rl_property_get(first, "renderer");
+    if (renderer)
+        cJSON_AddStringToObject(prop, "renderer", renderer);
     cJSON_AddStringToObject(prop, "unit", rl_property_unit(p));
     cJSON_AddItemToObject(prop, "options", options_json(first));
     if (second) {
@@ -294,6 +313,10 @@ static cJSON *result_json(const eval_args *a, const rl_scene *scene, const rl_pr
     bench_add_num(root, "measure", rl_approx_measure(ap));
     cJSON_AddStringToObject(root, "measure_unit", rl_approx_dims(ap) == 2 ? "m^2" : "m^3");
     cJSON_AddItemToObject(root, "region_stats", eval_stats_json(&r->stats));
+    /* Preparation (the property's renderers and their inputs) apart; the
+     * values are frames: each worker renders one unmeasured frame first. */
+    cJSON_AddNumberToObject(root, "prep_ms", r->prep_ms);
+    cJSON_AddItemToObject(root, "spread", eval_spread_json(&r->spread));
     if (r->validated) {
         cJSON *v = cJSON_AddObjectToObject(root, "validation");
         cJSON_AddNumberToObject(v, "points", (double)r->num_validated);
@@ -320,8 +343,8 @@ static void stats_table(html_doc *h, const char *name, const rl_stats *s)
 static int write_report(const eval_args *a, const char *path, const rl_scene *scene,
                         const rl_property *p, const rl_approx *ap, const eval_result *r)
 {
-    char title[256];
-    snprintf(title, sizeof title, "rl eval: %s on %s", rl_property_name(p), a->scene);
+    char title[1300];
+    snprintf(title, sizeof title, "rl eval: %s on %s", r->label, a->scene);
     html_doc *h = html_begin(path, title);
     if (!h)
         return RL_CLI_FAIL;
@@ -344,6 +367,18 @@ static int write_report(const eval_args *a, const char *path, const rl_scene *sc
                  rl_approx_sample_count(ap), rl_approx_region_count(ap), rl_approx_seconds(ap),
                  rl_approx_sample_count(ap) / rl_approx_seconds(ap),
                  d->dims == 2 ? "area" : "volume");
+    char build[512], load[256], prep[32];
+    cli_build_text(build, sizeof build);
+    cli_load_text(&r->load, load, sizeof load);
+    cli_format_ms(r->prep_ms, prep, sizeof prep);
+    html_para(h, "Experiment: %s. Command: %s. Build: %s. %s. Preparation (prep: the "
+                 "property's renderers and their inputs) %s, not in the values.",
+              r->label, cli_command_line(), build, load, prep);
+    if (r->spread.runs) {
+        char spread[256];
+        eval_spread_text(&r->spread, rl_property_unit(p), spread, sizeof spread);
+        html_para(h, "Run-to-run spread (the same position measured again): %s.", spread);
+    }
     html_heading(h, 2, "Distribution");
     stats_table(h, rl_property_unit(p), &r->stats);
 
@@ -425,13 +460,27 @@ int cli_eval(int argc, char **argv)
         rc = RL_CLI_FAIL;
         goto done;
     }
+    eval_property_label(first, r.label, sizeof r.label);
+    if (second) {
+        size_t used = strlen(r.label);
+        snprintf(r.label + used, sizeof r.label - used, " %s ", combine_ops[a.combine_op]);
+        used = strlen(r.label);
+        eval_property_label(second, r.label + used, sizeof r.label - used);
+    }
+    cli_load_begin(&r.load, a.sampling.desc.workers > 0 ? a.sampling.desc.workers : cli_threads());
+    rl_timer phase;
+    rl_timer_start(&phase);
     if ((rc = cli_load_scene(a.scene, &scene)) != RL_CLI_OK)
         goto done;
+    cli_debug("timing: load %.1f ms", rl_timer_ms(&phase));
     if (!eval_sampling_finish(&a.sampling, scene)) {
         rc = RL_CLI_USAGE;
         goto done;
     }
+    rl_timer_start(&phase);
     rl_status st = rl_property_commit(p, scene, a.sampling.desc.workers);
+    r.prep_ms = rl_timer_ms(&phase);
+    cli_debug("timing: build %.1f ms (the property's renderers and their inputs)", r.prep_ms);
     if (st != RL_OK) {
         rc = cli_fail_status(st == RL_ERR_INVALID_ARG ? RL_CLI_USAGE : RL_CLI_FAIL, st,
                                 "property");
@@ -450,6 +499,12 @@ int cli_eval(int argc, char **argv)
         rc = cli_fail_status(RL_CLI_FAIL, st, "sampling");
         goto done;
     }
+    cli_debug("timing: sampling %.1f ms (%u samples)", 1000.0 * rl_approx_seconds(ap), rl_approx_sample_count(ap));
+    rl_clear_error();
+    if ((st = eval_spread_measure(p, ap, a.spread_runs, r.label, &r.spread)) != RL_OK) {
+        rc = cli_fail_status(RL_CLI_FAIL, st, "spread");
+        goto done;
+    }
     double *values = NULL, *weights = NULL;
     size_t n = 0;
     if (!eval_leaf_series(ap, &values, &weights, &n)) {
@@ -465,6 +520,7 @@ int cli_eval(int argc, char **argv)
     }
     if (a.validate > 0 && (rc = validate(&a, p, ap, &r)) != RL_CLI_OK)
         goto done;
+    cli_load_end(&r.load);
     st = rl_approx_save_json(ap, approx_path);
     if (st != RL_OK) {
         rc = cli_fail_status(RL_CLI_FAIL, st, approx_path);
@@ -479,11 +535,16 @@ int cli_eval(int argc, char **argv)
     }
     if ((rc = write_report(&a, report, scene, p, ap, &r)) != RL_CLI_OK)
         goto done;
-    printf("%s on %s: %u samples, %u regions in %.1f s; %s mean %.4g, median %.4g, min %.4g, "
-           "max %.4g",
-           rl_property_name(p), a.scene, rl_approx_sample_count(ap), rl_approx_region_count(ap),
-           rl_approx_seconds(ap), rl_property_unit(p), r.stats.mean, r.stats.q[2], r.stats.min,
-           r.stats.max);
+    printf("%s on %s: %u samples, %u regions in %.1f s; %s mean %.4g, min %.4g, q25 %.4g, median %.4g, "
+           "q75 %.4g, max %.4g",
+           r.label, a.scene, rl_approx_sample_count(ap), rl_approx_region_count(ap),
+           rl_approx_seconds(ap), rl_property_unit(p), r.stats.mean, r.stats.min, r.stats.q[1], r.stats.q[2],
+           r.stats.q[3], r.stats.max);
+    if (r.spread.runs) {
+        char spread[256];
+        eval_spread_text(&r.spread, rl_property_unit(p), spread, sizeof spread);
+        printf("; spread: %s", spread);
+    }
     if (r.validated)
         printf("; validation at %zu points: mean |error| %.4g, median %.4g", r.num_validated,
                r.error.mean, r.error.q[2]);

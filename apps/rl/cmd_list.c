@@ -3,39 +3,6 @@
  * drift from the code. */
 #include "cli.h"
 
-static const char *option_type_name(rl_option_type t)
-{
-    switch (t) {
-    case RL_OPT_INT: return "int";
-    case RL_OPT_FLOAT: return "float";
-    case RL_OPT_BOOL: return "bool";
-    case RL_OPT_ENUM: return "enum";
-    case RL_OPT_STRING: return "string";
-    case RL_OPT_COLOR: return "color";
-    }
-    return "?";
-}
-
-static void print_option(const rl_option_info *o)
-{
-    /* An empty default: "" for text, "-" (none: the help says what then) else. */
-    const char *def = o->default_value && *o->default_value ? o->default_value
-                      : o->type == RL_OPT_STRING             ? "\"\""
-                                                             : "-";
-    printf("    %-22s %-6s default %-10s %s", o->key, option_type_name(o->type), def, o->help ? o->help : "");
-    if (o->type == RL_OPT_INT && o->max > o->min)
-        printf(" [%.0f..%.0f]", o->min, o->max);   /* integers as integers, not 9.0072e+15 */
-    if (o->type == RL_OPT_FLOAT && o->max > o->min)
-        printf(" [%g..%g]", o->min, o->max);
-    if (o->type == RL_OPT_ENUM && o->choices) {
-        printf(" {");
-        for (const char *const *c = o->choices; *c; c++)
-            printf("%s%s", c == o->choices ? "" : ", ", *c);
-        printf("}");
-    }
-    putchar('\n');
-}
-
 /* Takes only --help; anything else is a usage error. */
 static int no_arguments(int argc, char **argv, const char *help)
 {
@@ -70,7 +37,7 @@ int cli_scenes(int argc, char **argv)
         printf("%s: %s\n", scenes[i].name, scenes[i].description ? scenes[i].description : "");
         printf("  parameters:%s\n", scenes[i].num_options ? "" : " none");
         for (size_t k = 0; k < scenes[i].num_options; k++)
-            print_option(&scenes[i].options[k]);
+            cli_print_option(stdout, &scenes[i].options[k]);
         if (i + 1 < count)
             putchar('\n');
     }
@@ -106,7 +73,7 @@ int cli_algos(int argc, char **argv)
         const rl_option_info *options = rl_renderer_options(r, &num_options);
         printf("  options:%s\n", num_options ? "" : " none");
         for (size_t k = 0; k < num_options; k++)
-            print_option(&options[k]);
+            cli_print_option(stdout, &options[k]);
         rl_renderer_release(r);
         if (i + 1 < count)
             putchar('\n');

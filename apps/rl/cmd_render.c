@@ -17,8 +17,10 @@
 static const char render_help[] =
     "usage: rl render SCENE --out FILE.png|FILE.exr [options]\n"
     "\n"
-    "Renders one frame and prints a one-line summary (algorithm, size, time,\n"
-    "triangles rasterized, pixels written, rays by type).\n"
+    "Renders one frame and prints a one-line summary (algorithm, size, times,\n"
+    "triangles rasterized, pixels written, rays by type). Times: prep is the\n"
+    "one-time preparation (sampled inputs, structures built for the scene),\n"
+    "frame the rest of the frame; -v adds the phases load, build and frame.\n"
     "\n"
     "SCENE  a built-in name (see rl scenes), optionally with parameters\n"
     "       (cornell-teapot:triangles=70000), a .json scene or a mesh file\n"
@@ -266,7 +268,7 @@ static int choose_camera(const render_args *a, const rl_scene *scene, rl_camera 
 }
 
 static int write_outputs(const render_args *a, const rl_scene *scene, const rl_image *img,
-                         const rl_render_stats *stats)
+                         const rl_render_stats *stats, double inputs_ms)
 {
     rl_clear_error();
     rl_status st = rl_image_write(img, a->out);
@@ -277,7 +279,7 @@ static int write_outputs(const render_args *a, const rl_scene *scene, const rl_i
     if (a->id_out && (st = cli_write_ids(img, a->id_out)) != RL_OK)
         return cli_fail_status(RL_CLI_FAIL, st, a->id_out);
     if (a->stats_json) {
-        cJSON *obj = cli_render_stats_json(stats);
+        cJSON *obj = cli_render_stats_json(stats, inputs_ms);
         bool ok = obj != NULL;
         if (ok) {
             cJSON_AddStringToObject(obj, "algorithm", a->algo);
@@ -307,17 +309,23 @@ static int render_frame(const render_args *a)
     rl_progress *progress = NULL;
     rl_camera cam;
     rl_render_stats stats = { 0 };
+    double load_ms = 0.0, inputs_ms = 0.0;
+    rl_timer phase;
     int rc = check_outputs(a);
     if (rc == RL_CLI_OK)
         rc = create_renderer(a, &renderer);
+    rl_timer_start(&phase);
     if (rc == RL_CLI_OK)
         rc = cli_load_scene_with(a->scene, &a->model, &scene);
+    load_ms = rl_timer_ms(&phase);
     if (rc == RL_CLI_OK)
         rc = choose_camera(a, scene, &cam);
     if (rc == RL_CLI_OK) {
         /* visset and select: their sampled properties, before the frame. */
         rl_clear_error();
+        rl_timer_start(&phase);
         rl_status st = rl_renderer_prepare_inputs(renderer, scene);
+        inputs_ms = rl_timer_ms(&phase);
         if (st != RL_OK)
             rc = cli_fail_status(RL_CLI_FAIL, st, "render");
     }
@@ -342,11 +350,14 @@ static int render_frame(const render_args *a)
         if (st != RL_OK)
             rc = cli_fail_status(RL_CLI_FAIL, st, "render");
     }
-    if (rc == RL_CLI_OK)
-        rc = write_outputs(a, scene, img, &stats);
+    if (rc == RL_CLI_OK) {
+        cli_debug("timing: load %.1f ms, build %.1f ms (inputs %.1f ms, for the scene %.1f ms), frame %.1f ms",
+                  load_ms, inputs_ms + stats.prep_ms, inputs_ms, stats.prep_ms, stats.time_ms - stats.prep_ms);
+        rc = write_outputs(a, scene, img, &stats, inputs_ms);
+    }
     if (rc == RL_CLI_OK)
         cli_print_summary(stdout, rl_renderer_name(renderer), a->scene, cam.width, cam.height,
-                             &stats);
+                             &stats, inputs_ms);
     rl_image_release(img);
     rl_scene_release(scene);
     rl_renderer_release(renderer);
@@ -354,9 +365,10 @@ static int render_frame(const render_args *a)
 }
 
 /* One frame's entry of the path's stats JSON. */
-static cJSON *frame_json(long long i, double t, const rl_camera *cam, const char *file, const rl_render_stats *stats)
+static cJSON *frame_json(long long i, double t, const rl_camera *cam, const char *file, const rl_render_stats *stats,
+                         double inputs_ms)
 {
-    cJSON *e = cli_render_stats_json(stats);
+    cJSON *e = cli_render_stats_json(stats, inputs_ms);
     if (!e)
         return NULL;
     cJSON_AddNumberToObject(e, "frame", (double)i);
@@ -397,8 +409,11 @@ static int render_path(const render_args *a)
     int rc = check_outputs(&first);
     if (rc == RL_CLI_OK)
         rc = create_renderer(a, &renderer);
+    rl_timer phase;
+    rl_timer_start(&phase);
     if (rc == RL_CLI_OK)
         rc = cli_load_scene_with(a->scene, &a->model, &scene);
+    double load_ms = rl_timer_ms(&phase), inputs_ms = 0.0;
     const rl_scene_data *d = scene ? rl_scene_get_data(scene) : NULL;
     const rl_camera_path *path = d ? d->camera_path : NULL;
     if (rc == RL_CLI_OK && !path)
@@ -413,7 +428,9 @@ static int render_path(const render_args *a)
         rc = cli_fail(RL_CLI_USAGE, "--fps %g over %g s makes %lld frames (at most 1000000)", fps, duration, n);
     if (rc == RL_CLI_OK) {
         rl_clear_error();
+        rl_timer_start(&phase);
         rl_status st = rl_renderer_prepare_inputs(renderer, scene);
+        inputs_ms = rl_timer_ms(&phase);
         unsigned layers = RL_LAYER_COLOR | (a->depth_out ? RL_LAYER_DEPTH : 0u) | (a->id_out ? RL_LAYER_ID : 0u);
         if (st == RL_OK)
             st = rl_image_create(size.width, size.height, layers, &img);
@@ -442,7 +459,9 @@ static int render_path(const render_args *a)
         if (rl_log_get_level() >= RL_LOG_INFO)
             rl_progress_create(label, stderr, &progress);
     }
-    double total_ms = 0.0, max_ms = 0.0;
+    /* Frames without their preparation (the first frame's builds, the
+     * inputs), which is reported once, apart. */
+    double frames_ms = 0.0, max_ms = 0.0, prep_ms = inputs_ms;
     for (long long i = 0; rc == RL_CLI_OK && i < n; i++) {
         double t = a->frames ? (n > 1 ? duration * (double)i / (double)(n - 1) : 0.0) : (double)i / fps;
         rl_camera cam = rl_camera_path_eval(path, rl_camera_path_key(path, 0)->time_s + t);
@@ -471,11 +490,13 @@ static int render_path(const render_args *a)
             rc = cli_fail_status(RL_CLI_FAIL, st, what);
             break;
         }
-        rc = write_outputs(&fa, scene, img, &stats);
-        total_ms += stats.time_ms;
-        max_ms = stats.time_ms > max_ms ? stats.time_ms : max_ms;
+        rc = write_outputs(&fa, scene, img, &stats, 0.0);
+        double frame_ms = stats.time_ms - stats.prep_ms;
+        frames_ms += frame_ms;
+        prep_ms += stats.prep_ms;
+        max_ms = frame_ms > max_ms ? frame_ms : max_ms;
         if (rc == RL_CLI_OK && frames_json) {
-            cJSON *e = frame_json(i, t, &cam, out, &stats);
+            cJSON *e = frame_json(i, t, &cam, out, &stats, i == 0 ? inputs_ms : 0.0);
             if (!e)
                 rc = cli_fail(RL_CLI_FAIL, "out of memory");
             else
@@ -487,9 +508,15 @@ static int render_path(const render_args *a)
     rl_progress_finish(progress);
     if (rc == RL_CLI_OK && report && !cli_write_json(report, a->stats_json))
         rc = RL_CLI_FAIL;
-    if (rc == RL_CLI_OK)
-        printf("%s %dx%d %s: %lld frames of %.3g s, %.1f ms per frame (max %.1f), %s\n", rl_renderer_name(renderer),
-               size.width, size.height, a->scene, n, duration, total_ms / (double)n, max_ms, a->out);
+    if (rc == RL_CLI_OK) {
+        char prep[32];
+        cli_format_ms(prep_ms, prep, sizeof prep);
+        cli_debug("timing: load %.1f ms, build %.1f ms (inputs %.1f ms), frames %.1f ms", load_ms, prep_ms, inputs_ms,
+                  frames_ms);
+        printf("%s %dx%d %s: %lld frames of %.3g s, prep %s, frame %.1f ms on average (max %.1f), %s\n",
+               rl_renderer_name(renderer), size.width, size.height, a->scene, n, duration, prep,
+               frames_ms / (double)n, max_ms, a->out);
+    }
     cJSON_Delete(report);
     rl_image_release(img);
     rl_scene_release(scene);

@@ -47,7 +47,8 @@ static void put_cell(FILE *f, const cJSON *e)
     html_put_escaped(f, str(e, "file"));
     fputs("\" alt=\"", f);
     html_put_escaped(f, str(e, "file"));
-    fprintf(f, "\"></a><br>%.1f ms", num(rs, "time_ms"));
+    /* Preparation apart from the frame: one-time work is not a frame's cost. */
+    fprintf(f, "\"></a><br>prep %.1f ms &middot; frame %.1f ms", num(rs, "prep_ms"), num(rs, "frame_ms"));
     if (num(rs, "triangles_rasterized") > 0)
         fprintf(f, " &middot; %.0f triangles rasterized", num(rs, "triangles_rasterized"));
     fprintf(f, " &middot; %.0f pixels written", num(rs, "pixels_written"));
@@ -86,7 +87,15 @@ bool cli_write_demo_html(const cJSON *report, const char *path)
     html_put_escaped(f, str(report, "date"));
     fprintf(f, " &middot; %.0fx%.0f<br>machine: ", num(report, "width"), num(report, "height"));
     html_put_escaped(f, str(machine, "uname"));
-    fprintf(f, " &middot; %.0f processors</p>\n", num(machine, "nproc"));
+    fputs(" &middot; ", f);
+    html_put_escaped(f, str(machine, "cpu"));
+    fprintf(f, " &middot; %.0f processors<br>build: ", num(machine, "nproc"));
+    html_put_escaped(f, str(report, "build"));
+    fputs("<br>command: <code>", f);
+    html_put_escaped(f, str(report, "command"));
+    fputs("</code><br>Times: <em>prep</em> is the one-time preparation of a renderer for the scene "
+          "(sampled inputs, acceleration structures, octrees, surfels, visible sets), <em>frame</em> the "
+          "rest of the first frame.</p>\n", f);
 
     fputs("<table>\n<tr><th>scene</th>", f);
     for (int k = 0; k < num_algos; k++) {

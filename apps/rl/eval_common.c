@@ -63,12 +63,13 @@ static int pick(const char *option, const char *v, const char *const *names, int
     for (int k = 0; k < n; k++)
         if (strcmp(v, names[k]) == 0)
             return k;
-    char list[256] = "";
+    char list[256] = "", hint[96];
     for (int k = 0; k < n; k++) {
         strcat(list, k ? ", " : "");
         strcat(list, names[k]);
     }
-    cli_fail(RL_CLI_USAGE, "%s: unknown value '%s' (one of %s)", option, v, list);
+    cli_fail(RL_CLI_USAGE, "%s: unknown value '%s' (%sone of %s)", option, v,
+             cli_did_you_mean(v, names, (size_t)n, hint, sizeof hint), list);
     return -1;
 }
 
@@ -478,4 +479,101 @@ void eval_stats_cells(const rl_stats *s, char buf[7][32])
     const double v[6] = { s->min, s->q[1], s->q[2], s->q[3], s->max, s->mean };
     for (int k = 0; k < 6; k++)
         snprintf(buf[k + 1], 32, "%.4g", v[k]);
+}
+
+void eval_property_label(const rl_property *p, char *out, size_t size)
+{
+    snprintf(out, size, "%s", rl_property_name(p));
+    size_t no = 0;
+    const rl_option_info *o = rl_property_options(p, &no);
+    int shown = 0;
+    for (size_t k = 0; k < no; k++) {
+        const char *v = rl_property_get(p, o[k].key);
+        bool is_renderer = strcmp(o[k].key, "renderer") == 0;
+        if (!v || (!is_renderer && strcmp(v, o[k].default_value ? o[k].default_value : "") == 0))
+            continue;
+        size_t used = strlen(out);
+        snprintf(out + used, size - used, "%s%s=%s", shown++ ? ", " : " (", o[k].key, v);
+    }
+    if (shown) {
+        size_t used = strlen(out);
+        snprintf(out + used, size - used, ")");
+    }
+}
+
+const char eval_spread_help[] =
+    "  --spread N          timings: measure again N times at one position (the\n"
+    "                      first sample's) and report min, quartiles, median and\n"
+    "                      max of those runs, the run-to-run spread; default 5,\n"
+    "                      0: off. The load average at the start and the end is\n"
+    "                      recorded; a load above the threads is warned about\n";
+
+int eval_spread_arg(int argc, char **argv, int *i, int *runs)
+{
+    const char *v = NULL;
+    int m = cli_take_value(argc, argv, i, "--spread", &v);
+    if (m <= 0)
+        return m;
+    long long n = 0;
+    if (!rl_parse_int(v, &n) || n < 0 || n > 100) {
+        cli_fail(RL_CLI_USAGE, "--spread: expected a count in [0, 100], got '%s'", v);
+        return -1;
+    }
+    *runs = (int)n;
+    return 1;
+}
+
+rl_status eval_spread_measure(rl_property *p, const rl_approx *a, int runs, const char *label, eval_spread *out)
+{
+    memset(out, 0, sizeof *out);
+    if (runs <= 0 || !(rl_property_get_flags(p) & RL_PROPERTY_EXCLUSIVE) || rl_approx_sample_count(a) == 0)
+        return RL_OK;
+    double v0;
+    rl_approx_sample(a, 0, &out->pos, &v0);
+    rl_vec3 *pos = malloc((size_t)runs * sizeof *pos);
+    double *values = NULL;
+    if (!pos)
+        return RL_ERR_OUT_OF_MEMORY;
+    for (int k = 0; k < runs; k++)
+        pos[k] = out->pos;
+    char what[1100];
+    snprintf(what, sizeof what, "%s: spread", label);
+    rl_status st = eval_measure(p, pos, (size_t)runs, &values, what);
+    if (st == RL_OK)
+        st = rl_stats_compute(values, NULL, (size_t)runs, &out->stats);
+    free(pos);
+    free(values);
+    if (st == RL_OK)
+        out->runs = runs;
+    return st;
+}
+
+cJSON *eval_spread_json(const eval_spread *s)
+{
+    if (s->runs == 0)
+        return cJSON_CreateNull();
+    cJSON *o = cJSON_CreateObject();
+    if (!o)
+        return NULL;
+    cJSON_AddNumberToObject(o, "runs", s->runs);
+    const double xyz[3] = { s->pos.x, s->pos.y, s->pos.z };
+    cJSON_AddItemToObject(o, "position", cJSON_CreateDoubleArray(xyz, 3));
+    bench_add_num(o, "min", s->stats.min);
+    bench_add_num(o, "q25", s->stats.q[1]);
+    bench_add_num(o, "median", s->stats.q[2]);
+    bench_add_num(o, "q75", s->stats.q[3]);
+    bench_add_num(o, "max", s->stats.max);
+    bench_add_num(o, "iqr", s->stats.q[3] - s->stats.q[1]);
+    return o;
+}
+
+void eval_spread_text(const eval_spread *s, const char *unit, char *out, size_t size)
+{
+    if (s->runs == 0) {
+        snprintf(out, size, "not measured");
+        return;
+    }
+    snprintf(out, size, "%d runs at (%.3g, %.3g, %.3g): min %.4g, median %.4g, max %.4g %s (IQR %.4g)", s->runs,
+             s->pos.x, s->pos.y, s->pos.z, s->stats.min, s->stats.q[2], s->stats.max, unit,
+             s->stats.q[3] - s->stats.q[1]);
 }

@@ -76,4 +76,32 @@ bool eval_parse_quality_size(const char *option, const char *text, rl_quality_si
 /* Five-number summary plus mean as table cells (formatted into buf). */
 void eval_stats_cells(const rl_stats *s, char buf[7][32]);
 
+/* "time (renderer=whitted, repeats=3)": the property's name with its
+ * renderer (when it has one) and every option set away from its default,
+ * so that a report names the experiment. */
+void eval_property_label(const rl_property *p, char *out, size_t size);
+
+/* How far a timing moves when nothing but the run changes: the property
+ * measured `runs` times at one position (the first sample's) after the
+ * measurement proper. Times of one renderer three times over gave 18, 35
+ * and 19 ms on a busy machine; the spread says how far to trust a
+ * difference. */
+typedef struct eval_spread {
+    int runs;                    /* 0: not measured */
+    rl_vec3 pos;
+    rl_stats stats;              /* of the runs: min, quartiles, median, max */
+} eval_spread;
+#define EVAL_SPREAD_RUNS 5
+extern const char eval_spread_help[];
+/* Takes "--spread N" (0..100) at argv[*i]: 1 taken, 0 not it, -1 bad
+ * value (printed). */
+int eval_spread_arg(int argc, char **argv, int *i, int *runs);
+/* Measures the spread when p is a timing (RL_PROPERTY_EXCLUSIVE) and runs
+ * > 0; otherwise out->runs = 0. The measurement's status (its message in
+ * rl_last_error()). */
+rl_status eval_spread_measure(rl_property *p, const rl_approx *a, int runs, const char *label, eval_spread *out);
+struct cJSON *eval_spread_json(const eval_spread *s);   /* JSON null when not measured */
+/* "5 runs at (x, y, z): min 18.2, median 19.0, max 35.1 ms (IQR 0.4)". */
+void eval_spread_text(const eval_spread *s, const char *unit, char *out, size_t size);
+
 #endif

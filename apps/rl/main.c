@@ -40,7 +40,7 @@ static void print_usage(FILE *out)
             "  %-10s show this text (also: rl --help); rl <command> --help for details\n"
             "\n"
             "global flags (before or after the command):\n"
-            "  -v, --verbose   debug log\n"
+            "  -v, --verbose   debug log and the phases' times (load, build, frame)\n"
             "  -q, --quiet     errors only\n"
             "  --plugin FILE   load renderers from a shared object (README, \"Your own renderer\")\n"
             "  --version       print the version\n"
@@ -57,8 +57,22 @@ static void log_to_stderr(void *user, rl_log_level level, const char *message)
     fprintf(stderr, "rl: %s: %s\n", rl_log_level_name(level), message);
 }
 
+/* "unknown command 'rendr' (did you mean 'render'? see rl --help)". */
+static int unknown_command(const char *name)
+{
+    const char *names[sizeof commands / sizeof commands[0] + 1];
+    size_t n = 0;
+    for (size_t i = 0; i < sizeof commands / sizeof commands[0]; i++)
+        names[n++] = commands[i].name;
+    names[n++] = "help";
+    char hint[96];
+    return cli_fail(RL_CLI_USAGE, "unknown command '%s' (%ssee rl --help)", name,
+                    cli_did_you_mean(name, names, n, hint, sizeof hint));
+}
+
 int main(int argc, char **argv)
 {
+    cli_set_command_line(argc, argv);   /* for the reports, before the flags are taken out */
     rl_log_level level = RL_LOG_INFO;
     enum { MAX_PLUGINS = 8 };
     const char *plugins[MAX_PLUGINS];
@@ -101,7 +115,7 @@ int main(int argc, char **argv)
         for (size_t i = 0; i < sizeof commands / sizeof commands[0]; i++)
             if (strcmp(argv[1], commands[i].name) == 0)
                 return commands[i].run(2, help_argv);
-        return cli_fail(RL_CLI_USAGE, "unknown command '%s' (see rl --help)", argv[1]);
+        return unknown_command(argv[1]);
     }
     if (cli_is_help(name) || strcmp(name, "help") == 0) {
         print_usage(stdout);
@@ -116,5 +130,5 @@ int main(int argc, char **argv)
             return commands[i].run(n, argv);
     if (name[0] == '-')
         return cli_fail(RL_CLI_USAGE, "unknown option '%s' (see rl --help)", name);
-    return cli_fail(RL_CLI_USAGE, "unknown command '%s' (see rl --help)", name);
+    return unknown_command(name);
 }

@@ -34,6 +34,21 @@ typedef struct rl_option_info {
 RL_API bool rl_parse_int(const char *s, long long *out);
 RL_API bool rl_parse_float(const char *s, double *out);
 
+/* "Did you mean": the known name closest to what was typed. Zero-initialise
+ * an rl_suggestion, offer it every known name with rl_suggest(), then read
+ * .name: NULL when none is a likely typo. Likely means at most 1 edit for a
+ * name of up to 4 characters and 2 for a longer one (Levenshtein: insert,
+ * delete or replace a character; ASCII case ignored); the first of equally
+ * close names wins. Names are borrowed, not copied. */
+typedef struct rl_suggestion {
+    const char *name;                     /* best so far, or NULL */
+    int distance;
+} rl_suggestion;
+RL_API void rl_suggest(rl_suggestion *s, const char *typed, const char *known);
+/* Edit distance of a and b as above, counted up to limit (a larger
+ * distance returns limit + 1). */
+RL_API int rl_edit_distance(const char *a, const char *b, int limit);
+
 #ifdef __cplusplus
 }
 #endif

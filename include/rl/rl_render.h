@@ -38,7 +38,14 @@ typedef enum rl_ray_type {
 RL_API const char *rl_ray_type_name(rl_ray_type type);
 
 typedef struct rl_render_stats {
-    double time_ms;                       /* wall time of render() */
+    double time_ms;                       /* wall time of render(), prep_ms included */
+    /* Of time_ms, the one-time preparation: building what the renderer
+     * keeps for the scene (BVH or grid, Line Space, shadow map, octree,
+     * surfels, SVS's sets, select's second renderer); 0 on frames that
+     * reuse it. The frame's own time is time_ms - prep_ms. Inputs made by
+     * rl_renderer_prepare_inputs() (rl_sampling.h) are made before
+     * render() and are not in either. */
+    double prep_ms;
     uint64_t rays[RL_RAY_TYPE_COUNT];     /* traced rays by type */
     uint64_t triangles_rasterized;        /* triangles set up by a rasterizer */
     uint64_t pixels_written;              /* fragments/pixels written */

@@ -16,6 +16,14 @@ void rl_option_append(char *buf, size_t size, const char *text)
         snprintf(buf + used, size - used, "%s", text);
 }
 
+const char *rl_option_did_you_mean(const rl_suggestion *s, char *buf, size_t size)
+{
+    if (!s->name || size == 0)
+        return "";
+    snprintf(buf, size, "did you mean \"%s\"? ", s->name);
+    return buf;
+}
+
 static long rl_option_find(const rl_option_info *opts, size_t n, const char *prefix, const char *key)
 {
     if (!key)
@@ -31,18 +39,26 @@ static long rl_option_find(const rl_option_info *opts, size_t n, const char *pre
     return -1;
 }
 
-static rl_status rl_option_unknown(const rl_option_info *opts, size_t n, const char *context, const char *key)
+static rl_status rl_option_unknown(const rl_option_info *opts, size_t n, const char *context,
+                                   const char *prefix, const char *key)
 {
     if (n == 0)
         return rl_error(RL_ERR_INVALID_ARG, "%s: unknown option \"%s\" (it takes none)", context, key);
-    char keys[RL_OPTION_LIST_SIZE] = "";
+    /* "raster.shadng" is a typo of "shading": suggest without the prefix. */
+    const char *bare = key;
+    size_t len = prefix ? strlen(prefix) : 0;
+    if (prefix && strncmp(key, prefix, len) == 0 && key[len] == '.')
+        bare = key + len + 1;
+    char keys[RL_OPTION_LIST_SIZE] = "", hint[96];
+    rl_suggestion sg = { 0 };
     for (size_t k = 0; k < n; ++k) {
         if (k)
             rl_option_append(keys, sizeof keys, ", ");
         rl_option_append(keys, sizeof keys, opts[k].key);
+        rl_suggest(&sg, bare, opts[k].key);
     }
-    return rl_error(RL_ERR_INVALID_ARG, "%s: unknown option \"%s\" (options: %s)", context, key,
-                    keys);
+    return rl_error(RL_ERR_INVALID_ARG, "%s: unknown option \"%s\" (%soptions: %s)", context, key,
+                    rl_option_did_you_mean(&sg, hint, sizeof hint), keys);
 }
 
 static bool rl_option_parse_bool(const char *s, bool *out)
@@ -224,7 +240,7 @@ rl_status rl_option_store_set(rl_option_store *s, const char *key, const char *v
 {
     long i = rl_option_store_find(s, key);
     if (i < 0)
-        return rl_option_unknown(s->options, s->count, context, key);
+        return rl_option_unknown(s->options, s->count, context, s->prefix, key);
     const rl_option_info *o = &s->options[i];
     rl_status st = rl_option_validate(o, value, context);
     if (st == RL_OK && check)

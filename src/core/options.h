@@ -23,6 +23,9 @@
 /* Appends text to the NUL-terminated buf of size bytes, cutting it short
  * when full. */
 void rl_option_append(char *buf, size_t size, const char *text);
+/* "did you mean \"NAME\"? " for a suggestion with a name (rl_suggest), else
+ * "": the start of an unknown name's message, written into buf. */
+const char *rl_option_did_you_mean(const rl_suggestion *s, char *buf, size_t size);
 /* "r,g,b" or one grey value, each finite and >= 0 (no error recorded). */
 bool rl_option_parse_color(const char *text, rl_vec3 *out);
 

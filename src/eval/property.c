@@ -93,13 +93,16 @@ rl_status rl_property_create(const char *name, rl_property **out)
     for (size_t i = 0; i < NUM_BUILTINS; ++i)
         if (strcmp(builtin_classes[i]->info.name, name) == 0)
             return make(builtin_classes[i], name, out);
-    char names[RL_OPTION_LIST_SIZE] = "";
+    char names[RL_OPTION_LIST_SIZE] = "", hint[96];
+    rl_suggestion sg = { 0 };
     for (size_t i = 0; i < NUM_BUILTINS; ++i) {
         if (i)
             rl_option_append(names, sizeof names, ", ");
         rl_option_append(names, sizeof names, builtin_classes[i]->info.name);
+        rl_suggest(&sg, name, builtin_classes[i]->info.name);
     }
-    return rl_error(RL_ERR_NOT_FOUND, "unknown property \"%s\" (available: %s)", name, names);
+    return rl_error(RL_ERR_NOT_FOUND, "unknown property \"%s\" (%savailable: %s)", name,
+                    rl_option_did_you_mean(&sg, hint, sizeof hint), names);
 }
 
 static void unbind(rl_property *p)

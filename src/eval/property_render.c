@@ -70,7 +70,7 @@
 /* ---- options ----------------------------------------------------------- */
 
 #define RENDER_OPTION_ROWS                                                                      \
-    { "renderer", RL_OPT_STRING, "raster", "renderer name from the registry (rl list)", 0, 0,  \
+    { "renderer", RL_OPT_STRING, "raster", "renderer name from the registry (rl algos)", 0, 0,  \
       NULL },                                                                                   \
     { "renderer_options", RL_OPT_STRING, "",                                                    \
       "\"key=value,...\" options of the renderer, checked on commit", 0, 0, NULL },             \
@@ -136,16 +136,18 @@ static rl_status check_renderer_name(const char *key, const char *value)
         return RL_OK;
     size_t n = 0;
     const rl_renderer_info *list = rl_renderer_list(&n);
-    char names[RL_OPTION_LIST_SIZE] = "";
+    char names[RL_OPTION_LIST_SIZE] = "", hint[96];
+    rl_suggestion sg = { 0 };
     for (size_t i = 0; i < n; ++i) {
         if (strcmp(list[i].name, value) == 0)
             return RL_OK;
         if (i)
             rl_option_append(names, sizeof names, ", ");
         rl_option_append(names, sizeof names, list[i].name);
+        rl_suggest(&sg, value, list[i].name);
     }
-    return rl_error(RL_ERR_INVALID_ARG, "option %s=\"%s\" is not a renderer (available: %s)", key,
-                    value, names);
+    return rl_error(RL_ERR_INVALID_ARG, "option %s=\"%s\" is not a renderer (%savailable: %s)", key,
+                    value, rl_option_did_you_mean(&sg, hint, sizeof hint), names);
 }
 
 /* ---- shared state ------------------------------------------------------ */

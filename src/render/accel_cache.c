@@ -5,11 +5,14 @@
 
 #include "core/error.h"
 #include "rl/rl_scene.h"
+#include "rl/rl_timer.h"
 
 rl_status rl_accel_cache_get(rl_accel_cache *c, const char *who, const rl_scene *scene,
                              rl_accel_kind kind, int threads,
-                             bool (*progress)(void *user, double done), void *user)
+                             bool (*progress)(void *user, double done), void *user, double *built_ms)
 {
+    if (built_ms)
+        *built_ms = 0.0;
     if (!rl_accel_kind_available(kind))
         return rl_error(RL_ERR_UNSUPPORTED, "%s: accel=%s is not available in this build", who,
                         rl_accel_kind_name(kind));
@@ -17,6 +20,8 @@ rl_status rl_accel_cache_get(rl_accel_cache *c, const char *who, const rl_scene 
     if (c->accel && c->scene_uid == uid && c->kind == kind)
         return RL_OK;
     rl_accel_cache_release(c);
+    rl_timer t;
+    rl_timer_start(&t);
     rl_accel *a = NULL;
     rl_accel_desc desc = { .kind = kind, .threads = threads, .progress = progress, .user = user };
     rl_status st = rl_accel_create(scene, &desc, &a);
@@ -29,6 +34,8 @@ rl_status rl_accel_cache_get(rl_accel_cache *c, const char *who, const rl_scene 
     c->accel = a;
     c->scene_uid = uid;
     c->kind = kind;
+    if (built_ms)
+        *built_ms = rl_timer_ms(&t);
     return RL_OK;
 }
 

@@ -14,10 +14,11 @@ typedef struct rl_accel_cache {
 
 /* Makes c->accel a committed accel of `kind` over scene, building it (with
  * progress, may be NULL) unless the cached one fits. RL_ERR_UNSUPPORTED for
- * a kind this build lacks (the message names the renderer `who`). */
+ * a kind this build lacks (the message names the renderer `who`).
+ * *built_ms (may be NULL) gets the time building took, 0 when it reused. */
 rl_status rl_accel_cache_get(rl_accel_cache *c, const char *who, const rl_scene *scene,
                              rl_accel_kind kind, int threads,
-                             bool (*progress)(void *user, double done), void *user);
+                             bool (*progress)(void *user, double done), void *user, double *built_ms);
 void rl_accel_cache_release(rl_accel_cache *c);
 
 #endif

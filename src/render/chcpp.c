@@ -451,6 +451,7 @@ static rl_status chcpp_render(rl_renderer *r, void *state, const rl_scene *scene
     if (st != RL_OK)
         return st;
     stats->occlusion_queries = s->head.stats.queries;
+    stats->prep_ms = s->head.stats.preprocess_ms;
     s->head.have_frame = true;
     return RL_OK;
 }

@@ -694,6 +694,7 @@ static rl_status pt_render(rl_renderer *r, void *state, const rl_scene *scene, c
     }
     write_layers(s, image);
     finish_stats(s, &set, &sum, traced, cam, &total, stats, &ps);
+    stats->prep_ms = ps.time_build_ms;     /* the backends built for the scene */
     s->stats = ps;
     s->have_frame = true;
     return RL_OK;

@@ -56,9 +56,15 @@ rl_status rl_renderer_create(const char *name, rl_renderer **out)
         return rl_error(RL_ERR_INVALID_ARG, "rl_renderer_create: name and out must not be NULL");
     const rl_renderer_class *cls = rl_renderer_find_class(name);
     if (!cls) {
-        char names[RL_OPTION_LIST_SIZE];
+        char names[RL_OPTION_LIST_SIZE], hint[96];
         rl_renderer_class_names(names, sizeof names);
-        return rl_error(RL_ERR_NOT_FOUND, "unknown algorithm \"%s\" (available: %s)", name, names);
+        rl_suggestion sg = { 0 };
+        size_t count = 0;
+        const rl_renderer_info *infos = rl_renderer_list(&count);
+        for (size_t i = 0; i < count; ++i)
+            rl_suggest(&sg, name, infos[i].name);
+        return rl_error(RL_ERR_NOT_FOUND, "unknown algorithm \"%s\" (%savailable: %s)", name,
+                        rl_option_did_you_mean(&sg, hint, sizeof hint), names);
     }
 
     rl_renderer *r = rl_calloc(1, sizeof *r);

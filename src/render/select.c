@@ -216,7 +216,7 @@ static rl_status select_render(rl_renderer *r, void *state, const rl_scene *scen
     } else if (value_at(l[0], cam->eye, &v0) && value_at(l[1], cam->eye, &v1)) {
         pick = v1 < v0 ? 1 : 0;
     }
-    double pre_ms = s->head.stats.preprocess_ms;
+    double pre_ms = s->head.stats.preprocess_ms, other_ms = 0.0;
     uint64_t uid = rl_scene_uid(scene);
     if (s->built_uid[1 - pick] != uid) {
         /* The other one builds for the scene now, as preprocessing. */
@@ -226,11 +226,15 @@ static rl_status select_render(rl_renderer *r, void *state, const rl_scene *scen
         if (st != RL_OK)
             return st;
         s->built_uid[1 - pick] = uid;
-        pre_ms += rl_timer_ms(&t);
+        other_ms = rl_timer_ms(&t);
+        pre_ms += other_ms;
     }
     st = rl_renderer_render(s->child[pick], scene, cam, image, stats);
     if (st != RL_OK)
         return st;
+    /* The chosen one's own preparation and the other's whole first frame;
+     * the inputs were made before this frame. */
+    stats->prep_ms += other_ms;
     s->built_uid[pick] = uid;
     /* Another renderer than a culling one has its rl_render_stats only. */
     const rl_culling_stats *cs = rl_cull_stats_of(s->child[pick]);

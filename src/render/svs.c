@@ -530,6 +530,7 @@ static rl_status svs_render(rl_renderer *r, void *state, const rl_scene *scene, 
     st = rl_cull_frame_end(&f.cf, st, image, stats);
     if (st != RL_OK)
         return st;
+    stats->prep_ms = s->head.stats.preprocess_ms;
     s->head.have_frame = true;
     return RL_OK;
 }

@@ -143,7 +143,7 @@ static rl_status build_ranking(visset_state *s, const rl_position_lookup *l, con
  * per-object arrays; the ranking too in budget mode. Redone when the input
  * or the scene changes. */
 static rl_status prepare(visset_state *s, rl_renderer *r, const rl_scene *scene, const rl_scene_data *d,
-                         bool budget, const rl_position_lookup **out)
+                         bool budget, const rl_position_lookup **out, double *built_ms)
 {
     uint64_t generation;
     const rl_position_lookup *l = rl_renderer_input(r, "approx", &generation);
@@ -187,7 +187,8 @@ static rl_status prepare(visset_state *s, rl_renderer *r, const rl_scene *scene,
         }
         s->ranked = true;
     }
-    s->head.stats.preprocess_ms = input_ms + rl_timer_ms(&t0);
+    *built_ms = rl_timer_ms(&t0);   /* the frame's preparation; the input was made before */
+    s->head.stats.preprocess_ms = input_ms + *built_ms;
     return RL_OK;
 }
 
@@ -225,7 +226,7 @@ static rl_status visset_render(rl_renderer *r, void *state, const rl_scene *scen
     s->head.have_frame = false;
     const uint64_t budget = (uint64_t)rl_renderer_opt_int(r, "budget");
     const rl_position_lookup *l = NULL;
-    rl_status st = prepare(s, r, scene, d, budget > 0, &l);
+    rl_status st = prepare(s, r, scene, d, budget > 0, &l, &stats->prep_ms);
     if (st != RL_OK)
         return st;
 

@@ -261,11 +261,13 @@ static rl_status select_objects(const rl_scene *scene, const rl_scene_data *d, c
 }
 
 /* Rebuilds the VT meshes when the scene or the selection changed. */
-static rl_status ensure_mesh(vt_state *s, const rl_scene *scene, const rl_scene_data *d, const char *spec)
+static rl_status ensure_mesh(vt_state *s, const rl_scene *scene, const rl_scene_data *d, const char *spec,
+                             bool *built)
 {
     uint64_t uid = rl_scene_uid(scene);
     if (s->mesh_valid && s->mesh_scene == uid && s->mesh_objects && strcmp(s->mesh_objects, spec) == 0)
         return RL_OK;
+    *built = true;
     s->mesh_valid = false;
     free(s->object_vt);
     free(s->object_raster);
@@ -411,9 +413,10 @@ static rl_status keep_mesh(vt_state *s, const vt_run *run)
 
 /* The frame's tracer (exact shading, eq. 3.1-3.4, 3.17), the kept
  * structures made or reused for the scene, and the feeler cache forgotten
- * when what the feelers depend on changed (Sec. 3.4.5). */
+ * when what the feelers depend on changed (Sec. 3.4.5). *prep_ms: the time
+ * building the kept structures took (0 when they were reused). */
 static rl_status prepare_tracer(rl_renderer *r, vt_state *s, const rl_scene *scene, const rl_scene_data *d,
-                                const vt_settings *set, rl_tracer **tracer)
+                                const vt_settings *set, rl_tracer **tracer, double *prep_ms)
 {
     rl_accel_kind kind;
     rl_tracer_desc desc;
@@ -422,10 +425,16 @@ static rl_status prepare_tracer(rl_renderer *r, vt_state *s, const rl_scene *sce
         return st;
     desc.tree_shadow_any_hit = true;      /* shadow nodes say lit or blocked (Sec. 3.3.1) */
     desc.defer_through = rl_renderer_opt_bool(r, "defer_through");
-    if ((st = rl_accel_cache_get(&s->accel, "vt", scene, kind, set->threads, build_progress, r)) != RL_OK)
+    double accel_ms = 0.0;
+    if ((st = rl_accel_cache_get(&s->accel, "vt", scene, kind, set->threads, build_progress, r, &accel_ms)) !=
+        RL_OK)
         return st;
-    if ((st = ensure_mesh(s, scene, d, rl_renderer_opt_string(r, "objects"))) != RL_OK)
+    bool built = false;
+    rl_timer t;
+    rl_timer_start(&t);
+    if ((st = ensure_mesh(s, scene, d, rl_renderer_opt_string(r, "objects"), &built)) != RL_OK)
         return st;
+    *prep_ms = accel_ms + (built ? rl_timer_ms(&t) : 0.0);
     if ((st = rl_tracer_create(s->accel.accel, &desc, tracer)) != RL_OK)
         return st;
     uint64_t signature = feeler_signature(&desc);
@@ -533,7 +542,7 @@ static rl_status vt_render(rl_renderer *r, void *state, const rl_scene *scene, c
     s->have_frame = false;
 
     rl_tracer *tracer = NULL;
-    if ((st = prepare_tracer(r, s, scene, d, &set, &tracer)) != RL_OK)
+    if ((st = prepare_tracer(r, s, scene, d, &set, &tracer, &stats->prep_ms)) != RL_OK)
         return st;
     vt_mesh_reset(&s->mesh);
     vt_heap_clear(&s->heap);

@@ -211,7 +211,8 @@ static rl_status whitted_render(rl_renderer *r, void *state, const rl_scene *sce
 #else
     int num_threads = 1;
 #endif
-    if ((st = rl_accel_cache_get(&s->accel, "whitted", scene, kind, threads, build_progress, r)) != RL_OK)
+    if ((st = rl_accel_cache_get(&s->accel, "whitted", scene, kind, threads, build_progress, r,
+                                 &stats->prep_ms)) != RL_OK)
         return st;
     if ((st = prepare_trees(s, rl_renderer_opt_bool(r, "ray_trees"), image->width, image->height)) != RL_OK)
         return st;

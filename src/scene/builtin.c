@@ -43,16 +43,19 @@ rl_status rl_scene_create_builtin(const char *name, const char *params, rl_scene
     if (!name || !out)
         return rl_error(RL_ERR_INVALID_ARG, "rl_scene_create_builtin: NULL argument");
     const rl_builtin_class *cls = NULL;
-    char names[RL_OPTION_LIST_SIZE] = "";
+    char names[RL_OPTION_LIST_SIZE] = "", hint[96];
+    rl_suggestion sg = { 0 };
     for (size_t i = 0; i < NUM_BUILTINS; ++i) {
         if (strcmp(classes[i]->info.name, name) == 0)
             cls = classes[i];
         if (i)
             rl_option_append(names, sizeof names, ", ");
         rl_option_append(names, sizeof names, classes[i]->info.name);
+        rl_suggest(&sg, name, classes[i]->info.name);
     }
     if (!cls)
-        return rl_error(RL_ERR_NOT_FOUND, "unknown built-in scene \"%s\" (built-ins: %s)", name, names);
+        return rl_error(RL_ERR_NOT_FOUND, "unknown built-in scene \"%s\" (%sbuilt-ins: %s)", name,
+                        rl_option_did_you_mean(&sg, hint, sizeof hint), names);
     /* Every key=value checked against the table before anything is built;
      * a repeated key keeps the last value. */
     rl_params list;

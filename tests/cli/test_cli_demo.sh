@@ -38,6 +38,8 @@ assert len(r["images"]) == int(sys.argv[2]), len(r["images"])
 for e in r["images"]:
     assert {"scene", "algorithm", "file", "scene_stats", "render_stats"} <= e.keys(), e.keys()
     assert e["render_stats"]["time_ms"] >= 0
+    # One-time preparation apart from the frame.
+    assert e["render_stats"]["prep_ms"] >= 0 and e["render_stats"]["frame_ms"] >= 0
     assert e["scene_stats"]["triangles"] > 0
 assert r["machine"]["nproc"] >= 1 and r["date"]
 assert r["failures"] == []
@@ -53,4 +55,6 @@ for c in ch:
 PY
 grep -q "Changed on purpose" "$DIR/index.html" || fail "index.html lacks the changed defaults"
 grep -q "processors" "$DIR/index.html" || fail "index.html lacks the machine"
+grep -q "prep [0-9.]* ms &middot; frame [0-9.]* ms" "$DIR/index.html" || fail "index.html lacks prep and frame"
+grep -q "command: <code>" "$DIR/index.html" || fail "index.html lacks the command line"
 echo "ok"

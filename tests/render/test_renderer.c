@@ -9,8 +9,12 @@
 
 #include <cmocka.h>
 
+#include "rl/rl_culling.h"
 #include "rl/rl_render.h"
+#include "rl/rl_sampling.h"
 #include "rl/rl_scene.h"
+
+#include "render_fixtures.h"
 
 /* A one-triangle committed (or not) scene. */
 static rl_scene *make_scene(bool commit)
@@ -243,6 +247,39 @@ static void test_progress_callback_can_cancel_a_render(void **state)
     rl_scene_release(s);
 }
 
+/* prep_ms: what a renderer builds for the scene is timed on the first
+ * frame only, and is part of that frame's time_ms; a rasterizer builds
+ * nothing. For the culling renderers it is their preprocess_ms. */
+static void test_first_frame_reports_its_preparation_and_later_frames_none(void **state)
+{
+    (void)state;
+    rl_camera cam;
+    rl_scene *s = fx_cornell(&cam, 16);
+    const char *const names[] = { "raster", "whitted", "vt", "pt", "chcpp" };
+    for (size_t i = 0; i < sizeof names / sizeof names[0]; i++) {
+        rl_renderer *r = fx_make(names[i], NULL);
+        rl_render_stats first = { 0 }, second = { 0 };
+        rl_image *a = fx_render_with(r, s, &cam, RL_LAYER_COLOR, &first);
+        rl_image *b = fx_render_with(r, s, &cam, RL_LAYER_COLOR, &second);
+        bool builds = strcmp(names[i], "raster") != 0;
+        if (builds)
+            assert_true(first.prep_ms > 0.0);
+        else
+            assert_true(first.prep_ms == 0.0);
+        assert_true(first.prep_ms <= first.time_ms);
+        assert_true(second.prep_ms == 0.0);
+        rl_culling_stats cs;
+        if (strcmp(names[i], "chcpp") == 0) {
+            assert_int_equal(rl_culling_get_stats(r, &cs), RL_OK);
+            assert_true(cs.preprocess_ms == second.prep_ms);
+        }
+        rl_image_release(a);
+        rl_image_release(b);
+        rl_renderer_release(r);
+    }
+    rl_scene_release(s);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -256,6 +293,7 @@ int main(void)
         cmocka_unit_test(test_render_refuses_mismatched_image_and_bad_camera),
         cmocka_unit_test(test_render_refuses_null_arguments),
         cmocka_unit_test(test_progress_callback_can_cancel_a_render),
+        cmocka_unit_test(test_first_frame_reports_its_preparation_and_later_frames_none),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
