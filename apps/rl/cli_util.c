@@ -290,11 +290,20 @@ void cli_print_option(FILE *out, const rl_option_info *o)
                                                              : "-";
     fprintf(out, "    %-22s %-6s default %-10s %s", o->key, option_type_name(o->type), def, o->help ? o->help : "");
     if ((o->type == RL_OPT_INT || o->type == RL_OPT_FLOAT) && o->max > o->min) {
-        fputs(" [", out);
-        put_bound(out, o->min);
-        fputs("..", out);
-        put_bound(out, o->max);
-        fputs("]", out);
+        /* Tables write "no limit" as the largest exact integer (2^53 - 1)
+         * or as +-1e300; such a side is left out rather than printed. */
+        bool lo = o->min > -9007199254740991.0, hi = o->max < 9007199254740991.0;
+        if (lo && hi) {
+            fputs(" [", out);
+            put_bound(out, o->min);
+            fputs("..", out);
+            put_bound(out, o->max);
+            fputs("]", out);
+        } else if (lo || hi) {
+            fputs(lo ? " [>= " : " [<= ", out);
+            put_bound(out, lo ? o->min : o->max);
+            fputs("]", out);
+        }
     }
     if (o->type == RL_OPT_ENUM && o->choices) {
         fprintf(out, " {");

@@ -38,9 +38,15 @@ int cli_scenes(int argc, char **argv)
         printf("  parameters:%s\n", scenes[i].num_options ? "" : " none");
         for (size_t k = 0; k < scenes[i].num_options; k++)
             cli_print_option(stdout, &scenes[i].options[k]);
-        if (i + 1 < count)
-            putchar('\n');
+        putchar('\n');
     }
+    /* A model file takes parameters too (rl_model_options). */
+    size_t num_model = 0;
+    const rl_option_info *model = rl_model_options(&num_model);
+    printf("model files (OBJ, PLY, STL, glTF, DAE, FBX, 3DS, ... as FILE:key=value): framed and "
+           "lit when they bring no camera or light\n  parameters:\n");
+    for (size_t k = 0; k < num_model; k++)
+        cli_print_option(stdout, &model[k]);
     return RL_CLI_OK;
 }
 
