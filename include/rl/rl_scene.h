@@ -44,9 +44,19 @@ typedef struct rl_material {
     float ior;                /* index of refraction, >= 1 */
     rl_vec3 emission;         /* emitted radiance */
     uint32_t diffuse_texture; /* scene texture index or RL_NONE */
+    /* Tangent-space normal map (RGB = (n + 1) / 2, raw values, not sRGB)
+     * or RL_NONE; normal_scale scales its x and y (glTF's "scale"). Used by
+     * the ray tracers (whitted, vt's samples, pt): rl_shading_normal. */
+    uint32_t normal_texture;
+    float normal_scale;
+    /* Alpha mask (glTF alphaMode MASK): where the diffuse texture's alpha
+     * is below this cutoff the surface is a hole that rays pass through
+     * (rl_accel queries skip it). 0: opaque, no test. */
+    float alpha_cutoff;
 } rl_material;
 
-/* Grey diffuse (0.8), no specular, shininess 32, ior 1.5, no texture. */
+/* Grey diffuse (0.8), no specular, shininess 32, ior 1.5, no textures,
+ * normal scale 1. */
 RL_API rl_material rl_material_default(void);
 /* RL_ERR_INVALID_ARG for negative or non-finite coefficients, k_r + k_t > 1,
  * ior < 1. */
@@ -178,6 +188,16 @@ typedef struct rl_scene_data {
 
 /* NULL (with RL_ERR_NOT_COMMITTED recorded) unless committed. */
 RL_API const rl_scene_data *rl_scene_get_data(const rl_scene *scene);
+/* The shading normal of triangle tri at texture coordinate uv, given the
+ * interpolated vertex normal ns: ns itself, or ns bent by the material's
+ * normal map in the triangle's tangent frame (dP/du, dP/dv from its
+ * positions and uvs, Gram-Schmidt against ns), of unit length. Without a
+ * map, ns is returned as it came; where the frame is degenerate, ns
+ * normalised. */
+RL_API rl_vec3 rl_shading_normal(const rl_scene_data *d, uint32_t tri, rl_vec3 ns, rl_vec2 uv);
+/* Whether the hit at barycentrics (u, v) of triangle tri falls in a hole of
+ * its material's alpha mask (rl_material.alpha_cutoff). */
+RL_API bool rl_alpha_masked(const rl_scene_data *d, uint32_t tri, float u, float v);
 
 /* The named camera, the first camera (name NULL), or, when the scene has
  * none, rl_scene_fit_camera at the default size. RL_ERR_NOT_FOUND for an

@@ -15,6 +15,10 @@
 #include "core/error.h"
 #include "rl/rl_timer.h"
 
+/* Holes of alpha masks one query passes through before it gives up (a ray
+ * along a stack of foliage cards). */
+#define MAX_MASK_SKIPS 256
+
 struct rl_accel {
     const rl_scene *scene;
     const rl_scene_data *data;
@@ -22,6 +26,7 @@ struct rl_accel {
     const rl_accel_class *cls;
     void *state;
     bool committed;
+    bool masked;              /* some material has an alpha mask */
     rl_accel_stats stats;
 };
 
@@ -127,6 +132,9 @@ rl_status rl_accel_create(const rl_scene *scene, const rl_accel_desc *desc, rl_a
     a->desc = d;
     a->cls = class_of(d.kind);
     a->stats.kind = d.kind;
+    for (uint32_t m = 0; m < data->num_materials; ++m)
+        a->masked |= data->materials[m].alpha_cutoff > 0.0f &&
+                     data->materials[m].diffuse_texture < data->num_textures;
     *out = a;
     return RL_OK;
 }
@@ -199,6 +207,20 @@ bool rl_accel_intersect(const rl_accel *accel, rl_ray *ray, rl_hit *hit)
     rl_ray r = *ray;
     if (!accel->cls->intersect(accel->state, &r, &h))
         return false;
+    /* Alpha masks (glTF MASK): a hit in a hole is skipped by asking again
+     * beyond it. Every kind tests t in the open interval (t_min, t_max), so
+     * the same triangle is not found twice. Here rather than in each
+     * kind's inner loop: one place for all of them (Embree included), and
+     * no cost for scenes without masks. */
+    for (int skips = 0; accel->masked && rl_alpha_masked(accel->data, h.triangle, h.u, h.v); ++skips) {
+        if (skips == MAX_MASK_SKIPS)
+            return false;
+        r = *ray;
+        r.t_min = h.t;
+        h = (rl_hit){ .triangle = RL_ID_NONE, .object = RL_ID_NONE };
+        if (!accel->cls->intersect(accel->state, &r, &h))
+            return false;
+    }
     h.object = accel->data->triangle_object[h.triangle];
     ray->t_max = h.t;
     *hit = h;
@@ -209,7 +231,13 @@ bool rl_accel_occluded(const rl_accel *accel, const rl_ray *ray)
 {
     if (!accel || !ray || !accel->committed || !ray_is_valid(ray))
         return false;
-    return accel->cls->occluded(accel->state, ray);
+    if (!accel->masked)
+        return accel->cls->occluded(accel->state, ray);
+    /* With alpha masks an any-hit query could stop at a hole: walk the
+     * hits front to back instead (rl_accel_intersect skips the holes). */
+    rl_ray r = *ray;
+    rl_hit h;
+    return rl_accel_intersect(accel, &r, &h);
 }
 
 void rl_accel_intersect_n(const rl_accel *accel, rl_ray *rays, rl_hit *hits, size_t n)

@@ -73,7 +73,7 @@ void rl_pt_surface_finish(const rl_scene_data *d, uint32_t tri, rl_vec3 p, rl_ve
     const uint32_t *idx = &d->indices[3 * (size_t)tri];
     rl_vec3 p0 = d->positions[idx[0]], p1 = d->positions[idx[1]], p2 = d->positions[idx[2]];
     rl_vec3 ng = rl_normalize(rl_cross(rl_sub(p1, p0), rl_sub(p2, p0)));
-    ns = rl_normalize(ns);
+    ns = rl_normalize(rl_shading_normal(d, tri, ns, uv));
     if (!(rl_length2(ns) > 0.0f) || !rl_vfinite(ns))
         ns = ng;
     s->p = p;

@@ -162,7 +162,7 @@ void rl_trace_surface_finish(const rl_tracer *tr, uint32_t tri_index, rl_vec3 ns
     rl_vec3 p0 = data->positions[tri[0]], p1 = data->positions[tri[1]], p2 = data->positions[tri[2]];
     s->v = v;
     rl_vec3 ng = rl_normalize(rl_cross(rl_sub(p1, p0), rl_sub(p2, p0)));
-    ns = rl_normalize(ns);
+    ns = rl_normalize(rl_shading_normal(data, tri_index, ns, uv));
     if (!(rl_length2(ns) > 0.0f) || !rl_vfinite(ns))
         ns = ng;
     s->front = rl_dot(ng, v) > 0.0f;

@@ -299,6 +299,34 @@ static rl_status load_material_texture(material_ctx *c, const char *tex_path, ui
     return st;
 }
 
+/* A normal map holds vectors, not colours: the texture loaders decode sRGB,
+ * so the map gets a copy of its own with the decoding undone (exact for
+ * 8-bit texels, done before any filtering). The decoded texture stays
+ * shared by path for any colour use. */
+static rl_status load_normal_map(material_ctx *c, const char *tex_path, uint32_t *id)
+{
+    uint32_t colour = RL_NONE;
+    rl_status st = load_material_texture(c, tex_path, &colour);
+    *id = RL_NONE;
+    if (st != RL_OK || colour == RL_NONE)
+        return st;
+    const rl_texture *src = c->scene->textures[colour];
+    size_t n = (size_t)src->width * (size_t)src->height;
+    rl_vec4 *raw = rl_calloc(n ? n : 1, sizeof *raw);
+    if (!raw)
+        return rl_error(RL_ERR_OUT_OF_MEMORY, "%s: normal map: out of memory", c->path);
+    for (size_t i = 0; i < n; ++i) {
+        rl_vec4 t = src->texels[i];
+        raw[i] = rl_v4(rl_linear_to_srgb(t.x), rl_linear_to_srgb(t.y), rl_linear_to_srgb(t.z), t.w);
+    }
+    rl_texture *tex = NULL;
+    st = rl_texture_create(src->width, src->height, raw, &tex);
+    free(raw);
+    if (st == RL_OK && (st = rl_scene_add_texture(c->scene, tex, id)) != RL_OK)
+        rl_texture_release(tex);
+    return st;
+}
+
 static rl_status add_material(material_ctx *c, const struct aiMaterial *mat, uint32_t *id)
 {
     rl_material m = rl_material_default();
@@ -368,17 +396,35 @@ static rl_status add_material(material_ctx *c, const struct aiMaterial *mat, uin
         if (st != RL_OK)
             return st;
     }
+    if (aiGetMaterialTexture(mat, aiTextureType_NORMALS, 0, &tex, NULL, NULL, NULL, NULL, NULL,
+                             NULL) == aiReturn_SUCCESS) {
+        rl_status st = load_normal_map(c, tex.data, &m.normal_texture);
+        if (st != RL_OK)
+            return st;
+        float scale;
+        if (get_float(mat, "$tex.scale", aiTextureType_NORMALS, 0, &scale))
+            m.normal_scale = scale;
+    }
     /* What the material model cannot hold yet is counted, and reported once
-     * per file (import_notes). */
-    c->notes.normal_maps += aiGetMaterialTextureCount(mat, aiTextureType_NORMALS) > 0 ||
-                            aiGetMaterialTextureCount(mat, aiTextureType_HEIGHT) > 0;
+     * per file (import_notes). A height (bump) map would need its
+     * derivatives; OBJ's map_bump is one. */
+    c->notes.normal_maps += aiGetMaterialTextureCount(mat, aiTextureType_HEIGHT) > 0;
     c->notes.pbr_textures += aiGetMaterialTextureCount(mat, aiTextureType_METALNESS) > 0 ||
                              aiGetMaterialTextureCount(mat, aiTextureType_DIFFUSE_ROUGHNESS) > 0 ||
                              aiGetMaterialTextureCount(mat, aiTextureType_UNKNOWN) > 0;
+    /* glTF 2.0 alphaMode: MASK cuts holes where the base colour's alpha
+     * is below alphaCutoff (default 0.5); BLEND would need transparency
+     * sorted or stochastic, and is drawn opaque for now. */
     struct aiString mode;
-    if (aiGetMaterialString(mat, "$mat.gltf.alphaMode", 0, 0, &mode) == aiReturn_SUCCESS &&
-        strcmp(mode.data, "OPAQUE") != 0)
-        c->notes.alpha_modes++;
+    if (aiGetMaterialString(mat, "$mat.gltf.alphaMode", 0, 0, &mode) == aiReturn_SUCCESS) {
+        if (strcmp(mode.data, "MASK") == 0 && m.diffuse_texture != RL_NONE) {
+            float cutoff = 0.5f;
+            get_float(mat, "$mat.gltf.alphaCutoff", 0, 0, &cutoff);
+            m.alpha_cutoff = rl_clampf(cutoff, 0.0f, 1.0f);
+        } else if (strcmp(mode.data, "BLEND") == 0) {
+            c->notes.alpha_modes++;
+        }
+    }
     return rl_scene_add_material(c->scene, &m, id);
 }
 
@@ -698,7 +744,7 @@ static void report_notes(const char *path, const import_notes *n, uint64_t degen
         rl_option_append(text, sizeof text, part);
     }
     if (n->normal_maps) {
-        snprintf(part, sizeof part, "; normal or bump maps ignored (%u materials)", n->normal_maps);
+        snprintf(part, sizeof part, "; bump (height) maps ignored (%u materials)", n->normal_maps);
         rl_option_append(text, sizeof text, part);
     }
     if (n->pbr_textures) {
@@ -707,7 +753,7 @@ static void report_notes(const char *path, const import_notes *n, uint64_t degen
         rl_option_append(text, sizeof text, part);
     }
     if (n->alpha_modes) {
-        snprintf(part, sizeof part, "; alpha mask/blend ignored, drawn opaque (%u materials)",
+        snprintf(part, sizeof part, "; alpha blending ignored, drawn opaque (%u materials)",
                  n->alpha_modes);
         rl_option_append(text, sizeof text, part);
     }

@@ -20,6 +20,7 @@
 #include <string.h>
 #include <sys/stat.h>
 
+#include "rl/rl_accel.h"
 #include "rl/rl_image.h"
 #include "rl/rl_scene.h"
 
@@ -382,6 +383,101 @@ static void test_one_warning_per_file(void **state)
     rl_scene_release(s);
 }
 
+
+static void base64(const unsigned char *in, size_t n, char *out)
+{
+    static const char a[] = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+    size_t o = 0;
+    for (size_t i = 0; i < n; i += 3) {
+        uint32_t v = (uint32_t)in[i] << 16;
+        if (i + 1 < n) v |= (uint32_t)in[i + 1] << 8;
+        if (i + 2 < n) v |= in[i + 2];
+        out[o++] = a[(v >> 18) & 63];
+        out[o++] = a[(v >> 12) & 63];
+        out[o++] = i + 1 < n ? a[(v >> 6) & 63] : '=';
+        out[o++] = i + 2 < n ? a[v & 63] : '=';
+    }
+    out[o] = '\0';
+}
+
+/* A glTF quad (-1..1)^2 in z = 0 whose base colour texture is transparent
+ * on its left half (alphaMode MASK), with a normal map that tilts every
+ * normal to the tangent +x (+u). Rays through the left half pass; the
+ * bent normal follows the map. */
+static void test_gltf_alpha_mask_and_normal_map(void **state)
+{
+    (void)state;
+    char dir[1100], path[1200], png[1200];
+    dir_for("gltf_mask", dir, sizeof dir);
+    rl_image *img = NULL;
+    assert_int_equal(rl_image_create(2, 1, RL_LAYER_COLOR, &img), RL_OK);
+    img->color[0] = rl_v4(1, 1, 1, 0);
+    img->color[1] = rl_v4(1, 1, 1, 1);
+    snprintf(png, sizeof png, "%s/mask.png", dir);
+    assert_int_equal(rl_image_write_png(img, png), RL_OK);
+    /* Raw bytes (255, 128, 128) after the PNG's sRGB encoding. */
+    img->width = 1;
+    img->color[0] = rl_v4(1.0f, rl_srgb_to_linear(128.0f / 255.0f), rl_srgb_to_linear(128.0f / 255.0f), 1);
+    snprintf(png, sizeof png, "%s/bump.png", dir);
+    assert_int_equal(rl_image_write_png(img, png), RL_OK);
+    rl_image_release(img);
+
+    struct { float pos[12]; float uv[8]; uint16_t idx[6]; } buf = {
+        { -1, -1, 0, 1, -1, 0, 1, 1, 0, -1, 1, 0 },
+        { 0, 1, 1, 1, 1, 0, 0, 0 },   /* glTF's v runs down the picture */
+        { 0, 1, 2, 0, 2, 3 },
+    };
+    char b64[256], text[4096];
+    base64((const unsigned char *)&buf, sizeof buf, b64);
+    snprintf(text, sizeof text,
+             "{\"asset\": {\"version\": \"2.0\"}, \"scene\": 0, \"scenes\": [{\"nodes\": [0]}],"
+             " \"nodes\": [{\"mesh\": 0}],"
+             " \"meshes\": [{\"primitives\": [{\"attributes\": {\"POSITION\": 0, \"TEXCOORD_0\": 1},"
+             "   \"indices\": 2, \"material\": 0}]}],"
+             " \"materials\": [{\"alphaMode\": \"MASK\", \"alphaCutoff\": 0.5,"
+             "   \"pbrMetallicRoughness\": {\"baseColorTexture\": {\"index\": 0}},"
+             "   \"normalTexture\": {\"index\": 1}}],"
+             " \"textures\": [{\"source\": 0}, {\"source\": 1}],"
+             " \"images\": [{\"uri\": \"mask.png\"}, {\"uri\": \"bump.png\"}],"
+             " \"buffers\": [{\"byteLength\": %zu, \"uri\": \"data:application/octet-stream;base64,%s\"}],"
+             " \"bufferViews\": [{\"buffer\": 0, \"byteOffset\": 0, \"byteLength\": 48},"
+             "   {\"buffer\": 0, \"byteOffset\": 48, \"byteLength\": 32},"
+             "   {\"buffer\": 0, \"byteOffset\": 80, \"byteLength\": 12}],"
+             " \"accessors\": [{\"bufferView\": 0, \"componentType\": 5126, \"count\": 4, \"type\": \"VEC3\","
+             "   \"min\": [-1, -1, 0], \"max\": [1, 1, 0]},"
+             "  {\"bufferView\": 1, \"componentType\": 5126, \"count\": 4, \"type\": \"VEC2\"},"
+             "  {\"bufferView\": 2, \"componentType\": 5123, \"count\": 6, \"type\": \"SCALAR\"}]}",
+             sizeof buf, b64);
+    rl_scene *s = load(write_text(dir, "leaf.gltf", text, path, sizeof path), NULL);
+    const rl_scene_data *d = rl_scene_get_data(s);
+    const rl_material *m = first_material(s);
+    assert_true(fabsf(m->alpha_cutoff - 0.5f) < 1e-6f);
+    assert_int_not_equal(m->normal_texture, RL_NONE);
+
+    const rl_accel_kind kinds[] = { RL_ACCEL_BVH, RL_ACCEL_GRID, RL_ACCEL_BRUTE };
+    for (size_t k = 0; k < sizeof kinds / sizeof kinds[0]; ++k) {
+        rl_accel *a = NULL;
+        assert_int_equal(rl_accel_create(s, &(rl_accel_desc){ .kind = kinds[k] }, &a), RL_OK);
+        assert_int_equal(rl_accel_commit(a), RL_OK);
+        for (int side = 0; side < 2; ++side) {
+            float x = side ? 0.5f : -0.5f;   /* u = 0.75 opaque, u = 0.25 a hole */
+            rl_ray r = { rl_v3(x, 0.1f, 5.0f), 0.0f, rl_v3(0, 0, -1), INFINITY };
+            rl_hit h;
+            assert_int_equal(rl_accel_intersect(a, &r, &h), side == 1);
+            assert_int_equal(rl_accel_occluded(a, &(rl_ray){ rl_v3(x, 0.1f, 5.0f), 0.0f,
+                                                             rl_v3(0, 0, -1), 10.0f }), side == 1);
+            if (side == 1) {
+                /* The map's (1, 0, 0) in the frame (T = +x, B, N = +z). */
+                rl_vec2 uv = rl_v2(0.75f, 0.45f);
+                rl_vec3 n = rl_shading_normal(d, h.triangle, rl_v3(0, 0, 1), uv);
+                assert_true(n.x > 0.99f && fabsf(rl_length(n) - 1.0f) < 1e-5f);
+            }
+        }
+        rl_accel_release(a);
+    }
+    rl_scene_release(s);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -392,6 +488,7 @@ int main(void)
         cmocka_unit_test(test_fbx_camera_angle_and_light_falloff),
         cmocka_unit_test(test_model_parameters),
         cmocka_unit_test(test_one_warning_per_file),
+        cmocka_unit_test(test_gltf_alpha_mask_and_normal_map),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
