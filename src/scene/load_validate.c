@@ -79,6 +79,11 @@ static int obj_face_corners(const char *p, const char *end)
 
 static rl_status check_obj(const char *path, const char *data, size_t size)
 {
+    /* A UTF-16 file is text, but not text the OBJ reader can parse: say so
+     * rather than "binary". */
+    if (size >= 2 && (((unsigned char)data[0] == 0xFE && (unsigned char)data[1] == 0xFF) ||
+                      ((unsigned char)data[0] == 0xFF && (unsigned char)data[1] == 0xFE)))
+        return rl_error(RL_ERR_PARSE, "%s: UTF-16 text; save the OBJ file as UTF-8 or ASCII", path);
     for (size_t i = 0; i < size; ++i) {
         unsigned char c = (unsigned char)data[i];
         /* Tabs, line breaks, vertical tab and form feed are whitespace. */
