@@ -12,8 +12,11 @@
  *     counted lists (binary_little_endian / binary_big_endian). Faces need
  *     at least 3 corners (Assimp's triangulation asserts otherwise) and
  *     indices below the vertex count. */
+#define _POSIX_C_SOURCE 200809L   /* fstat, fileno */
 #include <errno.h>
+#include <stdint.h>
 #include <stdio.h>
+#include <sys/stat.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -24,11 +27,36 @@
 #define PLY_MAX_ELEMENTS 16
 #define PLY_MAX_PROPERTIES 64
 
+/* A mesh file is a regular file of at most this size: a path to a device
+ * (a symlink to /dev/zero) or an endless pipe would be read until memory
+ * runs out. 4 GiB holds far more than RL_SCENE_MAX_TRIANGLES in any format. */
+#define MESH_FILE_MAX_BYTES (4ull << 30)
+
+rl_status rl_check_regular_file(const char *path, FILE *f, unsigned long long *bytes)
+{
+    struct stat st;
+    if (fstat(fileno(f), &st) != 0)
+        return rl_error(RL_ERR_IO, "%s: cannot stat: %s", path, strerror(errno));
+    if (!S_ISREG(st.st_mode))
+        return rl_error(RL_ERR_IO, "%s: not a regular file", path);
+    if ((unsigned long long)st.st_size > MESH_FILE_MAX_BYTES)
+        return rl_error(RL_ERR_LIMIT, "%s: %llu bytes exceed the limit of %llu for a mesh file", path,
+                        (unsigned long long)st.st_size, MESH_FILE_MAX_BYTES);
+    if (bytes)
+        *bytes = (unsigned long long)st.st_size;
+    return RL_OK;
+}
+
 static rl_status read_all(const char *path, char **data, size_t *size)
 {
     FILE *f = fopen(path, "rb");
     if (!f)
         return rl_error(RL_ERR_IO, "%s: cannot open: %s", path, strerror(errno));
+    rl_status reg = rl_check_regular_file(path, f, NULL);
+    if (reg != RL_OK) {
+        fclose(f);
+        return reg;
+    }
     char *buf = NULL;
     size_t len = 0, cap = 0;
     for (;;) {
@@ -46,6 +74,11 @@ static rl_status read_all(const char *path, char **data, size_t *size)
         len += got;
         if (got == 0)
             break;
+        if (len > MESH_FILE_MAX_BYTES) {   /* the file grew while we read it */
+            free(buf);
+            fclose(f);
+            return rl_error(RL_ERR_LIMIT, "%s: more than %llu bytes", path, MESH_FILE_MAX_BYTES);
+        }
     }
     bool failed = ferror(f) != 0;
     fclose(f);
@@ -303,6 +336,17 @@ static rl_status check_ply(const char *path, const char *data, size_t size)
     for (int k = 0; k < num_elems; ++k)
         if (strcmp(elems[k].name, "vertex") == 0)
             vertices = elems[k].count;
+    /* The walk below checks every count against the body, and stops where
+     * the body ends. An element without properties has no body to run out
+     * of, yet Assimp loops over its count ("element vertex 4000000000" and
+     * nothing else ran forever): allow it at most one item per byte after
+     * the header. */
+    for (int k = 0; k < num_elems; ++k)
+        if (elems[k].num_props == 0 && elems[k].count > size - pos)
+            return rl_error(RL_ERR_PARSE,
+                            "%s: PLY element \"%s\" declares %llu items without properties, more "
+                            "than the %llu bytes after the header",
+                            path, elems[k].name, elems[k].count, (unsigned long long)(size - pos));
     const unsigned char *bytes = (const unsigned char *)data;
     rl_status st;
     for (int k = 0; k < num_elems; ++k) {
@@ -385,8 +429,63 @@ static bool starts_like_ply(const char *path)
     return n == 4 && memcmp(head, "ply", 3) == 0 && (head[3] == '\n' || head[3] == '\r');
 }
 
+static uint32_t le32(const unsigned char *p)
+{
+    return (uint32_t)p[0] | (uint32_t)p[1] << 8 | (uint32_t)p[2] << 16 | (uint32_t)p[3] << 24;
+}
+
+/* Binary glTF (glTF 2.0 spec, "GLB File Format Specification"): a 12-byte
+ * header (magic "glTF", version, total length) and chunks (length, type,
+ * data padded to 4 bytes). Assimp allocates what a chunk header claims, so a
+ * 300-byte file claiming 2 GB got 2 GB: every length is checked against
+ * the file's size first, reading only the headers. */
+static rl_status check_glb(const char *path)
+{
+    FILE *f = fopen(path, "rb");
+    if (!f)
+        return rl_error(RL_ERR_IO, "%s: cannot open: %s", path, strerror(errno));
+    unsigned long long file_size = 0;
+    rl_status st = rl_check_regular_file(path, f, &file_size);
+    unsigned char head[12];
+    if (st == RL_OK && (fread(head, 1, 12, f) != 12 || memcmp(head, "glTF", 4) != 0))
+        st = RL_OK;   /* not binary glTF after all: Assimp decides */
+    else if (st == RL_OK) {
+        unsigned long long total = le32(head + 8), at = 12;
+        if (total > file_size)
+            st = rl_error(RL_ERR_PARSE, "%s: GLB header claims %llu bytes, the file has %llu", path,
+                          total, file_size);
+        for (int chunk = 0; st == RL_OK && at + 8 <= total; ++chunk) {
+            unsigned char ch[8];
+            if (fseek(f, (long)at, SEEK_SET) != 0 || fread(ch, 1, 8, f) != 8) {
+                st = rl_error(RL_ERR_PARSE, "%s: GLB chunk %d header cut off", path, chunk);
+                break;
+            }
+            unsigned long long len = le32(ch);
+            if (len > total - at - 8)
+                st = rl_error(RL_ERR_PARSE, "%s: GLB chunk %d claims %llu bytes, %llu remain", path,
+                              chunk, len, total - at - 8);
+            at += 8 + ((len + 3) & ~3ull);
+        }
+    }
+    fclose(f);
+    return st;
+}
+
 rl_status rl_check_mesh_file(const char *path)
 {
+    /* Whatever the format: Assimp would read a device until memory runs out. */
+    FILE *f = fopen(path, "rb");
+    if (!f)
+        return rl_error(RL_ERR_IO, "%s: cannot open: %s", path, strerror(errno));
+    rl_status reg = rl_check_regular_file(path, f, NULL);
+    fclose(f);
+    if (reg != RL_OK)
+        return reg;
+    if (rl_path_has_ext(path, ".glb")) {
+        rl_status st = check_glb(path);
+        if (st != RL_OK)
+            return st;
+    }
     bool ply = rl_path_has_ext(path, ".ply") || starts_like_ply(path);
     bool obj = !ply && rl_path_has_ext(path, ".obj");
     if (!obj && !ply)

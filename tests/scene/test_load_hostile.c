@@ -1,0 +1,146 @@
+/* test_load_hostile.c: small model files that made Assimp hang or allocate
+ * gigabytes (issue 34), refused by our pre-checks (load_validate.c) before
+ * Assimp reads them: PLY element counts the file cannot hold (ASCII and
+ * binary), GLB chunk lengths beyond the file, and paths that are not
+ * regular files. Each must fail with a clear error, quickly. */
+#define _POSIX_C_SOURCE 200809L
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <cmocka.h>
+
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <time.h>
+#include <unistd.h>
+
+#include "rl/rl_scene.h"
+
+static const char *tmp_path(const char *name, char *out, size_t size)
+{
+    const char *base = getenv("RL_TEST_TMP");
+    char dir[1024];
+    snprintf(dir, sizeof dir, "%s/hostile", base && base[0] ? base : ".");
+    mkdir(dir, 0777);
+    snprintf(out, size, "%s/%s", dir, name);
+    return out;
+}
+
+static const char *write_bytes(const char *name, const void *data, size_t len, char *out, size_t size)
+{
+    tmp_path(name, out, size);
+    FILE *f = fopen(out, "wb");
+    assert_non_null(f);
+    assert_int_equal(fwrite(data, 1, len, f), len);
+    assert_int_equal(fclose(f), 0);
+    return out;
+}
+
+static double now_s(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+/* Loads path and expects code with want in the message, within seconds. */
+static void expect_refused(const char *path, rl_status code, const char *want)
+{
+    rl_clear_error();
+    rl_scene *s = NULL;
+    double t0 = now_s();
+    rl_status st = rl_scene_load(path, NULL, &s);
+    double dt = now_s() - t0;
+    if (st != code || !strstr(rl_last_error(), want))
+        fail_msg("%s: got %s \"%s\", want %s with \"%s\"", path, rl_status_name(st), rl_last_error(),
+                 rl_status_name(code), want);
+    assert_null(s);
+    /* A bound that only a hang would break (the test's whole point is that
+     * no Assimp loop runs); the checks themselves take microseconds. */
+    assert_true(dt < 10.0);
+    rl_clear_error();
+}
+
+static void test_ply_counts_beyond_the_file_are_refused(void **state)
+{
+    (void)state;
+    char path[1200];
+    /* The issue's 121-byte file: an element of four billion items without
+     * properties, which Assimp loops over forever. */
+    const char *endless = "ply\nformat ascii 1.0\nelement vertex 4000000000\nend_header\n";
+    expect_refused(write_bytes("endless.ply", endless, strlen(endless), path, sizeof path),
+                   RL_ERR_PARSE, "declares 4000000000 items");
+    /* Its binary twin with properties (Assimp took 28 s to fail). */
+    const char *binary = "ply\nformat binary_little_endian 1.0\nelement vertex 4000000000\n"
+                         "property float x\nproperty float y\nproperty float z\n"
+                         "element face 1\nproperty list uchar int vertex_indices\nend_header\n"
+                         "\x00\x00\x00\x00";
+    expect_refused(write_bytes("endless_bin.ply", binary, strlen(binary) + 4, path, sizeof path),
+                   RL_ERR_PARSE, "PLY body ends after 0 of 4000000000 \"vertex\" elements");
+    /* ASCII with properties: the body ends early. */
+    const char *ascii = "ply\nformat ascii 1.0\nelement vertex 10\nproperty float x\n"
+                        "property float y\nproperty float z\nend_header\n0 0 0\n";
+    expect_refused(write_bytes("short.ply", ascii, strlen(ascii), path, sizeof path), RL_ERR_PARSE,
+                   "PLY body ends after 1 of 10 \"vertex\" elements");
+}
+
+static void put32(unsigned char *p, uint32_t v)
+{
+    p[0] = (unsigned char)v;
+    p[1] = (unsigned char)(v >> 8);
+    p[2] = (unsigned char)(v >> 16);
+    p[3] = (unsigned char)(v >> 24);
+}
+
+static void test_glb_lengths_beyond_the_file_are_refused(void **state)
+{
+    (void)state;
+    char path[1200];
+    unsigned char glb[300];
+    memset(glb, ' ', sizeof glb);
+    memcpy(glb, "glTF", 4);
+    put32(glb + 4, 2);
+    put32(glb + 8, sizeof glb);
+    /* A JSON chunk that claims 2 GB (Assimp allocated it). */
+    put32(glb + 12, 0x80000000u);
+    memcpy(glb + 16, "JSON", 4);
+    expect_refused(write_bytes("huge_chunk.glb", glb, sizeof glb, path, sizeof path), RL_ERR_PARSE,
+                   "chunk 0 claims 2147483648 bytes");
+    /* A header whose total length is larger than the file. */
+    put32(glb + 8, 1u << 30);
+    put32(glb + 12, 8);
+    expect_refused(write_bytes("huge_total.glb", glb, sizeof glb, path, sizeof path), RL_ERR_PARSE,
+                   "claims 1073741824 bytes");
+    /* A chunk a few bytes longer than the file. */
+    put32(glb + 8, sizeof glb);
+    put32(glb + 12, 284);
+    expect_refused(write_bytes("cut_chunk.glb", glb, sizeof glb, path, sizeof path), RL_ERR_PARSE,
+                   "GLB chunk 0 claims 284 bytes, 280 remain");
+}
+
+static void test_a_device_is_not_read(void **state)
+{
+    (void)state;
+    char path[1200];
+    tmp_path("zero.obj", path, sizeof path);
+    unlink(path);
+    if (symlink("/dev/zero", path) != 0) {
+        print_message("cannot make a symlink here; check skipped\n");
+        return;
+    }
+    expect_refused(path, RL_ERR_IO, "not a regular file");
+    unlink(path);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_ply_counts_beyond_the_file_are_refused),
+        cmocka_unit_test(test_glb_lengths_beyond_the_file_are_refused),
+        cmocka_unit_test(test_a_device_is_not_read),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
