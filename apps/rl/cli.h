@@ -92,6 +92,10 @@ bool cli_split_source(const char *arg, char **source, char **params);
 int cli_load_scene(const char *arg, rl_scene **out);
 /* True when name is one of the built-in scenes (rl scenes). */
 bool cli_is_builtin(const char *name);
+/* True when the SCENE argument names a model file (anything rl_scene_load
+ * hands to Assimp): neither a built-in nor a .json scene. A model is one
+ * object seen from outside, not a space to stand in. */
+bool cli_is_model_file(const char *arg);
 
 /* The model-file parameters (rl_model_options) as flags: --file-cameras
  * file|off, --file-lights file|off|add, --headlight, --orbit AZ,EL. They are

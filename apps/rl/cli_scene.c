@@ -16,6 +16,17 @@ bool cli_is_builtin(const char *name)
     return false;
 }
 
+bool cli_is_model_file(const char *arg)
+{
+    char *source = NULL, *params = NULL;
+    if (!cli_split_source(arg, &source, &params))
+        return false;
+    bool model = !cli_is_builtin(source) && !cli_has_extension(source, (const char *const[]){ ".json", NULL });
+    free(source);
+    free(params);
+    return model;
+}
+
 static void append_param(cli_model_flags *f, const char *key, const char *value)
 {
     size_t n = strlen(f->params);

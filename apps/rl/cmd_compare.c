@@ -459,6 +459,15 @@ static cJSON *result_json(const compare_args *a, const rl_scene *scene, const rl
     cJSON_AddItemToObject(root, "sampling", eval_desc_json(&a->sampling.desc));
     cJSON_AddNumberToObject(root, "samples", rl_approx_sample_count(driver));
     cJSON_AddNumberToObject(root, "regions", rl_approx_region_count(driver));
+    /* Where every renderer was measured, so that a reader can check that the
+     * positions are where the experiment meant them (around a model, not in it). */
+    cJSON *where = cJSON_AddArrayToObject(root, "positions");
+    for (uint32_t k = 0; where && k < rl_approx_sample_count(driver); k++) {
+        rl_vec3 p;
+        double v;
+        rl_approx_sample(driver, k, &p, &v);
+        cJSON_AddItemToArray(where, cJSON_CreateFloatArray((const float[]){ p.x, p.y, p.z }, 3));
+    }
     cJSON_AddStringToObject(root, "reference", a->reference.label);
     cJSON_AddStringToObject(root, "quality_metric", quality_metrics[a->quality_metric]);
     cJSON_AddNumberToObject(root, "width", a->width);
@@ -684,6 +693,7 @@ int cli_compare(int argc, char **argv)
         rc = cli_load_scene(a.scene, &scene);
     if (rc == RL_CLI_OK)
         cli_debug("timing: load %.1f ms", rl_timer_ms(&phase));
+    a.sampling.model = cli_is_model_file(a.scene);
     if (rc == RL_CLI_OK && !eval_sampling_finish(&a.sampling, scene))
         rc = RL_CLI_USAGE;
     if (rc == RL_CLI_OK)

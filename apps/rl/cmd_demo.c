@@ -1,6 +1,12 @@
 /* cmd_demo.c: `rl demo`: every built-in scene with every renderer, one PNG
  * each, plus DIR/report.json (machine, date, scene and render statistics per
  * image) and DIR/index.html (the same, as a page). `make demo` runs it.
+ * --scenes also takes the user's own model files and JSON scenes, named by
+ * their file stem.
+ *
+ * Every image is marked exact or approximate and carries its error (RMSE,
+ * SSIM) against the scene's reference: Whitted ray tracing at its defaults,
+ * the default reference of `rl compare`.
  *
  * Then a small `rl compare` (Jähn 2015's evaluation: every renderer at the
  * same adaptively sampled positions) of the first demo scene, or `table`
@@ -12,8 +18,10 @@
 #include "cli.h"
 
 #include <cjson/cJSON.h>
+#include <ctype.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 #include <time.h>
 
 static const char demo_help[] =
@@ -22,7 +30,10 @@ static const char demo_help[] =
     "Renders every built-in scene (rl scenes) with every renderer (rl algos)\n"
     "and writes DIR/<scene>-<algo>.png, DIR/report.json (command, build,\n"
     "machine, date and, per image, scene and render statistics) and\n"
-    "DIR/index.html (the images and their statistics on one page). Prints one\n"
+    "DIR/index.html (the images and their statistics on one page). Each image\n"
+    "is marked exact or approximate, with its RMSE and SSIM against the\n"
+    "scene's reference (whitted at its defaults). A model file without\n"
+    "cameras is framed from its default view. Prints one\n"
     "line per image; its times separate the one-time preparation (prep:\n"
     "sampled inputs, structures built for the scene) from the frame. Defaults that\n"
     "changed on purpose are drawn once more with the old value, and where that\n"
@@ -33,19 +44,41 @@ static const char demo_help[] =
     "options:\n"
     "  --out DIR       output folder, created if missing; default out/demo\n"
     "  --size WxH      resolution of every image; default 640x480\n"
-    "  --scenes a,b    only these built-in scenes (default parameters)\n"
+    "  --scenes a,b    only these scenes: built-in names (default parameters),\n"
+    "                  model files (model.obj:lights=add,cameras=off; a k=v item\n"
+    "                  after a comma continues the file's parameters) and JSON\n"
+    "                  scenes, named by their file stem\n"
     "  --algos a,b     only these renderers\n"
     "  --no-compare    skip the comparison\n"
     "\n"
     "example:\n"
     "  rl demo --out out/demo\n"
-    "  rl demo --out /tmp/quick --size 160x120 --scenes cornell,spheres\n";
+    "  rl demo --out /tmp/quick --size 160x120 --scenes cornell,spheres\n"
+    "  rl demo --out /tmp/duck --scenes duck.dae,spider.obj:lights=add\n";
+
+/* One scene of the demo, as --scenes named it. */
+typedef struct demo_scene {
+    char *arg;            /* "cornell", "model.obj:lights=add,cameras=off" */
+    char name[128];       /* the built-in's name or the file's stem: file names, page */
+    bool builtin;
+} demo_scene;
 
 typedef struct demo_args {
     const char *out, *scenes, *algos;
     int width, height;
     bool no_compare;
+    demo_scene *list;     /* the scenes to render, in order */
+    size_t count;
 } demo_args;
+
+static void free_args(demo_args *a)
+{
+    for (size_t i = 0; i < a->count; i++)
+        free(a->list[i].arg);
+    free(a->list);
+    a->list = NULL;
+    a->count = 0;
+}
 
 /* True when name is an item of the comma-separated list (NULL = all). */
 static bool in_list(const char *list, const char *name)
@@ -91,6 +124,132 @@ static bool check_list(const char *option, const char *list, const char *const *
     return true;
 }
 
+/* The page and the file names take a file's stem; characters that a file
+ * name or a shell could trip over become '_'. */
+static void stem_of(const char *path, char *out, size_t size)
+{
+    const char *base = strrchr(path, '/');
+    base = base ? base + 1 : path;
+    const char *dot = strrchr(base, '.');
+    size_t n = dot && dot != base ? (size_t)(dot - base) : strlen(base);
+    if (n >= size)
+        n = size - 1;
+    for (size_t i = 0; i < n; i++) {
+        unsigned char c = (unsigned char)base[i];
+        out[i] = isalnum(c) || c == '-' || c == '_' || c == '+' || c == '.' ? (char)c : '_';
+    }
+    out[n] = '\0';
+}
+
+static bool name_taken(const demo_args *a, const char *name)
+{
+    for (size_t i = 0; i < a->count; i++)
+        if (strcmp(a->list[i].name, name) == 0)
+            return true;
+    return false;
+}
+
+/* Adds one scene of --scenes: a built-in name, or an existing file (model or
+ * JSON scene, with its parameters after a colon). Repeats are dropped;
+ * two files with one stem (Wuson.obj, Wuson.ply) get "-2", "-3". */
+static int add_scene(demo_args *a, const char *arg)
+{
+    for (size_t i = 0; i < a->count; i++)
+        if (strcmp(a->list[i].arg, arg) == 0)
+            return RL_CLI_OK;
+    char *source = NULL, *params = NULL;
+    if (!cli_split_source(arg, &source, &params))
+        return cli_fail(RL_CLI_FAIL, "out of memory");
+    struct stat st;
+    demo_scene sc = { .builtin = cli_is_builtin(source) };
+    int rc = RL_CLI_OK;
+    if (sc.builtin && params)
+        rc = cli_fail(RL_CLI_USAGE, "--scenes: '%s': built-in scenes take their default parameters here", arg);
+    else if (!sc.builtin && stat(source, &st) != 0) {
+        /* Neither a file nor a built-in: most likely a typo of a built-in. */
+        size_t ns = 0;
+        const rl_builtin_info *builtins = rl_builtin_scenes(&ns);
+        rl_suggestion sg = { 0 };
+        for (size_t i = 0; i < ns; i++)
+            rl_suggest(&sg, source, builtins[i].name);
+        if (sg.name)
+            rc = cli_fail(RL_CLI_USAGE, "--scenes: unknown name '%s' (did you mean '%s'?)", source, sg.name);
+        else
+            rc = cli_fail(RL_CLI_USAGE, "--scenes: unknown name '%s' (neither a built-in scene nor a file)", source);
+    }
+    if (rc == RL_CLI_OK) {
+        if (sc.builtin)
+            snprintf(sc.name, sizeof sc.name, "%s", source);
+        else {
+            char stem[100];
+            stem_of(source, stem, sizeof stem);
+            snprintf(sc.name, sizeof sc.name, "%s", stem);
+            for (int k = 2; name_taken(a, sc.name) && k < 1000; k++)
+                snprintf(sc.name, sizeof sc.name, "%s-%d", stem, k);
+        }
+        demo_scene *grown = realloc(a->list, (a->count + 1) * sizeof *grown);
+        sc.arg = strdup(arg);
+        if (!grown || !sc.arg) {
+            free(sc.arg);
+            if (grown)
+                a->list = grown;
+            rc = cli_fail(RL_CLI_FAIL, "out of memory");
+        } else {
+            a->list = grown;
+            a->list[a->count++] = sc;
+        }
+    }
+    free(source);
+    free(params);
+    return rc;
+}
+
+/* --scenes, item by item. A model file's parameters are separated by
+ * commas too: an item with '=' but no ':' continues the item before it
+ * ("spider.obj:lights=add,cameras=off"), as rl compare's --algos does. */
+static int collect_scenes(demo_args *a)
+{
+    size_t ns = 0;
+    const rl_builtin_info *builtins = rl_builtin_scenes(&ns);
+    if (!a->scenes) {
+        for (size_t i = 0; i < ns; i++) {
+            int rc = add_scene(a, builtins[i].name);
+            if (rc != RL_CLI_OK)
+                return rc;
+        }
+        return RL_CLI_OK;
+    }
+    size_t len = strlen(a->scenes);
+    char *item = malloc(len + 1);
+    if (!item)
+        return cli_fail(RL_CLI_FAIL, "out of memory");
+    int rc = RL_CLI_OK;
+    size_t n = 0;                  /* characters of the item being joined */
+    for (const char *p = a->scenes; rc == RL_CLI_OK && *p;) {
+        const char *end = strchr(p, ',');
+        size_t m = end ? (size_t)(end - p) : strlen(p);
+        bool continues = n > 0 && memchr(p, '=', m) && !memchr(p, ':', m);
+        if (n > 0 && !continues) {
+            item[n] = '\0';
+            rc = add_scene(a, item);
+            n = 0;
+        }
+        if (continues)
+            item[n++] = ',';
+        memcpy(item + n, p, m);
+        n += m;
+        p = end ? end + 1 : p + m;
+    }
+    if (rc == RL_CLI_OK && n > 0) {
+        item[n] = '\0';
+        rc = add_scene(a, item);
+    }
+    free(item);
+    if (rc == RL_CLI_OK && a->count == 0)
+        rc = cli_fail(RL_CLI_USAGE, "--scenes: no scene given");
+    return rc;
+}
+
 static int parse_args(int argc, char **argv, demo_args *a)
 {
     for (int i = 1; i < argc; i++) {
@@ -118,20 +277,16 @@ static int parse_args(int argc, char **argv, demo_args *a)
         if (m < 0)
             return RL_CLI_USAGE;
     }
-    size_t ns = 0, nr = 0;
-    const rl_builtin_info *scenes = rl_builtin_scenes(&ns);
+    size_t nr = 0;
     const rl_renderer_info *algos = rl_renderer_list(&nr);
-    const char **names = calloc(ns + nr + 1, sizeof *names);
+    const char **names = calloc(nr + 1, sizeof *names);
     if (!names)
         return cli_fail(RL_CLI_FAIL, "out of memory");
-    for (size_t i = 0; i < ns; i++)
-        names[i] = scenes[i].name;
     for (size_t i = 0; i < nr; i++)
-        names[ns + i] = algos[i].name;
-    bool ok = (!a->scenes || check_list("--scenes", a->scenes, names, ns)) &&
-              (!a->algos || check_list("--algos", a->algos, names + ns, nr));
+        names[i] = algos[i].name;
+    bool ok = !a->algos || check_list("--algos", a->algos, names, nr);
     free(names);
-    return ok ? RL_CLI_OK : RL_CLI_USAGE;
+    return ok ? collect_scenes(a) : RL_CLI_USAGE;
 }
 
 static void add_failure(cJSON *failures, const char *scene, const char *algo)
@@ -147,9 +302,10 @@ static void add_failure(cJSON *failures, const char *scene, const char *algo)
 
 /* Renders scene with one renderer into DIR/<scene>-<algo>.png and appends
  * the entry to images; returns false (error printed) on failure. keep (may
- * be NULL) receives the image. */
+ * be NULL) receives the image, entry (may be NULL) the entry. */
 static bool render_one(const demo_args *a, const char *scene_name, const rl_scene *scene,
-                       const rl_camera *cam, const char *algo, cJSON *images, rl_image **keep)
+                       const rl_camera *cam, const char *algo, cJSON *images, rl_image **keep,
+                       cJSON **entry)
 {
     char file[512], path[4096];
     snprintf(file, sizeof file, "%s-%s.png", scene_name, algo);
@@ -202,6 +358,8 @@ static bool render_one(const demo_args *a, const char *scene_name, const rl_scen
             if (rs)
                 cJSON_AddItemToObject(e, "render_stats", rs);
             cJSON_AddItemToArray(images, e);
+            if (entry)
+                *entry = e;
         }
     } else {
         char what[600];
@@ -293,6 +451,96 @@ static bool render_change(const demo_args *a, const char *scene_name, const rl_s
     return st == RL_OK;
 }
 
+/* The scene's reference: Whitted ray tracing at its defaults, the default
+ * reference of rl compare (every image of the demo uses its renderer's
+ * defaults). The renderers compute different things (pt global
+ * illumination, raster local lighting only), so an image's error says
+ * how far it is from the reference, and its note why. */
+static const char demo_reference[] = "whitted";
+
+/* Where each renderer's image differs from the reference's, for the page. */
+static const struct {
+    const char *algo, *note;
+} demo_notes[] = {
+    { "raster", "local Phong lighting: no shadows, reflection or refraction" },
+    { "whitted", "the reference" },
+    { "vt", "the VT objects (mirrors, glass) traced at adaptively refined vertices and interpolated, "
+            "the rest as raster" },
+    { "pt", "path tracing, 1 path per pixel: noise, and indirect light the reference lacks" },
+    { "chcpp", "raster's image: occlusion culling is exact" },
+    { "svs", "raster's image without the objects its sampled visibility misses" },
+    { "visset", "raster's image without the objects its sampled visible sets miss" },
+    { "surfels", "raster's image with distant parts drawn as surfels" },
+    { "select", "chcpp's or svs's image, chosen per position" },
+};
+
+static const char *demo_note(const char *algo)
+{
+    for (size_t i = 0; i < sizeof demo_notes / sizeof demo_notes[0]; i++)
+        if (strcmp(demo_notes[i].algo, algo) == 0)
+            return demo_notes[i].note;
+    return "";
+}
+
+/* The reference image when the reference renderer is not among --algos;
+ * NULL (a warning, no error values on the page) when it fails. */
+static rl_image *render_reference(const rl_scene *scene, const rl_camera *cam, const char *scene_name)
+{
+    rl_renderer *r = NULL;
+    rl_image *img = NULL;
+    rl_render_stats stats = { 0 };
+    rl_clear_error();
+    rl_status st = rl_renderer_create(demo_reference, &r);
+    if (st == RL_OK)
+        st = rl_image_create(cam->width, cam->height, RL_LAYER_COLOR, &img);
+    if (st == RL_OK)
+        st = rl_renderer_render(r, scene, cam, img, &stats);
+    rl_renderer_release(r);
+    if (st != RL_OK) {
+        fprintf(stderr, "rl: warning: %s: the reference (%s) failed, images go without their error: %s\n",
+                scene_name, demo_reference, *rl_last_error() ? rl_last_error() : rl_status_string(st));
+        rl_image_release(img);
+        return NULL;
+    }
+    return img;
+}
+
+/* Marks entry exact or approximate, with its error against ref (may be
+ * NULL: no error values). Exact: the reference itself, or an image equal
+ * to it; everything else approximates it. */
+static void add_accuracy(cJSON *entry, const char *algo, const rl_image *img, const rl_image *ref)
+{
+    rl_image_metrics m = { 0 };
+    bool measured = ref && rl_image_compare(img, ref, NULL, &m) == RL_OK;
+    bool exact = strcmp(algo, demo_reference) == 0 || (measured && m.max_abs == 0.0);
+    cJSON_AddStringToObject(entry, "accuracy", exact ? "exact" : "approximate");
+    cJSON_AddStringToObject(entry, "note", demo_note(algo));
+    cJSON *err = cJSON_AddObjectToObject(entry, "error");
+    if (!err)
+        return;
+    cJSON_AddStringToObject(err, "reference", demo_reference);
+    if (measured) {
+        cJSON_AddNumberToObject(err, "rmse", m.rmse);
+        cJSON_AddNumberToObject(err, "ssim", m.ssim);
+        cJSON_AddNumberToObject(err, "max_abs", m.max_abs);
+    }
+}
+
+/* The camera of a demo image. A built-in scene's own; a file's first
+ * camera, or, without one, the tight framing of the model from its default
+ * view at the demo's size (a fit for another aspect would crop or pad). */
+static rl_status demo_camera(const demo_args *a, const demo_scene *sc, const rl_scene *scene, rl_camera *cam)
+{
+    const rl_scene_data *sd = rl_scene_get_data(scene);
+    if (!sc->builtin && sd && sd->num_cameras == 0)
+        return rl_scene_fit_camera(scene, a->width, a->height, cam);
+    rl_status st = rl_scene_get_camera(scene, NULL, cam);
+    /* Same size for every image so the grid compares like with like. */
+    cam->width = a->width;
+    cam->height = a->height;
+    return st;
+}
+
 static int run_demo(const demo_args *a, cJSON *report)
 {
     cJSON *images = cJSON_AddArrayToObject(report, "images");
@@ -300,39 +548,57 @@ static int run_demo(const demo_args *a, cJSON *report)
     cJSON *changed = cJSON_AddArrayToObject(report, "changes");
     if (!images || !failures || !changed)
         return cli_fail(RL_CLI_FAIL, "out of memory");
-    size_t ns = 0, nr = 0;
-    const rl_builtin_info *scenes = rl_builtin_scenes(&ns);
+    size_t nr = 0;
     const rl_renderer_info *algos = rl_renderer_list(&nr);
+    /* A scene's images stay until its reference is there (whitted comes
+     * after raster): at most one image per renderer at the demo's size. */
+    rl_image **row = calloc(nr ? nr : 1, sizeof *row);
+    cJSON **entries = calloc(nr ? nr : 1, sizeof *entries);
+    if (!row || !entries) {
+        free(row);
+        free(entries);
+        return cli_fail(RL_CLI_FAIL, "out of memory");
+    }
     int rc = RL_CLI_OK;
-    for (size_t s = 0; s < ns; s++) {
-        const char *name = scenes[s].name;
-        if (!in_list(a->scenes, name))
-            continue;
+    cJSON *listed = cJSON_AddArrayToObject(report, "scenes");
+    for (size_t s = 0; s < a->count; s++) {
+        const demo_scene *sc = &a->list[s];
+        const char *name = sc->name;
+        cJSON *item = cJSON_CreateObject();
+        if (item) {
+            cJSON_AddStringToObject(item, "name", name);
+            cJSON_AddStringToObject(item, "source", sc->arg);
+            cJSON_AddBoolToObject(item, "builtin", sc->builtin);
+            cJSON_AddItemToArray(listed, item);
+        }
         rl_scene *scene = NULL;
         rl_camera cam;
         rl_timer phase;
         rl_clear_error();
         rl_timer_start(&phase);
-        rl_status st = rl_scene_create_builtin(name, NULL, &scene);
+        rl_status st = RL_OK;
+        if (sc->builtin)
+            st = rl_scene_create_builtin(name, NULL, &scene);
+        else if (cli_load_scene(sc->arg, &scene) != RL_CLI_OK)
+            st = RL_ERR_IO;   /* printed by cli_load_scene */
         if (st == RL_OK)
             cli_debug("timing: %s: load %.1f ms", name, rl_timer_ms(&phase));
         if (st == RL_OK)
-            st = rl_scene_get_camera(scene, NULL, &cam);
+            st = demo_camera(a, sc, scene, &cam);
         if (st != RL_OK) {
-            cli_fail_status(RL_CLI_FAIL, st, name);
+            if (sc->builtin || scene)
+                cli_fail_status(RL_CLI_FAIL, st, name);
             add_failure(failures, name, NULL);
             rl_scene_release(scene);
             rc = RL_CLI_FAIL;
             continue;
         }
-        /* Same size for every image so the grid compares like with like. */
-        cam.width = a->width;
-        cam.height = a->height;
+        rl_image *ref = NULL;
         for (size_t k = 0; k < nr; k++) {
             if (!in_list(a->algos, algos[k].name))
                 continue;
             rl_image *now = NULL;
-            if (!render_one(a, name, scene, &cam, algos[k].name, images, &now)) {
+            if (!render_one(a, name, scene, &cam, algos[k].name, images, &now, &entries[k])) {
                 add_failure(failures, name, algos[k].name);
                 rc = RL_CLI_FAIL;
             }
@@ -342,10 +608,27 @@ static int run_demo(const demo_args *a, cJSON *report)
                     add_failure(failures, name, algos[k].name);
                     rc = RL_CLI_FAIL;
                 }
-            rl_image_release(now);
+            row[k] = now;
+            if (now && strcmp(algos[k].name, demo_reference) == 0)
+                ref = now;
         }
+        bool own_ref = !ref && !in_list(a->algos, demo_reference);
+        if (own_ref)
+            ref = render_reference(scene, &cam, name);
+        for (size_t k = 0; k < nr; k++)
+            if (row[k] && entries[k])
+                add_accuracy(entries[k], algos[k].name, row[k], ref);
+        for (size_t k = 0; k < nr; k++) {   /* ref may be one of them */
+            rl_image_release(row[k]);
+            row[k] = NULL;
+            entries[k] = NULL;
+        }
+        if (own_ref)
+            rl_image_release(ref);
         rl_scene_release(scene);
     }
+    free(row);
+    free(entries);
     return rc;
 }
 
@@ -353,12 +636,9 @@ static int run_demo(const demo_args *a, cJSON *report)
  * one scene, tiny images, one timed render per direction. */
 static int run_compare(const demo_args *a)
 {
-    char scene[256] = "table", algos[1024] = "", out[4096];
-    if (a->scenes) {
-        const char *end = strchr(a->scenes, ',');
-        snprintf(scene, sizeof scene, "%.*s", end ? (int)(end - a->scenes) : (int)strlen(a->scenes),
-                 a->scenes);
-    }
+    char scene[4096] = "table", algos[1024] = "", out[4096];
+    if (a->scenes && a->count > 0)
+        snprintf(scene, sizeof scene, "%s", a->list[0].arg);
     size_t nr = 0;
     const rl_renderer_info *info = rl_renderer_list(&nr);
     for (size_t k = 0; k < nr; k++)
@@ -378,17 +658,22 @@ int cli_demo(int argc, char **argv)
 {
     demo_args a = { .out = "out/demo", .width = 640, .height = 480 };
     int rc = parse_args(argc, argv, &a);
-    if (rc != RL_CLI_OK)
+    if (rc != RL_CLI_OK) {
+        free_args(&a);
         return rc < 0 ? RL_CLI_OK : rc;
+    }
     char probe[4096];
+    cJSON *report = NULL;
     if ((size_t)snprintf(probe, sizeof probe, "%s/report.json", a.out) >= sizeof probe)
-        return cli_fail(RL_CLI_USAGE, "--out: path too long");
-    if (!cli_make_dirs(a.out) || !cli_check_writable(probe))
-        return RL_CLI_FAIL;
-
-    cJSON *report = cJSON_CreateObject();
-    if (!report)
-        return cli_fail(RL_CLI_FAIL, "out of memory");
+        rc = cli_fail(RL_CLI_USAGE, "--out: path too long");
+    else if (!cli_make_dirs(a.out) || !cli_check_writable(probe))
+        rc = RL_CLI_FAIL;
+    else if (!(report = cJSON_CreateObject()))
+        rc = cli_fail(RL_CLI_FAIL, "out of memory");
+    if (rc != RL_CLI_OK) {
+        free_args(&a);
+        return rc;
+    }
     char date[64];
     time_t now = time(NULL);
     struct tm tm;
@@ -404,6 +689,7 @@ int cli_demo(int argc, char **argv)
         cJSON_AddItemToObject(report, "machine", machine);
     cJSON_AddNumberToObject(report, "width", a.width);
     cJSON_AddNumberToObject(report, "height", a.height);
+    cJSON_AddStringToObject(report, "reference", demo_reference);
 
     rc = run_demo(&a, report);
     if (!a.no_compare) {
@@ -420,5 +706,6 @@ int cli_demo(int argc, char **argv)
     else
         printf("report: %s, %s\n", probe, html);
     cJSON_Delete(report);
+    free_args(&a);
     return rc;
 }

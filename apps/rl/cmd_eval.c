@@ -473,6 +473,7 @@ int cli_eval(int argc, char **argv)
     if ((rc = cli_load_scene(a.scene, &scene)) != RL_CLI_OK)
         goto done;
     cli_debug("timing: load %.1f ms", rl_timer_ms(&phase));
+    a.sampling.model = cli_is_model_file(a.scene);
     if (!eval_sampling_finish(&a.sampling, scene)) {
         rc = RL_CLI_USAGE;
         goto done;

@@ -1,8 +1,10 @@
 /* demo_html.c: the demo's index.html, written from the same cJSON object as
- * report.json so that the page and the data cannot disagree. One table row
- * per scene, one column per renderer; each cell shows the image and its
- * numbers. Self-contained: inline CSS, no scripts, no external resources;
- * the images are the PNGs next to the page. */
+ * report.json so that the page and the data cannot disagree. One section
+ * per scene, a grid of cards in it, one per renderer: the image scaled to
+ * its card (linked to the full size), marked exact or approximate with its
+ * error against the reference, and its numbers. Self-contained: inline
+ * CSS, no scripts, no external resources; the images are the PNGs next to
+ * the page. */
 #include "cli.h"
 #include "html.h"
 
@@ -21,43 +23,101 @@ static double num(const cJSON *obj, const char *key)
     return cJSON_IsNumber(item) ? item->valuedouble : 0.0;
 }
 
-/* Column headers: renderer names in first-seen order. */
-static int collect_algos(const cJSON *images, const char **algos, int max)
+/* Renderer names in first-seen order: every scene's cards come in this
+ * order, so a renderer keeps its place from scene to scene. */
+static int collect_names(const cJSON *items, const char *key, const char **names, int max)
 {
     int n = 0;
     const cJSON *e;
-    cJSON_ArrayForEach(e, images) {
-        const char *a = str(e, "algorithm");
+    cJSON_ArrayForEach(e, items) {
+        const char *a = str(e, key);
         int k = 0;
-        while (k < n && strcmp(algos[k], a) != 0)
+        while (k < n && strcmp(names[k], a) != 0)
             k++;
         if (k == n && n < max)
-            algos[n++] = a;
+            names[n++] = a;
     }
     return n;
 }
 
-static void put_cell(FILE *f, const cJSON *e)
+static const cJSON *find_image(const cJSON *images, const char *scene, const char *algo)
+{
+    const cJSON *e;
+    cJSON_ArrayForEach(e, images)
+        if (strcmp(str(e, "scene"), scene) == 0 && strcmp(str(e, "algorithm"), algo) == 0)
+            return e;
+    return NULL;
+}
+
+/* One image as a card: the thumbnail links to the full image; its mark,
+ * its error against the reference, why it differs, and its numbers. */
+static void put_card(FILE *f, const cJSON *e)
 {
     const cJSON *rs = cJSON_GetObjectItemCaseSensitive(e, "render_stats");
-    const cJSON *ss = cJSON_GetObjectItemCaseSensitive(e, "scene_stats");
-    fputs("<td><a href=\"", f);
+    const cJSON *err = cJSON_GetObjectItemCaseSensitive(e, "error");
+    const char *mark = str(e, "accuracy");
+    fputs("<figure><a href=\"", f);
     html_put_escaped(f, str(e, "file"));
     fputs("\"><img src=\"", f);
     html_put_escaped(f, str(e, "file"));
     fputs("\" alt=\"", f);
     html_put_escaped(f, str(e, "file"));
+    fputs("\"></a><figcaption><b>", f);
+    html_put_escaped(f, str(e, "algorithm"));
+    fputs("</b> <span class=\"mark ", f);
+    html_put_escaped(f, mark);
+    fputs("\">", f);
+    html_put_escaped(f, *mark ? mark : "unmarked");
+    fputs("</span> ", f);
+    if (cJSON_GetObjectItemCaseSensitive(err, "rmse"))
+        fprintf(f, "RMSE %.4f &middot; SSIM %.4f", num(err, "rmse"), num(err, "ssim"));
+    else
+        fputs("error: no reference image", f);
+    fputs("<br><span class=\"s\">", f);
+    html_put_escaped(f, str(e, "note"));
     /* Preparation apart from the frame: one-time work is not a frame's cost. */
-    fprintf(f, "\"></a><br>prep %.1f ms &middot; frame %.1f ms", num(rs, "prep_ms"), num(rs, "frame_ms"));
+    fprintf(f, "</span><br>prep %.1f ms &middot; frame %.1f ms", num(rs, "prep_ms"), num(rs, "frame_ms"));
     if (num(rs, "triangles_rasterized") > 0)
         fprintf(f, " &middot; %.0f triangles rasterized", num(rs, "triangles_rasterized"));
     fprintf(f, " &middot; %.0f pixels written", num(rs, "pixels_written"));
     if (num(rs, "rays_total") > 0)
         fprintf(f, " &middot; %.0f rays", num(rs, "rays_total"));
+    fputs("</figcaption></figure>\n", f);
+}
+
+/* A scene: heading, what it is, then a grid of cards that wraps to the
+ * screen's width (the one-row-per-scene table was about 4,600 px wide). */
+static void put_scene(FILE *f, const cJSON *report, const char *scene, const char *const *algos, int num_algos)
+{
+    const cJSON *images = cJSON_GetObjectItemCaseSensitive(report, "images");
+    const cJSON *first = NULL, *e;
+    cJSON_ArrayForEach(e, images)
+        if (!first && strcmp(str(e, "scene"), scene) == 0)
+            first = e;
+    fputs("<h2>", f);
+    html_put_escaped(f, scene);
+    fputs("</h2>\n<p class=\"s\">", f);
+    cJSON_ArrayForEach(e, cJSON_GetObjectItemCaseSensitive(report, "scenes"))
+        if (strcmp(str(e, "name"), scene) == 0 && !cJSON_IsTrue(cJSON_GetObjectItemCaseSensitive(e, "builtin"))) {
+            fputs("file: <code>", f);
+            html_put_escaped(f, str(e, "source"));
+            fputs("</code> &middot; ", f);
+        }
+    const cJSON *ss = cJSON_GetObjectItemCaseSensitive(first, "scene_stats");
     double lights = num(ss, "lights");
-    fprintf(f, "<br><span class=\"s\">scene: %.0f triangles, %.0f objects, %.0f light%s</span>",
-            num(ss, "triangles"), num(ss, "objects"), lights, lights == 1.0 ? "" : "s");
-    fputs("</td>", f);
+    fprintf(f, "%.0f triangles, %.0f objects, %.0f light%s</p>\n<div class=\"grid\">\n", num(ss, "triangles"),
+            num(ss, "objects"), lights, lights == 1.0 ? "" : "s");
+    for (int k = 0; k < num_algos; k++) {
+        const cJSON *img = find_image(images, scene, algos[k]);
+        if (img)
+            put_card(f, img);
+        else {
+            fputs("<figure class=\"failed\"><figcaption><b>", f);
+            html_put_escaped(f, algos[k]);
+            fputs("</b> failed (see failures)</figcaption></figure>\n", f);
+        }
+    }
+    fputs("</div>\n", f);
 }
 
 bool cli_write_demo_html(const cJSON *report, const char *path)
@@ -70,15 +130,24 @@ bool cli_write_demo_html(const cJSON *report, const char *path)
     const cJSON *images = cJSON_GetObjectItemCaseSensitive(report, "images");
     const cJSON *failures = cJSON_GetObjectItemCaseSensitive(report, "failures");
     const cJSON *machine = cJSON_GetObjectItemCaseSensitive(report, "machine");
-    const char *algos[64];
-    int num_algos = collect_algos(images, algos, 64);
+    const char *algos[64], *scenes[256];
+    int num_algos = collect_names(images, "algorithm", algos, 64);
+    int num_scenes = collect_names(images, "scene", scenes, 256);
 
+    /* No fixed width: images shrink to their card, cards wrap, the
+     * comparison table shares the page's width. */
     fputs("<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\">\n"
+          "<meta name=\"viewport\" content=\"width=device-width\">\n"
           "<title>renderlab demo</title>\n<style>\n"
           "body{font-family:sans-serif;margin:2em;color:#222}\n"
-          "table{border-collapse:collapse}td,th{border:1px solid #ccc;padding:.5em;"
-          "vertical-align:top;font-size:.85em}\n"
-          "img{max-width:480px;display:block;image-rendering:pixelated}\n"
+          ".grid{display:grid;grid-template-columns:repeat(auto-fill,minmax(300px,1fr));gap:1em}\n"
+          "figure{margin:0;border:1px solid #ccc;padding:.5em;font-size:.85em}\n"
+          "figcaption{margin-top:.4em}\n"
+          "img{max-width:100%;height:auto;display:block}\n"
+          ".mark{padding:0 .4em;border-radius:.3em;font-weight:bold}\n"
+          ".exact{background:#cfeccf}.approximate{background:#f7e2b5}\n"
+          "table{border-collapse:collapse;width:100%;table-layout:fixed}td,th{border:1px solid #ccc;"
+          "padding:.5em;vertical-align:top;font-size:.85em}\n"
           ".s{color:#666}\n</style></head><body>\n<h1>renderlab demo</h1>\n<p>",
           f);
     fputs("renderlab ", f);
@@ -95,41 +164,16 @@ bool cli_write_demo_html(const cJSON *report, const char *path)
     html_put_escaped(f, str(report, "command"));
     fputs("</code><br>Times: <em>prep</em> is the one-time preparation of a renderer for the scene "
           "(sampled inputs, acceleration structures, octrees, surfels, visible sets), <em>frame</em> the "
-          "rest of the first frame.</p>\n", f);
+          "rest of the first frame.<br>Marks: <span class=\"mark exact\">exact</span> is the scene's "
+          "reference, ", f);
+    html_put_escaped(f, str(report, "reference"));
+    fputs(" at its defaults, or an image equal to it; <span class=\"mark approximate\">approximate</span> "
+          "any other. The error of each image is against the reference: RMSE of the sRGB values in [0, 1] "
+          "and SSIM on luma (Wang et al. 2004). Click an image for its full size.</p>\n", f);
 
-    fputs("<table>\n<tr><th>scene</th>", f);
-    for (int k = 0; k < num_algos; k++) {
-        fputs("<th>", f);
-        html_put_escaped(f, algos[k]);
-        fputs("</th>", f);
-    }
-    fputs("</tr>\n", f);
-    /* Images come scene by scene; a new scene starts a new row and every
-     * renderer keeps its column even when one of them failed. */
-    const char *row = NULL;
-    int col = 0;
+    for (int i = 0; i < num_scenes; i++)
+        put_scene(f, report, scenes[i], algos, num_algos);
     const cJSON *e;
-    cJSON_ArrayForEach(e, images) {
-        const char *scene = str(e, "scene");
-        if (!row || strcmp(row, scene) != 0) {
-            if (row)
-                fputs("</tr>\n", f);
-            fputs("<tr><th>", f);
-            html_put_escaped(f, scene);
-            fputs("</th>", f);
-            row = scene;
-            col = 0;
-        }
-        while (col < num_algos && strcmp(algos[col], str(e, "algorithm")) != 0) {
-            fputs("<td></td>", f);
-            col++;
-        }
-        put_cell(f, e);
-        col++;
-    }
-    if (row)
-        fputs("</tr>\n", f);
-    fputs("</table>\n", f);
     if (cJSON_GetArraySize(failures) > 0) {
         fputs("<h2>failures</h2>\n<ul>\n", f);
         cJSON_ArrayForEach(e, failures) {

@@ -13,8 +13,11 @@ const char eval_sampling_help[] =
     "sampling (Jähn 2015, Ch. 5):\n"
     "  --dims 2|3          2: the horizontal slice y = --height (default);\n"
     "                      3: the whole region\n"
-    "  --region x0,y0,z0,x1,y1,z1   default: the scene's bounds\n"
+    "  --region x0,y0,z0,x1,y1,z1   default: the scene's bounds; for a model\n"
+    "                      file a box outside it, on the side of its default\n"
+    "                      view, holding that view's orbit (docs/evaluation.md)\n"
     "  --height H          slice height; default the middle of the region's y\n"
+    "                      (a model file: the default view's eye, above the model)\n"
     "  --method M          adaptive (Alg. 5.3, default) or grid (Alg. 5.2)\n"
     "  --positions P       bn (default), bn-corners, random or grid: how an\n"
     "                      adaptive region chooses its samples (Sec. 5.4.2)\n"
@@ -220,23 +223,76 @@ int eval_sampling_arg(int argc, char **argv, int *i, eval_sampling *s)
     return 1;
 }
 
+/* A model file is one object seen from outside: its bounds, the default
+ * region of a built-in scene (a room, a city: spaces to stand in), would
+ * place nearly every position inside the model, where all one sees is its
+ * back faces. The region should hold the positions a viewer of a model
+ * takes: around it, at about the distance of its default view. A shell or
+ * ring at that distance would be the natural shape, but the sampler
+ * (rl_sampling.h) splits axis-aligned boxes and 2-D slices, and a box
+ * around the shell holds the model again. So the box is moved out of the
+ * model's bounds instead, to the side the default view
+ * (rl_scene_fit_camera, with the model file's azimuth and elevation)
+ * looks from, above for the default 20° elevation:
+ *   x, z: the square of the orbit of the framing camera, the model's
+ *         centre +- D (D the framing camera's distance from the centre),
+ *         so every azimuth of that orbit, at every distance up to D, is in;
+ *   y:    from the eye of the framing camera, or a margin (5 % of D) past
+ *         the model's top when the eye is lower, to the orbit's top
+ *         (centre + D).
+ * The 2-D slice lies on the side facing the model: the default view's
+ * height, from its orbit inwards to right above the model. No position is
+ * inside the model's bounds, and each one sees the model: the properties
+ * look along the six main directions with 120° frusta (property_render.c,
+ * property_visibility.c), which overlap and cover the whole sphere. */
+bool eval_model_region(const rl_scene *scene, rl_aabb *region, float *height)
+{
+    const rl_scene_data *sd = rl_scene_get_data(scene);
+    rl_camera cam;
+    /* Square: the six views are square, and the fit depends on the aspect. */
+    if (!sd || rl_scene_fit_camera(scene, 256, 256, &cam) != RL_OK)
+        return false;
+    rl_aabb b = sd->bounds;
+    rl_vec3 c = rl_aabb_center(b);
+    float orbit = rl_length(rl_sub(cam.eye, c));
+    if (!(orbit > 0.0f) || !isfinite(orbit))
+        return false;
+    float margin = 0.05f * orbit;
+    bool above = cam.eye.y >= c.y;
+    float near = above ? fmaxf(cam.eye.y, b.max.y + margin) : fminf(cam.eye.y, b.min.y - margin);
+    float far = above ? fmaxf(c.y + orbit, near + margin) : fminf(c.y - orbit, near - margin);
+    region->min = rl_v3(fminf(c.x - orbit, b.min.x - margin), fminf(near, far), fminf(c.z - orbit, b.min.z - margin));
+    region->max = rl_v3(fmaxf(c.x + orbit, b.max.x + margin), fmaxf(near, far), fmaxf(c.z + orbit, b.max.z + margin));
+    *height = near;
+    return true;
+}
+
 bool eval_sampling_finish(eval_sampling *s, const rl_scene *scene)
 {
     rl_sampling_desc *d = &s->desc;
     const rl_scene_data *sd = rl_scene_get_data(scene);
     rl_aabb b = sd->bounds;
-    if (!s->has_region)
+    float model_height = 0.0f;
+    bool around = s->model && !s->has_region;
+    if (around && !eval_model_region(scene, &d->region, &model_height)) {
+        cli_fail(RL_CLI_FAIL, "no default region around the model: it cannot be framed");
+        return false;
+    }
+    if (!s->has_region && !around)
         d->region = b;
-    else if (d->region.max.x < b.min.x || d->region.min.x > b.max.x ||
-             d->region.max.z < b.min.z || d->region.min.z > b.max.z ||
-             (d->dims == 3 && (d->region.max.y < b.min.y || d->region.min.y > b.max.y))) {
+    /* A region of the user's beside a model, not overlapping it, is a fair
+     * choice: a model is seen from outside. */
+    else if (s->has_region && !s->model &&
+             (d->region.max.x < b.min.x || d->region.min.x > b.max.x ||
+              d->region.max.z < b.min.z || d->region.min.z > b.max.z ||
+              (d->dims == 3 && (d->region.max.y < b.min.y || d->region.min.y > b.max.y)))) {
         cli_fail(RL_CLI_USAGE, "--region does not overlap the scene (bounds %g,%g,%g .. %g,%g,%g)",
                     b.min.x, b.min.y, b.min.z, b.max.x, b.max.y, b.max.z);
         return false;
     }
     if (!s->has_height)
-        d->height = 0.5f * (d->region.min.y + d->region.max.y);
-    else if (d->dims == 2 && (d->height < b.min.y || d->height > b.max.y)) {
+        d->height = around ? model_height : 0.5f * (d->region.min.y + d->region.max.y);
+    else if (d->dims == 2 && !s->model && (d->height < b.min.y || d->height > b.max.y)) {
         cli_fail(RL_CLI_USAGE, "--height %g is outside the scene's y range [%g, %g]", d->height,
                     b.min.y, b.max.y);
         return false;

@@ -16,6 +16,7 @@ struct cJSON;
 typedef struct eval_sampling {
     rl_sampling_desc desc;
     bool has_region, has_height, has_min_side;
+    bool model;          /* a model file (cli_is_model_file): default region around it */
 } eval_sampling;
 
 /* The help lines of the shared options. */
@@ -26,12 +27,20 @@ void eval_sampling_init(eval_sampling *s);
 /* Takes one sampling option at argv[*i]: 1 taken (and *i advanced past its
  * value), 0 not a sampling option, -1 bad value (error printed). */
 int eval_sampling_arg(int argc, char **argv, int *i, eval_sampling *s);
-/* Fills what depends on the scene: the region (its bounds), the slice
- * height (the middle of the region's y extent), min_side (1 m, or 1/64 of
+/* Fills what depends on the scene: the region (its bounds; for a model,
+ * eval_model_region), the slice height (the middle of the region's y
+ * extent; for a model, the region's side facing it), min_side (1 m, or 1/64 of
  * the longest side when that is smaller, so that small scenes refine).
  * Prints the error and returns false for a region outside the scene or a
- * height outside the region. */
+ * height outside the region (neither is checked for a model, whose region
+ * lies outside it on purpose). */
 bool eval_sampling_finish(eval_sampling *s, const rl_scene *scene);
+
+/* The default region of a model: a box outside the model's bounds on the
+ * side of its default view, holding the framing camera's orbit in x and z
+ * (see eval_common.c for why). *height receives the 2-D slice: the side of
+ * the box that faces the model. False when the scene cannot be framed. */
+bool eval_model_region(const rl_scene *scene, rl_aabb *region, float *height);
 
 /* A near-orthographic view from high above of the region's x/z extent at
  * the slice height (raster renderer, flat shading), `width` pixels wide;

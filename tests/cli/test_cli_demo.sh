@@ -57,4 +57,28 @@ grep -q "Changed on purpose" "$DIR/index.html" || fail "index.html lacks the cha
 grep -q "processors" "$DIR/index.html" || fail "index.html lacks the machine"
 grep -q "prep [0-9.]* ms &middot; frame [0-9.]* ms" "$DIR/index.html" || fail "index.html lacks prep and frame"
 grep -q "command: <code>" "$DIR/index.html" || fail "index.html lacks the command line"
+# The page fits a screen (the old one-row-per-scene table was ~4,600 px
+# wide) and marks every image exact or approximate with its error against
+# the reference, as report.json does.
+python3 - "$DIR/index.html" "$DIR/report.json" <<'PY' || fail "index.html does not fit a screen or lacks the marks"
+import json, re, sys
+page = open(sys.argv[1]).read()
+r = json.load(open(sys.argv[2]))
+for m in re.finditer(r'(?:min-|max-)?width\s*[:=]\s*"?(\d+)(px)?', page):
+    assert m.group(0).startswith("max-") or int(m.group(1)) <= 1920, m.group(0)
+assert "<table" not in page.split("Changed on purpose")[0], "the images are still a table"
+cards = re.findall(r'<figure>(.*?)</figure>', page, re.S)
+assert len(cards) == len(r["images"]), (len(cards), len(r["images"]))
+for card in cards:
+    assert re.search(r'class="mark (exact|approximate)">(exact|approximate)</span> '
+                     r'RMSE [0-9.]+ &middot; SSIM -?[0-9.]+', card), card
+for e in r["images"]:
+    assert e["accuracy"] in ("exact", "approximate") and e["error"]["reference"] == "whitted", e
+    assert 0 <= e["error"]["rmse"] <= 1 and -1 <= e["error"]["ssim"] <= 1, e
+    # The reference is exact by definition; raster lacks its shadows.
+    if e["algorithm"] == "whitted":
+        assert e["accuracy"] == "exact" and e["error"]["rmse"] == 0, e
+    if e["algorithm"] == "raster":
+        assert e["accuracy"] == "approximate" and e["error"]["rmse"] > 0, e
+PY
 echo "ok"
