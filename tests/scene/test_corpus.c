@@ -272,6 +272,12 @@ static void test_corpus(void **state)
     read_expected();
 
     root_len = strlen(root);
+    /* Some of Assimp's importers leak (AMF: 1148 bytes per file); in a
+     * sanitizer build LeakSanitizer would turn that into exit 1, a "noload"
+     * that is not one. The renders leave leak checks to the other tests,
+     * which run our code on files we write (the stacks here are Assimp's,
+     * unsymbolised, so no suppression can single them out). */
+    setenv("ASAN_OPTIONS", "detect_leaks=0", 1);
     assert_int_equal(nftw(root, collect, 16, FTW_PHYS), 0);
     qsort(files, num_files, sizeof files[0], cmp_str);
     assert_true(num_files > 0);
