@@ -77,6 +77,9 @@
 
 #define TILE 16
 #define BUILD_SHARE 0.1
+/* The budget a caller without one spends (rl_renderer_info): measured in
+ * bench/README.md ("pt's default budget"). */
+#define PT_DEFAULT_TIME_S 10.0
 
 static const char *const rng_choices[] = { "lcg", "tausworthe", "hybrid", NULL };
 /* Order = rl_pt_backend. */
@@ -736,7 +739,7 @@ const rl_gbuffer *rl_pt_gbuffer(const rl_renderer *r)
 
 const rl_renderer_class rl_pt_renderer_class = {
     .info = { "pt", "Progressive path tracing with NEE, Russian roulette and Phong sampling; Line Space backends",
-              "Schröder 2017" },
+              "Schröder 2017", .progressive = true, .default_time_s = PT_DEFAULT_TIME_S },
     .options = pt_options,
     .num_options = NUM_OPTIONS,
     .state_size = sizeof(pt_state),
