@@ -6,6 +6,8 @@
  *   0  success
  *   1  failed input or output (scene file, camera, output path, render)
  *   2  bad usage (unknown subcommand/flag/algorithm/option, malformed value)
+ *   130  stopped by Ctrl-C (SIGINT), as a shell reports an interrupted
+ *      command; rl render has then saved what it had (its summary says so)
  * Every failure prints exactly one line "rl: error: <cause>" to stderr. */
 #ifndef RL_APP_CLI_H
 #define RL_APP_CLI_H
@@ -20,7 +22,7 @@
 #error "RL_CLI_VERSION must be defined by the build"
 #endif
 
-enum { RL_CLI_OK = 0, RL_CLI_FAIL = 1, RL_CLI_USAGE = 2 };
+enum { RL_CLI_OK = 0, RL_CLI_FAIL = 1, RL_CLI_USAGE = 2, RL_CLI_INTERRUPTED = 130 };
 
 /* Default resolution when neither --size nor the scene's camera gives one. */
 #define RL_CLI_DEFAULT_WIDTH 1280
@@ -72,6 +74,10 @@ bool cli_split_option(const char *what, const char *text, char *key, size_t key_
 bool cli_parse_size(const char *text, int *width, int *height);
 /* "x,y,z" of finite floats; prints the error itself (option names the flag). */
 bool cli_parse_vec3(const char *option, const char *text, rl_vec3 *out);
+/* A duration: a number with a unit ms, s, m or h ("500ms", "10s", "2m";
+ * a bare number is seconds), finite and >= 0, into seconds. Prints nothing:
+ * the caller names the flag and the range. */
+bool cli_parse_duration(const char *text, double *seconds);
 
 /* Extension check before any work: true when path ends in one of the
  * NULL-terminated extensions (".png", ".exr"), case-insensitively. */
@@ -134,6 +140,32 @@ bool cli_write_demo_html(const struct cJSON *report, const char *path);
  * frame 1.2 ms, ..." (prep and frame as in cli_render_stats_json). */
 void cli_print_summary(FILE *out, const char *algo, const char *scene, int width,
                           int height, const rl_render_stats *stats, double inputs_ms);
+
+/* How a progressive render loop (rl render --time, --spp) ended, for its
+ * summary: frames accumulated, mean samples per pixel, wall time of the
+ * frames, the budget it had and why it stopped. */
+typedef struct cli_accumulation {
+    long long frames;
+    double spp;
+    double elapsed_s;
+    double budget_s;           /* 0: none */
+    long long target_spp;      /* 0: none */
+    const char *stopped;       /* "time", "spp" or "interrupt" */
+} cli_accumulation;
+/* "pt 64x48 cornell: prep 1.0 ms, 12 frames, 12 spp in 0.29 s (time budget
+ * 0.3 s), frame 24.1 ms on average, ..." with the counters summed over the
+ * frames. */
+void cli_print_accumulation_summary(FILE *out, const char *algo, const char *scene, int width, int height,
+                                    const rl_render_stats *sum, double inputs_ms, const cli_accumulation *acc);
+
+/* interrupt.c: Ctrl-C during a render. begin installs a SIGINT handler
+ * that raises a flag and writes message (kept by pointer: a string
+ * literal) to stderr; the second Ctrl-C ends the process as usual. A SIGINT
+ * that the parent ignores stays ignored. end restores the previous
+ * handling. */
+void cli_interrupt_begin(const char *message);
+bool cli_interrupted(void);
+void cli_interrupt_end(void);
 
 /* cli_run.c: naming the experiment in every report. main() records the
  * command line (global flags included) before anything else. */

@@ -4,6 +4,7 @@
 
 #include <cjson/cJSON.h>
 #include <stdlib.h>
+#include <string.h>
 
 static cJSON *vec3_json(rl_vec3 v)
 {
@@ -133,13 +134,9 @@ bool cli_write_json(const cJSON *item, const char *path)
     return ok;
 }
 
-void cli_print_summary(FILE *out, const char *algo, const char *scene, int width,
-                          int height, const rl_render_stats *stats, double inputs_ms)
+/* The counters of a summary line, each only where it applies. */
+static void print_counters(FILE *out, const rl_render_stats *stats)
 {
-    char prep[32], frame[32];
-    cli_format_ms(inputs_ms + stats->prep_ms, prep, sizeof prep);
-    cli_format_ms(stats->time_ms - stats->prep_ms, frame, sizeof frame);
-    fprintf(out, "%s %dx%d %s: prep %s, frame %s", algo, width, height, scene, prep, frame);
     /* Rasterization counts only for the algorithms that rasterize. */
     if (stats->triangles_rasterized)
         fprintf(out, ", %llu triangles rasterized", (unsigned long long)stats->triangles_rasterized);
@@ -154,4 +151,34 @@ void cli_print_summary(FILE *out, const char *algo, const char *scene, int width
             fprintf(out, ", %llu %s rays", (unsigned long long)stats->rays[t],
                     rl_ray_type_name((rl_ray_type)t));
     fputc('\n', out);
+}
+
+void cli_print_summary(FILE *out, const char *algo, const char *scene, int width,
+                          int height, const rl_render_stats *stats, double inputs_ms)
+{
+    char prep[32], frame[32];
+    cli_format_ms(inputs_ms + stats->prep_ms, prep, sizeof prep);
+    cli_format_ms(stats->time_ms - stats->prep_ms, frame, sizeof frame);
+    fprintf(out, "%s %dx%d %s: prep %s, frame %s", algo, width, height, scene, prep, frame);
+    print_counters(out, stats);
+}
+
+void cli_print_accumulation_summary(FILE *out, const char *algo, const char *scene, int width, int height,
+                                    const rl_render_stats *sum, double inputs_ms, const cli_accumulation *acc)
+{
+    char prep[32], frame[32];
+    cli_format_ms(inputs_ms + sum->prep_ms, prep, sizeof prep);
+    double frames = acc->frames > 0 ? (double)acc->frames : 1.0;
+    cli_format_ms((sum->time_ms - sum->prep_ms) / frames, frame, sizeof frame);
+    fprintf(out, "%s %dx%d %s: prep %s, %lld frame%s, %.4g spp in %.3g s", algo, width, height, scene, prep,
+            acc->frames, acc->frames == 1 ? "" : "s", acc->spp, acc->elapsed_s);
+    /* Why it stopped, so that a short render is not mistaken for a budget. */
+    if (strcmp(acc->stopped, "interrupt") == 0)
+        fprintf(out, " (interrupted by Ctrl-C)");
+    else if (strcmp(acc->stopped, "spp") == 0)
+        fprintf(out, " (target %lld spp)", acc->target_spp);
+    else
+        fprintf(out, " (time budget %.3g s)", acc->budget_s);
+    fprintf(out, ", frame %s on average", frame);
+    print_counters(out, sum);
 }

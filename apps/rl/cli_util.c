@@ -97,6 +97,32 @@ int cli_unknown_arg(const char *command, const char *arg)
                        arg, command);
 }
 
+bool cli_parse_duration(const char *text, double *seconds)
+{
+    static const struct { const char *unit; double s; } units[] = {
+        { "ms", 1e-3 }, { "s", 1.0 }, { "m", 60.0 }, { "h", 3600.0 }, { "", 1.0 },
+    };
+    size_t len = strlen(text);
+    for (size_t k = 0; k < sizeof units / sizeof units[0]; k++) {
+        size_t n = strlen(units[k].unit);
+        if (len <= n || strcmp(text + len - n, units[k].unit) != 0)
+            continue;
+        char number[64];
+        if (len - n >= sizeof number)
+            return false;
+        memcpy(number, text, len - n);
+        number[len - n] = '\0';
+        double v;
+        /* The first unit that ends the text decides: "2m" is minutes, and
+         * "2ms" never reaches "s". */
+        if (!rl_parse_float(number, &v) || !isfinite(v) || v < 0.0)
+            return false;
+        *seconds = v * units[k].s;
+        return true;
+    }
+    return false;
+}
+
 bool cli_parse_size(const char *text, int *width, int *height)
 {
     const char *x = strpbrk(text, "xX");

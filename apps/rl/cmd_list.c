@@ -71,6 +71,9 @@ int cli_algos(int argc, char **argv)
         printf("%s: %s\n", list[i].name, list[i].description ? list[i].description : "");
         if (list[i].reference && *list[i].reference)
             printf("  reference: %s\n", list[i].reference);
+        if (list[i].progressive)
+            printf("  progressive: rl render adds frames until --time or --spp (default budget %g s)\n",
+                   list[i].default_time_s);
         rl_renderer *r = NULL;
         rl_clear_error();
         if (rl_renderer_create(list[i].name, &r) != RL_OK)

@@ -1,5 +1,8 @@
 /* cmd_render.c: `rl render SCENE --out FILE ...`: one frame of one scene
- * with one renderer, plus optional depth/ID layers and a stats file.
+ * with one renderer, plus optional depth/ID layers and a stats file. A
+ * progressive renderer (pt) renders frames into its accumulation until a
+ * time budget or a sample count is reached, writes previews to --out on the
+ * way, and on Ctrl-C saves what it has.
  *
  * Everything that can be checked without rendering is checked first, in the
  * order of cost: arguments and sizes (exit 2), output formats (2), output
@@ -8,7 +11,9 @@
 #include "cli.h"
 
 #include <cjson/cJSON.h>
+#include <errno.h>
 #include <math.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -21,6 +26,12 @@ static const char render_help[] =
     "triangles rasterized, pixels written, rays by type). Times: prep is the\n"
     "one-time preparation (sampled inputs, structures built for the scene),\n"
     "frame the rest of the frame; -v adds the phases load, build and frame.\n"
+    "\n"
+    "Progressive renderers (pt) add frames to one accumulation until --time is\n"
+    "spent or --spp is reached; with neither (and no --set spp or accumulate)\n"
+    "they take their default budget (pt: 10 s, see rl algos). The summary then\n"
+    "gives frames, samples per pixel and the time. Ctrl-C stops, saves what\n"
+    "has accumulated and exits 130; a second Ctrl-C aborts without saving.\n"
     "\n"
     "SCENE  a built-in name (see rl scenes), optionally with parameters\n"
     "       (cornell-teapot:triangles=70000), a .json scene or a mesh file\n"
@@ -35,10 +46,21 @@ static const char render_help[] =
     "  --up x,y,z          override the up vector\n"
     "  --fov DEG           override the vertical field of view\n"
     "  --set KEY=VALUE     renderer option, repeatable (see rl algos)\n"
+    "  --tonemap OP        PNG: none (clamp; default), reinhard (L/(1+L) on\n"
+    "                      luminance) or aces (Narkowicz 2015 fit)\n"
+    "  --exposure EV       PNG: scale by 2^EV before the tone mapping; default 0\n"
+    "                      (EXR output stays linear: neither applies to it)\n"
     "  --depth-out FILE    depth layer: .exr raw eye-space depth in R,G,B,\n"
     "                      .png grey (nearest white, background black)\n"
     "  --id-out FILE.png   object IDs in false colour (background black)\n"
     "  --stats-json FILE   render and scene statistics as JSON\n"
+    "\n"
+    "progressive renderers (pt):\n"
+    "  --time DURATION     time budget, e.g. 500ms, 10s, 2m (at least one frame)\n"
+    "  --spp N             stop at N samples per pixel (reproducible, unlike --time);\n"
+    "                      with --time, whichever comes first\n"
+    "  --preview SECONDS   write the image so far to --out this often (through a\n"
+    "                      temporary file and a rename); default 5s, 0: never\n"
     "\n"
     "model files (the same as SCENE:cameras=off,lights=add,...; see rl scenes):\n"
     CLI_MODEL_FLAGS_HELP
@@ -53,7 +75,8 @@ static const char render_help[] =
     "\n"
     "example:\n"
     "  rl render cornell --algo raster --size 640x480 --out cornell.png \\\n"
-    "     --set raster.shading=flat --depth-out depth.exr --stats-json stats.json\n";
+    "     --set raster.shading=flat --depth-out depth.exr --stats-json stats.json\n"
+    "  rl render cornell --algo pt --time 30s --tonemap aces --out pt.png\n";
 
 typedef struct render_args {
     const char *scene, *algo, *out, *camera, *depth_out, *id_out, *stats_json;
@@ -67,7 +90,18 @@ typedef struct render_args {
     float fov_deg;
     const char **sets; /* --set values, pointers into argv */
     int num_sets;
+    double time_s;              /* --time, 0: none */
+    long long spp;              /* --spp, 0: none */
+    double preview_s;           /* --preview, < 0: the default */
+    rl_tonemap_desc tonemap;    /* --tonemap, --exposure */
+    bool has_tonemap;           /* either was given */
 } render_args;
+
+/* Previews of a progressive render: often enough to watch it converge,
+ * rarely enough that encoding them costs little next to the frames. */
+#define PREVIEW_DEFAULT_S 5.0
+/* The longest budget and preview interval: a week bounds a typo. */
+#define DURATION_MAX_S 604800.0
 
 /* Whether name holds exactly one conversion %d, %Nd or %0Nd (N < 10) and no
  * other %: a frame file pattern that snprintf fills safely. */
@@ -154,6 +188,27 @@ static int parse_args(int argc, char **argv, render_args *a)
                                    v);
             a->fov_deg = (float)fov;
             a->has_fov = true;
+        } else if (VALUE("--time")) {
+            if (m > 0 && (!cli_parse_duration(v, &a->time_s) || !(a->time_s > 0.0) || a->time_s > DURATION_MAX_S))
+                return cli_fail(RL_CLI_USAGE, "--time: expected a duration such as 500ms, 10s or 2m "
+                                              "(above 0, at most a week), got '%s'", v);
+        } else if (VALUE("--spp")) {
+            if (m > 0 && (!rl_parse_int(v, &a->spp) || a->spp < 1 || a->spp > 1000000000))
+                return cli_fail(RL_CLI_USAGE, "--spp: expected samples per pixel in [1, 1000000000], got '%s'", v);
+        } else if (VALUE("--preview")) {
+            if (m > 0 && (!cli_parse_duration(v, &a->preview_s) || a->preview_s > DURATION_MAX_S))
+                return cli_fail(RL_CLI_USAGE, "--preview: expected an interval such as 5s or 500ms (0: no "
+                                              "previews), got '%s'", v);
+        } else if (VALUE("--exposure")) {
+            if (m > 0 && (!rl_parse_float(v, &a->tonemap.exposure_ev) || !(fabs(a->tonemap.exposure_ev) <= 64.0)))
+                return cli_fail(RL_CLI_USAGE, "--exposure: expected stops in [-64, 64], got '%s'", v);
+            a->has_tonemap = true;
+        } else if (VALUE("--tonemap")) {
+            if (m > 0 && rl_tonemap_parse(v, &a->tonemap.op) != RL_OK) {
+                rl_clear_error();
+                return cli_fail(RL_CLI_USAGE, "--tonemap: expected none, reinhard or aces, got '%s'", v);
+            }
+            a->has_tonemap = true;
         } else if ((m = cli_take_model_flag(argc, argv, &i, &a->model)) != 0) {
         } else if (argv[i][0] == '-' || a->scene)
             return cli_unknown_arg("render", argv[i]);
@@ -174,6 +229,9 @@ static int parse_args(int argc, char **argv, render_args *a)
     }
     if (!a->camera_path && (a->frames || a->fps > 0.0))
         return cli_fail(RL_CLI_USAGE, "--frames and --fps go with --camera-path");
+    if (a->camera_path && (a->time_s > 0.0 || a->spp || a->preview_s >= 0.0))
+        return cli_fail(RL_CLI_USAGE, "--time, --spp and --preview render one view progressively; they do not go "
+                                      "with --camera-path");
     if (a->camera_path) {
         if (a->frames && a->fps > 0.0)
             return cli_fail(RL_CLI_USAGE, "--frames and --fps: give one of them");
@@ -204,6 +262,8 @@ static int check_outputs(const render_args *a)
                            a->depth_out);
     if (a->id_out && !cli_has_extension(a->id_out, png_ext))
         return cli_fail(RL_CLI_USAGE, "%s: unsupported ID format (use .png)", a->id_out);
+    if (a->has_tonemap && !cli_has_extension(a->out, png_ext))
+        return cli_fail(RL_CLI_USAGE, "%s: --tonemap and --exposure are for PNG output (EXR stays linear)", a->out);
     const char *paths[] = { a->out, a->depth_out, a->id_out, a->stats_json };
     for (size_t k = 0; k < sizeof paths / sizeof paths[0]; k++)
         if (paths[k] && !cli_check_writable(paths[k]))
@@ -267,13 +327,61 @@ static int choose_camera(const render_args *a, const rl_scene *scene, rl_camera 
     return RL_CLI_OK;
 }
 
-static int write_outputs(const render_args *a, const rl_scene *scene, const rl_image *img,
-                         const rl_render_stats *stats, double inputs_ms)
+/* Writes img's colour to path, tone mapped for PNG when asked, through a
+ * temporary file in the same folder and a rename: whoever watches path (a
+ * viewer during a long render's previews) never sees half a file, and a
+ * failed write leaves the old file as it was. The temporary keeps the
+ * extension, which picks the format. */
+static int write_color(const render_args *a, const rl_image *img, const char *path)
 {
+    const rl_image *src = img;
+    rl_image *mapped = NULL;
+    rl_status st = RL_OK;
     rl_clear_error();
-    rl_status st = rl_image_write(img, a->out);
-    if (st != RL_OK)
-        return cli_fail_status(RL_CLI_FAIL, st, a->out);
+    if (a->tonemap.op != RL_TONEMAP_NONE || a->tonemap.exposure_ev != 0.0) {
+        /* A copy: the frame may be accumulated further, and stays linear. */
+        st = rl_image_create(img->width, img->height, RL_LAYER_COLOR, &mapped);
+        if (st == RL_OK) {
+            memcpy(mapped->color, img->color, (size_t)img->width * (size_t)img->height * sizeof *img->color);
+            st = rl_image_tonemap(mapped, &a->tonemap);
+            src = mapped;
+        }
+    }
+    const char *slash = strrchr(path, '/');
+    const char *base = slash ? slash + 1 : path;
+    const char *ext = strrchr(base, '.');
+    if (!ext)
+        ext = base + strlen(base);
+    char tmp[4200];
+    int n = snprintf(tmp, sizeof tmp, "%.*s.%.*s.tmp%s", (int)(base - path), path, (int)(ext - base), base, ext);
+    if (st == RL_OK && (n < 0 || (size_t)n >= sizeof tmp)) {
+        rl_image_release(mapped);
+        return cli_fail(RL_CLI_FAIL, "%s: the name is too long", path);
+    }
+    if (st == RL_OK)
+        st = rl_image_write(src, tmp);
+    rl_image_release(mapped);
+    if (st != RL_OK) {
+        remove(tmp);
+        return cli_fail_status(RL_CLI_FAIL, st, path);
+    }
+    if (rename(tmp, path) != 0) {
+        int err = errno;
+        remove(tmp);
+        return cli_fail(RL_CLI_FAIL, "%s: cannot replace it: %s", path, strerror(err));
+    }
+    return RL_CLI_OK;
+}
+
+/* acc: how a progressive loop ended, for the stats file; NULL for one frame. */
+static int write_outputs(const render_args *a, const rl_scene *scene, const rl_image *img,
+                         const rl_render_stats *stats, double inputs_ms, const cli_accumulation *acc)
+{
+    rl_status st;
+    int rc = write_color(a, img, a->out);
+    if (rc != RL_CLI_OK)
+        return rc;
+    rl_clear_error();
     if (a->depth_out && (st = cli_write_depth(img, a->depth_out)) != RL_OK)
         return cli_fail_status(RL_CLI_FAIL, st, a->depth_out);
     if (a->id_out && (st = cli_write_ids(img, a->id_out)) != RL_OK)
@@ -287,6 +395,19 @@ static int write_outputs(const render_args *a, const rl_scene *scene, const rl_i
             cJSON_AddNumberToObject(obj, "width", img->width);
             cJSON_AddNumberToObject(obj, "height", img->height);
             cJSON_AddStringToObject(obj, "file", a->out);
+            if (a->has_tonemap) {
+                cJSON_AddStringToObject(obj, "tonemap", rl_tonemap_name(a->tonemap.op));
+                cJSON_AddNumberToObject(obj, "exposure_ev", a->tonemap.exposure_ev);
+            }
+            if (acc) {
+                /* The counters above are summed over the frames. */
+                cJSON_AddNumberToObject(obj, "frames", (double)acc->frames);
+                cJSON_AddNumberToObject(obj, "spp", acc->spp);
+                cJSON_AddNumberToObject(obj, "elapsed_s", acc->elapsed_s);
+                cJSON_AddNumberToObject(obj, "time_budget_s", acc->budget_s);
+                cJSON_AddNumberToObject(obj, "target_spp", (double)acc->target_spp);
+                cJSON_AddStringToObject(obj, "stopped", acc->stopped);
+            }
             cJSON *scene_stats = cli_scene_stats_json(scene);
             if (scene_stats)
                 cJSON_AddItemToObject(obj, "scene_stats", scene_stats);
@@ -301,19 +422,195 @@ static int write_outputs(const render_args *a, const rl_scene *scene, const rl_i
     return RL_CLI_OK;
 }
 
+/* How many frames: one, or a progressive loop with its limits. */
+typedef struct loop_plan {
+    bool loop;
+    double budget_s;          /* 0: none */
+    long long target_spp;     /* 0: none */
+    double preview_s;         /* 0: no previews */
+} loop_plan;
+
+static const rl_renderer_info *renderer_info(const char *name)
+{
+    size_t n = 0;
+    const rl_renderer_info *list = rl_renderer_list(&n);
+    for (size_t i = 0; i < n; i++)
+        if (strcmp(list[i].name, name) == 0)
+            return &list[i];
+    return NULL;
+}
+
+/* Whether --set chose the samples of the frame ("spp") or switched the
+ * accumulation off: the user asked for one frame of a given quality, as
+ * before budgets existed, so no default budget is added. */
+static bool sets_frame_quality(const render_args *a, const char *algo)
+{
+    size_t prefix = strlen(algo);
+    for (int k = 0; k < a->num_sets; k++) {
+        const char *key = a->sets[k];
+        if (strncmp(key, algo, prefix) == 0 && key[prefix] == '.')
+            key += prefix + 1;
+        size_t len = strcspn(key, "=");
+        if ((len == 3 && strncmp(key, "spp", 3) == 0) || (len == 10 && strncmp(key, "accumulate", 10) == 0))
+            return true;
+    }
+    return false;
+}
+
+/* Before the scene is loaded, so that a flag that cannot apply costs nothing. */
+static int plan_loop(const render_args *a, const rl_renderer *r, loop_plan *p)
+{
+    const char *name = rl_renderer_name(r);
+    const rl_renderer_info *info = renderer_info(name);
+    bool progressive = info && info->progressive;
+    if (!progressive && (a->time_s > 0.0 || a->spp || a->preview_s >= 0.0))
+        return cli_fail(RL_CLI_USAGE, "--time, --spp and --preview need a progressive renderer such as pt; %s "
+                                      "renders its image in one frame", name);
+    p->budget_s = a->time_s;
+    p->target_spp = a->spp;
+    if (progressive && !p->budget_s && !p->target_spp && !sets_frame_quality(a, name))
+        p->budget_s = info->default_time_s;
+    p->loop = p->budget_s > 0.0 || p->target_spp > 0;
+    p->preview_s = !p->loop ? 0.0 : a->preview_s >= 0.0 ? a->preview_s : PREVIEW_DEFAULT_S;
+    return RL_CLI_OK;
+}
+
+/* The renderer's progress callback during the loop: Ctrl-C cancels the
+ * frame; the bar shows the share of the budget (or of the samples) spent. */
+typedef struct loop_progress {
+    rl_progress *bar;
+    const loop_plan *plan;
+    double start_s;
+    double spp, frame_spp;    /* accumulated before this frame; the last frame's */
+} loop_progress;
+
+static bool on_progress(void *user, double done)
+{
+    loop_progress *lp = user;
+    if (cli_interrupted())
+        return false;
+    if (!lp->bar)
+        return true;
+    double share = done;
+    if (lp->plan->loop) {
+        share = 0.0;
+        if (lp->plan->budget_s > 0.0)
+            share = (rl_time_s() - lp->start_s) / lp->plan->budget_s;
+        if (lp->plan->target_spp && lp->frame_spp > 0.0)
+            share = fmax(share, (lp->spp + done * lp->frame_spp) / (double)lp->plan->target_spp);
+    }
+    rl_progress_update(lp->bar, share);
+    return true;
+}
+
+static void add_stats(rl_render_stats *sum, const rl_render_stats *s)
+{
+    sum->time_ms += s->time_ms;
+    sum->prep_ms += s->prep_ms;
+    for (int t = 0; t < RL_RAY_TYPE_COUNT; t++)
+        sum->rays[t] += s->rays[t];
+    sum->triangles_rasterized += s->triangles_rasterized;
+    sum->pixels_written += s->pixels_written;
+    sum->samples += s->samples;
+    sum->occlusion_queries += s->occlusion_queries;
+    sum->points_drawn += s->points_drawn;
+}
+
+/* One frame, or the progressive loop: frames until the budget would be
+ * overrun by one more (mean frame time; at least one frame), the samples
+ * are reached, or Ctrl-C. *sum gets the counters summed over the frames.
+ * RL_CLI_INTERRUPTED with acc->frames > 0: img holds what accumulated (a
+ * cancelled frame leaves the image as the last finished one made it). */
+static int render_frames(const render_args *a, rl_renderer *r, const rl_scene *scene, const rl_camera *cam,
+                         rl_image *img, const loop_plan *plan, rl_render_stats *sum, cli_accumulation *acc)
+{
+    loop_progress lp = { .plan = plan, .start_s = rl_time_s() };
+    /* The bar is chatter: -q silences it with the info log. */
+    char label[256];
+    snprintf(label, sizeof label, "render %s", a->scene);
+    if (rl_log_get_level() >= RL_LOG_INFO)
+        rl_progress_create(label, stderr, &lp.bar);
+    rl_renderer_set_progress(r, on_progress, &lp);
+    cli_interrupt_begin(plan->loop ? "\nrl: interrupted: saving what has accumulated (Ctrl-C again aborts)\n"
+                                   : "\nrl: interrupted: cancelling the render (Ctrl-C again aborts)\n");
+    double pixels = (double)cam->width * (double)cam->height;
+    double next_preview = plan->preview_s > 0.0 ? lp.start_s + plan->preview_s : INFINITY;
+    acc->budget_s = plan->budget_s;
+    acc->target_spp = plan->target_spp;
+    acc->stopped = "time";
+    int rc = RL_CLI_OK;
+    for (;;) {
+        rl_render_stats stats = { 0 };
+        rl_clear_error();
+        rl_status st = rl_renderer_render(r, scene, cam, img, &stats);
+        if (st == RL_ERR_CANCELLED && cli_interrupted()) {
+            rc = RL_CLI_INTERRUPTED;
+            break;
+        }
+        if (st != RL_OK) {
+            rc = cli_fail_status(RL_CLI_FAIL, st, "render");
+            break;
+        }
+        add_stats(sum, &stats);
+        acc->frames++;
+        lp.frame_spp = (double)stats.samples / pixels;
+        lp.spp = acc->spp = (double)sum->samples / pixels;
+        if (!plan->loop)
+            break;
+        if (cli_interrupted()) {
+            rc = RL_CLI_INTERRUPTED;
+            break;
+        }
+        if (plan->target_spp && acc->spp >= (double)plan->target_spp) {
+            acc->stopped = "spp";
+            break;
+        }
+        if (plan->target_spp && stats.samples == 0) {
+            rc = cli_fail(RL_CLI_FAIL, "--spp: %s reports no samples, so the target cannot be reached",
+                          rl_renderer_name(r));
+            break;
+        }
+        double now = rl_time_s();
+        double mean_frame_s = (sum->time_ms - sum->prep_ms) / (double)acc->frames / 1e3;
+        if (plan->budget_s > 0.0 && now - lp.start_s + mean_frame_s > plan->budget_s) {
+            acc->stopped = "time";
+            break;
+        }
+        if (now >= next_preview) {
+            if ((rc = write_color(a, img, a->out)) != RL_CLI_OK)
+                break;
+            next_preview = rl_time_s() + plan->preview_s;
+        }
+    }
+    acc->elapsed_s = rl_time_s() - lp.start_s;
+    rl_renderer_set_progress(r, NULL, NULL);
+    rl_progress_finish(lp.bar);
+    cli_interrupt_end();
+    if (rc == RL_CLI_INTERRUPTED) {
+        acc->stopped = "interrupt";
+        if (acc->frames == 0)
+            return cli_fail(RL_CLI_INTERRUPTED, "render: interrupted before the first frame was done; nothing "
+                                                "written");
+    }
+    return rc;
+}
+
 static int render_frame(const render_args *a)
 {
     rl_renderer *renderer = NULL;
     rl_scene *scene = NULL;
     rl_image *img = NULL;
-    rl_progress *progress = NULL;
     rl_camera cam;
     rl_render_stats stats = { 0 };
+    cli_accumulation acc = { 0 };
+    loop_plan plan = { 0 };
     double load_ms = 0.0, inputs_ms = 0.0;
     rl_timer phase;
     int rc = check_outputs(a);
     if (rc == RL_CLI_OK)
         rc = create_renderer(a, &renderer);
+    if (rc == RL_CLI_OK)
+        rc = plan_loop(a, renderer, &plan);
     rl_timer_start(&phase);
     if (rc == RL_CLI_OK)
         rc = cli_load_scene_with(a->scene, &a->model, &scene);
@@ -337,27 +634,23 @@ static int render_frame(const render_args *a)
         if (st != RL_OK)
             rc = cli_fail_status(RL_CLI_FAIL, st, "image");
     }
-    if (rc == RL_CLI_OK) {
-        /* The bar is chatter: -q silences it with the info log. */
-        char label[256];
-        snprintf(label, sizeof label, "render %s", a->scene);
-        if (rl_log_get_level() >= RL_LOG_INFO && rl_progress_create(label, stderr, &progress) == RL_OK)
-            rl_renderer_set_progress(renderer, rl_progress_update, progress);
-        rl_clear_error();
-        rl_status st = rl_renderer_render(renderer, scene, &cam, img, &stats);
-        rl_renderer_set_progress(renderer, NULL, NULL);
-        rl_progress_finish(progress);
-        if (st != RL_OK)
-            rc = cli_fail_status(RL_CLI_FAIL, st, "render");
-    }
-    if (rc == RL_CLI_OK) {
+    if (rc == RL_CLI_OK)
+        rc = render_frames(a, renderer, scene, &cam, img, &plan, &stats, &acc);
+    /* Ctrl-C in a loop keeps the frames that were finished. */
+    bool saving = rc == RL_CLI_OK || (rc == RL_CLI_INTERRUPTED && acc.frames > 0);
+    if (saving) {
         cli_debug("timing: load %.1f ms, build %.1f ms (inputs %.1f ms, for the scene %.1f ms), frame %.1f ms",
                   load_ms, inputs_ms + stats.prep_ms, inputs_ms, stats.prep_ms, stats.time_ms - stats.prep_ms);
-        rc = write_outputs(a, scene, img, &stats, inputs_ms);
+        int wrc = write_outputs(a, scene, img, &stats, inputs_ms, plan.loop ? &acc : NULL);
+        if (wrc != RL_CLI_OK)
+            rc = wrc;
+        else if (plan.loop)
+            cli_print_accumulation_summary(stdout, rl_renderer_name(renderer), a->scene, cam.width, cam.height,
+                                           &stats, inputs_ms, &acc);
+        else
+            cli_print_summary(stdout, rl_renderer_name(renderer), a->scene, cam.width, cam.height, &stats,
+                              inputs_ms);
     }
-    if (rc == RL_CLI_OK)
-        cli_print_summary(stdout, rl_renderer_name(renderer), a->scene, cam.width, cam.height,
-                             &stats, inputs_ms);
     rl_image_release(img);
     rl_scene_release(scene);
     rl_renderer_release(renderer);
@@ -490,7 +783,7 @@ static int render_path(const render_args *a)
             rc = cli_fail_status(RL_CLI_FAIL, st, what);
             break;
         }
-        rc = write_outputs(&fa, scene, img, &stats, 0.0);
+        rc = write_outputs(&fa, scene, img, &stats, 0.0, NULL);
         double frame_ms = stats.time_ms - stats.prep_ms;
         frames_ms += frame_ms;
         prep_ms += stats.prep_ms;
@@ -526,7 +819,7 @@ static int render_path(const render_args *a)
 
 int cli_render(int argc, char **argv)
 {
-    render_args a = { .algo = "raster" };
+    render_args a = { .algo = "raster", .preview_s = -1.0 };
     a.sets = calloc((size_t)argc, sizeof *a.sets);
     if (!a.sets)
         return cli_fail(RL_CLI_FAIL, "out of memory");

@@ -55,6 +55,51 @@ static inline rl_vec4 *rl_image_pixel(rl_image *img, int x, int y) { return &img
 RL_API rl_status rl_image_write(const rl_image *img, const char *path);
 RL_API rl_status rl_image_write_png(const rl_image *img, const char *path);
 RL_API rl_status rl_image_write_exr(const rl_image *img, const char *path);
+/* Tone mapping: display colour in [0, 1] from linear radiance, for 8-bit
+ * output. The exposure (in stops: colour times 2^exposure_ev) comes first,
+ * then the operator. The PNG writer clamps to [0, 1] and encodes sRGB; it
+ * does not tone map by itself, so a caller that wants an operator applies
+ * it to a copy of the frame first (EXR output stays linear: it is for
+ * further processing). Alpha is left alone; NaN stays NaN (the writer makes
+ * it black, the sign of a renderer bug).
+ *   none      clamp only: what the PNG writer did before tone mapping existed
+ *   reinhard  Reinhard et al. 2002, eq. 3, L_d = L / (1 + L), on the
+ *             luminance L (Rec. 709 weights); the colour is scaled by L_d / L,
+ *             which keeps its hue and saturation (a saturated bright colour
+ *             can still leave [0, 1] in one channel and is clamped). The
+ *             paper's key scaling (eq. 1-2, log-average luminance) is left
+ *             out: the exposure takes its place and keeps the mapping the
+ *             same for every image.
+ *   aces      the ACES filmic curve as fitted by Narkowicz 2015 ("ACES Filmic
+ *             Tone Mapping Curve"), per channel:
+ *             f(x) = x (2.51 x + 0.03) / (x (2.43 x + 0.59) + 0.14), clamped
+ *             to [0, 1]; without the fit's 0.6 pre-exposure (use
+ *             exposure_ev = log2(0.6) for it). */
+typedef enum rl_tonemap_op {
+    RL_TONEMAP_NONE = 0,
+    RL_TONEMAP_REINHARD,
+    RL_TONEMAP_ACES,
+    RL_TONEMAP_COUNT
+} rl_tonemap_op;
+
+typedef struct rl_tonemap_desc {   /* zero = default: no exposure change, clamp */
+    rl_tonemap_op op;
+    double exposure_ev;            /* stops; finite */
+} rl_tonemap_desc;
+
+/* "none", "reinhard", "aces"; NULL for a value out of range. */
+RL_API const char *rl_tonemap_name(rl_tonemap_op op);
+/* The operator of a name; RL_ERR_INVALID_ARG (the message lists the names)
+ * for an unknown one. */
+RL_API rl_status rl_tonemap_parse(const char *name, rl_tonemap_op *out);
+/* One linear RGB colour mapped to [0, 1]^3 (NaN channels stay NaN). desc
+ * NULL = default. */
+RL_API rl_vec3 rl_tonemap_rgb(rl_vec3 c, const rl_tonemap_desc *desc);
+/* Maps img's colour layer in place. RL_ERR_INVALID_ARG for a NULL image,
+ * one without a colour layer, an unknown operator or a non-finite exposure;
+ * the image is untouched then. desc NULL = default. */
+RL_API rl_status rl_image_tonemap(rl_image *img, const rl_tonemap_desc *desc);
+
 /* Reads a PNG (8/16-bit) or EXR into a colour-only image, linear values
  * (PNG is decoded from sRGB). For round trips and tests. */
 RL_API rl_status rl_image_read(const char *path, rl_image **out);

@@ -61,6 +61,17 @@ typedef struct rl_renderer_info {
     const char *name;
     const char *description;
     const char *reference;                /* paper, or "" */
+    /* Progressive: every render() from the same camera adds to what the
+     * earlier ones accumulated (pt: more samples per pixel) until
+     * rl_renderer_reset() or a change restarts it, so a caller improves the
+     * image by rendering again. A caller that loops over frames (rl render
+     * --time) refuses to loop a renderer that is not progressive. */
+    bool progressive;
+    /* Progressive renderers: the time budget in seconds that a caller with
+     * no budget of its own should spend, one that gives a clean-enough
+     * image of a small scene at about 512 x 512 on a few cores; 0: one
+     * frame, as for the others. */
+    double default_time_s;
 } rl_renderer_info;
 
 RL_API const rl_renderer_info *rl_renderer_list(size_t *count);
@@ -173,7 +184,8 @@ typedef struct rl_renderer_class_desc {
  * Classes cannot be removed. Safe to call from any thread; a renderer
  * created concurrently by the new name may or may not find it.
  * RL_ERR_INVALID_ARG: NULL desc or render, a missing or malformed name, a
- * name already taken (built-in or registered), an option row without a key
+ * name already taken (built-in or registered), a progressive class's
+ * default_time_s outside [0, 86400], an option row without a key
  * or whose default does not pass its own check. RL_ERR_LIMIT after
  * RL_RENDERER_MAX_REGISTERED classes. Nothing is registered on failure. */
 RL_API rl_status rl_renderer_register(const rl_renderer_class_desc *desc);

@@ -171,6 +171,10 @@ rl_status rl_renderer_register(const rl_renderer_class_desc *desc)
         return rl_error(RL_ERR_INVALID_ARG,
                         "rl_renderer_register: name \"%s\" must be 1 to %d characters of A-Z, a-z, 0-9, _ and -",
                         name ? name : "(null)", MAX_NAME);
+    /* A budget is a wait the caller imposes on its user: a day bounds a typo. */
+    if (desc->info.progressive && !(desc->info.default_time_s >= 0.0 && desc->info.default_time_s <= 86400.0))
+        return rl_error(RL_ERR_INVALID_ARG, "rl_renderer_register: %s: default_time_s must be in [0, 86400] s",
+                        name);
     rl_status st = check_options(desc);
     if (st != RL_OK)
         return st;
@@ -199,7 +203,9 @@ rl_status rl_renderer_register(const rl_renderer_class_desc *desc)
             reg->description = description;
             reg->reference = reference;
             reg->cls = (rl_renderer_class){
-                .info = { .name = reg->name, .description = description, .reference = reference },
+                .info = { .name = reg->name, .description = description, .reference = reference,
+                          .progressive = desc->info.progressive,
+                          .default_time_s = desc->info.progressive ? desc->info.default_time_s : 0.0 },
                 .options = desc->num_options ? desc->options : NULL,
                 .num_options = desc->num_options,
                 .state_size = desc->state_size,

@@ -287,6 +287,29 @@ static void test_concurrent_registration_gives_each_name_once(void **state)
 }
 
 /* Last: fills the registry. */
+static void test_progressive_class_declares_its_default_budget(void **state)
+{
+    (void)state;
+    size_t at = 0;
+    assert_true(listed("pt", &at));
+    const rl_renderer_info *infos = rl_renderer_list(NULL);
+    assert_true(infos[at].progressive && infos[at].default_time_s > 0.0);
+    assert_true(listed("raster", &at));
+    assert_false(infos[at].progressive);
+    rl_renderer_class_desc d = fill_desc("fill_progressive");
+    d.info.progressive = true;
+    d.info.default_time_s = -1.0;
+    assert_int_equal(rl_renderer_register(&d), RL_ERR_INVALID_ARG);
+    rl_clear_error();
+    assert_false(listed("fill_progressive", NULL));
+    d.info.default_time_s = 2.5;
+    assert_int_equal(rl_renderer_register(&d), RL_OK);
+    assert_true(listed("fill_progressive", &at));
+    infos = rl_renderer_list(NULL);
+    assert_true(infos[at].progressive);
+    assert_true(infos[at].default_time_s == 2.5);
+}
+
 static void test_register_stops_at_the_limit(void **state)
 {
     (void)state;
@@ -317,6 +340,7 @@ int main(void)
         cmocka_unit_test(test_register_refuses_malformed_classes),
         cmocka_unit_test(test_register_copies_the_strings),
         cmocka_unit_test(test_concurrent_registration_gives_each_name_once),
+        cmocka_unit_test(test_progressive_class_declares_its_default_budget),
         cmocka_unit_test(test_register_stops_at_the_limit),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
