@@ -31,32 +31,6 @@ static bool is_regular_file(const char *path)
     return ok;
 }
 
-/* World-space bounds of the uncommitted scene: node transforms composed down
- * from the root (a parent's id is always smaller than its child's). */
-static rl_aabb scene_bounds(const rl_scene *s)
-{
-    rl_aabb b = rl_aabb_empty();
-    rl_mat4 *world = rl_calloc(s->num_nodes ? s->num_nodes : 1, sizeof *world);
-    if (!world)
-        return b;
-    for (uint32_t n = 0; n < s->num_nodes; ++n) {
-        const rl_node *node = &s->nodes[n];
-        world[n] = node->parent == RL_NONE || node->parent >= n
-                       ? node->local
-                       : rl_mat4_mul(&world[node->parent], &node->local);
-        if (node->mesh == RL_NONE || node->mesh >= s->num_meshes)
-            continue;
-        const rl_mesh *m = &s->meshes[node->mesh];
-        for (uint32_t v = 0; v < m->num_vertices; ++v) {
-            rl_vec3 p = rl_mat4_mul_point(&world[n], m->positions[v]);
-            if (rl_vfinite(p))
-                b = rl_aabb_grow(b, p);
-        }
-    }
-    free(world);
-    return b;
-}
-
 /* The options of a model file ("model.obj:lights=add,headlight=true"),
  * printed by `rl scenes`. */
 static const char *const camera_choices[] = { "file", "off", NULL };
@@ -85,8 +59,10 @@ const rl_option_info *rl_model_options(size_t *count)
     return model_options;
 }
 
-/* World-space vertex positions of the uncommitted scene: what the framing
- * camera will see (rl_scene_fit_camera fits the committed data alike). */
+/* World-space vertex positions of the uncommitted scene, node transforms
+ * composed down from the root (a parent's id is always smaller than its
+ * child's): what the framing camera will see (rl_scene_fit_camera fits the
+ * committed data alike). NULL when out of memory. */
 static rl_vec3 *scene_points(const rl_scene *s, size_t *count)
 {
     size_t n = 0;
@@ -115,6 +91,20 @@ static rl_vec3 *scene_points(const rl_scene *s, size_t *count)
     free(world);
     *count = k;
     return points;
+}
+
+/* World-space bounds of the uncommitted scene (empty when out of memory:
+ * the callers then add nothing, and commit reports what is wrong). */
+static rl_aabb scene_bounds(const rl_scene *s)
+{
+    rl_aabb b = rl_aabb_empty();
+    size_t n = 0;
+    rl_vec3 *points = scene_points(s, &n);
+    for (size_t i = 0; points && i < n; ++i)
+        if (rl_vfinite(points[i]))
+            b = rl_aabb_grow(b, points[i]);
+    free(points);
+    return b;
 }
 
 /* The view a render gets by default: the first camera, else the fit. */

@@ -116,6 +116,27 @@ static inline void fx_add_box(rl_scene *s, uint32_t mat, rl_vec3 lo, rl_vec3 hi,
     free(idx);
 }
 
+/* One triangle (-1,-1,0) (1,-1,0) (0,1,0) with the default material,
+ * committed or not. */
+static inline rl_scene *fx_triangle_scene(bool commit)
+{
+    rl_scene *s = NULL;
+    assert_int_equal(rl_scene_create(&s), RL_OK);
+    rl_material m = rl_material_default();
+    uint32_t mat, mesh, node;
+    assert_int_equal(rl_scene_add_material(s, &m, &mat), RL_OK);
+    const rl_vec3 pos[3] = { { -1, -1, 0 }, { 1, -1, 0 }, { 0, 1, 0 } };
+    const uint32_t idx[3] = { 0, 1, 2 };
+    rl_mesh_desc md = { .name = "tri", .num_vertices = 3, .positions = pos,
+                        .num_triangles = 1, .indices = idx, .material = mat };
+    assert_int_equal(rl_scene_add_mesh(s, &md, &mesh), RL_OK);
+    assert_int_equal(rl_scene_add_node(s, RL_NODE_ROOT, "tri", NULL, &node), RL_OK);
+    assert_int_equal(rl_scene_node_set_mesh(s, node, mesh), RL_OK);
+    if (commit)
+        assert_int_equal(rl_scene_commit(s), RL_OK);
+    return s;
+}
+
 /* An empty scene with one default material (its index in *mat), for
  * tests that place their own boxes. */
 static inline rl_scene *fx_scene_with_material(uint32_t *mat)

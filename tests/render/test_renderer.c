@@ -17,24 +17,7 @@
 #include "render_fixtures.h"
 
 /* A one-triangle committed (or not) scene. */
-static rl_scene *make_scene(bool commit)
-{
-    rl_scene *s = NULL;
-    assert_int_equal(rl_scene_create(&s), RL_OK);
-    rl_material m = rl_material_default();
-    uint32_t mat, mesh, node;
-    assert_int_equal(rl_scene_add_material(s, &m, &mat), RL_OK);
-    const rl_vec3 pos[3] = { { -1, -1, 0 }, { 1, -1, 0 }, { 0, 1, 0 } };
-    const uint32_t idx[3] = { 0, 1, 2 };
-    rl_mesh_desc md = { .name = "tri", .num_vertices = 3, .positions = pos,
-                        .num_triangles = 1, .indices = idx, .material = mat };
-    assert_int_equal(rl_scene_add_mesh(s, &md, &mesh), RL_OK);
-    assert_int_equal(rl_scene_add_node(s, RL_NODE_ROOT, "tri", NULL, &node), RL_OK);
-    assert_int_equal(rl_scene_node_set_mesh(s, node, mesh), RL_OK);
-    if (commit)
-        assert_int_equal(rl_scene_commit(s), RL_OK);
-    return s;
-}
+static rl_scene *make_scene(bool commit) { return fx_triangle_scene(commit); }
 
 static rl_camera small_camera(int w, int h)
 {

@@ -16,6 +16,7 @@
 #include "rl/rl_property.h"
 #include "rl/rl_render.h"
 #include "rl/rl_scene.h"
+#include "render_fixtures.h"
 
 /* A renderer that fills the image with its "colour" option, scaled by its
  * "gain", and counts what it did: enough to see the options arrive typed. */
@@ -71,23 +72,7 @@ static rl_renderer_class_desc fill_desc(const char *name)
     };
 }
 
-static rl_scene *make_scene(void)
-{
-    rl_scene *s = NULL;
-    assert_int_equal(rl_scene_create(&s), RL_OK);
-    rl_material m = rl_material_default();
-    uint32_t mat, mesh, node;
-    assert_int_equal(rl_scene_add_material(s, &m, &mat), RL_OK);
-    const rl_vec3 pos[3] = { { -1, -1, 0 }, { 1, -1, 0 }, { 0, 1, 0 } };
-    const uint32_t idx[3] = { 0, 1, 2 };
-    rl_mesh_desc md = { .name = "tri", .num_vertices = 3, .positions = pos,
-                        .num_triangles = 1, .indices = idx, .material = mat };
-    assert_int_equal(rl_scene_add_mesh(s, &md, &mesh), RL_OK);
-    assert_int_equal(rl_scene_add_node(s, RL_NODE_ROOT, "tri", NULL, &node), RL_OK);
-    assert_int_equal(rl_scene_node_set_mesh(s, node, mesh), RL_OK);
-    assert_int_equal(rl_scene_commit(s), RL_OK);
-    return s;
-}
+static rl_scene *make_scene(void) { return fx_triangle_scene(true); }
 
 static bool listed(const char *name, size_t *index)
 {

@@ -18,36 +18,17 @@
 
 #include "rl/rl_image.h"
 #include "rl/rl_scene.h"
+#include "scene/load_fixtures.h"
 
-static char tmp_dir[1024];
-
-/* $RL_TEST_TMP/assimp/<sub>/ (created), or the current folder. */
+/* $RL_TEST_TMP/assimp/<sub>/ (created). */
 static const char *dir_for(const char *sub, char *out, size_t size)
 {
-    const char *base = getenv("RL_TEST_TMP");
-    snprintf(tmp_dir, sizeof tmp_dir, "%s/assimp", base && base[0] ? base : ".");
-    mkdir(tmp_dir, 0777);
-    snprintf(out, size, "%s/%s", tmp_dir, sub);
-    mkdir(out, 0777);
-    return out;
+    return fx_dir("assimp", sub, out, size);
 }
 
-static void write_bytes(const char *path, const void *data, size_t len)
-{
-    FILE *f = fopen(path, "wb");
-    assert_non_null(f);
-    assert_int_equal(fwrite(data, 1, len, f), len);
-    assert_int_equal(fclose(f), 0);
-}
-
-/* Writes text into dir/name and returns the full path in out. */
-static const char *write_text(const char *dir, const char *name, const char *text, char *out,
-                              size_t size)
-{
-    snprintf(out, size, "%s/%s", dir, name);
-    write_bytes(out, text, strlen(text));
-    return out;
-}
+#define write_bytes fx_write_bytes
+#define write_text fx_write_text
+#define base64 fx_base64
 
 static double total_area(const rl_scene_data *d)
 {
@@ -141,7 +122,9 @@ static void test_obj_material_and_texture_resolve_relative_to_the_obj(void **sta
 
     /* Load from the temp root, so that the model's folder is not the cwd. */
     assert_non_null(getcwd(cwd, sizeof cwd));
-    assert_int_equal(chdir(tmp_dir), 0);
+    char root[1200];
+    snprintf(root, sizeof root, "%s/..", dir);
+    assert_int_equal(chdir(root), 0);
     rl_scene *s = NULL;
     rl_status st = rl_scene_load("textured/box.obj", NULL, &s);
     assert_int_equal(chdir(cwd), 0);
@@ -245,22 +228,6 @@ static void test_binary_stl_loads(void **state)
     assert_true(fabs(total_area(d) - 12.0) < 1e-5);
     assert_true(d->bounds.max.x == 3.0f && d->bounds.max.y == 4.0f && d->bounds.max.z == 1.0f);
     rl_scene_release(s);
-}
-
-static void base64(const unsigned char *in, size_t n, char *out)
-{
-    static const char a[] = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
-    size_t o = 0;
-    for (size_t i = 0; i < n; i += 3) {
-        uint32_t v = (uint32_t)in[i] << 16;
-        if (i + 1 < n) v |= (uint32_t)in[i + 1] << 8;
-        if (i + 2 < n) v |= in[i + 2];
-        out[o++] = a[(v >> 18) & 63];
-        out[o++] = a[(v >> 12) & 63];
-        out[o++] = i + 1 < n ? a[(v >> 6) & 63] : '=';
-        out[o++] = i + 2 < n ? a[v & 63] : '=';
-    }
-    out[o] = '\0';
 }
 
 /* A glTF 2.0 file with one triangle whose buffer is a base64 data URI; the

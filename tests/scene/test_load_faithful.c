@@ -23,31 +23,18 @@
 #include "rl/rl_accel.h"
 #include "rl/rl_image.h"
 #include "rl/rl_scene.h"
+#include "scene/load_fixtures.h"
 
 #define MODELS "/usr/share/assimp/models"
 #define PI 3.14159265358979323846
 
 static const char *dir_for(const char *sub, char *out, size_t size)
 {
-    const char *base = getenv("RL_TEST_TMP");
-    char top[1024];
-    snprintf(top, sizeof top, "%s/faithful", base && base[0] ? base : ".");
-    mkdir(top, 0777);
-    snprintf(out, size, "%s/%s", top, sub);
-    mkdir(out, 0777);
-    return out;
+    return fx_dir("faithful", sub, out, size);
 }
 
-static const char *write_text(const char *dir, const char *name, const char *text, char *out,
-                              size_t size)
-{
-    snprintf(out, size, "%s/%s", dir, name);
-    FILE *f = fopen(out, "wb");
-    assert_non_null(f);
-    assert_int_equal(fwrite(text, 1, strlen(text), f), strlen(text));
-    assert_int_equal(fclose(f), 0);
-    return out;
-}
+#define write_text fx_write_text
+#define base64 fx_base64
 
 static bool have(const char *path)
 {
@@ -383,22 +370,6 @@ static void test_one_warning_per_file(void **state)
     rl_scene_release(s);
 }
 
-
-static void base64(const unsigned char *in, size_t n, char *out)
-{
-    static const char a[] = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
-    size_t o = 0;
-    for (size_t i = 0; i < n; i += 3) {
-        uint32_t v = (uint32_t)in[i] << 16;
-        if (i + 1 < n) v |= (uint32_t)in[i + 1] << 8;
-        if (i + 2 < n) v |= in[i + 2];
-        out[o++] = a[(v >> 18) & 63];
-        out[o++] = a[(v >> 12) & 63];
-        out[o++] = i + 1 < n ? a[(v >> 6) & 63] : '=';
-        out[o++] = i + 2 < n ? a[v & 63] : '=';
-    }
-    out[o] = '\0';
-}
 
 /* A glTF quad (-1..1)^2 in z = 0 whose base colour texture is transparent
  * on its left half (alphaMode MASK), with a normal map that tilts every

@@ -18,24 +18,19 @@
 #include <unistd.h>
 
 #include "rl/rl_scene.h"
+#include "scene/load_fixtures.h"
 
 static const char *tmp_path(const char *name, char *out, size_t size)
 {
-    const char *base = getenv("RL_TEST_TMP");
     char dir[1024];
-    snprintf(dir, sizeof dir, "%s/hostile", base && base[0] ? base : ".");
-    mkdir(dir, 0777);
+    fx_dir("hostile", ".", dir, sizeof dir);
     snprintf(out, size, "%s/%s", dir, name);
     return out;
 }
 
 static const char *write_bytes(const char *name, const void *data, size_t len, char *out, size_t size)
 {
-    tmp_path(name, out, size);
-    FILE *f = fopen(out, "wb");
-    assert_non_null(f);
-    assert_int_equal(fwrite(data, 1, len, f), len);
-    assert_int_equal(fclose(f), 0);
+    fx_write_bytes(tmp_path(name, out, size), data, len);
     return out;
 }
 
