@@ -85,6 +85,9 @@ bool cli_has_extension(const char *path, const char *const *extensions);
 /* True when the folder that will hold path exists and is writable; prints
  * the error itself. Checked up front so a long render is not wasted. */
 bool cli_check_writable(const char *path);
+/* Whether two output paths name one file: the same text, or one existing
+ * file reached two ways. */
+bool cli_same_file(const char *a, const char *b);
 /* mkdir -p; prints the error itself. */
 bool cli_make_dirs(const char *dir);
 

@@ -339,3 +339,12 @@ void cli_print_option(FILE *out, const rl_option_info *o)
     }
     fputc('\n', out);
 }
+
+bool cli_same_file(const char *a, const char *b)
+{
+    if (strcmp(a, b) == 0)
+        return true;
+    /* Different spellings of one existing file ("./x.png", a link). */
+    struct stat sa, sb;
+    return stat(a, &sa) == 0 && stat(b, &sb) == 0 && sa.st_dev == sb.st_dev && sa.st_ino == sb.st_ino;
+}

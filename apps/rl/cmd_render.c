@@ -227,6 +227,17 @@ static int parse_args(int argc, char **argv, render_args *a)
         if (!eq || eq == a->sets[k])
             return cli_fail(RL_CLI_USAGE, "--set: expected KEY=VALUE, got '%s'", a->sets[k]);
     }
+    /* Two outputs in one file: the second write would silently replace the
+     * first (issue 34). */
+    const char *outs[] = { a->out, a->depth_out, a->id_out, a->stats_json };
+    const char *out_flags[] = { "--out", "--depth-out", "--id-out", "--stats-json" };
+    for (int x = 0; x < 4; ++x)
+        for (int y = x + 1; y < 4; ++y)
+            if (outs[x] && outs[y] && cli_same_file(outs[x], outs[y]))
+                return cli_fail(RL_CLI_USAGE, "%s and %s name the same file '%s'", out_flags[x], out_flags[y],
+                                outs[y]);
+    if (a->has_up && !(rl_length2(a->up) > 0.0f))
+        return cli_fail(RL_CLI_USAGE, "--up: a direction, not the zero vector");
     if (!a->camera_path && (a->frames || a->fps > 0.0))
         return cli_fail(RL_CLI_USAGE, "--frames and --fps go with --camera-path");
     if (a->camera_path && (a->time_s > 0.0 || a->spp || a->preview_s >= 0.0))

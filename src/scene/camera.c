@@ -37,7 +37,12 @@ rl_status rl_camera_validate(const rl_camera *cam)
     /* Relative to the coordinates: below that, eye and target round together. */
     if (!(dist > 1e-6f * rl_maxf(scale, 1e-30f)) || !(rl_length2(dir) > 0.0f))
         return rl_error(RL_ERR_INVALID_ARG, "camera: eye and target coincide");
-    float sin_up = rl_length(rl_cross(dir, c.up)) / (dist * rl_length(c.up));
+    /* In units of the largest component, so that huge coordinates (an eye
+     * at 1e30) do not overflow the lengths into a NaN that reads as
+     * "parallel". */
+    rl_vec3 dn = rl_scale(dir, 1.0f / rl_vmax_comp(rl_vmax(dir, rl_neg(dir))));
+    rl_vec3 un = rl_scale(c.up, 1.0f / rl_maxf(rl_vmax_comp(rl_vmax(c.up, rl_neg(c.up))), 1e-30f));
+    float sin_up = rl_length(rl_cross(dn, un)) / (rl_length(dn) * rl_length(un));
     if (!(sin_up > 1e-6f))
         return rl_error(RL_ERR_INVALID_ARG, "camera: up is parallel to the view direction");
     if (!(c.fov_deg > 0.0f && c.fov_deg < 180.0f))

@@ -70,4 +70,13 @@ expect_error 2 "x.bmp" "$RL" render cornell --size 32x24 --out "$TMP/x.bmp"
 
 # Unknown camera.
 expect_error 1 "no-such-camera" "$RL" render cornell --size 32x24 --camera no-such-camera --out "$OUT"
+
+# Issue 34: two outputs in one file (also spelt two ways), a zero up vector,
+# an eye far away (rendered, not misreported as "up is parallel").
+expect_error 2 "name the same file" "$RL" render cornell --size 32x24 --out "$OUT" --depth-out "$OUT"
+run_ok "$RL" render cornell --size 32x24 --out "$TMP/one.png"
+expect_error 2 "--out and --stats-json name the same file" "$RL" render cornell --size 32x24 \
+    --out "$TMP/one.png" --stats-json "$TMP/./one.png"
+expect_error 2 "zero vector" "$RL" render cornell --size 32x24 --up 0,0,0 --out "$OUT"
+run_ok "$RL" render cornell --size 32x24 --eye 1e30,1e30,1e30 --out "$OUT"
 echo "ok"

@@ -6,6 +6,8 @@
 #include <stdlib.h>
 #include <cmocka.h>
 
+#include <string.h>
+
 #include "rl/rl.h"
 
 static void assert_vec3_near(rl_vec3 a, rl_vec3 b, float eps)
@@ -113,6 +115,15 @@ static void test_validate_rejects_degenerate_cameras(void **state)
     c.z_far = 1.0f;
     assert_int_equal(rl_camera_validate(&c), RL_ERR_INVALID_ARG);
     assert_int_equal(rl_camera_validate(NULL), RL_ERR_INVALID_ARG);
+    rl_clear_error();
+    /* Huge coordinates: the angle test works in units of the largest
+     * component, so no length overflows into a false "parallel". */
+    c = ok;
+    c.eye = rl_v3s(1e30f);
+    assert_int_equal(rl_camera_validate(&c), RL_OK);
+    c.up = rl_v3s(1.0f);   /* along the view direction */
+    assert_int_equal(rl_camera_validate(&c), RL_ERR_INVALID_ARG);
+    assert_non_null(strstr(rl_last_error(), "parallel"));
     rl_clear_error();
 }
 
