@@ -415,6 +415,76 @@ static rl_status check_ply(const char *path, const char *data, size_t size)
     return RL_OK;
 }
 
+/* OFF (Geomview's Object File Format): a header word ending in "OFF"
+ * (OFF, COFF, NOFF, ...), the counts "vertices faces edges", one vertex
+ * per line, then one face per line: its corner count and the indices.
+ * Assimp's reader clamps an index past the vertices onto the last vertex,
+ * which hides a broken file; we refuse it, as for PLY. Only the text's
+ * structure is read: numbers stay Assimp's to parse. */
+static bool off_blank(const char *line)
+{
+    while (*line == ' ' || *line == '\t')
+        ++line;
+    return *line == '\0' || *line == '#';
+}
+
+static rl_status check_off(const char *path, const char *data, size_t size)
+{
+    char line[4096];
+    size_t pos = 0;
+    long long counts[3] = { -1, -1, -1 };
+    int have = 0;
+    bool header = false;
+    /* The header word, then the three counts (on its line or the next). */
+    while (have < 3 && next_line(data, size, &pos, line, sizeof line)) {
+        char *p = line;
+        if (off_blank(p))
+            continue;
+        if (!header) {
+            char word[16] = "";
+            int n = 0;
+            if (sscanf(p, "%15s%n", word, &n) != 1 || strlen(word) < 3 ||
+                strcmp(word + strlen(word) - 3, "OFF") != 0)
+                return RL_OK;   /* not the text form we know: Assimp decides */
+            header = true;
+            p += n;
+        }
+        for (char *end; have < 3; p = end) {
+            long long v = strtoll(p, &end, 10);
+            if (end == p)
+                break;
+            counts[have++] = v;
+        }
+    }
+    if (have < 3 || counts[0] < 0 || counts[1] < 0)
+        return RL_OK;
+    for (long long v = 0; v < counts[0];) {
+        if (!next_line(data, size, &pos, line, sizeof line))
+            return RL_OK;   /* short: Assimp reports it */
+        if (!off_blank(line))
+            ++v;
+    }
+    for (long long f = 0; f < counts[1];) {
+        if (!next_line(data, size, &pos, line, sizeof line))
+            return RL_OK;
+        if (off_blank(line))
+            continue;
+        char *p = line, *end;
+        long long corners = strtoll(p, &end, 10);
+        for (long long k = 0; end != p && k < corners; ++k) {
+            p = end;
+            long long idx = strtoll(p, &end, 10);
+            if (end == p)
+                break;
+            if (idx < 0 || idx >= counts[0])
+                return rl_error(RL_ERR_PARSE, "%s: OFF face %lld uses vertex %lld of %lld", path, f, idx,
+                                counts[0]);
+        }
+        ++f;
+    }
+    return RL_OK;
+}
+
 /* Assimp picks its reader by content when the extension's reader declines,
  * so a PLY body in a ".gltf" file still reaches the PLY reader: sniff the
  * magic as well as the extension. */
@@ -488,14 +558,15 @@ rl_status rl_check_mesh_file(const char *path)
     }
     bool ply = rl_path_has_ext(path, ".ply") || starts_like_ply(path);
     bool obj = !ply && rl_path_has_ext(path, ".obj");
-    if (!obj && !ply)
+    bool off = !ply && !obj && rl_path_has_ext(path, ".off");
+    if (!obj && !ply && !off)
         return RL_OK;
     char *data = NULL;
     size_t size = 0;
     rl_status st = read_all(path, &data, &size);
     if (st != RL_OK)
         return st;
-    st = obj ? check_obj(path, data, size) : check_ply(path, data, size);
+    st = obj ? check_obj(path, data, size) : ply ? check_ply(path, data, size) : check_off(path, data, size);
     free(data);
     return st;
 }

@@ -1,8 +1,8 @@
 /* test_load_hostile.c: small model files that made Assimp hang or allocate
  * gigabytes (issue 34), refused by our pre-checks (load_validate.c) before
  * Assimp reads them: PLY element counts the file cannot hold (ASCII and
- * binary), GLB chunk lengths beyond the file, and paths that are not
- * regular files. Each must fail with a clear error, quickly. */
+ * binary), GLB chunk lengths beyond the file, OFF indices past the
+ * vertices, and paths that are not regular files. Each must fail with a clear error, quickly. */
 #define _POSIX_C_SOURCE 200809L
 #include <setjmp.h>
 #include <stdarg.h>
@@ -116,6 +116,26 @@ static void test_glb_lengths_beyond_the_file_are_refused(void **state)
                    "GLB chunk 0 claims 284 bytes, 280 remain");
 }
 
+/* Assimp clamps an OFF index past the vertices onto the last one, which
+ * hid the broken file; the pre-check refuses it, as the docs say. */
+static void test_off_indices_out_of_range_are_refused(void **state)
+{
+    (void)state;
+    char path[1200];
+    const char *bad = "OFF\n# a comment\n3 1 0\n0 0 0\n1 0 0\n\n0 1 0\n3 0 1 7\n";
+    expect_refused(write_bytes("bad.off", bad, strlen(bad), path, sizeof path), RL_ERR_PARSE,
+                   "OFF face 0 uses vertex 7 of 3");
+    const char *negative = "OFF 3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 -1 2\n";
+    expect_refused(write_bytes("negative.off", negative, strlen(negative), path, sizeof path),
+                   RL_ERR_PARSE, "uses vertex -1 of 3");
+    const char *good = "OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n";
+    rl_scene *s = NULL;
+    assert_int_equal(rl_scene_load(write_bytes("good.off", good, strlen(good), path, sizeof path), NULL, &s),
+                     RL_OK);
+    assert_int_equal(rl_scene_get_data(s)->num_triangles, 1);
+    rl_scene_release(s);
+}
+
 static void test_a_device_is_not_read(void **state)
 {
     (void)state;
@@ -135,6 +155,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_ply_counts_beyond_the_file_are_refused),
         cmocka_unit_test(test_glb_lengths_beyond_the_file_are_refused),
+        cmocka_unit_test(test_off_indices_out_of_range_are_refused),
         cmocka_unit_test(test_a_device_is_not_read),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
