@@ -113,6 +113,17 @@ typedef struct rl_texture {
 
 /* Loads PNG/JPEG/BMP/TGA via stb_image; sRGB colour converted to linear. */
 RL_API rl_status rl_texture_load(const char *path, rl_texture **out);
+/* The largest texture (width x height) that loading decodes, read from the
+ * file's header before any decoding: a small PNG can claim 16384 x 16384,
+ * which is 4 GiB of float texels. Default RL_TEXTURE_MAX_PIXELS (8192 x
+ * 8192, 1 GiB); larger files fail with RL_ERR_LIMIT. Process-wide; set it
+ * before loading (not thread-safe against loads in flight). */
+#define RL_TEXTURE_MAX_PIXELS (8192ull * 8192ull)
+RL_API void rl_texture_set_max_pixels(unsigned long long pixels);
+RL_API unsigned long long rl_texture_max_pixels(void);
+/* RL_ERR_LIMIT (message naming what) unless 1 <= w, h <= RL_IMAGE_MAX_SIZE
+ * and w x h <= rl_texture_max_pixels(). */
+RL_API rl_status rl_texture_check_size(const char *what, long long w, long long h);
 /* Creates a texture from texels (copied). */
 RL_API rl_status rl_texture_create(int width, int height, const rl_vec4 *texels, rl_texture **out);
 RL_API void rl_texture_release(rl_texture *tex);

@@ -17,13 +17,24 @@
 #include "core/error.h"
 #include "core/texture_sample.h"
 
-#define TEXTURE_MAX_SIZE 16384
+static unsigned long long max_pixels = RL_TEXTURE_MAX_PIXELS;
 
-static rl_status check_texture_size(const char *what, long long w, long long h)
+void rl_texture_set_max_pixels(unsigned long long pixels)
 {
-    if (w < 1 || h < 1 || w > TEXTURE_MAX_SIZE || h > TEXTURE_MAX_SIZE)
+    max_pixels = pixels ? pixels : RL_TEXTURE_MAX_PIXELS;
+}
+
+unsigned long long rl_texture_max_pixels(void) { return max_pixels; }
+
+rl_status rl_texture_check_size(const char *what, long long w, long long h)
+{
+    if (w < 1 || h < 1 || w > RL_IMAGE_MAX_SIZE || h > RL_IMAGE_MAX_SIZE)
         return rl_error(RL_ERR_LIMIT, "%s: texture size %lldx%lld outside 1..%d per side", what,
-                        w, h, TEXTURE_MAX_SIZE);
+                        w, h, RL_IMAGE_MAX_SIZE);
+    if ((unsigned long long)w * (unsigned long long)h > max_pixels)
+        return rl_error(RL_ERR_LIMIT, "%s: texture of %lldx%lld pixels exceeds the limit of %llu "
+                        "(%.0f MiB as float texels; rl_texture_set_max_pixels)", what, w, h, max_pixels,
+                        (double)w * (double)h * 16.0 / (1024.0 * 1024.0));
     return RL_OK;
 }
 
@@ -59,7 +70,7 @@ rl_status rl_texture_load(const char *path, rl_texture **out)
         fclose(f);
         return rl_error(RL_ERR_PARSE, "%s: cannot decode image: %s", path, stbi_failure_reason());
     }
-    rl_status st = check_texture_size(path, w, h);
+    rl_status st = rl_texture_check_size(path, w, h);
     if (st != RL_OK) {
         fclose(f);
         return st;
@@ -93,7 +104,7 @@ rl_status rl_texture_create(int width, int height, const rl_vec4 *texels, rl_tex
 {
     if (!texels || !out)
         return rl_error(RL_ERR_INVALID_ARG, "rl_texture_create: texels or out is NULL");
-    rl_status st = check_texture_size("rl_texture_create", width, height);
+    rl_status st = rl_texture_check_size("rl_texture_create", width, height);
     if (st != RL_OK)
         return st;
     rl_texture *tex = NULL;

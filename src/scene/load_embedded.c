@@ -12,14 +12,6 @@
 #include "core/error.h"
 #include "scene/load_internal.h"
 
-static rl_status check_size(const char *what, long long w, long long h)
-{
-    if (w < 1 || h < 1 || w > RL_IMAGE_MAX_SIZE || h > RL_IMAGE_MAX_SIZE)
-        return rl_error(RL_ERR_LIMIT, "%s: embedded texture size %lldx%lld outside 1..%d", what,
-                        w, h, RL_IMAGE_MAX_SIZE);
-    return RL_OK;
-}
-
 static rl_vec4 texel(unsigned r, unsigned g, unsigned b, unsigned a)
 {
     const float s = 1.0f / 255.0f;
@@ -45,7 +37,7 @@ rl_status rl_embedded_texture_decode(const struct aiTexture *tex, const char *wh
         if (!stbi_info_from_memory(bytes, len, &w, &h, &comp))
             return rl_error(RL_ERR_PARSE, "%s: cannot decode embedded texture: %s", what,
                             stbi_failure_reason());
-        if ((st = check_size(what, w, h)) != RL_OK)
+        if ((st = rl_texture_check_size(what, w, h)) != RL_OK)
             return st;
         unsigned char *rgba = stbi_load_from_memory(bytes, len, &w, &h, &comp, 4);
         if (!rgba)
@@ -56,7 +48,7 @@ rl_status rl_embedded_texture_decode(const struct aiTexture *tex, const char *wh
             texels[i] = texel(rgba[4 * i], rgba[4 * i + 1], rgba[4 * i + 2], rgba[4 * i + 3]);
         stbi_image_free(rgba);
     } else {
-        if ((st = check_size(what, tex->mWidth, tex->mHeight)) != RL_OK)
+        if ((st = rl_texture_check_size(what, tex->mWidth, tex->mHeight)) != RL_OK)
             return st;
         w = (int)tex->mWidth;
         h = (int)tex->mHeight;

@@ -17,6 +17,7 @@
 #include <time.h>
 #include <unistd.h>
 
+#include "rl/rl_image.h"
 #include "rl/rl_scene.h"
 #include "scene/load_fixtures.h"
 
@@ -136,6 +137,35 @@ static void test_off_indices_out_of_range_are_refused(void **state)
     rl_scene_release(s);
 }
 
+/* A small PNG can claim a huge picture; the header is read first and the
+ * pixel limit applies before any decoding (here lowered so that a 16 x 16
+ * texture stands for one of 16384 x 16384). */
+static void test_texture_pixel_limit_applies_before_decoding(void **state)
+{
+    (void)state;
+    char png[1200], obj[1200], mtl[1200];
+    rl_image *img = NULL;
+    assert_int_equal(rl_image_create(16, 16, RL_LAYER_COLOR, &img), RL_OK);
+    rl_image_fill(img, rl_v4(0.5f, 0.5f, 0.5f, 1.0f));
+    assert_int_equal(rl_image_write_png(img, tmp_path("big.png", png, sizeof png)), RL_OK);
+    rl_image_release(img);
+    assert_true(rl_texture_max_pixels() == RL_TEXTURE_MAX_PIXELS);
+    rl_texture_set_max_pixels(100);
+    rl_texture *tex = NULL;
+    rl_clear_error();
+    assert_int_equal(rl_texture_load(png, &tex), RL_ERR_LIMIT);
+    assert_null(tex);
+    assert_non_null(strstr(rl_last_error(), "16x16 pixels exceeds the limit of 100"));
+    /* Through a model file too: its material names the texture. */
+    const char *m = "newmtl a\nmap_Kd big.png\n";
+    const char *o = "mtllib big.mtl\nusemtl a\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n";
+    write_bytes("big.mtl", m, strlen(m), mtl, sizeof mtl);
+    expect_refused(write_bytes("big.obj", o, strlen(o), obj, sizeof obj), RL_ERR_LIMIT, "exceeds the limit");
+    rl_texture_set_max_pixels(0);   /* back to the default */
+    assert_int_equal(rl_texture_load(png, &tex), RL_OK);
+    rl_texture_release(tex);
+}
+
 static void test_a_device_is_not_read(void **state)
 {
     (void)state;
@@ -156,6 +186,7 @@ int main(void)
         cmocka_unit_test(test_ply_counts_beyond_the_file_are_refused),
         cmocka_unit_test(test_glb_lengths_beyond_the_file_are_refused),
         cmocka_unit_test(test_off_indices_out_of_range_are_refused),
+        cmocka_unit_test(test_texture_pixel_limit_applies_before_decoding),
         cmocka_unit_test(test_a_device_is_not_read),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
