@@ -93,67 +93,53 @@ static rl_vec3 *scene_points(const rl_scene *s, size_t *count)
     return points;
 }
 
-/* World-space bounds of the uncommitted scene (empty when out of memory:
- * the callers then add nothing, and commit reports what is wrong). */
-static rl_aabb scene_bounds(const rl_scene *s)
-{
-    rl_aabb b = rl_aabb_empty();
-    size_t n = 0;
-    rl_vec3 *points = scene_points(s, &n);
-    for (size_t i = 0; points && i < n; ++i)
-        if (rl_vfinite(points[i]))
-            b = rl_aabb_grow(b, points[i]);
-    free(points);
-    return b;
-}
+/* Where the lights of a model file go: its bounds and the view a render
+ * gets by default (the first camera, else the fit), from one pass over the
+ * vertices. An empty bounds means no geometry: nothing is added, and
+ * commit reports the empty scene. */
+typedef struct model_view {
+    rl_aabb bounds;
+    rl_camera cam;
+} model_view;
 
-/* The view a render gets by default: the first camera, else the fit. */
-static rl_status default_view(const rl_scene *scene, rl_camera *cam)
+static rl_status view_of(const rl_scene *scene, model_view *mv)
 {
-    if (scene->num_cameras > 0) {
-        *cam = rl_camera_resolve(&scene->cameras[0]);
-        return RL_OK;
-    }
     size_t n = 0;
     rl_vec3 *points = scene_points(scene, &n);
     if (!points)
         return rl_error(RL_ERR_OUT_OF_MEMORY, "scene \"%s\": out of memory", scene->name);
-    *cam = rl_camera_fit_points(points, n, scene->view_azimuth_deg, scene->view_elevation_deg,
-                                RL_CAMERA_DEFAULT_WIDTH, RL_CAMERA_DEFAULT_HEIGHT);
+    mv->bounds = rl_aabb_empty();
+    for (size_t i = 0; i < n; ++i)
+        if (rl_vfinite(points[i]))
+            mv->bounds = rl_aabb_grow(mv->bounds, points[i]);
+    mv->cam = scene->num_cameras > 0
+                  ? rl_camera_resolve(&scene->cameras[0])
+                  : rl_camera_fit_points(points, n, scene->view_azimuth_deg, scene->view_elevation_deg,
+                                         RL_CAMERA_DEFAULT_WIDTH, RL_CAMERA_DEFAULT_HEIGHT);
     free(points);
     return RL_OK;
 }
 
 /* A point light at the default view's eye, of intensity d^2 to the
  * model's centre (irradiance ~1 there), as viewers' headlights. */
-static rl_status add_headlight(rl_scene *scene)
+static rl_status add_headlight(rl_scene *scene, const model_view *mv)
 {
-    rl_aabb bounds = scene_bounds(scene);
-    if (rl_aabb_is_empty(bounds))
+    if (rl_aabb_is_empty(mv->bounds))
         return RL_OK;
-    rl_camera cam;
-    rl_status st = default_view(scene, &cam);
-    if (st != RL_OK)
-        return st;
     rl_light l = { 0 };
     l.type = RL_LIGHT_POINT;
     l.color = rl_v3s(1.0f);
-    l.position = cam.eye;
-    float d = rl_length(rl_sub(cam.eye, rl_aabb_center(bounds)));
+    l.position = mv->cam.eye;
+    float d = rl_length(rl_sub(mv->cam.eye, rl_aabb_center(mv->bounds)));
     l.intensity = d > 0.0f && isfinite(d) ? d * d : 1.0f;
     return rl_scene_add_light(scene, &l);
 }
 
-static rl_status add_default_lights(rl_scene *scene)
+static rl_status add_default_lights(rl_scene *scene, const model_view *mv)
 {
-    rl_aabb bounds = scene_bounds(scene);
-    if (rl_aabb_is_empty(bounds))
-        return RL_OK;   /* commit reports the empty scene */
-    rl_camera cam;
-    rl_status st = default_view(scene, &cam);
-    if (st != RL_OK)
-        return st;
-    rl_vec3 extent = rl_aabb_extent(bounds);
+    if (rl_aabb_is_empty(mv->bounds))
+        return RL_OK;
+    rl_vec3 extent = rl_aabb_extent(mv->bounds);
     float radius = 0.5f * rl_length(extent);
     if (!(radius > 0.0f))
         radius = 1.0f;
@@ -163,10 +149,10 @@ static rl_status add_default_lights(rl_scene *scene)
     rl_light key = { 0 };
     key.type = RL_LIGHT_POINT;
     key.color = rl_v3s(1.0f);
-    key.position = rl_add(cam.eye, rl_v3(0.25f * radius, 0.5f * radius, 0.0f));
-    float d = rl_length(rl_sub(key.position, rl_aabb_center(bounds)));
+    key.position = rl_add(mv->cam.eye, rl_v3(0.25f * radius, 0.5f * radius, 0.0f));
+    float d = rl_length(rl_sub(key.position, rl_aabb_center(mv->bounds)));
     key.intensity = d > 0.0f ? 0.8f * d * d : 1.0f;
-    st = rl_scene_add_light(scene, &key);
+    rl_status st = rl_scene_add_light(scene, &key);
     if (st != RL_OK)
         return st;
     rl_light fill = { 0 };
@@ -228,10 +214,15 @@ static rl_status load_mesh_file(const char *path, const char *params, rl_scene *
     uint32_t root = RL_NONE;
     if (st == RL_OK)
         st = rl_scene_import_with(scene, path, RL_NODE_ROOT, &desc, &root);
-    if (st == RL_OK && (scene->num_lights == 0 || lights == 2))
-        st = add_default_lights(scene);
+    bool rig = scene->num_lights == 0 || lights == 2;
+    model_view mv;
+    memset(&mv, 0, sizeof mv);   /* only read after view_of() succeeds */
+    if (st == RL_OK && (rig || headlight))
+        st = view_of(scene, &mv);
+    if (st == RL_OK && rig)
+        st = add_default_lights(scene, &mv);
     if (st == RL_OK && headlight)
-        st = add_headlight(scene);
+        st = add_headlight(scene, &mv);
     if (st == RL_OK)
         st = rl_scene_commit(scene);
     if (st != RL_OK) {
