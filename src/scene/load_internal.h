@@ -2,8 +2,6 @@
 #ifndef RL_SCENE_LOAD_INTERNAL_H
 #define RL_SCENE_LOAD_INTERNAL_H
 
-#include <stdio.h>
-
 #include "rl/rl_image.h"
 
 struct aiTexture;
@@ -14,9 +12,6 @@ struct aiTexture;
  * announces, with valid faces. Other files pass. RL_ERR_PARSE
  * "path: what is wrong", RL_ERR_IO if the file cannot be read. */
 rl_status rl_check_mesh_file(const char *path);
-/* RL_ERR_IO unless the open file f is a regular file, RL_ERR_LIMIT above the
- * mesh-file size limit (4 GiB); *bytes (may be NULL) gets its size. */
-rl_status rl_check_regular_file(const char *path, FILE *f, unsigned long long *bytes);
 
 /* load_embedded.c: decodes a texture embedded in a model file (compressed
  * PNG/JPEG/... bytes, or raw BGRA texels) into linear RGBA. what names the

@@ -32,7 +32,9 @@
  * runs out. 4 GiB holds far more than RL_SCENE_MAX_TRIANGLES in any format. */
 #define MESH_FILE_MAX_BYTES (4ull << 30)
 
-rl_status rl_check_regular_file(const char *path, FILE *f, unsigned long long *bytes)
+/* RL_ERR_IO unless the open file f is a regular file, RL_ERR_LIMIT above
+ * MESH_FILE_MAX_BYTES; *bytes gets its size. */
+static rl_status check_regular_file(const char *path, FILE *f, unsigned long long *bytes)
 {
     struct stat st;
     if (fstat(fileno(f), &st) != 0)
@@ -42,21 +44,16 @@ rl_status rl_check_regular_file(const char *path, FILE *f, unsigned long long *b
     if ((unsigned long long)st.st_size > MESH_FILE_MAX_BYTES)
         return rl_error(RL_ERR_LIMIT, "%s: %llu bytes exceed the limit of %llu for a mesh file", path,
                         (unsigned long long)st.st_size, MESH_FILE_MAX_BYTES);
-    if (bytes)
-        *bytes = (unsigned long long)st.st_size;
+    *bytes = (unsigned long long)st.st_size;
     return RL_OK;
 }
 
-static rl_status read_all(const char *path, char **data, size_t *size)
+/* Reads the open file f (a regular file, checked by the caller) from the
+ * start; it stays open. */
+static rl_status read_all(const char *path, FILE *f, char **data, size_t *size)
 {
-    FILE *f = fopen(path, "rb");
-    if (!f)
-        return rl_error(RL_ERR_IO, "%s: cannot open: %s", path, strerror(errno));
-    rl_status reg = rl_check_regular_file(path, f, NULL);
-    if (reg != RL_OK) {
-        fclose(f);
-        return reg;
-    }
+    if (fseek(f, 0, SEEK_SET) != 0)
+        return rl_error(RL_ERR_IO, "%s: cannot seek: %s", path, strerror(errno));
     char *buf = NULL;
     size_t len = 0, cap = 0;
     for (;;) {
@@ -65,7 +62,6 @@ static rl_status read_all(const char *path, char **data, size_t *size)
             char *nb = rl_realloc_array(buf, cap + 1, 1);
             if (!nb) {
                 free(buf);
-                fclose(f);
                 return RL_ERR_OUT_OF_MEMORY;
             }
             buf = nb;
@@ -76,13 +72,10 @@ static rl_status read_all(const char *path, char **data, size_t *size)
             break;
         if (len > MESH_FILE_MAX_BYTES) {   /* the file grew while we read it */
             free(buf);
-            fclose(f);
             return rl_error(RL_ERR_LIMIT, "%s: more than %llu bytes", path, MESH_FILE_MAX_BYTES);
         }
     }
-    bool failed = ferror(f) != 0;
-    fclose(f);
-    if (failed) {
+    if (ferror(f)) {
         free(buf);
         return rl_error(RL_ERR_IO, "%s: read error", path);
     }
@@ -509,17 +502,13 @@ static uint32_t le32(const unsigned char *p)
  * data padded to 4 bytes). Assimp allocates what a chunk header claims, so a
  * 300-byte file claiming 2 GB got 2 GB: every length is checked against
  * the file's size first, reading only the headers. */
-static rl_status check_glb(const char *path)
+static rl_status check_glb(const char *path, FILE *f, unsigned long long file_size)
 {
-    FILE *f = fopen(path, "rb");
-    if (!f)
-        return rl_error(RL_ERR_IO, "%s: cannot open: %s", path, strerror(errno));
-    unsigned long long file_size = 0;
-    rl_status st = rl_check_regular_file(path, f, &file_size);
+    rl_status st = RL_OK;
     unsigned char head[12];
-    if (st == RL_OK && (fread(head, 1, 12, f) != 12 || memcmp(head, "glTF", 4) != 0))
+    if (fseek(f, 0, SEEK_SET) != 0 || fread(head, 1, 12, f) != 12 || memcmp(head, "glTF", 4) != 0)
         st = RL_OK;   /* not binary glTF after all: Assimp decides */
-    else if (st == RL_OK) {
+    else {
         unsigned long long total = le32(head + 8), at = 12;
         if (total > file_size)
             st = rl_error(RL_ERR_PARSE, "%s: GLB header claims %llu bytes, the file has %llu", path,
@@ -537,36 +526,28 @@ static rl_status check_glb(const char *path)
             at += 8 + ((len + 3) & ~3ull);
         }
     }
-    fclose(f);
     return st;
 }
 
 rl_status rl_check_mesh_file(const char *path)
 {
-    /* Whatever the format: Assimp would read a device until memory runs out. */
+    /* Whatever the format: Assimp would read a device until memory runs
+     * out. One open serves every check below. */
     FILE *f = fopen(path, "rb");
     if (!f)
         return rl_error(RL_ERR_IO, "%s: cannot open: %s", path, strerror(errno));
-    rl_status reg = rl_check_regular_file(path, f, NULL);
-    fclose(f);
-    if (reg != RL_OK)
-        return reg;
-    if (rl_path_has_ext(path, ".glb")) {
-        rl_status st = check_glb(path);
-        if (st != RL_OK)
-            return st;
-    }
+    unsigned long long file_size = 0;
+    rl_status st = check_regular_file(path, f, &file_size);
+    if (st == RL_OK && rl_path_has_ext(path, ".glb"))
+        st = check_glb(path, f, file_size);
     bool ply = rl_path_has_ext(path, ".ply") || starts_like_ply(path);
     bool obj = !ply && rl_path_has_ext(path, ".obj");
     bool off = !ply && !obj && rl_path_has_ext(path, ".off");
-    if (!obj && !ply && !off)
-        return RL_OK;
     char *data = NULL;
     size_t size = 0;
-    rl_status st = read_all(path, &data, &size);
-    if (st != RL_OK)
-        return st;
-    st = obj ? check_obj(path, data, size) : ply ? check_ply(path, data, size) : check_off(path, data, size);
+    if (st == RL_OK && (obj || ply || off) && (st = read_all(path, f, &data, &size)) == RL_OK)
+        st = obj ? check_obj(path, data, size) : ply ? check_ply(path, data, size) : check_off(path, data, size);
     free(data);
+    fclose(f);
     return st;
 }
