@@ -336,9 +336,11 @@ static rl_status add_material(material_ctx *c, const struct aiMaterial *mat, uin
 
     rl_vec3 base;
     float metallic = 0.0f, roughness = 1.0f, f;
-    bool pbr = get_color(mat, AI_MATKEY_BASE_COLOR, &base) &&
-               (get_float(mat, AI_MATKEY_METALLIC_FACTOR, &metallic) |
-                get_float(mat, AI_MATKEY_ROUGHNESS_FACTOR, &roughness));
+    /* Both factors are read (each keeps its default when absent); either
+     * one makes the material metallic-roughness. */
+    bool has_metallic = get_float(mat, AI_MATKEY_METALLIC_FACTOR, &metallic);
+    bool has_roughness = get_float(mat, AI_MATKEY_ROUGHNESS_FACTOR, &roughness);
+    bool pbr = get_color(mat, AI_MATKEY_BASE_COLOR, &base) && (has_metallic || has_roughness);
     if (pbr) {
         map_metal_roughness(&m, base, rl_clampf(metallic, 0.0f, 1.0f),
                             rl_clampf(roughness, 0.0f, 1.0f));
