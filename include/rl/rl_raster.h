@@ -98,6 +98,16 @@ typedef struct rl_raster_batch {
     uint32_t num_layers;                  /* 0..RL_RASTER_MAX_LAYERS */
     const rl_raster_layer *layers;
     const rl_raster_lazy_colors *lazy;    /* NULL: colors are filled already */
+    /* Alpha masks (glTF 2.0 alphaMode MASK, rl_material.alpha_cutoff): a
+     * fragment of triangle i is dropped before the depth test where the
+     * alpha of textures[mask_texture[i]] at the interpolated uvs is below
+     * mask_cutoff[i], exactly where rl_alpha_masked() says a ray passes.
+     * It holds in every pass, RL_RASTER_NO_COLOR included, so that ID and
+     * depth passes see the holes the ray tracers see. NULL: no masks;
+     * otherwise uvs, textures and mask_cutoff are required, and
+     * mask_texture[i] = RL_ID_NONE leaves triangle i whole. */
+    const uint32_t *mask_texture;
+    const float *mask_cutoff;
 } rl_raster_batch;
 
 /* Vertex colours computed on demand. A GPU runs its vertex shader on every

@@ -15,10 +15,6 @@
 #include "core/error.h"
 #include "rl/rl_timer.h"
 
-/* Holes of alpha masks one query passes through before it gives up (a ray
- * along a stack of foliage cards). */
-#define MAX_MASK_SKIPS 256
-
 struct rl_accel {
     const rl_scene *scene;
     const rl_scene_data *data;
@@ -132,9 +128,7 @@ rl_status rl_accel_create(const rl_scene *scene, const rl_accel_desc *desc, rl_a
     a->desc = d;
     a->cls = class_of(d.kind);
     a->stats.kind = d.kind;
-    for (uint32_t m = 0; m < data->num_materials; ++m)
-        a->masked |= data->materials[m].alpha_cutoff > 0.0f &&
-                     data->materials[m].diffuse_texture < data->num_textures;
+    a->masked = rl_data_has_masks(data);
     *out = a;
     return RL_OK;
 }
@@ -213,7 +207,7 @@ bool rl_accel_intersect(const rl_accel *accel, rl_ray *ray, rl_hit *hit)
      * kind's inner loop: one place for all of them (Embree included), and
      * no cost for scenes without masks. */
     for (int skips = 0; accel->masked && rl_alpha_masked(accel->data, h.triangle, h.u, h.v); ++skips) {
-        if (skips == MAX_MASK_SKIPS)
+        if (skips == RL_MAX_MASK_SKIPS)
             return false;
         r = *ray;
         r.t_min = h.t;

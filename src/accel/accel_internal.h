@@ -8,6 +8,7 @@
 #define RL_ACCEL_INTERNAL_H
 
 #include "rl/rl_accel.h"
+#include "scene/masks.h"
 
 typedef struct rl_accel_class {
     const char *name;
@@ -26,6 +27,11 @@ extern const rl_accel_class rl_accel_brute_class;
 #ifdef RL_HAVE_EMBREE
 extern const rl_accel_class rl_accel_embree_class;
 #endif
+
+/* Alpha masks (rl_material.alpha_cutoff): queries find a hit in a hole
+ * and ask again beyond it, through at most this many holes (a ray along a
+ * stack of foliage cards) before they give up. */
+#define RL_MAX_MASK_SKIPS 256
 
 /* The grid of a committed RL_ACCEL_GRID accel (the Line Space builds on
  * it, rl_linespace.h); NULL for any other kind or an uncommitted accel. */

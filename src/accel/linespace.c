@@ -39,6 +39,7 @@ rl_status rl_linespace_create(const rl_accel *grid, const rl_linespace_desc *des
     ls->accel = grid;
     ls->grid = g;
     ls->data = data;
+    ls->masked = rl_data_has_masks(data);
     ls->n = n;
     ls->k = k;
     ls->dynamic = d.dynamic;

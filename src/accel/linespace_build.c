@@ -302,20 +302,36 @@ static void pnmt_record(const rl_linespace *ls, const tri_info *t, double u, dou
     halves8(r, f);
 }
 
+/* Whether entry e's midpoint-ray hit lies in a hole of an alpha mask. */
+static inline bool in_hole(const rl_linespace *ls, const tri_info *tris, const rl_ls_entry *e)
+{
+    return ls->masked && rl_alpha_masked(ls->data, tris[e->tri].id, e->u, e->w);
+}
+
 /* Front and back picks of a list sorted front to back: the first midpoint
  * ray hit in front order; the hit with the largest parameter (lowest ID on
- * ties); without hits the front-most and back-most candidates. */
-static inline void pick_records(const rl_ls_entry *list, uint32_t m, const rl_ls_entry **ef_out,
-                                const rl_ls_entry **eb_out)
+ * ties); without hits the front-most and back-most candidates. Hits in the
+ * holes of alpha masks are no surfaces: where the midpoint ray meets only
+ * holes there is none, and pick_records returns false (the records say
+ * "empty", which the queries read as a free shaft). */
+static inline bool pick_records(const rl_linespace *ls, const tri_info *tris, const rl_ls_entry *list,
+                                uint32_t m, const rl_ls_entry **ef_out, const rl_ls_entry **eb_out)
 {
     const rl_ls_entry *ef = NULL, *eb = NULL;
+    bool holes = false;
     for (uint32_t i = 0; i < m; ++i)
         if (list[i].shaft & RL_LS_ENTRY_HIT) {
+            if (in_hole(ls, tris, &list[i])) {
+                holes = true;
+                continue;
+            }
             if (!ef)
                 ef = &list[i];
             if (!eb || list[i].key_back > eb->key_back)
                 eb = &list[i];
         }
+    if (!ef && holes)
+        return false;
     if (!ef) {
         ef = eb = &list[0];
         for (uint32_t i = 1; i < m; ++i)
@@ -324,6 +340,7 @@ static inline void pick_records(const rl_ls_entry *list, uint32_t m, const rl_ls
     }
     *ef_out = ef;
     *eb_out = eb;
+    return true;
 }
 
 /* The PNMT record of an occupied shaft (pn: 16 halves) from its list of m
@@ -333,7 +350,10 @@ static void shaft_pnmt(const rl_linespace *ls, const tri_info *tris, const rl_ls
                        uint32_t m, uint16_t *pn, const double a[3], const double b[3])
 {
     const rl_ls_entry *ef, *eb;
-    pick_records(list, m, &ef, &eb);
+    if (!pick_records(ls, tris, list, m, &ef, &eb)) {
+        memset(pn, 0, 2 * RL_LS_PNMT_RECORD * sizeof *pn);   /* material 0: empty */
+        return;
+    }
     double u, w;
     const tri_info *t = &tris[ef->tri];
     record_bary(t->v, a, b, ef, true, &u, &w);
@@ -354,7 +374,10 @@ static void shaft_preillum(const rl_linespace *ls, const tri_info *tris, const r
                            const double lo[3], const double ext[3])
 {
     const rl_ls_entry *pick[2];
-    pick_records(list, m, &pick[0], &pick[1]);
+    if (!pick_records(ls, tris, list, m, &pick[0], &pick[1])) {
+        memset(pi, 0, 8 * sizeof *pi);                       /* alpha 0: empty */
+        return;
+    }
     for (int side = 0; side < 2; ++side) {
         const tri_info *t = &tris[pick[side]->tri];
         double u, w;

@@ -35,6 +35,7 @@ struct rl_linespace {
     int n, k, threads;
     bool dynamic;
     bool huge_pages;              /* arrays on transparent huge pages */
+    bool masked;                  /* some material has an alpha mask */
     unsigned payloads;
     rl_progress_fn progress;
     void *user;

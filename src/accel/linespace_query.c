@@ -46,6 +46,7 @@
 #include <math.h>
 #include <string.h>
 
+#include "accel/accel_internal.h"
 #include "accel/linespace_internal.h"
 #include "accel/tri_list.h"
 #include "core/half.h"
@@ -157,10 +158,9 @@ static bool any_hit(const rl_linespace *ls, const rl_ray_watertight *w, const rl
     return rl_tri_list_any(ls->grid->tri_verts, l.ids, l.count, w, ray->t_min, t_max, mailbox);
 }
 
-bool rl_linespace_intersect(const rl_linespace *ls, rl_ray *ray, rl_hit *hit)
+/* The closest candidate hit, holes of alpha masks included. */
+static bool closest_hit(const rl_linespace *ls, rl_ray *ray, rl_hit *hit)
 {
-    if (!ray || !hit)
-        return false;
     hit->triangle = RL_ID_NONE;
     hit->object = RL_ID_NONE;
     if (!usable(ls, ray))
@@ -200,10 +200,37 @@ bool rl_linespace_intersect(const rl_linespace *ls, rl_ray *ray, rl_hit *hit)
     return true;
 }
 
+/* Alpha masks as in rl_accel_intersect: a hit in a hole is skipped by
+ * asking again beyond it (every test takes t in the open (t_min, t_max)). */
+bool rl_linespace_intersect(const rl_linespace *ls, rl_ray *ray, rl_hit *hit)
+{
+    if (!ray || !hit)
+        return false;
+    rl_ray r = *ray;
+    if (!closest_hit(ls, &r, hit))
+        return false;
+    for (int skips = 0; ls->masked && rl_alpha_masked(ls->data, hit->triangle, hit->u, hit->v); ++skips) {
+        r = *ray;
+        r.t_min = hit->t;
+        if (skips == RL_MAX_MASK_SKIPS || !closest_hit(ls, &r, hit)) {
+            hit->triangle = hit->object = RL_ID_NONE;
+            return false;
+        }
+    }
+    *ray = r;
+    return true;
+}
+
 bool rl_linespace_occluded(const rl_linespace *ls, const rl_ray *ray)
 {
     if (!usable(ls, ray))
         return false;
+    if (ls->masked) {
+        /* An any-hit test could stop at a hole: walk the hits instead. */
+        rl_ray r = *ray;
+        rl_hit h;
+        return rl_linespace_intersect(ls, &r, &h);
+    }
     rl_grid_dda it;
     if (!rl_grid_dda_begin(ls->grid, ray, &it))
         return false;
@@ -264,7 +291,20 @@ static bool origin_hit(const rl_linespace *ls, const rl_ray *ray, uint32_t cell,
     rl_mailbox_init(&mailbox);
     float limit = rl_minf(ray->t_max, t1 + T_SLACK_REL * fabsf(t1));
     rl_tri_closest best = { RL_NONE, limit, 0.0f, 0.0f };
-    test_list(ls, &w, ray, candidates(ls, cell, block, shaft, true), &mailbox, &best, &limit);
+    const tri_list l = candidates(ls, cell, block, shaft, true);
+    test_list(ls, &w, ray, l, &mailbox, &best, &limit);
+    /* A hole of an alpha mask is no surface: look again behind it. */
+    for (int skips = 0; best.id != RL_NONE && ls->masked && rl_alpha_masked(ls->data, best.id, best.u, best.v);
+         ++skips) {
+        if (skips == RL_MAX_MASK_SKIPS)
+            return false;
+        rl_ray behind = *ray;
+        behind.t_min = best.t;
+        rl_mailbox_init(&mailbox);
+        limit = rl_minf(ray->t_max, t1 + T_SLACK_REL * fabsf(t1));
+        best = (rl_tri_closest){ RL_NONE, limit, 0.0f, 0.0f };
+        test_list(ls, &w, &behind, l, &mailbox, &best, &limit);
+    }
     if (best.id == RL_NONE)
         return false;
     if (s) {
@@ -329,8 +369,10 @@ static bool pnmt_walk(const rl_linespace *ls, const rl_ray *ray, rl_ls_surface *
                 return true;
             continue;
         }
-        if (!out && voxel_within(ls, it.current, ray, ray->t_min, r))
-            return true;          /* the record lies in the voxel: inside (t_min, t_max) */
+        /* The record lies in the voxel, inside (t_min, t_max); with alpha
+         * masks it may say the shaft is empty (linespace_build.c). */
+        if (!out && !ls->masked && voxel_within(ls, it.current, ray, ray->t_min, r))
+            return true;
         const uint16_t *rec = ls->pnmt + rl_ls_shaft_rank(ls, block, shaft) * 16 +
                               (fwd ? 0 : RL_LS_PNMT_RECORD);
         rl_ls_surface s;
@@ -390,9 +432,13 @@ static bool preillum_walk(const rl_linespace *ls, const rl_ray *ray, rl_vec3 *co
             continue;
         float lo = origin ? ray->t_min + margin : ray->t_min;
         uint64_t g = rl_ls_shaft_rank(ls, block, shaft);
+        /* Alpha 0: the shaft's midpoint ray passes through holes only
+         * (linespace_build.c), no surface. */
+        if (ls->masked && rl_half_to_float(ls->preillum[g * 8 + (fwd ? 3 : 7)]) == 0.0f)
+            continue;
         float t = 0.5f * (t0 + t1);
         if (ls->pnmt) {
-            if (!color && voxel_within(ls, it.current, ray, lo, r))
+            if (!color && !ls->masked && voxel_within(ls, it.current, ray, lo, r))
                 return true;
             rl_ls_surface s;
             if (decode_pnmt(ls, it.current, ls->pnmt + g * 16 + (fwd ? 0 : RL_LS_PNMT_RECORD), &s))

@@ -136,6 +136,10 @@ rl_status rl_drawer_end(rl_drawer *dr)
 typedef struct software {
     rl_raster *ras;
     rl_scene_drawer *drawer;
+    /* The frame, for rl_scene_drawer_finish at its end. */
+    rl_image *target;
+    rl_mat4 view, proj;
+    bool points;                  /* points drawn: IDs are not all triangles' */
 } software;
 
 static void sw_release(void *impl)
@@ -152,6 +156,10 @@ static rl_status sw_begin(void *impl, rl_image *target, const rl_mat4 *view, con
 {
     software *sw = impl;
     rl_scene_drawer_new_frame(sw->drawer, eye);
+    sw->target = target;
+    sw->view = *view;
+    sw->proj = *proj;
+    sw->points = false;
     return rl_raster_set_target(sw->ras, target, view, proj);
 }
 
@@ -182,12 +190,15 @@ static rl_status sw_query(void *impl, const rl_raster_batch *boxes, uint64_t *pi
 static rl_status sw_draw_points(void *impl, const rl_raster_points *points, rl_raster_counters *c)
 {
     software *sw = impl;
+    sw->points = true;
     return rl_raster_draw_points(sw->ras, points, c);
 }
 
 static rl_status sw_end(void *impl)
 {
-    (void)impl;     /* drawn into the target already */
+    software *sw = impl;
+    if (!sw->points)
+        rl_scene_drawer_finish(sw->drawer, sw->target, &sw->view, &sw->proj);
     return RL_OK;
 }
 

@@ -65,6 +65,8 @@ static rl_status batch_problem(const rl_raster *r, const rl_raster_batch *b, cha
                     b->lazy->frame >= (1u << 31)))
         return problem(msg, size, "lazy colours need shade, stamps and 1 <= frame < 2^31 (frame %u)",
                        b->lazy->frame);
+    if (b->mask_texture && (!b->uvs || !b->textures || !b->mask_cutoff))
+        return problem(msg, size, "alpha masks need uvs, textures and mask_cutoff");
     if (b->num_triangles == 0)
         return RL_OK;
     if (!b->indices || !b->positions)

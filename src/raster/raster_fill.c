@@ -35,6 +35,21 @@ static inline rl_vec4 mul4(rl_vec4 a, rl_vec4 b)
     return rl_v4(a.x * b.x, a.y * b.y, a.z * b.z, a.w * b.w);
 }
 
+/* The perspective-correct uv of a textured or masked prim. */
+static inline rl_vec2 prim_uv(const rl_raster_prim *p, double l0, double l1, double l2, double inv_iw)
+{
+    const rl_vec2 *t = p->uvw;
+    return rl_v2((float)((l0 * t[0].x + l1 * t[1].x + l2 * t[2].x) * inv_iw),
+                 (float)((l0 * t[0].y + l1 * t[1].y + l2 * t[2].y) * inv_iw));
+}
+
+/* Whether a masked prim keeps its fragment: the test of rl_alpha_masked()
+ * (alpha below the cutoff is a hole), on the same bilinear lookup. */
+static bool mask_keeps(const rl_raster_prim *p, double l0, double l1, double l2, double inv_iw)
+{
+    return !(rl_texture_sample_inline(p->mask, prim_uv(p, l0, l1, l2, inv_iw)).w < p->cutoff);
+}
+
 static inline __attribute__((always_inline)) rl_vec4
 shade(const rl_raster_prim *p, double l0, double l1, double l2, double inv_iw)
 {
@@ -46,12 +61,8 @@ shade(const rl_raster_prim *p, double l0, double l1, double l2, double inv_iw)
                   (float)((l0 * a[0].z + l1 * a[1].z + l2 * a[2].z) * inv_iw),
                   (float)((l0 * a[0].w + l1 * a[1].w + l2 * a[2].w) * inv_iw));
     }
-    if (p->tex) {
-        const rl_vec2 *t = p->uvw;
-        rl_vec2 uv = rl_v2((float)((l0 * t[0].x + l1 * t[1].x + l2 * t[2].x) * inv_iw),
-                           (float)((l0 * t[0].y + l1 * t[1].y + l2 * t[2].y) * inv_iw));
-        c = mul4(c, rl_texture_sample_inline(p->tex, uv));
-    }
+    if (p->tex)
+        c = mul4(c, rl_texture_sample_inline(p->tex, prim_uv(p, l0, l1, l2, inv_iw)));
     return c;
 }
 
@@ -335,7 +346,7 @@ static inline bool row_span(const int64_t e[3], const int64_t dy_s[3], const dou
 
 /* The pixel loop, compiled twice: plain (the common single pass, kept as
  * lean as before multi-pass existed) and multi (DEPTH_EQUAL, BLEND_ADD,
- * layers). Both run the same depth arithmetic, so a multi pass sees the
+ * layers, alpha masks). Both run the same depth arithmetic, so a multi pass sees the
  * depth a plain pass wrote. */
 static inline __attribute__((always_inline)) uint64_t
 fill_prim(const rl_raster_target *t, const rl_raster_prim *p, const rl_raster_prim_src *src,
@@ -360,6 +371,7 @@ fill_prim(const rl_raster_target *t, const rl_raster_prim *p, const rl_raster_pr
     const bool write_color = t->color != NULL;
     const bool depth_equal = multi && t->depth_equal;
     const bool layered = multi && t->layered && write_color;
+    const bool masked = multi && p->mask;
     layer_terms terms;
     if (layered) {
         gather_layers(t->layered, src, &terms);
@@ -409,6 +421,10 @@ fill_prim(const rl_raster_target *t, const rl_raster_prim *p, const rl_raster_pr
                     memcpy(&dt, t->depth_test + pix, sizeof dt);
                     pass = depth_equal ? zf == dt : zf < dt;
                 }
+                if (masked)
+                    for (int j = 0; j < LANES; ++j)
+                        if (pass[j] && !mask_keeps(p, f.l0[j], f.l1[j], f.l2[j], f.inv_iw[j]))
+                            pass[j] = 0;
                 const int count = -(pass[0] + pass[1] + pass[2] + pass[3]);
                 if (!count)
                     continue;
@@ -449,6 +465,8 @@ fill_prim(const rl_raster_target *t, const rl_raster_prim *p, const rl_raster_pr
                 if (t->depth_test &&
                     !(depth_equal ? zf == t->depth_test[pix] : zf < t->depth_test[pix]))
                     continue;
+                if (masked && !mask_keeps(p, l0, l1, l2, inv_iw))
+                    continue;
                 ++passed;
                 if (t->depth)
                     t->depth[pix] = zf;
@@ -474,7 +492,7 @@ fill_prim(const rl_raster_target *t, const rl_raster_prim *p, const rl_raster_pr
 uint64_t rl_raster_fill_prim(const rl_raster_target *t, const rl_raster_prim *p,
                              const rl_raster_prim_src *src, int row0, int row1)
 {
-    if (t->depth_equal || t->blend_add || t->layered)
+    if (t->depth_equal || t->blend_add || t->layered || p->mask)
         return fill_prim(t, p, src, row0, row1, true);
     return fill_prim(t, p, src, row0, row1, false);
 }

@@ -42,9 +42,11 @@ typedef struct rl_raster_prim {
     float iw[3];                  /* 1/w */
     float dw[3];                  /* eye depth / w (affine projections only) */
     rl_vec4 cw[3];                /* vertex colour / w (Gouraud only) */
-    rl_vec2 uvw[3];               /* uv / w (textured only) */
+    rl_vec2 uvw[3];               /* uv / w (textured or masked only) */
     rl_vec4 color;                /* flat colour */
     const rl_texture *tex;        /* NULL: untextured */
+    const rl_texture *mask;       /* NULL: no alpha mask */
+    float cutoff;                 /* mask: drop where alpha < cutoff */
     uint32_t object_id, triangle_id;
     int gouraud;
 } rl_raster_prim;

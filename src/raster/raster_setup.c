@@ -349,10 +349,13 @@ bool rl_raster_setup(const rl_raster *r, const rl_raster_batch *b, const rl_vec4
                 tex = b->texture;
             }
         }
+        const rl_texture *mask = NULL;
+        if (b->mask_texture && b->mask_texture[t] != RL_ID_NONE)
+            mask = b->textures[b->mask_texture[t]];
         for (int k = 0; k < 3; ++k) {
             poly[k].c = !b->colors ? rl_v4(0, 0, 0, 0)
                         : lazy ? lazy_color(b, tri[k]) : b->colors[tri[k]];
-            poly[k].uv = tex ? b->uvs[tri[k]] : rl_v2(0, 0);
+            poly[k].uv = tex || mask ? b->uvs[tri[k]] : rl_v2(0, 0);
             poly[k].d = r->perspective ? 0.0f : eye_depth[tri[k]];
             poly[k].b = rl_v3(k == 0 ? 1.0f : 0.0f, k == 1 ? 1.0f : 0.0f, k == 2 ? 1.0f : 0.0f);
         }
@@ -372,6 +375,8 @@ bool rl_raster_setup(const rl_raster *r, const rl_raster_batch *b, const rl_vec4
         proto.gouraud = b->colors != NULL;
         proto.color = b->face_colors ? b->face_colors[t] : b->color;
         proto.tex = tex;
+        proto.mask = mask;
+        proto.cutoff = mask ? b->mask_cutoff[t] : 0.0f;
         proto.triangle_id = b->triangle_ids ? b->triangle_ids[t] : b->first_triangle_id + t;
         proto.object_id = b->object_ids ? b->object_ids[t] : b->object_id;
         bool drawn = false;

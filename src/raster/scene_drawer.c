@@ -27,6 +27,12 @@
  *    pass, Ullmann 2003, Sec. 3.5.4-3.5.5); not done, so that "raster"
  *    images stay comparable with earlier runs.
  *
+ * Materials from real models (glTF 2.0): alpha masks drop fragments in
+ * every pass, lit or not, so IDs and depth show the holes the ray tracers
+ * see; normal maps are applied per pixel by rl_scene_drawer_finish, a
+ * deferred pass over the ID layer at the end of a frame, because Gouraud
+ * interpolation would blur a map's detail away.
+ *
  * With RL_RASTER_NO_COLOR nothing is lit at all (the ID/Z pre-pass of
  * Vertex Tracing). An object whose box lies outside the view is neither
  * lit nor drawn (rl_raster_box_outside: the rasterizer would drop all of
@@ -46,6 +52,8 @@
 #include "raster/scene_drawer.h"
 #include "rl/rl_raster.h"
 #include "scene/light_eval.h"
+#include "scene/masks.h"
+#include "scene/tri_plane.h"
 
 /* What every lighting evaluation needs; read-only, shared by all threads. */
 typedef struct shade_ctx {
@@ -143,6 +151,10 @@ typedef struct frame_buffers {
      * drawn untouched. */
     uint32_t *local;
     uint8_t *local_ready;        /* per object */
+    /* Alpha masks, per scene triangle, only when some material has one:
+     * its texture (RL_ID_NONE: whole) and cutoff (rl_raster_batch). */
+    uint32_t *mask_texture;
+    float *mask_cutoff;
 } frame_buffers;
 
 static void free_buffers(frame_buffers *b)
@@ -157,12 +169,33 @@ static void free_buffers(frame_buffers *b)
     free(b->triangle_texture);
     free(b->local);
     free(b->local_ready);
+    free(b->mask_texture);
+    free(b->mask_cutoff);
 }
 
 static uint32_t texture_of(const rl_scene_data *d, uint32_t material)
 {
     uint32_t t = d->materials[material].diffuse_texture;
     return t < d->num_textures ? t : RL_ID_NONE;
+}
+
+/* The per-triangle mask arrays, when the scene has any masked material:
+ * every pass (lit or not) drops the same fragments, as the ray tracers
+ * skip the same hits. */
+static rl_status prepare_masks(const rl_scene_data *d, frame_buffers *b)
+{
+    if (!rl_data_has_masks(d))
+        return RL_OK;
+    b->mask_texture = rl_calloc((size_t)d->num_triangles + 1, sizeof *b->mask_texture);
+    b->mask_cutoff = rl_calloc((size_t)d->num_triangles + 1, sizeof *b->mask_cutoff);
+    if (!b->mask_texture || !b->mask_cutoff)
+        return RL_ERR_OUT_OF_MEMORY;
+    for (size_t t = 0; t < d->num_triangles; ++t) {
+        uint32_t m = d->triangle_material[t];
+        b->mask_texture[t] = rl_material_mask(d, m);
+        b->mask_cutoff[t] = d->materials[m].alpha_cutoff;
+    }
+    return RL_OK;
 }
 
 static bool selected(const uint8_t *mask, uint32_t object)
@@ -193,8 +226,9 @@ static rl_status prepare(const rl_scene_data *d, rl_raster_shading shading, bool
     b->local_ready = rl_calloc(d->num_objects ? d->num_objects : 1, 1);
     if (!b->local || !b->local_ready)
         return RL_ERR_OUT_OF_MEMORY;
-    if (!lit)
-        return RL_OK;
+    rl_status st = prepare_masks(d, b);
+    if (st != RL_OK || !lit)
+        return st;
 
     if (shading == RL_SHADING_FLAT) {
         b->face_colors = rl_calloc((size_t)d->num_triangles + 1, sizeof *b->face_colors);
@@ -310,8 +344,8 @@ static rl_status object_batch(const rl_scene_data *d, uint32_t o, rl_raster_shad
     rl_status st = object_indices(d, b, o, corners);
     if (st != RL_OK)
         return st;
+    const size_t first = (size_t)obj->first_triangle * 3;
     if (corners) {
-        size_t first = (size_t)obj->first_triangle * 3;
         batch->num_vertices = obj->num_triangles * 3;
         batch->positions = b->corner_positions + first;
         batch->colors = b->corner_colors + first;
@@ -321,22 +355,28 @@ static rl_status object_batch(const rl_scene_data *d, uint32_t o, rl_raster_shad
             batch->triangle_texture = b->triangle_texture + obj->first_triangle;
             batch->textures = d->textures;
         }
-        return RL_OK;
-    }
-    batch->num_vertices = obj->num_vertices;
-    batch->positions = d->positions + obj->first_vertex;
-    if (!lit)
-        return RL_OK;
-    if (shading == RL_SHADING_FLAT) {
-        batch->face_colors = b->face_colors + obj->first_triangle;
     } else {
-        batch->colors = b->vertex_colors + obj->first_vertex;
-        batch->lazy = lazy;
-        uint32_t tex = shading == RL_SHADING_TEXTURED ? texture_of(d, m) : RL_ID_NONE;
-        if (tex != RL_ID_NONE) {
-            batch->uvs = d->uvs + obj->first_vertex;
-            batch->texture = d->textures[tex];
+        batch->num_vertices = obj->num_vertices;
+        batch->positions = d->positions + obj->first_vertex;
+        if (lit && shading == RL_SHADING_FLAT) {
+            batch->face_colors = b->face_colors + obj->first_triangle;
+        } else if (lit) {
+            batch->colors = b->vertex_colors + obj->first_vertex;
+            batch->lazy = lazy;
+            uint32_t tex = shading == RL_SHADING_TEXTURED ? texture_of(d, m) : RL_ID_NONE;
+            if (tex != RL_ID_NONE) {
+                batch->uvs = d->uvs + obj->first_vertex;
+                batch->texture = d->textures[tex];
+            }
         }
+    }
+    if (b->mask_texture) {
+        /* uvs alone texture nothing (only a texture does), so setting them
+         * for the mask leaves gouraud and flat colours as they were. */
+        batch->uvs = corners ? b->corner_uvs + first : d->uvs + obj->first_vertex;
+        batch->textures = d->textures;
+        batch->mask_texture = b->mask_texture + obj->first_triangle;
+        batch->mask_cutoff = b->mask_cutoff + obj->first_triangle;
     }
     return RL_OK;
 }
@@ -346,6 +386,7 @@ struct rl_scene_drawer {
     const rl_scene_data *data;
     rl_drawer_desc opt;
     bool lit;                    /* the draws write colour */
+    bool normal_maps;            /* lit per vertex, and some material has a normal map */
     shade_ctx ctx;
     int threads;
     uint8_t *object_lit;         /* per object: lighting done */
@@ -408,6 +449,11 @@ rl_status rl_scene_drawer_create(const rl_scene_data *d, rl_vec3 eye, const rl_d
         return st;
     }
     dr->lit = !(dr->opt.flags & RL_RASTER_NO_COLOR);
+    /* Multi-pass blending (DEPTH_EQUAL, BLEND_ADD) adds to what is there;
+     * a per-pixel pass that replaces colours would break it. */
+    for (uint32_t m = 0; m < d->num_materials && dr->lit && dr->opt.shading != RL_SHADING_FLAT &&
+                         !(dr->opt.flags & (RL_RASTER_DEPTH_EQUAL | RL_RASTER_BLEND_ADD)); ++m)
+        dr->normal_maps |= d->materials[m].normal_texture < d->num_textures;
 #ifdef _OPENMP
     dr->threads = dr->opt.threads > 0 ? dr->opt.threads : omp_get_max_threads();
 #else
@@ -686,4 +732,67 @@ rl_status rl_raster_draw_scene(rl_raster *ras, const rl_scene_data *d, rl_vec3 e
         st = rl_scene_drawer_draw_all(dr, ras, c, progress, user);
     rl_scene_drawer_release(dr);
     return st;
+}
+
+/* Pixel i's colour, shaded anew where it shows a normal-mapped triangle of
+ * a selected object. */
+static void shade_pixel(const rl_scene_drawer *dr, rl_image *target, const rl_mat4 *inv, int x, int y)
+{
+    const rl_scene_data *d = dr->data;
+    const size_t i = (size_t)y * (size_t)target->width + (size_t)x;
+    const uint32_t tri = target->triangle_id[i];
+    if (tri >= d->num_triangles)
+        return;
+    const uint32_t mi = d->triangle_material[tri], o = d->triangle_object[tri];
+    const rl_material *m = &d->materials[mi];
+    /* A surfel's pixel holds a point ID, which names no triangle of o. */
+    if (m->normal_texture >= d->num_textures || !selected(dr->opt.object_mask, o) ||
+        (target->object_id && target->object_id[i] != o))
+        return;
+    /* The pixel centre's line between the near plane (NDC z = -1) and
+     * NDC z = 0, both finite for perspective and orthographic views. */
+    const float nx = 2.0f * ((float)x + 0.5f) / (float)target->width - 1.0f;
+    const float ny = 1.0f - 2.0f * ((float)y + 0.5f) / (float)target->height;
+    rl_vec4 a = rl_mat4_mul_vec4(inv, rl_v4(nx, ny, -1.0f, 1.0f));
+    rl_vec4 b = rl_mat4_mul_vec4(inv, rl_v4(nx, ny, 0.0f, 1.0f));
+    if (!(a.w != 0.0f && b.w != 0.0f))
+        return;
+    rl_vec3 pa = rl_scale(rl_v3(a.x, a.y, a.z), 1.0f / a.w), pb = rl_scale(rl_v3(b.x, b.y, b.z), 1.0f / b.w);
+    rl_ray ray = { pa, 0.0f, rl_sub(pb, pa), INFINITY };
+    float t, u, v;
+    if (!rl_tri_plane_hit(d, tri, &ray, &t, &u, &v))
+        return;
+    const uint32_t *idx = &d->indices[3 * (size_t)tri];
+    const float w = 1.0f - u - v;
+    rl_vec3 p = rl_ray_at(&ray, t);
+    rl_vec3 ns = rl_add(rl_add(rl_scale(d->normals[idx[0]], w), rl_scale(d->normals[idx[1]], u)),
+                        rl_scale(d->normals[idx[2]], v));
+    rl_vec2 t0 = d->uvs[idx[0]], t1 = d->uvs[idx[1]], t2 = d->uvs[idx[2]];
+    rl_vec2 uv = rl_v2(w * t0.x + u * t1.x + v * t2.x, w * t0.y + u * t1.y + v * t2.y);
+    /* Two-sided as phong(): the map bends the normal of the side seen. */
+    if (rl_dot(ns, rl_sub(dr->ctx.eye, p)) < 0.0f)
+        ns = rl_neg(ns);
+    rl_vec3 n = rl_normalize(rl_shading_normal(d, tri, rl_normalize(ns), uv));
+    rl_vec4 c = phong(&dr->ctx, m, p, n);
+    uint32_t tex = dr->opt.shading == RL_SHADING_TEXTURED ? texture_of(d, mi) : RL_ID_NONE;
+    if (tex != RL_ID_NONE) {
+        rl_vec4 texel = rl_texture_sample(d->textures[tex], uv);
+        c = rl_v4(c.x * texel.x, c.y * texel.y, c.z * texel.z, c.w * texel.w);
+    }
+    target->color[i] = c;
+}
+
+void rl_scene_drawer_finish(rl_scene_drawer *dr, rl_image *target, const rl_mat4 *view, const rl_mat4 *proj)
+{
+    if (!dr || !dr->normal_maps || !target || !(target->layers & RL_LAYER_COLOR) || !target->color ||
+        !(target->layers & RL_LAYER_ID) || !target->triangle_id)
+        return;
+    rl_mat4 view_proj = rl_mat4_mul(proj, view), inv;
+    if (!rl_mat4_invert(&view_proj, &inv))
+        return;
+    const int height = target->height;
+#pragma omp parallel for num_threads(dr->threads) schedule(dynamic, 4)
+    for (int y = 0; y < height; ++y)
+        for (int x = 0; x < target->width; ++x)
+            shade_pixel(dr, target, &inv, x, y);
 }

@@ -64,6 +64,16 @@ rl_status rl_scene_drawer_draw(rl_scene_drawer *dr, rl_raster *ras, uint32_t obj
 rl_status rl_scene_drawer_draw_list(rl_scene_drawer *dr, rl_raster *ras, const uint32_t *objects, uint32_t count,
                                     rl_raster_counters *c);
 void rl_scene_drawer_release(rl_scene_drawer *dr);    /* NULL is a no-op */
+/* Ends a lit gouraud or textured frame drawn into target with view and
+ * proj: the pixels that show a normal-mapped surface (rl_material
+ * .normal_texture) are shaded again per pixel with the bent normal of
+ * rl_shading_normal, because a map's detail is finer than the vertices
+ * that Gouraud shading lights (a deferred pass over the ID layer, Saito &
+ * Takahashi 1990). Needs the target's colour and ID layers; a no-op
+ * without normal maps, in flat shading, for unlit drawers and for
+ * multi-pass blending. Not for frames with points (their IDs are point
+ * IDs): the caller skips it there. */
+void rl_scene_drawer_finish(rl_scene_drawer *dr, rl_image *target, const rl_mat4 *view, const rl_mat4 *proj);
 /* Draws every selected object in index order (lists of many objects, see
  * rl_scene_drawer_draw_list): rl_raster_draw_scene with a drawer of one's
  * own. */

@@ -32,6 +32,7 @@
  * random surface points agree with an exact shadow ray; the rest lie within
  * a texel or two of silhouettes, where the jitter reaches the occluder. */
 #include "rl/rl_shadowmap.h"
+#include "scene/masks.h"
 
 #include <math.h>
 #include <stdlib.h>
@@ -134,8 +135,9 @@ static rl_vec3 light_point(const rl_light *l)
     return l->position;
 }
 
-static rl_status render_face(const rl_scene_data *d, const uint32_t *indices, uint32_t count,
-                             rl_vec3 eye, int size, sm_face *f)
+/* mask_texture, mask_cutoff: per drawn triangle, or NULL (no alpha masks). */
+static rl_status render_face(const rl_scene_data *d, const uint32_t *indices, const uint32_t *mask_texture,
+                             const float *mask_cutoff, uint32_t count, rl_vec3 eye, int size, sm_face *f)
 {
     /* Near plane far below any sensible feature size (depth is recovered
      * from 1/w, so a small near costs no precision); far encloses the
@@ -163,6 +165,11 @@ static rl_status render_face(const rl_scene_data *d, const uint32_t *indices, ui
             .num_triangles = count,
             .indices = indices,
             .flags = RL_RASTER_NO_COLOR | RL_RASTER_NO_ID,
+            /* Light passes through the holes of alpha masks, as rays do. */
+            .uvs = mask_texture ? d->uvs : NULL,
+            .textures = mask_texture ? d->textures : NULL,
+            .mask_texture = mask_texture,
+            .mask_cutoff = mask_cutoff,
         };
         s = rl_raster_draw(r, &batch, NULL);
     }
@@ -201,10 +208,15 @@ rl_status rl_shadowmap_create(const rl_scene *scene, const rl_shadowmap_desc *de
     rl_shadowmap *sm = rl_calloc(1, sizeof *sm);
     sm_light *lights = d->num_lights ? rl_calloc(d->num_lights, sizeof *lights) : NULL;
     uint32_t *indices = rl_alloc((size_t)d->num_triangles * 3 * sizeof *indices + 1);
-    if (!sm || (d->num_lights && !lights) || !indices) {
+    const bool masked = rl_data_has_masks(d);
+    uint32_t *mask_texture = masked ? rl_alloc((size_t)d->num_triangles * sizeof *mask_texture + 1) : NULL;
+    float *mask_cutoff = masked ? rl_alloc((size_t)d->num_triangles * sizeof *mask_cutoff + 1) : NULL;
+    if (!sm || (d->num_lights && !lights) || !indices || (masked && (!mask_texture || !mask_cutoff))) {
         free(sm);
         free(lights);
         free(indices);
+        free(mask_texture);
+        free(mask_cutoff);
         return RL_ERR_OUT_OF_MEMORY;
     }
     sm->size = p.size;
@@ -225,6 +237,10 @@ rl_status rl_shadowmap_create(const rl_scene *scene, const rl_shadowmap_desc *de
         for (uint32_t t = 0; t < d->num_triangles; ++t)
             if (!own_emitter(d, l, t, tol)) {
                 memcpy(&indices[3 * count], &d->indices[3 * t], 3 * sizeof *indices);
+                if (masked) {
+                    mask_texture[count] = rl_material_mask(d, d->triangle_material[t]);
+                    mask_cutoff[count] = d->materials[d->triangle_material[t]].alpha_cutoff;
+                }
                 ++count;
             }
         rl_status face_status[6] = { RL_OK };
@@ -233,8 +249,8 @@ rl_status rl_shadowmap_create(const rl_scene *scene, const rl_shadowmap_desc *de
         #pragma omp parallel for schedule(dynamic, 1)
         for (int f = 0; f < 6; ++f) {
             face_frame(f, &lights[li].faces[f]);
-            face_status[f] = render_face(d, indices, count, lights[li].position, p.size,
-                                         &lights[li].faces[f]);
+            face_status[f] = render_face(d, indices, mask_texture, mask_cutoff, count, lights[li].position,
+                                         p.size, &lights[li].faces[f]);
         }
         for (int f = 0; f < 6 && !status; ++f)
             if (face_status[f])
@@ -243,6 +259,8 @@ rl_status rl_shadowmap_create(const rl_scene *scene, const rl_shadowmap_desc *de
         sm->memory += 6 * (size_t)p.size * (size_t)p.size * sizeof(float);
     }
     free(indices);
+    free(mask_texture);
+    free(mask_cutoff);
     if (status) {
         rl_shadowmap_release(sm);
         return status;

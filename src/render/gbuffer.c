@@ -20,6 +20,7 @@
 #include "rl/rl_gbuffer.h"
 #include "rl/rl_image.h"
 #include "rl/rl_raster.h"
+#include "scene/tri_plane.h"
 
 static void clear_pixel(rl_gbuffer *g, size_t i)
 {
@@ -165,36 +166,6 @@ rl_status rl_gbuffer_trace(rl_gbuffer *g, const rl_accel *accel, const rl_camera
     return RL_OK;
 }
 
-/* The ray's intersection with the plane of triangle tri (Möller & Trumbore
- * 1997 without the inside test), barycentrics clamped onto the triangle.
- * False only for a ray parallel to the plane. */
-static bool hit_triangle_plane(const rl_scene_data *d, uint32_t tri, const rl_ray *ray, float *t, float *u, float *v)
-{
-    const uint32_t *idx = &d->indices[3 * (size_t)tri];
-    rl_vec3 p0 = d->positions[idx[0]];
-    rl_vec3 e1 = rl_sub(d->positions[idx[1]], p0), e2 = rl_sub(d->positions[idx[2]], p0);
-    rl_vec3 pv = rl_cross(ray->d, e2);
-    float det = rl_dot(e1, pv);
-    if (!(fabsf(det) > 0.0f))
-        return false;
-    float inv = 1.0f / det;
-    rl_vec3 tv = rl_sub(ray->o, p0);
-    float uu = rl_dot(tv, pv) * inv;
-    rl_vec3 qv = rl_cross(tv, e1);
-    float vv = rl_dot(ray->d, qv) * inv;
-    *t = rl_dot(e2, qv) * inv;
-    uu = rl_maxf(uu, 0.0f);
-    vv = rl_maxf(vv, 0.0f);
-    if (uu + vv > 1.0f) {
-        float s = 1.0f / (uu + vv);
-        uu *= s;
-        vv *= s;
-    }
-    *u = uu;
-    *v = vv;
-    return isfinite(*t) && *t > 0.0f;
-}
-
 rl_status rl_gbuffer_raster(rl_gbuffer *g, const rl_scene *scene, const rl_camera *cam)
 {
     rl_camera c;
@@ -230,7 +201,7 @@ rl_status rl_gbuffer_raster(rl_gbuffer *g, const rl_scene *scene, const rl_camer
             uint32_t tri = ids->triangle_id[i];
             rl_ray ray = rl_camera_frame_ray(&f, (float)x + 0.5f, (float)y + 0.5f);
             float t, u, v;
-            if (tri < d->num_triangles && hit_triangle_plane(d, tri, &ray, &t, &u, &v))
+            if (tri < d->num_triangles && rl_tri_plane_hit(d, tri, &ray, &t, &u, &v))
                 fill_pixel(g, i, d, ray.d, forward, tri, t, u, v);
             else
                 clear_pixel(g, i);
