@@ -739,8 +739,10 @@ const rl_gbuffer *rl_pt_gbuffer(const rl_renderer *r)
 }
 
 const rl_renderer_class rl_pt_renderer_class = {
-    .info = { "pt", "Progressive path tracing with NEE, Russian roulette and Phong sampling; Line Space backends",
-              "Schröder 2017", .progressive = true, .default_time_s = PT_DEFAULT_TIME_S },
+    .info = { .name = "pt",
+              .description = "Progressive path tracing with NEE, Russian roulette and Phong sampling; "
+                             "Line Space backends",
+              .reference = "Schröder 2017", .progressive = true, .default_time_s = PT_DEFAULT_TIME_S },
     .options = pt_options,
     .num_options = NUM_OPTIONS,
     .state_size = sizeof(pt_state),

@@ -247,9 +247,10 @@ static rl_status select_render(rl_renderer *r, void *state, const rl_scene *scen
 }
 
 const rl_renderer_class rl_select_renderer_class = {
-    .info = { "select", "Runtime selection per position of one of two culling renderers (default chcpp or "
-                        "svs) from sampled properties",
-              "Jähn 2015, Sec. 7.5" },
+    .info = { .name = "select",
+              .description = "Runtime selection per position of one of two culling renderers (default chcpp or "
+                             "svs) from sampled properties",
+              .reference = "Jähn 2015, Sec. 7.5" },
     .options = select_options,
     .num_options = sizeof select_options / sizeof select_options[0],
     .state_size = sizeof(select_state),

@@ -404,9 +404,10 @@ static rl_status surfels_render(rl_renderer *r, void *state, const rl_scene *sce
 }
 
 const rl_renderer_class rl_surfels_renderer_class = {
-    .info = { "surfels", "Progressive Blue Surfels: distant octree nodes as prefixes of blue-noise surfel "
-                         "sequences (approximate level of detail)",
-              "Jähn 2015, Ch. 6" },
+    .info = { .name = "surfels",
+              .description = "Progressive Blue Surfels: distant octree nodes as prefixes of blue-noise surfel "
+                             "sequences (approximate level of detail)",
+              .reference = "Jähn 2015, Ch. 6" },
     .options = surfels_options,
     .num_options = sizeof surfels_options / sizeof surfels_options[0],
     .state_size = sizeof(surfels_state),

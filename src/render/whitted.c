@@ -257,8 +257,9 @@ static rl_status whitted_render(rl_renderer *r, void *state, const rl_scene *sce
 }
 
 const rl_renderer_class rl_whitted_renderer_class = {
-    .info = { "whitted", "Recursive Whitted ray tracing with Phong shading, hard shadows, reflection and refraction",
-              "Whitted 1980; coefficient model of Ullmann 2003, Sec. 3.1 (eq. 3.1-3.4)" },
+    .info = { .name = "whitted",
+              .description = "Recursive Whitted ray tracing with Phong shading, hard shadows, reflection and refraction",
+              .reference = "Whitted 1980; coefficient model of Ullmann 2003, Sec. 3.1 (eq. 3.1-3.4)" },
     .options = whitted_options,
     .num_options = sizeof whitted_options / sizeof whitted_options[0],
     .state_size = sizeof(whitted_state),
