@@ -64,6 +64,9 @@ static const char bench_vt_help[] =
     "  threads     1, 2, 4, ... threads: speed-up, rays per thread, load imbalance,\n"
     "              time split (Fig. 5.9, 5.15)\n"
     "  visibility  ID/Z/clip tests on and off (Fig. 5.13)\n"
+    "  modes       the shading modes +-S +-R +-T (shadow, reflection, transmission\n"
+    "              rays on or off) for both renderers: time split, VT against\n"
+    "              Whitted in time and rays, samples, SSIM (Fig. 5.9, 5.10)\n"
     "  animation   cluster scene camera path with and without temporal coherence\n"
     "\n"
     "options:\n"
@@ -83,10 +86,15 @@ static const char bench_vt_help[] =
     "example:\n"
     "  rl bench vt --only criteria,quality --size 512x512\n";
 
-enum { SEC_CRITERIA, SEC_RESOLUTION, SEC_QUALITY, SEC_THREADS, SEC_VISIBILITY, SEC_ANIMATION,
+/* The static sections (the table scene) come before animation. */
+enum { SEC_CRITERIA, SEC_RESOLUTION, SEC_QUALITY, SEC_THREADS, SEC_VISIBILITY, SEC_MODES, SEC_ANIMATION,
        SEC_COUNT };
-static const char *const section_names[SEC_COUNT] = { "criteria", "resolution", "quality",
-                                                      "threads", "visibility", "animation" };
+static const char *const section_names[SEC_COUNT] = { "criteria", "resolution", "quality", "threads",
+                                                      "visibility", "modes", "animation" };
+
+/* The shading modes of Ullmann 2003, Figs. 5.9/5.10, as bits: shadow
+ * feelers (S), reflection rays (R), transmission rays (T). */
+enum { MODE_S = 1, MODE_R = 2, MODE_T = 4, MODE_ALL = 7 };
 
 /* Tracer options set on both renderers (their defaults, set explicitly so
  * that a changed default cannot make the comparison unfair). */
@@ -97,7 +105,7 @@ static const char *const section_names[SEC_COUNT] = { "criteria", "resolution", 
 #define MAX_FRAMES 100000
 #define SSIM_GOAL 0.95          /* "equal quality" for the min_edge sweep */
 #define TIME_RATIO_GOAL 0.1     /* VT time / Whitted time at equal quality */
-#define MAX_REFS 16
+#define MAX_REFS 32
 
 /* Ullmann 2003, Fig. 5.5/5.6: generated vertices on the table scene. */
 static const struct {
@@ -118,7 +126,7 @@ typedef struct bvt_args {
 
 /* A Whitted frame, the reference of every comparison at its size. */
 typedef struct ref_frame {
-    int width, height, threads;
+    int width, height, threads, mode;
     rl_image *image;               /* colour and IDs */
     uint8_t *mask;                 /* VT-object pixels */
     uint64_t mask_pixels;
@@ -311,6 +319,22 @@ static rl_status make_renderer(const char *name, int threads, rl_renderer **out)
     return st;
 }
 
+/* "+S-R+T" */
+static void mode_name(int mode, char out[8])
+{
+    snprintf(out, 8, "%cS%cR%cT", mode & MODE_S ? '+' : '-', mode & MODE_R ? '+' : '-', mode & MODE_T ? '+' : '-');
+}
+
+static rl_status set_mode(rl_renderer *r, int mode)
+{
+    rl_status st = rl_renderer_set(r, "shadows", mode & MODE_S ? "true" : "false");
+    if (st == RL_OK)
+        st = rl_renderer_set(r, "reflections", mode & MODE_R ? "true" : "false");
+    if (st == RL_OK)
+        st = rl_renderer_set(r, "transmission", mode & MODE_T ? "true" : "false");
+    return st;
+}
+
 static rl_status set_int(rl_renderer *r, const char *key, double value)
 {
     char text[32];
@@ -350,22 +374,24 @@ static rl_status render_timed(rl_renderer *r, const rl_scene *scene, const rl_ca
 
 /* The Whitted frame at width x height with threads, rendered on first use. */
 /* Whitted on the table at img's size: warm-up, then the fastest timed run. */
-static rl_status time_whitted(bvt *b, int threads, rl_image *img, timed_frame *t)
+static rl_status time_whitted(bvt *b, int threads, int mode, rl_image *img, timed_frame *t)
 {
     rl_renderer *r = NULL;
     rl_camera cam = sized(&b->table_cam, img->width, img->height);
     rl_status st = make_renderer("whitted", threads, &r);
+    if (st == RL_OK)
+        st = set_mode(r, mode);
     if (st == RL_OK)
         st = render_timed(r, b->table, &cam, img, b->runs, t);
     rl_renderer_release(r);
     return st;
 }
 
-static rl_status reference(bvt *b, int width, int height, int threads, ref_frame **out)
+static rl_status reference(bvt *b, int width, int height, int threads, int mode, ref_frame **out)
 {
     for (int i = 0; i < b->num_refs; i++) {
         ref_frame *f = &b->refs[i];
-        if (f->width == width && f->height == height && f->threads == threads) {
+        if (f->width == width && f->height == height && f->threads == threads && f->mode == mode) {
             *out = f;
             return RL_OK;
         }
@@ -379,7 +405,7 @@ static rl_status reference(bvt *b, int width, int height, int threads, ref_frame
     if (st == RL_OK && !(f->mask = malloc((size_t)width * (size_t)height)))
         st = RL_ERR_OUT_OF_MEMORY;
     if (st == RL_OK)
-        st = time_whitted(b, threads, f->image, &t);
+        st = time_whitted(b, threads, mode, f->image, &t);
     if (st != RL_OK) {
         rl_image_release(f->image);
         free(f->mask);
@@ -388,6 +414,7 @@ static rl_status reference(bvt *b, int width, int height, int threads, ref_frame
     f->width = width;
     f->height = height;
     f->threads = threads;
+    f->mode = mode;
     f->stats = t.stats;
     f->mask_pixels = fill_mask(f->image, b->table_vt, rl_scene_get_data(b->table)->num_objects,
                                f->mask);
@@ -424,7 +451,7 @@ static rl_status sec_criteria(void *ctx, cJSON *sec)
     bvt *b = ctx;
     int w = b->a->width, h = b->a->height;
     ref_frame *ref = NULL;
-    rl_status st = reference(b, w, h, b->threads, &ref);
+    rl_status st = reference(b, w, h, b->threads, MODE_ALL, &ref);
     if (st != RL_OK)
         return st;
     cJSON_AddStringToObject(sec, "scene", "table");
@@ -537,7 +564,7 @@ static rl_status sec_resolution(void *ctx, cJSON *sec)
         rl_vt_stats preview;
         quality q;
         int updates = 0;
-        st = reference(b, n, n, b->threads, &ref);
+        st = reference(b, n, n, b->threads, MODE_ALL, &ref);
         if (st == RL_OK)
             st = make_renderer("vt", b->threads, &r);
         if (st == RL_OK)
@@ -617,7 +644,7 @@ static rl_status retime_reference(bvt *b, const ref_frame *ref, double *ms)
     timed_frame t;
     rl_status st = rl_image_create(ref->width, ref->height, RL_LAYER_COLOR, &img);
     if (st == RL_OK)
-        st = time_whitted(b, ref->threads, img, &t);
+        st = time_whitted(b, ref->threads, ref->mode, img, &t);
     rl_image_release(img);
     if (st == RL_OK)
         *ms = t.stats.time_ms;
@@ -645,7 +672,7 @@ static rl_status sec_quality(void *ctx, cJSON *sec)
     enum { NUM_CRITS = sizeof crits / sizeof crits[0], NUM_EDGES = sizeof min_edges / sizeof min_edges[0] };
     int w = b->a->width, h = b->a->height;
     ref_frame *ref = NULL;
-    rl_status st = reference(b, w, h, b->threads, &ref);
+    rl_status st = reference(b, w, h, b->threads, MODE_ALL, &ref);
     if (st != RL_OK)
         return st;
     char size[32];
@@ -773,7 +800,7 @@ static rl_status sec_threads(void *ctx, cJSON *sec)
         rl_image *img = NULL;
         rl_camera cam = sized(&b->table_cam, w, h);
         timed_frame t;
-        st = reference(b, w, h, n, &ref);
+        st = reference(b, w, h, n, MODE_ALL, &ref);
         if (st == RL_OK)
             st = make_renderer("vt", n, &r);
         if (st == RL_OK)
@@ -850,7 +877,7 @@ static rl_status sec_visibility(void *ctx, cJSON *sec)
     };
     int w = b->a->width, h = b->a->height;
     ref_frame *ref = NULL;
-    rl_status st = reference(b, w, h, b->threads, &ref);
+    rl_status st = reference(b, w, h, b->threads, MODE_ALL, &ref);
     if (st != RL_OK)
         return st;
     char size[32];
@@ -905,6 +932,79 @@ static rl_status sec_visibility(void *ctx, cJSON *sec)
         fflush(stdout);
         note("visibility %s %s: %.1f ms, %llu vertices sampled", configs[i].name, size,
              t.stats.time_ms, (unsigned long long)t.vt.vertices_sampled);
+    }
+    rl_image_release(img);
+    rl_renderer_release(r);
+    return st;
+}
+
+/* ------------------------------------------------------------- modes -- */
+
+/* Figs. 5.9/5.10: every shading mode, VT against Whitted in the same mode.
+ * The thesis gives VT 6.8x (+S+R+T) to 86x (+S-R-T) Whitted's speed. */
+static rl_status sec_modes(void *ctx, cJSON *sec)
+{
+    bvt *b = ctx;
+    static const int modes[] = { MODE_ALL, MODE_S | MODE_R, MODE_S | MODE_T, MODE_S,
+                                 MODE_R | MODE_T, MODE_R, MODE_T, 0 };
+    int w = b->a->width, h = b->a->height;
+    char size[32];
+    snprintf(size, sizeof size, "%dx%d", w, h);
+    cJSON_AddStringToObject(sec, "scene", "table");
+    cJSON_AddStringToObject(sec, "size", size);
+    cJSON *rows = cJSON_AddArrayToObject(sec, "runs");
+    rl_renderer *r = NULL;
+    rl_image *img = NULL;
+    rl_camera cam = sized(&b->table_cam, w, h);
+    rl_status st = make_renderer("vt", b->threads, &r);
+    if (st == RL_OK)
+        st = rl_image_create(w, h, RL_LAYER_COLOR, &img);
+    printf("\nshading modes (Fig. 5.9/5.10): table %s, S shadow feelers, R reflection rays, T transmission rays\n",
+           size);
+    printf("%-7s %9s %9s %7s %7s %7s %7s %7s %8s %8s  %6s %6s\n", "mode", "whitted", "VT ms", "vis", "sample",
+           "refine", "draw", "x", "rays %", "samp %", "ssimVT", "thesis");
+    for (size_t i = 0; st == RL_OK && i < sizeof modes / sizeof modes[0]; i++) {
+        char name[8];
+        mode_name(modes[i], name);
+        ref_frame *ref = NULL;
+        timed_frame t;
+        quality q;
+        rl_clear_error();
+        st = reference(b, w, h, b->threads, modes[i], &ref);
+        if (st == RL_OK)
+            st = set_mode(r, modes[i]);
+        if (st == RL_OK)
+            st = render_timed(r, b->table, &cam, img, b->runs, &t);
+        if (st == RL_OK)
+            st = compare(img, ref->image, ref->mask, ref->mask_pixels, &q);
+        if (st != RL_OK)
+            break;
+        double speedup = ratio(ref->stats.time_ms, t.stats.time_ms);
+        double rays_pct = 100.0 * ratio((double)rays_total(&t.stats), (double)rays_total(&ref->stats));
+        double samples_pct = 100.0 * (double)t.vt.vertices_sampled / ((double)w * h);
+        double thesis = modes[i] == MODE_ALL ? 6.8 : modes[i] == MODE_S ? 86.0 : NAN;
+        cJSON *row = cJSON_CreateObject();
+        cJSON_AddItemToArray(rows, row);
+        cJSON_AddStringToObject(row, "mode", name);
+        cJSON_AddBoolToObject(row, "shadows", modes[i] & MODE_S);
+        cJSON_AddBoolToObject(row, "reflections", modes[i] & MODE_R);
+        cJSON_AddBoolToObject(row, "transmission", modes[i] & MODE_T);
+        cJSON_AddItemToObject(row, "whitted", ref_json(ref));
+        add_num(row, "time_ms", t.stats.time_ms);
+        cJSON_AddItemToObject(row, "rays", rays_json(&t.stats));
+        add_num(row, "whitted_over_vt_time", speedup);
+        add_num(row, "rays_percent_of_whitted", rays_pct);
+        add_num(row, "samples_percent_of_pixels", samples_pct);
+        add_num(row, "thesis_whitted_over_vt_time", thesis);
+        cJSON_AddItemToObject(row, "quality", quality_json(&q));
+        cJSON_AddItemToObject(row, "vt_stats", vt_stats_json(&t.vt));
+        printf("%-7s %9.1f %9.1f %7.1f %7.1f %7.1f %7.1f %7.2f %8.1f %8.2f  %6.3f %6s\n", name, ref->stats.time_ms,
+               t.stats.time_ms, t.vt.time_visibility_ms, t.vt.time_sampling_ms, t.vt.time_refine_ms,
+               t.vt.time_draw_ms, speedup, rays_pct, samples_pct, q.vt_px.ssim,
+               isnan(thesis) ? "" : (modes[i] == MODE_ALL ? "6.8" : "86"));
+        fflush(stdout);
+        note("mode %s %s: VT %.1f ms, whitted %.1f ms (%.2fx), SSIM %.3f (VT pixels)", name, size,
+             t.stats.time_ms, ref->stats.time_ms, speedup, q.vt_px.ssim);
     }
     rl_image_release(img);
     rl_renderer_release(r);
@@ -1282,9 +1382,8 @@ static int run(bvt *b)
     cJSON *root = report_root(b);
     if (!root)
         return cli_fail(RL_CLI_FAIL, "out of memory");
-    static const bench_section_fn fns[SEC_COUNT] = { sec_criteria, sec_resolution,
-                                                        sec_quality, sec_threads,
-                                                        sec_visibility, sec_animation };
+    static const bench_section_fn fns[SEC_COUNT] = { sec_criteria, sec_resolution, sec_quality, sec_threads,
+                                                     sec_visibility, sec_modes, sec_animation };
     printf("rl bench vt: Vertex Tracing vs Whitted, %d threads, max_depth %s, area_samples %s, "
            "shadows %s\n", b->threads, TRACE_MAX_DEPTH, TRACE_AREA_SAMPLES, TRACE_SHADOWS);
     rc = bench_run_sections("vt", root, section_names, fns, SEC_COUNT, a->sections, b,

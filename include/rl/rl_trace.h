@@ -60,6 +60,11 @@ typedef struct rl_tracer_desc {           /* zero = default */
     float ambient;            /* ambient term × k_d; 0 -> 0.05, < 0 -> none */
     rl_vec3 background;       /* radiance of rays that leave the scene */
     bool no_shadows;          /* skip shadow feelers (all lights visible) */
+    /* The shading modes of Ullmann 2003, Figs. 5.9/5.10 (+-S +-R +-T):
+     * without reflection (transmission) rays the k_r (k_t) term is left
+     * out, as the thesis switches the ray type off; no_shadows is -S. */
+    bool no_reflections;
+    bool no_transmission;
     /* Leave out eq. 3.17's transmitted highlight k_t cos^p φ_t (Ullmann
      * 2003, Sec. 3.5.2), which lights behind a transmissive surface add;
      * with it off the local term is classic Phong, as before 2026-12-05. */

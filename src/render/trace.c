@@ -134,6 +134,8 @@ rl_status rl_tracer_create(const rl_accel *accel, const rl_tracer_desc *desc, rl
     t->ambient = d.ambient == 0.0f ? 0.05f : rl_maxf(d.ambient, 0.0f);
     t->background = d.background;
     t->shadows = !d.no_shadows;
+    t->reflections = !d.no_reflections;
+    t->transmission = !d.no_transmission;
     t->transmitted_highlight = !d.no_transmitted_highlight;
     t->tree_shadow_any_hit = d.tree_shadow_any_hit;
     t->defer_through = d.defer_through;
@@ -204,7 +206,8 @@ static bool surface_at(const rl_tracer *tr, const rl_hit *hit, rl_vec3 d, rl_tra
 int rl_trace_secondary_rays(const rl_tracer *tr, const rl_trace_surface *s, rl_vec3 d, float weight,
                             rl_trace_secondary out[2])
 {
-    float k_r = s->m->reflectivity, k_t = s->m->transmissivity;
+    float k_r = tr->reflections ? s->m->reflectivity : 0.0f;
+    float k_t = tr->transmission ? s->m->transmissivity : 0.0f;
     rl_vec3 refracted = rl_v3s(0.0f);
     if (k_t > 0.0f) {
         /* Entering when the geometric normal faced the ray (eq. 3.4 with
@@ -212,7 +215,7 @@ int rl_trace_secondary_rays(const rl_tracer *tr, const rl_trace_surface *s, rl_v
         float ior = s->m->ior >= 1.0f ? s->m->ior : 1.0f;
         float eta = s->front ? 1.0f / ior : ior;
         if (!rl_refract(d, s->ns, eta, &refracted)) {
-            k_r += k_t;               /* total internal reflection */
+            k_r += tr->reflections ? k_t : 0.0f;   /* total internal reflection */
             k_t = 0.0f;
         }
     }

@@ -23,6 +23,7 @@ struct rl_tracer {
     float ambient;            /* resolved: 0 = none */
     rl_vec3 background;
     bool shadows;
+    bool reflections, transmission;   /* the +-R, +-T modes (rl_tracer_desc) */
     bool transmitted_highlight;   /* eq. 3.17's k_t cos^p φ_t term */
     bool tree_shadow_any_hit; /* see rl_tracer_desc */
     bool defer_through;       /* see rl_tracer_desc */

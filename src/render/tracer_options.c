@@ -26,6 +26,8 @@ rl_status rl_tracer_options_read(const rl_renderer *r, rl_tracer_desc *desc, rl_
     desc->ambient = ambient > 0.0f ? ambient : -1.0f;
     desc->background = rl_renderer_opt_color(r, "background");
     desc->no_shadows = !rl_renderer_opt_bool(r, "shadows");
+    desc->no_reflections = !rl_renderer_opt_bool(r, "reflections");
+    desc->no_transmission = !rl_renderer_opt_bool(r, "transmission");
     desc->no_transmitted_highlight = !rl_renderer_opt_bool(r, "transmitted_highlight");
     return rl_accel_kind_parse(rl_tracer_accel_choices[rl_renderer_opt_enum(r, "accel")], kind);
 }

@@ -19,7 +19,13 @@ extern const char *const rl_tracer_accel_choices[];
     { "max_depth", RL_OPT_INT, "5", "reflection/refraction recursion depth (0: local shading only)", \
       0, 64, NULL },                                                                                  \
     { "area_samples", RL_OPT_INT, "4", "n x n jittered shadow feelers per quad light", 1, 32, NULL }, \
-    { "shadows", RL_OPT_BOOL, "true", "trace shadow feelers (false: every light is visible)",        \
+    { "shadows", RL_OPT_BOOL, "true", "trace shadow feelers (false: every light is visible; -S)",    \
+      0, 0, NULL },                                                                                   \
+    { "reflections", RL_OPT_BOOL, "true",                                                             \
+      "trace reflection rays (false: the k_r term is left out; -R of Ullmann 2003, Fig. 5.10)",       \
+      0, 0, NULL },                                                                                   \
+    { "transmission", RL_OPT_BOOL, "true",                                                            \
+      "trace transmission rays (false: the k_t term is left out; -T of Ullmann 2003, Fig. 5.10)",     \
       0, 0, NULL },                                                                                   \
     { "transmitted_highlight", RL_OPT_BOOL, "true",                                                   \
       "eq. 3.17: lights behind a transmissive surface add k_t cos^n of the angle between their "      \

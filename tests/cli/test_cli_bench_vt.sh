@@ -26,7 +26,7 @@ expect_in "$TMP/err" "rl: error: "
 
 # Help, and the bench dispatcher knows vt.
 expect_exit 0 "$RL" bench vt --help
-for o in --size --anim-size --frames --threads --only --out --quick criteria animation; do
+for o in --size --anim-size --frames --threads --only --out --quick criteria modes animation; do
     expect_in "$TMP/out" "$o"
 done
 expect_error 2 "known: rays, vt, pt" "$RL" bench nosuch
@@ -34,7 +34,7 @@ expect_error 2 "known: rays, vt, pt" "$RL" bench nosuch
 # The quick run: every section, a table on stdout, JSON where --out says.
 expect_exit 0 "$RL" bench vt --quick --out "$TMP/vt.json"
 [ -s "$TMP/vt.json" ] || fail "vt.json was not written"
-for s in criteria resolution quality threads visibility animation tree+hsv min_edge; do
+for s in criteria resolution quality threads visibility modes animation tree+hsv min_edge +S-R-T; do
     expect_in "$TMP/out" "$s"
 done
 expect_in "$TMP/err" "bench vt: wrote"
@@ -61,7 +61,7 @@ def quality_ok(q):
     # The table's VT objects are in view: the VT pixels are measured.
     assert q["vt_pixels"]["pixels"] > 0 and q["vt_pixels"]["ssim"] is not None, q
 
-for name in ("criteria", "resolution", "quality", "threads", "visibility", "animation"):
+for name in ("criteria", "resolution", "quality", "threads", "visibility", "modes", "animation"):
     assert name in r, "missing section " + name
     assert r[name]["status"] == "ok", "%s: %s" % (name, r[name].get("reason"))
 
@@ -117,6 +117,18 @@ for x in v:
     assert x["time_ms"] > 0 and x["vertices_sampled"] > 0
 # Without the ID buffer every face counts as visible.
 assert v[3]["visible_primary_faces"] >= v[0]["visible_primary_faces"]
+
+m = r["modes"]["runs"]
+assert [x["mode"] for x in m] == ["+S+R+T", "+S+R-T", "+S-R+T", "+S-R-T", "-S+R+T", "-S+R-T", "-S-R+T",
+                                  "-S-R-T"], m
+for x in m:
+    # A switched-off ray type is traced by neither renderer, the others by both.
+    for key, ray in (("shadows", "shadow"), ("reflections", "reflection"), ("transmission", "refraction")):
+        for rays in (x["rays"], x["whitted"]["rays"]):
+            assert (rays[ray] > 0) == x[key], (x["mode"], key, rays)
+    assert x["time_ms"] > 0 and x["whitted_over_vt_time"] > 0 and x["samples_percent_of_pixels"] > 0, x
+    quality_ok(x["quality"])
+assert m[0]["thesis_whitted_over_vt_time"] == 6.8 and m[3]["thesis_whitted_over_vt_time"] == 86
 
 a = r["animation"]
 assert a["scene"] == "cluster" and a["frames"] == 3 and len(a["per_frame"]) == 3

@@ -207,6 +207,46 @@ static void test_max_depth_zero_traces_no_secondary_rays(void **state)
     rl_scene_release(s);
 }
 
+/* The shading modes +-S +-R +-T of Ullmann 2003, Figs. 5.9/5.10, in both
+ * ray tracers: each switch removes exactly its ray type and changes the
+ * image; the other types are still traced. */
+static void test_shading_modes_switch_their_ray_types_off(void **state)
+{
+    (void)state;
+    rl_scene *s = NULL;
+    assert_int_equal(rl_scene_create_builtin("table", NULL, &s), RL_OK);
+    rl_camera cam;
+    assert_int_equal(rl_scene_get_camera(s, NULL, &cam), RL_OK);
+    cam.width = 40;
+    cam.height = 30;
+    const char *const algos[] = { "whitted", "vt" };
+    const char *const keys[] = { "shadows", "reflections", "transmission" };
+    const rl_ray_type types[] = { RL_RAY_SHADOW, RL_RAY_REFLECTION, RL_RAY_REFRACTION };
+    for (int a = 0; a < 2; ++a) {
+        rl_render_stats all;
+        rl_image *full = fx_render(algos[a], s, &cam, ALL_LAYERS, NULL, &all);
+        for (int k = 0; k < 3; ++k)
+            assert_true(all.rays[types[k]] > 0);
+        for (int k = 0; k < 3; ++k) {
+            rl_render_stats st;
+            rl_image *img = fx_render(algos[a], s, &cam, ALL_LAYERS, (const char *const[]){ keys[k], "false", NULL },
+                                      &st);
+            for (int j = 0; j < 3; ++j)
+                if (j == k)
+                    assert_int_equal(st.rays[types[j]], 0);
+                else
+                    assert_true(st.rays[types[j]] > 0);
+            size_t differ = 0;
+            for (int i = 0; i < cam.width * cam.height; ++i)
+                differ += fabsf(img->color[i].x - full->color[i].x) > 1e-3f;
+            assert_true(differ > 0);
+            rl_image_release(img);
+        }
+        rl_image_release(full);
+    }
+    rl_scene_release(s);
+}
+
 static void test_pixel_trees_are_kept_on_request_and_match_the_ids(void **state)
 {
     (void)state;
@@ -318,6 +358,7 @@ int main(void)
         cmocka_unit_test(test_depth_and_ids_agree_with_the_raster_renderer),
         cmocka_unit_test(test_unshadowed_diffuse_floor_matches_gouraud_raster),
         cmocka_unit_test(test_max_depth_zero_traces_no_secondary_rays),
+        cmocka_unit_test(test_shading_modes_switch_their_ray_types_off),
         cmocka_unit_test(test_pixel_trees_are_kept_on_request_and_match_the_ids),
         cmocka_unit_test(test_cached_accel_follows_scene_and_kind_changes),
         cmocka_unit_test(test_a_view_of_nothing_renders_the_background),
