@@ -70,6 +70,8 @@ static const char bench_vt_help[] =
     "  animation   cluster scene camera path with and without temporal coherence\n"
     "\n"
     "options:\n"
+    "  --scene SPEC      scene of the static sections; default table (the thesis-like\n"
+    "                    table; e.g. table:cloth_kr=0.2,fill=0.15 for the mirror variant)\n"
     "  --size WxH        static sections (not resolution); default 1024x1024\n"
     "  --anim-size WxH   animation frames; default 640x480\n"
     "  --frames N        animation frames along the path; default 60\n"
@@ -122,6 +124,7 @@ typedef struct bvt_args {
     bool has_size, has_anim_size, has_frames, quick;
     unsigned sections;             /* bit per SEC_ */
     const char *out;
+    const char *scene;             /* static sections; NULL: "table" */
 } bvt_args;
 
 /* A Whitted frame, the reference of every comparison at its size. */
@@ -335,6 +338,12 @@ static rl_status set_mode(rl_renderer *r, int mode)
     return st;
 }
 
+/* The scene of the static sections (--scene). */
+static const char *table_spec(const bvt *b)
+{
+    return b->a->scene ? b->a->scene : "table";
+}
+
 static rl_status set_int(rl_renderer *r, const char *key, double value)
 {
     char text[32];
@@ -454,7 +463,7 @@ static rl_status sec_criteria(void *ctx, cJSON *sec)
     rl_status st = reference(b, w, h, b->threads, MODE_ALL, &ref);
     if (st != RL_OK)
         return st;
-    cJSON_AddStringToObject(sec, "scene", "table");
+    cJSON_AddStringToObject(sec, "scene", table_spec(b));
     char size[32];
     snprintf(size, sizeof size, "%dx%d", w, h);
     cJSON_AddStringToObject(sec, "size", size);
@@ -468,8 +477,8 @@ static rl_status sec_criteria(void *ctx, cJSON *sec)
     if (st == RL_OK)
         st = rl_image_create(w, h, RL_LAYER_COLOR, &img);
 
-    printf("\ncriteria (Fig. 5.5/5.6): table %s, whitted %.1f ms, %llu rays, %llu VT pixels\n",
-           size, ref->stats.time_ms, (unsigned long long)rays_total(&ref->stats),
+    printf("\ncriteria (Fig. 5.5/5.6): %s %s, whitted %.1f ms, %llu rays, %llu VT pixels\n",
+           table_spec(b), size, ref->stats.time_ms, (unsigned long long)rays_total(&ref->stats),
            (unsigned long long)ref->mask_pixels);
     printf("%-9s %9s %9s %9s %8s %8s %8s %7s %8s %10s %9s  %6s %7s %6s  %6s %7s\n", "criteria",
            "sampled", "generated", "thesis", "rgb", "hsv", "tree", "forced", "faces", "rays",
@@ -544,7 +553,7 @@ static rl_status sec_resolution(void *ctx, cJSON *sec)
     static const int full_sizes[] = { 512, 1024, 2048 }, quick_sizes[] = { 64, 128 };
     const int *sizes = b->a->quick ? quick_sizes : full_sizes;
     int num_sizes = b->a->quick ? 2 : 3;
-    cJSON_AddStringToObject(sec, "scene", "table");
+    cJSON_AddStringToObject(sec, "scene", table_spec(b));
     cJSON *rows = cJSON_AddArrayToObject(sec, "runs");
     printf("\nresolution (Fig. 5.10-5.12): table, default criteria; %% of Whitted's rays and "
            "of the pixels\n");
@@ -677,7 +686,7 @@ static rl_status sec_quality(void *ctx, cJSON *sec)
         return st;
     char size[32];
     snprintf(size, sizeof size, "%dx%d", w, h);
-    cJSON_AddStringToObject(sec, "scene", "table");
+    cJSON_AddStringToObject(sec, "scene", table_spec(b));
     cJSON_AddStringToObject(sec, "size", size);
     cJSON_AddItemToObject(sec, "whitted", ref_json(ref));
     add_num(sec, "ssim_goal", SSIM_GOAL);
@@ -724,8 +733,8 @@ static rl_status sec_quality(void *ctx, cJSON *sec)
     add_num(sec, "whitted_time_ms_end", again);
     add_num(sec, "whitted_time_ms", whitted_ms);
 
-    printf("\nquality: min_edge sweep, table %s, whitted %.1f ms (faster of %.1f at the start and "
-           "%.1f at the end)\n", size, whitted_ms, ref->stats.time_ms, again);
+    printf("\nquality: min_edge sweep, %s %s, whitted %.1f ms (faster of %.1f at the start and "
+           "%.1f at the end)\n", table_spec(b), size, whitted_ms, ref->stats.time_ms, again);
     printf("%-9s %-8s %9s %6s %9s %10s  %6s %7s  %6s\n", "criteria", "min_edge", "VT ms", "VT/W",
            "sampled", "rays", "ssimVT", "rmseVT", "ssim");
     cJSON *runs = cJSON_AddArrayToObject(sec, "runs");
@@ -783,11 +792,11 @@ static rl_status sec_threads(void *ctx, cJSON *sec)
     int w = b->a->width, h = b->a->height;
     char size[32];
     snprintf(size, sizeof size, "%dx%d", w, h);
-    cJSON_AddStringToObject(sec, "scene", "table");
+    cJSON_AddStringToObject(sec, "scene", table_spec(b));
     cJSON_AddStringToObject(sec, "size", size);
     cJSON *rows = cJSON_AddArrayToObject(sec, "runs");
-    printf("\nthreads (Fig. 5.9, 5.15): table %s; VT time split in ms; imbalance = (max - min) / "
-           "mean of the rays per thread\n", size);
+    printf("\nthreads (Fig. 5.9, 5.15): %s %s; VT time split in ms; imbalance = (max - min) / "
+           "mean of the rays per thread\n", table_spec(b), size);
     printf("%-7s %9s %7s %10s %7s %9s  %8s %8s %8s %8s  %s\n", "threads", "VT ms", "speedup",
            "Whitted ms", "speedup", "imbalance", "visib.", "sampling", "refine", "draw",
            "rays per thread");
@@ -882,7 +891,7 @@ static rl_status sec_visibility(void *ctx, cJSON *sec)
         return st;
     char size[32];
     snprintf(size, sizeof size, "%dx%d", w, h);
-    cJSON_AddStringToObject(sec, "scene", "table");
+    cJSON_AddStringToObject(sec, "scene", table_spec(b));
     cJSON_AddStringToObject(sec, "size", size);
     cJSON *rows = cJSON_AddArrayToObject(sec, "runs");
     rl_renderer *r = NULL;
@@ -891,8 +900,8 @@ static rl_status sec_visibility(void *ctx, cJSON *sec)
     st = make_renderer("vt", b->threads, &r);
     if (st == RL_OK)
         st = rl_image_create(w, h, RL_LAYER_COLOR, &img);
-    printf("\nvisibility tests (Fig. 5.13): table %s, ID buffer, Z buffer, viewport clipping\n",
-           size);
+    printf("\nvisibility tests (Fig. 5.13): %s %s, ID buffer, Z buffer, viewport clipping\n",
+           table_spec(b), size);
     printf("%-7s %9s %9s %9s %9s %9s %10s  %6s\n", "tests", "VT ms", "sampled", "vis.faces",
            "culled Z", "culled C", "rays", "ssimVT");
     for (size_t i = 0; st == RL_OK && i < sizeof configs / sizeof configs[0]; i++) {
@@ -950,7 +959,7 @@ static rl_status sec_modes(void *ctx, cJSON *sec)
     int w = b->a->width, h = b->a->height;
     char size[32];
     snprintf(size, sizeof size, "%dx%d", w, h);
-    cJSON_AddStringToObject(sec, "scene", "table");
+    cJSON_AddStringToObject(sec, "scene", table_spec(b));
     cJSON_AddStringToObject(sec, "size", size);
     cJSON *rows = cJSON_AddArrayToObject(sec, "runs");
     rl_renderer *r = NULL;
@@ -959,8 +968,8 @@ static rl_status sec_modes(void *ctx, cJSON *sec)
     rl_status st = make_renderer("vt", b->threads, &r);
     if (st == RL_OK)
         st = rl_image_create(w, h, RL_LAYER_COLOR, &img);
-    printf("\nshading modes (Fig. 5.9/5.10): table %s, S shadow feelers, R reflection rays, T transmission rays\n",
-           size);
+    printf("\nshading modes (Fig. 5.9/5.10): %s %s, S shadow feelers, R reflection rays, T transmission "
+           "rays\n", table_spec(b), size);
     printf("%-7s %9s %9s %7s %7s %7s %7s %7s %8s %8s  %6s %6s\n", "mode", "whitted", "VT ms", "vis", "sample",
            "refine", "draw", "x", "rays %", "samp %", "ssimVT", "thesis");
     for (size_t i = 0; st == RL_OK && i < sizeof modes / sizeof modes[0]; i++) {
@@ -1232,6 +1241,7 @@ static int parse_args(int argc, char **argv, bvt_args *a)
         RL_BENCH_COUNT("--threads", RL_VT_MAX_THREADS, &a->threads, NULL),
         RL_BENCH_SECTIONS(section_names, SEC_COUNT, &a->sections),
         RL_BENCH_OUT(&a->out),
+        RL_BENCH_STRING("--scene", &a->scene),
     };
     int rc = bench_parse_args(argc, argv, "bench vt", bench_vt_help, rows,
                                  (int)(sizeof rows / sizeof rows[0]));
@@ -1292,6 +1302,7 @@ static cJSON *params_json(const bvt *b)
     cJSON_AddStringToObject(o, "size", text);
     snprintf(text, sizeof text, "%dx%d", a->anim_width, a->anim_height);
     cJSON_AddStringToObject(o, "anim_size", text);
+    cJSON_AddStringToObject(o, "scene", table_spec(b));
     cJSON_AddNumberToObject(o, "frames", (double)a->frames);
     cJSON_AddNumberToObject(o, "threads", b->threads);
     cJSON_AddNumberToObject(o, "max_threads", b->max_threads);
@@ -1368,7 +1379,7 @@ static int run(bvt *b)
     for (int k = 0; k < SEC_ANIMATION; k++)
         static_sections = static_sections || wants(a, k);
     int rc = RL_CLI_OK;
-    if (static_sections && (rc = load("table", &b->table, &b->table_vt)) != RL_CLI_OK)
+    if (static_sections && (rc = load(table_spec(b), &b->table, &b->table_vt)) != RL_CLI_OK)
         return rc;
     if (static_sections) {
         rl_clear_error();

@@ -97,7 +97,7 @@ static rl_status add_cloth_texture(rl_scene *scene, uint32_t *id)
 }
 
 
-static rl_status add_materials(table *t)
+static rl_status add_materials(table *t, float cloth_kr)
 {
     uint32_t cloth_tex;
     rl_status s = add_cloth_texture(t->scene, &cloth_tex);
@@ -105,7 +105,7 @@ static rl_status add_materials(table *t)
         return s;
     rl_material cloth = rl_builtin_phong("tablecloth", rl_v3s(1.0f), 0.2f, 40.0f);
     cloth.diffuse_texture = cloth_tex;     /* k_d modulated by the checkers */
-    cloth.reflectivity = 0.2f;
+    cloth.reflectivity = cloth_kr;
     rl_material cup = rl_builtin_phong("cup_blue", rl_v3(0.04f, 0.10f, 0.42f), 0.8f, 120.0f);
     cup.reflectivity = 0.6f;
     /* The tracer does not tint transmitted light, so the red comes from a
@@ -450,9 +450,10 @@ static rl_status add_lights_and_cameras(table *t, double fill)
 static rl_status build_table(rl_scene *scene, const rl_option_store *params)
 {
     double detail = rl_option_store_float(params, "detail"), fill = rl_option_store_float(params, "fill");
+    double cloth_kr = rl_option_store_float(params, "cloth_kr");
     long long checks = rl_option_store_int(params, "checks");
     table t = { .scene = scene, .detail = (float)detail, .checks = checks };
-    rl_status s = add_materials(&t);
+    rl_status s = add_materials(&t, (float)cloth_kr);
     if (!s) s = add_furniture(&t);
     if (!s) s = add_cups(&t);
     if (!s) s = add_fork(&t);
@@ -467,6 +468,8 @@ static const rl_option_info table_options[] = {
     { "checks", RL_OPT_INT, "8", "tablecloth checkers across the table", 1, 256, NULL },
     { "fill", RL_OPT_FLOAT, "0.15", "dim fill light from behind the camera (0: the thesis' single lamp light)", 0,
       1, NULL },
+    { "cloth_kr", RL_OPT_FLOAT, "0.2", "reflectivity k_r of the tablecloth (the thesis' table top shows no mirror image: 0)",
+      0, 1, NULL },
 };
 
 const rl_builtin_class rl_builtin_table_class = {
