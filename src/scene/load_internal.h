@@ -14,6 +14,20 @@ struct aiTexture;
  * "path: what is wrong", RL_ERR_IO if the file cannot be read. */
 rl_status rl_check_mesh_file(const char *path);
 
+/* load_validate_graph.c: node hierarchies Assimp would recurse through
+ * without bound. glTF JSON text: child indices in range, one parent per
+ * node, no cycle; Collada XML: no <node> that instances itself or an
+ * ancestor. Both: at most RL_IMPORT_MAX_NODE_DEPTH levels (Assimp's
+ * recursion uses a few hundred bytes of stack per level, so 1024 levels
+ * stay far inside a 1 MiB thread stack; real files have tens), and for
+ * Collada at most RL_IMPORT_MAX_NODE_COPIES nodes once <instance_node> is
+ * expanded. RL_ERR_PARSE (cycles, bad indices) or RL_ERR_LIMIT,
+ * "path: what". */
+#define RL_IMPORT_MAX_NODE_DEPTH 1024
+#define RL_IMPORT_MAX_NODE_COPIES 10000000ull
+rl_status rl_check_gltf_nodes(const char *path, const char *json, size_t size);
+rl_status rl_check_dae_nodes(const char *path, const char *data, size_t size);
+
 /* load_embedded.c: decodes a texture embedded in a model file (compressed
  * PNG/JPEG/... bytes, or raw BGRA texels) into linear RGBA. what names the
  * texture in messages. RL_ERR_PARSE if it cannot be decoded, RL_ERR_LIMIT
