@@ -290,10 +290,12 @@ typedef struct rl_import_limits {
      * and for fuzzing Assimp itself. */
     bool in_process;
 } rl_import_limits;
-/* 120 s: the largest models of the Assimp test corpus import in a few
- * seconds, and a 10^7-triangle OBJ in well under a minute; 4096 MiB: what
- * Assimp needs for RL_SCENE_MAX_TRIANGLES-sized files is less, and a file
- * asking for more is hostile or needs an explicit raise. */
+/* 120 s: every model of the Assimp test corpus imports in under a second,
+ * a 10^6-triangle OBJ in about 3 s of CPU, so only a hang or a model of
+ * tens of millions of triangles gets near it. 4096 MiB of address space:
+ * that OBJ needs between 512 and 1024 MiB of it, so the default takes
+ * models about four times larger; a file that asks for more is hostile or
+ * needs an explicit raise. */
 #define RL_IMPORT_DEFAULT_TIMEOUT_S 120u
 #define RL_IMPORT_DEFAULT_MEMORY_MIB 4096u
 /* The limits that rl_scene_load, JSON scenes' "file" objects and imports

@@ -169,8 +169,8 @@ static void read_child(int fd, double deadline, size_t max, pipe_result *r)
                 r->too_big = true;
                 return;
             }
-            size_t want = r->cap ? r->cap * 2 : 1u << 16;
-            if (!rl_reserve((void **)&r->bytes, &r->cap, want < max ? want : max, 1, 1u << 16)) {
+            size_t want = r->cap ? r->cap * 2 : 1u << 20;
+            if (!rl_reserve((void **)&r->bytes, &r->cap, want < max ? want : max, 1, 1u << 20)) {
                 r->no_memory = true;
                 return;
             }
@@ -192,6 +192,12 @@ static rl_status import_isolated(rl_scene *scene, const char *path, uint32_t par
     if (pipe2(fds, O_CLOEXEC) != 0)
         return rl_error(RL_ERR_IO, "%s: cannot start the importer: pipe: %s", path,
                         strerror(errno));
+    /* A pipe holds 64 KiB by default: the child would stop at every 64 KiB
+     * until the parent is scheduled to read. 1 MiB (the unprivileged
+     * maximum) lets both run; failing to get it only costs time. */
+#ifdef F_SETPIPE_SZ
+    fcntl(fds[0], F_SETPIPE_SZ, 1 << 20);
+#endif
     uint64_t allowance = (uint64_t)lim->memory_mib << 20;
     uint64_t mapped = mapped_bytes();
     double start = now_s();
