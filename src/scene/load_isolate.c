@@ -16,6 +16,7 @@
  *   SIGXCPU / CPU time used  RL_ERR_LIMIT    "FILE: the importer ran out of CPU time (N s)"
  *   the deadline             RL_ERR_LIMIT    "FILE: the importer ran out of time (N s)"
  *   out of memory            RL_ERR_LIMIT    "FILE: the importer exceeded its memory limit (N MiB)"
+ *   SIGINT (Ctrl-C)          RL_ERR_CANCELLED "FILE: the import was interrupted"
  * The cheap pre-checks of our own (rl_check_mesh_file) run in the parent
  * before the fork. rl_import_limits.in_process skips the child: trusted
  * files only (rl_scene.h). */
@@ -119,8 +120,8 @@ static _Noreturn void run_child(int fd, rl_scene *scene, const char *path, uint3
 #else
     (void)address_space;
 #endif
-    /* A Ctrl-C belongs to the parent, which stops waiting and kills us;
-     * the CLI's handler, inherited, must not run here. */
+    /* A Ctrl-C ends the import, whatever handler the parent had: the
+     * parent reports it as cancelled. */
     signal(SIGINT, SIG_DFL);
     rl_import_writer w;
     rl_import_writer_init(&w, fd, scene);
@@ -144,7 +145,7 @@ static double now_s(void)
 typedef struct pipe_result {
     uint8_t *bytes;
     size_t len, cap;
-    bool timed_out, too_big, no_memory;
+    bool timed_out, too_big, no_memory, failed;
 } pipe_result;
 
 /* Reads fd to its end, the deadline, or max bytes. */
@@ -160,8 +161,10 @@ static void read_child(int fd, double deadline, size_t max, pipe_result *r)
         int n = poll(&p, 1, left > 1e6 ? 1000000000 : (int)(left * 1000.0) + 1);
         if (n < 0 && errno == EINTR)
             continue;
-        if (n < 0)
-            return;   /* the stream ends short and is reported malformed */
+        if (n < 0) {
+            r->failed = true;   /* the stream ends short and is reported malformed */
+            return;
+        }
         if (n == 0)
             continue;
         if (r->len == r->cap) {
@@ -178,6 +181,8 @@ static void read_child(int fd, double deadline, size_t max, pipe_result *r)
         ssize_t k = read(fd, r->bytes + r->len, r->cap - r->len);
         if (k < 0 && (errno == EINTR || errno == EAGAIN))
             continue;
+        if (k < 0)
+            r->failed = true;
         if (k <= 0)
             return;
         r->len += (size_t)k;
@@ -218,8 +223,8 @@ static rl_status import_isolated(rl_scene *scene, const char *path, uint32_t par
     pipe_result r = { 0 };
     read_child(fds[0], start + lim->timeout_s, (size_t)(allowance + (64u << 20)), &r);
     close(fds[0]);
-    if (r.timed_out || r.too_big || r.no_memory)
-        kill(pid, SIGKILL);
+    if (r.timed_out || r.too_big || r.no_memory || r.failed)
+        kill(pid, SIGKILL);   /* it must not outlive our interest in it */
     int status = 0;
     struct rusage ru;
     memset(&ru, 0, sizeof ru);
@@ -243,6 +248,10 @@ static rl_status import_isolated(rl_scene *scene, const char *path, uint32_t par
               (WTERMSIG(status) == SIGKILL && cpu_s >= (double)lim->timeout_s)))
         st = rl_error(RL_ERR_LIMIT, "%s: the importer ran out of CPU time (%u s)", path,
                       lim->timeout_s);
+    else if (WIFSIGNALED(status) && WTERMSIG(status) == SIGINT)
+        st = rl_error(RL_ERR_CANCELLED, "%s: the import was interrupted", path);
+    else if (r.failed)
+        st = rl_error(RL_ERR_IO, "%s: reading the importer's result failed", path);
     else if (WIFSIGNALED(status))
         st = rl_error(RL_ERR_CRASHED, "%s: the importer crashed (signal %d)", path,
                       WTERMSIG(status));
