@@ -263,7 +263,8 @@ RL_API const rl_option_info *rl_model_options(size_t *count);
 RL_API rl_status rl_scene_load_json(const char *path, rl_scene **out);   /* committed */
 /* Imports a mesh file with Assimp under parent: its node hierarchy,
  * meshes (triangulated; quads and n-gons split), materials and textures
- * (paths relative to the file). *root_node receives the imported root. */
+ * (paths relative to the file). *root_node receives the imported root.
+ * Assimp runs in a child process (rl_import_limits below). */
 RL_API rl_status rl_scene_import(rl_scene *scene, const char *path, uint32_t parent,
                                  uint32_t *root_node);
 /* Assimp can crash, hang or allocate without bound on malformed files, so
@@ -273,8 +274,12 @@ RL_API rl_status rl_scene_import(rl_scene *scene, const char *path, uint32_t par
  * crash, a timeout or an exhausted limit in the child fails the import:
  * RL_ERR_CRASHED "FILE: the importer crashed (signal 11)", RL_ERR_LIMIT
  * "FILE: the importer ran out of time (120 s)" or "... exceeded its memory
- * limit (4096 MiB)". Zero fields mean the process-wide value
- * (rl_scene_set_import_limits), whose zeros mean the defaults below. */
+ * limit (4096 MiB)", RL_ERR_CANCELLED when Ctrl-C ended it, RL_ERR_PARSE
+ * when what came back is malformed. Our own pre-checks (PLY counts, GLB
+ * lengths, node cycles and depth, ...) run before, in the calling
+ * process. docs/scene-format.md, "Untrusted files". Zero fields mean the
+ * process-wide value (rl_scene_set_import_limits), whose zeros mean the
+ * defaults below. */
 typedef struct rl_import_limits {
     /* Wall-clock seconds for the whole import; the child's CPU time is
      * capped at the same number (RLIMIT_CPU), so that a child whose parent
