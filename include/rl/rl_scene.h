@@ -295,7 +295,7 @@ typedef struct rl_import_limits {
      * and for fuzzing Assimp itself. */
     bool in_process;
 } rl_import_limits;
-/* 120 s: every model of the Assimp test corpus imports in under a second,
+/* 120 s: the models of the Assimp test corpus import in seconds,
  * a 10^6-triangle OBJ in about 3 s of CPU, so only a hang or a model of
  * tens of millions of triangles gets near it. 4096 MiB of address space:
  * that OBJ needs between 512 and 1024 MiB of it, so the default takes
