@@ -6,10 +6,12 @@
  * Why fork and not a helper executable: the child needs the caller's scene
  * as it is (texture sharing by path, unique camera names, ids) and the
  * library's code, and a helper would have to be found on disk. The child
- * runs one thread (the one that forked) and touches no OpenMP; it imports
- * into its copy of the scene, streams what the import added through a pipe
- * (import_stream.c) and leaves with _exit, so that no atexit handler, stdio
- * buffer or leak checker of the parent's image runs twice. The parent reads
+ * runs one thread (the one that forked) and touches no OpenMP; it logs
+ * through the stream, never through the caller's log callback (whose locks
+ * another thread may have held at the fork), and writes with write(2). It
+ * imports into its copy of the scene, streams what the import added through
+ * a pipe (import_stream.c) and leaves with _exit, so that no atexit
+ * handler, stdio buffer or leak checker of the parent's image runs twice. The parent reads
  * the pipe with poll() until the deadline, kills the child when it passes,
  * reaps it (never a zombie), and turns its end into one error:
  *   a signal                 RL_ERR_CRASHED  "FILE: the importer crashed (signal 11)"
