@@ -116,7 +116,8 @@ typedef struct cli_model_flags {
     "  --file-cameras file|off   use the model file's cameras or frame the model\n" \
     "  --file-lights file|off|add  the file's lights, the default lights, or both\n" \
     "  --headlight         a point light at the default view's eye\n" \
-    "  --orbit AZ,EL       the framing camera's orbit in degrees (default 25,20)\n"
+    "  --orbit AZ,EL       the framing camera's orbit in degrees (default 25,20)\n" \
+    "  (the importer's limits: --import-timeout, --import-memory, --trusted-import; rl --help)\n"
 /* 1 when argv[*i] was one of the flags (consumed, *i advanced past its
  * value), 0 when it is not, -1 after printing a usage error. */
 int cli_take_model_flag(int argc, char **argv, int *i, cli_model_flags *flags);

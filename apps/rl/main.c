@@ -5,6 +5,8 @@
  * and the subcommand sees only its own arguments. */
 #include "cli.h"
 
+#include <errno.h>
+#include <stdlib.h>
 #include <string.h>
 
 typedef struct command {
@@ -28,7 +30,7 @@ static const command commands[] = {
 static void print_usage(FILE *out)
 {
     fprintf(out,
-            "usage: rl [-v|-q] [--plugin FILE] <command> [options]\n"
+            "usage: rl [-v|-q] [--plugin FILE] [import limits] <command> [options]\n"
             "\n"
             "renderlab " RL_CLI_VERSION ": a laboratory of rendering algorithms.\n"
             "\n"
@@ -45,9 +47,16 @@ static void print_usage(FILE *out)
             "  --plugin FILE   load renderers from a shared object (README, \"Your own renderer\")\n"
             "  --version       print the version\n"
             "\n"
+            "model files (OBJ, PLY, glTF, DAE, ...; also a JSON scene's \"file\") are imported\n"
+            "with Assimp in a child process, so that a malformed file costs an error, not rl:\n"
+            "  --import-timeout S    wall-clock and CPU seconds per file (default %u)\n"
+            "  --import-memory MiB   memory the importer may add (default %u)\n"
+            "  --trusted-import      import in this process, without limits: UNSAFE for\n"
+            "                        files you do not trust (a bad one can crash or hang rl)\n"
+            "\n"
             "example:\n"
             "  rl render cornell --algo raster --size 640x480 --out cornell.png\n",
-            "help");
+            "help", RL_IMPORT_DEFAULT_TIMEOUT_S, RL_IMPORT_DEFAULT_MEMORY_MIB);
 }
 
 /* Log lines of the library go to stderr as "rl: warning: ...". */
@@ -70,6 +79,33 @@ static int unknown_command(const char *name)
                     cli_did_you_mean(name, names, n, hint, sizeof hint));
 }
 
+/* "--name V" or "--name=V": 1 and *value set when argv[*i] is the flag
+ * (*i advanced past a separate value), 0 when it is another argument. */
+static int global_value(int argc, char **argv, int *i, const char *name, const char **value)
+{
+    size_t n = strlen(name);
+    if (strncmp(argv[*i], name, n) != 0 || (argv[*i][n] != '\0' && argv[*i][n] != '='))
+        return 0;
+    *value = argv[*i][n] == '=' ? argv[*i] + n + 1 : (*i + 1 < argc ? argv[++*i] : NULL);
+    return 1;
+}
+
+/* A whole number in [lo, hi], or a usage error (-1 after printing). */
+static int parse_limit(const char *flag, const char *text, unsigned long lo, unsigned long hi,
+                       const char *unit, uint32_t *out)
+{
+    char *end = NULL;
+    errno = 0;
+    unsigned long v = text && *text && *text != '-' ? strtoul(text, &end, 10) : 0;
+    if (!text || !*text || *end || errno || v < lo || v > hi) {
+        cli_fail(RL_CLI_USAGE, "%s: expected %s from %lu to %lu, got '%s'", flag, unit, lo, hi,
+                 text ? text : "");
+        return -1;
+    }
+    *out = (uint32_t)v;
+    return 0;
+}
+
 int main(int argc, char **argv)
 {
     cli_set_command_line(argc, argv);   /* for the reports, before the flags are taken out */
@@ -77,10 +113,20 @@ int main(int argc, char **argv)
     enum { MAX_PLUGINS = 8 };
     const char *plugins[MAX_PLUGINS];
     int n = 0, num_plugins = 0;
+    rl_import_limits import = { 0 };
+    const char *v = NULL;
     /* Take out global flags wherever they are; keep everything else in order. */
     for (int i = 1; i < argc; i++) {
         const char *a = argv[i];
-        if (strcmp(a, "-v") == 0 || strcmp(a, "--verbose") == 0)
+        if (global_value(argc, argv, &i, "--import-timeout", &v)) {
+            if (parse_limit("--import-timeout", v, 1, 86400, "seconds", &import.timeout_s) < 0)
+                return RL_CLI_USAGE;
+        } else if (global_value(argc, argv, &i, "--import-memory", &v)) {
+            if (parse_limit("--import-memory", v, 64, 1ul << 22, "MiB", &import.memory_mib) < 0)
+                return RL_CLI_USAGE;
+        } else if (strcmp(a, "--trusted-import") == 0)
+            import.in_process = true;
+        else if (strcmp(a, "-v") == 0 || strcmp(a, "--verbose") == 0)
             level = RL_LOG_DEBUG;
         else if (strcmp(a, "-q") == 0 || strcmp(a, "--quiet") == 0)
             level = RL_LOG_ERROR;
@@ -95,6 +141,7 @@ int main(int argc, char **argv)
             argv[n++] = argv[i];
     }
     argv[n] = NULL;
+    rl_scene_set_import_limits(&import);
     rl_log_set_level(level);
     rl_log_set_callback(log_to_stderr, NULL);
     /* Before the subcommand, so that it finds the plugins' renderers by name. */

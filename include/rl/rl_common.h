@@ -40,7 +40,8 @@ extern "C" {
     X(RL_ERR_NOT_COMMITTED,   8, "object must be committed first")            \
     X(RL_ERR_CANCELLED,       9, "cancelled")                                 \
     X(RL_ERR_LIMIT,          10, "size or count exceeds a limit")             \
-    X(RL_ERR_INTERNAL,       11, "internal error")
+    X(RL_ERR_INTERNAL,       11, "internal error")                          \
+    X(RL_ERR_CRASHED,        12, "third-party code crashed in a child process")
 
 typedef enum rl_status {
 #define RL_STATUS_ENUM(code, value, msg) code = value,

@@ -263,13 +263,57 @@ RL_API const rl_option_info *rl_model_options(size_t *count);
 RL_API rl_status rl_scene_load_json(const char *path, rl_scene **out);   /* committed */
 /* Imports a mesh file with Assimp under parent: its node hierarchy,
  * meshes (triangulated; quads and n-gons split), materials and textures
- * (paths relative to the file). *root_node receives the imported root. */
+ * (paths relative to the file). *root_node receives the imported root.
+ * Assimp runs in a child process (rl_import_limits below). */
 RL_API rl_status rl_scene_import(rl_scene *scene, const char *path, uint32_t parent,
                                  uint32_t *root_node);
+/* Assimp can crash, hang or allocate without bound on malformed files, so
+ * by default an import runs it in a child process (fork) under these
+ * limits, and only our own plain data (meshes, materials, textures, nodes,
+ * cameras, lights, warnings) comes back, checked completely before use. A
+ * crash, a timeout or an exhausted limit in the child fails the import:
+ * RL_ERR_CRASHED "FILE: the importer crashed (signal 11)", RL_ERR_LIMIT
+ * "FILE: the importer ran out of time (120 s)" or "... exceeded its memory
+ * limit (4096 MiB)", RL_ERR_CANCELLED when Ctrl-C ended it, RL_ERR_PARSE
+ * when what came back is malformed. Our own pre-checks (PLY counts, GLB
+ * lengths, node cycles and depth, ...) run before, in the calling
+ * process. docs/scene-format.md, "Untrusted files". Zero fields mean the
+ * process-wide value (rl_scene_set_import_limits), whose zeros mean the
+ * defaults below. */
+typedef struct rl_import_limits {
+    /* Wall-clock seconds for the whole import; the child's CPU time is
+     * capped at the same number (RLIMIT_CPU), so that a child whose parent
+     * is gone still ends. 0 -> RL_IMPORT_DEFAULT_TIMEOUT_S. */
+    uint32_t timeout_s;
+    /* Address space the child may add to what it inherits (RLIMIT_AS), in
+     * MiB; 0 -> RL_IMPORT_DEFAULT_MEMORY_MIB. Not applied in
+     * AddressSanitizer builds, whose shadow memory needs terabytes of it. */
+    uint32_t memory_mib;
+    /* UNSAFE for untrusted files: runs Assimp in the calling process,
+     * without limits, where a malformed file can crash it, hang it or
+     * exhaust its memory. For trusted files where the fork costs too much,
+     * and for fuzzing Assimp itself. */
+    bool in_process;
+} rl_import_limits;
+/* 120 s: the models of the Assimp test corpus import in seconds,
+ * a 10^6-triangle OBJ in about 3 s of CPU, so only a hang or a model of
+ * tens of millions of triangles gets near it. 4096 MiB of address space:
+ * that OBJ needs between 512 and 1024 MiB of it, so the default takes
+ * models about four times larger; a file that asks for more is hostile or
+ * needs an explicit raise. */
+#define RL_IMPORT_DEFAULT_TIMEOUT_S 120u
+#define RL_IMPORT_DEFAULT_MEMORY_MIB 4096u
+/* The limits that rl_scene_load, JSON scenes' "file" objects and imports
+ * with zero fields use (NULL: the defaults). Process-wide; set it before
+ * loading, not while loads are in flight. */
+RL_API void rl_scene_set_import_limits(const rl_import_limits *limits);
+RL_API rl_import_limits rl_scene_import_limits(void);
+
 /* What of a file to take besides its geometry and materials; zero = all. */
 typedef struct rl_scene_import_desc {
     bool no_cameras;      /* skip the file's cameras */
     bool no_lights;       /* skip the file's lights */
+    rl_import_limits limits;   /* zero fields: rl_scene_import_limits() */
 } rl_scene_import_desc;
 /* rl_scene_import with a desc (NULL: defaults). */
 RL_API rl_status rl_scene_import_with(rl_scene *scene, const char *path, uint32_t parent,

@@ -18,6 +18,8 @@
  * line primitives are skipped with one warning. NaN positions pass through
  * to rl_scene_add_mesh(), which drops and counts those triangles.
  *
+ * It runs where load_isolate.c puts it: by default in a child process.
+ *
  * Failure: RL_ERR_IO for a missing file, RL_ERR_PARSE "path: <reason>" for
  * anything Assimp or our checks reject, including a file without triangles;
  * all of these are found before the scene is touched. Later failures (out of
@@ -814,34 +816,11 @@ static rl_status build(rl_scene *scene, const char *path, const struct aiScene *
     return st;
 }
 
-RL_API rl_status rl_scene_import(rl_scene *scene, const char *path, uint32_t parent,
-                                 uint32_t *root_node)
+/* The import proper; the caller checked its arguments and the file
+ * (load_isolate.c), and chose the process it runs in. */
+rl_status rl_assimp_import(rl_scene *scene, const char *path, uint32_t parent,
+                           const rl_scene_import_desc *desc, uint32_t *root_node)
 {
-    return rl_scene_import_with(scene, path, parent, NULL, root_node);
-}
-
-RL_API rl_status rl_scene_import_with(rl_scene *scene, const char *path, uint32_t parent,
-                                      const rl_scene_import_desc *desc, uint32_t *root_node)
-{
-    if (!scene || !path || !root_node)
-        return rl_error(RL_ERR_INVALID_ARG, "rl_scene_import: NULL argument");
-    rl_scene_import_desc defaults = { 0 };
-    if (!desc)
-        desc = &defaults;
-    rl_status st = rl_scene_check_mutable(scene, "rl_scene_import");
-    if (st != RL_OK)
-        return st;
-    if (parent >= scene->num_nodes)
-        return rl_error(RL_ERR_INVALID_ARG, "rl_scene_import: no parent node %u", parent);
-
-    FILE *f = fopen(path, "rb");
-    if (!f)
-        return rl_error(RL_ERR_IO, "%s: cannot open: %s", path, strerror(errno));
-    fclose(f);
-    st = rl_check_mesh_file(path);
-    if (st != RL_OK)
-        return st;
-
     /* No FindInvalidData: it deletes whole meshes over one NaN position,
      * which the scene core handles per triangle. No GenNormals either: the
      * scene computes area-weighted ones when a mesh has none. GenUVCoords
@@ -852,13 +831,20 @@ RL_API rl_status rl_scene_import_with(rl_scene *scene, const char *path, uint32_
         aiImportFile(path, aiProcess_Triangulate | aiProcess_JoinIdenticalVertices |
                                aiProcess_SortByPType | aiProcess_ValidateDataStructure |
                                aiProcess_GenUVCoords | aiProcess_TransformUVCoords);
-    if (!ai)
-        return rl_error(RL_ERR_PARSE, "%s: %s", path, aiGetErrorString());
+    if (!ai) {
+        /* Assimp catches the std::bad_alloc of a failed allocation and
+         * reports it as its error text: that is running out of memory (the
+         * isolated import's limit), not a malformed file. */
+        const char *why = aiGetErrorString();
+        if (strstr(why, "bad_alloc"))
+            return rl_error(RL_ERR_OUT_OF_MEMORY, "%s: out of memory in Assimp", path);
+        return rl_error(RL_ERR_PARSE, "%s: %s", path, why);
+    }
     if (!ai->mRootNode || (ai->mFlags & AI_SCENE_FLAGS_INCOMPLETE)) {
         aiReleaseImport(ai);
         return rl_error(RL_ERR_PARSE, "%s: incomplete scene", path);
     }
-    st = check_scene(path, ai);
+    rl_status st = check_scene(path, ai);
     if (st == RL_OK)
         st = build(scene, path, ai, parent, desc, root_node);
     aiReleaseImport(ai);

@@ -529,6 +529,30 @@ static rl_status check_glb(const char *path, FILE *f, unsigned long long file_si
     return st;
 }
 
+/* The JSON chunk of a GLB file whose chunk lengths check_glb accepted
+ * (the first chunk, glTF 2.0 spec): only it is read, not the binary
+ * buffers. NULL data when there is none. */
+static rl_status read_glb_json(const char *path, FILE *f, char **data, size_t *size)
+{
+    unsigned char ch[8];
+    *data = NULL;
+    *size = 0;
+    if (fseek(f, 12, SEEK_SET) != 0 || fread(ch, 1, 8, f) != 8 || memcmp(ch + 4, "JSON", 4) != 0)
+        return RL_OK;
+    size_t len = le32(ch);
+    char *json = rl_alloc(len + 1);
+    if (!json)
+        return RL_ERR_OUT_OF_MEMORY;
+    if (fread(json, 1, len, f) != len) {
+        free(json);
+        return rl_error(RL_ERR_IO, "%s: cannot read the GLB JSON chunk", path);
+    }
+    json[len] = '\0';
+    *data = json;
+    *size = len;
+    return RL_OK;
+}
+
 rl_status rl_check_mesh_file(const char *path)
 {
     /* Whatever the format: Assimp would read a device until memory runs
@@ -543,10 +567,19 @@ rl_status rl_check_mesh_file(const char *path)
     bool ply = rl_path_has_ext(path, ".ply") || starts_like_ply(path);
     bool obj = !ply && rl_path_has_ext(path, ".obj");
     bool off = !ply && !obj && rl_path_has_ext(path, ".off");
+    bool gltf = !ply && rl_path_has_ext(path, ".gltf"), glb = !ply && rl_path_has_ext(path, ".glb");
+    bool dae = !ply && rl_path_has_ext(path, ".dae");
     char *data = NULL;
     size_t size = 0;
-    if (st == RL_OK && (obj || ply || off) && (st = read_all(path, f, &data, &size)) == RL_OK)
-        st = obj ? check_obj(path, data, size) : ply ? check_ply(path, data, size) : check_off(path, data, size);
+    if (st == RL_OK && glb && (st = read_glb_json(path, f, &data, &size)) == RL_OK && data)
+        st = rl_check_gltf_nodes(path, data, size);
+    else if (st == RL_OK && (obj || ply || off || gltf || dae) &&
+             (st = read_all(path, f, &data, &size)) == RL_OK)
+        st = obj    ? check_obj(path, data, size)
+             : ply  ? check_ply(path, data, size)
+             : off  ? check_off(path, data, size)
+             : gltf ? rl_check_gltf_nodes(path, data, size)
+                    : rl_check_dae_nodes(path, data, size);
     free(data);
     fclose(f);
     return st;

@@ -152,7 +152,7 @@ static rl_status reserve_texture(rl_scene *s)
     return st;
 }
 
-static rl_status push_texture(rl_scene *scene, rl_texture *tex, const char *resolved, uint32_t *id)
+rl_status rl_scene_push_texture(rl_scene *scene, rl_texture *tex, const char *resolved, uint32_t *id)
 {
     char *path = NULL;
     if (resolved && !(path = rl_strdup(resolved)))
@@ -177,7 +177,7 @@ rl_status rl_scene_add_texture(rl_scene *scene, rl_texture *tex, uint32_t *id)
     rl_status st = rl_scene_check_mutable(scene, "add a texture");
     if (st != RL_OK)
         return st;
-    return push_texture(scene, tex, NULL, id);
+    return rl_scene_push_texture(scene, tex, NULL, id);
 }
 
 rl_status rl_scene_load_texture(rl_scene *scene, const char *path, uint32_t *id)
@@ -198,7 +198,7 @@ rl_status rl_scene_load_texture(rl_scene *scene, const char *path, uint32_t *id)
     rl_texture *tex = NULL;
     if ((st = rl_texture_load(resolved, &tex)) != RL_OK)
         return st;
-    if ((st = push_texture(scene, tex, resolved, id)) != RL_OK)
+    if ((st = rl_scene_push_texture(scene, tex, resolved, id)) != RL_OK)
         rl_texture_release(tex);
     return st;
 }

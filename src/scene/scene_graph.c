@@ -20,7 +20,7 @@ static rl_status check_node(const rl_scene *scene, uint32_t node, const char *wh
 
 /* Singular transforms would collapse geometry to zero area and make the
  * normal matrix undefined; reject them where the caller can still see why. */
-static rl_status check_transform(const rl_mat4 *t, const char *name)
+rl_status rl_node_check_transform(const rl_mat4 *t, const char *name)
 {
     for (int r = 0; r < 4; ++r)
         for (int c = 0; c < 4; ++c)
@@ -55,7 +55,7 @@ rl_status rl_scene_add_node(rl_scene *scene, uint32_t parent, const char *name,
     snprintf(fallback, sizeof fallback, "node%u", scene->num_nodes);
     if (!name)
         name = fallback;
-    if (transform && (st = check_transform(transform, name)) != RL_OK)
+    if (transform && (st = rl_node_check_transform(transform, name)) != RL_OK)
         return st;
     if ((st = rl_scene_reserve((void **)&scene->nodes, &scene->cap_nodes, scene->num_nodes + 1,
                                sizeof *scene->nodes)) != RL_OK)

@@ -70,6 +70,15 @@ rl_status rl_scene_check_mutable(const rl_scene *scene, const char *what);
  * RL_ERR_LIMIT past 2^31 elements; *array is untouched on failure. */
 rl_status rl_scene_reserve(void **array, uint32_t *cap, uint32_t need, size_t elem_size);
 
+/* RL_ERR_INVALID_ARG "node \"name\": ..." for a non-finite or singular
+ * node transform, which rl_scene_add_node refuses (scene_graph.c). */
+rl_status rl_node_check_transform(const rl_mat4 *t, const char *name);
+
+/* Appends tex (taken over on success) with its resolved file path, by
+ * which rl_scene_load_texture shares it, or NULL (scene.c). */
+rl_status rl_scene_push_texture(rl_scene *scene, rl_texture *tex, const char *resolved,
+                                uint32_t *id);
+
 /* Area-weighted smooth vertex normals; vertices without area get +z. */
 void rl_mesh_compute_normals(uint32_t num_vertices, const rl_vec3 *positions,
                              uint32_t num_triangles, const uint32_t *indices, rl_vec3 *normals);

@@ -11,7 +11,11 @@
  * bodies (also when the file is named .gltf: Assimp falls back to sniffing
  * the content), all now rejected by load_validate.c. Assimp also leaks a
  * little on some malformed PLY input (no renderlab frames in the report),
- * hence -detect_leaks=0. */
+ * hence -detect_leaks=0.
+ *
+ * The import runs in this process (rl_import_limits.in_process): isolated,
+ * a crash in Assimp would become an error and the fuzzer would stop seeing
+ * what is left to pre-check. */
 #define _POSIX_C_SOURCE 200809L
 #include <stdint.h>
 #include <stdio.h>
@@ -26,6 +30,11 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     static const char *const ext[] = { "obj", "ply", "stl", "gltf", "off", "dae" };
     if (size < 1)
         return 0;
+    static bool configured;
+    if (!configured) {
+        rl_scene_set_import_limits(&(rl_import_limits){ .in_process = true });
+        configured = true;
+    }
     char path[64];
     snprintf(path, sizeof path, "/tmp/rl_fuzz_%ld.%s", (long)getpid(),
              ext[data[0] % (sizeof ext / sizeof ext[0])]);

@@ -1,6 +1,8 @@
 /* test_corpus.c: every model of Debian's assimp-testmodels, rendered as a new
- * user would render it, `rl render FILE --algo raster`, in a child process with a time limit (Assimp
- * can crash or hang on some inputs; issue 34 isolates it in the library).
+ * user would render it, `rl render FILE --algo raster`, in a child process with a time limit.
+ * rl imports each file the default way, with Assimp isolated in a child of
+ * its own (load_isolate.c), so a crash or hang of Assimp shows up as exit 1
+ * ("noload") and a crash of rl itself stays a failure of ours.
  *
  * The file's cameras are left out (`FILE:cameras=off`): the check is of our
  * default framing, the tight fit from the default orbit. The file's lights

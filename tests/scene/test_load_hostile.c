@@ -2,7 +2,9 @@
  * gigabytes (issue 34), refused by our pre-checks (load_validate.c) before
  * Assimp reads them: PLY element counts the file cannot hold (ASCII and
  * binary), GLB chunk lengths beyond the file, OFF indices past the
- * vertices, and paths that are not regular files. Each must fail with a clear error, quickly. */
+ * vertices, node hierarchies Assimp recurses through without bound (glTF
+ * and Collada: cycles, depth, instancing blow-ups; load_validate_graph.c),
+ * and paths that are not regular files. Each must fail with a clear error, quickly. */
 #define _POSIX_C_SOURCE 200809L
 #include <setjmp.h>
 #include <stdarg.h>
@@ -180,6 +182,99 @@ static void test_a_device_is_not_read(void **state)
     unlink(path);
 }
 
+/* A Collada file with library nodes lib and visual-scene nodes scene. */
+static const char *write_dae(const char *name, const char *lib, const char *scene, char *out,
+                             size_t size)
+{
+    size_t n = strlen(lib) + strlen(scene) + 512;
+    char *text = malloc(n);
+    assert_non_null(text);
+    snprintf(text, n,
+             "<?xml version=\"1.0\"?>\n<COLLADA xmlns=\"http://www.collada.org/2005/11/"
+             "COLLADASchema\" version=\"1.4.1\">\n<library_nodes>%s</library_nodes>\n"
+             "<library_visual_scenes><visual_scene id=\"s\">%s</visual_scene>"
+             "</library_visual_scenes>\n<scene><instance_visual_scene url=\"#s\"/></scene>"
+             "</COLLADA>\n", lib, scene);
+    write_bytes(name, text, strlen(text), out, size);
+    free(text);
+    return out;
+}
+
+/* nodes[i] is "children": [children[i]] or none (-1). */
+static const char *write_gltf_nodes(const char *name, const char *nodes, char *out, size_t size)
+{
+    size_t n = strlen(nodes) + 256;
+    char *text = malloc(n);
+    assert_non_null(text);
+    snprintf(text, n, "{\"asset\":{\"version\":\"2.0\"},\"scene\":0,"
+             "\"scenes\":[{\"nodes\":[0]}],\"nodes\":[%s]}", nodes);
+    write_bytes(name, text, strlen(text), out, size);
+    free(text);
+    return out;
+}
+
+static void test_node_hierarchies_assimp_recurses_through_are_refused(void **state)
+{
+    (void)state;
+    char path[1200];
+    /* Each of these overflowed Assimp's stack or ran it out of memory. */
+    expect_refused(write_dae("self.dae", "", "<node id=\"a\"><instance_node url=\"#a\"/></node>",
+                             path, sizeof path),
+                   RL_ERR_PARSE, "<node id=\"a\"> instances itself or an ancestor");
+    expect_refused(write_dae("ancestor.dae", "",
+                             "<node id=\"a\"><node id=\"b\"><instance_node url=\"#a\"/></node></node>",
+                             path, sizeof path),
+                   RL_ERR_PARSE, "a cycle in the node hierarchy");
+    expect_refused(write_dae("mutual.dae",
+                             "<node id=\"p\"><instance_node url=\"#q\"/></node>"
+                             "<node id=\"q\"><instance_node url=\"#p\"/></node>",
+                             "<node><instance_node url=\"#p\"/></node>", path, sizeof path),
+                   RL_ERR_PARSE, "a cycle in the node hierarchy");
+    enum { DEEP = 100000 };
+    char *nest = malloc(13 * DEEP + 1);
+    assert_non_null(nest);
+    for (int i = 0; i < DEEP; ++i)
+        memcpy(nest + 6 * i, "<node>", 6);
+    for (int i = 0; i < DEEP; ++i)
+        memcpy(nest + 6 * DEEP + 7 * i, "</node>", 7);
+    nest[13 * DEEP] = '\0';
+    expect_refused(write_dae("deep.dae", "", nest, path, sizeof path), RL_ERR_LIMIT,
+                   "nested deeper than 1024 levels");
+    free(nest);
+    /* 40 levels, each instancing the next twice: 2^40 nodes. */
+    char lib[4096] = "";
+    for (int i = 0; i < 40; ++i)
+        snprintf(lib + strlen(lib), sizeof lib - strlen(lib),
+                 "<node id=\"n%d\"><instance_node url=\"#n%d\"/><instance_node url='#n%d'/></node>",
+                 i, i + 1, i + 1);
+    snprintf(lib + strlen(lib), sizeof lib - strlen(lib), "<node id=\"n40\"/>");
+    expect_refused(write_dae("doubling.dae", lib, "<node><instance_node url=\"#n0\"/></node>",
+                             path, sizeof path),
+                   RL_ERR_LIMIT, "expands to more than 10000000 nodes");
+
+    /* glTF: a chain 100,000 deep, a cycle, two parents, a bad index. */
+    char *chain = malloc(32 * (size_t)DEEP);
+    assert_non_null(chain);
+    size_t at = 0;
+    for (int i = 0; i + 1 < DEEP; ++i)
+        at += (size_t)sprintf(chain + at, "{\"children\":[%d]},", i + 1);
+    sprintf(chain + at, "{}");
+    expect_refused(write_gltf_nodes("chain.gltf", chain, path, sizeof path), RL_ERR_LIMIT,
+                   "node hierarchy deeper than 1024 levels");
+    free(chain);
+    expect_refused(write_gltf_nodes("cycle.gltf", "{\"children\":[1]},{\"children\":[0]}", path,
+                                    sizeof path),
+                   RL_ERR_PARSE, "node 0 is its own ancestor");
+    expect_refused(write_gltf_nodes("loop.gltf", "{\"children\":[0]}", path, sizeof path),
+                   RL_ERR_PARSE, "node 0 is its own ancestor");
+    expect_refused(write_gltf_nodes("shared.gltf",
+                                    "{\"children\":[1,2]},{\"children\":[3]},{\"children\":[3]},{}",
+                                    path, sizeof path),
+                   RL_ERR_PARSE, "node 3 has two parents (1 and 2)");
+    expect_refused(write_gltf_nodes("index.gltf", "{\"children\":[1.5]},{}", path, sizeof path),
+                   RL_ERR_PARSE, "node 0 has a child that is not a node index");
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -187,6 +282,7 @@ int main(void)
         cmocka_unit_test(test_glb_lengths_beyond_the_file_are_refused),
         cmocka_unit_test(test_off_indices_out_of_range_are_refused),
         cmocka_unit_test(test_texture_pixel_limit_applies_before_decoding),
+        cmocka_unit_test(test_node_hierarchies_assimp_recurses_through_are_refused),
         cmocka_unit_test(test_a_device_is_not_read),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
