@@ -30,6 +30,7 @@
 #include "accel/linespace_internal.h"
 #include "core/bigalloc.h"
 #include "core/error.h"
+#include "rl/rl_output.h"
 #include "rl/rl_rng.h"
 
 #define LS_MAGIC "RLLS"
@@ -202,9 +203,13 @@ rl_status rl_linespace_save(const rl_linespace *ls, const char *path)
     if (!(ls->payloads & RL_LS_CANDIDATES))
         h.num_cand = 0;
     array_sizes s = sizes_of(&h);
-    FILE *f = fopen(path, "wb");
-    if (!f)
-        return rl_error(RL_ERR_IO, "%s: cannot open for writing: %s", path, strerror(errno));
+    /* Through a temporary and a rename: a save that fails or is killed
+     * leaves the previous cache (or none), never a truncated one. */
+    rl_output *o = NULL;
+    rl_status st = rl_output_open(path, &o);
+    if (st != RL_OK)
+        return st;
+    FILE *f = rl_output_file(o);
     unsigned char buf[HEADER_BYTES];
     encode(&h, buf);
     uint64_t sum = 0;
@@ -216,13 +221,12 @@ rl_status rl_linespace_save(const rl_linespace *ls, const char *path)
               write_hashed(f, ls->pnmt, 2 * s.pnmt, &sum) &&
               write_hashed(f, ls->preillum, 2 * s.preillum, &sum);
     ok = ok && fwrite(&sum, 1, 8, f) == 8;
-    if (fclose(f) != 0)
-        ok = false;
     if (!ok) {
-        remove(path);
-        return rl_error(RL_ERR_IO, "%s: write failed", path);
+        st = rl_error(RL_ERR_IO, "%s: cannot write: %s", path, strerror(errno));
+        rl_output_abort(o);
+        return st;
     }
-    return RL_OK;
+    return rl_output_commit(o);
 }
 
 static bool read_hashed(FILE *f, void *p, size_t n, uint64_t *h)

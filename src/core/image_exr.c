@@ -4,6 +4,7 @@
  * we forward into rl_error(). Values are stored unclamped, as EXR is meant
  * for HDR; half precision keeps about 3 significant decimal digits. */
 #include "rl/rl_image.h"
+#include "rl/rl_output.h"
 
 #include <ImfCRgbaFile.h>
 #include <errno.h>
@@ -29,27 +30,30 @@ rl_status rl_image_write_exr(const rl_image *img, const char *path)
         ImfFloatToHalf(img->color[i].z, &px[i].b);
         ImfFloatToHalf(img->color[i].w, &px[i].a);
     }
-    /* OpenEXR's own message for an unwritable path lacks errno's wording;
-     * opening once ourselves gives the reason users expect. */
-    FILE *probe = fopen(path, "wb");
-    if (!probe) {
-        st = rl_error(RL_ERR_IO, "%s: cannot open for writing: %s", path, strerror(errno));
+    /* OpenEXR opens the file by name: it writes the output's temporary,
+     * and the output's own stream only serves the commit's sync. Opening
+     * it first also words an unwritable path as users expect (OpenEXR's
+     * message lacks errno's reason). */
+    rl_output *o = NULL;
+    st = rl_output_open(path, &o);
+    if (st != RL_OK) {
         free(px);
         return st;
     }
-    fclose(probe);
     ImfHeader *hdr = ImfNewHeader();
     if (!hdr) {
         free(px);
+        rl_output_abort(o);
         return rl_error(RL_ERR_OUT_OF_MEMORY, "%s: cannot create EXR header", path);
     }
     ImfHeaderSetDataWindow(hdr, 0, 0, w - 1, h - 1);
     ImfHeaderSetDisplayWindow(hdr, 0, 0, w - 1, h - 1);
-    ImfOutputFile *file = ImfOpenOutputFile(path, hdr, IMF_WRITE_RGBA);
+    ImfOutputFile *file = ImfOpenOutputFile(rl_output_temp_path(o), hdr, IMF_WRITE_RGBA);
     ImfDeleteHeader(hdr);
     if (!file) {
         st = rl_error(RL_ERR_IO, "%s: cannot open for writing: %s", path, ImfErrorMessage());
         free(px);
+        rl_output_abort(o);
         return st;
     }
     /* Strides are in ImfRgba units: one pixel across, one row down. */
@@ -59,7 +63,11 @@ rl_status rl_image_write_exr(const rl_image *img, const char *path)
     if (!ImfCloseOutputFile(file) && ok)
         st = rl_error(RL_ERR_IO, "%s: cannot write EXR: %s", path, ImfErrorMessage());
     free(px);
-    return st;
+    if (st != RL_OK) {
+        rl_output_abort(o);
+        return st;
+    }
+    return rl_output_commit(o);
 }
 
 rl_status rl_image_read_exr(const char *path, rl_image **out)

@@ -5,6 +5,7 @@
  * sRGB curve and rounded to nearest so that 8-bit values survive a
  * read/write round trip; alpha is stored linearly as PNG requires. */
 #include "rl/rl_image.h"
+#include "rl/rl_output.h"
 
 #include <errno.h>
 #include <math.h>
@@ -20,6 +21,7 @@
 typedef struct png_ctx {
     char message[256];
     FILE *file;
+    rl_output *output;          /* writing: file is its stream */
     png_structp png;
     png_infop info;
     unsigned char *pixels;
@@ -66,7 +68,9 @@ static void png_ctx_free(png_ctx *ctx, bool reading)
         png_destroy_read_struct(&ctx->png, ctx->info ? &ctx->info : NULL, NULL);
     else
         png_destroy_write_struct(&ctx->png, ctx->info ? &ctx->info : NULL);
-    if (ctx->file)
+    if (ctx->output)
+        rl_output_abort(ctx->output);
+    else if (ctx->file)
         fclose(ctx->file);
     free(ctx->pixels);
     free(ctx->rows);
@@ -101,13 +105,13 @@ rl_status rl_image_write_png(const rl_image *img, const char *path)
             row[4 * x + 3] = encode_linear(c.w);
         }
     }
-    ctx->file = fopen(path, "wb");
-    if (!ctx->file) {
-        st = rl_error(RL_ERR_IO, "%s: cannot open for writing: %s", path, strerror(errno));
+    st = rl_output_open(path, &ctx->output);
+    if (st != RL_OK) {
         png_ctx_free(ctx, false);
         free(ctx);
         return st;
     }
+    ctx->file = rl_output_file(ctx->output);
     ctx->png = png_create_write_struct(PNG_LIBPNG_VER_STRING, ctx, on_png_error, on_png_warning);
     if (ctx->png)
         ctx->info = png_create_info_struct(ctx->png);
@@ -129,18 +133,12 @@ rl_status rl_image_write_png(const rl_image *img, const char *path)
     png_write_info(ctx->png, ctx->info);
     png_write_image(ctx->png, ctx->rows);
     png_write_end(ctx->png, NULL);
-    FILE *f = ctx->file;
+    rl_output *o = ctx->output;
+    ctx->output = NULL;
     ctx->file = NULL;
-    bool flushed = fflush(f) == 0;
-    int err = errno;
-    bool closed = fclose(f) == 0;
-    if (!closed)
-        err = errno;
     png_ctx_free(ctx, false);
     free(ctx);
-    if (!flushed || !closed)
-        return rl_error(RL_ERR_IO, "%s: cannot write PNG: %s", path, strerror(err));
-    return RL_OK;
+    return rl_output_commit(o);
 }
 
 rl_status rl_image_read_png(const char *path, rl_image **out)
