@@ -36,6 +36,22 @@ static void on_png_error(png_structp png, png_const_charp msg)
     png_longjmp(png, 1);
 }
 
+/* libpng's own writer reports a failed write as "Write Error"; ours keeps
+ * the reason (disk full, file too large). */
+static void on_png_write(png_structp png, png_bytep data, png_size_t n)
+{
+    png_ctx *ctx = png_get_io_ptr(png);
+    if (fwrite(data, 1, n, ctx->file) != n)
+        png_error(png, strerror(errno));
+}
+
+static void on_png_flush(png_structp png)
+{
+    png_ctx *ctx = png_get_io_ptr(png);
+    if (fflush(ctx->file) != 0)
+        png_error(png, strerror(errno));
+}
+
 static void on_png_warning(png_structp png, png_const_charp msg)
 {
     (void)png;
@@ -126,7 +142,7 @@ rl_status rl_image_write_png(const rl_image *img, const char *path)
         free(ctx);
         return st;
     }
-    png_init_io(ctx->png, ctx->file);
+    png_set_write_fn(ctx->png, ctx, on_png_write, on_png_flush);
     png_set_IHDR(ctx->png, ctx->info, (png_uint_32)w, (png_uint_32)h, 8, PNG_COLOR_TYPE_RGBA,
                  PNG_INTERLACE_NONE, PNG_COMPRESSION_TYPE_DEFAULT, PNG_FILTER_TYPE_DEFAULT);
     png_set_sRGB(ctx->png, ctx->info, PNG_sRGB_INTENT_PERCEPTUAL);
