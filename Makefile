@@ -44,7 +44,7 @@ fuzz: build-fuzz
 	ASAN_OPTIONS=detect_leaks=0 $$f/fuzz_load_mesh $(FUZZ_FLAGS) -detect_leaks=0 -artifact_prefix=$$a/mesh- \
 	    $$c/mesh || fails=$$((fails + 1)); \
 	$$f/fuzz_approx $(FUZZ_FLAGS) -artifact_prefix=$$a/approx- $$c/approx || fails=$$((fails + 1)); \
-	$$f/fuzz_linespace_cache $(FUZZ_FLAGS) -artifact_prefix=$$a/linespace- $$c/linespace || fails=$$((fails + 1)); \
+	$$f/fuzz_linespace_cache $(FUZZ_FLAGS) -max_len=16384 -artifact_prefix=$$a/linespace- $$c/linespace || fails=$$((fails + 1)); \
 	ASAN_OPTIONS=detect_leaks=0 $$f/fuzz_texture $(FUZZ_FLAGS) -detect_leaks=0 -artifact_prefix=$$a/texture- \
 	    $$c/texture || fails=$$((fails + 1)); \
 	$$f/fuzz_options $(FUZZ_FLAGS) -close_fd_mask=3 -dict=tests/fuzz/options.dict \

@@ -3,11 +3,13 @@
  * library's C++ exceptions and reports them through ImfErrorMessage(), which
  * we forward into rl_error(). Values are stored unclamped, as EXR is meant
  * for HDR; half precision keeps about 3 significant decimal digits. */
+#define _POSIX_C_SOURCE 200809L   /* fseeko, ftello */
 #include "rl/rl_image.h"
 #include "rl/rl_output.h"
 
 #include <ImfCRgbaFile.h>
 #include <errno.h>
+#include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -70,20 +72,72 @@ rl_status rl_image_write_exr(const rl_image *img, const char *path)
     return rl_output_commit(o);
 }
 
+/* OpenEXR allocates each header attribute at the size the file declares
+ * before reading it: a few bytes could claim gigabytes (issue 34, found by
+ * tests/fuzz/fuzz_texture.c). Walks the attributes of every header (several
+ * in a multi-part file) and refuses one that is longer than the rest of the
+ * file, before OpenEXR sees it. */
+static rl_status check_exr_headers(FILE *f, const char *path)
+{
+    if (fseeko(f, 0, SEEK_END) != 0)
+        return rl_error(RL_ERR_IO, "%s: cannot seek", path);
+    off_t length = ftello(f);
+    unsigned char head[8];
+    if (fseeko(f, 0, SEEK_SET) != 0 || fread(head, 1, 8, f) != 8)
+        return rl_error(RL_ERR_PARSE, "%s: invalid EXR: too short", path);
+    bool multipart = head[5] & 0x10;
+    for (int attributes = 0;; ++attributes) {
+        char text[2][257];
+        for (int t = 0; t < 2; ++t) {
+            int n = 0, c;
+            while ((c = fgetc(f)) > 0 && n < 256)
+                text[t][n++] = (char)c;
+            text[t][n] = '\0';
+            if (c != 0)
+                return rl_error(RL_ERR_PARSE, "%s: invalid EXR: header ends early or names too long", path);
+            if (t == 0 && n == 0)
+                break;                      /* the end of a header */
+        }
+        if (!text[0][0]) {
+            /* A multi-part file's headers end with an empty one. */
+            if (!multipart || attributes == 0)
+                return RL_OK;
+            attributes = -1;
+            continue;
+        }
+        unsigned char b[4];
+        if (fread(b, 1, 4, f) != 4)
+            return rl_error(RL_ERR_PARSE, "%s: invalid EXR: header ends early", path);
+        int32_t size = (int32_t)((uint32_t)b[0] | (uint32_t)b[1] << 8 | (uint32_t)b[2] << 16 | (uint32_t)b[3] << 24);
+        off_t at = ftello(f);
+        if (size < 0 || at < 0 || (off_t)size > length - at)
+            return rl_error(RL_ERR_PARSE, "%s: invalid EXR: attribute \"%s\" of %d bytes, longer than the file",
+                            path, text[0], (int)size);
+        if (fseeko(f, size, SEEK_CUR) != 0)
+            return rl_error(RL_ERR_IO, "%s: cannot seek", path);
+    }
+}
+
 rl_status rl_image_read_exr(const char *path, rl_image **out)
 {
     /* ImfOpenInputFile's message for a missing file is terse; check first. */
     FILE *probe = fopen(path, "rb");
     if (!probe)
         return rl_error(RL_ERR_IO, "%s: cannot open: %s", path, strerror(errno));
+    rl_status checked = check_exr_headers(probe, path);
     fclose(probe);
+    if (checked != RL_OK)
+        return checked;
     ImfInputFile *file = ImfOpenInputFile(path);
     if (!file)
         return rl_error(RL_ERR_PARSE, "%s: invalid EXR: %s", path, ImfErrorMessage());
     int x0, y0, x1, y1;
     ImfHeaderDataWindow(ImfInputHeader(file), &x0, &y0, &x1, &y1);
     long long w = (long long)x1 - x0 + 1, h = (long long)y1 - y0 + 1;
+    /* One half-float channel is the least a pixel stores. */
     rl_status st = rl_image_check_size(path, w, h);
+    if (st == RL_OK)
+        st = rl_image_check_file_size(path, w, h, 2.0);
     if (st != RL_OK) {
         ImfCloseInputFile(file);
         return st;

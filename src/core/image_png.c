@@ -194,10 +194,11 @@ rl_status rl_image_read_png(const char *path, rl_image **out)
     png_read_info(ctx->png, ctx->info);
     png_uint_32 w = png_get_image_width(ctx->png, ctx->info);
     png_uint_32 h = png_get_image_height(ctx->png, ctx->info);
-    if (rl_image_check_size(path, w, h) != RL_OK) {
+    /* One bit (grey, depth 1) is the least a pixel stores. */
+    if ((st = rl_image_check_size(path, w, h)) != RL_OK || (st = rl_image_check_file_size(path, w, h, 0.125)) != RL_OK) {
         png_ctx_free(ctx, true);
         free(ctx);
-        return RL_ERR_LIMIT;
+        return st;
     }
     int depth = png_get_bit_depth(ctx->png, ctx->info);
     int type = png_get_color_type(ctx->png, ctx->info);

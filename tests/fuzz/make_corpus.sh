@@ -3,8 +3,8 @@
 # harnesses added for issue 34 (approx, linespace, texture, options) into
 # tests/fuzz/corpus/<kind>, replacing what is there. RL is a built `rl`,
 # FUZZ_LINESPACE_CACHE the built harness (it writes its own seeds, which
-# must belong to its grid). Every seed is small (the smoke runs cut inputs
-# at 4096 bytes). The committed seeds came from this script; rerun it when
+# must belong to its grid). Every seed is small: the runs cut inputs at
+# 4096 bytes, those of the Line Space harness at 16384. The committed seeds came from this script; rerun it when
 # a format changes.
 set -euo pipefail
 rl=${1:?usage: make_corpus.sh RL FUZZ_LINESPACE_CACHE}
@@ -77,4 +77,6 @@ printf '%s\n' cornell --size 320x240 --eye 0.2,0.3,-1 --target 0,0.2,0 --up 0,1,
 printf '%s\n' cornell --camera-path --frames 12 --out 'f/%04d.png' --set raster.shading=flat > "$here/corpus/options/path.txt"
 printf '%s\n' model.obj --headlight --orbit --algo whitted --set max_depth=3 --set background=0.1,0.2,0.3 \
     --out x.png > "$here/corpus/options/model.txt"
-ls -l "$here/corpus/approx" "$here/corpus/linespace" "$here/corpus/texture" "$here/corpus/options" | awk '$5 > 4096 { print "make_corpus.sh: over 4096 bytes: " $9; bad = 1 } END { exit bad }'
+ls -l "$here/corpus/approx" "$here/corpus/texture" "$here/corpus/options" |
+    awk '$5 > 4096 { print "make_corpus.sh: over 4096 bytes: " $9; bad = 1 } END { exit bad }'
+ls -l "$here/corpus/linespace" | awk '$5 > 16384 { print "make_corpus.sh: over 16384 bytes: " $9; bad = 1 } END { exit bad }'
