@@ -399,6 +399,41 @@ static void test_exr_attribute_longer_than_the_file_is_refused(void **state)
     rl_clear_error();
 }
 
+/* An EXR whose one chunk declares 1.9 GB: refused before OpenEXR
+ * allocates it (fuzz_texture found such files). */
+static void test_exr_chunk_longer_than_the_file_is_refused(void **state)
+{
+    (void)state;
+    rl_image *img = NULL;
+    assert_int_equal(rl_image_create(4, 4, RL_LAYER_COLOR, &img), RL_OK);
+    const char *good = tmp_path("small.exr");
+    assert_int_equal(rl_image_write(img, good), RL_OK);
+    rl_image_release(img);
+    size_t n = 0;
+    unsigned char *data = read_all(good, &n);
+    /* The chunk: y = 0, then its size, which runs to the end of the file. */
+    unsigned char *at = NULL;
+    for (size_t i = 4; i + 4 <= n && !at; ++i) {
+        int32_t y, size;
+        memcpy(&y, data + i - 4, 4);
+        memcpy(&size, data + i, 4);
+        if (y == 0 && size > 0 && (size_t)size == n - i - 4)
+            at = data + i;
+    }
+    assert_non_null(at);
+    int32_t huge = 1932551434;
+    memcpy(at, &huge, 4);
+    const char *bad = tmp_path("huge_chunk.exr");
+    write_bytes(bad, data, n);
+    rl_image *back = NULL;
+    rl_clear_error();
+    assert_int_equal(rl_image_read(bad, &back), RL_ERR_PARSE);
+    assert_null(back);
+    if (!strstr(rl_last_error(), "longer than the file"))
+        fail_msg("not refused by the chunk check: %s", rl_last_error());
+    rl_clear_error();
+}
+
 /* PNG's CRC-32 (ISO 3309), to re-seal an edited chunk. */
 static uint32_t crc32_of(const unsigned char *p, size_t n)
 {
@@ -459,6 +494,7 @@ int main(void)
         cmocka_unit_test(test_texture_sampling_is_bilinear_with_repeat),
         cmocka_unit_test(test_corrupted_png_is_an_error_not_a_crash),
         cmocka_unit_test(test_exr_attribute_longer_than_the_file_is_refused),
+        cmocka_unit_test(test_exr_chunk_longer_than_the_file_is_refused),
         cmocka_unit_test(test_png_claiming_more_pixels_than_its_bytes_hold_is_refused),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
