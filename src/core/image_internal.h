@@ -14,6 +14,10 @@ rl_status rl_image_check_file_size(const char *path, long long width, long long 
 /* Argument checks common to every writer, before the file is touched. */
 rl_status rl_image_check_writable(const rl_image *img, const char *who, const char *path);
 rl_status rl_image_read_png(const char *path, rl_image **out);
+/* Before stb_image decodes len bytes in memory (an embedded texture): when
+ * they are a PNG, RL_ERR_PARSE naming `what` if a chunk is longer than the
+ * bytes after it (stb would allocate its declared length). */
+rl_status rl_texture_check_png_memory(const unsigned char *data, size_t len, const char *what);
 rl_status rl_image_read_exr(const char *path, rl_image **out);
 
 #endif

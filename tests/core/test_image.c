@@ -434,6 +434,40 @@ static void test_exr_chunk_longer_than_the_file_is_refused(void **state)
     rl_clear_error();
 }
 
+/* A PNG whose IDAT chunk declares 2 GB: the texture loader refuses it
+ * before stb_image grows a buffer to that length (fuzz_texture found it:
+ * 8 s and gigabytes for 231 bytes). */
+static void test_png_chunk_longer_than_the_file_is_refused_by_the_texture_loader(void **state)
+{
+    (void)state;
+    rl_image *img = NULL;
+    assert_int_equal(rl_image_create(4, 4, RL_LAYER_COLOR, &img), RL_OK);
+    const char *good = tmp_path("chunk.png");
+    assert_int_equal(rl_image_write(img, good), RL_OK);
+    rl_image_release(img);
+    rl_texture *tex = NULL;
+    assert_int_equal(rl_texture_load(good, &tex), RL_OK);
+    rl_texture_release(tex);
+    size_t n = 0;
+    unsigned char *data = read_all(good, &n);
+    unsigned char *idat = NULL;
+    for (size_t i = 4; i + 4 <= n && !idat; ++i)
+        if (memcmp(data + i, "IDAT", 4) == 0)
+            idat = data + i - 4;
+    assert_non_null(idat);
+    static const unsigned char length[4] = { 0x7e, 0x00, 0x00, 0x1c };   /* big-endian, not in the CRC */
+    memcpy(idat, length, 4);
+    const char *bad = tmp_path("chunk_2gb.png");
+    write_bytes(bad, data, n);
+    tex = NULL;
+    rl_clear_error();
+    assert_int_equal(rl_texture_load(bad, &tex), RL_ERR_PARSE);
+    assert_null(tex);
+    if (!strstr(rl_last_error(), "longer than the file"))
+        fail_msg("not refused by the chunk check: %s", rl_last_error());
+    rl_clear_error();
+}
+
 /* PNG's CRC-32 (ISO 3309), to re-seal an edited chunk. */
 static uint32_t crc32_of(const unsigned char *p, size_t n)
 {
@@ -495,6 +529,7 @@ int main(void)
         cmocka_unit_test(test_corrupted_png_is_an_error_not_a_crash),
         cmocka_unit_test(test_exr_attribute_longer_than_the_file_is_refused),
         cmocka_unit_test(test_exr_chunk_longer_than_the_file_is_refused),
+        cmocka_unit_test(test_png_chunk_longer_than_the_file_is_refused_by_the_texture_loader),
         cmocka_unit_test(test_png_claiming_more_pixels_than_its_bytes_hold_is_refused),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

@@ -41,8 +41,14 @@ def chunk(kind, body):
 
 def png(name, w, h, depth, ctype, row_bytes, extra=b"", interlace=0):
     raw = b""
-    for y in range(h):
-        raw += b"\x00" + bytes((x * 37 + y * 11) & 0xff for x in range(row_bytes))
+    # Adam7's seven passes, each a small picture of its own; one pass of
+    # the whole picture otherwise. row_bytes / w: bytes per pixel (depth >= 8).
+    passes = [(0, 0, 8, 8), (4, 0, 8, 8), (0, 4, 4, 8), (2, 0, 4, 4), (0, 2, 2, 4), (1, 0, 2, 2), (0, 1, 1, 2)]
+    for x0, y0, dx, dy in passes if interlace else [(0, 0, 1, 1)]:
+        pw, ph = (w - x0 + dx - 1) // dx, (h - y0 + dy - 1) // dy
+        n = row_bytes * pw // w
+        for y in range(ph if pw > 0 else 0):
+            raw += b"\x00" + bytes((x * 37 + y * 11) & 0xff for x in range(n))
     data = b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", struct.pack(">IIBBBBB", w, h, depth, ctype, 0, 0, interlace))
     data += extra + chunk(b"IDAT", zlib.compress(raw)) + chunk(b"IEND", b"")
     open(f"{out}/{name}", "wb").write(data)
