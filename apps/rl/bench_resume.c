@@ -53,20 +53,20 @@ static char *slurp(const char *path, bool *missing)
     return text;
 }
 
-/* Writes text to path through path.tmp and a rename. */
+/* Through a temporary and a rename (rl_output.h): a run killed while
+ * saving leaves the previous state, never half a file. */
 static bool write_atomic(const char *path, const char *text)
 {
-    char tmp[1400];
-    snprintf(tmp, sizeof tmp, "%s.tmp", path);
-    FILE *f = fopen(tmp, "w");
-    bool ok = f && fputs(text, f) >= 0;
-    if (f && fclose(f) != 0)
-        ok = false;
-    if (ok && rename(tmp, path) != 0)
-        ok = false;
-    if (!ok)
-        cli_fail(RL_CLI_FAIL, "%s: cannot write", path);
-    return ok;
+    rl_output *o = NULL;
+    rl_clear_error();
+    rl_status st = rl_output_open(path, &o);
+    if (st == RL_OK) {
+        fputs(text, rl_output_file(o));
+        st = rl_output_commit(o);
+    }
+    if (st != RL_OK)
+        cli_fail_status(RL_CLI_FAIL, st, path);
+    return st == RL_OK;
 }
 
 bool bench_resume_open(const char *dir, const char *key, bench_resume **out)
@@ -176,16 +176,8 @@ bool bench_resume_save(bench_resume *r, const char *name, const double *values, 
 
 bool bench_resume_save_approx(bench_resume *r, const char *name, const rl_approx *a)
 {
-    char path[1280], tmp[1400];
-    snprintf(path, sizeof path, "%s", bench_resume_path(r, name));
-    snprintf(tmp, sizeof tmp, "%s.tmp", path);
-    if (rl_approx_save_json(a, tmp) != RL_OK)
-        return false;
-    if (rename(tmp, path) != 0) {
-        cli_fail(RL_CLI_FAIL, "%s: cannot write", path);
-        return false;
-    }
-    return true;
+    /* Atomic itself (rl_output.h); the caller reports the library's error. */
+    return rl_approx_save_json(a, bench_resume_path(r, name)) == RL_OK;
 }
 
 rl_status bench_resume_load_approx(bench_resume *r, const char *name, rl_approx **out)

@@ -124,14 +124,18 @@ bool cli_write_json(const cJSON *item, const char *path)
         cli_fail(RL_CLI_FAIL, "%s: out of memory while formatting JSON", path);
         return false;
     }
-    FILE *f = fopen(path, "w");
-    bool ok = f && fputs(text, f) >= 0 && fputc('\n', f) != EOF;
-    if (f && fclose(f) != 0)
-        ok = false;
+    rl_output *o = NULL;
+    rl_clear_error();
+    rl_status st = rl_output_open(path, &o);
+    if (st == RL_OK) {
+        fputs(text, rl_output_file(o));
+        fputc('\n', rl_output_file(o));
+        st = rl_output_commit(o);
+    }
     free(text);
-    if (!ok)
-        cli_fail(RL_CLI_FAIL, "%s: cannot write", path);
-    return ok;
+    if (st != RL_OK)
+        cli_fail_status(RL_CLI_FAIL, st, path);
+    return st == RL_OK;
 }
 
 /* The counters of a summary line, each only where it applies. */

@@ -614,8 +614,8 @@ static int measure_all(const compare_args *a, const rl_scene *scene, const rl_ap
 
 /* compare.json and report.html: the setup, where the samples are, and a
  * section per metric. */
-static int write_report(const compare_args *a, const rl_scene *scene, const rl_approx *driver, uint32_t ns,
-                        measured (*res)[M_COUNT], const char *report, const char *json_path)
+static int write_files(const compare_args *a, const rl_scene *scene, const rl_approx *driver, uint32_t ns,
+                       measured (*res)[M_COUNT], const char *report, const char *json_path)
 {
     cJSON *root = result_json(a, scene, driver, res);
     bool ok = root && cli_write_json(root, json_path);
@@ -661,6 +661,29 @@ static int write_report(const compare_args *a, const rl_scene *scene, const rl_a
     html_para(h, "Data: compare.json.");
     rl_image_release(top);
     return html_end(h, report) ? RL_CLI_OK : RL_CLI_FAIL;
+}
+
+/* Both files go to temporaries, renamed together once both are written
+ * (rl_output_batch): a failed report keeps the previous pair. */
+static int write_report(const compare_args *a, const rl_scene *scene, const rl_approx *driver, uint32_t ns,
+                        measured (*res)[M_COUNT], const char *report, const char *json_path)
+{
+    rl_output_batch *batch = NULL;
+    const char *json_tmp = NULL, *report_tmp = NULL;
+    rl_clear_error();
+    rl_status st = rl_output_batch_create(&batch);
+    if (st == RL_OK && (st = rl_output_batch_add(batch, json_path, &json_tmp)) == RL_OK)
+        st = rl_output_batch_add(batch, report, &report_tmp);
+    if (st != RL_OK) {
+        rl_output_batch_release(batch);
+        return cli_fail_status(RL_CLI_FAIL, st, "outputs");
+    }
+    int rc = write_files(a, scene, driver, ns, res, report_tmp, json_tmp);
+    rl_clear_error();
+    if (rc == RL_CLI_OK && (st = rl_output_batch_commit(batch)) != RL_OK)
+        rc = cli_fail_status(RL_CLI_FAIL, st, "outputs");
+    rl_output_batch_release(batch);
+    return rc;
 }
 
 int cli_compare(int argc, char **argv)

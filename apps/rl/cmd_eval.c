@@ -455,6 +455,7 @@ int cli_eval(int argc, char **argv)
     snprintf(approx_path, sizeof approx_path, "%s/approx.json", a.out);
     rl_scene *scene = NULL;
     rl_approx *ap = NULL;
+    rl_output_batch *batch = NULL;
     eval_result r = { 0 };
     if (!cli_make_dirs(a.out) || !cli_check_writable(report)) {
         rc = RL_CLI_FAIL;
@@ -522,20 +523,36 @@ int cli_eval(int argc, char **argv)
     if (a.validate > 0 && (rc = validate(&a, p, ap, &r)) != RL_CLI_OK)
         goto done;
     cli_load_end(&r.load);
-    st = rl_approx_save_json(ap, approx_path);
+    /* approx.json, eval.json and the report go to temporaries, renamed
+     * together once all three are written (rl_output_batch): a run that
+     * fails at the report keeps the previous run's three files. */
+    const char *approx_tmp = NULL, *json_tmp = NULL, *report_tmp = NULL;
+    rl_clear_error();
+    if ((st = rl_output_batch_create(&batch)) != RL_OK || (st = rl_output_batch_add(batch, approx_path, &approx_tmp)) != RL_OK ||
+        (st = rl_output_batch_add(batch, json_path, &json_tmp)) != RL_OK ||
+        (st = rl_output_batch_add(batch, report, &report_tmp)) != RL_OK) {
+        rc = cli_fail_status(RL_CLI_FAIL, st, "outputs");
+        goto done;
+    }
+    st = rl_approx_save_json(ap, approx_tmp);
     if (st != RL_OK) {
         rc = cli_fail_status(RL_CLI_FAIL, st, approx_path);
         goto done;
     }
     cJSON *root = result_json(&a, scene, p, first, second, ap, &r);
-    bool ok = root && cli_write_json(root, json_path);
+    bool ok = root && cli_write_json(root, json_tmp);
     cJSON_Delete(root);
     if (!ok) {
         rc = RL_CLI_FAIL;
         goto done;
     }
-    if ((rc = write_report(&a, report, scene, p, ap, &r)) != RL_CLI_OK)
+    if ((rc = write_report(&a, report_tmp, scene, p, ap, &r)) != RL_CLI_OK)
         goto done;
+    rl_clear_error();
+    if ((st = rl_output_batch_commit(batch)) != RL_OK) {
+        rc = cli_fail_status(RL_CLI_FAIL, st, "outputs");
+        goto done;
+    }
     printf("%s on %s: %u samples, %u regions in %.1f s; %s mean %.4g, min %.4g, q25 %.4g, median %.4g, "
            "q75 %.4g, max %.4g",
            r.label, a.scene, rl_approx_sample_count(ap), rl_approx_region_count(ap),
@@ -551,6 +568,7 @@ int cli_eval(int argc, char **argv)
                r.error.mean, r.error.q[2]);
     printf("\nwrote %s, %s, %s\n", approx_path, json_path, report);
 done:
+    rl_output_batch_release(batch);
     free(r.measured);
     free(r.approximated);
     rl_approx_release(ap);

@@ -338,17 +338,15 @@ static int choose_camera(const render_args *a, const rl_scene *scene, rl_camera 
     return RL_CLI_OK;
 }
 
-/* Writes img's colour to path, tone mapped for PNG when asked, through a
- * temporary file in the same folder and a rename: whoever watches path (a
- * viewer during a long render's previews) never sees half a file, and a
- * failed write leaves the old file as it was. The temporary keeps the
- * extension, which picks the format. */
-static int write_color(const render_args *a, const rl_image *img, const char *path)
+/* Writes img's colour to path, tone mapped for PNG when asked. Previews
+ * name --out itself: the writers go through a temporary file and a rename
+ * (rl_output.h), so whoever watches --out (a viewer during a long render)
+ * never sees half a file, and a failed write leaves the old one. */
+static rl_status write_color(const render_args *a, const rl_image *img, const char *path)
 {
     const rl_image *src = img;
     rl_image *mapped = NULL;
     rl_status st = RL_OK;
-    rl_clear_error();
     if (a->tonemap.op != RL_TONEMAP_NONE || a->tonemap.exposure_ev != 0.0) {
         /* A copy: the frame may be accumulated further, and stays linear. */
         st = rl_image_create(img->width, img->height, RL_LAYER_COLOR, &mapped);
@@ -358,79 +356,81 @@ static int write_color(const render_args *a, const rl_image *img, const char *pa
             src = mapped;
         }
     }
-    const char *slash = strrchr(path, '/');
-    const char *base = slash ? slash + 1 : path;
-    const char *ext = strrchr(base, '.');
-    if (!ext)
-        ext = base + strlen(base);
-    char tmp[4200];
-    int n = snprintf(tmp, sizeof tmp, "%.*s.%.*s.tmp%s", (int)(base - path), path, (int)(ext - base), base, ext);
-    if (st == RL_OK && (n < 0 || (size_t)n >= sizeof tmp)) {
-        rl_image_release(mapped);
-        return cli_fail(RL_CLI_FAIL, "%s: the name is too long", path);
-    }
     if (st == RL_OK)
-        st = rl_image_write(src, tmp);
+        st = rl_image_write(src, path);
     rl_image_release(mapped);
-    if (st != RL_OK) {
-        remove(tmp);
-        return cli_fail_status(RL_CLI_FAIL, st, path);
-    }
-    if (rename(tmp, path) != 0) {
-        int err = errno;
-        remove(tmp);
-        return cli_fail(RL_CLI_FAIL, "%s: cannot replace it: %s", path, strerror(err));
-    }
-    return RL_CLI_OK;
+    return st;
 }
 
-/* acc: how a progressive loop ended, for the stats file; NULL for one frame. */
+static rl_status write_stats_json(const render_args *a, const rl_scene *scene, const rl_image *img,
+                                  const rl_render_stats *stats, double inputs_ms, const cli_accumulation *acc,
+                                  const char *path)
+{
+    cJSON *obj = cli_render_stats_json(stats, inputs_ms);
+    if (!obj)
+        return RL_ERR_OUT_OF_MEMORY;
+    cJSON_AddStringToObject(obj, "algorithm", a->algo);
+    cJSON_AddStringToObject(obj, "scene", a->scene);
+    cJSON_AddNumberToObject(obj, "width", img->width);
+    cJSON_AddNumberToObject(obj, "height", img->height);
+    cJSON_AddStringToObject(obj, "file", a->out);
+    if (a->has_tonemap) {
+        cJSON_AddStringToObject(obj, "tonemap", rl_tonemap_name(a->tonemap.op));
+        cJSON_AddNumberToObject(obj, "exposure_ev", a->tonemap.exposure_ev);
+    }
+    if (acc) {
+        /* The counters above are summed over the frames. */
+        cJSON_AddNumberToObject(obj, "frames", (double)acc->frames);
+        cJSON_AddNumberToObject(obj, "spp", acc->spp);
+        cJSON_AddNumberToObject(obj, "elapsed_s", acc->elapsed_s);
+        cJSON_AddNumberToObject(obj, "time_budget_s", acc->budget_s);
+        cJSON_AddNumberToObject(obj, "target_spp", (double)acc->target_spp);
+        cJSON_AddStringToObject(obj, "stopped", acc->stopped);
+    }
+    cJSON *scene_stats = cli_scene_stats_json(scene);
+    if (scene_stats)
+        cJSON_AddItemToObject(obj, "scene_stats", scene_stats);
+    char *text = cJSON_Print(obj);
+    cJSON_Delete(obj);
+    if (!text)
+        return RL_ERR_OUT_OF_MEMORY;
+    rl_output *o = NULL;
+    rl_status st = rl_output_open(path, &o);
+    if (st == RL_OK) {
+        fputs(text, rl_output_file(o));
+        fputc('\n', rl_output_file(o));
+        st = rl_output_commit(o);
+    }
+    free(text);
+    return st;
+}
+
+/* Every output of the run (--out, --depth-out, --id-out, --stats-json) is
+ * written to a temporary beside it, and all are renamed together once each
+ * one was written (rl_output_batch): a run whose depth image fails keeps
+ * the previous --out as well. acc: how a progressive loop ended, for the
+ * stats file; NULL for one frame. */
 static int write_outputs(const render_args *a, const rl_scene *scene, const rl_image *img,
                          const rl_render_stats *stats, double inputs_ms, const cli_accumulation *acc)
 {
-    rl_status st;
-    int rc = write_color(a, img, a->out);
-    if (rc != RL_CLI_OK)
-        return rc;
+    rl_output_batch *batch = NULL;
+    const char *what = a->out, *tmp = NULL;
     rl_clear_error();
-    if (a->depth_out && (st = cli_write_depth(img, a->depth_out)) != RL_OK)
-        return cli_fail_status(RL_CLI_FAIL, st, a->depth_out);
-    if (a->id_out && (st = cli_write_ids(img, a->id_out)) != RL_OK)
-        return cli_fail_status(RL_CLI_FAIL, st, a->id_out);
-    if (a->stats_json) {
-        cJSON *obj = cli_render_stats_json(stats, inputs_ms);
-        bool ok = obj != NULL;
-        if (ok) {
-            cJSON_AddStringToObject(obj, "algorithm", a->algo);
-            cJSON_AddStringToObject(obj, "scene", a->scene);
-            cJSON_AddNumberToObject(obj, "width", img->width);
-            cJSON_AddNumberToObject(obj, "height", img->height);
-            cJSON_AddStringToObject(obj, "file", a->out);
-            if (a->has_tonemap) {
-                cJSON_AddStringToObject(obj, "tonemap", rl_tonemap_name(a->tonemap.op));
-                cJSON_AddNumberToObject(obj, "exposure_ev", a->tonemap.exposure_ev);
-            }
-            if (acc) {
-                /* The counters above are summed over the frames. */
-                cJSON_AddNumberToObject(obj, "frames", (double)acc->frames);
-                cJSON_AddNumberToObject(obj, "spp", acc->spp);
-                cJSON_AddNumberToObject(obj, "elapsed_s", acc->elapsed_s);
-                cJSON_AddNumberToObject(obj, "time_budget_s", acc->budget_s);
-                cJSON_AddNumberToObject(obj, "target_spp", (double)acc->target_spp);
-                cJSON_AddStringToObject(obj, "stopped", acc->stopped);
-            }
-            cJSON *scene_stats = cli_scene_stats_json(scene);
-            if (scene_stats)
-                cJSON_AddItemToObject(obj, "scene_stats", scene_stats);
-            ok = cli_write_json(obj, a->stats_json);
-        } else {
-            cli_fail(RL_CLI_FAIL, "out of memory");
-        }
-        cJSON_Delete(obj);
-        if (!ok)
-            return RL_CLI_FAIL;
+    rl_status st = rl_output_batch_create(&batch);
+    if (st == RL_OK && (st = rl_output_batch_add(batch, what, &tmp)) == RL_OK)
+        st = write_color(a, img, tmp);
+    if (st == RL_OK && a->depth_out && (st = rl_output_batch_add(batch, what = a->depth_out, &tmp)) == RL_OK)
+        st = cli_write_depth(img, tmp);
+    if (st == RL_OK && a->id_out && (st = rl_output_batch_add(batch, what = a->id_out, &tmp)) == RL_OK)
+        st = cli_write_ids(img, tmp);
+    if (st == RL_OK && a->stats_json && (st = rl_output_batch_add(batch, what = a->stats_json, &tmp)) == RL_OK)
+        st = write_stats_json(a, scene, img, stats, inputs_ms, acc, tmp);
+    if (st == RL_OK) {
+        what = "outputs";
+        st = rl_output_batch_commit(batch);
     }
-    return RL_CLI_OK;
+    rl_output_batch_release(batch);
+    return st == RL_OK ? RL_CLI_OK : cli_fail_status(RL_CLI_FAIL, st, what);
 }
 
 /* How many frames: one, or a progressive loop with its limits. */
@@ -588,8 +588,12 @@ static int render_frames(const render_args *a, rl_renderer *r, const rl_scene *s
             break;
         }
         if (now >= next_preview) {
-            if ((rc = write_color(a, img, a->out)) != RL_CLI_OK)
+            rl_clear_error();
+            rl_status wst = write_color(a, img, a->out);
+            if (wst != RL_OK) {
+                rc = cli_fail_status(RL_CLI_FAIL, wst, a->out);
                 break;
+            }
             next_preview = rl_time_s() + plan->preview_s;
         }
     }

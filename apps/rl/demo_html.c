@@ -122,11 +122,14 @@ static void put_scene(FILE *f, const cJSON *report, const char *scene, const cha
 
 bool cli_write_demo_html(const cJSON *report, const char *path)
 {
-    FILE *f = fopen(path, "w");
-    if (!f) {
-        cli_fail(RL_CLI_FAIL, "%s: cannot write", path);
+    rl_output *o = NULL;
+    rl_clear_error();
+    rl_status st = rl_output_open(path, &o);
+    if (st != RL_OK) {
+        cli_fail_status(RL_CLI_FAIL, st, path);
         return false;
     }
+    FILE *f = rl_output_file(o);
     const cJSON *images = cJSON_GetObjectItemCaseSensitive(report, "images");
     const cJSON *failures = cJSON_GetObjectItemCaseSensitive(report, "failures");
     const cJSON *machine = cJSON_GetObjectItemCaseSensitive(report, "machine");
@@ -219,10 +222,9 @@ bool cli_write_demo_html(const cJSON *report, const char *path)
     }
     fputs("<p class=\"s\">Data: <a href=\"report.json\">report.json</a></p>\n"
           "</body></html>\n", f);
-    bool ok = !ferror(f);
-    if (fclose(f) != 0)
-        ok = false;
-    if (!ok)
-        cli_fail(RL_CLI_FAIL, "%s: cannot write", path);
-    return ok;
+    rl_clear_error();
+    st = rl_output_commit(o);
+    if (st != RL_OK)
+        cli_fail_status(RL_CLI_FAIL, st, path);
+    return st == RL_OK;
 }

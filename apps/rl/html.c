@@ -8,7 +8,8 @@
 #include "cli.h"
 
 struct html_doc {
-    FILE *f;
+    rl_output *out;
+    FILE *f;                    /* out's stream */
 };
 
 void html_put_escaped(FILE *f, const char *s)
@@ -31,12 +32,14 @@ html_doc *html_begin(const char *path, const char *title)
         cli_fail(RL_CLI_FAIL, "out of memory");
         return NULL;
     }
-    h->f = fopen(path, "w");
-    if (!h->f) {
+    rl_clear_error();
+    rl_status st = rl_output_open(path, &h->out);
+    if (st != RL_OK) {
         free(h);
-        cli_fail(RL_CLI_FAIL, "%s: cannot write", path);
+        cli_fail_status(RL_CLI_FAIL, st, path);
         return NULL;
     }
+    h->f = rl_output_file(h->out);
     fputs("<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\">\n<title>", h->f);
     html_put_escaped(h->f, title);
     fputs("</title>\n<style>\n"
@@ -119,11 +122,10 @@ void html_table_end(html_doc *h) { fputs("</table>\n", h->f); }
 bool html_end(html_doc *h, const char *path)
 {
     fputs("</body></html>\n", h->f);
-    bool ok = !ferror(h->f);
-    if (fclose(h->f) != 0)
-        ok = false;
+    rl_clear_error();
+    rl_status st = rl_output_commit(h->out);
     free(h);
-    if (!ok)
-        cli_fail(RL_CLI_FAIL, "%s: cannot write", path);
-    return ok;
+    if (st != RL_OK)
+        cli_fail_status(RL_CLI_FAIL, st, path);
+    return st == RL_OK;
 }

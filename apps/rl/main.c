@@ -5,8 +5,12 @@
  * and the subcommand sees only its own arguments. */
 #include "cli.h"
 
+<<<<<<< HEAD
 #include <errno.h>
 #include <stdlib.h>
+=======
+#include <signal.h>
+>>>>>>> atomic
 #include <string.h>
 
 typedef struct command {
@@ -109,6 +113,10 @@ static int parse_limit(const char *flag, const char *text, unsigned long lo, uns
 int main(int argc, char **argv)
 {
     cli_set_command_line(argc, argv);   /* for the reports, before the flags are taken out */
+    /* A write past the file size limit (ulimit -f) would kill rl by SIGXFSZ
+     * mid-file; ignored, it fails with EFBIG, which the writers report as
+     * an error and clean up after, like a full disk. */
+    signal(SIGXFSZ, SIG_IGN);
     rl_log_level level = RL_LOG_INFO;
     enum { MAX_PLUGINS = 8 };
     const char *plugins[MAX_PLUGINS];

@@ -4,6 +4,7 @@
 #include "rl/rl_common.h"
 #include "rl/rl_options.h"
 #include "rl/rl_path.h"
+#include "rl/rl_output.h"
 #include "rl/rl_math.h"
 #include "rl/rl_rng.h"
 #include "rl/rl_image.h"

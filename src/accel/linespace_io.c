@@ -22,6 +22,7 @@
  * indices in range, monotone offsets). */
 #define _POSIX_C_SOURCE 200809L
 #include <errno.h>
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -29,7 +30,9 @@
 #include "accel/accel_internal.h"
 #include "accel/linespace_internal.h"
 #include "core/bigalloc.h"
+#include "core/half.h"
 #include "core/error.h"
+#include "rl/rl_output.h"
 #include "rl/rl_rng.h"
 
 #define LS_MAGIC "RLLS"
@@ -202,9 +205,13 @@ rl_status rl_linespace_save(const rl_linespace *ls, const char *path)
     if (!(ls->payloads & RL_LS_CANDIDATES))
         h.num_cand = 0;
     array_sizes s = sizes_of(&h);
-    FILE *f = fopen(path, "wb");
-    if (!f)
-        return rl_error(RL_ERR_IO, "%s: cannot open for writing: %s", path, strerror(errno));
+    /* Through a temporary and a rename: a save that fails or is killed
+     * leaves the previous cache (or none), never a truncated one. */
+    rl_output *o = NULL;
+    rl_status st = rl_output_open(path, &o);
+    if (st != RL_OK)
+        return st;
+    FILE *f = rl_output_file(o);
     unsigned char buf[HEADER_BYTES];
     encode(&h, buf);
     uint64_t sum = 0;
@@ -216,13 +223,12 @@ rl_status rl_linespace_save(const rl_linespace *ls, const char *path)
               write_hashed(f, ls->pnmt, 2 * s.pnmt, &sum) &&
               write_hashed(f, ls->preillum, 2 * s.preillum, &sum);
     ok = ok && fwrite(&sum, 1, 8, f) == 8;
-    if (fclose(f) != 0)
-        ok = false;
     if (!ok) {
-        remove(path);
-        return rl_error(RL_ERR_IO, "%s: write failed", path);
+        st = rl_error(RL_ERR_IO, "%s: cannot write: %s", path, strerror(errno));
+        rl_output_abort(o);
+        return st;
     }
-    return RL_OK;
+    return rl_output_commit(o);
 }
 
 static bool read_hashed(FILE *f, void *p, size_t n, uint64_t *h)
@@ -233,7 +239,33 @@ static bool read_hashed(FILE *f, void *p, size_t n, uint64_t *h)
     return true;
 }
 
-static rl_status check_contents(const rl_linespace *ls, const char *path)
+/* PNMT records become surfaces that renderers shade (Sec. 7.4, eq. 9):
+ * a record in use holds finite numbers, a position inside its voxel and a
+ * material of the scene (|m| - 1, rounded), so that a damaged file cannot
+ * send a query outside the material list (found by
+ * tests/fuzz/fuzz_linespace_cache.c). Empty records (m = 0) are never read. */
+static rl_status check_pnmt(const rl_linespace *ls, uint32_t num_materials, const char *path)
+{
+    uint64_t records = ls->pnmt ? 2 * ls->num_occupied : 0;
+    for (uint64_t i = 0; i < records; ++i) {
+        const uint16_t *r = ls->pnmt + i * RL_LS_PNMT_RECORD;
+        float m = rl_half_to_float(r[RL_LS_PNMT_MAT]);
+        if (m == 0.0f)
+            continue;
+        bool ok = isfinite(m) && fabsf(m) >= 0.5f && fabsf(m) - 0.5f < (float)num_materials;
+        for (int k = 0; k < RL_LS_PNMT_RECORD && ok; ++k)
+            ok = isfinite(rl_half_to_float(r[k]));
+        for (int k = RL_LS_PNMT_PX; k <= RL_LS_PNMT_PZ && ok; ++k)
+            ok = rl_half_to_float(r[k]) >= 0.0f && rl_half_to_float(r[k]) <= 1.0f;
+        if (!ok)
+            return rl_error(RL_ERR_PARSE, "%s: surface record %llu is not a surface of the scene (position, "
+                            "normal, material or texcoord)", path, (unsigned long long)i);
+    }
+    return RL_OK;
+}
+
+/* num_materials: the scene's, which the PNMT records index. */
+static rl_status check_contents(const rl_linespace *ls, uint32_t num_materials, const char *path)
 {
     const rl_grid *g = ls->grid;
     uint32_t next = 0;
@@ -278,7 +310,7 @@ static rl_status check_contents(const rl_linespace *ls, const char *path)
         if (ls->cand[i] >= g->num_triangles && (ls->dynamic || ls->cand[i] != RL_NONE))
             return rl_error(RL_ERR_PARSE, "%s: candidate %llu is not a triangle ID", path,
                             (unsigned long long)i);
-    return RL_OK;
+    return check_pnmt(ls, num_materials, path);
 }
 
 /* The header read and checked against itself and the file's length; f is
@@ -380,7 +412,8 @@ static rl_status adopt(const rl_accel *grid, const header *h, uint64_t shafts, r
     ls->occ_words = (ls->shafts_per_voxel + 63u) / 64u;
     ls->num_occupied = shafts - h->empty_shafts;
     ls->num_cand = (h->payloads & RL_LS_CANDIDATES) ? h->num_cand : 0;
-    if ((st = check_contents(ls, path)))
+    const rl_scene_data *data = rl_scene_get_data(rl_accel_scene(grid));
+    if ((st = check_contents(ls, data ? data->num_materials : 0, path)))
         return st;
     rl_linespace_stats *t = &ls->stats;
     t->filled_voxels = h->num_blocks;

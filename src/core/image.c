@@ -1,11 +1,14 @@
 /* image.c: rl_image allocation, clearing and format dispatch by extension.
  * Sizes are checked against RL_IMAGE_MAX_SIZE before anything is allocated,
  * so a corrupt header or a typo on the command line cannot ask for 64 GiB. */
+#define _POSIX_C_SOURCE 200809L
 #include "rl/rl_image.h"
 
+#include <errno.h>
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 
 #include "core/error.h"
 #include "rl/rl_path.h"
@@ -16,6 +19,20 @@ rl_status rl_image_check_size(const char *what, long long width, long long heigh
     if (width < 1 || height < 1 || width > RL_IMAGE_MAX_SIZE || height > RL_IMAGE_MAX_SIZE)
         return rl_error(RL_ERR_LIMIT, "%s: size %lldx%lld outside 1..%d per side", what,
                         width, height, RL_IMAGE_MAX_SIZE);
+    return RL_OK;
+}
+
+rl_status rl_image_check_file_size(const char *path, long long width, long long height, double min_bytes_per_pixel)
+{
+    struct stat s;
+    if (stat(path, &s) != 0)
+        return rl_error(RL_ERR_IO, "%s: cannot open: %s", path, strerror(errno));
+    /* Deflate, the strongest compression either format uses, shrinks at
+     * most 1032:1; 2048 leaves room for any header. */
+    double least = (double)width * (double)height * min_bytes_per_pixel / 2048.0;
+    if ((double)s.st_size < least)
+        return rl_error(RL_ERR_PARSE, "%s: %lld bytes cannot hold a %lldx%lld picture (truncated or corrupt)", path,
+                        (long long)s.st_size, width, height);
     return RL_OK;
 }
 

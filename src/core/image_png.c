@@ -5,6 +5,7 @@
  * sRGB curve and rounded to nearest so that 8-bit values survive a
  * read/write round trip; alpha is stored linearly as PNG requires. */
 #include "rl/rl_image.h"
+#include "rl/rl_output.h"
 
 #include <errno.h>
 #include <math.h>
@@ -20,6 +21,7 @@
 typedef struct png_ctx {
     char message[256];
     FILE *file;
+    rl_output *output;          /* writing: file is its stream */
     png_structp png;
     png_infop info;
     unsigned char *pixels;
@@ -32,6 +34,22 @@ static void on_png_error(png_structp png, png_const_charp msg)
     png_ctx *ctx = png_get_error_ptr(png);
     snprintf(ctx->message, sizeof ctx->message, "%s", msg);
     png_longjmp(png, 1);
+}
+
+/* libpng's own writer reports a failed write as "Write Error"; ours keeps
+ * the reason (disk full, file too large). */
+static void on_png_write(png_structp png, png_bytep data, png_size_t n)
+{
+    png_ctx *ctx = png_get_io_ptr(png);
+    if (fwrite(data, 1, n, ctx->file) != n)
+        png_error(png, strerror(errno));
+}
+
+static void on_png_flush(png_structp png)
+{
+    png_ctx *ctx = png_get_io_ptr(png);
+    if (fflush(ctx->file) != 0)
+        png_error(png, strerror(errno));
 }
 
 static void on_png_warning(png_structp png, png_const_charp msg)
@@ -66,7 +84,9 @@ static void png_ctx_free(png_ctx *ctx, bool reading)
         png_destroy_read_struct(&ctx->png, ctx->info ? &ctx->info : NULL, NULL);
     else
         png_destroy_write_struct(&ctx->png, ctx->info ? &ctx->info : NULL);
-    if (ctx->file)
+    if (ctx->output)
+        rl_output_abort(ctx->output);
+    else if (ctx->file)
         fclose(ctx->file);
     free(ctx->pixels);
     free(ctx->rows);
@@ -101,13 +121,13 @@ rl_status rl_image_write_png(const rl_image *img, const char *path)
             row[4 * x + 3] = encode_linear(c.w);
         }
     }
-    ctx->file = fopen(path, "wb");
-    if (!ctx->file) {
-        st = rl_error(RL_ERR_IO, "%s: cannot open for writing: %s", path, strerror(errno));
+    st = rl_output_open(path, &ctx->output);
+    if (st != RL_OK) {
         png_ctx_free(ctx, false);
         free(ctx);
         return st;
     }
+    ctx->file = rl_output_file(ctx->output);
     ctx->png = png_create_write_struct(PNG_LIBPNG_VER_STRING, ctx, on_png_error, on_png_warning);
     if (ctx->png)
         ctx->info = png_create_info_struct(ctx->png);
@@ -122,25 +142,19 @@ rl_status rl_image_write_png(const rl_image *img, const char *path)
         free(ctx);
         return st;
     }
-    png_init_io(ctx->png, ctx->file);
+    png_set_write_fn(ctx->png, ctx, on_png_write, on_png_flush);
     png_set_IHDR(ctx->png, ctx->info, (png_uint_32)w, (png_uint_32)h, 8, PNG_COLOR_TYPE_RGBA,
                  PNG_INTERLACE_NONE, PNG_COMPRESSION_TYPE_DEFAULT, PNG_FILTER_TYPE_DEFAULT);
     png_set_sRGB(ctx->png, ctx->info, PNG_sRGB_INTENT_PERCEPTUAL);
     png_write_info(ctx->png, ctx->info);
     png_write_image(ctx->png, ctx->rows);
     png_write_end(ctx->png, NULL);
-    FILE *f = ctx->file;
+    rl_output *o = ctx->output;
+    ctx->output = NULL;
     ctx->file = NULL;
-    bool flushed = fflush(f) == 0;
-    int err = errno;
-    bool closed = fclose(f) == 0;
-    if (!closed)
-        err = errno;
     png_ctx_free(ctx, false);
     free(ctx);
-    if (!flushed || !closed)
-        return rl_error(RL_ERR_IO, "%s: cannot write PNG: %s", path, strerror(err));
-    return RL_OK;
+    return rl_output_commit(o);
 }
 
 rl_status rl_image_read_png(const char *path, rl_image **out)
@@ -180,10 +194,11 @@ rl_status rl_image_read_png(const char *path, rl_image **out)
     png_read_info(ctx->png, ctx->info);
     png_uint_32 w = png_get_image_width(ctx->png, ctx->info);
     png_uint_32 h = png_get_image_height(ctx->png, ctx->info);
-    if (rl_image_check_size(path, w, h) != RL_OK) {
+    /* One bit (grey, depth 1) is the least a pixel stores. */
+    if ((st = rl_image_check_size(path, w, h)) != RL_OK || (st = rl_image_check_file_size(path, w, h, 0.125)) != RL_OK) {
         png_ctx_free(ctx, true);
         free(ctx);
-        return RL_ERR_LIMIT;
+        return st;
     }
     int depth = png_get_bit_depth(ctx->png, ctx->info);
     int type = png_get_color_type(ctx->png, ctx->info);

@@ -16,6 +16,7 @@
 
 #include "core/error.h"
 #include "core/json_scan.h"
+#include "rl/rl_output.h"
 
 /* Scene and result files are small; this only stops runaway inputs. */
 #define JSON_MAX_FILE_BYTES ((size_t)1 << 30)
@@ -268,20 +269,14 @@ rl_status rl_json_write_file(const cJSON *item, const char *path)
     char *text = cJSON_Print(item);
     if (!text)
         return rl_error(RL_ERR_OUT_OF_MEMORY, "%s: cannot serialise JSON", path);
-    FILE *f = fopen(path, "w");
-    if (!f) {
-        rl_status st = rl_error(RL_ERR_IO, "%s: cannot open for writing: %s", path, strerror(errno));
-        cJSON_free(text);
-        return st;
-    }
-    bool ok = fputs(text, f) >= 0 && fputc('\n', f) != EOF;
-    int err = errno;
-    if (fclose(f) != 0 && ok) {
-        ok = false;
-        err = errno;
+    rl_output *o = NULL;
+    rl_status st = rl_output_open(path, &o);
+    if (st == RL_OK) {
+        FILE *f = rl_output_file(o);
+        fputs(text, f);
+        fputc('\n', f);
+        st = rl_output_commit(o);
     }
     cJSON_free(text);
-    if (!ok)
-        return rl_error(RL_ERR_IO, "%s: cannot write: %s", path, strerror(err));
-    return RL_OK;
+    return st;
 }

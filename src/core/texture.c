@@ -15,6 +15,7 @@
 #include <stb/stb_image.h>
 
 #include "core/error.h"
+#include "core/image_internal.h"
 #include "core/texture_sample.h"
 
 static unsigned long long max_pixels = RL_TEXTURE_MAX_PIXELS;
@@ -57,6 +58,56 @@ static rl_status texture_alloc(int w, int h, const char *path, rl_texture **out)
     return RL_OK;
 }
 
+/* stb_image grows its buffer to a PNG chunk's declared length before it
+ * reads the chunk: 200 bytes claiming a 2 GB chunk cost 2 GB (issue 34,
+ * found by tests/fuzz/fuzz_texture.c). Every chunk must fit in the bytes
+ * that follow its header; len bytes of data (the whole file or an embedded
+ * picture) start with the PNG signature, others pass. next(user, at, 8)
+ * reads the 8 bytes of a chunk header at offset at. */
+static rl_status check_png_chunks(uint64_t len, bool (*next)(void *user, uint64_t at, unsigned char *b), void *user,
+                                  const char *what)
+{
+    static const unsigned char sig[8] = { 0x89, 'P', 'N', 'G', '\r', '\n', 0x1a, '\n' };
+    unsigned char b[8];
+    if (len < 8 || !next(user, 0, b) || memcmp(b, sig, 8) != 0)
+        return RL_OK;
+    for (uint64_t at = 8; at + 8 <= len; ) {
+        if (!next(user, at, b))
+            return rl_error(RL_ERR_IO, "%s: cannot read", what);
+        uint64_t n = (uint64_t)b[0] << 24 | (uint64_t)b[1] << 16 | (uint64_t)b[2] << 8 | b[3];
+        if (n > len - at - 8)
+            return rl_error(RL_ERR_PARSE, "%s: PNG chunk \"%.4s\" of %llu bytes, longer than the file", what,
+                            (const char *)b + 4, (unsigned long long)n);
+        if (memcmp(b + 4, "IEND", 4) == 0)
+            break;
+        at += 12 + n;
+    }
+    return RL_OK;
+}
+
+static bool file_chunk_header(void *user, uint64_t at, unsigned char *b)
+{
+    FILE *f = user;
+    return fseek(f, (long)at, SEEK_SET) == 0 && fread(b, 1, 8, f) == 8;
+}
+
+typedef struct bytes_view { const unsigned char *p; size_t n; } bytes_view;
+
+static bool memory_chunk_header(void *user, uint64_t at, unsigned char *b)
+{
+    const bytes_view *v = user;
+    if (at + 8 > v->n)
+        return false;
+    memcpy(b, v->p + at, 8);
+    return true;
+}
+
+rl_status rl_texture_check_png_memory(const unsigned char *data, size_t len, const char *what)
+{
+    bytes_view v = { data, len };
+    return check_png_chunks(len, memory_chunk_header, &v, what);
+}
+
 rl_status rl_texture_load(const char *path, rl_texture **out)
 {
     if (!path || !out)
@@ -64,6 +115,13 @@ rl_status rl_texture_load(const char *path, rl_texture **out)
     FILE *f = fopen(path, "rb");
     if (!f)
         return rl_error(RL_ERR_IO, "%s: cannot open: %s", path, strerror(errno));
+    long len = fseek(f, 0, SEEK_END) == 0 ? ftell(f) : -1;
+    rl_status checked = len < 0 ? rl_error(RL_ERR_IO, "%s: cannot seek", path)
+                                : check_png_chunks((uint64_t)len, file_chunk_header, f, path);
+    if (checked != RL_OK || fseek(f, 0, SEEK_SET) != 0) {
+        fclose(f);
+        return checked != RL_OK ? checked : rl_error(RL_ERR_IO, "%s: cannot seek", path);
+    }
     /* Read the header only, so absurd sizes are refused before decoding. */
     int w = 0, h = 0, comp = 0;
     if (!stbi_info_from_file(f, &w, &h, &comp)) {

@@ -26,6 +26,7 @@
 #include <string.h>
 
 #include "core/error.h"
+#include "rl/rl_output.h"
 #include "rl/rl_path.h"
 
 #define FONT_FAMILY "DejaVu Sans"
@@ -149,23 +150,15 @@ void rl_plot_abort(rl_plot *p)
     memset(p, 0, sizeof *p);
 }
 
-static rl_status write_file(const char *fn, const char *path, const unsigned char *data, size_t n)
+/* The output's messages name the file, which says enough without fn. */
+static rl_status write_file(const char *path, const unsigned char *data, size_t n)
 {
-    FILE *f = fopen(path, "wb");
-    if (!f)
-        return rl_error(RL_ERR_IO, "%s: %s: cannot open for writing: %s", fn, path, strerror(errno));
-    bool ok = fwrite(data, 1, n, f) == n;
-    int err = errno;
-    ok = fflush(f) == 0 && ok;
-    if (fclose(f) != 0 && ok) {
-        ok = false;
-        err = errno;
-    }
-    if (!ok) {
-        remove(path);
-        return rl_error(RL_ERR_IO, "%s: %s: cannot write: %s", fn, path, strerror(err));
-    }
-    return RL_OK;
+    rl_output *o = NULL;
+    rl_status st = rl_output_open(path, &o);
+    if (st != RL_OK)
+        return st;
+    fwrite(data, 1, n, rl_output_file(o));
+    return rl_output_commit(o);
 }
 
 /* FNV-1a, 32 bit: a short, content-derived id prefix. */
@@ -236,7 +229,7 @@ rl_status rl_plot_end(rl_plot *p)
     if (s != CAIRO_STATUS_SUCCESS || p->svg.failed || !p->svg.data) {
         st = cairo_failure(p->fn, s, &p->svg);
     } else if (p->out->path) {
-        st = write_file(p->fn, p->out->path, p->svg.data, p->svg.size);
+        st = write_file(p->out->path, p->svg.data, p->svg.size);
     } else {
         char *text = NULL;
         st = inline_svg(&p->svg, &text);

@@ -88,6 +88,31 @@ static bool file_exists(const char *path)
     return f != NULL;
 }
 
+/* Whether path is a Line Space file, intact or not: it starts with the
+ * magic, or is empty. Anything else was named by mistake and is not ours
+ * to overwrite. */
+static bool is_cache_file(const char *path)
+{
+    FILE *f = fopen(path, "rb");
+    if (!f)
+        return false;
+    char magic[4];
+    size_t n = fread(magic, 1, sizeof magic, f);
+    fclose(f);
+    return n == 0 || (n == sizeof magic && memcmp(magic, "RLLS", 4) == 0);
+}
+
+static rl_status ls_build_and_save(const rl_accel *grid, const rl_linespace_desc *desc, const char *path,
+                                   rl_linespace **out, double *ms)
+{
+    rl_status st = ls_build(grid, desc, NULL, NULL, out, ms);
+    if (st == RL_OK && (st = rl_linespace_save(*out, path)) != RL_OK) {
+        rl_linespace_release(*out);
+        *out = NULL;
+    }
+    return st;
+}
+
 /* The Line Space of desc through the cache file `path` (Sec. 13.3 of the
  * thesis proposes keeping it instead of rebuilding): loaded when the file
  * exists, which must then match the grid and the scene (rl_linespace_load
@@ -95,6 +120,10 @@ static bool file_exists(const char *path)
  * the payloads asked for); otherwise built and saved there. Pre-illuminated
  * colours depend on the lights and materials, which the file's
  * fingerprint does not cover, so they are refused rather than risked.
+ * A damaged file (truncated, checksum wrong, an older version) is stale:
+ * a warning, and it is rebuilt and overwritten, rather than failing every
+ * later run until someone deletes it. One for another scene or with other
+ * options is refused: it may be someone's good cache, named by mistake.
  * *ms: the build or the load time. */
 static rl_status ls_cached(const rl_accel *grid, const rl_linespace_desc *desc, const char *path,
                            rl_linespace **out, double *ms)
@@ -104,18 +133,17 @@ static rl_status ls_cached(const rl_accel *grid, const rl_linespace_desc *desc, 
         return rl_error(RL_ERR_INVALID_ARG, "pt: ls_file keeps geometry only (candidates, PNMT); the "
                         "pre-illuminated colours depend on lights and materials and are rebuilt: leave "
                         "ls_file empty with ls-preillum");
-    if (!file_exists(path)) {
-        rl_status st = ls_build(grid, desc, NULL, NULL, out, ms);
-        if (st == RL_OK && (st = rl_linespace_save(*out, path)) != RL_OK) {
-            rl_linespace_release(*out);
-            *out = NULL;
-        }
-        return st;
-    }
+    if (!file_exists(path))
+        return ls_build_and_save(grid, desc, path, out, ms);
     rl_timer t;
     rl_timer_start(&t);
     rl_linespace *ls = NULL;
     rl_status st = rl_linespace_load(grid, path, &ls);
+    if (st == RL_ERR_PARSE && is_cache_file(path)) {
+        rl_warn("pt: ls_file %s; rebuilding the Line Space and overwriting the file", rl_last_error());
+        rl_clear_error();
+        return ls_build_and_save(grid, desc, path, out, ms);
+    }
     if (st != RL_OK)
         return st;                        /* the loader's message names the file and the cause */
     *ms = rl_timer_ms(&t);

@@ -10,6 +10,7 @@
 #include <stb/stb_image.h>
 
 #include "core/error.h"
+#include "core/image_internal.h"
 #include "scene/load_internal.h"
 
 static rl_vec4 texel(unsigned r, unsigned g, unsigned b, unsigned a)
@@ -37,7 +38,8 @@ rl_status rl_embedded_texture_decode(const struct aiTexture *tex, const char *wh
         if (!stbi_info_from_memory(bytes, len, &w, &h, &comp))
             return rl_error(RL_ERR_PARSE, "%s: cannot decode embedded texture: %s", what,
                             stbi_failure_reason());
-        if ((st = rl_texture_check_size(what, w, h)) != RL_OK)
+        if ((st = rl_texture_check_size(what, w, h)) != RL_OK ||
+            (st = rl_texture_check_png_memory(bytes, (size_t)len, what)) != RL_OK)
             return st;
         unsigned char *rgba = stbi_load_from_memory(bytes, len, &w, &h, &comp, 4);
         if (!rgba)

@@ -1,6 +1,7 @@
 /* test_linespace_io.c: saving and loading a Line Space
  * (src/accel/linespace_io.c): bit-identical answers after a round trip;
- * corrupt, truncated and foreign files refused. */
+ * corrupt, truncated and foreign files refused, and intact files whose
+ * surface records are not surfaces of the scene. */
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
@@ -183,11 +184,100 @@ static void test_linespace_fixed_round_trip_is_bit_identical_and_bad_files_are_r
     round_trip(false);
 }
 
+/* The file's checksum, as linespace_io.c computes it: a test that edits a
+ * record and re-seals the file reaches the checks behind the checksum. */
+static uint64_t checksum(const unsigned char *p, size_t n)
+{
+    uint64_t h = 0;
+    for (; n >= 8; n -= 8, p += 8) {
+        uint64_t w;
+        memcpy(&w, p, 8);
+        h = (h ^ w) * 0xbf58476d1ce4e5b9ull;
+        h ^= h >> 31;
+    }
+    if (n) {
+        uint64_t w = 0;
+        memcpy(&w, p, n);
+        h = (h ^ w ^ ((uint64_t)n << 56)) * 0x94d049bb133111ebull;
+        h ^= h >> 29;
+    }
+    return h;
+}
+
+/* A PNMT record whose material half is NaN, or names a material the scene
+ * lacks, in an otherwise intact file: refused at load (fuzz_linespace_cache
+ * found the NaN turned into a material index by the query, undefined). */
+static void test_linespace_pnmt_record_with_a_bad_material_is_refused(void **state)
+{
+    (void)state;
+    rl_scene *s = builtin("cornell", NULL);
+    rl_accel *grid = grid_of(s, 2);
+    rl_linespace *ls = NULL;
+    assert_int_equal(rl_linespace_create(grid, &(rl_linespace_desc){ .n = 1, .payloads = RL_LS_PNMT }, &ls), RL_OK);
+    assert_int_equal(rl_linespace_commit(ls), RL_OK);
+    char path[1024], bad[1024];
+    tmp_path(path, sizeof path, "ls_pnmt_material.rlls");
+    tmp_path(bad, sizeof bad, "ls_pnmt_material_bad.rlls");
+    assert_int_equal(rl_linespace_save(ls, path), RL_OK);
+    rl_linespace_stats st;
+    rl_linespace_get_stats(ls, &st);
+    rl_linespace_release(ls);
+    long len = file_size(path);
+    unsigned char *buf = malloc((size_t)len);
+    assert_non_null(buf);
+    FILE *f = fopen(path, "rb");
+    assert_non_null(f);
+    assert_int_equal(fread(buf, 1, (size_t)len, f), (size_t)len);
+    fclose(f);
+    /* The PNMT array ends the file before the checksum: 16 halves per
+     * occupied shaft, the material the 6th of each 8-half record. */
+    uint64_t occupied = st.shafts - st.empty_shafts;
+    unsigned char *pnmt = buf + len - 8 - 32 * (long)occupied;
+    long used = -1;
+    for (uint64_t r = 0; r < 2 * occupied && used < 0; ++r)
+        if (pnmt[16 * r + 10] | pnmt[16 * r + 11])
+            used = 16 * (long)r + 10;
+    assert_true(used >= 0);
+    static const uint16_t materials[] = { 0x7e00 /* NaN */, 0x5bff /* 255.9: no such material */,
+                                          0xfc00 /* -inf */ };
+    for (size_t k = 0; k < sizeof materials / sizeof materials[0]; ++k) {
+        unsigned char *copy = malloc((size_t)len);
+        assert_non_null(copy);
+        memcpy(copy, buf, (size_t)len);
+        memcpy(copy + (pnmt - buf) + used, &materials[k], 2);
+        uint64_t sum = checksum(copy, (size_t)len - 8);
+        memcpy(copy + len - 8, &sum, 8);
+        FILE *g = fopen(bad, "wb");
+        assert_non_null(g);
+        assert_int_equal(fwrite(copy, 1, (size_t)len, g), (size_t)len);
+        fclose(g);
+        free(copy);
+        rl_linespace *loaded = NULL;
+        assert_int_equal(rl_linespace_load(grid, bad, &loaded), RL_ERR_PARSE);
+        assert_null(loaded);
+        rl_clear_error();
+    }
+    /* The same file unedited but re-sealed still loads: the checksum is right. */
+    uint64_t sum = checksum(buf, (size_t)len - 8);
+    memcpy(buf + len - 8, &sum, 8);
+    FILE *g = fopen(bad, "wb");
+    assert_non_null(g);
+    assert_int_equal(fwrite(buf, 1, (size_t)len, g), (size_t)len);
+    fclose(g);
+    rl_linespace *loaded = NULL;
+    assert_int_equal(rl_linespace_load(grid, bad, &loaded), RL_OK);
+    rl_linespace_release(loaded);
+    free(buf);
+    rl_accel_release(grid);
+    rl_scene_release(s);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_linespace_dynamic_round_trip_is_bit_identical_and_bad_files_are_refused),
         cmocka_unit_test(test_linespace_fixed_round_trip_is_bit_identical_and_bad_files_are_refused),
+        cmocka_unit_test(test_linespace_pnmt_record_with_a_bad_material_is_refused),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -24,7 +24,7 @@ declare -A rank=([core]=0 [scene]=1 [accel]=2 [raster]=2 [gl]=3 [render]=4 [eval
 # header must be added here, so that it is placed on purpose.
 declare -A header=(
   [rl_common.h]=core [rl_options.h]=core [rl_path.h]=core [rl_math.h]=core [rl_rng.h]=core
-  [rl_image.h]=core [rl_timer.h]=core
+  [rl_image.h]=core [rl_timer.h]=core [rl_output.h]=core
   [rl_camera.h]=scene [rl_scene.h]=scene [rl_octree.h]=scene
   [rl_accel.h]=accel [rl_linespace.h]=accel
   [rl_raster.h]=raster [rl_drawer.h]=raster [rl_shadowmap.h]=raster

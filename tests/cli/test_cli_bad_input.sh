@@ -79,4 +79,46 @@ expect_error 2 "--out and --stats-json name the same file" "$RL" render cornell 
     --out "$TMP/one.png" --stats-json "$TMP/./one.png"
 expect_error 2 "zero vector" "$RL" render cornell --size 32x24 --up 0,0,0 --out "$OUT"
 run_ok "$RL" render cornell --size 32x24 --eye 1e30,1e30,1e30 --out "$OUT"
+# Issue 34, no lost output: a write that fails partway (the file size limit:
+# rl ignores SIGXFSZ, so it is EFBIG) keeps the previous file, leaves no
+# temporary and prints one error line; with --out and --depth-out, a failed
+# depth image keeps the previous --out too (the outputs commit together).
+# At 1024x768 the Cornell box is ~40 KB as PNG, its depth ~85 KB as EXR.
+mkdir -p "$TMP/keep"
+run_ok "$RL" render cornell --size 32x24 --out "$TMP/keep/a.png" --stats-json "$TMP/keep/s.json"
+cp "$TMP/keep/a.png" "$TMP/a.good"
+cp "$TMP/keep/s.json" "$TMP/s.good"
+no_temporaries() {
+    ! ls -A "$TMP/keep" | grep -q '^\.' || fail "temporary files left: $(ls -A "$TMP/keep")"
+}
+expect_error 1 "a.png" bash -c 'ulimit -f 4; exec "$@"' - "$RL" render cornell --size 1024x768 --out "$TMP/keep/a.png"
+cmp -s "$TMP/keep/a.png" "$TMP/a.good" || fail "a failed write replaced a.png"
+no_temporaries
+expect_error 1 "d.exr" bash -c 'ulimit -f 60; exec "$@"' - "$RL" render cornell --size 1024x768 \
+    --out "$TMP/keep/a.png" --depth-out "$TMP/keep/d.exr" --stats-json "$TMP/keep/s.json"
+cmp -s "$TMP/keep/a.png" "$TMP/a.good" || fail "a failed --depth-out replaced --out"
+cmp -s "$TMP/keep/s.json" "$TMP/s.good" || fail "a failed --depth-out replaced --stats-json"
+[ ! -e "$TMP/keep/d.exr" ] || fail "a failed --depth-out left d.exr"
+no_temporaries
+run_ok "$RL" render cornell --size 64x48 --out "$TMP/keep/a.png" --depth-out "$TMP/keep/d.exr"
+cmp -s "$TMP/keep/a.png" "$TMP/a.good" && fail "a good run did not replace a.png"
+[ -s "$TMP/keep/d.exr" ] || fail "a good run did not write d.exr"
+no_temporaries
+
+# A damaged Line Space cache (cut short, as a killed save used to leave it)
+# is stale: a warning, rebuilt, overwritten with a valid one that the next
+# run loads silently. A file that is no cache at all is refused, untouched.
+LS=(--algo pt --set shadow=ls-pnmt --set ls_n=1 --set spp=1 --size 32x24 --out "$OUT")
+run_ok "$RL" render cornell "${LS[@]}" --set ls_file="$TMP/keep/c.rlls"
+cp "$TMP/keep/c.rlls" "$TMP/c.good"
+head -c 3000 "$TMP/c.good" >"$TMP/keep/c.rlls"
+run_ok "$RL" render cornell "${LS[@]}" --set ls_file="$TMP/keep/c.rlls"
+grep -q '^rl: warning: .*c.rlls.*rebuilding' "$TMP/err" || fail "no warning about the damaged cache: $(cat "$TMP/err")"
+cmp -s "$TMP/keep/c.rlls" "$TMP/c.good" || fail "the damaged cache was not rewritten as before"
+run_ok "$RL" render cornell "${LS[@]}" --set ls_file="$TMP/keep/c.rlls"
+! grep -q 'warning' "$TMP/err" || fail "the rewritten cache still warns: $(cat "$TMP/err")"
+no_temporaries
+echo "not a cache" >"$TMP/keep/other.rlls"
+expect_error 1 "other.rlls" "$RL" render cornell "${LS[@]}" --set ls_file="$TMP/keep/other.rlls"
+[ "$(cat "$TMP/keep/other.rlls")" = "not a cache" ] || fail "a file that is no cache was overwritten"
 echo "ok"

@@ -358,6 +358,161 @@ static void test_png_reader_expands_16bit_and_grey_to_rgba(void **state)
     rl_texture_release(tex);
 }
 
+static unsigned char *read_all(const char *path, size_t *n)
+{
+    static unsigned char data[65536];
+    FILE *f = fopen(path, "rb");
+    assert_non_null(f);
+    *n = fread(data, 1, sizeof data, f);
+    fclose(f);
+    assert_true(*n > 0 && *n < sizeof data);
+    return data;
+}
+
+/* An EXR header attribute that claims a gigabyte: refused before OpenEXR
+ * allocates it (issue 34; fuzz_texture found such files). */
+static void test_exr_attribute_longer_than_the_file_is_refused(void **state)
+{
+    (void)state;
+    rl_image *img = NULL;
+    assert_int_equal(rl_image_create(4, 4, RL_LAYER_COLOR, &img), RL_OK);
+    const char *good = tmp_path("small.exr");
+    assert_int_equal(rl_image_write(img, good), RL_OK);
+    rl_image_release(img);
+    size_t n = 0;
+    unsigned char *data = read_all(good, &n);
+    unsigned char *at = NULL;
+    for (size_t i = 0; i + 24 < n && !at; ++i)
+        if (memcmp(data + i, "compression\0compression\0", 24) == 0)
+            at = data + i + 24;
+    assert_non_null(at);
+    int32_t size = 0x40000000;
+    memcpy(at, &size, 4);
+    const char *bad = tmp_path("huge_attribute.exr");
+    write_bytes(bad, data, n);
+    rl_image *back = NULL;
+    rl_clear_error();
+    assert_int_equal(rl_image_read(bad, &back), RL_ERR_PARSE);
+    assert_null(back);
+    if (!strstr(rl_last_error(), "longer than the file"))
+        fail_msg("not refused by the attribute check: %s", rl_last_error());
+    rl_clear_error();
+}
+
+/* An EXR whose one chunk declares 1.9 GB: refused before OpenEXR
+ * allocates it (fuzz_texture found such files). */
+static void test_exr_chunk_longer_than_the_file_is_refused(void **state)
+{
+    (void)state;
+    rl_image *img = NULL;
+    assert_int_equal(rl_image_create(4, 4, RL_LAYER_COLOR, &img), RL_OK);
+    const char *good = tmp_path("small.exr");
+    assert_int_equal(rl_image_write(img, good), RL_OK);
+    rl_image_release(img);
+    size_t n = 0;
+    unsigned char *data = read_all(good, &n);
+    /* The chunk: y = 0, then its size, which runs to the end of the file. */
+    unsigned char *at = NULL;
+    for (size_t i = 4; i + 4 <= n && !at; ++i) {
+        int32_t y, size;
+        memcpy(&y, data + i - 4, 4);
+        memcpy(&size, data + i, 4);
+        if (y == 0 && size > 0 && (size_t)size == n - i - 4)
+            at = data + i;
+    }
+    assert_non_null(at);
+    int32_t huge = 1932551434;
+    memcpy(at, &huge, 4);
+    const char *bad = tmp_path("huge_chunk.exr");
+    write_bytes(bad, data, n);
+    rl_image *back = NULL;
+    rl_clear_error();
+    assert_int_equal(rl_image_read(bad, &back), RL_ERR_PARSE);
+    assert_null(back);
+    if (!strstr(rl_last_error(), "longer than the file"))
+        fail_msg("not refused by the chunk check: %s", rl_last_error());
+    rl_clear_error();
+}
+
+/* A PNG whose IDAT chunk declares 2 GB: the texture loader refuses it
+ * before stb_image grows a buffer to that length (fuzz_texture found it:
+ * 8 s and gigabytes for 231 bytes). */
+static void test_png_chunk_longer_than_the_file_is_refused_by_the_texture_loader(void **state)
+{
+    (void)state;
+    rl_image *img = NULL;
+    assert_int_equal(rl_image_create(4, 4, RL_LAYER_COLOR, &img), RL_OK);
+    const char *good = tmp_path("chunk.png");
+    assert_int_equal(rl_image_write(img, good), RL_OK);
+    rl_image_release(img);
+    rl_texture *tex = NULL;
+    assert_int_equal(rl_texture_load(good, &tex), RL_OK);
+    rl_texture_release(tex);
+    size_t n = 0;
+    unsigned char *data = read_all(good, &n);
+    unsigned char *idat = NULL;
+    for (size_t i = 4; i + 4 <= n && !idat; ++i)
+        if (memcmp(data + i, "IDAT", 4) == 0)
+            idat = data + i - 4;
+    assert_non_null(idat);
+    static const unsigned char length[4] = { 0x7e, 0x00, 0x00, 0x1c };   /* big-endian, not in the CRC */
+    memcpy(idat, length, 4);
+    const char *bad = tmp_path("chunk_2gb.png");
+    write_bytes(bad, data, n);
+    tex = NULL;
+    rl_clear_error();
+    assert_int_equal(rl_texture_load(bad, &tex), RL_ERR_PARSE);
+    assert_null(tex);
+    if (!strstr(rl_last_error(), "longer than the file"))
+        fail_msg("not refused by the chunk check: %s", rl_last_error());
+    rl_clear_error();
+}
+
+/* PNG's CRC-32 (ISO 3309), to re-seal an edited chunk. */
+static uint32_t crc32_of(const unsigned char *p, size_t n)
+{
+    uint32_t c = 0xffffffffu;
+    for (size_t i = 0; i < n; ++i) {
+        c ^= p[i];
+        for (int k = 0; k < 8; ++k)
+            c = (c >> 1) ^ (0xedb88320u & (0u - (c & 1u)));
+    }
+    return c ^ 0xffffffffu;
+}
+
+/* A valid PNG header (CRC right) claiming 16384x16384 pixels on a file of
+ * a few hundred bytes: refused from the file's size before gigabytes are
+ * allocated (issue 34). */
+static void test_png_claiming_more_pixels_than_its_bytes_hold_is_refused(void **state)
+{
+    (void)state;
+    rl_image *img = NULL;
+    assert_int_equal(rl_image_create(4, 4, RL_LAYER_COLOR, &img), RL_OK);
+    const char *good = tmp_path("small.png");
+    assert_int_equal(rl_image_write(img, good), RL_OK);
+    rl_image_release(img);
+    size_t n = 0;
+    unsigned char *data = read_all(good, &n);
+    /* Signature (8), IHDR length (4), "IHDR", width, height, ..., CRC at 29. */
+    assert_memory_equal(data + 12, "IHDR", 4);
+    static const unsigned char side[4] = { 0, 0, 0x40, 0 };     /* 16384, big-endian */
+    memcpy(data + 16, side, 4);
+    memcpy(data + 20, side, 4);
+    uint32_t crc = crc32_of(data + 12, 17);
+    unsigned char be[4] = { (unsigned char)(crc >> 24), (unsigned char)(crc >> 16), (unsigned char)(crc >> 8),
+                            (unsigned char)crc };
+    memcpy(data + 29, be, 4);
+    const char *bad = tmp_path("huge.png");
+    write_bytes(bad, data, n);
+    rl_image *back = NULL;
+    rl_clear_error();
+    assert_int_equal(rl_image_read(bad, &back), RL_ERR_PARSE);
+    assert_null(back);
+    if (!strstr(rl_last_error(), "cannot hold"))
+        fail_msg("not refused by its size: %s", rl_last_error());
+    rl_clear_error();
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -372,6 +527,10 @@ int main(void)
         cmocka_unit_test(test_texture_loads_png_with_uv_origin_bottom_left),
         cmocka_unit_test(test_texture_sampling_is_bilinear_with_repeat),
         cmocka_unit_test(test_corrupted_png_is_an_error_not_a_crash),
+        cmocka_unit_test(test_exr_attribute_longer_than_the_file_is_refused),
+        cmocka_unit_test(test_exr_chunk_longer_than_the_file_is_refused),
+        cmocka_unit_test(test_png_chunk_longer_than_the_file_is_refused_by_the_texture_loader),
+        cmocka_unit_test(test_png_claiming_more_pixels_than_its_bytes_hold_is_refused),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
