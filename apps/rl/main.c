@@ -5,12 +5,9 @@
  * and the subcommand sees only its own arguments. */
 #include "cli.h"
 
-<<<<<<< HEAD
 #include <errno.h>
-#include <stdlib.h>
-=======
 #include <signal.h>
->>>>>>> atomic
+#include <stdlib.h>
 #include <string.h>
 
 typedef struct command {
