@@ -7,7 +7,7 @@
 
 #include <math.h>
 
-#include "rl/rl_accel.h"
+#include "rl/rl_math.h"
 #include "rl/rl_scene.h"
 
 /* The ray's intersection with the plane of triangle tri (Möller & Trumbore
