@@ -165,6 +165,17 @@ const rl_position_lookup *rl_renderer_input(const rl_renderer *r, const char *sl
     return i >= 0 && r->inputs[i].set ? &r->inputs[i].lookup : NULL;
 }
 
+rl_status rl_renderer_check_input_property(const rl_renderer *r, const char *slot, const rl_position_lookup *l,
+                                           const char *want)
+{
+    const char *have = l->property ? l->property : "";
+    if (strcmp(have, want) == 0)
+        return RL_OK;
+    const char *file = rl_renderer_get(r, slot);
+    return rl_error(RL_ERR_INVALID_ARG, "%s: %s holds the property '%s', not %s", rl_renderer_name(r),
+                    file && file[0] ? file : slot, have, want);
+}
+
 const char *rl_renderer_name(const rl_renderer *r) { return r ? r->cls->info.name : NULL; }
 
 const rl_option_info *rl_renderer_options(const rl_renderer *r, size_t *count)

@@ -79,4 +79,26 @@ expect_error 2 "--out and --stats-json name the same file" "$RL" render cornell 
     --out "$TMP/one.png" --stats-json "$TMP/./one.png"
 expect_error 2 "zero vector" "$RL" render cornell --size 32x24 --up 0,0,0 --out "$OUT"
 run_ok "$RL" render cornell --size 32x24 --eye 1e30,1e30,1e30 --out "$OUT"
+
+# Issue 34: approximation files for visset. A few kilobytes of empty sets
+# that each claim 2^26 bits (4 GB once allocated), and sets of the right
+# size but of another property, are refused before anything is drawn.
+run_ok "$RL" eval cornell --property visibility --set resolution=16 --samples 8 --out "$TMP/ev"
+python3 - "$TMP/ev/approx.json" "$TMP" <<'PY'
+import json, sys
+good = json.load(open(sys.argv[1]))
+bomb = dict(good, set_size=1 << 26, nodes=[["leaf"]])
+n = 500
+bomb["samples"] = [good["samples"][0][:3] + [1]] * n
+bomb["sample_sets"] = [[]] * n
+bomb["leaves"] = [dict(good["leaves"][0], samples=n, set=[])]
+json.dump(bomb, open(sys.argv[2] + "/bomb.json", "w"), separators=(",", ":"))
+json.dump(dict(good, property="ops"), open(sys.argv[2] + "/ops.json", "w"))
+PY
+[ "$(stat -c %s "$TMP/bomb.json")" -lt 50000 ] || fail "bomb.json is not small"
+expect_bounded_error 1 "the scene has 8" "$RL" render cornell --algo visset --set approx="$TMP/bomb.json" \
+    --size 32x24 --out "$OUT"
+expect_bounded_error 1 "'ops', not visibility" "$RL" render cornell --algo visset --set approx="$TMP/ops.json" \
+    --size 32x24 --out "$OUT"
+run_ok "$RL" render cornell --algo visset --set approx="$TMP/ev/approx.json" --size 32x24 --out "$OUT"
 echo "ok"
