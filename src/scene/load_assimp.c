@@ -852,8 +852,11 @@ RL_API rl_status rl_scene_import_with(rl_scene *scene, const char *path, uint32_
         aiImportFile(path, aiProcess_Triangulate | aiProcess_JoinIdenticalVertices |
                                aiProcess_SortByPType | aiProcess_ValidateDataStructure |
                                aiProcess_GenUVCoords | aiProcess_TransformUVCoords);
-    if (!ai)
-        return rl_error(RL_ERR_PARSE, "%s: %s", path, aiGetErrorString());
+    if (!ai) {
+        char why[256];
+        rl_load_safe_message(path, aiGetErrorString(), why, sizeof why);
+        return rl_error(RL_ERR_PARSE, "%s: %s", path, why);
+    }
     if (!ai->mRootNode || (ai->mFlags & AI_SCENE_FLAGS_INCOMPLETE)) {
         aiReleaseImport(ai);
         return rl_error(RL_ERR_PARSE, "%s: incomplete scene", path);

@@ -80,6 +80,17 @@ expect_error 2 "--out and --stats-json name the same file" "$RL" render cornell 
 expect_error 2 "zero vector" "$RL" render cornell --size 32x24 --up 0,0,0 --out "$OUT"
 run_ok "$RL" render cornell --size 32x24 --eye 1e30,1e30,1e30 --out "$OUT"
 
+# Issue 34: an importer's error quotes at most 40 characters of the file
+# the user named, escaped, and nothing of a file it references (an mtllib
+# that is really a password file).
+mkdir -p "$TMP/etc" "$TMP/a/b"
+printf 'root:x:0:0:root:/root:/bin/bash\nnewmtl x\nd secret-hash-in-etc\n' >"$TMP/etc/passwd"
+printf 'mtllib ../../etc/passwd\nv 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl root\nf 1 2 3\n' >"$TMP/a/b/m.obj"
+expect_error 1 "m.obj" "$RL" render "$TMP/a/b/m.obj" --size 32x24 --out "$OUT"
+! grep -q 'secret\|root:' "$TMP/err" || fail "the error quotes the referenced file: $(cat "$TMP/err")"
+printf 'v 0 0 0\nv 1 0 0\nv 0 1 0\nvn abcdefghijklmnopqrstuvwxyzabcdefghijklmnopqrstuvwxyz 1 1\nf 1 2 3\n' >"$TMP/long.obj"
+expect_error 1 '"abcdefghijklmnopqrstuvwxyzabcdefghijklmn\.\.\."' "$RL" render "$TMP/long.obj" --size 32x24 --out "$OUT"
+
 # Issue 34: approximation files for visset. A few kilobytes of empty sets
 # that each claim 2^26 bits (4 GB once allocated), and sets of the right
 # size but of another property, are refused before anything is drawn.
