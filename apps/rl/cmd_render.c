@@ -333,6 +333,11 @@ static int choose_camera(const render_args *a, const rl_scene *scene, rl_camera 
     *cam = rl_camera_resolve(cam);
     rl_clear_error();
     st = rl_camera_validate(cam);
+    if (st != RL_OK && !a->has_eye && !a->has_target && !a->has_up && !a->has_fov)
+        /* Nothing of it was the user's: the scene's own camera, or the
+         * framing of a model whose coordinates are near the float limit. */
+        return cli_fail(RL_CLI_FAIL, "%s: no usable camera for this scene (%s; are its coordinates within "
+                        "float range?)", a->scene, rl_last_error());
     if (st != RL_OK)
         return cli_fail_status(RL_CLI_USAGE, st, "camera");
     return RL_CLI_OK;

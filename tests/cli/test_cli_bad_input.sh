@@ -80,6 +80,15 @@ expect_error 2 "--out and --stats-json name the same file" "$RL" render cornell 
 expect_error 2 "zero vector" "$RL" render cornell --size 32x24 --up 0,0,0 --out "$OUT"
 run_ok "$RL" render cornell --size 32x24 --eye 1e30,1e30,1e30 --out "$OUT"
 
+# Issue 34: a model whose coordinates reach the float limit: the error
+# names the file, alone (no lights to fit) and in a JSON scene (no camera
+# to frame it with). Exit 1: the file is at fault, not the command line.
+printf 'v -3e38 -3e38 -3e38\nv 3e38 0 0\nv 0 3e38 3e38\nf 1 2 3\n' >"$TMP/huge.obj"
+printf '{ "objects": [ { "file": "huge.obj" } ], "lights": [ { "type": "directional", "direction": [0, -1, 0] } ] }\n' \
+    >"$TMP/huge.json"
+expect_error 1 "huge.obj" "$RL" render "$TMP/huge.obj" --size 32x24 --out "$OUT"
+expect_error 1 "huge.json" "$RL" render "$TMP/huge.json" --size 32x24 --out "$OUT"
+
 # Issue 34: an importer's error quotes at most 40 characters of the file
 # the user named, escaped, and nothing of a file it references (an mtllib
 # that is really a password file).
