@@ -100,6 +100,12 @@ expect_error 1 "m.obj" "$RL" render "$TMP/a/b/m.obj" --size 32x24 --out "$OUT"
 printf 'v 0 0 0\nv 1 0 0\nv 0 1 0\nvn abcdefghijklmnopqrstuvwxyzabcdefghijklmnopqrstuvwxyz 1 1\nf 1 2 3\n' >"$TMP/long.obj"
 expect_error 1 '"abcdefghijklmnopqrstuvwxyzabcdefghijklmn\.\.\."' "$RL" render "$TMP/long.obj" --size 32x24 --out "$OUT"
 
+# Issue 34: a 64 MB JSON array of zeros (3.5 GB once parsed before the
+# value limit): refused before cJSON builds it, in bounded memory.
+python3 -c 'import sys; sys.stdout.write("[" + "0," * (2**25 - 1) + "0]")' >"$TMP/zeros.json"
+expect_bounded_error 1 "JSON values, more than the limit" "$RL" render "$TMP/zeros.json" --size 32x24 --out "$OUT"
+rm -f "$TMP/zeros.json"
+
 # Issue 34: approximation files for visset. A few kilobytes of empty sets
 # that each claim 2^26 bits (4 GB once allocated), and sets of the right
 # size but of another property, are refused before anything is drawn.
