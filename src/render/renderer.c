@@ -8,11 +8,14 @@
  * valid camera, an image that matches the camera, zeroed and timed stats. */
 #include "render/renderer.h"
 
+#include <limits.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
 #include "core/error.h"
 #include "core/options.h"
+#include "core/threads.h"
 #include "rl/rl_timer.h"
 
 struct rl_renderer {
@@ -189,7 +192,19 @@ rl_status rl_renderer_set(rl_renderer *r, const char *key, const char *value)
 {
     if (!r || !key || !value)
         return rl_error(RL_ERR_INVALID_ARG, "rl_renderer_set: renderer, key and value must not be NULL");
-    return rl_option_store_set(&r->options, key, value, r->cls->info.name, r->cls->check);
+    rl_status st = rl_option_store_set(&r->options, key, value, r->cls->info.name, r->cls->check);
+    /* OpenMP exits the process when it cannot start a thread, so the
+     * count is clamped here, where every renderer reads it from. */
+    const char *dot = strrchr(key, '.');
+    if (st != RL_OK || strcmp(dot ? dot + 1 : key, "threads") != 0)
+        return st;
+    long long asked = rl_option_store_int(&r->options, "threads");
+    char clamped[32];
+    int most = rl_threads_clamp(asked > INT_MAX ? INT_MAX : (int)asked, r->cls->info.name);
+    if (most == asked)
+        return RL_OK;
+    snprintf(clamped, sizeof clamped, "%d", most);
+    return rl_option_store_set(&r->options, "threads", clamped, r->cls->info.name, r->cls->check);
 }
 
 void rl_renderer_reset(rl_renderer *r)

@@ -106,6 +106,21 @@ python3 -c 'import sys; sys.stdout.write("[" + "0," * (2**25 - 1) + "0]")' >"$TM
 expect_bounded_error 1 "JSON values, more than the limit" "$RL" render "$TMP/zeros.json" --size 32x24 --out "$OUT"
 rm -f "$TMP/zeros.json"
 
+# Issue 34: threads=1024, the documented maximum, under an 8 GB address
+# space limit: libgomp used to exit 1 ("Thread creation failed") with no
+# rl: line; now the count is clamped to what can be started, with a
+# warning. (Sanitizer builds cannot run under such a limit.)
+limited_8g() { ( ulimit -v 8000000; exec "$@" ); }
+if [ "$RL_SANITIZED" = 0 ]; then
+    for algo in whitted pt; do
+        budget=()
+        [ "$algo" = pt ] && budget=(--time 0.2s)
+        expect_exit 0 limited_8g timeout 60 "$RL" render cornell --algo "$algo" --set threads=1024 "${budget[@]}" \
+            --size 32x24 --out "$OUT"
+        grep -q "^rl: warning: $algo: threads=1024 clamped to " "$TMP/err" || fail "no clamp warning: $(cat "$TMP/err")"
+    done
+fi
+
 # Issue 34: approximation files for visset. A few kilobytes of empty sets
 # that each claim 2^26 bits (4 GB once allocated), and sets of the right
 # size but of another property, are refused before anything is drawn.
