@@ -181,6 +181,11 @@ rl_status rl_renderer_check_input_property(const rl_renderer *r, const char *slo
 
 const char *rl_renderer_name(const rl_renderer *r) { return r ? r->cls->info.name : NULL; }
 
+double rl_renderer_frame_bytes(const rl_renderer *r, int width, int height)
+{
+    return r ? (double)width * (double)height * r->cls->info.frame_bytes_per_pixel : 0.0;
+}
+
 const rl_option_info *rl_renderer_options(const rl_renderer *r, size_t *count)
 {
     if (count)

@@ -248,7 +248,8 @@ static rl_status select_render(rl_renderer *r, void *state, const rl_scene *scen
 const rl_renderer_class rl_select_renderer_class = {
     .info = { "select", "Runtime selection per position of one of two culling renderers (default chcpp or "
                         "svs) from sampled properties",
-              "Jähn 2015, Sec. 7.5" },
+              "Jähn 2015, Sec. 7.5",
+              .frame_bytes_per_pixel = 2 * RL_CULL_FRAME_BYTES_PER_PIXEL },   /* both renderers it picks from */
     .options = select_options,
     .num_options = sizeof select_options / sizeof select_options[0],
     .state_size = sizeof(select_state),

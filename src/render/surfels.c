@@ -406,7 +406,7 @@ static rl_status surfels_render(rl_renderer *r, void *state, const rl_scene *sce
 const rl_renderer_class rl_surfels_renderer_class = {
     .info = { "surfels", "Progressive Blue Surfels: distant octree nodes as prefixes of blue-noise surfel "
                          "sequences (approximate level of detail)",
-              "Jähn 2015, Ch. 6" },
+              "Jähn 2015, Ch. 6", .frame_bytes_per_pixel = RL_CULL_FRAME_BYTES_PER_PIXEL },
     .options = surfels_options,
     .num_options = sizeof surfels_options / sizeof surfels_options[0],
     .state_size = sizeof(surfels_state),

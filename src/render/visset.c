@@ -277,7 +277,8 @@ static rl_status visset_render(rl_renderer *r, void *state, const rl_scene *scen
 const rl_renderer_class rl_visset_renderer_class = {
     .info = { "visset", "Draws the set of visible objects stored in a sampled visibility property "
                         "(approximate; optional triangle budget)",
-              "Jähn 2015, Sec. 7.6; Eikel, Jähn & Fischer 2010" },
+              "Jähn 2015, Sec. 7.6; Eikel, Jähn & Fischer 2010",
+              .frame_bytes_per_pixel = RL_CULL_FRAME_BYTES_PER_PIXEL },
     .options = visset_options,
     .num_options = sizeof visset_options / sizeof visset_options[0],
     .state_size = sizeof(visset_state),

@@ -121,6 +121,26 @@ if [ "$RL_SANITIZED" = 0 ]; then
     done
 fi
 
+# Issue 34: a frame's memory is estimated before it is allocated (16384 x
+# 16384 took 4.2-5.3 GB): refused above --max-memory, with the estimate,
+# whether the size comes from --size or from the scene's camera.
+rm -f "$OUT"
+expect_bounded_error 1 "a 16384x16384 frame of raster needs about 7.00 GiB, more than the 1.00 GiB of --max-memory" \
+    "$RL" render cornell --size 16384x16384 --max-memory 1G --out "$OUT"
+expect_bounded_error 1 "16384x16384 frame of pt needs about 41" "$RL" render cornell --algo pt --size 16384x16384 \
+    --max-memory 1G --out "$OUT"
+cat >"$TMP/bigcam.json" <<'JSON'
+{ "objects": [ { "generator": "teapot" } ],
+  "cameras": [ { "eye": [0, 1, 3], "target": [0, 0, 0], "size": [16384, 16384] } ],
+  "camera_path": { "keys": [ { "time_s": 0, "eye": [0, 1, 3], "target": [0, 0, 0] },
+                             { "time_s": 1, "eye": [1, 1, 3], "target": [0, 0, 0] } ] } }
+JSON
+expect_bounded_error 1 "16384x16384 frame" "$RL" render "$TMP/bigcam.json" --max-memory 1G --out "$OUT"
+expect_bounded_error 1 "16384x16384 frame" "$RL" render "$TMP/bigcam.json" --camera-path --max-memory 1G --out "$TMP/f%d.png"
+[ ! -e "$OUT" ] || fail "a refused frame still wrote $OUT"
+expect_usage_error "$RL" render cornell --max-memory 1X --out "$OUT"
+run_ok "$RL" render cornell --size 32x24 --max-memory 64M --out "$OUT"
+
 # Issue 34: approximation files for visset. A few kilobytes of empty sets
 # that each claim 2^26 bits (4 GB once allocated), and sets of the right
 # size but of another property, are refused before anything is drawn.
