@@ -86,8 +86,8 @@ run_ok "$RL" render cornell --size 32x24 --eye 1e30,1e30,1e30 --out "$OUT"
 printf 'v -3e38 -3e38 -3e38\nv 3e38 0 0\nv 0 3e38 3e38\nf 1 2 3\n' >"$TMP/huge.obj"
 printf '{ "objects": [ { "file": "huge.obj" } ], "lights": [ { "type": "directional", "direction": [0, -1, 0] } ] }\n' \
     >"$TMP/huge.json"
-expect_error 1 "huge.obj" "$RL" render "$TMP/huge.obj" --size 32x24 --out "$OUT"
-expect_error 1 "huge.json" "$RL" render "$TMP/huge.json" --size 32x24 --out "$OUT"
+expect_bounded_error 1 "huge.obj" "$RL" render "$TMP/huge.obj" --size 32x24 --out "$OUT"
+expect_bounded_error 1 "huge.json" "$RL" render "$TMP/huge.json" --size 32x24 --out "$OUT"
 
 # Issue 34: an importer's error quotes at most 40 characters of the file
 # the user named, escaped, and nothing of a file it references (an mtllib
@@ -95,10 +95,10 @@ expect_error 1 "huge.json" "$RL" render "$TMP/huge.json" --size 32x24 --out "$OU
 mkdir -p "$TMP/etc" "$TMP/a/b"
 printf 'root:x:0:0:root:/root:/bin/bash\nnewmtl x\nd secret-hash-in-etc\n' >"$TMP/etc/passwd"
 printf 'mtllib ../../etc/passwd\nv 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl root\nf 1 2 3\n' >"$TMP/a/b/m.obj"
-expect_error 1 "m.obj" "$RL" render "$TMP/a/b/m.obj" --size 32x24 --out "$OUT"
+expect_bounded_error 1 "m.obj" "$RL" render "$TMP/a/b/m.obj" --size 32x24 --out "$OUT"
 ! grep -q 'secret\|root:' "$TMP/err" || fail "the error quotes the referenced file: $(cat "$TMP/err")"
 printf 'v 0 0 0\nv 1 0 0\nv 0 1 0\nvn abcdefghijklmnopqrstuvwxyzabcdefghijklmnopqrstuvwxyz 1 1\nf 1 2 3\n' >"$TMP/long.obj"
-expect_error 1 '"abcdefghijklmnopqrstuvwxyzabcdefghijklmn\.\.\."' "$RL" render "$TMP/long.obj" --size 32x24 --out "$OUT"
+expect_bounded_error 1 '"abcdefghijklmnopqrstuvwxyzabcdefghijklmn\.\.\."' "$RL" render "$TMP/long.obj" --size 32x24 --out "$OUT"
 
 # Issue 34: a 64 MB JSON array of zeros (3.5 GB once parsed before the
 # value limit): refused before cJSON builds it, in bounded memory.
