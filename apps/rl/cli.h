@@ -78,6 +78,13 @@ bool cli_parse_vec3(const char *option, const char *text, rl_vec3 *out);
  * a bare number is seconds), finite and >= 0, into seconds. Prints nothing:
  * the caller names the flag and the range. */
 bool cli_parse_duration(const char *text, double *seconds);
+/* An amount of memory: a number with a unit K, M, G or T (powers of 1024,
+ * "512M", "1.5G"; a bare number is bytes), finite and > 0, into bytes.
+ * Prints nothing, as cli_parse_duration. */
+bool cli_parse_bytes(const char *text, double *bytes);
+/* MemAvailable of /proc/meminfo in bytes: what can be allocated without
+ * swapping; 0 where it cannot be read (then nothing is refused on it). */
+double cli_available_memory(void);
 
 /* Extension check before any work: true when path ends in one of the
  * NULL-terminated extensions (".png", ".exr"), case-insensitively. */

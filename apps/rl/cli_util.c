@@ -7,6 +7,7 @@
 #include <errno.h>
 #include <math.h>
 #include <stdarg.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <strings.h>
@@ -121,6 +122,41 @@ bool cli_parse_duration(const char *text, double *seconds)
         return true;
     }
     return false;
+}
+
+bool cli_parse_bytes(const char *text, double *bytes)
+{
+    static const char units[] = "KMGT";
+    size_t len = strlen(text);
+    char number[64];
+    if (len == 0 || len >= sizeof number)
+        return false;
+    memcpy(number, text, len + 1);
+    double scale = 1.0;
+    const char *u = strchr(units, toupper((unsigned char)text[len - 1]));
+    if (u && *u) {
+        scale = pow(1024.0, (double)(u - units + 1));
+        number[len - 1] = '\0';
+    }
+    double v;
+    if (!rl_parse_float(number, &v) || !isfinite(v) || !(v > 0.0))
+        return false;
+    *bytes = v * scale;
+    return true;
+}
+
+double cli_available_memory(void)
+{
+    FILE *f = fopen("/proc/meminfo", "r");
+    if (!f)
+        return 0.0;
+    char line[256];
+    unsigned long long kib = 0;
+    while (fgets(line, sizeof line, f))
+        if (sscanf(line, "MemAvailable: %llu kB", &kib) == 1)
+            break;
+    fclose(f);
+    return (double)kib * 1024.0;
 }
 
 bool cli_parse_size(const char *text, int *width, int *height)

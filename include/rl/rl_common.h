@@ -72,6 +72,18 @@ RL_API void rl_log_set_level(rl_log_level level);
 RL_API rl_log_level rl_log_get_level(void);
 RL_API const char *rl_log_level_name(rl_log_level level);
 
+/* JSON files the library reads (scenes, approximation files): at most
+ * rl_json_max_bytes() bytes (a regular file is refused before it is read)
+ * and one value per 16 of those bytes, counted before the tree is built:
+ * cJSON takes about 80 bytes per value, so a 64 MB array of zeros would
+ * take 3 GB. Default RL_JSON_MAX_BYTES (256 MiB: 16 M values, a tree of
+ * about 1.3 GB); above: RL_ERR_LIMIT naming the file. Process-wide; 0
+ * restores the default; set it before loading (not thread-safe against
+ * loads in flight). */
+#define RL_JSON_MAX_BYTES (256ull << 20)
+RL_API void rl_json_set_max_bytes(unsigned long long bytes);
+RL_API unsigned long long rl_json_max_bytes(void);
+
 /* Progress reporting for anything long: done in [0,1]. Return false to
  * cancel; the operation then fails with RL_ERR_CANCELLED. */
 typedef bool (*rl_progress_fn)(void *user, double done);

@@ -33,6 +33,8 @@ typedef struct rl_gbuffer {
     uint32_t *triangle;       /* RL_ID_NONE where nothing is seen */
     uint32_t *material;       /* RL_NONE where nothing is seen */
 } rl_gbuffer;
+/* Bytes per pixel of the layers above, for memory estimates. */
+#define RL_GBUFFER_BYTES_PER_PIXEL (3 * sizeof(rl_vec3) + sizeof(rl_vec2) + sizeof(float) + 3 * sizeof(uint32_t))
 
 /* RL_ERR_LIMIT for a size outside 1..RL_IMAGE_MAX_SIZE. Cleared to "nothing seen". */
 RL_API rl_status rl_gbuffer_create(int width, int height, rl_gbuffer **out);

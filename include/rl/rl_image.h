@@ -39,6 +39,9 @@ typedef struct rl_image {
     uint32_t *triangle_id;    /* width*height, or NULL */
 } rl_image;
 
+/* Bytes rl_image_create allocates for these layers (0 for unknown bits):
+ * for an estimate before allocating a large frame. */
+RL_API double rl_image_bytes(int width, int height, unsigned layers);
 /* Allocates an image with the given layers, cleared (see rl_image_clear). */
 RL_API rl_status rl_image_create(int width, int height, unsigned layers, rl_image **out);
 RL_API void rl_image_release(rl_image *img);      /* NULL is a no-op */

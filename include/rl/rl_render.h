@@ -72,9 +72,18 @@ typedef struct rl_renderer_info {
      * image of a small scene at about 512 x 512 on a few cores; 0: one
      * frame, as for the others. */
     double default_time_s;
+    /* Bytes per pixel of the frame buffers the renderer allocates beyond
+     * the caller's image (accumulation, G-buffer, scratch depth), so that a
+     * caller can estimate a frame's memory before allocating it
+     * (rl_renderer_frame_bytes); 0: none. */
+    double frame_bytes_per_pixel;
 } rl_renderer_info;
 
 RL_API const rl_renderer_info *rl_renderer_list(size_t *count);
+/* Estimated bytes of the renderer's own buffers for a width x height frame
+ * (info.frame_bytes_per_pixel per pixel; the image is the caller's:
+ * rl_image_bytes). 0 for NULL. */
+RL_API double rl_renderer_frame_bytes(const rl_renderer *r, int width, int height);
 /* RL_ERR_NOT_FOUND for an unknown name (the message lists the known ones). */
 RL_API rl_status rl_renderer_create(const char *name, rl_renderer **out);
 RL_API void rl_renderer_release(rl_renderer *r);

@@ -344,6 +344,10 @@ RL_API rl_status rl_approx_lookup(rl_approx *a, rl_position_lookup *out);
  * loading or sampling; RL_ERR_NOT_COMMITTED. */
 RL_API rl_status rl_renderer_prepare_inputs(rl_renderer *r, const rl_scene *scene);
 
+/* The bitsets a loaded file may need (one per node and per sample, of
+ * "set_size" bits each): checked before they are allocated, since empty
+ * sets take 2 bytes of file each. Above it: RL_ERR_PARSE at "set_size". */
+#define RL_APPROX_MAX_SET_BYTES ((size_t)1 << 30)
 RL_API rl_status rl_approx_save_json(const rl_approx *a, const char *path);
 RL_API rl_status rl_approx_load_json(const char *path, rl_approx **out);
 

@@ -28,6 +28,18 @@
 enum { RL_LS_PNMT_PX, RL_LS_PNMT_PY, RL_LS_PNMT_PZ, RL_LS_PNMT_NX, RL_LS_PNMT_NY,
        RL_LS_PNMT_MAT, RL_LS_PNMT_U, RL_LS_PNMT_V, RL_LS_PNMT_RECORD };
 
+/* The material ID in a PNMT record's signed "ID + 1" (decoded to a float);
+ * false for an empty record (0) and for what no build writes (NaN, |m| <
+ * 1), whose conversion to an integer would be undefined behaviour. */
+static inline bool rl_ls_pnmt_material(float m, uint32_t *id)
+{
+    float a = m < 0.0f ? -m : m;
+    if (!(a >= 1.0f && a <= 65504.0f))      /* 65504: the largest half float */
+        return false;
+    *id = (uint32_t)(a - 1.0f + 0.5f);
+    return true;
+}
+
 struct rl_linespace {
     const rl_accel *accel;
     const rl_grid *grid;

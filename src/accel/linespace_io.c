@@ -19,7 +19,9 @@
  * length before allocating anything, then the checksum (RL_ERR_PARSE), then
  * that the file belongs to the given grid and scene (RL_ERR_INVALID_ARG),
  * then the arrays' contents (occupancy bits against the header's count,
- * indices in range, monotone offsets). */
+ * indices in range, monotone offsets, PNMT and PREILLUM records finite and
+ * in their ranges: a forged file whose checksum was recomputed is refused
+ * like a corrupt one, RL_ERR_PARSE). */
 #define _POSIX_C_SOURCE 200809L
 #include <errno.h>
 #include <math.h>
@@ -33,6 +35,7 @@
 #include "core/half.h"
 #include "core/error.h"
 #include "rl/rl_output.h"
+#include "core/half.h"
 #include "rl/rl_rng.h"
 
 #define LS_MAGIC "RLLS"
@@ -239,33 +242,42 @@ static bool read_hashed(FILE *f, void *p, size_t n, uint64_t *h)
     return true;
 }
 
-/* PNMT records become surfaces that renderers shade (Sec. 7.4, eq. 9):
- * a record in use holds finite numbers, a position inside its voxel and a
- * material of the scene (|m| - 1, rounded), so that a damaged file cannot
- * send a query outside the material list (found by
- * tests/fuzz/fuzz_linespace_cache.c). Empty records (m = 0) are never read. */
-static rl_status check_pnmt(const rl_linespace *ls, uint32_t num_materials, const char *path)
+static bool in_range(uint16_t h, float lo, float hi)
 {
-    uint64_t records = ls->pnmt ? 2 * ls->num_occupied : 0;
-    for (uint64_t i = 0; i < records; ++i) {
+    float f = rl_half_to_float(h);
+    return f >= lo && f <= hi;      /* false for NaN */
+}
+
+/* The records as a build writes them (rl_linespace.h): the checksum only
+ * proves that a file is whole, and a forged one with a recomputed sum
+ * would hand NaN surfaces or a material past the scene's to the renderer.
+ * Positions are voxel-relative in [0, 1], the normal's x and y in [-1, 1],
+ * the material ID + 1 (signed) names a material of the scene, texture
+ * coordinates and pre-illuminated colours are finite (colours >= 0). */
+static rl_status check_records(const rl_linespace *ls, const char *path)
+{
+    const uint32_t materials = ls->data->num_materials;
+    for (uint64_t i = 0; ls->pnmt && i < 2 * ls->num_occupied; ++i) {
         const uint16_t *r = ls->pnmt + i * RL_LS_PNMT_RECORD;
-        float m = rl_half_to_float(r[RL_LS_PNMT_MAT]);
-        if (m == 0.0f)
-            continue;
-        bool ok = isfinite(m) && fabsf(m) >= 0.5f && fabsf(m) - 0.5f < (float)num_materials;
-        for (int k = 0; k < RL_LS_PNMT_RECORD && ok; ++k)
-            ok = isfinite(rl_half_to_float(r[k]));
-        for (int k = RL_LS_PNMT_PX; k <= RL_LS_PNMT_PZ && ok; ++k)
-            ok = rl_half_to_float(r[k]) >= 0.0f && rl_half_to_float(r[k]) <= 1.0f;
+        uint32_t id = 0;
+        bool ok = in_range(r[RL_LS_PNMT_PX], 0.0f, 1.0f) && in_range(r[RL_LS_PNMT_PY], 0.0f, 1.0f) &&
+                  in_range(r[RL_LS_PNMT_PZ], 0.0f, 1.0f) && in_range(r[RL_LS_PNMT_NX], -1.0f, 1.0f) &&
+                  in_range(r[RL_LS_PNMT_NY], -1.0f, 1.0f) &&
+                  in_range(r[RL_LS_PNMT_U], -65504.0f, 65504.0f) && in_range(r[RL_LS_PNMT_V], -65504.0f, 65504.0f) &&
+                  rl_ls_pnmt_material(rl_half_to_float(r[RL_LS_PNMT_MAT]), &id) && id < materials;
         if (!ok)
-            return rl_error(RL_ERR_PARSE, "%s: surface record %llu is not a surface of the scene (position, "
-                            "normal, material or texcoord)", path, (unsigned long long)i);
+            return rl_error(RL_ERR_PARSE, "%s: the %s surface record of occupied shaft %llu is not one a build "
+                            "writes (not finite, outside its voxel or an unknown material)", path,
+                            i % 2 ? "back" : "front", (unsigned long long)(i / 2));
     }
+    for (uint64_t i = 0; ls->preillum && i < 8 * ls->num_occupied; ++i)
+        if (!in_range(ls->preillum[i], 0.0f, 65504.0f))
+            return rl_error(RL_ERR_PARSE, "%s: pre-illuminated colour of shaft %llu is negative or not finite",
+                            path, (unsigned long long)(i / 8));
     return RL_OK;
 }
 
-/* num_materials: the scene's, which the PNMT records index. */
-static rl_status check_contents(const rl_linespace *ls, uint32_t num_materials, const char *path)
+static rl_status check_contents(const rl_linespace *ls, const char *path)
 {
     const rl_grid *g = ls->grid;
     uint32_t next = 0;
@@ -310,7 +322,7 @@ static rl_status check_contents(const rl_linespace *ls, uint32_t num_materials, 
         if (ls->cand[i] >= g->num_triangles && (ls->dynamic || ls->cand[i] != RL_NONE))
             return rl_error(RL_ERR_PARSE, "%s: candidate %llu is not a triangle ID", path,
                             (unsigned long long)i);
-    return check_pnmt(ls, num_materials, path);
+    return check_records(ls, path);
 }
 
 /* The header read and checked against itself and the file's length; f is
@@ -412,8 +424,7 @@ static rl_status adopt(const rl_accel *grid, const header *h, uint64_t shafts, r
     ls->occ_words = (ls->shafts_per_voxel + 63u) / 64u;
     ls->num_occupied = shafts - h->empty_shafts;
     ls->num_cand = (h->payloads & RL_LS_CANDIDATES) ? h->num_cand : 0;
-    const rl_scene_data *data = rl_scene_get_data(rl_accel_scene(grid));
-    if ((st = check_contents(ls, data ? data->num_materials : 0, path)))
+    if ((st = check_contents(ls, path)))
         return st;
     rl_linespace_stats *t = &ls->stats;
     t->filled_voxels = h->num_blocks;

@@ -260,7 +260,7 @@ bool rl_linespace_occluded(const rl_linespace *ls, const rl_ray *ray)
 static bool decode_pnmt(const rl_linespace *ls, const int xyz[3], const uint16_t *r, rl_ls_surface *s)
 {
     float m = rl_half_to_float(r[RL_LS_PNMT_MAT]);
-    if (m == 0.0f)
+    if (!rl_ls_pnmt_material(m, &s->material))
         return false;
     rl_aabb box = rl_grid_cell_bounds(ls->grid, xyz[0], xyz[1], xyz[2]);
     rl_vec3 ext = rl_sub(box.max, box.min);
@@ -270,7 +270,6 @@ static bool decode_pnmt(const rl_linespace *ls, const int xyz[3], const uint16_t
     float nx = rl_half_to_float(r[RL_LS_PNMT_NX]), ny = rl_half_to_float(r[RL_LS_PNMT_NY]);
     float nz = sqrtf(rl_maxf(0.0f, 1.0f - nx * nx - ny * ny));
     s->n = rl_v3(nx, ny, m < 0.0f ? -nz : nz);
-    s->material = (uint32_t)(fabsf(m) - 1.0f + 0.5f);
     s->uv = rl_v2(rl_half_to_float(r[RL_LS_PNMT_U]), rl_half_to_float(r[RL_LS_PNMT_V]));
     return true;
 }

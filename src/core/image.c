@@ -36,6 +36,15 @@ rl_status rl_image_check_file_size(const char *path, long long width, long long 
     return RL_OK;
 }
 
+double rl_image_bytes(int width, int height, unsigned layers)
+{
+    if (layers & ~(unsigned)(RL_LAYER_COLOR | RL_LAYER_DEPTH | RL_LAYER_ID))
+        return 0.0;
+    double per_pixel = ((layers & RL_LAYER_COLOR) ? sizeof(rl_vec4) : 0) + ((layers & RL_LAYER_DEPTH) ? sizeof(float) : 0) +
+                       ((layers & RL_LAYER_ID) ? 2 * sizeof(uint32_t) : 0);
+    return (double)width * (double)height * per_pixel;
+}
+
 rl_status rl_image_create(int width, int height, unsigned layers, rl_image **out)
 {
     if (!out)

@@ -1,10 +1,14 @@
 /* json.c: cJSON documents with source positions (json.h).
  *
- * cJSON builds the tree; json_scan.c checks the text strictly, explains
- * syntax errors in words and records where every item starts. The position
- * table is sorted by item address so rl_json_pos() is a binary search.
+ * json_scan.c first checks the text strictly, explains syntax errors in
+ * words and counts the values, so that a file of too many values is
+ * refused before cJSON allocates about 80 bytes for each; then cJSON
+ * builds the tree. The document keeps its text, and rl_json_pos() scans
+ * it again to find an item: positions are wanted only for messages, and
+ * a table of them cost 16 bytes per value, 8 times the text of "0,".
  * Duplicate keys are rejected: cJSON would keep both and lookups would see
  * only the first, which silently ignores the user's later value. */
+#define _POSIX_C_SOURCE 200809L
 #include "core/json.h"
 
 #include <errno.h>
@@ -13,34 +17,34 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 
 #include "core/error.h"
 #include "core/json_scan.h"
 #include "rl/rl_output.h"
 
-/* Scene and result files are small; this only stops runaway inputs. */
-#define JSON_MAX_FILE_BYTES ((size_t)1 << 30)
+/* Bytes of the limit per value allowed: 16 M values under the default
+ * 256 MiB, whose tree takes about 1.3 GB. */
+#define BYTES_PER_VALUE 16u
+
+static unsigned long long max_bytes = RL_JSON_MAX_BYTES;
+
+void rl_json_set_max_bytes(unsigned long long bytes) { max_bytes = bytes ? bytes : RL_JSON_MAX_BYTES; }
+unsigned long long rl_json_max_bytes(void) { return max_bytes; }
 
 struct rl_json_doc {
     char *name;
     cJSON *root;
-    rl_json_pos_entry *pos;   /* sorted by item address */
-    size_t npos;
+    char *text;                 /* NUL-terminated; for rl_json_pos */
+    size_t len;
 };
-
-static int cmp_pos(const void *a, const void *b)
-{
-    uintptr_t x = (uintptr_t)((const rl_json_pos_entry *)a)->item;
-    uintptr_t y = (uintptr_t)((const rl_json_pos_entry *)b)->item;
-    return x < y ? -1 : (x > y);
-}
 
 void rl_json_free(rl_json_doc *doc)
 {
     if (!doc)
         return;
     cJSON_Delete(doc->root);
-    free(doc->pos);
+    free(doc->text);
     free(doc->name);
     free(doc);
 }
@@ -51,13 +55,11 @@ const char *rl_json_name(const rl_json_doc *doc) { return doc ? doc->name : ""; 
 void rl_json_pos(const rl_json_doc *doc, const cJSON *item, int *line, int *col)
 {
     int l = 0, c = 0;
-    if (doc && item && doc->npos) {
-        rl_json_pos_entry key = { item, 0, 0 };
-        const rl_json_pos_entry *e = bsearch(&key, doc->pos, doc->npos, sizeof key, cmp_pos);
-        if (e) {
-            l = e->line;
-            c = e->col;
-        }
+    rl_json_scan_result res;
+    if (doc && item && doc->text && rl_json_scan(doc->text, doc->len, doc->root, item, &res) == RL_OK &&
+        res.found) {
+        l = res.line;
+        c = res.col;
     }
     if (line)
         *line = l;
@@ -122,58 +124,80 @@ static rl_status check_duplicates(const rl_json_doc *doc, const cJSON *item)
     return RL_OK;
 }
 
-rl_status rl_json_parse(const char *name, const char *text, size_t len, rl_json_doc **out)
+static rl_status too_large(const char *name, size_t len)
 {
-    if (!out || (!text && len))
-        return rl_error(RL_ERR_INVALID_ARG, "rl_json_parse: text or out is NULL");
-    name = name ? name : "<json>";
-    /* cJSON wants a terminated buffer even with an explicit length. */
-    char *buf = rl_alloc(len + 1);
+    return rl_error(RL_ERR_LIMIT, "%s: %zu bytes of JSON, more than the limit of %llu (rl_json_set_max_bytes)",
+                    name, len, max_bytes);
+}
+
+/* Parses buf (len bytes and a NUL after them), which the document takes
+ * over, also on failure. */
+static rl_status parse_owned(const char *name, char *buf, size_t len, rl_json_doc **out)
+{
+    if (len > max_bytes) {
+        free(buf);
+        return too_large(name, len);
+    }
     rl_json_doc *doc = rl_calloc(1, sizeof *doc);
     if (doc)
         doc->name = rl_strdup(name);
-    if (!buf || !doc || !doc->name) {
+    if (!doc || !doc->name) {
         free(buf);
         rl_json_free(doc);
         return RL_ERR_OUT_OF_MEMORY;
     }
-    if (len)
-        memcpy(buf, text, len);
-    buf[len] = '\0';
-    size_t bom = len >= 3 && memcmp(buf, "\xEF\xBB\xBF", 3) == 0 ? 3 : 0;
-    const char *end = NULL;
-    doc->root = cJSON_ParseWithLengthOpts(buf + bom, len - bom, &end, 0);
+    doc->text = buf;
+    doc->len = len;
     rl_json_scan_result res;
-    rl_status st = rl_json_scan(buf, len, doc->root, &res);
+    rl_status st = rl_json_scan(buf, len, NULL, NULL, &res);
     int line, col;
     if (st == RL_ERR_PARSE) {
         rl_json_line_col(buf, len, res.err_offset, &line, &col);
         st = rl_error(RL_ERR_PARSE, "%s:%d:%d: %s", name, line, col, res.message);
-    } else if (st == RL_OK && !doc->root) {
-        /* Valid JSON that cJSON still refused: out of memory or one of its
-         * own limits (e.g. numbers longer than 63 characters). */
-        size_t at = end && end >= buf && end <= buf + len ? (size_t)(end - buf) : 0;
-        rl_json_line_col(buf, len, at, &line, &col);
-        st = rl_error(RL_ERR_PARSE, "%s:%d:%d: cannot parse this value (too long or out of memory)",
-                      name, line, col);
-    } else if (st == RL_ERR_INTERNAL) {
-        st = rl_error(RL_ERR_INTERNAL, "%s: JSON scanner and cJSON disagree", name);
+    } else if (res.values > max_bytes / BYTES_PER_VALUE) {
+        st = rl_error(RL_ERR_LIMIT, "%s: %zu JSON values, more than the limit of %llu (one per %u bytes of "
+                      "rl_json_set_max_bytes)", name, res.values, max_bytes / BYTES_PER_VALUE, BYTES_PER_VALUE);
     }
-    free(buf);
+    if (st == RL_OK) {
+        size_t bom = len >= 3 && memcmp(buf, "\xEF\xBB\xBF", 3) == 0 ? 3 : 0;
+        const char *end = NULL;
+        doc->root = cJSON_ParseWithLengthOpts(buf + bom, len - bom, &end, 0);
+        if (!doc->root) {
+            /* Valid JSON that cJSON still refused: out of memory or one of
+             * its own limits (e.g. numbers longer than 63 characters). */
+            size_t at = end && end >= buf && end <= buf + len ? (size_t)(end - buf) : 0;
+            rl_json_line_col(buf, len, at, &line, &col);
+            st = rl_error(RL_ERR_PARSE, "%s:%d:%d: cannot parse this value (too long or out of memory)",
+                          name, line, col);
+        } else if (rl_json_scan(buf, len, doc->root, NULL, &res) != RL_OK) {
+            st = rl_error(RL_ERR_INTERNAL, "%s: JSON scanner and cJSON disagree", name);
+        }
+    }
+    if (st == RL_OK)
+        st = check_duplicates(doc, doc->root);
     if (st != RL_OK) {
-        free(res.pos);
-        rl_json_free(doc);
-        return st;
-    }
-    doc->pos = res.pos;
-    doc->npos = res.npos;
-    qsort(doc->pos, doc->npos, sizeof *doc->pos, cmp_pos);
-    if ((st = check_duplicates(doc, doc->root)) != RL_OK) {
         rl_json_free(doc);
         return st;
     }
     *out = doc;
     return RL_OK;
+}
+
+rl_status rl_json_parse(const char *name, const char *text, size_t len, rl_json_doc **out)
+{
+    if (!out || (!text && len))
+        return rl_error(RL_ERR_INVALID_ARG, "rl_json_parse: text or out is NULL");
+    name = name ? name : "<json>";
+    if (len > max_bytes)
+        return too_large(name, len);
+    /* cJSON wants a terminated buffer even with an explicit length. */
+    char *buf = rl_alloc(len + 1);
+    if (!buf)
+        return RL_ERR_OUT_OF_MEMORY;
+    if (len)
+        memcpy(buf, text, len);
+    buf[len] = '\0';
+    return parse_owned(name, buf, len, out);
 }
 
 rl_status rl_json_parse_file(const char *path, rl_json_doc **out)
@@ -183,15 +207,23 @@ rl_status rl_json_parse_file(const char *path, rl_json_doc **out)
     FILE *f = fopen(path, "rb");
     if (!f)
         return rl_error(RL_ERR_IO, "%s: cannot open: %s", path, strerror(errno));
-    /* Read in growing chunks so that pipes and /dev/stdin work too. */
+    /* A regular file is read into a buffer of its size (and the NUL) and
+     * refused unread when too large; pipes and /dev/stdin grow one. */
+    struct stat sb;
     size_t cap = 1 << 16, n = 0;
+    if (fstat(fileno(f), &sb) == 0 && S_ISREG(sb.st_mode)) {
+        if ((unsigned long long)sb.st_size > max_bytes) {
+            fclose(f);
+            return too_large(path, (size_t)sb.st_size);
+        }
+        cap = (size_t)sb.st_size + 1;
+    }
     char *data = rl_alloc(cap);
     rl_status st = data ? RL_OK : RL_ERR_OUT_OF_MEMORY;
     while (st == RL_OK) {
         if (n == cap) {
-            if (cap >= JSON_MAX_FILE_BYTES) {
-                st = rl_error(RL_ERR_LIMIT, "%s: JSON file larger than %zu bytes", path,
-                              JSON_MAX_FILE_BYTES);
+            if (n > max_bytes) {
+                st = too_large(path, n);
                 break;
             }
             char *bigger = rl_realloc_array(data, cap * 2, 1);
@@ -211,10 +243,12 @@ rl_status rl_json_parse_file(const char *path, rl_json_doc **out)
         }
     }
     fclose(f);
-    if (st == RL_OK)
-        st = rl_json_parse(path, data, n, out);
-    free(data);
-    return st;
+    if (st != RL_OK) {
+        free(data);
+        return st;
+    }
+    data[n] = '\0';          /* n < cap: the loop ends only on a read of nothing */
+    return parse_owned(path, data, n, out);
 }
 
 rl_status rl_json_number(const rl_json_doc *doc, const cJSON *item, double *out)

@@ -1,10 +1,12 @@
 /* json.h: cJSON with source positions, for scene files and result files.
  *
- * cJSON itself keeps no positions. rl_json_parse() parses with cJSON and then
- * walks the text once more in the same order as cJSON's tree to record the
- * line and column where every value (and every object member's key) starts,
- * so that semantic errors ("unknown key", "expected a number") can point at
- * file:line:col like syntax errors do. */
+ * cJSON itself keeps no positions. The document keeps its text, and
+ * rl_json_pos() walks it in the same order as cJSON's tree to find the
+ * line and column where a value (or an object member's key) starts, so
+ * that semantic errors ("unknown key", "expected a number") can point at
+ * file:line:col like syntax errors do. Files and texts above
+ * rl_json_max_bytes(), or with more values than it allows, are
+ * RL_ERR_LIMIT (rl_common.h). */
 #ifndef RL_CORE_JSON_H
 #define RL_CORE_JSON_H
 
@@ -23,7 +25,8 @@ void rl_json_free(rl_json_doc *doc);
 cJSON *rl_json_root(const rl_json_doc *doc);
 const char *rl_json_name(const rl_json_doc *doc);
 /* 1-based line/column where item starts (for object members: the key);
- * 0/0 if item is not part of doc. */
+ * 0/0 if item is not part of doc. Scans the text up to item: for messages,
+ * not for loops. */
 void rl_json_pos(const rl_json_doc *doc, const cJSON *item, int *line, int *col);
 /* Records RL_ERR_PARSE with "name:line:col: " + message at item; returns it. */
 rl_status rl_json_error(const rl_json_doc *doc, const cJSON *item, const char *fmt, ...)

@@ -23,10 +23,8 @@ typedef struct scan {
     int depth;
     rl_status status;
     rl_json_scan_result *res;
-    size_t cap;
-    /* Line cursor: recorded offsets only grow, so line/col are incremental. */
-    size_t cur_off, cur_line_start;
-    int cur_line;
+    const cJSON *target;        /* the item whose position is wanted, or NULL */
+    bool done;                  /* target found: the rest is not scanned */
 } scan;
 
 void rl_json_line_col(const char *text, size_t len, size_t offset, int *line, int *col)
@@ -96,28 +94,15 @@ static bool looks_like_comment(const scan *sc)
            (sc->s[sc->i + 1] == '/' || sc->s[sc->i + 1] == '*');
 }
 
+/* Notes that item starts at `at`; once it is the target, stops the scan
+ * (returning false unwinds the recursion; the status stays RL_OK). */
 static bool record(scan *sc, const cJSON *item, size_t at)
 {
-    if (!item)
+    if (!item || item != sc->target)
         return true;
-    rl_json_scan_result *r = sc->res;
-    if (r->npos == sc->cap) {
-        size_t cap = sc->cap ? 2 * sc->cap : 64;
-        rl_json_pos_entry *p = rl_realloc_array(r->pos, cap, sizeof *p);
-        if (!p) {
-            sc->status = RL_ERR_OUT_OF_MEMORY;
-            return false;
-        }
-        r->pos = p;
-        sc->cap = cap;
-    }
-    for (; sc->cur_off < at; ++sc->cur_off)
-        if (sc->s[sc->cur_off] == '\n') {
-            ++sc->cur_line;
-            sc->cur_line_start = sc->cur_off + 1;
-        }
-    r->pos[r->npos++] = (rl_json_pos_entry){ item, sc->cur_line, (int)(at - sc->cur_line_start) + 1 };
-    return true;
+    rl_json_line_col(sc->s, sc->len, at, &sc->res->line, &sc->res->col);
+    sc->res->found = sc->done = true;
+    return false;
 }
 
 static bool scan_value(scan *sc, const cJSON *node, bool record_here);
@@ -410,6 +395,7 @@ static bool scan_value(scan *sc, const cJSON *node, bool record_here)
         return expected_value(sc);
     if (!type_matches(node, c))
         return disagree(sc);
+    ++sc->res->values;
     if (record_here && !record(sc, node, sc->i))
         return false;
     switch (c) {
@@ -421,28 +407,24 @@ static bool scan_value(scan *sc, const cJSON *node, bool record_here)
     }
 }
 
-rl_status rl_json_scan(const char *text, size_t len, const cJSON *root, rl_json_scan_result *res)
+rl_status rl_json_scan(const char *text, size_t len, const cJSON *root, const cJSON *target,
+                       rl_json_scan_result *res)
 {
     memset(res, 0, sizeof *res);
-    scan sc = { .s = text, .len = len, .status = RL_OK, .res = res, .cur_line = 1 };
+    scan sc = { .s = text, .len = len, .status = RL_OK, .res = res, .target = root ? target : NULL };
     /* A UTF-8 byte order mark is tolerated (editors on Windows add one). */
     if (len >= 3 && memcmp(text, "\xEF\xBB\xBF", 3) == 0)
-        sc.i = sc.cur_off = sc.cur_line_start = 3;
+        sc.i = 3;
     skip_ws(&sc);
     if (at_end(&sc)) {
         fail(&sc, sc.i, "unexpected end of file: the document is empty (expected a value)");
-    } else if (scan_value(&sc, root, true)) {
+    } else if (scan_value(&sc, root, true) && !sc.done) {
         skip_ws(&sc);
         if (!at_end(&sc)) {
             char buf[16];
             fail(&sc, sc.i, "unexpected %s after the top-level value (a document holds one value)",
                  describe(&sc, sc.i, buf));
         }
-    }
-    if (sc.status != RL_OK) {
-        free(res->pos);
-        res->pos = NULL;
-        res->npos = 0;
     }
     return sc.status;
 }

@@ -236,6 +236,7 @@ rl_status rl_approx_save_json(const rl_approx *a, const char *path)
 
 typedef struct loader {
     const rl_json_doc *doc;
+    uint32_t want_set_size;     /* RL_APPROX_ANY_SET_SIZE: no scene to compare with */
 } loader;
 
 static rl_status member(const loader *l, const cJSON *obj, const char *key, const char *what, cJSON **out)
@@ -635,6 +636,31 @@ static rl_status load_samples(const loader *l, const cJSON *root, rl_approx *a)
     return st;
 }
 
+/* The sets are bitsets of set_size bits, one per node (an upper bound on
+ * the leaves) and one per sample: an empty set is 2 bytes of file and
+ * set_size / 8 bytes of memory, so a small file can claim gigabytes. Both
+ * are checked before anything is allocated: the size against the scene
+ * the sets are for, and the total against RL_APPROX_MAX_SET_BYTES. */
+static rl_status check_set_size(const loader *l, const cJSON *root, const cJSON *item, uint64_t set_size)
+{
+    if (l->want_set_size != RL_APPROX_ANY_SET_SIZE && set_size != l->want_set_size)
+        return rl_error(RL_ERR_INVALID_ARG,
+                        "%s: sets of %" PRIu64 " objects, the scene has %u (is it the visibility property "
+                        "of this scene?)",
+                        rl_json_name(l->doc), set_size, l->want_set_size);
+    const cJSON *nodes = cJSON_GetObjectItemCaseSensitive(root, "nodes");
+    const cJSON *samples = cJSON_GetObjectItemCaseSensitive(root, "samples");
+    double sets = (double)(cJSON_IsArray(nodes) ? cJSON_GetArraySize(nodes) : 0) +
+                  (double)(cJSON_IsArray(samples) ? cJSON_GetArraySize(samples) : 0);
+    double bytes = sets * (double)((set_size + 63) / 64) * 8.0;
+    if (bytes > (double)RL_APPROX_MAX_SET_BYTES)
+        return rl_json_error(l->doc, item,
+                             "\"set_size\": %.0f sets of %" PRIu64 " bits would take %.0f MiB, more than "
+                             "the limit of %.0f MiB",
+                             sets, set_size, bytes / 1048576.0, (double)RL_APPROX_MAX_SET_BYTES / 1048576.0);
+    return RL_OK;
+}
+
 static rl_status load(const loader *l, const cJSON *root, rl_approx **out)
 {
     static const char *const keys[] = { "format", "version", "property", "unit", "dims", "height", "bounds",
@@ -683,8 +709,9 @@ static rl_status load(const loader *l, const cJSON *root, rl_approx **out)
             return rl_json_error(l->doc, b, "\"bounds\": a 2-D slice has y = \"height\"");
     }
     uint64_t set_size = 0;
-    if (st == RL_OK && (st = member(l, root, "set_size", "the file", &c)) == RL_OK)
-        st = get_uint(l, c, "set_size", MAX_SET_SIZE, &set_size);
+    if (st == RL_OK && (st = member(l, root, "set_size", "the file", &c)) == RL_OK &&
+        (st = get_uint(l, c, "set_size", MAX_SET_SIZE, &set_size)) == RL_OK)
+        st = check_set_size(l, root, c, set_size);
     double seconds = 0.0;
     if (st == RL_OK && (st = member(l, root, "seconds", "the file", &c)) == RL_OK)
         st = get_finite(l, c, "seconds", &seconds);
@@ -730,13 +757,18 @@ static rl_status load(const loader *l, const cJSON *root, rl_approx **out)
 
 rl_status rl_approx_load_json(const char *path, rl_approx **out)
 {
+    return rl_approx_load_json_sets(path, RL_APPROX_ANY_SET_SIZE, out);
+}
+
+rl_status rl_approx_load_json_sets(const char *path, uint32_t set_size, rl_approx **out)
+{
     if (!path || !out)
         return rl_error(RL_ERR_INVALID_ARG, "rl_approx_load_json: path or out is NULL");
     rl_json_doc *doc = NULL;
     rl_status st = rl_json_parse_file(path, &doc);
     if (st != RL_OK)
         return st;
-    loader l = { doc };
+    loader l = { doc, set_size };
     rl_approx *a = NULL;
     st = load(&l, rl_json_root(doc), &a);
     rl_json_free(doc);

@@ -13,6 +13,7 @@
 #include <string.h>
 
 #include "core/error.h"
+#include "eval/sampling_internal.h"
 #include "render/renderer.h"
 #include "rl/rl_property.h"
 #include "rl/rl_sampling.h"
@@ -196,7 +197,9 @@ static void input_key(char *key, size_t size, const rl_scene *scene, const char 
 typedef rl_status (*sample_fn)(const rl_scene *scene, const sample_opts *o, const char *name, rl_approx **out);
 
 /* Loads path, or samples with sample(), and hands the lookup to slot; skips
- * both when the slot already holds a lookup of the same key. */
+ * both when the slot already holds a lookup of the same key. With
+ * object_pixels (visset) the file's sets must be the scene's objects: a
+ * file of another scene is refused before its sets are allocated. */
 static rl_status set_input(rl_renderer *r, const char *slot, const rl_scene *scene, const char *what,
                            const char *path, const sample_opts *o, sample_fn sample, bool object_pixels)
 {
@@ -208,7 +211,8 @@ static rl_status set_input(rl_renderer *r, const char *slot, const rl_scene *sce
     rl_timer t;
     rl_timer_start(&t);
     rl_approx *a = NULL;
-    rl_status st = path[0] ? rl_approx_load_json(path, &a) : sample(scene, o, what, &a);
+    uint32_t sets = object_pixels ? rl_scene_get_data(scene)->num_objects : RL_APPROX_ANY_SET_SIZE;
+    rl_status st = path[0] ? rl_approx_load_json_sets(path, sets, &a) : sample(scene, o, what, &a);
     rl_position_lookup l;
     if (st == RL_OK)
         st = make_lookup(a, object_pixels ? scene : NULL, o->resolution, o->threads, &l);

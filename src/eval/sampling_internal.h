@@ -114,6 +114,12 @@ static inline float rl_grid_edge(float lo, float hi, int i, int n)
     return lo + (hi - lo) * ((float)i / (float)n);
 }
 
+/* rl_approx_load_json for the sets of a scene of set_size objects: a file
+ * with sets of another size is refused (RL_ERR_INVALID_ARG) before they
+ * are allocated. RL_APPROX_ANY_SET_SIZE: any size, as the public loader. */
+#define RL_APPROX_ANY_SET_SIZE UINT32_MAX
+rl_status rl_approx_load_json_sets(const char *path, uint32_t set_size, rl_approx **out);
+
 /* Empty approximation (no nodes): copies name/unit, sets dims etc. */
 rl_status rl_approx_alloc(int dims, float height, rl_aabb bounds, const char *property,
                           const char *unit, uint32_t set_size, rl_approx **out);

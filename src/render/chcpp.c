@@ -459,7 +459,8 @@ static rl_status chcpp_render(rl_renderer *r, void *state, const rl_scene *scene
 const rl_renderer_class rl_chcpp_renderer_class = {
     .info = { .name = "chcpp",
               .description = "CHC++ occlusion culling over a loose octree; the same image as raster",
-              .reference = "Mattausch, Bittner & Wimmer 2008; Jähn 2015, Sec. 2.1.2, 7.3" },
+              .reference = "Mattausch, Bittner & Wimmer 2008; Jähn 2015, Sec. 2.1.2, 7.3",
+              .frame_bytes_per_pixel = RL_CULL_FRAME_BYTES_PER_PIXEL },
     .options = chcpp_options,
     .num_options = sizeof chcpp_options / sizeof chcpp_options[0],
     .state_size = sizeof(chcpp_state),

@@ -52,7 +52,10 @@ rl_status rl_box_query_run(rl_box_query *q, rl_drawer *dr, uint64_t *pixels, rl_
 void rl_box_query_free(rl_box_query *q);
 
 /* The caller's image as the rasterizer's target, with a private depth
- * layer if the caller asked for none, cleared to the background. */
+ * layer if the caller asked for none, cleared to the background. That
+ * layer is what a culling renderer's frame adds to the caller's image
+ * (rl_renderer_info.frame_bytes_per_pixel). */
+#define RL_CULL_FRAME_BYTES_PER_PIXEL sizeof(float)
 typedef struct rl_cull_target {
     rl_image image;
     float *own_depth;

@@ -742,7 +742,11 @@ const rl_renderer_class rl_pt_renderer_class = {
     .info = { .name = "pt",
               .description = "Progressive path tracing with NEE, Russian roulette and Phong sampling; "
                              "Line Space backends",
-              .reference = "Schröder 2017", .progressive = true, .default_time_s = PT_DEFAULT_TIME_S },
+              .reference = "Schröder 2017", .progressive = true, .default_time_s = PT_DEFAULT_TIME_S,
+              /* reset(): accumulation, sample counts, generators, first hits and
+               * directions, and the G-buffer of the first hits */
+              .frame_bytes_per_pixel = 3 * sizeof(double) + sizeof(uint32_t) + sizeof(rl_rng_gpu) + sizeof(rl_hit) +
+                                       sizeof(rl_vec3) + RL_GBUFFER_BYTES_PER_PIXEL },
     .options = pt_options,
     .num_options = NUM_OPTIONS,
     .state_size = sizeof(pt_state),

@@ -111,7 +111,8 @@ static rl_status raster_render(rl_renderer *r, void *state, const rl_scene *scen
 const rl_renderer_class rl_raster_renderer_class = {
     .info = { .name = "raster",
               .description = "Software rasterization with local Phong lighting; the hardware-path reference",
-              .reference = "Ullmann 2003, Sec. 3.1 (Phong model), Sec. 3.5 (hardware path)" },
+              .reference = "Ullmann 2003, Sec. 3.1 (Phong model), Sec. 3.5 (hardware path)",
+              .frame_bytes_per_pixel = sizeof(float) },   /* a depth buffer when the image has none */
     .options = raster_options,
     .num_options = sizeof raster_options / sizeof raster_options[0],
     .state_size = sizeof(raster_state),

@@ -205,7 +205,8 @@ rl_status rl_renderer_register(const rl_renderer_class_desc *desc)
             reg->cls = (rl_renderer_class){
                 .info = { .name = reg->name, .description = description, .reference = reference,
                           .progressive = desc->info.progressive,
-                          .default_time_s = desc->info.progressive ? desc->info.default_time_s : 0.0 },
+                          .default_time_s = desc->info.progressive ? desc->info.default_time_s : 0.0,
+                          .frame_bytes_per_pixel = desc->info.frame_bytes_per_pixel },
                 .options = desc->num_options ? desc->options : NULL,
                 .num_options = desc->num_options,
                 .state_size = desc->state_size,

@@ -8,11 +8,14 @@
  * valid camera, an image that matches the camera, zeroed and timed stats. */
 #include "render/renderer.h"
 
+#include <limits.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
 #include "core/error.h"
 #include "core/options.h"
+#include "core/threads.h"
 #include "rl/rl_timer.h"
 
 struct rl_renderer {
@@ -165,7 +168,23 @@ const rl_position_lookup *rl_renderer_input(const rl_renderer *r, const char *sl
     return i >= 0 && r->inputs[i].set ? &r->inputs[i].lookup : NULL;
 }
 
+rl_status rl_renderer_check_input_property(const rl_renderer *r, const char *slot, const rl_position_lookup *l,
+                                           const char *want)
+{
+    const char *have = l->property ? l->property : "";
+    if (strcmp(have, want) == 0)
+        return RL_OK;
+    const char *file = rl_renderer_get(r, slot);
+    return rl_error(RL_ERR_INVALID_ARG, "%s: %s holds the property '%s', not %s", rl_renderer_name(r),
+                    file && file[0] ? file : slot, have, want);
+}
+
 const char *rl_renderer_name(const rl_renderer *r) { return r ? r->cls->info.name : NULL; }
+
+double rl_renderer_frame_bytes(const rl_renderer *r, int width, int height)
+{
+    return r ? (double)width * (double)height * r->cls->info.frame_bytes_per_pixel : 0.0;
+}
 
 const rl_option_info *rl_renderer_options(const rl_renderer *r, size_t *count)
 {
@@ -178,7 +197,19 @@ rl_status rl_renderer_set(rl_renderer *r, const char *key, const char *value)
 {
     if (!r || !key || !value)
         return rl_error(RL_ERR_INVALID_ARG, "rl_renderer_set: renderer, key and value must not be NULL");
-    return rl_option_store_set(&r->options, key, value, r->cls->info.name, r->cls->check);
+    rl_status st = rl_option_store_set(&r->options, key, value, r->cls->info.name, r->cls->check);
+    /* OpenMP exits the process when it cannot start a thread, so the
+     * count is clamped here, where every renderer reads it from. */
+    const char *dot = strrchr(key, '.');
+    if (st != RL_OK || strcmp(dot ? dot + 1 : key, "threads") != 0)
+        return st;
+    long long asked = rl_option_store_int(&r->options, "threads");
+    char clamped[32];
+    int most = rl_threads_clamp(asked > INT_MAX ? INT_MAX : (int)asked, r->cls->info.name);
+    if (most == asked)
+        return RL_OK;
+    snprintf(clamped, sizeof clamped, "%d", most);
+    return rl_option_store_set(&r->options, "threads", clamped, r->cls->info.name, r->cls->check);
 }
 
 void rl_renderer_reset(rl_renderer *r)

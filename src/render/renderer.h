@@ -58,5 +58,11 @@ void *rl_renderer_state(const rl_renderer *r);
  * was set, so that a renderer can tell a new lookup from the one it built
  * its per-region data for. */
 const rl_position_lookup *rl_renderer_input(const rl_renderer *r, const char *slot, uint64_t *generation);
+/* A lookup must hold the property its renderer reads (select's times,
+ * visset's visible sets): the sets or values of any other would be read as
+ * if they were. RL_ERR_INVALID_ARG "<renderer>: <file or slot> holds the
+ * property 'p', not <want>". */
+rl_status rl_renderer_check_input_property(const rl_renderer *r, const char *slot, const rl_position_lookup *l,
+                                           const char *want);
 
 #endif

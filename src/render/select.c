@@ -172,10 +172,9 @@ static rl_status prepare(select_state *s, rl_renderer *r, int rule, const rl_pos
                                   slots[i], slots[i]);
         /* A time read from a file must be a time (of any renderer: the
          * file does not say which). */
-        if (rule == RULE_TIME && (!l[i]->property || strcmp(l[i]->property, "time") != 0))
-            return rl_error(RL_ERR_INVALID_ARG, "select: %s holds the property '%s', not time",
-                            rl_renderer_opt_string(r, slots[i])[0] ? rl_renderer_opt_string(r, slots[i]) : slots[i],
-                            l[i]->property ? l[i]->property : "");
+        rl_status st = rule == RULE_TIME ? rl_renderer_check_input_property(r, slots[i], l[i], "time") : RL_OK;
+        if (st != RL_OK)
+            return st;
         if (generation != s->generation[i]) {
             s->head.stats.preprocess_ms += l[i]->prepare_ms;
             s->generation[i] = generation;
@@ -250,7 +249,8 @@ const rl_renderer_class rl_select_renderer_class = {
     .info = { .name = "select",
               .description = "Runtime selection per position of one of two culling renderers (default chcpp or "
                              "svs) from sampled properties",
-              .reference = "Jähn 2015, Sec. 7.5" },
+              .reference = "Jähn 2015, Sec. 7.5",
+              .frame_bytes_per_pixel = 2 * RL_CULL_FRAME_BYTES_PER_PIXEL },   /* both renderers it picks from */
     .options = select_options,
     .num_options = sizeof select_options / sizeof select_options[0],
     .state_size = sizeof(select_state),

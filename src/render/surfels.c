@@ -407,7 +407,7 @@ const rl_renderer_class rl_surfels_renderer_class = {
     .info = { .name = "surfels",
               .description = "Progressive Blue Surfels: distant octree nodes as prefixes of blue-noise surfel "
                              "sequences (approximate level of detail)",
-              .reference = "Jähn 2015, Ch. 6" },
+              .reference = "Jähn 2015, Ch. 6", .frame_bytes_per_pixel = RL_CULL_FRAME_BYTES_PER_PIXEL },
     .options = surfels_options,
     .num_options = sizeof surfels_options / sizeof surfels_options[0],
     .state_size = sizeof(surfels_state),

@@ -539,7 +539,8 @@ const rl_renderer_class rl_svs_renderer_class = {
     .info = { .name = "svs",
               .description = "Spherical Visibility Sampling: per octree node, the objects visible from outside in "
                              "sampled directions (approximate)",
-              .reference = "Eikel, Jähn, Fischer & Meyer auf der Heide 2013; Jähn 2015, Sec. 2.1.1, 7.4" },
+              .reference = "Eikel, Jähn, Fischer & Meyer auf der Heide 2013; Jähn 2015, Sec. 2.1.1, 7.4",
+              .frame_bytes_per_pixel = RL_CULL_FRAME_BYTES_PER_PIXEL },
     .options = svs_options,
     .num_options = sizeof svs_options / sizeof svs_options[0],
     .state_size = sizeof(svs_state),

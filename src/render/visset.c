@@ -151,6 +151,9 @@ static rl_status prepare(visset_state *s, rl_renderer *r, const rl_scene *scene,
         return rl_error(RL_ERR_INVALID_ARG,
                         "visset: no visible sets: load or sample them with rl_renderer_prepare_inputs() "
                         "(rl_sampling.h; the rl tool does), or hand a lookup to input \"approx\"");
+    rl_status st = rl_renderer_check_input_property(r, "approx", l, "visibility");
+    if (st != RL_OK)
+        return st;
     *out = l;
     uint64_t uid = rl_scene_uid(scene);
     bool same_sets = s->ready && s->generation == generation && s->scene_uid == uid;
@@ -180,7 +183,7 @@ static rl_status prepare(visset_state *s, rl_renderer *r, const rl_scene *scene,
         input_ms = l->prepare_ms;   /* the first frame with these sets reports their making */
     }
     if (budget) {
-        rl_status st = build_ranking(s, l, d);
+        st = build_ranking(s, l, d);
         if (st != RL_OK) {
             drop(s);
             return st;
@@ -275,7 +278,8 @@ const rl_renderer_class rl_visset_renderer_class = {
     .info = { .name = "visset",
               .description = "Draws the set of visible objects stored in a sampled visibility property "
                              "(approximate; optional triangle budget)",
-              .reference = "Jähn 2015, Sec. 7.6; Eikel, Jähn & Fischer 2010" },
+              .reference = "Jähn 2015, Sec. 7.6; Eikel, Jähn & Fischer 2010",
+              .frame_bytes_per_pixel = RL_CULL_FRAME_BYTES_PER_PIXEL },
     .options = visset_options,
     .num_options = sizeof visset_options / sizeof visset_options[0],
     .state_size = sizeof(visset_state),

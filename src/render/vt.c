@@ -620,7 +620,9 @@ rl_status rl_vt_set_update_callback(rl_renderer *r, rl_vt_update_fn fn, void *us
 const rl_renderer_class rl_vt_renderer_class = {
     .info = { .name = "vt",
               .description = "Vertex Tracing: adaptive progressive ray tracing in object space, hybrid with rasterization",
-              .reference = "Ullmann 2003, Ch. 3-4" },
+              .reference = "Ullmann 2003, Ch. 3-4",
+              /* frame_buffers(): scratch depth, and depth and IDs of the pre-pass */
+              .frame_bytes_per_pixel = 2 * sizeof(float) + 2 * sizeof(uint32_t) },
     .options = vt_options,
     .num_options = sizeof vt_options / sizeof vt_options[0],
     .state_size = sizeof(vt_state),

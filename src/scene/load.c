@@ -173,6 +173,22 @@ static void file_stem(const char *path, char *out, size_t size)
         *dot = '\0';
 }
 
+/* A model's default lights, view and bounds come from its coordinates: for
+ * a model whose coordinates reach the float limit, the error ("point
+ * light: position is not finite") must name the file the user gave, not
+ * a light they never wrote. */
+static rl_status name_the_file(const char *path, rl_status st)
+{
+    if (strstr(rl_last_error(), path))
+        return st;
+    char msg[768];
+    snprintf(msg, sizeof msg, "%s", rl_last_error());
+    rl_clear_error();
+    /* The file's fault, as rl_jscene_located says for JSON scenes. */
+    return rl_error(st == RL_ERR_INVALID_ARG ? RL_ERR_PARSE : st, "%s: %s (are its coordinates within float range?)",
+                    path, msg);
+}
+
 static rl_status load_mesh_file(const char *path, const char *params, rl_scene **out)
 {
     /* Every key=value checked before the file is read. */
@@ -227,7 +243,7 @@ static rl_status load_mesh_file(const char *path, const char *params, rl_scene *
         st = rl_scene_commit(scene);
     if (st != RL_OK) {
         rl_scene_release(scene);
-        return st;
+        return root != RL_NONE && st != RL_ERR_OUT_OF_MEMORY ? name_the_file(path, st) : st;
     }
     *out = scene;
     return RL_OK;

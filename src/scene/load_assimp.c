@@ -835,9 +835,11 @@ rl_status rl_assimp_import(rl_scene *scene, const char *path, uint32_t parent,
         /* Assimp catches the std::bad_alloc of a failed allocation and
          * reports it as its error text: that is running out of memory (the
          * isolated import's limit), not a malformed file. */
-        const char *why = aiGetErrorString();
-        if (strstr(why, "bad_alloc"))
+        const char *raw = aiGetErrorString();
+        if (strstr(raw, "bad_alloc"))
             return rl_error(RL_ERR_OUT_OF_MEMORY, "%s: out of memory in Assimp", path);
+        char why[256];
+        rl_load_safe_message(path, raw, why, sizeof why);
         return rl_error(RL_ERR_PARSE, "%s: %s", path, why);
     }
     if (!ai->mRootNode || (ai->mFlags & AI_SCENE_FLAGS_INCOMPLETE)) {

@@ -2,6 +2,8 @@
 #ifndef RL_SCENE_LOAD_INTERNAL_H
 #define RL_SCENE_LOAD_INTERNAL_H
 
+#include <stddef.h>
+
 #include "rl/rl_image.h"
 #include "rl/rl_scene.h"
 
@@ -27,6 +29,11 @@ rl_status rl_check_mesh_file(const char *path);
 #define RL_IMPORT_MAX_NODE_COPIES 10000000ull
 rl_status rl_check_gltf_nodes(const char *path, const char *json, size_t size);
 rl_status rl_check_dae_nodes(const char *path, const char *data, size_t size);
+
+/* load_message.c: an importer's message msg about path as one safe line
+ * into out: text it quotes is kept only where path itself holds it, cut
+ * to 40 characters; non-printable bytes are escaped as \xNN. */
+void rl_load_safe_message(const char *path, const char *msg, char *out, size_t size);
 
 /* load_embedded.c: decodes a texture embedded in a model file (compressed
  * PNG/JPEG/... bytes, or raw BGRA texels) into linear RGBA. what names the

@@ -79,6 +79,93 @@ static long file_size(const char *path)
     return len;
 }
 
+/* The file's checksum (linespace_io.c): an attacker can recompute it, so
+ * the test does too, to check that the records themselves are validated. */
+static uint64_t checksum(uint64_t h, const unsigned char *p, size_t n)
+{
+    for (; n >= 8; n -= 8, p += 8) {
+        uint64_t w;
+        memcpy(&w, p, 8);
+        h = (h ^ w) * 0xbf58476d1ce4e5b9ull;
+        h ^= h >> 31;
+    }
+    if (n) {
+        uint64_t w = 0;
+        memcpy(&w, p, n);
+        h = (h ^ w ^ ((uint64_t)n << 56)) * 0x94d049bb133111ebull;
+        h ^= h >> 29;
+    }
+    return h;
+}
+
+/* A copy of `from` with the 16-bit word at `at` set to value and the
+ * checksum recomputed, as a forger would: over the header, then each of
+ * the arrays (bytes[]) in turn. */
+static void forge(const char *from, const char *to, const size_t bytes[7], long at, uint16_t value)
+{
+    long len = file_size(from);
+    unsigned char *buf = malloc((size_t)len);
+    assert_non_null(buf);
+    FILE *f = fopen(from, "rb");
+    assert_non_null(f);
+    assert_int_equal(fread(buf, 1, (size_t)len, f), (size_t)len);
+    fclose(f);
+    memcpy(buf + at, &value, 2);
+    uint64_t sum = 0;
+    size_t off = 0;
+    for (int i = 0; i < 7; off += bytes[i++])
+        sum = checksum(sum, buf + off, bytes[i]);
+    assert_int_equal(off, (size_t)len - 8);
+    memcpy(buf + len - 8, &sum, 8);
+    FILE *g = fopen(to, "wb");
+    assert_non_null(g);
+    assert_int_equal(fwrite(buf, 1, (size_t)len, g), (size_t)len);
+    fclose(g);
+    free(buf);
+}
+
+/* Issue 34: records that no build writes, in a file whose checksum was
+ * recomputed (NaN fields, a position outside its voxel, a material the
+ * scene lacks, a NaN colour), are refused; the unchanged copy loads. */
+static void forged_records_are_refused(const rl_accel *grid, const rl_linespace *ls, const char *path,
+                                       const char *bad)
+{
+    rl_linespace_data d;
+    rl_linespace_get_data(ls, &d);
+    uint64_t occupied = d.num_occupied;
+    const size_t bytes[7] = { 128, 4 * (size_t)d.num_cells, 8 * 2 * (size_t)d.num_blocks * d.occ_words,
+                              4 * (size_t)d.num_cand, d.cand_start ? 4 * (size_t)(occupied + 1) : 0,
+                              2 * 16 * (size_t)occupied, 2 * 8 * (size_t)occupied };
+    long len = file_size(path);
+    long preillum = len - 8 - (long)(occupied * 8 * 2), pnmt = preillum - (long)(occupied * 16 * 2);
+    const uint16_t nan = 0x7e00, two = 0x4000, many = 0x6400 /* 1024 */;
+    struct { long at; uint16_t value; } cases[] = {
+        { pnmt + 2 * 5, nan },                         /* material (front record of shaft 0) */
+        { pnmt + 2 * (16 * (long)(occupied / 2) + 8 + 5), nan },   /* material (back record) */
+        { pnmt + 2 * 0, nan },                         /* position x */
+        { pnmt + 2 * 1, two },                         /* position y outside its voxel */
+        { pnmt + 2 * 3, nan },                         /* normal x */
+        { pnmt + 2 * 5, many },                        /* material 1023 */
+        { pnmt + 2 * 6, nan },                         /* texture u */
+        { preillum + 2 * 9, nan },                     /* colour */
+    };
+    rl_linespace *back = NULL;
+    forge(path, bad, bytes, pnmt + 2 * 5, 0x3c00 /* material 0 */);
+    if (rl_linespace_load(grid, bad, &back) != RL_OK)
+        fail_msg("a valid record re-summed: %s", rl_last_error());
+    rl_linespace_release(back);
+    back = NULL;
+    for (size_t i = 0; i < sizeof cases / sizeof *cases; ++i) {
+        forge(path, bad, bytes, cases[i].at, cases[i].value);
+        rl_clear_error();
+        if (rl_linespace_load(grid, bad, &back) != RL_ERR_PARSE)
+            fail_msg("forged record %zu was not refused: %s", i, rl_last_error());
+        assert_null(back);
+        assert_non_null(strstr(rl_last_error(), "record") ? rl_last_error() : strstr(rl_last_error(), "colour"));
+    }
+    rl_clear_error();
+}
+
 static void round_trip(bool dynamic)
 {
     rl_scene *s = builtin("cornell-teapot", "triangles=2000");
@@ -141,6 +228,7 @@ static void round_trip(bool dynamic)
         assert_int_equal(rl_linespace_load(grid, bad, &back), RL_ERR_PARSE);
         assert_null(back);
     }
+    forged_records_are_refused(grid, ls, path, bad);
     long cuts[] = { 0, 10, 127, len / 3, len - 1 };
     for (size_t i = 0; i < sizeof cuts / sizeof *cuts; ++i) {
         copy_file(path, bad, cuts[i], -1);
@@ -184,26 +272,6 @@ static void test_linespace_fixed_round_trip_is_bit_identical_and_bad_files_are_r
     round_trip(false);
 }
 
-/* The file's checksum, as linespace_io.c computes it: a test that edits a
- * record and re-seals the file reaches the checks behind the checksum. */
-static uint64_t checksum(const unsigned char *p, size_t n)
-{
-    uint64_t h = 0;
-    for (; n >= 8; n -= 8, p += 8) {
-        uint64_t w;
-        memcpy(&w, p, 8);
-        h = (h ^ w) * 0xbf58476d1ce4e5b9ull;
-        h ^= h >> 31;
-    }
-    if (n) {
-        uint64_t w = 0;
-        memcpy(&w, p, n);
-        h = (h ^ w ^ ((uint64_t)n << 56)) * 0x94d049bb133111ebull;
-        h ^= h >> 29;
-    }
-    return h;
-}
-
 /* A PNMT record whose material half is NaN, or names a material the scene
  * lacks, in an otherwise intact file: refused at load (fuzz_linespace_cache
  * found the NaN turned into a material index by the query, undefined). */
@@ -245,7 +313,7 @@ static void test_linespace_pnmt_record_with_a_bad_material_is_refused(void **sta
         assert_non_null(copy);
         memcpy(copy, buf, (size_t)len);
         memcpy(copy + (pnmt - buf) + used, &materials[k], 2);
-        uint64_t sum = checksum(copy, (size_t)len - 8);
+        uint64_t sum = checksum(0, copy, (size_t)len - 8);
         memcpy(copy + len - 8, &sum, 8);
         FILE *g = fopen(bad, "wb");
         assert_non_null(g);
@@ -258,7 +326,7 @@ static void test_linespace_pnmt_record_with_a_bad_material_is_refused(void **sta
         rl_clear_error();
     }
     /* The same file unedited but re-sealed still loads: the checksum is right. */
-    uint64_t sum = checksum(buf, (size_t)len - 8);
+    uint64_t sum = checksum(0, buf, (size_t)len - 8);
     memcpy(buf + len - 8, &sum, 8);
     FILE *g = fopen(bad, "wb");
     assert_non_null(g);

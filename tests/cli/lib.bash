@@ -34,3 +34,21 @@ expect_usage_error() {
 }
 # expect_in FILE TEXT: FILE contains TEXT.
 expect_in() { grep -q -- "$2" "$1" || fail "$1 lacks '$2': $(head -c 400 "$1")"; }
+# bounded CMD...: runs CMD with at most 30 s and, outside sanitizer builds
+# (which reserve terabytes of address space up front), at most 2 GiB of
+# address space, so an input that makes rl allocate gigabytes fails the
+# test instead of the machine. Its peak RSS (KiB) is left in $TMP/rss.
+RL_SANITIZED=$(grep -c -m1 __asan_init "$RL" 2>/dev/null || true)
+bounded() {
+    (
+        [ "$RL_SANITIZED" != 0 ] || ulimit -v 2097152
+        exec /usr/bin/time -q -f %M -o "$TMP/rss" timeout 30 "$@"
+    )
+}
+# expect_bounded_error CODE TEXT CMD...: expect_error under bounded, with a
+# peak RSS below 512 MiB.
+expect_bounded_error() {
+    local code=$1 text=$2; shift 2
+    expect_error "$code" "$text" bounded "$@"
+    [ "$(tail -n1 "$TMP/rss")" -lt 524288 ] || fail "'$*' peaked at $(tail -n1 "$TMP/rss") KiB"
+}

@@ -121,4 +121,87 @@ no_temporaries
 echo "not a cache" >"$TMP/keep/other.rlls"
 expect_error 1 "other.rlls" "$RL" render cornell "${LS[@]}" --set ls_file="$TMP/keep/other.rlls"
 [ "$(cat "$TMP/keep/other.rlls")" = "not a cache" ] || fail "a file that is no cache was overwritten"
+
+# Issue 34: a model whose coordinates reach the float limit: the error
+# names the file, alone (no lights to fit) and in a JSON scene (no camera
+# to frame it with). Exit 1: the file is at fault, not the command line.
+printf 'v -3e38 -3e38 -3e38\nv 3e38 0 0\nv 0 3e38 3e38\nf 1 2 3\n' >"$TMP/huge.obj"
+printf '{ "objects": [ { "file": "huge.obj" } ], "lights": [ { "type": "directional", "direction": [0, -1, 0] } ] }\n' \
+    >"$TMP/huge.json"
+expect_bounded_error 1 "huge.obj" "$RL" render "$TMP/huge.obj" --size 32x24 --out "$OUT"
+expect_bounded_error 1 "huge.json" "$RL" render "$TMP/huge.json" --size 32x24 --out "$OUT"
+
+# Issue 34: an importer's error quotes at most 40 characters of the file
+# the user named, escaped, and nothing of a file it references (an mtllib
+# that is really a password file).
+mkdir -p "$TMP/etc" "$TMP/a/b"
+printf 'root:x:0:0:root:/root:/bin/bash\nnewmtl x\nd secret-hash-in-etc\n' >"$TMP/etc/passwd"
+printf 'mtllib ../../etc/passwd\nv 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl root\nf 1 2 3\n' >"$TMP/a/b/m.obj"
+expect_bounded_error 1 "m.obj" "$RL" render "$TMP/a/b/m.obj" --size 32x24 --out "$OUT"
+! grep -q 'secret\|root:' "$TMP/err" || fail "the error quotes the referenced file: $(cat "$TMP/err")"
+printf 'v 0 0 0\nv 1 0 0\nv 0 1 0\nvn abcdefghijklmnopqrstuvwxyzabcdefghijklmnopqrstuvwxyz 1 1\nf 1 2 3\n' >"$TMP/long.obj"
+expect_bounded_error 1 '"abcdefghijklmnopqrstuvwxyzabcdefghijklmn\.\.\."' "$RL" render "$TMP/long.obj" --size 32x24 --out "$OUT"
+
+# Issue 34: a 64 MB JSON array of zeros (3.5 GB once parsed before the
+# value limit): refused before cJSON builds it, in bounded memory.
+python3 -c 'import sys; sys.stdout.write("[" + "0," * (2**25 - 1) + "0]")' >"$TMP/zeros.json"
+expect_bounded_error 1 "JSON values, more than the limit" "$RL" render "$TMP/zeros.json" --size 32x24 --out "$OUT"
+rm -f "$TMP/zeros.json"
+
+# Issue 34: threads=1024, the documented maximum, under an 8 GB address
+# space limit: libgomp used to exit 1 ("Thread creation failed") with no
+# rl: line; now the count is clamped to what can be started, with a
+# warning. (Sanitizer builds cannot run under such a limit.)
+limited_8g() { ( ulimit -v 8000000; exec "$@" ); }
+if [ "$RL_SANITIZED" = 0 ]; then
+    for algo in whitted pt; do
+        budget=()
+        [ "$algo" = pt ] && budget=(--time 0.2s)
+        expect_exit 0 limited_8g timeout 60 "$RL" render cornell --algo "$algo" --set threads=1024 "${budget[@]}" \
+            --size 32x24 --out "$OUT"
+        grep -q "^rl: warning: $algo: threads=1024 clamped to " "$TMP/err" || fail "no clamp warning: $(cat "$TMP/err")"
+    done
+fi
+
+# Issue 34: a frame's memory is estimated before it is allocated (16384 x
+# 16384 took 4.2-5.3 GB): refused above --max-memory, with the estimate,
+# whether the size comes from --size or from the scene's camera.
+rm -f "$OUT"
+expect_bounded_error 1 "a 16384x16384 frame of raster needs about 7.00 GiB, more than the 1.00 GiB of --max-memory" \
+    "$RL" render cornell --size 16384x16384 --max-memory 1G --out "$OUT"
+expect_bounded_error 1 "16384x16384 frame of pt needs about 41" "$RL" render cornell --algo pt --size 16384x16384 \
+    --max-memory 1G --out "$OUT"
+cat >"$TMP/bigcam.json" <<'JSON'
+{ "objects": [ { "generator": "teapot" } ],
+  "cameras": [ { "eye": [0, 1, 3], "target": [0, 0, 0], "size": [16384, 16384] } ],
+  "camera_path": { "keys": [ { "time_s": 0, "eye": [0, 1, 3], "target": [0, 0, 0] },
+                             { "time_s": 1, "eye": [1, 1, 3], "target": [0, 0, 0] } ] } }
+JSON
+expect_bounded_error 1 "16384x16384 frame" "$RL" render "$TMP/bigcam.json" --max-memory 1G --out "$OUT"
+expect_bounded_error 1 "16384x16384 frame" "$RL" render "$TMP/bigcam.json" --camera-path --max-memory 1G --out "$TMP/f%d.png"
+[ ! -e "$OUT" ] || fail "a refused frame still wrote $OUT"
+expect_usage_error "$RL" render cornell --max-memory 1X --out "$OUT"
+run_ok "$RL" render cornell --size 32x24 --max-memory 64M --out "$OUT"
+
+# Issue 34: approximation files for visset. A few kilobytes of empty sets
+# that each claim 2^26 bits (4 GB once allocated), and sets of the right
+# size but of another property, are refused before anything is drawn.
+run_ok "$RL" eval cornell --property visibility --set resolution=16 --samples 8 --out "$TMP/ev"
+python3 - "$TMP/ev/approx.json" "$TMP" <<'PY'
+import json, sys
+good = json.load(open(sys.argv[1]))
+bomb = dict(good, set_size=1 << 26, nodes=[["leaf"]])
+n = 500
+bomb["samples"] = [good["samples"][0][:3] + [1]] * n
+bomb["sample_sets"] = [[]] * n
+bomb["leaves"] = [dict(good["leaves"][0], samples=n, set=[])]
+json.dump(bomb, open(sys.argv[2] + "/bomb.json", "w"), separators=(",", ":"))
+json.dump(dict(good, property="ops"), open(sys.argv[2] + "/ops.json", "w"))
+PY
+[ "$(stat -c %s "$TMP/bomb.json")" -lt 50000 ] || fail "bomb.json is not small"
+expect_bounded_error 1 "the scene has 8" "$RL" render cornell --algo visset --set approx="$TMP/bomb.json" \
+    --size 32x24 --out "$OUT"
+expect_bounded_error 1 "'ops', not visibility" "$RL" render cornell --algo visset --set approx="$TMP/ops.json" \
+    --size 32x24 --out "$OUT"
+run_ok "$RL" render cornell --algo visset --set approx="$TMP/ev/approx.json" --size 32x24 --out "$OUT"
 echo "ok"

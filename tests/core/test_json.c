@@ -295,9 +295,76 @@ static void test_random_mutations_never_crash_or_confuse_the_scanner(void **stat
     rl_clear_error();
 }
 
+/* Issue 34: the size limit and the value count that goes with it refuse a
+ * file before it is read and a document before cJSON builds its tree;
+ * positions of a large document still come out right (found by scanning
+ * again, with no table per value). */
+static void test_size_and_value_limits_refuse_before_building(void **state)
+{
+    (void)state;
+    assert_int_equal(rl_json_max_bytes(), RL_JSON_MAX_BYTES);
+    rl_json_set_max_bytes(1616);            /* 101 values */
+    char text[1700];
+    size_t n = 0;
+    text[n++] = '[';
+    for (int i = 0; i < 100; ++i)
+        n += (size_t)snprintf(text + n, sizeof text - n, "%s0", i ? "," : "");
+    text[n++] = ']';
+    text[n] = '\0';
+    rl_json_doc *doc = NULL;
+    assert_int_equal(rl_json_parse("ok.json", text, n, &doc), RL_OK);   /* 101 values in 201 bytes */
+    rl_json_free(doc);
+    doc = NULL;
+    rl_json_set_max_bytes(1600);
+    expect_error(text, RL_ERR_LIMIT, "101 JSON values, more than the limit of 100");
+    memset(text, ' ', sizeof text - 1);
+    text[0] = '0';
+    text[sizeof text - 1] = '\0';
+    expect_error(text, RL_ERR_LIMIT, "1699 bytes of JSON, more than the limit of 1600");
+
+    const char *dir = getenv("RL_TEST_TMP");
+    char path[1024];
+    snprintf(path, sizeof path, "%s/test_json_big.json", dir && *dir ? dir : "/tmp");
+    FILE *f = fopen(path, "wb");
+    assert_non_null(f);
+    assert_int_equal(fwrite(text, 1, strlen(text), f), strlen(text));
+    fclose(f);
+    rl_clear_error();
+    assert_int_equal(rl_json_parse_file(path, &doc), RL_ERR_LIMIT);
+    assert_non_null(strstr(rl_last_error(), "rl_json_set_max_bytes"));
+    assert_null(doc);
+    rl_clear_error();
+    remove(path);
+    rl_json_set_max_bytes(0);
+    assert_int_equal(rl_json_max_bytes(), RL_JSON_MAX_BYTES);
+
+    /* The last of 10000 members, and a key after a long string. */
+    size_t cap = (size_t)1 << 20;
+    char *big = malloc(cap);
+    assert_non_null(big);
+    n = (size_t)snprintf(big, cap, "{\"s\": \"%0500d\",\n", 7);
+    for (int i = 0; i < 10000; ++i)
+        n += (size_t)snprintf(big + n, cap - n, "  \"k%d\": [%d, {\"x\": true}]%s\n", i, i, i < 9999 ? "," : "");
+    n += (size_t)snprintf(big + n, cap - n, "}");
+    doc = parse_ok(big);
+    const cJSON *root = rl_json_root(doc);
+    assert_pos(doc, cJSON_GetObjectItem(root, "k0"), 2, 3);
+    assert_pos(doc, cJSON_GetObjectItem(root, "k9999"), 10001, 3);
+    assert_pos(doc, cJSON_GetObjectItem(cJSON_GetArrayItem(cJSON_GetObjectItem(root, "k9999"), 1), "x"), 10001, 20);
+    cJSON *orphan = cJSON_CreateNull();
+    int l = -1, c = -1;
+    rl_json_pos(doc, orphan, &l, &c);
+    assert_int_equal(l, 0);
+    assert_int_equal(c, 0);
+    cJSON_Delete(orphan);
+    rl_json_free(doc);
+    free(big);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_size_and_value_limits_refuse_before_building),
         cmocka_unit_test(test_valid_document_parses_with_member_order),
         cmocka_unit_test(test_positions_of_nested_keys_are_exact),
         cmocka_unit_test(test_syntax_errors_report_line_column_and_expectation),

@@ -307,6 +307,13 @@ static void edit_grid(cJSON *r)
     cJSON_ReplaceItemInArray(node, 0, cJSON_CreateString("grid"));
 }
 
+/* Issue 34: 200 samples and their nodes, each claiming a set of 2^26 bits,
+ * would be 1.7 GB of bitsets from a file of kilobytes. */
+static void edit_set_size_bomb(cJSON *r)
+{
+    cJSON_ReplaceItemInObject(r, "set_size", cJSON_CreateNumber(1 << 26));
+}
+
 static void test_broken_files_are_refused(void **state)
 {
     (void)state;
@@ -378,6 +385,7 @@ static void test_broken_files_are_refused(void **state)
     expect_edit_refused(good, broken, edit_seed, "seed");
     expect_edit_refused(good, broken, edit_grid_shift, "grid_shift");
     expect_edit_refused(good, broken, edit_grid, "nodes");
+    expect_edit_refused(good, broken, edit_set_size_bomb, "set_size");
 
     char missing[1024];
     tmp_path(missing, sizeof missing, "approx_does_not_exist.json");

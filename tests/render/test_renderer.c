@@ -5,10 +5,12 @@
 #include <stdarg.h>
 #include <stddef.h>
 #include <stdint.h>
+#include <stdlib.h>
 #include <string.h>
 
 #include <cmocka.h>
 
+#include "core/threads.h"
 #include "rl/rl_culling.h"
 #include "rl/rl_render.h"
 #include "rl/rl_sampling.h"
@@ -122,6 +124,27 @@ static void test_get_returns_default_then_set_value(void **state)
     assert_null(rl_renderer_get(r, "nosuch"));
     assert_int_equal(rl_renderer_set(r, "shading", "gouraud"), RL_OK);
     assert_string_equal(rl_renderer_get(r, "raster.shading"), "gouraud");
+    rl_renderer_release(r);
+}
+
+/* Issue 34: a thread count above what the process can start is clamped
+ * (OpenMP would exit the process), with or without the renderer's prefix;
+ * smaller counts are kept. */
+static void test_thread_counts_are_clamped_to_what_can_be_started(void **state)
+{
+    (void)state;
+    rl_renderer *r = NULL;
+    assert_int_equal(rl_renderer_create("pt", &r), RL_OK);
+    int most = rl_threads_creatable();
+    assert_true(most >= 1);
+    assert_int_equal(rl_renderer_set(r, "pt.threads", "1024"), RL_OK);
+    assert_int_equal(atoi(rl_renderer_get(r, "threads")), most < 1024 ? most : 1024);
+    assert_int_equal(rl_renderer_set(r, "threads", "1"), RL_OK);
+    assert_string_equal(rl_renderer_get(r, "threads"), "1");
+    assert_int_equal(rl_renderer_set(r, "threads", "0"), RL_OK);
+    assert_string_equal(rl_renderer_get(r, "threads"), "0");
+    assert_int_equal(rl_threads_clamp(most + 1, "test"), most);
+    assert_int_equal(rl_threads_clamp(0, "test"), 0);
     rl_renderer_release(r);
 }
 
@@ -271,6 +294,7 @@ int main(void)
         cmocka_unit_test(test_bad_options_are_invalid_and_name_the_option),
         cmocka_unit_test(test_good_options_are_accepted_with_or_without_prefix),
         cmocka_unit_test(test_get_returns_default_then_set_value),
+        cmocka_unit_test(test_thread_counts_are_clamped_to_what_can_be_started),
         cmocka_unit_test(test_ray_type_names_are_distinct),
         cmocka_unit_test(test_render_refuses_uncommitted_scene),
         cmocka_unit_test(test_render_refuses_mismatched_image_and_bad_camera),

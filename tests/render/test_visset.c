@@ -146,14 +146,17 @@ static void test_visset_reads_the_evaluators_approximation(void **state)
     rl_renderer_release(file);
     rl_renderer_release(own);
 
-    /* The same file for another scene, and a missing file, are refused. */
+    /* The same file for another scene (refused on loading, before its sets
+     * are allocated), and a missing file, are refused. */
     rl_scene *other = NULL;
     assert_int_equal(rl_scene_create_builtin("cornell", "", &other), RL_OK);
     rl_renderer *bad = fx_make("visset", (const char *const[]){ "approx", path, NULL });
     rl_camera cam = { .eye = rl_v3(0, 1, 3), .target = rl_v3(0, 1, 0), .width = 32, .height = 32 };
     rl_image *img = NULL;
     assert_int_equal(rl_image_create(32, 32, RL_LAYER_COLOR, &img), RL_OK);
-    assert_int_equal(rl_renderer_prepare_inputs(bad, other), RL_OK);
+    assert_int_equal(rl_renderer_prepare_inputs(bad, other), RL_ERR_INVALID_ARG);
+    assert_non_null(strstr(rl_last_error(), "the scene has"));
+    rl_clear_error();
     assert_int_equal(rl_renderer_render(bad, other, &cam, img, NULL), RL_ERR_INVALID_ARG);
     assert_int_equal(rl_renderer_set(bad, "approx", "/nonexistent/approx.json"), RL_OK);
     assert_int_not_equal(rl_renderer_prepare_inputs(bad, other), RL_OK);
@@ -242,6 +245,15 @@ static void test_visset_draws_a_lookup_of_its_own(void **state)
     rl_position_lookup l = { .user = set, .property = "visibility", .set_size = 3, .num_regions = 1,
                              .query = fixed_query, .region_set = fixed_set, .release = fixed_release };
     assert_int_equal(rl_renderer_set_input(r, "sets", &l, NULL), RL_ERR_INVALID_ARG);   /* unknown slot */
+    /* Sets of another property (a custom one may have any) are not drawn. */
+    rl_position_lookup other = l;
+    other.property = "ops";
+    other.release = NULL;
+    assert_int_equal(rl_renderer_set_input(r, "approx", &other, NULL), RL_OK);
+    rl_clear_error();
+    assert_int_equal(rl_renderer_render(r, s, &cam, img, NULL), RL_ERR_INVALID_ARG);
+    assert_non_null(strstr(rl_last_error(), "'ops', not visibility"));
+    rl_clear_error();
     fixed_released = 0;
     assert_int_equal(rl_renderer_set_input(r, "approx", &l, "mine"), RL_OK);
     assert_string_equal(rl_renderer_input_key(r, "approx"), "mine");

@@ -168,6 +168,18 @@ static void test_texture_pixel_limit_applies_before_decoding(void **state)
     rl_texture_release(tex);
 }
 
+/* Issue 34: a model whose coordinates reach the float limit has no default
+ * lights to give; the error names the file (it named a point light the
+ * user never wrote). */
+static void test_a_model_at_the_float_limit_is_refused_naming_the_file(void **state)
+{
+    (void)state;
+    static const char huge[] = "v -3e38 -3e38 -3e38\nv 3e38 0 0\nv 0 3e38 3e38\nf 1 2 3\n";
+    char path[1200];
+    write_bytes("float_limit.obj", huge, strlen(huge), path, sizeof path);
+    expect_refused(path, RL_ERR_PARSE, path);
+}
+
 static void test_a_device_is_not_read(void **state)
 {
     (void)state;
@@ -283,6 +295,7 @@ int main(void)
         cmocka_unit_test(test_off_indices_out_of_range_are_refused),
         cmocka_unit_test(test_texture_pixel_limit_applies_before_decoding),
         cmocka_unit_test(test_node_hierarchies_assimp_recurses_through_are_refused),
+        cmocka_unit_test(test_a_model_at_the_float_limit_is_refused_naming_the_file),
         cmocka_unit_test(test_a_device_is_not_read),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
