@@ -39,7 +39,7 @@
 /* Uniform locations of one program (-1: not used by it). */
 typedef struct uniforms {
     GLint view_proj, view_z, affine, depth_k, affine_z, eye, ambient, num_lights, mode, object, first_triangle,
-        normal_maps;
+        normal_maps, depth_equal;
 } uniforms;
 
 typedef struct gl_drawer {
@@ -111,6 +111,7 @@ static uniforms locate(GLuint p)
         .mode = glGetUniformLocation(p, "u_mode"), .object = glGetUniformLocation(p, "u_object"),
         .first_triangle = glGetUniformLocation(p, "u_first_triangle"),
         .normal_maps = glGetUniformLocation(p, "u_normal_maps"),
+        .depth_equal = glGetUniformLocation(p, "u_depth_equal"),
     };
 }
 
@@ -561,7 +562,10 @@ static bool box_outside(const gl_drawer *g, rl_aabb box)
 static void begin_triangles(gl_drawer *g)
 {
     const bool lit = !(g->desc.flags & RL_RASTER_NO_COLOR);
-    apply_flags(g->desc.flags);
+    const bool equal = (g->desc.flags & RL_RASTER_DEPTH_EQUAL) && !(g->desc.flags & RL_RASTER_NO_DEPTH_TEST);
+    /* Equal depth is tested on eye depth in the fragment stage (gl_shaders.c). */
+    apply_flags(equal ? (g->desc.flags & ~(unsigned)RL_RASTER_DEPTH_EQUAL) | RL_RASTER_NO_DEPTH_TEST : g->desc.flags);
+    glProgramUniform1i(g->tri_prog, g->tri_u.depth_equal, equal);
     glUseProgram(g->tri_prog);
     glProgramUniform1i(g->tri_prog, g->tri_u.mode, lit ? g->mode : RL_GL_MODE_UNLIT);
     glProgramUniform1i(g->tri_prog, g->tri_u.normal_maps, lit && g->normal_maps);
@@ -655,6 +659,7 @@ static rl_status gl_query(void *impl, const rl_raster_batch *boxes, uint64_t *pi
                 RL_RASTER_NO_DEPTH | RL_RASTER_NO_ID);
     glUseProgram(g->tri_prog);
     glProgramUniform1i(g->tri_prog, g->tri_u.mode, RL_GL_MODE_QUERY);
+    glProgramUniform1i(g->tri_prog, g->tri_u.depth_equal, 0);
     glBindVertexArray(g->stream_vao);
     glBeginQuery(GL_SAMPLES_PASSED, g->query);
     glDrawElements(GL_TRIANGLES, (GLsizei)n, GL_UNSIGNED_INT, NULL);

@@ -27,7 +27,11 @@
  * precision at every distance ("reversed" depth). The eye depth itself is
  * written to a colour attachment for readback. Affine projections, whose
  * w is 1, use (w - z) / 2 instead. The near plane is a clip distance,
- * z >= -w, as the software clips. y is negated so that GL's row 0 is the
+ * z >= -w, as the software clips. RL_RASTER_DEPTH_EQUAL (a later pass
+ * adding to what an earlier frame drew) compares eye depths, the frame's
+ * uploaded one with the fragment's: both are this interpolation's results,
+ * bit for bit, where the window depth made anew from an uploaded eye depth
+ * would not be. y is negated so that GL's row 0 is the
  * image's top row: no flip on readback, and front faces (counter-clockwise
  * in NDC) are clockwise in the window. */
 #include "gl/gl_shaders.h"
@@ -193,6 +197,8 @@ static const char *const triangle_fs = GLSL(
     uniform uint u_object;
     uniform uint u_first_triangle;
     uniform bool u_normal_maps;
+    uniform bool u_depth_equal;
+    layout(binding = 0) uniform sampler2D u_depth_in;
     layout(location = 0) out vec4 o_color;
     layout(location = 1) out float o_depth;
     layout(location = 2) out uint o_object;
@@ -237,6 +243,8 @@ static const char *const triangle_fs = GLSL(
         o_object = u_object;
         o_triangle = tri;
         o_color = v_color;
+        if (u_depth_equal && v_depth != texelFetch(u_depth_in, ivec2(gl_FragCoord.xy), 0).r)
+            discard;
         if (u_mode < 0)
             return;
         Material m = materials[tri_material[tri]];
