@@ -34,3 +34,10 @@ expect_usage_error() {
 }
 # expect_in FILE TEXT: FILE contains TEXT.
 expect_in() { grep -q -- "$2" "$1" || fail "$1 lacks '$2': $(head -c 400 "$1")"; }
+# available_algos: the renderers rl algos lists, less those it marks
+# unavailable on this machine (a GL renderer without a GL context).
+available_algos() {
+    "$RL" algos | awk '/^[a-z0-9+-]+: / { name = $1; sub(":$", "", name); names[++n] = name }
+                       /^  unavailable: / { gone[name] = 1 }
+                       END { for (i = 1; i <= n; i++) if (!(names[i] in gone)) print names[i] }'
+}
