@@ -278,8 +278,12 @@ static rl_status upload_geometry(gl_drawer *g, GLint64 max_block)
     /* The fragment stage reads these as storage buffers (flat shading,
      * normal maps): they must fit one block. */
     const bool fetch = g->mode == RL_GL_MODE_FLAT || g->normal_maps;
-    const uint64_t biggest = ni * sizeof(uint32_t) > nv * sizeof(rl_vec3) ? ni * sizeof(uint32_t) : nv * sizeof(rl_vec3);
-    if (fetch && biggest > (uint64_t)max_block) {
+    uint64_t biggest = (uint64_t)d->num_triangles * sizeof(uint32_t);   /* triangle materials, always */
+    if (fetch && ni * sizeof(uint32_t) > biggest)
+        biggest = ni * sizeof(uint32_t);
+    if (fetch && nv * sizeof(rl_vec3) > biggest)
+        biggest = nv * sizeof(rl_vec3);
+    if (biggest > (uint64_t)max_block) {
         free(object_material);
         return rl_error(RL_ERR_LIMIT, "gl: the scene's arrays (%llu MiB) exceed this GL's shader storage block size "
                         "(%lld MiB)", (unsigned long long)(biggest >> 20), (long long)(max_block >> 20));
@@ -389,6 +393,9 @@ static rl_status ensure_framebuffer(gl_drawer *g, int w, int h)
     if (w > max_size || h > max_h)
         return rl_error(RL_ERR_LIMIT, "gl: a %d x %d target exceeds this GL's framebuffer limit %d x %d", w, h,
                         (int)max_size, (int)max_h);
+    /* Readback sizes are GLsizei: the colour layer must stay below 2 GiB. */
+    if ((uint64_t)w * (uint64_t)h * sizeof(rl_vec4) > INT32_MAX)
+        return rl_error(RL_ERR_LIMIT, "gl: a %d x %d target exceeds 2 GiB of colour", w, h);
     const GLenum formats[] = { GL_RGBA32F, GL_R32F, GL_R32UI, GL_R32UI, GL_R32F };
     GLuint *tex[] = { &g->tex_color, &g->tex_depth, &g->tex_object, &g->tex_triangle, &g->tex_depth_in };
     for (int i = 0; i < 5; ++i) {
