@@ -289,6 +289,12 @@ rl_status rl_gl_context_make_current(rl_gl_context *c)
     return RL_OK;
 }
 
+void rl_gl_context_done(rl_gl_context *c)
+{
+    if (c && eglGetCurrentContext() == c->ctx)
+        eglMakeCurrent(c->dpy, EGL_NO_SURFACE, EGL_NO_SURFACE, EGL_NO_CONTEXT);
+}
+
 const rl_gl_info *rl_gl_context_info(const rl_gl_context *c) { return c->info; }
 
 void rl_gl_context_release(rl_gl_context *c)
@@ -332,6 +338,8 @@ rl_status rl_gl_context_make_current(rl_gl_context *ctx)
     (void)ctx;
     return rl_error(RL_ERR_UNSUPPORTED, "OpenGL unavailable: " NO_GL);
 }
+
+void rl_gl_context_done(rl_gl_context *ctx) { (void)ctx; }
 
 const rl_gl_info *rl_gl_context_info(const rl_gl_context *ctx)
 {

@@ -16,9 +16,13 @@ rl_status rl_gl_context_create(const char *device, rl_gl_context **out);
 /* Makes ctx current on the calling thread (a no-op when it is already);
  * RL_ERR_INTERNAL when another thread holds it. */
 rl_status rl_gl_context_make_current(rl_gl_context *ctx);
+/* Lets ctx go if it is current on the calling thread, so that another
+ * thread may make it current next. */
+void rl_gl_context_done(rl_gl_context *ctx);
 const rl_gl_info *rl_gl_context_info(const rl_gl_context *ctx);
-/* Destroys ctx; it must be current on the calling thread (GL objects are
- * freed with it). NULL is a no-op. */
+/* Destroys ctx and the GL objects made in it (at once where it is current
+ * on the calling thread or on none, else when that thread lets it go).
+ * NULL is a no-op. */
 void rl_gl_context_release(rl_gl_context *ctx);
 
 #endif

@@ -96,9 +96,18 @@ static void gl_release(void *impl)
     if (!g)
         return;
     /* The context's objects go with it; they are not deleted one by one. */
-    if (g->ctx && rl_gl_context_make_current(g->ctx) == RL_OK)
-        rl_gl_context_release(g->ctx);
+    rl_gl_context_release(g->ctx);
     free(g);
+}
+
+/* A call that fails ends the frame: the context is let go, so that the
+ * next frame may come from another thread (a renderer moves between the
+ * threads of an OpenMP pool, e.g. in rl compare). end() lets it go too. */
+static rl_status settle(gl_drawer *g, rl_status st)
+{
+    if (st != RL_OK)
+        rl_gl_context_done(g->ctx);
+    return st;
 }
 
 static uniforms locate(GLuint p)
@@ -482,7 +491,7 @@ static rl_status gl_begin(void *impl, rl_image *target, const rl_mat4 *view, con
     if (st == RL_OK)
         st = ensure_framebuffer(g, target->width, target->height);
     if (st != RL_OK)
-        return st;
+        return settle(g, st);
     g->target = target;
     g->view_proj = rl_mat4_mul(proj, view);
     g->affine = proj->m[3][0] == 0.0f && proj->m[3][1] == 0.0f && proj->m[3][2] == 0.0f && proj->m[3][3] == 1.0f;
@@ -523,7 +532,7 @@ static rl_status gl_begin(void *impl, rl_image *target, const rl_mat4 *view, con
     for (GLuint i = 0; i < 8; ++i)
         if (ssbos[i])
             glBindBufferBase(GL_SHADER_STORAGE_BUFFER, i, ssbos[i]);
-    return gl_check("rl_drawer_begin");
+    return settle(g, gl_check("rl_drawer_begin"));
 }
 
 static void gl_light(void *impl, const uint32_t *objects, uint32_t count)
@@ -615,14 +624,15 @@ static rl_status gl_draw(void *impl, const uint32_t *objects, uint32_t count, rl
     gl_drawer *g = impl;
     rl_status st = rl_gl_context_make_current(g->ctx);
     if (st != RL_OK)
-        return st;
+        return settle(g, st);
     for (uint32_t i = 0; i < count; ++i)
         if (objects[i] >= g->data->num_objects)
-            return rl_error(RL_ERR_INVALID_ARG, "rl_drawer_draw: object %u of %u", objects[i], g->data->num_objects);
+            return settle(g, rl_error(RL_ERR_INVALID_ARG, "rl_drawer_draw: object %u of %u", objects[i],
+                                      g->data->num_objects));
     begin_triangles(g);
     for (uint32_t i = 0; i < count; ++i)
         draw_object(g, objects[i], c);
-    return end_counted(g, c, "rl_drawer_draw");
+    return settle(g, end_counted(g, c, "rl_drawer_draw"));
 }
 
 static rl_status gl_draw_all(void *impl, rl_raster_counters *c, rl_progress_fn progress, void *user)
@@ -630,7 +640,7 @@ static rl_status gl_draw_all(void *impl, rl_raster_counters *c, rl_progress_fn p
     gl_drawer *g = impl;
     rl_status st = rl_gl_context_make_current(g->ctx);
     if (st != RL_OK)
-        return st;
+        return settle(g, st);
     const uint32_t total = g->data->num_objects, step = total / 100 + 1;
     begin_triangles(g);
     for (uint32_t o = 0; o < total && st == RL_OK; ++o) {
@@ -639,7 +649,7 @@ static rl_status gl_draw_all(void *impl, rl_raster_counters *c, rl_progress_fn p
             st = rl_error(RL_ERR_CANCELLED, "gl: cancelled by the progress callback");
     }
     rl_status end = end_counted(g, c, "rl_drawer_draw_all");
-    return st != RL_OK ? st : end;
+    return settle(g, st != RL_OK ? st : end);
 }
 
 static rl_status gl_query(void *impl, const rl_raster_batch *boxes, uint64_t *pixels)
@@ -648,16 +658,16 @@ static rl_status gl_query(void *impl, const rl_raster_batch *boxes, uint64_t *pi
     *pixels = 0;
     rl_status st = rl_gl_context_make_current(g->ctx);
     if (st != RL_OK || boxes->num_triangles == 0)
-        return st;
+        return settle(g, st);
     if (!boxes->positions || !boxes->indices)
-        return rl_error(RL_ERR_INVALID_ARG, "rl_drawer_query: %u triangles without positions or indices",
-                        boxes->num_triangles);
+        return settle(g, rl_error(RL_ERR_INVALID_ARG, "rl_drawer_query: %u triangles without positions or indices",
+                                  boxes->num_triangles));
     /* An index out of range would read outside the stream on the GPU. */
     const size_t n = 3 * (size_t)boxes->num_triangles;
     for (size_t i = 0; i < n; ++i)
         if (boxes->indices[i] >= boxes->num_vertices)
-            return rl_error(RL_ERR_INVALID_ARG, "rl_drawer_query: index %u of %u vertices", boxes->indices[i],
-                            boxes->num_vertices);
+            return settle(g, rl_error(RL_ERR_INVALID_ARG, "rl_drawer_query: index %u of %u vertices",
+                                      boxes->indices[i], boxes->num_vertices));
     glNamedBufferData(g->stream_pos, (GLsizeiptr)(sizeof(rl_vec3) * boxes->num_vertices), boxes->positions,
                       GL_STREAM_DRAW);
     glNamedBufferData(g->stream_idx, (GLsizeiptr)(sizeof(uint32_t) * n), boxes->indices, GL_STREAM_DRAW);
@@ -674,7 +684,7 @@ static rl_status gl_query(void *impl, const rl_raster_batch *boxes, uint64_t *pi
     GLuint64 passed = 0;
     glGetQueryObjectui64v(g->query, GL_QUERY_RESULT, &passed);
     *pixels = passed;
-    return gl_check("rl_drawer_query");
+    return settle(g, gl_check("rl_drawer_query"));
 }
 
 /* One point attribute: a stream of count items, or the constant value
@@ -694,9 +704,10 @@ static rl_status gl_draw_points(void *impl, const rl_raster_points *pts, rl_rast
     gl_drawer *g = impl;
     rl_status st = rl_gl_context_make_current(g->ctx);
     if (st != RL_OK || pts->count == 0)
-        return st;
+        return settle(g, st);
     if (!pts->positions)
-        return rl_error(RL_ERR_INVALID_ARG, "rl_drawer_draw_points: %u points without positions", pts->count);
+        return settle(g, rl_error(RL_ERR_INVALID_ARG, "rl_drawer_draw_points: %u points without positions",
+                                  pts->count));
     glBindVertexArray(g->point_vao);
     point_attribute(g, 0, g->point_pos, pts->positions, sizeof(rl_vec3), pts->count);
     point_attribute(g, 1, g->point_color, pts->colors, sizeof(rl_vec4), pts->count);
@@ -720,7 +731,7 @@ static rl_status gl_draw_points(void *impl, const rl_raster_points *pts, rl_rast
             c->points_drawn += p.w > 0.0f && p.z >= -p.w;
         }
     }
-    return end_counted(g, c, "rl_drawer_draw_points");
+    return settle(g, end_counted(g, c, "rl_drawer_draw_points"));
 }
 
 static rl_status gl_end(void *impl)
@@ -728,7 +739,7 @@ static rl_status gl_end(void *impl)
     gl_drawer *g = impl;
     rl_status st = rl_gl_context_make_current(g->ctx);
     if (st != RL_OK)
-        return st;
+        return settle(g, st);
     rl_image *t = g->target;
     const size_t n = (size_t)t->width * (size_t)t->height;
     if ((t->layers & RL_LAYER_COLOR) && t->color)
@@ -741,7 +752,9 @@ static rl_status gl_end(void *impl)
         glGetTextureImage(g->tex_triangle, 0, GL_RED_INTEGER, GL_UNSIGNED_INT, (GLsizei)(n * sizeof(uint32_t)),
                           t->triangle_id);
     g->target = NULL;
-    return gl_check("rl_drawer_end");
+    st = gl_check("rl_drawer_end");
+    rl_gl_context_done(g->ctx);
+    return st;
 }
 
 static const rl_drawer_ops gl_ops = {
@@ -806,6 +819,8 @@ rl_status rl_gl_drawer_create(const rl_scene *scene, const rl_drawer_desc *desc,
         gl_release(g);
         return st;
     }
+    /* The first frame may come from another thread. */
+    rl_gl_context_done(g->ctx);
     return rl_drawer_make(&gl_ops, g, scene, desc, out);
 }
 

@@ -6,6 +6,7 @@
  * with a reason, not a crash. Runs on llvmpipe (Mesa's surfaceless EGL);
  * where no GL 4.5 context can be made the GL cases say so and skip. */
 #include <math.h>
+#include <pthread.h>
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
@@ -300,6 +301,52 @@ static void test_gl_drawer_queries_and_points(void **state)
     rl_scene_release(s);
 }
 
+/* What a worker thread renders: one frame of r (the renderer's drawer and
+ * context made on whichever thread renders first). */
+typedef struct frame_job {
+    rl_renderer *r;
+    const rl_scene *s;
+    const rl_camera *cam;
+    rl_image *img;
+    rl_status st;
+} frame_job;
+
+static void *render_job(void *arg)
+{
+    frame_job *j = arg;
+    j->st = rl_renderer_render(j->r, j->s, j->cam, j->img, NULL);
+    return NULL;
+}
+
+/* A renderer moves between threads (rl compare evaluates positions on an
+ * OpenMP pool and releases its renderers on the main thread): every frame
+ * on another thread works, and releasing on a third frees the context
+ * (LSan in the sanitizer build sees a leak otherwise). */
+static void test_gl_renderer_moves_between_threads(void **state)
+{
+    (void)state;
+    NEED_GL();
+    rl_camera cam;
+    rl_scene *s = fx_cornell(&cam, 32);
+    rl_renderer *r = fx_make("gl-raster", NULL);
+    rl_image *ref = fx_render_with(r, s, &cam, FX_ALL_LAYERS, NULL);
+    for (int k = 0; k < 2; ++k) {
+        frame_job job = { r, s, &cam, NULL, RL_ERR_INTERNAL };
+        assert_int_equal(rl_image_create(32, 32, FX_ALL_LAYERS, &job.img), RL_OK);
+        pthread_t t;
+        assert_int_equal(pthread_create(&t, NULL, render_job, &job), 0);
+        assert_int_equal(pthread_join(t, NULL), 0);
+        if (job.st != RL_OK)
+            print_error("frame on thread %d: %s\n", k, rl_last_error());
+        assert_int_equal(job.st, RL_OK);
+        fx_assert_images_identical(job.img, ref);
+        rl_image_release(job.img);
+    }
+    rl_renderer_release(r);
+    rl_image_release(ref);
+    rl_scene_release(s);
+}
+
 /* A device that cannot be opened: unavailable with a reason, both from the
  * platform and from the renderer; rendering fails cleanly. Needs no GL. */
 static void test_gl_unopenable_device_is_reported_unavailable(void **state)
@@ -341,6 +388,7 @@ int main(void)
         cmocka_unit_test(test_gl_raster_matches_raster_on_every_builtin_scene),
         cmocka_unit_test(test_gl_drawer_honours_the_draw_flags),
         cmocka_unit_test(test_gl_drawer_queries_and_points),
+        cmocka_unit_test(test_gl_renderer_moves_between_threads),
         cmocka_unit_test(test_gl_unopenable_device_is_reported_unavailable),
     };
     return cmocka_run_group_tests(tests, find_gl, NULL);
