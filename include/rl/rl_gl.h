@@ -47,8 +47,9 @@ RL_API bool rl_gl_available(const char *device, char *why, size_t n);
 RL_API rl_status rl_gl_info_get(const char *device, rl_gl_info *out);
 
 /* A drawer of scene (committed) with OpenGL on device: rl_drawer_backend()
- * is "gl". It owns its own context, made current on the calling thread by
- * each call (a drawer is used by one thread at a time). Its images match
+ * is "gl". It owns its own context, current on the calling thread from
+ * rl_drawer_begin to rl_drawer_end (a frame stays on one thread; the next
+ * may come from another, and release may happen on any). Its images match
  * the software drawer's (same lighting, depth and IDs) up to the
  * deviations of docs/gl.md. Also RL_ERR_LIMIT where the scene's textures or
  * arrays exceed the GL's buffer size limit, RL_ERR_INTERNAL for a GL error. */
