@@ -664,6 +664,8 @@ static rl_status gl_query(void *impl, const rl_raster_batch *boxes, uint64_t *pi
                                   boxes->num_triangles));
     /* An index out of range would read outside the stream on the GPU. */
     const size_t n = 3 * (size_t)boxes->num_triangles;
+    if (n > INT32_MAX)
+        return settle(g, rl_error(RL_ERR_LIMIT, "rl_drawer_query: %u triangles in one batch", boxes->num_triangles));
     for (size_t i = 0; i < n; ++i)
         if (boxes->indices[i] >= boxes->num_vertices)
             return settle(g, rl_error(RL_ERR_INVALID_ARG, "rl_drawer_query: index %u of %u vertices",
