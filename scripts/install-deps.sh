@@ -11,6 +11,8 @@ PACKAGES=(
   libcjson-dev        # scene and result files
   libassimp-dev       # OBJ, PLY, STL, glTF, DAE, 3DS, FBX import
   libembree-dev       # Embree 3: reference accelerator and benchmark anchor
+  libepoxy-dev libegl-dev            # OpenGL 4.5 backend (src/gl): GL loader, EGL headers
+  libegl-mesa0 libgl1-mesa-dri       # headless EGL + llvmpipe, so the GL tests run without a GPU
   libcmocka-dev       # unit tests
   libcairo2-dev       # plots in evaluation reports (SVG, PNG)
   fonts-dejavu-core   # a font for plot labels

@@ -114,6 +114,8 @@ cJSON *cli_render_stats_json(const rl_render_stats *stats, double inputs_ms)
     add_count(obj, "occlusion_queries", stats->occlusion_queries);
     add_count(obj, "pixels_written", stats->pixels_written);
     add_count(obj, "samples", stats->samples);
+    if (stats->device)
+        cJSON_AddStringToObject(obj, "device", stats->device);
     return obj;
 }
 

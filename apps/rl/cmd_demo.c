@@ -80,6 +80,21 @@ static void free_args(demo_args *a)
     a->count = 0;
 }
 
+/* Whether renderer name can render here; a GL renderer without a GL
+ * context is left out of the demo with one warning, not a failure. */
+static bool available(const char *name, bool warn)
+{
+    rl_renderer *r = NULL;
+    if (rl_renderer_create(name, &r) != RL_OK)
+        return true;   /* render_one reports it */
+    char why[256];
+    bool ok = rl_renderer_available(r, why, sizeof why);
+    rl_renderer_release(r);
+    if (!ok && warn)
+        fprintf(stderr, "rl: warning: demo: %s left out: unavailable: %s\n", name, why);
+    return ok;
+}
+
 /* True when name is an item of the comma-separated list (NULL = all). */
 static bool in_list(const char *list, const char *name)
 {
@@ -559,6 +574,14 @@ static int run_demo(const demo_args *a, cJSON *report)
         free(entries);
         return cli_fail(RL_CLI_FAIL, "out of memory");
     }
+    bool *usable = calloc(nr ? nr : 1, sizeof *usable);
+    if (!usable) {
+        free(row);
+        free(entries);
+        return cli_fail(RL_CLI_FAIL, "out of memory");
+    }
+    for (size_t k = 0; k < nr; k++)
+        usable[k] = in_list(a->algos, algos[k].name) && available(algos[k].name, true);
     int rc = RL_CLI_OK;
     cJSON *listed = cJSON_AddArrayToObject(report, "scenes");
     for (size_t s = 0; s < a->count; s++) {
@@ -595,7 +618,7 @@ static int run_demo(const demo_args *a, cJSON *report)
         }
         rl_image *ref = NULL;
         for (size_t k = 0; k < nr; k++) {
-            if (!in_list(a->algos, algos[k].name))
+            if (!usable[k])
                 continue;
             rl_image *now = NULL;
             if (!render_one(a, name, scene, &cam, algos[k].name, images, &now, &entries[k])) {
@@ -629,6 +652,7 @@ static int run_demo(const demo_args *a, cJSON *report)
     }
     free(row);
     free(entries);
+    free(usable);
     return rc;
 }
 
@@ -642,7 +666,7 @@ static int run_compare(const demo_args *a)
     size_t nr = 0;
     const rl_renderer_info *info = rl_renderer_list(&nr);
     for (size_t k = 0; k < nr; k++)
-        if (in_list(a->algos, info[k].name)) {
+        if (in_list(a->algos, info[k].name) && available(info[k].name, false)) {
             size_t len = strlen(algos);
             snprintf(algos + len, sizeof algos - len, "%s%s", len ? "," : "", info[k].name);
         }

@@ -78,6 +78,9 @@ int cli_algos(int argc, char **argv)
         rl_clear_error();
         if (rl_renderer_create(list[i].name, &r) != RL_OK)
             return cli_fail_status(RL_CLI_FAIL, rl_last_status(), list[i].name);
+        char why[256];
+        if (!rl_renderer_available(r, why, sizeof why))
+            printf("  unavailable: %s\n", why);
         size_t num_options = 0;
         const rl_option_info *options = rl_renderer_options(r, &num_options);
         printf("  options:%s\n", num_options ? "" : " none");

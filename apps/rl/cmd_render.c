@@ -560,6 +560,8 @@ static void add_stats(rl_render_stats *sum, const rl_render_stats *s)
     sum->samples += s->samples;
     sum->occlusion_queries += s->occlusion_queries;
     sum->points_drawn += s->points_drawn;
+    if (s->device)
+        sum->device = s->device;
 }
 
 /* One frame, or the progressive loop: frames until the budget would be

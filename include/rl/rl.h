@@ -13,6 +13,7 @@
 #include "rl/rl_scene.h"
 #include "rl/rl_raster.h"
 #include "rl/rl_drawer.h"
+#include "rl/rl_gl.h"
 #include "rl/rl_render.h"
 #include "rl/rl_accel.h"
 #include "rl/rl_linespace.h"

@@ -1,8 +1,9 @@
 /* rl_drawer.h: drawing a committed scene, for the renderers that rasterize
  * it object by object. One interface with one implementation per backend:
- * the software rasterizer's scene drawer today (src/raster), the OpenGL one
- * to come (src/gl) beside it. The culling and level-of-detail renderers
- * (chcpp, svs, visset, surfels, select through them) and the visibility
+ * the software rasterizer's scene drawer (src/raster, rl_drawer_create) and
+ * the OpenGL one (src/gl, rl_gl_drawer_create in rl_gl.h). The culling and
+ * level-of-detail renderers (chcpp, svs, visset, surfels, select through
+ * them) and the visibility
  * property of Jähn 2015 draw, query and read back only through this header,
  * so that a second backend changes none of them.
  *
@@ -66,7 +67,7 @@ RL_API void rl_drawer_release(rl_drawer *dr);        /* NULL is a no-op */
 /* Whether dr was made for this scene (rl_scene_uid) and desc: a renderer
  * keeps its drawer while it fits and makes a new one otherwise. */
 RL_API bool rl_drawer_fits(const rl_drawer *dr, const rl_scene *scene, const rl_drawer_desc *desc);
-/* The backend's name ("software"). */
+/* The backend's name ("software", "gl"). */
 RL_API const char *rl_drawer_backend(const rl_drawer *dr);
 
 /* Starts a frame into target (which must have a depth layer; it is not

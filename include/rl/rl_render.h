@@ -52,6 +52,10 @@ typedef struct rl_render_stats {
     uint64_t samples;                     /* shading samples (e.g. spp * pixels) */
     uint64_t occlusion_queries;           /* rasterizer occlusion queries issued */
     uint64_t points_drawn;                /* point primitives rasterized (surfels) */
+    /* The GPU that drew the frame (GL renderers: "vendor | renderer |
+     * version" of their context), NULL for the CPU renderers; owned by
+     * the renderer, valid until it renders again or is released. */
+    const char *device;
 } rl_render_stats;
 
 
@@ -88,6 +92,11 @@ RL_API double rl_renderer_frame_bytes(const rl_renderer *r, int width, int heigh
 RL_API rl_status rl_renderer_create(const char *name, rl_renderer **out);
 RL_API void rl_renderer_release(rl_renderer *r);
 RL_API const char *rl_renderer_name(const rl_renderer *r);
+/* Whether r can render on this machine and build: false (with the reason
+ * in why, cut to n bytes; why may be NULL) for a GL renderer where no GL
+ * 4.5 context can be made on its device. rl_renderer_render() of an
+ * unavailable renderer fails with RL_ERR_UNSUPPORTED and that reason. */
+RL_API bool rl_renderer_available(const rl_renderer *r, char *why, size_t n);
 RL_API const rl_option_info *rl_renderer_options(const rl_renderer *r, size_t *count);
 /* Validates and stores one option. key may carry the renderer's name as a
  * prefix ("raster.shading"). */

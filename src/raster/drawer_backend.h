@@ -2,7 +2,7 @@
  * backend provides one rl_drawer_ops table and makes its drawers with
  * rl_drawer_make; rl_drawer.c dispatches every call through the table. The
  * software backend is drawer.c's own (the rasterizer and the scene drawer
- * of scene_drawer.c); the OpenGL one is to come from src/gl. */
+ * of scene_drawer.c); the OpenGL one is src/gl/gl_drawer.c. */
 #ifndef RL_RASTER_DRAWER_BACKEND_H
 #define RL_RASTER_DRAWER_BACKEND_H
 

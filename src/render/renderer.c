@@ -273,6 +273,15 @@ rl_vec3 rl_renderer_opt_color(const rl_renderer *r, const char *key)
     return rl_option_store_color(&r->options, key);
 }
 
+bool rl_renderer_available(const rl_renderer *r, char *why, size_t n)
+{
+    if (why && n)
+        why[0] = '\0';
+    if (!r)
+        return false;
+    return !r->cls->available || r->cls->available(r, why, n);
+}
+
 rl_status rl_renderer_render(rl_renderer *r, const rl_scene *scene, const rl_camera *cam,
                              rl_image *image, rl_render_stats *stats)
 {
@@ -291,6 +300,10 @@ rl_status rl_renderer_render(rl_renderer *r, const rl_scene *scene, const rl_cam
     if (image->width != resolved.width || image->height != resolved.height)
         return rl_error(RL_ERR_INVALID_ARG, "%s: image is %dx%d but the camera renders %dx%d",
                         name, image->width, image->height, resolved.width, resolved.height);
+
+    char why[256];
+    if (!rl_renderer_available(r, why, sizeof why))
+        return rl_error(RL_ERR_UNSUPPORTED, "%s: unavailable: %s", name, why);
 
     rl_render_stats local;
     memset(&local, 0, sizeof local);

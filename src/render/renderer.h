@@ -30,6 +30,9 @@ typedef struct rl_renderer_class {
     /* Optional: forget frame-to-frame state, keep per-scene preprocessing
      * (rl_renderer_reset); NULL: the renderer keeps none. */
     void (*reset)(void *state);
+    /* Optional: whether r can render here (rl_renderer_available), the
+     * reason into why (n bytes) if not; NULL: always. */
+    bool (*available)(const rl_renderer *r, char *why, size_t n);
     /* Optional lookup inputs (rl_renderer_set_input), by slot name. */
     const char *const *inputs;
     size_t num_inputs;

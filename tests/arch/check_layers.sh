@@ -28,6 +28,7 @@ declare -A header=(
   [rl_camera.h]=scene [rl_scene.h]=scene [rl_octree.h]=scene
   [rl_accel.h]=accel [rl_linespace.h]=accel
   [rl_raster.h]=raster [rl_drawer.h]=raster [rl_shadowmap.h]=raster
+  [rl_gl.h]=gl
   [rl_render.h]=render [rl_trace.h]=render [rl_gbuffer.h]=render [rl_filter.h]=render [rl_pt.h]=render
   [rl_vt.h]=render [rl_culling.h]=render [rl_surfels.h]=render
   [rl_property.h]=eval [rl_sampling.h]=eval [rl_metrics.h]=eval [rl_stats.h]=eval [rl_plot.h]=eval

@@ -52,3 +52,11 @@ expect_bounded_error() {
     expect_error "$code" "$text" bounded "$@"
     [ "$(tail -n1 "$TMP/rss")" -lt 524288 ] || fail "'$*' peaked at $(tail -n1 "$TMP/rss") KiB"
 }
+
+# available_algos: the renderers rl algos lists, less those it marks
+# unavailable on this machine (a GL renderer without a GL context).
+available_algos() {
+    "$RL" algos | awk '/^[a-z0-9+-]+: / { name = $1; sub(":$", "", name); names[++n] = name }
+                       /^  unavailable: / { gone[name] = 1 }
+                       END { for (i = 1; i <= n; i++) if (!(names[i] in gone)) print names[i] }'
+}

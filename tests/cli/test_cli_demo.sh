@@ -14,7 +14,7 @@ SCENES="cornell,cornell-teapot,spheres"
 [ -s "$DIR/index.html" ] || fail "index.html missing"
 [ -s "$DIR/report.json" ] || fail "report.json missing"
 
-algos=$("$RL" algos | grep -E '^[a-z+]+: ' | cut -d: -f1)
+algos=$(available_algos)
 [ -n "$algos" ] || fail "rl algos listed no renderer"
 n=0
 for s in ${SCENES//,/ }; do

@@ -30,7 +30,7 @@ cp "$TMP/box.obj" "$TMP/b/box.obj"
 # --- rl demo on model files: every renderer, the page, the marks ---
 DIR="$TMP/demo"
 run_ok "$RL" demo --out "$DIR" --size 64x48 --scenes "$TMP/box.obj:lights=add,cameras=off,$TMP/b/box.obj"
-algos=$("$RL" algos | grep -E '^[a-z+]+: ' | cut -d: -f1)
+algos=$(available_algos)
 for s in box box-2; do
     for a in $algos; do
         f="$DIR/$s-$a.png"

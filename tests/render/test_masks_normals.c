@@ -12,6 +12,7 @@
 
 #include "render_fixtures.h"
 #include "rl/rl_accel.h"
+#include "rl/rl_gl.h"
 #include "rl/rl_linespace.h"
 #include "rl/rl_raster.h"
 #include "rl/rl_shadowmap.h"
@@ -98,11 +99,17 @@ static void test_rasterizers_see_the_holes_the_ray_tracer_sees(void **state)
         { "raster", NULL }, { "raster", raster_flat }, { "raster", raster_gouraud },
         { "pt", pt_raster }, { "pt", pt_trace }, { "vt", NULL }, { "chcpp", NULL }, { "svs", NULL },
     };
-    for (size_t i = 0; i < sizeof cases / sizeof cases[0]; ++i) {
-        rl_image *img = fx_render(cases[i].name, s, &cam, FX_ALL_LAYERS, cases[i].opts, NULL);
+    /* The GL drawer drops the same fragments, where a GL context exists. */
+    const bool gl = rl_gl_available(NULL, NULL, 0);
+    const char *const *gl_opts[] = { NULL, raster_flat, raster_gouraud };
+    const size_t n = sizeof cases / sizeof cases[0];
+    for (size_t i = 0; i < n + (gl ? 3 : 0); ++i) {
+        const char *name = i < n ? cases[i].name : "gl-raster";
+        const char *const *opts = i < n ? cases[i].opts : gl_opts[i - n];
+        rl_image *img = fx_render(name, s, &cam, FX_ALL_LAYERS, opts, NULL);
         int diff = id_mismatches(img, ref);
         if (diff > SIZE)   /* the mask's edge: one column at most */
-            print_error("%s (case %zu): %d pixels differ from whitted\n", cases[i].name, i, diff);
+            print_error("%s (case %zu): %d pixels differ from whitted\n", name, i, diff);
         assert_true(diff <= SIZE);
         rl_image_release(img);
     }
@@ -264,26 +271,33 @@ static void test_raster_shades_normal_maps_per_pixel(void **state)
     (void)state;
     static const char *const gouraud[] = { "shading", "gouraud", NULL };
     const char *const *raster_opts[] = { NULL, gouraud };
-    double ref[2], ras[2][2];
+    /* gl-raster bends the normals in its fragment stage: the same test,
+     * where a GL context exists. */
+    const int backends = rl_gl_available(NULL, NULL, 0) ? 2 : 1;
+    const char *const names[] = { "raster", "gl-raster" };
+    double ref[2], ras[2][2][2];
     for (int mapped = 0; mapped < 2; ++mapped) {
         rl_camera cam;
         rl_scene *s = bent_scene(mapped, &cam);
         rl_image *img = fx_render("whitted", s, &cam, FX_ALL_LAYERS, NULL, NULL);
         ref[mapped] = mean_red(img);
         rl_image_release(img);
-        for (int k = 0; k < 2; ++k) {
-            img = fx_render("raster", s, &cam, FX_ALL_LAYERS, raster_opts[k], NULL);
-            ras[k][mapped] = mean_red(img);
-            rl_image_release(img);
-        }
+        for (int b = 0; b < backends; ++b)
+            for (int k = 0; k < 2; ++k) {
+                img = fx_render(names[b], s, &cam, FX_ALL_LAYERS, raster_opts[k], NULL);
+                ras[b][k][mapped] = mean_red(img);
+                rl_image_release(img);
+            }
         rl_scene_release(s);
     }
-    print_message("mean red, plain and mapped: whitted %.4f %.4f, raster %.4f %.4f, gouraud %.4f %.4f\n",
-                  ref[0], ref[1], ras[0][0], ras[0][1], ras[1][0], ras[1][1]);
     assert_true(ref[1] > 2.0 * ref[0]);
-    for (int k = 0; k < 2; ++k) {
-        assert_true(fabs(ras[k][1] / ref[1] - 1.0) < 0.02);
-        assert_true(fabs(ras[k][0] / ref[0] - 1.0) < 0.15);
+    for (int b = 0; b < backends; ++b) {
+        print_message("mean red, plain and mapped: whitted %.4f %.4f, %s %.4f %.4f, gouraud %.4f %.4f\n", ref[0],
+                      ref[1], names[b], ras[b][0][0], ras[b][0][1], ras[b][1][0], ras[b][1][1]);
+        for (int k = 0; k < 2; ++k) {
+            assert_true(fabs(ras[b][k][1] / ref[1] - 1.0) < 0.02);
+            assert_true(fabs(ras[b][k][0] / ref[0] - 1.0) < 0.15);
+        }
     }
 }
 

@@ -1,0 +1,56 @@
+/* gl_shaders.h: the GLSL 4.50 programs of the GL drawer (gl_shaders.c) and
+ * the layout of the buffers they read, shared with gl_drawer.c. */
+#ifndef RL_GL_SHADERS_H
+#define RL_GL_SHADERS_H
+
+#include <epoxy/gl.h>
+
+#include "rl/rl_common.h"
+
+/* Shader storage bindings. */
+enum {
+    RL_GL_SSBO_MATERIALS = 0,
+    RL_GL_SSBO_LIGHTS,
+    RL_GL_SSBO_TEX_INFO,
+    RL_GL_SSBO_TEXELS,
+    RL_GL_SSBO_TRI_MATERIAL,
+    RL_GL_SSBO_INDICES,
+    RL_GL_SSBO_POSITIONS,
+    RL_GL_SSBO_UVS,
+};
+
+/* Light kinds as the shaders number them. */
+enum { RL_GL_LIGHT_POINT = 0, RL_GL_LIGHT_SPOT, RL_GL_LIGHT_DIRECTIONAL, RL_GL_LIGHT_QUAD };
+
+/* What u_mode selects in the triangle program. */
+enum { RL_GL_MODE_QUERY = -1, RL_GL_MODE_UNLIT, RL_GL_MODE_FLAT, RL_GL_MODE_GOURAUD, RL_GL_MODE_TEXTURED };
+
+/* std430 records: every member a vec4 or uvec4, so C and GLSL agree on
+ * the layout without padding rules. */
+typedef struct rl_gl_material {
+    float diffuse[4];
+    float specular[4];            /* w: shininess */
+    float emission[4];            /* w: normal_scale */
+    uint32_t tex[4];              /* diffuse, normal, mask texture (RL_NONE: none), cutoff's bits */
+} rl_gl_material;
+
+typedef struct rl_gl_light {
+    float pos[4];                 /* point/spot position or quad centre; w: kind */
+    float power[4];               /* colour * intensity; w: quad area */
+    float dir[4];                 /* spot axis, directional l, quad normal (unit); w: cos outer */
+    float extra[4];               /* x: cos inner; y: 1 where a directional light is valid */
+} rl_gl_light;
+
+typedef struct rl_gl_tex_info {
+    uint32_t offset;              /* first texel in the texel buffer */
+    int32_t width, height, pad;
+} rl_gl_tex_info;
+
+/* The three programs: triangles (every shading mode, queries), points
+ * (surfels) and the depth upload at a frame's begin. Zero on failure, with
+ * the compiler's log in the recorded error. */
+GLuint rl_gl_program_triangles(void);
+GLuint rl_gl_program_points(void);
+GLuint rl_gl_program_depth_upload(void);
+
+#endif
