@@ -18,6 +18,7 @@ PACKAGES=(
   fonts-dejavu-core   # a font for plot labels
   assimp-testmodels   # real meshes for rl bench rays
   python3             # the JSON checks of the CLI tests
+  time                # /usr/bin/time: peak memory of the hostile-input tests
   clang libclang-rt-dev libomp-dev   # the libFuzzer harnesses (tests/fuzz)
 )
 
