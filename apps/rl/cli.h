@@ -140,8 +140,10 @@ int cli_load_scene_with(const char *arg, const cli_model_flags *flags, rl_scene 
 struct cJSON;
 struct cJSON *cli_scene_stats_json(const rl_scene *scene);
 struct cJSON *cli_render_stats_json(const rl_render_stats *stats, double inputs_ms);
-/* Serialises item (indented) to path; prints the error itself. */
+/* Serialises item (indented) to path, atomically (rl_output.h); prints the
+ * error itself. The _status form prints nothing and returns the status. */
 bool cli_write_json(const struct cJSON *item, const char *path);
+rl_status cli_write_json_status(const struct cJSON *item, const char *path);
 
 /* demo_html.c: DIR/index.html from the demo's report.json object (images
  * referenced by their file names next to it); prints the error itself. */

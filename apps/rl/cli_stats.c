@@ -119,15 +119,12 @@ cJSON *cli_render_stats_json(const rl_render_stats *stats, double inputs_ms)
     return obj;
 }
 
-bool cli_write_json(const cJSON *item, const char *path)
+rl_status cli_write_json_status(const cJSON *item, const char *path)
 {
     char *text = cJSON_Print(item);
-    if (!text) {
-        cli_fail(RL_CLI_FAIL, "%s: out of memory while formatting JSON", path);
-        return false;
-    }
+    if (!text)
+        return RL_ERR_OUT_OF_MEMORY;
     rl_output *o = NULL;
-    rl_clear_error();
     rl_status st = rl_output_open(path, &o);
     if (st == RL_OK) {
         fputs(text, rl_output_file(o));
@@ -135,6 +132,13 @@ bool cli_write_json(const cJSON *item, const char *path)
         st = rl_output_commit(o);
     }
     free(text);
+    return st;
+}
+
+bool cli_write_json(const cJSON *item, const char *path)
+{
+    rl_clear_error();
+    rl_status st = cli_write_json_status(item, path);
     if (st != RL_OK)
         cli_fail_status(RL_CLI_FAIL, st, path);
     return st == RL_OK;

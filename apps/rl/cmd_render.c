@@ -425,18 +425,8 @@ static rl_status write_stats_json(const render_args *a, const rl_scene *scene, c
     cJSON *scene_stats = cli_scene_stats_json(scene);
     if (scene_stats)
         cJSON_AddItemToObject(obj, "scene_stats", scene_stats);
-    char *text = cJSON_Print(obj);
+    rl_status st = cli_write_json_status(obj, path);
     cJSON_Delete(obj);
-    if (!text)
-        return RL_ERR_OUT_OF_MEMORY;
-    rl_output *o = NULL;
-    rl_status st = rl_output_open(path, &o);
-    if (st == RL_OK) {
-        fputs(text, rl_output_file(o));
-        fputc('\n', rl_output_file(o));
-        st = rl_output_commit(o);
-    }
-    free(text);
     return st;
 }
 

@@ -272,11 +272,7 @@ static rl_status upload_geometry(gl_drawer *g, GLint64 max_block)
     uint64_t corners = 0;
     for (uint32_t o = 0; o < d->num_objects; ++o) {
         const rl_object *obj = &d->objects[o];
-        uint32_t m = obj->num_triangles ? d->triangle_material[obj->first_triangle] : RL_NONE;
-        for (uint32_t t = 1; t < obj->num_triangles && m != RL_NONE; ++t)
-            if (d->triangle_material[obj->first_triangle + t] != m)
-                m = RL_NONE;
-        object_material[o] = m;
+        object_material[o] = rl_object_material(d, o);
         corners += by_corners(g, object_material, o) ? 3ull * obj->num_triangles : 0;
     }
     const uint64_t nv = (uint64_t)d->num_vertices + corners, ni = 3ull * d->num_triangles;

@@ -215,10 +215,7 @@ static rl_status prepare(const rl_scene_data *d, rl_raster_shading shading, bool
         return RL_ERR_OUT_OF_MEMORY;
     for (uint32_t o = 0; o < d->num_objects; ++o) {
         const rl_object *obj = &d->objects[o];
-        uint32_t m = obj->num_triangles ? d->triangle_material[obj->first_triangle] : RL_NONE;
-        for (uint32_t t = 1; t < obj->num_triangles && m != RL_NONE; ++t)
-            if (d->triangle_material[obj->first_triangle + t] != m)
-                m = RL_NONE;
+        uint32_t m = rl_object_material(d, o);
         b->object_material[o] = m;
         any_mixed |= obj->num_triangles > 0 && m == RL_NONE && selected(mask, o);
     }

@@ -20,6 +20,7 @@
 #include <string.h>
 
 #include "core/error.h"
+#include "render/culling.h"
 #include "render/renderer.h"
 #include "rl/rl_drawer.h"
 #include "rl/rl_gl.h"
@@ -75,21 +76,13 @@ static rl_status gl_raster_render(rl_renderer *r, void *state, const rl_scene *s
         .flags = rl_renderer_opt_bool(r, "cull") ? RL_RASTER_CULL_BACK : 0u,
     };
 
-    /* The drawer needs a depth layer; borrow one as raster does. */
-    rl_image target = *image;
-    const size_t num_pixels = (size_t)image->width * (size_t)image->height;
-    float *own_depth = NULL;
-    if (!(target.layers & RL_LAYER_DEPTH) || !target.depth) {
-        own_depth = rl_calloc(num_pixels, sizeof *own_depth);
-        if (!own_depth)
-            return RL_ERR_OUT_OF_MEMORY;
-        target.depth = own_depth;
-        target.layers |= RL_LAYER_DEPTH;
-    }
-    if (!(target.layers & RL_LAYER_ID) || !target.object_id || !target.triangle_id)
-        desc.flags |= RL_RASTER_NO_ID;
-
-    rl_status st = RL_OK;
+    /* The drawer needs a depth layer; borrowed as raster does, and the
+     * target cleared before the frame begins (the GL drawer uploads it). */
+    rl_cull_target target;
+    rl_status st = rl_cull_target_begin(image, rl_renderer_opt_color(r, "background"), &target);
+    if (st != RL_OK)
+        return st;
+    desc.flags |= target.flags;
     if (!rl_drawer_fits(s->drawer, scene, &desc) || strcmp(s->device, device) != 0) {
         rl_drawer_release(s->drawer);
         s->drawer = NULL;
@@ -107,23 +100,20 @@ static rl_status gl_raster_render(rl_renderer *r, void *state, const rl_scene *s
                 snprintf(s->info, sizeof s->info, "%s | %s | %s", info.vendor, info.renderer, info.version);
         }
     }
-    if (st == RL_OK) {
-        rl_vec3 bg = rl_renderer_opt_color(r, "background");
-        rl_image_clear_to(&target, rl_v4_from3(bg, 1.0f));
-        st = rl_drawer_begin_camera(s->drawer, &target, cam, d->bounds);
-    }
+    if (st == RL_OK)
+        st = rl_drawer_begin_camera(s->drawer, &target.image, cam, d->bounds);
     rl_raster_counters counters;
     memset(&counters, 0, sizeof counters);
     if (st == RL_OK)
         st = rl_drawer_draw_all(s->drawer, &counters, renderer_progress, r);
     if (st == RL_OK)
         st = rl_drawer_end(s->drawer);
-    free(own_depth);
+    rl_cull_target_end(&target);
     if (st != RL_OK)
         return st;
     stats->triangles_rasterized = counters.triangles_drawn;
     stats->pixels_written = counters.pixels_written;
-    stats->samples = num_pixels;
+    stats->samples = (uint64_t)image->width * (uint64_t)image->height;
     stats->device = s->info[0] ? s->info : NULL;
     return RL_OK;
 }

@@ -16,6 +16,7 @@
 
 #include "core/error.h"
 #include "rl/rl_drawer.h"
+#include "render/culling.h"
 #include "render/renderer.h"
 #include "rl/rl_raster.h"
 
@@ -65,46 +66,34 @@ static rl_status raster_render(rl_renderer *r, void *state, const rl_scene *scen
         .flags = rl_renderer_opt_bool(r, "cull") ? RL_RASTER_CULL_BACK : 0u,
     };
 
-    /* The rasterizer depth-tests against the target's depth layer; borrow a
-     * private one when the caller did not ask for depth. */
-    rl_image target = *image;
-    size_t num_pixels = (size_t)image->width * (size_t)image->height;
-    float *own_depth = NULL;
-    if (!(target.layers & RL_LAYER_DEPTH) || !target.depth) {
-        own_depth = rl_calloc(num_pixels, sizeof *own_depth);
-        if (!own_depth)
-            return RL_ERR_OUT_OF_MEMORY;
-        target.depth = own_depth;
-        target.layers |= RL_LAYER_DEPTH;
-    }
-    if (!(target.layers & RL_LAYER_ID) || !target.object_id || !target.triangle_id)
-        desc.flags |= RL_RASTER_NO_ID;
-
-    rl_status st = RL_OK;
+    /* The rasterizer depth-tests against the target's depth layer: the
+     * culling renderers' target borrows a private one when the caller did
+     * not ask for depth, and clears it to the background. */
+    rl_cull_target target;
+    rl_status st = rl_cull_target_begin(image, rl_renderer_opt_color(r, "background"), &target);
+    if (st != RL_OK)
+        return st;
+    desc.flags |= target.flags;
     if (!rl_drawer_fits(s->drawer, scene, &desc)) {
         rl_drawer_release(s->drawer);
         s->drawer = NULL;
         st = rl_drawer_create(scene, &desc, &s->drawer);
     }
     if (st == RL_OK)
-        st = rl_drawer_begin_camera(s->drawer, &target, cam, d->bounds);
-    if (st == RL_OK) {
-        rl_vec3 bg = rl_renderer_opt_color(r, "background");
-        rl_image_clear_to(&target, rl_v4_from3(bg, 1.0f));
-    }
+        st = rl_drawer_begin_camera(s->drawer, &target.image, cam, d->bounds);
     rl_raster_counters counters;
     memset(&counters, 0, sizeof counters);
     if (st == RL_OK)
         st = rl_drawer_draw_all(s->drawer, &counters, renderer_progress, r);
     if (st == RL_OK)
         st = rl_drawer_end(s->drawer);
-    free(own_depth);
+    rl_cull_target_end(&target);
     if (st != RL_OK)
         return st;
 
     stats->triangles_rasterized = counters.triangles_drawn;
     stats->pixels_written = counters.pixels_written;
-    stats->samples = num_pixels;
+    stats->samples = (uint64_t)image->width * (uint64_t)image->height;
     return RL_OK;
 }
 
