@@ -54,10 +54,13 @@ static void print_usage(FILE *out)
             "  --import-memory MiB   memory the importer may add (default %u)\n"
             "  --trusted-import      import in this process, without limits: UNSAFE for\n"
             "                        files you do not trust (a bad one can crash or hang rl)\n"
+            "  --max-texture-pixels MPIX  largest texture in 2^20 pixels, read from its\n"
+            "                        header before decoding (default %llu = 8192x8192)\n"
             "\n"
             "example:\n"
             "  rl render cornell --algo raster --size 640x480 --out cornell.png\n",
-            "help", RL_IMPORT_DEFAULT_TIMEOUT_S, RL_IMPORT_DEFAULT_MEMORY_MIB);
+            "help", RL_IMPORT_DEFAULT_TIMEOUT_S, RL_IMPORT_DEFAULT_MEMORY_MIB,
+            (unsigned long long)(RL_TEXTURE_MAX_PIXELS >> 20));
 }
 
 /* Log lines of the library go to stderr as "rl: warning: ...". */
@@ -129,6 +132,11 @@ int main(int argc, char **argv)
         } else if (global_value(argc, argv, &i, "--import-memory", &v)) {
             if (parse_limit("--import-memory", v, 64, 1ul << 22, "MiB", &import.memory_mib) < 0)
                 return RL_CLI_USAGE;
+        } else if (global_value(argc, argv, &i, "--max-texture-pixels", &v)) {
+            uint32_t mpix = 0;
+            if (parse_limit("--max-texture-pixels", v, 1, 1ul << 12, "megapixels (2^20 pixels)", &mpix) < 0)
+                return RL_CLI_USAGE;
+            rl_texture_set_max_pixels((unsigned long long)mpix << 20);
         } else if (strcmp(a, "--trusted-import") == 0)
             import.in_process = true;
         else if (strcmp(a, "-v") == 0 || strcmp(a, "--verbose") == 0)

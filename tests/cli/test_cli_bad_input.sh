@@ -163,6 +163,15 @@ if [ "$RL_SANITIZED" = 0 ]; then
     done
 fi
 
+# Issue 34: the texture pixel limit is a flag: a 2048x1024 texture (2 Mi
+# pixels) loads by default and is refused, naming it, under a 1 Mi limit.
+run_ok "$RL" render cornell --algo raster --size 2048x1024 --out "$TMP/tex2m.png"
+printf 'newmtl t\nKd 1 1 1\nmap_Kd tex2m.png\n' >"$TMP/texq.mtl"
+printf 'mtllib texq.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nvt 1 0\nvt 0 1\nusemtl t\nf 1/1 2/2 3/3\n' >"$TMP/texq.obj"
+run_ok "$RL" render "$TMP/texq.obj" --size 32x24 --out "$OUT"
+expect_bounded_error 1 "tex2m.png" "$RL" --max-texture-pixels 1 render "$TMP/texq.obj" --size 32x24 --out "$OUT"
+expect_usage_error "$RL" --max-texture-pixels 0 render "$TMP/texq.obj" --size 32x24 --out "$OUT"
+
 # Issue 34: a frame's memory is estimated before it is allocated (16384 x
 # 16384 took 4.2-5.3 GB): refused above --max-memory, with the estimate,
 # whether the size comes from --size or from the scene's camera.
