@@ -85,6 +85,13 @@ bool cli_parse_bytes(const char *text, double *bytes);
 /* MemAvailable of /proc/meminfo in bytes: what can be allocated without
  * swapping; 0 where it cannot be read (then nothing is refused on it). */
 double cli_available_memory(void);
+/* The memory a width x height frame of r needs, estimated before anything
+ * is allocated: an image of the layers, the renderer's own buffers
+ * (rl_renderer_frame_bytes) and extra_per_pixel bytes of the caller's
+ * (writing, tone mapping); above max_memory (bytes; 0: MemAvailable) it
+ * prints the estimate and returns RL_CLI_FAIL. */
+int cli_check_frame_memory(const rl_renderer *r, int width, int height, unsigned layers, double extra_per_pixel,
+                           double max_memory);
 
 /* Extension check before any work: true when path ends in one of the
  * NULL-terminated extensions (".png", ".exr"), case-insensitively. */

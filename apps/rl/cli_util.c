@@ -159,6 +159,19 @@ double cli_available_memory(void)
     return (double)kib * 1024.0;
 }
 
+int cli_check_frame_memory(const rl_renderer *r, int width, int height, unsigned layers, double extra_per_pixel,
+                           double max_memory)
+{
+    double need = rl_image_bytes(width, height, layers) + rl_renderer_frame_bytes(r, width, height) +
+                  (double)width * (double)height * extra_per_pixel;
+    double limit = max_memory > 0.0 ? max_memory : cli_available_memory();
+    if (limit > 0.0 && need > limit)
+        return cli_fail(RL_CLI_FAIL, "a %dx%d frame of %s needs about %.2f GiB, more than the %.2f GiB %s", width,
+                        height, rl_renderer_name(r), need / 1073741824.0, limit / 1073741824.0,
+                        max_memory > 0.0 ? "of --max-memory" : "available (MemAvailable; see --max-memory)");
+    return RL_CLI_OK;
+}
+
 bool cli_parse_size(const char *text, int *width, int *height)
 {
     const char *x = strpbrk(text, "xX");

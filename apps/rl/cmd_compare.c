@@ -47,6 +47,8 @@ static const char compare_help_head[] =
     "                      4.2.5), ssim, psnr (dB, at most 100) or rmse\n"
     "  --metrics LIST      time, rays, triangles, queries, quality; default all\n"
     "  --size WxH          image per direction; default 128x128\n"
+    "  --max-memory SIZE   refuse renderers whose frame needs more (e.g. 8G);\n"
+    "                      default the available memory\n"
     "  --fov DEG           field of view per direction; default 120 (Sec. 4.2.3)\n"
     "  --repeats N         renders per direction for time (median); default 3\n"
     "  --resolution N      cube-face resolution of the visibility that places\n"
@@ -84,6 +86,7 @@ typedef struct compare_args {
     int quality_metric;   /* index into quality_metrics */
     unsigned metrics;
     int width, height;
+    double max_memory;    /* --max-memory in bytes, 0: MemAvailable */
     double fov_deg;
     long long repeats, resolution;
     int spread_runs;      /* --spread */
@@ -298,6 +301,9 @@ static int parse_args(int argc, char **argv, compare_args *a)
         } else if (VALUE("--size")) {
             if (!cli_parse_size(v, &a->width, &a->height))
                 return RL_CLI_USAGE;
+        } else if (VALUE("--max-memory")) {
+            if (!cli_parse_bytes(v, &a->max_memory))
+                return cli_fail(RL_CLI_USAGE, "--max-memory: expected an amount such as 512M or 8G, got '%s'", v);
         } else if (VALUE("--fov")) {
             char *end = NULL;
             a->fov_deg = strtod(v, &end);
@@ -686,10 +692,28 @@ static int write_report(const compare_args *a, const rl_scene *scene, const rl_a
     return rc;
 }
 
+/* Every renderer's frame at --size fits in memory (issue 34: a huge size
+ * is refused with the estimate before minutes of sampling). */
+static int check_frame_memory(const compare_args *a)
+{
+    int rc = RL_CLI_OK;
+    for (int i = -1; i < a->num_algos && rc == RL_CLI_OK; ++i) {
+        const algo_spec *s = i < 0 ? &a->reference : &a->algos[i];
+        rl_renderer *r = NULL;
+        if (rl_renderer_create(s->name, &r) == RL_OK)
+            rc = cli_check_frame_memory(r, a->width, a->height, RL_LAYER_COLOR | RL_LAYER_DEPTH | RL_LAYER_ID, 0.0,
+                                        a->max_memory);
+        rl_renderer_release(r);
+    }
+    return rc;
+}
+
 int cli_compare(int argc, char **argv)
 {
     compare_args a = { 0 };
     int rc = parse_args(argc, argv, &a);
+    if (rc == RL_CLI_OK)
+        rc = check_frame_memory(&a);
     if (rc != RL_CLI_OK) {
         free_args(&a);
         return rc < 0 ? RL_CLI_OK : rc;

@@ -336,6 +336,10 @@ static bool render_one(const demo_args *a, const char *scene_name, const rl_scen
     double inputs_ms = 0.0;
     rl_clear_error();
     rl_status st = rl_renderer_create(algo, &r);
+    /* A frame that cannot fit is refused with its estimate (printed). */
+    if (st == RL_OK &&
+        cli_check_frame_memory(r, cam->width, cam->height, RL_LAYER_COLOR, 8.0, 0.0) != RL_CLI_OK)
+        st = RL_ERR_LIMIT;
     rl_timer_start(&phase);
     if (st == RL_OK)
         st = rl_renderer_prepare_inputs(r, scene);   /* visset, select: sampled here */

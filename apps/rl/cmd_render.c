@@ -361,16 +361,8 @@ static int choose_camera(const render_args *a, const rl_scene *scene, rl_camera 
 static int check_frame_memory(const render_args *a, const rl_renderer *r, const rl_camera *cam)
 {
     unsigned layers = RL_LAYER_COLOR | (a->depth_out ? RL_LAYER_DEPTH : 0u) | (a->id_out ? RL_LAYER_ID : 0u);
-    double pixels = (double)cam->width * (double)cam->height;
-    double need = rl_image_bytes(cam->width, cam->height, layers) +
-                  rl_renderer_frame_bytes(r, cam->width, cam->height) +
-                  pixels * (8.0 + (a->has_tonemap ? sizeof(rl_vec4) : 0.0));
-    double limit = a->max_memory > 0.0 ? a->max_memory : cli_available_memory();
-    if (limit > 0.0 && need > limit)
-        return cli_fail(RL_CLI_FAIL, "a %dx%d frame of %s needs about %.2f GiB, more than the %.2f GiB %s",
-                        cam->width, cam->height, rl_renderer_name(r), need / 1073741824.0, limit / 1073741824.0,
-                        a->max_memory > 0.0 ? "of --max-memory" : "available (MemAvailable; see --max-memory)");
-    return RL_CLI_OK;
+    return cli_check_frame_memory(r, cam->width, cam->height, layers,
+                                  8.0 + (a->has_tonemap ? sizeof(rl_vec4) : 0.0), a->max_memory);
 }
 
 /* Writes img's colour to path, tone mapped for PNG when asked. Previews

@@ -187,6 +187,10 @@ cat >"$TMP/bigcam.json" <<'JSON'
                              { "time_s": 1, "eye": [1, 1, 3], "target": [0, 0, 0] } ] } }
 JSON
 expect_bounded_error 1 "16384x16384 frame" "$RL" render "$TMP/bigcam.json" --max-memory 1G --out "$OUT"
+# rl compare checks every renderer's frame at --size (the reference, whitted,
+# first) before it samples; rl demo refuses such an image with the estimate.
+expect_bounded_error 1 "16384x16384 frame of whitted needs about 7.00 GiB, more than the 4.00 GiB of --max-memory" "$RL" compare cornell \
+    --algos raster,pt --size 16384x16384 --max-memory 4G --out "$TMP/cmp_huge"
 expect_bounded_error 1 "16384x16384 frame" "$RL" render "$TMP/bigcam.json" --camera-path --max-memory 1G --out "$TMP/f%d.png"
 [ ! -e "$OUT" ] || fail "a refused frame still wrote $OUT"
 expect_usage_error "$RL" render cornell --max-memory 1X --out "$OUT"
