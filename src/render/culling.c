@@ -156,6 +156,29 @@ void rl_cull_target_end(rl_cull_target *t)
     t->own_depth = NULL;
 }
 
+static bool renderer_progress(void *user, double done)
+{
+    return rl_renderer_progress((const rl_renderer *)user, done);
+}
+
+rl_status rl_cull_draw_all(rl_renderer *r, rl_drawer *dr, rl_cull_target *t, const rl_camera *cam, rl_aabb bounds,
+                           rl_render_stats *stats)
+{
+    rl_raster_counters counters;
+    memset(&counters, 0, sizeof counters);
+    rl_status st = rl_drawer_begin_camera(dr, &t->image, cam, bounds);
+    if (st == RL_OK)
+        st = rl_drawer_draw_all(dr, &counters, renderer_progress, r);
+    if (st == RL_OK)
+        st = rl_drawer_end(dr);
+    if (st != RL_OK)
+        return st;
+    stats->triangles_rasterized = counters.triangles_drawn;
+    stats->pixels_written = counters.pixels_written;
+    stats->samples = (uint64_t)t->image.width * (uint64_t)t->image.height;
+    return RL_OK;
+}
+
 rl_status rl_octree_cache_get(rl_octree_cache *c, const rl_scene *scene, const rl_octree_desc *desc,
                               bool *rebuilt)
 {

@@ -64,6 +64,12 @@ typedef struct rl_cull_target {
 
 rl_status rl_cull_target_begin(rl_image *image, rl_vec3 background, rl_cull_target *t);
 void rl_cull_target_end(rl_cull_target *t);
+/* One frame of every selected object, in index order, with drawer dr into
+ * t (begun with cam over bounds, then ended), the counts into stats: the
+ * whole frame of raster and gl-raster, which differ only in the drawer's
+ * backend. Progress goes to r's callback. */
+rl_status rl_cull_draw_all(rl_renderer *r, rl_drawer *dr, rl_cull_target *t, const rl_camera *cam, rl_aabb bounds,
+                           rl_render_stats *stats);
 
 /* A loose octree rebuilt only when the scene or its parameters change. */
 typedef struct rl_octree_cache {

@@ -46,11 +46,6 @@ typedef struct gl_raster_state {
     char info[528];               /* rl_render_stats.device: the three strings of rl_gl_info */
 } gl_raster_state;
 
-static bool renderer_progress(void *user, double done)
-{
-    return rl_renderer_progress((const rl_renderer *)user, done);
-}
-
 static void gl_raster_release(void *state)
 {
     gl_raster_state *s = state;
@@ -101,21 +96,11 @@ static rl_status gl_raster_render(rl_renderer *r, void *state, const rl_scene *s
         }
     }
     if (st == RL_OK)
-        st = rl_drawer_begin_camera(s->drawer, &target.image, cam, d->bounds);
-    rl_raster_counters counters;
-    memset(&counters, 0, sizeof counters);
-    if (st == RL_OK)
-        st = rl_drawer_draw_all(s->drawer, &counters, renderer_progress, r);
-    if (st == RL_OK)
-        st = rl_drawer_end(s->drawer);
+        st = rl_cull_draw_all(r, s->drawer, &target, cam, d->bounds, stats);
     rl_cull_target_end(&target);
-    if (st != RL_OK)
-        return st;
-    stats->triangles_rasterized = counters.triangles_drawn;
-    stats->pixels_written = counters.pixels_written;
-    stats->samples = (uint64_t)image->width * (uint64_t)image->height;
-    stats->device = s->info[0] ? s->info : NULL;
-    return RL_OK;
+    if (st == RL_OK)
+        stats->device = s->info[0] ? s->info : NULL;
+    return st;
 }
 
 const rl_renderer_class rl_gl_raster_renderer_class = {

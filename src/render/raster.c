@@ -34,11 +34,6 @@ static const rl_option_info raster_options[] = {
     { "threads", RL_OPT_INT, "0", "OpenMP threads for lighting and rasterization (0 = all)", 0, 1024, NULL },
 };
 
-static bool renderer_progress(void *user, double done)
-{
-    return rl_renderer_progress((const rl_renderer *)user, done);
-}
-
 /* The renderer's state: its rasterizer and drawer, kept between frames
  * (the drawer's buffers span the whole scene). Every frame still lights
  * every object, as plain rasterization does. */
@@ -80,21 +75,9 @@ static rl_status raster_render(rl_renderer *r, void *state, const rl_scene *scen
         st = rl_drawer_create(scene, &desc, &s->drawer);
     }
     if (st == RL_OK)
-        st = rl_drawer_begin_camera(s->drawer, &target.image, cam, d->bounds);
-    rl_raster_counters counters;
-    memset(&counters, 0, sizeof counters);
-    if (st == RL_OK)
-        st = rl_drawer_draw_all(s->drawer, &counters, renderer_progress, r);
-    if (st == RL_OK)
-        st = rl_drawer_end(s->drawer);
+        st = rl_cull_draw_all(r, s->drawer, &target, cam, d->bounds, stats);
     rl_cull_target_end(&target);
-    if (st != RL_OK)
-        return st;
-
-    stats->triangles_rasterized = counters.triangles_drawn;
-    stats->pixels_written = counters.pixels_written;
-    stats->samples = (uint64_t)image->width * (uint64_t)image->height;
-    return RL_OK;
+    return st;
 }
 
 const rl_renderer_class rl_raster_renderer_class = {
