@@ -1488,9 +1488,15 @@ int bench_pt(int argc, char **argv)
     rl_renderer *probe = NULL;
     rl_clear_error();
     rl_status st = rl_renderer_create("pt", &probe);
+    /* Issue 34: refuse a --size that cannot fit, with the estimate. */
+    int fits = st == RL_OK ? cli_check_frame_memory(probe, a.width, a.height, RL_LAYER_COLOR, 0.0,
+                                                    a.max_memory_gb > 0 ? b.max_memory_bytes : 0.0)
+                           : RL_CLI_OK;
     rl_renderer_release(probe);
     if (st != RL_OK)
         return cli_fail_status(RL_CLI_FAIL, st, "bench pt");
+    if (fits != RL_CLI_OK)
+        return fits;
     cJSON *root = bench_record_json("pt", b.threads);
     if (!root)
         return cli_fail(RL_CLI_FAIL, "out of memory");

@@ -1371,9 +1371,15 @@ static int run(bvt *b)
         rl_renderer *r = NULL;
         rl_clear_error();
         rl_status st = rl_renderer_create(names[i], &r);
+        /* Issue 34: a --size that cannot fit is refused with the estimate
+         * before the scene is loaded, not found out by the OOM killer. */
+        int fits = st == RL_OK ? cli_check_frame_memory(r, a->width, a->height, RL_LAYER_COLOR, 0.0, 0.0)
+                               : RL_CLI_OK;
         rl_renderer_release(r);
         if (st != RL_OK)
             return cli_fail_status(RL_CLI_FAIL, st, "bench vt");
+        if (fits != RL_CLI_OK)
+            return fits;
     }
     bool static_sections = false;
     for (int k = 0; k < SEC_ANIMATION; k++)

@@ -176,6 +176,10 @@ void rl_ls_closest_point(const double v[3][3], const double q[3], double *u, dou
 void rl_ls_surface_at(const rl_linespace *ls, uint32_t tri, float u, float v, rl_ls_surface *s);
 
 /* ---- build and queries ---- */
+/* The checksum of a Line Space file (linespace_io.c), continued from h
+ * over n bytes; a file ends with the sum over all bytes before it. */
+uint64_t rl_ls_file_hash(uint64_t h, const void *data, size_t n);
+
 rl_status rl_ls_build(rl_linespace *ls);
 /* Allocates ls->occupied (zeroed); false when out of memory. */
 bool rl_ls_occupancy_alloc(rl_linespace *ls);

@@ -16,6 +16,8 @@
 #include "rl/rl_rng.h"
 #include "rl/rl_scene.h"
 
+#include "accel/linespace_internal.h"
+
 static void tmp_path(char *buf, size_t n, const char *name)
 {
     const char *base = getenv("RL_TEST_TMP");
@@ -79,25 +81,6 @@ static long file_size(const char *path)
     return len;
 }
 
-/* The file's checksum (linespace_io.c): an attacker can recompute it, so
- * the test does too, to check that the records themselves are validated. */
-static uint64_t checksum(uint64_t h, const unsigned char *p, size_t n)
-{
-    for (; n >= 8; n -= 8, p += 8) {
-        uint64_t w;
-        memcpy(&w, p, 8);
-        h = (h ^ w) * 0xbf58476d1ce4e5b9ull;
-        h ^= h >> 31;
-    }
-    if (n) {
-        uint64_t w = 0;
-        memcpy(&w, p, n);
-        h = (h ^ w ^ ((uint64_t)n << 56)) * 0x94d049bb133111ebull;
-        h ^= h >> 29;
-    }
-    return h;
-}
-
 /* A copy of `from` with the 16-bit word at `at` set to value and the
  * checksum recomputed, as a forger would: over the header, then each of
  * the arrays (bytes[]) in turn. */
@@ -114,7 +97,7 @@ static void forge(const char *from, const char *to, const size_t bytes[7], long 
     uint64_t sum = 0;
     size_t off = 0;
     for (int i = 0; i < 7; off += bytes[i++])
-        sum = checksum(sum, buf + off, bytes[i]);
+        sum = rl_ls_file_hash(sum, buf + off, bytes[i]);
     assert_int_equal(off, (size_t)len - 8);
     memcpy(buf + len - 8, &sum, 8);
     FILE *g = fopen(to, "wb");
@@ -313,7 +296,7 @@ static void test_linespace_pnmt_record_with_a_bad_material_is_refused(void **sta
         assert_non_null(copy);
         memcpy(copy, buf, (size_t)len);
         memcpy(copy + (pnmt - buf) + used, &materials[k], 2);
-        uint64_t sum = checksum(0, copy, (size_t)len - 8);
+        uint64_t sum = rl_ls_file_hash(0, copy, (size_t)len - 8);
         memcpy(copy + len - 8, &sum, 8);
         FILE *g = fopen(bad, "wb");
         assert_non_null(g);
@@ -326,7 +309,7 @@ static void test_linespace_pnmt_record_with_a_bad_material_is_refused(void **sta
         rl_clear_error();
     }
     /* The same file unedited but re-sealed still loads: the checksum is right. */
-    uint64_t sum = checksum(0, buf, (size_t)len - 8);
+    uint64_t sum = rl_ls_file_hash(0, buf, (size_t)len - 8);
     memcpy(buf + len - 8, &sum, 8);
     FILE *g = fopen(bad, "wb");
     assert_non_null(g);

@@ -194,6 +194,10 @@ expect_bounded_error 1 "16384x16384 frame of whitted needs about 7.00 GiB, more 
 expect_bounded_error 1 "16384x16384 frame" "$RL" render "$TMP/bigcam.json" --camera-path --max-memory 1G --out "$TMP/f%d.png"
 [ ! -e "$OUT" ] || fail "a refused frame still wrote $OUT"
 expect_usage_error "$RL" render cornell --max-memory 1X --out "$OUT"
+# rl bench pt checks its frame at --size against its --max-memory (GB) too.
+expect_bounded_error 1 "16384x16384 frame of pt needs about 39.00 GiB, more than the 1.00 GiB" "$RL" bench pt --size 16384x16384 --max-memory 1 \
+    --out "$TMP/bench_huge.json"
+[ ! -e "$TMP/bench_huge.json" ] || fail "a refused benchmark still wrote its record"
 run_ok "$RL" render cornell --size 32x24 --max-memory 64M --out "$OUT"
 
 # Issue 34: approximation files for visset. A few kilobytes of empty sets

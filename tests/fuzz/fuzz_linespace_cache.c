@@ -9,9 +9,8 @@
  * checks after the fingerprint. The file's checksum would stop almost
  * every mutation before those checks; so each input is loaded twice: as
  * it is, and with its last 8 bytes replaced by the checksum of the rest
- * (computed as linespace_io.c does; should the two drift apart, the second
- * load merely fails early like the first). A loaded Line Space answers a
- * few rays: a file that passed the checks must be safe to query. Any
+ * (linespace_io.c's own rl_ls_file_hash, so the two cannot drift apart).
+ * A loaded Line Space answers a few rays: a file that passed the checks must be safe to query. Any
  * status is fine; crashes, leaks and sanitizer reports are not. */
 #define _POSIX_C_SOURCE 200809L
 #include <stdint.h>
@@ -24,30 +23,13 @@
 #include "rl/rl_linespace.h"
 #include "rl/rl_scene.h"
 
+#include "accel/linespace_internal.h"
+
 int LLVMFuzzerInitialize(int *argc, char ***argv);
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size);
 
 static rl_scene *scene;
 static rl_accel *grid;
-
-/* linespace_io.c's checksum: bijective per 8-byte word. */
-static uint64_t checksum(const uint8_t *p, size_t n)
-{
-    uint64_t h = 0;
-    for (; n >= 8; n -= 8, p += 8) {
-        uint64_t w;
-        memcpy(&w, p, 8);
-        h = (h ^ w) * 0xbf58476d1ce4e5b9ull;
-        h ^= h >> 31;
-    }
-    if (n) {
-        uint64_t w = 0;
-        memcpy(&w, p, n);
-        h = (h ^ w ^ ((uint64_t)n << 56)) * 0x94d049bb133111ebull;
-        h ^= h >> 29;
-    }
-    return h;
-}
 
 /* The seeds: every payload and list kind this grid can hold, small. */
 static void write_seeds(const char *dir)
@@ -127,7 +109,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
         if (!fixed)
             return 0;
         memcpy(fixed, data, size);
-        uint64_t sum = checksum(fixed, size - 8);
+        uint64_t sum = rl_ls_file_hash(0, fixed, size - 8);
         memcpy(fixed + size - 8, &sum, 8);
         load(path, fixed, size);
         free(fixed);
