@@ -41,6 +41,10 @@ static const char demo_help[] =
     "the renderers over a small sampled region of one scene (rl compare) into\n"
     "DIR/compare/report.html.\n"
     "\n"
+    "The images, report.json and index.html replace the previous ones together\n"
+    "at the end of the run: a run that is stopped, or fails to write an image,\n"
+    "leaves the previous demo in DIR as it was.\n"
+    "\n"
     "options:\n"
     "  --out DIR       output folder, created if missing; default out/demo\n"
     "  --size WxH      resolution of every image; default 640x480\n"
@@ -69,7 +73,24 @@ typedef struct demo_args {
     bool no_compare;
     demo_scene *list;     /* the scenes to render, in order */
     size_t count;
+    /* Every image, report.json and index.html of the run go through one
+     * batch (rl_output.h) committed at the end, so that the page never
+     * mixes two runs: a run killed or stopped by a full disk midway
+     * leaves the previous demo as it was. */
+    rl_output_batch *batch;
+    /* The first output that failed to write: the run stops there and does
+     * not commit; the message is the run's one error line. */
+    char *unwritten;      /* "" while every write succeeded */
 } demo_args;
+
+/* An image of the run could not be written (disk full, a size limit):
+ * its path (up to 4 KB) and the library's reason. */
+#define RL_DEMO_UNWRITTEN 8192
+static void note_unwritten(const demo_args *a, rl_status st, const char *path)
+{
+    if (!*a->unwritten)
+        snprintf(a->unwritten, RL_DEMO_UNWRITTEN, "%s: %s", path, rl_last_error()[0] ? rl_last_error() : rl_status_string(st));
+}
 
 static void free_args(demo_args *a)
 {
@@ -355,8 +376,14 @@ static bool render_one(const demo_args *a, const char *scene_name, const rl_scen
         rl_renderer_set_progress(r, NULL, NULL);
         rl_progress_finish(progress);
     }
+    const char *write_to = NULL;
     if (st == RL_OK)
-        st = rl_image_write(img, path);
+        st = rl_output_batch_add(a->batch, path, &write_to);
+    bool unwritten = false;
+    if (st == RL_OK && (st = rl_image_write(img, write_to)) != RL_OK) {
+        note_unwritten(a, st, path);
+        unwritten = true;
+    }
     bool ok = st == RL_OK;
     if (ok) {
         cli_debug("timing: %s %s: build %.1f ms (inputs %.1f ms, for the scene %.1f ms), frame %.1f ms", algo,
@@ -380,7 +407,7 @@ static bool render_one(const demo_args *a, const char *scene_name, const rl_scen
             if (entry)
                 *entry = e;
         }
-    } else {
+    } else if (!unwritten) {
         char what[600];
         snprintf(what, sizeof what, "%s with %s", scene_name, algo);
         cli_fail_status(RL_CLI_FAIL, st, what);
@@ -438,7 +465,10 @@ static bool render_change(const demo_args *a, const char *scene_name, const rl_s
     if (differs) {
         char dir[4096];
         snprintf(dir, sizeof dir, "%s/changes", a->out);
-        st = cli_make_dirs(dir) ? rl_image_write(img, path) : RL_ERR_IO;
+        const char *write_to = NULL;
+        st = cli_make_dirs(dir) ? rl_output_batch_add(a->batch, path, &write_to) : RL_ERR_IO;
+        if (st == RL_OK && (st = rl_image_write(img, write_to)) != RL_OK)
+            note_unwritten(a, st, path);
     }
     if (st == RL_OK && differs) {
         printf("changed: %s %s, %s=%s before: RMSE %.4f, SSIM %.4f\n", scene_name, c->algo, c->key, c->old_value,
@@ -460,7 +490,7 @@ static bool render_change(const demo_args *a, const char *scene_name, const rl_s
             cJSON_AddNumberToObject(e, "time_ms_before", stats.time_ms);
             cJSON_AddItemToArray(list, e);
         }
-    } else if (st != RL_OK) {
+    } else if (st != RL_OK && !*a->unwritten) {
         char what[600];
         snprintf(what, sizeof what, "%s with %s, %s=%s", scene_name, c->algo, c->key, c->old_value);
         cli_fail_status(RL_CLI_FAIL, st, what);
@@ -588,7 +618,7 @@ static int run_demo(const demo_args *a, cJSON *report)
         usable[k] = in_list(a->algos, algos[k].name) && available(algos[k].name, true);
     int rc = RL_CLI_OK;
     cJSON *listed = cJSON_AddArrayToObject(report, "scenes");
-    for (size_t s = 0; s < a->count; s++) {
+    for (size_t s = 0; s < a->count && !*a->unwritten; s++) {   /* a failed write ends the run */
         const demo_scene *sc = &a->list[s];
         const char *name = sc->name;
         cJSON *item = cJSON_CreateObject();
@@ -621,7 +651,7 @@ static int run_demo(const demo_args *a, cJSON *report)
             continue;
         }
         rl_image *ref = NULL;
-        for (size_t k = 0; k < nr; k++) {
+        for (size_t k = 0; k < nr && !*a->unwritten; k++) {
             if (!usable[k])
                 continue;
             rl_image *now = NULL;
@@ -684,7 +714,8 @@ static int run_compare(const demo_args *a)
 
 int cli_demo(int argc, char **argv)
 {
-    demo_args a = { .out = "out/demo", .width = 640, .height = 480 };
+    char unwritten[RL_DEMO_UNWRITTEN] = "";
+    demo_args a = { .out = "out/demo", .width = 640, .height = 480, .unwritten = unwritten };
     int rc = parse_args(argc, argv, &a);
     if (rc != RL_CLI_OK) {
         free_args(&a);
@@ -698,7 +729,10 @@ int cli_demo(int argc, char **argv)
         rc = RL_CLI_FAIL;
     else if (!(report = cJSON_CreateObject()))
         rc = cli_fail(RL_CLI_FAIL, "out of memory");
+    else if (rl_output_batch_create(&a.batch) != RL_OK)
+        rc = cli_fail_status(RL_CLI_FAIL, RL_ERR_OUT_OF_MEMORY, "demo");
     if (rc != RL_CLI_OK) {
+        cJSON_Delete(report);
         free_args(&a);
         return rc;
     }
@@ -720,7 +754,7 @@ int cli_demo(int argc, char **argv)
     cJSON_AddStringToObject(report, "reference", demo_reference);
 
     rc = run_demo(&a, report);
-    if (!a.no_compare) {
+    if (!a.no_compare && !*unwritten) {
         int crc = run_compare(&a);
         if (crc == RL_CLI_OK)
             cJSON_AddStringToObject(report, "compare", "compare/report.html");
@@ -729,10 +763,24 @@ int cli_demo(int argc, char **argv)
     }
     char html[4096];
     snprintf(html, sizeof html, "%s/index.html", a.out);
-    if (!cli_write_json(report, probe) || !cli_write_demo_html(report, html))
+    /* A renderer that failed is recorded in the report and the run still
+     * commits (the page says what failed); an output that could not be
+     * written stops the commit, and the previous demo stays whole. */
+    const char *json_tmp = NULL, *html_tmp = NULL;
+    rl_status st = rl_output_batch_add(a.batch, probe, &json_tmp);
+    if (st == RL_OK)
+        st = rl_output_batch_add(a.batch, html, &html_tmp);
+    if (st != RL_OK)
+        rc = cli_fail_status(RL_CLI_FAIL, st, "demo");
+    else if (*unwritten)
+        rc = cli_fail(RL_CLI_FAIL, "demo: %s; %s keeps the previous demo", unwritten, a.out);
+    else if (!cli_write_json(report, json_tmp) || !cli_write_demo_html(report, html_tmp))
         rc = RL_CLI_FAIL;
+    else if ((st = rl_output_batch_commit(a.batch)) != RL_OK)
+        rc = cli_fail_status(RL_CLI_FAIL, st, "demo");
     else
         printf("report: %s, %s\n", probe, html);
+    rl_output_batch_release(a.batch);
     cJSON_Delete(report);
     free_args(&a);
     return rc;

@@ -81,4 +81,19 @@ for e in r["images"]:
     if e["algorithm"] == "raster":
         assert e["accuracy"] == "approximate" and e["error"]["rmse"] > 0, e
 PY
+
+# Issue 34, no lost output: the run's images, report and page commit
+# together. A second run at 400x300 under a 20 KB file size limit (rl
+# ignores SIGXFSZ, so writes fail with EFBIG) writes raster's image (12 KB)
+# and the report (4 KB) but not whitted's (67 KB): it fails and keeps the
+# first run whole, with no temporaries, where writing each file on its own
+# would have mixed the two runs.
+KEEP="$TMP/demo-keep"
+run_ok "$RL" demo --out "$KEEP" --size 32x24 --scenes cornell --algos raster,whitted --no-compare
+cp -r "$KEEP" "$TMP/demo-good"
+expect_error 1 "demo: $KEEP/cornell-whitted.png: .*; $KEEP keeps the previous demo" \
+    bash -c 'ulimit -f 20; exec "$@"' - "$RL" demo --out "$KEEP" --size 400x300 --scenes cornell \
+    --algos raster,whitted --no-compare
+diff -r "$KEEP" "$TMP/demo-good" >/dev/null || fail "a failed demo run changed the previous demo"
+! ls -A "$KEEP" | grep -q '^\.' || fail "temporary files left: $(ls -A "$KEEP")"
 echo "ok"
