@@ -13,6 +13,7 @@ PACKAGES=(
   libembree-dev       # Embree 3: reference accelerator and benchmark anchor
   libepoxy-dev libegl-dev            # OpenGL 4.5 backend (src/gl): GL loader, EGL headers
   libegl-mesa0 libgl1-mesa-dri       # headless EGL + llvmpipe, so the GL tests run without a GPU
+  libopenmpi-dev openmpi-bin         # distributed runs (src/dist, rl --dist under mpirun)
   libcmocka-dev       # unit tests
   libcairo2-dev       # plots in evaluation reports (SVG, PNG)
   fonts-dejavu-core   # a font for plot labels

@@ -90,6 +90,19 @@ double cli_available_memory(void);
  * (rl_renderer_frame_bytes) and extra_per_pixel bytes of the caller's
  * (writing, tone mapping); above max_memory (bytes; 0: MemAvailable) it
  * prints the estimate and returns RL_CLI_FAIL. */
+/* cli_dist.c: the global flag --dist (rl_dist.h). begin joins the MPI job
+ * (a usage of its own: one rank prints); end leaves it, aborting the job
+ * when rc failed so that no rank waits for this one. cli_render_call
+ * renders one frame, spread over the job's ranks under --dist;
+ * cli_dist_master is false on the workers, which neither print nor write. */
+int cli_dist_begin(int *argc, char ***argv);
+int cli_dist_end(int rc);
+bool cli_dist_master(void);
+rl_status cli_render_call(rl_renderer *r, const rl_scene *scene, const rl_camera *cam, rl_image *img,
+                          rl_render_stats *stats);
+/* The last distributed frame's ranks, bands and per-rank work (master only). */
+void cli_print_dist_summary(FILE *out);
+
 int cli_check_frame_memory(const rl_renderer *r, int width, int height, unsigned layers, double extra_per_pixel,
                            double max_memory);
 

@@ -71,6 +71,8 @@ int cli_algos(int argc, char **argv)
         printf("%s: %s\n", list[i].name, list[i].description ? list[i].description : "");
         if (list[i].reference && *list[i].reference)
             printf("  reference: %s\n", list[i].reference);
+        if (list[i].regions)
+            printf("  distributable: renders image regions, so rl --dist render spreads it over MPI ranks\n");
         if (list[i].progressive)
             printf("  progressive: rl render adds frames until --time or --spp (default budget %g s)\n",
                    list[i].default_time_s);

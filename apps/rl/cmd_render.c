@@ -572,7 +572,7 @@ static int render_frames(const render_args *a, rl_renderer *r, const rl_scene *s
     for (;;) {
         rl_render_stats stats = { 0 };
         rl_clear_error();
-        rl_status st = rl_renderer_render(r, scene, cam, img, &stats);
+        rl_status st = cli_render_call(r, scene, cam, img, &stats);
         if (st == RL_ERR_CANCELLED && cli_interrupted()) {
             rc = RL_CLI_INTERRUPTED;
             break;
@@ -674,7 +674,7 @@ static int render_frame(const render_args *a)
         rc = render_frames(a, renderer, scene, &cam, img, &plan, &stats, &acc);
     /* Ctrl-C in a loop keeps the frames that were finished. */
     bool saving = rc == RL_CLI_OK || (rc == RL_CLI_INTERRUPTED && acc.frames > 0);
-    if (saving) {
+    if (saving && cli_dist_master()) {   /* --dist: the workers hold only their bands */
         cli_debug("timing: load %.1f ms, build %.1f ms (inputs %.1f ms, for the scene %.1f ms), frame %.1f ms",
                   load_ms, inputs_ms + stats.prep_ms, inputs_ms, stats.prep_ms, stats.time_ms - stats.prep_ms);
         int wrc = write_outputs(a, scene, img, &stats, inputs_ms, plan.loop ? &acc : NULL);
@@ -686,6 +686,7 @@ static int render_frame(const render_args *a)
         else
             cli_print_summary(stdout, rl_renderer_name(renderer), a->scene, cam.width, cam.height, &stats,
                               inputs_ms);
+        cli_print_dist_summary(stdout);
     }
     rl_image_release(img);
     rl_scene_release(scene);
@@ -814,14 +815,15 @@ static int render_path(const render_args *a)
         fa.id_out = a->id_out ? ids : NULL;
         fa.stats_json = NULL;
         rl_clear_error();
-        rl_status st = rl_renderer_render(renderer, scene, &cam, img, &stats);
+        rl_status st = cli_render_call(renderer, scene, &cam, img, &stats);
         if (st != RL_OK) {
             char what[64];
             snprintf(what, sizeof what, "render, frame %lld", i);
             rc = cli_fail_status(RL_CLI_FAIL, st, what);
             break;
         }
-        rc = write_outputs(&fa, scene, img, &stats, 0.0, NULL);
+        if (cli_dist_master())
+            rc = write_outputs(&fa, scene, img, &stats, 0.0, NULL);
         double frame_ms = stats.time_ms - stats.prep_ms;
         frames_ms += frame_ms;
         prep_ms += stats.prep_ms;
@@ -837,7 +839,7 @@ static int render_path(const render_args *a)
             rl_progress_update(progress, (double)(i + 1) / (double)n);
     }
     rl_progress_finish(progress);
-    if (rc == RL_CLI_OK && report && !cli_write_json(report, a->stats_json))
+    if (rc == RL_CLI_OK && report && cli_dist_master() && !cli_write_json(report, a->stats_json))
         rc = RL_CLI_FAIL;
     if (rc == RL_CLI_OK) {
         char prep[32];

@@ -47,6 +47,8 @@ static void print_usage(FILE *out)
             "  -q, --quiet     errors only\n"
             "  --plugin FILE   load renderers from a shared object (README, \"Your own renderer\")\n"
             "  --version       print the version\n"
+            "  --dist          spread the work over the ranks of an MPI job: run as\n"
+            "                  mpirun -np N rl --dist render ... (docs/distributed.md)\n"
             "\n"
             "model files (OBJ, PLY, glTF, DAE, ...; also a JSON scene's \"file\") are imported\n"
             "with Assimp in a child process, so that a malformed file costs an error, not rl:\n"
@@ -123,6 +125,7 @@ int main(int argc, char **argv)
     int n = 0, num_plugins = 0;
     rl_import_limits import = { 0 };
     const char *v = NULL;
+    bool dist = false;
     /* Take out global flags wherever they are; keep everything else in order. */
     for (int i = 1; i < argc; i++) {
         const char *a = argv[i];
@@ -139,6 +142,8 @@ int main(int argc, char **argv)
             rl_texture_set_max_pixels((unsigned long long)mpix << 20);
         } else if (strcmp(a, "--trusted-import") == 0)
             import.in_process = true;
+        else if (strcmp(a, "--dist") == 0)
+            dist = true;
         else if (strcmp(a, "-v") == 0 || strcmp(a, "--verbose") == 0)
             level = RL_LOG_DEBUG;
         else if (strcmp(a, "-q") == 0 || strcmp(a, "--quiet") == 0)
@@ -186,8 +191,14 @@ int main(int argc, char **argv)
         return RL_CLI_OK;
     }
     for (size_t i = 0; i < sizeof commands / sizeof commands[0]; i++)
-        if (strcmp(name, commands[i].name) == 0)
-            return commands[i].run(n, argv);
+        if (strcmp(name, commands[i].name) == 0) {
+            if (!dist)
+                return commands[i].run(n, argv);
+            if (strcmp(name, "render") != 0)
+                return cli_fail(RL_CLI_USAGE, "--dist: only rl render runs distributed so far (docs/distributed.md)");
+            int rc = cli_dist_begin(NULL, NULL);
+            return cli_dist_end(rc == RL_CLI_OK ? commands[i].run(n, argv) : rc);
+        }
     if (name[0] == '-')
         return cli_fail(RL_CLI_USAGE, "unknown option '%s' (see rl --help)", name);
     return unknown_command(name);

@@ -31,4 +31,5 @@
 #include "rl/rl_octree.h"
 #include "rl/rl_culling.h"
 #include "rl/rl_surfels.h"
+#include "rl/rl_dist.h"
 #endif

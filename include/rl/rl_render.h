@@ -81,6 +81,12 @@ typedef struct rl_renderer_info {
      * caller can estimate a frame's memory before allocating it
      * (rl_renderer_frame_bytes); 0: none. */
     double frame_bytes_per_pixel;
+    /* Regions: the renderer can render a part of the image
+     * (rl_renderer_set_region) with exactly the pixels a whole frame gives
+     * there, because every pixel depends only on its own position, the
+     * camera, the scene and the options; a distributed run (rl_dist.h)
+     * hands such a renderer's image out in parts. */
+    bool regions;
 } rl_renderer_info;
 
 RL_API const rl_renderer_info *rl_renderer_list(size_t *count);
@@ -109,6 +115,17 @@ RL_API const char *rl_renderer_get(const rl_renderer *r, const char *key);
  * next frame is rendered as if it were the first from its camera. This is
  * the "unconditioned" state of Jähn 2015, Sec. 4.2.3. NULL is a no-op. */
 RL_API void rl_renderer_reset(rl_renderer *r);
+/* A part of the image: the pixels x0 <= x < x1, y0 <= y < y1. */
+typedef struct rl_rect {
+    int x0, y0, x1, y1;
+} rl_rect;
+/* Restricts the following renders to region (NULL: the whole image, the
+ * default): the pixels inside it are rendered as a whole frame renders
+ * them, the image's other pixels are left as they are, and the stats count
+ * the region's work. A region must be non-empty and lie within the image
+ * at render time (RL_ERR_INVALID_ARG there). RL_ERR_UNSUPPORTED for a
+ * renderer without info.regions. */
+RL_API rl_status rl_renderer_set_region(rl_renderer *r, const rl_rect *region);
 /* Inputs measured elsewhere. A renderer that draws from a measured
  * position-dependent property (visset: the sets of visible objects of
  * Jähn 2015, Sec. 7.6; select: a time or another scalar per position,

@@ -31,6 +31,8 @@ struct rl_renderer {
         char *key;
         uint64_t generation;
     } inputs[RL_RENDERER_MAX_INPUTS];
+    rl_rect region;             /* rl_renderer_set_region */
+    bool has_region;
 };
 
 static void clear_input(struct renderer_input *in)
@@ -44,6 +46,28 @@ static void clear_input(struct renderer_input *in)
 }
 
 void *rl_renderer_state(const rl_renderer *r) { return r ? r->state : NULL; }
+
+rl_status rl_renderer_set_region(rl_renderer *r, const rl_rect *region)
+{
+    if (!r)
+        return rl_error(RL_ERR_INVALID_ARG, "rl_renderer_set_region: renderer is NULL");
+    if (region && !r->cls->info.regions)
+        return rl_error(RL_ERR_UNSUPPORTED, "%s: renders whole images only (no regions)", r->cls->info.name);
+    if (region && (region->x0 < 0 || region->y0 < 0 || region->x1 <= region->x0 || region->y1 <= region->y0))
+        return rl_error(RL_ERR_INVALID_ARG, "%s: region [%d,%d)x[%d,%d) is empty or negative", r->cls->info.name,
+                        region->x0, region->x1, region->y0, region->y1);
+    r->has_region = region != NULL;
+    if (region)
+        r->region = *region;
+    return RL_OK;
+}
+
+rl_rect rl_renderer_region(const rl_renderer *r, int width, int height)
+{
+    if (!r || !r->has_region)
+        return (rl_rect){ 0, 0, width, height };
+    return r->region;
+}
 
 const char *rl_ray_type_name(rl_ray_type type)
 {
@@ -300,6 +324,10 @@ rl_status rl_renderer_render(rl_renderer *r, const rl_scene *scene, const rl_cam
     if (image->width != resolved.width || image->height != resolved.height)
         return rl_error(RL_ERR_INVALID_ARG, "%s: image is %dx%d but the camera renders %dx%d",
                         name, image->width, image->height, resolved.width, resolved.height);
+
+    if (r->has_region && (r->region.x1 > image->width || r->region.y1 > image->height))
+        return rl_error(RL_ERR_INVALID_ARG, "%s: region [%d,%d)x[%d,%d) lies outside the %dx%d image", name,
+                        r->region.x0, r->region.x1, r->region.y0, r->region.y1, image->width, image->height);
 
     char why[256];
     if (!rl_renderer_available(r, why, sizeof why))

@@ -57,6 +57,10 @@ bool rl_renderer_parse_color(const char *text, rl_vec3 *out);
 /* The implementation's state made by its class's create(), for accessors
  * of a renderer's own (e.g. rl_whitted_pixel_tree). */
 void *rl_renderer_state(const rl_renderer *r);
+/* The part of a width x height image to render (rl_renderer_set_region;
+ * checked against the image by rl_renderer_render): the whole image when
+ * none was set. Only classes with info.regions read it. */
+rl_rect rl_renderer_region(const rl_renderer *r, int width, int height);
 /* The lookup in slot (NULL when none was handed in) and how often the slot
  * was set, so that a renderer can tell a new lookup from the one it built
  * its per-region data for. */

@@ -96,13 +96,17 @@ typedef struct frame {
     int ss;
     rl_ray_tree *trees;          /* or NULL */
     int tiles_x;
+    rl_rect region;              /* the pixels to trace (rl_renderer_set_region) */
 } frame;
 
 static void render_tile(const frame *f, int64_t tile, uint64_t rays[RL_RAY_TYPE_COUNT])
 {
-    int x0 = (int)(tile % f->tiles_x) * TILE, y0 = (int)(tile / f->tiles_x) * TILE;
-    int x1 = x0 + TILE < f->image->width ? x0 + TILE : f->image->width;
-    int y1 = y0 + TILE < f->image->height ? y0 + TILE : f->image->height;
+    /* Tiles are numbered over the region, from its corner: a whole frame's
+     * region is the image. */
+    const rl_rect *g = &f->region;
+    int x0 = g->x0 + (int)(tile % f->tiles_x) * TILE, y0 = g->y0 + (int)(tile / f->tiles_x) * TILE;
+    int x1 = x0 + TILE < g->x1 ? x0 + TILE : g->x1;
+    int y1 = y0 + TILE < g->y1 ? y0 + TILE : g->y1;
     int ss = f->ss, centre = ss / 2;
     rl_vec3 forward = rl_neg(f->cam.w);
     for (int y = y0; y < y1; ++y) {
@@ -217,7 +221,9 @@ static rl_status whitted_render(rl_renderer *r, void *state, const rl_scene *sce
     if ((st = prepare_trees(s, rl_renderer_opt_bool(r, "ray_trees"), image->width, image->height)) != RL_OK)
         return st;
 
-    int tiles_x = (image->width + TILE - 1) / TILE, tiles_y = (image->height + TILE - 1) / TILE;
+    rl_rect region = rl_renderer_region(r, image->width, image->height);
+    int rw = region.x1 - region.x0, rh = region.y1 - region.y0;
+    int tiles_x = (rw + TILE - 1) / TILE, tiles_y = (rh + TILE - 1) / TILE;
     int64_t num_tiles = (int64_t)tiles_x * tiles_y;
     rl_tracer *tracer = NULL;
     uint64_t (*tile_rays)[RL_RAY_TYPE_COUNT] = NULL;
@@ -238,6 +244,7 @@ static rl_status whitted_render(rl_renderer *r, void *state, const rl_scene *sce
         .ss = (int)rl_renderer_opt_int(r, "ss"),
         .trees = s->trees,
         .tiles_x = tiles_x,
+        .region = region,
     };
     bool finished = rl_renderer_progress(r, BUILD_SHARE) && trace_tiles(r, &f, num_threads, num_tiles, tile_rays);
     rl_tracer_release(tracer);
@@ -251,7 +258,7 @@ static rl_status whitted_render(rl_renderer *r, void *state, const rl_scene *sce
         for (int k = 0; k < RL_RAY_TYPE_COUNT; ++k)
             stats->rays[k] += tile_rays[t][k];
     free(tile_rays);
-    stats->pixels_written = (uint64_t)image->width * (uint64_t)image->height;
+    stats->pixels_written = (uint64_t)rw * (uint64_t)rh;
     stats->samples = stats->pixels_written * (uint64_t)(f.ss * f.ss);
     return RL_OK;
 }
@@ -259,7 +266,8 @@ static rl_status whitted_render(rl_renderer *r, void *state, const rl_scene *sce
 const rl_renderer_class rl_whitted_renderer_class = {
     .info = { .name = "whitted",
               .description = "Recursive Whitted ray tracing with Phong shading, hard shadows, reflection and refraction",
-              .reference = "Whitted 1980; coefficient model of Ullmann 2003, Sec. 3.1 (eq. 3.1-3.4)" },
+              .reference = "Whitted 1980; coefficient model of Ullmann 2003, Sec. 3.1 (eq. 3.1-3.4)",
+              .regions = true },
     .options = whitted_options,
     .num_options = sizeof whitted_options / sizeof whitted_options[0],
     .state_size = sizeof(whitted_state),

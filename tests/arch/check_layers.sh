@@ -32,6 +32,7 @@ declare -A header=(
   [rl_render.h]=render [rl_trace.h]=render [rl_gbuffer.h]=render [rl_filter.h]=render [rl_pt.h]=render
   [rl_vt.h]=render [rl_culling.h]=render [rl_surfels.h]=render
   [rl_property.h]=eval [rl_sampling.h]=eval [rl_metrics.h]=eval [rl_stats.h]=eval [rl_plot.h]=eval
+  [rl_dist.h]=dist
 )
 
 fails=0

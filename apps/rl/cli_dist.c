@@ -1,0 +1,59 @@
+/* cli_dist.c: the global flag --dist (rl_dist.h). Under mpirun every rank
+ * runs the same command line; rank 0 prints and writes, the workers render
+ * their bands quietly (their standard output goes to /dev/null, their
+ * errors still reach the terminal through mpirun). */
+#define _POSIX_C_SOURCE 200809L
+#include "cli.h"
+
+#include <stdio.h>
+
+static rl_dist *dist;
+static rl_dist_stats last;
+static bool have_last;
+
+int cli_dist_begin(int *argc, char ***argv)
+{
+    rl_clear_error();
+    rl_status st = rl_dist_init(argc, argv, &dist);
+    if (st != RL_OK)
+        return cli_fail_status(RL_CLI_FAIL, st, "--dist");
+    if (rl_dist_rank(dist) > 0 && !freopen("/dev/null", "w", stdout))
+        return cli_fail(RL_CLI_FAIL, "--dist: rank %d cannot silence its output", rl_dist_rank(dist));
+    return RL_CLI_OK;
+}
+
+int cli_dist_end(int rc)
+{
+    rl_dist_release(dist, rc == RL_CLI_OK ? RL_OK : RL_ERR_CANCELLED);
+    dist = NULL;
+    return rc;
+}
+
+bool cli_dist_master(void)
+{
+    return rl_dist_rank(dist) == 0;
+}
+
+rl_status cli_render_call(rl_renderer *r, const rl_scene *scene, const rl_camera *cam, rl_image *img,
+                          rl_render_stats *stats)
+{
+    if (!dist)
+        return rl_renderer_render(r, scene, cam, img, stats);
+    rl_status st = rl_dist_render(dist, r, scene, cam, img, stats, &last);
+    have_last = st == RL_OK && last.ranks > 1;
+    return st;
+}
+
+void cli_print_dist_summary(FILE *out)
+{
+    if (!have_last || !cli_dist_master())
+        return;
+    fprintf(out, "dist: %d ranks, %llu bands, %llu messages, %.1f MB; per rank: bands, pixels, busy ms, idle %%\n",
+            last.ranks, (unsigned long long)last.tasks, (unsigned long long)last.messages, (double)last.bytes / 1e6);
+    for (int k = 0; k < last.ranks; k++) {
+        const rl_dist_rank_stats *p = &last.per_rank[k];
+        double idle = last.time_ms > 0.0 ? 100.0 * (1.0 - p->busy_ms / last.time_ms) : 0.0;
+        fprintf(out, "  rank %d%s: %llu, %llu, %.1f, %.0f%%\n", k, k == 0 ? " (master)" : "",
+                (unsigned long long)p->tasks, (unsigned long long)p->pixels, p->busy_ms, idle < 0.0 ? 0.0 : idle);
+    }
+}

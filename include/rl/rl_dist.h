@@ -1,0 +1,86 @@
+/* rl_dist.h: one run spread over the processes of an MPI job (Open MPI).
+ *
+ * Every process of the job ("rank") loads the same scene, makes the same
+ * renderer with the same options and calls the same functions in the same
+ * order; rank 0 is the master (Ullmann 2003, Sec. 4.3: master/slave) and
+ * hands out the work on demand, the others are workers. OpenMP threads run
+ * inside every rank (Sec. 4.5). A process that was not started by mpirun,
+ * or a job of one rank, runs exactly as without distribution.
+ *
+ *     rl_dist *d;
+ *     rl_dist_init(&argc, &argv, &d);            // every rank, first thing
+ *     ... load the scene, make the renderer, the camera and the image ...
+ *     rl_dist_render(d, r, scene, &cam, img, &stats, &ds);   // collective
+ *     if (rl_dist_rank(d) == 0) ... img holds the whole frame ...
+ *     rl_dist_release(d, status);                // every rank, last thing
+ *
+ * Frames (rl_dist_render) go out as bands of image rows to renderers that
+ * can render regions (rl_renderer_info.regions: every pixel depends only on
+ * its own position), so the assembled image equals the one-process image
+ * bit for bit. */
+#ifndef RL_DIST_H
+#define RL_DIST_H
+
+#include <stdbool.h>
+#include <stddef.h>
+#include <stdint.h>
+
+#include "rl/rl_render.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+typedef struct rl_dist rl_dist;     /* opaque: this process's place in the job */
+
+/* Whether this build can join MPI jobs; if not, the reason into why (n bytes). */
+RL_API bool rl_dist_available(char *why, size_t n);
+/* Joins the job this process was started in (MPI_Init_thread, funneled:
+ * only the calling thread talks to MPI), or makes a job of one for a
+ * process started on its own. argc and argv may be NULL. Once per
+ * process. RL_ERR_UNSUPPORTED in a build without MPI. */
+RL_API rl_status rl_dist_init(int *argc, char ***argv, rl_dist **out);
+/* This process's rank (0: the master) and the job's size; 0 and 1 for NULL. */
+RL_API int rl_dist_rank(const rl_dist *d);
+RL_API int rl_dist_size(const rl_dist *d);
+/* Leaves the job: MPI_Finalize when status is RL_OK, else MPI_Abort, so
+ * that a rank that failed (a scene it could not load) ends the whole job
+ * with its error instead of leaving the others waiting for it. NULL is a
+ * no-op. */
+RL_API void rl_dist_release(rl_dist *d, rl_status status);
+
+/* What one rank did in a distributed frame (the master's view). */
+typedef struct rl_dist_rank_stats {
+    uint64_t tasks;          /* bands rendered */
+    uint64_t pixels;
+    double busy_ms;          /* rendering its bands */
+} rl_dist_rank_stats;
+
+typedef struct rl_dist_stats {
+    int ranks;
+    uint64_t tasks;          /* bands of the frame */
+    uint64_t messages;       /* point-to-point messages of the frame, both ways */
+    uint64_t bytes;          /* their payload */
+    double time_ms;          /* the frame, on the master */
+    /* Per rank, rank 0 (the master, which renders bands between its
+     * messages) first; NULL when the frame ran in one process. Owned by
+     * the rl_dist, valid until its next frame or release. */
+    const rl_dist_rank_stats *per_rank;
+} rl_dist_stats;
+
+/* Renders cam's frame into image with every rank's copy of r: collective,
+ * every rank calls it with the same renderer options, scene, camera and
+ * image size. On the master, image receives the whole frame (every layer
+ * it has) and stats the sum of every rank's rays and samples; the workers'
+ * images hold only their own bands. With one rank this is
+ * rl_renderer_render. RL_ERR_UNSUPPORTED for a renderer without
+ * info.regions in a job of several ranks; a rank's failure is the frame's
+ * status on the master. dstats may be NULL. */
+RL_API rl_status rl_dist_render(rl_dist *d, rl_renderer *r, const rl_scene *scene, const rl_camera *cam,
+                                rl_image *image, rl_render_stats *stats, rl_dist_stats *dstats);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif

@@ -1,0 +1,346 @@
+/* dist.c: rl_dist on Open MPI (rl_dist.h).
+ *
+ * A frame is cut into bands of BAND_ROWS image rows, handed out on demand
+ * as in Ullmann 2003, Sec. 4.3.2's queue balancing (Fig. 4.8): the master
+ * keeps PREFETCH bands queued at every worker, so that a worker finds its
+ * next band waiting when it returns one, and hands out the next band to
+ * whichever worker returned one. Between messages the master renders bands
+ * itself: with one rank per node it would otherwise leave a node idle.
+ * Bands are image rows, not squares, because a band's pixels are one
+ * contiguous run per layer: no packing on either side.
+ *
+ * Messages (tags below), all on the job's world communicator:
+ *   master -> worker  TAG_TASK    int32 band
+ *   master -> worker  TAG_DONE    int32 status of the frame
+ *   worker -> master  TAG_RESULT  band_result (band, status, counts, error)
+ *   worker -> master  TAG_PIXELS  the band's layers, present ones in order
+ *                                 colour, depth, object ID, triangle ID
+ * Only the calling thread talks to MPI (MPI_THREAD_FUNNELED); OpenMP
+ * threads render inside each rank. */
+#include "rl/rl_dist.h"
+
+#include <mpi.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "core/error.h"
+#include "rl/rl_timer.h"
+
+enum { TAG_TASK = 1, TAG_DONE, TAG_RESULT, TAG_PIXELS };
+
+/* 16 rows: whitted's tile height, so a band is whole tiles of it; small
+ * enough that a 1024-row frame has 64 bands to balance over the ranks. */
+#define BAND_ROWS 16
+#define PREFETCH 2
+
+struct rl_dist {
+    int rank, size;
+    bool own_mpi;                      /* we called MPI_Init: we finalize */
+    rl_dist_rank_stats *per_rank;      /* size entries */
+};
+
+typedef struct band_result {
+    int32_t band;
+    int32_t status;                    /* rl_status of the worker's render */
+    uint64_t rays[RL_RAY_TYPE_COUNT];
+    uint64_t samples, pixels;
+    double busy_ms;
+    char error[256];                   /* rl_last_error() when status failed */
+} band_result;
+
+static bool dist_initialised;
+
+bool rl_dist_available(char *why, size_t n)
+{
+    (void)why;
+    (void)n;
+    return true;
+}
+
+rl_status rl_dist_init(int *argc, char ***argv, rl_dist **out)
+{
+    if (!out)
+        return rl_error(RL_ERR_INVALID_ARG, "rl_dist_init: out is NULL");
+    *out = NULL;
+    if (dist_initialised)
+        return rl_error(RL_ERR_INVALID_ARG, "rl_dist_init: this process has joined its job already");
+    rl_dist *d = calloc(1, sizeof *d);
+    if (!d)
+        return RL_ERR_OUT_OF_MEMORY;
+    int ready = 0, provided = 0;
+    MPI_Initialized(&ready);
+    if (!ready) {
+        if (MPI_Init_thread(argc, argv, MPI_THREAD_FUNNELED, &provided) != MPI_SUCCESS) {
+            free(d);
+            return rl_error(RL_ERR_UNSUPPORTED, "MPI_Init_thread failed: cannot join the MPI job");
+        }
+        d->own_mpi = true;
+    }
+    /* Errors come back as codes, so a failed send is this run's error
+     * with its message rather than an abort deep inside MPI. */
+    MPI_Comm_set_errhandler(MPI_COMM_WORLD, MPI_ERRORS_RETURN);
+    MPI_Comm_rank(MPI_COMM_WORLD, &d->rank);
+    MPI_Comm_size(MPI_COMM_WORLD, &d->size);
+    d->per_rank = calloc((size_t)d->size, sizeof *d->per_rank);
+    if (!d->per_rank) {
+        if (d->own_mpi)
+            MPI_Finalize();
+        free(d);
+        return RL_ERR_OUT_OF_MEMORY;
+    }
+    dist_initialised = true;
+    *out = d;
+    return RL_OK;
+}
+
+int rl_dist_rank(const rl_dist *d) { return d ? d->rank : 0; }
+int rl_dist_size(const rl_dist *d) { return d ? d->size : 1; }
+
+void rl_dist_release(rl_dist *d, rl_status status)
+{
+    if (!d)
+        return;
+    bool own = d->own_mpi;
+    int size = d->size;
+    free(d->per_rank);
+    free(d);
+    if (!own)
+        return;
+    if (status != RL_OK && size > 1)
+        MPI_Abort(MPI_COMM_WORLD, 1);      /* ends every rank: nobody waits for this one */
+    MPI_Finalize();
+}
+
+static rl_status mpi_failed(int code, const char *what)
+{
+    char text[MPI_MAX_ERROR_STRING];
+    int len = 0;
+    if (MPI_Error_string(code, text, &len) != MPI_SUCCESS)
+        snprintf(text, sizeof text, "MPI error %d", code);
+    return rl_error(RL_ERR_IO, "distributed frame: %s: %s", what, text);
+}
+
+/* The band's rows of image: where each present layer's run starts, its
+ * bytes, and the total. */
+typedef struct band_layout {
+    void *part[4];
+    size_t bytes[4];
+    size_t total;
+} band_layout;
+
+static band_layout layout_of(rl_image *image, int band)
+{
+    int y0 = band * BAND_ROWS, y1 = y0 + BAND_ROWS < image->height ? y0 + BAND_ROWS : image->height;
+    size_t first = (size_t)y0 * (size_t)image->width, n = (size_t)(y1 - y0) * (size_t)image->width;
+    band_layout l = { { 0 }, { 0 }, 0 };
+    if (image->color) {
+        l.part[0] = image->color + first;
+        l.bytes[0] = n * sizeof *image->color;
+    }
+    if (image->depth) {
+        l.part[1] = image->depth + first;
+        l.bytes[1] = n * sizeof *image->depth;
+    }
+    if (image->object_id) {
+        l.part[2] = image->object_id + first;
+        l.bytes[2] = n * sizeof *image->object_id;
+    }
+    if (image->triangle_id) {
+        l.part[3] = image->triangle_id + first;
+        l.bytes[3] = n * sizeof *image->triangle_id;
+    }
+    for (int k = 0; k < 4; ++k)
+        l.total += l.bytes[k];
+    return l;
+}
+
+/* Renders band into image with r restricted to its rows. */
+static rl_status render_band(rl_renderer *r, const rl_scene *scene, const rl_camera *cam, rl_image *image,
+                             int band, rl_render_stats *stats)
+{
+    int y0 = band * BAND_ROWS, y1 = y0 + BAND_ROWS < image->height ? y0 + BAND_ROWS : image->height;
+    rl_rect rows = { 0, y0, image->width, y1 };
+    rl_status st = rl_renderer_set_region(r, &rows);
+    if (st == RL_OK)
+        st = rl_renderer_render(r, scene, cam, image, stats);
+    rl_renderer_set_region(r, NULL);
+    return st;
+}
+
+static void add_band(rl_render_stats *to, const uint64_t rays[RL_RAY_TYPE_COUNT], uint64_t samples,
+                     uint64_t pixels)
+{
+    for (int k = 0; k < RL_RAY_TYPE_COUNT; ++k)
+        to->rays[k] += rays[k];
+    to->samples += samples;
+    to->pixels_written += pixels;
+}
+
+/* A worker's frame: bands until TAG_DONE, whose status it returns. */
+static rl_status work(rl_dist *d, rl_renderer *r, const rl_scene *scene, const rl_camera *cam, rl_image *image)
+{
+    (void)d;
+    for (;;) {
+        MPI_Status ms;
+        int32_t value = 0;
+        int code = MPI_Recv(&value, 1, MPI_INT32_T, 0, MPI_ANY_TAG, MPI_COMM_WORLD, &ms);
+        if (code != MPI_SUCCESS)
+            return mpi_failed(code, "receiving a band from the master");
+        if (ms.MPI_TAG == TAG_DONE)
+            return value == RL_OK ? RL_OK
+                                  : rl_error((rl_status)value, "distributed frame: another rank failed (%s)",
+                                             rl_status_string((rl_status)value));
+        band_result res;
+        memset(&res, 0, sizeof res);
+        res.band = value;
+        rl_render_stats bs = { 0 };
+        rl_timer t;
+        rl_timer_start(&t);
+        rl_clear_error();
+        rl_status st = render_band(r, scene, cam, image, value, &bs);
+        res.busy_ms = rl_timer_ms(&t);
+        res.status = (int32_t)st;
+        if (st != RL_OK)
+            snprintf(res.error, sizeof res.error, "%s", rl_last_error());
+        memcpy(res.rays, bs.rays, sizeof res.rays);
+        res.samples = bs.samples;
+        res.pixels = bs.pixels_written;
+        code = MPI_Send(&res, (int)sizeof res, MPI_BYTE, 0, TAG_RESULT, MPI_COMM_WORLD);
+        band_layout l = layout_of(image, value);
+        for (int k = 0; code == MPI_SUCCESS && st == RL_OK && k < 4; ++k)
+            if (l.bytes[k])
+                code = MPI_Send(l.part[k], (int)l.bytes[k], MPI_BYTE, 0, TAG_PIXELS, MPI_COMM_WORLD);
+        if (code != MPI_SUCCESS)
+            return mpi_failed(code, "returning a band to the master");
+    }
+}
+
+/* The master's frame. */
+static rl_status lead(rl_dist *d, rl_renderer *r, const rl_scene *scene, const rl_camera *cam, rl_image *image,
+                      rl_render_stats *stats, rl_dist_stats *ds)
+{
+    const int bands = (image->height + BAND_ROWS - 1) / BAND_ROWS;
+    int next = 0, pending = 0, code = MPI_SUCCESS;
+    rl_status st = RL_OK;
+    char failure[320] = "";
+    /* Queue PREFETCH bands at every worker first. */
+    for (int k = 0; k < PREFETCH; ++k)
+        for (int w = 1; w < d->size && next < bands && code == MPI_SUCCESS; ++w) {
+            int32_t band = next++;
+            code = MPI_Send(&band, 1, MPI_INT32_T, w, TAG_TASK, MPI_COMM_WORLD);
+            ++pending;
+            ++ds->messages;
+        }
+    if (code != MPI_SUCCESS)
+        return mpi_failed(code, "handing out a band");
+    while (pending > 0 || (st == RL_OK && next < bands)) {
+        int arrived = 0;
+        MPI_Status ms;
+        if ((code = MPI_Iprobe(MPI_ANY_SOURCE, TAG_RESULT, MPI_COMM_WORLD, &arrived, &ms)) != MPI_SUCCESS)
+            break;
+        if (!arrived && st == RL_OK && next < bands) {
+            /* Nothing to answer: render a band here. */
+            rl_render_stats bs = { 0 };
+            rl_timer t;
+            rl_timer_start(&t);
+            int band = next++;
+            st = render_band(r, scene, cam, image, band, &bs);
+            d->per_rank[0].busy_ms += rl_timer_ms(&t);
+            if (st == RL_OK) {
+                add_band(stats, bs.rays, bs.samples, bs.pixels_written);
+                stats->prep_ms += bs.prep_ms;
+                ++d->per_rank[0].tasks;
+                d->per_rank[0].pixels += bs.pixels_written;
+            } else {
+                snprintf(failure, sizeof failure, "%s", rl_last_error());
+            }
+            continue;
+        }
+        if (!arrived && (code = MPI_Probe(MPI_ANY_SOURCE, TAG_RESULT, MPI_COMM_WORLD, &ms)) != MPI_SUCCESS)
+            break;
+        int w = ms.MPI_SOURCE;
+        band_result res;
+        if ((code = MPI_Recv(&res, (int)sizeof res, MPI_BYTE, w, TAG_RESULT, MPI_COMM_WORLD, MPI_STATUS_IGNORE)) !=
+            MPI_SUCCESS)
+            break;
+        --pending;
+        ++ds->messages;
+        ds->bytes += sizeof res;
+        if (res.status == RL_OK) {
+            if (res.band < 0 || res.band >= bands) {
+                code = MPI_ERR_OTHER;
+                break;
+            }
+            band_layout l = layout_of(image, res.band);
+            for (int k = 0; code == MPI_SUCCESS && k < 4; ++k)
+                if (l.bytes[k]) {
+                    code = MPI_Recv(l.part[k], (int)l.bytes[k], MPI_BYTE, w, TAG_PIXELS, MPI_COMM_WORLD,
+                                    MPI_STATUS_IGNORE);
+                    ++ds->messages;
+                    ds->bytes += l.bytes[k];
+                }
+            if (code != MPI_SUCCESS)
+                break;
+            add_band(stats, res.rays, res.samples, res.pixels);
+            ++d->per_rank[w].tasks;
+            d->per_rank[w].pixels += res.pixels;
+            d->per_rank[w].busy_ms += res.busy_ms;
+        } else if (st == RL_OK) {
+            st = (rl_status)res.status;
+            res.error[sizeof res.error - 1] = '\0';
+            snprintf(failure, sizeof failure, "rank %d: %s", w, res.error);
+        }
+        if (st == RL_OK && next < bands) {
+            int32_t band = next++;
+            if ((code = MPI_Send(&band, 1, MPI_INT32_T, w, TAG_TASK, MPI_COMM_WORLD)) != MPI_SUCCESS)
+                break;
+            ++pending;
+            ++ds->messages;
+        }
+    }
+    if (code != MPI_SUCCESS)
+        return mpi_failed(code, "collecting the bands");   /* the CLI then aborts the job */
+    int32_t done = (int32_t)st;
+    for (int w = 1; w < d->size && code == MPI_SUCCESS; ++w) {
+        code = MPI_Send(&done, 1, MPI_INT32_T, w, TAG_DONE, MPI_COMM_WORLD);
+        ++ds->messages;
+    }
+    ds->tasks = (uint64_t)bands;
+    if (st != RL_OK)
+        return rl_error(st, "%s", failure);
+    return code == MPI_SUCCESS ? RL_OK : mpi_failed(code, "ending the frame");
+}
+
+rl_status rl_dist_render(rl_dist *d, rl_renderer *r, const rl_scene *scene, const rl_camera *cam,
+                         rl_image *image, rl_render_stats *stats, rl_dist_stats *dstats)
+{
+    rl_dist_stats ds_local;
+    rl_dist_stats *ds = dstats ? dstats : &ds_local;
+    memset(ds, 0, sizeof *ds);
+    ds->ranks = rl_dist_size(d);
+    rl_render_stats local;
+    rl_render_stats *rs = stats ? stats : &local;
+    memset(rs, 0, sizeof *rs);
+    if (!d || d->size == 1)
+        return rl_renderer_render(r, scene, cam, image, rs);
+    if (!r || !scene || !cam || !image)
+        return rl_error(RL_ERR_INVALID_ARG, "rl_dist_render: renderer, scene, camera and image must not be NULL");
+    /* Every rank decides alike from what every rank has, so that all of
+     * them refuse together and none waits for a band. */
+    const rl_renderer_info *info = NULL;
+    size_t n = 0;
+    const rl_renderer_info *list = rl_renderer_list(&n);
+    for (size_t i = 0; i < n; ++i)
+        if (strcmp(list[i].name, rl_renderer_name(r)) == 0)
+            info = &list[i];
+    if (!info || !info->regions)
+        return rl_error(RL_ERR_UNSUPPORTED, "%s renders whole images only and cannot be distributed "
+                        "(distributed renderers render image regions: rl algos marks them)", rl_renderer_name(r));
+    memset(d->per_rank, 0, (size_t)d->size * sizeof *d->per_rank);
+    rl_timer t;
+    rl_timer_start(&t);
+    rl_status st = d->rank == 0 ? lead(d, r, scene, cam, image, rs, ds) : work(d, r, scene, cam, image);
+    rs->time_ms = ds->time_ms = rl_timer_ms(&t);
+    ds->per_rank = d->per_rank;
+    return st;
+}

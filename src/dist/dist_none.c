@@ -1,0 +1,41 @@
+/* dist_none.c: rl_dist in a build without Open MPI (rl_dist.h): no job to
+ * join, every frame renders in this process. */
+#include "rl/rl_dist.h"
+
+#include <stdio.h>
+
+#include "core/error.h"
+
+#define WHY "this build has no Open MPI (install libopenmpi-dev openmpi-bin and rebuild)"
+
+bool rl_dist_available(char *why, size_t n)
+{
+    if (why && n)
+        snprintf(why, n, "%s", WHY);
+    return false;
+}
+
+rl_status rl_dist_init(int *argc, char ***argv, rl_dist **out)
+{
+    (void)argc;
+    (void)argv;
+    if (out)
+        *out = NULL;
+    return rl_error(RL_ERR_UNSUPPORTED, "distributed runs: %s", WHY);
+}
+
+int rl_dist_rank(const rl_dist *d) { return (void)d, 0; }
+int rl_dist_size(const rl_dist *d) { return (void)d, 1; }
+void rl_dist_release(rl_dist *d, rl_status status) { (void)d, (void)status; }
+
+rl_status rl_dist_render(rl_dist *d, rl_renderer *r, const rl_scene *scene, const rl_camera *cam,
+                         rl_image *image, rl_render_stats *stats, rl_dist_stats *dstats)
+{
+    (void)d;
+    if (dstats)
+        *dstats = (rl_dist_stats){ .ranks = 1 };
+    rl_status st = rl_renderer_render(r, scene, cam, image, stats);
+    if (dstats && stats)
+        dstats->time_ms = stats->time_ms;
+    return st;
+}

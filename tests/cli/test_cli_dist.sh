@@ -1,0 +1,67 @@
+#!/usr/bin/env bash
+# test_cli_dist.sh: rl --dist render under mpirun (Open MPI, issue 39).
+# Three ranks, oversubscribed on the small CI machine, give the same image,
+# depth and IDs as one process, bit for bit, for single frames and for a
+# camera path; a renderer without regions is refused on every rank; without
+# mpirun --dist is a job of one. Skips (saying why) where this rl was built
+# without MPI or mpirun is missing.
+# Run as: bash test_cli_dist.sh <rl-binary> <scratch-dir>
+set -u
+. "$(dirname "${BASH_SOURCE[0]}")/lib.bash"
+
+# Not a distributed command: refused before MPI is touched.
+expect_usage_error "$RL" --dist eval cornell --property visibility
+grep -q "only rl render runs distributed" "$TMP/err" || fail "--dist eval: $(cat "$TMP/err")"
+
+# One process: --dist is a job of one, the same frame.
+if ! "$RL" --dist render cornell --algo whitted --size 32x24 --out "$TMP/one.png" >"$TMP/out" 2>"$TMP/err"; then
+    grep -q "no Open MPI" "$TMP/err" || fail "--dist without mpirun failed: $(cat "$TMP/err")"
+    echo "test_cli_dist: this rl has no MPI; the distributed cases are skipped"
+    exit 0
+fi
+command -v mpirun >/dev/null || { echo "test_cli_dist: no mpirun; the distributed cases are skipped"; exit 0; }
+
+# Open MPI refuses root without these, and each rank would otherwise spin
+# on the two cores; one OpenMP thread per rank keeps three ranks fair.
+export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 OMPI_MCA_mpi_yield_when_idle=1
+export OMP_NUM_THREADS=1
+MPI=(timeout 120 mpirun --oversubscribe -np 3)
+
+run_ok "$RL" render spheres --algo whitted --size 72x53 --out "$TMP/ref.png" --depth-out "$TMP/ref.exr" \
+    --id-out "$TMP/ref-id.png"
+run_ok "${MPI[@]}" "$RL" --dist render spheres --algo whitted --size 72x53 --out "$TMP/dist.png" \
+    --depth-out "$TMP/dist.exr" --id-out "$TMP/dist-id.png"
+for f in .png .exr -id.png; do
+    cmp -s "$TMP/ref$f" "$TMP/dist$f" || fail "3 ranks differ from one process in ref$f"
+done
+# One summary line, from the master only, and its per-rank lines.
+[ "$(grep -c '^whitted 72x53 spheres: ' "$TMP/out")" -eq 1 ] || fail "expected one summary: $(cat "$TMP/out")"
+expect_in "$TMP/out" "^dist: 3 ranks, 4 bands"
+expect_in "$TMP/out" "^  rank 2: "
+
+# A camera path: every frame spread, every frame equal.
+cat >"$TMP/path.json" <<'JSON'
+{ "objects": [ { "generator": "teapot" } ],
+  "camera_path": { "keys": [ { "time_s": 0, "eye": [0, 1, 3], "target": [0, 0, 0] },
+                             { "time_s": 1, "eye": [2, 1, 2], "target": [0, 0, 0] } ] } }
+JSON
+run_ok "$RL" render "$TMP/path.json" --algo whitted --camera-path --fps 3 --size 40x30 --out "$TMP/p-ref-%d.png"
+run_ok "${MPI[@]}" "$RL" --dist render "$TMP/path.json" --algo whitted --camera-path --fps 3 --size 40x30 \
+    --out "$TMP/p-dist-%d.png"
+n=0
+for f in "$TMP"/p-ref-*.png; do
+    cmp -s "$f" "${f/p-ref-/p-dist-}" || fail "camera path frame $f differs"
+    n=$((n + 1))
+done
+[ "$n" -ge 3 ] || fail "the camera path gave $n frames"
+
+# A renderer whose pixels depend on each other is refused, on every rank,
+# and nothing is written.
+expect_exit 1 "${MPI[@]}" "$RL" --dist render cornell --algo raster --size 32x24 --out "$TMP/raster.png"
+grep -q "^rl: error: raster renders whole images only and cannot be distributed" "$TMP/err" ||
+    fail "raster under --dist: $(head -c 600 "$TMP/err")"
+[ ! -e "$TMP/raster.png" ] || fail "a refused distributed run wrote an image"
+run_ok "$RL" algos
+sed -n '/^whitted: /,/^$/p' "$TMP/out" | grep -q "^  distributable:" || fail "rl algos does not mark whitted"
+sed -n '/^raster: /,/^$/p' "$TMP/out" | grep -q "^  distributable:" && fail "rl algos marks raster distributable"
+echo "test_cli_dist: ok"

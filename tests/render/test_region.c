@@ -1,0 +1,127 @@
+/* test_region.c: rl_renderer_set_region, what a distributed frame
+ * (rl_dist.h) builds on. A renderer with info.regions renders a region with
+ * exactly the pixels of a whole frame there and leaves the others alone; the
+ * image assembled from regions is the whole frame bit for bit. */
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <string.h>
+
+#include <cmocka.h>
+
+#include "render_fixtures.h"
+
+#define SENTINEL 12345.0f
+
+static bool has_regions(const char *name)
+{
+    size_t n = 0;
+    const rl_renderer_info *list = rl_renderer_list(&n);
+    for (size_t i = 0; i < n; ++i)
+        if (strcmp(list[i].name, name) == 0)
+            return list[i].regions;
+    fail_msg("no renderer %s", name);
+    return false;
+}
+
+/* Odd bands and a region that does not start on a tile corner: the region
+ * renders what the whole frame has there, the rest keeps the sentinel. */
+static void test_whitted_region_equals_whole_frame(void **state)
+{
+    (void)state;
+    assert_true(has_regions("whitted"));
+    rl_camera cam;
+    rl_scene *s = NULL;
+    assert_int_equal(rl_scene_create_builtin("spheres", NULL, &s), RL_OK);
+    assert_int_equal(rl_scene_get_camera(s, NULL, &cam), RL_OK);
+    cam.width = 53;
+    cam.height = 37;
+    rl_render_stats whole_stats;
+    rl_image *whole = fx_render("whitted", s, &cam, FX_ALL_LAYERS, NULL, &whole_stats);
+
+    rl_renderer *r = fx_make("whitted", NULL);
+    rl_image *part = NULL;
+    assert_int_equal(rl_image_create(cam.width, cam.height, FX_ALL_LAYERS, &part), RL_OK);
+    rl_image_fill(part, rl_v4(SENTINEL, SENTINEL, SENTINEL, SENTINEL));
+    const rl_rect region = { 5, 7, 41, 30 };
+    assert_int_equal(rl_renderer_set_region(r, &region), RL_OK);
+    rl_render_stats stats;
+    assert_int_equal(rl_renderer_render(r, s, &cam, part, &stats), RL_OK);
+    assert_int_equal(stats.pixels_written, (uint64_t)(36 * 23));
+    assert_true(stats.rays[RL_RAY_PRIMARY] < whole_stats.rays[RL_RAY_PRIMARY]);
+    for (int y = 0; y < cam.height; ++y)
+        for (int x = 0; x < cam.width; ++x) {
+            size_t i = (size_t)y * cam.width + x;
+            bool inside = x >= region.x0 && x < region.x1 && y >= region.y0 && y < region.y1;
+            if (inside) {
+                assert_memory_equal(&part->color[i], &whole->color[i], sizeof part->color[i]);
+                assert_memory_equal(&part->depth[i], &whole->depth[i], sizeof part->depth[i]);
+                assert_int_equal(part->object_id[i], whole->object_id[i]);
+                assert_int_equal(part->triangle_id[i], whole->triangle_id[i]);
+            } else {
+                assert_true(part->color[i].x == SENTINEL);
+            }
+        }
+
+    /* Bands of rows that tile the image assemble the whole frame, and the
+     * ray counts of the bands add up to the whole frame's. */
+    rl_image_fill(part, rl_v4(SENTINEL, SENTINEL, SENTINEL, SENTINEL));
+    uint64_t rays[RL_RAY_TYPE_COUNT] = { 0 };
+    for (int y0 = 0; y0 < cam.height; y0 += 16) {
+        rl_rect band = { 0, y0, cam.width, y0 + 16 < cam.height ? y0 + 16 : cam.height };
+        assert_int_equal(rl_renderer_set_region(r, &band), RL_OK);
+        assert_int_equal(rl_renderer_render(r, s, &cam, part, &stats), RL_OK);
+        for (int k = 0; k < RL_RAY_TYPE_COUNT; ++k)
+            rays[k] += stats.rays[k];
+    }
+    fx_assert_images_identical(part, whole);
+    assert_memory_equal(rays, whole_stats.rays, sizeof rays);
+
+    /* NULL returns to whole frames. */
+    assert_int_equal(rl_renderer_set_region(r, NULL), RL_OK);
+    assert_int_equal(rl_renderer_render(r, s, &cam, part, &stats), RL_OK);
+    assert_int_equal(stats.pixels_written, (uint64_t)cam.width * cam.height);
+    rl_image_release(part);
+    rl_image_release(whole);
+    rl_renderer_release(r);
+    rl_scene_release(s);
+}
+
+static void test_bad_regions_are_refused(void **state)
+{
+    (void)state;
+    rl_camera cam;
+    rl_scene *s = fx_cornell(&cam, 16);
+    rl_renderer *r = fx_make("whitted", NULL);
+    assert_int_equal(rl_renderer_set_region(r, &(rl_rect){ 4, 4, 4, 8 }), RL_ERR_INVALID_ARG);
+    assert_int_equal(rl_renderer_set_region(r, &(rl_rect){ -1, 0, 4, 8 }), RL_ERR_INVALID_ARG);
+    assert_int_equal(rl_renderer_set_region(NULL, NULL), RL_ERR_INVALID_ARG);
+    /* A region past the image is found at render time, when the image is known. */
+    assert_int_equal(rl_renderer_set_region(r, &(rl_rect){ 0, 0, 17, 8 }), RL_OK);
+    rl_image *img = NULL;
+    assert_int_equal(rl_image_create(16, 16, RL_LAYER_COLOR, &img), RL_OK);
+    rl_clear_error();
+    assert_int_equal(rl_renderer_render(r, s, &cam, img, NULL), RL_ERR_INVALID_ARG);
+    if (!strstr(rl_last_error(), "outside the 16x16 image"))
+        fail_msg("%s", rl_last_error());
+    rl_renderer_release(r);
+
+    /* A renderer whose pixels depend on each other renders whole images only. */
+    assert_false(has_regions("raster"));
+    r = fx_make("raster", NULL);
+    assert_int_equal(rl_renderer_set_region(r, &(rl_rect){ 0, 0, 8, 8 }), RL_ERR_UNSUPPORTED);
+    assert_int_equal(rl_renderer_set_region(r, NULL), RL_OK);
+    rl_renderer_release(r);
+    rl_image_release(img);
+    rl_scene_release(s);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_whitted_region_equals_whole_frame),
+        cmocka_unit_test(test_bad_regions_are_refused),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
