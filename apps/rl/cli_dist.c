@@ -17,8 +17,13 @@ int cli_dist_begin(int *argc, char ***argv)
     rl_status st = rl_dist_init(argc, argv, &dist);
     if (st != RL_OK)
         return cli_fail_status(RL_CLI_FAIL, st, "--dist");
-    if (rl_dist_rank(dist) > 0 && !freopen("/dev/null", "w", stdout))
-        return cli_fail(RL_CLI_FAIL, "--dist: rank %d cannot silence its output", rl_dist_rank(dist));
+    if (rl_dist_rank(dist) > 0) {
+        /* The master shows the run: its bar counts every rank's bands, and
+         * the workers' warnings would repeat its own (the same scene). */
+        rl_log_set_level(RL_LOG_ERROR);
+        if (!freopen("/dev/null", "w", stdout))
+            return cli_fail(RL_CLI_FAIL, "--dist: rank %d cannot silence its output", rl_dist_rank(dist));
+    }
     return RL_CLI_OK;
 }
 

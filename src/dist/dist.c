@@ -24,6 +24,7 @@
 #include <string.h>
 
 #include "core/error.h"
+#include "render/renderer.h"
 #include "rl/rl_timer.h"
 
 enum { TAG_TASK = 1, TAG_DONE, TAG_RESULT, TAG_PIXELS };
@@ -215,6 +216,29 @@ static rl_status work(rl_dist *d, rl_renderer *r, const rl_scene *scene, const r
     }
 }
 
+/* The master's progress: the caller's callback sees the whole frame, the
+ * bands done anywhere plus the share of the band rendering here. */
+typedef struct frame_progress {
+    rl_progress_fn fn;
+    void *user;
+    int bands, done;
+    bool cancelled;
+} frame_progress;
+
+static bool band_progress(void *user, double done)
+{
+    frame_progress *p = user;
+    if (p->fn && !p->fn(p->user, ((double)p->done + done) / (double)p->bands))
+        p->cancelled = true;
+    return !p->cancelled;
+}
+
+static void band_done(frame_progress *p)
+{
+    ++p->done;
+    band_progress(p, 0.0);
+}
+
 /* The master's frame. */
 static rl_status lead(rl_dist *d, rl_renderer *r, const rl_scene *scene, const rl_camera *cam, rl_image *image,
                       rl_render_stats *stats, rl_dist_stats *ds)
@@ -223,6 +247,9 @@ static rl_status lead(rl_dist *d, rl_renderer *r, const rl_scene *scene, const r
     int next = 0, pending = 0, code = MPI_SUCCESS;
     rl_status st = RL_OK;
     char failure[320] = "";
+    frame_progress fp = { .bands = bands };
+    rl_renderer_get_progress(r, &fp.fn, &fp.user);
+    rl_renderer_set_progress(r, band_progress, &fp);
     /* Queue PREFETCH bands at every worker first. */
     for (int k = 0; k < PREFETCH; ++k)
         for (int w = 1; w < d->size && next < bands && code == MPI_SUCCESS; ++w) {
@@ -231,9 +258,11 @@ static rl_status lead(rl_dist *d, rl_renderer *r, const rl_scene *scene, const r
             ++pending;
             ++ds->messages;
         }
-    if (code != MPI_SUCCESS)
-        return mpi_failed(code, "handing out a band");
-    while (pending > 0 || (st == RL_OK && next < bands)) {
+    while (code == MPI_SUCCESS && (pending > 0 || (st == RL_OK && next < bands))) {
+        if (fp.cancelled && st == RL_OK) {
+            st = RL_ERR_CANCELLED;          /* no more bands out; drain the rest */
+            snprintf(failure, sizeof failure, "cancelled by the progress callback");
+        }
         int arrived = 0;
         MPI_Status ms;
         if ((code = MPI_Iprobe(MPI_ANY_SOURCE, TAG_RESULT, MPI_COMM_WORLD, &arrived, &ms)) != MPI_SUCCESS)
@@ -251,6 +280,7 @@ static rl_status lead(rl_dist *d, rl_renderer *r, const rl_scene *scene, const r
                 stats->prep_ms += bs.prep_ms;
                 ++d->per_rank[0].tasks;
                 d->per_rank[0].pixels += bs.pixels_written;
+                band_done(&fp);
             } else {
                 snprintf(failure, sizeof failure, "%s", rl_last_error());
             }
@@ -285,6 +315,7 @@ static rl_status lead(rl_dist *d, rl_renderer *r, const rl_scene *scene, const r
             ++d->per_rank[w].tasks;
             d->per_rank[w].pixels += res.pixels;
             d->per_rank[w].busy_ms += res.busy_ms;
+            band_done(&fp);
         } else if (st == RL_OK) {
             st = (rl_status)res.status;
             res.error[sizeof res.error - 1] = '\0';
@@ -298,6 +329,7 @@ static rl_status lead(rl_dist *d, rl_renderer *r, const rl_scene *scene, const r
             ++ds->messages;
         }
     }
+    rl_renderer_set_progress(r, fp.fn, fp.user);
     if (code != MPI_SUCCESS)
         return mpi_failed(code, "collecting the bands");   /* the CLI then aborts the job */
     int32_t done = (int32_t)st;

@@ -255,6 +255,12 @@ void rl_renderer_set_progress(rl_renderer *r, rl_progress_fn fn, void *user)
     r->progress_user = user;
 }
 
+void rl_renderer_get_progress(const rl_renderer *r, rl_progress_fn *fn, void **user)
+{
+    *fn = r ? r->progress : NULL;
+    *user = r ? r->progress_user : NULL;
+}
+
 bool rl_renderer_progress(const rl_renderer *r, double done)
 {
     return !r || !r->progress || r->progress(r->progress_user, done);

@@ -61,6 +61,9 @@ void *rl_renderer_state(const rl_renderer *r);
  * checked against the image by rl_renderer_render): the whole image when
  * none was set. Only classes with info.regions read it. */
 rl_rect rl_renderer_region(const rl_renderer *r, int width, int height);
+/* The callback of rl_renderer_set_progress (NULLs when none), for a caller
+ * that renders a frame in parts and reports the whole (src/dist). */
+void rl_renderer_get_progress(const rl_renderer *r, rl_progress_fn *fn, void **user);
 /* The lookup in slot (NULL when none was handed in) and how often the slot
  * was set, so that a renderer can tell a new lookup from the one it built
  * its per-region data for. */
