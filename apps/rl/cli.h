@@ -100,7 +100,10 @@ int cli_dist_end(int rc);
 bool cli_dist_master(void);
 rl_status cli_render_call(rl_renderer *r, const rl_scene *scene, const rl_camera *cam, rl_image *img,
                           rl_render_stats *stats);
-/* The last distributed frame's ranks, bands and per-rank work (master only). */
+/* rl_sample_property, with the job's ranks as sampling nodes under --dist
+ * (the approximation on the master; NULL on the workers). */
+rl_status cli_sample_call(rl_property *p, const rl_sampling_desc *desc, rl_approx **out);
+/* The last distributed frame's or sampling's ranks and per-rank work (master only). */
 void cli_print_dist_summary(FILE *out);
 
 int cli_check_frame_memory(const rl_renderer *r, int width, int height, unsigned layers, double extra_per_pixel,

@@ -10,6 +10,7 @@
 static rl_dist *dist;
 static rl_dist_stats last;
 static bool have_last;
+static bool sampling;           /* the last run sampled: chunks of positions, not bands of pixels */
 
 int cli_dist_begin(int *argc, char ***argv)
 {
@@ -49,12 +50,24 @@ rl_status cli_render_call(rl_renderer *r, const rl_scene *scene, const rl_camera
     return st;
 }
 
+rl_status cli_sample_call(rl_property *p, const rl_sampling_desc *desc, rl_approx **out)
+{
+    if (!dist)
+        return rl_sample_property(p, desc, out);
+    rl_status st = rl_dist_sample_property(dist, p, desc, out, &last);
+    have_last = st == RL_OK && last.ranks > 1;
+    sampling = true;
+    return st;
+}
+
 void cli_print_dist_summary(FILE *out)
 {
     if (!have_last || !cli_dist_master())
         return;
-    fprintf(out, "dist: %d ranks, %llu bands, %llu messages, %.1f MB; per rank: bands, pixels, busy ms, idle %%\n",
-            last.ranks, (unsigned long long)last.tasks, (unsigned long long)last.messages, (double)last.bytes / 1e6);
+    const char *task = sampling ? "chunks" : "bands", *item = sampling ? "positions" : "pixels";
+    fprintf(out, "dist: %d ranks, %llu %s, %llu messages, %.1f MB; per rank: %s, %s, busy ms, idle %%\n",
+            last.ranks, (unsigned long long)last.tasks, task, (unsigned long long)last.messages,
+            (double)last.bytes / 1e6, task, item);
     for (int k = 0; k < last.ranks; k++) {
         const rl_dist_rank_stats *p = &last.per_rank[k];
         double idle = last.time_ms > 0.0 ? 100.0 * (1.0 - p->busy_ms / last.time_ms) : 0.0;

@@ -493,7 +493,7 @@ int cli_eval(int argc, char **argv)
         rl_progress_create("sampling", stderr, &progress);
     a.sampling.desc.progress = progress ? rl_progress_update : NULL;
     a.sampling.desc.progress_user = progress;
-    st = rl_sample_property(p, &a.sampling.desc, &ap);
+    st = cli_sample_call(p, &a.sampling.desc, &ap);
     if (progress)
         rl_progress_finish(progress);
     a.sampling.desc.progress = NULL;
@@ -501,6 +501,8 @@ int cli_eval(int argc, char **argv)
         rc = cli_fail_status(RL_CLI_FAIL, st, "sampling");
         goto done;
     }
+    if (!cli_dist_master())
+        goto done;      /* --dist: a sampling node; the control node reports */
     cli_debug("timing: sampling %.1f ms (%u samples)", 1000.0 * rl_approx_seconds(ap), rl_approx_sample_count(ap));
     rl_clear_error();
     if ((st = eval_spread_measure(p, ap, a.spread_runs, r.label, &r.spread)) != RL_OK) {
@@ -567,6 +569,7 @@ int cli_eval(int argc, char **argv)
         printf("; validation at %zu points: mean |error| %.4g, median %.4g", r.num_validated,
                r.error.mean, r.error.q[2]);
     printf("\nwrote %s, %s, %s\n", approx_path, json_path, report);
+    cli_print_dist_summary(stdout);
 done:
     rl_output_batch_release(batch);
     free(r.measured);

@@ -194,8 +194,9 @@ int main(int argc, char **argv)
         if (strcmp(name, commands[i].name) == 0) {
             if (!dist)
                 return commands[i].run(n, argv);
-            if (strcmp(name, "render") != 0)
-                return cli_fail(RL_CLI_USAGE, "--dist: only rl render runs distributed so far (docs/distributed.md)");
+            if (strcmp(name, "render") != 0 && strcmp(name, "eval") != 0)
+                return cli_fail(RL_CLI_USAGE, "--dist: only rl render and rl eval run distributed so far "
+                                              "(docs/distributed.md)");
             int rc = cli_dist_begin(NULL, NULL);
             return cli_dist_end(rc == RL_CLI_OK ? commands[i].run(n, argv) : rc);
         }

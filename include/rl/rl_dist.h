@@ -26,6 +26,7 @@
 #include <stdint.h>
 
 #include "rl/rl_render.h"
+#include "rl/rl_sampling.h"
 
 #ifdef __cplusplus
 extern "C" {
@@ -51,14 +52,14 @@ RL_API void rl_dist_release(rl_dist *d, rl_status status);
 
 /* What one rank did in a distributed frame (the master's view). */
 typedef struct rl_dist_rank_stats {
-    uint64_t tasks;          /* bands rendered */
-    uint64_t pixels;
-    double busy_ms;          /* rendering its bands */
+    uint64_t tasks;          /* bands rendered, or chunks of positions measured */
+    uint64_t pixels;         /* pixels rendered, or positions measured */
+    double busy_ms;          /* rendering or measuring */
 } rl_dist_rank_stats;
 
 typedef struct rl_dist_stats {
     int ranks;
-    uint64_t tasks;          /* bands of the frame */
+    uint64_t tasks;          /* bands of the frame, chunks of the sampling */
     uint64_t messages;       /* point-to-point messages of the frame, both ways */
     uint64_t bytes;          /* their payload */
     double time_ms;          /* the frame, on the master */
@@ -78,6 +79,20 @@ typedef struct rl_dist_stats {
  * status on the master. dstats may be NULL. */
 RL_API rl_status rl_dist_render(rl_dist *d, rl_renderer *r, const rl_scene *scene, const rl_camera *cam,
                                 rl_image *image, rl_render_stats *stats, rl_dist_stats *dstats);
+
+/* Parallel adaptive sampling (Jähn 2015, Sec. 5.5, Alg. 5.4): collective,
+ * every rank calls it with the same committed property (the same scene
+ * and options) and the same desc. The master is the control node and runs
+ * rl_sample_property; the batches of positions it chooses are measured on
+ * every rank (rl_sampling_desc.measure, rl_property_measure_sets), the
+ * master measuring too between messages. *out, on the master only, is the
+ * approximation one process makes with the same seed, sample for sample,
+ * except for properties that measure the machine (times): their values
+ * are this run's. The workers' *out is NULL. With one rank this is
+ * rl_sample_property. dstats may be NULL; its per-rank counts are chunks
+ * and positions. */
+RL_API rl_status rl_dist_sample_property(rl_dist *d, rl_property *p, const rl_sampling_desc *desc, rl_approx **out,
+                                         rl_dist_stats *dstats);
 
 #ifdef __cplusplus
 }

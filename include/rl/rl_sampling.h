@@ -242,6 +242,14 @@ typedef struct rl_sampling_desc {          /* zero = default */
     int workers;                           /* 0 -> rl_property_workers(p) */
     rl_progress_fn progress;               /* done = samples / max_samples */
     void *progress_user;
+    /* Optional: measures each batch of positions in place of the
+     * property's workers, e.g. on the ranks of an MPI job (rl_dist.h,
+     * Jähn 2015 Alg. 5.4's sampling nodes). It must give what
+     * rl_property_measure_sets gives: values[i] and, when sets is not NULL,
+     * the set of pos[i] at sets + i * words. NULL: the property's workers. */
+    rl_status (*measure)(void *user, const rl_vec3 *pos, uint32_t count, double *values, uint64_t *sets,
+                         size_t words);
+    void *measure_user;
 } rl_sampling_desc;
 
 typedef struct rl_approx rl_approx;
@@ -273,6 +281,12 @@ RL_API rl_status rl_sample_property(rl_property *p, const rl_sampling_desc *desc
  * (NULL arguments), RL_ERR_NOT_COMMITTED. */
 RL_API rl_status rl_property_measure(rl_property *p, const rl_vec3 *pos, size_t count, double *values,
                                      rl_progress_fn progress, void *user);
+/* rl_property_measure, and for properties with sets (rl_property_set_size
+ * above 0) also the set of every position into sets + i * words, words =
+ * rl_property_set_words(p); sets may be NULL. What a sampling node of a
+ * distributed run measures. */
+RL_API rl_status rl_property_measure_sets(rl_property *p, const rl_vec3 *pos, size_t count, double *values,
+                                          uint64_t *sets, rl_progress_fn progress, void *user);
 RL_API void rl_approx_release(rl_approx *a);                 /* NULL is a no-op */
 
 RL_API int rl_approx_dims(const rl_approx *a);

@@ -9,36 +9,30 @@
  * Bands are image rows, not squares, because a band's pixels are one
  * contiguous run per layer: no packing on either side.
  *
- * Messages (tags below), all on the job's world communicator:
- *   master -> worker  TAG_TASK    int32 band
- *   master -> worker  TAG_DONE    int32 status of the frame
- *   worker -> master  TAG_RESULT  band_result (band, status, counts, error)
- *   worker -> master  TAG_PIXELS  the band's layers, present ones in order
- *                                 colour, depth, object ID, triangle ID
+ * Messages (tags of dist_internal.h), all on the job's world communicator:
+ *   master -> worker  TASK    int32 band
+ *   master -> worker  DONE    int32 status of the frame
+ *   worker -> master  RESULT  band_result (band, status, counts, error)
+ *   worker -> master  PIXELS  the band's layers, present ones in order
+ *                             colour, depth, object ID, triangle ID
  * Only the calling thread talks to MPI (MPI_THREAD_FUNNELED); OpenMP
  * threads render inside each rank. */
 #include "rl/rl_dist.h"
 
-#include <mpi.h>
 #include <stdlib.h>
 #include <string.h>
 
 #include "core/error.h"
+#include "dist/dist_internal.h"
 #include "render/renderer.h"
 #include "rl/rl_timer.h"
 
-enum { TAG_TASK = 1, TAG_DONE, TAG_RESULT, TAG_PIXELS };
 
 /* 16 rows: whitted's tile height, so a band is whole tiles of it; small
  * enough that a 1024-row frame has 64 bands to balance over the ranks. */
 #define BAND_ROWS 16
 #define PREFETCH 2
 
-struct rl_dist {
-    int rank, size;
-    bool own_mpi;                      /* we called MPI_Init: we finalize */
-    rl_dist_rank_stats *per_rank;      /* size entries */
-};
 
 typedef struct band_result {
     int32_t band;
@@ -112,13 +106,13 @@ void rl_dist_release(rl_dist *d, rl_status status)
     MPI_Finalize();
 }
 
-static rl_status mpi_failed(int code, const char *what)
+rl_status rl_dist_mpi_failed(int code, const char *what)
 {
     char text[MPI_MAX_ERROR_STRING];
     int len = 0;
     if (MPI_Error_string(code, text, &len) != MPI_SUCCESS)
         snprintf(text, sizeof text, "MPI error %d", code);
-    return rl_error(RL_ERR_IO, "distributed frame: %s: %s", what, text);
+    return rl_error(RL_ERR_IO, "distributed run: %s: %s", what, text);
 }
 
 /* The band's rows of image: where each present layer's run starts, its
@@ -177,7 +171,7 @@ static void add_band(rl_render_stats *to, const uint64_t rays[RL_RAY_TYPE_COUNT]
     to->pixels_written += pixels;
 }
 
-/* A worker's frame: bands until TAG_DONE, whose status it returns. */
+/* A worker's frame: bands until RL_DIST_TAG_DONE, whose status it returns. */
 static rl_status work(rl_dist *d, rl_renderer *r, const rl_scene *scene, const rl_camera *cam, rl_image *image)
 {
     (void)d;
@@ -186,8 +180,8 @@ static rl_status work(rl_dist *d, rl_renderer *r, const rl_scene *scene, const r
         int32_t value = 0;
         int code = MPI_Recv(&value, 1, MPI_INT32_T, 0, MPI_ANY_TAG, MPI_COMM_WORLD, &ms);
         if (code != MPI_SUCCESS)
-            return mpi_failed(code, "receiving a band from the master");
-        if (ms.MPI_TAG == TAG_DONE)
+            return rl_dist_mpi_failed(code, "receiving a band from the master");
+        if (ms.MPI_TAG == RL_DIST_TAG_DONE)
             return value == RL_OK ? RL_OK
                                   : rl_error((rl_status)value, "distributed frame: another rank failed (%s)",
                                              rl_status_string((rl_status)value));
@@ -206,13 +200,13 @@ static rl_status work(rl_dist *d, rl_renderer *r, const rl_scene *scene, const r
         memcpy(res.rays, bs.rays, sizeof res.rays);
         res.samples = bs.samples;
         res.pixels = bs.pixels_written;
-        code = MPI_Send(&res, (int)sizeof res, MPI_BYTE, 0, TAG_RESULT, MPI_COMM_WORLD);
+        code = MPI_Send(&res, (int)sizeof res, MPI_BYTE, 0, RL_DIST_TAG_RESULT, MPI_COMM_WORLD);
         band_layout l = layout_of(image, value);
         for (int k = 0; code == MPI_SUCCESS && st == RL_OK && k < 4; ++k)
             if (l.bytes[k])
-                code = MPI_Send(l.part[k], (int)l.bytes[k], MPI_BYTE, 0, TAG_PIXELS, MPI_COMM_WORLD);
+                code = MPI_Send(l.part[k], (int)l.bytes[k], MPI_BYTE, 0, RL_DIST_TAG_PIXELS, MPI_COMM_WORLD);
         if (code != MPI_SUCCESS)
-            return mpi_failed(code, "returning a band to the master");
+            return rl_dist_mpi_failed(code, "returning a band to the master");
     }
 }
 
@@ -254,7 +248,7 @@ static rl_status lead(rl_dist *d, rl_renderer *r, const rl_scene *scene, const r
     for (int k = 0; k < PREFETCH; ++k)
         for (int w = 1; w < d->size && next < bands && code == MPI_SUCCESS; ++w) {
             int32_t band = next++;
-            code = MPI_Send(&band, 1, MPI_INT32_T, w, TAG_TASK, MPI_COMM_WORLD);
+            code = MPI_Send(&band, 1, MPI_INT32_T, w, RL_DIST_TAG_TASK, MPI_COMM_WORLD);
             ++pending;
             ++ds->messages;
         }
@@ -265,7 +259,7 @@ static rl_status lead(rl_dist *d, rl_renderer *r, const rl_scene *scene, const r
         }
         int arrived = 0;
         MPI_Status ms;
-        if ((code = MPI_Iprobe(MPI_ANY_SOURCE, TAG_RESULT, MPI_COMM_WORLD, &arrived, &ms)) != MPI_SUCCESS)
+        if ((code = MPI_Iprobe(MPI_ANY_SOURCE, RL_DIST_TAG_RESULT, MPI_COMM_WORLD, &arrived, &ms)) != MPI_SUCCESS)
             break;
         if (!arrived && st == RL_OK && next < bands) {
             /* Nothing to answer: render a band here. */
@@ -286,11 +280,11 @@ static rl_status lead(rl_dist *d, rl_renderer *r, const rl_scene *scene, const r
             }
             continue;
         }
-        if (!arrived && (code = MPI_Probe(MPI_ANY_SOURCE, TAG_RESULT, MPI_COMM_WORLD, &ms)) != MPI_SUCCESS)
+        if (!arrived && (code = MPI_Probe(MPI_ANY_SOURCE, RL_DIST_TAG_RESULT, MPI_COMM_WORLD, &ms)) != MPI_SUCCESS)
             break;
         int w = ms.MPI_SOURCE;
         band_result res;
-        if ((code = MPI_Recv(&res, (int)sizeof res, MPI_BYTE, w, TAG_RESULT, MPI_COMM_WORLD, MPI_STATUS_IGNORE)) !=
+        if ((code = MPI_Recv(&res, (int)sizeof res, MPI_BYTE, w, RL_DIST_TAG_RESULT, MPI_COMM_WORLD, MPI_STATUS_IGNORE)) !=
             MPI_SUCCESS)
             break;
         --pending;
@@ -304,7 +298,7 @@ static rl_status lead(rl_dist *d, rl_renderer *r, const rl_scene *scene, const r
             band_layout l = layout_of(image, res.band);
             for (int k = 0; code == MPI_SUCCESS && k < 4; ++k)
                 if (l.bytes[k]) {
-                    code = MPI_Recv(l.part[k], (int)l.bytes[k], MPI_BYTE, w, TAG_PIXELS, MPI_COMM_WORLD,
+                    code = MPI_Recv(l.part[k], (int)l.bytes[k], MPI_BYTE, w, RL_DIST_TAG_PIXELS, MPI_COMM_WORLD,
                                     MPI_STATUS_IGNORE);
                     ++ds->messages;
                     ds->bytes += l.bytes[k];
@@ -323,7 +317,7 @@ static rl_status lead(rl_dist *d, rl_renderer *r, const rl_scene *scene, const r
         }
         if (st == RL_OK && next < bands) {
             int32_t band = next++;
-            if ((code = MPI_Send(&band, 1, MPI_INT32_T, w, TAG_TASK, MPI_COMM_WORLD)) != MPI_SUCCESS)
+            if ((code = MPI_Send(&band, 1, MPI_INT32_T, w, RL_DIST_TAG_TASK, MPI_COMM_WORLD)) != MPI_SUCCESS)
                 break;
             ++pending;
             ++ds->messages;
@@ -331,16 +325,16 @@ static rl_status lead(rl_dist *d, rl_renderer *r, const rl_scene *scene, const r
     }
     rl_renderer_set_progress(r, fp.fn, fp.user);
     if (code != MPI_SUCCESS)
-        return mpi_failed(code, "collecting the bands");   /* the CLI then aborts the job */
+        return rl_dist_mpi_failed(code, "collecting the bands");   /* the CLI then aborts the job */
     int32_t done = (int32_t)st;
     for (int w = 1; w < d->size && code == MPI_SUCCESS; ++w) {
-        code = MPI_Send(&done, 1, MPI_INT32_T, w, TAG_DONE, MPI_COMM_WORLD);
+        code = MPI_Send(&done, 1, MPI_INT32_T, w, RL_DIST_TAG_DONE, MPI_COMM_WORLD);
         ++ds->messages;
     }
     ds->tasks = (uint64_t)bands;
     if (st != RL_OK)
         return rl_error(st, "%s", failure);
-    return code == MPI_SUCCESS ? RL_OK : mpi_failed(code, "ending the frame");
+    return code == MPI_SUCCESS ? RL_OK : rl_dist_mpi_failed(code, "ending the frame");
 }
 
 rl_status rl_dist_render(rl_dist *d, rl_renderer *r, const rl_scene *scene, const rl_camera *cam,

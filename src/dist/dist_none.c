@@ -39,3 +39,12 @@ rl_status rl_dist_render(rl_dist *d, rl_renderer *r, const rl_scene *scene, cons
         dstats->time_ms = stats->time_ms;
     return st;
 }
+
+rl_status rl_dist_sample_property(rl_dist *d, rl_property *p, const rl_sampling_desc *desc, rl_approx **out,
+                                  rl_dist_stats *dstats)
+{
+    (void)d;
+    if (dstats)
+        *dstats = (rl_dist_stats){ .ranks = 1 };
+    return rl_sample_property(p, desc, out);
+}

@@ -162,11 +162,13 @@ static rl_status evaluate_one(rl_property *p, int worker, rl_vec3 pos, double *v
  * on which worker took which position. On failure returns the status of the
  * lowest failing index seen, with the worker's message moved to this
  * thread. */
-static rl_status evaluate_batch(rl_property *p, int workers, bool exclusive, const rl_vec3 *pos, uint32_t n,
-                                double *values, uint64_t *sets, size_t words)
+static rl_status evaluate_batch(const rl_sampling_desc *d, rl_property *p, int workers, bool exclusive,
+                                const rl_vec3 *pos, uint32_t n, double *values, uint64_t *sets, size_t words)
 {
     if (n == 0)
         return RL_OK;
+    if (d && d->measure)        /* elsewhere: a distributed run's sampling nodes */
+        return d->measure(d->measure_user, pos, n, values, words ? sets : NULL, words);
     if (exclusive || workers <= 1 || n == 1) {
         /* RL_PROPERTY_EXCLUSIVE (timings): one position at a time, since the
          * property itself uses all threads and concurrency would distort it. */
@@ -221,6 +223,12 @@ static rl_status evaluate_batch(rl_property *p, int workers, bool exclusive, con
 rl_status rl_property_measure(rl_property *p, const rl_vec3 *pos, size_t count, double *values,
                               rl_progress_fn progress, void *user)
 {
+    return rl_property_measure_sets(p, pos, count, values, NULL, progress, user);
+}
+
+rl_status rl_property_measure_sets(rl_property *p, const rl_vec3 *pos, size_t count, double *values,
+                                   uint64_t *sets, rl_progress_fn progress, void *user)
+{
     if (!p || (count && (!pos || !values)))
         return rl_error(RL_ERR_INVALID_ARG, "rl_property_measure: property, positions and values must not be NULL");
     int workers = rl_property_workers(p);
@@ -233,7 +241,9 @@ rl_status rl_property_measure(rl_property *p, const rl_vec3 *pos, size_t count, 
     size_t chunk = exclusive || workers <= 1 ? 1 : (size_t)workers * 8;
     for (size_t i = 0; i < count;) {
         uint32_t n = (uint32_t)(count - i < chunk ? count - i : chunk);
-        rl_status st = evaluate_batch(p, workers, exclusive, pos + i, n, values + i, NULL, 0);
+        size_t words = sets ? rl_property_set_words(p) : 0;
+        rl_status st = evaluate_batch(NULL, p, workers, exclusive, pos + i, n, values + i,
+                                      words ? sets + i * words : NULL, words);
         if (st != RL_OK)
             return st;
         i += n;
@@ -366,7 +376,7 @@ static rl_status run_grid(rl_property *p, const rl_sampling_desc *d, int workers
         uint32_t n = cells - c0 < per_batch ? cells - c0 : per_batch;
         st = batch_reserve(&b, n, a->set_words);
         if (st == RL_OK)
-            st = evaluate_batch(p, workers, exclusive, pos + c0, n, b.values, b.sets, a->set_words);
+            st = evaluate_batch(d, p, workers, exclusive, pos + c0, n, b.values, b.sets, a->set_words);
         for (uint32_t i = 0; i < n && st == RL_OK; ++i) {
             uint32_t s = rl_approx_add_sample(a, pos[c0 + i], b.values[i],
                                               a->set_words ? b.sets + (size_t)i * a->set_words : NULL);
@@ -622,8 +632,8 @@ static rl_status evaluate_pending(adaptive *ad, rl_property *p, int workers, boo
 {
     rl_status st = batch_reserve(&ad->b, ad->s.pending_count, ad->s.a->set_words);
     if (st == RL_OK)
-        st = evaluate_batch(p, workers, exclusive, ad->s.pending, ad->s.pending_count, ad->b.values, ad->b.sets,
-                            ad->s.a->set_words);
+        st = evaluate_batch(&ad->s.d, p, workers, exclusive, ad->s.pending, ad->s.pending_count, ad->b.values,
+                            ad->b.sets, ad->s.a->set_words);
     if (st == RL_OK)
         st = commit_batch(ad);
     return st;
@@ -770,6 +780,8 @@ rl_status rl_sample_property(rl_property *p, const rl_sampling_desc *desc, rl_ap
     a->desc = d;
     a->desc.progress = NULL;
     a->desc.progress_user = NULL;
+    a->desc.measure = NULL;
+    a->desc.measure_user = NULL;
     a->seconds = rl_time_s() - t0;
     *out = a;
     return RL_OK;

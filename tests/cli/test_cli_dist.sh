@@ -1,8 +1,9 @@
 #!/usr/bin/env bash
-# test_cli_dist.sh: rl --dist render under mpirun (Open MPI, issue 39).
-# Three ranks, oversubscribed on the small CI machine, give the same image,
-# depth and IDs as one process, bit for bit, for single frames and for a
-# camera path; a renderer without regions is refused on every rank; without
+# test_cli_dist.sh: rl --dist render and eval under mpirun (Open MPI,
+# issue 39). Three ranks, oversubscribed on the small CI machine, give the
+# same image, depth and IDs as one process, bit for bit, for single frames
+# and for a camera path, and the same sampled approximation; a renderer
+# without regions is refused on every rank; without
 # mpirun --dist is a job of one. Skips (saying why) where this rl was built
 # without MPI or mpirun is missing.
 # Run as: bash test_cli_dist.sh <rl-binary> <scratch-dir>
@@ -10,8 +11,8 @@ set -u
 . "$(dirname "${BASH_SOURCE[0]}")/lib.bash"
 
 # Not a distributed command: refused before MPI is touched.
-expect_usage_error "$RL" --dist eval cornell --property visibility
-grep -q "only rl render runs distributed" "$TMP/err" || fail "--dist eval: $(cat "$TMP/err")"
+expect_usage_error "$RL" --dist compare cornell --algos raster,whitted
+grep -q "only rl render and rl eval run distributed" "$TMP/err" || fail "--dist compare: $(cat "$TMP/err")"
 
 # One process: --dist is a job of one, the same frame.
 if ! "$RL" --dist render cornell --algo whitted --size 32x24 --out "$TMP/one.png" >"$TMP/out" 2>"$TMP/err"; then
@@ -54,6 +55,22 @@ for f in "$TMP"/p-ref-*.png; do
     n=$((n + 1))
 done
 [ "$n" -ge 3 ] || fail "the camera path gave $n frames"
+
+# Parallel adaptive sampling (Jähn 2015, Alg. 5.4): the control node's
+# approximation is the one-process one, sample for sample, set for set;
+# only its wall time ("seconds") is this run's.
+run_ok "$RL" eval city:blocks=1 --property visibility --set resolution=16 --samples 40 --seed 7 --out "$TMP/e1"
+run_ok "${MPI[@]}" "$RL" --dist eval city:blocks=1 --property visibility --set resolution=16 --samples 40 \
+    --seed 7 --out "$TMP/e3"
+expect_in "$TMP/out" "^dist: 3 ranks, [0-9]* chunks"
+python3 - "$TMP/e1/approx.json" "$TMP/e3/approx.json" <<'PY' || fail "3 sampling ranks differ from one process"
+import json, sys
+a, b = (json.load(open(f)) for f in sys.argv[1:3])
+assert a.pop("seconds") >= 0 and b.pop("seconds") >= 0
+assert a["set_size"] > 0 and len(a["samples"]) == 40, (a["set_size"], len(a["samples"]))
+assert a == b
+PY
+[ ! -e "$TMP/e3/report.html" ] || [ "$(grep -c . "$TMP/e3/report.html")" -gt 0 ] || fail "empty report"
 
 # A renderer whose pixels depend on each other is refused, on every rank,
 # and nothing is written.

@@ -19,6 +19,8 @@
 #include "rl/rl_rng.h"
 #include "rl/rl_sampling.h"
 
+#include "core/error.h"
+
 #define assert_near(a, b, eps)                                                       \
     do {                                                                             \
         double a_ = (a), b_ = (b);                                                   \
@@ -540,6 +542,60 @@ static void test_results_are_identical_for_any_worker_count_and_seed(void **stat
     assert_true(pa.x != pb.x || pa.y != pb.y || pa.z != pb.z);
     rl_approx_release(a);
     rl_approx_release(b);
+    rl_property_release(p);
+}
+
+/* rl_sampling_desc.measure (a distributed run's sampling nodes): every
+ * batch goes through it, and measured there as rl_property_measure_sets
+ * measures, the approximation is the one the property's workers make. */
+typedef struct measure_log {
+    rl_property *p;
+    int batches;
+    uint32_t positions;
+} measure_log;
+
+static rl_status measure_elsewhere(void *user, const rl_vec3 *pos, uint32_t count, double *values,
+                                   uint64_t *sets, size_t words)
+{
+    measure_log *m = user;
+    ++m->batches;
+    m->positions += count;
+    assert_int_equal(words, 0);      /* fn properties have no sets */
+    return rl_property_measure_sets(m->p, pos, count, values, sets, NULL, NULL);
+}
+
+static rl_status measure_fails(void *user, const rl_vec3 *pos, uint32_t count, double *values, uint64_t *sets,
+                               size_t words)
+{
+    (void)user, (void)pos, (void)count, (void)values, (void)sets, (void)words;
+    return rl_error(RL_ERR_IO, "a sampling node went away");
+}
+
+static void test_a_measure_hook_measures_every_batch(void **state)
+{
+    (void)state;
+    fn_prop fp = { .f = f_wave };
+    rl_property *p = make_property(&fp, 2, 0);
+    for (int method = 0; method < 2; ++method) {
+        rl_sampling_desc d = { .region = box3(-5, 0, -5, 5, 3, 5), .max_samples = 300, .min_side = 0.2f,
+                               .method = method ? RL_SAMPLING_GRID : RL_SAMPLING_ADAPTIVE, .seed = 9 };
+        rl_approx *here = sample(p, d);
+        measure_log log = { .p = p };
+        d.measure = measure_elsewhere;
+        d.measure_user = &log;
+        rl_approx *there = sample(p, d);
+        assert_same(here, there);
+        assert_true(log.batches >= 1);
+        assert_int_equal(log.positions, rl_approx_sample_count(there));
+        rl_approx_release(here);
+        rl_approx_release(there);
+        d.measure = measure_fails;
+        rl_approx *none = NULL;
+        rl_clear_error();
+        assert_int_equal(rl_sample_property(p, &d, &none), RL_ERR_IO);
+        assert_null(none);
+        assert_non_null(strstr(rl_last_error(), "went away"));
+    }
     rl_property_release(p);
 }
 
@@ -1255,6 +1311,7 @@ int main(void)
         cmocka_unit_test(test_bad_input_is_refused_with_the_documented_status),
         cmocka_unit_test(test_a_failing_property_fails_the_run),
         cmocka_unit_test(test_measure_gives_each_position_its_value),
+        cmocka_unit_test(test_a_measure_hook_measures_every_batch),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

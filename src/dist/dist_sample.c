@@ -1,0 +1,305 @@
+/* dist_sample.c: parallel adaptive sampling (Jähn 2015, Sec. 5.5, Alg. 5.4)
+ * on the ranks of an MPI job (rl_dist.h).
+ *
+ * The master is the control node: it runs the sampling itself (Alg. 5.3,
+ * rl_sample_property), which chooses every position before it measures
+ * any of a batch; the batch's measuring (Alg. 5.4, lines 11-16) goes
+ * through rl_sampling_desc.measure to the sampling nodes. The master cuts
+ * a batch into chunks, keeps PREFETCH chunks queued at every worker, hands
+ * the next chunk to whichever worker answered, and measures chunks itself
+ * between messages. A value depends only on its position, so the
+ * approximation is the one a single process makes with the same seed: the
+ * same samples, regions and sets. The exception are properties that
+ * measure the machine (times, RL_PROPERTY_EXCLUSIVE): their values are
+ * this run's, as in any two runs.
+ *
+ * Messages (tags of dist_internal.h):
+ *   master -> worker  TASK    chunk_header + count positions (rl_vec3)
+ *   master -> worker  DONE    int32 status of the run
+ *   worker -> master  RESULT  chunk_result (chunk, status, error)
+ *   worker -> master  VALUES  count doubles, then count * words set words */
+#include "rl/rl_dist.h"
+
+#include <stdlib.h>
+#include <string.h>
+
+#include "core/error.h"
+#include "dist/dist_internal.h"
+#include "rl/rl_timer.h"
+
+#define PREFETCH 2
+/* Positions per chunk at most: a visibility sample costs milliseconds, so
+ * a chunk of 16 is tens of them against one message's microseconds. */
+#define MAX_CHUNK 16
+
+typedef struct chunk_header {
+    int32_t chunk, count;
+    int32_t words;                     /* set words per position wanted; 0: none */
+    int32_t pad;
+} chunk_header;
+
+typedef struct chunk_result {
+    int32_t chunk, status;
+    double busy_ms;
+    char error[256];
+} chunk_result;
+
+typedef struct sampler {
+    rl_dist *d;
+    rl_property *p;
+    uint64_t messages, bytes, chunks;
+    char failure[320];
+} sampler;
+
+static rl_status send_chunk(sampler *s, int w, int chunk, const rl_vec3 *pos, int count, size_t words,
+                            unsigned char **buf, size_t *cap)
+{
+    size_t bytes = sizeof(chunk_header) + (size_t)count * sizeof *pos;
+    if (bytes > *cap) {
+        unsigned char *b = realloc(*buf, bytes);
+        if (!b)
+            return RL_ERR_OUT_OF_MEMORY;
+        *buf = b;
+        *cap = bytes;
+    }
+    chunk_header h = { .chunk = chunk, .count = count, .words = (int32_t)words };
+    memcpy(*buf, &h, sizeof h);
+    memcpy(*buf + sizeof h, pos, (size_t)count * sizeof *pos);
+    int code = MPI_Send(*buf, (int)bytes, MPI_BYTE, w, RL_DIST_TAG_TASK, MPI_COMM_WORLD);
+    ++s->messages;
+    s->bytes += bytes;
+    return code == MPI_SUCCESS ? RL_OK : rl_dist_mpi_failed(code, "handing out positions");
+}
+
+/* rl_sampling_desc.measure on the master: one batch over every rank. */
+static rl_status measure(void *user, const rl_vec3 *pos, uint32_t n, double *values, uint64_t *sets, size_t words)
+{
+    sampler *s = user;
+    rl_dist *d = s->d;
+    const int workers = d->size - 1;
+    /* Chunks small enough that every rank gets a few per batch, so that
+     * the slowest chunk does not hold the batch up. */
+    uint32_t chunk = n / (uint32_t)(4 * d->size);
+    chunk = chunk < 1 ? 1 : chunk > MAX_CHUNK ? MAX_CHUNK : chunk;
+    const int chunks = (int)((n + chunk - 1) / chunk);
+    unsigned char *buf = NULL;
+    size_t cap = 0;
+    int next = 0, pending = 0, code = MPI_SUCCESS;
+    rl_status st = RL_OK;
+#define CHUNK_COUNT(c) ((int)((uint32_t)(c) * chunk + chunk <= n ? chunk : n - (uint32_t)(c) * chunk))
+    for (int k = 0; k < PREFETCH && st == RL_OK; ++k)
+        for (int w = 1; w <= workers && next < chunks && st == RL_OK; ++w, ++next, ++pending)
+            st = send_chunk(s, w, next, pos + (size_t)next * chunk, CHUNK_COUNT(next), words, &buf, &cap);
+    if (st != RL_OK) {
+        free(buf);
+        return st;           /* the CLI aborts the job: workers may hold chunks */
+    }
+    rl_status failed = RL_OK;
+    while (code == MPI_SUCCESS && (pending > 0 || (failed == RL_OK && next < chunks))) {
+        int arrived = 0;
+        MPI_Status ms;
+        if ((code = MPI_Iprobe(MPI_ANY_SOURCE, RL_DIST_TAG_RESULT, MPI_COMM_WORLD, &arrived, &ms)) != MPI_SUCCESS)
+            break;
+        if (!arrived && failed == RL_OK && next < chunks) {
+            /* Nothing to answer: measure a chunk here. */
+            int c = next++;
+            size_t off = (size_t)c * chunk;
+            rl_timer t;
+            rl_timer_start(&t);
+            rl_status ms_st = rl_property_measure_sets(s->p, pos + off, (size_t)CHUNK_COUNT(c), values + off,
+                                                       words ? sets + off * words : NULL, NULL, NULL);
+            d->per_rank[0].busy_ms += rl_timer_ms(&t);
+            d->per_rank[0].tasks += 1;
+            d->per_rank[0].pixels += (uint64_t)CHUNK_COUNT(c);
+            if (ms_st != RL_OK) {
+                failed = ms_st;
+                snprintf(s->failure, sizeof s->failure, "%s", rl_last_error());
+            }
+            continue;
+        }
+        if (!arrived && (code = MPI_Probe(MPI_ANY_SOURCE, RL_DIST_TAG_RESULT, MPI_COMM_WORLD, &ms)) != MPI_SUCCESS)
+            break;
+        int w = ms.MPI_SOURCE;
+        chunk_result res;
+        if ((code = MPI_Recv(&res, (int)sizeof res, MPI_BYTE, w, RL_DIST_TAG_RESULT, MPI_COMM_WORLD,
+                             MPI_STATUS_IGNORE)) != MPI_SUCCESS)
+            break;
+        --pending;
+        ++s->messages;
+        s->bytes += sizeof res;
+        if (res.chunk < 0 || res.chunk >= chunks) {
+            code = MPI_ERR_OTHER;
+            break;
+        }
+        if (res.status == RL_OK) {
+            size_t off = (size_t)res.chunk * chunk, cnt = (size_t)CHUNK_COUNT(res.chunk);
+            code = MPI_Recv(values + off, (int)cnt, MPI_DOUBLE, w, RL_DIST_TAG_VALUES, MPI_COMM_WORLD,
+                            MPI_STATUS_IGNORE);
+            s->bytes += cnt * sizeof(double);
+            ++s->messages;
+            if (code == MPI_SUCCESS && words) {
+                code = MPI_Recv(sets + off * words, (int)(cnt * words), MPI_UINT64_T, w, RL_DIST_TAG_VALUES,
+                                MPI_COMM_WORLD, MPI_STATUS_IGNORE);
+                s->bytes += cnt * words * sizeof(uint64_t);
+                ++s->messages;
+            }
+            if (code != MPI_SUCCESS)
+                break;
+            d->per_rank[w].tasks += 1;
+            d->per_rank[w].pixels += cnt;
+            d->per_rank[w].busy_ms += res.busy_ms;
+        } else if (failed == RL_OK) {
+            failed = (rl_status)res.status;
+            res.error[sizeof res.error - 1] = '\0';
+            snprintf(s->failure, sizeof s->failure, "rank %d: %s", w, res.error);
+        }
+        if (failed == RL_OK && next < chunks) {
+            int c = next++;
+            if ((st = send_chunk(s, w, c, pos + (size_t)c * chunk, CHUNK_COUNT(c), words, &buf, &cap)) != RL_OK)
+                break;
+            ++pending;
+        }
+    }
+#undef CHUNK_COUNT
+    free(buf);
+    s->chunks += (uint64_t)chunks;
+    if (code != MPI_SUCCESS)
+        return rl_dist_mpi_failed(code, "collecting measured values");
+    if (st != RL_OK)
+        return st;
+    return failed == RL_OK ? RL_OK : rl_error(failed, "%s", s->failure);
+}
+
+/* A sampling node: chunks until DONE, whose status it returns. */
+static rl_status serve(rl_property *p)
+{
+    unsigned char *buf = NULL;
+    double *values = NULL;
+    uint64_t *sets = NULL;
+    rl_status st = RL_OK;
+    for (;;) {
+        MPI_Status ms;
+        int code = MPI_Probe(0, MPI_ANY_TAG, MPI_COMM_WORLD, &ms);
+        int bytes = 0;
+        if (code == MPI_SUCCESS)
+            code = MPI_Get_count(&ms, MPI_BYTE, &bytes);
+        if (code != MPI_SUCCESS) {
+            st = rl_dist_mpi_failed(code, "receiving positions from the control node");
+            break;
+        }
+        if (ms.MPI_TAG == RL_DIST_TAG_DONE) {
+            int32_t done = 0;
+            code = MPI_Recv(&done, 1, MPI_INT32_T, 0, RL_DIST_TAG_DONE, MPI_COMM_WORLD, MPI_STATUS_IGNORE);
+            st = code != MPI_SUCCESS ? rl_dist_mpi_failed(code, "ending the sampling")
+                 : done == RL_OK     ? RL_OK
+                                     : rl_error((rl_status)done, "distributed sampling: another rank failed (%s)",
+                                                rl_status_string((rl_status)done));
+            break;
+        }
+        unsigned char *b = realloc(buf, (size_t)bytes + 1);
+        if (!b) {
+            st = RL_ERR_OUT_OF_MEMORY;
+            break;
+        }
+        buf = b;
+        if ((code = MPI_Recv(buf, bytes, MPI_BYTE, 0, RL_DIST_TAG_TASK, MPI_COMM_WORLD, MPI_STATUS_IGNORE)) !=
+            MPI_SUCCESS) {
+            st = rl_dist_mpi_failed(code, "receiving positions from the control node");
+            break;
+        }
+        chunk_header h;
+        memcpy(&h, buf, sizeof h);
+        size_t words = h.words > 0 ? rl_property_set_words(p) : 0;
+        if (h.count < 1 || (size_t)bytes != sizeof h + (size_t)h.count * sizeof(rl_vec3) ||
+            (h.words > 0 && (size_t)h.words != words)) {
+            st = rl_error(RL_ERR_INTERNAL, "distributed sampling: a malformed chunk from the control node");
+            break;
+        }
+        double *v = realloc(values, (size_t)h.count * sizeof *v);
+        uint64_t *ss = words ? realloc(sets, (size_t)h.count * words * sizeof *ss) : sets;
+        if (v)
+            values = v;
+        if (ss)
+            sets = ss;
+        if (!v || (!ss && words)) {
+            st = RL_ERR_OUT_OF_MEMORY;
+            break;
+        }
+        rl_vec3 *pos = malloc((size_t)h.count * sizeof *pos);
+        if (!pos) {
+            st = RL_ERR_OUT_OF_MEMORY;
+            break;
+        }
+        memcpy(pos, buf + sizeof h, (size_t)h.count * sizeof *pos);
+        chunk_result res;
+        memset(&res, 0, sizeof res);
+        res.chunk = h.chunk;
+        rl_timer t;
+        rl_timer_start(&t);
+        rl_clear_error();
+        rl_status ms_st = rl_property_measure_sets(p, pos, (size_t)h.count, values, words ? sets : NULL, NULL, NULL);
+        free(pos);
+        res.busy_ms = rl_timer_ms(&t);
+        res.status = (int32_t)ms_st;
+        if (ms_st != RL_OK)
+            snprintf(res.error, sizeof res.error, "%s", rl_last_error());
+        code = MPI_Send(&res, (int)sizeof res, MPI_BYTE, 0, RL_DIST_TAG_RESULT, MPI_COMM_WORLD);
+        if (code == MPI_SUCCESS && ms_st == RL_OK)
+            code = MPI_Send(values, h.count, MPI_DOUBLE, 0, RL_DIST_TAG_VALUES, MPI_COMM_WORLD);
+        if (code == MPI_SUCCESS && ms_st == RL_OK && words)
+            code = MPI_Send(sets, (int)((size_t)h.count * words), MPI_UINT64_T, 0, RL_DIST_TAG_VALUES,
+                            MPI_COMM_WORLD);
+        if (code != MPI_SUCCESS) {
+            st = rl_dist_mpi_failed(code, "returning measured values");
+            break;
+        }
+    }
+    free(buf);
+    free(values);
+    free(sets);
+    return st;
+}
+
+rl_status rl_dist_sample_property(rl_dist *d, rl_property *p, const rl_sampling_desc *desc, rl_approx **out,
+                                  rl_dist_stats *dstats)
+{
+    rl_dist_stats local;
+    rl_dist_stats *ds = dstats ? dstats : &local;
+    memset(ds, 0, sizeof *ds);
+    ds->ranks = rl_dist_size(d);
+    if (out)
+        *out = NULL;
+    if (!d || d->size == 1)
+        return rl_sample_property(p, desc, out);
+    if (!p || !desc || !out)
+        return rl_error(RL_ERR_INVALID_ARG, "rl_dist_sample_property: property, desc and out must not be NULL");
+    memset(d->per_rank, 0, (size_t)d->size * sizeof *d->per_rank);
+    rl_timer t;
+    rl_timer_start(&t);
+    rl_status st;
+    if (d->rank == 0) {
+        sampler s = { .d = d, .p = p };
+        rl_sampling_desc dd = *desc;
+        dd.measure = measure;
+        dd.measure_user = &s;
+        st = rl_sample_property(p, &dd, out);
+        int32_t done = (int32_t)st;
+        for (int w = 1; w < d->size; ++w) {
+            int code = MPI_Send(&done, 1, MPI_INT32_T, w, RL_DIST_TAG_DONE, MPI_COMM_WORLD);
+            ++s.messages;
+            if (code != MPI_SUCCESS && st == RL_OK) {
+                st = rl_dist_mpi_failed(code, "ending the sampling");
+                rl_approx_release(*out);
+                *out = NULL;
+            }
+        }
+        ds->tasks = s.chunks;
+        ds->messages = s.messages;
+        ds->bytes = s.bytes;
+    } else {
+        st = serve(p);
+    }
+    ds->time_ms = rl_timer_ms(&t);
+    ds->per_rank = d->per_rank;
+    return st;
+}
