@@ -68,6 +68,9 @@ void cli_print_dist_summary(FILE *out)
     fprintf(out, "dist: %d ranks, %llu %s, %llu messages, %.1f MB; per rank: %s, %s, busy ms, idle %%\n",
             last.ranks, (unsigned long long)last.tasks, task, (unsigned long long)last.messages,
             (double)last.bytes / 1e6, task, item);
+    if (last.lost)
+        fprintf(out, "dist: %d worker%s lost (silent past RL_DIST_TIMEOUT); the master handed their %s to the "
+                "others\n", last.lost, last.lost == 1 ? "" : "s", task);
     for (int k = 0; k < last.ranks; k++) {
         const rl_dist_rank_stats *p = &last.per_rank[k];
         double idle = last.time_ms > 0.0 ? 100.0 * (1.0 - p->busy_ms / last.time_ms) : 0.0;

@@ -63,6 +63,7 @@ typedef struct rl_dist_stats {
     uint64_t messages;       /* point-to-point messages of the frame, both ways */
     uint64_t bytes;          /* their payload */
     double time_ms;          /* the frame, on the master */
+    int lost;                /* workers taken for lost (silent past RL_DIST_TIMEOUT); their work was redone */
     /* Per rank, rank 0 (the master, which renders bands between its
      * messages) first; NULL when the frame ran in one process. Owned by
      * the rl_dist, valid until its next frame or release. */

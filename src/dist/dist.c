@@ -19,8 +19,11 @@
  * threads render inside each rank. */
 #include "rl/rl_dist.h"
 
+#include <signal.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <time.h>
 
 #include "core/error.h"
 #include "dist/dist_internal.h"
@@ -106,6 +109,71 @@ void rl_dist_release(rl_dist *d, rl_status status)
     MPI_Finalize();
 }
 
+double rl_dist_timeout_s(void)
+{
+    const char *e = getenv("RL_DIST_TIMEOUT");
+    char *end = NULL;
+    double t = e && *e ? strtod(e, &end) : 0.0;
+    return e && *e && end && !*end && t > 0.0 && t < 1e7 ? t : RL_DIST_DEFAULT_TIMEOUT_S;
+}
+
+void rl_dist_pause(void)
+{
+    /* Long enough not to spin a core away from the rank's own threads,
+     * short against a band's milliseconds. */
+    struct timespec ts = { 0, 200000 };
+    nanosleep(&ts, NULL);
+}
+
+rl_status rl_dist_wait(const rl_dist *d, int tag, MPI_Status *ms)
+{
+    const double timeout = rl_dist_timeout_s(), t0 = rl_time_s();
+    for (;;) {
+        int arrived = 0;
+        int code = MPI_Iprobe(0, tag, MPI_COMM_WORLD, &arrived, ms);
+        if (code != MPI_SUCCESS)
+            return rl_dist_mpi_failed(code, "waiting for the master");
+        if (arrived)
+            return RL_OK;
+        if (rl_time_s() - t0 > timeout)
+            return rl_error(RL_ERR_IO, "rank %d: no word from the master (rank 0) for %.0f s: it is gone or "
+                            "stuck; giving up (RL_DIST_TIMEOUT)", d->rank, timeout);
+        rl_dist_pause();
+    }
+}
+
+rl_status rl_dist_send(const rl_dist *d, const void *buf, int count, MPI_Datatype type, int dest, int tag)
+{
+    MPI_Request req;
+    int code = MPI_Isend(buf, count, type, dest, tag, MPI_COMM_WORLD, &req);
+    if (code != MPI_SUCCESS)
+        return rl_dist_mpi_failed(code, "sending");
+    const double timeout = rl_dist_timeout_s(), t0 = rl_time_s();
+    for (;;) {
+        int finished = 0;
+        if ((code = MPI_Test(&req, &finished, MPI_STATUS_IGNORE)) != MPI_SUCCESS)
+            return rl_dist_mpi_failed(code, "sending");
+        if (finished)
+            return RL_OK;
+        if (rl_time_s() - t0 > timeout) {
+            /* The request stays: the job ends anyway (rl_dist_release). */
+            return rl_error(RL_ERR_IO, "rank %d: rank %d has not taken a message for %.0f s: it is gone or "
+                            "stuck; giving up (RL_DIST_TIMEOUT)", d->rank, dest, timeout);
+        }
+        rl_dist_pause();
+    }
+}
+
+void rl_dist_fault_point(rl_dist *d)
+{
+    ++d->tasks_done;
+    const char *e = getenv("RL_DIST_FAULT");
+    int rank = -1;
+    unsigned long long after = 0;
+    if (e && sscanf(e, "%d:%llu", &rank, &after) == 2 && rank == d->rank && d->tasks_done == after)
+        raise(SIGKILL);
+}
+
 rl_status rl_dist_mpi_failed(int code, const char *what)
 {
     char text[MPI_MAX_ERROR_STRING];
@@ -174,11 +242,13 @@ static void add_band(rl_render_stats *to, const uint64_t rays[RL_RAY_TYPE_COUNT]
 /* A worker's frame: bands until RL_DIST_TAG_DONE, whose status it returns. */
 static rl_status work(rl_dist *d, rl_renderer *r, const rl_scene *scene, const rl_camera *cam, rl_image *image)
 {
-    (void)d;
     for (;;) {
         MPI_Status ms;
         int32_t value = 0;
-        int code = MPI_Recv(&value, 1, MPI_INT32_T, 0, MPI_ANY_TAG, MPI_COMM_WORLD, &ms);
+        rl_status wst = rl_dist_wait(d, MPI_ANY_TAG, &ms);
+        if (wst != RL_OK)
+            return wst;
+        int code = MPI_Recv(&value, 1, MPI_INT32_T, 0, ms.MPI_TAG, MPI_COMM_WORLD, &ms);
         if (code != MPI_SUCCESS)
             return rl_dist_mpi_failed(code, "receiving a band from the master");
         if (ms.MPI_TAG == RL_DIST_TAG_DONE)
@@ -200,13 +270,16 @@ static rl_status work(rl_dist *d, rl_renderer *r, const rl_scene *scene, const r
         memcpy(res.rays, bs.rays, sizeof res.rays);
         res.samples = bs.samples;
         res.pixels = bs.pixels_written;
-        code = MPI_Send(&res, (int)sizeof res, MPI_BYTE, 0, RL_DIST_TAG_RESULT, MPI_COMM_WORLD);
+        /* Sends that give up past the timeout: a band's pixels go by
+         * rendezvous, which would wait forever for a dead master. */
+        rl_status sst = rl_dist_send(d, &res, (int)sizeof res, MPI_BYTE, 0, RL_DIST_TAG_RESULT);
         band_layout l = layout_of(image, value);
-        for (int k = 0; code == MPI_SUCCESS && st == RL_OK && k < 4; ++k)
+        for (int k = 0; sst == RL_OK && st == RL_OK && k < 4; ++k)
             if (l.bytes[k])
-                code = MPI_Send(l.part[k], (int)l.bytes[k], MPI_BYTE, 0, RL_DIST_TAG_PIXELS, MPI_COMM_WORLD);
-        if (code != MPI_SUCCESS)
-            return rl_dist_mpi_failed(code, "returning a band to the master");
+                sst = rl_dist_send(d, l.part[k], (int)l.bytes[k], MPI_BYTE, 0, RL_DIST_TAG_PIXELS);
+        if (sst != RL_OK)
+            return sst;
+        rl_dist_fault_point(d);
     }
 }
 
@@ -233,26 +306,77 @@ static void band_done(frame_progress *p)
     band_progress(p, 0.0);
 }
 
-/* The master's frame. */
+/* The master's view of a worker during a frame. */
+typedef struct worker_state {
+    int32_t bands[PREFETCH];     /* handed out, not yet returned (-1: free slot) */
+    int pending;
+    double since;                /* when it last answered, or got work while idle */
+    bool lost;                   /* silent past the timeout: its bands went elsewhere */
+} worker_state;
+
+/* The next band to render: a lost worker's first, then new ones. */
+static int take_band(int *redo, int *num_redo, int *next, int bands)
+{
+    if (*num_redo > 0)
+        return redo[--*num_redo];
+    return *next < bands ? (*next)++ : -1;
+}
+
+static rl_status give_band(rl_dist_stats *ds, worker_state *ws, int w, int band)
+{
+    int32_t b = band;
+    int code = MPI_Send(&b, 1, MPI_INT32_T, w, RL_DIST_TAG_TASK, MPI_COMM_WORLD);
+    ++ds->messages;
+    if (code != MPI_SUCCESS)
+        return rl_dist_mpi_failed(code, "handing out a band");
+    if (ws->pending == 0)
+        ws->since = rl_time_s();
+    for (int k = 0; k < PREFETCH; ++k)
+        if (ws->bands[k] < 0) {
+            ws->bands[k] = b;
+            break;
+        }
+    ++ws->pending;
+    return RL_OK;
+}
+
+/* The master's frame. A worker that stays silent past the timeout with
+ * bands in hand is taken for lost (killed, its node gone): its bands go to
+ * the others and it gets no more. Should it answer after all, its bands
+ * are the same pixels and are taken as they come. */
 static rl_status lead(rl_dist *d, rl_renderer *r, const rl_scene *scene, const rl_camera *cam, rl_image *image,
                       rl_render_stats *stats, rl_dist_stats *ds)
 {
     const int bands = (image->height + BAND_ROWS - 1) / BAND_ROWS;
-    int next = 0, pending = 0, code = MPI_SUCCESS;
+    const double timeout = rl_dist_timeout_s();
+    int next = 0, num_redo = 0, code = MPI_SUCCESS, remaining = bands;
+    worker_state *ws = calloc((size_t)d->size, sizeof *ws);
+    int *redo = calloc((size_t)bands + 1, sizeof *redo);
+    unsigned char *done = calloc((size_t)bands + 1, 1);
+    if (!ws || !redo || !done) {
+        free(ws);
+        free(redo);
+        free(done);
+        return RL_ERR_OUT_OF_MEMORY;
+    }
+    for (int w = 0; w < d->size; ++w)
+        for (int k = 0; k < PREFETCH; ++k)
+            ws[w].bands[k] = -1;
     rl_status st = RL_OK;
     char failure[320] = "";
     frame_progress fp = { .bands = bands };
     rl_renderer_get_progress(r, &fp.fn, &fp.user);
     rl_renderer_set_progress(r, band_progress, &fp);
     /* Queue PREFETCH bands at every worker first. */
-    for (int k = 0; k < PREFETCH; ++k)
-        for (int w = 1; w < d->size && next < bands && code == MPI_SUCCESS; ++w) {
-            int32_t band = next++;
-            code = MPI_Send(&band, 1, MPI_INT32_T, w, RL_DIST_TAG_TASK, MPI_COMM_WORLD);
-            ++pending;
-            ++ds->messages;
-        }
-    while (code == MPI_SUCCESS && (pending > 0 || (st == RL_OK && next < bands))) {
+    for (int k = 0; k < PREFETCH && st == RL_OK; ++k)
+        for (int w = 1; w < d->size && next < bands && st == RL_OK; ++w)
+            st = give_band(ds, &ws[w], w, next++);
+    if (st != RL_OK)
+        snprintf(failure, sizeof failure, "%s", rl_last_error());
+    int pending = 0;
+    for (int w = 1; w < d->size; ++w)
+        pending += ws[w].pending;
+    while (code == MPI_SUCCESS && (st == RL_OK ? remaining > 0 : pending > 0)) {
         if (fp.cancelled && st == RL_OK) {
             st = RL_ERR_CANCELLED;          /* no more bands out; drain the rest */
             snprintf(failure, sizeof failure, "cancelled by the progress callback");
@@ -261,40 +385,68 @@ static rl_status lead(rl_dist *d, rl_renderer *r, const rl_scene *scene, const r
         MPI_Status ms;
         if ((code = MPI_Iprobe(MPI_ANY_SOURCE, RL_DIST_TAG_RESULT, MPI_COMM_WORLD, &arrived, &ms)) != MPI_SUCCESS)
             break;
-        if (!arrived && st == RL_OK && next < bands) {
-            /* Nothing to answer: render a band here. */
-            rl_render_stats bs = { 0 };
-            rl_timer t;
-            rl_timer_start(&t);
-            int band = next++;
-            st = render_band(r, scene, cam, image, band, &bs);
-            d->per_rank[0].busy_ms += rl_timer_ms(&t);
-            if (st == RL_OK) {
-                add_band(stats, bs.rays, bs.samples, bs.pixels_written);
-                stats->prep_ms += bs.prep_ms;
-                ++d->per_rank[0].tasks;
-                d->per_rank[0].pixels += bs.pixels_written;
-                band_done(&fp);
-            } else {
-                snprintf(failure, sizeof failure, "%s", rl_last_error());
+        if (!arrived) {
+            int band = st == RL_OK ? take_band(redo, &num_redo, &next, bands) : -1;
+            if (band >= 0 && !done[band]) {
+                /* Nothing to answer: render a band here. */
+                rl_render_stats bs = { 0 };
+                rl_timer t;
+                rl_timer_start(&t);
+                st = render_band(r, scene, cam, image, band, &bs);
+                d->per_rank[0].busy_ms += rl_timer_ms(&t);
+                if (st == RL_OK) {
+                    add_band(stats, bs.rays, bs.samples, bs.pixels_written);
+                    stats->prep_ms += bs.prep_ms;
+                    ++d->per_rank[0].tasks;
+                    d->per_rank[0].pixels += bs.pixels_written;
+                    done[band] = 1;
+                    --remaining;
+                    band_done(&fp);
+                    rl_dist_fault_point(d);
+                } else {
+                    snprintf(failure, sizeof failure, "%s", rl_last_error());
+                }
+                continue;
             }
+            /* Waiting: a worker silent past the timeout is lost. */
+            double now = rl_time_s();
+            for (int w = 1; w < d->size; ++w) {
+                if (ws[w].lost || ws[w].pending == 0 || now - ws[w].since <= timeout)
+                    continue;
+                ws[w].lost = true;
+                ++ds->lost;
+                pending -= ws[w].pending;
+                for (int k = 0; k < PREFETCH; ++k)
+                    if (ws[w].bands[k] >= 0 && !done[ws[w].bands[k]])
+                        redo[num_redo++] = ws[w].bands[k];
+                rl_log(RL_LOG_WARN, "rank %d has not answered for %.0f s: taken for lost, its bands go to the "
+                       "other ranks (RL_DIST_TIMEOUT)", w, now - ws[w].since);
+            }
+            if (pending > 0 || st != RL_OK)
+                rl_dist_pause();
             continue;
         }
-        if (!arrived && (code = MPI_Probe(MPI_ANY_SOURCE, RL_DIST_TAG_RESULT, MPI_COMM_WORLD, &ms)) != MPI_SUCCESS)
-            break;
         int w = ms.MPI_SOURCE;
         band_result res;
-        if ((code = MPI_Recv(&res, (int)sizeof res, MPI_BYTE, w, RL_DIST_TAG_RESULT, MPI_COMM_WORLD, MPI_STATUS_IGNORE)) !=
-            MPI_SUCCESS)
+        if ((code = MPI_Recv(&res, (int)sizeof res, MPI_BYTE, w, RL_DIST_TAG_RESULT, MPI_COMM_WORLD,
+                             MPI_STATUS_IGNORE)) != MPI_SUCCESS)
             break;
-        --pending;
         ++ds->messages;
         ds->bytes += sizeof res;
-        if (res.status == RL_OK) {
-            if (res.band < 0 || res.band >= bands) {
-                code = MPI_ERR_OTHER;
+        if (res.band < 0 || res.band >= bands) {
+            code = MPI_ERR_OTHER;
+            break;
+        }
+        for (int k = 0; k < PREFETCH; ++k)
+            if (ws[w].bands[k] == res.band) {
+                ws[w].bands[k] = -1;
+                --ws[w].pending;
+                if (!ws[w].lost)
+                    --pending;
                 break;
             }
+        ws[w].since = rl_time_s();
+        if (res.status == RL_OK) {
             band_layout l = layout_of(image, res.band);
             for (int k = 0; code == MPI_SUCCESS && k < 4; ++k)
                 if (l.bytes[k]) {
@@ -305,36 +457,51 @@ static rl_status lead(rl_dist *d, rl_renderer *r, const rl_scene *scene, const r
                 }
             if (code != MPI_SUCCESS)
                 break;
-            add_band(stats, res.rays, res.samples, res.pixels);
-            ++d->per_rank[w].tasks;
-            d->per_rank[w].pixels += res.pixels;
-            d->per_rank[w].busy_ms += res.busy_ms;
-            band_done(&fp);
+            if (!done[res.band]) {          /* a late answer of a lost worker may come twice */
+                add_band(stats, res.rays, res.samples, res.pixels);
+                ++d->per_rank[w].tasks;
+                d->per_rank[w].pixels += res.pixels;
+                d->per_rank[w].busy_ms += res.busy_ms;
+                done[res.band] = 1;
+                --remaining;
+                band_done(&fp);
+            }
         } else if (st == RL_OK) {
             st = (rl_status)res.status;
             res.error[sizeof res.error - 1] = '\0';
             snprintf(failure, sizeof failure, "rank %d: %s", w, res.error);
         }
-        if (st == RL_OK && next < bands) {
-            int32_t band = next++;
-            if ((code = MPI_Send(&band, 1, MPI_INT32_T, w, RL_DIST_TAG_TASK, MPI_COMM_WORLD)) != MPI_SUCCESS)
-                break;
-            ++pending;
-            ++ds->messages;
+        if (st == RL_OK && !ws[w].lost) {
+            int band = take_band(redo, &num_redo, &next, bands);
+            if (band >= 0) {
+                if ((st = give_band(ds, &ws[w], w, band)) != RL_OK)
+                    snprintf(failure, sizeof failure, "%s", rl_last_error());
+                else
+                    ++pending;
+            }
         }
     }
     rl_renderer_set_progress(r, fp.fn, fp.user);
+    if (code == MPI_SUCCESS) {
+        /* Every live worker hears the end. A lost one does not: a send to
+         * a dead rank may never return; one that was only slow gives up
+         * by its own timeout (rl_dist_wait). */
+        int32_t end = (int32_t)st;
+        for (int w = 1; w < d->size && code == MPI_SUCCESS; ++w)
+            if (!ws[w].lost) {
+                code = MPI_Send(&end, 1, MPI_INT32_T, w, RL_DIST_TAG_DONE, MPI_COMM_WORLD);
+                ++ds->messages;
+            }
+    }
+    free(ws);
+    free(redo);
+    free(done);
+    ds->tasks = (uint64_t)bands;
     if (code != MPI_SUCCESS)
         return rl_dist_mpi_failed(code, "collecting the bands");   /* the CLI then aborts the job */
-    int32_t done = (int32_t)st;
-    for (int w = 1; w < d->size && code == MPI_SUCCESS; ++w) {
-        code = MPI_Send(&done, 1, MPI_INT32_T, w, RL_DIST_TAG_DONE, MPI_COMM_WORLD);
-        ++ds->messages;
-    }
-    ds->tasks = (uint64_t)bands;
     if (st != RL_OK)
         return rl_error(st, "%s", failure);
-    return code == MPI_SUCCESS ? RL_OK : rl_dist_mpi_failed(code, "ending the frame");
+    return RL_OK;
 }
 
 rl_status rl_dist_render(rl_dist *d, rl_renderer *r, const rl_scene *scene, const rl_camera *cam,

@@ -21,9 +21,30 @@ struct rl_dist {
     int rank, size;
     bool own_mpi;                      /* we called MPI_Init: we finalize */
     rl_dist_rank_stats *per_rank;      /* size entries */
+    uint64_t tasks_done;               /* by this rank, for rl_dist_fault_point */
 };
 
 /* RL_ERR_IO "distributed run: WHAT: <MPI's text for code>". */
 rl_status rl_dist_mpi_failed(int code, const char *what);
+
+/* How long a rank waits for another before it takes it for lost: the
+ * environment variable RL_DIST_TIMEOUT in seconds, else this. Generous,
+ * since a worker's first answer waits for its scene to load. */
+#define RL_DIST_DEFAULT_TIMEOUT_S 120.0
+double rl_dist_timeout_s(void);
+/* A fraction of a millisecond's sleep between polls. */
+void rl_dist_pause(void);
+/* A worker waits for the master's next message with tag (MPI_ANY_TAG:
+ * any), polling; past the timeout RL_ERR_IO "no word from the master",
+ * so that a dead master ends its workers with an error, not a hang. */
+rl_status rl_dist_wait(const rl_dist *d, int tag, MPI_Status *ms);
+/* MPI_Send that gives up past the timeout (RL_ERR_IO naming dest): a
+ * large message waits for its receiver, forever if the receiver died. */
+rl_status rl_dist_send(const rl_dist *d, const void *buf, int count, MPI_Datatype type, int dest, int tag);
+/* Fault injection for the tests of docs/distributed.md: with
+ * RL_DIST_FAULT=RANK:N in the environment, rank RANK kills itself with
+ * SIGKILL after its N-th task, as a crashed node would vanish. Counts this
+ * rank's tasks. */
+void rl_dist_fault_point(rl_dist *d);
 
 #endif

@@ -171,7 +171,7 @@ static rl_status measure(void *user, const rl_vec3 *pos, uint32_t n, double *val
 }
 
 /* A sampling node: chunks until DONE, whose status it returns. */
-static rl_status serve(rl_property *p)
+static rl_status serve(const rl_dist *d, rl_property *p)
 {
     unsigned char *buf = NULL;
     double *values = NULL;
@@ -179,10 +179,10 @@ static rl_status serve(rl_property *p)
     rl_status st = RL_OK;
     for (;;) {
         MPI_Status ms;
-        int code = MPI_Probe(0, MPI_ANY_TAG, MPI_COMM_WORLD, &ms);
+        if ((st = rl_dist_wait(d, MPI_ANY_TAG, &ms)) != RL_OK)     /* a dead control node: an error */
+            break;
         int bytes = 0;
-        if (code == MPI_SUCCESS)
-            code = MPI_Get_count(&ms, MPI_BYTE, &bytes);
+        int code = MPI_Get_count(&ms, MPI_BYTE, &bytes);
         if (code != MPI_SUCCESS) {
             st = rl_dist_mpi_failed(code, "receiving positions from the control node");
             break;
@@ -243,16 +243,13 @@ static rl_status serve(rl_property *p)
         res.status = (int32_t)ms_st;
         if (ms_st != RL_OK)
             snprintf(res.error, sizeof res.error, "%s", rl_last_error());
-        code = MPI_Send(&res, (int)sizeof res, MPI_BYTE, 0, RL_DIST_TAG_RESULT, MPI_COMM_WORLD);
-        if (code == MPI_SUCCESS && ms_st == RL_OK)
-            code = MPI_Send(values, h.count, MPI_DOUBLE, 0, RL_DIST_TAG_VALUES, MPI_COMM_WORLD);
-        if (code == MPI_SUCCESS && ms_st == RL_OK && words)
-            code = MPI_Send(sets, (int)((size_t)h.count * words), MPI_UINT64_T, 0, RL_DIST_TAG_VALUES,
-                            MPI_COMM_WORLD);
-        if (code != MPI_SUCCESS) {
-            st = rl_dist_mpi_failed(code, "returning measured values");
+        st = rl_dist_send(d, &res, (int)sizeof res, MPI_BYTE, 0, RL_DIST_TAG_RESULT);
+        if (st == RL_OK && ms_st == RL_OK)
+            st = rl_dist_send(d, values, h.count, MPI_DOUBLE, 0, RL_DIST_TAG_VALUES);
+        if (st == RL_OK && ms_st == RL_OK && words)
+            st = rl_dist_send(d, sets, (int)((size_t)h.count * words), MPI_UINT64_T, 0, RL_DIST_TAG_VALUES);
+        if (st != RL_OK)
             break;
-        }
     }
     free(buf);
     free(values);
@@ -297,7 +294,7 @@ rl_status rl_dist_sample_property(rl_dist *d, rl_property *p, const rl_sampling_
         ds->messages = s.messages;
         ds->bytes = s.bytes;
     } else {
-        st = serve(p);
+        st = serve(d, p);
     }
     ds->time_ms = rl_timer_ms(&t);
     ds->per_rank = d->per_rank;

@@ -72,6 +72,30 @@ assert a == b
 PY
 [ ! -e "$TMP/e3/report.html" ] || [ "$(grep -c . "$TMP/e3/report.html")" -gt 0 ] || fail "empty report"
 
+# Fault tolerance (docs/distributed.md). With Open MPI's recovery on, the
+# job outlives a rank: rank 2 kills itself (SIGKILL, RL_DIST_FAULT) after
+# its first band, the master takes it for lost after RL_DIST_TIMEOUT and
+# hands its bands to the others, and the image is still the one-process
+# image.
+RECOVER=(env OMPI_MCA_orte_enable_recovery=1 OMPI_MCA_orte_abort_on_non_zero_status=0 RL_DIST_TIMEOUT=2)
+run_ok "${RECOVER[@]}" RL_DIST_FAULT=2:1 "${MPI[@]}" "$RL" --dist render spheres --algo whitted --size 72x53 \
+    --out "$TMP/lost.png"
+cmp -s "$TMP/ref.png" "$TMP/lost.png" || fail "a lost worker changed the image"
+expect_in "$TMP/out" "^dist: 1 worker lost"
+expect_in "$TMP/err" "rank 2 has not answered for [0-9]* s: taken for lost"
+# A dead master (it kills itself after its first band): by default mpirun
+# ends the job at once; with recovery on, every worker gives up with an
+# error after the timeout. Neither hangs (timeout 120 above), neither
+# writes an image.
+expect_exit 137 env RL_DIST_FAULT=0:1 "${MPI[@]}" "$RL" --dist render spheres --algo whitted --size 72x200 \
+    --out "$TMP/dead.png"
+[ ! -e "$TMP/dead.png" ] || fail "a dead master wrote an image"
+"${RECOVER[@]}" RL_DIST_FAULT=0:1 "${MPI[@]}" "$RL" --dist render spheres --algo whitted --size 72x200 \
+    --out "$TMP/dead.png" >"$TMP/out" 2>"$TMP/err"
+[ "$(grep -c '^rl: error: render: rank [12]: .*rank 0.* for 2 s: it is gone or stuck' "$TMP/err")" -ge 1 ] ||
+    fail "the workers of a dead master: $(grep -v '^ ' "$TMP/err" | head -c 600)"
+[ ! -e "$TMP/dead.png" ] || fail "a dead master wrote an image"
+
 # A renderer whose pixels depend on each other is refused, on every rank,
 # and nothing is written.
 expect_exit 1 "${MPI[@]}" "$RL" --dist render cornell --algo raster --size 32x24 --out "$TMP/raster.png"
