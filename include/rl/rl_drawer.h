@@ -58,6 +58,10 @@ typedef struct rl_drawer_desc {   /* zero = default */
                                    * selects at create: only with
                                    * RL_RASTER_NO_COLOR may its contents
                                    * change between frames */
+    bool deferred_counts;         /* the pixels_written of draws may reach
+                                   * their counters only at rl_drawer_end,
+                                   * so those must outlive the frame: a GPU
+                                   * backend then never waits for a draw */
 } rl_drawer_desc;
 
 typedef struct rl_drawer rl_drawer;

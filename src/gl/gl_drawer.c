@@ -19,7 +19,9 @@
  * gl_shaders.c). Counters: triangles submitted and drawn count whole
  * objects (drawn: box not outside the view; GL does not report its
  * clipping), pixels written are GL_SAMPLES_PASSED, read at the end of each
- * call. Occlusion queries are GL_SAMPLES_PASSED in query objects of a pool
+ * call (with desc.deferred_counts, as chcpp draws, at the frame's end, so
+ * that no draw waits for the GPU). Occlusion queries are GL_SAMPLES_PASSED
+ * in query objects of a pool
  * kept across frames, issued without waiting and read when the caller asks
  * (rl_drawer_query_poll / _result): chcpp hides their latency as Mattausch
  * et al. 2008 do. */
@@ -59,6 +61,12 @@ typedef struct gl_drawer {
     GLuint stream_vao, stream_pos, stream_idx;
     GLuint point_vao, point_pos, point_color, point_size, point_object;
     GLuint query;                 /* the pixels of counted draws */
+    /* desc.deferred_counts: each counted draw's query object (a pool kept
+     * across frames) and its counters, read at the frame's end. */
+    GLuint *count_pool;
+    rl_raster_counters **count_to;
+    uint32_t counts_used, count_n, count_cap, count_to_cap;
+    GLuint counting;              /* the query of the counted draw running */
     /* The pool of occlusion query objects, one per slot of rl_drawer.c,
      * kept across frames: a slot's object is reused by later queries. */
     GLuint *pool;
@@ -104,6 +112,8 @@ static void gl_release(void *impl)
     /* The context's objects go with it; they are not deleted one by one. */
     rl_gl_context_release(g->ctx);
     free(g->pool);
+    free(g->count_pool);
+    free(g->count_to);
     free(g);
 }
 
@@ -496,6 +506,7 @@ static rl_status gl_begin(void *impl, rl_image *target, const rl_mat4 *view, con
     if (st != RL_OK)
         return settle(g, st);
     g->target = target;
+    g->counts_used = 0;           /* of a frame that failed */
     g->view_proj = rl_mat4_mul(proj, view);
     g->affine = proj->m[3][0] == 0.0f && proj->m[3][1] == 0.0f && proj->m[3][2] == 0.0f && proj->m[3][3] == 1.0f;
     set_camera(g, g->tri_prog, &g->tri_u, view, proj, eye);
@@ -591,7 +602,27 @@ static void begin_triangles(gl_drawer *g)
     glProgramUniform1f(g->tri_prog, g->tri_u.ambient, g->desc.ambient);
     glProgramUniform1i(g->tri_prog, g->tri_u.num_lights, (GLint)g->data->num_lights);
     glBindVertexArray(g->vao);
-    glBeginQuery(GL_SAMPLES_PASSED, g->query);
+}
+
+/* Starts the query that counts a draw's pixels: the drawer's one, read at
+ * once, or with deferred counts the next of the frame's pool. */
+static rl_status start_counted(gl_drawer *g)
+{
+    g->counting = g->query;
+    if (g->desc.deferred_counts) {
+        if (g->counts_used == g->count_n) {
+            if (!rl_reserve_u32((void **)&g->count_pool, &g->count_cap, (uint64_t)g->count_n + 1,
+                                sizeof *g->count_pool, 16))
+                return RL_ERR_OUT_OF_MEMORY;
+            glCreateQueries(GL_SAMPLES_PASSED, 1, &g->count_pool[g->count_n++]);
+        }
+        if (!rl_reserve_u32((void **)&g->count_to, &g->count_to_cap, (uint64_t)g->counts_used + 1,
+                            sizeof *g->count_to, 16))
+            return RL_ERR_OUT_OF_MEMORY;
+        g->counting = g->count_pool[g->counts_used];
+    }
+    glBeginQuery(GL_SAMPLES_PASSED, g->counting);
+    return RL_OK;
 }
 
 static void draw_object(gl_drawer *g, uint32_t o, rl_raster_counters *c)
@@ -615,11 +646,28 @@ static void draw_object(gl_drawer *g, uint32_t o, rl_raster_counters *c)
 static rl_status end_counted(gl_drawer *g, rl_raster_counters *c, const char *where)
 {
     glEndQuery(GL_SAMPLES_PASSED);
+    if (g->desc.deferred_counts) {
+        g->count_to[g->counts_used++] = c;
+        return gl_check(where);
+    }
     GLuint64 passed = 0;
     glGetQueryObjectui64v(g->query, GL_QUERY_RESULT, &passed);
     if (c)
         c->pixels_written += passed;
     return gl_check(where);
+}
+
+/* The deferred counts of the frame's draws into their counters. */
+static void read_counts(gl_drawer *g)
+{
+    for (uint32_t i = 0; i < g->counts_used; ++i) {
+        if (!g->count_to[i])
+            continue;
+        GLuint64 passed = 0;
+        glGetQueryObjectui64v(g->count_pool[i], GL_QUERY_RESULT, &passed);
+        g->count_to[i]->pixels_written += passed;
+    }
+    g->counts_used = 0;
 }
 
 static rl_status gl_draw(void *impl, const uint32_t *objects, uint32_t count, rl_raster_counters *c)
@@ -633,6 +681,9 @@ static rl_status gl_draw(void *impl, const uint32_t *objects, uint32_t count, rl
             return settle(g, rl_error(RL_ERR_INVALID_ARG, "rl_drawer_draw: object %u of %u", objects[i],
                                       g->data->num_objects));
     begin_triangles(g);
+    st = start_counted(g);
+    if (st != RL_OK)
+        return settle(g, st);
     for (uint32_t i = 0; i < count; ++i)
         draw_object(g, objects[i], c);
     return settle(g, end_counted(g, c, "rl_drawer_draw"));
@@ -646,6 +697,9 @@ static rl_status gl_draw_all(void *impl, rl_raster_counters *c, rl_progress_fn p
         return settle(g, st);
     const uint32_t total = g->data->num_objects, step = total / 100 + 1;
     begin_triangles(g);
+    st = start_counted(g);
+    if (st != RL_OK)
+        return settle(g, st);
     for (uint32_t o = 0; o < total && st == RL_OK; ++o) {
         draw_object(g, o, c);
         if (progress && ((o + 1) % step == 0 || o + 1 == total) && !progress(user, (double)(o + 1) / total))
@@ -764,7 +818,9 @@ static rl_status gl_draw_points(void *impl, const rl_raster_points *pts, rl_rast
         glVertexAttribI1ui(3, pts->object_id);
     apply_flags(pts->flags);
     glUseProgram(g->point_prog);
-    glBeginQuery(GL_SAMPLES_PASSED, g->query);
+    st = start_counted(g);
+    if (st != RL_OK)
+        return settle(g, st);
     glDrawArrays(GL_POINTS, 0, (GLsizei)pts->count);
     if (c) {
         /* Points in front of the near plane (the software's count also
@@ -783,6 +839,7 @@ static rl_status gl_end(void *impl)
     rl_status st = rl_gl_context_make_current(g->ctx);
     if (st != RL_OK)
         return settle(g, st);
+    read_counts(g);
     rl_image *t = g->target;
     const size_t n = (size_t)t->width * (size_t)t->height;
     if ((t->layers & RL_LAYER_COLOR) && t->color)

@@ -55,7 +55,7 @@ bool rl_drawer_fits(const rl_drawer *dr, const rl_scene *scene, const rl_drawer_
     const rl_drawer_desc *d = desc ? desc : &zero;
     return dr && scene && dr->scene_uid == rl_scene_uid(scene) && dr->desc.shading == d->shading &&
            dr->desc.ambient == d->ambient && dr->desc.threads == d->threads && dr->desc.flags == d->flags &&
-           dr->desc.object_mask == d->object_mask;
+           dr->desc.object_mask == d->object_mask && dr->desc.deferred_counts == d->deferred_counts;
 }
 
 const char *rl_drawer_backend(const rl_drawer *dr) { return dr ? dr->ops->name : NULL; }

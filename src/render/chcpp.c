@@ -543,7 +543,7 @@ static rl_status chcpp_render(rl_renderer *r, void *state, const rl_scene *scene
     f.batch = (uint32_t)rl_renderer_opt_int(r, "batch");
     f.n_av = (uint32_t)rl_renderer_opt_int(r, "assumed_visible");
     f.seed = (uint64_t)rl_renderer_opt_int(r, "seed");
-    st = rl_cull_frame_begin(r, scene, &s->head, cam, image, &f.cf);
+    st = rl_cull_frame_begin(r, scene, &s->head, cam, image, true, &f.cf);
     if (st != RL_OK)
         return st;
     s->frame++;

@@ -284,7 +284,7 @@ static bool same_backend(rl_renderer *r, const rl_culling_head *head)
 }
 
 rl_status rl_cull_frame_begin(rl_renderer *r, const rl_scene *scene, rl_culling_head *head, const rl_camera *cam,
-                              rl_image *image, rl_cull_frame *f)
+                              rl_image *image, bool deferred, rl_cull_frame *f)
 {
     const rl_scene_data *d = rl_scene_get_data(scene);
     memset(f, 0, sizeof *f);
@@ -300,6 +300,7 @@ rl_status rl_cull_frame_begin(rl_renderer *r, const rl_scene *scene, rl_culling_
         .ambient = f->ambient,
         .threads = f->threads_opt,
         .flags = rl_renderer_opt_bool(r, "cull") ? RL_RASTER_CULL_BACK : 0u,
+        .deferred_counts = deferred,
     };
     rl_status st = rl_cull_target_begin(image, rl_renderer_opt_color(r, "background"), &f->target);
     if (st != RL_OK)

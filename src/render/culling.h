@@ -125,9 +125,11 @@ typedef struct rl_cull_frame {
 
 typedef struct rl_culling_head rl_culling_head;
 /* The drawer is the head's, kept while the scene, the options and the
- * drawer's backend and device stay. */
+ * drawer's backend and device stay. deferred: every draw counts into
+ * f->counters, which rl_cull_frame_end reads after the drawer's end
+ * (rl_drawer_desc.deferred_counts: a GL drawer never waits for a draw). */
 rl_status rl_cull_frame_begin(rl_renderer *r, const rl_scene *scene, rl_culling_head *head, const rl_camera *cam,
-                              rl_image *image, rl_cull_frame *f);
+                              rl_image *image, bool deferred, rl_cull_frame *f);
 /* Ends the drawer's frame and releases what begin made (not the kept
  * drawer); with st == RL_OK fills stats (triangles, points, pixels
  * written, samples, the GL device). Returns st, or the end's failure. */

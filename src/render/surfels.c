@@ -392,7 +392,7 @@ static rl_status surfels_render(rl_renderer *r, void *state, const rl_scene *sce
     f.max_size = max_size;
     f.overdraw = (float)rl_renderer_opt_float(r, "overdraw");
     f.point_size = (float)rl_renderer_opt_float(r, "point_size");
-    st = rl_cull_frame_begin(r, scene, &s->head, cam, image, &f.cf);
+    st = rl_cull_frame_begin(r, scene, &s->head, cam, image, false, &f.cf);
     if (st != RL_OK)
         return st;
     s->num_cmds = 0;

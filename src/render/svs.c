@@ -518,7 +518,7 @@ static rl_status svs_render(rl_renderer *r, void *state, const rl_scene *scene, 
     f.distance = (float)rl_renderer_opt_float(r, "distance");
     if (f.neighbours > s->num_dirs)
         f.neighbours = s->num_dirs;
-    st = rl_cull_frame_begin(r, scene, &s->head, cam, image, &f.cf);
+    st = rl_cull_frame_begin(r, scene, &s->head, cam, image, true, &f.cf);
     if (st != RL_OK)
         return st;
     if (++s->frame == 0) {

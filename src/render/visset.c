@@ -241,7 +241,7 @@ static rl_status visset_render(rl_renderer *r, void *state, const rl_scene *scen
     f.s = s;
     f.d = d;
     f.budget = budget;
-    st = rl_cull_frame_begin(r, scene, &s->head, cam, image, &f.cf);
+    st = rl_cull_frame_begin(r, scene, &s->head, cam, image, true, &f.cf);
     if (st != RL_OK)
         return st;
     if (++s->frame == 0) {

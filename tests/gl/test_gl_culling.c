@@ -158,6 +158,35 @@ static void test_async_queries_on_the_gl_drawer(void **state)
     print_message("quad before the box: %llu pixels on GL, %llu in software\n", (unsigned long long)gl_px,
                   (unsigned long long)sw_px);
     assert_true(llabs((long long)gl_px - (long long)sw_px) <= (long long)sw_px / 50);
+
+    /* Deferred counts: the pixels of each draw reach its counters at the
+     * frame's end, the same number as read at once. */
+    rl_drawer *dd = NULL;
+    assert_int_equal(rl_gl_drawer_create(s, &(rl_drawer_desc){ .shading = RL_SHADING_GOURAUD,
+                                                               .deferred_counts = true }, NULL, &dd), RL_OK);
+    assert_false(rl_drawer_fits(dd, s, &desc));
+    rl_image *img = NULL;
+    assert_int_equal(rl_image_create(cam.width, cam.height, FX_ALL_LAYERS, &img), RL_OK);
+    uint64_t counted[2][2];
+    rl_drawer *both[2] = { gd, dd };
+    for (int k = 0; k < 2; ++k) {
+        rl_raster_counters c[2] = { { 0 }, { 0 } };
+        const uint32_t half = rl_scene_get_data(s)->num_objects / 2, rest[] = { half, half + 1 };
+        rl_image_clear(img);
+        assert_int_equal(rl_drawer_begin_camera(both[k], img, &cam, rl_scene_get_data(s)->bounds), RL_OK);
+        assert_int_equal(rl_drawer_draw_all(both[k], &c[0], NULL, NULL), RL_OK);
+        assert_int_equal(rl_drawer_draw(both[k], rest, 2, &c[1]), RL_OK);
+        if (k == 1)
+            assert_int_equal(c[0].pixels_written + c[1].pixels_written, 0);
+        assert_int_equal(rl_drawer_end(both[k]), RL_OK);
+        counted[k][0] = c[0].pixels_written;
+        counted[k][1] = c[1].pixels_written;
+    }
+    assert_true(counted[0][0] > 1000);
+    assert_int_equal(counted[1][0], counted[0][0]);
+    assert_int_equal(counted[1][1], counted[0][1]);
+    rl_image_release(img);
+    rl_drawer_release(dd);
     rl_drawer_release(gd);
     rl_drawer_release(sd);
     rl_scene_release(s);
