@@ -985,7 +985,9 @@ static rl_status walk_renderer(bc_ctx *c, const char *name, bool gl, const rl_ca
             continue;
         }
         w->ms[k - 1] = rs.time_ms;
-        w->triangles += rs.triangles_rasterized;
+        /* The renderer's own count: the drawers count rasterized
+         * triangles differently (docs/gl.md). */
+        w->triangles += cs.triangles_drawn;
         w->queries += cs.queries;
         w->ready += cs.queries_ready;
         w->waited += cs.queries_waited;
