@@ -96,9 +96,9 @@ RL_API rl_status rl_drawer_draw(rl_drawer *dr, const uint32_t *objects, uint32_t
  * a hundred times, false cancels. */
 RL_API rl_status rl_drawer_draw_all(rl_drawer *dr, rl_raster_counters *c, rl_progress_fn progress, void *user);
 /* An occlusion query: the pixels of boxes (triangles, e.g. the front faces
- * of bounding boxes) that would pass the depth test, writing nothing. The
- * software backend answers at once; a GPU backend may answer later, which
- * callers hide as Mattausch et al. 2008 do. */
+ * of bounding boxes) that would pass the depth test, writing nothing;
+ * answered when it returns (on a GPU after a wait, which the asynchronous
+ * calls below avoid). */
 RL_API rl_status rl_drawer_query(rl_drawer *dr, const rl_raster_batch *boxes, uint64_t *pixels,
                                  rl_raster_counters *c);
 /* Asynchronous occlusion queries, for renderers that hide a GPU's query
