@@ -41,6 +41,14 @@
  *           --visset-positions random positions of the slice (not the
  *           samples, where the sets are exact), and the budgeted variant
  *           (--budget triangles).
+ *   walk    (only with --only walk) Sec. 7.4 frame by frame: chcpp and
+ *           svs down a walk of --walk-frames frames along the scene's
+ *           "street" camera (else its default one), with the software
+ *           drawer and the GL one (--drawer): frame times, triangles,
+ *           occlusion queries and how many of their answers chcpp found
+ *           ready or had to wait for. On a GPU this is the thesis'
+ *           question with real query latency; on llvmpipe (Mesa's CPU GL)
+ *           there is none to hide.
  * The reports of the same measurements as heat maps and violins come from
  * `rl compare` (docs/culling.md gives the commands). */
 #define _POSIX_C_SOURCE 200809L
@@ -73,6 +81,8 @@ static const char bench_culling_help[] =
     "           polygons in visible objects, svs quality\n"
     "  select   Sec. 7.5: runtime selection of chcpp or svs per position\n"
     "  visset   Sec. 7.6: the sampled visible sets as a renderer, with budget\n"
+    "  walk     Sec. 7.4 per frame down a street: chcpp and svs on the software\n"
+    "           and the GL drawer (only when named in --only)\n"
     "\n"
     "options:\n"
     "  --scene S            default city (the thesis: 4 Power Plants for 7.4-7.6;\n"
@@ -102,14 +112,20 @@ static const char bench_culling_help[] =
     "                       the depth section: the same command continues a\n"
     "                       run that stopped; DIR must be new or made by a run\n"
     "                       with the same options\n"
+    "  --walk-frames N      walk section: frames; default 40\n"
+    "  --drawer D           walk section: software, gl or both; default both\n"
+    "                       (gl where a GL 4.5 context can be made)\n"
     "  --quick              tiny run: cornell-sized box city, few samples\n"
     "\n"
     "example:\n"
     "  rl bench culling --only depth,svs --samples 256\n"
-    "  rl bench culling --scene city:blocks=12 --only svs --samples 4096 --resume out/svs4096\n";
+    "  rl bench culling --scene city:blocks=12 --only svs --samples 4096 --resume out/svs4096\n"
+    "  rl bench culling --only walk --size 640 --drawer both\n";
 
-enum { SEC_SURFELS, SEC_DEPTH, SEC_SVS, SEC_SELECT, SEC_VISSET, SEC_COUNT };
-static const char *const section_names[SEC_COUNT] = { "surfels", "depth", "svs", "select", "visset" };
+enum { SEC_SURFELS, SEC_DEPTH, SEC_SVS, SEC_SELECT, SEC_VISSET, SEC_WALK, SEC_COUNT };
+static const char *const section_names[SEC_COUNT] = { "surfels", "depth", "svs", "select", "visset", "walk" };
+static const char *const drawer_names[] = { "software", "gl", "both" };
+enum { DRAWER_SOFTWARE, DRAWER_GL, DRAWER_BOTH };
 
 /* Positions measured between two saves of a --resume run. */
 #define RESUME_BLOCK 32
@@ -117,6 +133,8 @@ static const char *const section_names[SEC_COUNT] = { "surfels", "depth", "svs",
 typedef struct bc_args {
     const char *scene, *out, *resume;
     long long samples, max_depth, size, resolution, select_positions, visset_positions, budget, threads, seed, surfels;
+    long long walk_frames;
+    int drawer;                   /* DRAWER_* */
     double height, select_quantile, extent;
     unsigned sections;
     bool quick;
@@ -901,6 +919,180 @@ static rl_status sec_visset(void *ctx, cJSON *sec)
     return st;
 }
 
+/* --- Sec. 7.4, frame by frame, software and GL --- */
+
+/* Frame k of n down the walk: from the street camera's eye along its view
+ * (kept level) for 80 % of the scene's extent that way, the view swinging
+ * 20 degrees left and right, at --size pixels. */
+static rl_camera walk_camera(const bc_ctx *c, const rl_camera *start, int k, int n)
+{
+    rl_vec3 dir = rl_sub(start->target, start->eye);
+    dir.y = 0.0f;
+    dir = rl_length(dir) > 0.0f ? rl_normalize(dir) : rl_v3(0, 0, -1);
+    rl_vec3 ext = rl_sub(c->d->bounds.max, c->d->bounds.min);
+    float len = 0.8f * (fabsf(dir.x) * ext.x + fabsf(dir.z) * ext.z);
+    float t = n > 1 ? (float)k / (float)(n - 1) : 0.0f;
+    float yaw = 0.35f * sinf(6.2831853f * 1.5f * t);
+    rl_vec3 look = rl_v3(dir.x * cosf(yaw) - dir.z * sinf(yaw), -0.05f, dir.x * sinf(yaw) + dir.z * cosf(yaw));
+    rl_camera cam = *start;
+    cam.eye = rl_add(start->eye, rl_scale(dir, len * t));
+    cam.target = rl_add(cam.eye, look);
+    cam.width = cam.height = (int)c->a->size;
+    cam.z_near = cam.z_far = 0.0f;
+    return cam;
+}
+
+/* What one renderer on one drawer did over the walk. */
+typedef struct walk_run {
+    double *ms;                   /* per frame after the first */
+    double first_ms, prep_ms;
+    uint64_t triangles, queries, ready, waited;
+    char device[512];
+} walk_run;
+
+static rl_status walk_renderer(bc_ctx *c, const char *name, bool gl, const rl_camera *start, walk_run *w)
+{
+    const int n = (int)c->a->walk_frames;
+    char th[32];
+    snprintf(th, sizeof th, "%lld", c->a->threads);
+    rl_renderer *r = NULL;
+    rl_image *img = NULL;
+    rl_status st = rl_renderer_create(name, &r);
+    if (st == RL_OK)
+        st = rl_renderer_set(r, "threads", th);
+    if (st == RL_OK && gl)
+        st = rl_renderer_set(r, "drawer", "gl");
+    if (st == RL_OK && strcmp(name, "svs") == 0 && c->a->quick)
+        st = rl_renderer_set(r, "levels", "0");
+    if (st == RL_OK && strcmp(name, "svs") == 0 && c->a->quick)
+        st = rl_renderer_set(r, "resolution", "32");
+    if (st == RL_OK)
+        st = rl_image_create((int)c->a->size, (int)c->a->size, RL_LAYER_COLOR, &img);
+    for (int k = 0; k < n && st == RL_OK; ++k) {
+        rl_camera cam = walk_camera(c, start, k, n);
+        rl_render_stats rs;
+        st = rl_renderer_render(r, c->scene, &cam, img, &rs);
+        rl_culling_stats cs;
+        if (st == RL_OK)
+            st = rl_culling_get_stats(r, &cs);
+        if (st != RL_OK)
+            break;
+        if (k == 0) {
+            /* The octree, svs' sets, a GL context and the scene's buffers. */
+            w->first_ms = rs.time_ms;
+            w->prep_ms = rs.prep_ms;
+            snprintf(w->device, sizeof w->device, "%s", rs.device ? rs.device : "");
+            continue;
+        }
+        w->ms[k - 1] = rs.time_ms;
+        /* The renderer's own count: the drawers count rasterized
+         * triangles differently (docs/gl.md). */
+        w->triangles += cs.triangles_drawn;
+        w->queries += cs.queries;
+        w->ready += cs.queries_ready;
+        w->waited += cs.queries_waited;
+    }
+    rl_image_release(img);
+    rl_renderer_release(r);
+    return st;
+}
+
+static int cmp_double(const void *a, const void *b)
+{
+    double x = *(const double *)a, y = *(const double *)b;
+    return (x > y) - (x < y);
+}
+
+static rl_status sec_walk(void *ctx, cJSON *sec)
+{
+    bc_ctx *c = ctx;
+    const int n = (int)c->a->walk_frames, m = n - 1;
+    rl_camera start;
+    if (rl_scene_get_camera(c->scene, "street", &start) != RL_OK &&
+        rl_scene_get_camera(c->scene, NULL, &start) != RL_OK)
+        return RL_ERR_NOT_FOUND;
+    bool drawers[2] = { c->a->drawer != DRAWER_GL, c->a->drawer != DRAWER_SOFTWARE };
+    char why[256] = "";
+    if (drawers[1] && !rl_gl_available(NULL, why, sizeof why)) {
+        if (c->a->drawer == DRAWER_GL) {
+            snprintf(c->reason, sizeof c->reason, "--drawer gl: no GL 4.5 context: %s", why);
+            return RL_ERR_UNSUPPORTED;
+        }
+        note("no GL 4.5 context (%s): the walk runs on the software drawer only", why);
+        cJSON_AddStringToObject(sec, "gl_unavailable", why);
+        drawers[1] = false;
+    }
+    printf("\nSec. 7.4 per frame: chcpp and svs down a walk of %d frames at %lldx%lld (the first frame, with "
+           "its preparation, apart)\n", n, c->a->size, c->a->size);
+    printf("%-8s %-8s %9s %9s %9s %9s %11s %9s %8s %8s\n", "renderer", "drawer", "mean ms", "min", "median", "first",
+           "triangles", "queries", "ready", "waited");
+    cJSON *rows = cJSON_AddArrayToObject(sec, "runs");
+    cJSON_AddNumberToObject(sec, "frames", n);
+    cJSON_AddNumberToObject(sec, "size", (double)c->a->size);
+    static const char *const names[2] = { "chcpp", "svs" };
+    double mean[2][2] = { { 0 } };
+    rl_status st = RL_OK;
+    for (int g = 0; g < 2 && st == RL_OK; ++g) {
+        if (!drawers[g])
+            continue;
+        for (int i = 0; i < 2 && st == RL_OK; ++i) {
+            walk_run w = { 0 };
+            w.ms = calloc((size_t)m, sizeof *w.ms);
+            if (!w.ms)
+                return RL_ERR_OUT_OF_MEMORY;
+            st = walk_renderer(c, names[i], g == 1, &start, &w);
+            if (st == RL_OK) {
+                double sum = 0.0;
+                for (int k = 0; k < m; ++k)
+                    sum += w.ms[k];
+                qsort(w.ms, (size_t)m, sizeof *w.ms, cmp_double);
+                mean[g][i] = sum / m;
+                const double per = 1.0 / m;
+                printf("%-8s %-8s %9.2f %9.2f %9.2f %9.1f %11.0f %9.1f %8.1f %8.1f\n", names[i], g ? "gl" : "software",
+                       mean[g][i], w.ms[0], w.ms[m / 2], w.first_ms, (double)w.triangles * per,
+                       (double)w.queries * per, (double)w.ready * per, (double)w.waited * per);
+                cJSON *o = cJSON_CreateObject();
+                cJSON_AddStringToObject(o, "renderer", names[i]);
+                cJSON_AddStringToObject(o, "drawer", g ? "gl" : "software");
+                if (w.device[0])
+                    cJSON_AddStringToObject(o, "gl_device", w.device);
+                bench_add_num(o, "mean_ms", mean[g][i]);
+                bench_add_num(o, "min_ms", w.ms[0]);
+                bench_add_num(o, "median_ms", w.ms[m / 2]);
+                bench_add_num(o, "max_ms", w.ms[m - 1]);
+                bench_add_num(o, "first_frame_ms", w.first_ms);
+                bench_add_num(o, "first_frame_prep_ms", w.prep_ms);
+                bench_add_num(o, "triangles_mean", (double)w.triangles * per);
+                bench_add_num(o, "queries_mean", (double)w.queries * per);
+                bench_add_num(o, "queries_ready_mean", (double)w.ready * per);
+                bench_add_num(o, "queries_waited_mean", (double)w.waited * per);
+                cJSON_AddItemToArray(rows, o);
+                if (w.device[0] && !cJSON_GetObjectItem(sec, "gl_device"))
+                    cJSON_AddStringToObject(sec, "gl_device", w.device);
+            }
+            free(w.ms);
+        }
+        if (st == RL_OK && mean[g][0] > 0.0) {
+            printf("svs / chcpp (%s): %.2fx (thesis, Power Plant on a GPU: 18 / 55 ms = 0.33x)\n",
+                   g ? "gl" : "software", mean[g][1] / mean[g][0]);
+            bench_add_num(sec, g ? "svs_over_chcpp_gl" : "svs_over_chcpp_software", mean[g][1] / mean[g][0]);
+        }
+    }
+    cJSON_AddNumberToObject(sec, "thesis_svs_over_chcpp", 18.0 / 55.0);
+    return st;
+}
+
+static bool take_drawer(void *a, const char *v)
+{
+    for (int i = 0; i < 3; ++i)
+        if (strcmp(v, drawer_names[i]) == 0) {
+            ((bc_args *)a)->drawer = i;
+            return true;
+        }
+    cli_fail(RL_CLI_USAGE, "--drawer: expected software, gl or both, got '%s'", v);
+    return false;
+}
+
 /* --max-depth: 0 is a valid depth, so not a count. */
 static bool take_max_depth(void *a, const char *v)
 {
@@ -917,7 +1109,9 @@ static bool take_max_depth(void *a, const char *v)
 /* Returns RL_CLI_OK, an exit code, or RL_BENCH_HELP_SHOWN. */
 static int parse_args(int argc, char **argv, bc_args *a)
 {
-    a->sections = (1u << SEC_COUNT) - 1;
+    /* The walk only when asked for: it wants a GL context and a GPU. */
+    a->sections = ((1u << SEC_COUNT) - 1) & ~(1u << SEC_WALK);
+    a->drawer = DRAWER_BOTH;
     a->seed = 1;
     a->select_quantile = 0.25;
     a->height = 10.0;
@@ -935,6 +1129,8 @@ static int parse_args(int argc, char **argv, bc_args *a)
         RL_BENCH_COUNT("--threads", 1024, &a->threads, NULL),
         RL_BENCH_COUNT("--seed", 1LL << 62, &a->seed, NULL),
         RL_BENCH_CUSTOM("--max-depth", take_max_depth, a, &has_depth),
+        RL_BENCH_COUNT("--walk-frames", 1 << 20, &a->walk_frames, NULL),
+        RL_BENCH_CUSTOM("--drawer", take_drawer, a, NULL),
         RL_BENCH_REAL("--height", -1e6, 1e6, &a->height, NULL),
         RL_BENCH_REAL("--extent", 0.01, 100.0, &a->extent, NULL),
         RL_BENCH_REAL("--select-quantile", 1e-6, 1.0 - 1e-6, &a->select_quantile, NULL),
@@ -963,6 +1159,10 @@ static int parse_args(int argc, char **argv, bc_args *a)
         a->surfels = a->quick ? 1000 : 40000;
     if (!a->visset_positions)
         a->visset_positions = a->quick ? 4 : a->samples;
+    if (!a->walk_frames)
+        a->walk_frames = a->quick ? 4 : 40;
+    if (a->walk_frames < 2)
+        return cli_fail(RL_CLI_USAGE, "--walk-frames: at least 2 (the first is timed apart)");
     return RL_CLI_OK;
 }
 
@@ -1019,7 +1219,10 @@ int bench_culling(int argc, char **argv)
     cJSON_AddNumberToObject(params, "seed", (double)a.seed);
     cJSON_AddBoolToObject(params, "quick", a.quick);
     cJSON_AddNumberToObject(params, "surfels", (double)a.surfels);
-    static const bench_section_fn fns[SEC_COUNT] = { sec_surfels, sec_depth, sec_svs, sec_select, sec_visset };
+    cJSON_AddNumberToObject(params, "walk_frames", (double)a.walk_frames);
+    cJSON_AddStringToObject(params, "drawer", drawer_names[a.drawer]);
+    static const bench_section_fn fns[SEC_COUNT] = { sec_surfels, sec_depth, sec_svs, sec_select, sec_visset,
+                                                     sec_walk };
     rc = bench_run_sections("culling", root, section_names, fns, SEC_COUNT, a.sections, &c, c.reason, threads,
                                out);
     cJSON_Delete(root);

@@ -30,6 +30,8 @@ typedef struct rl_culling_stats {
     double preprocess_ms;             /* building what the frame needed first (octree, surfels, visibility) */
     uint32_t selected;                /* select: 1 = its first, 2 = its second renderer drew the frame
                                        * (the other fields are that renderer's); 0 for the others */
+    uint64_t queries_ready;           /* chcpp: answers found there when polled (all, in software) */
+    uint64_t queries_waited;          /* chcpp: answers waited for, nothing else being left to do */
 } rl_culling_stats;
 
 /* RL_ERR_INVALID_ARG when r is not one of these renderers or has rendered

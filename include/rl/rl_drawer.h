@@ -11,6 +11,7 @@
  *     rl_drawer_begin(dr, image, &view, &proj, eye);   target and camera
  *     rl_drawer_draw(dr, objects, n, &counters);       any number of lists
  *     rl_drawer_query(dr, &boxes, &pixels, &counters); occlusion queries
+ *     rl_drawer_query_issue / _poll / _result(...);    the same, asynchronous
  *     rl_drawer_draw_points(dr, &points, &counters);   surfels
  *     rl_drawer_end(dr);                               image holds the frame
  * A frame starts from the target as it is (the caller clears it; a GPU
@@ -57,6 +58,10 @@ typedef struct rl_drawer_desc {   /* zero = default */
                                    * selects at create: only with
                                    * RL_RASTER_NO_COLOR may its contents
                                    * change between frames */
+    bool deferred_counts;         /* the pixels_written of draws may reach
+                                   * their counters only at rl_drawer_end,
+                                   * so those must outlive the frame: a GPU
+                                   * backend then never waits for a draw */
 } rl_drawer_desc;
 
 typedef struct rl_drawer rl_drawer;
@@ -91,11 +96,26 @@ RL_API rl_status rl_drawer_draw(rl_drawer *dr, const uint32_t *objects, uint32_t
  * a hundred times, false cancels. */
 RL_API rl_status rl_drawer_draw_all(rl_drawer *dr, rl_raster_counters *c, rl_progress_fn progress, void *user);
 /* An occlusion query: the pixels of boxes (triangles, e.g. the front faces
- * of bounding boxes) that would pass the depth test, writing nothing. The
- * software backend answers at once; a GPU backend may answer later, which
- * callers hide as Mattausch et al. 2008 do. */
+ * of bounding boxes) that would pass the depth test, writing nothing;
+ * answered when it returns (on a GPU after a wait, which the asynchronous
+ * calls below avoid). */
 RL_API rl_status rl_drawer_query(rl_drawer *dr, const rl_raster_batch *boxes, uint64_t *pixels,
                                  rl_raster_counters *c);
+/* Asynchronous occlusion queries, for renderers that hide a GPU's query
+ * latency as Mattausch et al. 2008 do: issue starts the query of boxes (as
+ * rl_drawer_query, against the depth buffer as it is at the issue) and
+ * returns a handle at once; poll says, without waiting, whether its answer
+ * is there; result waits for the answer where it is not, gives the pixels
+ * and frees the handle. Handles belong to the frame: rl_drawer_end drops
+ * those never read, and at most RL_DRAWER_MAX_QUERIES may be open at
+ * once (RL_ERR_LIMIT beyond). The software backend answers at the issue
+ * (poll is always true); the GL one runs GL query objects from a pool
+ * kept across frames. rl_drawer_query is issue followed by result. */
+#define RL_DRAWER_MAX_QUERIES (1u << 20)
+RL_API rl_status rl_drawer_query_issue(rl_drawer *dr, const rl_raster_batch *boxes, uint32_t *handle,
+                                       rl_raster_counters *c);
+RL_API rl_status rl_drawer_query_poll(rl_drawer *dr, uint32_t handle, bool *ready);
+RL_API rl_status rl_drawer_query_result(rl_drawer *dr, uint32_t handle, uint64_t *pixels);
 /* Draws points (surfels: square splats of a size in pixels). */
 RL_API rl_status rl_drawer_draw_points(rl_drawer *dr, const rl_raster_points *points, rl_raster_counters *c);
 /* Ends the frame: the target holds colour, depth and IDs. */

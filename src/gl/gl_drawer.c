@@ -19,8 +19,12 @@
  * gl_shaders.c). Counters: triangles submitted and drawn count whole
  * objects (drawn: box not outside the view; GL does not report its
  * clipping), pixels written are GL_SAMPLES_PASSED, read at the end of each
- * call. Occlusion queries are GL_SAMPLES_PASSED read synchronously; the
- * asynchronous use of Mattausch et al. 2008 is for chcpp on GL to come. */
+ * call (with desc.deferred_counts, as chcpp draws, at the frame's end, so
+ * that no draw waits for the GPU). Occlusion queries are GL_SAMPLES_PASSED
+ * in query objects of a pool
+ * kept across frames, issued without waiting and read when the caller asks
+ * (rl_drawer_query_poll / _result): chcpp hides their latency as Mattausch
+ * et al. 2008 do. */
 #include "gl/gl_context.h"
 
 #include <math.h>
@@ -56,7 +60,17 @@ typedef struct gl_drawer {
     /* Streams of queries and points, refilled by each call. */
     GLuint stream_vao, stream_pos, stream_idx;
     GLuint point_vao, point_pos, point_color, point_size, point_object;
-    GLuint query;
+    GLuint query;                 /* the pixels of counted draws */
+    /* desc.deferred_counts: each counted draw's query object (a pool kept
+     * across frames) and its counters, read at the frame's end. */
+    GLuint *count_pool;
+    rl_raster_counters **count_to;
+    uint32_t counts_used, count_n, count_cap, count_to_cap;
+    GLuint counting;              /* the query of the counted draw running */
+    /* The pool of occlusion query objects, one per slot of rl_drawer.c,
+     * kept across frames: a slot's object is reused by later queries. */
+    GLuint *pool;
+    uint32_t pool_n, pool_cap;
     /* The framebuffer, remade when the target's size changes. */
     GLuint fbo, tex_color, tex_depth, tex_object, tex_triangle, depth_buffer, tex_depth_in;
     int fb_width, fb_height;
@@ -97,6 +111,9 @@ static void gl_release(void *impl)
         return;
     /* The context's objects go with it; they are not deleted one by one. */
     rl_gl_context_release(g->ctx);
+    free(g->pool);
+    free(g->count_pool);
+    free(g->count_to);
     free(g);
 }
 
@@ -489,6 +506,7 @@ static rl_status gl_begin(void *impl, rl_image *target, const rl_mat4 *view, con
     if (st != RL_OK)
         return settle(g, st);
     g->target = target;
+    g->counts_used = 0;           /* of a frame that failed */
     g->view_proj = rl_mat4_mul(proj, view);
     g->affine = proj->m[3][0] == 0.0f && proj->m[3][1] == 0.0f && proj->m[3][2] == 0.0f && proj->m[3][3] == 1.0f;
     set_camera(g, g->tri_prog, &g->tri_u, view, proj, eye);
@@ -584,7 +602,27 @@ static void begin_triangles(gl_drawer *g)
     glProgramUniform1f(g->tri_prog, g->tri_u.ambient, g->desc.ambient);
     glProgramUniform1i(g->tri_prog, g->tri_u.num_lights, (GLint)g->data->num_lights);
     glBindVertexArray(g->vao);
-    glBeginQuery(GL_SAMPLES_PASSED, g->query);
+}
+
+/* Starts the query that counts a draw's pixels: the drawer's one, read at
+ * once, or with deferred counts the next of the frame's pool. */
+static rl_status start_counted(gl_drawer *g)
+{
+    g->counting = g->query;
+    if (g->desc.deferred_counts) {
+        if (g->counts_used == g->count_n) {
+            if (!rl_reserve_u32((void **)&g->count_pool, &g->count_cap, (uint64_t)g->count_n + 1,
+                                sizeof *g->count_pool, 16))
+                return RL_ERR_OUT_OF_MEMORY;
+            glCreateQueries(GL_SAMPLES_PASSED, 1, &g->count_pool[g->count_n++]);
+        }
+        if (!rl_reserve_u32((void **)&g->count_to, &g->count_to_cap, (uint64_t)g->counts_used + 1,
+                            sizeof *g->count_to, 16))
+            return RL_ERR_OUT_OF_MEMORY;
+        g->counting = g->count_pool[g->counts_used];
+    }
+    glBeginQuery(GL_SAMPLES_PASSED, g->counting);
+    return RL_OK;
 }
 
 static void draw_object(gl_drawer *g, uint32_t o, rl_raster_counters *c)
@@ -608,11 +646,28 @@ static void draw_object(gl_drawer *g, uint32_t o, rl_raster_counters *c)
 static rl_status end_counted(gl_drawer *g, rl_raster_counters *c, const char *where)
 {
     glEndQuery(GL_SAMPLES_PASSED);
+    if (g->desc.deferred_counts) {
+        g->count_to[g->counts_used++] = c;
+        return gl_check(where);
+    }
     GLuint64 passed = 0;
     glGetQueryObjectui64v(g->query, GL_QUERY_RESULT, &passed);
     if (c)
         c->pixels_written += passed;
     return gl_check(where);
+}
+
+/* The deferred counts of the frame's draws into their counters. */
+static void read_counts(gl_drawer *g)
+{
+    for (uint32_t i = 0; i < g->counts_used; ++i) {
+        if (!g->count_to[i])
+            continue;
+        GLuint64 passed = 0;
+        glGetQueryObjectui64v(g->count_pool[i], GL_QUERY_RESULT, &passed);
+        g->count_to[i]->pixels_written += passed;
+    }
+    g->counts_used = 0;
 }
 
 static rl_status gl_draw(void *impl, const uint32_t *objects, uint32_t count, rl_raster_counters *c)
@@ -626,6 +681,9 @@ static rl_status gl_draw(void *impl, const uint32_t *objects, uint32_t count, rl
             return settle(g, rl_error(RL_ERR_INVALID_ARG, "rl_drawer_draw: object %u of %u", objects[i],
                                       g->data->num_objects));
     begin_triangles(g);
+    st = start_counted(g);
+    if (st != RL_OK)
+        return settle(g, st);
     for (uint32_t i = 0; i < count; ++i)
         draw_object(g, objects[i], c);
     return settle(g, end_counted(g, c, "rl_drawer_draw"));
@@ -639,6 +697,9 @@ static rl_status gl_draw_all(void *impl, rl_raster_counters *c, rl_progress_fn p
         return settle(g, st);
     const uint32_t total = g->data->num_objects, step = total / 100 + 1;
     begin_triangles(g);
+    st = start_counted(g);
+    if (st != RL_OK)
+        return settle(g, st);
     for (uint32_t o = 0; o < total && st == RL_OK; ++o) {
         draw_object(g, o, c);
         if (progress && ((o + 1) % step == 0 || o + 1 == total) && !progress(user, (double)(o + 1) / total))
@@ -648,41 +709,79 @@ static rl_status gl_draw_all(void *impl, rl_raster_counters *c, rl_progress_fn p
     return settle(g, st != RL_OK ? st : end);
 }
 
-static rl_status gl_query(void *impl, const rl_raster_batch *boxes, uint64_t *pixels)
+/* Starts the occlusion query of boxes in query object q: every write
+ * masked, the depth test of the boxes' flags only. Nothing is read back. */
+static rl_status run_query(gl_drawer *g, const rl_raster_batch *boxes, GLuint q)
 {
-    gl_drawer *g = impl;
-    *pixels = 0;
-    rl_status st = rl_gl_context_make_current(g->ctx);
-    if (st != RL_OK || boxes->num_triangles == 0)
-        return settle(g, st);
-    if (!boxes->positions || !boxes->indices)
-        return settle(g, rl_error(RL_ERR_INVALID_ARG, "rl_drawer_query: %u triangles without positions or indices",
-                                  boxes->num_triangles));
+    if (boxes->num_triangles && (!boxes->positions || !boxes->indices))
+        return rl_error(RL_ERR_INVALID_ARG, "rl_drawer_query: %u triangles without positions or indices",
+                        boxes->num_triangles);
     /* An index out of range would read outside the stream on the GPU. */
     const size_t n = 3 * (size_t)boxes->num_triangles;
     if (n > INT32_MAX)
-        return settle(g, rl_error(RL_ERR_LIMIT, "rl_drawer_query: %u triangles in one batch", boxes->num_triangles));
+        return rl_error(RL_ERR_LIMIT, "rl_drawer_query: %u triangles in one batch", boxes->num_triangles);
     for (size_t i = 0; i < n; ++i)
         if (boxes->indices[i] >= boxes->num_vertices)
-            return settle(g, rl_error(RL_ERR_INVALID_ARG, "rl_drawer_query: index %u of %u vertices",
-                                      boxes->indices[i], boxes->num_vertices));
-    glNamedBufferData(g->stream_pos, (GLsizeiptr)(sizeof(rl_vec3) * boxes->num_vertices), boxes->positions,
-                      GL_STREAM_DRAW);
-    glNamedBufferData(g->stream_idx, (GLsizeiptr)(sizeof(uint32_t) * n), boxes->indices, GL_STREAM_DRAW);
-    /* Nothing written; the depth test of the boxes' flags only. */
+            return rl_error(RL_ERR_INVALID_ARG, "rl_drawer_query: index %u of %u vertices", boxes->indices[i],
+                            boxes->num_vertices);
+    /* An empty batch still runs its (empty) query, which answers 0. */
+    if (n) {
+        /* Respecified storage: the driver keeps the old contents for the
+         * queries still in flight that read them. */
+        glNamedBufferData(g->stream_pos, (GLsizeiptr)(sizeof(rl_vec3) * boxes->num_vertices), boxes->positions,
+                          GL_STREAM_DRAW);
+        glNamedBufferData(g->stream_idx, (GLsizeiptr)(sizeof(uint32_t) * n), boxes->indices, GL_STREAM_DRAW);
+    }
     apply_flags((boxes->flags & (RL_RASTER_DEPTH_EQUAL | RL_RASTER_CULL_BACK)) | RL_RASTER_NO_COLOR |
                 RL_RASTER_NO_DEPTH | RL_RASTER_NO_ID);
     glUseProgram(g->tri_prog);
     glProgramUniform1i(g->tri_prog, g->tri_u.mode, RL_GL_MODE_QUERY);
     glProgramUniform1i(g->tri_prog, g->tri_u.depth_equal, 0);
     glBindVertexArray(g->stream_vao);
-    glBeginQuery(GL_SAMPLES_PASSED, g->query);
-    glDrawElements(GL_TRIANGLES, (GLsizei)n, GL_UNSIGNED_INT, NULL);
+    glBeginQuery(GL_SAMPLES_PASSED, q);
+    if (n)
+        glDrawElements(GL_TRIANGLES, (GLsizei)n, GL_UNSIGNED_INT, NULL);
     glEndQuery(GL_SAMPLES_PASSED);
+    return gl_check("rl_drawer_query_issue");
+}
+
+static rl_status gl_query_issue(void *impl, const rl_raster_batch *boxes, uint32_t slot)
+{
+    gl_drawer *g = impl;
+    rl_status st = rl_gl_context_make_current(g->ctx);
+    if (st != RL_OK)
+        return settle(g, st);
+    if (slot >= g->pool_n) {
+        if (!rl_reserve_u32((void **)&g->pool, &g->pool_cap, (uint64_t)slot + 1, sizeof *g->pool, 64))
+            return settle(g, RL_ERR_OUT_OF_MEMORY);
+        glCreateQueries(GL_SAMPLES_PASSED, (GLsizei)(slot + 1 - g->pool_n), g->pool + g->pool_n);
+        g->pool_n = slot + 1;
+    }
+    return settle(g, run_query(g, boxes, g->pool[slot]));
+}
+
+static rl_status gl_query_poll(void *impl, uint32_t slot, bool *ready)
+{
+    gl_drawer *g = impl;
+    rl_status st = rl_gl_context_make_current(g->ctx);
+    if (st != RL_OK)
+        return settle(g, st);
+    GLuint available = GL_FALSE;
+    glGetQueryObjectuiv(g->pool[slot], GL_QUERY_RESULT_AVAILABLE, &available);
+    *ready = available != GL_FALSE;
+    return settle(g, gl_check("rl_drawer_query_poll"));
+}
+
+static rl_status gl_query_result(void *impl, uint32_t slot, uint64_t *pixels)
+{
+    gl_drawer *g = impl;
+    rl_status st = rl_gl_context_make_current(g->ctx);
+    if (st != RL_OK)
+        return settle(g, st);
     GLuint64 passed = 0;
-    glGetQueryObjectui64v(g->query, GL_QUERY_RESULT, &passed);
+    glGetQueryObjectui64v(g->pool[slot], GL_QUERY_RESULT, &passed);
     *pixels = passed;
-    return settle(g, gl_check("rl_drawer_query"));
+    return settle(g, gl_check("rl_drawer_query_result"));
 }
 
 /* One point attribute: a stream of count items, or the constant value
@@ -719,7 +818,9 @@ static rl_status gl_draw_points(void *impl, const rl_raster_points *pts, rl_rast
         glVertexAttribI1ui(3, pts->object_id);
     apply_flags(pts->flags);
     glUseProgram(g->point_prog);
-    glBeginQuery(GL_SAMPLES_PASSED, g->query);
+    st = start_counted(g);
+    if (st != RL_OK)
+        return settle(g, st);
     glDrawArrays(GL_POINTS, 0, (GLsizei)pts->count);
     if (c) {
         /* Points in front of the near plane (the software's count also
@@ -738,6 +839,7 @@ static rl_status gl_end(void *impl)
     rl_status st = rl_gl_context_make_current(g->ctx);
     if (st != RL_OK)
         return settle(g, st);
+    read_counts(g);
     rl_image *t = g->target;
     const size_t n = (size_t)t->width * (size_t)t->height;
     if ((t->layers & RL_LAYER_COLOR) && t->color)
@@ -762,7 +864,9 @@ static const rl_drawer_ops gl_ops = {
     .light = gl_light,
     .draw = gl_draw,
     .draw_all = gl_draw_all,
-    .query = gl_query,
+    .query_issue = gl_query_issue,
+    .query_poll = gl_query_poll,
+    .query_result = gl_query_result,
     .draw_points = gl_draw_points,
     .end = gl_end,
 };

@@ -17,6 +17,11 @@ struct rl_drawer {
     uint64_t scene_uid;
     rl_drawer_desc desc;
     bool in_frame;
+    /* The query slots: open[i] while slot i's answer is unread; free_slots
+     * a stack of the slots below num_slots that are not. */
+    uint8_t *open;
+    uint32_t *free_slots;
+    uint32_t num_slots, num_free, cap_slots;
 };
 
 rl_status rl_drawer_make(const rl_drawer_ops *ops, void *impl, const rl_scene *scene, const rl_drawer_desc *desc,
@@ -39,6 +44,8 @@ void rl_drawer_release(rl_drawer *dr)
     if (!dr)
         return;
     dr->ops->release(dr->impl);
+    free(dr->open);
+    free(dr->free_slots);
     free(dr);
 }
 
@@ -48,10 +55,21 @@ bool rl_drawer_fits(const rl_drawer *dr, const rl_scene *scene, const rl_drawer_
     const rl_drawer_desc *d = desc ? desc : &zero;
     return dr && scene && dr->scene_uid == rl_scene_uid(scene) && dr->desc.shading == d->shading &&
            dr->desc.ambient == d->ambient && dr->desc.threads == d->threads && dr->desc.flags == d->flags &&
-           dr->desc.object_mask == d->object_mask;
+           dr->desc.object_mask == d->object_mask && dr->desc.deferred_counts == d->deferred_counts;
 }
 
 const char *rl_drawer_backend(const rl_drawer *dr) { return dr ? dr->ops->name : NULL; }
+
+/* Every slot free again: the stack lists them downwards, so that the next
+ * frame takes slot 0 first. */
+static void drop_queries(rl_drawer *dr)
+{
+    for (uint32_t i = 0; i < dr->num_slots; ++i) {
+        dr->open[i] = 0;
+        dr->free_slots[i] = dr->num_slots - 1 - i;
+    }
+    dr->num_free = dr->num_slots;
+}
 
 rl_status rl_drawer_begin(rl_drawer *dr, rl_image *target, const rl_mat4 *view, const rl_mat4 *proj,
                           rl_vec3 eye)
@@ -60,6 +78,7 @@ rl_status rl_drawer_begin(rl_drawer *dr, rl_image *target, const rl_mat4 *view, 
         return rl_error(RL_ERR_INVALID_ARG, "rl_drawer_begin: NULL argument");
     if (!(target->layers & RL_LAYER_DEPTH) || !target->depth)
         return rl_error(RL_ERR_INVALID_ARG, "rl_drawer_begin: the target has no depth layer");
+    drop_queries(dr);   /* a frame that failed never ended */
     rl_status st = dr->ops->begin(dr->impl, target, view, proj, eye);
     dr->in_frame = st == RL_OK;
     return st;
@@ -102,16 +121,98 @@ rl_status rl_drawer_draw_all(rl_drawer *dr, rl_raster_counters *c, rl_progress_f
     return st == RL_OK ? dr->ops->draw_all(dr->impl, c, progress, user) : st;
 }
 
+/* A free query slot: the most recently freed one, so that a frame reuses
+ * few (and the GL backend few query objects), else a new one. */
+static rl_status take_slot(rl_drawer *dr, uint32_t *slot)
+{
+    if (dr->num_free) {
+        *slot = dr->free_slots[--dr->num_free];
+        return RL_OK;
+    }
+    if (dr->num_slots >= RL_DRAWER_MAX_QUERIES)
+        return rl_error(RL_ERR_LIMIT, "rl_drawer_query_issue: %u queries open, none read", dr->num_slots);
+    if (dr->num_slots == dr->cap_slots) {
+        uint32_t cap = dr->cap_slots ? 2 * dr->cap_slots : 64;
+        uint8_t *open = realloc(dr->open, cap);
+        if (!open)
+            return RL_ERR_OUT_OF_MEMORY;
+        dr->open = open;
+        uint32_t *free_slots = realloc(dr->free_slots, cap * sizeof *free_slots);
+        if (!free_slots)
+            return RL_ERR_OUT_OF_MEMORY;
+        dr->free_slots = free_slots;
+        dr->cap_slots = cap;
+    }
+    *slot = dr->num_slots++;
+    return RL_OK;
+}
+
+static rl_status open_slot(const rl_drawer *dr, uint32_t handle, const char *fn)
+{
+    if (handle < dr->num_slots && dr->open[handle])
+        return RL_OK;
+    return rl_error(RL_ERR_INVALID_ARG, "%s: query %u is not open in this frame", fn, handle);
+}
+
+rl_status rl_drawer_query_issue(rl_drawer *dr, const rl_raster_batch *boxes, uint32_t *handle,
+                                rl_raster_counters *c)
+{
+    rl_status st = in_frame(dr, "rl_drawer_query_issue");
+    if (st == RL_OK && (!boxes || !handle))
+        st = rl_error(RL_ERR_INVALID_ARG, "rl_drawer_query_issue: NULL argument");
+    uint32_t slot = 0;
+    if (st == RL_OK)
+        st = take_slot(dr, &slot);
+    if (st != RL_OK)
+        return st;
+    st = dr->ops->query_issue(dr->impl, boxes, slot);
+    if (st != RL_OK) {
+        dr->free_slots[dr->num_free++] = slot;
+        return st;
+    }
+    if (c)
+        c->triangles_in += boxes->num_triangles;
+    dr->open[slot] = 1;
+    *handle = slot;
+    return RL_OK;
+}
+
+rl_status rl_drawer_query_poll(rl_drawer *dr, uint32_t handle, bool *ready)
+{
+    rl_status st = in_frame(dr, "rl_drawer_query_poll");
+    if (st == RL_OK && !ready)
+        st = rl_error(RL_ERR_INVALID_ARG, "rl_drawer_query_poll: NULL argument");
+    if (st == RL_OK)
+        st = open_slot(dr, handle, "rl_drawer_query_poll");
+    return st == RL_OK ? dr->ops->query_poll(dr->impl, handle, ready) : st;
+}
+
+rl_status rl_drawer_query_result(rl_drawer *dr, uint32_t handle, uint64_t *pixels)
+{
+    rl_status st = in_frame(dr, "rl_drawer_query_result");
+    if (st == RL_OK && !pixels)
+        st = rl_error(RL_ERR_INVALID_ARG, "rl_drawer_query_result: NULL argument");
+    if (st == RL_OK)
+        st = open_slot(dr, handle, "rl_drawer_query_result");
+    if (st != RL_OK)
+        return st;
+    *pixels = 0;
+    st = dr->ops->query_result(dr->impl, handle, pixels);
+    /* Read or failed, the slot is free again: a failed frame ends anyway. */
+    dr->open[handle] = 0;
+    dr->free_slots[dr->num_free++] = handle;
+    return st;
+}
+
 rl_status rl_drawer_query(rl_drawer *dr, const rl_raster_batch *boxes, uint64_t *pixels, rl_raster_counters *c)
 {
     rl_status st = in_frame(dr, "rl_drawer_query");
     if (st == RL_OK && (!boxes || !pixels))
         st = rl_error(RL_ERR_INVALID_ARG, "rl_drawer_query: NULL argument");
-    if (st != RL_OK)
-        return st;
-    if (c)
-        c->triangles_in += boxes->num_triangles;
-    return dr->ops->query(dr->impl, boxes, pixels);
+    uint32_t handle = 0;
+    if (st == RL_OK)
+        st = rl_drawer_query_issue(dr, boxes, &handle, c);
+    return st == RL_OK ? rl_drawer_query_result(dr, handle, pixels) : st;
 }
 
 rl_status rl_drawer_draw_points(rl_drawer *dr, const rl_raster_points *points, rl_raster_counters *c)
@@ -128,6 +229,7 @@ rl_status rl_drawer_end(rl_drawer *dr)
     if (st != RL_OK)
         return st;
     dr->in_frame = false;
+    drop_queries(dr);
     return dr->ops->end(dr->impl);
 }
 
@@ -140,6 +242,8 @@ typedef struct software {
     rl_image *target;
     rl_mat4 view, proj;
     bool points;                  /* points drawn: IDs are not all triangles' */
+    uint64_t *answers;            /* per query slot: answered at the issue */
+    uint32_t cap_answers;
 } software;
 
 static void sw_release(void *impl)
@@ -149,6 +253,7 @@ static void sw_release(void *impl)
         return;
     rl_scene_drawer_release(sw->drawer);
     rl_raster_release(sw->ras);
+    free(sw->answers);
     free(sw);
 }
 
@@ -181,10 +286,29 @@ static rl_status sw_draw_all(void *impl, rl_raster_counters *c, rl_progress_fn p
     return rl_scene_drawer_draw_all(sw->drawer, sw->ras, c, progress, user);
 }
 
-static rl_status sw_query(void *impl, const rl_raster_batch *boxes, uint64_t *pixels)
+/* The software rasterizer answers at once: the answer waits in its slot. */
+static rl_status sw_query_issue(void *impl, const rl_raster_batch *boxes, uint32_t slot)
 {
     software *sw = impl;
-    return rl_raster_query(sw->ras, boxes, pixels);
+    if (!rl_reserve_u32((void **)&sw->answers, &sw->cap_answers, (uint64_t)slot + 1, sizeof *sw->answers, 64))
+        return RL_ERR_OUT_OF_MEMORY;
+    sw->answers[slot] = 0;
+    return rl_raster_query(sw->ras, boxes, &sw->answers[slot]);
+}
+
+static rl_status sw_query_poll(void *impl, uint32_t slot, bool *ready)
+{
+    (void)impl;
+    (void)slot;
+    *ready = true;
+    return RL_OK;
+}
+
+static rl_status sw_query_result(void *impl, uint32_t slot, uint64_t *pixels)
+{
+    software *sw = impl;
+    *pixels = sw->answers[slot];
+    return RL_OK;
 }
 
 static rl_status sw_draw_points(void *impl, const rl_raster_points *points, rl_raster_counters *c)
@@ -209,7 +333,9 @@ static const rl_drawer_ops software_ops = {
     .light = sw_light,
     .draw = sw_draw,
     .draw_all = sw_draw_all,
-    .query = sw_query,
+    .query_issue = sw_query_issue,
+    .query_poll = sw_query_poll,
+    .query_result = sw_query_result,
     .draw_points = sw_draw_points,
     .end = sw_end,
 };

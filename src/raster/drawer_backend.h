@@ -15,7 +15,12 @@ typedef struct rl_drawer_ops {
     void (*light)(void *impl, const uint32_t *objects, uint32_t count);
     rl_status (*draw)(void *impl, const uint32_t *objects, uint32_t count, rl_raster_counters *c);
     rl_status (*draw_all)(void *impl, rl_raster_counters *c, rl_progress_fn progress, void *user);
-    rl_status (*query)(void *impl, const rl_raster_batch *boxes, uint64_t *pixels);
+    /* Asynchronous queries in slots that rl_drawer.c hands out (0, 1, ...,
+     * reused once read or at the frame's end): issue starts the query in
+     * slot, poll tells whether its answer is there, result waits for it. */
+    rl_status (*query_issue)(void *impl, const rl_raster_batch *boxes, uint32_t slot);
+    rl_status (*query_poll)(void *impl, uint32_t slot, bool *ready);
+    rl_status (*query_result)(void *impl, uint32_t slot, uint64_t *pixels);
     rl_status (*draw_points)(void *impl, const rl_raster_points *points, rl_raster_counters *c);
     rl_status (*end)(void *impl);
 } rl_drawer_ops;

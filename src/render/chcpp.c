@@ -29,19 +29,32 @@
  * wherever no two surfaces fight for the same depth (coplanar overlaps are
  * resolved by drawing order, here front to back, there by object index).
  *
- * Deviation, on purpose: our queries are synchronous (the software
- * rasterizer answers at once), so there is no latency to hide: a query is
- * evaluated against the depth buffer as it is when the query is issued,
- * exactly the GPU semantics, and its result is used right away. The
- * V-queue of CHC++ (deferring the queries of previously visible nodes to
- * fill waiting time) therefore has nothing to fill; those queries are
- * issued just before the node's objects are drawn, as in the original CHC,
- * which also keeps a node's own geometry from hiding its box. Batching of
- * the I-queue keeps its purpose: later queries see more occluders, and
- * multi-queries save query fill.
+ * Latency (CHC++'s main loop): queries are issued without waiting
+ * (rl_drawer_query_issue) into a query queue. While there is something to
+ * draw, the answers at the queue's front are taken only when they are
+ * there (a non-blocking poll), and otherwise the next node of the distance
+ * queue is drawn; the traversal waits for an answer only when the distance
+ * queue and the I-queue are empty. A previously visible node is drawn
+ * without waiting for its own query; a failed multi-query's nodes are
+ * queried again one by one, as CHC++ does. rl_culling_stats counts the
+ * answers found ready and those waited for. With the software drawer (the
+ * default, drawer=software) every answer is there at its issue and is
+ * taken at once, so the frame is exactly the synchronous CHC order: each
+ * query is resolved before the next is issued. With drawer=gl the queries
+ * are GL query objects (GL_SAMPLES_PASSED) and the answers come when the
+ * GPU has them. Every query is evaluated against the depth buffer as it
+ * is when it is issued, so culling stays conservative in any order.
+ *
+ * Deviations: answers are read within their frame (CHC++ may carry them
+ * into the next); the queries of previously visible nodes are issued just
+ * before the node's objects are drawn, as in the original CHC (which keeps
+ * a node's own geometry from hiding its box), not gathered into CHC++'s
+ * V-queue to fill waiting time. Batching of the I-queue keeps its purpose:
+ * later queries see more occluders, and multi-queries save query fill.
  *
  * Options: the raster renderer's (shading, cull, ambient, background,
- * threads) plus max_depth 5 (Jähn 2015, Sec. 7.3), looseness 2.0, batch 50,
+ * threads), drawer (software | gl) and device (for gl), plus
+ * max_depth 5 (Jähn 2015, Sec. 7.3), looseness 2.0, batch 50,
  * assumed_visible 10, multiquery true, tight true, seed 1. The defaults for
  * batch and assumed_visible are ours, in the range the CHC++ paper
  * explores. */
@@ -88,6 +101,15 @@ typedef struct heap_item {
     uint32_t node;
 } heap_item;
 
+/* An issued query whose answer is not read yet. */
+enum { Q_INVISIBLE, Q_VISIBLE };
+typedef struct pending {
+    uint32_t handle;              /* rl_drawer_query_issue's */
+    uint32_t first, count;        /* its nodes: qnodes[first .. first + count) */
+    uint8_t kind;                 /* Q_INVISIBLE: a group of the I-queue; Q_VISIBLE: a previously
+                                   * visible node's own query, which does not hold up its drawing */
+} pending;
+
 typedef struct chcpp_state {
     rl_culling_head head;         /* first: rl_culling_get_stats */
     rl_octree_cache oc;
@@ -99,6 +121,12 @@ typedef struct chcpp_state {
     uint32_t *iqueue;
     uint32_t iq_n, iq_cap;
     rl_box_query query;
+    /* The query queue of CHC++, in issue order (head .. tail), and the
+     * nodes of its queries; both emptied every frame. */
+    pending *queue;
+    uint32_t q_head, q_tail, q_cap;
+    uint32_t *qnodes;
+    uint32_t qn_n, qn_cap;
 } chcpp_state;
 
 /* One frame's working set. */
@@ -111,6 +139,7 @@ typedef struct frame_ctx {
     bool tight, multiquery;
     uint32_t batch, n_av;
     uint64_t seed;
+    int draining;                 /* nesting of drain() */
 } frame_ctx;
 
 static void chcpp_release(void *state)
@@ -122,6 +151,8 @@ static void chcpp_release(void *state)
     free(s->ns);
     free(s->heap);
     free(s->iqueue);
+    free(s->queue);
+    free(s->qnodes);
 }
 
 static void chcpp_reset(void *state)
@@ -252,22 +283,38 @@ static rl_status add_node_boxes(frame_ctx *f, uint32_t n)
     return rl_box_query_add(&f->s->query, node->bounds, QUERY_MARGIN);
 }
 
-/* One occlusion query over the nodes list[0..count). */
-static rl_status query_nodes(frame_ctx *f, const uint32_t *list, uint32_t count, bool *visible)
+static rl_status drain(frame_ctx *f, bool block);
+
+/* Issues one occlusion query over the nodes list[0..count) and queues it;
+ * then takes the answers that are there (drain), so that with answers at
+ * the issue (the software drawer) every node is resolved right after its
+ * query, before the next is issued, as the synchronous CHC. */
+static rl_status issue_nodes(frame_ctx *f, const uint32_t *list, uint32_t count, uint8_t kind)
 {
-    rl_box_query_reset(&f->s->query);
+    chcpp_state *s = f->s;
+    rl_box_query_reset(&s->query);
     rl_status st = RL_OK;
     for (uint32_t i = 0; i < count && st == RL_OK; ++i)
         st = add_node_boxes(f, list[i]);
-    uint64_t pixels = 0;
+    if (st == RL_OK &&
+        (!rl_reserve_u32((void **)&s->qnodes, &s->qn_cap, (uint64_t)s->qn_n + count, sizeof *s->qnodes, 256) ||
+         !rl_reserve_u32((void **)&s->queue, &s->q_cap, (uint64_t)s->q_tail + 1, sizeof *s->queue, 64)))
+        st = RL_ERR_OUT_OF_MEMORY;
+    uint32_t handle = 0;
     if (st == RL_OK)
-        st = rl_box_query_run(&f->s->query, f->cf.drawer, &pixels, NULL);
-    f->s->head.stats.queries++;
-    f->s->head.stats.query_boxes += f->s->query.boxes;
+        st = rl_box_query_issue(&s->query, f->cf.drawer, &handle, NULL);
+    if (st != RL_OK)
+        return st;
+    s->head.stats.queries++;
+    s->head.stats.query_boxes += s->query.boxes;
     if (count > 1)
-        f->s->head.stats.multiqueries++;
-    *visible = pixels > 0;
-    return st;
+        s->head.stats.multiqueries++;
+    /* list never points into qnodes, which the reserve may have moved:
+     * take() hands a failed multi-query's nodes one by one as copies. */
+    memcpy(s->qnodes + s->qn_n, list, (size_t)count * sizeof *list);
+    s->queue[s->q_tail++] = (pending){ .handle = handle, .first = s->qn_n, .count = count, .kind = kind };
+    s->qn_n += count;
+    return drain(f, false);
 }
 
 /* A previously invisible node found visible (or invisible) by its query. */
@@ -286,8 +333,70 @@ static rl_status resolve(frame_ctx *f, uint32_t n, bool visible)
     return traverse(f, n);
 }
 
-/* Queries the I-queue: multi-queries grouped by the CHC++ cost model, a
- * failed one node by node. */
+/* What an answer means for the nodes of its query. */
+static rl_status take(frame_ctx *f, pending p, bool visible)
+{
+    chcpp_state *s = f->s;
+    if (p.kind == Q_VISIBLE) {
+        /* The node was drawn already; the answer decides only whether it
+         * stays in the coherent set (its subtree may pull it up anyway). */
+        uint32_t n = s->qnodes[p.first];
+        if (visible)
+            pull_up(f, n);
+        else
+            s->ns[n].invisible_frames++;
+        return RL_OK;
+    }
+    rl_status st = RL_OK;
+    if (p.count > 1 && visible) {
+        /* A failed multi-query: each node is asked again on its own. */
+        s->head.stats.multiqueries_failed++;
+        for (uint32_t k = 0; k < p.count && st == RL_OK; ++k) {
+            uint32_t n = s->qnodes[p.first + k];
+            st = issue_nodes(f, &n, 1, Q_INVISIBLE);
+        }
+        return st;
+    }
+    for (uint32_t k = 0; k < p.count && st == RL_OK; ++k)
+        st = resolve(f, s->qnodes[p.first + k], visible);
+    return st;
+}
+
+/* Takes the answers at the front of the query queue while they are there
+ * (CHC++: finished queries first); with block, waits for the first one,
+ * for when nothing else is left to do. A nested call (an answer's nodes
+ * issue queries) goes one level deep: deeper ones leave their answers to
+ * the loops above them. */
+static rl_status drain(frame_ctx *f, bool block)
+{
+    chcpp_state *s = f->s;
+    if (f->draining >= 2)
+        return RL_OK;
+    f->draining++;
+    rl_status st = RL_OK;
+    while (st == RL_OK && s->q_head < s->q_tail) {
+        pending p = s->queue[s->q_head];
+        bool ready = false;
+        st = rl_drawer_query_poll(f->cf.drawer, p.handle, &ready);
+        if (st != RL_OK || (!ready && !block))
+            break;
+        if (ready)
+            s->head.stats.queries_ready++;
+        else
+            s->head.stats.queries_waited++;
+        block = false;
+        s->q_head++;
+        uint64_t pixels = 0;
+        st = rl_drawer_query_result(f->cf.drawer, p.handle, &pixels);
+        if (st == RL_OK)
+            st = take(f, p, pixels > 0);
+    }
+    f->draining--;
+    return st;
+}
+
+/* Queries the I-queue: multi-queries grouped by the CHC++ cost model (a
+ * failed one node by node, in take). */
 static rl_status flush_iqueue(frame_ctx *f)
 {
     chcpp_state *s = f->s;
@@ -308,20 +417,7 @@ static rl_status flush_iqueue(frame_ctx *f)
                 ++m;
             }
         }
-        bool visible = false;
-        st = query_nodes(f, s->iqueue + i, m, &visible);
-        if (st == RL_OK && m > 1 && visible) {
-            s->head.stats.multiqueries_failed++;
-            for (uint32_t k = 0; k < m && st == RL_OK; ++k) {
-                bool v = false;
-                st = query_nodes(f, s->iqueue + i + k, 1, &v);
-                if (st == RL_OK)
-                    st = resolve(f, s->iqueue[i + k], v);
-            }
-        } else {
-            for (uint32_t k = 0; k < m && st == RL_OK; ++k)
-                st = resolve(f, s->iqueue[i + k], visible);
-        }
+        st = issue_nodes(f, s->iqueue + i, m, Q_INVISIBLE);
         i += m;
     }
     s->iq_n = 0;
@@ -341,12 +437,18 @@ static rl_status chcpp_frame(frame_ctx *f)
 {
     chcpp_state *s = f->s;
     rl_culling_stats *stats = &s->head.stats;
+    s->q_head = s->q_tail = s->qn_n = 0;
     rl_status st = heap_push(s, (heap_item){ rl_cull_box_distance(f->cf.view.eye, f->nodes[0].bounds), 0 });
-    while (st == RL_OK && (s->heap_n > 0 || s->iq_n > 0)) {
+    while (st == RL_OK && (s->heap_n > 0 || s->iq_n > 0 || s->q_head < s->q_tail)) {
         if (s->heap_n == 0) {
-            st = flush_iqueue(f);   /* may queue the children of visible nodes */
+            /* Nothing to draw: query what waits, else wait for an answer
+             * (either may queue the children of visible nodes). */
+            st = s->iq_n > 0 ? flush_iqueue(f) : drain(f, true);
             continue;
         }
+        st = drain(f, false);
+        if (st != RL_OK || s->heap_n == 0)
+            continue;
         uint32_t n = heap_pop(s).node;
         const rl_octree_node *node = &f->nodes[n];
         node_state *ns = &s->ns[n];
@@ -381,13 +483,10 @@ static rl_status chcpp_frame(frame_ctx *f)
         ns->visible = 0;
         if (node->num_objects) {
             if (s->frame >= ns->next_query) {
-                bool v = false;
-                st = query_nodes(f, &n, 1, &v);
+                /* Issued before the node's own objects draw, which would
+                 * hide its box; drawn without waiting for the answer. */
+                st = issue_nodes(f, &n, 1, Q_VISIBLE);
                 schedule_query(f, n);
-                if (v)
-                    pull_up(f, n);
-                else
-                    ns->invisible_frames++;
             } else {
                 pull_up(f, n);
             }
@@ -397,6 +496,7 @@ static rl_status chcpp_frame(frame_ctx *f)
     }
     s->heap_n = 0;
     s->iq_n = 0;
+    s->q_head = s->q_tail = s->qn_n = 0;
     return st;
 }
 
@@ -443,7 +543,7 @@ static rl_status chcpp_render(rl_renderer *r, void *state, const rl_scene *scene
     f.batch = (uint32_t)rl_renderer_opt_int(r, "batch");
     f.n_av = (uint32_t)rl_renderer_opt_int(r, "assumed_visible");
     f.seed = (uint64_t)rl_renderer_opt_int(r, "seed");
-    st = rl_cull_frame_begin(r, scene, &s->head.drawer, cam, image, &f.cf);
+    st = rl_cull_frame_begin(r, scene, &s->head, cam, image, true, &f.cf);
     if (st != RL_OK)
         return st;
     s->frame++;
@@ -468,4 +568,5 @@ const rl_renderer_class rl_chcpp_renderer_class = {
     .release = chcpp_release,
     .check = NULL,
     .reset = chcpp_reset,
+    .available = rl_cull_available,
 };

@@ -1,5 +1,6 @@
 /* culling.c: see culling.h. */
 #include <math.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -9,6 +10,7 @@
 #endif
 #include "render/culling.h"
 #include "render/renderer.h"
+#include "rl/rl_gl.h"
 
 void rl_cull_view_make(const rl_camera *cam, rl_aabb scene_bounds, rl_cull_view *v)
 {
@@ -125,6 +127,18 @@ rl_status rl_box_query_run(rl_box_query *q, rl_drawer *dr, uint64_t *pixels, rl_
     return rl_drawer_query(dr, &batch, pixels, c);
 }
 
+rl_status rl_box_query_issue(rl_box_query *q, rl_drawer *dr, uint32_t *handle, rl_raster_counters *c)
+{
+    rl_raster_batch batch;
+    memset(&batch, 0, sizeof batch);
+    batch.num_vertices = q->boxes * 8;
+    batch.positions = q->positions;
+    batch.num_triangles = q->boxes * 12;
+    batch.indices = q->indices;
+    batch.flags = RL_RASTER_CULL_BACK;
+    return rl_drawer_query_issue(dr, &batch, handle, c);
+}
+
 void rl_box_query_free(rl_box_query *q)
 {
     free(q->positions);
@@ -231,9 +245,46 @@ rl_status rl_culling_get_stats(const rl_renderer *r, rl_culling_stats *out)
 }
 
 const char *const rl_cull_shading_choices[] = { "flat", "gouraud", "textured", NULL };
+const char *const rl_cull_drawer_choices[] = { "software", "gl", NULL };
 
-rl_status rl_cull_frame_begin(rl_renderer *r, const rl_scene *scene, rl_drawer **kept, const rl_camera *cam,
-                              rl_image *image, rl_cull_frame *f)
+bool rl_cull_available(const rl_renderer *r, char *why, size_t n)
+{
+    if (rl_renderer_opt_enum(r, "drawer") != RL_CULL_DRAWER_GL)
+        return true;
+    return rl_gl_available(rl_renderer_opt_string(r, "device"), why, n);
+}
+
+/* A new drawer for desc on the backend the options ask for. */
+static rl_status make_drawer(rl_renderer *r, const rl_scene *scene, const rl_drawer_desc *desc,
+                             rl_culling_head *head)
+{
+    head->device[0] = head->info[0] = '\0';
+    if (rl_renderer_opt_enum(r, "drawer") != RL_CULL_DRAWER_GL)
+        return rl_drawer_create(scene, desc, &head->drawer);
+    const char *device = rl_renderer_opt_string(r, "device");
+    if (strlen(device) >= sizeof head->device)
+        return rl_error(RL_ERR_INVALID_ARG, "%s: device \"%.40s...\" is too long", rl_renderer_name(r), device);
+    rl_status st = rl_gl_drawer_create(scene, desc, device, &head->drawer);
+    if (st != RL_OK)
+        return st;
+    snprintf(head->device, sizeof head->device, "%s", device);
+    rl_gl_info info;
+    if (rl_gl_info_get(device, &info) == RL_OK)
+        snprintf(head->info, sizeof head->info, "%s | %s | %s", info.vendor, info.renderer, info.version);
+    return RL_OK;
+}
+
+/* Whether the kept drawer is on the backend and device the options ask for. */
+static bool same_backend(rl_renderer *r, const rl_culling_head *head)
+{
+    const bool gl = rl_renderer_opt_enum(r, "drawer") == RL_CULL_DRAWER_GL;
+    if (strcmp(rl_drawer_backend(head->drawer), gl ? "gl" : "software") != 0)
+        return false;
+    return !gl || strcmp(head->device, rl_renderer_opt_string(r, "device")) == 0;
+}
+
+rl_status rl_cull_frame_begin(rl_renderer *r, const rl_scene *scene, rl_culling_head *head, const rl_camera *cam,
+                              rl_image *image, bool deferred, rl_cull_frame *f)
 {
     const rl_scene_data *d = rl_scene_get_data(scene);
     memset(f, 0, sizeof *f);
@@ -249,6 +300,7 @@ rl_status rl_cull_frame_begin(rl_renderer *r, const rl_scene *scene, rl_drawer *
         .ambient = f->ambient,
         .threads = f->threads_opt,
         .flags = rl_renderer_opt_bool(r, "cull") ? RL_RASTER_CULL_BACK : 0u,
+        .deferred_counts = deferred,
     };
     rl_status st = rl_cull_target_begin(image, rl_renderer_opt_color(r, "background"), &f->target);
     if (st != RL_OK)
@@ -256,13 +308,14 @@ rl_status rl_cull_frame_begin(rl_renderer *r, const rl_scene *scene, rl_drawer *
     desc.flags |= f->target.flags;
     rl_cull_view_make(cam, d->bounds, &f->view);
     /* The drawer is kept while the scene and options stay: its buffers
-     * span the whole scene. */
-    if (!rl_drawer_fits(*kept, scene, &desc)) {
-        rl_drawer_release(*kept);
-        *kept = NULL;
-        st = rl_drawer_create(scene, &desc, kept);
+     * span the whole scene (and a GL drawer's context is costly). */
+    if (!rl_drawer_fits(head->drawer, scene, &desc) || !same_backend(r, head)) {
+        rl_drawer_release(head->drawer);
+        head->drawer = NULL;
+        st = make_drawer(r, scene, &desc, head);
     }
-    f->drawer = *kept;
+    f->drawer = head->drawer;
+    f->device = head->info[0] ? head->info : NULL;
     if (st == RL_OK)
         st = rl_drawer_begin(f->drawer, &f->target.image, &f->view.view, &f->view.proj, f->view.eye);
     if (st != RL_OK) {
@@ -284,6 +337,7 @@ rl_status rl_cull_frame_end(rl_cull_frame *f, rl_status st, const rl_image *imag
         stats->points_drawn = f->counters.points_drawn;
         stats->pixels_written = f->counters.pixels_written;
         stats->samples = (uint64_t)image->width * image->height;
+        stats->device = f->device;
     }
     return st;
 }

@@ -49,6 +49,9 @@ rl_aabb rl_box_query_bounds(rl_aabb b, float margin);
 rl_status rl_box_query_add(rl_box_query *q, rl_aabb b, float margin);
 /* Visible pixels of all boxes added since the last reset (0 boxes: 0). */
 rl_status rl_box_query_run(rl_box_query *q, rl_drawer *dr, uint64_t *pixels, rl_raster_counters *c);
+/* The same query issued without waiting (rl_drawer_query_issue): its
+ * answer comes with rl_drawer_query_poll / _result on *handle. */
+rl_status rl_box_query_issue(rl_box_query *q, rl_drawer *dr, uint32_t *handle, rl_raster_counters *c);
 void rl_box_query_free(rl_box_query *q);
 
 /* The caller's image as the rasterizer's target, with a private depth
@@ -86,13 +89,25 @@ void rl_octree_cache_release(rl_octree_cache *c);
 /* The option rows every culling renderer shares with raster (its mesh
  * drawing), first in its table; rl_cull_frame_begin() reads them. */
 extern const char *const rl_cull_shading_choices[];
+extern const char *const rl_cull_drawer_choices[];
+enum { RL_CULL_DRAWER_SOFTWARE, RL_CULL_DRAWER_GL };
 #define RL_CULL_RASTER_OPTIONS                                                                          \
     { "shading", RL_OPT_ENUM, "textured", "meshes: flat | gouraud | textured, as raster", 0, 0,          \
       rl_cull_shading_choices },                                                                        \
     { "cull", RL_OPT_BOOL, "false", "drop back faces (counter-clockwise = front)", 0, 0, NULL },        \
     { "ambient", RL_OPT_FLOAT, "0.05", "ambient light, multiplied by k_d", 0, 1, NULL },                \
     { "background", RL_OPT_COLOR, "0,0,0", "colour where nothing is drawn", 0, 0, NULL },              \
-    { "threads", RL_OPT_INT, "0", "OpenMP threads (0 = all)", 0, 1024, NULL }
+    { "threads", RL_OPT_INT, "0", "OpenMP threads (0 = all)", 0, 1024, NULL },                          \
+    { "drawer", RL_OPT_ENUM, "software",                                                                \
+      "the frame's drawing and queries: software (the CPU rasterizer) | gl (OpenGL 4.5, docs/gl.md)",   \
+      0, 0, rl_cull_drawer_choices },                                                                   \
+    { "device", RL_OPT_STRING, "",                                                                      \
+      "drawer=gl: EGL device auto, surfaceless or a number; empty: $RL_EGL_DEVICE, else auto", 0, 0,    \
+      NULL }
+
+/* rl_renderer_class.available of the culling renderers: always with the
+ * software drawer, where a GL 4.5 context can be made with drawer=gl. */
+bool rl_cull_available(const rl_renderer *r, char *why, size_t n);
 
 /* One frame of a culling renderer: the caller's image as target, the view,
  * and the renderer's kept drawer (rl_drawer.h, any backend) begun on them,
@@ -105,22 +120,30 @@ typedef struct rl_cull_frame {
     int threads_opt;              /* the option: 0 = all */
     int threads;                  /* resolved, >= 1 */
     float ambient;
+    const char *device;           /* drawer=gl: the head's info, for rl_render_stats.device */
 } rl_cull_frame;
 
-rl_status rl_cull_frame_begin(rl_renderer *r, const rl_scene *scene, rl_drawer **kept, const rl_camera *cam,
-                              rl_image *image, rl_cull_frame *f);
+typedef struct rl_culling_head rl_culling_head;
+/* The drawer is the head's, kept while the scene, the options and the
+ * drawer's backend and device stay. deferred: every draw counts into
+ * f->counters, which rl_cull_frame_end reads after the drawer's end
+ * (rl_drawer_desc.deferred_counts: a GL drawer never waits for a draw). */
+rl_status rl_cull_frame_begin(rl_renderer *r, const rl_scene *scene, rl_culling_head *head, const rl_camera *cam,
+                              rl_image *image, bool deferred, rl_cull_frame *f);
 /* Ends the drawer's frame and releases what begin made (not the kept
  * drawer); with st == RL_OK fills stats (triangles, points, pixels
- * written, samples). Returns st, or the end's failure. */
+ * written, samples, the GL device). Returns st, or the end's failure. */
 rl_status rl_cull_frame_end(rl_cull_frame *f, rl_status st, const rl_image *image, rl_render_stats *stats);
 
 /* Every culling renderer's state starts with this, so that
  * rl_culling_get_stats() can read any of them. */
-typedef struct rl_culling_head {
+struct rl_culling_head {
     rl_culling_stats stats;
     bool have_frame;
     rl_drawer *drawer;            /* kept across frames; released by the renderer's release */
-} rl_culling_head;
+    char device[64];              /* drawer=gl: the device option the drawer was made on */
+    char info[528];               /* and its "vendor | renderer | version" */
+};
 
 /* The statistics of r's last frame, or NULL when r is not a culling
  * renderer or has rendered nothing yet (rl_culling_get_stats without

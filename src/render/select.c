@@ -27,7 +27,8 @@
  * inputs, so neither may be one that reads them (visset, select).
  *
  * The chosen renderer draws the whole frame with the shared raster options
- * forwarded; both are kept between frames, so CHC++ keeps its temporal
+ * forwarded (drawer and device too, where it has them: drawer=gl draws on
+ * the GPU; the times sampled without files are the software drawer's); both are kept between frames, so CHC++ keeps its temporal
  * coherence across frames that SVS drew. The first frame for a scene also
  * lets the renderer not chosen draw once (into the same image, overwritten
  * after), so that both build for the scene (SVS' sets, CHC++'s octree) in
@@ -48,7 +49,11 @@ static const char *const rule_choices[] = { "time", "threshold", NULL };
 enum { RULE_TIME, RULE_THRESHOLD };
 
 /* The options forwarded to both renderers (RL_CULL_RASTER_OPTIONS). */
-static const char *const forwarded[] = { "shading", "cull", "ambient", "background", "threads" };
+static const char *const forwarded[] = { "shading", "cull", "ambient", "background", "threads", "drawer", "device" };
+/* The last two only reach renderers that have them (every culling one):
+ * another renderer draws with its own backend, so they must keep their
+ * defaults for it. */
+#define NUM_FORWARDED_ALWAYS 5
 
 static const rl_option_info select_options[] = {
     RL_CULL_RASTER_OPTIONS,
@@ -139,6 +144,18 @@ static rl_status prepare_children(select_state *s, rl_renderer *r)
             const char *want = rl_renderer_get(r, forwarded[k]), *have = rl_renderer_get(s->child[i], forwarded[k]);
             if (have && strcmp(have, want) == 0)
                 continue;
+            if (!have && k >= NUM_FORWARDED_ALWAYS) {
+                const rl_option_info *info = NULL;
+                size_t n = 0;
+                const rl_option_info *opts = rl_renderer_options(r, &n);
+                for (size_t j = 0; j < n; ++j)
+                    if (strcmp(opts[j].key, forwarded[k]) == 0)
+                        info = &opts[j];
+                if (info && strcmp(info->default_value, want) == 0)
+                    continue;
+                return rl_error(RL_ERR_INVALID_ARG, "select: %s=%s has no option %s (%s=%s)", keys[i],
+                                s->child_name[i], forwarded[k], forwarded[k], want);
+            }
             rl_status st = rl_renderer_set(s->child[i], forwarded[k], want);
             if (st != RL_OK)
                 return st;
@@ -258,6 +275,7 @@ const rl_renderer_class rl_select_renderer_class = {
     .release = select_release,
     .check = NULL,
     .reset = select_reset,
+    .available = rl_cull_available,
     .inputs = select_inputs,
     .num_inputs = sizeof select_inputs / sizeof select_inputs[0],
 };

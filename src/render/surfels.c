@@ -25,6 +25,10 @@
  * away (Sec. 6.2.1), lit like the meshes by raster's diffuse model at its
  * unlit colour (its 20 bytes hold no specular term).
  *
+ * drawer = gl (device: the EGL device) draws the frame, meshes and
+ * surfels (GL points of the same sizes), with the GL drawer of src/gl; the
+ * surfels are still built by the software drawer (docs/gl.md).
+ *
  * Options (thesis defaults, Sec. 6.3): min_size 100, max_size 200 (sides
  * of the projected size in pixels), overdraw 4, point_size 7, count 40000,
  * resolution 1024, start_sample 160; min_triangles (default = count, "of
@@ -388,7 +392,7 @@ static rl_status surfels_render(rl_renderer *r, void *state, const rl_scene *sce
     f.max_size = max_size;
     f.overdraw = (float)rl_renderer_opt_float(r, "overdraw");
     f.point_size = (float)rl_renderer_opt_float(r, "point_size");
-    st = rl_cull_frame_begin(r, scene, &s->head.drawer, cam, image, &f.cf);
+    st = rl_cull_frame_begin(r, scene, &s->head, cam, image, false, &f.cf);
     if (st != RL_OK)
         return st;
     s->num_cmds = 0;
@@ -415,4 +419,5 @@ const rl_renderer_class rl_surfels_renderer_class = {
     .release = surfels_release,
     .check = NULL,
     .reset = NULL,
+    .available = rl_cull_available,
 };

@@ -30,7 +30,9 @@
  * quality is measured against the conservative reference (rl compare, the
  * quality property).
  *
- * Options: the raster renderer's plus max_depth 5, looseness 2.0,
+ * Options: the raster renderer's, drawer (software | gl: the frame is drawn
+ * by the GL drawer of src/gl; the sets are still sampled by the software
+ * drawer, docs/gl.md) and device, plus max_depth 5, looseness 2.0,
  * levels 1 (42 directions), resolution 128, neighbours 3, distance 1. The
  * sample count and resolution are our defaults; the SVS paper varies both.
  * distance > 1 (ours) uses a node's sets only from viewers farther than
@@ -516,7 +518,7 @@ static rl_status svs_render(rl_renderer *r, void *state, const rl_scene *scene, 
     f.distance = (float)rl_renderer_opt_float(r, "distance");
     if (f.neighbours > s->num_dirs)
         f.neighbours = s->num_dirs;
-    st = rl_cull_frame_begin(r, scene, &s->head.drawer, cam, image, &f.cf);
+    st = rl_cull_frame_begin(r, scene, &s->head, cam, image, true, &f.cf);
     if (st != RL_OK)
         return st;
     if (++s->frame == 0) {
@@ -548,4 +550,5 @@ const rl_renderer_class rl_svs_renderer_class = {
     .release = svs_release,
     .check = NULL,
     .reset = NULL,
+    .available = rl_cull_available,
 };

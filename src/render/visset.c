@@ -22,6 +22,9 @@
  * ours (the lookup's object_pixels): the thesis' property stores pixels per
  * object and sample.
  *
+ * drawer = gl (device: the EGL device) draws the set with the GL drawer of
+ * src/gl; the sampled approximation is the software property's either way.
+ *
  * Frustum culling applies to each object of the set. Approximate: an
  * object that no sample of the region saw is missing (Fig. 7.11). */
 #include <math.h>
@@ -238,7 +241,7 @@ static rl_status visset_render(rl_renderer *r, void *state, const rl_scene *scen
     f.s = s;
     f.d = d;
     f.budget = budget;
-    st = rl_cull_frame_begin(r, scene, &s->head.drawer, cam, image, &f.cf);
+    st = rl_cull_frame_begin(r, scene, &s->head, cam, image, true, &f.cf);
     if (st != RL_OK)
         return st;
     if (++s->frame == 0) {
@@ -287,6 +290,7 @@ const rl_renderer_class rl_visset_renderer_class = {
     .release = visset_release,
     .check = NULL,
     .reset = NULL,
+    .available = rl_cull_available,
     .inputs = visset_inputs,
     .num_inputs = sizeof visset_inputs / sizeof visset_inputs[0],
 };

@@ -16,12 +16,15 @@ expect_usage_error "$RL" bench culling --visset-positions 0 --out "$TMP/x.json"
 expect_usage_error "$RL" bench culling --only depth,nosuch --out "$TMP/x.json"
 expect_usage_error "$RL" bench culling --quick --out "$TMP/x.txt"
 expect_usage_error "$RL" bench culling --frobnicate
+expect_usage_error "$RL" bench culling --only walk --drawer vulkan --out "$TMP/x.json"
+expect_usage_error "$RL" bench culling --only walk --walk-frames 1 --out "$TMP/x.json"
 [ -e "$TMP/x.json" ] && fail "a failed run wrote x.json"
 expect_exit 1 "$RL" bench culling --quick --out "$TMP/no/such/dir/c.json"
 
 expect_exit 0 "$RL" bench culling --help
 for o in --scene --only --samples --max-depth --size --height --extent --resolution --select-positions \
-         --select-quantile --visset-positions --surfels --budget --threads --seed --out --resume --quick; do
+         --select-quantile --visset-positions --surfels --budget --threads --seed --out --resume --quick \
+         --walk-frames --drawer; do
     expect_in "$TMP/out" "$o"
 done
 expect_exit 0 "$RL" bench --help
@@ -72,6 +75,29 @@ assert v["positions"] == 4 and 0 <= v["hssim_below_0_9"] <= 4 and len(v["worst_p
 assert v["budget_time_ms"]["mean"] > 0 and 0 <= v["budget_hssim"]["min"] <= v["budget_hssim"]["max"] <= 1, v
 # the svs section ran before, so visset is compared with its sampled time
 assert v["svs_sampled_time_mean_ms"] > 0, v
+PY
+
+# The walk section runs only when named (not in c.json above): chcpp and
+# svs frame by frame on the software drawer, and on GL where a context can
+# be made (else the record says why).
+python3 -c "import json, sys; assert 'walk' not in json.load(open(sys.argv[1]))" "$TMP/c.json" \
+    || fail "the walk section ran without --only walk"
+expect_exit 0 "$RL" bench culling --quick --only walk --walk-frames 3 --out "$TMP/w.json"
+expect_in "$TMP/out" "svs / chcpp (software)"
+python3 - "$TMP/w.json" <<'PY' || fail "w.json does not hold a sane walk record"
+import json, sys
+r = json.load(open(sys.argv[1]))
+w = r["walk"]
+assert w["status"] == "ok" and w["frames"] == 3 and r["parameters"]["drawer"] == "both", w
+runs = w["runs"]
+gl = [x for x in runs if x["drawer"] == "gl"]
+assert [(x["renderer"], x["drawer"]) for x in runs if x["drawer"] == "software"] == [("chcpp", "software"), ("svs", "software")]
+assert (len(gl) == 2 and all(x["gl_device"] for x in gl)) or (not gl and w["gl_unavailable"]), w
+for x in runs:
+    assert 0 < x["min_ms"] <= x["median_ms"] <= x["max_ms"] and x["first_frame_ms"] > 0, x
+    assert x["queries_ready_mean"] + x["queries_waited_mean"] == x["queries_mean"], x
+    assert x["drawer"] == "gl" or x["queries_waited_mean"] == 0, x
+assert w["svs_over_chcpp_software"] > 0
 PY
 
 # --extent widens the slice of Sec. 7.4-7.6 about the scene's centre: the

@@ -21,6 +21,14 @@ expect_error 1 "unavailable: .*device 15" \
     "$RL" render cornell --algo gl-raster --set gl-raster.device=15 --size 32x24 --out "$TMP/none.png"
 [ ! -e "$TMP/none.png" ] || fail "an unavailable renderer wrote an image"
 
+# The culling renderers with drawer=gl: unavailable with the device's reason.
+expect_error 1 "chcpp: unavailable: .*bogus" \
+    "$RL" render cornell --algo chcpp --set chcpp.drawer=gl --set chcpp.device=bogus --size 32x24 --out "$TMP/none.png"
+[ ! -e "$TMP/none.png" ] || fail "an unavailable renderer wrote an image"
+RL_EGL_DEVICE=bogus expect_error 1 "surfels: unavailable: .*bogus" \
+    "$RL" render cornell --algo surfels --set surfels.drawer=gl --size 32x24 --out "$TMP/none.png"
+expect_error 2 "drawer" "$RL" render cornell --algo svs --set svs.drawer=vulkan --size 32x24 --out "$TMP/none.png"
+
 # The CPU renderers do not care about the GL device.
 RL_EGL_DEVICE=bogus run_ok "$RL" render cornell --algo raster --size 32x24 --out "$TMP/raster.png" \
     --stats-json "$TMP/raster.json"
@@ -39,6 +47,16 @@ import json, sys
 s = json.load(open(sys.argv[1]))
 assert s["device"].count(" | ") == 2, s["device"]
 assert s["pixels_written"] > 0 and s["triangles_rasterized"] > 0, s
+PY
+    # chcpp on the GL drawer: the stats name the device; the image equals
+    # gl-raster's (conservative culling, the same drawer).
+    run_ok "$RL" render cornell --algo chcpp --set chcpp.drawer=gl --size 64x48 --out "$TMP/chc.png" \
+        --stats-json "$TMP/chc.json"
+    cmp -s "$TMP/chc.png" "$TMP/gl.png" || fail "chcpp on GL differs from gl-raster on cornell"
+    python3 - "$TMP/chc.json" <<'PY' || fail "chcpp's stats on GL lack the device"
+import json, sys
+s = json.load(open(sys.argv[1]))
+assert s["device"].count(" | ") == 2, s
 PY
 else
     echo "test_cli_gl: no GL 4.5 context here; the rendering case is skipped"
