@@ -34,6 +34,10 @@ expect_error 2 "visibility-backend: unknown value 'vulkan'" \
 expect_error 2 "visibility-backend: unknown value 'vulkan'" \
     "$RL" bench sampling --quick --visibility-backend vulkan --out "$TMP/none.json"
 
+RL_EGL_DEVICE=bogus expect_error 1 "bench gl: OpenGL unavailable: .*bogus" \
+    "$RL" bench gl --quick --out "$TMP/bench-none.json"
+[ ! -e "$TMP/bench-none.json" ] || fail "rl bench gl without GL wrote a record"
+
 # The CPU renderers do not care about the GL device.
 RL_EGL_DEVICE=bogus run_ok "$RL" render cornell --algo raster --size 32x24 --out "$TMP/raster.png" \
     --stats-json "$TMP/raster.json"
@@ -66,6 +70,23 @@ import json, sys
 a, b = (json.load(open(f)) for f in sys.argv[1:])
 assert len(a["samples"]) == 16 and a["samples"] == b["samples"], (a["samples"], b["samples"])
 assert a["sample_sets"] == b["sample_sets"]
+PY
+
+    # rl bench gl --quick: both sections, the GL strings in the record, the
+    # two backends' visibility values equal.
+    run_ok "$RL" bench gl --quick --scenes cornell --frames 1 --out "$TMP/bench-gl.json"
+    python3 - "$TMP/bench-gl.json" <<'PY' || fail "rl bench gl's record is incomplete"
+import json, sys
+r = json.load(open(sys.argv[1]))
+assert r["benchmark"] == "gl" and r["gl"]["renderer"] and r["gl"]["version"], r.get("gl")
+f, v = r["frames"], r["visibility"]
+assert f["status"] == "ok" and v["status"] == "ok", (f, v)
+row = f["rows"][0]
+assert row["scene"] == "cornell" and row["raster"]["min_ms"] > 0 and row["gl_raster"]["min_ms"] > 0, row
+assert row["ids_equal_percent"] > 99, row
+row = v["rows"][0]
+assert row["values_equal"] == r["parameters"]["positions"] == 2, row
+assert row["object_pixels_total"] > 0 and row["gl"]["mean_ms_per_position"] > 0, row
 PY
 else
     echo "test_cli_gl: no GL 4.5 context here; the rendering case is skipped"
