@@ -278,6 +278,47 @@ static void test_gl_visibility_honours_alpha_masks(void **state)
     rl_scene_release(s);
 }
 
+/* A wall 0.05 beside the viewer, closer than the near plane (0.1) in the
+ * +x face (whose frustum test leaves it out) and crossing it in the four
+ * faces that see it edge-on: there the near plane, a clip distance on GL,
+ * cuts off the part in front of it as the software rasterizer clips.
+ * (llvmpipe applies a written gl_ClipDistance even where GL_CLIP_DISTANCE0
+ * is not enabled, as measured; GPUs follow the spec and need the enable.) */
+static void test_gl_visibility_clips_at_the_near_plane(void **state)
+{
+    (void)state;
+    NEED_GL();
+    rl_scene *s = NULL;
+    assert_int_equal(rl_scene_create(&s), RL_OK);
+    rl_material m = rl_material_default();
+    uint32_t mat, mesh, node;
+    assert_int_equal(rl_scene_add_material(s, &m, &mat), RL_OK);
+    const rl_vec3 p[4] = { { 0.05f, -2, -2 }, { 0.05f, 2, -2 }, { 0.05f, 2, 2 }, { 0.05f, -2, 2 } };
+    const uint32_t idx[6] = { 0, 1, 2, 0, 2, 3 };
+    rl_mesh_desc md = { .name = "wall", .num_vertices = 4, .positions = p, .num_triangles = 2, .indices = idx,
+                        .material = mat };
+    assert_int_equal(rl_scene_add_mesh(s, &md, &mesh), RL_OK);
+    assert_int_equal(rl_scene_add_node(s, RL_NODE_ROOT, "wall", NULL, &node), RL_OK);
+    assert_int_equal(rl_scene_node_set_mesh(s, node, mesh), RL_OK);
+    assert_int_equal(rl_scene_commit(s), RL_OK);
+    rl_property *gl = make_vis(s, "gl", "pixels", RES, 1);
+    rl_property *sw = make_vis(s, "software", "pixels", RES, 1);
+    rl_property_sample a = { 0 }, b = { 0 };
+    assert_int_equal(rl_property_evaluate(gl, 0, rl_v3s(0.0f), &a), RL_OK);
+    assert_int_equal(rl_property_evaluate(sw, 0, rl_v3s(0.0f), &b), RL_OK);
+    print_message("wall: %g / %g pixels (GL / software); +z face %g / %g\n", a.value, b.value, a.direction[4],
+                  b.direction[4]);
+    /* Unclipped, the wall would fill the +z face's right half from x/z =
+     * 1/2 on; clipped, only beyond z = 0.1, i.e. up to x/z = 1/2. */
+    assert_true(b.direction[4] > 0.0 && b.direction[4] < 0.35 * RES * RES);
+    assert_true(a.value == b.value);
+    for (int f = 0; f < 6; ++f)
+        assert_true(a.direction[f] == b.direction[f]);
+    rl_property_release(gl);
+    rl_property_release(sw);
+    rl_scene_release(s);
+}
+
 /* Several workers evaluating at once share the one GL counter: each gets
  * what one worker alone gets. */
 static void test_gl_visibility_workers_share_the_counter(void **state)
@@ -348,6 +389,7 @@ int main(void)
         cmocka_unit_test(test_gl_visibility_matches_software_on_every_builtin_scene),
         cmocka_unit_test(test_gpu_counts_equal_cpu_counts_of_the_same_frame),
         cmocka_unit_test(test_gl_visibility_honours_alpha_masks),
+        cmocka_unit_test(test_gl_visibility_clips_at_the_near_plane),
         cmocka_unit_test(test_gl_visibility_workers_share_the_counter),
         cmocka_unit_test(test_gl_visibility_unavailable_is_a_clear_error),
     };
