@@ -370,8 +370,10 @@ static void test_gl_visibility_unavailable_is_a_clear_error(void **state)
     rl_clear_error();
     assert_int_equal(rl_property_commit(p, s, 1), RL_ERR_UNSUPPORTED);
     print_message("%s\n", rl_last_error());
-    assert_non_null(strstr(rl_last_error(), "backend gl: OpenGL unavailable"));
-    assert_non_null(strstr(rl_last_error(), "bogus"));
+    assert_non_null(strstr(rl_last_error(), "visibility: backend gl: OpenGL unavailable: "));
+    /* A build without GL says that instead of naming the device. */
+    if (have_gl)
+        assert_non_null(strstr(rl_last_error(), "bogus"));
     assert_int_equal(rl_property_workers(p), 0);
     assert_int_equal(rl_property_set(p, "backend", "vulkan"), RL_ERR_INVALID_ARG);
     assert_int_equal(rl_property_set(p, "backend", "software"), RL_OK);
