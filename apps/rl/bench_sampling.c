@@ -67,6 +67,8 @@ static const char bench_sampling_help[] =
     "  --scene S         default city:blocks=3 (see rl scenes)\n"
     "  --resolution N    cube-face resolution of the property; default 256\n"
     "                    (the thesis: 1024, see the throughput section)\n"
+    "  --visibility-backend B  software (default) or gl: the property drawn by\n"
+    "                    OpenGL and counted on the GPU (docs/gl.md)\n"
     "  --height H        2-D slice height above the scene's floor; default 1.7 m\n"
     "  --samples A,B,..  sample counts of the variants section; default 256,1024,4096\n"
     "  --validation N    random validation points per region; default 2000\n"
@@ -103,6 +105,7 @@ static const char *const section_names[SEC_COUNT] = { "variants", "convergence",
 typedef struct bs_args {
     const char *scene, *out;
     long long resolution, validation, threads, repeats;
+    const char *backend;          /* --visibility-backend: the property's backend option */
     double height;
     rl_quality_size quality_size;     /* of the adaptive variants but bnc-region */
     double samples_base, samples_per_meter;   /* the same; 0: the defaults (Sec. 5.4.2) */
@@ -388,6 +391,8 @@ static rl_status sec_throughput(void *ctx, cJSON *sec)
             if (st == RL_OK)
                 st = rl_property_set(p, "resolution", num);
             if (st == RL_OK)
+                st = rl_property_set(p, "backend", c->a->backend);
+            if (st == RL_OK)
                 st = rl_property_commit(p, c->scene, w);
             /* Enough positions for about a second of work at the first
              * measured rate; at least 4 per worker. */
@@ -451,6 +456,11 @@ static bool take_counts(void *a, const char *text)
     return parse_counts(text, a);
 }
 
+static bool take_backend(void *ctx, const char *text)
+{
+    return eval_parse_visibility_backend("--visibility-backend", text, &((bs_args *)ctx)->backend);
+}
+
 static bool take_quality_size(void *ctx, const char *text)
 {
     return eval_parse_quality_size("--quality-size", text, &((bs_args *)ctx)->quality_size);
@@ -472,6 +482,7 @@ static int parse_args(int argc, char **argv, bs_args *a)
           .hi = INFINITY, .expect = "metres >= 0" },
         RL_BENCH_CUSTOM("--samples", take_counts, a, &has_counts),
         RL_BENCH_CUSTOM("--quality-size", take_quality_size, a, NULL),
+        RL_BENCH_CUSTOM("--visibility-backend", take_backend, a, NULL),
         RL_BENCH_REAL("--samples-base", 1.0, 1e6, &a->samples_base, NULL),
         RL_BENCH_REAL("--samples-per-meter", 1e-9, 1e6, &a->samples_per_meter, NULL),
         RL_BENCH_COUNT("--threads", 1024, &a->threads, NULL),
@@ -484,6 +495,8 @@ static int parse_args(int argc, char **argv, bs_args *a)
         return rc;
     if (!a->scene)
         a->scene = a->quick ? "cornell" : "city:blocks=3";
+    if (!a->backend)
+        a->backend = "software";
     if (!has_res)
         a->resolution = a->quick ? 32 : 256;
     if (!has_val)
@@ -519,6 +532,8 @@ int bench_sampling(int argc, char **argv)
     if (st == RL_OK)
         st = rl_property_set(c.vis, "resolution", num);
     if (st == RL_OK)
+        st = rl_property_set(c.vis, "backend", a.backend);
+    if (st == RL_OK)
         st = rl_property_commit(c.vis, c.scene, (int)a.threads);
     if (st != RL_OK) {
         rl_property_release(c.vis);
@@ -532,6 +547,7 @@ int bench_sampling(int argc, char **argv)
     cJSON_AddItemToObject(params, "scene_stats", cli_scene_stats_json(c.scene));
     cJSON_AddStringToObject(params, "property", "visibility (objects)");
     cJSON_AddNumberToObject(params, "resolution", (double)a.resolution);
+    cJSON_AddStringToObject(params, "visibility_backend", a.backend);
     cJSON_AddNumberToObject(params, "validation_points", (double)a.validation);
     cJSON_AddNumberToObject(params, "repeats", (double)a.repeats);
     cJSON_AddStringToObject(params, "quality_size", eval_quality_size_name(a.quality_size));

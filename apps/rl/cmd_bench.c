@@ -15,6 +15,7 @@
 #include "bench_rays.h"
 #include "bench_sampling.h"
 #include "bench_culling.h"
+#include "bench_gl.h"
 #include "bench_surfels.h"
 #include "bench_util.h"
 #include "bench_vt.h"
@@ -32,7 +33,7 @@
 /* rl bench --help: every kind on one line. Durations are the defaults' on
  * 2 cores (bench/README.md); --quick is the toy run ctest uses. */
 static const char bench_overview[] =
-    "usage: rl bench rays|vt|pt|sampling|surfels|culling [options]\n"
+    "usage: rl bench rays|vt|pt|sampling|surfels|culling|gl [options]\n"
     "       rl bench KIND --help    the options of one kind\n"
     "\n"
     "Timed runs, each writing one JSON record (machine, build, command line,\n"
@@ -53,12 +54,14 @@ static const char bench_overview[] =
     "                     Jaehn 2015 Table 6.1 (minutes; variants capped by --max-seconds)\n"
     "  rl bench culling   CHC++, SVS, visible sets, runtime selection, Jaehn 2015\n"
     "                     Ch. 7 (about an hour on city; choose with --only)\n"
+    "  rl bench gl        the OpenGL backend vs the software paths: gl-raster vs\n"
+    "                     raster frames, the visibility property (~1 min)\n"
     "\n"
     "example:\n"
     "  rl bench rays --quick --out /tmp/rays.json\n"
     "  rl bench vt --help\n";
 
-static const char *const bench_kinds[] = { "rays", "vt", "pt", "sampling", "surfels", "culling" };
+static const char *const bench_kinds[] = { "rays", "vt", "pt", "sampling", "surfels", "culling", "gl" };
 
 static const char bench_help[] =
     "usage: rl bench rays [options]      (rl bench --help: every kind)\n"
@@ -214,7 +217,7 @@ static int parse_args(int argc, char **argv, bench_args *a)
 {
     if (argc < 2)
         return cli_fail(RL_CLI_USAGE,
-                           "bench: missing benchmark (rays, vt, pt, sampling, surfels, culling; see rl bench --help)");
+                           "bench: missing benchmark (rays, vt, pt, sampling, surfels, culling, gl; see rl bench --help)");
     if (cli_is_help(argv[1])) {
         fputs(bench_overview, stdout);
         return RL_BENCH_HELP_SHOWN;
@@ -222,7 +225,7 @@ static int parse_args(int argc, char **argv, bench_args *a)
     if (strcmp(argv[1], "rays") != 0) {
         char hint[96];
         return cli_fail(RL_CLI_USAGE, "bench: unknown benchmark '%s' (%sknown: rays, vt, pt, "
-                           "sampling, surfels, culling)",
+                           "sampling, surfels, culling, gl)",
                            argv[1], cli_did_you_mean(argv[1], bench_kinds, sizeof bench_kinds / sizeof *bench_kinds,
                                                      hint, sizeof hint));
     }
@@ -632,6 +635,8 @@ int cli_bench(int argc, char **argv)
         return bench_surfels(argc, argv);
     if (argc >= 2 && strcmp(argv[1], "culling") == 0)
         return bench_culling(argc, argv);
+    if (argc >= 2 && strcmp(argv[1], "gl") == 0)
+        return bench_gl(argc, argv);
     bench_args a;
     memset(&a, 0, sizeof a);
     int rc = parse_args(argc, argv, &a);

@@ -53,6 +53,8 @@ static const char compare_help_head[] =
     "  --repeats N         renders per direction for time (median); default 3\n"
     "  --resolution N      cube-face resolution of the visibility that places\n"
     "                      the samples; default 128\n"
+    "  --visibility-backend B  software (default) or gl: that visibility drawn\n"
+    "                      by OpenGL and counted on the GPU (docs/gl.md)\n"
     "  --out DIR           output folder; default out/compare\n";
 static const char compare_help_tail[] =
     "\n"
@@ -89,6 +91,7 @@ typedef struct compare_args {
     double max_memory;    /* --max-memory in bytes, 0: MemAvailable */
     double fov_deg;
     long long repeats, resolution;
+    const char *vis_backend;  /* --visibility-backend, or NULL: the property's default */
     int spread_runs;      /* --spread */
     eval_sampling sampling;
     cli_load load;
@@ -315,6 +318,9 @@ static int parse_args(int argc, char **argv, compare_args *a)
         } else if (VALUE("--resolution")) {
             if (!bench_parse_count("--resolution", v, 4096, &a->resolution))
                 return RL_CLI_USAGE;
+        } else if (VALUE("--visibility-backend")) {
+            if (!eval_parse_visibility_backend("--visibility-backend", v, &a->vis_backend))
+                return RL_CLI_USAGE;
         } else if (m == 0 && argv[i][0] != '-' && !a->scene)
             a->scene = argv[i];
         else if (m == 0)
@@ -531,6 +537,8 @@ static int place_samples(compare_args *a, const rl_scene *scene, rl_approx **dri
     rl_status st = rl_property_create("visibility", &vis);
     if (st == RL_OK)
         st = rl_property_set(vis, "resolution", num);
+    if (st == RL_OK && a->vis_backend)
+        st = rl_property_set(vis, "backend", a->vis_backend);
     if (st == RL_OK)
         st = rl_property_commit(vis, scene, a->sampling.desc.workers);
     rl_progress *progress = NULL;

@@ -90,6 +90,17 @@ bool eval_parse_quality_size(const char *option, const char *text, rl_quality_si
     return true;
 }
 
+static const char *const visibility_backends[] = { "software", "gl" };
+
+bool eval_parse_visibility_backend(const char *option, const char *text, const char **out)
+{
+    int k = pick(option, text, visibility_backends, 2);
+    if (k < 0)
+        return false;
+    *out = visibility_backends[k];
+    return true;
+}
+
 static bool parse_number(const char *option, const char *v, double lo, double hi, double *out)
 {
     char *end = NULL;

@@ -82,6 +82,10 @@ const char *eval_quality_size_name(rl_quality_size q);
 /* Parses the value of `option` as a quality size; false after printing a
  * usage error. */
 bool eval_parse_quality_size(const char *option, const char *text, rl_quality_size *out);
+/* The value of `option` (--visibility-backend of rl compare and rl bench
+ * sampling) as the visibility property's backend, software or gl, into
+ * *out (a static string); false after printing a usage error. */
+bool eval_parse_visibility_backend(const char *option, const char *text, const char **out);
 /* Five-number summary plus mean as table cells (formatted into buf). */
 void eval_stats_cells(const rl_stats *s, char buf[7][32]);
 

@@ -35,7 +35,12 @@
  *               The far plane encloses the scene. Options: resolution,
  *               near (near-plane distance, m, default 0.1), measure,
  *               threads (per worker's rasterizer; 0 = all threads for a
- *               single worker, 1 each when several workers are committed).
+ *               single worker, 1 each when several workers are committed),
+ *               backend (software, default, or gl: the six faces drawn by
+ *               OpenGL 4.5 and counted on the GPU, one GL context shared
+ *               by the workers; commit fails with RL_ERR_UNSUPPORTED and
+ *               the reason where no context can be made; see docs/gl.md),
+ *               device (backend gl's EGL device, as rl_gl.h).
  *   time        Rendering time of a renderer (Sec. 4.2.3, Def. 6), ms:
  *               per direction the median of `repeats` (default 5) renders
  *               with a `fov_deg` (default 120) frustum into width x height

@@ -31,17 +31,29 @@
  * Workers: each has its own rasterizer, image and counters. With several
  * workers every rasterizer runs single-threaded (the parallelism is across
  * positions, Jähn 2015, Sec. 5.5); a single worker's rasterizer uses all
- * threads. The `threads` option overrides both. */
+ * threads. The `threads` option overrides both.
+ *
+ * backend=gl renders the same six views on OpenGL and counts on the GPU
+ * (src/gl/gl_visibility.c): the per-object pixels and the per-face counts
+ * come back as one small buffer instead of six ID images. One GL counter
+ * (one context, one copy of the scene on the device) serves every worker,
+ * one position at a time: the device is one, and the workers' frustum
+ * tests and reductions still run in parallel around it. */
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
+#include <omp.h>
+
 #include "core/error.h"
 #include "eval/property_internal.h"
+#include "gl/gl_visibility.h"
 #include "rl/rl_drawer.h"
 
 static const char *const measure_choices[] = { "objects", "polygons", "pixels", NULL };
 enum { MEASURE_OBJECTS = 0, MEASURE_POLYGONS, MEASURE_PIXELS };
+static const char *const backend_choices[] = { "software", "gl", NULL };
+enum { BACKEND_SOFTWARE = 0, BACKEND_GL };
 
 static const rl_option_info visibility_options[] = {
     { "resolution", RL_OPT_INT, "1024",
@@ -54,6 +66,12 @@ static const rl_option_info visibility_options[] = {
     { "threads", RL_OPT_INT, "0",
       "rasterizer threads per worker (0: all for a single worker, 1 per worker otherwise)", 0,
       1024, NULL },
+    { "backend", RL_OPT_ENUM, "software",
+      "software: the software rasterizer, counted on the CPU; gl: OpenGL 4.5, counted on the GPU",
+      0, 0, backend_choices },
+    { "device", RL_OPT_STRING, "",
+      "EGL device of backend gl: auto, surfaceless or a device number; empty: $RL_EGL_DEVICE, else auto",
+      0, 0, NULL },
 };
 
 typedef struct vis_worker {
@@ -61,7 +79,7 @@ typedef struct vis_worker {
     rl_image *img;              /* depth + IDs, resolution² */
     uint32_t *pixels;           /* per object, this evaluation */
     uint32_t *seen;             /* per object: stamp of the last face that saw it */
-    uint8_t *mask;              /* per object: drawn into the current face */
+    uint8_t *mask;              /* per object: drawn into the current face; gl: 6 faces */
     uint32_t stamp;
 } vis_worker;
 
@@ -73,6 +91,8 @@ typedef struct vis_state {
     int workers;
     int threads;                /* per rasterizer; 0 = all */
     vis_worker *w;
+    rl_gl_visibility *gl;       /* backend gl: shared by the workers under lock */
+    omp_lock_t lock;
 } vis_state;
 
 static const char *visibility_unit(const rl_property *p)
@@ -86,6 +106,10 @@ static void visibility_release(void *state)
     vis_state *s = state;
     if (!s)
         return;
+    if (s->gl) {
+        rl_gl_visibility_release(s->gl);
+        omp_destroy_lock(&s->lock);
+    }
     for (int i = 0; s->w && i < s->workers; ++i) {
         rl_drawer_release(s->w[i].drawer);
         rl_image_release(s->w[i].img);
@@ -95,6 +119,20 @@ static void visibility_release(void *state)
     }
     free(s->w);
     free(s);
+}
+
+/* The GL counter of backend gl, with a clear error where there is no GL. */
+static rl_status make_gl(rl_property *p, const rl_scene *scene, vis_state *s)
+{
+    const char *device = rl_property_opt(p, "device");
+    char why[256];
+    if (!rl_gl_available(device, why, sizeof why))
+        return rl_error(RL_ERR_UNSUPPORTED, "%s: backend gl: OpenGL unavailable: %s", rl_property_name(p), why);
+    rl_status st = rl_gl_visibility_create(scene, s->resolution, device, &s->gl);
+    if (st != RL_OK)
+        return st;
+    omp_init_lock(&s->lock);
+    return RL_OK;
 }
 
 static rl_status visibility_commit(rl_property *p, const rl_scene *scene, int workers,
@@ -118,17 +156,22 @@ static rl_status visibility_commit(rl_property *p, const rl_scene *scene, int wo
         s->threads = workers > 1 ? 1 : 0;
     s->w = rl_calloc((size_t)workers, sizeof *s->w);
     rl_status st = s->w ? RL_OK : RL_ERR_OUT_OF_MEMORY;
+    const bool gl = rl_property_opt_enum(p, "backend") == BACKEND_GL;
+    if (st == RL_OK && gl)
+        st = make_gl(p, scene, s);
     const int threads = s->threads;
     for (int i = 0; st == RL_OK && i < workers; ++i) {
         vis_worker *w = &s->w[i];
+        w->pixels = rl_calloc(d->num_objects, sizeof *w->pixels);
+        w->mask = rl_calloc((size_t)d->num_objects * (gl ? 6 : 1), sizeof *w->mask);
+        if (!w->pixels || !w->mask)
+            st = RL_ERR_OUT_OF_MEMORY;
+        if (gl || st != RL_OK)
+            continue;
         st = rl_image_create(s->resolution, s->resolution, RL_LAYER_DEPTH | RL_LAYER_ID, &w->img);
-        if (st == RL_OK) {
-            w->pixels = rl_calloc(d->num_objects, sizeof *w->pixels);
-            w->seen = rl_calloc(d->num_objects, sizeof *w->seen);
-            w->mask = rl_calloc(d->num_objects, sizeof *w->mask);
-            if (!w->pixels || !w->seen || !w->mask)
-                st = RL_ERR_OUT_OF_MEMORY;
-        }
+        w->seen = st == RL_OK ? rl_calloc(d->num_objects, sizeof *w->seen) : NULL;
+        if (st == RL_OK && !w->seen)
+            st = RL_ERR_OUT_OF_MEMORY;
         /* Unlit, so the mask's contents may change from face to face. */
         const rl_drawer_desc desc = { .flags = RL_RASTER_NO_COLOR, .threads = threads, .object_mask = w->mask };
         if (st == RL_OK)
@@ -191,10 +234,55 @@ static void frustum_mask(const rl_scene_data *d, rl_vec3 pos, rl_vec3 dir, rl_ve
     }
 }
 
+/* Sec. 4.2.2: a frustum that covers exactly one cube face. */
+static void face_camera(const vis_state *s, rl_vec3 pos, int face, float z_far, rl_mat4 *view, rl_mat4 *proj)
+{
+    rl_vec3 dir, up;
+    rl_property_direction(face, &dir, &up);
+    rl_camera cam = { .eye = pos, .target = rl_add(pos, dir), .up = up, .fov_deg = 90.0f,
+                      .width = s->resolution, .height = s->resolution,
+                      .z_near = s->z_near, .z_far = z_far };
+    *view = rl_camera_view(&cam);
+    *proj = rl_camera_projection(&cam, s->z_near, z_far);
+}
+
+/* count_pixels on the GL counter: the same views and frustum masks, the
+ * counting on the GPU. */
+static rl_status count_pixels_gl(vis_state *s, vis_worker *w, rl_vec3 pos, double *direction)
+{
+    const rl_scene_data *d = s->d;
+    const float z_far = far_plane(d, pos, s->z_near);
+    rl_mat4 view_proj[6];
+    const uint8_t *masks[6];
+    for (int face = 0; face < 6; ++face) {
+        rl_mat4 view, proj;
+        face_camera(s, pos, face, z_far, &view, &proj);
+        view_proj[face] = rl_mat4_mul(&proj, &view);
+        rl_vec3 dir, up;
+        rl_property_direction(face, &dir, &up);
+        uint8_t *mask = w->mask + (size_t)face * d->num_objects;
+        frustum_mask(d, pos, dir, up, s->z_near, mask);
+        masks[face] = mask;
+    }
+    rl_gl_view_counts views[6];
+    omp_set_lock(&s->lock);
+    rl_status st = rl_gl_visibility_count(s->gl, view_proj, masks, w->pixels, views);
+    omp_unset_lock(&s->lock);
+    if (st != RL_OK || !direction)
+        return st;
+    for (int face = 0; face < 6; ++face)
+        direction[face] = s->measure == MEASURE_OBJECTS    ? (double)views[face].objects
+                          : s->measure == MEASURE_POLYGONS ? (double)views[face].polygons
+                                                           : (double)views[face].pixels;
+    return RL_OK;
+}
+
 /* Rasterizes the six faces and counts pixels per object into w->pixels;
  * per-face measures go to direction (may be NULL). */
 static rl_status count_pixels(vis_state *s, vis_worker *w, rl_vec3 pos, double *direction)
 {
+    if (s->gl)
+        return count_pixels_gl(s, w, pos, direction);
     const rl_scene_data *d = s->d;
     const size_t n = (size_t)s->resolution * (size_t)s->resolution;
     memset(w->pixels, 0, d->num_objects * sizeof *w->pixels);
@@ -202,12 +290,8 @@ static rl_status count_pixels(vis_state *s, vis_worker *w, rl_vec3 pos, double *
     for (int face = 0; face < 6; ++face) {
         rl_vec3 dir, up;
         rl_property_direction(face, &dir, &up);
-        /* Sec. 4.2.2: a frustum that covers exactly one cube face */
-        rl_camera cam = { .eye = pos, .target = rl_add(pos, dir), .up = up, .fov_deg = 90.0f,
-                          .width = s->resolution, .height = s->resolution,
-                          .z_near = s->z_near, .z_far = z_far };
-        rl_mat4 view = rl_camera_view(&cam);
-        rl_mat4 proj = rl_camera_projection(&cam, s->z_near, z_far);
+        rl_mat4 view, proj;
+        face_camera(s, pos, face, z_far, &view, &proj);
         frustum_mask(d, pos, dir, up, s->z_near, w->mask);
         rl_image_clear(w->img);
         rl_status st = rl_drawer_begin(w->drawer, w->img, &view, &proj, pos);
