@@ -532,6 +532,10 @@ static rl_status gl_begin(void *impl, rl_image *target, const rl_mat4 *view, con
     glBindFramebuffer(GL_FRAMEBUFFER, g->fbo);
     glViewport(0, 0, w, h);
     glEnable(GL_DEPTH_TEST);
+    /* The shaders' near plane (gl_shaders.c writes gl_ClipDistance[0]):
+     * by the GL spec it clips only while enabled; llvmpipe clips anyway,
+     * a GPU driver would not. */
+    glEnable(GL_CLIP_DISTANCE0);
     /* The target's eye depth into the depth attachment and the depth
      * buffer (gl_shaders.c upload_fs). */
     apply_flags(RL_RASTER_NO_DEPTH_TEST | RL_RASTER_NO_COLOR | RL_RASTER_NO_ID);

@@ -329,10 +329,13 @@ static const char *const points_fs = GLSL(
  * copied to the depth attachment and turned into window depth, the
  * inverse of what the vertex stage computes. */
 static const char *const upload_vs = GLSL(
+    out float gl_ClipDistance[1];
+
     void main()
     {
         vec2 corner = vec2(float((gl_VertexID & 1) << 2) - 1.0, float((gl_VertexID & 2) << 1) - 1.0);
         gl_Position = vec4(corner, 0.0, 1.0);
+        gl_ClipDistance[0] = 1.0;       /* the frame enables the near plane's clip distance */
     }
 );
 
