@@ -15,6 +15,8 @@ PACKAGES=(
   libegl-mesa0 libgl1-mesa-dri       # headless EGL + llvmpipe, so the GL tests run without a GPU
   libcmocka-dev       # unit tests
   libcairo2-dev       # plots in evaluation reports (SVG, PNG)
+  libsdl2-dev         # rl view: the interactive viewer's window
+  xvfb xauth          # xvfb-run: the viewer's tests without a display
   fonts-dejavu-core   # a font for plot labels
   assimp-testmodels   # real meshes for rl bench rays
   python3             # the JSON checks of the CLI tests
