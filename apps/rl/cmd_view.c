@@ -644,6 +644,8 @@ static bool worker_idle(viewer *v)
 
 /* ---- output ---- */
 
+static void draw(viewer *v);
+
 static rl_status write_shot_json(const viewer *v, const char *png, const char *path)
 {
     cJSON *obj = cli_render_stats_json(&v->shown_stats, 0.0);
@@ -694,6 +696,33 @@ static bool write_screenshot(viewer *v, const char *png)
     rl_output_batch_release(batch);
     if (st != RL_OK) {
         cli_fail_status(RL_CLI_FAIL, st, what);
+        return false;
+    }
+    return true;
+}
+
+/* What the window shows, overlay included (for documentation and for
+ * testing the overlay): the displayed bytes decoded back to linear, which
+ * the PNG writer encodes to the same bytes. */
+static bool write_capture(viewer *v, const char *png)
+{
+    draw(v);      /* a key of the script (help, stats) may have changed the overlay */
+    rl_image *img = NULL;
+    rl_clear_error();
+    rl_status st = rl_image_create(v->width, v->height, RL_LAYER_COLOR, &img);
+    if (st == RL_OK) {
+        float lin[256];
+        for (int i = 0; i < 256; i++)
+            lin[i] = rl_srgb_to_linear((float)i / 255.0f);
+        for (size_t i = 0; i < (size_t)v->width * (size_t)v->height; i++) {
+            uint32_t p = v->pixels[i];
+            img->color[i] = (rl_vec4){ lin[p >> 16 & 255], lin[p >> 8 & 255], lin[p & 255], 1.0f };
+        }
+        st = rl_image_write(img, png);
+    }
+    rl_image_release(img);
+    if (st != RL_OK) {
+        cli_fail_status(RL_CLI_FAIL, st, png);
         return false;
     }
     return true;
@@ -1251,7 +1280,7 @@ static int check_outputs(const view_args *a, const view_script *script)
             return RL_CLI_FAIL;
     for (size_t i = 0; i < script->count; i++) {
         const view_event *e = &script->events[i];
-        if ((e->kind == VIEW_EV_SCREENSHOT || e->kind == VIEW_EV_RECORD) && e->text && !cli_check_writable(e->text))
+        if ((e->kind == VIEW_EV_SCREENSHOT || e->kind == VIEW_EV_CAPTURE || e->kind == VIEW_EV_RECORD) && e->text && !cli_check_writable(e->text))
             return RL_CLI_FAIL;
     }
     if (a->record_dir && !cli_make_dirs(a->record_dir))
@@ -1451,6 +1480,10 @@ static int apply_event(viewer *v, const view_script *s, const view_event *e, boo
         break;
     case VIEW_EV_SCREENSHOT:
         if (!write_screenshot(v, e->text))
+            return RL_CLI_FAIL;
+        break;
+    case VIEW_EV_CAPTURE:
+        if (!write_capture(v, e->text))
             return RL_CLI_FAIL;
         break;
     case VIEW_EV_RESIZE:

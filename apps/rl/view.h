@@ -56,6 +56,7 @@ typedef enum view_event_kind {
     VIEW_EV_ALGO,         /* text */
     VIEW_EV_SET,          /* text: KEY=VALUE */
     VIEW_EV_SCREENSHOT,   /* text: FILE.png */
+    VIEW_EV_CAPTURE,      /* text: FILE.png, the window's pixels with the overlay */
     VIEW_EV_RESIZE,       /* dx x dy: window size */
     VIEW_EV_RECORD,       /* text: FILE.json starts, NULL stops and saves */
     VIEW_EV_QUIT

@@ -67,7 +67,8 @@ bool view_key_is_held(view_key k)
 static const char *const event_names[] = {
     [VIEW_EV_KEY] = "key", [VIEW_EV_KEYDOWN] = "keydown", [VIEW_EV_KEYUP] = "keyup", [VIEW_EV_DRAG] = "drag",
     [VIEW_EV_WHEEL] = "wheel", [VIEW_EV_MOVE] = "move", [VIEW_EV_CAMERA] = "camera", [VIEW_EV_ALGO] = "algo",
-    [VIEW_EV_SET] = "set", [VIEW_EV_SCREENSHOT] = "screenshot", [VIEW_EV_RESIZE] = "resize",
+    [VIEW_EV_SET] = "set", [VIEW_EV_SCREENSHOT] = "screenshot", [VIEW_EV_CAPTURE] = "capture",
+    [VIEW_EV_RESIZE] = "resize",
     [VIEW_EV_RECORD] = "record", [VIEW_EV_QUIT] = "quit",
 };
 #define NUM_EVENTS (sizeof event_names / sizeof event_names[0])
@@ -110,14 +111,16 @@ static int parse_event(const char *path, int line, char **w, int n, view_event *
     if (k == NUM_EVENTS) {
         char hint[96];
         return BAD("%s:%d: unknown event '%s' (%sevents: key, keydown, keyup, drag, wheel, move, camera, algo, "
-                   "set, screenshot, resize, record, quit)", path, line, w[1],
+                   "set, screenshot, capture, resize, record, quit)", path, line, w[1],
                    cli_did_you_mean(w[1], event_names, NUM_EVENTS, hint, sizeof hint));
     }
     e->kind = (view_event_kind)k;
     int want = 0;
     switch (e->kind) {
     case VIEW_EV_KEY: case VIEW_EV_KEYDOWN: case VIEW_EV_KEYUP: case VIEW_EV_CAMERA: case VIEW_EV_ALGO:
-    case VIEW_EV_SET: case VIEW_EV_SCREENSHOT: case VIEW_EV_RECORD: case VIEW_EV_WHEEL: want = 1; break;
+    case VIEW_EV_SET: case VIEW_EV_SCREENSHOT: case VIEW_EV_CAPTURE: case VIEW_EV_RECORD: case VIEW_EV_WHEEL:
+        want = 1;
+        break;
     case VIEW_EV_DRAG: want = 3; break;
     case VIEW_EV_RESIZE: want = 2; break;
     case VIEW_EV_MOVE: want = 4; break;
@@ -159,9 +162,9 @@ static int parse_event(const char *path, int line, char **w, int n, view_event *
         if (!strchr(w[2], '=') || w[2][0] == '=')
             return BAD("%s:%d: set: expected KEY=VALUE, got '%s'", path, line, w[2]);
         break;
-    case VIEW_EV_SCREENSHOT:
+    case VIEW_EV_SCREENSHOT: case VIEW_EV_CAPTURE:
         if (!cli_has_extension(w[2], (const char *const[]){ ".png", NULL }))
-            return BAD("%s:%d: screenshot: expected a .png file, got '%s'", path, line, w[2]);
+            return BAD("%s:%d: %s: expected a .png file, got '%s'", path, line, w[1], w[2]);
         break;
     case VIEW_EV_RECORD:
         if (strcmp(w[2], "stop") != 0 && !cli_has_extension(w[2], (const char *const[]){ ".json", NULL }))
@@ -171,7 +174,7 @@ static int parse_event(const char *path, int line, char **w, int n, view_event *
         break;
     }
     bool texted = e->kind == VIEW_EV_CAMERA || e->kind == VIEW_EV_ALGO || e->kind == VIEW_EV_SET ||
-                  e->kind == VIEW_EV_SCREENSHOT || (e->kind == VIEW_EV_RECORD && strcmp(w[2], "stop") != 0);
+                  e->kind == VIEW_EV_SCREENSHOT || e->kind == VIEW_EV_CAPTURE || (e->kind == VIEW_EV_RECORD && strcmp(w[2], "stop") != 0);
     if (texted && !(e->text = strdup(w[2])))
         return cli_fail(RL_CLI_FAIL, "out of memory");
     return RL_CLI_OK;

@@ -74,6 +74,11 @@ cat >"$TMP/tour.txt" <<EOT
 0.4  screenshot $TMP/resized.png
 0.5  key Shift+Tab
 0.5  key Tab
+0.5  capture $TMP/cap_stats.png
+0.6  key i
+0.6  capture $TMP/cap_clean.png
+0.6  key h
+0.6  capture $TMP/cap_help.png
 0.6  quit
 EOT
 run_ok xvfb "$RL" view cornell --size $SIZE --script "$TMP/tour.txt" --screenshot-at "0.45:$TMP/at.png" \
@@ -86,6 +91,12 @@ run_ok "$RL" render cornell --algo raster --size $SIZE --eye $EYE --target $TARG
 ssim_ok "$TMP/moved.png" "$TMP/ref_moved.png"
 ssim_ok "$TMP/resized.png" "$TMP/ref_moved.png"
 ssim_ok "$TMP/at.png" "$TMP/ref_moved.png"
+# The window: the stats overlay (on at the start), nothing once I hides
+# it, the key list after H.
+ssim_ok "$TMP/cap_clean.png" "$TMP/ref_moved.png"
+for c in stats help; do
+    cmp -s "$TMP/cap_$c.png" "$TMP/cap_clean.png" && fail "capture: the $c overlay left the window unchanged"
+done
 python3 - "$TMP" "$AFTER" <<'PY' || fail "the screenshots' stats or the viewer's stats are wrong"
 import json, os, sys
 tmp, after = sys.argv[1], sys.argv[2]
