@@ -319,10 +319,10 @@ static void apply_cmd(worker *w, const view_cmd *c)
         w->r = r;
         w->have_last = false;
         SDL_LockMutex(sh->lock);
-        snprintf(sh->algo, sizeof sh->algo, "%s", c->text);
+        snprintf(sh->algo, sizeof sh->algo, "%.63s", c->text);
         sh->worker_progressive = is_progressive(c->text);
         sh->worker_spp = 0.0;
-        snprintf(sh->status, sizeof sh->status, "renderer %s", c->text);
+        snprintf(sh->status, sizeof sh->status, "renderer %.200s", c->text);
         SDL_UnlockMutex(sh->lock);
         return;
     }
