@@ -1353,6 +1353,13 @@ static int open_window(viewer *v)
     if (!chosen && !env_set("DISPLAY") && !env_set("WAYLAND_DISPLAY"))
         return cli_fail(RL_CLI_FAIL, "view: cannot open a window: no display (DISPLAY and WAYLAND_DISPLAY are "
                                      "unset; a script runs under xvfb-run or SDL_VIDEODRIVER=offscreen)");
+    /* The image is made on the CPU; the window only scales it. SDL's
+     * software path does that without loading an OpenGL driver (under Xvfb
+     * that is Mesa, which SDL_Quit unloads with blocks still held, a leak
+     * the sanitizer build cannot attribute). The environment's
+     * SDL_RENDER_DRIVER and SDL_FRAMEBUFFER_ACCELERATION still override. */
+    SDL_SetHint(SDL_HINT_RENDER_DRIVER, "software");
+    SDL_SetHint(SDL_HINT_FRAMEBUFFER_ACCELERATION, "0");
     if (SDL_Init(SDL_INIT_VIDEO) != 0)
         return cli_fail(RL_CLI_FAIL, "view: cannot open a window: %s", SDL_GetError());
     const char *driver = SDL_GetCurrentVideoDriver();
@@ -1373,8 +1380,6 @@ static int open_window(viewer *v)
     if (!v->win)
         return cli_fail(RL_CLI_FAIL, "view: cannot open a window: %s", SDL_GetError());
     v->ren = SDL_CreateRenderer(v->win, -1, 0);
-    if (!v->ren)
-        v->ren = SDL_CreateRenderer(v->win, -1, SDL_RENDERER_SOFTWARE);
     if (!v->ren)
         return cli_fail(RL_CLI_FAIL, "view: cannot draw into the window: %s", SDL_GetError());
     /* Letterboxed scaling keeps the image's aspect ratio in any window. */

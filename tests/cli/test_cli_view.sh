@@ -146,6 +146,17 @@ read -r m1 m2 < <(python3 "$SSIM" "$TMP/pt.png" "$TMP/ref_pt.png" --mean)
 python3 -c "import sys; sys.exit(0 if abs($m1 - $m2) <= 0.05 * $m2 + 1 else 1)" ||
     fail "pt: the viewer's mean $m1 differs from rl render's $m2 at $SPP spp"
 
+# Interactive (no script): pt accumulates in the window until Ctrl-C, which
+# SDL turns into a quit: exit 0 and the stats written, also with a frame
+# in flight (the quit cancels it).
+run_ok xvfb bash -c "timeout --preserve-status -k 20 -s INT 3 '$RL' view cornell --algo pt --size 64x48 \
+    --stats-out '$TMP/interactive.json'"
+python3 - "$TMP/interactive.json" <<'PY' || fail "the interactive run's stats are wrong: $(cat "$TMP/interactive.json")"
+import json, sys
+s = json.load(open(sys.argv[1]))
+assert not s["scripted"] and s["renderers"][0]["algorithm"] == "pt", s
+PY
+
 # A set in the script that the renderer refuses: exit 2 with FILE:LINE.
 printf '0 set raster.shading=plaid\n0.1 quit\n' >"$TMP/bad_set.txt"
 expect_error 2 "bad_set.txt:1: set raster.shading=plaid" xvfb "$RL" view cornell --size 16x12 --script "$TMP/bad_set.txt"
