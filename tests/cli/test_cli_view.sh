@@ -134,6 +134,10 @@ run_ok "$RL" render "$TMP/path.json" --camera-path --frames 3 --size $SIZE --out
 ssim_ok "$TMP/replay0.png" "$TMP/ref_raster.png"
 ssim_ok "$TMP/replay2.png" "$TMP/rec_last.png"
 ssim_ok "$TMP/replay2.png" "$TMP/ref_moved.png"
+# P plays the saved path in the viewer: at its end, the last key's view.
+printf '0 key p\n0.5 screenshot %s\n' "$TMP/played.png" >"$TMP/play.txt"
+run_ok xvfb "$RL" view "$TMP/path.json" --size $SIZE --script "$TMP/play.txt"
+ssim_ok "$TMP/played.png" "$TMP/ref_moved.png"
 
 # pt accumulates while the camera stands still: the same mean as rl render
 # at the samples the screenshot reports.
