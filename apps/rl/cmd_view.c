@@ -134,6 +134,8 @@ typedef struct shared {
     /* the request */
     uint64_t req_seq;
     rl_camera req_cam;
+    bool req_moved;                /* the request restarted: a camera or renderer change */
+    double req_time_s;             /* when it was made */
     bool quit;
     view_cmd cmds[MAX_CMDS];
     int num_cmds;
@@ -153,6 +155,8 @@ typedef struct shared {
     char front_algo[64];
     double front_spp;
     double front_time_s;           /* when it was published */
+    bool front_moved;              /* its request's */
+    double front_request_s;
 } shared;
 
 /* The worker's own state. */
@@ -163,6 +167,8 @@ typedef struct worker {
     rl_renderer *r;
     rl_image *back;
     int running_gen;
+    bool running_moved;
+    double running_request_s;
     rl_camera last_cam;
     bool have_last;
 } worker;
@@ -191,6 +197,8 @@ static void publish(worker *w, const rl_image *img, const rl_render_stats *stats
     snprintf(sh->front_algo, sizeof sh->front_algo, "%s", rl_renderer_name(w->r));
     sh->front_spp = sh->worker_spp;
     sh->front_time_s = rl_time_s();
+    sh->front_moved = w->running_moved;
+    sh->front_request_s = w->running_request_s;
     SDL_UnlockMutex(sh->lock);
 }
 
@@ -388,6 +396,8 @@ static int worker_main(void *user)
         memcpy(cmds, sh->cmds, (size_t)ncmds * sizeof *cmds);
         sh->num_cmds = 0;
         w->running_gen = SDL_AtomicGet(&sh->gen);
+        w->running_moved = sh->req_moved;
+        w->running_request_s = sh->req_time_s;
         SDL_UnlockMutex(sh->lock);
 
         for (int i = 0; i < ncmds; i++)
@@ -552,8 +562,8 @@ typedef struct viewer {
     int num_final;
     algo_stat stats_by_algo[32];
     int num_stats;
-    double request_s;           /* when the frame in flight was asked for */
-    bool request_moved;
+    bool shown_moved;           /* the shown frame was asked for by a change */
+    double shown_request_s;
     int rc;
 } viewer;
 
@@ -609,10 +619,10 @@ static void request(viewer *v, bool restart)
         SDL_AtomicAdd(&sh->gen, 1);
     sh->req_cam = v->nav.cam;
     sh->req_seq++;
+    sh->req_moved = restart;
+    sh->req_time_s = rl_time_s();
     SDL_CondSignal(sh->wake);
     SDL_UnlockMutex(sh->lock);
-    v->request_s = rl_time_s();
-    v->request_moved = restart;
 }
 
 static void push_cmd(viewer *v, cmd_kind kind, const char *text, int dir, int line)
@@ -1099,6 +1109,8 @@ static bool take_frame(viewer *v)
             v->shown_stats = sh->front_stats;
         snprintf(v->shown_algo, sizeof v->shown_algo, "%s", sh->front_algo);
         v->shown_spp = sh->front_spp;
+        v->shown_moved = sh->front_moved;
+        v->shown_request_s = sh->front_request_s;
     }
     SDL_UnlockMutex(sh->lock);
     if (!fresh)
@@ -1117,9 +1129,9 @@ static bool take_frame(viewer *v)
         }
         if (s) {
             s->frames++;
-            if (v->request_moved) {
+            if (v->shown_moved) {
                 s->moving_frames++;
-                s->moving_s += now - v->request_s;
+                s->moving_s += now - v->shown_request_s;
             }
         }
         if (v->num_final == 32)
