@@ -16,6 +16,8 @@ PACKAGES=(
   libopenmpi-dev openmpi-bin         # distributed runs (src/dist, rl --dist under mpirun)
   libcmocka-dev       # unit tests
   libcairo2-dev       # plots in evaluation reports (SVG, PNG)
+  libsdl2-dev         # rl view: the interactive viewer's window
+  xvfb xauth          # xvfb-run: the viewer's tests without a display
   fonts-dejavu-core   # a font for plot labels
   assimp-testmodels   # real meshes for rl bench rays
   python3             # the JSON checks of the CLI tests

@@ -37,6 +37,7 @@ int cli_demo(int argc, char **argv);
 int cli_bench(int argc, char **argv);
 int cli_eval(int argc, char **argv);
 int cli_compare(int argc, char **argv);
+int cli_view(int argc, char **argv);
 
 /* Loads a plugin and runs its rl_plugin_init() (plugin.c); 0, or the exit
  * code with the error printed. */

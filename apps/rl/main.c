@@ -22,6 +22,7 @@ static const command commands[] = {
     { "renderers", cli_algos, NULL },
     { "info", cli_info, "print statistics and cameras of a scene" },
     { "render", cli_render, "render a scene to PNG or EXR" },
+    { "view", cli_view, "an interactive window on any renderer: fly, switch renderers, record paths" },
     { "demo", cli_demo, "render every built-in scene with every renderer + HTML report" },
     { "eval", cli_eval, "approximate a position-dependent property over a region (heat map, statistics)" },
     { "compare", cli_compare, "compare renderers over a sampled region: time, operations, image quality" },
@@ -171,7 +172,7 @@ int main(int argc, char **argv)
 
     if (n == 0)
         return cli_fail(RL_CLI_USAGE, "no command given (commands: scenes, algos, info, "
-                                         "render, demo, eval, compare, bench; see rl --help)");
+                                         "render, view, demo, eval, compare, bench; see rl --help)");
     const char *name = argv[0];
     if (strcmp(name, "help") == 0 && n > 1) {
         /* "rl help render" is "rl render --help". */
