@@ -82,16 +82,6 @@ typedef struct gl_drawer {
 
 static const float depth_k = 0x1p-40f;   /* window depth = K / w, gl_shaders.c */
 
-static rl_status gl_check(const char *where)
-{
-    GLenum e = glGetError(), first = e;
-    while (e != GL_NO_ERROR)
-        e = glGetError();
-    if (first == GL_NO_ERROR)
-        return RL_OK;
-    return rl_error(first == GL_OUT_OF_MEMORY ? RL_ERR_OUT_OF_MEMORY : RL_ERR_INTERNAL, "gl: GL error 0x%x in %s",
-                    (unsigned)first, where);
-}
 
 static void free_framebuffer(gl_drawer *g)
 {
@@ -433,7 +423,7 @@ static rl_status ensure_framebuffer(gl_drawer *g, int w, int h)
     const GLenum draw[] = { GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1, GL_COLOR_ATTACHMENT2, GL_COLOR_ATTACHMENT3 };
     glNamedFramebufferDrawBuffers(g->fbo, 4, draw);
     GLenum status = glCheckNamedFramebufferStatus(g->fbo, GL_DRAW_FRAMEBUFFER);
-    rl_status st = gl_check("the framebuffer");
+    rl_status st = rl_gl_check("the framebuffer");
     if (st == RL_OK && status != GL_FRAMEBUFFER_COMPLETE)
         st = rl_error(RL_ERR_INTERNAL, "gl: the %d x %d framebuffer is incomplete (0x%x)", w, h, (unsigned)status);
     if (st != RL_OK) {
@@ -550,7 +540,7 @@ static rl_status gl_begin(void *impl, rl_image *target, const rl_mat4 *view, con
     for (GLuint i = 0; i < 8; ++i)
         if (ssbos[i])
             glBindBufferBase(GL_SHADER_STORAGE_BUFFER, i, ssbos[i]);
-    return settle(g, gl_check("rl_drawer_begin"));
+    return settle(g, rl_gl_check("rl_drawer_begin"));
 }
 
 static void gl_light(void *impl, const uint32_t *objects, uint32_t count)
@@ -652,13 +642,13 @@ static rl_status end_counted(gl_drawer *g, rl_raster_counters *c, const char *wh
     glEndQuery(GL_SAMPLES_PASSED);
     if (g->desc.deferred_counts) {
         g->count_to[g->counts_used++] = c;
-        return gl_check(where);
+        return rl_gl_check(where);
     }
     GLuint64 passed = 0;
     glGetQueryObjectui64v(g->query, GL_QUERY_RESULT, &passed);
     if (c)
         c->pixels_written += passed;
-    return gl_check(where);
+    return rl_gl_check(where);
 }
 
 /* The deferred counts of the frame's draws into their counters. */
@@ -746,7 +736,7 @@ static rl_status run_query(gl_drawer *g, const rl_raster_batch *boxes, GLuint q)
     if (n)
         glDrawElements(GL_TRIANGLES, (GLsizei)n, GL_UNSIGNED_INT, NULL);
     glEndQuery(GL_SAMPLES_PASSED);
-    return gl_check("rl_drawer_query_issue");
+    return rl_gl_check("rl_drawer_query_issue");
 }
 
 static rl_status gl_query_issue(void *impl, const rl_raster_batch *boxes, uint32_t slot)
@@ -773,7 +763,7 @@ static rl_status gl_query_poll(void *impl, uint32_t slot, bool *ready)
     GLuint available = GL_FALSE;
     glGetQueryObjectuiv(g->pool[slot], GL_QUERY_RESULT_AVAILABLE, &available);
     *ready = available != GL_FALSE;
-    return settle(g, gl_check("rl_drawer_query_poll"));
+    return settle(g, rl_gl_check("rl_drawer_query_poll"));
 }
 
 static rl_status gl_query_result(void *impl, uint32_t slot, uint64_t *pixels)
@@ -785,7 +775,7 @@ static rl_status gl_query_result(void *impl, uint32_t slot, uint64_t *pixels)
     GLuint64 passed = 0;
     glGetQueryObjectui64v(g->pool[slot], GL_QUERY_RESULT, &passed);
     *pixels = passed;
-    return settle(g, gl_check("rl_drawer_query_result"));
+    return settle(g, rl_gl_check("rl_drawer_query_result"));
 }
 
 /* One point attribute: a stream of count items, or the constant value
@@ -856,7 +846,7 @@ static rl_status gl_end(void *impl)
         glGetTextureImage(g->tex_triangle, 0, GL_RED_INTEGER, GL_UNSIGNED_INT, (GLsizei)(n * sizeof(uint32_t)),
                           t->triangle_id);
     g->target = NULL;
-    st = gl_check("rl_drawer_end");
+    st = rl_gl_check("rl_drawer_end");
     rl_gl_context_done(g->ctx);
     return st;
 }
@@ -919,7 +909,7 @@ rl_status rl_gl_drawer_create(const rl_scene *scene, const rl_drawer_desc *desc,
         glFrontFace(GL_CW);      /* y is negated: see gl_shaders.c */
         glCullFace(GL_BACK);
         glEnable(GL_PROGRAM_POINT_SIZE);
-        st = gl_check("rl_gl_drawer_create");
+        st = rl_gl_check("rl_gl_drawer_create");
     }
     if (st != RL_OK) {
         gl_release(g);

@@ -361,7 +361,18 @@ static const char *const upload_fs = GLSL(
     }
 );
 
-static GLuint compile(GLenum stage, const char *const *parts, int count, const char *what)
+rl_status rl_gl_check(const char *where)
+{
+    GLenum e = glGetError(), first = e;
+    while (e != GL_NO_ERROR)
+        e = glGetError();
+    if (first == GL_NO_ERROR)
+        return RL_OK;
+    return rl_error(first == GL_OUT_OF_MEMORY ? RL_ERR_OUT_OF_MEMORY : RL_ERR_INTERNAL, "gl: GL error 0x%x in %s",
+                    (unsigned)first, where);
+}
+
+GLuint rl_gl_compile(GLenum stage, const char *const *parts, int count, const char *what)
 {
     GLuint s = glCreateShader(stage);
     glShaderSource(s, count, parts, NULL);
@@ -378,20 +389,19 @@ static GLuint compile(GLenum stage, const char *const *parts, int count, const c
     return s;
 }
 
-static GLuint link(const char *const *vs, int nvs, const char *const *fs, int nfs, const char *what)
+GLuint rl_gl_link(GLuint a, GLuint b, const char *what)
 {
-    GLuint v = compile(GL_VERTEX_SHADER, vs, nvs, what);
-    GLuint f = v ? compile(GL_FRAGMENT_SHADER, fs, nfs, what) : 0;
-    if (!f) {
-        glDeleteShader(v);
+    if (!a) {
+        glDeleteShader(b);
         return 0;
     }
     GLuint p = glCreateProgram();
-    glAttachShader(p, v);
-    glAttachShader(p, f);
+    glAttachShader(p, a);
+    if (b)
+        glAttachShader(p, b);
     glLinkProgram(p);
-    glDeleteShader(v);
-    glDeleteShader(f);
+    glDeleteShader(a);
+    glDeleteShader(b);
     GLint ok = 0;
     glGetProgramiv(p, GL_LINK_STATUS, &ok);
     if (!ok) {
@@ -402,6 +412,17 @@ static GLuint link(const char *const *vs, int nvs, const char *const *fs, int nf
         return 0;
     }
     return p;
+}
+
+static GLuint link(const char *const *vs, int nvs, const char *const *fs, int nfs, const char *what)
+{
+    GLuint v = rl_gl_compile(GL_VERTEX_SHADER, vs, nvs, what);
+    GLuint f = v ? rl_gl_compile(GL_FRAGMENT_SHADER, fs, nfs, what) : 0;
+    if (!f) {
+        glDeleteShader(v);
+        return 0;
+    }
+    return rl_gl_link(v, f, what);
 }
 
 GLuint rl_gl_program_triangles(void)

@@ -46,6 +46,16 @@ typedef struct rl_gl_tex_info {
     int32_t width, height, pad;
 } rl_gl_tex_info;
 
+/* The first GL error since the last check, as RL_ERR_INTERNAL (or
+ * RL_ERR_OUT_OF_MEMORY) "gl: GL error 0x.. in WHERE"; clears the rest. */
+rl_status rl_gl_check(const char *where);
+/* A shader of stage from parts[0..count-1] (concatenated); 0 with the
+ * compiler's log in the recorded error. */
+GLuint rl_gl_compile(GLenum stage, const char *const *parts, int count, const char *what);
+/* A program of shaders a and b (b may be 0, as for a compute program),
+ * which it deletes; 0 (also for a == 0) with the linker's log recorded. */
+GLuint rl_gl_link(GLuint a, GLuint b, const char *what);
+
 /* The three programs: triangles (every shading mode, queries), points
  * (surfels) and the depth upload at a frame's begin. Zero on failure, with
  * the compiler's log in the recorded error. */

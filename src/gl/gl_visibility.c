@@ -46,6 +46,8 @@
 
 #include <epoxy/gl.h>
 
+#include "gl/gl_shaders.h"
+
 #define GLSL(...) #__VA_ARGS__ "\n"
 
 /* Pixels per compute invocation, and invocations per work group. */
@@ -191,75 +193,23 @@ struct rl_gl_visibility {
     GLuint fbo, tex_ids, depth_buffer;
 };
 
-static rl_status gl_check(const char *where)
-{
-    GLenum e = glGetError(), first = e;
-    while (e != GL_NO_ERROR)
-        e = glGetError();
-    if (first == GL_NO_ERROR)
-        return RL_OK;
-    return rl_error(first == GL_OUT_OF_MEMORY ? RL_ERR_OUT_OF_MEMORY : RL_ERR_INTERNAL, "gl: GL error 0x%x in %s",
-                    (unsigned)first, where);
-}
-
-static GLuint compile(GLenum stage, const char *const *parts, int count, const char *what)
-{
-    GLuint s = glCreateShader(stage);
-    glShaderSource(s, count, parts, NULL);
-    glCompileShader(s);
-    GLint ok = 0;
-    glGetShaderiv(s, GL_COMPILE_STATUS, &ok);
-    if (!ok) {
-        char log[512] = "";
-        glGetShaderInfoLog(s, sizeof log, NULL, log);
-        rl_error(RL_ERR_INTERNAL, "gl: the %s shader does not compile: %s", what, log);
-        glDeleteShader(s);
-        return 0;
-    }
-    return s;
-}
-
-/* A program of the given stages (0 where absent); 0 with the log recorded. */
-static GLuint link_program(GLuint a, GLuint b, const char *what)
-{
-    if (!a)
-        return 0;
-    GLuint p = glCreateProgram();
-    glAttachShader(p, a);
-    if (b)
-        glAttachShader(p, b);
-    glLinkProgram(p);
-    glDeleteShader(a);
-    glDeleteShader(b);
-    GLint ok = 0;
-    glGetProgramiv(p, GL_LINK_STATUS, &ok);
-    if (!ok) {
-        char log[512] = "";
-        glGetProgramInfoLog(p, sizeof log, NULL, log);
-        rl_error(RL_ERR_INTERNAL, "gl: the %s program does not link: %s", what, log);
-        glDeleteProgram(p);
-        return 0;
-    }
-    return p;
-}
-
 static rl_status make_programs(rl_gl_visibility *v)
 {
     const char *const vs[] = { header, id_vs };
     const char *const fs[] = { header, id_fs };
-    GLuint a = compile(GL_VERTEX_SHADER, vs, 2, "visibility ID");
-    GLuint b = a ? compile(GL_FRAGMENT_SHADER, fs, 2, "visibility ID") : 0;
+    GLuint a = rl_gl_compile(GL_VERTEX_SHADER, vs, 2, "visibility ID");
+    GLuint b = a ? rl_gl_compile(GL_FRAGMENT_SHADER, fs, 2, "visibility ID") : 0;
     if (!b) {
         glDeleteShader(a);
         return RL_ERR_INTERNAL;
     }
-    v->id_prog = link_program(a, b, "visibility ID");
+    v->id_prog = rl_gl_link(a, b, "visibility ID");
     char defines[160];
     snprintf(defines, sizeof defines, "#define GROUP_SIZE %d\n#define RUN_LENGTH %d\n#define NUM_VIEWS %du\n", GROUP,
              RUN, VIEWS);
     const char *const cs[] = { header, defines, count_cs };
-    GLuint c = v->id_prog ? compile(GL_COMPUTE_SHADER, cs, 3, "visibility count") : 0;
-    v->count_prog = c ? link_program(c, 0, "visibility count") : 0;
+    GLuint c = v->id_prog ? rl_gl_compile(GL_COMPUTE_SHADER, cs, 3, "visibility count") : 0;
+    v->count_prog = c ? rl_gl_link(c, 0, "visibility count") : 0;
     if (!v->count_prog)
         return RL_ERR_INTERNAL;
     v->u_view_proj = glGetUniformLocation(v->id_prog, "u_view_proj");
@@ -400,7 +350,7 @@ static rl_status make_framebuffer(rl_gl_visibility *v)
     glNamedFramebufferTextureLayer(v->fbo, GL_COLOR_ATTACHMENT0, v->tex_ids, 0, 0);
     glNamedFramebufferRenderbuffer(v->fbo, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER, v->depth_buffer);
     GLenum status = glCheckNamedFramebufferStatus(v->fbo, GL_DRAW_FRAMEBUFFER);
-    rl_status st = gl_check("the visibility framebuffer");
+    rl_status st = rl_gl_check("the visibility framebuffer");
     if (st == RL_OK && status != GL_FRAMEBUFFER_COMPLETE)
         st = rl_error(RL_ERR_INTERNAL, "gl: the %d² visibility framebuffer is incomplete (0x%x)", r,
                       (unsigned)status);
@@ -445,7 +395,7 @@ rl_status rl_gl_visibility_create(const rl_scene *scene, int resolution, const c
     if (st == RL_OK) {
         glClipControl(GL_LOWER_LEFT, GL_ZERO_TO_ONE);
         glEnable(GL_CLIP_DISTANCE0);
-        st = gl_check("rl_gl_visibility_create");
+        st = rl_gl_check("rl_gl_visibility_create");
     }
     if (st != RL_OK) {
         rl_gl_visibility_release(v);
@@ -536,7 +486,7 @@ static rl_status count_views(rl_gl_visibility *v, const rl_mat4 view_proj[VIEWS]
     glGetNamedBufferSubData(v->ssbo_counts, sizeof counts, (GLsizeiptr)(sizeof *pixels * d->num_objects), pixels);
     for (int i = 0; i < VIEWS; ++i)
         views[i] = (rl_gl_view_counts){ counts[3 * i], counts[3 * i + 1], counts[3 * i + 2] };
-    return gl_check("rl_gl_visibility_count");
+    return rl_gl_check("rl_gl_visibility_count");
 }
 
 rl_status rl_gl_visibility_count(rl_gl_visibility *v, const rl_mat4 view_proj[VIEWS], const uint8_t *const *masks,
@@ -563,7 +513,7 @@ rl_status rl_gl_visibility_read_ids(rl_gl_visibility *v, int view, uint32_t *ids
         const int r = v->resolution;
         glGetTextureSubImage(v->tex_ids, 0, 0, 0, view, r, r, 1, GL_RED_INTEGER, GL_UNSIGNED_INT,
                              (GLsizei)((size_t)r * (size_t)r * sizeof *ids), ids);
-        st = gl_check("rl_gl_visibility_read_ids");
+        st = rl_gl_check("rl_gl_visibility_read_ids");
     }
     rl_gl_context_done(v->ctx);
     return st;
