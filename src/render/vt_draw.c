@@ -95,7 +95,7 @@ static rl_vec4 c4(rl_vec3 c)
 
 /* The texture of the term `layer` on the face when all three vertices see
  * the same one ("defined face", Fig. 3.20), else RL_NONE. */
-static uint32_t defined_texture(const rl_scene_data *d, const vt_vertex *v[3], int layer)
+static uint32_t defined_texture(const rl_scene_data *d, const vt_vertex_sample *v[3], int layer)
 {
     uint32_t t = v[0]->layers[layer].texture;
     if (!texture_at(d, t))
@@ -113,9 +113,9 @@ static uint32_t face_texture(const rl_scene_data *d, const vt_face *f)
 static void fill_face(const vt_run *run, vt_corners *b, size_t i, const vt_face *f, bool offset)
 {
     const rl_scene_data *d = run->data;
-    const vt_vertex *v[3];
+    const vt_vertex_sample *v[3];
     for (int k = 0; k < 3; ++k)
-        v[k] = &run->mesh->verts[f->v[k]];
+        v[k] = &run->mesh->samples[f->v[k]];
     float shift = offset ? run->set->overdraw_f * (float)f->stage : 0.0f;
     uint32_t tex0 = face_texture(d, f);
     uint32_t tex_refl = defined_texture(d, v, RL_TRACE_LAYER_REFLECTION);
@@ -129,18 +129,19 @@ static void fill_face(const vt_run *run, vt_corners *b, size_t i, const vt_face 
     b->tex[3][i] = mode == VT_TEX_SAMPLED ? RL_NONE : tex_refr;
     for (int k = 0; k < 3; ++k) {
         size_t c = 3 * i + (size_t)k;
-        const vt_vertex *x = v[k];
+        const vt_vertex_sample *x = v[k];
+        const vt_vertex *xv = &run->mesh->verts[f->v[k]];
         /* eq. 3.16 */
-        b->pos[c] = shift > 0.0f ? rl_sub(x->p, rl_scale(rl_sub(x->p, run->view.eye), shift)) : x->p;
+        b->pos[c] = shift > 0.0f ? rl_sub(xv->p, rl_scale(rl_sub(xv->p, run->view.eye), shift)) : xv->p;
         b->idx[c] = (uint32_t)c;
         const rl_trace_layer *L = x->layers;
         for (int l = 0; l < NUM_LAYERS; ++l)
             b->uv[l][c] = rl_v2(0.0f, 0.0f);
         if (mode == VT_TEX_SAMPLED) {
-            b->col[0][c] = c4(x->color);
+            b->col[0][c] = c4(x->flat);     /* the textured radiance in this mode */
             continue;
         }
-        b->uv[0][c] = x->uv;
+        b->uv[0][c] = xv->uv;
         b->uv[2][c] = L[RL_TRACE_LAYER_REFLECTION].uv;
         b->uv[3][c] = L[RL_TRACE_LAYER_REFRACTION].uv;
         rl_vec3 refl = tex_refl != RL_NONE ? L[RL_TRACE_LAYER_REFLECTION].diffuse

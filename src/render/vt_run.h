@@ -70,8 +70,8 @@ typedef struct vt_block {
     rl_trace_point point[VT_BLOCK];
     uint64_t key[VT_BLOCK];
     const rl_trace_feelers *cache_in[VT_BLOCK];
-    rl_trace_sample out[VT_BLOCK];
-    uint64_t tree_hash[VT_BLOCK];
+    vt_vertex_sample out[VT_BLOCK];
+    uint64_t rays[VT_BLOCK][RL_RAY_TYPE_COUNT];
     rl_trace_feelers feelers[VT_BLOCK];
     struct vt_block *next;
 } vt_block;

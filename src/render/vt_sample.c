@@ -133,14 +133,22 @@ static void sample_block(vt_run *run, vt_block *b)
     double t0 = (rl_time_s() * 1000.0);
     vt_thread_tally *tally = &run->tally[thread_index()];
     rl_ray_tree tree;
+    rl_trace_sample s;
     for (uint32_t i = 0; i < b->count; ++i) {
         rl_tracer_shade_point(run->tracer, run->view.eye, &b->point[i], b->key[i], b->cache_in[i],
-                              run->set->coherence ? &b->feelers[i] : NULL, &b->out[i],
+                              run->set->coherence ? &b->feelers[i] : NULL, &s,
                               run->want_tree ? &tree : NULL);
-        b->tree_hash[i] = run->want_tree ? rl_ray_tree_hash(&tree) : 0;
-        for (int k = 0; k < RL_RAY_TYPE_COUNT; ++k)
-            tally->rays += b->out[i].rays[k];
-        tally->feelers_reused += b->out[i].feelers_reused;
+        vt_vertex_sample *out = &b->out[i];
+        /* Without deferred textures the criteria see them too. */
+        out->flat = run->set->textures == VT_TEX_SAMPLED ? s.color : s.flat;
+        memcpy(out->layers, s.layers, sizeof out->layers);
+        out->tree_hash = run->want_tree ? rl_ray_tree_hash(&tree) : 0;
+        vt_criteria_prepare(out);
+        for (int k = 0; k < RL_RAY_TYPE_COUNT; ++k) {
+            b->rays[i][k] = s.rays[k];
+            tally->rays += s.rays[k];
+        }
+        tally->feelers_reused += s.feelers_reused;
     }
     tally->busy_ms += (rl_time_s() * 1000.0) - t0;
 }
@@ -210,16 +218,10 @@ void vt_sample_flush(vt_run *run)
         vt_block *b = run->pending;
         run->pending = b->next;
         for (uint32_t i = 0; i < b->count; ++i) {
-            vt_vertex *v = &m->verts[b->vertex[i]];
-            const rl_trace_sample *s = &b->out[i];
-            v->color = s->color;
-            /* Without deferred textures the criteria see them too. */
-            v->flat = run->set->textures == VT_TEX_SAMPLED ? s->color : s->flat;
-            memcpy(v->layers, s->layers, sizeof v->layers);
-            v->tree_hash = b->tree_hash[i];
-            v->state = VT_SAMPLED;
+            m->samples[b->vertex[i]] = b->out[i];
+            m->verts[b->vertex[i]].state = VT_SAMPLED;
             for (int k = 0; k < RL_RAY_TYPE_COUNT; ++k)
-                run->rays[k] += s->rays[k];
+                run->rays[k] += b->rays[i][k];
             run->stats.vertices_sampled++;
             if (run->set->coherence && b->vertex[i] < run->per_vertex_cap)
                 run->feelers[b->vertex[i]] = b->feelers[i];
