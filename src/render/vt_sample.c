@@ -43,7 +43,8 @@ bool vt_feelers_pack(const rl_trace_feelers *f, vt_feeler_pool *pool, vt_feelers
                                                     sizeof *pool->occluder, 256))
         return false;
     *out = (vt_feelers_packed){ (uint32_t)pool->count, (uint8_t)n, f->front, f->complete };
-    memcpy(pool->occluder + pool->count, f->occluder, n * sizeof *f->occluder);
+    if (n)                    /* an empty pool has no array yet */
+        memcpy(pool->occluder + pool->count, f->occluder, n * sizeof *f->occluder);
     pool->count += n;
     return true;
 }
@@ -53,7 +54,8 @@ void vt_feelers_unpack(const vt_feelers_packed *p, const uint32_t *occluder, rl_
     out->count = p->count;
     out->front = p->front;
     out->complete = p->complete;
-    memcpy(out->occluder, occluder + p->first, p->count * sizeof *occluder);
+    if (p->count)
+        memcpy(out->occluder, occluder + p->first, p->count * sizeof *occluder);
 }
 
 void vt_feeler_pool_free(vt_feeler_pool *pool)
