@@ -67,6 +67,10 @@ static const char bench_vt_help[] =
     "  modes       the shading modes +-S +-R +-T (shadow, reflection, transmission\n"
     "              rays on or off) for both renderers: time split, VT against\n"
     "              Whitted in time and rays, samples, SSIM (Fig. 5.9, 5.10)\n"
+    "  forced      forced refinement on and off at tree+hsv/min_edge 1 and at\n"
+    "              hsv/min_edge 14: vertices, forced splits, rays, time, SSIM (Fig. 5.3)\n"
+    "  preview     the preview alone (refinement stopped after the primary\n"
+    "              vertices) at 512, 1024, 2048 square: its time by phase (Fig. 5.12b)\n"
     "  animation   cluster scene camera path with and without temporal coherence\n"
     "\n"
     "options:\n"
@@ -89,10 +93,11 @@ static const char bench_vt_help[] =
     "  rl bench vt --only criteria,quality --size 512x512\n";
 
 /* The static sections (the table scene) come before animation. */
-enum { SEC_CRITERIA, SEC_RESOLUTION, SEC_QUALITY, SEC_THREADS, SEC_VISIBILITY, SEC_MODES, SEC_ANIMATION,
-       SEC_COUNT };
+enum { SEC_CRITERIA, SEC_RESOLUTION, SEC_QUALITY, SEC_THREADS, SEC_VISIBILITY, SEC_MODES, SEC_FORCED,
+       SEC_PREVIEW, SEC_ANIMATION, SEC_COUNT };
 static const char *const section_names[SEC_COUNT] = { "criteria", "resolution", "quality", "threads",
-                                                      "visibility", "modes", "animation" };
+                                                      "visibility", "modes", "forced", "preview",
+                                                      "animation" };
 
 /* The shading modes of Ullmann 2003, Figs. 5.9/5.10, as bits: shadow
  * feelers (S), reflection rays (R), transmission rays (T). */
@@ -1020,6 +1025,156 @@ static rl_status sec_modes(void *ctx, cJSON *sec)
     return st;
 }
 
+/* ------------------------------------------------------------ forced -- */
+
+/* Fig. 5.3: forced refinement (Sec. 3.3.2) on and off. The thesis shows
+ * the fork's shadow found completely with it and broken without it; here
+ * at the default setting and at the coarse equal-quality one, where the
+ * criteria alone leave more to forced refinement. */
+static rl_status sec_forced(void *ctx, cJSON *sec)
+{
+    bvt *b = ctx;
+    static const struct {
+        const char *criteria;
+        double min_edge;
+    } settings[] = { { "tree+hsv", 1 }, { "hsv", 14 } };
+    int w = b->a->width, h = b->a->height;
+    ref_frame *ref = NULL;
+    rl_status st = reference(b, w, h, b->threads, MODE_ALL, &ref);
+    if (st != RL_OK)
+        return st;
+    char size[32];
+    snprintf(size, sizeof size, "%dx%d", w, h);
+    cJSON_AddStringToObject(sec, "scene", table_spec(b));
+    cJSON_AddStringToObject(sec, "size", size);
+    cJSON_AddItemToObject(sec, "whitted", ref_json(ref));
+    cJSON *rows = cJSON_AddArrayToObject(sec, "runs");
+    rl_renderer *r = NULL;
+    rl_image *img = NULL;
+    rl_camera cam = sized(&b->table_cam, w, h);
+    st = make_renderer("vt", b->threads, &r);
+    if (st == RL_OK)
+        st = rl_image_create(w, h, RL_LAYER_COLOR, &img);
+    printf("\nforced refinement (Fig. 5.3): %s %s, whitted %.1f ms\n", table_spec(b), size,
+           ref->stats.time_ms);
+    printf("%-9s %8s %6s %9s %9s %7s %10s %9s  %6s %7s\n", "criteria", "min_edge", "forced", "sampled",
+           "generated", "splits", "rays", "VT ms", "ssimVT", "rmseVT");
+    for (size_t i = 0; st == RL_OK && i < sizeof settings / sizeof settings[0]; i++) {
+        for (int on = 1; st == RL_OK && on >= 0; on--) {
+            timed_frame t;
+            quality q;
+            rl_clear_error();
+            st = rl_renderer_set(r, "criteria", settings[i].criteria);
+            if (st == RL_OK)
+                st = set_int(r, "min_edge", settings[i].min_edge);
+            if (st == RL_OK)
+                st = rl_renderer_set(r, "forced", on ? "true" : "false");
+            if (st == RL_OK)
+                st = render_timed(r, b->table, &cam, img, b->runs, &t);
+            if (st == RL_OK)
+                st = compare(img, ref->image, ref->mask, ref->mask_pixels, &q);
+            if (st != RL_OK)
+                break;
+            cJSON *row = cJSON_CreateObject();
+            cJSON_AddItemToArray(rows, row);
+            cJSON_AddStringToObject(row, "criteria", settings[i].criteria);
+            cJSON_AddNumberToObject(row, "min_edge", settings[i].min_edge);
+            cJSON_AddBoolToObject(row, "forced", on);
+            cJSON_AddNumberToObject(row, "vertices_sampled", (double)t.vt.vertices_sampled);
+            cJSON_AddNumberToObject(row, "vertices_generated", (double)t.vt.vertices_generated);
+            cJSON_AddNumberToObject(row, "splits_forced", (double)t.vt.splits_forced);
+            cJSON_AddItemToObject(row, "rays", rays_json(&t.stats));
+            add_num(row, "time_ms", t.stats.time_ms);
+            add_num(row, "time_ratio_to_whitted", ratio(t.stats.time_ms, ref->stats.time_ms));
+            cJSON_AddItemToObject(row, "quality", quality_json(&q));
+            cJSON_AddItemToObject(row, "vt_stats", vt_stats_json(&t.vt));
+            printf("%-9s %8g %6s %9llu %9llu %7llu %10llu %9.1f  %6.3f %7.4f\n", settings[i].criteria,
+                   settings[i].min_edge, on ? "on" : "off", (unsigned long long)t.vt.vertices_sampled,
+                   (unsigned long long)t.vt.vertices_generated, (unsigned long long)t.vt.splits_forced,
+                   (unsigned long long)rays_total(&t.stats), t.stats.time_ms, q.vt_px.ssim, q.vt_px.rmse);
+            fflush(stdout);
+            note("forced %s %s/%g %s: %.1f ms, %llu vertices generated, SSIM %.3f (VT pixels)",
+                 on ? "on" : "off", settings[i].criteria, settings[i].min_edge, size, t.stats.time_ms,
+                 (unsigned long long)t.vt.vertices_generated, q.vt_px.ssim);
+        }
+    }
+    rl_image_release(img);
+    rl_renderer_release(r);
+    return st;
+}
+
+/* ----------------------------------------------------------- preview -- */
+
+/* Stops the refinement at the preview (stage 0). */
+static bool stop_at_preview(void *user, const rl_image *image, uint32_t stage, bool final)
+{
+    (void)user;
+    (void)image;
+    (void)final;
+    return stage > 0;
+}
+
+/* Fig. 5.12b: the preview (Sec. 3.5.1, the primary vertices sampled and
+ * drawn) alone, by phase, against the resolution. The thesis' preview
+ * takes nearly constant time: its rasterization runs on graphics hardware
+ * and only the read-back of the ID and Z buffers grows with the pixels. */
+static rl_status sec_preview(void *ctx, cJSON *sec)
+{
+    bvt *b = ctx;
+    static const int full_sizes[] = { 512, 1024, 2048 }, quick_sizes[] = { 64, 128 };
+    const int *sizes = b->a->quick ? quick_sizes : full_sizes;
+    int num_sizes = b->a->quick ? 2 : 3;
+    cJSON_AddStringToObject(sec, "scene", table_spec(b));
+    cJSON *rows = cJSON_AddArrayToObject(sec, "runs");
+    printf("\npreview (Fig. 5.12b): %s, refinement stopped after the primary vertices; ms by phase\n",
+           table_spec(b));
+    printf("%-9s %9s %9s %9s %9s %9s %9s %9s\n", "size", "preview", "frame", "visib.", "sampling",
+           "draw", "other", "sampled");
+    rl_status st = RL_OK;
+    for (int i = 0; st == RL_OK && i < num_sizes; i++) {
+        int n = sizes[i];
+        rl_renderer *r = NULL;
+        rl_image *img = NULL;
+        rl_camera cam = sized(&b->table_cam, n, n);
+        timed_frame t;
+        st = make_renderer("vt", b->threads, &r);
+        if (st == RL_OK)
+            st = rl_vt_set_update_callback(r, stop_at_preview, NULL);
+        if (st == RL_OK)
+            st = rl_image_create(n, n, RL_LAYER_COLOR, &img);
+        if (st == RL_OK)
+            st = render_timed(r, b->table, &cam, img, b->runs, &t);
+        rl_image_release(img);
+        rl_renderer_release(r);
+        if (st != RL_OK)
+            break;
+        double other = t.stats.time_ms - t.vt.time_visibility_ms - t.vt.time_sampling_ms -
+                       t.vt.time_refine_ms - t.vt.time_draw_ms;
+        cJSON *row = cJSON_CreateObject();
+        cJSON_AddItemToArray(rows, row);
+        char size[32];
+        snprintf(size, sizeof size, "%dx%d", n, n);
+        cJSON_AddStringToObject(row, "size", size);
+        cJSON_AddNumberToObject(row, "pixels", (double)n * n);
+        add_num(row, "preview_ms", t.vt.time_preview_ms);
+        add_num(row, "frame_ms", t.stats.time_ms);
+        cJSON *split = cJSON_AddObjectToObject(row, "time_split_ms");
+        add_num(split, "visibility", t.vt.time_visibility_ms);
+        add_num(split, "sampling", t.vt.time_sampling_ms);
+        add_num(split, "refine", t.vt.time_refine_ms);
+        add_num(split, "draw", t.vt.time_draw_ms);
+        add_num(split, "other", other);
+        cJSON_AddItemToObject(row, "vt_stats", vt_stats_json(&t.vt));
+        printf("%-9s %9.1f %9.1f %9.1f %9.1f %9.1f %9.1f %9llu\n", size, t.vt.time_preview_ms,
+               t.stats.time_ms, t.vt.time_visibility_ms, t.vt.time_sampling_ms, t.vt.time_draw_ms, other,
+               (unsigned long long)t.vt.vertices_sampled);
+        fflush(stdout);
+        note("preview %s: %.1f ms (visibility %.1f, sampling %.1f, draw %.1f)", size, t.vt.time_preview_ms,
+             t.vt.time_visibility_ms, t.vt.time_sampling_ms, t.vt.time_draw_ms);
+    }
+    return st;
+}
+
 /* --------------------------------------------------------- animation -- */
 
 typedef struct series {
@@ -1400,7 +1555,8 @@ static int run(bvt *b)
     if (!root)
         return cli_fail(RL_CLI_FAIL, "out of memory");
     static const bench_section_fn fns[SEC_COUNT] = { sec_criteria, sec_resolution, sec_quality, sec_threads,
-                                                     sec_visibility, sec_modes, sec_animation };
+                                                     sec_visibility, sec_modes, sec_forced, sec_preview,
+                                                     sec_animation };
     printf("rl bench vt: Vertex Tracing vs Whitted, %d threads, max_depth %s, area_samples %s, "
            "shadows %s\n", b->threads, TRACE_MAX_DEPTH, TRACE_AREA_SAMPLES, TRACE_SHADOWS);
     rc = bench_run_sections("vt", root, section_names, fns, SEC_COUNT, a->sections, b,

@@ -354,15 +354,16 @@ static uint64_t feeler_signature(const rl_tracer_desc *desc)
            (desc->no_transmitted_highlight ? 2u : 0u) ^ (desc->seed << 20);
 }
 
-/* Keeps this frame's feelers for the next one. */
-static rl_status keep_feelers(vt_state *s, const vt_run *run)
+/* Keeps this frame's feelers for the next one (the map takes the frame's
+ * pool of occluders over). */
+static rl_status keep_feelers(vt_state *s, vt_run *run)
 {
     const vt_mesh *m = run->mesh;
     size_t n = 0;
     for (uint32_t v = 0; v < m->num_verts; ++v)
         n += m->verts[v].state == VT_SAMPLED;
     uint64_t *keys = rl_realloc_array(NULL, n ? n : 1, sizeof *keys);
-    rl_trace_feelers *vals = rl_realloc_array(NULL, n ? n : 1, sizeof *vals);
+    vt_feelers_packed *vals = rl_realloc_array(NULL, n ? n : 1, sizeof *vals);
     rl_status st = keys && vals ? RL_OK : RL_ERR_OUT_OF_MEMORY;
     if (st == RL_OK) {
         size_t i = 0;
@@ -372,7 +373,7 @@ static rl_status keep_feelers(vt_state *s, const vt_run *run)
             keys[i] = m->verts[v].key;
             vals[i++] = run->feelers[v];
         }
-        st = vt_feeler_map_rebuild(&s->feelers, keys, vals, n);
+        st = vt_feeler_map_rebuild(&s->feelers, keys, vals, n, &run->feeler_pool);
     }
     free(keys);
     free(vals);
@@ -523,6 +524,7 @@ static rl_status run_frame(vt_run *run, vt_state *s, const vt_settings *set, rl_
     vt_run_free_blocks(run);
     free(run->reason);
     free(run->feelers);
+    vt_feeler_pool_free(&run->feeler_pool);
     return st;
 }
 

@@ -82,12 +82,18 @@ static rl_vec3 display_of(rl_vec3 c)
     return rl_v3(vt_display(c.x), vt_display(c.y), vt_display(c.z));
 }
 
-unsigned vt_criteria_test(const vt_criteria *c, const vt_vertex *a, const vt_vertex *b)
+void vt_criteria_prepare(vt_vertex_sample *sample)
 {
-    unsigned fired = 0;
     /* Sec. 3.5.3: deferred textures are applied by the rasterizer, so only
      * the untextured ("flat") radiance decides where to sample. */
-    rl_vec3 da = display_of(a->flat), db = display_of(b->flat);
+    sample->display = display_of(sample->flat);
+    vt_rgb_to_hsv(sample->display, &sample->h, &sample->s, &sample->v);
+}
+
+unsigned vt_criteria_test(const vt_criteria *c, const vt_vertex_sample *a, const vt_vertex_sample *b)
+{
+    unsigned fired = 0;
+    rl_vec3 da = a->display, db = b->display;
     if (c->bits & VT_CRIT_RGB) {
         /* eq. 3.11: L1 norm of the difference */
         float l1 = fabsf(da.x - db.x) + fabsf(da.y - db.y) + fabsf(da.z - db.z);
@@ -95,18 +101,15 @@ unsigned vt_criteria_test(const vt_criteria *c, const vt_vertex *a, const vt_ver
             fired |= VT_CRIT_RGB;
     }
     if (c->bits & VT_CRIT_HSV) {
-        float ha, sa, va, hb, sb, vb;
-        vt_rgb_to_hsv(da, &ha, &sa, &va);
-        vt_rgb_to_hsv(db, &hb, &sb, &vb);
         bool hue_fires = false;
-        if (sa >= VT_HUE_MIN_SATURATION && sb >= VT_HUE_MIN_SATURATION) {
+        if (a->s >= VT_HUE_MIN_SATURATION && b->s >= VT_HUE_MIN_SATURATION) {
             /* Hue lives on a circle: 0.95 and 0.05 are 0.1 apart. */
-            float dh = fabsf(ha - hb);
+            float dh = fabsf(a->h - b->h);
             if (dh > 0.5f)
                 dh = 1.0f - dh;
             hue_fires = dh > c->eps_h;
         }
-        if (hue_fires || fabsf(sa - sb) > c->eps_s || fabsf(va - vb) > c->eps_v)
+        if (hue_fires || fabsf(a->s - b->s) > c->eps_s || fabsf(a->v - b->v) > c->eps_v)
             fired |= VT_CRIT_HSV;
     }
     if ((c->bits & VT_CRIT_TREE) && a->tree_hash != b->tree_hash)

@@ -49,25 +49,35 @@ void vt_corners_free(vt_corners *b)
     memset(b, 0, sizeof *b);
 }
 
+/* Frees the corner arrays, keeps the face list. */
+static void free_corner_arrays(vt_corners *b)
+{
+    uint32_t *faces = b->faces;
+    size_t faces_cap = b->faces_cap;
+    b->faces = NULL;
+    vt_corners_free(b);
+    b->faces = faces;
+    b->faces_cap = faces_cap;
+}
+
 /* Room for `faces` faces: grows by doubling, never shrinks. */
 static bool reserve_corners(vt_corners *b, size_t faces)
 {
     if (faces <= b->cap)
         return true;
     size_t cap = rl_grow_capacity(b->cap, faces, 1024);
-    vt_corners_free(b);
+    free_corner_arrays(b);
     size_t n = cap * 3;
     bool ok = (b->pos = rl_realloc_array(NULL, n, sizeof *b->pos)) &&
               (b->idx = rl_realloc_array(NULL, n, sizeof *b->idx)) &&
               (b->tri_ids = rl_realloc_array(NULL, cap, sizeof *b->tri_ids)) &&
-              (b->obj_ids = rl_realloc_array(NULL, cap, sizeof *b->obj_ids)) &&
-              (b->faces = rl_realloc_array(NULL, cap, sizeof *b->faces));
+              (b->obj_ids = rl_realloc_array(NULL, cap, sizeof *b->obj_ids));
     for (int l = 0; ok && l < NUM_LAYERS; ++l)
         ok = (b->col[l] = rl_realloc_array(NULL, n, sizeof *b->col[l])) &&
              (b->uv[l] = rl_realloc_array(NULL, n, sizeof *b->uv[l])) &&
              (b->tex[l] = rl_realloc_array(NULL, cap, sizeof *b->tex[l]));
     if (!ok)
-        vt_corners_free(b);
+        free_corner_arrays(b);
     else
         b->cap = cap;
     return ok;
@@ -95,7 +105,7 @@ static rl_vec4 c4(rl_vec3 c)
 
 /* The texture of the term `layer` on the face when all three vertices see
  * the same one ("defined face", Fig. 3.20), else RL_NONE. */
-static uint32_t defined_texture(const rl_scene_data *d, const vt_vertex *v[3], int layer)
+static uint32_t defined_texture(const rl_scene_data *d, const vt_vertex_sample *v[3], int layer)
 {
     uint32_t t = v[0]->layers[layer].texture;
     if (!texture_at(d, t))
@@ -113,9 +123,9 @@ static uint32_t face_texture(const rl_scene_data *d, const vt_face *f)
 static void fill_face(const vt_run *run, vt_corners *b, size_t i, const vt_face *f, bool offset)
 {
     const rl_scene_data *d = run->data;
-    const vt_vertex *v[3];
+    const vt_vertex_sample *v[3];
     for (int k = 0; k < 3; ++k)
-        v[k] = &run->mesh->verts[f->v[k]];
+        v[k] = &run->mesh->samples[f->v[k]];
     float shift = offset ? run->set->overdraw_f * (float)f->stage : 0.0f;
     uint32_t tex0 = face_texture(d, f);
     uint32_t tex_refl = defined_texture(d, v, RL_TRACE_LAYER_REFLECTION);
@@ -129,18 +139,19 @@ static void fill_face(const vt_run *run, vt_corners *b, size_t i, const vt_face 
     b->tex[3][i] = mode == VT_TEX_SAMPLED ? RL_NONE : tex_refr;
     for (int k = 0; k < 3; ++k) {
         size_t c = 3 * i + (size_t)k;
-        const vt_vertex *x = v[k];
+        const vt_vertex_sample *x = v[k];
+        const vt_vertex *xv = &run->mesh->verts[f->v[k]];
         /* eq. 3.16 */
-        b->pos[c] = shift > 0.0f ? rl_sub(x->p, rl_scale(rl_sub(x->p, run->view.eye), shift)) : x->p;
+        b->pos[c] = shift > 0.0f ? rl_sub(xv->p, rl_scale(rl_sub(xv->p, run->view.eye), shift)) : xv->p;
         b->idx[c] = (uint32_t)c;
         const rl_trace_layer *L = x->layers;
         for (int l = 0; l < NUM_LAYERS; ++l)
             b->uv[l][c] = rl_v2(0.0f, 0.0f);
         if (mode == VT_TEX_SAMPLED) {
-            b->col[0][c] = c4(x->color);
+            b->col[0][c] = c4(x->flat);     /* the textured radiance in this mode */
             continue;
         }
-        b->uv[0][c] = x->uv;
+        b->uv[0][c] = xv->uv;
         b->uv[2][c] = L[RL_TRACE_LAYER_REFLECTION].uv;
         b->uv[3][c] = L[RL_TRACE_LAYER_REFRACTION].uv;
         rl_vec3 refl = tex_refl != RL_NONE ? L[RL_TRACE_LAYER_REFLECTION].diffuse
@@ -178,30 +189,28 @@ static bool taken(const vt_run *run, const vt_face *face, bool only_new)
     return (only_new ? face->stage > run->drawn_stage : face->leaf) && drawable(run->mesh, face);
 }
 
-static rl_status draw_faces(vt_run *run, rl_raster *ras, bool only_new, unsigned id_flags)
+/* Faces per draw of a single-pass batch. The corners of a face take 364
+ * bytes (three corners of four layers), and a 1024x1024 frame at min_edge
+ * 1 draws 700,000 faces: a quarter of a GB for one batch, where chunks
+ * need 24 MB. The rasterizer keeps submission order across draws as
+ * within one, so the image is the same. */
+#define DRAW_CHUNK 65536u
+
+/* The corner batch of faces list[0..count) into the rasterizer, in the
+ * texture mode's passes. */
+static rl_status draw_batch(vt_run *run, rl_raster *ras, const uint32_t *list, size_t count, bool offset,
+                            unsigned id_flags)
 {
     const vt_mesh *m = run->mesh;
-    size_t count = 0;
-    for (uint32_t f = 0; f < m->num_faces; ++f)
-        count += taken(run, &m->faces[f], only_new);
-    if (!count)
-        return RL_OK;
     vt_corners *b = run->corners;
     if (!reserve_corners(b, count))
         return RL_ERR_OUT_OF_MEMORY;
-    size_t i = 0;
-    for (uint32_t f = 0; f < m->num_faces; ++f)
-        if (taken(run, &m->faces[f], only_new))
-            b->faces[i++] = f;
     /* Each slot depends only on its face: any thread count gives the same
      * batch. */
-    const bool offset = run->set->progressive == VT_PROG_OVERDRAW;
     const int threads = count >= 4096 ? run->set->threads : 1;
     #pragma omp parallel for num_threads(threads) schedule(static)
     for (int64_t k = 0; k < (int64_t)count; ++k)
-        fill_face(run, b, (size_t)k, &m->faces[b->faces[k]], offset);
-    if (!only_new)
-        run->stats.faces_drawn = count;
+        fill_face(run, b, (size_t)k, &m->faces[list[k]], offset);
 
     rl_raster_batch batch;
     memset(&batch, 0, sizeof batch);
@@ -235,6 +244,35 @@ static rl_status draw_faces(vt_run *run, rl_raster *ras, bool only_new, unsigned
             st = rl_raster_draw(ras, &batch, &run->counters);
         }
     }
+    return st;
+}
+
+static rl_status draw_faces(vt_run *run, rl_raster *ras, bool only_new, unsigned id_flags)
+{
+    const vt_mesh *m = run->mesh;
+    size_t count = 0;
+    for (uint32_t f = 0; f < m->num_faces; ++f)
+        count += taken(run, &m->faces[f], only_new);
+    if (!count)
+        return RL_OK;
+    vt_corners *b = run->corners;
+    if (!rl_reserve((void **)&b->faces, &b->faces_cap, count, sizeof *b->faces, 1024))
+        return RL_ERR_OUT_OF_MEMORY;
+    size_t i = 0;
+    for (uint32_t f = 0; f < m->num_faces; ++f)
+        if (taken(run, &m->faces[f], only_new))
+            b->faces[i++] = f;
+    if (!only_new)
+        run->stats.faces_drawn = count;
+    const bool offset = run->set->progressive == VT_PROG_OVERDRAW;
+    /* Multipass adds passes 2 and 3 where the depth equals pass 1's over
+     * all faces; chunks would let a later chunk's equal-depth face drop an
+     * earlier chunk's sums, so it draws the whole batch at once. */
+    size_t chunk = run->set->textures == VT_TEX_MULTIPASS ? count : DRAW_CHUNK;
+    rl_status st = RL_OK;
+    for (size_t first = 0; st == RL_OK && first < count; first += chunk)
+        st = draw_batch(run, ras, b->faces + first, count - first < chunk ? count - first : chunk, offset,
+                        id_flags);
     return st;
 }
 

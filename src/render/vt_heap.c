@@ -13,22 +13,12 @@
 
 #define VT_HEAP_MAX_ITEMS (1u << 31)
 
-/* Whether element i belongs above element j. */
-static bool above(const vt_heap *h, uint32_t i, uint32_t j)
+/* Whether x belongs above y. */
+static inline bool above(vt_heap_item x, vt_heap_item y)
 {
-    if (h->keys[i] != h->keys[j])
-        return h->keys[i] > h->keys[j];
-    return h->items[i] < h->items[j];
-}
-
-static void swap_at(vt_heap *h, uint32_t i, uint32_t j)
-{
-    uint32_t it = h->items[i];
-    h->items[i] = h->items[j];
-    h->items[j] = it;
-    float k = h->keys[i];
-    h->keys[i] = h->keys[j];
-    h->keys[j] = k;
+    if (x.length != y.length)
+        return x.length > y.length;
+    return x.edge < y.edge;
 }
 
 rl_status vt_heap_push(vt_heap *h, uint32_t edge, float length)
@@ -37,29 +27,28 @@ rl_status vt_heap_push(vt_heap *h, uint32_t edge, float length)
         if (h->cap >= VT_HEAP_MAX_ITEMS)
             return rl_error(RL_ERR_LIMIT, "vt edge list: more than 2^31 edges");
         uint32_t cap = h->cap ? 2 * h->cap : 1024;
-        uint32_t *items = rl_realloc_array(h->items, cap, sizeof *items);
+        vt_heap_item *items = rl_realloc_array(h->items, cap, sizeof *items);
         if (!items)
             return RL_ERR_OUT_OF_MEMORY;
         h->items = items;
-        float *keys = rl_realloc_array(h->keys, cap, sizeof *keys);
-        if (!keys)
-            return RL_ERR_OUT_OF_MEMORY;
-        h->keys = keys;
         h->cap = cap;
     }
     /* A NaN length would break the ordering for every other edge. */
     if (isnan(length))
         length = -INFINITY;
+    vt_heap_item x = { length, edge };
+    /* The order (length, then edge index) is total, so the pops come out
+     * the same whichever way the elements are moved. Moving the hole up
+     * writes each displaced parent once instead of swapping. */
     uint32_t i = h->count++;
-    h->items[i] = edge;
-    h->keys[i] = length;
     while (i > 0) {
         uint32_t parent = (i - 1) / 2;
-        if (!above(h, i, parent))
+        if (!above(x, h->items[parent]))
             break;
-        swap_at(h, i, parent);
+        h->items[i] = h->items[parent];
         i = parent;
     }
+    h->items[i] = x;
     return RL_OK;
 }
 
@@ -68,30 +57,32 @@ bool vt_heap_pop(vt_heap *h, uint32_t *edge, float *length)
     if (h->count == 0)
         return false;
     if (edge)
-        *edge = h->items[0];
+        *edge = h->items[0].edge;
     if (length)
-        *length = h->keys[0];
+        *length = h->items[0].length;
     uint32_t n = --h->count;
-    h->items[0] = h->items[n];
-    h->keys[0] = h->keys[n];
+    if (n == 0)
+        return true;
+    vt_heap_item x = h->items[n];
     uint32_t i = 0;
     for (;;) {
-        uint32_t best = i, l = 2 * i + 1, r = 2 * i + 2;
-        if (l < n && above(h, l, best))
-            best = l;
-        if (r < n && above(h, r, best))
-            best = r;
-        if (best == i)
+        uint32_t best = 2 * i + 1;
+        if (best >= n)
             break;
-        swap_at(h, i, best);
+        if (best + 1 < n && above(h->items[best + 1], h->items[best]))
+            ++best;
+        if (!above(h->items[best], x))
+            break;
+        h->items[i] = h->items[best];
         i = best;
     }
+    h->items[i] = x;
     return true;
 }
 
 float vt_heap_top(const vt_heap *h)
 {
-    return h->count ? h->keys[0] : -INFINITY;
+    return h->count ? h->items[0].length : -INFINITY;
 }
 
 void vt_heap_clear(vt_heap *h)
@@ -104,8 +95,6 @@ void vt_heap_free(vt_heap *h)
     if (!h)
         return;
     free(h->items);
-    free(h->keys);
     h->items = NULL;
-    h->keys = NULL;
     h->count = h->cap = 0;
 }

@@ -38,13 +38,12 @@ enum vt_vertex_state {
     VT_SAMPLED,               /* sample fields valid */
 };
 
+/* A vertex as the refinement sees it. The fields it reads for every edge
+ * and face it touches come first, and the sample (vt_vertex_sample) lives
+ * in an array of its own: the refinement walks the mesh in no particular
+ * order, and a 72-byte vertex keeps three times as many of them in the
+ * cache as one with its 140-byte sample inside. */
 typedef struct vt_vertex {
-    rl_vec3 p;                /* world position (eq. 3.7: edge midpoint) */
-    rl_vec3 n;                /* unit shading normal (eq. 3.8) */
-    rl_vec2 uv;               /* interpolated like p */
-    uint32_t triangle;        /* scene triangle the vertex lies on */
-    uint32_t object;          /* scene object */
-    uint64_t key;             /* identity across frames: see vt_vertex_key */
     /* screen, filled by vt_project_vertex */
     float sx, sy;             /* pixel coordinates (x right, y down, pixel
                                * centres at +0.5); 0 when cw <= 0 */
@@ -53,12 +52,27 @@ typedef struct vt_vertex {
     uint8_t state;            /* vt_vertex_state */
     uint8_t visible;          /* z-buffer test passed (Sec. 3.4.2) */
     uint16_t stage;           /* refinement stage that created it (0 = primary) */
-    /* sample (state == VT_SAMPLED) */
-    rl_vec3 color;            /* radiance, textures applied */
-    rl_vec3 flat;             /* radiance with deferred textures white */
+    uint32_t triangle;        /* scene triangle the vertex lies on */
+    uint32_t object;          /* scene object */
+    uint64_t key;             /* identity across frames: see vt_vertex_key */
+    rl_vec3 p;                /* world position (eq. 3.7: edge midpoint) */
+    rl_vec3 n;                /* unit shading normal (eq. 3.8) */
+    rl_vec2 uv;               /* interpolated like p */
+} vt_vertex;
+
+/* The sample of a vertex, valid once its state is VT_SAMPLED: what the
+ * criteria compare (flat, tree_hash) and what the reconstruction draws. */
+typedef struct vt_vertex_sample {
+    rl_vec3 flat;             /* radiance with deferred textures white; with
+                               * textures=sampled the textured radiance */
+    /* flat as the criteria see it (vt_criteria_prepare): display values
+     * and their HSV, computed once by the thread that sampled the vertex
+     * instead of once per edge test on the refining thread */
+    rl_vec3 display;
+    float h, s, v;
     rl_trace_layer layers[RL_TRACE_LAYER_COUNT];
     uint64_t tree_hash;       /* rl_ray_tree_hash of its ray tree */
-} vt_vertex;
+} vt_vertex_sample;
 
 typedef struct vt_edge {
     uint32_t v[2];            /* end vertices */
@@ -83,10 +97,13 @@ typedef struct vt_face {
     uint16_t stage;           /* stage that created it (overdraw offset k, Sec. 3.5.1) */
     uint8_t leaf;             /* not split (drawn) */
     uint8_t visible;          /* its primary ancestor passed the ID-buffer test */
+    float height;             /* vt_face_height_px once vt_face_height asked
+                               * for it this frame, else negative */
 } vt_face;
 
 typedef struct vt_mesh {
     vt_vertex *verts;  uint32_t num_verts, cap_verts;
+    vt_vertex_sample *samples;  uint32_t cap_samples;   /* per vertex, like verts */
     vt_edge *edges;    uint32_t num_edges, cap_edges;
     vt_face *faces;    uint32_t num_faces, cap_faces;
     uint32_t num_primary_verts, num_primary_edges, num_primary_faces;
@@ -140,6 +157,11 @@ float vt_face_xi(const vt_mesh *m, uint32_t f, int i);
  * face's length, unlike xi (a 100-pixel sliver 2 pixels wide has xi
  * 0.9996). */
 float vt_face_height_px(const vt_mesh *m, uint32_t f);
+/* vt_face_height_px, computed once per face and frame: the refinement asks
+ * it of a face for each of its edges it tests, and each time it would load
+ * three vertices from all over the mesh. Valid once the face's vertices
+ * are projected; they are not projected again within a frame. */
+float vt_face_height(vt_mesh *m, uint32_t f);
 
 /* ------------------------------------------------------------ criteria -- */
 
@@ -159,12 +181,14 @@ typedef struct vt_criteria {
 /* Parses "rgb", "hsv", "tree", "tree+rgb", "tree+hsv" (also "rgb+tree",
  * "hsv+tree", and "rgb+hsv"); false for anything else. */
 bool vt_criteria_parse(const char *text, unsigned *bits);
-/* The criteria that fire for the samples a and b (both VT_SAMPLED), as
+/* Fills display, h, s and v of a sample from its flat colour. */
+void vt_criteria_prepare(vt_vertex_sample *sample);
+/* The criteria that fire for the samples a and b (prepared), as
  * vt_criterion_bits; 0 = interpolation along the edge is acceptable.
  * Colours compared are the vertices' flat colours (deferred textures left
  * out, Sec. 3.5.3). HSV: hue is ignored when either saturation is below
  * 1e-3 (it is undefined for greys); the hue difference wraps around. */
-unsigned vt_criteria_test(const vt_criteria *c, const vt_vertex *a, const vt_vertex *b);
+unsigned vt_criteria_test(const vt_criteria *c, const vt_vertex_sample *a, const vt_vertex_sample *b);
 /* sRGB display value of one linear channel, clamped to [0, 1]. */
 float vt_display(float linear);
 /* HSV of a display-space colour: h in [0, 1), s, v in [0, 1]. */
@@ -209,9 +233,14 @@ float vt_edge_length(const vt_view *view, const vt_vertex *a, const vt_vertex *b
  * first, so the order is fully deterministic. (The thesis uses a binary tree
  * with a linked list through it, Fig. 4.10; a heap has the same O(log n)
  * insertion and gives the longest edge in O(1).) */
+typedef struct vt_heap_item {
+    float length;
+    uint32_t edge;
+} vt_heap_item;
+
+/* Key and edge side by side: a sift step reads one cache line, not two. */
 typedef struct vt_heap {
-    uint32_t *items;
-    float *keys;
+    vt_heap_item *items;
     uint32_t count, cap;
 } vt_heap;
 

@@ -82,6 +82,9 @@ static rl_status reserve(vt_mesh *m, uint32_t verts, uint32_t edges, uint32_t fa
     rl_status st = grow((void **)&m->verts, &m->cap_verts, m->num_verts + verts, sizeof *m->verts,
                         "vertices");
     if (st == RL_OK)
+        st = grow((void **)&m->samples, &m->cap_samples, m->num_verts + verts, sizeof *m->samples,
+                  "vertices");
+    if (st == RL_OK)
         st = grow((void **)&m->edges, &m->cap_edges, m->num_edges + edges, sizeof *m->edges, "edges");
     if (st == RL_OK)
         st = grow((void **)&m->faces, &m->cap_faces, m->num_faces + faces, sizeof *m->faces, "faces");
@@ -255,6 +258,7 @@ static rl_status build_object(vt_mesh *m, const rl_scene_data *d, uint32_t o, bu
         f->object = o;
         f->parent = VT_NONE;
         f->leaf = 1;
+        f->height = -1.0f;
         for (int i = 0; i < 3; ++i)
             f->e[i] = pair_edge(m, s, edge_size - 1, fv[(i + 1) % 3], fv[(i + 2) % 3], fi);
     }
@@ -307,6 +311,7 @@ void vt_mesh_free(vt_mesh *m)
     if (!m)
         return;
     free(m->verts);
+    free(m->samples);
     free(m->edges);
     free(m->faces);
     memset(m, 0, sizeof *m);
@@ -330,6 +335,7 @@ void vt_mesh_reset(vt_mesh *m)
     for (uint32_t i = 0; i < m->num_primary_faces; ++i) {
         m->faces[i].leaf = 1;
         m->faces[i].visible = 0;
+        m->faces[i].height = -1.0f;
     }
     for (uint32_t i = 0; i < m->num_primary_verts; ++i) {
         m->verts[i].state = VT_UNSAMPLED;
@@ -365,6 +371,7 @@ static uint32_t add_face(vt_mesh *m, const vt_face *parent, uint32_t parent_inde
     f->stage = stage;
     f->leaf = 1;
     f->visible = parent->visible;
+    f->height = -1.0f;
     return fi;
 }
 
@@ -464,6 +471,18 @@ float vt_face_xi(const vt_mesh *m, uint32_t f, int i)
     return a + b > 0.0 ? (float)(c / (a + b)) : 0.0f;
 }
 
+static double side2_px(const vt_vertex *a, const vt_vertex *b)
+{
+    double dx = (double)a->sx - b->sx, dy = (double)a->sy - b->sy;
+    return dx * dx + dy * dy;
+}
+
+/* fmax without the library call it compiles to here. */
+static inline double max_d(double a, double b)
+{
+    return a > b || b != b ? a : b;
+}
+
 float vt_face_height_px(const vt_mesh *m, uint32_t f)
 {
     const uint32_t *v = m->faces[f].v;
@@ -471,6 +490,17 @@ float vt_face_height_px(const vt_mesh *m, uint32_t f)
     double ux = (double)b->sx - a->sx, uy = (double)b->sy - a->sy;
     double wx = (double)c->sx - a->sx, wy = (double)c->sy - a->sy;
     double twice_area = fabs(ux * wy - uy * wx);
-    double longest = fmax(side_px(m, v[0], v[1]), fmax(side_px(m, v[1], v[2]), side_px(m, v[2], v[0])));
+    /* One root instead of three: the refinement asks this of every face it
+     * tests or creates, and sqrt is monotonic, so the root of the largest
+     * square is exactly the largest root. */
+    double longest = sqrt(max_d(side2_px(a, b), max_d(side2_px(b, c), side2_px(c, a))));
     return longest > 0.0 ? (float)(twice_area / longest) : 0.0f;
+}
+
+float vt_face_height(vt_mesh *m, uint32_t f)
+{
+    vt_face *face = &m->faces[f];
+    if (face->height < 0.0f)
+        face->height = vt_face_height_px(m, f);
+    return face->height;
 }

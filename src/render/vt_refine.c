@@ -161,7 +161,7 @@ static void check_forced(refine_ctx *ctx, uint32_t f, uint32_t mid)
     const vt_edge *be = &m->edges[base];
     if (be->mid != VT_NONE)
         return;
-    if (!(vt_face_xi(m, f, slot) > run->set->eps_z) || !(vt_face_height_px(m, f) > FLAT_HEIGHT_PX))
+    if (!(vt_face_xi(m, f, slot) > run->set->eps_z) || !(vt_face_height(m, f) > FLAT_HEIGHT_PX))
         return;
     if (!rl_reserve_u32((void **)&ctx->forced, &ctx->forced_cap, (uint64_t)ctx->forced_count + 1, sizeof *ctx->forced, 1024)) {
         run->failed = true;
@@ -231,10 +231,10 @@ static void run_forced(refine_ctx *ctx, uint16_t stage)
 
 /* Sec. 3.3.2: refining where no adjacent face has projected area cannot
  * help and need not stop (the endless recursion of A -> 0). */
-static bool has_area(const vt_mesh *m, const vt_edge *ed)
+static bool has_area(vt_mesh *m, const vt_edge *ed)
 {
     for (int k = 0; k < 2; ++k)
-        if (ed->face[k] != VT_NONE && vt_face_height_px(m, ed->face[k]) > FLAT_HEIGHT_PX)
+        if (ed->face[k] != VT_NONE && vt_face_height(m, ed->face[k]) > FLAT_HEIGHT_PX)
             return true;
     return false;
 }
@@ -273,7 +273,7 @@ static void run_stage(refine_ctx *ctx, uint16_t stage)
             continue;                       /* cannot happen: queued when pushed */
         if (!has_area(m, ed))
             continue;
-        unsigned bits = vt_criteria_test(&run->set->criteria, a, b);
+        unsigned bits = vt_criteria_test(&run->set->criteria, &m->samples[ed->v[0]], &m->samples[ed->v[1]]);
         run->stats.edges_tested++;
         if (!bits)
             continue;

@@ -45,18 +45,44 @@ typedef struct vt_settings {
     int overlay;              /* VT_OVERLAY_* */
 } vt_settings;
 
+/* Depth-0 shadow feelers of one vertex, packed: rl_trace_feelers has room
+ * for 64 occluders (264 bytes) where a vertex under two point lights
+ * records two, and a frame at min_edge 1 keeps them for 360,000 vertices
+ * three times over (this frame's, the map of the last, the rebuild). The
+ * occluders live in a pool; this says where. */
+typedef struct vt_feelers_packed {
+    uint32_t first;           /* index of the first occluder in the pool */
+    uint8_t count;            /* <= RL_TRACE_FEELER_CACHE_MAX */
+    uint8_t front, complete;  /* as rl_trace_feelers */
+} vt_feelers_packed;
+
+typedef struct vt_feeler_pool {
+    uint32_t *occluder;
+    size_t count, cap;
+} vt_feeler_pool;
+
+/* Appends the occluders of f to pool and describes them in *out; false
+ * when out of memory or past 2^32 occluders. */
+bool vt_feelers_pack(const rl_trace_feelers *f, vt_feeler_pool *pool, vt_feelers_packed *out);
+/* The rl_trace_feelers that p describes (occluders past count untouched). */
+void vt_feelers_unpack(const vt_feelers_packed *p, const uint32_t *occluder, rl_trace_feelers *out);
+void vt_feeler_pool_free(vt_feeler_pool *pool);
+
 /* Temporal coherence: depth-0 shadow feelers by vertex key, from the last
  * frame. Open addressing; read-only while a frame samples. */
 typedef struct vt_feeler_map {
     uint64_t *keys;           /* 0 = empty slot (keys are never 0, see vt_key_nonzero) */
-    rl_trace_feelers *values;
+    vt_feelers_packed *values;
+    vt_feeler_pool pool;      /* the occluders the values point into */
     size_t cap, count;        /* cap a power of two */
 } vt_feeler_map;
 
-const rl_trace_feelers *vt_feeler_map_find(const vt_feeler_map *m, uint64_t key);
-/* Replaces the map's contents with the entries (keys[i], values[i]). */
-rl_status vt_feeler_map_rebuild(vt_feeler_map *m, const uint64_t *keys, const rl_trace_feelers *values,
-                                size_t count);
+const vt_feelers_packed *vt_feeler_map_find(const vt_feeler_map *m, uint64_t key);
+/* Replaces the map's contents with the entries (keys[i], values[i]),
+ * whose occluders are in pool; the map takes pool's arrays over and leaves
+ * it empty. */
+rl_status vt_feeler_map_rebuild(vt_feeler_map *m, const uint64_t *keys, const vt_feelers_packed *values,
+                                size_t count, vt_feeler_pool *pool);
 void vt_feeler_map_free(vt_feeler_map *m);
 static inline uint64_t vt_key_nonzero(uint64_t key) { return key ? key : 0x9E3779B97F4A7C15ull; }
 
@@ -69,10 +95,12 @@ typedef struct vt_block {
     uint32_t vertex[VT_BLOCK];
     rl_trace_point point[VT_BLOCK];
     uint64_t key[VT_BLOCK];
-    const rl_trace_feelers *cache_in[VT_BLOCK];
-    rl_trace_sample out[VT_BLOCK];
-    uint64_t tree_hash[VT_BLOCK];
-    rl_trace_feelers feelers[VT_BLOCK];
+    const vt_feelers_packed *cache_in[VT_BLOCK];   /* into run->cache */
+    vt_vertex_sample out[VT_BLOCK];
+    uint64_t rays[VT_BLOCK][RL_RAY_TYPE_COUNT];
+    vt_feelers_packed feelers[VT_BLOCK];           /* coherence: the new ones, */
+    vt_feeler_pool feeler_pool;                    /* ... their occluders */
+    bool failed;              /* out of memory in the sampling thread */
     struct vt_block *next;
 } vt_block;
 
@@ -89,14 +117,15 @@ typedef struct vt_thread_tally {
  * and only grown, so that a frame does not fault in fresh pages. */
 #define VT_NUM_LAYERS 4
 typedef struct vt_corners {
-    size_t cap;               /* faces the arrays hold */
+    size_t cap;               /* faces the corner arrays hold (one chunk) */
     rl_vec3 *pos;
     rl_vec4 *col[VT_NUM_LAYERS];
     rl_vec2 *uv[VT_NUM_LAYERS];
     uint32_t *tex[VT_NUM_LAYERS];    /* per face */
     uint32_t *idx;
     uint32_t *tri_ids, *obj_ids;     /* per face */
-    uint32_t *faces;          /* mesh face of each slot */
+    uint32_t *faces;          /* the faces to draw, all chunks */
+    size_t faces_cap;
 } vt_corners;
 void vt_corners_free(vt_corners *b);
 
@@ -124,7 +153,8 @@ typedef struct vt_run {
     rl_mat4 view_m, proj_m;   /* the rasterizer's matrices for this camera */
     /* per vertex, grown by the primary thread alongside mesh->verts */
     uint8_t *reason;
-    rl_trace_feelers *feelers;/* coherence only: this frame's feelers */
+    vt_feelers_packed *feelers;   /* coherence only: this frame's feelers, */
+    vt_feeler_pool feeler_pool;   /* ... and their occluders */
     uint32_t per_vertex_cap;
     bool want_tree;           /* the ray-tree criterion is on */
     /* temporal coherence */

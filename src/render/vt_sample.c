@@ -36,7 +36,35 @@ static size_t slot_of(uint64_t key, size_t cap)
     return (size_t)(rl_hash64(key) & (uint64_t)(cap - 1));
 }
 
-const rl_trace_feelers *vt_feeler_map_find(const vt_feeler_map *m, uint64_t key)
+bool vt_feelers_pack(const rl_trace_feelers *f, vt_feeler_pool *pool, vt_feelers_packed *out)
+{
+    uint32_t n = f->count < RL_TRACE_FEELER_CACHE_MAX ? f->count : RL_TRACE_FEELER_CACHE_MAX;
+    if (pool->count + n > UINT32_MAX || !rl_reserve((void **)&pool->occluder, &pool->cap, pool->count + n,
+                                                    sizeof *pool->occluder, 256))
+        return false;
+    *out = (vt_feelers_packed){ (uint32_t)pool->count, (uint8_t)n, f->front, f->complete };
+    if (n)                    /* an empty pool has no array yet */
+        memcpy(pool->occluder + pool->count, f->occluder, n * sizeof *f->occluder);
+    pool->count += n;
+    return true;
+}
+
+void vt_feelers_unpack(const vt_feelers_packed *p, const uint32_t *occluder, rl_trace_feelers *out)
+{
+    out->count = p->count;
+    out->front = p->front;
+    out->complete = p->complete;
+    if (p->count)
+        memcpy(out->occluder, occluder + p->first, p->count * sizeof *occluder);
+}
+
+void vt_feeler_pool_free(vt_feeler_pool *pool)
+{
+    free(pool->occluder);
+    memset(pool, 0, sizeof *pool);
+}
+
+const vt_feelers_packed *vt_feeler_map_find(const vt_feeler_map *m, uint64_t key)
 {
     if (!m || !m->cap)
         return NULL;
@@ -49,15 +77,15 @@ const rl_trace_feelers *vt_feeler_map_find(const vt_feeler_map *m, uint64_t key)
     }
 }
 
-rl_status vt_feeler_map_rebuild(vt_feeler_map *m, const uint64_t *keys, const rl_trace_feelers *values,
-                                size_t count)
+rl_status vt_feeler_map_rebuild(vt_feeler_map *m, const uint64_t *keys, const vt_feelers_packed *values,
+                                size_t count, vt_feeler_pool *pool)
 {
     size_t cap = 64;
     while (cap < 2 * count)                 /* load factor <= 1/2 */
         cap *= 2;
     if (cap != m->cap) {
         uint64_t *k = rl_calloc(cap, sizeof *k);
-        rl_trace_feelers *v = rl_realloc_array(NULL, cap, sizeof *v);
+        vt_feelers_packed *v = rl_realloc_array(NULL, cap, sizeof *v);
         if (!k || !v) {
             free(k);
             free(v);
@@ -70,6 +98,9 @@ rl_status vt_feeler_map_rebuild(vt_feeler_map *m, const uint64_t *keys, const rl
     } else {
         memset(m->keys, 0, cap * sizeof *m->keys);
     }
+    vt_feeler_pool_free(&m->pool);
+    m->pool = *pool;
+    memset(pool, 0, sizeof *pool);
     m->count = 0;
     for (size_t n = 0; n < count; ++n) {
         uint64_t key = vt_key_nonzero(keys[n]);
@@ -88,6 +119,7 @@ void vt_feeler_map_free(vt_feeler_map *m)
 {
     free(m->keys);
     free(m->values);
+    vt_feeler_pool_free(&m->pool);
     memset(m, 0, sizeof *m);
 }
 
@@ -106,7 +138,7 @@ rl_status vt_run_reserve(vt_run *run)
         return RL_ERR_OUT_OF_MEMORY;
     run->reason = reason;
     if (run->set->coherence) {
-        rl_trace_feelers *f = rl_realloc_array(run->feelers, cap, sizeof *f);
+        vt_feelers_packed *f = rl_realloc_array(run->feelers, cap, sizeof *f);
         if (!f)
             return RL_ERR_OUT_OF_MEMORY;
         run->feelers = f;
@@ -133,14 +165,29 @@ static void sample_block(vt_run *run, vt_block *b)
     double t0 = (rl_time_s() * 1000.0);
     vt_thread_tally *tally = &run->tally[thread_index()];
     rl_ray_tree tree;
+    rl_trace_sample s;
+    rl_trace_feelers in, out_feelers;
+    memset(&in, 0, sizeof in);
+    b->feeler_pool.count = 0;
+    b->failed = false;
     for (uint32_t i = 0; i < b->count; ++i) {
-        rl_tracer_shade_point(run->tracer, run->view.eye, &b->point[i], b->key[i], b->cache_in[i],
-                              run->set->coherence ? &b->feelers[i] : NULL, &b->out[i],
-                              run->want_tree ? &tree : NULL);
-        b->tree_hash[i] = run->want_tree ? rl_ray_tree_hash(&tree) : 0;
-        for (int k = 0; k < RL_RAY_TYPE_COUNT; ++k)
-            tally->rays += b->out[i].rays[k];
-        tally->feelers_reused += b->out[i].feelers_reused;
+        if (b->cache_in[i])
+            vt_feelers_unpack(b->cache_in[i], run->cache->pool.occluder, &in);
+        rl_tracer_shade_point(run->tracer, run->view.eye, &b->point[i], b->key[i], b->cache_in[i] ? &in : NULL,
+                              run->set->coherence ? &out_feelers : NULL, &s, run->want_tree ? &tree : NULL);
+        if (run->set->coherence && !vt_feelers_pack(&out_feelers, &b->feeler_pool, &b->feelers[i]))
+            b->failed = true;
+        vt_vertex_sample *out = &b->out[i];
+        /* Without deferred textures the criteria see them too. */
+        out->flat = run->set->textures == VT_TEX_SAMPLED ? s.color : s.flat;
+        memcpy(out->layers, s.layers, sizeof out->layers);
+        out->tree_hash = run->want_tree ? rl_ray_tree_hash(&tree) : 0;
+        vt_criteria_prepare(out);
+        for (int k = 0; k < RL_RAY_TYPE_COUNT; ++k) {
+            b->rays[i][k] = s.rays[k];
+            tally->rays += s.rays[k];
+        }
+        tally->feelers_reused += s.feelers_reused;
     }
     tally->busy_ms += (rl_time_s() * 1000.0) - t0;
 }
@@ -157,6 +204,8 @@ static vt_block *take_block(vt_run *run)
         run->free_blocks = b->next;
     else if (!(b = malloc(sizeof *b)))
         return NULL;
+    else
+        memset(&b->feeler_pool, 0, sizeof b->feeler_pool);
     b->count = 0;
     b->next = NULL;
     return b;
@@ -210,20 +259,21 @@ void vt_sample_flush(vt_run *run)
         vt_block *b = run->pending;
         run->pending = b->next;
         for (uint32_t i = 0; i < b->count; ++i) {
-            vt_vertex *v = &m->verts[b->vertex[i]];
-            const rl_trace_sample *s = &b->out[i];
-            v->color = s->color;
-            /* Without deferred textures the criteria see them too. */
-            v->flat = run->set->textures == VT_TEX_SAMPLED ? s->color : s->flat;
-            memcpy(v->layers, s->layers, sizeof v->layers);
-            v->tree_hash = b->tree_hash[i];
-            v->state = VT_SAMPLED;
+            m->samples[b->vertex[i]] = b->out[i];
+            m->verts[b->vertex[i]].state = VT_SAMPLED;
             for (int k = 0; k < RL_RAY_TYPE_COUNT; ++k)
-                run->rays[k] += s->rays[k];
+                run->rays[k] += b->rays[i][k];
             run->stats.vertices_sampled++;
-            if (run->set->coherence && b->vertex[i] < run->per_vertex_cap)
-                run->feelers[b->vertex[i]] = b->feelers[i];
+            if (run->set->coherence && !b->failed && b->vertex[i] < run->per_vertex_cap) {
+                /* Into the frame's pool: the block's is reused by its next
+                 * stage. */
+                rl_trace_feelers f;
+                vt_feelers_unpack(&b->feelers[i], b->feeler_pool.occluder, &f);
+                if (!vt_feelers_pack(&f, &run->feeler_pool, &run->feelers[b->vertex[i]]))
+                    run->failed = true;
+            }
         }
+        run->failed |= b->failed;
         b->next = run->free_blocks;
         run->free_blocks = b;
     }
@@ -235,6 +285,7 @@ void vt_run_free_blocks(vt_run *run)
     for (int l = 0; l < 3; ++l) {
         while (lists[l]) {
             vt_block *next = lists[l]->next;
+            vt_feeler_pool_free(&lists[l]->feeler_pool);
             free(lists[l]);
             lists[l] = next;
         }

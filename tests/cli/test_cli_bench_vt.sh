@@ -26,7 +26,7 @@ expect_in "$TMP/err" "rl: error: "
 
 # Help, and the bench dispatcher knows vt.
 expect_exit 0 "$RL" bench vt --help
-for o in --size --anim-size --frames --threads --only --out --quick criteria modes animation; do
+for o in --size --anim-size --frames --threads --only --out --quick criteria modes forced preview animation; do
     expect_in "$TMP/out" "$o"
 done
 expect_error 2 "known: rays, vt, pt" "$RL" bench nosuch
@@ -34,7 +34,7 @@ expect_error 2 "known: rays, vt, pt" "$RL" bench nosuch
 # The quick run: every section, a table on stdout, JSON where --out says.
 expect_exit 0 "$RL" bench vt --quick --out "$TMP/vt.json"
 [ -s "$TMP/vt.json" ] || fail "vt.json was not written"
-for s in criteria resolution quality threads visibility modes animation tree+hsv min_edge +S-R-T; do
+for s in criteria resolution quality threads visibility modes forced preview animation tree+hsv min_edge +S-R-T; do
     expect_in "$TMP/out" "$s"
 done
 expect_in "$TMP/err" "bench vt: wrote"
@@ -61,7 +61,8 @@ def quality_ok(q):
     # The table's VT objects are in view: the VT pixels are measured.
     assert q["vt_pixels"]["pixels"] > 0 and q["vt_pixels"]["ssim"] is not None, q
 
-for name in ("criteria", "resolution", "quality", "threads", "visibility", "modes", "animation"):
+for name in ("criteria", "resolution", "quality", "threads", "visibility", "modes", "forced", "preview",
+             "animation"):
     assert name in r, "missing section " + name
     assert r[name]["status"] == "ok", "%s: %s" % (name, r[name].get("reason"))
 
@@ -129,6 +130,29 @@ for x in m:
     assert x["time_ms"] > 0 and x["whitted_over_vt_time"] > 0 and x["samples_percent_of_pixels"] > 0, x
     quality_ok(x["quality"])
 assert m[0]["thesis_whitted_over_vt_time"] == 6.8 and m[3]["thesis_whitted_over_vt_time"] == 86
+
+# Fig. 5.3: forced refinement off makes no forced splits and never more
+# vertices than on, at each setting; on, it splits some edges.
+f = r["forced"]["runs"]
+assert [(x["criteria"], x["min_edge"], x["forced"]) for x in f] == \
+    [("tree+hsv", 1, True), ("tree+hsv", 1, False), ("hsv", 14, True), ("hsv", 14, False)], f
+for on, off in ((f[0], f[1]), (f[2], f[3])):
+    assert off["splits_forced"] == 0 and off["vt_stats"]["splits_forced"] == 0, off
+    assert off["vertices_generated"] <= on["vertices_generated"], (on, off)
+    for x in (on, off):
+        assert x["time_ms"] > 0 and x["rays"]["total"] > 0 and x["vertices_sampled"] > 0, x
+        quality_ok(x["quality"])
+assert f[0]["splits_forced"] > 0, f[0]
+
+# Fig. 5.12b: the preview stops the refinement at the primary vertices.
+p = r["preview"]["runs"]
+assert [x["size"] for x in p] == ["64x64", "128x128"], p
+for x in p:
+    assert x["preview_ms"] > 0 and x["frame_ms"] >= x["preview_ms"] * 0.5, x
+    assert x["vt_stats"]["stages"] == 0 and x["vt_stats"]["vertices_generated"] == 0, x
+    assert x["vt_stats"]["vertices_sampled"] > 0, x
+    for k in ("visibility", "sampling", "draw"):
+        assert x["time_split_ms"][k] >= 0, x
 
 a = r["animation"]
 assert a["scene"] == "cluster" and a["frames"] == 3 and len(a["per_frame"]) == 3

@@ -275,6 +275,45 @@ static void forced_refinement_stops_at_zero_area(void **state)
     rl_scene_release(s);
 }
 
+/* Fig. 5.3: forced refinement switched off splits nothing by force and
+ * makes fewer vertices, and the box's shadow on the floor comes out worse:
+ * it is found only where it makes two ends of an edge differ. */
+static void forced_refinement_off(void **state)
+{
+    (void)state;
+    rl_scene *s = floor_scene(true);
+    rl_camera slanted = look(rl_v3(0.0f, 5.0f, 3.0f), rl_v3(0.0f, 0.0f, 0.0f), 96);
+    const char *on_opts[] = { "criteria", "tree", "min_edge", "2", NULL };
+    const char *off_opts[] = { "criteria", "tree", "min_edge", "2", "forced", "false", NULL };
+    rl_renderer *on = make_vt(on_opts), *off = make_vt(off_opts);
+    rl_image *img_on = NULL, *img_off = NULL;
+    rl_vt_stats st_on = render_stats(on, s, &slanted, &img_on);
+    rl_vt_stats st_off = render_stats(off, s, &slanted, &img_off);
+    assert_true(st_on.splits_forced > 0);
+    assert_int_equal(st_off.splits_forced, 0);
+    assert_true(st_off.vertices_generated > 0);
+    assert_true(st_off.vertices_generated < st_on.vertices_generated);
+    const rl_vt_vertex_info *v;
+    const uint32_t *f;
+    size_t nv = 0, nf = 0;
+    assert_int_equal(rl_vt_get_mesh(off, &v, &nv, &f, &nf), RL_OK);
+    for (size_t i = 0; i < nv; ++i)
+        assert_false(v[i].reason & 8);
+    rl_image *ref = fx_render("whitted", s, &slanted, FX_ALL_LAYERS, NULL, NULL);
+    rl_image_metrics m_on, m_off;
+    assert_int_equal(rl_image_compare(img_on, ref, &(rl_metric_options){ 0 }, &m_on), RL_OK);
+    assert_int_equal(rl_image_compare(img_off, ref, &(rl_metric_options){ 0 }, &m_off), RL_OK);
+    if (getenv("VT_DEBUG"))
+        print_message("forced on: rmse %.4f, off: %.4f\n", m_on.rmse, m_off.rmse);
+    assert_true(m_on.rmse < m_off.rmse);
+    rl_image_release(ref);
+    rl_image_release(img_on);
+    rl_image_release(img_off);
+    rl_renderer_release(on);
+    rl_renderer_release(off);
+    rl_scene_release(s);
+}
+
 /* Sec. 3.3.2: "no area" is a face thinner than a fraction of a pixel, not
  * xi near 1. The blue cup of `table` is a lathe whose walls refine into
  * long slivers a pixel or two wide: when those counted as flat (xi >=
@@ -715,6 +754,7 @@ int main(void)
         cmocka_unit_test(flat_quad_is_not_refined),
         cmocka_unit_test(shadow_boundary_refined_only_there),
         cmocka_unit_test(forced_refinement_stops_at_zero_area),
+        cmocka_unit_test(forced_refinement_off),
         cmocka_unit_test(long_slivers_are_refined),
         cmocka_unit_test(hidden_vertices_cast_no_rays),
         cmocka_unit_test(converges_to_whitted),

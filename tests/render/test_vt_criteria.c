@@ -20,13 +20,12 @@ static float linear_of(float d)
     return d <= 0.04045f ? d / 12.92f : powf((d + 0.055f) / 1.055f, 2.4f);
 }
 
-static vt_vertex sample_display(float r, float g, float b)
+static vt_vertex_sample sample_display(float r, float g, float b)
 {
-    vt_vertex v;
+    vt_vertex_sample v;
     memset(&v, 0, sizeof v);
-    v.state = VT_SAMPLED;
     v.flat = rl_v3(linear_of(r), linear_of(g), linear_of(b));
-    v.color = v.flat;
+    vt_criteria_prepare(&v);
     return v;
 }
 
@@ -111,23 +110,27 @@ static void test_parse_accepts_the_documented_names_only(void **state)
 static void test_rgb_fires_on_l1_of_display_values(void **state)
 {
     (void)state;
-    vt_vertex a = sample_display(0.5f, 0.5f, 0.5f);
-    vt_vertex b = sample_display(0.6f, 0.45f, 0.5f);      /* L1 = 0.15 */
+    vt_vertex_sample a = sample_display(0.5f, 0.5f, 0.5f);
+    vt_vertex_sample b = sample_display(0.6f, 0.45f, 0.5f);      /* L1 = 0.15 */
     vt_criteria c = { .bits = VT_CRIT_RGB, .eps_rgb = 0.149f };
     assert_int_equal(vt_criteria_test(&c, &a, &b), VT_CRIT_RGB);
     assert_int_equal(vt_criteria_test(&c, &b, &a), VT_CRIT_RGB);
     c.eps_rgb = 0.151f;
     assert_int_equal(vt_criteria_test(&c, &a, &b), 0);
     /* overexposure clamps: 2 and 50 are both white */
-    vt_vertex w1 = sample_display(1, 1, 1), w2 = sample_display(1, 1, 1);
+    vt_vertex_sample w1 = sample_display(1, 1, 1), w2 = sample_display(1, 1, 1);
     w1.flat = rl_v3s(2.0f);
     w2.flat = rl_v3s(50.0f);
+    vt_criteria_prepare(&w1);
+    vt_criteria_prepare(&w2);
     c.eps_rgb = 0.0f;
     assert_int_equal(vt_criteria_test(&c, &w1, &w2), 0);
-    /* only the flat (untextured) radiance counts, Sec. 3.5.3 */
-    vt_vertex t1 = sample_display(0.2f, 0.2f, 0.2f), t2 = t1;
-    t1.color = rl_v3(1, 0, 0);
-    t2.color = rl_v3(0, 0, 1);
+    /* only the flat (untextured) radiance counts, Sec. 3.5.3: textures
+     * the layers would look up change nothing */
+    vt_vertex_sample t1 = sample_display(0.2f, 0.2f, 0.2f), t2 = t1;
+    t1.layers[RL_TRACE_LAYER_PRIMARY].texture = 0;
+    t2.layers[RL_TRACE_LAYER_PRIMARY].texture = 1;
+    t2.layers[RL_TRACE_LAYER_PRIMARY].uv = rl_v2(0.5f, 0.25f);
     assert_int_equal(vt_criteria_test(&c, &t1, &t2), 0);
 }
 
@@ -135,16 +138,18 @@ static void test_hsv_hue_wraps_and_is_ignored_for_greys(void **state)
 {
     (void)state;
     /* hues 0.95 and 0.05: 0.1 apart across red, same S and V */
-    vt_vertex a = sample_display(1.0f, 0.0f, 0.3f), b = sample_display(1.0f, 0.3f, 0.0f);
+    vt_vertex_sample a = sample_display(1.0f, 0.0f, 0.3f), b = sample_display(1.0f, 0.3f, 0.0f);
     vt_criteria c = { .bits = VT_CRIT_HSV, .eps_h = 0.11f, .eps_s = 0.01f, .eps_v = 0.01f };
     assert_int_equal(vt_criteria_test(&c, &a, &b), 0);
     c.eps_h = 0.09f;
     assert_int_equal(vt_criteria_test(&c, &a, &b), VT_CRIT_HSV);
 
     /* nearly grey: hues far apart but saturation below 1e-3 */
-    vt_vertex g1 = sample_display(0.5f, 0.5f, 0.5f), g2 = sample_display(0.5f, 0.5f, 0.5f);
+    vt_vertex_sample g1 = sample_display(0.5f, 0.5f, 0.5f), g2 = sample_display(0.5f, 0.5f, 0.5f);
     g1.flat.x *= 1.0004f;                 /* reddish */
     g2.flat.z *= 1.0004f;                 /* bluish */
+    vt_criteria_prepare(&g1);
+    vt_criteria_prepare(&g2);
     float h1, s1, v1, h2, s2, v2;
     vt_rgb_to_hsv(rl_v3(vt_display(g1.flat.x), vt_display(g1.flat.y), vt_display(g1.flat.z)),
                   &h1, &s1, &v1);
@@ -156,12 +161,12 @@ static void test_hsv_hue_wraps_and_is_ignored_for_greys(void **state)
     assert_int_equal(vt_criteria_test(&c, &g1, &g2), 0);
 
     /* saturation and value on their own */
-    vt_vertex p = sample_display(0.8f, 0.4f, 0.4f), q = sample_display(0.8f, 0.6f, 0.6f);
+    vt_vertex_sample p = sample_display(0.8f, 0.4f, 0.4f), q = sample_display(0.8f, 0.6f, 0.6f);
     c = (vt_criteria){ .bits = VT_CRIT_HSV, .eps_h = 0.5f, .eps_s = 0.2f, .eps_v = 1.0f };
     assert_int_equal(vt_criteria_test(&c, &p, &q), VT_CRIT_HSV);   /* dS = 0.25 */
     c.eps_s = 0.3f;
     assert_int_equal(vt_criteria_test(&c, &p, &q), 0);
-    vt_vertex r = sample_display(0.6f, 0.3f, 0.3f);                /* dV = 0.2 */
+    vt_vertex_sample r = sample_display(0.6f, 0.3f, 0.3f);                /* dV = 0.2 */
     c = (vt_criteria){ .bits = VT_CRIT_HSV, .eps_h = 0.5f, .eps_s = 1.0f, .eps_v = 0.19f };
     assert_int_equal(vt_criteria_test(&c, &p, &r), VT_CRIT_HSV);
     c.eps_v = 0.21f;
@@ -171,7 +176,7 @@ static void test_hsv_hue_wraps_and_is_ignored_for_greys(void **state)
 static void test_tree_and_combinations_report_what_fired(void **state)
 {
     (void)state;
-    vt_vertex a = sample_display(0.5f, 0.5f, 0.5f), b = sample_display(0.9f, 0.5f, 0.5f);
+    vt_vertex_sample a = sample_display(0.5f, 0.5f, 0.5f), b = sample_display(0.9f, 0.5f, 0.5f);
     a.tree_hash = 0x1111;
     b.tree_hash = 0x1111;
     vt_criteria c = { .bits = VT_CRIT_TREE, .eps_rgb = 0.1f, .eps_h = 0.5f, .eps_s = 1.0f,
