@@ -63,7 +63,8 @@ typedef struct rl_pt_stats {
      * (they are kept between frames); 0 for one not in use. With ls_file
      * the Line Space's is its load time when the file was loaded. */
     double build_bvh_ms, build_grid_ms, build_embree_ms, build_linespace_ms, build_shadowmap_ms;
-    rl_rng_gpu_kind rng;
+    rl_rng_gpu_kind rng;          /* the GPU generator, when not sobol */
+    bool sobol;                   /* rng=sobol: Owen-scrambled Sobol points */
     float filter_weight;          /* weight of the filtered image in the output */
 } rl_pt_stats;
 

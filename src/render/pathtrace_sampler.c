@@ -1,0 +1,121 @@
+/* pathtrace_sampler.c: the sample numbers of the path tracer "pt": either
+ * the thesis' per-pixel GPU generators (Schröder 2017, Sec. 5.3; rng=lcg,
+ * tausworthe, hybrid), drawn one after another, or (rng=sobol, the default)
+ * a low-discrepancy sequence: the first two dimensions of Sobol's sequence
+ * (Sobol 1967), Owen-scrambled (Owen 1995) by a hash (nested uniform
+ * scrambling as Laine & Karras 2011 and Burley 2020, "Practical Hash-based
+ * Owen Scrambling", describe it), and padded to every further dimension
+ * pair by shuffling the sample index with another scramble per pair
+ * (Burley 2020, Sec. 4), so that each 1D and 2D draw of a path is a
+ * stratified (0,2)-sequence over the pixel's samples.
+ *
+ * Decorrelation and reproducibility: a pixel's scrambles are seeded by a
+ * hash of (seed, pixel), a draw is addressed by (sample index in the pixel,
+ * slot), so a pixel's n-th sample is the same whatever the thread count or
+ * the frame it falls in. The slot of each draw is fixed by the path vertex
+ * and the purpose (pathtrace_internal.h, PT_SLOT_*), not by how many draws
+ * came before: a path that skips a light sample does not shift the
+ * dimensions of the next bounce.
+ *
+ * The scramble: read x as a binary fraction, most significant bit first;
+ * nested uniform scrambling flips each bit by a random function of the bits
+ * above it. Reversing the bits turns "above" into "below", and there every
+ * step of the chain below is a bijection in which bit j changes by a
+ * function of bits 0..j-1 and the seed only: adding a constant (carries run
+ * upwards), multiplying by an odd constant, and x ^= x * (even constant).
+ * The constants are ours; the stratification this guarantees is tested in
+ * tests/render/test_pathtrace_sampler.c. */
+#include "render/pathtrace_internal.h"
+
+#define TO_UNIT_24 (1.0f / 16777216.0f)   /* 2^-24: 24 bits fill a float's mantissa */
+
+static uint32_t reverse_bits(uint32_t x)
+{
+    x = (x << 16) | (x >> 16);
+    x = ((x & 0x00ff00ffu) << 8) | ((x >> 8) & 0x00ff00ffu);
+    x = ((x & 0x0f0f0f0fu) << 4) | ((x >> 4) & 0x0f0f0f0fu);
+    x = ((x & 0x33333333u) << 2) | ((x >> 2) & 0x33333333u);
+    return ((x & 0x55555555u) << 1) | ((x >> 1) & 0x55555555u);
+}
+
+uint32_t rl_pt_owen_scramble(uint32_t x, uint32_t seed)
+{
+    x = reverse_bits(x);
+    x += seed;
+    x ^= x * 0x2c1b3c6cu;
+    x *= (seed >> 1) | 1u;
+    x ^= x * 0x95a4e8d2u;
+    x += seed * 0x632be5abu;
+    x ^= x * 0xa3d15f40u;
+    x *= 0x8bb84b93u;
+    x ^= x * 0x5e27a3f6u;
+    return reverse_bits(x);
+}
+
+/* Sobol's first dimension is the van der Corput sequence in base 2. */
+static uint32_t sobol_dim0(uint32_t i)
+{
+    return reverse_bits(i);
+}
+
+/* Sobol's second dimension: primitive polynomial x + 1 (degree 1, m_1 = 1),
+ * so the direction numbers follow v_k = v_{k-1} ^ (v_{k-1} >> 1) from
+ * v_1 = 2^31 (Bratley & Fox 1988, eq. for s = 1). */
+static uint32_t sobol_dim1(uint32_t i)
+{
+    uint32_t r = 0;
+    for (uint32_t v = 1u << 31; i; i >>= 1, v ^= v >> 1)
+        if (i & 1u)
+            r ^= v;
+    return r;
+}
+
+void rl_pt_sampler_init(pt_sampler *s, rl_rng_gpu *rng, uint32_t pixel_seed, uint32_t index)
+{
+    s->rng = rng;
+    s->pixel_seed = pixel_seed;
+    s->index = index;
+    s->slot = 0;
+}
+
+uint32_t rl_pt_pixel_seed(uint64_t seed, uint64_t pixel)
+{
+    return (uint32_t)(rl_hash64(rl_hash64(seed) ^ (pixel * 0x9e3779b97f4a7c15ull)) >> 32);
+}
+
+/* Three independent 32-bit seeds of a slot: index shuffle, x, y. */
+static uint32_t slot_seed(const pt_sampler *s, uint32_t slot, uint32_t which)
+{
+    return (uint32_t)rl_hash64(((uint64_t)s->pixel_seed << 32) | ((uint64_t)slot << 2) | which);
+}
+
+static float to_unit(uint32_t x)
+{
+    return (float)(x >> 8) * TO_UNIT_24;
+}
+
+rl_vec2 rl_pt_sample_2d(pt_sampler *s)
+{
+    if (s->rng) {
+        float a = rl_rng_gpu_float(s->rng);
+        return rl_v2(a, rl_rng_gpu_float(s->rng));
+    }
+    uint32_t slot = s->slot++;
+    uint32_t i = rl_pt_owen_scramble(s->index, slot_seed(s, slot, 0));
+    return rl_v2(to_unit(rl_pt_owen_scramble(sobol_dim0(i), slot_seed(s, slot, 1))),
+                 to_unit(rl_pt_owen_scramble(sobol_dim1(i), slot_seed(s, slot, 2))));
+}
+
+float rl_pt_sample_1d(pt_sampler *s)
+{
+    if (s->rng)
+        return rl_rng_gpu_float(s->rng);
+    uint32_t slot = s->slot++;
+    uint32_t i = rl_pt_owen_scramble(s->index, slot_seed(s, slot, 0));
+    return to_unit(rl_pt_owen_scramble(sobol_dim0(i), slot_seed(s, slot, 1)));
+}
+
+void rl_pt_sampler_seek(pt_sampler *s, uint32_t slot)
+{
+    s->slot = slot;
+}
