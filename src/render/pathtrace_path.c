@@ -288,8 +288,10 @@ static rl_vec3 direct_light_mis(const pt_ctx *ctx, const pt_surface *s, pt_sampl
     for (int k = 0; k < n; ++k) {
         uint32_t slot = base + PT_SLOTS_VERTEX + PT_SLOTS_LIGHT * (uint32_t)k;
         rl_pt_sampler_seek(sp, slot + PT_SLOT_LIGHT_PICK);
-        float u_pick = rl_pt_sample_1d(sp);
+        float u_pick = lt->count > 1 ? rl_pt_sample_1d(sp) : 0.0f;
+        rl_pt_sampler_seek(sp, slot + PT_SLOT_LIGHT_POINT);
         rl_vec2 x = rl_pt_sample_2d(sp);
+        rl_pt_sampler_seek(sp, slot + PT_SLOT_LIGHT_JITTER);
         rl_vec2 j = jitter ? rl_pt_sample_2d(sp) : rl_v2(0.0f, 0.0f);
         uint32_t src = lt->source[rl_pt_lights_pick(lt, u_pick)];
         rl_vec3 q, n_e, le;
@@ -417,8 +419,11 @@ rl_vec3 rl_pt_trace_path(const pt_ctx *ctx, const pt_surface *first, pt_sampler 
         /* Sec. 6.4.1: Russian roulette over reflect / refract / diffuse,
          * each chosen with its coefficient, so the weight stays 1. */
         float k_r = s.m->reflectivity, k_t = s.m->transmissivity;
+        /* A slot is fixed, so the Sobol sampler may skip the draws a
+         * material does not need; the thesis' generators must draw them to
+         * keep their sequence. */
         rl_pt_sampler_seek(sp, base + PT_SLOT_EVENT);
-        float u_event = rl_pt_sample_1d(sp);
+        float u_event = sp->rng || k_r + k_t > 0.0f ? rl_pt_sample_1d(sp) : 1.0f;
         rl_vec3 dir;
         rl_ray_type type;
         if (u_event < k_r + k_t) {
@@ -446,7 +451,7 @@ rl_vec3 rl_pt_trace_path(const pt_ctx *ctx, const pt_surface *first, pt_sampler 
             if (last)
                 break;
             rl_pt_sampler_seek(sp, base + PT_SLOT_LOBE);
-            float u0 = rl_pt_sample_1d(sp);
+            float u0 = sp->rng || rl_vmax_comp(s.m->specular) > 0.0f ? rl_pt_sample_1d(sp) : 0.0f;
             rl_pt_sampler_seek(sp, base + PT_SLOT_BSDF);
             rl_vec2 u12 = rl_pt_sample_2d(sp);
             rl_vec3 w;

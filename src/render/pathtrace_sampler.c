@@ -38,9 +38,10 @@ static uint32_t reverse_bits(uint32_t x)
     return ((x & 0x55555555u) << 1) | ((x >> 1) & 0x55555555u);
 }
 
-uint32_t rl_pt_owen_scramble(uint32_t x, uint32_t seed)
+/* The scramble on reversed bits: bit j changes by a function of bits
+ * 0..j-1 and the seed. */
+static uint32_t scramble_reversed(uint32_t x, uint32_t seed)
 {
-    x = reverse_bits(x);
     x += seed;
     x ^= x * 0x2c1b3c6cu;
     x *= (seed >> 1) | 1u;
@@ -49,24 +50,33 @@ uint32_t rl_pt_owen_scramble(uint32_t x, uint32_t seed)
     x ^= x * 0xa3d15f40u;
     x *= 0x8bb84b93u;
     x ^= x * 0x5e27a3f6u;
-    return reverse_bits(x);
+    return x;
 }
 
-/* Sobol's first dimension is the van der Corput sequence in base 2. */
-static uint32_t sobol_dim0(uint32_t i)
+uint32_t rl_pt_owen_scramble(uint32_t x, uint32_t seed)
 {
-    return reverse_bits(i);
+    return reverse_bits(scramble_reversed(reverse_bits(x), seed));
 }
 
+/* Sobol's first dimension is the van der Corput sequence in base 2: the
+ * reversed index (written out where it is used). */
 /* Sobol's second dimension: primitive polynomial x + 1 (degree 1, m_1 = 1),
  * so the direction numbers follow v_k = v_{k-1} ^ (v_{k-1} >> 1) from
- * v_1 = 2^31 (Bratley & Fox 1988, eq. for s = 1). */
+ * v_1 = 2^31 (the rows of Pascal's triangle mod 2), tabulated here. Index
+ * bits from the 25th on only touch output bits below 2^-24, which to_unit
+ * drops, and the scramble after this keeps the leading 24 bits a function
+ * of the leading 24 bits: so 24 index bits suffice. */
+static const uint32_t sobol1_v[24] = {
+    0x80000000u, 0xc0000000u, 0xa0000000u, 0xf0000000u, 0x88000000u, 0xcc000000u, 0xaa000000u, 0xff000000u,
+    0x80800000u, 0xc0c00000u, 0xa0a00000u, 0xf0f00000u, 0x88880000u, 0xcccc0000u, 0xaaaa0000u, 0xffff0000u,
+    0x80008000u, 0xc000c000u, 0xa000a000u, 0xf000f000u, 0x88008800u, 0xcc00cc00u, 0xaa00aa00u, 0xff00ff00u,
+};
+
 static uint32_t sobol_dim1(uint32_t i)
 {
     uint32_t r = 0;
-    for (uint32_t v = 1u << 31; i; i >>= 1, v ^= v >> 1)
-        if (i & 1u)
-            r ^= v;
+    for (i &= 0xffffffu; i; i &= i - 1)
+        r ^= sobol1_v[__builtin_ctz(i)];
     return r;
 }
 
@@ -83,10 +93,15 @@ uint32_t rl_pt_pixel_seed(uint64_t seed, uint64_t pixel)
     return (uint32_t)(rl_hash64(rl_hash64(seed) ^ (pixel * 0x9e3779b97f4a7c15ull)) >> 32);
 }
 
-/* Three independent 32-bit seeds of a slot: index shuffle, x, y. */
-static uint32_t slot_seed(const pt_sampler *s, uint32_t slot, uint32_t which)
+/* The seeds of a slot (index shuffle, x, y) from one 64-bit hash: the
+ * hashing is most of the sampler's cost, and a scramble needs no more than
+ * distinct well-mixed words. */
+static void slot_seeds(const pt_sampler *s, uint32_t slot, uint32_t seed[3])
 {
-    return (uint32_t)rl_hash64(((uint64_t)s->pixel_seed << 32) | ((uint64_t)slot << 2) | which);
+    uint64_t h = rl_hash64(((uint64_t)s->pixel_seed << 32) | slot);
+    seed[0] = (uint32_t)h;
+    seed[1] = (uint32_t)(h >> 32);
+    seed[2] = (uint32_t)((h * 0xd1342543de82ef95ull) >> 32) ^ seed[0];
 }
 
 static float to_unit(uint32_t x)
@@ -100,19 +115,22 @@ rl_vec2 rl_pt_sample_2d(pt_sampler *s)
         float a = rl_rng_gpu_float(s->rng);
         return rl_v2(a, rl_rng_gpu_float(s->rng));
     }
-    uint32_t slot = s->slot++;
-    uint32_t i = rl_pt_owen_scramble(s->index, slot_seed(s, slot, 0));
-    return rl_v2(to_unit(rl_pt_owen_scramble(sobol_dim0(i), slot_seed(s, slot, 1))),
-                 to_unit(rl_pt_owen_scramble(sobol_dim1(i), slot_seed(s, slot, 2))));
+    uint32_t seed[3];
+    slot_seeds(s, s->slot++, seed);
+    uint32_t d0 = scramble_reversed(reverse_bits(s->index), seed[0]);
+    return rl_v2(to_unit(rl_pt_owen_scramble(d0, seed[1])),
+                 to_unit(rl_pt_owen_scramble(sobol_dim1(reverse_bits(d0)), seed[2])));
 }
 
 float rl_pt_sample_1d(pt_sampler *s)
 {
     if (s->rng)
         return rl_rng_gpu_float(s->rng);
-    uint32_t slot = s->slot++;
-    uint32_t i = rl_pt_owen_scramble(s->index, slot_seed(s, slot, 0));
-    return to_unit(rl_pt_owen_scramble(sobol_dim0(i), slot_seed(s, slot, 1)));
+    uint32_t seed[3];
+    slot_seeds(s, s->slot++, seed);
+    /* sobol_dim0(owen(index)) = reverse(owen(index)): one reversal less. */
+    uint32_t d0 = scramble_reversed(reverse_bits(s->index), seed[0]);
+    return to_unit(rl_pt_owen_scramble(d0, seed[1]));
 }
 
 void rl_pt_sampler_seek(pt_sampler *s, uint32_t slot)
