@@ -166,7 +166,19 @@ static bool visible(const pt_ctx *ctx, const pt_surface *s, rl_vec3 l, float dis
     if (k == RL_PT_BACKEND_SHADOWMAP)
         return rl_shadowmap_visible(b->sm, light, s->p, s->ng, ju, jv);
     c->rays[RL_RAY_SHADOW]++;
-    rl_ray ray = { offset_origin(ctx, s, l), 0.0f, l, isinf(dist) ? INFINITY : dist * (1.0f - SHADOW_T_SHRINK) };
+    rl_ray ray = { offset_origin(ctx, s, l), 0.0f, l, INFINITY };
+    if (!isinf(dist)) {
+        /* Aim from the offset origin at the light point itself: the ray
+         * along l from there would end eps beyond the light's plane when
+         * it leaves the surface at a grazing angle to that plane, and the
+         * light's own emissive mesh then shadowed it (issue 37: a floor
+         * 4 m wide under a lamp mesh went black). */
+        rl_vec3 to = rl_sub(rl_madd(s->p, l, dist), ray.o);
+        float len = rl_length(to);
+        if (len > 0.0f)
+            ray.d = rl_scale(to, 1.0f / len);
+        ray.t_max = len * (1.0f - SHADOW_T_SHRINK);
+    }
     switch (k) {
     case RL_PT_BACKEND_BVH:
     case RL_PT_BACKEND_GRID:
