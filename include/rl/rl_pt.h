@@ -6,7 +6,8 @@
  *
  * The path tracer in one paragraph: per pixel and frame, spp camera paths;
  * at each diffuse or glossy vertex the lights are sampled with shadow rays
- * (next-event estimation, eq. 7 for quad lights), then Russian roulette
+ * (next-event estimation, eq. 7 for quad lights; by default one light chosen
+ * by power and weighted against the BSDF sample by MIS), then Russian roulette
  * picks mirror, refraction or the Phong BRDF, whose direction is importance
  * sampled; frames are blended into the running mean (eq. 8). Shadow and
  * secondary rays go through selectable backends: BVH, grid, Embree, Line

@@ -11,7 +11,10 @@
  *                      -1 = the scene's root attribute max_path_length
  *                      (ls-open, ls-cornell carry the thesis' value), else 3
  *   rr = true, rr_depth = 2    Russian roulette from that bounce on
- *   rng = hybrid       lcg | tausworthe | hybrid (Sec. 5.3) [hybrid]
+ *   rng = sobol        sobol (Owen-scrambled Sobol points, issue 37) | lcg |
+ *                      tausworthe | hybrid (Sec. 5.3) [hybrid]
+ *   mis = on           on: lights chosen by power, MIS with the BSDF sample
+ *                      (Veach 1997, issue 37) | off [every light per vertex]
  *   seed = 0
  *   shadow = bvh       bvh | grid | embree | ls-candidates | ls-preillum |
  *                      ls-pnmt | shadowmap
@@ -50,8 +53,10 @@
  *
  * Random numbers (Sec. 5.3): one GPU-style generator state per pixel (the
  * thesis' state texture), seeded on reset from PCG32 (seed, pixel) and
- * advanced across frames. Every pixel's result depends only on its own
- * state, so images do not depend on the thread count.
+ * advanced across frames; or (rng=sobol) the Sobol point numbered by the
+ * pixel's accumulated samples (pathtrace_sampler.c). Every pixel's result
+ * depends only on its own state, so images do not depend on the thread
+ * count.
  *
  * Filter (Sec. 8.2): the filtered accumulated image is blended in with the
  * weight 1 / (1 + spp / filter_fade), spp the mean samples per pixel so far:

@@ -38,9 +38,14 @@
  * thesis' voxel offset against self-illumination, Sec. 12.1-12.2, Fig. 19, 21):
  * occluders closer than that are missed, as the thesis reports.
  *
- * Random numbers come from the pixel's GPU-style generator only, in an
- * order that does not depend on which shadow rays are traced, so exact
- * backends give the same image. */
+ * With mis=on (issue 37; docs/path-tracing.md) next-event estimation
+ * instead takes light_samples lights chosen by power (pathtrace_lights.c),
+ * emissive triangles included, and weights each light sample and each BSDF
+ * ray that hits an emitter by the power heuristic (Veach 1997).
+ *
+ * Random numbers come from the pixel's sampler only (pathtrace_sampler.c),
+ * in an order, or at slots, that do not depend on which shadow rays are
+ * traced, so exact backends give the same image. */
 #include <math.h>
 #include <string.h>
 
