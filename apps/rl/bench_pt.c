@@ -94,6 +94,8 @@ static const char bench_pt_help[] =
     "  --conv-ref-spp N  convergence: reference samples, rendered once and cached\n"
     "                    beside --out; default 4096 (quick: 64); 16384 on a big machine\n"
     "  --conv-spp-max N  convergence: the longest curves' samples; default 1024 (quick: 16)\n"
+    "  --conv-configs L  convergence: only these configurations (defaults, thesis,\n"
+    "                    mis=off, rng=hybrid, rr=false, light_samples=2, light_samples=4)\n"
     "  --max-memory GB   skip Line Spaces estimated to need more; default 60% of RAM\n"
     "  --builds N        generation: the fastest of N builds per row; default 3 (quick: 1)\n"
     "  --fixed-k K       generation: also build fixed lists of K (even; default 8), for\n"
@@ -163,6 +165,7 @@ typedef struct bpt_args {
     long long builds;              /* generation: fastest of this many builds */
     long long fixed_k;             /* generation: fixed lists of k for the cost of dynamic ones */
     long long conv_size, conv_ref_spp, conv_spp_max;
+    const char *conv_configs;
     bool has_conv_size, has_conv_ref_spp, has_conv_spp_max;
     bool has_size, has_err_size, has_ref_spp, has_spp_max, has_builds, has_fixed_k, quick, small_pages;
     unsigned sections;
@@ -1399,7 +1402,8 @@ static rl_status sec_convergence(void *ctx, cJSON *sec)
 {
     bpt *b = ctx;
     bench_pt_conv_args ca = { .size = (int)b->a->conv_size, .ref_spp = b->a->conv_ref_spp,
-                              .spp_max = b->a->conv_spp_max, .threads = b->threads, .out_path = b->out_path };
+                              .spp_max = b->a->conv_spp_max, .threads = b->threads, .out_path = b->out_path,
+                              .configs = b->a->conv_configs };
     return bench_pt_convergence(&ca, sec);
 }
 
@@ -1422,6 +1426,7 @@ static int parse_args(int argc, char **argv, bpt_args *a)
         RL_BENCH_COUNT("--conv-size", 8192, &a->conv_size, &a->has_conv_size),
         RL_BENCH_COUNT("--conv-ref-spp", 1 << 20, &a->conv_ref_spp, &a->has_conv_ref_spp),
         RL_BENCH_COUNT("--conv-spp-max", 1 << 20, &a->conv_spp_max, &a->has_conv_spp_max),
+        RL_BENCH_STRING("--conv-configs", &a->conv_configs),
         RL_BENCH_COUNT("--threads", 1024, &a->threads, NULL),
         RL_BENCH_SECTIONS(section_names, SEC_COUNT, &a->sections),
         RL_BENCH_OUT(&a->out),

@@ -79,6 +79,24 @@ static const conv_config configs[] = {
 };
 #define NUM_CONFIGS (sizeof configs / sizeof configs[0])
 
+/* Whether configuration c is in the comma-separated list of labels (their
+ * first words: "defaults", "thesis", "mis=off", ...); NULL or "" = all. */
+static bool wanted(const char *list, const conv_config *c)
+{
+    if (!list || !*list)
+        return true;
+    size_t len = strcspn(c->label, " ");
+    for (const char *p = list; *p;) {
+        size_t n = strcspn(p, ",");
+        if (n == len && strncmp(p, c->label, len) == 0)
+            return true;
+        p += n;
+        if (*p == ',')
+            ++p;
+    }
+    return false;
+}
+
 typedef struct checkpoint {
     long long spp;
     double wall_ms, cpu_ms, rmse;
@@ -134,21 +152,22 @@ static rl_status make_renderer(const bench_pt_conv_args *a, const char *const *o
     return st;
 }
 
-/* Renders spp samples in frames of up to 64 into rgb (3 floats per pixel). */
+/* Renders spp samples into rgb (3 floats per pixel), in frames of the
+ * largest power of two up to 64 that divides spp: the frame size is set
+ * once, since changing any option restarts the accumulation. */
 static rl_status render_spp(rl_renderer *r, const rl_scene *scene, const rl_camera *cam, long long spp,
                             rl_image *img, float *rgb)
 {
-    rl_status st = RL_OK;
-    for (long long done = 0; st == RL_OK && done < spp;) {
-        long long n = spp - done < 64 ? spp - done : 64;
-        char text[16];
-        snprintf(text, sizeof text, "%lld", n);
-        if ((st = rl_renderer_set(r, "spp", text)) != RL_OK)
-            break;
+    int frame = 64;
+    while (spp % frame != 0)
+        frame /= 2;
+    char text[24];
+    snprintf(text, sizeof text, "%d", frame);
+    rl_status st = rl_renderer_set(r, "spp", text);
+    for (long long done = 0; st == RL_OK && done < spp; done += frame) {
         rl_render_stats s;
         st = rl_renderer_render(r, scene, cam, img, &s);
-        done += n;
-        note("reference: %lld / %lld spp", done, spp);
+        note("reference: %lld / %lld spp", done + frame, spp);
     }
     size_t n = (size_t)cam->width * cam->height;
     for (size_t i = 0; st == RL_OK && i < n; ++i) {
@@ -436,6 +455,8 @@ rl_status bench_pt_convergence(const bench_pt_conv_args *a, cJSON *sec)
         st = RL_ERR_OUT_OF_MEMORY;
     for (size_t c = 0; st == RL_OK && c < NUM_CONFIGS; ++c) {
         checkpoint *p = pts + c * MAX_CHECKPOINTS;
+        if (!wanted(a->configs, &configs[c]))
+            continue;
         st = run_config(a, &configs[c], scene, &cam, ref, ref_mse, p, &nums[c], rgb, means[c]);
         if (st == RL_OK)
             st = report_config(a, &configs[c], p, nums[c], arr);
@@ -463,7 +484,7 @@ rl_status bench_pt_convergence(const bench_pt_conv_args *a, cJSON *sec)
         /* Channel means of the defaults' longest run against the reference. */
         cJSON *mj = cJSON_AddArrayToObject(sec, "mean_rel_diff_defaults");
         printf("channel means, defaults at %lld spp vs reference:", nums[0] ? pts[nums[0] - 1].spp : 0);
-        for (int k = 0; k < 3 && mj; ++k) {
+        for (int k = 0; k < 3 && mj && nums[0]; ++k) {
             double d = ref_mean[k] > 0.0 ? means[0][k] / ref_mean[k] - 1.0 : NAN;
             printf(" %+.3f %%", 100.0 * d);
             cJSON_AddItemToArray(mj, cJSON_CreateNumber(isfinite(d) ? d : 0.0));

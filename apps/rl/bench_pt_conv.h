@@ -16,6 +16,7 @@ typedef struct bench_pt_conv_args {
     long long spp_max;             /* the longest curve */
     int threads;
     const char *out_path;          /* the JSON record; the reference cache goes beside it */
+    const char *configs;           /* comma-separated labels to run; NULL = all */
 } bench_pt_conv_args;
 
 /* Fills sec; RL_OK or the failing status. */

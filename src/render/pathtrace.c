@@ -10,7 +10,7 @@
  *                      scenes, 3 Cornell box]; 0 = direct light only;
  *                      -1 = the scene's root attribute max_path_length
  *                      (ls-open, ls-cornell carry the thesis' value), else 3
- *   rr = true, rr_depth = 2    Russian roulette from that bounce on
+ *   rr = true, rr_depth = 4    Russian roulette from that bounce on [2]
  *   rng = sobol        sobol (Owen-scrambled Sobol points, issue 37) | lcg |
  *                      tausworthe | hybrid (Sec. 5.3) [hybrid]
  *   mis = on           on: lights chosen by power, MIS with the BSDF sample
@@ -108,7 +108,8 @@ static const rl_option_info pt_options[] = {
       "-1: the scene's root attribute max_path_length, else 3)",
       -1, 1024, NULL },
     { "rr", RL_OPT_BOOL, "true", "Russian roulette on the path length (Sec. 3.2.4)", 0, 0, NULL },
-    { "rr_depth", RL_OPT_INT, "2", "bounce from which Russian roulette may end a path", 0, 1024, NULL },
+    { "rr_depth", RL_OPT_INT, "4",
+      "bounce from which Russian roulette may end a path (thesis: 2; 4 by measurement, issue 37)", 0, 1024, NULL },
     { "rng", RL_OPT_ENUM, "sobol",
       "sample numbers: sobol (Owen-scrambled Sobol points) or the thesis' per-pixel generators (Sec. 5.3): lcg, "
       "tausworthe or their hybrid", 0, 0, rng_choices },
