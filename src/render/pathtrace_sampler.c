@@ -58,9 +58,8 @@ uint32_t rl_pt_owen_scramble(uint32_t x, uint32_t seed)
     return reverse_bits(scramble_reversed(reverse_bits(x), seed));
 }
 
-/* Sobol's first dimension is the van der Corput sequence in base 2: the
- * reversed index (written out where it is used). */
-/* Sobol's second dimension: primitive polynomial x + 1 (degree 1, m_1 = 1),
+/* Sobol's first dimension is the van der Corput sequence in base 2, the
+ * reversed index (written out where it is used). The second dimension: primitive polynomial x + 1 (degree 1, m_1 = 1),
  * so the direction numbers follow v_k = v_{k-1} ^ (v_{k-1} >> 1) from
  * v_1 = 2^31 (the rows of Pascal's triangle mod 2), tabulated here. Index
  * bits from the 25th on only touch output bits below 2^-24, which to_unit
