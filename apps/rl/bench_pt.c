@@ -21,6 +21,14 @@
  *                 payload (specular=diffuse), on ls-cornell's mirror cuboid
  *   accumulation  RMSE against total samples, and what each filter of
  *                 Sec. 8.2 does to RMSE and SSIM at 1, 4 and 16 spp
+ *   convergence   issue 37: RMSE against time on Bitterli's Cornell box
+ *                 settings, pt's defaults vs the thesis' settings and each
+ *                 improvement switched off (bench_pt_conv.c)
+ *
+ * Every section but convergence measures the thesis' configuration, so
+ * make_pt sets the thesis' sampling options explicitly (rng=hybrid,
+ * mis=off, light_samples=1, rr_depth=2): pt's defaults changed in issue 37
+ * and the records of bench/README stay comparable.
  *
  * Timing: per configuration one warm-up render (it builds and caches the
  * grid, Line Space and shadow maps, which the thesis also builds once per
@@ -33,6 +41,7 @@
 #include "bench_pt.h"
 
 #include "bench_args.h"
+#include "bench_pt_conv.h"
 #include "bench_rays.h"
 #include "bench_util.h"
 #include "cli.h"
@@ -72,12 +81,21 @@ static const char bench_pt_help[] =
     "  specular      mirror/refraction rays through the exact grid (the thesis) or\n"
     "                the diffuse Line Space payload: RMSE, SSIM, ms/spp on ls-cornell\n"
     "  accumulation  RMSE against total samples; each filter's RMSE/SSIM\n"
+    "  convergence   RMSE against time on cornell:variant=bitterli: pt's defaults, the\n"
+    "                thesis' settings, each improvement off, light_samples 1/2/4;\n"
+    "                time to RMSE 0.0069 and 0.0014, RMSE at 64 spp (issue 37)\n"
     "\n"
     "options:\n"
     "  --size WxH        frame sections; default 1280x720 (the thesis)\n"
     "  --error-size WxH  error and accumulation sections; default 320x180\n"
     "  --ref-spp N       samples of the BVH reference; default 1024\n"
     "  --spp-max N       samples accumulated per variant in the error section; default 64\n"
+    "  --conv-size N     convergence: image side; default 512 (quick: 64)\n"
+    "  --conv-ref-spp N  convergence: reference samples, rendered once and cached\n"
+    "                    beside --out; default 4096 (quick: 64); 16384 on a big machine\n"
+    "  --conv-spp-max N  convergence: the longest curves' samples; default 1024 (quick: 16)\n"
+    "  --conv-configs L  convergence: only these configurations (defaults, thesis,\n"
+    "                    mis=off, rng=hybrid, rr=false, light_samples=2, light_samples=4)\n"
     "  --max-memory GB   skip Line Spaces estimated to need more; default 60% of RAM\n"
     "  --builds N        generation: the fastest of N builds per row; default 3 (quick: 1)\n"
     "  --fixed-k K       generation: also build fixed lists of K (even; default 8), for\n"
@@ -94,9 +112,10 @@ static const char bench_pt_help[] =
     "  rl bench pt --only generation,shadow\n";
 
 enum { SEC_GENERATION, SEC_SCENES, SEC_DIFFUSE, SEC_SHADOW, SEC_ERROR, SEC_SPECULAR, SEC_ACCUMULATION,
-       SEC_COUNT };
-static const char *const section_names[SEC_COUNT] = { "generation", "scenes", "diffuse",  "shadow",
-                                                      "error",      "specular", "accumulation" };
+       SEC_CONVERGENCE, SEC_COUNT };
+static const char *const section_names[SEC_COUNT] = { "generation", "scenes",       "diffuse",
+                                                      "shadow",     "error",        "specular",
+                                                      "accumulation", "convergence" };
 
 /* Schröder 2017, Table 1: generation times in ms on a GeForce GTX 1080. */
 static const struct gen_row {
@@ -145,6 +164,9 @@ typedef struct bpt_args {
     long long max_memory_gb;       /* 0: 60% of physical memory */
     long long builds;              /* generation: fastest of this many builds */
     long long fixed_k;             /* generation: fixed lists of k for the cost of dynamic ones */
+    long long conv_size, conv_ref_spp, conv_spp_max;
+    const char *conv_configs;
+    bool has_conv_size, has_conv_ref_spp, has_conv_spp_max;
     bool has_size, has_err_size, has_ref_spp, has_spp_max, has_builds, has_fixed_k, quick, small_pages;
     unsigned sections;
     const char *out;
@@ -157,6 +179,7 @@ typedef struct bpt {
     struct { char name[64]; rl_scene *scene; } scenes[MAX_SCENES];
     int num_scenes;
     rl_image *reference;           /* error/accumulation reference, when made */
+    const char *out_path;          /* the JSON record (convergence caches its reference beside it) */
     double reference_ms;
     char reason[256];
 } bpt;
@@ -233,6 +256,11 @@ static rl_status make_pt(const bpt *b, const pt_config *c, rl_renderer **out)
     rl_renderer *r = NULL;
     rl_status st = rl_renderer_create("pt", &r);
     if (st == RL_OK) st = set_num(r, "threads", b->threads);
+    /* The thesis' sampling (pt's defaults before issue 37). */
+    if (st == RL_OK) st = rl_renderer_set(r, "rng", "hybrid");
+    if (st == RL_OK) st = rl_renderer_set(r, "mis", "off");
+    if (st == RL_OK) st = rl_renderer_set(r, "light_samples", "1");
+    if (st == RL_OK) st = rl_renderer_set(r, "rr_depth", "2");
     if (st == RL_OK) st = rl_renderer_set(r, "seed", c->seed ? c->seed : PT_SEED);
     if (st == RL_OK) st = rl_renderer_set(r, "shadow", c->shadow);
     if (st == RL_OK) st = rl_renderer_set(r, "diffuse", c->diffuse);
@@ -1370,6 +1398,15 @@ static rl_status sec_accumulation(void *ctx, cJSON *sec)
     return RL_OK;
 }
 
+static rl_status sec_convergence(void *ctx, cJSON *sec)
+{
+    bpt *b = ctx;
+    bench_pt_conv_args ca = { .size = (int)b->a->conv_size, .ref_spp = b->a->conv_ref_spp,
+                              .spp_max = b->a->conv_spp_max, .threads = b->threads, .out_path = b->out_path,
+                              .configs = b->a->conv_configs };
+    return bench_pt_convergence(&ca, sec);
+}
+
 /* ------------------------------------------------------- the command -- */
 
 /* Returns RL_CLI_OK, an exit code, or RL_BENCH_HELP_SHOWN. */
@@ -1386,6 +1423,10 @@ static int parse_args(int argc, char **argv, bpt_args *a)
         RL_BENCH_COUNT("--ref-spp", 1 << 20, &a->ref_spp, &a->has_ref_spp),
         RL_BENCH_COUNT("--spp-max", 1 << 16, &a->spp_max, &a->has_spp_max),
         RL_BENCH_COUNT("--max-memory", 1 << 16, &a->max_memory_gb, NULL),
+        RL_BENCH_COUNT("--conv-size", 8192, &a->conv_size, &a->has_conv_size),
+        RL_BENCH_COUNT("--conv-ref-spp", 1 << 20, &a->conv_ref_spp, &a->has_conv_ref_spp),
+        RL_BENCH_COUNT("--conv-spp-max", 1 << 20, &a->conv_spp_max, &a->has_conv_spp_max),
+        RL_BENCH_STRING("--conv-configs", &a->conv_configs),
         RL_BENCH_COUNT("--threads", 1024, &a->threads, NULL),
         RL_BENCH_SECTIONS(section_names, SEC_COUNT, &a->sections),
         RL_BENCH_OUT(&a->out),
@@ -1408,6 +1449,14 @@ static int parse_args(int argc, char **argv, bpt_args *a)
         a->spp_max = a->quick ? 8 : 64;
     if (!a->has_builds)
         a->builds = a->quick ? 1 : 3;
+    if (!a->has_conv_size)
+        a->conv_size = a->quick ? 64 : 512;
+    if (!a->has_conv_ref_spp)
+        a->conv_ref_spp = a->quick ? 64 : 4096;
+    if (!a->has_conv_spp_max)
+        a->conv_spp_max = a->quick ? 16 : 1024;
+    if (a->conv_ref_spp < 2 || a->conv_spp_max < 4)
+        return cli_fail(RL_CLI_USAGE, "--conv-ref-spp needs at least 2 (two halves), --conv-spp-max at least 4");
     if (!a->has_fixed_k)
         a->fixed_k = 8;
     if (a->fixed_k % 2 != 0)
@@ -1436,6 +1485,12 @@ static cJSON *params_json(const bpt *b)
     cJSON_AddBoolToObject(o, "ls_huge_pages", !a->small_pages);
     cJSON_AddNumberToObject(o, "ls_builds", (double)a->builds);
     cJSON_AddNumberToObject(o, "ls_fixed_k", (double)a->fixed_k);
+    cJSON_AddNumberToObject(o, "conv_size", (double)a->conv_size);
+    cJSON_AddNumberToObject(o, "conv_ref_spp", (double)a->conv_ref_spp);
+    cJSON_AddNumberToObject(o, "conv_spp_max", (double)a->conv_spp_max);
+    cJSON_AddStringToObject(o, "sampling",
+                            "all sections but convergence: rng=hybrid, mis=off, light_samples=1, rr_depth=2 "
+                            "(the thesis; pt's defaults before issue 37)");
     cJSON_AddNumberToObject(o, "warmup_renders", 1);
     cJSON_AddNumberToObject(o, "timed_renders", b->runs);
     cJSON_AddStringToObject(o, "seed", PT_SEED);
@@ -1502,9 +1557,10 @@ int bench_pt(int argc, char **argv)
         return cli_fail(RL_CLI_FAIL, "out of memory");
     cJSON_AddItemToObject(root, "parameters", params_json(&b));
     cJSON_AddItemToObject(root, "thesis", thesis_json());
-    static const bench_section_fn fns[SEC_COUNT] = { sec_generation, sec_scenes,   sec_diffuse,
-                                                        sec_shadow,     sec_error,    sec_specular,
-                                                        sec_accumulation };
+    static const bench_section_fn fns[SEC_COUNT] = { sec_generation, sec_scenes,       sec_diffuse,
+                                                        sec_shadow,     sec_error,        sec_specular,
+                                                        sec_accumulation, sec_convergence };
+    b.out_path = out;
     printf("rl bench pt: Line Space path tracing (Schroeder 2017), %d threads\n", b.threads);
     rc = bench_run_sections("pt", root, section_names, fns, SEC_COUNT, a.sections, &b,
                                b.reason, b.threads, out);

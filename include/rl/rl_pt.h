@@ -6,7 +6,8 @@
  *
  * The path tracer in one paragraph: per pixel and frame, spp camera paths;
  * at each diffuse or glossy vertex the lights are sampled with shadow rays
- * (next-event estimation, eq. 7 for quad lights), then Russian roulette
+ * (next-event estimation, eq. 7 for quad lights; by default one light chosen
+ * by power and weighted against the BSDF sample by MIS), then Russian roulette
  * picks mirror, refraction or the Phong BRDF, whose direction is importance
  * sampled; frames are blended into the running mean (eq. 8). Shadow and
  * secondary rays go through selectable backends: BVH, grid, Embree, Line
@@ -63,7 +64,8 @@ typedef struct rl_pt_stats {
      * (they are kept between frames); 0 for one not in use. With ls_file
      * the Line Space's is its load time when the file was loaded. */
     double build_bvh_ms, build_grid_ms, build_embree_ms, build_linespace_ms, build_shadowmap_ms;
-    rl_rng_gpu_kind rng;
+    rl_rng_gpu_kind rng;          /* the GPU generator, when not sobol */
+    bool sobol;                   /* rng=sobol: Owen-scrambled Sobol points */
     float filter_weight;          /* weight of the filtered image in the output */
 } rl_pt_stats;
 

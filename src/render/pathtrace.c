@@ -10,8 +10,11 @@
  *                      scenes, 3 Cornell box]; 0 = direct light only;
  *                      -1 = the scene's root attribute max_path_length
  *                      (ls-open, ls-cornell carry the thesis' value), else 3
- *   rr = true, rr_depth = 2    Russian roulette from that bounce on
- *   rng = hybrid       lcg | tausworthe | hybrid (Sec. 5.3) [hybrid]
+ *   rr = true, rr_depth = 4    Russian roulette from that bounce on [2]
+ *   rng = sobol        sobol (Owen-scrambled Sobol points, issue 37) | lcg |
+ *                      tausworthe | hybrid (Sec. 5.3) [hybrid]
+ *   mis = on           on: lights chosen by power, MIS with the BSDF sample
+ *                      (Veach 1997, issue 37) | off [every light per vertex]
  *   seed = 0
  *   shadow = bvh       bvh | grid | embree | ls-candidates | ls-preillum |
  *                      ls-pnmt | shadowmap
@@ -50,8 +53,10 @@
  *
  * Random numbers (Sec. 5.3): one GPU-style generator state per pixel (the
  * thesis' state texture), seeded on reset from PCG32 (seed, pixel) and
- * advanced across frames. Every pixel's result depends only on its own
- * state, so images do not depend on the thread count.
+ * advanced across frames; or (rng=sobol) the Sobol point numbered by the
+ * pixel's accumulated samples (pathtrace_sampler.c). Every pixel's result
+ * depends only on its own state, so images do not depend on the thread
+ * count.
  *
  * Filter (Sec. 8.2): the filtered accumulated image is blended in with the
  * weight 1 / (1 + spp / filter_fade), spp the mean samples per pixel so far:
@@ -82,7 +87,9 @@
  * quarter of 1 spp's (docs/path-tracing.md, "Time budget"). */
 #define PT_DEFAULT_TIME_S 10.0
 
-static const char *const rng_choices[] = { "lcg", "tausworthe", "hybrid", NULL };
+/* Order: sobol, then rl_rng_gpu_kind. */
+static const char *const rng_choices[] = { "sobol", "lcg", "tausworthe", "hybrid", NULL };
+static const char *const mis_choices[] = { "off", "on", NULL };
 /* Order = rl_pt_backend. */
 static const char *const shadow_choices[] = { "bvh", "grid", "embree", "ls-candidates", "ls-preillum", "ls-pnmt",
                                               "shadowmap", NULL };
@@ -101,9 +108,14 @@ static const rl_option_info pt_options[] = {
       "-1: the scene's root attribute max_path_length, else 3)",
       -1, 1024, NULL },
     { "rr", RL_OPT_BOOL, "true", "Russian roulette on the path length (Sec. 3.2.4)", 0, 0, NULL },
-    { "rr_depth", RL_OPT_INT, "2", "bounce from which Russian roulette may end a path", 0, 1024, NULL },
-    { "rng", RL_OPT_ENUM, "hybrid", "per-pixel random numbers (Sec. 5.3): lcg, tausworthe or their hybrid",
-      0, 0, rng_choices },
+    { "rr_depth", RL_OPT_INT, "4",
+      "bounce from which Russian roulette may end a path (thesis: 2; 4 by measurement, issue 37)", 0, 1024, NULL },
+    { "rng", RL_OPT_ENUM, "sobol",
+      "sample numbers: sobol (Owen-scrambled Sobol points) or the thesis' per-pixel generators (Sec. 5.3): lcg, "
+      "tausworthe or their hybrid", 0, 0, rng_choices },
+    { "mis", RL_OPT_ENUM, "on",
+      "on: lights chosen by power, light and BSDF samples weighted by the power heuristic (Veach 1997); off: "
+      "the thesis' next-event estimation of every light", 0, 0, mis_choices },
     { "seed", RL_OPT_INT, "0", "seed of the per-pixel generator states", 0, 9007199254740991.0, NULL },
     { "shadow", RL_OPT_ENUM, "bvh", "shadow test: exact accelerator, Line Space payload or shadow maps",
       0, 0, shadow_choices },
@@ -228,7 +240,10 @@ static void read_settings(const rl_renderer *r, pt_settings *set)
     set->max_depth = (int)rl_renderer_opt_int(r, "max_depth");
     set->rr = rl_renderer_opt_bool(r, "rr");
     set->rr_depth = (int)rl_renderer_opt_int(r, "rr_depth");
-    set->rng = (rl_rng_gpu_kind)rl_renderer_opt_enum(r, "rng");
+    int rng = rl_renderer_opt_enum(r, "rng");
+    set->sobol = rng == 0;
+    set->rng = set->sobol ? RL_RNG_GPU_HYBRID : (rl_rng_gpu_kind)(rng - 1);
+    set->mis = rl_renderer_opt_enum(r, "mis") == 1;
     set->seed = (uint64_t)rl_renderer_opt_int(r, "seed");
     set->shadow = (rl_pt_backend)rl_renderer_opt_enum(r, "shadow");
     set->diffuse = (rl_pt_backend)rl_renderer_opt_enum(r, "diffuse");
@@ -359,7 +374,17 @@ static void tile_bounds(const frame *f, int64_t t, int *x0, int *y0, int *x1, in
 
 /* Primary pass of one sample (trace mode): jittered camera rays, Sec. 8.1's
  * "jittering of the primary rays". */
-static void primary_tile(const frame *f, int64_t t, pt_counters *c)
+/* Sample `pass` of this frame in pixel i: the pixel's generator state, or
+ * the Sobol point numbered by the samples the pixel has accumulated. */
+static void pixel_sampler(const frame *f, size_t i, uint32_t pass, pt_sampler *sp)
+{
+    if (f->set->sobol)
+        rl_pt_sampler_init(sp, NULL, rl_pt_pixel_seed(f->set->seed, i), f->s->count[i] + pass);
+    else
+        rl_pt_sampler_init(sp, &f->s->rng[i], 0, 0);
+}
+
+static void primary_tile(const frame *f, int64_t t, uint32_t pass, pt_counters *c)
 {
     int x0, y0, x1, y1;
     tile_bounds(f, t, &x0, &y0, &x1, &y1);
@@ -368,9 +393,11 @@ static void primary_tile(const frame *f, int64_t t, pt_counters *c)
             if (!active(f, x, y))
                 continue;
             size_t i = (size_t)y * f->width + x;
-            rl_rng_gpu *rng = &f->s->rng[i];
-            float jx = rl_rng_gpu_float(rng), jy = rl_rng_gpu_float(rng);
-            rl_ray ray = rl_camera_frame_ray(&f->cam, (float)x + jx, (float)y + jy);
+            pt_sampler sp;
+            pixel_sampler(f, i, pass, &sp);
+            rl_pt_sampler_seek(&sp, PT_SLOT_PIXEL);
+            rl_vec2 j = rl_pt_sample_2d(&sp);   /* box filter: uniform in the pixel */
+            rl_ray ray = rl_camera_frame_ray(&f->cam, (float)x + j.x, (float)y + j.y);
             rl_hit hit = { INFINITY, 0.0f, 0.0f, RL_ID_NONE, RL_ID_NONE };
             c->rays[RL_RAY_PRIMARY]++;
             c->trace_q[RL_PT_BACKEND_BVH]++;
@@ -396,7 +423,7 @@ static bool first_vertex(const frame *f, size_t i, pt_surface *s)
     return true;
 }
 
-static void path_tile(const frame *f, int64_t t, pt_counters *c)
+static void path_tile(const frame *f, int64_t t, uint32_t pass, pt_counters *c)
 {
     int x0, y0, x1, y1;
     tile_bounds(f, t, &x0, &y0, &x1, &y1);
@@ -407,8 +434,11 @@ static void path_tile(const frame *f, int64_t t, pt_counters *c)
             size_t i = (size_t)y * f->width + x;
             pt_surface first;
             rl_vec3 L = f->ctx.background;   /* a camera ray that leaves the scene */
-            if (first_vertex(f, i, &first))
-                L = rl_pt_trace_path(&f->ctx, &first, &f->s->rng[i], c);
+            if (first_vertex(f, i, &first)) {
+                pt_sampler sp;
+                pixel_sampler(f, i, pass, &sp);
+                L = rl_pt_trace_path(&f->ctx, &first, &sp, c);
+            }
             /* A NaN or infinity would poison the pixel's mean for good. */
             if (!rl_vfinite(L))
                 continue;
@@ -431,14 +461,15 @@ static void add_counters(pt_counters *to, const pt_counters *from)
 }
 
 /* One pass over all tiles; tile counters keep adding. */
-static void run_pass(const frame *f, int threads, int64_t num_tiles, pt_counters *tile_c, bool primary)
+static void run_pass(const frame *f, int threads, int64_t num_tiles, uint32_t pass, pt_counters *tile_c,
+                     bool primary)
 {
 #pragma omp parallel for num_threads(threads) schedule(dynamic, 1)
     for (int64_t t = 0; t < num_tiles; ++t) {
         if (primary)
-            primary_tile(f, t, &tile_c[t]);
+            primary_tile(f, t, pass, &tile_c[t]);
         else
-            path_tile(f, t, &tile_c[t]);
+            path_tile(f, t, pass, &tile_c[t]);
     }
 }
 
@@ -592,11 +623,11 @@ static rl_status trace_passes(rl_renderer *r, const frame *f, const pt_settings 
     for (int k = 0; k < set->spp; ++k) {
         if (set->primary == PT_PRIMARY_TRACE) {
             rl_timer_start(&timer);
-            run_pass(f, set->threads, num_tiles, tile_c, true);
+            run_pass(f, set->threads, num_tiles, (uint32_t)k, tile_c, true);
             ps->time_primary_ms += rl_timer_ms(&timer);
         }
         rl_timer_start(&timer);
-        run_pass(f, set->threads, num_tiles, tile_c, false);
+        run_pass(f, set->threads, num_tiles, (uint32_t)k, tile_c, false);
         ps->time_paths_ms += rl_timer_ms(&timer);
         if (!rl_renderer_progress(r, BUILD_SHARE + (1.0 - BUILD_SHARE) * (k + 1) / set->spp)) {
             free(tile_c);
@@ -636,7 +667,16 @@ static void finish_stats(pt_state *s, const pt_settings *set, const pt_counters 
     ps->build_linespace_ms = s->b.ls ? s->b.ls_ms : 0.0;
     ps->build_shadowmap_ms = s->b.sm ? s->b.sm_ms : 0.0;
     ps->rng = set->rng;
+    ps->sobol = set->sobol;
     ps->time_total_ms = rl_timer_ms(total);
+}
+
+/* Whether secondary rays through backend k find the triangles themselves
+ * (not a Line Space payload), so emitters they hit can be MIS-weighted. */
+static bool exact_backend(rl_pt_backend k)
+{
+    return k == RL_PT_BACKEND_BVH || k == RL_PT_BACKEND_GRID || k == RL_PT_BACKEND_EMBREE ||
+           k == RL_PT_BACKEND_LS_CANDIDATES;
 }
 
 static rl_status pt_render(rl_renderer *r, void *state, const rl_scene *scene, const rl_camera *cam,
@@ -663,6 +703,10 @@ static rl_status pt_render(rl_renderer *r, void *state, const rl_scene *scene, c
         .ctx = { .data = d, .b = &s->b, .shadow = set.shadow, .diffuse = set.diffuse, .specular = set.specular,
                  .max_depth = set.max_depth >= 0 ? set.max_depth : scene_max_depth(scene),
                  .rr_depth = set.rr_depth, .light_samples = set.light_samples, .rr = set.rr,
+                 .mis = set.mis, .mis_hits = set.mis && exact_backend(set.diffuse),
+                 .tri_lights = set.mis && exact_backend(set.diffuse) && set.shadow != RL_PT_BACKEND_SHADOWMAP,
+                 .vertex_slots = PT_SLOTS_VERTEX + PT_SLOTS_LIGHT * (uint32_t)set.light_samples *
+                                                   (set.mis ? 1u : (d->num_lights ? d->num_lights : 1u)),
                  .background = set.background },
         .cam = rl_camera_frame_make(cam),
         .eye = cam->eye,

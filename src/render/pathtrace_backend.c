@@ -239,6 +239,7 @@ void rl_pt_backends_release(pt_backends *b)
         rl_accel_release(b->exact[k]);
     rl_shadowmap_release(b->sm);
     free(b->tri_cover);
+    rl_pt_lights_release(&b->lights);
     memset(b, 0, sizeof *b);
 }
 
@@ -303,8 +304,10 @@ rl_status rl_pt_backends_prepare(pt_backends *b, const rl_scene *scene, const pt
         b->scene_uid = uid;
         b->data = d;
         b->eps = EPS_SCALE * scene_scale(d->bounds);
-        if ((st = build_cover(b, d)) != RL_OK)
+        if ((st = build_cover(b, d)) != RL_OK || (st = rl_pt_lights_build(b, d)) != RL_OK) {
+            rl_pt_backends_release(b);    /* the next frame starts over */
             return st;
+        }
     }
     rl_pt_backend kinds[2] = { set->shadow, set->diffuse };
     for (int i = 0; i < 2; ++i) {

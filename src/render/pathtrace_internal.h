@@ -8,6 +8,11 @@
  *                      shader for the Line Space (Sec. 7.4)
  * pathtrace_bsdf.c     importance sampling of the modified Phong BRDF
  *                      (Sec. 6.4.3; Lafortune & Willems 1994)
+ * pathtrace_lights.c   the lights chosen by power for next-event estimation
+ *                      with MIS (Veach 1997): scene lights and emissive
+ *                      triangles, their pdfs
+ * pathtrace_sampler.c  the sample numbers: the thesis' GPU generators
+ *                      (Sec. 5.3) or Owen-scrambled Sobol points
  * pathtrace_backend.c  the acceleration structures the backends need (BVH,
  *                      grid, Embree, Line Space, shadow maps), built lazily
  *                      and kept between frames; query routing */
@@ -31,6 +36,8 @@ typedef struct pt_settings {
     int spp, max_depth, rr_depth, light_samples, threads;
     bool rr, checkerboard, accumulate, ls_dynamic;
     bool ls_origin_exact;          /* ls_origin=exact, else the voxel offset */
+    bool mis;                      /* mis=on: lights by power, MIS with the BSDF */
+    bool sobol;                    /* rng=sobol, else the GPU generator rng */
     rl_rng_gpu_kind rng;
     uint64_t seed;
     rl_pt_backend shadow, diffuse;
@@ -44,6 +51,19 @@ typedef struct pt_settings {
 } pt_settings;
 
 /* ------------------------------------------------------------ backends -- */
+
+/* The lights next-event estimation chooses from with mis=on, by power: the
+ * scene's lights, then the emissive triangles no quad light covers. */
+typedef struct pt_lights {
+    uint32_t count;                /* entries with power > 0 */
+    uint32_t *source;              /* per entry: a light index, or num_lights + triangle */
+    float *cdf;                    /* count + 1 running sums, cdf[count] = 1 */
+    float *light_pmf;              /* per scene light: its probability */
+    bool *light_hittable;          /* per scene light: a quad whose covering mesh a ray can hit */
+    float *tri_pmf;                /* per triangle: the probability of an uncovered emitter, else 0 */
+    rl_vec3 centre;                /* bounding sphere of the scene (directional lights) */
+    float radius;
+} pt_lights;
 
 /* Everything built for one scene, kept between frames (Sec. 5.1: "built
  * once and reused; only a new scene rebuilds them"). */
@@ -66,6 +86,7 @@ typedef struct pt_backends {
     int sm_size;
     double sm_ms;
     uint32_t *tri_cover;           /* per triangle: covering quad light or RL_NONE */
+    pt_lights lights;
     float eps;                     /* ray origin offset */
 } pt_backends;
 
@@ -75,6 +96,13 @@ typedef struct pt_backends {
 rl_status rl_pt_backends_prepare(pt_backends *b, const rl_scene *scene, const pt_settings *set,
                                  int threads, double *built_ms);
 void rl_pt_backends_release(pt_backends *b);
+/* Builds b->lights from the scene and b->tri_cover. */
+rl_status rl_pt_lights_build(pt_backends *b, const rl_scene_data *d);
+void rl_pt_lights_release(pt_lights *l);
+/* The entry of the light table whose cdf interval holds u in [0,1). */
+uint32_t rl_pt_lights_pick(const pt_lights *l, float u);
+/* Triangle t's area, and its unit geometric normal by its winding. */
+float rl_pt_triangle_area(const rl_scene_data *d, uint32_t t, rl_vec3 *normal);
 /* The quad light whose parallelogram contains p (within tol of its plane
  * and of its edges), or RL_NONE: the emission rule of pathtrace_path.c. */
 uint32_t rl_pt_cover_point(const rl_scene_data *d, rl_vec3 p, float tol);
@@ -100,8 +128,51 @@ typedef struct pt_ctx {
     rl_pt_backend specular;        /* mirror and refraction rays */
     int max_depth, rr_depth, light_samples;
     bool rr;
+    bool mis;                      /* lights by power, MIS weights (pathtrace_path.c) */
+    bool mis_hits;                 /* with mis: BSDF rays find emitters exactly (an exact
+                                    * diffuse backend), so both strategies are weighted */
+    bool tri_lights;               /* with mis_hits: emissive triangles are sampled too
+                                    * (not with shadow maps, which know scene lights only) */
+    uint32_t vertex_slots;         /* sampler slots per path vertex */
     rl_vec3 background;            /* radiance of rays that leave the scene */
 } pt_ctx;
+
+/* ------------------------------------------------------------ sampler -- */
+
+/* The numbers of one sample of one pixel: rng != NULL draws from the
+ * thesis' generator in call order; otherwise Owen-scrambled Sobol points
+ * addressed by (index, slot). */
+typedef struct pt_sampler {
+    rl_rng_gpu *rng;
+    uint32_t pixel_seed;
+    uint32_t index;                /* the sample's number within its pixel */
+    uint32_t slot;                 /* the next dimension (1D) or pair (2D) */
+} pt_sampler;
+
+/* Dimension layout of rng=sobol: the pixel filter, then per path vertex
+ * (depth 0 = the camera hit) a block of PT_SLOTS_VERTEX + PT_SLOTS_LIGHT *
+ * light_samples slots: the material event, the BSDF lobe, the BSDF
+ * direction (2D), Russian roulette, and per light sample the light choice,
+ * the point on it (2D) and the shadow-map jitter (2D). */
+enum {
+    PT_SLOT_PIXEL = 0,
+    PT_SLOT_FIRST_VERTEX = 1,
+    PT_SLOT_EVENT = 0, PT_SLOT_LOBE, PT_SLOT_BSDF, PT_SLOT_RR,
+    PT_SLOTS_VERTEX,
+    PT_SLOT_LIGHT_PICK = 0, PT_SLOT_LIGHT_POINT, PT_SLOT_LIGHT_JITTER,
+    PT_SLOTS_LIGHT
+};
+
+void rl_pt_sampler_init(pt_sampler *s, rl_rng_gpu *rng, uint32_t pixel_seed, uint32_t index);
+/* A pixel's scramble seed from the option seed and the pixel's number. */
+uint32_t rl_pt_pixel_seed(uint64_t seed, uint64_t pixel);
+/* Moves to a slot (ignored by the GPU generators, which run in order). */
+void rl_pt_sampler_seek(pt_sampler *s, uint32_t slot);
+float rl_pt_sample_1d(pt_sampler *s);
+rl_vec2 rl_pt_sample_2d(pt_sampler *s);
+/* Nested uniform scrambling of x read as a binary fraction (MSB first);
+ * exposed for the tests of its stratification. */
+uint32_t rl_pt_owen_scramble(uint32_t x, uint32_t seed);
 
 /* A surface point being shaded. Normals are unit and face the side the
  * ray came from; tri is RL_ID_NONE for a Line Space PNMT record. */
@@ -127,7 +198,7 @@ bool rl_pt_surface_at_hit(const rl_scene_data *d, const rl_hit *hit, rl_vec3 o, 
 
 /* Radiance arriving along the camera path whose first vertex is s
  * (Sec. 6.4: Trace, Shade, Phong sampling, until max_depth or roulette). */
-rl_vec3 rl_pt_trace_path(const pt_ctx *ctx, const pt_surface *first, rl_rng_gpu *rng, pt_counters *c);
+rl_vec3 rl_pt_trace_path(const pt_ctx *ctx, const pt_surface *first, pt_sampler *sampler, pt_counters *c);
 
 /* Closest surface along ray through backend `backend` (exact kinds, Line
  * Space candidates, PNMT), counted as `type`. False on a miss. */

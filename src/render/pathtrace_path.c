@@ -38,9 +38,14 @@
  * thesis' voxel offset against self-illumination, Sec. 12.1-12.2, Fig. 19, 21):
  * occluders closer than that are missed, as the thesis reports.
  *
- * Random numbers come from the pixel's GPU-style generator only, in an
- * order that does not depend on which shadow rays are traced, so exact
- * backends give the same image. */
+ * With mis=on (issue 37; docs/path-tracing.md) next-event estimation
+ * instead takes light_samples lights chosen by power (pathtrace_lights.c),
+ * emissive triangles included, and weights each light sample and each BSDF
+ * ray that hits an emitter by the power heuristic (Veach 1997).
+ *
+ * Random numbers come from the pixel's sampler only (pathtrace_sampler.c),
+ * in an order, or at slots, that do not depend on which shadow rays are
+ * traced, so exact backends give the same image. */
 #include <math.h>
 #include <string.h>
 
@@ -166,7 +171,19 @@ static bool visible(const pt_ctx *ctx, const pt_surface *s, rl_vec3 l, float dis
     if (k == RL_PT_BACKEND_SHADOWMAP)
         return rl_shadowmap_visible(b->sm, light, s->p, s->ng, ju, jv);
     c->rays[RL_RAY_SHADOW]++;
-    rl_ray ray = { offset_origin(ctx, s, l), 0.0f, l, isinf(dist) ? INFINITY : dist * (1.0f - SHADOW_T_SHRINK) };
+    rl_ray ray = { offset_origin(ctx, s, l), 0.0f, l, INFINITY };
+    if (!isinf(dist)) {
+        /* Aim from the offset origin at the light point itself: the ray
+         * along l from there would end eps beyond the light's plane when
+         * it leaves the surface at a grazing angle to that plane, and the
+         * light's own emissive mesh then shadowed it (issue 37: a floor
+         * 4 m wide under a lamp mesh went black). */
+        rl_vec3 to = rl_sub(rl_madd(s->p, l, dist), ray.o);
+        float len = rl_length(to);
+        if (len > 0.0f)
+            ray.d = rl_scale(to, 1.0f / len);
+        ray.t_max = len * (1.0f - SHADOW_T_SHRINK);
+    }
     switch (k) {
     case RL_PT_BACKEND_BVH:
     case RL_PT_BACKEND_GRID:
@@ -195,14 +212,16 @@ static bool visible(const pt_ctx *ctx, const pt_surface *s, rl_vec3 l, float dis
     }
 }
 
-/* Shade (Sec. 6.4.2): the light of all lights reflected at s towards s->v. */
-static rl_vec3 direct_light(const pt_ctx *ctx, const pt_surface *s, rl_rng_gpu *rng, pt_counters *c)
+/* Shade (Sec. 6.4.2): the light of all lights reflected at s towards s->v
+ * (mis=off, the thesis: every light, light_samples points per quad). */
+static rl_vec3 direct_light(const pt_ctx *ctx, const pt_surface *s, pt_sampler *sp, uint32_t base, pt_counters *c)
 {
     const rl_scene_data *d = ctx->data;
     bool jitter = ctx->shadow == RL_PT_BACKEND_SHADOWMAP;
     rl_vec3 sum = rl_v3s(0.0f);
     for (uint32_t i = 0; i < d->num_lights; ++i) {
         const rl_light *L = &d->lights[i];
+        uint32_t light_base = base + PT_SLOTS_VERTEX + PT_SLOTS_LIGHT * i * (uint32_t)ctx->light_samples;
         if (L->type == RL_LIGHT_QUAD) {
             rl_vec3 nq = rl_cross(L->edge_u, L->edge_v);
             float area = rl_length(nq);
@@ -215,9 +234,12 @@ static rl_vec3 direct_light(const pt_ctx *ctx, const pt_surface *s, rl_rng_gpu *
                 /* Sec. 6.3: a random point P_rnd on the light. Both numbers
                  * are drawn before any test, so the sequence does not
                  * depend on the outcome. */
-                float xu = rl_rng_gpu_float(rng), xv = rl_rng_gpu_float(rng);
-                float ju = jitter ? rl_rng_gpu_float(rng) : 0.0f, jv = jitter ? rl_rng_gpu_float(rng) : 0.0f;
-                rl_vec3 q = rl_add(L->position, rl_add(rl_scale(L->edge_u, xu), rl_scale(L->edge_v, xv)));
+                uint32_t slot = light_base + PT_SLOTS_LIGHT * (uint32_t)k;
+                rl_pt_sampler_seek(sp, slot + PT_SLOT_LIGHT_POINT);
+                rl_vec2 x = rl_pt_sample_2d(sp);
+                rl_pt_sampler_seek(sp, slot + PT_SLOT_LIGHT_JITTER);
+                rl_vec2 j = jitter ? rl_pt_sample_2d(sp) : rl_v2(0.0f, 0.0f);
+                rl_vec3 q = rl_add(L->position, rl_add(rl_scale(L->edge_u, x.x), rl_scale(L->edge_v, x.y)));
                 rl_vec3 to = rl_sub(q, s->p);
                 float d2 = rl_length2(to);
                 if (!(d2 > 0.0f))
@@ -225,22 +247,122 @@ static rl_vec3 direct_light(const pt_ctx *ctx, const pt_surface *s, rl_rng_gpu *
                 float dist = sqrtf(d2);
                 rl_vec3 l = rl_scale(to, 1.0f / dist);
                 float cos_e = -rl_dot(nq, l), cos_r = rl_dot(s->ns, l);
-                if (cos_e <= 0.0f || cos_r <= 0.0f || !visible(ctx, s, l, dist, i, ju, jv, c))
+                if (cos_e <= 0.0f || cos_r <= 0.0f || !visible(ctx, s, l, dist, i, j.x, j.y, c))
                     continue;
                 rl_vec3 f = rl_pt_phong_eval(s, l);
                 sum = rl_add(sum, rl_mul(f, rl_scale(le, cos_e * cos_r / d2)));   /* eq. 7 */
             }
             continue;
         }
-        float ju = jitter ? rl_rng_gpu_float(rng) : 0.0f, jv = jitter ? rl_rng_gpu_float(rng) : 0.0f;
+        rl_pt_sampler_seek(sp, light_base + PT_SLOT_LIGHT_JITTER);
+        rl_vec2 j = jitter ? rl_pt_sample_2d(sp) : rl_v2(0.0f, 0.0f);
         rl_vec3 E, l;
         float dist;
         if (!rl_light_eval_delta(L, s->p, &E, &l, &dist))
             continue;
         float cos_r = rl_dot(s->ns, l);
-        if (cos_r <= 0.0f || !visible(ctx, s, l, dist, i, ju, jv, c))
+        if (cos_r <= 0.0f || !visible(ctx, s, l, dist, i, j.x, j.y, c))
             continue;
         sum = rl_add(sum, rl_mul(rl_pt_phong_eval(s, l), rl_scale(E, cos_r)));
+    }
+    return sum;
+}
+
+/* Power heuristic with beta = 2 (Veach 1997, Sec. 9.2.4) for the strategy
+ * whose pdf times sample count is a, against b; written as a ratio so that
+ * a pdf that overflows at a grazing light still gives 0 or 1. */
+static float power_heuristic(float a, float b)
+{
+    if (!(a > 0.0f))
+        return 0.0f;
+    float r = b / a;
+    return 1.0f / (1.0f + r * r);
+}
+
+/* The pdf, in solid angle at s, with which the BSDF strategy produces wi:
+ * the Phong mixture, zero below the geometric surface where
+ * rl_pt_phong_sample refuses directions. */
+static float bsdf_pdf(const pt_surface *s, rl_vec3 wi)
+{
+    return rl_dot(s->ng, wi) > 0.0f ? rl_pt_phong_pdf(s, wi) : 0.0f;
+}
+
+/* Next-event estimation with mis=on: light_samples lights chosen by power
+ * (pathtrace_lights.c), a uniform point on an area light, and the power
+ * heuristic against the BSDF sample that follows (bsdf_follows; at the last
+ * vertex none does, and the light sample keeps the full weight). Delta
+ * lights cannot be hit and keep the full weight too. */
+static rl_vec3 direct_light_mis(const pt_ctx *ctx, const pt_surface *s, pt_sampler *sp, uint32_t base,
+                                bool bsdf_follows, pt_counters *c)
+{
+    const rl_scene_data *d = ctx->data;
+    const pt_lights *lt = &ctx->b->lights;
+    if (lt->count == 0)
+        return rl_v3s(0.0f);
+    bool jitter = ctx->shadow == RL_PT_BACKEND_SHADOWMAP;
+    int n = ctx->light_samples;
+    rl_vec3 sum = rl_v3s(0.0f);
+    for (int k = 0; k < n; ++k) {
+        uint32_t slot = base + PT_SLOTS_VERTEX + PT_SLOTS_LIGHT * (uint32_t)k;
+        rl_pt_sampler_seek(sp, slot + PT_SLOT_LIGHT_PICK);
+        float u_pick = lt->count > 1 ? rl_pt_sample_1d(sp) : 0.0f;
+        rl_pt_sampler_seek(sp, slot + PT_SLOT_LIGHT_POINT);
+        rl_vec2 x = rl_pt_sample_2d(sp);
+        rl_pt_sampler_seek(sp, slot + PT_SLOT_LIGHT_JITTER);
+        rl_vec2 j = jitter ? rl_pt_sample_2d(sp) : rl_v2(0.0f, 0.0f);
+        uint32_t src = lt->source[rl_pt_lights_pick(lt, u_pick)];
+        rl_vec3 q, n_e, le;
+        float area, pmf;
+        bool hittable;
+        if (src < d->num_lights) {
+            const rl_light *L = &d->lights[src];
+            pmf = lt->light_pmf[src];
+            if (L->type != RL_LIGHT_QUAD) {
+                rl_vec3 E, l;
+                float dist;
+                if (!rl_light_eval_delta(L, s->p, &E, &l, &dist))
+                    continue;
+                float cos_r = rl_dot(s->ns, l);
+                if (cos_r <= 0.0f || !visible(ctx, s, l, dist, src, j.x, j.y, c))
+                    continue;
+                sum = rl_add(sum, rl_mul(rl_pt_phong_eval(s, l), rl_scale(E, cos_r / (pmf * (float)n))));
+                continue;
+            }
+            n_e = rl_cross(L->edge_u, L->edge_v);
+            area = rl_length(n_e);
+            n_e = rl_scale(n_e, 1.0f / area);
+            q = rl_add(L->position, rl_add(rl_scale(L->edge_u, x.x), rl_scale(L->edge_v, x.y)));
+            le = rl_scale(L->color, L->intensity);
+            hittable = ctx->mis_hits && lt->light_hittable[src];
+        } else {
+            if (!ctx->tri_lights)
+                continue;             /* counted where rays hit it (emission rule) */
+            uint32_t t = src - d->num_lights;
+            const uint32_t *idx = &d->indices[3 * (size_t)t];
+            pmf = lt->tri_pmf[t];
+            area = rl_pt_triangle_area(d, t, &n_e);
+            /* Uniform on the triangle: barycentrics (1 - sqrt(u), v sqrt(u)). */
+            float r = sqrtf(x.x), b1 = x.y * r, b0 = 1.0f - r;
+            rl_vec3 p0 = d->positions[idx[0]], p1 = d->positions[idx[1]], p2 = d->positions[idx[2]];
+            q = rl_add(rl_add(rl_scale(p0, b0), rl_scale(p1, b1)), rl_scale(p2, 1.0f - b0 - b1));
+            le = d->materials[d->triangle_material[t]].emission;
+            hittable = true;
+        }
+        rl_vec3 to = rl_sub(q, s->p);
+        float d2 = rl_length2(to);
+        if (!(d2 > 0.0f))
+            continue;
+        float dist = sqrtf(d2);
+        rl_vec3 l = rl_scale(to, 1.0f / dist);
+        /* Quads emit on their front only; uncovered triangles on both sides. */
+        float cos_e = src < d->num_lights ? -rl_dot(n_e, l) : fabsf(rl_dot(n_e, l));
+        float cos_r = rl_dot(s->ns, l);
+        if (cos_e <= 0.0f || cos_r <= 0.0f || !visible(ctx, s, l, dist, src < d->num_lights ? src : 0, j.x, j.y, c))
+            continue;
+        float p_light = pmf * d2 / (area * cos_e);          /* solid angle at s */
+        float w = bsdf_follows && hittable ? power_heuristic((float)n * p_light, bsdf_pdf(s, l)) : 1.0f;
+        rl_vec3 f = rl_pt_phong_eval(s, l);
+        sum = rl_add(sum, rl_mul(f, rl_scale(le, w * cos_r / (p_light * (float)n))));
     }
     return sum;
 }
@@ -260,18 +382,65 @@ static rl_vec3 emitted(const pt_ctx *ctx, const pt_surface *s, bool after_brdf)
     return emitting_side && !after_brdf ? e : rl_v3s(0.0f);
 }
 
-rl_vec3 rl_pt_trace_path(const pt_ctx *ctx, const pt_surface *first, rl_rng_gpu *rng, pt_counters *c)
+/* The emission rule with mis=on: after a BSDF bounce from prev (with
+ * direction pdf bsdf_pdf) an emitter that light sampling also reaches gets
+ * the power-heuristic weight of the BSDF strategy, and a covered triangle
+ * stands for its quad light (radiance colour * intensity, the value light
+ * sampling uses). From the camera or a mirror / refraction event the
+ * emission counts in full, as with mis=off. */
+static rl_vec3 emitted_mis(const pt_ctx *ctx, const pt_surface *s, bool after_brdf, rl_vec3 prev, float pdf_bsdf)
+{
+    if (!after_brdf || !ctx->mis_hits)
+        return emitted(ctx, s, after_brdf);
+    rl_vec3 e = s->m->emission;
+    if (!(rl_vmax_comp(e) > 0.0f) || s->tri == RL_ID_NONE)
+        return emitted(ctx, s, after_brdf);
+    const pt_backends *b = ctx->b;
+    const pt_lights *lt = &b->lights;
+    uint32_t cover = b->tri_cover[s->tri];
+    float pmf, area;
+    if (cover == RL_NONE) {
+        if (!ctx->tri_lights)
+            return e;
+        pmf = lt->tri_pmf[s->tri];
+        area = rl_pt_triangle_area(ctx->data, s->tri, NULL);
+    } else {
+        const rl_light *L = &ctx->data->lights[cover];
+        rl_vec3 nq = rl_cross(L->edge_u, L->edge_v);
+        if (!(rl_dot(s->v, nq) > 0.0f) || !lt->light_hittable[cover])
+            return rl_v3s(0.0f);    /* its back, or a quad only NEE reaches */
+        e = rl_scale(L->color, L->intensity);
+        pmf = lt->light_pmf[cover];
+        area = rl_length(nq);
+    }
+    float cos_e = rl_dot(s->ng, s->v);     /* ng faces v */
+    float d2 = rl_length2(rl_sub(s->p, prev));
+    if (!(pmf > 0.0f) || !(cos_e > 0.0f) || !(area > 0.0f))
+        return e;                  /* light sampling never picks it */
+    float p_light = pmf * d2 / (area * cos_e);
+    return rl_scale(e, power_heuristic(pdf_bsdf, (float)ctx->light_samples * p_light));
+}
+
+rl_vec3 rl_pt_trace_path(const pt_ctx *ctx, const pt_surface *first, pt_sampler *sp, pt_counters *c)
 {
     rl_vec3 radiance = rl_v3s(0.0f), T = rl_v3s(1.0f);
     pt_surface s = *first;
     bool after_brdf = false;
+    rl_vec3 prev = s.p;
+    float prev_pdf = 0.0f;
     for (int depth = 0;; ++depth) {
-        radiance = rl_add(radiance, rl_mul(T, emitted(ctx, &s, after_brdf)));
+        uint32_t base = PT_SLOT_FIRST_VERTEX + (uint32_t)depth * ctx->vertex_slots;
+        rl_vec3 e = ctx->mis ? emitted_mis(ctx, &s, after_brdf, prev, prev_pdf) : emitted(ctx, &s, after_brdf);
+        radiance = rl_add(radiance, rl_mul(T, e));
 
         /* Sec. 6.4.1: Russian roulette over reflect / refract / diffuse,
          * each chosen with its coefficient, so the weight stays 1. */
         float k_r = s.m->reflectivity, k_t = s.m->transmissivity;
-        float u_event = rl_rng_gpu_float(rng);
+        /* A slot is fixed, so the Sobol sampler may skip the draws a
+         * material does not need; the thesis' generators must draw them to
+         * keep their sequence. */
+        rl_pt_sampler_seek(sp, base + PT_SLOT_EVENT);
+        float u_event = sp->rng || k_r + k_t > 0.0f ? rl_pt_sample_1d(sp) : 1.0f;
         rl_vec3 dir;
         rl_ray_type type;
         if (u_event < k_r + k_t) {
@@ -292,22 +461,31 @@ rl_vec3 rl_pt_trace_path(const pt_ctx *ctx, const pt_surface *first, rl_rng_gpu 
             }
             after_brdf = false;
         } else {
-            radiance = rl_add(radiance, rl_mul(T, direct_light(ctx, &s, rng, c)));
-            if (depth >= ctx->max_depth)
+            bool last = depth >= ctx->max_depth;
+            rl_vec3 direct = ctx->mis ? direct_light_mis(ctx, &s, sp, base, !last, c)
+                                      : direct_light(ctx, &s, sp, base, c);
+            radiance = rl_add(radiance, rl_mul(T, direct));
+            if (last)
                 break;
-            float u0 = rl_rng_gpu_float(rng), u1 = rl_rng_gpu_float(rng), u2 = rl_rng_gpu_float(rng);
+            rl_pt_sampler_seek(sp, base + PT_SLOT_LOBE);
+            float u0 = sp->rng || rl_vmax_comp(s.m->specular) > 0.0f ? rl_pt_sample_1d(sp) : 0.0f;
+            rl_pt_sampler_seek(sp, base + PT_SLOT_BSDF);
+            rl_vec2 u12 = rl_pt_sample_2d(sp);
             rl_vec3 w;
-            if (!rl_pt_phong_sample(&s, u0, u1, u2, &dir, &w))
+            if (!rl_pt_phong_sample(&s, u0, u12.x, u12.y, &dir, &w))
                 break;
             T = rl_mul(T, w);
             type = RL_RAY_DIFFUSE;
             after_brdf = true;
+            prev_pdf = ctx->mis ? rl_pt_phong_pdf(&s, dir) : 0.0f;
         }
+        prev = s.p;
 
         /* Sec. 3.3: Russian roulette on the path length. */
         if (ctx->rr && depth >= ctx->rr_depth) {
             float q = rl_minf(1.0f, rl_vmax_comp(T));
-            float xi = rl_rng_gpu_float(rng);
+            rl_pt_sampler_seek(sp, base + PT_SLOT_RR);
+            float xi = rl_pt_sample_1d(sp);
             if (!(xi < q))
                 break;
             T = rl_scale(T, 1.0f / q);
@@ -367,11 +545,13 @@ rl_vec3 rl_pt_preillum_shade(void *user, const rl_ls_surface *rec, rl_vec3 dir)
     key = rl_hash64(key ^ ((uint64_t)float_bits(s.p.z) << 32) ^ float_bits(dir.x + 2.0f * dir.y + 4.0f * dir.z));
     rl_rng_gpu rng;
     rl_rng_gpu_seed(&rng, RL_RNG_GPU_HYBRID, key, 0);
+    pt_sampler sp;
+    rl_pt_sampler_init(&sp, &rng, 0, 0);
     pt_counters c;
     memset(&c, 0, sizeof c);
     /* What a path arriving by a BRDF bounce would gather here: uncovered
      * emission, and the direct light of the BRDF event (probability
      * 1 - k_r - k_t). */
     float brdf = rl_maxf(0.0f, 1.0f - s.m->reflectivity - s.m->transmissivity);
-    return rl_add(emitted(&ctx, &s, true), rl_scale(direct_light(&ctx, &s, &rng, &c), brdf));
+    return rl_add(emitted(&ctx, &s, true), rl_scale(direct_light(&ctx, &s, &sp, 0, &c), brdf));
 }

@@ -13,7 +13,16 @@
  * are the usual RGB fits of the measured spectra: white 0.73, red
  * (0.65, 0.05, 0.05), green (0.12, 0.45, 0.15); emitted radiance (17, 12, 4).
  * Camera: eye (0.278, 0.273, -0.8) looking along +z, 35 mm lens on a 25 mm
- * film, i.e. vertical fov 2*atan(12.5/35) = 39.3 degrees, square image. */
+ * film, i.e. vertical fov 2*atan(12.5/35) = 39.3 degrees, square image.
+ *
+ * variant=bitterli takes the material settings of Bitterli's "cornell-box"
+ * (Rendering Resources, 2016), on which issue 37 compares path tracers:
+ * white (0.725, 0.71, 0.68), red (0.63, 0.065, 0.05), green (0.14, 0.45,
+ * 0.091), a black lamp (the one-sided emitter reflects nothing; ours
+ * reflects 0.78) and paths of up to 8 scattering vertices (root attribute
+ * max_path_length = 7: interactions after the camera hit, as pt counts
+ * them). The geometry and camera stay the measured data's above, not
+ * Bitterli's mesh. */
 #include "scene/builtin.h"
 
 #include <stdio.h>
@@ -102,19 +111,23 @@ static rl_status add_part(rl_scene *scene, const part *pt, const uint32_t *mater
     return s;
 }
 
+enum { VARIANT_CLASSIC, VARIANT_BITTERLI, NUM_VARIANTS };
+
 /* Walls, light (mesh + quad light), camera: everything but the contents. */
-static rl_status add_box(rl_scene *scene)
+static rl_status add_box(rl_scene *scene, int variant)
 {
     static const char *const names[NUM_MATERIALS] = { "white", "red", "green", "light" };
-    static const float colours[NUM_MATERIALS][3] = {
-        { 0.73f, 0.73f, 0.73f }, { 0.65f, 0.05f, 0.05f }, { 0.12f, 0.45f, 0.15f }, { 0.78f, 0.78f, 0.78f }
+    static const float colours[NUM_VARIANTS][NUM_MATERIALS][3] = {
+        { { 0.73f, 0.73f, 0.73f }, { 0.65f, 0.05f, 0.05f }, { 0.12f, 0.45f, 0.15f }, { 0.78f, 0.78f, 0.78f } },
+        { { 0.725f, 0.71f, 0.68f }, { 0.63f, 0.065f, 0.05f }, { 0.14f, 0.45f, 0.091f }, { 0.0f, 0.0f, 0.0f } },
     };
     uint32_t materials[NUM_MATERIALS];
     rl_status s = RL_OK;
     for (int i = 0; i < NUM_MATERIALS && !s; ++i) {
         rl_material m = rl_material_default();
         snprintf(m.name, sizeof m.name, "%s", names[i]);
-        m.diffuse = rl_v3(colours[i][0], colours[i][1], colours[i][2]);
+        const float *c = colours[variant][i];
+        m.diffuse = rl_v3(c[0], c[1], c[2]);
         if (i == LIGHT)
             m.emission = rl_v3(17.0f, 12.0f, 4.0f);
         s = rl_scene_add_material(scene, &m, &materials[i]);
@@ -148,8 +161,10 @@ static rl_status add_box(rl_scene *scene)
 
 static rl_status build_cornell(rl_scene *scene, const rl_option_store *params)
 {
-    (void)params;
-    rl_status s = add_box(scene);
+    int variant = rl_option_store_enum(params, "variant");
+    rl_status s = add_box(scene, variant);
+    if (!s && variant == VARIANT_BITTERLI)
+        s = rl_scene_node_set_attr(scene, RL_NODE_ROOT, "max_path_length", "7");
     uint32_t white = rl_scene_find_material(scene, "white");
     uint32_t materials[NUM_MATERIALS] = { white, white, white, white };
     for (size_t i = 0; i < sizeof blocks / sizeof blocks[0] && !s; ++i)
@@ -162,7 +177,7 @@ static rl_status build_cornell_teapot(rl_scene *scene, const rl_option_store *pa
     long long triangles = rl_option_store_int(params, "triangles");
     double size = rl_option_store_float(params, "size"), shininess = rl_option_store_float(params, "shininess"),
            rotate = rl_option_store_float(params, "rotate");
-    rl_status s = add_box(scene);
+    rl_status s = add_box(scene, VARIANT_CLASSIC);
     if (s)
         return s;
 
@@ -191,11 +206,18 @@ static rl_status build_cornell_teapot(rl_scene *scene, const rl_option_store *pa
     return s;
 }
 
+static const char *const variant_names[] = { "classic", "bitterli", NULL };
+static const rl_option_info cornell_options[] = {
+    { "variant", RL_OPT_ENUM, "classic",
+      "classic (the usual RGB fits, a lamp of albedo 0.78) or bitterli (Bitterli's cornell-box albedos, a "
+      "black lamp, max_path_length 7)", 0, 0, variant_names },
+};
+
 const rl_builtin_class rl_builtin_cornell_class = {
     { "cornell",
       "Cornell box from the Cornell measured data (metres): 5 walls, short and tall block, ceiling quad light; "
       "36 triangles",
-      NULL, 0 },
+      RL_BUILTIN_OPTIONS(cornell_options) },
     build_cornell,
 };
 

@@ -22,7 +22,7 @@ expect_in "$TMP/err" "rl: error: "
 
 expect_exit 0 "$RL" bench pt --help
 for o in --size --error-size --ref-spp --spp-max --max-memory --builds --fixed-k --small-pages --only --out \
-         --quick generation accumulation; do
+         --quick generation accumulation convergence --conv-size --conv-ref-spp --conv-spp-max; do
     expect_in "$TMP/out" "$o"
 done
 
@@ -148,4 +148,30 @@ PY
 expect_exit 2 "$RL" bench pt --quick --builds 0
 expect_in "$TMP/err" "--builds"
 expect_exit 2 "$RL" bench pt --quick --builds 101
+
+# convergence (issue 37): every configuration's curve, the reference cached
+# beside the record and reused by the next run.
+expect_usage_error "$RL" bench pt --only convergence --conv-ref-spp 1 --out "$TMP/c.json"
+expect_usage_error "$RL" bench pt --only convergence --conv-size 0 --out "$TMP/c.json"
+mkdir -p "$TMP/conv"
+expect_exit 0 "$RL" bench pt --only convergence --quick --conv-size 16 --conv-ref-spp 32 --conv-spp-max 8 \
+    --out "$TMP/conv/c.json"
+[ -s "$TMP/conv/pt-convergence-ref-16-32.bin" ] || fail "the convergence reference was not cached"
+python3 - "$TMP/conv/c.json" <<'PY' || fail "c.json is wrong"
+import json, sys
+c = json.load(open(sys.argv[1]))["convergence"]
+assert c["status"] == "ok", c
+assert c["scene"] == "cornell:variant=bitterli" and c["size"] == 16, c
+assert c["reference"]["spp"] == 32 and c["reference"]["cached"] is False, c["reference"]
+labels = [x["label"] for x in c["configurations"]]
+assert labels[0] == "defaults" and labels[1].startswith("thesis") and "mis=off" in labels, labels
+for x in c["configurations"]:
+    assert [p["spp"] for p in x["points"]] == [4, 8], x
+    assert all(0 < p["rmse"] < 1 and p["cpu_ms"] > 0 for p in x["points"]), x
+    assert x["points"][1]["rmse"] < x["points"][0]["rmse"], x
+PY
+expect_exit 0 "$RL" bench pt --only convergence --quick --conv-size 16 --conv-ref-spp 32 --conv-spp-max 8 \
+    --out "$TMP/conv/c2.json"
+python3 -c 'import json,sys; assert json.load(open(sys.argv[1]))["convergence"]["reference"]["cached"] is True' \
+    "$TMP/conv/c2.json" || fail "the cached reference was not reused"
 echo "ok"

@@ -68,7 +68,9 @@ static void test_pt_is_registered_and_refuses_bad_options(void **state)
 {
     (void)state;
     rl_renderer *r = fx_make("pt", NULL);
-    assert_string_equal(rl_renderer_get(r, "rng"), "hybrid");
+    assert_string_equal(rl_renderer_get(r, "rng"), "sobol");
+    assert_string_equal(rl_renderer_get(r, "mis"), "on");
+    assert_int_equal(rl_renderer_set(r, "mis", "maybe"), RL_ERR_INVALID_ARG);
     assert_string_equal(rl_renderer_get(r, "shadow"), "bvh");
     assert_string_equal(rl_renderer_get(r, "max_depth"), "-1");
     assert_int_equal(rl_renderer_set(r, "spp", "0"), RL_ERR_INVALID_ARG);
@@ -120,15 +122,31 @@ static void test_white_furnace_converges_to_e_over_one_minus_albedo(void **state
     assert_int_equal(rl_scene_commit(s), RL_OK);
     rl_camera cam = { .eye = rl_v3(0.0f, 0.0f, 0.0f), .target = rl_v3(0.0f, 0.0f, 1.0f), .fov_deg = 90.0f,
                       .width = 8, .height = 8 };
-    /* Without roulette every path is the same geometric series, cut at 64,
-     * but for the rare bounce that leaves below the geometric surface of
-     * the tessellated sphere (shading normals): within 1 %. */
+    /* The thesis' estimator without roulette: every path is the same
+     * geometric series, cut at 64, but for the rare bounce that leaves
+     * below the geometric surface of the tessellated sphere (shading
+     * normals): within 1 %. */
     rl_image *img = fx_render("pt", s, &cam, RL_LAYER_COLOR,
-                              (const char *const[]){ "max_depth", "64", "rr", "false", NULL }, NULL);
+                              (const char *const[]){ "max_depth", "64", "rr", "false", "mis", "off", "rng", "hybrid",
+                                                     NULL }, NULL);
     for (int i = 0; i < 8 * 8; ++i) {
         assert_float_equal(img->color[i].x, 0.6f, 0.6f * 0.01f);
         assert_float_equal(img->color[i].z, 1.8f, 1.8f * 0.01f);
     }
+    rl_image_release(img);
+    /* With MIS the sphere's triangles are lights too: light samples and
+     * BSDF hits share each bounce's emission, so a path is no longer the
+     * bare series, but its expectation is (pixels within 3 %, the mean
+     * within 1 %). */
+    img = fx_render("pt", s, &cam, RL_LAYER_COLOR,
+                    (const char *const[]){ "spp", "64", "max_depth", "64", "rr", "false", NULL }, NULL);
+    double mis_mean = 0.0;
+    for (int i = 0; i < 8 * 8; ++i) {
+        assert_float_equal(img->color[i].x, 0.6f, 0.6f * 0.03f);
+        assert_float_equal(img->color[i].z, 1.8f, 1.8f * 0.03f);
+        mis_mean += img->color[i].y / 64.0;
+    }
+    assert_float_equal(mis_mean, 1.2, 1.2 * 0.01);
     rl_image_release(img);
     /* With roulette (unbiased, noisier): a few % per pixel, 1-2 % overall. */
     img = fx_render("pt", s, &cam, RL_LAYER_COLOR, (const char *const[]){ "spp", "256", "max_depth", "64", NULL },
@@ -512,19 +530,21 @@ static void test_every_rng_renders_the_same_expectation(void **state)
     (void)state;
     rl_camera cam;
     rl_scene *s = fx_cornell(&cam, 12);
-    const char *const kinds[] = { "lcg", "tausworthe", "hybrid" };
-    rl_vec3 mean[3];
-    for (int k = 0; k < 3; ++k) {
+    const char *const kinds[] = { "lcg", "tausworthe", "hybrid", "sobol" };
+    rl_vec3 mean[4];
+    for (int k = 0; k < 4; ++k) {
         rl_renderer *r = fx_make("pt", (const char *const[]){ "rng", kinds[k], "spp", "64", NULL });
         rl_image *img = fx_render_with(r, s, &cam, RL_LAYER_COLOR, NULL);
         rl_pt_stats st;
         assert_int_equal(rl_pt_get_stats(r, &st), RL_OK);
-        assert_int_equal(st.rng, (rl_rng_gpu_kind)k);
+        assert_int_equal(st.sobol, k == 3);
+        if (k < 3)
+            assert_int_equal(st.rng, (rl_rng_gpu_kind)k);
         mean[k] = mean_color(img);
         rl_image_release(img);
         rl_renderer_release(r);
     }
-    for (int k = 1; k < 3; ++k) {
+    for (int k = 1; k < 4; ++k) {
         assert_float_equal(mean[k].x, mean[0].x, 0.05f * mean[0].x);
         assert_float_equal(mean[k].z, mean[0].z, 0.05f * mean[0].z);
     }

@@ -44,7 +44,7 @@ static void test_builtin_list_names_every_scene(void **state)
             assert_true(o->key && o->default_value && o->help && strlen(o->help) > 0);
         }
     }
-    assert_true(info[0].num_options == 0 && info[3].num_options == 8);   /* cornell none, city 8 */
+    assert_true(info[0].num_options == 1 && info[3].num_options == 8);   /* cornell variant, city 8 */
 }
 
 static void test_cornell_has_36_triangles_and_a_downward_quad_light(void **state)
@@ -81,6 +81,29 @@ static void test_cornell_has_36_triangles_and_a_downward_quad_light(void **state
     assert_true(cam.eye.z < d->bounds.min.z);   /* at the opening, looking in */
     /* Metres: the box is about 0.55 m on each side. */
     assert_within(rl_aabb_extent(d->bounds).y, 0.5488, 0.001);
+    rl_scene_release(s);
+}
+
+static void test_cornell_bitterli_variant_has_bitterlis_albedos_and_a_black_lamp(void **state)
+{
+    (void)state;
+    rl_scene *s = NULL;
+    assert_int_equal(rl_scene_create_builtin("cornell", "variant=bitterli", &s), RL_OK);
+    const rl_scene_data *d = rl_scene_get_data(s);
+    assert_non_null(d);
+    assert_int_equal(d->num_triangles, 36);
+    const rl_material *white = &d->materials[rl_scene_find_material(s, "white")];
+    const rl_material *green = &d->materials[rl_scene_find_material(s, "green")];
+    const rl_material *lamp = &d->materials[rl_scene_find_material(s, "light")];
+    assert_float_equal(white->diffuse.y, 0.71f, 1e-6f);
+    assert_float_equal(green->diffuse.z, 0.091f, 1e-6f);
+    assert_true(rl_vmax_comp(lamp->diffuse) == 0.0f && lamp->emission.x == 17.0f);
+    assert_string_equal(rl_scene_node_attr(s, RL_NODE_ROOT, "max_path_length"), "7");
+    rl_scene_release(s);
+    /* The classic box keeps its materials and no path length. */
+    assert_int_equal(rl_scene_create_builtin("cornell", NULL, &s), RL_OK);
+    assert_float_equal(rl_scene_get_data(s)->materials[rl_scene_find_material(s, "white")].diffuse.y, 0.73f, 1e-6f);
+    assert_null(rl_scene_node_attr(s, RL_NODE_ROOT, "max_path_length"));
     rl_scene_release(s);
 }
 
@@ -216,7 +239,10 @@ static void test_unknown_parameter_is_invalid(void **state)
     (void)state;
     rl_scene *s = NULL;
     assert_int_equal(rl_scene_create_builtin("cornell", "triangles=10", &s), RL_ERR_INVALID_ARG);
-    assert_non_null(strstr(rl_last_error(), "takes none"));
+    assert_non_null(strstr(rl_last_error(), "variant"));     /* lists the accepted keys */
+    rl_clear_error();
+    assert_int_equal(rl_scene_create_builtin("cornell", "variant=mitsuba", &s), RL_ERR_INVALID_ARG);
+    assert_non_null(strstr(rl_last_error(), "bitterli"));
     rl_clear_error();
     assert_int_equal(rl_scene_create_builtin("city", "blocks=65", &s), RL_ERR_INVALID_ARG);
     assert_non_null(strstr(rl_last_error(), "outside [1, 64]"));
@@ -259,6 +285,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_builtin_list_names_every_scene),
         cmocka_unit_test(test_cornell_has_36_triangles_and_a_downward_quad_light),
+        cmocka_unit_test(test_cornell_bitterli_variant_has_bitterlis_albedos_and_a_black_lamp),
         cmocka_unit_test(test_cornell_teapot_defaults_to_about_15700_triangles),
         cmocka_unit_test(test_cornell_teapot_honours_the_triangle_budget),
         cmocka_unit_test(test_spheres_has_mirror_glass_and_a_textured_floor),
