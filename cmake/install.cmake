@@ -47,6 +47,12 @@ endif()
 if(RL_GL)
   set(RL_PC_LIBS_PRIVATE "-lepoxy ${RL_PC_LIBS_PRIVATE}")
 endif()
+if(RL_MPI)
+  # MPI has no one pkg-config name (Open MPI: ompi-c, MPICH: mpich): the
+  # libraries CMake's FindMPI found, as paths.
+  list(JOIN MPI_C_LIBRARIES " " RL_PC_MPI)
+  set(RL_PC_LIBS_PRIVATE "${RL_PC_MPI} ${RL_PC_LIBS_PRIVATE}")
+endif()
 configure_file(cmake/renderlab.pc.in ${CMAKE_CURRENT_BINARY_DIR}/renderlab.pc @ONLY)
 install(FILES ${CMAKE_CURRENT_BINARY_DIR}/renderlab.pc DESTINATION ${CMAKE_INSTALL_LIBDIR}/pkgconfig)
 
