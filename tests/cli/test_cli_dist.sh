@@ -84,11 +84,14 @@ PY
 # its first band, the master takes it for lost after RL_DIST_TIMEOUT and
 # hands its bands to the others, and the image is still the one-process
 # image.
-RECOVER=(env OMPI_MCA_orte_enable_recovery=1 OMPI_MCA_orte_abort_on_non_zero_status=0 RL_DIST_TIMEOUT=2)
+# (4 s: long against a band, but a slow worker, e.g. one still loading its
+# scene under ASan, may be taken for lost too: harmless, its bands are
+# redone, hence "[12]" below.)
+RECOVER=(env OMPI_MCA_orte_enable_recovery=1 OMPI_MCA_orte_abort_on_non_zero_status=0 RL_DIST_TIMEOUT=4)
 run_ok "${RECOVER[@]}" RL_DIST_FAULT=2:1 "${MPI[@]}" "$RL" --dist render spheres --algo whitted --size 72x53 \
     --out "$TMP/lost.png"
 cmp -s "$TMP/ref.png" "$TMP/lost.png" || fail "a lost worker changed the image"
-expect_in "$TMP/out" "^dist: 1 worker lost"
+expect_in "$TMP/out" "^dist: [12] workers\? lost"
 expect_in "$TMP/err" "rank 2 has not answered for [0-9]* s: taken for lost"
 # A dead master (it kills itself after its first band): by default mpirun
 # ends the job at once; with recovery on, every worker gives up with an
@@ -99,7 +102,7 @@ expect_exit 137 env RL_DIST_FAULT=0:1 "${MPI[@]}" "$RL" --dist render spheres --
 [ ! -e "$TMP/dead.png" ] || fail "a dead master wrote an image"
 "${RECOVER[@]}" RL_DIST_FAULT=0:1 "${MPI[@]}" "$RL" --dist render spheres --algo whitted --size 72x200 \
     --out "$TMP/dead.png" >"$TMP/out" 2>"$TMP/err"
-[ "$(grep -c '^rl: error: render: rank [12]: .*rank 0.* for 2 s: it is gone or stuck' "$TMP/err")" -ge 1 ] ||
+[ "$(grep -c '^rl: error: render: rank [12]: .*rank 0.* for 4 s: it is gone or stuck' "$TMP/err")" -ge 1 ] ||
     fail "the workers of a dead master: $(grep -v '^ ' "$TMP/err" | head -c 600)"
 [ ! -e "$TMP/dead.png" ] || fail "a dead master wrote an image"
 
