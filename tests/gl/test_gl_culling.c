@@ -22,23 +22,7 @@
 #include "rl/rl_gl.h"
 #include "rl/rl_metrics.h"
 
-static bool have_gl;
-
-static int find_gl(void **state)
-{
-    (void)state;
-    char why[256];
-    have_gl = rl_gl_available(NULL, why, sizeof why);
-    if (!have_gl)
-        print_message("no OpenGL 4.5 context (%s): the GL cases skip\n", why);
-    return 0;
-}
-
-#define NEED_GL()                                                                                              \
-    do {                                                                                                       \
-        if (!have_gl)                                                                                          \
-            skip();                                                                                            \
-    } while (0)
+#include "gl_fixtures.h"
 
 /* A quad facing the camera at distance dist along its view, half side half. */
 static void view_quad(const rl_camera *cam, float dist, float half, rl_vec3 pos[4])

@@ -21,25 +21,9 @@
 #include "rl/rl_gl.h"
 #include "rl/rl_property.h"
 
+#include "gl_fixtures.h"
+
 #define RES 64
-
-static bool have_gl;
-
-static int find_gl(void **state)
-{
-    (void)state;
-    char why[256];
-    have_gl = rl_gl_available(NULL, why, sizeof why);
-    if (!have_gl)
-        print_message("no OpenGL 4.5 context (%s): the GL cases skip\n", why);
-    return 0;
-}
-
-#define NEED_GL()                                                                                              \
-    do {                                                                                                       \
-        if (!have_gl)                                                                                          \
-            skip();                                                                                            \
-    } while (0)
 
 static rl_property *make_vis(const rl_scene *s, const char *backend, const char *measure, int res, int workers)
 {
