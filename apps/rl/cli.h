@@ -249,5 +249,9 @@ const char *cli_did_you_mean(const char *typed, const char *const *names, size_t
  * object ID hashed to a colour, black where nothing was hit. */
 rl_status cli_write_depth(const rl_image *img, const char *path);
 rl_status cli_write_ids(const rl_image *img, const char *path);
+/* The same pictures as linear colour in out (width x height of img), for
+ * display: false where img lacks the layer. */
+typedef enum cli_layer { CLI_LAYER_COLOR, CLI_LAYER_DEPTH, CLI_LAYER_IDS } cli_layer;
+bool cli_layer_picture(const rl_image *img, cli_layer layer, rl_vec4 *out);
 
 #endif

@@ -57,6 +57,8 @@ static const char view_help[] =
     "                      while the camera moved, time to the first image\n"
     "  --max-spp N         progressive renderers stop accumulating at N samples\n"
     "                      per pixel; default 4096\n"
+    "  --ref-spp N         samples per pixel of the pt reference that X compares\n"
+    "                      the path tracers with; default 256\n"
     "\n"
     "model files (the same as SCENE:cameras=off,lights=add,...; see rl scenes):\n"
     CLI_MODEL_FLAGS_HELP
@@ -95,6 +97,9 @@ int view_run(int argc, char **argv)
 #define MAX_SHOTS 64
 #define MAX_CMDS 64
 #define DEFAULT_MAX_SPP 4096
+#define DEFAULT_REF_SPP 256
+/* Every image of the viewer: the depth and ID layers are shown by L. */
+#define VIEW_LAYERS (RL_LAYER_COLOR | RL_LAYER_DEPTH | RL_LAYER_ID)
 
 typedef struct shot_at {
     double time_s;
@@ -110,17 +115,23 @@ typedef struct view_args {
     int num_sets;
     shot_at shots[MAX_SHOTS];
     int num_shots;
-    long long max_spp;
+    long long max_spp, ref_spp;
     cli_model_flags model;
 } view_args;
 
 /* A change of the renderer that the worker applies before its next frame:
  * renderers are only ever touched on the worker thread. */
-typedef enum cmd_kind { CMD_ALGO, CMD_SET, CMD_STEP } cmd_kind;
+typedef enum cmd_kind {
+    CMD_ALGO,         /* text: the renderer */
+    CMD_SET,          /* text: KEY=VALUE */
+    CMD_STEP,         /* the renderer's main option by a factor */
+    CMD_CYCLE,        /* text: an enum option, set to its next choice */
+    CMD_REFERENCE     /* compare the next finished frame with a reference */
+} cmd_kind;
 typedef struct view_cmd {
     cmd_kind kind;
     char text[256];
-    int dir;          /* CMD_STEP: +1 or -1 */
+    int dir;          /* CMD_STEP, CMD_CYCLE: +1 or -1 */
     int line;         /* script line, 0 for a key */
 } view_cmd;
 
@@ -145,6 +156,12 @@ typedef struct shared {
     double worker_spp;             /* accumulated since the last restart */
     char algo[64];
     char status[256];              /* the last change's outcome, for the overlay */
+    char options[1024];            /* the current renderer's options, for the menu */
+    /* the last comparison with a reference (X) */
+    bool ref_valid;
+    char ref_algo[64], ref_of[64];
+    double ref_ssim, ref_hssim, ref_rmse, ref_spp;
+    int ref_levels;
     int fatal;                     /* exit code of a failure that ends a scripted run */
     char fatal_msg[512];
     /* the published image */
@@ -171,6 +188,9 @@ typedef struct worker {
     double running_request_s;
     rl_camera last_cam;
     bool have_last;
+    rl_renderer *ref;              /* the reference renderer of X, kept for the next X */
+    rl_image *ref_img;
+    bool want_ref;
 } worker;
 
 static bool same_camera(const rl_camera *a, const rl_camera *b)
@@ -189,7 +209,14 @@ static void publish(worker *w, const rl_image *img, const rl_render_stats *stats
 {
     shared *sh = w->sh;
     SDL_LockMutex(sh->lock);
-    memcpy(sh->front->color, img->color, (size_t)img->width * (size_t)img->height * sizeof *img->color);
+    size_t n = (size_t)img->width * (size_t)img->height;
+    memcpy(sh->front->color, img->color, n * sizeof *img->color);
+    /* An intermediate image without these layers must not show the last
+     * frame's depth and IDs under its colour. */
+    for (size_t i = 0; i < n; i++) {
+        sh->front->depth[i] = img->depth ? img->depth[i] : INFINITY;
+        sh->front->object_id[i] = img->object_id ? img->object_id[i] : RL_ID_NONE;
+    }
     sh->front_seq++;
     sh->front_final = final;
     if (stats)
@@ -311,6 +338,66 @@ static const step_option step_options[] = {
     { "surfels", "overdraw", 1.5, 0.01, 1000.0, false },
 };
 
+/* Sets the enum option key of the current renderer to its next (dir +1) or
+ * previous choice. A choice the renderer refuses here (embree in a build
+ * without it) is skipped. */
+static void cycle_option(worker *w, const char *key, int dir)
+{
+    shared *sh = w->sh;
+    const char *name = rl_renderer_name(w->r);
+    size_t n = 0;
+    const rl_option_info *opts = rl_renderer_options(w->r, &n);
+    const rl_option_info *o = NULL;
+    for (size_t i = 0; i < n; i++)
+        if (strcmp(opts[i].key, key) == 0 && opts[i].type == RL_OPT_ENUM && opts[i].choices)
+            o = &opts[i];
+    if (!o) {
+        set_status(sh, "%s has no option %s", name, key);
+        return;
+    }
+    int count = 0, cur = 0;
+    const char *value = rl_renderer_get(w->r, key);
+    for (; o->choices[count]; count++)
+        if (value && strcmp(o->choices[count], value) == 0)
+            cur = count;
+    for (int step = 1; step < count; step++) {
+        const char *next = o->choices[((cur + dir * step) % count + count) % count];
+        rl_clear_error();
+        if (rl_renderer_set(w->r, key, next) == RL_OK) {
+            set_status(sh, "%s %s=%s", name, key, next);
+            w->have_last = false;
+            rl_clear_error();
+            return;
+        }
+    }
+    set_status(sh, "%s %s: no other choice works here (%s)", name, key, rl_last_error());
+    rl_clear_error();
+}
+
+/* The current renderer's options, "name: key=value key=value ...", for the
+ * menu (which wraps them to the window). */
+static void publish_options(worker *w)
+{
+    shared *sh = w->sh;
+    char text[sizeof sh->options];
+    size_t n = 0, len = 0;
+    const rl_option_info *opts = rl_renderer_options(w->r, &n);
+    len = (size_t)snprintf(text, sizeof text, "%s:", rl_renderer_name(w->r));
+    for (size_t i = 0; i < n; i++) {
+        const char *value = rl_renderer_get(w->r, opts[i].key);
+        char item[160];
+        int k = snprintf(item, sizeof item, "%s=%s", opts[i].key, value ? value : "?");
+        if (k < 0 || k >= (int)sizeof item)
+            continue;
+        if (len + (size_t)k + 2 >= sizeof text)
+            break;
+        len += (size_t)snprintf(text + len, sizeof text - len, " %s", item);
+    }
+    SDL_LockMutex(sh->lock);
+    snprintf(sh->options, sizeof sh->options, "%s", text);
+    SDL_UnlockMutex(sh->lock);
+}
+
 static void apply_cmd(worker *w, const view_cmd *c)
 {
     shared *sh = w->sh;
@@ -351,6 +438,15 @@ static void apply_cmd(worker *w, const view_cmd *c)
         w->have_last = false;
         return;
     }
+    if (c->kind == CMD_CYCLE) {
+        cycle_option(w, c->text, c->dir);
+        return;
+    }
+    if (c->kind == CMD_REFERENCE) {
+        w->want_ref = true;
+        set_status(sh, "comparing with a reference after this frame ...");
+        return;
+    }
     const char *name = rl_renderer_name(w->r);
     for (size_t i = 0; i < sizeof step_options / sizeof step_options[0]; i++) {
         const step_option *o = &step_options[i];
@@ -375,6 +471,84 @@ static void apply_cmd(worker *w, const view_cmd *c)
         return;
     }
     set_status(sh, "%s: no option on + and - (vt min_edge, pt spp, surfels overdraw)", name);
+}
+
+static bool is_path_tracer(const char *name)
+{
+    return strcmp(name, "pt") == 0 || strcmp(name, "gl-pt") == 0 || strcmp(name, "bdpt") == 0;
+}
+
+/* X: the frame just finished against an exact reference of the same camera
+ * (Whitted ray tracing; pt at --ref-spp with another seed for the path
+ * tracers, whose images whitted's local model cannot match), by SSIM and
+ * the hierarchical SSIM of Jahn 2015 Sec. 4.2.5. A change cancels it. */
+static void compare_reference(worker *w, const rl_camera *cam)
+{
+    shared *sh = w->sh;
+    const char *of = rl_renderer_name(w->r);
+    const char *ref_name = is_path_tracer(of) ? "pt" : "whitted";
+    char why[512] = "";
+    if (w->ref && strcmp(rl_renderer_name(w->ref), ref_name) != 0) {
+        rl_renderer_release(w->ref);
+        w->ref = NULL;
+    }
+    if (!w->ref) {
+        w->ref = make_renderer(w, ref_name, why, sizeof why);
+        if (!w->ref) {
+            set_status(sh, "reference %s: %s", ref_name, why);
+            return;
+        }
+    }
+    char spp[32];
+    snprintf(spp, sizeof spp, "%lld", w->args->ref_spp);
+    rl_clear_error();
+    if (strcmp(ref_name, "pt") == 0 &&
+        (rl_renderer_set(w->ref, "spp", spp) != RL_OK || rl_renderer_set(w->ref, "accumulate", "false") != RL_OK ||
+         rl_renderer_set(w->ref, "seed", "7919") != RL_OK)) {
+        set_status(sh, "reference pt: %s", rl_last_error());
+        rl_clear_error();
+        return;
+    }
+    rl_status st = RL_OK;
+    if (!w->ref_img)
+        st = rl_image_create(cam->width, cam->height, RL_LAYER_COLOR, &w->ref_img);
+    rl_render_stats stats = { 0 };
+    rl_renderer_set_progress(w->ref, on_progress, w);
+    if (st == RL_OK)
+        st = rl_renderer_render(w->ref, w->scene, cam, w->ref_img, &stats);
+    if (st == RL_ERR_CANCELLED) {
+        set_status(sh, "reference cancelled by a change; press X again");
+        rl_clear_error();
+        return;
+    }
+    rl_image_metrics m = { 0 }, hm = { 0 };
+    int levels = 1;
+    while (levels < 5 && (cam->width < cam->height ? cam->width : cam->height) >> levels >= 11)
+        levels++;
+    if (st == RL_OK)
+        st = rl_image_compare(w->back, w->ref_img, NULL, &m);
+    if (st == RL_OK && levels >= 2)
+        st = rl_image_compare(w->back, w->ref_img, &(rl_metric_options){ .ssim_levels = levels }, &hm);
+    if (st != RL_OK) {
+        set_status(sh, "reference %s: %s", ref_name, rl_last_error()[0] ? rl_last_error() : rl_status_string(st));
+        rl_clear_error();
+        return;
+    }
+    SDL_LockMutex(sh->lock);
+    sh->ref_valid = true;
+    snprintf(sh->ref_algo, sizeof sh->ref_algo, "%s", ref_name);
+    snprintf(sh->ref_of, sizeof sh->ref_of, "%s", of);
+    sh->ref_ssim = m.ssim;
+    sh->ref_rmse = m.rmse;
+    sh->ref_levels = levels >= 2 ? levels : 0;
+    sh->ref_hssim = levels >= 2 ? hm.ssim : NAN;
+    sh->ref_spp = strcmp(ref_name, "pt") == 0 ? (double)w->args->ref_spp : 0.0;
+    if (levels >= 2)
+        snprintf(sh->status, sizeof sh->status, "%s vs %s: SSIM %.4f hSSIM(%d) %.4f RMSE %.4f", of, ref_name,
+                 m.ssim, levels, hm.ssim, m.rmse);
+    else
+        snprintf(sh->status, sizeof sh->status, "%s vs %s: SSIM %.4f RMSE %.4f", of, ref_name, m.ssim, m.rmse);
+    SDL_UnlockMutex(sh->lock);
 }
 
 static int worker_main(void *user)
@@ -402,6 +576,8 @@ static int worker_main(void *user)
 
         for (int i = 0; i < ncmds; i++)
             apply_cmd(w, &cmds[i]);
+        if (ncmds > 0 || !w->have_last)
+            publish_options(w);
         if (!w->have_last || !same_camera(&cam, &w->last_cam)) {
             SDL_LockMutex(sh->lock);
             sh->worker_spp = 0.0;
@@ -421,6 +597,10 @@ static int worker_main(void *user)
             sh->worker_spp += (double)stats.samples / pixels;
             SDL_UnlockMutex(sh->lock);
             publish(w, w->back, &stats, true);
+            if (w->want_ref) {
+                w->want_ref = false;
+                compare_reference(w, &cam);
+            }
         } else if (st != RL_ERR_CANCELLED) {
             const char *msg = rl_last_error()[0] ? rl_last_error() : rl_status_string(st);
             set_fatal(sh, RL_CLI_FAIL, "render: %s: %s", rl_renderer_name(w->r), msg);
@@ -539,7 +719,10 @@ typedef struct viewer {
     nav nav;
     int width, height;
     bool held[VIEW_KEY_COUNT];
-    bool help, stats;
+    bool help, stats, menu;
+    cli_layer layer;            /* what L shows: colour, depth or IDs */
+    rl_vec4 *layer_px;          /* the depth or ID picture */
+    bool need_frame;            /* a frame without a restart is wanted (X) */
     /* algorithms Tab cycles through */
     const char **algos;
     size_t num_algos;
@@ -678,6 +861,23 @@ static rl_status write_shot_json(const viewer *v, const char *png, const char *p
             cJSON_AddItemToArray(arr, cJSON_CreateNumber(c[j]));
     }
     cJSON_AddNumberToObject(obj, "fov_deg", v->nav.cam.fov_deg);
+    /* The last comparison of X, whichever frame it was made on. */
+    shared *sh = (shared *)&v->sh;
+    SDL_LockMutex(sh->lock);
+    cJSON *ref = sh->ref_valid ? cJSON_AddObjectToObject(obj, "reference") : NULL;
+    if (ref) {
+        cJSON_AddStringToObject(ref, "algorithm", sh->ref_algo);
+        cJSON_AddStringToObject(ref, "compared", sh->ref_of);
+        if (sh->ref_spp > 0.0)
+            cJSON_AddNumberToObject(ref, "spp", sh->ref_spp);
+        cJSON_AddNumberToObject(ref, "ssim", sh->ref_ssim);
+        if (sh->ref_levels >= 2) {
+            cJSON_AddNumberToObject(ref, "hssim", sh->ref_hssim);
+            cJSON_AddNumberToObject(ref, "hssim_levels", sh->ref_levels);
+        }
+        cJSON_AddNumberToObject(ref, "rmse", sh->ref_rmse);
+    }
+    SDL_UnlockMutex(sh->lock);
     rl_status st = cli_write_json_status(obj, path);
     cJSON_Delete(obj);
     return st;
@@ -980,6 +1180,27 @@ static bool press(viewer *v, view_key k)
         push_cmd(v, CMD_STEP, NULL, k == VIEW_KEY_OPTION_UP ? 1 : -1, 0);
         v->nav.changed = true;
         break;
+    case VIEW_KEY_CYCLE_OVERLAY:
+    case VIEW_KEY_CYCLE_SHADOW:
+    case VIEW_KEY_CYCLE_DIFFUSE:
+    case VIEW_KEY_CYCLE_FILTER:
+    case VIEW_KEY_CYCLE_CRITERIA: {
+        static const char *const keys[] = { "overlay", "shadow", "diffuse", "filter", "criteria" };
+        push_cmd(v, CMD_CYCLE, keys[k - VIEW_KEY_CYCLE_OVERLAY], 1, 0);
+        v->nav.changed = true;
+        break;
+    }
+    case VIEW_KEY_LAYER: {
+        static const char *const names[] = { "colour", "depth", "object IDs" };
+        v->layer = (cli_layer)((v->layer + 1) % 3);
+        say(v, "showing %s", names[v->layer]);
+        break;
+    }
+    case VIEW_KEY_MENU: v->menu = !v->menu; break;
+    case VIEW_KEY_REFERENCE:
+        push_cmd(v, CMD_REFERENCE, NULL, 0, 0);
+        v->need_frame = true;
+        break;
     case VIEW_KEY_SCREENSHOT: screenshot_key(v); break;
     case VIEW_KEY_QUIT: return false;
     default: break;
@@ -1029,6 +1250,14 @@ static view_key key_of(const SDL_Keysym *ks)
     case SDLK_r: return VIEW_KEY_RECORD;
     case SDLK_PLUS: case SDLK_EQUALS: case SDLK_KP_PLUS: return VIEW_KEY_OPTION_UP;
     case SDLK_MINUS: case SDLK_KP_MINUS: return VIEW_KEY_OPTION_DOWN;
+    case SDLK_o: return VIEW_KEY_CYCLE_OVERLAY;
+    case SDLK_b: return VIEW_KEY_CYCLE_SHADOW;
+    case SDLK_n: return VIEW_KEY_CYCLE_DIFFUSE;
+    case SDLK_f: return VIEW_KEY_CYCLE_FILTER;
+    case SDLK_k: return VIEW_KEY_CYCLE_CRITERIA;
+    case SDLK_l: return VIEW_KEY_LAYER;
+    case SDLK_m: return VIEW_KEY_MENU;
+    case SDLK_x: return VIEW_KEY_REFERENCE;
     case SDLK_F12: case SDLK_PRINTSCREEN: return VIEW_KEY_SCREENSHOT;
     case SDLK_ESCAPE: return VIEW_KEY_QUIT;
     default:
@@ -1102,7 +1331,10 @@ static bool take_frame(viewer *v)
     SDL_LockMutex(sh->lock);
     bool fresh = sh->front_seq != v->shown_seq;
     if (fresh) {
-        memcpy(v->shown->color, sh->front->color, (size_t)v->width * (size_t)v->height * sizeof *v->shown->color);
+        size_t n = (size_t)v->width * (size_t)v->height;
+        memcpy(v->shown->color, sh->front->color, n * sizeof *v->shown->color);
+        memcpy(v->shown->depth, sh->front->depth, n * sizeof *v->shown->depth);
+        memcpy(v->shown->object_id, sh->front->object_id, n * sizeof *v->shown->object_id);
         v->shown_seq = sh->front_seq;
         v->shown_final = sh->front_final;
         if (sh->front_final)
@@ -1154,8 +1386,11 @@ static double current_fps(const viewer *v)
 static void draw(viewer *v)
 {
     int w = v->width, h = v->height;
+    const rl_vec4 *src = v->shown->color;
+    if (v->layer != CLI_LAYER_COLOR && cli_layer_picture(v->shown, v->layer, v->layer_px))
+        src = v->layer_px;
     for (size_t i = 0; i < (size_t)w * (size_t)h; i++) {
-        rl_vec4 c = v->shown->color[i];
+        rl_vec4 c = src[i];
         v->pixels[i] = 0xff000000u | (uint32_t)to_byte(c.x) << 16 | (uint32_t)to_byte(c.y) << 8 | to_byte(c.z);
     }
     /* Text at a size that stays legible on large images and fits small ones. */
@@ -1186,6 +1421,35 @@ static void draw(viewer *v)
         if (n < (int)sizeof text && status[0])
             snprintf(text + n, sizeof text - (size_t)n, "%s\n", status);
         view_draw_text(v->pixels, w, h, 3 * scale, 3 * scale, scale, text, 0xffffff40u);
+    }
+    if (v->menu) {
+        /* The renderers Tab cycles through, the current one marked, and
+         * its options as they are now. */
+        char text[3072], options[sizeof v->sh.options];
+        int fit = w / (VIEW_FONT_ADVANCE * scale) - 1;
+        size_t len = 0, cols = fit > 8 ? (size_t)fit : 8, line = 0;
+        SDL_LockMutex(v->sh.lock);
+        snprintf(options, sizeof options, "%s", v->sh.options);
+        SDL_UnlockMutex(v->sh.lock);
+        /* Words wrapped to the window: renderer names, then key=value. */
+        for (size_t i = 0; i <= v->num_algos; i++) {
+            char *save = NULL;
+            for (char *word = i < v->num_algos ? (char *)v->algos[i] : strtok_r(options, " ", &save); word;
+                 word = i < v->num_algos ? NULL : strtok_r(NULL, " ", &save)) {
+                char item[160];
+                int k = snprintf(item, sizeof item, "%s%s", i == v->algo_index ? ">" : "", word);
+                if (k < 0 || len + (size_t)k + 4 >= sizeof text)
+                    break;
+                bool wrap = line > 0 && line + 2 + (size_t)k > cols;
+                len += (size_t)snprintf(text + len, sizeof text - len, "%s%s", wrap ? "\n" : (line ? "  " : ""), item);
+                line = (wrap ? 0 : line + (line ? 2 : 0)) + (size_t)k;
+            }
+            if (i + 1 == v->num_algos && len + 3 < sizeof text) {
+                len += (size_t)snprintf(text + len, sizeof text - len, "\n\n");
+                line = 0;
+            }
+        }
+        view_draw_text(v->pixels, w, h, 3 * scale, h / 2, scale, text, 0xffffffffu);
     }
     if (v->help)
         view_draw_text(v->pixels, w, h, 3 * scale, h / 3, scale, view_keys_help, 0xffffffffu);
@@ -1244,6 +1508,9 @@ static int parse_args(int argc, char **argv, view_args *a)
             if (m > 0 && (!rl_parse_int(v, &a->max_spp) || a->max_spp < 1 || a->max_spp > 1000000000))
                 return cli_fail(RL_CLI_USAGE, "--max-spp: expected samples per pixel in [1, 1000000000], got '%s'",
                                 v);
+        } else if (VALUE("--ref-spp")) {
+            if (m > 0 && (!rl_parse_int(v, &a->ref_spp) || a->ref_spp < 1 || a->ref_spp > 65536))
+                return cli_fail(RL_CLI_USAGE, "--ref-spp: expected samples per pixel in [1, 65536], got '%s'", v);
         } else if (VALUE("--screenshot-at")) {
             if (m > 0) {
                 const char *colon = strchr(v, ':');
@@ -1564,10 +1831,11 @@ static int run_script(viewer *v, const view_script *s)
         }
         if (v->nav.changed)
             request(v, true);
-        else if (!applied && wants_more(v))
+        else if (v->need_frame || (!applied && wants_more(v)))
             request(v, false);
         else if (ending)
             break;
+        v->need_frame = false;
     }
     return RL_CLI_OK;
 }
@@ -1589,9 +1857,12 @@ static int run_interactive(viewer *v)
         bool idle = worker_idle(v);
         if (v->nav.changed) {
             v->nav.changed = false;
+            v->need_frame = false;
             request(v, true);
-        } else if (idle && wants_more(v))
+        } else if (idle && (v->need_frame || wants_more(v))) {
+            v->need_frame = false;
             request(v, false);
+        }
         bool fresh = take_frame(v);
         if (fresh && !after_frame(v))
             return RL_CLI_FAIL;
@@ -1652,10 +1923,13 @@ static void close_viewer(viewer *v)
         SDL_WaitThread(v->thread, NULL);
     }
     rl_renderer_release(v->wk.r);
+    rl_renderer_release(v->wk.ref);
+    rl_image_release(v->wk.ref_img);
     rl_image_release(v->wk.back);
     rl_image_release(v->sh.front);
     rl_image_release(v->shown);
     free(v->pixels);
+    free(v->layer_px);
     free(v->algos);
     free(v->rec);
     if (v->sh.wake)
@@ -1676,7 +1950,7 @@ static void close_viewer(viewer *v)
 int view_run(int argc, char **argv)
 {
     view_args a = { .algo = "raster", .shot_dir = ".", .path_out = "rl-view-path.json",
-                    .max_spp = DEFAULT_MAX_SPP };
+                    .max_spp = DEFAULT_MAX_SPP, .ref_spp = DEFAULT_REF_SPP };
     a.sets = calloc((size_t)argc, sizeof *a.sets);
     if (!a.sets)
         return cli_fail(RL_CLI_FAIL, "out of memory");
@@ -1714,7 +1988,10 @@ int view_run(int argc, char **argv)
             diag = 1.0f;
         v.nav.speed = 0.25f * diag;
         v.nav.min_dist = 1e-3f * diag;
-        rc = cli_check_frame_memory(v.wk.r, v.width, v.height, RL_LAYER_COLOR, 3.0 * sizeof(rl_vec4) + 4.0, 0.0);
+        /* back, front, shown with their layers, the reference, the layer
+         * picture and the window's pixels */
+        rc = cli_check_frame_memory(v.wk.r, v.width, v.height, VIEW_LAYERS,
+                                    3.0 * (sizeof(rl_vec4) + 8.0) + 2.0 * sizeof(rl_vec4) + 4.0, 0.0);
     }
     if (rc == RL_CLI_OK) {
         rl_clear_error();
@@ -1729,13 +2006,14 @@ int view_run(int argc, char **argv)
     }
     if (rc == RL_CLI_OK) {
         rl_clear_error();
-        rl_status st = rl_image_create(v.width, v.height, RL_LAYER_COLOR, &v.wk.back);
+        rl_status st = rl_image_create(v.width, v.height, VIEW_LAYERS, &v.wk.back);
         if (st == RL_OK)
-            st = rl_image_create(v.width, v.height, RL_LAYER_COLOR, &v.sh.front);
+            st = rl_image_create(v.width, v.height, VIEW_LAYERS, &v.sh.front);
         if (st == RL_OK)
-            st = rl_image_create(v.width, v.height, RL_LAYER_COLOR, &v.shown);
+            st = rl_image_create(v.width, v.height, VIEW_LAYERS, &v.shown);
         v.pixels = st == RL_OK ? calloc((size_t)v.width * (size_t)v.height, sizeof *v.pixels) : NULL;
-        if (st != RL_OK || !v.pixels)
+        v.layer_px = v.pixels ? calloc((size_t)v.width * (size_t)v.height, sizeof *v.layer_px) : NULL;
+        if (st != RL_OK || !v.pixels || !v.layer_px)
             rc = cli_fail(RL_CLI_FAIL, "out of memory for a %dx%d view", v.width, v.height);
     }
     if (rc == RL_CLI_OK)

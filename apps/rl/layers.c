@@ -1,6 +1,7 @@
 /* layers.c: writes the depth and object-ID layers of a frame as pictures
- * (rl render --depth-out / --id-out). Both go through a temporary colour-only
- * rl_image so that rl_image_write() does the file formats. */
+ * (rl render --depth-out / --id-out), or fills a colour array with them
+ * (rl view's L key). Files go through a temporary colour-only rl_image so
+ * that rl_image_write() does the file formats. */
 #include "cli.h"
 
 #include <math.h>
@@ -13,12 +14,11 @@ static float srgb_to_linear(float v)
     return v <= 0.04045f ? v / 12.92f : powf((v + 0.055f) / 1.055f, 2.4f);
 }
 
-rl_status cli_write_depth(const rl_image *img, const char *path)
+/* The picture of a depth layer: raw (EXR) keeps the measurement; else the
+ * nearest surface is white and the farthest still 10 % grey, so that it
+ * differs from the black background. */
+static void depth_picture(const rl_image *img, bool raw, rl_vec4 *out)
 {
-    if (!img->depth)
-        return RL_ERR_INVALID_ARG;
-    static const char *const exr[] = { ".exr", NULL };
-    bool raw = cli_has_extension(path, exr);
     size_t n = (size_t)img->width * (size_t)img->height;
     float near = INFINITY, far = -INFINITY;
     for (size_t i = 0; i < n; i++)
@@ -26,10 +26,6 @@ rl_status cli_write_depth(const rl_image *img, const char *path)
             near = fminf(near, img->depth[i]);
             far = fmaxf(far, img->depth[i]);
         }
-    rl_image *out = NULL;
-    rl_status st = rl_image_create(img->width, img->height, RL_LAYER_COLOR, &out);
-    if (st != RL_OK)
-        return st;
     float range = far > near ? far - near : 1.0f;
     for (size_t i = 0; i < n; i++) {
         float d = img->depth[i];
@@ -38,14 +34,9 @@ rl_status cli_write_depth(const rl_image *img, const char *path)
         if (raw)
             g = d; /* EXR: the measurement itself (+inf where nothing was hit) */
         else
-            /* Nearest white, farthest still 10% grey so it differs from the
-             * black background. */
             g = hit ? srgb_to_linear(1.0f - 0.9f * (d - near) / range) : 0.0f;
-        out->color[i] = (rl_vec4){ g, g, g, hit || !raw ? 1.0f : 0.0f };
+        out[i] = (rl_vec4){ g, g, g, hit || !raw ? 1.0f : 0.0f };
     }
-    st = rl_image_write(out, path);
-    rl_image_release(out);
-    return st;
 }
 
 /* An integer hash (the "lowbias32" mixer by C. Wellons) spreads neighbouring
@@ -60,14 +51,8 @@ static uint32_t hash_id(uint32_t x)
     return x;
 }
 
-rl_status cli_write_ids(const rl_image *img, const char *path)
+static void id_picture(const rl_image *img, rl_vec4 *out)
 {
-    if (!img->object_id)
-        return RL_ERR_INVALID_ARG;
-    rl_image *out = NULL;
-    rl_status st = rl_image_create(img->width, img->height, RL_LAYER_COLOR, &out);
-    if (st != RL_OK)
-        return st;
     size_t n = (size_t)img->width * (size_t)img->height;
     for (size_t i = 0; i < n; i++) {
         uint32_t id = img->object_id[i];
@@ -79,9 +64,47 @@ rl_status cli_write_ids(const rl_image *img, const char *path)
             c.y = srgb_to_linear((48 + ((h >> 8) & 0xff) * 207 / 255) / 255.0f);
             c.z = srgb_to_linear((48 + ((h >> 16) & 0xff) * 207 / 255) / 255.0f);
         }
-        out->color[i] = c;
+        out[i] = c;
     }
+}
+
+bool cli_layer_picture(const rl_image *img, cli_layer layer, rl_vec4 *out)
+{
+    if (layer == CLI_LAYER_DEPTH && img->depth)
+        depth_picture(img, false, out);
+    else if (layer == CLI_LAYER_IDS && img->object_id)
+        id_picture(img, out);
+    else
+        return false;
+    return true;
+}
+
+static rl_status write_picture(const rl_image *img, cli_layer layer, bool raw, const char *path)
+{
+    rl_image *out = NULL;
+    rl_status st = rl_image_create(img->width, img->height, RL_LAYER_COLOR, &out);
+    if (st != RL_OK)
+        return st;
+    if (layer == CLI_LAYER_DEPTH)
+        depth_picture(img, raw, out->color);
+    else
+        id_picture(img, out->color);
     st = rl_image_write(out, path);
     rl_image_release(out);
     return st;
+}
+
+rl_status cli_write_depth(const rl_image *img, const char *path)
+{
+    if (!img->depth)
+        return RL_ERR_INVALID_ARG;
+    static const char *const exr[] = { ".exr", NULL };
+    return write_picture(img, CLI_LAYER_DEPTH, cli_has_extension(path, exr), path);
+}
+
+rl_status cli_write_ids(const rl_image *img, const char *path)
+{
+    if (!img->object_id)
+        return RL_ERR_INVALID_ARG;
+    return write_picture(img, CLI_LAYER_IDS, false, path);
 }

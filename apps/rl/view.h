@@ -32,6 +32,13 @@ typedef enum view_key {
     VIEW_KEY_PLAY, VIEW_KEY_SCRUB_BACK, VIEW_KEY_SCRUB_FORWARD,
     VIEW_KEY_RECORD,
     VIEW_KEY_OPTION_UP, VIEW_KEY_OPTION_DOWN,
+    /* Cycle an enum option of the current renderer through its choices:
+     * overlay, shadow / diffuse backend, filter, VT criteria. */
+    VIEW_KEY_CYCLE_OVERLAY, VIEW_KEY_CYCLE_SHADOW, VIEW_KEY_CYCLE_DIFFUSE, VIEW_KEY_CYCLE_FILTER,
+    VIEW_KEY_CYCLE_CRITERIA,
+    VIEW_KEY_LAYER,                      /* show colour, depth or object IDs */
+    VIEW_KEY_MENU,                       /* the renderers and the current one's options */
+    VIEW_KEY_REFERENCE,                  /* SSIM / hSSIM against an exact reference */
     VIEW_KEY_SCREENSHOT,
     VIEW_KEY_QUIT,
     VIEW_KEY_COUNT

@@ -29,6 +29,12 @@ const char view_keys_help[] =
     "  Tab, Shift+Tab  next / previous renderer (every available one of rl algos)\n"
     "  + -             main option of the renderer: vt min_edge, pt spp,\n"
     "                  surfels overdraw\n"
+    "  O B N F K       cycle the renderer's overlay (vt: wire, samples),\n"
+    "                  shadow backend, diffuse backend, filter, vt criteria\n"
+    "  L               show colour, depth or object IDs (false colours)\n"
+    "  M               menu: the renderers and the current one's options\n"
+    "  X               SSIM and hSSIM against an exact reference (whitted;\n"
+    "                  pt at --ref-spp for the path tracers)\n"
     "  F12             screenshot: PNG + stats JSON (--shot-dir)\n"
     "  F1 or H         this help on screen; I the stats overlay\n"
     "  Esc             quit\n";
@@ -48,7 +54,10 @@ static const key_name key_names[] = {
     { "7", VIEW_KEY_CAMERA_1 + 6 }, { "8", VIEW_KEY_CAMERA_1 + 7 }, { "9", VIEW_KEY_CAMERA_1 + 8 },
     { "c", VIEW_KEY_CAMERA_RESET }, { "p", VIEW_KEY_PLAY }, { ",", VIEW_KEY_SCRUB_BACK },
     { ".", VIEW_KEY_SCRUB_FORWARD }, { "r", VIEW_KEY_RECORD }, { "+", VIEW_KEY_OPTION_UP },
-    { "-", VIEW_KEY_OPTION_DOWN }, { "F12", VIEW_KEY_SCREENSHOT }, { "Escape", VIEW_KEY_QUIT },
+    { "-", VIEW_KEY_OPTION_DOWN }, { "o", VIEW_KEY_CYCLE_OVERLAY }, { "b", VIEW_KEY_CYCLE_SHADOW },
+    { "n", VIEW_KEY_CYCLE_DIFFUSE }, { "f", VIEW_KEY_CYCLE_FILTER }, { "k", VIEW_KEY_CYCLE_CRITERIA },
+    { "l", VIEW_KEY_LAYER }, { "m", VIEW_KEY_MENU }, { "x", VIEW_KEY_REFERENCE },
+    { "F12", VIEW_KEY_SCREENSHOT }, { "Escape", VIEW_KEY_QUIT },
 };
 
 view_key view_key_from_name(const char *name)

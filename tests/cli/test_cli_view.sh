@@ -4,7 +4,8 @@
 # whitted, a moved camera, after a window resize), renderers switch mid-run,
 # a recorded camera path replays through rl render --camera-path to the
 # same frames, pt accumulates, and bad input (an unknown event or key, a
-# missing file, no display) fails with one error line. Skipped (exit 77,
+# missing file, no display) fails with one error line; the live controls
+# (layers, overlay, reference SSIM, menu) work. Skipped (exit 77,
 # ctest's SKIP_RETURN_CODE) where rl was built without SDL2 or xvfb-run is
 # missing.
 # Run as: bash test_cli_view.sh <rl-binary> <scratch-dir>
@@ -159,6 +160,54 @@ python3 - "$TMP/interactive.json" <<'PY' || fail "the interactive run's stats ar
 import json, sys
 s = json.load(open(sys.argv[1]))
 assert not s["scripted"] and s["renderers"][0]["algorithm"] == "pt", s
+PY
+
+# The live controls: L shows depth and object IDs as rl render --depth-out
+# and --id-out draw them; O cycles vt's overlay (the same image as rl
+# render with that overlay); X compares with whitted (whitted itself: SSIM
+# exactly 1); M draws the menu; a cycle key on a renderer without that
+# option changes nothing.
+cat >"$TMP/live.txt" <<EOT
+0 key i
+0 algo whitted
+0 key x
+0 screenshot $TMP/live_whitted.png
+0 key l
+0 capture $TMP/live_depth.png
+0 key l
+0 capture $TMP/live_ids.png
+0 key l
+0 capture $TMP/live_colour.png
+0 key m
+0 capture $TMP/live_menu.png
+0 key m
+0 algo raster
+0 key k
+0 key x
+0 screenshot $TMP/live_raster.png
+0 algo vt
+0 key o
+0 screenshot $TMP/live_vt_wire.png
+EOT
+run_ok xvfb "$RL" view cornell --size $SIZE --script "$TMP/live.txt"
+run_ok "$RL" render cornell --algo whitted --size $SIZE --depth-out "$TMP/ref_depth.png" --id-out "$TMP/ref_ids.png" \
+    --out "$TMP/ref_live.png"
+ssim_ok "$TMP/live_depth.png" "$TMP/ref_depth.png"
+ssim_ok "$TMP/live_ids.png" "$TMP/ref_ids.png"
+ssim_ok "$TMP/live_colour.png" "$TMP/ref_live.png"
+cmp -s "$TMP/live_menu.png" "$TMP/live_colour.png" && fail "M: the menu left the window unchanged"
+run_ok "$RL" render cornell --algo vt --set overlay=wire --size $SIZE --out "$TMP/ref_vt_wire.png"
+ssim_ok "$TMP/live_vt_wire.png" "$TMP/ref_vt_wire.png"
+cmp -s "$TMP/live_vt_wire.png" "$TMP/ref_live.png" && fail "O: vt's wire overlay is missing"
+python3 - "$TMP" <<'PY' || fail "X: the comparisons with the reference are wrong"
+import json, sys
+tmp = sys.argv[1]
+w = json.load(open(tmp + "/live_whitted.json"))["reference"]
+assert w["algorithm"] == "whitted" and w["compared"] == "whitted", w
+assert w["ssim"] == 1 and w["hssim"] == 1 and w["rmse"] == 0 and w["hssim_levels"] >= 2, w
+r = json.load(open(tmp + "/live_raster.json"))["reference"]
+assert r["algorithm"] == "whitted" and r["compared"] == "raster", r
+assert 0.2 < r["ssim"] < 0.9999 and r["rmse"] > 0, r
 PY
 
 # A set in the script that the renderer refuses: exit 2 with FILE:LINE.
