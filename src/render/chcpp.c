@@ -64,6 +64,7 @@
 
 #include "core/error.h"
 #include "render/culling.h"
+#include "render/overlay.h"
 #include "rl/rl_drawer.h"
 #include "render/renderer.h"
 #include "rl/rl_rng.h"
@@ -72,6 +73,8 @@
 /* Query boxes grow by this share of their longest side, so that rounding
  * never lets the bounded geometry poke through their faces. */
 #define QUERY_MARGIN 1e-3f
+
+static const char *const overlay_choices[] = { "none", "nodes", NULL };
 
 static const rl_option_info chcpp_options[] = {
     RL_CULL_RASTER_OPTIONS,
@@ -87,6 +90,9 @@ static const rl_option_info chcpp_options[] = {
     { "tight", RL_OPT_BOOL, "true", "query the tight bounds of a node's objects, not its loose box", 0, 0,
       NULL },
     { "seed", RL_OPT_INT, "1", "seed of the random query offsets", 0, 4294967295.0, NULL },
+    { "overlay", RL_OPT_ENUM, "none",
+      "draw the octree nodes of the frame over the image: visible green, occluded red (nodes)", 0, 0,
+      overlay_choices },
 };
 
 typedef struct node_state {
@@ -500,6 +506,31 @@ static rl_status chcpp_frame(frame_ctx *f)
     return st;
 }
 
+/* overlay=nodes: the frame's outcome per octree node. Green: a visible
+ * node whose own objects were drawn. Red: a node in the frustum found
+ * occluded whose subtree the traversal did not enter, the boundary where
+ * the queries stopped it (an occluded node inside it is not drawn again).
+ * Drawn after the frame's end, when a GL drawer has read the image back. */
+static void draw_nodes(const frame_ctx *f, rl_image *image)
+{
+    const chcpp_state *s = f->s;
+    for (uint32_t n = 0; n < s->num_ns; ++n) {
+        const rl_octree_node *node = &f->nodes[n];
+        const node_state *ns = &s->ns[n];
+        if (ns->last_visited != s->frame || !rl_cull_box_in_frustum(&f->cf.view, node->bounds))
+            continue;
+        bool entered = false;
+        for (uint32_t c = 0; c < node->num_children && !entered; ++c)
+            entered = s->ns[node->first_child + c].last_visited == s->frame;
+        if (ns->visible && node->num_objects > 0)
+            rl_overlay_box(image, &f->cf.view.view_proj, f->cf.view.z_near, node->bounds,
+                           rl_v4(0.2f, 1.0f, 0.2f, 1.0f));
+        else if (!ns->visible && !entered)
+            rl_overlay_box(image, &f->cf.view.view_proj, f->cf.view.z_near, node->bounds,
+                           rl_v4(1.0f, 0.2f, 0.2f, 1.0f));
+    }
+}
+
 static rl_status chcpp_render(rl_renderer *r, void *state, const rl_scene *scene, const rl_camera *cam,
                               rl_image *image, rl_render_stats *stats)
 {
@@ -550,6 +581,8 @@ static rl_status chcpp_render(rl_renderer *r, void *state, const rl_scene *scene
     st = rl_cull_frame_end(&f.cf, chcpp_frame(&f), image, stats);
     if (st != RL_OK)
         return st;
+    if (rl_renderer_opt_enum(r, "overlay") == 1)
+        draw_nodes(&f, image);
     stats->occlusion_queries = s->head.stats.queries;
     stats->prep_ms = s->head.stats.preprocess_ms;
     s->head.have_frame = true;

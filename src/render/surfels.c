@@ -46,6 +46,8 @@
 #include "rl/rl_surfels.h"
 #include "rl/rl_timer.h"
 
+static const char *const overlay_choices[] = { "none", "levels", NULL };
+
 static const rl_option_info surfels_options[] = {
     RL_CULL_RASTER_OPTIONS,
     { "min_size", RL_OPT_FLOAT, "100", "below this projected side (px) a node is surfels only", 0, 1e6, NULL },
@@ -59,6 +61,8 @@ static const rl_option_info surfels_options[] = {
       NULL },
     { "max_depth", RL_OPT_INT, "5", "maximum depth of the loose octree", 0, RL_OCTREE_MAX_DEPTH, NULL },
     { "seed", RL_OPT_INT, "1", "seed of the surfel sampling", 0, 4294967295.0, NULL },
+    { "overlay", RL_OPT_ENUM, "none", "colour the surfels by their octree node's depth instead of lighting them "
+      "(levels: 0 red, 1 orange, 2 yellow, 3 green, 4 cyan, 5 blue, 6+ magenta)", 0, 0, overlay_choices },
 };
 
 typedef struct surfels_params {
@@ -166,7 +170,19 @@ typedef struct surfels_frame {
     const uint32_t *objects;
     rl_cull_frame cf;
     float min_size, max_size, overdraw, point_size;
+    bool levels;                  /* overlay=levels */
 } surfels_frame;
+
+/* overlay=levels: one colour per octree depth, so that a user sees which
+ * level of detail each distant district is drawn at (Sec. 6.2). */
+static rl_vec3 level_colour(uint32_t depth)
+{
+    static const float pal[7][3] = { { 1.0f, 0.15f, 0.15f }, { 1.0f, 0.55f, 0.1f }, { 1.0f, 0.95f, 0.15f },
+                                     { 0.2f, 0.9f, 0.2f },   { 0.15f, 0.9f, 0.95f }, { 0.2f, 0.35f, 1.0f },
+                                     { 0.95f, 0.2f, 0.95f } };
+    const float *c = pal[depth < 6 ? depth : 6];
+    return rl_v3(c[0], c[1], c[2]);
+}
 
 /* Projected size of a box: the area of its screen rectangle in pixels;
  * INFINITY when it reaches behind the near plane. */
@@ -209,8 +225,10 @@ static rl_status reserve(surfels_state *s, size_t n)
 }
 
 /* Sec. 6.2.1: the first n surfels of set, point size `base` px. */
-static rl_status draw_prefix(surfels_frame *f, const rl_surfel_set *set, uint32_t n, float base)
+static rl_status draw_prefix(surfels_frame *f, uint32_t node, uint32_t n, float base)
 {
+    const rl_surfel_set *set = &f->s->sets[node];
+    const rl_vec3 level = level_colour(f->nodes[node].depth);
     surfels_state *s = f->s;
     rl_status st = reserve(s, n);
     if (st != RL_OK)
@@ -231,7 +249,8 @@ static rl_status draw_prefix(surfels_frame *f, const rl_surfel_set *set, uint32_
         s->size[i] = rl_surfel_point_side(base, rl_surfel_size(sf), cosv);
         if (s->size[i] == 0.0f)
             continue;            /* faces away: hidden */
-        rl_vec3 c = rl_raster_light_diffuse(f->d, p, nrm, rl_surfel_color(sf), f->cf.ambient, eye);
+        rl_vec3 c = f->levels ? level
+                              : rl_raster_light_diffuse(f->d, p, nrm, rl_surfel_color(sf), f->cf.ambient, eye);
         s->col[i] = rl_v4_from3(c, 1.0f);
     }
     for (uint32_t i = 0; i < n; ++i) {
@@ -318,7 +337,7 @@ static rl_status draw_cmds(surfels_frame *f)
     for (size_t i = 0; i < s->num_cmds && st == RL_OK;) {
         const draw_cmd *c = &s->cmds[i];
         if (c->m) {
-            st = draw_prefix(f, &s->sets[c->index], c->m, c->point_size);
+            st = draw_prefix(f, c->index, c->m, c->point_size);
             ++i;
             continue;
         }
@@ -392,6 +411,7 @@ static rl_status surfels_render(rl_renderer *r, void *state, const rl_scene *sce
     f.max_size = max_size;
     f.overdraw = (float)rl_renderer_opt_float(r, "overdraw");
     f.point_size = (float)rl_renderer_opt_float(r, "point_size");
+    f.levels = rl_renderer_opt_enum(r, "overlay") == 1;
     st = rl_cull_frame_begin(r, scene, &s->head, cam, image, false, &f.cf);
     if (st != RL_OK)
         return st;

@@ -29,6 +29,7 @@
 #include <string.h>
 
 #include "core/error.h"
+#include "render/overlay.h"
 #include "render/vt_run.h"
 #include "rl/rl_timer.h"
 
@@ -395,26 +396,6 @@ rl_status vt_draw(vt_run *run, bool only_new)
 
 /* ------------------------------------------------------------- overlay -- */
 
-static void plot(rl_image *img, int x, int y, rl_vec4 c)
-{
-    if (x >= 0 && y >= 0 && x < img->width && y < img->height)
-        img->color[(size_t)y * img->width + x] = c;
-}
-
-/* Bresenham-free DDA: enough for a diagnostic wireframe. */
-static void line(rl_image *img, float x0, float y0, float x1, float y1, rl_vec4 c)
-{
-    float dx = x1 - x0, dy = y1 - y0;
-    float steps = fmaxf(fabsf(dx), fabsf(dy));
-    if (!(steps < 1e5f))
-        return;
-    int n = (int)ceilf(steps);
-    for (int i = 0; i <= n; ++i) {
-        float t = n ? (float)i / (float)n : 0.0f;
-        plot(img, (int)floorf(x0 + t * dx), (int)floorf(y0 + t * dy), c);
-    }
-}
-
 void vt_draw_overlay(vt_run *run)
 {
     const vt_mesh *m = run->mesh;
@@ -428,7 +409,7 @@ void vt_draw_overlay(vt_run *run)
             for (int k = 0; k < 3; ++k) {
                 const vt_vertex *a = &m->verts[face->v[k]], *b = &m->verts[face->v[(k + 1) % 3]];
                 if (a->cw > 0.0f && b->cw > 0.0f)
-                    line(img, a->sx, a->sy, b->sx, b->sy, c);
+                    rl_overlay_line(img, a->sx, a->sy, b->sx, b->sy, c);
             }
         }
     } else if (run->set->overlay == VT_OVERLAY_SAMPLES) {
@@ -444,7 +425,7 @@ void vt_draw_overlay(vt_run *run)
                       : (r & (VT_REASON_RGB | VT_REASON_HSV)) ? rl_v4(1.0f, 0.9f, 0.1f, 1.0f)
                       : (r & VT_REASON_FORCED) ? rl_v4(0.2f, 0.5f, 1.0f, 1.0f)
                       : rl_v4(0.6f, 0.6f, 0.6f, 1.0f);
-            plot(img, (int)floorf(x->sx), (int)floorf(x->sy), c);
+            rl_overlay_plot(img, (int)floorf(x->sx), (int)floorf(x->sy), c);
         }
     }
 }

@@ -1,7 +1,8 @@
 /* test_chcpp.c: CHC++ (renderer "chcpp") is conservative: on walks through
  * a box city built here, where no two surfaces are coplanar, every frame
  * equals "raster" in colour, depth and IDs, pixel for pixel; and it culls:
- * at street level it draws a fraction of the triangles. */
+ * at street level it draws a fraction of the triangles; its overlay shows
+ * the visible and occluded nodes. */
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
@@ -158,6 +159,44 @@ static void test_chcpp_culls_at_street_level(void **state)
     rl_scene_release(s);
 }
 
+/* overlay=nodes draws the node boxes over the colour and changes nothing
+ * else: depth and IDs stay raster's; at street level both kinds appear,
+ * green visible nodes and red occluded ones. */
+static void test_chcpp_overlay_draws_visible_and_occluded_nodes(void **state)
+{
+    (void)state;
+    rl_scene *s = fx_box_city();
+    rl_renderer *plain = fx_make("chcpp", NULL);
+    rl_renderer *boxes = fx_make("chcpp", (const char *const[]){ "overlay", "nodes", NULL });
+    rl_camera cam = street_camera(2.0f);
+    rl_image *a = NULL, *b = NULL;
+    for (int f = 0; f < 2; ++f) {
+        rl_image_release(a);
+        rl_image_release(b);
+        a = fx_render_with(plain, s, &cam, FX_ALL_LAYERS, NULL);
+        b = fx_render_with(boxes, s, &cam, FX_ALL_LAYERS, NULL);
+    }
+    size_t n = (size_t)cam.width * (size_t)cam.height, green = 0, red = 0, changed = 0;
+    for (size_t i = 0; i < n; ++i) {
+        assert_int_equal(a->object_id[i], b->object_id[i]);
+        assert_true(a->depth[i] == b->depth[i] || (a->depth[i] != a->depth[i] && b->depth[i] != b->depth[i]));
+        rl_vec4 p = a->color[i], q = b->color[i];
+        if (p.x != q.x || p.y != q.y || p.z != q.z) {
+            changed++;
+            green += q.x == 0.2f && q.y == 1.0f && q.z == 0.2f;
+            red += q.x == 1.0f && q.y == 0.2f && q.z == 0.2f;
+        }
+    }
+    assert_true(green > 0 && red > 0);
+    assert_int_equal(green + red, changed);
+    assert_true(changed < n / 2);
+    rl_image_release(a);
+    rl_image_release(b);
+    rl_renderer_release(plain);
+    rl_renderer_release(boxes);
+    rl_scene_release(s);
+}
+
 /* Sums of a street walk's culling statistics (frames after the first). */
 typedef struct walk_sums {
     uint64_t queries, multiqueries, occluded, triangles;
@@ -233,6 +272,7 @@ int main(void)
         cmocka_unit_test(test_chcpp_culls_at_street_level),
         cmocka_unit_test(test_chcpp_multiqueries_and_tight_bounds_are_used),
         cmocka_unit_test(test_chcpp_refuses_bad_options),
+        cmocka_unit_test(test_chcpp_overlay_draws_visible_and_occluded_nodes),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

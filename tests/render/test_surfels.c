@@ -2,7 +2,8 @@
  * 6.2) on the box city: never approximating gives raster's image; far away
  * the city becomes points only, at a measured quality; in between both are
  * drawn; the same options give the same image; the prefix and point-size
- * rule matches hand-computed values; bad sizes are refused. */
+ * rule matches hand-computed values; bad sizes are refused; the levels
+ * overlay recolours the points only. */
 #include <math.h>
 #include <setjmp.h>
 #include <stdarg.h>
@@ -185,6 +186,35 @@ static void test_surfel_lod_rule_by_hand(void **state)
     assert_float_equal(rl_surfel_point_side(7.0f, 1.0f, NAN), 0.0f, 1e-6f);
 }
 
+/* overlay=levels: the points take their node depth's colour, unlit; the
+ * meshes and the depth layer stay those of the lit frame. */
+static void test_surfels_overlay_colours_points_by_level(void **state)
+{
+    (void)state;
+    rl_scene *s = fx_box_city();
+    rl_camera cam = far_camera(110.0f);
+    const char *const lit_opts[] = { SMALL, "min_size", "60", "max_size", "120", NULL };
+    const char *const lvl_opts[] = { SMALL, "min_size", "60", "max_size", "120", "overlay", "levels", NULL };
+    rl_image *lit = fx_render("surfels", s, &cam, FX_ALL_LAYERS, lit_opts, NULL);
+    rl_image *lvl = fx_render("surfels", s, &cam, FX_ALL_LAYERS, lvl_opts, NULL);
+    size_t n = (size_t)cam.width * (size_t)cam.height, changed = 0;
+    for (size_t i = 0; i < n; ++i) {
+        assert_int_equal(lit->object_id[i], lvl->object_id[i]);
+        rl_vec4 p = lit->color[i], q = lvl->color[i];
+        if (p.x == q.x && p.y == q.y && p.z == q.z)
+            continue;
+        /* Only point pixels change, to a palette colour: one channel near
+         * full, as no lit surface of the city is. */
+        changed++;
+        assert_int_equal(lvl->object_id[i], RL_ID_NONE);
+        assert_true(fmaxf(q.x, fmaxf(q.y, q.z)) >= 0.9f);
+    }
+    assert_true(changed > 100);
+    rl_image_release(lit);
+    rl_image_release(lvl);
+    rl_scene_release(s);
+}
+
 static void test_surfels_refuse_bad_options(void **state)
 {
     (void)state;
@@ -209,6 +239,7 @@ int main(void)
         cmocka_unit_test(test_surfel_prefix_follows_projected_size_and_overdraw),
         cmocka_unit_test(test_surfel_lod_rule_by_hand),
         cmocka_unit_test(test_surfels_refuse_bad_options),
+        cmocka_unit_test(test_surfels_overlay_colours_points_by_level),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
