@@ -76,6 +76,10 @@ install:
 
 demo: deps build
 	@$(BUILD)/rl demo --out out/demo
+	@# The viewer's window, drawn without a display by SDL's offscreen driver.
+	@SDL_VIDEODRIVER=offscreen $(BUILD)/rl view table --algo vt --size 640x480 \
+		--script scripts/demo-view.txt && echo "demo: out/demo/viewer.png (rl view)" || \
+		echo "demo: no viewer screenshot (rl view failed, see above)"
 
 clean:
 	rm -rf $(BUILD) $(BUILD_SAN) $(BUILD_FUZZ) $(BUILD_INSTALL) out
