@@ -71,6 +71,8 @@ static const char bench_vt_help[] =
     "              hsv/min_edge 14: vertices, forced splits, rays, time, SSIM (Fig. 5.3)\n"
     "  preview     the preview alone (refinement stopped after the primary\n"
     "              vertices) at 512, 1024, 2048 square: its time by phase (Fig. 5.12b)\n"
+    "  reduction   sample reduction (Sec. 6.2.1, merge_px 0, 0.5, 1, 2): the preview\n"
+    "              and the full frame: samples, merged vertices, time, SSIM\n"
     "  animation   cluster scene camera path with and without temporal coherence\n"
     "\n"
     "options:\n"
@@ -94,10 +96,10 @@ static const char bench_vt_help[] =
 
 /* The static sections (the table scene) come before animation. */
 enum { SEC_CRITERIA, SEC_RESOLUTION, SEC_QUALITY, SEC_THREADS, SEC_VISIBILITY, SEC_MODES, SEC_FORCED,
-       SEC_PREVIEW, SEC_ANIMATION, SEC_COUNT };
+       SEC_PREVIEW, SEC_REDUCTION, SEC_ANIMATION, SEC_COUNT };
 static const char *const section_names[SEC_COUNT] = { "criteria", "resolution", "quality", "threads",
                                                       "visibility", "modes", "forced", "preview",
-                                                      "animation" };
+                                                      "reduction", "animation" };
 
 /* The shading modes of Ullmann 2003, Figs. 5.9/5.10, as bits: shadow
  * feelers (S), reflection rays (R), transmission rays (T). */
@@ -208,6 +210,7 @@ static cJSON *vt_stats_json(const rl_vt_stats *s)
         { "edges_culled_viewport", s->edges_culled_viewport },
         { "faces_drawn", s->faces_drawn },
         { "feelers_reused", s->feelers_reused },
+        { "vertices_merged", s->vertices_merged },
         { "stages", s->stages },
         { "threads", s->threads },
     };
@@ -1175,6 +1178,75 @@ static rl_status sec_preview(void *ctx, cJSON *sec)
     return st;
 }
 
+/* --------------------------------------------------------- reduction -- */
+
+/* Ullmann Sec. 6.2.1, sample reduction: the ends of a primary edge shorter
+ * than merge_px share one sample. The thesis expects the gain at the
+ * preview of scenes with high depth complexity; the full frame shows what
+ * is left of it once refinement adds its vertices. */
+static rl_status sec_reduction(void *ctx, cJSON *sec)
+{
+    bvt *b = ctx;
+    static const double merges[] = { 0.0, 0.5, 1.0, 2.0 };
+    int w = b->a->width, h = b->a->height;
+    ref_frame *ref = NULL;
+    rl_status st = reference(b, w, h, b->threads, MODE_ALL, &ref);
+    if (st != RL_OK)
+        return st;
+    char size[32];
+    snprintf(size, sizeof size, "%dx%d", w, h);
+    cJSON_AddStringToObject(sec, "scene", table_spec(b));
+    cJSON_AddStringToObject(sec, "size", size);
+    cJSON_AddItemToObject(sec, "whitted", ref_json(ref));
+    cJSON *rows = cJSON_AddArrayToObject(sec, "runs");
+    rl_camera cam = sized(&b->table_cam, w, h);
+    rl_image *img = NULL;
+    st = rl_image_create(w, h, RL_LAYER_COLOR, &img);
+    printf("\nsample reduction (Sec. 6.2.1): %s %s, whitted %.1f ms\n", table_spec(b), size, ref->stats.time_ms);
+    printf("%-8s %-8s %9s %9s %9s %9s  %6s %7s\n", "merge_px", "frame", "sampled", "merged", "VT ms", "preview",
+           "ssimVT", "rmseVT");
+    for (size_t i = 0; st == RL_OK && i < sizeof merges / sizeof merges[0]; i++) {
+        for (int preview = 1; st == RL_OK && preview >= 0; preview--) {
+            rl_renderer *r = NULL;
+            timed_frame t;
+            quality q;
+            st = make_renderer("vt", b->threads, &r);
+            if (st == RL_OK)
+                st = set_int(r, "merge_px", merges[i]);
+            if (st == RL_OK && preview)
+                st = rl_vt_set_update_callback(r, stop_at_preview, NULL);
+            if (st == RL_OK)
+                st = render_timed(r, b->table, &cam, img, b->runs, &t);
+            rl_renderer_release(r);
+            if (st == RL_OK)
+                st = compare(img, ref->image, ref->mask, ref->mask_pixels, &q);
+            if (st != RL_OK)
+                break;
+            cJSON *row = cJSON_CreateObject();
+            cJSON_AddItemToArray(rows, row);
+            cJSON_AddNumberToObject(row, "merge_px", merges[i]);
+            cJSON_AddStringToObject(row, "frame", preview ? "preview" : "full");
+            cJSON_AddNumberToObject(row, "vertices_sampled", (double)t.vt.vertices_sampled);
+            cJSON_AddNumberToObject(row, "vertices_merged", (double)t.vt.vertices_merged);
+            cJSON_AddItemToObject(row, "rays", rays_json(&t.stats));
+            add_num(row, "time_ms", t.stats.time_ms);
+            add_num(row, "preview_ms", t.vt.time_preview_ms);
+            add_num(row, "time_ratio_to_whitted", ratio(t.stats.time_ms, ref->stats.time_ms));
+            cJSON_AddItemToObject(row, "quality", quality_json(&q));
+            cJSON_AddItemToObject(row, "vt_stats", vt_stats_json(&t.vt));
+            printf("%-8g %-8s %9llu %9llu %9.1f %9.1f  %6.3f %7.4f\n", merges[i], preview ? "preview" : "full",
+                   (unsigned long long)t.vt.vertices_sampled, (unsigned long long)t.vt.vertices_merged,
+                   t.stats.time_ms, t.vt.time_preview_ms, q.vt_px.ssim, q.vt_px.rmse);
+            fflush(stdout);
+            note("merge_px %g %s %s: %llu sampled, %llu merged, %.1f ms, SSIM %.3f (VT pixels)", merges[i],
+                 preview ? "preview" : "full", size, (unsigned long long)t.vt.vertices_sampled,
+                 (unsigned long long)t.vt.vertices_merged, t.stats.time_ms, q.vt_px.ssim);
+        }
+    }
+    rl_image_release(img);
+    return st;
+}
+
 /* --------------------------------------------------------- animation -- */
 
 typedef struct series {
@@ -1556,7 +1628,7 @@ static int run(bvt *b)
         return cli_fail(RL_CLI_FAIL, "out of memory");
     static const bench_section_fn fns[SEC_COUNT] = { sec_criteria, sec_resolution, sec_quality, sec_threads,
                                                      sec_visibility, sec_modes, sec_forced, sec_preview,
-                                                     sec_animation };
+                                                     sec_reduction, sec_animation };
     printf("rl bench vt: Vertex Tracing vs Whitted, %d threads, max_depth %s, area_samples %s, "
            "shadows %s\n", b->threads, TRACE_MAX_DEPTH, TRACE_AREA_SAMPLES, TRACE_SHADOWS);
     rc = bench_run_sections("vt", root, section_names, fns, SEC_COUNT, a->sections, b,

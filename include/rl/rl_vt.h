@@ -38,6 +38,8 @@ typedef struct rl_vt_stats {
     uint64_t edges_culled_viewport;    /* new edges dropped by the viewport test */
     uint64_t faces_drawn;              /* VT faces rasterized in the final image */
     uint64_t feelers_reused;           /* shadow feelers answered by temporal coherence */
+    uint64_t vertices_merged;          /* primary vertices that took a neighbour's sample
+                                        * instead of casting rays (merge_px, Sec. 6.2.1) */
     uint32_t stages;                   /* refinement stages run */
     double time_visibility_ms;         /* ID/Z pre-pass and face flags */
     double time_sampling_ms;           /* ray tracing of vertices (wall) */

@@ -68,6 +68,9 @@ static const rl_option_info vt_options[] = {
     { "id_test", RL_OPT_BOOL, "true", "ID-buffer visibility pre-pass (Sec. 3.4.1; false: all faces)", 0, 0, NULL },
     { "z_test", RL_OPT_BOOL, "true", "z-buffer test of new edges (Sec. 3.4.2)", 0, 0, NULL },
     { "clip_test", RL_OPT_BOOL, "true", "viewport test of new edges (Sec. 3.4.3)", 0, 0, NULL },
+    { "merge_px", RL_OPT_FLOAT, "0",
+      "sample reduction (Sec. 6.2.1): the ends of a primary edge projected shorter than this many pixels "
+      "share one sample (0 = off; the thesis suggests <= 1)", 0, 16, NULL },
     { "textures", RL_OPT_ENUM, "multitexture",
       "deferred textures: multitexture (eq. 3.20, one pass), multipass (eq. 3.22), sampled (no deferral)",
       0, 0, texture_choices },
@@ -326,6 +329,7 @@ static void read_settings(rl_renderer *r, vt_settings *set)
     set->id_test = rl_renderer_opt_bool(r, "id_test");
     set->z_test = rl_renderer_opt_bool(r, "z_test");
     set->clip_test = rl_renderer_opt_bool(r, "clip_test");
+    set->merge_px = (float)rl_renderer_opt_float(r, "merge_px");
     set->textures = rl_renderer_opt_enum(r, "textures");
     set->progressive = rl_renderer_opt_enum(r, "progressive");
     set->update_every = (int)rl_renderer_opt_int(r, "update_every");

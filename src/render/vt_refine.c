@@ -304,19 +304,112 @@ static void end_interval(refine_ctx *ctx, double t0, double busy0)
     ctx->refine_ms += (now_ms() - t0) - (vt_sample_busy_ms(ctx->run) - busy0);
 }
 
+/* ------------------------------------------------------ sample merging -- */
+
+static uint32_t find_root(uint32_t *parent, uint32_t v)
+{
+    while (parent[v] != v) {
+        parent[v] = parent[parent[v]];   /* path halving */
+        v = parent[v];
+    }
+    return v;
+}
+
+static bool primary_edge_visible(const vt_mesh *m, const vt_edge *ed)
+{
+    return (ed->face[0] != VT_NONE && m->faces[ed->face[0]].visible) ||
+           (ed->face[1] != VT_NONE && m->faces[ed->face[1]].visible);
+}
+
+/* Sample reduction, Ullmann Sec. 6.2.1: the two ends of a visible primary
+ * edge whose projection is shorter than merge_px count as one sample.
+ * Chains of short edges form one group (union-find); the lowest vertex of
+ * a group is traced, the others are marked queued so that the stage-0
+ * queue skips them, and take its sample after the flush (merge_finish).
+ * Returns the group roots (parent[v] after path compression) or NULL when
+ * nothing merges; *fail on out of memory. */
+static uint32_t *merge_begin(vt_run *run, bool *fail)
+{
+    vt_mesh *m = run->mesh;
+    const float eps = run->set->merge_px;
+    *fail = false;
+    if (!(eps > 0.0f) || m->num_primary_verts == 0)
+        return NULL;
+    uint32_t *parent = malloc((size_t)m->num_primary_verts * sizeof *parent);
+    if (!parent) {
+        *fail = true;
+        return NULL;
+    }
+    for (uint32_t v = 0; v < m->num_primary_verts; ++v)
+        parent[v] = v;
+    bool any = false;
+    for (uint32_t e = 0; e < m->num_primary_edges; ++e) {
+        const vt_edge *ed = &m->edges[e];
+        const vt_vertex *a = &m->verts[ed->v[0]], *b = &m->verts[ed->v[1]];
+        if (!primary_edge_visible(m, ed) || !(a->cw > 0.0f) || !(b->cw > 0.0f) ||
+            !(vt_edge_length(&run->view, a, b) < eps))
+            continue;
+        uint32_t ra = find_root(parent, ed->v[0]), rb = find_root(parent, ed->v[1]);
+        if (ra != rb) {
+            /* The lower index is the root: the result does not depend on
+             * the order edges are visited in. */
+            if (ra < rb)
+                parent[rb] = ra;
+            else
+                parent[ra] = rb;
+            any = true;
+        }
+    }
+    if (!any) {
+        free(parent);
+        return NULL;
+    }
+    for (uint32_t v = 0; v < m->num_primary_verts; ++v)
+        if (find_root(parent, v) != v && m->verts[v].state == VT_UNSAMPLED)
+            m->verts[v].state = VT_QUEUED;
+    return parent;
+}
+
+/* After the stage-0 flush: every merged vertex takes its root's sample.
+ * The primary term's texture coordinates stay the vertex's own, so that
+ * deferred textures (Sec. 3.5.3) are still looked up where it lies. */
+static void merge_finish(vt_run *run, uint32_t *parent)
+{
+    vt_mesh *m = run->mesh;
+    for (uint32_t v = 0; v < m->num_primary_verts; ++v) {
+        uint32_t r = find_root(parent, v);
+        if (r == v || m->verts[v].state != VT_QUEUED || m->verts[r].state != VT_SAMPLED)
+            continue;
+        m->samples[v] = m->samples[r];
+        m->samples[v].layers[RL_TRACE_LAYER_PRIMARY].uv = m->verts[v].uv;
+        m->verts[v].state = VT_SAMPLED;
+        run->stats.vertices_merged++;
+    }
+    /* A member whose root was not traced (cannot happen: a merging edge is
+     * visible, so both its ends are queued) is traced after all. */
+    for (uint32_t v = 0; v < m->num_primary_verts; ++v)
+        if (m->verts[v].state == VT_QUEUED && find_root(parent, v) != v) {
+            m->verts[v].state = VT_UNSAMPLED;
+            vt_sample_queue(run, v);
+        }
+    vt_sample_flush(run);
+    free(parent);
+}
+
 static void refine_all(refine_ctx *ctx)
 {
     vt_run *run = ctx->run;
     vt_mesh *m = run->mesh;
     double t0 = now_ms(), busy0 = vt_sample_busy_ms(run);
 
+    bool merge_failed = false;
+    uint32_t *merged = merge_begin(run, &merge_failed);
+    run->failed |= merge_failed;
     /* Fig. 3.12: the edges of every visible primary face; their vertices
      * are ray traced (stage 0, the initial sample pattern of Sec. 3.2). */
     for (uint32_t e = 0; e < m->num_primary_edges && !run->failed; ++e) {
         const vt_edge *ed = &m->edges[e];
-        bool vis = (ed->face[0] != VT_NONE && m->faces[ed->face[0]].visible) ||
-                   (ed->face[1] != VT_NONE && m->faces[ed->face[1]].visible);
-        if (!vis)
+        if (!primary_edge_visible(m, ed))
             continue;
         vt_sample_queue(run, ed->v[0]);
         vt_sample_queue(run, ed->v[1]);
@@ -324,6 +417,8 @@ static void refine_all(refine_ctx *ctx)
     }
     end_interval(ctx, t0, busy0);
     vt_sample_flush(run);
+    if (merged)
+        merge_finish(run, merged);
 
     double tu = now_ms();
     if (run->update && !run->failed && !vt_update(run, 0, false))

@@ -32,6 +32,8 @@ typedef struct vt_settings {
     bool forced;              /* forced refinement (Sec. 3.3.2) */
     float eps_z;              /* its threshold on xi */
     bool id_test, z_test, clip_test;   /* Sec. 3.4.1-3.4.3 */
+    float merge_px;           /* Sec. 6.2.1: primary edges shorter than this
+                               * sample one end only; 0 = off */
     int textures;             /* VT_TEX_* (Sec. 3.5.3-3.5.5) */
     int progressive;          /* VT_PROG_* (Sec. 3.5.1) */
     int update_every;         /* k */

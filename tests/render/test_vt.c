@@ -436,6 +436,63 @@ static void converges_to_whitted(void **state)
     rl_scene_release(s);
 }
 
+/* Sec. 6.2.1, sample reduction: the ends of a primary edge shorter than
+ * merge_px share one sample. At the preview (no refinement) every merged
+ * vertex is one fewer traced; merged or not, the converged image stays
+ * Whitted's. */
+static void sample_reduction_merges_short_primary_edges(void **state)
+{
+    (void)state;
+    rl_scene *s = NULL;
+    assert_int_equal(rl_scene_create(&s), RL_OK);
+    uint32_t grey = add_material(s, "grey", rl_v3(0.7f, 0.7f, 0.7f), 0.0f, 0.0f);
+    uint32_t mirror = add_material(s, "mirror", rl_v3(0.1f, 0.1f, 0.1f), 0.8f, 0.0f);
+    add_grid(s, "floor", 8, 3.0f, grey, false);
+    const char *ball = "radius=0.5,segments=48,rings=24";
+    add_object(s, "near", "sphere", ball, mirror, rl_mat4_translate(rl_v3(-0.6f, 0.5f, 1.5f)), true);
+    add_object(s, "far", "sphere", ball, mirror, rl_mat4_translate(rl_v3(0.8f, 0.5f, -6.0f)), true);
+    rl_light l = { .type = RL_LIGHT_POINT, .color = rl_v3(1, 1, 1), .intensity = 20.0f,
+                   .position = rl_v3(1.0f, 4.0f, 2.0f) };
+    assert_int_equal(rl_scene_add_light(s, &l), RL_OK);
+    assert_int_equal(rl_scene_commit(s), RL_OK);
+    rl_camera cam = look(rl_v3(0.0f, 1.5f, 5.0f), rl_v3(0.0f, 0.4f, 0.0f), 96);
+    rl_vt_stats off, on;
+    const char *pre_off[] = { "min_edge", "100000", NULL };
+    const char *pre_on[] = { "min_edge", "100000", "merge_px", "1.5", NULL };
+    rl_renderer *r = make_vt(pre_off);
+    rl_image *img = fx_render_with(r, s, &cam, RL_LAYER_COLOR, NULL);
+    assert_int_equal(rl_vt_get_stats(r, &off), RL_OK);
+    rl_image_release(img);
+    rl_renderer_release(r);
+    r = make_vt(pre_on);
+    img = fx_render_with(r, s, &cam, RL_LAYER_COLOR, NULL);
+    assert_int_equal(rl_vt_get_stats(r, &on), RL_OK);
+    rl_image_release(img);
+    rl_renderer_release(r);
+    print_message("preview: %llu sampled, with merge_px 1.5 %llu sampled + %llu merged\n",
+                  (unsigned long long)off.vertices_sampled, (unsigned long long)on.vertices_sampled,
+                  (unsigned long long)on.vertices_merged);
+    assert_int_equal(off.vertices_merged, 0);
+    assert_true(on.vertices_merged > off.vertices_sampled / 10);
+    assert_int_equal(on.vertices_sampled + on.vertices_merged, off.vertices_sampled);
+
+    /* Refined: about the quality of the image without merging. */
+    const char *full[] = { "min_edge", "1", "criteria", "tree+rgb", "eps_rgb", "0.03", "merge_px", "1", NULL };
+    const char *plain[] = { "min_edge", "1", "criteria", "tree+rgb", "eps_rgb", "0.03", NULL };
+    rl_image *vt = fx_render("vt", s, &cam, RL_LAYER_COLOR, full, NULL);
+    rl_image *vt0 = fx_render("vt", s, &cam, RL_LAYER_COLOR, plain, NULL);
+    rl_image *ref = fx_render("whitted", s, &cam, RL_LAYER_COLOR, NULL, NULL);
+    rl_image_metrics m, m0;
+    assert_int_equal(rl_image_compare(vt, ref, NULL, &m), RL_OK);
+    assert_int_equal(rl_image_compare(vt0, ref, NULL, &m0), RL_OK);
+    print_message("vs whitted: ssim %.4f with merge_px 1, %.4f without\n", m.ssim, m0.ssim);
+    assert_true(m.ssim >= m0.ssim - 0.01);
+    rl_image_release(vt0);
+    rl_image_release(vt);
+    rl_image_release(ref);
+    rl_scene_release(s);
+}
+
 /* Ch. 4: the image does not depend on the number of threads; Sec. 3.4.5:
  * nor on temporal coherence, which must replay feelers exactly. */
 static void deterministic_and_coherent(void **state)
@@ -758,6 +815,7 @@ int main(void)
         cmocka_unit_test(long_slivers_are_refined),
         cmocka_unit_test(hidden_vertices_cast_no_rays),
         cmocka_unit_test(converges_to_whitted),
+        cmocka_unit_test(sample_reduction_merges_short_primary_edges),
         cmocka_unit_test(deterministic_and_coherent),
         cmocka_unit_test(kept_buffers_follow_size_threads_and_layers),
         cmocka_unit_test(progressive_updates),
