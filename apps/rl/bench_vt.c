@@ -73,6 +73,11 @@ static const char bench_vt_help[] =
     "              vertices) at 512, 1024, 2048 square: its time by phase (Fig. 5.12b)\n"
     "  reduction   sample reduction (Sec. 6.2.1, merge_px 0, 0.5, 1, 2): the preview\n"
     "              and the full frame: samples, merged vertices, time, SSIM\n"
+    "  overdraw    progressive overdraw against redraw, per stage k and for\n"
+    "              f = 0, 1e-5, 1e-4, 1e-3, 1e-2 (eq. 3.16): the rasterization error\n"
+    "              of overdrawing (Fig. 5.7)\n"
+    "  equalrays   the preview and the converged frame against Whitted with as many\n"
+    "              rays (a smaller image scaled up): SSIM on the VT pixels (Fig. 5.4)\n"
     "  animation   cluster scene camera path with and without temporal coherence\n"
     "\n"
     "options:\n"
@@ -96,10 +101,10 @@ static const char bench_vt_help[] =
 
 /* The static sections (the table scene) come before animation. */
 enum { SEC_CRITERIA, SEC_RESOLUTION, SEC_QUALITY, SEC_THREADS, SEC_VISIBILITY, SEC_MODES, SEC_FORCED,
-       SEC_PREVIEW, SEC_REDUCTION, SEC_ANIMATION, SEC_COUNT };
+       SEC_PREVIEW, SEC_REDUCTION, SEC_OVERDRAW, SEC_EQUAL_RAYS, SEC_ANIMATION, SEC_COUNT };
 static const char *const section_names[SEC_COUNT] = { "criteria", "resolution", "quality", "threads",
                                                       "visibility", "modes", "forced", "preview",
-                                                      "reduction", "animation" };
+                                                      "reduction", "overdraw", "equalrays", "animation" };
 
 /* The shading modes of Ullmann 2003, Figs. 5.9/5.10, as bits: shadow
  * feelers (S), reflection rays (R), transmission rays (T). */
@@ -1247,6 +1252,279 @@ static rl_status sec_reduction(void *ctx, cJSON *sec)
     return st;
 }
 
+/* ---------------------------------------------------------- overdraw -- */
+
+#define OD_STAGES 12
+
+/* The intermediate images of one progressive run, stage by stage. */
+typedef struct stage_grab {
+    rl_image *img[OD_STAGES];
+    uint32_t stage[OD_STAGES];
+    int n;
+    bool failed;
+} stage_grab;
+
+static bool grab_stage(void *user, const rl_image *image, uint32_t stage, bool final)
+{
+    stage_grab *g = user;
+    if (final || g->n >= OD_STAGES)
+        return true;
+    if (!g->img[g->n] && rl_image_create(image->width, image->height, RL_LAYER_COLOR, &g->img[g->n]) != RL_OK) {
+        g->failed = true;
+        return false;
+    }
+    memcpy(g->img[g->n]->color, image->color, (size_t)image->width * (size_t)image->height * sizeof *image->color);
+    g->stage[g->n++] = stage;
+    return true;
+}
+
+static void grab_free(stage_grab *g)
+{
+    for (int i = 0; i < OD_STAGES; i++)
+        rl_image_release(g->img[i]);
+    memset(g, 0, sizeof *g);
+}
+
+/* One progressive run (redraw or overdraw with f) into g; the final image
+ * into img. */
+static rl_status progressive_run(bvt *b, const rl_camera *cam, const char *mode, double f, rl_image *img,
+                                 stage_grab *g)
+{
+    rl_renderer *r = NULL;
+    rl_status st = make_renderer("vt", b->threads, &r);
+    if (st == RL_OK)
+        st = rl_renderer_set(r, "progressive", mode);
+    if (st == RL_OK)
+        st = set_int(r, "overdraw_f", f);
+    if (st == RL_OK)
+        st = rl_vt_set_update_callback(r, grab_stage, g);
+    if (st == RL_OK) {
+        g->n = 0;
+        rl_render_stats stats;
+        st = rl_renderer_render(r, b->table, cam, img, &stats);
+    }
+    if (st == RL_OK && g->failed)
+        st = bench_error(b, RL_ERR_OUT_OF_MEMORY, "out of memory for the stage images");
+    rl_renderer_release(r);
+    return st;
+}
+
+/* Share of the masked pixels (all without a mask) where a channel differs
+ * by more than one 8-bit step. */
+static double differing(const rl_image *a, const rl_image *b, const uint8_t *mask)
+{
+    size_t n = (size_t)a->width * (size_t)a->height, count = 0, diff = 0;
+    for (size_t i = 0; i < n; i++) {
+        if (mask && !mask[i])
+            continue;
+        count++;
+        rl_vec4 p = a->color[i], q = b->color[i];
+        diff += fabsf(p.x - q.x) > 1.0f / 255.0f || fabsf(p.y - q.y) > 1.0f / 255.0f ||
+                fabsf(p.z - q.z) > 1.0f / 255.0f;
+    }
+    return count ? (double)diff / (double)count : 0.0;
+}
+
+/* Fig. 5.7: progressive overdraw (Sec. 3.5.1) draws each stage's faces over
+ * the last image, moved towards the eye by eq. 3.16, v_k = v - (v - p_a) f k,
+ * so that children win the depth test against their parents. Too small an
+ * f leaves parents showing through; too large lets faces win against what
+ * lies in front of them. The error is the difference to redraw (the same
+ * stages drawn anew), per stage k and for each f, over the VT pixels. */
+static rl_status sec_overdraw(void *ctx, cJSON *sec)
+{
+    bvt *b = ctx;
+    static const double fs[] = { 0.0, 1e-5, 1e-4, 1e-3, 1e-2 };
+    int w = b->a->width, h = b->a->height;
+    ref_frame *ref = NULL;
+    rl_status st = reference(b, w, h, b->threads, MODE_ALL, &ref);
+    if (st != RL_OK)
+        return st;
+    char size[32];
+    snprintf(size, sizeof size, "%dx%d", w, h);
+    cJSON_AddStringToObject(sec, "scene", table_spec(b));
+    cJSON_AddStringToObject(sec, "size", size);
+    cJSON *rows = cJSON_AddArrayToObject(sec, "runs");
+    rl_camera cam = sized(&b->table_cam, w, h);
+    rl_image *redraw_img = NULL, *over_img = NULL;
+    stage_grab redraw, over;
+    memset(&redraw, 0, sizeof redraw);
+    memset(&over, 0, sizeof over);
+    st = rl_image_create(w, h, RL_LAYER_COLOR, &redraw_img);
+    if (st == RL_OK)
+        st = rl_image_create(w, h, RL_LAYER_COLOR, &over_img);
+    if (st == RL_OK)
+        st = progressive_run(b, &cam, "redraw", 0.0, redraw_img, &redraw);
+    printf("\nprogressive overdraw against redraw (Fig. 5.7): %s %s, RMSE on the VT pixels per stage k\n",
+           table_spec(b), size);
+    printf("%-7s", "f");
+    for (int k = 0; st == RL_OK && k < redraw.n; k++)
+        printf(" %7s%-2u", "k=", redraw.stage[k]);
+    printf(" %9s %8s %8s\n", "final", "ssimVT", "differ");
+    for (size_t i = 0; st == RL_OK && i < sizeof fs / sizeof fs[0]; i++) {
+        st = progressive_run(b, &cam, "overdraw", fs[i], over_img, &over);
+        if (st == RL_OK && over.n != redraw.n)
+            st = bench_error(b, RL_ERR_INTERNAL, "overdraw made %d stages, redraw %d", over.n, redraw.n);
+        if (st != RL_OK)
+            break;
+        cJSON *row = cJSON_CreateObject();
+        cJSON_AddItemToArray(rows, row);
+        cJSON_AddNumberToObject(row, "overdraw_f", fs[i]);
+        cJSON *stages = cJSON_AddArrayToObject(row, "stages");
+        printf("%-7g", fs[i]);
+        for (int k = 0; st == RL_OK && k < over.n; k++) {
+            quality q;
+            st = compare(over.img[k], redraw.img[k], ref->mask, ref->mask_pixels, &q);
+            if (st != RL_OK)
+                break;
+            cJSON *o = cJSON_CreateObject();
+            cJSON_AddItemToArray(stages, o);
+            cJSON_AddNumberToObject(o, "k", over.stage[k]);
+            add_num(o, "rmse_vt_pixels", q.vt_px.rmse);
+            add_num(o, "ssim_vt_pixels", q.vt_px.ssim);
+            add_num(o, "differing_vt_pixels", differing(over.img[k], redraw.img[k], ref->mask_pixels ? ref->mask : NULL));
+            printf(" %9.5f", q.vt_px.rmse);
+        }
+        quality q;
+        if (st == RL_OK)
+            st = compare(over_img, redraw_img, ref->mask, ref->mask_pixels, &q);
+        if (st != RL_OK)
+            break;
+        double diff = differing(over_img, redraw_img, ref->mask_pixels ? ref->mask : NULL);
+        cJSON *fin = cJSON_AddObjectToObject(row, "final");
+        add_num(fin, "rmse_vt_pixels", q.vt_px.rmse);
+        add_num(fin, "ssim_vt_pixels", q.vt_px.ssim);
+        add_num(fin, "differing_vt_pixels", diff);
+        printf(" %9.5f %8.4f %7.2f%%\n", q.vt_px.rmse, q.vt_px.ssim, 100.0 * diff);
+        fflush(stdout);
+        note("overdraw f %g %s: final RMSE %.5f, SSIM %.4f, %.2f %% of the VT pixels differ from redraw", fs[i],
+             size, q.vt_px.rmse, q.vt_px.ssim, 100.0 * diff);
+    }
+    grab_free(&redraw);
+    grab_free(&over);
+    rl_image_release(redraw_img);
+    rl_image_release(over_img);
+    return st;
+}
+
+/* --------------------------------------------------------- equalrays -- */
+
+static int clampi(int v, int lo, int hi)
+{
+    return v < lo ? lo : v > hi ? hi : v;
+}
+
+static rl_vec4 mix4(rl_vec4 a, rl_vec4 b, float t)
+{
+    return rl_v4(a.x + (b.x - a.x) * t, a.y + (b.y - a.y) * t, a.z + (b.z - a.z) * t, 1.0f);
+}
+
+/* src scaled to dst's size by bilinear interpolation between pixel centres. */
+static void upscale(const rl_image *src, rl_image *dst)
+{
+    for (int y = 0; y < dst->height; y++) {
+        float fy = ((float)y + 0.5f) * (float)src->height / (float)dst->height - 0.5f;
+        int y0 = (int)floorf(fy);
+        float ty = fy - (float)y0;
+        const rl_vec4 *r0 = src->color + (size_t)clampi(y0, 0, src->height - 1) * (size_t)src->width;
+        const rl_vec4 *r1 = src->color + (size_t)clampi(y0 + 1, 0, src->height - 1) * (size_t)src->width;
+        for (int x = 0; x < dst->width; x++) {
+            float fx = ((float)x + 0.5f) * (float)src->width / (float)dst->width - 0.5f;
+            int x0 = (int)floorf(fx);
+            float tx = fx - (float)x0;
+            int xa = clampi(x0, 0, src->width - 1), xb = clampi(x0 + 1, 0, src->width - 1);
+            dst->color[(size_t)y * (size_t)dst->width + (size_t)x] =
+                mix4(mix4(r0[xa], r0[xb], tx), mix4(r1[xa], r1[xb], tx), ty);
+        }
+    }
+}
+
+/* Fig. 5.4: VT's preview (and its converged frame) against a ray tracer
+ * that spends the same number of rays. Whitted traces about rho rays per
+ * pixel of the whole image; with VT's ray count R it can afford R / rho
+ * pixels, so it renders an image of that many pixels in the frame's aspect
+ * and scales it up bilinearly. Both are compared with the full-resolution
+ * Whitted frame on the VT pixels. Whitted's rays go to every object, VT's
+ * to the VT objects only: that is the trade the thesis' figure shows. */
+static rl_status sec_equal_rays(void *ctx, cJSON *sec)
+{
+    bvt *b = ctx;
+    int w = b->a->width, h = b->a->height;
+    ref_frame *ref = NULL;
+    rl_status st = reference(b, w, h, b->threads, MODE_ALL, &ref);
+    if (st != RL_OK)
+        return st;
+    char size[32];
+    snprintf(size, sizeof size, "%dx%d", w, h);
+    cJSON_AddStringToObject(sec, "scene", table_spec(b));
+    cJSON_AddStringToObject(sec, "size", size);
+    cJSON_AddItemToObject(sec, "whitted", ref_json(ref));
+    cJSON *rows = cJSON_AddArrayToObject(sec, "runs");
+    double rho = (double)rays_total(&ref->stats) / ((double)w * h);
+    rl_camera cam = sized(&b->table_cam, w, h);
+    rl_image *img = NULL, *up = NULL;
+    st = rl_image_create(w, h, RL_LAYER_COLOR, &img);
+    if (st == RL_OK)
+        st = rl_image_create(w, h, RL_LAYER_COLOR, &up);
+    printf("\nequal rays (Fig. 5.4): %s %s, whitted %.2f rays per pixel; SSIM / RMSE on the VT pixels\n",
+           table_spec(b), size, rho);
+    printf("%-8s %10s %8s %8s  %-11s %8s %8s\n", "VT", "rays", "ssimVT", "rmseVT", "whitted at", "ssimVT",
+           "rmseVT");
+    for (int preview = 1; st == RL_OK && preview >= 0; preview--) {
+        rl_renderer *r = NULL;
+        timed_frame t;
+        quality q_vt, q_rt;
+        st = make_renderer("vt", b->threads, &r);
+        if (st == RL_OK && preview)
+            st = rl_vt_set_update_callback(r, stop_at_preview, NULL);
+        if (st == RL_OK)
+            st = render_timed(r, b->table, &cam, img, 1, &t);
+        rl_renderer_release(r);
+        if (st == RL_OK)
+            st = compare(img, ref->image, ref->mask, ref->mask_pixels, &q_vt);
+        if (st != RL_OK)
+            break;
+        /* The ray tracer's image with as many rays, in the frame's aspect. */
+        uint64_t rays = rays_total(&t.stats);
+        double pixels = rho > 0.0 ? (double)rays / rho : 0.0;
+        double scale = sqrt(pixels / ((double)w * h));
+        int lw = (int)fmax(1.0, fmin((double)w, round(w * scale)));
+        int lh = (int)fmax(1.0, fmin((double)h, round(h * scale)));
+        rl_image *low = NULL;
+        timed_frame lt;
+        st = rl_image_create(lw, lh, RL_LAYER_COLOR, &low);
+        if (st == RL_OK)
+            st = time_whitted(b, b->threads, MODE_ALL, low, &lt);
+        if (st == RL_OK) {
+            upscale(low, up);
+            st = compare(up, ref->image, ref->mask, ref->mask_pixels, &q_rt);
+        }
+        rl_image_release(low);
+        if (st != RL_OK)
+            break;
+        char at[32];
+        snprintf(at, sizeof at, "%dx%d", lw, lh);
+        cJSON *row = cJSON_CreateObject();
+        cJSON_AddItemToArray(rows, row);
+        cJSON_AddStringToObject(row, "frame", preview ? "preview" : "converged");
+        cJSON_AddNumberToObject(row, "vt_rays", (double)rays);
+        cJSON_AddNumberToObject(row, "vt_samples", (double)t.vt.vertices_sampled);
+        cJSON_AddItemToObject(row, "vt_quality", quality_json(&q_vt));
+        cJSON_AddStringToObject(row, "whitted_size", at);
+        cJSON_AddNumberToObject(row, "whitted_rays", (double)rays_total(&lt.stats));
+        cJSON_AddItemToObject(row, "whitted_quality", quality_json(&q_rt));
+        printf("%-8s %10llu %8.4f %8.5f  %-11s %8.4f %8.5f\n", preview ? "preview" : "full",
+               (unsigned long long)rays, q_vt.vt_px.ssim, q_vt.vt_px.rmse, at, q_rt.vt_px.ssim, q_rt.vt_px.rmse);
+        fflush(stdout);
+        note("equal rays %s %s: VT %llu rays SSIM %.3f, whitted %s (%llu rays) SSIM %.3f (VT pixels)",
+             preview ? "preview" : "full", size, (unsigned long long)rays, q_vt.vt_px.ssim, at,
+             (unsigned long long)rays_total(&lt.stats), q_rt.vt_px.ssim);
+    }
+    rl_image_release(img);
+    rl_image_release(up);
+    return st;
+}
+
 /* --------------------------------------------------------- animation -- */
 
 typedef struct series {
@@ -1628,7 +1906,8 @@ static int run(bvt *b)
         return cli_fail(RL_CLI_FAIL, "out of memory");
     static const bench_section_fn fns[SEC_COUNT] = { sec_criteria, sec_resolution, sec_quality, sec_threads,
                                                      sec_visibility, sec_modes, sec_forced, sec_preview,
-                                                     sec_reduction, sec_animation };
+                                                     sec_reduction, sec_overdraw, sec_equal_rays,
+                                                     sec_animation };
     printf("rl bench vt: Vertex Tracing vs Whitted, %d threads, max_depth %s, area_samples %s, "
            "shadows %s\n", b->threads, TRACE_MAX_DEPTH, TRACE_AREA_SAMPLES, TRACE_SHADOWS);
     rc = bench_run_sections("vt", root, section_names, fns, SEC_COUNT, a->sections, b,

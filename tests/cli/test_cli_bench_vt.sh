@@ -26,7 +26,8 @@ expect_in "$TMP/err" "rl: error: "
 
 # Help, and the bench dispatcher knows vt.
 expect_exit 0 "$RL" bench vt --help
-for o in --size --anim-size --frames --threads --only --out --quick criteria modes forced preview animation; do
+for o in --size --anim-size --frames --threads --only --out --quick criteria modes forced preview reduction \
+    overdraw equalrays animation; do
     expect_in "$TMP/out" "$o"
 done
 expect_error 2 "known: rays, vt, pt" "$RL" bench nosuch
@@ -62,7 +63,7 @@ def quality_ok(q):
     assert q["vt_pixels"]["pixels"] > 0 and q["vt_pixels"]["ssim"] is not None, q
 
 for name in ("criteria", "resolution", "quality", "threads", "visibility", "modes", "forced", "preview",
-             "animation"):
+             "reduction", "overdraw", "equalrays", "animation"):
     assert name in r, "missing section " + name
     assert r[name]["status"] == "ok", "%s: %s" % (name, r[name].get("reason"))
 
@@ -153,6 +154,37 @@ for x in p:
     assert x["vt_stats"]["vertices_sampled"] > 0, x
     for k in ("visibility", "sampling", "draw"):
         assert x["time_split_ms"][k] >= 0, x
+
+# Sec. 6.2.1: merging only ever replaces traced primary vertices; off
+# merges none. At the preview, sampled + merged is the unmerged count.
+red = r["reduction"]["runs"]
+assert [(x["merge_px"], x["frame"]) for x in red] == \
+    [(m, f) for m in (0, 0.5, 1, 2) for f in ("preview", "full")], red
+assert red[0]["vertices_merged"] == 0 and red[1]["vertices_merged"] == 0
+for x in red[2::2]:
+    assert x["vertices_sampled"] + x["vertices_merged"] == red[0]["vertices_sampled"], (x, red[0])
+assert red[-2]["vertices_merged"] >= red[2]["vertices_merged"] > 0, red
+for x in red:
+    quality_ok(x["quality"])
+
+# Fig. 5.7: per stage and f, overdraw against redraw; f = 0 leaves
+# parents showing through, the default f = 1e-4 far less.
+od = r["overdraw"]["runs"]
+assert [x["overdraw_f"] for x in od] == [0, 1e-5, 1e-4, 1e-3, 1e-2], od
+assert all(len(x["stages"]) == len(od[0]["stages"]) > 1 for x in od), od
+assert od[0]["stages"][0]["rmse_vt_pixels"] == 0, "the preview is drawn the same way in both"
+assert od[2]["final"]["rmse_vt_pixels"] < od[0]["final"]["rmse_vt_pixels"], od
+for x in od:
+    assert 0 <= x["final"]["differing_vt_pixels"] <= 1, x
+
+# Fig. 5.4: Whitted with as many rays as VT, scaled up.
+eq = r["equalrays"]["runs"]
+assert [x["frame"] for x in eq] == ["preview", "converged"], eq
+for x in eq:
+    assert x["vt_rays"] > 0 and x["whitted_rays"] > 0, x
+    quality_ok(x["vt_quality"])
+    quality_ok(x["whitted_quality"])
+assert eq[0]["whitted_rays"] < r["equalrays"]["whitted"]["rays"]["total"], eq
 
 a = r["animation"]
 assert a["scene"] == "cluster" and a["frames"] == 3 and len(a["per_frame"]) == 3
