@@ -171,8 +171,10 @@ static uint32_t checker(rl_scene *s, const char *name, rl_vec4 a, rl_vec4 b, flo
 
 /* Fig. 3.21: a textured mirror floor (2 x 2 coarse faces) reflecting two
  * walls side by side with different textures: the faces whose vertices
- * see both walls are undefined for the reflection term, whose looked-up
- * radiance is interpolated instead (vt_draw.c defined_texture). */
+ * see both walls (or a wall and nothing) are undefined for the reflection
+ * term, whose looked-up radiance is interpolated instead (vt_draw.c
+ * defined_texture). Counted once with a probe in fill_face: 24 of the 108
+ * faces drawn per frame are undefined in their reflection. */
 static void test_vt_gl_undefined_faces(void **state)
 {
     (void)state;
