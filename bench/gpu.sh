@@ -4,7 +4,7 @@
 # device): builds renderlab (make build) and runs the GL benchmarks on the
 # first EGL device (RL_EGL_DEVICE=auto, else the one named), each under a
 # time limit, writing bench/results/gpu-<date>-*.json. The limits add up to
-# 450 s, the build to about 1-2 minutes on 16 cores: the whole run stays
+# 510 s, the build to about 1-1.5 minutes on 16 cores: the whole run stays
 # under 10 minutes; a benchmark that runs out of time is reported and the
 # next one still runs.
 # Run from anywhere: bash bench/gpu.sh      (RL_EGL_DEVICE=1 bash bench/gpu.sh)
@@ -48,6 +48,16 @@ step 150 "rl bench culling walk 1280" "$rl" bench culling --only walk --size 128
     --out "$out/gpu-$date-culling-walk-1280.json"
 step 60 "rl bench culling walk 640, GL" "$rl" bench culling --only walk --size 640 --walk-frames 40 \
     --drawer gl --out "$out/gpu-$date-culling-walk-640.json"
+
+# Jähn 2015, Table 6.1: the surfel atlas (8 views at 1024² of the whole
+# city) on the software rasterizer and on GL, against the thesis' 270 ms
+# (issue 35, part 6); about 10 s of work on 16 cores.
+step 30 "rl bench surfels, atlas" "$rl" bench surfels --only atlas --atlas-runs 2 \
+    --out "$out/gpu-$date-surfels-atlas.json"
+# Ullmann 2003, Sec. 3.5: Vertex Tracing's drawing on the CPU and on GL per
+# texture mode, table at 512x512 (issue 35, part 5).
+step 30 "rl bench vt, reconstruct" "$rl" bench vt --only reconstruct --size 512x512 \
+    --out "$out/gpu-$date-vt-reconstruct.json"
 
 echo "gpu.sh: records in $out/gpu-$date-*.json; $failed benchmark(s) failed"
 [ "$failed" -eq 0 ]

@@ -17,8 +17,17 @@
  *             --max-seconds is skipped: the estimate is its number of
  *             nearest-chosen queries (samples x sample size, from the round
  *             schedule) times the time per query of the default variant.
+ *   atlas     the 8 views rendered by the software rasterizer and by OpenGL
+ *             (issue 35, part 6: rl_surfel_desc.atlas_drawer = a GL drawer,
+ *             docs/gl.md) in the same run: the least atlas time of
+ *             --atlas-runs builds each (count 1, so that the sampling after
+ *             the atlas costs nothing), wall and process CPU time, the GL
+ *             drawer's making apart, the candidates of each; the record
+ *             names the GL renderer. Where no GL context can be made the
+ *             section records why and the software figures only.
  * Texture transfer (111 ms in the thesis) has no counterpart: our atlas is
- * rendered in main memory (src/render/surfels_build.c). */
+ * rendered in main memory, or on GL where only depth and IDs are read
+ * back (src/render/surfels_build.c). */
 #define _POSIX_C_SOURCE 200809L
 #include "bench_surfels.h"
 
@@ -32,8 +41,11 @@
 #include <omp.h>
 #include <stdlib.h>
 #include <string.h>
+#include <time.h>
 
+#include "rl/rl_gl.h"
 #include "rl/rl_surfels.h"
+#include "rl/rl_timer.h"
 
 #define note(...) (fflush(stdout), bench_note("surfels", __VA_ARGS__))
 
@@ -47,6 +59,8 @@ static const char bench_surfels_help[] =
     "  defaults   atlas (8 views), candidate set, sampling, relative sizes,\n"
     "             total, memory; target: sampling <= 520 ms\n"
     "  variants   random, prog-160, prog-1000, const-160, const-1000\n"
+    "  atlas      the 8 views on the software rasterizer and on OpenGL\n"
+    "             (GL drawer), least of --atlas-runs builds each\n"
     "\n"
     "options:\n"
     "  --scene S          default city (see rl scenes)\n"
@@ -56,14 +70,19 @@ static const char bench_surfels_help[] =
     "  --max-seconds S    skip variants estimated to sample longer; default 120\n"
     "  --seed N           default 1\n"
     "  --threads N        default all\n"
+    "  --only LIST        sections: defaults, variants, atlas; default all\n"
+    "  --atlas-runs N     builds per atlas backend; default 3\n"
+    "  --device D         EGL device of the GL atlas (auto, surfaceless, N);\n"
+    "                     default $RL_EGL_DEVICE, else auto\n"
     "  --out FILE.json    default bench/results/surfels-YYYYMMDD-HHMMSS.json\n"
     "  --quick            tiny run: cornell, 128^2, 2000 surfels\n"
     "\n"
     "example:\n"
-    "  rl bench surfels --variants random,prog-160,prog-1000\n";
+    "  rl bench surfels --variants random,prog-160,prog-1000\n"
+    "  rl bench surfels --only atlas\n";
 
-enum { SEC_DEFAULTS, SEC_VARIANTS, SEC_COUNT };
-static const char *const section_names[SEC_COUNT] = { "defaults", "variants" };
+enum { SEC_DEFAULTS, SEC_VARIANTS, SEC_ATLAS, SEC_COUNT };
+static const char *const section_names[SEC_COUNT] = { "defaults", "variants", "atlas" };
 
 enum { V_RANDOM, V_PROG_160, V_PROG_1000, V_CONST_160, V_CONST_1000, V_COUNT };
 static const char *const variant_names[V_COUNT] = { "random", "prog-160", "prog-1000",
@@ -83,8 +102,9 @@ static const double thesis_variant_ms[V_COUNT] = { 25, 520, 1740, 13000, 81000 }
 #define TARGET_SAMPLING_MS 520.0
 
 typedef struct bsf_args {
-    const char *scene, *out;
-    long long resolution, count, seed, threads;
+    const char *scene, *out, *device;
+    long long resolution, count, seed, threads, atlas_runs;
+    unsigned sections;
     double max_seconds;
     unsigned variants;
     bool quick;
@@ -281,6 +301,117 @@ static rl_status sec_variants(void *ctx, cJSON *sec)
     return RL_OK;
 }
 
+/* CPU time of the whole process (every thread, llvmpipe's included), s. */
+static double cpu_s(void)
+{
+    struct timespec t;
+    return clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t) == 0 ? (double)t.tv_sec + 1e-9 * (double)t.tv_nsec : NAN;
+}
+
+typedef struct atlas_time {
+    double min_ms, min_cpu_ms;    /* the least of the runs */
+    uint32_t candidates;
+    float coverage;
+} atlas_time;
+
+/* The least atlas time of the runs with drawer dr (NULL: software). The
+ * process CPU time spans the whole build, whose other steps cost next to
+ * nothing at count 1 besides the candidates. */
+static rl_status time_atlas(bsf_ctx *c, rl_drawer *dr, atlas_time *t)
+{
+    t->min_ms = t->min_cpu_ms = INFINITY;
+    for (long long k = 0; k < c->a->atlas_runs; ++k) {
+        rl_surfel_desc d = { .resolution = (uint32_t)c->a->resolution, .count = 1,
+                             .seed = (uint64_t)c->a->seed, .threads = (int)c->a->threads, .atlas_drawer = dr };
+        rl_surfel_set set;
+        double c0 = cpu_s();
+        rl_status st = rl_surfels_build(c->scene, NULL, 0, &d, &set);
+        double cpu_ms = 1e3 * (cpu_s() - c0);
+        if (st != RL_OK) {
+            snprintf(c->reason, sizeof c->reason, "atlas, %s: %s", dr ? "gl" : "software", rl_last_error());
+            return st;
+        }
+        t->min_ms = fmin(t->min_ms, set.timing.atlas_ms);
+        t->min_cpu_ms = fmin(t->min_cpu_ms, cpu_ms);
+        t->candidates = set.candidates;
+        t->coverage = set.coverage;
+        rl_surfel_set_free(&set);
+    }
+    return RL_OK;
+}
+
+static cJSON *atlas_json(const atlas_time *t)
+{
+    cJSON *o = cJSON_CreateObject();
+    bench_add_num(o, "min_atlas_ms", t->min_ms);
+    bench_add_num(o, "min_build_cpu_ms", t->min_cpu_ms);
+    cJSON_AddNumberToObject(o, "candidates", t->candidates);
+    bench_add_num(o, "coverage", t->coverage);
+    return o;
+}
+
+static rl_status sec_atlas(void *ctx, cJSON *sec)
+{
+    bsf_ctx *c = ctx;
+    note("atlas: software, %lld builds", c->a->atlas_runs);
+    atlas_time sw, gl;
+    rl_status st = time_atlas(c, NULL, &sw);
+    if (st != RL_OK)
+        return st;
+    cJSON_AddNumberToObject(sec, "runs", (double)c->a->atlas_runs);
+    cJSON_AddNumberToObject(sec, "thesis_atlas_ms", THESIS_ATLAS_MS);
+    cJSON_AddItemToObject(sec, "software", atlas_json(&sw));
+    printf("\natlas: the 8 views at %lld^2, least of %lld builds   %10s %10s %10s\n", c->a->resolution,
+           c->a->atlas_runs, "wall ms", "cpu ms", "thesis ms");
+    printf("%-52s %10.1f %10.1f %10.0f\n", "software rasterizer", sw.min_ms, sw.min_cpu_ms, THESIS_ATLAS_MS);
+    char why[512];
+    const char *device = c->a->device ? c->a->device : "";
+    rl_gl_info info;
+    bool ok = rl_gl_available(device, why, sizeof why);
+    if (ok && rl_gl_info_get(device, &info) != RL_OK) {
+        ok = false;
+        snprintf(why, sizeof why, "%s", rl_last_error());
+    }
+    if (!ok) {
+        printf("%-52s unavailable: %s\n", "OpenGL", why);
+        cJSON_AddStringToObject(sec, "gl_unavailable", why);
+        return RL_OK;
+    }
+    cJSON *g = cJSON_AddObjectToObject(sec, "gl_device");
+    cJSON_AddStringToObject(g, "vendor", info.vendor);
+    cJSON_AddStringToObject(g, "renderer", info.renderer);
+    cJSON_AddStringToObject(g, "version", info.version);
+    cJSON_AddStringToObject(g, "device", info.device);
+    note("atlas: OpenGL (%s), %lld builds", info.renderer, c->a->atlas_runs);
+    const rl_drawer_desc dd = RL_SURFEL_ATLAS_DRAWER_DESC;
+    rl_drawer *dr = NULL;
+    double t0 = rl_time_s();
+    st = rl_gl_drawer_create(c->scene, &dd, device, &dr);
+    double make_ms = 1e3 * (rl_time_s() - t0);
+    if (st != RL_OK) {
+        snprintf(c->reason, sizeof c->reason, "atlas: the GL drawer: %s", rl_last_error());
+        return st;
+    }
+    st = time_atlas(c, dr, &gl);
+    rl_drawer_release(dr);
+    if (st != RL_OK)
+        return st;
+    cJSON *o = atlas_json(&gl);
+    bench_add_num(o, "drawer_create_ms", make_ms);
+    cJSON_AddItemToObject(sec, "gl", o);
+    bench_add_num(sec, "software_over_gl", bench_ratio(sw.min_ms, gl.min_ms));
+    bench_add_num(sec, "software_over_gl_cpu", bench_ratio(sw.min_cpu_ms, gl.min_cpu_ms));
+    bench_add_num(sec, "gl_over_thesis", bench_ratio(gl.min_ms, THESIS_ATLAS_MS));
+    char label[96];
+    snprintf(label, sizeof label, "OpenGL (%.40s)", info.renderer);
+    printf("%-52s %10.1f %10.1f %10.0f\n", label, gl.min_ms, gl.min_cpu_ms, THESIS_ATLAS_MS);
+    printf("GL drawer made in %.1f ms (context, shaders, buffers; not in the atlas time); candidates "
+           "software %u, GL %u; software / GL %.2f (wall), %.2f (cpu); GL / thesis %.2f\n", make_ms,
+           sw.candidates, gl.candidates, bench_ratio(sw.min_ms, gl.min_ms),
+           bench_ratio(sw.min_cpu_ms, gl.min_cpu_ms), bench_ratio(gl.min_ms, THESIS_ATLAS_MS));
+    return RL_OK;
+}
+
 static bool parse_variants(const char *text, unsigned *bits)
 {
     *bits = 0;
@@ -312,6 +443,8 @@ static bool take_variants(void *a, const char *text)
 static int parse_args(int argc, char **argv, bsf_args *a)
 {
     a->variants = (1u << V_COUNT) - 1;
+    a->sections = (1u << SEC_COUNT) - 1;
+    a->atlas_runs = 3;
     a->seed = 1;
     a->max_seconds = 120.0;
     bool has_res = false, has_count = false, has_max = false;
@@ -325,6 +458,9 @@ static int parse_args(int argc, char **argv, bsf_args *a)
           .lo = 0.0, .lo_open = true, .hi = INFINITY, .expect = "seconds > 0", .set = &has_max },
         RL_BENCH_COUNT("--seed", 1LL << 62, &a->seed, NULL),
         RL_BENCH_COUNT("--threads", 1024, &a->threads, NULL),
+        RL_BENCH_SECTIONS(section_names, SEC_COUNT, &a->sections),
+        RL_BENCH_COUNT("--atlas-runs", 100, &a->atlas_runs, NULL),
+        RL_BENCH_STRING("--device", &a->device),
         RL_BENCH_OUT(&a->out),
     };
     int rc = bench_parse_args(argc, argv, "bench surfels", bench_surfels_help, rows,
@@ -371,6 +507,7 @@ int bench_surfels(int argc, char **argv)
     cJSON_AddNumberToObject(params, "seed", (double)a.seed);
     cJSON_AddNumberToObject(params, "max_seconds", a.max_seconds);
     cJSON_AddBoolToObject(params, "quick", a.quick);
+    cJSON_AddNumberToObject(params, "atlas_runs", (double)a.atlas_runs);
     cJSON *vl = cJSON_AddArrayToObject(params, "variants");
     for (int v = 0; v < V_COUNT; ++v)
         if ((a.variants >> v) & 1u)
@@ -393,9 +530,9 @@ int bench_surfels(int argc, char **argv)
     printf("rl bench surfels: Jaehn 2015, Table 6.1, on %s (%u objects, %u triangles) as one node: "
            "%lld surfels, %lld^2 per view, %d threads\n", a.scene, d->num_objects, d->num_triangles,
            a.count, a.resolution, threads);
-    static const bench_section_fn fns[SEC_COUNT] = { sec_defaults, sec_variants };
-    rc = bench_run_sections("surfels", root, section_names, fns, SEC_COUNT,
-                               (1u << SEC_COUNT) - 1, &c, c.reason, threads, out);
+    static const bench_section_fn fns[SEC_COUNT] = { sec_defaults, sec_variants, sec_atlas };
+    rc = bench_run_sections("surfels", root, section_names, fns, SEC_COUNT, a.sections, &c, c.reason,
+                            threads, out);
     cJSON_Delete(root);
     rl_surfel_set_free(&c.defaults);
     rl_scene_release(c.scene);

@@ -10,6 +10,10 @@
  *   visibility  Fig. 5.13: the ID, Z and clipping tests switched off in turn
  *   animation   Sec. 3.4.5: the `cluster` camera path with and without
  *               temporal coherence, which must give identical images
+ *   reconstruct Sec. 3.5 on OpenGL (issue 35, part 5): per texture mode the
+ *               drawing time (time_draw_ms) and frame time of
+ *               reconstruct=software and =gl in the same run, and the SSIM
+ *               between their images; the record names the GL renderer
  * The static sections use the built-in scene `table` (Sec. 5.1) with its
  * default camera.
  *
@@ -44,6 +48,7 @@
 #include <string.h>
 #include <time.h>
 
+#include "rl/rl_gl.h"
 #include "rl/rl_options.h"
 #include "rl/rl_metrics.h"
 #include "rl/rl_vt.h"
@@ -79,6 +84,8 @@ static const char bench_vt_help[] =
     "  equalrays   the preview and the converged frame against Whitted with as many\n"
     "              rays (a smaller image scaled up): SSIM on the VT pixels (Fig. 5.4)\n"
     "  animation   cluster scene camera path with and without temporal coherence\n"
+    "  reconstruct the drawing (Sec. 3.5) on the CPU rasterizer and on OpenGL\n"
+    "              (reconstruct=gl) per texture mode: draw and frame time, SSIM\n"
     "\n"
     "options:\n"
     "  --scene SPEC      scene of the static sections; default table (the thesis-like\n"
@@ -101,10 +108,12 @@ static const char bench_vt_help[] =
 
 /* The static sections (the table scene) come before animation. */
 enum { SEC_CRITERIA, SEC_RESOLUTION, SEC_QUALITY, SEC_THREADS, SEC_VISIBILITY, SEC_MODES, SEC_FORCED,
-       SEC_PREVIEW, SEC_REDUCTION, SEC_OVERDRAW, SEC_EQUAL_RAYS, SEC_ANIMATION, SEC_COUNT };
+       SEC_PREVIEW, SEC_REDUCTION, SEC_OVERDRAW, SEC_EQUAL_RAYS, SEC_ANIMATION,
+       SEC_RECONSTRUCT, SEC_COUNT };
 static const char *const section_names[SEC_COUNT] = { "criteria", "resolution", "quality", "threads",
                                                       "visibility", "modes", "forced", "preview",
-                                                      "reduction", "overdraw", "equalrays", "animation" };
+                                                      "reduction", "overdraw", "equalrays", "animation",
+                                                      "reconstruct" };
 
 /* The shading modes of Ullmann 2003, Figs. 5.9/5.10, as bits: shadow
  * feelers (S), reflection rays (R), transmission rays (T). */
@@ -1183,6 +1192,87 @@ static rl_status sec_preview(void *ctx, cJSON *sec)
     return st;
 }
 
+/* ------------------------------------------------------- reconstruct -- */
+
+/* Ullmann 2003, Sec. 3.5 on OpenGL: the same frame (the refinement is the
+ * CPU's either way) drawn by the rasterizer and by GL, per texture mode.
+ * draw is vt's time_draw_ms: the rasterized half, the final draw of the
+ * refined mesh and, on GL, the uploads and read-backs of its frames. */
+static rl_status sec_reconstruct(void *ctx, cJSON *sec)
+{
+    bvt *b = ctx;
+    static const char *const modes[] = { "multitexture", "multipass", "sampled" };
+    int w = b->a->width, h = b->a->height;
+    char size[32], why[512];
+    snprintf(size, sizeof size, "%dx%d", w, h);
+    cJSON_AddStringToObject(sec, "scene", table_spec(b));
+    cJSON_AddStringToObject(sec, "size", size);
+    rl_gl_info info;
+    bool ok = rl_gl_available(NULL, why, sizeof why);
+    if (ok && rl_gl_info_get(NULL, &info) != RL_OK) {
+        ok = false;
+        snprintf(why, sizeof why, "%s", rl_last_error());
+    }
+    printf("\nreconstruction (Sec. 3.5) on the CPU and on OpenGL: %s %s\n", table_spec(b), size);
+    if (!ok) {
+        printf("OpenGL unavailable: %s\n", why);
+        cJSON_AddStringToObject(sec, "gl_unavailable", why);
+        return RL_OK;
+    }
+    cJSON *g = cJSON_AddObjectToObject(sec, "gl");
+    cJSON_AddStringToObject(g, "vendor", info.vendor);
+    cJSON_AddStringToObject(g, "renderer", info.renderer);
+    cJSON_AddStringToObject(g, "version", info.version);
+    cJSON_AddStringToObject(g, "device", info.device);
+    printf("GL: %s | %s | %s\n", info.vendor, info.renderer, info.version);
+    printf("%-13s %12s %12s %12s %12s %8s %8s\n", "textures", "draw sw ms", "draw gl ms", "frame sw", "frame gl",
+           "sw/gl", "SSIM");
+    cJSON *rows = cJSON_AddArrayToObject(sec, "runs");
+    rl_camera cam = sized(&b->table_cam, w, h);
+    rl_status st = RL_OK;
+    for (int m = 0; st == RL_OK && m < 3; ++m) {
+        timed_frame t[2];
+        rl_image *img[2] = { NULL, NULL };
+        for (int k = 0; st == RL_OK && k < 2; ++k) {
+            rl_renderer *r = NULL;
+            st = make_renderer("vt", b->threads, &r);
+            if (st == RL_OK)
+                st = rl_renderer_set(r, "textures", modes[m]);
+            if (st == RL_OK)
+                st = rl_renderer_set(r, "reconstruct", k ? "gl" : "software");
+            if (st == RL_OK)
+                st = rl_image_create(w, h, RL_LAYER_COLOR, &img[k]);
+            if (st == RL_OK)
+                st = render_timed(r, b->table, &cam, img[k], b->runs, &t[k]);
+            rl_renderer_release(r);
+        }
+        rl_image_metrics q;
+        if (st == RL_OK)
+            st = rl_image_compare(img[1], img[0], NULL, &q);
+        rl_image_release(img[0]);
+        rl_image_release(img[1]);
+        if (st != RL_OK)
+            break;
+        cJSON *row = cJSON_CreateObject();
+        cJSON_AddItemToArray(rows, row);
+        cJSON_AddStringToObject(row, "textures", modes[m]);
+        add_num(row, "software_draw_ms", t[0].vt.time_draw_ms);
+        add_num(row, "gl_draw_ms", t[1].vt.time_draw_ms);
+        add_num(row, "software_frame_ms", t[0].stats.time_ms);
+        add_num(row, "gl_frame_ms", t[1].stats.time_ms);
+        add_num(row, "software_over_gl_draw", ratio(t[0].vt.time_draw_ms, t[1].vt.time_draw_ms));
+        cJSON_AddNumberToObject(row, "faces_drawn", (double)t[0].vt.faces_drawn);
+        cJSON_AddItemToObject(row, "gl_vs_software", metrics_json(&q));
+        printf("%-13s %12.1f %12.1f %12.1f %12.1f %8.2f %8.5f\n", modes[m], t[0].vt.time_draw_ms,
+               t[1].vt.time_draw_ms, t[0].stats.time_ms, t[1].stats.time_ms,
+               ratio(t[0].vt.time_draw_ms, t[1].vt.time_draw_ms), q.ssim);
+        fflush(stdout);
+        note("reconstruct %s %s: draw %.1f ms software, %.1f ms GL, SSIM %.5f", modes[m], size,
+             t[0].vt.time_draw_ms, t[1].vt.time_draw_ms, q.ssim);
+    }
+    return st;
+}
+
 /* --------------------------------------------------------- reduction -- */
 
 /* Ullmann Sec. 6.2.1, sample reduction: the ends of a primary edge shorter
@@ -1886,7 +1976,8 @@ static int run(bvt *b)
         if (fits != RL_CLI_OK)
             return fits;
     }
-    bool static_sections = false;
+    /* Every section but animation renders the table. */
+    bool static_sections = wants(a, SEC_RECONSTRUCT);
     for (int k = 0; k < SEC_ANIMATION; k++)
         static_sections = static_sections || wants(a, k);
     int rc = RL_CLI_OK;
@@ -1907,7 +1998,7 @@ static int run(bvt *b)
     static const bench_section_fn fns[SEC_COUNT] = { sec_criteria, sec_resolution, sec_quality, sec_threads,
                                                      sec_visibility, sec_modes, sec_forced, sec_preview,
                                                      sec_reduction, sec_overdraw, sec_equal_rays,
-                                                     sec_animation };
+                                                     sec_animation, sec_reconstruct };
     printf("rl bench vt: Vertex Tracing vs Whitted, %d threads, max_depth %s, area_samples %s, "
            "shadows %s\n", b->threads, TRACE_MAX_DEPTH, TRACE_AREA_SAMPLES, TRACE_SHADOWS);
     rc = bench_run_sections("vt", root, section_names, fns, SEC_COUNT, a->sections, b,

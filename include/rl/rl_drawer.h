@@ -116,6 +116,16 @@ RL_API rl_status rl_drawer_query_issue(rl_drawer *dr, const rl_raster_batch *box
                                        rl_raster_counters *c);
 RL_API rl_status rl_drawer_query_poll(rl_drawer *dr, uint32_t handle, bool *ready);
 RL_API rl_status rl_drawer_query_result(rl_drawer *dr, uint32_t handle, uint64_t *pixels);
+/* Draws a triangle batch made by the caller (rl_raster.h), e.g. Vertex
+ * Tracing's refined mesh with its deferred textures as layers (Ullmann
+ * 2003, Sec. 3.5), into the frame beside the scene's objects, with the
+ * batch's flags (the desc's are not added). Textures are the scene's:
+ * layers' textures must be rl_scene_data.textures (or NULL). Every
+ * backend draws positions with indices, IDs (per triangle or one) and
+ * the colour from layers, per-vertex colors or the one color; the GL
+ * backend refuses face_colors, a batch texture or uvs outside layers,
+ * and lazy colours (RL_ERR_UNSUPPORTED), which the software one draws. */
+RL_API rl_status rl_drawer_draw_batch(rl_drawer *dr, const rl_raster_batch *batch, rl_raster_counters *c);
 /* Draws points (surfels: square splats of a size in pixels). */
 RL_API rl_status rl_drawer_draw_points(rl_drawer *dr, const rl_raster_points *points, rl_raster_counters *c);
 /* Ends the frame: the target holds colour, depth and IDs. */

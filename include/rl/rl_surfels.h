@@ -3,7 +3,8 @@
  *
  * rl_surfels_build() renders the objects from the 8 corners of a cube
  * around their bounds towards its centre, orthographically, with our
- * rasterizer (Sec. 6.1.1: the 8 cube-corner directions; fewer leave holes),
+ * rasterizer (Sec. 6.1.1: the 8 cube-corner directions; fewer leave holes)
+ * or, given an atlas_drawer, with that drawer (OpenGL: rl_gl_drawer_create),
  * turns every covered pixel into a candidate surfel (position, normal,
  * unlit colour), records the relative coverage (covered pixels / all
  * pixels of the 8 views), draws a progressive best-candidate sequence from
@@ -19,6 +20,7 @@
 #define RL_SURFELS_H
 
 #include "rl/rl_common.h"
+#include "rl/rl_drawer.h"
 #include "rl/rl_math.h"
 #include "rl/rl_scene.h"
 
@@ -53,11 +55,22 @@ typedef struct rl_surfel_desc {   /* zero = default */
     int threads;                  /* 0 -> all */
     rl_progress_fn progress;      /* may be NULL; false cancels (RL_ERR_CANCELLED) */
     void *user;
+    rl_drawer *atlas_drawer;      /* NULL: the 8 views by the software rasterizer;
+                                   * else by this drawer (borrowed, e.g. the GPU's:
+                                   * rl_gl_drawer_create), made for the same scene with
+                                   * RL_SURFEL_ATLAS_DRAWER_DESC (RL_ERR_INVALID_ARG
+                                   * otherwise). Only the atlas moves; the steps after
+                                   * it are the same. One drawer may serve many builds */
 } rl_surfel_desc;
+
+/* The desc an atlas_drawer is made with: depth and IDs only, nothing lit,
+ * no culling, every object selectable. */
+#define RL_SURFEL_ATLAS_DRAWER_DESC ((rl_drawer_desc){ .flags = RL_RASTER_NO_COLOR })
 
 /* Time per step, the rows of Jähn 2015, Table 6.1. */
 typedef struct rl_surfel_timing {
-    double atlas_ms;              /* rendering the 8 views */
+    double atlas_ms;              /* rendering the 8 views (a drawer's: upload, draw,
+                                   * readback; its making is the caller's) */
     double candidates_ms;         /* building the initial candidate set */
     double sampling_ms;           /* drawing the sequence */
     double sizes_ms;              /* relative point sizes */

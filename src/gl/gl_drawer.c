@@ -28,6 +28,7 @@
 #include "gl/gl_context.h"
 
 #include <math.h>
+#include <stddef.h>
 #include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
@@ -43,7 +44,7 @@
 /* Uniform locations of one program (-1: not used by it). */
 typedef struct uniforms {
     GLint view_proj, view_z, affine, depth_k, affine_z, eye, ambient, num_lights, mode, object, first_triangle,
-        normal_maps, depth_equal;
+        normal_maps, depth_equal, num_layers;
 } uniforms;
 
 typedef struct gl_drawer {
@@ -52,14 +53,18 @@ typedef struct gl_drawer {
     rl_drawer_desc desc;
     int mode;                     /* RL_GL_MODE_* of lit draws */
     bool normal_maps;
-    GLuint tri_prog, point_prog, upload_prog;
-    uniforms tri_u, point_u, upload_u;
+    GLuint tri_prog, point_prog, upload_prog, batch_prog;
+    uniforms tri_u, point_u, upload_u, batch_u;
     /* The scene, made at create. */
     GLuint vao, vbo_pos, vbo_normal, vbo_uv, vbo_material, ibo;
     GLuint ssbo_materials, ssbo_lights, ssbo_tex_info, ssbo_texels, ssbo_tri_material, ssbo_indices;
     /* Streams of queries and points, refilled by each call. */
     GLuint stream_vao, stream_pos, stream_idx;
     GLuint point_vao, point_pos, point_color, point_size, point_object;
+    /* Caller batches (rl_drawer_draw_batch): unshared corners, staged here. */
+    GLuint batch_vao, batch_buf;
+    rl_gl_batch_corner *corners;
+    size_t corners_cap;
     GLuint query;                 /* the pixels of counted draws */
     /* desc.deferred_counts: each counted draw's query object (a pool kept
      * across frames) and its counters, read at the frame's end. */
@@ -102,6 +107,7 @@ static void gl_release(void *impl)
     /* The context's objects go with it; they are not deleted one by one. */
     rl_gl_context_release(g->ctx);
     free(g->pool);
+    free(g->corners);
     free(g->count_pool);
     free(g->count_to);
     free(g);
@@ -128,6 +134,7 @@ static uniforms locate(GLuint p)
         .first_triangle = glGetUniformLocation(p, "u_first_triangle"),
         .normal_maps = glGetUniformLocation(p, "u_normal_maps"),
         .depth_equal = glGetUniformLocation(p, "u_depth_equal"),
+        .num_layers = glGetUniformLocation(p, "u_num_layers"),
     };
 }
 
@@ -390,6 +397,24 @@ static void make_streams(gl_drawer *g)
     glVertexArrayAttribIFormat(g->point_vao, 3, 1, GL_UNSIGNED_INT, 0);
     glEnableVertexArrayAttrib(g->point_vao, 0);
     glCreateQueries(GL_SAMPLES_PASSED, 1, &g->query);
+
+    /* One interleaved stream of rl_gl_batch_corner (gl_shaders.c batch_vs). */
+    glCreateBuffers(1, &g->batch_buf);
+    glCreateVertexArrays(1, &g->batch_vao);
+    glVertexArrayVertexBuffer(g->batch_vao, 0, g->batch_buf, 0, sizeof(rl_gl_batch_corner));
+    glVertexArrayAttribFormat(g->batch_vao, 0, 3, GL_FLOAT, GL_FALSE, offsetof(rl_gl_batch_corner, pos));
+    glVertexArrayAttribIFormat(g->batch_vao, 1, 4, GL_UNSIGNED_INT, offsetof(rl_gl_batch_corner, tex));
+    glVertexArrayAttribIFormat(g->batch_vao, 2, 2, GL_UNSIGNED_INT, offsetof(rl_gl_batch_corner, ids));
+    for (GLuint l = 0; l < 4; ++l)
+        glVertexArrayAttribFormat(g->batch_vao, 3 + l, 4, GL_FLOAT, GL_FALSE,
+                                  (GLuint)(offsetof(rl_gl_batch_corner, col) + l * sizeof(float[4])));
+    for (GLuint h = 0; h < 2; ++h)
+        glVertexArrayAttribFormat(g->batch_vao, 7 + h, 4, GL_FLOAT, GL_FALSE,
+                                  (GLuint)(offsetof(rl_gl_batch_corner, uv) + h * sizeof(float[4])));
+    for (GLuint a = 0; a < 9; ++a) {
+        glVertexArrayAttribBinding(g->batch_vao, a, 0);
+        glEnableVertexArrayAttrib(g->batch_vao, a);
+    }
 }
 
 /* The framebuffer for a target of w x h. */
@@ -440,8 +465,10 @@ static rl_status make_programs(gl_drawer *g)
     g->tri_prog = rl_gl_program_triangles();
     g->point_prog = g->tri_prog ? rl_gl_program_points() : 0;
     g->upload_prog = g->point_prog ? rl_gl_program_depth_upload() : 0;
-    if (!g->upload_prog)
+    g->batch_prog = g->upload_prog ? rl_gl_program_batch() : 0;
+    if (!g->batch_prog)
         return RL_ERR_INTERNAL;
+    g->batch_u = locate(g->batch_prog);
     g->tri_u = locate(g->tri_prog);
     g->point_u = locate(g->point_prog);
     g->upload_u = locate(g->upload_prog);
@@ -502,6 +529,7 @@ static rl_status gl_begin(void *impl, rl_image *target, const rl_mat4 *view, con
     set_camera(g, g->tri_prog, &g->tri_u, view, proj, eye);
     set_camera(g, g->point_prog, &g->point_u, view, proj, eye);
     set_camera(g, g->upload_prog, &g->upload_u, view, proj, eye);
+    set_camera(g, g->batch_prog, &g->batch_u, view, proj, eye);
 
     const int w = target->width, h = target->height;
     if ((target->layers & RL_LAYER_COLOR) && target->color)
@@ -778,6 +806,109 @@ static rl_status gl_query_result(void *impl, uint32_t slot, uint64_t *pixels)
     return settle(g, rl_gl_check("rl_drawer_query_result"));
 }
 
+/* Triangles of a caller batch staged at a time: a bounded stream (130
+ * bytes a corner), drawn in submission order as one draw would. */
+#define BATCH_CHUNK 65536u
+
+static rl_status check_batch(const gl_drawer *g, const rl_raster_batch *b)
+{
+    if (b->face_colors || b->texture || b->uvs || b->triangle_texture || b->lazy)
+        return rl_error(RL_ERR_UNSUPPORTED, "rl_drawer_draw_batch: the GL drawer draws layers, per-vertex "
+                        "colors or one color (no face colours, batch textures or lazy colours)");
+    if (b->num_layers > RL_RASTER_MAX_LAYERS || (b->num_layers && !b->layers))
+        return rl_error(RL_ERR_INVALID_ARG, "rl_drawer_draw_batch: %u layers", b->num_layers);
+    for (uint32_t l = 0; l < b->num_layers; ++l) {
+        const rl_raster_layer *L = &b->layers[l];
+        if (!L->colors)
+            return rl_error(RL_ERR_INVALID_ARG, "rl_drawer_draw_batch: layer %u has no colours", l);
+        if (L->textures && L->textures != g->data->textures)
+            return rl_error(RL_ERR_UNSUPPORTED, "rl_drawer_draw_batch: layer %u's textures are not the "
+                            "scene's", l);
+    }
+    if (b->num_triangles && (!b->positions || !b->indices))
+        return rl_error(RL_ERR_INVALID_ARG, "rl_drawer_draw_batch: %u triangles without positions or indices",
+                        b->num_triangles);
+    const size_t n = 3 * (size_t)b->num_triangles;
+    for (size_t i = 0; i < n; ++i)
+        if (b->indices[i] >= b->num_vertices)
+            return rl_error(RL_ERR_INVALID_ARG, "rl_drawer_draw_batch: index %u of %u vertices", b->indices[i],
+                            b->num_vertices);
+    return RL_OK;
+}
+
+/* The corners of triangles [first, first + count) of b. */
+static void stage_corners(const gl_drawer *g, const rl_raster_batch *b, uint32_t first, uint32_t count)
+{
+    for (uint32_t i = 0; i < count; ++i) {
+        const uint32_t t = first + i;
+        uint32_t tex[4] = { RL_NONE, RL_NONE, RL_NONE, RL_NONE };
+        for (uint32_t l = 0; l < b->num_layers; ++l) {
+            const rl_raster_layer *L = &b->layers[l];
+            /* Textured where the software's gather_layers would be. */
+            if (L->uvs && L->textures && L->triangle_texture)
+                tex[l] = valid_texture(g->data, L->triangle_texture[t]);
+        }
+        const uint32_t tri = b->triangle_ids ? b->triangle_ids[t] : b->first_triangle_id + t;
+        const uint32_t obj = b->object_ids ? b->object_ids[t] : b->object_id;
+        for (int k = 0; k < 3; ++k) {
+            const uint32_t v = b->indices[3 * (size_t)t + (size_t)k];
+            rl_gl_batch_corner *c = &g->corners[3 * (size_t)i + (size_t)k];
+            memset(c, 0, sizeof *c);
+            c->pos[0] = b->positions[v].x;
+            c->pos[1] = b->positions[v].y;
+            c->pos[2] = b->positions[v].z;
+            memcpy(c->tex, tex, sizeof tex);
+            c->ids[0] = tri;
+            c->ids[1] = obj;
+            for (uint32_t l = 0; l < b->num_layers || l < 1; ++l) {
+                const rl_vec4 col = b->num_layers ? b->layers[l].colors[v] : b->colors ? b->colors[v] : b->color;
+                c->col[l][0] = col.x;
+                c->col[l][1] = col.y;
+                c->col[l][2] = col.z;
+                c->col[l][3] = col.w;
+                if (b->num_layers && b->layers[l].uvs) {
+                    c->uv[l][0] = b->layers[l].uvs[v].x;
+                    c->uv[l][1] = b->layers[l].uvs[v].y;
+                }
+            }
+        }
+    }
+}
+
+static rl_status gl_draw_batch(void *impl, const rl_raster_batch *b, rl_raster_counters *c)
+{
+    gl_drawer *g = impl;
+    rl_status st = rl_gl_context_make_current(g->ctx);
+    if (st == RL_OK)
+        st = check_batch(g, b);
+    if (st != RL_OK || b->num_triangles == 0)
+        return settle(g, st);
+    const uint32_t chunk = b->num_triangles < BATCH_CHUNK ? b->num_triangles : BATCH_CHUNK;
+    if (!rl_reserve((void **)&g->corners, &g->corners_cap, 3 * (size_t)chunk, sizeof *g->corners, 3 * 1024))
+        return settle(g, RL_ERR_OUT_OF_MEMORY);
+    apply_flags(b->flags);
+    glUseProgram(g->batch_prog);
+    glProgramUniform1i(g->batch_prog, g->batch_u.num_layers, (GLint)b->num_layers);
+    glBindVertexArray(g->batch_vao);
+    st = start_counted(g);
+    if (st != RL_OK)
+        return settle(g, st);
+    for (uint32_t first = 0; first < b->num_triangles; first += chunk) {
+        const uint32_t n = b->num_triangles - first < chunk ? b->num_triangles - first : chunk;
+        stage_corners(g, b, first, n);
+        /* Respecified storage: the draw before may still read the old. */
+        glNamedBufferData(g->batch_buf, (GLsizeiptr)(3 * (size_t)n * sizeof *g->corners), g->corners,
+                          GL_STREAM_DRAW);
+        glDrawArrays(GL_TRIANGLES, 0, (GLsizei)(3 * n));
+    }
+    if (c) {
+        /* GL does not report its clipping: every triangle counts as drawn. */
+        c->triangles_in += b->num_triangles;
+        c->triangles_drawn += b->num_triangles;
+    }
+    return settle(g, end_counted(g, c, "rl_drawer_draw_batch"));
+}
+
 /* One point attribute: a stream of count items, or the constant value
  * (NULL data) as the generic attribute. */
 static void point_attribute(gl_drawer *g, GLuint a, GLuint buf, const void *data, size_t item, uint32_t count)
@@ -861,6 +992,7 @@ static const rl_drawer_ops gl_ops = {
     .query_issue = gl_query_issue,
     .query_poll = gl_query_poll,
     .query_result = gl_query_result,
+    .draw_batch = gl_draw_batch,
     .draw_points = gl_draw_points,
     .end = gl_end,
 };

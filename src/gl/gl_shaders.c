@@ -325,6 +325,96 @@ static const char *const points_fs = GLSL(
     }
 );
 
+/* Caller-made triangle batches (rl_drawer_draw_batch), for Ullmann 2003,
+ * Sec. 3.5: Vertex Tracing's refined mesh drawn with Gouraud shading and
+ * its deferred textures by multitexturing (raster_fill.c gather_layers /
+ * shade_layers): the fragment is the sum over the layers of the
+ * interpolated colour times the texel at the interpolated uv (the colour
+ * alone where the face has no texture in that layer), alpha layer 0's;
+ * with no layers the interpolated per-vertex colour (Gouraud). Corners
+ * come unshared, each with its face's textures and IDs as flat
+ * attributes; the clip coordinates are the triangle program's, so that
+ * RL_RASTER_DEPTH_EQUAL passes (eq. 3.22's multipass) meet the depth of
+ * the pass before them with GL_EQUAL, bit for bit. */
+static const char *const batch_vs = GLSL(
+    layout(location = 0) in vec3 a_pos;
+    layout(location = 1) in uvec4 a_tex;
+    layout(location = 2) in uvec2 a_ids;
+    layout(location = 3) in vec4 a_col0;
+    layout(location = 4) in vec4 a_col1;
+    layout(location = 5) in vec4 a_col2;
+    layout(location = 6) in vec4 a_col3;
+    layout(location = 7) in vec4 a_uv01;
+    layout(location = 8) in vec4 a_uv23;
+    uniform mat4 u_view_proj;
+    uniform vec4 u_view_z;
+    uniform bool u_affine;
+    uniform float u_depth_k;
+    flat out uvec4 v_tex;
+    flat out uvec2 v_ids;
+    out vec4 v_col[4];
+    out vec4 v_uv01;
+    out vec4 v_uv23;
+    out float v_depth;
+    invariant gl_Position;
+    out float gl_ClipDistance[1];
+
+    void main()
+    {
+        vec4 c = u_view_proj * vec4(a_pos, 1.0);
+        gl_ClipDistance[0] = c.z + c.w;
+        if (u_affine) {
+            gl_Position = vec4(c.x, -c.y, 0.5 * (c.w - c.z), c.w);
+            v_depth = -(dot(u_view_z.xyz, a_pos) + u_view_z.w);
+        } else {
+            gl_Position = vec4(c.x, -c.y, u_depth_k, c.w);
+            v_depth = c.w;
+        }
+        v_tex = a_tex;
+        v_ids = a_ids;
+        v_col[0] = a_col0;
+        v_col[1] = a_col1;
+        v_col[2] = a_col2;
+        v_col[3] = a_col3;
+        v_uv01 = a_uv01;
+        v_uv23 = a_uv23;
+    }
+);
+
+static const char *const batch_fs = GLSL(
+    flat in uvec4 v_tex;
+    flat in uvec2 v_ids;
+    in vec4 v_col[4];
+    in vec4 v_uv01;
+    in vec4 v_uv23;
+    in float v_depth;
+    uniform int u_num_layers;
+    layout(location = 0) out vec4 o_color;
+    layout(location = 1) out float o_depth;
+    layout(location = 2) out uint o_object;
+    layout(location = 3) out uint o_triangle;
+
+    void main()
+    {
+        o_depth = v_depth;
+        o_triangle = v_ids.x;
+        o_object = v_ids.y;
+        if (u_num_layers == 0) {
+            o_color = v_col[0];
+            return;
+        }
+        vec2 uv[4] = vec2[4](v_uv01.xy, v_uv01.zw, v_uv23.xy, v_uv23.zw);
+        vec4 sum = vec4(0.0, 0.0, 0.0, v_col[0].w);
+        for (int l = 0; l < u_num_layers; ++l) {
+            vec3 c = v_col[l].rgb;
+            if (v_tex[l] != NONE)
+                c *= tex_sample(v_tex[l], uv[l]).rgb;
+            sum.rgb += c;
+        }
+        o_color = sum;
+    }
+);
+
 /* A frame starts from the target as it is (rl_drawer.h): its eye depth is
  * copied to the depth attachment and turned into window depth, the
  * inverse of what the vertex stage computes. */
@@ -444,4 +534,11 @@ GLuint rl_gl_program_depth_upload(void)
     const char *const vs[] = { header, upload_vs };
     const char *const fs[] = { header, upload_fs };
     return link(vs, 2, fs, 2, "depth upload");
+}
+
+GLuint rl_gl_program_batch(void)
+{
+    const char *const vs[] = { header, batch_vs };
+    const char *const fs[] = { header, common, batch_fs };
+    return link(vs, 2, fs, 3, "batch");
 }

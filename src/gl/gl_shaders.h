@@ -62,5 +62,19 @@ GLuint rl_gl_link(GLuint a, GLuint b, const char *what);
 GLuint rl_gl_program_triangles(void);
 GLuint rl_gl_program_points(void);
 GLuint rl_gl_program_depth_upload(void);
+/* Caller-made batches (rl_drawer_draw_batch): unshared corners of
+ * gl_batch_corner, colour from up to four texture layers or Gouraud. */
+GLuint rl_gl_program_batch(void);
+
+/* One corner of a batch as the batch program reads it (attribute
+ * locations in order: position, the face's textures per layer, its
+ * triangle and object IDs, four layer colours, four uv pairs). */
+typedef struct rl_gl_batch_corner {
+    float pos[3];
+    uint32_t tex[4];              /* per layer, RL_NONE: untextured */
+    uint32_t ids[2];              /* triangle, object */
+    float col[4][4];
+    float uv[4][2];
+} rl_gl_batch_corner;
 
 #endif

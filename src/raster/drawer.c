@@ -215,6 +215,14 @@ rl_status rl_drawer_query(rl_drawer *dr, const rl_raster_batch *boxes, uint64_t 
     return st == RL_OK ? rl_drawer_query_result(dr, handle, pixels) : st;
 }
 
+rl_status rl_drawer_draw_batch(rl_drawer *dr, const rl_raster_batch *batch, rl_raster_counters *c)
+{
+    rl_status st = in_frame(dr, "rl_drawer_draw_batch");
+    if (st == RL_OK && !batch)
+        st = rl_error(RL_ERR_INVALID_ARG, "rl_drawer_draw_batch: NULL batch");
+    return st == RL_OK ? dr->ops->draw_batch(dr->impl, batch, c) : st;
+}
+
 rl_status rl_drawer_draw_points(rl_drawer *dr, const rl_raster_points *points, rl_raster_counters *c)
 {
     rl_status st = in_frame(dr, "rl_drawer_draw_points");
@@ -241,7 +249,8 @@ typedef struct software {
     /* The frame, for rl_scene_drawer_finish at its end. */
     rl_image *target;
     rl_mat4 view, proj;
-    bool points;                  /* points drawn: IDs are not all triangles' */
+    bool points;                  /* points or caller batches drawn: IDs are
+                                   * not all the scene's triangles as drawn */
     uint64_t *answers;            /* per query slot: answered at the issue */
     uint32_t cap_answers;
 } software;
@@ -311,6 +320,15 @@ static rl_status sw_query_result(void *impl, uint32_t slot, uint64_t *pixels)
     return RL_OK;
 }
 
+static rl_status sw_draw_batch(void *impl, const rl_raster_batch *batch, rl_raster_counters *c)
+{
+    software *sw = impl;
+    /* Its pixels carry scene triangle IDs without the scene's shading:
+     * the deferred normal-map pass must not shade them again. */
+    sw->points = true;
+    return rl_raster_draw(sw->ras, batch, c);
+}
+
 static rl_status sw_draw_points(void *impl, const rl_raster_points *points, rl_raster_counters *c)
 {
     software *sw = impl;
@@ -336,6 +354,7 @@ static const rl_drawer_ops software_ops = {
     .query_issue = sw_query_issue,
     .query_poll = sw_query_poll,
     .query_result = sw_query_result,
+    .draw_batch = sw_draw_batch,
     .draw_points = sw_draw_points,
     .end = sw_end,
 };

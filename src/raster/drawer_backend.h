@@ -21,6 +21,7 @@ typedef struct rl_drawer_ops {
     rl_status (*query_issue)(void *impl, const rl_raster_batch *boxes, uint32_t slot);
     rl_status (*query_poll)(void *impl, uint32_t slot, bool *ready);
     rl_status (*query_result)(void *impl, uint32_t slot, uint64_t *pixels);
+    rl_status (*draw_batch)(void *impl, const rl_raster_batch *batch, rl_raster_counters *c);
     rl_status (*draw_points)(void *impl, const rl_raster_points *points, rl_raster_counters *c);
     rl_status (*end)(void *impl);
 } rl_drawer_ops;

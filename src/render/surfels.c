@@ -26,8 +26,11 @@
  * unlit colour (its 20 bytes hold no specular term).
  *
  * drawer = gl (device: the EGL device) draws the frame, meshes and
- * surfels (GL points of the same sizes), with the GL drawer of src/gl; the
- * surfels are still built by the software drawer (docs/gl.md).
+ * surfels (GL points of the same sizes), with the GL drawer of src/gl.
+ * atlas = gl renders the 8 views of the preprocessing with a GL drawer on
+ * the same device (one for all nodes, dropped after the build); the
+ * sampling after it is unchanged (docs/gl.md). The two are independent:
+ * the atlas decides which surfels exist, the drawer how a frame is drawn.
  *
  * Options (thesis defaults, Sec. 6.3): min_size 100, max_size 200 (sides
  * of the projected size in pixels), overdraw 4, point_size 7, count 40000,
@@ -35,21 +38,28 @@
  * the order of the surfel count"), max_depth 5, seed 1; plus raster's
  * shading options for the meshes. */
 #include <math.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
 #include "core/error.h"
 #include "render/culling.h"
 #include "rl/rl_drawer.h"
+#include "rl/rl_gl.h"
 #include "render/renderer.h"
 #include "render/surfels_internal.h"
 #include "rl/rl_surfels.h"
 #include "rl/rl_timer.h"
 
 static const char *const overlay_choices[] = { "none", "levels", NULL };
+static const char *const atlas_choices[] = { "software", "gl", NULL };
+enum { ATLAS_SOFTWARE, ATLAS_GL };
 
 static const rl_option_info surfels_options[] = {
     RL_CULL_RASTER_OPTIONS,
+    { "atlas", RL_OPT_ENUM, "software",
+      "the 8 views of the surfel preprocessing: software | gl (OpenGL on device, docs/gl.md)", 0, 0,
+      atlas_choices },
     { "min_size", RL_OPT_FLOAT, "100", "below this projected side (px) a node is surfels only", 0, 1e6, NULL },
     { "max_size", RL_OPT_FLOAT, "200", "above this projected side (px) a node is its meshes only", 0, 1e6, NULL },
     { "overdraw", RL_OPT_FLOAT, "4", "surfels per covered pixel", 0.01, 1000, NULL },
@@ -69,6 +79,8 @@ typedef struct surfels_params {
     rl_octree_desc od;
     uint32_t count, resolution, start_sample, min_triangles;
     uint64_t seed, scene_uid;
+    int atlas;
+    char device[64];              /* atlas = gl: the EGL device */
 } surfels_params;
 
 typedef struct surfels_state {
@@ -147,6 +159,11 @@ static rl_status build_sets(surfels_state *s, rl_renderer *r, const rl_scene *sc
     uint32_t todo = 0, done = 0;
     for (uint32_t n = 0; n < nn; ++n)
         todo += nodes[n].subtree_triangles > s->params.min_triangles;
+    /* One GL context and one copy of the scene's buffers for every node. */
+    rl_drawer *atlas = NULL;
+    const rl_drawer_desc atlas_desc = RL_SURFEL_ATLAS_DRAWER_DESC;
+    if (st == RL_OK && todo > 0 && s->params.atlas == ATLAS_GL)
+        st = rl_gl_drawer_create(scene, &atlas_desc, s->params.device, &atlas);
     for (uint32_t n = 0; n < nn && st == RL_OK; ++n) {
         if (nodes[n].subtree_triangles <= s->params.min_triangles)
             continue;
@@ -154,11 +171,12 @@ static rl_status build_sets(surfels_state *s, rl_renderer *r, const rl_scene *sc
         collect_objects(nodes, objects, n, list, &count);
         rl_surfel_desc desc = { .resolution = s->params.resolution, .count = s->params.count,
                                 .start_sample = s->params.start_sample, .seed = s->params.seed + n,
-                                .threads = threads };
+                                .threads = threads, .atlas_drawer = atlas };
         st = rl_surfels_build(scene, list, count, &desc, &s->sets[n]);
         if (st == RL_OK && !rl_renderer_progress(r, (double)++done / (double)(todo ? todo : 1)))
             st = rl_error(RL_ERR_CANCELLED, "surfels: cancelled by the progress callback");
     }
+    rl_drawer_release(atlas);
     free(list);
     return st;
 }
@@ -350,6 +368,22 @@ static rl_status draw_cmds(surfels_frame *f)
     return st;
 }
 
+/* Unavailable where either the frame's drawer or the atlas wants GL that
+ * cannot be had. */
+static bool surfels_available(const rl_renderer *r, char *why, size_t n)
+{
+    if (!rl_cull_available(r, why, n))
+        return false;
+    if (rl_renderer_opt_enum(r, "atlas") != ATLAS_GL)
+        return true;
+    char reason[400];
+    if (rl_gl_available(rl_renderer_opt_string(r, "device"), reason, sizeof reason))
+        return true;
+    if (why && n)
+        snprintf(why, n, "atlas=gl: %s", reason);
+    return false;
+}
+
 static rl_status surfels_render(rl_renderer *r, void *state, const rl_scene *scene, const rl_camera *cam,
                                 rl_image *image, rl_render_stats *stats)
 {
@@ -378,6 +412,13 @@ static rl_status surfels_render(rl_renderer *r, void *state, const rl_scene *sce
         p.min_triangles = p.count;
     p.seed = (uint64_t)rl_renderer_opt_int(r, "seed");
     p.scene_uid = rl_scene_uid(scene);
+    p.atlas = (int)rl_renderer_opt_enum(r, "atlas");
+    if (p.atlas == ATLAS_GL) {
+        const char *device = rl_renderer_opt_string(r, "device");
+        if (strlen(device) >= sizeof p.device)
+            return rl_error(RL_ERR_INVALID_ARG, "surfels: device \"%.40s...\" is too long", device);
+        snprintf(p.device, sizeof p.device, "%s", device);
+    }
 
     rl_timer t0;
     rl_timer_start(&t0);
@@ -439,5 +480,5 @@ const rl_renderer_class rl_surfels_renderer_class = {
     .release = surfels_release,
     .check = NULL,
     .reset = NULL,
-    .available = rl_cull_available,
+    .available = surfels_available,
 };

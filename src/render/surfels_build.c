@@ -3,7 +3,8 @@
  * prefix a blue-noise sample of the outside-visible surface (rl_surfels.h).
  *
  * Steps, timed separately as the rows of Table 6.1:
- *   atlas       the objects rendered by src/raster, orthographically, from the
+ *   atlas       the objects rendered by src/raster (or desc.atlas_drawer, e.g.
+ *               the GL drawer of src/gl), orthographically, from the
  *               8 corners of a cube around their bounds towards its centre
  *               (Sec. 6.1.1: the 6 face directions leave holes even on simple
  *               objects), each view framing the bounding sphere of the bounds
@@ -40,12 +41,23 @@
  *
  * Deviations from the thesis:
  *  - it renders positions, normals and colours into textures on the GPU and
- *    reads them back (Table 6.1: 111 ms transfer); we render depth + IDs on
- *    the CPU and reconstruct each candidate from its triangle, so there is no
- *    transfer step and positions are exact rather than texel-rounded;
+ *    reads them back (Table 6.1: 111 ms transfer); we render depth + IDs (on
+ *    the CPU, or on GL where only they are read back) and reconstruct each
+ *    candidate from its triangle, so positions are exact rather than
+ *    texel-rounded;
  *  - no normal maps (our scenes have none);
  *  - a "round" is one chosen surfel, so with the defaults r reaches half the
  *    sample (80) exactly at the 40000th surfel.
+ *
+ *
+ * With an atlas_drawer the views are frames of that drawer: the objects
+ * drawn one by one in index order (object and scene triangle IDs, as the
+ * batch gives), depth and IDs read back. On GL (docs/gl.md, "The surfel
+ * atlas on GL") the pixels on shared edges and silhouettes follow GL's
+ * rasterization rules, so a few candidates differ from the software
+ * atlas' and the sequence drawn from them differs after the first one
+ * that does; each candidate is still made from its pixel's triangle by
+ * the same code.
  *
  * Determinism: the atlas and the candidate order do not depend on the
  * thread count (the rasterizer is band-parallel and deterministic, the
@@ -282,11 +294,25 @@ static rl_status extract(build *b, const view *v, const rl_image *img, uint32_t 
     return RL_OK;
 }
 
-/* The triangles of the selected objects as one batch. */
+/* The triangles of the selected objects as one batch, or for a drawer the
+ * objects as a list. */
 typedef struct selection {
     rl_raster_batch batch;
     uint32_t *indices, *triangle_ids, *object_ids;   /* owned, NULL when all objects */
+    uint32_t *objects, num_objects;                  /* owned, only for a drawer */
 } selection;
+
+static rl_status select_list(const rl_scene_data *d, const uint8_t *mask, selection *sel)
+{
+    memset(sel, 0, sizeof *sel);
+    sel->objects = rl_alloc(((size_t)d->num_objects + 1) * sizeof *sel->objects);
+    if (!sel->objects)
+        return RL_ERR_OUT_OF_MEMORY;
+    for (uint32_t o = 0; o < d->num_objects; ++o)
+        if (mask[o] && d->objects[o].num_triangles > 0)
+            sel->objects[sel->num_objects++] = o;
+    return RL_OK;
+}
 
 static rl_status select_objects(const rl_scene_data *d, const uint8_t *mask, bool all, selection *sel)
 {
@@ -335,6 +361,19 @@ static void free_selection(selection *sel)
     free(sel->indices);
     free(sel->triangle_ids);
     free(sel->object_ids);
+    free(sel->objects);
+}
+
+/* One view into img (cleared) by the drawer: a frame of its own. */
+static rl_status drawer_view(rl_drawer *dr, const selection *sel, const view *v, const rl_mat4 *vm,
+                             const rl_mat4 *pm, rl_image *img)
+{
+    rl_status st = rl_drawer_begin(dr, img, vm, pm, v->eye);
+    if (st == RL_OK && sel->num_objects > 0)
+        st = rl_drawer_draw(dr, sel->objects, sel->num_objects, NULL);
+    if (st == RL_OK)
+        st = rl_drawer_end(dr);
+    return st;
 }
 
 static rl_status atlas_and_candidates(build *b, const selection *sel)
@@ -347,7 +386,7 @@ static rl_status atlas_and_candidates(build *b, const selection *sel)
     rl_status st = row_start ? RL_OK : RL_ERR_OUT_OF_MEMORY;
     if (st == RL_OK)
         st = rl_image_create(res, res, RL_LAYER_DEPTH | RL_LAYER_ID, &img);
-    if (st == RL_OK)
+    if (st == RL_OK && !b->p.atlas_drawer)
         st = rl_raster_create(&(rl_raster_desc){ .threads = b->threads }, &ras);
     for (int k = 0; k < SURFEL_VIEWS && st == RL_OK; ++k) {
         rl_timer t;
@@ -356,9 +395,13 @@ static rl_status atlas_and_candidates(build *b, const selection *sel)
         rl_mat4 vm, pm;
         view_matrices(&v, &vm, &pm);
         rl_image_clear(img);
-        st = rl_raster_set_target(ras, img, &vm, &pm);
-        if (st == RL_OK && sel->batch.num_triangles > 0)
-            st = rl_raster_draw(ras, &sel->batch, NULL);
+        if (b->p.atlas_drawer) {
+            st = drawer_view(b->p.atlas_drawer, sel, &v, &vm, &pm, img);
+        } else {
+            st = rl_raster_set_target(ras, img, &vm, &pm);
+            if (st == RL_OK && sel->batch.num_triangles > 0)
+                st = rl_raster_draw(ras, &sel->batch, NULL);
+        }
         b->timing.atlas_ms += rl_timer_ms(&t);
         if (st != RL_OK)
             break;
@@ -626,6 +669,10 @@ rl_status rl_surfels_build(const rl_scene *scene, const uint32_t *objects, uint3
     if (objects && num_objects == 0)
         return rl_error(RL_ERR_INVALID_ARG, "rl_surfels_build: an empty object list (NULL means all)");
     b.threads = thread_count(b.p.threads);
+    const rl_drawer_desc atlas_desc = RL_SURFEL_ATLAS_DRAWER_DESC;
+    if (b.p.atlas_drawer && !rl_drawer_fits(b.p.atlas_drawer, scene, &atlas_desc))
+        return rl_error(RL_ERR_INVALID_ARG, "rl_surfels_build: the atlas drawer was not made for this "
+                        "scene with RL_SURFEL_ATLAS_DRAWER_DESC");
 
     uint8_t *mask = rl_calloc(b.d->num_objects ? b.d->num_objects : 1, 1);
     if (!mask)
@@ -649,7 +696,7 @@ rl_status rl_surfels_build(const rl_scene *scene, const uint32_t *objects, uint3
     rl_vec3 *chosen = NULL;
     uint32_t n = 0;
     selection sel;
-    st = select_objects(b.d, mask, objects == NULL, &sel);
+    st = b.p.atlas_drawer ? select_list(b.d, mask, &sel) : select_objects(b.d, mask, objects == NULL, &sel);
     free(mask);
     /* Degenerate bounds (nothing with area) cover no pixel: an empty set. */
     if (st == RL_OK && b.radius > 0.0f && isfinite(b.radius))

@@ -28,8 +28,15 @@
  * a frame with coherence is bit-identical to one without.
  *
  * Collision detection (Sec. 3.4.4, the thesis' OOB hierarchy for ray-object
- * intersection) is the accel option: any rl_accel, BVH by default. */
+ * intersection) is the accel option: any rl_accel, BVH by default.
+ *
+ * reconstruct = gl (device: the EGL device) draws the image, the non-VT
+ * objects and the refined mesh with its deferred textures, with a GL
+ * drawer of src/gl (vt_draw.c; docs/gl.md) kept while scene, objects,
+ * shading and device stay; the pre-pass and the refinement stay on the
+ * CPU, so the refined mesh is the software path's. */
 #include <math.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -42,6 +49,7 @@
 #include "render/renderer.h"
 #include "render/tracer_options.h"
 #include "render/vt_run.h"
+#include "rl/rl_gl.h"
 #include "rl/rl_timer.h"
 #include "rl/rl_vt.h"
 
@@ -50,6 +58,8 @@ static const char *const texture_choices[] = { "multitexture", "multipass", "sam
 static const char *const progressive_choices[] = { "none", "overdraw", "redraw", NULL };
 static const char *const shading_choices[] = { "flat", "gouraud", "textured", NULL };
 static const char *const overlay_choices[] = { "none", "wire", "samples", NULL };
+static const char *const reconstruct_choices[] = { "software", "gl", NULL };
+enum { RECONSTRUCT_SOFTWARE, RECONSTRUCT_GL };
 
 static const rl_option_info vt_options[] = {
     { "objects", RL_OPT_STRING, "auto",
@@ -88,6 +98,11 @@ static const rl_option_info vt_options[] = {
     { "overlay", RL_OPT_ENUM, "none", "draw the refined mesh (wire) or samples by reason over the image",
       0, 0, overlay_choices },
     { "shading", RL_OPT_ENUM, "textured", "shading of the rasterized non-VT objects", 0, 0, shading_choices },
+    { "reconstruct", RL_OPT_ENUM, "software",
+      "drawing of the image (Sec. 3.5): software (the CPU rasterizer) | gl (OpenGL 4.5, docs/gl.md)", 0, 0,
+      reconstruct_choices },
+    { "device", RL_OPT_STRING, "", "reconstruct=gl: EGL device auto, surfaceless or a number; empty: "
+      "$RL_EGL_DEVICE, else auto", 0, 0, NULL },
     RL_TRACER_OPTION_ROWS,
 };
 
@@ -117,6 +132,8 @@ typedef struct vt_state {
      * fresh pages (a 1024² frame touches tens of MB) */
     rl_raster *ras;
     int ras_threads;
+    rl_drawer *gl;            /* reconstruct = gl, on gl_device */
+    char gl_device[64];
     rl_image *depth_ids;      /* the pre-pass' depth and IDs */
     float *scratch_depth;     /* the frame's depth when the image has none */
     size_t scratch_pixels;
@@ -147,6 +164,7 @@ static void vt_release(void *state)
     free(s->vinfo);
     free(s->finfo);
     rl_raster_release(s->ras);
+    rl_drawer_release(s->gl);
     rl_image_release(s->depth_ids);
     free(s->scratch_depth);
     vt_corners_free(&s->corners);
@@ -496,6 +514,45 @@ static void setup_run(vt_run *run, rl_renderer *r, vt_state *s, const rl_scene_d
         run->stats.vt_objects += s->object_vt[o];
 }
 
+/* reconstruct = gl: the kept GL drawer, made anew where it does not fit
+ * (another scene, object selection, shading, ID layer or device). */
+static rl_status gl_drawer_for(rl_renderer *r, vt_state *s, const rl_scene *scene, const vt_settings *set,
+                               const rl_image *image, rl_drawer **out)
+{
+    *out = NULL;
+    if (rl_renderer_opt_enum(r, "reconstruct") != RECONSTRUCT_GL)
+        return RL_OK;
+    const char *device = rl_renderer_opt_string(r, "device");
+    if (strlen(device) >= sizeof s->gl_device)
+        return rl_error(RL_ERR_INVALID_ARG, "vt: device \"%.40s...\" is too long", device);
+    const bool ids = (image->layers & RL_LAYER_ID) && image->object_id && image->triangle_id;
+    rl_drawer_desc desc = { .shading = set->shading, .ambient = set->ambient,
+                            .flags = ids ? 0u : RL_RASTER_NO_ID, .object_mask = s->object_raster };
+    if (!s->gl || !rl_drawer_fits(s->gl, scene, &desc) || strcmp(s->gl_device, device) != 0) {
+        rl_drawer_release(s->gl);
+        s->gl = NULL;
+        rl_status st = rl_gl_drawer_create(scene, &desc, device, &s->gl);
+        if (st != RL_OK)
+            return st;
+        snprintf(s->gl_device, sizeof s->gl_device, "%s", device);
+    }
+    *out = s->gl;
+    return RL_OK;
+}
+
+/* Unavailable with reconstruct = gl where no GL 4.5 context can be made. */
+static bool vt_available(const rl_renderer *r, char *why, size_t n)
+{
+    if (rl_renderer_opt_enum(r, "reconstruct") != RECONSTRUCT_GL)
+        return true;
+    char reason[400];
+    if (rl_gl_available(rl_renderer_opt_string(r, "device"), reason, sizeof reason))
+        return true;
+    if (why && n)
+        snprintf(why, n, "reconstruct=gl: %s", reason);
+    return false;
+}
+
 /* Fig. 3.17: the ID/Z pre-pass with the rasterized half, the refinement
  * with its sampling, the final draw; then what the next frame keeps
  * (feelers, the refined mesh). */
@@ -552,8 +609,14 @@ static rl_status vt_render(rl_renderer *r, void *state, const rl_scene *scene, c
         return st;
     vt_mesh_reset(&s->mesh);
     vt_heap_clear(&s->heap);
+    rl_drawer *gl = NULL;
+    if ((st = gl_drawer_for(r, s, scene, &set, image, &gl)) != RL_OK) {
+        rl_tracer_release(tracer);
+        return st;
+    }
     vt_run run;
     setup_run(&run, r, s, d, &set, tracer, &cam, image);
+    run.drawer = gl;
     st = run_frame(&run, s, &set, image);
     rl_tracer_release(tracer);
     if (st != RL_OK)
@@ -636,4 +699,5 @@ const rl_renderer_class rl_vt_renderer_class = {
     .release = vt_release,
     .check = vt_check,
     .reset = vt_reset,
+    .available = vt_available,
 };

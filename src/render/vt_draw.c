@@ -23,7 +23,16 @@
  * draws only the faces of the stages since the last update on top of it,
  * each vertex moved towards the eye by eq. 3.16,
  *     v_k = v - (v - p_a) f k,
- * so that children win the depth test against their parents. */
+ * so that children win the depth test against their parents.
+ *
+ * reconstruct = gl (run->drawer): the same corner batches, passes and
+ * flags go to a GL drawer (rl_drawer_draw_batch; gl_shaders.c batch_vs /
+ * batch_fs: Gouraud interpolation by the GPU, the layers' sum of eq. 3.20
+ * per fragment, eq. 3.22's passes added by blending where GL_EQUAL finds
+ * pass 1's depth), the non-VT objects by the same drawer's scene draw; a
+ * frame of the drawer starts from the image as it is and reads it back
+ * at its end, so progressive updates and redraws work on the image as
+ * with the rasterizer. */
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -197,8 +206,15 @@ static bool taken(const vt_run *run, const vt_face *face, bool only_new)
  * within one, so the image is the same. */
 #define DRAW_CHUNK 65536u
 
-/* The corner batch of faces list[0..count) into the rasterizer, in the
- * texture mode's passes. */
+/* One pass of a batch: into the rasterizer, or the GL drawer's frame. */
+static rl_status draw_pass(vt_run *run, rl_raster *ras, const rl_raster_batch *batch)
+{
+    return run->drawer ? rl_drawer_draw_batch(run->drawer, batch, &run->counters)
+                       : rl_raster_draw(ras, batch, &run->counters);
+}
+
+/* The corner batch of faces list[0..count) into the rasterizer (or the
+ * drawer), in the texture mode's passes. */
 static rl_status draw_batch(vt_run *run, rl_raster *ras, const uint32_t *list, size_t count, bool offset,
                             unsigned id_flags)
 {
@@ -228,21 +244,21 @@ static rl_status draw_batch(vt_run *run, rl_raster *ras, const uint32_t *list, s
     rl_status st;
     if (run->set->textures == VT_TEX_SAMPLED) {
         batch.colors = b->col[0];
-        st = rl_raster_draw(ras, &batch, &run->counters);
+        st = draw_pass(run, ras, &batch);
     } else if (run->set->textures == VT_TEX_MULTITEXTURE) {
         batch.num_layers = NUM_LAYERS;
         batch.layers = layers;
-        st = rl_raster_draw(ras, &batch, &run->counters);
+        st = draw_pass(run, ras, &batch);
     } else {
         /* Sec. 3.5.4: pass 1 writes, passes 2 and 3 add where the same
          * faces are in front (depth equal). */
         batch.num_layers = 1;
         batch.layers = &layers[0];
-        st = rl_raster_draw(ras, &batch, &run->counters);
+        st = draw_pass(run, ras, &batch);
         for (int l = 2; st == RL_OK && l < NUM_LAYERS; ++l) {
             batch.layers = &layers[l];
             batch.flags = RL_RASTER_DEPTH_EQUAL | RL_RASTER_BLEND_ADD | RL_RASTER_NO_DEPTH | RL_RASTER_NO_ID;
-            st = rl_raster_draw(ras, &batch, &run->counters);
+            st = draw_pass(run, ras, &batch);
         }
     }
     return st;
@@ -295,14 +311,27 @@ static unsigned id_flags_of(const rl_image *target)
                                                                                     : RL_RASTER_NO_ID;
 }
 
-/* The frame's rasterizer (kept by the renderer), aimed at target. */
+/* The frame's rasterizer (kept by the renderer), aimed at target; with a
+ * GL drawer its frame into target begins instead (*out stays NULL) and
+ * close_raster ends it. */
 static rl_status open_raster(vt_run *run, rl_image *target, rl_raster **out)
 {
     *out = NULL;
+    if (run->drawer)
+        return rl_drawer_begin(run->drawer, target, &run->view_m, &run->proj_m, run->view.eye);
     rl_status st = rl_raster_set_target(run->ras, target, &run->view_m, &run->proj_m);
     if (st == RL_OK)
         *out = run->ras;
     return st;
+}
+
+/* The drawer's frame ended after what st says of its draws: read back
+ * where they succeeded (a failed call has ended the frame already). */
+static rl_status close_raster(vt_run *run, rl_status st)
+{
+    if (!run->drawer || st != RL_OK)
+        return st;
+    return rl_drawer_end(run->drawer);
 }
 
 /* Copies n items between the frame and the kept base, when both exist. */
@@ -332,13 +361,18 @@ rl_status vt_draw_base(vt_run *run)
     rl_image target;
     rl_status st = vt_draw_target(run, &target);
     rl_raster *ras = NULL;
-    if (st == RL_OK)
-        st = open_raster(run, &target, &ras);
     if (st == RL_OK) {
         /* Fig. 3.17, second pass, its rasterized half: clear, the non-VT
          * objects. Drawn once: the pre-pass adds the VT objects to a copy
-         * of this depth, the VT faces go on top of it. */
+         * of this depth (with a GL drawer, to its own software depth of
+         * them: vt_prepass), the VT faces go on top of it. */
         rl_image_clear_to(&target, rl_v4_from3(run->set->background, 1.0f));
+        st = open_raster(run, &target, &ras);
+    }
+    if (st == RL_OK && run->drawer) {
+        /* The drawer was made with object_raster as its object mask. */
+        st = close_raster(run, rl_drawer_draw_all(run->drawer, &run->counters, NULL, NULL));
+    } else if (st == RL_OK) {
         rl_drawer_desc desc = { .shading = run->set->shading, .ambient = run->set->ambient,
                                       .threads = run->set->threads, .flags = id_flags_of(&target),
                                       .object_mask = run->object_raster };
@@ -388,7 +422,7 @@ rl_status vt_draw(vt_run *run, bool only_new)
     rl_raster *ras = NULL;
     st = open_raster(run, &target, &ras);
     if (st == RL_OK)
-        st = draw_faces(run, ras, only_new, id_flags_of(&target));
+        st = close_raster(run, draw_faces(run, ras, only_new, id_flags_of(&target)));
     if (st == RL_OK)
         run->drawn = true;
     return st;

@@ -63,15 +63,27 @@ rl_status vt_prepass(vt_run *run, rl_image *depth_ids)
          * it. Every triangle keeps its own ID, so the non-VT objects need
          * no special colour 0: their pixels name no VT face. */
         rl_image ids = *depth_ids;
-        ids.depth = NULL;         /* overwritten by the copy below */
-        rl_image_clear(&ids);
-        memcpy(depth_ids->depth, frame.depth,
-               (size_t)frame.width * (size_t)frame.height * sizeof *frame.depth);
-        rl_drawer_desc desc = { .shading = RL_SHADING_FLAT, .threads = set->threads,
-                                      .flags = RL_RASTER_NO_COLOR, .object_mask = run->object_vt };
         rl_raster_counters c;
         memset(&c, 0, sizeof c);
-        st = rl_raster_draw_scene(ras, run->data, run->view.eye, &desc, &c, NULL, NULL);
+        if (run->drawer) {
+            /* The image is GL's: the software's depth of the rasterized
+             * objects is drawn here (depth is that of the lit draw), so
+             * that the refinement, and with it the refined mesh, is the
+             * software path's whichever draws the image. */
+            rl_image_clear(&ids);
+            rl_drawer_desc base = { .shading = RL_SHADING_FLAT, .threads = set->threads,
+                                    .flags = RL_RASTER_NO_COLOR, .object_mask = run->object_raster };
+            st = rl_raster_draw_scene(ras, run->data, run->view.eye, &base, &c, NULL, NULL);
+        } else {
+            ids.depth = NULL;         /* overwritten by the copy below */
+            rl_image_clear(&ids);
+            memcpy(depth_ids->depth, frame.depth,
+                   (size_t)frame.width * (size_t)frame.height * sizeof *frame.depth);
+        }
+        rl_drawer_desc desc = { .shading = RL_SHADING_FLAT, .threads = set->threads,
+                                      .flags = RL_RASTER_NO_COLOR, .object_mask = run->object_vt };
+        if (st == RL_OK)
+            st = rl_raster_draw_scene(ras, run->data, run->view.eye, &desc, &c, NULL, NULL);
     }
     if (st != RL_OK)
         return st;

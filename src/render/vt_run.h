@@ -181,6 +181,8 @@ typedef struct vt_run {
     float *scratch_depth;     /* when the image has no depth layer */
     /* kept by the renderer across frames (vt_state) */
     rl_raster *ras;           /* every draw of the frame; its scratch stays */
+    rl_drawer *drawer;        /* reconstruct = gl: the GL drawer that draws
+                               * the image (vt_draw.c); NULL: ras does */
     vt_corners *corners;
     vt_base *base;            /* the rasterized half of the frame */
     bool have_base;           /* base holds this frame's */

@@ -44,6 +44,27 @@ for s in "atlas" "candidate set" "relative point sizes" "total with the defaults
 done
 expect_in "$TMP/err" "bench surfels: wrote"
 
+# The atlas section alone (issue 35, part 6): software and, where a GL 4.5
+# context can be made, GL in the same run; otherwise the reason.
+expect_usage_error "$RL" bench surfels --only atlas,nosuch --out "$TMP/x.json"
+expect_usage_error "$RL" bench surfels --atlas-runs 0 --out "$TMP/x.json"
+expect_exit 0 "$RL" bench surfels --quick --only atlas --atlas-runs 1 --out "$TMP/a.json"
+expect_in "$TMP/out" "software rasterizer"
+python3 - "$TMP/a.json" <<'PY' || fail "a.json does not hold a sane atlas record"
+import json, sys
+r = json.load(open(sys.argv[1]))
+assert "defaults" not in r and "variants" not in r, list(r)
+a = r["atlas"]
+assert a["runs"] == 1 and a["thesis_atlas_ms"] == 270, a
+assert a["software"]["candidates"] > 1000 and a["software"]["min_atlas_ms"] > 0, a
+if "gl_unavailable" not in a:
+    g = a["gl"]
+    assert g["candidates"] > 0 and g["min_atlas_ms"] > 0 and g["drawer_create_ms"] > 0, g
+    # Equal counts up to rasterization rules (docs/gl.md: equal on cornell).
+    assert abs(g["candidates"] - a["software"]["candidates"]) <= 0.005 * a["software"]["candidates"], a
+    assert a["gl_device"]["renderer"], a
+PY
+
 python3 - "$TMP/s.json" <<'PY' || fail "s.json does not hold a complete, sane record"
 import json, sys
 r = json.load(open(sys.argv[1]))

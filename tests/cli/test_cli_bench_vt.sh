@@ -209,4 +209,20 @@ assert r["parameters"]["sections"] == ["visibility"], r["parameters"]
 assert "visibility" in r and "criteria" not in r and "animation" not in r
 assert r["visibility"]["size"] == "32x32" and r["visibility"]["status"] == "ok"
 PY
+
+# The reconstruction on the CPU and on GL (issue 35, part 5): where a GL 4.5
+# context can be made, every texture mode in both, equal images; else why.
+expect_exit 0 "$RL" bench vt --quick --only reconstruct --size 48x48 -q --out "$TMP/g.json"
+python3 - "$TMP/g.json" <<'PY' || fail "g.json is wrong"
+import json, sys
+r = json.load(open(sys.argv[1]))
+g = r["reconstruct"]
+assert g["status"] == "ok" and g["size"] == "48x48", g
+if "gl_unavailable" not in g:
+    assert g["gl"]["renderer"], g
+    assert [x["textures"] for x in g["runs"]] == ["multitexture", "multipass", "sampled"], g
+    for x in g["runs"]:
+        assert x["software_draw_ms"] > 0 and x["gl_draw_ms"] > 0, x
+        assert x["gl_vs_software"]["ssim"] >= 0.99, x
+PY
 echo "ok"

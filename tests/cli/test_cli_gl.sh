@@ -30,6 +30,13 @@ expect_error 1 "chcpp: unavailable: .*bogus" \
 RL_EGL_DEVICE=bogus expect_error 1 "surfels: unavailable: .*bogus" \
     "$RL" render cornell --algo surfels --set surfels.drawer=gl --size 32x24 --out "$TMP/none.png"
 expect_error 2 "drawer" "$RL" render cornell --algo svs --set svs.drawer=vulkan --size 32x24 --out "$TMP/none.png"
+# The surfel atlas (part 6) and VT's reconstruction (part 5) on GL: the same.
+expect_error 1 "surfels: unavailable: atlas=gl: .*bogus" \
+    "$RL" render cornell --algo surfels --set surfels.atlas=gl --set surfels.device=bogus --size 32x24 --out "$TMP/none.png"
+RL_EGL_DEVICE=bogus expect_error 1 "vt: unavailable: reconstruct=gl: .*bogus" \
+    "$RL" render table --algo vt --set vt.reconstruct=gl --size 32x24 --out "$TMP/none.png"
+[ ! -e "$TMP/none.png" ] || fail "an unavailable renderer wrote an image"
+expect_error 2 "reconstruct" "$RL" render table --algo vt --set vt.reconstruct=vulkan --size 32x24 --out "$TMP/none.png"
 
 # The visibility property on GL: a clear error where there is no GL, a
 # usage error for a backend that does not exist.
