@@ -114,8 +114,11 @@ const char *const rl_gl_pt_glsl_common = GLSL(
         return tex_sample(m.tex.z, interp_uv(tri, u, v)).w < m.extra.z;
     }
 
-    /* accel/watertight.c: the axis permutation and shear of a ray. */
-    struct WRay { ivec3 k; vec3 s; vec3 o; };
+    /* accel/watertight.c: the axis permutation and shear of a ray. The
+     * permutation is a matrix of unit rows (kx, ky, kz): a product with it
+     * picks the components exactly, where indexing a vector by a varying
+     * component costs a scalar access per thread on SIMD hardware. */
+    struct WRay { mat3 perm; vec3 s; vec3 o; };
 
     WRay wt_setup(vec3 o, vec3 d)
     {
@@ -123,33 +126,35 @@ const char *const rl_gl_pt_glsl_common = GLSL(
         int kz = a.x > a.y ? (a.x > a.z ? 0 : 2) : (a.y > a.z ? 1 : 2);
         int kx = kz == 2 ? 0 : kz + 1;
         int ky = kx == 2 ? 0 : kx + 1;
-        float dz = d[kz];
+        float dz = kz == 0 ? d.x : (kz == 1 ? d.y : d.z);
         if (dz < 0.0) {
             int s = kx;
             kx = ky;
             ky = s;
         }
+        vec3 ex = vec3(equal(ivec3(kx), ivec3(0, 1, 2)));
+        vec3 ey = vec3(equal(ivec3(ky), ivec3(0, 1, 2)));
+        vec3 ez = vec3(equal(ivec3(kz), ivec3(0, 1, 2)));
         WRay w;
-        w.k = ivec3(kx, ky, kz);
-        w.s = vec3(d[kx] / dz, d[ky] / dz, 1.0 / dz);
+        w.perm = transpose(mat3(ex, ey, ez));
+        w.s = vec3(dot(d, ex) / dz, dot(d, ey) / dz, 1.0 / dz);
         w.o = o;
         return w;
     }
 
-    /* accel/watertight.h rl_watertight_hit_k, operation for operation;
+    /* accel/watertight.h rl_watertight_hit_k, operation for operation
+     * (A = (p0 - o) permuted is its (p0[kx] - ox, p0[ky] - oy, p0[kz] - oz));
      * the exact fallback in double as there. */
     bool wt_hit(WRay w, vec3 p0, vec3 p1, vec3 p2, float t_min, float t_max, out float t, out float u, out float v)
     {
         t = 0.0;
         u = 0.0;
         v = 0.0;
-        int kx = w.k.x, ky = w.k.y, kz = w.k.z;
-        float oz = w.o[kz];
-        float Az = p0[kz] - oz, Bz = p1[kz] - oz, Cz = p2[kz] - oz;
-        float ox = w.o[kx], oy = w.o[ky];
-        precise float Ax = (p0[kx] - ox) - w.s.x * Az, Ay = (p0[ky] - oy) - w.s.y * Az;
-        precise float Bx = (p1[kx] - ox) - w.s.x * Bz, By = (p1[ky] - oy) - w.s.y * Bz;
-        precise float Cx = (p2[kx] - ox) - w.s.x * Cz, Cy = (p2[ky] - oy) - w.s.y * Cz;
+        precise vec3 A = w.perm * (p0 - w.o), B = w.perm * (p1 - w.o), C = w.perm * (p2 - w.o);
+        float Az = A.z, Bz = B.z, Cz = C.z;
+        precise float Ax = A.x - w.s.x * Az, Ay = A.y - w.s.y * Az;
+        precise float Bx = B.x - w.s.x * Bz, By = B.y - w.s.y * Bz;
+        precise float Cx = C.x - w.s.x * Cz, Cy = C.y - w.s.y * Cz;
         precise float U = Cx * By - Cy * Bx;
         precise float V = Ax * Cy - Ay * Cx;
         precise float W = Bx * Ay - By * Ax;
@@ -195,8 +200,8 @@ const char *const rl_gl_pt_glsl_common = GLSL(
     /* The binary BVH (accel/bvh.h rl_bvh_node: the two children of an inner
      * node adjacent, count and split axis in the last word), its leaves'
      * triangles in leaf order (3 vec4 each, the scene ID in the first w).
-     * Closest hit into h (t_max shrinks), or with any = true the first hit. */
-    bool bvh_query(vec3 o, vec3 d, float t_min, float t_max, bool any, out Hit h)
+     * Closest hit into h (t_max shrinks), or with any_hit the first hit. */
+    bool bvh_query(vec3 o, vec3 d, float t_min, float t_max, bool any_hit, out Hit h)
     {
         h = Hit(t_max, 0.0, 0.0, NONE);
         if (u_num_nodes == 0u)
@@ -222,12 +227,12 @@ const char *const rl_gl_pt_glsl_common = GLSL(
                         if (masked(tri, u, v))
                             continue;
                         h = Hit(t, u, v, tri);
-                        if (any)
+                        if (any_hit)
                             return true;
                     }
                 } else {
                     uint axis = bits >> 16;
-                    bool flip = d[axis] < 0.0;
+                    bool flip = (axis == 0u ? d.x : (axis == 1u ? d.y : d.z)) < 0.0;
                     stack[sp++] = flip ? index : index + 1u;
                     node = flip ? index + 1u : index;
                     descend = true;
@@ -246,7 +251,7 @@ const char *const rl_gl_pt_glsl_common = GLSL(
      * back, each cell's triangles by their scene vertices. The closest hit
      * is final once it lies inside the cell just tested: every nearer
      * triangle is listed in a cell walked before. */
-    bool grid_query(vec3 o, vec3 d, float t_min, float t_max, bool any, out Hit h)
+    bool grid_query(vec3 o, vec3 d, float t_min, float t_max, bool any_hit, out Hit h)
     {
         h = Hit(t_max, 0.0, 0.0, NONE);
         vec3 inv = 1.0 / d;
@@ -261,11 +266,11 @@ const char *const rl_gl_pt_glsl_common = GLSL(
             return false;
         ivec3 cell = clamp(ivec3(floor((o + d * t_enter - u_grid_min) * u_grid_inv_cell)), ivec3(0), u_grid_res - 1);
         ivec3 step = ivec3(sign(d));
-        vec3 next;
-        for (int k = 0; k < 3; ++k) {
-            float plane = u_grid_min[k] + float(cell[k] + (step[k] > 0 ? 1 : 0)) * u_grid_cell[k];
-            next[k] = step[k] == 0 ? INF : (plane - o[k]) * inv[k];
-        }
+        /* per axis the parameter where the walk crosses the next boundary
+         * (recomputed from the plane, as grid.c) */
+        vec3 up = vec3(greaterThan(step, ivec3(0)));
+        vec3 next = (u_grid_min + (vec3(cell) + up) * u_grid_cell - o) * inv;
+        next = mix(next, vec3(INF), equal(step, ivec3(0)));
         WRay w = wt_setup(o, d);
         while (true) {
             uint c = uint(cell.x) + uint(u_grid_res.x) * (uint(cell.y) + uint(u_grid_res.y) * uint(cell.z));
@@ -278,29 +283,31 @@ const char *const rl_gl_pt_glsl_common = GLSL(
                 if (masked(tri, u, v))
                     continue;
                 h = Hit(t, u, v, tri);
-                if (any)
+                if (any_hit)
                     return true;
             }
-            int axis = next.x < next.y ? (next.x < next.z ? 0 : 2) : (next.y < next.z ? 1 : 2);
-            float cell_exit = next[axis];
+            float cell_exit = min(next.x, min(next.y, next.z));
             if (h.tri != NONE && h.t <= cell_exit)
                 break;
             if (cell_exit > t_exit)
                 break;
-            cell[axis] += step[axis];
-            if (cell[axis] < 0 || cell[axis] >= u_grid_res[axis])
+            /* the axis crossed first: the lowest of x, y, z on a tie */
+            bvec3 m = equal(next, vec3(cell_exit));
+            m = bvec3(m.x, m.y && !m.x, m.z && !m.x && !m.y);
+            cell += ivec3(m) * step;
+            if (any(lessThan(cell, ivec3(0))) || any(greaterThanEqual(cell, u_grid_res)))
                 break;
-            float plane = u_grid_min[axis] + float(cell[axis] + (step[axis] > 0 ? 1 : 0)) * u_grid_cell[axis];
-            next[axis] = (plane - o[axis]) * inv[axis];
+            vec3 crossed = (u_grid_min + (vec3(cell) + up) * u_grid_cell - o) * inv;
+            next = mix(next, crossed, m);
         }
         return h.tri != NONE;
     }
 
-    bool query(int structure, vec3 o, vec3 d, float t_min, float t_max, bool any, out Hit h)
+    bool query(int structure, vec3 o, vec3 d, float t_min, float t_max, bool any_hit, out Hit h)
     {
         if (structure == STRUCT_GRID)
-            return grid_query(o, d, t_min, t_max, any, h);
-        return bvh_query(o, d, t_min, t_max, any, h);
+            return grid_query(o, d, t_min, t_max, any_hit, h);
+        return bvh_query(o, d, t_min, t_max, any_hit, h);
     }
 );
 
