@@ -87,7 +87,7 @@ static const rl_option_info gl_pt_options[] = {
 #define NUM_OPTIONS (sizeof gl_pt_options / sizeof gl_pt_options[0])
 
 typedef struct gl_pt_state {
-    pt_backends b;                /* the light set, offsets and the CPU BVH of the G-buffer */
+    pt_backends b;                /* the light set, offsets; a CPU BVH for depth and ID layers */
     rl_gl_pt *gpu;
     uint64_t gpu_scene;           /* the scene uid the GPU tracer holds */
     char device[64];
@@ -234,15 +234,12 @@ static rl_status gl_pt_render(rl_renderer *r, void *state, const rl_scene *scene
     if (!d)
         return RL_ERR_NOT_COMMITTED;
     const int threads = (int)rl_renderer_opt_int(r, "threads");
-    /* What pt prepares for the GPU's estimator: BVH (G-buffer), offsets,
-     * covers, light table. */
-    pt_settings set;
-    memset(&set, 0, sizeof set);
-    set.shadow = set.diffuse = set.specular = RL_PT_BACKEND_BVH;
-    set.primary = PT_PRIMARY_TRACE;
-    double built_ms = 0.0;
-    rl_status st = rl_pt_backends_prepare(&s->b, scene, &set, threads, &built_ms);
-    stats->prep_ms = built_ms;
+    /* What pt prepares for the GPU's estimator: offsets, covers, light
+     * table (the GPU builds its own structures). */
+    rl_timer prep;
+    rl_timer_start(&prep);
+    rl_status st = rl_pt_backends_prepare_scene(&s->b, scene);
+    stats->prep_ms = rl_timer_ms(&prep);
     if (st == RL_OK)
         st = ensure_gpu(s, scene, rl_renderer_opt_string(r, "device"), threads, stats);
     if (st != RL_OK)
@@ -313,6 +310,21 @@ static rl_status gl_pt_render(rl_renderer *r, void *state, const rl_scene *scene
     bool layers = ((image->layers & RL_LAYER_DEPTH) && image->depth) ||
                   ((image->layers & RL_LAYER_ID) && image->object_id && image->triangle_id);
     if (layers && !s->gbuf) {
+        /* a CPU BVH only for these layers, kept with the scene's data */
+        if (!s->b.exact[RL_ACCEL_BVH]) {
+            rl_timer timer;
+            rl_timer_start(&timer);
+            st = rl_accel_create(scene, &(rl_accel_desc){ .kind = RL_ACCEL_BVH, .threads = threads },
+                                 &s->b.exact[RL_ACCEL_BVH]);
+            if (st == RL_OK)
+                st = rl_accel_commit(s->b.exact[RL_ACCEL_BVH]);
+            if (st != RL_OK) {
+                rl_accel_release(s->b.exact[RL_ACCEL_BVH]);
+                s->b.exact[RL_ACCEL_BVH] = NULL;
+                return st;
+            }
+            stats->prep_ms += rl_timer_ms(&timer);
+        }
         st = rl_gbuffer_create(cam->width, cam->height, &s->gbuf);
         if (st == RL_OK)
             st = rl_gbuffer_trace(s->gbuf, s->b.exact[RL_ACCEL_BVH], cam);
