@@ -44,7 +44,7 @@ step 60 "rl bench gl, city, frames 1280x720" "$rl" bench gl --scenes city --only
 # Jähn 2015, Sec. 7.4 with real query latency: chcpp and svs frame by frame
 # down the city's street, software drawer and GL drawer (chcpp with its
 # asynchronous queries), at 1280x1280, then the GL drawer alone at 640x640.
-step 150 "rl bench culling walk 1280" "$rl" bench culling --only walk --size 1280 --walk-frames 40 \
+step 120 "rl bench culling walk 1280" "$rl" bench culling --only walk --size 1280 --walk-frames 40 \
     --out "$out/gpu-$date-culling-walk-1280.json"
 step 60 "rl bench culling walk 640, GL" "$rl" bench culling --only walk --size 640 --walk-frames 40 \
     --drawer gl --out "$out/gpu-$date-culling-walk-640.json"
@@ -58,6 +58,12 @@ step 30 "rl bench surfels, atlas" "$rl" bench surfels --only atlas --atlas-runs 
 # texture mode, table at 512x512 (issue 35, part 5).
 step 30 "rl bench vt, reconstruct" "$rl" bench vt --only reconstruct --size 512x512 \
     --out "$out/gpu-$date-vt-reconstruct.json"
+# Schröder 2017, Diagram 1's setting: gl-pt (BVH; the Line Space backends
+# are not ported to GL yet) at 1280x720, 1 spp per frame, on the Cornell
+# box and Cornell + bunny: frames per second. gl-pt alone: pt at this size
+# would take seconds per frame.
+step 30 "rl bench gl, gl-pt 1280x720" "$rl" bench gl --only pt --pt-gl-only --pt-size 1280x720 --frames 10 \
+    --scenes cornell,ls-cornell:model=bunny --out "$out/gpu-$date-gl-pt.json"
 
 echo "gpu.sh: records in $out/gpu-$date-*.json; $failed benchmark(s) failed"
 [ "$failed" -eq 0 ]

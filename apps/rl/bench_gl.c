@@ -13,6 +13,11 @@
  *               minimum), one worker each (the software rasterizer then
  *               uses every thread, as llvmpipe does); and whether the two
  *               agree: values equal, per-object pixels that differ
+ *   pt          gl-pt vs pt (Schröder 2017's path tracer on GL compute
+ *               shaders and on the CPU) at the same spp per frame on
+ *               cornell (or --scenes) at 256x256: first frame (and its
+ *               preparation) and the minimum of N warm frames, their
+ *               ratio, and gl-pt's frames per second
  * Speed ratios come from the same run on the same machine. Besides wall
  * time every figure has the process's CPU time (all threads, llvmpipe's
  * included), which a machine shared with other work inflates less. On llvmpipe
@@ -47,6 +52,9 @@ static const char bench_gl_help[] =
     "              the minimum of N warm frames, ratio, object IDs that agree\n"
     "  visibility  the visibility property, backend=gl vs software: commit and\n"
     "              time per position, ratio, and whether the counts agree\n"
+    "  pt          gl-pt vs pt at the same spp: first frame, minimum of N warm\n"
+    "              frames (ms), ratio, gl-pt frames per second; cornell unless\n"
+    "              --scenes names others\n"
     "The record names the GL vendor, renderer and version.\n"
     "\n"
     "options:\n"
@@ -56,25 +64,30 @@ static const char bench_gl_help[] =
     "  --resolution N    visibility: cube-face side; default 256\n"
     "  --positions N     visibility: positions per scene; default 4\n"
     "  --device D        EGL device (rl_gl.h); default $RL_EGL_DEVICE, else auto\n"
-    "  --only A,B        sections: frames, visibility\n"
+    "  --pt-size WxH     pt: image size; default 256x256\n"
+    "  --pt-spp N        pt: samples per pixel and frame of both; default 1\n"
+    "  --pt-gl-only      pt: time gl-pt alone (no pt frames to wait for)\n"
+    "  --only A,B        sections: frames, visibility, pt\n"
     "  --out FILE.json   default bench/results/gl-YYYYMMDD-HHMMSS.json\n"
     "  --quick           tiny run: cornell and spheres, 160x120, 2 frames,\n"
-    "                    resolution 32, 2 positions\n"
+    "                    resolution 32, 2 positions, pt at 64x64\n"
     "\n"
     "example:\n"
     "  RL_EGL_DEVICE=surfaceless rl bench gl --only frames --scenes cornell,table\n";
 
-enum { SEC_FRAMES, SEC_VISIBILITY, SEC_COUNT };
-static const char *const section_names[SEC_COUNT] = { "frames", "visibility" };
+enum { SEC_FRAMES, SEC_VISIBILITY, SEC_PT, SEC_COUNT };
+static const char *const section_names[SEC_COUNT] = { "frames", "visibility", "pt" };
 
 #define MAX_SCENES 16
 
 typedef struct bgl_args {
     const char *scenes_text, *out, *device;
     int width, height;
-    long long frames, resolution, positions;
+    int pt_width, pt_height;
+    long long frames, resolution, positions, pt_spp;
     unsigned sections;
     bool quick;
+    bool pt_gl_only;              /* pt: gl-pt alone (a GPU's fps at sizes where pt takes seconds) */
 } bgl_args;
 
 typedef struct bgl_ctx {
@@ -139,7 +152,8 @@ static int parse_scenes(bgl_ctx *c, const char *text)
 static int parse_args(int argc, char **argv, bgl_args *a)
 {
     a->sections = (1u << SEC_COUNT) - 1;
-    bool has_size = false, has_frames = false, has_res = false, has_pos = false;
+    bool has_size = false, has_frames = false, has_res = false, has_pos = false, has_pt_size = false,
+         has_pt_spp = false;
     const bench_opt rows[] = {
         RL_BENCH_FLAG("--quick", &a->quick),
         RL_BENCH_STRING("--scenes", &a->scenes_text),
@@ -148,6 +162,9 @@ static int parse_args(int argc, char **argv, bgl_args *a)
         RL_BENCH_COUNT("--resolution", 4096, &a->resolution, &has_res),
         RL_BENCH_COUNT("--positions", 1000, &a->positions, &has_pos),
         RL_BENCH_STRING("--device", &a->device),
+        RL_BENCH_SIZE("--pt-size", &a->pt_width, &a->pt_height, &has_pt_size),
+        RL_BENCH_COUNT("--pt-spp", 65536, &a->pt_spp, &has_pt_spp),
+        RL_BENCH_FLAG("--pt-gl-only", &a->pt_gl_only),
         RL_BENCH_SECTIONS(section_names, SEC_COUNT, &a->sections),
         RL_BENCH_OUT(&a->out),
     };
@@ -164,6 +181,10 @@ static int parse_args(int argc, char **argv, bgl_args *a)
         a->resolution = a->quick ? 32 : 256;
     if (!has_pos)
         a->positions = a->quick ? 2 : 4;
+    if (!has_pt_size)
+        a->pt_width = a->pt_height = a->quick ? 64 : 256;
+    if (!has_pt_spp)
+        a->pt_spp = 1;
     if (!a->device)
         a->device = "";
     return RL_CLI_OK;
@@ -186,14 +207,17 @@ typedef struct frame_times {
     rl_image *img;                /* the last frame */
 } frame_times;
 
-static rl_status time_frames(const bgl_ctx *c, const char *algo, const rl_scene *scene, const rl_camera *cam,
-                             frame_times *t)
+/* opts: NULL or key, value, ..., NULL. */
+static rl_status time_frames(const bgl_ctx *c, const char *algo, const char *const *opts, const rl_scene *scene,
+                             const rl_camera *cam, frame_times *t)
 {
     const bgl_args *a = c->a;
     rl_renderer *r = NULL;
     rl_status st = rl_renderer_create(algo, &r);
-    if (st == RL_OK && strcmp(algo, "gl-raster") == 0 && a->device[0])
+    if (st == RL_OK && strncmp(algo, "gl-", 3) == 0 && a->device[0])
         st = rl_renderer_set(r, "device", a->device);
+    for (int k = 0; st == RL_OK && opts && opts[k]; k += 2)
+        st = rl_renderer_set(r, opts[k], opts[k + 1]);
     if (st == RL_OK)
         st = rl_image_create(cam->width, cam->height, RL_LAYER_COLOR | RL_LAYER_DEPTH | RL_LAYER_ID, &t->img);
     t->warm_ms = st == RL_OK ? calloc((size_t)a->frames, sizeof *t->warm_ms) : NULL;
@@ -252,10 +276,10 @@ static rl_status sec_frames(void *ctx, cJSON *sec)
         cam.height = a->height;
         frame_times sw = { 0 }, gl = { 0 };
         note("%s: raster", c->names[i]);
-        st = time_frames(c, "raster", scene, &cam, &sw);
+        st = time_frames(c, "raster", NULL, scene, &cam, &sw);
         if (st == RL_OK) {
             note("%s: gl-raster", c->names[i]);
-            st = time_frames(c, "gl-raster", scene, &cam, &gl);
+            st = time_frames(c, "gl-raster", NULL, scene, &cam, &gl);
         }
         if (st == RL_OK) {
             const size_t n = (size_t)a->width * (size_t)a->height;
@@ -283,6 +307,78 @@ static rl_status sec_frames(void *ctx, cJSON *sec)
         free(sw.warm_ms);
         free(gl.warm_ms);
         rl_image_release(sw.img);
+        rl_image_release(gl.img);
+    }
+    fflush(stdout);
+    return st;
+}
+
+/* -------------------------------------------------------------------- pt */
+
+/* gl-pt vs pt: the same options (their defaults: mis=on, rng=sobol, BVH),
+ * the same spp per frame, frames accumulating as in a progressive run. */
+static rl_status sec_pt(void *ctx, cJSON *sec)
+{
+    bgl_ctx *c = ctx;
+    const bgl_args *a = c->a;
+    cJSON *rows = cJSON_AddArrayToObject(sec, "rows");
+    char spp[32];
+    snprintf(spp, sizeof spp, "%lld", a->pt_spp);
+    const char *const opts[] = { "spp", spp, NULL };
+    printf("\npt %dx%d, %s spp per frame: first frame (prep) and min of %lld warm frames, ms\n"
+           "%-24s %10s %14s %16s %10s %10s %8s %8s %10s\n", a->pt_width, a->pt_height, spp, a->frames, "scene",
+           "triangles", "pt first", "gl first (prep)", "pt", "gl-pt", "gl/cpu", "cpu", "gl-pt fps");
+    rl_status st = RL_OK;
+    for (int i = 0; i < c->num_scenes && st == RL_OK; ++i) {
+        /* Path tracing every built-in scene would take minutes: cornell,
+         * unless the scenes were named. */
+        if (!a->scenes_text && strcmp(c->names[i], "cornell") != 0)
+            continue;
+        const rl_scene *scene = c->scenes[i];
+        rl_camera cam;
+        st = rl_scene_get_camera(scene, NULL, &cam);
+        if (st != RL_OK)
+            break;
+        cam.width = a->pt_width;
+        cam.height = a->pt_height;
+        frame_times cpu = { 0 }, gl = { 0 };
+        if (!a->pt_gl_only) {
+            note("%s: pt", c->names[i]);
+            st = time_frames(c, "pt", opts, scene, &cam, &cpu);
+        }
+        if (st == RL_OK) {
+            note("%s: gl-pt", c->names[i]);
+            st = time_frames(c, "gl-pt", opts, scene, &cam, &gl);
+        }
+        if (st == RL_OK) {
+            cJSON *o = cJSON_CreateObject();
+            cJSON_AddStringToObject(o, "scene", c->names[i]);
+            cJSON_AddNumberToObject(o, "triangles", rl_scene_get_data(scene)->num_triangles);
+            if (!a->pt_gl_only) {
+                cJSON_AddItemToObject(o, "pt", frames_json(&cpu, a->frames));
+                bench_add_num(o, "gl_over_pt_min", bench_ratio(gl.min_ms, cpu.min_ms));
+                bench_add_num(o, "gl_over_pt_min_cpu", bench_ratio(gl.min_cpu_ms, cpu.min_cpu_ms));
+            }
+            cJSON_AddItemToObject(o, "gl_pt", frames_json(&gl, a->frames));
+            bench_add_num(o, "gl_pt_fps", gl.min_ms > 0.0 ? 1e3 / gl.min_ms : 0.0);
+            cJSON_AddItemToArray(rows, o);
+            char first[40];
+            snprintf(first, sizeof first, "%.1f (%.1f)", gl.first_ms, gl.first_prep_ms);
+            if (a->pt_gl_only)
+                printf("%-24s %10u %14s %16s %10s %10.1f %8s %8s %10.2f\n", c->names[i],
+                       rl_scene_get_data(scene)->num_triangles, "-", first, "-", gl.min_ms, "-", "-",
+                       gl.min_ms > 0.0 ? 1e3 / gl.min_ms : 0.0);
+            else
+                printf("%-24s %10u %14.1f %16s %10.1f %10.1f %8.2f %8.2f %10.2f\n", c->names[i],
+                       rl_scene_get_data(scene)->num_triangles, cpu.first_ms, first, cpu.min_ms, gl.min_ms,
+                       bench_ratio(gl.min_ms, cpu.min_ms), bench_ratio(gl.min_cpu_ms, cpu.min_cpu_ms),
+                       gl.min_ms > 0.0 ? 1e3 / gl.min_ms : 0.0);
+        } else {
+            snprintf(c->reason, sizeof c->reason, "%s: %s", c->names[i], rl_last_error());
+        }
+        free(cpu.warm_ms);
+        free(gl.warm_ms);
+        rl_image_release(cpu.img);
         rl_image_release(gl.img);
     }
     fflush(stdout);
@@ -489,10 +585,14 @@ int bench_gl(int argc, char **argv)
     cJSON_AddNumberToObject(params, "resolution", (double)a.resolution);
     cJSON_AddNumberToObject(params, "positions", (double)a.positions);
     cJSON_AddStringToObject(params, "positions_at", "(k + 1) / (positions + 1) along the bounds' diagonal");
+    snprintf(size, sizeof size, "%dx%d", a.pt_width, a.pt_height);
+    cJSON_AddStringToObject(params, "pt_size", size);
+    cJSON_AddNumberToObject(params, "pt_spp", (double)a.pt_spp);
+    cJSON_AddBoolToObject(params, "pt_gl_only", a.pt_gl_only);
     cJSON_AddBoolToObject(params, "quick", a.quick);
     printf("rl bench gl: %s | %s | %s (%s), %d threads\n", info.vendor, info.renderer, info.version, info.device,
            threads);
-    static const bench_section_fn fns[SEC_COUNT] = { sec_frames, sec_visibility };
+    static const bench_section_fn fns[SEC_COUNT] = { sec_frames, sec_visibility, sec_pt };
     rc = bench_run_sections("gl", root, section_names, fns, SEC_COUNT, a.sections, &c, c.reason, threads, out);
     cJSON_Delete(root);
     release_ctx(&c);

@@ -516,6 +516,7 @@ static const struct {
     { "vt", "the VT objects (mirrors, glass) traced at adaptively refined vertices and interpolated, "
             "the rest as raster" },
     { "pt", "path tracing, 1 path per pixel: noise, and indirect light the reference lacks" },
+    { "gl-pt", "pt in GL compute shaders (1 path per pixel): pt's estimator, its own noise" },
     { "chcpp", "raster's image: occlusion culling is exact" },
     { "svs", "raster's image without the objects its sampled visibility misses" },
     { "visset", "raster's image without the objects its sampled visible sets miss" },

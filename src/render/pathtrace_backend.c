@@ -290,10 +290,8 @@ static unsigned payload_of(rl_pt_backend k)
     }
 }
 
-rl_status rl_pt_backends_prepare(pt_backends *b, const rl_scene *scene, const pt_settings *set, int threads,
-                                 double *built_ms)
+rl_status rl_pt_backends_prepare_scene(pt_backends *b, const rl_scene *scene)
 {
-    *built_ms = 0.0;
     const rl_scene_data *d = rl_scene_get_data(scene);
     if (!d)
         return RL_ERR_NOT_COMMITTED;
@@ -309,6 +307,17 @@ rl_status rl_pt_backends_prepare(pt_backends *b, const rl_scene *scene, const pt
             return st;
         }
     }
+    return RL_OK;
+}
+
+rl_status rl_pt_backends_prepare(pt_backends *b, const rl_scene *scene, const pt_settings *set, int threads,
+                                 double *built_ms)
+{
+    *built_ms = 0.0;
+    rl_status st = rl_pt_backends_prepare_scene(b, scene);
+    if (st != RL_OK)
+        return st;
+    const rl_scene_data *d = b->data;
     rl_pt_backend kinds[2] = { set->shadow, set->diffuse };
     for (int i = 0; i < 2; ++i) {
         if (!rl_pt_backend_available(kinds[i], i == 0))

@@ -96,6 +96,10 @@ typedef struct pt_backends {
 rl_status rl_pt_backends_prepare(pt_backends *b, const rl_scene *scene, const pt_settings *set,
                                  int threads, double *built_ms);
 void rl_pt_backends_release(pt_backends *b);
+/* The part of rl_pt_backends_prepare that depends on the scene alone: the
+ * ray offset, the covering quad light of every triangle and the light
+ * table (what gl-pt uploads; it builds its structures itself). */
+rl_status rl_pt_backends_prepare_scene(pt_backends *b, const rl_scene *scene);
 /* Builds b->lights from the scene and b->tri_cover. */
 rl_status rl_pt_lights_build(pt_backends *b, const rl_scene_data *d);
 void rl_pt_lights_release(pt_lights *l);

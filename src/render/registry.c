@@ -20,6 +20,7 @@
 /* Each class is defined in the file named after its algorithm. */
 extern const rl_renderer_class rl_raster_renderer_class;     /* raster.c */
 extern const rl_renderer_class rl_gl_raster_renderer_class;  /* gl_raster.c */
+extern const rl_renderer_class rl_gl_pt_renderer_class;      /* gl_pathtrace.c */
 extern const rl_renderer_class rl_whitted_renderer_class;    /* whitted.c */
 extern const rl_renderer_class rl_vt_renderer_class;         /* vt.c */
 extern const rl_renderer_class rl_pt_renderer_class;         /* pathtrace.c */
@@ -32,6 +33,7 @@ extern const rl_renderer_class rl_select_renderer_class;     /* select.c */
 static const rl_renderer_class *const builtins[] = {
     &rl_raster_renderer_class,
     &rl_gl_raster_renderer_class,
+    &rl_gl_pt_renderer_class,
     &rl_whitted_renderer_class,
     &rl_vt_renderer_class,
     &rl_pt_renderer_class,

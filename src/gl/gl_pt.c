@@ -1,0 +1,673 @@
+/* gl_pt.c: the host side of the GPU path tracer (gl_pt.h): the scene and
+ * its structures in shader storage buffers, the two state images of
+ * Schröder 2017 (Sec. 5.3: the per-pixel generator states, rgba32ui;
+ * Sec. 6.5: the accumulated colour, rgba32f), one dispatch of the path
+ * program per sample and frame, and the read-back of the mean.
+ *
+ * Buffers (gl_pt_shaders.c names them): 0 materials, 1 lights, 2 texture
+ * records, 3 texels, 4 triangles (three vertex indices and the material),
+ * 5 positions, 6 normals, 7 uvs, 8 BVH nodes, 9 BVH triangles, 10 grid cell
+ * offsets, 11 grid cell lists, 12 light table, 13 per-triangle light data,
+ * 14 and 15 the ray set and hits of rl_gl_pt_trace.
+ *
+ * The BVH is accel/bvh_build.c's binary tree as built (the CPU traversal
+ * then collapses it into a wide tree, which a GPU thread gains nothing
+ * from): its 32-byte nodes go up unchanged, and its leaf-order triangle
+ * copy as three vec4 per triangle, the scene ID in the first w, so that a
+ * leaf reads its triangles contiguously. */
+#include "gl/gl_pt.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "core/error.h"
+#include "gl/gl_context.h"
+
+#ifdef RL_HAVE_GL
+
+#include <epoxy/gl.h>
+
+#include "accel/bvh.h"
+#include "accel/grid.h"
+#include "gl/gl_shaders.h"
+#include "scene/masks.h"
+
+#define LOCAL 8                    /* the path program's work group: 8 x 8 pixels */
+#define RAYS_LOCAL 64
+
+enum {
+    B_MATERIALS = 0, B_LIGHTS, B_TEX_INFO, B_TEXELS, B_TRIANGLES, B_POSITIONS, B_NORMALS, B_UVS,
+    B_BVH_NODES, B_BVH_TRIS, B_CELL_START, B_CELL_TRIS, B_LIGHT_TABLE, B_TRI_LIGHT, B_RAYS, B_HITS,
+    B_COUNT
+};
+
+/* The uniforms of a program, by name once. */
+typedef struct uniforms {
+    GLint num_nodes, masks, grid_min, grid_cell, grid_inv_cell, grid_res;
+    GLint size, eye, cam_u, cam_v, cam_w, tan_half_fov, aspect, rng, sample, max_depth, rr_depth, rr, mis,
+        mis_hits, tri_lights, light_samples, vertex_slots, num_lights, table_count, num_textures, eps,
+        background, shadow, diffuse;
+    GLint count, structure, any;
+} uniforms;
+
+struct rl_gl_pt {
+    rl_gl_context *ctx;
+    const rl_scene_data *data;
+    float eps;
+    int threads;
+    uint32_t table_count;
+    uint32_t num_nodes;
+    bool masks;
+    GLuint path_prog, rays_prog;
+    uniforms pu, ru;
+    GLuint buf[B_COUNT];
+    /* the grid, built on first use */
+    bool have_grid;
+    int grid_res;
+    rl_vec3 grid_min, grid_cell, grid_inv_cell;
+    int grid_dims[3];
+    /* the accumulation */
+    GLuint tex_accum, tex_rng;
+    int width, height;
+    uint64_t samples;
+};
+
+/* An immutable buffer of at least 16 bytes (empty arrays still bind). */
+static GLuint make_buffer(const void *data, size_t bytes, GLbitfield flags)
+{
+    GLuint b = 0;
+    glCreateBuffers(1, &b);
+    if (bytes >= 16) {
+        glNamedBufferStorage(b, (GLsizeiptr)bytes, data, flags);
+    } else {
+        uint8_t pad[16] = { 0 };
+        if (data && bytes)
+            memcpy(pad, data, bytes);
+        glNamedBufferStorage(b, 16, pad, flags);
+    }
+    return b;
+}
+
+static void replace_buffer(rl_gl_pt *pt, int slot, const void *data, size_t bytes, GLbitfield flags)
+{
+    if (pt->buf[slot])
+        glDeleteBuffers(1, &pt->buf[slot]);
+    pt->buf[slot] = make_buffer(data, bytes, flags);
+}
+
+static void put4(float *dst, rl_vec3 v, float w)
+{
+    dst[0] = v.x;
+    dst[1] = v.y;
+    dst[2] = v.z;
+    dst[3] = w;
+}
+
+static uint32_t valid_texture(const rl_scene_data *d, uint32_t t)
+{
+    return t < d->num_textures && d->textures[t] ? t : RL_NONE;
+}
+
+static void locate(GLuint p, uniforms *u)
+{
+#define U(field, name) u->field = glGetUniformLocation(p, name)
+    U(num_nodes, "u_num_nodes");
+    U(masks, "u_masks");
+    U(grid_min, "u_grid_min");
+    U(grid_cell, "u_grid_cell");
+    U(grid_inv_cell, "u_grid_inv_cell");
+    U(grid_res, "u_grid_res");
+    U(size, "u_size");
+    U(eye, "u_eye");
+    U(cam_u, "u_cam_u");
+    U(cam_v, "u_cam_v");
+    U(cam_w, "u_cam_w");
+    U(tan_half_fov, "u_tan_half_fov");
+    U(aspect, "u_aspect");
+    U(rng, "u_rng");
+    U(sample, "u_sample");
+    U(max_depth, "u_max_depth");
+    U(rr_depth, "u_rr_depth");
+    U(rr, "u_rr");
+    U(mis, "u_mis");
+    U(mis_hits, "u_mis_hits");
+    U(tri_lights, "u_tri_lights");
+    U(light_samples, "u_light_samples");
+    U(vertex_slots, "u_vertex_slots");
+    U(num_lights, "u_num_lights");
+    U(table_count, "u_table_count");
+    U(num_textures, "u_num_textures");
+    U(eps, "u_eps");
+    U(background, "u_background");
+    U(shadow, "u_shadow");
+    U(diffuse, "u_diffuse");
+    U(count, "u_count");
+    U(structure, "u_structure");
+    U(any, "u_any");
+#undef U
+}
+
+static GLuint compute_program(const char *body, const char *what)
+{
+    char defines[512];
+    snprintf(defines, sizeof defines,
+             "#define LOCAL_SIZE %d\n#define BVH_STACK %d\n#define STRUCT_GRID %d\n"
+             "#define LIGHT_POINT %d\n#define LIGHT_SPOT %d\n#define LIGHT_DIRECTIONAL %d\n#define LIGHT_QUAD %d\n"
+             "#define INF uintBitsToFloat(0x7f800000u)\n",
+             LOCAL, RL_BVH_MAX_DEPTH, (int)RL_GL_PT_GRID, (int)RL_LIGHT_POINT, (int)RL_LIGHT_SPOT,
+             (int)RL_LIGHT_DIRECTIONAL, (int)RL_LIGHT_QUAD);
+    const char *const parts[] = { rl_gl_pt_glsl_header, defines, rl_gl_pt_glsl_common, body };
+    GLuint s = rl_gl_compile(GL_COMPUTE_SHADER, parts, 4, what);
+    return s ? rl_gl_link(s, 0, what) : 0;
+}
+
+static rl_status check_block(uint64_t bytes, GLint64 max_block, const char *what)
+{
+    if (bytes > (uint64_t)max_block)
+        return rl_error(RL_ERR_LIMIT, "gl-pt: the scene's %s (%llu MiB) exceed this GL's shader storage block size "
+                        "(%lld MiB)", what, (unsigned long long)(bytes >> 20), (long long)(max_block >> 20));
+    return RL_OK;
+}
+
+/* Materials and lights as gl_pt_shaders.c reads them: what does not depend
+ * on the point lit (a spot's cosines, a directional light's direction) is
+ * computed here with the C functions of scene/light_eval.c. */
+static rl_status upload_materials_lights(rl_gl_pt *pt, const rl_gl_pt_lights *lt)
+{
+    const rl_scene_data *d = pt->data;
+    typedef struct {
+        float diffuse[4], specular[4], emission[4], extra[4];
+        uint32_t tex[4];
+    } material;
+    material *mats = rl_calloc(d->num_materials ? d->num_materials : 1, sizeof *mats);
+    rl_gl_light *lights = rl_calloc(d->num_lights ? d->num_lights : 1, sizeof *lights);
+    if (!mats || !lights) {
+        free(mats);
+        free(lights);
+        return RL_ERR_OUT_OF_MEMORY;
+    }
+    for (uint32_t i = 0; i < d->num_materials; ++i) {
+        const rl_material *m = &d->materials[i];
+        put4(mats[i].diffuse, m->diffuse, m->reflectivity);
+        put4(mats[i].specular, m->specular, m->shininess);
+        put4(mats[i].emission, m->emission, m->normal_scale);
+        mats[i].extra[0] = m->transmissivity;
+        mats[i].extra[1] = m->ior;
+        mats[i].extra[2] = m->alpha_cutoff;
+        mats[i].tex[0] = valid_texture(d, m->diffuse_texture);
+        mats[i].tex[1] = valid_texture(d, m->normal_texture);
+        mats[i].tex[2] = rl_material_mask(d, i);
+        mats[i].tex[3] = RL_NONE;
+    }
+    for (uint32_t i = 0; i < d->num_lights; ++i) {
+        const rl_light *L = &d->lights[i];
+        rl_gl_light *o = &lights[i];
+        rl_vec3 power = rl_scale(L->color, L->intensity);
+        float pmf = lt->light_pmf ? lt->light_pmf[i] : 0.0f;
+        switch (L->type) {
+        case RL_LIGHT_DIRECTIONAL: {
+            rl_vec3 l = rl_normalize(rl_neg(L->direction));
+            put4(o->pos, rl_v3s(0.0f), (float)RL_LIGHT_DIRECTIONAL);
+            put4(o->dir, l, 0.0f);
+            o->extra[1] = rl_length2(l) > 0.0f ? 1.0f : 0.0f;
+            break;
+        }
+        case RL_LIGHT_QUAD:
+            put4(o->pos, L->position, (float)RL_LIGHT_QUAD);
+            put4(o->dir, L->edge_u, 0.0f);
+            put4(o->extra, L->edge_v, lt->light_hittable && lt->light_hittable[i] ? 1.0f : 0.0f);
+            break;
+        case RL_LIGHT_SPOT:
+            put4(o->pos, L->position, (float)RL_LIGHT_SPOT);
+            put4(o->dir, rl_normalize(L->direction), cosf(rl_radians(L->spot_outer_deg)));
+            o->extra[0] = cosf(rl_radians(L->spot_inner_deg));
+            break;
+        default:
+            put4(o->pos, L->position, (float)RL_LIGHT_POINT);
+            break;
+        }
+        put4(o->power, power, pmf);
+    }
+    pt->buf[B_MATERIALS] = make_buffer(mats, sizeof *mats * d->num_materials, 0);
+    pt->buf[B_LIGHTS] = make_buffer(lights, sizeof *lights * d->num_lights, 0);
+    free(mats);
+    free(lights);
+    return RL_OK;
+}
+
+static rl_status upload_textures(rl_gl_pt *pt, GLint64 max_block)
+{
+    const rl_scene_data *d = pt->data;
+    rl_gl_tex_info *info = rl_calloc(d->num_textures ? d->num_textures : 1, sizeof *info);
+    if (!info)
+        return RL_ERR_OUT_OF_MEMORY;
+    uint64_t total = 0;
+    for (uint32_t t = 0; t < d->num_textures; ++t) {
+        const rl_texture *tex = d->textures[t];
+        info[t].offset = (uint32_t)total;
+        info[t].width = tex ? tex->width : 1;
+        info[t].height = tex ? tex->height : 1;
+        total += tex ? (uint64_t)tex->width * (uint64_t)tex->height : 0;
+    }
+    rl_status st = check_block(total * sizeof(rl_vec4), max_block, "textures");
+    if (st == RL_OK && total > UINT32_MAX)
+        st = rl_error(RL_ERR_LIMIT, "gl-pt: the scene's textures hold more than 2^32 texels");
+    if (st == RL_OK) {
+        pt->buf[B_TEX_INFO] = make_buffer(info, sizeof *info * d->num_textures, 0);
+        pt->buf[B_TEXELS] = make_buffer(NULL, total * sizeof(rl_vec4), GL_DYNAMIC_STORAGE_BIT);
+        for (uint32_t t = 0; t < d->num_textures; ++t) {
+            const rl_texture *tex = d->textures[t];
+            if (tex && tex->width > 0 && tex->height > 0)
+                glNamedBufferSubData(pt->buf[B_TEXELS], (GLintptr)info[t].offset * (GLintptr)sizeof(rl_vec4),
+                                     (GLsizeiptr)tex->width * tex->height * (GLsizeiptr)sizeof(rl_vec4),
+                                     tex->texels);
+        }
+    }
+    free(info);
+    return st;
+}
+
+/* Triangles (indices and material), vertex arrays and the per-triangle
+ * light data (covering quad, MIS probability). */
+static rl_status upload_geometry(rl_gl_pt *pt, const rl_gl_pt_lights *lt, GLint64 max_block)
+{
+    const rl_scene_data *d = pt->data;
+    rl_status st = check_block((uint64_t)d->num_triangles * 16, max_block, "triangles");
+    if (st == RL_OK)
+        st = check_block((uint64_t)d->num_vertices * sizeof(rl_vec3), max_block, "vertices");
+    if (st != RL_OK)
+        return st;
+    uint32_t *tris = rl_calloc(d->num_triangles ? d->num_triangles : 1, 4 * sizeof *tris);
+    uint32_t *tri_light = rl_calloc(d->num_triangles ? d->num_triangles : 1, 2 * sizeof *tri_light);
+    if (!tris || !tri_light) {
+        free(tris);
+        free(tri_light);
+        return RL_ERR_OUT_OF_MEMORY;
+    }
+    for (uint32_t t = 0; t < d->num_triangles; ++t) {
+        memcpy(&tris[4 * (size_t)t], &d->indices[3 * (size_t)t], 3 * sizeof *tris);
+        tris[4 * (size_t)t + 3] = d->triangle_material[t];
+        tri_light[2 * (size_t)t] = lt->tri_cover ? lt->tri_cover[t] : RL_NONE;
+        float pmf = lt->tri_pmf ? lt->tri_pmf[t] : 0.0f;
+        memcpy(&tri_light[2 * (size_t)t + 1], &pmf, sizeof pmf);
+    }
+    pt->buf[B_TRIANGLES] = make_buffer(tris, 16 * (size_t)d->num_triangles, 0);
+    pt->buf[B_TRI_LIGHT] = make_buffer(tri_light, 8 * (size_t)d->num_triangles, 0);
+    free(tris);
+    free(tri_light);
+    pt->buf[B_POSITIONS] = make_buffer(d->positions, sizeof(rl_vec3) * d->num_vertices, 0);
+    pt->buf[B_NORMALS] = make_buffer(d->normals, sizeof(rl_vec3) * d->num_vertices, 0);
+    pt->buf[B_UVS] = make_buffer(d->uvs, sizeof(rl_vec2) * d->num_vertices, 0);
+
+    /* the table: (cdf, source) pairs, count + 1 cdf values */
+    float *table = rl_calloc((size_t)lt->count + 1, 2 * sizeof *table);
+    if (!table)
+        return RL_ERR_OUT_OF_MEMORY;
+    for (uint32_t k = 0; k <= lt->count && lt->cdf; ++k) {
+        table[2 * (size_t)k] = lt->cdf[k];
+        uint32_t src = k < lt->count ? lt->source[k] : RL_NONE;
+        memcpy(&table[2 * (size_t)k + 1], &src, sizeof src);
+    }
+    pt->table_count = lt->cdf ? lt->count : 0;
+    pt->buf[B_LIGHT_TABLE] = make_buffer(table, 2 * sizeof *table * ((size_t)lt->count + 1), 0);
+    free(table);
+    return RL_OK;
+}
+
+static rl_status upload_bvh(rl_gl_pt *pt, GLint64 max_block)
+{
+    const rl_scene_data *d = pt->data;
+    rl_accel_desc desc = { .kind = RL_ACCEL_BVH, .threads = pt->threads };
+    rl_accel_stats stats;
+    rl_bvh bvh;
+    memset(&bvh, 0, sizeof bvh);
+    memset(&stats, 0, sizeof stats);
+    if (d->num_triangles == 0) {
+        pt->num_nodes = 0;
+        pt->buf[B_BVH_NODES] = make_buffer(NULL, 0, 0);
+        pt->buf[B_BVH_TRIS] = make_buffer(NULL, 0, 0);
+        return RL_OK;
+    }
+    rl_status st = rl_bvh_build(d, &desc, &bvh, &stats);
+    if (st != RL_OK)
+        return st;
+    _Static_assert(sizeof(rl_bvh_node) == 32, "a node is two vec4");
+    st = check_block((uint64_t)bvh.num_tris * 48, max_block, "BVH triangles");
+    float *tris = st == RL_OK ? rl_calloc(bvh.num_tris ? bvh.num_tris : 1, 12 * sizeof *tris) : NULL;
+    if (st == RL_OK && !tris)
+        st = RL_ERR_OUT_OF_MEMORY;
+    if (st == RL_OK) {
+        for (uint32_t k = 0; k < bvh.num_tris; ++k) {
+            const rl_bvh_tri *t = &bvh.tris[k];
+            float id;
+            memcpy(&id, &t->id, sizeof id);
+            put4(&tris[12 * (size_t)k], t->p0, id);
+            put4(&tris[12 * (size_t)k + 4], t->p1, 0.0f);
+            put4(&tris[12 * (size_t)k + 8], t->p2, 0.0f);
+        }
+        pt->num_nodes = bvh.num_nodes;
+        pt->buf[B_BVH_NODES] = make_buffer(bvh.nodes, sizeof *bvh.nodes * bvh.num_nodes, 0);
+        pt->buf[B_BVH_TRIS] = make_buffer(tris, 48 * (size_t)bvh.num_tris, 0);
+    }
+    free(tris);
+    rl_bvh_free(&bvh);
+    return st;
+}
+
+/* The grid of accel/grid.h with grid_res cells per axis (0: heuristic):
+ * cell offsets and lists as they are. */
+static rl_status ensure_grid(rl_gl_pt *pt, int grid_res)
+{
+    if (pt->have_grid && pt->grid_res == grid_res)
+        return RL_OK;
+    GLint64 max_block = 0;
+    glGetInteger64v(GL_MAX_SHADER_STORAGE_BLOCK_SIZE, &max_block);
+    rl_accel_desc desc = { .kind = RL_ACCEL_GRID, .threads = pt->threads,
+                           .grid_res = { grid_res, grid_res, grid_res } };
+    rl_grid *g = NULL;
+    rl_status st = rl_grid_build(pt->data, &desc, &g);
+    if (st != RL_OK)
+        return st;
+    st = check_block(((uint64_t)g->num_cells + 1) * 4, max_block, "grid cells");
+    if (st == RL_OK)
+        st = check_block(g->num_references * 4, max_block, "grid lists");
+    if (st == RL_OK) {
+        replace_buffer(pt, B_CELL_START, g->cell_start, sizeof *g->cell_start * ((size_t)g->num_cells + 1), 0);
+        replace_buffer(pt, B_CELL_TRIS, g->cell_tris, sizeof *g->cell_tris * (size_t)g->num_references, 0);
+        pt->grid_min = g->bounds.min;
+        pt->grid_cell = g->cell_size;
+        pt->grid_inv_cell = g->inv_cell_size;
+        memcpy(pt->grid_dims, g->res, sizeof pt->grid_dims);
+        pt->grid_res = grid_res;
+        pt->have_grid = true;
+    }
+    rl_grid_free(g);
+    return st;
+}
+
+/* The uniforms common to both programs, and the buffers bound. */
+static void bind_scene(rl_gl_pt *pt, GLuint p, const uniforms *u)
+{
+    glProgramUniform1ui(p, u->num_nodes, pt->num_nodes);
+    glProgramUniform1i(p, u->masks, pt->masks);
+    if (pt->have_grid) {
+        glProgramUniform3f(p, u->grid_min, pt->grid_min.x, pt->grid_min.y, pt->grid_min.z);
+        glProgramUniform3f(p, u->grid_cell, pt->grid_cell.x, pt->grid_cell.y, pt->grid_cell.z);
+        glProgramUniform3f(p, u->grid_inv_cell, pt->grid_inv_cell.x, pt->grid_inv_cell.y, pt->grid_inv_cell.z);
+        glProgramUniform3i(p, u->grid_res, pt->grid_dims[0], pt->grid_dims[1], pt->grid_dims[2]);
+    }
+    for (GLuint b = 0; b < B_COUNT; ++b)
+        if (pt->buf[b])
+            glBindBufferBase(GL_SHADER_STORAGE_BUFFER, b, pt->buf[b]);
+}
+
+void rl_gl_pt_release(rl_gl_pt *pt)
+{
+    if (!pt)
+        return;
+    rl_gl_context_release(pt->ctx);   /* its objects go with it */
+    free(pt);
+}
+
+rl_status rl_gl_pt_create(const rl_scene *scene, const rl_gl_pt_desc *desc, rl_gl_pt **out)
+{
+    if (!scene || !desc || !out)
+        return rl_error(RL_ERR_INVALID_ARG, "rl_gl_pt_create: NULL argument");
+    *out = NULL;
+    const rl_scene_data *d = rl_scene_get_data(scene);
+    if (!d)
+        return rl_error(RL_ERR_NOT_COMMITTED, "rl_gl_pt_create: the scene is not committed");
+    rl_gl_pt *pt = rl_calloc(1, sizeof *pt);
+    if (!pt)
+        return RL_ERR_OUT_OF_MEMORY;
+    pt->data = d;
+    pt->eps = desc->eps;
+    pt->threads = desc->threads;
+    pt->masks = rl_data_has_masks(d);
+    rl_status st = rl_gl_context_create(desc->device, &pt->ctx);
+    GLint64 max_block = 0;
+    if (st == RL_OK) {
+        glGetInteger64v(GL_MAX_SHADER_STORAGE_BLOCK_SIZE, &max_block);
+        pt->path_prog = compute_program(rl_gl_pt_glsl_path, "gl-pt path");
+        pt->rays_prog = pt->path_prog ? compute_program(rl_gl_pt_glsl_rays, "gl-pt rays") : 0;
+        st = pt->rays_prog ? RL_OK : RL_ERR_INTERNAL;
+    }
+    if (st == RL_OK) {
+        locate(pt->path_prog, &pt->pu);
+        locate(pt->rays_prog, &pt->ru);
+        st = upload_materials_lights(pt, &desc->lights);
+    }
+    if (st == RL_OK)
+        st = upload_textures(pt, max_block);
+    if (st == RL_OK)
+        st = upload_geometry(pt, &desc->lights, max_block);
+    if (st == RL_OK)
+        st = upload_bvh(pt, max_block);
+    if (st == RL_OK)
+        st = rl_gl_check("rl_gl_pt_create");
+    if (st != RL_OK) {
+        rl_gl_pt_release(pt);
+        return st;
+    }
+    rl_gl_context_done(pt->ctx);
+    *out = pt;
+    return RL_OK;
+}
+
+const rl_gl_info *rl_gl_pt_info(const rl_gl_pt *pt)
+{
+    return pt ? rl_gl_context_info(pt->ctx) : NULL;
+}
+
+/* New state images when the size changes; the states and a cleared sum on
+ * every reset. */
+static rl_status reset_images(rl_gl_pt *pt, int w, int h, const uint32_t *states)
+{
+    if (!pt->tex_accum || pt->width != w || pt->height != h) {
+        GLint max_size = 0;
+        glGetIntegerv(GL_MAX_TEXTURE_SIZE, &max_size);
+        if (w > max_size || h > max_size)
+            return rl_error(RL_ERR_LIMIT, "gl-pt: %d x %d exceeds this GL's texture size limit %d", w, h,
+                            (int)max_size);
+        if (pt->tex_accum) {
+            glDeleteTextures(1, &pt->tex_accum);
+            glDeleteTextures(1, &pt->tex_rng);
+        }
+        glCreateTextures(GL_TEXTURE_2D, 1, &pt->tex_accum);
+        glTextureStorage2D(pt->tex_accum, 1, GL_RGBA32F, w, h);
+        glCreateTextures(GL_TEXTURE_2D, 1, &pt->tex_rng);
+        glTextureStorage2D(pt->tex_rng, 1, GL_RGBA32UI, w, h);
+        pt->width = w;
+        pt->height = h;
+    }
+    glTextureSubImage2D(pt->tex_rng, 0, 0, 0, w, h, GL_RGBA_INTEGER, GL_UNSIGNED_INT, states);
+    const float zero[4] = { 0.0f, 0.0f, 0.0f, 0.0f };
+    glClearTexImage(pt->tex_accum, 0, GL_RGBA, GL_FLOAT, zero);
+    pt->samples = 0;
+    return RL_OK;
+}
+
+static rl_status render_frame(rl_gl_pt *pt, const rl_gl_pt_frame *f, float *rgba)
+{
+    const rl_scene_data *d = pt->data;
+    const int w = f->cam.width, h = f->cam.height;
+    rl_status st = RL_OK;
+    if (f->reset_states)
+        st = reset_images(pt, w, h, f->reset_states);
+    else if (!pt->tex_accum || pt->width != w || pt->height != h)
+        st = rl_error(RL_ERR_INVALID_ARG, "rl_gl_pt_render: a new %d x %d accumulation needs its states", w, h);
+    if (st == RL_OK && (f->shadow == RL_GL_PT_GRID || f->diffuse == RL_GL_PT_GRID))
+        st = ensure_grid(pt, f->grid_res);
+    if (st != RL_OK)
+        return st;
+    const GLuint p = pt->path_prog;
+    const uniforms *u = &pt->pu;
+    glUseProgram(p);
+    bind_scene(pt, p, u);
+    glBindImageTexture(0, pt->tex_accum, 0, GL_FALSE, 0, GL_READ_WRITE, GL_RGBA32F);
+    glBindImageTexture(1, pt->tex_rng, 0, GL_FALSE, 0, GL_READ_WRITE, GL_RGBA32UI);
+    const rl_camera_frame *c = &f->cam;
+    glProgramUniform2i(p, u->size, w, h);
+    glProgramUniform3f(p, u->eye, c->eye.x, c->eye.y, c->eye.z);
+    glProgramUniform3f(p, u->cam_u, c->u.x, c->u.y, c->u.z);
+    glProgramUniform3f(p, u->cam_v, c->v.x, c->v.y, c->v.z);
+    glProgramUniform3f(p, u->cam_w, c->w.x, c->w.y, c->w.z);
+    glProgramUniform1f(p, u->tan_half_fov, c->tan_half_fov_y);
+    glProgramUniform1f(p, u->aspect, c->aspect);
+    glProgramUniform1i(p, u->rng, f->rng);
+    glProgramUniform1i(p, u->max_depth, f->max_depth);
+    glProgramUniform1i(p, u->rr_depth, f->rr_depth);
+    glProgramUniform1i(p, u->rr, f->rr);
+    glProgramUniform1i(p, u->mis, f->mis);
+    glProgramUniform1i(p, u->mis_hits, f->mis && f->mis_hits);
+    glProgramUniform1i(p, u->tri_lights, f->mis && f->tri_lights);
+    glProgramUniform1i(p, u->light_samples, f->light_samples);
+    /* pathtrace.c: sampler slots per path vertex */
+    uint32_t slots = 4u + 3u * (uint32_t)f->light_samples * (f->mis ? 1u : (d->num_lights ? d->num_lights : 1u));
+    glProgramUniform1ui(p, u->vertex_slots, slots);
+    glProgramUniform1i(p, u->num_lights, (GLint)d->num_lights);
+    glProgramUniform1ui(p, u->table_count, pt->table_count);
+    glProgramUniform1ui(p, u->num_textures, d->num_textures);
+    glProgramUniform1f(p, u->eps, pt->eps);
+    glProgramUniform3f(p, u->background, f->background.x, f->background.y, f->background.z);
+    glProgramUniform1i(p, u->shadow, (GLint)f->shadow);
+    glProgramUniform1i(p, u->diffuse, (GLint)f->diffuse);
+    const GLuint gx = (GLuint)(w + LOCAL - 1) / LOCAL, gy = (GLuint)(h + LOCAL - 1) / LOCAL;
+    for (int k = 0; k < f->spp; ++k) {
+        /* One sample per dispatch: the accumulation of eq. 8 reads what the
+         * previous sample wrote. */
+        glProgramUniform1ui(p, u->sample, (GLuint)(pt->samples + (uint64_t)k));
+        glDispatchCompute(gx, gy, 1);
+        glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT);
+    }
+    pt->samples += (uint64_t)f->spp;
+    if (rgba) {
+        glMemoryBarrier(GL_TEXTURE_UPDATE_BARRIER_BIT);
+        glGetTextureImage(pt->tex_accum, 0, GL_RGBA, GL_FLOAT, (GLsizei)((size_t)w * (size_t)h * 4 * sizeof(float)),
+                          rgba);
+    } else {
+        glFinish();
+    }
+    return rl_gl_check("rl_gl_pt_render");
+}
+
+rl_status rl_gl_pt_render(rl_gl_pt *pt, const rl_gl_pt_frame *frame, float *rgba, uint64_t *samples)
+{
+    if (!pt || !frame)
+        return rl_error(RL_ERR_INVALID_ARG, "rl_gl_pt_render: NULL argument");
+    if (frame->cam.width < 1 || frame->cam.height < 1 || frame->spp < 1 || frame->light_samples < 1 ||
+        (unsigned)frame->shadow >= RL_GL_PT_STRUCTURE_COUNT || (unsigned)frame->diffuse >= RL_GL_PT_STRUCTURE_COUNT ||
+        frame->rng < 0 || frame->rng > 3)
+        return rl_error(RL_ERR_INVALID_ARG, "rl_gl_pt_render: bad frame settings");
+    if (pt->samples + (uint64_t)frame->spp > UINT32_MAX)
+        return rl_error(RL_ERR_LIMIT, "gl-pt: more than 2^32 samples per pixel in one accumulation");
+    rl_status st = rl_gl_context_make_current(pt->ctx);
+    if (st == RL_OK)
+        st = render_frame(pt, frame, rgba);
+    if (st != RL_OK && frame->reset_states)
+        pt->samples = 0;
+    if (samples)
+        *samples = pt->samples;
+    rl_gl_context_done(pt->ctx);
+    return st;
+}
+
+static rl_status trace_rays(rl_gl_pt *pt, rl_gl_pt_structure structure, int grid_res, bool any, const rl_ray *rays,
+                            uint32_t n, rl_hit *hits)
+{
+    rl_status st = structure == RL_GL_PT_GRID ? ensure_grid(pt, grid_res) : RL_OK;
+    if (st != RL_OK)
+        return st;
+    float *in = rl_calloc(n, 8 * sizeof *in);
+    if (!in)
+        return RL_ERR_OUT_OF_MEMORY;
+    for (uint32_t i = 0; i < n; ++i) {
+        put4(&in[8 * (size_t)i], rays[i].o, rays[i].t_min);
+        put4(&in[8 * (size_t)i + 4], rays[i].d, rays[i].t_max);
+    }
+    replace_buffer(pt, B_RAYS, in, 32 * (size_t)n, 0);
+    replace_buffer(pt, B_HITS, NULL, 16 * (size_t)n, 0);
+    free(in);
+    const GLuint p = pt->rays_prog;
+    glUseProgram(p);
+    bind_scene(pt, p, &pt->ru);
+    glProgramUniform1ui(p, pt->ru.count, n);
+    glProgramUniform1i(p, pt->ru.structure, (GLint)structure);
+    glProgramUniform1i(p, pt->ru.any, any);
+    glDispatchCompute((n + RAYS_LOCAL - 1) / RAYS_LOCAL, 1, 1);
+    glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);
+    struct { float t, u, v; uint32_t tri; } *out = rl_calloc(n, 16);
+    if (!out)
+        return RL_ERR_OUT_OF_MEMORY;
+    glGetNamedBufferSubData(pt->buf[B_HITS], 0, 16 * (GLsizeiptr)n, out);
+    for (uint32_t i = 0; i < n; ++i)
+        hits[i] = (rl_hit){ out[i].t, out[i].u, out[i].v, out[i].tri, RL_ID_NONE };
+    free(out);
+    return rl_gl_check("rl_gl_pt_trace");
+}
+
+rl_status rl_gl_pt_trace(rl_gl_pt *pt, rl_gl_pt_structure structure, int grid_res, bool any, const rl_ray *rays,
+                         uint32_t n, rl_hit *hits)
+{
+    if (!pt || (n && (!rays || !hits)) || (unsigned)structure >= RL_GL_PT_STRUCTURE_COUNT)
+        return rl_error(RL_ERR_INVALID_ARG, "rl_gl_pt_trace: bad argument");
+    if (n == 0)
+        return RL_OK;
+    if ((uint64_t)n * 32 > (uint64_t)INT32_MAX)
+        return rl_error(RL_ERR_LIMIT, "rl_gl_pt_trace: %u rays in one call", n);
+    rl_status st = rl_gl_context_make_current(pt->ctx);
+    if (st == RL_OK)
+        st = trace_rays(pt, structure, grid_res, any, rays, n, hits);
+    rl_gl_context_done(pt->ctx);
+    return st;
+}
+
+#else /* !RL_HAVE_GL */
+
+struct rl_gl_pt {
+    int unused;
+};
+
+rl_status rl_gl_pt_create(const rl_scene *scene, const rl_gl_pt_desc *desc, rl_gl_pt **out)
+{
+    (void)scene;
+    if (out)
+        *out = NULL;
+    rl_gl_context *ctx = NULL;
+    return rl_gl_context_create(desc ? desc->device : NULL, &ctx);
+}
+
+void rl_gl_pt_release(rl_gl_pt *pt) { (void)pt; }
+
+const rl_gl_info *rl_gl_pt_info(const rl_gl_pt *pt)
+{
+    (void)pt;
+    return NULL;
+}
+
+rl_status rl_gl_pt_render(rl_gl_pt *pt, const rl_gl_pt_frame *frame, float *rgba, uint64_t *samples)
+{
+    (void)pt;
+    (void)frame;
+    (void)rgba;
+    if (samples)
+        *samples = 0;
+    return rl_error(RL_ERR_UNSUPPORTED, "gl: built without OpenGL");
+}
+
+rl_status rl_gl_pt_trace(rl_gl_pt *pt, rl_gl_pt_structure structure, int grid_res, bool any, const rl_ray *rays,
+                         uint32_t n, rl_hit *hits)
+{
+    (void)pt;
+    (void)structure;
+    (void)grid_res;
+    (void)any;
+    (void)rays;
+    (void)n;
+    (void)hits;
+    return rl_error(RL_ERR_UNSUPPORTED, "gl: built without OpenGL");
+}
+
+#endif

@@ -1,0 +1,96 @@
+/* gl_pt.h: the path tracer of Schröder 2017 (Ch. 5, 6) in GLSL compute
+ * shaders (gl_pt.c, gl_pt_shaders.c), the GPU side of renderer "gl-pt"
+ * (src/render/gl_pathtrace.c). It computes pt's estimator (pathtrace*.c):
+ * the same BSDFs, next-event estimation with or without MIS, Russian
+ * roulette, emission rule and sample numbers, so that the two converge to
+ * the same image.
+ *
+ * What the scene needs on the GPU is uploaded once per tracer: triangles,
+ * normals, uvs, materials, textures, lights, the light table of MIS, the
+ * binary BVH of accel/bvh_build.c (nodes and triangles in leaf order); the
+ * uniform grid of accel/grid.h is built and uploaded on the first use of
+ * RL_GL_PT_GRID (and again for another grid_res).
+ *
+ * Bindings: shader storage 0-15 and image units 0-1 are gl-pt's; 16-23
+ * stay free for the Line Space (docs/gl.md).
+ *
+ * A tracer owns its own GL context (gl_context.h), current on the calling
+ * thread for the length of one call: calls must not overlap, but
+ * consecutive ones may come from different threads. */
+#ifndef RL_GL_PT_H
+#define RL_GL_PT_H
+
+#include "rl/rl_accel.h"
+#include "rl/rl_camera.h"
+#include "rl/rl_gl.h"
+#include "rl/rl_scene.h"
+
+typedef struct rl_gl_pt rl_gl_pt;
+
+/* The structures shadow and secondary rays can go through. */
+typedef enum rl_gl_pt_structure { RL_GL_PT_BVH = 0, RL_GL_PT_GRID, RL_GL_PT_STRUCTURE_COUNT } rl_gl_pt_structure;
+
+/* The light set of pt's next-event estimation (pathtrace_lights.c: the
+ * table of lights chosen by power with mis=on) and the emission rule's
+ * covering quad light per triangle, as plain arrays the caller keeps. */
+typedef struct rl_gl_pt_lights {
+    uint32_t count;                /* table entries */
+    const uint32_t *source;        /* count: a light index, or num_lights + triangle */
+    const float *cdf;              /* count + 1 */
+    const float *light_pmf;        /* per scene light */
+    const bool *light_hittable;    /* per scene light */
+    const float *tri_pmf;          /* per triangle */
+    const uint32_t *tri_cover;     /* per triangle: covering quad light or RL_NONE */
+} rl_gl_pt_lights;
+
+typedef struct rl_gl_pt_desc {
+    const char *device;            /* rl_gl.h */
+    int threads;                   /* BVH and grid build threads (0: all) */
+    float eps;                     /* ray origin offset (pt's) */
+    rl_gl_pt_lights lights;
+} rl_gl_pt_desc;
+
+/* One frame's settings; the names are pt's options (pathtrace.c). */
+typedef struct rl_gl_pt_frame {
+    rl_camera_frame cam;
+    int spp, max_depth, rr_depth, light_samples;
+    bool rr, mis;
+    bool mis_hits, tri_lights;     /* pt_ctx's: exact backends, so both true with mis */
+    int rng;                       /* 0: sobol, else rl_rng_gpu_kind + 1 */
+    rl_gl_pt_structure shadow, diffuse;
+    int grid_res;                  /* 0: the grid heuristic */
+    rl_vec3 background;
+    /* Non-NULL: a new accumulation of cam.width x cam.height pixels starts
+     * from these per-pixel states (4 words each, row 0 the top row: the
+     * generator state, or for sobol the scramble seed in the first). */
+    const uint32_t *reset_states;
+} rl_gl_pt_frame;
+
+/* A tracer of scene (committed). RL_ERR_UNSUPPORTED where no GL 4.5
+ * context can be made (with the reason), RL_ERR_LIMIT where the scene's
+ * arrays exceed the GL's storage block size, RL_ERR_INTERNAL for a GL or
+ * shader error. desc's arrays are copied. */
+rl_status rl_gl_pt_create(const rl_scene *scene, const rl_gl_pt_desc *desc, rl_gl_pt **out);
+void rl_gl_pt_release(rl_gl_pt *pt);      /* NULL is a no-op */
+const rl_gl_info *rl_gl_pt_info(const rl_gl_pt *pt);
+
+/* Traces frame->spp samples per pixel and adds them to the accumulation
+ * (Sec. 6.5, eq. 8); rgba (4 floats per pixel, may be NULL) gets the
+ * accumulated mean. RL_ERR_INVALID_ARG without reset_states on the first
+ * frame or a size change. *samples: per pixel after this frame. */
+rl_status rl_gl_pt_render(rl_gl_pt *pt, const rl_gl_pt_frame *frame, float *rgba, uint64_t *samples);
+
+/* Traces n rays through structure on the GPU (closest hit, or with any the
+ * first hit found) into hits (t, u, v, triangle; the object is left
+ * RL_ID_NONE; t = INFINITY and triangle RL_ID_NONE on a miss): the ray set
+ * the tests compare with the CPU's structures. grid_res as in the frame. */
+rl_status rl_gl_pt_trace(rl_gl_pt *pt, rl_gl_pt_structure structure, int grid_res, bool any, const rl_ray *rays,
+                         uint32_t n, rl_hit *hits);
+
+/* The shader texts (gl_pt_shaders.c). */
+extern const char *const rl_gl_pt_glsl_header;
+extern const char *const rl_gl_pt_glsl_common;
+extern const char *const rl_gl_pt_glsl_path;
+extern const char *const rl_gl_pt_glsl_rays;
+
+#endif

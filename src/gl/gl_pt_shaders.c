@@ -1,0 +1,977 @@
+/* gl_pt_shaders.c: the GLSL 4.50 compute shaders of gl-pt (gl_pt.h), the
+ * path tracer "pt" (src/render/pathtrace*.c) on the GPU as Schröder 2017
+ * runs it (Ch. 5, 6). Each function mirrors the C function of pt named
+ * beside it, step for step, so that both compute the same estimator with
+ * the same sample numbers; docs/gl.md ("gl-pt") lists what is not ported.
+ *
+ *   scene buffers     materials, lights, textures, triangles (bindings 0-9)
+ *   hash64, sobol     pathtrace_sampler.c: Owen-scrambled Sobol points; the
+ *                     64-bit hash in pairs of 32-bit words (GLSL 4.50 core
+ *                     has no 64-bit integers)
+ *   rng_next          core/rng_gpu.c: LCG, Tausworthe, hybrid (Sec. 5.3),
+ *                     the state in an rgba32ui image (the state texture)
+ *   wt_hit            accel/watertight.h (Woop, Benthin, Wald 2013)
+ *   bvh_query         the binary BVH of accel/bvh_build.c, flattened to
+ *                     SSBOs: stack-based, near child first (Sec. 5.4 names
+ *                     the BVH as the exact alternative of the thesis)
+ *   grid_query        accel/grid.c: a 3-D DDA (Amanatides & Woo 1987) over
+ *                     the cells' offsets and triangle lists (Sec. 5.4)
+ *   surface_*, phong_ pathtrace_path.c, pathtrace_bsdf.c
+ *   direct_light*     Shade (Sec. 6.4.2, 6.3), with MIS (pathtrace_path.c)
+ *   trace_path        rl_pt_trace_path (Sec. 6.4)
+ *   main (path)       one sample of every pixel: jittered camera ray
+ *                     through the BVH (primary=trace), the path, eq. 8 of
+ *                     Sec. 6.5 into the rgba32f accumulation image
+ *   main (rays)       a fixed ray set through one structure, for the tests
+ *                     that compare it with the CPU's ray for ray */
+#include "gl/gl_pt.h"
+
+#ifdef RL_HAVE_GL
+
+#define GLSL(...) #__VA_ARGS__ "\n"
+
+const char *const rl_gl_pt_glsl_header = "#version 450 core\n";
+
+const char *const rl_gl_pt_glsl_common = GLSL(
+    const uint NONE = 0xffffffffu;
+    const float PI = 3.14159265358979323846;
+
+    struct Material { vec4 diffuse; vec4 specular; vec4 emission; vec4 extra; uvec4 tex; };
+    struct Light { vec4 pos; vec4 power; vec4 dir; vec4 extra; };
+    struct TexInfo { uint offset; int width; int height; int pad; };
+    struct Node { vec4 lo; vec4 hi; };
+    struct Hit { float t; float u; float v; uint tri; };
+
+    layout(std430, binding = 0) readonly buffer Materials { Material materials[]; };
+    layout(std430, binding = 1) readonly buffer Lights { Light lights[]; };
+    layout(std430, binding = 2) readonly buffer TexInfos { TexInfo tex_info[]; };
+    layout(std430, binding = 3) readonly buffer Texels { vec4 texels[]; };
+    layout(std430, binding = 4) readonly buffer Triangles { uvec4 triangles[]; };
+    layout(std430, binding = 5) readonly buffer Positions { float positions[]; };
+    layout(std430, binding = 6) readonly buffer Normals { float normals[]; };
+    layout(std430, binding = 7) readonly buffer Uvs { float uvs[]; };
+    layout(std430, binding = 8) readonly buffer BvhNodes { Node nodes[]; };
+    layout(std430, binding = 9) readonly buffer BvhTris { vec4 bvh_tris[]; };
+    layout(std430, binding = 10) readonly buffer CellStart { uint cell_start[]; };
+    layout(std430, binding = 11) readonly buffer CellTris { uint cell_tris[]; };
+
+    uniform uint u_num_nodes;
+    uniform bool u_masks;
+    uniform vec3 u_grid_min;
+    uniform vec3 u_grid_cell;
+    uniform vec3 u_grid_inv_cell;
+    uniform ivec3 u_grid_res;
+
+    bool finite3(vec3 v) { return !any(isnan(v)) && !any(isinf(v)); }
+    float max_comp(vec3 v) { return max(max(v.x, v.y), v.z); }
+    vec3 position(uint i) { return vec3(positions[3u * i], positions[3u * i + 1u], positions[3u * i + 2u]); }
+    vec3 normal_at(uint i) { return vec3(normals[3u * i], normals[3u * i + 1u], normals[3u * i + 2u]); }
+    vec2 uv_at(uint i) { return vec2(uvs[2u * i], uvs[2u * i + 1u]); }
+
+    /* core/texture_sample.h: bilinear, repeat, texel centres at
+     * half-integers, v up (as gl_shaders.c tex_sample). */
+    vec4 texel_at(TexInfo t, int x, int y)
+    {
+        return texels[t.offset + uint(clamp(y, 0, t.height - 1) * t.width + clamp(x, 0, t.width - 1))];
+    }
+
+    vec4 tex_sample(uint tex, vec2 uv)
+    {
+        TexInfo t = tex_info[tex];
+        float u = isnan(uv.x) || isinf(uv.x) ? 0.0 : uv.x - floor(uv.x);
+        float v = isnan(uv.y) || isinf(uv.y) ? 0.0 : uv.y - floor(uv.y);
+        float fx = u * float(t.width) - 0.5;
+        float fy = (1.0 - v) * float(t.height) - 0.5;
+        float x0f = floor(fx), y0f = floor(fy);
+        float tx = fx - x0f, ty = fy - y0f;
+        int x0 = int(x0f), y0 = int(y0f);
+        int x1 = x0 + 1, y1 = y0 + 1;
+        x0 += x0 < 0 ? t.width : 0;
+        y0 += y0 < 0 ? t.height : 0;
+        x1 -= x1 >= t.width ? t.width : 0;
+        y1 -= y1 >= t.height ? t.height : 0;
+        return (1.0 - tx) * (1.0 - ty) * texel_at(t, x0, y0) + tx * (1.0 - ty) * texel_at(t, x1, y0) +
+               (1.0 - tx) * ty * texel_at(t, x0, y1) + tx * ty * texel_at(t, x1, y1);
+    }
+
+    vec2 interp_uv(uint tri, float u, float v)
+    {
+        uvec4 T = triangles[tri];
+        float w = 1.0 - u - v;
+        vec2 t0 = uv_at(T.x), t1 = uv_at(T.y), t2 = uv_at(T.z);
+        return vec2(w * t0.x + u * t1.x + v * t2.x, w * t0.y + u * t1.y + v * t2.y);
+    }
+
+    /* scene/material.c rl_alpha_masked: a hit in a mask's hole is no hit
+     * (the CPU asks again beyond it; skipping it in the loop is the same). */
+    bool masked(uint tri, float u, float v)
+    {
+        if (!u_masks)
+            return false;
+        Material m = materials[triangles[tri].w];
+        if (m.tex.z == NONE)
+            return false;
+        return tex_sample(m.tex.z, interp_uv(tri, u, v)).w < m.extra.z;
+    }
+
+    /* accel/watertight.c: the axis permutation and shear of a ray. The
+     * permutation is a matrix of unit rows (kx, ky, kz): a product with it
+     * picks the components exactly, where indexing a vector by a varying
+     * component costs a scalar access per thread on SIMD hardware. */
+    struct WRay { mat3 perm; vec3 s; vec3 o; };
+
+    WRay wt_setup(vec3 o, vec3 d)
+    {
+        vec3 a = abs(d);
+        int kz = a.x > a.y ? (a.x > a.z ? 0 : 2) : (a.y > a.z ? 1 : 2);
+        int kx = kz == 2 ? 0 : kz + 1;
+        int ky = kx == 2 ? 0 : kx + 1;
+        float dz = kz == 0 ? d.x : (kz == 1 ? d.y : d.z);
+        if (dz < 0.0) {
+            int s = kx;
+            kx = ky;
+            ky = s;
+        }
+        vec3 ex = vec3(equal(ivec3(kx), ivec3(0, 1, 2)));
+        vec3 ey = vec3(equal(ivec3(ky), ivec3(0, 1, 2)));
+        vec3 ez = vec3(equal(ivec3(kz), ivec3(0, 1, 2)));
+        WRay w;
+        w.perm = transpose(mat3(ex, ey, ez));
+        w.s = vec3(dot(d, ex) / dz, dot(d, ey) / dz, 1.0 / dz);
+        w.o = o;
+        return w;
+    }
+
+    /* accel/watertight.h rl_watertight_hit_k, operation for operation
+     * (A = (p0 - o) permuted is its (p0[kx] - ox, p0[ky] - oy, p0[kz] - oz));
+     * the exact fallback in double as there. */
+    bool wt_hit(WRay w, vec3 p0, vec3 p1, vec3 p2, float t_min, float t_max, out float t, out float u, out float v)
+    {
+        t = 0.0;
+        u = 0.0;
+        v = 0.0;
+        precise vec3 A = w.perm * (p0 - w.o), B = w.perm * (p1 - w.o), C = w.perm * (p2 - w.o);
+        float Az = A.z, Bz = B.z, Cz = C.z;
+        precise float Ax = A.x - w.s.x * Az, Ay = A.y - w.s.y * Az;
+        precise float Bx = B.x - w.s.x * Bz, By = B.y - w.s.y * Bz;
+        precise float Cx = C.x - w.s.x * Cz, Cy = C.y - w.s.y * Cz;
+        precise float U = Cx * By - Cy * Bx;
+        precise float V = Ax * Cy - Ay * Cx;
+        precise float W = Bx * Ay - By * Ax;
+        if (U == 0.0 || V == 0.0 || W == 0.0) {
+            U = float(double(Cx) * double(By) - double(Cy) * double(Bx));
+            V = float(double(Ax) * double(Cy) - double(Ay) * double(Cx));
+            W = float(double(Bx) * double(Ay) - double(By) * double(Ax));
+        }
+        if ((U < 0.0 || V < 0.0 || W < 0.0) && (U > 0.0 || V > 0.0 || W > 0.0))
+            return false;
+        float det = U + V + W;
+        if (det == 0.0)
+            return false;
+        Az *= w.s.z;
+        Bz *= w.s.z;
+        Cz *= w.s.z;
+        float T = U * Az + V * Bz + W * Cz;
+        float det_abs = abs(det), T_abs = det < 0.0 ? -T : T;
+        if (t_min >= 0.0 && T_abs <= 0.0)
+            return false;
+        float bound = t_max * det_abs * (1.0 + 1.52587890625e-05);
+        if (bound > 7.888609052210118e-31 && T_abs > bound)
+            return false;
+        float th = T / det;
+        if (!(th > t_min && th < t_max))
+            return false;
+        t = th;
+        u = V / det;
+        v = W / det;
+        return true;
+    }
+
+    /* Slab test of a node's box against [t_min, t_max]. */
+    bool box_hit(vec3 lo, vec3 hi, vec3 o, vec3 inv, float t_min, float t_max)
+    {
+        vec3 a = (lo - o) * inv, b = (hi - o) * inv;
+        vec3 n = min(a, b), f = max(a, b);
+        float tn = max(max(n.x, n.y), max(n.z, t_min));
+        float tf = min(min(f.x, f.y), min(f.z, t_max));
+        return tn <= tf;
+    }
+
+    /* The binary BVH (accel/bvh.h rl_bvh_node: the two children of an inner
+     * node adjacent, count and split axis in the last word), its leaves'
+     * triangles in leaf order (3 vec4 each, the scene ID in the first w).
+     * Closest hit into h (t_max shrinks), or with any_hit the first hit. */
+    bool bvh_query(vec3 o, vec3 d, float t_min, float t_max, bool any_hit, out Hit h)
+    {
+        h = Hit(t_max, 0.0, 0.0, NONE);
+        if (u_num_nodes == 0u)
+            return false;
+        WRay w = wt_setup(o, d);
+        vec3 inv = 1.0 / d;
+        uint stack[BVH_STACK];
+        int sp = 0;
+        uint node = 0u;
+        while (true) {
+            Node n = nodes[node];
+            bool descend = false;
+            if (box_hit(n.lo.xyz, n.hi.xyz, o, inv, t_min, h.t)) {
+                uint bits = floatBitsToUint(n.hi.w), index = floatBitsToUint(n.lo.w);
+                uint count = bits & 0xffffu;
+                if (count > 0u) {
+                    for (uint k = index; k < index + count; ++k) {
+                        vec4 a = bvh_tris[3u * k], b = bvh_tris[3u * k + 1u], c = bvh_tris[3u * k + 2u];
+                        float t, u, v;
+                        if (!wt_hit(w, a.xyz, b.xyz, c.xyz, t_min, h.t, t, u, v))
+                            continue;
+                        uint tri = floatBitsToUint(a.w);
+                        if (masked(tri, u, v))
+                            continue;
+                        h = Hit(t, u, v, tri);
+                        if (any_hit)
+                            return true;
+                    }
+                } else {
+                    uint axis = bits >> 16;
+                    bool flip = (axis == 0u ? d.x : (axis == 1u ? d.y : d.z)) < 0.0;
+                    stack[sp++] = flip ? index : index + 1u;
+                    node = flip ? index + 1u : index;
+                    descend = true;
+                }
+            }
+            if (!descend) {
+                if (sp == 0)
+                    break;
+                node = stack[--sp];
+            }
+        }
+        return h.tri != NONE;
+    }
+
+    /* The uniform grid (accel/grid.h): the cells along the ray front to
+     * back, each cell's triangles by their scene vertices. The closest hit
+     * is final once it lies inside the cell just tested: every nearer
+     * triangle is listed in a cell walked before. */
+    bool grid_query(vec3 o, vec3 d, float t_min, float t_max, bool any_hit, out Hit h)
+    {
+        h = Hit(t_max, 0.0, 0.0, NONE);
+        vec3 inv = 1.0 / d;
+        vec3 gmax = u_grid_min + vec3(u_grid_res) * u_grid_cell;
+        vec3 a = (u_grid_min - o) * inv, b = (gmax - o) * inv;
+        vec3 n = min(a, b), f = max(a, b);
+        float t_enter = max(max(n.x, n.y), max(n.z, t_min));
+        /* widened as rl_grid_dda_begin: a ray grazing the bounds is walked */
+        float t_exit = min(min(f.x, f.y), min(f.z, t_max));
+        t_exit += abs(t_exit) * 1e-6;
+        if (!(t_enter <= t_exit))
+            return false;
+        ivec3 cell = clamp(ivec3(floor((o + d * t_enter - u_grid_min) * u_grid_inv_cell)), ivec3(0), u_grid_res - 1);
+        ivec3 step = ivec3(sign(d));
+        /* per axis the parameter where the walk crosses the next boundary
+         * (recomputed from the plane, as grid.c) */
+        vec3 up = vec3(greaterThan(step, ivec3(0)));
+        vec3 next = (u_grid_min + (vec3(cell) + up) * u_grid_cell - o) * inv;
+        next = mix(next, vec3(INF), equal(step, ivec3(0)));
+        WRay w = wt_setup(o, d);
+        while (true) {
+            uint c = uint(cell.x) + uint(u_grid_res.x) * (uint(cell.y) + uint(u_grid_res.y) * uint(cell.z));
+            for (uint k = cell_start[c]; k < cell_start[c + 1u]; ++k) {
+                uint tri = cell_tris[k];
+                uvec4 T = triangles[tri];
+                float t, u, v;
+                if (!wt_hit(w, position(T.x), position(T.y), position(T.z), t_min, h.t, t, u, v))
+                    continue;
+                if (masked(tri, u, v))
+                    continue;
+                h = Hit(t, u, v, tri);
+                if (any_hit)
+                    return true;
+            }
+            float cell_exit = min(next.x, min(next.y, next.z));
+            if (h.tri != NONE && h.t <= cell_exit)
+                break;
+            if (cell_exit > t_exit)
+                break;
+            /* the axis crossed first: the lowest of x, y, z on a tie */
+            bvec3 m = equal(next, vec3(cell_exit));
+            m = bvec3(m.x, m.y && !m.x, m.z && !m.x && !m.y);
+            cell += ivec3(m) * step;
+            if (any(lessThan(cell, ivec3(0))) || any(greaterThanEqual(cell, u_grid_res)))
+                break;
+            vec3 crossed = (u_grid_min + (vec3(cell) + up) * u_grid_cell - o) * inv;
+            next = mix(next, crossed, m);
+        }
+        return h.tri != NONE;
+    }
+
+    bool query(int structure, vec3 o, vec3 d, float t_min, float t_max, bool any_hit, out Hit h)
+    {
+        if (structure == STRUCT_GRID)
+            return grid_query(o, d, t_min, t_max, any_hit, h);
+        return bvh_query(o, d, t_min, t_max, any_hit, h);
+    }
+);
+
+/* The path tracer: one sample of every pixel per dispatch. */
+const char *const rl_gl_pt_glsl_path = GLSL(
+    layout(local_size_x = LOCAL_SIZE, local_size_y = LOCAL_SIZE) in;
+    layout(rgba32f, binding = 0) uniform image2D u_accum;
+    layout(rgba32ui, binding = 1) uniform uimage2D u_rng_state;
+    layout(std430, binding = 12) readonly buffer LightTable { vec2 light_table[]; };   /* cdf, source bits */
+    layout(std430, binding = 13) readonly buffer TriLight { uvec2 tri_light[]; };      /* cover, pmf bits */
+
+    uniform ivec2 u_size;
+    uniform vec3 u_eye;
+    uniform vec3 u_cam_u;
+    uniform vec3 u_cam_v;
+    uniform vec3 u_cam_w;
+    uniform float u_tan_half_fov;
+    uniform float u_aspect;
+    uniform int u_rng;                 /* 0: sobol, else rl_rng_gpu_kind + 1 */
+    uniform uint u_sample;             /* samples each pixel holds before this one */
+    uniform int u_max_depth;
+    uniform int u_rr_depth;
+    uniform bool u_rr;
+    uniform bool u_mis;
+    uniform bool u_mis_hits;
+    uniform bool u_tri_lights;
+    uniform int u_light_samples;
+    uniform uint u_vertex_slots;
+    uniform int u_num_lights;
+    uniform uint u_table_count;
+    uniform uint u_num_textures;
+    uniform float u_eps;
+    uniform vec3 u_background;
+    uniform int u_shadow;
+    uniform int u_diffuse;
+
+    /* -------------------------------------------------------- sampler -- */
+    const uint SLOT_PIXEL = 0u, SLOT_FIRST_VERTEX = 1u;
+    const uint SLOT_EVENT = 0u, SLOT_LOBE = 1u, SLOT_BSDF = 2u, SLOT_RR = 3u, SLOTS_VERTEX = 4u;
+    const uint SLOT_LIGHT_PICK = 0u, SLOT_LIGHT_POINT = 1u, SLOT_LIGHT_JITTER = 2u, SLOTS_LIGHT = 3u;
+
+    uvec4 g_state;                     /* the generator state, or x: the pixel's scramble seed */
+    uint g_index;
+    uint g_slot;
+
+    /* 64-bit words as (low, high) pairs. */
+    uvec2 add64(uvec2 a, uvec2 b)
+    {
+        uint carry;
+        uint lo = uaddCarry(a.x, b.x, carry);
+        return uvec2(lo, a.y + b.y + carry);
+    }
+    uvec2 mul64(uvec2 a, uvec2 b)
+    {
+        uint hi, lo;
+        umulExtended(a.x, b.x, hi, lo);
+        return uvec2(lo, hi + a.x * b.y + a.y * b.x);
+    }
+    uvec2 shr64(uvec2 a, int s) { return uvec2((a.x >> s) | (a.y << (32 - s)), a.y >> s); }
+
+    /* core/rng.c rl_hash64 (splitmix64). */
+    uvec2 hash64(uvec2 x)
+    {
+        x = add64(x, uvec2(0x7f4a7c15u, 0x9e3779b9u));
+        x = mul64(x ^ shr64(x, 30), uvec2(0x1ce4e5b9u, 0xbf58476du));
+        x = mul64(x ^ shr64(x, 27), uvec2(0x133111ebu, 0x94d049bbu));
+        return x ^ shr64(x, 31);
+    }
+
+    uint scramble_reversed(uint x, uint seed)
+    {
+        x += seed;
+        x ^= x * 0x2c1b3c6cu;
+        x *= (seed >> 1) | 1u;
+        x ^= x * 0x95a4e8d2u;
+        x += seed * 0x632be5abu;
+        x ^= x * 0xa3d15f40u;
+        x *= 0x8bb84b93u;
+        x ^= x * 0x5e27a3f6u;
+        return x;
+    }
+    uint owen_scramble(uint x, uint seed) { return bitfieldReverse(scramble_reversed(bitfieldReverse(x), seed)); }
+
+    const uint sobol1_v[24] = uint[](
+        0x80000000u, 0xc0000000u, 0xa0000000u, 0xf0000000u, 0x88000000u, 0xcc000000u, 0xaa000000u, 0xff000000u,
+        0x80800000u, 0xc0c00000u, 0xa0a00000u, 0xf0f00000u, 0x88880000u, 0xcccc0000u, 0xaaaa0000u, 0xffff0000u,
+        0x80008000u, 0xc000c000u, 0xa000a000u, 0xf000f000u, 0x88008800u, 0xcc00cc00u, 0xaa00aa00u, 0xff00ff00u);
+
+    uint sobol_dim1(uint i)
+    {
+        uint r = 0u;
+        for (i &= 0xffffffu; i != 0u; i &= i - 1u)
+            r ^= sobol1_v[findLSB(i)];
+        return r;
+    }
+
+    uvec3 slot_seeds(uint slot)
+    {
+        uvec2 h = hash64(uvec2(slot, g_state.x));
+        uint s2 = mul64(h, uvec2(0xde82ef95u, 0xd1342543u)).y ^ h.x;
+        return uvec3(h.x, h.y, s2);
+    }
+
+    float to_unit(uint x) { return float(x >> 8) * (1.0 / 16777216.0); }
+
+    /* core/rng_gpu.c */
+    uint ctg_step(uint x, int s1, int s2, int s3, uint m) { return ((x & m) << s3) ^ (((x << s1) ^ x) >> s2); }
+
+    uint rng_next()
+    {
+        if (u_rng == 1) {
+            g_state.w = 1664525u * g_state.w + 1013904223u;
+            return g_state.w;
+        }
+        g_state.x = ctg_step(g_state.x, 13, 19, 12, 4294967294u);
+        g_state.y = ctg_step(g_state.y, 2, 25, 4, 4294967288u);
+        g_state.z = ctg_step(g_state.z, 3, 11, 17, 4294967280u);
+        uint x = g_state.x ^ g_state.y ^ g_state.z;
+        if (u_rng == 3) {
+            g_state.w = 1664525u * g_state.w + 1013904223u;
+            x ^= g_state.w;
+        }
+        return x;
+    }
+
+    /* x 2^-32, as rl_rng_gpu_float; below 1 where rounding would reach it */
+    float rng_float() { return min(float(rng_next()) * 2.3283064365386963e-10, 0.99999994); }
+
+    void seek(uint slot) { g_slot = slot; }
+
+    float sample_1d()
+    {
+        if (u_rng != 0)
+            return rng_float();
+        uvec3 seed = slot_seeds(g_slot++);
+        uint d0 = scramble_reversed(bitfieldReverse(g_index), seed.x);
+        return to_unit(owen_scramble(d0, seed.y));
+    }
+
+    vec2 sample_2d()
+    {
+        if (u_rng != 0) {
+            float a = rng_float();
+            return vec2(a, rng_float());
+        }
+        uvec3 seed = slot_seeds(g_slot++);
+        uint d0 = scramble_reversed(bitfieldReverse(g_index), seed.x);
+        return vec2(to_unit(owen_scramble(d0, seed.y)), to_unit(owen_scramble(sobol_dim1(bitfieldReverse(d0)), seed.z)));
+    }
+
+    /* -------------------------------------------------------- surface -- */
+    struct Surf { vec3 p; vec3 ng; vec3 ns; vec3 v; bool front; vec3 kd; vec2 uv; uint mat; uint tri; };
+
+    /* scene/material.c rl_shading_normal */
+    vec3 shading_normal(uint tri, Material m, vec3 ns, vec2 uv)
+    {
+        uint tex = m.tex.y;
+        if (tex == NONE)
+            return ns;
+        vec3 n = normalize(ns);
+        if (!finite3(n))
+            return ns;
+        uvec4 T = triangles[tri];
+        vec3 e1 = position(T.y) - position(T.x), e2 = position(T.z) - position(T.x);
+        vec2 t0 = uv_at(T.x), t1 = uv_at(T.y), t2 = uv_at(T.z);
+        float du1 = t1.x - t0.x, dv1 = t1.y - t0.y, du2 = t2.x - t0.x, dv2 = t2.y - t0.y;
+        float det = du1 * dv2 - du2 * dv1;
+        if (!(abs(det) > 1e-20))
+            return n;
+        float inv = 1.0 / det;
+        vec3 Tg = (e1 * dv2 - e2 * dv1) * inv;
+        vec3 B = (e2 * du1 - e1 * du2) * inv;
+        Tg = Tg - n * dot(n, Tg);
+        if (!(dot(Tg, Tg) > 0.0) || !finite3(Tg))
+            return n;
+        Tg = normalize(Tg);
+        vec3 Bo = cross(n, Tg);
+        if (dot(Bo, B) < 0.0)
+            Bo = -Bo;
+        vec4 texel = tex_sample(tex, uv);
+        float x = (2.0 * texel.x - 1.0) * m.emission.w, y = (2.0 * texel.y - 1.0) * m.emission.w;
+        float z = 2.0 * texel.z - 1.0;
+        vec3 bent = Tg * x + Bo * y + n * z;
+        return dot(bent, bent) > 0.0 && finite3(bent) ? normalize(bent) : n;
+    }
+
+    /* rl_pt_surface_at_hit + rl_pt_surface_finish */
+    Surf surface_at(Hit h, vec3 dir)
+    {
+        uvec4 T = triangles[h.tri];
+        float u = h.u, v = h.v, w = 1.0 - u - v;
+        vec3 p0 = position(T.x), p1 = position(T.y), p2 = position(T.z);
+        Surf s;
+        s.p = p0 * w + p1 * u + p2 * v;
+        vec3 ns = normal_at(T.x) * w + normal_at(T.y) * u + normal_at(T.z) * v;
+        s.uv = interp_uv(h.tri, u, v);
+        s.v = -normalize(dir);
+        vec3 ng = normalize(cross(p1 - p0, p2 - p0));
+        Material m = materials[T.w];
+        ns = normalize(shading_normal(h.tri, m, ns, s.uv));
+        if (!(dot(ns, ns) > 0.0) || !finite3(ns))
+            ns = ng;
+        s.front = dot(ng, s.v) > 0.0;
+        s.ng = s.front ? ng : -ng;
+        s.ns = dot(ns, s.v) < 0.0 ? -ns : ns;
+        s.mat = T.w;
+        s.kd = m.diffuse.rgb;
+        if (m.tex.x != NONE)
+            s.kd *= tex_sample(m.tex.x, s.uv).rgb;
+        s.tri = h.tri;
+        return s;
+    }
+
+    /* ----------------------------------------------------------- BSDF -- */
+    float mean3(vec3 c) { return (c.x + c.y + c.z) * (1.0 / 3.0); }
+    vec3 mirror_dir(Surf s) { return s.ns * (2.0 * dot(s.ns, s.v)) - s.v; }
+    float lobe(vec3 r, vec3 wi, float n)
+    {
+        float c = dot(r, wi);
+        return c > 0.0 ? pow(c, n) : 0.0;
+    }
+
+    vec3 phong_eval(Surf s, vec3 wi)
+    {
+        Material m = materials[s.mat];
+        vec3 f = s.kd * (1.0 / PI);
+        if (max_comp(m.specular.rgb) > 0.0) {
+            float n = max(m.specular.w, 0.0);
+            f += m.specular.rgb * ((n + 2.0) * 0.5 * (1.0 / PI) * lobe(mirror_dir(s), wi, n));
+        }
+        return f;
+    }
+
+    float diffuse_probability(Surf s)
+    {
+        float wd = mean3(s.kd), ws = mean3(materials[s.mat].specular.rgb);
+        if (!(wd + ws > 0.0))
+            return -1.0;
+        return wd / (wd + ws);
+    }
+
+    float phong_pdf(Surf s, vec3 wi)
+    {
+        float pd = diffuse_probability(s);
+        float cos_theta = dot(s.ns, wi);
+        if (pd < 0.0 || cos_theta <= 0.0)
+            return 0.0;
+        float n = max(materials[s.mat].specular.w, 0.0);
+        float pdf = pd * cos_theta / PI;
+        if (pd < 1.0)
+            pdf += (1.0 - pd) * (n + 1.0) * 0.5 / PI * lobe(mirror_dir(s), wi, n);
+        return pdf;
+    }
+
+    /* rl_onb_from_normal / rl_onb_to_world */
+    vec3 around(vec3 a, float cos_t, float phi)
+    {
+        float sg = a.z < 0.0 || (a.z == 0.0 && floatBitsToUint(a.z) != 0u) ? -1.0 : 1.0;
+        float k = -1.0 / (sg + a.z);
+        float b = a.x * a.y * k;
+        vec3 t = vec3(1.0 + sg * a.x * a.x * k, sg * b, -sg * a.x);
+        vec3 bt = vec3(b, sg + a.y * a.y * k, -a.y);
+        float sin_t = sqrt(max(0.0, 1.0 - cos_t * cos_t));
+        return t * (cos(phi) * sin_t) + bt * (sin(phi) * sin_t) + a * cos_t;
+    }
+
+    bool phong_sample(Surf s, float u_lobe, float u1, float u2, out vec3 wi, out vec3 weight)
+    {
+        wi = vec3(0.0);
+        weight = vec3(0.0);
+        float pd = diffuse_probability(s);
+        if (pd < 0.0)
+            return false;
+        float phi = 2.0 * PI * u2;
+        vec3 dir;
+        if (u_lobe < pd) {
+            dir = around(s.ns, sqrt(1.0 - u1), phi);
+        } else {
+            float n = max(materials[s.mat].specular.w, 0.0);
+            dir = around(mirror_dir(s), pow(u1, 1.0 / (n + 1.0)), phi);
+        }
+        float cos_theta = dot(s.ns, dir);
+        if (cos_theta <= 0.0 || dot(s.ng, dir) <= 0.0)
+            return false;
+        float pdf = phong_pdf(s, dir);
+        if (!(pdf > 0.0))
+            return false;
+        wi = dir;
+        weight = phong_eval(s, dir) * (cos_theta / pdf);
+        return true;
+    }
+
+    /* --------------------------------------------------------- lights -- */
+    vec3 offset_origin(Surf s, vec3 dir) { return s.p + s.ng * ((dot(dir, s.ng) >= 0.0 ? 1.0 : -1.0) * u_eps); }
+
+    /* pathtrace_path.c visible(): the shadow ray aimed at the light point
+     * from the offset origin, stopped 1e-4 short of it. */
+    bool visible(Surf s, vec3 l, float dist)
+    {
+        vec3 o = offset_origin(s, l);
+        vec3 d = l;
+        float t_max = INF;
+        if (!isinf(dist)) {
+            vec3 to = (s.p + l * dist) - o;
+            float len = length(to);
+            if (len > 0.0)
+                d = to * (1.0 / len);
+            t_max = len * (1.0 - 1e-4);
+        }
+        Hit h;
+        return !query(u_shadow, o, d, 0.0, t_max, true, h);
+    }
+
+    /* scene/light_eval.c rl_light_eval_delta (the spot's cosines and the
+     * directional direction precomputed in the record) */
+    bool light_delta(Light L, vec3 p, out vec3 E, out vec3 l, out float dist)
+    {
+        int kind = int(L.pos.w);
+        E = vec3(0.0);
+        l = vec3(0.0);
+        dist = INF;
+        if (kind == LIGHT_DIRECTIONAL) {
+            l = L.dir.xyz;
+            E = L.power.rgb;
+            return L.extra.y > 0.0;
+        }
+        vec3 to_light = L.pos.xyz - p;
+        float d2 = dot(to_light, to_light);
+        if (!(d2 > 0.0))
+            return false;
+        dist = sqrt(d2);
+        l = to_light * (1.0 / dist);
+        float falloff = 1.0 / d2;
+        if (kind == LIGHT_SPOT) {
+            float cos_axis = dot(-l, L.dir.xyz);
+            float cos_outer = L.dir.w, cos_inner = L.extra.x;
+            falloff *= cos_inner > cos_outer ? smoothstep(cos_outer, cos_inner, cos_axis)
+                                             : (cos_axis >= cos_outer ? 1.0 : 0.0);
+        }
+        E = L.power.rgb * falloff;
+        return falloff > 0.0;
+    }
+
+    /* direct_light (mis=off): every light, light_samples points per quad */
+    vec3 direct_light(Surf s, uint base)
+    {
+        vec3 sum = vec3(0.0);
+        for (int i = 0; i < u_num_lights; ++i) {
+            Light L = lights[i];
+            uint light_base = base + SLOTS_VERTEX + SLOTS_LIGHT * uint(i) * uint(u_light_samples);
+            if (int(L.pos.w) == LIGHT_QUAD) {
+                vec3 nq = cross(L.dir.xyz, L.extra.xyz);
+                float area = length(nq);
+                if (!(area > 0.0))
+                    continue;
+                nq *= 1.0 / area;
+                int n = u_light_samples;
+                vec3 le = L.power.rgb * (area / float(n));
+                for (int k = 0; k < n; ++k) {
+                    seek(light_base + SLOTS_LIGHT * uint(k) + SLOT_LIGHT_POINT);
+                    vec2 x = sample_2d();
+                    vec3 q = L.pos.xyz + (L.dir.xyz * x.x + L.extra.xyz * x.y);
+                    vec3 to = q - s.p;
+                    float d2 = dot(to, to);
+                    if (!(d2 > 0.0))
+                        continue;
+                    float dist = sqrt(d2);
+                    vec3 l = to * (1.0 / dist);
+                    float cos_e = -dot(nq, l), cos_r = dot(s.ns, l);
+                    if (cos_e <= 0.0 || cos_r <= 0.0 || !visible(s, l, dist))
+                        continue;
+                    sum += phong_eval(s, l) * (le * (cos_e * cos_r / d2));
+                }
+                continue;
+            }
+            vec3 E, l;
+            float dist;
+            if (!light_delta(L, s.p, E, l, dist))
+                continue;
+            float cos_r = dot(s.ns, l);
+            if (cos_r <= 0.0 || !visible(s, l, dist))
+                continue;
+            sum += phong_eval(s, l) * (E * cos_r);
+        }
+        return sum;
+    }
+
+    float power_heuristic(float a, float b)
+    {
+        if (!(a > 0.0))
+            return 0.0;
+        float r = b / a;
+        return 1.0 / (1.0 + r * r);
+    }
+
+    float bsdf_pdf(Surf s, vec3 wi) { return dot(s.ng, wi) > 0.0 ? phong_pdf(s, wi) : 0.0; }
+
+    float triangle_area(uint tri, out vec3 n)
+    {
+        uvec4 T = triangles[tri];
+        vec3 p0 = position(T.x);
+        vec3 c = cross(position(T.y) - p0, position(T.z) - p0);
+        float len = length(c);
+        n = len > 0.0 ? c * (1.0 / len) : vec3(0.0, 0.0, 1.0);
+        return 0.5 * len;
+    }
+
+    /* rl_pt_lights_pick: the last k with cdf[k] <= u */
+    uint pick_light(float u)
+    {
+        uint lo = 0u, hi = u_table_count;
+        while (hi - lo > 1u) {
+            uint mid = lo + (hi - lo) / 2u;
+            if (light_table[mid].x <= u)
+                lo = mid;
+            else
+                hi = mid;
+        }
+        return lo;
+    }
+
+    /* direct_light_mis */
+    vec3 direct_light_mis(Surf s, uint base, bool bsdf_follows)
+    {
+        if (u_table_count == 0u)
+            return vec3(0.0);
+        int n = u_light_samples;
+        vec3 sum = vec3(0.0);
+        for (int k = 0; k < n; ++k) {
+            uint slot = base + SLOTS_VERTEX + SLOTS_LIGHT * uint(k);
+            seek(slot + SLOT_LIGHT_PICK);
+            float u_pick = u_table_count > 1u ? sample_1d() : 0.0;
+            seek(slot + SLOT_LIGHT_POINT);
+            vec2 x = sample_2d();
+            uint src = floatBitsToUint(light_table[pick_light(u_pick)].y);
+            vec3 q, n_e, le;
+            float area, pmf;
+            bool hittable;
+            bool is_light = src < uint(u_num_lights);
+            if (is_light) {
+                Light L = lights[src];
+                pmf = L.power.w;
+                if (int(L.pos.w) != LIGHT_QUAD) {
+                    vec3 E, l;
+                    float dist;
+                    if (!light_delta(L, s.p, E, l, dist))
+                        continue;
+                    float cos_r = dot(s.ns, l);
+                    if (cos_r <= 0.0 || !visible(s, l, dist))
+                        continue;
+                    sum += phong_eval(s, l) * (E * (cos_r / (pmf * float(n))));
+                    continue;
+                }
+                n_e = cross(L.dir.xyz, L.extra.xyz);
+                area = length(n_e);
+                n_e *= 1.0 / area;
+                q = L.pos.xyz + (L.dir.xyz * x.x + L.extra.xyz * x.y);
+                le = L.power.rgb;
+                hittable = u_mis_hits && L.extra.w > 0.0;
+            } else {
+                if (!u_tri_lights)
+                    continue;
+                uint t = src - uint(u_num_lights);
+                uvec4 T = triangles[t];
+                pmf = uintBitsToFloat(tri_light[t].y);
+                area = triangle_area(t, n_e);
+                float r = sqrt(x.x), b1 = x.y * r, b0 = 1.0 - r;
+                q = position(T.x) * b0 + position(T.y) * b1 + position(T.z) * (1.0 - b0 - b1);
+                le = materials[T.w].emission.rgb;
+                hittable = true;
+            }
+            vec3 to = q - s.p;
+            float d2 = dot(to, to);
+            if (!(d2 > 0.0))
+                continue;
+            float dist = sqrt(d2);
+            vec3 l = to * (1.0 / dist);
+            float cos_e = is_light ? -dot(n_e, l) : abs(dot(n_e, l));
+            float cos_r = dot(s.ns, l);
+            if (cos_e <= 0.0 || cos_r <= 0.0 || !visible(s, l, dist))
+                continue;
+            float p_light = pmf * d2 / (area * cos_e);
+            float w = bsdf_follows && hittable ? power_heuristic(float(n) * p_light, bsdf_pdf(s, l)) : 1.0;
+            sum += phong_eval(s, l) * (le * (w * cos_r / (p_light * float(n))));
+        }
+        return sum;
+    }
+
+    /* emitted: the emission rule of pathtrace_path.c */
+    vec3 emitted(Surf s, bool after_brdf)
+    {
+        vec3 e = materials[s.mat].emission.rgb;
+        if (!(max_comp(e) > 0.0))
+            return vec3(0.0);
+        uint cover = tri_light[s.tri].x;
+        if (cover == NONE)
+            return e;
+        Light L = lights[cover];
+        bool emitting_side = dot(s.v, cross(L.dir.xyz, L.extra.xyz)) > 0.0;
+        return emitting_side && !after_brdf ? e : vec3(0.0);
+    }
+
+    vec3 emitted_mis(Surf s, bool after_brdf, vec3 prev, float pdf_bsdf)
+    {
+        if (!after_brdf || !u_mis_hits)
+            return emitted(s, after_brdf);
+        vec3 e = materials[s.mat].emission.rgb;
+        if (!(max_comp(e) > 0.0))
+            return emitted(s, after_brdf);
+        uint cover = tri_light[s.tri].x;
+        float pmf, area;
+        if (cover == NONE) {
+            if (!u_tri_lights)
+                return e;
+            pmf = uintBitsToFloat(tri_light[s.tri].y);
+            vec3 n_unused;
+            area = triangle_area(s.tri, n_unused);
+        } else {
+            Light L = lights[cover];
+            vec3 nq = cross(L.dir.xyz, L.extra.xyz);
+            if (!(dot(s.v, nq) > 0.0) || !(L.extra.w > 0.0))
+                return vec3(0.0);
+            e = L.power.rgb;
+            pmf = L.power.w;
+            area = length(nq);
+        }
+        float cos_e = dot(s.ng, s.v);
+        vec3 dp = s.p - prev;
+        float d2 = dot(dp, dp);
+        if (!(pmf > 0.0) || !(cos_e > 0.0) || !(area > 0.0))
+            return e;
+        float p_light = pmf * d2 / (area * cos_e);
+        return e * power_heuristic(pdf_bsdf, float(u_light_samples) * p_light);
+    }
+
+    /* ----------------------------------------------------------- path -- */
+    vec3 trace_path(Surf first)
+    {
+        vec3 radiance = vec3(0.0), T = vec3(1.0);
+        Surf s = first;
+        bool after_brdf = false;
+        vec3 prev = s.p;
+        float prev_pdf = 0.0;
+        bool gen = u_rng != 0;
+        for (int depth = 0;; ++depth) {
+            uint base = SLOT_FIRST_VERTEX + uint(depth) * u_vertex_slots;
+            Material m = materials[s.mat];
+            vec3 e = u_mis ? emitted_mis(s, after_brdf, prev, prev_pdf) : emitted(s, after_brdf);
+            radiance += T * e;
+
+            float k_r = m.diffuse.w, k_t = m.extra.x;
+            seek(base + SLOT_EVENT);
+            float u_event = gen || k_r + k_t > 0.0 ? sample_1d() : 1.0;
+            vec3 dir;
+            bool diffuse_ray;
+            if (u_event < k_r + k_t) {
+                if (depth >= u_max_depth)
+                    break;
+                vec3 d = -s.v;
+                diffuse_ray = false;
+                dir = d - s.ns * (2.0 * dot(d, s.ns));
+                if (u_event >= k_r) {
+                    float ior = m.extra.y >= 1.0 ? m.extra.y : 1.0;
+                    float eta = s.front ? 1.0 / ior : ior;
+                    float cos_i = -dot(d, s.ns);
+                    float k = 1.0 - eta * eta * (1.0 - cos_i * cos_i);
+                    if (k >= 0.0)
+                        dir = normalize(d * eta + s.ns * (eta * cos_i - sqrt(k)));
+                }
+                after_brdf = false;
+            } else {
+                bool last = depth >= u_max_depth;
+                radiance += T * (u_mis ? direct_light_mis(s, base, !last) : direct_light(s, base));
+                if (last)
+                    break;
+                seek(base + SLOT_LOBE);
+                float u0 = gen || max_comp(m.specular.rgb) > 0.0 ? sample_1d() : 0.0;
+                seek(base + SLOT_BSDF);
+                vec2 u12 = sample_2d();
+                vec3 w;
+                if (!phong_sample(s, u0, u12.x, u12.y, dir, w))
+                    break;
+                T *= w;
+                diffuse_ray = true;
+                after_brdf = true;
+                prev_pdf = u_mis ? phong_pdf(s, dir) : 0.0;
+            }
+            prev = s.p;
+
+            if (u_rr && depth >= u_rr_depth) {
+                float q = min(1.0, max_comp(T));
+                seek(base + SLOT_RR);
+                float xi = sample_1d();
+                if (!(xi < q))
+                    break;
+                T *= 1.0 / q;
+            }
+            if (!(max_comp(T) > 0.0))
+                break;
+
+            /* exact backends only: specular rays take the diffuse one */
+            Hit h;
+            vec3 o = offset_origin(s, dir);
+            if (!query(u_diffuse, o, dir, 0.0, INF, false, h)) {
+                radiance += T * u_background;
+                break;
+            }
+            s = surface_at(h, dir);
+        }
+        return radiance;
+    }
+
+    void main()
+    {
+        ivec2 px = ivec2(gl_GlobalInvocationID.xy);
+        if (px.x >= u_size.x || px.y >= u_size.y)
+            return;
+        g_state = imageLoad(u_rng_state, px);
+        g_index = u_sample;
+        g_slot = 0u;
+        seek(SLOT_PIXEL);
+        vec2 j = sample_2d();
+        /* rl_camera_frame_ray: image plane at distance 1, rows downwards */
+        float sx = (2.0 * (float(px.x) + j.x) / float(u_size.x) - 1.0) * u_tan_half_fov * u_aspect;
+        float sy = (1.0 - 2.0 * (float(px.y) + j.y) / float(u_size.y)) * u_tan_half_fov;
+        vec3 dir = normalize(u_cam_u * sx + u_cam_v * sy - u_cam_w);
+        vec3 L = u_background;
+        Hit h;
+        if (bvh_query(u_eye, dir, 0.0, INF, false, h))
+            L = trace_path(surface_at(h, dir));
+        /* A NaN or infinity would poison the pixel's mean for good; it
+         * counts as black, as pt counts the sample but adds nothing. */
+        if (!finite3(L))
+            L = vec3(0.0);
+        if (u_rng != 0)
+            imageStore(u_rng_state, px, g_state);
+        /* Sec. 6.5, eq. 8: C_{s+1} = s/(s+1) C_s + 1/(s+1) C_trace */
+        float n = float(u_sample);
+        vec4 c = u_sample == 0u ? vec4(0.0) : imageLoad(u_accum, px);
+        imageStore(u_accum, px, vec4(c.rgb * (n / (n + 1.0)) + L * (1.0 / (n + 1.0)), 1.0));
+    }
+);
+
+/* The ray set of rl_gl_pt_trace through one structure. */
+const char *const rl_gl_pt_glsl_rays = GLSL(
+    layout(local_size_x = 64) in;
+    struct Ray { vec4 o; vec4 d; };                  /* w: t_min, t_max */
+    layout(std430, binding = 14) readonly buffer Rays { Ray rays[]; };
+    layout(std430, binding = 15) writeonly buffer Hits { Hit hits[]; };
+    uniform uint u_count;
+    uniform int u_structure;
+    uniform bool u_any;
+
+    void main()
+    {
+        uint i = gl_GlobalInvocationID.x;
+        if (i >= u_count)
+            return;
+        Ray r = rays[i];
+        Hit h;
+        if (!query(u_structure, r.o.xyz, r.d.xyz, r.o.w, r.d.w, u_any, h))
+            h = Hit(INF, 0.0, 0.0, NONE);
+        hits[i] = h;
+    }
+);
+
+#endif

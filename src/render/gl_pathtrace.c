@@ -1,0 +1,371 @@
+/* gl_pathtrace.c: renderer "gl-pt", the path tracer "pt" (pathtrace.c) in
+ * GLSL compute shaders on OpenGL 4.5 (src/gl/gl_pt.c), as Schröder 2017
+ * runs it on the GPU (Ch. 5, 6): one thread per pixel, the per-pixel
+ * generator states in an image (Sec. 5.3), progressive accumulation in an
+ * rgba32f image (Sec. 6.5, eq. 8), shadow and secondary rays through the
+ * BVH or the uniform grid (Sec. 5.4).
+ *
+ * Same estimator as pt: this file builds what pt builds on the CPU for it
+ * (pathtrace_backend.c: the ray offset, the covering quad light of every
+ * emissive triangle, the light table of mis=on) and seeds the per-pixel
+ * states exactly as pt seeds them (rl_rng_gpu_seed per pixel; for sobol
+ * the scramble seed rl_pt_pixel_seed), so that with the same options the
+ * two converge to the same image; with rng=lcg, tausworthe or hybrid they
+ * even draw the same numbers per pixel.
+ *
+ * Options: pt's names and defaults where ported (spp, max_depth, rr,
+ * rr_depth, rng, mis, seed, shadow, diffuse, specular, primary,
+ * checkerboard, accumulate, filter, grid_res, light_samples, background,
+ * threads) and device (rl_gl.h). Values pt has and gl-pt has not ported
+ * are refused with an option error naming what is ported: shadow and
+ * diffuse other than bvh and grid (Embree, the Line Space payloads, shadow
+ * maps), primary=raster, checkerboard=true, filter other than none. pt's
+ * Line Space and shadow-map options (ls_*, shadowmap_size) are not in the
+ * table until those backends are ported.
+ *
+ * Depth and ID layers, where the image has them, come from pt's traced
+ * G-buffer (CPU BVH, pixel centres), as pt writes them. */
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "core/error.h"
+#include "core/params.h"
+#include "gl/gl_pt.h"
+#include "render/pathtrace_internal.h"
+#include "render/renderer.h"
+#include "rl/rl_gl.h"
+#include "rl/rl_timer.h"
+
+static const char *const rng_choices[] = { "sobol", "lcg", "tausworthe", "hybrid", NULL };
+static const char *const mis_choices[] = { "off", "on", NULL };
+/* pt's lists, so that a value pt knows gets "not ported" rather than
+ * "unknown"; gl_pt_check admits bvh and grid. */
+static const char *const shadow_choices[] = { "bvh", "grid", "embree", "ls-candidates", "ls-preillum", "ls-pnmt",
+                                              "shadowmap", NULL };
+static const char *const diffuse_choices[] = { "bvh", "grid", "embree", "ls-candidates", "ls-preillum", "ls-pnmt",
+                                               NULL };
+static const char *const specular_choices[] = { "exact", "diffuse", NULL };
+static const char *const primary_choices[] = { "trace", "raster", NULL };
+static const char *const filter_choices[] = { "none", "gauss", "bilateral", "aniso", "kuwahara", NULL };
+
+static const rl_option_info gl_pt_options[] = {
+    { "spp", RL_OPT_INT, "1", "paths per pixel and frame (one compute dispatch each)", 1, 65536, NULL },
+    { "max_depth", RL_OPT_INT, "-1",
+      "surface interactions after the camera hit (0: direct light only; -1: the scene's root attribute "
+      "max_path_length, else 3)", -1, 1024, NULL },
+    { "rr", RL_OPT_BOOL, "true", "Russian roulette on the path length (Sec. 3.2.4)", 0, 0, NULL },
+    { "rr_depth", RL_OPT_INT, "4", "bounce from which Russian roulette may end a path", 0, 1024, NULL },
+    { "rng", RL_OPT_ENUM, "sobol",
+      "sample numbers: sobol (Owen-scrambled Sobol points) or the thesis' per-pixel state textures (Sec. 5.3): "
+      "lcg, tausworthe or their hybrid", 0, 0, rng_choices },
+    { "mis", RL_OPT_ENUM, "on",
+      "on: lights chosen by power, light and BSDF samples weighted by the power heuristic; off: every light",
+      0, 0, mis_choices },
+    { "seed", RL_OPT_INT, "0", "seed of the per-pixel generator states", 0, 9007199254740991.0, NULL },
+    { "shadow", RL_OPT_ENUM, "bvh", "shadow rays on the GPU: bvh or grid (Line Space: not ported yet)",
+      0, 0, shadow_choices },
+    { "diffuse", RL_OPT_ENUM, "bvh", "secondary rays on the GPU: bvh or grid (Line Space: not ported yet)",
+      0, 0, diffuse_choices },
+    { "specular", RL_OPT_ENUM, "exact",
+      "mirror and refraction rays: with the exact structures of gl-pt both values take the diffuse one", 0, 0,
+      specular_choices },
+    { "primary", RL_OPT_ENUM, "trace", "primary visibility: trace (jittered rays, BVH); raster: not ported yet",
+      0, 0, primary_choices },
+    { "checkerboard", RL_OPT_BOOL, "false", "Sec. 8.5: not ported yet (false only)", 0, 0, NULL },
+    { "accumulate", RL_OPT_BOOL, "true", "progressive accumulation across frames (Sec. 6.5, eq. 8)", 0, 0, NULL },
+    { "filter", RL_OPT_ENUM, "none", "noise filter (Sec. 8.2): not ported yet (none only)", 0, 0,
+      filter_choices },
+    { "grid_res", RL_OPT_INT, "0", "voxels per axis of the grid (0 = grid heuristic)", 0, 1024, NULL },
+    { "light_samples", RL_OPT_INT, "1", "shadow rays per quad light and vertex", 1, 1024, NULL },
+    { "background", RL_OPT_COLOR, "0,0,0",
+      "radiance arriving from every direction where a ray leaves the scene (a uniform environment)", 0, 0, NULL },
+    { "threads", RL_OPT_INT, "0", "CPU threads of the structure builds (0 = all)", 0, 1024, NULL },
+    { "device", RL_OPT_STRING, "",
+      "EGL device: auto, surfaceless or a device number; empty: $RL_EGL_DEVICE, else auto", 0, 0, NULL },
+};
+#define NUM_OPTIONS (sizeof gl_pt_options / sizeof gl_pt_options[0])
+
+typedef struct gl_pt_state {
+    pt_backends b;                /* the light set, offsets; a CPU BVH for depth and ID layers */
+    rl_gl_pt *gpu;
+    uint64_t gpu_scene;           /* the scene uid the GPU tracer holds */
+    char device[64];
+    char info[528];
+    /* the accumulation and what it depends on */
+    bool valid, force_reset;
+    uint64_t scene_uid;
+    rl_camera cam;
+    char *signature;
+    rl_gbuffer *gbuf;
+    float *rgba;
+    uint64_t frames;
+} gl_pt_state;
+
+static void gl_pt_release(void *state)
+{
+    gl_pt_state *s = state;
+    rl_gl_pt_release(s->gpu);
+    rl_pt_backends_release(&s->b);
+    rl_gbuffer_release(s->gbuf);
+    free(s->rgba);
+    free(s->signature);
+}
+
+static void gl_pt_reset_state(void *state)
+{
+    gl_pt_state *s = state;
+    if (s)
+        s->force_reset = true;
+}
+
+static bool gl_pt_available(const rl_renderer *r, char *why, size_t n)
+{
+    return rl_gl_available(rl_renderer_opt_string(r, "device"), why, n);
+}
+
+static rl_status gl_pt_check(const char *key, const char *value)
+{
+    if ((strcmp(key, "shadow") == 0 || strcmp(key, "diffuse") == 0) && strcmp(value, "bvh") != 0 &&
+        strcmp(value, "grid") != 0)
+        return rl_error(RL_ERR_INVALID_ARG, "gl-pt: %s=%s is not ported to GL yet (bvh or grid; pt has it)", key,
+                        value);
+    if (strcmp(key, "primary") == 0 && strcmp(value, "raster") == 0)
+        return rl_error(RL_ERR_INVALID_ARG, "gl-pt: primary=raster (the G-buffer pass) is not ported to GL yet");
+    if (strcmp(key, "checkerboard") == 0) {
+        /* the value passed the type check: one of options.c's true words */
+        bool on = strcmp(value, "true") == 0 || strcmp(value, "1") == 0 || strcmp(value, "yes") == 0 ||
+                  strcmp(value, "on") == 0;
+        if (on)
+            return rl_error(RL_ERR_INVALID_ARG, "gl-pt: checkerboard=true is not ported to GL yet");
+    }
+    if (strcmp(key, "filter") == 0 && strcmp(value, "none") != 0)
+        return rl_error(RL_ERR_INVALID_ARG, "gl-pt: filter=%s is not ported to GL yet (none only)", value);
+    return RL_OK;
+}
+
+/* The values of all options as one string: any change restarts the
+ * accumulation (threads and device only change how it runs, not the
+ * image, but a device change makes a new tracer anyway). */
+static char *option_signature(const rl_renderer *r)
+{
+    size_t len = 1;
+    for (size_t i = 0; i < NUM_OPTIONS; ++i)
+        len += strlen(gl_pt_options[i].key) + strlen(rl_renderer_get(r, gl_pt_options[i].key)) + 2;
+    char *sig = rl_alloc(len);
+    if (!sig)
+        return NULL;
+    size_t used = 0;
+    sig[0] = '\0';
+    for (size_t i = 0; i < NUM_OPTIONS; ++i)
+        used += (size_t)snprintf(sig + used, len - used, "%s=%s;", gl_pt_options[i].key,
+                                 rl_renderer_get(r, gl_pt_options[i].key));
+    return sig;
+}
+
+static bool same_camera(const rl_camera *a, const rl_camera *b)
+{
+    return memcmp(&a->eye, &b->eye, sizeof a->eye) == 0 && memcmp(&a->target, &b->target, sizeof a->target) == 0 &&
+           memcmp(&a->up, &b->up, sizeof a->up) == 0 && a->fov_deg == b->fov_deg && a->width == b->width &&
+           a->height == b->height && a->z_near == b->z_near && a->z_far == b->z_far;
+}
+
+static int scene_max_depth(const rl_scene *scene)
+{
+    const char *v = rl_scene_node_attr(scene, 0, "max_path_length");
+    long long n;
+    return v && rl_parse_int(v, &n) && n >= 0 && n <= 1024 ? (int)n : 3;
+}
+
+/* The tracer for this scene and device, made anew when either changed. */
+static rl_status ensure_gpu(gl_pt_state *s, const rl_scene *scene, const char *device, int threads,
+                            rl_render_stats *stats)
+{
+    if (s->gpu && s->gpu_scene == rl_scene_uid(scene) && strcmp(s->device, device) == 0)
+        return RL_OK;
+    rl_gl_pt_release(s->gpu);
+    s->gpu = NULL;
+    s->valid = false;
+    if (strlen(device) >= sizeof s->device)
+        return rl_error(RL_ERR_INVALID_ARG, "gl-pt: device \"%.40s...\" is too long", device);
+    const pt_lights *l = &s->b.lights;
+    rl_gl_pt_desc desc = {
+        .device = device, .threads = threads, .eps = s->b.eps,
+        .lights = { .count = l->count, .source = l->source, .cdf = l->cdf, .light_pmf = l->light_pmf,
+                    .light_hittable = l->light_hittable, .tri_pmf = l->tri_pmf, .tri_cover = s->b.tri_cover },
+    };
+    rl_timer timer;
+    rl_timer_start(&timer);
+    rl_status st = rl_gl_pt_create(scene, &desc, &s->gpu);
+    stats->prep_ms += rl_timer_ms(&timer);
+    if (st != RL_OK)
+        return st;
+    s->gpu_scene = rl_scene_uid(scene);
+    snprintf(s->device, sizeof s->device, "%s", device);
+    const rl_gl_info *info = rl_gl_pt_info(s->gpu);
+    if (info)
+        snprintf(s->info, sizeof s->info, "%s | %s | %s", info->vendor, info->renderer, info->version);
+    return RL_OK;
+}
+
+/* pt's per-pixel states (pathtrace.c reset, pixel_sampler). */
+static uint32_t *seed_states(int rng, uint64_t seed, size_t n)
+{
+    uint32_t *st = rl_calloc(n ? n : 1, 4 * sizeof *st);
+    if (!st)
+        return NULL;
+    for (size_t i = 0; i < n; ++i) {
+        if (rng == 0) {
+            st[4 * i] = rl_pt_pixel_seed(seed, i);
+            continue;
+        }
+        rl_rng_gpu g;
+        rl_rng_gpu_seed(&g, (rl_rng_gpu_kind)(rng - 1), seed, i);
+        memcpy(&st[4 * i], g.z, sizeof g.z);
+    }
+    return st;
+}
+
+static rl_status gl_pt_render(rl_renderer *r, void *state, const rl_scene *scene, const rl_camera *cam,
+                              rl_image *image, rl_render_stats *stats)
+{
+    gl_pt_state *s = state;
+    const rl_scene_data *d = rl_scene_get_data(scene);
+    if (!d)
+        return RL_ERR_NOT_COMMITTED;
+    const int threads = (int)rl_renderer_opt_int(r, "threads");
+    /* What pt prepares for the GPU's estimator: offsets, covers, light
+     * table (the GPU builds its own structures). */
+    rl_timer prep;
+    rl_timer_start(&prep);
+    rl_status st = rl_pt_backends_prepare_scene(&s->b, scene);
+    stats->prep_ms = rl_timer_ms(&prep);
+    if (st == RL_OK)
+        st = ensure_gpu(s, scene, rl_renderer_opt_string(r, "device"), threads, stats);
+    if (st != RL_OK)
+        return st;
+
+    char *sig = option_signature(r);
+    if (!sig)
+        return RL_ERR_OUT_OF_MEMORY;
+    const bool accumulate = rl_renderer_opt_bool(r, "accumulate");
+    bool reset = s->force_reset || !s->valid || !accumulate || s->scene_uid != rl_scene_uid(scene) ||
+                 !same_camera(&s->cam, cam) || strcmp(s->signature, sig) != 0;
+    const size_t n = (size_t)cam->width * (size_t)cam->height;
+    const int rng = rl_renderer_opt_enum(r, "rng");
+    uint32_t *states = NULL;
+    if (reset) {
+        free(s->rgba);
+        rl_gbuffer_release(s->gbuf);
+        s->gbuf = NULL;
+        s->valid = false;
+        s->rgba = rl_calloc(n, 4 * sizeof *s->rgba);
+        states = seed_states(rng, (uint64_t)rl_renderer_opt_int(r, "seed"), n);
+        if (!s->rgba || !states) {
+            free(states);
+            free(sig);
+            return RL_ERR_OUT_OF_MEMORY;
+        }
+        free(s->signature);
+        s->signature = sig;
+        s->scene_uid = rl_scene_uid(scene);
+        s->cam = *cam;
+        s->frames = 0;
+    } else {
+        free(sig);
+    }
+
+    const int diffuse = rl_renderer_opt_enum(r, "diffuse");
+    const int max_depth = (int)rl_renderer_opt_int(r, "max_depth");
+    const bool mis = rl_renderer_opt_enum(r, "mis") == 1;
+    rl_gl_pt_frame f = {
+        .cam = rl_camera_frame_make(cam),
+        .spp = (int)rl_renderer_opt_int(r, "spp"),
+        .max_depth = max_depth >= 0 ? max_depth : scene_max_depth(scene),
+        .rr_depth = (int)rl_renderer_opt_int(r, "rr_depth"),
+        .light_samples = (int)rl_renderer_opt_int(r, "light_samples"),
+        .rr = rl_renderer_opt_bool(r, "rr"),
+        .mis = mis, .mis_hits = mis, .tri_lights = mis,   /* both structures are exact (pathtrace.c) */
+        .rng = rng,
+        .shadow = rl_renderer_opt_enum(r, "shadow") == 1 ? RL_GL_PT_GRID : RL_GL_PT_BVH,
+        .diffuse = diffuse == 1 ? RL_GL_PT_GRID : RL_GL_PT_BVH,
+        .grid_res = (int)rl_renderer_opt_int(r, "grid_res"),
+        .background = rl_renderer_opt_color(r, "background"),
+        .reset_states = states,
+    };
+    uint64_t samples = 0;
+    st = rl_gl_pt_render(s->gpu, &f, s->rgba, &samples);
+    free(states);
+    if (st != RL_OK) {
+        s->force_reset = true;
+        return st;
+    }
+    s->valid = true;
+    s->force_reset = false;
+    s->frames++;
+    for (size_t i = 0; i < n; ++i)
+        image->color[i] = rl_v4(s->rgba[4 * i], s->rgba[4 * i + 1], s->rgba[4 * i + 2], 1.0f);
+
+    /* pt's depth and ID layers: the traced G-buffer's, once per accumulation */
+    bool layers = ((image->layers & RL_LAYER_DEPTH) && image->depth) ||
+                  ((image->layers & RL_LAYER_ID) && image->object_id && image->triangle_id);
+    if (layers && !s->gbuf) {
+        /* a CPU BVH only for these layers, kept with the scene's data */
+        if (!s->b.exact[RL_ACCEL_BVH]) {
+            rl_timer timer;
+            rl_timer_start(&timer);
+            st = rl_accel_create(scene, &(rl_accel_desc){ .kind = RL_ACCEL_BVH, .threads = threads },
+                                 &s->b.exact[RL_ACCEL_BVH]);
+            if (st == RL_OK)
+                st = rl_accel_commit(s->b.exact[RL_ACCEL_BVH]);
+            if (st != RL_OK) {
+                rl_accel_release(s->b.exact[RL_ACCEL_BVH]);
+                s->b.exact[RL_ACCEL_BVH] = NULL;
+                return st;
+            }
+            stats->prep_ms += rl_timer_ms(&timer);
+        }
+        st = rl_gbuffer_create(cam->width, cam->height, &s->gbuf);
+        if (st == RL_OK)
+            st = rl_gbuffer_trace(s->gbuf, s->b.exact[RL_ACCEL_BVH], cam);
+        if (st != RL_OK) {
+            rl_gbuffer_release(s->gbuf);
+            s->gbuf = NULL;
+            return st;
+        }
+    }
+    if (layers) {
+        if ((image->layers & RL_LAYER_DEPTH) && image->depth)
+            memcpy(image->depth, s->gbuf->depth, n * sizeof *image->depth);
+        if ((image->layers & RL_LAYER_ID) && image->object_id && image->triangle_id) {
+            memcpy(image->object_id, s->gbuf->object, n * sizeof *image->object_id);
+            memcpy(image->triangle_id, s->gbuf->triangle, n * sizeof *image->triangle_id);
+        }
+    }
+    stats->pixels_written = n;
+    stats->samples = n * (uint64_t)f.spp;
+    stats->device = s->info[0] ? s->info : NULL;
+    (void)samples;
+    if (!rl_renderer_progress(r, 1.0)) {
+        s->force_reset = true;
+        return rl_error(RL_ERR_CANCELLED, "gl-pt: cancelled by the progress callback");
+    }
+    return RL_OK;
+}
+
+const rl_renderer_class rl_gl_pt_renderer_class = {
+    .info = { .name = "gl-pt",
+              .description = "pt on OpenGL 4.5 compute shaders (headless EGL): the same estimator, BVH or grid "
+                             "on the GPU",
+              .reference = "Schröder 2017, Ch. 5-6 (GPU path tracing, Sec. 5.3 RNG textures, Sec. 6.5)",
+              .progressive = true, .default_time_s = 10.0,
+              .frame_bytes_per_pixel = 4 * sizeof(float) + 16 + 16 + RL_GBUFFER_BYTES_PER_PIXEL },
+    .options = gl_pt_options,
+    .num_options = NUM_OPTIONS,
+    .state_size = sizeof(gl_pt_state),
+    .render = gl_pt_render,
+    .release = gl_pt_release,
+    .check = gl_pt_check,
+    .reset = gl_pt_reset_state,
+    .available = gl_pt_available,
+};

@@ -1,0 +1,388 @@
+/* gl-pt against pt: the GPU path tracer computes pt's estimator, so its
+ * image converges to pt's (the RMSE of the difference to a CPU reference
+ * falls as 1/sqrt(spp) and the per-channel image means agree within 3
+ * sigma) on the Cornell box and on the spheres (mirror, glass, point and
+ * directional lights); the GLSL BVH and grid find the triangles the CPU
+ * BVH finds, ray for ray; options gl-pt has not ported are refused, and a
+ * device that cannot be opened makes it unavailable. Small images on
+ * llvmpipe; without a GL 4.5 context the GL cases skip. */
+#include <math.h>
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <cmocka.h>
+
+#include "gl/gl_pt.h"
+#include "render/render_fixtures.h"
+#include "rl/rl_accel.h"
+#include "rl/rl_rng.h"
+
+#include "gl_fixtures.h"
+
+#define SIZE 16
+#define REF_SPP "256"
+
+static rl_scene *scene_and_camera(const char *name, const char *params, rl_camera *cam)
+{
+    rl_scene *s = NULL;
+    assert_int_equal(rl_scene_create_builtin(name, params, &s), RL_OK);
+    assert_int_equal(rl_scene_get_camera(s, NULL, cam), RL_OK);
+    cam->width = cam->height = SIZE;
+    return s;
+}
+
+static void add_quad(rl_scene *s, const char *name, float half, float z, uint32_t mat)
+{
+    const rl_vec3 pos[4] = { { -half, -half, z }, { half, -half, z }, { half, half, z }, { -half, half, z } };
+    const rl_vec2 uv[4] = { { 0, 0 }, { 1, 0 }, { 1, 1 }, { 0, 1 } };
+    const uint32_t idx[6] = { 0, 1, 2, 0, 2, 3 };
+    uint32_t mesh, node;
+    rl_mesh_desc md = { .name = name, .num_vertices = 4, .positions = pos, .uvs = uv,
+                        .num_triangles = 2, .indices = idx, .material = mat };
+    assert_int_equal(rl_scene_add_mesh(s, &md, &mesh), RL_OK);
+    assert_int_equal(rl_scene_add_node(s, RL_NODE_ROOT, name, NULL, &node), RL_OK);
+    assert_int_equal(rl_scene_node_set_mesh(s, node, mesh), RL_OK);
+}
+
+/* A leaf quad whose texture is a hole (alpha 0, cutoff 0.5) where u < 1/2
+ * in front of a wall with a normal map, a point light and a quad light:
+ * rays pass the holes, and the bent normals shade the wall. */
+static rl_scene *mask_normal_scene(rl_camera *cam)
+{
+    rl_scene *s = NULL;
+    assert_int_equal(rl_scene_create(&s), RL_OK);
+    rl_vec4 alpha[8], bumps[16];
+    for (int i = 0; i < 8; ++i)
+        alpha[i] = (rl_vec4){ 1.0f, 0.9f, 0.6f, i < 4 ? 0.0f : 1.0f };
+    for (int i = 0; i < 16; ++i)
+        bumps[i] = (rl_vec4){ 0.5f + 0.35f * sinf((float)i), 0.5f + 0.35f * cosf(1.7f * (float)i), 0.8f, 1.0f };
+    rl_texture *ta = NULL, *tb = NULL;
+    assert_int_equal(rl_texture_create(8, 1, alpha, &ta), RL_OK);
+    assert_int_equal(rl_texture_create(4, 4, bumps, &tb), RL_OK);
+    uint32_t ia, ib, leaf, wall;
+    assert_int_equal(rl_scene_add_texture(s, ta, &ia), RL_OK);
+    assert_int_equal(rl_scene_add_texture(s, tb, &ib), RL_OK);
+    rl_material m = rl_material_default();
+    m.diffuse_texture = ia;
+    m.alpha_cutoff = 0.5f;
+    assert_int_equal(rl_scene_add_material(s, &m, &leaf), RL_OK);
+    m = rl_material_default();
+    m.diffuse = rl_v3(0.8f, 0.3f, 0.2f);
+    m.specular = rl_v3s(0.2f);
+    m.normal_texture = ib;
+    assert_int_equal(rl_scene_add_material(s, &m, &wall), RL_OK);
+    add_quad(s, "leaf", 1.0f, 0.0f, leaf);
+    add_quad(s, "wall", 2.5f, -1.0f, wall);
+    rl_light p = { .type = RL_LIGHT_POINT, .color = rl_v3s(1.0f), .intensity = 20.0f,
+                   .position = rl_v3(0.5f, 0.5f, 4.0f) };
+    rl_light q = { .type = RL_LIGHT_QUAD, .color = rl_v3s(1.0f), .intensity = 5.0f,
+                   .position = rl_v3(-1.0f, 2.0f, 1.0f), .edge_u = rl_v3(0.5f, 0.0f, 0.0f),
+                   .edge_v = rl_v3(0.0f, 0.0f, -0.5f) };
+    assert_int_equal(rl_scene_add_light(s, &p), RL_OK);
+    assert_int_equal(rl_scene_add_light(s, &q), RL_OK);
+    assert_int_equal(rl_scene_commit(s), RL_OK);
+    *cam = (rl_camera){ .eye = rl_v3(0, 0.3f, 4), .target = rl_v3(0, 0, 0), .fov_deg = 45.0f,
+                        .width = 24, .height = 24 };
+    return s;
+}
+
+/* Per channel: the RMSE of a - b and the difference of the image means. */
+static void difference(const rl_image *a, const rl_image *b, double rmse[3], double mean_diff[3])
+{
+    const size_t n = (size_t)a->width * (size_t)a->height;
+    for (int c = 0; c < 3; ++c) {
+        double sq = 0.0, sum = 0.0;
+        for (size_t i = 0; i < n; ++i) {
+            const float *pa = &a->color[i].x, *pb = &b->color[i].x;
+            double d = (double)pa[c] - pb[c];
+            sq += d * d;
+            sum += d;
+        }
+        rmse[c] = sqrt(sq / (double)n);
+        mean_diff[c] = sum / (double)n;
+    }
+}
+
+static double rmse_all(const double rmse[3])
+{
+    return sqrt((rmse[0] * rmse[0] + rmse[1] * rmse[1] + rmse[2] * rmse[2]) / 3.0);
+}
+
+/* The means agree within 3 sigma of the mean of n independent pixel
+ * differences, sigma^2 = their variance / n, estimated by RMSE^2 (pixels
+ * have independent generator states or scrambles in both tracers). */
+static void assert_means_agree(const char *what, const rl_image *gl, const rl_image *ref)
+{
+    double rmse[3], md[3];
+    difference(gl, ref, rmse, md);
+    const double n = (double)gl->width * gl->height;
+    for (int c = 0; c < 3; ++c) {
+        double sigma = rmse[c] / sqrt(n);
+        print_message("%s: channel %d mean difference %+.5f, sigma %.5f (%.2f sigma)\n", what, c, md[c], sigma,
+                      sigma > 0.0 ? fabs(md[c]) / sigma : 0.0);
+        assert_true(fabs(md[c]) <= 3.0 * sigma + 1e-6);
+    }
+}
+
+static rl_image *render(const char *algo, const rl_scene *s, const rl_camera *cam, const char *const *opts)
+{
+    rl_render_stats st = { 0 };
+    return fx_render(algo, s, cam, RL_LAYER_COLOR, opts, &st);
+}
+
+/* Cornell box, pure Monte Carlo numbers (rng=hybrid): RMSE(gl - ref) at
+ * 4, 16, 64 spp falls by about 2 per 4x samples (1.95 and 1.84 expected
+ * with the reference's own noise at 256 spp), and the means agree. */
+static void test_gl_pt_converges_to_pt_on_cornell(void **state)
+{
+    (void)state;
+    NEED_GL();
+    rl_camera cam;
+    rl_scene *s = scene_and_camera("cornell", NULL, &cam);
+    rl_image *ref = render("pt", s, &cam, (const char *const[]){ "spp", REF_SPP, "rng", "hybrid", "seed", "7", NULL });
+    static const char *const spps[] = { "4", "16", "64" };
+    double e[3];
+    rl_image *last = NULL;
+    for (int k = 0; k < 3; ++k) {
+        rl_image *gl = render("gl-pt", s, &cam, (const char *const[]){ "spp", spps[k], "rng", "hybrid", NULL });
+        double rmse[3], md[3];
+        difference(gl, ref, rmse, md);
+        e[k] = rmse_all(rmse);
+        print_message("cornell gl-pt %s spp: RMSE to pt at %s spp %.5f\n", spps[k], REF_SPP, e[k]);
+        rl_image_release(last);
+        last = gl;
+    }
+    print_message("ratios %.2f %.2f (1/sqrt(spp): 1.95, 1.84)\n", e[0] / e[1], e[1] / e[2]);
+    assert_true(e[0] / e[1] > 1.4 && e[0] / e[1] < 3.0);
+    assert_true(e[1] / e[2] > 1.4 && e[1] / e[2] < 3.0);
+    assert_means_agree("cornell hybrid 64 spp", last, ref);
+    rl_image_release(last);
+    rl_image_release(ref);
+    rl_scene_release(s);
+}
+
+/* The same estimator with the other sample numbers and mis=off, and on a
+ * scene with mirror and glass spheres, a texture, point and directional
+ * lights. */
+static void test_gl_pt_means_agree_with_pt(void **state)
+{
+    (void)state;
+    NEED_GL();
+    static const struct {
+        const char *scene, *params, *opt, *value;
+    } cases[] = {
+        { "cornell", NULL, "mis", "off" },
+        { "spheres", "segments=16,checks=4", "rng", "sobol" },
+        { "spheres", "segments=16,checks=4", "mis", "off" },
+    };
+    for (size_t i = 0; i < sizeof cases / sizeof cases[0]; ++i) {
+        rl_camera cam;
+        rl_scene *s = scene_and_camera(cases[i].scene, cases[i].params, &cam);
+        rl_image *ref = render("pt", s, &cam,
+                               (const char *const[]){ "spp", REF_SPP, cases[i].opt, cases[i].value, "seed", "3", NULL });
+        rl_image *gl = render("gl-pt", s, &cam,
+                              (const char *const[]){ "spp", "64", cases[i].opt, cases[i].value, NULL });
+        char what[96];
+        snprintf(what, sizeof what, "%s %s=%s 64 spp", cases[i].scene, cases[i].opt, cases[i].value);
+        assert_means_agree(what, gl, ref);
+        rl_image_release(gl);
+        rl_image_release(ref);
+        rl_scene_release(s);
+    }
+}
+
+/* With rng=hybrid both tracers draw the same numbers per pixel from the
+ * same seeded states: the paths are the same, and the pixels agree to
+ * float rounding (unless a rounding difference flips a choice), with the
+ * grid on the GPU as with the BVH, with mirror and glass, and through
+ * alpha-masked holes onto a normal-mapped wall. */
+static void test_gl_pt_draws_pts_numbers(void **state)
+{
+    (void)state;
+    NEED_GL();
+    static const struct {
+        const char *scene, *params, *structure, *mis;
+    } cases[] = {
+        { "cornell", NULL, "bvh", "on" },
+        { "cornell", NULL, "grid", "on" },
+        { "spheres", "segments=16,checks=4", "grid", "off" },
+        { "cornell", "variant=bitterli", "bvh", "on" },
+        { "ls-cornell", NULL, "grid", "on" },
+        { "masks and normal maps", NULL, "bvh", "on" },
+        { "masks and normal maps", NULL, "grid", "off" },
+    };
+    for (size_t k = 0; k < sizeof cases / sizeof cases[0]; ++k) {
+        rl_camera cam;
+        rl_scene *s = strncmp(cases[k].scene, "masks", 5) == 0 ? mask_normal_scene(&cam)
+                                                                 : scene_and_camera(cases[k].scene, cases[k].params, &cam);
+        cam.width = cam.height = 24;
+        rl_image *cpu = render("pt", s, &cam,
+                               (const char *const[]){ "spp", "4", "rng", "hybrid", "seed", "5", "mis", cases[k].mis,
+                                                      NULL });
+        rl_image *gl = render("gl-pt", s, &cam,
+                              (const char *const[]){ "spp", "4", "rng", "hybrid", "seed", "5", "mis", cases[k].mis,
+                                                     "shadow", cases[k].structure, "diffuse", cases[k].structure,
+                                                     NULL });
+        const size_t n = (size_t)cam.width * (size_t)cam.height;
+        size_t close = 0;
+        for (size_t i = 0; i < n; ++i) {
+            double worst = 0.0;
+            for (int c = 0; c < 3; ++c) {
+                const float a = (&gl->color[i].x)[c], b = (&cpu->color[i].x)[c];
+                double rel = fabs((double)a - b) / fmax(1e-3, fabs((double)b));
+                worst = rel > worst ? rel : worst;
+            }
+            close += worst < 1e-3;
+        }
+        print_message("%s%s%s, gl-pt through the %s, mis=%s: pixels equal to pt's to 1e-3: %.1f %%\n", cases[k].scene,
+                      cases[k].params ? ":" : "", cases[k].params ? cases[k].params : "", cases[k].structure, cases[k].mis, 100.0 * (double)close / (double)n);
+        assert_true((double)close >= 0.99 * (double)n);
+        rl_image_release(gl);
+        rl_image_release(cpu);
+        rl_scene_release(s);
+    }
+}
+
+/* 1024 rays from random points in the scene box in random directions, and
+ * shadow segments of random length: the GLSL BVH and grid against the CPU
+ * BVH. Equal triangle IDs, or where they differ the same distance (a tie:
+ * coincident or touching triangles); distances within 1e-4 relative. */
+static void test_gl_pt_structures_agree_ray_for_ray(void **state)
+{
+    (void)state;
+    NEED_GL();
+    rl_scene *s = NULL;
+    assert_int_equal(rl_scene_create_builtin("cornell-teapot", "triangles=2000", &s), RL_OK);
+    const rl_scene_data *d = rl_scene_get_data(s);
+    rl_accel *bvh = NULL;
+    assert_int_equal(rl_accel_create(s, &(rl_accel_desc){ .kind = RL_ACCEL_BVH }, &bvh), RL_OK);
+    assert_int_equal(rl_accel_commit(bvh), RL_OK);
+    rl_gl_pt *pt = NULL;
+    assert_int_equal(rl_gl_pt_create(s, &(rl_gl_pt_desc){ .eps = 1e-4f }, &pt), RL_OK);
+
+    enum { N = 1024 };
+    rl_ray *rays = calloc(N, sizeof *rays);
+    rl_hit *cpu = calloc(N, sizeof *cpu), *gpu = calloc(N, sizeof *gpu);
+    bool *occluded = calloc(N, sizeof *occluded);
+    assert_true(rays && cpu && gpu && occluded);
+    rl_rng rng;
+    rl_rng_seed(&rng, 11, 0);
+    rl_vec3 lo = d->bounds.min, ext = rl_sub(d->bounds.max, d->bounds.min);
+    size_t hits = 0;
+    for (int i = 0; i < N; ++i) {
+        rl_vec3 o = rl_v3(lo.x + ext.x * rl_rng_float(&rng), lo.y + ext.y * rl_rng_float(&rng),
+                          lo.z + ext.z * rl_rng_float(&rng));
+        float z = 1.0f - 2.0f * rl_rng_float(&rng), phi = 2.0f * RL_PI * rl_rng_float(&rng);
+        float r = sqrtf(fmaxf(0.0f, 1.0f - z * z));
+        rays[i] = (rl_ray){ o, 0.0f, rl_v3(r * cosf(phi), r * sinf(phi), z), INFINITY };
+        rl_ray q = rays[i];
+        cpu[i] = (rl_hit){ INFINITY, 0.0f, 0.0f, RL_ID_NONE, RL_ID_NONE };
+        hits += rl_accel_intersect(bvh, &q, &cpu[i]);
+    }
+    assert_true(hits > N / 2);
+    for (int k = 0; k < RL_GL_PT_STRUCTURE_COUNT; ++k) {
+        assert_int_equal(rl_gl_pt_trace(pt, (rl_gl_pt_structure)k, 0, false, rays, N, gpu), RL_OK);
+        size_t ties = 0;
+        for (int i = 0; i < N; ++i) {
+            if (cpu[i].triangle == RL_ID_NONE) {
+                assert_int_equal(gpu[i].triangle, RL_ID_NONE);
+                continue;
+            }
+            assert_int_not_equal(gpu[i].triangle, RL_ID_NONE);
+            assert_true(fabsf(gpu[i].t - cpu[i].t) <= 1e-4f * cpu[i].t);
+            ties += gpu[i].triangle != cpu[i].triangle;
+        }
+        print_message("%s: %d rays, %zu hits, %zu ties with other triangle IDs\n", k ? "grid" : "bvh", N, hits,
+                      ties);
+        assert_true(ties <= N / 100);
+    }
+    /* shadow segments: half of them end before the CPU's hit */
+    for (int i = 0; i < N; ++i) {
+        float len = isinf(cpu[i].t) ? 10.0f : cpu[i].t * (i % 2 ? 0.5f : 1.5f);
+        rays[i].t_max = len;
+        occluded[i] = rl_accel_occluded(bvh, &rays[i]);
+    }
+    for (int k = 0; k < RL_GL_PT_STRUCTURE_COUNT; ++k) {
+        assert_int_equal(rl_gl_pt_trace(pt, (rl_gl_pt_structure)k, 0, true, rays, N, gpu), RL_OK);
+        for (int i = 0; i < N; ++i)
+            assert_int_equal(gpu[i].triangle != RL_ID_NONE, occluded[i]);
+    }
+    /* another grid resolution rebuilds the grid */
+    for (int i = 0; i < N; ++i)
+        rays[i].t_max = INFINITY;
+    assert_int_equal(rl_gl_pt_trace(pt, RL_GL_PT_GRID, 5, false, rays, N, gpu), RL_OK);
+    for (int i = 0; i < N; ++i)
+        if (cpu[i].triangle != RL_ID_NONE)
+            assert_true(fabsf(gpu[i].t - cpu[i].t) <= 1e-4f * cpu[i].t);
+    free(rays);
+    free(cpu);
+    free(gpu);
+    free(occluded);
+    rl_gl_pt_release(pt);
+    rl_accel_release(bvh);
+    rl_scene_release(s);
+}
+
+static void expect_refused(rl_renderer *r, const char *key, const char *value, const char *says)
+{
+    rl_clear_error();
+    assert_int_equal(rl_renderer_set(r, key, value), RL_ERR_INVALID_ARG);
+    print_message("%s=%s: %s\n", key, value, rl_last_error());
+    assert_non_null(strstr(rl_last_error(), says));
+}
+
+static void test_gl_pt_refuses_what_is_not_ported(void **state)
+{
+    (void)state;
+    rl_renderer *r = fx_make("gl-pt", NULL);
+    expect_refused(r, "shadow", "ls-pnmt", "not ported");
+    expect_refused(r, "shadow", "shadowmap", "not ported");
+    expect_refused(r, "diffuse", "embree", "not ported");
+    expect_refused(r, "primary", "raster", "not ported");
+    expect_refused(r, "checkerboard", "true", "not ported");
+    expect_refused(r, "filter", "bilateral", "not ported");
+    expect_refused(r, "ls_n", "5", "unknown option");
+    expect_refused(r, "shadow", "octree", "shadow");
+    assert_int_equal(rl_renderer_set(r, "shadow", "grid"), RL_OK);
+    assert_int_equal(rl_renderer_set(r, "checkerboard", "false"), RL_OK);
+    assert_string_equal(rl_renderer_get(r, "shadow"), "grid");
+    rl_renderer_release(r);
+}
+
+static void test_gl_pt_unopenable_device_is_reported_unavailable(void **state)
+{
+    (void)state;
+    char why[256] = "";
+    rl_renderer *r = fx_make("gl-pt", (const char *const[]){ "device", "bogus", NULL });
+    assert_false(rl_renderer_available(r, why, sizeof why));
+    assert_non_null(strstr(why, "bogus"));
+    rl_camera cam;
+    rl_scene *s = fx_cornell(&cam, 16);
+    rl_image *img = NULL;
+    assert_int_equal(rl_image_create(16, 16, RL_LAYER_COLOR, &img), RL_OK);
+    rl_clear_error();
+    assert_int_equal(rl_renderer_render(r, s, &cam, img, NULL), RL_ERR_UNSUPPORTED);
+    rl_gl_pt *pt = NULL;
+    assert_int_equal(rl_gl_pt_create(s, &(rl_gl_pt_desc){ .device = "bogus" }, &pt), RL_ERR_UNSUPPORTED);
+    assert_null(pt);
+    rl_image_release(img);
+    rl_scene_release(s);
+    rl_renderer_release(r);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_gl_pt_converges_to_pt_on_cornell),
+        cmocka_unit_test(test_gl_pt_means_agree_with_pt),
+        cmocka_unit_test(test_gl_pt_draws_pts_numbers),
+        cmocka_unit_test(test_gl_pt_structures_agree_ray_for_ray),
+        cmocka_unit_test(test_gl_pt_refuses_what_is_not_ported),
+        cmocka_unit_test(test_gl_pt_unopenable_device_is_reported_unavailable),
+    };
+    return cmocka_run_group_tests(tests, find_gl, NULL);
+}
