@@ -69,6 +69,8 @@ RL_API rl_status rl_gl_drawer_create(const rl_scene *scene, const rl_drawer_desc
  * block size or 32-bit offsets. */
 typedef struct rl_gl_linespace_timing {
     double gpu_ms;                /* GL_TIME_ELAPSED of the build's passes */
+    double stamp_ms;              /* the same passes between GL_TIMESTAMP queries
+                                   * (llvmpipe's GL_TIME_ELAPSED reads 0 for compute) */
     double wall_ms;               /* uploads, passes and the total's readback, to glFinish */
     uint64_t shafts, occupied, candidates;
     uint64_t gpu_bytes;           /* every buffer the build made */

@@ -17,8 +17,8 @@
  *              in the dynamic lists and its rank among occupied shafts
  *   occ_cs     per 64 shafts the occupancy word and its rank, and the
  *              dynamic lists' start offsets (cand_start)
- *   fill_cs    per occupied shaft, its entries (triangle, key front, key
- *              back) at its offset, sorted in place by (key front,
+ *   fill_cs    per occupied shaft, its entries (triangle, key front, and
+ *              for fixed lists key back) at its offset, sorted in place by (key front,
  *              triangle), the CPU's order, then the IDs out: the whole
  *              list (dynamic), or the k/2 front-most and, sorted again by
  *              (key back descending, triangle), the k/2 back-most (fixed)
@@ -428,39 +428,32 @@ static const char *const fill_cs = GLSL(
     uniform bool u_dynamic;
     uniform int u_k;
 
-    bool front_less(uint a, uint b)
-    {
-        float ka = uintBitsToFloat(ent[3u * a + 1u]), kb = uintBitsToFloat(ent[3u * b + 1u]);
-        return ka < kb || (ka == kb && ent[3u * a] < ent[3u * b]);
-    }
-    bool back_less(uint a, uint b)
-    {
-        float ka = uintBitsToFloat(ent[3u * a + 2u]), kb = uintBitsToFloat(ent[3u * b + 2u]);
-        return ka > kb || (ka == kb && ent[3u * a] < ent[3u * b]);
-    }
     /* Insertion sort of entries [at, at + m) by one of the two orders; a
      * strict total order (the triangle breaks ties), so any correct sort
      * gives the CPU's sequence. */
     void sort_entries(uint at, uint m, bool back)
     {
         for (uint i = 1u; i < m; ++i) {
-            uvec3 x = uvec3(ent[3u * (at + i)], ent[3u * (at + i) + 1u], ent[3u * (at + i) + 2u]);
+            uint e = STRIDE * (at + i);
+            uvec3 x = uvec3(ent[e], ent[e + 1u], STRIDE > 2u ? ent[e + 2u] : 0u);
             uint j = i;
             for (; j > 0u; --j) {
                 uint p = at + j - 1u;
                 float kx = uintBitsToFloat(back ? x.z : x.y);
-                float kp = uintBitsToFloat(ent[3u * p + (back ? 2u : 1u)]);
-                bool less = back ? (kx > kp || (kx == kp && x.x < ent[3u * p]))
-                                 : (kx < kp || (kx == kp && x.x < ent[3u * p]));
+                float kp = uintBitsToFloat(ent[STRIDE * p + (back ? 2u : 1u)]);
+                bool less = back ? (kx > kp || (kx == kp && x.x < ent[STRIDE * p]))
+                                 : (kx < kp || (kx == kp && x.x < ent[STRIDE * p]));
                 if (!less)
                     break;
-                ent[3u * (p + 1u)] = ent[3u * p];
-                ent[3u * (p + 1u) + 1u] = ent[3u * p + 1u];
-                ent[3u * (p + 1u) + 2u] = ent[3u * p + 2u];
+                ent[STRIDE * (p + 1u)] = ent[STRIDE * p];
+                ent[STRIDE * (p + 1u) + 1u] = ent[STRIDE * p + 1u];
+                if (STRIDE > 2u)
+                    ent[STRIDE * (p + 1u) + 2u] = ent[STRIDE * p + 2u];
             }
-            ent[3u * (at + j)] = x.x;
-            ent[3u * (at + j) + 1u] = x.y;
-            ent[3u * (at + j) + 2u] = x.z;
+            ent[STRIDE * (at + j)] = x.x;
+            ent[STRIDE * (at + j) + 1u] = x.y;
+            if (STRIDE > 2u)
+                ent[STRIDE * (at + j) + 2u] = x.z;
         }
     }
 
@@ -482,9 +475,10 @@ static const char *const fill_cs = GLSL(
         for (uint j = first; j < last && c < m; ++j) {
             float kf, kb;
             if (tri_setup(cells[u_cells_at + j], blk) && overlaps(fa, pa, fb, pb, true, kf, kb)) {
-                ent[3u * (at + c)] = j - first;
-                ent[3u * (at + c) + 1u] = floatBitsToUint(kf);
-                ent[3u * (at + c) + 2u] = floatBitsToUint(kb);
+                ent[STRIDE * (at + c)] = j - first;
+                ent[STRIDE * (at + c) + 1u] = floatBitsToUint(kf);
+                if (!u_dynamic)
+                    ent[STRIDE * (at + c) + 2u] = floatBitsToUint(kb);
                 ++c;
             }
         }
@@ -492,15 +486,15 @@ static const char *const fill_cs = GLSL(
         uint tri0 = u_cells_at + first;
         if (u_dynamic) {
             for (uint i = 0u; i < m; ++i)
-                cand_out[at + i] = cells[tri0 + ent[3u * (at + i)]];
+                cand_out[at + i] = cells[tri0 + ent[STRIDE * (at + i)]];
             return;
         }
         uint half_k = uint(u_k) / 2u, nf = min(m, half_k), slot = here.y * uint(u_k);
         for (uint i = 0u; i < half_k; ++i)
-            cand_out[slot + i] = i < nf ? cells[tri0 + ent[3u * (at + i)]] : 0xffffffffu;
+            cand_out[slot + i] = i < nf ? cells[tri0 + ent[STRIDE * (at + i)]] : 0xffffffffu;
         sort_entries(at, m, true);
         for (uint i = 0u; i < half_k; ++i)
-            cand_out[slot + half_k + i] = i < nf ? cells[tri0 + ent[3u * (at + i)]] : 0xffffffffu;
+            cand_out[slot + half_k + i] = i < nf ? cells[tri0 + ent[STRIDE * (at + i)]] : 0xffffffffu;
     }
 );
 
@@ -590,14 +584,17 @@ static const char *const occ_cs = GLSL(
     }
 );
 
+/* fill: [0] dynamic lists (entries of 2 words: triangle, key front), [1]
+ * fixed lists (3 words, with the key back for the back half). */
 typedef struct programs {
-    GLuint count, fill, scan, add, occ;
+    GLuint count, fill[2], scan, add, occ;
 } programs;
 
 static void programs_free(programs *p)
 {
     glDeleteProgram(p->count);
-    glDeleteProgram(p->fill);
+    glDeleteProgram(p->fill[0]);
+    glDeleteProgram(p->fill[1]);
     glDeleteProgram(p->scan);
     glDeleteProgram(p->add);
     glDeleteProgram(p->occ);
@@ -612,13 +609,15 @@ static GLuint compute_program(const char *const *parts, int count, const char *w
 static rl_status make_programs(programs *p)
 {
     const char *count_parts[] = { header, build_common, count_cs };
-    const char *fill_parts[] = { header, build_common, fill_cs };
+    const char *fill_dyn[] = { header, "#define STRIDE 2u\n", build_common, fill_cs };
+    const char *fill_fixed[] = { header, "#define STRIDE 3u\n", build_common, fill_cs };
     const char *scan_parts[] = { header, scan_cs };
     const char *add_parts[] = { header, add_cs };
     const char *occ_parts[] = { header, occ_cs };
     p->count = compute_program(count_parts, 3, "line space count");
-    p->fill = p->count ? compute_program(fill_parts, 3, "line space fill") : 0;
-    p->scan = p->fill ? compute_program(scan_parts, 2, "line space scan") : 0;
+    p->fill[0] = p->count ? compute_program(fill_dyn, 4, "line space fill") : 0;
+    p->fill[1] = p->fill[0] ? compute_program(fill_fixed, 4, "line space fill") : 0;
+    p->scan = p->fill[1] ? compute_program(scan_parts, 2, "line space scan") : 0;
     p->add = p->scan ? compute_program(add_parts, 2, "line space scan add") : 0;
     p->occ = p->add ? compute_program(occ_parts, 2, "line space occupancy") : 0;
     return p->occ ? RL_OK : RL_ERR_INTERNAL;   /* the compiler's log is the recorded error */
@@ -943,7 +942,7 @@ static rl_status build_passes(rl_gl_ls *g, const programs *p, build_inputs *in, 
     if (st == RL_OK)
         st = make_buffer(&g->buf[BUF_CAND], g->num_cand * 4, NULL, cap, "candidate lists", &g->stats.gpu_bytes);
     if (st == RL_OK)
-        st = make_buffer(&in->entries, (uint64_t)total[0] * 12, NULL, cap, "sort entries", &g->stats.gpu_bytes);
+        st = make_buffer(&in->entries, (uint64_t)total[0] * (g->dynamic ? 8 : 12), NULL, cap, "sort entries", &g->stats.gpu_bytes);
     if (st != RL_OK)
         return st;
     glQueryCounter(queries[4], GL_TIMESTAMP);
@@ -964,10 +963,11 @@ static rl_status build_passes(rl_gl_ls *g, const programs *p, build_inputs *in, 
         glDispatchCompute(gx, gy, 1);
     /* ... and the fill pass. */
     groups_for(items, GROUP, &gx, &gy, &row);
-    glUseProgram(p->fill);
-    set_build_uniforms(p->fill, g, items, row, cells_at);
-    glProgramUniform1i(p->fill, glGetUniformLocation(p->fill, "u_dynamic"), g->dynamic);
-    glProgramUniform1i(p->fill, glGetUniformLocation(p->fill, "u_k"), g->k);
+    const GLuint fill = p->fill[g->dynamic ? 0 : 1];
+    glUseProgram(fill);
+    set_build_uniforms(fill, g, items, row, cells_at);
+    glProgramUniform1i(fill, glGetUniformLocation(fill, "u_dynamic"), g->dynamic);
+    glProgramUniform1i(fill, glGetUniformLocation(fill, "u_k"), g->k);
     bind_build(g, in);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 20, in->entries);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 21, g->buf[BUF_CAND]);
@@ -1260,7 +1260,8 @@ rl_status rl_gl_linespace_time_build(const rl_accel *grid, const rl_linespace_de
         st = rl_gl_ls_build(grid, desc, NULL, &g);
     if (st == RL_OK) {
         const rl_gl_ls_stats *s = &g->stats;
-        *out = (rl_gl_linespace_timing){ s->gpu_ms, s->wall_ms, s->shafts, s->occupied, s->candidates, s->gpu_bytes };
+        *out = (rl_gl_linespace_timing){ s->gpu_ms,     s->stamp_ms,   s->wall_ms,  s->shafts,
+                                         s->occupied, s->candidates, s->gpu_bytes };
     }
     rl_gl_ls_release(g);
     rl_gl_context_release(ctx);
