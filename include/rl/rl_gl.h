@@ -71,7 +71,8 @@ typedef struct rl_gl_linespace_timing {
     double gpu_ms;                /* GL_TIME_ELAPSED of the build's passes */
     double stamp_ms;              /* the same passes between GL_TIMESTAMP queries
                                    * (llvmpipe's GL_TIME_ELAPSED reads 0 for compute) */
-    double wall_ms;               /* uploads, passes and the total's readback, to glFinish */
+    double wall_ms;               /* uploads, passes and the total's readback, to glFinish
+                                   * (shader compilation not included) */
     uint64_t shafts, occupied, candidates;
     uint64_t gpu_bytes;           /* every buffer the build made */
 } rl_gl_linespace_timing;

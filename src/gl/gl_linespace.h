@@ -62,7 +62,7 @@ typedef struct rl_gl_ls_limits {
 /* Timings of a GPU build: GL_TIME_ELAPSED of its passes (count, scan,
  * occupancy, fill) and the wall time from the first upload to the result
  * in GPU memory (glFinish), uploads and the readback of the total
- * included. */
+ * included, the shaders' compilation (before it) not. */
 typedef struct rl_gl_ls_stats {
     bool gpu_built;
     int n, k;
