@@ -62,7 +62,7 @@ struct rl_gl_ls {
     GLuint buf[BUF_COUNT];
     uint64_t bytes[BUF_COUNT];
     int n, k;
-    bool dynamic, has_cand;
+    bool dynamic, has_cand, origin_exact;
     unsigned payloads;
     int res[3];
     float min[3], max[3], cell[3], inv_cell[3];
@@ -714,6 +714,7 @@ rl_status rl_gl_ls_upload(const rl_linespace *ls, const rl_gl_ls_limits *lim, rl
     g->dynamic = d.dynamic;
     g->payloads = ls->payloads;
     g->has_cand = (ls->payloads & RL_LS_CANDIDATES) != 0;
+    g->origin_exact = ls->origin == RL_LS_ORIGIN_EXACT;
     g->num_blocks = d.num_blocks;
     g->occ_words = d.occ_words;
     g->shafts_per_voxel = d.shafts_per_voxel;
@@ -1135,6 +1136,8 @@ void rl_gl_ls_set_uniforms(const rl_gl_ls *g, unsigned program)
     glProgramUniform3fv(p, glGetUniformLocation(p, "u_ls_inv_cell"), 1, g->inv_cell);
     glProgramUniform1ui(p, glGetUniformLocation(p, "u_ls_occ_words"), g->occ_words);
     glProgramUniform1ui(p, glGetUniformLocation(p, "u_ls_cell_tris_at"), g->num_cells + 1);
+    glProgramUniform1i(p, glGetUniformLocation(p, "u_ls_has_pnmt"), (g->payloads & RL_LS_PNMT) != 0);
+    glProgramUniform1i(p, glGetUniformLocation(p, "u_ls_origin_exact"), g->origin_exact);
 }
 
 static const char *const trace_cs = GLSL(
@@ -1142,6 +1145,7 @@ static const char *const trace_cs = GLSL(
     layout(std430, binding = 0) readonly buffer Rays { vec4 rays[]; };
     layout(std430, binding = 1) writeonly buffer Res { uvec4 res[]; };
     uniform uint u_count;
+    uniform bool u_pnmt;
 
     void main()
     {
@@ -1151,6 +1155,17 @@ static const char *const trace_cs = GLSL(
         vec4 a = rays[2u * i], b = rays[2u * i + 1u];
         uint tri;
         float t, u, v;
+        if (u_pnmt) {
+            vec3 p, n;
+            vec2 uv;
+            uint material;
+            bool h = rl_ls_pnmt_intersect(a.xyz, b.xyz, a.w, b.w, t, tri, p, n, uv, material);
+            bool o = rl_ls_pnmt_occluded(a.xyz, b.xyz, a.w, b.w);
+            uint kind = !h ? 0u : (tri == 0xffffffffu ? 2u : 1u);
+            res[2u * i] = uvec4(h ? tri : 0xffffffffu, floatBitsToUint(t), material, kind);
+            res[2u * i + 1u] = uvec4(o ? 1u : 0u, 0u, 0u, 0u);
+            return;
+        }
         bool h = rl_ls_intersect(a.xyz, b.xyz, a.w, b.w, tri, t, u, v);
         bool o = rl_ls_occluded(a.xyz, b.xyz, a.w, b.w);
         res[2u * i] = uvec4(h ? tri : 0xffffffffu, floatBitsToUint(t), floatBitsToUint(u), floatBitsToUint(v));
@@ -1158,10 +1173,14 @@ static const char *const trace_cs = GLSL(
     }
 );
 
-rl_status rl_gl_ls_trace(const rl_gl_ls *g, const rl_ray *rays, uint32_t count, rl_gl_ls_hit *out)
+rl_status rl_gl_ls_trace(const rl_gl_ls *g, const rl_ray *rays, uint32_t count, rl_gl_ls_query query,
+                         rl_gl_ls_hit *out)
 {
     if (!g || !rays || !out || count == 0 || count > (1u << 24))
         return rl_error(RL_ERR_INVALID_ARG, "rl_gl_ls_trace: NULL argument or %u rays", count);
+    const bool pnmt = query == RL_GL_LS_QUERY_PNMT;
+    if (pnmt && !(g->payloads & RL_LS_PNMT))
+        return rl_error(RL_ERR_INVALID_ARG, "rl_gl_ls_trace: no PNMT records uploaded");
     float *packed = malloc((size_t)count * 8 * sizeof *packed);
     uint32_t *res = malloc((size_t)count * 8 * sizeof *res);
     if (!packed || !res) {
@@ -1186,6 +1205,7 @@ rl_status rl_gl_ls_trace(const rl_gl_ls *g, const rl_ray *rays, uint32_t count, 
         rl_gl_ls_bind(g);
         rl_gl_ls_set_uniforms(g, prog);
         glProgramUniform1ui(prog, glGetUniformLocation(prog, "u_count"), count);
+        glProgramUniform1i(prog, glGetUniformLocation(prog, "u_pnmt"), pnmt);
         glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, bufs[0]);
         glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, bufs[1]);
         glDispatchCompute((count + 63) / 64, 1, 1);
@@ -1196,8 +1216,17 @@ rl_status rl_gl_ls_trace(const rl_gl_ls *g, const rl_ray *rays, uint32_t count, 
     for (uint32_t i = 0; st == RL_OK && i < count; ++i) {
         out[i].tri = res[8 * i];
         memcpy(&out[i].t, &res[8 * i + 1], sizeof out[i].t);
-        memcpy(&out[i].u, &res[8 * i + 2], sizeof out[i].u);
-        memcpy(&out[i].v, &res[8 * i + 3], sizeof out[i].v);
+        out[i].u = out[i].v = 0.0f;
+        out[i].material = 0;
+        out[i].record = false;
+        out[i].hit = pnmt ? res[8 * i + 3] != 0 : out[i].tri != RL_NONE;
+        if (pnmt) {
+            out[i].material = res[8 * i + 2];
+            out[i].record = res[8 * i + 3] == 2;
+        } else {
+            memcpy(&out[i].u, &res[8 * i + 2], sizeof out[i].u);
+            memcpy(&out[i].v, &res[8 * i + 3], sizeof out[i].v);
+        }
         out[i].occluded = res[8 * i + 4] != 0;
     }
     glDeleteBuffers(2, bufs);
@@ -1317,9 +1346,11 @@ void rl_gl_ls_set_uniforms(const rl_gl_ls *g, unsigned program)
     (void)program;
 }
 
-rl_status rl_gl_ls_trace(const rl_gl_ls *g, const rl_ray *rays, uint32_t count, rl_gl_ls_hit *out)
+rl_status rl_gl_ls_trace(const rl_gl_ls *g, const rl_ray *rays, uint32_t count, rl_gl_ls_query query,
+                         rl_gl_ls_hit *out)
 {
     (void)g;
+    (void)query;
     (void)rays;
     (void)count;
     (void)out;

@@ -100,21 +100,37 @@ void rl_gl_ls_set_uniforms(const rl_gl_ls *g, unsigned program);
  *                        out uint tri, out float t, out float u, out float v)
  *   bool rl_ls_occluded(vec3 o, vec3 d, float t_min, float t_max)
  * as rl_linespace_intersect / rl_linespace_occluded (CANDIDATES; without
- * that payload every filled voxel tests its grid list). Include it after
+ * that payload every filled voxel tests its grid list), and
+ *   bool rl_ls_pnmt_intersect(vec3 o, vec3 d, float t_min, float t_max,
+ *                             out float t, out uint tri, out vec3 p,
+ *                             out vec3 n, out vec2 uv, out uint material)
+ *   bool rl_ls_pnmt_occluded(vec3 o, vec3 d, float t_min, float t_max)
+ * as rl_linespace_pnmt_intersect / _occluded (uploaded PNMT records; the
+ * Line Space's origin rule at upload): a record gives tri = 0xffffffff and
+ * p, n, uv, material; the start voxel under RL_LS_ORIGIN_EXACT gives the
+ * exact hit's triangle and t, which the caller shades itself. Include it after
  * "#version 450 core" and before the program's own code. */
 const char *rl_gl_linespace_glsl(void);
 
 /* Traces rays[0..count) through the walk in one compute pass (buffers at
- * bindings 0 and 1, then 16-23): per ray the closest hit (tri RL_NONE for
- * none) and the occlusion answer of the same ray; what a GL renderer does
- * per pixel, for tests and measurements. RL_ERR_INVALID_ARG for a NULL
- * argument or count outside 1..2^24. */
+ * bindings 0 and 1, then 16-23), what a GL renderer does per pixel, for
+ * tests and measurements. CANDIDATES: per ray the closest hit (tri, t, u,
+ * v) and the occlusion answer; PNMT (uploaded records): the first stored
+ * surface (record: its material and t; in the start voxel under the exact
+ * origin rule a triangle) and the PNMT occlusion answer.
+ * RL_ERR_INVALID_ARG for a NULL argument, count outside 1..2^24, or PNMT
+ * without records. */
+typedef enum rl_gl_ls_query { RL_GL_LS_QUERY_CANDIDATES, RL_GL_LS_QUERY_PNMT } rl_gl_ls_query;
 typedef struct rl_gl_ls_hit {
-    uint32_t tri;
+    bool hit;
+    uint32_t tri;                 /* RL_NONE for none, or a PNMT record */
     float t, u, v;
+    uint32_t material;            /* PNMT records */
+    bool record;                  /* PNMT: the answer is a record */
     bool occluded;
 } rl_gl_ls_hit;
-rl_status rl_gl_ls_trace(const rl_gl_ls *g, const rl_ray *rays, uint32_t count, rl_gl_ls_hit *out);
+rl_status rl_gl_ls_trace(const rl_gl_ls *g, const rl_ray *rays, uint32_t count, rl_gl_ls_query query,
+                         rl_gl_ls_hit *out);
 
 /* The arrays back from GPU memory, in rl_linespace_data's layout (for
  * tests); free with rl_gl_ls_arrays_free. */

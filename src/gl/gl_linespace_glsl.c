@@ -39,6 +39,8 @@ static const char *const walk_glsl =
     uniform vec3 u_ls_inv_cell;
     uniform uint u_ls_occ_words;
     uniform uint u_ls_cell_tris_at;
+    uniform bool u_ls_has_pnmt;
+    uniform bool u_ls_origin_exact;
 
     /* grid.c's plane(): bounds.min + k * cell_size. */
     float rl_ls_plane(int a, int k)
@@ -436,6 +438,168 @@ static const char *const walk_glsl =
             }
         }
         return false;
+    }
+    /* ---- PNMT (Sec. 7.4; linespace_query.c pnmt_walk) ---- */
+
+    float rl_ls_half(uint rank, int i)
+    {
+        vec2 h = unpackHalf2x16(rl_ls_pnmt[rank * 8u + uint(i >> 1)]);
+        return (i & 1) == 0 ? h.x : h.y;
+    }
+
+    /* decode_pnmt: the record of direction fwd of occupied shaft `rank`
+     * in voxel xyz; false for an empty record. */
+    bool rl_ls_pnmt_decode(ivec3 xyz, uint rank, bool fwd, out vec3 p, out vec3 n, out vec2 uv, out uint material)
+    {
+        int b = fwd ? 0 : 8;
+        float m = rl_ls_half(rank, b + 5);
+        float a = m < 0.0 ? -m : m;
+        p = vec3(0.0);
+        n = vec3(0.0);
+        uv = vec2(0.0);
+        material = 0u;
+        if (!(a >= 1.0 && a <= 65504.0))
+            return false;
+        precise float mid = a - 1.0 + 0.5;
+        material = uint(mid);
+        for (int k = 0; k < 3; ++k) {
+            float lo = rl_ls_plane(k, xyz[k]), hi = rl_ls_plane(k, xyz[k] + 1);
+            precise float ext = hi - lo;
+            precise float x = lo + rl_ls_half(rank, b + k) * ext;
+            p[k] = x;
+        }
+        float nx = rl_ls_half(rank, b + 3), ny = rl_ls_half(rank, b + 4);
+        precise float q = 1.0 - nx * nx - ny * ny;
+        precise float nz = sqrt(0.0 > q ? 0.0 : q);
+        n = vec3(nx, ny, m < 0.0 ? -nz : nz);
+        uv = vec2(rl_ls_half(rank, b + 6), rl_ls_half(rank, b + 7));
+        return true;
+    }
+
+    float rl_ls_project_t(vec3 o, vec3 d, vec3 p)
+    {
+        precise vec3 q = p - o;
+        precise float num = q.x * d.x + q.y * d.y + q.z * d.z;
+        precise float den = d.x * d.x + d.y * d.y + d.z * d.z;
+        precise float t = num / den;
+        return t;
+    }
+
+    /* voxel_within: every point of voxel xyz projects inside (lo, t_max). */
+    bool rl_ls_voxel_within(ivec3 xyz, vec3 o, vec3 d, float lo, float t_max, float r)
+    {
+        vec3 c;
+        for (int k = 0; k < 3; ++k) {
+            precise float x = (rl_ls_plane(k, xyz[k]) + rl_ls_plane(k, xyz[k] + 1)) * 0.5;
+            c[k] = x;
+        }
+        float tc = rl_ls_project_t(o, d, c);
+        precise float slack = 1e-4 * r + 1e-6 * abs(tc);
+        precise float a = tc - r - slack, b = tc + r + slack;
+        return a > lo && b < t_max;
+    }
+
+    /* origin_hit: the closest hit among the start voxel's triangles (the
+     * shaft's dynamic list, else the cell's) before the voxel's exit t1. */
+    bool rl_ls_origin_hit(RlLsWt w, uint cell, uint shaft, uint rank, float t_min, float t_max, float t1,
+                          out uint tri, out float t)
+    {
+        precise float end = t1 + 1e-6 * abs(t1);
+        float limit = min(t_max, end);
+        tri = RL_LS_NONE;
+        t = limit;
+        uint first, count;
+        bool from_cells = shaft == RL_LS_NONE || !u_ls_has_cand || !u_ls_dynamic;
+        if (from_cells) {
+            first = u_ls_cell_tris_at + rl_ls_cells[cell];
+            count = rl_ls_cells[cell + 1u] - rl_ls_cells[cell];
+        } else {
+            first = rl_ls_cand_start[rank];
+            count = rl_ls_cand_start[rank + 1u] - first;
+        }
+        for (uint j = 0u; j < count; ++j) {
+            uint id = from_cells ? rl_ls_cells[first + j] : rl_ls_cand[first + j];
+            float th, uh, vh;
+            if (id == RL_LS_NONE || !rl_ls_wt_hit(w, id, t_min, limit, th, uh, vh))
+                continue;
+            if (tri == RL_LS_NONE || th < t || (th == t && id < tri)) {
+                tri = id;
+                t = th;
+                limit = rl_ls_next_up(th);
+            }
+        }
+        return tri != RL_LS_NONE;
+    }
+
+    /* rl_linespace_pnmt_intersect (want) / rl_linespace_pnmt_occluded: the
+     * first stored surface along the ray. In the start voxel under the
+     * exact origin rule the answer is a triangle (tri, t; the caller
+     * shades it), elsewhere a record (tri = RL_LS_NONE; p, n, uv,
+     * material; t its projection on the ray). */
+    bool rl_ls_pnmt_walk(vec3 o, vec3 d, float t_min, float t_max, bool want, out float t, out uint tri, out vec3 p,
+                         out vec3 n, out vec2 uv, out uint material)
+    {
+        t = 0.0;
+        tri = RL_LS_NONE;
+        p = vec3(0.0);
+        n = vec3(0.0);
+        uv = vec2(0.0);
+        material = 0u;
+        if (!u_ls_has_pnmt || !rl_ls_ray_ok(o, d, t_min, t_max))
+            return false;
+        RlLsDda it;
+        if (!rl_ls_dda_begin(o, d, t_min, t_max, it))
+            return false;
+        dvec3 lo, ld, linv;
+        rl_ls_line(o, d, lo, ld, linv);
+        RlLsWt w = rl_ls_wt_setup(o, d);
+        precise vec3 start = o + d * t_min;
+        bool first = u_ls_origin_exact && all(greaterThanEqual(start, u_ls_min)) && all(lessThanEqual(start, u_ls_max));
+        precise float r = want ? 0.0 : 0.5 * sqrt(u_ls_cell.x * u_ls_cell.x + u_ls_cell.y * u_ls_cell.y +
+                                                  u_ls_cell.z * u_ls_cell.z) / sqrt(d.x * d.x + d.y * d.y + d.z * d.z);
+        uint cell;
+        float t0, t1;
+        while (rl_ls_dda_next(it, cell, t0, t1)) {
+            bool origin = first;
+            first = false;
+            uint block = rl_ls_voxel_slot[cell];
+            if (block == RL_LS_NONE)
+                continue;
+            bool fwd = true;
+            uint rank = 0u;
+            uint shaft = rl_ls_shaft_of_ray(it.cur, lo, ld, linv, fwd);
+            if (shaft != RL_LS_NONE && !rl_ls_occupied(block, shaft, rank))
+                continue;
+            if (origin || shaft == RL_LS_NONE) {
+                if (rl_ls_origin_hit(w, cell, shaft, rank, t_min, t_max, t1, tri, t))
+                    return true;
+                continue;
+            }
+            if (!want && rl_ls_voxel_within(it.cur, o, d, t_min, t_max, r))
+                return true;
+            if (!rl_ls_pnmt_decode(it.cur, rank, fwd, p, n, uv, material))
+                continue;
+            t = rl_ls_project_t(o, d, p);
+            if (t > t_min && t < t_max)
+                return true;
+        }
+        tri = RL_LS_NONE;
+        return false;
+    }
+
+    bool rl_ls_pnmt_intersect(vec3 o, vec3 d, float t_min, float t_max, out float t, out uint tri, out vec3 p,
+                              out vec3 n, out vec2 uv, out uint material)
+    {
+        return rl_ls_pnmt_walk(o, d, t_min, t_max, true, t, tri, p, n, uv, material);
+    }
+
+    bool rl_ls_pnmt_occluded(vec3 o, vec3 d, float t_min, float t_max)
+    {
+        float t;
+        uint tri, material;
+        vec3 p, n;
+        vec2 uv;
+        return rl_ls_pnmt_walk(o, d, t_min, t_max, false, t, tri, p, n, uv, material);
     }
 );
 

@@ -203,7 +203,7 @@ static void compare_queries(const char *what, const rl_linespace *ls, const rl_g
     static rl_ray rays[RAYS];
     make_rays(d, rays, RAYS);
     static rl_gl_ls_hit res[RAYS];
-    if (rl_gl_ls_trace(g, rays, RAYS, res) != RL_OK)
+    if (rl_gl_ls_trace(g, rays, RAYS, RL_GL_LS_QUERY_CANDIDATES, res) != RL_OK)
         fail_msg("%s: trace: %s", what, rl_last_error());
     int hits = 0, occluded = 0;
     for (int i = 0; i < RAYS; ++i) {
@@ -226,6 +226,41 @@ static void compare_queries(const char *what, const rl_linespace *ls, const rl_g
     }
     print_message("%s: %d rays, %d hits, %d occluded, all equal\n", what, RAYS, hits, occluded);
     assert_true(hits > RAYS / 4 && occluded > RAYS / 4 && occluded < RAYS);
+}
+
+/* PNMT: the same first surface (record or start-voxel triangle) and the
+ * same occlusion answers, under both origin rules. */
+static void compare_pnmt(const char *what, const rl_linespace *ls, const rl_gl_ls *g, const rl_scene_data *d)
+{
+    static rl_ray rays[RAYS];
+    make_rays(d, rays, RAYS);
+    static rl_gl_ls_hit res[RAYS];
+    if (rl_gl_ls_trace(g, rays, RAYS, RL_GL_LS_QUERY_PNMT, res) != RL_OK)
+        fail_msg("%s: trace: %s", what, rl_last_error());
+    int hits = 0, records = 0, occluded = 0;
+    for (int i = 0; i < RAYS; ++i) {
+        rl_ls_surface s;
+        bool hit = rl_linespace_pnmt_intersect(ls, &rays[i], &s);
+        bool occ = rl_linespace_pnmt_occluded(ls, &rays[i]);
+        hits += hit;
+        records += res[i].record;
+        occluded += occ;
+        /* A record's material is the stored one; a start-voxel hit is a
+         * triangle, whose material the CPU looked up. */
+        bool same = res[i].hit == hit &&
+                    (!hit || (fabsf(res[i].t - s.t) <= 1e-4f * fabsf(s.t) &&
+                              (res[i].record ? res[i].material == s.material
+                                             : d->triangle_material[res[i].tri] == s.material)));
+        if (!same)
+            fail_msg("%s ray %d: cpu %d t %.9g material %u, gl %d t %.9g tri %u record %d material %u", what, i, hit,
+                     (double)s.t, hit ? s.material : 0u, res[i].hit, (double)res[i].t, res[i].tri, res[i].record,
+                     res[i].material);
+        if (res[i].occluded != occ)
+            fail_msg("%s ray %d: pnmt occluded cpu %d, gl %d", what, i, occ, res[i].occluded);
+    }
+    print_message("%s: %d rays, %d PNMT hits (%d from records), %d occluded, all equal\n", what, RAYS, hits,
+                  records, occluded);
+    assert_true(hits > RAYS / 4 && records > 0 && occluded > RAYS / 4);
 }
 
 static void walk_equals_cpu(void **state)
@@ -252,6 +287,16 @@ static void walk_equals_cpu(void **state)
                      descs[j].k, descs[j].payloads & RL_LS_PNMT ? " +PNMT" : "");
             compare_queries(what, ls, up, rl_scene_get_data(s));
             rl_gl_ls_release(up);
+            if (descs[j].payloads & RL_LS_PNMT)
+                for (int rule = 0; rule < 2; ++rule) {
+                    assert_int_equal(rl_linespace_set_origin(ls, rule ? RL_LS_ORIGIN_RECORDS : RL_LS_ORIGIN_EXACT),
+                                     RL_OK);
+                    if (rl_gl_ls_upload(ls, NULL, &up) != RL_OK)
+                        fail_msg("upload: %s", rl_last_error());
+                    snprintf(what, sizeof what, "%s uploaded PNMT, origin %s", su->name, rule ? "records" : "exact");
+                    compare_pnmt(what, ls, up, rl_scene_get_data(s));
+                    rl_gl_ls_release(up);
+                }
             if (!(descs[j].payloads & RL_LS_PNMT)) {
                 rl_gl_ls *built = NULL;
                 if (rl_gl_ls_build(grid, &descs[j], NULL, &built) != RL_OK)
