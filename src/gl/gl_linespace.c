@@ -1137,6 +1137,7 @@ void rl_gl_ls_set_uniforms(const rl_gl_ls *g, unsigned program)
     glProgramUniform1ui(p, glGetUniformLocation(p, "u_ls_occ_words"), g->occ_words);
     glProgramUniform1ui(p, glGetUniformLocation(p, "u_ls_cell_tris_at"), g->num_cells + 1);
     glProgramUniform1i(p, glGetUniformLocation(p, "u_ls_has_pnmt"), (g->payloads & RL_LS_PNMT) != 0);
+    glProgramUniform1i(p, glGetUniformLocation(p, "u_ls_has_preillum"), (g->payloads & RL_LS_PREILLUM) != 0);
     glProgramUniform1i(p, glGetUniformLocation(p, "u_ls_origin_exact"), g->origin_exact);
 }
 
@@ -1145,7 +1146,7 @@ static const char *const trace_cs = GLSL(
     layout(std430, binding = 0) readonly buffer Rays { vec4 rays[]; };
     layout(std430, binding = 1) writeonly buffer Res { uvec4 res[]; };
     uniform uint u_count;
-    uniform bool u_pnmt;
+    uniform int u_query;      /* rl_gl_ls_query */
 
     void main()
     {
@@ -1155,7 +1156,15 @@ static const char *const trace_cs = GLSL(
         vec4 a = rays[2u * i], b = rays[2u * i + 1u];
         uint tri;
         float t, u, v;
-        if (u_pnmt) {
+        if (u_query == 2) {
+            vec3 c;
+            bool h = rl_ls_preillum(a.xyz, b.xyz, a.w, b.w, c, t);
+            bool o = rl_ls_preillum_occluded(a.xyz, b.xyz, a.w, b.w);
+            res[2u * i] = uvec4(h ? 1u : 0u, floatBitsToUint(t), floatBitsToUint(c.r), floatBitsToUint(c.g));
+            res[2u * i + 1u] = uvec4(o ? 1u : 0u, floatBitsToUint(c.b), 0u, 0u);
+            return;
+        }
+        if (u_query == 1) {
             vec3 p, n;
             vec2 uv;
             uint material;
@@ -1178,9 +1187,9 @@ rl_status rl_gl_ls_trace(const rl_gl_ls *g, const rl_ray *rays, uint32_t count, 
 {
     if (!g || !rays || !out || count == 0 || count > (1u << 24))
         return rl_error(RL_ERR_INVALID_ARG, "rl_gl_ls_trace: NULL argument or %u rays", count);
-    const bool pnmt = query == RL_GL_LS_QUERY_PNMT;
-    if (pnmt && !(g->payloads & RL_LS_PNMT))
-        return rl_error(RL_ERR_INVALID_ARG, "rl_gl_ls_trace: no PNMT records uploaded");
+    const bool pnmt = query == RL_GL_LS_QUERY_PNMT, pre = query == RL_GL_LS_QUERY_PREILLUM;
+    if ((pnmt && !(g->payloads & RL_LS_PNMT)) || (pre && !(g->payloads & RL_LS_PREILLUM)))
+        return rl_error(RL_ERR_INVALID_ARG, "rl_gl_ls_trace: no %s records uploaded", pnmt ? "PNMT" : "PREILLUM");
     float *packed = malloc((size_t)count * 8 * sizeof *packed);
     uint32_t *res = malloc((size_t)count * 8 * sizeof *res);
     if (!packed || !res) {
@@ -1205,7 +1214,7 @@ rl_status rl_gl_ls_trace(const rl_gl_ls *g, const rl_ray *rays, uint32_t count, 
         rl_gl_ls_bind(g);
         rl_gl_ls_set_uniforms(g, prog);
         glProgramUniform1ui(prog, glGetUniformLocation(prog, "u_count"), count);
-        glProgramUniform1i(prog, glGetUniformLocation(prog, "u_pnmt"), pnmt);
+        glProgramUniform1i(prog, glGetUniformLocation(prog, "u_query"), (GLint)query);
         glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, bufs[0]);
         glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, bufs[1]);
         glDispatchCompute((count + 63) / 64, 1, 1);
@@ -1219,8 +1228,14 @@ rl_status rl_gl_ls_trace(const rl_gl_ls *g, const rl_ray *rays, uint32_t count, 
         out[i].u = out[i].v = 0.0f;
         out[i].material = 0;
         out[i].record = false;
-        out[i].hit = pnmt ? res[8 * i + 3] != 0 : out[i].tri != RL_NONE;
-        if (pnmt) {
+        out[i].hit = pnmt ? res[8 * i + 3] != 0 : (pre ? res[8 * i] != 0 : out[i].tri != RL_NONE);
+        out[i].color[0] = out[i].color[1] = out[i].color[2] = 0.0f;
+        if (pre) {
+            out[i].tri = RL_NONE;
+            memcpy(&out[i].color[0], &res[8 * i + 2], sizeof(float));
+            memcpy(&out[i].color[1], &res[8 * i + 3], sizeof(float));
+            memcpy(&out[i].color[2], &res[8 * i + 5], sizeof(float));
+        } else if (pnmt) {
             out[i].material = res[8 * i + 2];
             out[i].record = res[8 * i + 3] == 2;
         } else {

@@ -108,7 +108,11 @@ void rl_gl_ls_set_uniforms(const rl_gl_ls *g, unsigned program);
  * as rl_linespace_pnmt_intersect / _occluded (uploaded PNMT records; the
  * Line Space's origin rule at upload): a record gives tri = 0xffffffff and
  * p, n, uv, material; the start voxel under RL_LS_ORIGIN_EXACT gives the
- * exact hit's triangle and t, which the caller shades itself. Include it after
+ * exact hit's triangle and t, which the caller shades itself; and
+ *   bool rl_ls_preillum(vec3 o, vec3 d, float t_min, float t_max,
+ *                       out vec3 color, out float t)
+ *   bool rl_ls_preillum_occluded(vec3 o, vec3 d, float t_min, float t_max)
+ * as rl_linespace_preillum / _preillum_occluded (uploaded records). Include it after
  * "#version 450 core" and before the program's own code. */
 const char *rl_gl_linespace_glsl(void);
 
@@ -117,16 +121,22 @@ const char *rl_gl_linespace_glsl(void);
  * tests and measurements. CANDIDATES: per ray the closest hit (tri, t, u,
  * v) and the occlusion answer; PNMT (uploaded records): the first stored
  * surface (record: its material and t; in the start voxel under the exact
- * origin rule a triangle) and the PNMT occlusion answer.
+ * origin rule a triangle) and the PNMT occlusion answer; PREILLUM: the
+ * stored colour and t, and the PREILLUM occlusion answer.
  * RL_ERR_INVALID_ARG for a NULL argument, count outside 1..2^24, or PNMT
  * without records. */
-typedef enum rl_gl_ls_query { RL_GL_LS_QUERY_CANDIDATES, RL_GL_LS_QUERY_PNMT } rl_gl_ls_query;
+typedef enum rl_gl_ls_query {
+    RL_GL_LS_QUERY_CANDIDATES,
+    RL_GL_LS_QUERY_PNMT,
+    RL_GL_LS_QUERY_PREILLUM
+} rl_gl_ls_query;
 typedef struct rl_gl_ls_hit {
     bool hit;
     uint32_t tri;                 /* RL_NONE for none, or a PNMT record */
     float t, u, v;
     uint32_t material;            /* PNMT records */
     bool record;                  /* PNMT: the answer is a record */
+    float color[3];               /* PREILLUM */
     bool occluded;
 } rl_gl_ls_hit;
 rl_status rl_gl_ls_trace(const rl_gl_ls *g, const rl_ray *rays, uint32_t count, rl_gl_ls_query query,

@@ -24,7 +24,7 @@ static const char *const walk_glsl =
     layout(std430, binding = 18) readonly buffer RlLsCand { uint rl_ls_cand[]; };
     layout(std430, binding = 19) readonly buffer RlLsStart { uint rl_ls_cand_start[]; };
     layout(std430, binding = 20) readonly buffer RlLsPnmt { uint rl_ls_pnmt[]; };
-    layout(std430, binding = 21) readonly buffer RlLsPreillum { uint rl_ls_preillum[]; };
+    layout(std430, binding = 21) readonly buffer RlLsPreillum { uint rl_ls_preillum_rec[]; };
     layout(std430, binding = 22) readonly buffer RlLsTris { float rl_ls_tri_v[]; };
     layout(std430, binding = 23) readonly buffer RlLsCells { uint rl_ls_cells[]; };
 
@@ -40,6 +40,7 @@ static const char *const walk_glsl =
     uniform uint u_ls_occ_words;
     uniform uint u_ls_cell_tris_at;
     uniform bool u_ls_has_pnmt;
+    uniform bool u_ls_has_preillum;
     uniform bool u_ls_origin_exact;
 
     /* grid.c's plane(): bounds.min + k * cell_size. */
@@ -600,6 +601,79 @@ static const char *const walk_glsl =
         vec3 p, n;
         vec2 uv;
         return rl_ls_pnmt_walk(o, d, t_min, t_max, false, t, tri, p, n, uv, material);
+    }
+    /* ---- PREILLUM (Sec. 7.3; linespace_query.c preillum_walk) ---- */
+
+    /* rl_linespace_preillum (want: colour and t) / _preillum_occluded: the
+     * stored colour of the first surface; t from the PNMT record where one
+     * is uploaded, else the middle of the ray's interval in the voxel. The
+     * start voxel under the exact origin rule counts a record only beyond
+     * a tenth of the voxel diagonal. */
+    bool rl_ls_preillum_walk(vec3 o, vec3 d, float t_min, float t_max, bool want, out vec3 color, out float t)
+    {
+        color = vec3(0.0);
+        t = 0.0;
+        if (!u_ls_has_preillum || !rl_ls_ray_ok(o, d, t_min, t_max))
+            return false;
+        RlLsDda it;
+        if (!rl_ls_dda_begin(o, d, t_min, t_max, it))
+            return false;
+        dvec3 lo, ld, linv;
+        rl_ls_line(o, d, lo, ld, linv);
+        precise vec3 start = o + d * t_min;
+        bool first = u_ls_origin_exact && all(greaterThanEqual(start, u_ls_min)) && all(lessThanEqual(start, u_ls_max));
+        precise float len_c = sqrt(u_ls_cell.x * u_ls_cell.x + u_ls_cell.y * u_ls_cell.y + u_ls_cell.z * u_ls_cell.z);
+        precise float len_d = sqrt(d.x * d.x + d.y * d.y + d.z * d.z);
+        precise float margin = 0.1 * len_c / len_d;
+        precise float r = want ? 0.0 : 0.5 * len_c / len_d;
+        uint cell;
+        float t0, t1;
+        while (rl_ls_dda_next(it, cell, t0, t1)) {
+            bool origin = first;
+            first = false;
+            uint block = rl_ls_voxel_slot[cell];
+            if (block == RL_LS_NONE)
+                continue;
+            bool fwd = true;
+            uint rank = 0u;
+            uint shaft = rl_ls_shaft_of_ray(it.cur, lo, ld, linv, fwd);
+            if (shaft == RL_LS_NONE || !rl_ls_occupied(block, shaft, rank))
+                continue;
+            precise float lo_t = origin ? t_min + margin : t_min;
+            precise float tm = 0.5 * (t0 + t1);
+            float th = tm;
+            if (u_ls_has_pnmt) {
+                if (!want && rl_ls_voxel_within(it.cur, o, d, lo_t, t_max, r))
+                    return true;
+                vec3 p, n;
+                vec2 uv;
+                uint material;
+                if (rl_ls_pnmt_decode(it.cur, rank, fwd, p, n, uv, material))
+                    th = rl_ls_project_t(o, d, p);
+            }
+            if (!(th > lo_t && th < t_max))
+                continue;
+            if (want) {
+                uint w = rank * 4u + (fwd ? 0u : 2u);
+                vec2 rg = unpackHalf2x16(rl_ls_preillum_rec[w]), ba = unpackHalf2x16(rl_ls_preillum_rec[w + 1u]);
+                color = vec3(rg, ba.x);
+            }
+            t = th;
+            return true;
+        }
+        return false;
+    }
+
+    bool rl_ls_preillum(vec3 o, vec3 d, float t_min, float t_max, out vec3 color, out float t)
+    {
+        return rl_ls_preillum_walk(o, d, t_min, t_max, true, color, t);
+    }
+
+    bool rl_ls_preillum_occluded(vec3 o, vec3 d, float t_min, float t_max)
+    {
+        vec3 color;
+        float t;
+        return rl_ls_preillum_walk(o, d, t_min, t_max, false, color, t);
     }
 );
 

@@ -44,10 +44,14 @@ static rl_accel *grid_of(const rl_scene *s, int res)
     return a;
 }
 
+static rl_vec3 shade(void *user, const rl_ls_surface *s, rl_vec3 dir);
+
 static rl_linespace *cpu_ls(const rl_accel *grid, rl_linespace_desc d)
 {
     rl_linespace *ls = NULL;
     assert_int_equal(rl_linespace_create(grid, &d, &ls), RL_OK);
+    if (d.payloads & RL_LS_PREILLUM)
+        assert_int_equal(rl_linespace_set_shader(ls, shade, NULL), RL_OK);
     if (rl_linespace_commit(ls) != RL_OK)
         fail_msg("linespace: %s", rl_last_error());
     return ls;
@@ -263,6 +267,42 @@ static void compare_pnmt(const char *what, const rl_linespace *ls, const rl_gl_l
     assert_true(hits > RAYS / 4 && records > 0 && occluded > RAYS / 4);
 }
 
+/* A shading function for PREILLUM: any colour that varies over the
+ * surfaces does. */
+static rl_vec3 shade(void *user, const rl_ls_surface *s, rl_vec3 dir)
+{
+    (void)user;
+    return rl_v3(fabsf(s->n.x) + 0.1f * (float)s->material, fabsf(s->n.y) + s->uv.x, fabsf(dir.z) + s->p.y);
+}
+
+static void compare_preillum(const char *what, const rl_linespace *ls, const rl_gl_ls *g, const rl_scene_data *d)
+{
+    static rl_ray rays[RAYS];
+    make_rays(d, rays, RAYS);
+    static rl_gl_ls_hit res[RAYS];
+    if (rl_gl_ls_trace(g, rays, RAYS, RL_GL_LS_QUERY_PREILLUM, res) != RL_OK)
+        fail_msg("%s: trace: %s", what, rl_last_error());
+    int hits = 0, occluded = 0;
+    for (int i = 0; i < RAYS; ++i) {
+        rl_vec3 c = rl_v3(0, 0, 0);
+        float t = 0.0f;
+        bool hit = rl_linespace_preillum(ls, &rays[i], &c, &t);
+        bool occ = rl_linespace_preillum_occluded(ls, &rays[i]);
+        hits += hit;
+        occluded += occ;
+        /* Colours are the stored half floats: equal bit for bit. */
+        if (res[i].hit != hit || (hit && (fabsf(res[i].t - t) > 1e-4f * fabsf(t) || res[i].color[0] != c.x ||
+                                          res[i].color[1] != c.y || res[i].color[2] != c.z)))
+            fail_msg("%s ray %d: cpu %d t %.9g (%g %g %g), gl %d t %.9g (%g %g %g)", what, i, hit, (double)t,
+                     (double)c.x, (double)c.y, (double)c.z, res[i].hit, (double)res[i].t, (double)res[i].color[0],
+                     (double)res[i].color[1], (double)res[i].color[2]);
+        if (res[i].occluded != occ)
+            fail_msg("%s ray %d: preillum occluded cpu %d, gl %d", what, i, occ, res[i].occluded);
+    }
+    print_message("%s: %d rays, %d PREILLUM hits, %d occluded, all equal\n", what, RAYS, hits, occluded);
+    assert_true(hits > RAYS / 4 && occluded > RAYS / 4);
+}
+
 static void walk_equals_cpu(void **state)
 {
     (void)state;
@@ -276,18 +316,31 @@ static void walk_equals_cpu(void **state)
             { .n = su->n, .dynamic = true },
             { .n = su->n, .k = 4 },
             { .n = su->n, .dynamic = true, .payloads = RL_LS_CANDIDATES | RL_LS_PNMT },
+            { .n = su->n, .dynamic = true, .payloads = RL_LS_CANDIDATES | RL_LS_PREILLUM },
+            { .n = su->n, .dynamic = true, .payloads = RL_LS_CANDIDATES | RL_LS_PNMT | RL_LS_PREILLUM },
         };
         for (size_t j = 0; j < sizeof descs / sizeof descs[0]; ++j) {
             rl_linespace *ls = cpu_ls(grid, descs[j]);
-            char what[128];
+            char what[160];
             rl_gl_ls *up = NULL;
             if (rl_gl_ls_upload(ls, NULL, &up) != RL_OK)
                 fail_msg("upload: %s", rl_last_error());
-            snprintf(what, sizeof what, "%s uploaded, %s k=%d%s", su->name, descs[j].dynamic ? "dynamic" : "fixed",
-                     descs[j].k, descs[j].payloads & RL_LS_PNMT ? " +PNMT" : "");
+            snprintf(what, sizeof what, "%s uploaded, %s k=%d payloads 0x%x", su->name,
+                     descs[j].dynamic ? "dynamic" : "fixed", descs[j].k, descs[j].payloads);
             compare_queries(what, ls, up, rl_scene_get_data(s));
             rl_gl_ls_release(up);
-            if (descs[j].payloads & RL_LS_PNMT)
+            if (descs[j].payloads & RL_LS_PREILLUM)
+                for (int rule = 0; rule < 2; ++rule) {
+                    assert_int_equal(rl_linespace_set_origin(ls, rule ? RL_LS_ORIGIN_RECORDS : RL_LS_ORIGIN_EXACT),
+                                     RL_OK);
+                    if (rl_gl_ls_upload(ls, NULL, &up) != RL_OK)
+                        fail_msg("upload: %s", rl_last_error());
+                    snprintf(what, sizeof what, "%s uploaded PREILLUM%s, origin %s", su->name,
+                             descs[j].payloads & RL_LS_PNMT ? " +PNMT" : "", rule ? "records" : "exact");
+                    compare_preillum(what, ls, up, rl_scene_get_data(s));
+                    rl_gl_ls_release(up);
+                }
+            if ((descs[j].payloads & RL_LS_PNMT) && !(descs[j].payloads & RL_LS_PREILLUM))
                 for (int rule = 0; rule < 2; ++rule) {
                     assert_int_equal(rl_linespace_set_origin(ls, rule ? RL_LS_ORIGIN_RECORDS : RL_LS_ORIGIN_EXACT),
                                      RL_OK);
@@ -297,7 +350,7 @@ static void walk_equals_cpu(void **state)
                     compare_pnmt(what, ls, up, rl_scene_get_data(s));
                     rl_gl_ls_release(up);
                 }
-            if (!(descs[j].payloads & RL_LS_PNMT)) {
+            if (descs[j].payloads == RL_LS_CANDIDATES || descs[j].payloads == 0) {
                 rl_gl_ls *built = NULL;
                 if (rl_gl_ls_build(grid, &descs[j], NULL, &built) != RL_OK)
                     fail_msg("gpu build: %s", rl_last_error());
