@@ -18,6 +18,13 @@
  *               cornell (or --scenes) at 256x256: first frame (and its
  *               preparation) and the minimum of N warm frames, their
  *               ratio, and gl-pt's frames per second
+ *   linespace   Line Space generation (Schröder 2017, Table 1's scenes and
+ *               voxel resolutions, dynamic candidate lists) on the GPU
+ *               (compute shaders, gl_linespace.c) vs the CPU build (every
+ *               thread): GL_TIME_ELAPSED, GL_TIMESTAMP and wall ms on GL,
+ *               build ms on the CPU, the thesis' ms beside them, and
+ *               whether both give the same numbers of occupied shafts and
+ *               candidates (the test compares the arrays themselves)
  * Speed ratios come from the same run on the same machine. Besides wall
  * time every figure has the process's CPU time (all threads, llvmpipe's
  * included), which a machine shared with other work inflates less. On llvmpipe
@@ -55,6 +62,9 @@ static const char bench_gl_help[] =
     "  pt          gl-pt vs pt at the same spp: first frame, minimum of N warm\n"
     "              frames (ms), ratio, gl-pt frames per second; cornell unless\n"
     "              --scenes names others\n"
+    "  linespace   Line Space generation on GL vs CPU for the first rows of\n"
+    "              Schröder 2017's Table 1 (ls-cornell scenes), the thesis' ms beside\n"
+    "              ours\n"
     "The record names the GL vendor, renderer and version.\n"
     "\n"
     "options:\n"
@@ -63,20 +73,23 @@ static const char bench_gl_help[] =
     "  --frames N        frames: warm frames per renderer (minimum); default 5\n"
     "  --resolution N    visibility: cube-face side; default 256\n"
     "  --positions N     visibility: positions per scene; default 4\n"
+    "  --ls-rows N       linespace: Table 1 rows 1..N (1..8); default 1 (llvmpipe\n"
+    "                    needs about a minute for row 1, a GPU runs all 8)\n"
     "  --device D        EGL device (rl_gl.h); default $RL_EGL_DEVICE, else auto\n"
     "  --pt-size WxH     pt: image size; default 256x256\n"
     "  --pt-spp N        pt: samples per pixel and frame of both; default 1\n"
     "  --pt-gl-only      pt: time gl-pt alone (no pt frames to wait for)\n"
-    "  --only A,B        sections: frames, visibility, pt\n"
+    "  --only A,B        sections: frames, visibility, pt, linespace\n"
     "  --out FILE.json   default bench/results/gl-YYYYMMDD-HHMMSS.json\n"
     "  --quick           tiny run: cornell and spheres, 160x120, 2 frames,\n"
-    "                    resolution 32, 2 positions, pt at 64x64\n"
+    "                    resolution 32, 2 positions, pt at 64x64;\n"
+    "                    linespace: row 1's scene at 4^3 voxels, N = 2 (no thesis row)\n"
     "\n"
     "example:\n"
     "  RL_EGL_DEVICE=surfaceless rl bench gl --only frames --scenes cornell,table\n";
 
-enum { SEC_FRAMES, SEC_VISIBILITY, SEC_PT, SEC_COUNT };
-static const char *const section_names[SEC_COUNT] = { "frames", "visibility", "pt" };
+enum { SEC_FRAMES, SEC_VISIBILITY, SEC_PT, SEC_LINESPACE, SEC_COUNT };
+static const char *const section_names[SEC_COUNT] = { "frames", "visibility", "pt", "linespace" };
 
 #define MAX_SCENES 16
 
@@ -84,7 +97,7 @@ typedef struct bgl_args {
     const char *scenes_text, *out, *device;
     int width, height;
     int pt_width, pt_height;
-    long long frames, resolution, positions, pt_spp;
+    long long frames, resolution, positions, pt_spp, ls_rows;
     unsigned sections;
     bool quick;
     bool pt_gl_only;              /* pt: gl-pt alone (a GPU's fps at sizes where pt takes seconds) */
@@ -153,7 +166,7 @@ static int parse_args(int argc, char **argv, bgl_args *a)
 {
     a->sections = (1u << SEC_COUNT) - 1;
     bool has_size = false, has_frames = false, has_res = false, has_pos = false, has_pt_size = false,
-         has_pt_spp = false;
+         has_pt_spp = false, has_rows = false;
     const bench_opt rows[] = {
         RL_BENCH_FLAG("--quick", &a->quick),
         RL_BENCH_STRING("--scenes", &a->scenes_text),
@@ -161,6 +174,7 @@ static int parse_args(int argc, char **argv, bgl_args *a)
         RL_BENCH_COUNT("--frames", 1000, &a->frames, &has_frames),
         RL_BENCH_COUNT("--resolution", 4096, &a->resolution, &has_res),
         RL_BENCH_COUNT("--positions", 1000, &a->positions, &has_pos),
+        RL_BENCH_COUNT("--ls-rows", 8, &a->ls_rows, &has_rows),
         RL_BENCH_STRING("--device", &a->device),
         RL_BENCH_SIZE("--pt-size", &a->pt_width, &a->pt_height, &has_pt_size),
         RL_BENCH_COUNT("--pt-spp", 65536, &a->pt_spp, &has_pt_spp),
@@ -185,6 +199,8 @@ static int parse_args(int argc, char **argv, bgl_args *a)
         a->pt_width = a->pt_height = a->quick ? 64 : 256;
     if (!has_pt_spp)
         a->pt_spp = 1;
+    if (!has_rows)
+        a->ls_rows = 1;
     if (!a->device)
         a->device = "";
     return RL_CLI_OK;
@@ -523,6 +539,113 @@ static rl_status sec_visibility(void *ctx, cJSON *sec)
     return st;
 }
 
+/* ------------------------------------------------------------- linespace */
+
+/* Schröder 2017, Table 1: Line Space generation on a GeForce GTX 1080, ms
+ * (the scenes of Sec. 9.3 as our ls-cornell built-in models them). */
+static const struct ls_row {
+    const char *scene;
+    int res, n;
+    double thesis_ms;
+} ls_rows[] = {
+    { "ls-cornell:model=boxes", 8, 4, 154 },    { "ls-cornell:model=boxes", 8, 5, 269 },
+    { "ls-cornell:model=teapot", 8, 5, 644 },   { "ls-cornell:model=teapot", 32, 5, 1795 },
+    { "ls-cornell:model=bunny", 8, 5, 3915 },   { "ls-cornell:model=bunny", 64, 5, 10081 },
+    { "ls-cornell:model=dragon", 8, 5, 94393 }, { "ls-cornell:model=dragon", 72, 5, 53675 },
+};
+
+/* One row: the grid, the CPU build and the GL build of the same Line Space. */
+static rl_status ls_row_run(const bgl_ctx *c, const char *name, int res, int n, double thesis_ms, cJSON *rows)
+{
+    rl_scene *scene = NULL;
+    if (cli_load_scene(name, &scene) != RL_CLI_OK)
+        return RL_ERR_INVALID_ARG;
+    rl_accel *grid = NULL;
+    rl_accel_desc gd = { .kind = RL_ACCEL_GRID, .grid_res = { res, res, res } };
+    rl_status st = rl_accel_create(scene, &gd, &grid);
+    if (st == RL_OK)
+        st = rl_accel_commit(grid);
+    const rl_linespace_desc desc = { .n = n, .dynamic = true };
+    rl_linespace *ls = NULL;
+    rl_linespace_stats cs = { 0 };
+    if (st == RL_OK) {
+        note("%s %d^3 N=%d: cpu", name, res, n);
+        st = rl_linespace_create(grid, &desc, &ls);
+        if (st == RL_OK)
+            st = rl_linespace_commit(ls);
+        rl_linespace_get_stats(ls, &cs);
+        rl_linespace_release(ls);
+    }
+    rl_gl_linespace_timing gt = { 0 };
+    rl_status gst = RL_ERR_INTERNAL;
+    char gerr[256] = "";
+    if (st == RL_OK) {
+        note("%s %d^3 N=%d: gl", name, res, n);
+        gst = rl_gl_linespace_time_build(grid, &desc, c->a->device, &gt);
+        if (gst != RL_OK) {
+            /* A row over the GL's limits is reported, not fatal. */
+            snprintf(gerr, sizeof gerr, "%s", rl_last_error());
+            rl_clear_error();
+        }
+    }
+    if (st == RL_OK) {
+        const bool same = gst == RL_OK && gt.occupied == cs.shafts - cs.empty_shafts && gt.candidates == cs.candidates;
+        cJSON *o = cJSON_CreateObject();
+        cJSON_AddStringToObject(o, "scene", name);
+        cJSON_AddNumberToObject(o, "triangles", rl_scene_get_data(scene)->num_triangles);
+        cJSON_AddNumberToObject(o, "res", res);
+        cJSON_AddNumberToObject(o, "n", n);
+        cJSON_AddNumberToObject(o, "filled_voxels", cs.filled_voxels);
+        cJSON_AddNumberToObject(o, "candidates", (double)cs.candidates);
+        bench_add_num(o, "cpu_ms", cs.build_ms);
+        if (gst == RL_OK) {
+            bench_add_num(o, "gl_time_elapsed_ms", gt.gpu_ms);
+            bench_add_num(o, "gl_timestamp_ms", gt.stamp_ms);
+            bench_add_num(o, "gl_wall_ms", gt.wall_ms);
+            cJSON_AddNumberToObject(o, "gl_bytes", (double)gt.gpu_bytes);
+        } else {
+            cJSON_AddStringToObject(o, "gl_error", gerr);
+        }
+        cJSON_AddBoolToObject(o, "counts_equal", same);
+        if (thesis_ms > 0.0) {
+            bench_add_num(o, "thesis_ms", thesis_ms);
+            /* The target: the thesis' time over ours, >= 3 on a GPU. */
+            bench_add_num(o, "thesis_over_gl_wall", gst == RL_OK ? bench_ratio(thesis_ms, gt.wall_ms) : NAN);
+        }
+        cJSON_AddItemToArray(rows, o);
+        char thesis[16] = "-";
+        if (thesis_ms > 0.0)
+            snprintf(thesis, sizeof thesis, "%.0f", thesis_ms);
+        if (gst == RL_OK)
+            printf("%-26s %4d %2d %9u %10.1f %10.1f %10.1f %10.1f %8s %7s\n", name, res, n, cs.filled_voxels,
+                   cs.build_ms, gt.gpu_ms, gt.stamp_ms, gt.wall_ms, thesis, same ? "yes" : "NO");
+        else
+            printf("%-26s %4d %2d %9u %10.1f gl: %s\n", name, res, n, cs.filled_voxels, cs.build_ms, gerr);
+    }
+    rl_accel_release(grid);
+    rl_scene_release(scene);
+    return st;
+}
+
+static rl_status sec_linespace(void *ctx, cJSON *sec)
+{
+    bgl_ctx *c = ctx;
+    const bgl_args *a = c->a;
+    cJSON *rows = cJSON_AddArrayToObject(sec, "rows");
+    printf("\nLine Space generation, dynamic lists: cpu build vs GL compute (time elapsed, timestamps, wall), ms\n"
+           "%-26s %4s %2s %9s %10s %10s %10s %10s %8s %7s\n", "scene", "res", "N", "voxels", "cpu", "gl elapsed",
+           "gl stamps", "gl wall", "thesis", "equal");
+    rl_status st = RL_OK;
+    if (a->quick)
+        st = ls_row_run(c, ls_rows[0].scene, 4, 2, 0.0, rows);
+    for (long long i = 0; !a->quick && st == RL_OK && i < a->ls_rows; ++i)
+        st = ls_row_run(c, ls_rows[i].scene, ls_rows[i].res, ls_rows[i].n, ls_rows[i].thesis_ms, rows);
+    if (st != RL_OK)
+        snprintf(c->reason, sizeof c->reason, "linespace: %s", rl_last_error());
+    fflush(stdout);
+    return st;
+}
+
 /* ------------------------------------------------------------------ main */
 
 static void release_ctx(bgl_ctx *c)
@@ -553,7 +676,9 @@ int bench_gl(int argc, char **argv)
     rl_gl_info info;
     if (rc == RL_CLI_OK && rl_gl_info_get(a.device, &info) != RL_OK)
         rc = cli_fail(RL_CLI_FAIL, "bench gl: %s", rl_last_error());
-    for (int i = 0; rc == RL_CLI_OK && i < c.num_scenes; ++i)
+    /* The linespace section loads its own scenes (Table 1's). */
+    const bool only_ls = a.sections == 1u << SEC_LINESPACE;
+    for (int i = 0; !only_ls && rc == RL_CLI_OK && i < c.num_scenes; ++i)
         rc = cli_load_scene(c.names[i], &c.scenes[i]);
     if (rc != RL_CLI_OK) {
         release_ctx(&c);
@@ -572,7 +697,7 @@ int bench_gl(int argc, char **argv)
     cJSON_AddStringToObject(gl, "device", info.device);
     cJSON *params = cJSON_AddObjectToObject(root, "parameters");
     cJSON *sl = cJSON_AddArrayToObject(params, "scenes");
-    for (int i = 0; i < c.num_scenes; ++i) {
+    for (int i = 0; !only_ls && i < c.num_scenes; ++i) {
         cJSON *s = cJSON_CreateObject();
         cJSON_AddStringToObject(s, "name", c.names[i]);
         cJSON_AddItemToObject(s, "stats", cli_scene_stats_json(c.scenes[i]));
@@ -590,9 +715,13 @@ int bench_gl(int argc, char **argv)
     cJSON_AddNumberToObject(params, "pt_spp", (double)a.pt_spp);
     cJSON_AddBoolToObject(params, "pt_gl_only", a.pt_gl_only);
     cJSON_AddBoolToObject(params, "quick", a.quick);
+    cJSON_AddNumberToObject(params, "ls_rows", (double)a.ls_rows);
+    cJSON_AddStringToObject(params, "ls_note",
+                            "llvmpipe's GL_TIME_ELAPSED times draws only and reads 0 for compute passes; "
+                            "gl_timestamp_ms (GL_TIMESTAMP around the same passes) is the GPU-side time there");
     printf("rl bench gl: %s | %s | %s (%s), %d threads\n", info.vendor, info.renderer, info.version, info.device,
            threads);
-    static const bench_section_fn fns[SEC_COUNT] = { sec_frames, sec_visibility, sec_pt };
+    static const bench_section_fn fns[SEC_COUNT] = { sec_frames, sec_visibility, sec_pt, sec_linespace };
     rc = bench_run_sections("gl", root, section_names, fns, SEC_COUNT, a.sections, &c, c.reason, threads, out);
     cJSON_Delete(root);
     release_ctx(&c);

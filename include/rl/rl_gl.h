@@ -21,7 +21,9 @@
 #define RL_GL_H
 
 #include "rl/rl_common.h"
+#include "rl/rl_accel.h"
 #include "rl/rl_drawer.h"
+#include "rl/rl_linespace.h"
 #include "rl/rl_scene.h"
 
 #ifdef __cplusplus
@@ -55,6 +57,27 @@ RL_API rl_status rl_gl_info_get(const char *device, rl_gl_info *out);
  * arrays exceed the GL's buffer size limit, RL_ERR_INTERNAL for a GL error. */
 RL_API rl_status rl_gl_drawer_create(const rl_scene *scene, const rl_drawer_desc *desc, const char *device,
                                      rl_drawer **out);
+
+/* Line Space generation on the GPU (Schröder 2017, Sec. 7; docs/gl.md,
+ * "Line Space on GL"), for benchmarks: builds the candidate lists of
+ * rl_linespace_create(grid, desc) with compute shaders in a context of its
+ * own on device, with the same contents as the CPU build, and reports the
+ * time; the result is dropped. desc->payloads must be RL_LS_CANDIDATES
+ * (or 0); threads, progress and small_pages are ignored.
+ * RL_ERR_UNSUPPORTED without GL or for other payloads and alpha-masked
+ * scenes, RL_ERR_LIMIT where the buffers exceed the GL's shader storage
+ * block size or 32-bit offsets. */
+typedef struct rl_gl_linespace_timing {
+    double gpu_ms;                /* GL_TIME_ELAPSED of the build's passes */
+    double stamp_ms;              /* the same passes between GL_TIMESTAMP queries
+                                   * (llvmpipe's GL_TIME_ELAPSED reads 0 for compute) */
+    double wall_ms;               /* uploads, passes and the total's readback, to glFinish
+                                   * (shader compilation not included) */
+    uint64_t shafts, occupied, candidates;
+    uint64_t gpu_bytes;           /* every buffer the build made */
+} rl_gl_linespace_timing;
+RL_API rl_status rl_gl_linespace_time_build(const rl_accel *grid, const rl_linespace_desc *desc, const char *device,
+                                            rl_gl_linespace_timing *out);
 
 #ifdef __cplusplus
 }

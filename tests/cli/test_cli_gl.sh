@@ -97,8 +97,9 @@ assert len(a["samples"]) == 16 and a["samples"] == b["samples"], (a["samples"], 
 assert a["sample_sets"] == b["sample_sets"]
 PY
 
-    # rl bench gl --quick: both sections, the GL strings in the record, the
-    # two backends' visibility values equal.
+    # rl bench gl --quick: the three sections, the GL strings in the record,
+    # the two backends' visibility values equal, the GL-built Line Space
+    # with the CPU build's counts.
     run_ok "$RL" bench gl --quick --scenes cornell --frames 1 --out "$TMP/bench-gl.json"
     python3 - "$TMP/bench-gl.json" <<'PY' || fail "rl bench gl's record is incomplete"
 import json, sys
@@ -112,6 +113,10 @@ assert row["ids_equal_percent"] > 99, row
 row = v["rows"][0]
 assert row["values_equal"] == r["parameters"]["positions"] == 2, row
 assert row["object_pixels_total"] > 0 and row["gl"]["mean_ms_per_position"] > 0, row
+ls = r["linespace"]
+assert ls["status"] == "ok", ls
+row = ls["rows"][0]
+assert row["counts_equal"] is True and row["cpu_ms"] > 0 and row["gl_wall_ms"] > 0, row
 PY
 else
     echo "test_cli_gl: no GL 4.5 context here; the rendering case is skipped"
