@@ -101,6 +101,12 @@ int cli_dist_end(int rc);
 bool cli_dist_master(void);
 rl_status cli_render_call(rl_renderer *r, const rl_scene *scene, const rl_camera *cam, rl_image *img,
                           rl_render_stats *stats);
+/* The job's ranks (1 without --dist) and a progressive renderer's frames
+ * spread over them, every band accumulating all frames
+ * (rl_dist_render_frames). */
+int cli_dist_ranks(void);
+rl_status cli_render_frames_call(rl_renderer *r, const rl_scene *scene, const rl_camera *cam, long long frames,
+                                 rl_image *img, rl_render_stats *stats);
 /* rl_sample_property, with the job's ranks as sampling nodes under --dist
  * (the approximation on the master; NULL on the workers). */
 rl_status cli_sample_call(rl_property *p, const rl_sampling_desc *desc, rl_approx **out);

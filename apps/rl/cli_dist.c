@@ -50,6 +50,19 @@ rl_status cli_render_call(rl_renderer *r, const rl_scene *scene, const rl_camera
     return st;
 }
 
+int cli_dist_ranks(void)
+{
+    return rl_dist_size(dist);
+}
+
+rl_status cli_render_frames_call(rl_renderer *r, const rl_scene *scene, const rl_camera *cam, long long frames,
+                                 rl_image *img, rl_render_stats *stats)
+{
+    rl_status st = rl_dist_render_frames(dist, r, scene, cam, (uint64_t)frames, img, stats, &last);
+    have_last = st == RL_OK && last.ranks > 1;
+    return st;
+}
+
 rl_status cli_sample_call(rl_property *p, const rl_sampling_desc *desc, rl_approx **out)
 {
     if (!dist)

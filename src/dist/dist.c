@@ -217,15 +217,55 @@ static band_layout layout_of(rl_image *image, int band)
     return l;
 }
 
-/* Renders band into image with r restricted to its rows. */
-static rl_status render_band(rl_renderer *r, const rl_scene *scene, const rl_camera *cam, rl_image *image,
-                             int band, rl_render_stats *stats)
+/* The master's progress: the caller's callback sees the whole frame, the
+ * bands done anywhere plus the share of the band rendering here. */
+typedef struct frame_progress {
+    rl_progress_fn fn;
+    void *user;
+    int bands, done;
+    uint64_t frame, frames;      /* of the band rendering here */
+    bool cancelled;
+} frame_progress;
+
+static bool band_progress(void *user, double done)
+{
+    frame_progress *p = user;
+    double band = ((double)p->frame + done) / (double)p->frames;
+    if (p->fn && !p->fn(p->user, ((double)p->done + band) / (double)p->bands))
+        p->cancelled = true;
+    return !p->cancelled;
+}
+
+static void band_done(frame_progress *p)
+{
+    ++p->done;
+    p->frame = 0;
+    band_progress(p, 0.0);
+}
+
+/* Renders band into image with r restricted to its rows: frames frames of
+ * a new accumulation, so that a band is the same pixels whichever rank
+ * rendered what before it. stats: their counters summed over the frames
+ * (as a caller's loop over frames sums them). fp: the master's progress, else NULL. */
+static rl_status render_band(rl_renderer *r, const rl_scene *scene, const rl_camera *cam, uint64_t frames,
+                             rl_image *image, int band, rl_render_stats *stats, frame_progress *fp)
 {
     int y0 = band * BAND_ROWS, y1 = y0 + BAND_ROWS < image->height ? y0 + BAND_ROWS : image->height;
     rl_rect rows = { 0, y0, image->width, y1 };
     rl_status st = rl_renderer_set_region(r, &rows);
-    if (st == RL_OK)
-        st = rl_renderer_render(r, scene, cam, image, stats);
+    rl_renderer_reset(r);
+    for (uint64_t k = 0; st == RL_OK && k < frames; ++k) {
+        rl_render_stats fs = { 0 };
+        if (fp)
+            fp->frame = k;
+        if ((st = rl_renderer_render(r, scene, cam, image, &fs)) != RL_OK)
+            break;
+        for (int t = 0; t < RL_RAY_TYPE_COUNT; ++t)
+            stats->rays[t] += fs.rays[t];
+        stats->samples += fs.samples;
+        stats->prep_ms += fs.prep_ms;
+        stats->pixels_written += fs.pixels_written;
+    }
     rl_renderer_set_region(r, NULL);
     return st;
 }
@@ -240,7 +280,8 @@ static void add_band(rl_render_stats *to, const uint64_t rays[RL_RAY_TYPE_COUNT]
 }
 
 /* A worker's frame: bands until RL_DIST_TAG_DONE, whose status it returns. */
-static rl_status work(rl_dist *d, rl_renderer *r, const rl_scene *scene, const rl_camera *cam, rl_image *image)
+static rl_status work(rl_dist *d, rl_renderer *r, const rl_scene *scene, const rl_camera *cam, uint64_t frames,
+                      rl_image *image)
 {
     for (;;) {
         MPI_Status ms;
@@ -262,7 +303,7 @@ static rl_status work(rl_dist *d, rl_renderer *r, const rl_scene *scene, const r
         rl_timer t;
         rl_timer_start(&t);
         rl_clear_error();
-        rl_status st = render_band(r, scene, cam, image, value, &bs);
+        rl_status st = render_band(r, scene, cam, frames, image, value, &bs, NULL);
         res.busy_ms = rl_timer_ms(&t);
         res.status = (int32_t)st;
         if (st != RL_OK)
@@ -281,29 +322,6 @@ static rl_status work(rl_dist *d, rl_renderer *r, const rl_scene *scene, const r
             return sst;
         rl_dist_fault_point(d);
     }
-}
-
-/* The master's progress: the caller's callback sees the whole frame, the
- * bands done anywhere plus the share of the band rendering here. */
-typedef struct frame_progress {
-    rl_progress_fn fn;
-    void *user;
-    int bands, done;
-    bool cancelled;
-} frame_progress;
-
-static bool band_progress(void *user, double done)
-{
-    frame_progress *p = user;
-    if (p->fn && !p->fn(p->user, ((double)p->done + done) / (double)p->bands))
-        p->cancelled = true;
-    return !p->cancelled;
-}
-
-static void band_done(frame_progress *p)
-{
-    ++p->done;
-    band_progress(p, 0.0);
 }
 
 /* The master's view of a worker during a frame. */
@@ -344,8 +362,8 @@ static rl_status give_band(rl_dist_stats *ds, worker_state *ws, int w, int band)
  * bands in hand is taken for lost (killed, its node gone): its bands go to
  * the others and it gets no more. Should it answer after all, its bands
  * are the same pixels and are taken as they come. */
-static rl_status lead(rl_dist *d, rl_renderer *r, const rl_scene *scene, const rl_camera *cam, rl_image *image,
-                      rl_render_stats *stats, rl_dist_stats *ds)
+static rl_status lead(rl_dist *d, rl_renderer *r, const rl_scene *scene, const rl_camera *cam, uint64_t frames,
+                      rl_image *image, rl_render_stats *stats, rl_dist_stats *ds)
 {
     const int bands = (image->height + BAND_ROWS - 1) / BAND_ROWS;
     const double timeout = rl_dist_timeout_s();
@@ -364,7 +382,7 @@ static rl_status lead(rl_dist *d, rl_renderer *r, const rl_scene *scene, const r
             ws[w].bands[k] = -1;
     rl_status st = RL_OK;
     char failure[320] = "";
-    frame_progress fp = { .bands = bands };
+    frame_progress fp = { .bands = bands, .frames = frames };
     rl_renderer_get_progress(r, &fp.fn, &fp.user);
     rl_renderer_set_progress(r, band_progress, &fp);
     /* Queue PREFETCH bands at every worker first. */
@@ -392,7 +410,7 @@ static rl_status lead(rl_dist *d, rl_renderer *r, const rl_scene *scene, const r
                 rl_render_stats bs = { 0 };
                 rl_timer t;
                 rl_timer_start(&t);
-                st = render_band(r, scene, cam, image, band, &bs);
+                st = render_band(r, scene, cam, frames, image, band, &bs, &fp);
                 d->per_rank[0].busy_ms += rl_timer_ms(&t);
                 if (st == RL_OK) {
                     add_band(stats, bs.rays, bs.samples, bs.pixels_written);
@@ -504,8 +522,10 @@ static rl_status lead(rl_dist *d, rl_renderer *r, const rl_scene *scene, const r
     return RL_OK;
 }
 
-rl_status rl_dist_render(rl_dist *d, rl_renderer *r, const rl_scene *scene, const rl_camera *cam,
-                         rl_image *image, rl_render_stats *stats, rl_dist_stats *dstats)
+/* frames 0: one frame that continues the renderer's accumulation in a job
+ * of one (rl_dist_render). */
+static rl_status render_frames(rl_dist *d, rl_renderer *r, const rl_scene *scene, const rl_camera *cam,
+                               uint64_t frames, rl_image *image, rl_render_stats *stats, rl_dist_stats *dstats)
 {
     rl_dist_stats ds_local;
     rl_dist_stats *ds = dstats ? dstats : &ds_local;
@@ -514,10 +534,31 @@ rl_status rl_dist_render(rl_dist *d, rl_renderer *r, const rl_scene *scene, cons
     rl_render_stats local;
     rl_render_stats *rs = stats ? stats : &local;
     memset(rs, 0, sizeof *rs);
-    if (!d || d->size == 1)
-        return rl_renderer_render(r, scene, cam, image, rs);
     if (!r || !scene || !cam || !image)
         return rl_error(RL_ERR_INVALID_ARG, "rl_dist_render: renderer, scene, camera and image must not be NULL");
+    if (frames > RL_DIST_MAX_FRAMES)
+        return rl_error(RL_ERR_LIMIT, "rl_dist_render_frames: %llu frames (at most %d)", (unsigned long long)frames,
+                        RL_DIST_MAX_FRAMES);
+    if (!d || d->size == 1) {
+        if (frames == 0)
+            return rl_renderer_render(r, scene, cam, image, rs);
+        rl_timer t;
+        rl_timer_start(&t);
+        rl_renderer_reset(r);
+        rl_status st = RL_OK;
+        for (uint64_t k = 0; k < frames && st == RL_OK; ++k) {
+            rl_render_stats fs = { 0 };
+            if ((st = rl_renderer_render(r, scene, cam, image, &fs)) == RL_OK) {
+                add_band(rs, fs.rays, fs.samples, 0);
+                rs->prep_ms += fs.prep_ms;
+                rs->pixels_written += fs.pixels_written;
+            }
+        }
+        rs->time_ms = ds->time_ms = rl_timer_ms(&t);
+        return st;
+    }
+    if (frames == 0)
+        frames = 1;
     /* Every rank decides alike from what every rank has, so that all of
      * them refuse together and none waits for a band. */
     const rl_renderer_info *info = NULL;
@@ -532,8 +573,23 @@ rl_status rl_dist_render(rl_dist *d, rl_renderer *r, const rl_scene *scene, cons
     memset(d->per_rank, 0, (size_t)d->size * sizeof *d->per_rank);
     rl_timer t;
     rl_timer_start(&t);
-    rl_status st = d->rank == 0 ? lead(d, r, scene, cam, image, rs, ds) : work(d, r, scene, cam, image);
+    rl_status st = d->rank == 0 ? lead(d, r, scene, cam, frames, image, rs, ds)
+                                : work(d, r, scene, cam, frames, image);
     rs->time_ms = ds->time_ms = rl_timer_ms(&t);
     ds->per_rank = d->per_rank;
     return st;
+}
+
+rl_status rl_dist_render(rl_dist *d, rl_renderer *r, const rl_scene *scene, const rl_camera *cam,
+                         rl_image *image, rl_render_stats *stats, rl_dist_stats *dstats)
+{
+    return render_frames(d, r, scene, cam, 0, image, stats, dstats);
+}
+
+rl_status rl_dist_render_frames(rl_dist *d, rl_renderer *r, const rl_scene *scene, const rl_camera *cam,
+                                uint64_t frames, rl_image *image, rl_render_stats *stats, rl_dist_stats *dstats)
+{
+    if (frames == 0)
+        return rl_error(RL_ERR_INVALID_ARG, "rl_dist_render_frames: frames must be at least 1");
+    return render_frames(d, r, scene, cam, frames, image, stats, dstats);
 }

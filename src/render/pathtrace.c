@@ -830,6 +830,19 @@ const rl_gbuffer *rl_pt_gbuffer(const rl_renderer *r)
     return s && s->have_frame ? s->gbuf : NULL;
 }
 
+uint64_t rl_pt_frame_samples(const rl_renderer *r, int width, int height, uint64_t frame)
+{
+    if (!pt_of(r) || width < 1 || height < 1)
+        return 0;
+    uint64_t n = (uint64_t)width * (uint64_t)height, spp = (uint64_t)rl_renderer_opt_int(r, "spp");
+    if (!rl_renderer_opt_bool(r, "checkerboard"))
+        return n * spp;
+    /* active(): x + y + parity even; x + y even holds for the larger half
+     * when both sides are odd. */
+    uint64_t even = (width & height & 1) ? (n + 1) / 2 : n / 2;
+    return spp * ((frame & 1u) == 0 ? even : n - even);
+}
+
 const rl_renderer_class rl_pt_renderer_class = {
     .info = { .name = "pt",
               .description = "Progressive path tracing with NEE, Russian roulette and Phong sampling; "
