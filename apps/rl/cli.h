@@ -112,6 +112,11 @@ rl_status cli_render_frames_call(rl_renderer *r, const rl_scene *scene, const rl
 rl_status cli_sample_call(rl_property *p, const rl_sampling_desc *desc, rl_approx **out);
 /* The last distributed frame's or sampling's ranks and per-rank work (master only). */
 void cli_print_dist_summary(FILE *out);
+/* The same as JSON for stats files (rl bench dist reads it): ranks,
+ * tasks, messages, bytes, time_ms, lost, per_rank; a run under --dist of
+ * one rank too (no per_rank). NULL on workers, without --dist, or when out
+ * of memory. */
+struct cJSON *cli_dist_json(void);
 
 int cli_check_frame_memory(const rl_renderer *r, int width, int height, unsigned layers, double extra_per_pixel,
                            double max_memory);

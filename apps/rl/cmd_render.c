@@ -402,6 +402,9 @@ static rl_status write_stats_json(const render_args *a, const rl_scene *scene, c
     cJSON_AddNumberToObject(obj, "width", img->width);
     cJSON_AddNumberToObject(obj, "height", img->height);
     cJSON_AddStringToObject(obj, "file", a->out);
+    cJSON *dist = cli_dist_json();
+    if (dist)
+        cJSON_AddItemToObject(obj, "dist", dist);
     if (a->has_tonemap) {
         cJSON_AddStringToObject(obj, "tonemap", rl_tonemap_name(a->tonemap.op));
         cJSON_AddNumberToObject(obj, "exposure_ev", a->tonemap.exposure_ev);

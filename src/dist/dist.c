@@ -654,8 +654,11 @@ static rl_status render_frames(rl_dist *d, rl_renderer *r, const rl_scene *scene
         return rl_error(RL_ERR_LIMIT, "rl_dist_render_frames: %llu frames (at most %d)", (unsigned long long)frames,
                         RL_DIST_MAX_FRAMES);
     if (!d || d->size == 1) {
-        if (frames == 0)
-            return rl_renderer_render(r, scene, cam, image, rs);
+        if (frames == 0) {
+            rl_status st0 = rl_renderer_render(r, scene, cam, image, rs);
+            ds->time_ms = rs->time_ms;
+            return st0;
+        }
         rl_timer t;
         rl_timer_start(&t);
         rl_renderer_reset(r);
