@@ -15,6 +15,10 @@
  *   worker -> master  RESULT  band_result (band, status, counts, error)
  *   worker -> master  PIXELS  the band's layers, present ones in order
  *                             colour, depth, object ID, triangle ID
+ * A worker keeps its answers in flight (MPI_Isend) while it renders its
+ * next band; the master posts a band's pixel receives when its header
+ * comes and tests them between its own bands, so that it never blocks on
+ * one worker, not even on one killed mid-transfer (docs/distributed.md).
  * Only the calling thread talks to MPI (MPI_THREAD_FUNNELED); OpenMP
  * threads render inside each rank. */
 #include "rl/rl_dist.h"
@@ -614,6 +618,20 @@ static rl_status lead(rl_dist *d, rl_renderer *r, const rl_scene *scene, const r
         }
     }
     rl_renderer_set_progress(r, fp.fn, fp.user);
+    /* A worker taken for lost that answered late after all sends its
+     * pixels into the image: they must be in before the image may go. */
+    const double t_end = rl_time_s();
+    for (int w = 1; w < d->size && code == MPI_SUCCESS; ++w)
+        for (int k = 0; k < SLOTS && ws[w].lost; ++k)
+            while (ws[w].bands[k] >= 0 && ws[w].answered[k] && rl_time_s() - t_end <= timeout) {
+                int complete = 0;
+                if ((code = MPI_Testall(ws[w].nrx[k], ws[w].rx[k], &complete, MPI_STATUSES_IGNORE)) != MPI_SUCCESS)
+                    break;
+                if (complete)
+                    ws[w].bands[k] = -1;
+                else
+                    rl_dist_pause();
+            }
     if (code == MPI_SUCCESS) {
         /* Every live worker hears the end. A lost one does not: a send to
          * a dead rank may never return; one that was only slow gives up

@@ -134,6 +134,23 @@ grep -q "pt: filter=gauss filters the whole image; a region (rl --dist) needs fi
     fail "pt filter under --dist: $(head -c 600 "$TMP/err")"
 [ ! -e "$TMP/pt-t.png" ] && [ ! -e "$TMP/pt-f.png" ] || fail "a refused pt run wrote an image"
 
+# rl bench dist starts this rl under mpirun itself: its record has every
+# workload at every rank count, with the one-rank run as the reference.
+run_ok "$RL" bench dist --quick --only tiles --out "$TMP/bench-dist.json"
+python3 - "$TMP/bench-dist.json" <<'PY' || fail "rl bench dist: $(head -c 600 "$TMP/bench-dist.json")"
+import json, sys
+r = json.load(open(sys.argv[1]))
+runs = r["tiles"]["runs"]
+assert r["tiles"]["status"] == "ok" and [w["algorithm"] for w in runs] == ["whitted", "pt"], runs
+for w in runs:
+    one, two = w["ranks"]
+    assert one["ranks"] == 1 and two["ranks"] == 2 and one["speedup"] == 1, w
+    assert two["messages_per_frame"] > 0 and two["bytes_per_frame"] > 0 and two["imbalance"] >= 1, two
+    assert len(two["dist"]["per_rank"]) == 2, two
+PY
+expect_exit 2 "$RL" bench dist --ranks 0,2
+grep -q "^rl: error: bench dist: --ranks: expected" "$TMP/err" || fail "bench dist --ranks 0: $(cat "$TMP/err")"
+
 # A renderer whose pixels depend on each other is refused, on every rank,
 # and nothing is written.
 expect_exit 1 "${MPI[@]}" "$RL" --dist render cornell --algo raster --size 32x24 --out "$TMP/raster.png"
