@@ -33,6 +33,8 @@ static const char render_help[] =
     "they take their default budget (pt: 10 s, see rl algos). The summary then\n"
     "gives frames, samples per pixel and the time. Ctrl-C stops, saves what\n"
     "has accumulated and exits 130; a second Ctrl-C aborts without saving.\n"
+    "Under mpirun with --dist (docs/distributed.md) every band renders all the\n"
+    "frames, so several ranks need --spp (no --time, no --preview).\n"
     "\n"
     "SCENE  a built-in name (see rl scenes), optionally with parameters\n"
     "       (cornell-teapot:triangles=70000), a .json scene or a mesh file\n"
