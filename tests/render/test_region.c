@@ -11,6 +11,7 @@
 #include <cmocka.h>
 
 #include "render_fixtures.h"
+#include "rl/rl_pt.h"
 
 #define SENTINEL 12345.0f
 
@@ -132,6 +133,8 @@ static void check_pt_bands(const char *const *opts, int frames, const rl_scene *
     for (int k = 0; k < frames; ++k) {
         assert_int_equal(rl_renderer_render(whole_r, s, cam, whole, &ws), RL_OK);
         whole_samples += ws.samples;
+        /* What rl --dist fixes the frames of a sample target with. */
+        assert_int_equal(ws.samples, rl_pt_frame_samples(whole_r, cam->width, cam->height, (uint64_t)k));
     }
 
     rl_renderer *r = fx_make("pt", opts);
@@ -177,6 +180,7 @@ static void check_pt_bands(const char *const *opts, int frames, const rl_scene *
     for (int k = 0; k < frames; ++k)
         assert_int_equal(rl_renderer_render(r, s, cam, part, NULL), RL_OK);
     fx_assert_images_identical(part, whole);
+    assert_int_equal(rl_pt_frame_samples(NULL, cam->width, cam->height, 0), 0);
     rl_image_release(part);
     rl_image_release(whole);
     rl_renderer_release(r);
