@@ -101,11 +101,22 @@ int cli_dist_end(int rc);
 bool cli_dist_master(void);
 rl_status cli_render_call(rl_renderer *r, const rl_scene *scene, const rl_camera *cam, rl_image *img,
                           rl_render_stats *stats);
+/* The job's ranks (1 without --dist) and a progressive renderer's frames
+ * spread over them, every band accumulating all frames
+ * (rl_dist_render_frames). */
+int cli_dist_ranks(void);
+rl_status cli_render_frames_call(rl_renderer *r, const rl_scene *scene, const rl_camera *cam, long long frames,
+                                 rl_image *img, rl_render_stats *stats);
 /* rl_sample_property, with the job's ranks as sampling nodes under --dist
  * (the approximation on the master; NULL on the workers). */
 rl_status cli_sample_call(rl_property *p, const rl_sampling_desc *desc, rl_approx **out);
 /* The last distributed frame's or sampling's ranks and per-rank work (master only). */
 void cli_print_dist_summary(FILE *out);
+/* The same as JSON for stats files (rl bench dist reads it): ranks,
+ * tasks, messages, bytes, time_ms, lost, per_rank; a run under --dist of
+ * one rank too (no per_rank). NULL on workers, without --dist, or when out
+ * of memory. */
+struct cJSON *cli_dist_json(void);
 
 int cli_check_frame_memory(const rl_renderer *r, int width, int height, unsigned layers, double extra_per_pixel,
                            double max_memory);

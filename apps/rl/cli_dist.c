@@ -5,11 +5,13 @@
 #define _POSIX_C_SOURCE 200809L
 #include "cli.h"
 
+#include <cjson/cJSON.h>
 #include <stdio.h>
 
 static rl_dist *dist;
 static rl_dist_stats last;
-static bool have_last;
+static bool have_last;          /* the last run was spread over several ranks */
+static bool ran;                /* a run went through rl_dist (any ranks) */
 static bool sampling;           /* the last run sampled: chunks of positions, not bands of pixels */
 
 int cli_dist_begin(int *argc, char ***argv)
@@ -47,6 +49,21 @@ rl_status cli_render_call(rl_renderer *r, const rl_scene *scene, const rl_camera
         return rl_renderer_render(r, scene, cam, img, stats);
     rl_status st = rl_dist_render(dist, r, scene, cam, img, stats, &last);
     have_last = st == RL_OK && last.ranks > 1;
+    ran = st == RL_OK;
+    return st;
+}
+
+int cli_dist_ranks(void)
+{
+    return rl_dist_size(dist);
+}
+
+rl_status cli_render_frames_call(rl_renderer *r, const rl_scene *scene, const rl_camera *cam, long long frames,
+                                 rl_image *img, rl_render_stats *stats)
+{
+    rl_status st = rl_dist_render_frames(dist, r, scene, cam, (uint64_t)frames, img, stats, &last);
+    have_last = st == RL_OK && last.ranks > 1;
+    ran = st == RL_OK;
     return st;
 }
 
@@ -56,8 +73,36 @@ rl_status cli_sample_call(rl_property *p, const rl_sampling_desc *desc, rl_appro
         return rl_sample_property(p, desc, out);
     rl_status st = rl_dist_sample_property(dist, p, desc, out, &last);
     have_last = st == RL_OK && last.ranks > 1;
+    ran = st == RL_OK;
     sampling = true;
     return st;
+}
+
+cJSON *cli_dist_json(void)
+{
+    if (!ran || !cli_dist_master())
+        return NULL;
+    cJSON *o = cJSON_CreateObject();
+    if (!o)
+        return NULL;
+    cJSON_AddNumberToObject(o, "ranks", last.ranks);
+    cJSON_AddStringToObject(o, "task", sampling ? "chunk" : "band");
+    cJSON_AddNumberToObject(o, "tasks", (double)last.tasks);
+    cJSON_AddNumberToObject(o, "messages", (double)last.messages);
+    cJSON_AddNumberToObject(o, "bytes", (double)last.bytes);
+    cJSON_AddNumberToObject(o, "time_ms", last.time_ms);
+    cJSON_AddNumberToObject(o, "lost", last.lost);
+    cJSON *ranks = cJSON_AddArrayToObject(o, "per_rank");
+    for (int k = 0; ranks && last.per_rank && k < last.ranks; k++) {
+        cJSON *e = cJSON_CreateObject();
+        if (!e)
+            break;
+        cJSON_AddNumberToObject(e, "tasks", (double)last.per_rank[k].tasks);
+        cJSON_AddNumberToObject(e, sampling ? "positions" : "pixels", (double)last.per_rank[k].pixels);
+        cJSON_AddNumberToObject(e, "busy_ms", last.per_rank[k].busy_ms);
+        cJSON_AddItemToArray(ranks, e);
+    }
+    return o;
 }
 
 void cli_print_dist_summary(FILE *out)

@@ -15,6 +15,7 @@
 #include "bench_rays.h"
 #include "bench_sampling.h"
 #include "bench_culling.h"
+#include "bench_dist.h"
 #include "bench_gl.h"
 #include "bench_surfels.h"
 #include "bench_util.h"
@@ -33,7 +34,7 @@
 /* rl bench --help: every kind on one line. Durations are the defaults' on
  * 2 cores (bench/README.md); --quick is the toy run ctest uses. */
 static const char bench_overview[] =
-    "usage: rl bench rays|vt|pt|sampling|surfels|culling|gl [options]\n"
+    "usage: rl bench rays|vt|pt|sampling|surfels|culling|gl|dist [options]\n"
     "       rl bench KIND --help    the options of one kind\n"
     "\n"
     "Timed runs, each writing one JSON record (machine, build, command line,\n"
@@ -56,12 +57,14 @@ static const char bench_overview[] =
     "                     Ch. 7 (about an hour on city; choose with --only)\n"
     "  rl bench gl        the OpenGL backend vs the software paths: gl-raster vs\n"
     "                     raster frames, the visibility property (~1 min)\n"
+    "  rl bench dist      rl --dist under mpirun against the rank count: tiles\n"
+    "                     (whitted, pt) and Alg. 5.4 sampling (~3 min)\n"
     "\n"
     "example:\n"
     "  rl bench rays --quick --out /tmp/rays.json\n"
     "  rl bench vt --help\n";
 
-static const char *const bench_kinds[] = { "rays", "vt", "pt", "sampling", "surfels", "culling", "gl" };
+static const char *const bench_kinds[] = { "rays", "vt", "pt", "sampling", "surfels", "culling", "gl", "dist" };
 
 static const char bench_help[] =
     "usage: rl bench rays [options]      (rl bench --help: every kind)\n"
@@ -217,7 +220,8 @@ static int parse_args(int argc, char **argv, bench_args *a)
 {
     if (argc < 2)
         return cli_fail(RL_CLI_USAGE,
-                           "bench: missing benchmark (rays, vt, pt, sampling, surfels, culling, gl; see rl bench --help)");
+                           "bench: missing benchmark (rays, vt, pt, sampling, surfels, culling, gl, dist; see rl bench "
+                           "--help)");
     if (cli_is_help(argv[1])) {
         fputs(bench_overview, stdout);
         return RL_BENCH_HELP_SHOWN;
@@ -225,7 +229,7 @@ static int parse_args(int argc, char **argv, bench_args *a)
     if (strcmp(argv[1], "rays") != 0) {
         char hint[96];
         return cli_fail(RL_CLI_USAGE, "bench: unknown benchmark '%s' (%sknown: rays, vt, pt, "
-                           "sampling, surfels, culling, gl)",
+                           "sampling, surfels, culling, gl, dist)",
                            argv[1], cli_did_you_mean(argv[1], bench_kinds, sizeof bench_kinds / sizeof *bench_kinds,
                                                      hint, sizeof hint));
     }
@@ -637,6 +641,8 @@ int cli_bench(int argc, char **argv)
         return bench_culling(argc, argv);
     if (argc >= 2 && strcmp(argv[1], "gl") == 0)
         return bench_gl(argc, argv);
+    if (argc >= 2 && strcmp(argv[1], "dist") == 0)
+        return bench_dist(argc, argv);
     bench_args a;
     memset(&a, 0, sizeof a);
     int rc = parse_args(argc, argv, &a);

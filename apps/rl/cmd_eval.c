@@ -290,6 +290,9 @@ static cJSON *result_json(const eval_args *a, const rl_scene *scene, const rl_pr
     cJSON_AddItemToObject(root, "load", cli_load_json(&r->load));
     cJSON_AddStringToObject(root, "scene", a->scene);
     cJSON_AddItemToObject(root, "scene_stats", cli_scene_stats_json(scene));
+    cJSON *dist = cli_dist_json();
+    if (dist)
+        cJSON_AddItemToObject(root, "dist", dist);
     cJSON *prop = cJSON_AddObjectToObject(root, "property");
     cJSON_AddStringToObject(prop, "name", rl_property_name(p));
     cJSON_AddStringToObject(prop, "label", r->label);

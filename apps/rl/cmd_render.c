@@ -18,6 +18,7 @@
 #include <string.h>
 
 #include "rl/rl_options.h"
+#include "rl/rl_pt.h"
 
 static const char render_help[] =
     "usage: rl render SCENE --out FILE.png|FILE.exr [options]\n"
@@ -32,6 +33,8 @@ static const char render_help[] =
     "they take their default budget (pt: 10 s, see rl algos). The summary then\n"
     "gives frames, samples per pixel and the time. Ctrl-C stops, saves what\n"
     "has accumulated and exits 130; a second Ctrl-C aborts without saving.\n"
+    "Under mpirun with --dist (docs/distributed.md) every band renders all the\n"
+    "frames, so several ranks need --spp (no --time, no --preview).\n"
     "\n"
     "SCENE  a built-in name (see rl scenes), optionally with parameters\n"
     "       (cornell-teapot:triangles=70000), a .json scene or a mesh file\n"
@@ -401,6 +404,9 @@ static rl_status write_stats_json(const render_args *a, const rl_scene *scene, c
     cJSON_AddNumberToObject(obj, "width", img->width);
     cJSON_AddNumberToObject(obj, "height", img->height);
     cJSON_AddStringToObject(obj, "file", a->out);
+    cJSON *dist = cli_dist_json();
+    if (dist)
+        cJSON_AddItemToObject(obj, "dist", dist);
     if (a->has_tonemap) {
         cJSON_AddStringToObject(obj, "tonemap", rl_tonemap_name(a->tonemap.op));
         cJSON_AddNumberToObject(obj, "exposure_ev", a->tonemap.exposure_ev);
@@ -500,6 +506,19 @@ static int plan_loop(const render_args *a, const rl_renderer *r, loop_plan *p)
         p->budget_s = info->default_time_s;
     p->loop = p->budget_s > 0.0 || p->target_spp > 0;
     p->preview_s = !p->loop ? 0.0 : a->preview_s >= 0.0 ? a->preview_s : PREVIEW_DEFAULT_S;
+    if (p->loop && cli_dist_ranks() > 1) {
+        /* Every band renders all the frames (rl_dist_render_frames), so
+         * their number is fixed before the bands go out, and the image
+         * exists only when the last band is back. */
+        if (a->time_s > 0.0 || !p->target_spp)
+            return cli_fail(RL_CLI_USAGE, "--dist: %s over several ranks renders a fixed number of samples: give "
+                            "--spp N (or --set spp=N for one frame), not %s", name,
+                            a->time_s > 0.0 ? "--time" : "the default time budget");
+        if (a->preview_s >= 0.0)
+            return cli_fail(RL_CLI_USAGE, "--dist: no --preview over several ranks (the image is whole only at "
+                                          "the end)");
+        p->preview_s = 0.0;
+    }
     return RL_CLI_OK;
 }
 
@@ -544,6 +563,53 @@ static void add_stats(rl_render_stats *sum, const rl_render_stats *s)
     sum->points_drawn += s->points_drawn;
     if (s->device)
         sum->device = s->device;
+}
+
+/* --dist over several ranks: the frames one process renders to reach
+ * --spp, all of them in every band (rl_dist_render_frames), so that the
+ * image is the one-process image. */
+static int render_dist_frames(const render_args *a, rl_renderer *r, const rl_scene *scene, const rl_camera *cam,
+                              rl_image *img, const loop_plan *plan, rl_render_stats *sum, cli_accumulation *acc)
+{
+    double pixels = (double)cam->width * (double)cam->height;
+    uint64_t samples = 0;
+    long long frames = 0;
+    /* The stopping rule of render_frames, on pt's samples per frame. */
+    while ((double)samples / pixels < (double)plan->target_spp) {
+        uint64_t s = rl_pt_frame_samples(r, cam->width, cam->height, (uint64_t)frames);
+        if (s == 0)
+            return cli_fail(RL_CLI_USAGE, "--dist --spp: %s does not say its samples per frame in advance; only pt "
+                            "renders progressively over several ranks", rl_renderer_name(r));
+        if (frames == RL_DIST_MAX_FRAMES)
+            return cli_fail(RL_CLI_USAGE, "--dist --spp %lld: more than %d frames", plan->target_spp,
+                            RL_DIST_MAX_FRAMES);
+        samples += s;
+        frames++;
+    }
+    /* The bar: the share of the bands done, as the samples of one frame. */
+    loop_progress lp = { .plan = plan, .start_s = rl_time_s(), .frame_spp = (double)plan->target_spp };
+    char label[256];
+    snprintf(label, sizeof label, "render %s, %lld frames", a->scene, frames);
+    if (rl_log_get_level() >= RL_LOG_INFO && cli_dist_master())
+        rl_progress_create(label, stderr, &lp.bar);
+    rl_renderer_set_progress(r, on_progress, &lp);
+    cli_interrupt_begin("\nrl: interrupted: cancelling the render (Ctrl-C again aborts)\n");
+    rl_clear_error();
+    rl_status st = cli_render_frames_call(r, scene, cam, frames, img, sum);
+    int rc = RL_CLI_OK;
+    if (st == RL_ERR_CANCELLED && cli_interrupted())
+        rc = cli_fail(RL_CLI_INTERRUPTED, "render: interrupted before the bands were done; nothing written");
+    else if (st != RL_OK)
+        rc = cli_fail_status(RL_CLI_FAIL, st, "render");
+    acc->frames = rc == RL_CLI_OK ? frames : 0;     /* a cancelled run has no image to save */
+    acc->spp = (double)sum->samples / pixels;
+    acc->elapsed_s = rl_time_s() - lp.start_s;
+    acc->target_spp = plan->target_spp;
+    acc->stopped = "spp";
+    rl_renderer_set_progress(r, NULL, NULL);
+    rl_progress_finish(lp.bar);
+    cli_interrupt_end();
+    return rc;
 }
 
 /* One frame, or the progressive loop: frames until the budget would be
@@ -671,7 +737,8 @@ static int render_frame(const render_args *a)
             rc = cli_fail_status(RL_CLI_FAIL, st, "image");
     }
     if (rc == RL_CLI_OK)
-        rc = render_frames(a, renderer, scene, &cam, img, &plan, &stats, &acc);
+        rc = plan.loop && cli_dist_ranks() > 1 ? render_dist_frames(a, renderer, scene, &cam, img, &plan, &stats, &acc)
+                                               : render_frames(a, renderer, scene, &cam, img, &plan, &stats, &acc);
     /* Ctrl-C in a loop keeps the frames that were finished. */
     bool saving = rc == RL_CLI_OK || (rc == RL_CLI_INTERRUPTED && acc.frames > 0);
     if (saving && cli_dist_master()) {   /* --dist: the workers hold only their bands */

@@ -77,9 +77,24 @@ typedef struct rl_dist_stats {
  * images hold only their own bands. With one rank this is
  * rl_renderer_render. RL_ERR_UNSUPPORTED for a renderer without
  * info.regions in a job of several ranks; a rank's failure is the frame's
- * status on the master. dstats may be NULL. */
+ * status on the master. dstats may be NULL. With several ranks every band
+ * is a new accumulation (a progressive renderer's frame 1; see
+ * rl_dist_render_frames); with one, the renderer's accumulation goes on. */
 RL_API rl_status rl_dist_render(rl_dist *d, rl_renderer *r, const rl_scene *scene, const rl_camera *cam,
                                 rl_image *image, rl_render_stats *stats, rl_dist_stats *dstats);
+
+/* A progressive renderer's frames (pt's accumulation) spread as bands:
+ * every band renders all frames frames of a new accumulation
+ * (rl_renderer_reset, then frames renders with the band as region) and
+ * goes back to the master accumulated, so that the image equals frames
+ * frames of one process after rl_renderer_reset, bit for bit, for the same
+ * options (seed). stats: the rays and samples of every frame summed.
+ * Collective, as rl_dist_render; with one rank the frames render here.
+ * frames in 1..RL_DIST_MAX_FRAMES. */
+#define RL_DIST_MAX_FRAMES 1000000
+RL_API rl_status rl_dist_render_frames(rl_dist *d, rl_renderer *r, const rl_scene *scene, const rl_camera *cam,
+                                       uint64_t frames, rl_image *image, rl_render_stats *stats,
+                                       rl_dist_stats *dstats);
 
 /* Parallel adaptive sampling (Jähn 2015, Sec. 5.5, Alg. 5.4): collective,
  * every rank calls it with the same committed property (the same scene

@@ -42,6 +42,11 @@ RL_API void rl_gbuffer_release(rl_gbuffer *g);           /* NULL is a no-op */
 RL_API void rl_gbuffer_clear(rl_gbuffer *g);
 /* Fills g (camera resolution = g's size) by tracing the pixel-centre rays. */
 RL_API rl_status rl_gbuffer_trace(rl_gbuffer *g, const rl_accel *accel, const rl_camera *cam);
+/* rl_gbuffer_trace for the pixels x0 <= x < x1, y0 <= y < y1 only (a
+ * renderer's region, rl_renderer_set_region); the others keep what they
+ * hold. RL_ERR_INVALID_ARG for a part that is empty or leaves g. */
+RL_API rl_status rl_gbuffer_trace_part(rl_gbuffer *g, const rl_accel *accel, const rl_camera *cam, int x0, int y0,
+                                       int x1, int y1);
 /* Fills g from rasterized visibility (see above). Pixels agree with
  * rl_gbuffer_trace except where the rasterizer's coverage rule and the
  * ray disagree at triangle edges. */

@@ -77,8 +77,15 @@ RL_API rl_status rl_pt_get_stats(const rl_renderer *r, rl_pt_stats *out);
 RL_API rl_status rl_pt_reset(rl_renderer *r);
 /* The G-buffer of the current accumulation (pixel-centre primary hits),
  * valid until the next render or release; NULL when r is not "pt" or has
- * not rendered. */
+ * not rendered. After a render with a region (rl_renderer_set_region),
+ * only the region's pixels are this accumulation's. */
 RL_API const rl_gbuffer *rl_pt_gbuffer(const rl_renderer *r);
+/* The samples that frame number frame (0: the first after a reset) of a
+ * width x height image traces with r's options: spp per pixel, in half the
+ * pixels with checkerboard. Lets a caller fix the frames of a sample target
+ * before rendering (rl --dist: rl_dist_render_frames). 0 when r is not
+ * "pt" or the size is not positive. */
+RL_API uint64_t rl_pt_frame_samples(const rl_renderer *r, int width, int height, uint64_t frame);
 
 #ifdef __cplusplus
 }

@@ -15,6 +15,10 @@
  *   worker -> master  RESULT  band_result (band, status, counts, error)
  *   worker -> master  PIXELS  the band's layers, present ones in order
  *                             colour, depth, object ID, triangle ID
+ * A worker keeps its answers in flight (MPI_Isend) while it renders its
+ * next band; the master posts a band's pixel receives when its header
+ * comes and tests them between its own bands, so that it never blocks on
+ * one worker, not even on one killed mid-transfer (docs/distributed.md).
  * Only the calling thread talks to MPI (MPI_THREAD_FUNNELED); OpenMP
  * threads render inside each rank. */
 #include "rl/rl_dist.h"
@@ -217,15 +221,55 @@ static band_layout layout_of(rl_image *image, int band)
     return l;
 }
 
-/* Renders band into image with r restricted to its rows. */
-static rl_status render_band(rl_renderer *r, const rl_scene *scene, const rl_camera *cam, rl_image *image,
-                             int band, rl_render_stats *stats)
+/* The master's progress: the caller's callback sees the whole frame, the
+ * bands done anywhere plus the share of the band rendering here. */
+typedef struct frame_progress {
+    rl_progress_fn fn;
+    void *user;
+    int bands, done;
+    uint64_t frame, frames;      /* of the band rendering here */
+    bool cancelled;
+} frame_progress;
+
+static bool band_progress(void *user, double done)
+{
+    frame_progress *p = user;
+    double band = ((double)p->frame + done) / (double)p->frames;
+    if (p->fn && !p->fn(p->user, ((double)p->done + band) / (double)p->bands))
+        p->cancelled = true;
+    return !p->cancelled;
+}
+
+static void band_done(frame_progress *p)
+{
+    ++p->done;
+    p->frame = 0;
+    band_progress(p, 0.0);
+}
+
+/* Renders band into image with r restricted to its rows: frames frames of
+ * a new accumulation, so that a band is the same pixels whichever rank
+ * rendered what before it. stats: their counters summed over the frames
+ * (as a caller's loop over frames sums them). fp: the master's progress, else NULL. */
+static rl_status render_band(rl_renderer *r, const rl_scene *scene, const rl_camera *cam, uint64_t frames,
+                             rl_image *image, int band, rl_render_stats *stats, frame_progress *fp)
 {
     int y0 = band * BAND_ROWS, y1 = y0 + BAND_ROWS < image->height ? y0 + BAND_ROWS : image->height;
     rl_rect rows = { 0, y0, image->width, y1 };
     rl_status st = rl_renderer_set_region(r, &rows);
-    if (st == RL_OK)
-        st = rl_renderer_render(r, scene, cam, image, stats);
+    rl_renderer_reset(r);
+    for (uint64_t k = 0; st == RL_OK && k < frames; ++k) {
+        rl_render_stats fs = { 0 };
+        if (fp)
+            fp->frame = k;
+        if ((st = rl_renderer_render(r, scene, cam, image, &fs)) != RL_OK)
+            break;
+        for (int t = 0; t < RL_RAY_TYPE_COUNT; ++t)
+            stats->rays[t] += fs.rays[t];
+        stats->samples += fs.samples;
+        stats->prep_ms += fs.prep_ms;
+        stats->pixels_written += fs.pixels_written;
+    }
     rl_renderer_set_region(r, NULL);
     return st;
 }
@@ -239,9 +283,42 @@ static void add_band(rl_render_stats *to, const uint64_t rays[RL_RAY_TYPE_COUNT]
     to->pixels_written += pixels;
 }
 
-/* A worker's frame: bands until RL_DIST_TAG_DONE, whose status it returns. */
-static rl_status work(rl_dist *d, rl_renderer *r, const rl_scene *scene, const rl_camera *cam, rl_image *image)
+/* A band's answer on its way to the master: its header and layers, sent
+ * while the worker renders its next band. */
+typedef struct outgoing {
+    band_result res;
+    MPI_Request req[5];
+    int n;
+} outgoing;
+
+/* Waits (up to the timeout: the master may be gone) until o has gone out. */
+static rl_status finish_send(const rl_dist *d, outgoing *o)
 {
+    const double timeout = rl_dist_timeout_s(), t0 = rl_time_s();
+    while (o->n > 0) {
+        int finished = 0;
+        int code = MPI_Testall(o->n, o->req, &finished, MPI_STATUSES_IGNORE);
+        if (code != MPI_SUCCESS)
+            return rl_dist_mpi_failed(code, "sending a band");
+        if (finished) {
+            o->n = 0;
+            break;
+        }
+        if (rl_time_s() - t0 > timeout)
+            return rl_error(RL_ERR_IO, "rank %d: the master (rank 0) has not taken a band for %.0f s: it is gone "
+                            "or stuck; giving up (RL_DIST_TIMEOUT)", d->rank, timeout);
+        rl_dist_pause();
+    }
+    return RL_OK;
+}
+
+/* A worker's frame: bands until RL_DIST_TAG_DONE, whose status it returns. */
+static rl_status work(rl_dist *d, rl_renderer *r, const rl_scene *scene, const rl_camera *cam, uint64_t frames,
+                      rl_image *image)
+{
+    outgoing out[PREFETCH];
+    memset(out, 0, sizeof out);
+    int slot = 0;
     for (;;) {
         MPI_Status ms;
         int32_t value = 0;
@@ -251,10 +328,18 @@ static rl_status work(rl_dist *d, rl_renderer *r, const rl_scene *scene, const r
         int code = MPI_Recv(&value, 1, MPI_INT32_T, 0, ms.MPI_TAG, MPI_COMM_WORLD, &ms);
         if (code != MPI_SUCCESS)
             return rl_dist_mpi_failed(code, "receiving a band from the master");
+        for (int k = 0; ms.MPI_TAG == RL_DIST_TAG_DONE && k < PREFETCH; ++k)
+            if ((wst = finish_send(d, &out[k])) != RL_OK)
+                return wst;
         if (ms.MPI_TAG == RL_DIST_TAG_DONE)
             return value == RL_OK ? RL_OK
                                   : rl_error((rl_status)value, "distributed frame: another rank failed (%s)",
                                              rl_status_string((rl_status)value));
+        /* The slot's last band must be out before its header is reused. */
+        outgoing *o = &out[slot];
+        slot = (slot + 1) % PREFETCH;
+        if ((wst = finish_send(d, o)) != RL_OK)
+            return wst;
         band_result res;
         memset(&res, 0, sizeof res);
         res.band = value;
@@ -262,7 +347,7 @@ static rl_status work(rl_dist *d, rl_renderer *r, const rl_scene *scene, const r
         rl_timer t;
         rl_timer_start(&t);
         rl_clear_error();
-        rl_status st = render_band(r, scene, cam, image, value, &bs);
+        rl_status st = render_band(r, scene, cam, frames, image, value, &bs, NULL);
         res.busy_ms = rl_timer_ms(&t);
         res.status = (int32_t)st;
         if (st != RL_OK)
@@ -270,46 +355,36 @@ static rl_status work(rl_dist *d, rl_renderer *r, const rl_scene *scene, const r
         memcpy(res.rays, bs.rays, sizeof res.rays);
         res.samples = bs.samples;
         res.pixels = bs.pixels_written;
-        /* Sends that give up past the timeout: a band's pixels go by
-         * rendezvous, which would wait forever for a dead master. */
-        rl_status sst = rl_dist_send(d, &res, (int)sizeof res, MPI_BYTE, 0, RL_DIST_TAG_RESULT);
+        /* In flight while the next band renders: a band's pixels go by
+         * rendezvous, which completes only when the master takes them. */
+        o->res = res;
+        int code2 = MPI_Isend(&o->res, (int)sizeof o->res, MPI_BYTE, 0, RL_DIST_TAG_RESULT, MPI_COMM_WORLD,
+                              &o->req[o->n++]);
         band_layout l = layout_of(image, value);
-        for (int k = 0; sst == RL_OK && st == RL_OK && k < 4; ++k)
+        for (int k = 0; code2 == MPI_SUCCESS && st == RL_OK && k < 4; ++k)
             if (l.bytes[k])
-                sst = rl_dist_send(d, l.part[k], (int)l.bytes[k], MPI_BYTE, 0, RL_DIST_TAG_PIXELS);
-        if (sst != RL_OK)
-            return sst;
+                code2 = MPI_Isend(l.part[k], (int)l.bytes[k], MPI_BYTE, 0, RL_DIST_TAG_PIXELS, MPI_COMM_WORLD,
+                                  &o->req[o->n++]);
+        if (code2 != MPI_SUCCESS)
+            return rl_dist_mpi_failed(code2, "sending a band");
         rl_dist_fault_point(d);
     }
 }
 
-/* The master's progress: the caller's callback sees the whole frame, the
- * bands done anywhere plus the share of the band rendering here. */
-typedef struct frame_progress {
-    rl_progress_fn fn;
-    void *user;
-    int bands, done;
-    bool cancelled;
-} frame_progress;
-
-static bool band_progress(void *user, double done)
-{
-    frame_progress *p = user;
-    if (p->fn && !p->fn(p->user, ((double)p->done + done) / (double)p->bands))
-        p->cancelled = true;
-    return !p->cancelled;
-}
-
-static void band_done(frame_progress *p)
-{
-    ++p->done;
-    band_progress(p, 0.0);
-}
+/* A worker's bands in the master's hands: PREFETCH queued, and as many
+ * answered whose pixels are still coming (the worker sends them while it
+ * renders on). */
+#define SLOTS (2 * PREFETCH)
 
 /* The master's view of a worker during a frame. */
 typedef struct worker_state {
-    int32_t bands[PREFETCH];     /* handed out, not yet returned (-1: free slot) */
-    int pending;
+    int32_t bands[SLOTS];        /* handed out, pixels not yet in (-1: free slot) */
+    bool answered[SLOTS];        /* its header is in, its pixels are coming */
+    band_result res[SLOTS];
+    MPI_Request rx[SLOTS][4];    /* the pixels' receives */
+    int nrx[SLOTS];
+    int pending;                 /* bands not yet answered */
+    int receiving;               /* bands answered, pixels coming */
     double since;                /* when it last answered, or got work while idle */
     bool lost;                   /* silent past the timeout: its bands went elsewhere */
 } worker_state;
@@ -329,23 +404,36 @@ static rl_status give_band(rl_dist_stats *ds, worker_state *ws, int w, int band)
     ++ds->messages;
     if (code != MPI_SUCCESS)
         return rl_dist_mpi_failed(code, "handing out a band");
-    if (ws->pending == 0)
+    if (ws->pending == 0 && ws->receiving == 0)
         ws->since = rl_time_s();
-    for (int k = 0; k < PREFETCH; ++k)
+    for (int k = 0; k < SLOTS; ++k)
         if (ws->bands[k] < 0) {
             ws->bands[k] = b;
+            ws->answered[k] = false;
             break;
         }
     ++ws->pending;
     return RL_OK;
 }
 
+/* The slot of w's band (answered or not), or a free one; -1 if neither. */
+static int slot_of(const worker_state *ws, int band, bool answered)
+{
+    for (int k = 0; k < SLOTS; ++k)
+        if (ws->bands[k] == band && ws->answered[k] == answered)
+            return k;
+    for (int k = 0; k < SLOTS; ++k)
+        if (ws->bands[k] < 0)
+            return k;
+    return -1;
+}
+
 /* The master's frame. A worker that stays silent past the timeout with
  * bands in hand is taken for lost (killed, its node gone): its bands go to
  * the others and it gets no more. Should it answer after all, its bands
  * are the same pixels and are taken as they come. */
-static rl_status lead(rl_dist *d, rl_renderer *r, const rl_scene *scene, const rl_camera *cam, rl_image *image,
-                      rl_render_stats *stats, rl_dist_stats *ds)
+static rl_status lead(rl_dist *d, rl_renderer *r, const rl_scene *scene, const rl_camera *cam, uint64_t frames,
+                      rl_image *image, rl_render_stats *stats, rl_dist_stats *ds)
 {
     const int bands = (image->height + BAND_ROWS - 1) / BAND_ROWS;
     const double timeout = rl_dist_timeout_s();
@@ -360,11 +448,11 @@ static rl_status lead(rl_dist *d, rl_renderer *r, const rl_scene *scene, const r
         return RL_ERR_OUT_OF_MEMORY;
     }
     for (int w = 0; w < d->size; ++w)
-        for (int k = 0; k < PREFETCH; ++k)
+        for (int k = 0; k < SLOTS; ++k)
             ws[w].bands[k] = -1;
     rl_status st = RL_OK;
     char failure[320] = "";
-    frame_progress fp = { .bands = bands };
+    frame_progress fp = { .bands = bands, .frames = frames };
     rl_renderer_get_progress(r, &fp.fn, &fp.user);
     rl_renderer_set_progress(r, band_progress, &fp);
     /* Queue PREFETCH bands at every worker first. */
@@ -373,14 +461,42 @@ static rl_status lead(rl_dist *d, rl_renderer *r, const rl_scene *scene, const r
             st = give_band(ds, &ws[w], w, next++);
     if (st != RL_OK)
         snprintf(failure, sizeof failure, "%s", rl_last_error());
-    int pending = 0;
+    int pending = 0, receiving = 0;
     for (int w = 1; w < d->size; ++w)
         pending += ws[w].pending;
-    while (code == MPI_SUCCESS && (st == RL_OK ? remaining > 0 : pending > 0)) {
+    while (code == MPI_SUCCESS && (st == RL_OK ? remaining > 0 : pending + receiving > 0)) {
         if (fp.cancelled && st == RL_OK) {
             st = RL_ERR_CANCELLED;          /* no more bands out; drain the rest */
             snprintf(failure, sizeof failure, "cancelled by the progress callback");
         }
+        /* Pixels that have come in complete their bands. */
+        for (int w = 1; w < d->size && code == MPI_SUCCESS; ++w)
+            for (int k = 0; k < SLOTS && ws[w].receiving > 0; ++k) {
+                if (ws[w].bands[k] < 0 || !ws[w].answered[k])
+                    continue;
+                int complete = 0;
+                if ((code = MPI_Testall(ws[w].nrx[k], ws[w].rx[k], &complete, MPI_STATUSES_IGNORE)) != MPI_SUCCESS)
+                    break;
+                if (!complete)
+                    continue;
+                const band_result *res = &ws[w].res[k];
+                if (!done[res->band]) {          /* a late answer of a lost worker may come twice */
+                    add_band(stats, res->rays, res->samples, res->pixels);
+                    ++d->per_rank[w].tasks;
+                    d->per_rank[w].pixels += res->pixels;
+                    d->per_rank[w].busy_ms += res->busy_ms;
+                    done[res->band] = 1;
+                    --remaining;
+                    band_done(&fp);
+                }
+                ws[w].bands[k] = -1;
+                --ws[w].receiving;
+                if (!ws[w].lost)
+                    --receiving;
+                ws[w].since = rl_time_s();
+            }
+        if (code != MPI_SUCCESS)
+            break;
         int arrived = 0;
         MPI_Status ms;
         if ((code = MPI_Iprobe(MPI_ANY_SOURCE, RL_DIST_TAG_RESULT, MPI_COMM_WORLD, &arrived, &ms)) != MPI_SUCCESS)
@@ -392,7 +508,7 @@ static rl_status lead(rl_dist *d, rl_renderer *r, const rl_scene *scene, const r
                 rl_render_stats bs = { 0 };
                 rl_timer t;
                 rl_timer_start(&t);
-                st = render_band(r, scene, cam, image, band, &bs);
+                st = render_band(r, scene, cam, frames, image, band, &bs, &fp);
                 d->per_rank[0].busy_ms += rl_timer_ms(&t);
                 if (st == RL_OK) {
                     add_band(stats, bs.rays, bs.samples, bs.pixels_written);
@@ -411,18 +527,32 @@ static rl_status lead(rl_dist *d, rl_renderer *r, const rl_scene *scene, const r
             /* Waiting: a worker silent past the timeout is lost. */
             double now = rl_time_s();
             for (int w = 1; w < d->size; ++w) {
-                if (ws[w].lost || ws[w].pending == 0 || now - ws[w].since <= timeout)
+                if (ws[w].lost || ws[w].pending + ws[w].receiving == 0 || now - ws[w].since <= timeout)
                     continue;
                 ws[w].lost = true;
                 ++ds->lost;
                 pending -= ws[w].pending;
-                for (int k = 0; k < PREFETCH; ++k)
+                receiving -= ws[w].receiving;
+                for (int k = 0; k < SLOTS; ++k) {
                     if (ws[w].bands[k] >= 0 && !done[ws[w].bands[k]])
                         redo[num_redo++] = ws[w].bands[k];
+                    if (ws[w].bands[k] >= 0 && ws[w].answered[k]) {
+                        /* Pixels that stopped coming never will: the
+                         * receives are cancelled and left, their slot
+                         * closed (a dead sender completes nothing). */
+                        for (int j = 0; j < ws[w].nrx[k]; ++j)
+                            MPI_Cancel(&ws[w].rx[k][j]);
+                        ws[w].bands[k] = -2;
+                        ws[w].answered[k] = false;
+                    } else if (ws[w].bands[k] >= 0) {
+                        ws[w].bands[k] = -1;
+                    }
+                }
+                ws[w].pending = ws[w].receiving = 0;
                 rl_log(RL_LOG_WARN, "rank %d has not answered for %.0f s: taken for lost, its bands go to the "
                        "other ranks (RL_DIST_TIMEOUT)", w, now - ws[w].since);
             }
-            if (pending > 0 || st != RL_OK)
+            if (pending + receiving > 0 || st != RL_OK)
                 rl_dist_pause();
             continue;
         }
@@ -437,35 +567,41 @@ static rl_status lead(rl_dist *d, rl_renderer *r, const rl_scene *scene, const r
             code = MPI_ERR_OTHER;
             break;
         }
-        for (int k = 0; k < PREFETCH; ++k)
-            if (ws[w].bands[k] == res.band) {
-                ws[w].bands[k] = -1;
-                --ws[w].pending;
-                if (!ws[w].lost)
-                    --pending;
-                break;
-            }
+        int slot = slot_of(&ws[w], res.band, false);
+        bool queued = slot >= 0 && ws[w].bands[slot] == res.band;
+        if (queued) {
+            ws[w].bands[slot] = -1;
+            --ws[w].pending;
+            if (!ws[w].lost)
+                --pending;
+        }
         ws[w].since = rl_time_s();
+        if (res.status == RL_OK && slot < 0 && ws[w].lost)
+            continue;                        /* a lost worker's late answer with no slot left: its band is redone */
+        if (res.status == RL_OK && slot < 0) {
+            code = MPI_ERR_OTHER;            /* more answers than bands: not our protocol */
+            break;
+        }
         if (res.status == RL_OK) {
+            /* The pixels come while this rank renders on; the band is done
+             * when they are in (above). */
             band_layout l = layout_of(image, res.band);
+            ws[w].bands[slot] = res.band;
+            ws[w].answered[slot] = true;
+            ws[w].res[slot] = res;
+            ws[w].nrx[slot] = 0;
             for (int k = 0; code == MPI_SUCCESS && k < 4; ++k)
                 if (l.bytes[k]) {
-                    code = MPI_Recv(l.part[k], (int)l.bytes[k], MPI_BYTE, w, RL_DIST_TAG_PIXELS, MPI_COMM_WORLD,
-                                    MPI_STATUS_IGNORE);
+                    code = MPI_Irecv(l.part[k], (int)l.bytes[k], MPI_BYTE, w, RL_DIST_TAG_PIXELS, MPI_COMM_WORLD,
+                                     &ws[w].rx[slot][ws[w].nrx[slot]++]);
                     ++ds->messages;
                     ds->bytes += l.bytes[k];
                 }
             if (code != MPI_SUCCESS)
                 break;
-            if (!done[res.band]) {          /* a late answer of a lost worker may come twice */
-                add_band(stats, res.rays, res.samples, res.pixels);
-                ++d->per_rank[w].tasks;
-                d->per_rank[w].pixels += res.pixels;
-                d->per_rank[w].busy_ms += res.busy_ms;
-                done[res.band] = 1;
-                --remaining;
-                band_done(&fp);
-            }
+            ++ws[w].receiving;
+            if (!ws[w].lost)
+                ++receiving;
         } else if (st == RL_OK) {
             st = (rl_status)res.status;
             res.error[sizeof res.error - 1] = '\0';
@@ -482,6 +618,20 @@ static rl_status lead(rl_dist *d, rl_renderer *r, const rl_scene *scene, const r
         }
     }
     rl_renderer_set_progress(r, fp.fn, fp.user);
+    /* A worker taken for lost that answered late after all sends its
+     * pixels into the image: they must be in before the image may go. */
+    const double t_end = rl_time_s();
+    for (int w = 1; w < d->size && code == MPI_SUCCESS; ++w)
+        for (int k = 0; k < SLOTS && ws[w].lost; ++k)
+            while (ws[w].bands[k] >= 0 && ws[w].answered[k] && rl_time_s() - t_end <= timeout) {
+                int complete = 0;
+                if ((code = MPI_Testall(ws[w].nrx[k], ws[w].rx[k], &complete, MPI_STATUSES_IGNORE)) != MPI_SUCCESS)
+                    break;
+                if (complete)
+                    ws[w].bands[k] = -1;
+                else
+                    rl_dist_pause();
+            }
     if (code == MPI_SUCCESS) {
         /* Every live worker hears the end. A lost one does not: a send to
          * a dead rank may never return; one that was only slow gives up
@@ -504,8 +654,10 @@ static rl_status lead(rl_dist *d, rl_renderer *r, const rl_scene *scene, const r
     return RL_OK;
 }
 
-rl_status rl_dist_render(rl_dist *d, rl_renderer *r, const rl_scene *scene, const rl_camera *cam,
-                         rl_image *image, rl_render_stats *stats, rl_dist_stats *dstats)
+/* frames 0: one frame that continues the renderer's accumulation in a job
+ * of one (rl_dist_render). */
+static rl_status render_frames(rl_dist *d, rl_renderer *r, const rl_scene *scene, const rl_camera *cam,
+                               uint64_t frames, rl_image *image, rl_render_stats *stats, rl_dist_stats *dstats)
 {
     rl_dist_stats ds_local;
     rl_dist_stats *ds = dstats ? dstats : &ds_local;
@@ -514,10 +666,34 @@ rl_status rl_dist_render(rl_dist *d, rl_renderer *r, const rl_scene *scene, cons
     rl_render_stats local;
     rl_render_stats *rs = stats ? stats : &local;
     memset(rs, 0, sizeof *rs);
-    if (!d || d->size == 1)
-        return rl_renderer_render(r, scene, cam, image, rs);
     if (!r || !scene || !cam || !image)
         return rl_error(RL_ERR_INVALID_ARG, "rl_dist_render: renderer, scene, camera and image must not be NULL");
+    if (frames > RL_DIST_MAX_FRAMES)
+        return rl_error(RL_ERR_LIMIT, "rl_dist_render_frames: %llu frames (at most %d)", (unsigned long long)frames,
+                        RL_DIST_MAX_FRAMES);
+    if (!d || d->size == 1) {
+        if (frames == 0) {
+            rl_status st0 = rl_renderer_render(r, scene, cam, image, rs);
+            ds->time_ms = rs->time_ms;
+            return st0;
+        }
+        rl_timer t;
+        rl_timer_start(&t);
+        rl_renderer_reset(r);
+        rl_status st = RL_OK;
+        for (uint64_t k = 0; k < frames && st == RL_OK; ++k) {
+            rl_render_stats fs = { 0 };
+            if ((st = rl_renderer_render(r, scene, cam, image, &fs)) == RL_OK) {
+                add_band(rs, fs.rays, fs.samples, 0);
+                rs->prep_ms += fs.prep_ms;
+                rs->pixels_written += fs.pixels_written;
+            }
+        }
+        rs->time_ms = ds->time_ms = rl_timer_ms(&t);
+        return st;
+    }
+    if (frames == 0)
+        frames = 1;
     /* Every rank decides alike from what every rank has, so that all of
      * them refuse together and none waits for a band. */
     const rl_renderer_info *info = NULL;
@@ -532,8 +708,23 @@ rl_status rl_dist_render(rl_dist *d, rl_renderer *r, const rl_scene *scene, cons
     memset(d->per_rank, 0, (size_t)d->size * sizeof *d->per_rank);
     rl_timer t;
     rl_timer_start(&t);
-    rl_status st = d->rank == 0 ? lead(d, r, scene, cam, image, rs, ds) : work(d, r, scene, cam, image);
+    rl_status st = d->rank == 0 ? lead(d, r, scene, cam, frames, image, rs, ds)
+                                : work(d, r, scene, cam, frames, image);
     rs->time_ms = ds->time_ms = rl_timer_ms(&t);
     ds->per_rank = d->per_rank;
     return st;
+}
+
+rl_status rl_dist_render(rl_dist *d, rl_renderer *r, const rl_scene *scene, const rl_camera *cam,
+                         rl_image *image, rl_render_stats *stats, rl_dist_stats *dstats)
+{
+    return render_frames(d, r, scene, cam, 0, image, stats, dstats);
+}
+
+rl_status rl_dist_render_frames(rl_dist *d, rl_renderer *r, const rl_scene *scene, const rl_camera *cam,
+                                uint64_t frames, rl_image *image, rl_render_stats *stats, rl_dist_stats *dstats)
+{
+    if (frames == 0)
+        return rl_error(RL_ERR_INVALID_ARG, "rl_dist_render_frames: frames must be at least 1");
+    return render_frames(d, r, scene, cam, frames, image, stats, dstats);
 }

@@ -40,6 +40,35 @@ rl_status rl_dist_render(rl_dist *d, rl_renderer *r, const rl_scene *scene, cons
     return st;
 }
 
+rl_status rl_dist_render_frames(rl_dist *d, rl_renderer *r, const rl_scene *scene, const rl_camera *cam,
+                                uint64_t frames, rl_image *image, rl_render_stats *stats, rl_dist_stats *dstats)
+{
+    (void)d;
+    if (frames == 0 || frames > RL_DIST_MAX_FRAMES)
+        return rl_error(RL_ERR_INVALID_ARG, "rl_dist_render_frames: frames must be in 1..%d", RL_DIST_MAX_FRAMES);
+    if (dstats)
+        *dstats = (rl_dist_stats){ .ranks = 1 };
+    rl_render_stats sum = { 0 };
+    rl_status st = RL_OK;
+    rl_renderer_reset(r);
+    for (uint64_t k = 0; k < frames && st == RL_OK; ++k) {
+        rl_render_stats fs = { 0 };
+        if ((st = rl_renderer_render(r, scene, cam, image, &fs)) != RL_OK)
+            break;
+        for (int t = 0; t < RL_RAY_TYPE_COUNT; ++t)
+            sum.rays[t] += fs.rays[t];
+        sum.samples += fs.samples;
+        sum.prep_ms += fs.prep_ms;
+        sum.time_ms += fs.time_ms;
+        sum.pixels_written += fs.pixels_written;
+    }
+    if (stats)
+        *stats = sum;
+    if (dstats)
+        dstats->time_ms = sum.time_ms;
+    return st;
+}
+
 rl_status rl_dist_sample_property(rl_dist *d, rl_property *p, const rl_sampling_desc *desc, rl_approx **out,
                                   rl_dist_stats *dstats)
 {

@@ -266,8 +266,13 @@ rl_status rl_dist_sample_property(rl_dist *d, rl_property *p, const rl_sampling_
     ds->ranks = rl_dist_size(d);
     if (out)
         *out = NULL;
-    if (!d || d->size == 1)
-        return rl_sample_property(p, desc, out);
+    if (!d || d->size == 1) {
+        rl_timer t1;
+        rl_timer_start(&t1);
+        rl_status st1 = rl_sample_property(p, desc, out);
+        ds->time_ms = rl_timer_ms(&t1);
+        return st1;
+    }
     if (!p || !desc || !out)
         return rl_error(RL_ERR_INVALID_ARG, "rl_dist_sample_property: property, desc and out must not be NULL");
     memset(d->per_rank, 0, (size_t)d->size * sizeof *d->per_rank);

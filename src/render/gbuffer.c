@@ -139,12 +139,23 @@ static rl_status check_args(const rl_gbuffer *g, const rl_camera *cam, const cha
 
 rl_status rl_gbuffer_trace(rl_gbuffer *g, const rl_accel *accel, const rl_camera *cam)
 {
+    if (!g)
+        return rl_error(RL_ERR_INVALID_ARG, "rl_gbuffer_trace: NULL argument");
+    return rl_gbuffer_trace_part(g, accel, cam, 0, 0, g->width, g->height);
+}
+
+rl_status rl_gbuffer_trace_part(rl_gbuffer *g, const rl_accel *accel, const rl_camera *cam, int x0, int y0,
+                                int x1, int y1)
+{
     rl_camera c;
     rl_status st = check_args(g, cam, "rl_gbuffer_trace", &c);
     if (st != RL_OK)
         return st;
     if (!accel)
         return rl_error(RL_ERR_INVALID_ARG, "rl_gbuffer_trace: accel must not be NULL");
+    if (x0 < 0 || y0 < 0 || x1 > g->width || y1 > g->height || x1 <= x0 || y1 <= y0)
+        return rl_error(RL_ERR_INVALID_ARG, "rl_gbuffer_trace_part: [%d,%d)x[%d,%d) is empty or leaves the %dx%d "
+                        "G-buffer", x0, x1, y0, y1, g->width, g->height);
     const rl_scene *scene = rl_accel_scene(accel);
     const rl_scene_data *d = scene ? rl_scene_get_data(scene) : NULL;
     if (!d)
@@ -152,8 +163,8 @@ rl_status rl_gbuffer_trace(rl_gbuffer *g, const rl_accel *accel, const rl_camera
     rl_camera_frame f = rl_camera_frame_make(&c);
     rl_vec3 forward = rl_neg(f.w);
 #pragma omp parallel for schedule(dynamic, 4)
-    for (int y = 0; y < g->height; ++y) {
-        for (int x = 0; x < g->width; ++x) {
+    for (int y = y0; y < y1; ++y) {
+        for (int x = x0; x < x1; ++x) {
             size_t i = (size_t)y * g->width + x;
             rl_ray ray = rl_camera_frame_ray(&f, (float)x + 0.5f, (float)y + 0.5f);
             rl_hit hit = { INFINITY, 0.0f, 0.0f, RL_ID_NONE, RL_ID_NONE };

@@ -63,7 +63,16 @@
  * "the filter's influence decreases as the samples grow"; filter_fade = 0
  * keeps the full filter. The G-buffer guides the filter.
  *
- * Depth and ID layers come from the G-buffer (pixel centres). */
+ * Depth and ID layers come from the G-buffer (pixel centres).
+ *
+ * Regions (rl_renderer_set_region, what rl --dist hands out): every pixel's
+ * samples depend only on its own generator state or Sobol index, so a
+ * region renders exactly the pixels of the whole frame there. A region is
+ * an accumulation of its own: it restarts when the region changes, so N
+ * frames of a region are the region of N whole frames. With checkerboard,
+ * the first frame's holes need their neighbours, so a region traces a ring
+ * of one pixel around itself too. The filters work on the whole image and
+ * primary=raster rasterizes it: a region refuses both. */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -159,6 +168,7 @@ typedef struct pt_state {
     uint64_t scene_uid;
     rl_camera cam;
     int width, height;
+    rl_rect area;                 /* the traced pixels: the region (and its ring), else the image */
     char *signature;
     double *accum;                /* 3 per pixel: summed radiance */
     uint32_t *count;              /* samples per pixel */
@@ -308,9 +318,14 @@ static bool same_camera(const rl_camera *a, const rl_camera *b)
            a->height == b->height && a->z_near == b->z_near && a->z_far == b->z_far;
 }
 
-/* Starts a new accumulation: buffers, generator states, G-buffer. */
+static bool same_rect(const rl_rect *a, const rl_rect *b)
+{
+    return a->x0 == b->x0 && a->y0 == b->y0 && a->x1 == b->x1 && a->y1 == b->y1;
+}
+
+/* Starts a new accumulation in area: buffers, generator states, G-buffer. */
 static rl_status reset(pt_state *s, const rl_scene *scene, const rl_camera *cam, const pt_settings *set,
-                       char *signature)
+                       const rl_rect *area, char *signature)
 {
     int w = cam->width, h = cam->height;
     size_t n = (size_t)w * (size_t)h;
@@ -330,17 +345,24 @@ static rl_status reset(pt_state *s, const rl_scene *scene, const rl_camera *cam,
             return st;
         }
     }
-    memset(s->accum, 0, 3 * n * sizeof *s->accum);
-    memset(s->count, 0, n * sizeof *s->count);
-    /* Sec. 5.3.3: the state texture is filled once from the CPU generator. */
-    for (size_t i = 0; i < n; ++i)
-        rl_rng_gpu_seed(&s->rng[i], set->rng, set->seed, i);
+    /* Only area's pixels: a rank of rl --dist renders one band after
+     * another into the same buffers, each band its own accumulation. */
+    size_t len = (size_t)(area->x1 - area->x0);
+    for (int y = area->y0; y < area->y1; ++y) {
+        size_t row = (size_t)y * (size_t)w + (size_t)area->x0;
+        memset(s->accum + 3 * row, 0, 3 * len * sizeof *s->accum);
+        memset(s->count + row, 0, len * sizeof *s->count);
+        /* Sec. 5.3.3: the state texture is filled once from the CPU generator. */
+        for (size_t i = row; i < row + len; ++i)
+            rl_rng_gpu_seed(&s->rng[i], set->rng, set->seed, i);
+    }
     free(s->signature);
     s->signature = signature;
     s->scene_uid = rl_scene_uid(scene);
     s->cam = *cam;
     s->width = w;
     s->height = h;
+    s->area = *area;
     s->frames = 0;
     s->total_samples = 0;
     s->valid = true;
@@ -355,7 +377,9 @@ typedef struct frame {
     pt_ctx ctx;
     rl_camera_frame cam;
     rl_vec3 eye;
-    int width, height, tiles_x;
+    int width, height;
+    rl_rect area;                 /* the traced pixels; tiles are numbered from its corner */
+    int tiles_x;
     uint64_t parity;
 } frame;
 
@@ -366,10 +390,10 @@ static bool active(const frame *f, int x, int y)
 
 static void tile_bounds(const frame *f, int64_t t, int *x0, int *y0, int *x1, int *y1)
 {
-    *x0 = (int)(t % f->tiles_x) * TILE;
-    *y0 = (int)(t / f->tiles_x) * TILE;
-    *x1 = *x0 + TILE < f->width ? *x0 + TILE : f->width;
-    *y1 = *y0 + TILE < f->height ? *y0 + TILE : f->height;
+    *x0 = f->area.x0 + (int)(t % f->tiles_x) * TILE;
+    *y0 = f->area.y0 + (int)(t / f->tiles_x) * TILE;
+    *x1 = *x0 + TILE < f->area.x1 ? *x0 + TILE : f->area.x1;
+    *y1 = *y0 + TILE < f->area.y1 ? *y0 + TILE : f->area.y1;
 }
 
 /* Primary pass of one sample (trace mode): jittered camera rays, Sec. 8.1's
@@ -473,14 +497,14 @@ static void run_pass(const frame *f, int threads, int64_t num_tiles, uint32_t pa
     }
 }
 
-/* The accumulated mean into the image; checkerboard holes (first frame
- * after a reset) from the rendered 4-neighbours (Sec. 8.5, Fig. 17). */
-static void resolve(const pt_state *s, rl_image *image)
+/* The accumulated mean into the image's region; checkerboard holes (first
+ * frame after a reset) from the rendered 4-neighbours (Sec. 8.5, Fig. 17). */
+static void resolve(const pt_state *s, const rl_rect *region, rl_image *image)
 {
     int w = s->width, h = s->height;
 #pragma omp parallel for schedule(static)
-    for (int y = 0; y < h; ++y) {
-        for (int x = 0; x < w; ++x) {
+    for (int y = region->y0; y < region->y1; ++y) {
+        for (int x = region->x0; x < region->x1; ++x) {
             size_t i = (size_t)y * w + x;
             double c[3] = { 0.0, 0.0, 0.0 };
             if (s->count[i] > 0) {
@@ -546,15 +570,18 @@ static rl_status apply_filter(const pt_state *s, const pt_settings *set, rl_imag
     return st;
 }
 
-static void write_layers(const pt_state *s, rl_image *image)
+static void write_layers(const pt_state *s, const rl_rect *region, rl_image *image)
 {
-    size_t n = (size_t)s->width * s->height;
     const rl_gbuffer *g = s->gbuf;
-    if ((image->layers & RL_LAYER_DEPTH) && image->depth)
-        memcpy(image->depth, g->depth, n * sizeof *image->depth);
-    if ((image->layers & RL_LAYER_ID) && image->object_id && image->triangle_id) {
-        memcpy(image->object_id, g->object, n * sizeof *image->object_id);
-        memcpy(image->triangle_id, g->triangle, n * sizeof *image->triangle_id);
+    size_t n = (size_t)(region->x1 - region->x0);
+    for (int y = region->y0; y < region->y1; ++y) {
+        size_t i = (size_t)y * (size_t)s->width + (size_t)region->x0;
+        if ((image->layers & RL_LAYER_DEPTH) && image->depth)
+            memcpy(image->depth + i, g->depth + i, n * sizeof *image->depth);
+        if ((image->layers & RL_LAYER_ID) && image->object_id && image->triangle_id) {
+            memcpy(image->object_id + i, g->object + i, n * sizeof *image->object_id);
+            memcpy(image->triangle_id + i, g->triangle + i, n * sizeof *image->triangle_id);
+        }
     }
 }
 
@@ -570,7 +597,7 @@ static rl_status cancelled(pt_state *s)
  * G-buffer once per reset; the rasterized one every frame, as the thesis'
  * extra render pass, Sec. 8.1). */
 static rl_status prepare_frame(rl_renderer *r, pt_state *s, const rl_scene *scene, const rl_camera *cam,
-                               const pt_settings *set, rl_pt_stats *ps)
+                               const pt_settings *set, const rl_rect *area, rl_pt_stats *ps)
 {
     double built_ms = 0.0;
     rl_status st = rl_pt_backends_prepare(&s->b, scene, set, set->threads, &built_ms);
@@ -585,9 +612,9 @@ static rl_status prepare_frame(rl_renderer *r, pt_state *s, const rl_scene *scen
         return RL_ERR_OUT_OF_MEMORY;
     bool need_reset = s->force_reset || !s->valid || !set->accumulate || s->scene_uid != rl_scene_uid(scene) ||
                       s->width != cam->width || s->height != cam->height || !same_camera(&s->cam, cam) ||
-                      strcmp(s->signature, sig) != 0;
+                      !same_rect(&s->area, area) || strcmp(s->signature, sig) != 0;
     if (need_reset) {
-        if ((st = reset(s, scene, cam, set, sig)) != RL_OK)
+        if ((st = reset(s, scene, cam, set, area, sig)) != RL_OK)
             return st;
     } else {
         free(sig);
@@ -599,8 +626,8 @@ static rl_status prepare_frame(rl_renderer *r, pt_state *s, const rl_scene *scen
     if (set->primary == PT_PRIMARY_RASTER) {
         st = rl_gbuffer_raster(s->gbuf, scene, cam);
     } else if (need_reset) {
-        st = rl_gbuffer_trace(s->gbuf, s->b.exact[RL_ACCEL_BVH], cam);
-        ps->gbuffer_rays = (uint64_t)cam->width * cam->height;
+        st = rl_gbuffer_trace_part(s->gbuf, s->b.exact[RL_ACCEL_BVH], cam, area->x0, area->y0, area->x1, area->y1);
+        ps->gbuffer_rays = (uint64_t)(area->x1 - area->x0) * (uint64_t)(area->y1 - area->y0);
     }
     if (st != RL_OK) {
         s->force_reset = true;
@@ -615,7 +642,7 @@ static rl_status prepare_frame(rl_renderer *r, pt_state *s, const rl_scene *scen
 static rl_status trace_passes(rl_renderer *r, const frame *f, const pt_settings *set, pt_counters *sum,
                               rl_pt_stats *ps)
 {
-    int64_t num_tiles = (int64_t)f->tiles_x * ((f->height + TILE - 1) / TILE);
+    int64_t num_tiles = (int64_t)f->tiles_x * ((f->area.y1 - f->area.y0 + TILE - 1) / TILE);
     pt_counters *tile_c = rl_calloc((size_t)num_tiles, sizeof *tile_c);
     if (!tile_c)
         return RL_ERR_OUT_OF_MEMORY;
@@ -643,17 +670,17 @@ static rl_status trace_passes(rl_renderer *r, const frame *f, const pt_settings 
 
 /* The frame's statistics (rl_pt_stats and the generic ones). */
 static void finish_stats(pt_state *s, const pt_settings *set, const pt_counters *sum, uint64_t traced,
-                         const rl_camera *cam, const rl_timer *total, rl_render_stats *stats, rl_pt_stats *ps)
+                         uint64_t pixels, const rl_timer *total, rl_render_stats *stats, rl_pt_stats *ps)
 {
     for (int k = 0; k < RL_RAY_TYPE_COUNT; ++k)
         stats->rays[k] = ps->rays[k] = sum->rays[k];
     memcpy(ps->shadow_queries, sum->shadow_q, sizeof ps->shadow_queries);
     memcpy(ps->trace_queries, sum->trace_q, sizeof ps->trace_queries);
     ps->preillum_ends = sum->preillum_ends;
-    stats->pixels_written = (uint64_t)cam->width * cam->height;
+    stats->pixels_written = pixels;
     stats->samples = ps->samples = traced * (uint64_t)set->spp;
     ps->frames = s->frames;
-    ps->spp = (double)s->total_samples / ((double)cam->width * cam->height);
+    ps->spp = (double)s->total_samples / (double)pixels;
     ps->spp_frame = (uint32_t)set->spp;
     ps->pixels_traced = traced;
     uint64_t rays = 0;
@@ -691,9 +718,26 @@ static rl_status pt_render(rl_renderer *r, void *state, const rl_scene *scene, c
     pt_settings set;
     read_settings(r, &set);
     s->have_frame = false;
+    rl_rect region = rl_renderer_region(r, cam->width, cam->height), area = region;
+    if (region.x0 > 0 || region.y0 > 0 || region.x1 < cam->width || region.y1 < cam->height) {
+        if (set.filter != RL_FILTER_NONE)
+            return rl_error(RL_ERR_UNSUPPORTED, "pt: filter=%s filters the whole image; a region (rl --dist) "
+                            "needs filter=none", filter_choices[set.filter]);
+        if (set.primary == PT_PRIMARY_RASTER)
+            return rl_error(RL_ERR_UNSUPPORTED, "pt: primary=raster rasterizes the whole image; a region "
+                            "(rl --dist) needs primary=trace");
+        if (set.checkerboard) {
+            /* The first frame's holes are the mean of their neighbours,
+             * which may lie outside: trace those too. */
+            area.x0 = region.x0 > 0 ? region.x0 - 1 : 0;
+            area.y0 = region.y0 > 0 ? region.y0 - 1 : 0;
+            area.x1 = region.x1 < cam->width ? region.x1 + 1 : cam->width;
+            area.y1 = region.y1 < cam->height ? region.y1 + 1 : cam->height;
+        }
+    }
     rl_pt_stats ps;
     memset(&ps, 0, sizeof ps);
-    rl_status st = prepare_frame(r, s, scene, cam, &set, &ps);
+    rl_status st = prepare_frame(r, s, scene, cam, &set, &area, &ps);
     if (st != RL_OK)
         return st;
 
@@ -712,7 +756,8 @@ static rl_status pt_render(rl_renderer *r, void *state, const rl_scene *scene, c
         .eye = cam->eye,
         .width = cam->width,
         .height = cam->height,
-        .tiles_x = (cam->width + TILE - 1) / TILE,
+        .area = area,
+        .tiles_x = (area.x1 - area.x0 + TILE - 1) / TILE,
         .parity = s->frames & 1u,
     };
     pt_counters sum;
@@ -720,18 +765,20 @@ static rl_status pt_render(rl_renderer *r, void *state, const rl_scene *scene, c
         return st;
 
     /* Sec. 6.5, eq. 8: the traced pixels' sample counts (all of them, or
-     * the frame's checkerboard half). */
+     * the frame's checkerboard half); the samples are the region's, not
+     * its ring's. */
     uint64_t traced = 0;
-    for (int y = 0; y < cam->height; ++y)
-        for (int x = 0; x < cam->width; ++x)
+    for (int y = area.y0; y < area.y1; ++y)
+        for (int x = area.x0; x < area.x1; ++x)
             if (active(&f, x, y)) {
                 s->count[(size_t)y * cam->width + x] += (uint32_t)set.spp;
-                ++traced;
+                if (x >= region.x0 && x < region.x1 && y >= region.y0 && y < region.y1)
+                    ++traced;
             }
     s->frames++;
     s->total_samples += traced * (uint64_t)set.spp;
 
-    resolve(s, image);
+    resolve(s, &region, image);
     if (set.filter != RL_FILTER_NONE) {
         rl_timer timer;
         rl_timer_start(&timer);
@@ -740,8 +787,9 @@ static rl_status pt_render(rl_renderer *r, void *state, const rl_scene *scene, c
         if (st != RL_OK)
             return st;
     }
-    write_layers(s, image);
-    finish_stats(s, &set, &sum, traced, cam, &total, stats, &ps);
+    write_layers(s, &region, image);
+    uint64_t pixels = (uint64_t)(region.x1 - region.x0) * (uint64_t)(region.y1 - region.y0);
+    finish_stats(s, &set, &sum, traced, pixels, &total, stats, &ps);
     stats->prep_ms = ps.time_build_ms;     /* the backends built for the scene */
     s->stats = ps;
     s->have_frame = true;
@@ -782,11 +830,25 @@ const rl_gbuffer *rl_pt_gbuffer(const rl_renderer *r)
     return s && s->have_frame ? s->gbuf : NULL;
 }
 
+uint64_t rl_pt_frame_samples(const rl_renderer *r, int width, int height, uint64_t frame)
+{
+    if (!pt_of(r) || width < 1 || height < 1)
+        return 0;
+    uint64_t n = (uint64_t)width * (uint64_t)height, spp = (uint64_t)rl_renderer_opt_int(r, "spp");
+    if (!rl_renderer_opt_bool(r, "checkerboard"))
+        return n * spp;
+    /* active(): x + y + parity even; x + y even holds for the larger half
+     * when both sides are odd. */
+    uint64_t even = (width & height & 1) ? (n + 1) / 2 : n / 2;
+    return spp * ((frame & 1u) == 0 ? even : n - even);
+}
+
 const rl_renderer_class rl_pt_renderer_class = {
     .info = { .name = "pt",
               .description = "Progressive path tracing with NEE, Russian roulette and Phong sampling; "
                              "Line Space backends",
               .reference = "Schröder 2017", .progressive = true, .default_time_s = PT_DEFAULT_TIME_S,
+              .regions = true,
               /* reset(): accumulation, sample counts, generators, first hits and
                * directions, and the G-buffer of the first hits */
               .frame_bytes_per_pixel = 3 * sizeof(double) + sizeof(uint32_t) + sizeof(rl_rng_gpu) + sizeof(rl_hit) +

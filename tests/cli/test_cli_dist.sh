@@ -106,6 +106,51 @@ expect_exit 137 env RL_DIST_FAULT=0:1 "${MPI[@]}" "$RL" --dist render spheres --
     fail "the workers of a dead master: $(grep -v '^ ' "$TMP/err" | head -c 600)"
 [ ! -e "$TMP/dead.png" ] || fail "a dead master wrote an image"
 
+# pt (issue 39): every band accumulates all frames of --spp, so the image
+# equals one process's for the same seed, colour, depth and IDs; with
+# checkerboard a band's first frame fills its holes from the neighbouring
+# rows as one process does. Also with a worker lost after its first band,
+# while its band's pixels may still be on their way.
+PT=(render cornell --algo pt --size 40x37 --spp 3 --set checkerboard=true --set seed=3)
+run_ok "$RL" "${PT[@]}" --out "$TMP/pt-ref.png" --depth-out "$TMP/pt-ref.exr" --id-out "$TMP/pt-ref-id.png"
+run_ok "${MPI[@]}" "$RL" --dist "${PT[@]}" --out "$TMP/pt-dist.png" --depth-out "$TMP/pt-dist.exr" \
+    --id-out "$TMP/pt-dist-id.png"
+for f in .png .exr -id.png; do
+    cmp -s "$TMP/pt-ref$f" "$TMP/pt-dist$f" || fail "pt: 3 ranks differ from one process in pt-ref$f"
+done
+expect_in "$TMP/out" "^pt 40x37 cornell: .* 6 frames, 3 spp"
+run_ok "${RECOVER[@]}" RL_DIST_FAULT=1:1 "${MPI[@]}" "$RL" --dist "${PT[@]}" --out "$TMP/pt-lost.png"
+cmp -s "$TMP/pt-ref.png" "$TMP/pt-lost.png" || fail "pt: a lost worker changed the image"
+expect_in "$TMP/out" "^dist: [12] workers\? lost"
+# What a band cannot do: a time budget (the frames are fixed before the
+# bands go out; a usage error on every rank, which mpirun reports as 1)
+# and a whole-image filter.
+expect_exit 1 "${MPI[@]}" "$RL" --dist render cornell --algo pt --size 40x37 --time 1s --out "$TMP/pt-t.png"
+grep -q "^rl: error: --dist: pt over several ranks renders a fixed number of samples: give --spp N" "$TMP/err" ||
+    fail "pt --time under --dist: $(head -c 600 "$TMP/err")"
+expect_exit 1 "${MPI[@]}" "$RL" --dist render cornell --algo pt --size 40x37 --spp 2 --set filter=gauss \
+    --out "$TMP/pt-f.png"
+grep -q "pt: filter=gauss filters the whole image; a region (rl --dist) needs filter=none" "$TMP/err" ||
+    fail "pt filter under --dist: $(head -c 600 "$TMP/err")"
+[ ! -e "$TMP/pt-t.png" ] && [ ! -e "$TMP/pt-f.png" ] || fail "a refused pt run wrote an image"
+
+# rl bench dist starts this rl under mpirun itself: its record has every
+# workload at every rank count, with the one-rank run as the reference.
+run_ok "$RL" bench dist --quick --only tiles --out "$TMP/bench-dist.json"
+python3 - "$TMP/bench-dist.json" <<'PY' || fail "rl bench dist: $(head -c 600 "$TMP/bench-dist.json")"
+import json, sys
+r = json.load(open(sys.argv[1]))
+runs = r["tiles"]["runs"]
+assert r["tiles"]["status"] == "ok" and [w["algorithm"] for w in runs] == ["whitted", "pt"], runs
+for w in runs:
+    one, two = w["ranks"]
+    assert one["ranks"] == 1 and two["ranks"] == 2 and one["speedup"] == 1, w
+    assert two["messages_per_frame"] > 0 and two["bytes_per_frame"] > 0 and two["imbalance"] >= 1, two
+    assert len(two["dist"]["per_rank"]) == 2, two
+PY
+expect_exit 2 "$RL" bench dist --ranks 0,2
+grep -q "^rl: error: bench dist: --ranks: expected" "$TMP/err" || fail "bench dist --ranks 0: $(cat "$TMP/err")"
+
 # A renderer whose pixels depend on each other is refused, on every rank,
 # and nothing is written.
 expect_exit 1 "${MPI[@]}" "$RL" --dist render cornell --algo raster --size 32x24 --out "$TMP/raster.png"
@@ -114,5 +159,6 @@ grep -q "^rl: error: raster renders whole images only and cannot be distributed"
 [ ! -e "$TMP/raster.png" ] || fail "a refused distributed run wrote an image"
 run_ok "$RL" algos
 sed -n '/^whitted: /,/^$/p' "$TMP/out" | grep -q "^  distributable:" || fail "rl algos does not mark whitted"
+sed -n '/^pt: /,/^$/p' "$TMP/out" | grep -q "^  distributable:" || fail "rl algos does not mark pt"
 sed -n '/^raster: /,/^$/p' "$TMP/out" | grep -q "^  distributable:" && fail "rl algos marks raster distributable"
 echo "test_cli_dist: ok"

@@ -1,0 +1,29 @@
+#!/usr/bin/env bash
+# bench/dist.sh: the `rl bench dist` record of issue 39 on a machine with
+# 16 cores or more (one rank per core, one OpenMP thread each): builds
+# renderlab with Open MPI (make build; RL_MPI is on where the MPI C
+# bindings are found) and runs tiles (whitted and pt on table and cluster)
+# and Alg. 5.4 sampling (city) at 1, 2, 4, 8 and 16 ranks, writing
+# bench/results/dist-<date>-16core.json. The build takes 1-2 minutes on 16
+# cores, the benchmark a few minutes (its time limit 420 s; one run per
+# point, no repeats, to stay inside it): the whole run stays
+# under 10 minutes. Larger images and more samples than the 2-core record,
+# so that a band and a chunk stay long against their messages at 16 ranks.
+# Needs mpirun (Debian: openmpi-bin libopenmpi-dev); as root the Open MPI
+# root variables are set by rl bench dist itself.
+# Run from anywhere: bash bench/dist.sh
+set -u
+cd "$(dirname "${BASH_SOURCE[0]}")/.." || exit 1
+command -v mpirun >/dev/null || { echo "dist.sh: no mpirun (install openmpi-bin libopenmpi-dev)"; exit 1; }
+echo "== make build"
+timeout 300 make build || { echo "dist.sh: the build failed"; exit 1; }
+build/rl --dist render cornell --algo whitted --size 8x8 --out /tmp/rl-dist-check.png -q 2>&1 |
+    grep -q "no Open MPI" && { echo "dist.sh: this build has no Open MPI"; exit 1; }
+date=$(date -u +%Y%m%d)
+nproc
+echo "== rl bench dist (at most 420 s)"
+timeout --signal=INT --kill-after=10 420 build/rl bench dist --ranks 1,2,4,8,16 --size 1280x960 --spp 4 \
+    --samples 128 --eval-scene city:blocks=2 --repeats 1 --out "bench/results/dist-$date-16core.json"
+rc=$?
+echo "== rl bench dist: exit $rc"
+exit "$rc"
