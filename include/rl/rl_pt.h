@@ -67,6 +67,8 @@ typedef struct rl_pt_stats {
     rl_rng_gpu_kind rng;          /* the GPU generator, when not sobol */
     bool sobol;                   /* rng=sobol: Owen-scrambled Sobol points */
     float filter_weight;          /* weight of the filtered image in the output */
+    uint64_t adaptive_converged;  /* adaptive=on: traced pixels whose relative error was
+                                   * below adaptive_threshold at the frame's last round */
 } rl_pt_stats;
 
 /* Statistics of the last frame of r. RL_ERR_INVALID_ARG when r is not a
@@ -79,6 +81,10 @@ RL_API rl_status rl_pt_reset(rl_renderer *r);
  * valid until the next render or release; NULL when r is not "pt" or has
  * not rendered. */
 RL_API const rl_gbuffer *rl_pt_gbuffer(const rl_renderer *r);
+/* Samples per pixel of the current accumulation (width x height, row-major),
+ * valid until the next render or release; NULL when r is not "pt" or has
+ * not rendered. With adaptive=on they differ from pixel to pixel. */
+RL_API const uint32_t *rl_pt_sample_counts(const rl_renderer *r);
 
 #ifdef __cplusplus
 }

@@ -45,6 +45,11 @@ typedef struct pt_settings {
     pt_primary primary;
     rl_filter_kind filter;
     double filter_fade;
+    int atrous_iterations;         /* filter=atrous (rl_filter.h) */
+    double atrous_sigma_rt, atrous_sigma_n, atrous_sigma_x;   /* 0 (rt, x): derived */
+    bool adaptive;                 /* per-pixel adaptive sampling (pathtrace.c) */
+    double adaptive_threshold;
+    int adaptive_min_spp;
     int grid_res, ls_n, ls_k, shadowmap_size;
     const char *ls_file;           /* Line Space cache file; "" none (valid for one frame) */
     rl_vec3 background;            /* environment radiance of escaping rays */
