@@ -845,6 +845,15 @@ static void pixel_errors(const frame *f, uint64_t *converged)
     *converged = conv;
 }
 
+/* Whether pixel i takes part in a round: active, not converged, and with
+ * an error above zero (a zero weight would meet an infinite factor when
+ * the cap binds everywhere else). */
+static bool wants_samples(const frame *f, const float *e, size_t i, double thr)
+{
+    int x = (int)(i % (size_t)f->width), y = (int)(i / (size_t)f->width);
+    return active(f, x, y) && isfinite(e[i]) && e[i] >= thr && e[i] > 0.0f;
+}
+
 /* The share of `budget` samples by error (s->err[n..]) among the active
  * pixels: t_i = min(cap, lambda e_i) with sum t_i = budget (water-filling;
  * lambda by bisection when the cap binds), zero for converged pixels,
@@ -857,15 +866,18 @@ static uint64_t adaptive_shares(const frame *f, uint64_t budget, uint64_t num_ac
     pt_state *s = f->s;
     const size_t n = (size_t)f->width * f->height;
     const float *e = s->err + n;
+    /* The raw errors are used up: their half holds the weights of the
+     * pixels that want samples, packed, for the bisection. */
+    float *packed = s->err;
     const double thr = f->set->adaptive_threshold;
     const double cap = ADAPTIVE_CAP * (double)budget / (double)num_active;
     double total = 0.0, e_max = 0.0, e_min = INFINITY;
     uint64_t positive = 0;
     for (size_t i = 0; i < n; ++i) {
         s->share[i] = 0;
-        int x = (int)(i % (size_t)f->width), y = (int)(i / (size_t)f->width);
-        if (!active(f, x, y) || !(e[i] >= thr) || !isfinite(e[i]))
+        if (!wants_samples(f, e, i, thr))
             continue;
+        packed[positive] = e[i];
         total += e[i];
         e_max = e[i] > e_max ? e[i] : e_max;
         e_min = e[i] < e_min ? e[i] : e_min;
@@ -880,9 +892,8 @@ static uint64_t adaptive_shares(const frame *f, uint64_t budget, uint64_t num_ac
         double lo = lambda, hi = cap / e_min;
         for (int it = 0; it < 50; ++it) {
             double mid = 0.5 * (lo + hi), got = 0.0;
-            for (size_t i = 0; i < n; ++i)
-                if (e[i] >= thr && isfinite(e[i]) && active(f, (int)(i % (size_t)f->width), (int)(i / (size_t)f->width)))
-                    got += fmin(cap, mid * e[i]);
+            for (uint64_t k = 0; k < positive; ++k)
+                got += fmin(cap, mid * packed[k]);
             if (got < (double)budget)
                 lo = mid;
             else
@@ -893,8 +904,7 @@ static uint64_t adaptive_shares(const frame *f, uint64_t budget, uint64_t num_ac
     double run = 0.0;
     uint64_t given = 0;
     for (size_t i = 0; i < n; ++i) {
-        int x = (int)(i % (size_t)f->width), y = (int)(i / (size_t)f->width);
-        if (!active(f, x, y) || !(e[i] >= thr) || !isfinite(e[i]))
+        if (!wants_samples(f, e, i, thr))
             continue;
         run += fmin(cap, lambda * e[i]);
         uint64_t upto = (uint64_t)floor(run + 0.5);
