@@ -2,7 +2,8 @@
  * (Schröder 2017, Ch. 6 and 8).
  *
  * pathtrace.c          the renderer: options, frame loop, accumulation
- *                      (Sec. 6.5), checkerboard (Sec. 8.5), filter (Sec. 8.2)
+ *                      (Sec. 6.5), checkerboard (Sec. 8.5), filter (Sec. 8.2),
+ *                      per-pixel adaptive sampling (issue 37)
  * pathtrace_path.c     one camera path (Sec. 3.3, 6.4): Trace, Shade (NEE),
  *                      emission rule, Russian roulette; the pre-illumination
  *                      shader for the Line Space (Sec. 7.4)
