@@ -14,11 +14,21 @@
  *              vanishes across normal or depth edges;
  *   KUWAHARA   each pixel takes the mean of the least-variant of the four
  *              (r+1)x(r+1) quadrants around it (r = radius; 1 = the thesis'
- *              four 2x2 groups of the 3x3 neighbourhood).
+ *              four 2x2 groups of the 3x3 neighbourhood);
+ *   ATROUS     the edge-avoiding a-trous wavelet transform (Dammertz,
+ *              Sewtz, Hanika, Lensch 2010; issue 37): `iterations` passes of
+ *              the 5x5 B3-spline kernel with holes 2^i pixels apart, each tap
+ *              weighted by exp(-|dc|^2 / sigma_r_i^2) on colour (sigma_r_i =
+ *              sigma_r 2^-i), exp(-|dn|^2 / sigma_n^2) on the G-buffer
+ *              normals and exp(-|dx|^2 / sigma_x^2) on its world positions;
+ *              the result is the last coarse level (the detail coefficients
+ *              are the noise that is dropped). Taps outside the image drop
+ *              out of the normalised sum.
  * Filters read and write RL_LAYER_COLOR (linear RGB; alpha is copied from
  * `in`) and leave other layers as they are in the output. Borders clamp.
  * GAUSS and KUWAHARA ignore the G-buffer; its normal, depth and object
- * arrays may each be NULL (that term is then dropped). Multithreaded
+ * arrays (ATROUS: normal and position) may each be NULL (that term is then
+ * dropped). Multithreaded
  * (OpenMP) and deterministic: results do not depend on the thread count.
  * `in` and `out` must have the same size and must not be the same image. */
 #ifndef RL_FILTER_H
@@ -38,6 +48,7 @@ typedef enum rl_filter_kind {
     RL_FILTER_BILATERAL,
     RL_FILTER_ANISO,
     RL_FILTER_KUWAHARA,
+    RL_FILTER_ATROUS,
     RL_FILTER_KIND_COUNT
 } rl_filter_kind;
 
@@ -46,11 +57,14 @@ typedef struct rl_filter_desc {           /* zero = default */
     float sigma_s;            /* spatial sigma in pixels; 0 -> 1.5 */
     int radius;               /* window radius; 0 -> ceil(2·sigma_s) (Kuwahara: 1) */
     float sigma_r;            /* colour sigma (linear units); 0 -> 0.1 */
-    float sigma_n;            /* normal sigma (1 - n·n'); 0 -> 0.1 */
+    float sigma_n;            /* normal sigma (1 - n·n'; ATROUS: |n - n'|); 0 -> 0.1 */
     float sigma_z;            /* relative depth sigma; 0 -> 0.05 */
-    int iterations;           /* ANISO; 0 -> 20 */
+    int iterations;           /* ANISO: 0 -> 20; ATROUS (1..12): 0 -> 5 */
     float lambda;             /* ANISO rate, at most 0.25 for stability; 0 -> 0.2 */
     float kappa;              /* ANISO conductance scale; 0 -> 0.1 */
+    float sigma_x;            /* ATROUS position sigma in world units; 0 -> per pixel,
+                               * 2^iterations times the distance to its nearest
+                               * seen 4-neighbour (the pixel's footprint) */
 } rl_filter_desc;
 
 RL_API const char *rl_filter_kind_name(rl_filter_kind kind);    /* "gauss", ... */

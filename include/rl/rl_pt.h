@@ -67,6 +67,8 @@ typedef struct rl_pt_stats {
     rl_rng_gpu_kind rng;          /* the GPU generator, when not sobol */
     bool sobol;                   /* rng=sobol: Owen-scrambled Sobol points */
     float filter_weight;          /* weight of the filtered image in the output */
+    uint64_t adaptive_converged;  /* adaptive=on: traced pixels whose relative error was
+                                   * below adaptive_threshold at the frame's last round */
 } rl_pt_stats;
 
 /* Statistics of the last frame of r. RL_ERR_INVALID_ARG when r is not a
@@ -82,10 +84,14 @@ RL_API rl_status rl_pt_reset(rl_renderer *r);
 RL_API const rl_gbuffer *rl_pt_gbuffer(const rl_renderer *r);
 /* The samples that frame number frame (0: the first after a reset) of a
  * width x height image traces with r's options: spp per pixel, in half the
- * pixels with checkerboard. Lets a caller fix the frames of a sample target
+ * pixels with checkerboard (with adaptive=on, at most that many). Lets a caller fix the frames of a sample target
  * before rendering (rl --dist: rl_dist_render_frames). 0 when r is not
  * "pt" or the size is not positive. */
 RL_API uint64_t rl_pt_frame_samples(const rl_renderer *r, int width, int height, uint64_t frame);
+/* Samples per pixel of the current accumulation (width x height, row-major),
+ * valid until the next render or release; NULL when r is not "pt" or has
+ * not rendered. With adaptive=on they differ from pixel to pixel. */
+RL_API const uint32_t *rl_pt_sample_counts(const rl_renderer *r);
 
 #ifdef __cplusplus
 }

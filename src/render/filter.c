@@ -1,7 +1,9 @@
 /* filter.c: noise-reduction filters for path-traced images (Schröder 2017,
  * Sec. 8.2; the thesis follows Priese 2015): Gauss (Sec. 8.2.1), bilateral
  * (Sec. 8.2.2, Tomasi & Manduchi 1998), anisotropic diffusion (Sec. 8.2.3,
- * Perona & Malik 1990) and Kuwahara (Sec. 8.2.4, Kuwahara et al. 1976).
+ * Perona & Malik 1990) and Kuwahara (Sec. 8.2.4, Kuwahara et al. 1976);
+ * and, beyond the thesis (issue 37), the edge-avoiding a-trous wavelet
+ * filter of Dammertz, Sewtz, Hanika and Lensch 2010.
  *
  * Parameters and defaults are those of rl_filter.h. All filters work on the
  * RGB of RL_LAYER_COLOR; alpha is copied from the input. Pixels outside the
@@ -30,9 +32,11 @@
 
 #define FILTER_MAX_RADIUS 64          /* caps absurd windows (stb style) */
 #define FILTER_MAX_ITERATIONS 10000
+/* A-trous holes grow as 2^i: 12 levels already reach 2 x 2048 pixels. */
+#define ATROUS_MAX_ITERATIONS 12
 
 static const char *const kind_names[RL_FILTER_KIND_COUNT] = {
-    "none", "gauss", "bilateral", "aniso", "kuwahara"
+    "none", "gauss", "bilateral", "aniso", "kuwahara", "atrous"
 };
 
 const char *rl_filter_kind_name(rl_filter_kind kind)
@@ -50,14 +54,14 @@ rl_status rl_filter_kind_parse(const char *name, rl_filter_kind *out)
             return RL_OK;
         }
     return rl_error(RL_ERR_INVALID_ARG, "unknown filter \"%s\" (known: none, gauss, bilateral, "
-                                        "aniso, kuwahara)", name);
+                                        "aniso, kuwahara, atrous)", name);
 }
 
 /* ---- parameters ---------------------------------------------------------- */
 
 typedef struct filter_params {
     rl_filter_kind kind;
-    float sigma_s, sigma_r, sigma_n, sigma_z, lambda, kappa;
+    float sigma_s, sigma_r, sigma_n, sigma_z, lambda, kappa, sigma_x;
     int radius, iterations;
 } filter_params;
 
@@ -74,7 +78,14 @@ static rl_status resolve(const rl_filter_desc *d, filter_params *p)
     p->sigma_z = d->sigma_z == 0.0f ? 0.05f : d->sigma_z;
     p->lambda = d->lambda == 0.0f ? 0.2f : d->lambda;
     p->kappa = d->kappa == 0.0f ? 0.1f : d->kappa;
-    p->iterations = d->iterations == 0 ? 20 : d->iterations;
+    p->iterations = d->iterations != 0 ? d->iterations : d->kind == RL_FILTER_ATROUS ? 5 : 20;
+    p->sigma_x = d->sigma_x;
+    if (!(isfinite(p->sigma_x) && p->sigma_x >= 0.0f))
+        return rl_error(RL_ERR_INVALID_ARG, "rl_filter_apply: sigma_x %g must be finite and >= 0 "
+                        "(0: from the pixel footprint)", (double)p->sigma_x);
+    if (p->kind == RL_FILTER_ATROUS && (p->iterations < 1 || p->iterations > ATROUS_MAX_ITERATIONS))
+        return rl_error(RL_ERR_INVALID_ARG, "rl_filter_apply: a-trous iterations %d outside 1..%d",
+                        p->iterations, ATROUS_MAX_ITERATIONS);
     if (!positive(p->sigma_s) || !positive(p->sigma_r) || !positive(p->sigma_n) ||
         !positive(p->sigma_z) || !positive(p->kappa))
         return rl_error(RL_ERR_INVALID_ARG, "rl_filter_apply: sigma_s %g, sigma_r %g, sigma_n "
@@ -340,6 +351,124 @@ static rl_status kuwahara(const filter_params *p, const rl_image *in, rl_image *
     return RL_OK;
 }
 
+/* ---- edge-avoiding a-trous wavelets (Dammertz et al. 2010) --------------- */
+
+/* Whether pixel i of g sees a surface (as guide_weight decides it). */
+static bool seen(const rl_gbuffer *g, size_t i)
+{
+    return g->depth ? isfinite(g->depth[i]) : !g->object || g->object[i] != RL_ID_NONE;
+}
+
+/* 1 / sigma_x^2 per pixel when sigma_x is derived (0 in the description):
+ * the position scale then follows the pixel footprint, so the filter needs
+ * no scene unit. At level i the taps lie 2^i footprints apart on a surface
+ * facing the camera; with sigma_x = 2^iterations footprints the farthest
+ * taps of the last level (2 * 2^(n-1) = 2^n footprints) still weigh
+ * exp(-1), while a depth jump of many footprints weighs nothing. A pixel
+ * with no seen neighbour keeps 0 (no position term; it has no surface
+ * neighbour to protect). */
+static void footprint_inv_sigma2(const rl_gbuffer *g, int iterations, float *inv)
+{
+    const int w = g->width, h = g->height;
+    const float scale = (float)(1 << iterations);
+    #pragma omp parallel for schedule(static)
+    for (int y = 0; y < h; ++y) {
+        for (int x = 0; x < w; ++x) {
+            size_t i = (size_t)y * w + x;
+            inv[i] = 0.0f;
+            if (!seen(g, i))
+                continue;
+            size_t nb[4] = { x > 0 ? i - 1 : i, x + 1 < w ? i + 1 : i,
+                             y > 0 ? i - (size_t)w : i, y + 1 < h ? i + (size_t)w : i };
+            float best = INFINITY;
+            for (int k = 0; k < 4; ++k) {
+                float d = rl_length(rl_sub(g->position[nb[k]], g->position[i]));
+                if (nb[k] != i && seen(g, nb[k]) && d > 0.0f && d < best)
+                    best = d;
+            }
+            if (isfinite(best))
+                inv[i] = 1.0f / (scale * best * scale * best);
+        }
+    }
+}
+
+/* c_{i+1}(p) = sum_q h_i(q) w(p,q) c_i(q) / sum_q h_i(q) w(p,q) over the 25
+ * taps q = p + 2^i (dx, dy), dx, dy in -2..2, h the separable B3 spline
+ * (1, 4, 6, 4, 1) / 16 and w the product of the colour, normal and
+ * position edge-stopping functions. The three Gaussians share one exp.
+ * Taps that see a surface and taps that see nothing never mix. */
+static rl_status atrous(const filter_params *p, const rl_image *in, const rl_gbuffer *g, rl_image *out)
+{
+    static const float h5[5] = { 1.0f / 16.0f, 4.0f / 16.0f, 6.0f / 16.0f, 4.0f / 16.0f, 1.0f / 16.0f };
+    const int w = in->width, h = in->height;
+    const size_t n = (size_t)w * (size_t)h;
+    const bool use_n = g && g->normal, use_x = g && g->position;
+    rl_vec3 *a = rl_alloc(n * sizeof *a), *b = rl_alloc(n * sizeof *b);
+    float *inv_x = use_x && p->sigma_x == 0.0f ? rl_alloc(n * sizeof *inv_x) : NULL;
+    if (!a || !b || (use_x && p->sigma_x == 0.0f && !inv_x)) {
+        free(a);
+        free(b);
+        free(inv_x);
+        return RL_ERR_OUT_OF_MEMORY;
+    }
+    for (size_t i = 0; i < n; ++i)
+        a[i] = rgb(in->color[i]);
+    if (inv_x)
+        footprint_inv_sigma2(g, p->iterations, inv_x);
+    const float fixed_inv_x = p->sigma_x > 0.0f ? 1.0f / (p->sigma_x * p->sigma_x) : 0.0f;
+    const float inv_n = 1.0f / (p->sigma_n * p->sigma_n);
+    for (int it = 0; it < p->iterations; ++it) {
+        const int step = 1 << it;
+        /* The paper's colour sigma halves per level: each level has
+         * averaged away part of the noise the colour term must tolerate. */
+        const float sr = p->sigma_r / (float)step;
+        const float inv_c = 1.0f / (sr * sr);
+        #pragma omp parallel for schedule(static)
+        for (int y = 0; y < h; ++y) {
+            for (int x = 0; x < w; ++x) {
+                size_t i = (size_t)y * w + x;
+                rl_vec3 c = a[i], acc = rl_v3s(0.0f);
+                bool seen_i = g ? seen(g, i) : true;
+                float ix = inv_x ? inv_x[i] : fixed_inv_x, wsum = 0.0f;
+                for (int ky = 0; ky < 5; ++ky) {
+                    int yy = y + (ky - 2) * step;
+                    if (yy < 0 || yy >= h)
+                        continue;
+                    for (int kx = 0; kx < 5; ++kx) {
+                        int xx = x + (kx - 2) * step;
+                        if (xx < 0 || xx >= w)
+                            continue;
+                        size_t j = (size_t)yy * w + xx;
+                        float e = rl_length2(rl_sub(a[j], c)) * inv_c;
+                        if (g) {
+                            if (seen(g, j) != seen_i)
+                                continue;
+                            if (seen_i && use_n)
+                                e += rl_length2(rl_sub(g->normal[j], g->normal[i])) * inv_n;
+                            if (seen_i && use_x)
+                                e += rl_length2(rl_sub(g->position[j], g->position[i])) * ix;
+                        }
+                        float wt = h5[kx] * h5[ky] * expf(-e);
+                        acc = rl_madd(acc, a[j], wt);
+                        wsum += wt;
+                    }
+                }
+                /* The centre tap weighs 36/256 whatever the guide says. */
+                b[i] = rl_scale(acc, 1.0f / wsum);
+            }
+        }
+        rl_vec3 *t = a;
+        a = b;
+        b = t;
+    }
+    for (size_t i = 0; i < n; ++i)
+        out->color[i] = rl_v4_from3(a[i], in->color[i].w);
+    free(a);
+    free(b);
+    free(inv_x);
+    return RL_OK;
+}
+
 /* ---- entry point --------------------------------------------------------- */
 
 rl_status rl_filter_apply(const rl_filter_desc *desc, const rl_image *in, const rl_gbuffer *g,
@@ -369,6 +498,7 @@ rl_status rl_filter_apply(const rl_filter_desc *desc, const rl_image *in, const 
     case RL_FILTER_BILATERAL: return bilateral(&p, in, &gd, out);
     case RL_FILTER_ANISO:     return aniso(&p, in, &gd, out);
     case RL_FILTER_KUWAHARA:  return kuwahara(&p, in, out);
+    case RL_FILTER_ATROUS:    return atrous(&p, in, g, out);
     default:
         memcpy(out->color, in->color, (size_t)in->width * (size_t)in->height * sizeof *in->color);
         return RL_OK;

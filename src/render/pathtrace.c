@@ -30,7 +30,12 @@
  *                      jitter, so edges alias as the thesis notes)
  *   checkerboard = false       Sec. 8.5
  *   accumulate = true          Sec. 6.5, eq. 8
- *   filter = none, filter_fade = 16    Sec. 8.2
+ *   filter = none, filter_fade = 16    Sec. 8.2 (atrous: issue 37, Dammertz
+ *                      et al. 2010, with atrous_iterations = 5, atrous_sigma_rt
+ *                      = 0 (from the spp), atrous_sigma_n = 0.1,
+ *                      atrous_sigma_x = 0 (from the pixel footprint))
+ *   adaptive = off     on: per-pixel adaptive sampling (issue 37, below),
+ *                      adaptive_threshold = 0.01, adaptive_min_spp = 8
  *   grid_res = 0 (grid heuristic), ls_n = 5 [5], ls_k = 8, ls_dynamic = true,
  *   ls_origin = offset [offset], ls_file = "" (Line Space cache, Sec. 13.3)
  *   shadowmap_size = 1024 [1024], light_samples = 1, threads = 0 (all)
@@ -63,6 +68,29 @@
  * "the filter's influence decreases as the samples grow"; filter_fade = 0
  * keeps the full filter. The G-buffer guides the filter.
  *
+ * Adaptive sampling (adaptive=on, issue 37): a frame still spends spp
+ * paths per traced pixel on average, but hands them out by each pixel's
+ * estimated error. Per pixel we keep, beside the sum of the radiance, the
+ * sum of the squared luminance of its samples; the relative error of the
+ * mean is e = sqrt(s^2 / n) / (mean + ADAPTIVE_EPS), s^2 the sample
+ * variance of the luminance, averaged over the 3 x 3 neighbourhood because
+ * one pixel's few samples estimate it badly (a pixel whose samples all
+ * missed a light would otherwise claim to be exact). Pixels with fewer
+ * than adaptive_min_spp samples first get up to that many, uniformly; then
+ * the frame's remaining paths go out in rounds, each pixel's share in
+ * proportion to its e, none to a pixel with e < adaptive_threshold (it has
+ * converged), and at most ADAPTIVE_CAP times the round's mean to any one
+ * (water-filling; what the cap or convergence leaves over is not spent). A
+ * round at most doubles the mean count, so the estimate is refreshed as
+ * the samples grow within one large frame. The shares are computed in one
+ * sequential pass in pixel order and each pixel's samples keep their
+ * numbers (sample index = the pixel's count so far), so the image does not
+ * depend on the thread count and the Sobol sequence of a pixel continues
+ * where it stopped. In the uniform phase the image is bit-identical to
+ * adaptive=off's. The variance of Sobol samples overstates the error of
+ * their mean (they are stratified); as a relative measure between pixels
+ * it serves.
+ *
  * Depth and ID layers come from the G-buffer (pixel centres).
  *
  * Regions (rl_renderer_set_region, what rl --dist hands out): every pixel's
@@ -72,7 +100,8 @@
  * frames of a region are the region of N whole frames. With checkerboard,
  * the first frame's holes need their neighbours, so a region traces a ring
  * of one pixel around itself too. The filters work on the whole image and
- * primary=raster rasterizes it: a region refuses both. */
+ * primary=raster rasterizes it, and adaptive sampling shares a frame's
+ * paths over the whole image: a region refuses all three. */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -95,6 +124,12 @@
  * spp of cornell at 512 x 512 on 2 cores, where the noise has fallen to a
  * quarter of 1 spp's (docs/path-tracing.md, "Time budget"). */
 #define PT_DEFAULT_TIME_S 10.0
+/* Adaptive sampling (see the top): the offset that keeps dark pixels'
+ * relative error finite and stops them from drawing every path (a
+ * luminance of 0.05 is dark grey on the display), and the most one pixel
+ * takes of a round, in multiples of the round's mean. */
+#define ADAPTIVE_EPS 0.05
+#define ADAPTIVE_CAP 8.0
 
 /* Order: sobol, then rl_rng_gpu_kind. */
 static const char *const rng_choices[] = { "sobol", "lcg", "tausworthe", "hybrid", NULL };
@@ -108,7 +143,8 @@ static const char *const diffuse_choices[] = { "bvh", "grid", "embree", "ls-cand
 static const char *const ls_origin_choices[] = { "offset", "exact", NULL };
 static const char *const primary_choices[] = { "trace", "raster", NULL };
 /* Order = rl_filter_kind. */
-static const char *const filter_choices[] = { "none", "gauss", "bilateral", "aniso", "kuwahara", NULL };
+static const char *const filter_choices[] = { "none", "gauss", "bilateral", "aniso", "kuwahara", "atrous", NULL };
+static const char *const adaptive_choices[] = { "off", "on", NULL };
 
 static const rl_option_info pt_options[] = {
     { "spp", RL_OPT_INT, "1", "paths per pixel and frame", 1, 65536, NULL },
@@ -141,6 +177,20 @@ static const rl_option_info pt_options[] = {
     { "filter", RL_OPT_ENUM, "none", "noise filter on the accumulated image (Sec. 8.2)", 0, 0, filter_choices },
     { "filter_fade", RL_OPT_FLOAT, "16",
       "filter weight 1/(1 + spp/filter_fade) with spp the samples so far; 0 = never fade", 0, 1e9, NULL },
+    { "atrous_iterations", RL_OPT_INT, "5", "a-trous levels (holes 2^i pixels apart; Dammertz et al. 2010)",
+      1, 12, NULL },
+    { "atrous_sigma_rt", RL_OPT_FLOAT, "0",
+      "a-trous colour sigma at the first level, halved per level; 0 = from the samples per pixel", 0, 1e9, NULL },
+    { "atrous_sigma_n", RL_OPT_FLOAT, "0.1", "a-trous normal sigma (|n - n'|)", 1e-6, 1e9, NULL },
+    { "atrous_sigma_x", RL_OPT_FLOAT, "0",
+      "a-trous position sigma in world units; 0 = 2^atrous_iterations pixel footprints", 0, 1e9, NULL },
+    { "adaptive", RL_OPT_ENUM, "off",
+      "per-pixel adaptive sampling: a frame's paths go where the estimated relative error is largest",
+      0, 0, adaptive_choices },
+    { "adaptive_threshold", RL_OPT_FLOAT, "0.01",
+      "adaptive: relative error of a pixel's mean below which it gets no more samples", 0, 1e9, NULL },
+    { "adaptive_min_spp", RL_OPT_INT, "8", "adaptive: samples every pixel gets before the error decides",
+      2, 65536, NULL },
     { "grid_res", RL_OPT_INT, "0", "voxels per axis of the grid and the Line Space (0 = grid heuristic)",
       0, 1024, NULL },
     { "ls_n", RL_OPT_INT, "5", "Line Space patches per voxel face side (Sec. 9.2: 5)", 1, RL_LS_MAX_N, NULL },
@@ -172,6 +222,9 @@ typedef struct pt_state {
     char *signature;
     double *accum;                /* 3 per pixel: summed radiance */
     uint32_t *count;              /* samples per pixel */
+    double *sum2;                 /* adaptive: per pixel, the sum of squared sample luminances */
+    float *err;                   /* adaptive scratch: per pixel, the relative error */
+    uint32_t *share;              /* adaptive scratch: per pixel, the samples of a round */
     rl_rng_gpu *rng;              /* per pixel */
     rl_gbuffer *gbuf;
     uint64_t frames, total_samples;
@@ -187,12 +240,18 @@ static void free_frame(pt_state *s)
 {
     free(s->accum);
     free(s->count);
+    free(s->sum2);
+    free(s->err);
+    free(s->share);
     free(s->rng);
     free(s->hits);
     free(s->dirs);
     rl_gbuffer_release(s->gbuf);
     s->accum = NULL;
     s->count = NULL;
+    s->sum2 = NULL;
+    s->err = NULL;
+    s->share = NULL;
     s->rng = NULL;
     s->hits = NULL;
     s->dirs = NULL;
@@ -266,6 +325,13 @@ static void read_settings(const rl_renderer *r, pt_settings *set)
     set->accumulate = rl_renderer_opt_bool(r, "accumulate");
     set->filter = (rl_filter_kind)rl_renderer_opt_enum(r, "filter");
     set->filter_fade = rl_renderer_opt_float(r, "filter_fade");
+    set->atrous_iterations = (int)rl_renderer_opt_int(r, "atrous_iterations");
+    set->atrous_sigma_rt = rl_renderer_opt_float(r, "atrous_sigma_rt");
+    set->atrous_sigma_n = rl_renderer_opt_float(r, "atrous_sigma_n");
+    set->atrous_sigma_x = rl_renderer_opt_float(r, "atrous_sigma_x");
+    set->adaptive = rl_renderer_opt_enum(r, "adaptive") == 1;
+    set->adaptive_threshold = rl_renderer_opt_float(r, "adaptive_threshold");
+    set->adaptive_min_spp = (int)rl_renderer_opt_int(r, "adaptive_min_spp");
     set->grid_res = (int)rl_renderer_opt_int(r, "grid_res");
     set->ls_n = (int)rl_renderer_opt_int(r, "ls_n");
     set->ls_k = (int)rl_renderer_opt_int(r, "ls_k");
@@ -345,6 +411,16 @@ static rl_status reset(pt_state *s, const rl_scene *scene, const rl_camera *cam,
             return st;
         }
     }
+    if (set->adaptive && !s->sum2) {
+        s->sum2 = rl_calloc(n, sizeof *s->sum2);
+        s->err = rl_calloc(2 * n, sizeof *s->err);
+        s->share = rl_calloc(n, sizeof *s->share);
+        if (!s->sum2 || !s->err || !s->share) {
+            free_frame(s);
+            free(signature);
+            return RL_ERR_OUT_OF_MEMORY;
+        }
+    }
     /* Only area's pixels: a rank of rl --dist renders one band after
      * another into the same buffers, each band its own accumulation. */
     size_t len = (size_t)(area->x1 - area->x0);
@@ -352,6 +428,8 @@ static rl_status reset(pt_state *s, const rl_scene *scene, const rl_camera *cam,
         size_t row = (size_t)y * (size_t)w + (size_t)area->x0;
         memset(s->accum + 3 * row, 0, 3 * len * sizeof *s->accum);
         memset(s->count + row, 0, len * sizeof *s->count);
+        if (s->sum2)
+            memset(s->sum2 + row, 0, len * sizeof *s->sum2);
         /* Sec. 5.3.3: the state texture is filled once from the CPU generator. */
         for (size_t i = row; i < row + len; ++i)
             rl_rng_gpu_seed(&s->rng[i], set->rng, set->seed, i);
@@ -534,6 +612,8 @@ static void resolve(const pt_state *s, const rl_rect *region, rl_image *image)
 
 /* sigma_r (bilateral) and kappa (anisotropic diffusion) at 1 spp. */
 #define PT_FILTER_RANGE_1SPP 0.8f
+/* The a-trous colour sigma at 1 spp (atrous_sigma_rt = 0). */
+#define PT_ATROUS_RT_1SPP 1.0f
 
 /* Sec. 8.2: filter, faded out as the samples grow. */
 static rl_status apply_filter(const pt_state *s, const pt_settings *set, rl_image *image, float *weight)
@@ -559,6 +639,15 @@ static rl_status apply_filter(const pt_state *s, const pt_settings *set, rl_imag
         rl_filter_desc fd = { .kind = set->filter,
                               .sigma_r = PT_FILTER_RANGE_1SPP * (float)pow(n_spp, -0.75),
                               .kappa = PT_FILTER_RANGE_1SPP / (float)n_spp };
+        if (set->filter == RL_FILTER_ATROUS) {
+            /* The paper's colour sigma is a user setting; ours follows the
+             * noise of the mean, which falls as spp^-1/2. */
+            fd.sigma_r = set->atrous_sigma_rt > 0.0 ? (float)set->atrous_sigma_rt
+                                                     : PT_ATROUS_RT_1SPP / (float)sqrt(n_spp);
+            fd.sigma_n = (float)set->atrous_sigma_n;
+            fd.sigma_x = (float)set->atrous_sigma_x;
+            fd.iterations = set->atrous_iterations;
+        }
         st = rl_filter_apply(&fd, in, s->gbuf, out);
         for (size_t i = 0; st == RL_OK && i < n; ++i) {
             rl_vec4 a = in->color[i], b = out->color[i];
@@ -668,9 +757,267 @@ static rl_status trace_passes(rl_renderer *r, const frame *f, const pt_settings 
     return RL_OK;
 }
 
+/* ---- adaptive sampling (see the top) ------------------------------------ */
+
+static double luminance(rl_vec3 c)
+{
+    return 0.2126 * c.x + 0.7152 * c.y + 0.0722 * c.z;
+}
+
+/* Sample number `index` of pixel (x, y), primary ray and path in one go,
+ * drawing in the order of the uniform passes (primary_tile, then
+ * path_tile with a fresh sampler), so the samples are the same ones. */
+static rl_vec3 pixel_sample(const frame *f, int x, int y, uint32_t index, pt_counters *c)
+{
+    size_t i = (size_t)y * f->width + x;
+    uint32_t seed = f->set->sobol ? rl_pt_pixel_seed(f->set->seed, i) : 0;
+    rl_rng_gpu *rng = f->set->sobol ? NULL : &f->s->rng[i];
+    pt_sampler sp;
+    pt_surface first;
+    bool seen;
+    if (f->set->primary == PT_PRIMARY_TRACE) {
+        rl_pt_sampler_init(&sp, rng, seed, index);
+        rl_pt_sampler_seek(&sp, PT_SLOT_PIXEL);
+        rl_vec2 j = rl_pt_sample_2d(&sp);
+        rl_ray ray = rl_camera_frame_ray(&f->cam, (float)x + j.x, (float)y + j.y);
+        rl_hit hit = { INFINITY, 0.0f, 0.0f, RL_ID_NONE, RL_ID_NONE };
+        c->rays[RL_RAY_PRIMARY]++;
+        c->trace_q[RL_PT_BACKEND_BVH]++;
+        rl_accel_intersect(f->s->b.exact[RL_ACCEL_BVH], &ray, &hit);
+        seen = rl_pt_surface_at_hit(f->ctx.data, &hit, f->eye, ray.d, &first);
+    } else {
+        seen = first_vertex(f, i, &first);
+    }
+    if (!seen)
+        return f->ctx.background;
+    rl_pt_sampler_init(&sp, rng, seed, index);
+    return rl_pt_trace_path(&f->ctx, &first, &sp, c);
+}
+
+/* A round: every pixel of tile t traces its share of samples. */
+static void adaptive_tile(const frame *f, int64_t t, pt_counters *c)
+{
+    pt_state *s = f->s;
+    int x0, y0, x1, y1;
+    tile_bounds(f, t, &x0, &y0, &x1, &y1);
+    for (int y = y0; y < y1; ++y) {
+        for (int x = x0; x < x1; ++x) {
+            size_t i = (size_t)y * f->width + x;
+            for (uint32_t k = 0; k < s->share[i]; ++k) {
+                rl_vec3 L = pixel_sample(f, x, y, s->count[i] + k, c);
+                if (!rl_vfinite(L))       /* as path_tile: counted, not added */
+                    continue;
+                s->accum[3 * i + 0] += L.x;
+                s->accum[3 * i + 1] += L.y;
+                s->accum[3 * i + 2] += L.z;
+                double l = luminance(L);
+                s->sum2[i] += l * l;
+            }
+            s->count[i] += s->share[i];
+        }
+    }
+}
+
+static void adaptive_round(const frame *f, int threads, int64_t num_tiles, pt_counters *tile_c)
+{
+#pragma omp parallel for num_threads(threads) schedule(dynamic, 1)
+    for (int64_t t = 0; t < num_tiles; ++t)
+        adaptive_tile(f, t, &tile_c[t]);
+}
+
+/* s->err[n + i]: pixel i's relative error of the mean, averaged over its
+ * 3 x 3 neighbours with at least two samples (s->err[i], the raw value,
+ * is negative for the others); *converged: active pixels below the
+ * threshold. */
+static void pixel_errors(const frame *f, uint64_t *converged)
+{
+    pt_state *s = f->s;
+    const int w = f->width, h = f->height;
+    const size_t n = (size_t)w * h;
+    float *raw = s->err, *smooth = s->err + n;
+#pragma omp parallel for num_threads(f->set->threads) schedule(static)
+    for (int y = 0; y < h; ++y) {
+        for (int x = 0; x < w; ++x) {
+            size_t i = (size_t)y * w + x;
+            double cnt = s->count[i];
+            if (cnt < 2.0) {
+                raw[i] = -1.0f;
+                continue;
+            }
+            double mean = luminance(rl_v3((float)s->accum[3 * i], (float)s->accum[3 * i + 1],
+                                          (float)s->accum[3 * i + 2])) / cnt;
+            double var = (s->sum2[i] - cnt * mean * mean) / (cnt - 1.0);
+            raw[i] = (float)(sqrt((var > 0.0 ? var : 0.0) / cnt) / (fabs(mean) + ADAPTIVE_EPS));
+        }
+    }
+    uint64_t conv = 0;
+#pragma omp parallel for num_threads(f->set->threads) schedule(static) reduction(+ : conv)
+    for (int y = 0; y < h; ++y) {
+        for (int x = 0; x < w; ++x) {
+            double sum = 0.0;
+            int k = 0;
+            for (int yy = y > 0 ? y - 1 : 0; yy <= y + 1 && yy < h; ++yy)
+                for (int xx = x > 0 ? x - 1 : 0; xx <= x + 1 && xx < w; ++xx) {
+                    float e = raw[(size_t)yy * w + xx];
+                    if (e >= 0.0f) {
+                        sum += e;
+                        ++k;
+                    }
+                }
+            size_t i = (size_t)y * w + x;
+            smooth[i] = k > 0 ? (float)(sum / k) : INFINITY;
+            if (active(f, x, y) && smooth[i] < f->set->adaptive_threshold)
+                ++conv;
+        }
+    }
+    *converged = conv;
+}
+
+/* Whether pixel i takes part in a round: active, not converged, and with
+ * an error above zero (a zero weight would meet an infinite factor when
+ * the cap binds everywhere else). */
+static bool wants_samples(const frame *f, const float *e, size_t i, double thr)
+{
+    int x = (int)(i % (size_t)f->width), y = (int)(i / (size_t)f->width);
+    return active(f, x, y) && isfinite(e[i]) && e[i] >= thr && e[i] > 0.0f;
+}
+
+/* The share of `budget` samples by error (s->err[n..]) among the active
+ * pixels: t_i = min(cap, lambda e_i) with sum t_i = budget (water-filling;
+ * lambda by bisection when the cap binds), zero for converged pixels,
+ * rounded by the running sum so that the integers add up. One sequential
+ * pass in pixel order keeps it independent of the threads. Returns the
+ * samples handed out (less than budget when the cap or convergence leaves
+ * some over). */
+static uint64_t adaptive_shares(const frame *f, uint64_t budget, uint64_t num_active)
+{
+    pt_state *s = f->s;
+    const size_t n = (size_t)f->width * f->height;
+    const float *e = s->err + n;
+    /* The raw errors are used up: their half holds the weights of the
+     * pixels that want samples, packed, for the bisection. */
+    float *packed = s->err;
+    const double thr = f->set->adaptive_threshold;
+    const double cap = ADAPTIVE_CAP * (double)budget / (double)num_active;
+    double total = 0.0, e_max = 0.0, e_min = INFINITY;
+    uint64_t positive = 0;
+    for (size_t i = 0; i < n; ++i) {
+        s->share[i] = 0;
+        if (!wants_samples(f, e, i, thr))
+            continue;
+        packed[positive] = e[i];
+        total += e[i];
+        e_max = e[i] > e_max ? e[i] : e_max;
+        e_min = e[i] < e_min ? e[i] : e_min;
+        ++positive;
+    }
+    if (positive == 0 || !(total > 0.0))
+        return 0;
+    double lambda = (double)budget / total;
+    if ((double)positive * cap <= (double)budget) {
+        lambda = INFINITY;              /* every unconverged pixel takes the cap */
+    } else if (lambda * e_max > cap) {
+        double lo = lambda, hi = cap / e_min;
+        for (int it = 0; it < 50; ++it) {
+            double mid = 0.5 * (lo + hi), got = 0.0;
+            for (uint64_t k = 0; k < positive; ++k)
+                got += fmin(cap, mid * packed[k]);
+            if (got < (double)budget)
+                lo = mid;
+            else
+                hi = mid;
+        }
+        lambda = hi;
+    }
+    double run = 0.0;
+    uint64_t given = 0;
+    for (size_t i = 0; i < n; ++i) {
+        if (!wants_samples(f, e, i, thr))
+            continue;
+        run += fmin(cap, lambda * e[i]);
+        uint64_t upto = (uint64_t)floor(run + 0.5);
+        s->share[i] = (uint32_t)(upto - given);
+        given = upto;
+    }
+    return given;
+}
+
+/* The frame with adaptive sampling: the uniform start up to
+ * adaptive_min_spp, then rounds by error until the frame's spp x active
+ * pixels are spent or every pixel has converged. *traced: pixels that got
+ * samples; *samples: the paths traced. */
+static rl_status adaptive_passes(rl_renderer *r, const frame *f, const pt_settings *set, pt_counters *sum,
+                                 rl_pt_stats *ps, uint64_t *traced, uint64_t *samples)
+{
+    pt_state *s = f->s;
+    const size_t n = (size_t)f->width * f->height;
+    int64_t num_tiles = (int64_t)f->tiles_x * ((f->height + TILE - 1) / TILE);
+    pt_counters *tile_c = rl_calloc((size_t)num_tiles, sizeof *tile_c);
+    uint32_t *before = rl_alloc(n * sizeof *before);
+    if (!tile_c || !before) {
+        free(tile_c);
+        free(before);
+        return RL_ERR_OUT_OF_MEMORY;
+    }
+    memcpy(before, s->count, n * sizeof *before);
+    uint64_t num_active = 0, spent = 0, counted = 0;
+    uint32_t min_spp = (uint32_t)set->adaptive_min_spp, spp = (uint32_t)set->spp;
+    for (size_t i = 0; i < n; ++i) {
+        s->share[i] = 0;
+        if (!active(f, (int)(i % (size_t)f->width), (int)(i / (size_t)f->width)))
+            continue;
+        ++num_active;
+        counted += s->count[i];
+        if (s->count[i] < min_spp) {
+            uint32_t need = min_spp - s->count[i];
+            s->share[i] = need < spp ? need : spp;
+            spent += s->share[i];
+        }
+    }
+    uint64_t budget = (uint64_t)spp * num_active;
+    rl_timer timer;
+    rl_timer_start(&timer);
+    if (spent > 0)
+        adaptive_round(f, set->threads, num_tiles, tile_c);
+    counted += spent;
+    uint64_t remaining = budget - spent;
+    rl_status st = RL_OK;
+    ps->adaptive_converged = 0;
+    while (remaining > 0 && num_active > 0) {
+        if (!rl_renderer_progress(r, BUILD_SHARE + (1.0 - BUILD_SHARE) * (double)(budget - remaining) / budget)) {
+            st = cancelled(s);
+            break;
+        }
+        /* A round at most doubles the mean count: the errors are then
+         * re-estimated before the next. */
+        uint64_t mean = counted / num_active, round = num_active * (mean > 1 ? mean : 1);
+        round = round < remaining ? round : remaining;
+        pixel_errors(f, &ps->adaptive_converged);
+        uint64_t given = adaptive_shares(f, round, num_active);
+        if (given == 0)
+            break;
+        adaptive_round(f, set->threads, num_tiles, tile_c);
+        spent += given;
+        counted += given;
+        remaining -= round;
+    }
+    ps->time_paths_ms += rl_timer_ms(&timer);
+    *traced = 0;
+    for (size_t i = 0; i < n; ++i)
+        *traced += s->count[i] != before[i];
+    *samples = spent;
+    memset(sum, 0, sizeof *sum);
+    for (int64_t t = 0; t < num_tiles; ++t)
+        add_counters(sum, &tile_c[t]);
+    free(tile_c);
+    free(before);
+    return st == RL_OK && !rl_renderer_progress(r, 1.0) ? cancelled(s) : st;
+}
+
 /* The frame's statistics (rl_pt_stats and the generic ones). */
 static void finish_stats(pt_state *s, const pt_settings *set, const pt_counters *sum, uint64_t traced,
-                         uint64_t pixels, const rl_timer *total, rl_render_stats *stats, rl_pt_stats *ps)
+                         uint64_t samples, uint64_t pixels, const rl_timer *total, rl_render_stats *stats,
+                         rl_pt_stats *ps)
 {
     for (int k = 0; k < RL_RAY_TYPE_COUNT; ++k)
         stats->rays[k] = ps->rays[k] = sum->rays[k];
@@ -678,7 +1025,7 @@ static void finish_stats(pt_state *s, const pt_settings *set, const pt_counters 
     memcpy(ps->trace_queries, sum->trace_q, sizeof ps->trace_queries);
     ps->preillum_ends = sum->preillum_ends;
     stats->pixels_written = pixels;
-    stats->samples = ps->samples = traced * (uint64_t)set->spp;
+    stats->samples = ps->samples = samples;
     ps->frames = s->frames;
     ps->spp = (double)s->total_samples / (double)pixels;
     ps->spp_frame = (uint32_t)set->spp;
@@ -726,6 +1073,9 @@ static rl_status pt_render(rl_renderer *r, void *state, const rl_scene *scene, c
         if (set.primary == PT_PRIMARY_RASTER)
             return rl_error(RL_ERR_UNSUPPORTED, "pt: primary=raster rasterizes the whole image; a region "
                             "(rl --dist) needs primary=trace");
+        if (set.adaptive)
+            return rl_error(RL_ERR_UNSUPPORTED, "pt: adaptive=on shares a frame's paths over the whole image; a "
+                            "region (rl --dist) needs adaptive=off");
         if (set.checkerboard) {
             /* The first frame's holes are the mean of their neighbours,
              * which may lie outside: trace those too. */
@@ -761,22 +1111,28 @@ static rl_status pt_render(rl_renderer *r, void *state, const rl_scene *scene, c
         .parity = s->frames & 1u,
     };
     pt_counters sum;
-    if ((st = trace_passes(r, &f, &set, &sum, &ps)) != RL_OK)
-        return st;
-
-    /* Sec. 6.5, eq. 8: the traced pixels' sample counts (all of them, or
-     * the frame's checkerboard half); the samples are the region's, not
-     * its ring's. */
-    uint64_t traced = 0;
-    for (int y = area.y0; y < area.y1; ++y)
-        for (int x = area.x0; x < area.x1; ++x)
-            if (active(&f, x, y)) {
-                s->count[(size_t)y * cam->width + x] += (uint32_t)set.spp;
-                if (x >= region.x0 && x < region.x1 && y >= region.y0 && y < region.y1)
-                    ++traced;
-            }
+    uint64_t traced = 0, samples = 0;
+    if (set.adaptive) {
+        /* Whole frames only (a region refuses adaptive=on). */
+        if ((st = adaptive_passes(r, &f, &set, &sum, &ps, &traced, &samples)) != RL_OK)
+            return st;
+    } else {
+        if ((st = trace_passes(r, &f, &set, &sum, &ps)) != RL_OK)
+            return st;
+        /* Sec. 6.5, eq. 8: the traced pixels' sample counts (all of them, or
+         * the frame's checkerboard half); the samples are the region's, not
+         * its ring's. */
+        for (int y = area.y0; y < area.y1; ++y)
+            for (int x = area.x0; x < area.x1; ++x)
+                if (active(&f, x, y)) {
+                    s->count[(size_t)y * cam->width + x] += (uint32_t)set.spp;
+                    if (x >= region.x0 && x < region.x1 && y >= region.y0 && y < region.y1)
+                        ++traced;
+                }
+        samples = traced * (uint64_t)set.spp;
+    }
     s->frames++;
-    s->total_samples += traced * (uint64_t)set.spp;
+    s->total_samples += samples;
 
     resolve(s, &region, image);
     if (set.filter != RL_FILTER_NONE) {
@@ -789,7 +1145,7 @@ static rl_status pt_render(rl_renderer *r, void *state, const rl_scene *scene, c
     }
     write_layers(s, &region, image);
     uint64_t pixels = (uint64_t)(region.x1 - region.x0) * (uint64_t)(region.y1 - region.y0);
-    finish_stats(s, &set, &sum, traced, pixels, &total, stats, &ps);
+    finish_stats(s, &set, &sum, traced, samples, pixels, &total, stats, &ps);
     stats->prep_ms = ps.time_build_ms;     /* the backends built for the scene */
     s->stats = ps;
     s->have_frame = true;
@@ -843,6 +1199,12 @@ uint64_t rl_pt_frame_samples(const rl_renderer *r, int width, int height, uint64
     return spp * ((frame & 1u) == 0 ? even : n - even);
 }
 
+const uint32_t *rl_pt_sample_counts(const rl_renderer *r)
+{
+    pt_state *s = pt_of(r);
+    return s && s->have_frame ? s->count : NULL;
+}
+
 const rl_renderer_class rl_pt_renderer_class = {
     .info = { .name = "pt",
               .description = "Progressive path tracing with NEE, Russian roulette and Phong sampling; "
@@ -850,9 +1212,12 @@ const rl_renderer_class rl_pt_renderer_class = {
               .reference = "Schröder 2017", .progressive = true, .default_time_s = PT_DEFAULT_TIME_S,
               .regions = true,
               /* reset(): accumulation, sample counts, generators, first hits and
-               * directions, and the G-buffer of the first hits */
+               * directions, the G-buffer of the first hits, and adaptive
+               * sampling's buffers */
               .frame_bytes_per_pixel = 3 * sizeof(double) + sizeof(uint32_t) + sizeof(rl_rng_gpu) + sizeof(rl_hit) +
-                                       sizeof(rl_vec3) + RL_GBUFFER_BYTES_PER_PIXEL },
+                                       sizeof(rl_vec3) + RL_GBUFFER_BYTES_PER_PIXEL +
+                                       /* adaptive=on: squared sums, errors, shares, counts */
+                                       sizeof(double) + 2 * sizeof(float) + 2 * sizeof(uint32_t) },
     .options = pt_options,
     .num_options = NUM_OPTIONS,
     .state_size = sizeof(pt_state),

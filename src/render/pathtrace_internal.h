@@ -2,7 +2,8 @@
  * (Schröder 2017, Ch. 6 and 8).
  *
  * pathtrace.c          the renderer: options, frame loop, accumulation
- *                      (Sec. 6.5), checkerboard (Sec. 8.5), filter (Sec. 8.2)
+ *                      (Sec. 6.5), checkerboard (Sec. 8.5), filter (Sec. 8.2),
+ *                      per-pixel adaptive sampling (issue 37)
  * pathtrace_path.c     one camera path (Sec. 3.3, 6.4): Trace, Shade (NEE),
  *                      emission rule, Russian roulette; the pre-illumination
  *                      shader for the Line Space (Sec. 7.4)
@@ -45,6 +46,11 @@ typedef struct pt_settings {
     pt_primary primary;
     rl_filter_kind filter;
     double filter_fade;
+    int atrous_iterations;         /* filter=atrous (rl_filter.h) */
+    double atrous_sigma_rt, atrous_sigma_n, atrous_sigma_x;   /* 0 (rt, x): derived */
+    bool adaptive;                 /* per-pixel adaptive sampling (pathtrace.c) */
+    double adaptive_threshold;
+    int adaptive_min_spp;
     int grid_res, ls_n, ls_k, shadowmap_size;
     const char *ls_file;           /* Line Space cache file; "" none (valid for one frame) */
     rl_vec3 background;            /* environment radiance of escaping rays */

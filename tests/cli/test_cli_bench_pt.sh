@@ -165,10 +165,13 @@ assert c["scene"] == "cornell:variant=bitterli" and c["size"] == 16, c
 assert c["reference"]["spp"] == 32 and c["reference"]["cached"] is False, c["reference"]
 labels = [x["label"] for x in c["configurations"]]
 assert labels[0] == "defaults" and labels[1].startswith("thesis") and "mis=off" in labels, labels
+assert "adaptive=on" in labels and any(l.startswith("atrous") for l in labels), labels
 for x in c["configurations"]:
     assert [p["spp"] for p in x["points"]] == [4, 8], x
-    assert all(0 < p["rmse"] < 1 and p["cpu_ms"] > 0 for p in x["points"]), x
-    assert x["points"][1]["rmse"] < x["points"][0]["rmse"], x
+    assert all(0 < p["rmse"] < 1 and p["cpu_ms"] > 0 and abs(p["mean_error"]) < 1 for p in x["points"]), x
+    # A denoiser's error need not fall at 16 x 16 (its bias dominates).
+    if "atrous" not in x["label"]:
+        assert x["points"][1]["rmse"] < x["points"][0]["rmse"], x
 PY
 expect_exit 0 "$RL" bench pt --only convergence --quick --conv-size 16 --conv-ref-spp 32 --conv-spp-max 8 \
     --out "$TMP/conv/c2.json"

@@ -215,6 +215,7 @@ static void test_pt_region_refusals(void **state)
     } cases[] = {
         { { "filter", "bilateral", NULL }, "pt: filter=bilateral filters the whole image" },
         { { "primary", "raster", NULL }, "pt: primary=raster rasterizes the whole image" },
+        { { "adaptive", "on", NULL }, "pt: adaptive=on shares a frame's paths over the whole image" },
     };
     for (size_t k = 0; k < sizeof cases / sizeof cases[0]; ++k) {
         rl_renderer *r = fx_make("pt", cases[k].opts);
