@@ -273,7 +273,7 @@ static void test_error_falls_with_samples(void **state)
         const char *opts[] = { "spp", spps[k], NULL };
         rl_image *img = render("bdpt", s, &cam, opts);
         e[k] = rmse(img, ref);
-        print_message("bdpt %s spp: RMSE %.5f against pt 512 spp\n", spps[k], e[k]);
+        print_message("bdpt %s spp: RMSE %.5f against pt 256 spp\n", spps[k], e[k]);
         rl_image_release(img);
     }
     assert_true(e[1] < 0.7 * e[0]);
