@@ -516,6 +516,8 @@ static const struct {
     { "vt", "the VT objects (mirrors, glass) traced at adaptively refined vertices and interpolated, "
             "the rest as raster" },
     { "pt", "path tracing, 1 path per pixel: noise, and indirect light the reference lacks" },
+    { "bdpt", "bidirectional path tracing, 1 sample per pixel: noise (less where light arrives by bounces), "
+              "and indirect light the reference lacks" },
     { "chcpp", "raster's image: occlusion culling is exact" },
     { "svs", "raster's image without the objects its sampled visibility misses" },
     { "visset", "raster's image without the objects its sampled visible sets miss" },
