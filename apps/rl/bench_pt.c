@@ -24,6 +24,8 @@
  *   convergence   issue 37: RMSE against time on Bitterli's Cornell box
  *                 settings, pt's defaults vs the thesis' settings and each
  *                 improvement switched off (bench_pt_conv.c)
+ *   bdpt          issue 37: pt against bdpt at equal CPU time on the Cornell
+ *                 box lit directly and through a shade (bench_pt_bdpt.c)
  *
  * Every section but convergence measures the thesis' configuration, so
  * make_pt sets the thesis' sampling options explicitly (rng=hybrid,
@@ -41,6 +43,7 @@
 #include "bench_pt.h"
 
 #include "bench_args.h"
+#include "bench_pt_bdpt.h"
 #include "bench_pt_conv.h"
 #include "bench_rays.h"
 #include "bench_util.h"
@@ -85,6 +88,9 @@ static const char bench_pt_help[] =
     "                thesis' settings, each improvement off, light_samples 1/2/4,\n"
     "                adaptive sampling and the a-trous denoiser;\n"
     "                time to RMSE 0.0069 and 0.0014, RMSE at 64 spp (issue 37)\n"
+    "  bdpt          pt against bdpt at equal CPU time (5 s per thread; quick 0.5)\n"
+    "                on cornell:variant=bitterli and variant=shade, 96x96 (quick\n"
+    "                32x32): RMSE against a 512-spp bdpt reference, channel means\n"
     "\n"
     "options:\n"
     "  --size WxH        frame sections; default 1280x720 (the thesis)\n"
@@ -114,10 +120,10 @@ static const char bench_pt_help[] =
     "  rl bench pt --only generation,shadow\n";
 
 enum { SEC_GENERATION, SEC_SCENES, SEC_DIFFUSE, SEC_SHADOW, SEC_ERROR, SEC_SPECULAR, SEC_ACCUMULATION,
-       SEC_CONVERGENCE, SEC_COUNT };
+       SEC_CONVERGENCE, SEC_BDPT, SEC_COUNT };
 static const char *const section_names[SEC_COUNT] = { "generation", "scenes",       "diffuse",
                                                       "shadow",     "error",        "specular",
-                                                      "accumulation", "convergence" };
+                                                      "accumulation", "convergence", "bdpt" };
 
 /* Schröder 2017, Table 1: generation times in ms on a GeForce GTX 1080. */
 static const struct gen_row {
@@ -1409,6 +1415,13 @@ static rl_status sec_convergence(void *ctx, cJSON *sec)
     return bench_pt_convergence(&ca, sec);
 }
 
+static rl_status sec_bdpt(void *ctx, cJSON *sec)
+{
+    bpt *b = ctx;
+    bench_pt_bdpt_args ba = { .threads = b->threads, .quick = b->a->quick };
+    return bench_pt_bdpt(&ba, sec);
+}
+
 /* ------------------------------------------------------- the command -- */
 
 /* Returns RL_CLI_OK, an exit code, or RL_BENCH_HELP_SHOWN. */
@@ -1561,7 +1574,7 @@ int bench_pt(int argc, char **argv)
     cJSON_AddItemToObject(root, "thesis", thesis_json());
     static const bench_section_fn fns[SEC_COUNT] = { sec_generation, sec_scenes,       sec_diffuse,
                                                         sec_shadow,     sec_error,        sec_specular,
-                                                        sec_accumulation, sec_convergence };
+                                                        sec_accumulation, sec_convergence, sec_bdpt };
     b.out_path = out;
     printf("rl bench pt: Line Space path tracing (Schroeder 2017), %d threads\n", b.threads);
     rc = bench_run_sections("pt", root, section_names, fns, SEC_COUNT, a.sections, &b,

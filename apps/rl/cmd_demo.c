@@ -517,6 +517,8 @@ static const struct {
             "the rest as raster" },
     { "pt", "path tracing, 1 path per pixel: noise, and indirect light the reference lacks" },
     { "gl-pt", "pt in GL compute shaders (1 path per pixel): pt's estimator, its own noise" },
+    { "bdpt", "bidirectional path tracing, 1 sample per pixel: noise (less where light arrives by bounces), "
+              "and indirect light the reference lacks" },
     { "chcpp", "raster's image: occlusion culling is exact" },
     { "svs", "raster's image without the objects its sampled visibility misses" },
     { "visset", "raster's image without the objects its sampled visible sets miss" },

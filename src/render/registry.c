@@ -24,6 +24,7 @@ extern const rl_renderer_class rl_gl_pt_renderer_class;      /* gl_pathtrace.c *
 extern const rl_renderer_class rl_whitted_renderer_class;    /* whitted.c */
 extern const rl_renderer_class rl_vt_renderer_class;         /* vt.c */
 extern const rl_renderer_class rl_pt_renderer_class;         /* pathtrace.c */
+extern const rl_renderer_class rl_bdpt_renderer_class;       /* bdpt.c */
 extern const rl_renderer_class rl_chcpp_renderer_class;      /* chcpp.c */
 extern const rl_renderer_class rl_svs_renderer_class;        /* svs.c */
 extern const rl_renderer_class rl_visset_renderer_class;     /* visset.c */
@@ -37,6 +38,7 @@ static const rl_renderer_class *const builtins[] = {
     &rl_whitted_renderer_class,
     &rl_vt_renderer_class,
     &rl_pt_renderer_class,
+    &rl_bdpt_renderer_class,
     &rl_chcpp_renderer_class,
     &rl_svs_renderer_class,
     &rl_visset_renderer_class,

@@ -22,7 +22,13 @@
  * reflects 0.78) and paths of up to 8 scattering vertices (root attribute
  * max_path_length = 7: interactions after the camera hit, as pt counts
  * them). The geometry and camera stay the measured data's above, not
- * Bitterli's mesh. */
+ * Bitterli's mesh.
+ *
+ * variant=shade (issue 37, bdpt) hangs a white plate 30 mm wider than the
+ * lamp on each side 44 mm below it: the classic box lit by a lamp with a
+ * shade, where the room sees the lamp only through bounces off the plate
+ * and the ceiling (and a grazing strip of the walls' tops), the case
+ * bidirectional path tracing is for. */
 #include "scene/builtin.h"
 
 #include <stdio.h>
@@ -111,7 +117,17 @@ static rl_status add_part(rl_scene *scene, const part *pt, const uint32_t *mater
     return s;
 }
 
-enum { VARIANT_CLASSIC, VARIANT_BITTERLI, NUM_VARIANTS };
+enum { VARIANT_CLASSIC, VARIANT_BITTERLI, VARIANT_SHADE, NUM_VARIANTS };
+
+static const part shade = {
+    "shade", WHITE, 6,
+    { { { 183.0f, 505.0f, 197.0f }, { 373.0f, 505.0f, 197.0f }, { 373.0f, 505.0f, 362.0f }, { 183.0f, 505.0f, 362.0f } },
+      { { 183.0f, 500.0f, 197.0f }, { 373.0f, 500.0f, 197.0f }, { 373.0f, 500.0f, 362.0f }, { 183.0f, 500.0f, 362.0f } },
+      { { 183.0f, 500.0f, 197.0f }, { 373.0f, 500.0f, 197.0f }, { 373.0f, 505.0f, 197.0f }, { 183.0f, 505.0f, 197.0f } },
+      { { 183.0f, 500.0f, 362.0f }, { 373.0f, 500.0f, 362.0f }, { 373.0f, 505.0f, 362.0f }, { 183.0f, 505.0f, 362.0f } },
+      { { 183.0f, 500.0f, 197.0f }, { 183.0f, 500.0f, 362.0f }, { 183.0f, 505.0f, 362.0f }, { 183.0f, 505.0f, 197.0f } },
+      { { 373.0f, 500.0f, 197.0f }, { 373.0f, 500.0f, 362.0f }, { 373.0f, 505.0f, 362.0f }, { 373.0f, 505.0f, 197.0f } } },
+};
 
 /* Walls, light (mesh + quad light), camera: everything but the contents. */
 static rl_status add_box(rl_scene *scene, int variant)
@@ -120,6 +136,7 @@ static rl_status add_box(rl_scene *scene, int variant)
     static const float colours[NUM_VARIANTS][NUM_MATERIALS][3] = {
         { { 0.73f, 0.73f, 0.73f }, { 0.65f, 0.05f, 0.05f }, { 0.12f, 0.45f, 0.15f }, { 0.78f, 0.78f, 0.78f } },
         { { 0.725f, 0.71f, 0.68f }, { 0.63f, 0.065f, 0.05f }, { 0.14f, 0.45f, 0.091f }, { 0.0f, 0.0f, 0.0f } },
+        { { 0.73f, 0.73f, 0.73f }, { 0.65f, 0.05f, 0.05f }, { 0.12f, 0.45f, 0.15f }, { 0.78f, 0.78f, 0.78f } },
     };
     uint32_t materials[NUM_MATERIALS];
     rl_status s = RL_OK;
@@ -169,6 +186,8 @@ static rl_status build_cornell(rl_scene *scene, const rl_option_store *params)
     uint32_t materials[NUM_MATERIALS] = { white, white, white, white };
     for (size_t i = 0; i < sizeof blocks / sizeof blocks[0] && !s; ++i)
         s = add_part(scene, &blocks[i], materials, true);
+    if (!s && variant == VARIANT_SHADE)
+        s = add_part(scene, &shade, materials, true);
     return s;
 }
 
@@ -206,11 +225,12 @@ static rl_status build_cornell_teapot(rl_scene *scene, const rl_option_store *pa
     return s;
 }
 
-static const char *const variant_names[] = { "classic", "bitterli", NULL };
+static const char *const variant_names[] = { "classic", "bitterli", "shade", NULL };
 static const rl_option_info cornell_options[] = {
     { "variant", RL_OPT_ENUM, "classic",
       "classic (the usual RGB fits, a lamp of albedo 0.78) or bitterli (Bitterli's cornell-box albedos, a "
-      "black lamp, max_path_length 7)", 0, 0, variant_names },
+      "black lamp, max_path_length 7) or shade (classic with a plate under the lamp: lit by bounces)", 0, 0,
+      variant_names },
 };
 
 const rl_builtin_class rl_builtin_cornell_class = {

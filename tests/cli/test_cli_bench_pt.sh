@@ -22,7 +22,7 @@ expect_in "$TMP/err" "rl: error: "
 
 expect_exit 0 "$RL" bench pt --help
 for o in --size --error-size --ref-spp --spp-max --max-memory --builds --fixed-k --small-pages --only --out \
-         --quick generation accumulation convergence --conv-size --conv-ref-spp --conv-spp-max; do
+         --quick generation accumulation convergence --conv-size --conv-ref-spp --conv-spp-max bdpt; do
     expect_in "$TMP/out" "$o"
 done
 
@@ -177,4 +177,19 @@ expect_exit 0 "$RL" bench pt --only convergence --quick --conv-size 16 --conv-re
     --out "$TMP/conv/c2.json"
 python3 -c 'import json,sys; assert json.load(open(sys.argv[1]))["convergence"]["reference"]["cached"] is True' \
     "$TMP/conv/c2.json" || fail "the cached reference was not reused"
+
+# bdpt (issue 37): pt and bdpt at equal CPU time on both scenes; behind the
+# shade bdpt's error is the lower one
+expect_exit 0 "$RL" bench pt --only bdpt --quick --out "$TMP/bdpt.json"
+python3 - "$TMP/bdpt.json" <<'PY' || fail "bdpt section"
+import json, sys
+b = json.load(open(sys.argv[1]))["bdpt"]
+assert b["status"] == "ok" and b["size"] == 32, b
+assert [s["scene"] for s in b["scenes"]] == ["variant=bitterli", "variant=shade"], b
+for s in b["scenes"]:
+    assert [r["algo"] for r in s["runs"]] == ["pt", "bdpt"], s
+    assert all(r["spp"] > 0 and 0 <= r["rmse"] < 1 and r["cpu_ms"] > 0 for r in s["runs"]), s
+shade = b["scenes"][1]["runs"]
+assert shade[1]["rmse"] < shade[0]["rmse"], shade
+PY
 echo "ok"

@@ -1,0 +1,213 @@
+/* bench_pt_bdpt.c: `rl bench pt --only bdpt` (issue 37): the path tracer
+ * "pt" at its defaults against the bidirectional path tracer "bdpt" at
+ * equal time, on cornell:variant=bitterli (lit directly) and on
+ * cornell:variant=shade (the lamp behind a plate: lit by bounces).
+ *
+ * Per scene: a bdpt reference of REF_SPP samples in two independent halves;
+ * its own mean squared error, MSE(half A, half B) / 4, is subtracted from
+ * every measured MSE (as bench_pt_conv.c). Each renderer then accumulates
+ * frames of 1 spp after a warm-up frame (builds excluded) until its process
+ * CPU time divided by the threads reaches the budget: on a shared machine
+ * that is what a quiet machine's wall clock would show. Recorded: samples
+ * reached, wall and CPU time, RMSE of linear RGB clamped to [0, 1] (the
+ * lamp's radiance would otherwise decide it) against the reference, and the
+ * channel means (unclamped) of the image and of the reference. */
+#define _POSIX_C_SOURCE 200809L
+#include "bench_pt_bdpt.h"
+
+#include "bench_util.h"
+
+#include <cjson/cJSON.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+
+#include "rl/rl_render.h"
+#include "rl/rl_scene.h"
+#include "rl/rl_timer.h"
+
+#define note(...) bench_note("pt", __VA_ARGS__)
+
+static const char *const scenes[] = { "variant=bitterli", "variant=shade" };
+#define NUM_SCENES (sizeof scenes / sizeof scenes[0])
+static const char *const algos[] = { "pt", "bdpt" };
+
+static double cpu_ms_now(void)
+{
+    struct timespec ts;
+    if (clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts) != 0)
+        return 0.0;
+    return ts.tv_sec * 1e3 + ts.tv_nsec * 1e-6;
+}
+
+static float disp(float v)
+{
+    return v < 0.0f ? 0.0f : (v < 1.0f ? v : 1.0f);
+}
+
+static rl_status make(const char *algo, int threads, const char *seed, long long spp, rl_renderer **out)
+{
+    char buf[32];
+    rl_status st = rl_renderer_create(algo, out);
+    snprintf(buf, sizeof buf, "%d", threads);
+    if (st == RL_OK) st = rl_renderer_set(*out, "threads", buf);
+    snprintf(buf, sizeof buf, "%lld", spp);
+    if (st == RL_OK) st = rl_renderer_set(*out, "spp", buf);
+    if (st == RL_OK) st = rl_renderer_set(*out, "seed", seed);
+    return st;
+}
+
+/* Squared error of img against ref (clamped), summed over n pixels x 3. */
+static double mse(const rl_image *img, const float *ref, size_t n)
+{
+    double sum = 0.0;
+    for (size_t i = 0; i < n; ++i) {
+        const float c[3] = { img->color[i].x, img->color[i].y, img->color[i].z };
+        for (int k = 0; k < 3; ++k) {
+            double d = disp(c[k]) - disp(ref[3 * i + k]);
+            sum += d * d;
+        }
+    }
+    return sum / (3.0 * (double)n);
+}
+
+static void add_means(cJSON *o, const char *key, const double m[3])
+{
+    cJSON *a = cJSON_AddArrayToObject(o, key);
+    for (int k = 0; k < 3; ++k)
+        cJSON_AddItemToArray(a, cJSON_CreateNumber(m[k]));
+}
+
+static rl_status run_scene(const bench_pt_bdpt_args *a, const char *params, int size, long long ref_spp,
+                           double budget_s, cJSON *out)
+{
+    rl_scene *scene = NULL;
+    rl_status st = rl_scene_create_builtin("cornell", params, &scene);
+    rl_camera cam;
+    if (st == RL_OK) st = rl_scene_get_camera(scene, NULL, &cam);
+    if (st != RL_OK) {
+        rl_scene_release(scene);
+        return st;
+    }
+    cam.width = cam.height = size;
+    size_t n = (size_t)size * size;
+    float *ref = calloc(3 * n, sizeof *ref), *half = calloc(3 * n, sizeof *half);
+    rl_image *img = NULL;
+    if (!ref || !half || rl_image_create(size, size, RL_LAYER_COLOR, &img) != RL_OK) {
+        free(ref);
+        free(half);
+        rl_scene_release(scene);
+        return RL_ERR_OUT_OF_MEMORY;
+    }
+    /* The reference in two halves: their mean, and its own error. */
+    rl_timer timer;
+    rl_timer_start(&timer);
+    double ref_mse = 0.0, ref_means[3] = { 0.0, 0.0, 0.0 };
+    static const char *const ref_seeds[2] = { "4242", "4343" };
+    for (int h = 0; h < 2 && st == RL_OK; ++h) {
+        rl_renderer *r = NULL;
+        rl_render_stats s;
+        st = make("bdpt", a->threads, ref_seeds[h], ref_spp / 2, &r);
+        if (st == RL_OK) st = rl_renderer_render(r, scene, &cam, img, &s);
+        rl_renderer_release(r);
+        for (size_t i = 0; st == RL_OK && i < n; ++i) {
+            const float c[3] = { img->color[i].x, img->color[i].y, img->color[i].z };
+            for (int k = 0; k < 3; ++k) {
+                if (h == 0) {
+                    half[3 * i + k] = c[k];
+                } else {
+                    double d = disp(c[k]) - disp(half[3 * i + k]);
+                    ref_mse += d * d;
+                    ref[3 * i + k] = 0.5f * (c[k] + half[3 * i + k]);
+                    ref_means[k] += ref[3 * i + k] / (double)n;
+                }
+            }
+        }
+    }
+    ref_mse /= 4.0 * 3.0 * (double)n;
+    double ref_ms = rl_timer_ms(&timer);
+    if (st == RL_OK) {
+        cJSON_AddStringToObject(out, "scene", params);
+        bench_add_num(out, "reference_spp", (double)ref_spp);
+        bench_add_num(out, "reference_ms", ref_ms);
+        bench_add_num(out, "reference_rmse", sqrt(ref_mse));
+        add_means(out, "reference_means", ref_means);
+    }
+    cJSON *runs = st == RL_OK ? cJSON_AddArrayToObject(out, "runs") : NULL;
+    double rmse_of[2] = { 0.0, 0.0 };
+    for (int k = 0; k < 2 && st == RL_OK; ++k) {
+        rl_renderer *r = NULL;
+        rl_render_stats s;
+        /* Warm-up under another seed (builds the BVH and the light table),
+         * then the seed change restarts the accumulation. */
+        st = make(algos[k], a->threads, "9", 1, &r);
+        if (st == RL_OK) st = rl_renderer_render(r, scene, &cam, img, &s);
+        if (st == RL_OK) st = rl_renderer_set(r, "seed", "1");
+        double wall = 0.0, cpu = 0.0;
+        long long spp = 0;
+        while (st == RL_OK && cpu / 1e3 / a->threads < budget_s) {
+            double c0 = cpu_ms_now();
+            rl_timer_start(&timer);
+            st = rl_renderer_render(r, scene, &cam, img, &s);
+            wall += rl_timer_ms(&timer);
+            cpu += cpu_ms_now() - c0;
+            ++spp;
+        }
+        rl_renderer_release(r);
+        if (st != RL_OK)
+            break;
+        double e = mse(img, ref, n) - ref_mse;
+        double rmse = sqrt(e > 0.0 ? e : 0.0), m[3] = { 0.0, 0.0, 0.0 };
+        for (size_t i = 0; i < n; ++i) {
+            m[0] += img->color[i].x / (double)n;
+            m[1] += img->color[i].y / (double)n;
+            m[2] += img->color[i].z / (double)n;
+        }
+        rmse_of[k] = rmse;
+        cJSON *o = cJSON_CreateObject();
+        cJSON_AddStringToObject(o, "algo", algos[k]);
+        bench_add_num(o, "spp", (double)spp);
+        bench_add_num(o, "wall_ms", wall);
+        bench_add_num(o, "cpu_ms", cpu);
+        bench_add_num(o, "rmse", rmse);
+        add_means(o, "means", m);
+        cJSON_AddItemToArray(runs, o);
+        printf("%-18s %-5s %6lld spp %8.1f s cpu/thr %8.1f s wall  RMSE %.5f  means %.4f %.4f %.4f "
+               "(ref %.4f %.4f %.4f)\n", params, algos[k], spp, cpu / 1e3 / a->threads, wall / 1e3, rmse, m[0],
+               m[1], m[2], ref_means[0], ref_means[1], ref_means[2]);
+        fflush(stdout);
+    }
+    if (st == RL_OK)
+        bench_add_num(out, "rmse_ratio_pt_over_bdpt", bench_ratio(rmse_of[0], rmse_of[1]));
+    rl_image_release(img);
+    free(ref);
+    free(half);
+    rl_scene_release(scene);
+    return st;
+}
+
+rl_status bench_pt_bdpt(const bench_pt_bdpt_args *a, cJSON *sec)
+{
+    int size = a->quick ? 32 : 96;
+    long long ref_spp = a->quick ? 64 : 512;
+    double budget_s = a->quick ? 0.5 : 5.0;
+    note("bdpt: pt and bdpt at equal CPU time (%.1f s per thread) on cornell, %dx%d, reference bdpt %lld spp",
+         budget_s, size, size, ref_spp);
+    cJSON_AddStringToObject(sec, "error", "RMSE of linear RGB clamped to [0,1], all pixels and channels, against "
+                                          "a bdpt reference in two halves, its own MSE subtracted");
+    cJSON_AddStringToObject(sec, "time", "frames of 1 spp after a warm-up frame until process CPU time / threads "
+                                         "reaches budget_s");
+    bench_add_num(sec, "size", size);
+    bench_add_num(sec, "budget_s", budget_s);
+    bench_add_num(sec, "threads", a->threads);
+    cJSON *list = cJSON_AddArrayToObject(sec, "scenes");
+    rl_status st = RL_OK;
+    for (size_t i = 0; i < NUM_SCENES && st == RL_OK; ++i) {
+        cJSON *o = cJSON_CreateObject();
+        cJSON_AddItemToArray(list, o);
+        st = run_scene(a, scenes[i], size, ref_spp, budget_s, o);
+    }
+    return st;
+}

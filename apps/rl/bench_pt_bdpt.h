@@ -1,0 +1,20 @@
+/* bench_pt_bdpt.h: the bdpt section of `rl bench pt` (issue 37): pt
+ * against bdpt at equal time; see bench_pt_bdpt.c. */
+#ifndef RL_APP_BENCH_PT_BDPT_H
+#define RL_APP_BENCH_PT_BDPT_H
+
+#include <stdbool.h>
+
+#include "rl/rl_common.h"
+
+struct cJSON;
+
+typedef struct bench_pt_bdpt_args {
+    int threads;
+    bool quick;
+} bench_pt_bdpt_args;
+
+/* Fills sec; RL_OK or the failing status. */
+rl_status bench_pt_bdpt(const bench_pt_bdpt_args *a, struct cJSON *sec);
+
+#endif
