@@ -457,6 +457,23 @@ static rl_status reference(bvt *b, int width, int height, int threads, int mode,
     return RL_OK;
 }
 
+/* The start of a static section at --size: the Whitted reference (made
+ * once per size and kept), the section's scene and size in the record, and
+ * with with_ref the reference's own figures. */
+static rl_status table_section(bvt *b, cJSON *sec, bool with_ref, ref_frame **ref, char size[32])
+{
+    int w = b->a->width, h = b->a->height;
+    rl_status st = reference(b, w, h, b->threads, MODE_ALL, ref);
+    if (st != RL_OK)
+        return st;
+    snprintf(size, 32, "%dx%d", w, h);
+    cJSON_AddStringToObject(sec, "scene", table_spec(b));
+    cJSON_AddStringToObject(sec, "size", size);
+    if (with_ref)
+        cJSON_AddItemToObject(sec, "whitted", ref_json(*ref));
+    return RL_OK;
+}
+
 static void nan_metrics(rl_image_metrics *m)
 {
     *m = (rl_image_metrics){ .rmse = NAN, .psnr = NAN, .ssim = NAN, .max_abs = NAN };
@@ -482,14 +499,10 @@ static rl_status sec_criteria(void *ctx, cJSON *sec)
     bvt *b = ctx;
     int w = b->a->width, h = b->a->height;
     ref_frame *ref = NULL;
-    rl_status st = reference(b, w, h, b->threads, MODE_ALL, &ref);
+    char size[32];
+    rl_status st = table_section(b, sec, true, &ref, size);
     if (st != RL_OK)
         return st;
-    cJSON_AddStringToObject(sec, "scene", table_spec(b));
-    char size[32];
-    snprintf(size, sizeof size, "%dx%d", w, h);
-    cJSON_AddStringToObject(sec, "size", size);
-    cJSON_AddItemToObject(sec, "whitted", ref_json(ref));
     cJSON *rows = cJSON_AddArrayToObject(sec, "runs");
 
     rl_renderer *r = NULL;
@@ -703,14 +716,10 @@ static rl_status sec_quality(void *ctx, cJSON *sec)
     enum { NUM_CRITS = sizeof crits / sizeof crits[0], NUM_EDGES = sizeof min_edges / sizeof min_edges[0] };
     int w = b->a->width, h = b->a->height;
     ref_frame *ref = NULL;
-    rl_status st = reference(b, w, h, b->threads, MODE_ALL, &ref);
+    char size[32];
+    rl_status st = table_section(b, sec, true, &ref, size);
     if (st != RL_OK)
         return st;
-    char size[32];
-    snprintf(size, sizeof size, "%dx%d", w, h);
-    cJSON_AddStringToObject(sec, "scene", table_spec(b));
-    cJSON_AddStringToObject(sec, "size", size);
-    cJSON_AddItemToObject(sec, "whitted", ref_json(ref));
     add_num(sec, "ssim_goal", SSIM_GOAL);
     add_num(sec, "time_ratio_goal", TIME_RATIO_GOAL);
 
@@ -908,13 +917,10 @@ static rl_status sec_visibility(void *ctx, cJSON *sec)
     };
     int w = b->a->width, h = b->a->height;
     ref_frame *ref = NULL;
-    rl_status st = reference(b, w, h, b->threads, MODE_ALL, &ref);
+    char size[32];
+    rl_status st = table_section(b, sec, false, &ref, size);
     if (st != RL_OK)
         return st;
-    char size[32];
-    snprintf(size, sizeof size, "%dx%d", w, h);
-    cJSON_AddStringToObject(sec, "scene", table_spec(b));
-    cJSON_AddStringToObject(sec, "size", size);
     cJSON *rows = cJSON_AddArrayToObject(sec, "runs");
     rl_renderer *r = NULL;
     rl_image *img = NULL;
@@ -1057,14 +1063,10 @@ static rl_status sec_forced(void *ctx, cJSON *sec)
     } settings[] = { { "tree+hsv", 1 }, { "hsv", 14 } };
     int w = b->a->width, h = b->a->height;
     ref_frame *ref = NULL;
-    rl_status st = reference(b, w, h, b->threads, MODE_ALL, &ref);
+    char size[32];
+    rl_status st = table_section(b, sec, true, &ref, size);
     if (st != RL_OK)
         return st;
-    char size[32];
-    snprintf(size, sizeof size, "%dx%d", w, h);
-    cJSON_AddStringToObject(sec, "scene", table_spec(b));
-    cJSON_AddStringToObject(sec, "size", size);
-    cJSON_AddItemToObject(sec, "whitted", ref_json(ref));
     cJSON *rows = cJSON_AddArrayToObject(sec, "runs");
     rl_renderer *r = NULL;
     rl_image *img = NULL;
@@ -1285,14 +1287,10 @@ static rl_status sec_reduction(void *ctx, cJSON *sec)
     static const double merges[] = { 0.0, 0.5, 1.0, 2.0 };
     int w = b->a->width, h = b->a->height;
     ref_frame *ref = NULL;
-    rl_status st = reference(b, w, h, b->threads, MODE_ALL, &ref);
+    char size[32];
+    rl_status st = table_section(b, sec, true, &ref, size);
     if (st != RL_OK)
         return st;
-    char size[32];
-    snprintf(size, sizeof size, "%dx%d", w, h);
-    cJSON_AddStringToObject(sec, "scene", table_spec(b));
-    cJSON_AddStringToObject(sec, "size", size);
-    cJSON_AddItemToObject(sec, "whitted", ref_json(ref));
     cJSON *rows = cJSON_AddArrayToObject(sec, "runs");
     rl_camera cam = sized(&b->table_cam, w, h);
     rl_image *img = NULL;
@@ -1427,13 +1425,10 @@ static rl_status sec_overdraw(void *ctx, cJSON *sec)
     static const double fs[] = { 0.0, 1e-5, 1e-4, 1e-3, 1e-2 };
     int w = b->a->width, h = b->a->height;
     ref_frame *ref = NULL;
-    rl_status st = reference(b, w, h, b->threads, MODE_ALL, &ref);
+    char size[32];
+    rl_status st = table_section(b, sec, false, &ref, size);
     if (st != RL_OK)
         return st;
-    char size[32];
-    snprintf(size, sizeof size, "%dx%d", w, h);
-    cJSON_AddStringToObject(sec, "scene", table_spec(b));
-    cJSON_AddStringToObject(sec, "size", size);
     cJSON *rows = cJSON_AddArrayToObject(sec, "runs");
     rl_camera cam = sized(&b->table_cam, w, h);
     rl_image *redraw_img = NULL, *over_img = NULL;
@@ -1541,14 +1536,10 @@ static rl_status sec_equal_rays(void *ctx, cJSON *sec)
     bvt *b = ctx;
     int w = b->a->width, h = b->a->height;
     ref_frame *ref = NULL;
-    rl_status st = reference(b, w, h, b->threads, MODE_ALL, &ref);
+    char size[32];
+    rl_status st = table_section(b, sec, true, &ref, size);
     if (st != RL_OK)
         return st;
-    char size[32];
-    snprintf(size, sizeof size, "%dx%d", w, h);
-    cJSON_AddStringToObject(sec, "scene", table_spec(b));
-    cJSON_AddStringToObject(sec, "size", size);
-    cJSON_AddItemToObject(sec, "whitted", ref_json(ref));
     cJSON *rows = cJSON_AddArrayToObject(sec, "runs");
     double rho = (double)rays_total(&ref->stats) / ((double)w * h);
     rl_camera cam = sized(&b->table_cam, w, h);

@@ -178,7 +178,7 @@ expect_usage_error "$RL" --max-texture-pixels 0 render "$TMP/texq.obj" --size 32
 rm -f "$OUT"
 expect_bounded_error 1 "a 16384x16384 frame of raster needs about 7.00 GiB, more than the 1.00 GiB of --max-memory" \
     "$RL" render cornell --size 16384x16384 --max-memory 1G --out "$OUT"
-expect_bounded_error 1 "16384x16384 frame of pt needs about 41" "$RL" render cornell --algo pt --size 16384x16384 \
+expect_bounded_error 1 "16384x16384 frame of pt needs about 47" "$RL" render cornell --algo pt --size 16384x16384 \
     --max-memory 1G --out "$OUT"
 cat >"$TMP/bigcam.json" <<'JSON'
 { "objects": [ { "generator": "teapot" } ],
@@ -195,7 +195,7 @@ expect_bounded_error 1 "16384x16384 frame" "$RL" render "$TMP/bigcam.json" --cam
 [ ! -e "$OUT" ] || fail "a refused frame still wrote $OUT"
 expect_usage_error "$RL" render cornell --max-memory 1X --out "$OUT"
 # rl bench pt checks its frame at --size against its --max-memory (GB) too.
-expect_bounded_error 1 "16384x16384 frame of pt needs about 39.00 GiB, more than the 1.00 GiB" "$RL" bench pt --size 16384x16384 --max-memory 1 \
+expect_bounded_error 1 "16384x16384 frame of pt needs about 45.00 GiB, more than the 1.00 GiB" "$RL" bench pt --size 16384x16384 --max-memory 1 \
     --out "$TMP/bench_huge.json"
 [ ! -e "$TMP/bench_huge.json" ] || fail "a refused benchmark still wrote its record"
 run_ok "$RL" render cornell --size 32x24 --max-memory 64M --out "$OUT"
