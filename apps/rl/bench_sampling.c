@@ -82,7 +82,8 @@ static const char bench_sampling_help[] =
     "                    variants other than bnc-region; default 5 and 0.05/m\n"
     "                    (the thesis, Sec. 5.4.2)\n"
     "  --threads N       workers; default all\n"
-    "  --only A,B        sections: variants, convergence, throughput\n"
+    "  --only A,B        sections: variants, convergence, throughput (under\n"
+    "                    rl --dist: variants and convergence; docs/distributed.md)\n"
     "  --out FILE.json   default bench/results/sampling-YYYYMMDD-HHMMSS.json\n"
     "  --quick           tiny run (cornell, resolution 32, 16/48 samples,\n"
     "                    64 validation points): a smoke test\n"
@@ -196,6 +197,52 @@ static rl_status errors(const rl_approx *ap, const rl_vec3 *pos, const double *m
     return st;
 }
 
+/* The validation values: under --dist measured on every rank (the
+ * sampling nodes of Jähn 2015, Alg. 5.4, for positions chosen beforehand). */
+static rl_status measure_validation(rl_property *vis, const rl_vec3 *pos, size_t n, double **values)
+{
+    if (cli_dist_ranks() == 1)
+        return eval_measure(vis, pos, n, values, NULL);
+    double *v = malloc((n ? n : 1) * sizeof *v);
+    rl_status st = cli_measure_call(v ? vis : NULL, pos, n, v);
+    if (st != RL_OK || !v) {
+        free(v);
+        return v ? st : RL_ERR_OUT_OF_MEMORY;
+    }
+    *values = v;
+    return RL_OK;
+}
+
+/* A sampling node under --dist: the collective calls of sec_variants and
+ * sec_convergence in their order, every position measured for the control
+ * node, which keeps the approximations, computes and writes. A failure on
+ * the control node reaches every node through the call it was in (or the
+ * job ends with the control node's error). */
+static rl_status serve_sections(const bs_ctx *c)
+{
+    const bs_args *a = c->a;
+    rl_status st = RL_OK;
+    if (a->sections & (1u << SEC_VARIANTS))
+        for (int r = 0; r < 4 && st == RL_OK; r++) {
+            rl_sampling_desc d = base_desc(c, 2 + r / 2, r % 2);
+            if ((st = cli_measure_call(c->vis, NULL, 0, NULL)) != RL_OK)
+                break;
+            for (int ci = 0; ci < a->num_counts && st == RL_OK; ci++)
+                for (int k = 0; k < NUM_VARIANTS && st == RL_OK; k++)
+                    for (int seed = 1; k != V_GRID_IDW && seed <= variant_seeds(a, k) && st == RL_OK; seed++) {
+                        rl_approx *none = NULL;
+                        st = cli_sample_call(c->vis, &d, &none);
+                    }
+        }
+    if (a->sections & (1u << SEC_CONVERGENCE))
+        for (int i = 0; i < (a->quick ? 3 : 6) && st == RL_OK; i++) {
+            rl_sampling_desc d = base_desc(c, 3, false);
+            rl_approx *none = NULL;
+            st = cli_sample_call(c->vis, &d, &none);
+        }
+    return st;
+}
+
 static rl_status sec_variants(void *ctx, cJSON *sec)
 {
     bs_ctx *c = ctx;
@@ -229,7 +276,7 @@ static rl_status sec_variants(void *ctx, cJSON *sec)
                 return RL_ERR_OUT_OF_MEMORY;
             note("%dD %s region: measuring %zu validation points", dims,
                  doubled ? "doubled" : "tight", nv);
-            st = eval_measure(c->vis, pos, nv, &measured, NULL);
+            st = measure_validation(c->vis, pos, nv, &measured);
             if (st != RL_OK) {
                 free(pos);
                 return st;
@@ -261,7 +308,7 @@ static rl_status sec_variants(void *ctx, cJSON *sec)
                             grid_ap = NULL;
                             st = rl_approx_set_interpolation(ap, RL_INTERP_IDW, 0);
                         } else {
-                            st = rl_sample_property(c->vis, &dk, &ap);
+                            st = cli_sample_call(c->vis, &dk, &ap);
                         }
                         double secs = k == V_GRID_IDW ? grid_secs : rl_time_s() - t0;
                         rl_stats es;
@@ -347,7 +394,7 @@ static rl_status sec_convergence(void *ctx, cJSON *sec)
         d.positions = RL_POSITIONS_BLUE_NOISE_CORNERS;
         d.max_samples = (uint32_t)counts[i];
         rl_approx *ap = NULL;
-        rl_status st = rl_sample_property(c->vis, &d, &ap);
+        rl_status st = cli_sample_call(c->vis, &d, &ap);
         double *v = NULL, *w = NULL;
         size_t m = 0;
         rl_stats s;
@@ -517,8 +564,11 @@ int bench_sampling(int argc, char **argv)
     int rc = parse_args(argc, argv, &a);
     if (rc != RL_CLI_OK)
         return rc == RL_BENCH_HELP_SHOWN ? RL_CLI_OK : rc;
+    if (cli_dist_active() && (a.sections & (1u << SEC_THROUGHPUT)))
+        return cli_fail(RL_CLI_USAGE, "--dist: the throughput section measures this machine's samples/s and "
+                                      "does not run distributed; choose --only variants,convergence");
     char out[4096];
-    if (!bench_out_path(a.out, "sampling", out, sizeof out))
+    if (cli_dist_master() && !bench_out_path(a.out, "sampling", out, sizeof out))
         return RL_CLI_FAIL;
     bs_ctx c = { .a = &a };
     if ((rc = cli_load_scene(a.scene, &c.scene)) != RL_CLI_OK)
@@ -540,6 +590,13 @@ int bench_sampling(int argc, char **argv)
         rl_scene_release(c.scene);
         return cli_fail_status(RL_CLI_FAIL, st, "visibility property");
     }
+    if (!cli_dist_master()) {
+        /* --dist: a sampling node; the control node prints and writes. */
+        st = serve_sections(&c);
+        rl_property_release(c.vis);
+        rl_scene_release(c.scene);
+        return st == RL_OK ? RL_CLI_OK : cli_fail_status(RL_CLI_FAIL, st, "sampling node");
+    }
     int threads = rl_property_workers(c.vis);
     cJSON *root = bench_record_json("sampling", threads);
     cJSON *params = cJSON_AddObjectToObject(root, "parameters");
@@ -554,6 +611,12 @@ int bench_sampling(int argc, char **argv)
     cJSON_AddNumberToObject(params, "samples_base", a.samples_base > 0.0 ? a.samples_base : 5.0);
     cJSON_AddNumberToObject(params, "samples_per_meter", a.samples_per_meter > 0.0 ? a.samples_per_meter : 0.05);
     cJSON_AddNumberToObject(params, "height_above_floor", a.height);
+    if (cli_dist_ranks() > 1) {
+        /* Under --dist: the "seconds" are this job's, every other value one process's. */
+        cJSON *dist = cJSON_AddObjectToObject(root, "dist");
+        if (dist)
+            cJSON_AddNumberToObject(dist, "ranks", cli_dist_ranks());
+    }
     cJSON *thesis = cJSON_AddObjectToObject(root, "thesis");
     cJSON_AddStringToObject(thesis, "scene", "Power Plant, 1171 objects, 22 ms per sample at 1024^2");
     cJSON_AddStringToObject(thesis, "finding", "grid better only for 3-D, 1024 samples, small "

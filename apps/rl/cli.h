@@ -99,6 +99,8 @@ double cli_available_memory(void);
 int cli_dist_begin(int *argc, char ***argv);
 int cli_dist_end(int rc);
 bool cli_dist_master(void);
+/* Whether this run is under --dist (a job of one included). */
+bool cli_dist_active(void);
 rl_status cli_render_call(rl_renderer *r, const rl_scene *scene, const rl_camera *cam, rl_image *img,
                           rl_render_stats *stats);
 /* The job's ranks (1 without --dist) and a progressive renderer's frames
@@ -110,6 +112,12 @@ rl_status cli_render_frames_call(rl_renderer *r, const rl_scene *scene, const rl
 /* rl_sample_property, with the job's ranks as sampling nodes under --dist
  * (the approximation on the master; NULL on the workers). */
 rl_status cli_sample_call(rl_property *p, const rl_sampling_desc *desc, rl_approx **out);
+/* rl_property_measure at positions chosen beforehand, over the job's ranks
+ * under --dist (rl_dist_measure): the master passes the positions and gets
+ * the values, the workers pass NULL, 0, NULL. Every rank calls it for
+ * every property, p NULL where its commit failed, so that they stay in
+ * step. */
+rl_status cli_measure_call(rl_property *p, const rl_vec3 *pos, size_t count, double *values);
 /* The last distributed frame's or sampling's ranks and per-rank work (master only). */
 void cli_print_dist_summary(FILE *out);
 /* The same as JSON for stats files (rl bench dist reads it): ranks,

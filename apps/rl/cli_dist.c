@@ -37,6 +37,11 @@ int cli_dist_end(int rc)
     return rc;
 }
 
+bool cli_dist_active(void)
+{
+    return dist != NULL;
+}
+
 bool cli_dist_master(void)
 {
     return rl_dist_rank(dist) == 0;
@@ -72,6 +77,17 @@ rl_status cli_sample_call(rl_property *p, const rl_sampling_desc *desc, rl_appro
     if (!dist)
         return rl_sample_property(p, desc, out);
     rl_status st = rl_dist_sample_property(dist, p, desc, out, &last);
+    have_last = st == RL_OK && last.ranks > 1;
+    ran = st == RL_OK;
+    sampling = true;
+    return st;
+}
+
+rl_status cli_measure_call(rl_property *p, const rl_vec3 *pos, size_t count, double *values)
+{
+    if (!dist)
+        return rl_property_measure(p, pos, count, values, NULL, NULL);
+    rl_status st = rl_dist_measure(dist, p, pos, count, values, &last);
     have_last = st == RL_OK && last.ranks > 1;
     ran = st == RL_OK;
     sampling = true;

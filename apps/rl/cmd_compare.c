@@ -486,6 +486,13 @@ static cJSON *result_json(const compare_args *a, const rl_scene *scene, const rl
     cJSON_AddNumberToObject(root, "height", a->height);
     cJSON_AddNumberToObject(root, "fov_deg", a->fov_deg);
     cJSON_AddNumberToObject(root, "repeats", (double)a->repeats);
+    if (cli_dist_ranks() > 1) {
+        /* Where the measuring ran: the times are this job's (its ranks
+         * shared the machines), every other value is one process's. */
+        cJSON *dist = cJSON_AddObjectToObject(root, "dist");
+        if (dist)
+            cJSON_AddNumberToObject(dist, "ranks", cli_dist_ranks());
+    }
     cJSON *algos = cJSON_AddArrayToObject(root, "renderers");
     for (int i = 0; i < a->num_algos; i++) {
         cJSON *o = cJSON_CreateObject();
@@ -547,13 +554,18 @@ static int place_samples(compare_args *a, const rl_scene *scene, rl_approx **dri
     a->sampling.desc.progress = progress ? rl_progress_update : NULL;
     a->sampling.desc.progress_user = progress;
     if (st == RL_OK)
-        st = rl_sample_property(vis, &a->sampling.desc, driver);
+        st = cli_sample_call(vis, &a->sampling.desc, driver);
     if (progress)
         rl_progress_finish(progress);
     a->sampling.desc.progress = NULL;
     rl_property_release(vis);
     if (st != RL_OK)
         return cli_fail_status(RL_CLI_FAIL, st, "sampling");
+    if (!cli_dist_master()) {
+        *pos = NULL;         /* --dist: a sampling node; the positions stay on the control node */
+        *count = 0;
+        return RL_CLI_OK;
+    }
     uint32_t ns = rl_approx_sample_count(*driver);
     if (!(*pos = malloc((ns ? ns : 1) * sizeof **pos)))
         return cli_fail(RL_CLI_FAIL, "out of memory");
@@ -563,6 +575,26 @@ static int place_samples(compare_args *a, const rl_scene *scene, rl_approx **dri
     }
     *count = ns;
     return RL_CLI_OK;
+}
+
+/* One property at the positions: in this process, or under --dist on every
+ * rank (Jähn 2015, Alg. 5.4's sampling nodes for positions placed
+ * beforehand). Every rank takes part in every measuring, p NULL where its
+ * commit failed, so that the ranks stay in step; the workers get no values. */
+static rl_status measure_at(rl_property *p, const rl_vec3 *pos, uint32_t ns, double **values, const char *label)
+{
+    if (cli_dist_ranks() == 1)
+        return p ? eval_measure(p, pos, ns, values, label) : RL_ERR_INVALID_ARG;
+    if (!cli_dist_master())
+        return cli_measure_call(p, NULL, 0, NULL);
+    double *v = malloc((ns ? ns : 1) * sizeof *v);
+    rl_status st = cli_measure_call(v ? p : NULL, pos, ns, v);
+    if (st != RL_OK || !v) {
+        free(v);
+        return v ? st : RL_ERR_OUT_OF_MEMORY;
+    }
+    *values = v;
+    return RL_OK;
 }
 
 /* Every metric of every renderer at the positions, as an approximation over
@@ -587,11 +619,23 @@ static int measure_all(const compare_args *a, const rl_scene *scene, const rl_ap
             rl_timer_start(&phase);
             rl_status st = p ? rl_property_commit(p, scene, a->sampling.desc.workers) : RL_ERR_INVALID_ARG;
             r->prep_ms = rl_timer_ms(&phase);
-            if (st == RL_OK) {
+            if (st != RL_OK)
+                snprintf(r->error, sizeof r->error, "%s", *rl_last_error() ? rl_last_error() : rl_status_string(st));
+            if (st == RL_OK || cli_dist_ranks() > 1) {
                 cli_debug("timing: %s: build %.1f ms", label, r->prep_ms);
                 rl_timer_start(&phase);
-                st = eval_measure(p, pos, ns, &values, label);
+                rl_status mst = measure_at(st == RL_OK ? p : NULL, pos, ns, &values, label);
                 cli_debug("timing: %s: %u positions %.1f ms", label, ns, rl_timer_ms(&phase));
+                if (st == RL_OK && mst != RL_OK) {
+                    st = mst;
+                    snprintf(r->error, sizeof r->error, "%s",
+                             *rl_last_error() ? rl_last_error() : rl_status_string(st));
+                }
+            }
+            if (!cli_dist_master()) {
+                /* A sampling node: the control node reports (and warns). */
+                rl_property_release(p);
+                continue;
             }
             if (st == RL_OK)
                 st = rl_approx_with_values(driver, values, metric_names[m], rl_property_unit(p), &r->approx);
@@ -603,7 +647,9 @@ static int measure_all(const compare_args *a, const rl_scene *scene, const rl_ap
                 st = rl_stats_compute(v2, w2, n2, &r->stats);
             r->ok = st == RL_OK;
             if (!r->ok) {
-                snprintf(r->error, sizeof r->error, "%s", *rl_last_error() ? rl_last_error() : rl_status_string(st));
+                if (!*r->error)
+                    snprintf(r->error, sizeof r->error, "%s",
+                             *rl_last_error() ? rl_last_error() : rl_status_string(st));
                 fprintf(stderr, "rl: warning: %s: %s\n", label, r->error);
                 failures++;
             } else if (rl_log_get_level() >= RL_LOG_INFO) {
@@ -738,7 +784,7 @@ int cli_compare(int argc, char **argv)
         rc = cli_fail(RL_CLI_FAIL, "out of memory");
     if (rc == RL_CLI_OK)
         rc = check_metrics(&a);
-    if (rc == RL_CLI_OK && (!cli_make_dirs(a.out) || !cli_check_writable(report)))
+    if (rc == RL_CLI_OK && cli_dist_master() && (!cli_make_dirs(a.out) || !cli_check_writable(report)))
         rc = RL_CLI_FAIL;
     if (rc == RL_CLI_OK)
         cli_load_begin(&a.load, a.sampling.desc.workers > 0 ? a.sampling.desc.workers : cli_threads());
@@ -756,6 +802,8 @@ int cli_compare(int argc, char **argv)
     int failures = rc == RL_CLI_OK ? measure_all(&a, scene, driver, pos, ns, res) : 0;
     if (rc == RL_CLI_OK)
         cli_load_end(&a.load);
+    if (rc == RL_CLI_OK && !cli_dist_master())
+        goto done;          /* --dist: a sampling node; the control node writes */
     if (rc == RL_CLI_OK)
         rc = write_report(&a, scene, driver, ns, res, report, json_path);
     if (rc == RL_CLI_OK) {
@@ -765,6 +813,7 @@ int cli_compare(int argc, char **argv)
             rc = cli_fail(RL_CLI_FAIL, "%d measurement%s failed (see the warnings)", failures,
                           failures == 1 ? "" : "s");
     }
+done:
     if (res)
         for (int i = 0; i < MAX_ALGOS; i++)
             for (int m = 0; m < M_COUNT; m++)

@@ -49,7 +49,8 @@ static void print_usage(FILE *out)
             "  --plugin FILE   load renderers from a shared object (README, \"Your own renderer\")\n"
             "  --version       print the version\n"
             "  --dist          spread the work over the ranks of an MPI job: run as\n"
-            "                  mpirun -np N rl --dist render ... (docs/distributed.md)\n"
+            "                  mpirun -np N rl --dist render ... (also eval, compare,\n"
+            "                  bench sampling; docs/distributed.md)\n"
             "\n"
             "model files (OBJ, PLY, glTF, DAE, ...; also a JSON scene's \"file\") are imported\n"
             "with Assimp in a child process, so that a malformed file costs an error, not rl:\n"
@@ -195,9 +196,12 @@ int main(int argc, char **argv)
         if (strcmp(name, commands[i].name) == 0) {
             if (!dist)
                 return commands[i].run(n, argv);
-            if (strcmp(name, "render") != 0 && strcmp(name, "eval") != 0)
-                return cli_fail(RL_CLI_USAGE, "--dist: only rl render and rl eval run distributed so far "
-                                              "(docs/distributed.md)");
+            bool spreads = strcmp(name, "render") == 0 || strcmp(name, "eval") == 0 ||
+                           strcmp(name, "compare") == 0 ||
+                           (strcmp(name, "bench") == 0 && n > 1 && strcmp(argv[1], "sampling") == 0);
+            if (!spreads)
+                return cli_fail(RL_CLI_USAGE, "--dist: only rl render, eval, compare and bench sampling run "
+                                              "distributed so far (docs/distributed.md)");
             int rc = cli_dist_begin(NULL, NULL);
             return cli_dist_end(rc == RL_CLI_OK ? commands[i].run(n, argv) : rc);
         }

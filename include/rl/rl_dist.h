@@ -110,6 +110,18 @@ RL_API rl_status rl_dist_render_frames(rl_dist *d, rl_renderer *r, const rl_scen
 RL_API rl_status rl_dist_sample_property(rl_dist *d, rl_property *p, const rl_sampling_desc *desc, rl_approx **out,
                                          rl_dist_stats *dstats);
 
+/* The same sampling nodes for positions chosen beforehand (rl compare
+ * measures every renderer at the positions one sampling placed): count
+ * values of p at pos, measured in chunks on every rank, into values on
+ * the master (rl_property_measure there); the workers pass NULL pos and
+ * values, and any count. Collective: every rank calls it with the same
+ * property (scene and options). A rank whose property could not be
+ * committed passes NULL for p, so that the ranks stay in step: the call
+ * then fails on every rank. Times are this run's, as above. With one rank
+ * this is rl_property_measure. dstats may be NULL. */
+RL_API rl_status rl_dist_measure(rl_dist *d, rl_property *p, const rl_vec3 *pos, size_t count, double *values,
+                                 rl_dist_stats *dstats);
+
 #ifdef __cplusplus
 }
 #endif

@@ -77,3 +77,14 @@ rl_status rl_dist_sample_property(rl_dist *d, rl_property *p, const rl_sampling_
         *dstats = (rl_dist_stats){ .ranks = 1 };
     return rl_sample_property(p, desc, out);
 }
+
+rl_status rl_dist_measure(rl_dist *d, rl_property *p, const rl_vec3 *pos, size_t count, double *values,
+                          rl_dist_stats *dstats)
+{
+    (void)d;
+    if (dstats)
+        *dstats = (rl_dist_stats){ .ranks = 1 };
+    if (!p)
+        return rl_error(RL_ERR_INVALID_ARG, "rl_dist_measure: no property");
+    return rl_property_measure(p, pos, count, values, NULL, NULL);
+}

@@ -257,6 +257,19 @@ static rl_status serve(const rl_dist *d, rl_property *p)
     return st;
 }
 
+/* The control node ends a run: every worker gets its status (DONE). */
+static rl_status end_run(sampler *s, rl_status st)
+{
+    int32_t done = (int32_t)st;
+    for (int w = 1; w < s->d->size; ++w) {
+        int code = MPI_Send(&done, 1, MPI_INT32_T, w, RL_DIST_TAG_DONE, MPI_COMM_WORLD);
+        ++s->messages;
+        if (code != MPI_SUCCESS && st == RL_OK)
+            st = rl_dist_mpi_failed(code, "ending the sampling");
+    }
+    return st;
+}
+
 rl_status rl_dist_sample_property(rl_dist *d, rl_property *p, const rl_sampling_desc *desc, rl_approx **out,
                                   rl_dist_stats *dstats)
 {
@@ -285,20 +298,57 @@ rl_status rl_dist_sample_property(rl_dist *d, rl_property *p, const rl_sampling_
         dd.measure = measure;
         dd.measure_user = &s;
         st = rl_sample_property(p, &dd, out);
-        int32_t done = (int32_t)st;
-        for (int w = 1; w < d->size; ++w) {
-            int code = MPI_Send(&done, 1, MPI_INT32_T, w, RL_DIST_TAG_DONE, MPI_COMM_WORLD);
-            ++s.messages;
-            if (code != MPI_SUCCESS && st == RL_OK) {
-                st = rl_dist_mpi_failed(code, "ending the sampling");
-                rl_approx_release(*out);
-                *out = NULL;
-            }
+        if ((st = end_run(&s, st)) != RL_OK) {
+            rl_approx_release(*out);
+            *out = NULL;
         }
         ds->tasks = s.chunks;
         ds->messages = s.messages;
         ds->bytes = s.bytes;
     } else {
+        st = serve(d, p);
+    }
+    ds->time_ms = rl_timer_ms(&t);
+    ds->per_rank = d->per_rank;
+    return st;
+}
+
+rl_status rl_dist_measure(rl_dist *d, rl_property *p, const rl_vec3 *pos, size_t count, double *values,
+                          rl_dist_stats *dstats)
+{
+    rl_dist_stats local;
+    rl_dist_stats *ds = dstats ? dstats : &local;
+    memset(ds, 0, sizeof *ds);
+    ds->ranks = rl_dist_size(d);
+    rl_timer t;
+    rl_timer_start(&t);
+    if (!d || d->size == 1) {
+        rl_status st1 = p ? rl_property_measure(p, pos, count, values, NULL, NULL)
+                          : rl_error(RL_ERR_INVALID_ARG, "rl_dist_measure: no property");
+        ds->time_ms = rl_timer_ms(&t);
+        return st1;
+    }
+    memset(d->per_rank, 0, (size_t)d->size * sizeof *d->per_rank);
+    rl_status st;
+    if (d->rank == 0) {
+        sampler s = { .d = d, .p = p };
+        /* Even a call that cannot measure ends the run on the workers,
+         * which wait in serve() for it. */
+        if (!p)
+            st = rl_error(RL_ERR_INVALID_ARG, "rl_dist_measure: no property");
+        else if (count && (!pos || !values))
+            st = rl_error(RL_ERR_INVALID_ARG, "rl_dist_measure: positions and values must not be NULL");
+        else if (count > UINT32_MAX)
+            st = rl_error(RL_ERR_LIMIT, "rl_dist_measure: %zu positions (at most %u)", count, UINT32_MAX);
+        else
+            st = count ? measure(&s, pos, (uint32_t)count, values, NULL, 0) : RL_OK;
+        st = end_run(&s, st);
+        ds->tasks = s.chunks;
+        ds->messages = s.messages;
+        ds->bytes = s.bytes;
+    } else {
+        /* A worker without the property answers every chunk with the
+         * error, so that the master ends the run for all. */
         st = serve(d, p);
     }
     ds->time_ms = rl_timer_ms(&t);

@@ -1,18 +1,19 @@
 #!/usr/bin/env bash
-# test_cli_dist.sh: rl --dist render and eval under mpirun (Open MPI,
-# issue 39). Three ranks, oversubscribed on the small CI machine, give the
-# same image, depth and IDs as one process, bit for bit, for single frames
-# and for a camera path, and the same sampled approximation; a renderer
-# without regions is refused on every rank; without
-# mpirun --dist is a job of one. Skips (saying why) where this rl was built
-# without MPI or mpirun is missing.
+# test_cli_dist.sh: rl --dist render, eval, compare and bench sampling
+# under mpirun (Open MPI, issue 39). Three ranks, oversubscribed on the
+# small CI machine, give the same image, depth and IDs as one process, bit
+# for bit, for single frames and for a camera path, and the same sampled
+# approximation and measured values; a renderer without regions is refused
+# on every rank; without mpirun --dist is a job of one. Skips (saying why)
+# where this rl was built without MPI or mpirun is missing.
 # Run as: bash test_cli_dist.sh <rl-binary> <scratch-dir>
 set -u
 . "$(dirname "${BASH_SOURCE[0]}")/lib.bash"
 
 # Not a distributed command: refused before MPI is touched.
-expect_usage_error "$RL" --dist compare cornell --algos raster,whitted
-grep -q "only rl render and rl eval run distributed" "$TMP/err" || fail "--dist compare: $(cat "$TMP/err")"
+expect_usage_error "$RL" --dist bench culling --quick --out "$TMP/bc.json"
+grep -q "only rl render, eval, compare and bench sampling run distributed" "$TMP/err" ||
+    fail "--dist bench culling: $(cat "$TMP/err")"
 
 # Open MPI keeps memory past MPI_Finalize in its runtime and components;
 # tests/lsan.supp names its libraries, which needs the components kept
@@ -78,6 +79,57 @@ assert a["set_size"] > 0 and len(a["samples"]) == 40, (a["set_size"], len(a["sam
 assert a == b
 PY
 [ ! -e "$TMP/e3/report.html" ] || [ "$(grep -c . "$TMP/e3/report.html")" -gt 0 ] || fail "empty report"
+
+# rl compare and rl bench sampling: the positions placed beforehand (every
+# renderer's, the validation points) are measured on every rank too. All
+# but the times and the run's own record (command, date, load) is the
+# one-process result; the time metric and prep_ms measure the machine.
+CMP=(compare cornell --algos raster,whitted:max_depth=2 --samples 12 --resolution 8 --size 24x16 --seed 3)
+run_ok "$RL" "${CMP[@]}" --out "$TMP/c1"
+run_ok "${MPI[@]}" "$RL" --dist "${CMP[@]}" --out "$TMP/c3"
+[ "$(grep -c '^compared 2 renderers at 12 positions' "$TMP/out")" -eq 1 ] || fail "compare: $(cat "$TMP/out")"
+python3 - "$TMP/c1/compare.json" "$TMP/c3/compare.json" <<'PY' || fail "compare: 3 ranks differ from one process"
+import json, sys
+a, b = (json.load(open(f)) for f in sys.argv[1:3])
+assert "dist" not in a and b.pop("dist") == {"ranks": 3}
+for r in a, b:
+    for k in "experiment", "load":
+        r.pop(k)
+    for e in r["renderers"]:
+        assert e.pop("time")["mean"] > 0, e
+        for m in e.values():
+            if isinstance(m, dict):
+                assert m.pop("prep_ms") >= 0 and "error" not in m, m
+assert len(a["positions"]) == 12 and a["renderers"][1]["rays"]["mean"] > 0, a
+assert a == b
+PY
+BS=(bench sampling --quick --only variants,convergence)
+run_ok "$RL" "${BS[@]}" --out "$TMP/bs1.json"
+run_ok "${MPI[@]}" "$RL" --dist "${BS[@]}" --out "$TMP/bs3.json"
+python3 - "$TMP/bs1.json" "$TMP/bs3.json" <<'PY' || fail "bench sampling: 3 ranks differ from one process"
+import json, sys
+a, b = (json.load(open(f)) for f in sys.argv[1:3])
+assert "dist" not in a and b.pop("dist") == {"ranks": 3}
+def drop_seconds(o):
+    if isinstance(o, dict):
+        o.pop("seconds", None)
+        for v in o.values():
+            drop_seconds(v)
+    elif isinstance(o, list):
+        for v in o:
+            drop_seconds(v)
+for r in a, b:
+    for k in "command", "date", "machine":
+        r.pop(k)
+    drop_seconds(r)
+assert len(a["variants"]["cases"]) == 8 and len(a["convergence"]["rows"]) == 3, a
+assert a == b
+PY
+# Its throughput section is samples/s of this machine: refused under --dist.
+expect_usage_error "$RL" --dist bench sampling --quick --only throughput --out "$TMP/bst.json"
+grep -q "^rl: error: --dist: the throughput section measures this machine's samples/s" "$TMP/err" ||
+    fail "--dist bench sampling throughput: $(cat "$TMP/err")"
+[ ! -e "$TMP/bst.json" ] || fail "a refused bench sampling wrote a record"
 
 # Fault tolerance (docs/distributed.md). With Open MPI's recovery on, the
 # job outlives a rank: rank 2 kills itself (SIGKILL, RL_DIST_FAULT) after
