@@ -346,7 +346,8 @@ static void test_gl_pt_gpu_build_refuses_records(void **state)
     for (int k = 0; k < 2; ++k) {
         rl_camera cam;
         rl_scene *s = scene_and_camera("cornell", NULL, &cam);
-        rl_renderer *r = fx_make("gl-pt", (const char *const[]){ "ls_build", "gpu", "diffuse", payload[k], "ls_n", "3", NULL });
+        rl_renderer *r =
+            fx_make("gl-pt", (const char *const[]){ "ls_build", "gpu", "diffuse", payload[k], "ls_n", "3", NULL });
         rl_image *img = NULL;
         assert_int_equal(rl_image_create(SIZE, SIZE, RL_LAYER_COLOR, &img), RL_OK);
         rl_clear_error();
