@@ -8,7 +8,10 @@
  * records, 3 texels, 4 triangles (three vertex indices and the material),
  * 5 positions, 6 normals, 7 uvs, 8 BVH nodes, 9 BVH triangles, 10 grid cell
  * offsets, 11 grid cell lists, 12 light table, 13 per-triangle light data,
- * 14 and 15 the ray set and hits of rl_gl_pt_trace.
+ * 14 and 15 the ray set and hits of rl_gl_pt_trace. Of these, 3, 5, 6, 7,
+ * 12 and 13 are read as buffer textures (units 0-5, tex_buffers below), so
+ * that the path program stays within 16 storage blocks with the Line
+ * Space's 8 at 16-23 (rl_gl_pt_set_linespace, gl_linespace.h).
  *
  * The BVH is accel/bvh_build.c's binary tree as built (the CPU traversal
  * then collapses it into a wide tree, which a GPU thread gains nothing
@@ -633,7 +636,7 @@ rl_status rl_gl_pt_render(rl_gl_pt *pt, const rl_gl_pt_frame *frame, float *rgba
         return rl_error(RL_ERR_INVALID_ARG, "rl_gl_pt_render: NULL argument");
     if (frame->cam.width < 1 || frame->cam.height < 1 || frame->spp < 1 || frame->light_samples < 1 ||
         (unsigned)frame->shadow >= RL_GL_PT_STRUCTURE_COUNT || (unsigned)frame->diffuse >= RL_GL_PT_STRUCTURE_COUNT ||
-        (unsigned)frame->specular >= RL_GL_PT_STRUCTURE_COUNT || frame->specular == RL_GL_PT_LS_PREILLUM ||
+        (unsigned)frame->specular >= RL_GL_PT_STRUCTURE_COUNT ||
         frame->rng < 0 || frame->rng > 3)
         return rl_error(RL_ERR_INVALID_ARG, "rl_gl_pt_render: bad frame settings");
     if (pt->samples + (uint64_t)frame->spp > UINT32_MAX)

@@ -11,8 +11,8 @@
  * uniform grid of accel/grid.h is built and uploaded on the first use of
  * RL_GL_PT_GRID (and again for another grid_res).
  *
- * Bindings: shader storage 0-15 and image units 0-1 are gl-pt's; 16-23
- * stay free for the Line Space (docs/gl.md).
+ * Bindings: shader storage 0-15, texture units 0-5 and image units 0-1
+ * are gl-pt's; storage 16-23 the Line Space's (gl_linespace.h, docs/gl.md).
  *
  * A tracer owns its own GL context (gl_context.h), current on the calling
  * thread for the length of one call: calls must not overlap, but

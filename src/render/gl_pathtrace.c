@@ -3,7 +3,7 @@
  * runs it on the GPU (Ch. 5, 6): one thread per pixel, the per-pixel
  * generator states in an image (Sec. 5.3), progressive accumulation in an
  * rgba32f image (Sec. 6.5, eq. 8), shadow and secondary rays through the
- * BVH or the uniform grid (Sec. 5.4).
+ * BVH, the uniform grid (Sec. 5.4) or the Line Space (Sec. 7).
  *
  * Same estimator as pt: this file builds what pt builds on the CPU for it
  * (pathtrace_backend.c: the ray offset, the covering quad light of every

@@ -285,6 +285,7 @@ static void test_gl_pt_line_space_draws_pts_numbers(void **state)
         { "cornell", NULL, "ls-pnmt", "ls-pnmt", "ls_origin", "exact" },
         { "cornell", NULL, "ls-preillum", "ls-preillum", "ls_origin", "offset" },
         { "cornell", NULL, "bvh", "ls-preillum", "mis", "off" },
+        { "spheres", "segments=16,checks=4", "ls-candidates", "ls-preillum", "specular", "diffuse" },
         { "spheres", "segments=16,checks=4", "ls-pnmt", "ls-pnmt", "specular", "exact" },
         { "spheres", "segments=16,checks=4", "grid", "ls-pnmt", "specular", "diffuse" },
     };
