@@ -59,12 +59,18 @@ step 30 "rl bench surfels, atlas" "$rl" bench surfels --only atlas --atlas-runs 
 # texture mode, table at 512x512 (issue 35, part 5).
 step 30 "rl bench vt, reconstruct" "$rl" bench vt --only reconstruct --size 512x512 \
     --out "$out/gpu-$date-vt-reconstruct.json"
-# Schröder 2017, Diagram 1's setting: gl-pt (BVH; the Line Space backends
-# are not ported to GL yet) at 1280x720, 1 spp per frame, on the Cornell
-# box and Cornell + bunny: frames per second. gl-pt alone: pt at this size
-# would take seconds per frame.
-step 30 "rl bench gl, gl-pt 1280x720" "$rl" bench gl --only pt --pt-gl-only --pt-size 1280x720 --frames 10 \
+# Schröder 2017, Diagram 1's setting: gl-pt at 1280x720, 1 spp per frame,
+# on the Cornell box and Cornell + bunny, frames per second; first with the
+# BVH, then with Diagram 1's structure (shadow=ls-pnmt diffuse=ls-pnmt, the
+# CPU build uploaded) at 32^3 voxels: the thesis' 64^3 for the bunny makes
+# 3.9 GB of PNMT records, past what one GL storage block holds. gl-pt
+# alone: pt at this size would take seconds per frame. The two share the
+# step's former 30 s.
+step 12 "rl bench gl, gl-pt 1280x720, BVH" "$rl" bench gl --only pt --pt-gl-only --pt-size 1280x720 --frames 10 \
     --scenes cornell,ls-cornell:model=bunny --out "$out/gpu-$date-gl-pt.json"
+step 18 "rl bench gl, gl-pt 1280x720, ls-pnmt" "$rl" bench gl --only pt --pt-gl-only --pt-size 1280x720 \
+    --frames 5 --pt-backend ls-pnmt --pt-grid-res 32 --scenes cornell,ls-cornell:model=bunny \
+    --out "$out/gpu-$date-gl-pt-ls-pnmt.json"
 # Schröder 2017, Table 1: Line Space generation on the GPU (compute
 # shaders, the same lists as the CPU build) against the CPU build, all 8
 # rows, the thesis' GTX 1080 times beside; the target is >= 3x faster than

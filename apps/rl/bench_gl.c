@@ -79,6 +79,10 @@ static const char bench_gl_help[] =
     "  --pt-size WxH     pt: image size; default 256x256\n"
     "  --pt-spp N        pt: samples per pixel and frame of both; default 1\n"
     "  --pt-gl-only      pt: time gl-pt alone (no pt frames to wait for)\n"
+    "  --pt-backend A,B  pt: rows per backend of both (shadow and diffuse rays):\n"
+    "                    bvh, grid, ls-candidates, ls-pnmt, ls-preillum; default bvh\n"
+    "  --pt-grid-res N   pt: voxels per axis of the grid and the Line Space (0: the\n"
+    "                    grid heuristic); default 0\n"
     "  --only A,B        sections: frames, visibility, pt, linespace\n"
     "  --out FILE.json   default bench/results/gl-YYYYMMDD-HHMMSS.json\n"
     "  --quick           tiny run: cornell and spheres, 160x120, 2 frames,\n"
@@ -92,15 +96,21 @@ enum { SEC_FRAMES, SEC_VISIBILITY, SEC_PT, SEC_LINESPACE, SEC_COUNT };
 static const char *const section_names[SEC_COUNT] = { "frames", "visibility", "pt", "linespace" };
 
 #define MAX_SCENES 16
+#define PT_MAX_BACKENDS 5
+static const char *const pt_backend_names[PT_MAX_BACKENDS] = { "bvh", "grid", "ls-candidates", "ls-pnmt",
+                                                               "ls-preillum" };
 
 typedef struct bgl_args {
     const char *scenes_text, *out, *device;
     int width, height;
     int pt_width, pt_height;
-    long long frames, resolution, positions, pt_spp, ls_rows;
+    long long frames, resolution, positions, pt_spp, ls_rows, pt_grid_res;
     unsigned sections;
     bool quick;
     bool pt_gl_only;              /* pt: gl-pt alone (a GPU's fps at sizes where pt takes seconds) */
+    const char *pt_backend_text;  /* pt: the --pt-backend list */
+    const char *pt_backends[PT_MAX_BACKENDS];
+    int num_pt_backends;
 } bgl_args;
 
 typedef struct bgl_ctx {
@@ -179,6 +189,8 @@ static int parse_args(int argc, char **argv, bgl_args *a)
         RL_BENCH_SIZE("--pt-size", &a->pt_width, &a->pt_height, &has_pt_size),
         RL_BENCH_COUNT("--pt-spp", 65536, &a->pt_spp, &has_pt_spp),
         RL_BENCH_FLAG("--pt-gl-only", &a->pt_gl_only),
+        RL_BENCH_STRING("--pt-backend", &a->pt_backend_text),
+        RL_BENCH_COUNT("--pt-grid-res", 1024, &a->pt_grid_res, NULL),
         RL_BENCH_SECTIONS(section_names, SEC_COUNT, &a->sections),
         RL_BENCH_OUT(&a->out),
     };
@@ -201,6 +213,26 @@ static int parse_args(int argc, char **argv, bgl_args *a)
         a->pt_spp = 1;
     if (!has_rows)
         a->ls_rows = 1;
+    /* the names point into pt_backend_names, so they outlive the text */
+    const char *text = a->pt_backend_text ? a->pt_backend_text : "bvh";
+    for (const char *p = text; *p;) {
+        size_t len = strcspn(p, ",");
+        int found = -1;
+        for (int k = 0; k < PT_MAX_BACKENDS; ++k)
+            if (strlen(pt_backend_names[k]) == len && strncmp(p, pt_backend_names[k], len) == 0)
+                found = k;
+        if (found < 0 || a->num_pt_backends == PT_MAX_BACKENDS) {
+            fprintf(stderr, "rl: error: bench gl: --pt-backend %s: one to %d of bvh, grid, ls-candidates, "
+                    "ls-pnmt, ls-preillum\n", text, PT_MAX_BACKENDS);
+            return RL_CLI_USAGE;
+        }
+        a->pt_backends[a->num_pt_backends++] = pt_backend_names[found];
+        p += len + (p[len] == ',');
+    }
+    if (a->num_pt_backends == 0) {
+        fprintf(stderr, "rl: error: bench gl: --pt-backend is empty\n");
+        return RL_CLI_USAGE;
+    }
     if (!a->device)
         a->device = "";
     return RL_CLI_OK;
@@ -340,12 +372,18 @@ static rl_status sec_pt(void *ctx, cJSON *sec)
     cJSON *rows = cJSON_AddArrayToObject(sec, "rows");
     char spp[32];
     snprintf(spp, sizeof spp, "%lld", a->pt_spp);
-    const char *const opts[] = { "spp", spp, NULL };
     printf("\npt %dx%d, %s spp per frame: first frame (prep) and min of %lld warm frames, ms\n"
-           "%-24s %10s %14s %16s %10s %10s %8s %8s %10s\n", a->pt_width, a->pt_height, spp, a->frames, "scene",
-           "triangles", "pt first", "gl first (prep)", "pt", "gl-pt", "gl/cpu", "cpu", "gl-pt fps");
+           "%-24s %-14s %10s %14s %16s %10s %10s %8s %8s %10s\n", a->pt_width, a->pt_height, spp, a->frames,
+           "scene", "backend", "triangles", "pt first", "gl first (prep)", "pt", "gl-pt", "gl/cpu", "cpu",
+           "gl-pt fps");
     rl_status st = RL_OK;
-    for (int i = 0; i < c->num_scenes && st == RL_OK; ++i) {
+    for (int row = 0; row < c->num_scenes * a->num_pt_backends && st == RL_OK; ++row) {
+        const int i = row / a->num_pt_backends;
+        const char *backend = a->pt_backends[row % a->num_pt_backends];
+        /* the backend for shadow and diffuse rays, as Diagram 1 sets both */
+        char grid_res[32];
+        snprintf(grid_res, sizeof grid_res, "%lld", a->pt_grid_res);
+        const char *const opts[] = { "spp", spp, "shadow", backend, "diffuse", backend, "grid_res", grid_res, NULL };
         /* Path tracing every built-in scene would take minutes: cornell,
          * unless the scenes were named. */
         if (!a->scenes_text && strcmp(c->names[i], "cornell") != 0)
@@ -359,16 +397,17 @@ static rl_status sec_pt(void *ctx, cJSON *sec)
         cam.height = a->pt_height;
         frame_times cpu = { 0 }, gl = { 0 };
         if (!a->pt_gl_only) {
-            note("%s: pt", c->names[i]);
+            note("%s: pt, %s", c->names[i], backend);
             st = time_frames(c, "pt", opts, scene, &cam, &cpu);
         }
         if (st == RL_OK) {
-            note("%s: gl-pt", c->names[i]);
+            note("%s: gl-pt, %s", c->names[i], backend);
             st = time_frames(c, "gl-pt", opts, scene, &cam, &gl);
         }
         if (st == RL_OK) {
             cJSON *o = cJSON_CreateObject();
             cJSON_AddStringToObject(o, "scene", c->names[i]);
+            cJSON_AddStringToObject(o, "backend", backend);
             cJSON_AddNumberToObject(o, "triangles", rl_scene_get_data(scene)->num_triangles);
             if (!a->pt_gl_only) {
                 cJSON_AddItemToObject(o, "pt", frames_json(&cpu, a->frames));
@@ -381,16 +420,16 @@ static rl_status sec_pt(void *ctx, cJSON *sec)
             char first[40];
             snprintf(first, sizeof first, "%.1f (%.1f)", gl.first_ms, gl.first_prep_ms);
             if (a->pt_gl_only)
-                printf("%-24s %10u %14s %16s %10s %10.1f %8s %8s %10.2f\n", c->names[i],
+                printf("%-24s %-14s %10u %14s %16s %10s %10.1f %8s %8s %10.2f\n", c->names[i], backend,
                        rl_scene_get_data(scene)->num_triangles, "-", first, "-", gl.min_ms, "-", "-",
                        gl.min_ms > 0.0 ? 1e3 / gl.min_ms : 0.0);
             else
-                printf("%-24s %10u %14.1f %16s %10.1f %10.1f %8.2f %8.2f %10.2f\n", c->names[i],
+                printf("%-24s %-14s %10u %14.1f %16s %10.1f %10.1f %8.2f %8.2f %10.2f\n", c->names[i], backend,
                        rl_scene_get_data(scene)->num_triangles, cpu.first_ms, first, cpu.min_ms, gl.min_ms,
                        bench_ratio(gl.min_ms, cpu.min_ms), bench_ratio(gl.min_cpu_ms, cpu.min_cpu_ms),
                        gl.min_ms > 0.0 ? 1e3 / gl.min_ms : 0.0);
         } else {
-            snprintf(c->reason, sizeof c->reason, "%s: %s", c->names[i], rl_last_error());
+            snprintf(c->reason, sizeof c->reason, "%s, %s: %s", c->names[i], backend, rl_last_error());
         }
         free(cpu.warm_ms);
         free(gl.warm_ms);
@@ -714,6 +753,10 @@ int bench_gl(int argc, char **argv)
     cJSON_AddStringToObject(params, "pt_size", size);
     cJSON_AddNumberToObject(params, "pt_spp", (double)a.pt_spp);
     cJSON_AddBoolToObject(params, "pt_gl_only", a.pt_gl_only);
+    cJSON_AddNumberToObject(params, "pt_grid_res", (double)a.pt_grid_res);
+    cJSON *pt_backends = cJSON_AddArrayToObject(params, "pt_backends");
+    for (int k = 0; k < a.num_pt_backends; ++k)
+        cJSON_AddItemToArray(pt_backends, cJSON_CreateString(a.pt_backends[k]));
     cJSON_AddBoolToObject(params, "quick", a.quick);
     cJSON_AddNumberToObject(params, "ls_rows", (double)a.ls_rows);
     cJSON_AddStringToObject(params, "ls_note",

@@ -8,7 +8,10 @@
  * records, 3 texels, 4 triangles (three vertex indices and the material),
  * 5 positions, 6 normals, 7 uvs, 8 BVH nodes, 9 BVH triangles, 10 grid cell
  * offsets, 11 grid cell lists, 12 light table, 13 per-triangle light data,
- * 14 and 15 the ray set and hits of rl_gl_pt_trace.
+ * 14 and 15 the ray set and hits of rl_gl_pt_trace. Of these, 3, 5, 6, 7,
+ * 12 and 13 are read as buffer textures (units 0-5, tex_buffers below), so
+ * that the path program stays within 16 storage blocks with the Line
+ * Space's 8 at 16-23 (rl_gl_pt_set_linespace, gl_linespace.h).
  *
  * The BVH is accel/bvh_build.c's binary tree as built (the CPU traversal
  * then collapses it into a wide tree, which a GPU thread gains nothing
@@ -31,6 +34,7 @@
 
 #include "accel/bvh.h"
 #include "accel/grid.h"
+#include "gl/gl_linespace.h"
 #include "gl/gl_shaders.h"
 #include "scene/masks.h"
 
@@ -43,12 +47,33 @@ enum {
     B_COUNT
 };
 
+/* The arrays the shaders read as buffer textures (gl_pt_shaders.c: a
+ * compute shader has 16 storage blocks, the Line Space takes 8), by
+ * texture unit, with the buffer and the texel format. */
+enum { T_POSITIONS = 0, T_NORMALS, T_UVS, T_TEXELS, T_LIGHT_TABLE, T_TRI_LIGHT, T_COUNT };
+static const struct {
+    int buffer;
+    GLenum format;
+    unsigned texel_bytes;
+} tex_buffers[T_COUNT] = {
+    { B_POSITIONS, GL_R32F, 4 }, { B_NORMALS, GL_R32F, 4 }, { B_UVS, GL_R32F, 4 },
+    { B_TEXELS, GL_RGBA32F, 16 }, { B_LIGHT_TABLE, GL_RG32UI, 8 }, { B_TRI_LIGHT, GL_RG32UI, 8 },
+};
+
+static bool buffer_texture(GLuint b)
+{
+    for (int t = 0; t < T_COUNT; ++t)
+        if ((GLuint)tex_buffers[t].buffer == b)
+            return true;
+    return false;
+}
+
 /* The uniforms of a program, by name once. */
 typedef struct uniforms {
     GLint num_nodes, masks, grid_min, grid_cell, grid_inv_cell, grid_res;
     GLint size, eye, cam_u, cam_v, cam_w, tan_half_fov, aspect, rng, sample, max_depth, rr_depth, rr, mis,
         mis_hits, tri_lights, light_samples, vertex_slots, num_lights, table_count, num_textures, eps,
-        background, shadow, diffuse;
+        background, shadow, diffuse, specular, ls_start, ls_offset;
     GLint count, structure, any;
 } uniforms;
 
@@ -63,11 +88,15 @@ struct rl_gl_pt {
     GLuint path_prog, rays_prog;
     uniforms pu, ru;
     GLuint buf[B_COUNT];
+    GLuint tex[T_COUNT];
     /* the grid, built on first use */
     bool have_grid;
     int grid_res;
     rl_vec3 grid_min, grid_cell, grid_inv_cell;
     int grid_dims[3];
+    /* the Line Space of the LS structures (rl_gl_pt_set_linespace) */
+    rl_gl_ls *ls;
+    unsigned ls_payloads;
     /* the accumulation */
     GLuint tex_accum, tex_rng;
     int width, height;
@@ -143,23 +172,31 @@ static void locate(GLuint p, uniforms *u)
     U(background, "u_background");
     U(shadow, "u_shadow");
     U(diffuse, "u_diffuse");
+    U(specular, "u_specular");
+    U(ls_start, "u_ls_start");
+    U(ls_offset, "u_ls_offset");
     U(count, "u_count");
     U(structure, "u_structure");
     U(any, "u_any");
 #undef U
 }
 
-static GLuint compute_program(const char *body, const char *what)
+/* The path program includes the Line Space walk (its defines first, right
+ * after #version); the ray-set program has no use for it. */
+static GLuint compute_program(const char *body, bool linespace, const char *what)
 {
-    char defines[512];
+    char defines[640];
     snprintf(defines, sizeof defines,
              "#define LOCAL_SIZE %d\n#define BVH_STACK %d\n#define STRUCT_GRID %d\n"
+             "#define STRUCT_LS_CAND %d\n#define STRUCT_LS_PNMT %d\n#define STRUCT_LS_PREILLUM %d\n"
              "#define LIGHT_POINT %d\n#define LIGHT_SPOT %d\n#define LIGHT_DIRECTIONAL %d\n#define LIGHT_QUAD %d\n"
              "#define INF uintBitsToFloat(0x7f800000u)\n",
-             LOCAL, RL_BVH_MAX_DEPTH, (int)RL_GL_PT_GRID, (int)RL_LIGHT_POINT, (int)RL_LIGHT_SPOT,
+             LOCAL, RL_BVH_MAX_DEPTH, (int)RL_GL_PT_GRID, (int)RL_GL_PT_LS_CANDIDATES, (int)RL_GL_PT_LS_PNMT,
+             (int)RL_GL_PT_LS_PREILLUM, (int)RL_LIGHT_POINT, (int)RL_LIGHT_SPOT,
              (int)RL_LIGHT_DIRECTIONAL, (int)RL_LIGHT_QUAD);
-    const char *const parts[] = { rl_gl_pt_glsl_header, defines, rl_gl_pt_glsl_common, body };
-    GLuint s = rl_gl_compile(GL_COMPUTE_SHADER, parts, 4, what);
+    const char *const parts[] = { rl_gl_pt_glsl_header, linespace ? rl_gl_linespace_glsl() : "", defines,
+                                  rl_gl_pt_glsl_common, body };
+    GLuint s = rl_gl_compile(GL_COMPUTE_SHADER, parts, 5, what);
     return s ? rl_gl_link(s, 0, what) : 0;
 }
 
@@ -390,6 +427,8 @@ static rl_status ensure_grid(rl_gl_pt *pt, int grid_res)
 /* The uniforms common to both programs, and the buffers bound. */
 static void bind_scene(rl_gl_pt *pt, GLuint p, const uniforms *u)
 {
+    for (GLuint t = 0; t < T_COUNT; ++t)
+        glBindTextureUnit(t, pt->tex[t]);
     glProgramUniform1ui(p, u->num_nodes, pt->num_nodes);
     glProgramUniform1i(p, u->masks, pt->masks);
     if (pt->have_grid) {
@@ -399,14 +438,36 @@ static void bind_scene(rl_gl_pt *pt, GLuint p, const uniforms *u)
         glProgramUniform3i(p, u->grid_res, pt->grid_dims[0], pt->grid_dims[1], pt->grid_dims[2]);
     }
     for (GLuint b = 0; b < B_COUNT; ++b)
-        if (pt->buf[b])
+        if (pt->buf[b] && !buffer_texture(b))
             glBindBufferBase(GL_SHADER_STORAGE_BUFFER, b, pt->buf[b]);
+}
+
+/* The buffer textures over the uploaded arrays; RL_ERR_LIMIT past the GL's
+ * texel count. */
+static rl_status make_buffer_textures(rl_gl_pt *pt)
+{
+    GLint max_texels = 0;
+    glGetIntegerv(GL_MAX_TEXTURE_BUFFER_SIZE, &max_texels);
+    for (int t = 0; t < T_COUNT; ++t) {
+        GLint64 bytes = 0;
+        glGetNamedBufferParameteri64v(pt->buf[tex_buffers[t].buffer], GL_BUFFER_SIZE, &bytes);
+        if ((uint64_t)bytes / tex_buffers[t].texel_bytes > (uint64_t)max_texels)
+            return rl_error(RL_ERR_LIMIT, "gl-pt: %lld bytes of a scene array exceed this GL's buffer texture "
+                            "size of %d texels", (long long)bytes, (int)max_texels);
+        glCreateTextures(GL_TEXTURE_BUFFER, 1, &pt->tex[t]);
+        glTextureBuffer(pt->tex[t], tex_buffers[t].format, pt->buf[tex_buffers[t].buffer]);
+    }
+    return RL_OK;
 }
 
 void rl_gl_pt_release(rl_gl_pt *pt)
 {
     if (!pt)
         return;
+    if (pt->ls && rl_gl_context_make_current(pt->ctx) == RL_OK) {
+        rl_gl_ls_release(pt->ls);
+        rl_gl_context_done(pt->ctx);
+    }
     rl_gl_context_release(pt->ctx);   /* its objects go with it */
     free(pt);
 }
@@ -430,8 +491,8 @@ rl_status rl_gl_pt_create(const rl_scene *scene, const rl_gl_pt_desc *desc, rl_g
     GLint64 max_block = 0;
     if (st == RL_OK) {
         glGetInteger64v(GL_MAX_SHADER_STORAGE_BLOCK_SIZE, &max_block);
-        pt->path_prog = compute_program(rl_gl_pt_glsl_path, "gl-pt path");
-        pt->rays_prog = pt->path_prog ? compute_program(rl_gl_pt_glsl_rays, "gl-pt rays") : 0;
+        pt->path_prog = compute_program(rl_gl_pt_glsl_path, true, "gl-pt path");
+        pt->rays_prog = pt->path_prog ? compute_program(rl_gl_pt_glsl_rays, false, "gl-pt rays") : 0;
         st = pt->rays_prog ? RL_OK : RL_ERR_INTERNAL;
     }
     if (st == RL_OK) {
@@ -445,6 +506,8 @@ rl_status rl_gl_pt_create(const rl_scene *scene, const rl_gl_pt_desc *desc, rl_g
         st = upload_geometry(pt, &desc->lights, max_block);
     if (st == RL_OK)
         st = upload_bvh(pt, max_block);
+    if (st == RL_OK)
+        st = make_buffer_textures(pt);
     if (st == RL_OK)
         st = rl_gl_check("rl_gl_pt_create");
     if (st != RL_OK) {
@@ -498,8 +561,15 @@ static rl_status render_frame(rl_gl_pt *pt, const rl_gl_pt_frame *f, float *rgba
         st = reset_images(pt, w, h, f->reset_states);
     else if (!pt->tex_accum || pt->width != w || pt->height != h)
         st = rl_error(RL_ERR_INVALID_ARG, "rl_gl_pt_render: a new %d x %d accumulation needs its states", w, h);
-    if (st == RL_OK && (f->shadow == RL_GL_PT_GRID || f->diffuse == RL_GL_PT_GRID))
+    if (st == RL_OK && (f->shadow == RL_GL_PT_GRID || f->diffuse == RL_GL_PT_GRID || f->specular == RL_GL_PT_GRID))
         st = ensure_grid(pt, f->grid_res);
+    /* each LS structure needs its payload in the tracer's Line Space */
+    const rl_gl_pt_structure used[3] = { f->shadow, f->diffuse, f->specular };
+    const unsigned need[RL_GL_PT_STRUCTURE_COUNT] = { 0, 0, RL_LS_CANDIDATES, RL_LS_PNMT, RL_LS_PREILLUM };
+    for (int i = 0; i < 3 && st == RL_OK; ++i)
+        if (need[used[i]] && (!pt->ls || !(pt->ls_payloads & need[used[i]])))
+            st = rl_error(RL_ERR_INVALID_ARG, "rl_gl_pt_render: a Line Space structure without a Line Space "
+                          "holding its payload (rl_gl_pt_set_linespace)");
     if (st != RL_OK)
         return st;
     const GLuint p = pt->path_prog;
@@ -534,6 +604,13 @@ static rl_status render_frame(rl_gl_pt *pt, const rl_gl_pt_frame *f, float *rgba
     glProgramUniform3f(p, u->background, f->background.x, f->background.y, f->background.z);
     glProgramUniform1i(p, u->shadow, (GLint)f->shadow);
     glProgramUniform1i(p, u->diffuse, (GLint)f->diffuse);
+    glProgramUniform1i(p, u->specular, (GLint)f->specular);
+    glProgramUniform1f(p, u->ls_start, f->ls_start);
+    glProgramUniform1f(p, u->ls_offset, f->ls_offset);
+    if (pt->ls) {
+        rl_gl_ls_bind(pt->ls);
+        rl_gl_ls_set_uniforms(pt->ls, p);
+    }
     const GLuint gx = (GLuint)(w + LOCAL - 1) / LOCAL, gy = (GLuint)(h + LOCAL - 1) / LOCAL;
     for (int k = 0; k < f->spp; ++k) {
         /* One sample per dispatch: the accumulation of eq. 8 reads what the
@@ -559,6 +636,7 @@ rl_status rl_gl_pt_render(rl_gl_pt *pt, const rl_gl_pt_frame *frame, float *rgba
         return rl_error(RL_ERR_INVALID_ARG, "rl_gl_pt_render: NULL argument");
     if (frame->cam.width < 1 || frame->cam.height < 1 || frame->spp < 1 || frame->light_samples < 1 ||
         (unsigned)frame->shadow >= RL_GL_PT_STRUCTURE_COUNT || (unsigned)frame->diffuse >= RL_GL_PT_STRUCTURE_COUNT ||
+        (unsigned)frame->specular >= RL_GL_PT_STRUCTURE_COUNT ||
         frame->rng < 0 || frame->rng > 3)
         return rl_error(RL_ERR_INVALID_ARG, "rl_gl_pt_render: bad frame settings");
     if (pt->samples + (uint64_t)frame->spp > UINT32_MAX)
@@ -570,6 +648,30 @@ rl_status rl_gl_pt_render(rl_gl_pt *pt, const rl_gl_pt_frame *frame, float *rgba
         pt->samples = 0;
     if (samples)
         *samples = pt->samples;
+    rl_gl_context_done(pt->ctx);
+    return st;
+}
+
+rl_status rl_gl_pt_set_linespace(rl_gl_pt *pt, const rl_linespace *ls, const rl_accel *grid,
+                                 const rl_linespace_desc *desc)
+{
+    if (!pt || (!ls && (!grid || !desc)))
+        return rl_error(RL_ERR_INVALID_ARG, "rl_gl_pt_set_linespace: NULL argument");
+    rl_status st = rl_gl_context_make_current(pt->ctx);
+    if (st != RL_OK)
+        return st;
+    rl_gl_ls_release(pt->ls);
+    pt->ls = NULL;
+    pt->ls_payloads = 0;
+    const rl_gl_ls_limits lim = { 0 };
+    rl_gl_ls *g = NULL;
+    st = ls ? rl_gl_ls_upload(ls, &lim, &g) : rl_gl_ls_build(grid, desc, &lim, &g);
+    if (st == RL_OK) {
+        rl_gl_ls_stats gs;
+        rl_gl_ls_get_stats(g, &gs);
+        pt->ls = g;
+        pt->ls_payloads = gs.payloads;
+    }
     rl_gl_context_done(pt->ctx);
     return st;
 }
@@ -611,8 +713,8 @@ static rl_status trace_rays(rl_gl_pt *pt, rl_gl_pt_structure structure, int grid
 rl_status rl_gl_pt_trace(rl_gl_pt *pt, rl_gl_pt_structure structure, int grid_res, bool any, const rl_ray *rays,
                          uint32_t n, rl_hit *hits)
 {
-    if (!pt || (n && (!rays || !hits)) || (unsigned)structure >= RL_GL_PT_STRUCTURE_COUNT)
-        return rl_error(RL_ERR_INVALID_ARG, "rl_gl_pt_trace: bad argument");
+    if (!pt || (n && (!rays || !hits)) || (unsigned)structure > RL_GL_PT_GRID)
+        return rl_error(RL_ERR_INVALID_ARG, "rl_gl_pt_trace: bad argument (BVH or GRID)");
     if (n == 0)
         return RL_OK;
     if ((uint64_t)n * 32 > (uint64_t)INT32_MAX)
@@ -654,6 +756,16 @@ rl_status rl_gl_pt_render(rl_gl_pt *pt, const rl_gl_pt_frame *frame, float *rgba
     (void)rgba;
     if (samples)
         *samples = 0;
+    return rl_error(RL_ERR_UNSUPPORTED, "gl: built without OpenGL");
+}
+
+rl_status rl_gl_pt_set_linespace(rl_gl_pt *pt, const rl_linespace *ls, const rl_accel *grid,
+                                 const rl_linespace_desc *desc)
+{
+    (void)pt;
+    (void)ls;
+    (void)grid;
+    (void)desc;
     return rl_error(RL_ERR_UNSUPPORTED, "gl: built without OpenGL");
 }
 

@@ -11,8 +11,8 @@
  * uniform grid of accel/grid.h is built and uploaded on the first use of
  * RL_GL_PT_GRID (and again for another grid_res).
  *
- * Bindings: shader storage 0-15 and image units 0-1 are gl-pt's; 16-23
- * stay free for the Line Space (docs/gl.md).
+ * Bindings: shader storage 0-15, texture units 0-5 and image units 0-1
+ * are gl-pt's; storage 16-23 the Line Space's (gl_linespace.h, docs/gl.md).
  *
  * A tracer owns its own GL context (gl_context.h), current on the calling
  * thread for the length of one call: calls must not overlap, but
@@ -23,12 +23,18 @@
 #include "rl/rl_accel.h"
 #include "rl/rl_camera.h"
 #include "rl/rl_gl.h"
+#include "rl/rl_linespace.h"
 #include "rl/rl_scene.h"
 
 typedef struct rl_gl_pt rl_gl_pt;
 
-/* The structures shadow and secondary rays can go through. */
-typedef enum rl_gl_pt_structure { RL_GL_PT_BVH = 0, RL_GL_PT_GRID, RL_GL_PT_STRUCTURE_COUNT } rl_gl_pt_structure;
+/* The structures shadow and secondary rays can go through: the exact ones,
+ * and the Line Space's payloads (gl_linespace.h; rl_gl_pt_set_linespace
+ * gives the tracer one) as pt uses them (pathtrace_path.c). */
+typedef enum rl_gl_pt_structure {
+    RL_GL_PT_BVH = 0, RL_GL_PT_GRID, RL_GL_PT_LS_CANDIDATES, RL_GL_PT_LS_PNMT, RL_GL_PT_LS_PREILLUM,
+    RL_GL_PT_STRUCTURE_COUNT
+} rl_gl_pt_structure;
 
 /* The light set of pt's next-event estimation (pathtrace_lights.c: the
  * table of lights chosen by power with mis=on) and the emission rule's
@@ -58,6 +64,9 @@ typedef struct rl_gl_pt_frame {
     bool mis_hits, tri_lights;     /* pt_ctx's: exact backends, so both true with mis */
     int rng;                       /* 0: sobol, else rl_rng_gpu_kind + 1 */
     rl_gl_pt_structure shadow, diffuse;
+    rl_gl_pt_structure specular;   /* mirror and refraction rays (pt's specular routing) */
+    float ls_start, ls_offset;     /* pt_backends': where PNMT / preillum rays start; the
+                                    * voxel offset at a shadow ray's light end */
     int grid_res;                  /* 0: the grid heuristic */
     rl_vec3 background;
     /* Non-NULL: a new accumulation of cam.width x cam.height pixels starts
@@ -80,10 +89,19 @@ const rl_gl_info *rl_gl_pt_info(const rl_gl_pt *pt);
  * frame or a size change. *samples: per pixel after this frame. */
 rl_status rl_gl_pt_render(rl_gl_pt *pt, const rl_gl_pt_frame *frame, float *rgba, uint64_t *samples);
 
+/* The Line Space the LS structures walk, replacing the tracer's: uploaded
+ * from ls (committed, its origin rule as set) when ls is non-NULL, else
+ * built on the GPU from grid (a committed RL_ACCEL_GRID accel) and desc
+ * (CANDIDATES only, gl_linespace.h). Until one succeeds, a frame with an
+ * LS structure is RL_ERR_INVALID_ARG. */
+rl_status rl_gl_pt_set_linespace(rl_gl_pt *pt, const rl_linespace *ls, const rl_accel *grid,
+                                 const rl_linespace_desc *desc);
+
 /* Traces n rays through structure on the GPU (closest hit, or with any the
  * first hit found) into hits (t, u, v, triangle; the object is left
  * RL_ID_NONE; t = INFINITY and triangle RL_ID_NONE on a miss): the ray set
- * the tests compare with the CPU's structures. grid_res as in the frame. */
+ * the tests compare with the CPU's structures (BVH or GRID only). grid_res
+ * as in the frame. */
 rl_status rl_gl_pt_trace(rl_gl_pt *pt, rl_gl_pt_structure structure, int grid_res, bool any, const rl_ray *rays,
                          uint32_t n, rl_hit *hits);
 

@@ -45,11 +45,15 @@ const char *const rl_gl_pt_glsl_common = GLSL(
     layout(std430, binding = 0) readonly buffer Materials { Material materials[]; };
     layout(std430, binding = 1) readonly buffer Lights { Light lights[]; };
     layout(std430, binding = 2) readonly buffer TexInfos { TexInfo tex_info[]; };
-    layout(std430, binding = 3) readonly buffer Texels { vec4 texels[]; };
+    /* Read-only arrays as buffer textures (texture units 0-3; the path
+     * program's 4-5): a compute shader may use only 16 storage blocks
+     * (llvmpipe's GL_MAX_COMPUTE_SHADER_STORAGE_BLOCKS), and the Line
+     * Space's walk needs 8 of them. */
+    layout(binding = 0) uniform samplerBuffer u_positions;   /* r32f */
+    layout(binding = 1) uniform samplerBuffer u_normals;     /* r32f */
+    layout(binding = 2) uniform samplerBuffer u_uvs;         /* r32f */
+    layout(binding = 3) uniform samplerBuffer u_texels;      /* rgba32f */
     layout(std430, binding = 4) readonly buffer Triangles { uvec4 triangles[]; };
-    layout(std430, binding = 5) readonly buffer Positions { float positions[]; };
-    layout(std430, binding = 6) readonly buffer Normals { float normals[]; };
-    layout(std430, binding = 7) readonly buffer Uvs { float uvs[]; };
     layout(std430, binding = 8) readonly buffer BvhNodes { Node nodes[]; };
     layout(std430, binding = 9) readonly buffer BvhTris { vec4 bvh_tris[]; };
     layout(std430, binding = 10) readonly buffer CellStart { uint cell_start[]; };
@@ -64,15 +68,18 @@ const char *const rl_gl_pt_glsl_common = GLSL(
 
     bool finite3(vec3 v) { return !any(isnan(v)) && !any(isinf(v)); }
     float max_comp(vec3 v) { return max(max(v.x, v.y), v.z); }
-    vec3 position(uint i) { return vec3(positions[3u * i], positions[3u * i + 1u], positions[3u * i + 2u]); }
-    vec3 normal_at(uint i) { return vec3(normals[3u * i], normals[3u * i + 1u], normals[3u * i + 2u]); }
-    vec2 uv_at(uint i) { return vec2(uvs[2u * i], uvs[2u * i + 1u]); }
+    float fetch1(samplerBuffer b, uint i) { return texelFetch(b, int(i)).x; }
+    vec3 position(uint i) { return vec3(fetch1(u_positions, 3u * i), fetch1(u_positions, 3u * i + 1u),
+                                        fetch1(u_positions, 3u * i + 2u)); }
+    vec3 normal_at(uint i) { return vec3(fetch1(u_normals, 3u * i), fetch1(u_normals, 3u * i + 1u),
+                                         fetch1(u_normals, 3u * i + 2u)); }
+    vec2 uv_at(uint i) { return vec2(fetch1(u_uvs, 2u * i), fetch1(u_uvs, 2u * i + 1u)); }
 
     /* core/texture_sample.h: bilinear, repeat, texel centres at
      * half-integers, v up (as gl_shaders.c tex_sample). */
     vec4 texel_at(TexInfo t, int x, int y)
     {
-        return texels[t.offset + uint(clamp(y, 0, t.height - 1) * t.width + clamp(x, 0, t.width - 1))];
+        return texelFetch(u_texels, int(t.offset + uint(clamp(y, 0, t.height - 1) * t.width + clamp(x, 0, t.width - 1))));
     }
 
     vec4 tex_sample(uint tex, vec2 uv)
@@ -316,8 +323,12 @@ const char *const rl_gl_pt_glsl_path = GLSL(
     layout(local_size_x = LOCAL_SIZE, local_size_y = LOCAL_SIZE) in;
     layout(rgba32f, binding = 0) uniform image2D u_accum;
     layout(rgba32ui, binding = 1) uniform uimage2D u_rng_state;
-    layout(std430, binding = 12) readonly buffer LightTable { vec2 light_table[]; };   /* cdf, source bits */
-    layout(std430, binding = 13) readonly buffer TriLight { uvec2 tri_light[]; };      /* cover, pmf bits */
+    layout(binding = 4) uniform usamplerBuffer u_light_table;  /* rg32ui: cdf bits, source */
+    layout(binding = 5) uniform usamplerBuffer u_tri_light;    /* rg32ui: cover, pmf bits */
+    float table_cdf(uint k) { return uintBitsToFloat(texelFetch(u_light_table, int(k)).x); }
+    uint table_source(uint k) { return texelFetch(u_light_table, int(k)).y; }
+    uint tri_cover(uint t) { return texelFetch(u_tri_light, int(t)).x; }
+    float tri_pmf(uint t) { return uintBitsToFloat(texelFetch(u_tri_light, int(t)).y); }
 
     uniform ivec2 u_size;
     uniform vec3 u_eye;
@@ -343,6 +354,9 @@ const char *const rl_gl_pt_glsl_path = GLSL(
     uniform vec3 u_background;
     uniform int u_shadow;
     uniform int u_diffuse;
+    uniform int u_specular;
+    uniform float u_ls_start;
+    uniform float u_ls_offset;
 
     /* -------------------------------------------------------- sampler -- */
     const uint SLOT_PIXEL = 0u, SLOT_FIRST_VERTEX = 1u;
@@ -521,6 +535,76 @@ const char *const rl_gl_pt_glsl_path = GLSL(
         return s;
     }
 
+    /* pathtrace_path.c surface_of_record: a PNMT record knows only its
+     * shading normal, which serves as the geometric one too */
+    bool surface_of_record(vec3 p, vec3 n, vec2 uv, uint mat, vec3 v, out Surf s)
+    {
+        if (mat >= uint(materials.length()) || !finite3(p))
+            return false;
+        n = normalize(n);
+        if (!(dot(n, n) > 0.0) || !finite3(n))
+            n = v;
+        bool faces = dot(n, v) >= 0.0;
+        s.p = p;
+        s.v = v;
+        s.front = faces;
+        s.ng = faces ? n : -n;
+        s.ns = s.ng;
+        s.mat = mat;
+        s.uv = uv;
+        Material m = materials[mat];
+        s.kd = m.diffuse.rgb;
+        if (m.tex.x != NONE)
+            s.kd *= tex_sample(m.tex.x, uv).rgb;
+        s.tri = NONE;
+        return true;
+    }
+
+    /* rl_pt_closest: the first surface along a secondary ray */
+    bool closest(int structure, vec3 o, vec3 dir, out Surf s)
+    {
+        Hit h;
+        if (structure == STRUCT_LS_CAND) {
+            if (!rl_ls_intersect(o, dir, 0.0, INF, h.tri, h.t, h.u, h.v))
+                return false;
+        } else if (structure == STRUCT_LS_PNMT) {
+            float t, t0 = max(0.0, u_ls_start);
+            uint tri, mat;
+            vec3 p, n;
+            vec2 uv;
+            if (!rl_ls_pnmt_intersect(o, dir, t0, INF, t, tri, p, n, uv, mat))
+                return false;
+            if (tri != NONE) {
+                /* the start voxel's exact hit (ls_origin=exact), as
+                 * rl_ls_surface_at makes it a record: the walk's own
+                 * triangle test again for the barycentrics */
+                float u, v;
+                if (!rl_ls_wt_hit(rl_ls_wt_setup(o, dir), tri, t0, INF, t, u, v))
+                    return false;
+                float w = 1.0 - u - v;
+                vec3 q0 = vec3(rl_ls_tri_v[9u * tri], rl_ls_tri_v[9u * tri + 1u], rl_ls_tri_v[9u * tri + 2u]);
+                vec3 q1 = vec3(rl_ls_tri_v[9u * tri + 3u], rl_ls_tri_v[9u * tri + 4u], rl_ls_tri_v[9u * tri + 5u]);
+                vec3 q2 = vec3(rl_ls_tri_v[9u * tri + 6u], rl_ls_tri_v[9u * tri + 7u], rl_ls_tri_v[9u * tri + 8u]);
+                uvec4 T = triangles[tri];
+                p = q0 * w + q1 * u + q2 * v;
+                n = normal_at(T.x) * w + normal_at(T.y) * u + normal_at(T.z) * v;
+                float len = length(n);
+                if (!(len > 0.0)) {
+                    n = cross(q1 - q0, q2 - q0);
+                    len = length(n);
+                }
+                n = len > 0.0 ? n * (1.0 / len) : vec3(0.0, 0.0, 1.0);
+                uv = interp_uv(tri, u, v);
+                mat = T.w;
+            }
+            return surface_of_record(p, n, uv, mat, -normalize(dir), s);
+        } else if (!query(structure, o, dir, 0.0, INF, false, h)) {
+            return false;
+        }
+        s = surface_at(h, dir);
+        return true;
+    }
+
     /* ----------------------------------------------------------- BSDF -- */
     float mean3(vec3 c) { return (c.x + c.y + c.z) * (1.0 / 3.0); }
     vec3 mirror_dir(Surf s) { return s.ns * (2.0 * dot(s.ns, s.v)) - s.v; }
@@ -616,6 +700,18 @@ const char *const rl_gl_pt_glsl_path = GLSL(
             if (len > 0.0)
                 d = to * (1.0 / len);
             t_max = len * (1.0 - 1e-4);
+        }
+        if (u_shadow == STRUCT_LS_CAND)
+            return !rl_ls_occluded(o, d, 0.0, t_max);
+        if (u_shadow == STRUCT_LS_PNMT || u_shadow == STRUCT_LS_PREILLUM) {
+            /* pt's voxel offsets: at the light's end always, at the
+             * surface's with ls_origin=offset */
+            float t_min = max(0.0, u_ls_start);
+            t_max -= u_ls_offset;
+            if (!(t_min < t_max))
+                return true;
+            return !(u_shadow == STRUCT_LS_PNMT ? rl_ls_pnmt_occluded(o, d, t_min, t_max)
+                                                : rl_ls_preillum_occluded(o, d, t_min, t_max));
         }
         Hit h;
         return !query(u_shadow, o, d, 0.0, t_max, true, h);
@@ -721,7 +817,7 @@ const char *const rl_gl_pt_glsl_path = GLSL(
         uint lo = 0u, hi = u_table_count;
         while (hi - lo > 1u) {
             uint mid = lo + (hi - lo) / 2u;
-            if (light_table[mid].x <= u)
+            if (table_cdf(mid) <= u)
                 lo = mid;
             else
                 hi = mid;
@@ -742,7 +838,7 @@ const char *const rl_gl_pt_glsl_path = GLSL(
             float u_pick = u_table_count > 1u ? sample_1d() : 0.0;
             seek(slot + SLOT_LIGHT_POINT);
             vec2 x = sample_2d();
-            uint src = floatBitsToUint(light_table[pick_light(u_pick)].y);
+            uint src = table_source(pick_light(u_pick));
             vec3 q, n_e, le;
             float area, pmf;
             bool hittable;
@@ -772,7 +868,7 @@ const char *const rl_gl_pt_glsl_path = GLSL(
                     continue;
                 uint t = src - uint(u_num_lights);
                 uvec4 T = triangles[t];
-                pmf = uintBitsToFloat(tri_light[t].y);
+                pmf = tri_pmf(t);
                 area = triangle_area(t, n_e);
                 float r = sqrt(x.x), b1 = x.y * r, b0 = 1.0 - r;
                 q = position(T.x) * b0 + position(T.y) * b1 + position(T.z) * (1.0 - b0 - b1);
@@ -796,13 +892,41 @@ const char *const rl_gl_pt_glsl_path = GLSL(
         return sum;
     }
 
+    /* rl_pt_cover_point: the quad light whose parallelogram holds p (a
+     * PNMT record has no triangle to look up) */
+    uint cover_point(vec3 p, float tol)
+    {
+        for (int i = 0; i < u_num_lights; ++i) {
+            Light L = lights[i];
+            if (int(L.pos.w) != LIGHT_QUAD)
+                continue;
+            vec3 eu = L.dir.xyz, ev = L.extra.xyz;
+            vec3 n = cross(eu, ev);
+            float area = length(n);
+            if (!(area > 0.0))
+                continue;
+            vec3 r = p - L.pos.xyz;
+            if (abs(dot(r, n)) / area > tol)
+                continue;
+            float uu = dot(eu, eu), uv = dot(eu, ev), vv = dot(ev, ev), ru = dot(r, eu), rv = dot(r, ev);
+            float det = uu * vv - uv * uv;
+            if (!(det > 0.0))
+                continue;
+            float a = (ru * vv - rv * uv) / det, b = (rv * uu - ru * uv) / det;
+            float ta = tol / sqrt(uu), tb = tol / sqrt(vv);
+            if (a >= -ta && a <= 1.0 + ta && b >= -tb && b <= 1.0 + tb)
+                return uint(i);
+        }
+        return NONE;
+    }
+
     /* emitted: the emission rule of pathtrace_path.c */
     vec3 emitted(Surf s, bool after_brdf)
     {
         vec3 e = materials[s.mat].emission.rgb;
         if (!(max_comp(e) > 0.0))
             return vec3(0.0);
-        uint cover = tri_light[s.tri].x;
+        uint cover = s.tri != NONE ? tri_cover(s.tri) : cover_point(s.p, 10.0 * u_eps);
         if (cover == NONE)
             return e;
         Light L = lights[cover];
@@ -815,14 +939,14 @@ const char *const rl_gl_pt_glsl_path = GLSL(
         if (!after_brdf || !u_mis_hits)
             return emitted(s, after_brdf);
         vec3 e = materials[s.mat].emission.rgb;
-        if (!(max_comp(e) > 0.0))
+        if (!(max_comp(e) > 0.0) || s.tri == NONE)
             return emitted(s, after_brdf);
-        uint cover = tri_light[s.tri].x;
+        uint cover = tri_cover(s.tri);
         float pmf, area;
         if (cover == NONE) {
             if (!u_tri_lights)
                 return e;
-            pmf = uintBitsToFloat(tri_light[s.tri].y);
+            pmf = tri_pmf(s.tri);
             vec3 n_unused;
             area = triangle_area(s.tri, n_unused);
         } else {
@@ -908,14 +1032,23 @@ const char *const rl_gl_pt_glsl_path = GLSL(
             if (!(max_comp(T) > 0.0))
                 break;
 
-            /* exact backends only: specular rays take the diffuse one */
-            Hit h;
+            /* Sec. 11.2, 12.3: mirror and refraction rays may take another
+             * structure than the diffuse bounces */
+            int structure = diffuse_ray ? u_diffuse : u_specular;
             vec3 o = offset_origin(s, dir);
-            if (!query(u_diffuse, o, dir, 0.0, INF, false, h)) {
+            if (structure == STRUCT_LS_PREILLUM) {
+                /* the stored direct light ends the path (Sec. 7.4) */
+                vec3 col;
+                float t;
+                radiance += T * (rl_ls_preillum(o, dir, max(0.0, u_ls_start), INF, col, t) ? col : u_background);
+                break;
+            }
+            Surf next;
+            if (!closest(structure, o, dir, next)) {
                 radiance += T * u_background;
                 break;
             }
-            s = surface_at(h, dir);
+            s = next;
         }
         return radiance;
     }

@@ -3,7 +3,7 @@
  * runs it on the GPU (Ch. 5, 6): one thread per pixel, the per-pixel
  * generator states in an image (Sec. 5.3), progressive accumulation in an
  * rgba32f image (Sec. 6.5, eq. 8), shadow and secondary rays through the
- * BVH or the uniform grid (Sec. 5.4).
+ * BVH, the uniform grid (Sec. 5.4) or the Line Space (Sec. 7).
  *
  * Same estimator as pt: this file builds what pt builds on the CPU for it
  * (pathtrace_backend.c: the ray offset, the covering quad light of every
@@ -15,13 +15,17 @@
  *
  * Options: pt's names and defaults where ported (spp, max_depth, rr,
  * rr_depth, rng, mis, seed, shadow, diffuse, specular, primary,
- * checkerboard, accumulate, filter, grid_res, light_samples, background,
- * threads) and device (rl_gl.h). Values pt has and gl-pt has not ported
- * are refused with an option error naming what is ported: shadow and
- * diffuse other than bvh and grid (Embree, the Line Space payloads, shadow
- * maps), primary=raster, checkerboard=true, filter other than none. pt's
- * Line Space and shadow-map options (ls_*, shadowmap_size) are not in the
- * table until those backends are ported.
+ * checkerboard, accumulate, filter, grid_res, ls_n, ls_k, ls_dynamic,
+ * ls_origin, light_samples, background, threads), device (rl_gl.h) and
+ * ls_build. Values pt has and gl-pt has not ported are refused with an
+ * option error naming what is ported: shadow=embree|shadowmap,
+ * diffuse=embree, primary=raster, checkerboard=true, filter other than
+ * none; pt's ls_file and shadowmap_size are not in the table.
+ *
+ * The Line Space backends (ls-candidates, ls-pnmt, ls-preillum) walk the
+ * Line Space pt builds (pathtrace_backend.c, the same rl_linespace and
+ * voxel offsets), uploaded to the GPU (gl_linespace.h); ls_build=gpu builds
+ * the candidate lists on the GPU instead, from pt's CPU grid.
  *
  * Depth and ID layers, where the image has them, come from pt's traced
  * G-buffer (CPU BVH, pixel centres), as pt writes them. */
@@ -48,6 +52,8 @@ static const char *const diffuse_choices[] = { "bvh", "grid", "embree", "ls-cand
 static const char *const specular_choices[] = { "exact", "diffuse", NULL };
 static const char *const primary_choices[] = { "trace", "raster", NULL };
 static const char *const filter_choices[] = { "none", "gauss", "bilateral", "aniso", "kuwahara", NULL };
+static const char *const ls_origin_choices[] = { "offset", "exact", NULL };
+static const char *const ls_build_choices[] = { "cpu", "gpu", NULL };
 
 static const rl_option_info gl_pt_options[] = {
     { "spp", RL_OPT_INT, "1", "paths per pixel and frame (one compute dispatch each)", 1, 65536, NULL },
@@ -63,20 +69,33 @@ static const rl_option_info gl_pt_options[] = {
       "on: lights chosen by power, light and BSDF samples weighted by the power heuristic; off: every light",
       0, 0, mis_choices },
     { "seed", RL_OPT_INT, "0", "seed of the per-pixel generator states", 0, 9007199254740991.0, NULL },
-    { "shadow", RL_OPT_ENUM, "bvh", "shadow rays on the GPU: bvh or grid (Line Space: not ported yet)",
+    { "shadow", RL_OPT_ENUM, "bvh",
+      "shadow rays on the GPU: bvh, grid or a Line Space payload (ls-candidates, ls-preillum, ls-pnmt)",
       0, 0, shadow_choices },
-    { "diffuse", RL_OPT_ENUM, "bvh", "secondary rays on the GPU: bvh or grid (Line Space: not ported yet)",
+    { "diffuse", RL_OPT_ENUM, "bvh",
+      "secondary rays on the GPU: bvh, grid or a Line Space payload (ls-candidates, ls-preillum, ls-pnmt)",
       0, 0, diffuse_choices },
     { "specular", RL_OPT_ENUM, "exact",
-      "mirror and refraction rays: with the exact structures of gl-pt both values take the diffuse one", 0, 0,
-      specular_choices },
+      "mirror and refraction rays: exact (the grid under a Line Space payload, else the diffuse structure) or "
+      "diffuse (the diffuse structure, payloads included)", 0, 0, specular_choices },
     { "primary", RL_OPT_ENUM, "trace", "primary visibility: trace (jittered rays, BVH); raster: not ported yet",
       0, 0, primary_choices },
     { "checkerboard", RL_OPT_BOOL, "false", "Sec. 8.5: not ported yet (false only)", 0, 0, NULL },
     { "accumulate", RL_OPT_BOOL, "true", "progressive accumulation across frames (Sec. 6.5, eq. 8)", 0, 0, NULL },
     { "filter", RL_OPT_ENUM, "none", "noise filter (Sec. 8.2): not ported yet (none only)", 0, 0,
       filter_choices },
-    { "grid_res", RL_OPT_INT, "0", "voxels per axis of the grid (0 = grid heuristic)", 0, 1024, NULL },
+    { "grid_res", RL_OPT_INT, "0", "voxels per axis of the grid and the Line Space (0 = grid heuristic)", 0, 1024,
+      NULL },
+    { "ls_n", RL_OPT_INT, "5", "Line Space patches per voxel face side (Sec. 9.2: 5)", 1, RL_LS_MAX_N, NULL },
+    { "ls_k", RL_OPT_INT, "8", "Line Space fixed candidate slots per shaft (even; ls_dynamic=false only)", 2,
+      RL_LS_MAX_K, NULL },
+    { "ls_origin", RL_OPT_ENUM, "offset",
+      "PNMT/preillum rays: offset (start one voxel diagonal away, Sec. 12.1) or exact (start at the "
+      "surface; the start voxel's triangles answer PNMT rays exactly)", 0, 0, ls_origin_choices },
+    { "ls_dynamic", RL_OPT_BOOL, "true", "exact per-shaft candidate lists (prefix sums, Sec. 7.1.1)", 0, 0, NULL },
+    { "ls_build", RL_OPT_ENUM, "cpu",
+      "where the Line Space is built: cpu (pt's build, uploaded) or gpu (compute shaders; ls-candidates only)",
+      0, 0, ls_build_choices },
     { "light_samples", RL_OPT_INT, "1", "shadow rays per quad light and vertex", 1, 1024, NULL },
     { "background", RL_OPT_COLOR, "0,0,0",
       "radiance arriving from every direction where a ray leaves the scene (a uniform environment)", 0, 0, NULL },
@@ -90,6 +109,7 @@ typedef struct gl_pt_state {
     pt_backends b;                /* the light set, offsets; a CPU BVH for depth and ID layers */
     rl_gl_pt *gpu;
     uint64_t gpu_scene;           /* the scene uid the GPU tracer holds */
+    char ls_key[160];             /* what the tracer's Line Space was made from; "" none */
     char device[64];
     char info[528];
     /* the accumulation and what it depends on */
@@ -126,10 +146,13 @@ static bool gl_pt_available(const rl_renderer *r, char *why, size_t n)
 
 static rl_status gl_pt_check(const char *key, const char *value)
 {
-    if ((strcmp(key, "shadow") == 0 || strcmp(key, "diffuse") == 0) && strcmp(value, "bvh") != 0 &&
-        strcmp(value, "grid") != 0)
-        return rl_error(RL_ERR_INVALID_ARG, "gl-pt: %s=%s is not ported to GL yet (bvh or grid; pt has it)", key,
-                        value);
+    if ((strcmp(key, "shadow") == 0 || strcmp(key, "diffuse") == 0) &&
+        (strcmp(value, "embree") == 0 || strcmp(value, "shadowmap") == 0))
+        return rl_error(RL_ERR_INVALID_ARG,
+                        "gl-pt: %s=%s is not ported to GL yet (bvh, grid, ls-candidates, ls-preillum or ls-pnmt; "
+                        "pt has it)", key, value);
+    if (strcmp(key, "ls_k") == 0 && atoi(value) % 2 != 0)
+        return rl_error(RL_ERR_INVALID_ARG, "gl-pt: ls_k=%s must be even (front and back halves, Alg. 3)", value);
     if (strcmp(key, "primary") == 0 && strcmp(value, "raster") == 0)
         return rl_error(RL_ERR_INVALID_ARG, "gl-pt: primary=raster (the G-buffer pass) is not ported to GL yet");
     if (strcmp(key, "checkerboard") == 0) {
@@ -186,6 +209,7 @@ static rl_status ensure_gpu(gl_pt_state *s, const rl_scene *scene, const char *d
     rl_gl_pt_release(s->gpu);
     s->gpu = NULL;
     s->valid = false;
+    s->ls_key[0] = '\0';
     if (strlen(device) >= sizeof s->device)
         return rl_error(RL_ERR_INVALID_ARG, "gl-pt: device \"%.40s...\" is too long", device);
     const pt_lights *l = &s->b.lights;
@@ -205,6 +229,75 @@ static rl_status ensure_gpu(gl_pt_state *s, const rl_scene *scene, const char *d
     const rl_gl_info *info = rl_gl_pt_info(s->gpu);
     if (info)
         snprintf(s->info, sizeof s->info, "%s | %s | %s", info->vendor, info->renderer, info->version);
+    return RL_OK;
+}
+
+/* gl-pt's structure for pt's backend (the shadow and diffuse choices). */
+static rl_gl_pt_structure structure_of(rl_pt_backend k)
+{
+    switch (k) {
+    case RL_PT_BACKEND_GRID: return RL_GL_PT_GRID;
+    case RL_PT_BACKEND_LS_CANDIDATES: return RL_GL_PT_LS_CANDIDATES;
+    case RL_PT_BACKEND_LS_PNMT: return RL_GL_PT_LS_PNMT;
+    case RL_PT_BACKEND_LS_PREILLUM: return RL_GL_PT_LS_PREILLUM;
+    default: return RL_GL_PT_BVH;
+    }
+}
+
+static bool is_ls(rl_pt_backend k)
+{
+    return k == RL_PT_BACKEND_LS_CANDIDATES || k == RL_PT_BACKEND_LS_PNMT || k == RL_PT_BACKEND_LS_PREILLUM;
+}
+
+/* The Line Space of the ls-* backends in the tracer: pt's own (built by
+ * rl_pt_backends_prepare, so structure and offsets are pt's) uploaded, or
+ * with ls_build=gpu the candidate lists built on the GPU from pt's grid.
+ * Done again only when what it is made from changes. */
+static rl_status ensure_linespace(gl_pt_state *s, const rl_renderer *r, const rl_scene *scene, rl_pt_backend shadow,
+                                  rl_pt_backend diffuse, int threads, rl_render_stats *stats)
+{
+    const bool gpu = rl_renderer_opt_enum(r, "ls_build") == 1;
+    if (gpu && (!(shadow == RL_PT_BACKEND_LS_CANDIDATES || !is_ls(shadow)) ||
+                !(diffuse == RL_PT_BACKEND_LS_CANDIDATES || !is_ls(diffuse))))
+        return rl_error(RL_ERR_INVALID_ARG, "gl-pt: ls_build=gpu builds the candidate lists only: ls-pnmt and "
+                        "ls-preillum need ls_build=cpu");
+    /* pt's settings for its Line Space alone: the other side takes the Line
+     * Space side's backend so that no unneeded exact structure is built */
+    pt_settings set;
+    memset(&set, 0, sizeof set);
+    set.shadow = is_ls(shadow) ? shadow : diffuse;
+    set.diffuse = is_ls(diffuse) ? diffuse : shadow;
+    if (gpu)
+        set.shadow = set.diffuse = RL_PT_BACKEND_GRID;   /* the grid the GPU build reads */
+    set.primary = PT_PRIMARY_RASTER;                     /* no CPU BVH for primary rays */
+    set.grid_res = (int)rl_renderer_opt_int(r, "grid_res");
+    set.ls_n = (int)rl_renderer_opt_int(r, "ls_n");
+    set.ls_k = (int)rl_renderer_opt_int(r, "ls_k");
+    set.ls_dynamic = rl_renderer_opt_bool(r, "ls_dynamic");
+    set.ls_origin_exact = rl_renderer_opt_enum(r, "ls_origin") == 1;
+    set.ls_file = "";
+    double built = 0.0;
+    rl_timer timer;
+    rl_timer_start(&timer);
+    rl_status st = rl_pt_backends_prepare(&s->b, scene, &set, threads, &built);
+    if (st != RL_OK)
+        return st;
+    char key[sizeof s->ls_key];
+    snprintf(key, sizeof key, "%s n=%d k=%d dyn=%d payloads=%d/%d origin=%d grid=%d scene=%llu ls=%p",
+             gpu ? "gpu" : "cpu", set.ls_n, set.ls_dynamic ? 0 : set.ls_k, set.ls_dynamic, (int)set.shadow,
+             (int)set.diffuse, set.ls_origin_exact, set.grid_res, (unsigned long long)rl_scene_uid(scene),
+             gpu ? (void *)s->b.exact[RL_ACCEL_GRID] : (void *)s->b.ls);
+    if (strcmp(key, s->ls_key) != 0) {
+        s->ls_key[0] = '\0';
+        rl_linespace_desc desc = { .n = set.ls_n, .k = set.ls_k, .dynamic = set.ls_dynamic,
+                                   .payloads = RL_LS_CANDIDATES };
+        st = gpu ? rl_gl_pt_set_linespace(s->gpu, NULL, s->b.exact[RL_ACCEL_GRID], &desc)
+                 : rl_gl_pt_set_linespace(s->gpu, s->b.ls, NULL, NULL);
+        if (st != RL_OK)
+            return st;
+        snprintf(s->ls_key, sizeof s->ls_key, "%s", key);
+    }
+    stats->prep_ms += rl_timer_ms(&timer);
     return RL_OK;
 }
 
@@ -275,7 +368,23 @@ static rl_status gl_pt_render(rl_renderer *r, void *state, const rl_scene *scene
         free(sig);
     }
 
-    const int diffuse = rl_renderer_opt_enum(r, "diffuse");
+    const rl_pt_backend shadow = (rl_pt_backend)rl_renderer_opt_enum(r, "shadow");
+    const rl_pt_backend diffuse = (rl_pt_backend)rl_renderer_opt_enum(r, "diffuse");
+    /* pathtrace.c: specular rays leave the approximate payloads for the
+     * exact grid the Line Space lives in */
+    const bool payload = diffuse == RL_PT_BACKEND_LS_PNMT || diffuse == RL_PT_BACKEND_LS_PREILLUM;
+    const rl_pt_backend specular =
+        rl_renderer_opt_enum(r, "specular") == 0 && payload ? RL_PT_BACKEND_GRID : diffuse;
+    if (is_ls(shadow) || is_ls(diffuse)) {
+        st = ensure_linespace(s, r, scene, shadow, diffuse, threads, stats);
+        if (st != RL_OK) {
+            free(states);
+            s->force_reset = true;
+            return st;
+        }
+    }
+    /* pt's exact_backend: BSDF rays find emitters exactly */
+    const bool exact = !payload;
     const int max_depth = (int)rl_renderer_opt_int(r, "max_depth");
     const bool mis = rl_renderer_opt_enum(r, "mis") == 1;
     rl_gl_pt_frame f = {
@@ -285,10 +394,13 @@ static rl_status gl_pt_render(rl_renderer *r, void *state, const rl_scene *scene
         .rr_depth = (int)rl_renderer_opt_int(r, "rr_depth"),
         .light_samples = (int)rl_renderer_opt_int(r, "light_samples"),
         .rr = rl_renderer_opt_bool(r, "rr"),
-        .mis = mis, .mis_hits = mis, .tri_lights = mis,   /* both structures are exact (pathtrace.c) */
+        .mis = mis, .mis_hits = mis && exact, .tri_lights = mis && exact,
         .rng = rng,
-        .shadow = rl_renderer_opt_enum(r, "shadow") == 1 ? RL_GL_PT_GRID : RL_GL_PT_BVH,
-        .diffuse = diffuse == 1 ? RL_GL_PT_GRID : RL_GL_PT_BVH,
+        .shadow = structure_of(shadow),
+        .diffuse = structure_of(diffuse),
+        .specular = structure_of(specular),
+        .ls_start = s->b.ls_start,
+        .ls_offset = s->b.ls_offset,
         .grid_res = (int)rl_renderer_opt_int(r, "grid_res"),
         .background = rl_renderer_opt_color(r, "background"),
         .reset_states = states,
@@ -355,8 +467,8 @@ static rl_status gl_pt_render(rl_renderer *r, void *state, const rl_scene *scene
 
 const rl_renderer_class rl_gl_pt_renderer_class = {
     .info = { .name = "gl-pt",
-              .description = "pt on OpenGL 4.5 compute shaders (headless EGL): the same estimator, BVH or grid "
-                             "on the GPU",
+              .description = "pt on OpenGL 4.5 compute shaders (headless EGL): the same estimator, BVH, grid "
+                             "or Line Space on the GPU",
               .reference = "Schröder 2017, Ch. 5-6 (GPU path tracing, Sec. 5.3 RNG textures, Sec. 6.5)",
               .progressive = true, .default_time_s = 10.0,
               .frame_bytes_per_pixel = 4 * sizeof(float) + 16 + 16 + RL_GBUFFER_BYTES_PER_PIXEL },

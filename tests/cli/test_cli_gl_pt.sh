@@ -16,7 +16,7 @@ RL_EGL_DEVICE=bogus expect_error 1 "gl-pt: unavailable: .*bogus" \
 [ ! -e "$TMP/none.png" ] || fail "an unavailable renderer wrote an image"
 
 expect_error 2 "not ported to GL yet" \
-    "$RL" render cornell --algo gl-pt --set gl-pt.shadow=ls-pnmt --size 16x16 --out "$TMP/none.png"
+    "$RL" render cornell --algo gl-pt --set gl-pt.shadow=shadowmap --size 16x16 --out "$TMP/none.png"
 expect_error 2 "not ported to GL yet" \
     "$RL" render cornell --algo gl-pt --set gl-pt.primary=raster --size 16x16 --out "$TMP/none.png"
 expect_error 2 "not ported to GL yet" \
@@ -43,6 +43,15 @@ assert [row["scene"] for row in rows] == ["cornell"], rows
 assert rows[0]["gl_pt"]["min_ms"] > 0 and rows[0]["pt"]["min_ms"] > 0 and rows[0]["gl_pt_fps"] > 0, rows
 assert r["parameters"]["pt_size"] == "16x16" and r["gl"]["renderer"], r["parameters"]
 PY
+    # the Line Space backends (Diagram 1's configuration), and the pair of
+    # options the GPU build cannot serve
+    run_ok "$RL" render cornell --algo gl-pt --set gl-pt.shadow=ls-pnmt --set gl-pt.diffuse=ls-pnmt \
+        --set gl-pt.ls_n=3 --size 16x16 --spp 2 --out "$TMP/glpt_ls.png"
+    [ -s "$TMP/glpt_ls.png" ] || fail "gl-pt with ls-pnmt wrote no image"
+    expect_error 1 "ls_build=gpu builds the candidate lists only" \
+        "$RL" render cornell --algo gl-pt --set gl-pt.diffuse=ls-preillum --set gl-pt.ls_build=gpu \
+        --size 16x16 --spp 1 --out "$TMP/none.png"
+    [ ! -e "$TMP/none.png" ] || fail "a refused option pair still rendered"
 else
     echo "test_cli_gl_pt: no GL 4.5 context here; the rendering cases are skipped"
 fi

@@ -2,7 +2,10 @@
  * image converges to pt's (the RMSE of the difference to a CPU reference
  * falls as 1/sqrt(spp) and the per-channel image means agree within 3
  * sigma) on the Cornell box and on the spheres (mirror, glass, point and
- * directional lights); the GLSL BVH and grid find the triangles the CPU
+ * directional lights); with rng=hybrid it draws pt's numbers and gives
+ * pt's pixels, through the BVH, the grid and the Line Space backends (a
+ * GPU-built Line Space gives the uploaded one's image); the GLSL BVH and
+ * grid find the triangles the CPU
  * BVH finds, ray for ray; options gl-pt has not ported are refused, and a
  * device that cannot be opened makes it unavailable. Small images on
  * llvmpipe; without a GL 4.5 context the GL cases skip. */
@@ -247,6 +250,120 @@ static void test_gl_pt_draws_pts_numbers(void **state)
     }
 }
 
+/* The share of pixels whose channels all agree to 1e-3 (relative above
+ * 1e-3, absolute below). */
+static double share_equal(const rl_image *a, const rl_image *b, size_t n)
+{
+    size_t close = 0;
+    for (size_t i = 0; i < n; ++i) {
+        double worst = 0.0;
+        for (int c = 0; c < 3; ++c) {
+            const float x = (&a->color[i].x)[c], y = (&b->color[i].x)[c];
+            double rel = fabs((double)x - y) / fmax(1e-3, fabs((double)y));
+            worst = rel > worst ? rel : worst;
+        }
+        close += worst < 1e-3;
+    }
+    return (double)close / (double)n;
+}
+
+/* The Line Space backends as pt runs them: with rng=hybrid the same paths,
+ * so the GLSL walks through the uploaded Line Space (candidates, the PNMT
+ * records shaded as surfaces, the pre-illuminated colours that end a path)
+ * give pt's pixels, with the voxel offset or the exact origin rule, fixed
+ * or dynamic lists, and mirror and glass rays routed to the grid. */
+static void test_gl_pt_line_space_draws_pts_numbers(void **state)
+{
+    (void)state;
+    NEED_GL();
+    static const struct {
+        const char *scene, *params, *shadow, *diffuse, *extra_key, *extra_value;
+    } cases[] = {
+        { "cornell", NULL, "ls-candidates", "ls-candidates", "ls_dynamic", "false" },
+        { "cornell", NULL, "ls-candidates", "ls-candidates", "ls_dynamic", "true" },
+        { "cornell", NULL, "ls-pnmt", "ls-pnmt", "ls_origin", "offset" },
+        { "cornell", NULL, "ls-pnmt", "ls-pnmt", "ls_origin", "exact" },
+        { "cornell", NULL, "ls-preillum", "ls-preillum", "ls_origin", "offset" },
+        { "cornell", NULL, "bvh", "ls-preillum", "mis", "off" },
+        { "spheres", "segments=16,checks=4", "ls-candidates", "ls-preillum", "specular", "diffuse" },
+        { "spheres", "segments=16,checks=4", "ls-pnmt", "ls-pnmt", "specular", "exact" },
+        { "spheres", "segments=16,checks=4", "grid", "ls-pnmt", "specular", "diffuse" },
+    };
+    for (size_t k = 0; k < sizeof cases / sizeof cases[0]; ++k) {
+        rl_camera cam;
+        rl_scene *s = scene_and_camera(cases[k].scene, cases[k].params, &cam);
+        cam.width = cam.height = 24;
+        const char *const opts[] = { "spp", "4", "rng", "hybrid", "seed", "5", "ls_n", "3", "shadow", cases[k].shadow,
+                                     "diffuse", cases[k].diffuse, cases[k].extra_key, cases[k].extra_value, NULL };
+        rl_image *cpu = render("pt", s, &cam, opts);
+        rl_image *gl = render("gl-pt", s, &cam, opts);
+        double share = share_equal(gl, cpu, (size_t)cam.width * (size_t)cam.height);
+        print_message("%s, shadow=%s diffuse=%s %s=%s: pixels equal to pt's to 1e-3: %.1f %%\n", cases[k].scene,
+                      cases[k].shadow, cases[k].diffuse, cases[k].extra_key, cases[k].extra_value, 100.0 * share);
+        assert_true(share >= 0.99);
+        rl_image_release(gl);
+        rl_image_release(cpu);
+        rl_scene_release(s);
+    }
+}
+
+/* ls_build=gpu builds the candidate lists the CPU builds, in the same
+ * order: the image is the uploaded one's bit for bit. */
+static void test_gl_pt_gpu_built_line_space_gives_the_same_image(void **state)
+{
+    (void)state;
+    NEED_GL();
+    const char *const dynamic[] = { "true", "false" };
+    for (int k = 0; k < 2; ++k) {
+        rl_camera cam;
+        rl_scene *s = scene_and_camera("cornell", NULL, &cam);
+        const char *const cpu_opts[] = { "spp", "2", "rng", "hybrid", "ls_n", "3", "ls_dynamic", dynamic[k],
+                                         "shadow", "ls-candidates", "diffuse", "ls-candidates", "ls_build", "cpu",
+                                         NULL };
+        const char *const gpu_opts[] = { "spp", "2", "rng", "hybrid", "ls_n", "3", "ls_dynamic", dynamic[k],
+                                         "shadow", "ls-candidates", "diffuse", "ls-candidates", "ls_build", "gpu",
+                                         NULL };
+        rl_image *cpu = render("gl-pt", s, &cam, cpu_opts);
+        rl_image *gpu = render("gl-pt", s, &cam, gpu_opts);
+        const size_t n = (size_t)cam.width * (size_t)cam.height;
+        size_t lit = 0;
+        for (size_t i = 0; i < n; ++i)
+            lit += cpu->color[i].x > 0.0f;
+        assert_true(lit > n / 2);         /* not two black images */
+        assert_memory_equal(cpu->color, gpu->color, n * sizeof *cpu->color);
+        rl_image_release(gpu);
+        rl_image_release(cpu);
+        rl_scene_release(s);
+    }
+}
+
+/* The payloads only the CPU build makes are refused with ls_build=gpu, at
+ * render time (the option pair, not either value, is wrong). */
+static void test_gl_pt_gpu_build_refuses_records(void **state)
+{
+    (void)state;
+    NEED_GL();
+    const char *const payload[] = { "ls-pnmt", "ls-preillum" };
+    for (int k = 0; k < 2; ++k) {
+        rl_camera cam;
+        rl_scene *s = scene_and_camera("cornell", NULL, &cam);
+        rl_renderer *r =
+            fx_make("gl-pt", (const char *const[]){ "ls_build", "gpu", "diffuse", payload[k], "ls_n", "3", NULL });
+        rl_image *img = NULL;
+        assert_int_equal(rl_image_create(SIZE, SIZE, RL_LAYER_COLOR, &img), RL_OK);
+        rl_clear_error();
+        assert_int_equal(rl_renderer_render(r, s, &cam, img, NULL), RL_ERR_INVALID_ARG);
+        print_message("ls_build=gpu diffuse=%s: %s\n", payload[k], rl_last_error());
+        assert_non_null(strstr(rl_last_error(), "ls_build=gpu"));
+        /* and the same renderer works once the build is the CPU's */
+        assert_int_equal(rl_renderer_set(r, "ls_build", "cpu"), RL_OK);
+        assert_int_equal(rl_renderer_render(r, s, &cam, img, NULL), RL_OK);
+        rl_image_release(img);
+        rl_renderer_release(r);
+        rl_scene_release(s);
+    }
+}
+
 /* 1024 rays from random points in the scene box in random directions, and
  * shadow segments of random length: the GLSL BVH and grid against the CPU
  * BVH. Equal triangle IDs, or where they differ the same distance (a tie:
@@ -284,7 +401,7 @@ static void test_gl_pt_structures_agree_ray_for_ray(void **state)
         hits += rl_accel_intersect(bvh, &q, &cpu[i]);
     }
     assert_true(hits > N / 2);
-    for (int k = 0; k < RL_GL_PT_STRUCTURE_COUNT; ++k) {
+    for (int k = 0; k <= RL_GL_PT_GRID; ++k) {
         assert_int_equal(rl_gl_pt_trace(pt, (rl_gl_pt_structure)k, 0, false, rays, N, gpu), RL_OK);
         size_t ties = 0;
         for (int i = 0; i < N; ++i) {
@@ -306,7 +423,7 @@ static void test_gl_pt_structures_agree_ray_for_ray(void **state)
         rays[i].t_max = len;
         occluded[i] = rl_accel_occluded(bvh, &rays[i]);
     }
-    for (int k = 0; k < RL_GL_PT_STRUCTURE_COUNT; ++k) {
+    for (int k = 0; k <= RL_GL_PT_GRID; ++k) {
         assert_int_equal(rl_gl_pt_trace(pt, (rl_gl_pt_structure)k, 0, true, rays, N, gpu), RL_OK);
         for (int i = 0; i < N; ++i)
             assert_int_equal(gpu[i].triangle != RL_ID_NONE, occluded[i]);
@@ -339,13 +456,14 @@ static void test_gl_pt_refuses_what_is_not_ported(void **state)
 {
     (void)state;
     rl_renderer *r = fx_make("gl-pt", NULL);
-    expect_refused(r, "shadow", "ls-pnmt", "not ported");
     expect_refused(r, "shadow", "shadowmap", "not ported");
     expect_refused(r, "diffuse", "embree", "not ported");
     expect_refused(r, "primary", "raster", "not ported");
     expect_refused(r, "checkerboard", "true", "not ported");
     expect_refused(r, "filter", "bilateral", "not ported");
-    expect_refused(r, "ls_n", "5", "unknown option");
+    expect_refused(r, "ls_file", "x.rlls", "unknown option");
+    expect_refused(r, "ls_k", "3", "even");
+    expect_refused(r, "ls_build", "cuda", "ls_build");
     expect_refused(r, "shadow", "octree", "shadow");
     assert_int_equal(rl_renderer_set(r, "shadow", "grid"), RL_OK);
     assert_int_equal(rl_renderer_set(r, "checkerboard", "false"), RL_OK);
@@ -381,6 +499,9 @@ int main(void)
         cmocka_unit_test(test_gl_pt_means_agree_with_pt),
         cmocka_unit_test(test_gl_pt_draws_pts_numbers),
         cmocka_unit_test(test_gl_pt_structures_agree_ray_for_ray),
+        cmocka_unit_test(test_gl_pt_line_space_draws_pts_numbers),
+        cmocka_unit_test(test_gl_pt_gpu_built_line_space_gives_the_same_image),
+        cmocka_unit_test(test_gl_pt_gpu_build_refuses_records),
         cmocka_unit_test(test_gl_pt_refuses_what_is_not_ported),
         cmocka_unit_test(test_gl_pt_unopenable_device_is_reported_unavailable),
     };
