@@ -195,8 +195,8 @@ static GLuint compute_program(const char *body, bool linespace, const char *what
              (int)RL_GL_PT_LS_PREILLUM, (int)RL_LIGHT_POINT, (int)RL_LIGHT_SPOT,
              (int)RL_LIGHT_DIRECTIONAL, (int)RL_LIGHT_QUAD);
     const char *const parts[] = { rl_gl_pt_glsl_header, linespace ? rl_gl_linespace_glsl() : "", defines,
-                                  rl_gl_pt_glsl_common, body };
-    GLuint s = rl_gl_compile(GL_COMPUTE_SHADER, parts, 5, what);
+                                  rl_gl_pt_glsl_common, rl_gl_glsl_tex_sample, rl_gl_pt_glsl_common2, body };
+    GLuint s = rl_gl_compile(GL_COMPUTE_SHADER, parts, 7, what);
     return s ? rl_gl_link(s, 0, what) : 0;
 }
 

@@ -107,7 +107,9 @@ rl_status rl_gl_pt_trace(rl_gl_pt *pt, rl_gl_pt_structure structure, int grid_re
 
 /* The shader texts (gl_pt_shaders.c). */
 extern const char *const rl_gl_pt_glsl_header;
+/* common, then rl_gl_glsl_tex_sample (gl_shaders.h), then common2 */
 extern const char *const rl_gl_pt_glsl_common;
+extern const char *const rl_gl_pt_glsl_common2;
 extern const char *const rl_gl_pt_glsl_path;
 extern const char *const rl_gl_pt_glsl_rays;
 

@@ -75,32 +75,16 @@ const char *const rl_gl_pt_glsl_common = GLSL(
                                          fetch1(u_normals, 3u * i + 2u)); }
     vec2 uv_at(uint i) { return vec2(fetch1(u_uvs, 2u * i), fetch1(u_uvs, 2u * i + 1u)); }
 
-    /* core/texture_sample.h: bilinear, repeat, texel centres at
-     * half-integers, v up (as gl_shaders.c tex_sample). */
+    /* The texels of tex_sample (rl_gl_glsl_tex_sample, core/texture_sample.h). */
     vec4 texel_at(TexInfo t, int x, int y)
     {
         return texelFetch(u_texels, int(t.offset + uint(clamp(y, 0, t.height - 1) * t.width + clamp(x, 0, t.width - 1))));
     }
+);
 
-    vec4 tex_sample(uint tex, vec2 uv)
-    {
-        TexInfo t = tex_info[tex];
-        float u = isnan(uv.x) || isinf(uv.x) ? 0.0 : uv.x - floor(uv.x);
-        float v = isnan(uv.y) || isinf(uv.y) ? 0.0 : uv.y - floor(uv.y);
-        float fx = u * float(t.width) - 0.5;
-        float fy = (1.0 - v) * float(t.height) - 0.5;
-        float x0f = floor(fx), y0f = floor(fy);
-        float tx = fx - x0f, ty = fy - y0f;
-        int x0 = int(x0f), y0 = int(y0f);
-        int x1 = x0 + 1, y1 = y0 + 1;
-        x0 += x0 < 0 ? t.width : 0;
-        y0 += y0 < 0 ? t.height : 0;
-        x1 -= x1 >= t.width ? t.width : 0;
-        y1 -= y1 >= t.height ? t.height : 0;
-        return (1.0 - tx) * (1.0 - ty) * texel_at(t, x0, y0) + tx * (1.0 - ty) * texel_at(t, x1, y0) +
-               (1.0 - tx) * ty * texel_at(t, x0, y1) + tx * ty * texel_at(t, x1, y1);
-    }
-
+/* After rl_gl_glsl_tex_sample (gl_shaders.c), which the program puts between
+ * the two parts of common. */
+const char *const rl_gl_pt_glsl_common2 = GLSL(
     vec2 interp_uv(uint tri, float u, float v)
     {
         uvec4 T = triangles[tri];

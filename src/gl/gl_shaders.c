@@ -130,7 +130,13 @@ static const char *const common = GLSL(
     {
         return texels[t.offset + uint(clamp(y, 0, t.height - 1) * t.width + clamp(x, 0, t.width - 1))];
     }
+);
 
+/* core/texture_sample.h in GLSL: bilinear, repeat, texel centres at
+ * half-integers, v up. It reads texels through texel_at(TexInfo, x, y) and
+ * the texture records through tex_info[], which each program declares for
+ * its own storage (a storage buffer here, a buffer texture in gl-pt). */
+const char *const rl_gl_glsl_tex_sample = GLSL(
     vec4 tex_sample(uint tex, vec2 uv)
     {
         TexInfo t = tex_info[tex];
@@ -517,9 +523,9 @@ static GLuint link(const char *const *vs, int nvs, const char *const *fs, int nf
 
 GLuint rl_gl_program_triangles(void)
 {
-    const char *const vs[] = { header, common, triangle_vs };
-    const char *const fs[] = { header, common, triangle_fs };
-    return link(vs, 3, fs, 3, "triangle");
+    const char *const vs[] = { header, common, rl_gl_glsl_tex_sample, triangle_vs };
+    const char *const fs[] = { header, common, rl_gl_glsl_tex_sample, triangle_fs };
+    return link(vs, 4, fs, 4, "triangle");
 }
 
 GLuint rl_gl_program_points(void)
@@ -539,6 +545,6 @@ GLuint rl_gl_program_depth_upload(void)
 GLuint rl_gl_program_batch(void)
 {
     const char *const vs[] = { header, batch_vs };
-    const char *const fs[] = { header, common, batch_fs };
-    return link(vs, 2, fs, 3, "batch");
+    const char *const fs[] = { header, common, rl_gl_glsl_tex_sample, batch_fs };
+    return link(vs, 2, fs, 4, "batch");
 }

@@ -59,6 +59,10 @@ GLuint rl_gl_link(GLuint a, GLuint b, const char *what);
 /* The three programs: triangles (every shading mode, queries), points
  * (surfels) and the depth upload at a frame's begin. Zero on failure, with
  * the compiler's log in the recorded error. */
+/* The GLSL of tex_sample(uint tex, vec2 uv) (core/texture_sample.h), for
+ * programs that declare TexInfo, tex_info[] and texel_at() before it. */
+extern const char *const rl_gl_glsl_tex_sample;
+
 GLuint rl_gl_program_triangles(void);
 GLuint rl_gl_program_points(void);
 GLuint rl_gl_program_depth_upload(void);
