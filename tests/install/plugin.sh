@@ -11,8 +11,12 @@ rm -rf "$tmp"
 mkdir -p "$tmp"
 fail() { echo "plugin: $*" >&2; exit 1; }
 
-"$rl" --plugin "$plugin" algos | grep -q eyelight || fail "rl algos does not list the plugin's renderer"
-"$rl" algos | grep -q eyelight && fail "eyelight listed without the plugin"
+# Into files first: grep -q stops reading at its match, and with pipefail
+# the SIGPIPE that rl may then take would fail the test.
+"$rl" --plugin "$plugin" algos > "$tmp/algos_with" || fail "rl --plugin algos failed"
+"$rl" algos > "$tmp/algos_without" || fail "rl algos failed"
+grep -q eyelight "$tmp/algos_with" || fail "rl algos does not list the plugin's renderer"
+grep -q eyelight "$tmp/algos_without" && fail "eyelight listed without the plugin"
 "$rl" -q render cornell --algo eyelight --set eyelight.ambient=0.3 --size 64x48 --out "$tmp/e.png" \
   --plugin="$plugin" > /dev/null
 [ -s "$tmp/e.png" ] || fail "no image from the plugin's renderer"
