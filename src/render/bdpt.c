@@ -131,22 +131,6 @@ static int scene_max_depth(const rl_scene *scene)
     return v && rl_parse_int(v, &n) && n >= 0 && n <= 1024 ? (int)n : 3;
 }
 
-static char *option_signature(const rl_renderer *r)
-{
-    size_t len = 1;
-    for (size_t i = 0; i < NUM_OPTIONS; ++i)
-        len += strlen(bdpt_options[i].key) + strlen(rl_renderer_get(r, bdpt_options[i].key)) + 2;
-    char *sig = rl_alloc(len);
-    if (!sig)
-        return NULL;
-    size_t used = 0;
-    sig[0] = '\0';
-    for (size_t i = 0; i < NUM_OPTIONS; ++i)
-        used += (size_t)snprintf(sig + used, len - used, "%s=%s;", bdpt_options[i].key,
-                                 rl_renderer_get(r, bdpt_options[i].key));
-    return sig;
-}
-
 static bool same_camera(const rl_camera *a, const rl_camera *b)
 {
     return memcmp(&a->eye, &b->eye, sizeof a->eye) == 0 && memcmp(&a->target, &b->target, sizeof a->target) == 0 &&
@@ -271,7 +255,7 @@ static rl_status bdpt_render(rl_renderer *r, void *state, const rl_scene *scene,
     if (!rl_renderer_progress(r, BUILD_SHARE))
         return cancelled(s);
 
-    char *sig = option_signature(r);
+    char *sig = rl_renderer_option_signature(r, NULL);
     if (!sig)
         return RL_ERR_OUT_OF_MEMORY;
     size_t n = (size_t)cam->width * cam->height;

@@ -167,25 +167,6 @@ static rl_status gl_pt_check(const char *key, const char *value)
     return RL_OK;
 }
 
-/* The values of all options as one string: any change restarts the
- * accumulation (threads and device only change how it runs, not the
- * image, but a device change makes a new tracer anyway). */
-static char *option_signature(const rl_renderer *r)
-{
-    size_t len = 1;
-    for (size_t i = 0; i < NUM_OPTIONS; ++i)
-        len += strlen(gl_pt_options[i].key) + strlen(rl_renderer_get(r, gl_pt_options[i].key)) + 2;
-    char *sig = rl_alloc(len);
-    if (!sig)
-        return NULL;
-    size_t used = 0;
-    sig[0] = '\0';
-    for (size_t i = 0; i < NUM_OPTIONS; ++i)
-        used += (size_t)snprintf(sig + used, len - used, "%s=%s;", gl_pt_options[i].key,
-                                 rl_renderer_get(r, gl_pt_options[i].key));
-    return sig;
-}
-
 static bool same_camera(const rl_camera *a, const rl_camera *b)
 {
     return memcmp(&a->eye, &b->eye, sizeof a->eye) == 0 && memcmp(&a->target, &b->target, sizeof a->target) == 0 &&
@@ -338,7 +319,10 @@ static rl_status gl_pt_render(rl_renderer *r, void *state, const rl_scene *scene
     if (st != RL_OK)
         return st;
 
-    char *sig = option_signature(r);
+    /* Any option change restarts the accumulation (threads and device only
+     * change how it runs, not the image, but a device change makes a new
+     * tracer anyway). */
+    char *sig = rl_renderer_option_signature(r, NULL);
     if (!sig)
         return RL_ERR_OUT_OF_MEMORY;
     const bool accumulate = rl_renderer_opt_bool(r, "accumulate");

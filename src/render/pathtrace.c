@@ -357,26 +357,6 @@ static bool option_matters(const rl_renderer *r, size_t i)
     return strcmp(pt_options[i].key, "ls_k") != 0 || !rl_renderer_opt_bool(r, "ls_dynamic");
 }
 
-/* The values of all options that matter as one string: any change restarts
- * the accumulation. */
-static char *option_signature(const rl_renderer *r)
-{
-    size_t len = 1;
-    for (size_t i = 0; i < NUM_OPTIONS; ++i)
-        if (option_matters(r, i))
-            len += strlen(pt_options[i].key) + strlen(rl_renderer_get(r, pt_options[i].key)) + 2;
-    char *sig = rl_alloc(len);
-    if (!sig)
-        return NULL;
-    sig[0] = '\0';
-    size_t used = 0;
-    for (size_t i = 0; i < NUM_OPTIONS; ++i)
-        if (option_matters(r, i))
-            used += (size_t)snprintf(sig + used, len - used, "%s=%s;", pt_options[i].key,
-                                     rl_renderer_get(r, pt_options[i].key));
-    return sig;
-}
-
 static bool same_camera(const rl_camera *a, const rl_camera *b)
 {
     return memcmp(&a->eye, &b->eye, sizeof a->eye) == 0 && memcmp(&a->target, &b->target, sizeof a->target) == 0 &&
@@ -696,7 +676,7 @@ static rl_status prepare_frame(rl_renderer *r, pt_state *s, const rl_scene *scen
     if (!rl_renderer_progress(r, BUILD_SHARE))
         return cancelled(s);
 
-    char *sig = option_signature(r);
+    char *sig = rl_renderer_option_signature(r, option_matters);
     if (!sig)
         return RL_ERR_OUT_OF_MEMORY;
     bool need_reset = s->force_reset || !s->valid || !set->accumulate || s->scene_uid != rl_scene_uid(scene) ||

@@ -47,6 +47,24 @@ static void clear_input(struct renderer_input *in)
 
 void *rl_renderer_state(const rl_renderer *r) { return r ? r->state : NULL; }
 
+char *rl_renderer_option_signature(const rl_renderer *r, bool (*keep)(const rl_renderer *r, size_t i))
+{
+    const rl_option_info *opts = r->cls->options;
+    size_t len = 1;
+    for (size_t i = 0; i < r->cls->num_options; ++i)
+        if (!keep || keep(r, i))
+            len += strlen(opts[i].key) + strlen(rl_renderer_get(r, opts[i].key)) + 2;
+    char *sig = rl_alloc(len);
+    if (!sig)
+        return NULL;
+    sig[0] = '\0';
+    size_t used = 0;
+    for (size_t i = 0; i < r->cls->num_options; ++i)
+        if (!keep || keep(r, i))
+            used += (size_t)snprintf(sig + used, len - used, "%s=%s;", opts[i].key, rl_renderer_get(r, opts[i].key));
+    return sig;
+}
+
 rl_status rl_renderer_set_region(rl_renderer *r, const rl_rect *region)
 {
     if (!r)

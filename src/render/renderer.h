@@ -57,6 +57,11 @@ bool rl_renderer_parse_color(const char *text, rl_vec3 *out);
 /* The implementation's state made by its class's create(), for accessors
  * of a renderer's own (e.g. rl_whitted_pixel_tree). */
 void *rl_renderer_state(const rl_renderer *r);
+/* All of r's option values as one string "key=value;..." (rl_alloc'd; NULL
+ * when out of memory), leaving out option i where keep(r, i) is false (keep
+ * NULL: none left out). The accumulating renderers restart when it
+ * changes. */
+char *rl_renderer_option_signature(const rl_renderer *r, bool (*keep)(const rl_renderer *r, size_t i));
 /* The part of a width x height image to render (rl_renderer_set_region;
  * checked against the image by rl_renderer_render): the whole image when
  * none was set. Only classes with info.regions read it. */
