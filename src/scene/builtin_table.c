@@ -202,7 +202,7 @@ static rl_status add_furniture(table *t)
         b.material = t->m.wood;
         rl_meshbuf_box(&b, rl_v3(lx - 0.5f * LEG, 0.0f, lz - 0.5f * LEG),
                        rl_v3(lx + 0.5f * LEG, y0, lz + 0.5f * LEG));
-        char name[16];
+        char name[24]; /* room for any int: GCC -O1 cannot see i < 4 */
         snprintf(name, sizeof name, "table_leg_%d", i);
         s = add_part(t, &b, name, "table", NULL, NULL);
     }

@@ -167,7 +167,7 @@ static void test_adaptive_converges_to_the_uniform_means(void **state)
     double m[2][SEEDS][3];
     for (int mode = 0; mode < 2; ++mode)
         for (int k = 0; k < SEEDS; ++k) {
-            char seed[8];
+            char seed[16];
             snprintf(seed, sizeof seed, "%d", 10 + k);
             const char *opts[] = { "spp", "32", "seed", seed, "adaptive", mode ? "on" : "off", NULL };
             rl_renderer *r;
