@@ -40,7 +40,11 @@ static const char eval_help_head[] =
     "  --validate N        also measure at N uniform random positions and report\n"
     "                      the absolute error of the approximation there\n"
     "  --out DIR           output folder, created if missing; default out/eval\n"
-    "  --report FILE.html  default DIR/report.html\n";
+    "  --report FILE.html  default DIR/report.html\n"
+    "  --checkpoint FILE   record every measured batch in FILE; run the same\n"
+    "                      command again after a stop and it replays them and\n"
+    "                      measures on (also under rl --dist; the file belongs\n"
+    "                      to this scene, property, options and sampling)\n";
 static const char eval_help_tail[] =
     "\n"
     "example:\n"
@@ -55,7 +59,7 @@ static const char eval_help_tail[] =
 static const char *const combine_ops[] = { "minus", "ratio", "min", "max", NULL };
 
 typedef struct eval_args {
-    const char *scene, *property, *out, *report;
+    const char *scene, *property, *out, *report, *checkpoint;
     const char *sets[MAX_SETS];
     int num_sets;
     const char *second;          /* --property2, or NULL */
@@ -100,6 +104,31 @@ static int print_list(void)
     return RL_CLI_OK;
 }
 
+/* The caller's part of a checkpoint's key (rl_sampling_desc): the
+ * command's scene and properties with all their options. */
+static char *checkpoint_key(const eval_args *a)
+{
+    size_t len = strlen(a->scene) + strlen(a->property) + 64;
+    for (int k = 0; k < a->num_sets; ++k)
+        len += strlen(a->sets[k]) + 8;
+    for (int k = 0; k < a->num_sets2; ++k)
+        len += strlen(a->sets2[k]) + 8;
+    if (a->second)
+        len += strlen(a->second) + strlen(combine_ops[a->combine_op]) + 32;
+    char *key = malloc(len);
+    if (!key)
+        return NULL;
+    size_t at = (size_t)snprintf(key, len, "scene %s\nproperty %s\n", a->scene, a->property);
+    for (int k = 0; k < a->num_sets; ++k)
+        at += (size_t)snprintf(key + at, len - at, "set %s\n", a->sets[k]);
+    if (a->second) {
+        at += (size_t)snprintf(key + at, len - at, "property2 %s\nop %s\n", a->second, combine_ops[a->combine_op]);
+        for (int k = 0; k < a->num_sets2; ++k)
+            at += (size_t)snprintf(key + at, len - at, "set2 %s\n", a->sets2[k]);
+    }
+    return key;
+}
+
 static int parse_args(int argc, char **argv, eval_args *a)
 {
     eval_sampling_init(&a->sampling);
@@ -128,6 +157,8 @@ static int parse_args(int argc, char **argv, eval_args *a)
             a->out = v;
         else if (m == 0 && (m = cli_take_value(argc, argv, &i, "--report", &v)) > 0)
             a->report = v;
+        else if (m == 0 && (m = cli_take_value(argc, argv, &i, "--checkpoint", &v)) > 0)
+            a->checkpoint = v;
         else if (m == 0 && (m = cli_take_value(argc, argv, &i, "--set", &v)) > 0) {
             if (a->num_sets == MAX_SETS)
                 return cli_fail(RL_CLI_USAGE, "--set: at most %d options", MAX_SETS);
@@ -496,7 +527,20 @@ int cli_eval(int argc, char **argv)
         rl_progress_create("sampling", stderr, &progress);
     a.sampling.desc.progress = progress ? rl_progress_update : NULL;
     a.sampling.desc.progress_user = progress;
+    char *key = NULL;
+    if (a.checkpoint) {
+        /* What the library cannot see: the scene, and the options of the
+         * two properties of a combined one. */
+        if (!(key = checkpoint_key(&a))) {
+            rc = cli_fail(RL_CLI_FAIL, "out of memory");
+            goto done;
+        }
+        a.sampling.desc.checkpoint = a.checkpoint;
+        a.sampling.desc.checkpoint_key = key;
+    }
     st = cli_sample_call(p, &a.sampling.desc, &ap);
+    a.sampling.desc.checkpoint = a.sampling.desc.checkpoint_key = NULL;
+    free(key);
     if (progress)
         rl_progress_finish(progress);
     a.sampling.desc.progress = NULL;

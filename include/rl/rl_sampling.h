@@ -250,6 +250,18 @@ typedef struct rl_sampling_desc {          /* zero = default */
     rl_status (*measure)(void *user, const rl_vec3 *pos, uint32_t count, double *values, uint64_t *sets,
                          size_t words);
     void *measure_user;
+    /* Optional: a checkpoint file, a journal of every measured batch
+     * flushed to the disk as it is measured. Where it exists, the run
+     * replays its batches and measures on from its end, so that a run that
+     * stopped is continued by starting it again (the same approximation;
+     * time properties keep their recorded values). The file must belong to
+     * this run: the property, its options, the set size, the sampling
+     * settings and checkpoint_key (the caller's own, e.g. the scene) are
+     * its key, and every replayed batch must have the recorded positions;
+     * otherwise RL_ERR_IO or RL_ERR_INVALID_ARG, the file untouched. A
+     * batch cut off by a killed process is cut away. NULL: none. */
+    const char *checkpoint;
+    const char *checkpoint_key;
 } rl_sampling_desc;
 
 typedef struct rl_approx rl_approx;

@@ -84,7 +84,10 @@ rl_status rl_dist_init(int *argc, char ***argv, rl_dist **out)
     MPI_Comm_rank(MPI_COMM_WORLD, &d->rank);
     MPI_Comm_size(MPI_COMM_WORLD, &d->size);
     d->per_rank = calloc((size_t)d->size, sizeof *d->per_rank);
-    if (!d->per_rank) {
+    d->sampling_lost = calloc((size_t)d->size, 1);
+    if (!d->per_rank || !d->sampling_lost) {
+        free(d->per_rank);
+        free(d->sampling_lost);
         if (d->own_mpi)
             MPI_Finalize();
         free(d);
@@ -105,6 +108,7 @@ void rl_dist_release(rl_dist *d, rl_status status)
     bool own = d->own_mpi;
     int size = d->size;
     free(d->per_rank);
+    free(d->sampling_lost);
     free(d);
     if (!own)
         return;

@@ -22,6 +22,10 @@ struct rl_dist {
     bool own_mpi;                      /* we called MPI_Init: we finalize */
     rl_dist_rank_stats *per_rank;      /* size entries */
     uint64_t tasks_done;               /* by this rank, for rl_dist_fault_point */
+    /* Workers the sampling took for lost (size entries): they stay lost
+     * for the rest of the job, so that later batches and runs do not wait
+     * for them again. */
+    unsigned char *sampling_lost;
 };
 
 /* RL_ERR_IO "distributed run: WHAT: <MPI's text for code>". */

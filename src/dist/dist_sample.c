@@ -20,6 +20,7 @@
  *   worker -> master  VALUES  count doubles, then count * words set words */
 #include "rl/rl_dist.h"
 
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -44,10 +45,39 @@ typedef struct chunk_result {
     char error[256];
 } chunk_result;
 
+/* A worker's place in a batch: up to SLOTS chunks handed out, whose
+ * answers come in order; an answered chunk's values arrive into the
+ * slot's own buffers (a receive of a worker lost mid-transfer may never
+ * end, so it must not write where another rank's values go). */
+/* A worker holds at most PREFETCH chunks, but the values of chunks it has
+ * answered may still be arriving (or, lost mid-transfer, never arrive):
+ * room for both, and more. */
+#define SLOTS (2 * PREFETCH + 4)
+enum { SLOT_FREE, SLOT_HANDED, SLOT_RECEIVING, SLOT_CLOSED };
+
+typedef struct slot {
+    int state;
+    int32_t chunk;
+    MPI_Request rx[2];
+    int nrx;
+    double busy_ms;
+    double values[MAX_CHUNK];
+    uint64_t *sets;                    /* MAX_CHUNK * words, made on first use */
+} slot;
+
+typedef struct holder {
+    slot slots[SLOTS];
+    int pending, receiving;            /* slots handed out / receiving */
+    double since;                      /* when it last answered, or got work while idle */
+} holder;
+
 typedef struct sampler {
     rl_dist *d;
     rl_property *p;
     uint64_t messages, bytes, chunks;
+    int lost;                          /* workers taken for lost during this run */
+    holder *h;                         /* d->size entries, kept for the run: see slot */
+    size_t set_words;                  /* words of the slots' set buffers */
     char failure[320];
 } sampler;
 
@@ -62,106 +92,252 @@ static rl_status send_chunk(sampler *s, int w, int chunk, const rl_vec3 *pos, in
         *buf = b;
         *cap = bytes;
     }
+    holder *ho = &s->h[w];
+    slot *sl = NULL;
+    for (int k = 0; k < SLOTS && !sl; ++k)
+        if (ho->slots[k].state == SLOT_FREE)
+            sl = &ho->slots[k];
+    if (!sl)
+        return rl_error(RL_ERR_INTERNAL, "distributed sampling: rank %d holds more chunks than it has slots", w);
     chunk_header h = { .chunk = chunk, .count = count, .words = (int32_t)words };
     memcpy(*buf, &h, sizeof h);
     memcpy(*buf + sizeof h, pos, (size_t)count * sizeof *pos);
     int code = MPI_Send(*buf, (int)bytes, MPI_BYTE, w, RL_DIST_TAG_TASK, MPI_COMM_WORLD);
     ++s->messages;
     s->bytes += bytes;
-    return code == MPI_SUCCESS ? RL_OK : rl_dist_mpi_failed(code, "handing out positions");
+    if (code != MPI_SUCCESS)
+        return rl_dist_mpi_failed(code, "handing out positions");
+    if (ho->pending == 0 && ho->receiving == 0)
+        ho->since = rl_time_s();
+    sl->state = SLOT_HANDED;
+    sl->chunk = chunk;
+    ++ho->pending;
+    return RL_OK;
 }
 
-/* rl_sampling_desc.measure on the master: one batch over every rank. */
+/* The next chunk to measure: a lost worker's first, then new ones; -1
+ * when none is left. */
+static int take_chunk(int *redo, int *num_redo, int *next, int chunks, const unsigned char *done)
+{
+    while (*num_redo > 0) {
+        int c = redo[--*num_redo];
+        if (!done[c])
+            return c;
+    }
+    return *next < chunks ? (*next)++ : -1;
+}
+
+/* rl_sampling_desc.measure on the master: one batch over every rank.
+ * Fault tolerance as in a distributed frame (dist.c): the master never
+ * blocks on one worker; a worker that holds chunks and has not answered
+ * for RL_DIST_TIMEOUT seconds is taken for lost for the rest of the job,
+ * and its chunks are measured by the others. A value depends only on its
+ * position, so the batch's values are the same whoever measures them. */
 static rl_status measure(void *user, const rl_vec3 *pos, uint32_t n, double *values, uint64_t *sets, size_t words)
 {
     sampler *s = user;
     rl_dist *d = s->d;
-    const int workers = d->size - 1;
     /* Chunks small enough that every rank gets a few per batch, so that
      * the slowest chunk does not hold the batch up. */
     uint32_t chunk = n / (uint32_t)(4 * d->size);
     chunk = chunk < 1 ? 1 : chunk > MAX_CHUNK ? MAX_CHUNK : chunk;
     const int chunks = (int)((n + chunk - 1) / chunk);
+    const double timeout = rl_dist_timeout_s();
+    if (words > s->set_words) {
+        /* Set buffers of a larger size (a closed slot is never used
+         * again, and its buffer may still be a receive's target). */
+        for (int w = 1; w < d->size; ++w)
+            for (int k = 0; k < SLOTS; ++k)
+                if (s->h[w].slots[k].state != SLOT_CLOSED) {
+                    free(s->h[w].slots[k].sets);
+                    s->h[w].slots[k].sets = NULL;
+                }
+        s->set_words = words;
+    }
+    int *redo = malloc((size_t)chunks * sizeof *redo);
+    unsigned char *done = calloc((size_t)chunks, 1);
+    if (!redo || !done) {
+        free(redo);
+        free(done);
+        return RL_ERR_OUT_OF_MEMORY;
+    }
     unsigned char *buf = NULL;
     size_t cap = 0;
-    int next = 0, pending = 0, code = MPI_SUCCESS;
-    rl_status st = RL_OK;
+    int next = 0, num_redo = 0, remaining = chunks, pending = 0, receiving = 0, code = MPI_SUCCESS;
+    rl_status st = RL_OK, failed = RL_OK;
 #define CHUNK_COUNT(c) ((int)((uint32_t)(c) * chunk + chunk <= n ? chunk : n - (uint32_t)(c) * chunk))
     for (int k = 0; k < PREFETCH && st == RL_OK; ++k)
-        for (int w = 1; w <= workers && next < chunks && st == RL_OK; ++w, ++next, ++pending)
-            st = send_chunk(s, w, next, pos + (size_t)next * chunk, CHUNK_COUNT(next), words, &buf, &cap);
+        for (int w = 1; w < d->size && next < chunks && st == RL_OK; ++w)
+            if (!d->sampling_lost[w]) {
+                st = send_chunk(s, w, next, pos + (size_t)next * chunk, CHUNK_COUNT(next), words, &buf, &cap);
+                ++next;
+                ++pending;
+            }
     if (st != RL_OK) {
         free(buf);
+        free(redo);
+        free(done);
         return st;           /* the CLI aborts the job: workers may hold chunks */
     }
-    rl_status failed = RL_OK;
-    while (code == MPI_SUCCESS && (pending > 0 || (failed == RL_OK && next < chunks))) {
+    while (code == MPI_SUCCESS && (failed == RL_OK ? remaining > 0 : pending + receiving > 0)) {
+        /* Values that have come in complete their chunks. */
+        for (int w = 1; w < d->size && code == MPI_SUCCESS; ++w)
+            for (int k = 0; k < SLOTS && s->h[w].receiving > 0; ++k) {
+                slot *sl = &s->h[w].slots[k];
+                if (sl->state != SLOT_RECEIVING)
+                    continue;
+                int complete = 0;
+                if ((code = MPI_Testall(sl->nrx, sl->rx, &complete, MPI_STATUSES_IGNORE)) != MPI_SUCCESS)
+                    break;
+                if (!complete)
+                    continue;
+                if (!done[sl->chunk]) {          /* a lost worker's late answer may come twice */
+                    size_t off = (size_t)sl->chunk * chunk, cnt = (size_t)CHUNK_COUNT(sl->chunk);
+                    memcpy(values + off, sl->values, cnt * sizeof *values);
+                    if (words)
+                        memcpy(sets + off * words, sl->sets, cnt * words * sizeof *sets);
+                    d->per_rank[w].tasks += 1;
+                    d->per_rank[w].pixels += cnt;
+                    d->per_rank[w].busy_ms += sl->busy_ms;
+                    done[sl->chunk] = 1;
+                    --remaining;
+                }
+                sl->state = SLOT_FREE;
+                --s->h[w].receiving;
+                if (!d->sampling_lost[w])
+                    --receiving;
+                s->h[w].since = rl_time_s();
+            }
+        if (code != MPI_SUCCESS)
+            break;
         int arrived = 0;
         MPI_Status ms;
         if ((code = MPI_Iprobe(MPI_ANY_SOURCE, RL_DIST_TAG_RESULT, MPI_COMM_WORLD, &arrived, &ms)) != MPI_SUCCESS)
             break;
-        if (!arrived && failed == RL_OK && next < chunks) {
-            /* Nothing to answer: measure a chunk here. */
-            int c = next++;
-            size_t off = (size_t)c * chunk;
-            rl_timer t;
-            rl_timer_start(&t);
-            rl_status ms_st = rl_property_measure_sets(s->p, pos + off, (size_t)CHUNK_COUNT(c), values + off,
-                                                       words ? sets + off * words : NULL, NULL, NULL);
-            d->per_rank[0].busy_ms += rl_timer_ms(&t);
-            d->per_rank[0].tasks += 1;
-            d->per_rank[0].pixels += (uint64_t)CHUNK_COUNT(c);
-            if (ms_st != RL_OK) {
-                failed = ms_st;
-                snprintf(s->failure, sizeof s->failure, "%s", rl_last_error());
+        if (!arrived) {
+            int c = failed == RL_OK ? take_chunk(redo, &num_redo, &next, chunks, done) : -1;
+            if (c >= 0) {
+                /* Nothing to answer: measure a chunk here. */
+                size_t off = (size_t)c * chunk;
+                rl_timer t;
+                rl_timer_start(&t);
+                rl_status ms_st = rl_property_measure_sets(s->p, pos + off, (size_t)CHUNK_COUNT(c), values + off,
+                                                           words ? sets + off * words : NULL, NULL, NULL);
+                d->per_rank[0].busy_ms += rl_timer_ms(&t);
+                d->per_rank[0].tasks += 1;
+                d->per_rank[0].pixels += (uint64_t)CHUNK_COUNT(c);
+                if (ms_st != RL_OK) {
+                    failed = ms_st;
+                    snprintf(s->failure, sizeof s->failure, "%s", rl_last_error());
+                } else {
+                    done[c] = 1;
+                    --remaining;
+                }
+                continue;
             }
+            /* Waiting: a worker silent past the timeout is lost. */
+            double now = rl_time_s();
+            for (int w = 1; w < d->size; ++w) {
+                holder *ho = &s->h[w];
+                if (d->sampling_lost[w] || ho->pending + ho->receiving == 0 || now - ho->since <= timeout)
+                    continue;
+                d->sampling_lost[w] = 1;
+                ++s->lost;
+                pending -= ho->pending;
+                receiving -= ho->receiving;
+                for (int k = 0; k < SLOTS; ++k) {
+                    slot *sl = &ho->slots[k];
+                    if ((sl->state == SLOT_HANDED || sl->state == SLOT_RECEIVING) && !done[sl->chunk])
+                        redo[num_redo++] = sl->chunk;
+                    if (sl->state == SLOT_RECEIVING) {
+                        /* Values that stopped coming never will: the
+                         * receives are cancelled and left, the slot closed
+                         * for the run (a dead sender completes nothing). */
+                        for (int j = 0; j < sl->nrx; ++j)
+                            MPI_Cancel(&sl->rx[j]);
+                        sl->state = SLOT_CLOSED;
+                    } else if (sl->state == SLOT_HANDED) {
+                        sl->state = SLOT_FREE;
+                    }
+                }
+                ho->pending = ho->receiving = 0;
+                rl_log(RL_LOG_WARN, "rank %d has not answered for %.0f s: taken for lost, its positions go to "
+                       "the other ranks (RL_DIST_TIMEOUT)", w, now - ho->since);
+            }
+            if (pending + receiving > 0)
+                rl_dist_pause();
             continue;
         }
-        if (!arrived && (code = MPI_Probe(MPI_ANY_SOURCE, RL_DIST_TAG_RESULT, MPI_COMM_WORLD, &ms)) != MPI_SUCCESS)
-            break;
         int w = ms.MPI_SOURCE;
         chunk_result res;
         if ((code = MPI_Recv(&res, (int)sizeof res, MPI_BYTE, w, RL_DIST_TAG_RESULT, MPI_COMM_WORLD,
                              MPI_STATUS_IGNORE)) != MPI_SUCCESS)
             break;
-        --pending;
         ++s->messages;
         s->bytes += sizeof res;
-        if (res.chunk < 0 || res.chunk >= chunks) {
-            code = MPI_ERR_OTHER;
+        holder *ho = &s->h[w];
+        slot *sl = NULL;
+        if (res.chunk >= 0 && res.chunk < chunks)
+            for (int k = 0; k < SLOTS && !sl; ++k)
+                if (ho->slots[k].state == SLOT_HANDED && ho->slots[k].chunk == res.chunk)
+                    sl = &ho->slots[k];
+        if (!sl && d->sampling_lost[w])
+            continue;        /* a lost worker's late answer, of this batch or an earlier one: redone */
+        if (!sl) {
+            code = MPI_ERR_OTHER;        /* an answer nobody asked for: not our protocol */
             break;
         }
+        --ho->pending;
+        if (!d->sampling_lost[w])
+            --pending;
+        ho->since = rl_time_s();
         if (res.status == RL_OK) {
-            size_t off = (size_t)res.chunk * chunk, cnt = (size_t)CHUNK_COUNT(res.chunk);
-            code = MPI_Recv(values + off, (int)cnt, MPI_DOUBLE, w, RL_DIST_TAG_VALUES, MPI_COMM_WORLD,
-                            MPI_STATUS_IGNORE);
+            /* The values come while this rank measures on; the chunk is
+             * done when they are in (above). */
+            size_t cnt = (size_t)CHUNK_COUNT(res.chunk);
+            if (words && !sl->sets && !(sl->sets = malloc((size_t)MAX_CHUNK * words * sizeof *sl->sets))) {
+                st = RL_ERR_OUT_OF_MEMORY;
+                break;
+            }
+            sl->state = SLOT_RECEIVING;
+            sl->busy_ms = res.busy_ms;
+            sl->nrx = 0;
+            code = MPI_Irecv(sl->values, (int)cnt, MPI_DOUBLE, w, RL_DIST_TAG_VALUES, MPI_COMM_WORLD,
+                             &sl->rx[sl->nrx++]);
             s->bytes += cnt * sizeof(double);
             ++s->messages;
             if (code == MPI_SUCCESS && words) {
-                code = MPI_Recv(sets + off * words, (int)(cnt * words), MPI_UINT64_T, w, RL_DIST_TAG_VALUES,
-                                MPI_COMM_WORLD, MPI_STATUS_IGNORE);
+                code = MPI_Irecv(sl->sets, (int)(cnt * words), MPI_UINT64_T, w, RL_DIST_TAG_VALUES,
+                                 MPI_COMM_WORLD, &sl->rx[sl->nrx++]);
                 s->bytes += cnt * words * sizeof(uint64_t);
                 ++s->messages;
             }
             if (code != MPI_SUCCESS)
                 break;
-            d->per_rank[w].tasks += 1;
-            d->per_rank[w].pixels += cnt;
-            d->per_rank[w].busy_ms += res.busy_ms;
-        } else if (failed == RL_OK) {
-            failed = (rl_status)res.status;
-            res.error[sizeof res.error - 1] = '\0';
-            snprintf(s->failure, sizeof s->failure, "rank %d: %s", w, res.error);
+            ++ho->receiving;
+            if (!d->sampling_lost[w])
+                ++receiving;
+        } else {
+            sl->state = SLOT_FREE;
+            if (failed == RL_OK) {
+                failed = (rl_status)res.status;
+                res.error[sizeof res.error - 1] = '\0';
+                snprintf(s->failure, sizeof s->failure, "rank %d: %s", w, res.error);
+            }
         }
-        if (failed == RL_OK && next < chunks) {
-            int c = next++;
-            if ((st = send_chunk(s, w, c, pos + (size_t)c * chunk, CHUNK_COUNT(c), words, &buf, &cap)) != RL_OK)
-                break;
-            ++pending;
+        if (failed == RL_OK && !d->sampling_lost[w]) {
+            int c = take_chunk(redo, &num_redo, &next, chunks, done);
+            if (c >= 0) {
+                if ((st = send_chunk(s, w, c, pos + (size_t)c * chunk, CHUNK_COUNT(c), words, &buf, &cap)) != RL_OK)
+                    break;
+                ++pending;
+            }
         }
     }
 #undef CHUNK_COUNT
     free(buf);
+    free(redo);
+    free(done);
     s->chunks += (uint64_t)chunks;
     if (code != MPI_SUCCESS)
         return rl_dist_mpi_failed(code, "collecting measured values");
@@ -171,7 +347,7 @@ static rl_status measure(void *user, const rl_vec3 *pos, uint32_t n, double *val
 }
 
 /* A sampling node: chunks until DONE, whose status it returns. */
-static rl_status serve(const rl_dist *d, rl_property *p)
+static rl_status serve(rl_dist *d, rl_property *p)
 {
     unsigned char *buf = NULL;
     double *values = NULL;
@@ -250,6 +426,7 @@ static rl_status serve(const rl_dist *d, rl_property *p)
             st = rl_dist_send(d, sets, (int)((size_t)h.count * words), MPI_UINT64_T, 0, RL_DIST_TAG_VALUES);
         if (st != RL_OK)
             break;
+        rl_dist_fault_point(d);
     }
     free(buf);
     free(values);
@@ -257,17 +434,59 @@ static rl_status serve(const rl_dist *d, rl_property *p)
     return st;
 }
 
-/* The control node ends a run: every worker gets its status (DONE). */
+/* The control node ends a run: every live worker gets its status (DONE).
+ * A lost one does not: a send to a dead rank may never return; one that
+ * was only slow gives up by its own timeout (rl_dist_wait). */
 static rl_status end_run(sampler *s, rl_status st)
 {
     int32_t done = (int32_t)st;
     for (int w = 1; w < s->d->size; ++w) {
+        if (s->d->sampling_lost[w])
+            continue;
         int code = MPI_Send(&done, 1, MPI_INT32_T, w, RL_DIST_TAG_DONE, MPI_COMM_WORLD);
         ++s->messages;
         if (code != MPI_SUCCESS && st == RL_OK)
             st = rl_dist_mpi_failed(code, "ending the sampling");
     }
     return st;
+}
+
+static rl_status sampler_init(sampler *s, rl_dist *d, rl_property *p)
+{
+    memset(s, 0, sizeof *s);
+    s->d = d;
+    s->p = p;
+    if (!(s->h = calloc((size_t)d->size, sizeof *s->h)))
+        return RL_ERR_OUT_OF_MEMORY;
+    return RL_OK;
+}
+
+/* The run's totals into ds, and the slots' buffers freed. A closed slot
+ * (a lost worker's receive, cancelled) is freed only where MPI has let go
+ * of its receives; otherwise the holders stay allocated (a few kilobytes
+ * per worker lost mid-transfer), since the receive may still write. */
+static void sampler_finish(sampler *s, rl_dist_stats *ds)
+{
+    ds->tasks = s->chunks;
+    ds->messages = s->messages;
+    ds->bytes = s->bytes;
+    ds->lost = s->lost;
+    bool in_use = false;
+    for (int w = 1; s->h && w < s->d->size; ++w)
+        for (int k = 0; k < SLOTS; ++k) {
+            slot *sl = &s->h[w].slots[k];
+            int released = 1;
+            if (sl->state == SLOT_CLOSED &&
+                (MPI_Testall(sl->nrx, sl->rx, &released, MPI_STATUSES_IGNORE) != MPI_SUCCESS || !released)) {
+                in_use = true;
+                continue;
+            }
+            free(sl->sets);
+            sl->sets = NULL;
+        }
+    if (!in_use)
+        free(s->h);
+    s->h = NULL;
 }
 
 rl_status rl_dist_sample_property(rl_dist *d, rl_property *p, const rl_sampling_desc *desc, rl_approx **out,
@@ -293,18 +512,18 @@ rl_status rl_dist_sample_property(rl_dist *d, rl_property *p, const rl_sampling_
     rl_timer_start(&t);
     rl_status st;
     if (d->rank == 0) {
-        sampler s = { .d = d, .p = p };
+        sampler s;
+        st = sampler_init(&s, d, p);
         rl_sampling_desc dd = *desc;
         dd.measure = measure;
         dd.measure_user = &s;
-        st = rl_sample_property(p, &dd, out);
+        if (st == RL_OK)
+            st = rl_sample_property(p, &dd, out);
         if ((st = end_run(&s, st)) != RL_OK) {
             rl_approx_release(*out);
             *out = NULL;
         }
-        ds->tasks = s.chunks;
-        ds->messages = s.messages;
-        ds->bytes = s.bytes;
+        sampler_finish(&s, ds);
     } else {
         st = serve(d, p);
     }
@@ -331,10 +550,13 @@ rl_status rl_dist_measure(rl_dist *d, rl_property *p, const rl_vec3 *pos, size_t
     memset(d->per_rank, 0, (size_t)d->size * sizeof *d->per_rank);
     rl_status st;
     if (d->rank == 0) {
-        sampler s = { .d = d, .p = p };
+        sampler s;
+        rl_status init = sampler_init(&s, d, p);
         /* Even a call that cannot measure ends the run on the workers,
          * which wait in serve() for it. */
-        if (!p)
+        if (init != RL_OK)
+            st = init;
+        else if (!p)
             st = rl_error(RL_ERR_INVALID_ARG, "rl_dist_measure: no property");
         else if (count && (!pos || !values))
             st = rl_error(RL_ERR_INVALID_ARG, "rl_dist_measure: positions and values must not be NULL");
@@ -343,9 +565,7 @@ rl_status rl_dist_measure(rl_dist *d, rl_property *p, const rl_vec3 *pos, size_t
         else
             st = count ? measure(&s, pos, (uint32_t)count, values, NULL, 0) : RL_OK;
         st = end_run(&s, st);
-        ds->tasks = s.chunks;
-        ds->messages = s.messages;
-        ds->bytes = s.bytes;
+        sampler_finish(&s, ds);
     } else {
         /* A worker without the property answers every chunk with the
          * error, so that the master ends the run for all. */

@@ -31,6 +31,7 @@
 
 #include "core/error.h"
 #include "eval/sampling_internal.h"
+#include "eval/sampling_journal.h"
 #include "rl/rl_timer.h"
 
 #define DEFAULT_MAX_SAMPLES 1024u
@@ -757,6 +758,80 @@ static rl_status run_adaptive(rl_property *p, const rl_sampling_desc *d, int wor
     return st;
 }
 
+/* The checkpoint (rl_sampling_desc.checkpoint) sits between the sampler
+ * and whatever measures its batches: recorded batches are replayed, the
+ * others measured (by the property's workers or desc.measure) and
+ * recorded. */
+typedef struct journaled {
+    rl_journal *j;
+    rl_sampling_desc inner;             /* the run's desc with its own measure */
+    rl_property *p;
+    int workers;
+    bool exclusive, told;
+} journaled;
+
+static rl_status journaled_measure(void *user, const rl_vec3 *pos, uint32_t n, double *values, uint64_t *sets,
+                                   size_t words)
+{
+    journaled *jm = user;
+    bool hit = false;
+    rl_status st = rl_journal_replay(jm->j, pos, n, values, sets, words, &hit);
+    if (st != RL_OK || hit)
+        return st;
+    if (!jm->told && rl_journal_replayed(jm->j) > 0)
+        rl_info("checkpoint %s: %llu samples replayed; measuring on from there", jm->inner.checkpoint,
+                (unsigned long long)rl_journal_replayed(jm->j));
+    jm->told = true;
+    st = evaluate_batch(&jm->inner, jm->p, jm->workers, jm->exclusive, pos, n, values, sets, words);
+    return st == RL_OK ? rl_journal_append(jm->j, pos, n, values, sets, words) : st;
+}
+
+/* What a checkpoint must agree on beside its positions: the property and
+ * its options (a value depends on them, not only on its position), the
+ * set size and the sampling settings, and the caller's key. */
+static char *checkpoint_key(const rl_property *p, const rl_sampling_desc *d)
+{
+    size_t cap = 1024, len = 0;
+    char *k = malloc(cap);
+    if (!k)
+        return NULL;
+#define KEY_ADD(...)                                                                                             \
+    do {                                                                                                         \
+        int m_ = snprintf(k + len, cap - len, __VA_ARGS__);                                                      \
+        if (m_ < 0) {                                                                                            \
+            free(k);                                                                                             \
+            return NULL;                                                                                         \
+        }                                                                                                        \
+        if ((size_t)m_ >= cap - len) {                                                                           \
+            size_t c_ = 2 * cap + (size_t)m_;                                                                    \
+            char *b_ = realloc(k, c_);                                                                           \
+            if (!b_) {                                                                                           \
+                free(k);                                                                                         \
+                return NULL;                                                                                     \
+            }                                                                                                    \
+            k = b_;                                                                                              \
+            cap = c_;                                                                                            \
+            m_ = snprintf(k + len, cap - len, __VA_ARGS__);                                                      \
+        }                                                                                                        \
+        len += (size_t)m_;                                                                                       \
+    } while (0)
+    KEY_ADD("renderlab sampling checkpoint\nproperty %s\n", rl_property_name(p));
+    size_t n = 0;
+    const rl_option_info *opts = rl_property_options(p, &n);
+    for (size_t i = 0; i < n; ++i) {
+        const char *v = rl_property_get(p, opts[i].key);
+        KEY_ADD("option %s=%s\n", opts[i].key, v ? v : "");
+    }
+    KEY_ADD("set_size %u\nmethod %d positions %d dims %d height %.9g samples %u seconds %.17g seed %llu\n",
+            rl_property_set_size(p), (int)d->method, (int)d->positions, d->dims, (double)d->height,
+            d->max_samples, d->max_seconds, (unsigned long long)d->seed);
+    KEY_ADD("region %.9g %.9g %.9g %.9g %.9g %.9g\n", (double)d->region.min.x, (double)d->region.min.y,
+            (double)d->region.min.z, (double)d->region.max.x, (double)d->region.max.y, (double)d->region.max.z);
+    KEY_ADD("user %s\n", d->checkpoint_key ? d->checkpoint_key : "");
+#undef KEY_ADD
+    return k;
+}
+
 rl_status rl_sample_property(rl_property *p, const rl_sampling_desc *desc, rl_approx **out)
 {
     if (!p || !desc || !out)
@@ -772,7 +847,25 @@ rl_status rl_sample_property(rl_property *p, const rl_sampling_desc *desc, rl_ap
                          rl_property_set_size(p), &a);
     if (st != RL_OK)
         return st;
-    st = d.method == RL_SAMPLING_GRID ? run_grid(p, &d, workers, t0, a) : run_adaptive(p, &d, workers, t0, a);
+    journaled jm = { .inner = d, .p = p, .workers = workers,
+                     .exclusive = (rl_property_get_flags(p) & RL_PROPERTY_EXCLUSIVE) != 0 };
+    rl_sampling_desc run = d;
+    if (d.checkpoint) {
+        char *key = checkpoint_key(p, &d);
+        st = key ? rl_journal_open(d.checkpoint, key, &jm.j) : RL_ERR_OUT_OF_MEMORY;
+        free(key);
+        if (st != RL_OK) {
+            rl_approx_release(a);
+            return st;
+        }
+        run.measure = journaled_measure;
+        run.measure_user = &jm;
+    }
+    st = d.method == RL_SAMPLING_GRID ? run_grid(p, &run, workers, t0, a) : run_adaptive(p, &run, workers, t0, a);
+    if (st == RL_OK && jm.j && !jm.told)
+        rl_info("checkpoint %s: all %llu samples replayed", d.checkpoint,
+                (unsigned long long)rl_journal_replayed(jm.j));
+    rl_journal_close(jm.j);
     if (st != RL_OK) {
         rl_approx_release(a);
         return st;
@@ -782,6 +875,8 @@ rl_status rl_sample_property(rl_property *p, const rl_sampling_desc *desc, rl_ap
     a->desc.progress_user = NULL;
     a->desc.measure = NULL;
     a->desc.measure_user = NULL;
+    a->desc.checkpoint = NULL;
+    a->desc.checkpoint_key = NULL;
     a->seconds = rl_time_s() - t0;
     *out = a;
     return RL_OK;

@@ -145,6 +145,28 @@ run_ok "${RECOVER[@]}" RL_DIST_FAULT=2:1 "${MPI[@]}" "$RL" --dist render spheres
 cmp -s "$TMP/ref.png" "$TMP/lost.png" || fail "a lost worker changed the image"
 expect_in "$TMP/out" "^dist: [12] workers\? lost"
 expect_in "$TMP/err" "rank 2 has not answered for [0-9]* s: taken for lost"
+# The same for sampling: rank 2 dies after its first chunk of positions;
+# its chunks are measured by the others and the approximation is still the
+# one-process one, sample for sample.
+# It also keeps a checkpoint; cut short (a job killed while writing), the
+# checkpoint lets a new distributed run continue where it ended, with the
+# same approximation.
+run_ok "${RECOVER[@]}" RL_DIST_FAULT=2:1 "${MPI[@]}" "$RL" --dist eval city:blocks=1 --property visibility \
+    --set resolution=16 --samples 40 --seed 7 --out "$TMP/e-lost" --checkpoint "$TMP/e-ck.bin"
+expect_in "$TMP/out" "^dist: 1 worker lost"
+expect_in "$TMP/err" "rank 2 has not answered for [0-9]* s: taken for lost, its positions go to"
+truncate -s $(($(stat -c %s "$TMP/e-ck.bin") / 2)) "$TMP/e-ck.bin"
+run_ok "${MPI[@]}" "$RL" --dist eval city:blocks=1 --property visibility --set resolution=16 --samples 40 \
+    --seed 7 --out "$TMP/e-resumed" --checkpoint "$TMP/e-ck.bin"
+expect_in "$TMP/err" "checkpoint .*e-ck.bin: [0-9]* samples replayed; measuring on from there"
+python3 - "$TMP/e1/approx.json" "$TMP/e-lost/approx.json" "$TMP/e-resumed/approx.json" <<'PY' ||
+import json, sys
+a, b, c = (json.load(open(f)) for f in sys.argv[1:4])
+for x in (a, b, c):
+    x.pop("seconds")
+assert a == b == c
+PY
+    fail "a lost sampling node or a resumed distributed run changed the approximation"
 # A dead master (it kills itself after its first band): by default mpirun
 # ends the job at once; with recovery on, every worker gives up with an
 # error after the timeout. Neither hangs (timeout 120 above), neither

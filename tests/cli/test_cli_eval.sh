@@ -245,4 +245,35 @@ assert r["cases_met"] == sum(c["adaptive_no_worse_than_grid"] for c in r["cases"
 assert r["cases_met_thesis_grid"] == sum(c["adaptive_no_worse_than_thesis_grid"] for c in r["cases"])
 assert r["cases_met_shifted_grid"] == sum(c["adaptive_no_worse_than_shifted_grid"] for c in r["cases"])
 PY
+# --checkpoint: a journal of the measured batches. A run that stopped (here
+# the file cut in the middle of a batch, as a kill while writing leaves it)
+# is continued by the same command: the recorded batches are replayed, the
+# rest measured, and the approximation is the uninterrupted run's. A file of
+# another evaluation is refused and left alone; so is a folder.
+CK=(city:blocks=1 --property visibility --set resolution=16 --samples 60 --seed 7)
+run_ok "$RL" eval "${CK[@]}" --out "$TMP/ck0" -q
+run_ok "$RL" eval "${CK[@]}" --out "$TMP/ck1" --checkpoint "$TMP/ck.bin" -q
+size=$(stat -c %s "$TMP/ck.bin")
+cp "$TMP/ck.bin" "$TMP/ck-whole.bin"
+truncate -s $((size * 2 / 3)) "$TMP/ck.bin"
+run_ok "$RL" eval "${CK[@]}" --out "$TMP/ck2" --checkpoint "$TMP/ck.bin"
+expect_in "$TMP/err" "checkpoint .*ck.bin: [0-9]* samples replayed; measuring on from there"
+cmp -s "$TMP/ck.bin" "$TMP/ck-whole.bin" || fail "the resumed run's checkpoint differs from an uninterrupted one's"
+python3 - "$TMP/ck0/approx.json" "$TMP/ck1/approx.json" "$TMP/ck2/approx.json" <<'PY' ||
+import json, sys
+a, b, c = (json.load(open(f)) for f in sys.argv[1:4])
+for x in (a, b, c):
+    x.pop("seconds")
+assert a == b == c
+PY
+    fail "a checkpointed or resumed run differs from the plain one"
+expect_exit 1 "$RL" eval "${CK[@]}" --set resolution=32 --out "$TMP/ck3" --checkpoint "$TMP/ck.bin"
+expect_in "$TMP/err" "checkpoint .*ck.bin: it belongs to another evaluation"
+cmp -s "$TMP/ck.bin" "$TMP/ck-whole.bin" || fail "a refused checkpoint was changed"
+[ ! -e "$TMP/ck3/approx.json" ] || fail "a refused checkpoint run wrote an approximation"
+expect_exit 1 "$RL" eval "${CK[@]}" --out "$TMP/ck3" --checkpoint "$TMP"
+expect_in "$TMP/err" "not a regular file"
+printf 'garbage' >"$TMP/ck-bad.bin"
+expect_exit 1 "$RL" eval "${CK[@]}" --out "$TMP/ck3" --checkpoint "$TMP/ck-bad.bin"
+expect_in "$TMP/err" "not a renderlab sampling checkpoint"
 echo "ok"
