@@ -712,8 +712,13 @@ static rl_status render_frames(rl_dist *d, rl_renderer *r, const rl_scene *scene
     memset(d->per_rank, 0, (size_t)d->size * sizeof *d->per_rank);
     rl_timer t;
     rl_timer_start(&t);
+    /* Whole-image passes (pt's filter) wait for the assembled image. */
+    rl_renderer_defer_whole_passes(r, true);
     rl_status st = d->rank == 0 ? lead(d, r, scene, cam, frames, image, rs, ds)
                                 : work(d, r, scene, cam, frames, image);
+    rl_renderer_defer_whole_passes(r, false);
+    if (st == RL_OK && d->rank == 0)
+        st = rl_renderer_finish_regions(r, scene, cam, image, rs->samples);
     rs->time_ms = ds->time_ms = rl_timer_ms(&t);
     ds->per_rank = d->per_rank;
     return st;

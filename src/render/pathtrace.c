@@ -596,9 +596,10 @@ static void resolve(const pt_state *s, const rl_rect *region, rl_image *image)
 #define PT_ATROUS_RT_1SPP 1.0f
 
 /* Sec. 8.2: filter, faded out as the samples grow. */
-static rl_status apply_filter(const pt_state *s, const pt_settings *set, rl_image *image, float *weight)
+static rl_status apply_filter(const pt_state *s, const pt_settings *set, uint64_t total_samples, rl_image *image,
+                              float *weight)
 {
-    double spp = (double)s->total_samples / ((double)s->width * s->height);
+    double spp = (double)total_samples / ((double)s->width * s->height);
     float w = set->filter_fade > 0.0 ? (float)(1.0 / (1.0 + spp / set->filter_fade)) : 1.0f;
     *weight = w;
     rl_image *in = NULL, *out = NULL;
@@ -1046,8 +1047,11 @@ static rl_status pt_render(rl_renderer *r, void *state, const rl_scene *scene, c
     read_settings(r, &set);
     s->have_frame = false;
     rl_rect region = rl_renderer_region(r, cam->width, cam->height), area = region;
-    if (region.x0 > 0 || region.y0 > 0 || region.x1 < cam->width || region.y1 < cam->height) {
-        if (set.filter != RL_FILTER_NONE)
+    bool part = region.x0 > 0 || region.y0 > 0 || region.x1 < cam->width || region.y1 < cam->height;
+    /* A distributed frame filters its assembled image (pt_finish_regions). */
+    bool filter_here = set.filter != RL_FILTER_NONE && !(part && rl_renderer_whole_passes_deferred(r));
+    if (part) {
+        if (filter_here)
             return rl_error(RL_ERR_UNSUPPORTED, "pt: filter=%s filters the whole image; a region (rl --dist) "
                             "needs filter=none", filter_choices[set.filter]);
         if (set.primary == PT_PRIMARY_RASTER)
@@ -1115,10 +1119,10 @@ static rl_status pt_render(rl_renderer *r, void *state, const rl_scene *scene, c
     s->total_samples += samples;
 
     resolve(s, &region, image);
-    if (set.filter != RL_FILTER_NONE) {
+    if (filter_here) {
         rl_timer timer;
         rl_timer_start(&timer);
-        st = apply_filter(s, &set, image, &ps.filter_weight);
+        st = apply_filter(s, &set, s->total_samples, image, &ps.filter_weight);
         ps.time_filter_ms = rl_timer_ms(&timer);
         if (st != RL_OK)
             return st;
@@ -1130,6 +1134,34 @@ static rl_status pt_render(rl_renderer *r, void *state, const rl_scene *scene, c
     s->stats = ps;
     s->have_frame = true;
     return RL_OK;
+}
+
+/* After a distributed frame (rl_renderer_finish_regions): the filter of
+ * Sec. 8.2 over the assembled image, guided by a G-buffer of the whole
+ * image traced here (one ray per pixel), with the frame's samples over
+ * all regions; the one-process image bit for bit, since the filter reads
+ * only the accumulated colours, the G-buffer and the sample count. The
+ * state is left to restart: it holds no accumulation of the whole image. */
+static rl_status pt_finish_regions(rl_renderer *r, void *state, const rl_scene *scene, const rl_camera *cam,
+                                   rl_image *image, uint64_t samples)
+{
+    pt_state *s = state;
+    pt_settings set;
+    read_settings(r, &set);
+    if (set.filter == RL_FILTER_NONE)
+        return RL_OK;
+    if (!rl_scene_get_data(scene))
+        return RL_ERR_NOT_COMMITTED;
+    rl_rect whole = { 0, 0, cam->width, cam->height };
+    rl_pt_stats ps;
+    memset(&ps, 0, sizeof ps);
+    s->force_reset = true;
+    rl_status st = prepare_frame(r, s, scene, cam, &set, &whole, &ps);
+    s->force_reset = true;
+    if (st != RL_OK)
+        return st;
+    float weight = 0.0f;
+    return apply_filter(s, &set, samples, image, &weight);
 }
 
 /* The state of r if it is a "pt" renderer, else NULL. */
@@ -1205,4 +1237,5 @@ const rl_renderer_class rl_pt_renderer_class = {
     .release = pt_release,
     .check = pt_check,
     .reset = pt_reset_state,
+    .finish_regions = pt_finish_regions,
 };

@@ -33,6 +33,7 @@ struct rl_renderer {
     } inputs[RL_RENDERER_MAX_INPUTS];
     rl_rect region;             /* rl_renderer_set_region */
     bool has_region;
+    bool defer_whole;           /* rl_renderer_defer_whole_passes */
 };
 
 static void clear_input(struct renderer_input *in)
@@ -78,6 +79,22 @@ rl_status rl_renderer_set_region(rl_renderer *r, const rl_rect *region)
     if (region)
         r->region = *region;
     return RL_OK;
+}
+
+void rl_renderer_defer_whole_passes(rl_renderer *r, bool defer)
+{
+    if (r)
+        r->defer_whole = defer && r->cls->finish_regions;
+}
+
+bool rl_renderer_whole_passes_deferred(const rl_renderer *r) { return r && r->defer_whole; }
+
+rl_status rl_renderer_finish_regions(rl_renderer *r, const rl_scene *scene, const rl_camera *cam, rl_image *image,
+                                     uint64_t samples)
+{
+    if (!r || !r->cls->finish_regions)
+        return RL_OK;
+    return r->cls->finish_regions(r, r->state, scene, cam, image, samples);
 }
 
 rl_rect rl_renderer_region(const rl_renderer *r, int width, int height)

@@ -36,6 +36,12 @@ typedef struct rl_renderer_class {
     /* Optional lookup inputs (rl_renderer_set_input), by slot name. */
     const char *const *inputs;
     size_t num_inputs;
+    /* Optional, for classes with regions: the whole-image passes that a
+     * region render leaves out while they are deferred
+     * (rl_renderer_defer_whole_passes), run once on the assembled image;
+     * samples are the frame's samples over all its regions. */
+    rl_status (*finish_regions)(rl_renderer *r, void *state, const rl_scene *scene, const rl_camera *cam,
+                                rl_image *image, uint64_t samples);
 } rl_renderer_class;
 
 /* At most this many input slots per class. */
@@ -66,6 +72,16 @@ char *rl_renderer_option_signature(const rl_renderer *r, bool (*keep)(const rl_r
  * checked against the image by rl_renderer_render): the whole image when
  * none was set. Only classes with info.regions read it. */
 rl_rect rl_renderer_region(const rl_renderer *r, int width, int height);
+/* A distributed frame (src/dist) renders its image as regions on several
+ * ranks. Passes over the whole image (pt's filter, Schröder Sec. 8.2)
+ * cannot run on a region: while deferred, a class with finish_regions
+ * leaves them out of its region renders instead of refusing them, and
+ * rl_renderer_finish_regions runs them on the assembled image (RL_OK and
+ * nothing done for a class without). */
+void rl_renderer_defer_whole_passes(rl_renderer *r, bool defer);
+bool rl_renderer_whole_passes_deferred(const rl_renderer *r);
+rl_status rl_renderer_finish_regions(rl_renderer *r, const rl_scene *scene, const rl_camera *cam, rl_image *image,
+                                     uint64_t samples);
 /* The callback of rl_renderer_set_progress (NULLs when none), for a caller
  * that renders a frame in parts and reports the whole (src/dist). */
 void rl_renderer_get_progress(const rl_renderer *r, rl_progress_fn *fn, void **user);
