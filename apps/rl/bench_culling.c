@@ -156,6 +156,24 @@ typedef struct bc_ctx {
     char reason[512];
 } bc_ctx;
 
+/* eval_measure, over the job's ranks under --dist (the property service:
+ * the workers make the property themselves from its options). */
+static rl_status bc_measure(rl_property *p, const rl_vec3 *pos, size_t n, double **values, const char *label)
+{
+    if (cli_dist_ranks() == 1)
+        return eval_measure(p, pos, n, values, label);
+    double *v = malloc((n ? n : 1) * sizeof *v);
+    if (!v)
+        return RL_ERR_OUT_OF_MEMORY;
+    rl_status st = cli_measure_call(p, pos, n, v);
+    if (st != RL_OK) {
+        free(v);
+        return st;
+    }
+    *values = v;
+    return RL_OK;
+}
+
 /* A property with options {key, value, ..., NULL}, committed. */
 static rl_status make_property(bc_ctx *c, const char *name, const char *const *kv, rl_property **out)
 {
@@ -228,7 +246,7 @@ static rl_status sec_surfels(void *ctx, cJSON *sec)
     if (st == RL_OK) {
         note("surfels: sampling the time of [100,200] (%lld samples; the first builds the surfels)",
              c->a->samples);
-        st = rl_sample_property(p, &sd, &driver);
+        st = cli_sample_call(p, &sd, &driver);
     }
     rl_property_release(p);
     if (st != RL_OK)
@@ -258,7 +276,7 @@ static rl_status sec_surfels(void *ctx, cJSON *sec)
             rl_property *pt = NULL;
             st = make_property(c, "time", TIME_KV("surfels", opts[k]), &pt);
             if (st == RL_OK)
-                st = eval_measure(pt, pos, n, &values, "surfels time");
+                st = bc_measure(pt, pos, n, &values, "surfels time");
             if (st == RL_OK)
                 st = region_stats(driver, values, &t);
             free(values);
@@ -271,7 +289,7 @@ static rl_status sec_surfels(void *ctx, cJSON *sec)
         if (st == RL_OK)
             st = make_property(c, "quality", q_kv, &pq);
         if (st == RL_OK)
-            st = eval_measure(pq, pos, n, &values, "surfels quality");
+            st = bc_measure(pq, pos, n, &values, "surfels quality");
         if (st == RL_OK)
             st = region_stats(driver, values, &q);
         free(values);
@@ -283,7 +301,7 @@ static rl_status sec_surfels(void *ctx, cJSON *sec)
         if (st == RL_OK)
             st = make_property(c, "ops", prim_kv, &pp);
         if (st == RL_OK)
-            st = eval_measure(pp, pos, n, &values, "surfels primitives");
+            st = bc_measure(pp, pos, n, &values, "surfels primitives");
         if (st == RL_OK)
             st = region_stats(driver, values, &prim);
         free(values);
@@ -332,7 +350,7 @@ static rl_status depth_sampled(bc_ctx *c, int depth, const rl_aabb *region, cons
                             .seed = (uint64_t)c->a->seed };
     if (st == RL_OK) {
         note("depth %d: sampling chcpp's time (%lld samples)", depth, c->a->samples);
-        st = rl_sample_property(p, &sd, out);
+        st = cli_sample_call(p, &sd, out);
     }
     rl_property_release(p);
     if (st == RL_OK && c->resume && !bench_resume_save_approx(c->resume, name, *out)) {
@@ -444,7 +462,7 @@ static rl_status ensure_driver(bc_ctx *c)
                             .max_samples = (uint32_t)c->a->samples, .seed = (uint64_t)c->a->seed };
     if (st == RL_OK) {
         note("sampling polygons in visible objects (%lld samples)", c->a->samples);
-        st = rl_sample_property(vis, &sd, &c->driver);
+        st = cli_sample_call(vis, &sd, &c->driver);
     }
     rl_property_release(vis);
     if (st == RL_OK && c->resume && !bench_resume_save_approx(c->resume, "slice.json", c->driver))
@@ -486,7 +504,7 @@ static rl_status measure_resumable(bc_ctx *c, rl_property *p, const char *label,
         double *block = NULL;
         char what[160];
         snprintf(what, sizeof what, "%s (%zu-%zu of %u)", label, done + 1, done + n, npos);
-        st = eval_measure(p, pos + done, n, &block, what);
+        st = bc_measure(p, pos + done, n, &block, what);
         if (st == RL_OK) {
             memcpy(all + done, block, n * sizeof *block);
             done += n;
@@ -512,7 +530,7 @@ static rl_status measure_at(bc_ctx *c, const char *label, const char *name, cons
     rl_status st = make_property(c, name, kv, &p);
     if (st == RL_OK)
         st = c->resume ? measure_resumable(c, p, label, pos, npos, values)
-                       : eval_measure(p, pos, npos, values, label);
+                       : bc_measure(p, pos, npos, values, label);
     rl_property_release(p);
     return st;
 }
@@ -729,13 +747,13 @@ static rl_status sec_select(void *ctx, cJSON *sec)
         rl_property *tp = NULL;
         st = make_property(c, "time", TIME_KV("chcpp", ""), &tp);
         if (st == RL_OK)
-            st = eval_measure(tp, pos, n, &pc6, "select chcpp time");
+            st = bc_measure(tp, pos, n, &pc6, "select chcpp time");
         rl_property_release(tp);
         tp = NULL;
         if (st == RL_OK)
             st = make_property(c, "time", TIME_KV("svs", svs_options(c)), &tp);
         if (st == RL_OK)
-            st = eval_measure(tp, pos, n, &ps6, "select svs time");
+            st = bc_measure(tp, pos, n, &ps6, "select svs time");
         rl_property_release(tp);
         for (size_t i = 0; i < n && st == RL_OK; ++i) {
             sum_c6 += pc6[i];
@@ -1186,6 +1204,13 @@ int bench_culling(int argc, char **argv)
         return rc;
     c.d = rl_scene_get_data(c.scene);
     int threads = a.threads > 0 ? (int)a.threads : omp_get_max_threads();
+    if (!cli_dist_master()) {
+        /* --dist: a sampling node, measuring whatever property the master
+         * samples next; the master runs the sections, prints and writes. */
+        rc = cli_dist_serve(c.scene, threads);
+        rl_scene_release(c.scene);
+        return rc;
+    }
     if (a.resume) {
         /* Everything that changes the slice or a value measured on it. */
         char key[1024];
@@ -1223,8 +1248,18 @@ int bench_culling(int argc, char **argv)
     cJSON_AddStringToObject(params, "drawer", drawer_names[a.drawer]);
     static const bench_section_fn fns[SEC_COUNT] = { sec_surfels, sec_depth, sec_svs, sec_select, sec_visset,
                                                      sec_walk };
+    if (cli_dist_ranks() > 1) {
+        /* Under --dist: the sampled and measured values come from every
+         * rank (times from each rank's own machine); the rest is the
+         * master's. */
+        cJSON *dist = cJSON_AddObjectToObject(root, "dist");
+        if (dist)
+            cJSON_AddNumberToObject(dist, "ranks", cli_dist_ranks());
+    }
+    cli_dist_service_begin();
     rc = bench_run_sections("culling", root, section_names, fns, SEC_COUNT, a.sections, &c, c.reason, threads,
                                out);
+    rc = cli_dist_service_end(rc);
     cJSON_Delete(root);
     rl_approx_release(c.driver);
     rl_approx_release(c.time_chcpp);

@@ -118,6 +118,14 @@ rl_status cli_sample_call(rl_property *p, const rl_sampling_desc *desc, rl_appro
  * every property, p NULL where its commit failed, so that they stay in
  * step. */
 rl_status cli_measure_call(rl_property *p, const rl_vec3 *pos, size_t count, double *values);
+/* The property service (rl_dist.h) for commands whose runs the workers
+ * cannot follow (rl bench culling): the master brackets its work with
+ * cli_dist_service_begin and cli_dist_service_end(rc), which returns rc or
+ * the end's failure; the workers call cli_dist_serve once their scene is
+ * loaded, and return its code. Without --dist: no-ops (serve: RL_CLI_OK). */
+void cli_dist_service_begin(void);
+int cli_dist_service_end(int rc);
+int cli_dist_serve(const rl_scene *scene, int threads);
 /* The last distributed frame's or sampling's ranks and per-rank work (master only). */
 void cli_print_dist_summary(FILE *out);
 /* The same as JSON for stats files (rl bench dist reads it): ranks,

@@ -94,6 +94,33 @@ rl_status cli_measure_call(rl_property *p, const rl_vec3 *pos, size_t count, dou
     return st;
 }
 
+void cli_dist_service_begin(void)
+{
+    if (dist && rl_dist_size(dist) > 1 && rl_dist_rank(dist) == 0)
+        rl_dist_service_begin(dist);
+}
+
+int cli_dist_service_end(int rc)
+{
+    if (!dist || rl_dist_size(dist) == 1 || rl_dist_rank(dist) != 0)
+        return rc;
+    rl_clear_error();
+    rl_status st = rl_dist_service_end(dist, rc == RL_CLI_OK ? RL_OK : RL_ERR_CANCELLED);
+    if (rc == RL_CLI_OK && st != RL_OK)
+        return cli_fail_status(RL_CLI_FAIL, st, "--dist");
+    return rc;
+}
+
+int cli_dist_serve(const rl_scene *scene, int threads)
+{
+    if (!dist || rl_dist_rank(dist) == 0)
+        return RL_CLI_OK;
+    rl_clear_error();
+    rl_status st = rl_dist_serve_properties(dist, scene, threads);
+    sampling = true;
+    return st == RL_OK ? RL_CLI_OK : cli_fail_status(RL_CLI_FAIL, st, "--dist");
+}
+
 cJSON *cli_dist_json(void)
 {
     if (!ran || !cli_dist_master())

@@ -198,10 +198,11 @@ int main(int argc, char **argv)
                 return commands[i].run(n, argv);
             bool spreads = strcmp(name, "render") == 0 || strcmp(name, "eval") == 0 ||
                            strcmp(name, "compare") == 0 ||
-                           (strcmp(name, "bench") == 0 && n > 1 && strcmp(argv[1], "sampling") == 0);
+                           (strcmp(name, "bench") == 0 && n > 1 &&
+                            (strcmp(argv[1], "sampling") == 0 || strcmp(argv[1], "culling") == 0));
             if (!spreads)
-                return cli_fail(RL_CLI_USAGE, "--dist: only rl render, eval, compare and bench sampling run "
-                                              "distributed so far (docs/distributed.md)");
+                return cli_fail(RL_CLI_USAGE, "--dist: only rl render, eval, compare, bench sampling and bench "
+                                              "culling run distributed so far (docs/distributed.md)");
             int rc = cli_dist_begin(NULL, NULL);
             return cli_dist_end(rc == RL_CLI_OK ? commands[i].run(n, argv) : rc);
         }

@@ -122,6 +122,24 @@ RL_API rl_status rl_dist_sample_property(rl_dist *d, rl_property *p, const rl_sa
 RL_API rl_status rl_dist_measure(rl_dist *d, rl_property *p, const rl_vec3 *pos, size_t count, double *values,
                                  rl_dist_stats *dstats);
 
+/* The property service, for commands whose sampling runs the workers
+ * cannot follow step by step (rl bench culling: many properties, sections
+ * that resume from files only the master reads). Between
+ * rl_dist_service_begin and rl_dist_service_end on the master, every
+ * rl_dist_sample_property and rl_dist_measure first tells the workers its
+ * property by name and option values; the workers sit in
+ * rl_dist_serve_properties, which makes and commits each property on their
+ * own copy of the scene (a few are kept for the next runs) and measures
+ * for it, until the master ends the service with its status. Only
+ * properties made by rl_property_create and rl_property_set can be
+ * described this way; a combined or custom one fails the run on every
+ * rank. Between runs a worker waits up to RL_DIST_IDLE_TIMEOUT seconds
+ * (default 3600: the master may render for a long time between two runs)
+ * before it takes the master for gone. */
+RL_API rl_status rl_dist_service_begin(rl_dist *d);
+RL_API rl_status rl_dist_service_end(rl_dist *d, rl_status status);
+RL_API rl_status rl_dist_serve_properties(rl_dist *d, const rl_scene *scene, int threads);
+
 #ifdef __cplusplus
 }
 #endif

@@ -15,6 +15,8 @@ enum {
     RL_DIST_TAG_RESULT,        /* worker -> master: a task's header */
     RL_DIST_TAG_PIXELS,        /* worker -> master: a band's layers */
     RL_DIST_TAG_VALUES,        /* worker -> master: measured values and sets */
+    RL_DIST_TAG_SPEC,          /* master -> worker: the next run's property (service) */
+    RL_DIST_TAG_END,           /* master -> worker: the service's status, its end */
 };
 
 struct rl_dist {
@@ -26,6 +28,7 @@ struct rl_dist {
      * for the rest of the job, so that later batches and runs do not wait
      * for them again. */
     unsigned char *sampling_lost;
+    bool service;                      /* rl_dist_service_begin on the master */
 };
 
 /* RL_ERR_IO "distributed run: WHAT: <MPI's text for code>". */

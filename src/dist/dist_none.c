@@ -88,3 +88,25 @@ rl_status rl_dist_measure(rl_dist *d, rl_property *p, const rl_vec3 *pos, size_t
         return rl_error(RL_ERR_INVALID_ARG, "rl_dist_measure: no property");
     return rl_property_measure(p, pos, count, values, NULL, NULL);
 }
+
+/* Without MPI every job is one process: nobody to serve, nothing to end. */
+rl_status rl_dist_service_begin(rl_dist *d)
+{
+    (void)d;
+    return RL_OK;
+}
+
+rl_status rl_dist_service_end(rl_dist *d, rl_status status)
+{
+    (void)d;
+    return status;
+}
+
+rl_status rl_dist_serve_properties(rl_dist *d, const rl_scene *scene, int threads)
+{
+    (void)d;
+    (void)scene;
+    (void)threads;
+    return rl_error(RL_ERR_UNSUPPORTED, "rl_dist_serve_properties: this build has no MPI (a job of one has no "
+                    "workers)");
+}

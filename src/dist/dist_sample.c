@@ -18,6 +18,7 @@
  *   master -> worker  DONE    int32 status of the run
  *   worker -> master  RESULT  chunk_result (chunk, status, error)
  *   worker -> master  VALUES  count doubles, then count * words set words */
+#define _POSIX_C_SOURCE 200809L
 #include "rl/rl_dist.h"
 
 #include <stdio.h>
@@ -346,8 +347,31 @@ static rl_status measure(void *user, const rl_vec3 *pos, uint32_t n, double *val
     return failed == RL_OK ? RL_OK : rl_error(failed, "%s", s->failure);
 }
 
-/* A sampling node: chunks until DONE, whose status it returns. */
-static rl_status serve(rl_dist *d, rl_property *p)
+/* A sampling node waits for the master's next message (any tag), polling;
+ * past timeout seconds it takes the master for gone (an error naming
+ * what, the environment variable that sets it). */
+static rl_status wait_master(const rl_dist *d, double timeout, const char *what, MPI_Status *ms)
+{
+    const double t0 = rl_time_s();
+    for (;;) {
+        int arrived = 0;
+        int code = MPI_Iprobe(0, MPI_ANY_TAG, MPI_COMM_WORLD, &arrived, ms);
+        if (code != MPI_SUCCESS)
+            return rl_dist_mpi_failed(code, "waiting for the master");
+        if (arrived)
+            return RL_OK;
+        if (rl_time_s() - t0 > timeout)
+            return rl_error(RL_ERR_IO, "rank %d: no word from the master (rank 0) for %.0f s%s: it is gone or "
+                            "stuck; giving up (%s)", d->rank, timeout, what[0] ? " between runs" : "",
+                            what[0] ? what : "RL_DIST_TIMEOUT");
+        rl_dist_pause();
+    }
+}
+
+/* A sampling node: chunks until DONE, whose status it returns. Without
+ * a property (p NULL) it answers every chunk with an error (why, or
+ * MPI's), so that the control node fails the run for every rank. */
+static rl_status serve(rl_dist *d, rl_property *p, const char *why)
 {
     unsigned char *buf = NULL;
     double *values = NULL;
@@ -355,7 +379,11 @@ static rl_status serve(rl_dist *d, rl_property *p)
     rl_status st = RL_OK;
     for (;;) {
         MPI_Status ms;
-        if ((st = rl_dist_wait(d, MPI_ANY_TAG, &ms)) != RL_OK)     /* a dead control node: an error */
+        /* A dead control node: an error. Not before the control node has
+         * had the time to take another worker for lost (RL_DIST_TIMEOUT)
+         * and to hand its chunks out again: until then it may well have
+         * nothing for this one. */
+        if ((st = wait_master(d, 3.0 * rl_dist_timeout_s(), "", &ms)) != RL_OK)
             break;
         int bytes = 0;
         int code = MPI_Get_count(&ms, MPI_BYTE, &bytes);
@@ -385,9 +413,9 @@ static rl_status serve(rl_dist *d, rl_property *p)
         }
         chunk_header h;
         memcpy(&h, buf, sizeof h);
-        size_t words = h.words > 0 ? rl_property_set_words(p) : 0;
+        size_t words = h.words > 0 && p ? rl_property_set_words(p) : 0;
         if (h.count < 1 || (size_t)bytes != sizeof h + (size_t)h.count * sizeof(rl_vec3) ||
-            (h.words > 0 && (size_t)h.words != words)) {
+            (h.words > 0 && p && (size_t)h.words != words)) {
             st = rl_error(RL_ERR_INTERNAL, "distributed sampling: a malformed chunk from the control node");
             break;
         }
@@ -413,7 +441,9 @@ static rl_status serve(rl_dist *d, rl_property *p)
         rl_timer t;
         rl_timer_start(&t);
         rl_clear_error();
-        rl_status ms_st = rl_property_measure_sets(p, pos, (size_t)h.count, values, words ? sets : NULL, NULL, NULL);
+        rl_status ms_st = !p && why ? rl_error(RL_ERR_INVALID_ARG, "%s", why)
+                                    : rl_property_measure_sets(p, pos, (size_t)h.count, values, words ? sets : NULL,
+                                                               NULL, NULL);
         free(pos);
         res.busy_ms = rl_timer_ms(&t);
         res.status = (int32_t)ms_st;
@@ -448,6 +478,59 @@ static rl_status end_run(sampler *s, rl_status st)
         if (code != MPI_SUCCESS && st == RL_OK)
             st = rl_dist_mpi_failed(code, "ending the sampling");
     }
+    return st;
+}
+
+/* The property service (rl_dist.h): a property as text, its name on the
+ * first line, then key=value per option, for the workers to make it
+ * themselves. NULL (error recorded) when p cannot be described so. */
+static char *property_spec(const rl_property *p)
+{
+    if (!p) {
+        rl_error(RL_ERR_INVALID_ARG, "distributed run: no property");
+        return NULL;
+    }
+    size_t n = 0;
+    const rl_option_info *opts = rl_property_options(p, &n);
+    size_t len = strlen(rl_property_name(p)) + 2;
+    for (size_t i = 0; i < n; ++i) {
+        const char *v = rl_property_get(p, opts[i].key);
+        if (!v || strchr(v, '\n')) {
+            rl_error(RL_ERR_UNSUPPORTED, "distributed run: property %s: option %s cannot be sent to the workers",
+                     rl_property_name(p), opts[i].key);
+            return NULL;
+        }
+        len += strlen(opts[i].key) + strlen(v) + 2;
+    }
+    char *spec = malloc(len);
+    if (!spec) {
+        rl_error(RL_ERR_OUT_OF_MEMORY, "distributed run: out of memory");
+        return NULL;
+    }
+    size_t at = (size_t)snprintf(spec, len, "%s\n", rl_property_name(p));
+    for (size_t i = 0; i < n; ++i)
+        at += (size_t)snprintf(spec + at, len - at, "%s=%s\n", opts[i].key, rl_property_get(p, opts[i].key));
+    return spec;
+}
+
+/* The master tells every live worker the run's property. A property it
+ * cannot describe goes as an empty text with the reason, so that the
+ * workers answer the run's chunks with it and every rank fails alike. */
+static rl_status send_spec(sampler *s, const rl_property *p)
+{
+    char *spec = property_spec(p);
+    char why[300];
+    snprintf(why, sizeof why, "\n%s", rl_last_error());
+    const char *text = spec ? spec : why;
+    rl_status st = RL_OK;
+    for (int w = 1; w < s->d->size && st == RL_OK; ++w) {
+        if (s->d->sampling_lost[w])
+            continue;
+        st = rl_dist_send(s->d, text, (int)strlen(text) + 1, MPI_CHAR, w, RL_DIST_TAG_SPEC);
+        ++s->messages;
+        s->bytes += strlen(text) + 1;
+    }
+    free(spec);
     return st;
 }
 
@@ -514,6 +597,8 @@ rl_status rl_dist_sample_property(rl_dist *d, rl_property *p, const rl_sampling_
     if (d->rank == 0) {
         sampler s;
         st = sampler_init(&s, d, p);
+        if (st == RL_OK && d->service)
+            st = send_spec(&s, p);
         rl_sampling_desc dd = *desc;
         dd.measure = measure;
         dd.measure_user = &s;
@@ -525,7 +610,7 @@ rl_status rl_dist_sample_property(rl_dist *d, rl_property *p, const rl_sampling_
         }
         sampler_finish(&s, ds);
     } else {
-        st = serve(d, p);
+        st = serve(d, p, NULL);
     }
     ds->time_ms = rl_timer_ms(&t);
     ds->per_rank = d->per_rank;
@@ -552,6 +637,8 @@ rl_status rl_dist_measure(rl_dist *d, rl_property *p, const rl_vec3 *pos, size_t
     if (d->rank == 0) {
         sampler s;
         rl_status init = sampler_init(&s, d, p);
+        if (init == RL_OK && d->service)
+            init = send_spec(&s, p);
         /* Even a call that cannot measure ends the run on the workers,
          * which wait in serve() for it. */
         if (init != RL_OK)
@@ -569,9 +656,160 @@ rl_status rl_dist_measure(rl_dist *d, rl_property *p, const rl_vec3 *pos, size_t
     } else {
         /* A worker without the property answers every chunk with the
          * error, so that the master ends the run for all. */
-        st = serve(d, p);
+        st = serve(d, p, NULL);
     }
     ds->time_ms = rl_timer_ms(&t);
     ds->per_rank = d->per_rank;
+    return st;
+}
+
+rl_status rl_dist_service_begin(rl_dist *d)
+{
+    if (!d)
+        return rl_error(RL_ERR_INVALID_ARG, "rl_dist_service_begin: no job");
+    if (d->rank != 0)
+        return rl_error(RL_ERR_INVALID_ARG, "rl_dist_service_begin: only the master (rank 0) leads the service");
+    d->service = true;
+    return RL_OK;
+}
+
+rl_status rl_dist_service_end(rl_dist *d, rl_status status)
+{
+    if (!d || d->rank != 0 || !d->service)
+        return status;
+    d->service = false;
+    int32_t end = (int32_t)status;
+    for (int w = 1; w < d->size; ++w) {
+        if (d->sampling_lost[w])
+            continue;
+        rl_status st = rl_dist_send(d, &end, 1, MPI_INT32_T, w, RL_DIST_TAG_END);
+        if (st != RL_OK && status == RL_OK)
+            status = st;
+    }
+    return status;
+}
+
+/* RL_DIST_IDLE_TIMEOUT in seconds, else an hour. */
+static double idle_timeout_s(void)
+{
+    const char *e = getenv("RL_DIST_IDLE_TIMEOUT");
+    char *end = NULL;
+    double t = e && *e ? strtod(e, &end) : 0.0;
+    return e && *e && end && !*end && t > 0.0 && t < 1e7 ? t : 3600.0;
+}
+
+/* A worker's committed properties, by their text, the oldest replaced:
+ * the sections of a benchmark come back to the same few. */
+#define SERVICE_CACHE 4
+
+rl_status rl_dist_serve_properties(rl_dist *d, const rl_scene *scene, int threads)
+{
+    if (!d || !scene)
+        return rl_error(RL_ERR_INVALID_ARG, "rl_dist_serve_properties: job and scene must not be NULL");
+    if (d->rank == 0)
+        return rl_error(RL_ERR_INVALID_ARG, "rl_dist_serve_properties: the master (rank 0) leads, it does not serve");
+    struct {
+        char *spec;
+        rl_property *p;
+        uint64_t used;
+    } cache[SERVICE_CACHE] = { { 0 } };
+    uint64_t clock = 0;
+    char *text = NULL;
+    rl_status st = RL_OK;
+    const double timeout = idle_timeout_s();
+    for (;;) {
+        MPI_Status ms;
+        int code = MPI_SUCCESS;
+        if ((st = wait_master(d, timeout, "RL_DIST_IDLE_TIMEOUT", &ms)) != RL_OK)
+            break;
+        if (ms.MPI_TAG == RL_DIST_TAG_END) {
+            int32_t end = 0;
+            code = MPI_Recv(&end, 1, MPI_INT32_T, 0, RL_DIST_TAG_END, MPI_COMM_WORLD, MPI_STATUS_IGNORE);
+            st = code != MPI_SUCCESS ? rl_dist_mpi_failed(code, "ending the service")
+                 : end == RL_OK     ? RL_OK
+                                    : rl_error((rl_status)end, "distributed run: the master failed (%s)",
+                                               rl_status_string((rl_status)end));
+            break;
+        }
+        if (ms.MPI_TAG != RL_DIST_TAG_SPEC) {
+            st = rl_error(RL_ERR_INTERNAL, "distributed run: message %d from the master outside a run", ms.MPI_TAG);
+            break;
+        }
+        int bytes = 0;
+        if ((code = MPI_Get_count(&ms, MPI_CHAR, &bytes)) != MPI_SUCCESS || bytes < 1 || bytes > (1 << 20)) {
+            st = code != MPI_SUCCESS ? rl_dist_mpi_failed(code, "receiving a property")
+                                     : rl_error(RL_ERR_INTERNAL, "distributed run: a property of %d bytes", bytes);
+            break;
+        }
+        char *t = realloc(text, (size_t)bytes);
+        if (!t) {
+            st = RL_ERR_OUT_OF_MEMORY;
+            break;
+        }
+        text = t;
+        if ((code = MPI_Recv(text, bytes, MPI_CHAR, 0, RL_DIST_TAG_SPEC, MPI_COMM_WORLD, MPI_STATUS_IGNORE)) !=
+            MPI_SUCCESS) {
+            st = rl_dist_mpi_failed(code, "receiving a property");
+            break;
+        }
+        text[bytes - 1] = '\0';
+        /* The property of this run: from the cache, or made now. */
+        rl_property *p = NULL;
+        char why[320] = "";
+        int slot = -1, oldest = 0;
+        for (int k = 0; k < SERVICE_CACHE; ++k) {
+            if (cache[k].spec && strcmp(cache[k].spec, text) == 0)
+                slot = k;
+            if (cache[k].used < cache[oldest].used)
+                oldest = k;
+        }
+        if (slot >= 0) {
+            p = cache[slot].p;
+            cache[slot].used = ++clock;
+        } else if (text[0] == '\n') {
+            snprintf(why, sizeof why, "%s", text + 1);        /* the master could not describe it */
+        } else {
+            char *spec = strdup(text);
+            char *nl = strchr(text, '\n');
+            rl_status pst = spec && nl ? RL_OK : RL_ERR_OUT_OF_MEMORY;
+            if (pst == RL_OK) {
+                *nl = '\0';
+                pst = rl_property_create(text, &p);
+            }
+            for (char *line = nl ? nl + 1 : NULL; pst == RL_OK && line && *line;) {
+                char *next = strchr(line, '\n'), *eq = strchr(line, '=');
+                if (next)
+                    *next = '\0';
+                if (!eq) {
+                    pst = rl_error(RL_ERR_INTERNAL, "distributed run: a malformed property from the master");
+                    break;
+                }
+                *eq = '\0';
+                pst = rl_property_set(p, line, eq + 1);
+                line = next ? next + 1 : NULL;
+            }
+            if (pst == RL_OK)
+                pst = rl_property_commit(p, scene, threads);
+            if (pst != RL_OK) {
+                snprintf(why, sizeof why, "rank %d: %s", d->rank, rl_last_error());
+                rl_property_release(p);
+                p = NULL;
+                free(spec);
+            } else {
+                free(cache[oldest].spec);
+                rl_property_release(cache[oldest].p);
+                cache[oldest].spec = spec;
+                cache[oldest].p = p;
+                cache[oldest].used = ++clock;
+            }
+        }
+        if ((st = serve(d, p, p ? NULL : why)) != RL_OK)
+            break;
+    }
+    for (int k = 0; k < SERVICE_CACHE; ++k) {
+        free(cache[k].spec);
+        rl_property_release(cache[k].p);
+    }
+    free(text);
     return st;
 }

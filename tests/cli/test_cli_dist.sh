@@ -11,9 +11,9 @@ set -u
 . "$(dirname "${BASH_SOURCE[0]}")/lib.bash"
 
 # Not a distributed command: refused before MPI is touched.
-expect_usage_error "$RL" --dist bench culling --quick --out "$TMP/bc.json"
-grep -q "only rl render, eval, compare and bench sampling run distributed" "$TMP/err" ||
-    fail "--dist bench culling: $(cat "$TMP/err")"
+expect_usage_error "$RL" --dist bench rays --quick --out "$TMP/br.json"
+grep -q "only rl render, eval, compare, bench sampling and bench culling run distributed" "$TMP/err" ||
+    fail "--dist bench rays: $(cat "$TMP/err")"
 
 # Open MPI keeps memory past MPI_Finalize in its runtime and components;
 # tests/lsan.supp names its libraries, which needs the components kept
@@ -167,6 +167,32 @@ for x in (a, b, c):
 assert a == b == c
 PY
     fail "a lost sampling node or a resumed distributed run changed the approximation"
+# rl bench culling through the property service: the workers make each
+# property the master samples from its name and options. Everything but the
+# times (each rank's own) equals one process's record, also with rank 2
+# lost after its first chunk.
+run_ok "$RL" bench culling --quick --only svs --out "$TMP/bc1.json"
+run_ok "${RECOVER[@]}" RL_DIST_FAULT=2:1 "${MPI[@]}" "$RL" --dist bench culling --quick --only svs \
+    --out "$TMP/bc3.json"
+expect_in "$TMP/err" "rank 2 has not answered for [0-9]* s: taken for lost, its positions go to"
+python3 - "$TMP/bc1.json" "$TMP/bc3.json" <<'PY' || fail "rl --dist bench culling differs from one process"
+import json, sys
+a, b = (json.load(open(f)) for f in sys.argv[1:3])
+assert b["dist"]["ranks"] == 3 and b["svs"]["status"] == "ok", b.get("dist")
+def same(x, y, path):
+    if isinstance(x, dict):
+        for k in x:
+            if "time" not in k and not k.endswith("_ms"):
+                same(x[k], y[k], path + "/" + k)
+    elif isinstance(x, list):
+        assert len(x) == len(y), path
+        for u, v in zip(x, y):
+            same(u, v, path)
+    else:
+        assert x == y, (path, x, y)
+same(a["svs"], b["svs"], "svs")
+assert a["svs"]["positions"] >= 1
+PY
 # A dead master (it kills itself after its first band): by default mpirun
 # ends the job at once; with recovery on, every worker gives up with an
 # error after the timeout. Neither hangs (timeout 120 above), neither
