@@ -43,8 +43,10 @@ static const char view_help[] =
     "                      a renderer's prefix (vt.min_edge=14) also applies when\n"
     "                      Tab switches to that renderer\n"
     "  --camera NAME       a camera of the scene; default its first one\n"
-    "  --size WxH          image size; default the camera's, else 1280x720 (the\n"
-    "                      window scales it)\n"
+    "  --size WxH|window   WxH: a fixed image size, which the window scales;\n"
+    "                      window (the default): the image follows the window's\n"
+    "                      pixel size, at most 1920x1200's worth of pixels; the\n"
+    "                      window starts at the camera's size, else 1280x720\n"
     "  --script FILE       timed events (keys, mouse, camera moves, screenshots);\n"
     "                      exits at its end, on a virtual clock of 25 steps a\n"
     "                      second that advances by finished frames\n"
@@ -100,6 +102,12 @@ int view_run(int argc, char **argv)
 #define DEFAULT_REF_SPP 256
 /* Every image of the viewer: the depth and ID layers are shown by L. */
 #define VIEW_LAYERS (RL_LAYER_COLOR | RL_LAYER_DEPTH | RL_LAYER_ID)
+/* With the image following the window (--size window, the default), a
+ * window larger than this many pixels gets an image scaled down to it
+ * (same aspect; the window scales it up): a full-screen window on a 4K
+ * display would otherwise make every frame four times the work of 1080p
+ * and hold about a gigabyte of frame buffers. */
+#define VIEW_MAX_WINDOW_PIXELS (1920 * 1200)
 
 typedef struct shot_at {
     double time_s;
@@ -109,7 +117,7 @@ typedef struct shot_at {
 
 typedef struct view_args {
     const char *scene, *algo, *camera, *script, *record_dir, *shot_dir, *path_out, *stats_out;
-    bool has_size;
+    bool has_size;             /* --size WxH; without it (or with --size window) the image follows the window */
     int width, height;
     const char **sets;
     int num_sets;
@@ -124,14 +132,16 @@ typedef struct view_args {
 typedef enum cmd_kind {
     CMD_ALGO,         /* text: the renderer */
     CMD_SET,          /* text: KEY=VALUE */
-    CMD_STEP,         /* the renderer's main option by a factor */
+    CMD_STEP,         /* the renderer's selected live option up or down */
+    CMD_SELECT,       /* select the next / previous live option for CMD_STEP */
+    CMD_CLICK,        /* text: an option clicked in the menu; dir +1 left, -1 right */
     CMD_CYCLE,        /* text: an enum option, set to its next choice */
     CMD_REFERENCE     /* compare the next finished frame with a reference */
 } cmd_kind;
 typedef struct view_cmd {
     cmd_kind kind;
     char text[256];
-    int dir;          /* CMD_STEP, CMD_CYCLE: +1 or -1 */
+    int dir;          /* CMD_STEP, CMD_SELECT, CMD_CYCLE, CMD_CLICK: +1 or -1 */
     int line;         /* script line, 0 for a key */
 } view_cmd;
 
@@ -156,7 +166,7 @@ typedef struct shared {
     double worker_spp;             /* accumulated since the last restart */
     char algo[64];
     char status[256];              /* the last change's outcome, for the overlay */
-    char options[1024];            /* the current renderer's options, for the menu */
+    char options[2048];            /* the current renderer's options, for the menu: "key=value\n"... */
     /* the last comparison with a reference (X) */
     bool ref_valid;
     char ref_algo[64], ref_of[64];
@@ -188,10 +198,26 @@ typedef struct worker {
     double running_request_s;
     rl_camera last_cam;
     bool have_last;
+    int step_sel;                  /* the live option of + and -: an index among the renderer's */
     rl_renderer *ref;              /* the reference renderer of X, kept for the next X */
     rl_image *ref_img;
     bool want_ref;
 } worker;
+
+/* *img at w x h with layers: kept when it has that size, else replaced
+ * (its pixels are not kept: every user overwrites them). */
+static rl_status fit_image(rl_image **img, int w, int h, unsigned layers)
+{
+    if (*img && (*img)->width == w && (*img)->height == h)
+        return RL_OK;
+    rl_image *next = NULL;
+    rl_status st = rl_image_create(w, h, layers, &next);
+    if (st != RL_OK)
+        return st;
+    rl_image_release(*img);
+    *img = next;
+    return RL_OK;
+}
 
 static bool same_camera(const rl_camera *a, const rl_camera *b)
 {
@@ -209,6 +235,13 @@ static void publish(worker *w, const rl_image *img, const rl_render_stats *stats
 {
     shared *sh = w->sh;
     SDL_LockMutex(sh->lock);
+    /* The window's size may have changed the image's (--size window). */
+    if (fit_image(&sh->front, img->width, img->height, VIEW_LAYERS) != RL_OK) {
+        snprintf(sh->status, sizeof sh->status, "out of memory for a %dx%d image", img->width, img->height);
+        SDL_UnlockMutex(sh->lock);
+        rl_clear_error();
+        return;
+    }
     size_t n = (size_t)img->width * (size_t)img->height;
     memcpy(sh->front->color, img->color, n * sizeof *img->color);
     /* An intermediate image without these layers must not show the last
@@ -326,17 +359,110 @@ static void set_status(shared *sh, const char *fmt, ...)
     va_end(ap);
 }
 
-/* The option that + and - change, per renderer, and by what factor. */
+/* The live options of + and -, per renderer: those that trade quality for
+ * time (or show the trade). The first of a renderer is the one + and -
+ * change after a switch; [ and ] select another. A number is multiplied or
+ * divided by factor (an integer moves by at least 1) and kept in [lo, hi];
+ * factor 0 is a boolean that + and - switch. A number whose 0 means "no
+ * limit" (visset's budget) has start > 0: - from 0 sets start, + beyond hi
+ * returns to 0. Renderers rebuild what an option changes (svs its sets,
+ * surfels nothing but the selection) before the next frame. */
 typedef struct step_option {
     const char *algo, *key;
-    double factor, lo, hi;
-    bool integer;
+    double factor, lo, hi, start;
 } step_option;
 static const step_option step_options[] = {
-    { "vt", "min_edge", 1.25, 0.25, 1024.0, false },
-    { "pt", "spp", 2.0, 1.0, 1024.0, true },
-    { "surfels", "overdraw", 1.5, 0.01, 1000.0, false },
+    { "vt", "min_edge", 1.25, 0.25, 1024.0, 0.0 },
+    { "pt", "spp", 2.0, 1.0, 1024.0, 0.0 },
+    { "surfels", "overdraw", 1.5, 0.01, 1000.0, 0.0 },
+    { "surfels", "point_size", 1.25, 0.5, 64.0, 0.0 },
+    { "surfels", "min_size", 1.25, 1.0, 1e5, 0.0 },
+    { "surfels", "max_size", 1.25, 1.0, 1e5, 0.0 },
+    { "chcpp", "assumed_visible", 2.0, 1.0, 1000.0, 0.0 },
+    { "chcpp", "batch", 2.0, 1.0, 10000.0, 0.0 },
+    { "chcpp", "multiquery", 0.0, 0.0, 0.0, 0.0 },
+    { "chcpp", "tight", 0.0, 0.0, 0.0, 0.0 },
+    { "svs", "neighbours", 1.5, 1.0, 12.0, 0.0 },
+    { "svs", "distance", 1.25, 1.0, 1000.0, 0.0 },
+    { "svs", "levels", 1.5, 0.0, 3.0, 0.0 },
+    { "svs", "resolution", 2.0, 8.0, 1024.0, 0.0 },
+    { "visset", "budget", 2.0, 1024.0, 67108864.0, 65536.0 },
+    { "visset", "resolution", 2.0, 8.0, 1024.0, 0.0 },
+    { "select", "samples", 2.0, 1.0, 256.0, 0.0 },
+    { "select", "resolution", 2.0, 8.0, 256.0, 0.0 },
 };
+#define NUM_STEP_OPTIONS (sizeof step_options / sizeof step_options[0])
+
+/* The i-th live option of renderer name (i wraps), or NULL if it has none. */
+static const step_option *live_option(const char *name, int i)
+{
+    int count = 0;
+    for (size_t k = 0; k < NUM_STEP_OPTIONS; k++)
+        count += strcmp(step_options[k].algo, name) == 0;
+    if (count == 0)
+        return NULL;
+    i = (i % count + count) % count;
+    for (size_t k = 0; k < NUM_STEP_OPTIONS; k++)
+        if (strcmp(step_options[k].algo, name) == 0 && i-- == 0)
+            return &step_options[k];
+    return NULL;
+}
+
+static const rl_option_info *option_info(const rl_renderer *r, const char *key)
+{
+    size_t n = 0;
+    const rl_option_info *opts = rl_renderer_options(r, &n);
+    for (size_t i = 0; i < n; i++)
+        if (strcmp(opts[i].key, key) == 0)
+            return &opts[i];
+    return NULL;
+}
+
+/* Moves the live option o of the current renderer one step in dir. */
+static void step_option_apply(worker *w, const step_option *o, int dir)
+{
+    shared *sh = w->sh;
+    const char *name = rl_renderer_name(w->r);
+    const rl_option_info *info = option_info(w->r, o->key);
+    const char *cur = rl_renderer_get(w->r, o->key);
+    char text[64];
+    if (info && info->type == RL_OPT_BOOL) {
+        snprintf(text, sizeof text, "%s", cur && strcmp(cur, "true") == 0 ? "false" : "true");
+    } else {
+        double v = 0.0;
+        if (!info || !cur || !rl_parse_float(cur, &v)) {
+            set_status(sh, "%s has no option %s", name, o->key);
+            return;
+        }
+        bool integer = info->type == RL_OPT_INT;
+        double next;
+        if (o->start > 0.0 && v == 0.0)
+            next = dir < 0 ? o->start : 0.0;
+        else {
+            next = dir > 0 ? v * o->factor : v / o->factor;
+            if (integer) {
+                next = (double)llround(next);
+                if (next == v)
+                    next = v + dir;
+            }
+            if (o->start > 0.0 && dir > 0 && next > o->hi)
+                next = 0.0;
+            else
+                next = fmin(fmax(next, o->lo), o->hi);
+        }
+        if (integer)
+            snprintf(text, sizeof text, "%lld", (long long)llround(next));
+        else
+            snprintf(text, sizeof text, "%.4g", next);
+    }
+    rl_clear_error();
+    if (rl_renderer_set(w->r, o->key, text) == RL_OK)
+        set_status(sh, "%s %s=%s%s", name, o->key, text, o->start > 0.0 && strcmp(text, "0") == 0 ? " (none)" : "");
+    else
+        set_status(sh, "%s %s=%s: %s", name, o->key, text, rl_last_error());
+    rl_clear_error();
+    w->have_last = false;
+}
 
 /* Sets the enum option key of the current renderer to its next (dir +1) or
  * previous choice. A choice the renderer refuses here (embree in a build
@@ -374,24 +500,26 @@ static void cycle_option(worker *w, const char *key, int dir)
     rl_clear_error();
 }
 
-/* The current renderer's options, "name: key=value key=value ...", for the
- * menu (which wraps them to the window). */
+/* The current renderer's options for the menu, one a line: "key=value",
+ * the live option of + and - marked ">". */
 static void publish_options(worker *w)
 {
     shared *sh = w->sh;
     char text[sizeof sh->options];
     size_t n = 0, len = 0;
     const rl_option_info *opts = rl_renderer_options(w->r, &n);
-    len = (size_t)snprintf(text, sizeof text, "%s:", rl_renderer_name(w->r));
+    const step_option *sel = live_option(rl_renderer_name(w->r), w->step_sel);
+    text[0] = '\0';
     for (size_t i = 0; i < n; i++) {
         const char *value = rl_renderer_get(w->r, opts[i].key);
         char item[160];
-        int k = snprintf(item, sizeof item, "%s=%s", opts[i].key, value ? value : "?");
+        int k = snprintf(item, sizeof item, "%s%s=%s", sel && strcmp(sel->key, opts[i].key) == 0 ? ">" : "",
+                         opts[i].key, value ? value : "?");
         if (k < 0 || k >= (int)sizeof item)
             continue;
         if (len + (size_t)k + 2 >= sizeof text)
             break;
-        len += (size_t)snprintf(text + len, sizeof text - len, " %s", item);
+        len += (size_t)snprintf(text + len, sizeof text - len, "%s\n", item);
     }
     SDL_LockMutex(sh->lock);
     snprintf(sh->options, sizeof sh->options, "%s", text);
@@ -413,6 +541,7 @@ static void apply_cmd(worker *w, const view_cmd *c)
         rl_renderer_release(w->r);
         w->r = r;
         w->have_last = false;
+        w->step_sel = 0;
         SDL_LockMutex(sh->lock);
         snprintf(sh->algo, sizeof sh->algo, "%.63s", c->text);
         sh->worker_progressive = is_progressive(c->text);
@@ -448,29 +577,36 @@ static void apply_cmd(worker *w, const view_cmd *c)
         return;
     }
     const char *name = rl_renderer_name(w->r);
-    for (size_t i = 0; i < sizeof step_options / sizeof step_options[0]; i++) {
-        const step_option *o = &step_options[i];
-        if (strcmp(o->algo, name) != 0)
-            continue;
-        const char *cur = rl_renderer_get(w->r, o->key);
-        double v = 0.0;
-        if (!cur || !rl_parse_float(cur, &v))
-            break;
-        v = c->dir > 0 ? v * o->factor : v / o->factor;
-        v = fmin(fmax(v, o->lo), o->hi);
-        char text[64];
-        if (o->integer)
-            snprintf(text, sizeof text, "%lld", (long long)llround(v));
+    if (c->kind == CMD_CLICK) {
+        /* A menu entry: an enum or a boolean goes to its next choice, a
+         * live number one step (and becomes the one of + and -). */
+        const rl_option_info *info = option_info(w->r, c->text);
+        for (int i = 0; info && live_option(name, i) && i < (int)NUM_STEP_OPTIONS; i++)
+            if (strcmp(live_option(name, i)->key, c->text) == 0) {
+                w->step_sel = i;
+                step_option_apply(w, live_option(name, i), c->dir);
+                return;
+            }
+        if (info && info->type == RL_OPT_ENUM && info->choices)
+            cycle_option(w, c->text, c->dir);
+        else if (info && info->type == RL_OPT_BOOL)
+            step_option_apply(w, &(step_option){ .algo = name, .key = info->key }, c->dir);
         else
-            snprintf(text, sizeof text, "%.4g", v);
-        rl_clear_error();
-        if (rl_renderer_set(w->r, o->key, text) == RL_OK)
-            set_status(sh, "%s %s=%s", name, o->key, text);
-        rl_clear_error();
-        w->have_last = false;
+            set_status(sh, "%s %s: not a live option (--set it, or a script's set)", name, c->text);
         return;
     }
-    set_status(sh, "%s: no option on + and - (vt min_edge, pt spp, surfels overdraw)", name);
+    const step_option *o = live_option(name, w->step_sel);
+    if (!o) {
+        set_status(sh, "%s: no live option for + and -", name);
+        return;
+    }
+    if (c->kind == CMD_SELECT) {
+        w->step_sel += c->dir;
+        o = live_option(name, w->step_sel);
+        set_status(sh, "+ and - change %s %s=%s", name, o->key, rl_renderer_get(w->r, o->key));
+        return;
+    }
+    step_option_apply(w, o, c->dir);
 }
 
 static bool is_path_tracer(const char *name)
@@ -509,9 +645,7 @@ static void compare_reference(worker *w, const rl_camera *cam)
         rl_clear_error();
         return;
     }
-    rl_status st = RL_OK;
-    if (!w->ref_img)
-        st = rl_image_create(cam->width, cam->height, RL_LAYER_COLOR, &w->ref_img);
+    rl_status st = fit_image(&w->ref_img, cam->width, cam->height, RL_LAYER_COLOR);
     rl_render_stats stats = { 0 };
     rl_renderer_set_progress(w->ref, on_progress, w);
     if (st == RL_OK)
@@ -590,7 +724,9 @@ static int worker_main(void *user)
             rl_vt_set_update_callback(w->r, on_vt_update, w);
         rl_render_stats stats = { 0 };
         rl_clear_error();
-        rl_status st = rl_renderer_render(w->r, w->scene, &cam, w->back, &stats);
+        rl_status st = fit_image(&w->back, cam.width, cam.height, VIEW_LAYERS);
+        if (st == RL_OK)
+            st = rl_renderer_render(w->r, w->scene, &cam, w->back, &stats);
         if (st == RL_OK) {
             double pixels = (double)cam.width * (double)cam.height;
             SDL_LockMutex(sh->lock);
@@ -699,6 +835,14 @@ typedef struct algo_stat {
     bool have_first, have_final;
 } algo_stat;
 
+/* An entry of the menu (M) where it is drawn, for the mouse. */
+enum { MENU_MAX_ITEMS = 256 };
+typedef struct menu_item {
+    int x, y, w, h;
+    int algo;             /* the renderer's index in algos; -1 an option, -2 a heading */
+    char label[96];       /* as drawn: an option's "key=value", ">" before the live one */
+} menu_item;
+
 typedef struct viewer {
     view_args *a;
     const rl_scene *scene;
@@ -717,9 +861,13 @@ typedef struct viewer {
     bool shown_final;
     uint64_t shown_seq, recorded_seq;
     nav nav;
-    int width, height;
+    int width, height;          /* of the frames asked for now; the shown one's may still differ */
+    bool follow_window;         /* the image has the window's size (not --size WxH) */
     bool held[VIEW_KEY_COUNT];
     bool help, stats, menu;
+    menu_item menu_items[MENU_MAX_ITEMS];   /* where the menu's entries are drawn */
+    int num_menu_items;
+    bool mouse_taken;           /* the pressed button clicked the menu: its drag is no orbit */
     cli_layer layer;            /* what L shows: colour, depth or IDs */
     rl_vec4 *layer_px;          /* the depth or ID picture */
     bool need_frame;            /* a frame without a restart is wanted (X) */
@@ -838,6 +986,7 @@ static bool worker_idle(viewer *v)
 /* ---- output ---- */
 
 static void draw(viewer *v);
+static bool menu_click(viewer *v, int x, int y, int button);
 
 static rl_status write_shot_json(const viewer *v, const char *png, const char *path)
 {
@@ -846,8 +995,8 @@ static rl_status write_shot_json(const viewer *v, const char *png, const char *p
         return RL_ERR_OUT_OF_MEMORY;
     cJSON_AddStringToObject(obj, "algorithm", v->shown_algo);
     cJSON_AddStringToObject(obj, "scene", v->a->scene);
-    cJSON_AddNumberToObject(obj, "width", v->width);
-    cJSON_AddNumberToObject(obj, "height", v->height);
+    cJSON_AddNumberToObject(obj, "width", v->shown->width);
+    cJSON_AddNumberToObject(obj, "height", v->shown->height);
     cJSON_AddStringToObject(obj, "file", png);
     cJSON_AddNumberToObject(obj, "spp", v->shown_spp);
     cJSON_AddBoolToObject(obj, "final", v->shown_final);
@@ -864,6 +1013,19 @@ static rl_status write_shot_json(const viewer *v, const char *png, const char *p
     /* The last comparison of X, whichever frame it was made on. */
     shared *sh = (shared *)&v->sh;
     SDL_LockMutex(sh->lock);
+    /* The renderer's options, so that a screenshot says how to make it
+     * again with rl render --set (the live ones change during a run). */
+    cJSON *opts = cJSON_AddObjectToObject(obj, "options");
+    char options[sizeof sh->options];
+    snprintf(options, sizeof options, "%s", sh->options);
+    char *save = NULL;
+    for (char *line = strtok_r(options, "\n", &save); opts && line; line = strtok_r(NULL, "\n", &save)) {
+        char *eq = strchr(line, '=');
+        if (!eq)
+            continue;
+        *eq = '\0';
+        cJSON_AddStringToObject(opts, line[0] == '>' ? line + 1 : line, eq + 1);
+    }
     cJSON *ref = sh->ref_valid ? cJSON_AddObjectToObject(obj, "reference") : NULL;
     if (ref) {
         cJSON_AddStringToObject(ref, "algorithm", sh->ref_algo);
@@ -919,12 +1081,12 @@ static bool write_capture(viewer *v, const char *png)
     draw(v);      /* a key of the script (help, stats) may have changed the overlay */
     rl_image *img = NULL;
     rl_clear_error();
-    rl_status st = rl_image_create(v->width, v->height, RL_LAYER_COLOR, &img);
+    rl_status st = rl_image_create(v->shown->width, v->shown->height, RL_LAYER_COLOR, &img);
     if (st == RL_OK) {
         float lin[256];
         for (int i = 0; i < 256; i++)
             lin[i] = rl_srgb_to_linear((float)i / 255.0f);
-        for (size_t i = 0; i < (size_t)v->width * (size_t)v->height; i++) {
+        for (size_t i = 0; i < (size_t)img->width * (size_t)img->height; i++) {
             uint32_t p = v->pixels[i];
             img->color[i] = (rl_vec4){ lin[p >> 16 & 255], lin[p >> 8 & 255], lin[p & 255], 1.0f };
         }
@@ -1041,6 +1203,39 @@ static void say(viewer *v, const char *fmt, ...)
     vsnprintf(v->sh.status, sizeof v->sh.status, fmt, ap);
     SDL_UnlockMutex(v->sh.lock);
     va_end(ap);
+}
+
+/* The image size for a window of w x h pixels: the same, or scaled down
+ * with its aspect kept to at most VIEW_MAX_WINDOW_PIXELS. */
+static void window_image_size(int w, int h, int *iw, int *ih)
+{
+    w = w < 1 ? 1 : w;
+    h = h < 1 ? 1 : h;
+    double area = (double)w * (double)h;
+    if (area > VIEW_MAX_WINDOW_PIXELS) {
+        double f = sqrt(VIEW_MAX_WINDOW_PIXELS / area);
+        w = (int)fmax(1.0, floor(w * f));
+        h = (int)fmax(1.0, floor(h * f));
+    }
+    *iw = w;
+    *ih = h;
+}
+
+/* The window is w x h pixels now: an image that follows it is rendered
+ * anew at that size (the renderer restarts, as for a camera change). */
+static void window_resized(viewer *v, int w, int h)
+{
+    if (!v->follow_window)
+        return;
+    int iw, ih;
+    window_image_size(w, h, &iw, &ih);
+    if (iw == v->width && ih == v->height)
+        return;
+    v->width = iw;
+    v->height = ih;
+    v->nav.cam.width = iw;
+    v->nav.cam.height = ih;
+    v->nav.changed = true;
 }
 
 static void start_recording(viewer *v, const char *file)
@@ -1180,6 +1375,13 @@ static bool press(viewer *v, view_key k)
         push_cmd(v, CMD_STEP, NULL, k == VIEW_KEY_OPTION_UP ? 1 : -1, 0);
         v->nav.changed = true;
         break;
+    case VIEW_KEY_OPTION_NEXT:
+    case VIEW_KEY_OPTION_PREV:
+        /* Changes no image: a frame without a restart carries it to the
+         * worker, and pt keeps accumulating. */
+        push_cmd(v, CMD_SELECT, NULL, k == VIEW_KEY_OPTION_NEXT ? 1 : -1, 0);
+        v->need_frame = true;
+        break;
     case VIEW_KEY_CYCLE_OVERLAY:
     case VIEW_KEY_CYCLE_SHADOW:
     case VIEW_KEY_CYCLE_DIFFUSE:
@@ -1250,6 +1452,8 @@ static view_key key_of(const SDL_Keysym *ks)
     case SDLK_r: return VIEW_KEY_RECORD;
     case SDLK_PLUS: case SDLK_EQUALS: case SDLK_KP_PLUS: return VIEW_KEY_OPTION_UP;
     case SDLK_MINUS: case SDLK_KP_MINUS: return VIEW_KEY_OPTION_DOWN;
+    case SDLK_RIGHTBRACKET: return VIEW_KEY_OPTION_NEXT;
+    case SDLK_LEFTBRACKET: return VIEW_KEY_OPTION_PREV;
     case SDLK_o: return VIEW_KEY_CYCLE_OVERLAY;
     case SDLK_b: return VIEW_KEY_CYCLE_SHADOW;
     case SDLK_n: return VIEW_KEY_CYCLE_DIFFUSE;
@@ -1287,8 +1491,15 @@ static bool handle_events(viewer *v)
                 return false;
             break;
         }
+        case SDL_MOUSEBUTTONDOWN:
+            if (!v->scripted && (e.button.button == SDL_BUTTON_LEFT || e.button.button == SDL_BUTTON_RIGHT))
+                v->mouse_taken = menu_click(v, e.button.x, e.button.y, e.button.button == SDL_BUTTON_RIGHT);
+            break;
+        case SDL_MOUSEBUTTONUP:
+            v->mouse_taken = false;
+            break;
         case SDL_MOUSEMOTION:
-            if (v->scripted)
+            if (v->scripted || v->mouse_taken)
                 break;
             if (e.motion.state & SDL_BUTTON_LMASK)
                 nav_orbit(&v->nav, (float)e.motion.xrel, (float)e.motion.yrel);
@@ -1298,6 +1509,15 @@ static bool handle_events(viewer *v)
         case SDL_MOUSEWHEEL:
             if (!v->scripted)
                 nav_dolly(&v->nav, (float)e.wheel.y);
+            break;
+        case SDL_WINDOWEVENT:
+            /* A script sets the size itself (its resize event), so that a
+             * run does not depend on when the X server answers. */
+            if (!v->scripted && e.window.event == SDL_WINDOWEVENT_SIZE_CHANGED) {
+                int w = 0, h = 0;
+                if (SDL_GetRendererOutputSize(v->ren, &w, &h) == 0)
+                    window_resized(v, w, h);
+            }
             break;
         default: break;
         }
@@ -1324,14 +1544,57 @@ static uint8_t to_byte(float c)
     return srgb_lut[(int)(c * 4096.0f + 0.5f)];
 }
 
+/* The displayed frame's buffers and texture at w x h: a frame of a new
+ * size (the window was resized) replaces them. */
+static bool fit_shown(viewer *v, int w, int h)
+{
+    if (v->shown && v->shown->width == w && v->shown->height == h && v->tex)
+        return true;
+    rl_clear_error();
+    size_t n = (size_t)w * (size_t)h;
+    uint32_t *px = malloc(n * sizeof *px);
+    rl_vec4 *layer = malloc(n * sizeof *layer);
+    rl_image *img = NULL;
+    SDL_Texture *tex = NULL;
+    if (px && layer && rl_image_create(w, h, VIEW_LAYERS, &img) == RL_OK)
+        tex = SDL_CreateTexture(v->ren, SDL_PIXELFORMAT_ARGB8888, SDL_TEXTUREACCESS_STREAMING, w, h);
+    if (!tex) {
+        free(px);
+        free(layer);
+        rl_image_release(img);
+        rl_clear_error();
+        return false;
+    }
+    memset(px, 0, n * sizeof *px);
+    free(v->pixels);
+    free(v->layer_px);
+    rl_image_release(v->shown);
+    if (v->tex)
+        SDL_DestroyTexture(v->tex);
+    v->pixels = px;
+    v->layer_px = layer;
+    v->shown = img;
+    v->tex = tex;
+    /* Letterboxed scaling keeps the image's aspect ratio in any window; an
+     * image that follows the window is drawn 1:1 (unless capped). */
+    SDL_RenderSetLogicalSize(v->ren, w, h);
+    return true;
+}
+
 /* Takes the newest published image, if there is one. */
 static bool take_frame(viewer *v)
 {
     shared *sh = &v->sh;
     SDL_LockMutex(sh->lock);
     bool fresh = sh->front_seq != v->shown_seq;
+    if (fresh && !fit_shown(v, sh->front->width, sh->front->height)) {
+        fresh = false;
+        v->shown_seq = sh->front_seq;
+        snprintf(sh->status, sizeof sh->status, "out of memory for a %dx%d image", sh->front->width,
+                 sh->front->height);
+    }
     if (fresh) {
-        size_t n = (size_t)v->width * (size_t)v->height;
+        size_t n = (size_t)sh->front->width * (size_t)sh->front->height;
         memcpy(v->shown->color, sh->front->color, n * sizeof *v->shown->color);
         memcpy(v->shown->depth, sh->front->depth, n * sizeof *v->shown->depth);
         memcpy(v->shown->object_id, sh->front->object_id, n * sizeof *v->shown->object_id);
@@ -1383,9 +1646,111 @@ static double current_fps(const viewer *v)
     return span > 0.0 ? (double)(v->num_final - 1) / span : 0.0;
 }
 
+/* The size of the overlay's text: legible on large images, fitting small ones. */
+static int text_scale(const viewer *v)
+{
+    return v->shown->width >= 1200 ? 2 : 1;
+}
+
+static bool menu_add(viewer *v, int x, int y, int algo, const char *label)
+{
+    if (v->num_menu_items == MENU_MAX_ITEMS)
+        return false;
+    int scale = text_scale(v);
+    menu_item *m = &v->menu_items[v->num_menu_items++];
+    snprintf(m->label, sizeof m->label, "%s", label);
+    m->x = x;
+    m->y = y;
+    m->w = view_text_width(m->label, scale);
+    m->h = VIEW_FONT_LINE * scale;
+    m->algo = algo;
+    return true;
+}
+
+/* The menu from half the image's height down: the renderers Tab reaches,
+ * wrapped to the width (the current one marked ">"); a blank line; the
+ * current renderer's name and its options one a line, in columns where
+ * the height runs out. Fixed cells, so that a script's click can name an
+ * entry by its pixel (docs/viewer.md). */
+static void menu_layout(viewer *v)
+{
+    int scale = text_scale(v);
+    int adv = VIEW_FONT_ADVANCE * scale, lh = VIEW_FONT_LINE * scale;
+    int x0 = 3 * scale, y0 = v->shown->height / 2;
+    int cols = v->shown->width / adv - 1;
+    cols = cols > 8 ? cols : 8;
+    v->num_menu_items = 0;
+    int col = 0, row = 0;
+    for (size_t i = 0; i < v->num_algos; i++) {
+        char label[96];
+        int k = snprintf(label, sizeof label, "%s%s", i == v->algo_index ? ">" : "", v->algos[i]);
+        if (col > 0 && col + 2 + k > cols) {
+            row++;
+            col = 0;
+        } else if (col > 0)
+            col += 2;
+        menu_add(v, x0 + col * adv, y0 + row * lh, (int)i, label);
+        col += k;
+    }
+    row += 2;
+    char options[sizeof v->sh.options], heading[96];
+    SDL_LockMutex(v->sh.lock);
+    snprintf(options, sizeof options, "%s", v->sh.options);
+    snprintf(heading, sizeof heading, "%s options:", v->sh.algo);
+    SDL_UnlockMutex(v->sh.lock);
+    menu_add(v, x0, y0 + row * lh, -2, heading);
+    row++;
+    int rows = (v->shown->height - y0) / lh - row;
+    rows = rows > 1 ? rows : 1;
+    int x = x0, widest = 0, r = 0;
+    char *save = NULL;
+    for (char *line = strtok_r(options, "\n", &save); line; line = strtok_r(NULL, "\n", &save)) {
+        if (r == rows) {
+            x += (widest + 2) * adv;
+            widest = 0;
+            r = 0;
+        }
+        if (!menu_add(v, x, y0 + (row + r) * lh, -1, line))
+            break;
+        int k = (int)strlen(v->menu_items[v->num_menu_items - 1].label);
+        widest = k > widest ? k : widest;
+        r++;
+    }
+}
+
+/* A click at image pixel (x, y) with the menu open: an entry switches to
+ * that renderer or changes that option (button 1, the right one: the
+ * other way). false where no entry is. */
+static bool menu_click(viewer *v, int x, int y, int button)
+{
+    if (!v->menu)
+        return false;
+    menu_layout(v);
+    for (int i = 0; i < v->num_menu_items; i++) {
+        const menu_item *m = &v->menu_items[i];
+        if (x < m->x || x >= m->x + m->w || y < m->y || y >= m->y + m->h || m->algo == -2)
+            continue;
+        if (m->algo >= 0) {
+            if ((size_t)m->algo != v->algo_index) {
+                v->algo_index = (size_t)m->algo;
+                push_cmd(v, CMD_ALGO, v->algos[m->algo], 0, 0);
+                v->nav.changed = true;
+            }
+            return true;
+        }
+        char key[96];
+        const char *from = m->label[0] == '>' ? m->label + 1 : m->label;
+        snprintf(key, sizeof key, "%.*s", (int)strcspn(from, "="), from);
+        push_cmd(v, CMD_CLICK, key, button ? -1 : 1, 0);
+        v->nav.changed = true;
+        return true;
+    }
+    return false;
+}
+
 static void draw(viewer *v)
 {
-    int w = v->width, h = v->height;
+    int w = v->shown->width, h = v->shown->height;
     const rl_vec4 *src = v->shown->color;
     if (v->layer != CLI_LAYER_COLOR && cli_layer_picture(v->shown, v->layer, v->layer_px))
         src = v->layer_px;
@@ -1393,8 +1758,7 @@ static void draw(viewer *v)
         rl_vec4 c = src[i];
         v->pixels[i] = 0xff000000u | (uint32_t)to_byte(c.x) << 16 | (uint32_t)to_byte(c.y) << 8 | to_byte(c.z);
     }
-    /* Text at a size that stays legible on large images and fits small ones. */
-    int scale = w >= 1200 ? 2 : 1;
+    int scale = text_scale(v);
     if (v->stats) {
         const rl_render_stats *s = &v->shown_stats;
         char text[1024], status[256];
@@ -1423,33 +1787,10 @@ static void draw(viewer *v)
         view_draw_text(v->pixels, w, h, 3 * scale, 3 * scale, scale, text, 0xffffff40u);
     }
     if (v->menu) {
-        /* The renderers Tab cycles through, the current one marked, and
-         * its options as they are now. */
-        char text[3072], options[sizeof v->sh.options];
-        int fit = w / (VIEW_FONT_ADVANCE * scale) - 1;
-        size_t len = 0, cols = fit > 8 ? (size_t)fit : 8, line = 0;
-        SDL_LockMutex(v->sh.lock);
-        snprintf(options, sizeof options, "%s", v->sh.options);
-        SDL_UnlockMutex(v->sh.lock);
-        /* Words wrapped to the window: renderer names, then key=value. */
-        for (size_t i = 0; i <= v->num_algos; i++) {
-            char *save = NULL;
-            for (char *word = i < v->num_algos ? (char *)v->algos[i] : strtok_r(options, " ", &save); word;
-                 word = i < v->num_algos ? NULL : strtok_r(NULL, " ", &save)) {
-                char item[160];
-                int k = snprintf(item, sizeof item, "%s%s", i == v->algo_index ? ">" : "", word);
-                if (k < 0 || len + (size_t)k + 4 >= sizeof text)
-                    break;
-                bool wrap = line > 0 && line + 2 + (size_t)k > cols;
-                len += (size_t)snprintf(text + len, sizeof text - len, "%s%s", wrap ? "\n" : (line ? "  " : ""), item);
-                line = (wrap ? 0 : line + (line ? 2 : 0)) + (size_t)k;
-            }
-            if (i + 1 == v->num_algos && len + 3 < sizeof text) {
-                len += (size_t)snprintf(text + len, sizeof text - len, "\n\n");
-                line = 0;
-            }
-        }
-        view_draw_text(v->pixels, w, h, 3 * scale, h / 2, scale, text, 0xffffffffu);
+        menu_layout(v);
+        for (int i = 0; i < v->num_menu_items; i++)
+            view_draw_text(v->pixels, w, h, v->menu_items[i].x, v->menu_items[i].y, scale, v->menu_items[i].label,
+                           v->menu_items[i].algo == -2 ? 0xffffff40u : 0xffffffffu);
     }
     if (v->help)
         view_draw_text(v->pixels, w, h, 3 * scale, h / 3, scale, view_keys_help, 0xffffffffu);
@@ -1501,9 +1842,12 @@ static int parse_args(int argc, char **argv, view_args *a)
         else if (VALUE("--path-out")) a->path_out = v;
         else if (VALUE("--stats-out")) a->stats_out = v;
         else if (VALUE("--size")) {
-            if (m > 0 && !cli_parse_size(v, &a->width, &a->height))
+            if (m > 0 && strcmp(v, "window") == 0)
+                a->has_size = false;
+            else if (m > 0 && !cli_parse_size(v, &a->width, &a->height))
                 return RL_CLI_USAGE;
-            a->has_size = true;
+            else
+                a->has_size = true;
         } else if (VALUE("--max-spp")) {
             if (m > 0 && (!rl_parse_int(v, &a->max_spp) || a->max_spp < 1 || a->max_spp > 1000000000))
                 return cli_fail(RL_CLI_USAGE, "--max-spp: expected samples per pixel in [1, 1000000000], got '%s'",
@@ -1648,7 +1992,8 @@ static int open_window(viewer *v)
     char title[256];
     snprintf(title, sizeof title, "rl view %s", v->a->scene);
     /* The window starts at the image size, halved until it fits a common
-     * screen; it may then be resized freely (the image is scaled). */
+     * screen; it may then be resized freely (a --size image is scaled, an
+     * image that follows the window is rendered at its new size). */
     int ww = v->width, wh = v->height;
     while (ww > 1600 || wh > 1000) {
         ww /= 2;
@@ -1661,11 +2006,15 @@ static int open_window(viewer *v)
     v->ren = SDL_CreateRenderer(v->win, -1, 0);
     if (!v->ren)
         return cli_fail(RL_CLI_FAIL, "view: cannot draw into the window: %s", SDL_GetError());
-    /* Letterboxed scaling keeps the image's aspect ratio in any window. */
-    SDL_RenderSetLogicalSize(v->ren, v->width, v->height);
-    v->tex = SDL_CreateTexture(v->ren, SDL_PIXELFORMAT_ARGB8888, SDL_TEXTUREACCESS_STREAMING, v->width, v->height);
-    if (!v->tex)
-        return cli_fail(RL_CLI_FAIL, "view: cannot make the image texture: %s", SDL_GetError());
+    int ow = ww, oh = wh;
+    if (v->follow_window && SDL_GetRendererOutputSize(v->ren, &ow, &oh) == 0) {
+        window_image_size(ow, oh, &v->width, &v->height);
+        v->nav.cam.width = v->width;
+        v->nav.cam.height = v->height;
+    }
+    if (!fit_shown(v, v->width, v->height))
+        return cli_fail(RL_CLI_FAIL, "view: cannot make a %dx%d image and its texture: %s", v->width, v->height,
+                        SDL_GetError());
     return RL_CLI_OK;
 }
 
@@ -1772,6 +2121,11 @@ static int apply_event(viewer *v, const view_script *s, const view_event *e, boo
         break;
     case VIEW_EV_RESIZE:
         SDL_SetWindowSize(v->win, (int)e->dx, (int)e->dy);
+        window_resized(v, (int)e->dx, (int)e->dy);
+        break;
+    case VIEW_EV_CLICK:
+        if (!menu_click(v, (int)e->dx, (int)e->dy, e->button))
+            say(v, "click %g,%g: %s", e->dx, e->dy, v->menu ? "no menu entry there" : "the menu (M) is closed");
         break;
     case VIEW_EV_RECORD:
         if (e->text)
@@ -1989,8 +2343,13 @@ int view_run(int argc, char **argv)
         v.nav.speed = 0.25f * diag;
         v.nav.min_dist = 1e-3f * diag;
         /* back, front, shown with their layers, the reference, the layer
-         * picture and the window's pixels */
-        rc = cli_check_frame_memory(v.wk.r, v.width, v.height, VIEW_LAYERS,
+         * picture and the window's pixels; an image that follows the window
+         * may grow to the cap */
+        v.follow_window = !a.has_size;
+        int mw = v.width, mh = v.height;
+        if (v.follow_window)
+            window_image_size(16384, 16384 * 10 / 16, &mw, &mh);
+        rc = cli_check_frame_memory(v.wk.r, mw, mh, VIEW_LAYERS,
                                     3.0 * (sizeof(rl_vec4) + 8.0) + 2.0 * sizeof(rl_vec4) + 4.0, 0.0);
     }
     if (rc == RL_CLI_OK) {
@@ -2004,20 +2363,16 @@ int view_run(int argc, char **argv)
         } else if (st != RL_OK)
             rc = cli_fail_status(RL_CLI_FAIL, st, a.algo);
     }
+    if (rc == RL_CLI_OK)
+        rc = open_window(&v);
     if (rc == RL_CLI_OK) {
         rl_clear_error();
         rl_status st = rl_image_create(v.width, v.height, VIEW_LAYERS, &v.wk.back);
         if (st == RL_OK)
             st = rl_image_create(v.width, v.height, VIEW_LAYERS, &v.sh.front);
-        if (st == RL_OK)
-            st = rl_image_create(v.width, v.height, VIEW_LAYERS, &v.shown);
-        v.pixels = st == RL_OK ? calloc((size_t)v.width * (size_t)v.height, sizeof *v.pixels) : NULL;
-        v.layer_px = v.pixels ? calloc((size_t)v.width * (size_t)v.height, sizeof *v.layer_px) : NULL;
-        if (st != RL_OK || !v.pixels || !v.layer_px)
+        if (st != RL_OK)
             rc = cli_fail(RL_CLI_FAIL, "out of memory for a %dx%d view", v.width, v.height);
     }
-    if (rc == RL_CLI_OK)
-        rc = open_window(&v);
     if (rc == RL_CLI_OK) {
         init_lut();
         list_algos(&v);

@@ -210,6 +210,74 @@ assert r["algorithm"] == "whitted" and r["compared"] == "raster", r
 assert 0.2 < r["ssim"] < 0.9999 and r["rmse"] > 0, r
 PY
 
+# The image follows the window (--size window): a resize re-renders at
+# the new size (as rl render at that size); the menu's entries are clicked
+# (a renderer; an enum option back with the right button and forward with
+# the left); the live culling options ([ ] + -) change the options and the
+# stats. Where the entries are: the menu's fixed cells (docs/viewer.md),
+# from half the height down, 6 x 9 pixels each, renderers wrapped to the
+# width, the current one marked ">".
+read -r VS_X VS_Y RA_X RA_Y SH_X SH_Y < <(available_algos | python3 -c '
+import sys
+names, cols, col, row, at = sys.stdin.read().split(), 320 // 6 - 1, 0, 0, {}
+for n in names:
+    k = len(n) + (n == "raster")
+    if col > 0 and col + 2 + k > cols:
+        row, col = row + 1, 0
+    elif col > 0:
+        col += 2
+    at[n] = (3 + col * 6 + 2, 120 + row * 9 + 3)
+    col += k
+# raster options: a heading two lines below the renderers, shading first.
+print(*at["visset"], *at["raster"], 5, 120 + (row + 3) * 9 + 3)')
+cat >"$TMP/window.txt" <<EOT
+0 key i
+0 resize 320 240
+0 screenshot $TMP/win.png
+0 key m
+0 click right $SH_X $SH_Y
+0 screenshot $TMP/win_gouraud.png
+0 click $SH_X $SH_Y
+0 screenshot $TMP/win_back.png
+0 click $VS_X $VS_Y
+0 set budget=2048
+0 screenshot $TMP/win_vs2048.png
+0 key -
+0 screenshot $TMP/win_vs1024.png
+0 click $RA_X $RA_Y
+0 algo chcpp
+0 key ]
+0 key +
+0 key ]
+0 key ]
+0 key +
+0 screenshot $TMP/win_chcpp.png
+0 resize 64 48
+0 screenshot $TMP/win_small.png
+EOT
+run_ok xvfb "$RL" view table --size window --script "$TMP/window.txt"
+run_ok "$RL" render table --size 320x240 --out "$TMP/ref_win.png"
+run_ok "$RL" render table --size 320x240 --set shading=gouraud --out "$TMP/ref_gouraud.png"
+ssim_ok "$TMP/win.png" "$TMP/ref_win.png"
+ssim_ok "$TMP/win_gouraud.png" "$TMP/ref_gouraud.png"
+ssim_ok "$TMP/win_back.png" "$TMP/ref_win.png"
+cmp -s "$TMP/win_gouraud.png" "$TMP/win.png" && fail "click: shading did not change the image"
+python3 - "$TMP" <<'PY' || fail "the window's size, the menu's clicks or the live options are wrong"
+import json, sys
+tmp = sys.argv[1]
+j = lambda n: json.load(open(tmp + "/win_" + n + ".json"))
+w = json.load(open(tmp + "/win.json"))
+assert (w["width"], w["height"]) == (320, 240), w
+assert (j("small")["width"], j("small")["height"]) == (64, 48)
+assert j("gouraud")["options"]["shading"] == "gouraud" and j("back")["options"]["shading"] == "textured"
+a, b = j("vs2048"), j("vs1024")
+assert a["algorithm"] == "visset" and a["options"]["budget"] == "2048" and b["options"]["budget"] == "1024", (a, b)
+assert b["triangles_rasterized"] < a["triangles_rasterized"] <= w["triangles_rasterized"], (a, b, w)
+c = j("chcpp")
+assert c["algorithm"] == "chcpp" and c["options"]["batch"] == "100" and c["options"]["tight"] == "false", c
+assert c["occlusion_queries"] > 0, c
+PY
+
 # A set in the script that the renderer refuses: exit 2 with FILE:LINE.
 printf '0 set raster.shading=plaid\n0.1 quit\n' >"$TMP/bad_set.txt"
 expect_error 2 "bad_set.txt:1: set raster.shading=plaid" xvfb "$RL" view cornell --size 16x12 --script "$TMP/bad_set.txt"
