@@ -61,6 +61,9 @@ static const char view_help[] =
     "                      per pixel; default 4096\n"
     "  --ref-spp N         samples per pixel of the pt reference that X compares\n"
     "                      the path tracers with; default 256\n"
+    "  --display MODE      how the image reaches the window: software (SDL's\n"
+    "                      software renderer), gl (SDL's OpenGL renderer) or auto\n"
+    "                      (default: gl for the GL renderers, else software)\n"
     "\n"
     "model files (the same as SCENE:cameras=off,lights=add,...; see rl scenes):\n"
     CLI_MODEL_FLAGS_HELP
@@ -117,6 +120,7 @@ typedef struct shot_at {
 
 typedef struct view_args {
     const char *scene, *algo, *camera, *script, *record_dir, *shot_dir, *path_out, *stats_out;
+    const char *display;       /* --display: auto, software or gl */
     bool has_size;             /* --size WxH; without it (or with --size window) the image follows the window */
     int width, height;
     const char **sets;
@@ -831,6 +835,8 @@ typedef struct algo_stat {
     long long frames, moving_frames;
     double moving_s;            /* request to finished frame, summed over moving frames */
     double first_image_ms, first_final_ms, prep_ms;
+    double display_s;           /* taking and drawing its new images, summed */
+    long long displayed;
     double requested_s;         /* when the renderer was asked for */
     bool have_first, have_final;
 } algo_stat;
@@ -852,6 +858,7 @@ typedef struct viewer {
     SDL_Thread *thread;
     SDL_Window *win;
     SDL_Renderer *ren;
+    char display[32];           /* SDL's renderer: software or opengl */
     SDL_Texture *tex;
     uint32_t *pixels;
     rl_image *shown;            /* the displayed frame, without the overlay */
@@ -1638,6 +1645,23 @@ static bool take_frame(viewer *v)
     return true;
 }
 
+/* Takes the newest image and draws it, timing both for --stats-out: the
+ * display's share of a frame (the copy, the sRGB conversion, the upload
+ * and the present). */
+static bool show_frame(viewer *v)
+{
+    double t0 = rl_time_s();
+    if (!take_frame(v))
+        return false;
+    draw(v);
+    algo_stat *s = stat_of(v, v->shown_algo);
+    if (s) {
+        s->display_s += rl_time_s() - t0;
+        s->displayed++;
+    }
+    return true;
+}
+
 static double current_fps(const viewer *v)
 {
     if (v->num_final < 2)
@@ -1841,6 +1865,11 @@ static int parse_args(int argc, char **argv, view_args *a)
         else if (VALUE("--shot-dir")) a->shot_dir = v;
         else if (VALUE("--path-out")) a->path_out = v;
         else if (VALUE("--stats-out")) a->stats_out = v;
+        else if (VALUE("--display")) {
+            if (m > 0 && strcmp(v, "auto") != 0 && strcmp(v, "software") != 0 && strcmp(v, "gl") != 0)
+                return cli_fail(RL_CLI_USAGE, "--display: expected auto, software or gl, got '%s'", v);
+            a->display = v;
+        }
         else if (VALUE("--size")) {
             if (m > 0 && strcmp(v, "window") == 0)
                 a->has_size = false;
@@ -1979,10 +2008,25 @@ static int open_window(viewer *v)
     /* The image is made on the CPU; the window only scales it. SDL's
      * software path does that without loading an OpenGL driver (under Xvfb
      * that is Mesa, which SDL_Quit unloads with blocks still held, a leak
-     * the sanitizer build cannot attribute). The environment's
-     * SDL_RENDER_DRIVER and SDL_FRAMEBUFFER_ACCELERATION still override. */
-    SDL_SetHint(SDL_HINT_RENDER_DRIVER, "software");
-    SDL_SetHint(SDL_HINT_FRAMEBUFFER_ACCELERATION, "0");
+     * the sanitizer build cannot attribute). The GL renderers' images come
+     * back from the library's own context as rl_images as well (a context
+     * shared with the window is not possible through the API:
+     * docs/viewer.md), so for them only the upload and scaling go to SDL's
+     * OpenGL renderer (--display gl), which SDL replaces by its software
+     * one where it cannot make a context. auto does so only where the GL
+     * backend has a hardware device: on llvmpipe the GL upload is the CPU's
+     * too and measured twice the software path's time (docs/viewer.md).
+     * The environment's SDL_RENDER_DRIVER and SDL_FRAMEBUFFER_ACCELERATION
+     * still override. */
+    bool gl = strcmp(v->a->display, "gl") == 0;
+    rl_gl_info gi;
+    if (strcmp(v->a->display, "auto") == 0 && strncmp(v->a->algo, "gl-", 3) == 0 &&
+        rl_gl_info_get(NULL, &gi) == RL_OK)
+        gl = !strstr(gi.renderer, "llvmpipe") && !strstr(gi.renderer, "softpipe") && !strstr(gi.renderer, "swrast");
+    rl_clear_error();
+    SDL_SetHint(SDL_HINT_RENDER_DRIVER, gl ? "opengl" : "software");
+    if (!gl)
+        SDL_SetHint(SDL_HINT_FRAMEBUFFER_ACCELERATION, "0");
     if (SDL_Init(SDL_INIT_VIDEO) != 0)
         return cli_fail(RL_CLI_FAIL, "view: cannot open a window: %s", SDL_GetError());
     const char *driver = SDL_GetCurrentVideoDriver();
@@ -2006,6 +2050,11 @@ static int open_window(viewer *v)
     v->ren = SDL_CreateRenderer(v->win, -1, 0);
     if (!v->ren)
         return cli_fail(RL_CLI_FAIL, "view: cannot draw into the window: %s", SDL_GetError());
+    SDL_RendererInfo info;
+    snprintf(v->display, sizeof v->display, "%s", SDL_GetRendererInfo(v->ren, &info) == 0 ? info.name : "?");
+    cli_debug("view: SDL renderer %s", v->display);
+    if (gl && strcmp(v->display, "opengl") != 0)
+        snprintf(v->sh.status, sizeof v->sh.status, "--display gl: SDL made no OpenGL renderer; %s", v->display);
     int ow = ww, oh = wh;
     if (v->follow_window && SDL_GetRendererOutputSize(v->ren, &ow, &oh) == 0) {
         window_image_size(ow, oh, &v->width, &v->height);
@@ -2031,8 +2080,7 @@ static bool wait_frame(viewer *v)
         SDL_UnlockMutex(v->sh.lock);
         if (!handle_events(v))
             return false;
-        if (take_frame(v))
-            draw(v);
+        show_frame(v);
         if (idle)
             return true;
     }
@@ -2217,11 +2265,12 @@ static int run_interactive(viewer *v)
             v->need_frame = false;
             request(v, false);
         }
-        bool fresh = take_frame(v);
+        bool fresh = show_frame(v);
         if (fresh && !after_frame(v))
             return RL_CLI_FAIL;
         /* The overlay (help, status) changes without frames too. */
-        draw(v);
+        if (!fresh)
+            draw(v);
         SDL_Delay(fresh ? 1 : 8);
     }
     if (v->recording && !stop_recording(v))
@@ -2241,6 +2290,7 @@ static int write_stats_out(const viewer *v, double wall_s)
     cJSON_AddNumberToObject(obj, "width", v->width);
     cJSON_AddNumberToObject(obj, "height", v->height);
     cJSON_AddBoolToObject(obj, "scripted", v->scripted);
+    cJSON_AddStringToObject(obj, "display", v->display);
     cJSON_AddNumberToObject(obj, "wall_s", wall_s);
     for (int i = 0; i < v->num_stats; i++) {
         const algo_stat *s = &v->stats_by_algo[i];
@@ -2256,6 +2306,7 @@ static int write_stats_out(const viewer *v, double wall_s)
         cJSON_AddNumberToObject(e, "first_image_ms", s->first_image_ms);
         cJSON_AddNumberToObject(e, "first_final_ms", s->first_final_ms);
         cJSON_AddNumberToObject(e, "first_prep_ms", s->prep_ms);
+        cJSON_AddNumberToObject(e, "display_ms", s->displayed ? s->display_s * 1e3 / (double)s->displayed : 0.0);
         cJSON_AddItemToArray(arr, e);
     }
     cJSON *exp = cli_experiment_json(cli_threads());
@@ -2303,7 +2354,7 @@ static void close_viewer(viewer *v)
 
 int view_run(int argc, char **argv)
 {
-    view_args a = { .algo = "raster", .shot_dir = ".", .path_out = "rl-view-path.json",
+    view_args a = { .algo = "raster", .display = "auto", .shot_dir = ".", .path_out = "rl-view-path.json",
                     .max_spp = DEFAULT_MAX_SPP, .ref_spp = DEFAULT_REF_SPP };
     a.sets = calloc((size_t)argc, sizeof *a.sets);
     if (!a.sets)
