@@ -103,6 +103,10 @@ int view_run(int argc, char **argv)
 #define MAX_CMDS 64
 #define DEFAULT_MAX_SPP 4096
 #define DEFAULT_REF_SPP 256
+/* An accumulating renderer's image is stable once a new frame changes it
+ * by less than this mean absolute difference of 8-bit sRGB values: half a
+ * code value, below what a viewer sees. */
+#define STABLE_CHANGE 0.5
 /* Every image of the viewer: the depth and ID layers are shown by L. */
 #define VIEW_LAYERS (RL_LAYER_COLOR | RL_LAYER_DEPTH | RL_LAYER_ID)
 /* With the image following the window (--size window, the default), a
@@ -837,6 +841,18 @@ typedef struct algo_stat {
     double first_image_ms, first_final_ms, prep_ms;
     double display_s;           /* taking and drawing its new images, summed */
     long long displayed;
+    /* From a restart (camera, renderer or option change) to its first
+     * image on screen, an intermediate one included, summed. */
+    double latency_s;
+    long long latency_n;
+    double last_restart_s;      /* the request time of the restart shown last */
+    /* After the last restart: images shown until the image is stable, a
+     * final one that nothing more will change (a renderer that does not
+     * accumulate) or that changed less than STABLE_CHANGE from the one
+     * before (one that does). */
+    long long settle_frames;
+    double settle_ms, last_change;
+    bool settled;
     double requested_s;         /* when the renderer was asked for */
     bool have_first, have_final;
 } algo_stat;
@@ -1600,8 +1616,19 @@ static bool take_frame(viewer *v)
         snprintf(sh->status, sizeof sh->status, "out of memory for a %dx%d image", sh->front->width,
                  sh->front->height);
     }
+    double change = -1.0;
     if (fresh) {
         size_t n = (size_t)sh->front->width * (size_t)sh->front->height;
+        if (sh->front_final && !sh->front_moved && is_progressive(sh->front_algo) &&
+            strcmp(sh->front_algo, v->shown_algo) == 0) {
+            double sum = 0.0;
+            for (size_t i = 0; i < n; i++) {
+                rl_vec4 a = sh->front->color[i], b = v->shown->color[i];
+                sum += abs(to_byte(a.x) - to_byte(b.x)) + abs(to_byte(a.y) - to_byte(b.y)) +
+                       abs(to_byte(a.z) - to_byte(b.z));
+            }
+            change = sum / (3.0 * (double)n);
+        }
         memcpy(v->shown->color, sh->front->color, n * sizeof *v->shown->color);
         memcpy(v->shown->depth, sh->front->depth, n * sizeof *v->shown->depth);
         memcpy(v->shown->object_id, sh->front->object_id, n * sizeof *v->shown->object_id);
@@ -1622,6 +1649,20 @@ static bool take_frame(viewer *v)
     if (s && !s->have_first) {
         s->have_first = true;
         s->first_image_ms = (now - s->requested_s) * 1e3;
+    }
+    if (s && v->shown_moved && v->shown_request_s != s->last_restart_s) {
+        s->last_restart_s = v->shown_request_s;
+        s->latency_s += now - v->shown_request_s;
+        s->latency_n++;
+        s->settle_frames = 0;
+        s->settled = false;
+    }
+    if (s && !s->settled) {
+        s->settle_frames++;
+        s->settle_ms = (now - s->last_restart_s) * 1e3;
+        if (change >= 0.0)
+            s->last_change = change;
+        s->settled = v->shown_final && (!is_progressive(v->shown_algo) || (change >= 0.0 && change < STABLE_CHANGE));
     }
     if (v->shown_final) {
         if (s && !s->have_final) {
@@ -2307,6 +2348,18 @@ static int write_stats_out(const viewer *v, double wall_s)
         cJSON_AddNumberToObject(e, "first_final_ms", s->first_final_ms);
         cJSON_AddNumberToObject(e, "first_prep_ms", s->prep_ms);
         cJSON_AddNumberToObject(e, "display_ms", s->displayed ? s->display_s * 1e3 / (double)s->displayed : 0.0);
+        cJSON_AddNumberToObject(e, "latency_ms", s->latency_n ? s->latency_s * 1e3 / (double)s->latency_n : 0.0);
+        /* After the last restart: null where the run ended before the
+         * image was stable (last_change says how far it was). */
+        if (s->settled) {
+            cJSON_AddNumberToObject(e, "settle_frames", (double)s->settle_frames);
+            cJSON_AddNumberToObject(e, "settle_ms", s->settle_ms);
+        } else {
+            cJSON_AddNullToObject(e, "settle_frames");
+            cJSON_AddNullToObject(e, "settle_ms");
+        }
+        if (s->last_change > 0.0)
+            cJSON_AddNumberToObject(e, "last_change", s->last_change);
         cJSON_AddItemToArray(arr, e);
     }
     cJSON *exp = cli_experiment_json(cli_threads());
