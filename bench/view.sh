@@ -24,16 +24,16 @@ else
     run_view() { SDL_VIDEODRIVER=offscreen "$RL" view "$@"; }
 fi
 VT_EQ="--set vt.criteria=hsv --set vt.min_edge=14 --set vt.progressive=overdraw"
-# scene size renderer [--set ...]: the issue's scenes at 1280x720, vt's
-# target at 640x480 on table.
+# scene size renderer [options]: the issue's scenes at 1280x720, vt's
+# target at 640x480 on table, gl-raster through both --display paths.
 RUNS=(
     "table 1280x720 raster"
     "table 1280x720 chcpp"
     "table 1280x720 vt $VT_EQ"
     "table 640x480 vt $VT_EQ"
     "table 1280x720 pt"
-    "table 1280x720 gl-raster"
-    "table 1280x720 gl-pt"
+    "table 1280x720 gl-raster --display software"
+    "table 1280x720 gl-raster --display gl"
     "city 1280x720 raster"
     "city 1280x720 chcpp"
     "city 1280x720 surfels"
@@ -41,8 +41,9 @@ RUNS=(
     "ls-cornell:model=bunny 1280x720 raster"
     "ls-cornell:model=bunny 1280x720 vt $VT_EQ"
     "ls-cornell:model=bunny 1280x720 pt"
-    "ls-cornell:model=bunny 1280x720 gl-pt"
 )
+# gl-pt is left out: on llvmpipe its first 1280x720 frame had not finished
+# after 5 minutes (bench/README.md).
 i=0
 for run in "${RUNS[@]}"; do
     read -r scene size algo sets <<<"$run"

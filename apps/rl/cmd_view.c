@@ -1651,9 +1651,13 @@ static bool take_frame(viewer *v)
         s->first_image_ms = (now - s->requested_s) * 1e3;
     }
     if (s && v->shown_moved && v->shown_request_s != s->last_restart_s) {
+        /* The renderer's first restart is its first image (prep included),
+         * reported as first_image_ms: the latency is that of input. */
+        if (s->have_final) {
+            s->latency_s += now - v->shown_request_s;
+            s->latency_n++;
+        }
         s->last_restart_s = v->shown_request_s;
-        s->latency_s += now - v->shown_request_s;
-        s->latency_n++;
         s->settle_frames = 0;
         s->settled = false;
     }
@@ -1665,6 +1669,7 @@ static bool take_frame(viewer *v)
         s->settled = v->shown_final && (!is_progressive(v->shown_algo) || (change >= 0.0 && change < STABLE_CHANGE));
     }
     if (v->shown_final) {
+        bool first = s && !s->have_final;
         if (s && !s->have_final) {
             s->have_final = true;
             s->first_final_ms = (now - s->requested_s) * 1e3;
@@ -1672,7 +1677,7 @@ static bool take_frame(viewer *v)
         }
         if (s) {
             s->frames++;
-            if (v->shown_moved) {
+            if (v->shown_moved && !first) {
                 s->moving_frames++;
                 s->moving_s += now - v->shown_request_s;
             }

@@ -5,7 +5,9 @@
 # a recorded camera path replays through rl render --camera-path to the
 # same frames, pt accumulates, and bad input (an unknown event or key, a
 # missing file, no display) fails with one error line; the live controls
-# (layers, overlay, reference SSIM, menu) work. Skipped (exit 77,
+# (layers, overlay, reference SSIM, menu) work; the image follows a
+# resized window, menu entries are clicked and the live culling options
+# step. Skipped (exit 77,
 # ctest's SKIP_RETURN_CODE) where rl was built without SDL2 or xvfb-run is
 # missing.
 # Run as: bash test_cli_view.sh <rl-binary> <scratch-dir>
@@ -35,6 +37,9 @@ printf '# a comment\n\n0 key Hyper\n' >"$TMP/bad_key.txt"
 expect_error 2 "bad_key.txt:3: unknown key 'Hyper'" "$RL" view cornell --script "$TMP/bad_key.txt"
 printf '1 quit\n0.5 quit\n' >"$TMP/bad_time.txt"
 expect_error 2 "bad_time.txt:2: time 0.5 s is before" "$RL" view cornell --script "$TMP/bad_time.txt"
+printf '0 click left 10\n' >"$TMP/bad_click.txt"
+expect_error 2 "bad_click.txt:1: click: expected X Y" "$RL" view cornell --script "$TMP/bad_click.txt"
+expect_usage_error "$RL" view cornell --display vulkan
 printf '0 algo rayster\n' >"$TMP/bad_algo.txt"
 expect_error 2 "bad_algo.txt:1: unknown renderer 'rayster'" "$RL" view cornell --script "$TMP/bad_algo.txt"
 expect_error 1 "no-such-script.txt" "$RL" view cornell --script "$TMP/no-such-script.txt"
