@@ -9,7 +9,8 @@
 # and the images after the stop until the image is stable (settle_frames;
 # null where pt had not converged to half an 8-bit code value per frame by
 # the end). Writes bench/results/view-<date>.json (or OUT) with every run's
-# statistics and a summary line per run on stdout.
+# statistics and a summary line per run on stdout; RL_MACHINE names the
+# machine in the record.
 # Run from anywhere: bash bench/view.sh [OUT.json] [RL]
 set -u
 cd "$(dirname "${BASH_SOURCE[0]}")/.." || exit 1
@@ -69,10 +70,11 @@ PY
     echo "   ($(python3 -c "print(round($(date +%s.%N) - $t0, 1))") s wall, load $(cut -d' ' -f1-3 /proc/loadavg))"
 done
 python3 - "$OUT" "$TMP" <<'PY'
-import glob, json, sys
+import glob, json, os, sys
 out, tmp = sys.argv[1], sys.argv[2]
 runs = [json.load(open(f)) for f in sorted(glob.glob(tmp + "/run*.json"), key=lambda f: int(f.split("run")[-1][:-5]))]
 json.dump({"benchmark": "rl view (bench/view.sh, bench/view_stop.txt)",
+           "machine": os.environ.get("RL_MACHINE", "(set RL_MACHINE to name it)"),
            "note": "scripted runs under Xvfb on a shared machine (other agents' builds and tests running): "
                    "times are upper bounds; see bench/README.md, rl view",
            "runs": runs}, open(out, "w"), indent=1)
