@@ -40,8 +40,8 @@ static const char view_help[] =
     "options:\n"
     "  --algo NAME         renderer (see rl algos); default raster\n"
     "  --set KEY=VALUE     renderer option, repeatable (see rl algos); a key with\n"
-    "                      a renderer's prefix (vt.min_edge=14) also applies when\n"
-    "                      Tab switches to that renderer\n"
+    "                      a renderer's prefix (vt.min_edge=14) applies when Tab\n"
+    "                      or the menu switches to that renderer\n"
     "  --camera NAME       a camera of the scene; default its first one\n"
     "  --size WxH|window   WxH: a fixed image size, which the window scales;\n"
     "                      window (the default): the image follows the window's\n"
@@ -290,9 +290,25 @@ static bool is_progressive(const char *name)
     return false;
 }
 
-/* The --set options for renderer r: all of them for the first renderer
- * (where a failure is a usage error), only those with r's prefix for one
- * that Tab switched to (so "vt.min_edge=14" follows the user around). */
+/* The renderer whose name prefixes key ("visset" of "visset.samples"),
+ * other than self, or NULL. */
+static const char *other_prefix(const char *key, const char *self)
+{
+    size_t n = 0;
+    const rl_renderer_info *list = rl_renderer_list(&n);
+    for (size_t i = 0; i < n; i++) {
+        size_t len = strlen(list[i].name);
+        if (strcmp(list[i].name, self) != 0 && strncmp(key, list[i].name, len) == 0 && key[len] == '.')
+            return list[i].name;
+    }
+    return NULL;
+}
+
+/* The --set options for renderer r: for the first renderer all but those
+ * with another renderer's prefix, which are checked on that renderer
+ * instead (a failure is a usage error either way); for one that Tab or
+ * the menu switched to only those with r's prefix (so "vt.min_edge=14"
+ * follows the user around). */
 static int apply_sets(rl_renderer *r, const view_args *a, bool first)
 {
     const char *name = rl_renderer_name(r);
@@ -304,6 +320,19 @@ static int apply_sets(rl_renderer *r, const view_args *a, bool first)
             return RL_CLI_USAGE;
         if (!first && !(strncmp(key, name, len) == 0 && key[len] == '.'))
             continue;
+        const char *other = first ? other_prefix(key, name) : NULL;
+        if (other) {
+            rl_renderer *o = NULL;
+            rl_clear_error();
+            rl_status st = rl_renderer_create(other, &o);
+            if (st == RL_OK)
+                st = rl_renderer_set(o, key, value);
+            rl_renderer_release(o);
+            if (st != RL_OK)
+                return cli_fail_status(RL_CLI_USAGE, st, "--set");
+            rl_clear_error();
+            continue;
+        }
         rl_clear_error();
         rl_status st = rl_renderer_set(r, key, value);
         if (st != RL_OK && first)
@@ -394,7 +423,7 @@ static const step_option step_options[] = {
     { "svs", "distance", 1.25, 1.0, 1000.0, 0.0 },
     { "svs", "levels", 1.5, 0.0, 3.0, 0.0 },
     { "svs", "resolution", 2.0, 8.0, 1024.0, 0.0 },
-    { "visset", "budget", 2.0, 1024.0, 67108864.0, 65536.0 },
+    { "visset", "budget", 2.0, 64.0, 67108864.0, 65536.0 },
     { "visset", "resolution", 2.0, 8.0, 1024.0, 0.0 },
     { "select", "samples", 2.0, 1.0, 256.0, 0.0 },
     { "select", "resolution", 2.0, 8.0, 256.0, 0.0 },
