@@ -618,12 +618,16 @@ static void apply_cmd(worker *w, const view_cmd *c)
         /* A menu entry: an enum or a boolean goes to its next choice, a
          * live number one step (and becomes the one of + and -). */
         const rl_option_info *info = option_info(w->r, c->text);
-        for (int i = 0; info && live_option(name, i) && i < (int)NUM_STEP_OPTIONS; i++)
-            if (strcmp(live_option(name, i)->key, c->text) == 0) {
-                w->step_sel = i;
-                step_option_apply(w, live_option(name, i), c->dir);
+        for (int i = 0, n = 0; info && (size_t)i < NUM_STEP_OPTIONS; i++) {
+            if (strcmp(step_options[i].algo, name) != 0)
+                continue;
+            if (strcmp(step_options[i].key, c->text) == 0) {
+                w->step_sel = n;
+                step_option_apply(w, &step_options[i], c->dir);
                 return;
             }
+            n++;
+        }
         if (info && info->type == RL_OPT_ENUM && info->choices)
             cycle_option(w, c->text, c->dir);
         else if (info && info->type == RL_OPT_BOOL)
