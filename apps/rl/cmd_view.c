@@ -40,11 +40,13 @@ static const char view_help[] =
     "options:\n"
     "  --algo NAME         renderer (see rl algos); default raster\n"
     "  --set KEY=VALUE     renderer option, repeatable (see rl algos); a key with\n"
-    "                      a renderer's prefix (vt.min_edge=14) also applies when\n"
-    "                      Tab switches to that renderer\n"
+    "                      a renderer's prefix (vt.min_edge=14) applies when Tab\n"
+    "                      or the menu switches to that renderer\n"
     "  --camera NAME       a camera of the scene; default its first one\n"
-    "  --size WxH          image size; default the camera's, else 1280x720 (the\n"
-    "                      window scales it)\n"
+    "  --size WxH|window   WxH: a fixed image size, which the window scales;\n"
+    "                      window (the default): the image follows the window's\n"
+    "                      pixel size, at most 1920x1200's worth of pixels; the\n"
+    "                      window starts at the camera's size, else 1280x720\n"
     "  --script FILE       timed events (keys, mouse, camera moves, screenshots);\n"
     "                      exits at its end, on a virtual clock of 25 steps a\n"
     "                      second that advances by finished frames\n"
@@ -59,6 +61,9 @@ static const char view_help[] =
     "                      per pixel; default 4096\n"
     "  --ref-spp N         samples per pixel of the pt reference that X compares\n"
     "                      the path tracers with; default 256\n"
+    "  --display MODE      how the image reaches the window: software (SDL's\n"
+    "                      software renderer), gl (SDL's OpenGL renderer) or auto\n"
+    "                      (default: gl for the GL renderers, else software)\n"
     "\n"
     "model files (the same as SCENE:cameras=off,lights=add,...; see rl scenes):\n"
     CLI_MODEL_FLAGS_HELP
@@ -98,8 +103,18 @@ int view_run(int argc, char **argv)
 #define MAX_CMDS 64
 #define DEFAULT_MAX_SPP 4096
 #define DEFAULT_REF_SPP 256
+/* An accumulating renderer's image is stable once a new frame changes it
+ * by less than this mean absolute difference of 8-bit sRGB values: half a
+ * code value, below what a viewer sees. */
+#define STABLE_CHANGE 0.5
 /* Every image of the viewer: the depth and ID layers are shown by L. */
 #define VIEW_LAYERS (RL_LAYER_COLOR | RL_LAYER_DEPTH | RL_LAYER_ID)
+/* With the image following the window (--size window, the default), a
+ * window larger than this many pixels gets an image scaled down to it
+ * (same aspect; the window scales it up): a full-screen window on a 4K
+ * display would otherwise make every frame four times the work of 1080p
+ * and hold about a gigabyte of frame buffers. */
+#define VIEW_MAX_WINDOW_PIXELS (1920 * 1200)
 
 typedef struct shot_at {
     double time_s;
@@ -109,7 +124,8 @@ typedef struct shot_at {
 
 typedef struct view_args {
     const char *scene, *algo, *camera, *script, *record_dir, *shot_dir, *path_out, *stats_out;
-    bool has_size;
+    const char *display;       /* --display: auto, software or gl */
+    bool has_size;             /* --size WxH; without it (or with --size window) the image follows the window */
     int width, height;
     const char **sets;
     int num_sets;
@@ -124,14 +140,16 @@ typedef struct view_args {
 typedef enum cmd_kind {
     CMD_ALGO,         /* text: the renderer */
     CMD_SET,          /* text: KEY=VALUE */
-    CMD_STEP,         /* the renderer's main option by a factor */
+    CMD_STEP,         /* the renderer's selected live option up or down */
+    CMD_SELECT,       /* select the next / previous live option for CMD_STEP */
+    CMD_CLICK,        /* text: an option clicked in the menu; dir +1 left, -1 right */
     CMD_CYCLE,        /* text: an enum option, set to its next choice */
     CMD_REFERENCE     /* compare the next finished frame with a reference */
 } cmd_kind;
 typedef struct view_cmd {
     cmd_kind kind;
     char text[256];
-    int dir;          /* CMD_STEP, CMD_CYCLE: +1 or -1 */
+    int dir;          /* CMD_STEP, CMD_SELECT, CMD_CYCLE, CMD_CLICK: +1 or -1 */
     int line;         /* script line, 0 for a key */
 } view_cmd;
 
@@ -156,7 +174,7 @@ typedef struct shared {
     double worker_spp;             /* accumulated since the last restart */
     char algo[64];
     char status[256];              /* the last change's outcome, for the overlay */
-    char options[1024];            /* the current renderer's options, for the menu */
+    char options[2048];            /* the current renderer's options, for the menu: "key=value\n"... */
     /* the last comparison with a reference (X) */
     bool ref_valid;
     char ref_algo[64], ref_of[64];
@@ -188,10 +206,26 @@ typedef struct worker {
     double running_request_s;
     rl_camera last_cam;
     bool have_last;
+    int step_sel;                  /* the live option of + and -: an index among the renderer's */
     rl_renderer *ref;              /* the reference renderer of X, kept for the next X */
     rl_image *ref_img;
     bool want_ref;
 } worker;
+
+/* *img at w x h with layers: kept when it has that size, else replaced
+ * (its pixels are not kept: every user overwrites them). */
+static rl_status fit_image(rl_image **img, int w, int h, unsigned layers)
+{
+    if (*img && (*img)->width == w && (*img)->height == h)
+        return RL_OK;
+    rl_image *next = NULL;
+    rl_status st = rl_image_create(w, h, layers, &next);
+    if (st != RL_OK)
+        return st;
+    rl_image_release(*img);
+    *img = next;
+    return RL_OK;
+}
 
 static bool same_camera(const rl_camera *a, const rl_camera *b)
 {
@@ -209,6 +243,13 @@ static void publish(worker *w, const rl_image *img, const rl_render_stats *stats
 {
     shared *sh = w->sh;
     SDL_LockMutex(sh->lock);
+    /* The window's size may have changed the image's (--size window). */
+    if (fit_image(&sh->front, img->width, img->height, VIEW_LAYERS) != RL_OK) {
+        snprintf(sh->status, sizeof sh->status, "out of memory for a %dx%d image", img->width, img->height);
+        SDL_UnlockMutex(sh->lock);
+        rl_clear_error();
+        return;
+    }
     size_t n = (size_t)img->width * (size_t)img->height;
     memcpy(sh->front->color, img->color, n * sizeof *img->color);
     /* An intermediate image without these layers must not show the last
@@ -249,9 +290,25 @@ static bool is_progressive(const char *name)
     return false;
 }
 
-/* The --set options for renderer r: all of them for the first renderer
- * (where a failure is a usage error), only those with r's prefix for one
- * that Tab switched to (so "vt.min_edge=14" follows the user around). */
+/* The renderer whose name prefixes key ("visset" of "visset.samples"),
+ * other than self, or NULL. */
+static const char *other_prefix(const char *key, const char *self)
+{
+    size_t n = 0;
+    const rl_renderer_info *list = rl_renderer_list(&n);
+    for (size_t i = 0; i < n; i++) {
+        size_t len = strlen(list[i].name);
+        if (strcmp(list[i].name, self) != 0 && strncmp(key, list[i].name, len) == 0 && key[len] == '.')
+            return list[i].name;
+    }
+    return NULL;
+}
+
+/* The --set options for renderer r: for the first renderer all but those
+ * with another renderer's prefix, which are checked on that renderer
+ * instead (a failure is a usage error either way); for one that Tab or
+ * the menu switched to only those with r's prefix (so "vt.min_edge=14"
+ * follows the user around). */
 static int apply_sets(rl_renderer *r, const view_args *a, bool first)
 {
     const char *name = rl_renderer_name(r);
@@ -263,6 +320,19 @@ static int apply_sets(rl_renderer *r, const view_args *a, bool first)
             return RL_CLI_USAGE;
         if (!first && !(strncmp(key, name, len) == 0 && key[len] == '.'))
             continue;
+        const char *other = first ? other_prefix(key, name) : NULL;
+        if (other) {
+            rl_renderer *o = NULL;
+            rl_clear_error();
+            rl_status st = rl_renderer_create(other, &o);
+            if (st == RL_OK)
+                st = rl_renderer_set(o, key, value);
+            rl_renderer_release(o);
+            if (st != RL_OK)
+                return cli_fail_status(RL_CLI_USAGE, st, "--set");
+            rl_clear_error();
+            continue;
+        }
         rl_clear_error();
         rl_status st = rl_renderer_set(r, key, value);
         if (st != RL_OK && first)
@@ -326,17 +396,110 @@ static void set_status(shared *sh, const char *fmt, ...)
     va_end(ap);
 }
 
-/* The option that + and - change, per renderer, and by what factor. */
+/* The live options of + and -, per renderer: those that trade quality for
+ * time (or show the trade). The first of a renderer is the one + and -
+ * change after a switch; [ and ] select another. A number is multiplied or
+ * divided by factor (an integer moves by at least 1) and kept in [lo, hi];
+ * factor 0 is a boolean that + and - switch. A number whose 0 means "no
+ * limit" (visset's budget) has start > 0: - from 0 sets start, + beyond hi
+ * returns to 0. Renderers rebuild what an option changes (svs its sets,
+ * surfels nothing but the selection) before the next frame. */
 typedef struct step_option {
     const char *algo, *key;
-    double factor, lo, hi;
-    bool integer;
+    double factor, lo, hi, start;
 } step_option;
 static const step_option step_options[] = {
-    { "vt", "min_edge", 1.25, 0.25, 1024.0, false },
-    { "pt", "spp", 2.0, 1.0, 1024.0, true },
-    { "surfels", "overdraw", 1.5, 0.01, 1000.0, false },
+    { "vt", "min_edge", 1.25, 0.25, 1024.0, 0.0 },
+    { "pt", "spp", 2.0, 1.0, 1024.0, 0.0 },
+    { "surfels", "overdraw", 1.5, 0.01, 1000.0, 0.0 },
+    { "surfels", "point_size", 1.25, 0.5, 64.0, 0.0 },
+    { "surfels", "min_size", 1.25, 1.0, 1e5, 0.0 },
+    { "surfels", "max_size", 1.25, 1.0, 1e5, 0.0 },
+    { "chcpp", "assumed_visible", 2.0, 1.0, 1000.0, 0.0 },
+    { "chcpp", "batch", 2.0, 1.0, 10000.0, 0.0 },
+    { "chcpp", "multiquery", 0.0, 0.0, 0.0, 0.0 },
+    { "chcpp", "tight", 0.0, 0.0, 0.0, 0.0 },
+    { "svs", "neighbours", 1.5, 1.0, 12.0, 0.0 },
+    { "svs", "distance", 1.25, 1.0, 1000.0, 0.0 },
+    { "svs", "levels", 1.5, 0.0, 3.0, 0.0 },
+    { "svs", "resolution", 2.0, 8.0, 1024.0, 0.0 },
+    { "visset", "budget", 2.0, 64.0, 67108864.0, 65536.0 },
+    { "visset", "resolution", 2.0, 8.0, 1024.0, 0.0 },
+    { "select", "samples", 2.0, 1.0, 256.0, 0.0 },
+    { "select", "resolution", 2.0, 8.0, 256.0, 0.0 },
 };
+#define NUM_STEP_OPTIONS (sizeof step_options / sizeof step_options[0])
+
+/* The i-th live option of renderer name (i wraps), or NULL if it has none. */
+static const step_option *live_option(const char *name, int i)
+{
+    int count = 0;
+    for (size_t k = 0; k < NUM_STEP_OPTIONS; k++)
+        count += strcmp(step_options[k].algo, name) == 0;
+    if (count == 0)
+        return NULL;
+    i = (i % count + count) % count;
+    for (size_t k = 0; k < NUM_STEP_OPTIONS; k++)
+        if (strcmp(step_options[k].algo, name) == 0 && i-- == 0)
+            return &step_options[k];
+    return NULL;
+}
+
+static const rl_option_info *option_info(const rl_renderer *r, const char *key)
+{
+    size_t n = 0;
+    const rl_option_info *opts = rl_renderer_options(r, &n);
+    for (size_t i = 0; i < n; i++)
+        if (strcmp(opts[i].key, key) == 0)
+            return &opts[i];
+    return NULL;
+}
+
+/* Moves the live option o of the current renderer one step in dir. */
+static void step_option_apply(worker *w, const step_option *o, int dir)
+{
+    shared *sh = w->sh;
+    const char *name = rl_renderer_name(w->r);
+    const rl_option_info *info = option_info(w->r, o->key);
+    const char *cur = rl_renderer_get(w->r, o->key);
+    char text[64];
+    if (info && info->type == RL_OPT_BOOL) {
+        snprintf(text, sizeof text, "%s", cur && strcmp(cur, "true") == 0 ? "false" : "true");
+    } else {
+        double v = 0.0;
+        if (!info || !cur || !rl_parse_float(cur, &v)) {
+            set_status(sh, "%s has no option %s", name, o->key);
+            return;
+        }
+        bool integer = info->type == RL_OPT_INT;
+        double next;
+        if (o->start > 0.0 && v == 0.0)
+            next = dir < 0 ? o->start : 0.0;
+        else {
+            next = dir > 0 ? v * o->factor : v / o->factor;
+            if (integer) {
+                next = (double)llround(next);
+                if (next == v)
+                    next = v + dir;
+            }
+            if (o->start > 0.0 && dir > 0 && next > o->hi)
+                next = 0.0;
+            else
+                next = fmin(fmax(next, o->lo), o->hi);
+        }
+        if (integer)
+            snprintf(text, sizeof text, "%lld", (long long)llround(next));
+        else
+            snprintf(text, sizeof text, "%.4g", next);
+    }
+    rl_clear_error();
+    if (rl_renderer_set(w->r, o->key, text) == RL_OK)
+        set_status(sh, "%s %s=%s%s", name, o->key, text, o->start > 0.0 && strcmp(text, "0") == 0 ? " (none)" : "");
+    else
+        set_status(sh, "%s %s=%s: %s", name, o->key, text, rl_last_error());
+    rl_clear_error();
+    w->have_last = false;
+}
 
 /* Sets the enum option key of the current renderer to its next (dir +1) or
  * previous choice. A choice the renderer refuses here (embree in a build
@@ -374,24 +537,26 @@ static void cycle_option(worker *w, const char *key, int dir)
     rl_clear_error();
 }
 
-/* The current renderer's options, "name: key=value key=value ...", for the
- * menu (which wraps them to the window). */
+/* The current renderer's options for the menu, one a line: "key=value",
+ * the live option of + and - marked ">". */
 static void publish_options(worker *w)
 {
     shared *sh = w->sh;
     char text[sizeof sh->options];
     size_t n = 0, len = 0;
     const rl_option_info *opts = rl_renderer_options(w->r, &n);
-    len = (size_t)snprintf(text, sizeof text, "%s:", rl_renderer_name(w->r));
+    const step_option *sel = live_option(rl_renderer_name(w->r), w->step_sel);
+    text[0] = '\0';
     for (size_t i = 0; i < n; i++) {
         const char *value = rl_renderer_get(w->r, opts[i].key);
         char item[160];
-        int k = snprintf(item, sizeof item, "%s=%s", opts[i].key, value ? value : "?");
+        int k = snprintf(item, sizeof item, "%s%s=%s", sel && strcmp(sel->key, opts[i].key) == 0 ? ">" : "",
+                         opts[i].key, value ? value : "?");
         if (k < 0 || k >= (int)sizeof item)
             continue;
         if (len + (size_t)k + 2 >= sizeof text)
             break;
-        len += (size_t)snprintf(text + len, sizeof text - len, " %s", item);
+        len += (size_t)snprintf(text + len, sizeof text - len, "%s\n", item);
     }
     SDL_LockMutex(sh->lock);
     snprintf(sh->options, sizeof sh->options, "%s", text);
@@ -413,6 +578,7 @@ static void apply_cmd(worker *w, const view_cmd *c)
         rl_renderer_release(w->r);
         w->r = r;
         w->have_last = false;
+        w->step_sel = 0;
         SDL_LockMutex(sh->lock);
         snprintf(sh->algo, sizeof sh->algo, "%.63s", c->text);
         sh->worker_progressive = is_progressive(c->text);
@@ -448,29 +614,40 @@ static void apply_cmd(worker *w, const view_cmd *c)
         return;
     }
     const char *name = rl_renderer_name(w->r);
-    for (size_t i = 0; i < sizeof step_options / sizeof step_options[0]; i++) {
-        const step_option *o = &step_options[i];
-        if (strcmp(o->algo, name) != 0)
-            continue;
-        const char *cur = rl_renderer_get(w->r, o->key);
-        double v = 0.0;
-        if (!cur || !rl_parse_float(cur, &v))
-            break;
-        v = c->dir > 0 ? v * o->factor : v / o->factor;
-        v = fmin(fmax(v, o->lo), o->hi);
-        char text[64];
-        if (o->integer)
-            snprintf(text, sizeof text, "%lld", (long long)llround(v));
+    if (c->kind == CMD_CLICK) {
+        /* A menu entry: an enum or a boolean goes to its next choice, a
+         * live number one step (and becomes the one of + and -). */
+        const rl_option_info *info = option_info(w->r, c->text);
+        for (int i = 0, n = 0; info && (size_t)i < NUM_STEP_OPTIONS; i++) {
+            if (strcmp(step_options[i].algo, name) != 0)
+                continue;
+            if (strcmp(step_options[i].key, c->text) == 0) {
+                w->step_sel = n;
+                step_option_apply(w, &step_options[i], c->dir);
+                return;
+            }
+            n++;
+        }
+        if (info && info->type == RL_OPT_ENUM && info->choices)
+            cycle_option(w, c->text, c->dir);
+        else if (info && info->type == RL_OPT_BOOL)
+            step_option_apply(w, &(step_option){ .algo = name, .key = info->key }, c->dir);
         else
-            snprintf(text, sizeof text, "%.4g", v);
-        rl_clear_error();
-        if (rl_renderer_set(w->r, o->key, text) == RL_OK)
-            set_status(sh, "%s %s=%s", name, o->key, text);
-        rl_clear_error();
-        w->have_last = false;
+            set_status(sh, "%s %s: not a live option (--set it, or a script's set)", name, c->text);
         return;
     }
-    set_status(sh, "%s: no option on + and - (vt min_edge, pt spp, surfels overdraw)", name);
+    const step_option *o = live_option(name, w->step_sel);
+    if (!o) {
+        set_status(sh, "%s: no live option for + and -", name);
+        return;
+    }
+    if (c->kind == CMD_SELECT) {
+        w->step_sel += c->dir;
+        o = live_option(name, w->step_sel);
+        set_status(sh, "+ and - change %s %s=%s", name, o->key, rl_renderer_get(w->r, o->key));
+        return;
+    }
+    step_option_apply(w, o, c->dir);
 }
 
 static bool is_path_tracer(const char *name)
@@ -509,9 +686,7 @@ static void compare_reference(worker *w, const rl_camera *cam)
         rl_clear_error();
         return;
     }
-    rl_status st = RL_OK;
-    if (!w->ref_img)
-        st = rl_image_create(cam->width, cam->height, RL_LAYER_COLOR, &w->ref_img);
+    rl_status st = fit_image(&w->ref_img, cam->width, cam->height, RL_LAYER_COLOR);
     rl_render_stats stats = { 0 };
     rl_renderer_set_progress(w->ref, on_progress, w);
     if (st == RL_OK)
@@ -590,7 +765,9 @@ static int worker_main(void *user)
             rl_vt_set_update_callback(w->r, on_vt_update, w);
         rl_render_stats stats = { 0 };
         rl_clear_error();
-        rl_status st = rl_renderer_render(w->r, w->scene, &cam, w->back, &stats);
+        rl_status st = fit_image(&w->back, cam.width, cam.height, VIEW_LAYERS);
+        if (st == RL_OK)
+            st = rl_renderer_render(w->r, w->scene, &cam, w->back, &stats);
         if (st == RL_OK) {
             double pixels = (double)cam.width * (double)cam.height;
             SDL_LockMutex(sh->lock);
@@ -695,9 +872,31 @@ typedef struct algo_stat {
     long long frames, moving_frames;
     double moving_s;            /* request to finished frame, summed over moving frames */
     double first_image_ms, first_final_ms, prep_ms;
+    double display_s;           /* taking and drawing its new images, summed */
+    long long displayed;
+    /* From a restart (camera, renderer or option change) to its first
+     * image on screen, an intermediate one included, summed. */
+    double latency_s;
+    long long latency_n;
+    double last_restart_s;      /* the request time of the restart shown last */
+    /* After the last restart: images shown until the image is stable, a
+     * final one that nothing more will change (a renderer that does not
+     * accumulate) or that changed less than STABLE_CHANGE from the one
+     * before (one that does). */
+    long long settle_frames;
+    double settle_ms, last_change;
+    bool settled;
     double requested_s;         /* when the renderer was asked for */
     bool have_first, have_final;
 } algo_stat;
+
+/* An entry of the menu (M) where it is drawn, for the mouse. */
+enum { MENU_MAX_ITEMS = 256 };
+typedef struct menu_item {
+    int x, y, w, h;
+    int algo;             /* the renderer's index in algos; -1 an option, -2 a heading */
+    char label[96];       /* as drawn: an option's "key=value", ">" before the live one */
+} menu_item;
 
 typedef struct viewer {
     view_args *a;
@@ -708,6 +907,7 @@ typedef struct viewer {
     SDL_Thread *thread;
     SDL_Window *win;
     SDL_Renderer *ren;
+    char display[32];           /* SDL's renderer: software or opengl */
     SDL_Texture *tex;
     uint32_t *pixels;
     rl_image *shown;            /* the displayed frame, without the overlay */
@@ -717,9 +917,13 @@ typedef struct viewer {
     bool shown_final;
     uint64_t shown_seq, recorded_seq;
     nav nav;
-    int width, height;
+    int width, height;          /* of the frames asked for now; the shown one's may still differ */
+    bool follow_window;         /* the image has the window's size (not --size WxH) */
     bool held[VIEW_KEY_COUNT];
     bool help, stats, menu;
+    menu_item menu_items[MENU_MAX_ITEMS];   /* where the menu's entries are drawn */
+    int num_menu_items;
+    bool mouse_taken;           /* the pressed button clicked the menu: its drag is no orbit */
     cli_layer layer;            /* what L shows: colour, depth or IDs */
     rl_vec4 *layer_px;          /* the depth or ID picture */
     bool need_frame;            /* a frame without a restart is wanted (X) */
@@ -838,6 +1042,7 @@ static bool worker_idle(viewer *v)
 /* ---- output ---- */
 
 static void draw(viewer *v);
+static bool menu_click(viewer *v, int x, int y, int button);
 
 static rl_status write_shot_json(const viewer *v, const char *png, const char *path)
 {
@@ -846,8 +1051,8 @@ static rl_status write_shot_json(const viewer *v, const char *png, const char *p
         return RL_ERR_OUT_OF_MEMORY;
     cJSON_AddStringToObject(obj, "algorithm", v->shown_algo);
     cJSON_AddStringToObject(obj, "scene", v->a->scene);
-    cJSON_AddNumberToObject(obj, "width", v->width);
-    cJSON_AddNumberToObject(obj, "height", v->height);
+    cJSON_AddNumberToObject(obj, "width", v->shown->width);
+    cJSON_AddNumberToObject(obj, "height", v->shown->height);
     cJSON_AddStringToObject(obj, "file", png);
     cJSON_AddNumberToObject(obj, "spp", v->shown_spp);
     cJSON_AddBoolToObject(obj, "final", v->shown_final);
@@ -864,6 +1069,19 @@ static rl_status write_shot_json(const viewer *v, const char *png, const char *p
     /* The last comparison of X, whichever frame it was made on. */
     shared *sh = (shared *)&v->sh;
     SDL_LockMutex(sh->lock);
+    /* The renderer's options, so that a screenshot says how to make it
+     * again with rl render --set (the live ones change during a run). */
+    cJSON *opts = cJSON_AddObjectToObject(obj, "options");
+    char options[sizeof sh->options];
+    snprintf(options, sizeof options, "%s", sh->options);
+    char *save = NULL;
+    for (char *line = strtok_r(options, "\n", &save); opts && line; line = strtok_r(NULL, "\n", &save)) {
+        char *eq = strchr(line, '=');
+        if (!eq)
+            continue;
+        *eq = '\0';
+        cJSON_AddStringToObject(opts, line[0] == '>' ? line + 1 : line, eq + 1);
+    }
     cJSON *ref = sh->ref_valid ? cJSON_AddObjectToObject(obj, "reference") : NULL;
     if (ref) {
         cJSON_AddStringToObject(ref, "algorithm", sh->ref_algo);
@@ -919,12 +1137,12 @@ static bool write_capture(viewer *v, const char *png)
     draw(v);      /* a key of the script (help, stats) may have changed the overlay */
     rl_image *img = NULL;
     rl_clear_error();
-    rl_status st = rl_image_create(v->width, v->height, RL_LAYER_COLOR, &img);
+    rl_status st = rl_image_create(v->shown->width, v->shown->height, RL_LAYER_COLOR, &img);
     if (st == RL_OK) {
         float lin[256];
         for (int i = 0; i < 256; i++)
             lin[i] = rl_srgb_to_linear((float)i / 255.0f);
-        for (size_t i = 0; i < (size_t)v->width * (size_t)v->height; i++) {
+        for (size_t i = 0; i < (size_t)img->width * (size_t)img->height; i++) {
             uint32_t p = v->pixels[i];
             img->color[i] = (rl_vec4){ lin[p >> 16 & 255], lin[p >> 8 & 255], lin[p & 255], 1.0f };
         }
@@ -1041,6 +1259,39 @@ static void say(viewer *v, const char *fmt, ...)
     vsnprintf(v->sh.status, sizeof v->sh.status, fmt, ap);
     SDL_UnlockMutex(v->sh.lock);
     va_end(ap);
+}
+
+/* The image size for a window of w x h pixels: the same, or scaled down
+ * with its aspect kept to at most VIEW_MAX_WINDOW_PIXELS. */
+static void window_image_size(int w, int h, int *iw, int *ih)
+{
+    w = w < 1 ? 1 : w;
+    h = h < 1 ? 1 : h;
+    double area = (double)w * (double)h;
+    if (area > VIEW_MAX_WINDOW_PIXELS) {
+        double f = sqrt(VIEW_MAX_WINDOW_PIXELS / area);
+        w = (int)fmax(1.0, floor(w * f));
+        h = (int)fmax(1.0, floor(h * f));
+    }
+    *iw = w;
+    *ih = h;
+}
+
+/* The window is w x h pixels now: an image that follows it is rendered
+ * anew at that size (the renderer restarts, as for a camera change). */
+static void window_resized(viewer *v, int w, int h)
+{
+    if (!v->follow_window)
+        return;
+    int iw, ih;
+    window_image_size(w, h, &iw, &ih);
+    if (iw == v->width && ih == v->height)
+        return;
+    v->width = iw;
+    v->height = ih;
+    v->nav.cam.width = iw;
+    v->nav.cam.height = ih;
+    v->nav.changed = true;
 }
 
 static void start_recording(viewer *v, const char *file)
@@ -1180,6 +1431,13 @@ static bool press(viewer *v, view_key k)
         push_cmd(v, CMD_STEP, NULL, k == VIEW_KEY_OPTION_UP ? 1 : -1, 0);
         v->nav.changed = true;
         break;
+    case VIEW_KEY_OPTION_NEXT:
+    case VIEW_KEY_OPTION_PREV:
+        /* Changes no image: a frame without a restart carries it to the
+         * worker, and pt keeps accumulating. */
+        push_cmd(v, CMD_SELECT, NULL, k == VIEW_KEY_OPTION_NEXT ? 1 : -1, 0);
+        v->need_frame = true;
+        break;
     case VIEW_KEY_CYCLE_OVERLAY:
     case VIEW_KEY_CYCLE_SHADOW:
     case VIEW_KEY_CYCLE_DIFFUSE:
@@ -1250,6 +1508,8 @@ static view_key key_of(const SDL_Keysym *ks)
     case SDLK_r: return VIEW_KEY_RECORD;
     case SDLK_PLUS: case SDLK_EQUALS: case SDLK_KP_PLUS: return VIEW_KEY_OPTION_UP;
     case SDLK_MINUS: case SDLK_KP_MINUS: return VIEW_KEY_OPTION_DOWN;
+    case SDLK_RIGHTBRACKET: return VIEW_KEY_OPTION_NEXT;
+    case SDLK_LEFTBRACKET: return VIEW_KEY_OPTION_PREV;
     case SDLK_o: return VIEW_KEY_CYCLE_OVERLAY;
     case SDLK_b: return VIEW_KEY_CYCLE_SHADOW;
     case SDLK_n: return VIEW_KEY_CYCLE_DIFFUSE;
@@ -1287,8 +1547,15 @@ static bool handle_events(viewer *v)
                 return false;
             break;
         }
+        case SDL_MOUSEBUTTONDOWN:
+            if (!v->scripted && (e.button.button == SDL_BUTTON_LEFT || e.button.button == SDL_BUTTON_RIGHT))
+                v->mouse_taken = menu_click(v, e.button.x, e.button.y, e.button.button == SDL_BUTTON_RIGHT);
+            break;
+        case SDL_MOUSEBUTTONUP:
+            v->mouse_taken = false;
+            break;
         case SDL_MOUSEMOTION:
-            if (v->scripted)
+            if (v->scripted || v->mouse_taken)
                 break;
             if (e.motion.state & SDL_BUTTON_LMASK)
                 nav_orbit(&v->nav, (float)e.motion.xrel, (float)e.motion.yrel);
@@ -1298,6 +1565,15 @@ static bool handle_events(viewer *v)
         case SDL_MOUSEWHEEL:
             if (!v->scripted)
                 nav_dolly(&v->nav, (float)e.wheel.y);
+            break;
+        case SDL_WINDOWEVENT:
+            /* A script sets the size itself (its resize event), so that a
+             * run does not depend on when the X server answers. */
+            if (!v->scripted && e.window.event == SDL_WINDOWEVENT_SIZE_CHANGED) {
+                int w = 0, h = 0;
+                if (SDL_GetRendererOutputSize(v->ren, &w, &h) == 0)
+                    window_resized(v, w, h);
+            }
             break;
         default: break;
         }
@@ -1324,14 +1600,68 @@ static uint8_t to_byte(float c)
     return srgb_lut[(int)(c * 4096.0f + 0.5f)];
 }
 
+/* The displayed frame's buffers and texture at w x h: a frame of a new
+ * size (the window was resized) replaces them. */
+static bool fit_shown(viewer *v, int w, int h)
+{
+    if (v->shown && v->shown->width == w && v->shown->height == h && v->tex)
+        return true;
+    rl_clear_error();
+    size_t n = (size_t)w * (size_t)h;
+    uint32_t *px = malloc(n * sizeof *px);
+    rl_vec4 *layer = malloc(n * sizeof *layer);
+    rl_image *img = NULL;
+    SDL_Texture *tex = NULL;
+    if (px && layer && rl_image_create(w, h, VIEW_LAYERS, &img) == RL_OK)
+        tex = SDL_CreateTexture(v->ren, SDL_PIXELFORMAT_ARGB8888, SDL_TEXTUREACCESS_STREAMING, w, h);
+    if (!tex) {
+        free(px);
+        free(layer);
+        rl_image_release(img);
+        rl_clear_error();
+        return false;
+    }
+    memset(px, 0, n * sizeof *px);
+    free(v->pixels);
+    free(v->layer_px);
+    rl_image_release(v->shown);
+    if (v->tex)
+        SDL_DestroyTexture(v->tex);
+    v->pixels = px;
+    v->layer_px = layer;
+    v->shown = img;
+    v->tex = tex;
+    /* Letterboxed scaling keeps the image's aspect ratio in any window; an
+     * image that follows the window is drawn 1:1 (unless capped). */
+    SDL_RenderSetLogicalSize(v->ren, w, h);
+    return true;
+}
+
 /* Takes the newest published image, if there is one. */
 static bool take_frame(viewer *v)
 {
     shared *sh = &v->sh;
     SDL_LockMutex(sh->lock);
     bool fresh = sh->front_seq != v->shown_seq;
+    if (fresh && !fit_shown(v, sh->front->width, sh->front->height)) {
+        fresh = false;
+        v->shown_seq = sh->front_seq;
+        snprintf(sh->status, sizeof sh->status, "out of memory for a %dx%d image", sh->front->width,
+                 sh->front->height);
+    }
+    double change = -1.0;
     if (fresh) {
-        size_t n = (size_t)v->width * (size_t)v->height;
+        size_t n = (size_t)sh->front->width * (size_t)sh->front->height;
+        if (sh->front_final && !sh->front_moved && is_progressive(sh->front_algo) &&
+            strcmp(sh->front_algo, v->shown_algo) == 0) {
+            double sum = 0.0;
+            for (size_t i = 0; i < n; i++) {
+                rl_vec4 a = sh->front->color[i], b = v->shown->color[i];
+                sum += abs(to_byte(a.x) - to_byte(b.x)) + abs(to_byte(a.y) - to_byte(b.y)) +
+                       abs(to_byte(a.z) - to_byte(b.z));
+            }
+            change = sum / (3.0 * (double)n);
+        }
         memcpy(v->shown->color, sh->front->color, n * sizeof *v->shown->color);
         memcpy(v->shown->depth, sh->front->depth, n * sizeof *v->shown->depth);
         memcpy(v->shown->object_id, sh->front->object_id, n * sizeof *v->shown->object_id);
@@ -1353,7 +1683,26 @@ static bool take_frame(viewer *v)
         s->have_first = true;
         s->first_image_ms = (now - s->requested_s) * 1e3;
     }
+    if (s && v->shown_moved && v->shown_request_s != s->last_restart_s) {
+        /* The renderer's first restart is its first image (prep included),
+         * reported as first_image_ms: the latency is that of input. */
+        if (s->have_final) {
+            s->latency_s += now - v->shown_request_s;
+            s->latency_n++;
+        }
+        s->last_restart_s = v->shown_request_s;
+        s->settle_frames = 0;
+        s->settled = false;
+    }
+    if (s && !s->settled) {
+        s->settle_frames++;
+        s->settle_ms = (now - s->last_restart_s) * 1e3;
+        if (change >= 0.0)
+            s->last_change = change;
+        s->settled = v->shown_final && (!is_progressive(v->shown_algo) || (change >= 0.0 && change < STABLE_CHANGE));
+    }
     if (v->shown_final) {
+        bool first = s && !s->have_final;
         if (s && !s->have_final) {
             s->have_final = true;
             s->first_final_ms = (now - s->requested_s) * 1e3;
@@ -1361,7 +1710,7 @@ static bool take_frame(viewer *v)
         }
         if (s) {
             s->frames++;
-            if (v->shown_moved) {
+            if (v->shown_moved && !first) {
                 s->moving_frames++;
                 s->moving_s += now - v->shown_request_s;
             }
@@ -1375,6 +1724,23 @@ static bool take_frame(viewer *v)
     return true;
 }
 
+/* Takes the newest image and draws it, timing both for --stats-out: the
+ * display's share of a frame (the copy, the sRGB conversion, the upload
+ * and the present). */
+static bool show_frame(viewer *v)
+{
+    double t0 = rl_time_s();
+    if (!take_frame(v))
+        return false;
+    draw(v);
+    algo_stat *s = stat_of(v, v->shown_algo);
+    if (s) {
+        s->display_s += rl_time_s() - t0;
+        s->displayed++;
+    }
+    return true;
+}
+
 static double current_fps(const viewer *v)
 {
     if (v->num_final < 2)
@@ -1383,9 +1749,111 @@ static double current_fps(const viewer *v)
     return span > 0.0 ? (double)(v->num_final - 1) / span : 0.0;
 }
 
+/* The size of the overlay's text: legible on large images, fitting small ones. */
+static int text_scale(const viewer *v)
+{
+    return v->shown->width >= 1200 ? 2 : 1;
+}
+
+static bool menu_add(viewer *v, int x, int y, int algo, const char *label)
+{
+    if (v->num_menu_items == MENU_MAX_ITEMS)
+        return false;
+    int scale = text_scale(v);
+    menu_item *m = &v->menu_items[v->num_menu_items++];
+    snprintf(m->label, sizeof m->label, "%s", label);
+    m->x = x;
+    m->y = y;
+    m->w = view_text_width(m->label, scale);
+    m->h = VIEW_FONT_LINE * scale;
+    m->algo = algo;
+    return true;
+}
+
+/* The menu from half the image's height down: the renderers Tab reaches,
+ * wrapped to the width (the current one marked ">"); a blank line; the
+ * current renderer's name and its options one a line, in columns where
+ * the height runs out. Fixed cells, so that a script's click can name an
+ * entry by its pixel (docs/viewer.md). */
+static void menu_layout(viewer *v)
+{
+    int scale = text_scale(v);
+    int adv = VIEW_FONT_ADVANCE * scale, lh = VIEW_FONT_LINE * scale;
+    int x0 = 3 * scale, y0 = v->shown->height / 2;
+    int cols = v->shown->width / adv - 1;
+    cols = cols > 8 ? cols : 8;
+    v->num_menu_items = 0;
+    int col = 0, row = 0;
+    for (size_t i = 0; i < v->num_algos; i++) {
+        char label[96];
+        int k = snprintf(label, sizeof label, "%s%s", i == v->algo_index ? ">" : "", v->algos[i]);
+        if (col > 0 && col + 2 + k > cols) {
+            row++;
+            col = 0;
+        } else if (col > 0)
+            col += 2;
+        menu_add(v, x0 + col * adv, y0 + row * lh, (int)i, label);
+        col += k;
+    }
+    row += 2;
+    char options[sizeof v->sh.options], heading[96];
+    SDL_LockMutex(v->sh.lock);
+    snprintf(options, sizeof options, "%s", v->sh.options);
+    snprintf(heading, sizeof heading, "%s options:", v->sh.algo);
+    SDL_UnlockMutex(v->sh.lock);
+    menu_add(v, x0, y0 + row * lh, -2, heading);
+    row++;
+    int rows = (v->shown->height - y0) / lh - row;
+    rows = rows > 1 ? rows : 1;
+    int x = x0, widest = 0, r = 0;
+    char *save = NULL;
+    for (char *line = strtok_r(options, "\n", &save); line; line = strtok_r(NULL, "\n", &save)) {
+        if (r == rows) {
+            x += (widest + 2) * adv;
+            widest = 0;
+            r = 0;
+        }
+        if (!menu_add(v, x, y0 + (row + r) * lh, -1, line))
+            break;
+        int k = (int)strlen(v->menu_items[v->num_menu_items - 1].label);
+        widest = k > widest ? k : widest;
+        r++;
+    }
+}
+
+/* A click at image pixel (x, y) with the menu open: an entry switches to
+ * that renderer or changes that option (button 1, the right one: the
+ * other way). false where no entry is. */
+static bool menu_click(viewer *v, int x, int y, int button)
+{
+    if (!v->menu)
+        return false;
+    menu_layout(v);
+    for (int i = 0; i < v->num_menu_items; i++) {
+        const menu_item *m = &v->menu_items[i];
+        if (x < m->x || x >= m->x + m->w || y < m->y || y >= m->y + m->h || m->algo == -2)
+            continue;
+        if (m->algo >= 0) {
+            if ((size_t)m->algo != v->algo_index) {
+                v->algo_index = (size_t)m->algo;
+                push_cmd(v, CMD_ALGO, v->algos[m->algo], 0, 0);
+                v->nav.changed = true;
+            }
+            return true;
+        }
+        char key[96];
+        const char *from = m->label[0] == '>' ? m->label + 1 : m->label;
+        snprintf(key, sizeof key, "%.*s", (int)strcspn(from, "="), from);
+        push_cmd(v, CMD_CLICK, key, button ? -1 : 1, 0);
+        v->nav.changed = true;
+        return true;
+    }
+    return false;
+}
+
 static void draw(viewer *v)
 {
-    int w = v->width, h = v->height;
+    int w = v->shown->width, h = v->shown->height;
     const rl_vec4 *src = v->shown->color;
     if (v->layer != CLI_LAYER_COLOR && cli_layer_picture(v->shown, v->layer, v->layer_px))
         src = v->layer_px;
@@ -1393,8 +1861,7 @@ static void draw(viewer *v)
         rl_vec4 c = src[i];
         v->pixels[i] = 0xff000000u | (uint32_t)to_byte(c.x) << 16 | (uint32_t)to_byte(c.y) << 8 | to_byte(c.z);
     }
-    /* Text at a size that stays legible on large images and fits small ones. */
-    int scale = w >= 1200 ? 2 : 1;
+    int scale = text_scale(v);
     if (v->stats) {
         const rl_render_stats *s = &v->shown_stats;
         char text[1024], status[256];
@@ -1423,33 +1890,10 @@ static void draw(viewer *v)
         view_draw_text(v->pixels, w, h, 3 * scale, 3 * scale, scale, text, 0xffffff40u);
     }
     if (v->menu) {
-        /* The renderers Tab cycles through, the current one marked, and
-         * its options as they are now. */
-        char text[3072], options[sizeof v->sh.options];
-        int fit = w / (VIEW_FONT_ADVANCE * scale) - 1;
-        size_t len = 0, cols = fit > 8 ? (size_t)fit : 8, line = 0;
-        SDL_LockMutex(v->sh.lock);
-        snprintf(options, sizeof options, "%s", v->sh.options);
-        SDL_UnlockMutex(v->sh.lock);
-        /* Words wrapped to the window: renderer names, then key=value. */
-        for (size_t i = 0; i <= v->num_algos; i++) {
-            char *save = NULL;
-            for (char *word = i < v->num_algos ? (char *)v->algos[i] : strtok_r(options, " ", &save); word;
-                 word = i < v->num_algos ? NULL : strtok_r(NULL, " ", &save)) {
-                char item[160];
-                int k = snprintf(item, sizeof item, "%s%s", i == v->algo_index ? ">" : "", word);
-                if (k < 0 || len + (size_t)k + 4 >= sizeof text)
-                    break;
-                bool wrap = line > 0 && line + 2 + (size_t)k > cols;
-                len += (size_t)snprintf(text + len, sizeof text - len, "%s%s", wrap ? "\n" : (line ? "  " : ""), item);
-                line = (wrap ? 0 : line + (line ? 2 : 0)) + (size_t)k;
-            }
-            if (i + 1 == v->num_algos && len + 3 < sizeof text) {
-                len += (size_t)snprintf(text + len, sizeof text - len, "\n\n");
-                line = 0;
-            }
-        }
-        view_draw_text(v->pixels, w, h, 3 * scale, h / 2, scale, text, 0xffffffffu);
+        menu_layout(v);
+        for (int i = 0; i < v->num_menu_items; i++)
+            view_draw_text(v->pixels, w, h, v->menu_items[i].x, v->menu_items[i].y, scale, v->menu_items[i].label,
+                           v->menu_items[i].algo == -2 ? 0xffffff40u : 0xffffffffu);
     }
     if (v->help)
         view_draw_text(v->pixels, w, h, 3 * scale, h / 3, scale, view_keys_help, 0xffffffffu);
@@ -1500,10 +1944,18 @@ static int parse_args(int argc, char **argv, view_args *a)
         else if (VALUE("--shot-dir")) a->shot_dir = v;
         else if (VALUE("--path-out")) a->path_out = v;
         else if (VALUE("--stats-out")) a->stats_out = v;
+        else if (VALUE("--display")) {
+            if (m > 0 && strcmp(v, "auto") != 0 && strcmp(v, "software") != 0 && strcmp(v, "gl") != 0)
+                return cli_fail(RL_CLI_USAGE, "--display: expected auto, software or gl, got '%s'", v);
+            a->display = v;
+        }
         else if (VALUE("--size")) {
-            if (m > 0 && !cli_parse_size(v, &a->width, &a->height))
+            if (m > 0 && strcmp(v, "window") == 0)
+                a->has_size = false;
+            else if (m > 0 && !cli_parse_size(v, &a->width, &a->height))
                 return RL_CLI_USAGE;
-            a->has_size = true;
+            else
+                a->has_size = true;
         } else if (VALUE("--max-spp")) {
             if (m > 0 && (!rl_parse_int(v, &a->max_spp) || a->max_spp < 1 || a->max_spp > 1000000000))
                 return cli_fail(RL_CLI_USAGE, "--max-spp: expected samples per pixel in [1, 1000000000], got '%s'",
@@ -1635,10 +2087,25 @@ static int open_window(viewer *v)
     /* The image is made on the CPU; the window only scales it. SDL's
      * software path does that without loading an OpenGL driver (under Xvfb
      * that is Mesa, which SDL_Quit unloads with blocks still held, a leak
-     * the sanitizer build cannot attribute). The environment's
-     * SDL_RENDER_DRIVER and SDL_FRAMEBUFFER_ACCELERATION still override. */
-    SDL_SetHint(SDL_HINT_RENDER_DRIVER, "software");
-    SDL_SetHint(SDL_HINT_FRAMEBUFFER_ACCELERATION, "0");
+     * the sanitizer build cannot attribute). The GL renderers' images come
+     * back from the library's own context as rl_images as well (a context
+     * shared with the window is not possible through the API:
+     * docs/viewer.md), so for them only the upload and scaling go to SDL's
+     * OpenGL renderer (--display gl), which SDL replaces by its software
+     * one where it cannot make a context. auto does so only where the GL
+     * backend has a hardware device: on llvmpipe the GL upload is the CPU's
+     * too and measured twice the software path's time (docs/viewer.md).
+     * The environment's SDL_RENDER_DRIVER and SDL_FRAMEBUFFER_ACCELERATION
+     * still override. */
+    bool gl = strcmp(v->a->display, "gl") == 0;
+    rl_gl_info gi;
+    if (strcmp(v->a->display, "auto") == 0 && strncmp(v->a->algo, "gl-", 3) == 0 &&
+        rl_gl_info_get(NULL, &gi) == RL_OK)
+        gl = !strstr(gi.renderer, "llvmpipe") && !strstr(gi.renderer, "softpipe") && !strstr(gi.renderer, "swrast");
+    rl_clear_error();
+    SDL_SetHint(SDL_HINT_RENDER_DRIVER, gl ? "opengl" : "software");
+    if (!gl)
+        SDL_SetHint(SDL_HINT_FRAMEBUFFER_ACCELERATION, "0");
     if (SDL_Init(SDL_INIT_VIDEO) != 0)
         return cli_fail(RL_CLI_FAIL, "view: cannot open a window: %s", SDL_GetError());
     const char *driver = SDL_GetCurrentVideoDriver();
@@ -1648,7 +2115,8 @@ static int open_window(viewer *v)
     char title[256];
     snprintf(title, sizeof title, "rl view %s", v->a->scene);
     /* The window starts at the image size, halved until it fits a common
-     * screen; it may then be resized freely (the image is scaled). */
+     * screen; it may then be resized freely (a --size image is scaled, an
+     * image that follows the window is rendered at its new size). */
     int ww = v->width, wh = v->height;
     while (ww > 1600 || wh > 1000) {
         ww /= 2;
@@ -1661,11 +2129,20 @@ static int open_window(viewer *v)
     v->ren = SDL_CreateRenderer(v->win, -1, 0);
     if (!v->ren)
         return cli_fail(RL_CLI_FAIL, "view: cannot draw into the window: %s", SDL_GetError());
-    /* Letterboxed scaling keeps the image's aspect ratio in any window. */
-    SDL_RenderSetLogicalSize(v->ren, v->width, v->height);
-    v->tex = SDL_CreateTexture(v->ren, SDL_PIXELFORMAT_ARGB8888, SDL_TEXTUREACCESS_STREAMING, v->width, v->height);
-    if (!v->tex)
-        return cli_fail(RL_CLI_FAIL, "view: cannot make the image texture: %s", SDL_GetError());
+    SDL_RendererInfo info;
+    snprintf(v->display, sizeof v->display, "%s", SDL_GetRendererInfo(v->ren, &info) == 0 ? info.name : "?");
+    cli_debug("view: SDL renderer %s", v->display);
+    if (gl && strcmp(v->display, "opengl") != 0)
+        snprintf(v->sh.status, sizeof v->sh.status, "--display gl: SDL made no OpenGL renderer; %s", v->display);
+    int ow = ww, oh = wh;
+    if (v->follow_window && SDL_GetRendererOutputSize(v->ren, &ow, &oh) == 0) {
+        window_image_size(ow, oh, &v->width, &v->height);
+        v->nav.cam.width = v->width;
+        v->nav.cam.height = v->height;
+    }
+    if (!fit_shown(v, v->width, v->height))
+        return cli_fail(RL_CLI_FAIL, "view: cannot make a %dx%d image and its texture: %s", v->width, v->height,
+                        SDL_GetError());
     return RL_CLI_OK;
 }
 
@@ -1682,8 +2159,7 @@ static bool wait_frame(viewer *v)
         SDL_UnlockMutex(v->sh.lock);
         if (!handle_events(v))
             return false;
-        if (take_frame(v))
-            draw(v);
+        show_frame(v);
         if (idle)
             return true;
     }
@@ -1772,6 +2248,11 @@ static int apply_event(viewer *v, const view_script *s, const view_event *e, boo
         break;
     case VIEW_EV_RESIZE:
         SDL_SetWindowSize(v->win, (int)e->dx, (int)e->dy);
+        window_resized(v, (int)e->dx, (int)e->dy);
+        break;
+    case VIEW_EV_CLICK:
+        if (!menu_click(v, (int)e->dx, (int)e->dy, e->button))
+            say(v, "click %g,%g: %s", e->dx, e->dy, v->menu ? "no menu entry there" : "the menu (M) is closed");
         break;
     case VIEW_EV_RECORD:
         if (e->text)
@@ -1863,11 +2344,12 @@ static int run_interactive(viewer *v)
             v->need_frame = false;
             request(v, false);
         }
-        bool fresh = take_frame(v);
+        bool fresh = show_frame(v);
         if (fresh && !after_frame(v))
             return RL_CLI_FAIL;
         /* The overlay (help, status) changes without frames too. */
-        draw(v);
+        if (!fresh)
+            draw(v);
         SDL_Delay(fresh ? 1 : 8);
     }
     if (v->recording && !stop_recording(v))
@@ -1887,6 +2369,7 @@ static int write_stats_out(const viewer *v, double wall_s)
     cJSON_AddNumberToObject(obj, "width", v->width);
     cJSON_AddNumberToObject(obj, "height", v->height);
     cJSON_AddBoolToObject(obj, "scripted", v->scripted);
+    cJSON_AddStringToObject(obj, "display", v->display);
     cJSON_AddNumberToObject(obj, "wall_s", wall_s);
     for (int i = 0; i < v->num_stats; i++) {
         const algo_stat *s = &v->stats_by_algo[i];
@@ -1902,6 +2385,19 @@ static int write_stats_out(const viewer *v, double wall_s)
         cJSON_AddNumberToObject(e, "first_image_ms", s->first_image_ms);
         cJSON_AddNumberToObject(e, "first_final_ms", s->first_final_ms);
         cJSON_AddNumberToObject(e, "first_prep_ms", s->prep_ms);
+        cJSON_AddNumberToObject(e, "display_ms", s->displayed ? s->display_s * 1e3 / (double)s->displayed : 0.0);
+        cJSON_AddNumberToObject(e, "latency_ms", s->latency_n ? s->latency_s * 1e3 / (double)s->latency_n : 0.0);
+        /* After the last restart: null where the run ended before the
+         * image was stable (last_change says how far it was). */
+        if (s->settled) {
+            cJSON_AddNumberToObject(e, "settle_frames", (double)s->settle_frames);
+            cJSON_AddNumberToObject(e, "settle_ms", s->settle_ms);
+        } else {
+            cJSON_AddNullToObject(e, "settle_frames");
+            cJSON_AddNullToObject(e, "settle_ms");
+        }
+        if (s->last_change > 0.0)
+            cJSON_AddNumberToObject(e, "last_change", s->last_change);
         cJSON_AddItemToArray(arr, e);
     }
     cJSON *exp = cli_experiment_json(cli_threads());
@@ -1949,7 +2445,7 @@ static void close_viewer(viewer *v)
 
 int view_run(int argc, char **argv)
 {
-    view_args a = { .algo = "raster", .shot_dir = ".", .path_out = "rl-view-path.json",
+    view_args a = { .algo = "raster", .display = "auto", .shot_dir = ".", .path_out = "rl-view-path.json",
                     .max_spp = DEFAULT_MAX_SPP, .ref_spp = DEFAULT_REF_SPP };
     a.sets = calloc((size_t)argc, sizeof *a.sets);
     if (!a.sets)
@@ -1989,8 +2485,13 @@ int view_run(int argc, char **argv)
         v.nav.speed = 0.25f * diag;
         v.nav.min_dist = 1e-3f * diag;
         /* back, front, shown with their layers, the reference, the layer
-         * picture and the window's pixels */
-        rc = cli_check_frame_memory(v.wk.r, v.width, v.height, VIEW_LAYERS,
+         * picture and the window's pixels; an image that follows the window
+         * may grow to the cap */
+        v.follow_window = !a.has_size;
+        int mw = v.width, mh = v.height;
+        if (v.follow_window)
+            window_image_size(16384, 16384 * 10 / 16, &mw, &mh);
+        rc = cli_check_frame_memory(v.wk.r, mw, mh, VIEW_LAYERS,
                                     3.0 * (sizeof(rl_vec4) + 8.0) + 2.0 * sizeof(rl_vec4) + 4.0, 0.0);
     }
     if (rc == RL_CLI_OK) {
@@ -2004,20 +2505,16 @@ int view_run(int argc, char **argv)
         } else if (st != RL_OK)
             rc = cli_fail_status(RL_CLI_FAIL, st, a.algo);
     }
+    if (rc == RL_CLI_OK)
+        rc = open_window(&v);
     if (rc == RL_CLI_OK) {
         rl_clear_error();
         rl_status st = rl_image_create(v.width, v.height, VIEW_LAYERS, &v.wk.back);
         if (st == RL_OK)
             st = rl_image_create(v.width, v.height, VIEW_LAYERS, &v.sh.front);
-        if (st == RL_OK)
-            st = rl_image_create(v.width, v.height, VIEW_LAYERS, &v.shown);
-        v.pixels = st == RL_OK ? calloc((size_t)v.width * (size_t)v.height, sizeof *v.pixels) : NULL;
-        v.layer_px = v.pixels ? calloc((size_t)v.width * (size_t)v.height, sizeof *v.layer_px) : NULL;
-        if (st != RL_OK || !v.pixels || !v.layer_px)
+        if (st != RL_OK)
             rc = cli_fail(RL_CLI_FAIL, "out of memory for a %dx%d view", v.width, v.height);
     }
-    if (rc == RL_CLI_OK)
-        rc = open_window(&v);
     if (rc == RL_CLI_OK) {
         init_lut();
         list_algos(&v);

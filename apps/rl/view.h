@@ -32,6 +32,8 @@ typedef enum view_key {
     VIEW_KEY_PLAY, VIEW_KEY_SCRUB_BACK, VIEW_KEY_SCRUB_FORWARD,
     VIEW_KEY_RECORD,
     VIEW_KEY_OPTION_UP, VIEW_KEY_OPTION_DOWN,
+    /* Which of the renderer's live options + and - change. */
+    VIEW_KEY_OPTION_NEXT, VIEW_KEY_OPTION_PREV,
     /* Cycle an enum option of the current renderer through its choices:
      * overlay, shadow / diffuse backend, filter, VT criteria. */
     VIEW_KEY_CYCLE_OVERLAY, VIEW_KEY_CYCLE_SHADOW, VIEW_KEY_CYCLE_DIFFUSE, VIEW_KEY_CYCLE_FILTER,
@@ -65,6 +67,7 @@ typedef enum view_event_kind {
     VIEW_EV_SCREENSHOT,   /* text: FILE.png */
     VIEW_EV_CAPTURE,      /* text: FILE.png, the window's pixels with the overlay */
     VIEW_EV_RESIZE,       /* dx x dy: window size */
+    VIEW_EV_CLICK,        /* button 0 left, 1 right at dx, dy: image pixels (the menu's entries) */
     VIEW_EV_RECORD,       /* text: FILE.json starts, NULL stops and saves */
     VIEW_EV_QUIT
 } view_event_kind;

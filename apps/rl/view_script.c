@@ -27,12 +27,15 @@ const char view_keys_help[] =
     "  P               play / pause the scene's camera_path; , and . scrub 1 s\n"
     "  R               record a camera path; R again saves it (--path-out)\n"
     "  Tab, Shift+Tab  next / previous renderer (every available one of rl algos)\n"
-    "  + -             main option of the renderer: vt min_edge, pt spp,\n"
-    "                  surfels overdraw\n"
+    "  + -             the renderer's live option up / down (vt min_edge, pt\n"
+    "                  spp, surfels overdraw, chcpp assumed_visible, svs\n"
+    "                  neighbours, visset budget, ...); [ ] choose which one\n"
     "  O B N F K       cycle the renderer's overlay (vt: wire, samples),\n"
     "                  shadow backend, diffuse backend, filter, vt criteria\n"
     "  L               show colour, depth or object IDs (false colours)\n"
-    "  M               menu: the renderers and the current one's options\n"
+    "  M               menu: the renderers and the current one's options; a\n"
+    "                  click switches the renderer or changes the option\n"
+    "                  (right click: the other way)\n"
     "  X               SSIM and hSSIM against an exact reference (whitted;\n"
     "                  pt at --ref-spp for the path tracers)\n"
     "  F12             screenshot: PNG + stats JSON (--shot-dir)\n"
@@ -54,7 +57,8 @@ static const key_name key_names[] = {
     { "7", VIEW_KEY_CAMERA_1 + 6 }, { "8", VIEW_KEY_CAMERA_1 + 7 }, { "9", VIEW_KEY_CAMERA_1 + 8 },
     { "c", VIEW_KEY_CAMERA_RESET }, { "p", VIEW_KEY_PLAY }, { ",", VIEW_KEY_SCRUB_BACK },
     { ".", VIEW_KEY_SCRUB_FORWARD }, { "r", VIEW_KEY_RECORD }, { "+", VIEW_KEY_OPTION_UP },
-    { "-", VIEW_KEY_OPTION_DOWN }, { "o", VIEW_KEY_CYCLE_OVERLAY }, { "b", VIEW_KEY_CYCLE_SHADOW },
+    { "-", VIEW_KEY_OPTION_DOWN }, { "]", VIEW_KEY_OPTION_NEXT }, { "[", VIEW_KEY_OPTION_PREV },
+    { "o", VIEW_KEY_CYCLE_OVERLAY }, { "b", VIEW_KEY_CYCLE_SHADOW },
     { "n", VIEW_KEY_CYCLE_DIFFUSE }, { "f", VIEW_KEY_CYCLE_FILTER }, { "k", VIEW_KEY_CYCLE_CRITERIA },
     { "l", VIEW_KEY_LAYER }, { "m", VIEW_KEY_MENU }, { "x", VIEW_KEY_REFERENCE },
     { "F12", VIEW_KEY_SCREENSHOT }, { "Escape", VIEW_KEY_QUIT },
@@ -77,7 +81,7 @@ static const char *const event_names[] = {
     [VIEW_EV_KEY] = "key", [VIEW_EV_KEYDOWN] = "keydown", [VIEW_EV_KEYUP] = "keyup", [VIEW_EV_DRAG] = "drag",
     [VIEW_EV_WHEEL] = "wheel", [VIEW_EV_MOVE] = "move", [VIEW_EV_CAMERA] = "camera", [VIEW_EV_ALGO] = "algo",
     [VIEW_EV_SET] = "set", [VIEW_EV_SCREENSHOT] = "screenshot", [VIEW_EV_CAPTURE] = "capture",
-    [VIEW_EV_RESIZE] = "resize",
+    [VIEW_EV_RESIZE] = "resize", [VIEW_EV_CLICK] = "click",
     [VIEW_EV_RECORD] = "record", [VIEW_EV_QUIT] = "quit",
 };
 #define NUM_EVENTS (sizeof event_names / sizeof event_names[0])
@@ -120,7 +124,7 @@ static int parse_event(const char *path, int line, char **w, int n, view_event *
     if (k == NUM_EVENTS) {
         char hint[96];
         return BAD("%s:%d: unknown event '%s' (%sevents: key, keydown, keyup, drag, wheel, move, camera, algo, "
-                   "set, screenshot, capture, resize, record, quit)", path, line, w[1],
+                   "set, screenshot, capture, resize, click, record, quit)", path, line, w[1],
                    cli_did_you_mean(w[1], event_names, NUM_EVENTS, hint, sizeof hint));
     }
     e->kind = (view_event_kind)k;
@@ -132,6 +136,7 @@ static int parse_event(const char *path, int line, char **w, int n, view_event *
         break;
     case VIEW_EV_DRAG: want = 3; break;
     case VIEW_EV_RESIZE: want = 2; break;
+    case VIEW_EV_CLICK: want = n == 5 ? 3 : 2; break;     /* [left|right] X Y */
     case VIEW_EV_MOVE: want = 4; break;
     case VIEW_EV_QUIT: want = 0; break;
     }
@@ -161,6 +166,15 @@ static int parse_event(const char *path, int line, char **w, int n, view_event *
         if (!parse_number(w[2], 16, 16384, &e->dx) || !parse_number(w[3], 16, 16384, &e->dy))
             return BAD("%s:%d: resize: expected WIDTH HEIGHT in [16, 16384], got '%s %s'", path, line, w[2], w[3]);
         break;
+    case VIEW_EV_CLICK: {
+        int at = n == 5 ? 3 : 2;
+        if (n == 5 && strcmp(w[2], "left") != 0 && strcmp(w[2], "right") != 0)
+            return BAD("%s:%d: click: expected left or right, got '%s'", path, line, w[2]);
+        e->button = n == 5 && strcmp(w[2], "right") == 0;
+        if (!parse_number(w[at], 0, 16383, &e->dx) || !parse_number(w[at + 1], 0, 16383, &e->dy))
+            return BAD("%s:%d: click: expected X Y in image pixels, got '%s %s'", path, line, w[at], w[at + 1]);
+        break;
+    }
     case VIEW_EV_MOVE:
         if (strcmp(w[2], "eye") != 0 || strcmp(w[4], "target") != 0)
             return BAD("%s:%d: move: expected 'eye x,y,z target x,y,z'", path, line);

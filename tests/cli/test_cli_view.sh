@@ -5,7 +5,9 @@
 # a recorded camera path replays through rl render --camera-path to the
 # same frames, pt accumulates, and bad input (an unknown event or key, a
 # missing file, no display) fails with one error line; the live controls
-# (layers, overlay, reference SSIM, menu) work. Skipped (exit 77,
+# (layers, overlay, reference SSIM, menu) work; the image follows a
+# resized window, menu entries are clicked and the live culling options
+# step. Skipped (exit 77,
 # ctest's SKIP_RETURN_CODE) where rl was built without SDL2 or xvfb-run is
 # missing.
 # Run as: bash test_cli_view.sh <rl-binary> <scratch-dir>
@@ -35,6 +37,9 @@ printf '# a comment\n\n0 key Hyper\n' >"$TMP/bad_key.txt"
 expect_error 2 "bad_key.txt:3: unknown key 'Hyper'" "$RL" view cornell --script "$TMP/bad_key.txt"
 printf '1 quit\n0.5 quit\n' >"$TMP/bad_time.txt"
 expect_error 2 "bad_time.txt:2: time 0.5 s is before" "$RL" view cornell --script "$TMP/bad_time.txt"
+printf '0 click left 10\n' >"$TMP/bad_click.txt"
+expect_error 2 "bad_click.txt:1: click: expected X Y" "$RL" view cornell --script "$TMP/bad_click.txt"
+expect_usage_error "$RL" view cornell --display vulkan
 printf '0 algo rayster\n' >"$TMP/bad_algo.txt"
 expect_error 2 "bad_algo.txt:1: unknown renderer 'rayster'" "$RL" view cornell --script "$TMP/bad_algo.txt"
 expect_error 1 "no-such-script.txt" "$RL" view cornell --script "$TMP/no-such-script.txt"
@@ -208,6 +213,75 @@ assert w["ssim"] == 1 and w["hssim"] == 1 and w["rmse"] == 0 and w["hssim_levels
 r = json.load(open(tmp + "/live_raster.json"))["reference"]
 assert r["algorithm"] == "whitted" and r["compared"] == "raster", r
 assert 0.2 < r["ssim"] < 0.9999 and r["rmse"] > 0, r
+PY
+
+# The image follows the window (--size window): a resize re-renders at
+# the new size (as rl render at that size); the menu's entries are clicked
+# (a renderer; an enum option back with the right button and forward with
+# the left); the live culling options ([ ] + -) change the options and the
+# stats. Where the entries are: the menu's fixed cells (docs/viewer.md),
+# from half the height down, 6 x 9 pixels each, renderers wrapped to the
+# width, the current one marked ">".
+read -r VS_X VS_Y RA_X RA_Y SH_X SH_Y < <(available_algos | python3 -c '
+import sys
+names, cols, col, row, at = sys.stdin.read().split(), 320 // 6 - 1, 0, 0, {}
+for n in names:
+    k = len(n) + (n == "raster")
+    if col > 0 and col + 2 + k > cols:
+        row, col = row + 1, 0
+    elif col > 0:
+        col += 2
+    at[n] = (3 + col * 6 + 2, 120 + row * 9 + 3)
+    col += k
+# raster options: a heading two lines below the renderers, shading first.
+print(*at["visset"], *at["raster"], 5, 120 + (row + 3) * 9 + 3)')
+cat >"$TMP/window.txt" <<EOT
+0 key i
+0 resize 320 240
+0 screenshot $TMP/win.png
+0 key m
+0 click right $SH_X $SH_Y
+0 screenshot $TMP/win_gouraud.png
+0 click $SH_X $SH_Y
+0 screenshot $TMP/win_back.png
+0 click $VS_X $VS_Y
+0 set budget=1024
+0 screenshot $TMP/win_vs1024.png
+0 key -
+0 screenshot $TMP/win_vs512.png
+0 click $RA_X $RA_Y
+0 algo chcpp
+0 key ]
+0 key +
+0 key ]
+0 key ]
+0 key +
+0 screenshot $TMP/win_chcpp.png
+0 resize 64 48
+0 screenshot $TMP/win_small.png
+EOT
+run_ok xvfb "$RL" view table --size window --set visset.samples=16 --set visset.resolution=32 \
+    --script "$TMP/window.txt"
+run_ok "$RL" render table --size 320x240 --out "$TMP/ref_win.png"
+run_ok "$RL" render table --size 320x240 --set shading=gouraud --out "$TMP/ref_gouraud.png"
+ssim_ok "$TMP/win.png" "$TMP/ref_win.png"
+ssim_ok "$TMP/win_gouraud.png" "$TMP/ref_gouraud.png"
+ssim_ok "$TMP/win_back.png" "$TMP/ref_win.png"
+cmp -s "$TMP/win_gouraud.png" "$TMP/win.png" && fail "click: shading did not change the image"
+python3 - "$TMP" <<'PY' || fail "the window's size, the menu's clicks or the live options are wrong"
+import json, sys
+tmp = sys.argv[1]
+j = lambda n: json.load(open(tmp + "/win_" + n + ".json"))
+w = json.load(open(tmp + "/win.json"))
+assert (w["width"], w["height"]) == (320, 240), w
+assert (j("small")["width"], j("small")["height"]) == (64, 48)
+assert j("gouraud")["options"]["shading"] == "gouraud" and j("back")["options"]["shading"] == "textured"
+a, b = j("vs1024"), j("vs512")
+assert a["algorithm"] == "visset" and a["options"]["budget"] == "1024" and b["options"]["budget"] == "512", (a, b)
+assert b["triangles_rasterized"] < a["triangles_rasterized"] <= w["triangles_rasterized"], (a, b, w)
+c = j("chcpp")
+assert c["algorithm"] == "chcpp" and c["options"]["batch"] == "100" and c["options"]["tight"] == "false", c
+assert c["occlusion_queries"] > 0, c
 PY
 
 # A set in the script that the renderer refuses: exit 2 with FILE:LINE.
