@@ -515,8 +515,13 @@ static void path_tile(const frame *f, int64_t t, uint32_t pass, pt_counters *c)
                 continue;
             size_t i = (size_t)y * f->width + x;
             pt_surface first;
-            rl_vec3 L = f->ctx.background;   /* a camera ray that leaves the scene */
-            if (first_vertex(f, i, &first)) {
+            rl_vec3 L;
+            if (!first_vertex(f, i, &first)) {
+                /* a camera ray that leaves the scene */
+                L = f->ctx.env ? rl_pt_escape_radiance(&f->ctx, rl_camera_frame_ray(&f->cam, (float)x + 0.5f,
+                                                                                   (float)y + 0.5f).d)
+                               : f->ctx.background;
+            } else {
                 pt_sampler sp;
                 pixel_sampler(f, i, pass, &sp);
                 L = rl_pt_trace_path(&f->ctx, &first, &sp, c);
@@ -755,11 +760,13 @@ static rl_vec3 pixel_sample(const frame *f, int x, int y, uint32_t index, pt_cou
     pt_sampler sp;
     pt_surface first;
     bool seen;
+    rl_vec3 dir = rl_v3s(0.0f);   /* of the camera ray, for the environment */
     if (f->set->primary == PT_PRIMARY_TRACE) {
         rl_pt_sampler_init(&sp, rng, seed, index);
         rl_pt_sampler_seek(&sp, PT_SLOT_PIXEL);
         rl_vec2 j = rl_pt_sample_2d(&sp);
         rl_ray ray = rl_camera_frame_ray(&f->cam, (float)x + j.x, (float)y + j.y);
+        dir = ray.d;
         rl_hit hit = { INFINITY, 0.0f, 0.0f, RL_ID_NONE, RL_ID_NONE };
         c->rays[RL_RAY_PRIMARY]++;
         c->trace_q[RL_PT_BACKEND_BVH]++;
@@ -767,9 +774,11 @@ static rl_vec3 pixel_sample(const frame *f, int x, int y, uint32_t index, pt_cou
         seen = rl_pt_surface_at_hit(f->ctx.data, &hit, f->eye, ray.d, &first);
     } else {
         seen = first_vertex(f, i, &first);
+        if (!seen && f->ctx.env)
+            dir = rl_camera_frame_ray(&f->cam, (float)x + 0.5f, (float)y + 0.5f).d;
     }
     if (!seen)
-        return f->ctx.background;
+        return rl_pt_escape_radiance(&f->ctx, dir);
     rl_pt_sampler_init(&sp, rng, seed, index);
     return rl_pt_trace_path(&f->ctx, &first, &sp, c);
 }
@@ -1081,7 +1090,7 @@ static rl_status pt_render(rl_renderer *r, void *state, const rl_scene *scene, c
                  .tri_lights = set.mis && exact_backend(set.diffuse) && set.shadow != RL_PT_BACKEND_SHADOWMAP,
                  .vertex_slots = PT_SLOTS_VERTEX + PT_SLOTS_LIGHT * (uint32_t)set.light_samples *
                                                    (set.mis ? 1u : (d->num_lights ? d->num_lights : 1u)),
-                 .background = set.background },
+                 .background = set.background, .env = d->environment },
         .cam = rl_camera_frame_make(cam),
         .eye = cam->eye,
         .width = cam->width,
@@ -1090,6 +1099,12 @@ static rl_status pt_render(rl_renderer *r, void *state, const rl_scene *scene, c
         .tiles_x = (area.x1 - area.x0 + TILE - 1) / TILE,
         .parity = s->frames & 1u,
     };
+    if (d->environment) {
+        /* The environment's sample takes one slot after the lights' (pathtrace_path.c). */
+        f.ctx.env_nee = s->b.env.sampled && set.shadow != RL_PT_BACKEND_SHADOWMAP;
+        f.ctx.env_slot = f.ctx.vertex_slots;
+        f.ctx.vertex_slots += 1u;
+    }
     pt_counters sum;
     uint64_t traced = 0, samples = 0;
     if (set.adaptive) {
