@@ -327,7 +327,7 @@ RL_API rl_status rl_scene_create_builtin(const char *name, const char *params, r
  * and column. */
 RL_API rl_status rl_scene_load(const char *source, const char *params, rl_scene **out);
 /* The parameters rl_scene_load takes for a model file (cameras=file|off,
- * lights=file|off|add, headlight, azimuth, elevation). */
+ * lights=file|off|add, headlight, azimuth, elevation, materials=phong|ggx). */
 RL_API const rl_option_info *rl_model_options(size_t *count);
 RL_API rl_status rl_scene_load_json(const char *path, rl_scene **out);   /* committed */
 /* Imports a mesh file with Assimp under parent: its node hierarchy,
@@ -383,6 +383,10 @@ typedef struct rl_scene_import_desc {
     bool no_cameras;      /* skip the file's cameras */
     bool no_lights;       /* skip the file's lights */
     rl_import_limits limits;   /* zero fields: rl_scene_import_limits() */
+    /* glTF metallic-roughness materials as RL_BSDF_GGX with the file's
+     * base colour, metallic and roughness, instead of their Phong mapping
+     * (the model option materials=ggx). */
+    bool ggx_materials;
 } rl_scene_import_desc;
 /* rl_scene_import with a desc (NULL: defaults). */
 RL_API rl_status rl_scene_import_with(rl_scene *scene, const char *path, uint32_t parent,
