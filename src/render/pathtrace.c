@@ -134,6 +134,7 @@
 /* Order: sobol, then rl_rng_gpu_kind. */
 static const char *const rng_choices[] = { "sobol", "lcg", "tausworthe", "hybrid", NULL };
 static const char *const mis_choices[] = { "off", "on", NULL };
+static const char *const env_sampling_choices[] = { "importance", "uniform", "bsdf", NULL };
 /* Order = rl_pt_backend. */
 static const char *const shadow_choices[] = { "bvh", "grid", "embree", "ls-candidates", "ls-preillum", "ls-pnmt",
                                               "shadowmap", NULL };
@@ -206,7 +207,12 @@ static const rl_option_info pt_options[] = {
     { "shadowmap_size", RL_OPT_INT, "1024", "texels per shadow-map face side (Sec. 8.6)", 16, 16384, NULL },
     { "light_samples", RL_OPT_INT, "1", "shadow rays per quad light and vertex", 1, 1024, NULL },
     { "background", RL_OPT_COLOR, "0,0,0",
-      "radiance arriving from every direction where a ray leaves the scene (a uniform environment)", 0, 0, NULL },
+      "radiance arriving from every direction where a ray leaves the scene (a uniform environment); a scene "
+      "\"environment\" replaces it", 0, 0, NULL },
+    { "env_sampling", RL_OPT_ENUM, "importance",
+      "light samples of a scene environment (issue 37): importance (by its radiance x sin(theta)), uniform "
+      "(over the sphere) or bsdf (none: escaping BSDF rays only); MIS with the BSDF either way", 0, 0,
+      env_sampling_choices },
     { "threads", RL_OPT_INT, "0", "OpenMP threads (0 = all)", 0, 1024, NULL },
 };
 #define NUM_OPTIONS (sizeof pt_options / sizeof pt_options[0])
@@ -341,6 +347,7 @@ static void read_settings(const rl_renderer *r, pt_settings *set)
     set->shadowmap_size = (int)rl_renderer_opt_int(r, "shadowmap_size");
     set->light_samples = (int)rl_renderer_opt_int(r, "light_samples");
     set->background = rl_renderer_opt_color(r, "background");
+    set->env_sampling = (int)rl_renderer_opt_enum(r, "env_sampling");
     int threads = (int)rl_renderer_opt_int(r, "threads");
 #ifdef _OPENMP
     set->threads = threads > 0 ? threads : omp_get_max_threads();
@@ -676,6 +683,10 @@ static rl_status prepare_frame(rl_renderer *r, pt_state *s, const rl_scene *scen
     double built_ms = 0.0;
     rl_status st = rl_pt_backends_prepare(&s->b, scene, set, set->threads, &built_ms);
     if (st != RL_OK)
+        return st;
+    const rl_scene_data *d = s->b.data;
+    bool uniform = set->env_sampling == PT_ENV_UNIFORM;
+    if (d->environment && s->b.env.uniform != uniform && (st = rl_pt_env_build(&s->b.env, d->environment, uniform)))
         return st;
     ps->time_build_ms = built_ms;
     if (!rl_renderer_progress(r, BUILD_SHARE))
@@ -1101,7 +1112,7 @@ static rl_status pt_render(rl_renderer *r, void *state, const rl_scene *scene, c
     };
     if (d->environment) {
         /* The environment's sample takes one slot after the lights' (pathtrace_path.c). */
-        f.ctx.env_nee = s->b.env.sampled && set.shadow != RL_PT_BACKEND_SHADOWMAP;
+        f.ctx.env_nee = s->b.env.sampled && set.env_sampling != PT_ENV_BSDF && set.shadow != RL_PT_BACKEND_SHADOWMAP;
         f.ctx.env_slot = f.ctx.vertex_slots;
         f.ctx.vertex_slots += 1u;
     }

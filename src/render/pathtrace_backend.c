@@ -304,7 +304,7 @@ rl_status rl_pt_backends_prepare_scene(pt_backends *b, const rl_scene *scene)
         b->data = d;
         b->eps = EPS_SCALE * scene_scale(d->bounds);
         if ((st = build_cover(b, d)) != RL_OK || (st = rl_pt_lights_build(b, d)) != RL_OK ||
-            (st = rl_pt_env_build(&b->env, d->environment)) != RL_OK) {
+            (st = rl_pt_env_build(&b->env, d->environment, false)) != RL_OK) {
             rl_pt_backends_release(b);    /* the next frame starts over */
             return st;
         }

@@ -13,7 +13,8 @@
  *     p(w) = p(u, v) / (2 pi^2 sin(theta)),
  * p(u, v) = weight(i, j) W H / sum of weights, with theta the direction's
  * own polar angle. A constant environment (no map) uses ENV_CONST_ROWS
- * rows of one texel, nearly uniform in solid angle. */
+ * rows of one texel, nearly uniform in solid angle; env_sampling=uniform
+ * keeps the map's grid but weighs by sin(theta) alone, for comparison. */
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -31,10 +32,10 @@ void rl_pt_env_release(pt_env *e)
     memset(e, 0, sizeof *e);
 }
 
-static float texel_weight(const rl_environment *env, int x, int y, int h)
+static float texel_weight(const rl_environment *env, bool uniform, int x, int y, int h)
 {
     float sin_t = sinf(RL_PI * ((float)y + 0.5f) / (float)h);
-    if (!env->map)
+    if (!env->map || uniform)
         return sin_t;
     const rl_texture *m = env->map;
     rl_vec4 t = m->texels[(size_t)y * (size_t)m->width + (size_t)x];
@@ -42,12 +43,13 @@ static float texel_weight(const rl_environment *env, int x, int y, int h)
     return (c.x + c.y + c.z) * (1.0f / 3.0f) * sin_t;
 }
 
-rl_status rl_pt_env_build(pt_env *e, const rl_environment *env)
+rl_status rl_pt_env_build(pt_env *e, const rl_environment *env, bool uniform)
 {
     rl_pt_env_release(e);
     if (!env)
         return RL_OK;
     e->env = env;
+    e->uniform = uniform;
     int w = env->map ? env->map->width : 1, h = env->map ? env->map->height : ENV_CONST_ROWS;
     e->width = w;
     e->height = h;
@@ -70,7 +72,7 @@ rl_status rl_pt_env_build(pt_env *e, const rl_environment *env)
         float *cdf = &e->conditional[(size_t)y * (size_t)(w + 1)];
         double run = 0.0;
         for (int x = 0; x < w; ++x) {
-            float f = texel_weight(env, x, y, h);
+            float f = texel_weight(env, uniform, x, y, h);
             e->weight[(size_t)y * (size_t)w + (size_t)x] = f;
             run += f;
         }

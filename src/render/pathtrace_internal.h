@@ -56,7 +56,10 @@ typedef struct pt_settings {
     int grid_res, ls_n, ls_k, shadowmap_size;
     const char *ls_file;           /* Line Space cache file; "" none (valid for one frame) */
     rl_vec3 background;            /* environment radiance of escaping rays */
+    int env_sampling;              /* pt_env_sampling: light samples of a scene environment */
 } pt_settings;
+
+typedef enum pt_env_sampling { PT_ENV_IMPORTANCE = 0, PT_ENV_UNIFORM, PT_ENV_BSDF } pt_env_sampling;
 
 /* ------------------------------------------------------------ backends -- */
 
@@ -82,6 +85,7 @@ typedef struct pt_env {
     float *marginal;               /* height + 1 running sums over the rows */
     double sum;                    /* of the weights */
     bool sampled;                  /* some weight > 0: light samples go to it */
+    bool uniform;                  /* weights sin(theta) alone (env_sampling=uniform) */
 } pt_env;
 
 /* Everything built for one scene, kept between frames (Sec. 5.1: "built
@@ -123,8 +127,9 @@ rl_status rl_pt_backends_prepare_scene(pt_backends *b, const rl_scene *scene);
 /* Builds b->lights from the scene and b->tri_cover. */
 rl_status rl_pt_lights_build(pt_backends *b, const rl_scene_data *d);
 void rl_pt_lights_release(pt_lights *l);
-/* Builds e for env (NULL: none); RL_ERR_OUT_OF_MEMORY. */
-rl_status rl_pt_env_build(pt_env *e, const rl_environment *env);
+/* Builds e for env (NULL: none), by its radiance or, with uniform, by
+ * solid angle alone; RL_ERR_OUT_OF_MEMORY. */
+rl_status rl_pt_env_build(pt_env *e, const rl_environment *env, bool uniform);
 void rl_pt_env_release(pt_env *e);
 /* A direction drawn from the environment's distribution and its density in
  * solid angle; false when the environment is black or the draw hit a pole. */

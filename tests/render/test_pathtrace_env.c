@@ -63,7 +63,7 @@ static void test_environment_pdf_integrates_to_one_and_matches_its_samples(void 
     rl_environment env = { .radiance = rl_v3s(1.0f), .map = map, .rotation_deg = 30.0f };
     pt_env e;
     memset(&e, 0, sizeof e);
-    assert_int_equal(rl_pt_env_build(&e, &env), RL_OK);
+    assert_int_equal(rl_pt_env_build(&e, &env, false), RL_OK);
     assert_true(e.sampled);
 
     /* Mass of the pdf per block of 4 x 4 texels (in u, v) and in all. */
@@ -129,7 +129,7 @@ static void test_irradiance_by_importance_and_uniform_sampling_agree_with_quadra
     rl_environment env = { .radiance = rl_v3s(1.0f), .map = map, .rotation_deg = -75.0f };
     pt_env e;
     memset(&e, 0, sizeof e);
-    assert_int_equal(rl_pt_env_build(&e, &env), RL_OK);
+    assert_int_equal(rl_pt_env_build(&e, &env, false), RL_OK);
 
     double quad = 0.0;
     for (int y = 0; y < MAP_H * SUB; ++y) {
