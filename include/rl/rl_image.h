@@ -127,6 +127,11 @@ RL_API unsigned long long rl_texture_max_pixels(void);
 /* RL_ERR_LIMIT (message naming what) unless 1 <= w, h <= RL_IMAGE_MAX_SIZE
  * and w x h <= rl_texture_max_pixels(). */
 RL_API rl_status rl_texture_check_size(const char *what, long long w, long long h);
+/* Loads high-dynamic-range pictures with their linear values: OpenEXR
+ * (.exr) and Radiance RGBE (.hdr); anything else as rl_texture_load. The
+ * size is checked against rl_texture_max_pixels() from the header, before
+ * the pixels are decoded (RL_ERR_LIMIT). For environment maps. */
+RL_API rl_status rl_texture_load_linear(const char *path, rl_texture **out);
 /* Creates a texture from texels (copied). */
 RL_API rl_status rl_texture_create(int width, int height, const rl_vec4 *texels, rl_texture **out);
 RL_API void rl_texture_release(rl_texture *tex);

@@ -32,6 +32,27 @@ extern "C" {
 #define RL_NODE_ROOT 0u              /* every scene has a root node */
 #define RL_SCENE_MAX_TRIANGLES (1u << 30)
 
+/* The BRDF of a material's non-specular event. */
+typedef enum rl_material_bsdf {
+    RL_BSDF_PHONG = 0,        /* modified Phong (Lafortune & Willems 1994) */
+    RL_BSDF_GGX,              /* Cook-Torrance with the GGX distribution (Walter et al. 2007) */
+    RL_BSDF_COUNT
+} rl_material_bsdf;
+
+/* How the specular events weigh reflection against refraction. */
+typedef enum rl_fresnel_mode {
+    RL_FRESNEL_NONE = 0,      /* fixed k_r and k_t (Ullmann 2003, eq. 3.1) */
+    RL_FRESNEL_SCHLICK,       /* Schlick 1994's approximation */
+    RL_FRESNEL_COUNT
+} rl_fresnel_mode;
+
+/* Schlick's Fresnel reflectance F = F0 + (1 - F0) (1 - cos)^5 for a
+ * dielectric of relative index eta = n_t / n_i seen at cos_i from the
+ * incident side (cos_i > 0): F0 = ((eta - 1) / (eta + 1))^2; from the
+ * denser side the transmitted angle's cosine is used, and total internal
+ * reflection gives 1. */
+RL_API float rl_fresnel_schlick(float cos_i, float eta);
+
 /* Phong material with the ray-tracing coefficients of Ullmann 2003, Sec. 3.1
  * (eq. 3.1-3.4): local Phong term + k_r * reflected + k_t * transmitted. */
 typedef struct rl_material {
@@ -53,13 +74,27 @@ typedef struct rl_material {
      * is below this cutoff the surface is a hole that rays pass through
      * (rl_accel queries skip it). 0: opaque, no test. */
     float alpha_cutoff;
+    /* Physically based extensions (issue 37; docs/scene-format.md). Their
+     * zeros keep the Phong model above, so older materials render as
+     * before. The path tracers honour them (pt fully, bdpt without the
+     * environment); the other renderers approximate (docs/path-tracing.md). */
+    rl_material_bsdf bsdf;    /* the non-specular event's BRDF */
+    /* RL_BSDF_GGX: perceptual roughness r in [0,1], microfacet alpha = r^2;
+     * metallic in [0,1] blends F0 from the ior's dielectric value towards
+     * k_d and fades the diffuse lobe out. */
+    float roughness;
+    float metallic;
+    /* RL_FRESNEL_SCHLICK: the k_t event splits into reflection and
+     * refraction by Schlick's F(ior), and the k_r mirror reflects F with
+     * F0 = k_s; RL_FRESNEL_NONE: the fixed coefficients above. */
+    rl_fresnel_mode fresnel;
 } rl_material;
 
 /* Grey diffuse (0.8), no specular, shininess 32, ior 1.5, no textures,
- * normal scale 1. */
+ * normal scale 1, Phong BRDF, no Fresnel term. */
 RL_API rl_material rl_material_default(void);
 /* RL_ERR_INVALID_ARG for negative or non-finite coefficients, k_r + k_t > 1,
- * ior < 1. */
+ * ior < 1, an unknown bsdf or fresnel, roughness or metallic outside [0,1]. */
 RL_API rl_status rl_material_validate(const rl_material *m);
 
 typedef enum rl_light_type {
@@ -88,6 +123,33 @@ typedef struct rl_light {
 
 RL_API const char *rl_light_type_name(rl_light_type type);
 RL_API rl_status rl_light_validate(const rl_light *l);
+
+/* A scene's environment (issue 37): the radiance of directions that leave
+ * the scene, for the path tracers (pt; docs/path-tracing.md). Lat-long
+ * map: row 0 looks straight up (+y), the bottom row straight down, the
+ * columns sweep the azimuth phi = 2 pi u from +x towards -z (u = 0 the
+ * left edge), turned by rotation_deg about +y. Any aspect ratio is taken
+ * (2:1 keeps texels square in angle). Texels are read without filtering,
+ * as the piecewise-constant function the sampling uses. */
+typedef struct rl_environment {
+    rl_vec3 radiance;         /* colour * intensity: the constant, or the map's scale */
+    const rl_texture *map;    /* lat-long, linear RGB; NULL: constant */
+    float rotation_deg;
+} rl_environment;
+
+typedef struct rl_environment_desc {
+    const char *path;         /* .exr, .hdr (linear) or PNG etc. (sRGB), relative to the
+                               * base dir; NULL: a constant environment */
+    rl_vec3 color;            /* scales the map, or the constant radiance */
+    float intensity;          /* scales both; 0 -> 1 */
+    float rotation_deg;       /* about +y */
+} rl_environment_desc;
+
+/* The environment's radiance towards unit direction dir. */
+RL_API rl_vec3 rl_environment_radiance(const rl_environment *env, rl_vec3 dir);
+/* Lat-long coordinates (u, v in [0,1), v = 0 up) of unit dir, and back. */
+RL_API rl_vec2 rl_environment_uv(const rl_environment *env, rl_vec3 dir);
+RL_API rl_vec3 rl_environment_direction(const rl_environment *env, float u, float v);
 
 /* Mesh input. Data is copied. normals == NULL: area-weighted smooth normals
  * are computed; uvs == NULL: all (0,0). */
@@ -129,6 +191,12 @@ RL_API rl_status rl_scene_add_light(rl_scene *scene, const rl_light *light);
 RL_API rl_status rl_scene_add_camera(rl_scene *scene, const char *name, const rl_camera *cam);
 /* Takes ownership of path on success; replaces any previous path. */
 RL_API rl_status rl_scene_set_camera_path(rl_scene *scene, rl_camera_path *path);
+/* Sets the scene's environment (rl_environment above), replacing any
+ * previous one. RL_ERR_IO / RL_ERR_PARSE for an unreadable file or texels
+ * that are negative or not finite, RL_ERR_LIMIT past
+ * rl_texture_max_pixels(), RL_ERR_INVALID_ARG for negative or non-finite
+ * values; a map that is not 2:1 is taken with a warning. */
+RL_API rl_status rl_scene_set_environment(rl_scene *scene, const rl_environment_desc *desc);
 
 /* Scene graph. transform == NULL: identity. node ids are dense, root = 0. */
 RL_API rl_status rl_scene_add_node(rl_scene *scene, uint32_t parent, const char *name,
@@ -184,6 +252,7 @@ typedef struct rl_scene_data {
     const char *const *camera_names;
     const rl_camera_path *camera_path;  /* or NULL */
     rl_aabb bounds;
+    const rl_environment *environment;  /* or NULL: none (renderers' background) */
 } rl_scene_data;
 
 /* NULL (with RL_ERR_NOT_COMMITTED recorded) unless committed. */
@@ -258,7 +327,7 @@ RL_API rl_status rl_scene_create_builtin(const char *name, const char *params, r
  * and column. */
 RL_API rl_status rl_scene_load(const char *source, const char *params, rl_scene **out);
 /* The parameters rl_scene_load takes for a model file (cameras=file|off,
- * lights=file|off|add, headlight, azimuth, elevation). */
+ * lights=file|off|add, headlight, azimuth, elevation, materials=phong|ggx). */
 RL_API const rl_option_info *rl_model_options(size_t *count);
 RL_API rl_status rl_scene_load_json(const char *path, rl_scene **out);   /* committed */
 /* Imports a mesh file with Assimp under parent: its node hierarchy,
@@ -314,6 +383,10 @@ typedef struct rl_scene_import_desc {
     bool no_cameras;      /* skip the file's cameras */
     bool no_lights;       /* skip the file's lights */
     rl_import_limits limits;   /* zero fields: rl_scene_import_limits() */
+    /* glTF metallic-roughness materials as RL_BSDF_GGX with the file's
+     * base colour, metallic and roughness, instead of their Phong mapping
+     * (the model option materials=ggx). */
+    bool ggx_materials;
 } rl_scene_import_desc;
 /* rl_scene_import with a desc (NULL: defaults). */
 RL_API rl_status rl_scene_import_with(rl_scene *scene, const char *path, uint32_t parent,

@@ -181,6 +181,26 @@ static rl_status check_exr(FILE *f, const char *path)
     }
 }
 
+rl_status rl_image_exr_size(const char *path, long long *width, long long *height)
+{
+    FILE *probe = fopen(path, "rb");
+    if (!probe)
+        return rl_error(RL_ERR_IO, "%s: cannot open: %s", path, strerror(errno));
+    rl_status checked = check_exr(probe, path);
+    fclose(probe);
+    if (checked != RL_OK)
+        return checked;
+    ImfInputFile *file = ImfOpenInputFile(path);
+    if (!file)
+        return rl_error(RL_ERR_PARSE, "%s: invalid EXR: %s", path, ImfErrorMessage());
+    int x0, y0, x1, y1;
+    ImfHeaderDataWindow(ImfInputHeader(file), &x0, &y0, &x1, &y1);
+    ImfCloseInputFile(file);
+    *width = (long long)x1 - x0 + 1;
+    *height = (long long)y1 - y0 + 1;
+    return RL_OK;
+}
+
 rl_status rl_image_read_exr(const char *path, rl_image **out)
 {
     /* ImfOpenInputFile's message for a missing file is terse; check first. */

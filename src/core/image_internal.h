@@ -19,5 +19,7 @@ rl_status rl_image_read_png(const char *path, rl_image **out);
  * bytes after it (stb would allocate its declared length). */
 rl_status rl_texture_check_png_memory(const unsigned char *data, size_t len, const char *what);
 rl_status rl_image_read_exr(const char *path, rl_image **out);
+/* The data window's size from an EXR's header, nothing decoded. */
+rl_status rl_image_exr_size(const char *path, long long *width, long long *height);
 
 #endif

@@ -17,6 +17,7 @@
 #include "core/error.h"
 #include "core/image_internal.h"
 #include "core/texture_sample.h"
+#include "rl/rl_path.h"
 
 static unsigned long long max_pixels = RL_TEXTURE_MAX_PIXELS;
 
@@ -185,4 +186,61 @@ void rl_texture_release(rl_texture *tex)
 rl_vec4 rl_texture_sample(const rl_texture *tex, rl_vec2 uv)
 {
     return rl_texture_sample_inline(tex, uv);
+}
+
+/* Radiance RGBE (.hdr): stb_image's float path returns its linear values
+ * unchanged (the 2.2 gamma it applies is for LDR files only). */
+static rl_status load_hdr(const char *path, rl_texture **out)
+{
+    FILE *f = fopen(path, "rb");
+    if (!f)
+        return rl_error(RL_ERR_IO, "%s: cannot open: %s", path, strerror(errno));
+    int w = 0, h = 0, comp = 0;
+    if (!stbi_is_hdr_from_file(f) || !stbi_info_from_file(f, &w, &h, &comp)) {
+        fclose(f);
+        return rl_error(RL_ERR_PARSE, "%s: not a Radiance HDR (RGBE) file", path);
+    }
+    rl_status st = rl_texture_check_size(path, w, h);
+    if (st != RL_OK) {
+        fclose(f);
+        return st;
+    }
+    float *data = stbi_loadf_from_file(f, &w, &h, &comp, 4);
+    fclose(f);
+    if (!data)
+        return rl_error(RL_ERR_PARSE, "%s: cannot decode image: %s", path, stbi_failure_reason());
+    rl_texture *tex = NULL;
+    if ((st = texture_alloc(w, h, path, &tex)) != RL_OK) {
+        stbi_image_free(data);
+        return st;
+    }
+    for (size_t i = 0; i < (size_t)w * h; ++i)
+        tex->texels[i] = rl_v4(data[4 * i], data[4 * i + 1], data[4 * i + 2], 1.0f);
+    stbi_image_free(data);
+    *out = tex;
+    return RL_OK;
+}
+
+rl_status rl_texture_load_linear(const char *path, rl_texture **out)
+{
+    if (!path || !out)
+        return rl_error(RL_ERR_INVALID_ARG, "rl_texture_load_linear: path or out is NULL");
+    if (rl_path_has_ext(path, ".hdr"))
+        return load_hdr(path, out);
+    if (!rl_path_has_ext(path, ".exr"))
+        return rl_texture_load(path, out);
+    long long w = 0, h = 0;
+    rl_status st = rl_image_exr_size(path, &w, &h);
+    if (st == RL_OK)
+        st = rl_texture_check_size(path, w, h);   /* before the pixels are decoded */
+    rl_image *img = NULL;
+    if (st != RL_OK || (st = rl_image_read_exr(path, &img)) != RL_OK)
+        return st;
+    rl_texture *tex = NULL;
+    if ((st = texture_alloc(img->width, img->height, path, &tex)) == RL_OK) {
+        memcpy(tex->texels, img->color, (size_t)img->width * (size_t)img->height * sizeof *tex->texels);
+        *out = tex;
+    }
+    rl_image_release(img);
+    return st;
 }

@@ -232,6 +232,11 @@ static rl_status bdpt_render(rl_renderer *r, void *state, const rl_scene *scene,
     const rl_scene_data *d = rl_scene_get_data(scene);
     if (!d)
         return RL_ERR_NOT_COMMITTED;
+    /* Light subpaths would have to start on it too (an infinite emitter):
+     * not done yet, and ignoring it would give a wrong image. */
+    if (d->environment)
+        return rl_error(RL_ERR_UNSUPPORTED, "bdpt: scene \"%s\" has an environment, which bdpt does not "
+                        "sample yet (pt does)", rl_scene_name(scene));
     rl_timer total;
     rl_timer_start(&total);
     int threads = (int)rl_renderer_opt_int(r, "threads");

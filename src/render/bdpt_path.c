@@ -28,7 +28,10 @@
  * Materials as pt (pathtrace_path.c): at a vertex the event is mirror with
  * k_r, refraction with k_t, else the Phong BRDF; the BRDF part of the
  * scattering function is (1 - k_r - k_t) f_Phong, and its sampling density
- * carries the same factor, so a Phong bounce keeps pt's weight.
+ * carries the same factor, so a Phong bounce keeps pt's weight. The BRDF
+ * is pt's (Phong or GGX, pathtrace_ggx.c; both reciprocal, so light
+ * subpaths use it unchanged) and so is the specular event with Schlick's
+ * Fresnel. A scene environment map is pt's alone: bdpt refuses it.
  *
  * Emitters, as pt's light table (pathtrace_lights.c): a quad light whose
  * emissive mesh covers it ("hittable") emits its radiance colour *
@@ -267,7 +270,7 @@ static rl_vec3 bsdf_f(const pt_surface *s, rl_vec3 wi)
     float k = brdf_share(s);
     if (!(k > 0.0f) || rl_dot(s->ns, wi) <= 0.0f || rl_dot(s->ng, wi) <= 0.0f)
         return rl_v3s(0.0f);
-    return rl_scale(rl_pt_phong_eval(s, wi), k);
+    return rl_scale(rl_pt_bsdf_eval(s, wi), k);
 }
 
 /* Solid-angle density of sampling wi at s (event and lobe). */
@@ -276,7 +279,7 @@ static float bsdf_pdf(const pt_surface *s, rl_vec3 wi)
     float k = brdf_share(s);
     if (!(k > 0.0f) || rl_dot(s->ng, wi) <= 0.0f)
         return 0.0f;
-    return k * rl_pt_phong_pdf(s, wi);
+    return k * rl_pt_bsdf_pdf(s, wi);
 }
 
 /* The factor that turns the BRDF into its adjoint with shading normals
@@ -388,21 +391,19 @@ static int walk(const bd_ctx *ctx, rl_rng *rng, rl_ray ray, rl_vec3 beta, float 
         float u0 = rl_rng_float(rng), u1 = rl_rng_float(rng), u2 = rl_rng_float(rng);
         rl_vec3 dir;
         if (u_event < k_r + k_t) {
-            rl_vec3 d = rl_neg(s->v);
-            dir = rl_reflect(d, s->ns);
-            if (u_event >= k_r) {
-                float ior = s->m->ior >= 1.0f ? s->m->ior : 1.0f;
-                rl_vec3 t;
-                if (rl_refract(d, s->ns, s->front ? 1.0f / ior : ior, &t))
-                    dir = rl_normalize(t);
-            }
+            /* pt's event, Schlick's Fresnel included: F is the same from
+             * either end of the path, so light subpaths may use it too. */
+            rl_vec3 w;
+            bool refracted;
+            rl_pt_specular_event(s, u_event, &dir, &w, &refracted);
+            beta = rl_mul(beta, w);
             v->delta = true;
             delta_dir = true;
             pdf_dir = 1.0f;
             prev->pdf_rev = 1.0f;
         } else {
             rl_vec3 w;
-            if (!rl_pt_phong_sample(s, u0, u1, u2, &dir, &w))
+            if (!rl_pt_bsdf_sample(s, u0, u1, u2, &dir, &w))
                 break;
             if (importance)
                 w = rl_scale(w, adjoint_factor(s, dir));

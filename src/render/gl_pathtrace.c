@@ -300,6 +300,22 @@ static uint32_t *seed_states(int rng, uint64_t seed, size_t n)
     return st;
 }
 
+/* Issue 37's materials and environment live in pt's C code only: refuse
+ * them by name rather than render them as Phong on black. */
+static rl_status gl_pt_check_scene(const rl_scene *scene, const rl_scene_data *d)
+{
+    if (d->environment)
+        return rl_error(RL_ERR_UNSUPPORTED, "gl-pt: scene \"%s\" has an environment, not ported to GL yet (use pt)",
+                        rl_scene_name(scene));
+    for (uint32_t i = 0; i < d->num_materials; ++i) {
+        const rl_material *m = &d->materials[i];
+        if (m->bsdf != RL_BSDF_PHONG || m->fresnel != RL_FRESNEL_NONE)
+            return rl_error(RL_ERR_UNSUPPORTED, "gl-pt: material '%s' uses %s, not ported to GL yet (use pt)", m->name,
+                            m->bsdf != RL_BSDF_PHONG ? "GGX" : "Schlick Fresnel");
+    }
+    return RL_OK;
+}
+
 static rl_status gl_pt_render(rl_renderer *r, void *state, const rl_scene *scene, const rl_camera *cam,
                               rl_image *image, rl_render_stats *stats)
 {
@@ -307,6 +323,9 @@ static rl_status gl_pt_render(rl_renderer *r, void *state, const rl_scene *scene
     const rl_scene_data *d = rl_scene_get_data(scene);
     if (!d)
         return RL_ERR_NOT_COMMITTED;
+    rl_status refused = gl_pt_check_scene(scene, d);
+    if (refused != RL_OK)
+        return refused;
     const int threads = (int)rl_renderer_opt_int(r, "threads");
     /* What pt prepares for the GPU's estimator: offsets, covers, light
      * table (the GPU builds its own structures). */

@@ -134,6 +134,7 @@
 /* Order: sobol, then rl_rng_gpu_kind. */
 static const char *const rng_choices[] = { "sobol", "lcg", "tausworthe", "hybrid", NULL };
 static const char *const mis_choices[] = { "off", "on", NULL };
+static const char *const env_sampling_choices[] = { "importance", "uniform", "bsdf", NULL };
 /* Order = rl_pt_backend. */
 static const char *const shadow_choices[] = { "bvh", "grid", "embree", "ls-candidates", "ls-preillum", "ls-pnmt",
                                               "shadowmap", NULL };
@@ -206,7 +207,12 @@ static const rl_option_info pt_options[] = {
     { "shadowmap_size", RL_OPT_INT, "1024", "texels per shadow-map face side (Sec. 8.6)", 16, 16384, NULL },
     { "light_samples", RL_OPT_INT, "1", "shadow rays per quad light and vertex", 1, 1024, NULL },
     { "background", RL_OPT_COLOR, "0,0,0",
-      "radiance arriving from every direction where a ray leaves the scene (a uniform environment)", 0, 0, NULL },
+      "radiance arriving from every direction where a ray leaves the scene (a uniform environment); a scene "
+      "\"environment\" replaces it", 0, 0, NULL },
+    { "env_sampling", RL_OPT_ENUM, "importance",
+      "light samples of a scene environment (issue 37): importance (by its radiance x sin(theta)), uniform "
+      "(over the sphere) or bsdf (none: escaping BSDF rays only); MIS with the BSDF either way", 0, 0,
+      env_sampling_choices },
     { "threads", RL_OPT_INT, "0", "OpenMP threads (0 = all)", 0, 1024, NULL },
 };
 #define NUM_OPTIONS (sizeof pt_options / sizeof pt_options[0])
@@ -341,6 +347,7 @@ static void read_settings(const rl_renderer *r, pt_settings *set)
     set->shadowmap_size = (int)rl_renderer_opt_int(r, "shadowmap_size");
     set->light_samples = (int)rl_renderer_opt_int(r, "light_samples");
     set->background = rl_renderer_opt_color(r, "background");
+    set->env_sampling = (int)rl_renderer_opt_enum(r, "env_sampling");
     int threads = (int)rl_renderer_opt_int(r, "threads");
 #ifdef _OPENMP
     set->threads = threads > 0 ? threads : omp_get_max_threads();
@@ -515,8 +522,13 @@ static void path_tile(const frame *f, int64_t t, uint32_t pass, pt_counters *c)
                 continue;
             size_t i = (size_t)y * f->width + x;
             pt_surface first;
-            rl_vec3 L = f->ctx.background;   /* a camera ray that leaves the scene */
-            if (first_vertex(f, i, &first)) {
+            rl_vec3 L;
+            if (!first_vertex(f, i, &first)) {
+                /* a camera ray that leaves the scene */
+                L = f->ctx.env ? rl_pt_escape_radiance(&f->ctx, rl_camera_frame_ray(&f->cam, (float)x + 0.5f,
+                                                                                   (float)y + 0.5f).d)
+                               : f->ctx.background;
+            } else {
                 pt_sampler sp;
                 pixel_sampler(f, i, pass, &sp);
                 L = rl_pt_trace_path(&f->ctx, &first, &sp, c);
@@ -673,6 +685,10 @@ static rl_status prepare_frame(rl_renderer *r, pt_state *s, const rl_scene *scen
     rl_status st = rl_pt_backends_prepare(&s->b, scene, set, set->threads, &built_ms);
     if (st != RL_OK)
         return st;
+    const rl_scene_data *d = s->b.data;
+    bool uniform = set->env_sampling == PT_ENV_UNIFORM;
+    if (d->environment && s->b.env.uniform != uniform && (st = rl_pt_env_build(&s->b.env, d->environment, uniform)))
+        return st;
     ps->time_build_ms = built_ms;
     if (!rl_renderer_progress(r, BUILD_SHARE))
         return cancelled(s);
@@ -756,11 +772,13 @@ static rl_vec3 pixel_sample(const frame *f, int x, int y, uint32_t index, pt_cou
     pt_sampler sp;
     pt_surface first;
     bool seen;
+    rl_vec3 dir = rl_v3s(0.0f);   /* of the camera ray, for the environment */
     if (f->set->primary == PT_PRIMARY_TRACE) {
         rl_pt_sampler_init(&sp, rng, seed, index);
         rl_pt_sampler_seek(&sp, PT_SLOT_PIXEL);
         rl_vec2 j = rl_pt_sample_2d(&sp);
         rl_ray ray = rl_camera_frame_ray(&f->cam, (float)x + j.x, (float)y + j.y);
+        dir = ray.d;
         rl_hit hit = { INFINITY, 0.0f, 0.0f, RL_ID_NONE, RL_ID_NONE };
         c->rays[RL_RAY_PRIMARY]++;
         c->trace_q[RL_PT_BACKEND_BVH]++;
@@ -768,9 +786,11 @@ static rl_vec3 pixel_sample(const frame *f, int x, int y, uint32_t index, pt_cou
         seen = rl_pt_surface_at_hit(f->ctx.data, &hit, f->eye, ray.d, &first);
     } else {
         seen = first_vertex(f, i, &first);
+        if (!seen && f->ctx.env)
+            dir = rl_camera_frame_ray(&f->cam, (float)x + 0.5f, (float)y + 0.5f).d;
     }
     if (!seen)
-        return f->ctx.background;
+        return rl_pt_escape_radiance(&f->ctx, dir);
     rl_pt_sampler_init(&sp, rng, seed, index);
     return rl_pt_trace_path(&f->ctx, &first, &sp, c);
 }
@@ -1085,7 +1105,7 @@ static rl_status pt_render(rl_renderer *r, void *state, const rl_scene *scene, c
                  .tri_lights = set.mis && exact_backend(set.diffuse) && set.shadow != RL_PT_BACKEND_SHADOWMAP,
                  .vertex_slots = PT_SLOTS_VERTEX + PT_SLOTS_LIGHT * (uint32_t)set.light_samples *
                                                    (set.mis ? 1u : (d->num_lights ? d->num_lights : 1u)),
-                 .background = set.background },
+                 .background = set.background, .env = d->environment },
         .cam = rl_camera_frame_make(cam),
         .eye = cam->eye,
         .width = cam->width,
@@ -1094,6 +1114,12 @@ static rl_status pt_render(rl_renderer *r, void *state, const rl_scene *scene, c
         .tiles_x = (area.x1 - area.x0 + TILE - 1) / TILE,
         .parity = s->frames & 1u,
     };
+    if (d->environment) {
+        /* The environment's sample takes one slot after the lights' (pathtrace_path.c). */
+        f.ctx.env_nee = s->b.env.sampled && set.env_sampling != PT_ENV_BSDF && set.shadow != RL_PT_BACKEND_SHADOWMAP;
+        f.ctx.env_slot = f.ctx.vertex_slots;
+        f.ctx.vertex_slots += 1u;
+    }
     pt_counters sum;
     uint64_t traced = 0, samples = 0;
     if (set.adaptive) {

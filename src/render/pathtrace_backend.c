@@ -240,6 +240,7 @@ void rl_pt_backends_release(pt_backends *b)
     rl_shadowmap_release(b->sm);
     free(b->tri_cover);
     rl_pt_lights_release(&b->lights);
+    rl_pt_env_release(&b->env);
     memset(b, 0, sizeof *b);
 }
 
@@ -302,7 +303,8 @@ rl_status rl_pt_backends_prepare_scene(pt_backends *b, const rl_scene *scene)
         b->scene_uid = uid;
         b->data = d;
         b->eps = EPS_SCALE * scene_scale(d->bounds);
-        if ((st = build_cover(b, d)) != RL_OK || (st = rl_pt_lights_build(b, d)) != RL_OK) {
+        if ((st = build_cover(b, d)) != RL_OK || (st = rl_pt_lights_build(b, d)) != RL_OK ||
+            (st = rl_pt_env_build(&b->env, d->environment, false)) != RL_OK) {
             rl_pt_backends_release(b);    /* the next frame starts over */
             return st;
         }

@@ -9,6 +9,8 @@
  *                      shader for the Line Space (Sec. 7.4)
  * pathtrace_bsdf.c     importance sampling of the modified Phong BRDF
  *                      (Sec. 6.4.3; Lafortune & Willems 1994)
+ * pathtrace_ggx.c      the GGX microfacet BRDF with visible-normal sampling
+ *                      and Schlick's Fresnel on specular events (issue 37)
  * pathtrace_lights.c   the lights chosen by power for next-event estimation
  *                      with MIS (Veach 1997): scene lights and emissive
  *                      triangles, their pdfs
@@ -54,7 +56,10 @@ typedef struct pt_settings {
     int grid_res, ls_n, ls_k, shadowmap_size;
     const char *ls_file;           /* Line Space cache file; "" none (valid for one frame) */
     rl_vec3 background;            /* environment radiance of escaping rays */
+    int env_sampling;              /* pt_env_sampling: light samples of a scene environment */
 } pt_settings;
+
+typedef enum pt_env_sampling { PT_ENV_IMPORTANCE = 0, PT_ENV_UNIFORM, PT_ENV_BSDF } pt_env_sampling;
 
 /* ------------------------------------------------------------ backends -- */
 
@@ -70,6 +75,18 @@ typedef struct pt_lights {
     rl_vec3 centre;                /* bounding sphere of the scene (directional lights) */
     float radius;
 } pt_lights;
+
+/* The scene environment's sampling distribution (pathtrace_env.c). */
+typedef struct pt_env {
+    const rl_environment *env;     /* NULL: the scene has none */
+    int width, height;             /* the grid of texels */
+    float *weight;                 /* per texel: mean radiance * sin(theta) */
+    float *conditional;            /* per row: width + 1 running sums, last 1 */
+    float *marginal;               /* height + 1 running sums over the rows */
+    double sum;                    /* of the weights */
+    bool sampled;                  /* some weight > 0: light samples go to it */
+    bool uniform;                  /* weights sin(theta) alone (env_sampling=uniform) */
+} pt_env;
 
 /* Everything built for one scene, kept between frames (Sec. 5.1: "built
  * once and reused; only a new scene rebuilds them"). */
@@ -93,6 +110,7 @@ typedef struct pt_backends {
     double sm_ms;
     uint32_t *tri_cover;           /* per triangle: covering quad light or RL_NONE */
     pt_lights lights;
+    pt_env env;
     float eps;                     /* ray origin offset */
 } pt_backends;
 
@@ -109,6 +127,15 @@ rl_status rl_pt_backends_prepare_scene(pt_backends *b, const rl_scene *scene);
 /* Builds b->lights from the scene and b->tri_cover. */
 rl_status rl_pt_lights_build(pt_backends *b, const rl_scene_data *d);
 void rl_pt_lights_release(pt_lights *l);
+/* Builds e for env (NULL: none), by its radiance or, with uniform, by
+ * solid angle alone; RL_ERR_OUT_OF_MEMORY. */
+rl_status rl_pt_env_build(pt_env *e, const rl_environment *env, bool uniform);
+void rl_pt_env_release(pt_env *e);
+/* A direction drawn from the environment's distribution and its density in
+ * solid angle; false when the environment is black or the draw hit a pole. */
+bool rl_pt_env_sample(const pt_env *e, float u1, float u2, rl_vec3 *dir, float *pdf);
+/* That density for unit dir (0 without a sampled environment). */
+float rl_pt_env_pdf(const pt_env *e, rl_vec3 dir);
 /* The entry of the light table whose cdf interval holds u in [0,1). */
 uint32_t rl_pt_lights_pick(const pt_lights *l, float u);
 /* Triangle t's area, and its unit geometric normal by its winding. */
@@ -145,7 +172,18 @@ typedef struct pt_ctx {
                                     * (not with shadow maps, which know scene lights only) */
     uint32_t vertex_slots;         /* sampler slots per path vertex */
     rl_vec3 background;            /* radiance of rays that leave the scene */
+    /* The scene's environment replaces background: BSDF rays that leave
+     * the scene see it, and with env_nee every BRDF vertex also samples it
+     * (one 2D sample at slot env_slot of its block), weighted against the
+     * BSDF by the power heuristic. */
+    const rl_environment *env;     /* NULL: background */
+    bool env_nee;                  /* an environment to sample and a shadow ray that can test it */
+    uint32_t env_slot;
 } pt_ctx;
+
+/* The radiance a ray leaving the scene along unit dir brings: the scene's
+ * environment or the background. */
+rl_vec3 rl_pt_escape_radiance(const pt_ctx *ctx, rl_vec3 dir);
 
 /* ------------------------------------------------------------ sampler -- */
 
@@ -230,5 +268,34 @@ rl_vec3 rl_pt_phong_eval(const pt_surface *s, rl_vec3 wi);
 bool rl_pt_phong_sample(const pt_surface *s, float u_lobe, float u1, float u2, rl_vec3 *wi, rl_vec3 *weight);
 /* The mixture pdf of rl_pt_phong_sample in solid angle (for tests). */
 float rl_pt_phong_pdf(const pt_surface *s, rl_vec3 wi);
+
+/* The Cook-Torrance GGX BRDF of bsdf = ggx materials (pathtrace_ggx.c),
+ * with the same contract as the Phong functions above. */
+rl_vec3 rl_pt_ggx_eval(const pt_surface *s, rl_vec3 wi);
+bool rl_pt_ggx_sample(const pt_surface *s, float u_lobe, float u1, float u2, rl_vec3 *wi, rl_vec3 *weight);
+float rl_pt_ggx_pdf(const pt_surface *s, rl_vec3 wi);
+/* Its parts, for the tests: alpha = max(roughness^2, 1e-3); the GGX normal
+ * distribution D at a microfacet normal with cosine cos_m; Smith G1 and the
+ * height-correlated G2; a visible normal (Heitz 2018) for the local view wo
+ * (z = the normal). */
+float rl_pt_ggx_alpha(float roughness);
+float rl_pt_ggx_d(float alpha, float cos_m);
+float rl_pt_ggx_g1(float alpha, float cos_w);
+float rl_pt_ggx_g2(float alpha, float cos_i, float cos_o);
+rl_vec3 rl_pt_ggx_sample_vndf(rl_vec3 wo, float alpha, float u1, float u2);
+
+/* The material's BRDF, Phong or GGX by rl_material.bsdf: what pt and bdpt
+ * call at a non-specular event. */
+rl_vec3 rl_pt_bsdf_eval(const pt_surface *s, rl_vec3 wi);
+bool rl_pt_bsdf_sample(const pt_surface *s, float u_lobe, float u1, float u2, rl_vec3 *wi, rl_vec3 *weight);
+float rl_pt_bsdf_pdf(const pt_surface *s, rl_vec3 wi);
+/* Whether sampling m's BRDF uses the lobe number (more than one lobe). */
+bool rl_pt_bsdf_needs_lobe(const rl_material *m);
+/* The specular event chosen by u_event < k_r + k_t: the mirror (k_r) or
+ * the refraction (k_t; total internal reflection mirrors), with Schlick's
+ * Fresnel when the material asks for it (the mirror's weight becomes F
+ * with F0 = k_s; within k_t, reflection with probability F). *weight
+ * multiplies the throughput; *refracted tells the ray type. */
+void rl_pt_specular_event(const pt_surface *s, float u_event, rl_vec3 *dir, rl_vec3 *weight, bool *refracted);
 
 #endif

@@ -43,6 +43,13 @@
  * emissive triangles included, and weights each light sample and each BSDF
  * ray that hits an emitter by the power heuristic (Veach 1997).
  *
+ * A scene environment (issue 37) replaces the background: escaping rays
+ * see its radiance, and every BRDF vertex also samples it by its
+ * importance (pathtrace_env.c), both weighted by the power heuristic,
+ * whatever the mis option says (the environment is new, no thesis image
+ * depends on it). Its sample takes one more slot at the end of a vertex's
+ * block, only in scenes that have an environment.
+ *
  * Random numbers come from the pixel's sampler only (pathtrace_sampler.c),
  * in an order, or at slots, that do not depend on which shadow rays are
  * traced, so exact backends give the same image. */
@@ -249,7 +256,7 @@ static rl_vec3 direct_light(const pt_ctx *ctx, const pt_surface *s, pt_sampler *
                 float cos_e = -rl_dot(nq, l), cos_r = rl_dot(s->ns, l);
                 if (cos_e <= 0.0f || cos_r <= 0.0f || !visible(ctx, s, l, dist, i, j.x, j.y, c))
                     continue;
-                rl_vec3 f = rl_pt_phong_eval(s, l);
+                rl_vec3 f = rl_pt_bsdf_eval(s, l);
                 sum = rl_add(sum, rl_mul(f, rl_scale(le, cos_e * cos_r / d2)));   /* eq. 7 */
             }
             continue;
@@ -263,7 +270,7 @@ static rl_vec3 direct_light(const pt_ctx *ctx, const pt_surface *s, pt_sampler *
         float cos_r = rl_dot(s->ns, l);
         if (cos_r <= 0.0f || !visible(ctx, s, l, dist, i, j.x, j.y, c))
             continue;
-        sum = rl_add(sum, rl_mul(rl_pt_phong_eval(s, l), rl_scale(E, cos_r)));
+        sum = rl_add(sum, rl_mul(rl_pt_bsdf_eval(s, l), rl_scale(E, cos_r)));
     }
     return sum;
 }
@@ -280,11 +287,11 @@ static float power_heuristic(float a, float b)
 }
 
 /* The pdf, in solid angle at s, with which the BSDF strategy produces wi:
- * the Phong mixture, zero below the geometric surface where
- * rl_pt_phong_sample refuses directions. */
+ * the Phong or GGX mixture, zero below the geometric surface where
+ * rl_pt_bsdf_sample refuses directions. */
 static float bsdf_pdf(const pt_surface *s, rl_vec3 wi)
 {
-    return rl_dot(s->ng, wi) > 0.0f ? rl_pt_phong_pdf(s, wi) : 0.0f;
+    return rl_dot(s->ng, wi) > 0.0f ? rl_pt_bsdf_pdf(s, wi) : 0.0f;
 }
 
 /* Next-event estimation with mis=on: light_samples lights chosen by power
@@ -325,7 +332,7 @@ static rl_vec3 direct_light_mis(const pt_ctx *ctx, const pt_surface *s, pt_sampl
                 float cos_r = rl_dot(s->ns, l);
                 if (cos_r <= 0.0f || !visible(ctx, s, l, dist, src, j.x, j.y, c))
                     continue;
-                sum = rl_add(sum, rl_mul(rl_pt_phong_eval(s, l), rl_scale(E, cos_r / (pmf * (float)n))));
+                sum = rl_add(sum, rl_mul(rl_pt_bsdf_eval(s, l), rl_scale(E, cos_r / (pmf * (float)n))));
                 continue;
             }
             n_e = rl_cross(L->edge_u, L->edge_v);
@@ -361,10 +368,46 @@ static rl_vec3 direct_light_mis(const pt_ctx *ctx, const pt_surface *s, pt_sampl
             continue;
         float p_light = pmf * d2 / (area * cos_e);          /* solid angle at s */
         float w = bsdf_follows && hittable ? power_heuristic((float)n * p_light, bsdf_pdf(s, l)) : 1.0f;
-        rl_vec3 f = rl_pt_phong_eval(s, l);
+        rl_vec3 f = rl_pt_bsdf_eval(s, l);
         sum = rl_add(sum, rl_mul(f, rl_scale(le, w * cos_r / (p_light * (float)n))));
     }
     return sum;
+}
+
+/* Next-event estimation of the scene's environment (issue 37): one
+ * direction from its distribution (pathtrace_env.c), weighted by the power
+ * heuristic against the BSDF sample that follows, as the area lights. */
+static rl_vec3 environment_light(const pt_ctx *ctx, const pt_surface *s, pt_sampler *sp, uint32_t base,
+                                 bool bsdf_follows, pt_counters *c)
+{
+    rl_pt_sampler_seek(sp, base + ctx->env_slot);
+    rl_vec2 x = rl_pt_sample_2d(sp);
+    rl_vec3 l;
+    float p_env;
+    if (!rl_pt_env_sample(&ctx->b->env, x.x, x.y, &l, &p_env))
+        return rl_v3s(0.0f);
+    float cos_r = rl_dot(s->ns, l);
+    if (cos_r <= 0.0f || !visible(ctx, s, l, INFINITY, 0, 0.0f, 0.0f, c))
+        return rl_v3s(0.0f);
+    float w = bsdf_follows ? power_heuristic(p_env, bsdf_pdf(s, l)) : 1.0f;
+    rl_vec3 L = rl_environment_radiance(ctx->env, l);
+    return rl_mul(rl_pt_bsdf_eval(s, l), rl_scale(L, w * cos_r / p_env));
+}
+
+rl_vec3 rl_pt_escape_radiance(const pt_ctx *ctx, rl_vec3 dir)
+{
+    return ctx->env ? rl_environment_radiance(ctx->env, dir) : ctx->background;
+}
+
+/* A ray that left the scene along dir; after a BRDF bounce whose direction
+ * had density pdf_bsdf, the environment gets the BSDF strategy's weight
+ * when light samples also reach it. */
+static rl_vec3 escaped(const pt_ctx *ctx, rl_vec3 dir, bool after_brdf, float pdf_bsdf)
+{
+    rl_vec3 L = rl_pt_escape_radiance(ctx, dir);
+    if (!ctx->env || !ctx->env_nee || !after_brdf)
+        return L;
+    return rl_scale(L, power_heuristic(pdf_bsdf, rl_pt_env_pdf(&ctx->b->env, dir)));
 }
 
 /* The emission rule (see the top of the file). */
@@ -446,38 +489,32 @@ rl_vec3 rl_pt_trace_path(const pt_ctx *ctx, const pt_surface *first, pt_sampler 
         if (u_event < k_r + k_t) {
             if (depth >= ctx->max_depth)
                 break;
-            rl_vec3 d = rl_neg(s.v);
-            type = RL_RAY_REFLECTION;
-            dir = rl_reflect(d, s.ns);
-            if (u_event >= k_r) {
-                /* Entering when the geometric normal faced the ray, as
-                 * trace.c; total internal reflection mirrors instead. */
-                float ior = s.m->ior >= 1.0f ? s.m->ior : 1.0f;
-                rl_vec3 t;
-                if (rl_refract(d, s.ns, s.front ? 1.0f / ior : ior, &t)) {
-                    dir = rl_normalize(t);
-                    type = RL_RAY_REFRACTION;
-                }
-            }
+            rl_vec3 w;
+            bool refracted;
+            rl_pt_specular_event(&s, u_event, &dir, &w, &refracted);
+            T = rl_mul(T, w);
+            type = refracted ? RL_RAY_REFRACTION : RL_RAY_REFLECTION;
             after_brdf = false;
         } else {
             bool last = depth >= ctx->max_depth;
             rl_vec3 direct = ctx->mis ? direct_light_mis(ctx, &s, sp, base, !last, c)
                                       : direct_light(ctx, &s, sp, base, c);
             radiance = rl_add(radiance, rl_mul(T, direct));
+            if (ctx->env_nee)
+                radiance = rl_add(radiance, rl_mul(T, environment_light(ctx, &s, sp, base, !last, c)));
             if (last)
                 break;
             rl_pt_sampler_seek(sp, base + PT_SLOT_LOBE);
-            float u0 = sp->rng || rl_vmax_comp(s.m->specular) > 0.0f ? rl_pt_sample_1d(sp) : 0.0f;
+            float u0 = sp->rng || rl_pt_bsdf_needs_lobe(s.m) ? rl_pt_sample_1d(sp) : 0.0f;
             rl_pt_sampler_seek(sp, base + PT_SLOT_BSDF);
             rl_vec2 u12 = rl_pt_sample_2d(sp);
             rl_vec3 w;
-            if (!rl_pt_phong_sample(&s, u0, u12.x, u12.y, &dir, &w))
+            if (!rl_pt_bsdf_sample(&s, u0, u12.x, u12.y, &dir, &w))
                 break;
             T = rl_mul(T, w);
             type = RL_RAY_DIFFUSE;
             after_brdf = true;
-            prev_pdf = ctx->mis ? rl_pt_phong_pdf(&s, dir) : 0.0f;
+            prev_pdf = ctx->mis || ctx->env_nee ? rl_pt_bsdf_pdf(&s, dir) : 0.0f;
         }
         prev = s.p;
 
@@ -506,13 +543,13 @@ rl_vec3 rl_pt_trace_path(const pt_ctx *ctx, const pt_surface *first, pt_sampler 
                 radiance = rl_add(radiance, rl_mul(T, col));
                 c->preillum_ends++;
             } else {
-                radiance = rl_add(radiance, rl_mul(T, ctx->background));
+                radiance = rl_add(radiance, rl_mul(T, escaped(ctx, dir, after_brdf, prev_pdf)));
             }
             break;
         }
         pt_surface next;
         if (!rl_pt_closest(ctx, backend, &ray, &next, c)) {
-            radiance = rl_add(radiance, rl_mul(T, ctx->background));
+            radiance = rl_add(radiance, rl_mul(T, escaped(ctx, dir, after_brdf, prev_pdf)));
             break;
         }
         s = next;

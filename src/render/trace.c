@@ -286,11 +286,23 @@ static rl_vec3 shade_surface(rl_trace_ctx *ctx, const rl_trace_surface *s, rl_ve
     return color;
 }
 
-static rl_vec3 miss(const rl_tracer *tr, rl_trace_layer *layer)
+/* What a ray along dir that leaves the scene sees: the scene's environment
+ * (issue 37; pt samples it as a light, here it is only seen in mirrors,
+ * through glass and past the objects) or the background option. */
+static rl_vec3 escape(const rl_tracer *tr, rl_vec3 dir)
 {
+    const rl_environment *env = tr->data->environment;
+    if (!env || !(rl_length2(dir) > 0.0f) || !rl_vfinite(dir))
+        return tr->background;
+    return rl_environment_radiance(env, rl_normalize(dir));
+}
+
+static rl_vec3 miss(const rl_tracer *tr, rl_vec3 dir, rl_trace_layer *layer)
+{
+    rl_vec3 bg = escape(tr, dir);
     if (layer)
-        *layer = (rl_trace_layer){ rl_v3s(0.0f), tr->background, RL_NONE, rl_v2(0.0f, 0.0f) };
-    return tr->background;
+        *layer = (rl_trace_layer){ rl_v3s(0.0f), bg, RL_NONE, rl_v2(0.0f, 0.0f) };
+    return bg;
 }
 
 /* Radiance leaving the surface at hit back along ray. */
@@ -300,7 +312,7 @@ static rl_vec3 shade_hit(rl_trace_ctx *ctx, const rl_ray *ray, const rl_hit *hit
     rl_vec3 d = rl_normalize(ray->d);
     rl_trace_surface s;
     if (!surface_at(ctx->tracer, hit, d, &s))
-        return miss(ctx->tracer, layer);
+        return miss(ctx->tracer, d, layer);
     return shade_surface(ctx, &s, d, depth, weight, layer);
 }
 
@@ -311,7 +323,7 @@ rl_vec3 rl_trace_ray(rl_trace_ctx *ctx, rl_ray ray, rl_ray_type type, int depth,
     uint32_t node = rl_trace_tree_push(ctx, type, depth, RL_ID_NONE, RL_ID_NONE);
     rl_hit hit = { INFINITY, 0.0f, 0.0f, RL_ID_NONE, RL_ID_NONE };
     if (!rl_accel_intersect(ctx->tracer->accel, &ray, &hit))
-        return miss(ctx->tracer, layer);
+        return miss(ctx->tracer, ray.d, layer);
     if (node != RL_ID_NONE)
         ctx->tree->nodes[node].object = hit.object;
     return shade_hit(ctx, &ray, &hit, depth, weight, layer);
@@ -359,7 +371,7 @@ void rl_tracer_trace(const rl_tracer *tracer, const rl_ray *ray, rl_ray_type typ
     rl_ray r = *ray;
     rl_hit hit = out->hit;
     if (!rl_accel_intersect(tracer->accel, &r, &hit)) {
-        out->color = tracer->background;
+        out->color = escape(tracer, r.d);
         return;
     }
     if (node != RL_ID_NONE)

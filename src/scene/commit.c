@@ -279,6 +279,7 @@ rl_status rl_scene_commit(rl_scene *scene)
     d->cameras = scene->cameras;
     d->camera_names = (const char *const *)scene->camera_names;
     d->camera_path = scene->camera_path;
+    d->environment = scene->has_environment ? &scene->environment : NULL;
     scene->committed = true;
     return RL_OK;
 }

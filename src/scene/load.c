@@ -35,6 +35,7 @@ static bool is_regular_file(const char *path)
  * printed by `rl scenes`. */
 static const char *const camera_choices[] = { "file", "off", NULL };
 static const char *const light_choices[] = { "file", "off", "add", NULL };
+static const char *const material_choices[] = { "phong", "ggx", NULL };
 static const rl_option_info model_options[] = {
     { "cameras", RL_OPT_ENUM, "file",
       "file: the file's cameras, the first one the default view; off: none (the model is framed "
@@ -49,6 +50,9 @@ static const rl_option_info model_options[] = {
       -360, 360, NULL },
     { "elevation", RL_OPT_FLOAT, "20", "orbit of the framing camera: degrees above the xz plane",
       -89, 89, NULL },
+    { "materials", RL_OPT_ENUM, "phong",
+      "glTF metallic-roughness materials: phong (mapped onto the Phong model, all renderers) or ggx "
+      "(pt's microfacet BRDF with the file's values, issue 37)", 0, 0, material_choices },
 };
 #define NUM_MODEL_OPTIONS (sizeof model_options / sizeof model_options[0])
 
@@ -209,6 +213,7 @@ static rl_status load_mesh_file(const char *path, const char *params, rl_scene *
     rl_scene_import_desc desc = {
         .no_cameras = rl_option_store_enum(&opts, "cameras") == 1,
         .no_lights = lights == 1,
+        .ggx_materials = rl_option_store_enum(&opts, "materials") == 1,
     };
     bool headlight = rl_option_store_bool(&opts, "headlight");
     float azimuth = (float)rl_option_store_float(&opts, "azimuth");

@@ -142,6 +142,7 @@ typedef struct material_ctx {
     const struct aiScene *ai;
     uint32_t *embedded;         /* scene texture id per aiTexture, RL_NONE until used */
     import_notes notes;
+    bool ggx;                   /* rl_scene_import_desc.ggx_materials */
 } material_ctx;
 
 static float luminance(rl_vec3 c) { return 0.2126f * c.x + 0.7152f * c.y + 0.0722f * c.z; }
@@ -158,9 +159,18 @@ static float luminance(rl_vec3 c) { return 0.2126f * c.x + 0.7152f * c.y + 0.072
  * - reflectivity: a metal smoother than roughness 0.2 reflects as a
  *   mirror; its lobe would be narrower than a pixel at common sizes, which
  *   the Phong highlight cannot show. Our choice, since Phong has no
- *   microfacet lobe; pt's microfacet BRDF (issue 37) will replace it. */
+ *   microfacet lobe. */
 static void map_metal_roughness(rl_material *m, rl_vec3 base, float metallic, float roughness)
 {
+    /* ... unless the loader asks for the microfacet BRDF, which takes the
+     * glTF values as they are (materials=ggx; off by default so that
+     * imported models render as before). */
+    if (m->bsdf == RL_BSDF_GGX) {
+        m->diffuse = base;
+        m->metallic = metallic;
+        m->roughness = roughness;
+        return;
+    }
     m->diffuse = rl_scale(base, 1.0f - metallic);
     m->specular = rl_add(rl_scale(rl_v3s(0.04f), 1.0f - metallic), rl_scale(base, metallic));
     float alpha = rl_maxf(roughness * roughness, 1e-3f);
@@ -344,6 +354,8 @@ static rl_status add_material(material_ctx *c, const struct aiMaterial *mat, uin
     bool has_roughness = get_float(mat, AI_MATKEY_ROUGHNESS_FACTOR, &roughness);
     bool pbr = get_color(mat, AI_MATKEY_BASE_COLOR, &base) && (has_metallic || has_roughness);
     if (pbr) {
+        if (c->ggx)
+            m.bsdf = RL_BSDF_GGX;
         map_metal_roughness(&m, base, rl_clampf(metallic, 0.0f, 1.0f),
                             rl_clampf(roughness, 0.0f, 1.0f));
     } else {
@@ -777,7 +789,7 @@ static rl_status build(rl_scene *scene, const char *path, const struct aiScene *
     rl_status st = material_ids && mesh_ids && embedded ? RL_OK : RL_ERR_OUT_OF_MEMORY;
     for (unsigned i = 0; st == RL_OK && i < ai->mNumTextures; ++i)
         embedded[i] = RL_NONE;
-    material_ctx mc = { scene, path, model_dir, ai, embedded, { 0 } };
+    material_ctx mc = { scene, path, model_dir, ai, embedded, { 0 }, desc->ggx_materials };
     for (unsigned i = 0; st == RL_OK && i < ai->mNumMaterials; ++i)
         st = add_material(&mc, ai->mMaterials[i], &material_ids[i]);
     /* The scene counts what add_mesh drops; the import reports it once. */

@@ -56,7 +56,48 @@ static rl_status find_material(const rl_jscene_ctx *c, const cJSON *item, uint32
 
 static const char *const material_keys[] = { "base", "diffuse", "specular", "shininess",
                                              "reflectivity", "transmissivity", "ior",
-                                             "emission", "texture", NULL };
+                                             "emission", "texture", "bsdf", "roughness",
+                                             "metallic", "fresnel", NULL };
+
+/* One of names[] at key (absent: *out untouched). */
+static rl_status read_choice(rl_jscene_ctx *c, const cJSON *obj, const char *key, const char *const *names,
+                             const char *expected, int *out)
+{
+    const char *text = NULL;
+    rl_status st = rl_jscene_string(c, obj, key, &text);
+    if (st != RL_OK || !text)
+        return st;
+    for (int i = 0; names[i]; ++i)
+        if (strcmp(text, names[i]) == 0) {
+            *out = i;
+            return RL_OK;
+        }
+    return rl_json_error(c->doc, rl_jscene_member(obj, key), "\"%s\" must be one of: %s", key, expected);
+}
+
+/* The physically based fields (issue 37). roughness and metallic only mean
+ * something to the GGX BRDF: on a Phong material they would be silently
+ * ignored, so they are an error there. */
+static rl_status read_material_pbr(rl_jscene_ctx *c, const cJSON *obj, rl_material *m)
+{
+    static const char *const bsdf_names[] = { "phong", "ggx", NULL };
+    static const char *const fresnel_names[] = { "none", "schlick", NULL };
+    int bsdf = (int)m->bsdf, fresnel = (int)m->fresnel;
+    rl_status st;
+    if ((st = read_choice(c, obj, "bsdf", bsdf_names, "phong, ggx", &bsdf)) != RL_OK ||
+        (st = read_choice(c, obj, "fresnel", fresnel_names, "none, schlick", &fresnel)) != RL_OK ||
+        (st = rl_jscene_float(c, obj, "roughness", 0.0, 1.0, &m->roughness)) != RL_OK ||
+        (st = rl_jscene_float(c, obj, "metallic", 0.0, 1.0, &m->metallic)) != RL_OK)
+        return st;
+    m->bsdf = (rl_material_bsdf)bsdf;
+    m->fresnel = (rl_fresnel_mode)fresnel;
+    const char *pbr_key = rl_jscene_member(obj, "roughness") ? "roughness"
+                          : rl_jscene_member(obj, "metallic") ? "metallic" : NULL;
+    if (pbr_key && m->bsdf != RL_BSDF_GGX)
+        return rl_json_error(c->doc, rl_jscene_member(obj, pbr_key),
+                             "\"%s\" needs \"bsdf\": \"ggx\" (the Phong BRDF has no %s)", pbr_key, pbr_key);
+    return RL_OK;
+}
 
 /* Reads a material object over the defaults (or over "base"). */
 static rl_status read_material(rl_jscene_ctx *c, const cJSON *obj, const char *name,
@@ -80,7 +121,8 @@ static rl_status read_material(rl_jscene_ctx *c, const cJSON *obj, const char *n
         (st = rl_jscene_float(c, obj, "shininess", 0.0, INFINITY, &m.shininess)) != RL_OK ||
         (st = rl_jscene_float(c, obj, "reflectivity", 0.0, 1.0, &m.reflectivity)) != RL_OK ||
         (st = rl_jscene_float(c, obj, "transmissivity", 0.0, 1.0, &m.transmissivity)) != RL_OK ||
-        (st = rl_jscene_float(c, obj, "ior", 1.0, INFINITY, &m.ior)) != RL_OK)
+        (st = rl_jscene_float(c, obj, "ior", 1.0, INFINITY, &m.ior)) != RL_OK ||
+        (st = read_material_pbr(c, obj, &m)) != RL_OK)
         return st;
     /* Ullmann 2003, eq. 3.1: k_r + k_t > 1 would create energy. */
     if (m.reflectivity + m.transmissivity > 1.0f)
@@ -470,10 +512,30 @@ static rl_status create_scene(rl_jscene_ctx *c, const cJSON *root, rl_scene **ou
     return st;
 }
 
+/* ---- environment -------------------------------------------------------- */
+
+static rl_status read_environment(rl_jscene_ctx *c, const cJSON *obj)
+{
+    static const char *const keys[] = { "file", "color", "intensity", "rotation_deg", NULL };
+    rl_status st = rl_jscene_check_object(c, obj, "\"environment\"", keys);
+    if (st != RL_OK)
+        return st;
+    rl_environment_desc desc = { .color = rl_v3s(1.0f), .intensity = 1.0f };
+    if ((st = rl_jscene_string(c, obj, "file", &desc.path)) != RL_OK ||
+        (st = rl_jscene_color(c, obj, "color", &desc.color)) != RL_OK ||
+        (st = rl_jscene_float(c, obj, "intensity", 0.0, INFINITY, &desc.intensity)) != RL_OK ||
+        (st = rl_jscene_float(c, obj, "rotation_deg", -INFINITY, INFINITY, &desc.rotation_deg)) != RL_OK)
+        return st;
+    if (desc.intensity == 0.0f)
+        desc.color = rl_v3s(0.0f);    /* the desc's 0 means 1 */
+    st = rl_scene_set_environment(c->scene, &desc);
+    return rl_jscene_located(c, desc.path ? rl_jscene_member(obj, "file") : obj, st);
+}
+
 static rl_status load(rl_jscene_ctx *c, const cJSON *root)
 {
     static const char *const keys[] = { "name", "base", "params", "materials", "lights",
-                                        "cameras", "camera_path", "objects", NULL };
+                                        "cameras", "camera_path", "objects", "environment", NULL };
     rl_status st = rl_jscene_check_object(c, root, "the scene", keys);
     if (st != RL_OK)
         return st;
@@ -488,6 +550,8 @@ static rl_status load(rl_jscene_ctx *c, const cJSON *root)
         return st;
 
     const cJSON *item;
+    if ((item = rl_jscene_member(root, "environment")) && (st = read_environment(c, item)) != RL_OK)
+        return st;
     if ((item = rl_jscene_member(root, "materials")) && (st = read_materials(c, item)) != RL_OK)
         return st;
     /* Cameras before objects, so that the file's own cameras come first

@@ -49,7 +49,32 @@ rl_status rl_material_validate(const rl_material *m)
                         (double)(m->reflectivity + m->transmissivity));
     if (!isfinite(m->ior) || m->ior < 1.0f)
         return rl_error(RL_ERR_INVALID_ARG, "material \"%s\": ior %g < 1", n, (double)m->ior);
+    if ((unsigned)m->bsdf >= RL_BSDF_COUNT || (unsigned)m->fresnel >= RL_FRESNEL_COUNT)
+        return rl_error(RL_ERR_INVALID_ARG, "material \"%s\": unknown bsdf (%d) or fresnel (%d)", n,
+                        (int)m->bsdf, (int)m->fresnel);
+    if (!coefficient_ok(m->roughness) || !coefficient_ok(m->metallic))
+        return rl_error(RL_ERR_INVALID_ARG, "material \"%s\": roughness and metallic must be in [0,1]", n);
     return RL_OK;
+}
+
+float rl_fresnel_schlick(float cos_i, float eta)
+{
+    if (!(eta > 0.0f))
+        return 1.0f;
+    float c = rl_clampf(cos_i, 0.0f, 1.0f);
+    if (eta < 1.0f) {
+        /* From the denser side Schlick's formula needs the angle on the
+         * rarer side, which makes F the same for both directions through
+         * the interface (Fresnel reflectance is reciprocal). */
+        float sin2_t = (1.0f - c * c) / (eta * eta);
+        if (sin2_t >= 1.0f)
+            return 1.0f;      /* total internal reflection */
+        c = sqrtf(1.0f - sin2_t);
+    }
+    float r0 = (eta - 1.0f) / (eta + 1.0f);
+    r0 *= r0;
+    float k = 1.0f - c, k2 = k * k;
+    return r0 + (1.0f - r0) * k2 * k2 * k;
 }
 
 rl_status rl_scene_add_material(rl_scene *scene, const rl_material *m, uint32_t *id)

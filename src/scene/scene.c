@@ -102,6 +102,7 @@ void rl_scene_release(rl_scene *scene)
     free(scene->cameras);
     free(scene->camera_names);
     rl_camera_path_release(scene->camera_path);
+    rl_texture_release((rl_texture *)scene->environment.map);
     rl_scene_free_flat(scene);
     free(scene->name);
     free(scene->base_dir);

@@ -41,6 +41,8 @@ struct rl_scene {
     rl_light *lights;     uint32_t num_lights, cap_lights;
     rl_camera *cameras;   char **camera_names; uint32_t num_cameras, cap_cameras;
     rl_camera_path *camera_path;
+    bool has_environment;
+    rl_environment environment;   /* its map owned (environment.c) */
 
     uint64_t dropped_degenerate, dropped_nonfinite;
     /* Set by an import, which reports drops once per file instead of once

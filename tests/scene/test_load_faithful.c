@@ -241,6 +241,16 @@ static void test_gltf_metal_roughness_maps_onto_phong(void **state)
     /* alpha = 0.01: n = 2 / 1e-4 - 2, clamped to 1e4. */
     assert_true(m->shininess == 1e4f);
     assert_true(m->reflectivity > 0.0f && m->reflectivity < 1.0f);
+    assert_true(m->bsdf == RL_BSDF_PHONG);
+    rl_scene_release(s);
+
+    /* materials=ggx (issue 37): the file's values for pt's microfacet BRDF. */
+    s = load(path, "materials=ggx");
+    m = first_material(s);
+    assert_true(m->bsdf == RL_BSDF_GGX);
+    assert_true(fabsf(m->diffuse.x - 0.9f) < 1e-4f && fabsf(m->diffuse.y - 0.6f) < 1e-4f);
+    assert_true(m->metallic == 1.0f && fabsf(m->roughness - 0.1f) < 1e-6f);
+    assert_true(m->reflectivity == 0.0f);
     rl_scene_release(s);
 }
 

@@ -378,6 +378,118 @@ static void test_scene_load_picks_json_mesh_file_or_builtin(void **state)
     assert_null(s);
 }
 
+/* Issue 37: the physically based material fields and the environment. */
+static void test_pbr_materials_load_and_are_checked(void **state)
+{
+    (void)state;
+    rl_scene *s = NULL;
+    assert_int_equal(load_text("pbr.json",
+                               "{\"materials\": {\"gold\": {\"diffuse\": [1, 0.8, 0.3], \"bsdf\": \"ggx\", "
+                               "\"roughness\": 0.3, \"metallic\": 1},\n"
+                               " \"glass\": {\"transmissivity\": 1, \"fresnel\": \"schlick\"}},\n"
+                               " \"objects\": [{\"generator\": \"box\", \"material\": \"gold\"},\n"
+                               "  {\"generator\": \"sphere\", \"material\": \"glass\"}]}",
+                               &s),
+                     RL_OK);
+    const rl_scene_data *d = rl_scene_get_data(s);
+    uint32_t gold = rl_scene_find_material(s, "gold"), glass = rl_scene_find_material(s, "glass");
+    assert_true(d->materials[gold].bsdf == RL_BSDF_GGX && near(d->materials[gold].roughness, 0.3f) &&
+                near(d->materials[gold].metallic, 1.0f) && d->materials[gold].fresnel == RL_FRESNEL_NONE);
+    assert_true(d->materials[glass].bsdf == RL_BSDF_PHONG && d->materials[glass].fresnel == RL_FRESNEL_SCHLICK);
+    assert_null(d->environment);
+    rl_scene_release(s);
+    /* Defaults are the Phong model without Fresnel: older scenes unchanged. */
+    rl_material m = rl_material_default();
+    assert_true(m.bsdf == RL_BSDF_PHONG && m.fresnel == RL_FRESNEL_NONE && m.roughness == 0.0f);
+    m.roughness = 1.5f;
+    assert_int_equal(rl_material_validate(&m), RL_ERR_INVALID_ARG);
+
+    expect_error("pbr1.json", "{\"materials\": {\"m\": {\"roughness\": 0.5}}, \"objects\": [{\"generator\": \"box\"}]}",
+                 RL_ERR_PARSE, "needs \"bsdf\": \"ggx\"");
+    expect_error("pbr2.json", "{\"materials\": {\"m\": {\"bsdf\": \"cook\"}}, \"objects\": [{\"generator\": \"box\"}]}",
+                 RL_ERR_PARSE, "one of: phong, ggx");
+    expect_error("pbr3.json",
+                 "{\"materials\": {\"m\": {\"bsdf\": \"ggx\", \"metallic\": 2}}, \"objects\": [{\"generator\": \"box\"}]}",
+                 RL_ERR_PARSE, "pbr3.json:1:");
+    expect_error("pbr4.json", "{\"materials\": {\"m\": {\"fresnel\": \"exact\"}}, \"objects\": [{\"generator\": \"box\"}]}",
+                 RL_ERR_PARSE, "one of: none, schlick");
+}
+
+static void write_exr(const char *name, int w, int h, rl_vec4 (*texel)(int x, int y))
+{
+    rl_image *img = NULL;
+    assert_int_equal(rl_image_create(w, h, RL_LAYER_COLOR, &img), RL_OK);
+    for (int y = 0; y < h; ++y)
+        for (int x = 0; x < w; ++x)
+            img->color[(size_t)y * w + x] = texel(x, y);
+    char path[1200];
+    snprintf(path, sizeof path, "%s/%s", dir, name);
+    assert_int_equal(rl_image_write_exr(img, path), RL_OK);
+    rl_image_release(img);
+}
+
+/* Bright top row, dark rest; column x adds x / 8 to red. */
+static rl_vec4 sky_texel(int x, int y)
+{
+    return y == 0 ? rl_v4(4.0f + 0.125f * (float)x, 4.0f, 4.0f, 1.0f) : rl_v4(0.5f, 0.25f, 0.125f, 1.0f);
+}
+
+static void test_environment_loads_and_bad_maps_are_refused(void **state)
+{
+    (void)state;
+    rl_scene *s = NULL;
+    assert_int_equal(load_text("envc.json",
+                               "{\"environment\": {\"color\": [0.5, 0.25, 1], \"intensity\": 2},"
+                               " \"objects\": [{\"generator\": \"box\"}]}", &s),
+                     RL_OK);
+    const rl_scene_data *d = rl_scene_get_data(s);
+    assert_non_null(d->environment);
+    rl_vec3 L = rl_environment_radiance(d->environment, rl_v3(0.3f, 0.8f, -0.52f));
+    assert_true(near(L.x, 1.0f) && near(L.y, 0.5f) && near(L.z, 2.0f));
+    rl_scene_release(s);
+
+    write_exr("sky.exr", 8, 4, sky_texel);
+    assert_int_equal(load_text("envm.json",
+                               "{\"environment\": {\"file\": \"sky.exr\", \"intensity\": 0.5},"
+                               " \"objects\": [{\"generator\": \"box\"}]}", &s),
+                     RL_OK);
+    d = rl_scene_get_data(s);
+    const rl_environment *env = d->environment;
+    assert_non_null(env->map);
+    L = rl_environment_radiance(env, rl_v3(0.0f, 1.0f, 0.0f));          /* straight up: row 0 */
+    assert_true(near(L.y, 2.0f));
+    L = rl_environment_radiance(env, rl_v3(0.0f, -1.0f, 0.0f));
+    assert_true(near(L.x, 0.25f) && near(L.z, 0.0625f));
+    /* The parametrisation goes both ways. */
+    for (int i = 0; i < 16; ++i) {
+        float u = ((float)i + 0.5f) / 16.0f, v = ((float)(i % 5) + 0.5f) / 5.0f;
+        rl_vec2 uv = rl_environment_uv(env, rl_environment_direction(env, u, v));
+        assert_float_equal(uv.x, u, 1e-4f);
+        assert_float_equal(uv.y, v, 1e-4f);
+    }
+    rl_scene_release(s);
+
+    /* Not 2:1 is taken (with a warning); every column still spans 360 degrees. */
+    write_exr("square.exr", 4, 4, sky_texel);
+    assert_int_equal(load_text("envq.json", "{\"environment\": {\"file\": \"square.exr\"},"
+                                            " \"objects\": [{\"generator\": \"box\"}]}", &s),
+                     RL_OK);
+    rl_scene_release(s);
+
+    expect_error("envx.json", "{\"environment\": {\"file\": \"none.exr\"}, \"objects\": [{\"generator\": \"box\"}]}",
+                 RL_ERR_IO, "none.exr");
+    expect_error("envk.json", "{\"environment\": {\"map\": \"sky.exr\"}, \"objects\": [{\"generator\": \"box\"}]}",
+                 RL_ERR_PARSE, "envk.json:1:");
+    write_file("notexr.exr", "this is not an EXR file at all");
+    expect_error("envp.json", "{\"environment\": {\"file\": \"notexr.exr\"}, \"objects\": [{\"generator\": \"box\"}]}",
+                 RL_ERR_PARSE, "notexr.exr");
+    /* A map larger than the texture limit is refused from its header. */
+    rl_texture_set_max_pixels(16);
+    expect_error("envl.json", "{\"environment\": {\"file\": \"sky.exr\"}, \"objects\": [{\"generator\": \"box\"}]}",
+                 RL_ERR_LIMIT, "sky.exr");
+    rl_texture_set_max_pixels(0);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -392,6 +504,8 @@ int main(void)
         cmocka_unit_test(test_scene_without_geometry_is_empty),
         cmocka_unit_test(test_missing_asset_files_are_io_errors_at_their_key),
         cmocka_unit_test(test_scene_load_picks_json_mesh_file_or_builtin),
+        cmocka_unit_test(test_pbr_materials_load_and_are_checked),
+        cmocka_unit_test(test_environment_loads_and_bad_maps_are_refused),
     };
     return cmocka_run_group_tests(tests, setup, NULL);
 }
