@@ -1,8 +1,9 @@
 /* test_chcpp.c: CHC++ (renderer "chcpp") is conservative: on walks through
  * a box city built here, where no two surfaces are coplanar, every frame
- * equals "raster" in colour, depth and IDs, pixel for pixel; and it culls:
- * at street level it draws a fraction of the triangles; its overlay shows
- * the visible and occluded nodes. */
+ * equals "raster" in colour, depth and IDs, pixel for pixel, also with
+ * query latency simulated (answers a frame later, the V-queue); and it
+ * culls: at street level it draws a fraction of the triangles; its overlay
+ * shows the visible and occluded nodes. */
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
@@ -23,9 +24,37 @@ static rl_camera street_camera(float t)
     return c;
 }
 
-static void check_walk(const rl_scene *s, const char *const *opts, const char *const *raster_opts, int frames,
-                       uint64_t seed, bool street)
+/* The latency figures of a walk, summed over its frames. */
+typedef struct latency_sums {
+    uint64_t queries, ready, waited, carried, carried_in, filled;
+    uint32_t max_carried;
+} latency_sums;
+
+/* Every frame's answers add up: each query issued or carried in is read
+ * (found ready or waited for) or carried on, and what a frame carries the
+ * next one takes over. */
+static void add_latency(latency_sums *w, const rl_renderer *chc, uint64_t *carried)
 {
+    rl_culling_stats cs;
+    assert_int_equal(rl_culling_get_stats(chc, &cs), RL_OK);
+    assert_int_equal(cs.queries_carried_in, *carried);
+    assert_int_equal(cs.queries + cs.queries_carried_in, cs.queries_ready + cs.queries_waited + cs.queries_carried);
+    *carried = cs.queries_carried;
+    w->queries += cs.queries;
+    w->ready += cs.queries_ready;
+    w->waited += cs.queries_waited;
+    w->carried += cs.queries_carried;
+    w->carried_in += cs.queries_carried_in;
+    w->filled += cs.queries_filled;
+    if (cs.queries_carried > w->max_carried)
+        w->max_carried = (uint32_t)cs.queries_carried;
+}
+
+static latency_sums check_walk(const rl_scene *s, const char *const *opts, const char *const *raster_opts,
+                               int frames, uint64_t seed, bool street)
+{
+    latency_sums w = { 0 };
+    uint64_t carried = 0;
     rl_renderer *chc = fx_make("chcpp", opts);
     rl_rng rng;
     rl_rng_seed(&rng, seed, 3);
@@ -50,18 +79,92 @@ static void check_walk(const rl_scene *s, const char *const *opts, const char *c
         rl_image *img = fx_render_with(chc, s, &cam, FX_ALL_LAYERS, &b);
         fx_assert_images_identical(ref, img);
         assert_true(b.triangles_rasterized <= a.triangles_rasterized);
+        add_latency(&w, chc, &carried);
         rl_image_release(ref);
         rl_image_release(img);
     }
     rl_renderer_release(chc);
+    return w;
 }
 
+/* The 26 frames: 16 of a random walk, 10 down a street. */
+static latency_sums check_walks(const rl_scene *s, const char *const *opts)
+{
+    latency_sums a = check_walk(s, opts, NULL, 16, 11, false), b = check_walk(s, opts, NULL, 10, 0, true);
+    a.queries += b.queries;
+    a.ready += b.ready;
+    a.waited += b.waited;
+    a.carried += b.carried;
+    a.carried_in += b.carried_in;
+    a.filled += b.filled;
+    a.max_carried = a.max_carried > b.max_carried ? a.max_carried : b.max_carried;
+    return a;
+}
+
+/* The software drawer answers at the issue: nothing is waited for or
+ * carried, and the V-queue never fills a wait (it is issued at the end of
+ * each frame). */
 static void test_chcpp_equals_raster_on_random_walks(void **state)
 {
     (void)state;
     rl_scene *s = fx_box_city();
-    check_walk(s, NULL, NULL, 16, 11, false);
-    check_walk(s, NULL, NULL, 10, 0, true);
+    latency_sums w = check_walks(s, NULL);
+    assert_true(w.queries > 0);
+    assert_int_equal(w.ready, w.queries);
+    assert_int_equal(w.waited + w.carried + w.filled, 0);
+    rl_scene_release(s);
+}
+
+static void print_latency(const char *what, latency_sums w)
+{
+    print_message("%-30s %5llu queries, %5llu found ready, %4llu waited for, %4llu carried (at most %u), %4llu "
+                  "filled a wait\n", what, (unsigned long long)w.queries, (unsigned long long)w.ready,
+                  (unsigned long long)w.waited, (unsigned long long)w.carried, w.max_carried,
+                  (unsigned long long)w.filled);
+}
+
+/* Latency hiding (Mattausch et al. 2008, Sec. 4.1) on the 26 frames, with
+ * the drawer's latency simulated (query_delay: the first n polls after a
+ * query's issue find no answer): the V-queue's queries fill the waits for
+ * the I-queue's answers, previously visible nodes' answers not there at a
+ * frame's end are carried into the next one (latency=frame), and every
+ * frame still equals raster's. With latency=wait nothing is carried; CHC's
+ * order (vqueue=false) neither carries nor fills. An answer that never
+ * comes in a poll (query_delay huge) is waited for where the frame needs
+ * it and otherwise carried on, never piling up beyond one per node. */
+static void test_chcpp_latency_hiding_stays_conservative(void **state)
+{
+    (void)state;
+    rl_scene *s = fx_box_city();
+    latency_sums frame = check_walks(s, (const char *const[]){ "query_delay", "4", NULL });
+    print_latency("query_delay 4, latency=frame", frame);
+    assert_true(frame.filled > 0);
+    assert_true(frame.carried > 0);
+    assert_true(frame.carried_in > 0);
+    assert_true(frame.ready > 0 && frame.waited > 0);
+
+    latency_sums wait = check_walks(s, (const char *const[]){ "query_delay", "4", "latency", "wait", NULL });
+    print_latency("query_delay 4, latency=wait", wait);
+    assert_true(wait.filled > 0 && wait.waited > 0);
+    assert_int_equal(wait.carried + wait.carried_in, 0);
+
+    latency_sums chc = check_walks(s, (const char *const[]){ "query_delay", "4", "vqueue", "false", "latency",
+                                                             "wait", NULL });
+    print_latency("query_delay 4, CHC order, wait", chc);
+    assert_int_equal(chc.carried + chc.filled, 0);
+
+    rl_renderer *probe = fx_make("chcpp", NULL);
+    rl_camera cam = street_camera(0.0f);
+    rl_image *img = fx_render_with(probe, s, &cam, RL_LAYER_COLOR, NULL);
+    rl_culling_stats cs;
+    assert_int_equal(rl_culling_get_stats(probe, &cs), RL_OK);
+    rl_image_release(img);
+    rl_renderer_release(probe);
+    latency_sums never = check_walk(s, (const char *const[]){ "query_delay", "1000000", NULL }, NULL, 8, 0, true);
+    print_latency("query_delay 1000000", never);
+    assert_int_equal(never.ready, 0);
+    assert_true(never.carried > 0);
+    assert_true(never.max_carried <= cs.octree_nodes);
     rl_scene_release(s);
 }
 
@@ -255,6 +358,8 @@ static void test_chcpp_refuses_bad_options(void **state)
     assert_int_equal(rl_renderer_set(r, "looseness", "0.5"), RL_ERR_INVALID_ARG);
     assert_int_equal(rl_renderer_set(r, "batch", "0"), RL_ERR_INVALID_ARG);
     assert_int_equal(rl_renderer_set(r, "assumed_visible", "-1"), RL_ERR_INVALID_ARG);
+    assert_int_equal(rl_renderer_set(r, "latency", "never"), RL_ERR_INVALID_ARG);
+    assert_int_equal(rl_renderer_set(r, "query_delay", "-1"), RL_ERR_INVALID_ARG);
     rl_culling_stats cs;
     assert_int_equal(rl_culling_get_stats(r, &cs), RL_ERR_INVALID_ARG);   /* nothing rendered */
     rl_renderer *raster = fx_make("raster", NULL);
@@ -267,6 +372,7 @@ int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_chcpp_equals_raster_on_random_walks),
+        cmocka_unit_test(test_chcpp_latency_hiding_stays_conservative),
         cmocka_unit_test(test_chcpp_variants_stay_conservative),
         cmocka_unit_test(test_chcpp_is_conservative_for_viewers_at_a_wall),
         cmocka_unit_test(test_chcpp_culls_at_street_level),
