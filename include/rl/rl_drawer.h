@@ -63,12 +63,12 @@ typedef struct rl_drawer_desc {   /* zero = default */
                                    * so those must outlive the frame: a GPU
                                    * backend then never waits for a draw */
     uint32_t query_delay;         /* simulated query latency: the first
-                                   * query_delay polls (of any query) after
-                                   * a query's issue say its answer is not
-                                   * there; 0 = as the backend has it. For
-                                   * tests and measurements of latency
-                                   * hiding on a backend that answers at
-                                   * once (result still answers) */
+                                   * query_delay polls of each query say
+                                   * its answer is not there; 0 = as the
+                                   * backend has it. For tests and
+                                   * measurements of latency hiding on a
+                                   * backend that answers at once (result
+                                   * still answers) */
 } rl_drawer_desc;
 
 typedef struct rl_drawer rl_drawer;

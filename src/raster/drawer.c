@@ -23,10 +23,8 @@ struct rl_drawer {
     uint8_t *open;
     uint32_t *free_slots;
     uint32_t num_slots, num_free, cap_slots;
-    /* desc.query_delay: the polls so far (the latency's clock) and per slot
-     * the count of polls up to which its answer is not there. */
-    uint64_t polls;
-    uint64_t *ready_at;
+    /* desc.query_delay: per slot, the polls left that find no answer. */
+    uint32_t *late;
 };
 
 enum { SLOT_FREE, SLOT_OPEN, SLOT_KEPT };
@@ -53,7 +51,7 @@ void rl_drawer_release(rl_drawer *dr)
     dr->ops->release(dr->impl);
     free(dr->open);
     free(dr->free_slots);
-    free(dr->ready_at);
+    free(dr->late);
     free(dr);
 }
 
@@ -156,10 +154,10 @@ static rl_status take_slot(rl_drawer *dr, uint32_t *slot)
         if (!free_slots)
             return RL_ERR_OUT_OF_MEMORY;
         dr->free_slots = free_slots;
-        uint64_t *ready_at = realloc(dr->ready_at, cap * sizeof *ready_at);
-        if (!ready_at)
+        uint32_t *late = realloc(dr->late, cap * sizeof *late);
+        if (!late)
             return RL_ERR_OUT_OF_MEMORY;
-        dr->ready_at = ready_at;
+        dr->late = late;
         dr->cap_slots = cap;
     }
     *slot = dr->num_slots++;
@@ -192,7 +190,7 @@ rl_status rl_drawer_query_issue(rl_drawer *dr, const rl_raster_batch *boxes, uin
     if (c)
         c->triangles_in += boxes->num_triangles;
     dr->open[slot] = SLOT_OPEN;
-    dr->ready_at[slot] = dr->polls + dr->desc.query_delay;
+    dr->late[slot] = dr->desc.query_delay;
     *handle = slot;
     return RL_OK;
 }
@@ -206,7 +204,8 @@ rl_status rl_drawer_query_poll(rl_drawer *dr, uint32_t handle, bool *ready)
         st = open_slot(dr, handle, "rl_drawer_query_poll");
     if (st != RL_OK)
         return st;
-    if (dr->desc.query_delay && dr->polls++ < dr->ready_at[handle]) {
+    if (dr->late[handle] > 0) {
+        dr->late[handle]--;
         *ready = false;
         return RL_OK;
     }

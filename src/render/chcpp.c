@@ -63,7 +63,7 @@
  * depth buffer, and none is carried. With drawer=gl the queries are GL
  * query objects (GL_SAMPLES_PASSED) and the answers come when the GPU has
  * them; query_delay simulates such latency on any drawer (the first n
- * polls after a query's issue find no answer, rl_drawer_desc.query_delay).
+ * polls of each query find no answer, rl_drawer_desc.query_delay).
  *
  * Answers of previously invisible nodes are always read within their
  * frame: they decide what it draws, and drawing such a node before its
@@ -123,8 +123,8 @@ static const rl_option_info chcpp_options[] = {
       "previously visible nodes' answers not there at the frame's end: frame (read in the next frame, the "
       "node staying visible) | wait (waited for)", 0, 0, latency_choices },
     { "query_delay", RL_OPT_INT, "0",
-      "simulated query latency: the first n polls after a query's issue find no answer (0: as the drawer "
-      "has it)", 0, 1000000, NULL },
+      "simulated query latency: the first n polls of each query find no answer (0: as the drawer has it)", 0,
+      1000000, NULL },
     { "overlay", RL_OPT_ENUM, "none",
       "draw the octree nodes of the frame over the image: visible green, occluded red (nodes)", 0, 0,
       overlay_choices },
@@ -179,7 +179,7 @@ typedef struct chcpp_state {
      * not read yet, in issue order, carried into the next frame with
      * latency=frame (kept open with rl_drawer_query_keep). */
     uint32_t *vqueue;
-    uint32_t vq_n, vq_cap;
+    uint32_t vq_head, vq_n, vq_cap;
     vpending *vpend;
     uint32_t vp_head, vp_tail, vp_cap;
 } chcpp_state;
@@ -534,14 +534,14 @@ static rl_status drain(frame_ctx *f, bool block)
 static rl_status await_answer(frame_ctx *f)
 {
     chcpp_state *s = f->s;
-    if (s->vq_n == 0)
+    if (s->vq_head == s->vq_n)
         return drain(f, true);
     const uint32_t head = s->q_head;
     rl_status st = drain(f, false);
     if (st != RL_OK || s->q_head != head)
         return st;
     s->head.stats.queries_filled++;
-    return issue_visible(f, s->vqueue[--s->vq_n]);
+    return issue_visible(f, s->vqueue[s->vq_head++]);
 }
 
 /* Queries the I-queue: multi-queries grouped by the CHC++ cost model (a
@@ -597,8 +597,8 @@ static rl_status end_visible(frame_ctx *f)
 {
     chcpp_state *s = f->s;
     rl_status st = RL_OK;
-    while (st == RL_OK && s->vq_n > 0)
-        st = issue_visible(f, s->vqueue[--s->vq_n]);
+    while (st == RL_OK && s->vq_head < s->vq_n)
+        st = issue_visible(f, s->vqueue[s->vq_head++]);
     if (st == RL_OK)
         st = drain_visible(f, f->wait);
     for (uint32_t i = s->vp_head; i < s->vp_tail && st == RL_OK; ++i) {
@@ -622,7 +622,7 @@ static rl_status chcpp_frame(frame_ctx *f)
     chcpp_state *s = f->s;
     rl_culling_stats *stats = &s->head.stats;
     s->q_head = s->q_tail = s->qn_n = 0;
-    s->vq_n = 0;
+    s->vq_head = s->vq_n = 0;
     stats->queries_carried_in = s->vp_tail - s->vp_head;
     rl_status st = heap_push(s, (heap_item){ rl_cull_box_distance(f->cf.view.eye, f->nodes[0].bounds), 0 });
     while (st == RL_OK && (s->heap_n > 0 || s->iq_n > 0 || s->q_head < s->q_tail)) {
@@ -700,7 +700,7 @@ static rl_status chcpp_frame(frame_ctx *f)
     }
     s->heap_n = 0;
     s->iq_n = 0;
-    s->vq_n = 0;
+    s->vq_head = s->vq_n = 0;
     s->q_head = s->q_tail = s->qn_n = 0;
     return st;
 }

@@ -124,7 +124,7 @@ static void print_latency(const char *what, latency_sums w)
 }
 
 /* Latency hiding (Mattausch et al. 2008, Sec. 4.1) on the 26 frames, with
- * the drawer's latency simulated (query_delay: the first n polls after a
+ * the drawer's latency simulated (query_delay: the first n polls of each
  * query's issue find no answer): the V-queue's queries fill the waits for
  * the I-queue's answers, previously visible nodes' answers not there at a
  * frame's end are carried into the next one (latency=frame), and every
