@@ -49,9 +49,11 @@
  *           ready, had to wait for or carried into the next frame; chcpp
  *           twice: as CHC++ hides latency (its V-queue, answers a frame
  *           later: latency=frame, the default) and in CHC's order waiting
- *           for every answer (vqueue=false latency=wait, as before). On a
- *           GPU this is the thesis' question with real query latency; on
- *           llvmpipe (Mesa's CPU GL) there is little to hide.
+ *           for every answer (vqueue=false latency=wait, as before). The
+ *           rows' renderers take each frame in turn, so that a shared
+ *           machine's load falls on all of them alike. On a GPU this is
+ *           the thesis' question with real query latency; on llvmpipe
+ *           (Mesa's CPU GL) there is little to hide.
  * The reports of the same measurements as heat maps and violins come from
  * `rl compare` (docs/culling.md gives the commands). */
 #define _POSIX_C_SOURCE 200809L
@@ -969,56 +971,71 @@ static const walk_variant walk_variants[] = {
 };
 #define NUM_WALK_VARIANTS (sizeof walk_variants / sizeof walk_variants[0])
 
-static rl_status walk_renderer(bc_ctx *c, const walk_variant *v, bool gl, const rl_camera *start, walk_run *w)
+static rl_status make_walk_renderer(bc_ctx *c, const walk_variant *v, bool gl, rl_renderer **out)
 {
-    const char *name = v->name;
-    const int n = (int)c->a->walk_frames;
     char th[32];
     snprintf(th, sizeof th, "%lld", c->a->threads);
     rl_renderer *r = NULL;
-    rl_image *img = NULL;
-    rl_status st = rl_renderer_create(name, &r);
+    rl_status st = rl_renderer_create(v->name, &r);
     if (st == RL_OK)
         st = rl_renderer_set(r, "threads", th);
     if (st == RL_OK && gl)
         st = rl_renderer_set(r, "drawer", "gl");
     for (const char *const *o = v->opts; st == RL_OK && o && o[0]; o += 2)
         st = rl_renderer_set(r, o[0], o[1]);
-    if (st == RL_OK && strcmp(name, "svs") == 0 && c->a->quick)
+    if (st == RL_OK && strcmp(v->name, "svs") == 0 && c->a->quick)
         st = rl_renderer_set(r, "levels", "0");
-    if (st == RL_OK && strcmp(name, "svs") == 0 && c->a->quick)
+    if (st == RL_OK && strcmp(v->name, "svs") == 0 && c->a->quick)
         st = rl_renderer_set(r, "resolution", "32");
-    if (st == RL_OK)
-        st = rl_image_create((int)c->a->size, (int)c->a->size, RL_LAYER_COLOR, &img);
+    if (st != RL_OK)
+        rl_renderer_release(r);
+    *out = st == RL_OK ? r : NULL;
+    return st;
+}
+
+/* Every row's renderer on one drawer down the walk, frame by frame in
+ * turn, so that the load of a shared machine falls on all of them alike. */
+static rl_status walk_drawer(bc_ctx *c, bool gl, const rl_camera *start, walk_run *runs)
+{
+    const int n = (int)c->a->walk_frames;
+    rl_renderer *r[NUM_WALK_VARIANTS] = { NULL };
+    rl_image *img = NULL;
+    rl_status st = rl_image_create((int)c->a->size, (int)c->a->size, RL_LAYER_COLOR, &img);
+    for (size_t i = 0; i < NUM_WALK_VARIANTS && st == RL_OK; ++i)
+        st = make_walk_renderer(c, &walk_variants[i], gl, &r[i]);
     for (int k = 0; k < n && st == RL_OK; ++k) {
         rl_camera cam = walk_camera(c, start, k, n);
-        rl_render_stats rs;
-        st = rl_renderer_render(r, c->scene, &cam, img, &rs);
-        rl_culling_stats cs;
-        if (st == RL_OK)
-            st = rl_culling_get_stats(r, &cs);
-        if (st != RL_OK)
-            break;
-        if (k == 0) {
-            /* The octree, svs' sets, a GL context and the scene's buffers. */
-            w->first_ms = rs.time_ms;
-            w->prep_ms = rs.prep_ms;
-            snprintf(w->device, sizeof w->device, "%s", rs.device ? rs.device : "");
-            continue;
+        for (size_t i = 0; i < NUM_WALK_VARIANTS && st == RL_OK; ++i) {
+            walk_run *w = &runs[i];
+            rl_render_stats rs;
+            st = rl_renderer_render(r[i], c->scene, &cam, img, &rs);
+            rl_culling_stats cs;
+            if (st == RL_OK)
+                st = rl_culling_get_stats(r[i], &cs);
+            if (st != RL_OK)
+                break;
+            if (k == 0) {
+                /* The octree, svs' sets, a GL context and the scene's buffers. */
+                w->first_ms = rs.time_ms;
+                w->prep_ms = rs.prep_ms;
+                snprintf(w->device, sizeof w->device, "%s", rs.device ? rs.device : "");
+                continue;
+            }
+            w->ms[k - 1] = rs.time_ms;
+            /* The renderer's own count: the drawers count rasterized
+             * triangles differently (docs/gl.md). */
+            w->triangles += cs.triangles_drawn;
+            w->queries += cs.queries;
+            w->ready += cs.queries_ready;
+            w->waited += cs.queries_waited;
+            w->carried += cs.queries_carried;
+            w->carried_in += cs.queries_carried_in;
+            w->filled += cs.queries_filled;
         }
-        w->ms[k - 1] = rs.time_ms;
-        /* The renderer's own count: the drawers count rasterized
-         * triangles differently (docs/gl.md). */
-        w->triangles += cs.triangles_drawn;
-        w->queries += cs.queries;
-        w->ready += cs.queries_ready;
-        w->waited += cs.queries_waited;
-        w->carried += cs.queries_carried;
-        w->carried_in += cs.queries_carried_in;
-        w->filled += cs.queries_filled;
     }
     rl_image_release(img);
-    rl_renderer_release(r);
+    for (size_t i = 0; i < NUM_WALK_VARIANTS; ++i)
+        rl_renderer_release(r[i]);
     return st;
 }
 
@@ -1059,13 +1076,15 @@ static rl_status sec_walk(void *ctx, cJSON *sec)
     for (int g = 0; g < 2 && st == RL_OK; ++g) {
         if (!drawers[g])
             continue;
-        for (size_t i = 0; i < NUM_WALK_VARIANTS && st == RL_OK; ++i) {
+        walk_run runs[NUM_WALK_VARIANTS] = { { 0 } };
+        for (size_t i = 0; i < NUM_WALK_VARIANTS && st == RL_OK; ++i)
+            if (!(runs[i].ms = calloc((size_t)m, sizeof *runs[i].ms)))
+                st = RL_ERR_OUT_OF_MEMORY;
+        if (st == RL_OK)
+            st = walk_drawer(c, g == 1, &start, runs);
+        for (size_t i = 0; i < NUM_WALK_VARIANTS; ++i) {
             const walk_variant *v = &walk_variants[i];
-            walk_run w = { 0 };
-            w.ms = calloc((size_t)m, sizeof *w.ms);
-            if (!w.ms)
-                return RL_ERR_OUT_OF_MEMORY;
-            st = walk_renderer(c, v, g == 1, &start, &w);
+            walk_run w = runs[i];
             if (st == RL_OK) {
                 double sum = 0.0;
                 for (int k = 0; k < m; ++k)
