@@ -32,6 +32,14 @@ typedef struct rl_culling_stats {
                                        * (the other fields are that renderer's); 0 for the others */
     uint64_t queries_ready;           /* chcpp: answers found there when polled (all, in software) */
     uint64_t queries_waited;          /* chcpp: answers waited for, nothing else being left to do */
+    /* chcpp's latency hiding (Mattausch et al. 2008, Sec. 4.1). Answers
+     * read in the frame (queries_ready + queries_waited) include those of
+     * the queries the last frame carried in: queries + queries_carried_in
+     * = queries_ready + queries_waited + queries_carried. */
+    uint64_t queries_carried;         /* answers not read by the frame's end, left to the next frame
+                                       * (latency=frame; previously visible nodes only) */
+    uint64_t queries_carried_in;      /* the last frame's queries_carried, read here or carried on */
+    uint64_t queries_filled;          /* V-queue queries issued while an answer was awaited */
 } rl_culling_stats;
 
 /* RL_ERR_INVALID_ARG when r is not one of these renderers or has rendered

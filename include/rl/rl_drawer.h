@@ -62,6 +62,13 @@ typedef struct rl_drawer_desc {   /* zero = default */
                                    * their counters only at rl_drawer_end,
                                    * so those must outlive the frame: a GPU
                                    * backend then never waits for a draw */
+    uint32_t query_delay;         /* simulated query latency: the first
+                                   * query_delay polls of each query say
+                                   * its answer is not there; 0 = as the
+                                   * backend has it. For tests and
+                                   * measurements of latency hiding on a
+                                   * backend that answers at once (result
+                                   * still answers) */
 } rl_drawer_desc;
 
 typedef struct rl_drawer rl_drawer;
@@ -107,15 +114,22 @@ RL_API rl_status rl_drawer_query(rl_drawer *dr, const rl_raster_batch *boxes, ui
  * returns a handle at once; poll says, without waiting, whether its answer
  * is there; result waits for the answer where it is not, gives the pixels
  * and frees the handle. Handles belong to the frame: rl_drawer_end drops
- * those never read, and at most RL_DRAWER_MAX_QUERIES may be open at
- * once (RL_ERR_LIMIT beyond). The software backend answers at the issue
- * (poll is always true); the GL one runs GL query objects from a pool
- * kept across frames. rl_drawer_query is issue followed by result. */
+ * those never read unless kept (rl_drawer_query_keep), and at most
+ * RL_DRAWER_MAX_QUERIES may be open at once (RL_ERR_LIMIT beyond). The
+ * software backend answers at the issue (poll is always true, unless the
+ * desc's query_delay says otherwise); the GL one runs GL query objects from
+ * a pool kept across frames. rl_drawer_query is issue followed by result. */
 #define RL_DRAWER_MAX_QUERIES (1u << 20)
 RL_API rl_status rl_drawer_query_issue(rl_drawer *dr, const rl_raster_batch *boxes, uint32_t *handle,
                                        rl_raster_counters *c);
 RL_API rl_status rl_drawer_query_poll(rl_drawer *dr, uint32_t handle, bool *ready);
 RL_API rl_status rl_drawer_query_result(rl_drawer *dr, uint32_t handle, uint64_t *pixels);
+/* Keeps an open query past the frame's end (CHC++ reads the answers of
+ * previously visible nodes a frame later): rl_drawer_end leaves it open,
+ * and in the next frame (begun on the same drawer) poll and result read it
+ * as any other; there it is dropped at the end unless kept again. A frame
+ * begun while the last one never ended drops every open query. */
+RL_API rl_status rl_drawer_query_keep(rl_drawer *dr, uint32_t handle);
 /* Draws a triangle batch made by the caller (rl_raster.h), e.g. Vertex
  * Tracing's refined mesh with its deferred textures as layers (Ullmann
  * 2003, Sec. 3.5), into the frame beside the scene's objects, with the

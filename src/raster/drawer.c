@@ -17,12 +17,17 @@ struct rl_drawer {
     uint64_t scene_uid;
     rl_drawer_desc desc;
     bool in_frame;
-    /* The query slots: open[i] while slot i's answer is unread; free_slots
-     * a stack of the slots below num_slots that are not. */
+    /* The query slots: open[i] while slot i's answer is unread (SLOT_KEPT:
+     * and it outlives the frame's end); free_slots a stack of the slots
+     * below num_slots that are not open. */
     uint8_t *open;
     uint32_t *free_slots;
     uint32_t num_slots, num_free, cap_slots;
+    /* desc.query_delay: per slot, the polls left that find no answer. */
+    uint32_t *late;
 };
+
+enum { SLOT_FREE, SLOT_OPEN, SLOT_KEPT };
 
 rl_status rl_drawer_make(const rl_drawer_ops *ops, void *impl, const rl_scene *scene, const rl_drawer_desc *desc,
                          rl_drawer **out)
@@ -46,6 +51,7 @@ void rl_drawer_release(rl_drawer *dr)
     dr->ops->release(dr->impl);
     free(dr->open);
     free(dr->free_slots);
+    free(dr->late);
     free(dr);
 }
 
@@ -55,20 +61,26 @@ bool rl_drawer_fits(const rl_drawer *dr, const rl_scene *scene, const rl_drawer_
     const rl_drawer_desc *d = desc ? desc : &zero;
     return dr && scene && dr->scene_uid == rl_scene_uid(scene) && dr->desc.shading == d->shading &&
            dr->desc.ambient == d->ambient && dr->desc.threads == d->threads && dr->desc.flags == d->flags &&
-           dr->desc.object_mask == d->object_mask && dr->desc.deferred_counts == d->deferred_counts;
+           dr->desc.object_mask == d->object_mask && dr->desc.deferred_counts == d->deferred_counts &&
+           dr->desc.query_delay == d->query_delay;
 }
 
 const char *rl_drawer_backend(const rl_drawer *dr) { return dr ? dr->ops->name : NULL; }
 
-/* Every slot free again: the stack lists them downwards, so that the next
- * frame takes slot 0 first. */
-static void drop_queries(rl_drawer *dr)
+/* Every slot free again but the kept ones, which stay open for the next
+ * frame (once: kept again, they outlive that one too). The stack lists the
+ * free ones downwards, so that the next frame takes slot 0 first. */
+static void drop_queries(rl_drawer *dr, bool keep)
 {
-    for (uint32_t i = 0; i < dr->num_slots; ++i) {
-        dr->open[i] = 0;
-        dr->free_slots[i] = dr->num_slots - 1 - i;
+    dr->num_free = 0;
+    for (uint32_t i = dr->num_slots; i-- > 0;) {
+        if (keep && dr->open[i] == SLOT_KEPT) {
+            dr->open[i] = SLOT_OPEN;
+            continue;
+        }
+        dr->open[i] = SLOT_FREE;
+        dr->free_slots[dr->num_free++] = i;
     }
-    dr->num_free = dr->num_slots;
 }
 
 rl_status rl_drawer_begin(rl_drawer *dr, rl_image *target, const rl_mat4 *view, const rl_mat4 *proj,
@@ -78,7 +90,8 @@ rl_status rl_drawer_begin(rl_drawer *dr, rl_image *target, const rl_mat4 *view, 
         return rl_error(RL_ERR_INVALID_ARG, "rl_drawer_begin: NULL argument");
     if (!(target->layers & RL_LAYER_DEPTH) || !target->depth)
         return rl_error(RL_ERR_INVALID_ARG, "rl_drawer_begin: the target has no depth layer");
-    drop_queries(dr);   /* a frame that failed never ended */
+    if (dr->in_frame)
+        drop_queries(dr, false);   /* a frame that failed never ended */
     rl_status st = dr->ops->begin(dr->impl, target, view, proj, eye);
     dr->in_frame = st == RL_OK;
     return st;
@@ -141,6 +154,10 @@ static rl_status take_slot(rl_drawer *dr, uint32_t *slot)
         if (!free_slots)
             return RL_ERR_OUT_OF_MEMORY;
         dr->free_slots = free_slots;
+        uint32_t *late = realloc(dr->late, cap * sizeof *late);
+        if (!late)
+            return RL_ERR_OUT_OF_MEMORY;
+        dr->late = late;
         dr->cap_slots = cap;
     }
     *slot = dr->num_slots++;
@@ -149,7 +166,7 @@ static rl_status take_slot(rl_drawer *dr, uint32_t *slot)
 
 static rl_status open_slot(const rl_drawer *dr, uint32_t handle, const char *fn)
 {
-    if (handle < dr->num_slots && dr->open[handle])
+    if (handle < dr->num_slots && dr->open[handle] != SLOT_FREE)
         return RL_OK;
     return rl_error(RL_ERR_INVALID_ARG, "%s: query %u is not open in this frame", fn, handle);
 }
@@ -172,7 +189,8 @@ rl_status rl_drawer_query_issue(rl_drawer *dr, const rl_raster_batch *boxes, uin
     }
     if (c)
         c->triangles_in += boxes->num_triangles;
-    dr->open[slot] = 1;
+    dr->open[slot] = SLOT_OPEN;
+    dr->late[slot] = dr->desc.query_delay;
     *handle = slot;
     return RL_OK;
 }
@@ -184,7 +202,14 @@ rl_status rl_drawer_query_poll(rl_drawer *dr, uint32_t handle, bool *ready)
         st = rl_error(RL_ERR_INVALID_ARG, "rl_drawer_query_poll: NULL argument");
     if (st == RL_OK)
         st = open_slot(dr, handle, "rl_drawer_query_poll");
-    return st == RL_OK ? dr->ops->query_poll(dr->impl, handle, ready) : st;
+    if (st != RL_OK)
+        return st;
+    if (dr->late[handle] > 0) {
+        dr->late[handle]--;
+        *ready = false;
+        return RL_OK;
+    }
+    return dr->ops->query_poll(dr->impl, handle, ready);
 }
 
 rl_status rl_drawer_query_result(rl_drawer *dr, uint32_t handle, uint64_t *pixels)
@@ -199,8 +224,18 @@ rl_status rl_drawer_query_result(rl_drawer *dr, uint32_t handle, uint64_t *pixel
     *pixels = 0;
     st = dr->ops->query_result(dr->impl, handle, pixels);
     /* Read or failed, the slot is free again: a failed frame ends anyway. */
-    dr->open[handle] = 0;
+    dr->open[handle] = SLOT_FREE;
     dr->free_slots[dr->num_free++] = handle;
+    return st;
+}
+
+rl_status rl_drawer_query_keep(rl_drawer *dr, uint32_t handle)
+{
+    rl_status st = in_frame(dr, "rl_drawer_query_keep");
+    if (st == RL_OK)
+        st = open_slot(dr, handle, "rl_drawer_query_keep");
+    if (st == RL_OK)
+        dr->open[handle] = SLOT_KEPT;
     return st;
 }
 
@@ -237,7 +272,7 @@ rl_status rl_drawer_end(rl_drawer *dr)
     if (st != RL_OK)
         return st;
     dr->in_frame = false;
-    drop_queries(dr);
+    drop_queries(dr, true);
     return dr->ops->end(dr->impl);
 }
 

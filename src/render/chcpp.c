@@ -29,35 +29,59 @@
  * wherever no two surfaces fight for the same depth (coplanar overlaps are
  * resolved by drawing order, here front to back, there by object index).
  *
- * Latency (CHC++'s main loop): queries are issued without waiting
- * (rl_drawer_query_issue) into a query queue. While there is something to
- * draw, the answers at the queue's front are taken only when they are
- * there (a non-blocking poll), and otherwise the next node of the distance
- * queue is drawn; the traversal waits for an answer only when the distance
- * queue and the I-queue are empty. A previously visible node is drawn
- * without waiting for its own query; a failed multi-query's nodes are
- * queried again one by one, as CHC++ does. rl_culling_stats counts the
- * answers found ready and those waited for. With the software drawer (the
- * default, drawer=software) every answer is there at its issue and is
- * taken at once, so the frame is exactly the synchronous CHC order: each
- * query is resolved before the next is issued. With drawer=gl the queries
- * are GL query objects (GL_SAMPLES_PASSED) and the answers come when the
- * GPU has them. Every query is evaluated against the depth buffer as it
- * is when it is issued, so culling stays conservative in any order.
+ * Latency (CHC++'s main loop, Sec. 3-4.1): queries are issued without
+ * waiting (rl_drawer_query_issue). Those of the I-queue go into the query
+ * queue: while there is something to draw, the answers at its front are
+ * taken only when they are there (a non-blocking poll), and otherwise the
+ * next node of the distance queue is drawn; when the distance queue and
+ * the I-queue are empty, the traversal needs an answer, and while it is
+ * not there a query of the V-queue is issued to fill the wait; only with
+ * the V-queue empty does it wait. The V-queue (option vqueue) gathers the
+ * queries of previously visible nodes, which are drawn at once without
+ * their answers (those decide only the next frame's classification); what
+ * is left of it is issued at the frame's end. Their answers are taken as
+ * they come; those not there at the frame's end are, with latency=frame
+ * (the default), kept open into the next frame (rl_drawer_query_keep) and
+ * taken there, the node staying visible meanwhile, or, with latency=wait,
+ * waited for. An answer a frame late for a node the next frame has not
+ * reached yet says "invisible": the node then goes to the I-queue, so its
+ * objects are queried in that frame before they are drawn. With vqueue
+ * false such a query is issued just before its node's objects are drawn,
+ * as in CHC. A failed multi-query's nodes are queried again one by one,
+ * as CHC++ does. rl_culling_stats counts the answers found ready, waited
+ * for and carried, and the V-queue's queries that filled a wait.
  *
- * Deviations: answers are read within their frame (CHC++ may carry them
- * into the next); the queries of previously visible nodes are issued just
- * before the node's objects are drawn, as in the original CHC (which keeps
- * a node's own geometry from hiding its box), not gathered into CHC++'s
- * V-queue to fill waiting time. Batching of the I-queue keeps its purpose:
- * later queries see more occluders, and multi-queries save query fill.
+ * Conservative in any order: every I-queue query is answered within its
+ * frame, against the depth buffer as it is at its issue (a subset of the
+ * frame's final occluders), and only those answers keep objects from
+ * being drawn; a previously visible node is drawn whatever its answer,
+ * early or late. With the software drawer (the default, drawer=software)
+ * every answer is there at its issue, so the first frame (all queries in
+ * the I-queue) is exactly the synchronous CHC order: each query is
+ * resolved before the next is issued; the V-queue's queries, never needed
+ * to fill a wait, are all issued at the frame's end, against its final
+ * depth buffer, and none is carried. With drawer=gl the queries are GL
+ * query objects (GL_SAMPLES_PASSED) and the answers come when the GPU has
+ * them; query_delay simulates such latency on any drawer (the first n
+ * polls of each query find no answer, rl_drawer_desc.query_delay).
+ *
+ * Answers of previously invisible nodes are always read within their
+ * frame: they decide what it draws, and drawing such a node before its
+ * answer could only add objects, never culling more. Deviation: CHC++
+ * queries previously visible leaves; here every previously visible node
+ * holding objects is queried (the loose octree keeps objects in inner
+ * nodes too). Batching of the I-queue keeps its purpose: later queries see
+ * more occluders, and multi-queries save query fill.
  *
  * Options: the raster renderer's (shading, cull, ambient, background,
  * threads), drawer (software | gl) and device (for gl), plus
  * max_depth 5 (Jähn 2015, Sec. 7.3), looseness 2.0, batch 50,
- * assumed_visible 10, multiquery true, tight true, seed 1. The defaults for
- * batch and assumed_visible are ours, in the range the CHC++ paper
- * explores. */
+ * assumed_visible 10, multiquery true, tight true, seed 1, vqueue true,
+ * latency frame, query_delay 0. The defaults for batch and assumed_visible
+ * are ours, in the range the CHC++ paper explores. latency=frame is the
+ * default because an answer it carries changes no pixel of its frame (the
+ * node is drawn either way) and waiting for it would stall the GPU at
+ * every frame's end; in software it carries nothing. */
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -75,6 +99,8 @@
 #define QUERY_MARGIN 1e-3f
 
 static const char *const overlay_choices[] = { "none", "nodes", NULL };
+static const char *const latency_choices[] = { "frame", "wait", NULL };
+enum { LATENCY_FRAME, LATENCY_WAIT };
 
 static const rl_option_info chcpp_options[] = {
     RL_CULL_RASTER_OPTIONS,
@@ -90,6 +116,15 @@ static const rl_option_info chcpp_options[] = {
     { "tight", RL_OPT_BOOL, "true", "query the tight bounds of a node's objects, not its loose box", 0, 0,
       NULL },
     { "seed", RL_OPT_INT, "1", "seed of the random query offsets", 0, 4294967295.0, NULL },
+    { "vqueue", RL_OPT_BOOL, "true",
+      "gather previously visible nodes' queries in the V-queue, issued while an answer is awaited and at the "
+      "frame's end (CHC++ Sec. 4.1); false: each just before its node is drawn (CHC)", 0, 0, NULL },
+    { "latency", RL_OPT_ENUM, "frame",
+      "previously visible nodes' answers not there at the frame's end: frame (read in the next frame, the "
+      "node staying visible) | wait (waited for)", 0, 0, latency_choices },
+    { "query_delay", RL_OPT_INT, "0",
+      "simulated query latency: the first n polls of each query find no answer (0: as the drawer has it)", 0,
+      1000000, NULL },
     { "overlay", RL_OPT_ENUM, "none",
       "draw the octree nodes of the frame over the image: visible green, occluded red (nodes)", 0, 0,
       overlay_choices },
@@ -100,6 +135,8 @@ typedef struct node_state {
     uint64_t next_query;          /* frame when a visible node is queried again */
     uint32_t invisible_frames;    /* consecutive frames found invisible */
     uint8_t visible;
+    uint8_t in_flight;            /* its own query (as previously visible) waits in the V-queue
+                                   * or for its answer, maybe since the last frame */
 } node_state;
 
 typedef struct heap_item {
@@ -107,14 +144,18 @@ typedef struct heap_item {
     uint32_t node;
 } heap_item;
 
-/* An issued query whose answer is not read yet. */
-enum { Q_INVISIBLE, Q_VISIBLE };
+/* An issued query of a group of the I-queue whose answer is not read yet. */
 typedef struct pending {
     uint32_t handle;              /* rl_drawer_query_issue's */
     uint32_t first, count;        /* its nodes: qnodes[first .. first + count) */
-    uint8_t kind;                 /* Q_INVISIBLE: a group of the I-queue; Q_VISIBLE: a previously
-                                   * visible node's own query, which does not hold up its drawing */
 } pending;
+
+/* A previously visible node's own query, issued: its answer holds up
+ * nothing (the node is drawn) and may be read a frame later. */
+typedef struct vpending {
+    uint32_t handle;
+    uint32_t node;
+} vpending;
 
 typedef struct chcpp_state {
     rl_culling_head head;         /* first: rl_culling_get_stats */
@@ -133,6 +174,14 @@ typedef struct chcpp_state {
     uint32_t q_head, q_tail, q_cap;
     uint32_t *qnodes;
     uint32_t qn_n, qn_cap;
+    /* CHC++'s V-queue: previously visible nodes whose queries wait to be
+     * issued (emptied every frame); and the issued ones whose answers are
+     * not read yet, in issue order, carried into the next frame with
+     * latency=frame (kept open with rl_drawer_query_keep). */
+    uint32_t *vqueue;
+    uint32_t vq_head, vq_n, vq_cap;
+    vpending *vpend;
+    uint32_t vp_head, vp_tail, vp_cap;
 } chcpp_state;
 
 /* One frame's working set. */
@@ -142,7 +191,7 @@ typedef struct frame_ctx {
     const rl_octree_node *nodes;
     const uint32_t *objects;
     rl_cull_frame cf;
-    bool tight, multiquery;
+    bool tight, multiquery, vqueue, wait;
     uint32_t batch, n_av;
     uint64_t seed;
     int draining;                 /* nesting of drain() */
@@ -159,12 +208,28 @@ static void chcpp_release(void *state)
     free(s->iqueue);
     free(s->queue);
     free(s->qnodes);
+    free(s->vqueue);
+    free(s->vpend);
+}
+
+/* Forgets the queries carried from the last frame (their nodes no longer
+ * wait for them): the drawer drops them at the end of the frame that does
+ * not keep them again. */
+static void forget_carried(chcpp_state *s)
+{
+    for (uint32_t i = s->vp_head; i < s->vp_tail; ++i)
+        if (s->vpend[i].node < s->num_ns)
+            s->ns[s->vpend[i].node].in_flight = 0;
+    s->vp_head = s->vp_tail = 0;
 }
 
 static void chcpp_reset(void *state)
 {
     chcpp_state *s = state;
-    if (s && s->ns)
+    if (!s)
+        return;
+    forget_carried(s);
+    if (s->ns)
         memset(s->ns, 0, (size_t)s->num_ns * sizeof *s->ns);
 }
 
@@ -291,36 +356,59 @@ static rl_status add_node_boxes(frame_ctx *f, uint32_t n)
 
 static rl_status drain(frame_ctx *f, bool block);
 
-/* Issues one occlusion query over the nodes list[0..count) and queues it;
- * then takes the answers that are there (drain), so that with answers at
- * the issue (the software drawer) every node is resolved right after its
- * query, before the next is issued, as the synchronous CHC. */
-static rl_status issue_nodes(frame_ctx *f, const uint32_t *list, uint32_t count, uint8_t kind)
+/* Issues one occlusion query over the nodes list[0..count) into *handle. */
+static rl_status issue_query(frame_ctx *f, const uint32_t *list, uint32_t count, uint32_t *handle)
 {
     chcpp_state *s = f->s;
     rl_box_query_reset(&s->query);
     rl_status st = RL_OK;
     for (uint32_t i = 0; i < count && st == RL_OK; ++i)
         st = add_node_boxes(f, list[i]);
-    if (st == RL_OK &&
-        (!rl_reserve_u32((void **)&s->qnodes, &s->qn_cap, (uint64_t)s->qn_n + count, sizeof *s->qnodes, 256) ||
-         !rl_reserve_u32((void **)&s->queue, &s->q_cap, (uint64_t)s->q_tail + 1, sizeof *s->queue, 64)))
-        st = RL_ERR_OUT_OF_MEMORY;
-    uint32_t handle = 0;
     if (st == RL_OK)
-        st = rl_box_query_issue(&s->query, f->cf.drawer, &handle, NULL);
+        st = rl_box_query_issue(&s->query, f->cf.drawer, handle, NULL);
     if (st != RL_OK)
         return st;
     s->head.stats.queries++;
     s->head.stats.query_boxes += s->query.boxes;
     if (count > 1)
         s->head.stats.multiqueries++;
+    return RL_OK;
+}
+
+/* Issues the query of a group of the I-queue and queues it; then takes
+ * the answers that are there (drain), so that with answers at the issue
+ * (the software drawer) every node is resolved right after its query,
+ * before the next is issued, as the synchronous CHC. */
+static rl_status issue_nodes(frame_ctx *f, const uint32_t *list, uint32_t count)
+{
+    chcpp_state *s = f->s;
+    if (!rl_reserve_u32((void **)&s->qnodes, &s->qn_cap, (uint64_t)s->qn_n + count, sizeof *s->qnodes, 256) ||
+        !rl_reserve_u32((void **)&s->queue, &s->q_cap, (uint64_t)s->q_tail + 1, sizeof *s->queue, 64))
+        return RL_ERR_OUT_OF_MEMORY;
+    uint32_t handle = 0;
+    rl_status st = issue_query(f, list, count, &handle);
+    if (st != RL_OK)
+        return st;
     /* list never points into qnodes, which the reserve may have moved:
      * take() hands a failed multi-query's nodes one by one as copies. */
     memcpy(s->qnodes + s->qn_n, list, (size_t)count * sizeof *list);
-    s->queue[s->q_tail++] = (pending){ .handle = handle, .first = s->qn_n, .count = count, .kind = kind };
+    s->queue[s->q_tail++] = (pending){ .handle = handle, .first = s->qn_n, .count = count };
     s->qn_n += count;
     return drain(f, false);
+}
+
+/* Issues a previously visible node's own query; its answer is awaited by
+ * nothing but the node's classification. */
+static rl_status issue_visible(frame_ctx *f, uint32_t n)
+{
+    chcpp_state *s = f->s;
+    if (!rl_reserve_u32((void **)&s->vpend, &s->vp_cap, (uint64_t)s->vp_tail + 1, sizeof *s->vpend, 64))
+        return RL_ERR_OUT_OF_MEMORY;
+    uint32_t handle = 0;
+    rl_status st = issue_query(f, &n, 1, &handle);
+    if (st == RL_OK)
+        s->vpend[s->vp_tail++] = (vpending){ .handle = handle, .node = n };
+    return st;
 }
 
 /* A previously invisible node found visible (or invisible) by its query. */
@@ -339,27 +427,17 @@ static rl_status resolve(frame_ctx *f, uint32_t n, bool visible)
     return traverse(f, n);
 }
 
-/* What an answer means for the nodes of its query. */
+/* What an answer means for the nodes of an I-queue query. */
 static rl_status take(frame_ctx *f, pending p, bool visible)
 {
     chcpp_state *s = f->s;
-    if (p.kind == Q_VISIBLE) {
-        /* The node was drawn already; the answer decides only whether it
-         * stays in the coherent set (its subtree may pull it up anyway). */
-        uint32_t n = s->qnodes[p.first];
-        if (visible)
-            pull_up(f, n);
-        else
-            s->ns[n].invisible_frames++;
-        return RL_OK;
-    }
     rl_status st = RL_OK;
     if (p.count > 1 && visible) {
         /* A failed multi-query: each node is asked again on its own. */
         s->head.stats.multiqueries_failed++;
         for (uint32_t k = 0; k < p.count && st == RL_OK; ++k) {
             uint32_t n = s->qnodes[p.first + k];
-            st = issue_nodes(f, &n, 1, Q_INVISIBLE);
+            st = issue_nodes(f, &n, 1);
         }
         return st;
     }
@@ -368,11 +446,63 @@ static rl_status take(frame_ctx *f, pending p, bool visible)
     return st;
 }
 
+/* What a previously visible node's answer means: the node was drawn
+ * already; the answer decides only whether it stays in the coherent set
+ * (its subtree may pull it up anyway). One a frame late for a node this
+ * frame has not reached yet sends it to the I-queue when reached, where
+ * its objects are queried before they are drawn. */
+static void take_visible(frame_ctx *f, vpending p, bool visible)
+{
+    chcpp_state *s = f->s;
+    node_state *ns = &s->ns[p.node];
+    ns->in_flight = 0;
+    if (visible) {
+        pull_up(f, p.node);
+        return;
+    }
+    ns->invisible_frames++;
+    if (ns->last_visited != s->frame)
+        ns->visible = 0;
+}
+
+/* Reads an answer (polled ready or waited for) and counts it. */
+static rl_status read_answer(frame_ctx *f, uint32_t handle, bool ready, bool *visible)
+{
+    if (ready)
+        f->s->head.stats.queries_ready++;
+    else
+        f->s->head.stats.queries_waited++;
+    uint64_t pixels = 0;
+    rl_status st = rl_drawer_query_result(f->cf.drawer, handle, &pixels);
+    *visible = pixels > 0;
+    return st;
+}
+
+/* Takes the previously visible nodes' answers at the front of their queue
+ * while they are there; with all, waits for every one. */
+static rl_status drain_visible(frame_ctx *f, bool all)
+{
+    chcpp_state *s = f->s;
+    rl_status st = RL_OK;
+    while (st == RL_OK && s->vp_head < s->vp_tail) {
+        vpending p = s->vpend[s->vp_head];
+        bool ready = false, visible = false;
+        st = rl_drawer_query_poll(f->cf.drawer, p.handle, &ready);
+        if (st != RL_OK || (!ready && !all))
+            break;
+        s->vp_head++;
+        st = read_answer(f, p.handle, ready, &visible);
+        if (st == RL_OK)
+            take_visible(f, p, visible);
+    }
+    return st;
+}
+
 /* Takes the answers at the front of the query queue while they are there
- * (CHC++: finished queries first); with block, waits for the first one,
- * for when nothing else is left to do. A nested call (an answer's nodes
- * issue queries) goes one level deep: deeper ones leave their answers to
- * the loops above them. */
+ * (CHC++: finished queries first), then those of previously visible nodes;
+ * with block, waits for the first one of the query queue, for when nothing
+ * else is left to do. A nested call (an answer's nodes issue queries) goes
+ * one level deep: deeper ones leave their answers to the loops above them. */
 static rl_status drain(frame_ctx *f, bool block)
 {
     chcpp_state *s = f->s;
@@ -382,23 +512,36 @@ static rl_status drain(frame_ctx *f, bool block)
     rl_status st = RL_OK;
     while (st == RL_OK && s->q_head < s->q_tail) {
         pending p = s->queue[s->q_head];
-        bool ready = false;
+        bool ready = false, visible = false;
         st = rl_drawer_query_poll(f->cf.drawer, p.handle, &ready);
         if (st != RL_OK || (!ready && !block))
             break;
-        if (ready)
-            s->head.stats.queries_ready++;
-        else
-            s->head.stats.queries_waited++;
         block = false;
         s->q_head++;
-        uint64_t pixels = 0;
-        st = rl_drawer_query_result(f->cf.drawer, p.handle, &pixels);
+        st = read_answer(f, p.handle, ready, &visible);
         if (st == RL_OK)
-            st = take(f, p, pixels > 0);
+            st = take(f, p, visible);
     }
+    if (st == RL_OK)
+        st = drain_visible(f, false);
     f->draining--;
     return st;
+}
+
+/* Nothing to draw or to query until an answer of the query queue comes:
+ * CHC++ fills the wait with a query of the V-queue while the answer is not
+ * there (Sec. 4.1), and waits only when the V-queue is empty. */
+static rl_status await_answer(frame_ctx *f)
+{
+    chcpp_state *s = f->s;
+    if (s->vq_head == s->vq_n)
+        return drain(f, true);
+    const uint32_t head = s->q_head;
+    rl_status st = drain(f, false);
+    if (st != RL_OK || s->q_head != head)
+        return st;
+    s->head.stats.queries_filled++;
+    return issue_visible(f, s->vqueue[s->vq_head++]);
 }
 
 /* Queries the I-queue: multi-queries grouped by the CHC++ cost model (a
@@ -423,7 +566,7 @@ static rl_status flush_iqueue(frame_ctx *f)
                 ++m;
             }
         }
-        st = issue_nodes(f, s->iqueue + i, m, Q_INVISIBLE);
+        st = issue_nodes(f, s->iqueue + i, m);
         i += m;
     }
     s->iq_n = 0;
@@ -438,18 +581,55 @@ static rl_status iqueue_push(chcpp_state *s, uint32_t n)
     return RL_OK;
 }
 
+static rl_status vqueue_push(chcpp_state *s, uint32_t n)
+{
+    if (!rl_reserve_u32((void **)&s->vqueue, &s->vq_cap, (uint64_t)s->vq_n + 1, sizeof *s->vqueue, 256))
+        return RL_ERR_OUT_OF_MEMORY;
+    s->vqueue[s->vq_n++] = n;
+    return RL_OK;
+}
+
+/* The frame's end: the rest of the V-queue is issued (CHC++); with
+ * latency=wait every answer is read, with latency=frame those there now
+ * and the rest kept for the next frame, their nodes staying visible
+ * meanwhile (they are drawn this frame, whatever the answer). */
+static rl_status end_visible(frame_ctx *f)
+{
+    chcpp_state *s = f->s;
+    rl_status st = RL_OK;
+    while (st == RL_OK && s->vq_head < s->vq_n)
+        st = issue_visible(f, s->vqueue[s->vq_head++]);
+    if (st == RL_OK)
+        st = drain_visible(f, f->wait);
+    for (uint32_t i = s->vp_head; i < s->vp_tail && st == RL_OK; ++i) {
+        st = rl_drawer_query_keep(f->cf.drawer, s->vpend[i].handle);
+        s->head.stats.queries_carried++;
+        if (s->ns[s->vpend[i].node].last_visited == s->frame)
+            pull_up(f, s->vpend[i].node);
+    }
+    /* The carried ones first in the queue, for the next frame. */
+    if (s->vp_head > 0) {
+        memmove(s->vpend, s->vpend + s->vp_head, (size_t)(s->vp_tail - s->vp_head) * sizeof *s->vpend);
+        s->vp_tail -= s->vp_head;
+        s->vp_head = 0;
+    }
+    return st;
+}
+
 /* The CHC++ main loop over one frame. */
 static rl_status chcpp_frame(frame_ctx *f)
 {
     chcpp_state *s = f->s;
     rl_culling_stats *stats = &s->head.stats;
     s->q_head = s->q_tail = s->qn_n = 0;
+    s->vq_head = s->vq_n = 0;
+    stats->queries_carried_in = s->vp_tail - s->vp_head;
     rl_status st = heap_push(s, (heap_item){ rl_cull_box_distance(f->cf.view.eye, f->nodes[0].bounds), 0 });
     while (st == RL_OK && (s->heap_n > 0 || s->iq_n > 0 || s->q_head < s->q_tail)) {
         if (s->heap_n == 0) {
             /* Nothing to draw: query what waits, else wait for an answer
              * (either may queue the children of visible nodes). */
-            st = s->iq_n > 0 ? flush_iqueue(f) : drain(f, true);
+            st = s->iq_n > 0 ? flush_iqueue(f) : await_answer(f);
             continue;
         }
         st = drain(f, false);
@@ -485,13 +665,23 @@ static rl_status chcpp_frame(frame_ctx *f)
             continue;
         }
         /* Previously visible: reset, then let the node's own query (when
-         * due) or its subtree pull the visibility up again. */
+         * due, or still in flight from the last frame) or its subtree pull
+         * the visibility up again. */
         ns->visible = 0;
-        if (node->num_objects) {
+        if (node->num_objects && !ns->in_flight) {
             if (s->frame >= ns->next_query) {
-                /* Issued before the node's own objects draw, which would
-                 * hide its box; drawn without waiting for the answer. */
-                st = issue_nodes(f, &n, 1, Q_VISIBLE);
+                /* Drawn without waiting for the answer. In the V-queue the
+                 * query waits for a moment when the GPU would idle; without
+                 * it, it is issued before the node's objects are drawn, as
+                 * in CHC (the grown box stays in front of them anyway). */
+                ns->in_flight = 1;
+                if (f->vqueue) {
+                    st = vqueue_push(s, n);
+                } else {
+                    st = issue_visible(f, n);
+                    if (st == RL_OK)
+                        st = drain(f, false);
+                }
                 schedule_query(f, n);
             } else {
                 pull_up(f, n);
@@ -500,8 +690,17 @@ static rl_status chcpp_frame(frame_ctx *f)
         if (st == RL_OK)
             st = traverse(f, n);
     }
+    if (st == RL_OK)
+        st = end_visible(f);
+    if (st != RL_OK) {
+        /* The drawer drops what this frame does not keep. */
+        for (uint32_t i = 0; i < s->vq_n; ++i)
+            s->ns[s->vqueue[i]].in_flight = 0;
+        forget_carried(s);
+    }
     s->heap_n = 0;
     s->iq_n = 0;
+    s->vq_head = s->vq_n = 0;
     s->q_head = s->q_tail = s->qn_n = 0;
     return st;
 }
@@ -556,6 +755,7 @@ static rl_status chcpp_render(rl_renderer *r, void *state, const rl_scene *scene
         free(s->ns);
         s->ns = rl_calloc(nn, sizeof *s->ns);
         s->num_ns = s->ns ? nn : 0;
+        s->vp_head = s->vp_tail = 0;   /* their nodes are gone */
         if (!s->ns)
             return RL_ERR_OUT_OF_MEMORY;
         s->head.stats.preprocess_ms = rl_timer_ms(&t0);
@@ -574,9 +774,14 @@ static rl_status chcpp_render(rl_renderer *r, void *state, const rl_scene *scene
     f.batch = (uint32_t)rl_renderer_opt_int(r, "batch");
     f.n_av = (uint32_t)rl_renderer_opt_int(r, "assumed_visible");
     f.seed = (uint64_t)rl_renderer_opt_int(r, "seed");
+    f.vqueue = rl_renderer_opt_bool(r, "vqueue");
+    f.wait = rl_renderer_opt_enum(r, "latency") == LATENCY_WAIT;
+    s->head.query_delay = (uint32_t)rl_renderer_opt_int(r, "query_delay");
     st = rl_cull_frame_begin(r, scene, &s->head, cam, image, true, &f.cf);
     if (st != RL_OK)
         return st;
+    if (f.cf.new_drawer)
+        forget_carried(s);   /* they went with the old drawer */
     s->frame++;
     st = rl_cull_frame_end(&f.cf, chcpp_frame(&f), image, stats);
     if (st != RL_OK)

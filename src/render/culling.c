@@ -301,6 +301,7 @@ rl_status rl_cull_frame_begin(rl_renderer *r, const rl_scene *scene, rl_culling_
         .threads = f->threads_opt,
         .flags = rl_renderer_opt_bool(r, "cull") ? RL_RASTER_CULL_BACK : 0u,
         .deferred_counts = deferred,
+        .query_delay = head->query_delay,
     };
     rl_status st = rl_cull_target_begin(image, rl_renderer_opt_color(r, "background"), &f->target);
     if (st != RL_OK)
@@ -313,6 +314,7 @@ rl_status rl_cull_frame_begin(rl_renderer *r, const rl_scene *scene, rl_culling_
         rl_drawer_release(head->drawer);
         head->drawer = NULL;
         st = make_drawer(r, scene, &desc, head);
+        f->new_drawer = true;
     }
     f->drawer = head->drawer;
     f->device = head->info[0] ? head->info : NULL;

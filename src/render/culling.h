@@ -121,6 +121,8 @@ typedef struct rl_cull_frame {
     int threads;                  /* resolved, >= 1 */
     float ambient;
     const char *device;           /* drawer=gl: the head's info, for rl_render_stats.device */
+    bool new_drawer;              /* the drawer was made for this frame: queries kept open by
+                                   * the last frame (rl_drawer_query_keep) went with the old one */
 } rl_cull_frame;
 
 typedef struct rl_culling_head rl_culling_head;
@@ -143,6 +145,8 @@ struct rl_culling_head {
     rl_drawer *drawer;            /* kept across frames; released by the renderer's release */
     char device[64];              /* drawer=gl: the device option the drawer was made on */
     char info[528];               /* and its "vendor | renderer | version" */
+    uint32_t query_delay;         /* rl_drawer_desc.query_delay of the drawer to make (chcpp's
+                                   * option; 0 for the others) */
 };
 
 /* The statistics of r's last frame, or NULL when r is not a culling

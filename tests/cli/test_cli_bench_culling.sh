@@ -77,9 +77,10 @@ assert v["budget_time_ms"]["mean"] > 0 and 0 <= v["budget_hssim"]["min"] <= v["b
 assert v["svs_sampled_time_mean_ms"] > 0, v
 PY
 
-# The walk section runs only when named (not in c.json above): chcpp and
-# svs frame by frame on the software drawer, and on GL where a context can
-# be made (else the record says why).
+# The walk section runs only when named (not in c.json above): chcpp (as
+# CHC++, latency=frame, and in CHC's order, latency=wait) and svs frame by
+# frame on the software drawer, and on GL where a context can be made
+# (else the record says why). Every answer is read or carried on.
 python3 -c "import json, sys; assert 'walk' not in json.load(open(sys.argv[1]))" "$TMP/c.json" \
     || fail "the walk section ran without --only walk"
 expect_exit 0 "$RL" bench culling --quick --only walk --walk-frames 3 --out "$TMP/w.json"
@@ -91,13 +92,16 @@ w = r["walk"]
 assert w["status"] == "ok" and w["frames"] == 3 and r["parameters"]["drawer"] == "both", w
 runs = w["runs"]
 gl = [x for x in runs if x["drawer"] == "gl"]
-assert [(x["renderer"], x["drawer"]) for x in runs if x["drawer"] == "software"] == [("chcpp", "software"), ("svs", "software")]
-assert (len(gl) == 2 and all(x["gl_device"] for x in gl)) or (not gl and w["gl_unavailable"]), w
+assert [(x["renderer"], x.get("latency"), x["drawer"]) for x in runs if x["drawer"] == "software"] == \
+    [("chcpp", "frame", "software"), ("chcpp", "wait", "software"), ("svs", None, "software")], runs
+assert (len(gl) == 3 and all(x["gl_device"] for x in gl)) or (not gl and w["gl_unavailable"]), w
 for x in runs:
     assert 0 < x["min_ms"] <= x["median_ms"] <= x["max_ms"] and x["first_frame_ms"] > 0, x
-    assert x["queries_ready_mean"] + x["queries_waited_mean"] == x["queries_mean"], x
-    assert x["drawer"] == "gl" or x["queries_waited_mean"] == 0, x
-assert w["svs_over_chcpp_software"] > 0
+    assert abs(x["queries_ready_mean"] + x["queries_waited_mean"] + x["queries_carried_mean"]
+               - x["queries_mean"] - x["queries_carried_in_mean"]) < 1e-9, x
+    assert x["drawer"] == "gl" or x["queries_waited_mean"] + x["queries_carried_mean"] == 0, x
+    assert x.get("latency") != "wait" or x["queries_carried_mean"] + x["queries_filled_mean"] == 0, x
+assert w["svs_over_chcpp_software"] > 0 and w["chcpp_wait_over_frame_software"] > 0
 PY
 
 # --extent widens the slice of Sec. 7.4-7.6 about the scene's centre: the

@@ -87,6 +87,62 @@ static void check_async_queries(rl_drawer *dr, const rl_scene *s, const rl_camer
     rl_image_release(img);
 }
 
+/* A kept query outlives its frame (CHC++ reads previously visible nodes'
+ * answers a frame later): the next frame reads the answer of its own
+ * frame's depth buffer; kept again it lives one more frame; one never kept
+ * or not kept again is dropped at the frame's end. */
+static void check_kept_queries(rl_drawer *dr, const rl_scene *s, const rl_camera *cam)
+{
+    const float dist = rl_length(rl_sub(cam->target, cam->eye));
+    rl_vec3 quad[4];
+    view_quad(cam, 1.9f * dist, 0.1f * dist, quad);
+    const uint32_t idx[6] = { 0, 1, 2, 0, 2, 3 };
+    rl_raster_batch q = { .num_vertices = 4, .positions = quad, .num_triangles = 2, .indices = idx };
+    rl_image *img = NULL;
+    assert_int_equal(rl_image_create(cam->width, cam->height, FX_ALL_LAYERS, &img), RL_OK);
+    const rl_aabb bounds = rl_scene_get_data(s)->bounds;
+    uint32_t seen = 0, hidden = 0, lost = 0, fresh = 0;
+    uint64_t px = 0;
+    bool ready = false;
+    rl_image_clear(img);
+    assert_int_equal(rl_drawer_begin_camera(dr, img, cam, bounds), RL_OK);
+    assert_int_equal(rl_drawer_query_issue(dr, &q, &seen, NULL), RL_OK);
+    assert_int_equal(rl_drawer_draw_all(dr, NULL, NULL, NULL), RL_OK);
+    assert_int_equal(rl_drawer_query_issue(dr, &q, &hidden, NULL), RL_OK);
+    assert_int_equal(rl_drawer_query_issue(dr, &q, &lost, NULL), RL_OK);
+    assert_int_equal(rl_drawer_query_keep(dr, seen), RL_OK);
+    assert_int_equal(rl_drawer_query_keep(dr, hidden), RL_OK);
+    assert_int_equal(rl_drawer_query_keep(dr, 12345), RL_ERR_INVALID_ARG);
+    assert_int_equal(rl_drawer_end(dr), RL_OK);
+    assert_int_equal(rl_drawer_query_keep(dr, seen), RL_ERR_INVALID_ARG);   /* no frame */
+
+    /* The next frame draws nothing: a query issued now sees the quad. */
+    rl_image_clear(img);
+    assert_int_equal(rl_drawer_begin_camera(dr, img, cam, bounds), RL_OK);
+    assert_int_equal(rl_drawer_query_poll(dr, lost, &ready), RL_ERR_INVALID_ARG);
+    assert_int_equal(rl_drawer_query_result(dr, seen, &px), RL_OK);
+    assert_true(px > 50);
+    assert_int_equal(rl_drawer_query_issue(dr, &q, &fresh, NULL), RL_OK);
+    assert_int_not_equal(fresh, hidden);
+    assert_int_equal(rl_drawer_query_result(dr, fresh, &px), RL_OK);
+    assert_true(px > 50);
+    assert_int_equal(rl_drawer_query_keep(dr, hidden), RL_OK);
+    assert_int_equal(rl_drawer_query_issue(dr, &q, &lost, NULL), RL_OK);
+    assert_int_equal(rl_drawer_end(dr), RL_OK);
+
+    rl_image_clear(img);
+    assert_int_equal(rl_drawer_begin_camera(dr, img, cam, bounds), RL_OK);
+    assert_int_equal(rl_drawer_query_poll(dr, lost, &ready), RL_ERR_INVALID_ARG);
+    assert_int_equal(rl_drawer_query_result(dr, hidden, &px), RL_OK);
+    assert_int_equal(px, 0);
+    assert_int_equal(rl_drawer_end(dr), RL_OK);
+    /* The last frame kept nothing. */
+    assert_int_equal(rl_drawer_begin_camera(dr, img, cam, bounds), RL_OK);
+    assert_int_equal(rl_drawer_query_poll(dr, hidden, &ready), RL_ERR_INVALID_ARG);
+    assert_int_equal(rl_drawer_end(dr), RL_OK);
+    rl_image_release(img);
+}
+
 static void test_async_queries_on_the_software_drawer(void **state)
 {
     (void)state;
@@ -120,6 +176,46 @@ static void test_async_queries_on_the_software_drawer(void **state)
     }
     assert_true(sync > 0);
     assert_int_equal(rl_drawer_end(dr), RL_OK);
+    check_kept_queries(dr, s, &cam);
+
+    /* Simulated latency: the first query_delay polls of each query find no
+     * answer, also across a frame's end; result answers anyway (a wait). */
+    rl_drawer *late = NULL;
+    const rl_drawer_desc delayed = { .shading = RL_SHADING_GOURAUD, .query_delay = 3 };
+    assert_int_equal(rl_drawer_create(s, &delayed, &late), RL_OK);
+    assert_false(rl_drawer_fits(late, s, &(rl_drawer_desc){ .shading = RL_SHADING_GOURAUD }));
+    assert_true(rl_drawer_fits(late, s, &delayed));
+    rl_image_clear(img);
+    assert_int_equal(rl_drawer_begin_camera(late, img, &cam, rl_scene_get_data(s)->bounds), RL_OK);
+    uint32_t a = 0, b = 0;
+    bool ready = true;
+    assert_int_equal(rl_drawer_query_issue(late, &q, &a, NULL), RL_OK);
+    assert_int_equal(rl_drawer_query_issue(late, &q, &b, NULL), RL_OK);
+    for (int i = 0; i < 3; ++i) {
+        assert_int_equal(rl_drawer_query_poll(late, a, &ready), RL_OK);
+        assert_false(ready);
+    }
+    assert_int_equal(rl_drawer_query_poll(late, a, &ready), RL_OK);
+    assert_true(ready);
+    assert_int_equal(rl_drawer_query_poll(late, b, &ready), RL_OK);
+    assert_false(ready);                  /* a's polls are not b's */
+    assert_int_equal(rl_drawer_query_keep(late, b), RL_OK);
+    assert_int_equal(rl_drawer_end(late), RL_OK);
+    rl_image_clear(img);
+    assert_int_equal(rl_drawer_begin_camera(late, img, &cam, rl_scene_get_data(s)->bounds), RL_OK);
+    for (int i = 0; i < 2; ++i) {
+        assert_int_equal(rl_drawer_query_poll(late, b, &ready), RL_OK);
+        assert_false(ready);
+    }
+    assert_int_equal(rl_drawer_query_poll(late, b, &ready), RL_OK);
+    assert_true(ready);
+    assert_int_equal(rl_drawer_query_issue(late, &q, &a, NULL), RL_OK);
+    assert_int_equal(rl_drawer_query_result(late, b, &first), RL_OK);
+    assert_int_equal(first, sync);
+    assert_int_equal(rl_drawer_query_result(late, a, &first), RL_OK);   /* not polled: waited for */
+    assert_int_equal(first, sync);
+    assert_int_equal(rl_drawer_end(late), RL_OK);
+    rl_drawer_release(late);
     rl_image_release(img);
     rl_drawer_release(dr);
     rl_scene_release(s);
@@ -139,6 +235,7 @@ static void test_async_queries_on_the_gl_drawer(void **state)
     uint64_t gl_px = 0, sw_px = 0;
     check_async_queries(gd, s, &cam, &gl_px);
     check_async_queries(sd, s, &cam, &sw_px);
+    check_kept_queries(gd, s, &cam);
     print_message("quad before the box: %llu pixels on GL, %llu in software\n", (unsigned long long)gl_px,
                   (unsigned long long)sw_px);
     assert_true(llabs((long long)gl_px - (long long)sw_px) <= (long long)sw_px / 50);
@@ -180,12 +277,12 @@ static rl_camera street_camera(float t)
 {
     rl_camera c = { .eye = rl_v3(9.5f + 0.8f * t, 1.7f, -2.0f + 6.0f * t),
                     .target = rl_v3(9.5f + 3.0f * sinf(0.2f * t), 1.5f, 60.0f),
-                    .fov_deg = 60.0f, .width = 96, .height = 72 };
+                    .fov_deg = 60.0f, .width = 64, .height = 64 };
     return c;
 }
 
 /* The 26 frames of test_chcpp.c's first case (16 of a random walk, 10 down
- * a street), at a smaller size. */
+ * a street), at 64x64. */
 static rl_camera walk_camera(int f, rl_rng *rng, rl_vec3 *eye, rl_vec3 *dir)
 {
     if (f >= 16)
@@ -195,33 +292,45 @@ static rl_camera walk_camera(int f, rl_rng *rng, rl_vec3 *eye, rl_vec3 *dir)
     eye->y = rl_maxf(eye->y, 0.5f);
     *dir = rl_normalize(rl_add(*dir, rl_v3(0.6f * (rl_rng_float(rng) - 0.5f), 0.3f * (rl_rng_float(rng) - 0.5f),
                                            0.6f * (rl_rng_float(rng) - 0.5f))));
-    return (rl_camera){ .eye = *eye, .target = rl_add(*eye, *dir), .fov_deg = 70.0f, .width = 96, .height = 72 };
+    return (rl_camera){ .eye = *eye, .target = rl_add(*eye, *dir), .fov_deg = 70.0f, .width = 64, .height = 64 };
 }
 
 /* CHC++ on GL: the IDs (and, the draws being the same, every layer) of
  * gl-raster in each frame, fewer triangles, and every answer counted as
- * found ready or waited for. The software chcpp never waits. */
+ * found ready, waited for or carried into the next frame. The default
+ * (V-queue, latency=frame) on all 26 frames; the variants on the random
+ * walk's first frames: without multi-queries, CHC's order waiting for
+ * every answer, and latency simulated on top of the GPU's so that answers
+ * are surely carried. The software chcpp never waits. */
 static void test_chcpp_on_gl_is_conservative_on_the_walks(void **state)
 {
     (void)state;
     NEED_GL();
     rl_scene *s = fx_box_city();
-    static const char *const variants[][5] = { { "drawer", "gl", NULL },
-                                               { "drawer", "gl", "multiquery", "false", NULL } };
-    for (int v = 0; v < 2; ++v) {
-        rl_renderer *chc = fx_make("chcpp", variants[v]), *ref = fx_make("gl-raster", NULL);
-        rl_renderer *sw = fx_make("chcpp", NULL);
-        rl_rng rng;
-        rl_rng_seed(&rng, 11, 3);
-        rl_vec3 eye = rl_v3(60, 20, -30), dir = rl_v3(0, -0.3f, 1);
-        uint64_t queries = 0, waited = 0, ready = 0, culled = 0, all = 0;
-        /* The variant: the random walk's first frames, to stay quick. */
-        const int frames = v ? 6 : 26;
-        for (int f = 0; f < frames; ++f) {
-            rl_camera cam = walk_camera(f, &rng, &eye, &dir);
-            rl_render_stats a, b, c;
-            rl_image *want = fx_render_with(ref, s, &cam, FX_ALL_LAYERS, &a);
-            rl_image *img = fx_render_with(chc, s, &cam, FX_ALL_LAYERS, &b);
+    static const char *const variants[][9] = { { "drawer", "gl", NULL },
+                                               { "drawer", "gl", "multiquery", "false", NULL },
+                                               { "drawer", "gl", "vqueue", "false", "latency", "wait", NULL },
+                                               { "drawer", "gl", "query_delay", "3", "assumed_visible", "1",
+                                                 NULL } };
+    static const char *const what[] = { "", " without multi-queries", " (CHC order, latency=wait)",
+                                        " (query_delay 3, assumed_visible 1)" };
+    enum { V = sizeof variants / sizeof variants[0] };
+    rl_renderer *chc[V], *ref = fx_make("gl-raster", NULL), *sw = fx_make("chcpp", NULL);
+    uint64_t queries[V] = { 0 }, waited[V] = { 0 }, ready[V] = { 0 }, carried[V] = { 0 }, filled[V] = { 0 },
+             culled[V] = { 0 }, all[V] = { 0 }, last[V] = { 0 };
+    for (int v = 0; v < V; ++v)
+        chc[v] = fx_make("chcpp", variants[v]);
+    rl_rng rng;
+    rl_rng_seed(&rng, 11, 3);
+    rl_vec3 eye = rl_v3(60, 20, -30), dir = rl_v3(0, -0.3f, 1);
+    /* The variants: the random walk's first frames, to stay quick. */
+    const int frames = 26, variant_frames = 6;
+    for (int f = 0; f < frames; ++f) {
+        rl_camera cam = walk_camera(f, &rng, &eye, &dir);
+        rl_render_stats a, b, c;
+        rl_image *want = fx_render_with(ref, s, &cam, FX_ALL_LAYERS, &a);
+        for (int v = 0; v < (f < variant_frames ? V : 1); ++v) {
+            rl_image *img = fx_render_with(chc[v], s, &cam, FX_ALL_LAYERS, &b);
             const size_t n = (size_t)cam.width * cam.height;
             assert_memory_equal(want->object_id, img->object_id, n * sizeof *img->object_id);
             fx_assert_images_identical(want, img);
@@ -229,33 +338,44 @@ static void test_chcpp_on_gl_is_conservative_on_the_walks(void **state)
             assert_non_null(b.device);
             assert_string_equal(a.device, b.device);
             rl_culling_stats cs;
-            assert_int_equal(rl_culling_get_stats(chc, &cs), RL_OK);
-            assert_int_equal(cs.queries_ready + cs.queries_waited, cs.queries);
+            assert_int_equal(rl_culling_get_stats(chc[v], &cs), RL_OK);
+            assert_int_equal(cs.queries_carried_in, last[v]);
+            assert_int_equal(cs.queries + cs.queries_carried_in,
+                             cs.queries_ready + cs.queries_waited + cs.queries_carried);
             assert_int_equal(b.occlusion_queries, cs.queries);
-            queries += cs.queries;
-            waited += cs.queries_waited;
-            ready += cs.queries_ready;
-            culled += a.triangles_rasterized - b.triangles_rasterized;
-            all += a.triangles_rasterized;
-            rl_image *soft = fx_render_with(sw, s, &cam, RL_LAYER_COLOR, &c);
-            assert_null(c.device);
-            assert_int_equal(rl_culling_get_stats(sw, &cs), RL_OK);
-            assert_int_equal(cs.queries_waited, 0);
-            assert_int_equal(cs.queries_ready, cs.queries);
-            rl_image_release(soft);
-            rl_image_release(want);
+            last[v] = cs.queries_carried;
+            queries[v] += cs.queries;
+            waited[v] += cs.queries_waited;
+            ready[v] += cs.queries_ready;
+            carried[v] += cs.queries_carried;
+            filled[v] += cs.queries_filled;
+            culled[v] += a.triangles_rasterized - b.triangles_rasterized;
+            all[v] += a.triangles_rasterized;
             rl_image_release(img);
         }
-        print_message("chcpp%s on GL, %d frames: %llu queries, %llu found ready, %llu waited for; "
-                      "%.1f %% of gl-raster's triangles culled\n", v ? " without multi-queries" : "", frames,
-                      (unsigned long long)queries, (unsigned long long)ready, (unsigned long long)waited,
-                      100.0 * (double)culled / (double)all);
-        assert_true(queries > 0);
-        assert_true(culled > 0);
-        rl_renderer_release(chc);
-        rl_renderer_release(ref);
-        rl_renderer_release(sw);
+        rl_image *soft = fx_render_with(sw, s, &cam, RL_LAYER_COLOR, &c);
+        assert_null(c.device);
+        rl_culling_stats cs;
+        assert_int_equal(rl_culling_get_stats(sw, &cs), RL_OK);
+        assert_int_equal(cs.queries_waited + cs.queries_carried, 0);
+        assert_int_equal(cs.queries_ready, cs.queries);
+        rl_image_release(soft);
+        rl_image_release(want);
     }
+    for (int v = 0; v < V; ++v) {
+        print_message("chcpp%s on GL, %d frames: %llu queries, %llu found ready, %llu waited for, %llu carried, "
+                      "%llu filled a wait; %.1f %% of gl-raster's triangles culled\n", what[v],
+                      v ? variant_frames : frames, (unsigned long long)queries[v], (unsigned long long)ready[v],
+                      (unsigned long long)waited[v], (unsigned long long)carried[v], (unsigned long long)filled[v],
+                      100.0 * (double)culled[v] / (double)all[v]);
+        assert_true(queries[v] > 0);
+        assert_true(culled[v] > 0);
+        rl_renderer_release(chc[v]);
+    }
+    assert_int_equal(carried[2] + filled[2], 0);
+    assert_true(carried[3] > 0);
+    rl_renderer_release(ref);
+    rl_renderer_release(sw);
     rl_scene_release(s);
 }
 

@@ -1,8 +1,9 @@
 /* test_chcpp.c: CHC++ (renderer "chcpp") is conservative: on walks through
  * a box city built here, where no two surfaces are coplanar, every frame
- * equals "raster" in colour, depth and IDs, pixel for pixel; and it culls:
- * at street level it draws a fraction of the triangles; its overlay shows
- * the visible and occluded nodes. */
+ * equals "raster" in colour, depth and IDs, pixel for pixel, also with
+ * query latency simulated (answers a frame later, the V-queue); and it
+ * culls: at street level it draws a fraction of the triangles; its overlay
+ * shows the visible and occluded nodes. */
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
@@ -23,10 +24,46 @@ static rl_camera street_camera(float t)
     return c;
 }
 
-static void check_walk(const rl_scene *s, const char *const *opts, const char *const *raster_opts, int frames,
-                       uint64_t seed, bool street)
+/* The latency figures of a walk, summed over its frames. */
+typedef struct latency_sums {
+    uint64_t queries, ready, waited, carried, carried_in, filled;
+    uint32_t max_carried;
+} latency_sums;
+
+/* Every frame's answers add up: each query issued or carried in is read
+ * (found ready or waited for) or carried on, and what a frame carries the
+ * next one takes over. */
+static void add_latency(latency_sums *w, const rl_renderer *chc, uint64_t *carried)
 {
-    rl_renderer *chc = fx_make("chcpp", opts);
+    rl_culling_stats cs;
+    assert_int_equal(rl_culling_get_stats(chc, &cs), RL_OK);
+    assert_int_equal(cs.queries_carried_in, *carried);
+    assert_int_equal(cs.queries + cs.queries_carried_in, cs.queries_ready + cs.queries_waited + cs.queries_carried);
+    *carried = cs.queries_carried;
+    w->queries += cs.queries;
+    w->ready += cs.queries_ready;
+    w->waited += cs.queries_waited;
+    w->carried += cs.queries_carried;
+    w->carried_in += cs.queries_carried_in;
+    w->filled += cs.queries_filled;
+    if (cs.queries_carried > w->max_carried)
+        w->max_carried = (uint32_t)cs.queries_carried;
+}
+
+/* Frames of a walk, each rendered by raster and by one chcpp per option
+ * list of opts (n of them, kept across the frames): every chcpp frame
+ * equals raster's; sums[i] gets the latency figures of the i-th. */
+static void check_walk_all(const rl_scene *s, const char *const *const *opts, int n,
+                           const char *const *raster_opts, int frames, uint64_t seed, bool street,
+                           latency_sums *sums)
+{
+    rl_renderer *chc[8];
+    uint64_t carried[8] = { 0 };
+    assert_true(n <= 8);
+    for (int i = 0; i < n; ++i) {
+        chc[i] = fx_make("chcpp", opts[i]);
+        sums[i] = (latency_sums){ 0 };
+    }
     rl_rng rng;
     rl_rng_seed(&rng, seed, 3);
     rl_vec3 eye = rl_v3(60, 20, -30), dir = rl_v3(0, -0.3f, 1);
@@ -47,21 +84,91 @@ static void check_walk(const rl_scene *s, const char *const *opts, const char *c
         }
         rl_render_stats a, b;
         rl_image *ref = fx_render("raster", s, &cam, FX_ALL_LAYERS, raster_opts, &a);
-        rl_image *img = fx_render_with(chc, s, &cam, FX_ALL_LAYERS, &b);
-        fx_assert_images_identical(ref, img);
-        assert_true(b.triangles_rasterized <= a.triangles_rasterized);
+        for (int i = 0; i < n; ++i) {
+            rl_image *img = fx_render_with(chc[i], s, &cam, FX_ALL_LAYERS, &b);
+            fx_assert_images_identical(ref, img);
+            assert_true(b.triangles_rasterized <= a.triangles_rasterized);
+            add_latency(&sums[i], chc[i], &carried[i]);
+            rl_image_release(img);
+        }
         rl_image_release(ref);
-        rl_image_release(img);
     }
-    rl_renderer_release(chc);
+    for (int i = 0; i < n; ++i)
+        rl_renderer_release(chc[i]);
 }
 
+static void check_walk(const rl_scene *s, const char *const *opts, const char *const *raster_opts, int frames,
+                       uint64_t seed, bool street)
+{
+    latency_sums w;
+    check_walk_all(s, &opts, 1, raster_opts, frames, seed, street, &w);
+}
+
+static void print_latency(const char *what, latency_sums w)
+{
+    print_message("%-30s %5llu queries, %5llu found ready, %4llu waited for, %4llu carried (at most %u), %4llu "
+                  "filled a wait\n", what, (unsigned long long)w.queries, (unsigned long long)w.ready,
+                  (unsigned long long)w.waited, (unsigned long long)w.carried, w.max_carried,
+                  (unsigned long long)w.filled);
+}
+
+/* The 26 frames (16 of a random walk, 10 down a street) with the defaults
+ * and with the drawer's query latency simulated (query_delay: the first n
+ * polls of each query find no answer), and the street also with the other
+ * latency variants, each frame equal to raster's.
+ * Latency hiding (Mattausch et al. 2008, Sec. 4.1): the software drawer
+ * answers at the issue, so by default nothing is waited for or carried and
+ * the V-queue never fills a wait (it goes at each frame's end). With
+ * latency, the V-queue's queries fill the waits for the I-queue's answers
+ * and previously visible nodes' answers not there at a frame's end are
+ * carried into the next (latency=frame); with latency=wait nothing is
+ * carried; CHC's order (vqueue=false) neither carries nor fills. An answer
+ * that never comes in a poll (query_delay huge) is waited for where the
+ * frame needs it and otherwise carried on, never piling up beyond one per
+ * node. */
 static void test_chcpp_equals_raster_on_random_walks(void **state)
 {
     (void)state;
     rl_scene *s = fx_box_city();
-    check_walk(s, NULL, NULL, 16, 11, false);
-    check_walk(s, NULL, NULL, 10, 0, true);
+    static const char *const delay_frame[] = { "query_delay", "4", NULL };
+    static const char *const delay_wait[] = { "query_delay", "4", "latency", "wait", NULL };
+    static const char *const delay_chc[] = { "query_delay", "4", "vqueue", "false", "latency", "wait", NULL };
+    static const char *const never[] = { "query_delay", "1000000", NULL };
+    const char *const *opts[] = { NULL, delay_frame, delay_wait, delay_chc, never };
+    static const char *const what[] = { "defaults", "query_delay 4, latency=frame", "query_delay 4, latency=wait",
+                                        "query_delay 4, CHC order, wait", "query_delay 1000000" };
+    enum { N = sizeof opts / sizeof opts[0] };
+    latency_sums walk[2], w[N];
+    check_walk_all(s, opts, 2, NULL, 16, 11, false, walk);
+    assert_true(walk[0].queries > 0);
+    assert_int_equal(walk[0].ready, walk[0].queries);
+    assert_int_equal(walk[0].waited + walk[0].carried + walk[0].filled, 0);
+    assert_true(walk[1].carried > 0);
+    /* The street with every kind of latency (the others on it only, to
+     * stay quick). */
+    check_walk_all(s, opts, N, NULL, 10, 0, true, w);
+    for (int i = 0; i < N; ++i)
+        print_latency(what[i], w[i]);
+    assert_true(w[0].queries > 0);
+    assert_int_equal(w[0].ready, w[0].queries);
+    assert_int_equal(w[0].waited + w[0].carried + w[0].filled, 0);
+
+    assert_true(w[1].filled > 0 && w[1].carried > 0 && w[1].carried_in > 0);
+    assert_true(w[1].ready > 0 && w[1].waited > 0);
+    assert_true(w[2].filled > 0 && w[2].waited > 0);
+    assert_int_equal(w[2].carried + w[2].carried_in, 0);
+    assert_int_equal(w[3].carried + w[3].filled, 0);
+
+    rl_renderer *probe = fx_make("chcpp", NULL);
+    rl_camera cam = street_camera(0.0f);
+    rl_image *img = fx_render_with(probe, s, &cam, RL_LAYER_COLOR, NULL);
+    rl_culling_stats cs;
+    assert_int_equal(rl_culling_get_stats(probe, &cs), RL_OK);
+    assert_int_equal(w[4].ready, 0);
+    assert_true(w[4].carried > 0);
+    assert_true(w[4].max_carried <= cs.octree_nodes);
+    rl_image_release(img);
+    rl_renderer_release(probe);
     rl_scene_release(s);
 }
 
@@ -255,6 +362,8 @@ static void test_chcpp_refuses_bad_options(void **state)
     assert_int_equal(rl_renderer_set(r, "looseness", "0.5"), RL_ERR_INVALID_ARG);
     assert_int_equal(rl_renderer_set(r, "batch", "0"), RL_ERR_INVALID_ARG);
     assert_int_equal(rl_renderer_set(r, "assumed_visible", "-1"), RL_ERR_INVALID_ARG);
+    assert_int_equal(rl_renderer_set(r, "latency", "never"), RL_ERR_INVALID_ARG);
+    assert_int_equal(rl_renderer_set(r, "query_delay", "-1"), RL_ERR_INVALID_ARG);
     rl_culling_stats cs;
     assert_int_equal(rl_culling_get_stats(r, &cs), RL_ERR_INVALID_ARG);   /* nothing rendered */
     rl_renderer *raster = fx_make("raster", NULL);
