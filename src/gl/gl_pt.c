@@ -72,8 +72,8 @@ static bool buffer_texture(GLuint b)
 typedef struct uniforms {
     GLint num_nodes, masks, grid_min, grid_cell, grid_inv_cell, grid_res;
     GLint size, eye, cam_u, cam_v, cam_w, tan_half_fov, aspect, rng, held, checker, parity, raster, max_depth,
-        rr_depth, rr, mis, mis_hits, tri_lights, light_samples, vertex_slots, num_lights, table_count, num_textures, eps,
-        background, shadow, diffuse, specular, ls_start, ls_offset;
+        rr_depth, rr, mis, mis_hits, tri_lights, light_samples, vertex_slots, num_lights, table_count,
+        num_textures, eps, background, shadow, diffuse, specular, ls_start, ls_offset;
     GLint count, structure, any;
 } uniforms;
 
