@@ -628,19 +628,22 @@ static void test_gl_pt_filters_are_pts(void **state)
     assert_int_equal(rl_accel_commit(bvh), RL_OK);
     rl_gbuffer *g = NULL;
     assert_int_equal(rl_gbuffer_create(cam.width, cam.height, &g), RL_OK);
+    /* one renderer: an option change restarts the accumulation, the
+     * tracer and its context stay */
+    rl_renderer *r = fx_make("gl-pt", (const char *const[]){ "spp", "3", "filter_fade", "4", NULL });
     for (int raster = 0; raster < 2; ++raster) {
         const char *primary = raster ? "raster" : "trace";
         rl_render_stats st = { 0 };
-        rl_image *plain = fx_render("gl-pt", s, &cam, RL_LAYER_COLOR | RL_LAYER_ID,
-                                    (const char *const[]){ "spp", "3", "primary", primary, NULL }, &st);
+        assert_int_equal(rl_renderer_set(r, "primary", primary), RL_OK);
+        assert_int_equal(rl_renderer_set(r, "filter", "none"), RL_OK);
+        rl_image *plain = fx_render_with(r, s, &cam, RL_LAYER_COLOR | RL_LAYER_ID, &st);
         if (raster)
             assert_int_equal(rl_gbuffer_from_ids(g, s, &cam, plain->triangle_id), RL_OK);
         else
             assert_int_equal(rl_gbuffer_trace(g, bvh, &cam), RL_OK);
         for (int k = 0; k < 5; ++k) {
-            rl_image *filtered = fx_render("gl-pt", s, &cam, RL_LAYER_COLOR,
-                                           (const char *const[]){ "spp", "3", "primary", primary, "filter",
-                                                                  filters[k], "filter_fade", "4", NULL }, &st);
+            assert_int_equal(rl_renderer_set(r, "filter", filters[k]), RL_OK);
+            rl_image *filtered = fx_render_with(r, s, &cam, RL_LAYER_COLOR, &st);
             rl_image *expect = NULL;
             assert_int_equal(rl_image_create(cam.width, cam.height, RL_LAYER_COLOR, &expect), RL_OK);
             memcpy(expect->color, plain->color, n * sizeof *expect->color);
@@ -670,6 +673,7 @@ static void test_gl_pt_filters_are_pts(void **state)
         }
         rl_image_release(plain);
     }
+    rl_renderer_release(r);
     rl_gbuffer_release(g);
     rl_accel_release(bvh);
     rl_scene_release(s);
