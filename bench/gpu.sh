@@ -4,7 +4,7 @@
 # device): builds renderlab (make build) and runs the GL benchmarks on the
 # first EGL device (RL_EGL_DEVICE=auto, else the one named), each under a
 # time limit, writing bench/results/gpu-<date>-*.json. The limits add up to
-# 475 s, the build to about 1-1.5 minutes on 16 cores: the whole run stays
+# 485 s, the build to about 1-1.5 minutes on 16 cores: the whole run stays
 # under 10 minutes (the limits are ceilings, not the usual times); a
 # benchmark that runs out of time is reported and the
 # next one still runs.
@@ -74,6 +74,12 @@ step 12 "rl bench gl, gl-pt 1280x720, BVH" "$rl" bench gl --only pt --pt-gl-only
 step 18 "rl bench gl, gl-pt 1280x720, ls-pnmt" "$rl" bench gl --only pt --pt-gl-only --pt-size 1280x720 \
     --frames 5 --pt-backend ls-pnmt --pt-grid-res 32 --scenes cornell,ls-cornell:model=bunny \
     --out "$out/gpu-$date-gl-pt-ls-pnmt.json"
+# Sec. 8.1 and 8.5 on the GPU: gl-pt with the G-buffer from a GL raster
+# pass and checkerboard rendering, Cornell + bunny at 1280x720, 20 frames
+# of 1 spp; the stats (frame time, rays by type, device) as the record.
+step 10 "gl-pt 1280x720, primary=raster checkerboard" "$rl" render ls-cornell:model=bunny --algo gl-pt \
+    --set gl-pt.primary=raster --set gl-pt.checkerboard=true --size 1280x720 --spp 20 \
+    --stats-json "$out/gpu-$date-gl-pt-raster.json" --out "/tmp/gpu-$date-gl-pt-raster.png"
 # Schröder 2017, Table 1: Line Space generation on the GPU (compute
 # shaders, the same lists as the CPU build) against the CPU build, all 8
 # rows, the thesis' GTX 1080 times beside; the target is >= 3x faster than

@@ -51,6 +51,12 @@ RL_API rl_status rl_gbuffer_trace_part(rl_gbuffer *g, const rl_accel *accel, con
  * rl_gbuffer_trace except where the rasterizer's coverage rule and the
  * ray disagree at triangle edges. */
 RL_API rl_status rl_gbuffer_raster(rl_gbuffer *g, const rl_scene *scene, const rl_camera *cam);
+/* The second half of rl_gbuffer_raster for a triangle-ID layer drawn by
+ * another rasterizer (gl-pt's raster pass on GL): triangles holds per
+ * pixel (g's size, row 0 the top row) the scene triangle drawn there, or
+ * RL_ID_NONE. */
+RL_API rl_status rl_gbuffer_from_ids(rl_gbuffer *g, const rl_scene *scene, const rl_camera *cam,
+                                     const uint32_t *triangles);
 
 #ifdef __cplusplus
 }

@@ -71,9 +71,9 @@ static bool buffer_texture(GLuint b)
 /* The uniforms of a program, by name once. */
 typedef struct uniforms {
     GLint num_nodes, masks, grid_min, grid_cell, grid_inv_cell, grid_res;
-    GLint size, eye, cam_u, cam_v, cam_w, tan_half_fov, aspect, rng, sample, max_depth, rr_depth, rr, mis,
-        mis_hits, tri_lights, light_samples, vertex_slots, num_lights, table_count, num_textures, eps,
-        background, shadow, diffuse, specular, ls_start, ls_offset;
+    GLint size, eye, cam_u, cam_v, cam_w, tan_half_fov, aspect, rng, held, checker, parity, raster, max_depth,
+        rr_depth, rr, mis, mis_hits, tri_lights, light_samples, vertex_slots, num_lights, table_count,
+        num_textures, eps, background, shadow, diffuse, specular, ls_start, ls_offset;
     GLint count, structure, any;
 } uniforms;
 
@@ -100,7 +100,12 @@ struct rl_gl_pt {
     /* the accumulation */
     GLuint tex_accum, tex_rng;
     int width, height;
-    uint64_t samples;
+    uint64_t held[2];             /* samples per pixel, by the parity of x + y */
+    uint64_t frames;              /* since the reset */
+    /* primary=raster: the raster pass's triangle per pixel (r32ui) */
+    GLuint tex_ids;
+    /* the ray counters (atomic_uint, one per rl_ray_type) */
+    GLuint counters;
 };
 
 /* An immutable buffer of at least 16 bytes (empty arrays still bind). */
@@ -156,7 +161,10 @@ static void locate(GLuint p, uniforms *u)
     U(tan_half_fov, "u_tan_half_fov");
     U(aspect, "u_aspect");
     U(rng, "u_rng");
-    U(sample, "u_sample");
+    U(held, "u_held");
+    U(checker, "u_checker");
+    U(parity, "u_parity");
+    U(raster, "u_raster");
     U(max_depth, "u_max_depth");
     U(rr_depth, "u_rr_depth");
     U(rr, "u_rr");
@@ -537,22 +545,54 @@ static rl_status reset_images(rl_gl_pt *pt, int w, int h, const uint32_t *states
         if (pt->tex_accum) {
             glDeleteTextures(1, &pt->tex_accum);
             glDeleteTextures(1, &pt->tex_rng);
+            glDeleteTextures(1, &pt->tex_ids);
         }
         glCreateTextures(GL_TEXTURE_2D, 1, &pt->tex_accum);
         glTextureStorage2D(pt->tex_accum, 1, GL_RGBA32F, w, h);
         glCreateTextures(GL_TEXTURE_2D, 1, &pt->tex_rng);
         glTextureStorage2D(pt->tex_rng, 1, GL_RGBA32UI, w, h);
+        /* bound in both primary modes: a shader compiler that specializes
+         * on the bound textures (llvmpipe) then makes one variant */
+        glCreateTextures(GL_TEXTURE_2D, 1, &pt->tex_ids);
+        glTextureStorage2D(pt->tex_ids, 1, GL_R32UI, w, h);
+        /* an integer texture with the default linear filters is incomplete
+         * and every texelFetch reads 0 */
+        glTextureParameteri(pt->tex_ids, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
+        glTextureParameteri(pt->tex_ids, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
         pt->width = w;
         pt->height = h;
     }
     glTextureSubImage2D(pt->tex_rng, 0, 0, 0, w, h, GL_RGBA_INTEGER, GL_UNSIGNED_INT, states);
     const float zero[4] = { 0.0f, 0.0f, 0.0f, 0.0f };
     glClearTexImage(pt->tex_accum, 0, GL_RGBA, GL_FLOAT, zero);
-    pt->samples = 0;
+    pt->held[0] = pt->held[1] = 0;
+    pt->frames = 0;
     return RL_OK;
 }
 
-static rl_status render_frame(rl_gl_pt *pt, const rl_gl_pt_frame *f, float *rgba)
+
+/* The ray counters added to rays and cleared. */
+static void drain_counters(rl_gl_pt *pt, uint64_t rays[RL_RAY_TYPE_COUNT])
+{
+    uint32_t c[RL_RAY_TYPE_COUNT];
+    glMemoryBarrier(GL_ATOMIC_COUNTER_BARRIER_BIT | GL_BUFFER_UPDATE_BARRIER_BIT);
+    glGetNamedBufferSubData(pt->counters, 0, sizeof c, c);
+    for (int k = 0; k < RL_RAY_TYPE_COUNT; ++k)
+        rays[k] += c[k];
+    const uint32_t zero = 0;
+    glClearNamedBufferData(pt->counters, GL_R32UI, GL_RED_INTEGER, GL_UNSIGNED_INT, &zero);
+}
+
+/* The most rays of one type a dispatch of w x h paths can trace: the
+ * primary ray, and per path vertex (the camera hit and max_depth bounces)
+ * the shadow rays and one continuing ray. */
+static uint64_t rays_bound(const rl_gl_pt_frame *f, uint32_t num_lights)
+{
+    uint64_t per_vertex = (uint64_t)f->light_samples * (f->mis ? 1u : (num_lights ? num_lights : 1u)) + 1u;
+    return (uint64_t)f->cam.width * (uint64_t)f->cam.height * (1u + ((uint64_t)f->max_depth + 1u) * per_vertex);
+}
+
+static rl_status render_frame(rl_gl_pt *pt, const rl_gl_pt_frame *f, float *rgba, uint64_t rays[RL_RAY_TYPE_COUNT])
 {
     const rl_scene_data *d = pt->data;
     const int w = f->cam.width, h = f->cam.height;
@@ -587,6 +627,21 @@ static rl_status render_frame(rl_gl_pt *pt, const rl_gl_pt_frame *f, float *rgba
     glProgramUniform1f(p, u->tan_half_fov, c->tan_half_fov_y);
     glProgramUniform1f(p, u->aspect, c->aspect);
     glProgramUniform1i(p, u->rng, f->rng);
+    glProgramUniform1i(p, u->checker, f->checkerboard);
+    const uint32_t parity = (uint32_t)(pt->frames & 1u);
+    glProgramUniform1ui(p, u->parity, parity);
+    glProgramUniform1i(p, u->raster, f->raster_ids != NULL);
+    if (f->raster_ids) {
+        glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
+        glTextureSubImage2D(pt->tex_ids, 0, 0, 0, w, h, GL_RED_INTEGER, GL_UNSIGNED_INT, f->raster_ids);
+    }
+    glBindTextureUnit(6, pt->tex_ids);
+    if (!pt->counters) {
+        pt->counters = make_buffer(NULL, 32, GL_DYNAMIC_STORAGE_BIT);
+        const uint32_t zero = 0;
+        glClearNamedBufferData(pt->counters, GL_R32UI, GL_RED_INTEGER, GL_UNSIGNED_INT, &zero);
+    }
+    glBindBufferBase(GL_ATOMIC_COUNTER_BUFFER, 0, pt->counters);
     glProgramUniform1i(p, u->max_depth, f->max_depth);
     glProgramUniform1i(p, u->rr_depth, f->rr_depth);
     glProgramUniform1i(p, u->rr, f->rr);
@@ -612,14 +667,28 @@ static rl_status render_frame(rl_gl_pt *pt, const rl_gl_pt_frame *f, float *rgba
         rl_gl_ls_set_uniforms(pt->ls, p);
     }
     const GLuint gx = (GLuint)(w + LOCAL - 1) / LOCAL, gy = (GLuint)(h + LOCAL - 1) / LOCAL;
+    /* the counters are read only when the next dispatch could wrap them */
+    const uint64_t bound = rays_bound(f, d->num_lights);
+    uint64_t pending = 0;
     for (int k = 0; k < f->spp; ++k) {
+        if (pending > 0 && pending + bound > UINT32_MAX) {
+            drain_counters(pt, rays);
+            pending = 0;
+        }
         /* One sample per dispatch: the accumulation of eq. 8 reads what the
-         * previous sample wrote. */
-        glProgramUniform1ui(p, u->sample, (GLuint)(pt->samples + (uint64_t)k));
+         * previous sample wrote. Each class of pixels numbers its own
+         * samples (checkerboard traces one class per frame). */
+        const GLuint held[2] = { (GLuint)(pt->held[0] + (uint64_t)k), (GLuint)(pt->held[1] + (uint64_t)k) };
+        glProgramUniform1uiv(p, u->held, 2, held);
         glDispatchCompute(gx, gy, 1);
         glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT);
+        pending += bound;
     }
-    pt->samples += (uint64_t)f->spp;
+    drain_counters(pt, rays);
+    for (int c = 0; c < 2; ++c)
+        if (!f->checkerboard || (uint32_t)c == parity)
+            pt->held[c] += (uint64_t)f->spp;
+    pt->frames++;
     if (rgba) {
         glMemoryBarrier(GL_TEXTURE_UPDATE_BARRIER_BIT);
         glGetTextureImage(pt->tex_accum, 0, GL_RGBA, GL_FLOAT, (GLsizei)((size_t)w * (size_t)h * 4 * sizeof(float)),
@@ -630,7 +699,7 @@ static rl_status render_frame(rl_gl_pt *pt, const rl_gl_pt_frame *f, float *rgba
     return rl_gl_check("rl_gl_pt_render");
 }
 
-rl_status rl_gl_pt_render(rl_gl_pt *pt, const rl_gl_pt_frame *frame, float *rgba, uint64_t *samples)
+rl_status rl_gl_pt_render(rl_gl_pt *pt, const rl_gl_pt_frame *frame, float *rgba, rl_gl_pt_result *res)
 {
     if (!pt || !frame)
         return rl_error(RL_ERR_INVALID_ARG, "rl_gl_pt_render: NULL argument");
@@ -639,15 +708,22 @@ rl_status rl_gl_pt_render(rl_gl_pt *pt, const rl_gl_pt_frame *frame, float *rgba
         (unsigned)frame->specular >= RL_GL_PT_STRUCTURE_COUNT ||
         frame->rng < 0 || frame->rng > 3)
         return rl_error(RL_ERR_INVALID_ARG, "rl_gl_pt_render: bad frame settings");
-    if (pt->samples + (uint64_t)frame->spp > UINT32_MAX)
+    const uint64_t most = frame->reset_states ? 0 : (pt->held[0] > pt->held[1] ? pt->held[0] : pt->held[1]);
+    if (most + (uint64_t)frame->spp > UINT32_MAX)
         return rl_error(RL_ERR_LIMIT, "gl-pt: more than 2^32 samples per pixel in one accumulation");
+    uint64_t rays[RL_RAY_TYPE_COUNT] = { 0 };
     rl_status st = rl_gl_context_make_current(pt->ctx);
     if (st == RL_OK)
-        st = render_frame(pt, frame, rgba);
-    if (st != RL_OK && frame->reset_states)
-        pt->samples = 0;
-    if (samples)
-        *samples = pt->samples;
+        st = render_frame(pt, frame, rgba, rays);
+    if (st != RL_OK && frame->reset_states) {
+        pt->held[0] = pt->held[1] = 0;
+        pt->frames = 0;
+    }
+    if (res) {
+        memcpy(res->held, pt->held, sizeof res->held);
+        res->frames = pt->frames;
+        memcpy(res->rays, rays, sizeof res->rays);
+    }
     rl_gl_context_done(pt->ctx);
     return st;
 }
@@ -749,13 +825,13 @@ const rl_gl_info *rl_gl_pt_info(const rl_gl_pt *pt)
     return NULL;
 }
 
-rl_status rl_gl_pt_render(rl_gl_pt *pt, const rl_gl_pt_frame *frame, float *rgba, uint64_t *samples)
+rl_status rl_gl_pt_render(rl_gl_pt *pt, const rl_gl_pt_frame *frame, float *rgba, rl_gl_pt_result *res)
 {
     (void)pt;
     (void)frame;
     (void)rgba;
-    if (samples)
-        *samples = 0;
+    if (res)
+        memset(res, 0, sizeof *res);
     return rl_error(RL_ERR_UNSUPPORTED, "gl: built without OpenGL");
 }
 

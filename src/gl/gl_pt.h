@@ -24,6 +24,7 @@
 #include "rl/rl_camera.h"
 #include "rl/rl_gl.h"
 #include "rl/rl_linespace.h"
+#include "rl/rl_render.h"
 #include "rl/rl_scene.h"
 
 typedef struct rl_gl_pt rl_gl_pt;
@@ -69,6 +70,14 @@ typedef struct rl_gl_pt_frame {
                                     * voxel offset at a shadow ray's light end */
     int grid_res;                  /* 0: the grid heuristic */
     rl_vec3 background;
+    /* Sec. 8.5: this frame traces only the pixels whose x + y has the
+     * parity of the frames since the reset (pathtrace.c active()) */
+    bool checkerboard;
+    /* Non-NULL: primary=raster (Sec. 8.1): per pixel (row 0 the top row)
+     * the triangle the raster pass drew there, RL_ID_NONE where none; the
+     * paths start where the pixel-centre ray meets its plane, as pt's
+     * rasterized G-buffer (gbuffer.c). NULL: jittered camera rays. */
+    const uint32_t *raster_ids;
     /* Non-NULL: a new accumulation of cam.width x cam.height pixels starts
      * from these per-pixel states (4 words each, row 0 the top row: the
      * generator state, or for sobol the scramble seed in the first). */
@@ -83,11 +92,28 @@ rl_status rl_gl_pt_create(const rl_scene *scene, const rl_gl_pt_desc *desc, rl_g
 void rl_gl_pt_release(rl_gl_pt *pt);      /* NULL is a no-op */
 const rl_gl_info *rl_gl_pt_info(const rl_gl_pt *pt);
 
-/* Traces frame->spp samples per pixel and adds them to the accumulation
- * (Sec. 6.5, eq. 8); rgba (4 floats per pixel, may be NULL) gets the
- * accumulated mean. RL_ERR_INVALID_ARG without reset_states on the first
- * frame or a size change. *samples: per pixel after this frame. */
-rl_status rl_gl_pt_render(rl_gl_pt *pt, const rl_gl_pt_frame *frame, float *rgba, uint64_t *samples);
+/* What a frame did: the samples the pixels hold after it, by the parity of
+ * x + y (the two are equal without checkerboard; a pixel of a class that
+ * holds none has not been traced yet and its rgba is 0), the frames since
+ * the reset, and the rays the frame traced by rl_ray_type, counted by
+ * atomic counters in the shader where pt counts them (pathtrace*.c):
+ * primary rays of primary=trace, shadow rays, and the reflection,
+ * refraction and diffuse rays that continue a path. The 32-bit counters
+ * are read and cleared between dispatches before they could wrap, so the
+ * counts are exact as long as one dispatch traces fewer than 2^32 rays of
+ * a type. */
+typedef struct rl_gl_pt_result {
+    uint64_t held[2];
+    uint64_t frames;
+    uint64_t rays[RL_RAY_TYPE_COUNT];
+} rl_gl_pt_result;
+
+/* Traces frame->spp samples per pixel (of the frame's checkerboard half)
+ * and adds them to the accumulation (Sec. 6.5, eq. 8); rgba (4 floats per
+ * pixel, may be NULL) gets the accumulated mean. RL_ERR_INVALID_ARG
+ * without reset_states on the first frame or a size change. res may be
+ * NULL. */
+rl_status rl_gl_pt_render(rl_gl_pt *pt, const rl_gl_pt_frame *frame, float *rgba, rl_gl_pt_result *res);
 
 /* The Line Space the LS structures walk, replacing the tracer's: uploaded
  * from ls (committed, its origin rule as set) when ls is non-NULL, else

@@ -322,7 +322,18 @@ const char *const rl_gl_pt_glsl_path = GLSL(
     uniform float u_tan_half_fov;
     uniform float u_aspect;
     uniform int u_rng;                 /* 0: sobol, else rl_rng_gpu_kind + 1 */
-    uniform uint u_sample;             /* samples each pixel holds before this one */
+    uniform uint u_held[2];            /* samples the pixels hold before this one, by the
+                                        * parity of x + y */
+    uniform bool u_checker;            /* checkerboard (Sec. 8.5): only the pixels whose */
+    uniform uint u_parity;             /* x + y has this parity */
+    uniform bool u_raster;             /* primary=raster: paths start from u_ids' triangles */
+    layout(binding = 6) uniform usampler2D u_ids;
+    /* pt's ray counts by rl_ray_type (rl_render_stats.rays) */
+    layout(binding = 0, offset = 0) uniform atomic_uint c_primary;
+    layout(binding = 0, offset = 4) uniform atomic_uint c_shadow;
+    layout(binding = 0, offset = 8) uniform atomic_uint c_reflection;
+    layout(binding = 0, offset = 12) uniform atomic_uint c_refraction;
+    layout(binding = 0, offset = 16) uniform atomic_uint c_diffuse;
     uniform int u_max_depth;
     uniform int u_rr_depth;
     uniform bool u_rr;
@@ -492,20 +503,19 @@ const char *const rl_gl_pt_glsl_path = GLSL(
         return dot(bent, bent) > 0.0 && finite3(bent) ? normalize(bent) : n;
     }
 
-    /* rl_pt_surface_at_hit + rl_pt_surface_finish */
-    Surf surface_at(Hit h, vec3 dir)
+    /* rl_pt_surface_finish: the surface at p on tri, ns the interpolated
+     * normal, v towards the viewer */
+    Surf surface_finish(uint tri, vec3 p, vec3 ns, vec2 uv, vec3 v)
     {
-        uvec4 T = triangles[h.tri];
-        float u = h.u, v = h.v, w = 1.0 - u - v;
+        uvec4 T = triangles[tri];
         vec3 p0 = position(T.x), p1 = position(T.y), p2 = position(T.z);
         Surf s;
-        s.p = p0 * w + p1 * u + p2 * v;
-        vec3 ns = normal_at(T.x) * w + normal_at(T.y) * u + normal_at(T.z) * v;
-        s.uv = interp_uv(h.tri, u, v);
-        s.v = -normalize(dir);
+        s.p = p;
+        s.uv = uv;
+        s.v = v;
         vec3 ng = normalize(cross(p1 - p0, p2 - p0));
         Material m = materials[T.w];
-        ns = normalize(shading_normal(h.tri, m, ns, s.uv));
+        ns = normalize(shading_normal(tri, m, ns, uv));
         if (!(dot(ns, ns) > 0.0) || !finite3(ns))
             ns = ng;
         s.front = dot(ng, s.v) > 0.0;
@@ -514,9 +524,58 @@ const char *const rl_gl_pt_glsl_path = GLSL(
         s.mat = T.w;
         s.kd = m.diffuse.rgb;
         if (m.tex.x != NONE)
-            s.kd *= tex_sample(m.tex.x, s.uv).rgb;
-        s.tri = h.tri;
+            s.kd *= tex_sample(m.tex.x, uv).rgb;
+        s.tri = tri;
         return s;
+    }
+
+    /* rl_pt_surface_at_hit */
+    Surf surface_at(Hit h, vec3 dir)
+    {
+        uvec4 T = triangles[h.tri];
+        float u = h.u, v = h.v, w = 1.0 - u - v;
+        vec3 p = position(T.x) * w + position(T.y) * u + position(T.z) * v;
+        vec3 ns = normal_at(T.x) * w + normal_at(T.y) * u + normal_at(T.z) * v;
+        return surface_finish(h.tri, p, ns, interp_uv(h.tri, u, v), -normalize(dir));
+    }
+
+    /* primary=raster (pt's G-buffer, gbuffer.c rl_gbuffer_raster): the
+     * pixel-centre ray meets the plane of the triangle the raster pass
+     * drew there (scene/tri_plane.h rl_tri_plane_hit, barycentrics clamped
+     * onto the triangle), the point and normal as fill_pixel makes them
+     * (the normal turned towards the camera), v towards the eye */
+    bool surface_of_pixel(uint tri, vec3 eye, vec3 dir, out Surf s)
+    {
+        uvec4 T = triangles[tri];
+        vec3 p0 = position(T.x), p1 = position(T.y), p2 = position(T.z);
+        vec3 e1 = p1 - p0, e2 = p2 - p0;
+        vec3 pv = cross(dir, e2);
+        float det = dot(e1, pv);
+        if (!(abs(det) > 0.0))
+            return false;
+        float inv = 1.0 / det;
+        vec3 tv = eye - p0;
+        float u = dot(tv, pv) * inv;
+        vec3 qv = cross(tv, e1);
+        float v = dot(dir, qv) * inv;
+        float t = dot(e2, qv) * inv;
+        u = max(u, 0.0);
+        v = max(v, 0.0);
+        if (u + v > 1.0) {
+            float k = 1.0 / (u + v);
+            u *= k;
+            v *= k;
+        }
+        if (isinf(t) || isnan(t) || !(t > 0.0))
+            return false;
+        float w = 1.0 - u - v;
+        vec3 p = p0 * w + p1 * u + p2 * v;
+        vec3 n = normalize(normal_at(T.x) * w + normal_at(T.y) * u + normal_at(T.z) * v);
+        if (!(dot(n, n) > 0.0) || !finite3(n))
+            n = normalize(cross(e1, e2));
+        n = dot(n, dir) > 0.0 ? -n : n;
+        s = surface_finish(tri, p, n, interp_uv(tri, u, v), normalize(eye - p));
+        return true;
     }
 
     /* pathtrace_path.c surface_of_record: a PNMT record knows only its
@@ -685,6 +744,7 @@ const char *const rl_gl_pt_glsl_path = GLSL(
                 d = to * (1.0 / len);
             t_max = len * (1.0 - 1e-4);
         }
+        atomicCounterIncrement(c_shadow);
         if (u_shadow == STRUCT_LS_CAND)
             return !rl_ls_occluded(o, d, 0.0, t_max);
         if (u_shadow == STRUCT_LS_PNMT || u_shadow == STRUCT_LS_PREILLUM) {
@@ -970,7 +1030,7 @@ const char *const rl_gl_pt_glsl_path = GLSL(
             seek(base + SLOT_EVENT);
             float u_event = gen || k_r + k_t > 0.0 ? sample_1d() : 1.0;
             vec3 dir;
-            bool diffuse_ray;
+            bool diffuse_ray, refracted = false;
             if (u_event < k_r + k_t) {
                 if (depth >= u_max_depth)
                     break;
@@ -982,8 +1042,10 @@ const char *const rl_gl_pt_glsl_path = GLSL(
                     float eta = s.front ? 1.0 / ior : ior;
                     float cos_i = -dot(d, s.ns);
                     float k = 1.0 - eta * eta * (1.0 - cos_i * cos_i);
-                    if (k >= 0.0)
+                    if (k >= 0.0) {
                         dir = normalize(d * eta + s.ns * (eta * cos_i - sqrt(k)));
+                        refracted = true;
+                    }
                 }
                 after_brdf = false;
             } else {
@@ -1020,6 +1082,12 @@ const char *const rl_gl_pt_glsl_path = GLSL(
              * structure than the diffuse bounces */
             int structure = diffuse_ray ? u_diffuse : u_specular;
             vec3 o = offset_origin(s, dir);
+            if (diffuse_ray)
+                atomicCounterIncrement(c_diffuse);
+            else if (refracted)
+                atomicCounterIncrement(c_refraction);
+            else
+                atomicCounterIncrement(c_reflection);
             if (structure == STRUCT_LS_PREILLUM) {
                 /* the stored direct light ends the path (Sec. 7.4) */
                 vec3 col;
@@ -1042,19 +1110,36 @@ const char *const rl_gl_pt_glsl_path = GLSL(
         ivec2 px = ivec2(gl_GlobalInvocationID.xy);
         if (px.x >= u_size.x || px.y >= u_size.y)
             return;
+        /* pathtrace.c active(): the other half waits for the next frame */
+        uint cls = uint(px.x + px.y) & 1u;
+        if (u_checker && cls != u_parity)
+            return;
+        uint held = u_held[cls];
         g_state = imageLoad(u_rng_state, px);
-        g_index = u_sample;
+        g_index = held;
         g_slot = 0u;
-        seek(SLOT_PIXEL);
-        vec2 j = sample_2d();
-        /* rl_camera_frame_ray: image plane at distance 1, rows downwards */
-        float sx = (2.0 * (float(px.x) + j.x) / float(u_size.x) - 1.0) * u_tan_half_fov * u_aspect;
-        float sy = (1.0 - 2.0 * (float(px.y) + j.y) / float(u_size.y)) * u_tan_half_fov;
-        vec3 dir = normalize(u_cam_u * sx + u_cam_v * sy - u_cam_w);
         vec3 L = u_background;
-        Hit h;
-        if (bvh_query(u_eye, dir, 0.0, INF, false, h))
-            L = trace_path(surface_at(h, dir));
+        if (u_raster) {
+            /* the G-buffer's pixel centre: no jitter, no number drawn */
+            uint tri = texelFetch(u_ids, px, 0).x;
+            float sx = (2.0 * (float(px.x) + 0.5) / float(u_size.x) - 1.0) * u_tan_half_fov * u_aspect;
+            float sy = (1.0 - 2.0 * (float(px.y) + 0.5) / float(u_size.y)) * u_tan_half_fov;
+            vec3 dir = normalize(u_cam_u * sx + u_cam_v * sy - u_cam_w);
+            Surf first;
+            if (tri < uint(triangles.length()) && surface_of_pixel(tri, u_eye, dir, first))
+                L = trace_path(first);
+        } else {
+            seek(SLOT_PIXEL);
+            vec2 j = sample_2d();
+            /* rl_camera_frame_ray: image plane at distance 1, rows downwards */
+            float sx = (2.0 * (float(px.x) + j.x) / float(u_size.x) - 1.0) * u_tan_half_fov * u_aspect;
+            float sy = (1.0 - 2.0 * (float(px.y) + j.y) / float(u_size.y)) * u_tan_half_fov;
+            vec3 dir = normalize(u_cam_u * sx + u_cam_v * sy - u_cam_w);
+            Hit h;
+            atomicCounterIncrement(c_primary);
+            if (bvh_query(u_eye, dir, 0.0, INF, false, h))
+                L = trace_path(surface_at(h, dir));
+        }
         /* A NaN or infinity would poison the pixel's mean for good; it
          * counts as black, as pt counts the sample but adds nothing. */
         if (!finite3(L))
@@ -1062,8 +1147,8 @@ const char *const rl_gl_pt_glsl_path = GLSL(
         if (u_rng != 0)
             imageStore(u_rng_state, px, g_state);
         /* Sec. 6.5, eq. 8: C_{s+1} = s/(s+1) C_s + 1/(s+1) C_trace */
-        float n = float(u_sample);
-        vec4 c = u_sample == 0u ? vec4(0.0) : imageLoad(u_accum, px);
+        float n = float(held);
+        vec4 c = held == 0u ? vec4(0.0) : imageLoad(u_accum, px);
         imageStore(u_accum, px, vec4(c.rgb * (n / (n + 1.0)) + L * (1.0 / (n + 1.0)), 1.0));
     }
 );

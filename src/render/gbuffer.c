@@ -177,6 +177,27 @@ rl_status rl_gbuffer_trace_part(rl_gbuffer *g, const rl_accel *accel, const rl_c
     return RL_OK;
 }
 
+/* Each pixel from the triangle drawn there: its centre ray cut with the
+ * triangle's plane (no traversal). */
+static void fill_from_ids(rl_gbuffer *g, const rl_scene_data *d, const rl_camera *c, const uint32_t *triangles)
+{
+    rl_camera_frame f = rl_camera_frame_make(c);
+    rl_vec3 forward = rl_neg(f.w);
+#pragma omp parallel for schedule(dynamic, 4)
+    for (int y = 0; y < g->height; ++y) {
+        for (int x = 0; x < g->width; ++x) {
+            size_t i = (size_t)y * g->width + x;
+            uint32_t tri = triangles[i];
+            rl_ray ray = rl_camera_frame_ray(&f, (float)x + 0.5f, (float)y + 0.5f);
+            float t, u, v;
+            if (tri < d->num_triangles && rl_tri_plane_hit(d, tri, &ray, &t, &u, &v))
+                fill_pixel(g, i, d, ray.d, forward, tri, t, u, v);
+            else
+                clear_pixel(g, i);
+        }
+    }
+}
+
 rl_status rl_gbuffer_raster(rl_gbuffer *g, const rl_scene *scene, const rl_camera *cam)
 {
     rl_camera c;
@@ -199,25 +220,23 @@ rl_status rl_gbuffer_raster(rl_gbuffer *g, const rl_scene *scene, const rl_camer
         st = rl_raster_draw_scene(ras, d, c.eye, &desc, NULL, NULL, NULL);
     }
     rl_raster_release(ras);
-    if (st != RL_OK) {
-        rl_image_release(ids);
-        return st;
-    }
-    rl_camera_frame f = rl_camera_frame_make(&c);
-    rl_vec3 forward = rl_neg(f.w);
-#pragma omp parallel for schedule(dynamic, 4)
-    for (int y = 0; y < g->height; ++y) {
-        for (int x = 0; x < g->width; ++x) {
-            size_t i = (size_t)y * g->width + x;
-            uint32_t tri = ids->triangle_id[i];
-            rl_ray ray = rl_camera_frame_ray(&f, (float)x + 0.5f, (float)y + 0.5f);
-            float t, u, v;
-            if (tri < d->num_triangles && rl_tri_plane_hit(d, tri, &ray, &t, &u, &v))
-                fill_pixel(g, i, d, ray.d, forward, tri, t, u, v);
-            else
-                clear_pixel(g, i);
-        }
-    }
+    if (st == RL_OK)
+        fill_from_ids(g, d, &c, ids->triangle_id);
     rl_image_release(ids);
+    return st;
+}
+
+rl_status rl_gbuffer_from_ids(rl_gbuffer *g, const rl_scene *scene, const rl_camera *cam, const uint32_t *triangles)
+{
+    rl_camera c;
+    rl_status st = check_args(g, cam, "rl_gbuffer_from_ids", &c);
+    if (st != RL_OK)
+        return st;
+    const rl_scene_data *d = scene ? rl_scene_get_data(scene) : NULL;
+    if (!d)
+        return rl_error(RL_ERR_NOT_COMMITTED, "rl_gbuffer_from_ids: the scene must be committed");
+    if (!triangles)
+        return rl_error(RL_ERR_INVALID_ARG, "rl_gbuffer_from_ids: NULL triangle IDs");
+    fill_from_ids(g, d, &c, triangles);
     return RL_OK;
 }

@@ -15,20 +15,33 @@
  *
  * Options: pt's names and defaults where ported (spp, max_depth, rr,
  * rr_depth, rng, mis, seed, shadow, diffuse, specular, primary,
- * checkerboard, accumulate, filter, grid_res, ls_n, ls_k, ls_dynamic,
- * ls_origin, light_samples, background, threads), device (rl_gl.h) and
- * ls_build. Values pt has and gl-pt has not ported are refused with an
- * option error naming what is ported: shadow=embree|shadowmap,
- * diffuse=embree, primary=raster, checkerboard=true, filter other than
- * none; pt's ls_file and shadowmap_size are not in the table.
+ * checkerboard, accumulate, filter, filter_fade, atrous_*, grid_res, ls_n,
+ * ls_k, ls_dynamic, ls_origin, light_samples, background, threads), device
+ * (rl_gl.h) and ls_build. Values pt has and gl-pt has not ported are
+ * refused with an option error naming what is ported:
+ * shadow=embree|shadowmap, diffuse=embree; pt's ls_file, shadowmap_size
+ * and adaptive* are not in the table.
+ *
+ * primary=raster (Sec. 8.1): every frame a GL drawer (gl_drawer.c) draws
+ * the scene's triangle IDs, unlit, as rl_gbuffer_raster draws them with
+ * the software rasterizer; the compute shader starts each pixel's path
+ * where the pixel-centre ray meets the plane of the triangle drawn there.
+ * checkerboard (Sec. 8.5): the shader traces the pixels with x + y +
+ * frame even, each class numbering its own samples, and the first frame's
+ * holes are the mean of their traced 4-neighbours, as pt's resolve().
+ * Filters (Sec. 8.2): pt's own (rl_pt_filter_image, the library's CPU
+ * filters) on the read-back image, guided by the G-buffer pt would use:
+ * traced at the pixel centres, or with primary=raster made from the GL
+ * pass's triangle IDs (rl_gbuffer_from_ids). Ray counts come from atomic
+ * counters in the shader (gl_pt.h).
  *
  * The Line Space backends (ls-candidates, ls-pnmt, ls-preillum) walk the
  * Line Space pt builds (pathtrace_backend.c, the same rl_linespace and
  * voxel offsets), uploaded to the GPU (gl_linespace.h); ls_build=gpu builds
  * the candidate lists on the GPU instead, from pt's CPU grid.
  *
- * Depth and ID layers, where the image has them, come from pt's traced
- * G-buffer (CPU BVH, pixel centres), as pt writes them. */
+ * Depth and ID layers, where the image has them, come from that G-buffer,
+ * as pt writes them. */
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -38,6 +51,7 @@
 #include "gl/gl_pt.h"
 #include "render/pathtrace_internal.h"
 #include "render/renderer.h"
+#include "rl/rl_drawer.h"
 #include "rl/rl_gl.h"
 #include "rl/rl_timer.h"
 
@@ -51,7 +65,8 @@ static const char *const diffuse_choices[] = { "bvh", "grid", "embree", "ls-cand
                                                NULL };
 static const char *const specular_choices[] = { "exact", "diffuse", NULL };
 static const char *const primary_choices[] = { "trace", "raster", NULL };
-static const char *const filter_choices[] = { "none", "gauss", "bilateral", "aniso", "kuwahara", NULL };
+/* Order = rl_filter_kind, as pt's. */
+static const char *const filter_choices[] = { "none", "gauss", "bilateral", "aniso", "kuwahara", "atrous", NULL };
 static const char *const ls_origin_choices[] = { "offset", "exact", NULL };
 static const char *const ls_build_choices[] = { "cpu", "gpu", NULL };
 
@@ -78,12 +93,24 @@ static const rl_option_info gl_pt_options[] = {
     { "specular", RL_OPT_ENUM, "exact",
       "mirror and refraction rays: exact (the grid under a Line Space payload, else the diffuse structure) or "
       "diffuse (the diffuse structure, payloads included)", 0, 0, specular_choices },
-    { "primary", RL_OPT_ENUM, "trace", "primary visibility: trace (jittered rays, BVH); raster: not ported yet",
-      0, 0, primary_choices },
-    { "checkerboard", RL_OPT_BOOL, "false", "Sec. 8.5: not ported yet (false only)", 0, 0, NULL },
+    { "primary", RL_OPT_ENUM, "trace",
+      "primary visibility: trace (jittered rays, GPU BVH) or raster (triangle IDs drawn by GL, Sec. 8.1)", 0, 0,
+      primary_choices },
+    { "checkerboard", RL_OPT_BOOL, "false", "render alternate halves of the pixels per frame (Sec. 8.5)",
+      0, 0, NULL },
     { "accumulate", RL_OPT_BOOL, "true", "progressive accumulation across frames (Sec. 6.5, eq. 8)", 0, 0, NULL },
-    { "filter", RL_OPT_ENUM, "none", "noise filter (Sec. 8.2): not ported yet (none only)", 0, 0,
+    { "filter", RL_OPT_ENUM, "none",
+      "noise filter on the accumulated image (Sec. 8.2): pt's, on the CPU after the read-back", 0, 0,
       filter_choices },
+    { "filter_fade", RL_OPT_FLOAT, "16",
+      "filter weight 1/(1 + spp/filter_fade) with spp the samples so far; 0 = never fade", 0, 1e9, NULL },
+    { "atrous_iterations", RL_OPT_INT, "5", "a-trous levels (holes 2^i pixels apart; Dammertz et al. 2010)",
+      1, 12, NULL },
+    { "atrous_sigma_rt", RL_OPT_FLOAT, "0",
+      "a-trous colour sigma at the first level, halved per level; 0 = from the samples per pixel", 0, 1e9, NULL },
+    { "atrous_sigma_n", RL_OPT_FLOAT, "0.1", "a-trous normal sigma (|n - n'|)", 1e-6, 1e9, NULL },
+    { "atrous_sigma_x", RL_OPT_FLOAT, "0",
+      "a-trous position sigma in world units; 0 = 2^atrous_iterations pixel footprints", 0, 1e9, NULL },
     { "grid_res", RL_OPT_INT, "0", "voxels per axis of the grid and the Line Space (0 = grid heuristic)", 0, 1024,
       NULL },
     { "ls_n", RL_OPT_INT, "5", "Line Space patches per voxel face side (Sec. 9.2: 5)", 1, RL_LS_MAX_N, NULL },
@@ -118,8 +145,13 @@ typedef struct gl_pt_state {
     rl_camera cam;
     char *signature;
     rl_gbuffer *gbuf;
+    bool gbuf_traced;             /* gbuf holds the traced G-buffer of this accumulation */
     float *rgba;
     uint64_t frames;
+    /* primary=raster: the GL drawer of the ID pass and its target */
+    rl_drawer *drawer;
+    char drawer_device[64];
+    rl_image *ids;
 } gl_pt_state;
 
 static void gl_pt_release(void *state)
@@ -128,6 +160,8 @@ static void gl_pt_release(void *state)
     rl_gl_pt_release(s->gpu);
     rl_pt_backends_release(&s->b);
     rl_gbuffer_release(s->gbuf);
+    rl_drawer_release(s->drawer);
+    rl_image_release(s->ids);
     free(s->rgba);
     free(s->signature);
 }
@@ -153,17 +187,6 @@ static rl_status gl_pt_check(const char *key, const char *value)
                         "pt has it)", key, value);
     if (strcmp(key, "ls_k") == 0 && atoi(value) % 2 != 0)
         return rl_error(RL_ERR_INVALID_ARG, "gl-pt: ls_k=%s must be even (front and back halves, Alg. 3)", value);
-    if (strcmp(key, "primary") == 0 && strcmp(value, "raster") == 0)
-        return rl_error(RL_ERR_INVALID_ARG, "gl-pt: primary=raster (the G-buffer pass) is not ported to GL yet");
-    if (strcmp(key, "checkerboard") == 0) {
-        /* the value passed the type check: one of options.c's true words */
-        bool on = strcmp(value, "true") == 0 || strcmp(value, "1") == 0 || strcmp(value, "yes") == 0 ||
-                  strcmp(value, "on") == 0;
-        if (on)
-            return rl_error(RL_ERR_INVALID_ARG, "gl-pt: checkerboard=true is not ported to GL yet");
-    }
-    if (strcmp(key, "filter") == 0 && strcmp(value, "none") != 0)
-        return rl_error(RL_ERR_INVALID_ARG, "gl-pt: filter=%s is not ported to GL yet (none only)", value);
     return RL_OK;
 }
 
@@ -316,6 +339,127 @@ static rl_status gl_pt_check_scene(const rl_scene *scene, const rl_scene_data *d
     return RL_OK;
 }
 
+/* primary=raster (Sec. 8.1): the triangle IDs of the scene drawn by a GL
+ * drawer, unlit, into s->ids, as rl_gbuffer_raster draws them with the
+ * software rasterizer; every frame, as the thesis' extra render pass. The
+ * drawer is kept while scene and device stay. */
+static rl_status raster_pass(gl_pt_state *s, const rl_scene *scene, const rl_camera *cam, const char *device,
+                             rl_render_stats *stats)
+{
+    const rl_scene_data *d = rl_scene_get_data(scene);
+    const rl_drawer_desc desc = { .flags = RL_RASTER_NO_COLOR };
+    rl_status st = RL_OK;
+    if (!rl_drawer_fits(s->drawer, scene, &desc) || strcmp(s->drawer_device, device) != 0) {
+        rl_drawer_release(s->drawer);
+        s->drawer = NULL;
+        s->drawer_device[0] = '\0';
+        if (strlen(device) >= sizeof s->drawer_device)
+            return rl_error(RL_ERR_INVALID_ARG, "gl-pt: device \"%.40s...\" is too long", device);
+        rl_timer timer;
+        rl_timer_start(&timer);
+        st = rl_gl_drawer_create(scene, &desc, device, &s->drawer);
+        stats->prep_ms += rl_timer_ms(&timer);
+        if (st != RL_OK)
+            return st;
+        snprintf(s->drawer_device, sizeof s->drawer_device, "%s", device);
+    }
+    if (!s->ids || s->ids->width != cam->width || s->ids->height != cam->height) {
+        rl_image_release(s->ids);
+        s->ids = NULL;
+        st = rl_image_create(cam->width, cam->height, RL_LAYER_COLOR | RL_LAYER_DEPTH | RL_LAYER_ID, &s->ids);
+        if (st != RL_OK)
+            return st;
+    }
+    rl_image_clear(s->ids);
+    st = rl_drawer_begin_camera(s->drawer, s->ids, cam, d->bounds);
+    if (st == RL_OK)
+        st = rl_drawer_draw_all(s->drawer, NULL, NULL, NULL);
+    if (st == RL_OK)
+        st = rl_drawer_end(s->drawer);
+    return st;
+}
+
+/* The accumulated means into the image; pixels of a class not traced yet
+ * (checkerboard's first frame) the mean of their traced 4-neighbours, as
+ * pt's resolve() (Sec. 8.5, Fig. 17). */
+static void resolve(const float *rgba, const uint64_t held[2], int w, int h, rl_image *image)
+{
+    for (int y = 0; y < h; ++y) {
+        for (int x = 0; x < w; ++x) {
+            size_t i = (size_t)y * (size_t)w + (size_t)x;
+            if (held[(x + y) & 1] > 0) {
+                image->color[i] = rl_v4(rgba[4 * i], rgba[4 * i + 1], rgba[4 * i + 2], 1.0f);
+                continue;
+            }
+            static const int dx[4] = { -1, 1, 0, 0 }, dy[4] = { 0, 0, -1, 1 };
+            double c[3] = { 0.0, 0.0, 0.0 };
+            int n = 0;
+            for (int j = 0; j < 4; ++j) {
+                int nx = x + dx[j], ny = y + dy[j];
+                if (nx < 0 || ny < 0 || nx >= w || ny >= h || held[(nx + ny) & 1] == 0)
+                    continue;
+                size_t q = (size_t)ny * (size_t)w + (size_t)nx;
+                for (int k = 0; k < 3; ++k)
+                    c[k] += rgba[4 * q + k];
+                ++n;
+            }
+            for (int k = 0; k < 3 && n > 0; ++k)
+                c[k] /= n;
+            image->color[i] = rl_v4((float)c[0], (float)c[1], (float)c[2], 1.0f);
+        }
+    }
+}
+
+/* The G-buffer pt would have for this frame: with primary=raster made from
+ * the GL pass's IDs (every frame, as pt rasterizes its own every frame),
+ * else traced at the pixel centres through a CPU BVH once per
+ * accumulation. */
+static rl_status frame_gbuffer(gl_pt_state *s, const rl_scene *scene, const rl_camera *cam, bool raster, int threads,
+                               rl_render_stats *stats)
+{
+    rl_status st = RL_OK;
+    if (!s->gbuf)
+        st = rl_gbuffer_create(cam->width, cam->height, &s->gbuf);
+    if (st != RL_OK)
+        return st;
+    if (raster) {
+        s->gbuf_traced = false;
+        return rl_gbuffer_from_ids(s->gbuf, scene, cam, s->ids->triangle_id);
+    }
+    if (s->gbuf_traced)
+        return RL_OK;
+    if (!s->b.exact[RL_ACCEL_BVH]) {
+        /* a CPU BVH only for the G-buffer, kept with the scene's data */
+        rl_timer timer;
+        rl_timer_start(&timer);
+        st = rl_accel_create(scene, &(rl_accel_desc){ .kind = RL_ACCEL_BVH, .threads = threads },
+                             &s->b.exact[RL_ACCEL_BVH]);
+        if (st == RL_OK)
+            st = rl_accel_commit(s->b.exact[RL_ACCEL_BVH]);
+        if (st != RL_OK) {
+            rl_accel_release(s->b.exact[RL_ACCEL_BVH]);
+            s->b.exact[RL_ACCEL_BVH] = NULL;
+            return st;
+        }
+        stats->prep_ms += rl_timer_ms(&timer);
+    }
+    st = rl_gbuffer_trace(s->gbuf, s->b.exact[RL_ACCEL_BVH], cam);
+    s->gbuf_traced = st == RL_OK;
+    return st;
+}
+
+/* pt's filter settings (pathtrace.c read_settings) from the same options. */
+static void filter_settings(const rl_renderer *r, pt_settings *set)
+{
+    memset(set, 0, sizeof *set);
+    set->filter = (rl_filter_kind)rl_renderer_opt_enum(r, "filter");
+    set->filter_fade = rl_renderer_opt_float(r, "filter_fade");
+    set->atrous_iterations = (int)rl_renderer_opt_int(r, "atrous_iterations");
+    set->atrous_sigma_rt = rl_renderer_opt_float(r, "atrous_sigma_rt");
+    set->atrous_sigma_n = rl_renderer_opt_float(r, "atrous_sigma_n");
+    set->atrous_sigma_x = rl_renderer_opt_float(r, "atrous_sigma_x");
+}
+
 static rl_status gl_pt_render(rl_renderer *r, void *state, const rl_scene *scene, const rl_camera *cam,
                               rl_image *image, rl_render_stats *stats)
 {
@@ -354,6 +498,7 @@ static rl_status gl_pt_render(rl_renderer *r, void *state, const rl_scene *scene
         free(s->rgba);
         rl_gbuffer_release(s->gbuf);
         s->gbuf = NULL;
+        s->gbuf_traced = false;
         s->valid = false;
         s->rgba = rl_calloc(n, 4 * sizeof *s->rgba);
         states = seed_states(rng, (uint64_t)rl_renderer_opt_int(r, "seed"), n);
@@ -408,8 +553,20 @@ static rl_status gl_pt_render(rl_renderer *r, void *state, const rl_scene *scene
         .background = rl_renderer_opt_color(r, "background"),
         .reset_states = states,
     };
-    uint64_t samples = 0;
-    st = rl_gl_pt_render(s->gpu, &f, s->rgba, &samples);
+    const bool raster = rl_renderer_opt_enum(r, "primary") == 1;
+    const char *device = rl_renderer_opt_string(r, "device");
+    if (raster) {
+        st = raster_pass(s, scene, cam, device, stats);
+        if (st != RL_OK) {
+            free(states);
+            s->force_reset = true;
+            return st;
+        }
+        f.raster_ids = s->ids->triangle_id;
+    }
+    f.checkerboard = rl_renderer_opt_bool(r, "checkerboard");
+    rl_gl_pt_result res;
+    st = rl_gl_pt_render(s->gpu, &f, s->rgba, &res);
     free(states);
     if (st != RL_OK) {
         s->force_reset = true;
@@ -418,49 +575,40 @@ static rl_status gl_pt_render(rl_renderer *r, void *state, const rl_scene *scene
     s->valid = true;
     s->force_reset = false;
     s->frames++;
-    for (size_t i = 0; i < n; ++i)
-        image->color[i] = rl_v4(s->rgba[4 * i], s->rgba[4 * i + 1], s->rgba[4 * i + 2], 1.0f);
+    resolve(s->rgba, res.held, cam->width, cam->height, image);
 
-    /* pt's depth and ID layers: the traced G-buffer's, once per accumulation */
+    /* pathtrace.c active(): x + y + frame even holds for the larger half
+     * when both sides are odd */
+    const uint64_t even = (cam->width & cam->height & 1) ? (n + 1) / 2 : n / 2;
+    const uint64_t traced = !f.checkerboard ? n : (res.frames - 1) % 2 == 0 ? even : n - even;
+    pt_settings fs;
+    filter_settings(r, &fs);
     bool layers = ((image->layers & RL_LAYER_DEPTH) && image->depth) ||
                   ((image->layers & RL_LAYER_ID) && image->object_id && image->triangle_id);
-    if (layers && !s->gbuf) {
-        /* a CPU BVH only for these layers, kept with the scene's data */
-        if (!s->b.exact[RL_ACCEL_BVH]) {
-            rl_timer timer;
-            rl_timer_start(&timer);
-            st = rl_accel_create(scene, &(rl_accel_desc){ .kind = RL_ACCEL_BVH, .threads = threads },
-                                 &s->b.exact[RL_ACCEL_BVH]);
-            if (st == RL_OK)
-                st = rl_accel_commit(s->b.exact[RL_ACCEL_BVH]);
-            if (st != RL_OK) {
-                rl_accel_release(s->b.exact[RL_ACCEL_BVH]);
-                s->b.exact[RL_ACCEL_BVH] = NULL;
-                return st;
-            }
-            stats->prep_ms += rl_timer_ms(&timer);
-        }
-        st = rl_gbuffer_create(cam->width, cam->height, &s->gbuf);
-        if (st == RL_OK)
-            st = rl_gbuffer_trace(s->gbuf, s->b.exact[RL_ACCEL_BVH], cam);
-        if (st != RL_OK) {
-            rl_gbuffer_release(s->gbuf);
-            s->gbuf = NULL;
+    if (layers || fs.filter != RL_FILTER_NONE) {
+        st = frame_gbuffer(s, scene, cam, raster, threads, stats);
+        if (st != RL_OK)
             return st;
-        }
     }
-    if (layers) {
-        if ((image->layers & RL_LAYER_DEPTH) && image->depth)
-            memcpy(image->depth, s->gbuf->depth, n * sizeof *image->depth);
-        if ((image->layers & RL_LAYER_ID) && image->object_id && image->triangle_id) {
-            memcpy(image->object_id, s->gbuf->object, n * sizeof *image->object_id);
-            memcpy(image->triangle_id, s->gbuf->triangle, n * sizeof *image->triangle_id);
-        }
+    if (fs.filter != RL_FILTER_NONE) {
+        /* pt's mean samples per pixel over the image */
+        double spp = ((double)res.held[0] * (double)even + (double)res.held[1] * (double)(n - even)) / (double)n;
+        float weight;
+        st = rl_pt_filter_image(&fs, s->gbuf, spp, image, &weight);
+        if (st != RL_OK)
+            return st;
+    }
+    if ((image->layers & RL_LAYER_DEPTH) && image->depth)
+        memcpy(image->depth, s->gbuf->depth, n * sizeof *image->depth);
+    if ((image->layers & RL_LAYER_ID) && image->object_id && image->triangle_id) {
+        memcpy(image->object_id, s->gbuf->object, n * sizeof *image->object_id);
+        memcpy(image->triangle_id, s->gbuf->triangle, n * sizeof *image->triangle_id);
     }
     stats->pixels_written = n;
-    stats->samples = n * (uint64_t)f.spp;
+    stats->samples = traced * (uint64_t)f.spp;
+    for (int k = 0; k < RL_RAY_TYPE_COUNT; ++k)
+        stats->rays[k] = res.rays[k];
     stats->device = s->info[0] ? s->info : NULL;
-    (void)samples;
     if (!rl_renderer_progress(r, 1.0)) {
         s->force_reset = true;
         return rl_error(RL_ERR_CANCELLED, "gl-pt: cancelled by the progress callback");
@@ -474,7 +622,9 @@ const rl_renderer_class rl_gl_pt_renderer_class = {
                              "or Line Space on the GPU",
               .reference = "Schröder 2017, Ch. 5-6 (GPU path tracing, Sec. 5.3 RNG textures, Sec. 6.5)",
               .progressive = true, .default_time_s = 10.0,
-              .frame_bytes_per_pixel = 4 * sizeof(float) + 16 + 16 + RL_GBUFFER_BYTES_PER_PIXEL },
+              /* the read-back mean, the states, the G-buffer, and with
+               * primary=raster the ID pass's target (colour, depth, IDs) */
+              .frame_bytes_per_pixel = 4 * sizeof(float) + 16 + 16 + RL_GBUFFER_BYTES_PER_PIXEL + 16 + 4 + 8 },
     .options = gl_pt_options,
     .num_options = NUM_OPTIONS,
     .state_size = sizeof(gl_pt_state),

@@ -607,19 +607,19 @@ static void resolve(const pt_state *s, const rl_rect *region, rl_image *image)
 /* The a-trous colour sigma at 1 spp (atrous_sigma_rt = 0). */
 #define PT_ATROUS_RT_1SPP 1.0f
 
-/* Sec. 8.2: filter, faded out as the samples grow. */
-static rl_status apply_filter(const pt_state *s, const pt_settings *set, uint64_t total_samples, rl_image *image,
-                              float *weight)
+/* Sec. 8.2: filter, faded out as the samples grow (pathtrace_internal.h). */
+rl_status rl_pt_filter_image(const pt_settings *set, const rl_gbuffer *gbuf, double spp, rl_image *image,
+                             float *weight)
 {
-    double spp = (double)total_samples / ((double)s->width * s->height);
+    const int width = image->width, height = image->height;
     float w = set->filter_fade > 0.0 ? (float)(1.0 / (1.0 + spp / set->filter_fade)) : 1.0f;
     *weight = w;
     rl_image *in = NULL, *out = NULL;
-    rl_status st = rl_image_create(s->width, s->height, RL_LAYER_COLOR, &in);
+    rl_status st = rl_image_create(width, height, RL_LAYER_COLOR, &in);
     if (st == RL_OK)
-        st = rl_image_create(s->width, s->height, RL_LAYER_COLOR, &out);
+        st = rl_image_create(width, height, RL_LAYER_COLOR, &out);
     if (st == RL_OK) {
-        size_t n = (size_t)s->width * s->height;
+        size_t n = (size_t)width * height;
         memcpy(in->color, image->color, n * sizeof *in->color);
         /* The colour scales of the edge-stopping filters follow the noise,
          * which falls as the samples grow; the library's fixed 0.1 takes
@@ -641,7 +641,7 @@ static rl_status apply_filter(const pt_state *s, const pt_settings *set, uint64_
             fd.sigma_x = (float)set->atrous_sigma_x;
             fd.iterations = set->atrous_iterations;
         }
-        st = rl_filter_apply(&fd, in, s->gbuf, out);
+        st = rl_filter_apply(&fd, in, gbuf, out);
         for (size_t i = 0; st == RL_OK && i < n; ++i) {
             rl_vec4 a = in->color[i], b = out->color[i];
             image->color[i] = rl_v4(a.x + w * (b.x - a.x), a.y + w * (b.y - a.y), a.z + w * (b.z - a.z), 1.0f);
@@ -650,6 +650,12 @@ static rl_status apply_filter(const pt_state *s, const pt_settings *set, uint64_
     rl_image_release(in);
     rl_image_release(out);
     return st;
+}
+
+static rl_status apply_filter(const pt_state *s, const pt_settings *set, uint64_t total_samples, rl_image *image,
+                              float *weight)
+{
+    return rl_pt_filter_image(set, s->gbuf, (double)total_samples / ((double)s->width * s->height), image, weight);
 }
 
 static void write_layers(const pt_state *s, const rl_rect *region, rl_image *image)

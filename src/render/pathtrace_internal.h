@@ -61,6 +61,14 @@ typedef struct pt_settings {
 
 typedef enum pt_env_sampling { PT_ENV_IMPORTANCE = 0, PT_ENV_UNIFORM, PT_ENV_BSDF } pt_env_sampling;
 
+/* pt's noise filter (Sec. 8.2) on image, guided by gbuf: set's filter and
+ * its parameters, the edge-stopping scales following the noise of spp
+ * samples per pixel (the mean over the image), the filtered image blended
+ * in with the weight 1 / (1 + spp / filter_fade) (*weight). gl-pt filters
+ * its read-back image with it. */
+rl_status rl_pt_filter_image(const pt_settings *set, const rl_gbuffer *gbuf, double spp, rl_image *image,
+                             float *weight);
+
 /* ------------------------------------------------------------ backends -- */
 
 /* The lights next-event estimation chooses from with mis=on, by power: the

@@ -18,9 +18,7 @@ RL_EGL_DEVICE=bogus expect_error 1 "gl-pt: unavailable: .*bogus" \
 expect_error 2 "not ported to GL yet" \
     "$RL" render cornell --algo gl-pt --set gl-pt.shadow=shadowmap --size 16x16 --out "$TMP/none.png"
 expect_error 2 "not ported to GL yet" \
-    "$RL" render cornell --algo gl-pt --set gl-pt.primary=raster --size 16x16 --out "$TMP/none.png"
-expect_error 2 "not ported to GL yet" \
-    "$RL" render cornell --algo gl-pt --set gl-pt.filter=gauss --size 16x16 --out "$TMP/none.png"
+    "$RL" render cornell --algo gl-pt --set gl-pt.diffuse=embree --size 16x16 --out "$TMP/none.png"
 [ ! -e "$TMP/none.png" ] || fail "a refused option still rendered"
 
 if ! grep -A3 '^gl-pt: ' <("$RL" algos) | grep -q "unavailable:"; then
@@ -42,6 +40,18 @@ rows = r["pt"]["rows"]
 assert [row["scene"] for row in rows] == ["cornell"], rows
 assert rows[0]["gl_pt"]["min_ms"] > 0 and rows[0]["pt"]["min_ms"] > 0 and rows[0]["gl_pt_fps"] > 0, rows
 assert r["parameters"]["pt_size"] == "16x16" and r["gl"]["renderer"], r["parameters"]
+PY
+    # the thesis' raster modes: G-buffer pass, checkerboard, a filter; the
+    # shader's ray counters in the stats
+    run_ok "$RL" render cornell --algo gl-pt --set gl-pt.primary=raster --set gl-pt.checkerboard=true \
+        --set gl-pt.filter=bilateral --size 17x13 --spp 2 --out "$TMP/glpt_raster.png" \
+        --stats-json "$TMP/glpt_raster.json"
+    [ -s "$TMP/glpt_raster.png" ] || fail "gl-pt primary=raster wrote no image"
+    python3 - "$TMP/glpt_raster.json" <<'PY' || fail "gl-pt primary=raster's ray counts are not as expected"
+import json, sys
+s = json.load(open(sys.argv[1]))
+r = s["rays"]
+assert r["primary"] == 0 and r["shadow"] > 0 and r["diffuse"] > 0, s
 PY
     # the Line Space backends (Diagram 1's configuration), and the pair of
     # options the GPU build cannot serve

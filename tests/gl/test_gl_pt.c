@@ -6,9 +6,12 @@
  * pt's pixels, through the BVH, the grid and the Line Space backends (a
  * GPU-built Line Space gives the uploaded one's image); the GLSL BVH and
  * grid find the triangles the CPU
- * BVH finds, ray for ray; options gl-pt has not ported are refused, and a
- * device that cannot be opened makes it unavailable. Small images on
- * llvmpipe; without a GL 4.5 context the GL cases skip. */
+ * BVH finds, ray for ray; primary=raster (a GL raster pass) and
+ * checkerboard trace pt's paths and pixels, the shader's ray counters give
+ * pt's counts, and the filters are pt's on gl-pt's image; options gl-pt
+ * has not ported are refused, and a device that cannot be opened makes it
+ * unavailable. Small images on llvmpipe; without a GL 4.5 context the GL
+ * cases skip. */
 #include <math.h>
 #include <setjmp.h>
 #include <stdarg.h>
@@ -20,6 +23,7 @@
 #include <cmocka.h>
 
 #include "gl/gl_pt.h"
+#include "render/pathtrace_internal.h"
 #include "render/render_fixtures.h"
 #include "rl/rl_accel.h"
 #include "rl/rl_rng.h"
@@ -444,6 +448,237 @@ static void test_gl_pt_structures_agree_ray_for_ray(void **state)
     rl_scene_release(s);
 }
 
+/* primary=raster: the paths start from the G-buffer of a GL raster pass.
+ * With rng=hybrid gl-pt traces pt primary=raster's paths wherever both
+ * rasterizers put the same triangle in a pixel (they may differ on shared
+ * edges, docs/gl.md), through an alpha mask too, and the ID layers (from
+ * that G-buffer) agree; the image converges to pt's (RMSE falls, means
+ * within 3 sigma). */
+static void test_gl_pt_primary_raster_draws_pts_numbers(void **state)
+{
+    (void)state;
+    NEED_GL();
+    static const char *const scenes[] = { "cornell", "spheres", "masks and normal maps" };
+    for (int k = 0; k < 3; ++k) {
+        rl_camera cam;
+        rl_scene *s = k == 2 ? mask_normal_scene(&cam)
+                             : scene_and_camera(scenes[k], k == 1 ? "segments=16,checks=4" : NULL, &cam);
+        cam.width = cam.height = 24;
+        const char *const opts[] = { "spp", "4", "rng", "hybrid", "seed", "5", "primary", "raster", NULL };
+        rl_render_stats st = { 0 };
+        rl_image *cpu = fx_render("pt", s, &cam, RL_LAYER_COLOR | RL_LAYER_ID, opts, &st);
+        rl_image *gl = fx_render("gl-pt", s, &cam, RL_LAYER_COLOR | RL_LAYER_ID, opts, &st);
+        const size_t n = (size_t)cam.width * (size_t)cam.height;
+        size_t same_tri = 0, close = 0, seen = 0;
+        for (size_t i = 0; i < n; ++i) {
+            seen += cpu->triangle_id[i] != RL_ID_NONE;
+            if (gl->triangle_id[i] != cpu->triangle_id[i])
+                continue;
+            ++same_tri;
+            double worst = 0.0;
+            for (int c = 0; c < 3; ++c) {
+                const float a = (&gl->color[i].x)[c], b = (&cpu->color[i].x)[c];
+                worst = fmax(worst, fabs((double)a - b) / fmax(1e-3, fabs((double)b)));
+            }
+            close += worst < 1e-3;
+        }
+        print_message("%s primary=raster: triangle IDs equal at %.1f %% of the pixels (%zu covered), of those "
+                      "%.1f %% equal to pt's to 1e-3\n", scenes[k], 100.0 * (double)same_tri / (double)n, seen,
+                      100.0 * (double)close / (double)same_tri);
+        assert_true(seen > n / 4);
+        assert_true((double)same_tri >= 0.97 * (double)n);
+        assert_true((double)close >= 0.99 * (double)same_tri);
+        rl_image_release(gl);
+        rl_image_release(cpu);
+        rl_scene_release(s);
+    }
+}
+
+static void test_gl_pt_primary_raster_converges_to_pt(void **state)
+{
+    (void)state;
+    NEED_GL();
+    rl_camera cam;
+    rl_scene *s = scene_and_camera("cornell", NULL, &cam);
+    rl_image *ref = render("pt", s, &cam,
+                           (const char *const[]){ "spp", REF_SPP, "primary", "raster", "seed", "7", NULL });
+    static const char *const spps[] = { "4", "16", "64" };
+    double e[3];
+    rl_image *last = NULL;
+    for (int k = 0; k < 3; ++k) {
+        rl_image *gl = render("gl-pt", s, &cam, (const char *const[]){ "spp", spps[k], "primary", "raster", NULL });
+        double rmse[3], md[3];
+        difference(gl, ref, rmse, md);
+        e[k] = rmse_all(rmse);
+        print_message("cornell gl-pt primary=raster %s spp: RMSE to pt primary=raster at %s spp %.5f\n", spps[k],
+                      REF_SPP, e[k]);
+        rl_image_release(last);
+        last = gl;
+    }
+    print_message("ratios %.2f %.2f\n", e[0] / e[1], e[1] / e[2]);
+    assert_true(e[0] / e[1] > 1.4);
+    assert_true(e[1] / e[2] > 1.4);
+    assert_means_agree("cornell primary=raster 64 spp", last, ref);
+    rl_image_release(last);
+    rl_image_release(ref);
+    rl_scene_release(s);
+}
+
+/* checkerboard (Sec. 8.5): frame by frame gl-pt traces pt's half of the
+ * pixels with pt's numbers (each class numbering its own samples), so
+ * after the first frame (holes filled from the neighbours) and after each
+ * later one the pixels are pt's; the samples reported are pt's. Odd sides,
+ * where the halves differ in size; primary=trace and raster. */
+static void test_gl_pt_checkerboard_traces_pts_pixels(void **state)
+{
+    (void)state;
+    NEED_GL();
+    static const char *const primary[] = { "trace", "raster" };
+    static const char *const rng[] = { "hybrid", "sobol" };
+    for (int k = 0; k < 2; ++k) {
+        rl_camera cam;
+        rl_scene *s = scene_and_camera("cornell", NULL, &cam);
+        cam.width = 23;
+        cam.height = 21;
+        const char *const opts[] = { "spp", "2", "rng", rng[k], "seed", "5", "checkerboard", "true",
+                                     "primary", primary[k], NULL };
+        rl_renderer *cpu = fx_make("pt", opts), *gl = fx_make("gl-pt", opts);
+        const size_t n = (size_t)cam.width * (size_t)cam.height;
+        for (uint64_t frame = 0; frame < 3; ++frame) {
+            rl_render_stats sc = { 0 }, sg = { 0 };
+            rl_image *a = fx_render_with(cpu, s, &cam, RL_LAYER_COLOR, &sc);
+            rl_image *b = fx_render_with(gl, s, &cam, RL_LAYER_COLOR, &sg);
+            double share = share_equal(b, a, n);
+            print_message("checkerboard primary=%s rng=%s frame %llu: %llu samples (pt %llu), pixels equal to pt's "
+                          "to 1e-3: %.1f %%\n", primary[k], rng[k], (unsigned long long)frame,
+                          (unsigned long long)sg.samples, (unsigned long long)sc.samples, 100.0 * share);
+            assert_int_equal(sg.samples, rl_pt_frame_samples(cpu, cam.width, cam.height, frame));
+            assert_int_equal(sg.samples, sc.samples);
+            assert_true(share >= (k == 1 ? 0.97 : 0.99));
+            rl_image_release(a);
+            rl_image_release(b);
+        }
+        rl_renderer_release(gl);
+        rl_renderer_release(cpu);
+        rl_scene_release(s);
+    }
+}
+
+/* The rays gl-pt counts (atomic counters in the shader) against pt's, by
+ * type, with pt's paths (rng=hybrid): within 1 % where a rounding
+ * difference parts a few paths, and zero exactly where pt has none. */
+static void test_gl_pt_ray_counts_match_pts(void **state)
+{
+    (void)state;
+    NEED_GL();
+    static const struct {
+        const char *scene, *params, *structure, *mis, *primary;
+    } cases[] = {
+        { "cornell", NULL, "bvh", "on", "trace" },
+        { "spheres", "segments=16,checks=4", "grid", "off", "trace" },
+        { "cornell", NULL, "ls-candidates", "off", "raster" },
+    };
+    for (size_t k = 0; k < sizeof cases / sizeof cases[0]; ++k) {
+        rl_camera cam;
+        rl_scene *s = scene_and_camera(cases[k].scene, cases[k].params, &cam);
+        cam.width = cam.height = 24;
+        const char *const opts[] = { "spp", "4", "rng", "hybrid", "seed", "5", "mis", cases[k].mis, "ls_n", "3",
+                                     "shadow", cases[k].structure, "diffuse", cases[k].structure,
+                                     "primary", cases[k].primary, NULL };
+        rl_render_stats sc = { 0 }, sg = { 0 };
+        rl_image *a = fx_render("pt", s, &cam, RL_LAYER_COLOR, opts, &sc);
+        rl_image *b = fx_render("gl-pt", s, &cam, RL_LAYER_COLOR, opts, &sg);
+        static const char *const names[RL_RAY_TYPE_COUNT] = { "primary", "shadow", "reflection", "refraction",
+                                                              "diffuse" };
+        for (int t = 0; t < RL_RAY_TYPE_COUNT; ++t) {
+            double rel = sc.rays[t] ? fabs((double)sg.rays[t] - (double)sc.rays[t]) / (double)sc.rays[t] : 0.0;
+            print_message("%s %s/%s primary=%s: %s rays gl-pt %llu, pt %llu (%.3f %%)\n", cases[k].scene,
+                          cases[k].structure, cases[k].mis, cases[k].primary, names[t],
+                          (unsigned long long)sg.rays[t], (unsigned long long)sc.rays[t], 100.0 * rel);
+            if (sc.rays[t] == 0)
+                assert_int_equal(sg.rays[t], 0);
+            assert_true(rel <= 0.01);
+        }
+        assert_true(sc.rays[RL_RAY_SHADOW] > 0 && sc.rays[RL_RAY_DIFFUSE] > 0);
+        if (k == 1)
+            assert_true(sc.rays[RL_RAY_REFLECTION] > 0 && sc.rays[RL_RAY_REFRACTION] > 0);
+        assert_int_equal(sg.rays[RL_RAY_PRIMARY], strcmp(cases[k].primary, "trace") == 0 ? 4 * 24 * 24 : 0);
+        rl_image_release(a);
+        rl_image_release(b);
+        rl_scene_release(s);
+    }
+}
+
+/* The filters of Sec. 8.2 on gl-pt: pt's filter (rl_pt_filter_image, what
+ * pt calls) applied to gl-pt's unfiltered image with pt's G-buffer (traced
+ * at the pixel centres, or from the raster pass's IDs) is gl-pt's filtered
+ * image, bit for bit; and the filter changes it. */
+static void test_gl_pt_filters_are_pts(void **state)
+{
+    (void)state;
+    NEED_GL();
+    static const char *const filters[] = { "gauss", "bilateral", "aniso", "kuwahara", "atrous" };
+    rl_camera cam;
+    rl_scene *s = scene_and_camera("cornell", NULL, &cam);
+    cam.width = 24;
+    cam.height = 20;
+    const size_t n = (size_t)cam.width * (size_t)cam.height;
+    rl_accel *bvh = NULL;
+    assert_int_equal(rl_accel_create(s, &(rl_accel_desc){ .kind = RL_ACCEL_BVH }, &bvh), RL_OK);
+    assert_int_equal(rl_accel_commit(bvh), RL_OK);
+    rl_gbuffer *g = NULL;
+    assert_int_equal(rl_gbuffer_create(cam.width, cam.height, &g), RL_OK);
+    /* one renderer: an option change restarts the accumulation, the
+     * tracer and its context stay */
+    rl_renderer *r = fx_make("gl-pt", (const char *const[]){ "spp", "3", "filter_fade", "4", NULL });
+    for (int raster = 0; raster < 2; ++raster) {
+        const char *primary = raster ? "raster" : "trace";
+        rl_render_stats st = { 0 };
+        assert_int_equal(rl_renderer_set(r, "primary", primary), RL_OK);
+        assert_int_equal(rl_renderer_set(r, "filter", "none"), RL_OK);
+        rl_image *plain = fx_render_with(r, s, &cam, RL_LAYER_COLOR | RL_LAYER_ID, &st);
+        if (raster)
+            assert_int_equal(rl_gbuffer_from_ids(g, s, &cam, plain->triangle_id), RL_OK);
+        else
+            assert_int_equal(rl_gbuffer_trace(g, bvh, &cam), RL_OK);
+        for (int k = 0; k < 5; ++k) {
+            assert_int_equal(rl_renderer_set(r, "filter", filters[k]), RL_OK);
+            rl_image *filtered = fx_render_with(r, s, &cam, RL_LAYER_COLOR, &st);
+            rl_image *expect = NULL;
+            assert_int_equal(rl_image_create(cam.width, cam.height, RL_LAYER_COLOR, &expect), RL_OK);
+            memcpy(expect->color, plain->color, n * sizeof *expect->color);
+            pt_settings set;
+            memset(&set, 0, sizeof set);
+            set.filter = (rl_filter_kind)(k + 1);
+            set.filter_fade = 4.0;
+            set.atrous_iterations = 5;
+            set.atrous_sigma_n = 0.1;
+            float weight = 0.0f;
+            assert_int_equal(rl_pt_filter_image(&set, g, 3.0, expect, &weight), RL_OK);
+            size_t changed = 0;
+            double worst = 0.0;
+            for (size_t i = 0; i < n; ++i) {
+                for (int c = 0; c < 3; ++c) {
+                    const float f = (&filtered->color[i].x)[c];
+                    worst = fmax(worst, fabs((double)f - (&expect->color[i].x)[c]));
+                    changed += fabs((double)f - (&plain->color[i].x)[c]) > 1e-4;
+                }
+            }
+            print_message("primary=%s filter=%s (weight %.3f): largest difference to pt's filter %.2g, %zu of %zu "
+                          "channels changed by the filter\n", primary, filters[k], weight, worst, changed, 3 * n);
+            assert_true(worst <= 1e-6);
+            assert_true(changed > n / 2);
+            rl_image_release(expect);
+            rl_image_release(filtered);
+        }
+        rl_image_release(plain);
+    }
+    rl_renderer_release(r);
+    rl_gbuffer_release(g);
+    rl_accel_release(bvh);
+    rl_scene_release(s);
+}
+
 static void expect_refused(rl_renderer *r, const char *key, const char *value, const char *says)
 {
     rl_clear_error();
@@ -458,15 +693,15 @@ static void test_gl_pt_refuses_what_is_not_ported(void **state)
     rl_renderer *r = fx_make("gl-pt", NULL);
     expect_refused(r, "shadow", "shadowmap", "not ported");
     expect_refused(r, "diffuse", "embree", "not ported");
-    expect_refused(r, "primary", "raster", "not ported");
-    expect_refused(r, "checkerboard", "true", "not ported");
-    expect_refused(r, "filter", "bilateral", "not ported");
+    expect_refused(r, "shadow", "embree", "not ported");
     expect_refused(r, "ls_file", "x.rlls", "unknown option");
     expect_refused(r, "ls_k", "3", "even");
     expect_refused(r, "ls_build", "cuda", "ls_build");
     expect_refused(r, "shadow", "octree", "shadow");
     assert_int_equal(rl_renderer_set(r, "shadow", "grid"), RL_OK);
-    assert_int_equal(rl_renderer_set(r, "checkerboard", "false"), RL_OK);
+    assert_int_equal(rl_renderer_set(r, "checkerboard", "true"), RL_OK);
+    assert_int_equal(rl_renderer_set(r, "primary", "raster"), RL_OK);
+    assert_int_equal(rl_renderer_set(r, "filter", "atrous"), RL_OK);
     assert_string_equal(rl_renderer_get(r, "shadow"), "grid");
     rl_renderer_release(r);
 }
@@ -502,6 +737,11 @@ int main(void)
         cmocka_unit_test(test_gl_pt_line_space_draws_pts_numbers),
         cmocka_unit_test(test_gl_pt_gpu_built_line_space_gives_the_same_image),
         cmocka_unit_test(test_gl_pt_gpu_build_refuses_records),
+        cmocka_unit_test(test_gl_pt_primary_raster_draws_pts_numbers),
+        cmocka_unit_test(test_gl_pt_primary_raster_converges_to_pt),
+        cmocka_unit_test(test_gl_pt_checkerboard_traces_pts_pixels),
+        cmocka_unit_test(test_gl_pt_ray_counts_match_pts),
+        cmocka_unit_test(test_gl_pt_filters_are_pts),
         cmocka_unit_test(test_gl_pt_refuses_what_is_not_ported),
         cmocka_unit_test(test_gl_pt_unopenable_device_is_reported_unavailable),
     };
