@@ -181,7 +181,10 @@ static rl_status check_exr(FILE *f, const char *path)
     }
 }
 
-rl_status rl_image_exr_size(const char *path, long long *width, long long *height)
+/* path opened by OpenEXR after our own walk of its header and chunk
+ * table (check_exr); ImfOpenInputFile's message for a missing file is
+ * terse, so that is checked first too. */
+static rl_status open_exr(const char *path, ImfInputFile **out)
 {
     FILE *probe = fopen(path, "rb");
     if (!probe)
@@ -190,9 +193,17 @@ rl_status rl_image_exr_size(const char *path, long long *width, long long *heigh
     fclose(probe);
     if (checked != RL_OK)
         return checked;
-    ImfInputFile *file = ImfOpenInputFile(path);
-    if (!file)
+    if (!(*out = ImfOpenInputFile(path)))
         return rl_error(RL_ERR_PARSE, "%s: invalid EXR: %s", path, ImfErrorMessage());
+    return RL_OK;
+}
+
+rl_status rl_image_exr_size(const char *path, long long *width, long long *height)
+{
+    ImfInputFile *file = NULL;
+    rl_status opened = open_exr(path, &file);
+    if (opened != RL_OK)
+        return opened;
     int x0, y0, x1, y1;
     ImfHeaderDataWindow(ImfInputHeader(file), &x0, &y0, &x1, &y1);
     ImfCloseInputFile(file);
@@ -203,17 +214,10 @@ rl_status rl_image_exr_size(const char *path, long long *width, long long *heigh
 
 rl_status rl_image_read_exr(const char *path, rl_image **out)
 {
-    /* ImfOpenInputFile's message for a missing file is terse; check first. */
-    FILE *probe = fopen(path, "rb");
-    if (!probe)
-        return rl_error(RL_ERR_IO, "%s: cannot open: %s", path, strerror(errno));
-    rl_status checked = check_exr(probe, path);
-    fclose(probe);
-    if (checked != RL_OK)
-        return checked;
-    ImfInputFile *file = ImfOpenInputFile(path);
-    if (!file)
-        return rl_error(RL_ERR_PARSE, "%s: invalid EXR: %s", path, ImfErrorMessage());
+    ImfInputFile *file = NULL;
+    rl_status opened = open_exr(path, &file);
+    if (opened != RL_OK)
+        return opened;
     int x0, y0, x1, y1;
     ImfHeaderDataWindow(ImfInputHeader(file), &x0, &y0, &x1, &y1);
     long long w = (long long)x1 - x0 + 1, h = (long long)y1 - y0 + 1;
