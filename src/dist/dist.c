@@ -84,7 +84,10 @@ rl_status rl_dist_init(int *argc, char ***argv, rl_dist **out)
     MPI_Comm_rank(MPI_COMM_WORLD, &d->rank);
     MPI_Comm_size(MPI_COMM_WORLD, &d->size);
     d->per_rank = calloc((size_t)d->size, sizeof *d->per_rank);
-    if (!d->per_rank) {
+    d->vt_speed = calloc((size_t)d->size, sizeof *d->vt_speed);
+    if (!d->per_rank || !d->vt_speed) {
+        free(d->per_rank);
+        free(d->vt_speed);
         if (d->own_mpi)
             MPI_Finalize();
         free(d);
@@ -105,6 +108,7 @@ void rl_dist_release(rl_dist *d, rl_status status)
     bool own = d->own_mpi;
     int size = d->size;
     free(d->per_rank);
+    free(d->vt_speed);
     free(d);
     if (!own)
         return;
@@ -690,6 +694,19 @@ static rl_status render_frames(rl_dist *d, rl_renderer *r, const rl_scene *scene
             }
         }
         rs->time_ms = ds->time_ms = rl_timer_ms(&t);
+        return st;
+    }
+    if (strcmp(rl_renderer_name(r), "vt") == 0) {
+        /* Vertex Tracing splits the frame by faces, not pixels (dist_vt.c). */
+        if (frames > 1)
+            return rl_error(RL_ERR_UNSUPPORTED, "vt renders single frames (no accumulation over frames)");
+        memset(d->per_rank, 0, (size_t)d->size * sizeof *d->per_rank);
+        rl_timer t;
+        rl_timer_start(&t);
+        rl_status st = rl_dist_vt_frame(d, r, scene, cam, image, rs, ds);
+        rs->time_ms = ds->time_ms = rl_timer_ms(&t);
+        ds->per_rank = d->per_rank;
+        ds->task_kind = "package";
         return st;
     }
     if (frames == 0)

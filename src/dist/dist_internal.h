@@ -15,6 +15,7 @@ enum {
     RL_DIST_TAG_RESULT,        /* worker -> master: a task's header */
     RL_DIST_TAG_PIXELS,        /* worker -> master: a band's layers */
     RL_DIST_TAG_VALUES,        /* worker -> master: measured values and sets */
+    RL_DIST_TAG_VT_PART,       /* worker -> master: a VT package's result (dist_vt.c) */
 };
 
 struct rl_dist {
@@ -22,6 +23,9 @@ struct rl_dist {
     bool own_mpi;                      /* we called MPI_Init: we finalize */
     rl_dist_rank_stats *per_rank;      /* size entries */
     uint64_t tasks_done;               /* by this rank, for rl_dist_fault_point */
+    uint64_t vt_camera;                /* distributed VT frames so far: the camera ID */
+    double *vt_speed;                  /* per rank: faces per busy ms of the last VT frame */
+    bool vt_speed_valid;               /* ... for balance=precompute */
 };
 
 /* RL_ERR_IO "distributed run: WHAT: <MPI's text for code>". */
@@ -46,5 +50,11 @@ rl_status rl_dist_send(const rl_dist *d, const void *buf, int count, MPI_Datatyp
  * SIGKILL after its N-th task, as a crashed node would vanish. Counts this
  * rank's tasks. */
 void rl_dist_fault_point(rl_dist *d);
+
+/* A Vertex Tracing frame over the ranks (dist_vt.c): collective, as
+ * rl_dist_render, which calls it for the renderer "vt" in a job of
+ * several ranks. */
+rl_status rl_dist_vt_frame(rl_dist *d, rl_renderer *r, const rl_scene *scene, const rl_camera *cam,
+                           rl_image *image, rl_render_stats *stats, rl_dist_stats *ds);
 
 #endif

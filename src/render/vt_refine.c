@@ -102,14 +102,19 @@ rl_status vt_prepass(vt_run *run, rl_image *depth_ids)
     }
     for (uint32_t f = 0; f < m->num_primary_faces; ++f)
         run->stats.visible_primary_faces += m->faces[f].visible;
+    vt_project_primary(run, depth_ids);
+    return RL_OK;
+}
 
+void vt_project_primary(vt_run *run, const rl_image *depth_ids)
+{
+    vt_mesh *m = run->mesh;
     run->view.depth = depth_ids->depth;
     for (uint32_t v = 0; v < m->num_primary_verts; ++v) {
         vt_vertex *vx = &m->verts[v];
         vt_project_vertex(&run->view, vx);
-        vx->visible = set->z_test ? (uint8_t)vt_vertex_visible(&run->view, vx) : 1;
+        vx->visible = run->set->z_test ? (uint8_t)vt_vertex_visible(&run->view, vx) : 1;
     }
-    return RL_OK;
 }
 
 /* ---------------------------------------------------------- refinement -- */
@@ -333,6 +338,19 @@ static bool primary_edge_visible(const vt_mesh *m, const vt_edge *ed)
            (ed->face[1] != VT_NONE && m->faces[ed->face[1]].visible);
 }
 
+/* A primary edge starts the refinement (stage 0) when one of its faces is
+ * visible, or, for a package of a distributed frame (run->seed), one of
+ * its faces is in the package: the ring of visible faces around it is
+ * visible only so that forced refinement checks their sub-faces as one
+ * process would (vt_run.seed). */
+static bool primary_edge_seeds(const vt_run *run, const vt_edge *ed)
+{
+    if (!run->seed)
+        return primary_edge_visible(run->mesh, ed);
+    return (ed->face[0] != VT_NONE && run->seed[ed->face[0]]) ||
+           (ed->face[1] != VT_NONE && run->seed[ed->face[1]]);
+}
+
 /* Sample reduction, Ullmann Sec. 6.2.1: the two ends of a visible primary
  * edge whose projection is shorter than merge_px count as one sample.
  * Chains of short edges form one group (union-find); the lowest vertex of
@@ -421,7 +439,7 @@ static void refine_all(refine_ctx *ctx)
      * are ray traced (stage 0, the initial sample pattern of Sec. 3.2). */
     for (uint32_t e = 0; e < m->num_primary_edges && !run->failed; ++e) {
         const vt_edge *ed = &m->edges[e];
-        if (!primary_edge_visible(m, ed))
+        if (!primary_edge_seeds(run, ed))
             continue;
         vt_sample_queue(run, ed->v[0]);
         vt_sample_queue(run, ed->v[1]);
