@@ -135,7 +135,12 @@ void rl_dist_pause(void)
 
 rl_status rl_dist_wait(const rl_dist *d, int tag, MPI_Status *ms)
 {
-    const double timeout = rl_dist_timeout_s(), t0 = rl_time_s();
+    return rl_dist_wait_for(d, tag, ms, rl_dist_timeout_s());
+}
+
+rl_status rl_dist_wait_for(const rl_dist *d, int tag, MPI_Status *ms, double timeout)
+{
+    const double t0 = rl_time_s();
     for (;;) {
         int arrived = 0;
         int code = MPI_Iprobe(0, tag, MPI_COMM_WORLD, &arrived, ms);

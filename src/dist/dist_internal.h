@@ -15,7 +15,8 @@ enum {
     RL_DIST_TAG_RESULT,        /* worker -> master: a task's header */
     RL_DIST_TAG_PIXELS,        /* worker -> master: a band's layers */
     RL_DIST_TAG_VALUES,        /* worker -> master: measured values and sets */
-    RL_DIST_TAG_VT_PART,       /* worker -> master: a VT package's result (dist_vt.c) */
+    RL_DIST_TAG_VT_PART,       /* worker -> master: a VT package's result header (dist_vt.c) */
+    RL_DIST_TAG_VT_DATA,       /* worker -> master: ... and its part */
 };
 
 struct rl_dist {
@@ -42,6 +43,8 @@ void rl_dist_pause(void);
  * any), polling; past the timeout RL_ERR_IO "no word from the master",
  * so that a dead master ends its workers with an error, not a hang. */
 rl_status rl_dist_wait(const rl_dist *d, int tag, MPI_Status *ms);
+/* ... with a timeout of its own, in seconds. */
+rl_status rl_dist_wait_for(const rl_dist *d, int tag, MPI_Status *ms, double timeout);
 /* MPI_Send that gives up past the timeout (RL_ERR_IO naming dest): a
  * large message waits for its receiver, forever if the receiver died. */
 rl_status rl_dist_send(const rl_dist *d, const void *buf, int count, MPI_Datatype type, int dest, int tag);

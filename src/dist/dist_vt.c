@@ -29,10 +29,11 @@
  * Messages:
  *   master -> worker  TASK     uint32: camera (2 words), package, count, faces
  *   master -> worker  DONE     int32 status of the frame
- *   worker -> master  VT_PART  vt_result, then the part (rl_vt.h), as one
- *                              message: the master receives it by a
- *                              matched probe (MPI_Improbe, MPI_Imrecv), so
- *                              that it never blocks on one worker. */
+ *   worker -> master  VT_PART  vt_result (the package, camera, counts, the
+ *                              part's size)
+ *   worker -> master  VT_DATA  the part (rl_vt.h), received in flight
+ *                              (MPI_Irecv, tested between packages), so
+ *                              that the master never blocks on one worker. */
 #include <limits.h>
 #include <signal.h>
 #include <stdio.h>
@@ -55,6 +56,7 @@ typedef struct vt_result {
     int32_t status;
     uint64_t rays[RL_RAY_TYPE_COUNT];
     uint64_t samples, faces;
+    uint64_t part_bytes;         /* the part that follows (RL_DIST_TAG_VT_DATA) */
     double busy_ms;
     char error[256];
 } vt_result;
@@ -71,7 +73,8 @@ typedef struct package {
 /* A worker's answer on its way: header and part in one buffer. */
 typedef struct outgoing {
     unsigned char *buf;
-    MPI_Request req;
+    MPI_Request req[2];
+    int n;
     bool busy;
 } outgoing;
 
@@ -80,7 +83,7 @@ static rl_status out_finish(const rl_dist *d, outgoing *o)
     const double timeout = rl_dist_timeout_s(), t0 = rl_time_s();
     while (o->busy) {
         int finished = 0;
-        int code = MPI_Test(&o->req, &finished, MPI_STATUS_IGNORE);
+        int code = MPI_Testall(o->n, o->req, &finished, MPI_STATUSES_IGNORE);
         if (code != MPI_SUCCESS)
             return rl_dist_mpi_failed(code, "sending a package's result");
         if (finished) {
@@ -97,21 +100,28 @@ static rl_status out_finish(const rl_dist *d, outgoing *o)
     return RL_OK;
 }
 
-/* Header and part into one buffer, sent in flight (MPI_Isend). */
+/* Header and part into one buffer, sent in flight (MPI_Isend) as two
+ * messages: the small header goes eagerly, and the master posts the
+ * part's receive when it has read it, as the tiles' pixels go. */
 static rl_status out_post(outgoing *o, const vt_result *res, const void *part, size_t part_size)
 {
-    size_t n = sizeof *res + part_size;
-    if (n > (size_t)INT_MAX)
-        return rl_error(RL_ERR_LIMIT, "vt: a package's result of %zu bytes (MPI counts end at 2^31)", n);
-    if (!(o->buf = malloc(n)))
-        return rl_error(RL_ERR_OUT_OF_MEMORY, "vt: a package's result of %zu bytes", n);
-    memcpy(o->buf, res, sizeof *res);
+    if (part_size > (size_t)INT_MAX)
+        return rl_error(RL_ERR_LIMIT, "vt: a package's part of %zu bytes (MPI counts end at 2^31)", part_size);
+    if (!(o->buf = malloc(sizeof *res + part_size)))
+        return rl_error(RL_ERR_OUT_OF_MEMORY, "vt: a package's part of %zu bytes", part_size);
+    vt_result *head = (vt_result *)o->buf;
+    memcpy(head, res, sizeof *res);
+    head->part_bytes = part_size;
     if (part_size)
         memcpy(o->buf + sizeof *res, part, part_size);
-    int code = MPI_Isend(o->buf, (int)n, MPI_BYTE, 0, RL_DIST_TAG_VT_PART, MPI_COMM_WORLD, &o->req);
+    o->n = 0;
+    int code = MPI_Isend(o->buf, (int)sizeof *res, MPI_BYTE, 0, RL_DIST_TAG_VT_PART, MPI_COMM_WORLD, &o->req[o->n++]);
+    if (code == MPI_SUCCESS && part_size)
+        code = MPI_Isend(o->buf + sizeof *res, (int)part_size, MPI_BYTE, 0, RL_DIST_TAG_VT_DATA, MPI_COMM_WORLD,
+                         &o->req[o->n++]);
+    o->busy = true;
     if (code != MPI_SUCCESS)
         return rl_dist_mpi_failed(code, "sending a package's result");
-    o->busy = true;
     return RL_OK;
 }
 
@@ -138,8 +148,11 @@ static rl_status vt_work(rl_dist *d, rl_renderer *r, const rl_scene *scene, cons
     uint32_t *task = NULL;
     rl_status result = RL_OK;
     for (;;) {
+        /* All packages may be out while the master waits out a lost
+         * worker's timeout before it hands them on: twice the timeout
+         * tells a master that waits from one that is gone. */
         MPI_Status ms;
-        rl_status wst = rl_dist_wait(d, MPI_ANY_TAG, &ms);
+        rl_status wst = rl_dist_wait_for(d, MPI_ANY_TAG, &ms, 2.0 * rl_dist_timeout_s());
         if (wst != RL_OK) {
             result = wst;
             break;
@@ -247,6 +260,12 @@ typedef struct vt_worker {
     unsigned char *rxbuf[SLOTS];
     size_t rxsize[SLOTS];
     int receiving;
+    /* Tasks go out in flight (MPI_Isend): a blocking send to a worker
+     * that died waits forever (Open MPI 4.1's ob1, even for a few
+     * hundred bytes), before the master could take it for lost. */
+    MPI_Request tx[SLOTS];
+    uint32_t *txbuf[SLOTS];
+    bool lost_rx[SLOTS];         /* cancelled with its worker: never tested again */
     double since;                /* last answer, or work handed to it while idle */
     bool lost;
 } vt_worker;
@@ -335,11 +354,32 @@ static int next_for(const vt_lead_ctx *c, int w)
     return any;
 }
 
+/* Frees the task buffers whose sends are done. */
+static int reap_sends(vt_worker *ws)
+{
+    int code = MPI_SUCCESS;
+    for (int k = 0; k < SLOTS && code == MPI_SUCCESS; ++k) {
+        int done = 0;
+        if (ws->txbuf[k] && (code = MPI_Test(&ws->tx[k], &done, MPI_STATUS_IGNORE)) == MPI_SUCCESS && done) {
+            free(ws->txbuf[k]);
+            ws->txbuf[k] = NULL;
+        }
+    }
+    return code;
+}
+
 static rl_status give(vt_lead_ctx *c, int w, int p)
 {
     vt_worker *ws = &c->ws[w];
     package *pk = &c->pkg[p];
     size_t words = TASK_WORDS + pk->count;
+    int code = reap_sends(ws), slot = 0;
+    if (code != MPI_SUCCESS)
+        return rl_dist_mpi_failed(code, "handing out a package");
+    while (slot < SLOTS && ws->txbuf[slot])
+        ++slot;
+    if (slot == SLOTS)
+        return rl_error(RL_ERR_IO, "rank %d takes no packages (%d sends in flight)", w, SLOTS);
     uint32_t *task = malloc(words * sizeof *task);
     if (!task)
         return RL_ERR_OUT_OF_MEMORY;
@@ -348,8 +388,15 @@ static rl_status give(vt_lead_ctx *c, int w, int p)
     task[2] = (uint32_t)p;
     task[3] = pk->count;
     memcpy(task + TASK_WORDS, c->faces + pk->first, pk->count * sizeof *task);
-    int code = MPI_Send(task, (int)words, MPI_UINT32_T, w, RL_DIST_TAG_TASK, MPI_COMM_WORLD);
-    free(task);
+    if (words > (size_t)INT_MAX) {
+        free(task);
+        return rl_error(RL_ERR_LIMIT, "vt: a package of %u faces", pk->count);
+    }
+    code = MPI_Isend(task, (int)words, MPI_UINT32_T, w, RL_DIST_TAG_TASK, MPI_COMM_WORLD, &ws->tx[slot]);
+    if (code == MPI_SUCCESS)
+        ws->txbuf[slot] = task;
+    else
+        free(task);
     ++c->ds->messages;
     c->ds->bytes += words * sizeof *task;
     if (code != MPI_SUCCESS)
@@ -545,7 +592,7 @@ static rl_status vt_lead(rl_dist *d, rl_renderer *r, const rl_scene *scene, cons
         for (int w = 1; w < d->size && code == MPI_SUCCESS; ++w)
             for (int k = 0; k < SLOTS && c.ws[w].receiving > 0; ++k) {
                 vt_worker *ws = &c.ws[w];
-                if (!ws->rxbuf[k])
+                if (!ws->rxbuf[k] || ws->lost_rx[k])
                     continue;
                 int complete = 0;
                 if ((code = MPI_Test(&ws->rx[k], &complete, MPI_STATUS_IGNORE)) != MPI_SUCCESS || !complete)
@@ -584,32 +631,44 @@ static rl_status vt_lead(rl_dist *d, rl_renderer *r, const rl_scene *scene, cons
         if (st == RL_OK && (st = hand_out(&c)) != RL_OK)
             snprintf(failure, sizeof failure, "%s", rl_last_error());
         int arrived = 0;
-        MPI_Message msg;
         MPI_Status ms;
-        if ((code = MPI_Improbe(MPI_ANY_SOURCE, RL_DIST_TAG_VT_PART, MPI_COMM_WORLD, &arrived, &msg, &ms)) !=
-            MPI_SUCCESS)
+        if ((code = MPI_Iprobe(MPI_ANY_SOURCE, RL_DIST_TAG_VT_PART, MPI_COMM_WORLD, &arrived, &ms)) != MPI_SUCCESS)
             break;
         if (arrived) {
+            /* The header, small and sent eagerly, then the part's receive
+             * posted and tested between packages: a worker that dies
+             * mid-transfer leaves a receive that is cancelled, never a
+             * blocked master (a matched receive from a dead rank would
+             * also hold MPI_Finalize up). */
             const int w = ms.MPI_SOURCE;
-            int bytes = 0, k = 0;
-            MPI_Get_count(&ms, MPI_BYTE, &bytes);
+            vt_result head;
+            if ((code = MPI_Recv(&head, (int)sizeof head, MPI_BYTE, w, RL_DIST_TAG_VT_PART, MPI_COMM_WORLD,
+                                 MPI_STATUS_IGNORE)) != MPI_SUCCESS)
+                break;
+            ++ds->messages;
+            ds->bytes += sizeof head;
+            c.ws[w].since = rl_time_s();
+            int k = 0;
             while (k < SLOTS && c.ws[w].rxbuf[k])
                 ++k;
-            unsigned char *buf = k < SLOTS && bytes >= 0 ? malloc(bytes > 0 ? (size_t)bytes : 1) : NULL;
+            unsigned char *buf = k < SLOTS && head.part_bytes <= (uint64_t)INT_MAX
+                                     ? malloc(sizeof head + (size_t)head.part_bytes) : NULL;
             if (!buf) {
-                code = MPI_ERR_NO_MEM;       /* more answers than packages, or no memory: not our protocol */
+                code = MPI_ERR_NO_MEM;       /* more answers than packages, a huge part, or no memory */
                 break;
             }
-            if ((code = MPI_Imrecv(buf, bytes, MPI_BYTE, &msg, &c.ws[w].rx[k])) != MPI_SUCCESS) {
-                free(buf);
-                break;
-            }
+            memcpy(buf, &head, sizeof head);
             c.ws[w].rxbuf[k] = buf;
-            c.ws[w].rxsize[k] = (size_t)bytes;
+            c.ws[w].rxsize[k] = sizeof head + (size_t)head.part_bytes;
             ++c.ws[w].receiving;
-            c.ws[w].since = rl_time_s();
-            ++ds->messages;
-            ds->bytes += (uint64_t)bytes;
+            if (head.part_bytes) {
+                code = MPI_Irecv(buf + sizeof head, (int)head.part_bytes, MPI_BYTE, w, RL_DIST_TAG_VT_DATA,
+                                 MPI_COMM_WORLD, &c.ws[w].rx[k]);
+                ++ds->messages;
+                ds->bytes += head.part_bytes;
+            } else {
+                c.ws[w].rx[k] = MPI_REQUEST_NULL;    /* tests complete at once */
+            }
             continue;
         }
         /* Nothing to answer: refine a package here. */
@@ -659,6 +718,14 @@ static rl_status vt_lead(rl_dist *d, rl_renderer *r, const rl_scene *scene, cons
                 ws->out[k] = -1;
             }
             ws->pending = 0;
+            /* Parts that stopped coming never will: their receives are
+             * cancelled (a dead sender completes nothing). */
+            for (int k = 0; k < SLOTS; ++k)
+                if (ws->rxbuf[k]) {
+                    MPI_Cancel(&ws->rx[k]);
+                    ws->lost_rx[k] = true;
+                }
+            ws->receiving = 0;
             rl_log(RL_LOG_WARN, "rank %d has not answered for %.0f s: taken for lost, its packages go to the "
                    "other ranks (RL_DIST_TIMEOUT)", w, now - ws->since);
         }
@@ -707,11 +774,22 @@ static rl_status vt_lead(rl_dist *d, rl_renderer *r, const rl_scene *scene, cons
     for (int w = 1; w < d->size; ++w)
         for (int k = 0; k < SLOTS; ++k)
             if (c.ws[w].rxbuf[k]) {
-                /* A lost worker's answer that stopped coming: a dead
-                 * sender writes nothing more. */
-                MPI_Cancel(&c.ws[w].rx[k]);
+                /* A lost worker's part that stopped coming (cancelled
+                 * above): a dead sender writes nothing more. */
+                if (!c.ws[w].lost_rx[k])
+                    MPI_Cancel(&c.ws[w].rx[k]);
                 free(c.ws[w].rxbuf[k]);
             }
+    for (int w = 1; w < d->size; ++w) {
+        /* A live worker has taken its tasks (it answered them); a lost
+         * one's sends are cancelled. */
+        reap_sends(&c.ws[w]);
+        for (int k = 0; k < SLOTS; ++k)
+            if (c.ws[w].txbuf[k]) {
+                MPI_Cancel(&c.ws[w].tx[k]);
+                free(c.ws[w].txbuf[k]);
+            }
+    }
     free(c.ws);
     if (code != MPI_SUCCESS)
         return rl_dist_mpi_failed(code, "collecting the packages");
