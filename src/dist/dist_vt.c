@@ -542,7 +542,7 @@ static rl_status vt_lead(rl_dist *d, rl_renderer *r, const rl_scene *scene, cons
     if (st == RL_OK && !precompute) {
         long long opt = rl_renderer_opt_int(r, "package");
         uint32_t size = opt > 0 ? (uint32_t)(opt < (long long)n ? opt : (long long)(n ? n : 1))
-                                : (n + 4 * ranks - 1) / (4 * ranks);
+                                : (n + 8 * ranks - 1) / (8 * ranks);
         if (size == 0)
             size = 1;
         for (uint32_t first = 0; first < n && st == RL_OK; first += size)

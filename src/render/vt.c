@@ -109,7 +109,7 @@ static const rl_option_info vt_options[] = {
       "rl --dist: load balancing of the face packages (Sec. 4.3.2): queue (equal packages on demand, Fig. 4.8) "
       "| precompute (one package per rank, sized by its measured speed)", 0, 0, balance_choices },
     { "package", RL_OPT_INT, "0",
-      "rl --dist, balance=queue: visible primary faces per package (0: a quarter of an equal share per rank)",
+      "rl --dist, balance=queue: visible primary faces per package (0: an eighth of an equal share per rank)",
       0, 1000000000, NULL },
     { "dist_halo", RL_OPT_BOOL, "true",
       "rl --dist: a package also flags the visible faces around it, so that forced refinement crosses package "

@@ -128,6 +128,26 @@ typedef struct refine_ctx {
     double update_ms;   /* primary thread in progressive updates */
 } refine_ctx;
 
+/* A package of a distributed frame (run->seed) refines its own faces: an
+ * edge is its business when a face on either side descends from one of
+ * them. Splits of border edges reach into the neighbours, whose insides
+ * their own packages refine; without this test a package would refine
+ * the neighbours' insides too, twice the work for nothing drawn. */
+static bool edge_in_package(const vt_run *run, const vt_edge *ed)
+{
+    if (!run->seed)
+        return true;
+    const vt_mesh *m = run->mesh;
+    for (int k = 0; k < 2; ++k) {
+        uint32_t f = ed->face[k];
+        while (f != VT_NONE && f >= m->num_primary_faces)
+            f = m->faces[f].parent;
+        if (f != VT_NONE && run->seed[f])
+            return true;
+    }
+    return false;
+}
+
 /* An edge enters the edge list (Fig. 3.4) if it is long enough to be split
  * and visible: on screen (Sec. 3.4.3) and, unless it is primary (the ID
  * buffer already decided those, Fig. 3.12), with at least one end passing
@@ -141,7 +161,8 @@ static void consider_edge(refine_ctx *ctx, uint32_t e, bool primary)
     vt_edge *ed = &m->edges[e];
     const vt_vertex *a = &m->verts[ed->v[0]], *b = &m->verts[ed->v[1]];
     ed->length = vt_edge_length(&run->view, a, b);
-    if (!(ed->length > set->min_edge) || ed->mid != VT_NONE || ed->queued)
+    if (!(ed->length > set->min_edge) || ed->mid != VT_NONE || ed->queued ||
+        (!primary && !edge_in_package(run, ed)))
         return;
     if (!primary && set->z_test && !a->visible && !b->visible) {
         run->stats.edges_culled_z++;
@@ -230,7 +251,7 @@ static void run_forced(refine_ctx *ctx, uint16_t stage)
         uint32_t e = ctx->forced[--ctx->forced_count];
         vt_mesh *m = run->mesh;
         vt_edge *ed = &m->edges[e];
-        if (ed->mid != VT_NONE)
+        if (ed->mid != VT_NONE || !edge_in_package(run, ed))
             continue;
         const vt_vertex *a = &m->verts[ed->v[0]], *b = &m->verts[ed->v[1]];
         ed->length = vt_edge_length(&run->view, a, b);
