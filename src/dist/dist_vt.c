@@ -46,6 +46,10 @@
 #include "rl/rl_timer.h"
 #include "rl/rl_vt.h"
 
+#ifdef _OPENMP
+#include <omp.h>
+#endif
+
 #define PREFETCH 2
 #define SLOTS (2 * PREFETCH)
 #define TASK_WORDS 4            /* camera lo, camera hi, package, count */
@@ -147,6 +151,16 @@ static rl_status vt_work(rl_dist *d, rl_renderer *r, const rl_scene *scene, cons
     uint64_t tasks = 0;
     uint32_t *task = NULL;
     rl_status result = RL_OK;
+    /* The pre-pass (and the first frame's BVH) while the master runs its
+     * own, not on the first package's critical path; a failure is the
+     * first package's answer. */
+    const uint32_t *visible;
+    size_t num_visible;
+    char prep_error[256] = "";
+    rl_clear_error();
+    rl_status prep = rl_vt_prepare(r, scene, cam, image, &visible, &num_visible);
+    if (prep != RL_OK)
+        snprintf(prep_error, sizeof prep_error, "%s", rl_last_error());
     for (;;) {
         /* All packages may be out while the master waits out a lost
          * worker's timeout before it hands them on: twice the timeout
@@ -203,7 +217,9 @@ static rl_status vt_work(rl_dist *d, rl_renderer *r, const rl_scene *scene, cons
         rl_timer_start(&tm);
         rl_clear_error();
         rl_status st;
-        if (res.camera != camera)
+        if (prep != RL_OK)
+            st = rl_error(prep, "%s", prep_error);
+        else if (res.camera != camera)
             st = rl_error(RL_ERR_INTERNAL, "rank %d: a package of camera %llu while at camera %llu (out of step)",
                           d->rank, (unsigned long long)res.camera, (unsigned long long)camera);
         else if (count != (uint32_t)words - TASK_WORDS)
@@ -438,10 +454,9 @@ static rl_status take_answer(vt_lead_ctx *c, int w, unsigned char *buf, size_t s
         return rl_error(RL_ERR_IO, "rank %d: an answer of %zu bytes", w, size);
     }
     memcpy(&res, buf, sizeof res);
-    vt_worker *ws = &c->ws[w];
     c->ws[w].since = rl_time_s();
     if (res.camera != c->camera) {
-        /* Sec. 4.3.1: a result of another camera is not this frame's. */
+        /* Sec. 4.3.2: a result of another camera is not this frame's. */
         ++c->ds->dropped;
         free(buf);
         return RL_OK;
@@ -450,12 +465,6 @@ static rl_status take_answer(vt_lead_ctx *c, int w, unsigned char *buf, size_t s
         free(buf);
         return rl_error(RL_ERR_IO, "rank %d: an answer for package %d of %zu", w, res.package, c->num_pkg);
     }
-    for (int k = 0; k < SLOTS; ++k)
-        if (ws->out[k] == res.package) {
-            ws->out[k] = -1;
-            --ws->pending;
-            break;
-        }
     package *pk = &c->pkg[res.package];
     if (res.status != RL_OK) {
         res.error[sizeof res.error - 1] = '\0';
@@ -488,6 +497,61 @@ static rl_status take_answer(vt_lead_ctx *c, int w, unsigned char *buf, size_t s
     return RL_OK;
 }
 
+/* The headers that have come: each one's part receive posted (tested
+ * between packages) and its package off the worker's queue, so that the
+ * worker's next one goes out now, not when the part is in. A worker that
+ * dies mid-transfer leaves a receive that is cancelled, never a blocked
+ * master (a matched receive, MPI_Improbe + MPI_Imrecv, from a dead rank
+ * cannot be cancelled and held MPI_Finalize up). *arrived: any came. */
+static int take_headers(vt_lead_ctx *c, int *arrived)
+{
+    *arrived = 0;
+    for (;;) {
+        int any = 0;
+        MPI_Status ms;
+        int code = MPI_Iprobe(MPI_ANY_SOURCE, RL_DIST_TAG_VT_PART, MPI_COMM_WORLD, &any, &ms);
+        if (code != MPI_SUCCESS || !any)
+            return code;
+        *arrived = 1;
+        const int w = ms.MPI_SOURCE;
+        vt_worker *ws = &c->ws[w];
+        vt_result head;
+        if ((code = MPI_Recv(&head, (int)sizeof head, MPI_BYTE, w, RL_DIST_TAG_VT_PART, MPI_COMM_WORLD,
+                             MPI_STATUS_IGNORE)) != MPI_SUCCESS)
+            return code;
+        ++c->ds->messages;
+        c->ds->bytes += sizeof head;
+        ws->since = rl_time_s();
+        for (int k = 0; head.camera == c->camera && k < SLOTS; ++k)
+            if (ws->out[k] >= 0 && ws->out[k] == head.package) {
+                ws->out[k] = -1;
+                --ws->pending;
+                break;
+            }
+        int k = 0;
+        while (k < SLOTS && ws->rxbuf[k])
+            ++k;
+        unsigned char *buf = k < SLOTS && head.part_bytes <= (uint64_t)INT_MAX
+                                 ? malloc(sizeof head + (size_t)head.part_bytes) : NULL;
+        if (!buf)
+            return MPI_ERR_NO_MEM;       /* more answers than packages, a huge part, or no memory */
+        memcpy(buf, &head, sizeof head);
+        ws->rxbuf[k] = buf;
+        ws->rxsize[k] = sizeof head + (size_t)head.part_bytes;
+        ws->lost_rx[k] = false;
+        ++ws->receiving;
+        ws->rx[k] = MPI_REQUEST_NULL;    /* no part: tests complete at once */
+        if (head.part_bytes) {
+            code = MPI_Irecv(buf + sizeof head, (int)head.part_bytes, MPI_BYTE, w, RL_DIST_TAG_VT_DATA,
+                             MPI_COMM_WORLD, &ws->rx[k]);
+            ++c->ds->messages;
+            c->ds->bytes += head.part_bytes;
+            if (code != MPI_SUCCESS)
+                return code;
+        }
+    }
+}
+
 /* The master's progress: the caller's callback sees the frame's faces,
  * those done anywhere plus the share of the package refined here. */
 typedef struct vt_progress {
@@ -495,11 +559,29 @@ typedef struct vt_progress {
     void *user;
     double total, done, current;
     bool cancelled;
+    /* While the master refines a package of its own it answers the
+     * workers from here (after every refinement stage): a package can
+     * take a second where a worker's queue lasts milliseconds. */
+    vt_lead_ctx *serve;
+    int code;                    /* the first MPI failure in here */
+    rl_status st;
+    char failure[320];
 } vt_progress;
 
 static bool package_progress(void *user, double done)
 {
     vt_progress *p = user;
+#ifdef _OPENMP
+    const bool main_thread = omp_get_thread_num() == 0;   /* MPI_THREAD_FUNNELED */
+#else
+    const bool main_thread = true;
+#endif
+    if (p->serve && main_thread && p->code == MPI_SUCCESS && p->st == RL_OK) {
+        int arrived = 0;
+        p->code = take_headers(p->serve, &arrived);
+        if (p->code == MPI_SUCCESS && arrived && (p->st = hand_out(p->serve)) != RL_OK)
+            snprintf(p->failure, sizeof p->failure, "%s", rl_last_error());
+    }
     double f = p->total > 0.0 ? (p->done + done * p->current) / p->total : 1.0;
     if (p->fn && !p->fn(p->user, f > 1.0 ? 1.0 : f))
         p->cancelled = true;
@@ -542,7 +624,7 @@ static rl_status vt_lead(rl_dist *d, rl_renderer *r, const rl_scene *scene, cons
     if (st == RL_OK && !precompute) {
         long long opt = rl_renderer_opt_int(r, "package");
         uint32_t size = opt > 0 ? (uint32_t)(opt < (long long)n ? opt : (long long)(n ? n : 1))
-                                : (n + 8 * ranks - 1) / (8 * ranks);
+                                : (n + 32 * ranks - 1) / (32 * ranks);
         if (size == 0)
             size = 1;
         for (uint32_t first = 0; first < n && st == RL_OK; first += size)
@@ -631,46 +713,10 @@ static rl_status vt_lead(rl_dist *d, rl_renderer *r, const rl_scene *scene, cons
         if (st == RL_OK && (st = hand_out(&c)) != RL_OK)
             snprintf(failure, sizeof failure, "%s", rl_last_error());
         int arrived = 0;
-        MPI_Status ms;
-        if ((code = MPI_Iprobe(MPI_ANY_SOURCE, RL_DIST_TAG_VT_PART, MPI_COMM_WORLD, &arrived, &ms)) != MPI_SUCCESS)
+        if ((code = take_headers(&c, &arrived)) != MPI_SUCCESS)
             break;
-        if (arrived) {
-            /* The header, small and sent eagerly, then the part's receive
-             * posted and tested between packages: a worker that dies
-             * mid-transfer leaves a receive that is cancelled, never a
-             * blocked master (a matched receive from a dead rank would
-             * also hold MPI_Finalize up). */
-            const int w = ms.MPI_SOURCE;
-            vt_result head;
-            if ((code = MPI_Recv(&head, (int)sizeof head, MPI_BYTE, w, RL_DIST_TAG_VT_PART, MPI_COMM_WORLD,
-                                 MPI_STATUS_IGNORE)) != MPI_SUCCESS)
-                break;
-            ++ds->messages;
-            ds->bytes += sizeof head;
-            c.ws[w].since = rl_time_s();
-            int k = 0;
-            while (k < SLOTS && c.ws[w].rxbuf[k])
-                ++k;
-            unsigned char *buf = k < SLOTS && head.part_bytes <= (uint64_t)INT_MAX
-                                     ? malloc(sizeof head + (size_t)head.part_bytes) : NULL;
-            if (!buf) {
-                code = MPI_ERR_NO_MEM;       /* more answers than packages, a huge part, or no memory */
-                break;
-            }
-            memcpy(buf, &head, sizeof head);
-            c.ws[w].rxbuf[k] = buf;
-            c.ws[w].rxsize[k] = sizeof head + (size_t)head.part_bytes;
-            ++c.ws[w].receiving;
-            if (head.part_bytes) {
-                code = MPI_Irecv(buf + sizeof head, (int)head.part_bytes, MPI_BYTE, w, RL_DIST_TAG_VT_DATA,
-                                 MPI_COMM_WORLD, &c.ws[w].rx[k]);
-                ++ds->messages;
-                ds->bytes += head.part_bytes;
-            } else {
-                c.ws[w].rx[k] = MPI_REQUEST_NULL;    /* tests complete at once */
-            }
+        if (arrived)
             continue;
-        }
         /* Nothing to answer: refine a package here. */
         int p = st == RL_OK ? next_for(&c, 0) : -1;
         if (p >= 0) {
@@ -679,11 +725,21 @@ static rl_status vt_lead(rl_dist *d, rl_renderer *r, const rl_scene *scene, cons
             rl_timer tm;
             rl_timer_start(&tm);
             vp.current = pk->count;
+            vp.serve = &c;
             pk->state = 1;
             st = rl_vt_refine_faces(r, scene, cam, image, faces + pk->first, pk->count, &pk->part, &pk->part_size,
                                     &ps);
             vp.current = 0.0;
+            vp.serve = NULL;
             d->per_rank[0].busy_ms += rl_timer_ms(&tm);
+            if (vp.code != MPI_SUCCESS) {
+                code = vp.code;
+                break;
+            }
+            if (vp.st != RL_OK && st == RL_OK) {
+                st = vp.st;
+                snprintf(failure, sizeof failure, "%s", vp.failure);
+            }
             if (st != RL_OK) {
                 snprintf(failure, sizeof failure, "%s", rl_last_error());
                 continue;
@@ -721,9 +777,17 @@ static rl_status vt_lead(rl_dist *d, rl_renderer *r, const rl_scene *scene, cons
             /* Parts that stopped coming never will: their receives are
              * cancelled (a dead sender completes nothing). */
             for (int k = 0; k < SLOTS; ++k)
-                if (ws->rxbuf[k]) {
+                if (ws->rxbuf[k] && !ws->lost_rx[k]) {
                     MPI_Cancel(&ws->rx[k]);
                     ws->lost_rx[k] = true;
+                    /* answered, but its part never came: redone */
+                    vt_result head;
+                    memcpy(&head, ws->rxbuf[k], sizeof head);
+                    if (head.camera == c.camera && head.package >= 0 && (size_t)head.package < c.num_pkg &&
+                        c.pkg[head.package].state == 1) {
+                        c.pkg[head.package].state = 0;
+                        c.pkg[head.package].owner = -1;
+                    }
                 }
             ws->receiving = 0;
             rl_log(RL_LOG_WARN, "rank %d has not answered for %.0f s: taken for lost, its packages go to the "
@@ -806,3 +870,4 @@ rl_status rl_dist_vt_frame(rl_dist *d, rl_renderer *r, const rl_scene *scene, co
     return d->rank == 0 ? vt_lead(d, r, scene, cam, image, camera, stats, ds)
                         : vt_work(d, r, scene, cam, image, camera);
 }
+
