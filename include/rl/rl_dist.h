@@ -64,7 +64,7 @@ typedef struct rl_dist_stats {
     uint64_t bytes;          /* their payload */
     double time_ms;          /* the frame, on the master */
     int lost;                /* workers taken for lost (silent past RL_DIST_TIMEOUT); their work was redone */
-    uint64_t dropped;        /* Vertex Tracing: results of an older camera dropped (Ullmann Sec. 4.3.1) */
+    uint64_t dropped;        /* Vertex Tracing: results of an older camera dropped (Ullmann Sec. 4.3.2) */
     const char *task_kind;   /* "package" for Vertex Tracing's face packages; NULL: bands or chunks */
     /* Per rank, rank 0 (the master, which renders bands between its
      * messages) first; NULL when the frame ran in one process. Owned by

@@ -9,7 +9,7 @@
  * 4.5) into parts, the master draws the frame from all parts
  * (rl_vt_draw_parts), in package order whoever refined them.
  *
- * Load balancing (option balance of vt, Sec. 4.3.2):
+ * Load balancing (option balance of vt, Sec. 4.3.3):
  *   queue       equal packages of `package` faces on demand (Fig. 4.8):
  *               PREFETCH at every worker, the next to whichever answers,
  *               the master refining packages between messages;
@@ -21,7 +21,7 @@
  * A lost worker's packages (silent past RL_DIST_TIMEOUT) go to whoever is
  * free, as the tiles' bands do.
  *
- * Camera ID (Sec. 4.3.1): every rank counts its distributed VT frames, and
+ * Camera ID (Sec. 4.3.2): every rank counts its distributed VT frames, and
  * every task and result carries the count of its frame; a result of an
  * older camera (a slow worker answering late) is dropped, counted in
  * rl_dist_stats.dropped. A worker refuses a task of a camera it is not at.
@@ -51,7 +51,7 @@
 #endif
 
 #define PREFETCH 2
-#define SLOTS (2 * PREFETCH)
+#define SLOTS (4 * PREFETCH)    /* per worker: queued packages, parts coming, a stale answer */
 #define TASK_WORDS 4            /* camera lo, camera hi, package, count */
 
 typedef struct vt_result {
@@ -309,7 +309,7 @@ static rl_status add_package(vt_lead_ctx *c, uint32_t first, uint32_t count, int
     return RL_OK;
 }
 
-/* Sec. 4.3.2: n_i = N v_i / sum v_j faces for rank i, from first on; the
+/* Sec. 4.3.3: n_i = N v_i / sum v_j faces for rank i, from first on; the
  * rounding's rest goes to the fastest rank. Ranks lost or unmeasured
  * (v_i = 0) get none; none measured: equal shares. */
 static rl_status split_by_speed(vt_lead_ctx *c, uint32_t first, uint32_t n, const double *speed)
@@ -430,12 +430,22 @@ static rl_status give(vt_lead_ctx *c, int w, int p)
     return RL_OK;
 }
 
+/* Receive slots left for w's answers: every package handed out needs one
+ * (its part may still be coming when its header frees the queue). */
+static int slots_free(const vt_worker *ws)
+{
+    int used = ws->pending;
+    for (int k = 0; k < SLOTS; ++k)
+        used += ws->rxbuf[k] != NULL;
+    return SLOTS - used;
+}
+
 /* Tops every live worker up to PREFETCH packages. */
 static rl_status hand_out(vt_lead_ctx *c)
 {
     rl_status st = RL_OK;
     for (int w = 1; w < c->d->size && st == RL_OK; ++w)
-        while (st == RL_OK && !c->ws[w].lost && c->ws[w].pending < PREFETCH) {
+        while (st == RL_OK && !c->ws[w].lost && c->ws[w].pending < PREFETCH && slots_free(&c->ws[w]) > 1) {
             int p = next_for(c, w);
             if (p < 0)
                 break;
@@ -552,6 +562,36 @@ static int take_headers(vt_lead_ctx *c, int *arrived)
     }
 }
 
+/* The parts that are in complete their packages (take_answer); the
+ * first failure into *st and failure, unless *st has one. *completed:
+ * how many came. */
+static int take_parts(vt_lead_ctx *c, rl_status *st, char *failure, size_t n, int *completed)
+{
+    *completed = 0;
+    int code = MPI_SUCCESS;
+    for (int w = 1; w < c->d->size && code == MPI_SUCCESS; ++w)
+        for (int k = 0; k < SLOTS && c->ws[w].receiving > 0 && code == MPI_SUCCESS; ++k) {
+            vt_worker *ws = &c->ws[w];
+            if (!ws->rxbuf[k] || ws->lost_rx[k])
+                continue;
+            int complete = 0;
+            if ((code = MPI_Test(&ws->rx[k], &complete, MPI_STATUS_IGNORE)) != MPI_SUCCESS || !complete)
+                continue;
+            unsigned char *buf = ws->rxbuf[k];
+            ws->rxbuf[k] = NULL;
+            --ws->receiving;
+            char why[320] = "";
+            rl_status as = take_answer(c, w, buf, ws->rxsize[k], why, sizeof why);
+            if (as == RL_OK) {
+                ++*completed;
+            } else if (*st == RL_OK) {
+                *st = as;
+                snprintf(failure, n, "%s", why[0] ? why : rl_last_error());
+            }
+        }
+    return code;
+}
+
 /* The master's progress: the caller's callback sees the frame's faces,
  * those done anywhere plus the share of the package refined here. */
 typedef struct vt_progress {
@@ -577,9 +617,11 @@ static bool package_progress(void *user, double done)
     const bool main_thread = true;
 #endif
     if (p->serve && main_thread && p->code == MPI_SUCCESS && p->st == RL_OK) {
-        int arrived = 0;
-        p->code = take_headers(p->serve, &arrived);
-        if (p->code == MPI_SUCCESS && arrived && (p->st = hand_out(p->serve)) != RL_OK)
+        int arrived = 0, completed = 0;
+        p->code = take_parts(p->serve, &p->st, p->failure, sizeof p->failure, &completed);
+        if (p->code == MPI_SUCCESS)
+            p->code = take_headers(p->serve, &arrived);
+        if (p->code == MPI_SUCCESS && p->st == RL_OK && arrived && (p->st = hand_out(p->serve)) != RL_OK)
             snprintf(p->failure, sizeof p->failure, "%s", rl_last_error());
     }
     double f = p->total > 0.0 ? (p->done + done * p->current) / p->total : 1.0;
@@ -671,31 +713,15 @@ static rl_status vt_lead(rl_dist *d, rl_renderer *r, const rl_scene *scene, cons
             snprintf(failure, sizeof failure, "cancelled by the progress callback");
         }
         /* Answers that are in. */
-        for (int w = 1; w < d->size && code == MPI_SUCCESS; ++w)
-            for (int k = 0; k < SLOTS && c.ws[w].receiving > 0; ++k) {
-                vt_worker *ws = &c.ws[w];
-                if (!ws->rxbuf[k] || ws->lost_rx[k])
-                    continue;
-                int complete = 0;
-                if ((code = MPI_Test(&ws->rx[k], &complete, MPI_STATUS_IGNORE)) != MPI_SUCCESS || !complete)
-                    continue;
-                unsigned char *buf = ws->rxbuf[k];
-                ws->rxbuf[k] = NULL;
-                --ws->receiving;
-                char why[320] = "";
-                rl_status as = take_answer(&c, w, buf, ws->rxsize[k], why, sizeof why);
-                if (as == RL_OK) {
-                    vp.done = 0.0;
-                    for (size_t i = 0; i < c.num_pkg; ++i)
-                        vp.done += c.pkg[i].state == 2 ? c.pkg[i].count : 0;
-                    package_progress(&vp, 0.0);
-                } else if (st == RL_OK) {
-                    st = as;
-                    snprintf(failure, sizeof failure, "%s", why[0] ? why : rl_last_error());
-                }
-            }
-        if (code != MPI_SUCCESS)
+        int completed = 0;
+        if ((code = take_parts(&c, &st, failure, sizeof failure, &completed)) != MPI_SUCCESS)
             break;
+        if (completed) {
+            vp.done = 0.0;
+            for (size_t i = 0; i < c.num_pkg; ++i)
+                vp.done += c.pkg[i].state == 2 ? c.pkg[i].count : 0;
+            package_progress(&vp, 0.0);
+        }
         /* precompute, first frame: the rest by the calibrated speeds. */
         if (st == RL_OK && rest_count && calibrated(&c, calibration)) {
             double *speed = calloc(ranks, sizeof *speed);

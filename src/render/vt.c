@@ -106,10 +106,10 @@ static const rl_option_info vt_options[] = {
     { "device", RL_OPT_STRING, "", "reconstruct=gl: EGL device auto, surfaceless or a number; empty: "
       "$RL_EGL_DEVICE, else auto", 0, 0, NULL },
     { "balance", RL_OPT_ENUM, "queue",
-      "rl --dist: load balancing of the face packages (Sec. 4.3.2): queue (equal packages on demand, Fig. 4.8) "
+      "rl --dist: load balancing of the face packages (Sec. 4.3.3): queue (equal packages on demand, Fig. 4.8) "
       "| precompute (one package per rank, sized by its measured speed)", 0, 0, balance_choices },
     { "package", RL_OPT_INT, "0",
-      "rl --dist, balance=queue: visible primary faces per package (0: an eighth of an equal share per rank)",
+      "rl --dist, balance=queue: visible primary faces per package (0: 1/32 of an equal share per rank)",
       0, 1000000000, NULL },
     { "dist_halo", RL_OPT_BOOL, "true",
       "rl --dist: a package also flags the visible faces around it, so that forced refinement crosses package "
