@@ -652,10 +652,18 @@ static rl_status vt_lead(rl_dist *d, rl_renderer *r, const rl_scene *scene, cons
         st = rl_error(RL_ERR_LIMIT, "vt: %zu visible faces to distribute", nfaces);
     if (st != RL_OK)
         snprintf(failure, sizeof failure, "%s", rl_last_error());
-    vt_lead_ctx c = { .d = d, .ds = ds, .stats = stats, .faces = faces, .camera = camera };
+    /* r owns the list until its next call, and the master refines with r. */
+    uint32_t *own_faces = malloc((nfaces ? nfaces : 1) * sizeof *own_faces);
+    if (own_faces && nfaces)
+        memcpy(own_faces, faces, nfaces * sizeof *own_faces);
+    vt_lead_ctx c = { .d = d, .ds = ds, .stats = stats, .faces = own_faces, .camera = camera };
     c.ws = calloc((size_t)d->size, sizeof *c.ws);
-    if (!c.ws)
+    if (!c.ws || !own_faces) {
+        free(c.ws);
+        free(own_faces);
         return RL_ERR_OUT_OF_MEMORY;         /* the CLI aborts the job */
+    }
+    faces = own_faces;
     for (int w = 0; w < d->size; ++w)
         for (int k = 0; k < SLOTS; ++k)
             c.ws[w].out[k] = -1;
@@ -881,6 +889,7 @@ static rl_status vt_lead(rl_dist *d, rl_renderer *r, const rl_scene *scene, cons
             }
     }
     free(c.ws);
+    free(own_faces);
     if (code != MPI_SUCCESS)
         return rl_dist_mpi_failed(code, "collecting the packages");
     if (st != RL_OK)
