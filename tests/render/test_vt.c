@@ -884,7 +884,7 @@ static double vt_pixel_ssim(const rl_image *test, const rl_image *ref, const rl_
  * their parts. One package is the whole frame: the same faces as one
  * process, whose image it matches but for the hidden faces a part leaves
  * out (their vertices were sampled for their neighbours). Split into the
- * 24 equal packages of queue balancing on 3 ranks, or 3 unequal ones of
+ * 8 equal packages of queue balancing, or 3 unequal ones of
  * precompute, the borders cost little: SSIM > 0.995 on the VT pixels (the
  * thesis' Sec. 4.3.3 trade-off; docs/distributed.md has the figures). */
 static void packages_match_one_process(void **state)
@@ -895,28 +895,28 @@ static void packages_match_one_process(void **state)
     rl_renderer *r = make_vt(NULL);
     rl_image *ref = fx_render_with(r, s, &cam, FX_ALL_LAYERS, NULL);
     const double one[] = { 1.0 };
-    double queue[24];
-    for (int i = 0; i < 24; ++i)
-        queue[i] = 1 / 24.0;
+    double queue[8];
+    for (int i = 0; i < 8; ++i)
+        queue[i] = 1 / 8.0;
     const double precompute[] = { 0.2, 0.5, 0.3 };
     rl_image *whole = draw_packages(r, s, &cam, one, 1);
     double ssim_one = vt_pixel_ssim(whole, ref, s);
-    rl_image *q = draw_packages(r, s, &cam, queue, 24);
+    rl_image *q = draw_packages(r, s, &cam, queue, 8);
     double ssim_queue = vt_pixel_ssim(q, ref, s);
     rl_image *p = draw_packages(r, s, &cam, precompute, 3);
     double ssim_pre = vt_pixel_ssim(p, ref, s);
     assert_int_equal(rl_renderer_set(r, "dist_halo", "false"), RL_OK);
-    rl_image *nh = draw_packages(r, s, &cam, queue, 24);
+    rl_image *nh = draw_packages(r, s, &cam, queue, 8);
     double ssim_nohalo = vt_pixel_ssim(nh, ref, s);
     if (getenv("VT_DEBUG"))
-        print_message("vt packages: SSIM one %.5f, queue 24 %.5f, precompute 3 %.5f, queue 24 no halo %.5f\n",
+        print_message("vt packages: SSIM one %.5f, queue 8 %.5f, precompute 3 %.5f, queue 8 no halo %.5f\n",
                       ssim_one, ssim_queue, ssim_pre, ssim_nohalo);
     assert_true(ssim_one > 0.998);
     assert_true(ssim_queue > 0.995);
     assert_true(ssim_pre > 0.995);
     assert_true(ssim_nohalo > 0.99);
     /* The same packages give the same image, whichever ranks refine them. */
-    rl_image *q2 = draw_packages(r, s, &cam, queue, 24);
+    rl_image *q2 = draw_packages(r, s, &cam, queue, 8);
     fx_assert_images_identical(q2, nh);
     rl_image_release(q2);
     rl_image_release(nh);
