@@ -27,7 +27,11 @@
  * rl_dist_stats.dropped. A worker refuses a task of a camera it is not at.
  *
  * Messages:
- *   master -> worker  TASK     uint32: camera (2 words), package, count, faces
+ *   master -> worker  TASK     uint32: camera (2 words), package, first, count:
+ *                              a range of the visible faces, which every
+ *                              rank's own pre-pass lists alike (20 bytes:
+ *                              a larger task to a dead rank never left,
+ *                              and its pending send held MPI_Finalize up)
  *   master -> worker  DONE     int32 status of the frame
  *   worker -> master  VT_PART  vt_result (the package, camera, counts, the
  *                              part's size)
@@ -52,7 +56,7 @@
 
 #define PREFETCH 2
 #define SLOTS (4 * PREFETCH)    /* per worker: queued packages, parts coming, a stale answer */
-#define TASK_WORDS 4            /* camera lo, camera hi, package, count */
+#define TASK_WORDS 5            /* camera lo, camera hi, package, first, count */
 
 typedef struct vt_result {
     uint64_t camera;
@@ -159,6 +163,14 @@ static rl_status vt_work(rl_dist *d, rl_renderer *r, const rl_scene *scene, cons
     char prep_error[256] = "";
     rl_clear_error();
     rl_status prep = rl_vt_prepare(r, scene, cam, image, &visible, &num_visible);
+    /* The same pre-pass as the master's gives the same visible faces, so
+     * a task names a range of them (r owns its list only until its next
+     * call: a copy). */
+    uint32_t *mine = prep == RL_OK ? malloc((num_visible ? num_visible : 1) * sizeof *mine) : NULL;
+    if (prep == RL_OK && !mine)
+        prep = rl_error(RL_ERR_OUT_OF_MEMORY, "rank %d: the visible faces", d->rank);
+    else if (mine && num_visible)
+        memcpy(mine, visible, num_visible * sizeof *mine);
     if (prep != RL_OK)
         snprintf(prep_error, sizeof prep_error, "%s", rl_last_error());
     for (;;) {
@@ -185,7 +197,7 @@ static rl_status vt_work(rl_dist *d, rl_renderer *r, const rl_scene *scene, cons
         }
         int words = 0;
         MPI_Get_count(&ms, MPI_UINT32_T, &words);
-        if (ms.MPI_TAG != RL_DIST_TAG_TASK || words < TASK_WORDS) {
+        if (ms.MPI_TAG != RL_DIST_TAG_TASK || words != TASK_WORDS) {
             result = rl_error(RL_ERR_IO, "rank %d: a message of tag %d and %d words from the master is no "
                               "Vertex Tracing task", d->rank, ms.MPI_TAG, words);
             break;
@@ -205,7 +217,7 @@ static rl_status vt_work(rl_dist *d, rl_renderer *r, const rl_scene *scene, cons
         memset(&res, 0, sizeof res);
         res.camera = (uint64_t)task[0] | (uint64_t)task[1] << 32;
         res.package = (int32_t)task[2];
-        uint32_t count = task[3];
+        uint32_t first = task[3], count = task[4];
         outgoing *o = &out[slot];
         slot = (slot + 1) % (PREFETCH + 1);
         if ((result = out_finish(d, o)) != RL_OK)
@@ -222,10 +234,11 @@ static rl_status vt_work(rl_dist *d, rl_renderer *r, const rl_scene *scene, cons
         else if (res.camera != camera)
             st = rl_error(RL_ERR_INTERNAL, "rank %d: a package of camera %llu while at camera %llu (out of step)",
                           d->rank, (unsigned long long)res.camera, (unsigned long long)camera);
-        else if (count != (uint32_t)words - TASK_WORDS)
-            st = rl_error(RL_ERR_IO, "rank %d: a package of %u faces in %d words", d->rank, count, words);
+        else if (first > num_visible || count > num_visible - first)
+            st = rl_error(RL_ERR_IO, "rank %d: a package of faces %u..%u of %zu visible (out of step)", d->rank,
+                          first, first + count, num_visible);
         else
-            st = rl_vt_refine_faces(r, scene, cam, image, task + TASK_WORDS, count, &part, &part_size, &ps);
+            st = rl_vt_refine_faces(r, scene, cam, image, mine + first, count, &part, &part_size, &ps);
         res.busy_ms = rl_timer_ms(&tm);
         res.status = (int32_t)st;
         if (st != RL_OK)
@@ -262,6 +275,7 @@ static rl_status vt_work(rl_dist *d, rl_renderer *r, const rl_scene *scene, cons
         rl_dist_fault_point(d);
     }
     free(task);
+    free(mine);
     for (int k = 0; k <= PREFETCH; ++k)
         if (!out[k].busy)
             free(out[k].buf);        /* a send still in flight keeps its buffer: the job ends anyway */
@@ -388,7 +402,7 @@ static rl_status give(vt_lead_ctx *c, int w, int p)
 {
     vt_worker *ws = &c->ws[w];
     package *pk = &c->pkg[p];
-    size_t words = TASK_WORDS + pk->count;
+    size_t words = TASK_WORDS;
     int code = reap_sends(ws), slot = 0;
     if (code != MPI_SUCCESS)
         return rl_dist_mpi_failed(code, "handing out a package");
@@ -402,12 +416,8 @@ static rl_status give(vt_lead_ctx *c, int w, int p)
     task[0] = (uint32_t)c->camera;
     task[1] = (uint32_t)(c->camera >> 32);
     task[2] = (uint32_t)p;
-    task[3] = pk->count;
-    memcpy(task + TASK_WORDS, c->faces + pk->first, pk->count * sizeof *task);
-    if (words > (size_t)INT_MAX) {
-        free(task);
-        return rl_error(RL_ERR_LIMIT, "vt: a package of %u faces", pk->count);
-    }
+    task[3] = pk->first;
+    task[4] = pk->count;
     code = MPI_Isend(task, (int)words, MPI_UINT32_T, w, RL_DIST_TAG_TASK, MPI_COMM_WORLD, &ws->tx[slot]);
     if (code == MPI_SUCCESS)
         ws->txbuf[slot] = task;
