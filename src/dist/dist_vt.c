@@ -290,11 +290,6 @@ typedef struct vt_worker {
     unsigned char *rxbuf[SLOTS];
     size_t rxsize[SLOTS];
     int receiving;
-    /* Tasks go out in flight (MPI_Isend): a blocking send to a worker
-     * that died waits forever (Open MPI 4.1's ob1, even for a few
-     * hundred bytes), before the master could take it for lost. */
-    MPI_Request tx[SLOTS];
-    uint32_t *txbuf[SLOTS];
     bool lost_rx[SLOTS];         /* cancelled with its worker: never tested again */
     double since;                /* last answer, or work handed to it while idle */
     bool lost;
@@ -384,45 +379,21 @@ static int next_for(const vt_lead_ctx *c, int w)
     return any;
 }
 
-/* Frees the task buffers whose sends are done. */
-static int reap_sends(vt_worker *ws)
-{
-    int code = MPI_SUCCESS;
-    for (int k = 0; k < SLOTS && code == MPI_SUCCESS; ++k) {
-        int done = 0;
-        if (ws->txbuf[k] && (code = MPI_Test(&ws->tx[k], &done, MPI_STATUS_IGNORE)) == MPI_SUCCESS && done) {
-            free(ws->txbuf[k]);
-            ws->txbuf[k] = NULL;
-        }
-    }
-    return code;
-}
-
 static rl_status give(vt_lead_ctx *c, int w, int p)
 {
     vt_worker *ws = &c->ws[w];
     package *pk = &c->pkg[p];
-    size_t words = TASK_WORDS;
-    int code = reap_sends(ws), slot = 0;
-    if (code != MPI_SUCCESS)
-        return rl_dist_mpi_failed(code, "handing out a package");
-    while (slot < SLOTS && ws->txbuf[slot])
-        ++slot;
-    if (slot == SLOTS)
-        return rl_error(RL_ERR_IO, "rank %d takes no packages (%d sends in flight)", w, SLOTS);
-    uint32_t *task = malloc(words * sizeof *task);
-    if (!task)
-        return RL_ERR_OUT_OF_MEMORY;
+    uint32_t task[TASK_WORDS];
+    const size_t words = TASK_WORDS;
     task[0] = (uint32_t)c->camera;
     task[1] = (uint32_t)(c->camera >> 32);
     task[2] = (uint32_t)p;
     task[3] = pk->first;
     task[4] = pk->count;
-    code = MPI_Isend(task, (int)words, MPI_UINT32_T, w, RL_DIST_TAG_TASK, MPI_COMM_WORLD, &ws->tx[slot]);
-    if (code == MPI_SUCCESS)
-        ws->txbuf[slot] = task;
-    else
-        free(task);
+    /* A blocking send, as the tiles' bands: 20 bytes go eagerly, also to
+     * a rank that died (a pending MPI_Isend to one, cancelled, held
+     * MPI_Finalize up now and then). */
+    int code = MPI_Send(task, (int)words, MPI_UINT32_T, w, RL_DIST_TAG_TASK, MPI_COMM_WORLD);
     ++c->ds->messages;
     c->ds->bytes += words * sizeof *task;
     if (code != MPI_SUCCESS)
@@ -888,16 +859,6 @@ static rl_status vt_lead(rl_dist *d, rl_renderer *r, const rl_scene *scene, cons
                     MPI_Cancel(&c.ws[w].rx[k]);
                 free(c.ws[w].rxbuf[k]);
             }
-    for (int w = 1; w < d->size; ++w) {
-        /* A live worker has taken its tasks (it answered them); a lost
-         * one's sends are cancelled. */
-        reap_sends(&c.ws[w]);
-        for (int k = 0; k < SLOTS; ++k)
-            if (c.ws[w].txbuf[k]) {
-                MPI_Cancel(&c.ws[w].tx[k]);
-                free(c.ws[w].txbuf[k]);
-            }
-    }
     free(c.ws);
     free(own_faces);
     if (code != MPI_SUCCESS)
