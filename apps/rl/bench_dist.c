@@ -45,6 +45,9 @@ static const char bench_dist_help[] =
     "busy time / mean) and messages and bytes per frame or sample. Sections:\n"
     "  tiles     rl --dist render: whitted and pt (--spp) on --scenes\n"
     "  sampling  rl --dist eval (Jaehn 2015, Alg. 5.4) on --eval-scene\n"
+    "  vt        rl --dist render --algo vt (Ullmann 2003, Sec. 4.3, Fig. 5.14) on\n"
+    "            --scenes, both load balancers (queue, precompute), and the SSIM\n"
+    "            on the VT pixels against the one-rank image\n"
     "Rank counts above the machine's cores are marked oversubscribed.\n"
     "\n"
     "options:\n"
@@ -52,12 +55,13 @@ static const char bench_dist_help[] =
     "  --threads N        OpenMP threads per rank; default 1\n"
     "  --scenes A,B       tiles: scenes; default table,cluster\n"
     "  --size WxH         tiles: image size; default 640x480\n"
+    "  --vt-size WxH      vt: image size; default 320x240\n"
     "  --spp N            tiles: pt's samples per pixel; default 4\n"
     "  --eval-scene S     sampling: scene; default city:blocks=2\n"
     "  --samples N        sampling: samples of the visibility property; default 64\n"
     "  --repeats N        runs per point, the fastest kept; default 2\n"
     "  --mpirun PATH      default mpirun\n"
-    "  --only A,B         sections: tiles, sampling\n"
+    "  --only A,B         sections: tiles, sampling, vt\n"
     "  --out FILE.json    default bench/results/dist-YYYYMMDD-HHMMSS.json\n"
     "  --quick            tiny run: ranks 1,2, cornell at 96x64, 1 spp, 16 samples\n"
     "                     on city:blocks=1, one run each\n"
@@ -66,8 +70,8 @@ static const char bench_dist_help[] =
     "(set for the runs when missing). Example, a 16-core node (bench/dist.sh):\n"
     "  rl bench dist --ranks 1,2,4,8,16 --size 1280x960\n";
 
-enum { SEC_TILES, SEC_SAMPLING, SEC_COUNT };
-static const char *const section_names[SEC_COUNT] = { "tiles", "sampling" };
+enum { SEC_TILES, SEC_SAMPLING, SEC_VT, SEC_COUNT };
+static const char *const section_names[SEC_COUNT] = { "tiles", "sampling", "vt" };
 
 #define MAX_RANKS 16
 #define MAX_RANK_COUNT 1024
@@ -78,9 +82,9 @@ typedef struct bd_args {
     const char *scenes, *eval_scene, *mpirun, *out;
     int ranks[MAX_RANKS], num_ranks;
     long long threads, spp, samples, repeats;
-    int width, height;
+    int width, height, vt_width, vt_height;
     unsigned sections;
-    bool quick, has_ranks, has_size, has_spp, has_samples, has_repeats;
+    bool quick, has_ranks, has_size, has_vt_size, has_spp, has_samples, has_repeats;
 } bd_args;
 
 typedef struct bd_ctx {
@@ -261,8 +265,12 @@ static double imbalance(const cJSON *dist)
 
 /* The runs of one workload over every rank count into arr; per: what the
  * bytes and messages are divided by (1 for a frame, the samples). */
-static rl_status sweep(bd_ctx *c, const char *label, const char *const *cmd, const char *json_path, double per,
-                       const char *per_what, cJSON *arr)
+/* Called after a rank count's runs with its entry (the last run's outputs
+ * are still in the scratch folder). */
+typedef void (*sweep_fn)(bd_ctx *c, int ranks, cJSON *entry, void *user);
+
+static rl_status sweep_with(bd_ctx *c, const char *label, const char *const *cmd, const char *json_path,
+                            double per, const char *per_what, cJSON *arr, sweep_fn after, void *user)
 {
     double t1 = NAN;
     for (int i = 0; i < c->a->num_ranks; ++i) {
@@ -311,6 +319,8 @@ static rl_status sweep(bd_ctx *c, const char *label, const char *const *cmd, con
         bench_add_num(e, "lost", num(dist, "lost"));
         cJSON_AddItemToObject(e, "dist", cJSON_Duplicate(dist, true));
         cJSON_AddItemToArray(arr, e);
+        if (after)
+            after(c, ranks, e, user);
         printf("  %-28s %3d ranks%s  %9.1f ms  speed-up %5.2f  efficiency %4.0f%%  imbalance %4.2f  "
                "%7.1f msg, %9.0f B per %s\n",
                label, ranks, ranks * c->a->threads > c->cores ? " (oversubscribed)" : "                 ", best,
@@ -319,6 +329,12 @@ static rl_status sweep(bd_ctx *c, const char *label, const char *const *cmd, con
         cJSON_Delete(best_doc);
     }
     return RL_OK;
+}
+
+static rl_status sweep(bd_ctx *c, const char *label, const char *const *cmd, const char *json_path, double per,
+                       const char *per_what, cJSON *arr)
+{
+    return sweep_with(c, label, cmd, json_path, per, per_what, arr, NULL, NULL);
 }
 
 static rl_status sec_tiles(void *ctx, cJSON *sec)
@@ -378,6 +394,130 @@ static rl_status sec_sampling(void *ctx, cJSON *sec)
     return sweep(c, label, cmd, json, (double)a->samples, "sample", runs);
 }
 
+/* The vt section's quality: every rank count's image against the one-rank
+ * image (one process: rl --dist with one rank renders as rl render), SSIM
+ * over the pixels of the VT objects (node attribute vt, inherited). */
+typedef struct vt_quality {
+    const char *png;
+    rl_image *reference;     /* the one-rank image */
+    uint8_t *mask;           /* VT-object pixels, or NULL: every pixel */
+    uint64_t mask_pixels;
+} vt_quality;
+
+/* The VT objects' pixels of scene's default camera at w x h, from an ID
+ * image of the raster renderer (the same geometry the frames draw). */
+static uint8_t *vt_mask(const char *scene_name, int w, int h, uint64_t *count)
+{
+    *count = 0;
+    rl_scene *scene = NULL;
+    rl_renderer *r = NULL;
+    rl_image *img = NULL;
+    rl_camera cam;
+    uint8_t *mask = NULL;
+    if (rl_scene_load(scene_name, NULL, &scene) != RL_OK || rl_scene_get_camera(scene, NULL, &cam) != RL_OK ||
+        rl_renderer_create("raster", &r) != RL_OK || rl_image_create(w, h, RL_LAYER_COLOR | RL_LAYER_DEPTH |
+                                                                                RL_LAYER_ID, &img) != RL_OK)
+        goto done;
+    cam.width = w;
+    cam.height = h;
+    if (rl_renderer_render(r, scene, &cam, img, NULL) != RL_OK || !(mask = calloc((size_t)w * (size_t)h, 1)))
+        goto done;
+    const rl_scene_data *d = rl_scene_get_data(scene);
+    for (size_t i = 0; i < (size_t)w * (size_t)h; ++i) {
+        uint32_t o = img->object_id[i];
+        if (o >= d->num_objects)
+            continue;
+        for (uint32_t n = d->objects[o].node; n != RL_NONE; n = rl_scene_node_parent(scene, n)) {
+            const char *v = rl_scene_node_attr(scene, n, "vt");
+            if (v) {
+                mask[i] = strcmp(v, "true") == 0;
+                break;
+            }
+        }
+        *count += mask[i];
+    }
+done:
+    rl_image_release(img);
+    rl_renderer_release(r);
+    rl_scene_release(scene);
+    if (mask && !*count) {
+        free(mask);
+        mask = NULL;
+    }
+    return mask;
+}
+
+static void vt_after(bd_ctx *c, int ranks, cJSON *entry, void *user)
+{
+    (void)c;
+    vt_quality *q = user;
+    rl_image *img = NULL;
+    if (rl_image_read(q->png, &img) != RL_OK)
+        return;
+    if (ranks == 1 && !q->reference) {
+        q->reference = img;
+        return;
+    }
+    rl_metric_options opt = { .mask = q->mask };
+    rl_image_metrics m;
+    if (q->reference && rl_image_compare(img, q->reference, &opt, &m) == RL_OK) {
+        bench_add_num(entry, "ssim_vt", m.ssim);
+        bench_add_num(entry, "psnr_vt", m.psnr);
+        printf("  %-28s %3d ranks: SSIM %.5f on %s against one rank\n", "", ranks, m.ssim,
+               q->mask ? "the VT pixels" : "all pixels");
+    }
+    rl_image_release(img);
+}
+
+/* Fig. 5.14's analogue: distributed Vertex Tracing against the ranks, for
+ * both load balancers (Sec. 4.3.2). The first rank count should be 1: it
+ * is the reference of the speed-up and of the image. */
+static rl_status sec_vt(void *ctx, cJSON *sec)
+{
+    bd_ctx *c = ctx;
+    const bd_args *a = c->a;
+    cJSON *arr = cJSON_AddArrayToObject(sec, "runs");
+    char scenes[1024];
+    snprintf(scenes, sizeof scenes, "%s", a->scenes);
+    char size[32], threads[48], png[300], json[300];
+    snprintf(size, sizeof size, "%dx%d", a->vt_width, a->vt_height);
+    snprintf(threads, sizeof threads, "threads=%lld", a->threads);
+    snprintf(png, sizeof png, "%s/vt.png", c->dir);
+    snprintf(json, sizeof json, "%s/vt.json", c->dir);
+    cJSON_AddStringToObject(sec, "note", "ssim_vt: SSIM (luma, sRGB) on the pixels of the VT objects against the "
+                                         "one-rank image of the same balancer; the first rank count's frame "
+                                         "includes every rank's BVH build (prep), as the tiles' do");
+    static const char *const balances[] = { "queue", "precompute" };
+    rl_status st = RL_OK;
+    for (char *save = NULL, *scene = strtok_r(scenes, ",", &save); scene && st == RL_OK;
+         scene = strtok_r(NULL, ",", &save)) {
+        vt_quality q = { .png = png };
+        q.mask = vt_mask(scene, a->vt_width, a->vt_height, &q.mask_pixels);
+        for (int k = 0; k < 2 && st == RL_OK; ++k) {
+            char balance[48];
+            snprintf(balance, sizeof balance, "balance=%s", balances[k]);
+            const char *cmd[] = { "render", scene, "--algo", "vt", "--size", size, "--set", threads, "--set", balance,
+                                  "--out", png, "--stats-json", json, "-q", NULL };
+            char label[128];
+            snprintf(label, sizeof label, "vt %s %s", scene, balances[k]);
+            note("vt: %s", label);
+            cJSON *w = cJSON_CreateObject();
+            cJSON_AddStringToObject(w, "scene", scene);
+            cJSON_AddStringToObject(w, "algorithm", "vt");
+            cJSON_AddStringToObject(w, "balance", balances[k]);
+            cJSON_AddStringToObject(w, "size", size);
+            cJSON_AddNumberToObject(w, "vt_pixels", (double)q.mask_pixels);
+            cJSON *runs = cJSON_AddArrayToObject(w, "ranks");
+            cJSON_AddItemToArray(arr, w);
+            st = sweep_with(c, label, cmd, json, 1.0, "frame", runs, vt_after, &q);
+            rl_image_release(q.reference);
+            q.reference = NULL;
+        }
+        free(q.mask);
+    }
+    return st;
+}
+
 static int remove_entry(const char *path, const struct stat *sb, int flag, struct FTW *ftw)
 {
     (void)sb;
@@ -395,6 +535,7 @@ static int parse_args(int argc, char **argv, bd_args *a)
         RL_BENCH_COUNT("--threads", 4096, &a->threads, NULL),
         RL_BENCH_STRING("--scenes", &a->scenes),
         RL_BENCH_SIZE("--size", &a->width, &a->height, &a->has_size),
+        RL_BENCH_SIZE("--vt-size", &a->vt_width, &a->vt_height, &a->has_vt_size),
         RL_BENCH_COUNT("--spp", 1 << 20, &a->spp, &a->has_spp),
         RL_BENCH_STRING("--eval-scene", &a->eval_scene),
         RL_BENCH_COUNT("--samples", 1 << 24, &a->samples, &a->has_samples),
@@ -418,6 +559,10 @@ static int parse_args(int argc, char **argv, bd_args *a)
     if (!a->has_size) {
         a->width = a->quick ? 96 : 640;
         a->height = a->quick ? 64 : 480;
+    }
+    if (!a->has_vt_size) {
+        a->vt_width = a->quick ? 64 : 320;
+        a->vt_height = a->quick ? 48 : 240;
     }
     if (!a->has_spp)
         a->spp = a->quick ? 1 : 4;
@@ -486,7 +631,7 @@ int bench_dist(int argc, char **argv)
     for (int i = 0; i < a.num_ranks; ++i)
         printf("%s%d", i ? "," : " ", a.ranks[i]);
     printf(", %lld thread%s per rank, %d cores\n", a.threads, a.threads == 1 ? "" : "s", c.cores);
-    static const bench_section_fn fns[SEC_COUNT] = { sec_tiles, sec_sampling };
+    static const bench_section_fn fns[SEC_COUNT] = { sec_tiles, sec_sampling, sec_vt };
     rc = bench_run_sections("dist", root, section_names, fns, SEC_COUNT, a.sections, &c, c.reason,
                             (int)a.threads, out);
     cJSON_Delete(root);

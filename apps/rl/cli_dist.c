@@ -129,19 +129,21 @@ cJSON *cli_dist_json(void)
     if (!o)
         return NULL;
     cJSON_AddNumberToObject(o, "ranks", last.ranks);
-    cJSON_AddStringToObject(o, "task", sampling ? "chunk" : "band");
+    cJSON_AddStringToObject(o, "task", sampling ? "chunk" : last.task_kind ? last.task_kind : "band");
     cJSON_AddNumberToObject(o, "tasks", (double)last.tasks);
     cJSON_AddNumberToObject(o, "messages", (double)last.messages);
     cJSON_AddNumberToObject(o, "bytes", (double)last.bytes);
     cJSON_AddNumberToObject(o, "time_ms", last.time_ms);
     cJSON_AddNumberToObject(o, "lost", last.lost);
+    if (last.task_kind)
+        cJSON_AddNumberToObject(o, "dropped", (double)last.dropped);
     cJSON *ranks = cJSON_AddArrayToObject(o, "per_rank");
     for (int k = 0; ranks && last.per_rank && k < last.ranks; k++) {
         cJSON *e = cJSON_CreateObject();
         if (!e)
             break;
         cJSON_AddNumberToObject(e, "tasks", (double)last.per_rank[k].tasks);
-        cJSON_AddNumberToObject(e, sampling ? "positions" : "pixels", (double)last.per_rank[k].pixels);
+        cJSON_AddNumberToObject(e, sampling ? "positions" : last.task_kind ? "faces" : "pixels", (double)last.per_rank[k].pixels);
         cJSON_AddNumberToObject(e, "busy_ms", last.per_rank[k].busy_ms);
         cJSON_AddItemToArray(ranks, e);
     }
@@ -152,13 +154,18 @@ void cli_print_dist_summary(FILE *out)
 {
     if (!have_last || !cli_dist_master())
         return;
-    const char *task = sampling ? "chunks" : "bands", *item = sampling ? "positions" : "pixels";
+    const bool faces = !sampling && last.task_kind;      /* Vertex Tracing's face packages */
+    const char *task = sampling ? "chunks" : faces ? "packages" : "bands",
+               *item = sampling ? "positions" : faces ? "faces" : "pixels";
     fprintf(out, "dist: %d ranks, %llu %s, %llu messages, %.1f MB; per rank: %s, %s, busy ms, idle %%\n",
             last.ranks, (unsigned long long)last.tasks, task, (unsigned long long)last.messages,
             (double)last.bytes / 1e6, task, item);
     if (last.lost)
         fprintf(out, "dist: %d worker%s lost (silent past RL_DIST_TIMEOUT); the master handed their %s to the "
                 "others\n", last.lost, last.lost == 1 ? "" : "s", task);
+    if (last.dropped)
+        fprintf(out, "dist: %llu result%s of an older camera dropped\n", (unsigned long long)last.dropped,
+                last.dropped == 1 ? "" : "s");
     for (int k = 0; k < last.ranks; k++) {
         const rl_dist_rank_stats *p = &last.per_rank[k];
         double idle = last.time_ms > 0.0 ? 100.0 * (1.0 - p->busy_ms / last.time_ms) : 0.0;

@@ -64,12 +64,23 @@ typedef struct rl_dist_stats {
     uint64_t bytes;          /* their payload */
     double time_ms;          /* the frame, on the master */
     int lost;                /* workers taken for lost (silent past RL_DIST_TIMEOUT); their work was redone */
+    uint64_t dropped;        /* Vertex Tracing: results of an older camera dropped (Ullmann Sec. 4.3.2) */
+    const char *task_kind;   /* "package" for Vertex Tracing's face packages; NULL: bands or chunks */
     /* Per rank, rank 0 (the master, which renders bands between its
      * messages) first; NULL when the frame ran in one process. Owned by
      * the rl_dist, valid until its next frame or release. */
     const rl_dist_rank_stats *per_rank;
 } rl_dist_stats;
 
+/* The renderer "vt" (Vertex Tracing) has no regions: its frames are split
+ * by primary faces instead (Ullmann 2003, Sec. 4.3; rl_vt.h's
+ * rl_vt_prepare, rl_vt_refine_faces and rl_vt_draw_parts): the master
+ * runs the ID pre-pass and hands out packages of visible faces, by the
+ * renderer's option balance (queue: equal packages of `package` faces on
+ * demand; precompute: one package per rank sized by its measured speed);
+ * every task and result carries the frame's camera ID, and results of an
+ * older camera are dropped (dstats->dropped). Its image is close to one
+ * process', not equal at package borders (docs/distributed.md). */
 /* Renders cam's frame into image with every rank's copy of r: collective,
  * every rank calls it with the same renderer options, scene, camera and
  * image size. On the master, image receives the whole frame (every layer

@@ -78,6 +78,46 @@ RL_API rl_status rl_vt_get_mesh(const rl_renderer *r, const rl_vt_vertex_info **
 typedef bool (*rl_vt_update_fn)(void *user, const rl_image *image, uint32_t stage, bool final);
 RL_API rl_status rl_vt_set_update_callback(rl_renderer *r, rl_vt_update_fn fn, void *user);
 
+/* Distributed Vertex Tracing (Ullmann 2003, Sec. 4.3; rl_dist.h runs it
+ * over MPI ranks). A frame is split by primary faces: the master takes the
+ * visible primary faces of the ID pre-pass (rl_vt_prepare), hands them out
+ * in packages, every rank refines its packages (rl_vt_refine_faces) into
+ * parts, and the master draws the frame from all parts (rl_vt_draw_parts).
+ * Every rank needs the same scene, options, camera and image size.
+ *
+ * A package's faces start the refinement; splits spread into neighbouring
+ * faces as in one process, and with the option dist_halo (default) the
+ * visible faces sharing an edge with the package are flagged visible too,
+ * so that forced refinement (Sec. 3.3.2) crosses the package's border as
+ * in one process. A part holds the package's refined leaf faces only:
+ * neighbours are drawn from their own packages (docs/distributed.md). */
+
+/* The ID pre-pass for cam at image's size (it draws the rasterized half
+ * of the frame into image): *faces receives the visible primary faces in
+ * ascending order, *count of them, owned by r until its next call. */
+RL_API rl_status rl_vt_prepare(rl_renderer *r, const rl_scene *scene, const rl_camera *cam, rl_image *image,
+                               const uint32_t **faces, size_t *count);
+/* Refines the primary faces faces[0..count) (any primary faces; the
+ * invisible ones add nothing) of cam's frame and writes the part: a
+ * malloc'd buffer for free() into *part, *part_size bytes. Runs the
+ * pre-pass first unless r ran it last for the same scene, camera, size
+ * and options (image is its scratch then). stats: rays and samples. */
+RL_API rl_status rl_vt_refine_faces(rl_renderer *r, const rl_scene *scene, const rl_camera *cam, rl_image *image,
+                                    const uint32_t *faces, size_t count, void **part, size_t *part_size,
+                                    rl_render_stats *stats);
+/* Draws cam's frame into image: the rasterized half and the faces of
+ * parts[0..count) (sizes[i] bytes each), in that order. A part that fails
+ * rl_vt_part_check, or names triangles the scene lacks, is RL_ERR_PARSE
+ * and the image is not drawn. rl_vt_get_stats and rl_vt_get_mesh then
+ * describe the drawn faces (no refinement counts). */
+RL_API rl_status rl_vt_draw_parts(rl_renderer *r, const rl_scene *scene, const rl_camera *cam, rl_image *image,
+                                  const void *const *parts, const size_t *sizes, size_t count,
+                                  rl_render_stats *stats);
+/* Checks a part without a scene (magic, version, counts against its size,
+ * checksum, vertex indices): RL_OK with its vertex and face counts, or
+ * RL_ERR_PARSE saying what is wrong. vertices and faces may be NULL. */
+RL_API rl_status rl_vt_part_check(const void *part, size_t size, size_t *vertices, size_t *faces);
+
 #ifdef __cplusplus
 }
 #endif

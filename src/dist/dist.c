@@ -85,9 +85,11 @@ rl_status rl_dist_init(int *argc, char ***argv, rl_dist **out)
     MPI_Comm_size(MPI_COMM_WORLD, &d->size);
     d->per_rank = calloc((size_t)d->size, sizeof *d->per_rank);
     d->sampling_lost = calloc((size_t)d->size, 1);
-    if (!d->per_rank || !d->sampling_lost) {
+    d->vt_speed = calloc((size_t)d->size, sizeof *d->vt_speed);
+    if (!d->per_rank || !d->sampling_lost || !d->vt_speed) {
         free(d->per_rank);
         free(d->sampling_lost);
+        free(d->vt_speed);
         if (d->own_mpi)
             MPI_Finalize();
         free(d);
@@ -109,6 +111,7 @@ void rl_dist_release(rl_dist *d, rl_status status)
     int size = d->size;
     free(d->per_rank);
     free(d->sampling_lost);
+    free(d->vt_speed);
     free(d);
     if (!own)
         return;
@@ -135,7 +138,12 @@ void rl_dist_pause(void)
 
 rl_status rl_dist_wait(const rl_dist *d, int tag, MPI_Status *ms)
 {
-    const double timeout = rl_dist_timeout_s(), t0 = rl_time_s();
+    return rl_dist_wait_for(d, tag, ms, rl_dist_timeout_s());
+}
+
+rl_status rl_dist_wait_for(const rl_dist *d, int tag, MPI_Status *ms, double timeout)
+{
+    const double t0 = rl_time_s();
     for (;;) {
         int arrived = 0;
         int code = MPI_Iprobe(0, tag, MPI_COMM_WORLD, &arrived, ms);
@@ -694,6 +702,19 @@ static rl_status render_frames(rl_dist *d, rl_renderer *r, const rl_scene *scene
             }
         }
         rs->time_ms = ds->time_ms = rl_timer_ms(&t);
+        return st;
+    }
+    if (strcmp(rl_renderer_name(r), "vt") == 0) {
+        /* Vertex Tracing splits the frame by faces, not pixels (dist_vt.c). */
+        if (frames > 1)
+            return rl_error(RL_ERR_UNSUPPORTED, "vt renders single frames (no accumulation over frames)");
+        memset(d->per_rank, 0, (size_t)d->size * sizeof *d->per_rank);
+        rl_timer t;
+        rl_timer_start(&t);
+        rl_status st = rl_dist_vt_frame(d, r, scene, cam, image, rs, ds);
+        rs->time_ms = ds->time_ms = rl_timer_ms(&t);
+        ds->per_rank = d->per_rank;
+        ds->task_kind = "package";
         return st;
     }
     if (frames == 0)

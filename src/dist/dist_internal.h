@@ -17,6 +17,8 @@ enum {
     RL_DIST_TAG_VALUES,        /* worker -> master: measured values and sets */
     RL_DIST_TAG_SPEC,          /* master -> worker: the next run's property (service) */
     RL_DIST_TAG_END,           /* master -> worker: the service's status, its end */
+    RL_DIST_TAG_VT_PART,       /* worker -> master: a VT package's result header (dist_vt.c) */
+    RL_DIST_TAG_VT_DATA,       /* worker -> master: ... and its part */
 };
 
 struct rl_dist {
@@ -29,6 +31,9 @@ struct rl_dist {
      * for them again. */
     unsigned char *sampling_lost;
     bool service;                      /* rl_dist_service_begin on the master */
+    uint64_t vt_camera;                /* distributed VT frames so far: the camera ID */
+    double *vt_speed;                  /* per rank: faces per busy ms of the last VT frame */
+    bool vt_speed_valid;               /* ... for balance=precompute */
 };
 
 /* RL_ERR_IO "distributed run: WHAT: <MPI's text for code>". */
@@ -45,6 +50,8 @@ void rl_dist_pause(void);
  * any), polling; past the timeout RL_ERR_IO "no word from the master",
  * so that a dead master ends its workers with an error, not a hang. */
 rl_status rl_dist_wait(const rl_dist *d, int tag, MPI_Status *ms);
+/* ... with a timeout of its own, in seconds. */
+rl_status rl_dist_wait_for(const rl_dist *d, int tag, MPI_Status *ms, double timeout);
 /* MPI_Send that gives up past the timeout (RL_ERR_IO naming dest): a
  * large message waits for its receiver, forever if the receiver died. */
 rl_status rl_dist_send(const rl_dist *d, const void *buf, int count, MPI_Datatype type, int dest, int tag);
@@ -53,5 +60,11 @@ rl_status rl_dist_send(const rl_dist *d, const void *buf, int count, MPI_Datatyp
  * SIGKILL after its N-th task, as a crashed node would vanish. Counts this
  * rank's tasks. */
 void rl_dist_fault_point(rl_dist *d);
+
+/* A Vertex Tracing frame over the ranks (dist_vt.c): collective, as
+ * rl_dist_render, which calls it for the renderer "vt" in a job of
+ * several ranks. */
+rl_status rl_dist_vt_frame(rl_dist *d, rl_renderer *r, const rl_scene *scene, const rl_camera *cam,
+                           rl_image *image, rl_render_stats *stats, rl_dist_stats *ds);
 
 #endif

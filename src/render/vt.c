@@ -48,6 +48,7 @@
 #include "render/accel_cache.h"
 #include "render/renderer.h"
 #include "render/tracer_options.h"
+#include "render/vt_part.h"
 #include "render/vt_run.h"
 #include "rl/rl_gl.h"
 #include "rl/rl_timer.h"
@@ -59,6 +60,7 @@ static const char *const progressive_choices[] = { "none", "overdraw", "redraw",
 static const char *const shading_choices[] = { "flat", "gouraud", "textured", NULL };
 static const char *const overlay_choices[] = { "none", "wire", "samples", NULL };
 static const char *const reconstruct_choices[] = { "software", "gl", NULL };
+static const char *const balance_choices[] = { "queue", "precompute", NULL };
 enum { RECONSTRUCT_SOFTWARE, RECONSTRUCT_GL };
 
 static const rl_option_info vt_options[] = {
@@ -103,6 +105,15 @@ static const rl_option_info vt_options[] = {
       reconstruct_choices },
     { "device", RL_OPT_STRING, "", "reconstruct=gl: EGL device auto, surfaceless or a number; empty: "
       "$RL_EGL_DEVICE, else auto", 0, 0, NULL },
+    { "balance", RL_OPT_ENUM, "queue",
+      "rl --dist: load balancing of the face packages (Sec. 4.3.3): queue (equal packages on demand, Fig. 4.8) "
+      "| precompute (one package per rank, sized by its measured speed)", 0, 0, balance_choices },
+    { "package", RL_OPT_INT, "0",
+      "rl --dist, balance=queue: visible primary faces per package (0: 1/32 of an equal share per rank)",
+      0, 1000000000, NULL },
+    { "dist_halo", RL_OPT_BOOL, "true",
+      "rl --dist: a package also flags the visible faces around it, so that forced refinement crosses package "
+      "borders as in one process (Sec. 4.3.3)", 0, 0, NULL },
     RL_TRACER_OPTION_ROWS,
 };
 
@@ -139,6 +150,17 @@ typedef struct vt_state {
     size_t scratch_pixels;
     vt_corners corners;
     vt_base base;             /* progressive frames' copy of the rasterized half */
+    /* distributed frames (rl_vt_prepare): the pre-pass kept for the camera
+     * in depth_ids, with what it was made for */
+    bool prepared;
+    rl_camera prep_cam;
+    int prep_width, prep_height;
+    uint64_t prep_scene;
+    char *prep_signature;
+    uint8_t *prep_visible;    /* per primary face: passed the ID test */
+    uint32_t *prep_list;      /* the visible ones, ascending */
+    size_t prep_count;
+    uint8_t *package;         /* per primary face: in the package being refined */
 } vt_state;
 
 /* Temporal coherence (Sec. 3.4.5) is the only state a frame leaves for the
@@ -169,6 +191,10 @@ static void vt_release(void *state)
     free(s->scratch_depth);
     vt_corners_free(&s->corners);
     vt_base_free(&s->base);
+    free(s->prep_signature);
+    free(s->prep_visible);
+    free(s->prep_list);
+    free(s->package);
 }
 
 /* The kept rasterizer, pre-pass image and scratch depth (for an image
@@ -603,6 +629,7 @@ static rl_status vt_render(rl_renderer *r, void *state, const rl_scene *scene, c
     vt_settings set;
     read_settings(r, &set);
     s->have_frame = false;
+    s->prepared = false;      /* depth_ids is this frame's now */
 
     rl_tracer *tracer = NULL;
     if ((st = prepare_tracer(r, s, scene, d, &set, &tracer, &stats->prep_ms)) != RL_OK)
@@ -684,6 +711,283 @@ rl_status rl_vt_set_update_callback(rl_renderer *r, rl_vt_update_fn fn, void *us
     s->update = fn;
     s->update_user = user;
     return RL_OK;
+}
+
+/* ------------------------------------------------- distributed frames -- */
+
+static void dist_end(vt_run *run, rl_tracer *tracer)
+{
+    vt_run_free_blocks(run);
+    free(run->reason);
+    free(run->feelers);
+    vt_feeler_pool_free(&run->feeler_pool);
+    rl_tracer_release(tracer);
+}
+
+/* What the distributed entry points share: the kept structures for the
+ * scene, a fresh mesh, a run over image with the kept buffers. No update
+ * callback: a package is no picture, the master draws once. */
+static rl_status dist_begin(rl_renderer *r, vt_state *s, const rl_scene *scene, const rl_camera *cam_in,
+                            rl_image *image, vt_settings *set, rl_camera *cam, rl_tracer **tracer, vt_run *run)
+{
+    memset(run, 0, sizeof *run);
+    *tracer = NULL;
+    const rl_scene_data *d = rl_scene_get_data(scene);
+    if (!d)
+        return RL_ERR_NOT_COMMITTED;
+    rl_status st = rl_camera_validate(cam_in);
+    if (st != RL_OK)
+        return st;
+    if (image->width <= 0 || image->height <= 0 || !image->color)
+        return rl_error(RL_ERR_INVALID_ARG, "vt: a distributed frame needs an image with colour");
+    *cam = rl_camera_resolve(cam_in);
+    read_settings(r, set);
+    s->have_frame = false;
+    if (rl_renderer_opt_enum(r, "reconstruct") != RECONSTRUCT_SOFTWARE)
+        return rl_error(RL_ERR_UNSUPPORTED, "vt: distributed frames draw with reconstruct=software only");
+    double prep_ms = 0.0;
+    if ((st = prepare_tracer(r, s, scene, d, set, tracer, &prep_ms)) != RL_OK)
+        return st;
+    vt_mesh_reset(&s->mesh);
+    vt_heap_clear(&s->heap);
+    setup_run(run, r, s, d, set, *tracer, cam, image);
+    run->update = NULL;
+    if ((st = vt_run_reserve(run)) == RL_OK)
+        st = frame_buffers(s, set->threads, image);
+    run->ras = s->ras;
+    run->corners = &s->corners;
+    run->scratch_depth = s->scratch_depth;
+    run->base = &s->base;
+    return st;
+}
+
+/* The ID pre-pass for the run's camera, unless the kept one is for the
+ * same scene, camera, size and options: a worker refines many packages
+ * of one frame and needs the pre-pass' depth and face flags for each. */
+static rl_status dist_prepass(rl_renderer *r, vt_state *s, const rl_scene *scene, const rl_camera *cam,
+                              vt_run *run)
+{
+    char *sig = rl_renderer_option_signature(r, NULL);
+    if (!sig)
+        return RL_ERR_OUT_OF_MEMORY;
+    if (s->prepared && s->prep_scene == rl_scene_uid(scene) && memcmp(&s->prep_cam, cam, sizeof *cam) == 0 &&
+        s->prep_width == run->image->width && s->prep_height == run->image->height && s->prep_signature &&
+        strcmp(sig, s->prep_signature) == 0) {
+        free(sig);
+        return RL_OK;
+    }
+    s->prepared = false;
+    free(s->prep_signature);
+    s->prep_signature = sig;
+    const vt_mesh *m = run->mesh;
+    size_t nf = m->num_primary_faces ? m->num_primary_faces : 1;
+    uint8_t *vis = rl_realloc_array(s->prep_visible, nf, 1);
+    if (vis)
+        s->prep_visible = vis;
+    uint32_t *list = rl_realloc_array(s->prep_list, nf, sizeof *list);
+    if (list)
+        s->prep_list = list;
+    uint8_t *pkg = rl_realloc_array(s->package, nf, 1);
+    if (pkg)
+        s->package = pkg;
+    if (!vis || !list || !pkg)
+        return rl_error(RL_ERR_OUT_OF_MEMORY, "vt: face flags of %zu faces", nf);
+    rl_status st = vt_prepass(run, s->depth_ids);
+    if (st != RL_OK)
+        return st;
+    s->prep_count = 0;
+    for (uint32_t f = 0; f < m->num_primary_faces; ++f) {
+        vis[f] = m->faces[f].visible;
+        if (vis[f])
+            list[s->prep_count++] = f;
+    }
+    s->prep_cam = *cam;
+    s->prep_width = run->image->width;
+    s->prep_height = run->image->height;
+    s->prep_scene = rl_scene_uid(scene);
+    s->prepared = true;
+    return RL_OK;
+}
+
+rl_status rl_vt_prepare(rl_renderer *r, const rl_scene *scene, const rl_camera *cam, rl_image *image,
+                        const uint32_t **faces, size_t *count)
+{
+    vt_state *s = vt_of(r, "rl_vt_prepare");
+    if (!s || !scene || !cam || !image || !faces || !count)
+        return rl_error(RL_ERR_INVALID_ARG, "rl_vt_prepare: needs a \"vt\" renderer, scene, camera, image and "
+                        "outputs");
+    *faces = NULL;
+    *count = 0;
+    vt_settings set;
+    rl_camera c;
+    rl_tracer *tracer;
+    vt_run run;
+    rl_status st = dist_begin(r, s, scene, cam, image, &set, &c, &tracer, &run);
+    if (st == RL_OK)
+        st = dist_prepass(r, s, scene, &c, &run);
+    dist_end(&run, tracer);
+    if (st == RL_OK) {
+        *faces = s->prep_list;
+        *count = s->prep_count;
+    }
+    return st;
+}
+
+/* The package's faces and, with dist_halo, the visible faces sharing a
+ * primary edge with them are flagged visible: splits reach those
+ * neighbours anyway (a split edge splits both its faces), and forced
+ * refinement checks only visible faces' children, so without the ring a
+ * border sub-edge that one process splits by force from the other side
+ * stays whole here (Sec. 4.3.3). */
+static uint64_t flag_package(vt_state *s, vt_mesh *m, const uint32_t *faces, size_t count, bool halo)
+{
+    memset(s->package, 0, m->num_primary_faces);
+    uint64_t visible = 0;
+    for (size_t i = 0; i < count; ++i) {
+        uint32_t f = faces[i];
+        s->package[f] = 1;
+        if (s->prep_visible[f] && !m->faces[f].visible) {
+            m->faces[f].visible = 1;
+            ++visible;
+        }
+    }
+    for (size_t i = 0; halo && i < count; ++i) {
+        uint32_t f = faces[i];
+        if (!s->prep_visible[f])
+            continue;
+        for (int k = 0; k < 3; ++k) {
+            const vt_edge *e = &m->edges[m->faces[f].e[k]];
+            for (int side = 0; side < 2; ++side) {
+                uint32_t g = e->face[side];
+                if (g != VT_NONE && g < m->num_primary_faces && s->prep_visible[g])
+                    m->faces[g].visible = 1;
+            }
+        }
+    }
+    return visible;
+}
+
+rl_status rl_vt_refine_faces(rl_renderer *r, const rl_scene *scene, const rl_camera *cam, rl_image *image,
+                             const uint32_t *faces, size_t count, void **part, size_t *part_size,
+                             rl_render_stats *stats)
+{
+    vt_state *s = vt_of(r, "rl_vt_refine_faces");
+    if (!s || !scene || !cam || !image || (!faces && count) || !part || !part_size)
+        return rl_error(RL_ERR_INVALID_ARG, "rl_vt_refine_faces: needs a \"vt\" renderer, scene, camera, image, "
+                        "faces and outputs");
+    *part = NULL;
+    *part_size = 0;
+    vt_settings set;
+    rl_camera c;
+    rl_tracer *tracer;
+    vt_run run;
+    rl_status st = dist_begin(r, s, scene, cam, image, &set, &c, &tracer, &run);
+    if (st == RL_OK)
+        st = dist_prepass(r, s, scene, &c, &run);
+    vt_mesh *m = &s->mesh;
+    for (size_t i = 0; st == RL_OK && i < count; ++i)
+        if (faces[i] >= m->num_primary_faces)
+            st = rl_error(RL_ERR_INVALID_ARG, "rl_vt_refine_faces: face %u of %u primary faces", faces[i],
+                          m->num_primary_faces);
+    if (st == RL_OK) {
+        /* The pre-pass flagged the whole frame's faces. */
+        vt_mesh_reset(m);
+        vt_heap_clear(&s->heap);
+        run.stats.visible_primary_faces = flag_package(s, m, faces, count, rl_renderer_opt_bool(r, "dist_halo"));
+        run.seed = s->package;
+        vt_project_primary(&run, s->depth_ids);
+        st = vt_refine(&run);
+    }
+    if (st == RL_OK)
+        st = vt_part_write(m, s->package, part, part_size);
+    if (st == RL_OK) {
+        for (int t = 0; t < set.threads && t < RL_VT_MAX_THREADS; ++t) {
+            run.stats.thread_rays[t] = run.tally[t].rays;
+            run.stats.thread_busy_ms[t] = run.tally[t].busy_ms;
+            run.stats.feelers_reused += run.tally[t].feelers_reused;
+        }
+        s->stats = run.stats;
+        if (stats) {
+            for (int k = 0; k < RL_RAY_TYPE_COUNT; ++k)
+                stats->rays[k] += run.rays[k];
+            stats->samples += run.stats.vertices_sampled;
+        }
+    }
+    dist_end(&run, tracer);
+    if (st == RL_OK && run.cancelled) {
+        free(*part);
+        *part = NULL;
+        *part_size = 0;
+        return rl_error(RL_ERR_CANCELLED, "vt: cancelled by the progress callback");
+    }
+    return st;
+}
+
+rl_status rl_vt_draw_parts(rl_renderer *r, const rl_scene *scene, const rl_camera *cam, rl_image *image,
+                           const void *const *parts, const size_t *sizes, size_t count, rl_render_stats *stats)
+{
+    vt_state *s = vt_of(r, "rl_vt_draw_parts");
+    if (!s || !scene || !cam || !image || (count && (!parts || !sizes)))
+        return rl_error(RL_ERR_INVALID_ARG, "rl_vt_draw_parts: needs a \"vt\" renderer, scene, camera, image and "
+                        "parts");
+    /* Every part is checked before anything is drawn. */
+    for (size_t i = 0; i < count; ++i) {
+        uint32_t nv, nf;
+        rl_status st = vt_part_check(parts[i], sizes[i], &nv, &nf);
+        if (st != RL_OK) {
+            char why[256];
+            snprintf(why, sizeof why, "%s", rl_last_error());
+            rl_clear_error();         /* the part's number goes first */
+            return rl_error(st, "rl_vt_draw_parts: part %zu: %s", i, why);
+        }
+    }
+    vt_settings set;
+    rl_camera c;
+    rl_tracer *tracer;
+    vt_run run;
+    rl_status st = dist_begin(r, s, scene, cam, image, &set, &c, &tracer, &run);
+    /* The parts' faces go after the primary ones. */
+    for (size_t i = 0; st == RL_OK && i < count; ++i)
+        if ((st = vt_part_import(&s->mesh, run.data, parts[i], sizes[i])) != RL_OK) {
+            char why[256];
+            snprintf(why, sizeof why, "%s", rl_last_error());
+            rl_clear_error();
+            st = rl_error(st, "rl_vt_draw_parts: part %zu: %s", i, why);
+        }
+    /* The primary faces are drawn from the parts' leaves only. */
+    for (uint32_t f = 0; st == RL_OK && f < s->mesh.num_primary_faces; ++f)
+        s->mesh.faces[f].leaf = 0;
+    if (st == RL_OK)
+        st = vt_draw_base(&run);
+    if (st == RL_OK)
+        st = vt_run_reserve(&run);
+    if (st == RL_OK)
+        st = vt_draw(&run, false);
+    if (st == RL_OK)
+        vt_draw_overlay(&run);
+    if (st == RL_OK)
+        st = keep_mesh(s, &run);
+    if (st == RL_OK) {
+        s->stats = run.stats;
+        s->have_frame = true;
+        if (stats) {
+            stats->triangles_rasterized += run.counters.triangles_drawn;
+            stats->pixels_written += run.counters.pixels_written;
+        }
+    }
+    dist_end(&run, tracer);
+    return st;
+}
+
+rl_status rl_vt_part_check(const void *part, size_t size, size_t *vertices, size_t *faces)
+{
+    uint32_t nv, nf;
+    rl_status st = vt_part_check(part, size, &nv, &nf);
+    if (vertices)
+        *vertices = st == RL_OK ? nv : 0;
+    if (faces)
+        *faces = st == RL_OK ? nf : 0;
+    return st;
 }
 
 const rl_renderer_class rl_vt_renderer_class = {

@@ -91,6 +91,11 @@ static rl_status reserve(vt_mesh *m, uint32_t verts, uint32_t edges, uint32_t fa
     return st;
 }
 
+rl_status vt_mesh_reserve(vt_mesh *m, uint32_t verts, uint32_t edges, uint32_t faces)
+{
+    return reserve(m, verts, edges, faces);
+}
+
 /* ------------------------------------------------------------- building -- */
 
 static uint64_t hash_bits(const void *data, size_t size)

@@ -102,14 +102,19 @@ rl_status vt_prepass(vt_run *run, rl_image *depth_ids)
     }
     for (uint32_t f = 0; f < m->num_primary_faces; ++f)
         run->stats.visible_primary_faces += m->faces[f].visible;
+    vt_project_primary(run, depth_ids);
+    return RL_OK;
+}
 
+void vt_project_primary(vt_run *run, const rl_image *depth_ids)
+{
+    vt_mesh *m = run->mesh;
     run->view.depth = depth_ids->depth;
     for (uint32_t v = 0; v < m->num_primary_verts; ++v) {
         vt_vertex *vx = &m->verts[v];
         vt_project_vertex(&run->view, vx);
-        vx->visible = set->z_test ? (uint8_t)vt_vertex_visible(&run->view, vx) : 1;
+        vx->visible = run->set->z_test ? (uint8_t)vt_vertex_visible(&run->view, vx) : 1;
     }
-    return RL_OK;
 }
 
 /* ---------------------------------------------------------- refinement -- */
@@ -122,6 +127,26 @@ typedef struct refine_ctx {
                          * blocks the runtime had it sample meanwhile */
     double update_ms;   /* primary thread in progressive updates */
 } refine_ctx;
+
+/* A package of a distributed frame (run->seed) refines its own faces: an
+ * edge is its business when a face on either side descends from one of
+ * them. Splits of border edges reach into the neighbours, whose insides
+ * their own packages refine; without this test a package would refine
+ * the neighbours' insides too, twice the work for nothing drawn. */
+static bool edge_in_package(const vt_run *run, const vt_edge *ed)
+{
+    if (!run->seed)
+        return true;
+    const vt_mesh *m = run->mesh;
+    for (int k = 0; k < 2; ++k) {
+        uint32_t f = ed->face[k];
+        while (f != VT_NONE && f >= m->num_primary_faces)
+            f = m->faces[f].parent;
+        if (f != VT_NONE && run->seed[f])
+            return true;
+    }
+    return false;
+}
 
 /* An edge enters the edge list (Fig. 3.4) if it is long enough to be split
  * and visible: on screen (Sec. 3.4.3) and, unless it is primary (the ID
@@ -136,7 +161,8 @@ static void consider_edge(refine_ctx *ctx, uint32_t e, bool primary)
     vt_edge *ed = &m->edges[e];
     const vt_vertex *a = &m->verts[ed->v[0]], *b = &m->verts[ed->v[1]];
     ed->length = vt_edge_length(&run->view, a, b);
-    if (!(ed->length > set->min_edge) || ed->mid != VT_NONE || ed->queued)
+    if (!(ed->length > set->min_edge) || ed->mid != VT_NONE || ed->queued ||
+        (!primary && !edge_in_package(run, ed)))
         return;
     if (!primary && set->z_test && !a->visible && !b->visible) {
         run->stats.edges_culled_z++;
@@ -225,7 +251,7 @@ static void run_forced(refine_ctx *ctx, uint16_t stage)
         uint32_t e = ctx->forced[--ctx->forced_count];
         vt_mesh *m = run->mesh;
         vt_edge *ed = &m->edges[e];
-        if (ed->mid != VT_NONE)
+        if (ed->mid != VT_NONE || !edge_in_package(run, ed))
             continue;
         const vt_vertex *a = &m->verts[ed->v[0]], *b = &m->verts[ed->v[1]];
         ed->length = vt_edge_length(&run->view, a, b);
@@ -333,6 +359,19 @@ static bool primary_edge_visible(const vt_mesh *m, const vt_edge *ed)
            (ed->face[1] != VT_NONE && m->faces[ed->face[1]].visible);
 }
 
+/* A primary edge starts the refinement (stage 0) when one of its faces is
+ * visible, or, for a package of a distributed frame (run->seed), one of
+ * its faces is in the package: the ring of visible faces around it is
+ * visible only so that forced refinement checks their sub-faces as one
+ * process would (vt_run.seed). */
+static bool primary_edge_seeds(const vt_run *run, const vt_edge *ed)
+{
+    if (!run->seed)
+        return primary_edge_visible(run->mesh, ed);
+    return (ed->face[0] != VT_NONE && run->seed[ed->face[0]]) ||
+           (ed->face[1] != VT_NONE && run->seed[ed->face[1]]);
+}
+
 /* Sample reduction, Ullmann Sec. 6.2.1: the two ends of a visible primary
  * edge whose projection is shorter than merge_px count as one sample.
  * Chains of short edges form one group (union-find); the lowest vertex of
@@ -421,7 +460,7 @@ static void refine_all(refine_ctx *ctx)
      * are ray traced (stage 0, the initial sample pattern of Sec. 3.2). */
     for (uint32_t e = 0; e < m->num_primary_edges && !run->failed; ++e) {
         const vt_edge *ed = &m->edges[e];
-        if (!primary_edge_visible(m, ed))
+        if (!primary_edge_seeds(run, ed))
             continue;
         vt_sample_queue(run, ed->v[0]);
         vt_sample_queue(run, ed->v[1]);

@@ -152,6 +152,11 @@ typedef struct vt_run {
     uint8_t *object_vt;       /* per object: vertex traced */
     const uint8_t *object_raster; /* per object: rasterized (not VT) */
     const uint32_t *tri_face; /* scene triangle -> primary face, VT_NONE */
+    /* A package of a distributed frame (vt_part.c): per primary face, 1
+     * for the package's faces, whose edges start the refinement; visible
+     * faces outside it are refined only where splits reach them. NULL: a
+     * whole frame, every visible face starts. */
+    const uint8_t *seed;
     rl_mat4 view_m, proj_m;   /* the rasterizer's matrices for this camera */
     /* per vertex, grown by the primary thread alongside mesh->verts */
     uint8_t *reason;
@@ -214,6 +219,10 @@ void vt_run_free_blocks(vt_run *run);
  * primary vertices, z-tests them. depth_ids is a scratch image with depth
  * and IDs. */
 rl_status vt_prepass(vt_run *run, rl_image *depth_ids);
+/* Projects and z-tests the primary vertices against the pre-pass' depth
+ * (the second half of vt_prepass; a package of a distributed frame redoes
+ * it after vt_mesh_reset, from the kept pre-pass). */
+void vt_project_primary(vt_run *run, const rl_image *depth_ids);
 /* Fills the edge list with the edges of visible primary faces and queues
  * their vertices; then all refinement stages until the list is empty, the
  * vertex budget is spent or an update/progress callback stops it. Runs the

@@ -1,0 +1,252 @@
+/* vt_part.c: the result of one package of a distributed Vertex Tracing
+ * frame (Ullmann 2003, Sec. 4.3): the refined leaf faces of the package's
+ * primary faces and their vertices' samples, in a compact checked form
+ * that a worker sends and the master draws (rl_vt.h, src/dist/dist_vt.c).
+ *
+ * The part carries what the reconstruction reads (vt_draw.c) and nothing
+ * of the refinement (no edges, keys or feelers): the master only draws.
+ * Layout, host byte order (every rank of a job runs the same build):
+ *   header  "RLVP", version, vertices, faces, payload bytes, FNV-1a of the payload
+ *   vertex  position 3f, uv 2f, flat 3f, per trace layer (3): diffuse 3f,
+ *           rest 3f, texture u32, uv 2f                   (140 bytes)
+ *   face    vertex u32 x3, triangle u32, object u32, stage u16, 0 u16  (24 bytes)
+ * A vertex shared by several faces of the part is written once. */
+#include <stdlib.h>
+#include <string.h>
+
+#include "core/error.h"
+#include "render/vt_part.h"
+
+#define PART_MAGIC "RLVP"
+#define PART_VERSION 1u
+#define HEADER_BYTES 32u
+#define VERTEX_BYTES (8u * 4u + RL_TRACE_LAYER_COUNT * 9u * 4u)
+#define FACE_BYTES 24u
+
+static uint64_t fnv1a(const unsigned char *b, size_t n)
+{
+    uint64_t h = 0xcbf29ce484222325ull;
+    for (size_t i = 0; i < n; ++i) {
+        h ^= b[i];
+        h *= 0x100000001b3ull;
+    }
+    return h;
+}
+
+static unsigned char *put(unsigned char *p, const void *x, size_t n)
+{
+    memcpy(p, x, n);
+    return p + n;
+}
+
+static const unsigned char *get(const unsigned char *p, void *x, size_t n)
+{
+    memcpy(x, p, n);
+    return p + n;
+}
+
+static unsigned char *put_vec3(unsigned char *p, rl_vec3 v)
+{
+    float f[3] = { v.x, v.y, v.z };
+    return put(p, f, sizeof f);
+}
+
+static const unsigned char *get_vec3(const unsigned char *p, rl_vec3 *v)
+{
+    float f[3];
+    p = get(p, f, sizeof f);
+    *v = rl_v3(f[0], f[1], f[2]);
+    return p;
+}
+
+static unsigned char *put_vec2(unsigned char *p, rl_vec2 v)
+{
+    float f[2] = { v.x, v.y };
+    return put(p, f, sizeof f);
+}
+
+static const unsigned char *get_vec2(const unsigned char *p, rl_vec2 *v)
+{
+    float f[2];
+    p = get(p, f, sizeof f);
+    *v = rl_v2(f[0], f[1]);
+    return p;
+}
+
+rl_status vt_part_write(const vt_mesh *m, const uint8_t *mine, void **out, size_t *size)
+{
+    *out = NULL;
+    *size = 0;
+    /* A leaf belongs to the package of its primary ancestor; a child comes
+     * after its parent in the face array, so one pass finds every root. */
+    uint32_t *root = rl_realloc_array(NULL, m->num_faces ? m->num_faces : 1, sizeof *root);
+    uint32_t *remap = rl_realloc_array(NULL, m->num_verts ? m->num_verts : 1, sizeof *remap);
+    if (!root || !remap) {
+        free(root);
+        free(remap);
+        return rl_error(RL_ERR_OUT_OF_MEMORY, "vt: a package's result (%u faces)", m->num_faces);
+    }
+    for (uint32_t v = 0; v < m->num_verts; ++v)
+        remap[v] = VT_NONE;
+    uint32_t nv = 0, nf = 0;
+    for (uint32_t f = 0; f < m->num_faces; ++f) {
+        const vt_face *face = &m->faces[f];
+        root[f] = f < m->num_primary_faces ? f : root[face->parent];
+        if (!face->leaf || !mine[root[f]])
+            continue;
+        bool sampled = true;
+        for (int k = 0; k < 3; ++k)
+            sampled &= m->verts[face->v[k]].state == VT_SAMPLED;
+        if (!sampled)
+            continue;                 /* not drawn in one process either (vt_draw.c) */
+        ++nf;
+        for (int k = 0; k < 3; ++k)
+            if (remap[face->v[k]] == VT_NONE)
+                remap[face->v[k]] = nv++;
+    }
+    uint64_t payload = (uint64_t)nv * VERTEX_BYTES + (uint64_t)nf * FACE_BYTES;
+    unsigned char *buf = malloc((size_t)(HEADER_BYTES + payload));
+    if (!buf) {
+        free(root);
+        free(remap);
+        return rl_error(RL_ERR_OUT_OF_MEMORY, "vt: a package's result of %u faces", nf);
+    }
+    /* Vertices in the order of their new numbers: the inverse of remap. */
+    unsigned char *vp = buf + HEADER_BYTES, *fp = vp + (size_t)nv * VERTEX_BYTES;
+    for (uint32_t v = 0; v < m->num_verts; ++v) {
+        if (remap[v] == VT_NONE)
+            continue;
+        const vt_vertex *x = &m->verts[v];
+        const vt_vertex_sample *s = &m->samples[v];
+        unsigned char *p = vp + (size_t)remap[v] * VERTEX_BYTES;
+        p = put_vec3(p, x->p);
+        p = put_vec2(p, x->uv);
+        p = put_vec3(p, s->flat);
+        for (int l = 0; l < RL_TRACE_LAYER_COUNT; ++l) {
+            p = put_vec3(p, s->layers[l].diffuse);
+            p = put_vec3(p, s->layers[l].rest);
+            p = put(p, &s->layers[l].texture, 4);
+            p = put_vec2(p, s->layers[l].uv);
+        }
+    }
+    for (uint32_t f = 0; f < m->num_faces; ++f) {
+        const vt_face *face = &m->faces[f];
+        if (!face->leaf || !mine[root[f]])
+            continue;
+        uint32_t idx[3] = { remap[face->v[0]], remap[face->v[1]], remap[face->v[2]] };
+        if (idx[0] == VT_NONE || idx[1] == VT_NONE || idx[2] == VT_NONE)
+            continue;
+        uint16_t stage[2] = { face->stage, 0 };
+        fp = put(fp, idx, sizeof idx);
+        fp = put(fp, &face->triangle, 4);
+        fp = put(fp, &face->object, 4);
+        fp = put(fp, stage, sizeof stage);
+    }
+    uint32_t head[4] = { PART_VERSION, nv, nf, 0 };
+    uint64_t sum = fnv1a(buf + HEADER_BYTES, (size_t)payload);
+    unsigned char *p = put(buf, PART_MAGIC, 4);
+    p = put(p, head, 3 * sizeof head[0]);
+    p = put(p, &payload, 8);
+    put(p, &sum, 8);
+    free(root);
+    free(remap);
+    *out = buf;
+    *size = (size_t)(HEADER_BYTES + payload);
+    return RL_OK;
+}
+
+rl_status vt_part_check(const void *part, size_t size, uint32_t *num_verts, uint32_t *num_faces)
+{
+    *num_verts = *num_faces = 0;
+    if (!part || size < HEADER_BYTES)
+        return rl_error(RL_ERR_PARSE, "vt part: %zu bytes, shorter than its %u-byte header", size, HEADER_BYTES);
+    const unsigned char *p = part;
+    if (memcmp(p, PART_MAGIC, 4) != 0)
+        return rl_error(RL_ERR_PARSE, "vt part: not a Vertex Tracing part (no \"" PART_MAGIC "\")");
+    uint32_t head[3];
+    uint64_t payload, sum;
+    p = get(p + 4, head, sizeof head);
+    p = get(p, &payload, 8);
+    get(p, &sum, 8);
+    if (head[0] != PART_VERSION)
+        return rl_error(RL_ERR_PARSE, "vt part: version %u (this build reads %u)", head[0], PART_VERSION);
+    /* Counts below 2^32 keep the products far from overflowing 64 bits. */
+    uint64_t want = (uint64_t)head[1] * VERTEX_BYTES + (uint64_t)head[2] * FACE_BYTES;
+    if (payload != want || payload != size - HEADER_BYTES)
+        return rl_error(RL_ERR_PARSE, "vt part: %u vertices and %u faces need %llu bytes; the header says %llu, "
+                        "%zu came", head[1], head[2], (unsigned long long)want, (unsigned long long)payload,
+                        size - HEADER_BYTES);
+    const unsigned char *body = (const unsigned char *)part + HEADER_BYTES;
+    if (fnv1a(body, (size_t)payload) != sum)
+        return rl_error(RL_ERR_PARSE, "vt part: checksum mismatch (damaged in transit)");
+    const unsigned char *fp = body + (size_t)head[1] * VERTEX_BYTES;
+    for (uint32_t f = 0; f < head[2]; ++f) {
+        uint32_t idx[3];
+        get(fp + (size_t)f * FACE_BYTES, idx, sizeof idx);
+        if (idx[0] >= head[1] || idx[1] >= head[1] || idx[2] >= head[1])
+            return rl_error(RL_ERR_PARSE, "vt part: face %u names vertex %u of %u", f,
+                            idx[0] >= head[1] ? idx[0] : idx[1] >= head[1] ? idx[1] : idx[2], head[1]);
+    }
+    *num_verts = head[1];
+    *num_faces = head[2];
+    return RL_OK;
+}
+
+rl_status vt_part_import(vt_mesh *m, const rl_scene_data *d, const void *part, size_t size)
+{
+    uint32_t nv, nf;
+    rl_status st = vt_part_check(part, size, &nv, &nf);
+    if (st != RL_OK)
+        return st;
+    if ((st = vt_mesh_reserve(m, nv, 0, nf)) != RL_OK)
+        return st;
+    const unsigned char *p = (const unsigned char *)part + HEADER_BYTES;
+    const uint32_t first = m->num_verts;
+    for (uint32_t v = 0; v < nv; ++v) {
+        vt_vertex *x = &m->verts[first + v];
+        vt_vertex_sample *s = &m->samples[first + v];
+        memset(x, 0, sizeof *x);
+        memset(s, 0, sizeof *s);
+        p = get_vec3(p, &x->p);
+        p = get_vec2(p, &x->uv);
+        p = get_vec3(p, &s->flat);
+        for (int l = 0; l < RL_TRACE_LAYER_COUNT; ++l) {
+            p = get_vec3(p, &s->layers[l].diffuse);
+            p = get_vec3(p, &s->layers[l].rest);
+            p = get(p, &s->layers[l].texture, 4);
+            p = get_vec2(p, &s->layers[l].uv);
+        }
+        x->state = VT_SAMPLED;
+        x->visible = 1;
+    }
+    /* Faces last: a bad one leaves the mesh as it was (the vertices past
+     * num_verts are not the mesh's yet). */
+    const uint32_t first_face = m->num_faces;
+    for (uint32_t f = 0; f < nf; ++f) {
+        uint32_t idx[3], tri, obj;
+        uint16_t stage[2];
+        p = get(p, idx, sizeof idx);
+        p = get(p, &tri, 4);
+        p = get(p, &obj, 4);
+        p = get(p, stage, sizeof stage);
+        if (tri >= d->num_triangles || obj >= d->num_objects)
+            return rl_error(RL_ERR_PARSE, "vt part: face %u names triangle %u and object %u; the scene has %u and "
+                            "%u (a part of another scene?)", f, tri, obj, d->num_triangles, d->num_objects);
+        vt_face *face = &m->faces[first_face + f];
+        memset(face, 0, sizeof *face);
+        for (int k = 0; k < 3; ++k) {
+            face->v[k] = first + idx[k];
+            face->e[k] = VT_NONE;
+        }
+        face->triangle = tri;
+        face->object = obj;
+        face->parent = VT_NONE;
+        face->stage = stage[0];
+        face->leaf = 1;
+        face->visible = 1;
+        face->height = -1.0f;
+    }
+    m->num_verts += nv;
+    m->num_faces += nf;
+    return RL_OK;
+}
