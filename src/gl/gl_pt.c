@@ -572,12 +572,12 @@ static rl_status reset_images(rl_gl_pt *pt, int w, int h, const uint32_t *states
 
 
 /* The ray counters added to rays and cleared. */
-static void drain_counters(rl_gl_pt *pt, uint64_t rays[RL_RAY_TYPE_COUNT])
+static void drain_counters(rl_gl_pt *pt, uint64_t rays[RL_GL_PT_RAY_TYPES])
 {
-    uint32_t c[RL_RAY_TYPE_COUNT];
+    uint32_t c[RL_GL_PT_RAY_TYPES];
     glMemoryBarrier(GL_ATOMIC_COUNTER_BARRIER_BIT | GL_BUFFER_UPDATE_BARRIER_BIT);
     glGetNamedBufferSubData(pt->counters, 0, sizeof c, c);
-    for (int k = 0; k < RL_RAY_TYPE_COUNT; ++k)
+    for (int k = 0; k < RL_GL_PT_RAY_TYPES; ++k)
         rays[k] += c[k];
     const uint32_t zero = 0;
     glClearNamedBufferData(pt->counters, GL_R32UI, GL_RED_INTEGER, GL_UNSIGNED_INT, &zero);
@@ -592,7 +592,7 @@ static uint64_t rays_bound(const rl_gl_pt_frame *f, uint32_t num_lights)
     return (uint64_t)f->cam.width * (uint64_t)f->cam.height * (1u + ((uint64_t)f->max_depth + 1u) * per_vertex);
 }
 
-static rl_status render_frame(rl_gl_pt *pt, const rl_gl_pt_frame *f, float *rgba, uint64_t rays[RL_RAY_TYPE_COUNT])
+static rl_status render_frame(rl_gl_pt *pt, const rl_gl_pt_frame *f, float *rgba, uint64_t rays[RL_GL_PT_RAY_TYPES])
 {
     const rl_scene_data *d = pt->data;
     const int w = f->cam.width, h = f->cam.height;
@@ -711,7 +711,7 @@ rl_status rl_gl_pt_render(rl_gl_pt *pt, const rl_gl_pt_frame *frame, float *rgba
     const uint64_t most = frame->reset_states ? 0 : (pt->held[0] > pt->held[1] ? pt->held[0] : pt->held[1]);
     if (most + (uint64_t)frame->spp > UINT32_MAX)
         return rl_error(RL_ERR_LIMIT, "gl-pt: more than 2^32 samples per pixel in one accumulation");
-    uint64_t rays[RL_RAY_TYPE_COUNT] = { 0 };
+    uint64_t rays[RL_GL_PT_RAY_TYPES] = { 0 };
     rl_status st = rl_gl_context_make_current(pt->ctx);
     if (st == RL_OK)
         st = render_frame(pt, frame, rgba, rays);

@@ -24,7 +24,6 @@
 #include "rl/rl_camera.h"
 #include "rl/rl_gl.h"
 #include "rl/rl_linespace.h"
-#include "rl/rl_render.h"
 #include "rl/rl_scene.h"
 
 typedef struct rl_gl_pt rl_gl_pt;
@@ -102,10 +101,15 @@ const rl_gl_info *rl_gl_pt_info(const rl_gl_pt *pt);
  * are read and cleared between dispatches before they could wrap, so the
  * counts are exact as long as one dispatch traces fewer than 2^32 rays of
  * a type. */
+/* Ray types in rl_ray_type's order (primary, shadow, reflection,
+ * refraction, diffuse); the render layer's enum is above this layer, so
+ * gl_pathtrace.c checks that the two agree. */
+#define RL_GL_PT_RAY_TYPES 5
+
 typedef struct rl_gl_pt_result {
     uint64_t held[2];
     uint64_t frames;
-    uint64_t rays[RL_RAY_TYPE_COUNT];
+    uint64_t rays[RL_GL_PT_RAY_TYPES];
 } rl_gl_pt_result;
 
 /* Traces frame->spp samples per pixel (of the frame's checkerboard half)

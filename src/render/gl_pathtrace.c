@@ -55,6 +55,8 @@
 #include "rl/rl_gl.h"
 #include "rl/rl_timer.h"
 
+_Static_assert(RL_GL_PT_RAY_TYPES == RL_RAY_TYPE_COUNT, "gl-pt counts rays in rl_ray_type's order");
+
 static const char *const rng_choices[] = { "sobol", "lcg", "tausworthe", "hybrid", NULL };
 static const char *const mis_choices[] = { "off", "on", NULL };
 /* pt's lists, so that a value pt knows gets "not ported" rather than
