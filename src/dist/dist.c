@@ -146,10 +146,10 @@ void rl_dist_pause(void)
 
 rl_status rl_dist_wait(const rl_dist *d, int tag, MPI_Status *ms)
 {
-    return rl_dist_wait_for(d, tag, ms, rl_dist_timeout_s());
+    return rl_dist_wait_for(d, tag, ms, rl_dist_timeout_s(), "RL_DIST_TIMEOUT");
 }
 
-rl_status rl_dist_wait_for(const rl_dist *d, int tag, MPI_Status *ms, double timeout)
+rl_status rl_dist_wait_for(const rl_dist *d, int tag, MPI_Status *ms, double timeout, const char *setting)
 {
     const double t0 = rl_time_s();
     for (;;) {
@@ -161,7 +161,7 @@ rl_status rl_dist_wait_for(const rl_dist *d, int tag, MPI_Status *ms, double tim
             return RL_OK;
         if (rl_time_s() - t0 > timeout)
             return rl_error(RL_ERR_IO, "rank %d: no word from the master (rank 0) for %.0f s: it is gone or "
-                            "stuck; giving up (RL_DIST_TIMEOUT)", d->rank, timeout);
+                            "stuck; giving up (%s)", d->rank, timeout, setting);
         rl_dist_pause();
     }
 }

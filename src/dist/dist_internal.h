@@ -50,8 +50,9 @@ void rl_dist_pause(void);
  * any), polling; past the timeout RL_ERR_IO "no word from the master",
  * so that a dead master ends its workers with an error, not a hang. */
 rl_status rl_dist_wait(const rl_dist *d, int tag, MPI_Status *ms);
-/* ... with a timeout of its own, in seconds. */
-rl_status rl_dist_wait_for(const rl_dist *d, int tag, MPI_Status *ms, double timeout);
+/* ... with a timeout of its own, in seconds, and the setting that the
+ * error names (the environment variable that sets the timeout). */
+rl_status rl_dist_wait_for(const rl_dist *d, int tag, MPI_Status *ms, double timeout, const char *setting);
 /* MPI_Send that gives up past the timeout (RL_ERR_IO naming dest): a
  * large message waits for its receiver, forever if the receiver died. */
 rl_status rl_dist_send(const rl_dist *d, const void *buf, int count, MPI_Datatype type, int dest, int tag);

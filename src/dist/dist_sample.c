@@ -347,25 +347,15 @@ static rl_status measure(void *user, const rl_vec3 *pos, uint32_t n, double *val
     return failed == RL_OK ? RL_OK : rl_error(failed, "%s", s->failure);
 }
 
-/* A sampling node waits for the master's next message (any tag), polling;
- * past timeout seconds it takes the master for gone (an error naming
- * what, the environment variable that sets it). */
-static rl_status wait_master(const rl_dist *d, double timeout, const char *what, MPI_Status *ms)
+/* The status the master ends a run (DONE) or the service (END) with, as
+ * this rank's: RL_OK, or an error saying who failed. */
+static rl_status receive_end(int tag, const char *what, const char *who_failed)
 {
-    const double t0 = rl_time_s();
-    for (;;) {
-        int arrived = 0;
-        int code = MPI_Iprobe(0, MPI_ANY_TAG, MPI_COMM_WORLD, &arrived, ms);
-        if (code != MPI_SUCCESS)
-            return rl_dist_mpi_failed(code, "waiting for the master");
-        if (arrived)
-            return RL_OK;
-        if (rl_time_s() - t0 > timeout)
-            return rl_error(RL_ERR_IO, "rank %d: no word from the master (rank 0) for %.0f s%s: it is gone or "
-                            "stuck; giving up (%s)", d->rank, timeout, what[0] ? " between runs" : "",
-                            what[0] ? what : "RL_DIST_TIMEOUT");
-        rl_dist_pause();
-    }
+    int32_t end = 0;
+    int code = MPI_Recv(&end, 1, MPI_INT32_T, 0, tag, MPI_COMM_WORLD, MPI_STATUS_IGNORE);
+    if (code != MPI_SUCCESS)
+        return rl_dist_mpi_failed(code, what);
+    return end == RL_OK ? RL_OK : rl_error((rl_status)end, "%s (%s)", who_failed, rl_status_string((rl_status)end));
 }
 
 /* A sampling node: chunks until DONE, whose status it returns. Without
@@ -383,7 +373,7 @@ static rl_status serve(rl_dist *d, rl_property *p, const char *why)
          * had the time to take another worker for lost (RL_DIST_TIMEOUT)
          * and to hand its chunks out again: until then it may well have
          * nothing for this one. */
-        if ((st = wait_master(d, 3.0 * rl_dist_timeout_s(), "", &ms)) != RL_OK)
+        if ((st = rl_dist_wait_for(d, MPI_ANY_TAG, &ms, 3.0 * rl_dist_timeout_s(), "RL_DIST_TIMEOUT")) != RL_OK)
             break;
         int bytes = 0;
         int code = MPI_Get_count(&ms, MPI_BYTE, &bytes);
@@ -392,12 +382,7 @@ static rl_status serve(rl_dist *d, rl_property *p, const char *why)
             break;
         }
         if (ms.MPI_TAG == RL_DIST_TAG_DONE) {
-            int32_t done = 0;
-            code = MPI_Recv(&done, 1, MPI_INT32_T, 0, RL_DIST_TAG_DONE, MPI_COMM_WORLD, MPI_STATUS_IGNORE);
-            st = code != MPI_SUCCESS ? rl_dist_mpi_failed(code, "ending the sampling")
-                 : done == RL_OK     ? RL_OK
-                                     : rl_error((rl_status)done, "distributed sampling: another rank failed (%s)",
-                                                rl_status_string((rl_status)done));
+            st = receive_end(RL_DIST_TAG_DONE, "ending the sampling", "distributed sampling: another rank failed");
             break;
         }
         unsigned char *b = realloc(buf, (size_t)bytes + 1);
@@ -720,15 +705,10 @@ rl_status rl_dist_serve_properties(rl_dist *d, const rl_scene *scene, int thread
     for (;;) {
         MPI_Status ms;
         int code = MPI_SUCCESS;
-        if ((st = wait_master(d, timeout, "RL_DIST_IDLE_TIMEOUT", &ms)) != RL_OK)
+        if ((st = rl_dist_wait_for(d, MPI_ANY_TAG, &ms, timeout, "RL_DIST_IDLE_TIMEOUT")) != RL_OK)
             break;
         if (ms.MPI_TAG == RL_DIST_TAG_END) {
-            int32_t end = 0;
-            code = MPI_Recv(&end, 1, MPI_INT32_T, 0, RL_DIST_TAG_END, MPI_COMM_WORLD, MPI_STATUS_IGNORE);
-            st = code != MPI_SUCCESS ? rl_dist_mpi_failed(code, "ending the service")
-                 : end == RL_OK     ? RL_OK
-                                    : rl_error((rl_status)end, "distributed run: the master failed (%s)",
-                                               rl_status_string((rl_status)end));
+            st = receive_end(RL_DIST_TAG_END, "ending the service", "distributed run: the master failed");
             break;
         }
         if (ms.MPI_TAG != RL_DIST_TAG_SPEC) {

@@ -178,7 +178,7 @@ static rl_status vt_work(rl_dist *d, rl_renderer *r, const rl_scene *scene, cons
          * worker's timeout before it hands them on: twice the timeout
          * tells a master that waits from one that is gone. */
         MPI_Status ms;
-        rl_status wst = rl_dist_wait_for(d, MPI_ANY_TAG, &ms, 2.0 * rl_dist_timeout_s());
+        rl_status wst = rl_dist_wait_for(d, MPI_ANY_TAG, &ms, 2.0 * rl_dist_timeout_s(), "RL_DIST_TIMEOUT");
         if (wst != RL_OK) {
             result = wst;
             break;
