@@ -14,7 +14,8 @@
  *   strategy = all     all | "s,t": that strategy alone, unweighted (a
  *                      debugging view; each alone estimates the paths of
  *                      s + t vertices without bias)
- *   seed = 0, background = 0,0,0, accumulate = true, threads = 0 (all)
+ *   seed = 0, background = 0,0,0, ggx_ms = true, accumulate = true,
+ *   threads = 0 (all)
  *
  * A frame: spp passes over 16 x 16 tiles handed out dynamically to OpenMP
  * threads. Every pixel sample draws from its own PCG32 stream, keyed by
@@ -64,6 +65,7 @@ static const rl_option_info bdpt_options[] = {
     { "seed", RL_OPT_INT, "0", "seed of the per-sample generators", 0, 9007199254740991.0, NULL },
     { "background", RL_OPT_COLOR, "0,0,0",
       "radiance arriving from every direction where a camera ray leaves the scene", 0, 0, NULL },
+    { "ggx_ms", RL_OPT_BOOL, "true", "GGX energy compensation (Kulla & Conty 2017), as pt", 0, 0, NULL },
     { "accumulate", RL_OPT_BOOL, "true", "progressive accumulation across frames", 0, 0, NULL },
     { "threads", RL_OPT_INT, "0", "OpenMP threads (0 = all)", 0, 1024, NULL },
 };
@@ -304,6 +306,7 @@ static rl_status bdpt_render(rl_renderer *r, void *state, const rl_scene *scene,
     c->mis = (bd_mis)rl_renderer_opt_enum(r, "mis");
     parse_strategy(rl_renderer_opt_string(r, "strategy"), &c->only_s, &c->only_t);
     c->background = rl_renderer_opt_color(r, "background");
+    c->ggx_ms = rl_renderer_opt_bool(r, "ggx_ms");
     c->cam = rl_camera_frame_make(cam);
     c->forward = rl_neg(c->cam.w);
     c->film_area = 4.0f * c->cam.tan_half_fov_y * c->cam.tan_half_fov_y * c->cam.aspect;

@@ -26,6 +26,7 @@ typedef struct bd_ctx {
     bd_mis mis;
     int only_s, only_t;            /* strategy=s,t: that one alone, unweighted; -1 all */
     rl_vec3 background;
+    bool ggx_ms;                   /* GGX energy compensation (pathtrace_ggx.c) */
     /* the pinhole camera (importance W_e, Veach 1997 Sec. 10.3) */
     rl_camera_frame cam;
     rl_vec3 forward;

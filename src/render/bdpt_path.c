@@ -375,6 +375,7 @@ static int walk(const bd_ctx *ctx, rl_rng *rng, rl_ray ray, rl_vec3 beta, float 
         memset(v, 0, sizeof *v);
         if (!rl_pt_surface_at_hit(ctx->data, &hit, ray.o, ray.d, &v->s))
             return n;
+        v->s.ggx_ms = ctx->ggx_ms;
         v->kind = BD_V_SURFACE;
         v->p = v->s.p;
         v->ng = v->s.ng;

@@ -194,14 +194,16 @@ static rl_scene *sphere_under_sky(const rl_material *m, float L)
 /* Mean radiance over the sphere's pixels (ID layer of a raster pass is not
  * pt's, so the pixels are told by their distance from the image centre)
  * and over the background's. */
-static void furnace(const rl_material *m, const char *max_depth, double want_ball, double tol)
+static double furnace_with(const char *algo, const rl_material *m, const char *max_depth, const char *ggx_ms,
+                           double want_ball, double tol)
 {
     const float L = 1.5f;
     rl_scene *s = sphere_under_sky(m, L);
     const int size = 32;
     rl_camera cam = { .eye = rl_v3(0.0f, 0.0f, 4.0f), .target = rl_v3(0.0f, 0.0f, 0.0f), .up = rl_v3(0, 1, 0),
                       .fov_deg = 40.0f, .width = size, .height = size };
-    rl_renderer *r = fx_make("pt", (const char *const[]){ "spp", "32", "max_depth", max_depth, NULL });
+    rl_renderer *r = fx_make(algo, (const char *const[]){ "spp", "32", "max_depth", max_depth, "ggx_ms", ggx_ms,
+                                                          NULL });
     rl_image *img = fx_render_with(r, s, &cam, RL_LAYER_COLOR, NULL);
     rl_renderer_release(r);
     /* The sphere's radius on screen: 1 / (4 tan 20 deg) of the half-height. */
@@ -222,13 +224,19 @@ static void furnace(const rl_material *m, const char *max_depth, double want_bal
         }
     ball /= nb;
     sky /= ns;
-    print_message("furnace %s: ball %.4f (want %.4f), sky %.4f (want %.4f)\n", m->name, ball / L, want_ball, sky / L,
-                  1.0);
+    print_message("furnace %s %s ggx_ms=%s: ball %.4f (want %.4f), sky %.4f (want %.4f)\n", algo, m->name, ggx_ms,
+                  ball / L, want_ball, sky / L, 1.0);
     assert_true(nb > 150 && ns > 300);
     assert_float_equal(sky / L, 1.0, 1e-5);
     assert_float_equal(ball / L, want_ball, tol);
     rl_image_release(img);
     rl_scene_release(s);
+    return ball / L;
+}
+
+static void furnace(const rl_material *m, const char *max_depth, double want_ball, double tol)
+{
+    furnace_with("pt", m, max_depth, "true", want_ball, tol);
 }
 
 static void test_white_furnaces_under_a_constant_environment(void **state)
@@ -267,6 +275,52 @@ static void test_white_furnaces_under_a_constant_environment(void **state)
     plastic.metallic = 0.0f;
     plastic.roughness = 0.4f;
     furnace(&plastic, "2", 0.48, 0.04);
+}
+
+/* What single scattering keeps of the sky over the pixels furnace_with
+ * counts as the ball: the albedo table E at each pixel centre's view
+ * cosine on the unit sphere, seen from (0, 0, 4) with 40 degrees. */
+static double ball_single_scattering(float roughness)
+{
+    const int size = 32;
+    double r_px = 0.5 * size / (sqrt(15.0) * tan(20.0 * PI_D / 180.0)), t = tan(20.0 * PI_D / 180.0);
+    double sum = 0.0;
+    int n = 0;
+    for (int y = 0; y < size; ++y)
+        for (int x = 0; x < size; ++x) {
+            double dx = x + 0.5 - 0.5 * size, dy = y + 0.5 - 0.5 * size;
+            if (sqrt(dx * dx + dy * dy) >= r_px - 1.5)
+                continue;
+            double d[3] = { dx / (0.5 * size) * t, -dy / (0.5 * size) * t, -1.0 };
+            double len = sqrt(d[0] * d[0] + d[1] * d[1] + 1.0);
+            double b = 4.0 * d[2] / len, c = 16.0 - 1.0;      /* |o + s d|^2 = 1, o = (0, 0, 4) */
+            double s_hit = -b - sqrt(b * b - c);
+            double pz = 4.0 + s_hit * d[2] / len;
+            double px = s_hit * d[0] / len, py = s_hit * d[1] / len;
+            double mu = -(px * d[0] + py * d[1] + pz * d[2]) / len;
+            sum += rl_pt_ggx_ms_albedo(roughness, (float)mu);
+            ++n;
+        }
+    return sum / n;
+}
+
+/* GGX's energy compensation in whole images (pathtrace_ggx.c): an F = 1
+ * metal sphere of roughness 0.5 and 1 vanishes into the sky with ggx_ms
+ * (the default), and without it keeps what single scattering keeps. */
+static void test_ggx_energy_compensation_furnace(void **state)
+{
+    (void)state;
+    rl_material metal = rl_material_default();
+    snprintf(metal.name, sizeof metal.name, "metal");
+    metal.diffuse = rl_v3s(1.0f);
+    metal.bsdf = RL_BSDF_GGX;
+    metal.metallic = 1.0f;
+    const float roughness[] = { 0.5f, 1.0f };
+    for (int i = 0; i < 2; ++i) {
+        metal.roughness = roughness[i];
+        furnace_with("pt", &metal, "2", "true", 1.0, 0.015);
+        furnace_with("pt", &metal, "2", "false", ball_single_scattering(roughness[i]), 0.015);
+    }
 }
 
 /* The Cornell box restyled from JSON: GGX walls (glossy plastic) and a
@@ -362,6 +416,7 @@ int main(void)
         cmocka_unit_test(test_environment_pdf_integrates_to_one_and_matches_its_samples),
         cmocka_unit_test(test_irradiance_by_importance_and_uniform_sampling_agree_with_quadrature),
         cmocka_unit_test(test_white_furnaces_under_a_constant_environment),
+        cmocka_unit_test(test_ggx_energy_compensation_furnace),
         cmocka_unit_test(test_ggx_cornell_box_mis_on_and_off_agree),
         cmocka_unit_test(test_whitted_shows_the_environment),
         cmocka_unit_test(test_bdpt_refuses_an_environment),
