@@ -389,24 +389,92 @@ static void test_whitted_shows_the_environment(void **state)
     rl_scene_release(s);
 }
 
-/* bdpt does not sample an environment: it must refuse the scene by name,
- * not render it black. */
-static void test_bdpt_refuses_an_environment(void **state)
+/* bdpt with the environment as an emitter at infinity (bdpt_path.c):
+ * white furnaces as pt's (a Lambertian sphere k_d L, an F = 1 GGX metal
+ * with the compensation vanishing) and, under the test's sky map, the
+ * same image as pt: a grey sphere on a plate, lit by the map alone (the
+ * channel means within 1 %, 40 x 40 pixels at 32 samples). */
+static void test_bdpt_furnaces_under_a_constant_environment(void **state)
 {
     (void)state;
-    rl_material m = rl_material_default();
-    rl_scene *s = sphere_under_sky(&m, 1.0f);
-    rl_camera cam = { .eye = rl_v3(0.0f, 0.0f, 4.0f), .target = rl_v3(0.0f, 0.0f, 0.0f), .up = rl_v3(0, 1, 0),
-                      .fov_deg = 40.0f, .width = 8, .height = 8 };
-    rl_renderer *r = fx_make("bdpt", NULL);
-    rl_image *img = NULL;
-    assert_int_equal(rl_image_create(8, 8, RL_LAYER_COLOR, &img), RL_OK);
-    rl_render_stats st;
-    rl_clear_error();
-    assert_int_equal(rl_renderer_render(r, s, &cam, img, &st), RL_ERR_UNSUPPORTED);
-    assert_non_null(strstr(rl_last_error(), "environment"));
-    rl_image_release(img);
-    rl_renderer_release(r);
+    rl_material diffuse = rl_material_default();
+    snprintf(diffuse.name, sizeof diffuse.name, "diffuse");
+    diffuse.diffuse = rl_v3s(0.8f);
+    furnace_with("bdpt", &diffuse, "2", "true", 0.8, 0.01);
+    rl_material metal = rl_material_default();
+    snprintf(metal.name, sizeof metal.name, "metal");
+    metal.diffuse = rl_v3s(1.0f);
+    metal.bsdf = RL_BSDF_GGX;
+    metal.metallic = 1.0f;
+    metal.roughness = 0.5f;
+    furnace_with("bdpt", &metal, "2", "true", 1.0, 0.015);
+}
+
+static void channel_means(const rl_image *img, double mean[3])
+{
+    mean[0] = mean[1] = mean[2] = 0.0;
+    size_t n = (size_t)img->width * img->height;
+    for (size_t i = 0; i < n; ++i) {
+        mean[0] += img->color[i].x;
+        mean[1] += img->color[i].y;
+        mean[2] += img->color[i].z;
+    }
+    for (int c = 0; c < 3; ++c)
+        mean[c] /= (double)n;
+}
+
+static void test_bdpt_and_pt_agree_under_an_environment_map(void **state)
+{
+    (void)state;
+    /* The sky map as a file: a scene takes its environment by path. */
+    rl_image *sky = NULL;
+    assert_int_equal(rl_image_create(MAP_W, MAP_H, RL_LAYER_COLOR, &sky), RL_OK);
+    rl_texture *map = sky_map();
+    for (int i = 0; i < MAP_W * MAP_H; ++i)
+        sky->color[i] = map->texels[i];
+    rl_texture_release(map);
+    const char *base = getenv("RL_TEST_TMP");
+    char path[1024];
+    snprintf(path, sizeof path, "%s/bdpt_sky.exr", base && base[0] ? base : ".");
+    assert_int_equal(rl_image_write_exr(sky, path), RL_OK);
+    rl_image_release(sky);
+    rl_scene *s = NULL;
+    assert_int_equal(rl_scene_create(&s), RL_OK);
+    rl_material grey = rl_material_default(), floor = rl_material_default();
+    snprintf(grey.name, sizeof grey.name, "grey");
+    grey.diffuse = rl_v3(0.7f, 0.6f, 0.5f);
+    snprintf(floor.name, sizeof floor.name, "floor");
+    floor.diffuse = rl_v3s(0.5f);
+    uint32_t mg, mf, ball, plate, node;
+    assert_int_equal(rl_scene_add_material(s, &grey, &mg), RL_OK);
+    assert_int_equal(rl_scene_add_material(s, &floor, &mf), RL_OK);
+    assert_int_equal(rl_scene_add_generated(s, "sphere", "segments=32,rings=16", mg, &ball), RL_OK);
+    assert_int_equal(rl_scene_add_generated(s, "quad", "sx=40,sz=40", mf, &plate), RL_OK);
+    assert_int_equal(rl_scene_add_node(s, RL_NODE_ROOT, "ball", NULL, &node), RL_OK);
+    assert_int_equal(rl_scene_node_set_mesh(s, node, ball), RL_OK);
+    rl_mat4 down = rl_mat4_translate(rl_v3(0.0f, -1.0f, 0.0f));
+    assert_int_equal(rl_scene_add_node(s, RL_NODE_ROOT, "plate", &down, &node), RL_OK);
+    assert_int_equal(rl_scene_node_set_mesh(s, node, plate), RL_OK);
+    assert_int_equal(rl_scene_set_environment(s, &(rl_environment_desc){ .path = path, .color = rl_v3s(1.0f) }),
+                     RL_OK);
+    assert_int_equal(rl_scene_commit(s), RL_OK);
+    /* Looking down: no pixel sees the sky straight, all its light comes
+     * by the surfaces. */
+    rl_camera cam = { .eye = rl_v3(0.0f, 4.0f, 3.0f), .target = rl_v3(0.0f, -0.5f, 0.0f), .up = rl_v3(0, 1, 0),
+                      .fov_deg = 45.0f, .width = 40, .height = 40 };
+    double mean[2][3];
+    const char *algos[] = { "pt", "bdpt" };
+    for (int a = 0; a < 2; ++a) {
+        rl_renderer *r = fx_make(algos[a], (const char *const[]){ "spp", "32", "max_depth", "3", NULL });
+        rl_image *img = fx_render_with(r, s, &cam, RL_LAYER_COLOR, NULL);
+        channel_means(img, mean[a]);
+        rl_image_release(img);
+        rl_renderer_release(r);
+    }
+    print_message("environment only: pt %.4f %.4f %.4f, bdpt %.4f %.4f %.4f\n", mean[0][0], mean[0][1], mean[0][2],
+                  mean[1][0], mean[1][1], mean[1][2]);
+    for (int c = 0; c < 3; ++c)
+        assert_float_equal(mean[1][c], mean[0][c], 0.01 * mean[0][c]);
     rl_scene_release(s);
 }
 
@@ -419,7 +487,8 @@ int main(void)
         cmocka_unit_test(test_ggx_energy_compensation_furnace),
         cmocka_unit_test(test_ggx_cornell_box_mis_on_and_off_agree),
         cmocka_unit_test(test_whitted_shows_the_environment),
-        cmocka_unit_test(test_bdpt_refuses_an_environment),
+        cmocka_unit_test(test_bdpt_furnaces_under_a_constant_environment),
+        cmocka_unit_test(test_bdpt_and_pt_agree_under_an_environment_map),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
