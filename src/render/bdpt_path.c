@@ -42,8 +42,8 @@
  * only (a light subpath that picks one is empty, and s = 1 gets the full
  * weight); covered triangles of a quad that is not hittable emit nothing.
  *
- * The scene's environment is an emitter at infinity (Veach 1997, Sec.
- * 10.3.6 leaves it open; we follow the usual construction): a light
+ * The scene's environment is an emitter at infinity (the construction of
+ * pbrt's bidirectional path tracer, Pharr et al. 2016): a light
  * subpath picks it with probability env_pick, draws a direction w from its
  * importance distribution (pathtrace_env.c) and starts on a disk of the
  * bounding sphere's radius R across w, outside the scene, travelling along

@@ -173,7 +173,7 @@ static void ms_build(void)
 /* Roughness r's node below and the weight of the one above. */
 static int ms_row(float roughness, float *t)
 {
-    float x = rl_clampf(roughness, 0.0f, 1.0f) * (float)(MS_NODES - 1);
+    float x = (roughness > 0.0f ? rl_minf(roughness, 1.0f) : 0.0f) * (float)(MS_NODES - 1);
     int i = (int)x;
     if (i > MS_NODES - 2)
         i = MS_NODES - 2;
@@ -186,7 +186,7 @@ float rl_pt_ggx_ms_albedo(float roughness, float mu)
     pthread_once(&ms_once, ms_build);
     float t;
     int i = ms_row(roughness, &t);
-    mu = rl_clampf(mu, 0.0f, 1.0f);
+    mu = mu > 0.0f ? rl_minf(mu, 1.0f) : 0.0f;     /* a NaN must not index the table */
     int j = (int)(sqrtf(mu) * (float)(MS_NODES - 1));
     if (j > MS_NODES - 2)
         j = MS_NODES - 2;
