@@ -336,7 +336,6 @@ static void test_ggx_samples_follow_the_reported_pdf(void **state)
     rl_material gold = ggx_material(0.9f, 0.7f, 1.0f);
     gold.diffuse = rl_v3(1.0f, 0.78f, 0.34f);
     check_sampling_mass(&gold, 45.0f, 0.7, true);
-    check_sampling_mass(&rough, 30.0f, 0.5, true);
 }
 
 /* The white furnace of one microfacet lobe: F = 1 (metallic, k_d = 1),
@@ -402,8 +401,9 @@ static void test_ggx_white_furnace(void **state)
 }
 
 /* The energy compensation's tables (pathtrace_ggx.c): E(mu) at nodes and
- * between them against a quadrature of 512^2 visible normals, and E_avg
- * against 2 int E mu dmu by that quadrature at 64 midpoints of mu. */
+ * between them against a quadrature of 256^2 visible normals (8x the
+ * tables' cells per side), and E_avg against 2 int E mu dmu by 96^2 at 32
+ * midpoints of mu. */
 static void test_ggx_ms_tables_match_the_quadrature(void **state)
 {
     (void)state;
@@ -413,7 +413,7 @@ static void test_ggx_ms_tables_match_the_quadrature(void **state)
     for (size_t i = 0; i < sizeof roughness / sizeof roughness[0]; ++i) {
         float alpha = rl_pt_ggx_alpha(roughness[i]);
         for (size_t j = 0; j < sizeof mus / sizeof mus[0]; ++j) {
-            double ref = rl_pt_ggx_albedo_quadrature(alpha, mus[j], 512);
+            double ref = rl_pt_ggx_albedo_quadrature(alpha, mus[j], 256);
             double e = rl_pt_ggx_ms_albedo(roughness[i], mus[j]);
             assert_true(e >= 0.0 && e <= 1.0);
             if (fabs(e - ref) > worst)
@@ -421,10 +421,10 @@ static void test_ggx_ms_tables_match_the_quadrature(void **state)
             worst = fmax(worst, fabs(e - ref));
         }
         double avg = 0.0;
-        const int n = 64;
+        const int n = 32;
         for (int k = 0; k < n; ++k) {
             double mu = (k + 0.5) / n;
-            avg += 2.0 * rl_pt_ggx_albedo_quadrature(alpha, (float)mu, 128) * mu / n;
+            avg += 2.0 * rl_pt_ggx_albedo_quadrature(alpha, (float)mu, 96) * mu / n;
         }
         double e_avg = rl_pt_ggx_ms_average(roughness[i]);
         print_message("ggx ms roughness %.2f: E_avg %.4f (quadrature %.4f), E(1) %.4f\n", roughness[i], e_avg, avg,
