@@ -14,7 +14,8 @@
  *   strategy = all     all | "s,t": that strategy alone, unweighted (a
  *                      debugging view; each alone estimates the paths of
  *                      s + t vertices without bias)
- *   seed = 0, background = 0,0,0, accumulate = true, threads = 0 (all)
+ *   seed = 0, background = 0,0,0, ggx_ms = true, accumulate = true,
+ *   threads = 0 (all)
  *
  * A frame: spp passes over 16 x 16 tiles handed out dynamically to OpenMP
  * threads. Every pixel sample draws from its own PCG32 stream, keyed by
@@ -63,7 +64,9 @@ static const rl_option_info bdpt_options[] = {
       0, 0, NULL },
     { "seed", RL_OPT_INT, "0", "seed of the per-sample generators", 0, 9007199254740991.0, NULL },
     { "background", RL_OPT_COLOR, "0,0,0",
-      "radiance arriving from every direction where a camera ray leaves the scene", 0, 0, NULL },
+      "radiance arriving from every direction where a camera ray leaves the scene (no light samples it); a "
+      "scene \"environment\" replaces it", 0, 0, NULL },
+    { "ggx_ms", RL_OPT_BOOL, "true", "GGX energy compensation (Kulla & Conty 2017), as pt", 0, 0, NULL },
     { "accumulate", RL_OPT_BOOL, "true", "progressive accumulation across frames", 0, 0, NULL },
     { "threads", RL_OPT_INT, "0", "OpenMP threads (0 = all)", 0, 1024, NULL },
 };
@@ -232,11 +235,6 @@ static rl_status bdpt_render(rl_renderer *r, void *state, const rl_scene *scene,
     const rl_scene_data *d = rl_scene_get_data(scene);
     if (!d)
         return RL_ERR_NOT_COMMITTED;
-    /* Light subpaths would have to start on it too (an infinite emitter):
-     * not done yet, and ignoring it would give a wrong image. */
-    if (d->environment)
-        return rl_error(RL_ERR_UNSUPPORTED, "bdpt: scene \"%s\" has an environment, which bdpt does not "
-                        "sample yet (pt does)", rl_scene_name(scene));
     rl_timer total;
     rl_timer_start(&total);
     int threads = (int)rl_renderer_opt_int(r, "threads");
@@ -304,6 +302,18 @@ static rl_status bdpt_render(rl_renderer *r, void *state, const rl_scene *scene,
     c->mis = (bd_mis)rl_renderer_opt_enum(r, "mis");
     parse_strategy(rl_renderer_opt_string(r, "strategy"), &c->only_s, &c->only_t);
     c->background = rl_renderer_opt_color(r, "background");
+    c->ggx_ms = rl_renderer_opt_bool(r, "ggx_ms");
+    /* The environment shares the light subpaths with the light table half
+     * and half (all of them when the table is empty): a choice by power
+     * would need the sky's power against the lights', and either is
+     * unbiased. A black environment is reached by escaping rays alone. */
+    c->environment = d->environment;
+    c->env = &s->b.env;
+    c->env_pick = d->environment && s->b.env.sampled ? (s->b.lights.count > 0 ? 0.5f : 1.0f) : 0.0f;
+    c->light_share = 1.0f - c->env_pick;
+    c->env_centre = s->b.lights.centre;
+    c->env_radius = 1.001f * s->b.lights.radius;
+    c->env_disk_pdf = 1.0f / (RL_PI * c->env_radius * c->env_radius);
     c->cam = rl_camera_frame_make(cam);
     c->forward = rl_neg(c->cam.w);
     c->film_area = 4.0f * c->cam.tan_half_fov_y * c->cam.tan_half_fov_y * c->cam.aspect;

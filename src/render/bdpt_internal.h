@@ -7,8 +7,8 @@
  *               connection strategy (s, t), their MIS weights
  *
  * It stands on the parts of "pt" (pathtrace_internal.h): the BVH and the
- * light table chosen by power (pt_backends), the surfaces and the modified
- * Phong BRDF. */
+ * light table chosen by power (pt_backends), the environment's importance
+ * distribution, the surfaces and the BRDFs. */
 #ifndef RL_RENDER_BDPT_INTERNAL_H
 #define RL_RENDER_BDPT_INTERNAL_H
 
@@ -25,7 +25,17 @@ typedef struct bd_ctx {
     bool rr;
     bd_mis mis;
     int only_s, only_t;            /* strategy=s,t: that one alone, unweighted; -1 all */
-    rl_vec3 background;
+    rl_vec3 background;            /* without an environment */
+    bool ggx_ms;                   /* GGX energy compensation (pathtrace_ggx.c) */
+    /* The scene's environment as an emitter at infinity (bdpt_path.c):
+     * light subpaths start on it with probability env_pick (the light
+     * table gets the rest, light_share), from a disk of the bounding
+     * sphere's radius across the sampled direction (density env_disk_pdf). */
+    const rl_environment *environment;   /* NULL: background */
+    const pt_env *env;             /* its importance distribution */
+    float env_pick, light_share;
+    rl_vec3 env_centre;
+    float env_radius, env_disk_pdf;
     /* the pinhole camera (importance W_e, Veach 1997 Sec. 10.3) */
     rl_camera_frame cam;
     rl_vec3 forward;

@@ -31,7 +31,7 @@
  * carries the same factor, so a Phong bounce keeps pt's weight. The BRDF
  * is pt's (Phong or GGX, pathtrace_ggx.c; both reciprocal, so light
  * subpaths use it unchanged) and so is the specular event with Schlick's
- * Fresnel. A scene environment map is pt's alone: bdpt refuses it.
+ * Fresnel.
  *
  * Emitters, as pt's light table (pathtrace_lights.c): a quad light whose
  * emissive mesh covers it ("hittable") emits its radiance colour *
@@ -41,6 +41,20 @@
  * by light_eval.h); a directional light is reached by next-event estimation
  * only (a light subpath that picks one is empty, and s = 1 gets the full
  * weight); covered triangles of a quad that is not hittable emit nothing.
+ *
+ * The scene's environment is an emitter at infinity (the construction of
+ * pbrt's bidirectional path tracer, Pharr et al. 2016): a light
+ * subpath picks it with probability env_pick, draws a direction w from its
+ * importance distribution (pathtrace_env.c) and starts on a disk of the
+ * bounding sphere's radius R across w, outside the scene, travelling along
+ * -w. Its vertex y_0 has no position: its density is that of the direction,
+ * env_pick p_env(w), in solid angle, and the next vertex's is the disk's
+ * 1 / (pi R^2) times its cosine to w, with no distance (parallel rays).
+ * The camera side makes the same vertex when a BSDF ray leaves the scene,
+ * with the BSDF's density in solid angle. So s = 0 is a camera path that
+ * escapes, s = 1 a direction drawn from the environment at z_{t-1} and a
+ * shadow ray to infinity, and s >= 2 joins light subpaths that came in
+ * from the sky; one set of ratios weighs them all.
  *
  * Light subpaths carry importance: at surfaces with shading normals their
  * scattering takes the adjoint factor |v.ns| |wi.ng| / (|v.ng| |wi.ns|)
@@ -57,7 +71,9 @@
 
 #define SHADOW_T_SHRINK 1e-4f
 
-typedef enum bd_light_kind { BD_LIGHT_NONE = 0, BD_LIGHT_QUAD, BD_LIGHT_TRI, BD_LIGHT_POINT, BD_LIGHT_DIRECTIONAL } bd_light_kind;
+typedef enum bd_light_kind {
+    BD_LIGHT_NONE = 0, BD_LIGHT_QUAD, BD_LIGHT_TRI, BD_LIGHT_POINT, BD_LIGHT_DIRECTIONAL, BD_LIGHT_ENV
+} bd_light_kind;
 
 /* An emitter at a point: what emits, how strongly, and how a light subpath
  * would have sampled it. */
@@ -65,8 +81,10 @@ typedef struct bd_light {
     bd_light_kind kind;
     const rl_light *L;             /* point, spot, directional */
     rl_vec3 n;                     /* quad: emitting side; triangle: its normal */
-    rl_vec3 le;                    /* area radiance */
-    float pdf_pos;                 /* pmf / area, or the pmf of a delta position */
+    rl_vec3 le;                    /* area radiance; environment: its radiance along dir */
+    rl_vec3 dir;                   /* environment: unit direction from the scene towards it */
+    float pdf_pos;                 /* pmf / area, or the pmf of a delta position; environment:
+                                    * env_pick p_env(dir), in solid angle */
     bool hittable;                 /* a camera ray can find it (s = 0 possible) */
 } bd_light;
 
@@ -124,7 +142,7 @@ static bd_light surface_emitter(const bd_ctx *ctx, const pt_surface *s)
             return e;
         e.kind = BD_LIGHT_TRI;
         e.le = s->m->emission;
-        e.pdf_pos = lt->tri_pmf[s->tri] / area;
+        e.pdf_pos = ctx->light_share * lt->tri_pmf[s->tri] / area;
         e.hittable = true;
         return e;
     }
@@ -136,7 +154,7 @@ static bd_light surface_emitter(const bd_ctx *ctx, const pt_surface *s)
     e.kind = BD_LIGHT_QUAD;
     e.n = rl_scale(nq, 1.0f / area);
     e.le = rl_scale(L->color, L->intensity);
-    e.pdf_pos = lt->light_pmf[cover] / area;
+    e.pdf_pos = ctx->light_share * lt->light_pmf[cover] / area;
     e.hittable = true;
     return e;
 }
@@ -201,12 +219,25 @@ static bool sample_light(const bd_ctx *ctx, float u_pick, rl_vec2 x, bd_light *e
     const rl_scene_data *d = ctx->data;
     const pt_lights *lt = &ctx->b->lights;
     memset(e, 0, sizeof *e);
-    if (lt->count == 0)
+    if (u_pick < ctx->env_pick) {
+        float pdf;
+        if (!rl_pt_env_sample(ctx->env, x.x, x.y, &e->dir, &pdf))
+            return false;
+        e->kind = BD_LIGHT_ENV;
+        e->le = rl_environment_radiance(ctx->environment, e->dir);
+        e->pdf_pos = ctx->env_pick * pdf;
+        e->hittable = true;
+        *p = rl_madd(ctx->env_centre, e->dir, ctx->env_radius);
+        return true;
+    }
+    if (lt->count == 0 || !(ctx->light_share > 0.0f))
         return false;
+    /* The rest of [env_pick, 1) picks from the table. */
+    u_pick = rl_minf((u_pick - ctx->env_pick) / ctx->light_share, 0.99999994f);
     uint32_t src = lt->source[rl_pt_lights_pick(lt, u_pick)];
     if (src < d->num_lights) {
         const rl_light *L = &d->lights[src];
-        float pmf = lt->light_pmf[src];
+        float pmf = ctx->light_share * lt->light_pmf[src];
         e->L = L;
         if (L->type == RL_LIGHT_QUAD) {
             rl_vec3 nq = rl_cross(L->edge_u, L->edge_v);
@@ -237,7 +268,7 @@ static bool sample_light(const bd_ctx *ctx, float u_pick, rl_vec2 x, bd_light *e
     *p = rl_add(rl_add(rl_scale(p0, b0), rl_scale(p1, b1)), rl_scale(p2, 1.0f - b0 - b1));
     e->kind = BD_LIGHT_TRI;
     e->le = d->materials[d->triangle_material[t]].emission;
-    e->pdf_pos = lt->tri_pmf[t] / area;
+    e->pdf_pos = ctx->light_share * lt->tri_pmf[t] / area;
     e->hittable = true;
     return true;
 }
@@ -317,6 +348,22 @@ static bool unoccluded(const bd_ctx *ctx, rl_vec3 a, rl_vec3 na, rl_vec3 b, rl_v
     return !rl_accel_occluded(ctx->b->exact[RL_ACCEL_BVH], &ray);
 }
 
+static bool is_env(const bd_vertex *v)
+{
+    return v->kind == BD_V_LIGHT && v->light.kind == BD_LIGHT_ENV;
+}
+
+/* Unit direction from vertex a to vertex b; an environment vertex lies at
+ * infinity along its direction. */
+static rl_vec3 dir_between(const bd_vertex *a, const bd_vertex *b)
+{
+    if (is_env(b))
+        return b->light.dir;
+    if (is_env(a))
+        return rl_neg(a->light.dir);
+    return rl_normalize(rl_sub(b->p, a->p));
+}
+
 /* Solid-angle density of the pinhole sampling unit w (the film uniform). */
 static float camera_pdf_dir(const bd_ctx *ctx, rl_vec3 w)
 {
@@ -329,6 +376,8 @@ static float camera_pdf_dir(const bd_ctx *ctx, rl_vec3 w)
 /* Density in area at vertex to of a direction density at `from`. */
 static float to_area(float pdf_dir, rl_vec3 from, const bd_vertex *to)
 {
+    if (is_env(to))
+        return pdf_dir;            /* the environment's vertex is measured by direction */
     rl_vec3 d = rl_sub(to->p, from);
     float d2 = rl_length2(d);
     if (!(d2 > 0.0f))
@@ -341,14 +390,19 @@ static float to_area(float pdf_dir, rl_vec3 from, const bd_vertex *to)
  * reached from prev (NULL for the camera and light ends). */
 static float pdf_area(const bd_ctx *ctx, const bd_vertex *v, const bd_vertex *prev, const bd_vertex *to)
 {
-    rl_vec3 w = rl_normalize(rl_sub(to->p, v->p));
+    rl_vec3 w = dir_between(v, to);
     float pdf;
+    if (is_env(v)) {
+        /* Parallel rays through the disk: its density projected onto to. */
+        float c = rl_length2(to->ng) > 0.0f ? fabsf(rl_dot(to->ng, w)) : 1.0f;
+        return ctx->env_disk_pdf * c;
+    }
     if (v->kind == BD_V_CAMERA) {
         pdf = camera_pdf_dir(ctx, w);
     } else if (v->kind == BD_V_LIGHT || !prev) {
         pdf = emitter_pdf_dir(&v->light, w);     /* a light end, or an emitter hit (s = 0) */
     } else {
-        pt_surface s = seen_from(&v->s, rl_normalize(rl_sub(prev->p, v->p)));
+        pt_surface s = seen_from(&v->s, dir_between(v, prev));
         pdf = bsdf_pdf(&s, w);
     }
     return to_area(pdf, v->p, to);
@@ -358,7 +412,10 @@ static float pdf_area(const bd_ctx *ctx, const bd_vertex *v, const bd_vertex *pr
 
 /* Extends a subpath whose last vertex is path[n - 1] along ray with
  * throughput beta, the direction's density pdf_dir (solid angle; 1 after a
- * delta event), until max_vertices; returns the vertex count. */
+ * delta event), until max_vertices; returns the vertex count. A ray that
+ * leaves the scene sets *escaped and leaves in path[n] (not counted) the
+ * environment's vertex as this side made it: its direction, throughput
+ * and density. */
 static int walk(const bd_ctx *ctx, rl_rng *rng, rl_ray ray, rl_vec3 beta, float pdf_dir, bool delta_dir,
                 bool importance, bd_vertex *path, int n, int max_vertices, bool *escaped, uint64_t *rays)
 {
@@ -367,19 +424,30 @@ static int walk(const bd_ctx *ctx, rl_rng *rng, rl_ray ray, rl_vec3 beta, float 
     while (n < max_vertices) {
         rl_hit hit = { INFINITY, 0.0f, 0.0f, RL_ID_NONE, RL_ID_NONE };
         (*rays)++;
-        if (!rl_accel_intersect(ctx->b->exact[RL_ACCEL_BVH], &ray, &hit)) {
-            *escaped = true;
-            return n;
-        }
         bd_vertex *v = &path[n], *prev = &path[n - 1];
         memset(v, 0, sizeof *v);
+        if (!rl_accel_intersect(ctx->b->exact[RL_ACCEL_BVH], &ray, &hit)) {
+            *escaped = true;
+            v->kind = BD_V_LIGHT;
+            v->light.kind = BD_LIGHT_ENV;
+            v->light.dir = ray.d;
+            v->beta = beta;
+            v->pdf_fwd = delta_dir ? 1.0f : pdf_dir;
+            return n;
+        }
         if (!rl_pt_surface_at_hit(ctx->data, &hit, ray.o, ray.d, &v->s))
             return n;
+        v->s.ggx_ms = ctx->ggx_ms;
         v->kind = BD_V_SURFACE;
         v->p = v->s.p;
         v->ng = v->s.ng;
         v->beta = beta;
-        v->pdf_fwd = delta_dir ? 1.0f : to_area(pdf_dir, prev->p, v);
+        if (delta_dir)
+            v->pdf_fwd = 1.0f;
+        else if (is_env(prev))
+            v->pdf_fwd = ctx->env_disk_pdf * fabsf(rl_dot(v->ng, ray.d));
+        else
+            v->pdf_fwd = to_area(pdf_dir, prev->p, v);
         v->light = surface_emitter(ctx, &v->s);
         ++n;
         if (n >= max_vertices)
@@ -442,6 +510,25 @@ static int light_subpath(const bd_ctx *ctx, rl_rng *rng, bd_vertex *y, int max_v
     if (v->light.kind == BD_LIGHT_DIRECTIONAL || !(v->light.pdf_pos > 0.0f))
         return 0;                  /* directional: next-event estimation only */
     v->kind = BD_V_LIGHT;
+    bool escaped;
+    if (v->light.kind == BD_LIGHT_ENV) {
+        /* From the disk of radius R across dir, centred R beyond the
+         * bounding sphere's centre: every ray along -dir that meets the
+         * scene crosses it once. */
+        rl_vec3 dir = v->light.dir;
+        rl_onb onb = rl_onb_from_normal(dir);
+        float r = ctx->env_radius * sqrtf(u.x), phi = 2.0f * RL_PI * u.y;
+        rl_vec3 o = rl_madd(ctx->env_centre, dir, ctx->env_radius);
+        o = rl_add(o, rl_onb_to_world(&onb, rl_v3(r * cosf(phi), r * sinf(phi), 0.0f)));
+        v->p = o;
+        v->pdf_fwd = v->light.pdf_pos;
+        v->beta = rl_v3s(1.0f / v->light.pdf_pos);
+        if (!(rl_vmax_comp(v->light.le) > 0.0f))
+            return 1;
+        rl_vec3 beta = rl_scale(v->light.le, 1.0f / (v->light.pdf_pos * ctx->env_disk_pdf));
+        rl_ray ray = { o, 0.0f, rl_neg(dir), INFINITY };
+        return walk(ctx, rng, ray, beta, 0.0f, false, true, y, 1, max_vertices, &escaped, rays);
+    }
     v->ng = v->light.kind == BD_LIGHT_POINT ? rl_v3s(0.0f) : v->light.n;
     v->pdf_fwd = v->light.pdf_pos;
     v->beta = rl_v3s(1.0f / v->light.pdf_pos);
@@ -477,7 +564,6 @@ static int light_subpath(const bd_ctx *ctx, rl_rng *rng, bd_vertex *y, int max_v
         return 1;
     rl_vec3 beta = rl_scale(le, emitter_cos(&v->light, w) / (v->light.pdf_pos * pdf_dir));
     rl_ray ray = { offset_point(ctx, v->p, v->ng, w), 0.0f, w, INFINITY };
-    bool escaped;
     return walk(ctx, rng, ray, beta, pdf_dir, false, true, y, 1, max_vertices, &escaped, rays);
 }
 
@@ -652,6 +738,17 @@ static rl_vec3 connect_light(const bd_ctx *ctx, bd_scratch *sc, rl_rng *rng, con
     lv.kind = BD_V_LIGHT;
     lv.pdf_fwd = lv.light.pdf_pos;
     lv.beta = rl_v3s(1.0f / lv.light.pdf_pos);
+    if (lv.light.kind == BD_LIGHT_ENV) {
+        rl_vec3 l = lv.light.dir;
+        rl_vec3 f = bsdf_f(&ze->s, l);
+        if (!(rl_vmax_comp(f) > 0.0f) || !(rl_vmax_comp(lv.light.le) > 0.0f))
+            return rl_v3s(0.0f);
+        rl_vec3 c = rl_scale(rl_mul(rl_mul(ze->beta, f), lv.light.le), fabsf(rl_dot(ze->s.ns, l)) / lv.light.pdf_pos);
+        rl_vec3 far = rl_madd(ze->p, l, 2.0f * (ctx->env_radius + rl_length(rl_sub(ze->p, ctx->env_centre))));
+        if (!(rl_vmax_comp(c) > 0.0f) || !unoccluded(ctx, ze->p, ze->ng, far, rl_v3s(0.0f), rays))
+            return rl_v3s(0.0f);
+        return rl_scale(c, mis_weight(ctx, sc, &lv, 1, z, t));
+    }
     if (lv.light.kind == BD_LIGHT_DIRECTIONAL) {
         /* Only this strategy reaches it: full weight. */
         rl_vec3 E, l;
@@ -726,8 +823,19 @@ rl_vec3 bd_sample(const bd_ctx *ctx, bd_scratch *sc, rl_rng *rng, int x, int y, 
     int ny = light_subpath(ctx, rng, yv, max_vertices - 1, rays);
 
     rl_vec3 L = rl_v3s(0.0f);
-    if (escaped && wanted(ctx, 0, nz + 1))
-        L = rl_add(L, rl_mul(z[nz - 1].beta, ctx->background));   /* no light samples it */
+    if (escaped && wanted(ctx, 0, nz + 1)) {
+        /* z[nz]: the direction the camera path left by, with its throughput. */
+        bd_vertex *ze = &z[nz];
+        if (ctx->environment) {
+            ze->light.le = rl_environment_radiance(ctx->environment, ze->light.dir);
+            ze->light.pdf_pos = ctx->env_pick * rl_pt_env_pdf(ctx->env, ze->light.dir);
+            ze->light.hittable = true;
+            if (rl_vmax_comp(ze->light.le) > 0.0f)
+                L = rl_add(L, rl_scale(rl_mul(ze->beta, ze->light.le), mis_weight(ctx, sc, NULL, 0, z, nz + 1)));
+        } else {
+            L = rl_add(L, rl_mul(ze->beta, ctx->background));   /* no light samples it */
+        }
+    }
     for (int t = 1; t <= nz; ++t) {
         for (int s = 0; s <= (ny > 1 ? ny : 1); ++s) {
             if (s + t > max_vertices || (s == 1 && t == 1) || (s == 0 && t < 2) || !wanted(ctx, s, t))

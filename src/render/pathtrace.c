@@ -213,6 +213,9 @@ static const rl_option_info pt_options[] = {
       "light samples of a scene environment (issue 37): importance (by its radiance x sin(theta)), uniform "
       "(over the sphere) or bsdf (none: escaping BSDF rays only); MIS with the BSDF either way", 0, 0,
       env_sampling_choices },
+    { "ggx_ms", RL_OPT_BOOL, "true",
+      "GGX energy compensation (Kulla & Conty 2017): the light single scattering loses returns as a "
+      "diffuse-like lobe; false: single scattering alone", 0, 0, NULL },
     { "threads", RL_OPT_INT, "0", "OpenMP threads (0 = all)", 0, 1024, NULL },
 };
 #define NUM_OPTIONS (sizeof pt_options / sizeof pt_options[0])
@@ -348,6 +351,7 @@ static void read_settings(const rl_renderer *r, pt_settings *set)
     set->light_samples = (int)rl_renderer_opt_int(r, "light_samples");
     set->background = rl_renderer_opt_color(r, "background");
     set->env_sampling = (int)rl_renderer_opt_enum(r, "env_sampling");
+    set->ggx_ms = rl_renderer_opt_bool(r, "ggx_ms");
     int threads = (int)rl_renderer_opt_int(r, "threads");
 #ifdef _OPENMP
     set->threads = threads > 0 ? threads : omp_get_max_threads();
@@ -1111,7 +1115,7 @@ static rl_status pt_render(rl_renderer *r, void *state, const rl_scene *scene, c
                  .tri_lights = set.mis && exact_backend(set.diffuse) && set.shadow != RL_PT_BACKEND_SHADOWMAP,
                  .vertex_slots = PT_SLOTS_VERTEX + PT_SLOTS_LIGHT * (uint32_t)set.light_samples *
                                                    (set.mis ? 1u : (d->num_lights ? d->num_lights : 1u)),
-                 .background = set.background, .env = d->environment },
+                 .background = set.background, .env = d->environment, .ggx_ms = set.ggx_ms },
         .cam = rl_camera_frame_make(cam),
         .eye = cam->eye,
         .width = cam->width,

@@ -23,8 +23,24 @@
  * Single scattering: the light that microfacets send below the horizon or
  * into each other is lost. With F = 1 at normal view that is 0.4 % at
  * roughness 0.25, 8 % at 0.5, 38 % at 0.75 and 69 % at 1 (alpha = 1;
- * tests/render/test_pathtrace_bsdf.c, docs/path-tracing.md). */
+ * tests/render/test_pathtrace_bsdf.c, docs/path-tracing.md).
+ *
+ * Energy compensation (pt_surface.ggx_ms, the renderers' option ggx_ms;
+ * Kulla & Conty 2017, "Revisiting Physically Based Shading at
+ * Imageworks"): the lost light comes back as a diffuse-like lobe
+ *     f_ms(wi, wo) = F_ms (1 - E(wo.n)) (1 - E(wi.n)) / (pi (1 - E_avg)),
+ * E(mu) the albedo of the specular lobe with F = 1, E_avg = 2 int E mu dmu
+ * its hemispherical average, so that int f_ms cos dwi = 1 - E(wo.n) when
+ * F_ms = 1. Coloured Fresnel: each bounce between microfacets keeps
+ * F_avg = 2 int F mu dmu = F0 + (1 - F0) / 21 (Schlick), and the series of
+ * bounces gives F_ms = F_avg^2 E_avg / (1 - F_avg (1 - E_avg)) per channel.
+ * f_ms is symmetric, so f stays reciprocal. It is sampled by the cosine,
+ * with the diffuse lobe, its albedo F_ms (1 - E) added to theirs in the
+ * lobe choice. E is tabulated over roughness and mu once per process (see
+ * ms_build); E_avg is the exact integral of the table's interpolant, so
+ * the added lobe returns exactly 1 - E of the table. */
 #include <math.h>
+#include <pthread.h>
 
 #include "render/pathtrace_internal.h"
 
@@ -87,6 +103,108 @@ rl_vec3 rl_pt_ggx_sample_vndf(rl_vec3 wo, float alpha, float u1, float u2)
     return rl_normalize(rl_v3(alpha * nh.x, alpha * nh.y, rl_maxf(1e-7f, nh.z)));
 }
 
+/* ------------------------------------------------ energy compensation -- */
+
+/* E(mu) is smooth in roughness r (alpha = r^2) and mu except near mu = 0,
+ * where it changes fastest: MS_NODES x MS_NODES nodes, evenly spaced in r
+ * and in x = sqrt(mu) over [0, 1] (dense at grazing), linear in mu in
+ * between. Each
+ * node is a midpoint quadrature of MS_QUAD x MS_QUAD cells over the
+ * visible-normal sampling (its weight G2 / G1 is in [0, 1] and smooth but
+ * for the horizon). The errors against 512^2 cells and between nodes:
+ * tests/render/test_pathtrace_bsdf.c. */
+#define MS_NODES 32
+#define MS_QUAD 32
+#define MS_MU_MIN 1e-3f          /* node mu = 0: G1 and G2 vanish at the horizon, their ratio does not */
+
+static float ms_e[MS_NODES][MS_NODES];     /* [roughness node][mu node] */
+static float ms_eavg[MS_NODES];
+static pthread_once_t ms_once = PTHREAD_ONCE_INIT;
+
+double rl_pt_ggx_albedo_quadrature(float alpha, float mu, int cells)
+{
+    mu = rl_clampf(mu, MS_MU_MIN, 1.0f);
+    rl_vec3 wo = rl_v3(sqrtf(rl_maxf(0.0f, 1.0f - mu * mu)), 0.0f, mu);
+    float g1 = rl_pt_ggx_g1(alpha, mu);
+    double sum = 0.0;
+    for (int i = 0; i < cells; ++i) {
+        /* u1 = 1 - (1 - x)^2 with x at midpoints: the disk's rim (u1 near
+         * 1), where the steepest normals and all of the masking lie and
+         * the lift onto the hemisphere is steepest, gets most cells. */
+        double x = ((double)i + 0.5) / cells;
+        float u1 = (float)(1.0 - (1.0 - x) * (1.0 - x));
+        double jac = 2.0 * (1.0 - x);
+        double row = 0.0;
+        for (int j = 0; j < cells; ++j) {
+            float u2 = ((float)j + 0.5f) / (float)cells;
+            rl_vec3 m = rl_pt_ggx_sample_vndf(wo, alpha, u1, u2);
+            float wi_z = 2.0f * rl_dot(wo, m) * m.z - wo.z;
+            if (wi_z > 0.0f)
+                row += rl_pt_ggx_g2(alpha, wi_z, mu) / g1;
+        }
+        sum += row * jac;
+    }
+    return sum / ((double)cells * (double)cells);
+}
+
+static float ms_mu(int j)
+{
+    float x = (float)j / (float)(MS_NODES - 1);
+    return x * x;
+}
+
+static void ms_build(void)
+{
+    for (int i = 0; i < MS_NODES; ++i) {
+        float alpha = rl_pt_ggx_alpha((float)i / (float)(MS_NODES - 1));
+        for (int j = 0; j < MS_NODES; ++j)
+            ms_e[i][j] = (float)rl_pt_ggx_albedo_quadrature(alpha, ms_mu(j), MS_QUAD);
+        /* 2 int E(mu) mu dmu of the piecewise-linear E, exactly: on
+         * [a, b] the segment adds (b - a) / 6 (E_a (2a + b) + E_b (a + 2b)). */
+        double avg = 0.0;
+        for (int j = 0; j + 1 < MS_NODES; ++j) {
+            double a = ms_mu(j), b = ms_mu(j + 1);
+            avg += (b - a) / 6.0 * (ms_e[i][j] * (2.0 * a + b) + ms_e[i][j + 1] * (a + 2.0 * b));
+        }
+        ms_eavg[i] = (float)(2.0 * avg);
+    }
+}
+
+/* Roughness r's node below and the weight of the one above. */
+static int ms_row(float roughness, float *t)
+{
+    float x = (roughness > 0.0f ? rl_minf(roughness, 1.0f) : 0.0f) * (float)(MS_NODES - 1);
+    int i = (int)x;
+    if (i > MS_NODES - 2)
+        i = MS_NODES - 2;
+    *t = x - (float)i;
+    return i;
+}
+
+float rl_pt_ggx_ms_albedo(float roughness, float mu)
+{
+    pthread_once(&ms_once, ms_build);
+    float t;
+    int i = ms_row(roughness, &t);
+    mu = mu > 0.0f ? rl_minf(mu, 1.0f) : 0.0f;     /* a NaN must not index the table */
+    int j = (int)(sqrtf(mu) * (float)(MS_NODES - 1));
+    if (j > MS_NODES - 2)
+        j = MS_NODES - 2;
+    float a = ms_mu(j), b = ms_mu(j + 1);
+    float v = rl_clampf((mu - a) / (b - a), 0.0f, 1.0f);
+    float e0 = ms_e[i][j] + (ms_e[i][j + 1] - ms_e[i][j]) * v;
+    float e1 = ms_e[i + 1][j] + (ms_e[i + 1][j + 1] - ms_e[i + 1][j]) * v;
+    return e0 + (e1 - e0) * t;
+}
+
+float rl_pt_ggx_ms_average(float roughness)
+{
+    pthread_once(&ms_once, ms_build);
+    float t;
+    int i = ms_row(roughness, &t);
+    return ms_eavg[i] + (ms_eavg[i + 1] - ms_eavg[i]) * t;
+}
+
 /* The parameters of s's GGX material at its outgoing direction. */
 typedef struct ggx_lobe {
     rl_onb frame;              /* n = the shading normal */
@@ -96,6 +214,9 @@ typedef struct ggx_lobe {
     float f0_dielectric;       /* the scalar one of the diffuse lobe's coat */
     rl_vec3 diffuse;           /* (1 - metallic) k_d */
     float p_spec;              /* probability of sampling the specular lobe; < 0: black */
+    /* Energy compensation: f_ms(wi) = ms (1 - E(wi.z)); zero without it. */
+    rl_vec3 ms;
+    float roughness;
 } ggx_lobe;
 
 static float schlick_weight(float c)
@@ -126,6 +247,23 @@ static ggx_lobe ggx_setup(const pt_surface *s)
      * normal-ish microfacets, the diffuse one what the coat lets through. */
     float w_spec = mean3(schlick3(g.f0, g.wo.z));
     float w_diff = mean3(g.diffuse) * (1.0f - (g.f0_dielectric + (1.0f - g.f0_dielectric) * schlick_weight(g.wo.z)));
+    g.roughness = m->roughness;
+    g.ms = rl_v3s(0.0f);
+    if (s->ggx_ms) {
+        float e_avg = rl_pt_ggx_ms_average(m->roughness);
+        float e_o = rl_pt_ggx_ms_albedo(m->roughness, g.wo.z);
+        /* Smooth surfaces lose nothing, and 1 - E_avg would only be the
+         * tables' rounding. */
+        if (1.0f - e_avg > 1e-4f && e_o < 1.0f) {
+            rl_vec3 f_avg = rl_add(g.f0, rl_scale(rl_sub(rl_v3s(1.0f), g.f0), 1.0f / 21.0f));
+            rl_vec3 f_ms = rl_mul(rl_mul(f_avg, f_avg), rl_v3s(e_avg));
+            f_ms = rl_mul(f_ms, rl_v3(1.0f / (1.0f - f_avg.x * (1.0f - e_avg)), 1.0f / (1.0f - f_avg.y * (1.0f - e_avg)),
+                                      1.0f / (1.0f - f_avg.z * (1.0f - e_avg))));
+            g.ms = rl_scale(f_ms, (1.0f - e_o) / (RL_PI * (1.0f - e_avg)));
+            /* Its albedo at wo is F_ms (1 - E(wo)) = pi ms. */
+            w_diff += RL_PI * mean3(g.ms);
+        }
+    }
     g.p_spec = w_spec + w_diff > 0.0f ? w_spec / (w_spec + w_diff) : -1.0f;
     return g;
 }
@@ -138,6 +276,8 @@ static rl_vec3 ggx_eval_local(const ggx_lobe *g, rl_vec3 wi)
     float fd0 = g->f0_dielectric;
     float coat = (1.0f - (fd0 + (1.0f - fd0) * schlick_weight(ci))) * (1.0f - (fd0 + (1.0f - fd0) * schlick_weight(co)));
     rl_vec3 f = rl_scale(g->diffuse, coat / RL_PI);
+    if (rl_vmax_comp(g->ms) > 0.0f)
+        f = rl_add(f, rl_scale(g->ms, rl_maxf(0.0f, 1.0f - rl_pt_ggx_ms_albedo(g->roughness, ci))));
     rl_vec3 h = rl_add(wi, g->wo);
     if (!(rl_length2(h) > 0.0f))
         return f;

@@ -57,6 +57,7 @@ typedef struct pt_settings {
     const char *ls_file;           /* Line Space cache file; "" none (valid for one frame) */
     rl_vec3 background;            /* environment radiance of escaping rays */
     int env_sampling;              /* pt_env_sampling: light samples of a scene environment */
+    bool ggx_ms;                   /* GGX energy compensation (pathtrace_ggx.c) */
 } pt_settings;
 
 typedef enum pt_env_sampling { PT_ENV_IMPORTANCE = 0, PT_ENV_UNIFORM, PT_ENV_BSDF } pt_env_sampling;
@@ -187,6 +188,7 @@ typedef struct pt_ctx {
     const rl_environment *env;     /* NULL: background */
     bool env_nee;                  /* an environment to sample and a shadow ray that can test it */
     uint32_t env_slot;
+    bool ggx_ms;                   /* GGX energy compensation at every vertex */
 } pt_ctx;
 
 /* The radiance a ray leaving the scene along unit dir brings: the scene's
@@ -242,6 +244,7 @@ typedef struct pt_surface {
     rl_vec2 uv;
     const rl_material *m;
     uint32_t tri;
+    bool ggx_ms;              /* GGX with Kulla-Conty energy compensation (option ggx_ms) */
 } pt_surface;
 
 /* Surface on triangle tri at p with raw shading normal ns and texture
@@ -291,6 +294,13 @@ float rl_pt_ggx_d(float alpha, float cos_m);
 float rl_pt_ggx_g1(float alpha, float cos_w);
 float rl_pt_ggx_g2(float alpha, float cos_i, float cos_o);
 rl_vec3 rl_pt_ggx_sample_vndf(rl_vec3 wo, float alpha, float u1, float u2);
+/* Energy compensation (Kulla & Conty 2017): the albedo E(mu) of the
+ * specular lobe with F = 1 at a view with cosine mu, and its average
+ * E_avg = 2 int E mu dmu, from the tables built on first use; and E by
+ * the quadrature of cells x cells visible normals that builds them. */
+float rl_pt_ggx_ms_albedo(float roughness, float mu);
+float rl_pt_ggx_ms_average(float roughness);
+double rl_pt_ggx_albedo_quadrature(float alpha, float mu, int cells);
 
 /* The material's BRDF, Phong or GGX by rl_material.bsdf: what pt and bdpt
  * call at a non-specular event. */

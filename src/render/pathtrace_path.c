@@ -97,6 +97,7 @@ void rl_pt_surface_finish(const rl_scene_data *d, uint32_t tri, rl_vec3 p, rl_ve
     s->uv = uv;
     s->kd = textured_kd(d, s->m, uv);
     s->tri = tri;
+    s->ggx_ms = false;             /* the renderer's option: set where the path uses s */
 }
 
 bool rl_pt_surface_at_hit(const rl_scene_data *d, const rl_hit *hit, rl_vec3 o, rl_vec3 dir, pt_surface *s)
@@ -136,6 +137,7 @@ static bool surface_of_record(const rl_scene_data *d, const rl_ls_surface *r, rl
     s->uv = r->uv;
     s->kd = textured_kd(d, s->m, r->uv);
     s->tri = RL_ID_NONE;
+    s->ggx_ms = false;
     return true;
 }
 
@@ -473,6 +475,7 @@ rl_vec3 rl_pt_trace_path(const pt_ctx *ctx, const pt_surface *first, pt_sampler 
     float prev_pdf = 0.0f;
     for (int depth = 0;; ++depth) {
         uint32_t base = PT_SLOT_FIRST_VERTEX + (uint32_t)depth * ctx->vertex_slots;
+        s.ggx_ms = ctx->ggx_ms;
         rl_vec3 e = ctx->mis ? emitted_mis(ctx, &s, after_brdf, prev, prev_pdf) : emitted(ctx, &s, after_brdf);
         radiance = rl_add(radiance, rl_mul(T, e));
 
