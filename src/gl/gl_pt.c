@@ -532,6 +532,20 @@ const rl_gl_info *rl_gl_pt_info(const rl_gl_pt *pt)
     return pt ? rl_gl_context_info(pt->ctx) : NULL;
 }
 
+/* The allocated extent of an image side: never a power of two where the
+ * limit allows. llvmpipe compiles a variant of the path program for each
+ * power-of-two pattern of the bound images' sides (its sampler state keys
+ * on it), and one variant of this program costs it about 100 s of CPU; with
+ * the sides padded, 24 x 24, 32 x 32 and 64 x 48 share one. The pixels
+ * beyond w x h are never written or read. */
+static int unpowered(int n, int limit)
+{
+    int m = n;
+    while (m > 0 && (m & (m - 1)) == 0)
+        ++m;
+    return m <= limit ? m : n;
+}
+
 /* New state images when the size changes; the states and a cleared sum on
  * every reset. */
 static rl_status reset_images(rl_gl_pt *pt, int w, int h, const uint32_t *states)
@@ -547,14 +561,15 @@ static rl_status reset_images(rl_gl_pt *pt, int w, int h, const uint32_t *states
             glDeleteTextures(1, &pt->tex_rng);
             glDeleteTextures(1, &pt->tex_ids);
         }
+        const int aw = unpowered(w, max_size), ah = unpowered(h, max_size);
         glCreateTextures(GL_TEXTURE_2D, 1, &pt->tex_accum);
-        glTextureStorage2D(pt->tex_accum, 1, GL_RGBA32F, w, h);
+        glTextureStorage2D(pt->tex_accum, 1, GL_RGBA32F, aw, ah);
         glCreateTextures(GL_TEXTURE_2D, 1, &pt->tex_rng);
-        glTextureStorage2D(pt->tex_rng, 1, GL_RGBA32UI, w, h);
+        glTextureStorage2D(pt->tex_rng, 1, GL_RGBA32UI, aw, ah);
         /* bound in both primary modes: a shader compiler that specializes
          * on the bound textures (llvmpipe) then makes one variant */
         glCreateTextures(GL_TEXTURE_2D, 1, &pt->tex_ids);
-        glTextureStorage2D(pt->tex_ids, 1, GL_R32UI, w, h);
+        glTextureStorage2D(pt->tex_ids, 1, GL_R32UI, aw, ah);
         /* an integer texture with the default linear filters is incomplete
          * and every texelFetch reads 0 */
         glTextureParameteri(pt->tex_ids, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
@@ -691,8 +706,8 @@ static rl_status render_frame(rl_gl_pt *pt, const rl_gl_pt_frame *f, float *rgba
     pt->frames++;
     if (rgba) {
         glMemoryBarrier(GL_TEXTURE_UPDATE_BARRIER_BIT);
-        glGetTextureImage(pt->tex_accum, 0, GL_RGBA, GL_FLOAT, (GLsizei)((size_t)w * (size_t)h * 4 * sizeof(float)),
-                          rgba);
+        glGetTextureSubImage(pt->tex_accum, 0, 0, 0, 0, w, h, 1, GL_RGBA, GL_FLOAT,
+                             (GLsizei)((size_t)w * (size_t)h * 4 * sizeof(float)), rgba);
     } else {
         glFinish();
     }
