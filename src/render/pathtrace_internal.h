@@ -202,6 +202,7 @@ typedef struct pt_sampler {
     rl_rng_gpu *rng;
     uint32_t pixel_seed;
     uint32_t index;                /* the sample's number within its pixel */
+    uint32_t index_reversed;       /* its bits reversed: every Sobol draw starts from it */
     uint32_t slot;                 /* the next dimension (1D) or pair (2D) */
 } pt_sampler;
 
@@ -229,6 +230,10 @@ rl_vec2 rl_pt_sample_2d(pt_sampler *s);
 /* Nested uniform scrambling of x read as a binary fraction (MSB first);
  * exposed for the tests of its stratification. */
 uint32_t rl_pt_owen_scramble(uint32_t x, uint32_t seed);
+/* The second dimension of Sobol's sequence for index i (only its 24 low
+ * bits count; see pathtrace_sampler.c), as a 0.32 binary fraction; exposed
+ * for the tests against its direction numbers. */
+uint32_t rl_pt_sobol_dim1(uint32_t i);
 
 /* A surface point being shaded. Normals are unit and face the side the
  * ray came from; tri is RL_ID_NONE for a Line Space PNMT record. */
