@@ -279,6 +279,10 @@ rl_vec3 rl_pt_phong_eval(const pt_surface *s, rl_vec3 wi);
  * *weight = f cos / pdf with the mixture pdf. False when the sample points
  * below the surface or the material reflects nothing. */
 bool rl_pt_phong_sample(const pt_surface *s, float u_lobe, float u1, float u2, rl_vec3 *wi, rl_vec3 *weight);
+/* The same, and *pdf (pdf may be NULL) = rl_pt_phong_pdf(s, *wi), which
+ * the sampling has computed anyway. */
+bool rl_pt_phong_sample_pdf(const pt_surface *s, float u_lobe, float u1, float u2, rl_vec3 *wi, rl_vec3 *weight,
+                            float *pdf);
 /* The mixture pdf of rl_pt_phong_sample in solid angle (for tests). */
 float rl_pt_phong_pdf(const pt_surface *s, rl_vec3 wi);
 
@@ -301,6 +305,11 @@ rl_vec3 rl_pt_ggx_sample_vndf(rl_vec3 wo, float alpha, float u1, float u2);
  * call at a non-specular event. */
 rl_vec3 rl_pt_bsdf_eval(const pt_surface *s, rl_vec3 wi);
 bool rl_pt_bsdf_sample(const pt_surface *s, float u_lobe, float u1, float u2, rl_vec3 *wi, rl_vec3 *weight);
+/* rl_pt_bsdf_sample, and *pdf = rl_pt_bsdf_pdf(s, *wi) bit for bit (pdf
+ * may be NULL; Phong has it from the sampling, GGX, which samples in its
+ * local frame, asks rl_pt_ggx_pdf). */
+bool rl_pt_bsdf_sample_pdf(const pt_surface *s, float u_lobe, float u1, float u2, rl_vec3 *wi, rl_vec3 *weight,
+                           float *pdf);
 float rl_pt_bsdf_pdf(const pt_surface *s, rl_vec3 wi);
 /* Whether sampling m's BRDF uses the lobe number (more than one lobe). */
 bool rl_pt_bsdf_needs_lobe(const rl_material *m);
