@@ -44,7 +44,8 @@
  * scene, pathtrace_backend.c); on a reset fill the G-buffer; then for each
  * of the spp samples a primary pass (jittered camera rays, or the
  * rasterized G-buffer once per frame) and a path pass (pathtrace_path.c),
- * both over 16 x 16 tiles handed out dynamically to OpenMP threads.
+ * over 16 x 16 tiles handed out dynamically to OpenMP threads: a tile
+ * makes all the frame's passes over its pixels (run_tiles).
  *
  * Accumulation (Sec. 6.5, eq. 8): C_{s+1} = s/(s+1) C_s + 1/(s+1) C_trace.
  * We keep the per-pixel sum in double and its sample count and divide,
