@@ -66,7 +66,7 @@ uint32_t rl_pt_owen_scramble(uint32_t x, uint32_t seed)
  * bit j is the parity of the index bits k that are supersets of j, a
  * superset transform over the 5-bit bit numbers: five shift-and-xor steps
  * instead of one table lookup per set index bit (a loop of 12 data-dependent
- * iterations on average, which was most of the sampler's time). The result
+ * iterations on average, about 40 % of the sampler's time). The result
  * is bit-reversed, the order the scramble wants it in; tests compare it
  * with the direction numbers. Index bits from the 25th on only touch output
  * bits below 2^-24, which to_unit drops, and the scramble after this keeps
