@@ -82,6 +82,12 @@ static rl_vec3 around(rl_vec3 a, float cos_t, float phi)
 
 bool rl_pt_phong_sample(const pt_surface *s, float u_lobe, float u1, float u2, rl_vec3 *wi, rl_vec3 *weight)
 {
+    return rl_pt_phong_sample_pdf(s, u_lobe, u1, u2, wi, weight, NULL);
+}
+
+bool rl_pt_phong_sample_pdf(const pt_surface *s, float u_lobe, float u1, float u2, rl_vec3 *wi, rl_vec3 *weight,
+                            float *pdf_out)
+{
     float pd = diffuse_probability(s);
     if (pd < 0.0f)
         return false;
@@ -101,5 +107,7 @@ bool rl_pt_phong_sample(const pt_surface *s, float u_lobe, float u1, float u2, r
         return false;
     *wi = dir;
     *weight = rl_scale(rl_pt_phong_eval(s, dir), cos_theta / pdf);
+    if (pdf_out)
+        *pdf_out = pdf;
     return true;
 }

@@ -356,6 +356,18 @@ bool rl_pt_bsdf_sample(const pt_surface *s, float u_lobe, float u1, float u2, rl
                                      : rl_pt_phong_sample(s, u_lobe, u1, u2, wi, weight);
 }
 
+bool rl_pt_bsdf_sample_pdf(const pt_surface *s, float u_lobe, float u1, float u2, rl_vec3 *wi, rl_vec3 *weight,
+                           float *pdf)
+{
+    if (s->m->bsdf != RL_BSDF_GGX)
+        return rl_pt_phong_sample_pdf(s, u_lobe, u1, u2, wi, weight, pdf);
+    if (!rl_pt_ggx_sample(s, u_lobe, u1, u2, wi, weight))
+        return false;
+    if (pdf)
+        *pdf = rl_pt_ggx_pdf(s, *wi);
+    return true;
+}
+
 bool rl_pt_bsdf_needs_lobe(const rl_material *m)
 {
     return m->bsdf == RL_BSDF_GGX || rl_vmax_comp(m->specular) > 0.0f;

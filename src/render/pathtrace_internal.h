@@ -204,6 +204,7 @@ typedef struct pt_sampler {
     rl_rng_gpu *rng;
     uint32_t pixel_seed;
     uint32_t index;                /* the sample's number within its pixel */
+    uint32_t index_reversed;       /* its bits reversed: every Sobol draw starts from it */
     uint32_t slot;                 /* the next dimension (1D) or pair (2D) */
 } pt_sampler;
 
@@ -231,6 +232,10 @@ rl_vec2 rl_pt_sample_2d(pt_sampler *s);
 /* Nested uniform scrambling of x read as a binary fraction (MSB first);
  * exposed for the tests of its stratification. */
 uint32_t rl_pt_owen_scramble(uint32_t x, uint32_t seed);
+/* The second dimension of Sobol's sequence for index i (only its 24 low
+ * bits count; see pathtrace_sampler.c), as a 0.32 binary fraction; exposed
+ * for the tests against its direction numbers. */
+uint32_t rl_pt_sobol_dim1(uint32_t i);
 
 /* A surface point being shaded. Normals are unit and face the side the
  * ray came from; tri is RL_ID_NONE for a Line Space PNMT record. */
@@ -277,6 +282,10 @@ rl_vec3 rl_pt_phong_eval(const pt_surface *s, rl_vec3 wi);
  * *weight = f cos / pdf with the mixture pdf. False when the sample points
  * below the surface or the material reflects nothing. */
 bool rl_pt_phong_sample(const pt_surface *s, float u_lobe, float u1, float u2, rl_vec3 *wi, rl_vec3 *weight);
+/* The same, and *pdf (pdf may be NULL) = rl_pt_phong_pdf(s, *wi), which
+ * the sampling has computed anyway. */
+bool rl_pt_phong_sample_pdf(const pt_surface *s, float u_lobe, float u1, float u2, rl_vec3 *wi, rl_vec3 *weight,
+                            float *pdf);
 /* The mixture pdf of rl_pt_phong_sample in solid angle (for tests). */
 float rl_pt_phong_pdf(const pt_surface *s, rl_vec3 wi);
 
@@ -306,6 +315,11 @@ double rl_pt_ggx_albedo_quadrature(float alpha, float mu, int cells);
  * call at a non-specular event. */
 rl_vec3 rl_pt_bsdf_eval(const pt_surface *s, rl_vec3 wi);
 bool rl_pt_bsdf_sample(const pt_surface *s, float u_lobe, float u1, float u2, rl_vec3 *wi, rl_vec3 *weight);
+/* rl_pt_bsdf_sample, and *pdf = rl_pt_bsdf_pdf(s, *wi) bit for bit (pdf
+ * may be NULL; Phong has it from the sampling, GGX, which samples in its
+ * local frame, asks rl_pt_ggx_pdf). */
+bool rl_pt_bsdf_sample_pdf(const pt_surface *s, float u_lobe, float u1, float u2, rl_vec3 *wi, rl_vec3 *weight,
+                           float *pdf);
 float rl_pt_bsdf_pdf(const pt_surface *s, rl_vec3 wi);
 /* Whether sampling m's BRDF uses the lobe number (more than one lobe). */
 bool rl_pt_bsdf_needs_lobe(const rl_material *m);

@@ -512,12 +512,12 @@ rl_vec3 rl_pt_trace_path(const pt_ctx *ctx, const pt_surface *first, pt_sampler 
             rl_pt_sampler_seek(sp, base + PT_SLOT_BSDF);
             rl_vec2 u12 = rl_pt_sample_2d(sp);
             rl_vec3 w;
-            if (!rl_pt_bsdf_sample(&s, u0, u12.x, u12.y, &dir, &w))
+            prev_pdf = 0.0f;          /* the BSDF strategy's density, for MIS only */
+            if (!rl_pt_bsdf_sample_pdf(&s, u0, u12.x, u12.y, &dir, &w, ctx->mis || ctx->env_nee ? &prev_pdf : NULL))
                 break;
             T = rl_mul(T, w);
             type = RL_RAY_DIFFUSE;
             after_brdf = true;
-            prev_pdf = ctx->mis || ctx->env_nee ? rl_pt_bsdf_pdf(&s, dir) : 0.0f;
         }
         prev = s.p;
 

@@ -31,8 +31,7 @@
 
 static uint32_t reverse_bits(uint32_t x)
 {
-    x = (x << 16) | (x >> 16);
-    x = ((x & 0x00ff00ffu) << 8) | ((x >> 8) & 0x00ff00ffu);
+    x = __builtin_bswap32(x);     /* the bytes in one instruction, then the bits within them */
     x = ((x & 0x0f0f0f0fu) << 4) | ((x >> 4) & 0x0f0f0f0fu);
     x = ((x & 0x33333333u) << 2) | ((x >> 2) & 0x33333333u);
     return ((x & 0x55555555u) << 1) | ((x >> 1) & 0x55555555u);
@@ -59,24 +58,34 @@ uint32_t rl_pt_owen_scramble(uint32_t x, uint32_t seed)
 }
 
 /* Sobol's first dimension is the van der Corput sequence in base 2, the
- * reversed index (written out where it is used). The second dimension: primitive polynomial x + 1 (degree 1, m_1 = 1),
- * so the direction numbers follow v_k = v_{k-1} ^ (v_{k-1} >> 1) from
- * v_1 = 2^31 (the rows of Pascal's triangle mod 2), tabulated here. Index
- * bits from the 25th on only touch output bits below 2^-24, which to_unit
- * drops, and the scramble after this keeps the leading 24 bits a function
- * of the leading 24 bits: so 24 index bits suffice. */
-static const uint32_t sobol1_v[24] = {
-    0x80000000u, 0xc0000000u, 0xa0000000u, 0xf0000000u, 0x88000000u, 0xcc000000u, 0xaa000000u, 0xff000000u,
-    0x80800000u, 0xc0c00000u, 0xa0a00000u, 0xf0f00000u, 0x88880000u, 0xcccc0000u, 0xaaaa0000u, 0xffff0000u,
-    0x80008000u, 0xc000c000u, 0xa000a000u, 0xf000f000u, 0x88008800u, 0xcc00cc00u, 0xaa00aa00u, 0xff00ff00u,
-};
-
-static uint32_t sobol_dim1(uint32_t i)
+ * reversed index (written out where it is used). The second dimension:
+ * primitive polynomial x + 1 (degree 1, m_1 = 1), so the direction numbers
+ * follow v_k = v_{k-1} ^ (v_{k-1} >> 1) from v_1 = 2^31: v_k's bit j,
+ * counted from the top, is the binomial coefficient C(k, j) mod 2, which by
+ * Lucas' theorem is 1 exactly when j's bits are a subset of k's. So output
+ * bit j is the parity of the index bits k that are supersets of j, a
+ * superset transform over the 5-bit bit numbers: five shift-and-xor steps
+ * instead of one table lookup per set index bit (a loop of 12 data-dependent
+ * iterations on average, about 40 % of the sampler's time). The result
+ * is bit-reversed, the order the scramble wants it in; tests compare it
+ * with the direction numbers. Index bits from the 25th on only touch output
+ * bits below 2^-24, which to_unit drops, and the scramble after this keeps
+ * the leading 24 bits a function of the leading 24 bits: so 24 index bits
+ * suffice. */
+static uint32_t sobol_dim1_reversed(uint32_t i)
 {
-    uint32_t r = 0;
-    for (i &= 0xffffffu; i; i &= i - 1)
-        r ^= sobol1_v[__builtin_ctz(i)];
-    return r;
+    i &= 0xffffffu;
+    i ^= (i >> 1) & 0x55555555u;
+    i ^= (i >> 2) & 0x33333333u;
+    i ^= (i >> 4) & 0x0f0f0f0fu;
+    i ^= (i >> 8) & 0x00ff00ffu;
+    i ^= (i >> 16) & 0x0000ffffu;
+    return i;
+}
+
+uint32_t rl_pt_sobol_dim1(uint32_t i)
+{
+    return reverse_bits(sobol_dim1_reversed(i));
 }
 
 void rl_pt_sampler_init(pt_sampler *s, rl_rng_gpu *rng, uint32_t pixel_seed, uint32_t index)
@@ -84,6 +93,7 @@ void rl_pt_sampler_init(pt_sampler *s, rl_rng_gpu *rng, uint32_t pixel_seed, uin
     s->rng = rng;
     s->pixel_seed = pixel_seed;
     s->index = index;
+    s->index_reversed = reverse_bits(index);
     s->slot = 0;
 }
 
@@ -116,9 +126,14 @@ rl_vec2 rl_pt_sample_2d(pt_sampler *s)
     }
     uint32_t seed[3];
     slot_seeds(s, s->slot++, seed);
-    uint32_t d0 = scramble_reversed(reverse_bits(s->index), seed[0]);
-    return rl_v2(to_unit(rl_pt_owen_scramble(d0, seed[1])),
-                 to_unit(rl_pt_owen_scramble(sobol_dim1(reverse_bits(d0)), seed[2])));
+    /* The shuffled index i = owen(index) and, reversed, its van der Corput
+     * point d0; then owen(d0) and owen(sobol_dim1(i)), each written as
+     * reverse(scramble_reversed(reverse(.))) with the inner reversals
+     * cancelled against the ones before them. */
+    uint32_t d0 = scramble_reversed(s->index_reversed, seed[0]);
+    uint32_t i = reverse_bits(d0);
+    return rl_v2(to_unit(reverse_bits(scramble_reversed(i, seed[1]))),
+                 to_unit(reverse_bits(scramble_reversed(sobol_dim1_reversed(i), seed[2]))));
 }
 
 float rl_pt_sample_1d(pt_sampler *s)
@@ -128,7 +143,7 @@ float rl_pt_sample_1d(pt_sampler *s)
     uint32_t seed[3];
     slot_seeds(s, s->slot++, seed);
     /* sobol_dim0(owen(index)) = reverse(owen(index)): one reversal less. */
-    uint32_t d0 = scramble_reversed(reverse_bits(s->index), seed[0]);
+    uint32_t d0 = scramble_reversed(s->index_reversed, seed[0]);
     return to_unit(rl_pt_owen_scramble(d0, seed[1]));
 }
 

@@ -2,8 +2,9 @@
  * (pathtrace_sampler.c): the scramble is nested (an output's leading bits
  * depend on the input's leading bits only) and a bijection, the first 2^m
  * samples of every 2D slot of every pixel form a (0,m,2)-net (one point in
- * each elementary interval of area 2^-m), 1D slots are stratified, and
- * pixels and slots are decorrelated. */
+ * each elementary interval of area 2^-m), 1D slots are stratified,
+ * pixels and slots are decorrelated, and the draws equal their
+ * straightforward evaluation. */
 #include <math.h>
 #include <setjmp.h>
 #include <stdarg.h>
@@ -162,6 +163,74 @@ static void test_gpu_generators_draw_in_call_order(void **state)
     assert_true(y.y == rl_rng_gpu_float(&b));
 }
 
+/* The straightforward evaluations the sampler's shortcuts must agree with,
+ * bit for bit (pathtrace_sampler.c): Sobol's second dimension by its
+ * direction numbers, one XOR per set index bit, and each draw as the
+ * composition it stands for. */
+static uint32_t sobol_dim1_by_directions(uint32_t i)
+{
+    uint32_t v = 0x80000000u, r = 0;
+    for (int k = 0; k < 24; ++k, v ^= v >> 1)
+        if (i >> k & 1u)
+            r ^= v;
+    return r;
+}
+
+static uint32_t reversed(uint32_t x)
+{
+    uint32_t r = 0;
+    for (int k = 0; k < 32; ++k)
+        r |= (x >> k & 1u) << (31 - k);
+    return r;
+}
+
+static float unit24(uint32_t x)
+{
+    return (float)(x >> 8) * (1.0f / 16777216.0f);
+}
+
+static void test_sobol_dim1_matches_its_direction_numbers(void **state)
+{
+    (void)state;
+    /* Every index below 2^16, then random ones, whose bits from the 25th
+     * on must not count. */
+    for (uint32_t i = 0; i < 65536; ++i)
+        assert_int_equal(rl_pt_sobol_dim1(i), sobol_dim1_by_directions(i));
+    uint64_t g = 23;
+    for (int k = 0; k < 100000; ++k) {
+        uint32_t i = next_u32(&g);
+        assert_int_equal(rl_pt_sobol_dim1(i), sobol_dim1_by_directions(i));
+    }
+    assert_int_equal(rl_pt_sobol_dim1(1u << 23), 0xff00ff00u);   /* the 24th direction number */
+}
+
+static void test_draws_match_the_straightforward_evaluation(void **state)
+{
+    (void)state;
+    for (uint32_t pixel = 0; pixel < 4; ++pixel) {
+        uint32_t seed = rl_pt_pixel_seed(9, pixel * 1237u);
+        for (uint32_t index = 0; index < 300; index += 7) {
+            for (uint32_t slot = 0; slot < 40; ++slot) {
+                /* The slot's three scramble seeds, the shuffled index, and
+                 * dimensions 0 (van der Corput: the reversed index) and 1. */
+                uint64_t h = rl_hash64(((uint64_t)seed << 32) | slot);
+                uint32_t s0 = (uint32_t)h, s1 = (uint32_t)(h >> 32);
+                uint32_t s2 = (uint32_t)((h * 0xd1342543de82ef95ull) >> 32) ^ s0;
+                uint32_t shuffled = rl_pt_owen_scramble(index, s0);
+                float x = unit24(rl_pt_owen_scramble(reversed(shuffled), s1));
+                float y = unit24(rl_pt_owen_scramble(sobol_dim1_by_directions(shuffled), s2));
+                pt_sampler sp;
+                rl_pt_sampler_init(&sp, NULL, seed, index);
+                rl_pt_sampler_seek(&sp, slot);
+                rl_vec2 p = rl_pt_sample_2d(&sp);
+                assert_true(p.x == x && p.y == y);
+                rl_pt_sampler_seek(&sp, slot);
+                assert_true(rl_pt_sample_1d(&sp) == x);
+            }
+        }
+    }
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -171,6 +240,8 @@ int main(void)
         cmocka_unit_test(test_1d_slots_are_stratified),
         cmocka_unit_test(test_pixels_and_slots_are_decorrelated),
         cmocka_unit_test(test_gpu_generators_draw_in_call_order),
+        cmocka_unit_test(test_sobol_dim1_matches_its_direction_numbers),
+        cmocka_unit_test(test_draws_match_the_straightforward_evaluation),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
