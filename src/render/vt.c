@@ -614,6 +614,7 @@ static rl_status run_frame(vt_run *run, vt_state *s, const vt_settings *set, rl_
     run->stats.time_visibility_ms = rl_time_s() * 1000.0 - t0 - run->stats.time_draw_ms;
     if (st == RL_OK)
         st = vt_refine(run);
+    run->stats.mesh_bytes = vt_mesh_bytes(run->mesh);
     if (st == RL_OK) {
         double td = rl_time_s() * 1000.0;
         if (!vt_update(run, run->stats.stages, true) && run->failed)
@@ -916,6 +917,7 @@ rl_status rl_vt_refine_faces(rl_renderer *r, const rl_scene *scene, const rl_cam
         run.seed = s->package;
         vt_project_primary(&run, s->depth_ids);
         st = vt_refine(&run);
+        run.stats.mesh_bytes = vt_mesh_bytes(m);
     }
     if (st == RL_OK)
         st = vt_part_write(m, run.data, s->package, part, part_size);
@@ -987,6 +989,7 @@ rl_status rl_vt_draw_parts(rl_renderer *r, const rl_scene *scene, const rl_camer
     if (st == RL_OK)
         keep_mesh(s, &run);
     if (st == RL_OK) {
+        run.stats.mesh_bytes = vt_mesh_bytes(&s->mesh);
         s->stats = run.stats;
         s->have_frame = true;
         if (stats) {

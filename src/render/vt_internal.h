@@ -133,6 +133,10 @@ void vt_mesh_free(vt_mesh *m);
  * unsampled): the start of a new camera frame. Keeps the allocations. */
 void vt_mesh_reset(vt_mesh *m);
 
+/* Bytes the mesh's elements take (counts times sizes, without the arrays'
+ * spare room). */
+uint64_t vt_mesh_bytes(const vt_mesh *m);
+
 /* Room for this many more vertices (and samples), edges and faces; on
  * failure the mesh is unchanged. RL_ERR_OUT_OF_MEMORY or RL_ERR_LIMIT. */
 rl_status vt_mesh_reserve(vt_mesh *m, uint32_t verts, uint32_t edges, uint32_t faces);

@@ -96,6 +96,13 @@ rl_status vt_mesh_reserve(vt_mesh *m, uint32_t verts, uint32_t edges, uint32_t f
     return reserve(m, verts, edges, faces);
 }
 
+uint64_t vt_mesh_bytes(const vt_mesh *m)
+{
+    return (uint64_t)m->num_verts * (sizeof *m->verts + sizeof *m->samples) +
+           (uint64_t)m->num_edges * sizeof *m->edges + (uint64_t)m->num_faces * sizeof *m->faces +
+           (uint64_t)m->num_layers * sizeof *m->layers;
+}
+
 /* ------------------------------------------------------------- samples -- */
 
 /* What rl_tracer_shade_point leaves in a layer it has nothing for. */

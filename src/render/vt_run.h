@@ -169,6 +169,7 @@ typedef struct vt_run {
     const vt_feeler_map *cache;   /* or NULL */
     /* sampling */
     vt_block *pending;        /* blocks spawned this stage, to read back */
+    uint32_t num_pending;
     vt_block *filling;        /* block the primary thread is filling */
     vt_block *free_blocks;
     uint64_t rays[RL_RAY_TYPE_COUNT];  /* summed by the primary thread */
@@ -204,7 +205,12 @@ typedef struct vt_run {
  * region (or outside it: then the block is sampled at vt_sample_flush). */
 void vt_sample_queue(vt_run *run, uint32_t v);
 /* Spawns the partly filled block, waits for all blocks of this stage and
- * copies their results into the mesh (state VT_SAMPLED). */
+ * copies their results into the mesh (state VT_SAMPLED). vt_sample_queue
+ * does the same for the full blocks alone when too many are pending: a
+ * stage at min_edge 1 makes up to 90,000 vertices, 2,800 blocks of 9 KB.
+ * That is exact: a stage tests only edges whose ends an earlier stage
+ * sampled, so no decision depends on when within a stage a vertex's
+ * sample arrives. */
 void vt_sample_flush(vt_run *run);
 /* Time the calling thread has spent sampling blocks so far (ms): the
  * refinement subtracts what its thread sampled inside its own intervals. */

@@ -224,45 +224,16 @@ static void spawn(vt_run *run, vt_block *b)
 {
     b->next = run->pending;
     run->pending = b;
+    run->num_pending++;
 #pragma omp task firstprivate(b) shared(run)
     sample_block(run, b);
 }
 
-void vt_sample_queue(vt_run *run, uint32_t v)
+/* Waits for the pending blocks and copies their results into the mesh. */
+static void collect(vt_run *run)
 {
-    vt_vertex *vx = &run->mesh->verts[v];
-    if (vx->state != VT_UNSAMPLED)
-        return;
-    if (!run->filling && !(run->filling = take_block(run))) {
-        run->failed = true;
-        return;
-    }
-    vx->state = VT_QUEUED;
-    vt_block *b = run->filling;
-    uint32_t i = b->count++;
-    b->vertex[i] = v;
-    b->point[i] = (rl_trace_point){ vx->p, vx->n, vx->uv, vx->triangle };
-    b->key[i] = vx->key;
-    b->cache_in[i] = run->cache ? vt_feeler_map_find(run->cache, vx->key) : NULL;
-    if (b->count == VT_BLOCK) {
-        run->filling = NULL;
-        spawn(run, b);
-    }
-}
-
-void vt_sample_flush(vt_run *run)
-{
-    if (run->filling) {
-        vt_block *b = run->filling;
-        run->filling = NULL;
-        if (b->count)
-            spawn(run, b);
-        else {
-            b->next = run->free_blocks;
-            run->free_blocks = b;
-        }
-    }
 #pragma omp taskwait
+    run->num_pending = 0;
     vt_mesh *m = run->mesh;
     while (run->pending) {
         vt_block *b = run->pending;
@@ -287,6 +258,48 @@ void vt_sample_flush(vt_run *run)
         b->next = run->free_blocks;
         run->free_blocks = b;
     }
+}
+
+void vt_sample_queue(vt_run *run, uint32_t v)
+{
+    vt_vertex *vx = &run->mesh->verts[v];
+    if (vx->state != VT_UNSAMPLED)
+        return;
+    if (!run->filling && !(run->filling = take_block(run))) {
+        run->failed = true;
+        return;
+    }
+    vx->state = VT_QUEUED;
+    vt_block *b = run->filling;
+    uint32_t i = b->count++;
+    b->vertex[i] = v;
+    b->point[i] = (rl_trace_point){ vx->p, vx->n, vx->uv, vx->triangle };
+    b->key[i] = vx->key;
+    b->cache_in[i] = run->cache ? vt_feeler_map_find(run->cache, vx->key) : NULL;
+    if (b->count == VT_BLOCK) {
+        run->filling = NULL;
+        spawn(run, b);
+        /* Enough to keep the other threads busy while the primary thread
+         * refines on; more would only hold results back. */
+        uint32_t most = 16u * (uint32_t)run->set->threads;
+        if (run->num_pending >= (most > 256 ? most : 256))
+            collect(run);
+    }
+}
+
+void vt_sample_flush(vt_run *run)
+{
+    if (run->filling) {
+        vt_block *b = run->filling;
+        run->filling = NULL;
+        if (b->count)
+            spawn(run, b);
+        else {
+            b->next = run->free_blocks;
+            run->free_blocks = b;
+        }
+    }
+    collect(run);
 }
 
 void vt_run_free_blocks(vt_run *run)
