@@ -440,9 +440,9 @@ static void converges_to_whitted(void **state)
  * the library's own count (rl_vt_stats.mesh_bytes), on a frame that makes
  * every kind of sample: reflective (one deferred layer), glass (two) and
  * diffuse (none). Here a generated vertex costs 445 bytes: itself (64),
- * its sample (80) and deferred layers (36 each), and the ~3 edges (28)
- * and ~4 faces (40) its split adds; with the sample of 152 bytes, the
- * 72-byte vertex, 36-byte edges and 44-byte faces it was about 530. */
+ * its sample (80) and 0.9 deferred layers (36 each), and the 4 edges (28)
+ * and 4 faces (40) its split adds; with the sample of 152 bytes, the
+ * 72-byte vertex, 36-byte edges and 44-byte faces the same mesh took 540. */
 static void mesh_bytes_per_generated_vertex(void **state)
 {
     (void)state;
