@@ -225,6 +225,7 @@ static cJSON *vt_stats_json(const rl_vt_stats *s)
         { "faces_drawn", s->faces_drawn },
         { "feelers_reused", s->feelers_reused },
         { "vertices_merged", s->vertices_merged },
+        { "mesh_bytes", s->mesh_bytes },
         { "stages", s->stages },
         { "threads", s->threads },
     };

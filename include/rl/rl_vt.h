@@ -50,6 +50,10 @@ typedef struct rl_vt_stats {
     uint32_t threads;
     uint64_t thread_rays[RL_VT_MAX_THREADS];   /* rays traced per thread (Fig. 5.15b) */
     double thread_busy_ms[RL_VT_MAX_THREADS];  /* sampling time per thread */
+    uint64_t mesh_bytes;               /* the refined mesh at the frame's end:
+                                        * its vertices, samples, edges, faces
+                                        * and deferred layers, as used (the
+                                        * arrays' spare room not counted) */
 } rl_vt_stats;
 
 /* Statistics of the last frame rendered by r. RL_ERR_INVALID_ARG when r is

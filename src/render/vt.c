@@ -134,9 +134,15 @@ typedef struct vt_state {
     /* the last frame */
     bool have_frame;
     rl_vt_stats stats;
+    /* rl_vt_get_mesh's copy of the refined mesh, made when first asked
+     * for: every frame copying it would add 36 bytes per vertex to the
+     * frame's peak for a view few callers take */
+    bool have_copy;
     rl_vt_vertex_info *vinfo;
     uint32_t *finfo;
     size_t num_vinfo, num_finfo;
+    uint8_t *reason;          /* per vertex of the mesh (run->reason's) */
+    uint32_t num_reason;
     rl_vt_update_fn update;
     void *update_user;
     /* frame buffers kept across frames, so that a frame does not fault in
@@ -185,6 +191,7 @@ static void vt_release(void *state)
     vt_feeler_map_free(&s->feelers);
     free(s->vinfo);
     free(s->finfo);
+    free(s->reason);
     rl_raster_release(s->ras);
     rl_drawer_release(s->gl);
     rl_image_release(s->depth_ids);
@@ -406,47 +413,55 @@ static uint64_t feeler_signature(const rl_tracer_desc *desc)
  * pool of occluders over). */
 static rl_status keep_feelers(vt_state *s, vt_run *run)
 {
-    const vt_mesh *m = run->mesh;
-    size_t n = 0;
-    for (uint32_t v = 0; v < m->num_verts; ++v)
-        n += m->verts[v].state == VT_SAMPLED;
-    uint64_t *keys = rl_realloc_array(NULL, n ? n : 1, sizeof *keys);
-    vt_feelers_packed *vals = rl_realloc_array(NULL, n ? n : 1, sizeof *vals);
-    rl_status st = keys && vals ? RL_OK : RL_ERR_OUT_OF_MEMORY;
-    if (st == RL_OK) {
-        size_t i = 0;
-        for (uint32_t v = 0; v < m->num_verts; ++v) {
-            if (m->verts[v].state != VT_SAMPLED)
-                continue;
-            keys[i] = m->verts[v].key;
-            vals[i++] = run->feelers[v];
-        }
-        st = vt_feeler_map_rebuild(&s->feelers, keys, vals, n, &run->feeler_pool);
-    }
-    free(keys);
-    free(vals);
-    return st;
+    return vt_feeler_map_rebuild(&s->feelers, run->mesh, run->feelers, &run->feeler_pool);
+}
+
+/* The last frame goes: the mesh will be reset, so its copy for
+ * rl_vt_get_mesh and the vertices' reasons are dropped too. */
+static void forget_frame(vt_state *s)
+{
+    s->have_frame = false;
+    s->have_copy = false;
+    free(s->vinfo);
+    free(s->finfo);
+    free(s->reason);
+    s->vinfo = NULL;
+    s->finfo = NULL;
+    s->reason = NULL;
+    s->num_vinfo = s->num_finfo = 0;
+    s->num_reason = 0;
+}
+
+/* Keeps what rl_vt_get_mesh needs of the frame besides the mesh: the
+ * reasons the run recorded (taken over, not copied). */
+static void keep_mesh(vt_state *s, vt_run *run)
+{
+    free(s->reason);
+    s->reason = run->reason;
+    s->num_reason = run->reason ? run->per_vertex_cap : 0;
+    run->reason = NULL;
+    run->per_vertex_cap = 0;
 }
 
 /* Copies the refined mesh out for rl_vt_get_mesh. */
-static rl_status keep_mesh(vt_state *s, const vt_run *run)
+static rl_status copy_mesh(vt_state *s)
 {
-    const vt_mesh *m = run->mesh;
+    const vt_mesh *m = &s->mesh;
     size_t faces = 0;
     for (uint32_t f = 0; f < m->num_faces; ++f)
         faces += m->faces[f].leaf;
     rl_vt_vertex_info *vi = rl_realloc_array(s->vinfo, m->num_verts ? m->num_verts : 1, sizeof *vi);
     if (!vi)
-        return RL_ERR_OUT_OF_MEMORY;
+        return rl_error(RL_ERR_OUT_OF_MEMORY, "rl_vt_get_mesh: %u vertices", m->num_verts);
     s->vinfo = vi;
     uint32_t *fi = rl_realloc_array(s->finfo, faces ? 3 * faces : 1, sizeof *fi);
     if (!fi)
-        return RL_ERR_OUT_OF_MEMORY;
+        return rl_error(RL_ERR_OUT_OF_MEMORY, "rl_vt_get_mesh: %zu faces", faces);
     s->finfo = fi;
     for (uint32_t v = 0; v < m->num_verts; ++v) {
         const vt_vertex *x = &m->verts[v];
         vi[v] = (rl_vt_vertex_info){ x->sx, x->sy, x->stage, x->state == VT_SAMPLED,
-                                     v < run->per_vertex_cap ? run->reason[v] : 0 };
+                                     v < s->num_reason ? s->reason[v] : 0 };
     }
     size_t k = 0;
     for (uint32_t f = 0; f < m->num_faces; ++f) {
@@ -457,6 +472,7 @@ static rl_status keep_mesh(vt_state *s, const vt_run *run)
     }
     s->num_vinfo = m->num_verts;
     s->num_finfo = faces;
+    s->have_copy = true;
     return RL_OK;
 }
 
@@ -598,6 +614,7 @@ static rl_status run_frame(vt_run *run, vt_state *s, const vt_settings *set, rl_
     run->stats.time_visibility_ms = rl_time_s() * 1000.0 - t0 - run->stats.time_draw_ms;
     if (st == RL_OK)
         st = vt_refine(run);
+    run->stats.mesh_bytes = vt_mesh_bytes(run->mesh);
     if (st == RL_OK) {
         double td = rl_time_s() * 1000.0;
         if (!vt_update(run, run->stats.stages, true) && run->failed)
@@ -607,7 +624,7 @@ static rl_status run_frame(vt_run *run, vt_state *s, const vt_settings *set, rl_
     if (st == RL_OK && set->coherence)
         st = keep_feelers(s, run);
     if (st == RL_OK)
-        st = keep_mesh(s, run);
+        keep_mesh(s, run);
     vt_run_free_blocks(run);
     free(run->reason);
     free(run->feelers);
@@ -628,7 +645,7 @@ static rl_status vt_render(rl_renderer *r, void *state, const rl_scene *scene, c
     rl_camera cam = rl_camera_resolve(cam_in);
     vt_settings set;
     read_settings(r, &set);
-    s->have_frame = false;
+    forget_frame(s);
     s->prepared = false;      /* depth_ids is this frame's now */
 
     rl_tracer *tracer = NULL;
@@ -696,6 +713,9 @@ rl_status rl_vt_get_mesh(const rl_renderer *r, const rl_vt_vertex_info **vertice
         return rl_error(RL_ERR_INVALID_ARG, "rl_vt_get_mesh: needs a \"vt\" renderer and outputs");
     if (!s->have_frame)
         return rl_error(RL_ERR_INVALID_ARG, "rl_vt_get_mesh: no frame rendered yet");
+    rl_status st = s->have_copy ? RL_OK : copy_mesh(s);
+    if (st != RL_OK)
+        return st;
     *vertices = s->vinfo;
     *num_vertices = s->num_vinfo;
     *faces = s->finfo;
@@ -742,7 +762,7 @@ static rl_status dist_begin(rl_renderer *r, vt_state *s, const rl_scene *scene, 
         return rl_error(RL_ERR_INVALID_ARG, "vt: a distributed frame needs an image with colour");
     *cam = rl_camera_resolve(cam_in);
     read_settings(r, set);
-    s->have_frame = false;
+    forget_frame(s);
     if (rl_renderer_opt_enum(r, "reconstruct") != RECONSTRUCT_SOFTWARE)
         return rl_error(RL_ERR_UNSUPPORTED, "vt: distributed frames draw with reconstruct=software only");
     double prep_ms = 0.0;
@@ -897,9 +917,10 @@ rl_status rl_vt_refine_faces(rl_renderer *r, const rl_scene *scene, const rl_cam
         run.seed = s->package;
         vt_project_primary(&run, s->depth_ids);
         st = vt_refine(&run);
+        run.stats.mesh_bytes = vt_mesh_bytes(m);
     }
     if (st == RL_OK)
-        st = vt_part_write(m, s->package, part, part_size);
+        st = vt_part_write(m, run.data, s->package, part, part_size);
     if (st == RL_OK) {
         for (int t = 0; t < set.threads && t < RL_VT_MAX_THREADS; ++t) {
             run.stats.thread_rays[t] = run.tally[t].rays;
@@ -966,8 +987,9 @@ rl_status rl_vt_draw_parts(rl_renderer *r, const rl_scene *scene, const rl_camer
     if (st == RL_OK)
         vt_draw_overlay(&run);
     if (st == RL_OK)
-        st = keep_mesh(s, &run);
+        keep_mesh(s, &run);
     if (st == RL_OK) {
+        run.stats.mesh_bytes = vt_mesh_bytes(&s->mesh);
         s->stats = run.stats;
         s->have_frame = true;
         if (stats) {

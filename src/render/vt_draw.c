@@ -115,12 +115,12 @@ static rl_vec4 c4(rl_vec3 c)
 
 /* The texture of the term `layer` on the face when all three vertices see
  * the same one ("defined face", Fig. 3.20), else RL_NONE. */
-static uint32_t defined_texture(const rl_scene_data *d, const vt_vertex_sample *v[3], int layer)
+static uint32_t defined_texture(const rl_scene_data *d, const rl_trace_layer v[3][RL_TRACE_LAYER_COUNT], int layer)
 {
-    uint32_t t = v[0]->layers[layer].texture;
+    uint32_t t = v[0][layer].texture;
     if (!texture_at(d, t))
         return RL_NONE;
-    return v[1]->layers[layer].texture == t && v[2]->layers[layer].texture == t ? t : RL_NONE;
+    return v[1][layer].texture == t && v[2][layer].texture == t ? t : RL_NONE;
 }
 
 static uint32_t face_texture(const rl_scene_data *d, const vt_face *f)
@@ -133,15 +133,15 @@ static uint32_t face_texture(const rl_scene_data *d, const vt_face *f)
 static void fill_face(const vt_run *run, vt_corners *b, size_t i, const vt_face *f, bool offset)
 {
     const rl_scene_data *d = run->data;
-    const vt_vertex_sample *v[3];
+    rl_trace_layer v[3][RL_TRACE_LAYER_COUNT];
     for (int k = 0; k < 3; ++k)
-        v[k] = &run->mesh->samples[f->v[k]];
+        vt_mesh_sample_layers(run->mesh, f->v[k], v[k]);
     float shift = offset ? run->set->overdraw_f * (float)f->stage : 0.0f;
     uint32_t tex0 = face_texture(d, f);
     uint32_t tex_refl = defined_texture(d, v, RL_TRACE_LAYER_REFLECTION);
     uint32_t tex_refr = defined_texture(d, v, RL_TRACE_LAYER_REFRACTION);
     b->tri_ids[i] = f->triangle;
-    b->obj_ids[i] = f->object;
+    b->obj_ids[i] = d->triangle_object[f->triangle];
     int mode = run->set->textures;
     b->tex[0][i] = mode == VT_TEX_SAMPLED ? RL_NONE : tex0;
     b->tex[1][i] = RL_NONE;
@@ -149,16 +149,15 @@ static void fill_face(const vt_run *run, vt_corners *b, size_t i, const vt_face 
     b->tex[3][i] = mode == VT_TEX_SAMPLED ? RL_NONE : tex_refr;
     for (int k = 0; k < 3; ++k) {
         size_t c = 3 * i + (size_t)k;
-        const vt_vertex_sample *x = v[k];
         const vt_vertex *xv = &run->mesh->verts[f->v[k]];
         /* eq. 3.16 */
         b->pos[c] = shift > 0.0f ? rl_sub(xv->p, rl_scale(rl_sub(xv->p, run->view.eye), shift)) : xv->p;
         b->idx[c] = (uint32_t)c;
-        const rl_trace_layer *L = x->layers;
+        const rl_trace_layer *L = v[k];
         for (int l = 0; l < NUM_LAYERS; ++l)
             b->uv[l][c] = rl_v2(0.0f, 0.0f);
         if (mode == VT_TEX_SAMPLED) {
-            b->col[0][c] = c4(x->flat);     /* the textured radiance in this mode */
+            b->col[0][c] = c4(run->mesh->samples[f->v[k]].flat);   /* the textured radiance in this mode */
             continue;
         }
         b->uv[0][c] = xv->uv;
@@ -202,9 +201,9 @@ static bool taken(const vt_run *run, const vt_face *face, bool only_new)
 /* Faces per draw of a single-pass batch. The corners of a face take 364
  * bytes (three corners of four layers), and a 1024x1024 frame at min_edge
  * 1 draws 700,000 faces: a quarter of a GB for one batch, where chunks
- * need 24 MB. The rasterizer keeps submission order across draws as
+ * need 6 MB. The rasterizer keeps submission order across draws as
  * within one, so the image is the same. */
-#define DRAW_CHUNK 65536u
+#define DRAW_CHUNK 16384u
 
 /* One pass of a batch: into the rasterizer, or the GL drawer's frame. */
 static rl_status draw_pass(vt_run *run, rl_raster *ras, const rl_raster_batch *batch)

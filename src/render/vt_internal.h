@@ -41,8 +41,9 @@ enum vt_vertex_state {
 /* A vertex as the refinement sees it. The fields it reads for every edge
  * and face it touches come first, and the sample (vt_vertex_sample) lives
  * in an array of its own: the refinement walks the mesh in no particular
- * order, and a 72-byte vertex keeps three times as many of them in the
- * cache as one with its 140-byte sample inside. */
+ * order, and a 64-byte vertex keeps more of them in the cache than one
+ * with its sample inside. Its object is its triangle's
+ * (rl_scene_data.triangle_object), not stored. */
 typedef struct vt_vertex {
     /* screen, filled by vt_project_vertex */
     float sx, sy;             /* pixel coordinates (x right, y down, pixel
@@ -53,7 +54,6 @@ typedef struct vt_vertex {
     uint8_t visible;          /* z-buffer test passed (Sec. 3.4.2) */
     uint16_t stage;           /* refinement stage that created it (0 = primary) */
     uint32_t triangle;        /* scene triangle the vertex lies on */
-    uint32_t object;          /* scene object */
     uint64_t key;             /* identity across frames: see vt_vertex_key */
     rl_vec3 p;                /* world position (eq. 3.7: edge midpoint) */
     rl_vec3 n;                /* unit shading normal (eq. 3.8) */
@@ -61,7 +61,12 @@ typedef struct vt_vertex {
 } vt_vertex;
 
 /* The sample of a vertex, valid once its state is VT_SAMPLED: what the
- * criteria compare (flat, tree_hash) and what the reconstruction draws. */
+ * criteria compare (display, h/s/v, tree_hash) and what the reconstruction
+ * draws. A refined mesh holds hundreds of thousands of them, so only what
+ * is read later is kept: of the primary layer its diffuse and rest terms
+ * (its texture and uv are the face's and the vertex's, Sec. 3.5.3), and
+ * the deferred layers (reflection, refraction) only where they are not
+ * empty, in the mesh's layer pool (vt_mesh_set_sample). */
 typedef struct vt_vertex_sample {
     rl_vec3 flat;             /* radiance with deferred textures white; with
                                * textures=sampled the textured radiance */
@@ -70,7 +75,9 @@ typedef struct vt_vertex_sample {
      * instead of once per edge test on the refining thread */
     rl_vec3 display;
     float h, s, v;
-    rl_trace_layer layers[RL_TRACE_LAYER_COUNT];
+    rl_vec3 diffuse, rest;    /* of the primary layer */
+    uint32_t deferred[2];     /* reflection, refraction: index into
+                               * vt_mesh.layers, VT_NONE when empty */
     uint64_t tree_hash;       /* rl_ray_tree_hash of its ray tree */
 } vt_vertex_sample;
 
@@ -82,8 +89,8 @@ typedef struct vt_edge {
                                * (v[1] -> v[0] when consistently wound);
                                * sub-edges keep the direction and slots */
     uint32_t mid;             /* midpoint vertex once split, else VT_NONE */
-    uint32_t child[2];        /* sub-edges (v[0],mid) and (mid,v[1]) once split */
-    float length;             /* projected length in pixels (vt_edge_length) */
+    uint32_t child;           /* sub-edge (v[0],mid) once split, else VT_NONE;
+                               * (mid,v[1]) is child + 1 */
     uint8_t queued;           /* currently in the edge list */
     uint8_t forced;           /* split by forced refinement */
 } vt_edge;
@@ -91,8 +98,8 @@ typedef struct vt_edge {
 typedef struct vt_face {
     uint32_t v[3];            /* counter-clockwise, as the source triangle */
     uint32_t e[3];            /* e[i] joins v[(i+1)%3] and v[(i+2)%3] (opposite v[i]) */
-    uint32_t triangle;        /* source scene triangle */
-    uint32_t object;
+    uint32_t triangle;        /* source scene triangle (its object is
+                               * rl_scene_data.triangle_object's) */
     uint32_t parent;          /* VT_NONE for a primary face */
     uint16_t stage;           /* stage that created it (overdraw offset k, Sec. 3.5.1) */
     uint8_t leaf;             /* not split (drawn) */
@@ -106,6 +113,7 @@ typedef struct vt_mesh {
     vt_vertex_sample *samples;  uint32_t cap_samples;   /* per vertex, like verts */
     vt_edge *edges;    uint32_t num_edges, cap_edges;
     vt_face *faces;    uint32_t num_faces, cap_faces;
+    rl_trace_layer *layers;  uint32_t num_layers, cap_layers;   /* the samples' deferred layers */
     uint32_t num_primary_verts, num_primary_edges, num_primary_faces;
 } vt_mesh;
 
@@ -125,9 +133,23 @@ void vt_mesh_free(vt_mesh *m);
  * unsampled): the start of a new camera frame. Keeps the allocations. */
 void vt_mesh_reset(vt_mesh *m);
 
+/* Bytes the mesh's elements take (counts times sizes, without the arrays'
+ * spare room). */
+uint64_t vt_mesh_bytes(const vt_mesh *m);
+
 /* Room for this many more vertices (and samples), edges and faces; on
  * failure the mesh is unchanged. RL_ERR_OUT_OF_MEMORY or RL_ERR_LIMIT. */
 rl_status vt_mesh_reserve(vt_mesh *m, uint32_t verts, uint32_t edges, uint32_t faces);
+
+/* Stores the sample of vertex v: s with its deferred indices set from
+ * layers (all RL_TRACE_LAYER_COUNT of them, as rl_tracer_shade_point gives
+ * them); a deferred layer that is empty (zero, no texture) takes no room.
+ * RL_ERR_OUT_OF_MEMORY or RL_ERR_LIMIT (the sample is then unchanged). */
+rl_status vt_mesh_set_sample(vt_mesh *m, uint32_t v, const vt_vertex_sample *s,
+                             const rl_trace_layer layers[RL_TRACE_LAYER_COUNT]);
+/* The layers of vertex v's sample as vt_mesh_set_sample got them, but for
+ * the primary layer's texture (RL_NONE) and uv (0), which are not kept. */
+void vt_mesh_sample_layers(const vt_mesh *m, uint32_t v, rl_trace_layer out[RL_TRACE_LAYER_COUNT]);
 
 uint64_t vt_vertex_key_primary(uint32_t object, uint32_t index);
 /* Symmetric in a and b: the midpoint of an edge has the same key whichever
@@ -136,12 +158,12 @@ uint64_t vt_vertex_key_mid(uint64_t a, uint64_t b);
 
 /* Splits edge e at its midpoint (Sec. 3.3, Fig. 3.5): new vertex v' =
  * (v_i + v_j)/2 (eq. 3.7), n' = normalize(n_i + n_j) (eq. 3.8; n_i if the
- * sum vanishes), uv averaged, triangle/object from the edge's first
+ * sum vanishes), uv averaged, triangle from the edge's first
  * adjacent face, key vt_vertex_key_mid, stage as given, state UNSAMPLED.
  * Each adjacent leaf face (a, b, c) with the edge (a, b) opposite c becomes
  * two leaf children (a, v', c) and (v', b, c), joined by a new edge (v', c);
  * the parent stops being a leaf; the children inherit its visible flag and
- * get the given stage. Edge e gets mid and child[] set. The faces' old edges
+ * get the given stage. Edge e gets mid and child set. The faces' old edges
  * get their face references moved to the children. Returns the new vertex
  * index, or VT_NONE when out of memory (the mesh is unchanged then) or when
  * e is already split (returns its mid then, no change).

@@ -96,6 +96,57 @@ rl_status vt_mesh_reserve(vt_mesh *m, uint32_t verts, uint32_t edges, uint32_t f
     return reserve(m, verts, edges, faces);
 }
 
+uint64_t vt_mesh_bytes(const vt_mesh *m)
+{
+    return (uint64_t)m->num_verts * (sizeof *m->verts + sizeof *m->samples) +
+           (uint64_t)m->num_edges * sizeof *m->edges + (uint64_t)m->num_faces * sizeof *m->faces +
+           (uint64_t)m->num_layers * sizeof *m->layers;
+}
+
+/* ------------------------------------------------------------- samples -- */
+
+/* What rl_tracer_shade_point leaves in a layer it has nothing for. */
+static const rl_trace_layer no_layer = { { 0.0f, 0.0f, 0.0f }, { 0.0f, 0.0f, 0.0f }, RL_NONE, { 0.0f, 0.0f } };
+
+static bool layer_empty(const rl_trace_layer *L)
+{
+    /* Bitwise: a -0 term is kept as it came, so an unpacked layer is
+     * always the packed one. */
+    return memcmp(L, &no_layer, sizeof no_layer) == 0;
+}
+
+rl_status vt_mesh_set_sample(vt_mesh *m, uint32_t v, const vt_vertex_sample *s,
+                             const rl_trace_layer layers[RL_TRACE_LAYER_COUNT])
+{
+    const rl_trace_layer *deferred[2] = { &layers[RL_TRACE_LAYER_REFLECTION], &layers[RL_TRACE_LAYER_REFRACTION] };
+    uint32_t need = !layer_empty(deferred[0]) + !layer_empty(deferred[1]);
+    if (need > VT_MESH_MAX_ELEMENTS - m->num_layers)
+        return rl_error(RL_ERR_LIMIT, "vt mesh: more than 2^31 deferred layers");
+    rl_status st = grow((void **)&m->layers, &m->cap_layers, m->num_layers + need, sizeof *m->layers, "layers");
+    if (st != RL_OK)
+        return st;
+    vt_vertex_sample *out = &m->samples[v];
+    *out = *s;
+    out->diffuse = layers[RL_TRACE_LAYER_PRIMARY].diffuse;
+    out->rest = layers[RL_TRACE_LAYER_PRIMARY].rest;
+    for (int k = 0; k < 2; ++k) {
+        out->deferred[k] = VT_NONE;
+        if (!layer_empty(deferred[k])) {
+            out->deferred[k] = m->num_layers;
+            m->layers[m->num_layers++] = *deferred[k];
+        }
+    }
+    return RL_OK;
+}
+
+void vt_mesh_sample_layers(const vt_mesh *m, uint32_t v, rl_trace_layer out[RL_TRACE_LAYER_COUNT])
+{
+    const vt_vertex_sample *s = &m->samples[v];
+    out[RL_TRACE_LAYER_PRIMARY] = (rl_trace_layer){ s->diffuse, s->rest, RL_NONE, { 0.0f, 0.0f } };
+    out[RL_TRACE_LAYER_REFLECTION] = s->deferred[0] != VT_NONE ? m->layers[s->deferred[0]] : no_layer;
+    out[RL_TRACE_LAYER_REFRACTION] = s->deferred[1] != VT_NONE ? m->layers[s->deferred[1]] : no_layer;
+}
+
 /* ------------------------------------------------------------- building -- */
 
 static uint64_t hash_bits(const void *data, size_t size)
@@ -173,7 +224,6 @@ static uint32_t weld_vertex(vt_mesh *m, const rl_scene_data *d, build_scratch *s
     v->n = a.n;
     v->uv = a.uv;
     v->triangle = triangle;
-    v->object = object;
     v->key = vt_vertex_key_primary(object, (*next_index)++);
     v->state = VT_UNSAMPLED;
     return vi;
@@ -189,7 +239,7 @@ static uint32_t new_edge(vt_mesh *m, uint32_t a, uint32_t b, uint32_t face)
     e->face[0] = face;
     e->face[1] = VT_NONE;
     e->mid = VT_NONE;
-    e->child[0] = e->child[1] = VT_NONE;
+    e->child = VT_NONE;
     return ei;
 }
 
@@ -260,7 +310,6 @@ static rl_status build_object(vt_mesh *m, const rl_scene_data *d, uint32_t o, bu
         memset(f, 0, sizeof *f);
         memcpy(f->v, fv, sizeof fv);
         f->triangle = t;
-        f->object = o;
         f->parent = VT_NONE;
         f->leaf = 1;
         f->height = -1.0f;
@@ -319,6 +368,7 @@ void vt_mesh_free(vt_mesh *m)
     free(m->samples);
     free(m->edges);
     free(m->faces);
+    free(m->layers);
     memset(m, 0, sizeof *m);
 }
 
@@ -333,7 +383,7 @@ void vt_mesh_reset(vt_mesh *m)
             while (e->face[s] != VT_NONE && e->face[s] >= m->num_primary_faces)
                 e->face[s] = m->faces[e->face[s]].parent;
         e->mid = VT_NONE;
-        e->child[0] = e->child[1] = VT_NONE;
+        e->child = VT_NONE;
         e->queued = 0;
         e->forced = 0;
     }
@@ -349,6 +399,7 @@ void vt_mesh_reset(vt_mesh *m)
     m->num_verts = m->num_primary_verts;
     m->num_edges = m->num_primary_edges;
     m->num_faces = m->num_primary_faces;
+    m->num_layers = 0;
 }
 
 /* ------------------------------------------------------------ splitting -- */
@@ -371,7 +422,6 @@ static uint32_t add_face(vt_mesh *m, const vt_face *parent, uint32_t parent_inde
     f->v[0] = a; f->v[1] = b; f->v[2] = c;
     f->e[0] = ea; f->e[1] = eb; f->e[2] = ec;
     f->triangle = parent->triangle;
-    f->object = parent->object;
     f->parent = parent_index;
     f->stage = stage;
     f->leaf = 1;
@@ -408,7 +458,6 @@ uint32_t vt_mesh_split(vt_mesh *m, uint32_t e, uint16_t stage, uint32_t new_edge
     v->n = rl_length2(n) > 0.0f ? rl_normalize(n) : va->n;
     v->uv = rl_v2(0.5f * (va->uv.x + vb->uv.x), 0.5f * (va->uv.y + vb->uv.y));
     v->triangle = first_face != VT_NONE ? m->faces[first_face].triangle : va->triangle;
-    v->object = first_face != VT_NONE ? m->faces[first_face].object : va->object;
     v->key = vt_vertex_key_mid(va->key, vb->key);
     v->stage = stage;
     v->state = VT_UNSAMPLED;
@@ -418,8 +467,7 @@ uint32_t vt_mesh_split(vt_mesh *m, uint32_t e, uint16_t stage, uint32_t new_edge
     sub[0] = new_edge(m, old.v[0], mid, VT_NONE);
     sub[1] = new_edge(m, mid, old.v[1], VT_NONE);
     m->edges[e].mid = mid;
-    m->edges[e].child[0] = sub[0];
-    m->edges[e].child[1] = sub[1];
+    m->edges[e].child = sub[0];           /* sub[1] is sub[0] + 1 */
     new_edges[(*num_new_edges)++] = sub[0];
     new_edges[(*num_new_edges)++] = sub[1];
 

@@ -73,7 +73,7 @@ static const unsigned char *get_vec2(const unsigned char *p, rl_vec2 *v)
     return p;
 }
 
-rl_status vt_part_write(const vt_mesh *m, const uint8_t *mine, void **out, size_t *size)
+rl_status vt_part_write(const vt_mesh *m, const rl_scene_data *d, const uint8_t *mine, void **out, size_t *size)
 {
     *out = NULL;
     *size = 0;
@@ -117,16 +117,17 @@ rl_status vt_part_write(const vt_mesh *m, const uint8_t *mine, void **out, size_
         if (remap[v] == VT_NONE)
             continue;
         const vt_vertex *x = &m->verts[v];
-        const vt_vertex_sample *s = &m->samples[v];
+        rl_trace_layer layers[RL_TRACE_LAYER_COUNT];
+        vt_mesh_sample_layers(m, v, layers);
         unsigned char *p = vp + (size_t)remap[v] * VERTEX_BYTES;
         p = put_vec3(p, x->p);
         p = put_vec2(p, x->uv);
-        p = put_vec3(p, s->flat);
+        p = put_vec3(p, m->samples[v].flat);
         for (int l = 0; l < RL_TRACE_LAYER_COUNT; ++l) {
-            p = put_vec3(p, s->layers[l].diffuse);
-            p = put_vec3(p, s->layers[l].rest);
-            p = put(p, &s->layers[l].texture, 4);
-            p = put_vec2(p, s->layers[l].uv);
+            p = put_vec3(p, layers[l].diffuse);
+            p = put_vec3(p, layers[l].rest);
+            p = put(p, &layers[l].texture, 4);
+            p = put_vec2(p, layers[l].uv);
         }
     }
     for (uint32_t f = 0; f < m->num_faces; ++f) {
@@ -139,7 +140,7 @@ rl_status vt_part_write(const vt_mesh *m, const uint8_t *mine, void **out, size_
         uint16_t stage[2] = { face->stage, 0 };
         fp = put(fp, idx, sizeof idx);
         fp = put(fp, &face->triangle, 4);
-        fp = put(fp, &face->object, 4);
+        fp = put(fp, &d->triangle_object[face->triangle], 4);
         fp = put(fp, stage, sizeof stage);
     }
     uint32_t head[4] = { PART_VERSION, nv, nf, 0 };
@@ -204,18 +205,23 @@ rl_status vt_part_import(vt_mesh *m, const rl_scene_data *d, const void *part, s
     const uint32_t first = m->num_verts;
     for (uint32_t v = 0; v < nv; ++v) {
         vt_vertex *x = &m->verts[first + v];
-        vt_vertex_sample *s = &m->samples[first + v];
+        vt_vertex_sample s;
+        rl_trace_layer layers[RL_TRACE_LAYER_COUNT];
         memset(x, 0, sizeof *x);
-        memset(s, 0, sizeof *s);
+        memset(&s, 0, sizeof s);
         p = get_vec3(p, &x->p);
         p = get_vec2(p, &x->uv);
-        p = get_vec3(p, &s->flat);
+        p = get_vec3(p, &s.flat);
         for (int l = 0; l < RL_TRACE_LAYER_COUNT; ++l) {
-            p = get_vec3(p, &s->layers[l].diffuse);
-            p = get_vec3(p, &s->layers[l].rest);
-            p = get(p, &s->layers[l].texture, 4);
-            p = get_vec2(p, &s->layers[l].uv);
+            p = get_vec3(p, &layers[l].diffuse);
+            p = get_vec3(p, &layers[l].rest);
+            p = get(p, &layers[l].texture, 4);
+            p = get_vec2(p, &layers[l].uv);
         }
+        /* Before any face names it: a failure leaves the mesh as it was
+         * but for unused room in the layer pool. */
+        if ((st = vt_mesh_set_sample(m, first + v, &s, layers)) != RL_OK)
+            return st;
         x->state = VT_SAMPLED;
         x->visible = 1;
     }
@@ -229,9 +235,14 @@ rl_status vt_part_import(vt_mesh *m, const rl_scene_data *d, const void *part, s
         p = get(p, &tri, 4);
         p = get(p, &obj, 4);
         p = get(p, stage, sizeof stage);
-        if (tri >= d->num_triangles || obj >= d->num_objects)
-            return rl_error(RL_ERR_PARSE, "vt part: face %u names triangle %u and object %u; the scene has %u and "
-                            "%u (a part of another scene?)", f, tri, obj, d->num_triangles, d->num_objects);
+        /* The object is the triangle's; a part that says otherwise is
+         * not of this scene. */
+        if (tri >= d->num_triangles)
+            return rl_error(RL_ERR_PARSE, "vt part: face %u names triangle %u; the scene has %u (a part of another "
+                            "scene?)", f, tri, d->num_triangles);
+        if (obj != d->triangle_object[tri])
+            return rl_error(RL_ERR_PARSE, "vt part: face %u puts triangle %u in object %u; the scene has it in %u "
+                            "(a part of another scene?)", f, tri, obj, d->triangle_object[tri]);
         vt_face *face = &m->faces[first_face + f];
         memset(face, 0, sizeof *face);
         for (int k = 0; k < 3; ++k) {
@@ -239,7 +250,6 @@ rl_status vt_part_import(vt_mesh *m, const rl_scene_data *d, const void *part, s
             face->e[k] = VT_NONE;
         }
         face->triangle = tri;
-        face->object = obj;
         face->parent = VT_NONE;
         face->stage = stage[0];
         face->leaf = 1;

@@ -10,7 +10,7 @@
 
 /* The drawable leaf faces of m whose primary ancestor f has mine[f] != 0,
  * with their vertices, into a malloc'd buffer (*out, *size bytes). */
-rl_status vt_part_write(const vt_mesh *m, const uint8_t *mine, void **out, size_t *size);
+rl_status vt_part_write(const vt_mesh *m, const rl_scene_data *d, const uint8_t *mine, void **out, size_t *size);
 /* Checks a part without a scene: header, sizes, checksum, vertex indices.
  * RL_ERR_PARSE with the reason. */
 rl_status vt_part_check(const void *part, size_t size, uint32_t *num_verts, uint32_t *num_faces);

@@ -160,8 +160,8 @@ static void consider_edge(refine_ctx *ctx, uint32_t e, bool primary)
     vt_mesh *m = run->mesh;
     vt_edge *ed = &m->edges[e];
     const vt_vertex *a = &m->verts[ed->v[0]], *b = &m->verts[ed->v[1]];
-    ed->length = vt_edge_length(&run->view, a, b);
-    if (!(ed->length > set->min_edge) || ed->mid != VT_NONE || ed->queued ||
+    const float length = vt_edge_length(&run->view, a, b);
+    if (!(length > set->min_edge) || ed->mid != VT_NONE || ed->queued ||
         (!primary && !edge_in_package(run, ed)))
         return;
     if (!primary && set->z_test && !a->visible && !b->visible) {
@@ -173,7 +173,6 @@ static void consider_edge(refine_ctx *ctx, uint32_t e, bool primary)
         return;
     }
     uint32_t v0 = ed->v[0], v1 = ed->v[1];
-    float length = ed->length;
     vt_sample_queue(run, v0);
     vt_sample_queue(run, v1);
     if (vt_heap_push(run->heap, e, length) != RL_OK) {
@@ -254,8 +253,7 @@ static void run_forced(refine_ctx *ctx, uint16_t stage)
         if (ed->mid != VT_NONE || !edge_in_package(run, ed))
             continue;
         const vt_vertex *a = &m->verts[ed->v[0]], *b = &m->verts[ed->v[1]];
-        ed->length = vt_edge_length(&run->view, a, b);
-        if (!(ed->length > set->min_edge))
+        if (!(vt_edge_length(&run->view, a, b) > set->min_edge))
             continue;
         /* Hidden bases are not worth rays: the same tests as the edge list. */
         if ((set->z_test && !a->visible && !b->visible) ||
@@ -422,8 +420,9 @@ static uint32_t *merge_begin(vt_run *run, bool *fail)
 }
 
 /* After the stage-0 flush: every merged vertex takes its root's sample.
- * The primary term's texture coordinates stay the vertex's own, so that
- * deferred textures (Sec. 3.5.3) are still looked up where it lies. */
+ * The primary term's texture coordinates stay the vertex's own (the draw
+ * takes them from the vertex, not the sample), so that deferred textures
+ * (Sec. 3.5.3) are still looked up where it lies. */
 static void merge_finish(vt_run *run, uint32_t *parent)
 {
     vt_mesh *m = run->mesh;
@@ -432,7 +431,6 @@ static void merge_finish(vt_run *run, uint32_t *parent)
         if (r == v || m->verts[v].state != VT_QUEUED || m->verts[r].state != VT_SAMPLED)
             continue;
         m->samples[v] = m->samples[r];
-        m->samples[v].layers[RL_TRACE_LAYER_PRIMARY].uv = m->verts[v].uv;
         m->verts[v].state = VT_SAMPLED;
         run->stats.vertices_merged++;
     }

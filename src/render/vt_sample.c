@@ -77,13 +77,21 @@ const vt_feelers_packed *vt_feeler_map_find(const vt_feeler_map *m, uint64_t key
     }
 }
 
-rl_status vt_feeler_map_rebuild(vt_feeler_map *m, const uint64_t *keys, const vt_feelers_packed *values,
-                                size_t count, vt_feeler_pool *pool)
+rl_status vt_feeler_map_rebuild(vt_feeler_map *m, const vt_mesh *mesh, const vt_feelers_packed *values,
+                                vt_feeler_pool *pool)
 {
+    size_t count = 0;
+    for (uint32_t v = 0; v < mesh->num_verts; ++v)
+        count += mesh->verts[v].state == VT_SAMPLED;
+    /* Load factor <= 3/4: linear probing stays short, and the map, which
+     * outlives the frame's mesh, takes 16 bytes a slot. */
     size_t cap = 64;
-    while (cap < 2 * count)                 /* load factor <= 1/2 */
+    while (cap < count + count / 3 + 1)
         cap *= 2;
     if (cap != m->cap) {
+        /* The old map goes first: nothing reads it any more, and the two
+         * together would be the frame's peak. */
+        vt_feeler_map_free(m);
         uint64_t *k = rl_calloc(cap, sizeof *k);
         vt_feelers_packed *v = rl_realloc_array(NULL, cap, sizeof *v);
         if (!k || !v) {
@@ -91,7 +99,6 @@ rl_status vt_feeler_map_rebuild(vt_feeler_map *m, const uint64_t *keys, const vt
             free(v);
             return RL_ERR_OUT_OF_MEMORY;
         }
-        vt_feeler_map_free(m);
         m->keys = k;
         m->values = v;
         m->cap = cap;
@@ -102,8 +109,10 @@ rl_status vt_feeler_map_rebuild(vt_feeler_map *m, const uint64_t *keys, const vt
     m->pool = *pool;
     memset(pool, 0, sizeof *pool);
     m->count = 0;
-    for (size_t n = 0; n < count; ++n) {
-        uint64_t key = vt_key_nonzero(keys[n]);
+    for (uint32_t n = 0; n < mesh->num_verts; ++n) {
+        if (mesh->verts[n].state != VT_SAMPLED)
+            continue;
+        uint64_t key = vt_key_nonzero(mesh->verts[n].key);
         size_t i = slot_of(key, cap);
         while (m->keys[i] != 0 && m->keys[i] != key)
             i = (i + 1) & (cap - 1);
@@ -180,7 +189,7 @@ static void sample_block(vt_run *run, vt_block *b)
         vt_vertex_sample *out = &b->out[i];
         /* Without deferred textures the criteria see them too. */
         out->flat = run->set->textures == VT_TEX_SAMPLED ? s.color : s.flat;
-        memcpy(out->layers, s.layers, sizeof out->layers);
+        memcpy(b->layers[i], s.layers, sizeof b->layers[i]);
         out->tree_hash = run->want_tree ? rl_ray_tree_hash(&tree) : 0;
         vt_criteria_prepare(out);
         for (int k = 0; k < RL_RAY_TYPE_COUNT; ++k) {
@@ -215,8 +224,40 @@ static void spawn(vt_run *run, vt_block *b)
 {
     b->next = run->pending;
     run->pending = b;
+    run->num_pending++;
 #pragma omp task firstprivate(b) shared(run)
     sample_block(run, b);
+}
+
+/* Waits for the pending blocks and copies their results into the mesh. */
+static void collect(vt_run *run)
+{
+#pragma omp taskwait
+    run->num_pending = 0;
+    vt_mesh *m = run->mesh;
+    while (run->pending) {
+        vt_block *b = run->pending;
+        run->pending = b->next;
+        for (uint32_t i = 0; i < b->count; ++i) {
+            if (vt_mesh_set_sample(m, b->vertex[i], &b->out[i], b->layers[i]) != RL_OK)
+                run->failed = true;
+            m->verts[b->vertex[i]].state = VT_SAMPLED;
+            for (int k = 0; k < RL_RAY_TYPE_COUNT; ++k)
+                run->rays[k] += b->rays[i][k];
+            run->stats.vertices_sampled++;
+            if (run->set->coherence && !b->failed && b->vertex[i] < run->per_vertex_cap) {
+                /* Into the frame's pool: the block's is reused by its next
+                 * stage. */
+                rl_trace_feelers f;
+                vt_feelers_unpack(&b->feelers[i], b->feeler_pool.occluder, &f);
+                if (!vt_feelers_pack(&f, &run->feeler_pool, &run->feelers[b->vertex[i]]))
+                    run->failed = true;
+            }
+        }
+        run->failed |= b->failed;
+        b->next = run->free_blocks;
+        run->free_blocks = b;
+    }
 }
 
 void vt_sample_queue(vt_run *run, uint32_t v)
@@ -238,6 +279,11 @@ void vt_sample_queue(vt_run *run, uint32_t v)
     if (b->count == VT_BLOCK) {
         run->filling = NULL;
         spawn(run, b);
+        /* Enough to keep the other threads busy while the primary thread
+         * refines on; more would only hold results back. */
+        uint32_t most = 16u * (uint32_t)run->set->threads;
+        if (run->num_pending >= (most > 256 ? most : 256))
+            collect(run);
     }
 }
 
@@ -253,30 +299,7 @@ void vt_sample_flush(vt_run *run)
             run->free_blocks = b;
         }
     }
-#pragma omp taskwait
-    vt_mesh *m = run->mesh;
-    while (run->pending) {
-        vt_block *b = run->pending;
-        run->pending = b->next;
-        for (uint32_t i = 0; i < b->count; ++i) {
-            m->samples[b->vertex[i]] = b->out[i];
-            m->verts[b->vertex[i]].state = VT_SAMPLED;
-            for (int k = 0; k < RL_RAY_TYPE_COUNT; ++k)
-                run->rays[k] += b->rays[i][k];
-            run->stats.vertices_sampled++;
-            if (run->set->coherence && !b->failed && b->vertex[i] < run->per_vertex_cap) {
-                /* Into the frame's pool: the block's is reused by its next
-                 * stage. */
-                rl_trace_feelers f;
-                vt_feelers_unpack(&b->feelers[i], b->feeler_pool.occluder, &f);
-                if (!vt_feelers_pack(&f, &run->feeler_pool, &run->feelers[b->vertex[i]]))
-                    run->failed = true;
-            }
-        }
-        run->failed |= b->failed;
-        b->next = run->free_blocks;
-        run->free_blocks = b;
-    }
+    collect(run);
 }
 
 void vt_run_free_blocks(vt_run *run)

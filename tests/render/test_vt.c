@@ -436,6 +436,51 @@ static void converges_to_whitted(void **state)
     rl_scene_release(s);
 }
 
+/* Memory (issue 36): what the refined mesh takes per generated vertex, by
+ * the library's own count (rl_vt_stats.mesh_bytes), on a frame that makes
+ * every kind of sample: reflective (one deferred layer), glass (two) and
+ * diffuse (none). Here a generated vertex costs 445 bytes: itself (64),
+ * its sample (80) and 0.9 deferred layers (36 each), and the 4 edges (28)
+ * and 4 faces (40) its split adds; with the sample of 152 bytes, the
+ * 72-byte vertex, 36-byte edges and 44-byte faces the same mesh took 540. */
+static void mesh_bytes_per_generated_vertex(void **state)
+{
+    (void)state;
+    rl_scene *s = NULL;
+    assert_int_equal(rl_scene_create(&s), RL_OK);
+    uint32_t grey = add_material(s, "grey", rl_v3(0.7f, 0.7f, 0.7f), 0.0f, 0.0f);
+    uint32_t mirror = add_material(s, "mirror", rl_v3(0.1f, 0.1f, 0.1f), 0.8f, 0.0f);
+    uint32_t glass = add_material(s, "glass", rl_v3(0.05f, 0.05f, 0.05f), 0.1f, 0.85f);
+    add_grid(s, "floor", 8, 3.0f, grey, true);
+    const char *ball = "radius=0.5,segments=16,rings=8";
+    add_object(s, "mirror", "sphere", ball, mirror, rl_mat4_translate(rl_v3(-0.7f, 0.5f, 0.0f)), true);
+    add_object(s, "glass", "sphere", ball, glass, rl_mat4_translate(rl_v3(0.7f, 0.5f, 0.3f)), true);
+    rl_light l = { .type = RL_LIGHT_POINT, .color = rl_v3(1, 1, 1), .intensity = 20.0f,
+                   .position = rl_v3(1.0f, 4.0f, 2.0f) };
+    assert_int_equal(rl_scene_add_light(s, &l), RL_OK);
+    assert_int_equal(rl_scene_commit(s), RL_OK);
+    rl_camera cam = look(rl_v3(0.0f, 2.0f, 4.5f), rl_v3(0.0f, 0.3f, 0.0f), 64);
+    /* The primary mesh alone (no edge is long enough to split), then the
+     * full frame at the defaults. */
+    const char *preview[] = { "min_edge", "100000", NULL };
+    rl_renderer *r = make_vt(preview);
+    rl_vt_stats pre = render_stats(r, s, &cam, NULL);
+    rl_renderer_release(r);
+    r = make_vt(NULL);
+    rl_vt_stats full = render_stats(r, s, &cam, NULL);
+    rl_renderer_release(r);
+    assert_int_equal(pre.vertices_generated, 0);
+    assert_true(pre.mesh_bytes > 0);
+    assert_true(full.vertices_generated > 500);
+    double per_vertex = (double)(full.mesh_bytes - pre.mesh_bytes) / (double)full.vertices_generated;
+    print_message("mesh: %llu bytes primary, %.1f bytes per generated vertex (%llu generated)\n",
+                  (unsigned long long)pre.mesh_bytes, per_vertex, (unsigned long long)full.vertices_generated);
+    /* at least a vertex, its sample, two edges and two faces */
+    assert_true(per_vertex >= 64.0 + 80.0 + 2 * 28.0 + 2 * 40.0);
+    assert_true(per_vertex <= 470.0);
+    rl_scene_release(s);
+}
+
 /* Sec. 6.2.1, sample reduction: the ends of a primary edge shorter than
  * merge_px share one sample. At the preview (no refinement) every merged
  * vertex is one fewer traced; merged or not, the converged image stays
@@ -1023,6 +1068,7 @@ int main(void)
         cmocka_unit_test(hidden_vertices_cast_no_rays),
         cmocka_unit_test(converges_to_whitted),
         cmocka_unit_test(sample_reduction_merges_short_primary_edges),
+        cmocka_unit_test(mesh_bytes_per_generated_vertex),
         cmocka_unit_test(deterministic_and_coherent),
         cmocka_unit_test(kept_buffers_follow_size_threads_and_layers),
         cmocka_unit_test(progressive_updates),

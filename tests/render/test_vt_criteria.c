@@ -125,12 +125,13 @@ static void test_rgb_fires_on_l1_of_display_values(void **state)
     vt_criteria_prepare(&w2);
     c.eps_rgb = 0.0f;
     assert_int_equal(vt_criteria_test(&c, &w1, &w2), 0);
-    /* only the flat (untextured) radiance counts, Sec. 3.5.3: textures
-     * the layers would look up change nothing */
+    /* only the flat (untextured) radiance counts, Sec. 3.5.3: the terms
+     * the reconstruction modulates with textures change nothing */
     vt_vertex_sample t1 = sample_display(0.2f, 0.2f, 0.2f), t2 = t1;
-    t1.layers[RL_TRACE_LAYER_PRIMARY].texture = 0;
-    t2.layers[RL_TRACE_LAYER_PRIMARY].texture = 1;
-    t2.layers[RL_TRACE_LAYER_PRIMARY].uv = rl_v2(0.5f, 0.25f);
+    t1.diffuse = rl_v3(0.1f, 0.1f, 0.1f);
+    t2.diffuse = rl_v3(0.9f, 0.0f, 0.4f);
+    t1.deferred[0] = VT_NONE;
+    t2.deferred[0] = 3;
     assert_int_equal(vt_criteria_test(&c, &t1, &t2), 0);
 }
 

@@ -201,7 +201,6 @@ static void check_mesh(const vt_mesh *m, bool closed)
             /* same orientation as the parent */
             assert_true(rl_dot(face_cross(m, f), face_cross(m, fc->parent)) > 0.0f);
             assert_int_equal(fc->triangle, m->faces[fc->parent].triangle);
-            assert_int_equal(fc->object, m->faces[fc->parent].object);
         }
         if (!fc->leaf)
             continue;
@@ -235,7 +234,7 @@ static void check_mesh(const vt_mesh *m, bool closed)
         assert_true(e->v[0] != e->v[1]);
         if (e->mid != VT_NONE) {
             split_edges++;
-            const vt_edge *c0 = &m->edges[e->child[0]], *c1 = &m->edges[e->child[1]];
+            const vt_edge *c0 = &m->edges[e->child], *c1 = &m->edges[e->child + 1];
             assert_int_equal(c0->v[0], e->v[0]);
             assert_int_equal(c0->v[1], e->mid);
             assert_int_equal(c1->v[0], e->mid);
@@ -250,7 +249,7 @@ static void check_mesh(const vt_mesh *m, bool closed)
                     assert_false(m->faces[e->face[s]].leaf);
             continue;
         }
-        assert_int_equal(e->child[0], VT_NONE);
+        assert_int_equal(e->child, VT_NONE);
         live_edges++;
         assert_true(e->face[0] != VT_NONE);
         if (closed)
@@ -312,8 +311,8 @@ static void random_splits(vt_mesh *m, int count, uint64_t seed, bool closed, int
         assert_int_equal(num_e, 2 + (uint32_t)sides);
         assert_int_equal(num_f, 2 * (uint32_t)sides);
         assert_int_equal(m->num_faces, faces + 2 * (uint32_t)sides);
-        assert_int_equal(ne[0], m->edges[e].child[0]);
-        assert_int_equal(ne[1], m->edges[e].child[1]);
+        assert_int_equal(ne[0], m->edges[e].child);
+        assert_int_equal(ne[1], m->edges[e].child + 1);
         for (uint32_t k = 0; k < num_f; ++k) {
             assert_true(m->faces[nf[k]].leaf);
             assert_int_equal(m->faces[nf[k]].stage, 1 + i % 7);
@@ -445,9 +444,8 @@ static void test_objects_are_masked_and_never_welded_together(void **state)
     assert_int_equal(vt_mesh_build(&m, toy_data(&t), some), RL_OK);
     assert_int_equal(m.num_verts, 3);
     assert_int_equal(m.num_faces, 1);
-    assert_int_equal(m.faces[0].object, 2);
     assert_int_equal(m.faces[0].triangle, 2);
-    assert_int_equal(m.verts[0].object, 2);
+    assert_int_equal(m.verts[0].triangle, 2);
     assert_true(m.verts[1].key == vt_vertex_key_primary(2, 1));
 
     uint8_t none[3] = { 0, 0, 0 };
@@ -714,8 +712,7 @@ static void test_reset_restores_the_primary_mesh(void **state)
             assert_int_equal(a->face[0], b->face[0]);
             assert_int_equal(a->face[1], b->face[1]);
             assert_int_equal(a->mid, VT_NONE);
-            assert_int_equal(a->child[0], VT_NONE);
-            assert_int_equal(a->child[1], VT_NONE);
+            assert_int_equal(a->child, VT_NONE);
             assert_int_equal(a->queued, 0);
             assert_int_equal(a->forced, 0);
         }
@@ -740,6 +737,60 @@ static int cmp_u64(const void *a, const void *b)
 {
     uint64_t x = *(const uint64_t *)a, y = *(const uint64_t *)b;
     return (x > y) - (x < y);
+}
+
+/* The kept sample (vt_mesh_set_sample): empty deferred layers take no room
+ * in the pool, the others come back bit for bit, and a reset empties the
+ * pool. */
+static void test_samples_keep_only_deferred_layers_that_are_not_empty(void **state)
+{
+    (void)state;
+    toy t;
+    toy_grid(&t, 2);
+    uint8_t mask[1] = { 1 };
+    vt_mesh m = { 0 };
+    assert_int_equal(vt_mesh_build(&m, toy_data(&t), mask), RL_OK);
+    const rl_trace_layer none = { { 0, 0, 0 }, { 0, 0, 0 }, RL_NONE, { 0, 0 } };
+    rl_trace_layer in[4][RL_TRACE_LAYER_COUNT];
+    for (int v = 0; v < 4; ++v)
+        for (int l = 0; l < RL_TRACE_LAYER_COUNT; ++l)
+            in[v][l] = none;
+    /* 0: primary only; 1: a reflection; 2: both, one of them -0 only (not
+     * empty bitwise); 3: a refraction with a texture and nothing else */
+    in[0][RL_TRACE_LAYER_PRIMARY] = (rl_trace_layer){ { 0.5f, 0.25f, 1 }, { 0.125f, 0, 0 }, 7, { 0.3f, 0.6f } };
+    in[1][RL_TRACE_LAYER_REFLECTION] = (rl_trace_layer){ { 0.1f, 0.2f, 0.3f }, { 1, 2, 3 }, RL_NONE, { 0, 0 } };
+    in[2][RL_TRACE_LAYER_REFLECTION] = (rl_trace_layer){ { -0.0f, 0, 0 }, { 0, 0, 0 }, RL_NONE, { 0, 0 } };
+    in[2][RL_TRACE_LAYER_REFRACTION] = (rl_trace_layer){ { 4, 5, 6 }, { 7, 8, 9 }, 2, { 0.75f, 0.5f } };
+    in[3][RL_TRACE_LAYER_REFRACTION] = (rl_trace_layer){ { 0, 0, 0 }, { 0, 0, 0 }, 1, { 0, 0 } };
+    for (uint32_t v = 0; v < 4; ++v) {
+        vt_vertex_sample s;
+        memset(&s, 0, sizeof s);
+        s.flat = rl_v3((float)v, 1, 2);
+        s.tree_hash = 1000 + v;
+        assert_int_equal(vt_mesh_set_sample(&m, v, &s, in[v]), RL_OK);
+    }
+    assert_int_equal(m.num_layers, 4);
+    assert_int_equal(m.samples[0].deferred[0], VT_NONE);
+    assert_int_equal(m.samples[0].deferred[1], VT_NONE);
+    assert_int_equal(m.samples[1].deferred[1], VT_NONE);
+    assert_true(m.samples[2].deferred[0] != VT_NONE && m.samples[2].deferred[1] != VT_NONE);
+    for (uint32_t v = 0; v < 4; ++v) {
+        rl_trace_layer out[RL_TRACE_LAYER_COUNT];
+        vt_mesh_sample_layers(&m, v, out);
+        /* the primary layer's texture and uv are the face's and the
+         * vertex's, not kept */
+        rl_trace_layer want = in[v][RL_TRACE_LAYER_PRIMARY];
+        want.texture = RL_NONE;
+        want.uv = rl_v2(0, 0);
+        assert_memory_equal(&out[RL_TRACE_LAYER_PRIMARY], &want, sizeof want);
+        assert_memory_equal(&out[RL_TRACE_LAYER_REFLECTION], &in[v][RL_TRACE_LAYER_REFLECTION], sizeof want);
+        assert_memory_equal(&out[RL_TRACE_LAYER_REFRACTION], &in[v][RL_TRACE_LAYER_REFRACTION], sizeof want);
+        assert_true(m.samples[v].flat.x == (float)v && m.samples[v].tree_hash == 1000 + v);
+    }
+    vt_mesh_reset(&m);
+    assert_int_equal(m.num_layers, 0);
+    vt_mesh_free(&m);
+    toy_free(&t);
 }
 
 static void test_keys_are_distinct_and_mid_is_symmetric(void **state)
@@ -814,6 +865,7 @@ int main(void)
         cmocka_unit_test(test_random_splits_keep_cube_closed),
         cmocka_unit_test(test_random_splits_on_committed_sphere),
         cmocka_unit_test(test_reset_restores_the_primary_mesh),
+        cmocka_unit_test(test_samples_keep_only_deferred_layers_that_are_not_empty),
         cmocka_unit_test(test_keys_are_distinct_and_mid_is_symmetric),
         cmocka_unit_test(test_xi_and_height_of_a_face),
     };
