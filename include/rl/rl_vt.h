@@ -110,10 +110,11 @@ RL_API rl_status rl_vt_refine_faces(rl_renderer *r, const rl_scene *scene, const
  * the face's primary vertices are sampled, and b_f is the mean over its
  * edges of the ends' sample difference (1 for different ray trees, else
  * the mean colour channel difference) times the projected length over
- * the viewport's diagonal, plus the face's own share of the primary
- * samples (half a sample, in the same unit), so that no face is free.
- * Runs the pre-pass first unless kept, as rl_vt_refine_faces. cost[i]
- * receives faces[i]'s estimate; stats (may be NULL): rays and samples. */
+ * the viewport's diagonal, here weighted by the rays the ends' samples
+ * traced, plus the face's own share of the primary samples (half a
+ * sample), so that no face is free (docs/distributed.md). Runs the
+ * pre-pass first unless kept, as rl_vt_refine_faces. cost[i] receives
+ * faces[i]'s estimate; stats (may be NULL): its rays and samples. */
 RL_API rl_status rl_vt_estimate_costs(rl_renderer *r, const rl_scene *scene, const rl_camera *cam, rl_image *image,
                                       const uint32_t *faces, size_t count, double *cost, rl_render_stats *stats);
 /* Draws cam's frame into image: the rasterized half and the faces of

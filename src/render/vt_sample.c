@@ -261,8 +261,13 @@ void vt_sample_flush(vt_run *run)
         for (uint32_t i = 0; i < b->count; ++i) {
             m->samples[b->vertex[i]] = b->out[i];
             m->verts[b->vertex[i]].state = VT_SAMPLED;
+            uint64_t rays = 0;
+            for (int k = 0; k < RL_RAY_TYPE_COUNT; ++k)
+                rays += b->rays[i][k];
             for (int k = 0; k < RL_RAY_TYPE_COUNT; ++k)
                 run->rays[k] += b->rays[i][k];
+            if (run->vertex_rays)
+                run->vertex_rays[b->vertex[i]] = (uint32_t)(rays < UINT32_MAX ? rays : UINT32_MAX);
             run->stats.vertices_sampled++;
             if (run->set->coherence && !b->failed && b->vertex[i] < run->per_vertex_cap) {
                 /* Into the frame's pool: the block's is reused by its next
