@@ -13,11 +13,15 @@
  *   queue       equal packages of `package` faces on demand (Fig. 4.8):
  *               PREFETCH at every worker, the next to whichever answers,
  *               the master refining packages between messages;
- *   precompute  one package per rank sized by its speed v_i (faces per
- *               busy millisecond), n_i = N v_i / sum_j v_j (the thesis'
- *               equation). The speeds are the last frame's; a first frame
- *               measures them with a calibration package of N / (8 ranks)
- *               faces per rank and splits the rest once all are back.
+ *   precompute  one package per rank sized by its speed v_i (cost per
+ *               busy millisecond): the share v_i / sum_j v_j of the faces'
+ *               summed cost (the thesis' equation), a face costing 1
+ *               (cost=faces) or its estimate b_f (cost=estimate,
+ *               rl_vt_estimate_costs on the master first; the cut is
+ *               rl_dist_cut_by_cost). The speeds are the last frame's; a
+ *               first frame measures them with a calibration package of
+ *               N / (8 ranks) faces per rank and splits the rest once all
+ *               are back.
  * A lost worker's packages (silent past RL_DIST_TIMEOUT) go to whoever is
  * free, as the tiles' bands do.
  *
