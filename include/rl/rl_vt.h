@@ -109,6 +109,18 @@ RL_API rl_status rl_vt_prepare(rl_renderer *r, const rl_scene *scene, const rl_c
 RL_API rl_status rl_vt_refine_faces(rl_renderer *r, const rl_scene *scene, const rl_camera *cam, rl_image *image,
                                     const uint32_t *faces, size_t count, void **part, size_t *part_size,
                                     rl_render_stats *stats);
+/* The pre-compute balancer's cost estimate b_f of every primary face
+ * faces[0..count) of cam's frame (Ullmann 2003, Sec. 4.3.3, eq. 4.4-4.5):
+ * the face's primary vertices are sampled, and b_f is the mean over its
+ * edges of the ends' sample difference (1 for different ray trees, else
+ * the mean colour channel difference) times the projected length over
+ * the viewport's diagonal, here weighted by the rays the ends' samples
+ * traced, plus the face's own share of the primary samples (half a
+ * sample), so that no face is free (docs/distributed.md). Runs the
+ * pre-pass first unless kept, as rl_vt_refine_faces. cost[i] receives
+ * faces[i]'s estimate; stats (may be NULL): its rays and samples. */
+RL_API rl_status rl_vt_estimate_costs(rl_renderer *r, const rl_scene *scene, const rl_camera *cam, rl_image *image,
+                                      const uint32_t *faces, size_t count, double *cost, rl_render_stats *stats);
 /* Draws cam's frame into image: the rasterized half and the faces of
  * parts[0..count) (sizes[i] bytes each), in that order. A part that fails
  * rl_vt_part_check, or names triangles the scene lacks, is RL_ERR_PARSE

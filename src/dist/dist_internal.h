@@ -34,6 +34,7 @@ struct rl_dist {
     uint64_t vt_camera;                /* distributed VT frames so far: the camera ID */
     double *vt_speed;                  /* per rank: faces per busy ms of the last VT frame */
     bool vt_speed_valid;               /* ... for balance=precompute */
+    bool vt_speed_estimate;            /* ... per busy ms in b_f (cost=estimate), not in faces */
 };
 
 /* RL_ERR_IO "distributed run: WHAT: <MPI's text for code>". */

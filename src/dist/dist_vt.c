@@ -13,11 +13,15 @@
  *   queue       equal packages of `package` faces on demand (Fig. 4.8):
  *               PREFETCH at every worker, the next to whichever answers,
  *               the master refining packages between messages;
- *   precompute  one package per rank sized by its speed v_i (faces per
- *               busy millisecond), n_i = N v_i / sum_j v_j (the thesis'
- *               equation). The speeds are the last frame's; a first frame
- *               measures them with a calibration package of N / (8 ranks)
- *               faces per rank and splits the rest once all are back.
+ *   precompute  one package per rank sized by its speed v_i (cost per
+ *               busy millisecond): the share v_i / sum_j v_j of the faces'
+ *               summed cost (the thesis' equation), a face costing 1
+ *               (cost=faces) or its estimate b_f (cost=estimate,
+ *               rl_vt_estimate_costs on the master first; the cut is
+ *               rl_dist_cut_by_cost). The speeds are the last frame's; a
+ *               first frame measures them with a calibration package of
+ *               N / (8 ranks) faces per rank and splits the rest once all
+ *               are back.
  * A lost worker's packages (silent past RL_DIST_TIMEOUT) go to whoever is
  * free, as the tiles' bands do.
  *
@@ -45,6 +49,7 @@
 #include <string.h>
 
 #include "core/error.h"
+#include "dist/dist_balance.h"
 #include "dist/dist_internal.h"
 #include "render/renderer.h"
 #include "rl/rl_timer.h"
@@ -71,6 +76,7 @@ typedef struct vt_result {
 
 typedef struct package {
     uint32_t first, count;       /* into the visible faces */
+    double cost;                 /* the sum of its faces' costs (count with cost=faces) */
     int owner;                   /* precompute: the rank it was sized for; -1: anyone */
     int state;                   /* 0 free, 1 out, 2 done */
     int rank;                    /* out to / done by */
@@ -300,6 +306,8 @@ typedef struct vt_lead_ctx {
     rl_dist_stats *ds;
     rl_render_stats *stats;
     const uint32_t *faces;
+    const double *cost;          /* per visible face (cost=estimate), else NULL: a face is the unit */
+    double *cost_done;           /* per rank: the cost of its packages done this frame */
     package *pkg;
     size_t num_pkg, cap_pkg;
     vt_worker *ws;
@@ -313,14 +321,22 @@ static rl_status add_package(vt_lead_ctx *c, uint32_t first, uint32_t count, int
         return RL_OK;
     if (!rl_reserve((void **)&c->pkg, &c->cap_pkg, c->num_pkg + 1, sizeof *c->pkg, 16))
         return RL_ERR_OUT_OF_MEMORY;
-    c->pkg[c->num_pkg++] = (package){ .first = first, .count = count, .owner = owner, .rank = -1 };
+    double cost = count;
+    if (c->cost) {
+        cost = 0.0;
+        for (uint32_t i = first; i < first + count; ++i)
+            cost += c->cost[i];
+    }
+    c->pkg[c->num_pkg++] = (package){ .first = first, .count = count, .cost = cost, .owner = owner, .rank = -1 };
     ++c->remaining;
     return RL_OK;
 }
 
-/* Sec. 4.3.3: n_i = N v_i / sum v_j faces for rank i, from first on; the
- * rounding's rest goes to the fastest rank. Ranks lost or unmeasured
- * (v_i = 0) get none; none measured: equal shares. */
+/* Sec. 4.3.3: rank i's package from first on holds the share v_i / sum
+ * v_j of the faces' summed cost (b_Slave_i = c_Slave_i / c_total *
+ * b_total): of their number with cost=faces, of their estimates b_f with
+ * cost=estimate. Ranks lost or unmeasured (v_i = 0) get none; none
+ * measured: equal shares. */
 static rl_status split_by_speed(vt_lead_ctx *c, uint32_t first, uint32_t n, const double *speed)
 {
     const size_t size = (size_t)(c->d->size > 0 ? c->d->size : 1);
@@ -331,28 +347,16 @@ static rl_status split_by_speed(vt_lead_ctx *c, uint32_t first, uint32_t n, cons
         free(share);
         return RL_ERR_OUT_OF_MEMORY;
     }
-    double sum = 0.0;
-    size_t fastest = 0;
+    bool any = false;
     for (size_t i = 0; i < size; ++i) {
         bool live = i == 0 || !c->ws[i].lost;
         v[i] = live && speed[i] > 0.0 ? speed[i] : 0.0;
-        sum += v[i];
-        if (v[i] > v[fastest])
-            fastest = i;
+        any |= v[i] > 0.0;
     }
-    if (!(sum > 0.0))
-        for (size_t i = 0; i < size; ++i) {
+    if (!any)
+        for (size_t i = 0; i < size; ++i)
             v[i] = i == 0 || !c->ws[i].lost ? 1.0 : 0.0;
-            sum += v[i];
-        }
-    uint32_t given = 0;
-    for (size_t i = 0; i < size; ++i) {
-        share[i] = (uint32_t)((double)n * v[i] / sum);
-        if (share[i] > n - given)
-            share[i] = n - given;
-        given += share[i];
-    }
-    share[fastest] += n - given;
+    rl_dist_cut_by_cost(c->cost ? c->cost + first : NULL, n, v, size, share);
     rl_status st = RL_OK;
     uint32_t at = first;
     for (size_t i = 0; i < size && st == RL_OK; ++i) {
@@ -482,6 +486,7 @@ static rl_status take_answer(vt_lead_ctx *c, int w, unsigned char *buf, size_t s
     c->d->per_rank[w].tasks++;
     c->d->per_rank[w].pixels += res.faces;
     c->d->per_rank[w].busy_ms += res.busy_ms;
+    c->cost_done[w] += pk->cost;
     for (int k = 0; k < RL_RAY_TYPE_COUNT; ++k)
         c->stats->rays[k] += res.rays[k];
     c->stats->samples += res.samples;
@@ -639,8 +644,14 @@ static rl_status vt_lead(rl_dist *d, rl_renderer *r, const rl_scene *scene, cons
         memcpy(own_faces, faces, nfaces * sizeof *own_faces);
     vt_lead_ctx c = { .d = d, .ds = ds, .stats = stats, .faces = own_faces, .camera = camera };
     c.ws = calloc((size_t)d->size, sizeof *c.ws);
-    if (!c.ws || !own_faces) {
+    c.cost_done = calloc((size_t)d->size, sizeof *c.cost_done);
+    const bool precompute = strcmp(rl_renderer_get(r, "balance"), "precompute") == 0;
+    const bool estimate = precompute && strcmp(rl_renderer_get(r, "cost"), "estimate") == 0;
+    double *face_cost = estimate ? malloc((nfaces ? nfaces : 1) * sizeof *face_cost) : NULL;
+    if (!c.ws || !own_faces || !c.cost_done || (estimate && !face_cost)) {
         free(c.ws);
+        free(c.cost_done);
+        free(face_cost);
         free(own_faces);
         return RL_ERR_OUT_OF_MEMORY;         /* the CLI aborts the job */
     }
@@ -648,7 +659,20 @@ static rl_status vt_lead(rl_dist *d, rl_renderer *r, const rl_scene *scene, cons
     for (int w = 0; w < d->size; ++w)
         for (int k = 0; k < SLOTS; ++k)
             c.ws[w].out[k] = -1;
-    const bool precompute = strcmp(rl_renderer_get(r, "balance"), "precompute") == 0;
+    /* Sec. 4.3.3's sequential pre-compute step: the workers wait for
+     * their packages meanwhile (they run their own pre-pass first). */
+    double estimate_ms = 0.0;
+    if (st == RL_OK && estimate) {
+        rl_timer tm;
+        rl_timer_start(&tm);
+        if ((st = rl_vt_estimate_costs(r, scene, cam, image, own_faces, nfaces, face_cost, stats)) != RL_OK)
+            snprintf(failure, sizeof failure, "%s", rl_last_error());
+        c.cost = face_cost;
+        estimate_ms = rl_timer_ms(&tm);
+    }
+    /* Speeds of another unit (cost=faces, cost=estimate) say nothing. */
+    if (d->vt_speed_estimate != estimate)
+        d->vt_speed_valid = false;
     const uint32_t n = (uint32_t)nfaces, ranks = (uint32_t)d->size;
     size_t calibration = 0;
     uint32_t rest_first = 0, rest_count = 0;
@@ -716,8 +740,7 @@ static rl_status vt_lead(rl_dist *d, rl_renderer *r, const rl_scene *scene, cons
             double *speed = calloc(ranks, sizeof *speed);
             st = speed ? RL_OK : RL_ERR_OUT_OF_MEMORY;
             for (uint32_t i = 0; speed && i < ranks; ++i)
-                speed[i] = d->per_rank[i].busy_ms > 0.0 ? (double)d->per_rank[i].pixels / d->per_rank[i].busy_ms
-                                                         : 0.0;
+                speed[i] = d->per_rank[i].busy_ms > 0.0 ? c.cost_done[i] / d->per_rank[i].busy_ms : 0.0;
             if (st == RL_OK)
                 st = split_by_speed(&c, rest_first, rest_count, speed);
             free(speed);
@@ -765,6 +788,7 @@ static rl_status vt_lead(rl_dist *d, rl_renderer *r, const rl_scene *scene, cons
             --c.remaining;
             ++d->per_rank[0].tasks;
             d->per_rank[0].pixels += pk->count;
+            c.cost_done[0] += pk->cost;
             for (int k = 0; k < RL_RAY_TYPE_COUNT; ++k)
                 stats->rays[k] += ps.rays[k];
             stats->samples += ps.samples;
@@ -823,12 +847,13 @@ static rl_status vt_lead(rl_dist *d, rl_renderer *r, const rl_scene *scene, cons
     }
     ds->tasks = c.num_pkg;
     if (code == MPI_SUCCESS && st == RL_OK) {
-        /* The next frame's precompute speeds; a rank without a package
-         * this frame keeps its last speed. */
+        /* The next frame's precompute speeds, in the unit of cost; a rank
+         * without a package this frame keeps its last speed. */
         for (int i = 0; i < d->size; ++i)
             if (d->per_rank[i].busy_ms > 0.0 && d->per_rank[i].pixels > 0)
-                d->vt_speed[i] = (double)d->per_rank[i].pixels / d->per_rank[i].busy_ms;
+                d->vt_speed[i] = c.cost_done[i] / d->per_rank[i].busy_ms;
         d->vt_speed_valid = precompute;
+        d->vt_speed_estimate = estimate;
         const void **parts = calloc(c.num_pkg ? c.num_pkg : 1, sizeof *parts);
         size_t *sizes = calloc(c.num_pkg ? c.num_pkg : 1, sizeof *sizes);
         if (!parts || !sizes) {
@@ -843,7 +868,7 @@ static rl_status vt_lead(rl_dist *d, rl_renderer *r, const rl_scene *scene, cons
         rl_timer_start(&tm);
         if (st == RL_OK && (st = rl_vt_draw_parts(r, scene, cam, image, parts, sizes, c.num_pkg, stats)) != RL_OK)
             snprintf(failure, sizeof failure, "%s", rl_last_error());
-        d->per_rank[0].busy_ms += rl_timer_ms(&tm);
+        d->per_rank[0].busy_ms += rl_timer_ms(&tm) + estimate_ms;
         free(parts);
         free(sizes);
     }
@@ -860,6 +885,8 @@ static rl_status vt_lead(rl_dist *d, rl_renderer *r, const rl_scene *scene, cons
                 free(c.ws[w].rxbuf[k]);
             }
     free(c.ws);
+    free(c.cost_done);
+    free(face_cost);
     free(own_faces);
     if (code != MPI_SUCCESS)
         return rl_dist_mpi_failed(code, "collecting the packages");

@@ -61,6 +61,7 @@ static const char *const shading_choices[] = { "flat", "gouraud", "textured", NU
 static const char *const overlay_choices[] = { "none", "wire", "samples", NULL };
 static const char *const reconstruct_choices[] = { "software", "gl", NULL };
 static const char *const balance_choices[] = { "queue", "precompute", NULL };
+static const char *const cost_choices[] = { "faces", "estimate", NULL };
 enum { RECONSTRUCT_SOFTWARE, RECONSTRUCT_GL };
 
 static const rl_option_info vt_options[] = {
@@ -111,6 +112,9 @@ static const rl_option_info vt_options[] = {
     { "package", RL_OPT_INT, "0",
       "rl --dist, balance=queue: visible primary faces per package (0: 1/32 of an equal share per rank)",
       0, 1000000000, NULL },
+    { "cost", RL_OPT_ENUM, "faces",
+      "rl --dist, balance=precompute: what the packages share by speed: faces (visible primary faces) | estimate "
+      "(the thesis' per-face cost b_f from the primary vertices' samples, Sec. 4.3.3)", 0, 0, cost_choices },
     { "dist_halo", RL_OPT_BOOL, "true",
       "rl --dist: a package also flags the visible faces around it, so that forced refinement crosses package "
       "borders as in one process (Sec. 4.3.3)", 0, 0, NULL },
@@ -941,6 +945,106 @@ rl_status rl_vt_refine_faces(rl_renderer *r, const rl_scene *scene, const rl_cam
         *part_size = 0;
         return rl_error(RL_ERR_CANCELLED, "vt: cancelled by the progress callback");
     }
+    return st;
+}
+
+/* Eq. 4.4-4.5 for one primary edge: its ends' sample difference (1 for
+ * different ray trees, else the mean channel difference of the criteria's
+ * colours) times its projected length over the viewport's diagonal;
+ * weighted by the rays of its ends' samples (below). */
+static double edge_cost(const vt_run *run, const vt_mesh *m, const vt_edge *ed, double diagonal)
+{
+    const vt_vertex *a = &m->verts[ed->v[0]], *b = &m->verts[ed->v[1]];
+    if (a->state != VT_SAMPLED || b->state != VT_SAMPLED)
+        return 0.0;
+    const vt_vertex_sample *sa = &m->samples[ed->v[0]], *sb = &m->samples[ed->v[1]];
+    const unsigned bits = run->set->criteria.bits;
+    double delta;
+    if ((bits & VT_CRIT_TREE) && sa->tree_hash != sb->tree_hash) {
+        delta = 1.0;
+    } else if (bits & VT_CRIT_RGB || !(bits & VT_CRIT_HSV)) {
+        delta = (fabsf(sa->display.x - sb->display.x) + fabsf(sa->display.y - sb->display.y) +
+                 fabsf(sa->display.z - sb->display.z)) / 3.0;
+    } else {
+        float dh = fabsf(sa->h - sb->h);
+        dh = dh > 0.5f ? 1.0f - dh : dh;
+        delta = (2.0 * dh + fabsf(sa->s - sb->s) + fabsf(sa->v - sb->v)) / 3.0;  /* hue circle: 0.5 at most */
+    }
+    /* An end behind the eye has no projection: the edge counts as the
+     * longest possible. */
+    double l = a->cw > 0.0f && b->cw > 0.0f ? vt_edge_length(&run->view, a, b) : diagonal;
+    double rays = 0.5 * ((double)run->vertex_rays[ed->v[0]] + (double)run->vertex_rays[ed->v[1]]);
+    return delta * (l < diagonal ? l : diagonal) / diagonal * rays;
+}
+
+rl_status rl_vt_estimate_costs(rl_renderer *r, const rl_scene *scene, const rl_camera *cam, rl_image *image,
+                               const uint32_t *faces, size_t count, double *cost, rl_render_stats *stats)
+{
+    vt_state *s = vt_of(r, "rl_vt_estimate_costs");
+    if (!s || !scene || !cam || !image || (count && (!faces || !cost)))
+        return rl_error(RL_ERR_INVALID_ARG, "rl_vt_estimate_costs: needs a \"vt\" renderer, scene, camera, "
+                        "image, faces and costs");
+    vt_settings set;
+    rl_camera c;
+    rl_tracer *tracer;
+    vt_run run;
+    rl_status st = dist_begin(r, s, scene, cam, image, &set, &c, &tracer, &run);
+    if (st == RL_OK)
+        st = dist_prepass(r, s, scene, &c, &run);
+    vt_mesh *m = &s->mesh;
+    for (size_t i = 0; st == RL_OK && i < count; ++i)
+        if (faces[i] >= m->num_primary_faces)
+            st = rl_error(RL_ERR_INVALID_ARG, "rl_vt_estimate_costs: face %u of %u primary faces", faces[i],
+                          m->num_primary_faces);
+    uint32_t *vertex_rays = NULL;
+    if (st == RL_OK && !(vertex_rays = calloc(m->num_primary_verts ? m->num_primary_verts : 1, sizeof *vertex_rays)))
+        st = rl_error(RL_ERR_OUT_OF_MEMORY, "vt: the rays of %u primary vertices", m->num_primary_verts);
+    run.vertex_rays = vertex_rays;
+    if (st == RL_OK) {
+        vt_mesh_reset(m);
+        vt_project_primary(&run, s->depth_ids);
+        /* The primary vertices of the faces, sampled as a refinement's
+         * stage 0 would (Sec. 4.3.3: the estimate needs their samples). */
+#pragma omp parallel num_threads(set.threads)
+#pragma omp single
+        {
+            for (size_t i = 0; i < count && !run.failed; ++i)
+                for (int k = 0; k < 3; ++k)
+                    vt_sample_queue(&run, m->faces[faces[i]].v[k]);
+            vt_sample_flush(&run);
+        }
+        if (run.failed)
+            st = rl_error(RL_ERR_OUT_OF_MEMORY, "vt: out of memory while sampling %zu faces' vertices", count);
+    }
+    if (st == RL_OK) {
+        const double diagonal = hypot((double)image->width, (double)image->height);
+        /* b_f = 1/3 sum b_e, with two changes: b_e is weighted by the
+         * rays of its ends' samples, since the samples that refine an
+         * edge cost about what its ends did (a glass' samples trace tens
+         * of rays, a wall's a few: with the thesis' b_f the glass' package
+         * of three took 2.2 times its share on table); and the face
+         * pays its own share of the primary samples (a vertex serves
+         * about six faces: half a sample each, in the unit of eq. 4.4, a
+         * sample per min_edge pixels), so that a run of uniform faces is
+         * not free. */
+        const double own = 0.5 * (set.min_edge > 0.0f ? set.min_edge : 1.0) / diagonal;
+        for (size_t i = 0; i < count; ++i) {
+            const vt_face *f = &m->faces[faces[i]];
+            double b = 0.0, rays = 0.0;
+            for (int k = 0; k < 3; ++k) {
+                b += edge_cost(&run, m, &m->edges[f->e[k]], diagonal);
+                rays += vertex_rays[f->v[k]] / 3.0;
+            }
+            cost[i] = b / 3.0 + own * rays;
+        }
+        if (stats) {
+            for (int k = 0; k < RL_RAY_TYPE_COUNT; ++k)
+                stats->rays[k] += run.rays[k];
+            stats->samples += run.stats.vertices_sampled;
+        }
+    }
+    free(vertex_rays);
+    dist_end(&run, tracer);
     return st;
 }
 

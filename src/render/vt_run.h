@@ -173,6 +173,8 @@ typedef struct vt_run {
     vt_block *filling;        /* block the primary thread is filling */
     vt_block *free_blocks;
     uint64_t rays[RL_RAY_TYPE_COUNT];  /* summed by the primary thread */
+    uint32_t *vertex_rays;    /* or NULL: rays of each vertex's sample, per vertex
+                               * index below num_verts (the cost estimate) */
     vt_thread_tally tally[RL_VT_MAX_THREADS];
     bool failed;              /* out of memory inside the parallel region */
     /* progress and updates */

@@ -242,8 +242,13 @@ static void collect(vt_run *run)
             if (vt_mesh_set_sample(m, b->vertex[i], &b->out[i], b->layers[i]) != RL_OK)
                 run->failed = true;
             m->verts[b->vertex[i]].state = VT_SAMPLED;
+            uint64_t rays = 0;
+            for (int k = 0; k < RL_RAY_TYPE_COUNT; ++k)
+                rays += b->rays[i][k];
             for (int k = 0; k < RL_RAY_TYPE_COUNT; ++k)
                 run->rays[k] += b->rays[i][k];
+            if (run->vertex_rays)
+                run->vertex_rays[b->vertex[i]] = (uint32_t)(rays < UINT32_MAX ? rays : UINT32_MAX);
             run->stats.vertices_sampled++;
             if (run->set->coherence && !b->failed && b->vertex[i] < run->per_vertex_cap) {
                 /* Into the frame's pool: the block's is reused by its next

@@ -263,19 +263,26 @@ PY
 run_ok env RL_DIST_STALE=1:1 timeout 120 mpirun --oversubscribe -np 2 "$RL" --dist "${VT[@]}" --out "$TMP/vt2.png"
 cmp -s "$TMP/vt3.png" "$TMP/vt2.png" || fail "vt: 2 ranks with a stale result differ from 3 ranks"
 expect_in "$TMP/out" "^dist: 1 result of an older camera dropped"
-# A worker killed while the master pulls its part (Open MPI's "Read -1")
-# leaves a matched receive that cannot be cancelled; in recovery mode the
-# ranks end without MPI_Finalize, which waited for it (docs/distributed.md),
-# so the job ends, and well within the timeout.
+# A worker killed after its first package, while the master may pull its
+# part (Open MPI's "Read -1"). MPI_Finalize's runtime fence over all ranks,
+# the dead one included, did not always return (1 job in 3); in recovery
+# mode the ranks end without it (docs/distributed.md). The job must end
+# within seconds of the master writing the image: a hang at the end fails
+# here, whatever the time the frame took (timeout only stops it).
 "${RECOVER[@]}" RL_DIST_FAULT=2:1 timeout 45 mpirun --oversubscribe -np 3 "$RL" --dist "${VT[@]}" \
     --out "$TMP/vt-lost.png" >"$TMP/out" 2>"$TMP/err"
 rc=$?
+ended=$(date +%s)
 [ "$rc" -eq 0 ] || fail "vt: a lost worker: exit $rc: $(grep -v '^\[' "$TMP/err" | head -c 600)"
+[ $((ended - $(stat -c %Y "$TMP/vt-lost.png"))) -le 10 ] ||
+    fail "vt: a lost worker: the ranks ended $((ended - $(stat -c %Y "$TMP/vt-lost.png"))) s after the image"
 cmp -s "$TMP/vt3.png" "$TMP/vt-lost.png" || fail "vt: a lost worker changed the image"
 expect_in "$TMP/out" "^dist: [12] workers\? lost"
 # precompute: a calibration package per rank, then one per rank sized by
-# the measured speeds (a rank may get none of the rest).
-run_ok "${MPI[@]}" "$RL" --dist render table --algo vt --size 64x48 --set balance=precompute --out "$TMP/vtp.png"
+# the measured speeds (a rank may get none of the rest), here by the faces'
+# estimated cost b_f (cost=estimate; the cut itself: tests/dist).
+run_ok "${MPI[@]}" "$RL" --dist render table --algo vt --size 64x48 --set balance=precompute --set cost=estimate \
+    --out "$TMP/vtp.png"
 expect_in "$TMP/out" "^dist: 3 ranks, [3-6] packages, "
 python3 -c 'import sys; sys.exit(float(sys.argv[1]) <= 0.998)' "$(python3 "$(dirname "${BASH_SOURCE[0]}")/ssim.py" \
     "$TMP/vt1.png" "$TMP/vtp.png")" || fail "vt: precompute too far from one process"

@@ -932,6 +932,53 @@ static double vt_pixel_ssim(const rl_image *test, const rl_image *ref, const rl_
  * 8 equal packages of queue balancing, or 3 unequal ones of
  * precompute, the borders cost little: SSIM > 0.995 on the VT pixels (the
  * thesis' Sec. 4.3.3 trade-off; docs/distributed.md has the figures). */
+/* The pre-compute balancer's b_f (rl_vt_estimate_costs): every visible
+ * face costs something, the glass' faces (refraction samples of many
+ * rays, ray trees that differ) far more than the table's; bad faces are
+ * refused. */
+static void cost_estimate(void **state)
+{
+    (void)state;
+    rl_camera cam;
+    rl_scene *s = table_scene(&cam);
+    rl_renderer *r = make_vt(NULL);
+    rl_image *img = NULL;
+    assert_int_equal(rl_image_create(cam.width, cam.height, FX_ALL_LAYERS, &img), RL_OK);
+    const uint32_t *visible;
+    size_t n;
+    assert_int_equal(rl_vt_prepare(r, s, &cam, img, &visible, &n), RL_OK);
+    assert_true(n > 20);
+    uint32_t *faces = malloc(n * sizeof *faces);
+    double *cost = malloc(n * sizeof *cost);
+    assert_non_null(faces);
+    assert_non_null(cost);
+    memcpy(faces, visible, n * sizeof *faces);
+    rl_render_stats rs = { 0 };
+    assert_int_equal(rl_vt_estimate_costs(r, s, &cam, img, faces, n, cost, &rs), RL_OK);
+    double lo = cost[0], hi = cost[0];
+    for (size_t i = 0; i < n; ++i) {
+        assert_true(isfinite(cost[i]) && cost[i] > 0.0);
+        lo = cost[i] < lo ? cost[i] : lo;
+        hi = cost[i] > hi ? cost[i] : hi;
+    }
+    assert_true(hi > 10.0 * lo);
+    assert_true(rs.samples > 0 && rs.rays[RL_RAY_PRIMARY] > 0);
+    /* The same frame gives the same estimates (a sample depends only on
+     * its vertex). */
+    double *again = malloc(n * sizeof *again);
+    assert_non_null(again);
+    assert_int_equal(rl_vt_estimate_costs(r, s, &cam, img, faces, n, again, NULL), RL_OK);
+    assert_memory_equal(cost, again, n * sizeof *cost);
+    const uint32_t bad = UINT32_MAX;
+    assert_int_equal(rl_vt_estimate_costs(r, s, &cam, img, &bad, 1, again, NULL), RL_ERR_INVALID_ARG);
+    free(again);
+    free(cost);
+    free(faces);
+    rl_image_release(img);
+    rl_renderer_release(r);
+    rl_scene_release(s);
+}
+
 static void packages_match_one_process(void **state)
 {
     (void)state;
@@ -1077,6 +1124,7 @@ int main(void)
         cmocka_unit_test(nothing_in_view),
         cmocka_unit_test(bad_options),
         cmocka_unit_test(packages_match_one_process),
+        cmocka_unit_test(cost_estimate),
         cmocka_unit_test(part_round_trip_and_bad_parts),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
