@@ -250,8 +250,8 @@ static int compare_ranges(const void *a, const void *b)
 
 /* Whether no two batches of a group share a lazy colour stamp: then every
  * stamp is touched only by the chunk that holds its batch, a group being
- * cut between whole batches. Callers draw each object once a list, so
- * this holds but for a caller that lists an object twice. */
+ * cut between whole batches. It fails only for a list that names an
+ * object twice, whose stamps then take the locked path. */
 static bool lazy_disjoint(rl_raster *r, const rl_raster_batch *batches, uint32_t count)
 {
     size_t n = 0;
