@@ -10,7 +10,8 @@
 # null where pt had not converged to half an 8-bit code value per frame by
 # the end). Writes bench/results/view-<date>.json (or OUT) with every run's
 # statistics and a summary line per run on stdout; RL_MACHINE names the
-# machine in the record.
+# machine in the record; VIEW_RUNS, a regular expression, keeps only the
+# runs whose line below it matches (e.g. VIEW_RUNS='^city .* (raster|chcpp)$').
 # Run from anywhere: bash bench/view.sh [OUT.json] [RL]
 set -u
 cd "$(dirname "${BASH_SOURCE[0]}")/.." || exit 1
@@ -47,6 +48,7 @@ RUNS=(
 # after 5 minutes (bench/README.md).
 i=0
 for run in "${RUNS[@]}"; do
+    [[ -n "${VIEW_RUNS:-}" && ! "$run" =~ $VIEW_RUNS ]] && continue
     read -r scene size algo sets <<<"$run"
     i=$((i + 1))
     t0=$(date +%s.%N)

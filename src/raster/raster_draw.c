@@ -21,6 +21,7 @@
 #include <omp.h>
 #include <stdarg.h>
 #include <stdio.h>
+#include <stdlib.h>
 
 #include "core/error.h"
 #include "raster/raster_internal.h"
@@ -34,6 +35,14 @@
  * scratch), and batches of at least PARALLEL_TRIANGLES are drawn alone: their
  * own setup already runs on every thread. */
 #define GROUP_VERTICES (1u << 18)
+
+/* A group is set up in this many chunks per thread, taken in turn by
+ * whichever thread is free: the cost of a batch varies a lot (one lies
+ * beyond the viewport and is rejected at once, the next covers it with
+ * many pixels), so one equal share of the triangles per thread left one
+ * thread waiting for the other most of the time. The fill walks the
+ * chunks in order, so their number changes nothing in the image. */
+#define CHUNKS_PER_THREAD 4
 
 /* Writes a batch's problem to msg; every problem is an invalid argument. */
 static rl_status RL_PRINTF(3, 4) problem(char *msg, size_t size, const char *fmt, ...)
@@ -181,6 +190,8 @@ static void setup_chunk(rl_raster *r, const rl_raster_batch *b, uint32_t first, 
     uint32_t hi = (uint32_t)((uint64_t)slab * (uint64_t)(c + 1) / (uint64_t)num_chunks);
     ch->num_prims = 0;
     ch->triangles_drawn = 0;
+    /* Chunks of one batch share its vertices, and so their stamps. */
+    ch->lazy_alone = num_chunks == 1;
     ch->failed = !rl_raster_setup(r, b, r->clip, r->eye_depth, first + lo, hi - lo, ch) ||
                  !rl_raster_bin(&ch->bins, ch->prims, ch->num_prims, sizeof *ch->prims, num_bands);
 }
@@ -197,17 +208,18 @@ static rl_status run(rl_raster *r, const rl_raster_batch *b, bool query, uint64_
     rl_status st = transform(r, b->positions, b->num_vertices, threads);
     if (st != RL_OK)
         return st;
-    if ((st = rl_raster_reserve_chunks(r, threads)) != RL_OK)
+    const int max_chunks = threads > 1 ? threads * CHUNKS_PER_THREAD : 1;
+    if ((st = rl_raster_reserve_chunks(r, max_chunks)) != RL_OK)
         return st;
     uint64_t passed = 0, drawn = 0;
     for (uint32_t first = 0; first < b->num_triangles; first += RL_RASTER_SLAB) {
         uint32_t rest = b->num_triangles - first;
         uint32_t slab = rest < RL_RASTER_SLAB ? rest : RL_RASTER_SLAB;
-        int num_chunks = slab >= PARALLEL_TRIANGLES ? threads : 1;
+        int num_chunks = slab >= PARALLEL_TRIANGLES ? max_chunks : 1;
         if (num_chunks == 1) {
             setup_chunk(r, b, first, slab, 0, 1, num_bands);
         } else {
-            #pragma omp parallel for num_threads(num_chunks) schedule(static)
+            #pragma omp parallel for num_threads(threads) schedule(dynamic, 1)
             for (int c = 0; c < num_chunks; ++c)
                 setup_chunk(r, b, first, slab, c, num_chunks, num_bands);
         }
@@ -228,6 +240,38 @@ static rl_status run(rl_raster *r, const rl_raster_batch *b, bool query, uint64_
 static inline size_t group_vertices(const rl_raster_batch *b)
 {
     return b->num_triangles ? b->num_vertices : 0;
+}
+
+static int compare_ranges(const void *a, const void *b)
+{
+    const uintptr_t x = ((const uintptr_t *)a)[0], y = ((const uintptr_t *)b)[0];
+    return x < y ? -1 : x > y;
+}
+
+/* Whether no two batches of a group share a lazy colour stamp: then every
+ * stamp is touched only by the chunk that holds its batch, a group being
+ * cut between whole batches. It fails only for a list that names an
+ * object twice, whose stamps then take the locked path. */
+static bool lazy_disjoint(rl_raster *r, const rl_raster_batch *batches, uint32_t count)
+{
+    size_t n = 0;
+    for (uint32_t k = 0; k < count; ++k) {
+        const rl_raster_batch *b = &batches[k];
+        if (!b->lazy || !b->colors || b->num_triangles == 0)
+            continue;
+        if (!rl_reserve((void **)&r->lazy_ranges, &r->lazy_range_cap, 2 * (n + 1), sizeof *r->lazy_ranges, 64))
+            return false;
+        r->lazy_ranges[2 * n] = (uintptr_t)b->lazy->stamps;
+        r->lazy_ranges[2 * n + 1] = (uintptr_t)(b->lazy->stamps + b->num_vertices);
+        ++n;
+    }
+    if (n < 2)
+        return true;
+    qsort(r->lazy_ranges, n, 2 * sizeof *r->lazy_ranges, compare_ranges);
+    for (size_t i = 1; i < n; ++i)
+        if (r->lazy_ranges[2 * i] < r->lazy_ranges[2 * i - 1])
+            return false;
+    return true;
 }
 
 /* Transforms and sets up the batches of chunk c of a group (c->group_lo ..
@@ -266,7 +310,7 @@ static rl_status run_group(rl_raster *r, const rl_raster_batch *batches, uint32_
         return st;
     if (!rl_reserve((void **)&r->group_vertex, &r->group_cap, count, sizeof *r->group_vertex, 64))
         return rl_error(RL_ERR_OUT_OF_MEMORY, "rl_raster_draw_many: %u batches", count);
-    int num_chunks = triangles >= PARALLEL_TRIANGLES ? threads : 1;
+    int num_chunks = triangles >= PARALLEL_TRIANGLES && threads > 1 ? threads * CHUNKS_PER_THREAD : 1;
     if ((uint32_t)num_chunks > count)
         num_chunks = (int)count;
     if ((st = rl_raster_reserve_chunks(r, num_chunks)) != RL_OK)
@@ -289,10 +333,13 @@ static rl_status run_group(rl_raster *r, const rl_raster_batch *batches, uint32_
     r->chunks[c].group_hi = count;
     while (++c < num_chunks)
         r->chunks[c].group_lo = r->chunks[c].group_hi = count;
+    const bool alone = num_chunks == 1 || lazy_disjoint(r, batches, count);
+    for (int k = 0; k < num_chunks; ++k)
+        r->chunks[k].lazy_alone = alone;
     if (num_chunks == 1) {
         setup_group_chunk(r, batches, 0, num_bands);
     } else {
-        #pragma omp parallel for num_threads(num_chunks) schedule(static, 1)
+        #pragma omp parallel for num_threads(threads) schedule(dynamic, 1)
         for (int k = 0; k < num_chunks; ++k)
             setup_group_chunk(r, batches, k, num_bands);
     }

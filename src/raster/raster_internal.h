@@ -92,6 +92,10 @@ typedef struct rl_raster_chunk {
     uint64_t triangles_drawn;
     uint32_t group_lo, group_hi;  /* rl_raster_draw_many: this chunk's batches */
     bool failed;                  /* allocation failed inside a parallel region */
+    /* Set by the caller of rl_raster_setup: no other thread touches the
+     * lazy colour stamps of the batches this chunk sets up until the draw
+     * ends, so that they need no atomic read-modify-write. */
+    bool lazy_alone;
 } rl_raster_chunk;
 
 /* What a fill may touch: NULL pointers are layers not written (a query
@@ -121,6 +125,8 @@ struct rl_raster {
     size_t vert_cap, eye_depth_cap;
     size_t *group_vertex;         /* rl_raster_draw_many: each batch's first clip vertex */
     size_t group_cap;
+    uintptr_t *lazy_ranges;       /* rl_raster_draw_many: lazy stamp ranges, [start, end) pairs */
+    size_t lazy_range_cap;
     rl_raster_chunk *chunks;
     int chunk_cap;
     rl_raster_point *points;

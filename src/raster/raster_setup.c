@@ -156,14 +156,16 @@ typedef struct svert {
     rl_vec3 bw;                   /* source barycentrics / w */
 } svert;
 
-/* The snapped pixel position of clip-space p, and the exact one in fx, fy;
- * false where it cannot be projected (w <= 0, or beyond the guard band). */
+/* The snapped pixel position of clip-space p, the exact one in fx, fy and
+ * 1/w in *inv_w_out; false where it cannot be projected (w <= 0, or beyond
+ * the guard band). */
 static inline bool snap(rl_vec4 p, int width, int height, int32_t *x, int32_t *y, double *fx,
-                        double *fy)
+                        double *fy, double *inv_w_out)
 {
     if (!(p.w > 0.0f))
         return false;
     double inv_w = 1.0 / p.w;
+    *inv_w_out = inv_w;
     double x_pix = (p.x * inv_w + 1.0) * 0.5 * width;
     double y_pix = (1.0 - p.y * inv_w) * 0.5 * height;
     /* Cannot trigger after guard-band clipping except through rounding; it
@@ -179,17 +181,24 @@ static inline bool snap(rl_vec4 p, int width, int height, int32_t *x, int32_t *y
     return true;
 }
 
-static bool project(const cvert *v, int width, int height, bool layered, svert *s)
+/* The attributes over w of v, whose position s holds already (snap). */
+static inline void project_attributes(const cvert *v, double inv_w, bool layered, svert *s)
 {
-    if (!snap(v->p, width, height, &s->x, &s->y, &s->fx, &s->fy))
-        return false;
-    float iw = (float)(1.0 / v->p.w);
+    float iw = (float)inv_w;
     s->iw = iw;
     s->dw = v->d * iw;
     s->cw = rl_v4(v->c.x * iw, v->c.y * iw, v->c.z * iw, v->c.w * iw);
     s->uvw = rl_v2(v->uv.x * iw, v->uv.y * iw);
     if (layered)
         s->bw = rl_v3(v->b.x * iw, v->b.y * iw, v->b.z * iw);
+}
+
+static bool project(const cvert *v, int width, int height, bool layered, svert *s)
+{
+    double inv_w;
+    if (!snap(v->p, width, height, &s->x, &s->y, &s->fx, &s->fy, &inv_w))
+        return false;
+    project_attributes(v, inv_w, layered, s);
     return true;
 }
 
@@ -276,14 +285,16 @@ static bool vec4_finite(rl_vec4 v)
  * and skip all attribute work; the answer is setup_tri's by construction
  * (the same pure functions of the same positions), which keeps every image
  * bit-identical. */
-static bool may_cover(rl_vec4 a, rl_vec4 b, rl_vec4 c, bool cull_back, int width, int height)
+static bool may_cover(const cvert poly[3], bool cull_back, int width, int height, svert sv[3],
+                      double inv_w[3])
 {
     int32_t xs[3], ys[3];
-    double fx, fy;
-    if (!snap(a, width, height, &xs[0], &ys[0], &fx, &fy) ||
-        !snap(b, width, height, &xs[1], &ys[1], &fx, &fy) ||
-        !snap(c, width, height, &xs[2], &ys[2], &fx, &fy))
-        return false;
+    for (int k = 0; k < 3; ++k) {
+        if (!snap(poly[k].p, width, height, &sv[k].x, &sv[k].y, &sv[k].fx, &sv[k].fy, &inv_w[k]))
+            return false;
+        xs[k] = sv[k].x;
+        ys[k] = sv[k].y;
+    }
     int64_t area2 = twice_area(xs[0], ys[0], xs[1], ys[1], xs[2], ys[2]);
     if (area2 == 0 || (area2 > 0 && cull_back))
         return false;
@@ -295,10 +306,20 @@ static bool may_cover(rl_vec4 a, rl_vec4 b, rl_vec4 c, bool cull_back, int width
  * stamps[v] == 2 frame means shaded this frame, 2 frame - 1 that a thread
  * is shading it now; whoever moves it to "busy" shades, everyone else waits
  * for "done" (a rare, short wait: parallel chunks share few vertices). */
-static rl_vec4 lazy_color(const rl_raster_batch *b, uint32_t v)
+static rl_vec4 lazy_color(const rl_raster_batch *b, uint32_t v, bool alone)
 {
     const rl_raster_lazy_colors *lz = b->lazy;
     const uint32_t done = 2 * lz->frame, busy = done - 1;
+    if (alone) {
+        /* No other thread reads these stamps during this draw
+         * (rl_raster_chunk.lazy_alone): no locked instruction, which would
+         * stall on the stamp's cache miss with every access around it. */
+        if (__atomic_load_n(&lz->stamps[v], __ATOMIC_RELAXED) != done) {
+            lz->shade(lz->user, v);
+            __atomic_store_n(&lz->stamps[v], done, __ATOMIC_RELAXED);
+        }
+        return b->colors[v];
+    }
     uint32_t s = __atomic_load_n(&lz->stamps[v], __ATOMIC_ACQUIRE);
     if (s != done) {
         if (s != busy && __atomic_compare_exchange_n(&lz->stamps[v], &s, busy, false, __ATOMIC_ACQUIRE,
@@ -336,8 +357,12 @@ bool rl_raster_setup(const rl_raster *r, const rl_raster_batch *b, const rl_vec4
         /* Non-finite positions are skipped silently (rl_raster.h). */
         if (!finite || oc_and != 0)
             continue;
-        if (!(oc_or & CLIP_PLANES) &&
-            !may_cover(poly[0].p, poly[1].p, poly[2].p, cull_back, width, height))
+        /* An unclipped triangle keeps its corners: their snapped
+         * positions (and 1/w) serve the setup below as they are. */
+        svert sv[MAX_POLY];
+        double inv_w[3] = { 0.0, 0.0, 0.0 };
+        const bool clipped = (oc_or & CLIP_PLANES) != 0;
+        if (!clipped && !may_cover(poly, cull_back, width, height, sv, inv_w))
             continue;
 
         const rl_texture *tex = NULL;
@@ -354,22 +379,25 @@ bool rl_raster_setup(const rl_raster *r, const rl_raster_batch *b, const rl_vec4
             mask = b->textures[b->mask_texture[t]];
         for (int k = 0; k < 3; ++k) {
             poly[k].c = !b->colors ? rl_v4(0, 0, 0, 0)
-                        : lazy ? lazy_color(b, tri[k]) : b->colors[tri[k]];
+                        : lazy ? lazy_color(b, tri[k], chunk->lazy_alone) : b->colors[tri[k]];
             poly[k].uv = tex || mask ? b->uvs[tri[k]] : rl_v2(0, 0);
             poly[k].d = r->perspective ? 0.0f : eye_depth[tri[k]];
             poly[k].b = rl_v3(k == 0 ? 1.0f : 0.0f, k == 1 ? 1.0f : 0.0f, k == 2 ? 1.0f : 0.0f);
         }
         int n = 3;
-        if (oc_or & CLIP_PLANES)
+        if (clipped) {
             n = clip_polygon(poly, n, oc_or & CLIP_PLANES, gx, gy);
-        if (n < 3)
-            continue;
-        svert sv[MAX_POLY];
-        bool ok = true;
-        for (int k = 0; k < n && ok; ++k)
-            ok = project(&poly[k], width, height, layered, &sv[k]);
-        if (!ok)
-            continue;
+            if (n < 3)
+                continue;
+            bool ok = true;
+            for (int k = 0; k < n && ok; ++k)
+                ok = project(&poly[k], width, height, layered, &sv[k]);
+            if (!ok)
+                continue;
+        } else {
+            for (int k = 0; k < 3; ++k)
+                project_attributes(&poly[k], inv_w[k], layered, &sv[k]);
+        }
 
         rl_raster_prim proto;
         proto.gouraud = b->colors != NULL;

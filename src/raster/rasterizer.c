@@ -39,6 +39,7 @@ void rl_raster_release(rl_raster *r)
     free(r->clip);
     free(r->eye_depth);
     free(r->group_vertex);
+    free(r->lazy_ranges);
     free(r->points);
     free(r);
 }

@@ -39,7 +39,9 @@
  * its triangles), and in gouraud and textured shading a vertex is lit only
  * when the rasterizer keeps a triangle that uses it (rl_raster_lazy_colors);
  * both leave the image as it was and save most of the work of a frame in a
- * large scene. */
+ * large scene. A colour lit in an earlier frame is kept where it cannot
+ * have changed (phong_cached: no specular term, the same side towards the
+ * eye), so a moving camera relights few vertices of most scenes. */
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -85,15 +87,26 @@ static bool light_at(const rl_light *L, rl_vec3 p, rl_vec3 *E, rl_vec3 *l)
     return cos_light > 0.0f;
 }
 
-/* Local Phong colour at p with shading normal n (Ullmann 2003, eq. 3.1
- * without the recursive terms). */
-static rl_vec4 phong(const shade_ctx *ctx, const rl_material *m, rl_vec3 p, rl_vec3 n)
+/* The direction from p to the eye, and whether two-sided lighting turns
+ * n around to face it. */
+static inline bool phong_flips(const shade_ctx *ctx, rl_vec3 p, rl_vec3 n, rl_vec3 *v)
 {
-    rl_vec3 v = rl_normalize(rl_sub(ctx->eye, p));
-    if (rl_dot(n, v) < 0.0f)
-        n = rl_neg(n);                        /* two-sided lighting */
+    *v = rl_normalize(rl_sub(ctx->eye, p));
+    return rl_dot(n, *v) < 0.0f;
+}
+
+/* Whether phong() depends on the eye only through phong_flips(): without
+ * a specular term the eye's direction enters nowhere else. */
+static inline bool phong_view_free(const rl_material *m)
+{
+    return !(rl_vmax_comp(m->specular) > 0.0f);
+}
+
+/* phong() with n already facing the viewer and v from phong_flips(). */
+static rl_vec4 phong_lit(const shade_ctx *ctx, const rl_material *m, rl_vec3 p, rl_vec3 n, rl_vec3 v)
+{
     rl_vec3 c = rl_add(m->emission, rl_scale(m->diffuse, ctx->ambient));
-    bool specular = rl_vmax_comp(m->specular) > 0.0f;
+    bool specular = !phong_view_free(m);
     for (uint32_t i = 0; i < ctx->data->num_lights; ++i) {
         rl_vec3 E, l;
         if (!light_at(&ctx->data->lights[i], p, &E, &l))
@@ -110,6 +123,40 @@ static rl_vec4 phong(const shade_ctx *ctx, const rl_material *m, rl_vec3 p, rl_v
         c = rl_add(c, rl_mul(term, E));
     }
     return rl_v4_from3(c, 1.0f);
+}
+
+/* Local Phong colour at p with shading normal n (Ullmann 2003, eq. 3.1
+ * without the recursive terms). */
+static rl_vec4 phong(const shade_ctx *ctx, const rl_material *m, rl_vec3 p, rl_vec3 n)
+{
+    rl_vec3 v;
+    if (phong_flips(ctx, p, n, &v))
+        n = rl_neg(n);                        /* two-sided lighting */
+    return phong_lit(ctx, m, p, n, v);
+}
+
+/* Values of a vertex's (or corner's) lit_side: what its colour holds. */
+enum { SIDE_NONE, SIDE_FRONT, SIDE_BACK };
+
+/* phong() into *out, kept from an earlier frame where that is the same
+ * value: a material without specular lights a vertex with one of two
+ * colours, one per side it shows the eye, neither of which depends on
+ * where the eye is (the lights, the material and the ambient term are the
+ * drawer's for its whole life). *side remembers which of them *out holds,
+ * so that a still or slowly moving camera relights only the vertices
+ * whose side turned and those with a specular term; the kept colour is
+ * the same computation on the same inputs, so images stay bit-identical. */
+static void phong_cached(const shade_ctx *ctx, const rl_material *m, rl_vec3 p, rl_vec3 n, uint8_t *side,
+                         rl_vec4 *out)
+{
+    rl_vec3 v;
+    const bool flips = phong_flips(ctx, p, n, &v);
+    const uint8_t now = flips ? SIDE_BACK : SIDE_FRONT;
+    const bool view_free = phong_view_free(m);
+    if (view_free && *side == now)
+        return;
+    *out = phong_lit(ctx, m, p, flips ? rl_neg(n) : n, v);
+    *side = view_free ? now : SIDE_NONE;
 }
 
 rl_vec3 rl_raster_light_diffuse(const rl_scene_data *d, rl_vec3 p, rl_vec3 n, rl_vec3 kd, float ambient,
@@ -136,6 +183,9 @@ typedef struct frame_buffers {
     uint32_t *vertex_material;   /* per vertex of single-material objects */
     rl_vec4 *vertex_colors;      /* gouraud/textured, single-material objects */
     rl_vec4 *face_colors;        /* flat */
+    /* Per vertex, face and corner colour: which side's colour it holds
+     * (phong_cached), kept across frames. */
+    uint8_t *vertex_side, *face_side, *corner_side;
     /* Objects mixing materials: one vertex per triangle corner, indexed by
      * 3 * global triangle index, because a shared vertex would need one
      * colour per material. */
@@ -163,6 +213,9 @@ static void free_buffers(frame_buffers *b)
     free(b->vertex_material);
     free(b->vertex_colors);
     free(b->face_colors);
+    free(b->vertex_side);
+    free(b->face_side);
+    free(b->corner_side);
     free(b->corner_positions);
     free(b->corner_uvs);
     free(b->corner_colors);
@@ -229,13 +282,15 @@ static rl_status prepare(const rl_scene_data *d, rl_raster_shading shading, bool
 
     if (shading == RL_SHADING_FLAT) {
         b->face_colors = rl_calloc((size_t)d->num_triangles + 1, sizeof *b->face_colors);
-        return b->face_colors ? RL_OK : RL_ERR_OUT_OF_MEMORY;
+        b->face_side = rl_calloc((size_t)d->num_triangles + 1, sizeof *b->face_side);
+        return b->face_colors && b->face_side ? RL_OK : RL_ERR_OUT_OF_MEMORY;
     }
 
     size_t nv = (size_t)d->num_vertices + 1;
     b->vertex_material = rl_calloc(nv, sizeof *b->vertex_material);
     b->vertex_colors = rl_calloc(nv, sizeof *b->vertex_colors);
-    if (!b->vertex_material || !b->vertex_colors)
+    b->vertex_side = rl_calloc(nv, sizeof *b->vertex_side);
+    if (!b->vertex_material || !b->vertex_colors || !b->vertex_side)
         return RL_ERR_OUT_OF_MEMORY;
     for (uint32_t v = 0; v < d->num_vertices; ++v)
         b->vertex_material[v] = RL_NONE;
@@ -252,8 +307,9 @@ static rl_status prepare(const rl_scene_data *d, rl_raster_shading shading, bool
     b->corner_positions = rl_calloc(corners, sizeof *b->corner_positions);
     b->corner_uvs = rl_calloc(corners, sizeof *b->corner_uvs);
     b->corner_colors = rl_calloc(corners, sizeof *b->corner_colors);
+    b->corner_side = rl_calloc(corners, sizeof *b->corner_side);
     b->triangle_texture = rl_calloc(d->num_triangles, sizeof *b->triangle_texture);
-    if (!b->corner_positions || !b->corner_uvs || !b->corner_colors || !b->triangle_texture)
+    if (!b->corner_positions || !b->corner_uvs || !b->corner_colors || !b->corner_side || !b->triangle_texture)
         return RL_ERR_OUT_OF_MEMORY;
     /* What does not depend on the eye, once: positions, uvs, textures. */
     for (uint32_t o = 0; o < d->num_objects; ++o) {
@@ -281,7 +337,7 @@ static void light_face(const shade_ctx *ctx, frame_buffers *b, int64_t t)
     rl_vec3 p0 = d->positions[tri[0]], p1 = d->positions[tri[1]], p2 = d->positions[tri[2]];
     rl_vec3 centroid = rl_scale(rl_add(rl_add(p0, p1), p2), 1.0f / 3.0f);
     rl_vec3 n = rl_normalize(rl_cross(rl_sub(p1, p0), rl_sub(p2, p0)));
-    b->face_colors[t] = phong(ctx, &d->materials[d->triangle_material[t]], centroid, n);
+    phong_cached(ctx, &d->materials[d->triangle_material[t]], centroid, n, &b->face_side[t], &b->face_colors[t]);
 }
 
 /* Corner c (3 t + k) of triangle t of a mixed-material object, lit with
@@ -290,7 +346,8 @@ static void light_corner(const shade_ctx *ctx, frame_buffers *b, size_t c)
 {
     const rl_scene_data *d = ctx->data;
     uint32_t vi = d->indices[c];
-    b->corner_colors[c] = phong(ctx, &d->materials[d->triangle_material[c / 3]], d->positions[vi], d->normals[vi]);
+    phong_cached(ctx, &d->materials[d->triangle_material[c / 3]], d->positions[vi], d->normals[vi],
+                 &b->corner_side[c], &b->corner_colors[c]);
 }
 
 /* Object o's batch indices (b->local), made on its first draw: the
@@ -502,7 +559,8 @@ static void light_object(rl_scene_drawer *dr, uint32_t o, int threads)
         const int64_t v0 = obj->first_vertex, v1 = v0 + obj->num_vertices;
 #pragma omp parallel for num_threads(threads) schedule(static)
         for (int64_t v = v0; v < v1; ++v)
-            b->vertex_colors[v] = phong(ctx, &d->materials[m], d->positions[v], d->normals[v]);
+            phong_cached(ctx, &d->materials[m], d->positions[v], d->normals[v], &b->vertex_side[v],
+                         &b->vertex_colors[v]);
         return;
     }
 #pragma omp parallel for num_threads(threads) schedule(static)
@@ -543,7 +601,8 @@ static void shade_vertex(void *user, uint32_t v)
     const lazy_object *u = user;
     const rl_scene_data *d = u->dr->data;
     const uint32_t g = u->first + v;
-    u->dr->b.vertex_colors[g] = phong(&u->dr->ctx, u->material, d->positions[g], d->normals[g]);
+    phong_cached(&u->dr->ctx, u->material, d->positions[g], d->normals[g], &u->dr->b.vertex_side[g],
+                 &u->dr->b.vertex_colors[g]);
 }
 
 /* The same for corner v of a mixed-material object. */

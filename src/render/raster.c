@@ -7,7 +7,8 @@
  * renderers share. raster_render() only sets up the target, clears it and
  * draws every object with the drawer (rl_drawer.h) it keeps between
  * frames: the buffers for the whole scene are made once, the lighting is
- * redone every frame.
+ * redone every frame where it can change (the drawer keeps the colours of
+ * vertices without a specular term while they show the eye the same side).
  *
  * Options (defaults): shading = textured (flat | gouraud | textured),
  * cull = false, ambient = 0.05, background = "0,0,0", threads = 0 (all). */
@@ -36,7 +37,7 @@ static const rl_option_info raster_options[] = {
 
 /* The renderer's state: its rasterizer and drawer, kept between frames
  * (the drawer's buffers span the whole scene). Every frame still lights
- * every object, as plain rasterization does. */
+ * every object whose light depends on the eye. */
 typedef struct raster_state {
     rl_drawer *drawer;
 } raster_state;

@@ -48,10 +48,17 @@ typedef struct scene {
     size_t num_vertices;
 } scene;
 
+/* When set, shade() counts its calls per vertex of the scene whose lazy
+ * colours start at shade_base. */
+static uint32_t *shade_count;
+static const rl_vec4 *shade_base;
+
 /* Lazy shading: a pure function of the vertex, as rl_raster_lazy_colors asks. */
 static void shade(void *user, uint32_t v)
 {
     rl_vec4 *c = user;
+    if (shade_count)
+        __atomic_add_fetch(&shade_count[(size_t)(c - shade_base) + v], 1, __ATOMIC_RELAXED);
     c[v] = rl_v4((float)(v % 7) / 7.0f, (float)(v % 11) / 11.0f, (float)(v % 13) / 13.0f, 1.0f);
 }
 
@@ -162,8 +169,10 @@ typedef struct frame {
     rl_raster_counters counters;
 } frame;
 
-/* Draws sc with `threads` threads, one by one or with draw_many. */
-static void render(scene *sc, bool ortho, bool many, int threads, frame *out)
+/* Draws list[0 .. count) of sc's batches with `threads` threads, one by
+ * one or with draw_many. */
+static void render_list(scene *sc, const rl_raster_batch *list, int count, bool ortho, bool many, int threads,
+                        frame *out)
 {
     /* Lazy colours are shaded anew in every run. */
     memset(sc->stamps, 0, sc->num_vertices * sizeof *sc->stamps);
@@ -182,10 +191,10 @@ static void render(scene *sc, bool ortho, bool many, int threads, frame *out)
     assert_int_equal(rl_raster_set_target(r, img, &view, &proj), RL_OK);
     memset(&out->counters, 0, sizeof out->counters);
     if (many) {
-        assert_int_equal(rl_raster_draw_many(r, sc->b, NB, &out->counters), RL_OK);
+        assert_int_equal(rl_raster_draw_many(r, list, (uint32_t)count, &out->counters), RL_OK);
     } else {
-        for (int k = 0; k < NB; ++k)
-            assert_int_equal(rl_raster_draw(r, &sc->b[k], &out->counters), RL_OK);
+        for (int k = 0; k < count; ++k)
+            assert_int_equal(rl_raster_draw(r, &list[k], &out->counters), RL_OK);
     }
     memcpy(out->color, img->color, sizeof out->color);
     memcpy(out->depth, img->depth, sizeof out->depth);
@@ -193,6 +202,11 @@ static void render(scene *sc, bool ortho, bool many, int threads, frame *out)
     memcpy(out->triangle_id, img->triangle_id, sizeof out->triangle_id);
     rl_image_release(img);
     rl_raster_release(r);
+}
+
+static void render(scene *sc, bool ortho, bool many, int threads, frame *out)
+{
+    render_list(sc, sc->b, NB, ortho, many, threads, out);
 }
 
 static void check_equal_to_one_by_one(bool ortho)
@@ -232,6 +246,53 @@ static void test_draw_many_equals_draws_one_by_one_in_orthographic(void **state)
 {
     (void)state;
     check_equal_to_one_by_one(true);
+}
+
+/* A list that holds lazily coloured batches twice, side by side and far
+ * apart (a caller that lists an object twice): their stamps are shared
+ * between the parallel chunks of a group, which must then shade each
+ * vertex once, as the draws one by one do. */
+static void test_batches_listed_twice_share_their_lazy_colours(void **state)
+{
+    (void)state;
+    enum { N = 700 };
+    scene *sc = malloc(sizeof *sc);
+    rl_raster_batch *list = malloc(2 * N * sizeof *list);
+    frame *ref = malloc(sizeof *ref), *got = malloc(sizeof *got);
+    assert_non_null(sc);
+    assert_non_null(list);
+    assert_non_null(ref);
+    assert_non_null(got);
+    make_scene(sc);
+    int n = 0;
+    for (int k = 0; k < N; ++k) {
+        list[n++] = sc->b[k];
+        if (k % 5 == 3 && k % 2)
+            list[n++] = sc->b[k];          /* next to itself */
+    }
+    for (int k = 0; k < N && n < 2 * N; k += 5)
+        list[n++] = sc->b[k + 3];          /* again, a group or more later */
+    render_list(sc, list, n, false, false, 1, ref);
+    assert_true(ref->counters.triangles_drawn > 1000);
+    shade_count = calloc(sc->num_vertices, sizeof *shade_count);
+    shade_base = sc->lazy_col;
+    assert_non_null(shade_count);
+    for (int threads = 2; threads <= 4; ++threads) {
+        memset(shade_count, 0, sc->num_vertices * sizeof *shade_count);
+        render_list(sc, list, n, false, true, threads, got);
+        assert_memory_equal(ref, got, sizeof *ref);
+        uint32_t most = 0;
+        for (size_t v = 0; v < sc->num_vertices; ++v)
+            most = shade_count[v] > most ? shade_count[v] : most;
+        assert_int_equal(most, 1);
+    }
+    free(shade_count);
+    shade_count = NULL;
+    free_scene(sc);
+    free(sc);
+    free(list);
+    free(ref);
+    free(got);
 }
 
 static void test_an_invalid_batch_fails_before_anything_is_drawn(void **state)
@@ -275,6 +336,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_draw_many_equals_draws_one_by_one_in_perspective),
         cmocka_unit_test(test_draw_many_equals_draws_one_by_one_in_orthographic),
+        cmocka_unit_test(test_batches_listed_twice_share_their_lazy_colours),
         cmocka_unit_test(test_an_invalid_batch_fails_before_anything_is_drawn),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

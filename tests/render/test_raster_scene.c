@@ -253,6 +253,49 @@ static void test_lighting_ahead_draws_the_same_image(void **state)
     rl_scene_release(s);
 }
 
+/* A drawer kept over frames keeps the colours of vertices without a
+ * specular term while they show the eye the same side: the frames of one
+ * drawer, from eyes that move in front of the quads, go behind them (every
+ * side turns) and come back, equal those of a fresh drawer per frame in
+ * every shading, with the specular (green) quad relit at every move. */
+static void test_colours_kept_over_frames_equal_fresh_ones(void **state)
+{
+    (void)state;
+    rl_camera cam;
+    rl_scene *s = stack_scene(&cam);
+    const rl_scene_data *d = rl_scene_get_data(s);
+    const rl_vec3 eyes[5] = { { 0.1f, 0.05f, 3.0f }, { 0.5f, 0.3f, 2.5f }, { 0.2f, -0.1f, -3.0f },
+                              { -0.4f, 0.2f, -2.5f }, { 0.1f, 0.05f, 3.0f } };
+    for (int k = 0; k < 3; ++k) {
+        rl_drawer_desc desc = { .shading = (rl_raster_shading)k, .ambient = 0.1f };
+        rl_scene_drawer *dr = NULL;
+        assert_int_equal(rl_scene_drawer_create(d, eyes[0], &desc, &dr), RL_OK);
+        for (int frame = 0; frame < 5; ++frame) {
+            rl_camera c = cam;
+            c.eye = eyes[frame];
+            c.target = rl_v3(0.0f, 0.0f, eyes[frame].z > 0.0f ? -1.0f : 1.0f);
+            rl_scene_drawer_new_frame(dr, c.eye);
+            rl_image *img = NULL;
+            assert_int_equal(rl_image_create(c.width, c.height, FX_ALL_LAYERS, &img), RL_OK);
+            rl_image_fill(img, rl_v4(0.0f, 0.0f, 0.0f, 1.0f));
+            rl_raster *ras = NULL;
+            assert_int_equal(rl_raster_create(NULL, &ras), RL_OK);
+            assert_int_equal(rl_raster_set_camera(ras, img, &c, d->bounds), RL_OK);
+            assert_int_equal(rl_scene_drawer_draw_all(dr, ras, NULL, NULL, NULL), RL_OK);
+            drawn direct = draw_scene(s, &c, &desc, rl_v4(0.0f, 0.0f, 0.0f, 1.0f));
+            /* The view sees the quads, lit. */
+            assert_true(pixels_of(direct.img, 0) + pixels_of(direct.img, 1) + pixels_of(direct.img, 2) >
+                        SIZE * SIZE / 4);
+            fx_assert_images_identical(img, direct.img);
+            rl_image_release(direct.img);
+            rl_raster_release(ras);
+            rl_image_release(img);
+        }
+        rl_scene_drawer_release(dr);
+    }
+    rl_scene_release(s);
+}
+
 /* A list (rl_scene_drawer_draw_list) draws exactly what its objects drawn
  * one by one in the same order draw, counters included, in every shading
  * (the mixed-material object goes by corners), with a mask, and over two
@@ -467,6 +510,7 @@ int main(void)
         cmocka_unit_test(test_no_color_writes_depth_and_ids_of_a_lit_draw_and_leaves_colour_alone),
         cmocka_unit_test(test_raster_renderer_output_equals_drawing_the_whole_scene),
         cmocka_unit_test(test_lighting_ahead_draws_the_same_image),
+        cmocka_unit_test(test_colours_kept_over_frames_equal_fresh_ones),
         cmocka_unit_test(test_a_list_draws_what_its_objects_draw_one_by_one),
         cmocka_unit_test(test_progress_reaches_one_and_can_cancel),
         cmocka_unit_test(test_the_public_drawer_draws_what_the_scene_drawer_draws),
