@@ -891,6 +891,23 @@ static uint64_t flag_package(vt_state *s, vt_mesh *m, const uint32_t *faces, siz
     return visible;
 }
 
+/* dist_begin and the pre-pass for a package's faces, which must be
+ * primary faces of the scene. */
+static rl_status dist_open(rl_renderer *r, vt_state *s, const rl_scene *scene, const rl_camera *cam,
+                           rl_image *image, const uint32_t *faces, size_t count, const char *what, vt_settings *set,
+                           rl_camera *c, rl_tracer **tracer, vt_run *run)
+{
+    rl_status st = dist_begin(r, s, scene, cam, image, set, c, tracer, run);
+    if (st == RL_OK)
+        st = dist_prepass(r, s, scene, c, run);
+    const vt_mesh *m = &s->mesh;
+    for (size_t i = 0; st == RL_OK && i < count; ++i)
+        if (faces[i] >= m->num_primary_faces)
+            st = rl_error(RL_ERR_INVALID_ARG, "%s: face %u of %u primary faces", what, faces[i],
+                          m->num_primary_faces);
+    return st;
+}
+
 rl_status rl_vt_refine_faces(rl_renderer *r, const rl_scene *scene, const rl_camera *cam, rl_image *image,
                              const uint32_t *faces, size_t count, void **part, size_t *part_size,
                              rl_render_stats *stats)
@@ -905,14 +922,8 @@ rl_status rl_vt_refine_faces(rl_renderer *r, const rl_scene *scene, const rl_cam
     rl_camera c;
     rl_tracer *tracer;
     vt_run run;
-    rl_status st = dist_begin(r, s, scene, cam, image, &set, &c, &tracer, &run);
-    if (st == RL_OK)
-        st = dist_prepass(r, s, scene, &c, &run);
+    rl_status st = dist_open(r, s, scene, cam, image, faces, count, "rl_vt_refine_faces", &set, &c, &tracer, &run);
     vt_mesh *m = &s->mesh;
-    for (size_t i = 0; st == RL_OK && i < count; ++i)
-        if (faces[i] >= m->num_primary_faces)
-            st = rl_error(RL_ERR_INVALID_ARG, "rl_vt_refine_faces: face %u of %u primary faces", faces[i],
-                          m->num_primary_faces);
     if (st == RL_OK) {
         /* The pre-pass flagged the whole frame's faces. */
         vt_mesh_reset(m);
@@ -988,14 +999,8 @@ rl_status rl_vt_estimate_costs(rl_renderer *r, const rl_scene *scene, const rl_c
     rl_camera c;
     rl_tracer *tracer;
     vt_run run;
-    rl_status st = dist_begin(r, s, scene, cam, image, &set, &c, &tracer, &run);
-    if (st == RL_OK)
-        st = dist_prepass(r, s, scene, &c, &run);
+    rl_status st = dist_open(r, s, scene, cam, image, faces, count, "rl_vt_estimate_costs", &set, &c, &tracer, &run);
     vt_mesh *m = &s->mesh;
-    for (size_t i = 0; st == RL_OK && i < count; ++i)
-        if (faces[i] >= m->num_primary_faces)
-            st = rl_error(RL_ERR_INVALID_ARG, "rl_vt_estimate_costs: face %u of %u primary faces", faces[i],
-                          m->num_primary_faces);
     uint32_t *vertex_rays = NULL;
     if (st == RL_OK && !(vertex_rays = calloc(m->num_primary_verts ? m->num_primary_verts : 1, sizeof *vertex_rays)))
         st = rl_error(RL_ERR_OUT_OF_MEMORY, "vt: the rays of %u primary vertices", m->num_primary_verts);
