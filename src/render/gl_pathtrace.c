@@ -67,8 +67,6 @@ static const char *const diffuse_choices[] = { "bvh", "grid", "embree", "ls-cand
                                                NULL };
 static const char *const specular_choices[] = { "exact", "diffuse", NULL };
 static const char *const primary_choices[] = { "trace", "raster", NULL };
-/* Order = rl_filter_kind, as pt's. */
-static const char *const filter_choices[] = { "none", "gauss", "bilateral", "aniso", "kuwahara", "atrous", NULL };
 static const char *const ls_origin_choices[] = { "offset", "exact", NULL };
 static const char *const ls_build_choices[] = { "cpu", "gpu", NULL };
 
@@ -103,16 +101,8 @@ static const rl_option_info gl_pt_options[] = {
     { "accumulate", RL_OPT_BOOL, "true", "progressive accumulation across frames (Sec. 6.5, eq. 8)", 0, 0, NULL },
     { "filter", RL_OPT_ENUM, "none",
       "noise filter on the accumulated image (Sec. 8.2): pt's, on the CPU after the read-back", 0, 0,
-      filter_choices },
-    { "filter_fade", RL_OPT_FLOAT, "16",
-      "filter weight 1/(1 + spp/filter_fade) with spp the samples so far; 0 = never fade", 0, 1e9, NULL },
-    { "atrous_iterations", RL_OPT_INT, "5", "a-trous levels (holes 2^i pixels apart; Dammertz et al. 2010)",
-      1, 12, NULL },
-    { "atrous_sigma_rt", RL_OPT_FLOAT, "0",
-      "a-trous colour sigma at the first level, halved per level; 0 = from the samples per pixel", 0, 1e9, NULL },
-    { "atrous_sigma_n", RL_OPT_FLOAT, "0.1", "a-trous normal sigma (|n - n'|)", 1e-6, 1e9, NULL },
-    { "atrous_sigma_x", RL_OPT_FLOAT, "0",
-      "a-trous position sigma in world units; 0 = 2^atrous_iterations pixel footprints", 0, 1e9, NULL },
+      rl_pt_filter_choices },
+    RL_PT_FILTER_PARAM_OPTIONS,
     { "grid_res", RL_OPT_INT, "0", "voxels per axis of the grid and the Line Space (0 = grid heuristic)", 0, 1024,
       NULL },
     { "ls_n", RL_OPT_INT, "5", "Line Space patches per voxel face side (Sec. 9.2: 5)", 1, RL_LS_MAX_N, NULL },
@@ -454,12 +444,7 @@ static rl_status frame_gbuffer(gl_pt_state *s, const rl_scene *scene, const rl_c
 static void filter_settings(const rl_renderer *r, pt_settings *set)
 {
     memset(set, 0, sizeof *set);
-    set->filter = (rl_filter_kind)rl_renderer_opt_enum(r, "filter");
-    set->filter_fade = rl_renderer_opt_float(r, "filter_fade");
-    set->atrous_iterations = (int)rl_renderer_opt_int(r, "atrous_iterations");
-    set->atrous_sigma_rt = rl_renderer_opt_float(r, "atrous_sigma_rt");
-    set->atrous_sigma_n = rl_renderer_opt_float(r, "atrous_sigma_n");
-    set->atrous_sigma_x = rl_renderer_opt_float(r, "atrous_sigma_x");
+    rl_pt_read_filter_settings(r, set);
 }
 
 static rl_status gl_pt_render(rl_renderer *r, void *state, const rl_scene *scene, const rl_camera *cam,

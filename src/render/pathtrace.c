@@ -145,7 +145,7 @@ static const char *const diffuse_choices[] = { "bvh", "grid", "embree", "ls-cand
 static const char *const ls_origin_choices[] = { "offset", "exact", NULL };
 static const char *const primary_choices[] = { "trace", "raster", NULL };
 /* Order = rl_filter_kind. */
-static const char *const filter_choices[] = { "none", "gauss", "bilateral", "aniso", "kuwahara", "atrous", NULL };
+const char *const rl_pt_filter_choices[] = { "none", "gauss", "bilateral", "aniso", "kuwahara", "atrous", NULL };
 static const char *const adaptive_choices[] = { "off", "on", NULL };
 
 static const rl_option_info pt_options[] = {
@@ -176,16 +176,8 @@ static const rl_option_info pt_options[] = {
     { "checkerboard", RL_OPT_BOOL, "false", "render alternate halves of the pixels per frame (Sec. 8.5)",
       0, 0, NULL },
     { "accumulate", RL_OPT_BOOL, "true", "progressive accumulation across frames (Sec. 6.5, eq. 8)", 0, 0, NULL },
-    { "filter", RL_OPT_ENUM, "none", "noise filter on the accumulated image (Sec. 8.2)", 0, 0, filter_choices },
-    { "filter_fade", RL_OPT_FLOAT, "16",
-      "filter weight 1/(1 + spp/filter_fade) with spp the samples so far; 0 = never fade", 0, 1e9, NULL },
-    { "atrous_iterations", RL_OPT_INT, "5", "a-trous levels (holes 2^i pixels apart; Dammertz et al. 2010)",
-      1, 12, NULL },
-    { "atrous_sigma_rt", RL_OPT_FLOAT, "0",
-      "a-trous colour sigma at the first level, halved per level; 0 = from the samples per pixel", 0, 1e9, NULL },
-    { "atrous_sigma_n", RL_OPT_FLOAT, "0.1", "a-trous normal sigma (|n - n'|)", 1e-6, 1e9, NULL },
-    { "atrous_sigma_x", RL_OPT_FLOAT, "0",
-      "a-trous position sigma in world units; 0 = 2^atrous_iterations pixel footprints", 0, 1e9, NULL },
+    { "filter", RL_OPT_ENUM, "none", "noise filter on the accumulated image (Sec. 8.2)", 0, 0, rl_pt_filter_choices },
+    RL_PT_FILTER_PARAM_OPTIONS,
     { "adaptive", RL_OPT_ENUM, "off",
       "per-pixel adaptive sampling: a frame's paths go where the estimated relative error is largest",
       0, 0, adaptive_choices },
@@ -333,12 +325,7 @@ static void read_settings(const rl_renderer *r, pt_settings *set)
     set->primary = (pt_primary)rl_renderer_opt_enum(r, "primary");
     set->checkerboard = rl_renderer_opt_bool(r, "checkerboard");
     set->accumulate = rl_renderer_opt_bool(r, "accumulate");
-    set->filter = (rl_filter_kind)rl_renderer_opt_enum(r, "filter");
-    set->filter_fade = rl_renderer_opt_float(r, "filter_fade");
-    set->atrous_iterations = (int)rl_renderer_opt_int(r, "atrous_iterations");
-    set->atrous_sigma_rt = rl_renderer_opt_float(r, "atrous_sigma_rt");
-    set->atrous_sigma_n = rl_renderer_opt_float(r, "atrous_sigma_n");
-    set->atrous_sigma_x = rl_renderer_opt_float(r, "atrous_sigma_x");
+    rl_pt_read_filter_settings(r, set);
     set->adaptive = rl_renderer_opt_enum(r, "adaptive") == 1;
     set->adaptive_threshold = rl_renderer_opt_float(r, "adaptive_threshold");
     set->adaptive_min_spp = (int)rl_renderer_opt_int(r, "adaptive_min_spp");
@@ -646,6 +633,16 @@ static void resolve(const pt_state *s, const rl_rect *region, rl_image *image)
 
 /* sigma_r (bilateral) and kappa (anisotropic diffusion) at 1 spp. */
 #define PT_FILTER_RANGE_1SPP 0.8f
+void rl_pt_read_filter_settings(const rl_renderer *r, pt_settings *set)
+{
+    set->filter = (rl_filter_kind)rl_renderer_opt_enum(r, "filter");
+    set->filter_fade = rl_renderer_opt_float(r, "filter_fade");
+    set->atrous_iterations = (int)rl_renderer_opt_int(r, "atrous_iterations");
+    set->atrous_sigma_rt = rl_renderer_opt_float(r, "atrous_sigma_rt");
+    set->atrous_sigma_n = rl_renderer_opt_float(r, "atrous_sigma_n");
+    set->atrous_sigma_x = rl_renderer_opt_float(r, "atrous_sigma_x");
+}
+
 /* The a-trous colour sigma at 1 spp (atrous_sigma_rt = 0). */
 #define PT_ATROUS_RT_1SPP 1.0f
 
@@ -1130,7 +1127,7 @@ static rl_status pt_render(rl_renderer *r, void *state, const rl_scene *scene, c
     if (part) {
         if (filter_here)
             return rl_error(RL_ERR_UNSUPPORTED, "pt: filter=%s filters the whole image; a region (rl --dist) "
-                            "needs filter=none", filter_choices[set.filter]);
+                            "needs filter=none", rl_pt_filter_choices[set.filter]);
         if (set.primary == PT_PRIMARY_RASTER)
             return rl_error(RL_ERR_UNSUPPORTED, "pt: primary=raster rasterizes the whole image; a region "
                             "(rl --dist) needs primary=trace");

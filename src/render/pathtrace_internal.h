@@ -26,7 +26,9 @@
 #include "rl/rl_filter.h"
 #include "rl/rl_gbuffer.h"
 #include "rl/rl_linespace.h"
+#include "rl/rl_options.h"
 #include "rl/rl_pt.h"
+#include "rl/rl_render.h"
 #include "rl/rl_rng.h"
 #include "rl/rl_scene.h"
 #include "rl/rl_shadowmap.h"
@@ -69,6 +71,23 @@ typedef enum pt_env_sampling { PT_ENV_IMPORTANCE = 0, PT_ENV_UNIFORM, PT_ENV_BSD
  * its read-back image with it. */
 rl_status rl_pt_filter_image(const pt_settings *set, const rl_gbuffer *gbuf, double spp, rl_image *image,
                              float *weight);
+
+/* What gl-pt shares of the filter's options with pt: the choices of
+ * "filter" (in the order of rl_filter_kind), the rows of its parameters
+ * (placed after "filter" in an rl_option_info table), and the reading of
+ * "filter" and those parameters into set. */
+extern const char *const rl_pt_filter_choices[];
+#define RL_PT_FILTER_PARAM_OPTIONS                                                                                 \
+    { "filter_fade", RL_OPT_FLOAT, "16",                                                                           \
+      "filter weight 1/(1 + spp/filter_fade) with spp the samples so far; 0 = never fade", 0, 1e9, NULL },         \
+    { "atrous_iterations", RL_OPT_INT, "5", "a-trous levels (holes 2^i pixels apart; Dammertz et al. 2010)",       \
+      1, 12, NULL },                                                                                              \
+    { "atrous_sigma_rt", RL_OPT_FLOAT, "0",                                                                        \
+      "a-trous colour sigma at the first level, halved per level; 0 = from the samples per pixel", 0, 1e9, NULL }, \
+    { "atrous_sigma_n", RL_OPT_FLOAT, "0.1", "a-trous normal sigma (|n - n'|)", 1e-6, 1e9, NULL },                \
+    { "atrous_sigma_x", RL_OPT_FLOAT, "0",                                                                         \
+      "a-trous position sigma in world units; 0 = 2^atrous_iterations pixel footprints", 0, 1e9, NULL }
+void rl_pt_read_filter_settings(const rl_renderer *r, pt_settings *set);
 
 /* ------------------------------------------------------------ backends -- */
 
