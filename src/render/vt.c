@@ -767,8 +767,6 @@ static rl_status dist_begin(rl_renderer *r, vt_state *s, const rl_scene *scene, 
     *cam = rl_camera_resolve(cam_in);
     read_settings(r, set);
     forget_frame(s);
-    if (rl_renderer_opt_enum(r, "reconstruct") != RECONSTRUCT_SOFTWARE)
-        return rl_error(RL_ERR_UNSUPPORTED, "vt: distributed frames draw with reconstruct=software only");
     double prep_ms = 0.0;
     if ((st = prepare_tracer(r, s, scene, d, set, tracer, &prep_ms)) != RL_OK)
         return st;
@@ -847,6 +845,12 @@ rl_status rl_vt_prepare(rl_renderer *r, const rl_scene *scene, const rl_camera *
     rl_tracer *tracer;
     vt_run run;
     rl_status st = dist_begin(r, s, scene, cam, image, &set, &c, &tracer, &run);
+    /* The master prepares before any worker refines: a drawing it cannot
+     * make (reconstruct = gl without GL) stops the frame here, not after
+     * the refinement. */
+    char why[512];
+    if (st == RL_OK && !vt_available(r, why, sizeof why))
+        st = rl_error(RL_ERR_UNSUPPORTED, "vt: unavailable: %s", why);
     if (st == RL_OK)
         st = dist_prepass(r, s, scene, &c, &run);
     dist_end(&run, tracer);
@@ -1076,6 +1080,12 @@ rl_status rl_vt_draw_parts(rl_renderer *r, const rl_scene *scene, const rl_camer
     rl_tracer *tracer;
     vt_run run;
     rl_status st = dist_begin(r, s, scene, cam, image, &set, &c, &tracer, &run);
+    /* Only the master draws, so only it needs the GL drawer of
+     * reconstruct = gl: the workers' pre-pass and refinement are the CPU's
+     * in either mode, as in one process. */
+    rl_drawer *gl = NULL;
+    if (st == RL_OK && (st = gl_drawer_for(r, s, scene, &set, image, &gl)) == RL_OK)
+        run.drawer = gl;
     /* The parts' faces go after the primary ones. */
     for (size_t i = 0; st == RL_OK && i < count; ++i)
         if ((st = vt_part_import(&s->mesh, run.data, parts[i], sizes[i])) != RL_OK) {

@@ -36,6 +36,7 @@ command -v mpirun >/dev/null || { echo "test_cli_dist: no mpirun; the distribute
 export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 OMPI_MCA_mpi_yield_when_idle=1
 export OMP_NUM_THREADS=1
 MPI=(timeout 120 mpirun --oversubscribe -np 3)
+MPI2=(timeout 120 mpirun --oversubscribe -np 2)
 
 run_ok "$RL" render spheres --algo whitted --size 72x53 --out "$TMP/ref.png" --depth-out "$TMP/ref.exr" \
     --id-out "$TMP/ref-id.png"
@@ -286,6 +287,32 @@ run_ok "${MPI[@]}" "$RL" --dist render table --algo vt --size 64x48 --set balanc
 expect_in "$TMP/out" "^dist: 3 ranks, [3-6] packages, "
 python3 -c 'import sys; sys.exit(float(sys.argv[1]) <= 0.998)' "$(python3 "$(dirname "${BASH_SOURCE[0]}")/ssim.py" \
     "$TMP/vt1.png" "$TMP/vtp.png")" || fail "vt: precompute too far from one process"
+
+# reconstruct=gl: the workers refine on the CPU as always and the master
+# draws the parts with the GL drawer (Ullmann Sec. 3.5 on the GPU). The
+# GL drawing must be used (another triangle count: the GL drawer counts
+# every triangle it submits, the rasterizer those its culling keeps) and stay
+# within SSIM 0.99 of the software drawing, as in one process
+# (tests/gl/test_gl_vt.c). Skipped where this machine has no GL 4.5.
+if "$RL" render table --algo vt --set reconstruct=gl --size 16x12 --out "$TMP/vt-gl-probe.png" >/dev/null 2>&1; then
+    run_ok "${MPI2[@]}" "$RL" --dist "${VT[@]}" --set reconstruct=gl --out "$TMP/vt-gl.png" \
+        --stats-json "$TMP/vt-gl.json"
+    expect_in "$TMP/out" "^dist: 2 ranks, 10 packages, "
+    python3 -c 'import sys; sys.exit(float(sys.argv[1]) <= 0.99)' "$(python3 "$(dirname "${BASH_SOURCE[0]}")/ssim.py" \
+        "$TMP/vt3.png" "$TMP/vt-gl.png")" || fail "vt: reconstruct=gl too far from the software drawing"
+    python3 - "$TMP/vt3.json" "$TMP/vt-gl.json" <<'PY' || fail "vt: reconstruct=gl did not draw with GL"
+import json, sys
+sw, gl = (json.load(open(f)) for f in sys.argv[1:3])
+assert gl["samples"] == sw["samples"] and gl["rays_total"] == sw["rays_total"], (sw, gl)
+assert gl["triangles_rasterized"] != sw["triangles_rasterized"], (sw, gl)
+PY
+else
+    echo "test_cli_dist: no GL 4.5 context here; the reconstruct=gl case is skipped"
+fi
+# Without GL the master stops before handing out a package: one error line.
+RL_EGL_DEVICE=bogus expect_error 1 "vt: unavailable: reconstruct=gl: .*bogus" \
+    "${MPI2[@]}" "$RL" --dist "${VT[@]}" --set reconstruct=gl --out "$TMP/vt-nogl.png"
+[ ! -e "$TMP/vt-nogl.png" ] || fail "vt: a distributed run without GL wrote an image"
 
 # rl bench dist starts this rl under mpirun itself: its record has every
 # workload at every rank count, with the one-rank run as the reference.
