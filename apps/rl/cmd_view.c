@@ -227,11 +227,6 @@ static rl_status fit_image(rl_image **img, int w, int h, unsigned layers)
     return RL_OK;
 }
 
-static bool same_camera(const rl_camera *a, const rl_camera *b)
-{
-    return memcmp(a, b, sizeof *a) == 0;
-}
-
 static bool on_progress(void *user, double done)
 {
     (void)done;
@@ -753,7 +748,7 @@ static int worker_main(void *user)
             apply_cmd(w, &cmds[i]);
         if (ncmds > 0 || !w->have_last)
             publish_options(w);
-        if (!w->have_last || !same_camera(&cam, &w->last_cam)) {
+        if (!w->have_last || !rl_camera_equal(&cam, &w->last_cam)) {
             SDL_LockMutex(sh->lock);
             sh->worker_spp = 0.0;
             SDL_UnlockMutex(sh->lock);
@@ -1308,7 +1303,7 @@ static void record_tick(viewer *v)
 {
     if (!v->recording)
         return;
-    if (v->num_rec > 0 && same_camera(&v->rec[v->num_rec - 1].camera, &v->nav.cam))
+    if (v->num_rec > 0 && rl_camera_equal(&v->rec[v->num_rec - 1].camera, &v->nav.cam))
         return;
     double t = v->now - v->rec_t0;
     /* At most a key per script step (1/25 s): the times must increase, and

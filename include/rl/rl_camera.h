@@ -33,6 +33,11 @@ RL_API rl_camera rl_camera_resolve(const rl_camera *cam);
  * fov outside (0,180), non-finite values; RL_ERR_LIMIT for a resolution
  * outside 1..RL_IMAGE_MAX_SIZE. Checks the resolved camera. */
 RL_API rl_status rl_camera_validate(const rl_camera *cam);
+/* Whether a and b are the same camera, field by field as given (not
+ * resolved: a zero field and its default differ). The vectors compare bit
+ * for bit, the scalars by value. Progressive renderers restart their
+ * accumulation when this is false. */
+RL_API bool rl_camera_equal(const rl_camera *a, const rl_camera *b);
 
 /* Precomputed frame for generating rays quickly. */
 typedef struct rl_camera_frame {

@@ -633,7 +633,14 @@ static rl_status vt_lead(rl_dist *d, rl_renderer *r, const rl_scene *scene, cons
     const uint32_t *faces = NULL;
     size_t nfaces = 0;
     char failure[320] = "";
-    rl_status st = rl_vt_prepare(r, scene, cam, image, &faces, &nfaces);
+    /* Only the master draws: a drawing it cannot make (reconstruct = gl
+     * without GL) ends the frame before any package is refined. The
+     * workers never ask, so they need no GL. */
+    char why[512];
+    rl_status st = rl_renderer_available(r, why, sizeof why)
+                       ? RL_OK : rl_error(RL_ERR_UNSUPPORTED, "%s: unavailable: %s", rl_renderer_name(r), why);
+    if (st == RL_OK)
+        st = rl_vt_prepare(r, scene, cam, image, &faces, &nfaces);
     if (st == RL_OK && nfaces > UINT32_MAX / 2)
         st = rl_error(RL_ERR_LIMIT, "vt: %zu visible faces to distribute", nfaces);
     if (st != RL_OK)

@@ -134,13 +134,6 @@ static int scene_max_depth(const rl_scene *scene)
     return v && rl_parse_int(v, &n) && n >= 0 && n <= 1024 ? (int)n : 3;
 }
 
-static bool same_camera(const rl_camera *a, const rl_camera *b)
-{
-    return memcmp(&a->eye, &b->eye, sizeof a->eye) == 0 && memcmp(&a->target, &b->target, sizeof a->target) == 0 &&
-           memcmp(&a->up, &b->up, sizeof a->up) == 0 && a->fov_deg == b->fov_deg && a->width == b->width &&
-           a->height == b->height;
-}
-
 typedef struct bd_frame {
     bdpt_state *s;
     bd_ctx ctx;
@@ -264,7 +257,7 @@ static rl_status bdpt_render(rl_renderer *r, void *state, const rl_scene *scene,
     size_t n = (size_t)cam->width * cam->height;
     bool reset = s->force_reset || !s->valid || !rl_renderer_opt_bool(r, "accumulate") ||
                  s->scene_uid != rl_scene_uid(scene) || s->width != cam->width || s->height != cam->height ||
-                 !same_camera(&s->cam, cam) || strcmp(s->signature, sig) != 0;
+                 !rl_camera_equal(&s->cam, cam) || strcmp(s->signature, sig) != 0;
     if (reset) {
         if (!s->accum || s->width != cam->width || s->height != cam->height) {
             free(s->accum);

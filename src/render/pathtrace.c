@@ -356,13 +356,6 @@ static bool option_matters(const rl_renderer *r, size_t i)
     return strcmp(pt_options[i].key, "ls_k") != 0 || !rl_renderer_opt_bool(r, "ls_dynamic");
 }
 
-static bool same_camera(const rl_camera *a, const rl_camera *b)
-{
-    return memcmp(&a->eye, &b->eye, sizeof a->eye) == 0 && memcmp(&a->target, &b->target, sizeof a->target) == 0 &&
-           memcmp(&a->up, &b->up, sizeof a->up) == 0 && a->fov_deg == b->fov_deg && a->width == b->width &&
-           a->height == b->height && a->z_near == b->z_near && a->z_far == b->z_far;
-}
-
 static bool same_rect(const rl_rect *a, const rl_rect *b)
 {
     return a->x0 == b->x0 && a->y0 == b->y0 && a->x1 == b->x1 && a->y1 == b->y1;
@@ -742,7 +735,7 @@ static rl_status prepare_frame(rl_renderer *r, pt_state *s, const rl_scene *scen
     if (!sig)
         return RL_ERR_OUT_OF_MEMORY;
     bool need_reset = s->force_reset || !s->valid || !set->accumulate || s->scene_uid != rl_scene_uid(scene) ||
-                      s->width != cam->width || s->height != cam->height || !same_camera(&s->cam, cam) ||
+                      s->width != cam->width || s->height != cam->height || !rl_camera_equal(&s->cam, cam) ||
                       !same_rect(&s->area, area) || strcmp(s->signature, sig) != 0;
     if (need_reset) {
         if ((st = reset(s, scene, cam, set, area, sig)) != RL_OK)

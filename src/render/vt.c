@@ -845,12 +845,6 @@ rl_status rl_vt_prepare(rl_renderer *r, const rl_scene *scene, const rl_camera *
     rl_tracer *tracer;
     vt_run run;
     rl_status st = dist_begin(r, s, scene, cam, image, &set, &c, &tracer, &run);
-    /* The master prepares before any worker refines: a drawing it cannot
-     * make (reconstruct = gl without GL) stops the frame here, not after
-     * the refinement. */
-    char why[512];
-    if (st == RL_OK && !vt_available(r, why, sizeof why))
-        st = rl_error(RL_ERR_UNSUPPORTED, "vt: unavailable: %s", why);
     if (st == RL_OK)
         st = dist_prepass(r, s, scene, &c, &run);
     dist_end(&run, tracer);

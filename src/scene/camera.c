@@ -2,6 +2,8 @@
  * OpenGL-style view/projection matrices built from that same frame (so that
  * rasterizers and ray tracers agree pixel for pixel), clip ranges and a
  * default camera that frames a bounding box. */
+#include <string.h>
+
 #include "rl/rl_camera.h"
 #include "rl/rl_image.h"
 #include "core/error.h"
@@ -20,6 +22,15 @@ rl_camera rl_camera_resolve(const rl_camera *cam)
     if (c.height == 0)
         c.height = RL_CAMERA_DEFAULT_HEIGHT;
     return c;
+}
+
+bool rl_camera_equal(const rl_camera *a, const rl_camera *b)
+{
+    if (!a || !b)
+        return a == b;
+    return memcmp(&a->eye, &b->eye, sizeof a->eye) == 0 && memcmp(&a->target, &b->target, sizeof a->target) == 0 &&
+           memcmp(&a->up, &b->up, sizeof a->up) == 0 && a->fov_deg == b->fov_deg && a->width == b->width &&
+           a->height == b->height && a->z_near == b->z_near && a->z_far == b->z_far;
 }
 
 rl_status rl_camera_validate(const rl_camera *cam)

@@ -130,6 +130,36 @@ static void test_validate_rejects_degenerate_cameras(void **state)
 /* rl_camera_fit_points: every point inside the frame with the 4 % margin,
  * and the fit tight: the extreme points touch the margin on one axis and
  * are centred on the other. */
+/* Every field takes part: a progressive renderer that missed a change
+ * would keep accumulating the old view. */
+static void test_equal_sees_every_field(void **state)
+{
+    (void)state;
+    const rl_camera a = { .eye = { 1, 2, 3 }, .target = { 0, 0, 0 }, .up = { 0, 1, 0 }, .fov_deg = 40.0f,
+                          .width = 64, .height = 48, .z_near = 0.1f, .z_far = 100.0f };
+    assert_true(rl_camera_equal(&a, &a));
+    rl_camera b = a;
+    assert_true(rl_camera_equal(&a, &b));
+    for (int k = 0; k < 10; ++k) {
+        b = a;
+        switch (k) {
+        case 0: b.eye.x += 0.5f; break;
+        case 1: b.target.z = -1.0f; break;
+        case 2: b.up = rl_v3(0.0f, 0.0f, 1.0f); break;
+        case 3: b.fov_deg = 41.0f; break;
+        case 4: b.width = 65; break;
+        case 5: b.height = 47; break;
+        case 6: b.z_near = 0.2f; break;
+        case 7: b.z_far = 99.0f; break;
+        case 8: b.up = rl_v3(0.0f, 0.0f, 0.0f); break;   /* zero means +y, yet is another camera as given */
+        default: b.eye.y = nextafterf(a.eye.y, 3.0f); break;   /* one ulp */
+        }
+        assert_false(rl_camera_equal(&a, &b));
+    }
+    assert_false(rl_camera_equal(&a, NULL));
+    assert_true(rl_camera_equal(NULL, NULL));
+}
+
 static void test_fit_points_is_tight_from_every_orbit(void **state)
 {
     (void)state;
@@ -322,6 +352,7 @@ int main(void)
         cmocka_unit_test(test_validate_rejects_degenerate_cameras),
         cmocka_unit_test(test_frame_bounds_sees_all_corners_of_the_box),
         cmocka_unit_test(test_fit_points_is_tight_from_every_orbit),
+        cmocka_unit_test(test_equal_sees_every_field),
         cmocka_unit_test(test_clip_range_keeps_near_at_least_far_times_1e_minus_5),
         cmocka_unit_test(test_path_eval_hits_keys_exactly_at_key_times),
         cmocka_unit_test(test_path_eval_is_continuous_and_stays_near_the_keys),
