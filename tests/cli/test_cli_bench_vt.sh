@@ -218,7 +218,9 @@ c = r["correctness"]
 assert c["status"] == "ok", c
 opts = ["off", "nonlinear=extremum", "nonlinear=interval", "shaft_cull=shadow", "shaft_cull=all"]
 rows = {(x["scene"], x["option"]): x for x in c["runs"]}
-assert [x["option"] for x in c["runs"] if x["scene"] == "table"] == opts, c["runs"]
+assert [(x["setting"], x["option"]) for x in c["runs"] if x["scene"] == "table"] == \
+    [(s, o) for s in ("tree+hsv/1", "hsv/14") for o in opts], c["runs"]
+rows = {(x["scene"], x["option"]): x for x in c["runs"] if x.get("setting", "tree+hsv/1") == "tree+hsv/1"}
 for scene in ("highlight", "shadow"):
     assert [x["option"] for x in c["runs"] if x["scene"] == scene] == ["whitted"] + opts, c["runs"]
     assert rows[(scene, "off")]["vertices_generated"] == 0
