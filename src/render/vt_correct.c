@@ -409,8 +409,18 @@ bool vt_shaft_meets_box(const vt_shaft *s, rl_aabb x)
     return true;
 }
 
-/* Whether geometry of an object other than skip meets the shaft. */
-static bool shaft_occupied(const vt_shaft_index *ix, const rl_scene_data *d, const vt_shaft *s, uint32_t skip)
+static bool box_inside(rl_aabb x, rl_aabb in)
+{
+    return x.min.x >= in.min.x && x.min.y >= in.min.y && x.min.z >= in.min.z && x.max.x <= in.max.x &&
+           x.max.y <= in.max.y && x.max.z <= in.max.z;
+}
+
+/* Whether geometry of an object other than skip meets the shaft. A
+ * triangle inside the box emitter (when not NULL) is the light's own
+ * geometry (the emitting quad of an area light drawn as a mesh): a feeler
+ * stops short of it (trace_shade.c), so it casts no shadow. */
+static bool shaft_occupied(const vt_shaft_index *ix, const rl_scene_data *d, const vt_shaft *s, uint32_t skip,
+                           const rl_aabb *emitter)
 {
     for (uint32_t o = 0; o < d->num_objects; ++o) {
         const rl_object *ob = &d->objects[o];
@@ -426,7 +436,7 @@ static bool shaft_occupied(const vt_shaft_index *ix, const rl_scene_data *d, con
                 rl_aabb tb = rl_aabb_empty();
                 for (int k = 0; k < 3; ++k)
                     tb = rl_aabb_grow(tb, d->positions[idx[k]]);
-                if (vt_shaft_meets_box(s, tb))
+                if (vt_shaft_meets_box(s, tb) && !(emitter && box_inside(tb, *emitter)))
                     return true;
             }
         }
@@ -496,6 +506,7 @@ bool vt_shaft_face_fires(const vt_run *run, const vt_shaft_index *ix, uint32_t f
         if (!lit)
             continue;
         rl_aabb lb;
+        bool area = false;
         if (L->type == RL_LIGHT_DIRECTIONAL) {
             rl_vec3 off = rl_scale(rl_normalize(rl_neg(L->direction)), dist);
             lb = (rl_aabb){ rl_add(fb.min, off), rl_add(fb.max, off) };
@@ -503,11 +514,16 @@ bool vt_shaft_face_fires(const vt_run *run, const vt_shaft_index *ix, uint32_t f
             rl_vec3 c[4] = { L->position, rl_add(L->position, L->edge_u), rl_add(L->position, L->edge_v),
                              rl_add(rl_add(L->position, L->edge_u), L->edge_v) };
             lb = box_of(c, 4);
+            area = true;
         } else {
             lb = (rl_aabb){ L->position, L->position };
         }
         vt_shaft_build(&s, fb, lb);
-        if (shaft_occupied(ix, d, &s, own))
+        /* the quad's box, grown by a hair of the scene's size for the
+         * rounding of a mesh placed on it */
+        float hair = 1e-4f * dist;
+        rl_aabb em = { rl_sub(lb.min, rl_v3(hair, hair, hair)), rl_add(lb.max, rl_v3(hair, hair, hair)) };
+        if (shaft_occupied(ix, d, &s, own, area ? &em : NULL))
             return true;
     }
     if (run->set->shaft_cull == VT_SHAFT_ALL) {
@@ -515,7 +531,7 @@ bool vt_shaft_face_fires(const vt_run *run, const vt_shaft_index *ix, uint32_t f
             if (!(t ? mat->transmissivity : mat->reflectivity) || !(dist > 0.0f))
                 continue;
             vt_shaft_build(&s, fb, moved_box(run, f, t == 1, dist));
-            if (shaft_occupied(ix, d, &s, own))
+            if (shaft_occupied(ix, d, &s, own, NULL))
                 return true;
         }
     }

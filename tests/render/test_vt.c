@@ -817,6 +817,31 @@ static void shaft_culling_finds_the_small_shadow(void **state)
     assert_int_equal(all.vertices_generated, sh.vertices_generated);
     assert_int_equal(ext.vertices_generated, 0);
     rl_scene_release(s);
+
+    /* An area light drawn as an emissive quad mesh: its own triangles
+     * fill every shadow shaft's far end but shadow nothing (feelers stop
+     * short of the light), so nothing is split for them. */
+    assert_int_equal(rl_scene_create(&s), RL_OK);
+    uint32_t grey = add_material(s, "grey", rl_v3(0.7f, 0.7f, 0.7f), 0.0f, 0.0f);
+    rl_material glow = rl_material_default();
+    snprintf(glow.name, sizeof glow.name, "glow");
+    glow.emission = rl_v3(4.0f, 4.0f, 4.0f);
+    uint32_t glow_id;
+    assert_int_equal(rl_scene_add_material(s, &glow, &glow_id), RL_OK);
+    add_grid(s, "floor", 1, 2.0f, grey, true);
+    rl_mat4 up = rl_mat4_translate(rl_v3(0.0f, 2.0f, 0.0f));
+    add_grid_at(s, "lamp", 1, 0.25f, glow_id, false, &up);
+    rl_light quad = { .type = RL_LIGHT_QUAD, .color = rl_v3(1, 1, 1), .intensity = 8.0f,
+                      .position = rl_v3(-0.25f, 2.0f, -0.25f), .edge_u = rl_v3(0.5f, 0.0f, 0.0f),
+                      .edge_v = rl_v3(0.0f, 0.0f, 0.5f) };
+    assert_int_equal(rl_scene_add_light(s, &quad), RL_OK);
+    assert_int_equal(rl_scene_commit(s), RL_OK);
+    rl_renderer *r = make_vt(o_sh);
+    sh = render_stats(r, s, &cam, NULL);
+    assert_true(sh.shaft_faces_tested > 0);
+    assert_int_equal(sh.splits_shaft, 0);
+    rl_renderer_release(r);
+    rl_scene_release(s);
 }
 
 /* Invalid thresholds and lengths are refused with a message naming them. */
