@@ -54,6 +54,9 @@ typedef struct rl_vt_stats {
                                         * its vertices, samples, edges, faces
                                         * and deferred layers, as used (the
                                         * arrays' spare room not counted) */
+    uint64_t splits_nonlinear;         /* edges split by option nonlinear (Sec. 6.1.1) */
+    uint64_t splits_shaft;             /* edges split by option shaft_cull (Sec. 6.1.2) */
+    uint64_t shaft_faces_tested;       /* faces whose shafts were built and tested */
 } rl_vt_stats;
 
 /* Statistics of the last frame rendered by r. RL_ERR_INVALID_ARG when r is
@@ -66,7 +69,8 @@ typedef struct rl_vt_vertex_info {
     uint16_t stage;                    /* 0 = primary */
     uint8_t sampled;                   /* cast rays */
     uint8_t reason;                    /* why it exists: 0 primary, else the
-                                        * bits 1 rgb, 2 hsv, 4 tree, 8 forced */
+                                        * bits 1 rgb, 2 hsv, 4 tree, 8 forced,
+                                        * 16 nonlinear, 32 shaft (Sec. 6.1) */
 } rl_vt_vertex_info;
 
 /* The vertices and the leaf faces (3 vertex indices each) of the last frame.

@@ -62,6 +62,8 @@ static const char *const overlay_choices[] = { "none", "wire", "samples", NULL }
 static const char *const reconstruct_choices[] = { "software", "gl", NULL };
 static const char *const balance_choices[] = { "queue", "precompute", NULL };
 static const char *const cost_choices[] = { "faces", "estimate", NULL };
+static const char *const nonlinear_choices[] = { "off", "extremum", "interval", NULL };
+static const char *const shaft_choices[] = { "off", "shadow", "all", NULL };
 enum { RECONSTRUCT_SOFTWARE, RECONSTRUCT_GL };
 
 static const rl_option_info vt_options[] = {
@@ -84,6 +86,17 @@ static const rl_option_info vt_options[] = {
     { "merge_px", RL_OPT_FLOAT, "0",
       "sample reduction (Sec. 6.2.1): the ends of a primary edge projected shorter than this many pixels "
       "share one sample (0 = off; the thesis suggests <= 1)", 0, 16, NULL },
+    { "nonlinear", RL_OPT_ENUM, "off",
+      "Sec. 6.1.1, highlights between an edge's samples: off | extremum (split where a light's diffuse or "
+      "specular peak lies between the ends, eq. 6.4-6.5) | interval (split where interval arithmetic bounds the "
+      "interpolation error of the local Phong term above eps_ia, Fig. 6.4)", 0, 0, nonlinear_choices },
+    { "eps_ia", RL_OPT_FLOAT, "0.05",
+      "nonlinear=interval: bound eps_IA on the interpolation error (linear radiance, sum over lights) that splits",
+      1e-4, 1e6, NULL },
+    { "shaft_cull", RL_OPT_ENUM, "off",
+      "Sec. 6.1.2, small occluders between an edge's samples: off | shadow (split the edges of a face whose "
+      "shaft to a light holds another object's triangles, [HW91], Fig. 6.6a) | all (also its reflection and "
+      "transmission shafts, Fig. 6.6b)", 0, 0, shaft_choices },
     { "textures", RL_OPT_ENUM, "multitexture",
       "deferred textures: multitexture (eq. 3.20, one pass), multipass (eq. 3.22), sampled (no deferral)",
       0, 0, texture_choices },
@@ -385,6 +398,9 @@ static void read_settings(rl_renderer *r, vt_settings *set)
     set->z_test = rl_renderer_opt_bool(r, "z_test");
     set->clip_test = rl_renderer_opt_bool(r, "clip_test");
     set->merge_px = (float)rl_renderer_opt_float(r, "merge_px");
+    set->nonlinear = rl_renderer_opt_enum(r, "nonlinear");
+    set->eps_ia = (float)rl_renderer_opt_float(r, "eps_ia");
+    set->shaft_cull = rl_renderer_opt_enum(r, "shaft_cull");
     set->textures = rl_renderer_opt_enum(r, "textures");
     set->progressive = rl_renderer_opt_enum(r, "progressive");
     set->update_every = (int)rl_renderer_opt_int(r, "update_every");

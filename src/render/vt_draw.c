@@ -448,14 +448,15 @@ void vt_draw_overlay(vt_run *run)
     } else if (run->set->overlay == VT_OVERLAY_SAMPLES) {
         /* Fig. 5.2c-d: red for discontinuities (ray tree), yellow for
          * non-linearities (intensity), blue for forced refinement, grey for
-         * the initial pattern. */
+         * the initial pattern. Sec. 6.1's splits join their kind: shafts
+         * the discontinuities, the nonlinearity tests the intensities. */
         for (uint32_t v = 0; v < m->num_verts; ++v) {
             const vt_vertex *x = &m->verts[v];
             if (x->state != VT_SAMPLED || !(x->cw > 0.0f))
                 continue;
             uint8_t r = v < run->per_vertex_cap ? run->reason[v] : 0;
-            rl_vec4 c = (r & VT_REASON_TREE) ? rl_v4(1.0f, 0.1f, 0.1f, 1.0f)
-                      : (r & (VT_REASON_RGB | VT_REASON_HSV)) ? rl_v4(1.0f, 0.9f, 0.1f, 1.0f)
+            rl_vec4 c = (r & (VT_REASON_TREE | VT_REASON_SHAFT)) ? rl_v4(1.0f, 0.1f, 0.1f, 1.0f)
+                      : (r & (VT_REASON_RGB | VT_REASON_HSV | VT_REASON_NONLINEAR)) ? rl_v4(1.0f, 0.9f, 0.1f, 1.0f)
                       : (r & VT_REASON_FORCED) ? rl_v4(0.2f, 0.5f, 1.0f, 1.0f)
                       : rl_v4(0.6f, 0.6f, 0.6f, 1.0f);
             rl_overlay_plot(img, (int)floorf(x->sx), (int)floorf(x->sy), c);

@@ -126,6 +126,11 @@ typedef struct refine_ctx {
     double refine_ms;   /* primary thread in refinement code, without the
                          * blocks the runtime had it sample meanwhile */
     double update_ms;   /* primary thread in progressive updates */
+    /* Sec. 6.1.2, shaft_cull on: the scene's triangle boxes, and per face
+     * the verdict of its shafts (0 not yet tested, 1 empty, 2 occupied):
+     * each face is asked once for each of its edges */
+    vt_shaft_index shafts;
+    uint8_t *face_shaft;  uint32_t face_shaft_cap;
 } refine_ctx;
 
 /* A package of a distributed frame (run->seed) refines its own faces: an
@@ -281,6 +286,49 @@ static uint8_t reason_of(unsigned bits)
                      ((bits & VT_CRIT_TREE) ? VT_REASON_TREE : 0));
 }
 
+/* Sec. 6.1.2: whether face f's shafts hold another object. */
+static bool face_shaft_fires(refine_ctx *ctx, uint32_t f)
+{
+    vt_run *run = ctx->run;
+    if (f == VT_NONE)
+        return false;
+    if (f >= ctx->face_shaft_cap) {
+        uint32_t old = ctx->face_shaft_cap;
+        if (!rl_reserve_u32((void **)&ctx->face_shaft, &ctx->face_shaft_cap, (uint64_t)run->mesh->num_faces,
+                            sizeof *ctx->face_shaft, 4096)) {
+            run->failed = true;
+            return false;
+        }
+        memset(ctx->face_shaft + old, 0, ctx->face_shaft_cap - old);
+    }
+    if (!ctx->face_shaft[f]) {
+        ctx->face_shaft[f] = vt_shaft_face_fires(run, &ctx->shafts, f) ? 2 : 1;
+        run->stats.shaft_faces_tested++;
+    }
+    return ctx->face_shaft[f] == 2;
+}
+
+/* Sec. 6.1: an edge the criteria let pass may still hide a highlight or a
+ * small occluder between its ends; the reason it is split for, or 0. */
+static uint8_t correctness_reason(refine_ctx *ctx, const vt_edge *ed)
+{
+    vt_run *run = ctx->run;
+    const vt_settings *set = run->set;
+    vt_mesh *m = run->mesh;
+    if (set->nonlinear != VT_NONLINEAR_OFF && vt_nonlinear_fires(run, &m->verts[ed->v[0]], &m->verts[ed->v[1]])) {
+        run->stats.splits_nonlinear++;
+        return VT_REASON_NONLINEAR;
+    }
+    if (set->shaft_cull != VT_SHAFT_OFF) {
+        uint32_t f0 = ed->face[0], f1 = ed->face[1];
+        if (face_shaft_fires(ctx, f0) || face_shaft_fires(ctx, f1)) {
+            run->stats.splits_shaft++;
+            return VT_REASON_SHAFT;
+        }
+    }
+    return 0;
+}
+
 /* One stage: the edges of the top octave, tested longest first. */
 static void run_stage(refine_ctx *ctx, uint16_t stage)
 {
@@ -311,8 +359,14 @@ static void run_stage(refine_ctx *ctx, uint16_t stage)
             continue;
         unsigned bits = vt_criteria_test(&run->set->criteria, &m->samples[ed->v[0]], &m->samples[ed->v[1]]);
         run->stats.edges_tested++;
-        if (!bits)
+        if (!bits) {
+            uint8_t why = correctness_reason(ctx, ed);
+            if (why && !run->failed)
+                split_edge(ctx, ctx->batch[i], why, stage);
+            if (why)
+                run_forced(ctx, stage);
             continue;
+        }
         run->stats.splits_rgb += (bits & VT_CRIT_RGB) != 0;
         run->stats.splits_hsv += (bits & VT_CRIT_HSV) != 0;
         run->stats.splits_tree += (bits & VT_CRIT_TREE) != 0;
@@ -506,12 +560,19 @@ rl_status vt_refine(vt_run *run)
     memset(&ctx, 0, sizeof ctx);
     ctx.run = run;
     double t0 = now_ms();
+    if (run->set->shaft_cull != VT_SHAFT_OFF) {
+        rl_status st = vt_shaft_index_build(&ctx.shafts, run->data);
+        if (st != RL_OK)
+            return st;
+    }
 #pragma omp parallel num_threads(run->set->threads)
 #pragma omp single
     refine_all(&ctx);
     double wall = now_ms() - t0;
     free(ctx.batch);
     free(ctx.forced);
+    free(ctx.face_shaft);
+    vt_shaft_index_free(&ctx.shafts);
     run->stats.time_refine_ms = ctx.refine_ms;
     run->stats.time_sampling_ms = wall - ctx.refine_ms - ctx.update_ms;
     if (run->failed)

@@ -24,6 +24,10 @@ enum { VT_OVERLAY_NONE = 0, VT_OVERLAY_WIRE, VT_OVERLAY_SAMPLES };
 
 /* Why a vertex exists (rl_vt_vertex_info.reason). */
 enum { VT_REASON_RGB = 1, VT_REASON_HSV = 2, VT_REASON_TREE = 4, VT_REASON_FORCED = 8 };
+/* Sec. 6.1 (vt_correct.c): a nonlinearity or a shaft's occluder split it. */
+enum { VT_REASON_NONLINEAR = 16, VT_REASON_SHAFT = 32 };
+enum { VT_NONLINEAR_OFF = 0, VT_NONLINEAR_EXTREMUM, VT_NONLINEAR_INTERVAL };
+enum { VT_SHAFT_OFF = 0, VT_SHAFT_SHADOW, VT_SHAFT_ALL };
 
 /* The options of one frame, validated and resolved (vt.c). */
 typedef struct vt_settings {
@@ -34,6 +38,9 @@ typedef struct vt_settings {
     bool id_test, z_test, clip_test;   /* Sec. 3.4.1-3.4.3 */
     float merge_px;           /* Sec. 6.2.1: primary edges shorter than this
                                * sample one end only; 0 = off */
+    int nonlinear;            /* Sec. 6.1.1: VT_NONLINEAR_* */
+    float eps_ia;             /* its interval bound that splits */
+    int shaft_cull;           /* Sec. 6.1.2: VT_SHAFT_* */
     int textures;             /* VT_TEX_* (Sec. 3.5.3-3.5.5) */
     int progressive;          /* VT_PROG_* (Sec. 3.5.1) */
     int update_every;         /* k */
@@ -237,6 +244,42 @@ void vt_project_primary(vt_run *run, const rl_image *depth_ids);
  * vertex budget is spent or an update/progress callback stops it. Runs the
  * parallel region. */
 rl_status vt_refine(vt_run *run);
+
+/* vt_correct.c (Sec. 6.1) ----------------------------------------------- */
+/* Sec. 6.1.1: whether the local term of some light may have an extremum
+ * (extremum, eq. 6.4-6.5) or a larger interpolation error than eps_ia
+ * (interval, Fig. 6.4) between the ends a and b of an edge, under the
+ * frame's setting nonlinear (false when off). */
+bool vt_nonlinear_fires(const vt_run *run, const vt_vertex *a, const vt_vertex *b);
+
+/* Sec. 6.1.2: the scene's triangles for the shaft test, per object in runs
+ * of VT_SHAFT_GROUP with their boxes (a two-level hierarchy below the
+ * objects' boxes), and the scene's extent d (Fig. 6.6b). */
+#define VT_SHAFT_GROUP 32
+typedef struct vt_shaft_index {
+    uint32_t *first;          /* per object + 1: its first group */
+    rl_aabb *box;             /* per group */
+    float extent;             /* diagonal of the scene's bounds */
+} vt_shaft_index;
+rl_status vt_shaft_index_build(vt_shaft_index *ix, const rl_scene_data *d);
+void vt_shaft_index_free(vt_shaft_index *ix);
+
+/* The shaft of [HW91]: the convex hull of two boxes, as their joint
+ * extent and up to 12 planes n.x <= offset. */
+typedef struct vt_shaft {
+    rl_aabb extent;
+    int num_planes;
+    rl_vec3 normal[12];
+    float offset[12];
+} vt_shaft;
+void vt_shaft_build(vt_shaft *s, rl_aabb a, rl_aabb b);
+/* false only when box x lies outside the shaft (conservative: a box near
+ * an edge of the hull may be called inside). */
+bool vt_shaft_meets_box(const vt_shaft *s, rl_aabb x);
+/* Fig. 6.6: whether a shaft of face (to a light; with shaft_cull = all
+ * also along its reflected and transmitted rays) holds geometry of
+ * another object: then all its edges are to be split. */
+bool vt_shaft_face_fires(const vt_run *run, const vt_shaft_index *ix, uint32_t face);
 
 /* vt_draw.c -------------------------------------------------------------- */
 /* Fig. 3.17, the rasterized half of the frame, drawn once per frame before

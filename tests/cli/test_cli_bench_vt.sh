@@ -27,7 +27,7 @@ expect_in "$TMP/err" "rl: error: "
 # Help, and the bench dispatcher knows vt.
 expect_exit 0 "$RL" bench vt --help
 for o in --size --anim-size --frames --threads --only --out --quick criteria modes forced preview reduction \
-    overdraw equalrays animation; do
+    overdraw equalrays animation correctness; do
     expect_in "$TMP/out" "$o"
 done
 expect_error 2 "known: rays, vt, pt" "$RL" bench nosuch
@@ -200,14 +200,40 @@ for k in ("vt_coherent_ms", "vt_plain_ms", "whitted_ms"):
     assert 0 < s["min"] <= s["mean"] <= s["max"], (k, s)
 PY
 
+# The full run leaves out the Sec. 6.1 study, which --only asks for.
+python3 -c 'import json, sys; assert "correctness" not in json.load(open(sys.argv[1]))' "$TMP/vt.json" ||
+    fail "the full run measured correctness"
+
 # --only runs the named sections and nothing else.
-expect_exit 0 "$RL" bench vt --quick --only visibility --size 32x32 -q --out "$TMP/o.json"
+expect_exit 0 "$RL" bench vt --quick --only visibility,correctness --size 32x32 -q --out "$TMP/o.json"
 python3 - "$TMP/o.json" <<'PY' || fail "o.json is wrong"
 import json, sys
 r = json.load(open(sys.argv[1]))
-assert r["parameters"]["sections"] == ["visibility"], r["parameters"]
+assert r["parameters"]["sections"] == ["visibility", "correctness"], r["parameters"]
 assert "visibility" in r and "criteria" not in r and "animation" not in r
 assert r["visibility"]["size"] == "32x32" and r["visibility"]["status"] == "ok"
+# Sec. 6.1: each option against off on the table and the two miss scenes;
+# off misses the highlight and the shadow, the matching option finds them.
+c = r["correctness"]
+assert c["status"] == "ok", c
+opts = ["off", "nonlinear=extremum", "nonlinear=interval", "shaft_cull=shadow", "shaft_cull=all"]
+rows = {(x["scene"], x["option"]): x for x in c["runs"]}
+assert [(x["setting"], x["option"]) for x in c["runs"] if x["scene"] == "table"] == \
+    [(s, o) for s in ("tree+hsv/1", "hsv/14") for o in opts], c["runs"]
+rows = {(x["scene"], x["option"]): x for x in c["runs"] if x.get("setting", "tree+hsv/1") == "tree+hsv/1"}
+for scene in ("highlight", "shadow"):
+    assert [x["option"] for x in c["runs"] if x["scene"] == scene] == ["whitted"] + opts, c["runs"]
+    assert rows[(scene, "off")]["vertices_generated"] == 0
+for x in c["runs"]:
+    if x["option"] != "whitted":
+        assert x["time_ms"] > 0 and x["vertices_sampled"] > 0, x
+        assert (x["splits_nonlinear"] > 0) <= x["option"].startswith("nonlinear"), x
+        assert (x["splits_shaft"] > 0) <= x["option"].startswith("shaft"), x
+def rmse(scene, opt):
+    return rows[(scene, opt)]["quality"]["vt_pixels"]["rmse"]
+for opt in ("nonlinear=extremum", "nonlinear=interval"):
+    assert rmse("highlight", opt) < 0.5 * rmse("highlight", "off"), (opt, rows)
+assert rmse("shadow", "shaft_cull=shadow") < 0.5 * rmse("shadow", "off"), rows
 PY
 
 # The reconstruction on the CPU and on GL (issue 35, part 5): where a GL 4.5

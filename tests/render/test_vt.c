@@ -700,6 +700,150 @@ static void nothing_in_view(void **state)
     rl_scene_release(s);
 }
 
+/* Sec. 6.1: a 4 x 4 m floor of one quad (two triangles, VT) under a
+ * directional light, seen from above. shiny: k_d 0.3, k_s 1, n 200, and
+ * the light mirrors into the eye at (0.8, 0, 0.6), about a metre from every
+ * vertex: a highlight none of the four samples sees (Fig. 6.1). Else a
+ * diffuse floor and a 0.3 m box (not VT) hovering over it, whose shadow
+ * falls around (0.3, 0, 0.6), inside a face too (Fig. 6.5a). */
+static rl_scene *sec61_scene(bool shiny)
+{
+    rl_scene *s = NULL;
+    assert_int_equal(rl_scene_create(&s), RL_OK);
+    rl_material m = rl_material_default();
+    snprintf(m.name, sizeof m.name, "%s", shiny ? "shiny" : "grey");
+    m.diffuse = shiny ? rl_v3(0.3f, 0.3f, 0.3f) : rl_v3(0.7f, 0.7f, 0.7f);
+    if (shiny) {
+        m.specular = rl_v3(1.0f, 1.0f, 1.0f);
+        m.shininess = 200.0f;
+    }
+    uint32_t mat;
+    assert_int_equal(rl_scene_add_material(s, &m, &mat), RL_OK);
+    add_grid(s, "floor", 1, 2.0f, mat, true);
+    rl_light l = { .type = RL_LIGHT_DIRECTIONAL, .color = rl_v3(1, 1, 1), .intensity = 1.0f };
+    if (shiny) {
+        /* the view direction from the highlight to the eye, mirrored */
+        rl_vec3 a = rl_normalize(rl_sub(rl_v3(0.0f, 4.0f, 3.0f), rl_v3(0.8f, 0.0f, 0.6f)));
+        l.direction = rl_neg(rl_v3(-a.x, a.y, -a.z));
+    } else {
+        l.direction = rl_v3(-0.5f, -1.0f, 0.0f);
+        uint32_t grey = add_material(s, "box", rl_v3(0.7f, 0.7f, 0.7f), 0.0f, 0.0f);
+        add_object(s, "box", "box", "size=0.3", grey, rl_mat4_translate(rl_v3(0.8f, 1.0f, 0.6f)), false);
+    }
+    assert_int_equal(rl_scene_add_light(s, &l), RL_OK);
+    assert_int_equal(rl_scene_commit(s), RL_OK);
+    return s;
+}
+
+/* RMSE of vt with opts against whitted on s, and its statistics. */
+static double sec61_error(const rl_scene *s, const rl_camera *cam, const char *const *opts, rl_vt_stats *st)
+{
+    rl_renderer *r = make_vt(opts);
+    rl_image *img = NULL;
+    *st = render_stats(r, s, cam, &img);
+    rl_image *ref = fx_render("whitted", s, cam, RL_LAYER_COLOR, NULL, NULL);
+    rl_image_metrics m;
+    assert_int_equal(rl_image_compare(img, ref, NULL, &m), RL_OK);
+    rl_image_release(ref);
+    rl_image_release(img);
+    rl_renderer_release(r);
+    return m.rmse;
+}
+
+/* Sec. 6.1.1: the default criteria miss the highlight inside a face (all
+ * four samples agree, nothing is refined); the extremum test (eq. 6.4-6.5)
+ * and the interval bound (Fig. 6.4) each split towards it and find it.
+ * Explicitly off is the default, to the byte. */
+static void nonlinear_finds_the_highlight(void **state)
+{
+    (void)state;
+    rl_scene *s = sec61_scene(true);
+    rl_camera cam = look(rl_v3(0.0f, 4.0f, 3.0f), rl_v3(0.0f, 0.0f, 0.0f), 64);
+    rl_vt_stats off, ext, ia;
+    const char *o_off[] = { "min_edge", "1", NULL };
+    const char *o_ext[] = { "min_edge", "1", "nonlinear", "extremum", NULL };
+    const char *o_ia[] = { "min_edge", "1", "nonlinear", "interval", NULL };
+    double e_off = sec61_error(s, &cam, o_off, &off);
+    double e_ext = sec61_error(s, &cam, o_ext, &ext);
+    double e_ia = sec61_error(s, &cam, o_ia, &ia);
+    print_message("highlight: rmse off %.4f (%llu generated), extremum %.4f (%llu, %llu nonlinear), "
+                  "interval %.4f (%llu, %llu nonlinear)\n", e_off, (unsigned long long)off.vertices_generated,
+                  e_ext, (unsigned long long)ext.vertices_generated, (unsigned long long)ext.splits_nonlinear,
+                  e_ia, (unsigned long long)ia.vertices_generated, (unsigned long long)ia.splits_nonlinear);
+    assert_int_equal(off.vertices_generated, 0);
+    assert_int_equal(off.splits_nonlinear, 0);
+    assert_true(e_off > 0.02);
+    assert_true(ext.splits_nonlinear > 0);
+    assert_true(ia.splits_nonlinear > 0);
+    assert_true(e_ext < 0.5 * e_off);
+    assert_true(e_ia < 0.5 * e_off);
+
+    const char *o_expl[] = { "min_edge", "1", "nonlinear", "off", "shaft_cull", "off", NULL };
+    rl_image *a = fx_render("vt", s, &cam, RL_LAYER_COLOR, o_off, NULL);
+    rl_image *b = fx_render("vt", s, &cam, RL_LAYER_COLOR, o_expl, NULL);
+    assert_memory_equal(a->color, b->color, (size_t)64 * 64 * sizeof *a->color);
+    rl_image_release(a);
+    rl_image_release(b);
+    rl_scene_release(s);
+}
+
+/* Sec. 6.1.2: the box's shadow falls inside a face and no feeler of the
+ * four corners meets the box: the default misses it. Shaft culling finds
+ * the box in the face's shaft to the light and refines down to it. The
+ * extremum test has nothing to find on this evenly lit floor. */
+static void shaft_culling_finds_the_small_shadow(void **state)
+{
+    (void)state;
+    rl_scene *s = sec61_scene(false);
+    rl_camera cam = look(rl_v3(0.0f, 4.0f, 3.0f), rl_v3(0.0f, 0.0f, 0.0f), 64);
+    rl_vt_stats off, sh, all, ext;
+    const char *o_off[] = { "min_edge", "1", NULL };
+    const char *o_sh[] = { "min_edge", "1", "shaft_cull", "shadow", NULL };
+    const char *o_all[] = { "min_edge", "1", "shaft_cull", "all", NULL };
+    const char *o_ext[] = { "min_edge", "1", "nonlinear", "extremum", NULL };
+    double e_off = sec61_error(s, &cam, o_off, &off);
+    double e_sh = sec61_error(s, &cam, o_sh, &sh);
+    double e_all = sec61_error(s, &cam, o_all, &all);
+    sec61_error(s, &cam, o_ext, &ext);
+    print_message("shadow: rmse off %.4f (%llu generated), shadow %.4f (%llu, %llu shaft, %llu faces tested), "
+                  "all %.4f (%llu)\n", e_off, (unsigned long long)off.vertices_generated, e_sh,
+                  (unsigned long long)sh.vertices_generated, (unsigned long long)sh.splits_shaft,
+                  (unsigned long long)sh.shaft_faces_tested, e_all, (unsigned long long)all.vertices_generated);
+    assert_int_equal(off.vertices_generated, 0);
+    assert_true(e_off > 0.02);
+    assert_true(sh.splits_shaft > 0);
+    assert_true(e_sh < 0.5 * e_off);
+    /* a diffuse floor reflects nothing: all adds no shaft */
+    assert_int_equal(all.vertices_generated, sh.vertices_generated);
+    assert_int_equal(ext.vertices_generated, 0);
+    rl_scene_release(s);
+
+    /* An area light drawn as an emissive quad mesh: its own triangles
+     * fill every shadow shaft's far end but shadow nothing (feelers stop
+     * short of the light), so nothing is split for them. */
+    assert_int_equal(rl_scene_create(&s), RL_OK);
+    uint32_t grey = add_material(s, "grey", rl_v3(0.7f, 0.7f, 0.7f), 0.0f, 0.0f);
+    rl_material glow = rl_material_default();
+    snprintf(glow.name, sizeof glow.name, "glow");
+    glow.emission = rl_v3(4.0f, 4.0f, 4.0f);
+    uint32_t glow_id;
+    assert_int_equal(rl_scene_add_material(s, &glow, &glow_id), RL_OK);
+    add_grid(s, "floor", 1, 2.0f, grey, true);
+    rl_mat4 up = rl_mat4_translate(rl_v3(0.0f, 2.0f, 0.0f));
+    add_grid_at(s, "lamp", 1, 0.25f, glow_id, false, &up);
+    rl_light quad = { .type = RL_LIGHT_QUAD, .color = rl_v3(1, 1, 1), .intensity = 8.0f,
+                      .position = rl_v3(-0.25f, 2.0f, -0.25f), .edge_u = rl_v3(0.5f, 0.0f, 0.0f),
+                      .edge_v = rl_v3(0.0f, 0.0f, 0.5f) };
+    assert_int_equal(rl_scene_add_light(s, &quad), RL_OK);
+    assert_int_equal(rl_scene_commit(s), RL_OK);
+    rl_renderer *r = make_vt(o_sh);
+    sh = render_stats(r, s, &cam, NULL);
+    assert_true(sh.shaft_faces_tested > 0);
+    assert_int_equal(sh.splits_shaft, 0);
+    rl_renderer_release(r);
+    rl_scene_release(s);
+}
+
 /* Invalid thresholds and lengths are refused with a message naming them. */
 static void bad_options(void **state)
 {
@@ -709,6 +853,8 @@ static void bad_options(void **state)
         { "eps_rgb", "-1" }, { "eps_h", "0.7" }, { "eps_s", "nan" }, { "eps_v", "-0.1" },
         { "min_edge", "-2" }, { "min_edge", "0" }, { "eps_z", "1.5" }, { "criteria", "colour" },
         { "objects", "" }, { "update_every", "0" }, { "max_vertices", "-5" },
+        { "nonlinear", "derivative" }, { "nonlinear", "" }, { "shaft_cull", "on" }, { "eps_ia", "0" },
+        { "eps_ia", "-1" },
     };
     for (size_t i = 0; i < sizeof bad / sizeof bad[0]; ++i) {
         rl_clear_error();
@@ -1122,6 +1268,8 @@ int main(void)
         cmocka_unit_test(deferred_textures_keep_the_texture),
         cmocka_unit_test(overdraw_offset_lets_children_win),
         cmocka_unit_test(nothing_in_view),
+        cmocka_unit_test(nonlinear_finds_the_highlight),
+        cmocka_unit_test(shaft_culling_finds_the_small_shadow),
         cmocka_unit_test(bad_options),
         cmocka_unit_test(packages_match_one_process),
         cmocka_unit_test(cost_estimate),

@@ -2,7 +2,8 @@
  * (vt_criteria.c; Ullmann 2003, Sec. 3.3.1): sRGB display values against
  * the closed form, HSV of the primaries and a mixed colour, and each
  * criterion firing just above its threshold and not just below it, with the
- * hue wrapping round the circle and ignored for greys. */
+ * hue wrapping round the circle and ignored for greys; and the shaft of
+ * [HW91] that Sec. 6.1.2's shaft culling builds (vt_correct.c). */
 #include <math.h>
 #include <setjmp.h>
 #include <stdarg.h>
@@ -12,7 +13,7 @@
 
 #include <cmocka.h>
 
-#include "render/vt_internal.h"
+#include "render/vt_run.h"
 
 /* Linear value whose display value is d (inverse sRGB transfer). */
 static float linear_of(float d)
@@ -195,6 +196,58 @@ static void test_tree_and_combinations_report_what_fired(void **state)
     assert_int_equal(vt_criteria_test(&c, &a, &b), 0);
 }
 
+static rl_aabb box_around(rl_vec3 p, float h)
+{
+    return (rl_aabb){ rl_v3(p.x - h, p.y - h, p.z - h), rl_v3(p.x + h, p.y + h, p.z + h) };
+}
+
+/* Sec. 6.1.2, [HW91]: the shaft of two boxes holds every point between
+ * them (no occluder is ever culled), and leaves out what lies in their
+ * joint extent but off the hull: past the slanted planes in the (x, y) and
+ * the (x, z) projection. */
+static void test_shaft_is_the_hull_of_two_boxes(void **state)
+{
+    (void)state;
+    vt_shaft s;
+    rl_aabb unit = { rl_v3(0.0f, 0.0f, 0.0f), rl_v3(1.0f, 1.0f, 1.0f) };
+    rl_vec3 light = rl_v3(3.0f, 3.0f, 0.5f);
+    vt_shaft_build(&s, unit, (rl_aabb){ light, light });
+    assert_true(s.num_planes > 0 && s.num_planes <= 12);
+    assert_true(vt_shaft_meets_box(&s, box_around(rl_v3(1.5f, 1.5f, 0.5f), 0.01f)));
+    assert_true(vt_shaft_meets_box(&s, box_around(rl_v3(2.9f, 2.9f, 0.5f), 0.01f)));
+    assert_false(vt_shaft_meets_box(&s, box_around(rl_v3(2.9f, 0.1f, 0.5f), 0.01f)));   /* (x, y) */
+    assert_false(vt_shaft_meets_box(&s, box_around(rl_v3(2.8f, 2.8f, 0.95f), 0.01f)));  /* (x, z) */
+    assert_false(vt_shaft_meets_box(&s, box_around(rl_v3(5.0f, 5.0f, 0.5f), 0.01f)));   /* past the extent */
+
+    /* Random pairs of boxes: a point between a point of each is inside. */
+    uint32_t seed = 12345u;
+    for (int trial = 0; trial < 200; ++trial) {
+        float v[12];
+        for (int k = 0; k < 12; ++k) {
+            seed = seed * 1664525u + 1013904223u;
+            v[k] = (float)(seed >> 8) / 16777216.0f * 10.0f - 5.0f;
+        }
+        rl_aabb a = { rl_vmin(rl_v3(v[0], v[1], v[2]), rl_v3(v[3], v[4], v[5])),
+                      rl_vmax(rl_v3(v[0], v[1], v[2]), rl_v3(v[3], v[4], v[5])) };
+        rl_aabb b = { rl_vmin(rl_v3(v[6], v[7], v[8]), rl_v3(v[9], v[10], v[11])),
+                      rl_vmax(rl_v3(v[6], v[7], v[8]), rl_v3(v[9], v[10], v[11])) };
+        vt_shaft_build(&s, a, b);
+        for (int k = 0; k < 20; ++k) {
+            float u[7];
+            for (int c = 0; c < 7; ++c) {
+                seed = seed * 1664525u + 1013904223u;
+                u[c] = (float)(seed >> 8) / 16777216.0f;
+            }
+            rl_vec3 pa = rl_v3(a.min.x + u[0] * (a.max.x - a.min.x), a.min.y + u[1] * (a.max.y - a.min.y),
+                               a.min.z + u[2] * (a.max.z - a.min.z));
+            rl_vec3 pb = rl_v3(b.min.x + u[3] * (b.max.x - b.min.x), b.min.y + u[4] * (b.max.y - b.min.y),
+                               b.min.z + u[5] * (b.max.z - b.min.z));
+            rl_vec3 p = rl_vlerp(pa, pb, u[6]);
+            assert_true(vt_shaft_meets_box(&s, (rl_aabb){ p, p }));
+        }
+    }
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -204,6 +257,7 @@ int main(void)
         cmocka_unit_test(test_rgb_fires_on_l1_of_display_values),
         cmocka_unit_test(test_hsv_hue_wraps_and_is_ignored_for_greys),
         cmocka_unit_test(test_tree_and_combinations_report_what_fired),
+        cmocka_unit_test(test_shaft_is_the_hull_of_two_boxes),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
