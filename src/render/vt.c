@@ -62,6 +62,7 @@ static const char *const overlay_choices[] = { "none", "wire", "samples", NULL }
 static const char *const reconstruct_choices[] = { "software", "gl", NULL };
 static const char *const balance_choices[] = { "queue", "precompute", NULL };
 static const char *const cost_choices[] = { "faces", "estimate", NULL };
+static const char *const hint_choices[] = { "off", "agree", "parents", NULL };   /* VT_HINT_* */
 enum { RECONSTRUCT_SOFTWARE, RECONSTRUCT_GL };
 
 static const rl_option_info vt_options[] = {
@@ -84,6 +85,13 @@ static const rl_option_info vt_options[] = {
     { "merge_px", RL_OPT_FLOAT, "0",
       "sample reduction (Sec. 6.2.1): the ends of a primary edge projected shorter than this many pixels "
       "share one sample (0 = off; the thesis suggests <= 1)", 0, 16, NULL },
+    { "hint", RL_OPT_ENUM, "off",
+      "intersection hints (Sec. 3.3.1, 6.2.2): a refined vertex's rays first test the triangles its parent "
+      "vertices' rays hit: off | agree (parents whose ray trees name the same triangles) | parents (both "
+      "parents' triangles, ray by ray); exact: the image does not change", 0, 0, hint_choices },
+    { "presort", RL_OPT_BOOL, "false",
+      "ray presorting (Sec. 6.2.2): sample the vertices of a refinement stage by VT object and along a "
+      "Morton curve on the screen; the image does not change", 0, 0, NULL },
     { "textures", RL_OPT_ENUM, "multitexture",
       "deferred textures: multitexture (eq. 3.20, one pass), multipass (eq. 3.22), sampled (no deferral)",
       0, 0, texture_choices },
@@ -404,6 +412,8 @@ static void read_settings(rl_renderer *r, vt_settings *set)
     set->ambient = (float)rl_renderer_opt_float(r, "ambient");
     set->background = rl_renderer_opt_color(r, "background");
     set->overlay = rl_renderer_opt_enum(r, "overlay");
+    set->hint = rl_renderer_opt_enum(r, "hint");
+    set->presort = rl_renderer_opt_bool(r, "presort");
 }
 
 /* What the cached feelers depend on besides the scene. */
@@ -633,6 +643,9 @@ static rl_status run_frame(vt_run *run, vt_state *s, const vt_settings *set, rl_
     free(run->reason);
     free(run->feelers);
     vt_feeler_pool_free(&run->feeler_pool);
+    free(run->hints);
+    vt_feeler_pool_free(&run->hint_pool);
+    free(run->sorting);
     return st;
 }
 
@@ -674,6 +687,8 @@ static rl_status vt_render(rl_renderer *r, void *state, const rl_scene *scene, c
         run.stats.thread_rays[t] = run.tally[t].rays;
         run.stats.thread_busy_ms[t] = run.tally[t].busy_ms;
         run.stats.feelers_reused += run.tally[t].feelers_reused;
+        run.stats.hint_tests += run.tally[t].hint_tests;
+        run.stats.hint_hits += run.tally[t].hint_hits;
     }
     s->stats = run.stats;
     s->have_frame = true;
@@ -745,6 +760,9 @@ static void dist_end(vt_run *run, rl_tracer *tracer)
     free(run->reason);
     free(run->feelers);
     vt_feeler_pool_free(&run->feeler_pool);
+    free(run->hints);
+    vt_feeler_pool_free(&run->hint_pool);
+    free(run->sorting);
     rl_tracer_release(tracer);
 }
 
@@ -941,6 +959,8 @@ rl_status rl_vt_refine_faces(rl_renderer *r, const rl_scene *scene, const rl_cam
             run.stats.thread_rays[t] = run.tally[t].rays;
             run.stats.thread_busy_ms[t] = run.tally[t].busy_ms;
             run.stats.feelers_reused += run.tally[t].feelers_reused;
+            run.stats.hint_tests += run.tally[t].hint_tests;
+            run.stats.hint_hits += run.tally[t].hint_hits;
         }
         s->stats = run.stats;
         if (stats) {
