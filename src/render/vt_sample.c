@@ -60,25 +60,40 @@ void vt_feelers_unpack(const vt_feelers_packed *p, const uint32_t *occluder, rl_
 
 /* ------------------------------------------------- intersection hints -- */
 
-/* A sample's hint list (rl_trace_hints) into pool, like vt_feelers_pack. */
+/* A sample's hint list (rl_trace_hints) into pool, like vt_feelers_pack,
+ * run-length coded as (triangle, run) pairs: the feelers of an area light
+ * mostly all see the light or all hit one triangle, and every sampled
+ * vertex keeps its list for the frame. Maximal runs make the code
+ * canonical: two lists are equal exactly when their codes are. */
+_Static_assert(2 * RL_TRACE_HINT_MAX <= UINT8_MAX, "a code's length fits vt_feelers_packed.count");
 static bool hints_pack(const rl_trace_hints *h, vt_feeler_pool *pool, vt_feelers_packed *out)
 {
     uint32_t n = h->count < RL_TRACE_HINT_MAX ? h->count : RL_TRACE_HINT_MAX;
-    if (pool->count + n > UINT32_MAX || !rl_reserve((void **)&pool->occluder, &pool->cap, pool->count + n,
-                                                    sizeof *pool->occluder, 256))
+    uint32_t code[2 * RL_TRACE_HINT_MAX], words = 0;
+    for (uint32_t i = 0; i < n; ++i) {
+        if (words && code[words - 2] == h->triangle[i]) {
+            code[words - 1]++;
+            continue;
+        }
+        code[words++] = h->triangle[i];
+        code[words++] = 1;
+    }
+    if (pool->count + words > UINT32_MAX || !rl_reserve((void **)&pool->occluder, &pool->cap, pool->count + words,
+                                                        sizeof *pool->occluder, 256))
         return false;
-    *out = (vt_feelers_packed){ (uint32_t)pool->count, (uint8_t)n, 0, 1 };
-    if (n)
-        memcpy(pool->occluder + pool->count, h->triangle, n * sizeof *h->triangle);
-    pool->count += n;
+    *out = (vt_feelers_packed){ (uint32_t)pool->count, (uint8_t)words, 0, 1 };
+    if (words)
+        memcpy(pool->occluder + pool->count, code, words * sizeof *code);
+    pool->count += words;
     return true;
 }
 
 static void hints_unpack(const vt_feelers_packed *p, const uint32_t *pool, rl_trace_hints *out)
 {
-    out->count = p->count;
-    if (p->count)
-        memcpy(out->triangle, pool + p->first, p->count * sizeof *pool);
+    out->count = 0;
+    for (uint32_t w = 0; w + 1 < p->count; w += 2)
+        for (uint32_t k = 0; k < pool[p->first + w + 1] && out->count < RL_TRACE_HINT_MAX; ++k)
+            out->triangle[out->count++] = pool[p->first + w];
 }
 
 static bool hints_equal(const vt_feelers_packed *a, const vt_feelers_packed *b, const uint32_t *pool)
