@@ -354,7 +354,8 @@ static void test_triangle_test_and_occluder_agree_with_the_queries(void **state)
         /* triangles about a quarter of the box wide, scattered through it */
         rl_vec3 centre = i % 3 == 0 ? rl_v3(4.0f * c[0] - 2.0f, 4.0f * c[1] - 2.0f, 4.0f * c[2] - 2.0f)
                                     : pos[i - i % 3];
-        pos[i] = i % 3 == 0 ? centre : rl_add(centre, rl_v3(2.0f * c[0] - 1.0f, 2.0f * c[1] - 1.0f, 2.0f * c[2] - 1.0f));
+        rl_vec3 offset = rl_v3(2.0f * c[0] - 1.0f, 2.0f * c[1] - 1.0f, 2.0f * c[2] - 1.0f);
+        pos[i] = i % 3 == 0 ? centre : rl_add(centre, offset);
     }
     rl_scene *s = triangles_scene(pos, T, true);
     const rl_accel_kind kinds[] = { RL_ACCEL_BRUTE, RL_ACCEL_BVH, RL_ACCEL_GRID };
