@@ -28,7 +28,10 @@
  * a frame with coherence is bit-identical to one without.
  *
  * Collision detection (Sec. 3.4.4, the thesis' OOB hierarchy for ray-object
- * intersection) is the accel option: any rl_accel, BVH by default.
+ * intersection) is the accel option: any rl_accel, BVH by default. Its
+ * speed-ups of Sec. 6.2.2 are options, both exact: hint (a refined vertex's
+ * rays test its parents' hit triangles first, trace.c) and presort (a
+ * stage's vertices sampled in object and Morton order, vt_sample.c).
  *
  * reconstruct = gl (device: the EGL device) draws the image, the non-VT
  * objects and the refined mesh with its deferred textures, with a GL
