@@ -19,6 +19,9 @@
  *               drawing time (time_draw_ms) and frame time of
  *               reconstruct=software and =gl in the same run, and the SSIM
  *               between their images; the record names the GL renderer
+ *   hint        Sec. 6.2.2: intersection hints and ray presorting on the
+ *               table and cluster scenes, one thread, CPU time; the images
+ *               must not change
  * The static sections use the built-in scene `table` (Sec. 5.1) with its
  * default camera.
  *
@@ -96,6 +99,10 @@ static const char bench_vt_help[] =
     "  animation   cluster scene camera path with and without temporal coherence\n"
     "  reconstruct the drawing (Sec. 3.5) on the CPU rasterizer and on OpenGL\n"
     "              (reconstruct=gl) per texture mode: draw and frame time, SSIM\n"
+    "  hint        intersection hints and ray presorting (Sec. 6.2.2) on and off on\n"
+    "              the table and cluster scenes, one thread: hint tests and hits,\n"
+    "              CPU time (least of 3, interleaved); the images must not change\n"
+    "              (--quick: table only, off against hint=parents presort=true)\n"
     "\n"
     "options:\n"
     "  --scene SPEC      scene of the static sections; default table (the thesis-like\n"
@@ -119,11 +126,11 @@ static const char bench_vt_help[] =
 /* The static sections (the table scene) come before animation. */
 enum { SEC_CRITERIA, SEC_RESOLUTION, SEC_QUALITY, SEC_THREADS, SEC_VISIBILITY, SEC_MODES, SEC_FORCED,
        SEC_PREVIEW, SEC_REDUCTION, SEC_OVERDRAW, SEC_EQUAL_RAYS, SEC_ANIMATION,
-       SEC_RECONSTRUCT, SEC_CORRECTNESS, SEC_COUNT };
+       SEC_RECONSTRUCT, SEC_CORRECTNESS, SEC_HINT, SEC_COUNT };
 static const char *const section_names[SEC_COUNT] = { "criteria", "resolution", "quality", "threads",
                                                       "visibility", "modes", "forced", "preview",
                                                       "reduction", "overdraw", "equalrays", "animation",
-                                                      "reconstruct", "correctness" };
+                                                      "reconstruct", "correctness", "hint" };
 
 /* The shading modes of Ullmann 2003, Figs. 5.9/5.10, as bits: shadow
  * feelers (S), reflection rays (R), transmission rays (T). */
@@ -238,6 +245,8 @@ static cJSON *vt_stats_json(const rl_vt_stats *s)
         { "splits_nonlinear", s->splits_nonlinear },
         { "splits_shaft", s->splits_shaft },
         { "shaft_faces_tested", s->shaft_faces_tested },
+        { "hint_tests", s->hint_tests },
+        { "hint_hits", s->hint_hits },
         { "mesh_bytes", s->mesh_bytes },
         { "stages", s->stages },
         { "threads", s->threads },
@@ -1563,6 +1572,149 @@ static rl_status sec_reduction(void *ctx, cJSON *sec)
     return st;
 }
 
+/* -------------------------------------------------------------- hint -- */
+
+static double cpu_ms(void)
+{
+    struct timespec t;
+    return clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t) == 0 ? 1e3 * (double)t.tv_sec + 1e-6 * (double)t.tv_nsec
+                                                             : NAN;
+}
+
+/* One configuration of the hint section: its renderer, last image and the
+ * least times over the rounds. */
+typedef struct hint_run {
+    const char *hint, *presort;
+    rl_renderer *r;
+    rl_image *img;
+    double cpu_ms, wall_ms, sampling_ms, refine_ms, preview_ms;
+    rl_render_stats stats;
+    rl_vt_stats vt;
+} hint_run;
+
+/* Ullmann Sec. 6.2.2, efficient collision detection: intersection hints
+ * from the parents' ray trees (Sec. 3.3.1) and ray presorting, each on and
+ * off. Exact, so every configuration must give the off image bit for bit;
+ * what changes is the work. One thread: the CPU time of the process is
+ * then the frame's, and the configurations take turns round by round, so
+ * that a load change on the shared machine hits them all alike; the least
+ * of each is kept. */
+static rl_status hint_scene(bvt *b, cJSON *rows, const char *name, const rl_scene *scene, const rl_camera *cam0)
+{
+    static const struct {
+        const char *hint, *presort;
+    } cfg[] = { { "off", "false" }, { "agree", "false" }, { "parents", "false" }, { "off", "true" },
+                { "parents", "true" } };
+    enum { N = sizeof cfg / sizeof cfg[0] };
+    const int rounds = b->runs > 1 ? 3 : 1;
+    /* --quick (ctest): off against both on, enough to check the record */
+    const int n = b->a->quick ? 2 : N;
+    const int pick[N] = { 0, b->a->quick ? N - 1 : 1, 2, 3, 4 };
+    int w = b->a->width, h = b->a->height;
+    rl_camera cam = sized(cam0, w, h);
+    hint_run x[N];
+    memset(x, 0, sizeof x);
+    rl_status st = RL_OK;
+    for (int i = 0; st == RL_OK && i < n; i++) {
+        x[i].hint = cfg[pick[i]].hint;
+        x[i].presort = cfg[pick[i]].presort;
+        x[i].cpu_ms = x[i].wall_ms = x[i].sampling_ms = x[i].refine_ms = x[i].preview_ms = INFINITY;
+        st = make_renderer("vt", 1, &x[i].r);
+        if (st == RL_OK)
+            st = rl_renderer_set(x[i].r, "hint", x[i].hint);
+        if (st == RL_OK)
+            st = rl_renderer_set(x[i].r, "presort", x[i].presort);
+        if (st == RL_OK)
+            st = rl_image_create(w, h, RL_LAYER_COLOR, &x[i].img);
+        if (st == RL_OK)   /* warm-up: accelerator and VT meshes */
+            st = rl_renderer_render(x[i].r, scene, &cam, x[i].img, NULL);
+    }
+    for (int k = 0; st == RL_OK && k < rounds; k++) {
+        for (int j = 0; st == RL_OK && j < n; j++) {
+            hint_run *c = &x[(j + k) % n];   /* a different one first each round */
+            rl_render_stats stats;
+            double c0 = cpu_ms();
+            st = rl_renderer_render(c->r, scene, &cam, c->img, &stats);
+            double cpu = cpu_ms() - c0;
+            rl_vt_stats vt;
+            if (st == RL_OK)
+                st = rl_vt_get_stats(c->r, &vt);
+            if (st != RL_OK)
+                break;
+            c->cpu_ms = fmin(c->cpu_ms, cpu);
+            c->sampling_ms = fmin(c->sampling_ms, vt.time_sampling_ms);
+            c->refine_ms = fmin(c->refine_ms, vt.time_refine_ms);
+            c->preview_ms = fmin(c->preview_ms, vt.time_preview_ms);
+            if (stats.time_ms < c->wall_ms) {
+                c->wall_ms = stats.time_ms;
+                c->stats = stats;
+                c->vt = vt;
+            }
+        }
+    }
+    char size[32];
+    snprintf(size, sizeof size, "%dx%d", w, h);
+    if (st == RL_OK) {
+        printf("\nintersection hints and presorting (Sec. 6.2.2): %s %s, 1 thread, least of %d interleaved\n",
+               name, size, rounds);
+        printf("%-8s %-7s %10s %10s %10s %9s %8s %9s %9s %8s %s\n", "hint", "presort", "rays", "hint tests",
+               "hint hits", "CPU ms", "/off", "sample ms", "refine ms", "wall ms", "image");
+    }
+    size_t pixels = (size_t)w * (size_t)h;
+    for (int i = 0; st == RL_OK && i < n; i++) {
+        bool same = memcmp(x[i].img->color, x[0].img->color, pixels * sizeof *x[0].img->color) == 0;
+        cJSON *row = cJSON_CreateObject();
+        cJSON_AddItemToArray(rows, row);
+        cJSON_AddStringToObject(row, "scene", name);
+        cJSON_AddStringToObject(row, "size", size);
+        cJSON_AddStringToObject(row, "hint", x[i].hint);
+        cJSON_AddBoolToObject(row, "presort", strcmp(x[i].presort, "true") == 0);
+        cJSON_AddBoolToObject(row, "image_identical_to_off", same);
+        cJSON_AddItemToObject(row, "rays", rays_json(&x[i].stats));
+        cJSON_AddNumberToObject(row, "hint_tests", (double)x[i].vt.hint_tests);
+        cJSON_AddNumberToObject(row, "hint_hits", (double)x[i].vt.hint_hits);
+        add_num(row, "min_cpu_ms", x[i].cpu_ms);
+        add_num(row, "cpu_ratio_to_off", ratio(x[i].cpu_ms, x[0].cpu_ms));
+        add_num(row, "min_wall_ms", x[i].wall_ms);
+        add_num(row, "min_sampling_ms", x[i].sampling_ms);
+        add_num(row, "min_refine_ms", x[i].refine_ms);
+        add_num(row, "min_preview_ms", x[i].preview_ms);
+        cJSON_AddItemToObject(row, "vt_stats", vt_stats_json(&x[i].vt));
+        printf("%-8s %-7s %10llu %10llu %10llu %9.1f %8.3f %9.1f %9.1f %8.1f %s\n", x[i].hint, x[i].presort,
+               (unsigned long long)rays_total(&x[i].stats), (unsigned long long)x[i].vt.hint_tests,
+               (unsigned long long)x[i].vt.hint_hits, x[i].cpu_ms, ratio(x[i].cpu_ms, x[0].cpu_ms),
+               x[i].sampling_ms, x[i].refine_ms, x[i].wall_ms, same ? "same" : "DIFFERS");
+        fflush(stdout);
+        note("hint %s presort %s %s %s: %.1f ms CPU (%.3f of off), %llu hint hits of %llu tests", x[i].hint,
+             x[i].presort, name, size, x[i].cpu_ms, ratio(x[i].cpu_ms, x[0].cpu_ms),
+             (unsigned long long)x[i].vt.hint_hits, (unsigned long long)x[i].vt.hint_tests);
+        if (!same)
+            st = bench_error(b, RL_ERR_INTERNAL, "hint %s presort %s changed the image of %s", x[i].hint,
+                             x[i].presort, name);
+    }
+    for (int i = 0; i < N; i++) {
+        rl_renderer_release(x[i].r);
+        rl_image_release(x[i].img);
+    }
+    return st;
+}
+
+static rl_status sec_hint(void *ctx, cJSON *sec)
+{
+    bvt *b = ctx;
+    cJSON_AddStringToObject(sec, "note", "one thread; CPU time of the process per frame, least of the rounds, "
+                                         "configurations interleaved; the machine may be shared, so ratios "
+                                         "within a scene are what to compare");
+    cJSON *rows = cJSON_AddArrayToObject(sec, "runs");
+    rl_status st = hint_scene(b, rows, table_spec(b), b->table, &b->table_cam);
+    rl_camera cam;
+    if (st == RL_OK && !b->a->quick)
+        st = rl_scene_get_camera(b->cluster, NULL, &cam);
+    if (st == RL_OK && !b->a->quick)
+        st = hint_scene(b, rows, "cluster", b->cluster, &cam);
+    return st;
+}
+
 /* ---------------------------------------------------------- overdraw -- */
 
 #define OD_STAGES 12
@@ -2194,7 +2346,7 @@ static int run(bvt *b)
             return fits;
     }
     /* Every section but animation renders the table. */
-    bool static_sections = wants(a, SEC_RECONSTRUCT) || wants(a, SEC_CORRECTNESS);
+    bool static_sections = wants(a, SEC_RECONSTRUCT) || wants(a, SEC_CORRECTNESS) || wants(a, SEC_HINT);
     for (int k = 0; k < SEC_ANIMATION; k++)
         static_sections = static_sections || wants(a, k);
     int rc = RL_CLI_OK;
@@ -2206,7 +2358,8 @@ static int run(bvt *b)
         if (st != RL_OK)
             return cli_fail_status(RL_CLI_FAIL, st, "bench vt: table camera");
     }
-    if (wants(a, SEC_ANIMATION) && (rc = load("cluster", &b->cluster, &b->cluster_vt)) != RL_CLI_OK)
+    if ((wants(a, SEC_ANIMATION) || (wants(a, SEC_HINT) && !a->quick)) &&
+        (rc = load("cluster", &b->cluster, &b->cluster_vt)) != RL_CLI_OK)
         return rc;
 
     cJSON *root = report_root(b);
@@ -2215,7 +2368,7 @@ static int run(bvt *b)
     static const bench_section_fn fns[SEC_COUNT] = { sec_criteria, sec_resolution, sec_quality, sec_threads,
                                                      sec_visibility, sec_modes, sec_forced, sec_preview,
                                                      sec_reduction, sec_overdraw, sec_equal_rays,
-                                                     sec_animation, sec_reconstruct, sec_correctness };
+                                                     sec_animation, sec_reconstruct, sec_correctness, sec_hint };
     printf("rl bench vt: Vertex Tracing vs Whitted, %d threads, max_depth %s, area_samples %s, "
            "shadows %s\n", b->threads, TRACE_MAX_DEPTH, TRACE_AREA_SAMPLES, TRACE_SHADOWS);
     rc = bench_run_sections("vt", root, section_names, fns, SEC_COUNT, a->sections, b,

@@ -90,6 +90,21 @@ RL_API const rl_scene *rl_accel_scene(const rl_accel *accel);
 RL_API bool rl_accel_intersect(const rl_accel *accel, rl_ray *ray, rl_hit *hit);
 /* Any hit in (t_min, t_max): shadow and visibility rays. */
 RL_API bool rl_accel_occluded(const rl_accel *accel, const rl_ray *ray);
+/* Intersection hints (Ullmann 2003, Sec. 3.3.1, 6.2.2: the ray tree of
+ * neighbouring samples names the surfaces a ray will likely hit).
+ * rl_accel_intersect_triangle runs the watertight test of the kinds of ours
+ * against one scene triangle alone: true for a hit with t in (t_min, t_max)
+ * that is not in an alpha-mask hole, with *hit filled (object too) and the
+ * ray left as it is. Its t, u, v are bit for bit those the BVH, grid and
+ * brute force compute for that triangle (not necessarily Embree's). False
+ * for a triangle out of range or an invalid ray.
+ * rl_accel_occluder is rl_accel_occluded that also names a triangle that
+ * blocks the ray (any one in range, not necessarily the closest), or
+ * RL_ID_NONE when the ray is not occluded; what it returns is exactly what
+ * rl_accel_occluded returns. */
+RL_API bool rl_accel_intersect_triangle(const rl_accel *accel, const rl_ray *ray, uint32_t triangle,
+                                        rl_hit *hit);
+RL_API bool rl_accel_occluder(const rl_accel *accel, const rl_ray *ray, uint32_t *triangle);
 /* Batches: the same as calling the single-ray query for each ray in order
  * (same results), possibly faster. Single-threaded: callers parallelise. */
 RL_API void rl_accel_intersect_n(const rl_accel *accel, rl_ray *rays, rl_hit *hits, size_t n);

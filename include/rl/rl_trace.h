@@ -158,6 +158,22 @@ typedef struct rl_trace_feelers {
     uint32_t occluder[RL_TRACE_FEELER_CACHE_MAX];
 } rl_trace_feelers;
 
+/* Intersection hints (Ullmann 2003, Sec. 3.3.1 and 6.2.2): the triangle each
+ * ray of a sample hit, in the order the rays were met (the ray tree's order
+ * without the primary ray; a feeler replayed from the cache takes its slot
+ * too): the closest hit of a reflection or refraction ray, the occluder of
+ * a blocked shadow feeler (with the any-hit query, any occluder in range),
+ * RL_ID_NONE for a miss, a visible light or a replayed feeler. A sample
+ * traced with the hints of its neighbours first tests each ray against the
+ * triangles they name in its slot: a shadow feeler that hits one is
+ * blocked at once, a closest-hit ray searches the accelerator only up to
+ * that hit. Exact: the results are the same as without hints (trace.c). */
+#define RL_TRACE_HINT_MAX 64
+typedef struct rl_trace_hints {
+    uint32_t count;           /* slots filled, 0..RL_TRACE_HINT_MAX */
+    uint32_t triangle[RL_TRACE_HINT_MAX];
+} rl_trace_hints;
+
 typedef struct rl_trace_sample {
     rl_vec3 color;            /* radiance towards the eye, textures applied:
                                * equals rl_tracer_shade() of the same point */
@@ -167,6 +183,10 @@ typedef struct rl_trace_sample {
     uint64_t rays[RL_RAY_TYPE_COUNT];  /* rays traced (cached feelers excluded;
                                         * the eye ray counts as one primary) */
     uint32_t feelers_reused;  /* depth-0 feelers answered from the cache */
+    uint32_t hint_tests;      /* rays tested against a hinted triangle first */
+    uint32_t hint_hits;       /* of those, a hinted triangle was hit: a
+                               * feeler ended there, or the search was
+                               * bounded by it */
 } rl_trace_sample;
 
 /* Shades the point as seen from eye (the primary ray eye -> p, eq. 3.1, is
@@ -182,6 +202,19 @@ RL_API void rl_tracer_shade_point(const rl_tracer *tracer, rl_vec3 eye, const rl
                                   uint64_t sample_id, const rl_trace_feelers *cache_in,
                                   rl_trace_feelers *cache_out, rl_trace_sample *out,
                                   rl_ray_tree *tree);
+
+/* rl_tracer_shade_point with intersection hints: hint_in (may be NULL, or
+ * either entry NULL) lists the triangles to test first, slot by slot; two
+ * lists, so that a vertex can take those of both its parents (Ullmann 2003,
+ * Sec. 3.3.1: the ray trees of the samples at an edge's ends). hint_out
+ * (may be NULL) receives this sample's own. Hints never change the result,
+ * only the work: the tracer falls back to the full search wherever a hint
+ * does not hold, and ignores them on an Embree accelerator, whose triangle
+ * test is not ours. */
+RL_API void rl_tracer_shade_point_hinted(const rl_tracer *tracer, rl_vec3 eye, const rl_trace_point *pt,
+                                         uint64_t sample_id, const rl_trace_feelers *cache_in,
+                                         rl_trace_feelers *cache_out, const rl_trace_hints *const hint_in[2],
+                                         rl_trace_hints *hint_out, rl_trace_sample *out, rl_ray_tree *tree);
 
 #ifdef __cplusplus
 }

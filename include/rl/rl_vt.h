@@ -57,6 +57,11 @@ typedef struct rl_vt_stats {
     uint64_t splits_nonlinear;         /* edges split by option nonlinear (Sec. 6.1.1) */
     uint64_t splits_shaft;             /* edges split by option shaft_cull (Sec. 6.1.2) */
     uint64_t shaft_faces_tested;       /* faces whose shafts were built and tested */
+    /* Sec. 6.2.2, option hint: rays of refined vertices tested first
+     * against a triangle their parent vertices' rays hit in the same slot
+     * of the ray tree, and of those the rays where a hinted triangle was
+     * hit (a shadow feeler ended there, or the search stopped at it). */
+    uint64_t hint_tests, hint_hits;
 } rl_vt_stats;
 
 /* Statistics of the last frame rendered by r. RL_ERR_INVALID_ARG when r is

@@ -234,6 +234,47 @@ bool rl_accel_occluded(const rl_accel *accel, const rl_ray *ray)
     return rl_accel_intersect(accel, &r, &h);
 }
 
+bool rl_accel_occluder(const rl_accel *accel, const rl_ray *ray, uint32_t *triangle)
+{
+    if (!triangle)
+        return rl_accel_occluded(accel, ray);
+    *triangle = RL_ID_NONE;
+    if (!accel || !ray || !accel->committed || !ray_is_valid(ray))
+        return false;
+    if (!accel->masked && accel->cls->occluder)
+        return accel->cls->occluder(accel->state, ray, triangle);
+    /* Masks (see rl_accel_occluded), or a kind that cannot name its
+     * occluder: the closest hit names one, at the price of a full search. */
+    rl_ray r = *ray;
+    rl_hit h;
+    if (!rl_accel_intersect(accel, &r, &h))
+        return false;
+    *triangle = h.triangle;
+    return true;
+}
+
+bool rl_accel_intersect_triangle(const rl_accel *accel, const rl_ray *ray, uint32_t triangle, rl_hit *hit)
+{
+    if (!accel || !ray || !hit || !accel->committed || !ray_is_valid(ray) ||
+        triangle >= accel->data->num_triangles)
+        return false;
+    const rl_scene_data *d = accel->data;
+    const uint32_t *idx = &d->indices[3 * (size_t)triangle];
+    rl_ray_watertight w;
+    rl_ray_watertight_setup(ray, &w);
+    float t, u, v;
+    /* The vertices in scene index order, as every kind of ours stores them:
+     * the edge functions then sum in the same order and t is the same
+     * float. */
+    if (!rl_triangle_intersect_watertight(&w, d->positions[idx[0]], d->positions[idx[1]], d->positions[idx[2]],
+                                          ray->t_min, ray->t_max, &t, &u, &v))
+        return false;
+    if (accel->masked && rl_alpha_masked(d, triangle, u, v))
+        return false;
+    *hit = (rl_hit){ .t = t, .u = u, .v = v, .triangle = triangle, .object = d->triangle_object[triangle] };
+    return true;
+}
+
 void rl_accel_intersect_n(const rl_accel *accel, rl_ray *rays, rl_hit *hits, size_t n)
 {
     if (!rays || !hits)

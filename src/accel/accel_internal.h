@@ -18,6 +18,9 @@ typedef struct rl_accel_class {
                        rl_accel_stats *stats);
     bool (*intersect)(const void *state, rl_ray *ray, rl_hit *hit);
     bool (*occluded)(const void *state, const rl_ray *ray);
+    /* occluded naming the blocking triangle (rl_accel_occluder); may be
+     * NULL: accel.c then asks intersect, which names the closest. */
+    bool (*occluder)(const void *state, const rl_ray *ray, uint32_t *triangle);
     void (*release)(void *state);
 } rl_accel_class;
 

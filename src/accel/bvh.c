@@ -50,6 +50,11 @@ static bool bvh_occluded(const void *state, const rl_ray *ray) {
     return rl_bvh_wide_occluded(state, ray);
 }
 
+static bool bvh_occluder(const void *state, const rl_ray *ray, uint32_t *triangle)
+{
+    return rl_bvh_wide_occluder(state, ray, triangle);
+}
+
 static void bvh_release(void *state)
 {
     rl_bvh_free(state);
@@ -61,5 +66,6 @@ const rl_accel_class rl_accel_bvh_class = {
     .build = bvh_build,
     .intersect = bvh_intersect,
     .occluded = bvh_occluded,
+    .occluder = bvh_occluder,
     .release = bvh_release,
 };

@@ -91,5 +91,7 @@ rl_status rl_bvh_widen(rl_bvh *bvh);
 /* Traversal of the wide tree (bvh_wide_traverse.c). */
 bool rl_bvh_wide_intersect(const rl_bvh *bvh, rl_ray *ray, rl_hit *hit);
 bool rl_bvh_wide_occluded(const rl_bvh *bvh, const rl_ray *ray);
+/* rl_bvh_wide_occluded naming the first blocking triangle it met. */
+bool rl_bvh_wide_occluder(const rl_bvh *bvh, const rl_ray *ray, uint32_t *triangle);
 
 #endif

@@ -362,15 +362,18 @@ RL_WT_INLINE void leaf_closest_k(const rl_bvh_block *blk, uint32_t count, const 
     }
 }
 
-RL_WT_INLINE bool leaf_any_k(const rl_bvh_block *blk, uint32_t count, const rl_ray_watertight *w, int kx,
-                             int ky, int kz, float t_min, float t_max)
+/* The ID of a triangle of the leaf in (t_min, t_max), RL_ID_NONE if none:
+ * rl_accel_occluder names it, and a hit costs one bit scan more. */
+RL_WT_INLINE uint32_t leaf_any_k(const rl_bvh_block *blk, uint32_t count, const rl_ray_watertight *w, int kx,
+                                 int ky, int kz, float t_min, float t_max)
 {
     for (uint32_t i = 0; i < count; i += RL_BVH_LANES, ++blk) {
         float t[RL_BVH_LANES], u[RL_BVH_LANES], v[RL_BVH_LANES];
-        if (block_hits_k(blk, w, kx, ky, kz, t_min, t_max, t, u, v))
-            return true;
+        int mask = block_hits_k(blk, w, kx, ky, kz, t_min, t_max, t, u, v);
+        if (mask)
+            return blk->id[lowest_lane((unsigned)mask)];
     }
-    return false;
+    return RL_ID_NONE;
 }
 
 /* One loop per axis permutation (kz, then kx; ky follows), so that the
@@ -388,7 +391,8 @@ static void leaf_closest(const rl_bvh_block *tri, uint32_t count, const rl_ray_w
     }
 }
 
-static bool leaf_any(const rl_bvh_block *tri, uint32_t count, const rl_ray_watertight *w, float t_min, float t_max)
+static uint32_t leaf_any(const rl_bvh_block *tri, uint32_t count, const rl_ray_watertight *w, float t_min,
+                         float t_max)
 {
     switch (w->kz * 3 + w->kx) {
     case 0 * 3 + 1: return leaf_any_k(tri, count, w, 1, 2, 0, t_min, t_max);
@@ -438,6 +442,12 @@ finished:
 
 bool rl_bvh_wide_occluded(const rl_bvh *bvh, const rl_ray *ray)
 {
+    uint32_t triangle;
+    return rl_bvh_wide_occluder(bvh, ray, &triangle);
+}
+
+bool rl_bvh_wide_occluder(const rl_bvh *bvh, const rl_ray *ray, uint32_t *triangle)
+{
     ray_pre p;
     ray_pre_setup(ray, &p);
     rl_ray_watertight w;
@@ -451,11 +461,16 @@ bool rl_bvh_wide_occluded(const rl_bvh *bvh, const rl_ray *ray)
             if (visit(bvh, &bvh->wide[cur.ref], &p, t_min, t_max, stack, &sp, &cur))
                 continue;
         } else {
-            if (leaf_any(&bvh->blocks[cur.ref], cur.count, &w, t_min, t_max))
+            uint32_t id = leaf_any(&bvh->blocks[cur.ref], cur.count, &w, t_min, t_max);
+            if (id != RL_ID_NONE) {
+                *triangle = id;
                 return true;   /* any hit will do */
+            }
         }
-        if (sp == 0)
+        if (sp == 0) {
+            *triangle = RL_ID_NONE;
             return false;
+        }
         cur = stack[--sp];
     }
 }

@@ -139,6 +139,10 @@ rl_status rl_tracer_create(const rl_accel *accel, const rl_tracer_desc *desc, rl
     t->transmitted_highlight = !d.no_transmitted_highlight;
     t->tree_shadow_any_hit = d.tree_shadow_any_hit;
     t->defer_through = d.defer_through;
+    /* Hints rely on the triangle test being the accelerator's own. */
+    rl_accel_stats st;
+    rl_accel_get_stats(accel, &st);
+    t->hints = st.kind != RL_ACCEL_EMBREE;
     t->seed = d.seed;
     t->eps = EPS_SCALE * scene_scale(data->bounds);
     *out = t;
@@ -316,13 +320,119 @@ static rl_vec3 shade_hit(rl_trace_ctx *ctx, const rl_ray *ray, const rl_hit *hit
     return shade_surface(ctx, &s, d, depth, weight, layer);
 }
 
+/* ---------------------------------------------- intersection hints -- */
+
+/* Ullmann 2003, Sec. 3.3.1 (Fig. 3.7: the ray tree also serves object-space
+ * coherence) and Sec. 6.2.2 (faster collision detection for the samples of
+ * refinement, which lie between samples already traced). A hinted
+ * triangle is a guess, so each use must give what the full query gives:
+ *  - any hit (shadow feelers without a tree): the query asks whether some
+ *    triangle not in a hole is hit in (t_min, t_max). A hinted triangle
+ *    hit there by the very test the accelerator runs (watertight.h, the
+ *    same floats) is such a triangle: the answer is yes, and the search is
+ *    skipped.
+ *  - closest hit: the accelerators of ours return the hit of least t, ties
+ *    to the lowest triangle ID (accel.c), whatever the t_max they start
+ *    from, as long as that hit is below it; a hinted hit at t_h proves the
+ *    closest one is at t <= t_h, so a search up to nextafter(t_h), which
+ *    still admits ties at t_h, finds the same hit; its boxes beyond t_h are
+ *    culled, which is the whole gain (the traversal is built to be exact
+ *    from any bound, since it shrinks its own as it goes). Should that
+ *    search come back empty (an alpha-mask hole at t_h hides the rest of
+ *    its interval), the full search runs after all.
+ * The hinted hit itself is never returned: the search finds it again, so
+ * the result cannot depend on the hint. */
+
+uint32_t rl_trace_slot(rl_trace_ctx *ctx)
+{
+    return ctx->slot++;
+}
+
+void rl_trace_record(rl_trace_ctx *ctx, uint32_t slot, uint32_t triangle)
+{
+    rl_trace_hints *h = ctx->hint_out;
+    if (!h || slot >= RL_TRACE_HINT_MAX)
+        return;
+    while (h->count < slot)
+        h->triangle[h->count++] = RL_ID_NONE;
+    h->triangle[slot] = triangle;
+    if (h->count <= slot)
+        h->count = slot + 1;
+}
+
+/* The distinct triangles the hint lists name in slot (0-2). */
+static int hints_at(const rl_trace_ctx *ctx, uint32_t slot, uint32_t cand[2])
+{
+    int n = 0;
+    for (int i = 0; i < 2; ++i) {
+        const rl_trace_hints *h = ctx->hint_in[i];
+        if (!h || slot >= h->count || slot >= RL_TRACE_HINT_MAX)
+            continue;
+        uint32_t t = h->triangle[slot];
+        if (t != RL_ID_NONE && (n == 0 || cand[0] != t))
+            cand[n++] = t;
+    }
+    return n;
+}
+
+bool rl_trace_intersect(rl_trace_ctx *ctx, uint32_t slot, rl_ray *ray, rl_hit *hit)
+{
+    const rl_accel *accel = ctx->tracer->accel;
+    uint32_t cand[2];
+    int n = hints_at(ctx, slot, cand);
+    bool found = false;
+    if (n) {
+        ctx->hint_tests++;
+        float t_h = INFINITY;
+        for (int i = 0; i < n; ++i) {
+            rl_hit h;
+            if (rl_accel_intersect_triangle(accel, ray, cand[i], &h) && h.t < t_h)
+                t_h = h.t;
+        }
+        if (t_h < INFINITY) {
+            ctx->hint_hits++;
+            rl_ray bounded = *ray;
+            bounded.t_max = nextafterf(t_h, INFINITY);   /* <= ray->t_max, as t_h < it */
+            if ((found = rl_accel_intersect(accel, &bounded, hit)))
+                ray->t_max = bounded.t_max;
+        }
+    }
+    if (!found)
+        found = rl_accel_intersect(accel, ray, hit);
+    rl_trace_record(ctx, slot, found ? hit->triangle : RL_ID_NONE);
+    return found;
+}
+
+bool rl_trace_occluded(rl_trace_ctx *ctx, uint32_t slot, const rl_ray *ray)
+{
+    const rl_accel *accel = ctx->tracer->accel;
+    uint32_t cand[2];
+    int n = hints_at(ctx, slot, cand);
+    if (n)
+        ctx->hint_tests++;
+    for (int i = 0; i < n; ++i) {
+        rl_hit h;
+        if (rl_accel_intersect_triangle(accel, ray, cand[i], &h)) {
+            ctx->hint_hits++;
+            rl_trace_record(ctx, slot, cand[i]);
+            return true;
+        }
+    }
+    if (!ctx->hint_out)
+        return rl_accel_occluded(accel, ray);
+    uint32_t tri;
+    bool blocked = rl_accel_occluder(accel, ray, &tri);
+    rl_trace_record(ctx, slot, tri);
+    return blocked;
+}
+
 rl_vec3 rl_trace_ray(rl_trace_ctx *ctx, rl_ray ray, rl_ray_type type, int depth, float weight,
                      rl_trace_layer *layer)
 {
     ctx->rays[type]++;
     uint32_t node = rl_trace_tree_push(ctx, type, depth, RL_ID_NONE, RL_ID_NONE);
     rl_hit hit = { INFINITY, 0.0f, 0.0f, RL_ID_NONE, RL_ID_NONE };
-    if (!rl_accel_intersect(ctx->tracer->accel, &ray, &hit))
+    if (!rl_trace_intersect(ctx, rl_trace_slot(ctx), &ray, &hit))
         return miss(ctx->tracer, ray.d, layer);
     if (node != RL_ID_NONE)
         ctx->tree->nodes[node].object = hit.object;

@@ -27,6 +27,7 @@ struct rl_tracer {
     bool transmitted_highlight;   /* eq. 3.17's k_t cos^p φ_t term */
     bool tree_shadow_any_hit; /* see rl_tracer_desc */
     bool defer_through;       /* see rl_tracer_desc */
+    bool hints;               /* intersection hints are exact on this accel */
     uint64_t seed;
     float eps;                /* secondary-ray origin offset, see trace.c */
 };
@@ -42,7 +43,21 @@ typedef struct rl_trace_ctx {
     rl_trace_feelers *cache_out;       /* recorded depth-0 feelers, or NULL */
     uint32_t feelers;         /* depth-0 feelers met so far */
     uint32_t reused;          /* of those, answered from cache_in */
+    /* intersection hints (rl_trace_hints); both NULL outside trace_point.c */
+    const rl_trace_hints *hint_in[2];  /* entries may be NULL */
+    rl_trace_hints *hint_out;
+    uint32_t slot;            /* rays met so far: the next ray's hint slot */
+    uint32_t hint_tests, hint_hits;
 } rl_trace_ctx;
+
+/* Intersection hints (trace.c). rl_trace_slot takes the next ray's slot;
+ * the queries answer like rl_accel_intersect / the feeler's query, trying
+ * the slot's hinted triangles first, and record the triangle found in
+ * hint_out. */
+uint32_t rl_trace_slot(rl_trace_ctx *ctx);
+void rl_trace_record(rl_trace_ctx *ctx, uint32_t slot, uint32_t triangle);
+bool rl_trace_intersect(rl_trace_ctx *ctx, uint32_t slot, rl_ray *ray, rl_hit *hit);
+bool rl_trace_occluded(rl_trace_ctx *ctx, uint32_t slot, const rl_ray *ray);
 
 /* Zeroes rays (RL_RAY_TYPE_COUNT counters), empties the tree and seeds the
  * jitter from (tracer seed, sample_id) so that a sample repeats exactly. */

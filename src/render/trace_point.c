@@ -72,6 +72,14 @@ void rl_tracer_shade_point(const rl_tracer *tracer, rl_vec3 eye, const rl_trace_
                            const rl_trace_feelers *cache_in, rl_trace_feelers *cache_out, rl_trace_sample *out,
                            rl_ray_tree *tree)
 {
+    rl_tracer_shade_point_hinted(tracer, eye, pt, sample_id, cache_in, cache_out, NULL, NULL, out, tree);
+}
+
+void rl_tracer_shade_point_hinted(const rl_tracer *tracer, rl_vec3 eye, const rl_trace_point *pt,
+                                  uint64_t sample_id, const rl_trace_feelers *cache_in, rl_trace_feelers *cache_out,
+                                  const rl_trace_hints *const hint_in[2], rl_trace_hints *hint_out,
+                                  rl_trace_sample *out, rl_ray_tree *tree)
+{
     if (!tracer || !pt || !out)
         return;
     const rl_scene_data *data = tracer->data;
@@ -81,6 +89,15 @@ void rl_tracer_shade_point(const rl_tracer *tracer, rl_vec3 eye, const rl_trace_
     rl_trace_ctx ctx;
     rl_trace_begin(tracer, sample_id, out->rays, tree, &ctx);
     ctx.rays[RL_RAY_PRIMARY]++;
+    if (hint_out)
+        hint_out->count = 0;
+    if (tracer->hints) {
+        if (hint_in) {
+            ctx.hint_in[0] = hint_in[0];
+            ctx.hint_in[1] = hint_in[1];
+        }
+        ctx.hint_out = hint_out;
+    }
 
     /* Like rl_tracer_shade(): no triangle, or no direction to the eye, is a
      * miss; the point's own object names the primary node otherwise. */
@@ -114,6 +131,8 @@ void rl_tracer_shade_point(const rl_tracer *tracer, rl_vec3 eye, const rl_trace_
         cache_out->complete = ctx.feelers <= RL_TRACE_FEELER_CACHE_MAX;
     }
     out->feelers_reused = ctx.reused;
+    out->hint_tests = ctx.hint_tests;
+    out->hint_hits = ctx.hint_hits;
 
     for (int i = 0; i < RL_TRACE_LAYER_COUNT; ++i) {
         const rl_trace_layer *layer = &out->layers[i];

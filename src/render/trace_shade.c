@@ -92,15 +92,15 @@ static bool transmits(const rl_trace_ctx *ctx, const rl_trace_surface *s)
 }
 
 /* Occluder of a feeler by tracing it; RL_ID_NONE if the light is visible. */
-static uint32_t trace_feeler(rl_trace_ctx *ctx, const rl_trace_surface *s, rl_vec3 l, float dist)
+static uint32_t trace_feeler(rl_trace_ctx *ctx, uint32_t slot, const rl_trace_surface *s, rl_vec3 l, float dist)
 {
     const rl_tracer *tr = ctx->tracer;
     ctx->rays[RL_RAY_SHADOW]++;
     rl_ray ray = { rl_trace_offset(tr, s, l), 0.0f, l, isinf(dist) ? INFINITY : dist * (1.0f - SHADOW_T_SHRINK) };
     if (!ctx->tree || tr->tree_shadow_any_hit)
-        return rl_accel_occluded(tr->accel, &ray) ? RL_TRACE_OCCLUDER_UNKNOWN : RL_ID_NONE;
+        return rl_trace_occluded(ctx, slot, &ray) ? RL_TRACE_OCCLUDER_UNKNOWN : RL_ID_NONE;
     rl_hit hit = { INFINITY, 0.0f, 0.0f, RL_ID_NONE, RL_ID_NONE };
-    return rl_accel_intersect(tr->accel, &ray, &hit) ? hit.object : RL_ID_NONE;
+    return rl_trace_intersect(ctx, slot, &ray, &hit) ? hit.object : RL_ID_NONE;
 }
 
 /* One feeler from s towards unit l over dist; true if the light is visible.
@@ -113,11 +113,13 @@ static bool feeler(rl_trace_ctx *ctx, const rl_trace_surface *s, rl_vec3 l, floa
     if (!ctx->tracer->shadows)
         return true;
     uint32_t occluder;
+    uint32_t slot = rl_trace_slot(ctx);
     if (depth == 0 && ctx->cache_in && ctx->feelers < ctx->cache_in->count) {
         occluder = ctx->cache_in->occluder[ctx->feelers];
         ctx->reused++;
+        rl_trace_record(ctx, slot, RL_ID_NONE);   /* the cache names no triangle */
     } else {
-        occluder = trace_feeler(ctx, s, l, dist);
+        occluder = trace_feeler(ctx, slot, s, l, dist);
     }
     rl_trace_tree_push(ctx, RL_RAY_SHADOW, depth + 1, occluder, light);
     if (depth == 0) {

@@ -28,7 +28,10 @@
  * a frame with coherence is bit-identical to one without.
  *
  * Collision detection (Sec. 3.4.4, the thesis' OOB hierarchy for ray-object
- * intersection) is the accel option: any rl_accel, BVH by default.
+ * intersection) is the accel option: any rl_accel, BVH by default. Its
+ * speed-ups of Sec. 6.2.2 are options, both exact: hint (a refined vertex's
+ * rays test its parents' hit triangles first, trace.c) and presort (a
+ * stage's vertices sampled in object and Morton order, vt_sample.c).
  *
  * reconstruct = gl (device: the EGL device) draws the image, the non-VT
  * objects and the refined mesh with its deferred textures, with a GL
@@ -64,6 +67,7 @@ static const char *const balance_choices[] = { "queue", "precompute", NULL };
 static const char *const cost_choices[] = { "faces", "estimate", NULL };
 static const char *const nonlinear_choices[] = { "off", "extremum", "interval", NULL };
 static const char *const shaft_choices[] = { "off", "shadow", "all", NULL };
+static const char *const hint_choices[] = { "off", "agree", "parents", NULL };   /* VT_HINT_* */
 enum { RECONSTRUCT_SOFTWARE, RECONSTRUCT_GL };
 
 static const rl_option_info vt_options[] = {
@@ -97,6 +101,13 @@ static const rl_option_info vt_options[] = {
       "Sec. 6.1.2, small occluders between an edge's samples: off | shadow (split the edges of a face whose "
       "shaft to a light holds another object's triangles, [HW91], Fig. 6.6a) | all (also its reflection and "
       "transmission shafts, Fig. 6.6b)", 0, 0, shaft_choices },
+    { "hint", RL_OPT_ENUM, "off",
+      "intersection hints (Sec. 3.3.1, 6.2.2): a refined vertex's rays first test the triangles its parent "
+      "vertices' rays hit: off | agree (parents whose ray trees name the same triangles) | parents (both "
+      "parents' triangles, ray by ray); exact: the image does not change", 0, 0, hint_choices },
+    { "presort", RL_OPT_BOOL, "false",
+      "ray presorting (Sec. 6.2.2): sample the vertices of a refinement stage by VT object and along a "
+      "Morton curve on the screen; the image does not change", 0, 0, NULL },
     { "textures", RL_OPT_ENUM, "multitexture",
       "deferred textures: multitexture (eq. 3.20, one pass), multipass (eq. 3.22), sampled (no deferral)",
       0, 0, texture_choices },
@@ -420,6 +431,8 @@ static void read_settings(rl_renderer *r, vt_settings *set)
     set->ambient = (float)rl_renderer_opt_float(r, "ambient");
     set->background = rl_renderer_opt_color(r, "background");
     set->overlay = rl_renderer_opt_enum(r, "overlay");
+    set->hint = rl_renderer_opt_enum(r, "hint");
+    set->presort = rl_renderer_opt_bool(r, "presort");
 }
 
 /* What the cached feelers depend on besides the scene. */
@@ -649,6 +662,9 @@ static rl_status run_frame(vt_run *run, vt_state *s, const vt_settings *set, rl_
     free(run->reason);
     free(run->feelers);
     vt_feeler_pool_free(&run->feeler_pool);
+    free(run->hints);
+    vt_feeler_pool_free(&run->hint_pool);
+    free(run->sorting);
     return st;
 }
 
@@ -690,6 +706,8 @@ static rl_status vt_render(rl_renderer *r, void *state, const rl_scene *scene, c
         run.stats.thread_rays[t] = run.tally[t].rays;
         run.stats.thread_busy_ms[t] = run.tally[t].busy_ms;
         run.stats.feelers_reused += run.tally[t].feelers_reused;
+        run.stats.hint_tests += run.tally[t].hint_tests;
+        run.stats.hint_hits += run.tally[t].hint_hits;
     }
     s->stats = run.stats;
     s->have_frame = true;
@@ -761,6 +779,9 @@ static void dist_end(vt_run *run, rl_tracer *tracer)
     free(run->reason);
     free(run->feelers);
     vt_feeler_pool_free(&run->feeler_pool);
+    free(run->hints);
+    vt_feeler_pool_free(&run->hint_pool);
+    free(run->sorting);
     rl_tracer_release(tracer);
 }
 
@@ -955,6 +976,8 @@ rl_status rl_vt_refine_faces(rl_renderer *r, const rl_scene *scene, const rl_cam
             run.stats.thread_rays[t] = run.tally[t].rays;
             run.stats.thread_busy_ms[t] = run.tally[t].busy_ms;
             run.stats.feelers_reused += run.tally[t].feelers_reused;
+            run.stats.hint_tests += run.tally[t].hint_tests;
+            run.stats.hint_hits += run.tally[t].hint_hits;
         }
         s->stats = run.stats;
         if (stats) {

@@ -237,7 +237,7 @@ static void split_edge(refine_ctx *ctx, uint32_t e, uint8_t reason, uint16_t sta
     run->stats.vertices_generated++;
     if (reason & VT_REASON_FORCED)
         run->stats.splits_forced++;
-    vt_sample_queue(run, mid);
+    vt_sample_queue_mid(run, mid, m->edges[e].v[0], m->edges[e].v[1]);
     for (uint32_t i = 0; i < ne; ++i)
         consider_edge(ctx, new_edges[i], false);
     if (run->set->forced)

@@ -52,7 +52,16 @@ typedef struct vt_settings {
     float ambient;
     rl_vec3 background;
     int overlay;              /* VT_OVERLAY_* */
+    int hint;                 /* VT_HINT_* (Sec. 3.3.1, 6.2.2) */
+    bool presort;             /* sample a stage's vertices in VT-object and
+                               * screen Morton order (Sec. 6.2.2) */
 } vt_settings;
+
+/* Intersection hints (Sec. 3.3.1, 6.2.2): which triangles a refined
+ * vertex's rays test first. agree: those of its two parent vertices when
+ * their ray trees name the same triangles throughout (the thesis' case);
+ * parents: those of both parents slot by slot, whether or not they agree. */
+enum { VT_HINT_OFF = 0, VT_HINT_AGREE, VT_HINT_PARENTS };
 
 /* Depth-0 shadow feelers of one vertex, packed: rl_trace_feelers has room
  * for 64 occluders (264 bytes) where a vertex under two point lights
@@ -110,6 +119,11 @@ typedef struct vt_block {
     uint64_t rays[VT_BLOCK][RL_RAY_TYPE_COUNT];
     vt_feelers_packed feelers[VT_BLOCK];           /* coherence: the new ones, */
     vt_feeler_pool feeler_pool;                    /* ... their occluders */
+    /* hints: the parents' lists in run->hint_pool (count 0: none) and the
+     * block's own, in hint_pool */
+    vt_feelers_packed hint_in[VT_BLOCK][2];
+    vt_feelers_packed hints[VT_BLOCK];
+    vt_feeler_pool hint_pool;
     bool failed;              /* out of memory in the sampling thread */
     struct vt_block *next;
 } vt_block;
@@ -119,7 +133,8 @@ typedef struct vt_thread_tally {
     uint64_t rays;
     uint64_t feelers_reused;
     double busy_ms;
-    char pad[40];
+    uint64_t hint_tests, hint_hits;
+    char pad[24];
 } vt_thread_tally;
 
 /* The VT leaf faces as a layered raster batch (vt_draw.c): three corners
@@ -170,7 +185,13 @@ typedef struct vt_run {
     uint8_t *reason;
     vt_feelers_packed *feelers;   /* coherence only: this frame's feelers, */
     vt_feeler_pool feeler_pool;   /* ... and their occluders */
+    vt_feelers_packed *hints;     /* hint only: each sampled vertex's ray */
+    vt_feeler_pool hint_pool;     /* ... triangles (rl_trace_hints), packed */
     uint32_t per_vertex_cap;
+    /* presort: the vertices queued this stage, sorted and sampled at the
+     * flush */
+    struct vt_queued *sorting;
+    uint32_t num_sorting, cap_sorting;
     bool want_tree;           /* the ray-tree criterion is on */
     /* temporal coherence */
     const vt_feeler_map *cache;   /* or NULL */
@@ -213,6 +234,9 @@ typedef struct vt_run {
  * is spawned as a task. Call from the primary thread inside the parallel
  * region (or outside it: then the block is sampled at vt_sample_flush). */
 void vt_sample_queue(vt_run *run, uint32_t v);
+/* vt_sample_queue for the midpoint v of the edge (a, b): with hints on, its
+ * rays test the triangles of a's and b's first (VT_HINT_*). */
+void vt_sample_queue_mid(vt_run *run, uint32_t v, uint32_t a, uint32_t b);
 /* Spawns the partly filled block, waits for all blocks of this stage and
  * copies their results into the mesh (state VT_SAMPLED). vt_sample_queue
  * does the same for the full blocks alone when too many are pending: a

@@ -58,6 +58,49 @@ void vt_feelers_unpack(const vt_feelers_packed *p, const uint32_t *occluder, rl_
         memcpy(out->occluder, occluder + p->first, p->count * sizeof *occluder);
 }
 
+/* ------------------------------------------------- intersection hints -- */
+
+/* A sample's hint list (rl_trace_hints) into pool, like vt_feelers_pack,
+ * run-length coded as (triangle, run) pairs: the feelers of an area light
+ * mostly all see the light or all hit one triangle, and every sampled
+ * vertex keeps its list for the frame. Maximal runs make the code
+ * canonical: two lists are equal exactly when their codes are. */
+_Static_assert(2 * RL_TRACE_HINT_MAX <= UINT8_MAX, "a code's length fits vt_feelers_packed.count");
+static bool hints_pack(const rl_trace_hints *h, vt_feeler_pool *pool, vt_feelers_packed *out)
+{
+    uint32_t n = h->count < RL_TRACE_HINT_MAX ? h->count : RL_TRACE_HINT_MAX;
+    uint32_t code[2 * RL_TRACE_HINT_MAX], words = 0;
+    for (uint32_t i = 0; i < n; ++i) {
+        if (words && code[words - 2] == h->triangle[i]) {
+            code[words - 1]++;
+            continue;
+        }
+        code[words++] = h->triangle[i];
+        code[words++] = 1;
+    }
+    if (pool->count + words > UINT32_MAX || !rl_reserve((void **)&pool->occluder, &pool->cap, pool->count + words,
+                                                        sizeof *pool->occluder, 256))
+        return false;
+    *out = (vt_feelers_packed){ (uint32_t)pool->count, (uint8_t)words, 0, 1 };
+    if (words)
+        memcpy(pool->occluder + pool->count, code, words * sizeof *code);
+    pool->count += words;
+    return true;
+}
+
+static void hints_unpack(const vt_feelers_packed *p, const uint32_t *pool, rl_trace_hints *out)
+{
+    out->count = 0;
+    for (uint32_t w = 0; w + 1 < p->count; w += 2)
+        for (uint32_t k = 0; k < pool[p->first + w + 1] && out->count < RL_TRACE_HINT_MAX; ++k)
+            out->triangle[out->count++] = pool[p->first + w];
+}
+
+static bool hints_equal(const vt_feelers_packed *a, const vt_feelers_packed *b, const uint32_t *pool)
+{
+    return a->count == b->count && memcmp(pool + a->first, pool + b->first, a->count * sizeof *pool) == 0;
+}
+
 void vt_feeler_pool_free(vt_feeler_pool *pool)
 {
     free(pool->occluder);
@@ -152,6 +195,14 @@ rl_status vt_run_reserve(vt_run *run)
             return RL_ERR_OUT_OF_MEMORY;
         run->feelers = f;
     }
+    if (run->set->hint != VT_HINT_OFF) {
+        vt_feelers_packed *h = rl_realloc_array(run->hints, cap, sizeof *h);
+        if (!h)
+            return RL_ERR_OUT_OF_MEMORY;
+        run->hints = h;
+        /* count 0: no hints (a vertex not sampled, or merged) */
+        memset(h + run->per_vertex_cap, 0, (cap - run->per_vertex_cap) * sizeof *h);
+    }
     memset(run->reason + run->per_vertex_cap, 0, cap - run->per_vertex_cap);
     run->per_vertex_cap = cap;
     return RL_OK;
@@ -176,16 +227,33 @@ static void sample_block(vt_run *run, vt_block *b)
     rl_ray_tree tree;
     rl_trace_sample s;
     rl_trace_feelers in, out_feelers;
+    /* The parents' lists live in run->hint_pool, which only collect()
+     * grows, after its taskwait: no block runs meanwhile. */
+    rl_trace_hints parent[2], own;
+    const bool hint = run->set->hint != VT_HINT_OFF;
     memset(&in, 0, sizeof in);
     b->feeler_pool.count = 0;
+    b->hint_pool.count = 0;
     b->failed = false;
     for (uint32_t i = 0; i < b->count; ++i) {
         if (b->cache_in[i])
             vt_feelers_unpack(b->cache_in[i], run->cache->pool.occluder, &in);
-        rl_tracer_shade_point(run->tracer, run->view.eye, &b->point[i], b->key[i], b->cache_in[i] ? &in : NULL,
-                              run->set->coherence ? &out_feelers : NULL, &s, run->want_tree ? &tree : NULL);
+        const rl_trace_hints *hint_in[2] = { NULL, NULL };
+        for (int k = 0; hint && k < 2; ++k) {
+            if (b->hint_in[i][k].count) {
+                hints_unpack(&b->hint_in[i][k], run->hint_pool.occluder, &parent[k]);
+                hint_in[k] = &parent[k];
+            }
+        }
+        rl_tracer_shade_point_hinted(run->tracer, run->view.eye, &b->point[i], b->key[i],
+                                     b->cache_in[i] ? &in : NULL, run->set->coherence ? &out_feelers : NULL,
+                                     hint_in, hint ? &own : NULL, &s, run->want_tree ? &tree : NULL);
         if (run->set->coherence && !vt_feelers_pack(&out_feelers, &b->feeler_pool, &b->feelers[i]))
             b->failed = true;
+        if (hint && !hints_pack(&own, &b->hint_pool, &b->hints[i]))
+            b->failed = true;
+        tally->hint_tests += s.hint_tests;
+        tally->hint_hits += s.hint_hits;
         vt_vertex_sample *out = &b->out[i];
         /* Without deferred textures the criteria see them too. */
         out->flat = run->set->textures == VT_TEX_SAMPLED ? s.color : s.flat;
@@ -213,8 +281,10 @@ static vt_block *take_block(vt_run *run)
         run->free_blocks = b->next;
     else if (!(b = malloc(sizeof *b)))
         return NULL;
-    else
+    else {
         memset(&b->feeler_pool, 0, sizeof b->feeler_pool);
+        memset(&b->hint_pool, 0, sizeof b->hint_pool);
+    }
     b->count = 0;
     b->next = NULL;
     return b;
@@ -258,6 +328,12 @@ static void collect(vt_run *run)
                 if (!vt_feelers_pack(&f, &run->feeler_pool, &run->feelers[b->vertex[i]]))
                     run->failed = true;
             }
+            if (run->set->hint != VT_HINT_OFF && !b->failed && b->vertex[i] < run->per_vertex_cap) {
+                rl_trace_hints h;
+                hints_unpack(&b->hints[i], b->hint_pool.occluder, &h);
+                if (!hints_pack(&h, &run->hint_pool, &run->hints[b->vertex[i]]))
+                    run->failed = true;
+            }
         }
         run->failed |= b->failed;
         b->next = run->free_blocks;
@@ -265,22 +341,46 @@ static void collect(vt_run *run)
     }
 }
 
-void vt_sample_queue(vt_run *run, uint32_t v)
+/* A vertex waiting for the presort (Sec. 6.2.2) at the stage's flush. */
+typedef struct vt_queued {
+    uint64_t order;           /* VT object, then screen Morton code */
+    uint32_t v, a, b;         /* the vertex and its parents (VT_NONE) */
+} vt_queued;
+
+/* The hint lists of parent p for a child, or none (count 0). */
+static vt_feelers_packed parent_hints(const vt_run *run, uint32_t p)
 {
-    vt_vertex *vx = &run->mesh->verts[v];
-    if (vx->state != VT_UNSAMPLED)
-        return;
+    if (p == VT_NONE || p >= run->per_vertex_cap || run->mesh->verts[p].state != VT_SAMPLED)
+        return (vt_feelers_packed){ 0, 0, 0, 0 };
+    return run->hints[p];
+}
+
+/* Into the block being filled; a full block is spawned. */
+static void add_to_block(vt_run *run, uint32_t v, uint32_t pa, uint32_t pb)
+{
     if (!run->filling && !(run->filling = take_block(run))) {
         run->failed = true;
         return;
     }
-    vx->state = VT_QUEUED;
+    const vt_vertex *vx = &run->mesh->verts[v];
     vt_block *b = run->filling;
     uint32_t i = b->count++;
     b->vertex[i] = v;
     b->point[i] = (rl_trace_point){ vx->p, vx->n, vx->uv, vx->triangle };
     b->key[i] = vx->key;
     b->cache_in[i] = run->cache ? vt_feeler_map_find(run->cache, vx->key) : NULL;
+    b->hint_in[i][0] = b->hint_in[i][1] = (vt_feelers_packed){ 0, 0, 0, 0 };
+    if (run->set->hint != VT_HINT_OFF) {
+        vt_feelers_packed ha = parent_hints(run, pa), hb = parent_hints(run, pb);
+        /* agree: the thesis' case, parents whose ray trees name the same
+         * triangles in every slot (then one list says it all) */
+        if (run->set->hint == VT_HINT_PARENTS) {
+            b->hint_in[i][0] = ha;
+            b->hint_in[i][1] = hb;
+        } else if (ha.count && hints_equal(&ha, &hb, run->hint_pool.occluder)) {
+            b->hint_in[i][0] = ha;
+        }
+    }
     if (b->count == VT_BLOCK) {
         run->filling = NULL;
         spawn(run, b);
@@ -292,8 +392,75 @@ void vt_sample_queue(vt_run *run, uint32_t v)
     }
 }
 
+/* Morton code of the pixel coordinates, 16 bits each (a 65536-pixel-wide
+ * image at most; wider ones fold, which only costs coherence). */
+static uint32_t morton2(float sx, float sy)
+{
+    uint32_t xy[2] = { (uint32_t)(sx > 0.0f ? (sx < 65535.0f ? sx : 65535.0f) : 0.0f),
+                       (uint32_t)(sy > 0.0f ? (sy < 65535.0f ? sy : 65535.0f) : 0.0f) };
+    for (int k = 0; k < 2; ++k) {
+        uint32_t x = xy[k] & 0xFFFFu;
+        x = (x | (x << 8)) & 0x00FF00FFu;
+        x = (x | (x << 4)) & 0x0F0F0F0Fu;
+        x = (x | (x << 2)) & 0x33333333u;
+        x = (x | (x << 1)) & 0x55555555u;
+        xy[k] = x;
+    }
+    return xy[0] | (xy[1] << 1);
+}
+
+static void queue_vertex(vt_run *run, uint32_t v, uint32_t pa, uint32_t pb)
+{
+    vt_vertex *vx = &run->mesh->verts[v];
+    if (vx->state != VT_UNSAMPLED)
+        return;
+    vx->state = VT_QUEUED;
+    if (!run->set->presort) {
+        add_to_block(run, v, pa, pb);
+        return;
+    }
+    if (!rl_reserve_u32((void **)&run->sorting, &run->cap_sorting, (uint64_t)run->num_sorting + 1,
+                        sizeof *run->sorting, 1024)) {
+        run->failed = true;
+        return;
+    }
+    uint32_t object = vx->triangle < run->data->num_triangles ? run->data->triangle_object[vx->triangle] : 0;
+    run->sorting[run->num_sorting++] =
+        (vt_queued){ ((uint64_t)object << 32) | morton2(vx->sx, vx->sy), v, pa, pb };
+}
+
+void vt_sample_queue(vt_run *run, uint32_t v)
+{
+    queue_vertex(run, v, VT_NONE, VT_NONE);
+}
+
+void vt_sample_queue_mid(vt_run *run, uint32_t v, uint32_t a, uint32_t b)
+{
+    queue_vertex(run, v, a, b);
+}
+
+static int by_order(const void *pa, const void *pb)
+{
+    const vt_queued *a = pa, *b = pb;
+    if (a->order != b->order)
+        return a->order < b->order ? -1 : 1;
+    return a->v < b->v ? -1 : a->v > b->v;
+}
+
 void vt_sample_flush(vt_run *run)
 {
+    if (run->num_sorting) {
+        /* Sec. 6.2.2, ray presorting: the rays of a stage leave vertices
+         * created all over the image in edge-length order; sampled by VT
+         * object and along a Morton curve over the screen, consecutive
+         * vertices (and the blocks the threads take) are neighbours, whose
+         * rays touch the same BVH nodes and triangles. */
+        qsort(run->sorting, run->num_sorting, sizeof *run->sorting, by_order);
+        uint32_t n = run->num_sorting;
+        run->num_sorting = 0;
+        for (uint32_t i = 0; i < n; ++i)
+            add_to_block(run, run->sorting[i].v, run->sorting[i].a, run->sorting[i].b);
+    }
     if (run->filling) {
         vt_block *b = run->filling;
         run->filling = NULL;
@@ -314,6 +481,7 @@ void vt_run_free_blocks(vt_run *run)
         while (lists[l]) {
             vt_block *next = lists[l]->next;
             vt_feeler_pool_free(&lists[l]->feeler_pool);
+            vt_feeler_pool_free(&lists[l]->hint_pool);
             free(lists[l]);
             lists[l] = next;
         }

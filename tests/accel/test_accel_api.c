@@ -1,6 +1,7 @@
 /* test_accel_api.c: the generic rl_accel layer (accel.c) and the shared
  * watertight test (watertight.c): kind names, desc validation, lifecycle,
- * invalid rays, the barycentric convention, t_max shortening and batches.
+ * invalid rays, the barycentric convention, t_max shortening, batches and
+ * the queries of intersection hints (one triangle, a named occluder).
  * Runs against our own kinds (brute, bvh); scenes are built in code. */
 #include <math.h>
 #include <setjmp.h>
@@ -335,6 +336,76 @@ static void test_batches_equal_single_queries(void **state)
     rl_scene_release(s);
 }
 
+/* Intersection hints (rl_accel.h): the one-triangle test gives bit for bit
+ * what the structure's closest hit gives for that triangle, never a closer
+ * hit than it, and the occluder a query names really blocks the ray. */
+static void test_triangle_test_and_occluder_agree_with_the_queries(void **state)
+{
+    (void)state;
+    enum { T = 48 };
+    rl_vec3 pos[3 * T];
+    uint32_t seed = 12345u;
+    for (int i = 0; i < 3 * T; ++i) {
+        float c[3];
+        for (int k = 0; k < 3; ++k) {
+            seed = seed * 1664525u + 1013904223u;
+            c[k] = (float)(seed >> 8) / 16777216.0f;
+        }
+        /* triangles about a quarter of the box wide, scattered through it */
+        rl_vec3 centre = i % 3 == 0 ? rl_v3(4.0f * c[0] - 2.0f, 4.0f * c[1] - 2.0f, 4.0f * c[2] - 2.0f)
+                                    : pos[i - i % 3];
+        rl_vec3 offset = rl_v3(2.0f * c[0] - 1.0f, 2.0f * c[1] - 1.0f, 2.0f * c[2] - 1.0f);
+        pos[i] = i % 3 == 0 ? centre : rl_add(centre, offset);
+    }
+    rl_scene *s = triangles_scene(pos, T, true);
+    const rl_accel_kind kinds[] = { RL_ACCEL_BRUTE, RL_ACCEL_BVH, RL_ACCEL_GRID };
+    for (size_t k = 0; k < sizeof kinds / sizeof kinds[0]; ++k) {
+        rl_accel *a = make_accel(s, kinds[k]);
+        int hits = 0, blocked = 0;
+        for (int i = 0; i < 400; ++i) {
+            float x = -2.0f + 4.0f * (float)(i % 20) / 19.0f, y = -2.0f + 4.0f * (float)(i / 20) / 19.0f;
+            rl_ray ray = ray_of(rl_v3(x, y, 4.0f), rl_v3(0.1f * (float)(i % 7) - 0.3f, 0.05f * (float)(i % 5), -1.0f));
+            if (i % 3 == 1)
+                ray.t_max = 5.0f;   /* shadow-like: ends inside the box */
+            rl_ray r = ray;
+            rl_hit full;
+            bool got = rl_accel_intersect(a, &r, &full);
+            for (uint32_t t = 0; t < T; ++t) {
+                rl_hit h;
+                if (!rl_accel_intersect_triangle(a, &ray, t, &h))
+                    continue;
+                assert_true(got);
+                assert_int_equal(h.object, 0);
+                assert_true(h.t > full.t || (h.t == full.t && t >= full.triangle));
+                if (t == full.triangle)
+                    assert_true(h.t == full.t && h.u == full.u && h.v == full.v);
+            }
+            if (got) {
+                ++hits;
+                rl_hit h;
+                assert_true(rl_accel_intersect_triangle(a, &ray, full.triangle, &h));
+            }
+            uint32_t by = 7;
+            bool occ = rl_accel_occluder(a, &ray, &by);
+            assert_true(occ == rl_accel_occluded(a, &ray));
+            assert_true(occ == got);
+            if (occ) {
+                ++blocked;
+                rl_hit h;
+                assert_true(by < T && rl_accel_intersect_triangle(a, &ray, by, &h));
+            } else {
+                assert_int_equal(by, RL_ID_NONE);
+            }
+            rl_hit h;
+            assert_false(rl_accel_intersect_triangle(a, &ray, T, &h));   /* out of range */
+        }
+        print_message("%s: %d of 400 rays hit, %d blocked\n", rl_accel_kind_name(kinds[k]), hits, blocked);
+        assert_true(hits > 40 && hits < 400);
+        rl_accel_release(a);
+    }
+    rl_scene_release(s);
+}
+
 static bool cancel_at_once(void *user, double done)
 {
     (void)done;
@@ -394,6 +465,7 @@ int main(void)
         cmocka_unit_test(test_watertight_test_respects_the_open_interval),
         cmocka_unit_test(test_intersect_shortens_t_max_and_occluded_respects_it),
         cmocka_unit_test(test_batches_equal_single_queries),
+        cmocka_unit_test(test_triangle_test_and_occluder_agree_with_the_queries),
         cmocka_unit_test(test_cancelled_build_fails_and_leaves_the_accel_uncommitted),
         cmocka_unit_test(test_stats_describe_the_structure),
     };

@@ -27,7 +27,7 @@ expect_in "$TMP/err" "rl: error: "
 # Help, and the bench dispatcher knows vt.
 expect_exit 0 "$RL" bench vt --help
 for o in --size --anim-size --frames --threads --only --out --quick criteria modes forced preview reduction \
-    overdraw equalrays animation correctness; do
+    overdraw equalrays animation correctness hint; do
     expect_in "$TMP/out" "$o"
 done
 expect_error 2 "known: rays, vt, pt" "$RL" bench nosuch
@@ -166,6 +166,15 @@ for x in red[2::2]:
 assert red[-2]["vertices_merged"] >= red[2]["vertices_merged"] > 0, red
 for x in red:
     quality_ok(x["quality"])
+
+# Sec. 6.2.2: hints and presorting change no image and no ray count; the
+# hints are used.
+h = r["hint"]["runs"]
+assert [(x["scene"], x["hint"], x["presort"]) for x in h] == \
+    [("table", "off", False), ("table", "parents", True)], h
+assert all(x["image_identical_to_off"] for x in h), h
+assert h[0]["rays"] == h[1]["rays"], h
+assert h[0]["hint_tests"] == 0 and 0 < h[1]["hint_hits"] <= h[1]["hint_tests"], h
 
 # Fig. 5.7: per stage and f, overdraw against redraw; f = 0 leaves
 # parents showing through, the default f = 1e-4 far less.

@@ -15,6 +15,7 @@
 
 #include <cmocka.h>
 
+#include "render/trace_internal.h"
 #include "rl/rl_accel.h"
 #include "rl/rl_scene.h"
 #include "rl/rl_trace.h"
@@ -530,6 +531,131 @@ static void test_a_cache_from_the_other_side_or_incomplete_is_not_used(void **st
     release(&f);
 }
 
+/* Intersection hints (Ullmann 2003, Sec. 3.3.1, 6.2.2): a point traced with
+ * the hints of a neighbour, or with hints naming arbitrary triangles, gives
+ * bit for bit the sample, ray counts and ray tree it gives without, with
+ * closest-hit and with any-hit feelers, on brute force and on the BVH; the
+ * neighbour's hints are hit often (else they would be dead code). */
+static void test_hints_change_nothing_and_neighbours_hints_hit(void **state)
+{
+    (void)state;
+    fixture f = { 0 };
+    penumbra(&f, 4);
+    rl_accel *bvh = NULL;
+    assert_int_equal(rl_accel_create(f.scene, &(rl_accel_desc){ .kind = RL_ACCEL_BVH }, &bvh), RL_OK);
+    assert_int_equal(rl_accel_commit(bvh), RL_OK);
+    rl_tracer *tracers[3] = { f.tracer, NULL, NULL };
+    const rl_tracer_desc closest = { .area_samples = 4, .seed = 3 };
+    const rl_tracer_desc any = { .area_samples = 4, .seed = 3, .tree_shadow_any_hit = true };
+    assert_int_equal(rl_tracer_create(bvh, &closest, &tracers[1]), RL_OK);
+    assert_int_equal(rl_tracer_create(bvh, &any, &tracers[2]), RL_OK);
+    const rl_vec3 eye = rl_v3(3.0f, 1.0f, 0.0f);
+    const rl_scene_data *d = f.data;
+    uint32_t seed = 99u;
+    for (int k = 0; k < 3; ++k) {
+        uint32_t tests = 0, hits = 0;
+        const rl_object *floor = &d->objects[0];
+        for (uint32_t t = floor->first_triangle; t < floor->first_triangle + floor->num_triangles; ++t) {
+            rl_hit unused;
+            /* The neighbour: the midpoint of the triangle's first edge, as
+             * a refined vertex would be between two parents. */
+            rl_trace_point a = vertex_point(d, t, 0, &unused), b = vertex_point(d, t, 1, &unused);
+            rl_trace_point mid = { rl_scale(rl_add(a.p, b.p), 0.5f), rl_v3(0, 1, 0), rl_v2(0.5f, 0.5f), t };
+            rl_trace_hints ha, hb, junk, own;
+            rl_trace_sample sa, sb, want, got;
+            rl_tracer_shade_point_hinted(tracers[k], eye, &a, 7, NULL, NULL, NULL, &ha, &sa, NULL);
+            rl_tracer_shade_point_hinted(tracers[k], eye, &b, 8, NULL, NULL, NULL, &hb, &sb, NULL);
+            assert_true(ha.count > 0 && ha.count <= RL_TRACE_HINT_MAX);
+            junk.count = RL_TRACE_HINT_MAX;
+            for (uint32_t i = 0; i < junk.count; ++i) {
+                seed = seed * 1664525u + 1013904223u;
+                junk.triangle[i] = (seed >> 8) % (d->num_triangles + 2);   /* some out of range */
+            }
+            for (int with_tree = 0; with_tree < 2; ++with_tree) {
+                rl_ray_tree tw, tg;
+                rl_tracer_shade_point(tracers[k], eye, &mid, 9, NULL, NULL, &want, with_tree ? &tw : NULL);
+                const rl_trace_hints *parents[2] = { &ha, &hb }, *bad[2] = { &junk, NULL };
+                for (int h = 0; h < 2; ++h) {
+                    rl_tracer_shade_point_hinted(tracers[k], eye, &mid, 9, NULL, NULL, h ? bad : parents, &own,
+                                                 &got, with_tree ? &tg : NULL);
+                    assert_samples_identical(&want, &got);
+                    assert_memory_equal(want.rays, got.rays, sizeof want.rays);
+                    if (with_tree)
+                        assert_true(rl_ray_tree_equal(&tw, &tg));
+                    assert_true(got.hint_hits <= got.hint_tests);
+                    if (!h) {
+                        tests += got.hint_tests;
+                        hits += got.hint_hits;
+                    }
+                }
+            }
+        }
+        print_message("tracer %d: %u of %u hinted rays hit their hint\n", k, hits, tests);
+        assert_true(tests > 0 && hits > tests / 4);
+    }
+    rl_tracer_release(tracers[1]);
+    rl_tracer_release(tracers[2]);
+    rl_accel_release(bvh);
+    release(&f);
+}
+
+/* The hint is a guess: one naming a triangle behind the closest hit only
+ * bounds the search, which still finds the closer one; a feeler ends at a
+ * hinted triangle only if it lies within the feeler's reach. Straight down
+ * at x = -1 a ray meets the occluder (y = 1.5) before the floor. */
+static void test_a_far_hint_only_bounds_the_search(void **state)
+{
+    (void)state;
+    fixture f = { 0 };
+    penumbra(&f, 1);
+    rl_accel *bvh = NULL;
+    assert_int_equal(rl_accel_create(f.scene, &(rl_accel_desc){ .kind = RL_ACCEL_BVH }, &bvh), RL_OK);
+    assert_int_equal(rl_accel_commit(bvh), RL_OK);
+    rl_tracer *tr = NULL;
+    assert_int_equal(rl_tracer_create(bvh, NULL, &tr), RL_OK);
+    rl_hit near, far;
+    rl_ray down = { rl_v3(-1.1f, 2.5f, 0.3f), 0.0f, rl_v3(0, -1, 0), INFINITY };
+    rl_ray below = { rl_v3(-1.1f, 1.0f, 0.3f), 0.0f, rl_v3(0, -1, 0), INFINITY };
+    assert_true(rl_accel_intersect(bvh, &(rl_ray){ down.o, 0.0f, down.d, INFINITY }, &near));
+    assert_true(rl_accel_intersect(bvh, &below, &far));
+    assert_int_equal(near.object, 1);
+    assert_int_equal(far.object, 0);
+
+    rl_trace_hints hint = { .count = 2, .triangle = { far.triangle, far.triangle } }, out;
+    uint64_t rays[RL_RAY_TYPE_COUNT];
+    rl_trace_ctx ctx;
+    rl_trace_begin(tr, 1, rays, NULL, &ctx);
+    ctx.hint_in[0] = &hint;
+    ctx.hint_out = &out;
+    out.count = 0;
+    rl_ray r = down;
+    rl_hit got;
+    assert_true(rl_trace_intersect(&ctx, rl_trace_slot(&ctx), &r, &got));
+    assert_int_equal(got.triangle, near.triangle);
+    assert_true(got.t == near.t && got.u == near.u && got.v == near.v && r.t_max == near.t);
+    assert_int_equal(ctx.hint_tests, 1);
+    assert_int_equal(ctx.hint_hits, 1);   /* the far hit bounded the search */
+    assert_int_equal(out.triangle[0], near.triangle);
+
+    /* Any hit: the far floor is within a feeler to y = -1 (blocked, at once),
+     * not within one that ends at y = 0.5 above it (the search decides:
+     * the occluder blocks). */
+    rl_ray feeler = down;
+    feeler.t_max = 3.5f;
+    assert_true(rl_trace_occluded(&ctx, rl_trace_slot(&ctx), &feeler));
+    assert_int_equal(ctx.hint_hits, 2);
+    assert_int_equal(out.triangle[1], far.triangle);
+    feeler.t_max = 2.0f;
+    ctx.slot = 1;
+    assert_true(rl_trace_occluded(&ctx, rl_trace_slot(&ctx), &feeler));
+    assert_int_equal(ctx.hint_tests, 3);
+    assert_int_equal(ctx.hint_hits, 2);
+    assert_int_equal(out.triangle[1], near.triangle);
+    rl_tracer_release(tr);
+    rl_accel_release(bvh);
+    release(&f);
+}
+
 static void test_degenerate_points_shade_as_the_background(void **state)
 {
     (void)state;
@@ -626,6 +752,8 @@ int main(void)
         cmocka_unit_test(test_total_internal_reflection_folds_refraction_into_the_mirror_layer),
         cmocka_unit_test(test_replayed_feelers_are_bit_identical_and_save_shadow_rays),
         cmocka_unit_test(test_a_cache_from_the_other_side_or_incomplete_is_not_used),
+        cmocka_unit_test(test_hints_change_nothing_and_neighbours_hints_hit),
+        cmocka_unit_test(test_a_far_hint_only_bounds_the_search),
         cmocka_unit_test(test_degenerate_points_shade_as_the_background),
         cmocka_unit_test(test_tree_hash_follows_tree_equality),
     };

@@ -538,6 +538,68 @@ static void sample_reduction_merges_short_primary_edges(void **state)
     rl_scene_release(s);
 }
 
+/* Sec. 6.2.2: intersection hints (from the parent vertices' ray trees,
+ * Sec. 3.3.1) and ray presorting change the work, never the result: the
+ * image and every count but the hints' own are the same with each on and
+ * off. The hints are used: refined vertices under the box's shadow and
+ * reflecting it hit their parents' triangles. */
+static void hints_and_presort_change_no_image_or_count(void **state)
+{
+    (void)state;
+    rl_scene *s = NULL;
+    assert_int_equal(rl_scene_create(&s), RL_OK);
+    uint32_t shiny = add_material(s, "shiny", rl_v3(0.6f, 0.6f, 0.6f), 0.3f, 0.0f);
+    uint32_t red = add_material(s, "red", rl_v3(0.8f, 0.2f, 0.1f), 0.0f, 0.0f);
+    add_grid(s, "floor", 6, 2.0f, shiny, true);
+    add_object(s, "box", "box", "size=1", red, rl_mat4_translate(rl_v3(0.3f, 1.0f, 0.2f)), false);
+    rl_light l = { .type = RL_LIGHT_POINT, .color = rl_v3(1, 1, 1), .intensity = 16.0f,
+                   .position = rl_v3(-0.5f, 4.0f, 0.5f) };
+    assert_int_equal(rl_scene_add_light(s, &l), RL_OK);
+    assert_int_equal(rl_scene_commit(s), RL_OK);
+    rl_camera cam = look(rl_v3(0.0f, 3.0f, 3.5f), rl_v3(0.0f, 0.0f, 0.0f), 64);
+    static const char *const hints[] = { "off", "agree", "parents" };
+    rl_image *want = NULL;
+    rl_vt_stats ws;
+    rl_render_stats wr;
+    for (int h = 0; h < 3; ++h) {
+        for (int p = 0; p < 2; ++p) {
+            const char *opts[] = { "hint", hints[h], "presort", p ? "true" : "false", "threads", "2",
+                                   "coherence", "false", NULL };
+            rl_renderer *r = make_vt(opts);
+            rl_render_stats rs;
+            rl_image *img = fx_render_with(r, s, &cam, FX_ALL_LAYERS, &rs);
+            rl_vt_stats st;
+            assert_int_equal(rl_vt_get_stats(r, &st), RL_OK);
+            rl_renderer_release(r);
+            print_message("hint %s presort %d: %llu sampled, %llu hint hits of %llu tests\n", hints[h], p,
+                          (unsigned long long)st.vertices_sampled, (unsigned long long)st.hint_hits,
+                          (unsigned long long)st.hint_tests);
+            if (!want) {
+                want = img;
+                ws = st;
+                wr = rs;
+                assert_int_equal(st.hint_tests, 0);
+                assert_true(st.vertices_generated > 100);
+                continue;
+            }
+            fx_assert_images_identical(want, img);
+            rl_image_release(img);
+            assert_int_equal(st.vertices_sampled, ws.vertices_sampled);
+            assert_int_equal(st.vertices_generated, ws.vertices_generated);
+            assert_int_equal(st.edges_tested, ws.edges_tested);
+            assert_int_equal(st.splits_tree, ws.splits_tree);
+            assert_int_equal(st.faces_drawn, ws.faces_drawn);
+            assert_memory_equal(rs.rays, wr.rays, sizeof rs.rays);
+            if (h == 0)
+                assert_int_equal(st.hint_tests, 0);
+            if (h == 2)
+                assert_true(st.hint_hits > 100 && st.hint_hits <= st.hint_tests);
+        }
+    }
+    rl_image_release(want);
+    rl_scene_release(s);
+}
+
 /* Ch. 4: the image does not depend on the number of threads; Sec. 3.4.5:
  * nor on temporal coherence, which must replay feelers exactly. */
 static void deterministic_and_coherent(void **state)
@@ -1270,6 +1332,7 @@ int main(void)
         cmocka_unit_test(nothing_in_view),
         cmocka_unit_test(nonlinear_finds_the_highlight),
         cmocka_unit_test(shaft_culling_finds_the_small_shadow),
+        cmocka_unit_test(hints_and_presort_change_no_image_or_count),
         cmocka_unit_test(bad_options),
         cmocka_unit_test(packages_match_one_process),
         cmocka_unit_test(cost_estimate),
