@@ -35,8 +35,8 @@ expect_error 2 "known: rays, vt, pt" "$RL" bench nosuch
 # The quick run: every section, a table on stdout, JSON where --out says.
 expect_exit 0 "$RL" bench vt --quick --out "$TMP/vt.json" --images "$TMP/img"
 [ -s "$TMP/vt.json" ] || fail "vt.json was not written"
-for f in fig5.8a-vt fig5.8b-whitted fig5.8-error-x4 fig5.16-vt fig5.16-whitted fig5.17-vt fig5.19-vt fig5.20-vt \
-    fig5.21-whitted; do
+for f in fig5.8a-vt fig5.8b-whitted fig5.8-error-x4 fig5.16-vt fig5.16-hsv14-vt fig5.16-whitted fig5.17-vt \
+    fig5.19-vt fig5.20-vt fig5.21-whitted; do
     [ -s "$TMP/img/$f.png" ] || fail "--images did not write $f.png"
 done
 for s in criteria resolution quality threads visibility modes forced preview animation tree+hsv min_edge +S-R-T; do
@@ -215,21 +215,27 @@ sc = r["scenario"]
 assert sc["scene"] == "cluster" and sc["size"] == "80x64" and sc["triangles"] > 0, sc
 assert sc["thesis"]["full_refinement_ms"] == 2500 and sc["thesis"]["preview_ms"] == 200, sc["thesis"]
 runs = sc["runs"]
-assert [(x["fig"], x["camera"], x["mode"]) for x in runs] == [
-    ("5.16", "driver", "+S+R+T"), ("5.17", "driver", "+S+R+T"), ("5.18", "lateral", "+S+R+T"),
-    ("5.19", "driver", "+S-R+T"), ("5.20", "driver", "+S+R-T"), ("5.21", "zoom", "+S+R+T")], runs
+assert [(x["fig"], x["camera"], x["mode"], x["criteria"], x["min_edge"]) for x in runs] == [
+    ("5.16", "driver", "+S+R+T", "tree+hsv", 1), ("5.16", "driver", "+S+R+T", "hsv", 14),
+    ("5.17", "driver", "+S+R+T", "tree+hsv", 1), ("5.18", "lateral", "+S+R+T", "tree+hsv", 1),
+    ("5.19", "driver", "+S-R+T", "tree+hsv", 1), ("5.20", "driver", "+S+R-T", "tree+hsv", 1),
+    ("5.21", "zoom", "+S+R+T", "tree+hsv", 1)], runs
 for x in runs:
     assert x["time_ms"] > 0 and x["whitted"]["time_ms"] > 0 and x["whitted"]["vt_pixels"] > 0, x
     assert 0 < x["preview_ms"] <= x["time_ms"] and x["samples_percent_of_pixels"] > 0, x
     quality_ok(x["quality"])
     assert x["preview"] == (x["fig"] == "5.17"), x
+# The same reference frame for the driver's view at both settings and its
+# preview; the coarse setting samples fewer vertices.
+assert runs[0]["whitted"] == runs[1]["whitted"] == runs[2]["whitted"], runs[:3]
+assert runs[1]["vt_stats"]["vertices_sampled"] < runs[0]["vt_stats"]["vertices_sampled"], runs[:2]
 for fig, ray in (("5.19", "reflection"), ("5.20", "refraction")):
     x = [y for y in runs if y["fig"] == fig][0]
     assert x["rays"][ray] == 0 and x["whitted"]["rays"][ray] == 0, x
     assert runs[0]["rays"][ray] > 0, runs[0]
-pv = runs[1]["vt_stats"]
+pv = runs[2]["vt_stats"]
 assert pv["stages"] == 0 and pv["vertices_generated"] == 0, pv
-assert runs[1]["vt_stats"]["vertices_sampled"] <= runs[0]["vt_stats"]["vertices_sampled"]
+assert pv["vertices_sampled"] <= runs[0]["vt_stats"]["vertices_sampled"]
 
 a = r["animation"]
 assert a["scene"] == "cluster" and a["frames"] == 3 and len(a["per_frame"]) == 3
