@@ -1800,16 +1800,19 @@ static rl_status sec_deferred(void *ctx, cJSON *sec)
                 note("deferred %s/%g %s %s: RMSE %.5f SSIM %.4f on %llu deferred pixels, edge %.2f px", crits[c],
                      edges[e], textures[t], size, def.rmse, def.ssim, (unsigned long long)mask_pixels, edge);
                 /* Fig. 5.8a: the thesis' setting, ray tree alone, at the
-                 * finest mesh; 5.8b is Whitted's frame. */
-                if (c == 0 && e == 0 && t == 0 && b->a->images) {
+                 * finest and the coarsest mesh; 5.8b is Whitted's frame. */
+                if (c == 0 && (e == 0 || e == num_edges - 1) && t == 0 && b->a->images) {
                     rl_image *err = NULL;
-                    st = save_image(b, img, "fig5.8a-vt.png");
-                    if (st == RL_OK)
+                    char file[64];
+                    snprintf(file, sizeof file, "fig5.8a-vt-min_edge-%g.png", edges[e]);
+                    st = save_image(b, img, file);
+                    if (st == RL_OK && e == 0)
                         st = save_image(b, ref->image, "fig5.8b-whitted.png");
                     if (st == RL_OK)
                         st = error_image(img, ref->image, mask, 4.0f, &err);
+                    snprintf(file, sizeof file, "fig5.8-error-x4-min_edge-%g.png", edges[e]);
                     if (st == RL_OK)
-                        st = save_image(b, err, "fig5.8-error-x4.png");
+                        st = save_image(b, err, file);
                     rl_image_release(err);
                 }
             }

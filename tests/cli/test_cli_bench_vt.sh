@@ -35,7 +35,7 @@ expect_error 2 "known: rays, vt, pt" "$RL" bench nosuch
 # The quick run: every section, a table on stdout, JSON where --out says.
 expect_exit 0 "$RL" bench vt --quick --out "$TMP/vt.json" --images "$TMP/img"
 [ -s "$TMP/vt.json" ] || fail "vt.json was not written"
-for f in fig5.8a-vt fig5.8b-whitted fig5.8-error-x4 fig5.16-vt fig5.16-hsv14-vt fig5.16-whitted fig5.17-vt \
+for f in fig5.8a-vt-min_edge-1 fig5.8a-vt-min_edge-8 fig5.8b-whitted fig5.8-error-x4-min_edge-8 fig5.16-vt fig5.16-hsv14-vt fig5.16-whitted fig5.17-vt \
     fig5.19-vt fig5.20-vt fig5.21-whitted; do
     [ -s "$TMP/img/$f.png" ] || fail "--images did not write $f.png"
 done
