@@ -1936,6 +1936,7 @@ static rl_status sec_scenario(void *ctx, cJSON *sec)
      * accelerator and the glass' mesh, which the views share; a full-size
      * warm-up per view would cost as much as a timed frame. */
     rl_camera warm;
+    memset(&warm, 0, sizeof warm);
     if (st == RL_OK)
         st = rl_scene_get_camera(b->cluster, scenario_views[0].camera, &warm);
     warm = sized(&warm, w / 4 > 0 ? w / 4 : 1, h / 4 > 0 ? h / 4 : 1);
@@ -1961,6 +1962,7 @@ static rl_status sec_scenario(void *ctx, cJSON *sec)
         int mode = scenario_views[i].mode;
         bool preview = scenario_views[i].preview;
         rl_camera cam;
+        memset(&cam, 0, sizeof cam);
         timed_frame tv;
         double cpu_vt = NAN;
         quality q;
