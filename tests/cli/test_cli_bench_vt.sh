@@ -26,15 +26,19 @@ expect_in "$TMP/err" "rl: error: "
 
 # Help, and the bench dispatcher knows vt.
 expect_exit 0 "$RL" bench vt --help
-for o in --size --anim-size --frames --threads --only --out --quick criteria modes forced preview reduction \
-    overdraw equalrays animation correctness hint; do
+for o in --size --anim-size --frames --threads --only --out --images --quick criteria modes forced preview \
+    reduction overdraw equalrays deferred animation correctness hint scenario; do
     expect_in "$TMP/out" "$o"
 done
 expect_error 2 "known: rays, vt, pt" "$RL" bench nosuch
 
 # The quick run: every section, a table on stdout, JSON where --out says.
-expect_exit 0 "$RL" bench vt --quick --out "$TMP/vt.json"
+expect_exit 0 "$RL" bench vt --quick --out "$TMP/vt.json" --images "$TMP/img"
 [ -s "$TMP/vt.json" ] || fail "vt.json was not written"
+for f in fig5.8a-vt-min_edge-1 fig5.8a-vt-min_edge-8 fig5.8b-whitted fig5.8-error-x4-min_edge-8 fig5.16-vt fig5.16-hsv14-vt fig5.16-whitted fig5.17-vt \
+    fig5.19-vt fig5.20-vt fig5.21-whitted; do
+    [ -s "$TMP/img/$f.png" ] || fail "--images did not write $f.png"
+done
 for s in criteria resolution quality threads visibility modes forced preview animation tree+hsv min_edge +S-R-T; do
     expect_in "$TMP/out" "$s"
 done
@@ -63,7 +67,7 @@ def quality_ok(q):
     assert q["vt_pixels"]["pixels"] > 0 and q["vt_pixels"]["ssim"] is not None, q
 
 for name in ("criteria", "resolution", "quality", "threads", "visibility", "modes", "forced", "preview",
-             "reduction", "overdraw", "equalrays", "animation"):
+             "reduction", "overdraw", "equalrays", "deferred", "animation", "scenario"):
     assert name in r, "missing section " + name
     assert r[name]["status"] == "ok", "%s: %s" % (name, r[name].get("reason"))
 
@@ -194,6 +198,53 @@ for x in eq:
     quality_ok(x["vt_quality"])
     quality_ok(x["whitted_quality"])
 assert eq[0]["whitted_rays"] < r["equalrays"]["whitted"]["rays"]["total"], eq
+
+# Fig. 5.8: the deferred textures' error on the pixels that show a
+# reflection or refraction; the mesh there is measured, coarser min_edge
+# never adds vertices.
+de = r["deferred"]
+assert 0 < de["deferred_pixels"] <= de["whitted"]["vt_pixels"], de
+dr = de["runs"]
+assert [(x["criteria"], x["min_edge"], x["textures"]) for x in dr] == \
+    [(c, e, t) for c in ("tree", "tree+hsv") for e in (1, 8) for t in ("multitexture", "sampled")], dr
+for x in dr:
+    m = x["deferred_pixels"]
+    assert m["pixels"] == de["deferred_pixels"] and ssim_ok(m["ssim"]) and 0 < m["rmse"] <= 1, x
+    assert x["faces_on_deferred_pixels"] > 0 and x["edge_px_on_deferred_pixels"] > 0, x
+    assert x["vertices_sampled"] > 0 and x["rays"]["total"] > 0, x
+    quality_ok(x["quality"])
+for i in range(0, len(dr), 4):
+    for t in (0, 1):
+        fine, coarse = dr[i + t], dr[i + 2 + t]
+        assert coarse["vertices_generated"] <= fine["vertices_generated"], (fine, coarse)
+
+# Sec. 5.4: the cluster's views; -R and -T trace no such rays in either
+# renderer; the preview stops at the primary vertices.
+sc = r["scenario"]
+assert sc["scene"] == "cluster" and sc["size"] == "80x64" and sc["triangles"] > 0, sc
+assert sc["thesis"]["full_refinement_ms"] == 2500 and sc["thesis"]["preview_ms"] == 200, sc["thesis"]
+runs = sc["runs"]
+assert [(x["fig"], x["camera"], x["mode"], x["criteria"], x["min_edge"]) for x in runs] == [
+    ("5.16", "driver", "+S+R+T", "tree+hsv", 1), ("5.16", "driver", "+S+R+T", "hsv", 14),
+    ("5.17", "driver", "+S+R+T", "tree+hsv", 1), ("5.18", "lateral", "+S+R+T", "tree+hsv", 1),
+    ("5.19", "driver", "+S-R+T", "tree+hsv", 1), ("5.20", "driver", "+S+R-T", "tree+hsv", 1),
+    ("5.21", "zoom", "+S+R+T", "tree+hsv", 1)], runs
+for x in runs:
+    assert x["time_ms"] > 0 and x["whitted"]["time_ms"] > 0 and x["whitted"]["vt_pixels"] > 0, x
+    assert 0 < x["preview_ms"] <= x["time_ms"] and x["samples_percent_of_pixels"] > 0, x
+    quality_ok(x["quality"])
+    assert x["preview"] == (x["fig"] == "5.17"), x
+# The same reference frame for the driver's view at both settings and its
+# preview; the coarse setting samples fewer vertices.
+assert runs[0]["whitted"] == runs[1]["whitted"] == runs[2]["whitted"], runs[:3]
+assert runs[1]["vt_stats"]["vertices_sampled"] < runs[0]["vt_stats"]["vertices_sampled"], runs[:2]
+for fig, ray in (("5.19", "reflection"), ("5.20", "refraction")):
+    x = [y for y in runs if y["fig"] == fig][0]
+    assert x["rays"][ray] == 0 and x["whitted"]["rays"][ray] == 0, x
+    assert runs[0]["rays"][ray] > 0, runs[0]
+pv = runs[2]["vt_stats"]
+assert pv["stages"] == 0 and pv["vertices_generated"] == 0, pv
+assert pv["vertices_sampled"] <= runs[0]["vt_stats"]["vertices_sampled"]
 
 a = r["animation"]
 assert a["scene"] == "cluster" and a["frames"] == 3 and len(a["per_frame"]) == 3
