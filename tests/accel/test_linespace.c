@@ -1169,15 +1169,15 @@ static void test_linespace_objects_equal_the_bvh_on_instanced_objects(void **sta
     assert_int_equal(st.objects, 6);
     assert_true(st.linespaces == 2 || st.linespaces == 3);
     assert_int_equal(st.world_space, 0);
-    int hits = agree_exactly("objects/instanced", s, o, objects_closest, objects_occl, NULL, 30000 / RAYS_SCALE, 11);
+    int hits = agree_exactly("objects/instanced", s, o, objects_closest, objects_occl, NULL, 15000 / RAYS_SCALE, 11);
     print_message("object Line Space, instanced teapots: %d hits, %u Line Spaces for %u objects, %.1f MiB\n",
                   hits, st.linespaces, st.objects, st.memory_bytes / 1048576.0);
     rl_ls_objects_release(o);
     rl_scene_release(s);
     /* The built-ins: several objects in a box (teapot, blocks, bunny). */
     s = builtin("cornell-teapot", "triangles=5000");
-    o = objects_of(s, (rl_ls_objects_desc){ 0 });
-    agree_exactly("objects/cornell-teapot", s, o, objects_closest, objects_occl, NULL, 20000 / RAYS_SCALE, 12);
+    o = objects_of(s, (rl_ls_objects_desc){ .n = 3 });
+    agree_exactly("objects/cornell-teapot", s, o, objects_closest, objects_occl, NULL, 10000 / RAYS_SCALE, 12);
     rl_ls_objects_release(o);
     rl_scene_release(s);
 }
@@ -1209,7 +1209,7 @@ static void test_linespace_objects_share_one_line_space_across_moved_instances(v
     assert_int_equal(st.objects, 8);
     assert_int_equal(st.linespaces, 1);
     assert_int_equal(st.world_space, 0);
-    agree_exactly("objects/moved spheres", s, o, objects_closest, objects_occl, NULL, 20000 / RAYS_SCALE, 13);
+    agree_exactly("objects/moved spheres", s, o, objects_closest, objects_occl, NULL, 10000 / RAYS_SCALE, 13);
     rl_ls_objects_release(o);
     rl_scene_release(s);
 }
@@ -1228,15 +1228,15 @@ static void test_linespace_scene_signatures_are_conservative_and_answers_exact(v
     assert_int_equal(st.shafts, 15u * 8 * 8 * 8 * 8);
     /* Some shafts have empty stretches, else the signature is useless. */
     assert_true(st.filled_bits > 0 && st.filled_bits < st.shafts * 64u * 9 / 10);
-    int hits = agree_exactly("scene/bvh", s, sb, scene_closest, scene_occl, bvh, 30000 / RAYS_SCALE, 21);
+    int hits = agree_exactly("scene/bvh", s, sb, scene_closest, scene_occl, bvh, 15000 / RAYS_SCALE, 21);
     print_message("scene Line Space: %d hits, %.1f %% of the signature bits set, %u filled cells\n", hits,
                   100.0 * (double)st.filled_bits / ((double)st.shafts * 64.0), st.filled_cells);
     /* Coarse and odd parameters, the per-voxel and the object Line Spaces
      * inside: each gives its inner structure's answer (the BVH's). */
     rl_ls_scene *sv = scene_ls_of(s, (rl_ls_scene_desc){ .n = 3, .segments = 5, .cells = 7, .inner.linespace = ls });
-    agree_exactly("scene/per-voxel", s, sv, scene_closest, scene_occl, NULL, 20000 / RAYS_SCALE, 22);
+    agree_exactly("scene/per-voxel", s, sv, scene_closest, scene_occl, NULL, 8000 / RAYS_SCALE, 22);
     rl_ls_scene *so = scene_ls_of(s, (rl_ls_scene_desc){ .n = 1, .segments = 64, .cells = 64, .inner.objects = o });
-    agree_exactly("scene/objects", s, so, scene_closest, scene_occl, NULL, 20000 / RAYS_SCALE, 23);
+    agree_exactly("scene/objects", s, so, scene_closest, scene_occl, NULL, 8000 / RAYS_SCALE, 23);
     /* Conservative: every hit of a ray through the box lies in a set
      * segment of its shaft (checked from the hit point itself). */
     const rl_scene_data *d = rl_scene_get_data(s);
@@ -1284,8 +1284,8 @@ static void test_linespace_scene_and_objects_handle_flat_and_tiny_scenes(void **
         assert_int_equal(rl_scene_node_set_mesh(s, node, mesh), RL_OK);
         assert_int_equal(rl_scene_commit(s), RL_OK);
         rl_accel *bvh = accel_of(s, (rl_accel_desc){ .kind = RL_ACCEL_BVH });
-        rl_ls_objects *o = objects_of(s, (rl_ls_objects_desc){ 0 });
-        rl_ls_scene *sl = scene_ls_of(s, (rl_ls_scene_desc){ .inner.objects = o });
+        rl_ls_objects *o = objects_of(s, (rl_ls_objects_desc){ .n = 3 });
+        rl_ls_scene *sl = scene_ls_of(s, (rl_ls_scene_desc){ .n = 4, .inner.objects = o });
         const char *what = k == 0 ? "flat quad" : "tiny triangle";
         agree_exactly(what, s, o, objects_closest, objects_occl, NULL, 5000 / RAYS_SCALE, 31 + (uint64_t)k);
         agree_exactly(what, s, sl, scene_closest, scene_occl, NULL, 5000 / RAYS_SCALE, 33 + (uint64_t)k);
@@ -1314,7 +1314,7 @@ static void test_linespace_scene_and_objects_reject_bad_arguments(void **state)
                      RL_ERR_INVALID_ARG);
     assert_null(o);
     /* Uncommitted: queries miss, and it cannot serve as an inner structure. */
-    assert_int_equal(rl_ls_objects_create(s, NULL, &o), RL_OK);
+    assert_int_equal(rl_ls_objects_create(s, &(rl_ls_objects_desc){ .n = 2, .res = 2 }, &o), RL_OK);
     rl_ray ray = { rl_v3(0.1f, 0.2f, 0.3f), 0.0f, rl_v3(0, 1, 0), INFINITY };
     rl_hit h;
     assert_false(rl_ls_objects_intersect(o, &ray, &h));
