@@ -18,8 +18,9 @@
  * per axis, default 32) whose cells list the triangles their surface
  * overlaps (grid.h, exact triangle/box test, cells grown); per shaft every
  * filled cell's interval sets its segments. Cells are visited in bricks
- * of 4³ so that a brick whose interval is empty, or whose segments are set
- * already, is skipped whole. Conservative: a point of a triangle on a line
+ * of 4³, and bricks in super-bricks of 4³ bricks, so that a (super-)brick
+ * whose interval is empty, or whose segments are set already, is skipped
+ * whole. Conservative: a point of a triangle on a line
  * through the shaft lies in a filled cell at that line's λ, so its segment
  * is set; cells and patches are grown by small margins against rounding.
  *
@@ -46,6 +47,7 @@
 #include "rl/rl_timer.h"
 
 #define BRICK 4                   /* cells per brick side */
+#define SUPER 4                   /* bricks per super-brick side */
 #define CELL_GROW 1e-3            /* of a cell, against rounding (grid cells grow 1e-4) */
 #define PATCH_GROW 1e-6           /* unit coordinates of the box */
 #define RUN_GROW_REL 1e-4         /* of the line's t-span inside the box */
@@ -56,8 +58,8 @@ typedef struct cell_box {
 } cell_box;
 
 typedef struct brick {
-    cell_box box;                 /* union of its filled cells */
-    uint32_t first, count;        /* into the cell boxes */
+    cell_box box;                 /* union of its filled cells (super-brick: of its bricks) */
+    uint32_t first, count;        /* into the cell boxes (super-brick: into the bricks) */
 } brick;
 
 struct rl_ls_scene {
@@ -71,8 +73,8 @@ struct rl_ls_scene {
     uint32_t shafts;
     uint64_t *sig;
     cell_box *cell;               /* filled cells, brick by brick */
-    brick *bricks;
-    uint32_t num_cells, num_bricks;
+    brick *bricks, *supers;
+    uint32_t num_cells, num_bricks, num_supers;
     rl_ls_scene_stats stats;
 };
 
@@ -155,6 +157,7 @@ void rl_ls_scene_release(rl_ls_scene *s)
     free(s->sig);
     free(s->cell);
     free(s->bricks);
+    free(s->supers);
     free(s);
 }
 
@@ -173,40 +176,61 @@ uint64_t rl_ls_scene_signature(const rl_ls_scene *s, uint32_t shaft)
  * grouped by brick. */
 static rl_status gather_cells(rl_ls_scene *s, const rl_grid *g)
 {
-    int nb[3];
-    for (int a = 0; a < 3; ++a)
+    int nb[3], ns[3];
+    for (int a = 0; a < 3; ++a) {
         nb[a] = (g->res[a] + BRICK - 1) / BRICK;
+        ns[a] = (nb[a] + SUPER - 1) / SUPER;
+    }
     uint32_t filled = 0;
     for (uint32_t i = 0; i < g->num_cells; ++i)
         filled += g->cell_start[i + 1] > g->cell_start[i];
     s->cell = rl_calloc(filled ? filled : 1, sizeof *s->cell);
     s->bricks = rl_calloc((size_t)nb[0] * nb[1] * nb[2], sizeof *s->bricks);
-    if (!s->cell || !s->bricks)
+    s->supers = rl_calloc((size_t)ns[0] * ns[1] * ns[2], sizeof *s->supers);
+    if (!s->cell || !s->bricks || !s->supers)
         return RL_ERR_OUT_OF_MEMORY;
-    for (int bz = 0; bz < nb[2]; ++bz)
-        for (int by = 0; by < nb[1]; ++by)
-            for (int bx = 0; bx < nb[0]; ++bx) {
-                brick b = { { { 2.0f, 2.0f, 2.0f }, { -1.0f, -1.0f, -1.0f } }, s->num_cells, 0 };
-                for (int z = bz * BRICK; z < g->res[2] && z < (bz + 1) * BRICK; ++z)
-                    for (int y = by * BRICK; y < g->res[1] && y < (by + 1) * BRICK; ++y)
-                        for (int x = bx * BRICK; x < g->res[0] && x < (bx + 1) * BRICK; ++x) {
-                            uint32_t i = rl_grid_cell_index(g, x, y, z);
-                            if (g->cell_start[i + 1] == g->cell_start[i])
-                                continue;
-                            int xyz[3] = { x, y, z };
-                            cell_box *c = &s->cell[s->num_cells++];
-                            for (int a = 0; a < 3; ++a) {
-                                double r = (double)g->res[a];
-                                c->lo[a] = (float)((xyz[a] - CELL_GROW) / r);
-                                c->hi[a] = (float)((xyz[a] + 1 + CELL_GROW) / r);
-                                b.box.lo[a] = rl_minf(b.box.lo[a], c->lo[a]);
-                                b.box.hi[a] = rl_maxf(b.box.hi[a], c->hi[a]);
-                            }
-                            b.count++;
-                        }
-                if (b.count)
-                    s->bricks[s->num_bricks++] = b;
+    const brick none = { { { 2.0f, 2.0f, 2.0f }, { -1.0f, -1.0f, -1.0f } }, 0, 0 };
+    for (int q = 0; q < ns[0] * ns[1] * ns[2]; ++q) {
+        int sq[3] = { q % ns[0], (q / ns[0]) % ns[1], q / (ns[0] * ns[1]) };
+        brick sup = none;
+        sup.first = s->num_bricks;
+        for (int k = 0; k < SUPER * SUPER * SUPER; ++k) {
+            int bq[3] = { sq[0] * SUPER + k % SUPER, sq[1] * SUPER + (k / SUPER) % SUPER,
+                          sq[2] * SUPER + k / (SUPER * SUPER) };
+            if (bq[0] >= nb[0] || bq[1] >= nb[1] || bq[2] >= nb[2])
+                continue;
+            brick b = none;
+            b.first = s->num_cells;
+            for (int c = 0; c < BRICK * BRICK * BRICK; ++c) {
+                int xyz[3] = { bq[0] * BRICK + c % BRICK, bq[1] * BRICK + (c / BRICK) % BRICK,
+                               bq[2] * BRICK + c / (BRICK * BRICK) };
+                if (xyz[0] >= g->res[0] || xyz[1] >= g->res[1] || xyz[2] >= g->res[2])
+                    continue;
+                uint32_t i = rl_grid_cell_index(g, xyz[0], xyz[1], xyz[2]);
+                if (g->cell_start[i + 1] == g->cell_start[i])
+                    continue;
+                cell_box *cb = &s->cell[s->num_cells++];
+                for (int a = 0; a < 3; ++a) {
+                    double r = (double)g->res[a];
+                    cb->lo[a] = (float)((xyz[a] - CELL_GROW) / r);
+                    cb->hi[a] = (float)((xyz[a] + 1 + CELL_GROW) / r);
+                    b.box.lo[a] = rl_minf(b.box.lo[a], cb->lo[a]);
+                    b.box.hi[a] = rl_maxf(b.box.hi[a], cb->hi[a]);
+                }
+                b.count++;
             }
+            if (!b.count)
+                continue;
+            s->bricks[s->num_bricks++] = b;
+            sup.count++;
+            for (int a = 0; a < 3; ++a) {
+                sup.box.lo[a] = rl_minf(sup.box.lo[a], b.box.lo[a]);
+                sup.box.hi[a] = rl_maxf(sup.box.hi[a], b.box.hi[a]);
+            }
+        }
+        if (sup.count)
+            s->supers[s->num_supers++] = sup;
+    }
     s->stats.filled_cells = s->num_cells;
     return RL_OK;
 }
@@ -270,15 +294,20 @@ static uint64_t shaft_signature(const rl_ls_scene *s, uint32_t shaft)
     double alo[3], ahi[3], blo[3], bhi[3];
     patch_rect(s->n, fa, pa, alo, ahi);
     patch_rect(s->n, fb, pb, blo, bhi);
-    uint64_t sig = 0;
-    for (uint32_t k = 0; k < s->num_bricks; ++k) {
-        const brick *b = &s->bricks[k];
+    uint64_t sig = 0, full = segment_mask(s->segments, 0.0, 1.0);
+    for (uint32_t q = 0; q < s->num_supers && sig != full; ++q) {
+        const brick *sb = &s->supers[q];
         double l0, l1;
-        if (!lambda_range(alo, ahi, blo, bhi, &b->box, &l0, &l1) || !(segment_mask(s->segments, l0, l1) & ~sig))
+        if (!lambda_range(alo, ahi, blo, bhi, &sb->box, &l0, &l1) || !(segment_mask(s->segments, l0, l1) & ~sig))
             continue;
-        for (uint32_t i = b->first; i < b->first + b->count; ++i)
-            if (lambda_range(alo, ahi, blo, bhi, &s->cell[i], &l0, &l1))
-                sig |= segment_mask(s->segments, l0, l1);
+        for (uint32_t k = sb->first; k < sb->first + sb->count; ++k) {
+            const brick *b = &s->bricks[k];
+            if (!lambda_range(alo, ahi, blo, bhi, &b->box, &l0, &l1) || !(segment_mask(s->segments, l0, l1) & ~sig))
+                continue;
+            for (uint32_t i = b->first; i < b->first + b->count; ++i)
+                if (lambda_range(alo, ahi, blo, bhi, &s->cell[i], &l0, &l1))
+                    sig |= segment_mask(s->segments, l0, l1);
+        }
     }
     return sig;
 }
@@ -325,7 +354,7 @@ rl_status rl_ls_scene_commit(rl_ls_scene *s)
         bits += (uint64_t)__builtin_popcountll(s->sig[k]);
     s->stats.filled_bits = bits;
     s->stats.memory_bytes = (size_t)s->shafts * sizeof *s->sig + (size_t)s->num_cells * sizeof(cell_box) +
-                            (size_t)s->num_bricks * sizeof(brick);
+                            (size_t)(s->num_bricks + s->num_supers) * sizeof(brick);
     s->committed = true;
     s->stats.build_ms = rl_timer_ms(&timer);
     return RL_OK;
