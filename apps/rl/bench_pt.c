@@ -12,7 +12,11 @@
  *                 (the thesis tuned the resolution per structure), and a
  *                 frame without diffuse rays as the floor of the rays' share
  *   shadow        Diagram 3: the same scene, shadow rays through each
- *                 structure (and shadow maps), diffuse rays by the BVH
+ *                 structure (and shadow maps), diffuse rays by the BVH;
+ *                 then shadow and first-bounce diffuse rays alone, also
+ *                 through the scene and object Line Spaces (Sec. 13.1-13.2,
+ *                 with their build time and memory); both sections also
+ *                 render with ls-object and ls-scene
  *   error         RMSE and SSIM of every variant against a converged BVH
  *                 reference at equal sample counts, and the time each needs
  *                 to reach the RMSE the BVH reaches at 4, 16, 64 spp
@@ -77,7 +81,9 @@ static const char bench_pt_help[] =
     "                8^3..64^3, best per variant; shadows by shadow maps (Diagram 2)\n"
     "  shadow        the same for shadow rays, plus shadow maps; diffuse rays by\n"
     "                the BVH (Diagram 3); then the frame's shadow rays alone through\n"
-    "                the BVH, the grid and each Line Space (Mrays/s, occluded counts)\n"
+    "                the BVH, the grid and each Line Space (Mrays/s, occluded counts),\n"
+    "                and first-bounce diffuse rays through the exact ones; both\n"
+    "                sections also time ls-object and ls-scene (Sec. 13.1, 13.2)\n"
     "  error         RMSE/SSIM of each variant (PNMT and pre-illuminated at every\n"
     "                voxel resolution) against a converged BVH reference at equal\n"
     "                spp, and time to reach the BVH's RMSE at 4/16/64 spp\n"

@@ -114,10 +114,9 @@ rl_status rl_ls_objects_create(const rl_scene *scene, const rl_ls_objects_desc *
     return RL_OK;
 }
 
-void rl_ls_objects_release(rl_ls_objects *o)
+/* Everything commit builds, so that a failed commit can be retried. */
+static void free_built(rl_ls_objects *o)
 {
-    if (!o)
-        return;
     for (uint32_t i = 0; i < o->num_entries; ++i) {
         rl_linespace_release(o->entries[i].ls);   /* before the grid it borrows */
         rl_accel_release(o->entries[i].grid);
@@ -129,6 +128,21 @@ void rl_ls_objects_release(rl_ls_objects *o)
     free(o->order);
     free(o->nodes);
     free(o->verts);
+    o->entries = NULL;
+    o->inst = NULL;
+    o->order = NULL;
+    o->nodes = NULL;
+    o->verts = NULL;
+    o->num_entries = o->num_inst = o->num_nodes = 0;
+    int n = o->stats.n, res = o->stats.res;
+    o->stats = (rl_ls_objects_stats){ .n = n, .res = res };
+}
+
+void rl_ls_objects_release(rl_ls_objects *o)
+{
+    if (!o)
+        return;
+    free_built(o);
     free(o);
 }
 
@@ -358,8 +372,10 @@ rl_status rl_ls_objects_commit(rl_ls_objects *o)
     o->order = rl_calloc(no ? no : 1, sizeof *o->order);
     o->nodes = rl_calloc(no ? 2 * (size_t)no : 1, sizeof *o->nodes);
     o->verts = rl_calloc(3 * (size_t)(d->num_triangles ? d->num_triangles : 1), sizeof *o->verts);
-    if (!o->entries || !o->inst || !o->order || !o->nodes || !o->verts)
+    if (!o->entries || !o->inst || !o->order || !o->nodes || !o->verts) {
+        free_built(o);
         return RL_ERR_OUT_OF_MEMORY;
+    }
     for (uint32_t t = 0; t < d->num_triangles; ++t)
         for (int k = 0; k < 3; ++k)
             o->verts[3 * (size_t)t + k] = d->positions[d->indices[3 * (size_t)t + k]];
@@ -367,8 +383,10 @@ rl_status rl_ls_objects_commit(rl_ls_objects *o)
     for (uint32_t i = 0; i < no && st == RL_OK; ++i)
         if (d->objects[i].num_triangles > 0)
             st = add_instance(o, i);
-    if (st != RL_OK)
+    if (st != RL_OK) {
+        free_built(o);
         return st;
+    }
     for (uint32_t i = 0; i < o->num_inst; ++i)
         o->order[i] = i;
     if (o->num_inst > 0) {

@@ -335,6 +335,15 @@ rl_status rl_ls_scene_commit(rl_ls_scene *s)
         s->lo[a] = rl_vget(g->bounds.min, a);
         s->ext[a] = (double)rl_vget(g->bounds.max, a) - s->lo[a];
     }
+    /* A failed commit may be retried: start from nothing. */
+    free(s->cell);
+    free(s->bricks);
+    free(s->supers);
+    free(s->sig);
+    s->cell = NULL;
+    s->bricks = s->supers = NULL;
+    s->sig = NULL;
+    s->num_cells = s->num_bricks = s->num_supers = 0;
     st = gather_cells(s, g);
     rl_grid_free(g);
     if (st != RL_OK)
