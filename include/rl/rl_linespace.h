@@ -271,7 +271,7 @@ RL_API rl_status rl_linespace_load(const rl_accel *grid, const char *path, rl_li
 
 typedef struct rl_ls_objects rl_ls_objects;     /* opaque */
 
-#define RL_LS_OBJECT_DEFAULT_RES 4   /* voxels per axis and object */
+#define RL_LS_OBJECT_DEFAULT_RES 8   /* voxels per axis and object (measured: docs/line-space.md) */
 #define RL_LS_OBJECT_MAX_RES 64
 
 typedef struct rl_ls_objects_desc {             /* zero = default */
@@ -306,11 +306,11 @@ RL_API bool rl_ls_objects_occluded(const rl_ls_objects *o, const rl_ray *ray);
 
 typedef struct rl_ls_scene rl_ls_scene;         /* opaque */
 
-#define RL_LS_SCENE_DEFAULT_N 8
+#define RL_LS_SCENE_DEFAULT_N 4      /* N and cells measured: docs/line-space.md */
 #define RL_LS_SCENE_MAX_N 24
 #define RL_LS_SCENE_DEFAULT_SEGMENTS 64
 #define RL_LS_SCENE_MAX_SEGMENTS 64  /* one 64-bit signature per shaft */
-#define RL_LS_SCENE_DEFAULT_CELLS 32
+#define RL_LS_SCENE_DEFAULT_CELLS 16
 #define RL_LS_SCENE_MAX_CELLS 256
 
 /* What answers the filled intervals; exactly one is set, borrowed (it

@@ -9,13 +9,13 @@
  * its lower face (λ = 0) to patch B (λ = 1). The thesis leaves the
  * signature's form open; equal λ steps make the mapping from a ray's t
  * linear. Shafts: N x N patches per face of the scene box, indexed as the
- * per-voxel Line Space's (rl_linespace.h), default N = 8.
+ * per-voxel Line Space's (rl_linespace.h), default N = 4.
  *
  * Build. The points at λ of all lines from A to B fill the axis-aligned
  * box (1-λ)·A + λ·B, so a shaft meets an axis-aligned cell exactly for the
  * λ where that box overlaps the cell: six inequalities linear in λ, an
  * interval. Occupancy comes from a uniform grid over the scene (`cells`
- * per axis, default 32) whose cells list the triangles their surface
+ * per axis, default 16) whose cells list the triangles their surface
  * overlaps (grid.h, exact triangle/box test, cells grown); per shaft every
  * filled cell's interval sets its segments. Cells are visited in bricks
  * of 4³, and bricks in super-bricks of 4³ bricks, so that a (super-)brick

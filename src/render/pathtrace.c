@@ -39,8 +39,8 @@
  *                      adaptive_threshold = 0.01, adaptive_min_spp = 8
  *   grid_res = 0 (grid heuristic), ls_n = 5 [5], ls_k = 8, ls_dynamic = true,
  *   ls_origin = offset [offset], ls_file = "" (Line Space cache, Sec. 13.3)
- *   ls_scene_n = 8, ls_scene_segments = 64, ls_scene_cells = 32,
- *   ls_scene_inner = object, ls_object_res = 4 (outlook, not in the thesis)
+ *   ls_scene_n = 4, ls_scene_segments = 64, ls_scene_cells = 16,
+ *   ls_scene_inner = object, ls_object_res = 8 (outlook, not in the thesis)
  *   shadowmap_size = 1024 [1024], light_samples = 1, threads = 0 (all)
  *
  * A frame (Sec. 5.1, Fig. 8): build what the backends need (once per
@@ -204,16 +204,16 @@ static const rl_option_info pt_options[] = {
     { "ls_file", RL_OPT_STRING, "",
       "Line Space cache (Sec. 13.3): loaded if the file exists (it must match the scene, grid and "
       "ls_* options), else built and saved there; empty = build in memory only", 0, 0, NULL },
-    { "ls_scene_n", RL_OPT_INT, "8", "ls-scene: patches per face side of the scene box (Sec. 13.1)", 1,
+    { "ls_scene_n", RL_OPT_INT, "4", "ls-scene: patches per face side of the scene box (Sec. 13.1)", 1,
       RL_LS_SCENE_MAX_N, NULL },
     { "ls_scene_segments", RL_OPT_INT, "64", "ls-scene: signature bits per shaft (filled/empty stretches)", 1,
       RL_LS_SCENE_MAX_SEGMENTS, NULL },
-    { "ls_scene_cells", RL_OPT_INT, "32", "ls-scene: occupancy cells per axis behind the signatures", 1,
+    { "ls_scene_cells", RL_OPT_INT, "16", "ls-scene: occupancy cells per axis behind the signatures", 1,
       RL_LS_SCENE_MAX_CELLS, NULL },
     { "ls_scene_inner", RL_OPT_ENUM, "object",
       "ls-scene: what answers the filled stretches: object (the object Line Spaces, Sec. 13.2), bvh, or "
       "candidates (the per-voxel Line Space on the grid of grid_res)", 0, 0, ls_scene_inner_choices },
-    { "ls_object_res", RL_OPT_INT, "4", "ls-object: voxels per axis of each object's Line Space (N = ls_n; Sec. 13.2)",
+    { "ls_object_res", RL_OPT_INT, "8", "ls-object: voxels per axis of each object's Line Space (N = ls_n; Sec. 13.2)",
       1, RL_LS_OBJECT_MAX_RES, NULL },
     { "shadowmap_size", RL_OPT_INT, "1024", "texels per shadow-map face side (Sec. 8.6)", 16, 16384, NULL },
     { "light_samples", RL_OPT_INT, "1", "shadow rays per quad light and vertex", 1, 1024, NULL },

@@ -1222,7 +1222,7 @@ static void test_linespace_scene_signatures_are_conservative_and_answers_exact(v
     rl_accel *grid = accel_of(s, (rl_accel_desc){ .kind = RL_ACCEL_GRID, .grid_res = { 8, 8, 8 } });
     rl_linespace *ls = ls_of(grid, (rl_linespace_desc){ .n = 3, .dynamic = true }, NULL);
     rl_ls_objects *o = objects_of(s, (rl_ls_objects_desc){ .n = 3 });
-    rl_ls_scene *sb = scene_ls_of(s, (rl_ls_scene_desc){ .inner.accel = bvh });
+    rl_ls_scene *sb = scene_ls_of(s, (rl_ls_scene_desc){ .n = 8, .cells = 32, .inner.accel = bvh });
     rl_ls_scene_stats st;
     rl_ls_scene_get_stats(sb, &st);
     assert_int_equal(st.shafts, 15u * 8 * 8 * 8 * 8);
