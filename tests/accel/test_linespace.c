@@ -1176,8 +1176,8 @@ static void test_linespace_objects_equal_the_bvh_on_instanced_objects(void **sta
     rl_scene_release(s);
     /* The built-ins: several objects in a box (teapot, blocks, bunny). */
     s = builtin("cornell-teapot", "triangles=5000");
-    o = objects_of(s, (rl_ls_objects_desc){ .n = 3 });
-    agree_exactly("objects/cornell-teapot", s, o, objects_closest, objects_occl, NULL, 10000 / RAYS_SCALE, 12);
+    o = objects_of(s, (rl_ls_objects_desc){ .n = 3, .res = 4 });
+    agree_exactly("objects/cornell-teapot", s, o, objects_closest, objects_occl, NULL, 8000 / RAYS_SCALE, 12);
     rl_ls_objects_release(o);
     rl_scene_release(s);
 }
@@ -1221,7 +1221,7 @@ static void test_linespace_scene_signatures_are_conservative_and_answers_exact(v
     rl_accel *bvh = accel_of(s, (rl_accel_desc){ .kind = RL_ACCEL_BVH });
     rl_accel *grid = accel_of(s, (rl_accel_desc){ .kind = RL_ACCEL_GRID, .grid_res = { 8, 8, 8 } });
     rl_linespace *ls = ls_of(grid, (rl_linespace_desc){ .n = 3, .dynamic = true }, NULL);
-    rl_ls_objects *o = objects_of(s, (rl_ls_objects_desc){ .n = 3 });
+    rl_ls_objects *o = objects_of(s, (rl_ls_objects_desc){ .n = 3, .res = 4 });
     rl_ls_scene *sb = scene_ls_of(s, (rl_ls_scene_desc){ .n = 8, .cells = 32, .inner.accel = bvh });
     rl_ls_scene_stats st;
     rl_ls_scene_get_stats(sb, &st);

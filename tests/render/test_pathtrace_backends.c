@@ -207,7 +207,7 @@ static void test_scene_and_object_line_spaces_reproduce_the_bvh_image(void **sta
     };
     for (size_t c = 0; c < sizeof cases / sizeof cases[0]; ++c) {
         rl_renderer *r = fx_make("pt", (const char *const[]){ "spp", "2", "shadow", cases[c][0], "diffuse", cases[c][0],
-                                                              "ls_scene_inner", cases[c][1], "ls_n", "3", "ls_scene_n", "4", cases[c][2],
+                                                              "ls_scene_inner", cases[c][1], "ls_n", "3", "ls_object_res", "2", cases[c][2],
                                                               cases[c][3], NULL });
         rl_image *img = fx_render_with(r, s, &cam, RL_LAYER_COLOR, NULL);
         if (rmse(bvh, img) > 1e-6)
