@@ -269,6 +269,12 @@ static void set_identity(double m[3][4])
             m[r][c] = r == c ? 1.0 : 0.0;
 }
 
+/* The largest |coordinate| of b: what float rounding scales with. */
+static float max_abs(rl_aabb b)
+{
+    return rl_vmax_comp(rl_vmax(rl_vmax(b.min, rl_neg(b.min)), rl_vmax(b.max, rl_neg(b.max))));
+}
+
 static rl_status add_instance(rl_ls_objects *o, uint32_t object)
 {
     const rl_object *obj = &o->data->objects[object];
@@ -276,8 +282,7 @@ static rl_status add_instance(rl_ls_objects *o, uint32_t object)
     in->first_triangle = obj->first_triangle;
     in->num_triangles = obj->num_triangles;
     rl_vec3 ext = rl_aabb_extent(obj->bounds);
-    float grow = BOX_GROW_REL * rl_maxf(rl_length(ext), rl_vmax_comp(rl_vmax(rl_vmax(obj->bounds.min, rl_neg(obj->bounds.min)),
-                                                                            rl_vmax(obj->bounds.max, rl_neg(obj->bounds.max)))));
+    float grow = BOX_GROW_REL * rl_maxf(rl_length(ext), max_abs(obj->bounds));
     in->box.min = rl_sub(obj->bounds.min, rl_v3s(grow));
     in->box.max = rl_add(obj->bounds.max, rl_v3s(grow));
     rl_mat4 inv;
@@ -419,7 +424,7 @@ static void local_ray(const instance *in, const rl_ray *ray, float t_enter, floa
         lr->d[r] = in->inv[r][0] * ray->d.x + in->inv[r][1] * ray->d.y + in->inv[r][2] * ray->d.z;
     lr->t_shift = t_enter;
     float dl = rl_length(ray->d);
-    float coord = rl_vmax_comp(rl_vmax(rl_vmax(in->box.min, rl_neg(in->box.min)), rl_vmax(in->box.max, rl_neg(in->box.max))));
+    float coord = max_abs(in->box);
     lr->slack = SLACK_REL * (fabsf(t_enter) + fabsf(t_exit - t_enter) + coord / dl);
 }
 
