@@ -12,7 +12,11 @@
  *                 (the thesis tuned the resolution per structure), and a
  *                 frame without diffuse rays as the floor of the rays' share
  *   shadow        Diagram 3: the same scene, shadow rays through each
- *                 structure (and shadow maps), diffuse rays by the BVH
+ *                 structure (and shadow maps), diffuse rays by the BVH;
+ *                 then shadow and first-bounce diffuse rays alone, also
+ *                 through the scene and object Line Spaces (Sec. 13.1-13.2,
+ *                 with their build time and memory); both sections also
+ *                 render with ls-object and ls-scene
  *   error         RMSE and SSIM of every variant against a converged BVH
  *                 reference at equal sample counts, and the time each needs
  *                 to reach the RMSE the BVH reaches at 4, 16, 64 spp
@@ -77,7 +81,9 @@ static const char bench_pt_help[] =
     "                8^3..64^3, best per variant; shadows by shadow maps (Diagram 2)\n"
     "  shadow        the same for shadow rays, plus shadow maps; diffuse rays by\n"
     "                the BVH (Diagram 3); then the frame's shadow rays alone through\n"
-    "                the BVH, the grid and each Line Space (Mrays/s, occluded counts)\n"
+    "                the BVH, the grid and each Line Space (Mrays/s, occluded counts),\n"
+    "                and first-bounce diffuse rays through the exact ones; both\n"
+    "                sections also time ls-object and ls-scene (Sec. 13.1, 13.2)\n"
     "  error         RMSE/SSIM of each variant (PNMT and pre-illuminated at every\n"
     "                voxel resolution) against a converged BVH reference at equal\n"
     "                spp, and time to reach the BVH's RMSE at 4/16/64 spp\n"
@@ -203,6 +209,7 @@ typedef struct pt_config {
     const char *ls_origin;         /* NULL: the renderer's default (offset) */
     const char *specular;          /* NULL: the renderer's default (exact) */
     bool ls_fixed;                 /* the thesis' fixed lists of k = 8 (ls_dynamic=false) */
+    const char *ls_scene_inner;    /* NULL: the renderer's default (object) */
     int spp;
     bool accumulate;
     const char *seed;
@@ -278,6 +285,7 @@ static rl_status make_pt(const bpt *b, const pt_config *c, rl_renderer **out)
     if (st == RL_OK && c->max_depth) st = set_num(r, "max_depth", c->max_depth);
     if (st == RL_OK && c->direct_only) st = set_num(r, "max_depth", 0);
     if (st == RL_OK && c->ls_origin) st = rl_renderer_set(r, "ls_origin", c->ls_origin);
+    if (st == RL_OK && c->ls_scene_inner) st = rl_renderer_set(r, "ls_scene_inner", c->ls_scene_inner);
     if (st == RL_OK && c->specular) st = rl_renderer_set(r, "specular", c->specular);
     if (st == RL_OK && c->ls_fixed) st = rl_renderer_set(r, "ls_dynamic", "false");
     if (st == RL_OK) st = set_num(r, "spp", c->spp ? c->spp : 1);
@@ -750,6 +758,24 @@ static int add_sweep(pt_config *configs, int count, int cap, char labels[][32], 
     return count;
 }
 
+/* The scene and object Line Spaces (Sec. 13.1, 13.2) at the renderer's
+ * defaults after the sweep: exact, on no voxel resolution of the sweep
+ * (the object grids have ls_object_res voxels per axis and object), the
+ * scene Line Space over the object Line Spaces and over the BVH. */
+static int add_levels(pt_config *configs, int count, int cap, sweep_rays rays)
+{
+    static const char *const labels[3] = { "ls-object", "ls-scene/object", "ls-scene/bvh" };
+    static const char *const backends[3] = { "ls-object", "ls-scene", "ls-scene" };
+    static const char *const inner[3] = { NULL, "object", "bvh" };
+    for (int i = 0; i < 3 && count < cap; i++, count++) {
+        pt_config c = { .label = labels[i], .ls_scene_inner = inner[i],
+                        .shadow = rays == SWEEP_DIFFUSE ? "shadowmap" : backends[i],
+                        .diffuse = rays == SWEEP_SHADOW ? "bvh" : backends[i] };
+        configs[count] = c;
+    }
+    return count;
+}
+
 /* Per Line Space variant, the fastest resolution of the sweep, against
  * the grid (config 0) and the BVH (config 1); with floor >= 0 also the
  * rays' own share (see frame_table). */
@@ -801,6 +827,7 @@ static rl_status sec_diffuse(void *ctx, cJSON *sec)
     };
     char labels[MAX_CONFIGS][32];
     int count = add_sweep(configs, 3, MAX_CONFIGS, labels, 0, res, nres, SWEEP_DIFFUSE);
+    count = add_levels(configs, count, MAX_CONFIGS, SWEEP_DIFFUSE);
     printf("\ndiffuse (Diagram 2: %s, %dx%d, 1 spp, shadows by shadow maps, each Line Space variant "
            "at voxels %d^3..%d^3; x base = speed-up over the grid, (rays): of the frame without "
            "the direct-light-only floor; thesis: PNMT > 20x the grid)\n", name, b->a->width,
@@ -824,27 +851,81 @@ static rl_status sec_diffuse(void *ctx, cJSON *sec)
  * timed on those rays too, for a like-for-like ratio; the candidate Line
  * Space is exact and answers the full rays. Pre-illuminated shadow tests
  * walk like PNMT and need a shading function, so they are not repeated. */
-typedef enum ray_structure { RS_BVH, RS_GRID, RS_LS_CAND, RS_LS_PNMT } ray_structure;
+typedef enum ray_structure { RS_BVH, RS_GRID, RS_LS_CAND, RS_LS_PNMT, RS_LS_OBJECT, RS_LS_SCENE } ray_structure;
 
-static double occluded_pass(const bpt *b, ray_structure k, const rl_accel *acc, const rl_linespace *ls,
-                            const rl_ray *rays, size_t n, uint64_t *occluded)
+/* The structure a pass queries: acc for RS_BVH/RS_GRID, ls for the
+ * per-voxel Line Space, lso/lss for the object and scene Line Spaces. */
+typedef struct ray_target {
+    const rl_accel *acc;
+    const rl_linespace *ls;
+    const rl_ls_objects *lso;
+    const rl_ls_scene *lss;
+} ray_target;
+
+static bool target_occluded(ray_structure k, const ray_target *t, const rl_ray *ray)
+{
+    switch (k) {
+    case RS_LS_CAND: return rl_linespace_occluded(t->ls, ray);
+    case RS_LS_PNMT: return rl_linespace_pnmt_occluded(t->ls, ray);
+    case RS_LS_OBJECT: return rl_ls_objects_occluded(t->lso, ray);
+    case RS_LS_SCENE: return rl_ls_scene_occluded(t->lss, ray);
+    default: return rl_accel_occluded(t->acc, ray);
+    }
+}
+
+static bool target_closest(ray_structure k, const ray_target *t, rl_ray *ray, rl_hit *h)
+{
+    switch (k) {
+    case RS_LS_CAND: return rl_linespace_intersect(t->ls, ray, h);
+    case RS_LS_OBJECT: return rl_ls_objects_intersect(t->lso, ray, h);
+    case RS_LS_SCENE: return rl_ls_scene_intersect(t->lss, ray, h);
+    default: return rl_accel_intersect(t->acc, ray, h);
+    }
+}
+
+static double occluded_pass_on(const bpt *b, ray_structure k, const ray_target *t, const rl_ray *rays, size_t n,
+                               uint64_t *occluded)
 {
     double best = INFINITY;
     for (int r = 0; r < b->runs; r++) {
         uint64_t occ = 0;
         double t0 = omp_get_wtime();
         #pragma omp parallel for num_threads(b->threads) schedule(dynamic, 1024) reduction(+ : occ)
-        for (long i = 0; i < (long)n; i++) {
-            bool hit = k == RS_LS_CAND   ? rl_linespace_occluded(ls, &rays[i])
-                       : k == RS_LS_PNMT ? rl_linespace_pnmt_occluded(ls, &rays[i])
-                                         : rl_accel_occluded(acc, &rays[i]);
-            occ += hit;
-        }
+        for (long i = 0; i < (long)n; i++)
+            occ += target_occluded(k, t, &rays[i]);
         double ms = (omp_get_wtime() - t0) * 1e3;
         best = ms < best ? ms : best;
         *occluded = occ;
     }
     return best;
+}
+
+/* The fastest of b->runs closest-hit passes over rays; *hits: rays that hit. */
+static double closest_pass(const bpt *b, ray_structure k, const ray_target *t, const rl_ray *rays, size_t n,
+                           uint64_t *hits)
+{
+    double best = INFINITY;
+    for (int r = 0; r < b->runs; r++) {
+        uint64_t hit = 0;
+        double t0 = omp_get_wtime();
+        #pragma omp parallel for num_threads(b->threads) schedule(dynamic, 1024) reduction(+ : hit)
+        for (long i = 0; i < (long)n; i++) {
+            rl_ray ray = rays[i];
+            rl_hit h;
+            hit += target_closest(k, t, &ray, &h);
+        }
+        double ms = (omp_get_wtime() - t0) * 1e3;
+        best = ms < best ? ms : best;
+        *hits = hit;
+    }
+    return best;
+}
+
+static double occluded_pass(const bpt *b, ray_structure k, const rl_accel *acc, const rl_linespace *ls,
+                            const rl_ray *rays, size_t n, uint64_t *occluded)
+{
+    ray_target t = { .acc = acc, .ls = ls };
+    return occluded_pass_on(b, k, &t, rays, n, occluded);
 }
 
 static cJSON *pass_json(cJSON *parent, const char *name, double ms, size_t rays, uint64_t occluded)
@@ -919,6 +1000,126 @@ static rl_status shadow_rays(const bpt *b, const rl_scene *scene, const rl_accel
     return RL_OK;
 }
 
+/* One diffuse ray per pixel: from the primary hit (by the BVH), offset
+ * along the geometric normal, in a cosine-distributed direction of its
+ * hemisphere (the path tracer's first bounce on a Lambertian surface). */
+static rl_status diffuse_rays(const bpt *b, const rl_scene *scene, const rl_accel *bvh, rl_ray **out, size_t *count)
+{
+    const rl_scene_data *d = rl_scene_get_data(scene);
+    rl_camera cam = scene_camera(scene, b->a->width, b->a->height);
+    rl_camera_frame f = rl_camera_frame_make(&cam);
+    rl_ray *rays = malloc((size_t)cam.width * (size_t)cam.height * sizeof *rays);
+    *out = NULL;
+    *count = 0;
+    if (!rays)
+        return RL_ERR_OUT_OF_MEMORY;
+    rl_vec3 ext = rl_sub(d->bounds.max, d->bounds.min);
+    float eps = 1e-4f * rl_maxf(1.0f, rl_maxf(ext.x, rl_maxf(ext.y, ext.z)));
+    size_t n = 0;
+    for (int y = 0; y < cam.height; y++)
+        for (int x = 0; x < cam.width; x++) {
+            rl_ray pr = rl_camera_frame_ray(&f, (float)x + 0.5f, (float)y + 0.5f);
+            rl_hit h;
+            if (!rl_accel_intersect(bvh, &pr, &h))
+                continue;
+            const uint32_t *tri = d->indices + 3 * (size_t)h.triangle;
+            rl_vec3 ng = rl_normalize(rl_cross(rl_sub(d->positions[tri[1]], d->positions[tri[0]]),
+                                               rl_sub(d->positions[tri[2]], d->positions[tri[0]])));
+            if (rl_dot(ng, pr.d) > 0.0f)
+                ng = rl_scale(ng, -1.0f);
+            rl_rng rng;
+            rl_rng_seed(&rng, 2, (uint64_t)y * (uint64_t)cam.width + (uint64_t)x);
+            float u = rl_rng_float(&rng), v = rl_rng_float(&rng), r = sqrtf(u), phi = 2.0f * RL_PI * v;
+            rl_onb basis = rl_onb_from_normal(ng);
+            rl_vec3 dir = rl_onb_to_world(&basis, rl_v3(r * cosf(phi), r * sinf(phi), sqrtf(rl_maxf(0.0f, 1.0f - u))));
+            rays[n++] = (rl_ray){ rl_madd(rl_ray_at(&pr, h.t), ng, eps), 0.0f, dir, INFINITY };
+        }
+    *out = rays;
+    *count = n;
+    return RL_OK;
+}
+
+/* The scene and object Line Spaces (Sec. 13.1, 13.2) at pt's defaults:
+ * build time and memory, then the shadow rays and the diffuse rays
+ * through them, against the BVH and the grid on the same rays. */
+static rl_status levels_alone(const bpt *b, const rl_scene *scene, rl_accel *const acc[2], const rl_ray *rays,
+                              size_t n, const double acc_ms[2], const rl_ray *drays, size_t dn,
+                              const double dacc_ms[2], cJSON *o)
+{
+    rl_ls_objects *lso = NULL;
+    rl_ls_scene *lss[2] = { NULL, NULL };
+    rl_status st = rl_ls_objects_create(scene, &(rl_ls_objects_desc){ .threads = b->threads }, &lso);
+    if (st == RL_OK)
+        st = rl_ls_objects_commit(lso);
+    for (int k = 0; k < 2 && st == RL_OK; k++) {
+        rl_ls_scene_desc sd = { .threads = b->threads };
+        if (k == 0)
+            sd.inner.objects = lso;
+        else
+            sd.inner.accel = acc[0];
+        st = rl_ls_scene_create(scene, &sd, &lss[k]);
+        if (st == RL_OK)
+            st = rl_ls_scene_commit(lss[k]);
+    }
+    cJSON *lv = st == RL_OK ? cJSON_AddObjectToObject(o, "scene_and_object_line_spaces") : NULL;
+    if (st == RL_OK && !lv)
+        st = RL_ERR_OUT_OF_MEMORY;
+    if (st == RL_OK) {
+        rl_ls_objects_stats os;
+        rl_ls_scene_stats ss;
+        rl_ls_objects_get_stats(lso, &os);
+        rl_ls_scene_get_stats(lss[0], &ss);
+        rl_accel_stats bs, gs;
+        rl_accel_get_stats(acc[0], &bs);
+        rl_accel_get_stats(acc[1], &gs);
+        printf("scene and object Line Spaces (Sec. 13.1, 13.2; pt's defaults): builds ls-object %.1f ms "
+               "(%u Line Spaces for %u objects, N = %d, %d^3 voxels each, %.1f MiB), ls-scene signatures %.1f ms "
+               "(N = %d, %d bits, %d^3 cells, %.1f %% set, %.2f MiB); bvh %.1f ms (%.1f MiB), grid %.1f ms "
+               "(%.1f MiB)\n", os.build_ms, os.linespaces, os.objects, os.n, os.res, os.memory_bytes / 1048576.0,
+               ss.build_ms, ss.n, ss.segments, ss.cells,
+               100.0 * (double)ss.filled_bits / ((double)ss.shafts * ss.segments), ss.memory_bytes / 1048576.0,
+               bs.build_ms, bs.memory_bytes / 1048576.0, gs.build_ms, gs.memory_bytes / 1048576.0);
+        cJSON *bj = cJSON_AddObjectToObject(lv, "build");
+        bench_add_num(bj, "ls_object_ms", os.build_ms);
+        bench_add_num(bj, "ls_object_bytes", (double)os.memory_bytes);
+        cJSON_AddNumberToObject(bj, "ls_object_linespaces", os.linespaces);
+        cJSON_AddNumberToObject(bj, "ls_object_objects", os.objects);
+        bench_add_num(bj, "ls_scene_ms", ss.build_ms);
+        bench_add_num(bj, "ls_scene_bytes", (double)ss.memory_bytes);
+        bench_add_num(bj, "ls_scene_fill", (double)ss.filled_bits / ((double)ss.shafts * ss.segments));
+        bench_add_num(bj, "bvh_ms", bs.build_ms);
+        bench_add_num(bj, "bvh_bytes", (double)bs.memory_bytes);
+        bench_add_num(bj, "grid_ms", gs.build_ms);
+        bench_add_num(bj, "grid_bytes", (double)gs.memory_bytes);
+        static const char *const names[3] = { "ls-object", "ls-scene/object", "ls-scene/bvh" };
+        const ray_structure kinds[3] = { RS_LS_OBJECT, RS_LS_SCENE, RS_LS_SCENE };
+        const ray_target targets[3] = { { .lso = lso }, { .lss = lss[0] }, { .lss = lss[1] } };
+        cJSON *sj = cJSON_AddObjectToObject(lv, "shadow"), *dj = cJSON_AddObjectToObject(lv, "diffuse");
+        for (int k = 0; k < 3; k++) {
+            uint64_t occ = 0, hits = 0;
+            double ms = occluded_pass_on(b, kinds[k], &targets[k], rays, n, &occ);
+            double dms = closest_pass(b, kinds[k], &targets[k], drays, dn, &hits);
+            cJSON *e = pass_json(sj, names[k], ms, n, occ);
+            bench_add_num(e, "speedup_vs_bvh", bench_ratio(acc_ms[0], ms));
+            bench_add_num(e, "speedup_vs_grid", bench_ratio(acc_ms[1], ms));
+            e = pass_json(dj, names[k], dms, dn, hits);
+            bench_add_num(e, "speedup_vs_bvh", bench_ratio(dacc_ms[0], dms));
+            bench_add_num(e, "speedup_vs_grid", bench_ratio(dacc_ms[1], dms));
+            printf("  %-22s shadow %8.1f ms %8.2f Mrays/s %9llu  %5.2fx the BVH, %5.2fx the grid\n", names[k], ms,
+                   (double)n / (ms * 1e3), (unsigned long long)occ, bench_ratio(acc_ms[0], ms),
+                   bench_ratio(acc_ms[1], ms));
+            printf("  %-22s diffuse %7.1f ms %8.2f Mrays/s %9llu  %5.2fx the BVH, %5.2fx the grid\n", names[k], dms,
+                   (double)dn / (dms * 1e3), (unsigned long long)hits, bench_ratio(dacc_ms[0], dms),
+                   bench_ratio(dacc_ms[1], dms));
+            fflush(stdout);
+        }
+    }
+    rl_ls_scene_release(lss[1]);
+    rl_ls_scene_release(lss[0]);
+    rl_ls_objects_release(lso);
+    return st;
+}
+
 static rl_status shadow_rays_alone(bpt *b, const char *name, const int *res, int nres, cJSON *sec)
 {
     rl_scene *scene = NULL;
@@ -956,6 +1157,25 @@ static rl_status shadow_rays_alone(bpt *b, const char *name, const int *res, int
         printf("  %-22s %8.1f ms %8.2f Mrays/s %9llu\n", acc_names[k], acc_ms[k],
                (double)n / (acc_ms[k] * 1e3), (unsigned long long)occ);
     }
+    /* Diffuse rays too, for the structures that answer closest hits
+     * exactly: the BVH, the grid, the candidate Line Space, and the scene
+     * and object Line Spaces. */
+    rl_ray *drays = NULL;
+    size_t dn = 0;
+    double dacc_ms[2] = { NAN, NAN };
+    if (st == RL_OK)
+        st = diffuse_rays(b, scene, acc[0], &drays, &dn);
+    cJSON *dj = st == RL_OK ? cJSON_AddObjectToObject(o, "diffuse_rays") : NULL;
+    for (int k = 0; k < 2 && dj; k++) {
+        uint64_t hits = 0;
+        ray_target t = { .acc = acc[k] };
+        dacc_ms[k] = closest_pass(b, k ? RS_GRID : RS_BVH, &t, drays, dn, &hits);
+        pass_json(dj, acc_names[k], dacc_ms[k], dn, hits);
+        printf("  %-22s diffuse %7.1f ms %8.2f Mrays/s %9llu (closest hits, %zu rays)\n", acc_names[k], dacc_ms[k],
+               (double)dn / (dacc_ms[k] * 1e3), (unsigned long long)hits, dn);
+    }
+    if (st == RL_OK)
+        st = levels_alone(b, scene, acc, rays, n, acc_ms, drays, dn, dacc_ms, o);
     cut = st == RL_OK ? malloc(n * sizeof *cut) : NULL;
     if (st == RL_OK && !cut)
         st = RL_ERR_OUT_OF_MEMORY;
@@ -986,14 +1206,18 @@ static rl_status shadow_rays_alone(bpt *b, const char *name, const int *res, int
                 if (c.t_min < c.t_max)
                     cut[m++] = c;
             }
-            uint64_t occ_c = 0, occ_p = 0, occ_b = 0;
+            uint64_t occ_c = 0, occ_p = 0, occ_b = 0, hits_c = 0;
             double ms_c = occluded_pass(b, RS_LS_CAND, NULL, ls, rays, n, &occ_c);
+            ray_target lt = { .ls = ls };
+            double dms_c = closest_pass(b, RS_LS_CAND, &lt, drays, dn, &hits_c);
             double ms_p = occluded_pass(b, RS_LS_PNMT, NULL, ls, cut, m, &occ_p);
             double ms_b = occluded_pass(b, RS_BVH, acc[0], NULL, cut, m, &occ_b);
             cJSON *e = cJSON_CreateObject();
             cJSON_AddItemToArray(lsj, e);
             cJSON_AddNumberToObject(e, "voxel_res", res[i]);
             pass_json(e, "candidates", ms_c, n, occ_c);
+            bench_add_num(pass_json(e, "candidates_diffuse", dms_c, dn, hits_c), "speedup_vs_bvh",
+                          bench_ratio(dacc_ms[0], dms_c));
             pass_json(e, "pnmt", ms_p, m, occ_p);
             pass_json(e, "bvh_same_rays", ms_b, m, occ_b);
             bench_add_num(e, "candidates_speedup_vs_bvh", bench_ratio(acc_ms[0], ms_c));
@@ -1004,6 +1228,9 @@ static rl_status shadow_rays_alone(bpt *b, const char *name, const int *res, int
             printf("  %-22s %8.1f ms %8.2f Mrays/s %9llu  %5.2fx the BVH, %5.2fx the grid\n",
                    label, ms_c, (double)n / (ms_c * 1e3), (unsigned long long)occ_c,
                    bench_ratio(acc_ms[0], ms_c), bench_ratio(acc_ms[1], ms_c));
+            printf("  %-22s diffuse %7.1f ms %8.2f Mrays/s %9llu  %5.2fx the BVH, %5.2fx the grid\n", label, dms_c,
+                   (double)dn / (dms_c * 1e3), (unsigned long long)hits_c, bench_ratio(dacc_ms[0], dms_c),
+                   bench_ratio(dacc_ms[1], dms_c));
             printf("  ls-pnmt@%-14d %8.1f ms %8.2f Mrays/s %9llu  %5.2fx the BVH on the same %zu rays "
                    "(%.1f ms, %llu occluded)\n", res[i], ms_p, (double)m / (ms_p * 1e3),
                    (unsigned long long)occ_p, bench_ratio(ms_b, ms_p), m, ms_b,
@@ -1016,6 +1243,7 @@ static rl_status shadow_rays_alone(bpt *b, const char *name, const int *res, int
     rl_accel_release(acc[0]);
     rl_accel_release(acc[1]);
     free(rays);
+    free(drays);
     free(cut);
     return st;
 }
@@ -1032,6 +1260,7 @@ static rl_status sec_shadow(void *ctx, cJSON *sec)
     };
     char labels[MAX_CONFIGS][32];
     int count = add_sweep(configs, 3, MAX_CONFIGS, labels, 0, res, nres, SWEEP_SHADOW);
+    count = add_levels(configs, count, MAX_CONFIGS, SWEEP_SHADOW);
     printf("\nshadow (Diagram 3: %s, %dx%d, 1 spp, diffuse rays by the BVH, each Line Space variant "
            "at voxels %d^3..%d^3; x base = speed-up over the grid; thesis: PNMT ~10x the grid, "
            "shadow maps faster still)\n", name, b->a->width, b->a->height, nres ? res[0] : 0,

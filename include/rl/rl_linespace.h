@@ -235,6 +235,128 @@ RL_API void rl_linespace_get_data(const rl_linespace *ls, rl_linespace_data *out
 RL_API rl_status rl_linespace_save(const rl_linespace *ls, const char *path);
 RL_API rl_status rl_linespace_load(const rl_accel *grid, const char *path, rl_linespace **out);
 
+
+/* ---- scene and object Line Spaces (Schröder 2017, Sec. 13.1, 13.2) ----
+ * docs/line-space.md has the design and the measurements.
+ *
+ * SCENE LINE SPACE (Sec. 13.1). One Line Space whose single "voxel" is the
+ * scene's box: N x N patches per face, 15·N^4 shafts, and per shaft a
+ * signature of M bits (M segments of equal length in λ, the parameter that
+ * runs from 0 on the shaft's patch A (lower face) to 1 on patch B): bit j is
+ * set when geometry may lie in the part of the shaft with λ in
+ * [j/M, (j+1)/M]. A line through patches A and B at points a and b is, at
+ * λ, in the box (1-λ)·A + λ·B (a Minkowski sum of two axis-aligned
+ * rectangles), so the λ-range over which a shaft meets an axis-aligned
+ * cell is an interval found from six linear inequalities, exactly. The
+ * build marks the segments of every filled cell of an occupancy grid
+ * (the cells of RL_ACCEL_GRID's exact triangle/box test, `cells` per axis)
+ * in every shaft: conservative, so a ray's hits all lie in set segments.
+ * A query maps the ray to its shaft (its line's entry and exit on the
+ * box), turns the runs of set bits within (t_min, t_max) into t-intervals
+ * and asks the inner structure about each in ray order, stopping at the
+ * first hit: the same hit as the inner structure alone, and for shadow
+ * rays often no inner query at all.
+ *
+ * OBJECT LINE SPACE (Sec. 13.2). One per-voxel Line Space (dynamic
+ * candidates, on a grid of `res` voxels per axis) per mesh, built in the
+ * mesh's object space (the flattened world triangles mapped back by the
+ * inverse of the instance transform); instances of one mesh whose object-
+ * space vertices agree share it. A top level (a BVH over the instances'
+ * world boxes) orders the instances; a ray is transformed into the
+ * instance's object space, walks its Line Space there, and the candidates
+ * are tested in world space against the scene's triangles with the shared
+ * watertight test, so answers are the BVH's bit for bit. A transform that
+ * cannot be inverted (a flattened instance) gets a Line Space of its own
+ * in world space. */
+
+typedef struct rl_ls_objects rl_ls_objects;     /* opaque */
+
+#define RL_LS_OBJECT_DEFAULT_RES 8   /* voxels per axis and object (measured: docs/line-space.md) */
+#define RL_LS_OBJECT_MAX_RES 64
+
+typedef struct rl_ls_objects_desc {             /* zero = default */
+    int n;                    /* patches per voxel face side; 0 -> RL_LS_DEFAULT_N */
+    int res;                  /* voxels per axis of each object's grid;
+                               * 0 -> RL_LS_OBJECT_DEFAULT_RES */
+    int threads;              /* build threads; 0 -> all */
+} rl_ls_objects_desc;
+
+typedef struct rl_ls_objects_stats {
+    int n, res;
+    uint32_t objects;                  /* instances with triangles */
+    uint32_t linespaces;               /* built (instances may share one) */
+    uint32_t world_space;              /* of these, built in world space */
+    uint64_t shafts, candidates;       /* summed over the Line Spaces */
+    double build_ms;
+    size_t memory_bytes;               /* Line Spaces, their grids, the top level */
+} rl_ls_objects_stats;
+
+/* RL_ERR_INVALID_ARG: NULL, a scene that is not committed, n outside
+ * 1..RL_LS_MAX_N, res outside 1..RL_LS_OBJECT_MAX_RES, threads < 0. */
+RL_API rl_status rl_ls_objects_create(const rl_scene *scene, const rl_ls_objects_desc *desc,
+                                      rl_ls_objects **out);
+/* Builds; RL_ERR_OUT_OF_MEMORY, RL_ERR_LIMIT. A second commit is a no-op. */
+RL_API rl_status rl_ls_objects_commit(rl_ls_objects *o);
+RL_API void rl_ls_objects_release(rl_ls_objects *o);     /* NULL is a no-op */
+RL_API void rl_ls_objects_get_stats(const rl_ls_objects *o, rl_ls_objects_stats *out);
+/* Exact queries, as rl_accel_intersect / rl_accel_occluded (alpha masks
+ * included); thread-safe; bad rays miss. */
+RL_API bool rl_ls_objects_intersect(const rl_ls_objects *o, rl_ray *ray, rl_hit *hit);
+RL_API bool rl_ls_objects_occluded(const rl_ls_objects *o, const rl_ray *ray);
+
+typedef struct rl_ls_scene rl_ls_scene;         /* opaque */
+
+#define RL_LS_SCENE_DEFAULT_N 4      /* N and cells measured: docs/line-space.md */
+#define RL_LS_SCENE_MAX_N 24
+#define RL_LS_SCENE_DEFAULT_SEGMENTS 64
+#define RL_LS_SCENE_MAX_SEGMENTS 64  /* one 64-bit signature per shaft */
+#define RL_LS_SCENE_DEFAULT_CELLS 16
+#define RL_LS_SCENE_MAX_CELLS 256
+
+/* What answers the filled intervals; exactly one is set, borrowed (it
+ * must be committed, on the same scene, and outlive the scene Line Space). */
+typedef struct rl_ls_scene_inner {
+    const rl_accel *accel;            /* any kind: BVH, grid, Embree */
+    const rl_linespace *linespace;    /* per-voxel, CANDIDATES payload */
+    const rl_ls_objects *objects;     /* object Line Spaces */
+} rl_ls_scene_inner;
+
+typedef struct rl_ls_scene_desc {               /* zero = default */
+    int n;                    /* patches per face side of the scene box;
+                               * 0 -> RL_LS_SCENE_DEFAULT_N */
+    int segments;             /* signature bits per shaft, M;
+                               * 0 -> RL_LS_SCENE_DEFAULT_SEGMENTS */
+    int cells;                /* occupancy cells per axis;
+                               * 0 -> RL_LS_SCENE_DEFAULT_CELLS */
+    int threads;              /* build threads; 0 -> all */
+    rl_ls_scene_inner inner;
+} rl_ls_scene_desc;
+
+typedef struct rl_ls_scene_stats {
+    int n, segments, cells;
+    uint64_t shafts;                   /* 15·N^2·N^2 */
+    uint64_t filled_bits;              /* set signature bits over all shafts */
+    uint32_t filled_cells;
+    double build_ms;                   /* occupancy grid and signatures */
+    size_t memory_bytes;               /* signatures and occupancy grid */
+} rl_ls_scene_stats;
+
+/* RL_ERR_INVALID_ARG: NULL, a scene that is not committed, parameters out
+ * of range (n 1..RL_LS_SCENE_MAX_N, segments 1..64, cells
+ * 1..RL_LS_SCENE_MAX_CELLS, threads >= 0), not exactly one inner
+ * structure, an inner one not committed, of another scene, or a per-voxel
+ * Line Space without CANDIDATES. */
+RL_API rl_status rl_ls_scene_create(const rl_scene *scene, const rl_ls_scene_desc *desc,
+                                    rl_ls_scene **out);
+RL_API rl_status rl_ls_scene_commit(rl_ls_scene *s);     /* builds; a second is a no-op */
+RL_API void rl_ls_scene_release(rl_ls_scene *s);         /* NULL is a no-op */
+RL_API void rl_ls_scene_get_stats(const rl_ls_scene *s, rl_ls_scene_stats *out);
+/* The signature of shaft `shaft` (< 15·N^4; 0 beyond), bit j = segment j. */
+RL_API uint64_t rl_ls_scene_signature(const rl_ls_scene *s, uint32_t shaft);
+/* Exact queries (the inner structure's answers); thread-safe; bad rays miss. */
+RL_API bool rl_ls_scene_intersect(const rl_ls_scene *s, rl_ray *ray, rl_hit *hit);
+RL_API bool rl_ls_scene_occluded(const rl_ls_scene *s, const rl_ray *ray);
+
 #ifdef __cplusplus
 }
 #endif

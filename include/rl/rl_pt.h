@@ -34,6 +34,8 @@ typedef enum rl_pt_backend {
     RL_PT_BACKEND_LS_PREILLUM,     /* stored direct light of the first surface (Sec. 7.4) */
     RL_PT_BACKEND_LS_PNMT,         /* stored surface, no triangle test (Sec. 7.2-7.3) */
     RL_PT_BACKEND_SHADOWMAP,       /* shadow maps, shadow tests only (Sec. 8.6) */
+    RL_PT_BACKEND_LS_SCENE,        /* scene Line Space signatures over an inner structure (Sec. 13.1) */
+    RL_PT_BACKEND_LS_OBJECT,       /* object Line Spaces under a BVH of instance boxes (Sec. 13.2) */
     RL_PT_BACKEND_COUNT
 } rl_pt_backend;
 
@@ -64,6 +66,7 @@ typedef struct rl_pt_stats {
      * (they are kept between frames); 0 for one not in use. With ls_file
      * the Line Space's is its load time when the file was loaded. */
     double build_bvh_ms, build_grid_ms, build_embree_ms, build_linespace_ms, build_shadowmap_ms;
+    double build_ls_scene_ms, build_ls_object_ms;   /* ls-scene's signatures; the object Line Spaces */
     rl_rng_gpu_kind rng;          /* the GPU generator, when not sobol */
     bool sobol;                   /* rng=sobol: Owen-scrambled Sobol points */
     float filter_weight;          /* weight of the filtered image in the output */

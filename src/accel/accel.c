@@ -297,3 +297,8 @@ const struct rl_grid *rl_accel_grid_state(const rl_accel *a)
         return NULL;
     return a->state;
 }
+
+bool rl_accel_is_committed(const rl_accel *a)
+{
+    return a && a->committed;
+}

@@ -40,6 +40,8 @@ extern const rl_accel_class rl_accel_embree_class;
  * it, rl_linespace.h); NULL for any other kind or an uncommitted accel. */
 struct rl_grid;
 const struct rl_grid *rl_accel_grid_state(const rl_accel *a);
+/* Whether a has been committed (the scene Line Space borrows one). */
+bool rl_accel_is_committed(const rl_accel *a);
 
 /* The precomputed watertight ray/triangle test (Woop, Benthin, Wald 2013),
  * shared by every kind of ours so that they agree bit for bit on a hit. */

@@ -16,6 +16,7 @@
 #define RL_ACCEL_LINESPACE_INTERNAL_H
 
 #include "accel/grid.h"
+#include "accel/tri_list.h"
 #include "rl/rl_linespace.h"
 
 /* Growth of shafts and of the voxel a triangle is clipped to, in cell units:
@@ -185,5 +186,31 @@ rl_status rl_ls_build(rl_linespace *ls);
 bool rl_ls_occupancy_alloc(rl_linespace *ls);
 size_t rl_ls_memory_bytes(const rl_linespace *ls);
 void rl_ls_free_arrays(rl_linespace *ls);
+
+/* ---- object Line Spaces (linespace_object.c, walks in linespace_query.c) ---- */
+/* A world ray in an object's space: the object-space point at world
+ * parameter t is o + (t - t_shift)·d (o is taken near the object so that
+ * its rounding stays small against the voxels); slack bounds, in t, how far
+ * the object-space and the world parametrisation may disagree. */
+typedef struct rl_ls_local_ray {
+    double o[3], d[3];
+    float t_shift, slack;
+} rl_ls_local_ray;
+
+/* The closest hit among the candidates of ls (dynamic lists, built in
+ * object space, local triangle i = scene triangle id_base + i with world
+ * vertices verts[3(id_base + i) ..]) along lr, tested against the world
+ * ray's w within (t_min, *limit), as rl_tri_list_closest. */
+void rl_ls_mapped_closest(const rl_linespace *ls, const rl_ls_local_ray *lr, const rl_vec3 *verts,
+                          uint32_t id_base, const rl_ray_watertight *w, float t_min, rl_mailbox *mailbox,
+                          rl_tri_closest *best, float *limit);
+/* For the scene Line Space, whose inner structure may be object Line
+ * Spaces: their scene, and whether they are committed. */
+const rl_scene *rl_ls_objects_scene(const rl_ls_objects *o);
+bool rl_ls_objects_committed(const rl_ls_objects *o);
+
+/* Whether any candidate is hit within (t_min, t_max). */
+bool rl_ls_mapped_any(const rl_linespace *ls, const rl_ls_local_ray *lr, const rl_vec3 *verts, uint32_t id_base,
+                      const rl_ray_watertight *w, float t_min, float t_max, rl_mailbox *mailbox);
 
 #endif

@@ -465,3 +465,99 @@ bool rl_linespace_preillum_occluded(const rl_linespace *ls, const rl_ray *ray)
 {
     return preillum_walk(ls, ray, NULL, NULL);
 }
+
+/* ---- object Line Spaces (linespace_object.c) ----
+ * The walk of closest_hit/occluded on a Line Space built in an object's
+ * space, with the candidates tested in world space: the shaft is found
+ * from the object-space line (in double, shifted near the object by the
+ * caller), the triangles are the scene's, against the world ray. Both
+ * parametrise the same line by the same t (the transform is affine), up to
+ * the transform's rounding, which `slack` (in t) covers: the walk goes
+ * slack beyond both ends and stops only slack past the best hit. */
+
+static bool mapped_setup(const rl_linespace *ls, const rl_ls_local_ray *lr, float t_lo, float t_hi, rl_grid_dda *it,
+                         cell_line *l)
+{
+    rl_ray r = { rl_v3((float)lr->o[0], (float)lr->o[1], (float)lr->o[2]), t_lo - lr->t_shift - lr->slack,
+                 rl_v3((float)lr->d[0], (float)lr->d[1], (float)lr->d[2]), t_hi - lr->t_shift + lr->slack };
+    if (!ray_is_valid(&r) || !rl_grid_dda_begin(ls->grid, &r, it))
+        return false;
+    for (int a = 0; a < 3; ++a) {
+        double size = rl_vget(ls->grid->cell_size, a);
+        l->o[a] = (lr->o[a] - rl_vget(ls->grid->bounds.min, a)) / size;
+        l->d[a] = lr->d[a] / size;
+        l->inv[a] = l->d[a] != 0.0 ? 1.0 / l->d[a] : 0.0;
+    }
+    return true;
+}
+
+static tri_list mapped_list(const rl_linespace *ls, const rl_grid_dda *it, const cell_line *l, uint32_t cell,
+                            bool *skip)
+{
+    uint32_t block = ls->voxel_slot[cell];
+    *skip = block == RL_NONE;
+    if (*skip)
+        return (tri_list){ NULL, 0 };
+    bool fwd;
+    uint32_t shaft = shaft_of_ray(ls, it->current, l, &fwd);
+    *skip = shaft != RL_NONE && !rl_ls_shaft_occupied(ls, block, shaft);
+    return *skip ? (tri_list){ NULL, 0 } : candidates(ls, cell, block, shaft, true);
+}
+
+void rl_ls_mapped_closest(const rl_linespace *ls, const rl_ls_local_ray *lr, const rl_vec3 *verts,
+                          uint32_t id_base, const rl_ray_watertight *w, float t_min, rl_mailbox *mailbox,
+                          rl_tri_closest *best, float *limit)
+{
+    rl_grid_dda it;
+    cell_line line;
+    if (!mapped_setup(ls, lr, t_min, *limit, &it, &line))
+        return;
+    uint32_t cell;
+    float t0, t1;
+    while (rl_grid_dda_next(&it, &cell, &t0, &t1)) {
+        if (t0 + lr->t_shift > *limit + lr->slack)
+            break;
+        bool skip;
+        tri_list l = mapped_list(ls, &it, &line, cell, &skip);
+        for (uint32_t j = 0; !skip && j < l.count; ++j) {
+            uint32_t id = id_base + l.ids[j];
+            if (rl_mailbox_seen(mailbox, id))
+                continue;
+            const rl_vec3 *v = verts + 3 * (size_t)id;
+            float t, u, vv;
+            if (!rl_watertight_hit(w, v[0], v[1], v[2], t_min, *limit, &t, &u, &vv))
+                continue;
+            if (best->id == RL_ID_NONE || t < best->t || (t == best->t && id < best->id)) {
+                *best = (rl_tri_closest){ id, t, u, vv };
+                *limit = nextafterf(t, INFINITY);
+            }
+        }
+        if (best->id != RL_ID_NONE && best->t + lr->slack <= t1 + lr->t_shift)
+            break;
+    }
+}
+
+bool rl_ls_mapped_any(const rl_linespace *ls, const rl_ls_local_ray *lr, const rl_vec3 *verts, uint32_t id_base,
+                      const rl_ray_watertight *w, float t_min, float t_max, rl_mailbox *mailbox)
+{
+    rl_grid_dda it;
+    cell_line line;
+    if (!mapped_setup(ls, lr, t_min, t_max, &it, &line))
+        return false;
+    uint32_t cell;
+    float t0, t1;
+    while (rl_grid_dda_next(&it, &cell, &t0, &t1)) {
+        bool skip;
+        tri_list l = mapped_list(ls, &it, &line, cell, &skip);
+        for (uint32_t j = 0; !skip && j < l.count; ++j) {
+            uint32_t id = id_base + l.ids[j];
+            if (rl_mailbox_seen(mailbox, id))
+                continue;
+            const rl_vec3 *v = verts + 3 * (size_t)id;
+            float t, u, vv;
+            if (rl_watertight_hit(w, v[0], v[1], v[2], t_min, t_max, &t, &u, &vv))
+                return true;
+        }
+    }
+    return false;
+}

@@ -62,9 +62,9 @@ static const char *const mis_choices[] = { "off", "on", NULL };
 /* pt's lists, so that a value pt knows gets "not ported" rather than
  * "unknown"; gl_pt_check admits bvh and grid. */
 static const char *const shadow_choices[] = { "bvh", "grid", "embree", "ls-candidates", "ls-preillum", "ls-pnmt",
-                                              "shadowmap", NULL };
+                                              "shadowmap", "ls-scene", "ls-object", NULL };
 static const char *const diffuse_choices[] = { "bvh", "grid", "embree", "ls-candidates", "ls-preillum", "ls-pnmt",
-                                               NULL };
+                                               "ls-scene", "ls-object", NULL };
 static const char *const specular_choices[] = { "exact", "diffuse", NULL };
 static const char *const primary_choices[] = { "trace", "raster", NULL };
 static const char *const ls_origin_choices[] = { "offset", "exact", NULL };
@@ -173,7 +173,8 @@ static bool gl_pt_available(const rl_renderer *r, char *why, size_t n)
 static rl_status gl_pt_check(const char *key, const char *value)
 {
     if ((strcmp(key, "shadow") == 0 || strcmp(key, "diffuse") == 0) &&
-        (strcmp(value, "embree") == 0 || strcmp(value, "shadowmap") == 0))
+        (strcmp(value, "embree") == 0 || strcmp(value, "shadowmap") == 0 || strcmp(value, "ls-scene") == 0 ||
+         strcmp(value, "ls-object") == 0))
         return rl_error(RL_ERR_INVALID_ARG,
                         "gl-pt: %s=%s is not ported to GL yet (bvh, grid, ls-candidates, ls-preillum or ls-pnmt; "
                         "pt has it)", key, value);

@@ -17,8 +17,9 @@
  *                      (Veach 1997, issue 37) | off [every light per vertex]
  *   seed = 0
  *   shadow = bvh       bvh | grid | embree | ls-candidates | ls-preillum |
- *                      ls-pnmt | shadowmap
+ *                      ls-pnmt | shadowmap | ls-scene | ls-object
  *   diffuse = bvh      bvh | grid | embree | ls-candidates | ls-preillum | ls-pnmt
+ *                      | ls-scene | ls-object (exact, Sec. 13.1, 13.2)
  *   specular = exact   mirror and refraction rays: exact (the thesis, Sec.
  *                      11.2, 12.3: the PNMT Line Space is not accurate enough
  *                      for them, so they go to the voxel grid it lives in;
@@ -38,6 +39,8 @@
  *                      adaptive_threshold = 0.01, adaptive_min_spp = 8
  *   grid_res = 0 (grid heuristic), ls_n = 5 [5], ls_k = 8, ls_dynamic = true,
  *   ls_origin = offset [offset], ls_file = "" (Line Space cache, Sec. 13.3)
+ *   ls_scene_n = 4, ls_scene_segments = 64, ls_scene_cells = 16,
+ *   ls_scene_inner = object, ls_object_res = 8 (outlook, not in the thesis)
  *   shadowmap_size = 1024 [1024], light_samples = 1, threads = 0 (all)
  *
  * A frame (Sec. 5.1, Fig. 8): build what the backends need (once per
@@ -138,10 +141,14 @@ static const char *const mis_choices[] = { "off", "on", NULL };
 static const char *const env_sampling_choices[] = { "importance", "uniform", "bsdf", NULL };
 /* Order = rl_pt_backend. */
 static const char *const shadow_choices[] = { "bvh", "grid", "embree", "ls-candidates", "ls-preillum", "ls-pnmt",
-                                              "shadowmap", NULL };
+                                              "shadowmap", "ls-scene", "ls-object", NULL };
 static const char *const specular_choices[] = { "exact", "diffuse", NULL };
+/* Order = rl_pt_backend up to ls-pnmt; then ls-scene and ls-object, which
+ * come after shadowmap there (diffuse_backend maps them). */
 static const char *const diffuse_choices[] = { "bvh", "grid", "embree", "ls-candidates", "ls-preillum", "ls-pnmt",
-                                               NULL };
+                                               "ls-scene", "ls-object", NULL };
+/* Order = pt_ls_scene_inner. */
+static const char *const ls_scene_inner_choices[] = { "object", "bvh", "candidates", NULL };
 static const char *const ls_origin_choices[] = { "offset", "exact", NULL };
 static const char *const primary_choices[] = { "trace", "raster", NULL };
 /* Order = rl_filter_kind. */
@@ -197,6 +204,17 @@ static const rl_option_info pt_options[] = {
     { "ls_file", RL_OPT_STRING, "",
       "Line Space cache (Sec. 13.3): loaded if the file exists (it must match the scene, grid and "
       "ls_* options), else built and saved there; empty = build in memory only", 0, 0, NULL },
+    { "ls_scene_n", RL_OPT_INT, "4", "ls-scene: patches per face side of the scene box (Sec. 13.1)", 1,
+      RL_LS_SCENE_MAX_N, NULL },
+    { "ls_scene_segments", RL_OPT_INT, "64", "ls-scene: signature bits per shaft (filled/empty stretches)", 1,
+      RL_LS_SCENE_MAX_SEGMENTS, NULL },
+    { "ls_scene_cells", RL_OPT_INT, "16", "ls-scene: occupancy cells per axis behind the signatures", 1,
+      RL_LS_SCENE_MAX_CELLS, NULL },
+    { "ls_scene_inner", RL_OPT_ENUM, "object",
+      "ls-scene: what answers the filled stretches: object (the object Line Spaces, Sec. 13.2), bvh, or "
+      "candidates (the per-voxel Line Space on the grid of grid_res)", 0, 0, ls_scene_inner_choices },
+    { "ls_object_res", RL_OPT_INT, "8", "ls-object: voxels per axis of each object's Line Space (N = ls_n; Sec. 13.2)",
+      1, RL_LS_OBJECT_MAX_RES, NULL },
     { "shadowmap_size", RL_OPT_INT, "1024", "texels per shadow-map face side (Sec. 8.6)", 16, 16384, NULL },
     { "light_samples", RL_OPT_INT, "1", "shadow rays per quad light and vertex", 1, 1024, NULL },
     { "background", RL_OPT_COLOR, "0,0,0",
@@ -317,7 +335,9 @@ static void read_settings(const rl_renderer *r, pt_settings *set)
     set->mis = rl_renderer_opt_enum(r, "mis") == 1;
     set->seed = (uint64_t)rl_renderer_opt_int(r, "seed");
     set->shadow = (rl_pt_backend)rl_renderer_opt_enum(r, "shadow");
-    set->diffuse = (rl_pt_backend)rl_renderer_opt_enum(r, "diffuse");
+    int diffuse = rl_renderer_opt_enum(r, "diffuse");
+    set->diffuse = diffuse <= RL_PT_BACKEND_LS_PNMT ? (rl_pt_backend)diffuse
+                                                    : (rl_pt_backend)(RL_PT_BACKEND_LS_SCENE + diffuse - RL_PT_BACKEND_SHADOWMAP);
     /* Sec. 11.2, 12.3: specular rays leave the approximate payloads for the
      * exact grid the Line Space lives in (always built with a payload). */
     bool payload = set->diffuse == RL_PT_BACKEND_LS_PNMT || set->diffuse == RL_PT_BACKEND_LS_PREILLUM;
@@ -335,6 +355,11 @@ static void read_settings(const rl_renderer *r, pt_settings *set)
     set->ls_dynamic = rl_renderer_opt_bool(r, "ls_dynamic");
     set->ls_origin_exact = rl_renderer_opt_enum(r, "ls_origin") == 1;
     set->ls_file = rl_renderer_opt_string(r, "ls_file");
+    set->ls_scene_n = (int)rl_renderer_opt_int(r, "ls_scene_n");
+    set->ls_scene_segments = (int)rl_renderer_opt_int(r, "ls_scene_segments");
+    set->ls_scene_cells = (int)rl_renderer_opt_int(r, "ls_scene_cells");
+    set->ls_scene_inner = rl_renderer_opt_enum(r, "ls_scene_inner");
+    set->ls_object_res = (int)rl_renderer_opt_int(r, "ls_object_res");
     set->shadowmap_size = (int)rl_renderer_opt_int(r, "shadowmap_size");
     set->light_samples = (int)rl_renderer_opt_int(r, "light_samples");
     set->background = rl_renderer_opt_color(r, "background");
@@ -1088,6 +1113,8 @@ static void finish_stats(pt_state *s, const pt_settings *set, const pt_counters 
     ps->build_embree_ms = s->b.exact[RL_ACCEL_EMBREE] ? s->b.exact_ms[RL_ACCEL_EMBREE] : 0.0;
     ps->build_linespace_ms = s->b.ls ? s->b.ls_ms : 0.0;
     ps->build_shadowmap_ms = s->b.sm ? s->b.sm_ms : 0.0;
+    ps->build_ls_scene_ms = s->b.lss ? s->b.lss_ms : 0.0;
+    ps->build_ls_object_ms = s->b.lso ? s->b.lso_ms : 0.0;
     ps->rng = set->rng;
     ps->sobol = set->sobol;
     ps->time_total_ms = rl_timer_ms(total);
@@ -1098,7 +1125,7 @@ static void finish_stats(pt_state *s, const pt_settings *set, const pt_counters 
 static bool exact_backend(rl_pt_backend k)
 {
     return k == RL_PT_BACKEND_BVH || k == RL_PT_BACKEND_GRID || k == RL_PT_BACKEND_EMBREE ||
-           k == RL_PT_BACKEND_LS_CANDIDATES;
+           k == RL_PT_BACKEND_LS_CANDIDATES || k == RL_PT_BACKEND_LS_SCENE || k == RL_PT_BACKEND_LS_OBJECT;
 }
 
 static rl_status pt_render(rl_renderer *r, void *state, const rl_scene *scene, const rl_camera *cam,

@@ -5,7 +5,11 @@
  * and diffuse backends ask for, on the grid of grid_res), and the shadow
  * maps. Each is built lazily, the first time a frame needs it, and kept
  * until the scene (rl_scene_uid) or its own parameters change, so that
- * switching backends back and forth costs nothing.
+ * switching backends back and forth costs nothing. ls-object builds the
+ * object Line Spaces (N = ls_n, ls_object_res voxels per axis and object);
+ * ls-scene builds the scene Line Space's signatures over its inner
+ * structure (ls_scene_inner: the object Line Spaces, the BVH, or the
+ * per-voxel Line Space's candidates on the grid of grid_res).
  *
  * Also here: the quad-light cover of emissive triangles used by the
  * emission rule (pathtrace_path.c). */
@@ -23,7 +27,7 @@
 const char *rl_pt_backend_name(rl_pt_backend backend)
 {
     static const char *const names[RL_PT_BACKEND_COUNT] = {
-        "bvh", "grid", "embree", "ls-candidates", "ls-preillum", "ls-pnmt", "shadowmap"
+        "bvh", "grid", "embree", "ls-candidates", "ls-preillum", "ls-pnmt", "shadowmap", "ls-scene", "ls-object"
     };
     return (unsigned)backend < RL_PT_BACKEND_COUNT ? names[backend] : "unknown";
 }
@@ -233,6 +237,8 @@ static rl_status build_cover(pt_backends *b, const rl_scene_data *d)
 
 void rl_pt_backends_release(pt_backends *b)
 {
+    rl_ls_scene_release(b->lss);          /* before the inner structure it borrows */
+    rl_ls_objects_release(b->lso);
     rl_linespace_release(b->ls);          /* before the grid it borrows */
     free(b->ls_file);
     for (int k = 0; k < 3; ++k)
@@ -312,6 +318,71 @@ rl_status rl_pt_backends_prepare_scene(pt_backends *b, const rl_scene *scene)
     return RL_OK;
 }
 
+/* The object and scene Line Spaces the backends need (Sec. 13.1, 13.2),
+ * after the per-voxel Line Space and the exact structures, since the scene
+ * Line Space borrows one of them. */
+static rl_status prepare_levels(pt_backends *b, const rl_scene *scene, const pt_settings *set, int threads,
+                                double *built_ms)
+{
+    bool want_scene = set->shadow == RL_PT_BACKEND_LS_SCENE || set->diffuse == RL_PT_BACKEND_LS_SCENE;
+    bool want_objects = set->shadow == RL_PT_BACKEND_LS_OBJECT || set->diffuse == RL_PT_BACKEND_LS_OBJECT ||
+                        (want_scene && set->ls_scene_inner == PT_LS_INNER_OBJECT);
+    rl_status st;
+    if (want_objects && (!b->lso || b->lso_n != set->ls_n || b->lso_res != set->ls_object_res)) {
+        rl_ls_scene_release(b->lss);      /* it may borrow these */
+        b->lss = NULL;
+        rl_ls_objects_release(b->lso);
+        b->lso = NULL;
+        rl_ls_objects_desc od = { .n = set->ls_n, .res = set->ls_object_res, .threads = threads };
+        if ((st = rl_ls_objects_create(scene, &od, &b->lso)) != RL_OK ||
+            (st = rl_ls_objects_commit(b->lso)) != RL_OK) {
+            rl_ls_objects_release(b->lso);
+            b->lso = NULL;
+            return st;
+        }
+        rl_ls_objects_stats os;
+        rl_ls_objects_get_stats(b->lso, &os);
+        b->lso_n = set->ls_n;
+        b->lso_res = set->ls_object_res;
+        b->lso_ms = os.build_ms;
+        *built_ms += os.build_ms;
+    }
+    if (!want_scene)
+        return RL_OK;
+    rl_ls_scene_inner inner = { 0 };
+    if (set->ls_scene_inner == PT_LS_INNER_OBJECT)
+        inner.objects = b->lso;
+    else if (set->ls_scene_inner == PT_LS_INNER_CANDIDATES)
+        inner.linespace = b->ls;
+    else if ((st = build_exact(b, scene, RL_ACCEL_BVH, 0, threads, built_ms)) != RL_OK)
+        return st;
+    else
+        inner.accel = b->exact[RL_ACCEL_BVH];
+    const void *ptr = inner.objects ? (const void *)inner.objects
+                                    : (inner.linespace ? (const void *)inner.linespace : (const void *)inner.accel);
+    if (b->lss && b->lss_inner == ptr && b->lss_n == set->ls_scene_n && b->lss_segments == set->ls_scene_segments &&
+        b->lss_cells == set->ls_scene_cells)
+        return RL_OK;
+    rl_ls_scene_release(b->lss);
+    b->lss = NULL;
+    rl_ls_scene_desc sd = { .n = set->ls_scene_n, .segments = set->ls_scene_segments, .cells = set->ls_scene_cells,
+                            .threads = threads, .inner = inner };
+    if ((st = rl_ls_scene_create(scene, &sd, &b->lss)) != RL_OK || (st = rl_ls_scene_commit(b->lss)) != RL_OK) {
+        rl_ls_scene_release(b->lss);
+        b->lss = NULL;
+        return st;
+    }
+    rl_ls_scene_stats ss;
+    rl_ls_scene_get_stats(b->lss, &ss);
+    b->lss_inner = ptr;
+    b->lss_n = set->ls_scene_n;
+    b->lss_segments = set->ls_scene_segments;
+    b->lss_cells = set->ls_scene_cells;
+    b->lss_ms = ss.build_ms;
+    *built_ms += ss.build_ms;
+    return RL_OK;
+}
+
 rl_status rl_pt_backends_prepare(pt_backends *b, const rl_scene *scene, const pt_settings *set, int threads,
                                  double *built_ms)
 {
@@ -335,7 +406,10 @@ rl_status rl_pt_backends_prepare(pt_backends *b, const rl_scene *scene, const pt
             (st = build_exact(b, scene, (rl_accel_kind)kinds[i], set->grid_res, threads, built_ms)))
             return st;
 
+    bool want_scene = set->shadow == RL_PT_BACKEND_LS_SCENE || set->diffuse == RL_PT_BACKEND_LS_SCENE;
     unsigned payloads = payload_of(set->shadow) | payload_of(set->diffuse);
+    if (want_scene && set->ls_scene_inner == PT_LS_INNER_CANDIDATES)
+        payloads |= RL_LS_CANDIDATES;
     if (payloads) {
         /* The Line Space lives in the grid's voxels (Sec. 4.2, 6.1). */
         if ((st = build_exact(b, scene, RL_ACCEL_GRID, set->grid_res, threads, built_ms)))
@@ -391,6 +465,8 @@ rl_status rl_pt_backends_prepare(pt_backends *b, const rl_scene *scene, const pt
         rl_linespace_set_origin(b->ls, set->ls_origin_exact ? RL_LS_ORIGIN_EXACT : RL_LS_ORIGIN_RECORDS);
         b->ls_start = set->ls_origin_exact ? 0.0f : b->ls_offset;
     }
+    if ((st = prepare_levels(b, scene, set, threads, built_ms)) != RL_OK)
+        return st;
     if (set->shadow == RL_PT_BACKEND_SHADOWMAP && (!b->sm || b->sm_size != set->shadowmap_size)) {
         rl_shadowmap_release(b->sm);
         b->sm = NULL;

@@ -36,6 +36,8 @@
 /* ------------------------------------------------------------ settings -- */
 
 typedef enum pt_primary { PT_PRIMARY_TRACE = 0, PT_PRIMARY_RASTER } pt_primary;
+/* What answers the filled intervals of ls-scene (option ls_scene_inner). */
+typedef enum pt_ls_scene_inner { PT_LS_INNER_OBJECT = 0, PT_LS_INNER_BVH, PT_LS_INNER_CANDIDATES } pt_ls_scene_inner;
 
 typedef struct pt_settings {
     int spp, max_depth, rr_depth, light_samples, threads;
@@ -56,6 +58,8 @@ typedef struct pt_settings {
     double adaptive_threshold;
     int adaptive_min_spp;
     int grid_res, ls_n, ls_k, shadowmap_size;
+    int ls_scene_n, ls_scene_segments, ls_scene_cells, ls_object_res;
+    int ls_scene_inner;            /* pt_ls_scene_inner */
     const char *ls_file;           /* Line Space cache file; "" none (valid for one frame) */
     rl_vec3 background;            /* environment radiance of escaping rays */
     int env_sampling;              /* pt_env_sampling: light samples of a scene environment */
@@ -133,6 +137,15 @@ typedef struct pt_backends {
     float ls_offset;               /* one voxel diagonal (Sec. 12.1-12.2: "Voxel-Offset") */
     float ls_start;                /* where PNMT / preillum rays start: ls_offset,
                                     * or 0 with ls_origin=exact */
+    /* Scene and object Line Spaces (Sec. 13.1, 13.2), with the options they
+     * were built with; the scene one borrows its inner structure. */
+    rl_ls_objects *lso;
+    int lso_n, lso_res;
+    double lso_ms;
+    rl_ls_scene *lss;
+    int lss_n, lss_segments, lss_cells;
+    const void *lss_inner;         /* the structure it was created on */
+    double lss_ms;
     rl_shadowmap *sm;
     int sm_size;
     double sm_ms;

@@ -157,6 +157,14 @@ bool rl_pt_closest(const pt_ctx *ctx, rl_pt_backend backend, rl_ray *ray, pt_sur
         if (!rl_linespace_intersect(b->ls, ray, &hit))
             return false;
         return rl_pt_surface_at_hit(ctx->data, &hit, ray->o, ray->d, s);
+    case RL_PT_BACKEND_LS_SCENE:
+        if (!rl_ls_scene_intersect(b->lss, ray, &hit))
+            return false;
+        return rl_pt_surface_at_hit(ctx->data, &hit, ray->o, ray->d, s);
+    case RL_PT_BACKEND_LS_OBJECT:
+        if (!rl_ls_objects_intersect(b->lso, ray, &hit))
+            return false;
+        return rl_pt_surface_at_hit(ctx->data, &hit, ray->o, ray->d, s);
     case RL_PT_BACKEND_LS_PNMT: {
         rl_ls_surface rec;
         ray->t_min = rl_maxf(ray->t_min, b->ls_start);
@@ -200,6 +208,10 @@ static bool visible(const pt_ctx *ctx, const pt_surface *s, rl_vec3 l, float dis
         return !rl_accel_occluded(b->exact[k], &ray);
     case RL_PT_BACKEND_LS_CANDIDATES:
         return !rl_linespace_occluded(b->ls, &ray);
+    case RL_PT_BACKEND_LS_SCENE:
+        return !rl_ls_scene_occluded(b->lss, &ray);
+    case RL_PT_BACKEND_LS_OBJECT:
+        return !rl_ls_objects_occluded(b->lso, &ray);
     case RL_PT_BACKEND_LS_PNMT:
         /* Voxel offset at the light's end always (its voxel holds the lamp
          * and what it is mounted on, which no stored point can tell apart

@@ -1060,6 +1060,306 @@ static void test_linespace_rejects_bad_arguments(void **state)
     rl_scene_release(s);
 }
 
+/* ---- scene and object Line Spaces (Sec. 13.1, 13.2) --------------------- */
+
+static rl_ls_objects *objects_of(const rl_scene *s, rl_ls_objects_desc d)
+{
+    rl_ls_objects *o = NULL;
+    assert_int_equal(rl_ls_objects_create(s, &d, &o), RL_OK);
+    if (rl_ls_objects_commit(o) != RL_OK)
+        fail_msg("objects commit: %s", rl_last_error());
+    return o;
+}
+
+static rl_ls_scene *scene_ls_of(const rl_scene *s, rl_ls_scene_desc d)
+{
+    rl_ls_scene *ls = NULL;
+    if (rl_ls_scene_create(s, &d, &ls) != RL_OK)
+        fail_msg("scene Line Space create: %s", rl_last_error());
+    if (rl_ls_scene_commit(ls) != RL_OK)
+        fail_msg("scene Line Space commit: %s", rl_last_error());
+    return ls;
+}
+
+typedef bool (*closest_fn)(const void *st, rl_ray *ray, rl_hit *hit);
+typedef bool (*occluded_fn)(const void *st, const rl_ray *ray);
+static bool objects_closest(const void *st, rl_ray *ray, rl_hit *hit) { return rl_ls_objects_intersect(st, ray, hit); }
+static bool objects_occl(const void *st, const rl_ray *ray) { return rl_ls_objects_occluded(st, ray); }
+static bool scene_closest(const void *st, rl_ray *ray, rl_hit *hit) { return rl_ls_scene_intersect(st, ray, hit); }
+static bool scene_occl(const void *st, const rl_ray *ray) { return rl_ls_scene_occluded(st, ray); }
+
+/* Same triangle, object and t (bit for bit: the same watertight test on
+ * the same vertices) and the same shadow answer as the reference on
+ * num_rays random rays; ref NULL: the BVH, or brute force for t_min < 0. */
+static int agree_exactly(const char *what, const rl_scene *s, const void *st, closest_fn closest,
+                         occluded_fn occluded, const rl_accel *ref_fixed, int num_rays, uint64_t seed)
+{
+    const rl_scene_data *d = rl_scene_get_data(s);
+    rl_accel *bvh = accel_of(s, (rl_accel_desc){ .kind = RL_ACCEL_BVH });
+    rl_accel *brute = accel_of(s, (rl_accel_desc){ .kind = RL_ACCEL_BRUTE });
+    rl_rng r;
+    rl_rng_seed(&r, seed, 5);
+    int hits = 0;
+    for (int i = 0; i < num_rays; ++i) {
+        rl_ray ray = random_ray(&r, d);
+        rl_ray rb = ray, rl = ray;
+        rl_hit hb, hl;
+        const rl_accel *ref = ref_fixed ? ref_fixed : reference(bvh, brute, &ray);
+        bool b = rl_accel_intersect(ref, &rb, &hb), l = closest(st, &rl, &hl);
+        hits += b;
+        if (b != l || (b && (hb.triangle != hl.triangle || hb.object != hl.object || hb.t != hl.t ||
+                             rb.t_max != rl.t_max)))
+            fail_msg("%s ray %d o=(%.9g %.9g %.9g) d=(%.9g %.9g %.9g) t=(%g %g): ref %d tri %u t %.9g, "
+                     "ls %d tri %u t %.9g",
+                     what, i, (double)ray.o.x, (double)ray.o.y, (double)ray.o.z, (double)ray.d.x, (double)ray.d.y,
+                     (double)ray.d.z, (double)ray.t_min, (double)ray.t_max, b, hb.triangle, (double)hb.t, l,
+                     hl.triangle, (double)hl.t);
+        if (rl_accel_occluded(ref, &ray) != occluded(st, &ray))
+            fail_msg("%s ray %d: occluded differs", what, i);
+    }
+    rl_accel_release(brute);
+    rl_accel_release(bvh);
+    assert_true(hits > num_rays / 10);
+    return hits;
+}
+
+/* A scene of several objects: one mesh instanced five times (moved,
+ * rotated, scaled, mirrored, squashed to a thousandth in y: the scene
+ * refuses singular transforms) beside a floor. */
+static rl_scene *instanced_scene(void)
+{
+    rl_scene *s = NULL;
+    assert_int_equal(rl_scene_create(&s), RL_OK);
+    rl_material m = rl_material_default();
+    uint32_t mat, teapot, floor, node;
+    assert_int_equal(rl_scene_add_material(s, &m, &mat), RL_OK);
+    assert_int_equal(rl_scene_add_generated(s, "teapot", "triangles=800", mat, &teapot), RL_OK);
+    assert_int_equal(rl_scene_add_generated(s, "quad", NULL, mat, &floor), RL_OK);
+    rl_mat4 big = rl_mat4_scale(rl_v3(6.0f, 6.0f, 6.0f));
+    assert_int_equal(rl_scene_add_node(s, 0, "floor", &big, &node), RL_OK);
+    assert_int_equal(rl_scene_node_set_mesh(s, node, floor), RL_OK);
+    rl_mat4 t[5];
+    t[0] = rl_mat4_translate(rl_v3(-1.5f, 0.0f, 0.0f));
+    rl_mat4 rot = rl_mat4_rotate(rl_normalize(rl_v3(1.0f, 2.0f, 0.5f)), 0.7f), tr = rl_mat4_translate(rl_v3(1.5f, 0.3f, 0.2f));
+    t[1] = rl_mat4_mul(&tr, &rot);
+    rl_mat4 sc = rl_mat4_scale(rl_v3(0.5f, 1.5f, 0.8f)), tr2 = rl_mat4_translate(rl_v3(0.0f, 0.2f, 1.8f));
+    t[2] = rl_mat4_mul(&tr2, &sc);
+    rl_mat4 mir = rl_mat4_scale(rl_v3(-1.0f, 1.0f, 1.0f)), tr3 = rl_mat4_translate(rl_v3(0.0f, 0.5f, -1.8f));
+    t[3] = rl_mat4_mul(&tr3, &mir);
+    rl_mat4 flat = rl_mat4_scale(rl_v3(1.0f, 1e-3f, 1.0f)), tr4 = rl_mat4_translate(rl_v3(2.0f, 1.0f, 2.0f));
+    t[4] = rl_mat4_mul(&tr4, &flat);
+    for (int i = 0; i < 5; ++i) {
+        assert_int_equal(rl_scene_add_node(s, 0, "teapot", &t[i], &node), RL_OK);
+        assert_int_equal(rl_scene_node_set_mesh(s, node, teapot), RL_OK);
+    }
+    assert_int_equal(rl_scene_commit(s), RL_OK);
+    return s;
+}
+
+static void test_linespace_objects_equal_the_bvh_on_instanced_objects(void **state)
+{
+    (void)state;
+    rl_scene *s = instanced_scene();
+    rl_ls_objects *o = objects_of(s, (rl_ls_objects_desc){ .n = 3, .res = 4 });
+    rl_ls_objects_stats st;
+    rl_ls_objects_get_stats(o, &st);
+    /* Floor and five teapots: the first four share one Line Space; the
+     * squashed one shares it too unless the inverse's factor 1000 pushed
+     * its object-space vertices beyond the sharing tolerance. */
+    assert_int_equal(st.objects, 6);
+    assert_true(st.linespaces == 2 || st.linespaces == 3);
+    assert_int_equal(st.world_space, 0);
+    int hits = agree_exactly("objects/instanced", s, o, objects_closest, objects_occl, NULL, 15000 / RAYS_SCALE, 11);
+    print_message("object Line Space, instanced teapots: %d hits, %u Line Spaces for %u objects, %.1f MiB\n",
+                  hits, st.linespaces, st.objects, st.memory_bytes / 1048576.0);
+    rl_ls_objects_release(o);
+    rl_scene_release(s);
+    /* The built-ins: several objects in a box (teapot, blocks, bunny). */
+    s = builtin("cornell-teapot", "triangles=5000");
+    o = objects_of(s, (rl_ls_objects_desc){ .n = 3, .res = 4 });
+    agree_exactly("objects/cornell-teapot", s, o, objects_closest, objects_occl, NULL, 8000 / RAYS_SCALE, 12);
+    rl_ls_objects_release(o);
+    rl_scene_release(s);
+}
+
+/* The thesis' point for object Line Spaces (Sec. 13.2): an object moves
+ * without a rebuild. Our committed scenes are immutable, so the same mesh
+ * at five places is the test: one Line Space, built once, answers all of
+ * them exactly (above); here also moved far from the origin. */
+static void test_linespace_objects_share_one_line_space_across_moved_instances(void **state)
+{
+    (void)state;
+    rl_scene *s = NULL;
+    assert_int_equal(rl_scene_create(&s), RL_OK);
+    rl_material m = rl_material_default();
+    uint32_t mat, mesh, node;
+    assert_int_equal(rl_scene_add_material(s, &m, &mat), RL_OK);
+    assert_int_equal(rl_scene_add_generated(s, "sphere", NULL, mat, &mesh), RL_OK);
+    for (int i = 0; i < 8; ++i) {
+        rl_mat4 rot = rl_mat4_rotate(rl_v3(0.0f, 1.0f, 0.0f), 0.4f * (float)i);
+        rl_mat4 tr = rl_mat4_translate(rl_v3(100.0f + 2.5f * (float)i, 50.0f, -3.0f * (float)(i % 3)));
+        rl_mat4 t = rl_mat4_mul(&tr, &rot);
+        assert_int_equal(rl_scene_add_node(s, 0, "ball", &t, &node), RL_OK);
+        assert_int_equal(rl_scene_node_set_mesh(s, node, mesh), RL_OK);
+    }
+    assert_int_equal(rl_scene_commit(s), RL_OK);
+    rl_ls_objects *o = objects_of(s, (rl_ls_objects_desc){ .n = 4, .res = 3 });
+    rl_ls_objects_stats st;
+    rl_ls_objects_get_stats(o, &st);
+    assert_int_equal(st.objects, 8);
+    assert_int_equal(st.linespaces, 1);
+    assert_int_equal(st.world_space, 0);
+    agree_exactly("objects/moved spheres", s, o, objects_closest, objects_occl, NULL, 10000 / RAYS_SCALE, 13);
+    rl_ls_objects_release(o);
+    rl_scene_release(s);
+}
+
+static void test_linespace_scene_signatures_are_conservative_and_answers_exact(void **state)
+{
+    (void)state;
+    rl_scene *s = builtin("cornell-teapot", "triangles=5000");
+    rl_accel *bvh = accel_of(s, (rl_accel_desc){ .kind = RL_ACCEL_BVH });
+    rl_accel *grid = accel_of(s, (rl_accel_desc){ .kind = RL_ACCEL_GRID, .grid_res = { 8, 8, 8 } });
+    rl_linespace *ls = ls_of(grid, (rl_linespace_desc){ .n = 3, .dynamic = true }, NULL);
+    rl_ls_objects *o = objects_of(s, (rl_ls_objects_desc){ .n = 3, .res = 4 });
+    rl_ls_scene *sb = scene_ls_of(s, (rl_ls_scene_desc){ .n = 8, .cells = 32, .inner.accel = bvh });
+    rl_ls_scene_stats st;
+    rl_ls_scene_get_stats(sb, &st);
+    assert_int_equal(st.shafts, 15u * 8 * 8 * 8 * 8);
+    /* Some shafts have empty stretches, else the signature is useless. */
+    assert_true(st.filled_bits > 0 && st.filled_bits < st.shafts * 64u * 9 / 10);
+    int hits = agree_exactly("scene/bvh", s, sb, scene_closest, scene_occl, bvh, 15000 / RAYS_SCALE, 21);
+    print_message("scene Line Space: %d hits, %.1f %% of the signature bits set, %u filled cells\n", hits,
+                  100.0 * (double)st.filled_bits / ((double)st.shafts * 64.0), st.filled_cells);
+    /* Coarse and odd parameters, the per-voxel and the object Line Spaces
+     * inside: each gives its inner structure's answer (the BVH's). */
+    rl_ls_scene *sv = scene_ls_of(s, (rl_ls_scene_desc){ .n = 3, .segments = 5, .cells = 7, .inner.linespace = ls });
+    agree_exactly("scene/per-voxel", s, sv, scene_closest, scene_occl, NULL, 8000 / RAYS_SCALE, 22);
+    rl_ls_scene *so = scene_ls_of(s, (rl_ls_scene_desc){ .n = 1, .segments = 64, .cells = 64, .inner.objects = o });
+    agree_exactly("scene/objects", s, so, scene_closest, scene_occl, NULL, 8000 / RAYS_SCALE, 23);
+    /* Conservative: every hit of a ray through the box lies in a set
+     * segment of its shaft (checked from the hit point itself). */
+    const rl_scene_data *d = rl_scene_get_data(s);
+    rl_rng r;
+    rl_rng_seed(&r, 24, 1);
+    rl_aabb box = d->bounds;
+    for (int i = 0; i < 5000 / RAYS_SCALE; ++i) {
+        rl_vec3 a = random_in(&r, box), b = random_in(&r, box);
+        rl_ray ray = { a, 0.0f, rl_sub(b, a), 1.0f };
+        rl_hit h;
+        if (rl_accel_intersect(bvh, &ray, &h) != rl_ls_scene_occluded(sb, &(rl_ray){ a, 0.0f, rl_sub(b, a), 1.0f }))
+            fail_msg("segment %d: the scene Line Space's shadow answer differs", i);
+    }
+    rl_ls_scene_release(so);
+    rl_ls_scene_release(sv);
+    rl_ls_scene_release(sb);
+    rl_ls_objects_release(o);
+    rl_linespace_release(ls);
+    rl_accel_release(grid);
+    rl_accel_release(bvh);
+    rl_scene_release(s);
+}
+
+/* A scene of one flat quad (a degenerate box axis) and one of a single
+ * tiny triangle far from the origin: both structures still exact. */
+static void test_linespace_scene_and_objects_handle_flat_and_tiny_scenes(void **state)
+{
+    (void)state;
+    for (int k = 0; k < 2; ++k) {
+        rl_scene *s = NULL;
+        assert_int_equal(rl_scene_create(&s), RL_OK);
+        rl_material m = rl_material_default();
+        uint32_t mat, mesh, node;
+        assert_int_equal(rl_scene_add_material(s, &m, &mat), RL_OK);
+        if (k == 0) {
+            assert_int_equal(rl_scene_add_generated(s, "quad", NULL, mat, &mesh), RL_OK);
+        } else {
+            rl_vec3 p[3] = { rl_v3(1000.0f, 2000.0f, 0.0f), rl_v3(1000.001f, 2000.0f, 0.0f),
+                             rl_v3(1000.0f, 2000.001f, 0.0005f) };
+            uint32_t idx[3] = { 0, 1, 2 };
+            rl_mesh_desc md = { .num_vertices = 3, .positions = p, .num_triangles = 1, .indices = idx, .material = mat };
+            assert_int_equal(rl_scene_add_mesh(s, &md, &mesh), RL_OK);
+        }
+        assert_int_equal(rl_scene_add_node(s, 0, "it", NULL, &node), RL_OK);
+        assert_int_equal(rl_scene_node_set_mesh(s, node, mesh), RL_OK);
+        assert_int_equal(rl_scene_commit(s), RL_OK);
+        rl_accel *bvh = accel_of(s, (rl_accel_desc){ .kind = RL_ACCEL_BVH });
+        rl_ls_objects *o = objects_of(s, (rl_ls_objects_desc){ .n = 3 });
+        rl_ls_scene *sl = scene_ls_of(s, (rl_ls_scene_desc){ .n = 4, .inner.objects = o });
+        const char *what = k == 0 ? "flat quad" : "tiny triangle";
+        agree_exactly(what, s, o, objects_closest, objects_occl, NULL, 5000 / RAYS_SCALE, 31 + (uint64_t)k);
+        agree_exactly(what, s, sl, scene_closest, scene_occl, NULL, 5000 / RAYS_SCALE, 33 + (uint64_t)k);
+        rl_ls_scene_release(sl);
+        rl_ls_objects_release(o);
+        rl_accel_release(bvh);
+        rl_scene_release(s);
+    }
+}
+
+static void test_linespace_scene_and_objects_reject_bad_arguments(void **state)
+{
+    (void)state;
+    rl_scene *s = builtin("cornell", NULL), *other = builtin("cornell", NULL), *raw = NULL;
+    assert_int_equal(rl_scene_create(&raw), RL_OK);
+    rl_accel *bvh = accel_of(s, (rl_accel_desc){ .kind = RL_ACCEL_BVH });
+    rl_accel *bvh_other = accel_of(other, (rl_accel_desc){ .kind = RL_ACCEL_BVH });
+    rl_accel *uncommitted = NULL;
+    assert_int_equal(rl_accel_create(s, &(rl_accel_desc){ .kind = RL_ACCEL_BVH }, &uncommitted), RL_OK);
+    rl_ls_objects *o = NULL;
+    assert_int_equal(rl_ls_objects_create(NULL, NULL, &o), RL_ERR_INVALID_ARG);
+    assert_int_equal(rl_ls_objects_create(raw, NULL, &o), RL_ERR_INVALID_ARG);
+    assert_int_equal(rl_ls_objects_create(s, &(rl_ls_objects_desc){ .n = RL_LS_MAX_N + 1 }, &o), RL_ERR_INVALID_ARG);
+    assert_int_equal(rl_ls_objects_create(s, &(rl_ls_objects_desc){ .res = -2 }, &o), RL_ERR_INVALID_ARG);
+    assert_int_equal(rl_ls_objects_create(s, &(rl_ls_objects_desc){ .res = RL_LS_OBJECT_MAX_RES + 1 }, &o),
+                     RL_ERR_INVALID_ARG);
+    assert_null(o);
+    /* Uncommitted: queries miss, and it cannot serve as an inner structure. */
+    assert_int_equal(rl_ls_objects_create(s, &(rl_ls_objects_desc){ .n = 2, .res = 2 }, &o), RL_OK);
+    rl_ray ray = { rl_v3(0.1f, 0.2f, 0.3f), 0.0f, rl_v3(0, 1, 0), INFINITY };
+    rl_hit h;
+    assert_false(rl_ls_objects_intersect(o, &ray, &h));
+    rl_ls_scene *sl = NULL;
+    assert_int_equal(rl_ls_scene_create(s, &(rl_ls_scene_desc){ .inner.objects = o }, &sl), RL_ERR_INVALID_ARG);
+    assert_int_equal(rl_ls_objects_commit(o), RL_OK);
+    assert_int_equal(rl_ls_objects_commit(o), RL_OK);
+    rl_clear_error();
+    assert_int_equal(rl_ls_scene_create(s, &(rl_ls_scene_desc){ 0 }, &sl), RL_ERR_INVALID_ARG);
+    assert_non_null(strstr(rl_last_error(), "exactly one"));
+    assert_int_equal(rl_ls_scene_create(s, &(rl_ls_scene_desc){ .inner.accel = bvh, .inner.objects = o }, &sl),
+                     RL_ERR_INVALID_ARG);
+    assert_int_equal(rl_ls_scene_create(s, &(rl_ls_scene_desc){ .inner.accel = uncommitted }, &sl), RL_ERR_INVALID_ARG);
+    rl_clear_error();
+    assert_int_equal(rl_ls_scene_create(s, &(rl_ls_scene_desc){ .inner.accel = bvh_other }, &sl), RL_ERR_INVALID_ARG);
+    assert_non_null(strstr(rl_last_error(), "another scene"));
+    assert_int_equal(rl_ls_scene_create(raw, &(rl_ls_scene_desc){ .inner.accel = bvh }, &sl), RL_ERR_INVALID_ARG);
+    assert_int_equal(rl_ls_scene_create(s, &(rl_ls_scene_desc){ .n = RL_LS_SCENE_MAX_N + 1, .inner.accel = bvh }, &sl),
+                     RL_ERR_INVALID_ARG);
+    assert_int_equal(rl_ls_scene_create(s, &(rl_ls_scene_desc){ .segments = 65, .inner.accel = bvh }, &sl),
+                     RL_ERR_INVALID_ARG);
+    assert_int_equal(rl_ls_scene_create(s, &(rl_ls_scene_desc){ .cells = -1, .inner.accel = bvh }, &sl),
+                     RL_ERR_INVALID_ARG);
+    assert_null(sl);
+    /* Bad rays miss; signatures beyond the last shaft are empty. */
+    sl = scene_ls_of(s, (rl_ls_scene_desc){ .n = 2, .inner.objects = o });
+    rl_ray bad = { rl_v3(0.1f, 0.2f, 0.3f), 0.0f, rl_v3(0, 0, 0), INFINITY };
+    assert_false(rl_ls_scene_intersect(sl, &bad, &h));
+    assert_false(rl_ls_scene_occluded(sl, &bad));
+    assert_false(rl_ls_objects_occluded(o, &bad));
+    bad.d = rl_v3(NAN, 1, 0);
+    assert_false(rl_ls_scene_occluded(sl, &bad));
+    assert_int_equal(rl_ls_scene_signature(sl, 15u * 16), 0);
+    rl_ls_scene_release(sl);
+    rl_ls_scene_release(NULL);
+    rl_ls_objects_release(o);
+    rl_ls_objects_release(NULL);
+    rl_accel_release(uncommitted);
+    rl_accel_release(bvh_other);
+    rl_accel_release(bvh);
+    rl_scene_release(raw);
+    rl_scene_release(other);
+    rl_scene_release(s);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -1080,6 +1380,11 @@ int main(void)
         cmocka_unit_test(test_linespace_origin_rules_differ_only_in_the_start_voxel),
         cmocka_unit_test(test_linespace_build_is_identical_with_1_2_and_7_threads_and_either_page_size),
         cmocka_unit_test(test_linespace_rejects_bad_arguments),
+        cmocka_unit_test(test_linespace_objects_equal_the_bvh_on_instanced_objects),
+        cmocka_unit_test(test_linespace_objects_share_one_line_space_across_moved_instances),
+        cmocka_unit_test(test_linespace_scene_signatures_are_conservative_and_answers_exact),
+        cmocka_unit_test(test_linespace_scene_and_objects_handle_flat_and_tiny_scenes),
+        cmocka_unit_test(test_linespace_scene_and_objects_reject_bad_arguments),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

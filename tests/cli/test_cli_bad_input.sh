@@ -122,6 +122,12 @@ echo "not a cache" >"$TMP/keep/other.rlls"
 expect_error 1 "other.rlls" "$RL" render cornell "${LS[@]}" --set ls_file="$TMP/keep/other.rlls"
 [ "$(cat "$TMP/keep/other.rlls")" = "not a cache" ] || fail "a file that is no cache was overwritten"
 
+# The scene and object Line Spaces' options (Sec. 13.1, 13.2): out of
+# range or unknown, a usage error naming the option.
+expect_error 2 "ls_scene_segments=65 is outside" "$RL" render cornell --algo pt --set ls_scene_segments=65 --out "$OUT"
+expect_error 2 "ls_object_res=0 is outside" "$RL" render cornell --algo pt --set ls_object_res=0 --out "$OUT"
+expect_error 2 "ls_scene_inner=\"grid\" is not one of" "$RL" render cornell --algo pt --set ls_scene_inner=grid --out "$OUT"
+
 # Issue 34: a model whose coordinates reach the float limit: the error
 # names the file, alone (no lights to fit) and in a JSON scene (no camera
 # to frame it with). Exit 1: the file is at fault, not the command line.

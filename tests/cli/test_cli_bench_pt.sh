@@ -77,8 +77,9 @@ frames_ok(sc[0]["frames"], ["grid", "ls-pnmt", "ls-candidates", "bvh"])
 # quick sweep (4^3, 8^3), and the fastest per variant.
 variants = ("ls-candidates", "ls-fixed-k8", "ls-pnmt", "ls-preillum")
 sweep = ["%s@%d" % (v, n) for v in variants for n in (4, 8)]
-frames_ok(r["diffuse"]["frames"], ["grid", "bvh", "no diffuse rays"] + sweep)
-frames_ok(r["shadow"]["frames"], ["grid", "bvh", "shadowmap"] + sweep)
+levels = ["ls-object", "ls-scene/object", "ls-scene/bvh"]     # Sec. 13.1, 13.2
+frames_ok(r["diffuse"]["frames"], ["grid", "bvh", "no diffuse rays"] + sweep + levels)
+frames_ok(r["shadow"]["frames"], ["grid", "bvh", "shadowmap"] + sweep + levels)
 for sec in ("diffuse", "shadow"):
     best = r[sec]["best"]
     assert sorted(best) == sorted(variants), best
@@ -97,6 +98,20 @@ for x in ra["line_spaces"]:
     assert abs(x["candidates"]["occluded"] - ra["bvh"]["occluded"]) <= max(2, n // 500), x
     assert 0 < x["pnmt"]["rays"] == x["bvh_same_rays"]["rays"] <= n, x
     assert x["pnmt"]["ms"] > 0 and x["pnmt_speedup_vs_bvh"] > 0, x
+# Diffuse rays alone ("occluded" counts their hits), and the scene and
+# object Line Spaces: exact, so the BVH's counts (the tolerance as above).
+dr = ra["diffuse_rays"]
+m = dr["bvh"]["rays"]
+near = lambda a, b, k: abs(a - b) <= max(2, k // 500)
+assert m > 0 and near(dr["grid"]["occluded"], dr["bvh"]["occluded"], m), dr
+lv = ra["scene_and_object_line_spaces"]
+assert lv["build"]["ls_object_ms"] > 0 and lv["build"]["ls_scene_ms"] > 0, lv["build"]
+assert lv["build"]["ls_object_bytes"] > 0 and 0 < lv["build"]["ls_scene_fill"] <= 1, lv["build"]
+for name in levels:
+    assert lv["shadow"][name]["rays"] == n and near(lv["shadow"][name]["occluded"], ra["bvh"]["occluded"], n), lv
+    assert lv["diffuse"][name]["rays"] == m and near(lv["diffuse"][name]["occluded"], dr["bvh"]["occluded"], m), lv
+for x in ra["line_spaces"]:
+    assert near(x["candidates_diffuse"]["occluded"], dr["bvh"]["occluded"], m), x
 d = {f["label"]: f for f in r["diffuse"]["frames"]}
 assert d["no diffuse rays"]["rays"].get("diffuse", 0) == 0, d["no diffuse rays"]["rays"]
 assert "rays_speedup_vs_base" in d["ls-pnmt@4"]

@@ -188,6 +188,61 @@ static void test_approximate_backends_stay_close_to_the_exact_image(void **state
     rl_scene_release(s);
 }
 
+/* Schröder 2017, Sec. 13.1, 13.2: the scene Line Space (over each inner
+ * structure) and the object Line Spaces answer every query exactly as the
+ * BVH does (tests/accel/test_linespace.c, bit for bit), so the path
+ * tracer takes the same random decisions and writes the same image: the
+ * tolerance only allows for float summation, not for another hit. */
+static void test_scene_and_object_line_spaces_reproduce_the_bvh_image(void **state)
+{
+    (void)state;
+    rl_camera cam;
+    rl_scene *s = fx_cornell(&cam, SIZE);
+    rl_image *bvh = fx_render("pt", s, &cam, RL_LAYER_COLOR, (const char *const[]){ "spp", "2", NULL }, NULL);
+    const char *const cases[][4] = {
+        { "ls-object", "object", "ls_object_res", "3" },
+        { "ls-scene", "object", "ls_scene_segments", "13" },
+        { "ls-scene", "bvh", "ls_scene_n", "3" },
+        { "ls-scene", "candidates", "ls_scene_cells", "5" },
+    };
+    for (size_t c = 0; c < sizeof cases / sizeof cases[0]; ++c) {
+        rl_renderer *r = fx_make("pt", (const char *const[]){ "spp", "2", "shadow", cases[c][0], "diffuse", cases[c][0],
+                                                              "ls_scene_inner", cases[c][1], "ls_n", "3", "ls_object_res", "2", cases[c][2],
+                                                              cases[c][3], NULL });
+        rl_image *img = fx_render_with(r, s, &cam, RL_LAYER_COLOR, NULL);
+        if (rmse(bvh, img) > 1e-6)
+            print_error("%s (%s): rmse %g against the BVH image\n", cases[c][0], cases[c][1], rmse(bvh, img));
+        assert_true(rmse(bvh, img) <= 1e-6);
+        assert_float_equal(mean(img), mean(bvh), 1e-6 * mean(bvh));
+        rl_pt_stats st;
+        assert_int_equal(rl_pt_get_stats(r, &st), RL_OK);
+        rl_pt_backend be = c == 0 ? RL_PT_BACKEND_LS_OBJECT : RL_PT_BACKEND_LS_SCENE;
+        assert_true(st.shadow_queries[be] > 0 && st.trace_queries[be] > 0);
+        assert_int_equal(st.shadow_queries[RL_PT_BACKEND_BVH], 0);
+        assert_true(c == 0 ? st.build_ls_object_ms > 0.0 : st.build_ls_scene_ms > 0.0);
+        assert_true((strcmp(cases[c][1], "object") == 0) == (st.build_ls_object_ms > 0.0));
+        /* Kept: the next frame builds nothing. */
+        assert_int_equal(rl_renderer_render(r, s, &cam, img, NULL), RL_OK);
+        assert_int_equal(rl_pt_get_stats(r, &st), RL_OK);
+        assert_float_equal(st.time_build_ms, 0.0, 0.0);
+        rl_image_release(img);
+        rl_renderer_release(r);
+    }
+    /* Out-of-range parameters and unknown choices are refused by name. */
+    rl_renderer *r = fx_make("pt", NULL);
+    const char *const bad[][2] = { { "ls_scene_segments", "65" }, { "ls_scene_segments", "0" }, { "ls_scene_n", "25" },
+                                   { "ls_scene_cells", "0" }, { "ls_object_res", "65" }, { "ls_scene_inner", "grid" },
+                                   { "diffuse", "ls-scenes" } };
+    for (size_t i = 0; i < sizeof bad / sizeof bad[0]; ++i) {
+        rl_clear_error();
+        assert_int_not_equal(rl_renderer_set(r, bad[i][0], bad[i][1]), RL_OK);
+        assert_non_null(strstr(rl_last_error(), bad[i][0]));
+    }
+    rl_renderer_release(r);
+    rl_image_release(bvh);
+    rl_scene_release(s);
+}
+
 static rl_status render_status(rl_renderer *r, const rl_scene *s, const rl_camera *cam)
 {
     rl_image *img = NULL;
@@ -308,6 +363,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_dynamic_line_space_candidates_reproduce_the_bvh_image),
         cmocka_unit_test(test_approximate_backends_stay_close_to_the_exact_image),
+        cmocka_unit_test(test_scene_and_object_line_spaces_reproduce_the_bvh_image),
         cmocka_unit_test(test_specular_rays_take_the_exact_grid_by_default),
         cmocka_unit_test(test_ls_file_saves_then_loads_the_same_line_space),
         cmocka_unit_test(test_filter_is_applied_and_fades_with_the_samples),
