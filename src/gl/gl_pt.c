@@ -37,7 +37,6 @@
 #include "gl/gl_linespace.h"
 #include "gl/gl_shaders.h"
 #include "raster/shadowmap_internal.h"
-#include "rl/rl_timer.h"
 #include "scene/masks.h"
 
 #define LOCAL 8                    /* the path program's work group: 8 x 8 pixels */
@@ -122,7 +121,6 @@ struct rl_gl_pt {
     GLuint sm_buf, sm_tex;
     bool have_sm;
     rl_shadowmap_desc sm_desc;
-    double sm_ms;
 };
 
 /* An immutable buffer of at least 16 bytes (empty arrays still bind). */
@@ -1002,19 +1000,14 @@ rl_status rl_gl_pt_set_shadowmaps(rl_gl_pt *pt, const rl_shadowmap_desc *desc)
     if (st != RL_OK)
         return st;
     pt->have_sm = false;
-    rl_timer timer;
-    rl_timer_start(&timer);
     st = make_shadowmaps(pt, &p);
     if (st == RL_OK) {
-        pt->sm_ms = rl_timer_ms(&timer);
         pt->sm_desc = p;
         pt->have_sm = true;
     }
     rl_gl_context_done(pt->ctx);
     return st;
 }
-
-double rl_gl_pt_shadowmap_build_ms(const rl_gl_pt *pt) { return pt ? pt->sm_ms : 0.0; }
 
 static rl_status trace_rays(rl_gl_pt *pt, rl_gl_pt_structure structure, int grid_res, bool any, const rl_ray *rays,
                             uint32_t n, rl_hit *hits)
@@ -1114,12 +1107,6 @@ rl_status rl_gl_pt_set_shadowmaps(rl_gl_pt *pt, const rl_shadowmap_desc *desc)
     (void)pt;
     (void)desc;
     return rl_error(RL_ERR_UNSUPPORTED, "gl: built without OpenGL");
-}
-
-double rl_gl_pt_shadowmap_build_ms(const rl_gl_pt *pt)
-{
-    (void)pt;
-    return 0.0;
 }
 
 rl_status rl_gl_pt_trace(rl_gl_pt *pt, rl_gl_pt_structure structure, int grid_res, bool any, const rl_ray *rays,

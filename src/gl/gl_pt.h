@@ -142,9 +142,6 @@ rl_status rl_gl_pt_set_linespace(rl_gl_pt *pt, const rl_linespace *ls, const rl_
  * RL_ERR_LIMIT where the maps exceed the GL's buffer texture size. Until
  * one succeeds, a frame with shadow = SHADOWMAP is RL_ERR_INVALID_ARG. */
 rl_status rl_gl_pt_set_shadowmaps(rl_gl_pt *pt, const rl_shadowmap_desc *desc);
-/* Milliseconds the last rl_gl_pt_set_shadowmaps that drew maps took (to
- * glFinish), 0 before any. */
-double rl_gl_pt_shadowmap_build_ms(const rl_gl_pt *pt);
 
 /* Traces n rays through structure on the GPU (closest hit, or with any the
  * first hit found) into hits (t, u, v, triangle; the object is left
