@@ -68,8 +68,10 @@ step 30 "rl bench vt, reconstruct" "$rl" bench vt --only reconstruct --size 512x
 # CPU build uploaded) at 32^3 voxels: the thesis' 64^3 for the bunny makes
 # 3.9 GB of PNMT records, past what one GL storage block holds. gl-pt
 # alone: pt at this size would take seconds per frame. The two share the
-# step's former 30 s.
-step 12 "rl bench gl, gl-pt 1280x720, BVH" "$rl" bench gl --only pt --pt-gl-only --pt-size 1280x720 --frames 10 \
+# step's former 30 s. The BVH step has a second row with shadow maps for
+# the shadow tests (Diagram 3's fastest technique, BVH diffuse rays).
+step 12 "rl bench gl, gl-pt 1280x720, BVH and shadow maps" "$rl" bench gl --only pt --pt-gl-only \
+    --pt-size 1280x720 --frames 5 --pt-backend bvh,shadowmap \
     --scenes cornell,ls-cornell:model=bunny --out "$out/gpu-$date-gl-pt.json"
 step 18 "rl bench gl, gl-pt 1280x720, ls-pnmt" "$rl" bench gl --only pt --pt-gl-only --pt-size 1280x720 \
     --frames 5 --pt-backend ls-pnmt --pt-grid-res 32 --scenes cornell,ls-cornell:model=bunny \

@@ -80,7 +80,8 @@ static const char bench_gl_help[] =
     "  --pt-spp N        pt: samples per pixel and frame of both; default 1\n"
     "  --pt-gl-only      pt: time gl-pt alone (no pt frames to wait for)\n"
     "  --pt-backend A,B  pt: rows per backend of both (shadow and diffuse rays):\n"
-    "                    bvh, grid, ls-candidates, ls-pnmt, ls-preillum; default bvh\n"
+    "                    bvh, grid, ls-candidates, ls-pnmt, ls-preillum; default bvh;\n"
+    "                    shadowmap: shadow maps for shadows, the BVH for diffuse rays\n"
     "  --pt-grid-res N   pt: voxels per axis of the grid and the Line Space (0: the\n"
     "                    grid heuristic); default 0\n"
     "  --only A,B        sections: frames, visibility, pt, linespace\n"
@@ -96,9 +97,9 @@ enum { SEC_FRAMES, SEC_VISIBILITY, SEC_PT, SEC_LINESPACE, SEC_COUNT };
 static const char *const section_names[SEC_COUNT] = { "frames", "visibility", "pt", "linespace" };
 
 #define MAX_SCENES 16
-#define PT_MAX_BACKENDS 5
+#define PT_MAX_BACKENDS 6
 static const char *const pt_backend_names[PT_MAX_BACKENDS] = { "bvh", "grid", "ls-candidates", "ls-pnmt",
-                                                               "ls-preillum" };
+                                                               "ls-preillum", "shadowmap" };
 
 typedef struct bgl_args {
     const char *scenes_text, *out, *device;
@@ -223,7 +224,7 @@ static int parse_args(int argc, char **argv, bgl_args *a)
                 found = k;
         if (found < 0 || a->num_pt_backends == PT_MAX_BACKENDS) {
             fprintf(stderr, "rl: error: bench gl: --pt-backend %s: one to %d of bvh, grid, ls-candidates, "
-                    "ls-pnmt, ls-preillum\n", text, PT_MAX_BACKENDS);
+                    "ls-pnmt, ls-preillum, shadowmap\n", text, PT_MAX_BACKENDS);
             return RL_CLI_USAGE;
         }
         a->pt_backends[a->num_pt_backends++] = pt_backend_names[found];
@@ -383,7 +384,9 @@ static rl_status sec_pt(void *ctx, cJSON *sec)
         /* the backend for shadow and diffuse rays, as Diagram 1 sets both */
         char grid_res[32];
         snprintf(grid_res, sizeof grid_res, "%lld", a->pt_grid_res);
-        const char *const opts[] = { "spp", spp, "shadow", backend, "diffuse", backend, "grid_res", grid_res, NULL };
+        /* shadow maps answer shadow tests only (Diagram 3) */
+        const char *diffuse = strcmp(backend, "shadowmap") == 0 ? "bvh" : backend;
+        const char *const opts[] = { "spp", spp, "shadow", backend, "diffuse", diffuse, "grid_res", grid_res, NULL };
         /* Path tracing every built-in scene would take minutes: cornell,
          * unless the scenes were named. */
         if (!a->scenes_text && strcmp(c->names[i], "cornell") != 0)

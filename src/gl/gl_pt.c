@@ -36,6 +36,7 @@
 #include "accel/grid.h"
 #include "gl/gl_linespace.h"
 #include "gl/gl_shaders.h"
+#include "raster/shadowmap_internal.h"
 #include "scene/masks.h"
 
 #define LOCAL 8                    /* the path program's work group: 8 x 8 pixels */
@@ -74,8 +75,14 @@ typedef struct uniforms {
     GLint size, eye, cam_u, cam_v, cam_w, tan_half_fov, aspect, rng, held, checker, parity, raster, max_depth,
         rr_depth, rr, mis, mis_hits, tri_lights, light_samples, vertex_slots, num_lights, table_count,
         num_textures, eps, background, shadow, diffuse, specular, ls_start, ls_offset;
+    GLint sm_size, sm_bias, sm_slope, sm_pcf, sm_frame;
     GLint count, structure, any;
 } uniforms;
+
+/* The shadow maps' depth pass (rl_gl_pt_set_shadowmaps). */
+#define SM_UNIT 7                  /* the path program's texture unit of the maps */
+#define SM_CASTERS 14              /* the casters list's storage binding (B_RAYS's: the pass is
+                                    * no ray set's) */
 
 struct rl_gl_pt {
     rl_gl_context *ctx;
@@ -106,6 +113,14 @@ struct rl_gl_pt {
     GLuint tex_ids;
     /* the ray counters (atomic_uint, one per rl_ray_type) */
     GLuint counters;
+    /* the cube shadow maps (rl_gl_pt_set_shadowmaps): the depth pass's
+     * program, made on first use, and the maps as an r32f buffer texture
+     * (an empty one until then) */
+    GLuint sm_prog;
+    GLint sm_eye, sm_face_s, sm_face_u, sm_face_axis, sm_near, sm_far, sm_masks;
+    GLuint sm_buf, sm_tex;
+    bool have_sm;
+    rl_shadowmap_desc sm_desc;
 };
 
 /* An immutable buffer of at least 16 bytes (empty arrays still bind). */
@@ -183,6 +198,11 @@ static void locate(GLuint p, uniforms *u)
     U(specular, "u_specular");
     U(ls_start, "u_ls_start");
     U(ls_offset, "u_ls_offset");
+    U(sm_size, "u_sm_size");
+    U(sm_bias, "u_sm_bias");
+    U(sm_slope, "u_sm_slope");
+    U(sm_pcf, "u_sm_pcf");
+    U(sm_frame, "u_sm_frame");
     U(count, "u_count");
     U(structure, "u_structure");
     U(any, "u_any");
@@ -190,18 +210,32 @@ static void locate(GLuint p, uniforms *u)
 }
 
 /* The path program includes the Line Space walk (its defines first, right
- * after #version); the ray-set program has no use for it. */
+ * after #version); the ray-set program has no use for it. body NULL: the
+ * shadow maps' depth pass, a vertex and a fragment stage. */
 static GLuint compute_program(const char *body, bool linespace, const char *what)
 {
     char defines[640];
     snprintf(defines, sizeof defines,
              "#define LOCAL_SIZE %d\n#define BVH_STACK %d\n#define STRUCT_GRID %d\n"
              "#define STRUCT_LS_CAND %d\n#define STRUCT_LS_PNMT %d\n#define STRUCT_LS_PREILLUM %d\n"
+             "#define STRUCT_SHADOWMAP %d\n"
              "#define LIGHT_POINT %d\n#define LIGHT_SPOT %d\n#define LIGHT_DIRECTIONAL %d\n#define LIGHT_QUAD %d\n"
              "#define INF uintBitsToFloat(0x7f800000u)\n",
              LOCAL, RL_BVH_MAX_DEPTH, (int)RL_GL_PT_GRID, (int)RL_GL_PT_LS_CANDIDATES, (int)RL_GL_PT_LS_PNMT,
-             (int)RL_GL_PT_LS_PREILLUM, (int)RL_LIGHT_POINT, (int)RL_LIGHT_SPOT,
+             (int)RL_GL_PT_LS_PREILLUM, (int)RL_GL_PT_SHADOWMAP, (int)RL_LIGHT_POINT, (int)RL_LIGHT_SPOT,
              (int)RL_LIGHT_DIRECTIONAL, (int)RL_LIGHT_QUAD);
+    if (!body) {
+        /* the shadow maps' depth pass: common's declarations, and for the
+         * fragment stage the texture lookup of the masks */
+        const char *const vs[] = { rl_gl_pt_glsl_header, defines, rl_gl_pt_glsl_common, rl_gl_pt_glsl_shadow_vs };
+        const char *const fs[] = { rl_gl_pt_glsl_header, defines, rl_gl_pt_glsl_common, rl_gl_glsl_tex_sample,
+                                   rl_gl_pt_glsl_shadow_fs };
+        GLuint v = rl_gl_compile(GL_VERTEX_SHADER, vs, 4, what);
+        GLuint f = v ? rl_gl_compile(GL_FRAGMENT_SHADER, fs, 5, what) : 0;
+        if (v && !f)
+            glDeleteShader(v);
+        return f ? rl_gl_link(v, f, what) : 0;
+    }
     const char *const parts[] = { rl_gl_pt_glsl_header, linespace ? rl_gl_linespace_glsl() : "", defines,
                                   rl_gl_pt_glsl_common, rl_gl_glsl_tex_sample, rl_gl_pt_glsl_common2, body };
     GLuint s = rl_gl_compile(GL_COMPUTE_SHADER, parts, 7, what);
@@ -468,6 +502,20 @@ static rl_status make_buffer_textures(rl_gl_pt *pt)
     return RL_OK;
 }
 
+/* The shadow maps' buffer where there are none: three texels, not
+ * make_buffer's four. llvmpipe's variant key holds the power-of-two flag of
+ * a buffer's byte size, and the maps' lights x 6 x size^2 floats are never
+ * a power of two, so 12 bytes keep one variant of the path program with
+ * and without maps. */
+static GLuint no_maps(void)
+{
+    const float none[3] = { 0.0f, 0.0f, 0.0f };
+    GLuint b = 0;
+    glCreateBuffers(1, &b);
+    glNamedBufferStorage(b, sizeof none, none, 0);
+    return b;
+}
+
 void rl_gl_pt_release(rl_gl_pt *pt)
 {
     if (!pt)
@@ -516,8 +564,12 @@ rl_status rl_gl_pt_create(const rl_scene *scene, const rl_gl_pt_desc *desc, rl_g
         st = upload_bvh(pt, max_block);
     if (st == RL_OK)
         st = make_buffer_textures(pt);
-    if (st == RL_OK)
+    if (st == RL_OK) {
+        pt->sm_buf = no_maps();
+        glCreateTextures(GL_TEXTURE_BUFFER, 1, &pt->sm_tex);
+        glTextureBuffer(pt->sm_tex, GL_R32F, pt->sm_buf);
         st = rl_gl_check("rl_gl_pt_create");
+    }
     if (st != RL_OK) {
         rl_gl_pt_release(pt);
         return st;
@@ -620,11 +672,13 @@ static rl_status render_frame(rl_gl_pt *pt, const rl_gl_pt_frame *f, float *rgba
         st = ensure_grid(pt, f->grid_res);
     /* each LS structure needs its payload in the tracer's Line Space */
     const rl_gl_pt_structure used[3] = { f->shadow, f->diffuse, f->specular };
-    const unsigned need[RL_GL_PT_STRUCTURE_COUNT] = { 0, 0, RL_LS_CANDIDATES, RL_LS_PNMT, RL_LS_PREILLUM };
+    const unsigned need[RL_GL_PT_STRUCTURE_COUNT] = { 0, 0, RL_LS_CANDIDATES, RL_LS_PNMT, RL_LS_PREILLUM, 0 };
     for (int i = 0; i < 3 && st == RL_OK; ++i)
         if (need[used[i]] && (!pt->ls || !(pt->ls_payloads & need[used[i]])))
             st = rl_error(RL_ERR_INVALID_ARG, "rl_gl_pt_render: a Line Space structure without a Line Space "
                           "holding its payload (rl_gl_pt_set_linespace)");
+    if (st == RL_OK && f->shadow == RL_GL_PT_SHADOWMAP && !pt->have_sm)
+        st = rl_error(RL_ERR_INVALID_ARG, "rl_gl_pt_render: shadow maps not made (rl_gl_pt_set_shadowmaps)");
     if (st != RL_OK)
         return st;
     const GLuint p = pt->path_prog;
@@ -651,6 +705,21 @@ static rl_status render_frame(rl_gl_pt *pt, const rl_gl_pt_frame *f, float *rgba
         glTextureSubImage2D(pt->tex_ids, 0, 0, 0, w, h, GL_RED_INTEGER, GL_UNSIGNED_INT, f->raster_ids);
     }
     glBindTextureUnit(6, pt->tex_ids);
+    glBindTextureUnit(SM_UNIT, pt->sm_tex);
+    if (pt->have_sm) {
+        glProgramUniform1i(p, u->sm_size, pt->sm_desc.size);
+        glProgramUniform1f(p, u->sm_bias, pt->sm_desc.bias);
+        glProgramUniform1f(p, u->sm_slope, pt->sm_desc.slope_bias);
+        glProgramUniform1f(p, u->sm_pcf, pt->sm_desc.pcf_radius);
+        float frames[18][3];
+        for (int face = 0; face < 6; ++face) {
+            rl_vec3 v[3];
+            rl_shadowmap_face_frame(face, &v[0], &v[1], &v[2]);
+            for (int k = 0; k < 3; ++k)
+                memcpy(frames[3 * face + k], &v[k], sizeof frames[0]);
+        }
+        glProgramUniform3fv(p, u->sm_frame, 18, &frames[0][0]);
+    }
     if (!pt->counters) {
         pt->counters = make_buffer(NULL, 32, GL_DYNAMIC_STORAGE_BIT);
         const uint32_t zero = 0;
@@ -720,7 +789,8 @@ rl_status rl_gl_pt_render(rl_gl_pt *pt, const rl_gl_pt_frame *frame, float *rgba
         return rl_error(RL_ERR_INVALID_ARG, "rl_gl_pt_render: NULL argument");
     if (frame->cam.width < 1 || frame->cam.height < 1 || frame->spp < 1 || frame->light_samples < 1 ||
         (unsigned)frame->shadow >= RL_GL_PT_STRUCTURE_COUNT || (unsigned)frame->diffuse >= RL_GL_PT_STRUCTURE_COUNT ||
-        (unsigned)frame->specular >= RL_GL_PT_STRUCTURE_COUNT ||
+        (unsigned)frame->specular >= RL_GL_PT_STRUCTURE_COUNT || frame->diffuse == RL_GL_PT_SHADOWMAP ||
+        frame->specular == RL_GL_PT_SHADOWMAP ||
         frame->rng < 0 || frame->rng > 3)
         return rl_error(RL_ERR_INVALID_ARG, "rl_gl_pt_render: bad frame settings");
     const uint64_t most = frame->reset_states ? 0 : (pt->held[0] > pt->held[1] ? pt->held[0] : pt->held[1]);
@@ -762,6 +832,178 @@ rl_status rl_gl_pt_set_linespace(rl_gl_pt *pt, const rl_linespace *ls, const rl_
         rl_gl_ls_get_stats(g, &gs);
         pt->ls = g;
         pt->ls_payloads = gs.payloads;
+    }
+    rl_gl_context_done(pt->ctx);
+    return st;
+}
+
+/* The depth pass's program, once. */
+static rl_status shadow_program(rl_gl_pt *pt)
+{
+    if (pt->sm_prog)
+        return RL_OK;
+    GLuint p = compute_program(NULL, false, "gl-pt shadow maps");
+    if (!p)
+        return RL_ERR_INTERNAL;
+    pt->sm_prog = p;
+    pt->sm_eye = glGetUniformLocation(p, "u_sm_eye");
+    pt->sm_face_s = glGetUniformLocation(p, "u_face_s");
+    pt->sm_face_u = glGetUniformLocation(p, "u_face_u");
+    pt->sm_face_axis = glGetUniformLocation(p, "u_face_axis");
+    pt->sm_near = glGetUniformLocation(p, "u_near");
+    pt->sm_far = glGetUniformLocation(p, "u_far");
+    pt->sm_masks = glGetUniformLocation(p, "u_masks");
+    return RL_OK;
+}
+
+/* Every light's six faces drawn into a size x size target (eye depth in an
+ * r32f colour attachment, the test on a float depth buffer) and copied,
+ * face by face, into maps at (light * 6 + face) * size^2 through the pixel
+ * pack buffer: the maps never leave the GPU. A light's casters
+ * (rl_shadowmap_casts) go up into one list buffer, light after light. */
+static rl_status draw_shadowmaps(rl_gl_pt *pt, const rl_shadowmap_desc *p, GLuint maps)
+{
+    const rl_scene_data *d = pt->data;
+    const int size = p->size;
+    uint32_t *list = rl_calloc(d->num_triangles ? d->num_triangles : 1, sizeof *list);
+    if (!list)
+        return RL_ERR_OUT_OF_MEMORY;
+    GLuint casters = make_buffer(NULL, sizeof *list * d->num_triangles, GL_DYNAMIC_STORAGE_BIT);
+    GLuint color = 0, depth = 0, fbo = 0;
+    glCreateTextures(GL_TEXTURE_2D, 1, &color);
+    glTextureStorage2D(color, 1, GL_R32F, size, size);
+    glCreateTextures(GL_TEXTURE_2D, 1, &depth);
+    glTextureStorage2D(depth, 1, GL_DEPTH_COMPONENT32F, size, size);
+    glCreateFramebuffers(1, &fbo);
+    glNamedFramebufferTexture(fbo, GL_COLOR_ATTACHMENT0, color, 0);
+    glNamedFramebufferTexture(fbo, GL_DEPTH_ATTACHMENT, depth, 0);
+    rl_status st = RL_OK;
+    if (glCheckNamedFramebufferStatus(fbo, GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE)
+        st = rl_error(RL_ERR_INTERNAL, "gl-pt: the shadow maps' %d x %d target is incomplete", size, size);
+    if (st == RL_OK) {
+        const GLuint prog = pt->sm_prog;
+        glUseProgram(prog);
+        for (GLuint t = 0; t < T_COUNT; ++t)
+            glBindTextureUnit(t, pt->tex[t]);
+        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, B_MATERIALS, pt->buf[B_MATERIALS]);
+        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, B_TEX_INFO, pt->buf[B_TEX_INFO]);
+        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, B_TRIANGLES, pt->buf[B_TRIANGLES]);
+        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, SM_CASTERS, casters);
+        glProgramUniform1i(prog, pt->sm_masks, pt->masks);
+        glBindFramebuffer(GL_FRAMEBUFFER, fbo);
+        glViewport(0, 0, size, size);
+        glDisable(GL_CULL_FACE);
+        glDisable(GL_BLEND);
+        glEnable(GL_DEPTH_TEST);
+        glDepthFunc(GL_LESS);
+        glDepthMask(GL_TRUE);
+        /* an empty VAO: the vertices are pulled from the storage buffers */
+        GLuint vao = 0;
+        glCreateVertexArrays(1, &vao);
+        glBindVertexArray(vao);
+        /* the software rasterizer's cleared depth: nothing there, lit */
+        const float far_away[4] = { INFINITY, 0.0f, 0.0f, 0.0f };
+        const float one = 1.0f;
+        glBindBuffer(GL_PIXEL_PACK_BUFFER, maps);
+        glPixelStorei(GL_PACK_ALIGNMENT, 4);
+        const size_t face_bytes = (size_t)size * (size_t)size * sizeof(float);
+        for (uint32_t li = 0; li < d->num_lights; ++li) {
+            const rl_vec3 eye = rl_shadowmap_light_point(&d->lights[li]);
+            float z_near, z_far;
+            rl_shadowmap_depth_range(d, eye, &z_near, &z_far);
+            uint32_t count = 0;
+            for (uint32_t t = 0; t < d->num_triangles; ++t)
+                if (rl_shadowmap_casts(d, &d->lights[li], t))
+                    list[count++] = t;
+            if (count > 0)
+                glNamedBufferSubData(casters, 0, (GLsizeiptr)(sizeof *list * count), list);
+            glProgramUniform3f(prog, pt->sm_eye, eye.x, eye.y, eye.z);
+            glProgramUniform1f(prog, pt->sm_near, z_near);
+            glProgramUniform1f(prog, pt->sm_far, z_far);
+            for (int face = 0; face < 6; ++face) {
+                rl_vec3 fs, fu, fa;
+                rl_shadowmap_face_frame(face, &fs, &fu, &fa);
+                glProgramUniform3f(prog, pt->sm_face_s, fs.x, fs.y, fs.z);
+                glProgramUniform3f(prog, pt->sm_face_u, fu.x, fu.y, fu.z);
+                glProgramUniform3f(prog, pt->sm_face_axis, fa.x, fa.y, fa.z);
+                glClearNamedFramebufferfv(fbo, GL_COLOR, 0, far_away);
+                glClearNamedFramebufferfv(fbo, GL_DEPTH, 0, &one);
+                if (count > 0)
+                    glDrawArrays(GL_TRIANGLES, 0, (GLsizei)(3u * count));
+                const size_t offset = ((size_t)li * 6u + (size_t)face) * face_bytes;
+                glGetTextureImage(color, 0, GL_RED, GL_FLOAT, (GLsizei)face_bytes, (void *)(uintptr_t)offset);
+            }
+        }
+        glBindBuffer(GL_PIXEL_PACK_BUFFER, 0);
+        glBindFramebuffer(GL_FRAMEBUFFER, 0);
+        glBindVertexArray(0);
+        glDeleteVertexArrays(1, &vao);
+        glDisable(GL_DEPTH_TEST);
+        glFinish();
+    }
+    glDeleteFramebuffers(1, &fbo);
+    glDeleteTextures(1, &color);
+    glDeleteTextures(1, &depth);
+    glDeleteBuffers(1, &casters);
+    free(list);
+    rl_status gl = rl_gl_check("rl_gl_pt_set_shadowmaps");
+    return st != RL_OK ? st : gl;
+}
+
+static rl_status make_shadowmaps(rl_gl_pt *pt, const rl_shadowmap_desc *p)
+{
+    const rl_scene_data *d = pt->data;
+    GLint max_texels = 0, max_size = 0;
+    glGetIntegerv(GL_MAX_TEXTURE_BUFFER_SIZE, &max_texels);
+    glGetIntegerv(GL_MAX_TEXTURE_SIZE, &max_size);
+    const uint64_t texels = (uint64_t)d->num_lights * 6u * (uint64_t)p->size * (uint64_t)p->size;
+    if (p->size > max_size)
+        return rl_error(RL_ERR_LIMIT, "gl-pt: shadow maps of %d texels a side exceed this GL's texture size %d",
+                        p->size, (int)max_size);
+    if (texels > (uint64_t)max_texels || texels > (uint64_t)INT32_MAX)
+        return rl_error(RL_ERR_LIMIT, "gl-pt: %u lights x 6 faces x %d^2 shadow-map texels exceed this GL's buffer "
+                        "texture size of %d texels (a smaller shadowmap_size fits)", d->num_lights, p->size,
+                        (int)max_texels);
+    if ((uint64_t)d->num_triangles * 3u > (uint64_t)INT32_MAX)
+        return rl_error(RL_ERR_LIMIT, "gl-pt: %u triangles are too many to draw into shadow maps in one call",
+                        d->num_triangles);
+    rl_status st = shadow_program(pt);
+    if (st != RL_OK)
+        return st;
+    GLuint maps = texels ? make_buffer(NULL, texels * sizeof(float), 0) : no_maps();
+    st = draw_shadowmaps(pt, p, maps);
+    if (st != RL_OK) {
+        glDeleteBuffers(1, &maps);
+        return st;
+    }
+    glDeleteTextures(1, &pt->sm_tex);
+    glDeleteBuffers(1, &pt->sm_buf);
+    pt->sm_buf = maps;
+    glCreateTextures(GL_TEXTURE_BUFFER, 1, &pt->sm_tex);
+    glTextureBuffer(pt->sm_tex, GL_R32F, pt->sm_buf);
+    return rl_gl_check("rl_gl_pt_set_shadowmaps");
+}
+
+rl_status rl_gl_pt_set_shadowmaps(rl_gl_pt *pt, const rl_shadowmap_desc *desc)
+{
+    if (!pt)
+        return rl_error(RL_ERR_INVALID_ARG, "rl_gl_pt_set_shadowmaps: NULL argument");
+    rl_shadowmap_desc p;
+    rl_status st = rl_shadowmap_resolve_desc(desc, "rl_gl_pt_set_shadowmaps", &p);
+    if (st == RL_OK)
+        st = rl_shadowmap_check_lights(pt->data, "gl-pt shadow maps");
+    if (st != RL_OK)
+        return st;
+    if (pt->have_sm && memcmp(&p, &pt->sm_desc, sizeof p) == 0)
+        return RL_OK;
+    st = rl_gl_context_make_current(pt->ctx);
+    if (st != RL_OK)
+        return st;
+    pt->have_sm = false;
+    st = make_shadowmaps(pt, &p);
+    if (st == RL_OK) {
+        pt->sm_desc = p;
+        pt->have_sm = true;
     }
     rl_gl_context_done(pt->ctx);
     return st;
@@ -856,6 +1098,13 @@ rl_status rl_gl_pt_set_linespace(rl_gl_pt *pt, const rl_linespace *ls, const rl_
     (void)pt;
     (void)ls;
     (void)grid;
+    (void)desc;
+    return rl_error(RL_ERR_UNSUPPORTED, "gl: built without OpenGL");
+}
+
+rl_status rl_gl_pt_set_shadowmaps(rl_gl_pt *pt, const rl_shadowmap_desc *desc)
+{
+    (void)pt;
     (void)desc;
     return rl_error(RL_ERR_UNSUPPORTED, "gl: built without OpenGL");
 }

@@ -11,7 +11,8 @@
  * uniform grid of accel/grid.h is built and uploaded on the first use of
  * RL_GL_PT_GRID (and again for another grid_res).
  *
- * Bindings: shader storage 0-15, texture units 0-5 and image units 0-1
+ * Bindings: shader storage 0-15, texture units 0-7 (6 the raster IDs,
+ * 7 the shadow maps) and image units 0-1
  * are gl-pt's; storage 16-23 the Line Space's (gl_linespace.h, docs/gl.md).
  *
  * A tracer owns its own GL context (gl_context.h), current on the calling
@@ -25,15 +26,18 @@
 #include "rl/rl_gl.h"
 #include "rl/rl_linespace.h"
 #include "rl/rl_scene.h"
+#include "rl/rl_shadowmap.h"
 
 typedef struct rl_gl_pt rl_gl_pt;
 
 /* The structures shadow and secondary rays can go through: the exact ones,
  * and the Line Space's payloads (gl_linespace.h; rl_gl_pt_set_linespace
- * gives the tracer one) as pt uses them (pathtrace_path.c). */
+ * gives the tracer one) as pt uses them (pathtrace_path.c). SHADOWMAP is
+ * for shadow rays only: the cube shadow maps of rl_gl_pt_set_shadowmaps,
+ * looked up as rl_shadowmap_visible looks up the CPU's. */
 typedef enum rl_gl_pt_structure {
     RL_GL_PT_BVH = 0, RL_GL_PT_GRID, RL_GL_PT_LS_CANDIDATES, RL_GL_PT_LS_PNMT, RL_GL_PT_LS_PREILLUM,
-    RL_GL_PT_STRUCTURE_COUNT
+    RL_GL_PT_SHADOWMAP, RL_GL_PT_STRUCTURE_COUNT
 } rl_gl_pt_structure;
 
 /* The light set of pt's next-event estimation (pathtrace_lights.c: the
@@ -127,6 +131,18 @@ rl_status rl_gl_pt_render(rl_gl_pt *pt, const rl_gl_pt_frame *frame, float *rgba
 rl_status rl_gl_pt_set_linespace(rl_gl_pt *pt, const rl_linespace *ls, const rl_accel *grid,
                                  const rl_linespace_desc *desc);
 
+/* The cube shadow maps of RL_GL_PT_SHADOWMAP (Schröder 2017, Sec. 8.6), the
+ * ones rl_shadowmap_create makes on the CPU (desc the same, zeros the
+ * defaults) but drawn by GL: per light six depth-only raster passes from
+ * the light's point (a quad light's centre) with the same face frames,
+ * depth range and casters (all triangles but a quad light's own emitter,
+ * alpha masks' holes let light through), each face's eye depths copied on
+ * the GPU into one buffer the path program reads. Made again only when
+ * desc changes. RL_ERR_UNSUPPORTED for a directional light (as the CPU's),
+ * RL_ERR_LIMIT where the maps exceed the GL's buffer texture size. Until
+ * one succeeds, a frame with shadow = SHADOWMAP is RL_ERR_INVALID_ARG. */
+rl_status rl_gl_pt_set_shadowmaps(rl_gl_pt *pt, const rl_shadowmap_desc *desc);
+
 /* Traces n rays through structure on the GPU (closest hit, or with any the
  * first hit found) into hits (t, u, v, triangle; the object is left
  * RL_ID_NONE; t = INFINITY and triangle RL_ID_NONE on a miss): the ray set
@@ -142,5 +158,9 @@ extern const char *const rl_gl_pt_glsl_common;
 extern const char *const rl_gl_pt_glsl_common2;
 extern const char *const rl_gl_pt_glsl_path;
 extern const char *const rl_gl_pt_glsl_rays;
+/* the shadow maps' depth pass: after header, defines and common */
+extern const char *const rl_gl_pt_glsl_shadow_vs;
+/* after header, defines, common and rl_gl_glsl_tex_sample */
+extern const char *const rl_gl_pt_glsl_shadow_fs;
 
 #endif

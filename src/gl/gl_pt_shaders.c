@@ -313,6 +313,16 @@ const char *const rl_gl_pt_glsl_path = GLSL(
     uint table_source(uint k) { return texelFetch(u_light_table, int(k)).y; }
     uint tri_cover(uint t) { return texelFetch(u_tri_light, int(t)).x; }
     float tri_pmf(uint t) { return uintBitsToFloat(texelFetch(u_tri_light, int(t)).y); }
+    /* The cube shadow maps (rl_gl_pt_set_shadowmaps): per light six faces of
+     * u_sm_size^2 eye depths, row 0 the top row, as rl_shadowmap's. Always
+     * bound (an empty buffer without maps), so that a compiler that
+     * specializes on the bound textures makes one variant. */
+    layout(binding = 7) uniform samplerBuffer u_shadow_maps;  /* r32f */
+    uniform int u_sm_size;
+    uniform float u_sm_bias;
+    uniform float u_sm_slope;
+    uniform float u_sm_pcf;
+    uniform vec3 u_sm_frame[18];       /* per face: right, up, axis (rl_shadowmap_face_frame) */
 
     uniform ivec2 u_size;
     uniform vec3 u_eye;
@@ -730,10 +740,47 @@ const char *const rl_gl_pt_glsl_path = GLSL(
     /* --------------------------------------------------------- lights -- */
     vec3 offset_origin(Surf s, vec3 dir) { return s.p + s.ng * ((dot(dir, s.ng) >= 0.0 ? 1.0 : -1.0) * u_eps); }
 
-    /* pathtrace_path.c visible(): the shadow ray aimed at the light point
-     * from the offset origin, stopped 1e-4 short of it. */
-    bool visible(Surf s, vec3 l, float dist)
+    /* raster/shadowmap.c rl_shadowmap_visible (Sec. 8.6): the face of the
+     * major axis of p - light, the texel moved by the jitter j (the thesis'
+     * PCF-like offset), the slope-scaled bias against acne; a receiver
+     * whose geometric normal faces away from the light is in shadow. */
+    bool shadowmap_visible(uint light, vec3 p, vec3 n, vec2 j)
     {
+        Light L = lights[light];
+        vec3 lp = int(L.pos.w) == LIGHT_QUAD ? L.pos.xyz + (L.dir.xyz + L.extra.xyz) * 0.5 : L.pos.xyz;
+        vec3 d = p - lp;
+        float dist = length(d);
+        if (!(dist > 0.0))
+            return true;
+        float n_len = length(n);
+        float cos_t = n_len > 0.0 ? -dot(n, d) / (n_len * dist) : 1.0;
+        if (cos_t <= 0.0)
+            return false;
+        vec3 a = abs(d);
+        int face = a.x >= a.y && a.x >= a.z ? int(d.x < 0.0) : (a.y >= a.z ? 2 + int(d.y < 0.0) : 4 + int(d.z < 0.0));
+        float depth = dot(d, u_sm_frame[3 * face + 2]);
+        float half_size = 0.5 * float(u_sm_size);
+        float px = (dot(d, u_sm_frame[3 * face]) / depth + 1.0) * half_size + (2.0 * j.x - 1.0) * u_sm_pcf;
+        float py = (1.0 - dot(d, u_sm_frame[3 * face + 1]) / depth) * half_size + (2.0 * j.y - 1.0) * u_sm_pcf;
+        /* clamped as floats: a cast of a value beyond int's range is undefined */
+        int tx = int(clamp(floor(px), 0.0, float(u_sm_size - 1)));
+        int ty = int(clamp(floor(py), 0.0, float(u_sm_size - 1)));
+        int base = (int(light) * 6 + face) * u_sm_size * u_sm_size;
+        float stored = texelFetch(u_shadow_maps, base + ty * u_sm_size + tx).x;
+        float sin_t = sqrt(max(0.0, 1.0 - cos_t * cos_t));
+        float tan_t = sin_t < 1000.0 * cos_t ? sin_t / cos_t : 1000.0;
+        float texel = 2.0 * depth / float(u_sm_size);
+        float bias = u_sm_bias * depth + u_sm_slope * texel * tan_t;
+        return depth - bias <= stored;
+    }
+
+    /* pathtrace_path.c visible(): the shadow ray aimed at the light point
+     * from the offset origin, stopped 1e-4 short of it; with shadow maps
+     * light's maps looked up with the jitter j (no ray, none counted). */
+    bool visible(Surf s, vec3 l, float dist, uint light, vec2 j)
+    {
+        if (u_shadow == STRUCT_SHADOWMAP)
+            return shadowmap_visible(light, s.p, s.ng, j);
         vec3 o = offset_origin(s, l);
         vec3 d = l;
         float t_max = INF;
@@ -794,6 +841,7 @@ const char *const rl_gl_pt_glsl_path = GLSL(
     /* direct_light (mis=off): every light, light_samples points per quad */
     vec3 direct_light(Surf s, uint base)
     {
+        bool jitter = u_shadow == STRUCT_SHADOWMAP;
         vec3 sum = vec3(0.0);
         for (int i = 0; i < u_num_lights; ++i) {
             Light L = lights[i];
@@ -807,8 +855,11 @@ const char *const rl_gl_pt_glsl_path = GLSL(
                 int n = u_light_samples;
                 vec3 le = L.power.rgb * (area / float(n));
                 for (int k = 0; k < n; ++k) {
+                    /* both numbers drawn before any test, as pt draws them */
                     seek(light_base + SLOTS_LIGHT * uint(k) + SLOT_LIGHT_POINT);
                     vec2 x = sample_2d();
+                    seek(light_base + SLOTS_LIGHT * uint(k) + SLOT_LIGHT_JITTER);
+                    vec2 j = jitter ? sample_2d() : vec2(0.0);
                     vec3 q = L.pos.xyz + (L.dir.xyz * x.x + L.extra.xyz * x.y);
                     vec3 to = q - s.p;
                     float d2 = dot(to, to);
@@ -817,18 +868,20 @@ const char *const rl_gl_pt_glsl_path = GLSL(
                     float dist = sqrt(d2);
                     vec3 l = to * (1.0 / dist);
                     float cos_e = -dot(nq, l), cos_r = dot(s.ns, l);
-                    if (cos_e <= 0.0 || cos_r <= 0.0 || !visible(s, l, dist))
+                    if (cos_e <= 0.0 || cos_r <= 0.0 || !visible(s, l, dist, uint(i), j))
                         continue;
                     sum += phong_eval(s, l) * (le * (cos_e * cos_r / d2));
                 }
                 continue;
             }
+            seek(light_base + SLOT_LIGHT_JITTER);
+            vec2 j = jitter ? sample_2d() : vec2(0.0);
             vec3 E, l;
             float dist;
             if (!light_delta(L, s.p, E, l, dist))
                 continue;
             float cos_r = dot(s.ns, l);
-            if (cos_r <= 0.0 || !visible(s, l, dist))
+            if (cos_r <= 0.0 || !visible(s, l, dist, uint(i), j))
                 continue;
             sum += phong_eval(s, l) * (E * cos_r);
         }
@@ -874,6 +927,7 @@ const char *const rl_gl_pt_glsl_path = GLSL(
     {
         if (u_table_count == 0u)
             return vec3(0.0);
+        bool jitter = u_shadow == STRUCT_SHADOWMAP;
         int n = u_light_samples;
         vec3 sum = vec3(0.0);
         for (int k = 0; k < n; ++k) {
@@ -882,6 +936,8 @@ const char *const rl_gl_pt_glsl_path = GLSL(
             float u_pick = u_table_count > 1u ? sample_1d() : 0.0;
             seek(slot + SLOT_LIGHT_POINT);
             vec2 x = sample_2d();
+            seek(slot + SLOT_LIGHT_JITTER);
+            vec2 j = jitter ? sample_2d() : vec2(0.0);
             uint src = table_source(pick_light(u_pick));
             vec3 q, n_e, le;
             float area, pmf;
@@ -896,7 +952,7 @@ const char *const rl_gl_pt_glsl_path = GLSL(
                     if (!light_delta(L, s.p, E, l, dist))
                         continue;
                     float cos_r = dot(s.ns, l);
-                    if (cos_r <= 0.0 || !visible(s, l, dist))
+                    if (cos_r <= 0.0 || !visible(s, l, dist, src, j))
                         continue;
                     sum += phong_eval(s, l) * (E * (cos_r / (pmf * float(n))));
                     continue;
@@ -927,7 +983,7 @@ const char *const rl_gl_pt_glsl_path = GLSL(
             vec3 l = to * (1.0 / dist);
             float cos_e = is_light ? -dot(n_e, l) : abs(dot(n_e, l));
             float cos_r = dot(s.ns, l);
-            if (cos_e <= 0.0 || cos_r <= 0.0 || !visible(s, l, dist))
+            if (cos_e <= 0.0 || cos_r <= 0.0 || !visible(s, l, dist, src, j))
                 continue;
             float p_light = pmf * d2 / (area * cos_e);
             float w = bsdf_follows && hittable ? power_heuristic(float(n) * p_light, bsdf_pdf(s, l)) : 1.0;
@@ -1150,6 +1206,63 @@ const char *const rl_gl_pt_glsl_path = GLSL(
         float n = float(held);
         vec4 c = held == 0u ? vec4(0.0) : imageLoad(u_accum, px);
         imageStore(u_accum, px, vec4(c.rgb * (n / (n + 1.0)) + L * (1.0 / (n + 1.0)), 1.0));
+    }
+);
+
+/* The shadow maps' depth pass (raster/shadowmap.c render_face): one cube
+ * face from the light's point u_sm_eye, the light's casters list pulled by
+ * gl_VertexID. The face's frame with unit focal
+ * length, y negated so that GL's row 0 is the face's top row as the CPU
+ * stores it; clip z is gluPerspective's between the CPU's near and far
+ * planes (clipping as the CPU clips). */
+const char *const rl_gl_pt_glsl_shadow_vs = GLSL(
+    layout(std430, binding = 14) readonly buffer Casters { uint casters[]; };
+    uniform vec3 u_sm_eye;
+    uniform vec3 u_face_s;
+    uniform vec3 u_face_u;
+    uniform vec3 u_face_axis;
+    uniform float u_near;
+    uniform float u_far;
+    out float v_depth;
+    out vec2 v_uv;
+    flat out uint v_material;
+
+    void main()
+    {
+        uvec4 T = triangles[casters[uint(gl_VertexID) / 3u]];
+        uint k = uint(gl_VertexID) % 3u;
+        uint vi = k == 0u ? T.x : (k == 1u ? T.y : T.z);
+        vec3 d = position(vi) - u_sm_eye;
+        float z = dot(d, u_face_axis);
+        v_depth = z;
+        v_uv = uv_at(vi);
+        v_material = T.w;
+        gl_Position = vec4(dot(d, u_face_s), -dot(d, u_face_u),
+                           (u_far + u_near) / (u_far - u_near) * z - 2.0 * u_far * u_near / (u_far - u_near), z);
+    }
+);
+
+/* The eye depth, perspective-correct as the software rasterizer's 1 / (1/w)
+ * interpolation, into the colour attachment; the depth test on it scaled
+ * by the far plane (linear, full float precision, where gluPerspective's
+ * window depth would merge surfaces close together far from the light).
+ * raster_fill.c mask_keeps: a fragment in an alpha mask's hole is none. */
+const char *const rl_gl_pt_glsl_shadow_fs = GLSL(
+    in float v_depth;
+    in vec2 v_uv;
+    flat in uint v_material;
+    uniform float u_far;
+    layout(location = 0) out float o_depth;
+
+    void main()
+    {
+        if (u_masks) {
+            Material m = materials[v_material];
+            if (m.tex.z != NONE && tex_sample(m.tex.z, v_uv).w < m.extra.z)
+                discard;
+        }
+        o_depth = v_depth;
+        gl_FragDepth = clamp(v_depth / u_far, 0.0, 1.0);
     }
 );
 

@@ -31,7 +31,7 @@
  * Measured on the Cornell box (tests/raster/test_shadowmap.c): 99.6 % of
  * random surface points agree with an exact shadow ray; the rest lie within
  * a texel or two of silhouettes, where the jitter reaches the occluder. */
-#include "rl/rl_shadowmap.h"
+#include "raster/shadowmap_internal.h"
 #include "scene/masks.h"
 
 #include <math.h>
@@ -66,17 +66,19 @@ struct rl_shadowmap {
 
 /* Cube face frames: axis, and an up that is not parallel to it. Right =
  * axis x up, so each face is an exact look-at frame of 0/±1 entries. */
-static void face_frame(int face, sm_face *f)
+void rl_shadowmap_face_frame(int face, rl_vec3 *s, rl_vec3 *u, rl_vec3 *axis)
 {
     static const float axes[6][3] = { { 1, 0, 0 }, { -1, 0, 0 }, { 0, 1, 0 },
                                       { 0, -1, 0 }, { 0, 0, 1 }, { 0, 0, -1 } };
     static const float ups[6][3] = { { 0, 1, 0 }, { 0, 1, 0 }, { 0, 0, -1 },
                                      { 0, 0, 1 }, { 0, 1, 0 }, { 0, 1, 0 } };
-    f->axis = rl_v3(axes[face][0], axes[face][1], axes[face][2]);
+    *axis = rl_v3(axes[face][0], axes[face][1], axes[face][2]);
     rl_vec3 up = rl_v3(ups[face][0], ups[face][1], ups[face][2]);
-    f->s = rl_cross(f->axis, up);
-    f->u = rl_cross(f->s, f->axis);
+    *s = rl_cross(*axis, up);
+    *u = rl_cross(*s, *axis);
 }
+
+static void face_frame(int face, sm_face *f) { rl_shadowmap_face_frame(face, &f->s, &f->u, &f->axis); }
 
 /* gluLookAt rows (s, u, -axis) and a 90-degree square gluPerspective with
  * exact unit focal length, so that lookups can project without matrices. */
@@ -128,20 +130,15 @@ static bool own_emitter(const rl_scene_data *d, const rl_light *l, uint32_t t, f
     return true;
 }
 
-static rl_vec3 light_point(const rl_light *l)
+rl_vec3 rl_shadowmap_light_point(const rl_light *l)
 {
     if (l->type == RL_LIGHT_QUAD)
         return rl_add(l->position, rl_scale(rl_add(l->edge_u, l->edge_v), 0.5f));
     return l->position;
 }
 
-/* mask_texture, mask_cutoff: per drawn triangle, or NULL (no alpha masks). */
-static rl_status render_face(const rl_scene_data *d, const uint32_t *indices, const uint32_t *mask_texture,
-                             const float *mask_cutoff, uint32_t count, rl_vec3 eye, int size, sm_face *f)
+void rl_shadowmap_depth_range(const rl_scene_data *d, rl_vec3 eye, float *z_near, float *z_far)
 {
-    /* Near plane far below any sensible feature size (depth is recovered
-     * from 1/w, so a small near costs no precision); far encloses the
-     * scene. */
     rl_vec3 ext = rl_aabb_extent(d->bounds);
     float diag = rl_length(ext);
     float far_d = 0.0f;
@@ -151,7 +148,19 @@ static rl_status render_face(const rl_scene_data *d, const uint32_t *indices, co
                                c & 4 ? d->bounds.max.z : d->bounds.min.z);
         far_d = fmaxf(far_d, rl_length(rl_sub(corner, eye)));
     }
-    float z_near = fmaxf(diag * 1e-5f, 1e-30f), z_far = fmaxf(far_d * 1.01f, z_near * 2.0f);
+    *z_near = fmaxf(diag * 1e-5f, 1e-30f);
+    *z_far = fmaxf(far_d * 1.01f, *z_near * 2.0f);
+}
+
+/* mask_texture, mask_cutoff: per drawn triangle, or NULL (no alpha masks). */
+static rl_status render_face(const rl_scene_data *d, const uint32_t *indices, const uint32_t *mask_texture,
+                             const float *mask_cutoff, uint32_t count, rl_vec3 eye, int size, sm_face *f)
+{
+    /* Near plane far below any sensible feature size (depth is recovered
+     * from 1/w, so a small near costs no precision); far encloses the
+     * scene. */
+    float z_near, z_far;
+    rl_shadowmap_depth_range(d, eye, &z_near, &z_far);
     rl_mat4 view, proj;
     face_matrices(f, eye, z_near, z_far, &view, &proj);
     rl_raster *r = NULL;
@@ -177,6 +186,45 @@ static rl_status render_face(const rl_scene_data *d, const uint32_t *indices, co
     return s;
 }
 
+rl_status rl_shadowmap_resolve_desc(const rl_shadowmap_desc *desc, const char *who, rl_shadowmap_desc *out)
+{
+    rl_shadowmap_desc p = desc ? *desc : (rl_shadowmap_desc){ 0 };
+    if (p.size == 0) p.size = 1024;                /* Schröder 2017, Sec. 9.2 */
+    if (p.bias == 0.0f) p.bias = 1e-3f;
+    if (p.slope_bias == 0.0f) p.slope_bias = 2.0f;
+    if (p.pcf_radius == 0.0f) p.pcf_radius = 1.0f;
+    if (p.size < 1 || p.size > SM_MAX_SIZE)
+        return rl_error(RL_ERR_INVALID_ARG, "%s: size %d outside 1..%d", who, p.size, SM_MAX_SIZE);
+    if (!(p.bias >= 0.0f && p.bias < 1.0f) || !(p.slope_bias >= 0.0f && p.slope_bias < 1e4f) ||
+        !(p.pcf_radius >= 0.0f && p.pcf_radius <= 64.0f))
+        return rl_error(RL_ERR_INVALID_ARG, "%s: bias %g (0..1), slope_bias %g "
+                        "(0..1e4) or pcf_radius %g (0..64) out of range", who, (double)p.bias,
+                        (double)p.slope_bias, (double)p.pcf_radius);
+    *out = p;
+    return RL_OK;
+}
+
+rl_status rl_shadowmap_check_lights(const rl_scene_data *d, const char *who)
+{
+    for (uint32_t i = 0; i < d->num_lights; ++i)
+        if (d->lights[i].type == RL_LIGHT_DIRECTIONAL)
+            return rl_error(RL_ERR_UNSUPPORTED, "%s: light %u is directional; "
+                            "cube shadow maps need a light position", who, i);
+    return RL_OK;
+}
+
+/* The tolerance of own_emitter: the plane distance that still counts as on
+ * the light, relative to the scene's size. */
+static float emitter_tol(const rl_scene_data *d)
+{
+    return 1e-4f * fmaxf(rl_length(rl_aabb_extent(d->bounds)), 1e-30f);
+}
+
+bool rl_shadowmap_casts(const rl_scene_data *d, const rl_light *l, uint32_t t)
+{
+    return !own_emitter(d, l, t, emitter_tol(d));
+}
+
 rl_status rl_shadowmap_create(const rl_scene *scene, const rl_shadowmap_desc *desc,
                               rl_shadowmap **out)
 {
@@ -185,23 +233,12 @@ rl_status rl_shadowmap_create(const rl_scene *scene, const rl_shadowmap_desc *de
     const rl_scene_data *d = rl_scene_get_data(scene);
     if (!d)
         return rl_error(RL_ERR_NOT_COMMITTED, "rl_shadowmap_create: scene is not committed");
-    rl_shadowmap_desc p = desc ? *desc : (rl_shadowmap_desc){ 0 };
-    if (p.size == 0) p.size = 1024;                /* Schröder 2017, Sec. 9.2 */
-    if (p.bias == 0.0f) p.bias = 1e-3f;
-    if (p.slope_bias == 0.0f) p.slope_bias = 2.0f;
-    if (p.pcf_radius == 0.0f) p.pcf_radius = 1.0f;
-    if (p.size < 1 || p.size > SM_MAX_SIZE)
-        return rl_error(RL_ERR_INVALID_ARG, "rl_shadowmap_create: size %d outside 1..%d", p.size,
-                        SM_MAX_SIZE);
-    if (!(p.bias >= 0.0f && p.bias < 1.0f) || !(p.slope_bias >= 0.0f && p.slope_bias < 1e4f) ||
-        !(p.pcf_radius >= 0.0f && p.pcf_radius <= 64.0f))
-        return rl_error(RL_ERR_INVALID_ARG, "rl_shadowmap_create: bias %g (0..1), slope_bias %g "
-                        "(0..1e4) or pcf_radius %g (0..64) out of range", (double)p.bias,
-                        (double)p.slope_bias, (double)p.pcf_radius);
-    for (uint32_t i = 0; i < d->num_lights; ++i)
-        if (d->lights[i].type == RL_LIGHT_DIRECTIONAL)
-            return rl_error(RL_ERR_UNSUPPORTED, "rl_shadowmap_create: light %u is directional; "
-                            "cube shadow maps need a light position", i);
+    rl_shadowmap_desc p;
+    rl_status checked = rl_shadowmap_resolve_desc(desc, "rl_shadowmap_create", &p);
+    if (checked == RL_OK)
+        checked = rl_shadowmap_check_lights(d, "rl_shadowmap_create");
+    if (checked != RL_OK)
+        return checked;
 
     rl_timer timer;
     rl_timer_start(&timer);
@@ -228,10 +265,10 @@ rl_status rl_shadowmap_create(const rl_scene *scene, const rl_shadowmap_desc *de
     sm->memory = sizeof *sm + d->num_lights * sizeof *lights;
 
     rl_status status = RL_OK;
-    const float tol = 1e-4f * fmaxf(rl_length(rl_aabb_extent(d->bounds)), 1e-30f);
+    const float tol = emitter_tol(d);
     for (uint32_t li = 0; li < d->num_lights && !status; ++li) {
         const rl_light *l = &d->lights[li];
-        lights[li].position = light_point(l);
+        lights[li].position = rl_shadowmap_light_point(l);
         /* Triangles to draw for this light (all but its own emitter). */
         uint32_t count = 0;
         for (uint32_t t = 0; t < d->num_triangles; ++t)

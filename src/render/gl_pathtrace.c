@@ -16,11 +16,17 @@
  * Options: pt's names and defaults where ported (spp, max_depth, rr,
  * rr_depth, rng, mis, seed, shadow, diffuse, specular, primary,
  * checkerboard, accumulate, filter, filter_fade, atrous_*, grid_res, ls_n,
- * ls_k, ls_dynamic, ls_origin, light_samples, background, threads), device
- * (rl_gl.h) and ls_build. Values pt has and gl-pt has not ported are
- * refused with an option error naming what is ported:
- * shadow=embree|shadowmap, diffuse=embree; pt's ls_file, shadowmap_size
- * and adaptive* are not in the table.
+ * ls_k, ls_dynamic, ls_origin, light_samples, background, threads,
+ * shadowmap_size), device (rl_gl.h) and ls_build. Values pt has and gl-pt
+ * has not ported are refused with an option error naming what is ported:
+ * shadow=embree, diffuse=embree; pt's ls_file and adaptive* are not in the
+ * table.
+ *
+ * shadow=shadowmap (Sec. 8.6): pt's cube shadow maps (raster/shadowmap.c,
+ * the same size, bias and jitter) drawn by GL, depth-only passes per light
+ * and face (gl_pt.c rl_gl_pt_set_shadowmaps), looked up in the shader as
+ * rl_shadowmap_visible looks them up; as in pt, emissive triangles are
+ * then no light source of their own (no triangle lights).
  *
  * primary=raster (Sec. 8.1): every frame a GL drawer (gl_drawer.c) draws
  * the scene's triangle IDs, unlit, as rl_gbuffer_raster draws them with
@@ -60,7 +66,7 @@ _Static_assert(RL_GL_PT_RAY_TYPES == RL_RAY_TYPE_COUNT, "gl-pt counts rays in rl
 static const char *const rng_choices[] = { "sobol", "lcg", "tausworthe", "hybrid", NULL };
 static const char *const mis_choices[] = { "off", "on", NULL };
 /* pt's lists, so that a value pt knows gets "not ported" rather than
- * "unknown"; gl_pt_check admits bvh and grid. */
+ * "unknown"; gl_pt_check refuses embree. */
 static const char *const shadow_choices[] = { "bvh", "grid", "embree", "ls-candidates", "ls-preillum", "ls-pnmt",
                                               "shadowmap", "ls-scene", "ls-object", NULL };
 static const char *const diffuse_choices[] = { "bvh", "grid", "embree", "ls-candidates", "ls-preillum", "ls-pnmt",
@@ -85,8 +91,8 @@ static const rl_option_info gl_pt_options[] = {
       0, 0, mis_choices },
     { "seed", RL_OPT_INT, "0", "seed of the per-pixel generator states", 0, 9007199254740991.0, NULL },
     { "shadow", RL_OPT_ENUM, "bvh",
-      "shadow rays on the GPU: bvh, grid or a Line Space payload (ls-candidates, ls-preillum, ls-pnmt)",
-      0, 0, shadow_choices },
+      "shadow rays on the GPU: bvh, grid, a Line Space payload (ls-candidates, ls-preillum, ls-pnmt) or "
+      "shadowmap (cube shadow maps drawn by GL, Sec. 8.6)", 0, 0, shadow_choices },
     { "diffuse", RL_OPT_ENUM, "bvh",
       "secondary rays on the GPU: bvh, grid or a Line Space payload (ls-candidates, ls-preillum, ls-pnmt)",
       0, 0, diffuse_choices },
@@ -116,6 +122,7 @@ static const rl_option_info gl_pt_options[] = {
       "where the Line Space is built: cpu (pt's build, uploaded) or gpu (compute shaders; ls-candidates only)",
       0, 0, ls_build_choices },
     { "light_samples", RL_OPT_INT, "1", "shadow rays per quad light and vertex", 1, 1024, NULL },
+    { "shadowmap_size", RL_OPT_INT, "1024", "texels per shadow-map face side (Sec. 8.6)", 16, 16384, NULL },
     { "background", RL_OPT_COLOR, "0,0,0",
       "radiance arriving from every direction where a ray leaves the scene (a uniform environment)", 0, 0, NULL },
     { "threads", RL_OPT_INT, "0", "CPU threads of the structure builds (0 = all)", 0, 1024, NULL },
@@ -173,11 +180,10 @@ static bool gl_pt_available(const rl_renderer *r, char *why, size_t n)
 static rl_status gl_pt_check(const char *key, const char *value)
 {
     if ((strcmp(key, "shadow") == 0 || strcmp(key, "diffuse") == 0) &&
-        (strcmp(value, "embree") == 0 || strcmp(value, "shadowmap") == 0 || strcmp(value, "ls-scene") == 0 ||
-         strcmp(value, "ls-object") == 0))
+        (strcmp(value, "embree") == 0 || strcmp(value, "ls-scene") == 0 || strcmp(value, "ls-object") == 0))
         return rl_error(RL_ERR_INVALID_ARG,
-                        "gl-pt: %s=%s is not ported to GL yet (bvh, grid, ls-candidates, ls-preillum or ls-pnmt; "
-                        "pt has it)", key, value);
+                        "gl-pt: %s=%s is not ported to GL yet (bvh, grid, ls-candidates, ls-preillum or ls-pnmt%s; "
+                        "pt has it)", key, value, strcmp(key, "shadow") == 0 ? ", shadowmap" : "");
     if (strcmp(key, "ls_k") == 0 && atoi(value) % 2 != 0)
         return rl_error(RL_ERR_INVALID_ARG, "gl-pt: ls_k=%s must be even (front and back halves, Alg. 3)", value);
     return RL_OK;
@@ -237,6 +243,7 @@ static rl_gl_pt_structure structure_of(rl_pt_backend k)
     case RL_PT_BACKEND_LS_CANDIDATES: return RL_GL_PT_LS_CANDIDATES;
     case RL_PT_BACKEND_LS_PNMT: return RL_GL_PT_LS_PNMT;
     case RL_PT_BACKEND_LS_PREILLUM: return RL_GL_PT_LS_PREILLUM;
+    case RL_PT_BACKEND_SHADOWMAP: return RL_GL_PT_SHADOWMAP;
     default: return RL_GL_PT_BVH;
     }
 }
@@ -519,6 +526,18 @@ static rl_status gl_pt_render(rl_renderer *r, void *state, const rl_scene *scene
             return st;
         }
     }
+    if (shadow == RL_PT_BACKEND_SHADOWMAP) {
+        rl_timer timer;
+        rl_timer_start(&timer);
+        const rl_shadowmap_desc sm = { .size = (int)rl_renderer_opt_int(r, "shadowmap_size") };
+        st = rl_gl_pt_set_shadowmaps(s->gpu, &sm);
+        stats->prep_ms += rl_timer_ms(&timer);
+        if (st != RL_OK) {
+            free(states);
+            s->force_reset = true;
+            return st;
+        }
+    }
     /* pt's exact_backend: BSDF rays find emitters exactly */
     const bool exact = !payload;
     const int max_depth = (int)rl_renderer_opt_int(r, "max_depth");
@@ -530,7 +549,8 @@ static rl_status gl_pt_render(rl_renderer *r, void *state, const rl_scene *scene
         .rr_depth = (int)rl_renderer_opt_int(r, "rr_depth"),
         .light_samples = (int)rl_renderer_opt_int(r, "light_samples"),
         .rr = rl_renderer_opt_bool(r, "rr"),
-        .mis = mis, .mis_hits = mis && exact, .tri_lights = mis && exact,
+        /* pathtrace.c: shadow maps are rendered per light; no triangle lights */
+        .mis = mis, .mis_hits = mis && exact, .tri_lights = mis && exact && shadow != RL_PT_BACKEND_SHADOWMAP,
         .rng = rng,
         .shadow = structure_of(shadow),
         .diffuse = structure_of(diffuse),

@@ -3,7 +3,8 @@
 # unavailable with the device's reason (one error line, exit 1, no image)
 # where the EGL device cannot be opened, options it has not ported refused
 # as usage errors, and where GL is available a progressive render whose
-# stats name the GL device, and the record of rl bench gl's pt section.
+# stats name the GL device, the record of rl bench gl's pt section, and
+# shadow maps drawn by GL.
 # Run as: bash test_cli_gl_pt.sh <rl-binary> <scratch-dir>
 set -u
 . "$(dirname "${BASH_SOURCE[0]}")/lib.bash"
@@ -16,7 +17,7 @@ RL_EGL_DEVICE=bogus expect_error 1 "gl-pt: unavailable: .*bogus" \
 [ ! -e "$TMP/none.png" ] || fail "an unavailable renderer wrote an image"
 
 expect_error 2 "not ported to GL yet" \
-    "$RL" render cornell --algo gl-pt --set gl-pt.shadow=shadowmap --size 16x16 --out "$TMP/none.png"
+    "$RL" render cornell --algo gl-pt --set gl-pt.shadow=embree --size 16x16 --out "$TMP/none.png"
 expect_error 2 "not ported to GL yet" \
     "$RL" render cornell --algo gl-pt --set gl-pt.diffuse=embree --size 16x16 --out "$TMP/none.png"
 [ ! -e "$TMP/none.png" ] || fail "a refused option still rendered"
@@ -53,6 +54,19 @@ s = json.load(open(sys.argv[1]))
 r = s["rays"]
 assert r["primary"] == 0 and r["shadow"] > 0 and r["diffuse"] > 0, s
 PY
+    # shadow maps drawn by GL (Sec. 8.6): no shadow rays traced; a
+    # directional light refused as pt refuses it
+    run_ok "$RL" render cornell --algo gl-pt --set gl-pt.shadow=shadowmap --set gl-pt.shadowmap_size=64 \
+        --size 16x16 --spp 2 --out "$TMP/glpt_sm.png" --stats-json "$TMP/glpt_sm.json"
+    [ -s "$TMP/glpt_sm.png" ] || fail "gl-pt shadow=shadowmap wrote no image"
+    python3 - "$TMP/glpt_sm.json" <<'PY' || fail "gl-pt shadow=shadowmap traced shadow rays"
+import json, sys
+s = json.load(open(sys.argv[1]))
+assert s["rays"]["shadow"] == 0 and s["rays"]["diffuse"] > 0, s
+PY
+    expect_error 1 "directional" \
+        "$RL" render spheres --algo gl-pt --set gl-pt.shadow=shadowmap --size 16x16 --spp 1 --out "$TMP/none.png"
+    [ ! -e "$TMP/none.png" ] || fail "a refused scene still rendered"
     # the Line Space backends (Diagram 1's configuration), and the pair of
     # options the GPU build cannot serve
     run_ok "$RL" render cornell --algo gl-pt --set gl-pt.shadow=ls-pnmt --set gl-pt.diffuse=ls-pnmt \

@@ -8,7 +8,8 @@
  * grid find the triangles the CPU
  * BVH finds, ray for ray; primary=raster (a GL raster pass) and
  * checkerboard trace pt's paths and pixels, the shader's ray counters give
- * pt's counts, and the filters are pt's on gl-pt's image; options gl-pt
+ * pt's counts, the filters are pt's on gl-pt's image, and the GL-drawn
+ * shadow maps give pt's shadow-map pixels; options gl-pt
  * has not ported are refused, and a device that cannot be opened makes it
  * unavailable. Small images on llvmpipe; without a GL 4.5 context the GL
  * cases skip. */
@@ -679,6 +680,76 @@ static void test_gl_pt_filters_are_pts(void **state)
     rl_scene_release(s);
 }
 
+/* shadow=shadowmap: the cube shadow maps drawn by GL and looked up in the
+ * shader as pt looks up its CPU-rasterized ones (same size, bias, jitter
+ * numbers). With rng=hybrid the paths are pt's, and the pixels are pt's
+ * except where a GL-rasterized texel differs from the software
+ * rasterizer's (silhouettes); with an alpha mask's holes, a point and a
+ * quad light too. The means agree with pt's shadow maps within 3 sigma;
+ * against exact shadow rays they differ by what the maps' bias lights
+ * (measured here, bounded loosely; docs/gl.md). A directional light is
+ * refused as pt refuses it. */
+static void test_gl_pt_shadow_maps_are_pts(void **state)
+{
+    (void)state;
+    NEED_GL();
+    static const struct {
+        const char *scene, *mis;
+    } cases[] = { { "cornell", "on" }, { "masks and normal maps", "off" } };
+    for (size_t k = 0; k < sizeof cases / sizeof cases[0]; ++k) {
+        rl_camera cam;
+        rl_scene *s = strncmp(cases[k].scene, "masks", 5) == 0 ? mask_normal_scene(&cam)
+                                                                 : scene_and_camera(cases[k].scene, NULL, &cam);
+        cam.width = cam.height = 24;
+        const char *const opts[] = { "spp", "4", "rng", "hybrid", "seed", "5", "mis", cases[k].mis, "shadow",
+                                     "shadowmap", "shadowmap_size", "256", NULL };
+        rl_image *cpu = render("pt", s, &cam, opts);
+        rl_image *gl = render("gl-pt", s, &cam, opts);
+        const double share = share_equal(gl, cpu, (size_t)cam.width * (size_t)cam.height);
+        print_message("%s, shadow maps 256^2, mis=%s: pixels equal to pt's to 1e-3: %.1f %%\n", cases[k].scene,
+                      cases[k].mis, 100.0 * share);
+        assert_true(share >= 0.97);
+        rl_image_release(gl);
+        rl_image_release(cpu);
+        rl_scene_release(s);
+    }
+
+    rl_camera cam;
+    rl_scene *s = scene_and_camera("cornell", NULL, &cam);
+    rl_image *ref = render("pt", s, &cam, (const char *const[]){ "spp", REF_SPP, "shadow", "shadowmap", "seed", "3",
+                                                                 NULL });
+    rl_image *exact = render("pt", s, &cam, (const char *const[]){ "spp", REF_SPP, "seed", "3", NULL });
+    rl_image *gl = render("gl-pt", s, &cam, (const char *const[]){ "spp", "64", "shadow", "shadowmap", NULL });
+    assert_means_agree("cornell shadow=shadowmap 64 spp", gl, ref);
+    double rmse[3], md[3];
+    difference(gl, exact, rmse, md);
+    for (int c = 0; c < 3; ++c) {
+        double mean = 0.0;
+        for (size_t i = 0; i < (size_t)SIZE * SIZE; ++i)
+            mean += (&exact->color[i].x)[c];
+        mean /= (double)SIZE * SIZE;
+        print_message("cornell, channel %d: gl-pt shadow maps - pt exact shadow rays: mean %+.5f (%+.2f %% of %.4f), "
+                      "RMSE %.4f\n", c, md[c], 100.0 * md[c] / mean, mean, rmse[c]);
+        assert_true(fabs(md[c]) <= 0.05 * mean);
+    }
+    rl_image_release(gl);
+    rl_image_release(exact);
+    rl_image_release(ref);
+    rl_scene_release(s);
+
+    s = scene_and_camera("spheres", "segments=16,checks=4", &cam);
+    rl_renderer *r = fx_make("gl-pt", (const char *const[]){ "shadow", "shadowmap", NULL });
+    rl_image *img = NULL;
+    assert_int_equal(rl_image_create(cam.width, cam.height, RL_LAYER_COLOR, &img), RL_OK);
+    rl_clear_error();
+    assert_int_equal(rl_renderer_render(r, s, &cam, img, NULL), RL_ERR_UNSUPPORTED);
+    print_message("spheres (a directional light): %s\n", rl_last_error());
+    assert_non_null(strstr(rl_last_error(), "directional"));
+    rl_image_release(img);
+    rl_renderer_release(r);
+    rl_scene_release(s);
+}
+
 static void expect_refused(rl_renderer *r, const char *key, const char *value, const char *says)
 {
     rl_clear_error();
@@ -691,13 +762,15 @@ static void test_gl_pt_refuses_what_is_not_ported(void **state)
 {
     (void)state;
     rl_renderer *r = fx_make("gl-pt", NULL);
-    expect_refused(r, "shadow", "shadowmap", "not ported");
     expect_refused(r, "diffuse", "embree", "not ported");
     expect_refused(r, "shadow", "embree", "not ported");
     expect_refused(r, "ls_file", "x.rlls", "unknown option");
     expect_refused(r, "ls_k", "3", "even");
     expect_refused(r, "ls_build", "cuda", "ls_build");
     expect_refused(r, "shadow", "octree", "shadow");
+    assert_int_equal(rl_renderer_set(r, "shadow", "shadowmap"), RL_OK);
+    assert_int_equal(rl_renderer_set(r, "shadowmap_size", "512"), RL_OK);
+    expect_refused(r, "shadowmap_size", "8", "shadowmap_size");
     assert_int_equal(rl_renderer_set(r, "shadow", "grid"), RL_OK);
     assert_int_equal(rl_renderer_set(r, "checkerboard", "true"), RL_OK);
     assert_int_equal(rl_renderer_set(r, "primary", "raster"), RL_OK);
@@ -742,6 +815,7 @@ int main(void)
         cmocka_unit_test(test_gl_pt_checkerboard_traces_pts_pixels),
         cmocka_unit_test(test_gl_pt_ray_counts_match_pts),
         cmocka_unit_test(test_gl_pt_filters_are_pts),
+        cmocka_unit_test(test_gl_pt_shadow_maps_are_pts),
         cmocka_unit_test(test_gl_pt_refuses_what_is_not_ported),
         cmocka_unit_test(test_gl_pt_unopenable_device_is_reported_unavailable),
     };
