@@ -127,13 +127,6 @@ static rl_status bdpt_check(const char *key, const char *value)
     return RL_OK;
 }
 
-static int scene_max_depth(const rl_scene *scene)
-{
-    const char *v = rl_scene_node_attr(scene, 0, "max_path_length");
-    long long n;
-    return v && rl_parse_int(v, &n) && n >= 0 && n <= 1024 ? (int)n : 3;
-}
-
 typedef struct bd_frame {
     bdpt_state *s;
     bd_ctx ctx;
@@ -289,7 +282,7 @@ static rl_status bdpt_render(rl_renderer *r, void *state, const rl_scene *scene,
     bd_ctx *c = &f.ctx;
     c->data = d;
     c->b = &s->b;
-    c->max_depth = max_depth >= 0 ? max_depth : scene_max_depth(scene);
+    c->max_depth = max_depth >= 0 ? max_depth : rl_pt_scene_max_depth(scene);
     c->rr = rl_renderer_opt_bool(r, "rr");
     c->rr_depth = (int)rl_renderer_opt_int(r, "rr_depth");
     c->mis = (bd_mis)rl_renderer_opt_enum(r, "mis");

@@ -189,20 +189,6 @@ static rl_status gl_pt_check(const char *key, const char *value)
     return RL_OK;
 }
 
-static bool same_camera(const rl_camera *a, const rl_camera *b)
-{
-    return memcmp(&a->eye, &b->eye, sizeof a->eye) == 0 && memcmp(&a->target, &b->target, sizeof a->target) == 0 &&
-           memcmp(&a->up, &b->up, sizeof a->up) == 0 && a->fov_deg == b->fov_deg && a->width == b->width &&
-           a->height == b->height && a->z_near == b->z_near && a->z_far == b->z_far;
-}
-
-static int scene_max_depth(const rl_scene *scene)
-{
-    const char *v = rl_scene_node_attr(scene, 0, "max_path_length");
-    long long n;
-    return v && rl_parse_int(v, &n) && n >= 0 && n <= 1024 ? (int)n : 3;
-}
-
 /* The tracer for this scene and device, made anew when either changed. */
 static rl_status ensure_gpu(gl_pt_state *s, const rl_scene *scene, const char *device, int threads,
                             rl_render_stats *stats)
@@ -485,7 +471,7 @@ static rl_status gl_pt_render(rl_renderer *r, void *state, const rl_scene *scene
         return RL_ERR_OUT_OF_MEMORY;
     const bool accumulate = rl_renderer_opt_bool(r, "accumulate");
     bool reset = s->force_reset || !s->valid || !accumulate || s->scene_uid != rl_scene_uid(scene) ||
-                 !same_camera(&s->cam, cam) || strcmp(s->signature, sig) != 0;
+                 !rl_camera_equal(&s->cam, cam) || strcmp(s->signature, sig) != 0;
     const size_t n = (size_t)cam->width * (size_t)cam->height;
     const int rng = rl_renderer_opt_enum(r, "rng");
     uint32_t *states = NULL;
@@ -545,7 +531,7 @@ static rl_status gl_pt_render(rl_renderer *r, void *state, const rl_scene *scene
     rl_gl_pt_frame f = {
         .cam = rl_camera_frame_make(cam),
         .spp = (int)rl_renderer_opt_int(r, "spp"),
-        .max_depth = max_depth >= 0 ? max_depth : scene_max_depth(scene),
+        .max_depth = max_depth >= 0 ? max_depth : rl_pt_scene_max_depth(scene),
         .rr_depth = (int)rl_renderer_opt_int(r, "rr_depth"),
         .light_samples = (int)rl_renderer_opt_int(r, "light_samples"),
         .rr = rl_renderer_opt_bool(r, "rr"),

@@ -295,9 +295,7 @@ static void pt_release(void *state)
     free(s->signature);
 }
 
-/* The thesis' path length stored with a scene (Sec. 9.3; the built-ins
- * ls-open and ls-cornell set it on their root node), else 3. */
-static int scene_max_depth(const rl_scene *scene)
+int rl_pt_scene_max_depth(const rl_scene *scene)
 {
     const char *v = rl_scene_node_attr(scene, 0, "max_path_length");
     long long n;
@@ -1173,7 +1171,7 @@ static rl_status pt_render(rl_renderer *r, void *state, const rl_scene *scene, c
         .s = s,
         .set = &set,
         .ctx = { .data = d, .b = &s->b, .shadow = set.shadow, .diffuse = set.diffuse, .specular = set.specular,
-                 .max_depth = set.max_depth >= 0 ? set.max_depth : scene_max_depth(scene),
+                 .max_depth = set.max_depth >= 0 ? set.max_depth : rl_pt_scene_max_depth(scene),
                  .rr_depth = set.rr_depth, .light_samples = set.light_samples, .rr = set.rr,
                  .mis = set.mis, .mis_hits = set.mis && exact_backend(set.diffuse),
                  .tri_lights = set.mis && exact_backend(set.diffuse) && set.shadow != RL_PT_BACKEND_SHADOWMAP,

@@ -93,6 +93,11 @@ extern const char *const rl_pt_filter_choices[];
       "a-trous position sigma in world units; 0 = 2^atrous_iterations pixel footprints", 0, 1e9, NULL }
 void rl_pt_read_filter_settings(const rl_renderer *r, pt_settings *set);
 
+/* The path length a scene asks for when max_depth is -1, for pt, gl-pt and
+ * bdpt alike: the thesis' "max_path_length" root attribute (Sec. 9.3; the
+ * built-ins ls-open, ls-cornell and cornell:variant=bitterli set it), else 3. */
+int rl_pt_scene_max_depth(const rl_scene *scene);
+
 /* ------------------------------------------------------------ backends -- */
 
 /* The lights next-event estimation chooses from with mis=on, by power: the
