@@ -63,17 +63,9 @@
 
 _Static_assert(RL_GL_PT_RAY_TYPES == RL_RAY_TYPE_COUNT, "gl-pt counts rays in rl_ray_type's order");
 
-static const char *const rng_choices[] = { "sobol", "lcg", "tausworthe", "hybrid", NULL };
-static const char *const mis_choices[] = { "off", "on", NULL };
-/* pt's lists, so that a value pt knows gets "not ported" rather than
- * "unknown"; gl_pt_check refuses embree. */
-static const char *const shadow_choices[] = { "bvh", "grid", "embree", "ls-candidates", "ls-preillum", "ls-pnmt",
-                                              "shadowmap", "ls-scene", "ls-object", NULL };
-static const char *const diffuse_choices[] = { "bvh", "grid", "embree", "ls-candidates", "ls-preillum", "ls-pnmt",
-                                               "ls-scene", "ls-object", NULL };
-static const char *const specular_choices[] = { "exact", "diffuse", NULL };
-static const char *const primary_choices[] = { "trace", "raster", NULL };
-static const char *const ls_origin_choices[] = { "offset", "exact", NULL };
+/* The choices it shares with pt are pt's lists (pathtrace_internal.h), so
+ * that a value pt knows gets "not ported" rather than "unknown" where
+ * gl-pt lacks it (gl_pt_check). */
 static const char *const ls_build_choices[] = { "cpu", "gpu", NULL };
 
 static const rl_option_info gl_pt_options[] = {
@@ -85,23 +77,23 @@ static const rl_option_info gl_pt_options[] = {
     { "rr_depth", RL_OPT_INT, "4", "bounce from which Russian roulette may end a path", 0, 1024, NULL },
     { "rng", RL_OPT_ENUM, "sobol",
       "sample numbers: sobol (Owen-scrambled Sobol points) or the thesis' per-pixel state textures (Sec. 5.3): "
-      "lcg, tausworthe or their hybrid", 0, 0, rng_choices },
+      "lcg, tausworthe or their hybrid", 0, 0, rl_pt_rng_choices },
     { "mis", RL_OPT_ENUM, "on",
       "on: lights chosen by power, light and BSDF samples weighted by the power heuristic; off: every light",
-      0, 0, mis_choices },
+      0, 0, rl_pt_mis_choices },
     { "seed", RL_OPT_INT, "0", "seed of the per-pixel generator states", 0, 9007199254740991.0, NULL },
     { "shadow", RL_OPT_ENUM, "bvh",
       "shadow rays on the GPU: bvh, grid, a Line Space payload (ls-candidates, ls-preillum, ls-pnmt) or "
-      "shadowmap (cube shadow maps drawn by GL, Sec. 8.6)", 0, 0, shadow_choices },
+      "shadowmap (cube shadow maps drawn by GL, Sec. 8.6)", 0, 0, rl_pt_shadow_choices },
     { "diffuse", RL_OPT_ENUM, "bvh",
       "secondary rays on the GPU: bvh, grid or a Line Space payload (ls-candidates, ls-preillum, ls-pnmt)",
-      0, 0, diffuse_choices },
+      0, 0, rl_pt_diffuse_choices },
     { "specular", RL_OPT_ENUM, "exact",
       "mirror and refraction rays: exact (the grid under a Line Space payload, else the diffuse structure) or "
-      "diffuse (the diffuse structure, payloads included)", 0, 0, specular_choices },
+      "diffuse (the diffuse structure, payloads included)", 0, 0, rl_pt_specular_choices },
     { "primary", RL_OPT_ENUM, "trace",
       "primary visibility: trace (jittered rays, GPU BVH) or raster (triangle IDs drawn by GL, Sec. 8.1)", 0, 0,
-      primary_choices },
+      rl_pt_primary_choices },
     { "checkerboard", RL_OPT_BOOL, "false", "render alternate halves of the pixels per frame (Sec. 8.5)",
       0, 0, NULL },
     { "accumulate", RL_OPT_BOOL, "true", "progressive accumulation across frames (Sec. 6.5, eq. 8)", 0, 0, NULL },
@@ -116,7 +108,7 @@ static const rl_option_info gl_pt_options[] = {
       RL_LS_MAX_K, NULL },
     { "ls_origin", RL_OPT_ENUM, "offset",
       "PNMT/preillum rays: offset (start one voxel diagonal away, Sec. 12.1) or exact (start at the "
-      "surface; the start voxel's triangles answer PNMT rays exactly)", 0, 0, ls_origin_choices },
+      "surface; the start voxel's triangles answer PNMT rays exactly)", 0, 0, rl_pt_ls_origin_choices },
     { "ls_dynamic", RL_OPT_BOOL, "true", "exact per-shaft candidate lists (prefix sums, Sec. 7.1.1)", 0, 0, NULL },
     { "ls_build", RL_OPT_ENUM, "cpu",
       "where the Line Space is built: cpu (pt's build, uploaded) or gpu (compute shaders; ls-candidates only)",

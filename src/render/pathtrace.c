@@ -136,21 +136,21 @@
 #define ADAPTIVE_CAP 8.0
 
 /* Order: sobol, then rl_rng_gpu_kind. */
-static const char *const rng_choices[] = { "sobol", "lcg", "tausworthe", "hybrid", NULL };
-static const char *const mis_choices[] = { "off", "on", NULL };
+const char *const rl_pt_rng_choices[] = { "sobol", "lcg", "tausworthe", "hybrid", NULL };
+const char *const rl_pt_mis_choices[] = { "off", "on", NULL };
 static const char *const env_sampling_choices[] = { "importance", "uniform", "bsdf", NULL };
 /* Order = rl_pt_backend. */
-static const char *const shadow_choices[] = { "bvh", "grid", "embree", "ls-candidates", "ls-preillum", "ls-pnmt",
+const char *const rl_pt_shadow_choices[] = { "bvh", "grid", "embree", "ls-candidates", "ls-preillum", "ls-pnmt",
                                               "shadowmap", "ls-scene", "ls-object", NULL };
-static const char *const specular_choices[] = { "exact", "diffuse", NULL };
+const char *const rl_pt_specular_choices[] = { "exact", "diffuse", NULL };
 /* Order = rl_pt_backend up to ls-pnmt; then ls-scene and ls-object, which
  * come after shadowmap there (diffuse_backend maps them). */
-static const char *const diffuse_choices[] = { "bvh", "grid", "embree", "ls-candidates", "ls-preillum", "ls-pnmt",
+const char *const rl_pt_diffuse_choices[] = { "bvh", "grid", "embree", "ls-candidates", "ls-preillum", "ls-pnmt",
                                                "ls-scene", "ls-object", NULL };
 /* Order = pt_ls_scene_inner. */
 static const char *const ls_scene_inner_choices[] = { "object", "bvh", "candidates", NULL };
-static const char *const ls_origin_choices[] = { "offset", "exact", NULL };
-static const char *const primary_choices[] = { "trace", "raster", NULL };
+const char *const rl_pt_ls_origin_choices[] = { "offset", "exact", NULL };
+const char *const rl_pt_primary_choices[] = { "trace", "raster", NULL };
 /* Order = rl_filter_kind. */
 const char *const rl_pt_filter_choices[] = { "none", "gauss", "bilateral", "aniso", "kuwahara", "atrous", NULL };
 static const char *const adaptive_choices[] = { "off", "on", NULL };
@@ -166,20 +166,20 @@ static const rl_option_info pt_options[] = {
       "bounce from which Russian roulette may end a path (thesis: 2; 4 by measurement, issue 37)", 0, 1024, NULL },
     { "rng", RL_OPT_ENUM, "sobol",
       "sample numbers: sobol (Owen-scrambled Sobol points) or the thesis' per-pixel generators (Sec. 5.3): lcg, "
-      "tausworthe or their hybrid", 0, 0, rng_choices },
+      "tausworthe or their hybrid", 0, 0, rl_pt_rng_choices },
     { "mis", RL_OPT_ENUM, "on",
       "on: lights chosen by power, light and BSDF samples weighted by the power heuristic (Veach 1997); off: "
-      "the thesis' next-event estimation of every light", 0, 0, mis_choices },
+      "the thesis' next-event estimation of every light", 0, 0, rl_pt_mis_choices },
     { "seed", RL_OPT_INT, "0", "seed of the per-pixel generator states", 0, 9007199254740991.0, NULL },
     { "shadow", RL_OPT_ENUM, "bvh", "shadow test: exact accelerator, Line Space payload or shadow maps",
-      0, 0, shadow_choices },
+      0, 0, rl_pt_shadow_choices },
     { "diffuse", RL_OPT_ENUM, "bvh", "secondary rays: exact accelerator or Line Space payload",
-      0, 0, diffuse_choices },
+      0, 0, rl_pt_diffuse_choices },
     { "specular", RL_OPT_ENUM, "exact",
       "mirror and refraction rays: exact (the thesis, Sec. 11.2, 12.3: the grid under a Line Space payload, "
-      "else the diffuse backend) or diffuse (the diffuse backend, payloads included)", 0, 0, specular_choices },
+      "else the diffuse backend) or diffuse (the diffuse backend, payloads included)", 0, 0, rl_pt_specular_choices },
     { "primary", RL_OPT_ENUM, "trace",
-      "primary visibility: trace (jittered rays, BVH) or raster (G-buffer, Sec. 8.1)", 0, 0, primary_choices },
+      "primary visibility: trace (jittered rays, BVH) or raster (G-buffer, Sec. 8.1)", 0, 0, rl_pt_primary_choices },
     { "checkerboard", RL_OPT_BOOL, "false", "render alternate halves of the pixels per frame (Sec. 8.5)",
       0, 0, NULL },
     { "accumulate", RL_OPT_BOOL, "true", "progressive accumulation across frames (Sec. 6.5, eq. 8)", 0, 0, NULL },
@@ -199,7 +199,7 @@ static const rl_option_info pt_options[] = {
       RL_LS_MAX_K, NULL },
     { "ls_origin", RL_OPT_ENUM, "offset",
       "PNMT/preillum rays: offset (start one voxel diagonal away, Sec. 12.1) or exact (start at the "
-      "surface; the start voxel's triangles answer PNMT rays exactly)", 0, 0, ls_origin_choices },
+      "surface; the start voxel's triangles answer PNMT rays exactly)", 0, 0, rl_pt_ls_origin_choices },
     { "ls_dynamic", RL_OPT_BOOL, "true", "exact per-shaft candidate lists (prefix sums, Sec. 7.1.1)", 0, 0, NULL },
     { "ls_file", RL_OPT_STRING, "",
       "Line Space cache (Sec. 13.3): loaded if the file exists (it must match the scene, grid and "

@@ -81,6 +81,10 @@ rl_status rl_pt_filter_image(const pt_settings *set, const rl_gbuffer *gbuf, dou
  * (placed after "filter" in an rl_option_info table), and the reading of
  * "filter" and those parameters into set. */
 extern const char *const rl_pt_filter_choices[];
+/* The other choice lists gl-pt shares with pt (orders: pathtrace.c). */
+extern const char *const rl_pt_rng_choices[], *const rl_pt_mis_choices[], *const rl_pt_shadow_choices[],
+    *const rl_pt_diffuse_choices[], *const rl_pt_specular_choices[], *const rl_pt_primary_choices[],
+    *const rl_pt_ls_origin_choices[];
 #define RL_PT_FILTER_PARAM_OPTIONS                                                                                 \
     { "filter_fade", RL_OPT_FLOAT, "16",                                                                           \
       "filter weight 1/(1 + spp/filter_fade) with spp the samples so far; 0 = never fade", 0, 1e9, NULL },         \
