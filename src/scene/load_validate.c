@@ -451,6 +451,17 @@ static rl_status check_off(const char *path, const char *data, size_t size)
     }
     if (have < 3 || counts[0] < 0 || counts[1] < 0)
         return RL_OK;
+    /* Assimp sizes its arrays by the declared counts before it reads a
+     * line, so a few bytes declaring 10^12 faces ask for gigabytes (found
+     * by fuzz_load_mesh). Every vertex and face takes a line of at least
+     * two bytes (a number and its end; the last may lack the end), so
+     * counts beyond about half of what follows the header cannot be true;
+     * strtoll saturates, so a count too long for any integer lands here
+     * too. */
+    const long long room = (long long)((size - pos + 1) / 2);
+    if (counts[0] > room || counts[1] > room || counts[0] + counts[1] > room)
+        return rl_error(RL_ERR_PARSE, "%s: OFF declares %lld vertices and %lld faces, more than its %zu bytes after "
+                        "the header can hold", path, counts[0], counts[1], size - pos);
     for (long long v = 0; v < counts[0];) {
         if (!next_line(data, size, &pos, line, sizeof line))
             return RL_OK;   /* short: Assimp reports it */

@@ -131,7 +131,16 @@ static void test_off_indices_out_of_range_are_refused(void **state)
     const char *negative = "OFF 3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 -1 2\n";
     expect_refused(write_bytes("negative.off", negative, strlen(negative), path, sizeof path),
                    RL_ERR_PARSE, "uses vertex -1 of 3");
-    const char *good = "OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n";
+    /* Counts the file cannot hold: Assimp would size its arrays by them
+     * first (fuzz_load_mesh found 53 GB asked for by a 90-byte file whose
+     * face count overflows any integer). */
+    const char *huge = "\004OFF\n4 1111111111111111111111111111111111111112 0\n0 0 0\n1 0 10 1\n1 1 0\n0 1 0\n3 0 2\n";
+    expect_refused(write_bytes("huge.off", huge, strlen(huge), path, sizeof path), RL_ERR_PARSE,
+                   "more than its 33 bytes after the header can hold");
+    const char *many = "OFF\n3 40 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n";
+    expect_refused(write_bytes("many.off", many, strlen(many), path, sizeof path), RL_ERR_PARSE,
+                   "OFF declares 3 vertices and 40 faces");
+    const char *good = "OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2";   /* no end after the last line */
     rl_scene *s = NULL;
     assert_int_equal(rl_scene_load(write_bytes("good.off", good, strlen(good), path, sizeof path), NULL, &s),
                      RL_OK);
