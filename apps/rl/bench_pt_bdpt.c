@@ -22,7 +22,6 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <time.h>
 
 #include "rl/rl_render.h"
 #include "rl/rl_scene.h"
@@ -33,14 +32,6 @@
 static const char *const scenes[] = { "variant=bitterli", "variant=shade" };
 #define NUM_SCENES (sizeof scenes / sizeof scenes[0])
 static const char *const algos[] = { "pt", "bdpt" };
-
-static double cpu_ms_now(void)
-{
-    struct timespec ts;
-    if (clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts) != 0)
-        return 0.0;
-    return ts.tv_sec * 1e3 + ts.tv_nsec * 1e-6;
-}
 
 static float disp(float v)
 {
@@ -145,16 +136,11 @@ static rl_status run_scene(const bench_pt_bdpt_args *a, const char *params, int 
         st = make(algos[k], a->threads, "9", 1, &r);
         if (st == RL_OK) st = rl_renderer_render(r, scene, &cam, img, &s);
         if (st == RL_OK) st = rl_renderer_set(r, "seed", "1");
-        double wall = 0.0, cpu = 0.0;
-        long long spp = 0;
-        while (st == RL_OK && cpu / 1e3 / a->threads < budget_s) {
-            double c0 = cpu_ms_now();
-            rl_timer_start(&timer);
-            st = rl_renderer_render(r, scene, &cam, img, &s);
-            wall += rl_timer_ms(&timer);
-            cpu += cpu_ms_now() - c0;
-            ++spp;
-        }
+        bench_budget_run run = { 0 };
+        if (st == RL_OK)
+            st = bench_render_for_cpu(r, scene, &cam, img, a->threads, budget_s, &run);
+        double wall = run.wall_ms, cpu = run.cpu_ms;
+        long long spp = run.frames;
         rl_renderer_release(r);
         if (st != RL_OK)
             break;

@@ -41,7 +41,6 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <time.h>
 
 #include "rl/rl_pt.h"
 #include "rl/rl_timer.h"
@@ -125,14 +124,6 @@ static bool has_opt(const conv_config *c, const char *key, const char *value)
     return false;
 }
 
-
-static double cpu_ms_now(void)
-{
-    struct timespec ts;
-    if (clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts) != 0)
-        return 0.0;
-    return ts.tv_sec * 1e3 + ts.tv_nsec * 1e-6;
-}
 
 static float disp(float v)
 {
@@ -348,11 +339,11 @@ static rl_status run_config(const bench_pt_conv_args *a, const conv_config *cc, 
     for (long long next = 4; st == RL_OK && next <= max_spp && *num < MAX_CHECKPOINTS; next *= 2) {
         while (st == RL_OK && done < next) {
             rl_timer t;
-            double c0 = cpu_ms_now();
+            double c0 = bench_cpu_ms();
             rl_timer_start(&t);
             st = rl_renderer_render(r, scene, cam, img, &s);
             wall += rl_timer_ms(&t);
-            cpu += cpu_ms_now() - c0;
+            cpu += bench_cpu_ms() - c0;
             done += 4;
         }
         if (st != RL_OK)

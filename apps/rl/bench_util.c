@@ -178,3 +178,32 @@ int bench_run_sections(const char *bench, cJSON *root, const char *const *names,
         rc = cli_fail(RL_CLI_FAIL, "bench %s: section %s failed", bench, failed);
     return rc;
 }
+
+double bench_cpu_ms(void)
+{
+    struct timespec ts;
+    if (clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts) != 0)
+        return 0.0;
+    return (double)ts.tv_sec * 1e3 + (double)ts.tv_nsec * 1e-6;
+}
+
+rl_status bench_render_for_cpu(rl_renderer *r, const rl_scene *scene, const rl_camera *cam, rl_image *img,
+                               int threads, double budget_s, bench_budget_run *out)
+{
+    bench_budget_run run = { 0 };
+    rl_status st = RL_OK;
+    rl_timer timer;
+    if (threads < 1)
+        threads = 1;
+    do {
+        rl_render_stats s;
+        double c0 = bench_cpu_ms();
+        rl_timer_start(&timer);
+        st = rl_renderer_render(r, scene, cam, img, &s);
+        run.wall_ms += rl_timer_ms(&timer);
+        run.cpu_ms += bench_cpu_ms() - c0;
+        run.frames++;
+    } while (st == RL_OK && run.cpu_ms / 1e3 / threads < budget_s);
+    *out = run;
+    return st;
+}

@@ -29,6 +29,21 @@ struct cJSON *bench_rays_json(const rl_render_stats *s);
 /* {ssim, rmse, psnr, max_abs, pixels} */
 struct cJSON *bench_metrics_json(const rl_image_metrics *m);
 double bench_ratio(double a, double b);          /* NaN when b is 0 */
+/* The process's CPU time so far (all threads), in ms; 0 where unknown. */
+double bench_cpu_ms(void);
+
+/* What bench_render_for_cpu did. */
+typedef struct bench_budget_run {
+    long long frames;     /* renders made (each adds the renderer's spp) */
+    double wall_ms, cpu_ms;
+} bench_budget_run;
+/* Renders frames of r into img until the process's CPU time divided by
+ * threads reaches budget_s (at least one frame). r accumulates over frames
+ * of one camera (pt, bdpt). CPU time over threads is what a quiet
+ * machine's wall clock would show on a shared one, so equal budgets are
+ * equal time for renderers that keep their threads busy. */
+rl_status bench_render_for_cpu(rl_renderer *r, const rl_scene *scene, const rl_camera *cam, rl_image *img,
+                               int threads, double budget_s, bench_budget_run *out);
 
 /* A whole number in 1..max for option; prints the usage error. */
 bool bench_parse_count(const char *option, const char *text, long long max, long long *out);

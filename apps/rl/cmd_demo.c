@@ -8,6 +8,9 @@
  * SSIM) against the scene's reference: Whitted ray tracing at its defaults,
  * the default reference of `rl compare`.
  *
+ * Then pt and bdpt at equal time on two Cornell boxes (issue 37), when
+ * both renderers and the Cornell box are in the run.
+ *
  * Then a small `rl compare` (Jähn 2015's evaluation: every renderer at the
  * same adaptively sampled positions) of the first demo scene, or `table`
  * by default, into DIR/compare/, linked from the page.
@@ -16,6 +19,8 @@
  * error line, listed in the report, and the exit code becomes 1. */
 #define _POSIX_C_SOURCE 200809L
 #include "cli.h"
+
+#include "bench_util.h"
 
 #include <cjson/cJSON.h>
 #include <ctype.h>
@@ -41,6 +46,11 @@ static const char demo_help[] =
     "the renderers over a small sampled region of one scene (rl compare) into\n"
     "DIR/compare/report.html.\n"
     "\n"
+    "When pt, bdpt and cornell are all in the run, also draws pt and bdpt at\n"
+    "equal time on the Cornell box lit directly and lit through bounces only\n"
+    "(DIR/equal-time/): each accumulates samples until its CPU time per thread\n"
+    "reaches --equal-time. These images depend on the machine's speed.\n"
+    "\n"
     "The images, report.json and index.html replace the previous ones together\n"
     "at the end of the run: a run that is stopped, or fails to write an image,\n"
     "leaves the previous demo in DIR as it was.\n"
@@ -54,6 +64,8 @@ static const char demo_help[] =
     "                  scenes, named by their file stem\n"
     "  --algos a,b     only these renderers\n"
     "  --no-compare    skip the comparison\n"
+    "  --equal-time T  CPU time per thread of each equal-time image (500ms,\n"
+    "                  2s, ...); default 2s; 0 skips them\n"
     "\n"
     "example:\n"
     "  rl demo --out out/demo\n"
@@ -71,6 +83,7 @@ typedef struct demo_args {
     const char *out, *scenes, *algos;
     int width, height;
     bool no_compare;
+    double equal_time;    /* seconds of CPU per thread for pt and bdpt; 0: none */
     demo_scene *list;     /* the scenes to render, in order */
     size_t count;
     /* Every image, report.json and index.html of the run go through one
@@ -308,6 +321,10 @@ static int parse_args(int argc, char **argv, demo_args *a)
         else if (m == 0 && (m = cli_take_value(argc, argv, &i, "--size", &v)) > 0) {
             if (!cli_parse_size(v, &a->width, &a->height))
                 return RL_CLI_USAGE;
+        } else if (m == 0 && (m = cli_take_value(argc, argv, &i, "--equal-time", &v)) > 0) {
+            if (!cli_parse_duration(v, &a->equal_time) || a->equal_time > 3600.0)
+                return cli_fail(RL_CLI_USAGE, "--equal-time: expected a duration from 0 to 1h (2s, 500ms), got "
+                                              "'%s'", v);
         } else if (m == 0)
             return cli_unknown_arg("demo", argv[i]);
         if (m < 0)
@@ -693,6 +710,134 @@ static int run_demo(const demo_args *a, cJSON *report)
     return rc;
 }
 
+/* pt against bdpt at equal time (issue 37, "the demo page shows pt and
+ * bdpt at equal time"): the Cornell box lit directly (variant=bitterli)
+ * and lit only by bounces off a plate under the lamp (variant=shade).
+ * Each renderer first draws one frame under another seed (its BVH and
+ * light tables: preparation, not counted), then accumulates frames of one
+ * sample until its CPU time per thread reaches --equal-time, as `rl bench
+ * pt --only bdpt` does (bench_render_for_cpu). CPU time, not wall time:
+ * on a busy machine the two would otherwise get different shares. The
+ * images are square, at most 256 pixels a side, to keep the samples a
+ * few seconds buy visible. */
+static const char *const equal_time_variants[] = { "bitterli", "shade" };
+static const char *const equal_time_algos[] = { "pt", "bdpt" };
+
+static bool equal_time_wanted(const demo_args *a)
+{
+    if (a->equal_time <= 0.0)
+        return false;
+    for (size_t k = 0; k < 2; k++)
+        if (!in_list(a->algos, equal_time_algos[k]) || !available(equal_time_algos[k], false))
+            return false;
+    for (size_t s = 0; s < a->count; s++)
+        if (a->list[s].builtin && strcmp(a->list[s].name, "cornell") == 0)
+            return true;
+    return false;
+}
+
+static rl_status equal_time_one(const demo_args *a, const rl_scene *scene, const rl_camera *cam,
+                                const char *variant, const char *algo, cJSON *list)
+{
+    char file[256], path[4096 + 256], dir[4096 + 16];   /* a->out is shorter than 4096 (cli_demo) */
+    snprintf(file, sizeof file, "equal-time/cornell-%s-%s.png", variant, algo);
+    snprintf(path, sizeof path, "%s/%s", a->out, file);
+    snprintf(dir, sizeof dir, "%s/equal-time", a->out);
+    int threads = cli_threads();
+    rl_renderer *r = NULL;
+    rl_image *img = NULL;
+    rl_render_stats stats = { 0 };
+    bench_budget_run run = { 0 };
+    rl_status st = rl_renderer_create(algo, &r);
+    if (st == RL_OK) st = rl_renderer_set(r, "spp", "1");
+    if (st == RL_OK) st = rl_renderer_set(r, "seed", "9");
+    if (st == RL_OK) st = rl_image_create(cam->width, cam->height, RL_LAYER_COLOR, &img);
+    if (st == RL_OK) st = rl_renderer_render(r, scene, cam, img, &stats);
+    /* A new seed restarts the accumulation: the warm-up frame is not in it. */
+    if (st == RL_OK) st = rl_renderer_set(r, "seed", "1");
+    if (st == RL_OK) st = bench_render_for_cpu(r, scene, cam, img, threads, a->equal_time, &run);
+    const char *write_to = NULL;
+    if (st == RL_OK)
+        st = cli_make_dirs(dir) ? rl_output_batch_add(a->batch, path, &write_to) : RL_ERR_IO;
+    if (st == RL_OK && (st = rl_image_write(img, write_to)) != RL_OK)
+        note_unwritten(a, st, path);
+    if (st == RL_OK) {
+        double m[3] = { 0.0, 0.0, 0.0 }, n = (double)cam->width * cam->height;
+        for (size_t i = 0; i < (size_t)cam->width * cam->height; i++) {
+            m[0] += img->color[i].x / n;
+            m[1] += img->color[i].y / n;
+            m[2] += img->color[i].z / n;
+        }
+        double cpu_s = run.cpu_ms / 1e3 / threads;
+        printf("equal time: cornell:variant=%s %s, %lld spp in %.2f s CPU per thread (%.2f s wall)\n", variant,
+               algo, run.frames, cpu_s, run.wall_ms / 1e3);
+        fflush(stdout);
+        cJSON *e = cJSON_CreateObject();
+        if (e) {
+            cJSON_AddStringToObject(e, "scene", "cornell");
+            cJSON_AddStringToObject(e, "variant", variant);
+            cJSON_AddStringToObject(e, "algorithm", algo);
+            cJSON_AddStringToObject(e, "file", file);
+            cJSON_AddNumberToObject(e, "spp", (double)run.frames);
+            cJSON_AddNumberToObject(e, "cpu_s_per_thread", cpu_s);
+            cJSON_AddNumberToObject(e, "wall_ms", run.wall_ms);
+            cJSON_AddNumberToObject(e, "threads", threads);
+            cJSON *mean = cJSON_AddArrayToObject(e, "means");
+            for (int k = 0; k < 3 && mean; k++)
+                cJSON_AddItemToArray(mean, cJSON_CreateNumber(m[k]));
+            cJSON_AddItemToArray(list, e);
+        }
+    }
+    rl_image_release(img);
+    rl_renderer_release(r);
+    return st;
+}
+
+static int run_equal_time(const demo_args *a, cJSON *report)
+{
+    if (!equal_time_wanted(a))
+        return RL_CLI_OK;
+    cJSON *list = cJSON_AddArrayToObject(report, "equal_time");
+    cJSON *failures = cJSON_GetObjectItemCaseSensitive(report, "failures");
+    if (!list)
+        return cli_fail(RL_CLI_FAIL, "out of memory");
+    cJSON_AddNumberToObject(report, "equal_time_s", a->equal_time);
+    int side = a->width < a->height ? a->width : a->height;
+    if (side > 256)
+        side = 256;
+    int rc = RL_CLI_OK;
+    for (size_t v = 0; v < 2 && !*a->unwritten; v++) {
+        char params[64], name[96];
+        snprintf(params, sizeof params, "variant=%s", equal_time_variants[v]);
+        snprintf(name, sizeof name, "cornell:%s", params);
+        rl_scene *scene = NULL;
+        rl_camera cam;
+        rl_clear_error();
+        rl_status st = rl_scene_create_builtin("cornell", params, &scene);
+        if (st == RL_OK)
+            st = rl_scene_get_camera(scene, NULL, &cam);
+        cam.width = cam.height = side;
+        for (size_t k = 0; k < 2 && st == RL_OK && !*a->unwritten; k++) {
+            rl_clear_error();
+            if ((st = equal_time_one(a, scene, &cam, equal_time_variants[v], equal_time_algos[k], list)) != RL_OK) {
+                char what[160];
+                snprintf(what, sizeof what, "%s with %s at equal time", name, equal_time_algos[k]);
+                if (!*a->unwritten)
+                    cli_fail_status(RL_CLI_FAIL, st, what);
+                add_failure(failures, name, equal_time_algos[k]);
+                rc = RL_CLI_FAIL;
+            }
+        }
+        if (st != RL_OK && rc == RL_CLI_OK) {   /* the scene itself */
+            cli_fail_status(RL_CLI_FAIL, st, name);
+            add_failure(failures, name, NULL);
+            rc = RL_CLI_FAIL;
+        }
+        rl_scene_release(scene);
+    }
+    return rc;
+}
+
 /* The small comparison: every demo renderer at the same 24 positions of
  * one scene, tiny images, one timed render per direction. */
 static int run_compare(const demo_args *a)
@@ -718,7 +863,7 @@ static int run_compare(const demo_args *a)
 int cli_demo(int argc, char **argv)
 {
     char unwritten[RL_DEMO_UNWRITTEN] = "";
-    demo_args a = { .out = "out/demo", .width = 640, .height = 480, .unwritten = unwritten };
+    demo_args a = { .out = "out/demo", .width = 640, .height = 480, .equal_time = 2.0, .unwritten = unwritten };
     int rc = parse_args(argc, argv, &a);
     if (rc != RL_CLI_OK) {
         free_args(&a);
@@ -757,6 +902,8 @@ int cli_demo(int argc, char **argv)
     cJSON_AddStringToObject(report, "reference", demo_reference);
 
     rc = run_demo(&a, report);
+    if (!*unwritten && run_equal_time(&a, report) != RL_CLI_OK)
+        rc = RL_CLI_FAIL;
     if (!a.no_compare && !*unwritten) {
         int crc = run_compare(&a);
         if (crc == RL_CLI_OK)

@@ -214,6 +214,48 @@ bool cli_write_demo_html(const cJSON *report, const char *path)
         }
         fputs("</table>\n", f);
     }
+    /* pt and bdpt at equal time: one row per Cornell box, pt left. */
+    const cJSON *eq = cJSON_GetObjectItemCaseSensitive(report, "equal_time");
+    if (cJSON_GetArraySize(eq) > 0) {
+        fprintf(f, "<h2>pt and bdpt at equal time</h2>\n<p>The Cornell box lit directly (variant=bitterli) "
+                   "and lit only by light bounced off the plate under the lamp (variant=shade). Each renderer "
+                   "accumulated samples until its CPU time per thread reached %.2f s, after an uncounted first "
+                   "frame (its BVH and light tables). Where light arrives by bounces, bdpt's connections find "
+                   "it; where it arrives directly, pt's cheaper samples win. The samples reached, and so these "
+                   "images, depend on the machine. <code>rl bench pt --only bdpt</code> measures the error "
+                   "against a reference.</p>\n<table>\n<tr><th>scene</th><th>pt</th><th>bdpt</th></tr>\n",
+                num(report, "equal_time_s"));
+        const char *variants[8];
+        int nv = collect_names(eq, "variant", variants, 8);
+        for (int v = 0; v < nv; v++) {
+            fputs("<tr><th>cornell:variant=", f);
+            html_put_escaped(f, variants[v]);
+            fputs("</th>", f);
+            static const char *const algos_eq[2] = { "pt", "bdpt" };
+            for (int k = 0; k < 2; k++) {
+                const cJSON *hit = NULL;
+                cJSON_ArrayForEach(e, eq) {
+                    if (strcmp(str(e, "variant"), variants[v]) == 0 && strcmp(str(e, "algorithm"), algos_eq[k]) == 0)
+                        hit = e;
+                }
+                fputs("<td>", f);
+                if (hit) {
+                    fputs("<a href=\"", f);
+                    html_put_escaped(f, str(hit, "file"));
+                    fputs("\"><img src=\"", f);
+                    html_put_escaped(f, str(hit, "file"));
+                    fprintf(f, "\" alt=\"%s\"></a>%.0f spp in %.2f s CPU per thread (%.2f s wall, %.0f threads)",
+                            algos_eq[k], num(hit, "spp"), num(hit, "cpu_s_per_thread"), num(hit, "wall_ms") / 1e3,
+                            num(hit, "threads"));
+                } else {
+                    fputs("failed", f);
+                }
+                fputs("</td>", f);
+            }
+            fputs("</tr>\n", f);
+        }
+        fputs("</table>\n", f);
+    }
     if (*str(report, "compare")) {
         fputs("<p>The renderers compared over a sampled region of the scene (time, rays, "
               "triangles, image quality; Jähn 2015): <a href=\"", f);

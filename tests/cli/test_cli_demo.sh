@@ -9,7 +9,7 @@ set -u
 DIR="$TMP/demo/nested"   # does not exist yet: rl demo creates it
 SCENES="cornell,cornell-teapot,spheres"
 
-"$RL" demo --out "$DIR" --size 64x48 --scenes "$SCENES" >"$TMP/out" 2>"$TMP/err" ||
+"$RL" demo --out "$DIR" --size 64x48 --scenes "$SCENES" --equal-time 200ms >"$TMP/out" 2>"$TMP/err" ||
     fail "rl demo exited $?: $(head -c 400 "$TMP/err")"
 [ -s "$DIR/index.html" ] || fail "index.html missing"
 [ -s "$DIR/report.json" ] || fail "report.json missing"
@@ -27,6 +27,29 @@ for s in ${SCENES//,/ }; do
         n=$((n + 1))
     done
 done
+# Issue 37: pt and bdpt at equal time on the two Cornell boxes, apart from
+# the grid (their own lines, folder, JSON list and table on the page).
+eq=0
+for v in bitterli shade; do
+    for a in pt bdpt; do
+        f="$DIR/equal-time/cornell-$v-$a.png"
+        [ -s "$f" ] || fail "$f missing"
+        grep -q "src=\"equal-time/cornell-$v-$a.png\"" "$DIR/index.html" || fail "index.html does not show $f"
+        grep -q "^equal time: cornell:variant=$v $a, [0-9]* spp in " "$TMP/out" || fail "no equal-time line for $v $a"
+        eq=$((eq + 1))
+    done
+done
+grep -q "pt and bdpt at equal time" "$DIR/index.html" || fail "index.html lacks the equal-time section"
+python3 - "$DIR/report.json" <<'PY' || fail "report.json's equal_time is not as expected"
+import json, sys
+r = json.load(open(sys.argv[1]))
+eq = r["equal_time"]
+assert r["equal_time_s"] == 0.2 and len(eq) == 4, eq
+for e in eq:
+    # Every run reached the budget (CPU time per thread) with at least one sample.
+    assert e["spp"] >= 1 and e["cpu_s_per_thread"] >= 0.2 and e["threads"] >= 1, e
+    assert all(0 < m < 1 for m in e["means"]), e
+PY
 # One line per image (plus the closing "report:" line), no other PNGs.
 [ "$(grep -c ' ms, ' "$TMP/out")" -eq "$n" ] || fail "expected $n image lines: $(cat "$TMP/out")"
 [ "$(ls "$DIR"/*.png | wc -l)" -eq "$n" ] || fail "expected exactly $n PNGs in $DIR"
@@ -88,6 +111,12 @@ PY
 # and the report (4 KB) but not whitted's (67 KB): it fails and keeps the
 # first run whole, with no temporaries, where writing each file on its own
 # would have mixed the two runs.
+# The equal-time section needs pt, bdpt and cornell, and a sane budget.
+run_ok "$RL" demo --out "$TMP/demo-noeq" --size 32x24 --scenes cornell --algos raster,pt --no-compare
+[ ! -e "$TMP/demo-noeq/equal-time" ] || fail "equal-time images without bdpt"
+expect_error 2 "--equal-time: expected a duration" "$RL" demo --out "$TMP/demo-bad" --equal-time soon
+expect_error 2 "--equal-time: expected a duration" "$RL" demo --out "$TMP/demo-bad" --equal-time 2h
+
 KEEP="$TMP/demo-keep"
 run_ok "$RL" demo --out "$KEEP" --size 32x24 --scenes cornell --algos raster,whitted --no-compare
 cp -r "$KEEP" "$TMP/demo-good"
