@@ -74,6 +74,7 @@ static const char *const opts_no_rr[] = { "rr", "false", NULL };
 static const char *const opts_ls2[] = { "light_samples", "2", NULL };
 static const char *const opts_ls4[] = { "light_samples", "4", NULL };
 static const char *const opts_adaptive[] = { "adaptive", "on", NULL };
+static const char *const opts_quad_sa[] = { "quad_sampling", "solid_angle", NULL };
 static const char *const opts_atrous[] = { "filter", "atrous", "filter_fade", "0", NULL };
 static const char *const opts_adaptive_atrous[] = { "adaptive", "on", "filter", "atrous", "filter_fade", "0", NULL };
 
@@ -86,6 +87,7 @@ static const conv_config configs[] = {
     { "light_samples=2", opts_ls2, false },
     { "light_samples=4", opts_ls4, false },
     { "adaptive=on", opts_adaptive, true },
+    { "quad_sampling=solid_angle", opts_quad_sa, false },
     { "atrous (filter=atrous, filter_fade=0)", opts_atrous, false },
     { "adaptive+atrous (adaptive=on, filter=atrous, filter_fade=0)", opts_adaptive_atrous, false },
 };

@@ -42,6 +42,7 @@
  *   ls_scene_n = 4, ls_scene_segments = 64, ls_scene_cells = 16,
  *   ls_scene_inner = object, ls_object_res = 8 (outlook, not in the thesis)
  *   shadowmap_size = 1024 [1024], light_samples = 1, threads = 0 (all)
+ *   quad_sampling = area [area]: solid_angle (pathtrace_quad.c) is ours
  *
  * A frame (Sec. 5.1, Fig. 8): build what the backends need (once per
  * scene, pathtrace_backend.c); on a reset fill the G-buffer; then for each
@@ -139,6 +140,7 @@
 const char *const rl_pt_rng_choices[] = { "sobol", "lcg", "tausworthe", "hybrid", NULL };
 const char *const rl_pt_mis_choices[] = { "off", "on", NULL };
 static const char *const env_sampling_choices[] = { "importance", "uniform", "bsdf", NULL };
+static const char *const quad_sampling_choices[] = { "area", "solid_angle", NULL };
 /* Order = rl_pt_backend. */
 const char *const rl_pt_shadow_choices[] = { "bvh", "grid", "embree", "ls-candidates", "ls-preillum", "ls-pnmt",
                                               "shadowmap", "ls-scene", "ls-object", NULL };
@@ -217,6 +219,9 @@ static const rl_option_info pt_options[] = {
       1, RL_LS_OBJECT_MAX_RES, NULL },
     { "shadowmap_size", RL_OPT_INT, "1024", "texels per shadow-map face side (Sec. 8.6)", 16, 16384, NULL },
     { "light_samples", RL_OPT_INT, "1", "shadow rays per quad light and vertex", 1, 1024, NULL },
+    { "quad_sampling", RL_OPT_ENUM, "area",
+      "next-event points on a rectangular quad light with mis=on: area (uniform on the quad, Sec. 6.3) or "
+      "solid_angle (uniform in the solid angle it subtends; Urena et al. 2013)", 0, 0, quad_sampling_choices },
     { "background", RL_OPT_COLOR, "0,0,0",
       "radiance arriving from every direction where a ray leaves the scene (a uniform environment); a scene "
       "\"environment\" replaces it", 0, 0, NULL },
@@ -360,6 +365,7 @@ static void read_settings(const rl_renderer *r, pt_settings *set)
     set->ls_object_res = (int)rl_renderer_opt_int(r, "ls_object_res");
     set->shadowmap_size = (int)rl_renderer_opt_int(r, "shadowmap_size");
     set->light_samples = (int)rl_renderer_opt_int(r, "light_samples");
+    set->quad_solid_angle = rl_renderer_opt_enum(r, "quad_sampling") == 1;
     set->background = rl_renderer_opt_color(r, "background");
     set->env_sampling = (int)rl_renderer_opt_enum(r, "env_sampling");
     set->ggx_ms = rl_renderer_opt_bool(r, "ggx_ms");
@@ -1174,6 +1180,7 @@ static rl_status pt_render(rl_renderer *r, void *state, const rl_scene *scene, c
                  .max_depth = set.max_depth >= 0 ? set.max_depth : rl_pt_scene_max_depth(scene),
                  .rr_depth = set.rr_depth, .light_samples = set.light_samples, .rr = set.rr,
                  .mis = set.mis, .mis_hits = set.mis && exact_backend(set.diffuse),
+                 .quad_solid_angle = set.mis && set.quad_solid_angle,
                  .tri_lights = set.mis && exact_backend(set.diffuse) && set.shadow != RL_PT_BACKEND_SHADOWMAP,
                  .vertex_slots = PT_SLOTS_VERTEX + PT_SLOTS_LIGHT * (uint32_t)set.light_samples *
                                                    (set.mis ? 1u : (d->num_lights ? d->num_lights : 1u)),

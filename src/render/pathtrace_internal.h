@@ -44,6 +44,7 @@ typedef struct pt_settings {
     bool rr, checkerboard, accumulate, ls_dynamic;
     bool ls_origin_exact;          /* ls_origin=exact, else the voxel offset */
     bool mis;                      /* mis=on: lights by power, MIS with the BSDF */
+    bool quad_solid_angle;         /* quad_sampling=solid_angle (pathtrace_quad.c) */
     bool sobol;                    /* rng=sobol, else the GPU generator rng */
     rl_rng_gpu_kind rng;
     uint64_t seed;
@@ -193,6 +194,23 @@ float rl_pt_triangle_area(const rl_scene_data *d, uint32_t t, rl_vec3 *normal);
 /* The quad light whose parallelogram contains p (within tol of its plane
  * and of its edges), or RL_NONE: the emission rule of pathtrace_path.c. */
 uint32_t rl_pt_cover_point(const rl_scene_data *d, rl_vec3 p, float tol);
+/* A rectangular quad light seen from a point, for sampling by solid angle
+ * (pathtrace_quad.c, Ureña et al. 2013): the rectangle's frame (x, y along
+ * its edges, z its front normal), the point o, the rectangle's extent in
+ * that frame and the constants of the paper's eq. 9-12; S is the solid
+ * angle, the sample density 1 / S. */
+typedef struct pt_sph_rect {
+    double o[3], x[3], y[3], z[3];
+    double x0, x1, y0, y1, z0;
+    double b0, b1, k, S;
+} pt_sph_rect;
+/* Sets r up for quad light L seen from p. False, and the quad is to be
+ * sampled by area, when L is not a rectangle, p is behind or in its
+ * emitting plane, or the solid angle is below 1e-7 sr. */
+bool rl_pt_sph_rect_init(pt_sph_rect *r, const rl_light *L, rl_vec3 p);
+/* The point on the rectangle for (u, v) in [0,1)^2; density 1 / r->S in
+ * solid angle at r->o. */
+rl_vec3 rl_pt_sph_rect_sample(const pt_sph_rect *r, float u, float v);
 /* Whether backend can be used in this build (Embree is optional) for shadow
  * tests (shadow = true: all) or secondary rays (not shadow maps). */
 bool rl_pt_backend_available(rl_pt_backend backend, bool shadow);
@@ -218,6 +236,7 @@ typedef struct pt_ctx {
     bool mis;                      /* lights by power, MIS weights (pathtrace_path.c) */
     bool mis_hits;                 /* with mis: BSDF rays find emitters exactly (an exact
                                     * diffuse backend), so both strategies are weighted */
+    bool quad_solid_angle;         /* with mis: rectangular quads sampled by solid angle */
     bool tri_lights;               /* with mis_hits: emissive triangles are sampled too
                                     * (not with shadow maps, which know scene lights only) */
     uint32_t vertex_slots;         /* sampler slots per path vertex */

@@ -333,7 +333,7 @@ static rl_vec3 direct_light_mis(const pt_ctx *ctx, const pt_surface *s, pt_sampl
         rl_vec2 j = jitter ? rl_pt_sample_2d(sp) : rl_v2(0.0f, 0.0f);
         uint32_t src = lt->source[rl_pt_lights_pick(lt, u_pick)];
         rl_vec3 q, n_e, le;
-        float area, pmf;
+        float area, pmf, p_sa = 0.0f;   /* p_sa: the density in solid angle where sampled so */
         bool hittable;
         if (src < d->num_lights) {
             const rl_light *L = &d->lights[src];
@@ -352,7 +352,13 @@ static rl_vec3 direct_light_mis(const pt_ctx *ctx, const pt_surface *s, pt_sampl
             n_e = rl_cross(L->edge_u, L->edge_v);
             area = rl_length(n_e);
             n_e = rl_scale(n_e, 1.0f / area);
-            q = rl_add(L->position, rl_add(rl_scale(L->edge_u, x.x), rl_scale(L->edge_v, x.y)));
+            pt_sph_rect rect;
+            if (ctx->quad_solid_angle && rl_pt_sph_rect_init(&rect, L, s->p)) {
+                q = rl_pt_sph_rect_sample(&rect, x.x, x.y);
+                p_sa = pmf / (float)rect.S;
+            } else {
+                q = rl_add(L->position, rl_add(rl_scale(L->edge_u, x.x), rl_scale(L->edge_v, x.y)));
+            }
             le = rl_scale(L->color, L->intensity);
             hittable = ctx->mis_hits && lt->light_hittable[src];
         } else {
@@ -380,7 +386,7 @@ static rl_vec3 direct_light_mis(const pt_ctx *ctx, const pt_surface *s, pt_sampl
         float cos_r = rl_dot(s->ns, l);
         if (cos_e <= 0.0f || cos_r <= 0.0f || !visible(ctx, s, l, dist, src < d->num_lights ? src : 0, j.x, j.y, c))
             continue;
-        float p_light = pmf * d2 / (area * cos_e);          /* solid angle at s */
+        float p_light = p_sa > 0.0f ? p_sa : pmf * d2 / (area * cos_e);   /* solid angle at s */
         float w = bsdf_follows && hittable ? power_heuristic((float)n * p_light, bsdf_pdf(s, l)) : 1.0f;
         rl_vec3 f = rl_pt_bsdf_eval(s, l);
         sum = rl_add(sum, rl_mul(f, rl_scale(le, w * cos_r / (p_light * (float)n))));
@@ -469,6 +475,11 @@ static rl_vec3 emitted_mis(const pt_ctx *ctx, const pt_surface *s, bool after_br
         e = rl_scale(L->color, L->intensity);
         pmf = lt->light_pmf[cover];
         area = rl_length(nq);
+        /* The density light sampling had at prev: by solid angle where
+         * pathtrace_quad.c samples this quad from there. */
+        pt_sph_rect rect;
+        if (ctx->quad_solid_angle && pmf > 0.0f && rl_pt_sph_rect_init(&rect, L, prev))
+            return rl_scale(e, power_heuristic(pdf_bsdf, (float)ctx->light_samples * pmf / (float)rect.S));
     }
     float cos_e = rl_dot(s->ng, s->v);     /* ng faces v */
     float d2 = rl_length2(rl_sub(s->p, prev));

@@ -21,6 +21,7 @@
 #include "rl/rl_pt.h"
 #include "rl/rl_render.h"
 #include "rl/rl_scene.h"
+#include "render/pathtrace_internal.h"
 #include "render/render_fixtures.h"
 
 static float disp(float v)
@@ -90,14 +91,15 @@ static double floor_radiance(double kd, double L, double w, double h, double px,
     return kd * L * F;
 }
 
-static void check_quad_light_on_plane(const char *mis, bool mesh)
+static void check_quad_light_on_plane(const char *mis, bool mesh, const char *quad_sampling)
 {
     const float kd = 0.6f, L = 3.0f, w = 0.5f, h = 1.0f;
     rl_scene *s = quad_over_floor(kd, L, w, h, mesh);
     /* Looking down at the floor past the lamp's edge. */
     rl_camera cam = { .eye = rl_v3(0.0f, 0.9f, 2.2f), .target = rl_v3(0.0f, 0.0f, 0.3f), .fov_deg = 60.0f,
                       .width = 16, .height = 16 };
-    rl_renderer *r = fx_make("pt", (const char *const[]){ "spp", "256", "primary", "raster", "mis", mis, NULL });
+    rl_renderer *r = fx_make("pt", (const char *const[]){ "spp", "256", "primary", "raster", "mis", mis,
+                                                          "quad_sampling", quad_sampling, NULL });
     rl_image *img = fx_render_with(r, s, &cam, RL_LAYER_COLOR, NULL);
     const rl_gbuffer *g = rl_pt_gbuffer(r);
     double sum = 0.0, sum_ref = 0.0;
@@ -126,11 +128,81 @@ static void test_quad_light_on_a_plane_matches_the_closed_form(void **state)
      * shadow rays leaving it at a grazing angle to the lamp's plane ended
      * beyond the lamp's own mesh. */
     /* A hittable lamp: light samples and BSDF hits share it by MIS. */
-    check_quad_light_on_plane("on", true);
+    check_quad_light_on_plane("on", true, "area");
     /* The thesis' next-event estimation alone. */
-    check_quad_light_on_plane("off", true);
+    check_quad_light_on_plane("off", true, "area");
     /* A quad light no ray can hit: light samples keep the full weight. */
-    check_quad_light_on_plane("on", false);
+    check_quad_light_on_plane("on", false, "area");
+    /* The same two with points drawn by solid angle (pathtrace_quad.c):
+     * light samples and the BSDF hits' MIS weights use its density. */
+    check_quad_light_on_plane("on", true, "solid_angle");
+    check_quad_light_on_plane("on", false, "solid_angle");
+}
+
+/* Solid angle of the rectangle [0,x] x [0,z] at height h over a point
+ * below its corner, signed as corner_factor: atan(x z / (h sqrt(x^2 + z^2 + h^2))). */
+static double corner_solid_angle(double x, double z, double h)
+{
+    double f = atan(fabs(x) * fabs(z) / (h * sqrt(x * x + z * z + h * h)));
+    return (x < 0.0) != (z < 0.0) ? -f : f;
+}
+
+/* pathtrace_quad.c: every sample lies on the rectangle, S is the solid
+ * angle in closed form, and the estimator S f of the cosine towards a
+ * parallel plane's normal, f = max(0, n . l), gives pi F (Howell's form
+ * factor, as above). Points behind the light, in its plane, tiny solid
+ * angles and parallelograms that are not rectangles are refused (sampled
+ * by area instead). Area sampling would need far more samples at the point
+ * 3 cm under the light: that is what the solid angle is for. */
+static void test_solid_angle_samples_of_a_rectangle(void **state)
+{
+    (void)state;
+    const double lx0 = -0.3, lx1 = 0.5, lz0 = -0.2, lz1 = 0.3, ly = 1.0;
+    rl_light L = { .type = RL_LIGHT_QUAD, .color = rl_v3s(1.0f), .intensity = 1.0f,
+                   .position = rl_v3((float)lx0, (float)ly, (float)lz0),
+                   .edge_u = rl_v3((float)(lx1 - lx0), 0.0f, 0.0f),
+                   .edge_v = rl_v3(0.0f, 0.0f, (float)(lz1 - lz0)) };   /* emits towards -y */
+    rl_vec3 nq = rl_normalize(rl_cross(L.edge_u, L.edge_v)), up = rl_v3(0.0f, 1.0f, 0.0f);
+    const rl_vec3 points[] = { { 0.0f, 0.0f, 0.0f }, { 2.5f, 0.2f, -1.0f }, { 0.1f, 0.97f, 0.05f },
+                               { -3.0f, -4.0f, 6.0f }, { 0.49f, 0.9f, 0.29f } };
+    for (size_t i = 0; i < sizeof points / sizeof points[0]; ++i) {
+        const rl_vec3 p = points[i];
+        double h = ly - p.y, x0 = lx0 - p.x, x1 = lx1 - p.x, z0 = lz0 - p.z, z1 = lz1 - p.z;
+        double omega = corner_solid_angle(x1, z1, h) - corner_solid_angle(x0, z1, h) -
+                       corner_solid_angle(x1, z0, h) + corner_solid_angle(x0, z0, h);
+        double cos_int = RL_PI * (corner_factor(x1, z1, h) - corner_factor(x0, z1, h) - corner_factor(x1, z0, h) +
+                                  corner_factor(x0, z0, h));
+        pt_sph_rect r;
+        assert_true(rl_pt_sph_rect_init(&r, &L, p));
+        rl_rng g;
+        rl_rng_seed(&g, 5, i);
+        const int n = 100000;
+        double est = 0.0;
+        for (int k = 0; k < n; ++k) {
+            rl_vec3 q = rl_pt_sph_rect_sample(&r, rl_rng_float(&g), rl_rng_float(&g));
+            rl_vec3 rel = rl_sub(q, L.position);
+            /* On the rectangle: in its plane and inside its edges. */
+            assert_float_equal(rl_dot(rel, nq), 0.0, 1e-5);
+            float s = rl_dot(rel, L.edge_u) / rl_length2(L.edge_u), t = rl_dot(rel, L.edge_v) / rl_length2(L.edge_v);
+            assert_true(s >= -1e-5f && s <= 1.0f + 1e-5f && t >= -1e-5f && t <= 1.0f + 1e-5f);
+            est += fmax(0.0, rl_dot(up, rl_normalize(rl_sub(q, p)))) * r.S;
+        }
+        est /= n;
+        print_message("point %zu: S %.6f (closed form %.6f), cosine integral %.6f (closed form %.6f)\n", i, r.S,
+                      omega, est, cos_int);
+        assert_float_equal(r.S, omega, 1e-4 * omega);   /* the inputs are floats */
+        assert_float_equal(est, cos_int, 0.01 * cos_int);
+    }
+    pt_sph_rect r;
+    assert_false(rl_pt_sph_rect_init(&r, &L, rl_v3(0.0f, 2.0f, 0.0f)));    /* behind: it emits down */
+    assert_false(rl_pt_sph_rect_init(&r, &L, rl_v3(5.0f, 1.0f, 0.0f)));    /* in its plane */
+    rl_light skew = L;
+    skew.edge_v = rl_v3(0.2f, 0.0f, 0.5f);
+    assert_false(rl_pt_sph_rect_init(&r, &skew, rl_v3(0.0f, 0.0f, 0.0f))); /* not a rectangle */
+    rl_light tiny = L;
+    tiny.edge_u = rl_v3(1e-4f, 0.0f, 0.0f);
+    tiny.edge_v = rl_v3(0.0f, 0.0f, 1e-4f);
+    assert_false(rl_pt_sph_rect_init(&r, &tiny, rl_v3(0.0f, -9.0f, 0.0f)));  /* 1e-10 sr: by area */
 }
 
 /* The Bitterli Cornell box at size x size. */
@@ -408,6 +480,7 @@ int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_quad_light_on_a_plane_matches_the_closed_form),
+        cmocka_unit_test(test_solid_angle_samples_of_a_rectangle),
         cmocka_unit_test(test_emissive_triangles_are_sampled_as_lights),
         cmocka_unit_test(test_mis_on_and_off_converge_to_the_same_image),
         cmocka_unit_test(test_upper_back_wall_and_ceiling_corner_agree_with_an_independent_estimator),
