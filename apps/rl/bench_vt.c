@@ -669,8 +669,8 @@ static rl_status sec_resolution(void *ctx, cJSON *sec)
     int num_sizes = b->a->quick ? 2 : 3;
     cJSON_AddStringToObject(sec, "scene", table_spec(b));
     cJSON *rows = cJSON_AddArrayToObject(sec, "runs");
-    printf("\nresolution (Fig. 5.10-5.12): table, default criteria; %% of Whitted's rays and "
-           "of the pixels\n");
+    printf("\nresolution (Fig. 5.10-5.12): %s, default criteria; %% of Whitted's rays and "
+           "of the pixels\n", table_spec(b));
     printf("%-9s %10s %10s %6s %9s %6s %6s  %6s %7s %9s %9s %6s %10s\n", "size", "VT rays",
            "Whitted", "rays%", "samples", "smpl%", "growth", "ssimVT", "rmseVT", "VT ms",
            "Whitted ms", "VT/W", "preview ms");
