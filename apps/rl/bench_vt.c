@@ -118,8 +118,14 @@ static const char bench_vt_help[] =
     "              Whitted times, preview time, rays, samples, SSIM on the glass\n"
     "\n"
     "options:\n"
-    "  --scene SPEC      scene of the static sections; default table (the thesis-like\n"
-    "                    table; e.g. table:cloth_kr=0.2,fill=0.15 for the mirror variant)\n"
+    "  --scene SPEC      scene of the static sections; default table (its variant\n"
+    "                    mirror: fill light, mirroring tablecloth); table:variant=thesis\n"
+    "                    is Sec. 5.1's set-up, table:variant=cup its blue cup as the\n"
+    "                    only VT object (Figs. 5.5/5.6)\n"
+    "  --set KEY=VALUE   vt option every renderer starts from (repeatable, up to 16);\n"
+    "                    tracer keys such as max_depth go to Whitted too; sections\n"
+    "                    still set what they vary. The thesis' counts of Figs. 5.5/5.6:\n"
+    "                    --scene table:variant=cup --set min_edge=2 --set max_depth=4\n"
     "  --size WxH        static sections (not resolution); default 1024x1024\n"
     "  --anim-size WxH   animation frames; default 640x480\n"
     "  --frames N        animation frames along the path; default 60\n"
@@ -174,6 +180,22 @@ static const struct {
     { "tree+hsv", 28037 },
 };
 
+/* --set KEY=VALUE (issue 36): vt options every renderer of the run starts
+ * from, after the bench's own settings; a section still sets what it
+ * varies (criteria, min_edge, ...). A key Whitted has too (the tracer's:
+ * max_depth, area_samples, shadows, ...) goes to Whitted as well, so that
+ * both renderers keep the same tracer. */
+#define MAX_SETS 16
+typedef struct bvt_sets {
+    int count;
+    char key[MAX_SETS][64];
+    const char *value[MAX_SETS];   /* points into argv */
+    const char *text[MAX_SETS];    /* the whole KEY=VALUE, for the record */
+} bvt_sets;
+
+/* The run's --set list; make_renderer reads it (one bench per process). */
+static const bvt_sets *run_sets;
+
 typedef struct bvt_args {
     int width, height, anim_width, anim_height;
     long long frames, threads;     /* threads 0 = all */
@@ -182,6 +204,7 @@ typedef struct bvt_args {
     const char *out;
     const char *scene;             /* static sections; NULL: "table" */
     const char *images;            /* folder for the figures' images; NULL: none */
+    bvt_sets sets;                 /* --set */
 } bvt_args;
 
 /* A Whitted frame, the reference of every comparison at its size. */
@@ -366,6 +389,16 @@ static uint64_t fill_mask(const rl_image *ref, const uint8_t *object_vt, uint32_
 
 /* --------------------------------------------------------- rendering -- */
 
+static bool has_option(const rl_renderer *r, const char *key)
+{
+    size_t count = 0;
+    const rl_option_info *opts = rl_renderer_options(r, &count);
+    for (size_t i = 0; i < count; i++)
+        if (strcmp(opts[i].key, key) == 0)
+            return true;
+    return false;
+}
+
 static rl_status make_renderer(const char *name, int threads, rl_renderer **out)
 {
     rl_renderer *r = NULL;
@@ -378,6 +411,10 @@ static rl_status make_renderer(const char *name, int threads, rl_renderer **out)
         st = rl_renderer_set(r, keys[i], values[i]);
     if (st == RL_OK && strcmp(name, "vt") == 0)
         st = rl_renderer_set(r, "coherence", "false");
+    bool vt = strcmp(name, "vt") == 0;
+    for (int i = 0; st == RL_OK && run_sets && i < run_sets->count; i++)
+        if (vt || has_option(r, run_sets->key[i]))
+            st = rl_renderer_set(r, run_sets->key[i], run_sets->value[i]);
     if (st != RL_OK) {
         rl_renderer_release(r);
         r = NULL;
@@ -632,8 +669,8 @@ static rl_status sec_resolution(void *ctx, cJSON *sec)
     int num_sizes = b->a->quick ? 2 : 3;
     cJSON_AddStringToObject(sec, "scene", table_spec(b));
     cJSON *rows = cJSON_AddArrayToObject(sec, "runs");
-    printf("\nresolution (Fig. 5.10-5.12): table, default criteria; %% of Whitted's rays and "
-           "of the pixels\n");
+    printf("\nresolution (Fig. 5.10-5.12): %s, default criteria; %% of Whitted's rays and "
+           "of the pixels\n", table_spec(b));
     printf("%-9s %10s %10s %6s %9s %6s %6s  %6s %7s %9s %9s %6s %10s\n", "size", "VT rays",
            "Whitted", "rays%", "samples", "smpl%", "growth", "ssimVT", "rmseVT", "VT ms",
            "Whitted ms", "VT/W", "preview ms");
@@ -2637,6 +2674,40 @@ static rl_status sec_animation(void *ctx, cJSON *sec)
 
 /* ------------------------------------------------------- the command -- */
 
+/* --set KEY=VALUE: checked on a vt renderer at once, so that a typo fails
+ * before minutes of rendering. */
+static bool take_set(void *ctx, const char *v)
+{
+    bvt_sets *sets = ctx;
+    const char *eq = strchr(v, '=');
+    size_t n = eq ? (size_t)(eq - v) : 0;
+    if (!eq || n == 0 || n >= sizeof sets->key[0]) {
+        cli_fail(RL_CLI_USAGE, "--set: expected KEY=VALUE (a vt option, see rl algos), got '%s'", v);
+        return false;
+    }
+    if (sets->count >= MAX_SETS) {
+        cli_fail(RL_CLI_USAGE, "--set: at most %d options", MAX_SETS);
+        return false;
+    }
+    int i = sets->count;
+    memcpy(sets->key[i], v, n);
+    sets->key[i][n] = '\0';
+    rl_renderer *r = NULL;
+    rl_clear_error();
+    rl_status st = rl_renderer_create("vt", &r);
+    if (st == RL_OK)
+        st = rl_renderer_set(r, sets->key[i], eq + 1);
+    rl_renderer_release(r);
+    if (st != RL_OK) {
+        cli_fail(RL_CLI_USAGE, "--set %s: %s", v, rl_last_error());
+        return false;
+    }
+    sets->value[i] = eq + 1;
+    sets->text[i] = v;
+    sets->count++;
+    return true;
+}
+
 /* Returns RL_CLI_OK, an exit code, or RL_BENCH_HELP_SHOWN. */
 static int parse_args(int argc, char **argv, bvt_args *a)
 {
@@ -2651,6 +2722,7 @@ static int parse_args(int argc, char **argv, bvt_args *a)
         RL_BENCH_OUT(&a->out),
         RL_BENCH_STRING("--scene", &a->scene),
         RL_BENCH_STRING("--images", &a->images),
+        RL_BENCH_CUSTOM("--set", take_set, &a->sets, NULL),
     };
     int rc = bench_parse_args(argc, argv, "bench vt", bench_vt_help, rows,
                                  (int)(sizeof rows / sizeof rows[0]));
@@ -2732,10 +2804,18 @@ static cJSON *params_json(const bvt *b)
             cJSON_AddItemToArray(only, cJSON_CreateString(section_names[k]));
     cJSON_AddNumberToObject(o, "warmup_renders", 1);
     cJSON_AddNumberToObject(o, "timed_renders", b->runs);
+    /* The tracer as Whitted has it, --set included. */
     cJSON *tracer = cJSON_AddObjectToObject(o, "tracer");
-    cJSON_AddNumberToObject(tracer, "max_depth", atoi(TRACE_MAX_DEPTH));
-    cJSON_AddNumberToObject(tracer, "area_samples", atoi(TRACE_AREA_SAMPLES));
-    cJSON_AddBoolToObject(tracer, "shadows", strcmp(TRACE_SHADOWS, "true") == 0);
+    rl_renderer *w = NULL;
+    if (make_renderer("whitted", b->threads, &w) == RL_OK) {
+        cJSON_AddNumberToObject(tracer, "max_depth", atoi(rl_renderer_get(w, "max_depth")));
+        cJSON_AddNumberToObject(tracer, "area_samples", atoi(rl_renderer_get(w, "area_samples")));
+        cJSON_AddBoolToObject(tracer, "shadows", strcmp(rl_renderer_get(w, "shadows"), "true") == 0);
+    }
+    rl_renderer_release(w);
+    cJSON *set = cJSON_AddArrayToObject(o, "set");
+    for (int i = 0; set && i < a->sets.count; i++)
+        cJSON_AddItemToArray(set, cJSON_CreateString(a->sets.text[i]));
     cJSON_AddItemToObject(o, "vt_options", vt_options_json(b->threads));
     cJSON_AddStringToObject(o, "timing",
                             "wall time of rl_renderer_render; per configuration one warm-up "
@@ -2828,7 +2908,10 @@ static int run(bvt *b)
                                                      sec_deferred, sec_animation, sec_reconstruct,
                                                      sec_correctness, sec_hint, sec_scenario };
     printf("rl bench vt: Vertex Tracing vs Whitted, %d threads, max_depth %s, area_samples %s, "
-           "shadows %s\n", b->threads, TRACE_MAX_DEPTH, TRACE_AREA_SAMPLES, TRACE_SHADOWS);
+           "shadows %s", b->threads, TRACE_MAX_DEPTH, TRACE_AREA_SAMPLES, TRACE_SHADOWS);
+    for (int i = 0; i < a->sets.count; i++)
+        printf("%s --set %s", i ? "" : ", then", a->sets.text[i]);
+    printf("\n");
     rc = bench_run_sections("vt", root, section_names, fns, SEC_COUNT, a->sections, b,
                                b->reason, b->threads, out);
     cJSON_Delete(root);
@@ -2845,6 +2928,7 @@ int bench_vt(int argc, char **argv)
     bvt b;
     memset(&b, 0, sizeof b);
     b.a = &a;
+    run_sets = &a.sets;
     b.threads = a.threads ? (int)a.threads : omp_get_max_threads();
     b.threads = b.threads < RL_VT_MAX_THREADS ? b.threads : RL_VT_MAX_THREADS;
     b.max_threads = a.threads ? (int)a.threads : omp_get_num_procs();
@@ -2861,5 +2945,6 @@ int bench_vt(int argc, char **argv)
     rl_scene_release(b.cluster);
     free(b.table_vt);
     free(b.cluster_vt);
+    run_sets = NULL;
     return rc;
 }

@@ -18,6 +18,9 @@ expect_usage_error "$RL" bench vt --only "" --out "$TMP/x.json"
 expect_usage_error "$RL" bench vt --quick --out "$TMP/x.txt"
 expect_usage_error "$RL" bench vt --frobnicate
 expect_usage_error "$RL" bench vt --size
+expect_usage_error "$RL" bench vt --set nosuch=1 --out "$TMP/x.json"
+expect_usage_error "$RL" bench vt --set min_edge --out "$TMP/x.json"
+expect_usage_error "$RL" bench vt --set min_edge=-3 --out "$TMP/x.json"
 [ -e "$TMP/x.json" ] && fail "a failed run wrote x.json"
 
 # Output folder that does not exist: exit 1, checked before the run.
@@ -26,7 +29,7 @@ expect_in "$TMP/err" "rl: error: "
 
 # Help, and the bench dispatcher knows vt.
 expect_exit 0 "$RL" bench vt --help
-for o in --size --anim-size --frames --threads --only --out --images --quick criteria modes forced preview \
+for o in --size --anim-size --frames --threads --only --out --images --set --quick criteria modes forced preview \
     reduction overdraw equalrays deferred animation correctness hint scenario; do
     expect_in "$TMP/out" "$o"
 done
@@ -258,6 +261,28 @@ assert a["identical"] is True and all(x["identical"] for x in a["per_frame"])
 for k in ("vt_coherent_ms", "vt_plain_ms", "whitted_ms"):
     s = a["summary"][k]
     assert 0 < s["min"] <= s["mean"] <= s["max"], (k, s)
+PY
+
+# --set (issue 36): the thesis' counts of Figs. 5.5/5.6 are measured on
+# table:variant=cup with min_edge 2 and max_depth 4; the options reach vt
+# (and the tracer's max_depth Whitted too) and are recorded.
+expect_exit 0 "$RL" bench vt --quick --only criteria --size 96x96 --scene table:variant=cup \
+    --set min_edge=2 --set max_depth=4 -q --out "$TMP/set.json"
+expect_exit 0 "$RL" bench vt --quick --only criteria --size 96x96 --scene table:variant=cup -q --out "$TMP/noset.json"
+python3 - "$TMP/set.json" "$TMP/noset.json" <<'PY' || fail "set.json is wrong"
+import json, sys
+r, n = (json.load(open(f)) for f in sys.argv[1:3])
+p = r["parameters"]
+assert p["set"] == ["min_edge=2", "max_depth=4"] and n["parameters"]["set"] == [], p["set"]
+assert p["tracer"]["max_depth"] == 4 and n["parameters"]["tracer"]["max_depth"] == 5, p["tracer"]
+assert p["vt_options"]["min_edge"] == "2" and p["vt_options"]["max_depth"] == "4"
+rows = {x["criteria"]: x for x in r["criteria"]["runs"]}
+base = {x["criteria"]: x for x in n["criteria"]["runs"]}
+assert list(rows) == ["rgb", "hsv", "tree", "tree+rgb", "tree+hsv"]
+for c in rows:
+    assert rows[c]["vt_stats"]["vt_objects"] == 1, rows[c]["vt_stats"]
+    # A longer minimal edge refines less.
+    assert 0 < rows[c]["vertices_generated"] < base[c]["vertices_generated"], (c, rows[c], base[c])
 PY
 
 # The full run leaves out the Sec. 6.1 study, which --only asks for.

@@ -436,6 +436,74 @@ static void converges_to_whitted(void **state)
     rl_scene_release(s);
 }
 
+/* Issue 36: table:variant=cup, the set-up that reproduces the vertex counts
+ * of Ullmann 2003, Figs. 5.5/5.6 (docs/vertex-tracing.md): only the blue
+ * cup is vertex traced, so every refined vertex lies on the cup and there
+ * are fewer than with the three VT objects of variant=thesis; and the
+ * thesis' minimal edge length 1 (edges no shorter than a pixel) is our
+ * min_edge 2, which refines much less than min_edge 1. */
+static void table_cup_variant_counts(void **state)
+{
+    (void)state;
+    rl_scene *cup = NULL, *thesis = NULL;
+    assert_int_equal(rl_scene_create_builtin("table", "variant=cup", &cup), RL_OK);
+    assert_int_equal(rl_scene_create_builtin("table", "variant=thesis", &thesis), RL_OK);
+    rl_camera cam;
+    assert_int_equal(rl_scene_get_camera(cup, NULL, &cam), RL_OK);
+    cam.width = cam.height = 192;
+    const char *const opts[] = { "criteria", "tree+rgb", "min_edge", "2", "max_depth", "4", "coherence", "false", NULL };
+    const char *const fine[] = { "criteria", "tree+rgb", "min_edge", "1", "max_depth", "4", "coherence", "false", NULL };
+
+    rl_renderer *r = make_vt(opts);
+    rl_image *img = NULL;
+    rl_vt_stats c = render_stats(r, cup, &cam, &img);
+    assert_int_equal(c.vt_objects, 1);
+    assert_true(c.vertices_generated > 100);
+    /* The cup's pixels in the ID layer (the renderer writes every object). */
+    const rl_scene_data *d = rl_scene_get_data(cup);
+    uint32_t cup_id = RL_ID_NONE;
+    for (uint32_t o = 0; o < d->num_objects; ++o)
+        if (strcmp(d->objects[o].name, "cup_blue") == 0)
+            cup_id = o;
+    assert_int_not_equal(cup_id, RL_ID_NONE);
+    int x0 = img->width, y0 = img->height, x1 = -1, y1 = -1;
+    for (int y = 0; y < img->height; ++y)
+        for (int x = 0; x < img->width; ++x)
+            if (img->object_id[(size_t)y * (size_t)img->width + (size_t)x] == cup_id) {
+                x0 = x < x0 ? x : x0;
+                x1 = x > x1 ? x : x1;
+                y0 = y < y0 ? y : y0;
+                y1 = y > y1 ? y : y1;
+            }
+    assert_true(x1 >= x0 && y1 >= y0);
+    const rl_vt_vertex_info *v = NULL;
+    const uint32_t *faces = NULL;
+    size_t nv = 0, nf = 0;
+    assert_int_equal(rl_vt_get_mesh(r, &v, &nv, &faces, &nf), RL_OK);
+    size_t refined = 0;
+    for (size_t i = 0; i < nv; ++i) {
+        if (v[i].stage == 0)
+            continue;
+        ++refined;
+        assert_true(v[i].x >= (float)x0 - 2.0f && v[i].x <= (float)x1 + 3.0f);
+        assert_true(v[i].y >= (float)y0 - 2.0f && v[i].y <= (float)y1 + 3.0f);
+    }
+    assert_int_equal(refined, c.vertices_generated);
+    rl_image_release(img);
+
+    rl_vt_stats t = render_stats(r, thesis, &cam, NULL);
+    assert_int_equal(t.vt_objects, 3);
+    assert_true(t.vertices_generated > 2 * c.vertices_generated);
+    rl_renderer_release(r);
+
+    r = make_vt(fine);
+    rl_vt_stats f = render_stats(r, cup, &cam, NULL);
+    assert_true(f.vertices_generated > c.vertices_generated + c.vertices_generated / 2);
+    rl_renderer_release(r);
+    rl_scene_release(cup);
+    rl_scene_release(thesis);
+}
+
 /* Memory (issue 36): what the refined mesh takes per generated vertex, by
  * the library's own count (rl_vt_stats.mesh_bytes), on a frame that makes
  * every kind of sample: reflective (one deferred layer), glass (two) and
@@ -1324,6 +1392,7 @@ int main(void)
         cmocka_unit_test(converges_to_whitted),
         cmocka_unit_test(sample_reduction_merges_short_primary_edges),
         cmocka_unit_test(mesh_bytes_per_generated_vertex),
+        cmocka_unit_test(table_cup_variant_counts),
         cmocka_unit_test(deterministic_and_coherent),
         cmocka_unit_test(kept_buffers_follow_size_threads_and_layers),
         cmocka_unit_test(progressive_updates),

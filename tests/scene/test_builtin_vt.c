@@ -211,6 +211,49 @@ static void test_table_marks_the_cups_and_the_table_top_as_vt(void **state)
     rl_scene_release(s);
 }
 
+/* Issue 36: variant=thesis is Sec. 5.1's set-up (one light, a table top
+ * that mirrors nothing, three VT objects), variant=cup the same with the
+ * blue cup as the only VT object (Figs. 5.5/5.6); given fill and cloth_kr
+ * win over a variant's; the default stays the mirror variant. */
+static void test_table_variants(void **state)
+{
+    (void)state;
+    static const char *const three[] = { "table_top", "cup_blue", "glass_red" };
+    static const char *const cup[] = { "cup_blue" };
+    struct {
+        const char *params;
+        uint32_t lights;
+        float cloth_kr;
+        const char *const *vt;
+        int num_vt;
+    } rows[] = {
+        { NULL, 2, 0.2f, three, 3 },
+        { "variant=mirror", 2, 0.2f, three, 3 },
+        { "variant=thesis", 1, 0.0f, three, 3 },
+        { "variant=cup", 1, 0.0f, cup, 1 },
+        { "variant=cup,fill=0.15,cloth_kr=0.3", 2, 0.3f, cup, 1 },
+    };
+    uint64_t tris = triangles("table", NULL);
+    for (size_t i = 0; i < sizeof rows / sizeof rows[0]; ++i) {
+        rl_scene *s = build("table", rows[i].params);
+        const rl_scene_data *d = rl_scene_get_data(s);
+        assert_int_equal(d->num_lights, rows[i].lights);
+        const rl_material *mt = &d->materials[d->triangle_material[object_named(d, "table_top")->first_triangle]];
+        assert_float_equal(mt->reflectivity, rows[i].cloth_kr, 1e-6f);
+        assert_vt_nodes(s, rows[i].vt, rows[i].num_vt);
+        /* Same geometry and cameras in every variant. */
+        rl_scene_stats st;
+        rl_scene_get_stats(s, &st);
+        assert_int_equal(st.triangles, tris);
+        rl_camera cam;
+        assert_int_equal(rl_scene_get_camera(s, "default", &cam), RL_OK);
+        rl_scene_release(s);
+    }
+    rl_scene *bad = NULL;
+    assert_int_equal(rl_scene_create_builtin("table", "variant=cups", &bad), RL_ERR_INVALID_ARG);
+    assert_null(bad);
+}
+
 static void test_table_glass_is_a_closed_outward_solid(void **state)
 {
     (void)state;
@@ -391,6 +434,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_table_has_about_20000_triangles_and_18_objects),
         cmocka_unit_test(test_table_marks_the_cups_and_the_table_top_as_vt),
+        cmocka_unit_test(test_table_variants),
         cmocka_unit_test(test_table_glass_is_a_closed_outward_solid),
         cmocka_unit_test(test_table_detail_changes_the_tessellation),
         cmocka_unit_test(test_cluster_has_a_moderate_triangle_count),
