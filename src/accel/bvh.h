@@ -11,7 +11,9 @@
 #ifndef RL_ACCEL_BVH_H
 #define RL_ACCEL_BVH_H
 
+#include <math.h>
 #include <stdint.h>
+#include <string.h>
 
 #include "accel/accel_internal.h"
 
@@ -89,9 +91,75 @@ void rl_bvh_free(rl_bvh *bvh);
 rl_status rl_bvh_widen(rl_bvh *bvh);
 
 /* Traversal of the wide tree (bvh_wide_traverse.c). */
+/* A ray's slab-test constants (Williams et al. 2005: the near plane per axis
+ * by the direction's sign). */
+typedef struct rl_bvh_ray_pre {
+    float o[3], inv[3];
+    int neg[3];
+} rl_bvh_ray_pre;
+
+static inline void rl_bvh_ray_pre_setup(const rl_ray *r, rl_bvh_ray_pre *p)
+{
+    const float d[3] = { r->d.x, r->d.y, r->d.z };
+    p->o[0] = r->o.x;
+    p->o[1] = r->o.y;
+    p->o[2] = r->o.z;
+    for (int a = 0; a < 3; ++a) {
+        p->inv[a] = 1.0f / d[a];
+        p->neg[a] = signbit(d[a]) ? 1 : 0;
+    }
+}
+
+/* nextafterf(t, INFINITY) for a finite t, without the libm call. */
+static inline float rl_bvh_next_up(float t)
+{
+    uint32_t u;
+    memcpy(&u, &t, sizeof u);
+    if (u == 0x80000000u)   /* -0 */
+        u = 1u;
+    else if (u & 0x80000000u)
+        u -= 1u;
+    else
+        u += 1u;
+    memcpy(&t, &u, sizeof t);
+    return t;
+}
+
+/* The closest hit so far, with the tie rule of accel.c (equal t: lowest
+ * ID): t_test = next_up(t) lets equal t through to the ID comparison. */
+typedef struct rl_bvh_closest {
+    float t, t_test, u, v;
+    uint32_t id;
+} rl_bvh_closest;
+
 bool rl_bvh_wide_intersect(const rl_bvh *bvh, rl_ray *ray, rl_hit *hit);
 bool rl_bvh_wide_occluded(const rl_bvh *bvh, const rl_ray *ray);
 /* rl_bvh_wide_occluded naming the first blocking triangle it met. */
 bool rl_bvh_wide_occluder(const rl_bvh *bvh, const rl_ray *ray, uint32_t *triangle);
+/* The single-ray traversal from one entry of the tree (ref, count as in a
+ * wide node's child: count 0 = inner node ref, else a leaf's first block),
+ * for the packet traversal's lanes (bvh_packet.c). Updates *c / returns a
+ * blocking triangle or RL_ID_NONE. */
+void rl_bvh_closest_from(const rl_bvh *bvh, const rl_bvh_ray_pre *p, const rl_ray_watertight *w, float t_min,
+                         uint32_t ref, uint32_t count, rl_bvh_closest *c);
+void rl_bvh_leaf_closest(const rl_bvh *bvh, uint32_t ref, uint32_t count, const rl_ray_watertight *w, float t_min,
+                         rl_bvh_closest *c);
+uint32_t rl_bvh_occluder_from(const rl_bvh *bvh, const rl_bvh_ray_pre *p, const rl_ray_watertight *w, float t_min,
+                              float t_max, uint32_t ref, uint32_t count);
+
+/* Packet traversal of up to RL_BVH_PACKET coherent rays (bvh_packet.c):
+ * lanes in active (bit l: rays[l]; valid rays with t_min >= 0 only). The
+ * same hits, bit for bit, as the single-ray traversal of each lane:
+ * intersect returns the lanes that hit and shortens their t_max and fills
+ * their hits as rl_bvh_wide_intersect does; occluded returns the blocked
+ * lanes. */
+#define RL_BVH_PACKET 8
+/* Compile-time switch: -DRL_BVH_PACKETS=0 sends the batch queries down the
+ * single-ray path (accel.c loops). */
+#ifndef RL_BVH_PACKETS
+#define RL_BVH_PACKETS 1
+#endif
+unsigned rl_bvh_packet_intersect(const rl_bvh *bvh, rl_ray *rays, rl_hit *hits, unsigned active);
+unsigned rl_bvh_packet_occluded(const rl_bvh *bvh, const rl_ray *rays, unsigned active);
 
 #endif
