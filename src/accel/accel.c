@@ -295,23 +295,21 @@ static unsigned octant(const rl_ray *r)
     return (signbit(r->d.x) ? 1u : 0u) | (signbit(r->d.y) ? 2u : 0u) | (signbit(r->d.z) ? 4u : 0u);
 }
 
-static unsigned packet_lanes(const rl_accel *accel, const rl_ray *rays, size_t k)
+static unsigned packet_lanes(const rl_ray *rays, size_t k)
 {
     unsigned lanes = 0, first = 8;
+    int count = 0;
     for (size_t l = 0; l < k; ++l) {
         const rl_ray *r = &rays[l];
-        if (!ray_is_valid(r) || !(r->t_min >= 0.0f))
+        if (!(r->t_min >= 0.0f) || !ray_is_valid(r))
             continue;
         unsigned o = octant(r);
-        if (first == 8)
-            first = o;
-        if (o == first)
+        first = first == 8 ? o : first;
+        if (o == first) {
             lanes |= 1u << l;
+            ++count;
+        }
     }
-    (void)accel;
-    int count = 0;
-    for (unsigned m = lanes; m; m &= m - 1)
-        ++count;
     return count >= PACKET_MIN ? lanes : 0;
 }
 
@@ -346,7 +344,7 @@ void rl_accel_intersect_n(const rl_accel *accel, rl_ray *rays, rl_hit *hits, siz
     bool packets = accel && accel->committed && accel->cls->intersect8;
     for (size_t i = 0; i < n; i += RL_ACCEL_PACKET) {
         size_t k = n - i < RL_ACCEL_PACKET ? n - i : RL_ACCEL_PACKET;
-        intersect_group(accel, rays + i, hits + i, k, packets ? packet_lanes(accel, rays + i, k) : 0);
+        intersect_group(accel, rays + i, hits + i, k, packets ? packet_lanes(rays + i, k) : 0);
     }
 }
 
@@ -357,7 +355,7 @@ void rl_accel_occluded_n(const rl_accel *accel, const rl_ray *rays, bool *occlud
     bool packets = accel && accel->committed && accel->cls->occluded8 && accel->cls->intersect8;
     for (size_t i = 0; i < n; i += RL_ACCEL_PACKET) {
         size_t k = n - i < RL_ACCEL_PACKET ? n - i : RL_ACCEL_PACKET;
-        unsigned packet = packets ? packet_lanes(accel, rays + i, k) : 0;
+        unsigned packet = packets ? packet_lanes(rays + i, k) : 0;
         if (!packet) {
             for (size_t l = 0; l < k; ++l)
                 occluded[i + l] = rl_accel_occluded(accel, &rays[i + l]);

@@ -15,6 +15,10 @@
 #include <stdint.h>
 #include <string.h>
 
+#if defined(__SSE2__)
+#include <immintrin.h>
+#endif
+
 #include "accel/accel_internal.h"
 
 /* Above this depth the builder only halves (object median), so that the
@@ -108,6 +112,82 @@ static inline void rl_bvh_ray_pre_setup(const rl_ray *r, rl_bvh_ray_pre *p)
         p->inv[a] = 1.0f / d[a];
         p->neg[a] = signbit(d[a]) ? 1 : 0;
     }
+}
+
+/* The boxes' relative slack (bvh_wide_traverse.c). */
+#define RL_BVH_SLACK_LO (1.0f - 0x1p-15f)
+#define RL_BVH_SLACK_HI (1.0f + 0x1p-15f)
+
+/* Entry distances of the children; returns the mask of hit lanes. The
+ * interval [lo, hi] is widened by a relative 2^-15 so that rounding never
+ * loses a flat box (a wall: lo == hi). Scaling by (1 -+ eps) widens it only
+ * for lo, hi >= 0, which holds whenever t_min >= 0 (else lo >= 0 > hi and
+ * the box is rejected anyway); a range reaching back (t_min < 0) takes the
+ * sign-safe form. */
+static inline int rl_bvh_box_n(const rl_bvh_wide_node *n, const rl_bvh_ray_pre *r, float t_min, float t_max, float dist[RL_BVH_WIDTH])
+{
+#if defined(__AVX__) && RL_BVH_WIDTH == 8
+    __m256 lo = _mm256_set1_ps(t_min), hi = _mm256_set1_ps(t_max);
+    for (int a = 0; a < 3; ++a) {
+        __m256 o = _mm256_set1_ps(r->o[a]), inv = _mm256_set1_ps(r->inv[a]);
+        __m256 near = _mm256_loadu_ps(r->neg[a] ? n->bmax[a] : n->bmin[a]);
+        __m256 far = _mm256_loadu_ps(r->neg[a] ? n->bmin[a] : n->bmax[a]);
+        lo = _mm256_max_ps(_mm256_mul_ps(_mm256_sub_ps(near, o), inv), lo);
+        hi = _mm256_min_ps(_mm256_mul_ps(_mm256_sub_ps(far, o), inv), hi);
+    }
+    _mm256_storeu_ps(dist, lo);
+    if (t_min < 0.0f) {
+        /* The slack must widen the interval whatever the signs (below). */
+        const __m256 abs = _mm256_castsi256_ps(_mm256_set1_epi32(0x7fffffff));
+        const __m256 eps = _mm256_set1_ps(0x1p-15f);
+        lo = _mm256_sub_ps(lo, _mm256_mul_ps(_mm256_and_ps(lo, abs), eps));
+        hi = _mm256_add_ps(hi, _mm256_mul_ps(_mm256_and_ps(hi, abs), eps));
+        return _mm256_movemask_ps(_mm256_cmp_ps(lo, hi, _CMP_LE_OQ));
+    }
+    return _mm256_movemask_ps(_mm256_cmp_ps(_mm256_mul_ps(lo, _mm256_set1_ps(RL_BVH_SLACK_LO)),
+                                            _mm256_mul_ps(hi, _mm256_set1_ps(RL_BVH_SLACK_HI)), _CMP_LE_OQ));
+#elif defined(__SSE2__)
+    int mask = 0;
+    for (int c = 0; c < RL_BVH_WIDTH; c += 4) {
+        __m128 lo = _mm_set1_ps(t_min), hi = _mm_set1_ps(t_max);
+        for (int a = 0; a < 3; ++a) {
+            __m128 o = _mm_set1_ps(r->o[a]), inv = _mm_set1_ps(r->inv[a]);
+            __m128 near = _mm_loadu_ps((r->neg[a] ? n->bmax[a] : n->bmin[a]) + c);
+            __m128 far = _mm_loadu_ps((r->neg[a] ? n->bmin[a] : n->bmax[a]) + c);
+            lo = _mm_max_ps(_mm_mul_ps(_mm_sub_ps(near, o), inv), lo);
+            hi = _mm_min_ps(_mm_mul_ps(_mm_sub_ps(far, o), inv), hi);
+        }
+        _mm_storeu_ps(dist + c, lo);
+        if (t_min < 0.0f) {
+            const __m128 abs = _mm_castsi128_ps(_mm_set1_epi32(0x7fffffff));
+            const __m128 eps = _mm_set1_ps(0x1p-15f);
+            lo = _mm_sub_ps(lo, _mm_mul_ps(_mm_and_ps(lo, abs), eps));
+            hi = _mm_add_ps(hi, _mm_mul_ps(_mm_and_ps(hi, abs), eps));
+            mask |= _mm_movemask_ps(_mm_cmple_ps(lo, hi)) << c;
+            continue;
+        }
+        mask |= _mm_movemask_ps(_mm_cmple_ps(_mm_mul_ps(lo, _mm_set1_ps(RL_BVH_SLACK_LO)),
+                                             _mm_mul_ps(hi, _mm_set1_ps(RL_BVH_SLACK_HI)))) << c;
+    }
+    return mask;
+#else
+    int mask = 0;
+    for (int i = 0; i < RL_BVH_WIDTH; ++i) {
+        float lo = t_min, hi = t_max;
+        for (int a = 0; a < 3; ++a) {
+            float near = r->neg[a] ? n->bmax[a][i] : n->bmin[a][i];
+            float far = r->neg[a] ? n->bmin[a][i] : n->bmax[a][i];
+            float tn = (near - r->o[a]) * r->inv[a];
+            float tf = (far - r->o[a]) * r->inv[a];
+            lo = tn > lo ? tn : lo;
+            hi = tf < hi ? tf : hi;
+        }
+        dist[i] = lo;
+        if (lo - fabsf(lo) * 0x1p-15f <= hi + fabsf(hi) * 0x1p-15f)
+            mask |= 1 << i;
+    }
+    return mask;
+#endif
 }
 
 /* nextafterf(t, INFINITY) for a finite t, without the libm call. */

@@ -40,10 +40,17 @@
 #define LANES RL_BVH_PACKET
 #define SLACK_LO (1.0f - 0x1p-15f)
 #define SLACK_HI (1.0f + 0x1p-15f)
-/* An entry with at most this many lanes is finished by single rays: on
- * primary and shadow rays of city and cornell-teapot 2 was fastest (1 and
- * 3 within a few %, rl bench rays' packet section). */
-#define SINGLE_BELOW 2
+/* An entry with at most this many lanes is finished by single rays (the
+ * hybrid above). Measured on 2026-12-06 (rl bench rays' packet section,
+ * cornell-teapot:triangles=70000 and Wuson, two interleaved series): 0
+ * (never: one triangle against all lanes pays even for one or two lanes)
+ * 0.89-0.90x / 0.98-0.99x Embree's packets on primary / shadow rays of
+ * the teapot, 0.79-0.81x / 0.81x on Wuson; 1 the same within noise; 2
+ * 0.87x / 0.96-0.98x and 0.76-0.77x / 0.78x; 3 and 4 lower still. */
+#ifndef RL_BVH_PACKET_SINGLE_BELOW
+#define RL_BVH_PACKET_SINGLE_BELOW 0
+#endif
+#define SINGLE_BELOW RL_BVH_PACKET_SINGLE_BELOW
 
 _Static_assert(LANES == 8, "the packet masks and AVX code assume 8 lanes");
 
@@ -51,6 +58,10 @@ typedef struct packet {
     float o[3][LANES], inv[3][LANES];
     uint32_t neg[3][LANES];      /* all ones where the direction is negative */
     int octant[3];               /* one octant: each axis' sign (0/1), else -1 */
+    /* The packet's frustum (one octant, finite 1/d only): the range of
+     * origins and of 1/d over the active lanes per axis. */
+    bool frustum;
+    float o_lo[3], o_hi[3], inv_lo[3], inv_hi[3];
     float t_min[LANES];
     float t[LANES];              /* closest hit so far, or t_max (any hit) */
     float t_test[LANES];         /* closest: next_up(t), the triangles' bound */
@@ -166,6 +177,21 @@ static void packet_setup(packet *p, const rl_ray *rays, unsigned active)
         p->sz[l] = 1.0f / d[p->kz][l];
     }
 #endif
+    p->frustum = p->octant[0] >= 0 && p->octant[1] >= 0 && p->octant[2] >= 0;
+    for (int a = 0; a < 3; ++a) {
+        p->o_lo[a] = p->inv_lo[a] = INFINITY;
+        p->o_hi[a] = p->inv_hi[a] = -INFINITY;
+        for (unsigned m = active; m; m &= m - 1) {
+            int l = lowest(m);
+            float o = p->o[a][l], inv = p->inv[a][l];
+            if (!isfinite(inv))
+                p->frustum = false;
+            p->o_lo[a] = o < p->o_lo[a] ? o : p->o_lo[a];
+            p->o_hi[a] = o > p->o_hi[a] ? o : p->o_hi[a];
+            p->inv_lo[a] = inv < p->inv_lo[a] ? inv : p->inv_lo[a];
+            p->inv_hi[a] = inv > p->inv_hi[a] ? inv : p->inv_hi[a];
+        }
+    }
     memcpy(p->wo[0], p->o[p->kx], sizeof p->wo[0]);
     memcpy(p->wo[1], p->o[p->ky], sizeof p->wo[1]);
     memcpy(p->wo[2], p->o[p->kz], sizeof p->wo[2]);
@@ -360,7 +386,7 @@ static inline unsigned child_lanes(const rl_bvh_wide_node *n, int i, const packe
                               _mm256_mul_ps(hi, _mm256_set1_ps(SLACK_HI)), _CMP_LE_OQ);
     unsigned hit = (unsigned)_mm256_movemask_ps(ok) & mask;
     if (hit) {
-        /* Horizontal minimum over the hit lanes. */
+        /* The children's order: the least entry distance of a hit lane. */
         __m256 k = _mm256_blendv_ps(_mm256_set1_ps(INFINITY), lo, ok);
         __m128 m4 = _mm_min_ps(_mm256_castps256_ps128(k), _mm256_extractf128_ps(k, 1));
         m4 = _mm_min_ps(m4, _mm_movehl_ps(m4, m4));
@@ -393,6 +419,69 @@ static inline unsigned child_lanes(const rl_bvh_wide_node *n, int i, const packe
 #endif
 }
 
+/* Memory latency dominates on large scenes (city): start fetching a child
+ * as soon as it is known to be visited, as the single-ray visit does
+ * (node: all its cache lines; leaf: its blocks). */
+static inline void prefetch_entry(const rl_bvh *bvh, const pentry *e)
+{
+#if defined(__GNUC__)
+    const char *p;
+    size_t bytes;
+    if (e->count == 0) {
+        p = (const char *)&bvh->wide[e->ref];
+        bytes = sizeof(rl_bvh_wide_node);
+    } else {
+        p = (const char *)&bvh->blocks[e->ref];
+        bytes = (e->count + RL_BVH_LANES - 1) / RL_BVH_LANES * sizeof(rl_bvh_block);
+    }
+    for (size_t off = 0; off < bytes; off += 64)
+        __builtin_prefetch(p + off);
+    __builtin_prefetch(p + bytes - 1);
+#else
+    (void)bvh;
+    (void)e;
+#endif
+}
+
+#if defined(__AVX__) && RL_BVH_WIDTH == 8
+/* A quick reject of the children that no lane of the packet can hit, all
+ * children at once (Wald 2001's packets share a frustum; here its
+ * interval form): per axis the lanes' slab distance (b - o)·(1/d) lies
+ * between the least and the greatest product of the interval ends, b -
+ * o_hi .. b - o_lo and inv_lo .. inv_hi. Rounding is monotone, so those
+ * products, rounded, also bound every lane's rounded distance: a child
+ * rejected here fails child_lanes' test on every lane (lo >= LO and hi <=
+ * HI per lane), and the exact result does not change. */
+static inline unsigned frustum_children(const rl_bvh_wide_node *n, const packet *p, unsigned mask)
+{
+    float t_lo = INFINITY, t_hi = -INFINITY;
+    for (unsigned m = mask; m; m &= m - 1) {
+        int l = lowest(m);
+        t_lo = p->t_min[l] < t_lo ? p->t_min[l] : t_lo;
+        t_hi = p->t[l] > t_hi ? p->t[l] : t_hi;
+    }
+    __m256 LO = _mm256_set1_ps(t_lo), HI = _mm256_set1_ps(t_hi);
+    for (int a = 0; a < 3; ++a) {
+        const __m256 bn = _mm256_loadu_ps(p->octant[a] ? n->bmax[a] : n->bmin[a]);
+        const __m256 bf = _mm256_loadu_ps(p->octant[a] ? n->bmin[a] : n->bmax[a]);
+        const __m256 olo = _mm256_set1_ps(p->o_lo[a]), ohi = _mm256_set1_ps(p->o_hi[a]);
+        const __m256 i0 = _mm256_set1_ps(p->inv_lo[a]), i1 = _mm256_set1_ps(p->inv_hi[a]);
+        __m256 d0 = _mm256_sub_ps(bn, ohi), d1 = _mm256_sub_ps(bn, olo);
+        __m256 near = _mm256_min_ps(_mm256_min_ps(_mm256_mul_ps(d0, i0), _mm256_mul_ps(d0, i1)),
+                                    _mm256_min_ps(_mm256_mul_ps(d1, i0), _mm256_mul_ps(d1, i1)));
+        __m256 e0 = _mm256_sub_ps(bf, ohi), e1 = _mm256_sub_ps(bf, olo);
+        __m256 far = _mm256_max_ps(_mm256_max_ps(_mm256_mul_ps(e0, i0), _mm256_mul_ps(e0, i1)),
+                                   _mm256_max_ps(_mm256_mul_ps(e1, i0), _mm256_mul_ps(e1, i1)));
+        LO = _mm256_max_ps(near, LO);
+        HI = _mm256_min_ps(far, HI);
+    }
+    /* NaN (never expected: finite 1/d, finite origins) keeps the child. */
+    __m256 miss = _mm256_cmp_ps(_mm256_mul_ps(LO, _mm256_set1_ps(SLACK_LO)),
+                                _mm256_mul_ps(HI, _mm256_set1_ps(SLACK_HI)), _CMP_GT_OQ);
+    return ~(unsigned)_mm256_movemask_ps(miss) & 0xffu;
+}
+#endif
+
 /* The children of n that some lane of mask hits: pushed farthest first (by
  * their least entry distance), the nearest returned in *next; false when
  * none is hit. Unused slots have inverted bounds and are skipped. */
@@ -403,18 +492,24 @@ static bool visit_packet(const rl_bvh *bvh, const rl_bvh_wide_node *n, const pac
     float key[RL_BVH_WIDTH];
     int order[RL_BVH_WIDTH];
     int k = 0;
-    (void)bvh;
-    for (int i = 0; i < RL_BVH_WIDTH; ++i) {
-        if (!(n->bmin[0][i] <= n->bmax[0][i]))
-            continue;
-        float dist[LANES], least;
-        unsigned lanes = child_lanes(n, i, p, mask, dist, &least);
+    /* Used slots: unused ones have inverted bounds. */
+    unsigned used = 0;
+    for (int i = 0; i < RL_BVH_WIDTH; ++i)
+        used |= (n->bmin[0][i] <= n->bmax[0][i]) ? 1u << i : 0u;
+#if defined(__AVX__) && RL_BVH_WIDTH == 8
+    if (p->frustum)
+        used &= frustum_children(n, p, mask);
+#endif
+    for (; used; used &= used - 1) {
+        int i = lowest(used);
+        float least = 0.0f;
+        unsigned lanes = child_lanes(n, i, p, mask, hit[k].dist, &least);
         if (!lanes)
             continue;
         hit[k].ref = n->child[i];
         hit[k].count = n->count[i];
         hit[k].mask = lanes;
-        memcpy(hit[k].dist, dist, sizeof dist);
+        prefetch_entry(bvh, &hit[k]);
         key[k] = least;
         /* Insertion into the order, descending by key. */
         int j = k++;
@@ -432,10 +527,87 @@ static bool visit_packet(const rl_bvh *bvh, const rl_bvh_wide_node *n, const pac
     return true;
 }
 
+/* visit_packet for a packet with few lanes left: each lane tests all
+ * children at once with the single ray's box test (rl_bvh_box_n), and the
+ * per-lane child masks are turned into per-child lane masks. Its cost
+ * grows with the lanes, visit_packet's with the children. */
+static bool visit_lanes(const rl_bvh *bvh, const rl_bvh_wide_node *n, packet *p, unsigned mask, pentry *stack,
+                        int *sp, pentry *next)
+{
+    pentry hit[RL_BVH_WIDTH];
+    unsigned lanes_of[RL_BVH_WIDTH];
+    float key[RL_BVH_WIDTH];
+    unsigned any = 0;
+    for (unsigned m = mask; m; m &= m - 1) {
+        int l = lowest(m);
+        lane_ready(p, l);
+        float dist[RL_BVH_WIDTH];
+        unsigned cm = (unsigned)rl_bvh_box_n(n, &p->pre[l], p->t_min[l], p->t[l], dist);
+        for (; cm; cm &= cm - 1) {
+            int i = lowest(cm);
+            if (!(any & (1u << i))) {
+                any |= 1u << i;
+                key[i] = dist[i];
+                lanes_of[i] = 0;
+            } else if (dist[i] < key[i]) {
+                key[i] = dist[i];
+            }
+            lanes_of[i] |= 1u << l;
+            hit[i].dist[l] = dist[i];
+        }
+    }
+    if (!any)
+        return false;
+    int order[RL_BVH_WIDTH], k = 0;
+    for (; any; any &= any - 1) {
+        int i = lowest(any);
+        hit[i].ref = n->child[i];
+        hit[i].count = n->count[i];
+        hit[i].mask = lanes_of[i];
+        prefetch_entry(bvh, &hit[i]);
+        int j = k++;
+        while (j > 0 && key[order[j - 1]] < key[i]) {
+            order[j] = order[j - 1];
+            --j;
+        }
+        order[j] = i;
+    }
+    for (int j = 0; j < k - 1; ++j)
+        stack[(*sp)++] = hit[order[j]];
+    *next = hit[order[k - 1]];
+    return true;
+}
+
+/* A node whose entry has at most this many lanes left is visited lane by
+ * lane (visit_lanes), else child by child (visit_packet). Measured on
+ * 2026-12-06 (CPU-time ratios to Embree's packets, one run each, machine
+ * loaded): city 512x384 primary / shadow 0.66 / 0.71x at 0 (never), 0.69
+ * / 0.81x at 2, 0.68 / 0.83x at 4, 0.60 / 0.70x at 8 (always);
+ * cornell-teapot and Wuson 0.88 / 1.00x and 0.79 / 0.78x at 0, 0.88 /
+ * 0.87x and 0.80 / 0.74x at 4. */
+#ifndef RL_BVH_PACKET_LANE_MAJOR_BELOW
+#define RL_BVH_PACKET_LANE_MAJOR_BELOW 2
+#endif
+
+static inline bool visit(const rl_bvh *bvh, const rl_bvh_wide_node *n, packet *p, unsigned mask, pentry *stack,
+                         int *sp, pentry *next)
+{
+    if (popcount8(mask) <= RL_BVH_PACKET_LANE_MAJOR_BELOW)
+        return visit_lanes(bvh, n, p, mask, stack, sp, next);
+    return visit_packet(bvh, n, p, mask, stack, sp, next);
+}
+
 /* The lanes of e whose entry distance is not beyond their closest hit, with
  * the single-ray pop's sign-safe slack. */
 static inline unsigned still_near(const pentry *e, const packet *p)
 {
+#if defined(__AVX__)
+    const __m256 abs = _mm256_castsi256_ps(_mm256_set1_epi32(0x7fffffff)), eps = _mm256_set1_ps(0x1p-15f);
+    __m256 d = _mm256_loadu_ps(e->dist), t = _mm256_loadu_ps(p->t);
+    d = _mm256_sub_ps(d, _mm256_mul_ps(_mm256_and_ps(d, abs), eps));
+    t = _mm256_add_ps(t, _mm256_mul_ps(_mm256_and_ps(t, abs), eps));
+    return e->mask & (unsigned)_mm256_movemask_ps(_mm256_cmp_ps(d, t, _CMP_LE_OQ));
+#else
     unsigned keep = 0;
     for (unsigned m = e->mask; m; m &= m - 1) {
         int l = lowest(m);
@@ -444,6 +616,7 @@ static inline unsigned still_near(const pentry *e, const packet *p)
             keep |= 1u << l;
     }
     return keep;
+#endif
 }
 
 unsigned rl_bvh_packet_intersect(const rl_bvh *bvh, rl_ray *rays, rl_hit *hits, unsigned active)
@@ -483,7 +656,7 @@ unsigned rl_bvh_packet_intersect(const rl_bvh *bvh, rl_ray *rays, rl_hit *hits, 
                 p.t[l] = c[l].t;
                 p.t_test[l] = c[l].t_test;
             }
-        } else if (visit_packet(bvh, &bvh->wide[cur.ref], &p, cur.mask, stack, &sp, &cur)) {
+        } else if (visit(bvh, &bvh->wide[cur.ref], &p, cur.mask, stack, &sp, &cur)) {
             continue;
         }
         /* Pop, dropping the lanes whose closest hit is already nearer. */
@@ -544,7 +717,7 @@ unsigned rl_bvh_packet_occluded(const rl_bvh *bvh, const rl_ray *rays, unsigned 
                     RL_ID_NONE)
                     done |= 1u << l;
             }
-        } else if (visit_packet(bvh, &bvh->wide[cur.ref], &p, cur.mask, stack, &sp, &cur)) {
+        } else if (visit(bvh, &bvh->wide[cur.ref], &p, cur.mask, stack, &sp, &cur)) {
             cur.mask &= ~done;
             if (cur.mask)
                 continue;
