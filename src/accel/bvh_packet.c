@@ -8,13 +8,17 @@
  * 8 lanes; a portable loop over the lanes with the same IEEE operations
  * otherwise). A stack entry carries the mask of lanes that hit the box and
  * their entry distances, so that a pop drops the lanes whose closest hit is
- * already nearer. Once few lanes are left in an entry the packet is not
- * worth its overhead: those lanes finish that subtree one by one with the
- * single-ray traversal (the hybrid of Benthin, Wald, Woop, Ernst, Mark
- * 2012, "Combining Single and Packet-Ray Tracing for Arbitrary Ray
- * Distributions on the Intel MIC Architecture", Sec. 4; as Embree does).
- * Leaves are tested per lane with the single-ray leaf test (SoA blocks of
- * 4 triangles, bvh_wide_traverse.c).
+ * already nearer. Before the exact test, an interval test over the
+ * packet's origins and 1/d rejects the children no lane can hit, all 8 at
+ * once. An entry with few lanes left tests the children lane by lane
+ * (visit_lanes). The hybrid of Benthin, Wald, Woop, Ernst, Mark 2012
+ * ("Combining Single and Packet-Ray Tracing for Arbitrary Ray
+ * Distributions on the Intel MIC Architecture", Sec. 4: such lanes finish
+ * the subtree as single rays) is here too but off by measurement
+ * (RL_BVH_PACKET_SINGLE_BELOW). Leaves test one triangle against all
+ * lanes that share the watertight test's axis permutation; other lanes use
+ * the single-ray leaf test (SoA blocks of 4 triangles,
+ * bvh_wide_traverse.c).
  *
  * Exactness: every lane gets bit for bit the single-ray path's hit. The
  * triangle test is the same code; its acceptance depends on the divided t
