@@ -111,16 +111,17 @@ static rl_ray diffuse_ray(const surface *s, uint64_t seed, uint64_t pixel)
     return ray;
 }
 
-/* Primary rays in tile order; pixel_of[i] is the row-major pixel of ray i. */
-static void make_primary(const rl_camera *cam, rl_ray *rays, uint32_t *pixel_of)
+/* Primary rays in scanline order of tile_w x tile_h tiles; pixel_of[i] is
+ * the row-major pixel of ray i. */
+static void make_primary(const rl_camera *cam, int tile_w, int tile_h, rl_ray *rays, uint32_t *pixel_of)
 {
     rl_camera_frame f = rl_camera_frame_make(cam);
     int w = f.width, h = f.height;
     size_t i = 0;
-    for (int ty = 0; ty < h; ty += TILE)
-        for (int tx = 0; tx < w; tx += TILE)
-            for (int y = ty; y < ty + TILE && y < h; y++)
-                for (int x = tx; x < tx + TILE && x < w; x++) {
+    for (int ty = 0; ty < h; ty += tile_h)
+        for (int tx = 0; tx < w; tx += tile_w)
+            for (int y = ty; y < ty + tile_h && y < h; y++)
+                for (int x = tx; x < tx + tile_w && x < w; x++) {
                     rays[i] = rl_camera_frame_ray(&f, (float)x + 0.5f, (float)y + 0.5f);
                     pixel_of[i++] = (uint32_t)y * (uint32_t)w + (uint32_t)x;
                 }
@@ -139,7 +140,7 @@ bool bench_make_rays(const rl_scene *scene, const rl_camera *cam, const rl_accel
     bool ok = data && primary && pixel_of && surf;
     size_t hits = 0;
     if (ok) {
-        make_primary(&c, primary, pixel_of);
+        make_primary(&c, TILE, TILE, primary, pixel_of);
         long long count = (long long)n;
 #pragma omp parallel for num_threads(threads) schedule(dynamic, CHUNK) reduction(+ : hits)
         for (long long i = 0; i < count; i++) {
@@ -184,6 +185,56 @@ bool bench_make_rays(const rl_scene *scene, const rl_camera *cam, const rl_accel
     return ok;
 }
 
+bool bench_make_packet_rays(const rl_scene *scene, const rl_camera *cam, const rl_accel *reference,
+                            int threads, bench_rays *out)
+{
+    const rl_scene_data *data = rl_scene_get_data(scene);
+    rl_camera c = rl_camera_resolve(cam);
+    size_t n = (size_t)c.width * (size_t)c.height;
+    rl_ray *primary = malloc(n * sizeof *primary);
+    uint32_t *pixel_of = malloc(n * sizeof *pixel_of);
+    surface *surf = calloc(n, sizeof *surf);            /* in ray order */
+    rl_ray *shadow = NULL;
+    if (!data || !primary || !pixel_of || !surf)
+        goto fail;
+    make_primary(&c, RL_BENCH_PACKET_TILE_W, RL_BENCH_PACKET_TILE_H, primary, pixel_of);
+    size_t hits = 0;
+    long long count = (long long)n;
+#pragma omp parallel for num_threads(threads) schedule(dynamic, CHUNK) reduction(+ : hits)
+    for (long long i = 0; i < count; i++) {
+        rl_ray r = primary[i];
+        rl_hit hit;
+        if (rl_accel_intersect(reference, &r, &hit)) {
+            surf[i] = surface_at(data, &primary[i], &hit);
+            hits++;
+        }
+    }
+    shadow = malloc((hits ? hits : 1) * sizeof *shadow);
+    if (!shadow)
+        goto fail;
+    /* In the tiles' order: consecutive shadow rays start at neighbouring
+     * pixels' hit points and go to one light, as a renderer's would. */
+    shadow_target target = shadow_target_of(data);
+    size_t k = 0;
+    for (size_t i = 0; i < n; i++)
+        if (surf[i].hit)
+            shadow[k++] = shadow_ray(&surf[i], &target);
+    memset(out, 0, sizeof *out);
+    out->rays[RL_BENCH_PRIMARY] = primary;
+    out->count[RL_BENCH_PRIMARY] = n;
+    out->rays[RL_BENCH_SHADOW] = shadow;
+    out->count[RL_BENCH_SHADOW] = k;
+    free(pixel_of);
+    free(surf);
+    return true;
+fail:
+    free(primary);
+    free(pixel_of);
+    free(surf);
+    free(shadow);
+    return false;
+}
+
 void bench_rays_free(bench_rays *rays)
 {
     if (!rays)
@@ -206,7 +257,7 @@ static double thread_cpu_s(void)
 /* One pass over all rays on all threads; returns the number of hits and in
  * *cpu_s the CPU seconds the threads spent tracing (barrier waits excluded). */
 static uint64_t trace_pass(const rl_accel *accel, const rl_ray *rays, size_t count, bool any_hit,
-                           int threads, double *cpu_s)
+                           bool batched, int threads, double *cpu_s)
 {
     uint64_t hits = 0;
     double cpu = 0.0;
@@ -220,7 +271,24 @@ static uint64_t trace_pass(const rl_accel *accel, const rl_ray *rays, size_t cou
             size_t begin = (size_t)c * CHUNK;
             size_t end = begin + CHUNK < count ? begin + CHUNK : count;
             uint64_t local = 0;
-            if (any_hit) {
+            if (batched) {
+                /* The batch queries (packets of 8 where they pay, accel.c)
+                 * on the chunk; intersect shortens t_max: keep the workload. */
+                rl_ray r[CHUNK];
+                rl_hit hit[CHUNK];
+                bool occluded[CHUNK];
+                size_t k = end - begin;
+                if (any_hit) {
+                    rl_accel_occluded_n(accel, rays + begin, occluded, k);
+                    for (size_t i = 0; i < k; i++)
+                        local += occluded[i];
+                } else {
+                    memcpy(r, rays + begin, k * sizeof *r);
+                    rl_accel_intersect_n(accel, r, hit, k);
+                    for (size_t i = 0; i < k; i++)
+                        local += hit[i].triangle != RL_ID_NONE;
+                }
+            } else if (any_hit) {
                 for (size_t i = begin; i < end; i++)
                     local += rl_accel_occluded(accel, &rays[i]);
             } else {
@@ -238,9 +306,9 @@ static uint64_t trace_pass(const rl_accel *accel, const rl_ray *rays, size_t cou
     return hits;
 }
 
-void bench_time_rays(const rl_accel *const *accels, int num_accels, const rl_ray *rays,
-                        size_t count, bool any_hit, int threads, int min_runs, int max_runs,
-                        double min_total_s, bench_timing *out)
+void bench_time_rays(const rl_accel *const *accels, const bool *batched, int num_accels,
+                     const rl_ray *rays, size_t count, bool any_hit, int threads, int min_runs,
+                     int max_runs, double min_total_s, bench_timing *out)
 {
     for (int a = 0; a < num_accels; a++) {
         out[a] = (bench_timing){ .best_s = INFINITY, .best_cpu_s = INFINITY,
@@ -248,7 +316,7 @@ void bench_time_rays(const rl_accel *const *accels, int num_accels, const rl_ray
         /* The warm-up pass faults in the structure and the rays, fills the
          * caches, and counts the hits. */
         double cpu_s;
-        out[a].hits = trace_pass(accels[a], rays, count, any_hit, threads, &cpu_s);
+        out[a].hits = trace_pass(accels[a], rays, count, any_hit, batched && batched[a], threads, &cpu_s);
     }
     /* Round robin: on a shared machine a burst of foreign load then slows
      * one pass of every accelerator instead of all passes of one, and the
@@ -262,7 +330,8 @@ void bench_time_rays(const rl_accel *const *accels, int num_accels, const rl_ray
             if (t->runs >= max_runs || (t->runs >= min_runs && spent >= min_total_s))
                 continue;
             double cpu_s, t0 = rl_time_s();
-            uint64_t hits = trace_pass(accels[a], rays, count, any_hit, threads, &cpu_s);
+            uint64_t hits = trace_pass(accels[a], rays, count, any_hit, batched && batched[a], threads,
+                                       &cpu_s);
             double dt = rl_time_s() - t0;
             if (hits != t->hits)
                 t->deterministic = false;

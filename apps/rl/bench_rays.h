@@ -37,6 +37,15 @@ bool bench_make_rays(const rl_scene *scene, const rl_camera *cam, const rl_accel
                         uint64_t seed, int threads, bench_rays *out);
 void bench_rays_free(bench_rays *rays);
 
+/* The packet section's workloads: primary rays in scanline order of 4x2
+ * pixel tiles (one packet of 8 rays per tile) and the shadow rays of their
+ * hits to the first light, in the same order (as bench_make_rays: the
+ * diffuse slot stays empty). False only when out of memory. */
+#define RL_BENCH_PACKET_TILE_W 4
+#define RL_BENCH_PACKET_TILE_H 2
+bool bench_make_packet_rays(const rl_scene *scene, const rl_camera *cam, const rl_accel *reference,
+                            int threads, bench_rays *out);
+
 typedef struct bench_timing {
     uint64_t hits;          /* of the warm-up pass */
     double best_s;          /* fastest timed pass, wall clock */
@@ -48,10 +57,12 @@ typedef struct bench_timing {
 /* Times each of accels on the same rays: one warm-up pass each (which counts
  * the hits), then interleaved timed passes until each has run min_runs
  * times and for min_total_s in all (at most max_runs); out[i] for accels[i].
- * Closest hit (rl_accel_intersect) unless any_hit (rl_accel_occluded). */
-void bench_time_rays(const rl_accel *const *accels, int num_accels, const rl_ray *rays,
-                        size_t count, bool any_hit, int threads, int min_runs, int max_runs,
-                        double min_total_s, bench_timing *out);
+ * Closest hit (rl_accel_intersect) unless any_hit (rl_accel_occluded);
+ * where batched[i] (batched may be NULL), the batch queries
+ * rl_accel_intersect_n / rl_accel_occluded_n on chunks of rays instead. */
+void bench_time_rays(const rl_accel *const *accels, const bool *batched, int num_accels,
+                     const rl_ray *rays, size_t count, bool any_hit, int threads, int min_runs,
+                     int max_runs, double min_total_s, bench_timing *out);
 
 /* Results of one accelerator on one scene. */
 typedef struct bench_accel_result {
@@ -67,6 +78,24 @@ typedef struct bench_accel_result {
     double cpu_ratio_to_embree[RL_BENCH_WORKLOADS];
 } bench_accel_result;
 
+/* The packet section: one accelerator traced with single queries or with
+ * the batch queries (packets of 8: our packet traversal for bvh,
+ * rtcIntersect8 / rtcOccluded8 for embree) on the primary and shadow rays
+ * of 4x2 tiles (bench_make_packet_rays). */
+#define RL_BENCH_PACKET_WORKLOADS 2        /* primary, shadow */
+#define RL_BENCH_PACKET_RUNS 4             /* bvh, embree x single, packets */
+typedef struct bench_packet_result {
+    rl_accel_kind kind;
+    bool packets;                                  /* batch queries, else single */
+    bench_timing timing[RL_BENCH_PACKET_WORKLOADS];
+    double mrays_per_s[RL_BENCH_PACKET_WORKLOADS];
+    double mrays_per_cpu_s[RL_BENCH_PACKET_WORKLOADS];
+    /* CPU-time ratios: to Embree's packets of the same run, and to the
+     * same accelerator's single queries; NAN when unknown. */
+    double cpu_ratio_to_embree_packets[RL_BENCH_PACKET_WORKLOADS];
+    double cpu_ratio_to_single[RL_BENCH_PACKET_WORKLOADS];
+} bench_packet_result;
+
 typedef struct bench_scene_result {
     const char *arg;                    /* as given to --scenes */
     char label[64];                     /* short name for the table */
@@ -78,6 +107,12 @@ typedef struct bench_scene_result {
     bool hits_agree[RL_BENCH_WORKLOADS];
     bench_accel_result *accels;
     int num_accels;
+    /* The packet section (num_packet_runs 0: not run). */
+    size_t packet_rays[RL_BENCH_PACKET_WORKLOADS];
+    bool packet_hits_agree[RL_BENCH_PACKET_WORKLOADS];
+    bench_packet_result packet_runs[RL_BENCH_PACKET_RUNS];
+    int num_packet_runs;
+    int packet_mismatches;              /* packet workloads whose hit counts differ */
 } bench_scene_result;
 
 typedef struct bench_params {

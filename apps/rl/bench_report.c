@@ -104,6 +104,57 @@ static cJSON *accel_json(const bench_scene_result *sc, const bench_accel_result 
     return o;
 }
 
+/* The packet section: per run (accel, single or packets) and workload. */
+static cJSON *packets_json(const bench_scene_result *sc)
+{
+    cJSON *o = cJSON_CreateObject();
+    if (!o)
+        return NULL;
+    char tile[16];
+    snprintf(tile, sizeof tile, "%dx%d", RL_BENCH_PACKET_TILE_W, RL_BENCH_PACKET_TILE_H);
+    cJSON_AddStringToObject(o, "tile", tile);
+    cJSON_AddNumberToObject(o, "packet_size", 8);
+    static const char *const names[RL_BENCH_PACKET_WORKLOADS] = { "primary", "shadow" };
+    cJSON *rays = cJSON_AddObjectToObject(o, "rays");
+    cJSON *agree = cJSON_AddObjectToObject(o, "hits_agree");
+    for (int w = 0; rays && agree && w < RL_BENCH_PACKET_WORKLOADS; w++) {
+        cJSON_AddNumberToObject(rays, names[w], (double)sc->packet_rays[w]);
+        cJSON_AddBoolToObject(agree, names[w], sc->packet_hits_agree[w]);
+    }
+    cJSON *runs = cJSON_AddArrayToObject(o, "runs");
+    for (int k = 0; runs && k < sc->num_packet_runs; k++) {
+        const bench_packet_result *r = &sc->packet_runs[k];
+        cJSON *rj = cJSON_CreateObject();
+        if (!rj)
+            break;
+        cJSON_AddStringToObject(rj, "accel", rl_accel_kind_name(r->kind));
+        cJSON_AddStringToObject(rj, "mode", r->packets ? "packets" : "single");
+        cJSON_AddStringToObject(rj, "calls", r->packets ? (r->kind == RL_ACCEL_EMBREE
+                                                               ? "rtcIntersect8/rtcOccluded8"
+                                                               : "rl_accel_intersect_n/occluded_n")
+                                                        : "rl_accel_intersect/occluded");
+        cJSON *work = cJSON_AddObjectToObject(rj, "workloads");
+        for (int w = 0; work && w < RL_BENCH_PACKET_WORKLOADS; w++) {
+            const bench_timing *t = &r->timing[w];
+            cJSON *wj = cJSON_AddObjectToObject(work, names[w]);
+            if (!wj)
+                break;
+            bool any = sc->packet_rays[w] > 0;
+            cJSON_AddNumberToObject(wj, "hits", (double)t->hits);
+            cJSON_AddNumberToObject(wj, "runs", t->runs);
+            add_number(wj, "seconds", any ? t->best_s : NAN);
+            add_number(wj, "mrays_per_s", r->mrays_per_s[w]);
+            add_number(wj, "cpu_seconds", any ? t->best_cpu_s : NAN);
+            add_number(wj, "mrays_per_cpu_s", r->mrays_per_cpu_s[w]);
+            add_number(wj, "cpu_ratio_to_single", r->cpu_ratio_to_single[w]);
+            add_number(wj, "cpu_ratio_to_embree_packets", r->cpu_ratio_to_embree_packets[w]);
+            cJSON_AddBoolToObject(wj, "deterministic", t->deterministic);
+        }
+        cJSON_AddItemToArray(runs, rj);
+    }
+    return o;
+}
+
 static cJSON *scene_json(const bench_scene_result *sc)
 {
     cJSON *o = cJSON_CreateObject();
@@ -130,6 +181,10 @@ static cJSON *scene_json(const bench_scene_result *sc)
     cJSON *accels = cJSON_AddArrayToObject(o, "accels");
     for (int i = 0; accels && i < sc->num_accels; i++)
         cJSON_AddItemToArray(accels, accel_json(sc, &sc->accels[i]));
+    if (sc->num_packet_runs > 0)
+        cJSON_AddItemToObject(o, "packets", packets_json(sc));
+    else
+        cJSON_AddNullToObject(o, "packets");
     return o;
 }
 

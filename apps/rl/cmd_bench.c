@@ -76,6 +76,10 @@ static const char bench_help[] =
     "  diffuse  cosine-weighted directions from each primary hit, in pixel order\n"
     "Prints build time, memory and Mrays/s per workload with the ratio to Embree,\n"
     "warns when accelerators disagree on the number of hits, and writes JSON.\n"
+    "Packet section (bvh and embree, when among --accels): primary rays in 4x2\n"
+    "tiles and their shadow rays, each accelerator with single queries and with\n"
+    "the batch queries in packets of 8 (our packet traversal; rtcIntersect8),\n"
+    "interleaved, with CPU-time ratios to single rays and to Embree's packets.\n"
     "\n"
     "options:\n"
     "  --scenes A,B,...   scenes (built-in[:k=v,...], .json or mesh file); a\n"
@@ -376,8 +380,8 @@ static void measure(rl_accel **built, const bench_rays *rays, const bench_params
         if (rays->count[w] == 0 || n == 0)
             continue;
         progress(sc->label, "tracing", bench_workload_name(w));
-        bench_time_rays(list, n, rays->rays[w], rays->count[w], w == RL_BENCH_SHADOW,
-                           p->threads, p->min_runs, p->max_runs, p->min_total_s, timing);
+        bench_time_rays(list, NULL, n, rays->rays[w], rays->count[w], w == RL_BENCH_SHADOW,
+                        p->threads, p->min_runs, p->max_runs, p->min_total_s, timing);
         for (int k = 0; k < n; k++) {
             which[k]->timing[w] = timing[k];
             if (timing[k].best_s > 0.0)
@@ -387,6 +391,94 @@ static void measure(rl_accel **built, const bench_rays *rays, const bench_params
                     (double)rays->count[w] / timing[k].best_cpu_s * 1e-6;
         }
     }
+}
+
+/* The packet section: bvh and embree, each with single queries and with
+ * the batch queries (packets of 8), interleaved on the primary rays of 4x2
+ * tiles and their shadow rays; CPU-time ratios to Embree's packets and to
+ * single rays. Returns the number of workloads whose hit counts differ. */
+static int measure_packets(const rl_scene *scene, const rl_camera *cam, const rl_accel *ref,
+                           rl_accel **built, const bench_params *p, bench_scene_result *sc)
+{
+    const rl_accel *list[RL_BENCH_PACKET_RUNS];
+    bool batched[RL_BENCH_PACKET_RUNS];
+    int n = 0;
+    for (int i = 0; i < sc->num_accels; i++) {
+        rl_accel_kind k = sc->accels[i].kind;
+        if (!built[i] || (k != RL_ACCEL_BVH && k != RL_ACCEL_EMBREE) || n + 2 > RL_BENCH_PACKET_RUNS)
+            continue;
+        for (int mode = 0; mode < 2; mode++) {
+            list[n] = built[i];
+            batched[n] = mode == 1;
+            bench_packet_result *r = &sc->packet_runs[n++];
+            *r = (bench_packet_result){ .kind = k, .packets = mode == 1 };
+            for (int w = 0; w < RL_BENCH_PACKET_WORKLOADS; w++) {
+                r->timing[w] = (bench_timing){ .deterministic = true };
+                r->mrays_per_s[w] = r->mrays_per_cpu_s[w] = NAN;
+                r->cpu_ratio_to_embree_packets[w] = r->cpu_ratio_to_single[w] = NAN;
+            }
+        }
+    }
+    if (n == 0)
+        return 0;
+    bench_rays rays = { { NULL }, { 0 } };
+    if (!bench_make_packet_rays(scene, cam, ref, p->threads, &rays)) {
+        if (rl_log_get_level() >= RL_LOG_WARN)
+            fprintf(stderr, "rl: warning: bench: %s: out of memory for the packet workloads\n",
+                    sc->label);
+        return 0;
+    }
+    sc->num_packet_runs = n;
+    static const int workload[RL_BENCH_PACKET_WORKLOADS] = { RL_BENCH_PRIMARY, RL_BENCH_SHADOW };
+    int mismatches = 0;
+    for (int w = 0; w < RL_BENCH_PACKET_WORKLOADS; w++) {
+        size_t count = rays.count[workload[w]];
+        sc->packet_rays[w] = count;
+        sc->packet_hits_agree[w] = true;
+        if (count == 0)
+            continue;
+        progress(sc->label, "tracing packets of", bench_workload_name(workload[w]));
+        bench_timing timing[RL_BENCH_PACKET_RUNS];
+        bench_time_rays(list, batched, n, rays.rays[workload[w]], count,
+                        workload[w] == RL_BENCH_SHADOW, p->threads, p->min_runs, p->max_runs,
+                        p->min_total_s, timing);
+        const bench_packet_result *embree_packets = NULL;
+        for (int k = 0; k < n; k++) {
+            bench_packet_result *r = &sc->packet_runs[k];
+            r->timing[w] = timing[k];
+            if (timing[k].best_s > 0.0)
+                r->mrays_per_s[w] = (double)count / timing[k].best_s * 1e-6;
+            if (timing[k].best_cpu_s > 0.0)
+                r->mrays_per_cpu_s[w] = (double)count / timing[k].best_cpu_s * 1e-6;
+            if (r->kind == RL_ACCEL_EMBREE && r->packets)
+                embree_packets = r;
+            if (timing[k].hits != timing[0].hits)
+                sc->packet_hits_agree[w] = false;
+        }
+        for (int k = 0; k < n; k++) {
+            bench_packet_result *r = &sc->packet_runs[k];
+            if (embree_packets)
+                r->cpu_ratio_to_embree_packets[w] = r->mrays_per_cpu_s[w] /
+                                                    embree_packets->mrays_per_cpu_s[w];
+            /* Runs come in pairs: single, then packets of the same accel. */
+            const bench_packet_result *single = &sc->packet_runs[k & ~1];
+            r->cpu_ratio_to_single[w] = r->mrays_per_cpu_s[w] / single->mrays_per_cpu_s[w];
+        }
+        if (!sc->packet_hits_agree[w]) {
+            mismatches++;
+            if (rl_log_get_level() >= RL_LOG_WARN) {
+                fprintf(stderr, "rl: warning: bench: %s packets %s: hit counts differ:", sc->label,
+                        bench_workload_name(workload[w]));
+                for (int k = 0; k < n; k++)
+                    fprintf(stderr, " %s/%s %llu", rl_accel_kind_name(sc->packet_runs[k].kind),
+                            sc->packet_runs[k].packets ? "packets" : "single",
+                            (unsigned long long)sc->packet_runs[k].timing[w].hits);
+                fprintf(stderr, " (of %zu rays)\n", count);
+            }
+        }
+    }
+    bench_rays_free(&rays);
+    return mismatches;
 }
 
 /* Ratios to Embree of the same run, and the hit-count check; returns the
@@ -512,11 +604,12 @@ static bool run_scene(const rl_scene *scene, const bench_args *a, const bench_pa
         rl_accel_get_stats(built[i], &r->stats);
     }
     measure(built, &rays, p, sc);
+    bench_rays_free(&rays);   /* the packet workloads may be large too */
+    sc->packet_mismatches = measure_packets(scene, &cam, ref, built, p, sc);
     for (int i = 0; i < sc->num_accels; i++)
         if (built[i] != ref)
             rl_accel_release(built[i]);
     rl_accel_release(ref);
-    bench_rays_free(&rays);
     return ok;
 }
 
@@ -567,6 +660,34 @@ static void print_scene(const bench_scene_result *sc)
     fflush(stdout);
 }
 
+/* The packet section of a scene: Mrays per CPU second and CPU-time ratios. */
+static void print_packets(const bench_scene_result *sc)
+{
+    if (sc->num_packet_runs == 0)
+        return;
+    printf("  packets of 8 (%dx%d tiles)  %-8s  Mrays/CPU-s: %9s %9s   x single: %7s %7s   "
+           "x embree packets: %7s %7s\n", RL_BENCH_PACKET_TILE_W, RL_BENCH_PACKET_TILE_H, "",
+           "primary", "shadow", "primary", "shadow", "primary", "shadow");
+    for (int k = 0; k < sc->num_packet_runs; k++) {
+        const bench_packet_result *r = &sc->packet_runs[k];
+        printf("  %-6s %-20s %-8s %13s", rl_accel_kind_name(r->kind),
+               r->packets ? (r->kind == RL_ACCEL_EMBREE ? "rtcIntersect8" : "packets") : "single rays",
+               "", "");
+        for (int w = 0; w < RL_BENCH_PACKET_WORKLOADS; w++)
+            isfinite(r->mrays_per_cpu_s[w]) ? printf(" %9.2f", r->mrays_per_cpu_s[w]) : printf(" %9s", "-");
+        printf("   %9s", "");
+        for (int w = 0; w < RL_BENCH_PACKET_WORKLOADS; w++)
+            isfinite(r->cpu_ratio_to_single[w]) ? printf(" %6.2fx", r->cpu_ratio_to_single[w])
+                                                : printf(" %7s", "-");
+        printf("   %17s", "");
+        for (int w = 0; w < RL_BENCH_PACKET_WORKLOADS; w++)
+            isfinite(r->cpu_ratio_to_embree_packets[w]) ? printf(" %6.2fx", r->cpu_ratio_to_embree_packets[w])
+                                                        : printf(" %7s", "-");
+        putchar('\n');
+    }
+    fflush(stdout);
+}
+
 static int run(bench_args *a)
 {
     char out[4096];
@@ -601,8 +722,9 @@ static int run(bench_args *a)
         if (!run_scene(scenes[i], a, &p, sc))
             ok = false;
         if (strcmp(sc->status, "ok") == 0)
-            mismatches += compare(sc);
+            mismatches += compare(sc) + sc->packet_mismatches;
         print_scene(sc);
+        print_packets(sc);
         /* Free the scene now: the next one may be large. */
         rl_scene_release(scenes[i]);
         scenes[i] = NULL;

@@ -6,7 +6,8 @@
  *   RL_ACCEL_GRID   uniform voxel grid with 3D-DDA traversal (Amanatides &
  *                   Woo 1987); its voxels also host the Line Space
  *                   (Schröder 2017, Sec. 4.2);
- *   RL_ACCEL_EMBREE Embree 3 (rtcIntersect1/rtcOccluded1), the correctness
+ *   RL_ACCEL_EMBREE Embree 3 (rtcIntersect1/rtcOccluded1; rtcIntersect8/
+ *                   rtcOccluded8 in the batch queries), the correctness
  *                   oracle and performance anchor, when built with Embree;
  *   RL_ACCEL_BRUTE  every ray against every triangle with the same watertight
  *                   test: the reference for tests, O(N) per ray.
@@ -106,7 +107,15 @@ RL_API bool rl_accel_intersect_triangle(const rl_accel *accel, const rl_ray *ray
                                         rl_hit *hit);
 RL_API bool rl_accel_occluder(const rl_accel *accel, const rl_ray *ray, uint32_t *triangle);
 /* Batches: the same as calling the single-ray query for each ray in order
- * (same results), possibly faster. Single-threaded: callers parallelise. */
+ * (same results, bit for bit for our kinds), possibly faster.
+ * Single-threaded: callers parallelise. The rays go in groups of 8; in a
+ * group, the valid rays with t_min >= 0 whose directions share the octant
+ * of the first such ray form a packet when there are at least 4 of them,
+ * the rest are single queries. RL_ACCEL_BVH traces a packet with its
+ * packet traversal (one traversal for all lanes, src/accel/bvh_packet.c),
+ * RL_ACCEL_EMBREE with rtcIntersect8 / rtcOccluded8; the others loop.
+ * Coherent rays pay: neighbouring pixels' primary rays (a 4x2 tile per
+ * group), shadow rays from neighbouring points to one light. */
 RL_API void rl_accel_intersect_n(const rl_accel *accel, rl_ray *rays, rl_hit *hits, size_t n);
 RL_API void rl_accel_occluded_n(const rl_accel *accel, const rl_ray *rays, bool *occluded, size_t n);
 

@@ -189,6 +189,31 @@ static bool ray_is_valid(const rl_ray *r)
     return r->t_min <= r->t_max;
 }
 
+/* The rest of rl_accel_intersect once the kind found its first hit h for
+ * *ray (from a single query or a packet lane): skips alpha-mask holes,
+ * names the object, shortens the ray. */
+static bool finish_hit(const rl_accel *accel, rl_ray *ray, rl_hit *hit, rl_hit h)
+{
+    /* Alpha masks (glTF MASK): a hit in a hole is skipped by asking again
+     * beyond it. Every kind tests t in the open interval (t_min, t_max), so
+     * the same triangle is not found twice. Here rather than in each
+     * kind's inner loop: one place for all of them (Embree included), and
+     * no cost for scenes without masks. */
+    for (int skips = 0; accel->masked && rl_alpha_masked(accel->data, h.triangle, h.u, h.v); ++skips) {
+        if (skips == RL_MAX_MASK_SKIPS)
+            return false;
+        rl_ray r = *ray;
+        r.t_min = h.t;
+        h = (rl_hit){ .triangle = RL_ID_NONE, .object = RL_ID_NONE };
+        if (!accel->cls->intersect(accel->state, &r, &h))
+            return false;
+    }
+    h.object = accel->data->triangle_object[h.triangle];
+    ray->t_max = h.t;
+    *hit = h;
+    return true;
+}
+
 bool rl_accel_intersect(const rl_accel *accel, rl_ray *ray, rl_hit *hit)
 {
     if (!ray || !hit)
@@ -201,24 +226,7 @@ bool rl_accel_intersect(const rl_accel *accel, rl_ray *ray, rl_hit *hit)
     rl_ray r = *ray;
     if (!accel->cls->intersect(accel->state, &r, &h))
         return false;
-    /* Alpha masks (glTF MASK): a hit in a hole is skipped by asking again
-     * beyond it. Every kind tests t in the open interval (t_min, t_max), so
-     * the same triangle is not found twice. Here rather than in each
-     * kind's inner loop: one place for all of them (Embree included), and
-     * no cost for scenes without masks. */
-    for (int skips = 0; accel->masked && rl_alpha_masked(accel->data, h.triangle, h.u, h.v); ++skips) {
-        if (skips == RL_MAX_MASK_SKIPS)
-            return false;
-        r = *ray;
-        r.t_min = h.t;
-        h = (rl_hit){ .triangle = RL_ID_NONE, .object = RL_ID_NONE };
-        if (!accel->cls->intersect(accel->state, &r, &h))
-            return false;
-    }
-    h.object = accel->data->triangle_object[h.triangle];
-    ray->t_max = h.t;
-    *hit = h;
-    return true;
+    return finish_hit(accel, ray, hit, h);
 }
 
 bool rl_accel_occluded(const rl_accel *accel, const rl_ray *ray)
@@ -275,20 +283,98 @@ bool rl_accel_intersect_triangle(const rl_accel *accel, const rl_ray *ray, uint3
     return true;
 }
 
+/* Which rays of a group of up to RL_ACCEL_PACKET go through the kind's
+ * packet query: the valid ones with t_min >= 0 whose directions lie in the
+ * octant of the first such ray (a packet of mixed octants is exact too but
+ * visits the union of their paths). Fewer than PACKET_MIN such rays: none,
+ * single queries are then faster. The others take the single query. */
+#define PACKET_MIN 4
+
+static unsigned octant(const rl_ray *r)
+{
+    return (signbit(r->d.x) ? 1u : 0u) | (signbit(r->d.y) ? 2u : 0u) | (signbit(r->d.z) ? 4u : 0u);
+}
+
+static unsigned packet_lanes(const rl_ray *rays, size_t k)
+{
+    unsigned lanes = 0, first = 8;
+    int count = 0;
+    for (size_t l = 0; l < k; ++l) {
+        const rl_ray *r = &rays[l];
+        if (!(r->t_min >= 0.0f) || !ray_is_valid(r))
+            continue;
+        unsigned o = octant(r);
+        first = first == 8 ? o : first;
+        if (o == first) {
+            lanes |= 1u << l;
+            ++count;
+        }
+    }
+    return count >= PACKET_MIN ? lanes : 0;
+}
+
+/* Closest hits of up to RL_ACCEL_PACKET rays, the lanes of packet through
+ * the kind's packet query, the rest one by one. */
+static void intersect_group(const rl_accel *accel, rl_ray *rays, rl_hit *hits, size_t k, unsigned packet)
+{
+    rl_ray r[RL_ACCEL_PACKET];
+    rl_hit h[RL_ACCEL_PACKET];
+    for (size_t l = 0; l < k; ++l) {
+        if (!(packet & (1u << l))) {
+            rl_accel_intersect(accel, &rays[l], &hits[l]);
+            continue;
+        }
+        hits[l].triangle = RL_ID_NONE;
+        hits[l].object = RL_ID_NONE;
+        r[l] = rays[l];
+        h[l] = (rl_hit){ .triangle = RL_ID_NONE, .object = RL_ID_NONE };
+    }
+    if (!packet)
+        return;
+    unsigned found = accel->cls->intersect8(accel->state, r, h, packet);
+    for (size_t l = 0; l < k; ++l)
+        if (found & (1u << l))
+            finish_hit(accel, &rays[l], &hits[l], h[l]);
+}
+
 void rl_accel_intersect_n(const rl_accel *accel, rl_ray *rays, rl_hit *hits, size_t n)
 {
     if (!rays || !hits)
         return;
-    for (size_t i = 0; i < n; ++i)
-        rl_accel_intersect(accel, &rays[i], &hits[i]);
+    bool packets = accel && accel->committed && accel->cls->intersect8;
+    for (size_t i = 0; i < n; i += RL_ACCEL_PACKET) {
+        size_t k = n - i < RL_ACCEL_PACKET ? n - i : RL_ACCEL_PACKET;
+        intersect_group(accel, rays + i, hits + i, k, packets ? packet_lanes(rays + i, k) : 0);
+    }
 }
 
 void rl_accel_occluded_n(const rl_accel *accel, const rl_ray *rays, bool *occluded, size_t n)
 {
     if (!rays || !occluded)
         return;
-    for (size_t i = 0; i < n; ++i)
-        occluded[i] = rl_accel_occluded(accel, &rays[i]);
+    bool packets = accel && accel->committed && accel->cls->occluded8 && accel->cls->intersect8;
+    for (size_t i = 0; i < n; i += RL_ACCEL_PACKET) {
+        size_t k = n - i < RL_ACCEL_PACKET ? n - i : RL_ACCEL_PACKET;
+        unsigned packet = packets ? packet_lanes(rays + i, k) : 0;
+        if (!packet) {
+            for (size_t l = 0; l < k; ++l)
+                occluded[i + l] = rl_accel_occluded(accel, &rays[i + l]);
+            continue;
+        }
+        if (accel->masked) {
+            /* As rl_accel_occluded: the closest hit beyond the holes. */
+            rl_ray r[RL_ACCEL_PACKET];
+            rl_hit h[RL_ACCEL_PACKET];
+            memcpy(r, rays + i, k * sizeof *r);
+            intersect_group(accel, r, h, k, packet);
+            for (size_t l = 0; l < k; ++l)
+                occluded[i + l] = h[l].triangle != RL_ID_NONE;
+            continue;
+        }
+        unsigned blocked = accel->cls->occluded8(accel->state, rays + i, packet);
+        for (size_t l = 0; l < k; ++l)
+            occluded[i + l] = packet & (1u << l) ? (blocked >> l) & 1u : rl_accel_occluded(accel, &rays[i + l]);
+    }
 }
 
 const struct rl_grid *rl_accel_grid_state(const rl_accel *a)

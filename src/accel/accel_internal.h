@@ -22,7 +22,18 @@ typedef struct rl_accel_class {
      * NULL: accel.c then asks intersect, which names the closest. */
     bool (*occluder)(const void *state, const rl_ray *ray, uint32_t *triangle);
     void (*release)(void *state);
+    /* Packets of RL_ACCEL_PACKET rays for the batch queries (may be NULL:
+     * accel.c then loops over single rays). Lanes in active (bit l: rays[l])
+     * are valid rays with t_min >= 0 whose directions share one octant;
+     * each lane's result must be exactly the single query's. intersect8
+     * returns the lanes that hit, with their rays' t_max shortened and hits
+     * filled as intersect does; occluded8 returns the blocked lanes. */
+    unsigned (*intersect8)(const void *state, rl_ray *rays, rl_hit *hits, unsigned active);
+    unsigned (*occluded8)(const void *state, const rl_ray *rays, unsigned active);
 } rl_accel_class;
+
+/* Rays per packet of the batch queries (as Embree's rtcIntersect8). */
+#define RL_ACCEL_PACKET 8
 
 extern const rl_accel_class rl_accel_bvh_class;
 extern const rl_accel_class rl_accel_grid_class;

@@ -55,6 +55,18 @@ static bool bvh_occluder(const void *state, const rl_ray *ray, uint32_t *triangl
     return rl_bvh_wide_occluder(state, ray, triangle);
 }
 
+#if RL_BVH_PACKETS
+static unsigned bvh_intersect8(const void *state, rl_ray *rays, rl_hit *hits, unsigned active)
+{
+    return rl_bvh_packet_intersect(state, rays, hits, active);
+}
+
+static unsigned bvh_occluded8(const void *state, const rl_ray *rays, unsigned active)
+{
+    return rl_bvh_packet_occluded(state, rays, active);
+}
+#endif
+
 static void bvh_release(void *state)
 {
     rl_bvh_free(state);
@@ -68,4 +80,8 @@ const rl_accel_class rl_accel_bvh_class = {
     .occluded = bvh_occluded,
     .occluder = bvh_occluder,
     .release = bvh_release,
+#if RL_BVH_PACKETS
+    .intersect8 = bvh_intersect8,
+    .occluded8 = bvh_occluded8,
+#endif
 };

@@ -11,7 +11,13 @@
 #ifndef RL_ACCEL_BVH_H
 #define RL_ACCEL_BVH_H
 
+#include <math.h>
 #include <stdint.h>
+#include <string.h>
+
+#if defined(__SSE2__)
+#include <immintrin.h>
+#endif
 
 #include "accel/accel_internal.h"
 
@@ -89,9 +95,151 @@ void rl_bvh_free(rl_bvh *bvh);
 rl_status rl_bvh_widen(rl_bvh *bvh);
 
 /* Traversal of the wide tree (bvh_wide_traverse.c). */
+/* A ray's slab-test constants (Williams et al. 2005: the near plane per axis
+ * by the direction's sign). */
+typedef struct rl_bvh_ray_pre {
+    float o[3], inv[3];
+    int neg[3];
+} rl_bvh_ray_pre;
+
+static inline void rl_bvh_ray_pre_setup(const rl_ray *r, rl_bvh_ray_pre *p)
+{
+    const float d[3] = { r->d.x, r->d.y, r->d.z };
+    p->o[0] = r->o.x;
+    p->o[1] = r->o.y;
+    p->o[2] = r->o.z;
+    for (int a = 0; a < 3; ++a) {
+        p->inv[a] = 1.0f / d[a];
+        p->neg[a] = signbit(d[a]) ? 1 : 0;
+    }
+}
+
+/* The boxes' relative slack (bvh_wide_traverse.c). */
+#define RL_BVH_SLACK_LO (1.0f - 0x1p-15f)
+#define RL_BVH_SLACK_HI (1.0f + 0x1p-15f)
+
+/* Entry distances of the children; returns the mask of hit lanes. The
+ * interval [lo, hi] is widened by a relative 2^-15 so that rounding never
+ * loses a flat box (a wall: lo == hi). Scaling by (1 -+ eps) widens it only
+ * for lo, hi >= 0, which holds whenever t_min >= 0 (else lo >= 0 > hi and
+ * the box is rejected anyway); a range reaching back (t_min < 0) takes the
+ * sign-safe form. */
+static inline int rl_bvh_box_n(const rl_bvh_wide_node *n, const rl_bvh_ray_pre *r, float t_min, float t_max, float dist[RL_BVH_WIDTH])
+{
+#if defined(__AVX__) && RL_BVH_WIDTH == 8
+    __m256 lo = _mm256_set1_ps(t_min), hi = _mm256_set1_ps(t_max);
+    for (int a = 0; a < 3; ++a) {
+        __m256 o = _mm256_set1_ps(r->o[a]), inv = _mm256_set1_ps(r->inv[a]);
+        __m256 near = _mm256_loadu_ps(r->neg[a] ? n->bmax[a] : n->bmin[a]);
+        __m256 far = _mm256_loadu_ps(r->neg[a] ? n->bmin[a] : n->bmax[a]);
+        lo = _mm256_max_ps(_mm256_mul_ps(_mm256_sub_ps(near, o), inv), lo);
+        hi = _mm256_min_ps(_mm256_mul_ps(_mm256_sub_ps(far, o), inv), hi);
+    }
+    _mm256_storeu_ps(dist, lo);
+    if (t_min < 0.0f) {
+        /* The slack must widen the interval whatever the signs (below). */
+        const __m256 abs = _mm256_castsi256_ps(_mm256_set1_epi32(0x7fffffff));
+        const __m256 eps = _mm256_set1_ps(0x1p-15f);
+        lo = _mm256_sub_ps(lo, _mm256_mul_ps(_mm256_and_ps(lo, abs), eps));
+        hi = _mm256_add_ps(hi, _mm256_mul_ps(_mm256_and_ps(hi, abs), eps));
+        return _mm256_movemask_ps(_mm256_cmp_ps(lo, hi, _CMP_LE_OQ));
+    }
+    return _mm256_movemask_ps(_mm256_cmp_ps(_mm256_mul_ps(lo, _mm256_set1_ps(RL_BVH_SLACK_LO)),
+                                            _mm256_mul_ps(hi, _mm256_set1_ps(RL_BVH_SLACK_HI)), _CMP_LE_OQ));
+#elif defined(__SSE2__)
+    int mask = 0;
+    for (int c = 0; c < RL_BVH_WIDTH; c += 4) {
+        __m128 lo = _mm_set1_ps(t_min), hi = _mm_set1_ps(t_max);
+        for (int a = 0; a < 3; ++a) {
+            __m128 o = _mm_set1_ps(r->o[a]), inv = _mm_set1_ps(r->inv[a]);
+            __m128 near = _mm_loadu_ps((r->neg[a] ? n->bmax[a] : n->bmin[a]) + c);
+            __m128 far = _mm_loadu_ps((r->neg[a] ? n->bmin[a] : n->bmax[a]) + c);
+            lo = _mm_max_ps(_mm_mul_ps(_mm_sub_ps(near, o), inv), lo);
+            hi = _mm_min_ps(_mm_mul_ps(_mm_sub_ps(far, o), inv), hi);
+        }
+        _mm_storeu_ps(dist + c, lo);
+        if (t_min < 0.0f) {
+            const __m128 abs = _mm_castsi128_ps(_mm_set1_epi32(0x7fffffff));
+            const __m128 eps = _mm_set1_ps(0x1p-15f);
+            lo = _mm_sub_ps(lo, _mm_mul_ps(_mm_and_ps(lo, abs), eps));
+            hi = _mm_add_ps(hi, _mm_mul_ps(_mm_and_ps(hi, abs), eps));
+            mask |= _mm_movemask_ps(_mm_cmple_ps(lo, hi)) << c;
+            continue;
+        }
+        mask |= _mm_movemask_ps(_mm_cmple_ps(_mm_mul_ps(lo, _mm_set1_ps(RL_BVH_SLACK_LO)),
+                                             _mm_mul_ps(hi, _mm_set1_ps(RL_BVH_SLACK_HI)))) << c;
+    }
+    return mask;
+#else
+    int mask = 0;
+    for (int i = 0; i < RL_BVH_WIDTH; ++i) {
+        float lo = t_min, hi = t_max;
+        for (int a = 0; a < 3; ++a) {
+            float near = r->neg[a] ? n->bmax[a][i] : n->bmin[a][i];
+            float far = r->neg[a] ? n->bmin[a][i] : n->bmax[a][i];
+            float tn = (near - r->o[a]) * r->inv[a];
+            float tf = (far - r->o[a]) * r->inv[a];
+            lo = tn > lo ? tn : lo;
+            hi = tf < hi ? tf : hi;
+        }
+        dist[i] = lo;
+        if (lo - fabsf(lo) * 0x1p-15f <= hi + fabsf(hi) * 0x1p-15f)
+            mask |= 1 << i;
+    }
+    return mask;
+#endif
+}
+
+/* nextafterf(t, INFINITY) for a finite t, without the libm call. */
+static inline float rl_bvh_next_up(float t)
+{
+    uint32_t u;
+    memcpy(&u, &t, sizeof u);
+    if (u == 0x80000000u)   /* -0 */
+        u = 1u;
+    else if (u & 0x80000000u)
+        u -= 1u;
+    else
+        u += 1u;
+    memcpy(&t, &u, sizeof t);
+    return t;
+}
+
+/* The closest hit so far, with the tie rule of accel.c (equal t: lowest
+ * ID): t_test = next_up(t) lets equal t through to the ID comparison. */
+typedef struct rl_bvh_closest {
+    float t, t_test, u, v;
+    uint32_t id;
+} rl_bvh_closest;
+
 bool rl_bvh_wide_intersect(const rl_bvh *bvh, rl_ray *ray, rl_hit *hit);
 bool rl_bvh_wide_occluded(const rl_bvh *bvh, const rl_ray *ray);
 /* rl_bvh_wide_occluded naming the first blocking triangle it met. */
 bool rl_bvh_wide_occluder(const rl_bvh *bvh, const rl_ray *ray, uint32_t *triangle);
+/* The single-ray traversal from one entry of the tree (ref, count as in a
+ * wide node's child: count 0 = inner node ref, else a leaf's first block),
+ * for the packet traversal's lanes (bvh_packet.c). Updates *c / returns a
+ * blocking triangle or RL_ID_NONE. */
+void rl_bvh_closest_from(const rl_bvh *bvh, const rl_bvh_ray_pre *p, const rl_ray_watertight *w, float t_min,
+                         uint32_t ref, uint32_t count, rl_bvh_closest *c);
+void rl_bvh_leaf_closest(const rl_bvh *bvh, uint32_t ref, uint32_t count, const rl_ray_watertight *w, float t_min,
+                         rl_bvh_closest *c);
+uint32_t rl_bvh_occluder_from(const rl_bvh *bvh, const rl_bvh_ray_pre *p, const rl_ray_watertight *w, float t_min,
+                              float t_max, uint32_t ref, uint32_t count);
+
+/* Packet traversal of up to RL_BVH_PACKET coherent rays (bvh_packet.c):
+ * lanes in active (bit l: rays[l]; valid rays with t_min >= 0 only). The
+ * same hits, bit for bit, as the single-ray traversal of each lane:
+ * intersect returns the lanes that hit and shortens their t_max and fills
+ * their hits as rl_bvh_wide_intersect does; occluded returns the blocked
+ * lanes. */
+#define RL_BVH_PACKET 8
+/* Compile-time switch: -DRL_BVH_PACKETS=0 sends the batch queries down the
+ * single-ray path (accel.c loops). */
+#ifndef RL_BVH_PACKETS
+#define RL_BVH_PACKETS 1
+#endif
+unsigned rl_bvh_packet_intersect(const rl_bvh *bvh, rl_ray *rays, rl_hit *hits, unsigned active);
+unsigned rl_bvh_packet_occluded(const rl_bvh *bvh, const rl_ray *rays, unsigned active);
 
 #endif

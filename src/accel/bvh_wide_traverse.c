@@ -34,13 +34,8 @@
 #include "accel/bvh.h"
 #include "accel/watertight.h"
 
-#define SLACK_LO (1.0f - 0x1p-15f)
-#define SLACK_HI (1.0f + 0x1p-15f)
 
-typedef struct ray_pre {
-    float o[3], inv[3];
-    int neg[3];
-} ray_pre;
+typedef rl_bvh_ray_pre ray_pre;
 
 typedef struct entry {
     uint32_t ref;             /* wide node, or first block of a leaf */
@@ -50,87 +45,10 @@ typedef struct entry {
 
 static inline void ray_pre_setup(const rl_ray *r, ray_pre *p)
 {
-    const float d[3] = { r->d.x, r->d.y, r->d.z };
-    p->o[0] = r->o.x;
-    p->o[1] = r->o.y;
-    p->o[2] = r->o.z;
-    for (int a = 0; a < 3; ++a) {
-        p->inv[a] = 1.0f / d[a];
-        p->neg[a] = signbit(d[a]) ? 1 : 0;
-    }
+    rl_bvh_ray_pre_setup(r, p);
 }
 
-/* Entry distances of the children; returns the mask of hit lanes. The
- * interval [lo, hi] is widened by a relative 2^-15 so that rounding never
- * loses a flat box (a wall: lo == hi). Scaling by (1 -+ eps) widens it only
- * for lo, hi >= 0, which holds whenever t_min >= 0 (else lo >= 0 > hi and
- * the box is rejected anyway); a range reaching back (t_min < 0) takes the
- * sign-safe form. */
-static inline int box_n(const rl_bvh_wide_node *n, const ray_pre *r, float t_min, float t_max, float dist[RL_BVH_WIDTH])
-{
-#if defined(__AVX__) && RL_BVH_WIDTH == 8
-    __m256 lo = _mm256_set1_ps(t_min), hi = _mm256_set1_ps(t_max);
-    for (int a = 0; a < 3; ++a) {
-        __m256 o = _mm256_set1_ps(r->o[a]), inv = _mm256_set1_ps(r->inv[a]);
-        __m256 near = _mm256_loadu_ps(r->neg[a] ? n->bmax[a] : n->bmin[a]);
-        __m256 far = _mm256_loadu_ps(r->neg[a] ? n->bmin[a] : n->bmax[a]);
-        lo = _mm256_max_ps(_mm256_mul_ps(_mm256_sub_ps(near, o), inv), lo);
-        hi = _mm256_min_ps(_mm256_mul_ps(_mm256_sub_ps(far, o), inv), hi);
-    }
-    _mm256_storeu_ps(dist, lo);
-    if (t_min < 0.0f) {
-        /* The slack must widen the interval whatever the signs (below). */
-        const __m256 abs = _mm256_castsi256_ps(_mm256_set1_epi32(0x7fffffff));
-        const __m256 eps = _mm256_set1_ps(0x1p-15f);
-        lo = _mm256_sub_ps(lo, _mm256_mul_ps(_mm256_and_ps(lo, abs), eps));
-        hi = _mm256_add_ps(hi, _mm256_mul_ps(_mm256_and_ps(hi, abs), eps));
-        return _mm256_movemask_ps(_mm256_cmp_ps(lo, hi, _CMP_LE_OQ));
-    }
-    return _mm256_movemask_ps(_mm256_cmp_ps(_mm256_mul_ps(lo, _mm256_set1_ps(SLACK_LO)),
-                                            _mm256_mul_ps(hi, _mm256_set1_ps(SLACK_HI)), _CMP_LE_OQ));
-#elif defined(__SSE2__)
-    int mask = 0;
-    for (int c = 0; c < RL_BVH_WIDTH; c += 4) {
-        __m128 lo = _mm_set1_ps(t_min), hi = _mm_set1_ps(t_max);
-        for (int a = 0; a < 3; ++a) {
-            __m128 o = _mm_set1_ps(r->o[a]), inv = _mm_set1_ps(r->inv[a]);
-            __m128 near = _mm_loadu_ps((r->neg[a] ? n->bmax[a] : n->bmin[a]) + c);
-            __m128 far = _mm_loadu_ps((r->neg[a] ? n->bmin[a] : n->bmax[a]) + c);
-            lo = _mm_max_ps(_mm_mul_ps(_mm_sub_ps(near, o), inv), lo);
-            hi = _mm_min_ps(_mm_mul_ps(_mm_sub_ps(far, o), inv), hi);
-        }
-        _mm_storeu_ps(dist + c, lo);
-        if (t_min < 0.0f) {
-            const __m128 abs = _mm_castsi128_ps(_mm_set1_epi32(0x7fffffff));
-            const __m128 eps = _mm_set1_ps(0x1p-15f);
-            lo = _mm_sub_ps(lo, _mm_mul_ps(_mm_and_ps(lo, abs), eps));
-            hi = _mm_add_ps(hi, _mm_mul_ps(_mm_and_ps(hi, abs), eps));
-            mask |= _mm_movemask_ps(_mm_cmple_ps(lo, hi)) << c;
-            continue;
-        }
-        mask |= _mm_movemask_ps(_mm_cmple_ps(_mm_mul_ps(lo, _mm_set1_ps(SLACK_LO)),
-                                             _mm_mul_ps(hi, _mm_set1_ps(SLACK_HI)))) << c;
-    }
-    return mask;
-#else
-    int mask = 0;
-    for (int i = 0; i < RL_BVH_WIDTH; ++i) {
-        float lo = t_min, hi = t_max;
-        for (int a = 0; a < 3; ++a) {
-            float near = r->neg[a] ? n->bmax[a][i] : n->bmin[a][i];
-            float far = r->neg[a] ? n->bmin[a][i] : n->bmax[a][i];
-            float tn = (near - r->o[a]) * r->inv[a];
-            float tf = (far - r->o[a]) * r->inv[a];
-            lo = tn > lo ? tn : lo;
-            hi = tf < hi ? tf : hi;
-        }
-        dist[i] = lo;
-        if (lo - fabsf(lo) * 0x1p-15f <= hi + fabsf(hi) * 0x1p-15f)
-            mask |= 1 << i;
-    }
-    return mask;
-#endif
-}
+#define box_n rl_bvh_box_n
 
 /* Incoherent rays are bound by memory latency: start fetching every child
  * we will visit (node: all its cache lines; leaf: its triangles' first lines). */
@@ -225,27 +143,11 @@ static inline bool visit(const rl_bvh *bvh, const rl_bvh_wide_node *n, const ray
     return true;
 }
 
-/* nextafterf(t, INFINITY) for a finite t, without the libm call. */
-static inline float next_up(float t)
-{
-    uint32_t u;
-    memcpy(&u, &t, sizeof u);
-    if (u == 0x80000000u)   /* -0 */
-        u = 1u;
-    else if (u & 0x80000000u)
-        u -= 1u;
-    else
-        u += 1u;
-    memcpy(&t, &u, sizeof t);
-    return t;
-}
+#define next_up rl_bvh_next_up
 
 /* The closest hit so far, with the tie rule of accel.c (equal t: lowest
  * ID): t_test lets equal t through to the ID comparison. */
-typedef struct closest {
-    float t, t_test, u, v;
-    uint32_t id;
-} closest;
+typedef rl_bvh_closest closest;
 
 /* Lane l of a block as the scalar test's vertices. */
 static inline void block_lane(const rl_bvh_block *b, int l, rl_vec3 p[3])
@@ -404,6 +306,45 @@ static uint32_t leaf_any(const rl_bvh_block *tri, uint32_t count, const rl_ray_w
     }
 }
 
+/* The closest-hit traversal of the subtree (or leaf) start, updating *c:
+ * the whole tree for a single ray, a subtree for a lane that leaves a
+ * packet (bvh_packet.c). */
+static inline void closest_from(const rl_bvh *bvh, const ray_pre *p, const rl_ray_watertight *w, float t_min,
+                                entry cur, closest *c)
+{
+    entry stack[RL_BVH_WIDE_STACK + 1];
+    int sp = 0;
+    for (;;) {
+        if (cur.count == 0) {
+            if (visit(bvh, &bvh->wide[cur.ref], p, t_min, c->t, stack, &sp, &cur))
+                continue;
+        } else {
+            leaf_closest(&bvh->blocks[cur.ref], cur.count, w, t_min, c);
+        }
+        /* Pop, skipping boxes that now start beyond the closest hit. */
+        for (;;) {
+            if (sp == 0)
+                return;
+            cur = stack[--sp];
+            /* The same relative slack as box_n, sign-safe (t may be < 0). */
+            if (cur.dist - fabsf(cur.dist) * 0x1p-15f <= c->t + fabsf(c->t) * 0x1p-15f)
+                break;
+        }
+    }
+}
+
+void rl_bvh_closest_from(const rl_bvh *bvh, const rl_bvh_ray_pre *p, const rl_ray_watertight *w, float t_min,
+                         uint32_t ref, uint32_t count, rl_bvh_closest *c)
+{
+    closest_from(bvh, p, w, t_min, (entry){ ref, count, t_min }, c);
+}
+
+void rl_bvh_leaf_closest(const rl_bvh *bvh, uint32_t ref, uint32_t count, const rl_ray_watertight *w, float t_min,
+                         rl_bvh_closest *c)
+{
+    leaf_closest(&bvh->blocks[ref], count, w, t_min, c);
+}
+
 bool rl_bvh_wide_intersect(const rl_bvh *bvh, rl_ray *ray, rl_hit *hit)
 {
     ray_pre p;
@@ -412,27 +353,7 @@ bool rl_bvh_wide_intersect(const rl_bvh *bvh, rl_ray *ray, rl_hit *hit)
     rl_ray_watertight_setup(ray, &w);
     const float t_min = ray->t_min;
     closest c = { ray->t_max, ray->t_max, 0.0f, 0.0f, RL_ID_NONE };
-    entry stack[RL_BVH_WIDE_STACK + 1];
-    int sp = 0;
-    entry cur = { 0, 0, t_min };
-    for (;;) {
-        if (cur.count == 0) {
-            if (visit(bvh, &bvh->wide[cur.ref], &p, t_min, c.t, stack, &sp, &cur))
-                continue;
-        } else {
-            leaf_closest(&bvh->blocks[cur.ref], cur.count, &w, t_min, &c);
-        }
-        /* Pop, skipping boxes that now start beyond the closest hit. */
-        for (;;) {
-            if (sp == 0)
-                goto finished;
-            cur = stack[--sp];
-            /* The same relative slack as box_n, sign-safe (t may be < 0). */
-            if (cur.dist - fabsf(cur.dist) * 0x1p-15f <= c.t + fabsf(c.t) * 0x1p-15f)
-                break;
-        }
-    }
-finished:
+    closest_from(bvh, &p, &w, t_min, (entry){ 0, 0, t_min }, &c);
     if (c.id == RL_ID_NONE)
         return false;
     ray->t_max = c.t;
@@ -446,31 +367,42 @@ bool rl_bvh_wide_occluded(const rl_bvh *bvh, const rl_ray *ray)
     return rl_bvh_wide_occluder(bvh, ray, &triangle);
 }
 
+/* The any-hit traversal of the subtree (or leaf) start: the ID of a
+ * blocking triangle, RL_ID_NONE if none. */
+static inline uint32_t occluder_from(const rl_bvh *bvh, const ray_pre *p, const rl_ray_watertight *w, float t_min,
+                                     float t_max, entry cur)
+{
+    entry stack[RL_BVH_WIDE_STACK + 1];
+    int sp = 0;
+    for (;;) {
+        if (cur.count == 0) {
+            if (visit(bvh, &bvh->wide[cur.ref], p, t_min, t_max, stack, &sp, &cur))
+                continue;
+        } else {
+            uint32_t id = leaf_any(&bvh->blocks[cur.ref], cur.count, w, t_min, t_max);
+            if (id != RL_ID_NONE)
+                return id;   /* any hit will do */
+        }
+        if (sp == 0)
+            return RL_ID_NONE;
+        cur = stack[--sp];
+    }
+}
+
+uint32_t rl_bvh_occluder_from(const rl_bvh *bvh, const rl_bvh_ray_pre *p, const rl_ray_watertight *w, float t_min,
+                              float t_max, uint32_t ref, uint32_t count)
+{
+    if (count)
+        return leaf_any(&bvh->blocks[ref], count, w, t_min, t_max);
+    return occluder_from(bvh, p, w, t_min, t_max, (entry){ ref, count, t_min });
+}
+
 bool rl_bvh_wide_occluder(const rl_bvh *bvh, const rl_ray *ray, uint32_t *triangle)
 {
     ray_pre p;
     ray_pre_setup(ray, &p);
     rl_ray_watertight w;
     rl_ray_watertight_setup(ray, &w);
-    const float t_min = ray->t_min, t_max = ray->t_max;
-    entry stack[RL_BVH_WIDE_STACK + 1];
-    int sp = 0;
-    entry cur = { 0, 0, t_min };
-    for (;;) {
-        if (cur.count == 0) {
-            if (visit(bvh, &bvh->wide[cur.ref], &p, t_min, t_max, stack, &sp, &cur))
-                continue;
-        } else {
-            uint32_t id = leaf_any(&bvh->blocks[cur.ref], cur.count, &w, t_min, t_max);
-            if (id != RL_ID_NONE) {
-                *triangle = id;
-                return true;   /* any hit will do */
-            }
-        }
-        if (sp == 0) {
-            *triangle = RL_ID_NONE;
-            return false;
-        }
-        cur = stack[--sp];
-    }
+    *triangle = occluder_from(bvh, &p, &w, ray->t_min, ray->t_max, (entry){ 0, 0, ray->t_min });
+    return *triangle != RL_ID_NONE;
 }

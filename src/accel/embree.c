@@ -26,7 +26,8 @@
  *    serialised here, and one that would overlap another is skipped.
  *
  * Builds use TBB; desc->threads > 0 becomes the device config "threads=N".
- * Queries are thread-safe (Embree's rtcIntersect1/rtcOccluded1 are). */
+ * Queries are thread-safe (Embree's rtcIntersect1/rtcOccluded1 and the
+ * packet calls rtcIntersect8/rtcOccluded8 of the batch queries are). */
 #ifdef RL_HAVE_EMBREE
 
 #include <math.h>
@@ -50,6 +51,7 @@ typedef struct embree_accel {
     void *user;
     atomic_flag progress_busy;
     atomic_bool cancelled;
+    bool ray8;                           /* rtcIntersect8 in this Embree build */
 } embree_accel;
 
 static const char *error_text(enum RTCError code)
@@ -182,6 +184,7 @@ static rl_status embree_build(const rl_scene_data *data, const rl_accel_desc *de
                         error_text(code));
     }
     rtcSetDeviceErrorFunction(e->device, on_error, NULL);
+    e->ray8 = rtcGetDeviceProperty(e->device, RTC_DEVICE_PROPERTY_NATIVE_RAY8_SUPPORTED) != 0;
     rtcSetDeviceMemoryMonitorFunction(e->device, on_memory, e);
 
     e->scene = rtcNewScene(e->device);
@@ -263,12 +266,106 @@ static bool embree_occluded(const void *state, const rl_ray *ray)
     return r.tfar == -INFINITY;   /* Embree's mark for "something was hit" */
 }
 
+/* Packets (accel.c's batch queries): Embree's own 8-wide packet traversal,
+ * rtcIntersect8 / rtcOccluded8, with the coherent-rays hint, so that `rl
+ * bench rays` compares our packets with Embree's. Lanes are set up as by
+ * setup_ray. Without packet support in this Embree build, single rays. */
+static void setup_ray8(const rl_ray *ray, struct RTCRay8 *r, int l, float *shift)
+{
+    struct RTCRay one;
+    *shift = setup_ray(ray, &one);
+    r->org_x[l] = one.org_x;
+    r->org_y[l] = one.org_y;
+    r->org_z[l] = one.org_z;
+    r->dir_x[l] = one.dir_x;
+    r->dir_y[l] = one.dir_y;
+    r->dir_z[l] = one.dir_z;
+    r->tnear[l] = one.tnear;
+    r->tfar[l] = one.tfar;
+    r->time[l] = 0.0f;
+    r->mask[l] = 0xFFFFFFFFu;
+    r->id[l] = 0;
+    r->flags[l] = 0;
+}
+
+static unsigned embree_intersect8(const void *state, rl_ray *rays, rl_hit *hits, unsigned active)
+{
+    const embree_accel *e = state;
+    unsigned found = 0;
+    if (!e->ray8) {
+        for (int l = 0; l < 8; ++l)
+            if ((active & (1u << l)) && embree_intersect(state, &rays[l], &hits[l]))
+                found |= 1u << l;
+        return found;
+    }
+    struct RTCIntersectContext ctx;
+    rtcInitIntersectContext(&ctx);
+    ctx.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
+    struct RTCRayHit8 rh;   /* RTC_ALIGN(32) by declaration */
+    int valid[8];
+    float shift[8] = { 0.0f };
+    memset(&rh, 0, sizeof rh);
+    for (int l = 0; l < 8; ++l) {
+        valid[l] = active & (1u << l) ? -1 : 0;
+        if (valid[l])
+            setup_ray8(&rays[l], &rh.ray, l, &shift[l]);
+        rh.hit.geomID[l] = RTC_INVALID_GEOMETRY_ID;
+        rh.hit.primID[l] = RTC_INVALID_GEOMETRY_ID;
+        rh.hit.instID[0][l] = RTC_INVALID_GEOMETRY_ID;
+    }
+    rtcIntersect8(valid, e->scene, &ctx, &rh);
+    for (int l = 0; l < 8; ++l) {
+        if (!valid[l] || rh.hit.geomID[l] == RTC_INVALID_GEOMETRY_ID)
+            continue;
+        float t = rh.ray.tfar[l] + shift[l];
+        rays[l].t_max = t;
+        hits[l].t = t;
+        hits[l].u = rh.hit.u[l];
+        hits[l].v = rh.hit.v[l];
+        hits[l].triangle = rh.hit.primID[l];
+        hits[l].object = e->triangle_object[rh.hit.primID[l]];
+        found |= 1u << l;
+    }
+    return found;
+}
+
+static unsigned embree_occluded8(const void *state, const rl_ray *rays, unsigned active)
+{
+    const embree_accel *e = state;
+    unsigned blocked = 0;
+    if (!e->ray8) {
+        for (int l = 0; l < 8; ++l)
+            if ((active & (1u << l)) && embree_occluded(state, &rays[l]))
+                blocked |= 1u << l;
+        return blocked;
+    }
+    struct RTCIntersectContext ctx;
+    rtcInitIntersectContext(&ctx);
+    ctx.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
+    struct RTCRay8 r;
+    int valid[8];
+    memset(&r, 0, sizeof r);
+    for (int l = 0; l < 8; ++l) {
+        float shift;
+        valid[l] = active & (1u << l) ? -1 : 0;
+        if (valid[l])
+            setup_ray8(&rays[l], &r, l, &shift);
+    }
+    rtcOccluded8(valid, e->scene, &ctx, &r);
+    for (int l = 0; l < 8; ++l)
+        if (valid[l] && r.tfar[l] == -INFINITY)
+            blocked |= 1u << l;
+    return blocked;
+}
+
 const rl_accel_class rl_accel_embree_class = {
     .name = "embree",
     .build = embree_build,
     .intersect = embree_intersect,
     .occluded = embree_occluded,
     .release = embree_release,
+    .intersect8 = embree_intersect8,
+    .occluded8 = embree_occluded8,
 };
 
 #endif /* RL_HAVE_EMBREE */

@@ -27,17 +27,9 @@
 
 void rl_ray_watertight_setup(const rl_ray *ray, rl_ray_watertight *w)
 {
-    float ax = fabsf(ray->d.x), ay = fabsf(ray->d.y), az = fabsf(ray->d.z);
-    int kz = ax > ay ? (ax > az ? 0 : 2) : (ay > az ? 1 : 2);
-    int kx = kz == 2 ? 0 : kz + 1;
-    int ky = kx == 2 ? 0 : kx + 1;
+    int kx, ky, kz;
+    rl_watertight_axes(ray->d, &kx, &ky, &kz);
     float dz = rl_vget(ray->d, kz);
-    /* Keep the winding of the projected triangle: swap when looking down -z. */
-    if (dz < 0.0f) {
-        int s = kx;
-        kx = ky;
-        ky = s;
-    }
     w->kx = kx;
     w->ky = ky;
     w->kz = kz;

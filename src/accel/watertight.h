@@ -16,6 +16,25 @@
 #define RL_WT_INLINE static inline
 #endif
 
+/* The axis permutation of rl_ray_watertight_setup: kz = the largest |d|
+ * component, kx, ky the next ones cyclically, swapped when looking down
+ * -z so that the projected triangle keeps its winding. */
+static inline void rl_watertight_axes(rl_vec3 d, int *kx, int *ky, int *kz)
+{
+    float ax = fabsf(d.x), ay = fabsf(d.y), az = fabsf(d.z);
+    int z = ax > ay ? (ax > az ? 0 : 2) : (ay > az ? 1 : 2);
+    int x = z == 2 ? 0 : z + 1;
+    int y = x == 2 ? 0 : x + 1;
+    if (rl_vget(d, z) < 0.0f) {
+        int s = x;
+        x = y;
+        y = s;
+    }
+    *kx = x;
+    *ky = y;
+    *kz = z;
+}
+
 /* Component k of v; with a constant k the choice folds away. */
 #define RL_WT_COMP(v, k) ((k) == 0 ? (v).x : ((k) == 1 ? (v).y : (v).z))
 

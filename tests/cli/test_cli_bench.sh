@@ -2,7 +2,8 @@
 # test_cli_bench.sh: `rl bench rays --quick` runs every available accelerator
 # on the Cornell box and writes a complete JSON record in which our own
 # accelerators (which share the watertight triangle test) agree on every hit
-# count; missing mesh files are skipped, bad usage exits 2, an unwritable
+# count, with the packet section (bvh and embree, single rays and packets of
+# 8, whose hit counts agree too); missing mesh files are skipped, bad usage exits 2, an unwritable
 # output 1. Keeps the benchmark from rotting; it measures nothing.
 # Run as: bash test_cli_bench.sh <rl-binary> <scratch-dir>
 set -u
@@ -53,7 +54,35 @@ for w in ("primary", "shadow", "diffuse"):
     # The shadow and diffuse workloads are neither all hits nor all misses.
     if w != "primary":
         assert 0 < hits["brute"] < s["rays"][w], "%s: %s of %s rays hit" % (w, hits, s["rays"][w])
+# The packet section: bvh (and embree) with single queries and with the
+# batch queries in packets of 8, on the primary rays of 4x2 tiles and their
+# shadow rays, in the same run. Our packets find exactly the single rays'
+# hits; the workloads are the main ones in another order.
+p = s["packets"]
+assert p["tile"] == "4x2" and p["packet_size"] == 8
+assert p["rays"]["primary"] == s["rays"]["primary"] and p["rays"]["shadow"] == s["rays"]["shadow"]
+runs = {(x["accel"], x["mode"]): x for x in p["runs"]}
+want = {("bvh", "single"), ("bvh", "packets")} | ({("embree", "single"), ("embree", "packets")} if r["embree"] else set())
+assert set(runs) == want, "packet runs %s" % sorted(runs)
+for (name, mode), x in runs.items():
+    for w in ("primary", "shadow"):
+        y = x["workloads"][w]
+        assert y["runs"] == 1 and y["deterministic"] and y["cpu_seconds"] >= 0 and y["mrays_per_cpu_s"] > 0
+        assert y["hits"] == accels["bvh"]["workloads"][w]["hits"], (name, mode, w)
+        assert y["cpu_ratio_to_single"] > 0
+        if mode == "single":
+            assert y["cpu_ratio_to_single"] == 1
+        if r["embree"]:
+            assert y["cpu_ratio_to_embree_packets"] > 0
+        else:
+            assert y["cpu_ratio_to_embree_packets"] is None
+    if (name, mode) == ("embree", "packets"):
+        assert x["calls"] == "rtcIntersect8/rtcOccluded8"
+        assert all(x["workloads"][w]["cpu_ratio_to_embree_packets"] == 1 for w in ("primary", "shadow"))
+assert p["hits_agree"] == {"primary": True, "shadow": True}
 EOF
+expect_in "$TMP/out" "packets of 8 (4x2 tiles)"
+expect_in "$TMP/out" "rtcIntersect8"
 
 # --rays sets the number of primary rays; k=v after a comma continues the
 # previous scene's parameters; a mesh file that is not there is skipped.
@@ -67,6 +96,8 @@ s = r["scenes"]
 assert [x["scene"] for x in s] == ["cornell-teapot:triangles=200,size=0.1", sys.argv[2]], s
 assert s[0]["status"] == "ok" and 90 <= s[0]["rays"]["primary"] <= 110, s[0]
 assert s[1]["status"] == "skipped" and "no such file" in s[1]["reason"], s[1]
+# Without bvh or embree there is no packet section.
+assert s[0]["packets"] is None, s[0]["packets"]
 EOF
 
 # Bad usage: exit 2 with one error line, before anything runs.
