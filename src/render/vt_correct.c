@@ -733,8 +733,15 @@ bool vt_nonlinear_fires(const vt_run *run, const vt_vertex *a, const vt_vertex *
                    : vt_derivative_test(d->lights, d->num_lights, run->view.eye, &ea, &eb);
     }
     case VT_NONLINEAR_INTERVAL:
-    case VT_NONLINEAR_AFFINE:
-        return nonlinear_bound(run, run->set->nonlinear, a, b) > run->set->eps_ia;
+    case VT_NONLINEAR_AFFINE: {
+        float eps = run->set->eps_ia, ib = nonlinear_bound(run, VT_NONLINEAR_INTERVAL, a, b);
+        if (run->set->nonlinear == VT_NONLINEAR_INTERVAL)
+            return ib > eps;
+        /* the affine bound is never above the interval one (affine_term):
+         * what the interval lets pass, affine does too, and the forms are
+         * only worked out where the interval bound would split */
+        return !(ib <= eps) && nonlinear_bound(run, VT_NONLINEAR_AFFINE, a, b) > eps;
+    }
     default:
         return false;
     }
