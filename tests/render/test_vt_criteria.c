@@ -483,6 +483,47 @@ static void test_derivative_agrees_with_extremum(void **state)
     assert_true(only_ext < n / 100);
 }
 
+/* Sec. 6.1.1, eq. 6.3: the derivative test is the sign of the slope of the
+ * term along the edge: on random edges lit at both ends, with one term at
+ * a time (k_d or k_s), it fires exactly where finite differences of the
+ * term at the two ends have opposite signs (slopes too flat to tell by
+ * differences are left out). */
+static void test_derivative_test_is_the_sign_of_the_slope(void **state)
+{
+    (void)state;
+    const rl_vec3 eye = rl_v3(0.0f, 4.0f, 3.0f);
+    rl_rng g;
+    rl_rng_seed(&g, 2003u, 62u);
+    int checked = 0, turns = 0;
+    for (int trial = 0; trial < 4000; ++trial) {
+        rl_light L;
+        vt_edge_end e[2];
+        random_edge(&g, &L, e, eye);
+        bool diffuse = trial & 1;
+        for (int k = 0; k < 2; ++k) {
+            if (diffuse)
+                e[k].ks = 0.0f;
+            else
+                e[k].kd = 0.0f;
+        }
+        if (!((diffuse ? e[0].kd : e[0].ks) > 0.0f))
+            continue;
+        const float h = 1e-3f;
+        float f0 = vt_term_at(&L, eye, &e[0], &e[1], 0.0f), f1 = vt_term_at(&L, eye, &e[0], &e[1], 1.0f);
+        float s0 = (vt_term_at(&L, eye, &e[0], &e[1], h) - f0) / h;
+        float s1 = (f1 - vt_term_at(&L, eye, &e[0], &e[1], 1.0f - h)) / h;
+        float flat = 1e-2f * rl_maxf(f0, f1);
+        if (!(f0 > 1e-6f && f1 > 1e-6f) || fabsf(s0) < flat || fabsf(s1) < flat)
+            continue;
+        bool turn = (s0 > 0.0f) != (s1 > 0.0f);
+        checked++;
+        turns += turn;
+        assert_int_equal(vt_derivative_test(&L, 1, eye, &e[0], &e[1]), turn);
+    }
+    print_message("derivative test against finite differences: %d edges, %d turns\n", checked, turns);
+    assert_true(checked > 1000 && turns > 20);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -495,6 +536,7 @@ int main(void)
         cmocka_unit_test(test_shaft_is_the_hull_of_two_boxes),
         cmocka_unit_test(test_affine_encloses_the_term_and_is_tighter_than_intervals),
         cmocka_unit_test(test_derivative_agrees_with_extremum),
+        cmocka_unit_test(test_derivative_test_is_the_sign_of_the_slope),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
