@@ -407,8 +407,10 @@ static void interval_term(const rl_light *L, rl_vec3 eye, const vt_edge_end *e1,
 /* Affine arithmetic ([CS93]; de Figueiredo & Stolfi 2004) over the edge: a
  * quantity is x = c + a e + [-r, r], e in [-1, 1] the edge's one noise
  * symbol (t = (1 + e) / 2), r the radius of all approximation errors so
- * far, folded into one term (the Phong term never needs them to cancel;
- * what must cancel is the edge parameter, which keeps its symbol). Unlike
+ * far, folded into one term: what must cancel is the edge parameter, which
+ * keeps its symbol; the folded errors lose their correlation (that of one
+ * normalisation shared by a vector's three components, say), the price of
+ * a form of fixed size. Unlike
  * an interval, the form remembers how each quantity goes along the edge:
  * the linear interpolant is itself an affine form in e, so the
  * interpolation error keeps only what is not linear in e, and it shrinks
