@@ -91,9 +91,10 @@ static const char bench_vt_help[] =
     "              vertices) at 512, 1024, 2048 square: its time by phase (Fig. 5.12b)\n"
     "  reduction   sample reduction (Sec. 6.2.1, merge_px 0, 0.5, 1, 2): the preview\n"
     "              and the full frame: samples, merged vertices, time, SSIM\n"
-    "  correctness (only with --only) Sec. 6.1: nonlinear=extremum|interval and\n"
-    "              shaft_cull=shadow|all against off, on the table at the defaults and\n"
-    "              at hsv/min_edge 14, and on two small scenes whose highlight\n"
+    "  correctness (only with --only) Sec. 6.1: nonlinear=extremum|interval|\n"
+    "              derivative|affine and shaft_cull=shadow|all against off, on the\n"
+    "              table at the defaults and at hsv/min_edge 14, and on two small\n"
+    "              scenes whose highlight\n"
     "              and shadow fall inside a face (the miss of Fig. 6.1/6.5): vertices,\n"
     "              splits, rays, time, SSIM/RMSE against Whitted\n"
     "  overdraw    progressive overdraw against redraw, per stage k and for\n"
@@ -1283,6 +1284,8 @@ static const struct {
     { "off", NULL, NULL },
     { "nonlinear=extremum", "nonlinear", "extremum" },
     { "nonlinear=interval", "nonlinear", "interval" },
+    { "nonlinear=derivative", "nonlinear", "derivative" },
+    { "nonlinear=affine", "nonlinear", "affine" },
     { "shaft_cull=shadow", "shaft_cull", "shadow" },
     { "shaft_cull=all", "shaft_cull", "all" },
 };
@@ -1398,7 +1401,7 @@ static rl_status correctness_row(bvt *b, const char *label, const rl_scene *scen
     add_num(row, "time_ratio_to_whitted", ratio(t.stats.time_ms, ref_ms));
     cJSON_AddItemToObject(row, "quality", quality_json(&q));
     cJSON_AddItemToObject(row, "vt_stats", vt_stats_json(&t.vt));
-    printf("%-9s %-10s %-18s %9llu %9llu %8llu %8llu %10llu %9.1f %8.1f %6.3f  %6.3f %7.4f\n", label,
+    printf("%-9s %-10s %-20s %9llu %9llu %8llu %8llu %10llu %9.1f %8.1f %6.3f  %6.3f %7.4f\n", label,
            correctness_settings[k].name, correctness_runs[i].name, (unsigned long long)t.vt.vertices_sampled,
            (unsigned long long)t.vt.vertices_generated, (unsigned long long)t.vt.splits_nonlinear,
            (unsigned long long)t.vt.splits_shaft, (unsigned long long)rays_total(&t.stats), t.stats.time_ms,
@@ -1429,7 +1432,7 @@ static rl_status sec_correctness(void *ctx, cJSON *sec)
     st = rl_image_create(w, h, RL_LAYER_COLOR, &img);
     printf("\ncorrectness (Sec. 6.1): %s %s, whitted %.1f ms; miss scenes %s\n", table_spec(b), size,
            ref->stats.time_ms, b->a->quick ? "64x64" : "256x256");
-    printf("%-9s %-10s %-18s %9s %9s %8s %8s %10s %9s %8s %6s  %6s %7s\n", "scene", "setting", "option",
+    printf("%-9s %-10s %-20s %9s %9s %8s %8s %10s %9s %8s %6s  %6s %7s\n", "scene", "setting", "option",
            "sampled", "generated", "nonlin", "shaft", "rays", "VT ms", "refine", "xWhit", "ssimVT", "rmseVT");
     for (size_t k = 0; k < sizeof correctness_settings / sizeof correctness_settings[0]; k++)
         for (size_t i = 0; st == RL_OK && i < n; i++)

@@ -65,7 +65,7 @@ static const char *const overlay_choices[] = { "none", "wire", "samples", NULL }
 static const char *const reconstruct_choices[] = { "software", "gl", NULL };
 static const char *const balance_choices[] = { "queue", "precompute", NULL };
 static const char *const cost_choices[] = { "faces", "estimate", NULL };
-static const char *const nonlinear_choices[] = { "off", "extremum", "interval", NULL };
+static const char *const nonlinear_choices[] = { "off", "extremum", "interval", "derivative", "affine", NULL };   /* VT_NONLINEAR_* */
 static const char *const shaft_choices[] = { "off", "shadow", "all", NULL };
 static const char *const hint_choices[] = { "off", "agree", "parents", NULL };   /* VT_HINT_* */
 enum { RECONSTRUCT_SOFTWARE, RECONSTRUCT_GL };
@@ -93,9 +93,12 @@ static const rl_option_info vt_options[] = {
     { "nonlinear", RL_OPT_ENUM, "off",
       "Sec. 6.1.1, highlights between an edge's samples: off | extremum (split where a light's diffuse or "
       "specular peak lies between the ends, eq. 6.4-6.5) | interval (split where interval arithmetic bounds the "
-      "interpolation error of the local Phong term above eps_ia, Fig. 6.4)", 0, 0, nonlinear_choices },
+      "interpolation error of the local Phong term above eps_ia, Fig. 6.4) | derivative (split where the slope "
+      "of a light's diffuse or specular term along the edge changes sign, eq. 6.3) | affine (as interval, in "
+      "affine arithmetic [CS93]: a tighter bound)", 0, 0, nonlinear_choices },
     { "eps_ia", RL_OPT_FLOAT, "0.05",
-      "nonlinear=interval: bound eps_IA on the interpolation error (linear radiance, sum over lights) that splits",
+      "nonlinear=interval|affine: bound eps_IA on the interpolation error (linear radiance, sum over lights) "
+      "that splits",
       1e-4, 1e6, NULL },
     { "shaft_cull", RL_OPT_ENUM, "off",
       "Sec. 6.1.2, small occluders between an edge's samples: off | shadow (split the edges of a face whose "

@@ -22,7 +22,16 @@
  *             [lo, hi] of f bounds the error of the linear interpolant f'
  *             by eps_IA = max(hi - min(f_1, f_2), max(f_1, f_2) - lo) >=
  *             eps_A, and an edge with eps_IA > eps_ia is split.
- * Both test the local term only: shadows are discontinuities (Sec. 6.1.2)
+ *   derivative eq. 6.3: the sign of the derivative of each light's diffuse
+ *             and specular term along the edge at both ends; opposite
+ *             signs put an extremum between them. The thesis offers it
+ *             first and the geometric test as the faster alternative.
+ *   affine    the interval bound in affine arithmetic ([CS93], which the
+ *             thesis names as the tighter form): every quantity keeps its
+ *             linear dependence on the edge parameter, so the linear
+ *             interpolant cancels out of the error bound, which then
+ *             shrinks with the square of the edge; same eps_ia.
+ * All test the local term only: shadows are discontinuities (Sec. 6.1.2)
  * and reflections are the ray tree's business (Sec. 3.3.1).
  *
  * Sec. 6.1.2, discontinuities (option shaft_cull), after [HW91] (Fig. 6.6):
@@ -48,15 +57,16 @@
 
 /* ------------------------------------------------ Sec. 6.1.1 extremum -- */
 
-/* The direction from p towards light L and E, the light's irradiance scale
- * at p without the cosine (colour intensity / d^2 for point and spot,
+/* The unit direction from p towards light L, E, the light's irradiance
+ * scale at p without the cosine (colour intensity / d^2 for point and spot,
  * colour intensity for directional; a quad as a point at its centre with
- * its radiance times its area). */
-static rl_vec3 light_at(const rl_light *L, rl_vec3 p, float *E)
+ * its radiance times its area), and the distance d (0 for directional). */
+static rl_vec3 light_geom(const rl_light *L, rl_vec3 p, float *E, float *dist)
 {
     float power = rl_vmax_comp(L->color) * L->intensity;
     if (L->type == RL_LIGHT_DIRECTIONAL) {
         *E = power;
+        *dist = 0.0f;
         return rl_normalize(rl_neg(L->direction));
     }
     rl_vec3 at = L->position;
@@ -67,26 +77,32 @@ static rl_vec3 light_at(const rl_light *L, rl_vec3 p, float *E)
     rl_vec3 d = rl_sub(at, p);
     float d2 = rl_dot(d, d);
     *E = d2 > 0.0f ? power / d2 : 0.0f;
-    return d2 > 0.0f ? rl_scale(d, 1.0f / sqrtf(d2)) : rl_v3(0.0f, 0.0f, 0.0f);
+    *dist = sqrtf(d2);
+    return d2 > 0.0f ? rl_scale(d, 1.0f / *dist) : rl_v3(0.0f, 0.0f, 0.0f);
 }
 
-/* What the extremum test needs of one end of an edge: its position, its
- * normal turned towards the eye (the side the tracer shades), the unit
- * direction a to the eye, its material. */
-typedef struct edge_end {
-    rl_vec3 p, n, a;
-    const rl_material *m;
-} edge_end;
+static rl_vec3 light_at(const rl_light *L, rl_vec3 p, float *E)
+{
+    float dist;
+    return light_geom(L, p, E, &dist);
+}
 
-static edge_end end_of(const vt_run *run, const vt_vertex *v)
+vt_edge_end vt_edge_end_of(rl_vec3 p, rl_vec3 n, rl_vec3 eye, const rl_material *mat)
+{
+    vt_edge_end e;
+    e.p = p;
+    e.a = rl_normalize(rl_sub(eye, p));
+    e.n = rl_dot(n, e.a) < 0.0f ? rl_neg(n) : n;
+    e.kd = rl_vmax_comp(mat->diffuse);
+    e.ks = rl_vmax_comp(mat->specular);
+    e.m = mat->shininess;
+    return e;
+}
+
+static vt_edge_end end_of(const vt_run *run, const vt_vertex *v)
 {
     const rl_scene_data *d = run->data;
-    edge_end e;
-    e.p = v->p;
-    e.a = rl_normalize(rl_sub(run->view.eye, v->p));
-    e.n = rl_dot(v->n, e.a) < 0.0f ? rl_neg(v->n) : v->n;
-    e.m = &d->materials[d->triangle_material[v->triangle]];
-    return e;
+    return vt_edge_end_of(v->p, v->n, run->view.eye, &d->materials[d->triangle_material[v->triangle]]);
 }
 
 /* eq. 6.4-6.5 for one lobe: g_i = -(x_i . y_i) x_i + y_i with axis x and
@@ -104,14 +120,13 @@ static bool lobes_part(rl_vec3 x1, rl_vec3 y1, rl_vec3 x2, rl_vec3 y2)
     return rl_dot(g1, g2) <= 0.0f;
 }
 
-static bool extremum_fires(const vt_run *run, const edge_end *e1, const edge_end *e2)
+bool vt_extremum_test(const rl_light *lights, uint32_t num_lights, const vt_edge_end *e1, const vt_edge_end *e2)
 {
-    const rl_scene_data *d = run->data;
-    bool diffuse = rl_vmax_comp(e1->m->diffuse) > 0.0f || rl_vmax_comp(e2->m->diffuse) > 0.0f;
-    bool specular = rl_vmax_comp(e1->m->specular) > 0.0f || rl_vmax_comp(e2->m->specular) > 0.0f;
-    for (uint32_t i = 0; i < d->num_lights; ++i) {
+    bool diffuse = e1->kd > 0.0f || e2->kd > 0.0f;
+    bool specular = e1->ks > 0.0f || e2->ks > 0.0f;
+    for (uint32_t i = 0; i < num_lights; ++i) {
         float E1, E2;
-        rl_vec3 l1 = light_at(&d->lights[i], e1->p, &E1), l2 = light_at(&d->lights[i], e2->p, &E2);
+        rl_vec3 l1 = light_at(&lights[i], e1->p, &E1), l2 = light_at(&lights[i], e2->p, &E2);
         float nl1 = rl_dot(e1->n, l1), nl2 = rl_dot(e2->n, l2);
         if (!(nl1 > 0.0f) && !(nl2 > 0.0f))
             continue;                       /* the light is behind both ends */
@@ -124,6 +139,100 @@ static bool extremum_fires(const vt_run *run, const edge_end *e1, const edge_end
             if ((rl_dot(r1, e1->a) > 0.0f || rl_dot(r2, e2->a) > 0.0f) && lobes_part(e1->a, r1, e2->a, r2))
                 return true;
         }
+    }
+    return false;
+}
+
+/* ---------------------------------------------- Sec. 6.1.1 derivative -- */
+
+/* One light at one end of an edge: the cosines of eq. 6.1 and the slopes
+ * of the diffuse and specular terms along the edge, up to positive factors. */
+typedef struct term_slopes {
+    float cd, sd;             /* cos(theta) = n.l and the slope of I_d */
+    float cs, ss;             /* cos(phi) = r.a and the slope of I_s */
+    float tol;                /* a slope within +-tol is zero: rounding */
+} term_slopes;
+
+/* eq. 6.3 differentiates I_d = I_source k_d cos(theta) and I_s = I_source
+ * k_s cos^m(phi) by the angles; the sign that tells a hidden extremum is
+ * that of the derivative along the edge, which the chain rule gives. With
+ * p(t) = p_1 + t dp, n(t) = (n_1 + t dn) / |n_1 + t dn| (the midpoint
+ * normal of eq. 3.8 at every t), ' = d/dt at an end, where |n| = 1:
+ *
+ *   n' = dn - n (n.dn)
+ *   l' = (-dp + l (l.dp)) / d_l            point light at distance d_l
+ *   a' = (-dp + a (a.dp)) / d_a            the eye at distance d_a
+ *   (cos theta)' = n'.l + n.l'
+ *   (cos phi)'   = 2 ((cos theta)' n.a + cos theta (n'.a + n.a')) - (l'.a + l.a')
+ *                  (cos phi = r.a = 2 (n.l)(n.a) - l.a, r = l mirrored about n)
+ *   E' = 2 E (l.dp) / d_l = kappa E        E = I / d_l^2, the light's falloff
+ *
+ *   dI_d/dt = dI_d/dtheta dtheta/dt + E' k_d cos theta
+ *           = -E k_d sin theta dtheta/dt + kappa E k_d cos theta     (eq. 6.3)
+ *           = E k_d ((cos theta)' + kappa cos theta),
+ *   dI_s/dt = -E k_s (cos^m phi m sin phi / cos phi) dphi/dt + kappa E k_s cos^m phi   (eq. 6.3)
+ *           = E k_s cos^(m-1) phi (m (cos phi)' + kappa cos phi).
+ *
+ * E, k and cos^(m-1) phi are positive where the term is lit, so each sign
+ * is that of the bracket. The thesis holds I_source constant; with kappa
+ * the slope is that of the term the tracer computes (kappa = 0 for a
+ * directional light). Where the cosine is not positive the term is clamped
+ * to zero at that end; the cosine's own slope then says whether the lobe
+ * comes towards the other end. */
+static term_slopes slopes_at(const rl_light *L, const vt_edge_end *e, rl_vec3 eye, rl_vec3 dp, rl_vec3 dn, float m)
+{
+    term_slopes s;
+    float E, dl;
+    const rl_vec3 zero = rl_v3(0.0f, 0.0f, 0.0f);
+    rl_vec3 l = light_geom(L, e->p, &E, &dl), n = e->n, a = e->a;
+    float da = rl_length(rl_sub(eye, e->p));
+    rl_vec3 n_d = rl_sub(dn, rl_scale(n, rl_dot(n, dn)));
+    rl_vec3 l_d = dl > 0.0f ? rl_scale(rl_sub(rl_scale(l, rl_dot(l, dp)), dp), 1.0f / dl) : zero;
+    rl_vec3 a_d = da > 0.0f ? rl_scale(rl_sub(rl_scale(a, rl_dot(a, dp)), dp), 1.0f / da) : zero;
+    float kappa = dl > 0.0f ? 2.0f * rl_dot(l, dp) / dl : 0.0f;
+    float nl = rl_dot(n, l), na = rl_dot(n, a), la = rl_dot(l, a);
+    float nl_d = rl_dot(n_d, l) + rl_dot(n, l_d);
+    float na_d = rl_dot(n_d, a) + rl_dot(n, a_d);
+    float la_d = rl_dot(l_d, a) + rl_dot(l, a_d);
+    float cs_d = 2.0f * (nl_d * na + nl * na_d) - la_d;
+    s.cd = nl;
+    s.sd = nl > 0.0f ? nl_d + kappa * nl : nl_d;
+    s.cs = 2.0f * nl * na - la;
+    s.ss = s.cs > 0.0f ? m * cs_d + kappa * s.cs : cs_d;
+    /* the slopes are sums of products of unit vectors with dn and dp / d:
+     * float rounding leaves them a few 1e-7 of that size */
+    s.tol = 1e-4f * (rl_length(dn) + rl_length(dp) * ((dl > 0.0f ? 1.0f / dl : 0.0f) + (da > 0.0f ? 1.0f / da : 0.0f)));
+    return s;
+}
+
+/* Opposite signs at the two ends (eq. 6.3): a maximum of the term lies
+ * between them (rising at t = 0, falling at t = 1), or a minimum between
+ * two ends where the term is lit (a minimum next to an unlit end is the
+ * clamp at zero, at the end itself). */
+static bool slopes_turn(float s1, float s2, float c1, float c2, float tol)
+{
+    if (s1 > tol && s2 < -tol)
+        return true;
+    return s1 < -tol && s2 > tol && c1 > 0.0f && c2 > 0.0f;
+}
+
+bool vt_derivative_test(const rl_light *lights, uint32_t num_lights, rl_vec3 eye, const vt_edge_end *e1,
+                        const vt_edge_end *e2)
+{
+    bool diffuse = e1->kd > 0.0f || e2->kd > 0.0f;
+    bool specular = e1->ks > 0.0f || e2->ks > 0.0f;
+    rl_vec3 dp = rl_sub(e2->p, e1->p), dn = rl_sub(e2->n, e1->n);
+    float m = rl_maxf(e1->m, 1e-3f);
+    for (uint32_t i = 0; i < num_lights; ++i) {
+        term_slopes s1 = slopes_at(&lights[i], e1, eye, dp, dn, m), s2 = slopes_at(&lights[i], e2, eye, dp, dn, m);
+        if (!(s1.cd > 0.0f) && !(s2.cd > 0.0f))
+            continue;                       /* the light is behind both ends, as for extremum */
+        float tol = rl_maxf(s1.tol, s2.tol);
+        if (diffuse && slopes_turn(s1.sd, s2.sd, s1.cd, s2.cd, tol))
+            return true;
+        if (specular && (s1.cs > 0.0f || s2.cs > 0.0f) &&
+            slopes_turn(s1.ss, s2.ss, s1.cs, s2.cs, tol * (m + 2.0f)))
+            return true;
     }
     return false;
 }
@@ -270,43 +379,371 @@ static ia phong_ia(const rl_light *L, ia3 p, ia3 n, ia3 eye, float kd, float ks,
     return f;
 }
 
-/* eps_IA of the edge (a, b), summed over the lights. */
-static float interval_bound(const vt_run *run, const vt_vertex *a, const vt_vertex *b)
+/* The enclosure of light L's term over the edge by standard interval
+ * arithmetic, and its bound on the interpolation error (Fig. 6.4). */
+static void interval_term(const rl_light *L, rl_vec3 eye, const vt_edge_end *e1, const vt_edge_end *e2,
+                          vt_term_bound *out)
 {
-    const rl_scene_data *d = run->data;
-    const edge_end ea = end_of(run, a), eb = end_of(run, b);
     /* One material for the interval: an edge between two materials is a
      * discontinuity, not a smooth term; the larger coefficients bound
      * both. */
-    float kd = rl_maxf(rl_vmax_comp(ea.m->diffuse), rl_vmax_comp(eb.m->diffuse));
-    float ks = rl_maxf(rl_vmax_comp(ea.m->specular), rl_vmax_comp(eb.m->specular));
-    float m = rl_maxf(ea.m->shininess, 1e-3f);
-    rl_vec3 eye = run->view.eye;
+    float kd = rl_maxf(e1->kd, e2->kd), ks = rl_maxf(e1->ks, e2->ks), m = rl_maxf(e1->m, 1e-3f);
     ia3 ie = ia3_of(eye, eye);
-    ia3 p = ia3_of(a->p, b->p), n = ia3_of(ea.n, eb.n);
     /* the normal between the ends is normalize(lerp) (eq. 3.8) */
-    n = ia3_normalize(n);
+    ia3 p = ia3_of(e1->p, e2->p), n = ia3_normalize(ia3_of(e1->n, e2->n));
+    ia f = phong_ia(L, p, n, ie, kd, ks, m);
+    float f1 = phong_ia(L, ia3_of(e1->p, e1->p), ia3_of(e1->n, e1->n), ie, kd, ks, m).hi;
+    float f2 = phong_ia(L, ia3_of(e2->p, e2->p), ia3_of(e2->n, e2->n), ie, kd, ks, m).hi;
+    out->lo = f.lo;
+    out->hi = f.hi;
+    out->f1 = f1;
+    out->f2 = f2;
+    /* f' lies between f_1 and f_2, f within [lo, hi] */
+    out->eps = rl_maxf(f.hi - rl_minf(f1, f2), rl_maxf(f1, f2) - f.lo);
+}
+
+/* -------------------------------------------------- Sec. 6.1.1 affine -- */
+
+/* Affine arithmetic ([CS93]; de Figueiredo & Stolfi 2004) over the edge: a
+ * quantity is x = c + a e + [-r, r], e in [-1, 1] the edge's one noise
+ * symbol (t = (1 + e) / 2), r the radius of all approximation errors so
+ * far, folded into one term: what must cancel is the edge parameter, which
+ * keeps its symbol; the folded errors lose their correlation (that of one
+ * normalisation shared by a vector's three components, say), the price of
+ * a form of fixed size. Unlike
+ * an interval, the form remembers how each quantity goes along the edge:
+ * the linear interpolant is itself an affine form in e, so the
+ * interpolation error keeps only what is not linear in e, and it shrinks
+ * with the square of the edge where an interval's shrinks linearly.
+ * Doubles keep rounding far below the terms; it is not directed outwards
+ * (as for intervals). */
+typedef struct aa {
+    double c, a, r;
+} aa;
+
+typedef struct aa3 {
+    aa x, y, z;
+} aa3;
+
+/* A quantity without a finite form (a distance that may reach 0): NaN
+ * passes through every operation below, and the edge is split. */
+static const aa AA_NONE = { NAN, NAN, NAN };
+
+static aa aa_const(double c)
+{
+    return (aa){ c, 0.0, 0.0 };
+}
+
+/* x(t) from x_1 at t = 0 to x_2 at t = 1 */
+static aa aa_lerp(double x1, double x2)
+{
+    return (aa){ 0.5 * (x1 + x2), 0.5 * (x2 - x1), 0.0 };
+}
+
+static double aa_lo(aa x)
+{
+    return x.c - fabs(x.a) - x.r;
+}
+
+static double aa_hi(aa x)
+{
+    return x.c + fabs(x.a) + x.r;
+}
+
+static aa aa_add(aa x, aa y)
+{
+    return (aa){ x.c + y.c, x.a + y.a, x.r + y.r };
+}
+
+static aa aa_sub(aa x, aa y)
+{
+    return (aa){ x.c - y.c, x.a - y.a, x.r + y.r };
+}
+
+static aa aa_scale(aa x, double s)
+{
+    return (aa){ s * x.c, s * x.a, fabs(s) * x.r };
+}
+
+/* x y: the product's e^2 is 1/2 + (e^2 - 1/2), the second part within
+ * +-1/2; every product with an error term goes to the error term. */
+static aa aa_mul(aa x, aa y)
+{
+    return (aa){ x.c * y.c + 0.5 * x.a * y.a, x.c * y.a + y.c * x.a,
+                 0.5 * fabs(x.a * y.a) + (fabs(x.c) + fabs(x.a)) * y.r + (fabs(y.c) + fabs(y.a)) * x.r +
+                     x.r * y.r };
+}
+
+/* x^2, tighter than x x: the error's square r^2 h^2 lies in [0, r^2]. */
+static aa aa_sqr(aa x)
+{
+    return (aa){ x.c * x.c + 0.5 * x.a * x.a + 0.5 * x.r * x.r, 2.0 * x.c * x.a,
+                 0.5 * x.a * x.a + 2.0 * (fabs(x.c) + fabs(x.a)) * x.r + 0.5 * x.r * x.r };
+}
+
+/* f(x) for f monotone and convex or concave on [lo, hi], the values x can
+ * take, cut to the domain dlo..dhi that the true quantity keeps (a clamped
+ * cosine lies in [0, 1]; rounding can push the form's range past it). The
+ * Chebyshev approximation of de Figueiredo & Stolfi 2004: the chord (slope
+ * alpha) and the tangent of the same slope at u, where f'(u) = alpha,
+ * bracket f; the line halfway between them is off by at most half their
+ * distance. u_of gives u for alpha. */
+static aa aa_apply(aa x, double dlo, double dhi, double (*f)(double, double), double (*u_of)(double, double),
+                   double param)
+{
+    if (!isfinite(aa_hi(x)))
+        return AA_NONE;                     /* fmin and fmax would drop a NaN */
+    double lo = fmin(fmax(aa_lo(x), dlo), dhi), hi = fmax(fmin(aa_hi(x), dhi), dlo);
+    double flo = f(lo, param), fhi = f(hi, param);
+    if (hi - lo <= 1e-12 * fmax(fabs(lo), fabs(hi)))
+        return (aa){ 0.5 * (flo + fhi), 0.0, 0.5 * fabs(fhi - flo) };   /* a point: its range */
+    double alpha = (fhi - flo) / (hi - lo);
+    double u = fmin(fmax(u_of(alpha, param), lo), hi);
+    double d1 = flo - alpha * lo, d2 = f(u, param) - alpha * u;     /* the lines' intercepts */
+    return (aa){ alpha * x.c + 0.5 * (d1 + d2), alpha * x.a, fabs(alpha) * x.r + 0.5 * fabs(d1 - d2) };
+}
+
+static double f_recip(double x, double unused)
+{
+    (void)unused;
+    return 1.0 / x;
+}
+
+static double u_recip(double alpha, double unused)   /* -1 / u^2 = alpha */
+{
+    (void)unused;
+    return 1.0 / sqrt(-alpha);
+}
+
+static double f_rsqrt(double x, double unused)
+{
+    (void)unused;
+    return 1.0 / sqrt(x);
+}
+
+static double u_rsqrt(double alpha, double unused)   /* -u^(-3/2) / 2 = alpha */
+{
+    (void)unused;
+    return pow(-2.0 * alpha, -2.0 / 3.0);
+}
+
+static double f_pow(double x, double m)
+{
+    return pow(x, m);
+}
+
+static double u_pow(double alpha, double m)          /* m u^(m-1) = alpha */
+{
+    return pow(alpha / m, 1.0 / (m - 1.0));
+}
+
+/* 1 / x and 1 / sqrt(x) for x > 0 */
+static aa aa_recip(aa x)
+{
+    return aa_lo(x) > 0.0 ? aa_apply(x, 0.0, INFINITY, f_recip, u_recip, 0.0) : AA_NONE;
+}
+
+static aa aa_rsqrt(aa x)
+{
+    return aa_lo(x) > 0.0 ? aa_apply(x, 0.0, INFINITY, f_rsqrt, u_rsqrt, 0.0) : AA_NONE;
+}
+
+/* x^m for the true x in [0, 1] (a clamped cosine), m > 0: convex for
+ * m > 1, concave below; one Chebyshev step, not repeated squaring, whose
+ * errors would compound over log2(m) products. */
+static aa aa_pow01(aa x, double m)
+{
+    return m == 1.0 ? x : aa_apply(x, 0.0, 1.0, f_pow, u_pow, m);
+}
+
+/* max(0, x): where x changes sign, the chord from (lo, 0) to (hi, hi) lies
+ * above and the function lowest under it at 0, by alpha (-lo): the line
+ * half that below the chord is off by at most half that. */
+static aa aa_relu(aa x)
+{
+    double lo = aa_lo(x), hi = aa_hi(x);
+    if (lo >= 0.0)
+        return x;
+    if (hi <= 0.0)
+        return aa_const(0.0);
+    double alpha = hi / (hi - lo), half = -0.5 * alpha * lo;
+    return (aa){ alpha * x.c + half, alpha * x.a, alpha * x.r + half };
+}
+
+static aa3 aa3_const(rl_vec3 v)
+{
+    return (aa3){ aa_const(v.x), aa_const(v.y), aa_const(v.z) };
+}
+
+static aa3 aa3_lerp(rl_vec3 v1, rl_vec3 v2)
+{
+    return (aa3){ aa_lerp(v1.x, v2.x), aa_lerp(v1.y, v2.y), aa_lerp(v1.z, v2.z) };
+}
+
+static aa3 aa3_sub(aa3 u, aa3 v)
+{
+    return (aa3){ aa_sub(u.x, v.x), aa_sub(u.y, v.y), aa_sub(u.z, v.z) };
+}
+
+static aa3 aa3_mul(aa3 v, aa s)
+{
+    return (aa3){ aa_mul(v.x, s), aa_mul(v.y, s), aa_mul(v.z, s) };
+}
+
+static aa aa3_dot(aa3 u, aa3 v)
+{
+    return aa_add(aa_add(aa_mul(u.x, v.x), aa_mul(u.y, v.y)), aa_mul(u.z, v.z));
+}
+
+static aa aa3_len2(aa3 v)
+{
+    return aa_add(aa_add(aa_sqr(v.x), aa_sqr(v.y)), aa_sqr(v.z));
+}
+
+static aa3 aa3_normalize(aa3 v)
+{
+    return aa3_mul(v, aa_rsqrt(aa3_len2(v)));
+}
+
+/* The unshadowed local Phong term of light L as phong_ia, in affine forms:
+ * E (k_d max(0, n.l) + k_s max(0, r.a)^m) where n.l > 0. */
+static aa phong_aa(const rl_light *L, aa3 p, aa3 n, rl_vec3 eye, double kd, double ks, double m)
+{
+    aa3 a = aa3_normalize(aa3_sub(aa3_const(eye), p));
+    aa3 l;
+    aa E;
+    float power = rl_vmax_comp(L->color) * L->intensity;
+    if (L->type == RL_LIGHT_DIRECTIONAL) {
+        l = aa3_const(rl_normalize(rl_neg(L->direction)));
+        E = aa_const(power);
+    } else {
+        rl_vec3 at = L->position;
+        if (L->type == RL_LIGHT_QUAD) {
+            at = rl_add(at, rl_scale(rl_add(L->edge_u, L->edge_v), 0.5f));
+            power *= rl_length(rl_cross(L->edge_u, L->edge_v));
+        }
+        aa3 to = aa3_sub(aa3_const(at), p);
+        aa d2 = aa3_len2(to);
+        l = aa3_mul(to, aa_rsqrt(d2));
+        E = aa_scale(aa_recip(d2), power);
+    }
+    aa nl = aa3_dot(n, l);
+    if (!isfinite(aa_hi(nl)))
+        return AA_NONE;
+    if (!(aa_hi(nl) > 0.0))
+        return aa_const(0.0);               /* the light is behind the whole edge */
+    aa f = aa_scale(aa_relu(nl), kd);
+    if (ks > 0.0) {
+        aa ra = aa_sub(aa_scale(aa_mul(nl, aa3_dot(n, a)), 2.0), aa3_dot(l, a));
+        aa s = aa_scale(aa_pow01(aa_relu(ra), m), ks);
+        if (aa_lo(nl) <= 0.0) {
+            /* the tracer adds the highlight only where n.l > 0: on the
+             * part of the edge where it does not, the term is 0, so only
+             * the range [0, hi] is known, not the form */
+            double hi = fmax(aa_hi(s), 0.0);
+            s = (aa){ 0.5 * hi, 0.0, 0.5 * hi };
+        }
+        f = aa_add(f, s);
+    }
+    return aa_mul(f, E);
+}
+
+/* The term at the point t of the edge (p and n as the enclosures take
+ * them), in plain double arithmetic: the forms of a point have a = r = 0. */
+static double affine_point(const rl_light *L, rl_vec3 eye, const vt_edge_end *e1, const vt_edge_end *e2, double t,
+                           double kd, double ks, double m)
+{
+    aa3 p = { aa_const(e1->p.x + t * (e2->p.x - e1->p.x)), aa_const(e1->p.y + t * (e2->p.y - e1->p.y)),
+              aa_const(e1->p.z + t * (e2->p.z - e1->p.z)) };
+    aa3 n = { aa_const(e1->n.x + t * (e2->n.x - e1->n.x)), aa_const(e1->n.y + t * (e2->n.y - e1->n.y)),
+              aa_const(e1->n.z + t * (e2->n.z - e1->n.z)) };
+    return phong_aa(L, p, aa3_normalize(n), eye, kd, ks, m).c;
+}
+
+/* The enclosure of light L's term over the edge in affine arithmetic and
+ * its bound on the interpolation error: with f = c + a e + [-r, r] and the
+ * interpolant f' = (f_1 + f_2)/2 + (f_2 - f_1)/2 e,
+ *   eps_AA = |c - (f_1 + f_2)/2| + |a - (f_2 - f_1)/2| + r >= eps_A.
+ * Affine ranges are not always narrower than intervals: 1 / d^2 of a point
+ * light over a long edge, or the product of two wide forms, can overshoot
+ * (on a fifth of the random edges of test_vt_criteria). Both enclosures
+ * hold the term, so their intersection does; and the bound of Fig. 6.4 on
+ * it holds as well as eps_AA: the smallest of them is used. */
+static void affine_term(const rl_light *L, rl_vec3 eye, const vt_edge_end *e1, const vt_edge_end *e2,
+                        vt_term_bound *out)
+{
+    double kd = rl_maxf(e1->kd, e2->kd), ks = rl_maxf(e1->ks, e2->ks), m = rl_maxf(e1->m, 1e-3f);
+    aa f = phong_aa(L, aa3_lerp(e1->p, e2->p), aa3_normalize(aa3_lerp(e1->n, e2->n)), eye, kd, ks, m);
+    double f1 = affine_point(L, eye, e1, e2, 0.0, kd, ks, m), f2 = affine_point(L, eye, e1, e2, 1.0, kd, ks, m);
+    vt_term_bound ia;
+    interval_term(L, eye, e1, e2, &ia);
+    double eps_aa = fabs(f.c - 0.5 * (f1 + f2)) + fabs(f.a - 0.5 * (f2 - f1)) + f.r;
+    if (!isfinite(eps_aa)) {
+        *out = ia;                          /* no finite form: the interval's answer */
+        if (!(out->eps >= 0.0f))
+            out->eps = INFINITY;            /* nor a finite interval: split */
+        return;
+    }
+    double lo = fmax(aa_lo(f), ia.lo), hi = fmin(aa_hi(f), ia.hi);
+    double eps_range = fmax(hi - fmin(f1, f2), fmax(f1, f2) - lo);
+    out->lo = (float)lo;
+    out->hi = (float)hi;
+    out->f1 = (float)f1;
+    out->f2 = (float)f2;
+    out->eps = (float)fmin(fmin(eps_aa, eps_range), ia.eps);
+}
+
+void vt_term_bound_of(int mode, const rl_light *L, rl_vec3 eye, const vt_edge_end *e1, const vt_edge_end *e2,
+                      vt_term_bound *out)
+{
+    if (mode == VT_NONLINEAR_AFFINE)
+        affine_term(L, eye, e1, e2, out);
+    else
+        interval_term(L, eye, e1, e2, out);
+}
+
+float vt_term_at(const rl_light *L, rl_vec3 eye, const vt_edge_end *e1, const vt_edge_end *e2, float t)
+{
+    double kd = rl_maxf(e1->kd, e2->kd), ks = rl_maxf(e1->ks, e2->ks), m = rl_maxf(e1->m, 1e-3f);
+    return (float)affine_point(L, eye, e1, e2, t, kd, ks, m);
+}
+
+/* eps_IA of the edge (a, b) in interval or affine arithmetic, summed over
+ * the lights. */
+static float nonlinear_bound(const vt_run *run, int mode, const vt_vertex *a, const vt_vertex *b)
+{
+    const rl_scene_data *d = run->data;
+    const vt_edge_end ea = end_of(run, a), eb = end_of(run, b);
     float bound = 0.0f;
     for (uint32_t i = 0; i < d->num_lights; ++i) {
-        const rl_light *L = &d->lights[i];
-        ia f = phong_ia(L, p, n, ie, kd, ks, m);
-        float f1 = phong_ia(L, ia3_of(a->p, a->p), ia3_of(ea.n, ea.n), ie, kd, ks, m).hi;
-        float f2 = phong_ia(L, ia3_of(b->p, b->p), ia3_of(eb.n, eb.n), ie, kd, ks, m).hi;
-        /* f' lies between f_1 and f_2, f within [lo, hi] */
-        bound += rl_maxf(f.hi - rl_minf(f1, f2), rl_maxf(f1, f2) - f.lo);
+        vt_term_bound tb;
+        vt_term_bound_of(mode, &d->lights[i], run->view.eye, &ea, &eb, &tb);
+        bound += tb.eps;
     }
     return bound;
 }
 
 bool vt_nonlinear_fires(const vt_run *run, const vt_vertex *a, const vt_vertex *b)
 {
+    const rl_scene_data *d = run->data;
     switch (run->set->nonlinear) {
-    case VT_NONLINEAR_EXTREMUM: {
-        const edge_end ea = end_of(run, a), eb = end_of(run, b);
-        return extremum_fires(run, &ea, &eb);
+    case VT_NONLINEAR_EXTREMUM:
+    case VT_NONLINEAR_DERIVATIVE: {
+        const vt_edge_end ea = end_of(run, a), eb = end_of(run, b);
+        return run->set->nonlinear == VT_NONLINEAR_EXTREMUM
+                   ? vt_extremum_test(d->lights, d->num_lights, &ea, &eb)
+                   : vt_derivative_test(d->lights, d->num_lights, run->view.eye, &ea, &eb);
     }
     case VT_NONLINEAR_INTERVAL:
-        return interval_bound(run, a, b) > run->set->eps_ia;
+    case VT_NONLINEAR_AFFINE: {
+        float eps = run->set->eps_ia, ib = nonlinear_bound(run, VT_NONLINEAR_INTERVAL, a, b);
+        if (run->set->nonlinear == VT_NONLINEAR_INTERVAL)
+            return ib > eps;
+        /* the affine bound is never above the interval one (affine_term):
+         * what the interval lets pass, affine does too, and the forms are
+         * only worked out where the interval bound would split */
+        return !(ib <= eps) && nonlinear_bound(run, VT_NONLINEAR_AFFINE, a, b) > eps;
+    }
     default:
         return false;
     }

@@ -26,7 +26,7 @@ enum { VT_OVERLAY_NONE = 0, VT_OVERLAY_WIRE, VT_OVERLAY_SAMPLES };
 enum { VT_REASON_RGB = 1, VT_REASON_HSV = 2, VT_REASON_TREE = 4, VT_REASON_FORCED = 8 };
 /* Sec. 6.1 (vt_correct.c): a nonlinearity or a shaft's occluder split it. */
 enum { VT_REASON_NONLINEAR = 16, VT_REASON_SHAFT = 32 };
-enum { VT_NONLINEAR_OFF = 0, VT_NONLINEAR_EXTREMUM, VT_NONLINEAR_INTERVAL };
+enum { VT_NONLINEAR_OFF = 0, VT_NONLINEAR_EXTREMUM, VT_NONLINEAR_INTERVAL, VT_NONLINEAR_DERIVATIVE, VT_NONLINEAR_AFFINE };
 enum { VT_SHAFT_OFF = 0, VT_SHAFT_SHADOW, VT_SHAFT_ALL };
 
 /* The options of one frame, validated and resolved (vt.c). */
@@ -271,10 +271,37 @@ rl_status vt_refine(vt_run *run);
 
 /* vt_correct.c (Sec. 6.1) ----------------------------------------------- */
 /* Sec. 6.1.1: whether the local term of some light may have an extremum
- * (extremum, eq. 6.4-6.5) or a larger interpolation error than eps_ia
- * (interval, Fig. 6.4) between the ends a and b of an edge, under the
- * frame's setting nonlinear (false when off). */
+ * (extremum, eq. 6.4-6.5; derivative, eq. 6.3) or a larger interpolation
+ * error than eps_ia (interval, Fig. 6.4; affine) between the ends a and b
+ * of an edge, under the frame's setting nonlinear (false when off). */
 bool vt_nonlinear_fires(const vt_run *run, const vt_vertex *a, const vt_vertex *b);
+
+/* The pieces of Sec. 6.1.1, on their own for the tests. One end of an
+ * edge: its position, its normal turned towards the eye (the side the
+ * tracer shades), the unit direction a to the eye, and the material's
+ * largest diffuse and specular channel and its Phong exponent. */
+typedef struct vt_edge_end {
+    rl_vec3 p, n, a;
+    float kd, ks, m;
+} vt_edge_end;
+vt_edge_end vt_edge_end_of(rl_vec3 p, rl_vec3 n, rl_vec3 eye, const rl_material *mat);
+/* eq. 6.4-6.5 and eq. 6.3 over the lights: whether the edge hides an
+ * extremum of a light's diffuse or specular term. */
+bool vt_extremum_test(const rl_light *lights, uint32_t num_lights, const vt_edge_end *e1, const vt_edge_end *e2);
+bool vt_derivative_test(const rl_light *lights, uint32_t num_lights, rl_vec3 eye, const vt_edge_end *e1,
+                        const vt_edge_end *e2);
+/* The unshadowed local Phong term of one light over the edge (positions
+ * linear, normals normalize(lerp), eq. 3.8): its enclosure [lo, hi] in
+ * interval (mode VT_NONLINEAR_INTERVAL) or affine arithmetic
+ * (VT_NONLINEAR_AFFINE), its values at the ends and the bound eps_IA >=
+ * max |f - f'| on the error of the linear interpolant f'. */
+typedef struct vt_term_bound {
+    float lo, hi, f1, f2, eps;
+} vt_term_bound;
+void vt_term_bound_of(int mode, const rl_light *L, rl_vec3 eye, const vt_edge_end *e1, const vt_edge_end *e2,
+                      vt_term_bound *out);
+/* The same term at t in [0, 1] along the edge. */
+float vt_term_at(const rl_light *L, rl_vec3 eye, const vt_edge_end *e1, const vt_edge_end *e2, float t);
 
 /* Sec. 6.1.2: the scene's triangles for the shaft test, per object in runs
  * of VT_SHAFT_GROUP with their boxes (a two-level hierarchy below the

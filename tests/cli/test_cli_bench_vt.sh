@@ -301,7 +301,8 @@ assert r["visibility"]["size"] == "32x32" and r["visibility"]["status"] == "ok"
 # off misses the highlight and the shadow, the matching option finds them.
 c = r["correctness"]
 assert c["status"] == "ok", c
-opts = ["off", "nonlinear=extremum", "nonlinear=interval", "shaft_cull=shadow", "shaft_cull=all"]
+opts = ["off", "nonlinear=extremum", "nonlinear=interval", "nonlinear=derivative", "nonlinear=affine",
+        "shaft_cull=shadow", "shaft_cull=all"]
 rows = {(x["scene"], x["option"]): x for x in c["runs"]}
 assert [(x["setting"], x["option"]) for x in c["runs"] if x["scene"] == "table"] == \
     [(s, o) for s in ("tree+hsv/1", "hsv/14") for o in opts], c["runs"]
@@ -316,7 +317,7 @@ for x in c["runs"]:
         assert (x["splits_shaft"] > 0) <= x["option"].startswith("shaft"), x
 def rmse(scene, opt):
     return rows[(scene, opt)]["quality"]["vt_pixels"]["rmse"]
-for opt in ("nonlinear=extremum", "nonlinear=interval"):
+for opt in ("nonlinear=extremum", "nonlinear=interval", "nonlinear=derivative", "nonlinear=affine"):
     assert rmse("highlight", opt) < 0.5 * rmse("highlight", "off"), (opt, rows)
 assert rmse("shadow", "shaft_cull=shadow") < 0.5 * rmse("shadow", "off"), rows
 PY

@@ -881,32 +881,38 @@ static double sec61_error(const rl_scene *s, const rl_camera *cam, const char *c
 }
 
 /* Sec. 6.1.1: the default criteria miss the highlight inside a face (all
- * four samples agree, nothing is refined); the extremum test (eq. 6.4-6.5)
- * and the interval bound (Fig. 6.4) each split towards it and find it.
- * Explicitly off is the default, to the byte. */
+ * four samples agree, nothing is refined); the extremum test (eq. 6.4-6.5),
+ * the derivative test (eq. 6.3), the interval bound (Fig. 6.4) and the
+ * affine bound each split towards it and find it; affine with fewer
+ * vertices than interval, its bound being tighter. Explicitly off is the
+ * default, to the byte. */
 static void nonlinear_finds_the_highlight(void **state)
 {
     (void)state;
     rl_scene *s = sec61_scene(true);
     rl_camera cam = look(rl_v3(0.0f, 4.0f, 3.0f), rl_v3(0.0f, 0.0f, 0.0f), 64);
-    rl_vt_stats off, ext, ia;
+    static const char *const modes[] = { "extremum", "derivative", "interval", "affine" };
+    rl_vt_stats off, st[4];
+    double err[4];
     const char *o_off[] = { "min_edge", "1", NULL };
-    const char *o_ext[] = { "min_edge", "1", "nonlinear", "extremum", NULL };
-    const char *o_ia[] = { "min_edge", "1", "nonlinear", "interval", NULL };
     double e_off = sec61_error(s, &cam, o_off, &off);
-    double e_ext = sec61_error(s, &cam, o_ext, &ext);
-    double e_ia = sec61_error(s, &cam, o_ia, &ia);
-    print_message("highlight: rmse off %.4f (%llu generated), extremum %.4f (%llu, %llu nonlinear), "
-                  "interval %.4f (%llu, %llu nonlinear)\n", e_off, (unsigned long long)off.vertices_generated,
-                  e_ext, (unsigned long long)ext.vertices_generated, (unsigned long long)ext.splits_nonlinear,
-                  e_ia, (unsigned long long)ia.vertices_generated, (unsigned long long)ia.splits_nonlinear);
+    print_message("highlight: rmse off %.4f (%llu generated)\n", e_off, (unsigned long long)off.vertices_generated);
+    for (int i = 0; i < 4; ++i) {
+        const char *o[] = { "min_edge", "1", "nonlinear", modes[i], NULL };
+        err[i] = sec61_error(s, &cam, o, &st[i]);
+        print_message("highlight: %-10s rmse %.4f (%llu generated, %llu nonlinear)\n", modes[i], err[i],
+                      (unsigned long long)st[i].vertices_generated, (unsigned long long)st[i].splits_nonlinear);
+    }
     assert_int_equal(off.vertices_generated, 0);
     assert_int_equal(off.splits_nonlinear, 0);
     assert_true(e_off > 0.02);
-    assert_true(ext.splits_nonlinear > 0);
-    assert_true(ia.splits_nonlinear > 0);
-    assert_true(e_ext < 0.5 * e_off);
-    assert_true(e_ia < 0.5 * e_off);
+    for (int i = 0; i < 4; ++i) {
+        assert_true(st[i].splits_nonlinear > 0);
+        assert_true(err[i] < 0.5 * e_off);
+    }
+    /* the affine bound is the tighter one: fewer splits for as good an image */
+    assert_true(st[3].vertices_generated < st[2].vertices_generated);
+    assert_true(err[3] < 0.1 * e_off);
 
     const char *o_expl[] = { "min_edge", "1", "nonlinear", "off", "shaft_cull", "off", NULL };
     rl_image *a = fx_render("vt", s, &cam, RL_LAYER_COLOR, o_off, NULL);
@@ -983,7 +989,7 @@ static void bad_options(void **state)
         { "eps_rgb", "-1" }, { "eps_h", "0.7" }, { "eps_s", "nan" }, { "eps_v", "-0.1" },
         { "min_edge", "-2" }, { "min_edge", "0" }, { "eps_z", "1.5" }, { "criteria", "colour" },
         { "objects", "" }, { "update_every", "0" }, { "max_vertices", "-5" },
-        { "nonlinear", "derivative" }, { "nonlinear", "" }, { "shaft_cull", "on" }, { "eps_ia", "0" },
+        { "nonlinear", "gradient" }, { "nonlinear", "" }, { "nonlinear", "Affine" }, { "shaft_cull", "on" }, { "eps_ia", "0" },
         { "eps_ia", "-1" },
     };
     for (size_t i = 0; i < sizeof bad / sizeof bad[0]; ++i) {

@@ -2,8 +2,11 @@
  * (vt_criteria.c; Ullmann 2003, Sec. 3.3.1): sRGB display values against
  * the closed form, HSV of the primaries and a mixed colour, and each
  * criterion firing just above its threshold and not just below it, with the
- * hue wrapping round the circle and ignored for greys; and the shaft of
- * [HW91] that Sec. 6.1.2's shaft culling builds (vt_correct.c). */
+ * hue wrapping round the circle and ignored for greys; the pieces of
+ * Sec. 6.1.1 (vt_correct.c): the interval and affine enclosures of the local
+ * Phong term against sampled values, and the derivative test (eq. 6.3)
+ * against the extremum test (eq. 6.4-6.5); and the shaft of [HW91] that
+ * Sec. 6.1.2's shaft culling builds. */
 #include <math.h>
 #include <setjmp.h>
 #include <stdarg.h>
@@ -14,6 +17,8 @@
 #include <cmocka.h>
 
 #include "render/vt_run.h"
+#include "rl/rl_rng.h"
+#include "rl/rl_scene.h"
 
 /* Linear value whose display value is d (inverse sRGB transfer). */
 static float linear_of(float d)
@@ -248,6 +253,277 @@ static void test_shaft_is_the_hull_of_two_boxes(void **state)
     }
 }
 
+/* ------------------------------------------------------ Sec. 6.1.1 -- */
+
+static float urand(rl_rng *g, float lo, float hi)
+{
+    return lo + (hi - lo) * rl_rng_float(g);
+}
+
+static rl_vec3 tilted_up(rl_rng *g, float spread)
+{
+    return rl_normalize(rl_v3(urand(g, -spread, spread), 1.0f, urand(g, -spread, spread)));
+}
+
+/* The term as the tracer adds it (trace_shade.c), written out on its own:
+ * E (k_d n.l + k_s max(0, r.a)^m) where n.l > 0. */
+static float phong_ref(const rl_light *L, rl_vec3 p, rl_vec3 n, rl_vec3 eye, float kd, float ks, float m)
+{
+    rl_vec3 l;
+    float E = L->intensity * rl_vmax_comp(L->color);
+    if (L->type == RL_LIGHT_DIRECTIONAL) {
+        l = rl_normalize(rl_neg(L->direction));
+    } else {
+        rl_vec3 d = rl_sub(L->position, p);
+        E /= rl_dot(d, d);
+        l = rl_normalize(d);
+    }
+    rl_vec3 a = rl_normalize(rl_sub(eye, p));
+    float nl = rl_dot(n, l);
+    if (nl <= 0.0f)
+        return 0.0f;
+    float ra = rl_dot(rl_sub(rl_scale(n, 2.0f * nl), l), a);
+    return E * (kd * nl + (ra > 0.0f ? ks * powf(ra, m) : 0.0f));
+}
+
+/* A random edge over the floor y = 0 (normals within ~30 degrees of up),
+ * seen from (0, 4, 3), lit by a random point or directional light, with a
+ * random Phong material; lengths from 1 mm to 2 m. */
+static void random_edge(rl_rng *g, rl_light *L, vt_edge_end e[2], rl_vec3 eye)
+{
+    rl_material mat = rl_material_default();
+    float kd = urand(g, 0.0f, 1.0f), ks = urand(g, 0.0f, 1.0f);
+    static const float exps[] = { 1.0f, 4.0f, 20.0f, 80.0f, 200.0f };
+    mat.diffuse = rl_v3(kd, kd, kd);
+    mat.specular = rl_v3(ks, ks, ks);
+    mat.shininess = exps[rl_rng_bounded(g, 5)];
+    memset(L, 0, sizeof *L);
+    L->color = rl_v3(1.0f, 1.0f, 1.0f);
+    if (rl_rng_bounded(g, 2)) {
+        L->type = RL_LIGHT_POINT;
+        L->position = rl_v3(urand(g, -2.0f, 2.0f), urand(g, 0.5f, 3.0f), urand(g, -2.0f, 2.0f));
+        L->intensity = 4.0f;
+    } else {
+        L->type = RL_LIGHT_DIRECTIONAL;
+        L->direction = rl_neg(tilted_up(g, 1.0f));
+        L->intensity = 1.0f;
+    }
+    rl_vec3 p1 = rl_v3(urand(g, -2.0f, 2.0f), 0.0f, urand(g, -2.0f, 2.0f));
+    float len = powf(10.0f, urand(g, -3.0f, 0.3f)), phi = urand(g, 0.0f, 6.2831853f);
+    rl_vec3 p2 = rl_add(p1, rl_v3(len * cosf(phi), 0.0f, len * sinf(phi)));
+    float spread = rl_rng_bounded(g, 2) ? 0.0f : 0.6f;
+    e[0] = vt_edge_end_of(p1, tilted_up(g, spread), eye, &mat);
+    e[1] = vt_edge_end_of(p2, tilted_up(g, spread), eye, &mat);
+}
+
+/* Sec. 6.1.1, Fig. 6.4, [CS93]: along random edges, every sampled value of
+ * the local term (checked against the term written out here) lies in both
+ * enclosures, both bounds eps_IA hold the largest error of the linear
+ * interpolant, and the affine enclosure and bound are no wider than the
+ * interval ones, the bound under half of it on most edges: it shrinks with
+ * the square of the edge, the interval's linearly. */
+static void test_affine_encloses_the_term_and_is_tighter_than_intervals(void **state)
+{
+    (void)state;
+    const rl_vec3 eye = rl_v3(0.0f, 4.0f, 3.0f);
+    rl_rng g;
+    rl_rng_seed(&g, 2003u, 61u);
+    int tighter = 0, n_lit = 0;
+    double width_ratio_sum = 0.0, eps_ratio_sum = 0.0;
+    for (int trial = 0; trial < 4000; ++trial) {
+        rl_light L;
+        vt_edge_end e[2];
+        random_edge(&g, &L, e, eye);
+        vt_term_bound ia, af;
+        vt_term_bound_of(VT_NONLINEAR_INTERVAL, &L, eye, &e[0], &e[1], &ia);
+        vt_term_bound_of(VT_NONLINEAR_AFFINE, &L, eye, &e[0], &e[1], &af);
+        float scale = 1e-4f * (1.0f + ia.hi);          /* float rounding of the samples */
+        float worst_af = 0.0f, worst_ia = 0.0f;
+        for (int k = 0; k <= 64; ++k) {
+            float t = (float)k / 64.0f;
+            float f = vt_term_at(&L, eye, &e[0], &e[1], t);
+            rl_vec3 p = rl_vlerp(e[0].p, e[1].p, t), n = rl_normalize(rl_vlerp(e[0].n, e[1].n, t));
+            float ref = phong_ref(&L, p, n, eye, e[0].kd, e[0].ks, rl_maxf(e[0].m, 1e-3f));
+            assert_float_equal(f, ref, 1e-4f * (1.0f + fabsf(ref)));
+            assert_true(f >= ia.lo - scale && f <= ia.hi + scale);
+            assert_true(f >= af.lo - scale && f <= af.hi + scale);
+            /* the interpolant f' of the ends' values */
+            worst_af = rl_maxf(worst_af, fabsf(f - (af.f1 + t * (af.f2 - af.f1))));
+            worst_ia = rl_maxf(worst_ia, fabsf(f - (ia.f1 + t * (ia.f2 - ia.f1))));
+        }
+        assert_true(worst_af <= af.eps + scale);
+        assert_true(worst_ia <= ia.eps + scale);
+        /* no wider, up to rounding */
+        assert_true(af.lo >= ia.lo && af.hi <= ia.hi);
+        assert_true(af.eps <= ia.eps);
+        if (ia.eps > 1e-6f && ia.eps < INFINITY) {
+            n_lit++;
+            tighter += af.eps < 0.5f * ia.eps;
+            width_ratio_sum += (af.hi - af.lo) / (ia.hi - ia.lo);
+            eps_ratio_sum += af.eps / ia.eps;
+        }
+    }
+    print_message("affine vs interval on %d lit random edges: bound under half on %d, mean width ratio %.3f, "
+                  "mean bound ratio %.3f\n", n_lit, tighter, width_ratio_sum / n_lit, eps_ratio_sum / n_lit);
+    assert_true(n_lit > 1000);
+    assert_true(tighter > n_lit / 2);
+
+    /* The error bound's order: halving a short edge across a highlight
+     * quarters the affine bound, only halves the interval one. */
+    rl_material shiny = rl_material_default();
+    shiny.diffuse = rl_v3(0.3f, 0.3f, 0.3f);
+    shiny.specular = rl_v3(1.0f, 1.0f, 1.0f);
+    shiny.shininess = 20.0f;
+    rl_light sun = { .type = RL_LIGHT_DIRECTIONAL, .color = rl_v3(1, 1, 1), .intensity = 1.0f,
+                     .direction = rl_v3(0.3f, -1.0f, 0.2f) };
+    rl_vec3 up = rl_v3(0.0f, 1.0f, 0.0f), c = rl_v3(0.2f, 0.0f, 0.1f), dir = rl_v3(0.6f, 0.0f, 0.8f);
+    float prev_ia = 0.0f, prev_af = 0.0f;
+    for (int k = 0; k < 4; ++k) {
+        float h = 0.02f / (float)(1 << k);
+        vt_edge_end e1 = vt_edge_end_of(rl_madd(c, dir, -h), up, eye, &shiny);
+        vt_edge_end e2 = vt_edge_end_of(rl_madd(c, dir, h), up, eye, &shiny);
+        vt_term_bound ia, af;
+        vt_term_bound_of(VT_NONLINEAR_INTERVAL, &sun, eye, &e1, &e2, &ia);
+        vt_term_bound_of(VT_NONLINEAR_AFFINE, &sun, eye, &e1, &e2, &af);
+        print_message("half-length %.5f: eps interval %.3g, affine %.3g\n", h, ia.eps, af.eps);
+        if (k > 0) {
+            assert_true(ia.eps > 0.4f * prev_ia);
+            assert_true(af.eps < 0.3f * prev_af);
+        }
+        prev_ia = ia.eps;
+        prev_af = af.eps;
+    }
+}
+
+/* Ends on the floor y = 0 with the normal up, lit by light L, seen from
+ * eye; material k_d, k_s, m. */
+static int tests_agree(const rl_light *L, rl_vec3 eye, rl_vec3 p1, rl_vec3 p2, float kd, float ks, float m,
+                       bool *ext, bool *der)
+{
+    rl_material mat = rl_material_default();
+    mat.diffuse = rl_v3(kd, kd, kd);
+    mat.specular = rl_v3(ks, ks, ks);
+    mat.shininess = m;
+    rl_vec3 up = rl_v3(0.0f, 1.0f, 0.0f);
+    vt_edge_end e1 = vt_edge_end_of(p1, up, eye, &mat), e2 = vt_edge_end_of(p2, up, eye, &mat);
+    *ext = vt_extremum_test(L, 1, &e1, &e2);
+    *der = vt_derivative_test(L, 1, eye, &e1, &e2);
+    return *ext == *der;
+}
+
+/* Sec. 6.1.1: the derivative test (eq. 6.3) and the geometric one (eq.
+ * 6.4-6.5) agree where the peak lies on the edge or far off it, and on
+ * most random edges; they differ, as they must, where the edge passes
+ * beside the peak: the slope along the edge turns at its point nearest the
+ * peak (eq. 6.3 sees that maximum of the restriction to the edge), while
+ * the lobe's direction across the axis turns by less than 90 degrees (eq.
+ * 6.5 does not). */
+static void test_derivative_agrees_with_extremum(void **state)
+{
+    (void)state;
+    const rl_vec3 eye = rl_v3(0.0f, 4.0f, 3.0f);
+    const rl_vec3 h = rl_v3(0.8f, 0.0f, 0.6f);      /* where the sun mirrors into the eye */
+    rl_vec3 a = rl_normalize(rl_sub(eye, h));
+    rl_light sun = { .type = RL_LIGHT_DIRECTIONAL, .color = rl_v3(1, 1, 1), .intensity = 1.0f,
+                     .direction = rl_v3(a.x, -a.y, a.z) };
+    bool ext, der;
+    /* specular only: the highlight on the edge, off its end, far off */
+    assert_true(tests_agree(&sun, eye, rl_v3(0.3f, 0.0f, 0.6f), rl_v3(1.3f, 0.0f, 0.6f), 0.0f, 1.0f, 50.0f, &ext, &der));
+    assert_true(ext && der);
+    assert_true(tests_agree(&sun, eye, rl_v3(0.8f, 0.0f, 0.1f), rl_v3(0.8f, 0.0f, 1.1f), 0.0f, 1.0f, 50.0f, &ext, &der));
+    assert_true(ext && der);
+    assert_true(tests_agree(&sun, eye, rl_v3(1.0f, 0.0f, 0.6f), rl_v3(1.9f, 0.0f, 0.6f), 0.0f, 1.0f, 50.0f, &ext, &der));
+    assert_true(!ext && !der);
+    assert_true(tests_agree(&sun, eye, rl_v3(-1.9f, 0.0f, -1.0f), rl_v3(-1.0f, 0.0f, -1.9f), 0.0f, 1.0f, 50.0f, &ext, &der));
+    assert_true(!ext && !der);
+    /* beside the highlight: the edge's nearest point to it is inside */
+    tests_agree(&sun, eye, rl_v3(0.3f, 0.0f, 1.2f), rl_v3(1.3f, 0.0f, 1.2f), 0.0f, 1.0f, 50.0f, &ext, &der);
+    assert_true(der && !ext);
+
+    /* diffuse under a point light 1 m over (0.5, 0, -0.5): across its foot
+     * both fire, beside it only the derivative, away from it neither */
+    rl_light bulb = { .type = RL_LIGHT_POINT, .color = rl_v3(1, 1, 1), .intensity = 4.0f,
+                      .position = rl_v3(0.5f, 1.0f, -0.5f) };
+    assert_true(tests_agree(&bulb, eye, rl_v3(0.0f, 0.0f, -0.5f), rl_v3(1.2f, 0.0f, -0.5f), 0.7f, 0.0f, 1.0f, &ext, &der));
+    assert_true(ext && der);
+    assert_true(tests_agree(&bulb, eye, rl_v3(1.0f, 0.0f, -0.5f), rl_v3(1.8f, 0.0f, -0.5f), 0.7f, 0.0f, 1.0f, &ext, &der));
+    assert_true(!ext && !der);
+    tests_agree(&bulb, eye, rl_v3(0.0f, 0.0f, 0.5f), rl_v3(1.0f, 0.0f, 0.5f), 0.7f, 0.0f, 1.0f, &ext, &der);
+    assert_true(der && !ext);
+    /* a directional light onto a plane: both terms constant or monotone */
+    rl_light down = { .type = RL_LIGHT_DIRECTIONAL, .color = rl_v3(1, 1, 1), .intensity = 1.0f,
+                      .direction = rl_v3(0.0f, -1.0f, 0.0f) };
+    assert_true(tests_agree(&down, eye, rl_v3(-1.0f, 0.0f, 1.0f), rl_v3(1.0f, 0.0f, 1.0f), 0.7f, 0.0f, 1.0f, &ext, &der));
+    assert_true(!ext && !der);
+
+    /* random edges, random lights and materials: mostly the same answer;
+     * every edge with one normal that the extremum test splits, the
+     * derivative test splits too (a peak between the ends is a turn of the
+     * slope) */
+    rl_rng g;
+    rl_rng_seed(&g, 2003u, 63u);
+    int agree = 0, n = 0, only_ext = 0, only_der = 0, only_ext_flat = 0;
+    for (int trial = 0; trial < 4000; ++trial) {
+        rl_light L;
+        vt_edge_end e[2];
+        random_edge(&g, &L, e, eye);
+        bool x = vt_extremum_test(&L, 1, &e[0], &e[1]), d = vt_derivative_test(&L, 1, eye, &e[0], &e[1]);
+        n++;
+        agree += x == d;
+        only_ext += x && !d;
+        only_ext_flat += x && !d && rl_dot(e[0].n, e[1].n) > 0.99999f;
+        only_der += d && !x;
+    }
+    print_message("derivative vs extremum on %d random edges: agree %d, only extremum %d, only derivative %d\n",
+                  n, agree, only_ext, only_der);
+    assert_true(agree > 8 * n / 10);
+    /* where the normals swing across a short edge the term can turn twice
+     * inside it (equal slopes at the ends) while the lobe passes the axis */
+    assert_int_equal(only_ext_flat, 0);
+    assert_true(only_ext < n / 100);
+}
+
+/* Sec. 6.1.1, eq. 6.3: the derivative test is the sign of the slope of the
+ * term along the edge: on random edges lit at both ends, with one term at
+ * a time (k_d or k_s), it fires exactly where finite differences of the
+ * term at the two ends have opposite signs (slopes too flat to tell by
+ * differences are left out). */
+static void test_derivative_test_is_the_sign_of_the_slope(void **state)
+{
+    (void)state;
+    const rl_vec3 eye = rl_v3(0.0f, 4.0f, 3.0f);
+    rl_rng g;
+    rl_rng_seed(&g, 2003u, 62u);
+    int checked = 0, turns = 0;
+    for (int trial = 0; trial < 4000; ++trial) {
+        rl_light L;
+        vt_edge_end e[2];
+        random_edge(&g, &L, e, eye);
+        bool diffuse = trial & 1;
+        for (int k = 0; k < 2; ++k) {
+            if (diffuse)
+                e[k].ks = 0.0f;
+            else
+                e[k].kd = 0.0f;
+        }
+        if (!((diffuse ? e[0].kd : e[0].ks) > 0.0f))
+            continue;
+        const float h = 1e-3f;
+        float f0 = vt_term_at(&L, eye, &e[0], &e[1], 0.0f), f1 = vt_term_at(&L, eye, &e[0], &e[1], 1.0f);
+        float s0 = (vt_term_at(&L, eye, &e[0], &e[1], h) - f0) / h;
+        float s1 = (f1 - vt_term_at(&L, eye, &e[0], &e[1], 1.0f - h)) / h;
+        float flat = 1e-2f * rl_maxf(f0, f1);
+        if (!(f0 > 1e-6f && f1 > 1e-6f) || fabsf(s0) < flat || fabsf(s1) < flat)
+            continue;
+        bool turn = (s0 > 0.0f) != (s1 > 0.0f);
+        checked++;
+        turns += turn;
+        assert_int_equal(vt_derivative_test(&L, 1, eye, &e[0], &e[1]), turn);
+    }
+    print_message("derivative test against finite differences: %d edges, %d turns\n", checked, turns);
+    assert_true(checked > 1000 && turns > 20);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -258,6 +534,9 @@ int main(void)
         cmocka_unit_test(test_hsv_hue_wraps_and_is_ignored_for_greys),
         cmocka_unit_test(test_tree_and_combinations_report_what_fired),
         cmocka_unit_test(test_shaft_is_the_hull_of_two_boxes),
+        cmocka_unit_test(test_affine_encloses_the_term_and_is_tighter_than_intervals),
+        cmocka_unit_test(test_derivative_agrees_with_extremum),
+        cmocka_unit_test(test_derivative_test_is_the_sign_of_the_slope),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
