@@ -197,26 +197,12 @@ bool rl_accel_intersect(const rl_accel *accel, rl_ray *ray, rl_hit *hit)
     hit->object = RL_ID_NONE;
     if (!accel || !accel->committed || !ray_is_valid(ray))
         return false;
+    /* Alpha masks here rather than in each kind's inner loop: one place for
+     * all of them (Embree included), and no cost for scenes without masks. */
     rl_hit h = { .triangle = RL_ID_NONE, .object = RL_ID_NONE };
-    rl_ray r = *ray;
-    if (!accel->cls->intersect(accel->state, &r, &h))
+    if (!rl_closest_unmasked_hit(accel->data, accel->masked, accel->cls->intersect, accel->state, ray, &h))
         return false;
-    /* Alpha masks (glTF MASK): a hit in a hole is skipped by asking again
-     * beyond it. Every kind tests t in the open interval (t_min, t_max), so
-     * the same triangle is not found twice. Here rather than in each
-     * kind's inner loop: one place for all of them (Embree included), and
-     * no cost for scenes without masks. */
-    for (int skips = 0; accel->masked && rl_alpha_masked(accel->data, h.triangle, h.u, h.v); ++skips) {
-        if (skips == RL_MAX_MASK_SKIPS)
-            return false;
-        r = *ray;
-        r.t_min = h.t;
-        h = (rl_hit){ .triangle = RL_ID_NONE, .object = RL_ID_NONE };
-        if (!accel->cls->intersect(accel->state, &r, &h))
-            return false;
-    }
     h.object = accel->data->triangle_object[h.triangle];
-    ray->t_max = h.t;
     *hit = h;
     return true;
 }
