@@ -37,6 +37,7 @@
 #include "gl/gl_shaders.h"
 
 #include <stdlib.h>
+#include <string.h>
 
 #include "core/error.h"
 
@@ -456,6 +457,53 @@ static const char *const upload_fs = GLSL(
         gl_FragDepth = isnan(z) ? 1.0 : clamp(z, 0.0, 1.0);
     }
 );
+
+GLuint rl_gl_make_buffer(const void *data, size_t bytes, GLbitfield flags)
+{
+    GLuint b = 0;
+    glCreateBuffers(1, &b);
+    if (bytes >= 16) {
+        glNamedBufferStorage(b, (GLsizeiptr)bytes, data, flags);
+    } else {
+        uint8_t pad[16] = { 0 };
+        if (data && bytes)
+            memcpy(pad, data, bytes);
+        glNamedBufferStorage(b, 16, pad, flags);
+    }
+    return b;
+}
+
+rl_status rl_gl_upload_textures(const rl_scene_data *d, GLint64 max_block, const char *who, GLuint *tex_info,
+                                GLuint *texels)
+{
+    rl_gl_tex_info *info = rl_calloc(d->num_textures ? d->num_textures : 1, sizeof *info);
+    if (!info)
+        return RL_ERR_OUT_OF_MEMORY;
+    uint64_t total = 0;
+    for (uint32_t t = 0; t < d->num_textures; ++t) {
+        const rl_texture *tex = d->textures[t];
+        info[t].offset = (uint32_t)total;
+        info[t].width = tex ? tex->width : 1;
+        info[t].height = tex ? tex->height : 1;
+        total += tex ? (uint64_t)tex->width * (uint64_t)tex->height : 0;
+    }
+    if (total * sizeof(rl_vec4) > (uint64_t)max_block || total > UINT32_MAX) {
+        free(info);
+        return rl_error(RL_ERR_LIMIT, "%s: the scene's textures (%llu texels, %llu MiB) exceed this GL's shader "
+                        "storage block size (%lld MiB) or 2^32 texels", who, (unsigned long long)total,
+                        (unsigned long long)(total * sizeof(rl_vec4) >> 20), (long long)(max_block >> 20));
+    }
+    *tex_info = rl_gl_make_buffer(info, sizeof *info * d->num_textures, 0);
+    *texels = rl_gl_make_buffer(NULL, total * sizeof(rl_vec4), GL_DYNAMIC_STORAGE_BIT);
+    for (uint32_t t = 0; t < d->num_textures; ++t) {
+        const rl_texture *tex = d->textures[t];
+        if (tex && tex->width > 0 && tex->height > 0)
+            glNamedBufferSubData(*texels, (GLintptr)info[t].offset * (GLintptr)sizeof(rl_vec4),
+                                 (GLsizeiptr)tex->width * tex->height * (GLsizeiptr)sizeof(rl_vec4), tex->texels);
+    }
+    free(info);
+    return RL_OK;
+}
 
 rl_status rl_gl_check(const char *where)
 {
