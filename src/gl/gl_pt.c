@@ -221,8 +221,9 @@ static GLuint compute_program(const char *body, bool linespace, const char *what
         return f ? rl_gl_link(v, f, what) : 0;
     }
     const char *const parts[] = { rl_gl_pt_glsl_header, linespace ? rl_gl_linespace_glsl() : "", defines,
-                                  rl_gl_pt_glsl_common, rl_gl_glsl_tex_sample, rl_gl_pt_glsl_common2, body };
-    GLuint s = rl_gl_compile(GL_COMPUTE_SHADER, parts, 7, what);
+                                  rl_gl_pt_glsl_common, rl_gl_glsl_tex_sample, rl_gl_pt_glsl_common2,
+                                  rl_gl_glsl_light_delta, body };
+    GLuint s = rl_gl_compile(GL_COMPUTE_SHADER, parts, 8, what);
     return s ? rl_gl_link(s, 0, what) : 0;
 }
 

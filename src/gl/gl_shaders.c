@@ -65,40 +65,27 @@ static const char *const common = GLSL(
     uniform int u_mode;
 
     bool finite3(vec3 v) { return !any(isnan(v)) && !any(isinf(v)); }
+);
 
+/* Quad lights as points (Ullmann 2003, Sec. 3.1; docs/gl.md), the other
+ * kinds by rl_gl_glsl_light_delta; then Phong and the texel fetch. */
+static const char *const lighting = GLSL(
     bool light_at(Light L, vec3 p, out vec3 E, out vec3 l)
     {
-        int kind = int(L.pos.w);
-        E = vec3(0.0);
-        l = vec3(0.0);
-        if (kind == 2) {
-            l = L.dir.xyz;
-            E = L.power.rgb;
-            return L.extra.y > 0.0;
-        }
-        vec3 to_light = L.pos.xyz - p;
-        float d2 = dot(to_light, to_light);
-        if (!(d2 > 0.0))
-            return false;
-        if (kind == 3) {
-            if (!(L.power.w > 0.0))
+        if (int(L.pos.w) == 3) {
+            E = vec3(0.0);
+            l = vec3(0.0);
+            vec3 to_light = L.pos.xyz - p;
+            float d2 = dot(to_light, to_light);
+            if (!(d2 > 0.0) || !(L.power.w > 0.0))
                 return false;
             l = to_light * (1.0 / sqrt(d2));
             float cos_light = dot(L.dir.xyz, -l);
             E = (L.power.rgb * (L.power.w * max(0.0, cos_light))) * (1.0 / d2);
             return cos_light > 0.0;
         }
-        float dist = sqrt(d2);
-        l = to_light * (1.0 / dist);
-        float falloff = 1.0 / d2;
-        if (kind == 1) {
-            float cos_axis = dot(-l, L.dir.xyz);
-            float cos_outer = L.dir.w, cos_inner = L.extra.x;
-            falloff *= cos_inner > cos_outer ? smoothstep(cos_outer, cos_inner, cos_axis)
-                                             : (cos_axis >= cos_outer ? 1.0 : 0.0);
-        }
-        E = L.power.rgb * falloff;
-        return falloff > 0.0;
+        float dist;
+        return light_delta(L, p, E, l, dist);
     }
 
     vec3 phong(Material m, vec3 p, vec3 n)
@@ -155,6 +142,49 @@ const char *const rl_gl_glsl_tex_sample = GLSL(
         y1 -= y1 >= t.height ? t.height : 0;
         return (1.0 - tx) * (1.0 - ty) * texel_at(t, x0, y0) + tx * (1.0 - ty) * texel_at(t, x1, y0) +
                (1.0 - tx) * ty * texel_at(t, x0, y1) + tx * ty * texel_at(t, x1, y1);
+    }
+);
+
+/* The drawer's and gl-pt's light records agree on the three delta kinds,
+ * numbered as rl_light_type: pos.w the kind, dir.xyz the spot axis or the
+ * directional light's l, dir.w the spot's cos outer, extra.x its cos
+ * inner, extra.y whether a directional light is valid. */
+_Static_assert((int)RL_GL_LIGHT_POINT == (int)RL_LIGHT_POINT && (int)RL_GL_LIGHT_SPOT == (int)RL_LIGHT_SPOT &&
+                   (int)RL_GL_LIGHT_DIRECTIONAL == (int)RL_LIGHT_DIRECTIONAL &&
+                   (int)RL_GL_LIGHT_QUAD == (int)RL_LIGHT_QUAD && RL_LIGHT_SPOT == 1 && RL_LIGHT_DIRECTIONAL == 2,
+               "rl_gl_glsl_light_delta numbers the kinds as rl_light_type");
+
+/* scene/light_eval.c rl_light_eval_delta in GLSL: a point, spot or
+ * directional light's irradiance E at p and direction l towards it, dist
+ * its distance (infinite for a directional light); false where it gives
+ * none. For programs that declare struct Light as rl_gl_light. */
+const char *const rl_gl_glsl_light_delta = GLSL(
+    bool light_delta(Light L, vec3 p, out vec3 E, out vec3 l, out float dist)
+    {
+        int kind = int(L.pos.w);
+        E = vec3(0.0);
+        l = vec3(0.0);
+        dist = uintBitsToFloat(0x7f800000u);
+        if (kind == 2) {
+            l = L.dir.xyz;
+            E = L.power.rgb;
+            return L.extra.y > 0.0;
+        }
+        vec3 to_light = L.pos.xyz - p;
+        float d2 = dot(to_light, to_light);
+        if (!(d2 > 0.0))
+            return false;
+        dist = sqrt(d2);
+        l = to_light * (1.0 / dist);
+        float falloff = 1.0 / d2;
+        if (kind == 1) {
+            float cos_axis = dot(-l, L.dir.xyz);
+            float cos_outer = L.dir.w, cos_inner = L.extra.x;
+            falloff *= cos_inner > cos_outer ? smoothstep(cos_outer, cos_inner, cos_axis)
+                                             : (cos_axis >= cos_outer ? 1.0 : 0.0);
+        }
+        E = L.power.rgb * falloff;
+        return falloff > 0.0;
     }
 );
 
@@ -571,9 +601,9 @@ static GLuint link(const char *const *vs, int nvs, const char *const *fs, int nf
 
 GLuint rl_gl_program_triangles(void)
 {
-    const char *const vs[] = { header, common, rl_gl_glsl_tex_sample, triangle_vs };
-    const char *const fs[] = { header, common, rl_gl_glsl_tex_sample, triangle_fs };
-    return link(vs, 4, fs, 4, "triangle");
+    const char *const vs[] = { header, common, rl_gl_glsl_light_delta, lighting, rl_gl_glsl_tex_sample, triangle_vs };
+    const char *const fs[] = { header, common, rl_gl_glsl_light_delta, lighting, rl_gl_glsl_tex_sample, triangle_fs };
+    return link(vs, 6, fs, 6, "triangle");
 }
 
 GLuint rl_gl_program_points(void)
@@ -593,6 +623,6 @@ GLuint rl_gl_program_depth_upload(void)
 GLuint rl_gl_program_batch(void)
 {
     const char *const vs[] = { header, batch_vs };
-    const char *const fs[] = { header, common, rl_gl_glsl_tex_sample, batch_fs };
-    return link(vs, 2, fs, 4, "batch");
+    const char *const fs[] = { header, common, rl_gl_glsl_light_delta, lighting, rl_gl_glsl_tex_sample, batch_fs };
+    return link(vs, 2, fs, 6, "batch");
 }

@@ -77,6 +77,11 @@ GLuint rl_gl_link(GLuint a, GLuint b, const char *what);
  * programs that declare TexInfo, tex_info[] and texel_at() before it. */
 extern const char *const rl_gl_glsl_tex_sample;
 
+/* The GLSL of light_delta(Light L, vec3 p, out E, out l, out dist)
+ * (scene/light_eval.c rl_light_eval_delta: point, spot, directional), for
+ * programs that declare struct Light as rl_gl_light before it. */
+extern const char *const rl_gl_glsl_light_delta;
+
 GLuint rl_gl_program_triangles(void);
 GLuint rl_gl_program_points(void);
 GLuint rl_gl_program_depth_upload(void);
