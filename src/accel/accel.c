@@ -189,27 +189,14 @@ static bool ray_is_valid(const rl_ray *r)
     return r->t_min <= r->t_max;
 }
 
-/* The rest of rl_accel_intersect once the kind found its first hit h for
- * *ray (from a single query or a packet lane): skips alpha-mask holes,
- * names the object, shortens the ray. */
+/* The rest of rl_accel_intersect for a packet lane's first hit h of *ray:
+ * the same alpha-mask retries as a single query (rl_skip_masked_hits),
+ * then the object's name. */
 static bool finish_hit(const rl_accel *accel, rl_ray *ray, rl_hit *hit, rl_hit h)
 {
-    /* Alpha masks (glTF MASK): a hit in a hole is skipped by asking again
-     * beyond it. Every kind tests t in the open interval (t_min, t_max), so
-     * the same triangle is not found twice. Here rather than in each
-     * kind's inner loop: one place for all of them (Embree included), and
-     * no cost for scenes without masks. */
-    for (int skips = 0; accel->masked && rl_alpha_masked(accel->data, h.triangle, h.u, h.v); ++skips) {
-        if (skips == RL_MAX_MASK_SKIPS)
-            return false;
-        rl_ray r = *ray;
-        r.t_min = h.t;
-        h = (rl_hit){ .triangle = RL_ID_NONE, .object = RL_ID_NONE };
-        if (!accel->cls->intersect(accel->state, &r, &h))
-            return false;
-    }
+    if (!rl_skip_masked_hits(accel->data, accel->masked, accel->cls->intersect, accel->state, ray, &h, true))
+        return false;
     h.object = accel->data->triangle_object[h.triangle];
-    ray->t_max = h.t;
     *hit = h;
     return true;
 }
@@ -222,11 +209,14 @@ bool rl_accel_intersect(const rl_accel *accel, rl_ray *ray, rl_hit *hit)
     hit->object = RL_ID_NONE;
     if (!accel || !accel->committed || !ray_is_valid(ray))
         return false;
+    /* Alpha masks here rather than in each kind's inner loop: one place for
+     * all of them (Embree included), and no cost for scenes without masks. */
     rl_hit h = { .triangle = RL_ID_NONE, .object = RL_ID_NONE };
-    rl_ray r = *ray;
-    if (!accel->cls->intersect(accel->state, &r, &h))
+    if (!rl_closest_unmasked_hit(accel->data, accel->masked, accel->cls->intersect, accel->state, ray, &h))
         return false;
-    return finish_hit(accel, ray, hit, h);
+    h.object = accel->data->triangle_object[h.triangle];
+    *hit = h;
+    return true;
 }
 
 bool rl_accel_occluded(const rl_accel *accel, const rl_ray *ray)

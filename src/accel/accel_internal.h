@@ -47,6 +47,46 @@ extern const rl_accel_class rl_accel_embree_class;
  * stack of foliage cards) before they give up. */
 #define RL_MAX_MASK_SKIPS 256
 
+/* A structure's closest hit, holes of alpha masks included: on a hit fills
+ * *hit and shortens ray->t_max (rl_accel_class.intersect has this shape). */
+typedef bool (*rl_closest_hit_fn)(const void *state, rl_ray *ray, rl_hit *hit);
+
+/* The closest hit outside the holes of alpha masks (glTF MASK), for
+ * rl_accel_intersect and the Line Spaces' exact queries: a hit in a hole is
+ * skipped by asking closest again beyond it. Every test of ours (and
+ * Embree's) takes t in the open interval (t_min, t_max), so the same
+ * triangle is not found twice. masked = whether the scene has masks at all
+ * (rl_data_has_masks): without them this is one call to closest. On a hit
+ * shortens ray->t_max; on a miss hit->triangle and hit->object are
+ * RL_ID_NONE. Inline so that each caller's closest is called directly.
+ *
+ * rl_skip_masked_hits is the loop after the first query, whose result
+ * (found, *hit) comes from the caller: a packet lane's hit
+ * (rl_accel_intersect_n) takes the same retries as a single ray's. */
+static inline bool rl_skip_masked_hits(const rl_scene_data *data, bool masked, rl_closest_hit_fn closest,
+                                       const void *state, rl_ray *ray, rl_hit *hit, bool found)
+{
+    for (int skips = 0; found && masked && rl_alpha_masked(data, hit->triangle, hit->u, hit->v); ++skips) {
+        rl_ray r = *ray;
+        r.t_min = hit->t;
+        found = skips < RL_MAX_MASK_SKIPS && closest(state, &r, hit);
+    }
+    if (!found) {
+        hit->triangle = hit->object = RL_ID_NONE;
+        return false;
+    }
+    ray->t_max = hit->t;
+    return true;
+}
+
+static inline bool rl_closest_unmasked_hit(const rl_scene_data *data, bool masked, rl_closest_hit_fn closest,
+                                           const void *state, rl_ray *ray, rl_hit *hit)
+{
+    rl_ray r = *ray;
+    bool found = closest(state, &r, hit);
+    return rl_skip_masked_hits(data, masked, closest, state, ray, hit, found);
+}
+
 /* The grid of a committed RL_ACCEL_GRID accel (the Line Space builds on
  * it, rl_linespace.h); NULL for any other kind or an uncommitted accel. */
 struct rl_grid;

@@ -504,8 +504,11 @@ static bool walk(const rl_ls_objects *o, const rl_ray *ray, bool any, rl_tri_clo
     return best->id != RL_ID_NONE;
 }
 
-static bool closest_hit(const rl_ls_objects *o, rl_ray *ray, rl_hit *hit)
+/* The closest hit, holes of alpha masks included (an rl_closest_hit_fn:
+ * state is the rl_ls_objects). */
+static bool closest_hit(const void *state, rl_ray *ray, rl_hit *hit)
 {
+    const rl_ls_objects *o = state;
     rl_tri_closest best = { RL_ID_NONE, ray->t_max, 0.0f, 0.0f };
     if (!walk(o, ray, false, &best))
         return false;
@@ -518,25 +521,13 @@ static bool closest_hit(const rl_ls_objects *o, rl_ray *ray, rl_hit *hit)
     return true;
 }
 
-/* Alpha masks as rl_linespace_intersect: ask again beyond a hole. */
+/* Alpha masks as rl_accel_intersect (rl_closest_unmasked_hit). */
 bool rl_ls_objects_intersect(const rl_ls_objects *o, rl_ray *ray, rl_hit *hit)
 {
     if (!o || !ray || !hit || !o->committed || !ray_ok(ray))
         return false;
     hit->triangle = hit->object = RL_ID_NONE;
-    rl_ray r = *ray;
-    if (!closest_hit(o, &r, hit))
-        return false;
-    for (int skips = 0; o->masked && rl_alpha_masked(o->data, hit->triangle, hit->u, hit->v); ++skips) {
-        r = *ray;
-        r.t_min = hit->t;
-        if (skips == RL_MAX_MASK_SKIPS || !closest_hit(o, &r, hit)) {
-            hit->triangle = hit->object = RL_ID_NONE;
-            return false;
-        }
-    }
-    *ray = r;
-    return true;
+    return rl_closest_unmasked_hit(o->data, o->masked, closest_hit, o, ray, hit);
 }
 
 bool rl_ls_objects_occluded(const rl_ls_objects *o, const rl_ray *ray)

@@ -158,9 +158,11 @@ static bool any_hit(const rl_linespace *ls, const rl_ray_watertight *w, const rl
     return rl_tri_list_any(ls->grid->tri_verts, l.ids, l.count, w, ray->t_min, t_max, mailbox);
 }
 
-/* The closest candidate hit, holes of alpha masks included. */
-static bool closest_hit(const rl_linespace *ls, rl_ray *ray, rl_hit *hit)
+/* The closest candidate hit, holes of alpha masks included (an
+ * rl_closest_hit_fn: state is the rl_linespace). */
+static bool closest_hit(const void *state, rl_ray *ray, rl_hit *hit)
 {
+    const rl_linespace *ls = state;
     hit->triangle = RL_ID_NONE;
     hit->object = RL_ID_NONE;
     if (!usable(ls, ray))
@@ -200,25 +202,17 @@ static bool closest_hit(const rl_linespace *ls, rl_ray *ray, rl_hit *hit)
     return true;
 }
 
-/* Alpha masks as in rl_accel_intersect: a hit in a hole is skipped by
- * asking again beyond it (every test takes t in the open (t_min, t_max)). */
+/* Alpha masks as in rl_accel_intersect (rl_closest_unmasked_hit). */
 bool rl_linespace_intersect(const rl_linespace *ls, rl_ray *ray, rl_hit *hit)
 {
     if (!ray || !hit)
         return false;
-    rl_ray r = *ray;
-    if (!closest_hit(ls, &r, hit))
+    if (!ls) {
+        hit->triangle = hit->object = RL_ID_NONE;
         return false;
-    for (int skips = 0; ls->masked && rl_alpha_masked(ls->data, hit->triangle, hit->u, hit->v); ++skips) {
-        r = *ray;
-        r.t_min = hit->t;
-        if (skips == RL_MAX_MASK_SKIPS || !closest_hit(ls, &r, hit)) {
-            hit->triangle = hit->object = RL_ID_NONE;
-            return false;
-        }
     }
-    *ray = r;
-    return true;
+    /* closest_hit checks that ls is committed and the ray valid. */
+    return rl_closest_unmasked_hit(ls->data, ls->masked, closest_hit, ls, ray, hit);
 }
 
 bool rl_linespace_occluded(const rl_linespace *ls, const rl_ray *ray)

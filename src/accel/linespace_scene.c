@@ -502,10 +502,13 @@ static bool walk_next(run_walk *w, double *t0, double *t1)
     return true;
 }
 
-bool rl_ls_scene_intersect(const rl_ls_scene *s, rl_ray *ray, rl_hit *hit)
+/* The walk of both queries: each run of set segments, front to back, is
+ * asked of the inner structure with the ray clipped to it. hit NULL: any
+ * hit (occluded); else the closest, its t in *t_hit. Inline with a constant
+ * hit at both calls, so that each query gets its own loop without the
+ * mode's test. */
+static inline bool walk_runs(const rl_ls_scene *s, const rl_ray *ray, rl_hit *hit, float *t_hit)
 {
-    if (!s || !ray || !hit || !s->committed || !ray_ok(ray))
-        return false;
     run_walk w;
     if (!walk_begin(s, ray, &w))
         return false;
@@ -518,30 +521,27 @@ bool rl_ls_scene_intersect(const rl_ls_scene *s, rl_ray *ray, rl_hit *hit)
             r.t_max = (float)t1;
         if (r.t_min > r.t_max)
             continue;
-        if (inner_intersect(s, &r, hit)) {
-            ray->t_max = r.t_max;
+        if (!hit) {
+            if (inner_occluded(s, &r))
+                return true;
+        } else if (inner_intersect(s, &r, hit)) {
+            *t_hit = r.t_max;
             return true;
         }
     }
     return false;
 }
 
+bool rl_ls_scene_intersect(const rl_ls_scene *s, rl_ray *ray, rl_hit *hit)
+{
+    if (!s || !ray || !hit || !s->committed || !ray_ok(ray))
+        return false;
+    return walk_runs(s, ray, hit, &ray->t_max);
+}
+
 bool rl_ls_scene_occluded(const rl_ls_scene *s, const rl_ray *ray)
 {
     if (!s || !ray || !s->committed || !ray_ok(ray))
         return false;
-    run_walk w;
-    if (!walk_begin(s, ray, &w))
-        return false;
-    double t0, t1;
-    while (walk_next(&w, &t0, &t1)) {
-        rl_ray r = *ray;
-        if (t0 > r.t_min)
-            r.t_min = (float)t0;
-        if (t1 < r.t_max)
-            r.t_max = (float)t1;
-        if (r.t_min <= r.t_max && inner_occluded(s, &r))
-            return true;
-    }
-    return false;
+    return walk_runs(s, ray, NULL, NULL);
 }

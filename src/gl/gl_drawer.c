@@ -138,23 +138,6 @@ static uniforms locate(GLuint p)
     };
 }
 
-/* An immutable buffer of bytes (at least 16, so that empty scenes' arrays
- * still bind). */
-static GLuint make_buffer(const void *data, size_t bytes)
-{
-    GLuint b = 0;
-    glCreateBuffers(1, &b);
-    if (bytes >= 16) {
-        glNamedBufferStorage(b, (GLsizeiptr)bytes, data, 0);
-    } else {
-        uint8_t pad[16] = { 0 };
-        if (data && bytes)
-            memcpy(pad, data, bytes);
-        glNamedBufferStorage(b, 16, pad, 0);
-    }
-    return b;
-}
-
 static uint32_t valid_texture(const rl_scene_data *d, uint32_t t)
 {
     return t < d->num_textures && d->textures[t] ? t : RL_NONE;
@@ -225,45 +208,10 @@ static rl_status upload_materials_lights(gl_drawer *g)
             break;
         }
     }
-    g->ssbo_materials = make_buffer(mats, sizeof *mats * d->num_materials);
-    g->ssbo_lights = make_buffer(lights, sizeof *lights * d->num_lights);
+    g->ssbo_materials = rl_gl_make_buffer(mats, sizeof *mats * d->num_materials, 0);
+    g->ssbo_lights = rl_gl_make_buffer(lights, sizeof *lights * d->num_lights, 0);
     free(mats);
     free(lights);
-    return RL_OK;
-}
-
-/* Every texture in one texel buffer, bounded by the storage block size. */
-static rl_status upload_textures(gl_drawer *g, GLint64 max_block)
-{
-    const rl_scene_data *d = g->data;
-    rl_gl_tex_info *info = rl_calloc(d->num_textures ? d->num_textures : 1, sizeof *info);
-    if (!info)
-        return RL_ERR_OUT_OF_MEMORY;
-    uint64_t total = 0;
-    for (uint32_t t = 0; t < d->num_textures; ++t) {
-        const rl_texture *tex = d->textures[t];
-        info[t].offset = (uint32_t)total;
-        info[t].width = tex ? tex->width : 1;
-        info[t].height = tex ? tex->height : 1;
-        total += tex ? (uint64_t)tex->width * (uint64_t)tex->height : 0;
-    }
-    if (total * sizeof(rl_vec4) > (uint64_t)max_block || total > UINT32_MAX) {
-        free(info);
-        return rl_error(RL_ERR_LIMIT, "gl: the scene's textures (%llu texels, %llu MiB) exceed this GL's shader "
-                        "storage block size (%lld MiB)", (unsigned long long)total,
-                        (unsigned long long)(total * sizeof(rl_vec4) >> 20), (long long)(max_block >> 20));
-    }
-    g->ssbo_tex_info = make_buffer(info, sizeof *info * d->num_textures);
-    glCreateBuffers(1, &g->ssbo_texels);
-    glNamedBufferStorage(g->ssbo_texels, total ? (GLsizeiptr)(total * sizeof(rl_vec4)) : 16, NULL,
-                         GL_DYNAMIC_STORAGE_BIT);
-    for (uint32_t t = 0; t < d->num_textures; ++t) {
-        const rl_texture *tex = d->textures[t];
-        if (tex && tex->width > 0 && tex->height > 0)
-            glNamedBufferSubData(g->ssbo_texels, (GLintptr)info[t].offset * (GLintptr)sizeof(rl_vec4),
-                                 (GLsizeiptr)tex->width * tex->height * (GLsizeiptr)sizeof(rl_vec4), tex->texels);
-    }
-    free(info);
     return RL_OK;
 }
 
@@ -336,14 +284,14 @@ static rl_status upload_geometry(gl_drawer *g, GLint64 max_block)
                     idx[3 * t + k] = next++;
                 }
         }
-        g->vbo_pos = make_buffer(pos, sizeof *pos * nv);
-        g->vbo_normal = make_buffer(nrm, sizeof *nrm * nv);
-        g->vbo_uv = make_buffer(uv, sizeof *uv * nv);
-        g->vbo_material = make_buffer(mat, sizeof *mat * nv);
-        g->ibo = make_buffer(idx, sizeof *idx * ni);
+        g->vbo_pos = rl_gl_make_buffer(pos, sizeof *pos * nv, 0);
+        g->vbo_normal = rl_gl_make_buffer(nrm, sizeof *nrm * nv, 0);
+        g->vbo_uv = rl_gl_make_buffer(uv, sizeof *uv * nv, 0);
+        g->vbo_material = rl_gl_make_buffer(mat, sizeof *mat * nv, 0);
+        g->ibo = rl_gl_make_buffer(idx, sizeof *idx * ni, 0);
         /* The fragment stage's indices are the scene's, corners or not. */
-        g->ssbo_indices = fetch ? make_buffer(d->indices, sizeof *idx * ni) : 0;
-        g->ssbo_tri_material = make_buffer(d->triangle_material, sizeof(uint32_t) * d->num_triangles);
+        g->ssbo_indices = fetch ? rl_gl_make_buffer(d->indices, sizeof *idx * ni, 0) : 0;
+        g->ssbo_tri_material = rl_gl_make_buffer(d->triangle_material, sizeof(uint32_t) * d->num_triangles, 0);
     }
     free(pos);
     free(nrm);
@@ -1032,7 +980,7 @@ rl_status rl_gl_drawer_create(const rl_scene *scene, const rl_drawer_desc *desc,
     if (st == RL_OK)
         st = upload_materials_lights(g);
     if (st == RL_OK)
-        st = upload_textures(g, max_block);
+        st = rl_gl_upload_textures(d, max_block, "gl", &g->ssbo_tex_info, &g->ssbo_texels);
     if (st == RL_OK)
         st = upload_geometry(g, max_block);
     if (st == RL_OK) {

@@ -357,6 +357,27 @@ static const char *const walk_glsl =
         }
     }
 
+    /* The start of every walk: a valid ray, the 3D-DDA over the voxels
+     * and the ray's line in cell units (for its shafts); false where the
+     * ray can hit nothing. */
+    bool rl_ls_walk_begin(vec3 o, vec3 d, float t_min, float t_max, out RlLsDda it, out dvec3 lo, out dvec3 ld,
+                          out dvec3 linv)
+    {
+        if (!rl_ls_ray_ok(o, d, t_min, t_max) || !rl_ls_dda_begin(o, d, t_min, t_max, it))
+            return false;
+        rl_ls_line(o, d, lo, ld, linv);
+        return true;
+    }
+
+    /* The payload walks' exact origin rule (ls_origin=exact, Sec. 12.1):
+     * whether the ray starts inside the box, so that its first voxel is
+     * the start voxel. */
+    bool rl_ls_starts_inside(vec3 o, vec3 d, float t_min)
+    {
+        precise vec3 start = o + d * t_min;
+        return u_ls_origin_exact && all(greaterThanEqual(start, u_ls_min)) && all(lessThanEqual(start, u_ls_max));
+    }
+
     bool rl_ls_intersect(vec3 o, vec3 d, float t_min, float t_max, out uint tri, out float t, out float u,
                          out float v)
     {
@@ -364,13 +385,10 @@ static const char *const walk_glsl =
         t = t_max;
         u = 0.0;
         v = 0.0;
-        if (!rl_ls_ray_ok(o, d, t_min, t_max))
-            return false;
         RlLsDda it;
-        if (!rl_ls_dda_begin(o, d, t_min, t_max, it))
-            return false;
         dvec3 lo, ld, linv;
-        rl_ls_line(o, d, lo, ld, linv);
+        if (!rl_ls_walk_begin(o, d, t_min, t_max, it, lo, ld, linv))
+            return false;
         RlLsWt w = rl_ls_wt_setup(o, d);
         float limit = t_max;
         uint cell;
@@ -409,13 +427,10 @@ static const char *const walk_glsl =
 
     bool rl_ls_occluded(vec3 o, vec3 d, float t_min, float t_max)
     {
-        if (!rl_ls_ray_ok(o, d, t_min, t_max))
-            return false;
         RlLsDda it;
-        if (!rl_ls_dda_begin(o, d, t_min, t_max, it))
-            return false;
         dvec3 lo, ld, linv;
-        rl_ls_line(o, d, lo, ld, linv);
+        if (!rl_ls_walk_begin(o, d, t_min, t_max, it, lo, ld, linv))
+            return false;
         RlLsWt w = rl_ls_wt_setup(o, d);
         uint cell;
         float t0, t1;
@@ -546,16 +561,12 @@ static const char *const walk_glsl =
         n = vec3(0.0);
         uv = vec2(0.0);
         material = 0u;
-        if (!u_ls_has_pnmt || !rl_ls_ray_ok(o, d, t_min, t_max))
-            return false;
         RlLsDda it;
-        if (!rl_ls_dda_begin(o, d, t_min, t_max, it))
-            return false;
         dvec3 lo, ld, linv;
-        rl_ls_line(o, d, lo, ld, linv);
+        if (!u_ls_has_pnmt || !rl_ls_walk_begin(o, d, t_min, t_max, it, lo, ld, linv))
+            return false;
         RlLsWt w = rl_ls_wt_setup(o, d);
-        precise vec3 start = o + d * t_min;
-        bool first = u_ls_origin_exact && all(greaterThanEqual(start, u_ls_min)) && all(lessThanEqual(start, u_ls_max));
+        bool first = rl_ls_starts_inside(o, d, t_min);
         precise float r = want ? 0.0 : 0.5 * sqrt(u_ls_cell.x * u_ls_cell.x + u_ls_cell.y * u_ls_cell.y +
                                                   u_ls_cell.z * u_ls_cell.z) / sqrt(d.x * d.x + d.y * d.y + d.z * d.z);
         uint cell;
@@ -613,15 +624,11 @@ static const char *const walk_glsl =
     {
         color = vec3(0.0);
         t = 0.0;
-        if (!u_ls_has_preillum || !rl_ls_ray_ok(o, d, t_min, t_max))
-            return false;
         RlLsDda it;
-        if (!rl_ls_dda_begin(o, d, t_min, t_max, it))
-            return false;
         dvec3 lo, ld, linv;
-        rl_ls_line(o, d, lo, ld, linv);
-        precise vec3 start = o + d * t_min;
-        bool first = u_ls_origin_exact && all(greaterThanEqual(start, u_ls_min)) && all(lessThanEqual(start, u_ls_max));
+        if (!u_ls_has_preillum || !rl_ls_walk_begin(o, d, t_min, t_max, it, lo, ld, linv))
+            return false;
+        bool first = rl_ls_starts_inside(o, d, t_min);
         precise float len_c = sqrt(u_ls_cell.x * u_ls_cell.x + u_ls_cell.y * u_ls_cell.y + u_ls_cell.z * u_ls_cell.z);
         precise float len_d = sqrt(d.x * d.x + d.y * d.y + d.z * d.z);
         precise float margin = 0.1 * len_c / len_d;

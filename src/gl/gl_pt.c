@@ -123,27 +123,11 @@ struct rl_gl_pt {
     rl_shadowmap_desc sm_desc;
 };
 
-/* An immutable buffer of at least 16 bytes (empty arrays still bind). */
-static GLuint make_buffer(const void *data, size_t bytes, GLbitfield flags)
-{
-    GLuint b = 0;
-    glCreateBuffers(1, &b);
-    if (bytes >= 16) {
-        glNamedBufferStorage(b, (GLsizeiptr)bytes, data, flags);
-    } else {
-        uint8_t pad[16] = { 0 };
-        if (data && bytes)
-            memcpy(pad, data, bytes);
-        glNamedBufferStorage(b, 16, pad, flags);
-    }
-    return b;
-}
-
 static void replace_buffer(rl_gl_pt *pt, int slot, const void *data, size_t bytes, GLbitfield flags)
 {
     if (pt->buf[slot])
         glDeleteBuffers(1, &pt->buf[slot]);
-    pt->buf[slot] = make_buffer(data, bytes, flags);
+    pt->buf[slot] = rl_gl_make_buffer(data, bytes, flags);
 }
 
 static void put4(float *dst, rl_vec3 v, float w)
@@ -237,8 +221,9 @@ static GLuint compute_program(const char *body, bool linespace, const char *what
         return f ? rl_gl_link(v, f, what) : 0;
     }
     const char *const parts[] = { rl_gl_pt_glsl_header, linespace ? rl_gl_linespace_glsl() : "", defines,
-                                  rl_gl_pt_glsl_common, rl_gl_glsl_tex_sample, rl_gl_pt_glsl_common2, body };
-    GLuint s = rl_gl_compile(GL_COMPUTE_SHADER, parts, 7, what);
+                                  rl_gl_pt_glsl_common, rl_gl_glsl_tex_sample, rl_gl_pt_glsl_common2,
+                                  rl_gl_glsl_light_delta, body };
+    GLuint s = rl_gl_compile(GL_COMPUTE_SHADER, parts, 8, what);
     return s ? rl_gl_link(s, 0, what) : 0;
 }
 
@@ -309,43 +294,11 @@ static rl_status upload_materials_lights(rl_gl_pt *pt, const rl_gl_pt_lights *lt
         }
         put4(o->power, power, pmf);
     }
-    pt->buf[B_MATERIALS] = make_buffer(mats, sizeof *mats * d->num_materials, 0);
-    pt->buf[B_LIGHTS] = make_buffer(lights, sizeof *lights * d->num_lights, 0);
+    pt->buf[B_MATERIALS] = rl_gl_make_buffer(mats, sizeof *mats * d->num_materials, 0);
+    pt->buf[B_LIGHTS] = rl_gl_make_buffer(lights, sizeof *lights * d->num_lights, 0);
     free(mats);
     free(lights);
     return RL_OK;
-}
-
-static rl_status upload_textures(rl_gl_pt *pt, GLint64 max_block)
-{
-    const rl_scene_data *d = pt->data;
-    rl_gl_tex_info *info = rl_calloc(d->num_textures ? d->num_textures : 1, sizeof *info);
-    if (!info)
-        return RL_ERR_OUT_OF_MEMORY;
-    uint64_t total = 0;
-    for (uint32_t t = 0; t < d->num_textures; ++t) {
-        const rl_texture *tex = d->textures[t];
-        info[t].offset = (uint32_t)total;
-        info[t].width = tex ? tex->width : 1;
-        info[t].height = tex ? tex->height : 1;
-        total += tex ? (uint64_t)tex->width * (uint64_t)tex->height : 0;
-    }
-    rl_status st = check_block(total * sizeof(rl_vec4), max_block, "textures");
-    if (st == RL_OK && total > UINT32_MAX)
-        st = rl_error(RL_ERR_LIMIT, "gl-pt: the scene's textures hold more than 2^32 texels");
-    if (st == RL_OK) {
-        pt->buf[B_TEX_INFO] = make_buffer(info, sizeof *info * d->num_textures, 0);
-        pt->buf[B_TEXELS] = make_buffer(NULL, total * sizeof(rl_vec4), GL_DYNAMIC_STORAGE_BIT);
-        for (uint32_t t = 0; t < d->num_textures; ++t) {
-            const rl_texture *tex = d->textures[t];
-            if (tex && tex->width > 0 && tex->height > 0)
-                glNamedBufferSubData(pt->buf[B_TEXELS], (GLintptr)info[t].offset * (GLintptr)sizeof(rl_vec4),
-                                     (GLsizeiptr)tex->width * tex->height * (GLsizeiptr)sizeof(rl_vec4),
-                                     tex->texels);
-        }
-    }
-    free(info);
-    return st;
 }
 
 /* Triangles (indices and material), vertex arrays and the per-triangle
@@ -372,13 +325,13 @@ static rl_status upload_geometry(rl_gl_pt *pt, const rl_gl_pt_lights *lt, GLint6
         float pmf = lt->tri_pmf ? lt->tri_pmf[t] : 0.0f;
         memcpy(&tri_light[2 * (size_t)t + 1], &pmf, sizeof pmf);
     }
-    pt->buf[B_TRIANGLES] = make_buffer(tris, 16 * (size_t)d->num_triangles, 0);
-    pt->buf[B_TRI_LIGHT] = make_buffer(tri_light, 8 * (size_t)d->num_triangles, 0);
+    pt->buf[B_TRIANGLES] = rl_gl_make_buffer(tris, 16 * (size_t)d->num_triangles, 0);
+    pt->buf[B_TRI_LIGHT] = rl_gl_make_buffer(tri_light, 8 * (size_t)d->num_triangles, 0);
     free(tris);
     free(tri_light);
-    pt->buf[B_POSITIONS] = make_buffer(d->positions, sizeof(rl_vec3) * d->num_vertices, 0);
-    pt->buf[B_NORMALS] = make_buffer(d->normals, sizeof(rl_vec3) * d->num_vertices, 0);
-    pt->buf[B_UVS] = make_buffer(d->uvs, sizeof(rl_vec2) * d->num_vertices, 0);
+    pt->buf[B_POSITIONS] = rl_gl_make_buffer(d->positions, sizeof(rl_vec3) * d->num_vertices, 0);
+    pt->buf[B_NORMALS] = rl_gl_make_buffer(d->normals, sizeof(rl_vec3) * d->num_vertices, 0);
+    pt->buf[B_UVS] = rl_gl_make_buffer(d->uvs, sizeof(rl_vec2) * d->num_vertices, 0);
 
     /* the table: (cdf, source) pairs, count + 1 cdf values */
     float *table = rl_calloc((size_t)lt->count + 1, 2 * sizeof *table);
@@ -390,7 +343,7 @@ static rl_status upload_geometry(rl_gl_pt *pt, const rl_gl_pt_lights *lt, GLint6
         memcpy(&table[2 * (size_t)k + 1], &src, sizeof src);
     }
     pt->table_count = lt->cdf ? lt->count : 0;
-    pt->buf[B_LIGHT_TABLE] = make_buffer(table, 2 * sizeof *table * ((size_t)lt->count + 1), 0);
+    pt->buf[B_LIGHT_TABLE] = rl_gl_make_buffer(table, 2 * sizeof *table * ((size_t)lt->count + 1), 0);
     free(table);
     return RL_OK;
 }
@@ -405,8 +358,8 @@ static rl_status upload_bvh(rl_gl_pt *pt, GLint64 max_block)
     memset(&stats, 0, sizeof stats);
     if (d->num_triangles == 0) {
         pt->num_nodes = 0;
-        pt->buf[B_BVH_NODES] = make_buffer(NULL, 0, 0);
-        pt->buf[B_BVH_TRIS] = make_buffer(NULL, 0, 0);
+        pt->buf[B_BVH_NODES] = rl_gl_make_buffer(NULL, 0, 0);
+        pt->buf[B_BVH_TRIS] = rl_gl_make_buffer(NULL, 0, 0);
         return RL_OK;
     }
     rl_status st = rl_bvh_build(d, &desc, &bvh, &stats);
@@ -427,8 +380,8 @@ static rl_status upload_bvh(rl_gl_pt *pt, GLint64 max_block)
             put4(&tris[12 * (size_t)k + 8], t->p2, 0.0f);
         }
         pt->num_nodes = bvh.num_nodes;
-        pt->buf[B_BVH_NODES] = make_buffer(bvh.nodes, sizeof *bvh.nodes * bvh.num_nodes, 0);
-        pt->buf[B_BVH_TRIS] = make_buffer(tris, 48 * (size_t)bvh.num_tris, 0);
+        pt->buf[B_BVH_NODES] = rl_gl_make_buffer(bvh.nodes, sizeof *bvh.nodes * bvh.num_nodes, 0);
+        pt->buf[B_BVH_TRIS] = rl_gl_make_buffer(tris, 48 * (size_t)bvh.num_tris, 0);
     }
     free(tris);
     rl_bvh_free(&bvh);
@@ -503,7 +456,7 @@ static rl_status make_buffer_textures(rl_gl_pt *pt)
 }
 
 /* The shadow maps' buffer where there are none: three texels, not
- * make_buffer's four. llvmpipe's variant key holds the power-of-two flag of
+ * rl_gl_make_buffer's four. llvmpipe's variant key holds the power-of-two flag of
  * a buffer's byte size, and the maps' lights x 6 x size^2 floats are never
  * a power of two, so 12 bytes keep one variant of the path program with
  * and without maps. */
@@ -557,7 +510,7 @@ rl_status rl_gl_pt_create(const rl_scene *scene, const rl_gl_pt_desc *desc, rl_g
         st = upload_materials_lights(pt, &desc->lights);
     }
     if (st == RL_OK)
-        st = upload_textures(pt, max_block);
+        st = rl_gl_upload_textures(pt->data, max_block, "gl-pt", &pt->buf[B_TEX_INFO], &pt->buf[B_TEXELS]);
     if (st == RL_OK)
         st = upload_geometry(pt, &desc->lights, max_block);
     if (st == RL_OK)
@@ -721,7 +674,7 @@ static rl_status render_frame(rl_gl_pt *pt, const rl_gl_pt_frame *f, float *rgba
         glProgramUniform3fv(p, u->sm_frame, 18, &frames[0][0]);
     }
     if (!pt->counters) {
-        pt->counters = make_buffer(NULL, 32, GL_DYNAMIC_STORAGE_BIT);
+        pt->counters = rl_gl_make_buffer(NULL, 32, GL_DYNAMIC_STORAGE_BIT);
         const uint32_t zero = 0;
         glClearNamedBufferData(pt->counters, GL_R32UI, GL_RED_INTEGER, GL_UNSIGNED_INT, &zero);
     }
@@ -868,7 +821,7 @@ static rl_status draw_shadowmaps(rl_gl_pt *pt, const rl_shadowmap_desc *p, GLuin
     uint32_t *list = rl_calloc(d->num_triangles ? d->num_triangles : 1, sizeof *list);
     if (!list)
         return RL_ERR_OUT_OF_MEMORY;
-    GLuint casters = make_buffer(NULL, sizeof *list * d->num_triangles, GL_DYNAMIC_STORAGE_BIT);
+    GLuint casters = rl_gl_make_buffer(NULL, sizeof *list * d->num_triangles, GL_DYNAMIC_STORAGE_BIT);
     GLuint color = 0, depth = 0, fbo = 0;
     glCreateTextures(GL_TEXTURE_2D, 1, &color);
     glTextureStorage2D(color, 1, GL_R32F, size, size);
@@ -970,7 +923,7 @@ static rl_status make_shadowmaps(rl_gl_pt *pt, const rl_shadowmap_desc *p)
     rl_status st = shadow_program(pt);
     if (st != RL_OK)
         return st;
-    GLuint maps = texels ? make_buffer(NULL, texels * sizeof(float), 0) : no_maps();
+    GLuint maps = texels ? rl_gl_make_buffer(NULL, texels * sizeof(float), 0) : no_maps();
     st = draw_shadowmaps(pt, p, maps);
     if (st != RL_OK) {
         glDeleteBuffers(1, &maps);

@@ -808,36 +808,6 @@ const char *const rl_gl_pt_glsl_path = GLSL(
         return !query(u_shadow, o, d, 0.0, t_max, true, h);
     }
 
-    /* scene/light_eval.c rl_light_eval_delta (the spot's cosines and the
-     * directional direction precomputed in the record) */
-    bool light_delta(Light L, vec3 p, out vec3 E, out vec3 l, out float dist)
-    {
-        int kind = int(L.pos.w);
-        E = vec3(0.0);
-        l = vec3(0.0);
-        dist = INF;
-        if (kind == LIGHT_DIRECTIONAL) {
-            l = L.dir.xyz;
-            E = L.power.rgb;
-            return L.extra.y > 0.0;
-        }
-        vec3 to_light = L.pos.xyz - p;
-        float d2 = dot(to_light, to_light);
-        if (!(d2 > 0.0))
-            return false;
-        dist = sqrt(d2);
-        l = to_light * (1.0 / dist);
-        float falloff = 1.0 / d2;
-        if (kind == LIGHT_SPOT) {
-            float cos_axis = dot(-l, L.dir.xyz);
-            float cos_outer = L.dir.w, cos_inner = L.extra.x;
-            falloff *= cos_inner > cos_outer ? smoothstep(cos_outer, cos_inner, cos_axis)
-                                             : (cos_axis >= cos_outer ? 1.0 : 0.0);
-        }
-        E = L.power.rgb * falloff;
-        return falloff > 0.0;
-    }
-
     /* direct_light (mis=off): every light, light_samples points per quad */
     vec3 direct_light(Surf s, uint base)
     {

@@ -37,6 +37,7 @@
 #include "gl/gl_shaders.h"
 
 #include <stdlib.h>
+#include <string.h>
 
 #include "core/error.h"
 
@@ -64,40 +65,27 @@ static const char *const common = GLSL(
     uniform int u_mode;
 
     bool finite3(vec3 v) { return !any(isnan(v)) && !any(isinf(v)); }
+);
 
+/* Quad lights as points (Ullmann 2003, Sec. 3.1; docs/gl.md), the other
+ * kinds by rl_gl_glsl_light_delta; then Phong and the texel fetch. */
+static const char *const lighting = GLSL(
     bool light_at(Light L, vec3 p, out vec3 E, out vec3 l)
     {
-        int kind = int(L.pos.w);
-        E = vec3(0.0);
-        l = vec3(0.0);
-        if (kind == 2) {
-            l = L.dir.xyz;
-            E = L.power.rgb;
-            return L.extra.y > 0.0;
-        }
-        vec3 to_light = L.pos.xyz - p;
-        float d2 = dot(to_light, to_light);
-        if (!(d2 > 0.0))
-            return false;
-        if (kind == 3) {
-            if (!(L.power.w > 0.0))
+        if (int(L.pos.w) == 3) {
+            E = vec3(0.0);
+            l = vec3(0.0);
+            vec3 to_light = L.pos.xyz - p;
+            float d2 = dot(to_light, to_light);
+            if (!(d2 > 0.0) || !(L.power.w > 0.0))
                 return false;
             l = to_light * (1.0 / sqrt(d2));
             float cos_light = dot(L.dir.xyz, -l);
             E = (L.power.rgb * (L.power.w * max(0.0, cos_light))) * (1.0 / d2);
             return cos_light > 0.0;
         }
-        float dist = sqrt(d2);
-        l = to_light * (1.0 / dist);
-        float falloff = 1.0 / d2;
-        if (kind == 1) {
-            float cos_axis = dot(-l, L.dir.xyz);
-            float cos_outer = L.dir.w, cos_inner = L.extra.x;
-            falloff *= cos_inner > cos_outer ? smoothstep(cos_outer, cos_inner, cos_axis)
-                                             : (cos_axis >= cos_outer ? 1.0 : 0.0);
-        }
-        E = L.power.rgb * falloff;
-        return falloff > 0.0;
+        float dist;
+        return light_delta(L, p, E, l, dist);
     }
 
     vec3 phong(Material m, vec3 p, vec3 n)
@@ -154,6 +142,49 @@ const char *const rl_gl_glsl_tex_sample = GLSL(
         y1 -= y1 >= t.height ? t.height : 0;
         return (1.0 - tx) * (1.0 - ty) * texel_at(t, x0, y0) + tx * (1.0 - ty) * texel_at(t, x1, y0) +
                (1.0 - tx) * ty * texel_at(t, x0, y1) + tx * ty * texel_at(t, x1, y1);
+    }
+);
+
+/* The drawer's and gl-pt's light records agree on the three delta kinds,
+ * numbered as rl_light_type: pos.w the kind, dir.xyz the spot axis or the
+ * directional light's l, dir.w the spot's cos outer, extra.x its cos
+ * inner, extra.y whether a directional light is valid. */
+_Static_assert((int)RL_GL_LIGHT_POINT == (int)RL_LIGHT_POINT && (int)RL_GL_LIGHT_SPOT == (int)RL_LIGHT_SPOT &&
+                   (int)RL_GL_LIGHT_DIRECTIONAL == (int)RL_LIGHT_DIRECTIONAL &&
+                   (int)RL_GL_LIGHT_QUAD == (int)RL_LIGHT_QUAD && RL_LIGHT_SPOT == 1 && RL_LIGHT_DIRECTIONAL == 2,
+               "rl_gl_glsl_light_delta numbers the kinds as rl_light_type");
+
+/* scene/light_eval.c rl_light_eval_delta in GLSL: a point, spot or
+ * directional light's irradiance E at p and direction l towards it, dist
+ * its distance (infinite for a directional light); false where it gives
+ * none. For programs that declare struct Light as rl_gl_light. */
+const char *const rl_gl_glsl_light_delta = GLSL(
+    bool light_delta(Light L, vec3 p, out vec3 E, out vec3 l, out float dist)
+    {
+        int kind = int(L.pos.w);
+        E = vec3(0.0);
+        l = vec3(0.0);
+        dist = uintBitsToFloat(0x7f800000u);
+        if (kind == 2) {
+            l = L.dir.xyz;
+            E = L.power.rgb;
+            return L.extra.y > 0.0;
+        }
+        vec3 to_light = L.pos.xyz - p;
+        float d2 = dot(to_light, to_light);
+        if (!(d2 > 0.0))
+            return false;
+        dist = sqrt(d2);
+        l = to_light * (1.0 / dist);
+        float falloff = 1.0 / d2;
+        if (kind == 1) {
+            float cos_axis = dot(-l, L.dir.xyz);
+            float cos_outer = L.dir.w, cos_inner = L.extra.x;
+            falloff *= cos_inner > cos_outer ? smoothstep(cos_outer, cos_inner, cos_axis)
+                                             : (cos_axis >= cos_outer ? 1.0 : 0.0);
+        }
+        E = L.power.rgb * falloff;
+        return falloff > 0.0;
     }
 );
 
@@ -457,6 +488,53 @@ static const char *const upload_fs = GLSL(
     }
 );
 
+GLuint rl_gl_make_buffer(const void *data, size_t bytes, GLbitfield flags)
+{
+    GLuint b = 0;
+    glCreateBuffers(1, &b);
+    if (bytes >= 16) {
+        glNamedBufferStorage(b, (GLsizeiptr)bytes, data, flags);
+    } else {
+        uint8_t pad[16] = { 0 };
+        if (data && bytes)
+            memcpy(pad, data, bytes);
+        glNamedBufferStorage(b, 16, pad, flags);
+    }
+    return b;
+}
+
+rl_status rl_gl_upload_textures(const rl_scene_data *d, GLint64 max_block, const char *who, GLuint *tex_info,
+                                GLuint *texels)
+{
+    rl_gl_tex_info *info = rl_calloc(d->num_textures ? d->num_textures : 1, sizeof *info);
+    if (!info)
+        return RL_ERR_OUT_OF_MEMORY;
+    uint64_t total = 0;
+    for (uint32_t t = 0; t < d->num_textures; ++t) {
+        const rl_texture *tex = d->textures[t];
+        info[t].offset = (uint32_t)total;
+        info[t].width = tex ? tex->width : 1;
+        info[t].height = tex ? tex->height : 1;
+        total += tex ? (uint64_t)tex->width * (uint64_t)tex->height : 0;
+    }
+    if (total * sizeof(rl_vec4) > (uint64_t)max_block || total > UINT32_MAX) {
+        free(info);
+        return rl_error(RL_ERR_LIMIT, "%s: the scene's textures (%llu texels, %llu MiB) exceed this GL's shader "
+                        "storage block size (%lld MiB) or 2^32 texels", who, (unsigned long long)total,
+                        (unsigned long long)(total * sizeof(rl_vec4) >> 20), (long long)(max_block >> 20));
+    }
+    *tex_info = rl_gl_make_buffer(info, sizeof *info * d->num_textures, 0);
+    *texels = rl_gl_make_buffer(NULL, total * sizeof(rl_vec4), GL_DYNAMIC_STORAGE_BIT);
+    for (uint32_t t = 0; t < d->num_textures; ++t) {
+        const rl_texture *tex = d->textures[t];
+        if (tex && tex->width > 0 && tex->height > 0)
+            glNamedBufferSubData(*texels, (GLintptr)info[t].offset * (GLintptr)sizeof(rl_vec4),
+                                 (GLsizeiptr)tex->width * tex->height * (GLsizeiptr)sizeof(rl_vec4), tex->texels);
+    }
+    free(info);
+    return RL_OK;
+}
+
 rl_status rl_gl_check(const char *where)
 {
     GLenum e = glGetError(), first = e;
@@ -523,9 +601,9 @@ static GLuint link(const char *const *vs, int nvs, const char *const *fs, int nf
 
 GLuint rl_gl_program_triangles(void)
 {
-    const char *const vs[] = { header, common, rl_gl_glsl_tex_sample, triangle_vs };
-    const char *const fs[] = { header, common, rl_gl_glsl_tex_sample, triangle_fs };
-    return link(vs, 4, fs, 4, "triangle");
+    const char *const vs[] = { header, common, rl_gl_glsl_light_delta, lighting, rl_gl_glsl_tex_sample, triangle_vs };
+    const char *const fs[] = { header, common, rl_gl_glsl_light_delta, lighting, rl_gl_glsl_tex_sample, triangle_fs };
+    return link(vs, 6, fs, 6, "triangle");
 }
 
 GLuint rl_gl_program_points(void)
@@ -545,6 +623,6 @@ GLuint rl_gl_program_depth_upload(void)
 GLuint rl_gl_program_batch(void)
 {
     const char *const vs[] = { header, batch_vs };
-    const char *const fs[] = { header, common, rl_gl_glsl_tex_sample, batch_fs };
-    return link(vs, 2, fs, 4, "batch");
+    const char *const fs[] = { header, common, rl_gl_glsl_light_delta, lighting, rl_gl_glsl_tex_sample, batch_fs };
+    return link(vs, 2, fs, 6, "batch");
 }

@@ -6,6 +6,7 @@
 #include <epoxy/gl.h>
 
 #include "rl/rl_common.h"
+#include "rl/rl_scene.h"
 
 /* Shader storage bindings. */
 enum {
@@ -46,6 +47,19 @@ typedef struct rl_gl_tex_info {
     int32_t width, height, pad;
 } rl_gl_tex_info;
 
+/* An immutable buffer of bytes from data (NULL: zeros where the buffer is
+ * padded, else undefined), at least 16 bytes so that empty arrays still
+ * bind; flags as glNamedBufferStorage's. */
+GLuint rl_gl_make_buffer(const void *data, size_t bytes, GLbitfield flags);
+/* Every texture of d in one texel buffer (*texels, vec4 per texel, updatable
+ * by glNamedBufferSubData) and where each starts (*tex_info,
+ * rl_gl_tex_info), as tex_sample reads them: any number of textures of any
+ * size is one binding. RL_ERR_LIMIT ("WHO: the scene's textures ...") when
+ * they exceed max_block (GL_MAX_SHADER_STORAGE_BLOCK_SIZE) or 2^32 texels;
+ * RL_ERR_OUT_OF_MEMORY. Nothing is made on failure. */
+rl_status rl_gl_upload_textures(const rl_scene_data *d, GLint64 max_block, const char *who, GLuint *tex_info,
+                                GLuint *texels);
+
 /* The first GL error since the last check, as RL_ERR_INTERNAL (or
  * RL_ERR_OUT_OF_MEMORY) "gl: GL error 0x.. in WHERE"; clears the rest. */
 rl_status rl_gl_check(const char *where);
@@ -62,6 +76,11 @@ GLuint rl_gl_link(GLuint a, GLuint b, const char *what);
 /* The GLSL of tex_sample(uint tex, vec2 uv) (core/texture_sample.h), for
  * programs that declare TexInfo, tex_info[] and texel_at() before it. */
 extern const char *const rl_gl_glsl_tex_sample;
+
+/* The GLSL of light_delta(Light L, vec3 p, out E, out l, out dist)
+ * (scene/light_eval.c rl_light_eval_delta: point, spot, directional), for
+ * programs that declare struct Light as rl_gl_light before it. */
+extern const char *const rl_gl_glsl_light_delta;
 
 GLuint rl_gl_program_triangles(void);
 GLuint rl_gl_program_points(void);

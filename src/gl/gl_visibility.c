@@ -221,21 +221,6 @@ static rl_status make_programs(rl_gl_visibility *v)
     return RL_OK;
 }
 
-/* An immutable buffer (at least 16 bytes, so that empty arrays still bind). */
-static GLuint make_buffer(const void *data, size_t bytes, GLbitfield flags)
-{
-    GLuint b = 0;
-    glCreateBuffers(1, &b);
-    if (bytes >= 16 || !data) {
-        glNamedBufferStorage(b, (GLsizeiptr)(bytes >= 16 ? bytes : 16), data, flags);
-    } else {
-        uint8_t pad[16] = { 0 };
-        memcpy(pad, data, bytes);
-        glNamedBufferStorage(b, 16, pad, flags);
-    }
-    return b;
-}
-
 /* The mask of every triangle and the alpha of the mask textures, for the
  * scenes with alpha-masked materials. */
 static rl_status upload_masks(rl_gl_visibility *v, GLint64 max_block)
@@ -279,9 +264,9 @@ static rl_status upload_masks(rl_gl_visibility *v, GLint64 max_block)
         tri_mask[t] = m < d->num_materials ? entry[m] : RL_NONE;
     }
     if (st == RL_OK) {
-        v->ssbo_tri_mask = make_buffer(tri_mask, sizeof *tri_mask * d->num_triangles, 0);
-        v->ssbo_masks = make_buffer(info, sizeof *info * count, 0);
-        v->ssbo_alpha = make_buffer(alpha, sizeof *alpha * texels, 0);
+        v->ssbo_tri_mask = rl_gl_make_buffer(tri_mask, sizeof *tri_mask * d->num_triangles, 0);
+        v->ssbo_masks = rl_gl_make_buffer(info, sizeof *info * count, 0);
+        v->ssbo_alpha = rl_gl_make_buffer(alpha, sizeof *alpha * texels, 0);
     }
     free(info);
     free(entry);
@@ -299,9 +284,9 @@ static rl_status upload_scene(rl_gl_visibility *v, GLint64 max_block)
                         d->num_triangles, (long long)(max_block >> 20));
     if ((18ull + d->num_objects) * sizeof(uint32_t) > (uint64_t)max_block)
         return rl_error(RL_ERR_LIMIT, "gl: %u objects exceed this GL's shader storage block size", d->num_objects);
-    v->vbo_pos = make_buffer(d->positions, sizeof(rl_vec3) * d->num_vertices, 0);
-    v->vbo_uv = make_buffer(d->uvs, sizeof(rl_vec2) * d->num_vertices, 0);
-    v->ibo = make_buffer(d->indices, 3 * sizeof(uint32_t) * d->num_triangles, 0);
+    v->vbo_pos = rl_gl_make_buffer(d->positions, sizeof(rl_vec3) * d->num_vertices, 0);
+    v->vbo_uv = rl_gl_make_buffer(d->uvs, sizeof(rl_vec2) * d->num_vertices, 0);
+    v->ibo = rl_gl_make_buffer(d->indices, 3 * sizeof(uint32_t) * d->num_triangles, 0);
     glCreateVertexArrays(1, &v->vao);
     glVertexArrayVertexBuffer(v->vao, 0, v->vbo_pos, 0, sizeof(rl_vec3));
     glVertexArrayVertexBuffer(v->vao, 1, v->vbo_uv, 0, sizeof(rl_vec2));
@@ -312,18 +297,18 @@ static rl_status upload_scene(rl_gl_visibility *v, GLint64 max_block)
         glEnableVertexArrayAttrib(v->vao, a);
     }
     glVertexArrayElementBuffer(v->vao, v->ibo);
-    v->ssbo_tri_object = make_buffer(d->triangle_object, sizeof(uint32_t) * d->num_triangles, 0);
+    v->ssbo_tri_object = rl_gl_make_buffer(d->triangle_object, sizeof(uint32_t) * d->num_triangles, 0);
 
     uint32_t *tris = rl_calloc(d->num_objects ? d->num_objects : 1, sizeof *tris);
     if (!tris)
         return RL_ERR_OUT_OF_MEMORY;
     for (uint32_t o = 0; o < d->num_objects; ++o)
         tris[o] = d->objects[o].num_triangles;
-    v->ssbo_object_triangles = make_buffer(tris, sizeof *tris * d->num_objects, 0);
+    v->ssbo_object_triangles = rl_gl_make_buffer(tris, sizeof *tris * d->num_objects, 0);
     free(tris);
-    v->ssbo_counts = make_buffer(NULL, sizeof(uint32_t) * (3 * VIEWS + (size_t)d->num_objects),
+    v->ssbo_counts = rl_gl_make_buffer(NULL, sizeof(uint32_t) * (3 * VIEWS + (size_t)d->num_objects),
                                  GL_DYNAMIC_STORAGE_BIT);
-    v->ssbo_seen = make_buffer(NULL, sizeof(uint32_t) * d->num_objects, GL_DYNAMIC_STORAGE_BIT);
+    v->ssbo_seen = rl_gl_make_buffer(NULL, sizeof(uint32_t) * d->num_objects, GL_DYNAMIC_STORAGE_BIT);
     v->has_masks = rl_data_has_masks(d);
     return v->has_masks ? upload_masks(v, max_block) : RL_OK;
 }

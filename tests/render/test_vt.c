@@ -96,6 +96,46 @@ static uint32_t add_grid(rl_scene *s, const char *name, int n, float h, uint32_t
     return add_grid_at(s, name, n, h, mat, vt, NULL);
 }
 
+/* The sphere scenes of Ch. 5's tests: a grey floor of n x n quads, 3 m
+ * wide (floor_vt: a VT object), the first num_materials of ball_materials
+ * and the spheres (VT objects) of ball's tessellation, under a point light
+ * at (1, 4, 2) that casts hard shadows. */
+enum { BALL_MIRROR, BALL_GLASS, BALL_RED };
+static const struct {
+    const char *name;
+    rl_vec3 kd;
+    float kr, kt;
+} ball_materials[] = {
+    { "mirror", { 0.1f, 0.1f, 0.1f }, 0.8f, 0.0f },
+    { "glass", { 0.05f, 0.05f, 0.05f }, 0.1f, 0.85f },
+    { "red", { 0.8f, 0.2f, 0.15f }, 0.0f, 0.0f },
+};
+typedef struct test_ball {
+    const char *name;
+    int material;                 /* BALL_* */
+    rl_vec3 at;
+} test_ball;
+
+static rl_scene *sphere_scene(int floor_n, bool floor_vt, int num_materials, const char *ball, const test_ball *balls,
+                              int num_balls)
+{
+    rl_scene *s = NULL;
+    assert_int_equal(rl_scene_create(&s), RL_OK);
+    uint32_t grey = add_material(s, "grey", rl_v3(0.7f, 0.7f, 0.7f), 0.0f, 0.0f);
+    uint32_t mats[3];
+    for (int m = 0; m < num_materials; ++m)
+        mats[m] = add_material(s, ball_materials[m].name, ball_materials[m].kd, ball_materials[m].kr,
+                               ball_materials[m].kt);
+    add_grid(s, "floor", floor_n, 3.0f, grey, floor_vt);
+    for (int b = 0; b < num_balls; ++b)
+        add_object(s, balls[b].name, "sphere", ball, mats[balls[b].material], rl_mat4_translate(balls[b].at), true);
+    rl_light l = { .type = RL_LIGHT_POINT, .color = rl_v3(1, 1, 1), .intensity = 20.0f,
+                   .position = rl_v3(1.0f, 4.0f, 2.0f) };
+    assert_int_equal(rl_scene_add_light(s, &l), RL_OK);
+    assert_int_equal(rl_scene_commit(s), RL_OK);
+    return s;
+}
+
 /* A 4 x 4 m diffuse floor (VT, 8 x 8 quads) at y = 0. With occluder: a 1 m box hovering
  * above it (not VT) and a point light above, casting a sharp shadow; without:
  * a directional light from straight above, so the floor's radiance is
@@ -408,21 +448,10 @@ static void hidden_vertices_cast_no_rays(void **state)
 static void converges_to_whitted(void **state)
 {
     (void)state;
-    rl_scene *s = NULL;
-    assert_int_equal(rl_scene_create(&s), RL_OK);
-    uint32_t grey = add_material(s, "grey", rl_v3(0.7f, 0.7f, 0.7f), 0.0f, 0.0f);
-    uint32_t mirror = add_material(s, "mirror", rl_v3(0.1f, 0.1f, 0.1f), 0.8f, 0.0f);
-    uint32_t glass = add_material(s, "glass", rl_v3(0.05f, 0.05f, 0.05f), 0.1f, 0.85f);
-    uint32_t red = add_material(s, "red", rl_v3(0.8f, 0.2f, 0.15f), 0.0f, 0.0f);
-    add_grid(s, "floor", 32, 3.0f, grey, true);
-    const char *ball = "radius=0.5,segments=32,rings=16";
-    add_object(s, "mirror", "sphere", ball, mirror, rl_mat4_translate(rl_v3(-1.2f, 0.5f, 0.0f)), true);
-    add_object(s, "glass", "sphere", ball, glass, rl_mat4_translate(rl_v3(0.0f, 0.5f, 0.3f)), true);
-    add_object(s, "red", "sphere", ball, red, rl_mat4_translate(rl_v3(1.2f, 0.5f, 0.0f)), true);
-    rl_light l = { .type = RL_LIGHT_POINT, .color = rl_v3(1, 1, 1), .intensity = 20.0f,
-                   .position = rl_v3(1.0f, 4.0f, 2.0f) };
-    assert_int_equal(rl_scene_add_light(s, &l), RL_OK);
-    assert_int_equal(rl_scene_commit(s), RL_OK);
+    const test_ball balls[] = { { "mirror", BALL_MIRROR, { -1.2f, 0.5f, 0.0f } },
+                                { "glass", BALL_GLASS, { 0.0f, 0.5f, 0.3f } },
+                                { "red", BALL_RED, { 1.2f, 0.5f, 0.0f } } };
+    rl_scene *s = sphere_scene(32, true, 3, "radius=0.5,segments=32,rings=16", balls, 3);
     rl_camera cam = look(rl_v3(0.0f, 2.0f, 4.5f), rl_v3(0.0f, 0.3f, 0.0f), 160);
     const char *vopts[] = { "min_edge", "1", "criteria", "tree+rgb", "eps_rgb", "0.03", NULL };
     rl_image *vt = fx_render("vt", s, &cam, FX_ALL_LAYERS, vopts, NULL);
@@ -514,19 +543,9 @@ static void table_cup_variant_counts(void **state)
 static void mesh_bytes_per_generated_vertex(void **state)
 {
     (void)state;
-    rl_scene *s = NULL;
-    assert_int_equal(rl_scene_create(&s), RL_OK);
-    uint32_t grey = add_material(s, "grey", rl_v3(0.7f, 0.7f, 0.7f), 0.0f, 0.0f);
-    uint32_t mirror = add_material(s, "mirror", rl_v3(0.1f, 0.1f, 0.1f), 0.8f, 0.0f);
-    uint32_t glass = add_material(s, "glass", rl_v3(0.05f, 0.05f, 0.05f), 0.1f, 0.85f);
-    add_grid(s, "floor", 8, 3.0f, grey, true);
-    const char *ball = "radius=0.5,segments=16,rings=8";
-    add_object(s, "mirror", "sphere", ball, mirror, rl_mat4_translate(rl_v3(-0.7f, 0.5f, 0.0f)), true);
-    add_object(s, "glass", "sphere", ball, glass, rl_mat4_translate(rl_v3(0.7f, 0.5f, 0.3f)), true);
-    rl_light l = { .type = RL_LIGHT_POINT, .color = rl_v3(1, 1, 1), .intensity = 20.0f,
-                   .position = rl_v3(1.0f, 4.0f, 2.0f) };
-    assert_int_equal(rl_scene_add_light(s, &l), RL_OK);
-    assert_int_equal(rl_scene_commit(s), RL_OK);
+    const test_ball balls[] = { { "mirror", BALL_MIRROR, { -0.7f, 0.5f, 0.0f } },
+                                { "glass", BALL_GLASS, { 0.7f, 0.5f, 0.3f } } };
+    rl_scene *s = sphere_scene(8, true, 2, "radius=0.5,segments=16,rings=8", balls, 2);
     rl_camera cam = look(rl_v3(0.0f, 2.0f, 4.5f), rl_v3(0.0f, 0.3f, 0.0f), 64);
     /* The primary mesh alone (no edge is long enough to split), then the
      * full frame at the defaults. */
@@ -556,18 +575,9 @@ static void mesh_bytes_per_generated_vertex(void **state)
 static void sample_reduction_merges_short_primary_edges(void **state)
 {
     (void)state;
-    rl_scene *s = NULL;
-    assert_int_equal(rl_scene_create(&s), RL_OK);
-    uint32_t grey = add_material(s, "grey", rl_v3(0.7f, 0.7f, 0.7f), 0.0f, 0.0f);
-    uint32_t mirror = add_material(s, "mirror", rl_v3(0.1f, 0.1f, 0.1f), 0.8f, 0.0f);
-    add_grid(s, "floor", 8, 3.0f, grey, false);
-    const char *ball = "radius=0.5,segments=48,rings=24";
-    add_object(s, "near", "sphere", ball, mirror, rl_mat4_translate(rl_v3(-0.6f, 0.5f, 1.5f)), true);
-    add_object(s, "far", "sphere", ball, mirror, rl_mat4_translate(rl_v3(0.8f, 0.5f, -6.0f)), true);
-    rl_light l = { .type = RL_LIGHT_POINT, .color = rl_v3(1, 1, 1), .intensity = 20.0f,
-                   .position = rl_v3(1.0f, 4.0f, 2.0f) };
-    assert_int_equal(rl_scene_add_light(s, &l), RL_OK);
-    assert_int_equal(rl_scene_commit(s), RL_OK);
+    const test_ball balls[] = { { "near", BALL_MIRROR, { -0.6f, 0.5f, 1.5f } },
+                                { "far", BALL_MIRROR, { 0.8f, 0.5f, -6.0f } } };
+    rl_scene *s = sphere_scene(8, false, 1, "radius=0.5,segments=48,rings=24", balls, 2);
     rl_camera cam = look(rl_v3(0.0f, 1.5f, 5.0f), rl_v3(0.0f, 0.4f, 0.0f), 96);
     rl_vt_stats off, on;
     const char *pre_off[] = { "min_edge", "100000", NULL };
