@@ -21,12 +21,21 @@
  * object median.
  *
  * Parallelism (subtrees are independent once partitioned): OpenMP
- * tasks for subtrees above TASK_MIN triangles. The result must not depend on
- * scheduling, so no node is allocated from a shared counter: a node over n
- * triangles owns the 2n - 2 slots after its children's pair in a sparse
- * array (a binary tree whose leaves partition n triangles has at most 2n - 1
- * nodes), and a serial depth-first pass then compacts the sparse array
- * into the final one with adjacent sibling pairs. */
+ * tasks for subtrees above TASK_MIN triangles. Each thread takes the slots
+ * of the node pairs it creates from chunks of a shared counter, so which
+ * slot a node gets depends on the scheduling; the tree itself does not (the
+ * partitions and splits are a function of the triangles alone), and a
+ * serial depth-first pass lays it out (compact) or the collapse walks it
+ * from the root (rl_bvh_build_wide), so the result is the same for any
+ * schedule and thread count.
+ *
+ * Speed (issue 37, bench/README.md "BVH build time", 2026-12-06): the
+ * triangles' boxes are 32-byte records sorted in place (no index array
+ * into separate box and centroid arrays, whose gathers slowed the binning,
+ * 38 % of the build's CPU time on city); one pass bins all three axes; the children's centroid
+ * boxes come from the partition; RL_ACCEL_BVH makes neither the
+ * depth-first binary array nor the triangle copies. Every step keeps the
+ * tree bit for bit. */
 #include <math.h>
 #include <stdatomic.h>
 #include <stdlib.h>
@@ -49,12 +58,18 @@
 /* Node pairs are handed out to each thread in chunks of this many slots
  * (even, so a pair never straddles two chunks). */
 #define SLOT_CHUNK 4096u
+/* Below this many triangles the build runs on one thread: waking a second
+ * one costs more than it saves, much more on a loaded machine, where the
+ * first thread spins in OpenMP's barriers while the second waits for a
+ * core (cornell, 36 triangles: 70-95 ms with two threads, nearly all in
+ * libgomp's spin loop, on the VM of 2026-12-06 at load 10-13). The tree
+ * does not depend on the thread count. */
+#define PARALLEL_MIN 32768u
 
 /* One triangle's box, 32 bytes, read as two 4-float vectors: the build
  * sorts these in place instead of an index array into separate box and
  * centroid arrays, so binning and partitioning stream through memory
- * instead of gathering (city: 38 % of the build was the gathers of the
- * binning). The centroid is recomputed as (lo + hi) / 2, exactly what
+ * instead of gathering. The centroid is recomputed as (lo + hi) / 2, exactly what
  * rl_aabb_center gives, so the tree is bit for bit the one of before. */
 typedef struct prim {
     float lo[3];
@@ -563,15 +578,17 @@ static rl_status build_tree(const rl_scene_data *data, const rl_accel_desc *desc
     return RL_OK;
 }
 
-static int build_threads(const rl_accel_desc *desc)
+static int build_threads(const rl_accel_desc *desc, uint32_t num_tris)
 {
+    if (num_tris < PARALLEL_MIN)
+        return 1;
     return desc->threads > 0 ? desc->threads : omp_get_max_threads();
 }
 
 rl_status rl_bvh_build(const rl_scene_data *data, const rl_accel_desc *desc, rl_bvh *bvh,
                        rl_accel_stats *stats)
 {
-    int threads = build_threads(desc);
+    int threads = build_threads(desc, data->num_triangles);
     tree t;
     rl_status st = build_tree(data, desc, threads, &t);
     if (st)
@@ -636,7 +653,7 @@ static rl_status finish_wide(const rl_scene_data *data, tree *t, rl_bvh_block *b
 rl_status rl_bvh_build_wide(const rl_scene_data *data, const rl_accel_desc *desc, rl_bvh *bvh,
                             rl_accel_stats *stats)
 {
-    int threads = build_threads(desc);
+    int threads = build_threads(desc, data->num_triangles);
     tree t;
     rl_status st = build_tree(data, desc, threads, &t);
     if (st)
