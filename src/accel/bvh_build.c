@@ -58,13 +58,16 @@
 /* Node pairs are handed out to each thread in chunks of this many slots
  * (even, so a pair never straddles two chunks). */
 #define SLOT_CHUNK 4096u
-/* Below this many triangles the build runs on one thread: waking a second
- * one costs more than it saves, much more on a loaded machine, where the
- * first thread spins in OpenMP's barriers while the second waits for a
- * core (cornell, 36 triangles: 70-95 ms with two threads, nearly all in
- * libgomp's spin loop, on the VM of 2026-12-06 at load 10-13). The tree
- * does not depend on the thread count. */
-#define PARALLEL_MIN 32768u
+/* Below this many triangles the build runs on one thread: waking and
+ * waiting for a second one costs more than it saves on the shared 2-core
+ * VM, where the first thread spins in OpenMP's barriers while the second
+ * waits for a core. Measured there on 2026-12-06 (load 7-13, build ms,
+ * one thread vs two, interleaved): cornell (36 triangles) 0.1 vs 70-95
+ * (nearly all of it libgomp's spin loop), cornell-teapot 70k 39-64 vs
+ * 62-120, 2CylinderEngine.glb 110k 113-168 vs 160-196, city 1.38M
+ * 1,781-1,824 vs 1,603-1,709. On an idle machine the crossover is likely
+ * lower. The tree does not depend on the thread count. */
+#define PARALLEL_MIN 262144u
 
 /* One triangle's box, 32 bytes, read as two 4-float vectors: the build
  * sorts these in place instead of an index array into separate box and
