@@ -140,7 +140,7 @@ static void plan_node(widener *w, uint32_t n)
 /* Children before their parent: a post-order walk from the root, so that
  * any slot order of the binary nodes will do (the builder's own array is in
  * allocation order, where a child may sit before its parent). The stack
- * holds at most two entries per level of the binary tree (depth < 
+ * holds at most two entries per level of the binary tree (depth <
  * RL_BVH_MAX_DEPTH, bvh.h). */
 static void plan_collapse(widener *w)
 {
