@@ -17,26 +17,16 @@ static rl_status bvh_build(const rl_scene_data *data, const rl_accel_desc *desc,
     rl_bvh *bvh = rl_calloc(1, sizeof *bvh);
     if (!bvh)
         return RL_ERR_OUT_OF_MEMORY;
-    rl_status s = rl_bvh_build(data, desc, bvh, stats);
-    if (!s)
-        s = rl_bvh_widen(bvh);
+    /* The binary tree and the triangle copies are build scaffolding that
+     * rl_bvh_build_wide never keeps; its shape stays in the stats (nodes,
+     * leaves, depth, SAH cost). */
+    rl_status s = rl_bvh_build_wide(data, desc, bvh, stats);
     if (s) {
         rl_bvh_free(bvh);
         free(bvh);
         return s;
     }
     stats->memory_bytes += sizeof *bvh;
-    /* Traversal only needs the wide tree; the binary one was scaffolding
-     * (its shape stays in the stats: nodes, leaves, depth, SAH cost). */
-    stats->memory_bytes += (size_t)bvh->num_wide * sizeof *bvh->wide;
-    stats->memory_bytes -= (size_t)bvh->num_nodes * sizeof *bvh->nodes;
-    free(bvh->nodes);
-    bvh->nodes = NULL;
-    /* Leaves are tested from their SoA blocks; the AoS copy was scaffolding too. */
-    stats->memory_bytes += (size_t)bvh->num_blocks * sizeof *bvh->blocks;
-    stats->memory_bytes -= (size_t)bvh->num_tris * sizeof *bvh->tris;
-    free(bvh->tris);
-    bvh->tris = NULL;
     *state = bvh;
     return RL_OK;
 }

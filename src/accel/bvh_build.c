@@ -21,18 +21,30 @@
  * object median.
  *
  * Parallelism (subtrees are independent once partitioned): OpenMP
- * tasks for subtrees above TASK_MIN triangles. The result must not depend on
- * scheduling, so no node is allocated from a shared counter: a node over n
- * triangles owns the 2n - 2 slots after its children's pair in a sparse
- * array (a binary tree whose leaves partition n triangles has at most 2n - 1
- * nodes), and a serial depth-first pass then compacts the sparse array
- * into the final one with adjacent sibling pairs. */
+ * tasks for subtrees above TASK_MIN triangles. Each thread takes the slots
+ * of the node pairs it creates from chunks of a shared counter, so which
+ * slot a node gets depends on the scheduling; the tree itself does not (the
+ * partitions and splits are a function of the triangles alone), and a
+ * serial depth-first pass lays it out (compact) or the collapse walks it
+ * from the root (rl_bvh_build_wide), so the result is the same for any
+ * schedule and thread count.
+ *
+ * Speed (issue 37, bench/README.md "BVH build time", 2026-12-06): the
+ * triangles' boxes are 32-byte records sorted in place (no index array
+ * into separate box and centroid arrays, whose gathers slowed the binning,
+ * 38 % of the build's CPU time on city); one pass bins all three axes; the children's centroid
+ * boxes come from the partition; RL_ACCEL_BVH makes neither the
+ * depth-first binary array nor the triangle copies. Every step keeps the
+ * tree bit for bit. */
 #include <math.h>
 #include <stdatomic.h>
 #include <stdlib.h>
 #include <string.h>
 
 #include <omp.h>
+#if defined(__SSE2__)
+#include <immintrin.h>
+#endif
 
 #include "accel/bvh.h"
 #include "core/bigalloc.h"
@@ -43,31 +55,120 @@
 #define C_ISECT 1.0f
 #define TASK_MIN 4096u
 #define MAX_BINS 256
+/* Node pairs are handed out to each thread in chunks of this many slots
+ * (even, so a pair never straddles two chunks). */
+#define SLOT_CHUNK 4096u
+/* Below this many triangles the build runs on one thread: waking and
+ * waiting for a second one costs more than it saves on the shared 2-core
+ * VM, where the first thread spins in OpenMP's barriers while the second
+ * waits for a core. Measured there on 2026-12-06 (load 7-13, build ms,
+ * one thread vs two, interleaved): cornell (36 triangles) 0.1 vs 70-95
+ * (nearly all of it libgomp's spin loop), cornell-teapot 70k 39-64 vs
+ * 62-120, 2CylinderEngine.glb 110k 113-168 vs 160-196, city 1.38M
+ * 1,781-1,824 vs 1,603-1,709. On an idle machine the crossover is likely
+ * lower. The tree does not depend on the thread count. */
+#define PARALLEL_MIN 262144u
+
+/* One triangle's box, 32 bytes, read as two 4-float vectors: the build
+ * sorts these in place instead of an index array into separate box and
+ * centroid arrays, so binning and partitioning stream through memory
+ * instead of gathering. The centroid is recomputed as (lo + hi) / 2, exactly what
+ * rl_aabb_center gives, so the tree is bit for bit the one of before. */
+typedef struct prim {
+    float lo[3];
+    float zero;              /* 0: keeps the fourth lane of lo harmless */
+    float hi[3];
+    uint32_t id;             /* scene triangle ID */
+} prim;
+_Static_assert(sizeof(prim) == 32, "prim is two vectors");
+
+/* Per-thread source of node-pair slots (SLOT_CHUNK at a time from a shared
+ * counter); a cache line each so that the threads do not share one. */
+typedef struct cursor {
+    uint32_t next, end;
+    uint32_t pairs;          /* pairs handed out by this thread */
+    uint32_t blocks;         /* leaf blocks of the leaves it made */
+    uint8_t pad[48];
+} cursor;
 
 typedef struct builder {
-    const rl_aabb *tri_bounds;   /* by triangle ID */
-    const rl_vec3 *centroids;    /* by triangle ID */
-    uint32_t *ref;               /* triangle IDs, partitioned in place */
-    rl_bvh_node *sparse;         /* 2N - 1 slots */
+    prim *prims;                 /* partitioned in place */
+    rl_bvh_node *sparse;         /* node pairs in allocation order */
+    cursor *cursors;             /* one per thread */
     uint32_t num_tris;
     int bins, leaf_size;
     rl_progress_fn progress;
     void *user;
     atomic_bool cancelled;
-    atomic_uint_fast32_t nodes;  /* written sparse slots */
-    atomic_uint_fast64_t done;   /* triangles in finished leaves */
+    atomic_uint_fast32_t next_slot;
+    atomic_uint_fast64_t done;   /* triangles in finished leaves (with progress only) */
     double last_report;          /* touched by OpenMP thread 0 only */
 } builder;
 
-typedef struct bin {
-    rl_aabb bounds;
-    uint32_t count;
-} bin;
+/* Four floats, the last one unused: SSE where there is SSE2, else scalar
+ * (identical results: the same IEEE operations per lane, min/max as
+ * rl_minf/rl_maxf, a < b ? a : b). */
+#if defined(__SSE2__)
+typedef __m128 v4;
+static inline v4 v4_load(const float *p) { return _mm_load_ps(p); }
+static inline v4 v4_set1(float a) { return _mm_set1_ps(a); }
+static inline v4 v4_add(v4 a, v4 b) { return _mm_add_ps(a, b); }
+static inline v4 v4_sub(v4 a, v4 b) { return _mm_sub_ps(a, b); }
+static inline v4 v4_mul(v4 a, v4 b) { return _mm_mul_ps(a, b); }
+static inline v4 v4_min(v4 a, v4 b) { return _mm_min_ps(a, b); }
+static inline v4 v4_max(v4 a, v4 b) { return _mm_max_ps(a, b); }
+static inline v4 v4_make(float x, float y, float z) { return _mm_setr_ps(x, y, z, 0.0f); }
+static inline void v4_store(float *out, v4 a) { _mm_storeu_ps(out, a); }
+static inline v4 v4_clear3(v4 a) { return _mm_and_ps(a, _mm_castsi128_ps(_mm_setr_epi32(-1, -1, -1, 0))); }
+/* (int) of each lane (truncation, as the scalar cast). */
+static inline void v4_trunc(v4 a, int32_t out[4]) { _mm_storeu_si128((__m128i *)out, _mm_cvttps_epi32(a)); }
+#else
+typedef struct v4 { float v[4]; } v4;
+static inline v4 v4_load(const float *p) { return (v4){ { p[0], p[1], p[2], p[3] } }; }
+static inline v4 v4_set1(float a) { return (v4){ { a, a, a, a } }; }
+#define V4_OP(name, expr) \
+    static inline v4 name(v4 a, v4 b) { v4 r; for (int i = 0; i < 4; ++i) { float x = a.v[i], y = b.v[i]; r.v[i] = (expr); } return r; }
+V4_OP(v4_add, x + y)
+V4_OP(v4_sub, x - y)
+V4_OP(v4_mul, x * y)
+V4_OP(v4_min, x < y ? x : y)
+V4_OP(v4_max, x > y ? x : y)
+#undef V4_OP
+static inline v4 v4_make(float x, float y, float z) { return (v4){ { x, y, z, 0.0f } }; }
+static inline void v4_store(float *out, v4 a) { memcpy(out, a.v, sizeof a.v); }
+static inline v4 v4_clear3(v4 a) { a.v[3] = 0.0f; return a; }
+static inline void v4_trunc(v4 a, int32_t out[4])
+{
+    for (int i = 0; i < 4; ++i)   /* out of int range: INT32_MIN, as cvttps2dq */
+        out[i] = a.v[i] > -2147483520.0f && a.v[i] < 2147483520.0f ? (int32_t)a.v[i] : INT32_MIN;
+}
+#endif
+
+static inline v4 prim_lo(const prim *p) { return v4_load(p->lo); }
+/* Lane 3 holds the ID's bits, which read as a float are mostly denormals:
+ * arithmetic on them is slow (a microcode assist per operation, which made
+ * the binning 2.5x slower), so the lane is cleared. */
+static inline v4 prim_hi(const prim *p) { return v4_clear3(v4_load(p->hi)); }
+/* rl_aabb_center's (min + max) * 0.5f per axis; lane 3 is 0. */
+static inline v4 prim_centroid(const prim *p) { return v4_mul(v4_add(prim_lo(p), prim_hi(p)), v4_set1(0.5f)); }
+
+static rl_aabb v4_box(v4 lo, v4 hi)
+{
+    float l[4], h[4];
+    v4_store(l, lo);
+    v4_store(h, hi);
+    return (rl_aabb){ { l[0], l[1], l[2] }, { h[0], h[1], h[2] } };
+}
 
 static void set_bounds(rl_bvh_node *node, rl_aabb b)
 {
     node->min[0] = b.min.x; node->min[1] = b.min.y; node->min[2] = b.min.z;
     node->max[0] = b.max.x; node->max[1] = b.max.y; node->max[2] = b.max.z;
+}
+
+static uint32_t leaf_blocks(uint32_t count)
+{
+    return (count + RL_BVH_LANES - 1) / RL_BVH_LANES;
 }
 
 static void make_leaf(builder *b, uint32_t slot, uint32_t begin, uint32_t n, rl_aabb bounds)
@@ -77,11 +178,13 @@ static void make_leaf(builder *b, uint32_t slot, uint32_t begin, uint32_t n, rl_
     node->index = begin;
     node->count = (uint16_t)n;
     node->axis = 0;
-    atomic_fetch_add(&b->nodes, 1);
+    b->cursors[omp_get_thread_num()].blocks += leaf_blocks(n);   /* the collapse's block count */
+    if (!b->progress)
+        return;
     uint64_t done = atomic_fetch_add(&b->done, n) + n;
     /* The callback need not be thread-safe: only thread 0 reports, at most
      * every 1 % (tasks land on thread 0 too, so it keeps reporting). */
-    if (b->progress && omp_get_thread_num() == 0) {
+    if (omp_get_thread_num() == 0) {
         double f = (double)done / (double)b->num_tris;
         if (f - b->last_report >= 0.01) {
             b->last_report = f;
@@ -89,6 +192,23 @@ static void make_leaf(builder *b, uint32_t slot, uint32_t begin, uint32_t n, rl_
                 atomic_store(&b->cancelled, true);
         }
     }
+}
+
+/* Two adjacent slots for the children of a split node. Which slots a node
+ * gets depends on the scheduling; compact() then lays the tree out depth
+ * first, so the final array does not. A tied OpenMP task stays on its
+ * thread, and there is no scheduling point in here. */
+static uint32_t alloc_pair(builder *b)
+{
+    cursor *c = &b->cursors[omp_get_thread_num()];
+    if (c->next == c->end) {
+        c->next = (uint32_t)atomic_fetch_add(&b->next_slot, SLOT_CHUNK);
+        c->end = c->next + SLOT_CHUNK;
+    }
+    uint32_t slot = c->next;
+    c->next += 2;
+    c->pairs++;
+    return slot;
 }
 
 /* Wald 2007: bin index k = K(1-ε)(c - cmin)/(cmax - cmin); the
@@ -99,6 +219,11 @@ static inline int bin_of(float c, float cmin, float k1, int bins)
     return k < 0 ? 0 : (k >= bins ? bins - 1 : k);
 }
 
+static inline int clamp_bin(int32_t k, int bins)
+{
+    return k < 0 ? 0 : (k >= bins ? bins - 1 : k);
+}
+
 typedef struct split {
     int axis, bin;               /* axis -1: none found */
     float cost;                  /* A_L·N_L + A_R·N_R */
@@ -106,61 +231,143 @@ typedef struct split {
     float cmin, k1;
 } split;
 
+typedef struct bin_set {
+    v4 lo[3][MAX_BINS], hi[3][MAX_BINS];
+    uint32_t count[3][MAX_BINS];
+} bin_set;
+
+static void bins_clear(bin_set *bs, int K)
+{
+    for (int a = 0; a < 3; ++a)
+        for (int k = 0; k < K; ++k) {
+            bs->lo[a][k] = v4_set1(INFINITY);
+            bs->hi[a][k] = v4_set1(-INFINITY);
+            bs->count[a][k] = 0;
+        }
+}
+
+static inline void bin_prim(bin_set *bs, const prim *p, v4 vmin, v4 vk1, int K)
+{
+    v4 lo = prim_lo(p), hi = prim_hi(p);
+    int32_t k[4];
+    v4_trunc(v4_mul(vk1, v4_sub(v4_mul(v4_add(lo, hi), v4_set1(0.5f)), vmin)), k);
+    for (int a = 0; a < 3; ++a) {
+        int j = clamp_bin(k[a], K);
+        bs->lo[a][j] = v4_min(bs->lo[a][j], lo);
+        bs->hi[a][j] = v4_max(bs->hi[a][j], hi);
+        bs->count[a][j]++;
+    }
+}
+
+/* One pass over the range bins every triangle on all three axes at once
+ * (the same bin index per axis as bin_of: k1·(c - cmin), truncated). Long
+ * ranges alternate between two bin sets, merged at the end (min, max and
+ * counts are exact, so the bins are the same): neighbouring triangles
+ * mostly fall into the same bin, and each update would otherwise wait for
+ * the previous one's store. */
+static void bin_range(const builder *b, uint32_t begin, uint32_t end, const float cmin[3], const float k1[3],
+                      bin_set *bs, bin_set *spare)
+{
+    int K = b->bins;
+    v4 vmin = v4_make(cmin[0], cmin[1], cmin[2]), vk1 = v4_make(k1[0], k1[1], k1[2]);
+    bins_clear(bs, K);
+    if (end - begin < 256) {
+        for (uint32_t i = begin; i < end; ++i)
+            bin_prim(bs, &b->prims[i], vmin, vk1, K);
+        return;
+    }
+    bins_clear(spare, K);
+    uint32_t i = begin;
+    for (; i + 1 < end; i += 2) {
+        bin_prim(bs, &b->prims[i], vmin, vk1, K);
+        bin_prim(spare, &b->prims[i + 1], vmin, vk1, K);
+    }
+    if (i < end)
+        bin_prim(bs, &b->prims[i], vmin, vk1, K);
+    for (int a = 0; a < 3; ++a)
+        for (int k = 0; k < K; ++k) {
+            bs->lo[a][k] = v4_min(bs->lo[a][k], spare->lo[a][k]);
+            bs->hi[a][k] = v4_max(bs->hi[a][k], spare->hi[a][k]);
+            bs->count[a][k] += spare->count[a][k];
+        }
+}
+
 static split find_split(const builder *b, uint32_t begin, uint32_t end, rl_aabb cb)
 {
     split best = { .axis = -1, .cost = INFINITY };
     int K = b->bins;
+    float cmin[3], k1[3];
+    bool live[3], any = false;
     for (int axis = 0; axis < 3; ++axis) {
-        float cmin = rl_vget(cb.min, axis), ext = rl_vget(cb.max, axis) - cmin;
-        if (!(ext > 0.0f))
+        cmin[axis] = rl_vget(cb.min, axis);
+        float ext = rl_vget(cb.max, axis) - cmin[axis];
+        live[axis] = ext > 0.0f;
+        k1[axis] = live[axis] ? (float)K * (1.0f - 1e-6f) / ext : 0.0f;
+        any = any || live[axis];
+    }
+    if (!any)
+        return best;
+    bin_set bs, spare;
+    bin_range(b, begin, end, cmin, k1, &bs, &spare);
+    for (int axis = 0; axis < 3; ++axis) {
+        if (!live[axis])
             continue;
-        float k1 = (float)K * (1.0f - 1e-6f) / ext;
-        bin bins[MAX_BINS];
+        /* The sweep visits the non-empty bins only: planes between two
+         * of them with only empty bins in between all split alike, at the
+         * same cost, and the strict comparison below would keep the first
+         * of them, the one right after the left bin, so that is the plane
+         * taken (bit for bit the choice of a sweep over all K - 1 planes;
+         * deep nodes of a few triangles fill only a few of the K bins). */
+        int used[MAX_BINS], m = 0;
         for (int k = 0; k < K; ++k)
-            bins[k] = (bin){ rl_aabb_empty(), 0 };
-        for (uint32_t i = begin; i < end; ++i) {
-            uint32_t t = b->ref[i];
-            int k = bin_of(rl_vget(b->centroids[t], axis), cmin, k1, K);
-            bins[k].bounds = rl_aabb_union(bins[k].bounds, b->tri_bounds[t]);
-            bins[k].count++;
-        }
+            if (bs.count[axis][k] > 0)
+                used[m++] = k;
         /* Sweep from the right storing suffix boxes, then from the left. */
         rl_aabb right_box[MAX_BINS];
         uint32_t right_n[MAX_BINS];
         rl_aabb acc = rl_aabb_empty();
         uint32_t n = 0;
-        for (int k = K - 1; k > 0; --k) {
-            acc = rl_aabb_union(acc, bins[k].bounds);
-            n += bins[k].count;
-            right_box[k] = acc;
-            right_n[k] = n;
+        for (int u = m - 1; u > 0; --u) {
+            int k = used[u];
+            acc = rl_aabb_union(acc, v4_box(bs.lo[axis][k], bs.hi[axis][k]));
+            n += bs.count[axis][k];
+            right_box[u] = acc;
+            right_n[u] = n;
         }
         acc = rl_aabb_empty();
         n = 0;
-        for (int k = 1; k < K; ++k) {   /* plane between bin k-1 and bin k */
-            acc = rl_aabb_union(acc, bins[k - 1].bounds);
-            n += bins[k - 1].count;
-            if (n == 0 || right_n[k] == 0)
-                continue;
-            float cost = rl_aabb_area(acc) * (float)n + rl_aabb_area(right_box[k]) * (float)right_n[k];
+        for (int u = 1; u < m; ++u) {   /* plane right after bin used[u - 1] */
+            int k = used[u - 1];
+            acc = rl_aabb_union(acc, v4_box(bs.lo[axis][k], bs.hi[axis][k]));
+            n += bs.count[axis][k];
+            float cost = rl_aabb_area(acc) * (float)n + rl_aabb_area(right_box[u]) * (float)right_n[u];
             if (cost < best.cost) {   /* strict: the first of equals wins, deterministically */
-                best = (split){ axis, k, cost, acc, right_box[k], cmin, k1 };
+                best = (split){ axis, k + 1, cost, acc, right_box[u], cmin[axis], k1[axis] };
             }
         }
     }
     return best;
 }
 
-static rl_aabb range_bounds(const builder *b, uint32_t begin, uint32_t end)
+/* Box and centroid box of a range (the median fallback's halves). */
+static void range_bounds(const builder *b, uint32_t begin, uint32_t end, rl_aabb *box, rl_aabb *cbox)
 {
-    rl_aabb box = rl_aabb_empty();
-    for (uint32_t i = begin; i < end; ++i)
-        box = rl_aabb_union(box, b->tri_bounds[b->ref[i]]);
-    return box;
+    v4 lo = v4_set1(INFINITY), hi = v4_set1(-INFINITY), clo = lo, chi = hi;
+    for (uint32_t i = begin; i < end; ++i) {
+        const prim *p = &b->prims[i];
+        lo = v4_min(lo, prim_lo(p));
+        hi = v4_max(hi, prim_hi(p));
+        v4 c = prim_centroid(p);
+        clo = v4_min(clo, c);
+        chi = v4_max(chi, c);
+    }
+    *box = v4_box(lo, hi);
+    *cbox = v4_box(clo, chi);
 }
 
-static void build_node(builder *b, uint32_t slot, uint32_t region, uint32_t begin, uint32_t end,
-                       rl_aabb bounds, int depth)
+/* cb: the centroid box of the range, computed by the parent's partition. */
+static void build_node(builder *b, uint32_t slot, uint32_t begin, uint32_t end, rl_aabb bounds, rl_aabb cb,
+                       int depth)
 {
     if (atomic_load_explicit(&b->cancelled, memory_order_relaxed))
         return;
@@ -169,9 +376,6 @@ static void build_node(builder *b, uint32_t slot, uint32_t region, uint32_t begi
         make_leaf(b, slot, begin, n, bounds);
         return;
     }
-    rl_aabb cb = rl_aabb_empty();
-    for (uint32_t i = begin; i < end; ++i)
-        cb = rl_aabb_grow(cb, b->centroids[b->ref[i]]);
     split s = { .axis = -1 };
     if (depth < RL_BVH_SAH_MAX_DEPTH)
         s = find_split(b, begin, end, cb);
@@ -184,63 +388,69 @@ static void build_node(builder *b, uint32_t slot, uint32_t region, uint32_t begi
         }
     }
     uint32_t mid;
-    rl_aabb left, right;
+    rl_aabb left, right, cleft, cright;
     if (s.axis >= 0) {
+        /* The partition of before, element for element (so the leaves keep
+         * their triangle order), and every triangle is classified exactly
+         * once, so the children's centroid boxes come for free. */
+        v4 llo = v4_set1(INFINITY), lhi = v4_set1(-INFINITY), rlo = llo, rhi = lhi;
         uint32_t i = begin, j = end;
         while (i < j) {
-            float c = rl_vget(b->centroids[b->ref[i]], s.axis);
+            prim *p = &b->prims[i];
+            float c = (p->lo[s.axis] + p->hi[s.axis]) * 0.5f;
+            v4 cv = prim_centroid(p);
             if (bin_of(c, s.cmin, s.k1, b->bins) < s.bin) {
+                llo = v4_min(llo, cv);
+                lhi = v4_max(lhi, cv);
                 ++i;
             } else {
-                uint32_t t = b->ref[i];
-                b->ref[i] = b->ref[--j];
-                b->ref[j] = t;
+                rlo = v4_min(rlo, cv);
+                rhi = v4_max(rhi, cv);
+                prim t = *p;
+                *p = b->prims[--j];
+                b->prims[j] = t;
             }
         }
         mid = i;
         left = s.left;
         right = s.right;
+        cleft = v4_box(llo, lhi);
+        cright = v4_box(rlo, rhi);
     } else {
         /* Coinciding centroids or too deep: halve the range. */
         mid = begin + n / 2;
-        left = range_bounds(b, begin, mid);
-        right = range_bounds(b, mid, end);
+        range_bounds(b, begin, mid, &left, &cleft);
+        range_bounds(b, mid, end, &right, &cright);
     }
+    uint32_t pair = alloc_pair(b);
     rl_bvh_node *node = &b->sparse[slot];
     set_bounds(node, bounds);
-    node->index = region;
+    node->index = pair;
     node->count = 0;
     node->axis = (uint16_t)(s.axis >= 0 ? s.axis : 0);
-    atomic_fetch_add(&b->nodes, 1);
-    uint32_t nl = mid - begin;
-    /* Left subtree's own slots follow the pair; the right's follow those. */
-    uint32_t left_region = region + 2, right_region = region + 2 * nl;
     if (n >= TASK_MIN) {
-#pragma omp task firstprivate(b, region, left_region, begin, mid, left, depth)
-        build_node(b, region, left_region, begin, mid, left, depth + 1);
+#pragma omp task firstprivate(b, pair, begin, mid, left, cleft, depth)
+        build_node(b, pair, begin, mid, left, cleft, depth + 1);
     } else {
-        build_node(b, region, left_region, begin, mid, left, depth + 1);
+        build_node(b, pair, begin, mid, left, cleft, depth + 1);
     }
-    build_node(b, region + 1, right_region, mid, end, right, depth + 1);
+    build_node(b, pair + 1, mid, end, right, cright, depth + 1);
 }
 
 typedef struct frame {
     uint32_t old_slot, new_index, depth;
 } frame;
 
-/* Depth-first compaction (sibling pairs stay adjacent) plus the statistics:
+/* Depth-first compaction (sibling pairs stay adjacent) into dense, or with
+ * dense NULL only the walk, plus the statistics:
  * SAH cost = Σ_inner C_trav·A/A_root + Σ_leaf C_isect·N·A/A_root. */
-static rl_status compact(const builder *b, uint32_t count, rl_bvh_node **out, rl_accel_stats *stats)
+static rl_status compact(const rl_bvh_node *sparse, uint32_t count, rl_bvh_node *dense, rl_accel_stats *stats)
 {
-    rl_bvh_node *dense = rl_big_array(count, sizeof *dense, false);
     frame *stack = rl_alloc(((size_t)RL_BVH_SAH_MAX_DEPTH + 64) * 2 * sizeof *stack);
-    if (!dense || !stack) {
-        free(dense);
-        free(stack);
+    if (!stack)
         return RL_ERR_OUT_OF_MEMORY;
-    }
-    float root_area = rl_aabb_area((rl_aabb){ { b->sparse[0].min[0], b->sparse[0].min[1], b->sparse[0].min[2] },
-                                              { b->sparse[0].max[0], b->sparse[0].max[1], b->sparse[0].max[2] } });
+    float root_area = rl_aabb_area((rl_aabb){ { sparse[0].min[0], sparse[0].min[1], sparse[0].min[2] },
+                                              { sparse[0].max[0], sparse[0].max[1], sparse[0].max[2] } });
     double inv_root = root_area > 0.0f ? 1.0 / (double)root_area : 0.0;
     uint32_t next = 1, leaves = 0, max_depth = 0;
     double sah = 0.0;
@@ -248,7 +458,7 @@ static rl_status compact(const builder *b, uint32_t count, rl_bvh_node **out, rl
     stack[sp++] = (frame){ 0, 0, 0 };
     while (sp > 0) {
         frame f = stack[--sp];
-        rl_bvh_node node = b->sparse[f.old_slot];
+        rl_bvh_node node = sparse[f.old_slot];
         rl_aabb box = { { node.min[0], node.min[1], node.min[2] }, { node.max[0], node.max[1], node.max[2] } };
         double rel_area = inv_root > 0.0 ? (double)rl_aabb_area(box) * inv_root : 1.0;
         if (f.depth > max_depth)
@@ -264,10 +474,10 @@ static rl_status compact(const builder *b, uint32_t count, rl_bvh_node **out, rl
             stack[sp++] = (frame){ old_child, next, f.depth + 1 };
             next += 2;
         }
-        dense[f.new_index] = node;
+        if (dense)
+            dense[f.new_index] = node;
     }
     free(stack);
-    *out = dense;
     stats->nodes = count;
     stats->leaves = leaves;
     stats->max_depth = max_depth;
@@ -275,8 +485,22 @@ static rl_status compact(const builder *b, uint32_t count, rl_bvh_node **out, rl
     return RL_OK;
 }
 
-rl_status rl_bvh_build(const rl_scene_data *data, const rl_accel_desc *desc, rl_bvh *bvh,
-                       rl_accel_stats *stats)
+/* The binary tree as the builder leaves it: prims in leaf order, the nodes
+ * in sparse[0..num_slots) in allocation order (root at 0). */
+typedef struct tree {
+    prim *prims;
+    rl_bvh_node *sparse;
+    uint32_t num_slots, num_nodes, num_blocks;
+} tree;
+
+static void tree_free(tree *t)
+{
+    free(t->prims);
+    free(t->sparse);
+    memset(t, 0, sizeof *t);
+}
+
+static rl_status build_tree(const rl_scene_data *data, const rl_accel_desc *desc, int threads, tree *out)
 {
     uint32_t N = data->num_triangles;
     if (N == 0)
@@ -289,24 +513,24 @@ rl_status rl_bvh_build(const rl_scene_data *data, const rl_accel_desc *desc, rl_
         .user = desc->user,
     };
     atomic_init(&b.cancelled, false);
-    atomic_init(&b.nodes, 0);
+    atomic_init(&b.next_slot, 1);   /* slot 0: the root */
     atomic_init(&b.done, 0);
-    rl_aabb *tri_bounds = rl_big_array(N, sizeof *tri_bounds, false);
-    rl_vec3 *centroids = rl_big_array(N, sizeof *centroids, false);
-    uint32_t *ref = rl_big_array(N, sizeof *ref, false);
-    rl_bvh_node *sparse = rl_big_array((size_t)2 * N - 1, sizeof *sparse, false);
-    rl_bvh_tri *tris = rl_big_array(N, sizeof *tris, false);
-    rl_bvh_node *nodes = NULL;
-    rl_status st = RL_OK;
-    if (!tri_bounds || !centroids || !ref || !sparse || !tris) {
-        st = RL_ERR_OUT_OF_MEMORY;
-        goto done;
+    /* 2N - 1 nodes at most, plus each thread's last chunk, partly unused;
+     * only the slots handed out are ever touched. */
+    size_t capacity = (size_t)2 * N - 1 + (size_t)threads * SLOT_CHUNK;
+    prim *prims = rl_big_array(N, sizeof *prims, false);
+    rl_bvh_node *sparse = rl_big_array(capacity, sizeof *sparse, false);
+    cursor *cursors = rl_calloc((size_t)threads, sizeof *cursors);
+    if (!prims || !sparse || !cursors) {
+        free(prims);
+        free(sparse);
+        free(cursors);
+        return RL_ERR_OUT_OF_MEMORY;
     }
-    int threads = desc->threads > 0 ? desc->threads : omp_get_max_threads();
-    rl_aabb root = rl_aabb_empty();
+    v4 root_lo = v4_set1(INFINITY), root_hi = v4_set1(-INFINITY), croot_lo = root_lo, croot_hi = root_hi;
 #pragma omp parallel num_threads(threads)
     {
-        rl_aabb mine = rl_aabb_empty();
+        v4 lo_mine = v4_set1(INFINITY), hi_mine = v4_set1(-INFINITY), clo_mine = lo_mine, chi_mine = hi_mine;
 #pragma omp for schedule(static)
         for (int64_t i = 0; i < (int64_t)N; ++i) {
             const uint32_t *idx = data->indices + 3 * i;
@@ -314,38 +538,82 @@ rl_status rl_bvh_build(const rl_scene_data *data, const rl_accel_desc *desc, rl_
             box = rl_aabb_grow(box, data->positions[idx[0]]);
             box = rl_aabb_grow(box, data->positions[idx[1]]);
             box = rl_aabb_grow(box, data->positions[idx[2]]);
-            tri_bounds[i] = box;
-            centroids[i] = rl_aabb_center(box);
-            ref[i] = (uint32_t)i;
-            mine = rl_aabb_union(mine, box);
+            prim *p = &prims[i];
+            *p = (prim){ { box.min.x, box.min.y, box.min.z }, 0.0f, { box.max.x, box.max.y, box.max.z }, (uint32_t)i };
+            lo_mine = v4_min(lo_mine, prim_lo(p));
+            hi_mine = v4_max(hi_mine, prim_hi(p));
+            v4 c = prim_centroid(p);
+            clo_mine = v4_min(clo_mine, c);
+            chi_mine = v4_max(chi_mine, c);
         }
         /* min/max are exact, so merging in any order gives the same box. */
 #pragma omp critical(rl_bvh_root_bounds)
-        root = rl_aabb_union(root, mine);
+        {
+            root_lo = v4_min(root_lo, lo_mine);
+            root_hi = v4_max(root_hi, hi_mine);
+            croot_lo = v4_min(croot_lo, clo_mine);
+            croot_hi = v4_max(croot_hi, chi_mine);
+        }
 #pragma omp barrier
 #pragma omp single
         {
-            b.tri_bounds = tri_bounds;
-            b.centroids = centroids;
-            b.ref = ref;
+            b.prims = prims;
             b.sparse = sparse;
-            build_node(&b, 0, 1, 0, N, root, 0);
+            b.cursors = cursors;
+            build_node(&b, 0, 0, N, v4_box(root_lo, root_hi), v4_box(croot_lo, croot_hi), 0);
         }
     }
     if (!atomic_load(&b.cancelled) && b.progress && !b.progress(b.user, 1.0))
         atomic_store(&b.cancelled, true);
     if (atomic_load(&b.cancelled)) {
-        st = rl_error(RL_ERR_CANCELLED, "accel bvh: build cancelled");
-        goto done;
+        free(prims);
+        free(sparse);
+        free(cursors);
+        return rl_error(RL_ERR_CANCELLED, "accel bvh: build cancelled");
     }
-    st = compact(&b, (uint32_t)atomic_load(&b.nodes), &nodes, stats);
+    uint32_t pairs = 0, blocks = 0;
+    for (int t = 0; t < threads; ++t) {
+        pairs += cursors[t].pairs;
+        blocks += cursors[t].blocks;
+    }
+    free(cursors);
+    *out = (tree){ prims, sparse, (uint32_t)atomic_load(&b.next_slot), 1 + 2 * pairs, blocks };
+    return RL_OK;
+}
+
+static int build_threads(const rl_accel_desc *desc, uint32_t num_tris)
+{
+    if (num_tris < PARALLEL_MIN)
+        return 1;
+    return desc->threads > 0 ? desc->threads : omp_get_max_threads();
+}
+
+rl_status rl_bvh_build(const rl_scene_data *data, const rl_accel_desc *desc, rl_bvh *bvh,
+                       rl_accel_stats *stats)
+{
+    int threads = build_threads(desc, data->num_triangles);
+    tree t;
+    rl_status st = build_tree(data, desc, threads, &t);
     if (st)
-        goto done;
+        return st;
+    uint32_t N = data->num_triangles;
+    rl_bvh_node *nodes = rl_big_array(t.num_nodes, sizeof *nodes, false);
+    rl_bvh_tri *tris = rl_big_array(N, sizeof *tris, false);
+    if (!nodes || !tris) {
+        st = RL_ERR_OUT_OF_MEMORY;
+        goto fail;
+    }
+    st = compact(t.sparse, t.num_nodes, nodes, stats);
+    if (st)
+        goto fail;
+    const prim *prims = t.prims;
 #pragma omp parallel for num_threads(threads) schedule(static)
     for (int64_t i = 0; i < (int64_t)N; ++i) {
-        const uint32_t *idx = data->indices + 3 * (size_t)ref[i];
-        tris[i] = (rl_bvh_tri){ data->positions[idx[0]], data->positions[idx[1]], data->positions[idx[2]], ref[i] };
+        uint32_t id = prims[i].id;
+        const uint32_t *idx = data->indices + 3 * (size_t)id;
+        tris[i] = (rl_bvh_tri){ data->positions[idx[0]], data->positions[idx[1]], data->positions[idx[2]], id };
     }
+    tree_free(&t);
     bvh->nodes = nodes;
     bvh->num_nodes = stats->nodes;
     bvh->wide = NULL;
@@ -354,15 +622,73 @@ rl_status rl_bvh_build(const rl_scene_data *data, const rl_accel_desc *desc, rl_
     bvh->num_blocks = 0;
     bvh->tris = tris;
     bvh->num_tris = N;
-    tris = NULL;
     stats->memory_bytes = (size_t)bvh->num_nodes * sizeof *nodes + (size_t)N * sizeof *bvh->tris;
-done:
-    free(tri_bounds);
-    free(centroids);
-    free(ref);
-    free(sparse);
+    return RL_OK;
+fail:
+    tree_free(&t);
+    free(nodes);
     free(tris);
     return st;
+}
+
+/* The steps after the parallel build: the statistics walk, the IDs in
+ * leaf order (so that the 32-byte prims can go before the collapse
+ * allocates its costs, which then reuse their pages), the collapse, which
+ * takes blocks over on success. */
+static rl_status finish_wide(const rl_scene_data *data, tree *t, rl_bvh_block *blocks, rl_bvh *bvh,
+                             rl_accel_stats *stats)
+{
+    rl_status st = compact(t->sparse, t->num_nodes, NULL, stats);
+    uint32_t N = data->num_triangles;
+    uint32_t *ids = st ? NULL : rl_big_array(N, sizeof *ids, false);
+    if (!ids)
+        return st ? st : RL_ERR_OUT_OF_MEMORY;
+    for (uint32_t i = 0; i < N; ++i)
+        ids[i] = t->prims[i].id;
+    free(t->prims);
+    t->prims = NULL;
+    rl_bvh_leaf_source src = { .ids = ids, .id_stride = 1, .data = data };
+    st = rl_bvh_collapse(t->sparse, t->num_slots, t->num_blocks, &src, blocks, bvh);
+    free(ids);
+    return st;
+}
+
+rl_status rl_bvh_build_wide(const rl_scene_data *data, const rl_accel_desc *desc, rl_bvh *bvh,
+                            rl_accel_stats *stats)
+{
+    int threads = build_threads(desc, data->num_triangles);
+    tree t;
+    rl_status st = build_tree(data, desc, threads, &t);
+    if (st)
+        return st;
+    /* The leaf blocks are the largest array written (city: 107 MB). What
+     * follows the build is serial, so a second thread faults the blocks'
+     * pages in meanwhile (rl_big_prefault), and the serial writer finds
+     * them present. */
+    rl_bvh_block *blocks = rl_bvh_alloc_blocks(t.num_blocks);
+    if (!blocks) {
+        tree_free(&t);
+        return rl_error(RL_ERR_OUT_OF_MEMORY, "accel bvh: out of memory for %u leaf blocks", (unsigned)t.num_blocks);
+    }
+    if (threads > 1) {
+#pragma omp parallel sections num_threads(2)
+        {
+#pragma omp section
+            st = finish_wide(data, &t, blocks, bvh, stats);
+#pragma omp section
+            rl_big_prefault(blocks, (size_t)t.num_blocks * sizeof *blocks);
+        }
+    } else {
+        st = finish_wide(data, &t, blocks, bvh, stats);
+    }
+    tree_free(&t);
+    if (st) {
+        free(blocks);   /* joined: the prefault is done with it */
+        return st;
+    }
+    bvh->num_tris = data->num_triangles;
+    stats->memory_bytes = (size_t)bvh->num_wide * sizeof *bvh->wide + (size_t)bvh->num_blocks * sizeof *bvh->blocks;
+    return RL_OK;
 }
 
 void rl_bvh_free(rl_bvh *bvh)

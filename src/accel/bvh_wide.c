@@ -25,7 +25,7 @@
 
 typedef struct widener {
     const rl_bvh_node *bin;
-    const rl_bvh_tri *tris;
+    rl_bvh_leaf_source src;
     rl_bvh_wide_node *wide;
     uint32_t count;
     rl_bvh_block *blocks;
@@ -53,12 +53,24 @@ static uint32_t pack_leaf(widener *w, uint32_t first, uint32_t count)
                 b->id[l] = RL_ID_NONE;
                 continue;
             }
-            const rl_bvh_tri *t = &w->tris[first + i + l];
-            const rl_vec3 p[3] = { t->p0, t->p1, t->p2 };
+            rl_vec3 p[3];
+            uint32_t id;
+            if (w->src.tris) {
+                const rl_bvh_tri *t = &w->src.tris[first + i + l];
+                p[0] = t->p0;
+                p[1] = t->p1;
+                p[2] = t->p2;
+                id = t->id;
+            } else {
+                id = w->src.ids[(size_t)(first + i + l) * w->src.id_stride];
+                const uint32_t *idx = w->src.data->indices + 3 * (size_t)id;
+                for (int k = 0; k < 3; ++k)
+                    p[k] = w->src.data->positions[idx[k]];
+            }
             for (int k = 0; k < 3; ++k)
                 for (int a = 0; a < 3; ++a)
                     b->p[k][a][l] = rl_vget(p[k], a);
-            b->id[l] = t->id;
+            b->id[l] = id;
         }
     }
     return start;
@@ -96,31 +108,59 @@ static float opened_cost(const widener *w, uint32_t n, int k, int *best_j)
     return best;
 }
 
-static void plan_collapse(widener *w, uint32_t num_nodes)
+static void plan_node(widener *w, uint32_t n)
 {
-    for (uint32_t n = num_nodes; n-- > 0;) {
-        float *f = &w->cost[(size_t)n * RL_BVH_WIDTH];
-        uint8_t *sp = &w->split[(size_t)n * RL_BVH_WIDTH];
-        if (w->bin[n].count > 0) {
-            for (int k = 0; k < RL_BVH_WIDTH; ++k) {
-                f[k] = 0.0f;
-                sp[k] = 0;
-            }
+    float *f = &w->cost[(size_t)n * RL_BVH_WIDTH];
+    uint8_t *sp = &w->split[(size_t)n * RL_BVH_WIDTH];
+    if (w->bin[n].count > 0) {
+        for (int k = 0; k < RL_BVH_WIDTH; ++k) {
+            f[k] = 0.0f;
+            sp[k] = 0;
+        }
+        return;
+    }
+    int j = 1;
+    f[0] = node_area(&w->bin[n]) + opened_cost(w, n, RL_BVH_WIDTH, &j);
+    /* k = 1 never splits, so sp[0] keeps the split of n's own W slots
+     * when n becomes a wide node: the cut then needs no costs, and they
+     * are freed before the wide nodes and blocks are written. */
+    sp[0] = (uint8_t)j;
+    for (int k = 2; k <= RL_BVH_WIDTH; ++k) {
+        float c = opened_cost(w, n, k, &j);
+        if (c < f[0]) {
+            f[k - 1] = c;
+            sp[k - 1] = (uint8_t)j;
+        } else {
+            f[k - 1] = f[0];
+            sp[k - 1] = 0;
+        }
+    }
+}
+
+/* Children before their parent: a post-order walk from the root, so that
+ * any slot order of the binary nodes will do (the builder's own array is in
+ * allocation order, where a child may sit before its parent). The stack
+ * holds at most two entries per level of the binary tree (depth <
+ * RL_BVH_MAX_DEPTH, bvh.h). */
+static void plan_collapse(widener *w)
+{
+    struct { uint32_t node, children_done; } stack[2 * RL_BVH_MAX_DEPTH + 4];
+    size_t sp = 0;
+    stack[sp].node = 0;
+    stack[sp++].children_done = 0;
+    while (sp > 0) {
+        --sp;
+        uint32_t n = stack[sp].node;
+        const rl_bvh_node *node = &w->bin[n];
+        if (stack[sp].children_done || node->count > 0) {
+            plan_node(w, n);
             continue;
         }
-        int j = 1;
-        f[0] = node_area(&w->bin[n]) + opened_cost(w, n, RL_BVH_WIDTH, &j);
-        sp[0] = 0;
-        for (int k = 2; k <= RL_BVH_WIDTH; ++k) {
-            float c = opened_cost(w, n, k, &j);
-            if (c < f[0]) {
-                f[k - 1] = c;
-                sp[k - 1] = (uint8_t)j;
-            } else {
-                f[k - 1] = f[0];
-                sp[k - 1] = 0;
-            }
-        }
+        stack[sp++].children_done = 1;
+        stack[sp].node = node->index + 1;
+        stack[sp++].children_done = 0;
+        stack[sp].node = node->index;
+        stack[sp++].children_done = 0;
     }
 }
 
@@ -146,8 +186,7 @@ static void widen_node(widener *w, uint32_t slot, uint32_t b)
     if (bn->count > 0) {
         kids[n++] = b;
     } else {
-        int j = 1;
-        opened_cost(w, b, RL_BVH_WIDTH, &j);
+        int j = w->split[(size_t)b * RL_BVH_WIDTH];
         cut(w, bn->index, j, kids, &n);
         cut(w, bn->index + 1, RL_BVH_WIDTH - j, kids, &n);
     }
@@ -192,43 +231,63 @@ static rl_bvh_wide_node *alloc_wide(uint32_t count)
     return alloc_lines((size_t)count * sizeof(rl_bvh_wide_node));   /* a multiple of 64 */
 }
 
-rl_status rl_bvh_widen(rl_bvh *bvh)
+/* Wide nodes below and including the one made from binary node b: the
+ * exact size of the wide array, so it is allocated once, not allocated for
+ * the bound num_nodes / 2 + 1 and copied into a smaller one. */
+static uint32_t count_wide(const widener *w, uint32_t b)
 {
-    /* Every wide node consumes at least one binary inner node. */
-    uint32_t bound = bvh->num_nodes / 2 + 1;
-    rl_bvh_wide_node *wide = alloc_wide(bound);
-    if (!wide)
-        return rl_error(RL_ERR_OUT_OF_MEMORY, "accel bvh: out of memory for %u wide nodes", (unsigned)bound);
-    uint32_t num_blocks = 0;
-    for (uint32_t i = 0; i < bvh->num_nodes; ++i)
-        num_blocks += leaf_blocks(bvh->nodes[i].count);
-    rl_bvh_block *blocks = alloc_lines(((size_t)num_blocks * sizeof *blocks + 63) / 64 * 64);
-    if (!blocks) {
-        free(wide);
-        return rl_error(RL_ERR_OUT_OF_MEMORY, "accel bvh: out of memory for %u leaf blocks", (unsigned)num_blocks);
-    }
-    float *cost = rl_big_alloc((size_t)bvh->num_nodes * RL_BVH_WIDTH * sizeof *cost, true);
-    uint8_t *split = rl_big_alloc((size_t)bvh->num_nodes * RL_BVH_WIDTH, true);
-    if (!cost || !split) {
+    uint32_t kids[RL_BVH_WIDTH];
+    int n = 0;
+    const rl_bvh_node *bn = &w->bin[b];
+    if (bn->count > 0)
+        return 1;   /* a leaf root: one wide node holding it */
+    int j = w->split[(size_t)b * RL_BVH_WIDTH];
+    cut(w, bn->index, j, kids, &n);
+    cut(w, bn->index + 1, RL_BVH_WIDTH - j, kids, &n);
+    uint32_t total = 1;
+    for (int i = 0; i < n; ++i)
+        if (w->bin[kids[i]].count == 0)
+            total += count_wide(w, kids[i]);
+    return total;
+}
+
+rl_bvh_block *rl_bvh_alloc_blocks(uint32_t count)
+{
+    return alloc_lines(((size_t)count * sizeof(rl_bvh_block) + 63) / 64 * 64);
+}
+
+rl_status rl_bvh_collapse(const rl_bvh_node *nodes, uint32_t num_slots, uint32_t num_blocks,
+                          const rl_bvh_leaf_source *src, rl_bvh_block *blocks, rl_bvh *bvh)
+{
+    /* Allocation order: the costs are freed before the wide nodes are
+     * allocated, so these reuse their pages (first touches of fresh pages
+     * are the expensive part on a VM: bvh_build.c). */
+    float *cost = rl_big_alloc((size_t)num_slots * RL_BVH_WIDTH * sizeof *cost, true);
+    uint8_t *split = rl_big_alloc((size_t)num_slots * RL_BVH_WIDTH, true);
+    rl_bvh_block *own = blocks ? NULL : rl_bvh_alloc_blocks(num_blocks);
+    if (!blocks)
+        blocks = own;
+    if (!cost || !split || !blocks) {
         free(cost);
         free(split);
-        free(wide);
-        free(blocks);
+        free(own);
         return rl_error(RL_ERR_OUT_OF_MEMORY, "accel bvh: out of memory for the collapse of %u nodes",
-                        (unsigned)bvh->num_nodes);
+                        (unsigned)num_slots);
     }
-    widener w = { bvh->nodes, bvh->tris, wide, 1, blocks, 0, cost, split };
-    plan_collapse(&w, bvh->num_nodes);
-    widen_node(&w, 0, 0);
+    widener w = { nodes, *src, NULL, 1, blocks, 0, cost, split };
+    plan_collapse(&w);
     free(cost);
-    free(split);
-    /* Shrink by copying: realloc would not keep the alignment. */
-    rl_bvh_wide_node *shrunk = w.count < bound ? alloc_wide(w.count) : NULL;
-    if (shrunk) {
-        memcpy(shrunk, wide, (size_t)w.count * sizeof *wide);
-        free(wide);
-        wide = shrunk;
+    w.cost = NULL;
+    uint32_t num_wide = count_wide(&w, 0);
+    rl_bvh_wide_node *wide = alloc_wide(num_wide);
+    if (!wide) {
+        free(split);
+        free(own);
+        return rl_error(RL_ERR_OUT_OF_MEMORY, "accel bvh: out of memory for %u wide nodes", (unsigned)num_wide);
     }
+    w.wide = wide;
+    widen_node(&w, 0, 0);
+    free(split);
     free(bvh->wide);
     bvh->wide = wide;
     bvh->num_wide = w.count;
@@ -236,4 +295,13 @@ rl_status rl_bvh_widen(rl_bvh *bvh)
     bvh->blocks = blocks;
     bvh->num_blocks = w.num_blocks;
     return RL_OK;
+}
+
+rl_status rl_bvh_widen(rl_bvh *bvh)
+{
+    uint32_t num_blocks = 0;
+    for (uint32_t i = 0; i < bvh->num_nodes; ++i)
+        num_blocks += leaf_blocks(bvh->nodes[i].count);
+    rl_bvh_leaf_source src = { .tris = bvh->tris };
+    return rl_bvh_collapse(bvh->nodes, bvh->num_nodes, num_blocks, &src, NULL, bvh);
 }

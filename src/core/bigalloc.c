@@ -49,3 +49,18 @@ void *rl_big_array(size_t count, size_t size, bool zero)
         memset(p, 0, bytes ? bytes : 1);
     return p;
 }
+
+void rl_big_prefault(void *p, size_t bytes)
+{
+#if defined(__linux__) && defined(MADV_POPULATE_WRITE)
+    /* madvise wants a page-aligned start: round it up (the part before
+     * is faulted by its writer). Errors (an older kernel: EINVAL) only
+     * leave the faults to the writer. */
+    uintptr_t start = ((uintptr_t)p + 4095) & ~(uintptr_t)4095, end = (uintptr_t)p + bytes;
+    if (p && end > start)
+        (void)madvise((void *)start, end - start, MADV_POPULATE_WRITE);
+#else
+    (void)p;
+    (void)bytes;
+#endif
+}

@@ -27,4 +27,14 @@ void *rl_big_alloc(size_t bytes, bool huge);
  * 0.58-0.67 s with them against 1.55-1.7 s without on the same VM. */
 void *rl_big_array(size_t count, size_t size, bool zero);
 
+/* Faults the pages of p[0..bytes) in without changing their contents
+ * (Linux >= 5.14: madvise MADV_POPULATE_WRITE; elsewhere a no-op), so that
+ * an idle thread can take a later writer's first-touch faults off its
+ * path; safe while another thread reads or writes the array. Why: first
+ * touches of fresh memory cost about 2 ms per MiB on the 2-core VM (a 200
+ * MiB memset: 0.4-0.6 s the first time in a process, 31 ms on pages it
+ * freed just before), more than building a BVH over them (bench/README.md,
+ * rays, 2026-12-06). */
+void rl_big_prefault(void *p, size_t bytes);
+
 #endif

@@ -411,6 +411,81 @@ static void test_bvh_breaks_ties_by_lowest_triangle_id(void **state)
     rl_scene_release(s);
 }
 
+/* RL_ACCEL_BVH builds through rl_bvh_build_wide (no binary array, no
+ * triangle copies, the blocks packed from the scene); it must give exactly
+ * the wide tree, blocks and statistics of rl_bvh_build + rl_bvh_widen,
+ * with one thread and two, on SAH splits, on the median fallback (stacked
+ * copies of one triangle: all centroids coincide) and on leaf-size and bin
+ * settings off the defaults. */
+static void assert_build_wide_matches(const rl_scene_data *d, rl_accel_desc desc)
+{
+    rl_bvh ref = { 0 };
+    rl_accel_stats ref_st = { 0 };
+    assert_int_equal(rl_bvh_build(d, &desc, &ref, &ref_st), RL_OK);
+    assert_int_equal(rl_bvh_widen(&ref), RL_OK);
+    for (int threads = 1; threads <= 2; ++threads) {
+        desc.threads = threads;
+        rl_bvh w = { 0 };
+        rl_accel_stats st = { 0 };
+        assert_int_equal(rl_bvh_build_wide(d, &desc, &w, &st), RL_OK);
+        assert_null(w.nodes);
+        assert_null(w.tris);
+        assert_int_equal(w.num_tris, d->num_triangles);
+        assert_int_equal(w.num_wide, ref.num_wide);
+        assert_int_equal(w.num_blocks, ref.num_blocks);
+        assert_memory_equal(w.wide, ref.wide, (size_t)w.num_wide * sizeof *w.wide);
+        assert_memory_equal(w.blocks, ref.blocks, (size_t)w.num_blocks * sizeof *w.blocks);
+        assert_int_equal(st.nodes, ref_st.nodes);
+        assert_int_equal(st.leaves, ref_st.leaves);
+        assert_int_equal(st.max_depth, ref_st.max_depth);
+        assert_true(st.sah_cost == ref_st.sah_cost);
+        assert_int_equal(st.memory_bytes,
+                         (size_t)w.num_wide * sizeof *w.wide + (size_t)w.num_blocks * sizeof *w.blocks);
+        rl_bvh_free(&w);
+    }
+    rl_bvh_free(&ref);
+}
+
+static void test_bvh_build_wide_equals_build_then_widen(void **state)
+{
+    (void)state;
+    rl_scene *teapot = builtin("cornell-teapot", "triangles=20000");
+    assert_build_wide_matches(rl_scene_get_data(teapot), (rl_accel_desc){ 0 });
+    assert_build_wide_matches(rl_scene_get_data(teapot), (rl_accel_desc){ .bvh_leaf_size = 1, .bvh_bins = 4 });
+    assert_build_wide_matches(rl_scene_get_data(teapot), (rl_accel_desc){ .bvh_leaf_size = 8, .bvh_bins = 256 });
+    rl_scene_release(teapot);
+    rl_scene *city = builtin("city", "blocks=1,detail=0");
+    assert_build_wide_matches(rl_scene_get_data(city), (rl_accel_desc){ 0 });
+    rl_scene_release(city);
+    /* 5,000 copies of one triangle plus a ramp of small ones: the copies
+     * reach the median fallback over a range bigger than a task's. */
+    enum { COPIES = 5000, RAMP = 3000 };
+    rl_vec3 *pos = malloc((3 + 3 * RAMP) * sizeof *pos);
+    uint32_t *idx = malloc(3 * (COPIES + RAMP) * sizeof *idx);
+    assert_true(pos && idx);
+    pos[0] = rl_v3(-1, -1, 0);
+    pos[1] = rl_v3(1, -1, 0);
+    pos[2] = rl_v3(0, 1, 0);
+    for (uint32_t i = 0; i < COPIES; ++i) {
+        idx[3 * i] = 0;
+        idx[3 * i + 1] = 1;
+        idx[3 * i + 2] = 2;
+    }
+    for (uint32_t i = 0; i < RAMP; ++i) {
+        float x = 2.0f + 0.01f * (float)i, z = 0.001f * (float)(i % 7);
+        pos[3 + 3 * i] = rl_v3(x, 0, z);
+        pos[4 + 3 * i] = rl_v3(x + 0.005f, 0, z);
+        pos[5 + 3 * i] = rl_v3(x, 0.005f, z + 0.002f);
+        for (int k = 0; k < 3; ++k)
+            idx[3 * (COPIES + i) + (uint32_t)k] = 3 + 3 * i + (uint32_t)k;
+    }
+    rl_scene *stack = mesh_scene(pos, 3 + 3 * RAMP, idx, COPIES + RAMP);
+    assert_build_wide_matches(rl_scene_get_data(stack), (rl_accel_desc){ 0 });
+    rl_scene_release(stack);
+    free(pos);
+    free(idx);
+}
+
 /* A closed UV sphere (shared vertices, poles), rotated off the axes so that
  * edges are not axis-aligned. */
 static void uv_sphere(uint32_t rings, uint32_t segs, rl_vec3 **pos, uint32_t *nv, uint32_t **idx, uint32_t *nt)
@@ -602,6 +677,7 @@ int main(void)
         cmocka_unit_test(test_bvh_finds_hits_at_negative_t),
         cmocka_unit_test(test_bvh_build_is_identical_with_one_and_two_threads),
         cmocka_unit_test(test_bvh_structure_is_consistent_and_stats_are_sane),
+        cmocka_unit_test(test_bvh_build_wide_equals_build_then_widen),
         cmocka_unit_test(test_bvh_breaks_ties_by_lowest_triangle_id),
         cmocka_unit_test(test_rays_at_shared_edges_and_vertices_never_escape),
         cmocka_unit_test(test_bvh_agrees_with_brute_force_at_vertices_and_edges),
