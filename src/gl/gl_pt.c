@@ -11,7 +11,9 @@
  * 14 and 15 the ray set and hits of rl_gl_pt_trace. Of these, 3, 5, 6, 7,
  * 12 and 13 are read as buffer textures (units 0-5, tex_buffers below), so
  * that the path program stays within 16 storage blocks with the Line
- * Space's 8 at 16-23 (rl_gl_pt_set_linespace, gl_linespace.h).
+ * Space's 8 at 16-23 (rl_gl_pt_set_linespace, gl_linespace.h). For the
+ * same reason the environment's arrays (rl_gl_pt_set_environment) are one
+ * r32f buffer texture on unit 8, not storage buffers.
  *
  * The BVH is accel/bvh_build.c's binary tree as built (the CPU traversal
  * then collapses it into a wide tree, which a GPU thread gains nothing
@@ -76,6 +78,7 @@ typedef struct uniforms {
         rr_depth, rr, mis, mis_hits, tri_lights, light_samples, vertex_slots, num_lights, table_count,
         num_textures, eps, background, shadow, diffuse, specular, ls_start, ls_offset;
     GLint sm_size, sm_bias, sm_slope, sm_pcf, sm_frame;
+    GLint env, env_nee, env_slot, env_map, env_size, env_rot, env_sum, env_off;
     GLint count, structure, any;
 } uniforms;
 
@@ -83,6 +86,7 @@ typedef struct uniforms {
 #define SM_UNIT 7                  /* the path program's texture unit of the maps */
 #define SM_CASTERS 14              /* the casters list's storage binding (B_RAYS's: the pass is
                                     * no ray set's) */
+#define ENV_UNIT 8                 /* the path program's texture unit of the environment */
 
 struct rl_gl_pt {
     rl_gl_context *ctx;
@@ -121,6 +125,14 @@ struct rl_gl_pt {
     GLuint sm_buf, sm_tex;
     bool have_sm;
     rl_shadowmap_desc sm_desc;
+    /* the environment (rl_gl_pt_set_environment): radiance texels, then
+     * weights, conditional and marginal sums, in one r32f buffer texture
+     * (a 12-byte one without) at the offsets env_off */
+    GLuint env_buf, env_tex;
+    bool have_env;
+    int env_map[2], env_size[2], env_off[3];
+    float env_rot;
+    double env_sum;
 };
 
 static void replace_buffer(rl_gl_pt *pt, int slot, const void *data, size_t bytes, GLbitfield flags)
@@ -187,6 +199,14 @@ static void locate(GLuint p, uniforms *u)
     U(sm_slope, "u_sm_slope");
     U(sm_pcf, "u_sm_pcf");
     U(sm_frame, "u_sm_frame");
+    U(env, "u_env");
+    U(env_nee, "u_env_nee");
+    U(env_slot, "u_env_slot");
+    U(env_map, "u_env_map");
+    U(env_size, "u_env_size");
+    U(env_rot, "u_env_rot");
+    U(env_sum, "u_env_sum");
+    U(env_off, "u_env_off");
     U(count, "u_count");
     U(structure, "u_structure");
     U(any, "u_any");
@@ -260,6 +280,7 @@ static rl_status upload_materials_lights(rl_gl_pt *pt, const rl_gl_pt_lights *lt
         mats[i].extra[0] = m->transmissivity;
         mats[i].extra[1] = m->ior;
         mats[i].extra[2] = m->alpha_cutoff;
+        mats[i].extra[3] = m->fresnel == RL_FRESNEL_SCHLICK ? 1.0f : 0.0f;   /* issue 37 */
         mats[i].tex[0] = valid_texture(d, m->diffuse_texture);
         mats[i].tex[1] = valid_texture(d, m->normal_texture);
         mats[i].tex[2] = rl_material_mask(d, i);
@@ -459,7 +480,8 @@ static rl_status make_buffer_textures(rl_gl_pt *pt)
  * rl_gl_make_buffer's four. llvmpipe's variant key holds the power-of-two flag of
  * a buffer's byte size, and the maps' lights x 6 x size^2 floats are never
  * a power of two, so 12 bytes keep one variant of the path program with
- * and without maps. */
+ * and without maps. The environment's buffer without an environment is the
+ * same (and one with is padded off a power of two). */
 static GLuint no_maps(void)
 {
     const float none[3] = { 0.0f, 0.0f, 0.0f };
@@ -521,6 +543,9 @@ rl_status rl_gl_pt_create(const rl_scene *scene, const rl_gl_pt_desc *desc, rl_g
         pt->sm_buf = no_maps();
         glCreateTextures(GL_TEXTURE_BUFFER, 1, &pt->sm_tex);
         glTextureBuffer(pt->sm_tex, GL_R32F, pt->sm_buf);
+        pt->env_buf = no_maps();
+        glCreateTextures(GL_TEXTURE_BUFFER, 1, &pt->env_tex);
+        glTextureBuffer(pt->env_tex, GL_R32F, pt->env_buf);
         st = rl_gl_check("rl_gl_pt_create");
     }
     if (st != RL_OK) {
@@ -605,10 +630,11 @@ static void drain_counters(rl_gl_pt *pt, uint64_t rays[RL_GL_PT_RAY_TYPES])
 
 /* The most rays of one type a dispatch of w x h paths can trace: the
  * primary ray, and per path vertex (the camera hit and max_depth bounces)
- * the shadow rays and one continuing ray. */
+ * the shadow rays (the environment's one included) and one continuing ray. */
 static uint64_t rays_bound(const rl_gl_pt_frame *f, uint32_t num_lights)
 {
-    uint64_t per_vertex = (uint64_t)f->light_samples * (f->mis ? 1u : (num_lights ? num_lights : 1u)) + 1u;
+    uint64_t per_vertex = (uint64_t)f->light_samples * (f->mis ? 1u : (num_lights ? num_lights : 1u)) + 1u +
+                          (f->env_nee ? 1u : 0u);
     return (uint64_t)f->cam.width * (uint64_t)f->cam.height * (1u + ((uint64_t)f->max_depth + 1u) * per_vertex);
 }
 
@@ -659,6 +685,7 @@ static rl_status render_frame(rl_gl_pt *pt, const rl_gl_pt_frame *f, float *rgba
     }
     glBindTextureUnit(6, pt->tex_ids);
     glBindTextureUnit(SM_UNIT, pt->sm_tex);
+    glBindTextureUnit(ENV_UNIT, pt->env_tex);
     if (pt->have_sm) {
         glProgramUniform1i(p, u->sm_size, pt->sm_desc.size);
         glProgramUniform1f(p, u->sm_bias, pt->sm_desc.bias);
@@ -688,7 +715,17 @@ static rl_status render_frame(rl_gl_pt *pt, const rl_gl_pt_frame *f, float *rgba
     glProgramUniform1i(p, u->light_samples, f->light_samples);
     /* pathtrace.c: sampler slots per path vertex */
     uint32_t slots = 4u + 3u * (uint32_t)f->light_samples * (f->mis ? 1u : (d->num_lights ? d->num_lights : 1u));
-    glProgramUniform1ui(p, u->vertex_slots, slots);
+    /* the environment's sample: one slot after the lights', in scenes
+     * that have one (pathtrace.c) */
+    glProgramUniform1ui(p, u->env_slot, slots);
+    glProgramUniform1ui(p, u->vertex_slots, slots + (pt->have_env ? 1u : 0u));
+    glProgramUniform1i(p, u->env, pt->have_env);
+    glProgramUniform1i(p, u->env_nee, pt->have_env && f->env_nee);
+    glProgramUniform2i(p, u->env_map, pt->env_map[0], pt->env_map[1]);
+    glProgramUniform2i(p, u->env_size, pt->env_size[0], pt->env_size[1]);
+    glProgramUniform3i(p, u->env_off, pt->env_off[0], pt->env_off[1], pt->env_off[2]);
+    glProgramUniform1f(p, u->env_rot, pt->env_rot);
+    glProgramUniform1d(p, u->env_sum, pt->env_sum);
     glProgramUniform1i(p, u->num_lights, (GLint)d->num_lights);
     glProgramUniform1ui(p, u->table_count, pt->table_count);
     glProgramUniform1ui(p, u->num_textures, d->num_textures);
@@ -962,6 +999,75 @@ rl_status rl_gl_pt_set_shadowmaps(rl_gl_pt *pt, const rl_shadowmap_desc *desc)
     return st;
 }
 
+/* The environment's arrays into one r32f buffer: radiance texels (rgb),
+ * weights, conditional sums, marginal sums; one float of padding where the
+ * byte size would be a power of two (no_maps). */
+static rl_status upload_environment(rl_gl_pt *pt, const rl_gl_pt_env *e)
+{
+    const size_t texels = (size_t)e->map_width * (size_t)e->map_height;
+    const size_t cells = (size_t)e->width * (size_t)e->height;
+    const size_t n_w = cells, n_c = ((size_t)e->width + 1) * (size_t)e->height, n_m = (size_t)e->height + 1;
+    size_t total = 3 * texels + n_w + n_c + n_m;
+    if (((total * 4) & (total * 4 - 1)) == 0)
+        ++total;
+    GLint max_texels = 0;
+    glGetIntegerv(GL_MAX_TEXTURE_BUFFER_SIZE, &max_texels);
+    if (total > (size_t)max_texels || total > (size_t)INT32_MAX)
+        return rl_error(RL_ERR_LIMIT, "gl-pt: the environment's %zu floats (map %d x %d) exceed this GL's buffer "
+                        "texture size of %d texels", total, e->map_width, e->map_height, (int)max_texels);
+    float *data = rl_calloc(total, sizeof *data);
+    if (!data)
+        return RL_ERR_OUT_OF_MEMORY;
+    memcpy(data, e->radiance, 3 * texels * sizeof *data);
+    memcpy(data + 3 * texels, e->weight, n_w * sizeof *data);
+    memcpy(data + 3 * texels + n_w, e->conditional, n_c * sizeof *data);
+    memcpy(data + 3 * texels + n_w + n_c, e->marginal, n_m * sizeof *data);
+    GLuint b = rl_gl_make_buffer(data, total * sizeof *data, 0);
+    free(data);
+    glDeleteTextures(1, &pt->env_tex);
+    glDeleteBuffers(1, &pt->env_buf);
+    pt->env_buf = b;
+    glCreateTextures(GL_TEXTURE_BUFFER, 1, &pt->env_tex);
+    glTextureBuffer(pt->env_tex, GL_R32F, pt->env_buf);
+    pt->env_map[0] = e->map_width;
+    pt->env_map[1] = e->map_height;
+    pt->env_size[0] = e->width;
+    pt->env_size[1] = e->height;
+    pt->env_off[0] = (int)(3 * texels);
+    pt->env_off[1] = (int)(3 * texels + n_w);
+    pt->env_off[2] = (int)(3 * texels + n_w + n_c);
+    pt->env_rot = e->rotation;
+    pt->env_sum = e->sum;
+    pt->have_env = true;
+    return rl_gl_check("rl_gl_pt_set_environment");
+}
+
+rl_status rl_gl_pt_set_environment(rl_gl_pt *pt, const rl_gl_pt_env *env)
+{
+    if (!pt)
+        return rl_error(RL_ERR_INVALID_ARG, "rl_gl_pt_set_environment: NULL argument");
+    if (env && (!env->radiance || !env->weight || !env->conditional || !env->marginal || env->map_width < 1 ||
+                env->map_height < 1 || env->width < 1 || env->height < 1 || !isfinite(env->rotation) ||
+                !(env->sum >= 0.0) || !isfinite(env->sum)))
+        return rl_error(RL_ERR_INVALID_ARG, "rl_gl_pt_set_environment: missing arrays, empty grids or a bad sum");
+    rl_status st = rl_gl_context_make_current(pt->ctx);
+    if (st != RL_OK)
+        return st;
+    if (env) {
+        st = upload_environment(pt, env);
+    } else {
+        glDeleteTextures(1, &pt->env_tex);
+        glDeleteBuffers(1, &pt->env_buf);
+        pt->env_buf = no_maps();
+        glCreateTextures(GL_TEXTURE_BUFFER, 1, &pt->env_tex);
+        glTextureBuffer(pt->env_tex, GL_R32F, pt->env_buf);
+        pt->have_env = false;
+        st = rl_gl_check("rl_gl_pt_set_environment");
+    }
+    rl_gl_context_done(pt->ctx);
+    return st;
+}
+
 static rl_status trace_rays(rl_gl_pt *pt, rl_gl_pt_structure structure, int grid_res, bool any, const rl_ray *rays,
                             uint32_t n, rl_hit *hits)
 {
@@ -1059,6 +1165,13 @@ rl_status rl_gl_pt_set_shadowmaps(rl_gl_pt *pt, const rl_shadowmap_desc *desc)
 {
     (void)pt;
     (void)desc;
+    return rl_error(RL_ERR_UNSUPPORTED, "gl: built without OpenGL");
+}
+
+rl_status rl_gl_pt_set_environment(rl_gl_pt *pt, const rl_gl_pt_env *env)
+{
+    (void)pt;
+    (void)env;
     return rl_error(RL_ERR_UNSUPPORTED, "gl: built without OpenGL");
 }
 

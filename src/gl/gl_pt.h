@@ -11,8 +11,8 @@
  * uniform grid of accel/grid.h is built and uploaded on the first use of
  * RL_GL_PT_GRID (and again for another grid_res).
  *
- * Bindings: shader storage 0-15, texture units 0-7 (6 the raster IDs,
- * 7 the shadow maps) and image units 0-1
+ * Bindings: shader storage 0-15, texture units 0-8 (6 the raster IDs,
+ * 7 the shadow maps, 8 the environment) and image units 0-1
  * are gl-pt's; storage 16-23 the Line Space's (gl_linespace.h, docs/gl.md).
  *
  * A tracer owns its own GL context (gl_context.h), current on the calling
@@ -72,7 +72,11 @@ typedef struct rl_gl_pt_frame {
     float ls_start, ls_offset;     /* pt_backends': where PNMT / preillum rays start; the
                                     * voxel offset at a shadow ray's light end */
     int grid_res;                  /* 0: the grid heuristic */
-    rl_vec3 background;
+    rl_vec3 background;            /* escaping rays without an environment */
+    /* With an environment (rl_gl_pt_set_environment): every BRDF vertex
+     * also samples it by its distribution (pt's env_nee: the distribution
+     * has weight and shadow rays are traced, not looked up in shadow maps). */
+    bool env_nee;
     /* Sec. 8.5: this frame traces only the pixels whose x + y has the
      * parity of the frames since the reset (pathtrace.c active()) */
     bool checkerboard;
@@ -142,6 +146,32 @@ rl_status rl_gl_pt_set_linespace(rl_gl_pt *pt, const rl_linespace *ls, const rl_
  * RL_ERR_LIMIT where the maps exceed the GL's buffer texture size. Until
  * one succeeds, a frame with shadow = SHADOWMAP is RL_ERR_INVALID_ARG. */
 rl_status rl_gl_pt_set_shadowmaps(rl_gl_pt *pt, const rl_shadowmap_desc *desc);
+
+/* The scene's environment (issue 37; pt's pathtrace_env.c,
+ * scene/environment.c) as plain arrays the caller keeps: the radiance of
+ * each texel of the lat-long map (rl_environment_radiance's product of the
+ * colour and the texel; 1 x 1 for a constant environment) and the
+ * sampling distribution rl_pt_env_build made for it (the grid of weights,
+ * per row width + 1 running sums, height + 1 over the rows, their sum in
+ * double), so that the shader looks up and samples it as pt does. */
+typedef struct rl_gl_pt_env {
+    const float *radiance;         /* map_width * map_height rgb triples, row 0 at v = 0 (up) */
+    int map_width, map_height;
+    float rotation;                /* about +y, radians (rl_radians(rotation_deg)) */
+    int width, height;             /* the distribution's grid */
+    const float *weight;           /* width * height */
+    const float *conditional;      /* height * (width + 1) */
+    const float *marginal;         /* height + 1 */
+    double sum;                    /* of the weights; the density's normaliser */
+} rl_gl_pt_env;
+
+/* Gives the tracer env (copied), or with NULL takes its environment away
+ * (escaping rays then see the frame's background). RL_ERR_INVALID_ARG for
+ * inconsistent sizes, RL_ERR_LIMIT past the GL's buffer texture size. The
+ * arrays live in one r32f buffer texture; without an environment a
+ * 12-byte one is bound, so llvmpipe compiles one variant of the path
+ * program for both (see no_maps in gl_pt.c). */
+rl_status rl_gl_pt_set_environment(rl_gl_pt *pt, const rl_gl_pt_env *env);
 
 /* Traces n rays through structure on the GPU (closest hit, or with any the
  * first hit found) into hits (t, u, v, triangle; the object is left

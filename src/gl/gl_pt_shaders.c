@@ -18,6 +18,11 @@
  *                     the cells' offsets and triangle lists (Sec. 5.4)
  *   surface_*, phong_ pathtrace_path.c, pathtrace_bsdf.c
  *   direct_light*     Shade (Sec. 6.4.2, 6.3), with MIS (pathtrace_path.c)
+ *   env_*             scene/environment.c (lookup) and pathtrace_env.c
+ *                     (sampling by pt's own CDFs, density), environment_light
+ *                     and escaped of pathtrace_path.c (issue 37)
+ *   fresnel_schlick   scene/material.c rl_fresnel_schlick, and the specular
+ *                     event of pathtrace_ggx.c rl_pt_specular_event (issue 37)
  *   trace_path        rl_pt_trace_path (Sec. 6.4)
  *   main (path)       one sample of every pixel: jittered camera ray
  *                     through the BVH (primary=trace), the path, eq. 8 of
@@ -323,6 +328,18 @@ const char *const rl_gl_pt_glsl_path = GLSL(
     uniform float u_sm_slope;
     uniform float u_sm_pcf;
     uniform vec3 u_sm_frame[18];       /* per face: right, up, axis (rl_shadowmap_face_frame) */
+    /* The scene's environment (rl_gl_pt_set_environment): radiance texels
+     * (rgb) from 0, then at u_env_off the weights, the conditional and the
+     * marginal running sums of rl_pt_env_build. Always bound, as the maps. */
+    layout(binding = 8) uniform samplerBuffer u_env_data;     /* r32f */
+    uniform bool u_env;                /* escaping rays see it, not u_background */
+    uniform bool u_env_nee;            /* BRDF vertices sample it (pt's env_nee) */
+    uniform uint u_env_slot;           /* its 2D sample's slot in a vertex's block */
+    uniform ivec2 u_env_map;           /* the map's texels (1 x 1: constant) */
+    uniform ivec2 u_env_size;          /* the distribution's grid */
+    uniform ivec3 u_env_off;           /* weights, conditional, marginal */
+    uniform float u_env_rot;           /* radians about +y */
+    uniform double u_env_sum;          /* of the weights */
 
     uniform ivec2 u_size;
     uniform vec3 u_eye;
@@ -808,6 +825,89 @@ const char *const rl_gl_pt_glsl_path = GLSL(
         return !query(u_shadow, o, d, 0.0, t_max, true, h);
     }
 
+    /* ---------------------------------------------------- environment -- */
+    float env_at(int i) { return texelFetch(u_env_data, i).x; }
+
+    /* scene/environment.c rl_environment_uv */
+    vec2 env_uv(vec3 dir)
+    {
+        float theta = acos(clamp(dir.y, -1.0, 1.0));
+        float phi = atan(-dir.z, dir.x) - u_env_rot;
+        float u = phi / (2.0 * PI);
+        u -= floor(u);
+        if (u >= 1.0)
+            u = 0.0;
+        return vec2(u, clamp(theta / PI, 0.0, 1.0));
+    }
+
+    /* rl_environment_direction */
+    vec3 env_direction(float u, float v)
+    {
+        float theta = PI * v, phi = 2.0 * PI * u + u_env_rot;
+        float st = sin(theta);
+        return vec3(st * cos(phi), cos(theta), -st * sin(phi));
+    }
+
+    /* rl_environment_radiance: the nearest texel, no filtering (the
+     * uploaded texels are already colour times texel) */
+    vec3 env_radiance(vec3 dir)
+    {
+        vec2 uv = env_uv(dir);
+        int x = clamp(int(uv.x * float(u_env_map.x)), 0, u_env_map.x - 1);
+        int y = clamp(int(uv.y * float(u_env_map.y)), 0, u_env_map.y - 1);
+        int i = 3 * (y * u_env_map.x + x);
+        return vec3(env_at(i), env_at(i + 1), env_at(i + 2));
+    }
+
+    /* rl_pt_env_pdf: p(u, v) / (2 pi^2 sin theta), in double as there */
+    float env_pdf(vec3 dir)
+    {
+        vec2 uv = env_uv(dir);
+        float sin_t = sqrt(max(0.0, 1.0 - dir.y * dir.y));
+        if (!(sin_t > 0.0) || !(u_env_sum > 0.0LF))
+            return 0.0;
+        int w = u_env_size.x, h = u_env_size.y;
+        int x = clamp(int(uv.x * float(w)), 0, w - 1), y = clamp(int(uv.y * float(h)), 0, h - 1);
+        double p_uv = double(env_at(u_env_off.x + y * w + x)) * double(w) * double(h) / u_env_sum;
+        return float(p_uv / (2.0LF * double(PI) * double(PI) * double(sin_t)));
+    }
+
+    /* pathtrace_env.c pick: the cell of the n + 1 sums from off holding u,
+     * and u's position in it */
+    int env_pick(int off, int n, float u, out float frac)
+    {
+        int lo = 0, hi = n;
+        while (hi - lo > 1) {
+            int mid = lo + (hi - lo) / 2;
+            if (env_at(off + mid) <= u)
+                lo = mid;
+            else
+                hi = mid;
+        }
+        float c0 = env_at(off + lo), width = env_at(off + lo + 1) - c0;
+        frac = width > 0.0 ? clamp((u - c0) / width, 0.0, 0.99999994) : 0.5;
+        return lo;
+    }
+
+    /* rl_pt_env_sample: row by the marginal, texel by the row's
+     * conditional, the density of the texel the direction looks up */
+    bool env_sample(float u1, float u2, out vec3 dir, out float pdf)
+    {
+        dir = vec3(0.0);
+        pdf = 0.0;
+        float fy, fx;
+        int w = u_env_size.x, h = u_env_size.y;
+        int y = env_pick(u_env_off.z, h, u1, fy);
+        int x = env_pick(u_env_off.y + y * (w + 1), w, u2, fx);
+        vec3 d = env_direction((float(x) + fx) / float(w), (float(y) + fy) / float(h));
+        float p = env_pdf(d);
+        if (!(p > 0.0) || isinf(p))
+            return false;
+        dir = d;
+        pdf = p;
+        return true;
+    }
+
     /* direct_light (mis=off): every light, light_samples points per quad */
     vec3 direct_light(Surf s, uint base)
     {
@@ -962,6 +1062,37 @@ const char *const rl_gl_pt_glsl_path = GLSL(
         return sum;
     }
 
+    /* environment_light: one direction from the environment's
+     * distribution, the power heuristic against the BSDF sample that
+     * follows */
+    vec3 environment_light(Surf s, uint base, bool bsdf_follows)
+    {
+        seek(base + u_env_slot);
+        vec2 x = sample_2d();
+        vec3 l;
+        float p_env;
+        if (!env_sample(x.x, x.y, l, p_env))
+            return vec3(0.0);
+        float cos_r = dot(s.ns, l);
+        if (cos_r <= 0.0 || !visible(s, l, INF, 0u, vec2(0.0)))
+            return vec3(0.0);
+        float w = bsdf_follows ? power_heuristic(p_env, bsdf_pdf(s, l)) : 1.0;
+        return phong_eval(s, l) * (env_radiance(l) * (w * cos_r / p_env));
+    }
+
+    /* escaped: a ray that left the scene; after a BRDF bounce with density
+     * pdf_bsdf the environment gets the BSDF strategy's weight when light
+     * samples also reach it */
+    vec3 escaped(vec3 dir, bool after_brdf, float pdf_bsdf)
+    {
+        if (!u_env)
+            return u_background;
+        vec3 L = env_radiance(dir);
+        if (!u_env_nee || !after_brdf)
+            return L;
+        return L * power_heuristic(pdf_bsdf, env_pdf(dir));
+    }
+
     /* rl_pt_cover_point: the quad light whose parallelogram holds p (a
      * PNMT record has no triangle to look up) */
     uint cover_point(vec3 p, float tol)
@@ -1037,6 +1168,33 @@ const char *const rl_gl_pt_glsl_path = GLSL(
         return e * power_heuristic(pdf_bsdf, float(u_light_samples) * p_light);
     }
 
+    /* -------------------------------------------------------- Fresnel -- */
+    float schlick_weight(float c)
+    {
+        float k = 1.0 - clamp(c, 0.0, 1.0), k2 = k * k;
+        return k2 * k2 * k;
+    }
+
+    /* scene/material.c rl_fresnel_schlick: eta = n_t / n_i; from the
+     * denser side with the angle on the rarer one (reciprocal), 1 past
+     * the critical angle */
+    float fresnel_schlick(float cos_i, float eta)
+    {
+        if (!(eta > 0.0))
+            return 1.0;
+        float c = clamp(cos_i, 0.0, 1.0);
+        if (eta < 1.0) {
+            float sin2_t = (1.0 - c * c) / (eta * eta);
+            if (sin2_t >= 1.0)
+                return 1.0;
+            c = sqrt(1.0 - sin2_t);
+        }
+        float r0 = (eta - 1.0) / (eta + 1.0);
+        r0 *= r0;
+        float k = 1.0 - c, k2 = k * k;
+        return r0 + (1.0 - r0) * k2 * k2 * k;
+    }
+
     /* ----------------------------------------------------------- path -- */
     vec3 trace_path(Surf first)
     {
@@ -1060,10 +1218,23 @@ const char *const rl_gl_pt_glsl_path = GLSL(
             if (u_event < k_r + k_t) {
                 if (depth >= u_max_depth)
                     break;
+                /* rl_pt_specular_event: with Schlick's Fresnel (extra.w) a
+                 * mirror reflects F with F0 = k_s, and within k_t the
+                 * event reflects with probability F (weight 1) */
                 vec3 d = -s.v;
                 diffuse_ray = false;
                 dir = d - s.ns * (2.0 * dot(d, s.ns));
-                if (u_event >= k_r) {
+                bool schlick = m.extra.w > 0.0;
+                bool fresnel_mirror = false;
+                if (u_event < k_r && schlick) {
+                    T *= m.specular.rgb + (vec3(1.0) - m.specular.rgb) * schlick_weight(dot(s.ns, s.v));
+                } else if (u_event >= k_r && schlick) {
+                    float ior = m.extra.y >= 1.0 ? m.extra.y : 1.0;
+                    float F = fresnel_schlick(dot(s.ns, s.v), s.front ? ior : 1.0 / ior);
+                    float u = k_t > 0.0 ? (u_event - k_r) / k_t : 0.0;
+                    fresnel_mirror = u < F;
+                }
+                if (u_event >= k_r && !fresnel_mirror) {
                     float ior = m.extra.y >= 1.0 ? m.extra.y : 1.0;
                     float eta = s.front ? 1.0 / ior : ior;
                     float cos_i = -dot(d, s.ns);
@@ -1077,6 +1248,8 @@ const char *const rl_gl_pt_glsl_path = GLSL(
             } else {
                 bool last = depth >= u_max_depth;
                 radiance += T * (u_mis ? direct_light_mis(s, base, !last) : direct_light(s, base));
+                if (u_env_nee)
+                    radiance += T * environment_light(s, base, !last);
                 if (last)
                     break;
                 seek(base + SLOT_LOBE);
@@ -1089,7 +1262,7 @@ const char *const rl_gl_pt_glsl_path = GLSL(
                 T *= w;
                 diffuse_ray = true;
                 after_brdf = true;
-                prev_pdf = u_mis ? phong_pdf(s, dir) : 0.0;
+                prev_pdf = u_mis || u_env_nee ? phong_pdf(s, dir) : 0.0;
             }
             prev = s.p;
 
@@ -1118,12 +1291,13 @@ const char *const rl_gl_pt_glsl_path = GLSL(
                 /* the stored direct light ends the path (Sec. 7.4) */
                 vec3 col;
                 float t;
-                radiance += T * (rl_ls_preillum(o, dir, max(0.0, u_ls_start), INF, col, t) ? col : u_background);
+                radiance += T * (rl_ls_preillum(o, dir, max(0.0, u_ls_start), INF, col, t) ? col
+                                                                                  : escaped(dir, after_brdf, prev_pdf));
                 break;
             }
             Surf next;
             if (!closest(structure, o, dir, next)) {
-                radiance += T * u_background;
+                radiance += T * escaped(dir, after_brdf, prev_pdf);
                 break;
             }
             s = next;
@@ -1144,15 +1318,18 @@ const char *const rl_gl_pt_glsl_path = GLSL(
         g_state = imageLoad(u_rng_state, px);
         g_index = held;
         g_slot = 0u;
-        vec3 L = u_background;
+        /* the pixel-centre ray: primary=raster's, and the one whose
+         * environment radiance pt's uniform passes give a pixel whose
+         * camera ray leaves the scene (pathtrace.c path_tile) */
+        float cx = (2.0 * (float(px.x) + 0.5) / float(u_size.x) - 1.0) * u_tan_half_fov * u_aspect;
+        float cy = (1.0 - 2.0 * (float(px.y) + 0.5) / float(u_size.y)) * u_tan_half_fov;
+        vec3 centre = normalize(u_cam_u * cx + u_cam_v * cy - u_cam_w);
+        vec3 L = u_env ? env_radiance(centre) : u_background;
         if (u_raster) {
             /* the G-buffer's pixel centre: no jitter, no number drawn */
             uint tri = texelFetch(u_ids, px, 0).x;
-            float sx = (2.0 * (float(px.x) + 0.5) / float(u_size.x) - 1.0) * u_tan_half_fov * u_aspect;
-            float sy = (1.0 - 2.0 * (float(px.y) + 0.5) / float(u_size.y)) * u_tan_half_fov;
-            vec3 dir = normalize(u_cam_u * sx + u_cam_v * sy - u_cam_w);
             Surf first;
-            if (tri < uint(triangles.length()) && surface_of_pixel(tri, u_eye, dir, first))
+            if (tri < uint(triangles.length()) && surface_of_pixel(tri, u_eye, centre, first))
                 L = trace_path(first);
         } else {
             seek(SLOT_PIXEL);

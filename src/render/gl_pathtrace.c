@@ -16,8 +16,8 @@
  * Options: pt's names and defaults where ported (spp, max_depth, rr,
  * rr_depth, rng, mis, seed, shadow, diffuse, specular, primary,
  * checkerboard, accumulate, filter, filter_fade, atrous_*, grid_res, ls_n,
- * ls_k, ls_dynamic, ls_origin, light_samples, background, threads,
- * shadowmap_size), device (rl_gl.h) and ls_build. Values pt has and gl-pt
+ * ls_k, ls_dynamic, ls_origin, light_samples, background, env_sampling,
+ * threads, shadowmap_size), device (rl_gl.h) and ls_build. Values pt has and gl-pt
  * has not ported are refused with an option error naming what is ported:
  * shadow=embree, diffuse=embree; pt's ls_file and adaptive* are not in the
  * table.
@@ -45,6 +45,14 @@
  * Line Space pt builds (pathtrace_backend.c, the same rl_linespace and
  * voxel offsets), uploaded to the GPU (gl_linespace.h); ls_build=gpu builds
  * the candidate lists on the GPU instead, from pt's CPU grid.
+ *
+ * The scene's environment (issue 37): the distribution pt builds for it
+ * (rl_pt_env_build, pathtrace_env.c; by radiance, or with
+ * env_sampling=uniform by solid angle) and the map's radiance go to the
+ * tracer as plain arrays (rl_gl_pt_set_environment); the shader looks it up
+ * and samples it as pt does, at pt's slot with pt's MIS weights. Schlick's
+ * Fresnel on mirrors and dielectrics is the shader's too (pt's
+ * rl_pt_specular_event); GGX materials are refused (gl_pt_check_scene).
  *
  * Depth and ID layers, where the image has them, come from that G-buffer,
  * as pt writes them. */
@@ -116,7 +124,11 @@ static const rl_option_info gl_pt_options[] = {
     { "light_samples", RL_OPT_INT, "1", "shadow rays per quad light and vertex", 1, 1024, NULL },
     { "shadowmap_size", RL_OPT_INT, "1024", "texels per shadow-map face side (Sec. 8.6)", 16, 16384, NULL },
     { "background", RL_OPT_COLOR, "0,0,0",
-      "radiance arriving from every direction where a ray leaves the scene (a uniform environment)", 0, 0, NULL },
+      "radiance arriving from every direction where a ray leaves the scene (a uniform environment); a scene "
+      "\"environment\" replaces it", 0, 0, NULL },
+    { "env_sampling", RL_OPT_ENUM, "importance",
+      "light samples of a scene environment (issue 37): importance (by its radiance x sin(theta)), uniform "
+      "(by solid angle) or bsdf (none: BSDF rays alone find it)", 0, 0, rl_pt_env_sampling_choices },
     { "threads", RL_OPT_INT, "0", "CPU threads of the structure builds (0 = all)", 0, 1024, NULL },
     { "device", RL_OPT_STRING, "",
       "EGL device: auto, surfaceless or a device number; empty: $RL_EGL_DEVICE, else auto", 0, 0, NULL },
@@ -128,6 +140,8 @@ typedef struct gl_pt_state {
     rl_gl_pt *gpu;
     uint64_t gpu_scene;           /* the scene uid the GPU tracer holds */
     char ls_key[160];             /* what the tracer's Line Space was made from; "" none */
+    bool env_set;                 /* the tracer holds b.env (for the scene it was made for) */
+    bool env_uniform;             /* which distribution it holds */
     char device[64];
     char info[528];
     /* the accumulation and what it depends on */
@@ -191,6 +205,7 @@ static rl_status ensure_gpu(gl_pt_state *s, const rl_scene *scene, const char *d
     s->gpu = NULL;
     s->valid = false;
     s->ls_key[0] = '\0';
+    s->env_set = false;
     if (strlen(device) >= sizeof s->device)
         return rl_error(RL_ERR_INVALID_ARG, "gl-pt: device \"%.40s...\" is too long", device);
     const pt_lights *l = &s->b.lights;
@@ -301,18 +316,57 @@ static uint32_t *seed_states(int rng, uint64_t seed, size_t n)
     return st;
 }
 
-/* Issue 37's materials and environment live in pt's C code only: refuse
- * them by name rather than render them as Phong on black. */
+/* The scene's environment in the tracer: pt's distribution for
+ * env_sampling (importance or uniform; bsdf samples none but keeps the
+ * importance one for nothing, as pt) and the radiance of every map texel,
+ * rl_environment_radiance's product colour x texel, computed here in C so
+ * that the shader's lookup returns pt's values exactly. Uploaded again only
+ * when the tracer or the distribution changes. */
+static rl_status ensure_environment(gl_pt_state *s, const rl_scene_data *d, bool uniform)
+{
+    const rl_environment *env = d->environment;
+    if (!env)
+        return RL_OK;
+    rl_status st;
+    if (s->b.env.uniform != uniform && (st = rl_pt_env_build(&s->b.env, env, uniform)) != RL_OK)
+        return st;
+    if (s->env_set && s->env_uniform == uniform)
+        return RL_OK;
+    const rl_texture *m = env->map;
+    const int mw = m ? m->width : 1, mh = m ? m->height : 1;
+    float *rad = rl_calloc((size_t)mw * (size_t)mh, 3 * sizeof *rad);
+    if (!rad)
+        return RL_ERR_OUT_OF_MEMORY;
+    for (size_t i = 0; i < (size_t)mw * (size_t)mh; ++i) {
+        rl_vec3 c = m ? rl_mul(env->radiance, rl_v3(m->texels[i].x, m->texels[i].y, m->texels[i].z)) : env->radiance;
+        rad[3 * i] = c.x;
+        rad[3 * i + 1] = c.y;
+        rad[3 * i + 2] = c.z;
+    }
+    const pt_env *e = &s->b.env;
+    const rl_gl_pt_env ge = { .radiance = rad, .map_width = mw, .map_height = mh,
+                              .rotation = rl_radians(env->rotation_deg), .width = e->width, .height = e->height,
+                              .weight = e->weight, .conditional = e->conditional, .marginal = e->marginal,
+                              .sum = e->sampled ? e->sum : 0.0 };   /* an overflowing map: not sampled, as pt */
+    st = rl_gl_pt_set_environment(s->gpu, &ge);
+    free(rad);
+    if (st != RL_OK)
+        return st;
+    s->env_set = true;
+    s->env_uniform = uniform;
+    return RL_OK;
+}
+
+/* Issue 37's GGX BRDF lives in pt's C code only: refuse it by name rather
+ * than render it as Phong (Schlick's Fresnel is ported). */
 static rl_status gl_pt_check_scene(const rl_scene *scene, const rl_scene_data *d)
 {
-    if (d->environment)
-        return rl_error(RL_ERR_UNSUPPORTED, "gl-pt: scene \"%s\" has an environment, not ported to GL yet (use pt)",
-                        rl_scene_name(scene));
+    (void)scene;
     for (uint32_t i = 0; i < d->num_materials; ++i) {
         const rl_material *m = &d->materials[i];
-        if (m->bsdf != RL_BSDF_PHONG || m->fresnel != RL_FRESNEL_NONE)
-            return rl_error(RL_ERR_UNSUPPORTED, "gl-pt: material '%s' uses %s, not ported to GL yet (use pt)", m->name,
-                            m->bsdf != RL_BSDF_PHONG ? "GGX" : "Schlick Fresnel");
+        if (m->bsdf != RL_BSDF_PHONG)
+            return rl_error(RL_ERR_UNSUPPORTED, "gl-pt: material '%s' uses GGX, not ported to GL yet (use pt)",
+                            m->name);
     }
     return RL_OK;
 }
@@ -452,6 +506,9 @@ static rl_status gl_pt_render(rl_renderer *r, void *state, const rl_scene *scene
     stats->prep_ms = rl_timer_ms(&prep);
     if (st == RL_OK)
         st = ensure_gpu(s, scene, rl_renderer_opt_string(r, "device"), threads, stats);
+    const int env_sampling = (int)rl_renderer_opt_enum(r, "env_sampling");
+    if (st == RL_OK)
+        st = ensure_environment(s, d, env_sampling == PT_ENV_UNIFORM);
     if (st != RL_OK)
         return st;
 
@@ -537,6 +594,9 @@ static rl_status gl_pt_render(rl_renderer *r, void *state, const rl_scene *scene
         .ls_offset = s->b.ls_offset,
         .grid_res = (int)rl_renderer_opt_int(r, "grid_res"),
         .background = rl_renderer_opt_color(r, "background"),
+        /* pathtrace.c: env_nee */
+        .env_nee = d->environment && s->b.env.sampled && env_sampling != PT_ENV_BSDF &&
+                   shadow != RL_PT_BACKEND_SHADOWMAP,
         .reset_states = states,
     };
     const bool raster = rl_renderer_opt_enum(r, "primary") == 1;

@@ -139,7 +139,8 @@
 /* Order: sobol, then rl_rng_gpu_kind. */
 const char *const rl_pt_rng_choices[] = { "sobol", "lcg", "tausworthe", "hybrid", NULL };
 const char *const rl_pt_mis_choices[] = { "off", "on", NULL };
-static const char *const env_sampling_choices[] = { "importance", "uniform", "bsdf", NULL };
+/* Order = pt_env_sampling. */
+const char *const rl_pt_env_sampling_choices[] = { "importance", "uniform", "bsdf", NULL };
 static const char *const quad_sampling_choices[] = { "area", "solid_angle", NULL };
 /* Order = rl_pt_backend. */
 const char *const rl_pt_shadow_choices[] = { "bvh", "grid", "embree", "ls-candidates", "ls-preillum", "ls-pnmt",
@@ -228,7 +229,7 @@ static const rl_option_info pt_options[] = {
     { "env_sampling", RL_OPT_ENUM, "importance",
       "light samples of a scene environment (issue 37): importance (by its radiance x sin(theta)), uniform "
       "(over the sphere) or bsdf (none: escaping BSDF rays only); MIS with the BSDF either way", 0, 0,
-      env_sampling_choices },
+      rl_pt_env_sampling_choices },
     { "ggx_ms", RL_OPT_BOOL, "true",
       "GGX energy compensation (Kulla & Conty 2017): the light single scattering loses returns as a "
       "diffuse-like lobe; false: single scattering alone", 0, 0, NULL },

@@ -85,7 +85,7 @@ extern const char *const rl_pt_filter_choices[];
 /* The other choice lists gl-pt shares with pt (orders: pathtrace.c). */
 extern const char *const rl_pt_rng_choices[], *const rl_pt_mis_choices[], *const rl_pt_shadow_choices[],
     *const rl_pt_diffuse_choices[], *const rl_pt_specular_choices[], *const rl_pt_primary_choices[],
-    *const rl_pt_ls_origin_choices[];
+    *const rl_pt_ls_origin_choices[], *const rl_pt_env_sampling_choices[];
 #define RL_PT_FILTER_PARAM_OPTIONS                                                                                 \
     { "filter_fade", RL_OPT_FLOAT, "16",                                                                           \
       "filter weight 1/(1 + spp/filter_fade) with spp the samples so far; 0 = never fade", 0, 1e9, NULL },         \

@@ -2,7 +2,8 @@
 # test_cli_materials.sh: issue 37's materials and environment on the command
 # line: the example scene renders with pt, bdpt (both lit by its sky, with
 # and without GGX energy compensation) and whitted (which shows the sky),
-# gl-pt refuses what it does not support with one error line naming it,
+# gl-pt refuses GGX with one error line naming the material and renders
+# the sky and Schlick's Fresnel (the scene with its GGX spheres made Phong),
 # and a scene whose environment file is missing or not an image fails with
 # the file's name and position.
 # Run as: bash test_cli_materials.sh <rl-binary> <scratch-dir>
@@ -23,8 +24,21 @@ run_ok "$RL" render "$SCENE" --algo bdpt --size 16x9 --spp 1 --out "$TMP/bdpt.ex
 run_ok "$RL" render "$SCENE" --algo pt --set pt.ggx_ms=false --size 16x9 --spp 1 --out "$TMP/single.exr"
 expect_usage_error "$RL" render "$SCENE" --algo bdpt --set bdpt.ggx_ms=maybe --size 16x9 --out "$TMP/none.png"
 if ! grep -A3 '^gl-pt: ' <("$RL" algos) | grep -q "unavailable:"; then
-    expect_error 1 "gl-pt: scene .*has an environment, not ported to GL yet" \
+    expect_error 1 "gl-pt: material 'gold-10' uses GGX, not ported to GL yet" \
         "$RL" render "$SCENE" --algo gl-pt --size 16x9 --spp 1 --out "$TMP/none.png"
+    SKY="$(cd "$(dirname "$SCENE")" && pwd)/sky.hdr"
+    cat > "$TMP/phong.json" <<JSON
+{ "environment": { "file": "$SKY", "rotation_deg": 30 },
+  "materials": { "glass": { "diffuse": 0, "transmissivity": 1, "ior": 1.5, "fresnel": "schlick" },
+                 "chrome": { "diffuse": 0, "specular": [0.55, 0.56, 0.55], "reflectivity": 1, "fresnel": "schlick" } },
+  "objects": [ { "generator": "sphere", "material": "glass" },
+               { "generator": "sphere", "material": "chrome", "transform": { "translate": [2.2, 0, 0] } } ] }
+JSON
+    run_ok "$RL" render "$TMP/phong.json" --algo gl-pt --set gl-pt.env_sampling=uniform --size 16x9 --spp 1 \
+        --out "$TMP/gl.exr"
+    [ -s "$TMP/gl.exr" ] || fail "gl-pt wrote no image"
+    expect_usage_error "$RL" render "$TMP/phong.json" --algo gl-pt --set gl-pt.env_sampling=cosine --size 16x9 \
+        --out "$TMP/none.png"
     cat > "$TMP/ggx.json" <<'JSON'
 { "materials": { "rough": { "bsdf": "ggx", "roughness": 0.5 } },
   "objects": [ { "generator": "sphere", "material": "rough" } ],

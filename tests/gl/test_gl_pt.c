@@ -9,9 +9,12 @@
  * BVH finds, ray for ray; primary=raster (a GL raster pass) and
  * checkerboard trace pt's paths and pixels, the shader's ray counters give
  * pt's counts, the filters are pt's on gl-pt's image, and the GL-drawn
- * shadow maps give pt's shadow-map pixels; options gl-pt
- * has not ported are refused, and a device that cannot be opened makes it
- * unavailable. Small images on llvmpipe; without a GL 4.5 context the GL
+ * shadow maps give pt's shadow-map pixels; a scene environment (constant
+ * or a map, issue 37) gives pt's means with every env_sampling, pt's pixels
+ * with pt's numbers, and pt's radiance exactly where camera rays leave the
+ * scene; Schlick's Fresnel on glass and chrome gives pt's pixels too;
+ * options and GGX materials gl-pt has not ported are refused, and a
+ * device that cannot be opened makes it unavailable. Small images on llvmpipe; without a GL 4.5 context the GL
  * cases skip. */
 #include <math.h>
 #include <setjmp.h>
@@ -750,6 +753,303 @@ static void test_gl_pt_shadow_maps_are_pts(void **state)
     rl_scene_release(s);
 }
 
+/* ------------------------------------------------ environment (issue 37) */
+
+#define ENV_W 16
+#define ENV_H 8
+#define ENV_SIZE 32
+
+/* A small sky as an EXR under RL_TEST_TMP (a scene takes a map by path):
+ * a gradient above the horizon, a bright sun block, a dark ground and one
+ * black column, as pt's own tests (test_pathtrace_env.c). */
+static void write_sky(char *path, size_t n)
+{
+    rl_image *sky = NULL;
+    assert_int_equal(rl_image_create(ENV_W, ENV_H, RL_LAYER_COLOR, &sky), RL_OK);
+    for (int y = 0; y < ENV_H; ++y)
+        for (int x = 0; x < ENV_W; ++x) {
+            float v = ((float)y + 0.5f) / ENV_H;
+            rl_vec3 c = y < ENV_H / 2 ? rl_v3(0.3f + v, 0.5f + v, 1.0f) : rl_v3(0.2f, 0.15f, 0.1f);
+            if (x >= 10 && x < 12 && y >= 1 && y < 3)
+                c = rl_v3(30.0f, 25.0f, 20.0f);
+            if (x == 3)
+                c = rl_v3s(0.0f);
+            sky->color[y * ENV_W + x] = rl_v4(c.x, c.y, c.z, 1.0f);
+        }
+    const char *base = getenv("RL_TEST_TMP");
+    snprintf(path, n, "%s/gl_pt_sky.exr", base && base[0] ? base : ".");
+    assert_int_equal(rl_image_write_exr(sky, path), RL_OK);
+    rl_image_release(sky);
+}
+
+/* A diffuse sphere (albedo by channel) under an environment: constant L
+ * (path NULL; a white furnace whose sphere pixels are albedo x L at any
+ * depth, a convex body never seeing itself) or the sky map rotated by 40
+ * degrees over a grey floor. The camera sees sky beside the sphere. With
+ * fresnel the sphere is glass and a chrome sphere stands beside it, both
+ * with Schlick's Fresnel (issue 37). */
+static rl_scene *sky_scene(const char *path, bool fresnel, rl_camera *cam)
+{
+    rl_scene *s = NULL;
+    assert_int_equal(rl_scene_create(&s), RL_OK);
+    rl_material ball = rl_material_default(), floor = rl_material_default();
+    ball.diffuse = rl_v3(0.8f, 0.5f, 0.3f);
+    floor.diffuse = rl_v3s(0.5f);
+    uint32_t mb, mf, mesh, node;
+    if (fresnel) {
+        ball.diffuse = rl_v3s(0.0f);
+        ball.transmissivity = 1.0f;
+        ball.ior = 1.5f;
+        ball.fresnel = RL_FRESNEL_SCHLICK;
+        rl_material chrome = rl_material_default();
+        chrome.diffuse = rl_v3s(0.0f);
+        chrome.specular = rl_v3(0.55f, 0.56f, 0.55f);
+        chrome.reflectivity = 1.0f;
+        chrome.fresnel = RL_FRESNEL_SCHLICK;
+        uint32_t mc;
+        assert_int_equal(rl_scene_add_material(s, &chrome, &mc), RL_OK);
+        assert_int_equal(rl_scene_add_generated(s, "sphere", "segments=24,rings=12", mc, &mesh), RL_OK);
+        rl_mat4 right = rl_mat4_translate(rl_v3(2.1f, -0.3f, -0.5f));
+        assert_int_equal(rl_scene_add_node(s, RL_NODE_ROOT, "chrome", &right, &node), RL_OK);
+        assert_int_equal(rl_scene_node_set_mesh(s, node, mesh), RL_OK);
+    }
+    assert_int_equal(rl_scene_add_material(s, &ball, &mb), RL_OK);
+    assert_int_equal(rl_scene_add_generated(s, "sphere", "segments=24,rings=12", mb, &mesh), RL_OK);
+    assert_int_equal(rl_scene_add_node(s, RL_NODE_ROOT, "ball", NULL, &node), RL_OK);
+    assert_int_equal(rl_scene_node_set_mesh(s, node, mesh), RL_OK);
+    if (path) {
+        assert_int_equal(rl_scene_add_material(s, &floor, &mf), RL_OK);
+        assert_int_equal(rl_scene_add_generated(s, "quad", "sx=8,sz=8", mf, &mesh), RL_OK);
+        rl_mat4 down = rl_mat4_translate(rl_v3(0.0f, -1.0f, 0.0f));
+        assert_int_equal(rl_scene_add_node(s, RL_NODE_ROOT, "floor", &down, &node), RL_OK);
+        assert_int_equal(rl_scene_node_set_mesh(s, node, mesh), RL_OK);
+    }
+    const rl_environment_desc env = { .path = path, .color = path ? rl_v3s(1.0f) : rl_v3(1.0f, 0.9f, 0.7f),
+                                      .rotation_deg = path ? 40.0f : 0.0f };
+    assert_int_equal(rl_scene_set_environment(s, &env), RL_OK);
+    assert_int_equal(rl_scene_commit(s), RL_OK);
+    *cam = (rl_camera){ .eye = rl_v3(0.6f, 0.8f, 4.0f), .target = rl_v3(0.6f, 0.0f, 0.0f), .up = rl_v3(0, 1, 0),
+                        .fov_deg = 50.0f, .width = ENV_SIZE, .height = ENV_SIZE };
+    return s;
+}
+
+/* gl-pt against pt under both environments, with each env_sampling (mis
+ * on, and mis=off with BSDF rays alone finding the sky): the means agree
+ * within 3 sigma. Then with pt's numbers (rng=hybrid) the pixels are pt's:
+ * the environment's sample at pt's slot, pt's CDFs, pt's MIS weights. */
+static void test_gl_pt_environment_is_pts(void **state)
+{
+    (void)state;
+    NEED_GL();
+    char path[1024];
+    write_sky(path, sizeof path);
+    static const struct {
+        bool map, fresnel;
+        const char *sampling, *mis;
+    } cases[] = {
+        { false, false, "importance", "on" },
+        { true, false, "importance", "on" },
+        { true, false, "uniform", "on" },
+        { true, false, "bsdf", "off" },
+        { true, true, "importance", "on" },
+    };
+    for (size_t k = 0; k < sizeof cases / sizeof cases[0]; ++k) {
+        rl_camera cam;
+        rl_scene *s = sky_scene(cases[k].map ? path : NULL, cases[k].fresnel, &cam);
+        rl_image *ref = render("pt", s, &cam,
+                               (const char *const[]){ "spp", REF_SPP, "env_sampling", cases[k].sampling, "mis",
+                                                      cases[k].mis, "seed", "3", NULL });
+        rl_image *gl = render("gl-pt", s, &cam,
+                              (const char *const[]){ "spp", "64", "env_sampling", cases[k].sampling, "mis",
+                                                     cases[k].mis, NULL });
+        char what[96];
+        snprintf(what, sizeof what, "%s environment%s, env_sampling=%s mis=%s 64 spp",
+                 cases[k].map ? "map" : "constant", cases[k].fresnel ? ", Schlick glass and chrome" : "",
+                 cases[k].sampling, cases[k].mis);
+        assert_means_agree(what, gl, ref);
+        rl_image_release(gl);
+        rl_image_release(ref);
+        /* pt's numbers: pt's pixels */
+        rl_image *cpu = render("pt", s, &cam, (const char *const[]){ "spp", "4", "rng", "hybrid", "seed", "5",
+                                                                    "env_sampling", cases[k].sampling, "mis",
+                                                                    cases[k].mis, NULL });
+        gl = render("gl-pt", s, &cam, (const char *const[]){ "spp", "4", "rng", "hybrid", "seed", "5",
+                                                            "env_sampling", cases[k].sampling, "mis", cases[k].mis,
+                                                            NULL });
+        const size_t n = (size_t)cam.width * (size_t)cam.height;
+        double equal = share_equal(gl, cpu, n);
+        print_message("%s, rng=hybrid 4 spp: pixels equal to pt's to 1e-3: %.1f %%\n", what, 100.0 * equal);
+        assert_true(equal >= 0.99);
+        rl_image_release(gl);
+        rl_image_release(cpu);
+        rl_scene_release(s);
+    }
+    remove(path);
+}
+
+/* Whether the camera ray of pixel (x, y) leaves the scene: its centre's
+ * (the ID layer is the G-buffer's, traced at the centres) and, with
+ * jittered rays (primary=trace), its 8 neighbours' too, so that no jitter
+ * within the pixel meets the sphere or the floor. */
+static bool sky_around(const rl_image *img, int w, int h, int x, int y, bool centre_only)
+{
+    for (int dy = -1; dy <= 1; ++dy)
+        for (int dx = -1; dx <= 1; ++dx) {
+            int nx = x + dx, ny = y + dy;
+            if ((centre_only && (dx || dy)) || nx < 0 || ny < 0 || nx >= w || ny >= h)
+                continue;
+            if (img->triangle_id[(size_t)ny * w + nx] != RL_ID_NONE)
+                return false;
+        }
+    return true;
+}
+
+/* Whether pixel (x, y) and its 8 neighbours all lie on a surface. */
+static bool whole_ball(const rl_image *img, int w, int h, int x, int y)
+{
+    for (int dy = -1; dy <= 1; ++dy)
+        for (int dx = -1; dx <= 1; ++dx) {
+            int nx = x + dx, ny = y + dy;
+            if (nx < 0 || ny < 0 || nx >= w || ny >= h || img->triangle_id[(size_t)ny * w + nx] == RL_ID_NONE)
+                return false;
+        }
+    return true;
+}
+
+/* The white furnace: under a constant environment L the sphere's pixels
+ * converge to albedo x L and the sky's are L. */
+static void test_gl_pt_constant_environment_furnace(void **state)
+{
+    (void)state;
+    NEED_GL();
+    rl_camera cam;
+    rl_scene *s = sky_scene(NULL, false, &cam);
+    rl_renderer *r = fx_make("gl-pt", (const char *const[]){ "spp", "64", "max_depth", "4", NULL });
+    rl_image *img = fx_render_with(r, s, &cam, RL_LAYER_COLOR | RL_LAYER_ID, NULL);
+    const rl_vec3 L = rl_v3(1.0f, 0.9f, 0.7f), albedo = rl_v3(0.8f, 0.5f, 0.3f);
+    double sum[3] = { 0, 0, 0 };
+    size_t ball = 0, sky = 0;
+    /* pixels wholly on the sphere or wholly sky; the edge mixes both */
+    for (size_t i = 0; i < (size_t)cam.width * cam.height; ++i) {
+        const float *c = &img->color[i].x;
+        if (sky_around(img, cam.width, cam.height, (int)(i % (size_t)cam.width), (int)(i / (size_t)cam.width),
+                       false)) {
+            /* eq. 8's float running mean may round in the last bits */
+            for (int k = 0; k < 3; ++k)
+                assert_true(fabs(c[k] - (&L.x)[k]) <= 1e-5 * (&L.x)[k]);
+            ++sky;
+            continue;
+        }
+        if (!whole_ball(img, cam.width, cam.height, (int)(i % (size_t)cam.width), (int)(i / (size_t)cam.width)))
+            continue;
+        for (int k = 0; k < 3; ++k)
+            sum[k] += c[k];
+        ++ball;
+    }
+    assert_true(sky > 50 && ball > 50);
+    for (int k = 0; k < 3; ++k) {
+        double mean = sum[k] / (double)ball, want = (double)(&albedo.x)[k] * (&L.x)[k];
+        print_message("furnace channel %d: sphere mean %.5f, albedo x L %.5f\n", k, mean, want);
+        assert_true(fabs(mean - want) < 0.01 * want);
+    }
+    rl_image_release(img);
+    rl_renderer_release(r);
+    rl_scene_release(s);
+}
+
+/* Camera rays that leave the scene see the map's radiance exactly, in the
+ * direction pt looks it up (the pixel centre, pathtrace.c path_tile):
+ * rl_environment_radiance's value, bit for bit, in every pixel whose
+ * direction is not within 1e-3 texel of a texel edge (there the GPU's acos
+ * and atan may round to the neighbour). One sample: no accumulation
+ * rounding. With primary=trace a pixel whose jittered ray meets a surface
+ * shows the path (as pt's): only pixels with sky all around count. */
+static void test_gl_pt_environment_seen_directly_is_exact(void **state)
+{
+    (void)state;
+    NEED_GL();
+    char path[1024];
+    write_sky(path, sizeof path);
+    rl_camera cam;
+    rl_scene *s = sky_scene(path, false, &cam);
+    const rl_environment *env = rl_scene_get_data(s)->environment;
+    assert_non_null(env);
+    for (int raster = 0; raster < 2; ++raster) {
+        rl_renderer *r = fx_make("gl-pt", (const char *const[]){ "spp", "1", "primary", raster ? "raster" : "trace",
+                                                                 NULL });
+        rl_image *img = fx_render_with(r, s, &cam, RL_LAYER_COLOR | RL_LAYER_ID, NULL);
+        const rl_camera_frame f = rl_camera_frame_make(&cam);
+        size_t sky = 0, exact = 0, edge = 0;
+        for (int y = 0; y < cam.height; ++y)
+            for (int x = 0; x < cam.width; ++x) {
+                size_t i = (size_t)y * cam.width + x;
+                if (!sky_around(img, cam.width, cam.height, x, y, raster))
+                    continue;
+                ++sky;
+                rl_vec3 d = rl_camera_frame_ray(&f, (float)x + 0.5f, (float)y + 0.5f).d;
+                rl_vec3 want = rl_environment_radiance(env, d);
+                rl_vec2 uv = rl_environment_uv(env, d);
+                double fu = uv.x * ENV_W - floor(uv.x * ENV_W), fv = uv.y * ENV_H - floor(uv.y * ENV_H);
+                bool near_edge = fu < 1e-3 || fu > 1.0 - 1e-3 || fv < 1e-3 || fv > 1.0 - 1e-3;
+                const rl_vec4 c = img->color[i];
+                if (c.x == want.x && c.y == want.y && c.z == want.z)
+                    ++exact;
+                else
+                    assert_true(near_edge);
+                edge += near_edge;
+            }
+        print_message("primary=%s: %zu sky pixels, %zu exact, %zu near a texel edge\n", raster ? "raster" : "trace",
+                      sky, exact, edge);
+        assert_true(sky > 100);
+        rl_image_release(img);
+        rl_renderer_release(r);
+    }
+    rl_scene_release(s);
+    remove(path);
+}
+
+/* GGX is pt's alone: refused by name; Schlick's Fresnel renders. */
+static void test_gl_pt_refuses_ggx(void **state)
+{
+    (void)state;
+    NEED_GL();
+    for (int k = 0; k < 2; ++k) {
+        rl_scene *s = NULL;
+        assert_int_equal(rl_scene_create(&s), RL_OK);
+        rl_material m = rl_material_default();
+        snprintf(m.name, sizeof m.name, "%s", k ? "chrome" : "gold");
+        if (k) {
+            m.reflectivity = 1.0f;
+            m.fresnel = RL_FRESNEL_SCHLICK;
+        } else {
+            m.bsdf = RL_BSDF_GGX;
+            m.roughness = 0.3f;
+        }
+        uint32_t mat, mesh, node;
+        assert_int_equal(rl_scene_add_material(s, &m, &mat), RL_OK);
+        assert_int_equal(rl_scene_add_generated(s, "sphere", "segments=8,rings=4", mat, &mesh), RL_OK);
+        assert_int_equal(rl_scene_add_node(s, RL_NODE_ROOT, "ball", NULL, &node), RL_OK);
+        assert_int_equal(rl_scene_node_set_mesh(s, node, mesh), RL_OK);
+        assert_int_equal(rl_scene_commit(s), RL_OK);
+        rl_camera cam = { .eye = rl_v3(0, 0, 4), .target = rl_v3(0, 0, 0), .up = rl_v3(0, 1, 0), .fov_deg = 45.0f,
+                          .width = 8, .height = 8 };
+        rl_renderer *r = fx_make("gl-pt", NULL);
+        rl_image *img = NULL;
+        assert_int_equal(rl_image_create(8, 8, RL_LAYER_COLOR, &img), RL_OK);
+        rl_clear_error();
+        if (k) {
+            assert_int_equal(rl_renderer_render(r, s, &cam, img, NULL), RL_OK);
+        } else {
+            assert_int_equal(rl_renderer_render(r, s, &cam, img, NULL), RL_ERR_UNSUPPORTED);
+            print_message("%s: %s\n", m.name, rl_last_error());
+            assert_non_null(strstr(rl_last_error(), "GGX"));
+        }
+        rl_image_release(img);
+        rl_renderer_release(r);
+        rl_scene_release(s);
+    }
+}
+
 static void expect_refused(rl_renderer *r, const char *key, const char *value, const char *says)
 {
     rl_clear_error();
@@ -768,6 +1068,8 @@ static void test_gl_pt_refuses_what_is_not_ported(void **state)
     expect_refused(r, "ls_k", "3", "even");
     expect_refused(r, "ls_build", "cuda", "ls_build");
     expect_refused(r, "shadow", "octree", "shadow");
+    expect_refused(r, "env_sampling", "cosine", "env_sampling");
+    assert_int_equal(rl_renderer_set(r, "env_sampling", "uniform"), RL_OK);
     assert_int_equal(rl_renderer_set(r, "shadow", "shadowmap"), RL_OK);
     assert_int_equal(rl_renderer_set(r, "shadowmap_size", "512"), RL_OK);
     expect_refused(r, "shadowmap_size", "8", "shadowmap_size");
@@ -816,6 +1118,10 @@ int main(void)
         cmocka_unit_test(test_gl_pt_ray_counts_match_pts),
         cmocka_unit_test(test_gl_pt_filters_are_pts),
         cmocka_unit_test(test_gl_pt_shadow_maps_are_pts),
+        cmocka_unit_test(test_gl_pt_environment_is_pts),
+        cmocka_unit_test(test_gl_pt_constant_environment_furnace),
+        cmocka_unit_test(test_gl_pt_environment_seen_directly_is_exact),
+        cmocka_unit_test(test_gl_pt_refuses_ggx),
         cmocka_unit_test(test_gl_pt_refuses_what_is_not_ported),
         cmocka_unit_test(test_gl_pt_unopenable_device_is_reported_unavailable),
     };
