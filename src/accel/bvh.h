@@ -219,6 +219,21 @@ static inline int rl_bvh_box_n(const rl_bvh_wide_node *n, const rl_bvh_ray_pre *
 #endif
 }
 
+/* Index of the lowest set bit of m != 0 (a hit child, a packet lane). */
+static inline int rl_bvh_lowest_bit(unsigned m)
+{
+#if defined(__GNUC__)
+    return __builtin_ctz(m);
+#else
+    int i = 0;
+    while (!(m & 1u)) {
+        m >>= 1;
+        ++i;
+    }
+    return i;
+#endif
+}
+
 /* nextafterf(t, INFINITY) for a finite t, without the libm call. */
 static inline float rl_bvh_next_up(float t)
 {

@@ -102,20 +102,6 @@ static inline int popcount8(unsigned m)
 #endif
 }
 
-static inline int lowest(unsigned m)
-{
-#if defined(__GNUC__)
-    return __builtin_ctz(m);
-#else
-    int i = 0;
-    while (!(m & 1u)) {
-        m >>= 1;
-        ++i;
-    }
-    return i;
-#endif
-}
-
 /* The lanes' constants in SIMD layout. Divisions are IEEE exact whether
  * vector or scalar, so inv, sx, sy, sz equal rl_bvh_ray_pre_setup's and
  * rl_ray_watertight_setup's bit for bit. */
@@ -186,7 +172,7 @@ static void packet_setup(packet *p, const rl_ray *rays, unsigned active)
         p->o_lo[a] = p->inv_lo[a] = INFINITY;
         p->o_hi[a] = p->inv_hi[a] = -INFINITY;
         for (unsigned m = active; m; m &= m - 1) {
-            int l = lowest(m);
+            int l = rl_bvh_lowest_bit(m);
             float o = p->o[a][l], inv = p->inv[a][l];
             if (!isfinite(inv))
                 p->frustum = false;
@@ -303,6 +289,23 @@ static inline rl_vec3 vertex_of(const rl_bvh_block *b, int k, int j)
     return (rl_vec3){ b->p[k][0][j], b->p[k][1][j], b->p[k][2][j] };
 }
 
+/* The lanes of fallback that tri_lanes left to the single-ray test:
+ * triangle j of block b against each of them up to t_max[lane]; returns
+ * those that hit, with th, u, v filled. */
+static inline unsigned fallback_lanes(packet *p, const rl_bvh_block *b, int j, unsigned fallback,
+                                      const float *t_max, float *th, float *u, float *v)
+{
+    unsigned hit = 0;
+    for (unsigned m = fallback; m; m &= m - 1) {
+        int l = rl_bvh_lowest_bit(m);
+        lane_ready(p, l);
+        if (rl_watertight_hit(&p->w[l], vertex_of(b, 0, j), vertex_of(b, 1, j), vertex_of(b, 2, j), p->t_min[l],
+                              t_max[l], &th[l], &u[l], &v[l]))
+            hit |= 1u << l;
+    }
+    return hit;
+}
+
 /* Closest hits of a leaf for the lanes of mask (all in same_k), one
  * triangle against all lanes at a time; the tie rule as leaf_closest_k. */
 static void leaf_packet_closest(const rl_bvh *bvh, uint32_t ref, uint32_t count, packet *p, unsigned mask,
@@ -315,15 +318,9 @@ static void leaf_packet_closest(const rl_bvh *bvh, uint32_t ref, uint32_t count,
         unsigned fallback;
         tri_of(b, j, p, P);
         unsigned hit = tri_lanes(p, P[0], P[1], P[2], mask, p->t_test, th, u, v, &fallback);
-        for (unsigned m = fallback; m; m &= m - 1) {
-            int l = lowest(m);
-            lane_ready(p, l);
-            if (rl_watertight_hit(&p->w[l], vertex_of(b, 0, j), vertex_of(b, 1, j), vertex_of(b, 2, j), p->t_min[l],
-                                  p->t_test[l], &th[l], &u[l], &v[l]))
-                hit |= 1u << l;
-        }
+        hit |= fallback_lanes(p, b, j, fallback, p->t_test, th, u, v);
         for (; hit; hit &= hit - 1) {
-            int l = lowest(hit);
+            int l = rl_bvh_lowest_bit(hit);
             if (!(th[l] < c[l].t_test))
                 continue;
             if (th[l] < c[l].t || b->id[j] < c[l].id) {
@@ -346,13 +343,7 @@ static unsigned leaf_packet_any(const rl_bvh *bvh, uint32_t ref, uint32_t count,
         unsigned fallback;
         tri_of(b, j, p, P);
         unsigned hit = tri_lanes(p, P[0], P[1], P[2], mask, p->t, th, u, v, &fallback);
-        for (unsigned m = fallback; m; m &= m - 1) {
-            int l = lowest(m);
-            lane_ready(p, l);
-            if (rl_watertight_hit(&p->w[l], vertex_of(b, 0, j), vertex_of(b, 1, j), vertex_of(b, 2, j), p->t_min[l],
-                                  p->t[l], &th[l], &u[l], &v[l]))
-                hit |= 1u << l;
-        }
+        hit |= fallback_lanes(p, b, j, fallback, p->t, th, u, v);
         blocked |= hit;
         mask &= ~hit;
     }
@@ -402,7 +393,7 @@ static inline unsigned child_lanes(const rl_bvh_wide_node *n, int i, const packe
     unsigned hit = 0;
     float least = INFINITY;
     for (unsigned m = mask; m; m &= m - 1) {
-        int l = lowest(m);
+        int l = rl_bvh_lowest_bit(m);
         float lo = p->t_min[l], hi = p->t[l];
         for (int a = 0; a < 3; ++a) {
             float near = p->neg[a][l] ? n->bmax[a][i] : n->bmin[a][i];
@@ -460,7 +451,7 @@ static inline unsigned frustum_children(const rl_bvh_wide_node *n, const packet 
 {
     float t_lo = INFINITY, t_hi = -INFINITY;
     for (unsigned m = mask; m; m &= m - 1) {
-        int l = lowest(m);
+        int l = rl_bvh_lowest_bit(m);
         t_lo = p->t_min[l] < t_lo ? p->t_min[l] : t_lo;
         t_hi = p->t[l] > t_hi ? p->t[l] : t_hi;
     }
@@ -505,7 +496,7 @@ static bool visit_packet(const rl_bvh *bvh, const rl_bvh_wide_node *n, const pac
         used &= frustum_children(n, p, mask);
 #endif
     for (; used; used &= used - 1) {
-        int i = lowest(used);
+        int i = rl_bvh_lowest_bit(used);
         float least = 0.0f;
         unsigned lanes = child_lanes(n, i, p, mask, hit[k].dist, &least);
         if (!lanes)
@@ -543,12 +534,12 @@ static bool visit_lanes(const rl_bvh *bvh, const rl_bvh_wide_node *n, packet *p,
     float key[RL_BVH_WIDTH];
     unsigned any = 0;
     for (unsigned m = mask; m; m &= m - 1) {
-        int l = lowest(m);
+        int l = rl_bvh_lowest_bit(m);
         lane_ready(p, l);
         float dist[RL_BVH_WIDTH];
         unsigned cm = (unsigned)rl_bvh_box_n(n, &p->pre[l], p->t_min[l], p->t[l], dist);
         for (; cm; cm &= cm - 1) {
-            int i = lowest(cm);
+            int i = rl_bvh_lowest_bit(cm);
             if (!(any & (1u << i))) {
                 any |= 1u << i;
                 key[i] = dist[i];
@@ -564,7 +555,7 @@ static bool visit_lanes(const rl_bvh *bvh, const rl_bvh_wide_node *n, packet *p,
         return false;
     int order[RL_BVH_WIDTH], k = 0;
     for (; any; any &= any - 1) {
-        int i = lowest(any);
+        int i = rl_bvh_lowest_bit(any);
         hit[i].ref = n->child[i];
         hit[i].count = n->count[i];
         hit[i].mask = lanes_of[i];
@@ -614,7 +605,7 @@ static inline unsigned still_near(const pentry *e, const packet *p)
 #else
     unsigned keep = 0;
     for (unsigned m = e->mask; m; m &= m - 1) {
-        int l = lowest(m);
+        int l = rl_bvh_lowest_bit(m);
         float d = e->dist[l], t = p->t[l];
         if (d - fabsf(d) * 0x1p-15f <= t + fabsf(t) * 0x1p-15f)
             keep |= 1u << l;
@@ -639,7 +630,7 @@ unsigned rl_bvh_packet_intersect(const rl_bvh *bvh, rl_ray *rays, rl_hit *hits, 
     for (;;) {
         if (popcount8(cur.mask) <= SINGLE_BELOW) {
             for (unsigned m = cur.mask; m; m &= m - 1) {
-                int l = lowest(m);
+                int l = rl_bvh_lowest_bit(m);
                 lane_ready(&p, l);
                 rl_bvh_closest_from(bvh, &p.pre[l], &p.w[l], p.t_min[l], cur.ref, cur.count, &c[l]);
                 p.t[l] = c[l].t;
@@ -654,7 +645,7 @@ unsigned rl_bvh_packet_intersect(const rl_bvh *bvh, rl_ray *rays, rl_hit *hits, 
             }
 #endif
             for (unsigned m = rest; m; m &= m - 1) {
-                int l = lowest(m);
+                int l = rl_bvh_lowest_bit(m);
                 lane_ready(&p, l);
                 rl_bvh_leaf_closest(bvh, cur.ref, cur.count, &p.w[l], p.t_min[l], &c[l]);
                 p.t[l] = c[l].t;
@@ -676,7 +667,7 @@ unsigned rl_bvh_packet_intersect(const rl_bvh *bvh, rl_ray *rays, rl_hit *hits, 
 finished:;
     unsigned found = 0;
     for (unsigned m = active; m; m &= m - 1) {
-        int l = lowest(m);
+        int l = rl_bvh_lowest_bit(m);
         if (c[l].id == RL_ID_NONE)
             continue;
         found |= 1u << l;
@@ -700,7 +691,7 @@ unsigned rl_bvh_packet_occluded(const rl_bvh *bvh, const rl_ray *rays, unsigned 
     for (;;) {
         if (popcount8(cur.mask) <= SINGLE_BELOW) {
             for (unsigned m = cur.mask; m; m &= m - 1) {
-                int l = lowest(m);
+                int l = rl_bvh_lowest_bit(m);
                 lane_ready(&p, l);
                 if (rl_bvh_occluder_from(bvh, &p.pre[l], &p.w[l], p.t_min[l], p.t[l], cur.ref, cur.count) !=
                     RL_ID_NONE)
@@ -715,7 +706,7 @@ unsigned rl_bvh_packet_occluded(const rl_bvh *bvh, const rl_ray *rays, unsigned 
             }
 #endif
             for (unsigned m = rest; m; m &= m - 1) {
-                int l = lowest(m);
+                int l = rl_bvh_lowest_bit(m);
                 lane_ready(&p, l);
                 if (rl_bvh_occluder_from(bvh, &p.pre[l], &p.w[l], p.t_min[l], p.t[l], cur.ref, cur.count) !=
                     RL_ID_NONE)

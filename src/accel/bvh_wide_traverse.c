@@ -73,21 +73,6 @@ static inline void prefetch_child(const rl_bvh *bvh, entry e)
 #endif
 }
 
-/* Index of the lowest set bit of m != 0. */
-static inline int lowest_lane(unsigned m)
-{
-#if defined(__GNUC__)
-    return __builtin_ctz(m);
-#else
-    int i = 0;
-    while (!(m & 1u)) {
-        m >>= 1;
-        ++i;
-    }
-    return i;
-#endif
-}
-
 /* Pushes the hit children of n farthest first and returns the nearest in
  * *next; false when none is hit. Most steps of an incoherent ray hit one
  * or two children, so those skip the sort; the hit lanes are walked by
@@ -99,7 +84,7 @@ static inline bool visit(const rl_bvh *bvh, const rl_bvh_wide_node *n, const ray
     unsigned mask = (unsigned)box_n(n, r, t_min, t_max, dist);
     if (!mask)
         return false;
-    int i = lowest_lane(mask);
+    int i = rl_bvh_lowest_bit(mask);
     mask &= mask - 1;
     entry a = { n->child[i], n->count[i], dist[i] };
     if (!mask) {   /* visited at once: no use prefetching it */
@@ -107,7 +92,7 @@ static inline bool visit(const rl_bvh *bvh, const rl_bvh_wide_node *n, const ray
         return true;
     }
     prefetch_child(bvh, a);
-    i = lowest_lane(mask);
+    i = rl_bvh_lowest_bit(mask);
     mask &= mask - 1;
     entry b = { n->child[i], n->count[i], dist[i] };
     prefetch_child(bvh, b);
@@ -127,7 +112,7 @@ static inline bool visit(const rl_bvh *bvh, const rl_bvh_wide_node *n, const ray
     int k = 1;
     hit[0] = a;
     for (mask |= 1u << i; mask; mask &= mask - 1) {
-        i = lowest_lane(mask);
+        i = rl_bvh_lowest_bit(mask);
         entry e = { n->child[i], n->count[i], dist[i] };
         if (k > 1)
             prefetch_child(bvh, e);
@@ -273,7 +258,7 @@ RL_WT_INLINE uint32_t leaf_any_k(const rl_bvh_block *blk, uint32_t count, const 
         float t[RL_BVH_LANES], u[RL_BVH_LANES], v[RL_BVH_LANES];
         int mask = block_hits_k(blk, w, kx, ky, kz, t_min, t_max, t, u, v);
         if (mask)
-            return blk->id[lowest_lane((unsigned)mask)];
+            return blk->id[rl_bvh_lowest_bit((unsigned)mask)];
     }
     return RL_ID_NONE;
 }
