@@ -232,7 +232,13 @@ static void test_a_hanging_importer_is_killed_at_the_deadline(void **state)
     rl_status st = rl_scene_import_with(s, path, 1, &desc, &root);
     double dt = now_s() - t0;
     assert_int_equal(st, RL_ERR_LIMIT);
-    assert_non_null(strstr(rl_last_error(), "hang.gltf: the importer ran out of time (1 s)"));
+    /* The CPU limit equals the deadline (load_isolate.c): a child that
+     * gets a whole core may reach SIGXCPU while the parent, descheduled on
+     * a busy machine, has not yet seen the deadline pass. Either message
+     * names the same limit. */
+    const char *e = rl_last_error();
+    assert_true(strstr(e, "hang.gltf: the importer ran out of time (1 s)") ||
+                strstr(e, "hang.gltf: the importer ran out of CPU time (1 s)"));
     assert_true(dt >= 0.9 && dt < 5.0);
     assert_int_equal(s->num_nodes, 2);   /* untouched */
     assert_int_equal(root, RL_NONE);
