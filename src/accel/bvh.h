@@ -219,6 +219,33 @@ static inline int rl_bvh_box_n(const rl_bvh_wide_node *n, const rl_bvh_ray_pre *
 #endif
 }
 
+/* Memory latency bounds traversal on large scenes: start fetching an entry
+ * as soon as it is known to be visited. ref, count as in a traversal
+ * entry: count 0 is wide node ref (all its cache lines, a whole number of
+ * them), else the leaf's blocks from ref (every 64 bytes and the last). */
+static inline void rl_bvh_prefetch(const rl_bvh *bvh, uint32_t ref, uint32_t count)
+{
+#if defined(__GNUC__)
+    const char *p;
+    size_t bytes;
+    if (count == 0) {
+        p = (const char *)&bvh->wide[ref];
+        bytes = sizeof(rl_bvh_wide_node);
+    } else {
+        p = (const char *)&bvh->blocks[ref];
+        bytes = (count + RL_BVH_LANES - 1) / RL_BVH_LANES * sizeof(rl_bvh_block);
+    }
+    for (size_t off = 0; off < bytes; off += 64)
+        __builtin_prefetch(p + off);
+    if (count != 0)
+        __builtin_prefetch(p + bytes - 1);
+#else
+    (void)bvh;
+    (void)ref;
+    (void)count;
+#endif
+}
+
 /* Index of the lowest set bit of m != 0 (a hit child, a packet lane). */
 static inline int rl_bvh_lowest_bit(unsigned m)
 {

@@ -24,7 +24,7 @@
  * triangle test is the same code; its acceptance depends on the divided t
  * alone (watertight.c), so the closest hit (ties: lowest ID) does not
  * depend on the order in which triangles are met; the lane's box test is
- * box_n's operations (the near plane chosen per lane by its direction's
+ * rl_bvh_box_n's operations (the near plane chosen per lane by its direction's
  * sign, the same 2^-15 slack), so no box is culled that the single ray
  * would enter with the same t_max. The caller (accel.c) hands over valid
  * rays with t_min >= 0 only, so the slack takes the scaled form. Rays of
@@ -351,7 +351,7 @@ static unsigned leaf_packet_any(const rl_bvh *bvh, uint32_t ref, uint32_t count,
 }
 #endif
 
-/* Child i of n against the lanes of mask: box_n's operations per lane
+/* Child i of n against the lanes of mask: rl_bvh_box_n's operations per lane
  * (bvh_wide_traverse.c), entry distances into dist, the hit lanes back;
  * *key = the least entry distance of a hit lane (the child's order). */
 static inline unsigned child_lanes(const rl_bvh_wide_node *n, int i, const packet *p, unsigned mask,
@@ -411,30 +411,6 @@ static inline unsigned child_lanes(const rl_bvh_wide_node *n, int i, const packe
     }
     *key = least;
     return hit;
-#endif
-}
-
-/* Memory latency dominates on large scenes (city): start fetching a child
- * as soon as it is known to be visited, as the single-ray visit does
- * (node: all its cache lines; leaf: its blocks). */
-static inline void prefetch_entry(const rl_bvh *bvh, const pentry *e)
-{
-#if defined(__GNUC__)
-    const char *p;
-    size_t bytes;
-    if (e->count == 0) {
-        p = (const char *)&bvh->wide[e->ref];
-        bytes = sizeof(rl_bvh_wide_node);
-    } else {
-        p = (const char *)&bvh->blocks[e->ref];
-        bytes = (e->count + RL_BVH_LANES - 1) / RL_BVH_LANES * sizeof(rl_bvh_block);
-    }
-    for (size_t off = 0; off < bytes; off += 64)
-        __builtin_prefetch(p + off);
-    __builtin_prefetch(p + bytes - 1);
-#else
-    (void)bvh;
-    (void)e;
 #endif
 }
 
@@ -504,7 +480,7 @@ static bool visit_packet(const rl_bvh *bvh, const rl_bvh_wide_node *n, const pac
         hit[k].ref = n->child[i];
         hit[k].count = n->count[i];
         hit[k].mask = lanes;
-        prefetch_entry(bvh, &hit[k]);
+        rl_bvh_prefetch(bvh, hit[k].ref, hit[k].count);
         key[k] = least;
         /* Insertion into the order, descending by key. */
         int j = k++;
@@ -559,7 +535,7 @@ static bool visit_lanes(const rl_bvh *bvh, const rl_bvh_wide_node *n, packet *p,
         hit[i].ref = n->child[i];
         hit[i].count = n->count[i];
         hit[i].mask = lanes_of[i];
-        prefetch_entry(bvh, &hit[i]);
+        rl_bvh_prefetch(bvh, hit[i].ref, hit[i].count);
         int j = k++;
         while (j > 0 && key[order[j - 1]] < key[i]) {
             order[j] = order[j - 1];

@@ -43,36 +43,6 @@ typedef struct entry {
     float dist;               /* entry distance of its box */
 } entry;
 
-static inline void ray_pre_setup(const rl_ray *r, ray_pre *p)
-{
-    rl_bvh_ray_pre_setup(r, p);
-}
-
-#define box_n rl_bvh_box_n
-
-/* Incoherent rays are bound by memory latency: start fetching every child
- * we will visit (node: all its cache lines; leaf: its triangles' first lines). */
-static inline void prefetch_child(const rl_bvh *bvh, entry e)
-{
-#if defined(__GNUC__)
-    if (e.count == 0) {
-        const char *p = (const char *)&bvh->wide[e.ref];
-        for (size_t line = 0; line < sizeof(rl_bvh_wide_node); line += 64)
-            __builtin_prefetch(p + line);
-    } else {
-        /* The leaf's blocks: the first two lines, then one per 64 bytes. */
-        const char *p = (const char *)&bvh->blocks[e.ref];
-        size_t bytes = (e.count + RL_BVH_LANES - 1) / RL_BVH_LANES * sizeof(rl_bvh_block);
-        for (size_t off = 0; off < bytes; off += 64)
-            __builtin_prefetch(p + off);
-        __builtin_prefetch(p + bytes - 1);
-    }
-#else
-    (void)bvh;
-    (void)e;
-#endif
-}
-
 /* Pushes the hit children of n farthest first and returns the nearest in
  * *next; false when none is hit. Most steps of an incoherent ray hit one
  * or two children, so those skip the sort; the hit lanes are walked by
@@ -81,7 +51,7 @@ static inline bool visit(const rl_bvh *bvh, const rl_bvh_wide_node *n, const ray
                          entry *stack, int *sp, entry *next)
 {
     float dist[RL_BVH_WIDTH];
-    unsigned mask = (unsigned)box_n(n, r, t_min, t_max, dist);
+    unsigned mask = (unsigned)rl_bvh_box_n(n, r, t_min, t_max, dist);
     if (!mask)
         return false;
     int i = rl_bvh_lowest_bit(mask);
@@ -91,11 +61,11 @@ static inline bool visit(const rl_bvh *bvh, const rl_bvh_wide_node *n, const ray
         *next = a;
         return true;
     }
-    prefetch_child(bvh, a);
+    rl_bvh_prefetch(bvh, a.ref, a.count);
     i = rl_bvh_lowest_bit(mask);
     mask &= mask - 1;
     entry b = { n->child[i], n->count[i], dist[i] };
-    prefetch_child(bvh, b);
+    rl_bvh_prefetch(bvh, b.ref, b.count);
     if (!mask) {
         if (b.dist <= a.dist) {   /* as the sort below: equal, the later lane first */
             stack[(*sp)++] = a;
@@ -115,7 +85,7 @@ static inline bool visit(const rl_bvh *bvh, const rl_bvh_wide_node *n, const ray
         i = rl_bvh_lowest_bit(mask);
         entry e = { n->child[i], n->count[i], dist[i] };
         if (k > 1)
-            prefetch_child(bvh, e);
+            rl_bvh_prefetch(bvh, e.ref, e.count);
         int j = k++;
         while (j > 0 && hit[j - 1].dist < e.dist) {   /* descending; stable */
             hit[j] = hit[j - 1];
@@ -311,7 +281,7 @@ static inline void closest_from(const rl_bvh *bvh, const ray_pre *p, const rl_ra
             if (sp == 0)
                 return;
             cur = stack[--sp];
-            /* The same relative slack as box_n, sign-safe (t may be < 0). */
+            /* The same relative slack as rl_bvh_box_n, sign-safe (t may be < 0). */
             if (cur.dist - fabsf(cur.dist) * 0x1p-15f <= c->t + fabsf(c->t) * 0x1p-15f)
                 break;
         }
@@ -333,7 +303,7 @@ void rl_bvh_leaf_closest(const rl_bvh *bvh, uint32_t ref, uint32_t count, const 
 bool rl_bvh_wide_intersect(const rl_bvh *bvh, rl_ray *ray, rl_hit *hit)
 {
     ray_pre p;
-    ray_pre_setup(ray, &p);
+    rl_bvh_ray_pre_setup(ray, &p);
     rl_ray_watertight w;
     rl_ray_watertight_setup(ray, &w);
     const float t_min = ray->t_min;
@@ -385,7 +355,7 @@ uint32_t rl_bvh_occluder_from(const rl_bvh *bvh, const rl_bvh_ray_pre *p, const 
 bool rl_bvh_wide_occluder(const rl_bvh *bvh, const rl_ray *ray, uint32_t *triangle)
 {
     ray_pre p;
-    ray_pre_setup(ray, &p);
+    rl_bvh_ray_pre_setup(ray, &p);
     rl_ray_watertight w;
     rl_ray_watertight_setup(ray, &w);
     *triangle = occluder_from(bvh, &p, &w, ray->t_min, ray->t_max, (entry){ 0, 0, ray->t_min });
