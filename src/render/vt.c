@@ -68,6 +68,7 @@ static const char *const cost_choices[] = { "faces", "estimate", NULL };
 static const char *const nonlinear_choices[] = { "off", "extremum", "interval", "derivative", "affine", NULL };   /* VT_NONLINEAR_* */
 static const char *const shaft_choices[] = { "off", "shadow", "all", NULL };
 static const char *const hint_choices[] = { "off", "agree", "parents", NULL };   /* VT_HINT_* */
+static const char *const tree_shadow_choices[] = { "blocked", "visible", "occluder", "none", NULL };   /* VT_TREE_SHADOW_* */
 enum { RECONSTRUCT_SOFTWARE, RECONSTRUCT_GL };
 
 static const rl_option_info vt_options[] = {
@@ -111,6 +112,14 @@ static const rl_option_info vt_options[] = {
     { "presort", RL_OPT_BOOL, "false",
       "ray presorting (Sec. 6.2.2): sample the vertices of a refinement stage by VT object and along a "
       "Morton curve on the screen; the image does not change", 0, 0, NULL },
+    { "tree_shadow", RL_OPT_ENUM, "blocked",
+      "ray-tree criterion (Sec. 3.3.1), the shadow feelers' nodes: blocked (one per feeler sent: the light lit "
+      "or blocked) | visible (only lights the feeler reaches: a blocked light and one behind the surface are "
+      "alike) | occluder (blocked feelers name their occluder) | none (no light nodes)", 0, 0,
+      tree_shadow_choices },
+    { "tree_depth", RL_OPT_INT, "0",
+      "ray-tree criterion: compare the rays down to this recursion depth and the feelers of their hits "
+      "(0 = the whole tree)", 0, 64, NULL },
     { "textures", RL_OPT_ENUM, "multitexture",
       "deferred textures: multitexture (eq. 3.20, one pass), multipass (eq. 3.22), sampled (no deferral)",
       0, 0, texture_choices },
@@ -436,13 +445,16 @@ static void read_settings(rl_renderer *r, vt_settings *set)
     set->overlay = rl_renderer_opt_enum(r, "overlay");
     set->hint = rl_renderer_opt_enum(r, "hint");
     set->presort = rl_renderer_opt_bool(r, "presort");
+    set->tree_shadow = rl_renderer_opt_enum(r, "tree_shadow");
+    set->tree_depth = (int)rl_renderer_opt_int(r, "tree_depth");
 }
 
 /* What the cached feelers depend on besides the scene. */
 static uint64_t feeler_signature(const rl_tracer_desc *desc)
 {
     return ((uint64_t)(unsigned)desc->area_samples << 8) ^ (desc->no_shadows ? 1u : 0u) ^
-           (desc->no_transmitted_highlight ? 2u : 0u) ^ (desc->seed << 20);
+           (desc->no_transmitted_highlight ? 2u : 0u) ^ (desc->tree_shadow_any_hit ? 0u : 4u) ^
+           (desc->seed << 20);
 }
 
 /* Keeps this frame's feelers for the next one (the map takes the frame's
@@ -524,7 +536,9 @@ static rl_status prepare_tracer(rl_renderer *r, vt_state *s, const rl_scene *sce
     rl_status st = rl_tracer_options_read(r, &desc, &kind);
     if (st != RL_OK)
         return st;
-    desc.tree_shadow_any_hit = true;      /* shadow nodes say lit or blocked (Sec. 3.3.1) */
+    /* Shadow nodes say lit or blocked (Sec. 3.3.1), unless the occluder
+     * reading asks for the occluder's identity (a full search per feeler). */
+    desc.tree_shadow_any_hit = set->tree_shadow != VT_TREE_SHADOW_OCCLUDER;
     desc.defer_through = rl_renderer_opt_bool(r, "defer_through");
     double accel_ms = 0.0;
     if ((st = rl_accel_cache_get(&s->accel, "vt", scene, kind, set->threads, build_progress, r, &accel_ms)) !=

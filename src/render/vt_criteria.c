@@ -90,6 +90,32 @@ void vt_criteria_prepare(vt_vertex_sample *sample)
     vt_rgb_to_hsv(sample->display, &sample->h, &sample->s, &sample->v);
 }
 
+uint64_t vt_tree_hash(const rl_ray_tree *tree, int shadow, int depth)
+{
+    if (!tree)
+        return 0;
+    bool keep_shadows = shadow == VT_TREE_SHADOW_BLOCKED || shadow == VT_TREE_SHADOW_OCCLUDER;
+    if (keep_shadows && depth <= 0)
+        return rl_ray_tree_hash(tree);
+    rl_ray_tree kept;
+    kept.count = 0;
+    kept.truncated = tree->truncated;
+    for (uint32_t i = 0; i < tree->count && i < RL_RAY_TREE_MAX; ++i) {
+        const rl_ray_tree_node *n = &tree->nodes[i];
+        bool feeler = n->type == RL_RAY_SHADOW;
+        /* A feeler is one level below the ray whose hit it lights. */
+        int ray_depth = feeler ? (int)n->depth - 1 : (int)n->depth;
+        if (depth > 0 && ray_depth > depth)
+            continue;
+        if (feeler && shadow == VT_TREE_SHADOW_NONE)
+            continue;
+        if (feeler && shadow == VT_TREE_SHADOW_VISIBLE && n->object != RL_ID_NONE)
+            continue;
+        kept.nodes[kept.count++] = *n;
+    }
+    return rl_ray_tree_hash(&kept);
+}
+
 unsigned vt_criteria_test(const vt_criteria *c, const vt_vertex_sample *a, const vt_vertex_sample *b)
 {
     unsigned fired = 0;

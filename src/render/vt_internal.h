@@ -215,6 +215,19 @@ void vt_criteria_prepare(vt_vertex_sample *sample);
  * out, Sec. 3.5.3). HSV: hue is ignored when either saturation is below
  * 1e-3 (it is undefined for greys); the hue difference wraps around. */
 unsigned vt_criteria_test(const vt_criteria *c, const vt_vertex_sample *a, const vt_vertex_sample *b);
+/* Which shadow-feeler nodes the ray-tree criterion compares (Sec. 3.3.1,
+ * option tree_shadow). BLOCKED: every feeler sent, lit or blocked, as the
+ * tracer records it with tree_shadow_any_hit (the default). VISIBLE: only
+ * the lights a feeler reaches, the thesis' "sichtbare ... Lichtquellen";
+ * a blocked light then equals one the surface faces away from (no feeler
+ * sent). OCCLUDER: blocked feelers name their occluder (the tracer must
+ * record it: tree_shadow_any_hit off). NONE: no light nodes at all. */
+enum { VT_TREE_SHADOW_BLOCKED = 0, VT_TREE_SHADOW_VISIBLE, VT_TREE_SHADOW_OCCLUDER, VT_TREE_SHADOW_NONE };
+/* The hash the ray-tree criterion compares: rl_ray_tree_hash of the tree
+ * as the reading (shadow: VT_TREE_SHADOW_*; depth: rays of recursion depth
+ * <= depth and the feelers of their hits, 0 = all) keeps it. BLOCKED and
+ * OCCLUDER with depth 0 keep the tree as traced. */
+uint64_t vt_tree_hash(const rl_ray_tree *tree, int shadow, int depth);
 /* sRGB display value of one linear channel, clamped to [0, 1]. */
 float vt_display(float linear);
 /* HSV of a display-space colour: h in [0, 1), s, v in [0, 1]. */

@@ -55,6 +55,10 @@ typedef struct vt_settings {
     int hint;                 /* VT_HINT_* (Sec. 3.3.1, 6.2.2) */
     bool presort;             /* sample a stage's vertices in VT-object and
                                * screen Morton order (Sec. 6.2.2) */
+    int tree_shadow;          /* VT_TREE_SHADOW_* (vt_internal.h): the
+                               * feeler nodes the ray-tree criterion compares */
+    int tree_depth;           /* the ray tree compared down to this
+                               * recursion depth; 0 = all of it */
 } vt_settings;
 
 /* Intersection hints (Sec. 3.3.1, 6.2.2): which triangles a refined
