@@ -678,6 +678,55 @@ static void hints_and_presort_change_no_image_or_count(void **state)
     rl_scene_release(s);
 }
 
+/* Readings of the ray-tree criterion (options tree_shadow, tree_depth;
+ * Sec. 3.3.1, docs/vertex-tracing.md "Issue 36: why the ray tree makes more
+ * vertices than RGB"): the default names the tree as traced, to the byte;
+ * each reading that leaves nodes out generates fewer vertices on the cup,
+ * the occluder reading (more nodes differ) more. */
+static void tree_readings_counts(void **state)
+{
+    (void)state;
+    rl_scene *cup = NULL;
+    assert_int_equal(rl_scene_create_builtin("table", "variant=cup", &cup), RL_OK);
+    rl_camera cam;
+    assert_int_equal(rl_scene_get_camera(cup, NULL, &cam), RL_OK);
+    cam.width = cam.height = 192;
+    enum { DEFAULT, BLOCKED, VISIBLE, OCCLUDER, NONE, DEPTH1, VISIBLE2, N };
+    static const char *const reading[N][2] = {
+        { NULL, NULL }, { "blocked", "0" }, { "visible", "0" }, { "occluder", "0" }, { "none", "0" },
+        { "blocked", "1" }, { "visible", "2" },
+    };
+    uint64_t gen[N];
+    /* VT_DEBUG prints each reading's statistics (render_stats). */
+    rl_image *want = NULL;
+    for (int i = 0; i < N; ++i) {
+        const char *opts[] = { "criteria", "tree", "min_edge", "2", "max_depth", "4", "coherence", "false",
+                               i ? "tree_shadow" : NULL, reading[i][0], "tree_depth", reading[i][1], NULL };
+        rl_renderer *r = make_vt(opts);
+        rl_image *img = NULL;
+        rl_vt_stats st = render_stats(r, cup, &cam, &img);
+        gen[i] = st.vertices_generated;
+        if (i == DEFAULT) {
+            want = img;
+            assert_true(st.vertices_generated > 1000);
+        } else {
+            if (i == BLOCKED)
+                fx_assert_images_identical(want, img);
+            rl_image_release(img);
+        }
+        rl_renderer_release(r);
+    }
+    assert_int_equal(gen[BLOCKED], gen[DEFAULT]);
+    assert_true(gen[VISIBLE] < gen[DEFAULT]);
+    assert_true(gen[NONE] < gen[VISIBLE]);
+    assert_true(gen[DEPTH1] < gen[DEFAULT]);
+    assert_true(gen[VISIBLE2] < gen[VISIBLE]);
+    assert_true(gen[OCCLUDER] > gen[DEFAULT]);   /* the tracer names occluders */
+
+    rl_image_release(want);
+    rl_scene_release(cup);
+}
+
 /* Ch. 4: the image does not depend on the number of threads; Sec. 3.4.5:
  * nor on temporal coherence, which must replay feelers exactly. */
 static void deterministic_and_coherent(void **state)
@@ -1000,7 +1049,7 @@ static void bad_options(void **state)
         { "min_edge", "-2" }, { "min_edge", "0" }, { "eps_z", "1.5" }, { "criteria", "colour" },
         { "objects", "" }, { "update_every", "0" }, { "max_vertices", "-5" },
         { "nonlinear", "gradient" }, { "nonlinear", "" }, { "nonlinear", "Affine" }, { "shaft_cull", "on" }, { "eps_ia", "0" },
-        { "eps_ia", "-1" },
+        { "eps_ia", "-1" }, { "tree_shadow", "lit" }, { "tree_depth", "-1" }, { "tree_depth", "65" },
     };
     for (size_t i = 0; i < sizeof bad / sizeof bad[0]; ++i) {
         rl_clear_error();
@@ -1409,6 +1458,7 @@ int main(void)
         cmocka_unit_test(sample_reduction_merges_short_primary_edges),
         cmocka_unit_test(mesh_bytes_per_generated_vertex),
         cmocka_unit_test(table_cup_variant_counts),
+        cmocka_unit_test(tree_readings_counts),
         cmocka_unit_test(deterministic_and_coherent),
         cmocka_unit_test(kept_buffers_follow_size_threads_and_layers),
         cmocka_unit_test(progressive_updates),

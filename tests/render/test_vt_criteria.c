@@ -6,7 +6,9 @@
  * Sec. 6.1.1 (vt_correct.c): the interval and affine enclosures of the local
  * Phong term against sampled values, and the derivative test (eq. 6.3)
  * against the extremum test (eq. 6.4-6.5); and the shaft of [HW91] that
- * Sec. 6.1.2's shaft culling builds. */
+ * Sec. 6.1.2's shaft culling builds; the readings of the ray tree the
+ * ray-tree criterion compares (vt_tree_hash, options tree_shadow and
+ * tree_depth). */
 #include <math.h>
 #include <setjmp.h>
 #include <stdarg.h>
@@ -488,6 +490,66 @@ static void test_derivative_agrees_with_extremum(void **state)
  * a time (k_d or k_s), it fires exactly where finite differences of the
  * term at the two ends have opposite signs (slopes too flat to tell by
  * differences are left out). */
+/* A ray tree of a mirror hit: primary (object 1) lit by light 0, its
+ * reflection (depth 1) on object 2 lit by light 0, that one's reflection
+ * (depth 2) on object 3 with its feeler. Feeler occluders: RL_ID_NONE =
+ * lit, else blocked. */
+static rl_ray_tree mirror_tree(uint32_t occ0, uint32_t occ1, uint32_t occ2, uint32_t deep_object)
+{
+    rl_ray_tree t;
+    memset(&t, 0, sizeof t);
+    const rl_ray_tree_node n[] = {
+        { RL_RAY_PRIMARY, 0, 1, RL_ID_NONE },   { RL_RAY_SHADOW, 1, occ0, 0 },
+        { RL_RAY_REFLECTION, 1, 2, RL_ID_NONE }, { RL_RAY_SHADOW, 2, occ1, 0 },
+        { RL_RAY_REFLECTION, 2, deep_object, RL_ID_NONE }, { RL_RAY_SHADOW, 3, occ2, 0 },
+    };
+    for (size_t i = 0; i < sizeof n / sizeof n[0]; ++i)
+        t.nodes[t.count++] = n[i];
+    return t;
+}
+
+static void test_tree_readings_keep_what_they_say(void **state)
+{
+    (void)state;
+    const uint32_t lit = RL_ID_NONE, blocked = 7;
+    rl_ray_tree base = mirror_tree(lit, lit, lit, 3);
+    /* The default reading is the tree as traced. */
+    assert_true(vt_tree_hash(&base, VT_TREE_SHADOW_BLOCKED, 0) == rl_ray_tree_hash(&base));
+    assert_true(vt_tree_hash(&base, VT_TREE_SHADOW_OCCLUDER, 0) == rl_ray_tree_hash(&base));
+    assert_true(vt_tree_hash(NULL, VT_TREE_SHADOW_VISIBLE, 2) == 0);
+
+    /* The reflected object in shadow (Fig. 3.7): every reading but none
+     * sees it. */
+    rl_ray_tree shadowed = mirror_tree(lit, blocked, lit, 3);
+    for (int r = VT_TREE_SHADOW_BLOCKED; r <= VT_TREE_SHADOW_OCCLUDER; ++r)
+        assert_true(vt_tree_hash(&base, r, 0) != vt_tree_hash(&shadowed, r, 0));
+    assert_true(vt_tree_hash(&base, VT_TREE_SHADOW_NONE, 0) == vt_tree_hash(&shadowed, VT_TREE_SHADOW_NONE, 0));
+    /* Depth 1 keeps the rays of depth 1 and the feelers of their hits. */
+    assert_true(vt_tree_hash(&base, VT_TREE_SHADOW_BLOCKED, 1) != vt_tree_hash(&shadowed, VT_TREE_SHADOW_BLOCKED, 1));
+
+    /* A blocked light and one the surface faces away from (no feeler):
+     * equal only in the visible reading. */
+    rl_ray_tree away = base, blocked_tree = mirror_tree(blocked, lit, lit, 3);
+    memmove(&away.nodes[1], &away.nodes[2], 4 * sizeof away.nodes[0]);
+    away.count--;
+    assert_true(vt_tree_hash(&away, VT_TREE_SHADOW_VISIBLE, 0) == vt_tree_hash(&blocked_tree, VT_TREE_SHADOW_VISIBLE, 0));
+    assert_true(vt_tree_hash(&away, VT_TREE_SHADOW_BLOCKED, 0) != vt_tree_hash(&blocked_tree, VT_TREE_SHADOW_BLOCKED, 0));
+    assert_true(vt_tree_hash(&away, VT_TREE_SHADOW_VISIBLE, 0) != vt_tree_hash(&base, VT_TREE_SHADOW_VISIBLE, 0));
+
+    /* Another object at depth 2, or its feeler blocked: seen at depth 0
+     * (all) and 2, not at depth 1. */
+    rl_ray_tree deep = mirror_tree(lit, lit, lit, 4), deep_shadow = mirror_tree(lit, lit, blocked, 3);
+    for (int depth = 0; depth <= 3; ++depth) {
+        bool seen = depth != 1;
+        assert_true((vt_tree_hash(&base, VT_TREE_SHADOW_BLOCKED, depth) != vt_tree_hash(&deep, VT_TREE_SHADOW_BLOCKED, depth)) == seen);
+        assert_true((vt_tree_hash(&base, VT_TREE_SHADOW_BLOCKED, depth) != vt_tree_hash(&deep_shadow, VT_TREE_SHADOW_BLOCKED, depth)) == seen);
+    }
+    /* Truncation still counts. */
+    rl_ray_tree cut = base;
+    cut.truncated = true;
+    assert_true(vt_tree_hash(&base, VT_TREE_SHADOW_VISIBLE, 1) != vt_tree_hash(&cut, VT_TREE_SHADOW_VISIBLE, 1));
+}
+
 static void test_derivative_test_is_the_sign_of_the_slope(void **state)
 {
     (void)state;
@@ -537,6 +599,7 @@ int main(void)
         cmocka_unit_test(test_affine_encloses_the_term_and_is_tighter_than_intervals),
         cmocka_unit_test(test_derivative_agrees_with_extremum),
         cmocka_unit_test(test_derivative_test_is_the_sign_of_the_slope),
+        cmocka_unit_test(test_tree_readings_keep_what_they_say),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
