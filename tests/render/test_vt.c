@@ -727,6 +727,51 @@ static void tree_readings_counts(void **state)
     rl_scene_release(cup);
 }
 
+/* tree_shadow=occluder with temporal coherence (Sec. 3.4.5): two boxes side
+ * by side cast adjacent shadows on a VT floor, so across the line between
+ * them both ends are blocked, by different objects. The occluder reading
+ * splits there, blocked does not; a renderer switched from occluder to
+ * blocked must not replay the feelers that named their occluders (the
+ * feeler cache's signature includes the reading), or it would split there
+ * too. */
+static void tree_shadow_switch_does_not_replay_occluders(void **state)
+{
+    (void)state;
+    rl_scene *s = NULL;
+    assert_int_equal(rl_scene_create(&s), RL_OK);
+    uint32_t grey = add_material(s, "grey", rl_v3(0.7f, 0.7f, 0.7f), 0.0f, 0.0f);
+    add_grid(s, "floor", 8, 2.0f, grey, true);
+    add_object(s, "box_a", "box", "size=0.5", grey, rl_mat4_translate(rl_v3(-0.25f, 1.2f, 0.0f)), false);
+    add_object(s, "box_b", "box", "size=0.5", grey, rl_mat4_translate(rl_v3(0.25f, 1.2f, 0.0f)), false);
+    rl_light l;
+    memset(&l, 0, sizeof l);
+    l.type = RL_LIGHT_POINT;
+    l.color = rl_v3(1.0f, 1.0f, 1.0f);
+    l.position = rl_v3(0.0f, 4.0f, 0.0f);
+    l.intensity = 16.0f;
+    assert_int_equal(rl_scene_add_light(s, &l), RL_OK);
+    assert_int_equal(rl_scene_commit(s), RL_OK);
+    rl_camera cam = look(rl_v3(0.0f, 5.0f, 3.0f), rl_v3(0.0f, 0.0f, 0.0f), 96);
+
+    const char *blocked[] = { "criteria", "tree", "coherence", "false", NULL };
+    const char *occluder[] = { "criteria", "tree", "coherence", "false", "tree_shadow", "occluder", NULL };
+    rl_renderer *r = make_vt(blocked);
+    uint64_t g_blocked = render_stats(r, s, &cam, NULL).vertices_generated;
+    rl_renderer_release(r);
+    r = make_vt(occluder);
+    uint64_t g_occluder = render_stats(r, s, &cam, NULL).vertices_generated;
+    rl_renderer_release(r);
+    assert_true(g_occluder > g_blocked);
+
+    const char *coherent[] = { "criteria", "tree", "coherence", "true", "tree_shadow", "occluder", NULL };
+    r = make_vt(coherent);
+    assert_int_equal(render_stats(r, s, &cam, NULL).vertices_generated, g_occluder);
+    assert_int_equal(rl_renderer_set(r, "tree_shadow", "blocked"), RL_OK);
+    assert_int_equal(render_stats(r, s, &cam, NULL).vertices_generated, g_blocked);
+    rl_renderer_release(r);
+    rl_scene_release(s);
+}
+
 /* Ch. 4: the image does not depend on the number of threads; Sec. 3.4.5:
  * nor on temporal coherence, which must replay feelers exactly. */
 static void deterministic_and_coherent(void **state)
@@ -1459,6 +1504,7 @@ int main(void)
         cmocka_unit_test(mesh_bytes_per_generated_vertex),
         cmocka_unit_test(table_cup_variant_counts),
         cmocka_unit_test(tree_readings_counts),
+        cmocka_unit_test(tree_shadow_switch_does_not_replay_occluders),
         cmocka_unit_test(deterministic_and_coherent),
         cmocka_unit_test(kept_buffers_follow_size_threads_and_layers),
         cmocka_unit_test(progressive_updates),
