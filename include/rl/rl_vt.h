@@ -62,6 +62,12 @@ typedef struct rl_vt_stats {
      * of the ray tree, and of those the rays where a hinted triangle was
      * hit (a shadow feeler ended there, or the search stopped at it). */
     uint64_t hint_tests, hint_hits;
+    /* rl --dist with option dist_postpass, the master's drawing (Ullmann
+     * 2003, Sec. 6.1.3; docs/distributed.md): the post-pass replays one
+     * process' refinement over the packages' samples; vertices whose
+     * sample a part carried, and vertices it traced itself: the places
+     * where the merged packages differ from one process. */
+    uint64_t postpass_reused, postpass_traced;
 } rl_vt_stats;
 
 /* Statistics of the last frame rendered by r. RL_ERR_INVALID_ARG when r is

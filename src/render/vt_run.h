@@ -180,6 +180,11 @@ typedef struct vt_run {
      * faces outside it are refined only where splits reach them. NULL: a
      * whole frame, every visible face starts. */
     const uint8_t *seed;
+    /* The master's post-pass of a distributed frame (vt_part.h, option
+     * dist_postpass): a vertex queued for sampling takes its sample from
+     * the packages' parts when one carries it, else it is traced. NULL:
+     * every queued vertex is traced. */
+    const struct vt_part_samples *given;
     rl_mat4 view_m, proj_m;   /* the rasterizer's matrices for this camera */
     /* per vertex, grown by the primary thread alongside mesh->verts */
     uint8_t *reason;

@@ -1312,6 +1312,77 @@ static void packages_match_one_process(void **state)
     rl_scene_release(s);
 }
 
+/* The master's post-pass (Ullmann 2003, Sec. 6.1.3; option dist_postpass)
+ * closes the gap of packages_match_one_process: with it the frame drawn
+ * from packages is the one-process frame bit for bit (every layer), for
+ * one package, 8 equal ones, 3 unequal ones, without the halo and at a
+ * larger size with 24 packages. Without it the same packages differ from
+ * one process; the post-pass traced vertices itself exactly where they
+ * differ, and took every other sample from the parts. */
+static void postpass_matches_one_process(void **state)
+{
+    (void)state;
+    rl_camera cam;
+    rl_scene *s = table_scene(&cam);
+    rl_renderer *r = make_vt(NULL);
+    rl_image *ref = fx_render_with(r, s, &cam, FX_ALL_LAYERS, NULL);
+    rl_vt_stats one;
+    assert_int_equal(rl_vt_get_stats(r, &one), RL_OK);
+    const double whole[] = { 1.0 };
+    double queue[24];
+    for (int i = 0; i < 24; ++i)
+        queue[i] = 1 / 24.0;
+    const double eight[] = { 0.125, 0.125, 0.125, 0.125, 0.125, 0.125, 0.125, 0.125 };
+    const double precompute[] = { 0.2, 0.5, 0.3 };
+    /* Without the post-pass: not the one-process image (the gap). */
+    rl_image *before = draw_packages(r, s, &cam, eight, 8);
+    assert_true(memcmp(before->color, ref->color, (size_t)cam.width * (size_t)cam.height * sizeof *ref->color) !=
+                0);
+    assert_int_equal(rl_renderer_set(r, "dist_postpass", "on"), RL_OK);
+    const struct {
+        const double *shares;
+        size_t n;
+        const char *halo;
+    } runs[] = { { whole, 1, "true" }, { eight, 8, "true" }, { precompute, 3, "true" }, { eight, 8, "false" } };
+    for (size_t k = 0; k < sizeof runs / sizeof runs[0]; ++k) {
+        assert_int_equal(rl_renderer_set(r, "dist_halo", runs[k].halo), RL_OK);
+        rl_image *img = draw_packages(r, s, &cam, runs[k].shares, runs[k].n);
+        rl_vt_stats st;
+        assert_int_equal(rl_vt_get_stats(r, &st), RL_OK);
+        if (getenv("VT_DEBUG"))
+            print_message("vt post-pass, %zu packages, halo %s: %llu samples from the parts, %llu traced; one "
+                          "process sampled %llu\n", runs[k].n, runs[k].halo,
+                          (unsigned long long)st.postpass_reused, (unsigned long long)st.postpass_traced,
+                          (unsigned long long)one.vertices_sampled);
+        fx_assert_images_identical(img, ref);
+        /* Every sample one process traced, from a part or traced here. */
+        assert_int_equal(st.postpass_reused + st.postpass_traced, one.vertices_sampled);
+        assert_int_equal(st.vertices_sampled, st.postpass_traced);
+        assert_int_equal(st.faces_drawn, one.faces_drawn);
+        assert_int_equal(st.vertices_generated, one.vertices_generated);
+        /* Most samples come from the parts. */
+        assert_true(st.postpass_reused > 4 * st.postpass_traced);
+        if (runs[k].n == 8)
+            assert_true(st.postpass_traced > 0);    /* the borders' gap, closed here */
+        rl_image_release(img);
+    }
+    rl_image_release(before);
+    rl_image_release(ref);
+    /* A larger frame, 24 packages: more borders, still identical. */
+    cam.width = 160;
+    cam.height = 120;
+    assert_int_equal(rl_renderer_set(r, "dist_halo", "true"), RL_OK);
+    assert_int_equal(rl_renderer_set(r, "dist_postpass", "off"), RL_OK);
+    ref = fx_render_with(r, s, &cam, FX_ALL_LAYERS, NULL);
+    assert_int_equal(rl_renderer_set(r, "dist_postpass", "on"), RL_OK);
+    rl_image *big = draw_packages(r, s, &cam, queue, 24);
+    fx_assert_images_identical(big, ref);
+    rl_image_release(big);
+    rl_image_release(ref);
+    rl_renderer_release(r);
+    rl_scene_release(s);
+}
+
 /* A part is checked before the master draws it: a truncated part, counts
  * that do not fit its size, a damaged byte, a foreign buffer and a face
  * naming a vertex the part lacks are clean RL_ERR_PARSE errors, and
@@ -1420,6 +1491,7 @@ int main(void)
         cmocka_unit_test(hints_and_presort_change_no_image_or_count),
         cmocka_unit_test(bad_options),
         cmocka_unit_test(packages_match_one_process),
+        cmocka_unit_test(postpass_matches_one_process),
         cmocka_unit_test(cost_estimate),
         cmocka_unit_test(part_round_trip_and_bad_parts),
     };
