@@ -905,9 +905,16 @@ rl_status rl_vt_prepare(rl_renderer *r, const rl_scene *scene, const rl_camera *
  * refinement checks only visible faces' children, so without the ring a
  * border sub-edge that one process splits by force from the other side
  * stays whole here (Sec. 4.3.3). */
-static uint64_t flag_package(vt_state *s, vt_mesh *m, const uint32_t *faces, size_t count, bool halo)
+static uint64_t flag_package(vt_state *s, vt_mesh *m, const uint32_t *faces, size_t count, bool halo, bool postpass)
 {
     memset(s->package, 0, m->num_primary_faces);
+    /* With the post-pass (Sec. 6.1.3), the faces that lost the ID test are
+     * every package's (2): one process refines the hidden faces its
+     * splits reach, and every such vertex a package leaves out the master
+     * traces in its post-pass, alone. A hidden face between two packages
+     * is refined by both, to the same samples. */
+    for (uint32_t f = 0; postpass && f < m->num_primary_faces; ++f)
+        s->package[f] = s->prep_visible[f] ? 0 : 2;
     uint64_t visible = 0;
     for (size_t i = 0; i < count; ++i) {
         uint32_t f = faces[i];
@@ -970,7 +977,8 @@ rl_status rl_vt_refine_faces(rl_renderer *r, const rl_scene *scene, const rl_cam
         /* The pre-pass flagged the whole frame's faces. */
         vt_mesh_reset(m);
         vt_heap_clear(&s->heap);
-        run.stats.visible_primary_faces = flag_package(s, m, faces, count, rl_renderer_opt_bool(r, "dist_halo"));
+        run.stats.visible_primary_faces = flag_package(s, m, faces, count, rl_renderer_opt_bool(r, "dist_halo"),
+                                                       rl_renderer_opt_bool(r, "dist_postpass"));
         run.seed = s->package;
         vt_project_primary(&run, s->depth_ids);
         st = vt_refine(&run);

@@ -110,7 +110,7 @@ rl_status vt_part_write(const vt_mesh *m, const rl_scene_data *d, const uint8_t 
     for (uint32_t f = 0; f < m->num_faces; ++f) {
         const vt_face *face = &m->faces[f];
         root[f] = f < m->num_primary_faces ? f : root[face->parent];
-        if (!face->leaf || !mine[root[f]])
+        if (!face->leaf || mine[root[f]] != 1)
             continue;
         bool sampled = true;
         for (int k = 0; k < 3; ++k)
@@ -161,7 +161,7 @@ rl_status vt_part_write(const vt_mesh *m, const rl_scene_data *d, const uint8_t 
     }
     for (uint32_t f = 0; f < m->num_faces; ++f) {
         const vt_face *face = &m->faces[f];
-        if (!face->leaf || !mine[root[f]])
+        if (!face->leaf || mine[root[f]] != 1)
             continue;
         uint32_t idx[3] = { remap[face->v[0]], remap[face->v[1]], remap[face->v[2]] };
         if (idx[0] == VT_NONE || idx[1] == VT_NONE || idx[2] == VT_NONE)

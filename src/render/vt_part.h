@@ -8,7 +8,7 @@
 
 #include "render/vt_internal.h"
 
-/* The drawable leaf faces of m whose primary ancestor f has mine[f] != 0,
+/* The drawable leaf faces of m whose primary ancestor f has mine[f] == 1,
  * with their vertices, into a malloc'd buffer (*out, *size bytes).
  * all_samples (option dist_postpass): version 2, which also carries every
  * other sampled vertex of m and each vertex's key, triangle and ray-tree

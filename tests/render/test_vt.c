@@ -1317,8 +1317,8 @@ static void packages_match_one_process(void **state)
  * from packages is the one-process frame bit for bit (every layer), for
  * one package, 8 equal ones, 3 unequal ones, without the halo and at a
  * larger size with 24 packages. Without it the same packages differ from
- * one process; the post-pass traced vertices itself exactly where they
- * differ, and took every other sample from the parts. */
+ * one process; the post-pass traces vertices itself exactly where they
+ * differ, and takes every other sample from the parts. */
 static void postpass_matches_one_process(void **state)
 {
     (void)state;
@@ -1360,10 +1360,13 @@ static void postpass_matches_one_process(void **state)
         assert_int_equal(st.vertices_sampled, st.postpass_traced);
         assert_int_equal(st.faces_drawn, one.faces_drawn);
         assert_int_equal(st.vertices_generated, one.vertices_generated);
-        /* Most samples come from the parts. */
-        assert_true(st.postpass_reused > 4 * st.postpass_traced);
-        if (runs[k].n == 8)
-            assert_true(st.postpass_traced > 0);    /* the borders' gap, closed here */
+        /* One package is one process: nothing to trace. Several leave a
+         * few vertices at their borders (14 of 4873 for 8 packages), the
+         * gap the post-pass closes; the rest come from the parts. */
+        if (runs[k].n == 1)
+            assert_int_equal(st.postpass_traced, 0);
+        else
+            assert_true(st.postpass_traced > 0 && st.postpass_reused > 50 * st.postpass_traced);
         rl_image_release(img);
     }
     rl_image_release(before);
