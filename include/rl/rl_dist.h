@@ -88,7 +88,9 @@ typedef struct rl_dist_stats {
  * demand; precompute: one package per rank sized by its measured speed);
  * every task and result carries the frame's camera ID, and results of an
  * older camera are dropped (dstats->dropped). Its image is close to one
- * process', not equal at package borders (docs/distributed.md). */
+ * process', not equal at package borders (docs/distributed.md), unless
+ * the option dist_postpass is on: then the master's post-pass makes it
+ * the one-process image (dstats->postpass*). */
 /* Renders cam's frame into image with every rank's copy of r: collective,
  * every rank calls it with the same renderer options, scene, camera and
  * image size. On the master, image receives the whole frame (every layer

@@ -1464,6 +1464,31 @@ static void part_round_trip_and_bad_parts(void **state)
     size_t s2 = 0;
     assert_int_equal(rl_vt_refine_faces(r, s, &cam, img, &wrong, 1, &p2, &s2, NULL), RL_ERR_INVALID_ARG);
     assert_null(p2);
+    /* With dist_postpass a part is of version 2: every sampled vertex
+     * (those of no drawn face too), 160 bytes each; drawn alone without
+     * the post-pass it shows its faces. */
+    size_t nv1 = 0, nf1 = 0;
+    assert_int_equal(rl_vt_part_check(part, size, &nv1, &nf1), RL_OK);
+    assert_int_equal(rl_renderer_set(r, "dist_postpass", "on"), RL_OK);
+    void *part2;
+    size_t size2;
+    assert_int_equal(rl_vt_prepare(r, s, &cam, img, &faces, &count), RL_OK);
+    assert_int_equal(rl_vt_refine_faces(r, s, &cam, img, faces, count / 4, &part2, &size2, NULL), RL_OK);
+    assert_int_equal(rl_vt_part_check(part2, size2, &nv, &nf), RL_OK);
+    if (getenv("VT_DEBUG"))
+        print_message("part v1 %zu vertices %zu faces, v2 %zu vertices %zu faces\n", nv1, nf1, nv, nf);
+    /* Not the same faces: hidden faces are the package's business too
+     * now (2 in vt_run.seed), and their edges change how the package's
+     * stages group its edges (v1 981 vertices and 1827 faces, v2 1000
+     * and 1805 here). */
+    assert_true(nf > 0 && nv > 0 && nv1 > 0 && nf1 > 0);
+    assert_int_equal(size2, 32 + nv * 160 + nf * 24);
+    assert_int_equal(rl_renderer_set(r, "dist_postpass", "off"), RL_OK);
+    const void *two[] = { part2 };
+    assert_int_equal(rl_vt_draw_parts(r, s, &cam, img, two, &size2, 1, NULL), RL_OK);
+    assert_int_equal(rl_vt_get_stats(r, &st), RL_OK);
+    assert_int_equal(st.faces_drawn, nf);
+    free(part2);
     free(part);
     rl_image_release(img);
     rl_renderer_release(r);
