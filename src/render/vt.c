@@ -1105,6 +1105,21 @@ rl_status rl_vt_estimate_costs(rl_renderer *r, const rl_scene *scene, const rl_c
     return st;
 }
 
+/* The caller's progress while the post-pass runs: its packages are all
+ * in, so the frame stays at "done" (the replay's stages would otherwise
+ * take the bar back to 0), and a cancel still stops it. */
+typedef struct postpass_progress {
+    rl_progress_fn fn;
+    void *user;
+} postpass_progress;
+
+static bool postpass_progress_fn(void *user, double done)
+{
+    (void)done;
+    const postpass_progress *p = user;
+    return p->fn ? p->fn(p->user, 1.0) : true;
+}
+
 /* The post-pass of a distributed frame (Ullmann 2003, Sec. 6.1.3; option
  * dist_postpass), on the master once all parts are in. The thesis
  * proposes that the master collect the forced splits a border stopped and
@@ -1123,22 +1138,8 @@ rl_status rl_vt_estimate_costs(rl_renderer *r, const rl_scene *scene, const rl_c
  * The master traces rather than sending a second round of tasks: the
  * missing vertices come one forced chain at a time (each stage's splits
  * decide the next), so a second round would be a round trip per stage,
- * for a few hundred vertices a frame (docs/distributed.md). */
-/* The caller's progress while the post-pass runs: its packages are all
- * in, so the frame stays at "done" (the replay's stages would otherwise
- * take the bar back to 0), and a cancel still stops it. */
-typedef struct postpass_progress {
-    rl_progress_fn fn;
-    void *user;
-} postpass_progress;
-
-static bool postpass_progress_fn(void *user, double done)
-{
-    (void)done;
-    const postpass_progress *p = user;
-    return p->fn ? p->fn(p->user, 1.0) : true;
-}
-
+ * for 0.5-10 % of a frame's samples spread over its stages
+ * (docs/distributed.md, "The post-pass"). */
 static rl_status draw_postpass(rl_renderer *r, vt_state *s, const rl_scene *scene, const rl_camera *cam,
                                vt_run *run, const void *const *parts, const size_t *sizes, size_t count)
 {
