@@ -349,19 +349,8 @@ for w in runs:
     assert two["messages_per_frame"] > 0 and two["bytes_per_frame"] > 0 and two["imbalance"] >= 1, two
     assert len(two["dist"]["per_rank"]) == 2, two
 PY
-# Its vt section with the post-pass: 2 ranks give the one-rank image, byte
-# for byte, and the record has the post-pass' counts.
-run_ok "$RL" bench dist --quick --only vt --scenes table --vt-postpass on --out "$TMP/bench-dist-vt.json"
-python3 - "$TMP/bench-dist-vt.json" <<'PY' || fail "rl bench dist vt: $(head -c 600 "$TMP/bench-dist-vt.json")"
-import json, sys
-r = json.load(open(sys.argv[1]))
-runs = r["vt"]["runs"]
-assert [(w["balance"], w["dist_postpass"]) for w in runs] == [("queue", "on"), ("precompute", "on")], runs
-for w in runs:
-    two = w["ranks"][1]
-    assert two["ranks"] == 2 and two["identical"] is True and two["ssim_vt"] == 1, two
-    assert two["dist"]["postpass"]["reused"] > 0, two
-PY
+# (Its vt section with --vt-postpass: run by hand for bench/README.md; a
+# run here would add 40 s to this test under the sanitizers.)
 expect_exit 2 "$RL" bench dist --vt-postpass maybe
 grep -q "^rl: error: bench dist: --vt-postpass: expected off, on or off,on" "$TMP/err" ||
     fail "bench dist --vt-postpass maybe: $(cat "$TMP/err")"
