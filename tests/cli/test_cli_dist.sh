@@ -349,8 +349,8 @@ for w in runs:
     assert two["messages_per_frame"] > 0 and two["bytes_per_frame"] > 0 and two["imbalance"] >= 1, two
     assert len(two["dist"]["per_rank"]) == 2, two
 PY
-# (Its vt section with --vt-postpass: run by hand for bench/README.md; a
-# run here would add 40 s to this test under the sanitizers.)
+# Its vt section with --vt-postpass ran by hand (bench/README.md): a run
+# here would add 40 s to this test under the sanitizers.
 expect_exit 2 "$RL" bench dist --vt-postpass maybe
 grep -q "^rl: error: bench dist: --vt-postpass: expected off, on or off,on" "$TMP/err" ||
     fail "bench dist --vt-postpass maybe: $(cat "$TMP/err")"
