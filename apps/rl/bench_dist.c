@@ -47,7 +47,8 @@ static const char bench_dist_help[] =
     "  sampling  rl --dist eval (Jaehn 2015, Alg. 5.4) on --eval-scene\n"
     "  vt        rl --dist render --algo vt (Ullmann 2003, Sec. 4.3, Fig. 5.14) on\n"
     "            --scenes, both load balancers (queue, precompute), and the SSIM\n"
-    "            on the VT pixels against the one-rank image\n"
+    "            on the VT pixels against the one-rank image, without and with\n"
+    "            the master's post-pass (--vt-postpass)\n"
     "Rank counts above the machine's cores are marked oversubscribed.\n"
     "\n"
     "options:\n"
@@ -56,6 +57,7 @@ static const char bench_dist_help[] =
     "  --scenes A,B       tiles: scenes; default table,cluster\n"
     "  --size WxH         tiles: image size; default 640x480\n"
     "  --vt-size WxH      vt: image size; default 320x240\n"
+    "  --vt-postpass L    vt: the option dist_postpass, each of off,on; default off,on\n"
     "  --spp N            tiles: pt's samples per pixel; default 4\n"
     "  --eval-scene S     sampling: scene; default city:blocks=2\n"
     "  --samples N        sampling: samples of the visibility property; default 64\n"
@@ -79,7 +81,7 @@ static const char *const section_names[SEC_COUNT] = { "tiles", "sampling", "vt" 
 #define CHILD_TIMEOUT_S 900.0
 
 typedef struct bd_args {
-    const char *scenes, *eval_scene, *mpirun, *out;
+    const char *scenes, *eval_scene, *mpirun, *out, *vt_postpass;
     int ranks[MAX_RANKS], num_ranks;
     long long threads, spp, samples, repeats;
     int width, height, vt_width, vt_height;
@@ -463,8 +465,18 @@ static void vt_after(bd_ctx *c, int ranks, cJSON *entry, void *user)
     if (q->reference && rl_image_compare(img, q->reference, &opt, &m) == RL_OK) {
         bench_add_num(entry, "ssim_vt", m.ssim);
         bench_add_num(entry, "psnr_vt", m.psnr);
-        printf("  %-28s %3d ranks: SSIM %.5f on %s against one rank\n", "", ranks, m.ssim,
-               q->mask ? "the VT pixels" : "all pixels");
+        /* Byte for byte, the whole image (the post-pass' aim). */
+        const bool same = img->width == q->reference->width && img->height == q->reference->height &&
+                          memcmp(img->color, q->reference->color,
+                                 (size_t)img->width * (size_t)img->height * sizeof *img->color) == 0;
+        cJSON_AddBoolToObject(entry, "identical", same);
+        const cJSON *pp = cJSON_GetObjectItemCaseSensitive(cJSON_GetObjectItemCaseSensitive(entry, "dist"), "postpass");
+        printf("  %-28s %3d ranks: SSIM %.5f on %s against one rank%s", "", ranks, m.ssim,
+               q->mask ? "the VT pixels" : "all pixels", same ? ", identical" : "");
+        if (pp)
+            printf("; post-pass %.0f traced, %.0f from the parts, %.1f ms", num(pp, "traced"), num(pp, "reused"),
+                   num(pp, "time_ms"));
+        printf("\n");
     }
     rl_image_release(img);
 }
@@ -493,18 +505,23 @@ static rl_status sec_vt(void *ctx, cJSON *sec)
          scene = strtok_r(NULL, ",", &save)) {
         vt_quality q = { .png = png };
         q.mask = vt_mask(scene, a->vt_width, a->vt_height, &q.mask_pixels);
-        for (int k = 0; k < 2 && st == RL_OK; ++k) {
-            char balance[48];
-            snprintf(balance, sizeof balance, "balance=%s", balances[k]);
+        for (int k = 0; k < 4 && st == RL_OK; ++k) {
+            const bool post = k % 2 == 1;
+            if (!strstr(a->vt_postpass, post ? "on" : "off"))
+                continue;
+            char balance[48], postpass[48];
+            snprintf(balance, sizeof balance, "balance=%s", balances[k / 2]);
+            snprintf(postpass, sizeof postpass, "dist_postpass=%s", post ? "on" : "off");
             const char *cmd[] = { "render", scene, "--algo", "vt", "--size", size, "--set", threads, "--set", balance,
-                                  "--out", png, "--stats-json", json, "-q", NULL };
+                                  "--set", postpass, "--out", png, "--stats-json", json, "-q", NULL };
             char label[128];
-            snprintf(label, sizeof label, "vt %s %s", scene, balances[k]);
+            snprintf(label, sizeof label, "vt %s %s%s", scene, balances[k / 2], post ? " post-pass" : "");
             note("vt: %s", label);
             cJSON *w = cJSON_CreateObject();
             cJSON_AddStringToObject(w, "scene", scene);
             cJSON_AddStringToObject(w, "algorithm", "vt");
-            cJSON_AddStringToObject(w, "balance", balances[k]);
+            cJSON_AddStringToObject(w, "balance", balances[k / 2]);
+            cJSON_AddStringToObject(w, "dist_postpass", post ? "on" : "off");
             cJSON_AddStringToObject(w, "size", size);
             cJSON_AddNumberToObject(w, "vt_pixels", (double)q.mask_pixels);
             cJSON *runs = cJSON_AddArrayToObject(w, "ranks");
@@ -536,6 +553,7 @@ static int parse_args(int argc, char **argv, bd_args *a)
         RL_BENCH_STRING("--scenes", &a->scenes),
         RL_BENCH_SIZE("--size", &a->width, &a->height, &a->has_size),
         RL_BENCH_SIZE("--vt-size", &a->vt_width, &a->vt_height, &a->has_vt_size),
+        RL_BENCH_STRING("--vt-postpass", &a->vt_postpass),
         RL_BENCH_COUNT("--spp", 1 << 20, &a->spp, &a->has_spp),
         RL_BENCH_STRING("--eval-scene", &a->eval_scene),
         RL_BENCH_COUNT("--samples", 1 << 24, &a->samples, &a->has_samples),
@@ -563,6 +581,15 @@ static int parse_args(int argc, char **argv, bd_args *a)
     if (!a->has_vt_size) {
         a->vt_width = a->quick ? 64 : 320;
         a->vt_height = a->quick ? 48 : 240;
+    }
+    if (!a->vt_postpass)
+        a->vt_postpass = "off,on";
+    for (const char *p = a->vt_postpass; *p;) {
+        size_t n = strcspn(p, ",");
+        if (!((n == 2 && strncmp(p, "on", 2) == 0) || (n == 3 && strncmp(p, "off", 3) == 0)))
+            return cli_fail(RL_CLI_USAGE, "bench dist: --vt-postpass: expected off, on or off,on, got '%s'",
+                            a->vt_postpass);
+        p += n + (p[n] == ',');
     }
     if (!a->has_spp)
         a->spp = a->quick ? 1 : 4;

@@ -137,6 +137,14 @@ cJSON *cli_dist_json(void)
     cJSON_AddNumberToObject(o, "lost", last.lost);
     if (last.task_kind)
         cJSON_AddNumberToObject(o, "dropped", (double)last.dropped);
+    if (last.postpass) {
+        cJSON *pp = cJSON_AddObjectToObject(o, "postpass");
+        if (pp) {
+            cJSON_AddNumberToObject(pp, "reused", (double)last.postpass_reused);
+            cJSON_AddNumberToObject(pp, "traced", (double)last.postpass_traced);
+            cJSON_AddNumberToObject(pp, "time_ms", last.postpass_ms);
+        }
+    }
     cJSON *ranks = cJSON_AddArrayToObject(o, "per_rank");
     for (int k = 0; ranks && last.per_rank && k < last.ranks; k++) {
         cJSON *e = cJSON_CreateObject();
@@ -166,6 +174,10 @@ void cli_print_dist_summary(FILE *out)
     if (last.dropped)
         fprintf(out, "dist: %llu result%s of an older camera dropped\n", (unsigned long long)last.dropped,
                 last.dropped == 1 ? "" : "s");
+    if (last.postpass)
+        fprintf(out, "dist: post-pass: %llu samples from the parts, %llu traced on the master, %.1f ms\n",
+                (unsigned long long)last.postpass_reused, (unsigned long long)last.postpass_traced,
+                last.postpass_ms);
     for (int k = 0; k < last.ranks; k++) {
         const rl_dist_rank_stats *p = &last.per_rank[k];
         double idle = last.time_ms > 0.0 ? 100.0 * (1.0 - p->busy_ms / last.time_ms) : 0.0;

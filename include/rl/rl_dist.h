@@ -66,6 +66,14 @@ typedef struct rl_dist_stats {
     int lost;                /* workers taken for lost (silent past RL_DIST_TIMEOUT); their work was redone */
     uint64_t dropped;        /* Vertex Tracing: results of an older camera dropped (Ullmann Sec. 4.3.2) */
     const char *task_kind;   /* "package" for Vertex Tracing's face packages; NULL: bands or chunks */
+    /* Vertex Tracing with option dist_postpass (Ullmann Sec. 6.1.3): the
+     * master's post-pass ran; the samples it took from the parts, the
+     * vertices it traced itself (where the packages differ from one
+     * process) and its time (the replayed refinement and those samples,
+     * without the drawing). */
+    bool postpass;
+    uint64_t postpass_reused, postpass_traced;
+    double postpass_ms;
     /* Per rank, rank 0 (the master, which renders bands between its
      * messages) first; NULL when the frame ran in one process. Owned by
      * the rl_dist, valid until its next frame or release. */
@@ -80,7 +88,9 @@ typedef struct rl_dist_stats {
  * demand; precompute: one package per rank sized by its measured speed);
  * every task and result carries the frame's camera ID, and results of an
  * older camera are dropped (dstats->dropped). Its image is close to one
- * process', not equal at package borders (docs/distributed.md). */
+ * process', not equal at package borders (docs/distributed.md), unless
+ * the option dist_postpass is on: then the master's post-pass makes it
+ * the one-process image (dstats->postpass*). */
 /* Renders cam's frame into image with every rank's copy of r: collective,
  * every rank calls it with the same renderer options, scene, camera and
  * image size. On the master, image receives the whole frame (every layer

@@ -62,6 +62,12 @@ typedef struct rl_vt_stats {
      * of the ray tree, and of those the rays where a hinted triangle was
      * hit (a shadow feeler ended there, or the search stopped at it). */
     uint64_t hint_tests, hint_hits;
+    /* rl --dist with option dist_postpass, the master's drawing (Ullmann
+     * 2003, Sec. 6.1.3; docs/distributed.md): the post-pass replays one
+     * process' refinement over the packages' samples; vertices whose
+     * sample a part carried, and vertices it traced itself: the places
+     * where the merged packages differ from one process. */
+    uint64_t postpass_reused, postpass_traced;
 } rl_vt_stats;
 
 /* Statistics of the last frame rendered by r. RL_ERR_INVALID_ARG when r is
@@ -103,7 +109,11 @@ RL_API rl_status rl_vt_set_update_callback(rl_renderer *r, rl_vt_update_fn fn, v
  * visible faces sharing an edge with the package are flagged visible too,
  * so that forced refinement (Sec. 3.3.2) crosses the package's border as
  * in one process. A part holds the package's refined leaf faces only:
- * neighbours are drawn from their own packages (docs/distributed.md). */
+ * neighbours are drawn from their own packages (docs/distributed.md).
+ * With the option dist_postpass (Sec. 6.1.3) a part also carries every
+ * sample its package traced, and rl_vt_draw_parts replays one process'
+ * refinement over them, tracing only the vertices no part has: the image
+ * is then the one-process image bit for bit (rl_vt_stats.postpass_*). */
 
 /* The ID pre-pass for cam at image's size (it draws the rasterized half
  * of the frame into image): *faces receives the visible primary faces in
@@ -131,7 +141,9 @@ RL_API rl_status rl_vt_refine_faces(rl_renderer *r, const rl_scene *scene, const
 RL_API rl_status rl_vt_estimate_costs(rl_renderer *r, const rl_scene *scene, const rl_camera *cam, rl_image *image,
                                       const uint32_t *faces, size_t count, double *cost, rl_render_stats *stats);
 /* Draws cam's frame into image: the rasterized half and the faces of
- * parts[0..count) (sizes[i] bytes each), in that order. A part that fails
+ * parts[0..count) (sizes[i] bytes each), in that order; with dist_postpass,
+ * the faces of one process' refinement replayed over the parts' samples
+ * (see above). A part that fails
  * rl_vt_part_check, or names triangles the scene lacks, is RL_ERR_PARSE
  * and the image is not drawn. rl_vt_get_stats and rl_vt_get_mesh then
  * describe the drawn faces (no refinement counts). */

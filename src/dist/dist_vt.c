@@ -875,6 +875,13 @@ static rl_status vt_lead(rl_dist *d, rl_renderer *r, const rl_scene *scene, cons
         rl_timer_start(&tm);
         if (st == RL_OK && (st = rl_vt_draw_parts(r, scene, cam, image, parts, sizes, c.num_pkg, stats)) != RL_OK)
             snprintf(failure, sizeof failure, "%s", rl_last_error());
+        rl_vt_stats vs;
+        if (st == RL_OK && rl_renderer_opt_bool(r, "dist_postpass") && rl_vt_get_stats(r, &vs) == RL_OK) {
+            ds->postpass = true;
+            ds->postpass_reused = vs.postpass_reused;
+            ds->postpass_traced = vs.postpass_traced;
+            ds->postpass_ms = vs.time_refine_ms + vs.time_sampling_ms;
+        }
         d->per_rank[0].busy_ms += rl_timer_ms(&tm) + estimate_ms;
         free(parts);
         free(sizes);

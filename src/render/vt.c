@@ -154,6 +154,10 @@ static const rl_option_info vt_options[] = {
     { "dist_halo", RL_OPT_BOOL, "true",
       "rl --dist: a package also flags the visible faces around it, so that forced refinement crosses package "
       "borders as in one process (Sec. 4.3.3)", 0, 0, NULL },
+    { "dist_postpass", RL_OPT_BOOL, "false",
+      "rl --dist: the master's post-pass (Sec. 6.1.3): it replays one process' refinement over the packages' "
+      "samples and traces what differs at package borders, so the image is the one-process image; the parts "
+      "carry every sample (20 bytes more a vertex)", 0, 0, NULL },
     RL_TRACER_OPTION_ROWS,
 };
 
@@ -915,9 +919,16 @@ rl_status rl_vt_prepare(rl_renderer *r, const rl_scene *scene, const rl_camera *
  * refinement checks only visible faces' children, so without the ring a
  * border sub-edge that one process splits by force from the other side
  * stays whole here (Sec. 4.3.3). */
-static uint64_t flag_package(vt_state *s, vt_mesh *m, const uint32_t *faces, size_t count, bool halo)
+static uint64_t flag_package(vt_state *s, vt_mesh *m, const uint32_t *faces, size_t count, bool halo, bool postpass)
 {
     memset(s->package, 0, m->num_primary_faces);
+    /* With the post-pass (Sec. 6.1.3), the faces that lost the ID test are
+     * every package's (2): one process refines the hidden faces its
+     * splits reach, and every such vertex a package leaves out the master
+     * traces in its post-pass, alone. A hidden face between two packages
+     * is refined by both, to the same samples. */
+    for (uint32_t f = 0; postpass && f < m->num_primary_faces; ++f)
+        s->package[f] = s->prep_visible[f] ? 0 : 2;
     uint64_t visible = 0;
     for (size_t i = 0; i < count; ++i) {
         uint32_t f = faces[i];
@@ -980,14 +991,15 @@ rl_status rl_vt_refine_faces(rl_renderer *r, const rl_scene *scene, const rl_cam
         /* The pre-pass flagged the whole frame's faces. */
         vt_mesh_reset(m);
         vt_heap_clear(&s->heap);
-        run.stats.visible_primary_faces = flag_package(s, m, faces, count, rl_renderer_opt_bool(r, "dist_halo"));
+        run.stats.visible_primary_faces = flag_package(s, m, faces, count, rl_renderer_opt_bool(r, "dist_halo"),
+                                                       rl_renderer_opt_bool(r, "dist_postpass"));
         run.seed = s->package;
         vt_project_primary(&run, s->depth_ids);
         st = vt_refine(&run);
         run.stats.mesh_bytes = vt_mesh_bytes(m);
     }
     if (st == RL_OK)
-        st = vt_part_write(m, run.data, s->package, part, part_size);
+        st = vt_part_write(m, run.data, s->package, rl_renderer_opt_bool(r, "dist_postpass"), part, part_size);
     if (st == RL_OK) {
         for (int t = 0; t < set.threads && t < RL_VT_MAX_THREADS; ++t) {
             run.stats.thread_rays[t] = run.tally[t].rays;
@@ -1107,6 +1119,92 @@ rl_status rl_vt_estimate_costs(rl_renderer *r, const rl_scene *scene, const rl_c
     return st;
 }
 
+/* The caller's progress while the post-pass runs: its packages are all
+ * in, so the frame stays at "done" (the replay's stages would otherwise
+ * take the bar back to 0), and a cancel still stops it. */
+typedef struct postpass_progress {
+    rl_progress_fn fn;
+    void *user;
+} postpass_progress;
+
+static bool postpass_progress_fn(void *user, double done)
+{
+    (void)done;
+    const postpass_progress *p = user;
+    return p->fn ? p->fn(p->user, 1.0) : true;
+}
+
+/* The post-pass of a distributed frame (Ullmann 2003, Sec. 6.1.3; option
+ * dist_postpass), on the master once all parts are in. The thesis
+ * proposes that the master collect the forced splits a border stopped and
+ * have the slaves redo them, iterated until none is left. Here the master
+ * replays one process' refinement of the whole frame (the same pre-pass,
+ * edge list, criteria and forced refinement, stage by stage until the
+ * edge list is empty) and takes every vertex's sample from the parts,
+ * which carry all the samples their packages traced (part version 2);
+ * only a vertex no package sampled is traced, by the master itself with
+ * its threads. Those are exactly the places where the merged packages
+ * differ from one process: a forced chain a border stopped, an edge split
+ * on one side only, a hidden face's vertices. Since a vertex's sample
+ * depends only on the vertex (vt_sample.c) and the refinement's decisions
+ * only on the samples and the geometry, the mesh, and with it the image,
+ * is one process' bit for bit, whatever the packages and ranks.
+ * The master traces rather than sending a second round of tasks: the
+ * missing vertices come one forced chain at a time (each stage's splits
+ * decide the next), so a second round would be a round trip per stage,
+ * for 0.5-10 % of a frame's samples spread over its stages
+ * (docs/distributed.md, "The post-pass"). */
+static rl_status draw_postpass(rl_renderer *r, vt_state *s, const rl_scene *scene, const rl_camera *cam,
+                               vt_run *run, const void *const *parts, const size_t *sizes, size_t count)
+{
+    rl_timer t;
+    rl_timer_start(&t);
+    rl_status st = dist_prepass(r, s, scene, cam, run);
+    vt_part_samples given;
+    memset(&given, 0, sizeof given);
+    if (st == RL_OK)
+        st = vt_part_samples_build(&given, parts, sizes, count);
+    vt_mesh *m = &s->mesh;
+    if (st == RL_OK) {
+        /* As vt_prepass leaves the mesh: the ID test's faces visible. */
+        vt_mesh_reset(m);
+        vt_heap_clear(&s->heap);
+        run->stats.visible_primary_faces = 0;
+        for (uint32_t f = 0; f < m->num_primary_faces; ++f) {
+            m->faces[f].visible = s->prep_visible[f];
+            run->stats.visible_primary_faces += s->prep_visible[f];
+        }
+        vt_project_primary(run, s->depth_ids);
+        run->given = &given;
+        postpass_progress pp;
+        rl_renderer_get_progress(r, &pp.fn, &pp.user);
+        rl_renderer_set_progress(r, postpass_progress_fn, &pp);
+        st = vt_refine(run);
+        rl_renderer_set_progress(r, pp.fn, pp.user);
+        run->given = NULL;
+    }
+    vt_part_samples_free(&given);
+    run->stats.time_visibility_ms = rl_timer_ms(&t) - run->stats.time_refine_ms - run->stats.time_sampling_ms;
+    if (st == RL_OK)
+        st = vt_draw_base(run);
+    if (st == RL_OK)
+        st = vt_run_reserve(run);
+    if (st == RL_OK && !vt_update(run, run->stats.stages, true))
+        st = run->failed ? RL_ERR_OUT_OF_MEMORY : RL_OK;
+    if (st == RL_OK) {
+        for (int k = 0; k < run->set->threads && k < RL_VT_MAX_THREADS; ++k) {
+            run->stats.thread_rays[k] = run->tally[k].rays;
+            run->stats.thread_busy_ms[k] = run->tally[k].busy_ms;
+            run->stats.hint_tests += run->tally[k].hint_tests;
+            run->stats.hint_hits += run->tally[k].hint_hits;
+        }
+        keep_mesh(s, run);
+    }
+    if (st == RL_OK && run->cancelled)
+        st = rl_error(RL_ERR_CANCELLED, "vt: cancelled by the progress callback");
+    return st;
+}
+
 rl_status rl_vt_draw_parts(rl_renderer *r, const rl_scene *scene, const rl_camera *cam, rl_image *image,
                            const void *const *parts, const size_t *sizes, size_t count, rl_render_stats *stats)
 {
@@ -1136,6 +1234,23 @@ rl_status rl_vt_draw_parts(rl_renderer *r, const rl_scene *scene, const rl_camer
     rl_drawer *gl = NULL;
     if (st == RL_OK && (st = gl_drawer_for(r, s, scene, &set, image, &gl)) == RL_OK)
         run.drawer = gl;
+    if (st == RL_OK && rl_renderer_opt_bool(r, "dist_postpass")) {
+        st = draw_postpass(r, s, scene, &c, &run, parts, sizes, count);
+        if (st == RL_OK) {
+            run.stats.mesh_bytes = vt_mesh_bytes(&s->mesh);
+            s->stats = run.stats;
+            s->have_frame = true;
+            if (stats) {
+                for (int k = 0; k < RL_RAY_TYPE_COUNT; ++k)
+                    stats->rays[k] += run.rays[k];
+                stats->samples += run.stats.vertices_sampled;
+                stats->triangles_rasterized += run.counters.triangles_drawn;
+                stats->pixels_written += run.counters.pixels_written;
+            }
+        }
+        dist_end(&run, tracer);
+        return st;
+    }
     /* The parts' faces go after the primary ones. */
     for (size_t i = 0; st == RL_OK && i < count; ++i)
         if ((st = vt_part_import(&s->mesh, run.data, parts[i], sizes[i])) != RL_OK) {

@@ -10,18 +10,33 @@
  *   vertex  position 3f, uv 2f, flat 3f, per trace layer (3): diffuse 3f,
  *           rest 3f, texture u32, uv 2f                   (140 bytes)
  *   face    vertex u32 x3, triangle u32, object u32, stage u16, 0 u16  (24 bytes)
- * A vertex shared by several faces of the part is written once. */
+ * A vertex shared by several faces of the part is written once.
+ *
+ * Version 2 (option dist_postpass, Sec. 6.1.3): every vertex the package
+ * sampled, also those of no drawn face, and per vertex 20 bytes more:
+ *           key u64, triangle u32, ray-tree hash u64       (160 bytes)
+ * so that the master's post-pass can take the samples by vertex identity
+ * instead of tracing them again (vt_part_samples_*). */
 #include <stdlib.h>
 #include <string.h>
 
 #include "core/error.h"
 #include "render/vt_part.h"
+#include "render/vt_run.h"
+#include "rl/rl_rng.h"
 
 #define PART_MAGIC "RLVP"
 #define PART_VERSION 1u
+#define PART_VERSION_SAMPLES 2u
 #define HEADER_BYTES 32u
 #define VERTEX_BYTES (8u * 4u + RL_TRACE_LAYER_COUNT * 9u * 4u)
+#define VERTEX_EXTRA_BYTES 20u      /* version 2: key, triangle, tree hash */
 #define FACE_BYTES 24u
+
+static uint32_t vertex_bytes(uint32_t version)
+{
+    return VERTEX_BYTES + (version == PART_VERSION_SAMPLES ? VERTEX_EXTRA_BYTES : 0u);
+}
 
 static uint64_t fnv1a(const unsigned char *b, size_t n)
 {
@@ -73,8 +88,11 @@ static const unsigned char *get_vec2(const unsigned char *p, rl_vec2 *v)
     return p;
 }
 
-rl_status vt_part_write(const vt_mesh *m, const rl_scene_data *d, const uint8_t *mine, void **out, size_t *size)
+rl_status vt_part_write(const vt_mesh *m, const rl_scene_data *d, const uint8_t *mine, bool all_samples, void **out,
+                        size_t *size)
 {
+    const uint32_t version = all_samples ? PART_VERSION_SAMPLES : PART_VERSION;
+    const uint32_t vbytes = vertex_bytes(version);
     *out = NULL;
     *size = 0;
     /* A leaf belongs to the package of its primary ancestor; a child comes
@@ -92,7 +110,7 @@ rl_status vt_part_write(const vt_mesh *m, const rl_scene_data *d, const uint8_t 
     for (uint32_t f = 0; f < m->num_faces; ++f) {
         const vt_face *face = &m->faces[f];
         root[f] = f < m->num_primary_faces ? f : root[face->parent];
-        if (!face->leaf || !mine[root[f]])
+        if (!face->leaf || mine[root[f]] != 1)
             continue;
         bool sampled = true;
         for (int k = 0; k < 3; ++k)
@@ -104,7 +122,13 @@ rl_status vt_part_write(const vt_mesh *m, const rl_scene_data *d, const uint8_t 
             if (remap[face->v[k]] == VT_NONE)
                 remap[face->v[k]] = nv++;
     }
-    uint64_t payload = (uint64_t)nv * VERTEX_BYTES + (uint64_t)nf * FACE_BYTES;
+    /* Version 2: the samples of no drawn face too (a hidden face's, a
+     * halo face's): the post-pass replays one process' refinement, which
+     * needs them as well. */
+    for (uint32_t v = 0; all_samples && v < m->num_verts; ++v)
+        if (remap[v] == VT_NONE && m->verts[v].state == VT_SAMPLED)
+            remap[v] = nv++;
+    uint64_t payload = (uint64_t)nv * vbytes + (uint64_t)nf * FACE_BYTES;
     unsigned char *buf = malloc((size_t)(HEADER_BYTES + payload));
     if (!buf) {
         free(root);
@@ -112,14 +136,14 @@ rl_status vt_part_write(const vt_mesh *m, const rl_scene_data *d, const uint8_t 
         return rl_error(RL_ERR_OUT_OF_MEMORY, "vt: a package's result of %u faces", nf);
     }
     /* Vertices in the order of their new numbers: the inverse of remap. */
-    unsigned char *vp = buf + HEADER_BYTES, *fp = vp + (size_t)nv * VERTEX_BYTES;
+    unsigned char *vp = buf + HEADER_BYTES, *fp = vp + (size_t)nv * vbytes;
     for (uint32_t v = 0; v < m->num_verts; ++v) {
         if (remap[v] == VT_NONE)
             continue;
         const vt_vertex *x = &m->verts[v];
         rl_trace_layer layers[RL_TRACE_LAYER_COUNT];
         vt_mesh_sample_layers(m, v, layers);
-        unsigned char *p = vp + (size_t)remap[v] * VERTEX_BYTES;
+        unsigned char *p = vp + (size_t)remap[v] * vbytes;
         p = put_vec3(p, x->p);
         p = put_vec2(p, x->uv);
         p = put_vec3(p, m->samples[v].flat);
@@ -129,10 +153,15 @@ rl_status vt_part_write(const vt_mesh *m, const rl_scene_data *d, const uint8_t 
             p = put(p, &layers[l].texture, 4);
             p = put_vec2(p, layers[l].uv);
         }
+        if (all_samples) {
+            p = put(p, &x->key, 8);
+            p = put(p, &x->triangle, 4);
+            put(p, &m->samples[v].tree_hash, 8);
+        }
     }
     for (uint32_t f = 0; f < m->num_faces; ++f) {
         const vt_face *face = &m->faces[f];
-        if (!face->leaf || !mine[root[f]])
+        if (!face->leaf || mine[root[f]] != 1)
             continue;
         uint32_t idx[3] = { remap[face->v[0]], remap[face->v[1]], remap[face->v[2]] };
         if (idx[0] == VT_NONE || idx[1] == VT_NONE || idx[2] == VT_NONE)
@@ -143,7 +172,7 @@ rl_status vt_part_write(const vt_mesh *m, const rl_scene_data *d, const uint8_t 
         fp = put(fp, &d->triangle_object[face->triangle], 4);
         fp = put(fp, stage, sizeof stage);
     }
-    uint32_t head[4] = { PART_VERSION, nv, nf, 0 };
+    uint32_t head[4] = { version, nv, nf, 0 };
     uint64_t sum = fnv1a(buf + HEADER_BYTES, (size_t)payload);
     unsigned char *p = put(buf, PART_MAGIC, 4);
     p = put(p, head, 3 * sizeof head[0]);
@@ -169,10 +198,12 @@ rl_status vt_part_check(const void *part, size_t size, uint32_t *num_verts, uint
     p = get(p + 4, head, sizeof head);
     p = get(p, &payload, 8);
     get(p, &sum, 8);
-    if (head[0] != PART_VERSION)
-        return rl_error(RL_ERR_PARSE, "vt part: version %u (this build reads %u)", head[0], PART_VERSION);
+    if (head[0] != PART_VERSION && head[0] != PART_VERSION_SAMPLES)
+        return rl_error(RL_ERR_PARSE, "vt part: version %u (this build reads %u and %u)", head[0], PART_VERSION,
+                        PART_VERSION_SAMPLES);
+    const uint32_t vbytes = vertex_bytes(head[0]);
     /* Counts below 2^32 keep the products far from overflowing 64 bits. */
-    uint64_t want = (uint64_t)head[1] * VERTEX_BYTES + (uint64_t)head[2] * FACE_BYTES;
+    uint64_t want = (uint64_t)head[1] * vbytes + (uint64_t)head[2] * FACE_BYTES;
     if (payload != want || payload != size - HEADER_BYTES)
         return rl_error(RL_ERR_PARSE, "vt part: %u vertices and %u faces need %llu bytes; the header says %llu, "
                         "%zu came", head[1], head[2], (unsigned long long)want, (unsigned long long)payload,
@@ -180,7 +211,7 @@ rl_status vt_part_check(const void *part, size_t size, uint32_t *num_verts, uint
     const unsigned char *body = (const unsigned char *)part + HEADER_BYTES;
     if (fnv1a(body, (size_t)payload) != sum)
         return rl_error(RL_ERR_PARSE, "vt part: checksum mismatch (damaged in transit)");
-    const unsigned char *fp = body + (size_t)head[1] * VERTEX_BYTES;
+    const unsigned char *fp = body + (size_t)head[1] * vbytes;
     for (uint32_t f = 0; f < head[2]; ++f) {
         uint32_t idx[3];
         get(fp + (size_t)f * FACE_BYTES, idx, sizeof idx);
@@ -201,6 +232,8 @@ rl_status vt_part_import(vt_mesh *m, const rl_scene_data *d, const void *part, s
         return st;
     if ((st = vt_mesh_reserve(m, nv, 0, nf)) != RL_OK)
         return st;
+    uint32_t version;
+    memcpy(&version, (const unsigned char *)part + 4, 4);
     const unsigned char *p = (const unsigned char *)part + HEADER_BYTES;
     const uint32_t first = m->num_verts;
     for (uint32_t v = 0; v < nv; ++v) {
@@ -218,6 +251,8 @@ rl_status vt_part_import(vt_mesh *m, const rl_scene_data *d, const void *part, s
             p = get(p, &layers[l].texture, 4);
             p = get_vec2(p, &layers[l].uv);
         }
+        if (version == PART_VERSION_SAMPLES)
+            p += VERTEX_EXTRA_BYTES;  /* the post-pass' identity; drawing needs none */
         /* Before any face names it: a failure leaves the mesh as it was
          * but for unused room in the layer pool. */
         if ((st = vt_mesh_set_sample(m, first + v, &s, layers)) != RL_OK)
@@ -259,4 +294,114 @@ rl_status vt_part_import(vt_mesh *m, const rl_scene_data *d, const void *part, s
     m->num_verts += nv;
     m->num_faces += nf;
     return RL_OK;
+}
+
+/* ------------------------------------------- the post-pass' samples -- */
+
+rl_status vt_part_samples_build(vt_part_samples *ps, const void *const *parts, const size_t *sizes, size_t count)
+{
+    memset(ps, 0, sizeof *ps);
+    uint64_t total = 0;
+    for (size_t i = 0; i < count; ++i) {
+        uint32_t version, nv;
+        if (!parts[i] || sizes[i] < HEADER_BYTES)
+            continue;
+        memcpy(&version, (const unsigned char *)parts[i] + 4, 4);
+        memcpy(&nv, (const unsigned char *)parts[i] + 8, 4);
+        if (version == PART_VERSION_SAMPLES)
+            total += nv;
+    }
+    if (!total)
+        return RL_OK;           /* no part carries samples: the post-pass traces */
+    /* Load factor <= 1/2: every vertex the frame's refinement makes is
+     * looked up once, most of them found. */
+    size_t cap = 64;
+    while (cap < 2 * total)
+        cap *= 2;
+    ps->keys = rl_calloc(cap, sizeof *ps->keys);
+    ps->rec = rl_realloc_array(NULL, cap, sizeof *ps->rec);
+    if (!ps->keys || !ps->rec) {
+        vt_part_samples_free(ps);
+        return rl_error(RL_ERR_OUT_OF_MEMORY, "vt: the post-pass' map of %llu samples", (unsigned long long)total);
+    }
+    ps->cap = cap;
+    const uint32_t vbytes = vertex_bytes(PART_VERSION_SAMPLES);
+    for (size_t i = 0; i < count; ++i) {
+        uint32_t version, nv;
+        if (!parts[i] || sizes[i] < HEADER_BYTES)
+            continue;
+        memcpy(&version, (const unsigned char *)parts[i] + 4, 4);
+        memcpy(&nv, (const unsigned char *)parts[i] + 8, 4);
+        if (version != PART_VERSION_SAMPLES)
+            continue;
+        const unsigned char *body = (const unsigned char *)parts[i] + HEADER_BYTES;
+        for (uint32_t v = 0; v < nv; ++v) {
+            const unsigned char *rec = body + (size_t)v * vbytes;
+            uint64_t key;
+            memcpy(&key, rec + VERTEX_BYTES, 8);
+            key = vt_key_nonzero(key);
+            size_t k = (size_t)(rl_hash64(key) & (uint64_t)(cap - 1));
+            while (ps->keys[k] && ps->keys[k] != key)
+                k = (k + 1) & (cap - 1);
+            if (ps->keys[k])
+                continue;     /* a border vertex both sides sampled: the same sample */
+            ps->keys[k] = key;
+            ps->rec[k] = rec;
+            ps->count++;
+        }
+    }
+    return RL_OK;
+}
+
+bool vt_part_samples_take(const vt_part_samples *ps, vt_mesh *m, uint32_t v, bool *failed)
+{
+    if (!ps || !ps->cap)
+        return false;
+    const vt_vertex *x = &m->verts[v];
+    const uint64_t key = vt_key_nonzero(x->key);
+    size_t k = (size_t)(rl_hash64(key) & (uint64_t)(ps->cap - 1));
+    while (ps->keys[k] && ps->keys[k] != key)
+        k = (k + 1) & (ps->cap - 1);
+    if (!ps->keys[k])
+        return false;
+    /* The key is a hash: the position and triangle must agree too, or the
+     * vertex is traced (a sample depends only on those, Sec. 4.4). */
+    const unsigned char *p = ps->rec[k];
+    float pos[3];
+    uint32_t tri;
+    memcpy(pos, p, sizeof pos);
+    memcpy(&tri, p + VERTEX_BYTES + 8, 4);
+    const float mine[3] = { x->p.x, x->p.y, x->p.z };
+    if (memcmp(pos, mine, sizeof pos) != 0 || tri != x->triangle)
+        return false;
+    vt_vertex_sample s;
+    rl_trace_layer layers[RL_TRACE_LAYER_COUNT];
+    memset(&s, 0, sizeof s);
+    rl_vec3 skip3;
+    rl_vec2 skip2;
+    p = get_vec3(p, &skip3);
+    p = get_vec2(p, &skip2);
+    p = get_vec3(p, &s.flat);
+    for (int l = 0; l < RL_TRACE_LAYER_COUNT; ++l) {
+        p = get_vec3(p, &layers[l].diffuse);
+        p = get_vec3(p, &layers[l].rest);
+        p = get(p, &layers[l].texture, 4);
+        p = get_vec2(p, &layers[l].uv);
+    }
+    memcpy(&s.tree_hash, p + 12, 8);
+    /* As the sampling thread does (vt_sample.c): the criteria's view of
+     * the colour is computed from flat, so it is the tracer's bit for bit. */
+    vt_criteria_prepare(&s);
+    if (vt_mesh_set_sample(m, v, &s, layers) != RL_OK) {
+        *failed = true;
+        return false;
+    }
+    return true;
+}
+
+void vt_part_samples_free(vt_part_samples *ps)
+{
+    free(ps->keys);
+    free(ps->rec);
+    memset(ps, 0, sizeof *ps);
 }

@@ -8,9 +8,13 @@
 
 #include "render/vt_internal.h"
 
-/* The drawable leaf faces of m whose primary ancestor f has mine[f] != 0,
- * with their vertices, into a malloc'd buffer (*out, *size bytes). */
-rl_status vt_part_write(const vt_mesh *m, const rl_scene_data *d, const uint8_t *mine, void **out, size_t *size);
+/* The drawable leaf faces of m whose primary ancestor f has mine[f] == 1,
+ * with their vertices, into a malloc'd buffer (*out, *size bytes).
+ * all_samples (option dist_postpass): version 2, which also carries every
+ * other sampled vertex of m and each vertex's key, triangle and ray-tree
+ * hash, for the master's post-pass (Ullmann 2003, Sec. 6.1.3). */
+rl_status vt_part_write(const vt_mesh *m, const rl_scene_data *d, const uint8_t *mine, bool all_samples, void **out,
+                        size_t *size);
 /* Checks a part without a scene: header, sizes, checksum, vertex indices.
  * RL_ERR_PARSE with the reason. */
 rl_status vt_part_check(const void *part, size_t size, uint32_t *num_verts, uint32_t *num_faces);
@@ -18,5 +22,24 @@ rl_status vt_part_check(const void *part, size_t size, uint32_t *num_verts, uint
  * vt_part_check and a check of its triangles and objects against d; on
  * failure m is unchanged. */
 rl_status vt_part_import(vt_mesh *m, const rl_scene_data *d, const void *part, size_t size);
+
+/* The samples of checked version-2 parts by vertex key, for the master's
+ * post-pass: it replays one process' refinement and takes a vertex's
+ * sample from the parts instead of tracing it. The map points into the
+ * parts, which must outlive it. */
+typedef struct vt_part_samples {
+    uint64_t *keys;           /* vt_key_nonzero(key), 0 = empty slot */
+    const unsigned char **rec;/* the vertex's record in its part */
+    size_t cap, count;
+} vt_part_samples;
+
+/* Builds the map over the parts' version-2 vertices (version-1 parts add
+ * nothing); the parts must have passed vt_part_check. */
+rl_status vt_part_samples_build(vt_part_samples *ps, const void *const *parts, const size_t *sizes, size_t count);
+/* Stores the parts' sample of vertex v of m (its key, position and
+ * triangle must all match) and returns true; false when no part has it
+ * (the caller traces it), or, with *failed set, when out of memory. */
+bool vt_part_samples_take(const vt_part_samples *ps, vt_mesh *m, uint32_t v, bool *failed);
+void vt_part_samples_free(vt_part_samples *ps);
 
 #endif

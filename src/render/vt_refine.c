@@ -135,7 +135,7 @@ typedef struct refine_ctx {
 
 /* A package of a distributed frame (run->seed) refines its own faces: an
  * edge is its business when a face on either side descends from one of
- * them. Splits of border edges reach into the neighbours, whose insides
+ * them (or, with dist_postpass, from a face hidden in the ID test). Splits of border edges reach into the neighbours, whose insides
  * their own packages refine; without this test a package would refine
  * the neighbours' insides too, twice the work for nothing drawn. */
 static bool edge_in_package(const vt_run *run, const vt_edge *ed)
@@ -420,8 +420,8 @@ static bool primary_edge_seeds(const vt_run *run, const vt_edge *ed)
 {
     if (!run->seed)
         return primary_edge_visible(run->mesh, ed);
-    return (ed->face[0] != VT_NONE && run->seed[ed->face[0]]) ||
-           (ed->face[1] != VT_NONE && run->seed[ed->face[1]]);
+    return (ed->face[0] != VT_NONE && run->seed[ed->face[0]] == 1) ||
+           (ed->face[1] != VT_NONE && run->seed[ed->face[1]] == 1);
 }
 
 /* Sample reduction, Ullmann Sec. 6.2.1: the two ends of a visible primary

@@ -181,9 +181,16 @@ typedef struct vt_run {
     const uint32_t *tri_face; /* scene triangle -> primary face, VT_NONE */
     /* A package of a distributed frame (vt_part.c): per primary face, 1
      * for the package's faces, whose edges start the refinement; visible
-     * faces outside it are refined only where splits reach them. NULL: a
-     * whole frame, every visible face starts. */
+     * faces outside it are refined only where splits reach them; 2 (with
+     * dist_postpass) for the faces hidden in the ID test, which any
+     * package refines where its splits reach them, as one process does.
+     * NULL: a whole frame, every visible face starts. */
     const uint8_t *seed;
+    /* The master's post-pass of a distributed frame (vt_part.h, option
+     * dist_postpass): a vertex queued for sampling takes its sample from
+     * the packages' parts when one carries it, else it is traced. NULL:
+     * every queued vertex is traced. */
+    const struct vt_part_samples *given;
     rl_mat4 view_m, proj_m;   /* the rasterizer's matrices for this camera */
     /* per vertex, grown by the primary thread alongside mesh->verts */
     uint8_t *reason;

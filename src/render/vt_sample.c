@@ -25,6 +25,7 @@
 #endif
 
 #include "core/error.h"
+#include "render/vt_part.h"
 #include "render/vt_run.h"
 #include "rl/rl_rng.h"
 #include "rl/rl_timer.h"
@@ -414,6 +415,20 @@ static void queue_vertex(vt_run *run, uint32_t v, uint32_t pa, uint32_t pb)
     vt_vertex *vx = &run->mesh->verts[v];
     if (vx->state != VT_UNSAMPLED)
         return;
+    if (run->given) {
+        /* The post-pass (Sec. 6.1.3): a package sampled this vertex. It is
+         * sampled now rather than at the stage's flush, which changes no
+         * decision: a stage tests only edges whose ends an earlier stage
+         * queued (vt_sample_flush). */
+        bool failed = false;
+        if (vt_part_samples_take(run->given, run->mesh, v, &failed)) {
+            vx->state = VT_SAMPLED;
+            run->stats.postpass_reused++;
+            return;
+        }
+        run->failed |= failed;
+        run->stats.postpass_traced++;
+    }
     vx->state = VT_QUEUED;
     if (!run->set->presort) {
         add_to_block(run, v, pa, pb);

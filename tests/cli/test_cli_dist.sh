@@ -287,6 +287,23 @@ run_ok "${MPI[@]}" "$RL" --dist render table --algo vt --size 64x48 --set balanc
 expect_in "$TMP/out" "^dist: 3 ranks, [3-6] packages, "
 python3 -c 'import sys; sys.exit(float(sys.argv[1]) <= 0.998)' "$(python3 "$(dirname "${BASH_SOURCE[0]}")/ssim.py" \
     "$TMP/vt1.png" "$TMP/vtp.png")" || fail "vt: precompute too far from one process"
+# The master's post-pass (dist_postpass, Ullmann Sec. 6.1.3): the same
+# packages, and the master replays one process' refinement over their
+# samples, tracing only what no package sampled: the image is the
+# one-process image byte for byte, for queue on 3 ranks and precompute on 2.
+run_ok "${MPI[@]}" "$RL" --dist "${VT[@]}" --set dist_postpass=on --out "$TMP/vt3pp.png" \
+    --stats-json "$TMP/vt3pp.json"
+cmp -s "$TMP/vt1.png" "$TMP/vt3pp.png" || fail "vt: dist_postpass: 3 ranks differ from one process"
+expect_in "$TMP/out" "^dist: post-pass: [0-9]* samples from the parts, [0-9]* traced on the master"
+python3 - "$TMP/vt3pp.json" <<'PY' || fail "vt: dist_postpass: the dist record: $(head -c 600 "$TMP/vt3pp.json")"
+import json, sys
+d = json.load(open(sys.argv[1]))["dist"]
+p = d["postpass"]
+assert d["tasks"] == 10 and p["reused"] > 50 * p["traced"] and p["time_ms"] >= 0, d
+PY
+run_ok "${MPI2[@]}" "$RL" --dist render table --algo vt --size 64x48 --set balance=precompute \
+    --set dist_postpass=on --out "$TMP/vtppp.png"
+cmp -s "$TMP/vt1.png" "$TMP/vtppp.png" || fail "vt: dist_postpass: precompute on 2 ranks differs from one process"
 
 # reconstruct=gl: the workers refine on the CPU as always and the master
 # draws the parts with the GL drawer (Ullmann Sec. 3.5 on the GPU). The
@@ -332,6 +349,11 @@ for w in runs:
     assert two["messages_per_frame"] > 0 and two["bytes_per_frame"] > 0 and two["imbalance"] >= 1, two
     assert len(two["dist"]["per_rank"]) == 2, two
 PY
+# Its vt section with --vt-postpass ran by hand (bench/README.md): a run
+# here would add 40 s to this test under the sanitizers.
+expect_exit 2 "$RL" bench dist --vt-postpass maybe
+grep -q "^rl: error: bench dist: --vt-postpass: expected off, on or off,on" "$TMP/err" ||
+    fail "bench dist --vt-postpass maybe: $(cat "$TMP/err")"
 expect_exit 2 "$RL" bench dist --ranks 0,2
 grep -q "^rl: error: bench dist: --ranks: expected" "$TMP/err" || fail "bench dist --ranks 0: $(cat "$TMP/err")"
 
