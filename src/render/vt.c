@@ -1017,9 +1017,12 @@ static double edge_cost(const vt_run *run, const vt_mesh *m, const vt_edge *ed, 
         delta = (fabsf(sa->display.x - sb->display.x) + fabsf(sa->display.y - sb->display.y) +
                  fabsf(sa->display.z - sb->display.z)) / 3.0;
     } else {
-        float dh = fabsf(sa->h - sb->h);
+        float ha, sat_a, va, hb, sat_b, vb;
+        vt_rgb_to_hsv(sa->display, &ha, &sat_a, &va);
+        vt_rgb_to_hsv(sb->display, &hb, &sat_b, &vb);
+        float dh = fabsf(ha - hb);
         dh = dh > 0.5f ? 1.0f - dh : dh;
-        delta = (2.0 * dh + fabsf(sa->s - sb->s) + fabsf(sa->v - sb->v)) / 3.0;  /* hue circle: 0.5 at most */
+        delta = (2.0 * dh + fabsf(sat_a - sat_b) + fabsf(va - vb)) / 3.0;  /* hue circle: 0.5 at most */
     }
     /* An end behind the eye has no projection: the edge counts as the
      * longest possible. */

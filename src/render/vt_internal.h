@@ -70,11 +70,13 @@ typedef struct vt_vertex {
 typedef struct vt_vertex_sample {
     rl_vec3 flat;             /* radiance with deferred textures white; with
                                * textures=sampled the textured radiance */
-    /* flat as the criteria see it (vt_criteria_prepare): display values
-     * and their HSV, computed once by the thread that sampled the vertex
-     * instead of once per edge test on the refining thread */
+    /* flat as the criteria see it (vt_criteria_prepare): display values,
+     * computed once by the thread that sampled the vertex instead of once
+     * per edge test on the refining thread (three powf per end). Their HSV
+     * is not kept: it costs the HSV criterion a few compares and one
+     * division per end and test (vt_rgb_to_hsv), and would take 12 bytes
+     * of each of a refined mesh's hundreds of thousands of samples */
     rl_vec3 display;
-    float h, s, v;
     rl_vec3 diffuse, rest;    /* of the primary layer */
     uint32_t deferred[2];     /* reflection, refraction: index into
                                * vt_mesh.layers, VT_NONE when empty */
@@ -88,12 +90,13 @@ typedef struct vt_edge {
                                * (it created the edge), face[1] the other
                                * (v[1] -> v[0] when consistently wound);
                                * sub-edges keep the direction and slots */
-    uint32_t mid;             /* midpoint vertex once split, else VT_NONE */
     uint32_t child;           /* sub-edge (v[0],mid) once split, else VT_NONE;
-                               * (mid,v[1]) is child + 1 */
-    uint8_t queued;           /* currently in the edge list */
-    uint8_t forced;           /* split by forced refinement */
+                               * (mid,v[1]) is child + 1, so the midpoint is
+                               * the sub-edge's v[1] (vt_edge_mid) */
 } vt_edge;
+/* 20 bytes, four per generated vertex: whether an edge is in the edge
+ * list is a bit of vt_mesh.edge_queued, not a byte here that would pad
+ * the edge to 24. */
 
 typedef struct vt_face {
     uint32_t v[3];            /* counter-clockwise, as the source triangle */
@@ -112,6 +115,8 @@ typedef struct vt_mesh {
     vt_vertex *verts;  uint32_t num_verts, cap_verts;
     vt_vertex_sample *samples;  uint32_t cap_samples;   /* per vertex, like verts */
     vt_edge *edges;    uint32_t num_edges, cap_edges;
+    uint32_t *edge_queued;    /* bit e: edge e is in the edge list (vt_heap);
+                               * cap_edges bits */
     vt_face *faces;    uint32_t num_faces, cap_faces;
     rl_trace_layer *layers;  uint32_t num_layers, cap_layers;   /* the samples' deferred layers */
     uint32_t num_primary_verts, num_primary_edges, num_primary_faces;
@@ -151,6 +156,26 @@ rl_status vt_mesh_set_sample(vt_mesh *m, uint32_t v, const vt_vertex_sample *s,
  * the primary layer's texture (RL_NONE) and uv (0), which are not kept. */
 void vt_mesh_sample_layers(const vt_mesh *m, uint32_t v, rl_trace_layer out[RL_TRACE_LAYER_COUNT]);
 
+/* The midpoint vertex of edge e once split, else VT_NONE. */
+static inline uint32_t vt_edge_mid(const vt_mesh *m, uint32_t e)
+{
+    uint32_t c = m->edges[e].child;
+    return c != VT_NONE ? m->edges[c].v[1] : VT_NONE;
+}
+static inline bool vt_edge_is_split(const vt_edge *e)
+{
+    return e->child != VT_NONE;
+}
+static inline bool vt_edge_queued(const vt_mesh *m, uint32_t e)
+{
+    return (m->edge_queued[e >> 5] >> (e & 31)) & 1u;
+}
+static inline void vt_edge_set_queued(vt_mesh *m, uint32_t e, bool queued)
+{
+    uint32_t bit = 1u << (e & 31);
+    m->edge_queued[e >> 5] = queued ? m->edge_queued[e >> 5] | bit : m->edge_queued[e >> 5] & ~bit;
+}
+
 uint64_t vt_vertex_key_primary(uint32_t object, uint32_t index);
 /* Symmetric in a and b: the midpoint of an edge has the same key whichever
  * way round or in whichever order the edge was split. */
@@ -163,7 +188,7 @@ uint64_t vt_vertex_key_mid(uint64_t a, uint64_t b);
  * Each adjacent leaf face (a, b, c) with the edge (a, b) opposite c becomes
  * two leaf children (a, v', c) and (v', b, c), joined by a new edge (v', c);
  * the parent stops being a leaf; the children inherit its visible flag and
- * get the given stage. Edge e gets mid and child set. The faces' old edges
+ * get the given stage. Edge e gets its child set (vt_edge_mid is v'). The faces' old edges
  * get their face references moved to the children. Returns the new vertex
  * index, or VT_NONE when out of memory (the mesh is unchanged then) or when
  * e is already split (returns its mid then, no change).
@@ -207,7 +232,7 @@ typedef struct vt_criteria {
 /* Parses "rgb", "hsv", "tree", "tree+rgb", "tree+hsv" (also "rgb+tree",
  * "hsv+tree", and "rgb+hsv"); false for anything else. */
 bool vt_criteria_parse(const char *text, unsigned *bits);
-/* Fills display, h, s and v of a sample from its flat colour. */
+/* Fills the display values of a sample from its flat colour. */
 void vt_criteria_prepare(vt_vertex_sample *sample);
 /* The criteria that fire for the samples a and b (prepared), as
  * vt_criterion_bits; 0 = interpolation along the edge is acceptable.

@@ -84,8 +84,22 @@ static rl_status reserve(vt_mesh *m, uint32_t verts, uint32_t edges, uint32_t fa
     if (st == RL_OK)
         st = grow((void **)&m->samples, &m->cap_samples, m->num_verts + verts, sizeof *m->samples,
                   "vertices");
-    if (st == RL_OK)
+    if (st == RL_OK) {
+        uint32_t old_cap = m->cap_edges;
         st = grow((void **)&m->edges, &m->cap_edges, m->num_edges + edges, sizeof *m->edges, "edges");
+        if (st == RL_OK && m->cap_edges != old_cap) {
+            /* The queued bits follow the edges' capacity (a multiple of 256,
+             * so of 32); new words start clear. */
+            uint32_t words = m->cap_edges / 32, old_words = old_cap / 32;
+            uint32_t *q = rl_realloc_array(m->edge_queued, words, sizeof *q);
+            if (!q) {
+                m->cap_edges = old_cap;   /* the edges keep their new room unused */
+                return RL_ERR_OUT_OF_MEMORY;
+            }
+            memset(q + old_words, 0, (size_t)(words - old_words) * sizeof *q);
+            m->edge_queued = q;
+        }
+    }
     if (st == RL_OK)
         st = grow((void **)&m->faces, &m->cap_faces, m->num_faces + faces, sizeof *m->faces, "faces");
     return st;
@@ -238,8 +252,8 @@ static uint32_t new_edge(vt_mesh *m, uint32_t a, uint32_t b, uint32_t face)
     e->v[1] = b;
     e->face[0] = face;
     e->face[1] = VT_NONE;
-    e->mid = VT_NONE;
     e->child = VT_NONE;
+    vt_edge_set_queued(m, ei, false);
     return ei;
 }
 
@@ -367,6 +381,7 @@ void vt_mesh_free(vt_mesh *m)
     free(m->verts);
     free(m->samples);
     free(m->edges);
+    free(m->edge_queued);
     free(m->faces);
     free(m->layers);
     memset(m, 0, sizeof *m);
@@ -382,10 +397,8 @@ void vt_mesh_reset(vt_mesh *m)
         for (int s = 0; s < 2; ++s)
             while (e->face[s] != VT_NONE && e->face[s] >= m->num_primary_faces)
                 e->face[s] = m->faces[e->face[s]].parent;
-        e->mid = VT_NONE;
         e->child = VT_NONE;
-        e->queued = 0;
-        e->forced = 0;
+        vt_edge_set_queued(m, i, false);
     }
     for (uint32_t i = 0; i < m->num_primary_faces; ++i) {
         m->faces[i].leaf = 1;
@@ -437,8 +450,8 @@ uint32_t vt_mesh_split(vt_mesh *m, uint32_t e, uint16_t stage, uint32_t new_edge
     *num_new_faces = 0;
     if (e >= m->num_edges)
         return VT_NONE;
-    if (m->edges[e].mid != VT_NONE)
-        return m->edges[e].mid;
+    if (vt_edge_is_split(&m->edges[e]))
+        return vt_edge_mid(m, e);
     const vt_edge old = m->edges[e];
     int sides = 0;
     for (int s = 0; s < 2; ++s)
@@ -466,8 +479,7 @@ uint32_t vt_mesh_split(vt_mesh *m, uint32_t e, uint16_t stage, uint32_t new_edge
     uint32_t sub[2];
     sub[0] = new_edge(m, old.v[0], mid, VT_NONE);
     sub[1] = new_edge(m, mid, old.v[1], VT_NONE);
-    m->edges[e].mid = mid;
-    m->edges[e].child = sub[0];           /* sub[1] is sub[0] + 1 */
+    m->edges[e].child = sub[0];           /* sub[1] is sub[0] + 1; mid is sub[0].v[1] */
     new_edges[(*num_new_edges)++] = sub[0];
     new_edges[(*num_new_edges)++] = sub[1];
 

@@ -211,7 +211,7 @@ static void check_mesh(const vt_mesh *m, bool closed)
             const vt_edge *e = &m->edges[fc->e[i]];
             /* a leaf face's edges are unsplit, join the right corners and
              * reference the face back */
-            assert_int_equal(e->mid, VT_NONE);
+            assert_int_equal(e->child, VT_NONE);
             uint32_t a = fc->v[(i + 1) % 3], b = fc->v[(i + 2) % 3];
             assert_true((e->v[0] == a && e->v[1] == b) || (e->v[0] == b && e->v[1] == a));
             assert_true(e->face[0] == f || e->face[1] == f);
@@ -232,17 +232,19 @@ static void check_mesh(const vt_mesh *m, bool closed)
         const vt_edge *e = &m->edges[ei];
         assert_true(e->v[0] < m->num_verts && e->v[1] < m->num_verts);
         assert_true(e->v[0] != e->v[1]);
-        if (e->mid != VT_NONE) {
+        if (e->child != VT_NONE) {
             split_edges++;
+            const uint32_t mid = vt_edge_mid(m, ei);
+            assert_true(mid < m->num_verts);
             const vt_edge *c0 = &m->edges[e->child], *c1 = &m->edges[e->child + 1];
             assert_int_equal(c0->v[0], e->v[0]);
-            assert_int_equal(c0->v[1], e->mid);
-            assert_int_equal(c1->v[0], e->mid);
+            assert_int_equal(c0->v[1], mid);
+            assert_int_equal(c1->v[0], mid);
             assert_int_equal(c1->v[1], e->v[1]);
             rl_vec3 want = rl_scale(rl_add(m->verts[e->v[0]].p, m->verts[e->v[1]].p), 0.5f);
-            assert_float_equal(m->verts[e->mid].p.x, want.x, 1e-6);
-            assert_float_equal(m->verts[e->mid].p.y, want.y, 1e-6);
-            assert_float_equal(m->verts[e->mid].p.z, want.z, 1e-6);
+            assert_float_equal(m->verts[mid].p.x, want.x, 1e-6);
+            assert_float_equal(m->verts[mid].p.y, want.y, 1e-6);
+            assert_float_equal(m->verts[mid].p.z, want.z, 1e-6);
             /* no T-junction: every face beside a split edge was split too */
             for (int s = 0; s < 2; ++s)
                 if (e->face[s] != VT_NONE)
@@ -300,7 +302,7 @@ static void random_splits(vt_mesh *m, int count, uint64_t seed, bool closed, int
         uint32_t e;
         do
             e = (uint32_t)(rng_next(&seed) % m->num_edges);
-        while (m->edges[e].mid != VT_NONE);
+        while (m->edges[e].child != VT_NONE);
         int sides = (m->edges[e].face[0] != VT_NONE) + (m->edges[e].face[1] != VT_NONE);
         uint32_t a = m->edges[e].v[0], b = m->edges[e].v[1];
         uint32_t verts = m->num_verts, faces = m->num_faces;
@@ -548,7 +550,7 @@ static void test_split_of_one_edge_follows_fig_3_5(void **state)
 
     assert_int_equal(num_e, 4);
     assert_int_equal(num_f, 4);
-    assert_int_equal(m.edges[e].mid, 4);
+    assert_int_equal(vt_edge_mid(&m, e), 4);
     assert_false(m.faces[0].leaf);
     assert_false(m.faces[1].leaf);
     /* (a, b, c) = (0, 1, 2): children (0, v', 2) and (v', 1, 2) */
@@ -697,7 +699,7 @@ static void test_reset_restores_the_primary_mesh(void **state)
         for (uint32_t v = 0; v < m.num_verts; ++v)
             m.verts[v].state = VT_SAMPLED;
         for (uint32_t e = 0; e < m.num_edges; ++e)
-            m.edges[e].queued = 1;
+            vt_edge_set_queued(&m, e, true);
         random_splits(&m, 500, 77 + (uint64_t)round, false, 1000);
         uint32_t cap = m.cap_faces;
         vt_mesh_reset(&m);
@@ -711,10 +713,8 @@ static void test_reset_restores_the_primary_mesh(void **state)
             assert_int_equal(a->v[1], b->v[1]);
             assert_int_equal(a->face[0], b->face[0]);
             assert_int_equal(a->face[1], b->face[1]);
-            assert_int_equal(a->mid, VT_NONE);
             assert_int_equal(a->child, VT_NONE);
-            assert_int_equal(a->queued, 0);
-            assert_int_equal(a->forced, 0);
+            assert_int_equal(vt_edge_queued(&m, e), 0);
         }
         for (uint32_t f = 0; f < m.num_faces; ++f) {
             assert_memory_equal(m.faces[f].v, fresh.faces[f].v, sizeof m.faces[f].v);
