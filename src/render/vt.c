@@ -154,8 +154,7 @@ typedef struct vt_state {
     uint64_t mesh_scene;
     char *mesh_objects;
     uint8_t *object_vt, *object_raster;
-    uint32_t *tri_face;
-    vt_mesh mesh;
+    vt_mesh mesh;                 /* its tri_face maps triangles to primary faces */
     bool mesh_valid;
     vt_heap heap;
     /* temporal coherence */
@@ -216,7 +215,6 @@ static void vt_release(void *state)
     free(s->mesh_objects);
     free(s->object_vt);
     free(s->object_raster);
-    free(s->tri_face);
     vt_mesh_free(&s->mesh);
     vt_heap_free(&s->heap);
     vt_feeler_map_free(&s->feelers);
@@ -356,19 +354,16 @@ static rl_status ensure_mesh(vt_state *s, const rl_scene *scene, const rl_scene_
     s->mesh_valid = false;
     free(s->object_vt);
     free(s->object_raster);
-    free(s->tri_face);
     free(s->mesh_objects);
     s->object_raster = s->object_vt = NULL;
-    s->tri_face = NULL;
     s->mesh_objects = NULL;
     vt_mesh_free(&s->mesh);
     size_t no = d->num_objects ? d->num_objects : 1;
     s->object_vt = rl_calloc(no, 1);
     s->object_raster = rl_calloc(no, 1);
-    s->tri_face = rl_realloc_array(NULL, d->num_triangles ? d->num_triangles : 1, sizeof *s->tri_face);
     size_t len = strlen(spec);
     s->mesh_objects = malloc(len + 1);
-    if (!s->object_vt || !s->object_raster || !s->tri_face || !s->mesh_objects)
+    if (!s->object_vt || !s->object_raster || !s->mesh_objects)
         return RL_ERR_OUT_OF_MEMORY;
     memcpy(s->mesh_objects, spec, len + 1);
     rl_status st = select_objects(scene, d, spec, s->object_vt);
@@ -378,10 +373,6 @@ static rl_status ensure_mesh(vt_state *s, const rl_scene *scene, const rl_scene_
         return st;
     for (uint32_t o = 0; o < d->num_objects; ++o)
         s->object_raster[o] = !s->object_vt[o];
-    for (uint32_t t = 0; t < d->num_triangles; ++t)
-        s->tri_face[t] = VT_NONE;
-    for (uint32_t f = 0; f < s->mesh.num_primary_faces; ++f)
-        s->tri_face[s->mesh.faces[f].triangle] = f;
     s->mesh_scene = uid;
     s->mesh_valid = true;
     return RL_OK;
@@ -480,19 +471,31 @@ static void keep_mesh(vt_state *s, vt_run *run)
 }
 
 /* Copies the refined mesh out for rl_vt_get_mesh. */
+static bool pick_leaf(const void *user, const vt_face *f)
+{
+    (void)user;
+    return f->leaf;
+}
+
 static rl_status copy_mesh(vt_state *s)
 {
     const vt_mesh *m = &s->mesh;
-    size_t faces = 0;
-    for (uint32_t f = 0; f < m->num_faces; ++f)
-        faces += m->faces[f].leaf;
+    /* The leaves in creation order (vt_mesh.drop_parents reuses slots). */
+    uint32_t *order = NULL;
+    size_t order_cap = 0, faces = 0;
+    if (vt_mesh_pick_in_order(m, pick_leaf, NULL, &order, &order_cap, &faces) != RL_OK)
+        return rl_error(RL_ERR_OUT_OF_MEMORY, "rl_vt_get_mesh: %u faces", m->num_faces);
     rl_vt_vertex_info *vi = rl_realloc_array(s->vinfo, m->num_verts ? m->num_verts : 1, sizeof *vi);
-    if (!vi)
+    if (!vi) {
+        free(order);
         return rl_error(RL_ERR_OUT_OF_MEMORY, "rl_vt_get_mesh: %u vertices", m->num_verts);
+    }
     s->vinfo = vi;
     uint32_t *fi = rl_realloc_array(s->finfo, faces ? 3 * faces : 1, sizeof *fi);
-    if (!fi)
+    if (!fi) {
+        free(order);
         return rl_error(RL_ERR_OUT_OF_MEMORY, "rl_vt_get_mesh: %zu faces", faces);
+    }
     s->finfo = fi;
     for (uint32_t v = 0; v < m->num_verts; ++v) {
         const vt_vertex *x = &m->verts[v];
@@ -500,12 +503,10 @@ static rl_status copy_mesh(vt_state *s)
                                      v < s->num_reason ? s->reason[v] : 0 };
     }
     size_t k = 0;
-    for (uint32_t f = 0; f < m->num_faces; ++f) {
-        if (!m->faces[f].leaf)
-            continue;
+    for (size_t i = 0; i < faces; ++i)
         for (int j = 0; j < 3; ++j)
-            fi[k++] = m->faces[f].v[j];
-    }
+            fi[k++] = m->faces[order[i]].v[j];
+    free(order);
     s->num_vinfo = m->num_verts;
     s->num_finfo = faces;
     s->have_copy = true;
@@ -561,7 +562,7 @@ static void setup_run(vt_run *run, rl_renderer *r, vt_state *s, const rl_scene_d
     run->heap = &s->heap;
     run->object_vt = s->object_vt;
     run->object_raster = s->object_raster;
-    run->tri_face = s->tri_face;
+    run->tri_face = s->mesh.tri_face;
     run->want_tree = (set->criteria.bits & VT_CRIT_TREE) != 0;
     run->cache = set->coherence && s->feelers.count ? &s->feelers : NULL;
     run->renderer = r;

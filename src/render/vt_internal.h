@@ -89,7 +89,10 @@ typedef struct vt_edge {
                                * face[0] has v[0] -> v[1] counter-clockwise
                                * (it created the edge), face[1] the other
                                * (v[1] -> v[0] when consistently wound);
-                               * sub-edges keep the direction and slots */
+                               * sub-edges keep the direction and slots.
+                               * Once the edge is split, a slot may hold the
+                               * face's first child (vt_mesh.drop_parents):
+                               * then only its primary face is read */
     uint32_t child;           /* sub-edge (v[0],mid) once split, else VT_NONE;
                                * (mid,v[1]) is child + 1, so the midpoint is
                                * the sub-edge's v[1] (vt_edge_mid) */
@@ -102,8 +105,12 @@ typedef struct vt_face {
     uint32_t v[3];            /* counter-clockwise, as the source triangle */
     uint32_t e[3];            /* e[i] joins v[(i+1)%3] and v[(i+2)%3] (opposite v[i]) */
     uint32_t triangle;        /* source scene triangle (its object is
-                               * rl_scene_data.triangle_object's) */
-    uint32_t parent;          /* VT_NONE for a primary face */
+                               * rl_scene_data.triangle_object's); its
+                               * primary face is the face's primary
+                               * ancestor (vt_face_root) */
+    uint32_t seq;             /* creation number since the last reset: the
+                               * draw order (equals the index unless the mesh
+                               * drops split parents, vt_mesh.drop_parents) */
     uint16_t stage;           /* stage that created it (overdraw offset k, Sec. 3.5.1) */
     uint8_t leaf;             /* not split (drawn) */
     uint8_t visible;          /* its primary ancestor passed the ID-buffer test */
@@ -118,6 +125,18 @@ typedef struct vt_mesh {
     uint32_t *edge_queued;    /* bit e: edge e is in the edge list (vt_heap);
                                * cap_edges bits */
     vt_face *faces;    uint32_t num_faces, cap_faces;
+    uint32_t num_created;     /* faces created since the last reset, primary
+                               * ones included: the next face's seq */
+    /* When set, a split face that is not primary gives its slot to its
+     * first child instead of staying behind as a non-leaf: nothing reads
+     * it again (its edges' face references move to the children, and the
+     * primary ancestor is found through the triangle). About half a refined
+     * mesh's faces are such parents. Unset (the default), every face stays
+     * (vt_draw's progressive overdraw redraws the faces of the last
+     * stages, split or not; the shaft test keeps a verdict per face). */
+    bool drop_parents;
+    uint32_t *tri_face;       /* scene triangle -> its primary face, VT_NONE */
+    uint32_t num_tri_face;
     rl_trace_layer *layers;  uint32_t num_layers, cap_layers;   /* the samples' deferred layers */
     uint32_t num_primary_verts, num_primary_edges, num_primary_faces;
 } vt_mesh;
@@ -137,6 +156,23 @@ void vt_mesh_free(vt_mesh *m);
  * state (edges unsplit and unqueued, faces leaf and invisible, vertices
  * unsampled): the start of a new camera frame. Keeps the allocations. */
 void vt_mesh_reset(vt_mesh *m);
+
+/* The primary face that face f descends from (f itself when primary);
+ * VT_NONE for a face that is not of the mesh's triangles (vt_part_import). */
+static inline uint32_t vt_face_root(const vt_mesh *m, uint32_t f)
+{
+    if (f < m->num_primary_faces)
+        return f;
+    uint32_t t = m->faces[f].triangle;
+    return t < m->num_tri_face ? m->tri_face[t] : VT_NONE;
+}
+
+/* The faces for which pick(user, face) holds, in creation order (vt_face.seq),
+ * into *list (grown as needed, capacity *cap); their number in *count.
+ * The order is the one faces had when every split parent stayed: children
+ * after all faces created before them. RL_ERR_OUT_OF_MEMORY. */
+rl_status vt_mesh_pick_in_order(const vt_mesh *m, bool (*pick)(const void *user, const vt_face *f),
+                                const void *user, uint32_t **list, size_t *cap, size_t *count);
 
 /* Bytes the mesh's elements take (counts times sizes, without the arrays'
  * spare room). */
@@ -187,8 +223,9 @@ uint64_t vt_vertex_key_mid(uint64_t a, uint64_t b);
  * adjacent face, key vt_vertex_key_mid, stage as given, state UNSAMPLED.
  * Each adjacent leaf face (a, b, c) with the edge (a, b) opposite c becomes
  * two leaf children (a, v', c) and (v', b, c), joined by a new edge (v', c);
- * the parent stops being a leaf; the children inherit its visible flag and
- * get the given stage. Edge e gets its child set (vt_edge_mid is v'). The faces' old edges
+ * the parent stops being a leaf, or, with drop_parents and when it is not
+ * primary, the first child takes its slot; the children inherit its visible
+ * flag and triangle, get the given stage and the next two seq numbers. Edge e gets its child set (vt_edge_mid is v'). The faces' old edges
  * get their face references moved to the children. Returns the new vertex
  * index, or VT_NONE when out of memory (the mesh is unchanged then) or when
  * e is already split (returns its mid then, no change).

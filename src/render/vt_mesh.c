@@ -114,7 +114,58 @@ uint64_t vt_mesh_bytes(const vt_mesh *m)
 {
     return (uint64_t)m->num_verts * (sizeof *m->verts + sizeof *m->samples) +
            (uint64_t)m->num_edges * sizeof *m->edges + (uint64_t)m->num_faces * sizeof *m->faces +
-           (uint64_t)m->num_layers * sizeof *m->layers;
+           (uint64_t)m->num_layers * sizeof *m->layers + ((uint64_t)m->num_edges + 7) / 8;
+}
+
+rl_status vt_mesh_pick_in_order(const vt_mesh *m, bool (*pick)(const void *user, const vt_face *f),
+                                const void *user, uint32_t **list, size_t *cap, size_t *count)
+{
+    *count = 0;
+    size_t n = 0;
+    for (uint32_t f = 0; f < m->num_faces; ++f)
+        n += pick(user, &m->faces[f]);
+    if (!n)
+        return RL_OK;
+    if (!rl_reserve((void **)list, cap, n, sizeof **list, 1024))
+        return RL_ERR_OUT_OF_MEMORY;
+    uint32_t *out = *list;
+    if (m->num_created == m->num_faces) {
+        /* No slot was reused: seq is the index. */
+        for (uint32_t f = 0; f < m->num_faces; ++f)
+            if (pick(user, &m->faces[f]))
+                out[(*count)++] = f;
+        return RL_OK;
+    }
+    /* A face's place is the number of picked faces created before it: a
+     * bit per seq and a running count per 64 of them (a fraction of a
+     * list indexed by seq, which would be twice the faces drawn). */
+    size_t words = ((size_t)m->num_created + 63) / 64;
+    uint64_t *bits = rl_calloc(words, sizeof *bits);
+    uint32_t *before = rl_realloc_array(NULL, words, sizeof *before);
+    if (!bits || !before) {
+        free(bits);
+        free(before);
+        return RL_ERR_OUT_OF_MEMORY;
+    }
+    for (uint32_t f = 0; f < m->num_faces; ++f)
+        if (pick(user, &m->faces[f]))
+            bits[m->faces[f].seq >> 6] |= 1ull << (m->faces[f].seq & 63);
+    uint32_t sum = 0;
+    for (size_t w = 0; w < words; ++w) {
+        before[w] = sum;
+        sum += (uint32_t)__builtin_popcountll(bits[w]);
+    }
+    for (uint32_t f = 0; f < m->num_faces; ++f) {
+        uint32_t q = m->faces[f].seq;
+        if (!((bits[q >> 6] >> (q & 63)) & 1u))
+            continue;
+        uint64_t below = bits[q >> 6] & ((1ull << (q & 63)) - 1u);
+        out[before[q >> 6] + (uint32_t)__builtin_popcountll(below)] = f;
+    }
+    free(bits);
+    free(before);
+    *count = n;
+    return RL_OK;
 }
 
 /* ------------------------------------------------------------- samples -- */
@@ -324,8 +375,9 @@ static rl_status build_object(vt_mesh *m, const rl_scene_data *d, uint32_t o, bu
         memset(f, 0, sizeof *f);
         memcpy(f->v, fv, sizeof fv);
         f->triangle = t;
-        f->parent = VT_NONE;
+        f->seq = fi;
         f->leaf = 1;
+        m->tri_face[t] = fi;
         f->height = -1.0f;
         for (int i = 0; i < 3; ++i)
             f->e[i] = pair_edge(m, s, edge_size - 1, fv[(i + 1) % 3], fv[(i + 2) % 3], fi);
@@ -346,6 +398,12 @@ rl_status vt_mesh_build(vt_mesh *m, const rl_scene_data *d, const uint8_t *objec
         if (d->objects[o].num_triangles > max_triangles)
             max_triangles = d->objects[o].num_triangles;
     }
+    m->tri_face = rl_realloc_array(NULL, d->num_triangles ? d->num_triangles : 1, sizeof *m->tri_face);
+    if (!m->tri_face)
+        return RL_ERR_OUT_OF_MEMORY;
+    m->num_tri_face = d->num_triangles;
+    for (uint32_t t = 0; t < d->num_triangles; ++t)
+        m->tri_face[t] = VT_NONE;
     if (max_triangles == 0)
         return RL_OK;
     uint64_t corners = 3ull * max_triangles;
@@ -371,6 +429,7 @@ rl_status vt_mesh_build(vt_mesh *m, const rl_scene_data *d, const uint8_t *objec
     m->num_primary_verts = m->num_verts;
     m->num_primary_edges = m->num_edges;
     m->num_primary_faces = m->num_faces;
+    m->num_created = m->num_faces;
     return RL_OK;
 }
 
@@ -384,19 +443,21 @@ void vt_mesh_free(vt_mesh *m)
     free(m->edge_queued);
     free(m->faces);
     free(m->layers);
+    free(m->tri_face);
     memset(m, 0, sizeof *m);
 }
 
 void vt_mesh_reset(vt_mesh *m)
 {
     /* Splits moved the primary edges' face references down to descendants;
-     * walking the parent chain finds the primary face again without storing
-     * a copy of the original adjacency. */
+     * a descendant's triangle names its primary face, so the original
+     * adjacency needs no copy. (Primary faces never give their slot away,
+     * so their corners and edges are still the built ones.) */
     for (uint32_t i = 0; i < m->num_primary_edges; ++i) {
         vt_edge *e = &m->edges[i];
         for (int s = 0; s < 2; ++s)
-            while (e->face[s] != VT_NONE && e->face[s] >= m->num_primary_faces)
-                e->face[s] = m->faces[e->face[s]].parent;
+            if (e->face[s] != VT_NONE)
+                e->face[s] = vt_face_root(m, e->face[s]);
         e->child = VT_NONE;
         vt_edge_set_queued(m, i, false);
     }
@@ -412,6 +473,7 @@ void vt_mesh_reset(vt_mesh *m)
     m->num_verts = m->num_primary_verts;
     m->num_edges = m->num_primary_edges;
     m->num_faces = m->num_primary_faces;
+    m->num_created = m->num_primary_faces;
     m->num_layers = 0;
 }
 
@@ -425,17 +487,16 @@ static void replace_face(vt_edge *e, uint32_t from, uint32_t to)
         e->face[1] = to;
 }
 
-static uint32_t add_face(vt_mesh *m, const vt_face *parent, uint32_t parent_index, uint32_t a,
-                         uint32_t b, uint32_t c, uint32_t ea, uint32_t eb, uint32_t ec,
-                         uint16_t stage)
+/* A child of parent into slot fi (a new one, or the parent's own). */
+static uint32_t add_face(vt_mesh *m, const vt_face *parent, uint32_t fi, uint32_t a, uint32_t b,
+                         uint32_t c, uint32_t ea, uint32_t eb, uint32_t ec, uint16_t stage)
 {
-    uint32_t fi = m->num_faces++;
     vt_face *f = &m->faces[fi];
     memset(f, 0, sizeof *f);
     f->v[0] = a; f->v[1] = b; f->v[2] = c;
     f->e[0] = ea; f->e[1] = eb; f->e[2] = ec;
     f->triangle = parent->triangle;
-    f->parent = parent_index;
+    f->seq = m->num_created++;
     f->stage = stage;
     f->leaf = 1;
     f->visible = parent->visible;
@@ -501,9 +562,12 @@ uint32_t vt_mesh_split(vt_mesh *m, uint32_t e, uint16_t stage, uint32_t new_edge
         uint32_t sub_b = sub_a == sub[0] ? sub[1] : sub[0];
         /* (a, v', c): e[0] = (v', c), e[1] = (c, a), e[2] = (a, v');
          * (v', b, c): e[0] = (b, c), e[1] = (c, v'), e[2] = (v', b). */
-        uint32_t f1 = add_face(m, &parent, fi, a, mid, c, inner, e_ca, sub_a, stage);
-        uint32_t f2 = add_face(m, &parent, fi, mid, b, c, e_bc, inner, sub_b, stage);
-        m->faces[fi].leaf = 0;
+        /* A primary parent stays: vt_mesh_reset starts from it again. */
+        const bool reuse = m->drop_parents && fi >= m->num_primary_faces;
+        uint32_t f1 = add_face(m, &parent, reuse ? fi : m->num_faces++, a, mid, c, inner, e_ca, sub_a, stage);
+        uint32_t f2 = add_face(m, &parent, m->num_faces++, mid, b, c, e_bc, inner, sub_b, stage);
+        if (!reuse)
+            m->faces[fi].leaf = 0;
         m->edges[inner].face[0] = f1;
         m->edges[inner].face[1] = f2;
         m->edges[sub_a].face[s] = f1;

@@ -144,9 +144,7 @@ static bool edge_in_package(const vt_run *run, const vt_edge *ed)
         return true;
     const vt_mesh *m = run->mesh;
     for (int k = 0; k < 2; ++k) {
-        uint32_t f = ed->face[k];
-        while (f != VT_NONE && f >= m->num_primary_faces)
-            f = m->faces[f].parent;
+        uint32_t f = ed->face[k] != VT_NONE ? vt_face_root(m, ed->face[k]) : VT_NONE;
         if (f != VT_NONE && run->seed[f])
             return true;
     }
@@ -558,6 +556,14 @@ rl_status vt_refine(vt_run *run)
     refine_ctx ctx;
     memset(&ctx, 0, sizeof ctx);
     ctx.run = run;
+    /* A whole frame drawn once at its end reads no split face again: the
+     * first child takes a split face's slot (about half of the faces of a
+     * refined mesh). The progressive overdraw redraws the faces of the last
+     * stages, split or not (vt_draw), the shaft test keeps a verdict per
+     * face slot, and a package's result is written in index order
+     * (vt_part_write): those keep every face. */
+    run->mesh->drop_parents = !run->seed && run->set->shaft_cull == VT_SHAFT_OFF &&
+                              !(run->update && run->set->progressive == VT_PROG_OVERDRAW);
     double t0 = now_ms();
     if (run->set->shaft_cull != VT_SHAFT_OFF) {
         rl_status st = vt_shaft_index_build(&ctx.shafts, run->data);

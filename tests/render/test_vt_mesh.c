@@ -185,26 +185,34 @@ static bool face_has_edge_ccw(const vt_face *f, uint32_t a, uint32_t b)
 static void check_mesh(const vt_mesh *m, bool closed)
 {
     uint32_t split_edges = 0, live_edges = 0, leaf_faces = 0;
-    double *child_area = calloc(m->num_faces, sizeof *child_area);
-    uint32_t *child_count = calloc(m->num_faces, sizeof *child_count);
-    assert_non_null(child_area);
-    assert_non_null(child_count);
+    /* per primary face: the area of its leaves */
+    double *leaf_area = calloc(m->num_primary_faces ? m->num_primary_faces : 1, sizeof *leaf_area);
+    uint8_t *seq_seen = calloc(m->num_created ? m->num_created : 1, 1);
+    assert_non_null(leaf_area);
+    assert_non_null(seq_seen);
 
     for (uint32_t f = 0; f < m->num_faces; ++f) {
         const vt_face *fc = &m->faces[f];
-        assert_true((f < m->num_primary_faces) == (fc->parent == VT_NONE));
-        if (fc->parent != VT_NONE) {
-            assert_true(fc->parent < f);
-            assert_false(m->faces[fc->parent].leaf);
-            child_area[fc->parent] += face_area(m, f);
-            child_count[fc->parent]++;
-            /* same orientation as the parent */
-            assert_true(rl_dot(face_cross(m, f), face_cross(m, fc->parent)) > 0.0f);
-            assert_int_equal(fc->triangle, m->faces[fc->parent].triangle);
+        /* seq: unique, below num_created; the index when nothing was dropped */
+        assert_true(fc->seq < m->num_created);
+        assert_false(seq_seen[fc->seq]);
+        seq_seen[fc->seq] = 1;
+        if (!m->drop_parents)
+            assert_int_equal(fc->seq, f);
+        uint32_t root = vt_face_root(m, f);
+        assert_true(root < m->num_primary_faces);
+        assert_int_equal(m->faces[root].triangle, fc->triangle);
+        if (f >= m->num_primary_faces) {
+            /* same orientation as its primary face; a dropped parent
+             * leaves only leaves behind */
+            assert_true(rl_dot(face_cross(m, f), face_cross(m, root)) > 0.0f);
+            if (m->drop_parents)
+                assert_true(fc->leaf);
         }
         if (!fc->leaf)
             continue;
         leaf_faces++;
+        leaf_area[root] += face_area(m, f);
         for (int i = 0; i < 3; ++i) {
             assert_true(fc->v[i] < m->num_verts);
             assert_true(fc->e[i] < m->num_edges);
@@ -217,15 +225,11 @@ static void check_mesh(const vt_mesh *m, bool closed)
             assert_true(e->face[0] == f || e->face[1] == f);
         }
     }
-    for (uint32_t f = 0; f < m->num_faces; ++f) {
-        if (m->faces[f].leaf) {
-            assert_int_equal(child_count[f], 0);
-            continue;
-        }
-        assert_int_equal(child_count[f], 2);
+    /* the leaves of each primary face cover it exactly */
+    for (uint32_t f = 0; f < m->num_primary_faces; ++f) {
         double a = face_area(m, f);
-        if (!(fabs(child_area[f] - a) <= 1e-4 * a + 1e-12))
-            fail_msg("face %u: area %g, children %g", f, a, child_area[f]);
+        if (!(fabs(leaf_area[f] - a) <= 1e-4 * a + 1e-12))
+            fail_msg("face %u: area %g, leaves %g", f, a, leaf_area[f]);
     }
 
     for (uint32_t ei = 0; ei < m->num_edges; ++ei) {
@@ -245,10 +249,17 @@ static void check_mesh(const vt_mesh *m, bool closed)
             assert_float_equal(m->verts[mid].p.x, want.x, 1e-6);
             assert_float_equal(m->verts[mid].p.y, want.y, 1e-6);
             assert_float_equal(m->verts[mid].p.z, want.z, 1e-6);
-            /* no T-junction: every face beside a split edge was split too */
+            /* no T-junction: every face beside a split edge was split too
+             * (with drop_parents its slot may hold its first child: a split
+             * edge's faces are read only for their primary face, which the
+             * child shares) */
             for (int s = 0; s < 2; ++s)
-                if (e->face[s] != VT_NONE)
-                    assert_false(m->faces[e->face[s]].leaf);
+                if (e->face[s] != VT_NONE) {
+                    if (!m->drop_parents || e->face[s] < m->num_primary_faces)
+                        assert_false(m->faces[e->face[s]].leaf);
+                    else
+                        assert_true(vt_face_root(m, e->face[s]) < m->num_primary_faces);
+                }
             continue;
         }
         assert_int_equal(e->child, VT_NONE);
@@ -282,8 +293,8 @@ static void check_mesh(const vt_mesh *m, bool closed)
             leaves += face_area(m, f);
     }
     assert_true(fabs(primary - leaves) <= 1e-5 * primary);
-    free(child_area);
-    free(child_count);
+    free(leaf_area);
+    free(seq_seen);
 }
 
 static uint64_t rng_next(uint64_t *s)
@@ -312,7 +323,10 @@ static void random_splits(vt_mesh *m, int count, uint64_t seed, bool closed, int
         assert_int_equal(m->num_verts, verts + 1);
         assert_int_equal(num_e, 2 + (uint32_t)sides);
         assert_int_equal(num_f, 2 * (uint32_t)sides);
-        assert_int_equal(m->num_faces, faces + 2 * (uint32_t)sides);
+        if (m->drop_parents)     /* a split face that is not primary gives its slot */
+            assert_true(m->num_faces >= faces + (uint32_t)sides && m->num_faces <= faces + 2 * (uint32_t)sides);
+        else
+            assert_int_equal(m->num_faces, faces + 2 * (uint32_t)sides);
         assert_int_equal(ne[0], m->edges[e].child);
         assert_int_equal(ne[1], m->edges[e].child + 1);
         for (uint32_t k = 0; k < num_f; ++k) {
@@ -561,7 +575,9 @@ static void test_split_of_one_edge_follows_fig_3_5(void **state)
     assert_int_equal(f2->v[0], 4);
     assert_int_equal(f2->v[1], 1);
     assert_int_equal(f2->v[2], 2);
-    assert_int_equal(f1->parent, 0);
+    assert_int_equal(vt_face_root(&m, nf[0]), 0);
+    assert_int_equal(f1->seq, nf[0]);
+    assert_int_equal(f2->seq, nf[1]);
     assert_int_equal(f1->stage, 3);
     assert_int_equal(f1->visible, 0);
     /* the other side (1, 0, 3) split on (1, 0): (1, v', 3) and (v', 0, 3),
@@ -574,7 +590,7 @@ static void test_split_of_one_edge_follows_fig_3_5(void **state)
     assert_int_equal(f4->v[1], 0);
     assert_int_equal(f4->v[2], 3);
     assert_int_equal(f3->visible, 1);
-    assert_int_equal(f4->parent, 1);
+    assert_int_equal(vt_face_root(&m, nf[3]), 1);
     /* inner edges v' -> c */
     assert_int_equal(m.edges[ne[2]].v[0], 4);
     assert_int_equal(m.edges[ne[2]].v[1], 2);
@@ -682,6 +698,103 @@ static void test_random_splits_on_committed_sphere(void **state)
     random_splits(&m, 2000, 0x5eed, false, 250);
     vt_mesh_free(&m);
     rl_scene_release(s);
+}
+
+static bool pick_leaf(const void *user, const vt_face *f)
+{
+    (void)user;
+    return f->leaf;
+}
+
+/* vt_mesh.drop_parents: the same splits give the same leaves, in the same
+ * creation order (the draw order), with about half the faces; reset
+ * restores the primary mesh. */
+static void dropped_parents_match(toy *t, bool closed, uint64_t seed)
+{
+    uint8_t mask[1] = { 1 };
+    vt_mesh keep = { 0 }, drop = { 0 }, fresh = { 0 };
+    assert_int_equal(vt_mesh_build(&keep, toy_data(t), mask), RL_OK);
+    assert_int_equal(vt_mesh_build(&drop, toy_data(t), mask), RL_OK);
+    assert_int_equal(vt_mesh_build(&fresh, toy_data(t), mask), RL_OK);
+    for (int round = 0; round < 2; ++round) {
+        drop.drop_parents = true;
+        for (uint32_t f = 0; f < keep.num_faces; ++f)
+            keep.faces[f].visible = drop.faces[f].visible = (uint8_t)(f % 3 != 0);
+        uint64_t s = seed + (uint64_t)round;
+        for (int i = 0; i < 3000; ++i) {
+            uint32_t e;
+            do
+                e = (uint32_t)(rng_next(&s) % keep.num_edges);
+            while (keep.edges[e].child != VT_NONE);
+            uint32_t ne[4], nf[4], num_e, num_f, ne2[4], nf2[4], num_e2, num_f2;
+            uint32_t v1 = vt_mesh_split(&keep, e, (uint16_t)(1 + i % 5), ne, &num_e, nf, &num_f);
+            uint32_t v2 = vt_mesh_split(&drop, e, (uint16_t)(1 + i % 5), ne2, &num_e2, nf2, &num_f2);
+            /* edges and vertices do not depend on the faces' slots */
+            assert_int_equal(v1, v2);
+            assert_int_equal(num_e, num_e2);
+            assert_int_equal(num_f, num_f2);
+            assert_memory_equal(ne, ne2, num_e * sizeof *ne);
+            for (uint32_t k = 0; k < num_f; ++k) {
+                assert_memory_equal(keep.faces[nf[k]].v, drop.faces[nf2[k]].v, sizeof keep.faces[0].v);
+                assert_int_equal(keep.faces[nf[k]].seq, drop.faces[nf2[k]].seq);
+            }
+            if ((i + 1) % 500 == 0)
+                check_mesh(&drop, closed);
+        }
+        check_mesh(&drop, closed);
+        check_mesh(&keep, closed);
+        assert_int_equal(keep.num_verts, drop.num_verts);
+        assert_int_equal(keep.num_edges, drop.num_edges);
+        assert_int_equal(keep.num_created, drop.num_created);
+        /* 3000 splits of a small mesh: most split faces are not primary */
+        assert_true(drop.num_faces < keep.num_faces * 2 / 3);
+        uint32_t *lk = NULL, *ld = NULL;
+        size_t ck = 0, cd = 0, nk = 0, nd = 0;
+        assert_int_equal(vt_mesh_pick_in_order(&keep, pick_leaf, NULL, &lk, &ck, &nk), RL_OK);
+        assert_int_equal(vt_mesh_pick_in_order(&drop, pick_leaf, NULL, &ld, &cd, &nd), RL_OK);
+        assert_int_equal(nk, nd);
+        for (size_t i = 0; i < nk; ++i) {
+            const vt_face *a = &keep.faces[lk[i]], *b = &drop.faces[ld[i]];
+            assert_memory_equal(a->v, b->v, sizeof a->v);
+            assert_memory_equal(a->e, b->e, sizeof a->e);
+            assert_int_equal(a->triangle, b->triangle);
+            assert_int_equal(a->seq, b->seq);
+            assert_int_equal(a->stage, b->stage);
+            assert_int_equal(a->visible, b->visible);
+            assert_int_equal(vt_face_root(&keep, lk[i]), vt_face_root(&drop, ld[i]));
+            if (i > 0)
+                assert_true(drop.faces[ld[i - 1]].seq < b->seq);
+        }
+        free(lk);
+        free(ld);
+        vt_mesh_reset(&keep);
+        vt_mesh_reset(&drop);
+        assert_int_equal(drop.num_faces, fresh.num_faces);
+        assert_int_equal(drop.num_created, fresh.num_faces);
+        for (uint32_t e = 0; e < drop.num_edges; ++e) {
+            assert_int_equal(drop.edges[e].face[0], fresh.edges[e].face[0]);
+            assert_int_equal(drop.edges[e].face[1], fresh.edges[e].face[1]);
+        }
+        for (uint32_t f = 0; f < drop.num_faces; ++f) {
+            assert_memory_equal(drop.faces[f].v, fresh.faces[f].v, sizeof drop.faces[f].v);
+            assert_memory_equal(drop.faces[f].e, fresh.faces[f].e, sizeof drop.faces[f].e);
+        }
+    }
+    vt_mesh_free(&keep);
+    vt_mesh_free(&drop);
+    vt_mesh_free(&fresh);
+}
+
+static void test_dropped_parents_keep_the_leaves_and_their_order(void **state)
+{
+    (void)state;
+    toy t;
+    toy_grid(&t, 8);
+    dropped_parents_match(&t, false, 0x77aa);
+    toy_free(&t);
+    toy_cube_soup(&t);
+    dropped_parents_match(&t, true, 0x1357);
+    toy_free(&t);
 }
 
 static void test_reset_restores_the_primary_mesh(void **state)
@@ -864,6 +977,7 @@ int main(void)
         cmocka_unit_test(test_random_splits_keep_grid_consistent),
         cmocka_unit_test(test_random_splits_keep_cube_closed),
         cmocka_unit_test(test_random_splits_on_committed_sphere),
+        cmocka_unit_test(test_dropped_parents_keep_the_leaves_and_their_order),
         cmocka_unit_test(test_reset_restores_the_primary_mesh),
         cmocka_unit_test(test_samples_keep_only_deferred_layers_that_are_not_empty),
         cmocka_unit_test(test_keys_are_distinct_and_mid_is_symmetric),
