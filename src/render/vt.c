@@ -181,7 +181,13 @@ typedef struct vt_state {
     int ras_threads;
     rl_drawer *gl;            /* reconstruct = gl, on gl_device */
     char gl_device[64];
-    rl_image *depth_ids;      /* the pre-pass' depth and IDs */
+    rl_image *depth_ids;      /* the pre-pass' depth */
+    uint32_t *prepass_ids;    /* the pre-pass' triangle IDs, width*height,
+                               * kept between frames while they are small
+                               * (small_frames), else made for each pre-pass */
+    size_t prepass_pixels;
+    bool small_frames;        /* the last frame generated fewer than
+                               * VT_LARGE_FRAME_VERTICES vertices */
     float *scratch_depth;     /* the frame's depth when the image has none */
     size_t scratch_pixels;
     vt_corners corners;
@@ -224,6 +230,7 @@ static void vt_release(void *state)
     rl_raster_release(s->ras);
     rl_drawer_release(s->gl);
     rl_image_release(s->depth_ids);
+    free(s->prepass_ids);
     free(s->scratch_depth);
     vt_corners_free(&s->corners);
     vt_base_free(&s->base);
@@ -258,7 +265,7 @@ static rl_status frame_buffers(vt_state *s, int threads, const rl_image *image)
     if (!s->depth_ids || s->depth_ids->width != width || s->depth_ids->height != height) {
         rl_image_release(s->depth_ids);
         s->depth_ids = NULL;
-        if ((st = rl_image_create(width, height, RL_LAYER_DEPTH | RL_LAYER_ID, &s->depth_ids)) != RL_OK)
+        if ((st = rl_image_create(width, height, RL_LAYER_DEPTH, &s->depth_ids)) != RL_OK)
             return st;
     }
     return RL_OK;
@@ -632,6 +639,34 @@ static bool vt_available(const rl_renderer *r, char *why, size_t n)
     return false;
 }
 
+/* Generated vertices from which a frame gives its pre-pass image, edge
+ * list and draw corners back once it is done with them (run_frame). */
+#define VT_LARGE_FRAME_VERTICES 65536u
+
+/* The ID-buffer pre-pass (vt_prepass) with a triangle-ID buffer that lives
+ * only as long as it is read, unless the last frame was small: a frame
+ * that refines far peaks later, with the whole mesh, and has no use for 4
+ * bytes a pixel meanwhile (4 MB at 1024^2); small frames of a preview keep
+ * it instead of faulting it in again. */
+static rl_status run_prepass(vt_state *s, vt_run *run)
+{
+    const size_t n = (size_t)s->depth_ids->width * (size_t)s->depth_ids->height;
+    if (s->prepass_pixels != n) {
+        free(s->prepass_ids);
+        s->prepass_pixels = 0;
+        if (!(s->prepass_ids = rl_realloc_array(NULL, n ? n : 1, sizeof *s->prepass_ids)))
+            return rl_error(RL_ERR_OUT_OF_MEMORY, "vt: triangle IDs of %zu pixels", n);
+        s->prepass_pixels = n;
+    }
+    rl_status st = vt_prepass(run, s->depth_ids, s->prepass_ids);
+    if (!s->small_frames) {
+        free(s->prepass_ids);
+        s->prepass_ids = NULL;
+        s->prepass_pixels = 0;
+    }
+    return st;
+}
+
 /* Fig. 3.17: the ID/Z pre-pass with the rasterized half, the refinement
  * with its sampling, the final draw; then what the next frame keeps
  * (feelers, the refined mesh). */
@@ -646,18 +681,37 @@ static rl_status run_frame(vt_run *run, vt_state *s, const vt_settings *set, rl_
     run->base = &s->base;
     double t0 = rl_time_s() * 1000.0;
     if (st == RL_OK)
-        st = vt_prepass(run, s->depth_ids);
+        st = run_prepass(s, run);
     /* The rasterized half drawn inside the pre-pass counts as drawing. */
     run->stats.time_visibility_ms = rl_time_s() * 1000.0 - t0 - run->stats.time_draw_ms;
     if (st == RL_OK)
         st = vt_refine(run);
     run->stats.mesh_bytes = vt_mesh_bytes(run->mesh);
+    /* A frame that refined far keeps its buffers only as long as it needs
+     * them: the peak is at the frame's end, with the whole mesh, the draw's
+     * corners and the feeler map being rebuilt (heaptrack). The pre-pass
+     * image (12 MB at 1024^2) and the emptied edge list are not read after
+     * the refinement (a distributed frame's pre-pass is made again after a
+     * frame, s->prepared), the corners not after the final draw. Faulting
+     * them in again costs the next frame a few ms, where a frame of this
+     * size samples for seconds; a small frame keeps them (warm frames of
+     * an interactive preview). */
+    const bool large = run->mesh->num_verts - run->mesh->num_primary_verts >= VT_LARGE_FRAME_VERTICES;
+    s->small_frames = !large;
+    if (large) {
+        rl_image_release(s->depth_ids);
+        s->depth_ids = NULL;
+        run->view.depth = NULL;
+        vt_heap_free(run->heap);
+    }
     if (st == RL_OK) {
         double td = rl_time_s() * 1000.0;
         if (!vt_update(run, run->stats.stages, true) && run->failed)
             st = RL_ERR_OUT_OF_MEMORY;
         run->stats.time_draw_ms += rl_time_s() * 1000.0 - td;
     }
+    if (large)
+        vt_corners_free(&s->corners);
     if (st == RL_OK && set->coherence)
         st = keep_feelers(s, run);
     if (st == RL_OK)
@@ -855,7 +909,7 @@ static rl_status dist_prepass(rl_renderer *r, vt_state *s, const rl_scene *scene
         s->package = pkg;
     if (!vis || !list || !pkg)
         return rl_error(RL_ERR_OUT_OF_MEMORY, "vt: face flags of %zu faces", nf);
-    rl_status st = vt_prepass(run, s->depth_ids);
+    rl_status st = run_prepass(s, run);
     if (st != RL_OK)
         return st;
     s->prep_count = 0;
@@ -1175,8 +1229,8 @@ const rl_renderer_class rl_vt_renderer_class = {
     .info = { .name = "vt",
               .description = "Vertex Tracing: adaptive progressive ray tracing in object space, hybrid with rasterization",
               .reference = "Ullmann 2003, Ch. 3-4",
-              /* frame_buffers(): scratch depth, and depth and IDs of the pre-pass */
-              .frame_bytes_per_pixel = 2 * sizeof(float) + 2 * sizeof(uint32_t) },
+              /* frame_buffers(): scratch depth, and depth and triangle IDs of the pre-pass */
+              .frame_bytes_per_pixel = 2 * sizeof(float) + sizeof(uint32_t) },
     .options = vt_options,
     .num_options = sizeof vt_options / sizeof vt_options[0],
     .state_size = sizeof(vt_state),

@@ -45,8 +45,15 @@ static double now_ms(void)
 
 /* ------------------------------------------------------------ pre-pass -- */
 
-rl_status vt_prepass(vt_run *run, rl_image *depth_ids)
+rl_status vt_prepass(vt_run *run, rl_image *depth_image, uint32_t *triangle_ids)
 {
+    /* The target with the triangle IDs and no object IDs (a NULL layer is
+     * not written, rl_raster_target_for). */
+    rl_image target = *depth_image;
+    target.layers |= RL_LAYER_ID;
+    target.object_id = NULL;
+    target.triangle_id = triangle_ids;
+    rl_image *depth_ids = &target;
     const vt_settings *set = run->set;
     vt_mesh *m = run->mesh;
     rl_image frame;
