@@ -79,7 +79,8 @@ typedef struct vt_vertex_sample {
     rl_vec3 display;
     rl_vec3 diffuse, rest;    /* of the primary layer */
     uint32_t deferred[2];     /* reflection, refraction: index into
-                               * vt_mesh.layers, VT_NONE when empty */
+                               * vt_mesh.layers, or with VT_PLAIN_LAYER
+                               * set into vt_mesh.plain; VT_NONE when empty */
     uint64_t tree_hash;       /* rl_ray_tree_hash of its ray tree */
 } vt_vertex_sample;
 
@@ -118,6 +119,14 @@ typedef struct vt_face {
                                * for it this frame, else negative */
 } vt_face;
 
+/* A deferred layer without texture (RL_NONE): most reflected and
+ * refracted terms (only textured surfaces seen in a mirror have more), 24
+ * bytes instead of rl_trace_layer's 36; its uv is never read. */
+typedef struct vt_plain_layer {
+    rl_vec3 diffuse, rest;
+} vt_plain_layer;
+#define VT_PLAIN_LAYER 0x80000000u   /* vt_vertex_sample.deferred: in vt_mesh.plain */
+
 typedef struct vt_mesh {
     vt_vertex *verts;  uint32_t num_verts, cap_verts;
     vt_vertex_sample *samples;  uint32_t cap_samples;   /* per vertex, like verts */
@@ -138,6 +147,7 @@ typedef struct vt_mesh {
     uint32_t *tri_face;       /* scene triangle -> its primary face, VT_NONE */
     uint32_t num_tri_face;
     rl_trace_layer *layers;  uint32_t num_layers, cap_layers;   /* the samples' deferred layers */
+    vt_plain_layer *plain;   uint32_t num_plain, cap_plain;     /* ... those without texture and uv */
     uint32_t num_primary_verts, num_primary_edges, num_primary_faces;
 } vt_mesh;
 
@@ -189,7 +199,8 @@ rl_status vt_mesh_reserve(vt_mesh *m, uint32_t verts, uint32_t edges, uint32_t f
 rl_status vt_mesh_set_sample(vt_mesh *m, uint32_t v, const vt_vertex_sample *s,
                              const rl_trace_layer layers[RL_TRACE_LAYER_COUNT]);
 /* The layers of vertex v's sample as vt_mesh_set_sample got them, but for
- * the primary layer's texture (RL_NONE) and uv (0), which are not kept. */
+ * the primary layer's texture (RL_NONE) and uv (0), and the uv (0) of a
+ * deferred layer without texture, which are not kept. */
 void vt_mesh_sample_layers(const vt_mesh *m, uint32_t v, rl_trace_layer out[RL_TRACE_LAYER_COUNT]);
 
 /* The midpoint vertex of edge e once split, else VT_NONE. */

@@ -114,7 +114,8 @@ uint64_t vt_mesh_bytes(const vt_mesh *m)
 {
     return (uint64_t)m->num_verts * (sizeof *m->verts + sizeof *m->samples) +
            (uint64_t)m->num_edges * sizeof *m->edges + (uint64_t)m->num_faces * sizeof *m->faces +
-           (uint64_t)m->num_layers * sizeof *m->layers + ((uint64_t)m->num_edges + 7) / 8;
+           (uint64_t)m->num_layers * sizeof *m->layers + (uint64_t)m->num_plain * sizeof *m->plain +
+           ((uint64_t)m->num_edges + 7) / 8;
 }
 
 rl_status vt_mesh_pick_in_order(const vt_mesh *m, bool (*pick)(const void *user, const vt_face *f),
@@ -180,14 +181,31 @@ static bool layer_empty(const rl_trace_layer *L)
     return memcmp(L, &no_layer, sizeof no_layer) == 0;
 }
 
+/* A layer without texture: its uv is never read (rl_trace_layer_color,
+ * vt_draw's lookups, the rasterizer's layers sample only a texture), so it
+ * is not kept; it comes back as 0. */
+static bool layer_plain(const rl_trace_layer *L)
+{
+    return L->texture == RL_NONE;
+}
+
 rl_status vt_mesh_set_sample(vt_mesh *m, uint32_t v, const vt_vertex_sample *s,
                              const rl_trace_layer layers[RL_TRACE_LAYER_COUNT])
 {
     const rl_trace_layer *deferred[2] = { &layers[RL_TRACE_LAYER_REFLECTION], &layers[RL_TRACE_LAYER_REFRACTION] };
-    uint32_t need = !layer_empty(deferred[0]) + !layer_empty(deferred[1]);
-    if (need > VT_MESH_MAX_ELEMENTS - m->num_layers)
+    uint32_t need = 0, need_plain = 0;
+    for (int k = 0; k < 2; ++k)
+        if (!layer_empty(deferred[k])) {
+            if (layer_plain(deferred[k]))
+                ++need_plain;
+            else
+                ++need;
+        }
+    if (need > VT_MESH_MAX_ELEMENTS - m->num_layers || need_plain > VT_MESH_MAX_ELEMENTS - m->num_plain)
         return rl_error(RL_ERR_LIMIT, "vt mesh: more than 2^31 deferred layers");
     rl_status st = grow((void **)&m->layers, &m->cap_layers, m->num_layers + need, sizeof *m->layers, "layers");
+    if (st == RL_OK)
+        st = grow((void **)&m->plain, &m->cap_plain, m->num_plain + need_plain, sizeof *m->plain, "layers");
     if (st != RL_OK)
         return st;
     vt_vertex_sample *out = &m->samples[v];
@@ -196,7 +214,12 @@ rl_status vt_mesh_set_sample(vt_mesh *m, uint32_t v, const vt_vertex_sample *s,
     out->rest = layers[RL_TRACE_LAYER_PRIMARY].rest;
     for (int k = 0; k < 2; ++k) {
         out->deferred[k] = VT_NONE;
-        if (!layer_empty(deferred[k])) {
+        if (layer_empty(deferred[k]))
+            continue;
+        if (layer_plain(deferred[k])) {
+            out->deferred[k] = VT_PLAIN_LAYER | m->num_plain;
+            m->plain[m->num_plain++] = (vt_plain_layer){ deferred[k]->diffuse, deferred[k]->rest };
+        } else {
             out->deferred[k] = m->num_layers;
             m->layers[m->num_layers++] = *deferred[k];
         }
@@ -204,12 +227,23 @@ rl_status vt_mesh_set_sample(vt_mesh *m, uint32_t v, const vt_vertex_sample *s,
     return RL_OK;
 }
 
+static rl_trace_layer unpack_layer(const vt_mesh *m, uint32_t index)
+{
+    if (index == VT_NONE)
+        return no_layer;
+    if (index & VT_PLAIN_LAYER) {
+        const vt_plain_layer *p = &m->plain[index & ~VT_PLAIN_LAYER];
+        return (rl_trace_layer){ p->diffuse, p->rest, RL_NONE, { 0.0f, 0.0f } };
+    }
+    return m->layers[index];
+}
+
 void vt_mesh_sample_layers(const vt_mesh *m, uint32_t v, rl_trace_layer out[RL_TRACE_LAYER_COUNT])
 {
     const vt_vertex_sample *s = &m->samples[v];
     out[RL_TRACE_LAYER_PRIMARY] = (rl_trace_layer){ s->diffuse, s->rest, RL_NONE, { 0.0f, 0.0f } };
-    out[RL_TRACE_LAYER_REFLECTION] = s->deferred[0] != VT_NONE ? m->layers[s->deferred[0]] : no_layer;
-    out[RL_TRACE_LAYER_REFRACTION] = s->deferred[1] != VT_NONE ? m->layers[s->deferred[1]] : no_layer;
+    out[RL_TRACE_LAYER_REFLECTION] = unpack_layer(m, s->deferred[0]);
+    out[RL_TRACE_LAYER_REFRACTION] = unpack_layer(m, s->deferred[1]);
 }
 
 /* ------------------------------------------------------------- building -- */
@@ -443,6 +477,7 @@ void vt_mesh_free(vt_mesh *m)
     free(m->edge_queued);
     free(m->faces);
     free(m->layers);
+    free(m->plain);
     free(m->tri_face);
     memset(m, 0, sizeof *m);
 }
@@ -475,6 +510,7 @@ void vt_mesh_reset(vt_mesh *m)
     m->num_faces = m->num_primary_faces;
     m->num_created = m->num_primary_faces;
     m->num_layers = 0;
+    m->num_plain = 0;
 }
 
 /* ------------------------------------------------------------ splitting -- */

@@ -871,7 +871,7 @@ static void test_samples_keep_only_deferred_layers_that_are_not_empty(void **sta
     /* 0: primary only; 1: a reflection; 2: both, one of them -0 only (not
      * empty bitwise); 3: a refraction with a texture and nothing else */
     in[0][RL_TRACE_LAYER_PRIMARY] = (rl_trace_layer){ { 0.5f, 0.25f, 1 }, { 0.125f, 0, 0 }, 7, { 0.3f, 0.6f } };
-    in[1][RL_TRACE_LAYER_REFLECTION] = (rl_trace_layer){ { 0.1f, 0.2f, 0.3f }, { 1, 2, 3 }, RL_NONE, { 0, 0 } };
+    in[1][RL_TRACE_LAYER_REFLECTION] = (rl_trace_layer){ { 0.1f, 0.2f, 0.3f }, { 1, 2, 3 }, RL_NONE, { 0.5f, 0.25f } };
     in[2][RL_TRACE_LAYER_REFLECTION] = (rl_trace_layer){ { -0.0f, 0, 0 }, { 0, 0, 0 }, RL_NONE, { 0, 0 } };
     in[2][RL_TRACE_LAYER_REFRACTION] = (rl_trace_layer){ { 4, 5, 6 }, { 7, 8, 9 }, 2, { 0.75f, 0.5f } };
     in[3][RL_TRACE_LAYER_REFRACTION] = (rl_trace_layer){ { 0, 0, 0 }, { 0, 0, 0 }, 1, { 0, 0 } };
@@ -882,7 +882,11 @@ static void test_samples_keep_only_deferred_layers_that_are_not_empty(void **sta
         s.tree_hash = 1000 + v;
         assert_int_equal(vt_mesh_set_sample(&m, v, &s, in[v]), RL_OK);
     }
-    assert_int_equal(m.num_layers, 4);
+    /* untextured ones (1's reflection, 2's -0 reflection) in the plain pool */
+    assert_int_equal(m.num_layers, 2);
+    assert_int_equal(m.num_plain, 2);
+    assert_true(m.samples[1].deferred[0] & VT_PLAIN_LAYER);
+    assert_false(m.samples[3].deferred[1] & VT_PLAIN_LAYER);
     assert_int_equal(m.samples[0].deferred[0], VT_NONE);
     assert_int_equal(m.samples[0].deferred[1], VT_NONE);
     assert_int_equal(m.samples[1].deferred[1], VT_NONE);
@@ -896,12 +900,18 @@ static void test_samples_keep_only_deferred_layers_that_are_not_empty(void **sta
         want.texture = RL_NONE;
         want.uv = rl_v2(0, 0);
         assert_memory_equal(&out[RL_TRACE_LAYER_PRIMARY], &want, sizeof want);
-        assert_memory_equal(&out[RL_TRACE_LAYER_REFLECTION], &in[v][RL_TRACE_LAYER_REFLECTION], sizeof want);
-        assert_memory_equal(&out[RL_TRACE_LAYER_REFRACTION], &in[v][RL_TRACE_LAYER_REFRACTION], sizeof want);
+        /* a deferred layer without texture: its uv (never read) is 0 */
+        for (int l = RL_TRACE_LAYER_REFLECTION; l <= RL_TRACE_LAYER_REFRACTION; ++l) {
+            want = in[v][l];
+            if (want.texture == RL_NONE)
+                want.uv = rl_v2(0, 0);
+            assert_memory_equal(&out[l], &want, sizeof want);
+        }
         assert_true(m.samples[v].flat.x == (float)v && m.samples[v].tree_hash == 1000 + v);
     }
     vt_mesh_reset(&m);
     assert_int_equal(m.num_layers, 0);
+    assert_int_equal(m.num_plain, 0);
     vt_mesh_free(&m);
     toy_free(&t);
 }
