@@ -46,6 +46,9 @@
 #ifdef _OPENMP
 #include <omp.h>
 #endif
+#if defined(__GLIBC__)
+#include <malloc.h>
+#endif
 
 #include "core/error.h"
 #include "render/accel_cache.h"
@@ -639,6 +642,15 @@ static bool vt_available(const rl_renderer *r, char *why, size_t n)
     return false;
 }
 
+/* Hands freed heap pages back to the system (glibc keeps freed chunks
+ * below the top of the heap resident); elsewhere a no-op. */
+static void give_back_freed(void)
+{
+#if defined(__GLIBC__)
+    malloc_trim(0);
+#endif
+}
+
 /* Generated vertices from which a frame gives its pre-pass image, edge
  * list and draw corners back once it is done with them (run_frame). */
 #define VT_LARGE_FRAME_VERTICES 65536u
@@ -703,6 +715,7 @@ static rl_status run_frame(vt_run *run, vt_state *s, const vt_settings *set, rl_
         s->depth_ids = NULL;
         run->view.depth = NULL;
         vt_heap_free(run->heap);
+        give_back_freed();
     }
     if (st == RL_OK) {
         double td = rl_time_s() * 1000.0;
@@ -710,8 +723,10 @@ static rl_status run_frame(vt_run *run, vt_state *s, const vt_settings *set, rl_
             st = RL_ERR_OUT_OF_MEMORY;
         run->stats.time_draw_ms += rl_time_s() * 1000.0 - td;
     }
-    if (large)
+    if (large) {
         vt_corners_free(&s->corners);
+        give_back_freed();
+    }
     if (st == RL_OK && set->coherence)
         st = keep_feelers(s, run);
     if (st == RL_OK)
