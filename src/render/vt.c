@@ -46,6 +46,9 @@
 #ifdef _OPENMP
 #include <omp.h>
 #endif
+#if defined(__GLIBC__)
+#include <malloc.h>
+#endif
 
 #include "core/error.h"
 #include "render/accel_cache.h"
@@ -167,8 +170,7 @@ typedef struct vt_state {
     uint64_t mesh_scene;
     char *mesh_objects;
     uint8_t *object_vt, *object_raster;
-    uint32_t *tri_face;
-    vt_mesh mesh;
+    vt_mesh mesh;                 /* its tri_face maps triangles to primary faces */
     bool mesh_valid;
     vt_heap heap;
     /* temporal coherence */
@@ -195,7 +197,13 @@ typedef struct vt_state {
     int ras_threads;
     rl_drawer *gl;            /* reconstruct = gl, on gl_device */
     char gl_device[64];
-    rl_image *depth_ids;      /* the pre-pass' depth and IDs */
+    rl_image *depth_ids;      /* the pre-pass' depth */
+    uint32_t *prepass_ids;    /* the pre-pass' triangle IDs, width*height,
+                               * kept between frames while they are small
+                               * (small_frames), else made for each pre-pass */
+    size_t prepass_pixels;
+    bool small_frames;        /* the last frame generated fewer than
+                               * VT_LARGE_FRAME_VERTICES vertices */
     float *scratch_depth;     /* the frame's depth when the image has none */
     size_t scratch_pixels;
     vt_corners corners;
@@ -229,7 +237,6 @@ static void vt_release(void *state)
     free(s->mesh_objects);
     free(s->object_vt);
     free(s->object_raster);
-    free(s->tri_face);
     vt_mesh_free(&s->mesh);
     vt_heap_free(&s->heap);
     vt_feeler_map_free(&s->feelers);
@@ -239,6 +246,7 @@ static void vt_release(void *state)
     rl_raster_release(s->ras);
     rl_drawer_release(s->gl);
     rl_image_release(s->depth_ids);
+    free(s->prepass_ids);
     free(s->scratch_depth);
     vt_corners_free(&s->corners);
     vt_base_free(&s->base);
@@ -273,7 +281,7 @@ static rl_status frame_buffers(vt_state *s, int threads, const rl_image *image)
     if (!s->depth_ids || s->depth_ids->width != width || s->depth_ids->height != height) {
         rl_image_release(s->depth_ids);
         s->depth_ids = NULL;
-        if ((st = rl_image_create(width, height, RL_LAYER_DEPTH | RL_LAYER_ID, &s->depth_ids)) != RL_OK)
+        if ((st = rl_image_create(width, height, RL_LAYER_DEPTH, &s->depth_ids)) != RL_OK)
             return st;
     }
     return RL_OK;
@@ -369,19 +377,16 @@ static rl_status ensure_mesh(vt_state *s, const rl_scene *scene, const rl_scene_
     s->mesh_valid = false;
     free(s->object_vt);
     free(s->object_raster);
-    free(s->tri_face);
     free(s->mesh_objects);
     s->object_raster = s->object_vt = NULL;
-    s->tri_face = NULL;
     s->mesh_objects = NULL;
     vt_mesh_free(&s->mesh);
     size_t no = d->num_objects ? d->num_objects : 1;
     s->object_vt = rl_calloc(no, 1);
     s->object_raster = rl_calloc(no, 1);
-    s->tri_face = rl_realloc_array(NULL, d->num_triangles ? d->num_triangles : 1, sizeof *s->tri_face);
     size_t len = strlen(spec);
     s->mesh_objects = malloc(len + 1);
-    if (!s->object_vt || !s->object_raster || !s->tri_face || !s->mesh_objects)
+    if (!s->object_vt || !s->object_raster || !s->mesh_objects)
         return RL_ERR_OUT_OF_MEMORY;
     memcpy(s->mesh_objects, spec, len + 1);
     rl_status st = select_objects(scene, d, spec, s->object_vt);
@@ -391,10 +396,6 @@ static rl_status ensure_mesh(vt_state *s, const rl_scene *scene, const rl_scene_
         return st;
     for (uint32_t o = 0; o < d->num_objects; ++o)
         s->object_raster[o] = !s->object_vt[o];
-    for (uint32_t t = 0; t < d->num_triangles; ++t)
-        s->tri_face[t] = VT_NONE;
-    for (uint32_t f = 0; f < s->mesh.num_primary_faces; ++f)
-        s->tri_face[s->mesh.faces[f].triangle] = f;
     s->mesh_scene = uid;
     s->mesh_valid = true;
     return RL_OK;
@@ -496,19 +497,31 @@ static void keep_mesh(vt_state *s, vt_run *run)
 }
 
 /* Copies the refined mesh out for rl_vt_get_mesh. */
+static bool pick_leaf(const void *user, const vt_face *f)
+{
+    (void)user;
+    return f->leaf;
+}
+
 static rl_status copy_mesh(vt_state *s)
 {
     const vt_mesh *m = &s->mesh;
-    size_t faces = 0;
-    for (uint32_t f = 0; f < m->num_faces; ++f)
-        faces += m->faces[f].leaf;
+    /* The leaves in creation order (vt_mesh.drop_parents reuses slots). */
+    uint32_t *order = NULL;
+    size_t order_cap = 0, faces = 0;
+    if (vt_mesh_pick_in_order(m, pick_leaf, NULL, &order, &order_cap, &faces) != RL_OK)
+        return rl_error(RL_ERR_OUT_OF_MEMORY, "rl_vt_get_mesh: %u faces", m->num_faces);
     rl_vt_vertex_info *vi = rl_realloc_array(s->vinfo, m->num_verts ? m->num_verts : 1, sizeof *vi);
-    if (!vi)
+    if (!vi) {
+        free(order);
         return rl_error(RL_ERR_OUT_OF_MEMORY, "rl_vt_get_mesh: %u vertices", m->num_verts);
+    }
     s->vinfo = vi;
     uint32_t *fi = rl_realloc_array(s->finfo, faces ? 3 * faces : 1, sizeof *fi);
-    if (!fi)
+    if (!fi) {
+        free(order);
         return rl_error(RL_ERR_OUT_OF_MEMORY, "rl_vt_get_mesh: %zu faces", faces);
+    }
     s->finfo = fi;
     for (uint32_t v = 0; v < m->num_verts; ++v) {
         const vt_vertex *x = &m->verts[v];
@@ -516,12 +529,10 @@ static rl_status copy_mesh(vt_state *s)
                                      v < s->num_reason ? s->reason[v] : 0 };
     }
     size_t k = 0;
-    for (uint32_t f = 0; f < m->num_faces; ++f) {
-        if (!m->faces[f].leaf)
-            continue;
+    for (size_t i = 0; i < faces; ++i)
         for (int j = 0; j < 3; ++j)
-            fi[k++] = m->faces[f].v[j];
-    }
+            fi[k++] = m->faces[order[i]].v[j];
+    free(order);
     s->num_vinfo = m->num_verts;
     s->num_finfo = faces;
     s->have_copy = true;
@@ -579,7 +590,7 @@ static void setup_run(vt_run *run, rl_renderer *r, vt_state *s, const rl_scene_d
     run->heap = &s->heap;
     run->object_vt = s->object_vt;
     run->object_raster = s->object_raster;
-    run->tri_face = s->tri_face;
+    run->tri_face = s->mesh.tri_face;
     run->want_tree = (set->criteria.bits & VT_CRIT_TREE) != 0;
     run->cache = set->coherence && s->feelers.count ? &s->feelers : NULL;
     run->renderer = r;
@@ -649,6 +660,43 @@ static bool vt_available(const rl_renderer *r, char *why, size_t n)
     return false;
 }
 
+/* Hands freed heap pages back to the system (glibc keeps freed chunks
+ * below the top of the heap resident); elsewhere a no-op. */
+static void give_back_freed(void)
+{
+#if defined(__GLIBC__)
+    malloc_trim(0);
+#endif
+}
+
+/* Generated vertices from which a frame gives its pre-pass image, edge
+ * list and draw corners back once it is done with them (run_frame). */
+#define VT_LARGE_FRAME_VERTICES 65536u
+
+/* The ID-buffer pre-pass (vt_prepass) with a triangle-ID buffer that lives
+ * only as long as it is read, unless the last frame was small: a frame
+ * that refines far peaks later, with the whole mesh, and has no use for 4
+ * bytes a pixel meanwhile (4 MB at 1024^2); small frames of a preview keep
+ * it instead of faulting it in again. */
+static rl_status run_prepass(vt_state *s, vt_run *run)
+{
+    const size_t n = (size_t)s->depth_ids->width * (size_t)s->depth_ids->height;
+    if (s->prepass_pixels != n) {
+        free(s->prepass_ids);
+        s->prepass_pixels = 0;
+        if (!(s->prepass_ids = rl_realloc_array(NULL, n ? n : 1, sizeof *s->prepass_ids)))
+            return rl_error(RL_ERR_OUT_OF_MEMORY, "vt: triangle IDs of %zu pixels", n);
+        s->prepass_pixels = n;
+    }
+    rl_status st = vt_prepass(run, s->depth_ids, s->prepass_ids);
+    if (!s->small_frames) {
+        free(s->prepass_ids);
+        s->prepass_ids = NULL;
+        s->prepass_pixels = 0;
+    }
+    return st;
+}
+
 /* Fig. 3.17: the ID/Z pre-pass with the rasterized half, the refinement
  * with its sampling, the final draw; then what the next frame keeps
  * (feelers, the refined mesh). */
@@ -663,17 +711,39 @@ static rl_status run_frame(vt_run *run, vt_state *s, const vt_settings *set, rl_
     run->base = &s->base;
     double t0 = rl_time_s() * 1000.0;
     if (st == RL_OK)
-        st = vt_prepass(run, s->depth_ids);
+        st = run_prepass(s, run);
     /* The rasterized half drawn inside the pre-pass counts as drawing. */
     run->stats.time_visibility_ms = rl_time_s() * 1000.0 - t0 - run->stats.time_draw_ms;
     if (st == RL_OK)
         st = vt_refine(run);
     run->stats.mesh_bytes = vt_mesh_bytes(run->mesh);
+    /* A frame that refined far keeps its buffers only as long as it needs
+     * them: the peak is at the frame's end, with the whole mesh, the draw's
+     * corners and the feeler map being rebuilt (heaptrack). The pre-pass
+     * image (12 MB at 1024^2) and the emptied edge list are not read after
+     * the refinement (a distributed frame's pre-pass is made again after a
+     * frame, s->prepared), the corners not after the final draw. Faulting
+     * them in again costs the next frame a few ms, where a frame of this
+     * size samples for seconds; a small frame keeps them (warm frames of
+     * an interactive preview). */
+    const bool large = run->mesh->num_verts - run->mesh->num_primary_verts >= VT_LARGE_FRAME_VERTICES;
+    s->small_frames = !large;
+    if (large) {
+        rl_image_release(s->depth_ids);
+        s->depth_ids = NULL;
+        run->view.depth = NULL;
+        vt_heap_free(run->heap);
+        give_back_freed();
+    }
     if (st == RL_OK) {
         double td = rl_time_s() * 1000.0;
         if (!vt_update(run, run->stats.stages, true) && run->failed)
             st = RL_ERR_OUT_OF_MEMORY;
         run->stats.time_draw_ms += rl_time_s() * 1000.0 - td;
+    }
+    if (large) {
+        vt_corners_free(&s->corners);
+        give_back_freed();
     }
     if (st == RL_OK && set->coherence)
         st = keep_feelers(s, run);
@@ -872,7 +942,7 @@ static rl_status dist_prepass(rl_renderer *r, vt_state *s, const rl_scene *scene
         s->package = pkg;
     if (!vis || !list || !pkg)
         return rl_error(RL_ERR_OUT_OF_MEMORY, "vt: face flags of %zu faces", nf);
-    rl_status st = vt_prepass(run, s->depth_ids);
+    rl_status st = run_prepass(s, run);
     if (st != RL_OK)
         return st;
     s->prep_count = 0;
@@ -1043,9 +1113,12 @@ static double edge_cost(const vt_run *run, const vt_mesh *m, const vt_edge *ed, 
         delta = (fabsf(sa->display.x - sb->display.x) + fabsf(sa->display.y - sb->display.y) +
                  fabsf(sa->display.z - sb->display.z)) / 3.0;
     } else {
-        float dh = fabsf(sa->h - sb->h);
+        float ha, sat_a, va, hb, sat_b, vb;
+        vt_rgb_to_hsv(sa->display, &ha, &sat_a, &va);
+        vt_rgb_to_hsv(sb->display, &hb, &sat_b, &vb);
+        float dh = fabsf(ha - hb);
         dh = dh > 0.5f ? 1.0f - dh : dh;
-        delta = (2.0 * dh + fabsf(sa->s - sb->s) + fabsf(sa->v - sb->v)) / 3.0;  /* hue circle: 0.5 at most */
+        delta = (2.0 * dh + fabsf(sat_a - sat_b) + fabsf(va - vb)) / 3.0;  /* hue circle: 0.5 at most */
     }
     /* An end behind the eye has no projection: the edge counts as the
      * longest possible. */
@@ -1300,8 +1373,8 @@ const rl_renderer_class rl_vt_renderer_class = {
     .info = { .name = "vt",
               .description = "Vertex Tracing: adaptive progressive ray tracing in object space, hybrid with rasterization",
               .reference = "Ullmann 2003, Ch. 3-4",
-              /* frame_buffers(): scratch depth, and depth and IDs of the pre-pass */
-              .frame_bytes_per_pixel = 2 * sizeof(float) + 2 * sizeof(uint32_t) },
+              /* frame_buffers(): scratch depth, and depth and triangle IDs of the pre-pass */
+              .frame_bytes_per_pixel = 2 * sizeof(float) + sizeof(uint32_t) },
     .options = vt_options,
     .num_options = sizeof vt_options / sizeof vt_options[0],
     .state_size = sizeof(vt_state),

@@ -87,7 +87,6 @@ void vt_criteria_prepare(vt_vertex_sample *sample)
     /* Sec. 3.5.3: deferred textures are applied by the rasterizer, so only
      * the untextured ("flat") radiance decides where to sample. */
     sample->display = display_of(sample->flat);
-    vt_rgb_to_hsv(sample->display, &sample->h, &sample->s, &sample->v);
 }
 
 uint64_t vt_tree_hash(const rl_ray_tree *tree, int shadow, int depth)
@@ -127,15 +126,20 @@ unsigned vt_criteria_test(const vt_criteria *c, const vt_vertex_sample *a, const
             fired |= VT_CRIT_RGB;
     }
     if (c->bits & VT_CRIT_HSV) {
+        /* From the display values each time: the same numbers as stored
+         * ones, without their room in every sample. */
+        float ha, sa, va, hb, sb, vb;
+        vt_rgb_to_hsv(da, &ha, &sa, &va);
+        vt_rgb_to_hsv(db, &hb, &sb, &vb);
         bool hue_fires = false;
-        if (a->s >= VT_HUE_MIN_SATURATION && b->s >= VT_HUE_MIN_SATURATION) {
+        if (sa >= VT_HUE_MIN_SATURATION && sb >= VT_HUE_MIN_SATURATION) {
             /* Hue lives on a circle: 0.95 and 0.05 are 0.1 apart. */
-            float dh = fabsf(a->h - b->h);
+            float dh = fabsf(ha - hb);
             if (dh > 0.5f)
                 dh = 1.0f - dh;
             hue_fires = dh > c->eps_h;
         }
-        if (hue_fires || fabsf(a->s - b->s) > c->eps_s || fabsf(a->v - b->v) > c->eps_v)
+        if (hue_fires || fabsf(sa - sb) > c->eps_s || fabsf(va - vb) > c->eps_v)
             fired |= VT_CRIT_HSV;
     }
     if ((c->bits & VT_CRIT_TREE) && a->tree_hash != b->tree_hash)

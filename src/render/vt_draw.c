@@ -263,21 +263,29 @@ static rl_status draw_batch(vt_run *run, rl_raster *ras, const uint32_t *list, s
     return st;
 }
 
+typedef struct pick_ctx {
+    const vt_run *run;
+    bool only_new;
+} pick_ctx;
+
+static bool pick_taken(const void *user, const vt_face *face)
+{
+    const pick_ctx *p = user;
+    return taken(p->run, face, p->only_new);
+}
+
 static rl_status draw_faces(vt_run *run, rl_raster *ras, bool only_new, unsigned id_flags)
 {
-    const vt_mesh *m = run->mesh;
+    vt_corners *b = run->corners;
+    /* In creation order, as the faces were numbered when every split face
+     * stayed (vt_mesh.drop_parents): the same submission order, so the
+     * same depth ties and pixels written. */
+    pick_ctx pick = { run, only_new };
     size_t count = 0;
-    for (uint32_t f = 0; f < m->num_faces; ++f)
-        count += taken(run, &m->faces[f], only_new);
+    if (vt_mesh_pick_in_order(run->mesh, pick_taken, &pick, &b->faces, &b->faces_cap, &count) != RL_OK)
+        return RL_ERR_OUT_OF_MEMORY;
     if (!count)
         return RL_OK;
-    vt_corners *b = run->corners;
-    if (!rl_reserve((void **)&b->faces, &b->faces_cap, count, sizeof *b->faces, 1024))
-        return RL_ERR_OUT_OF_MEMORY;
-    size_t i = 0;
-    for (uint32_t f = 0; f < m->num_faces; ++f)
-        if (taken(run, &m->faces[f], only_new))
-            b->faces[i++] = f;
     if (!only_new)
         run->stats.faces_drawn = count;
     const bool offset = run->set->progressive == VT_PROG_OVERDRAW;

@@ -70,14 +70,17 @@ typedef struct vt_vertex {
 typedef struct vt_vertex_sample {
     rl_vec3 flat;             /* radiance with deferred textures white; with
                                * textures=sampled the textured radiance */
-    /* flat as the criteria see it (vt_criteria_prepare): display values
-     * and their HSV, computed once by the thread that sampled the vertex
-     * instead of once per edge test on the refining thread */
+    /* flat as the criteria see it (vt_criteria_prepare): display values,
+     * computed once by the thread that sampled the vertex instead of once
+     * per edge test on the refining thread (three powf per end). Their HSV
+     * is not kept: it costs the HSV criterion a few compares and one
+     * division per end and test (vt_rgb_to_hsv), and would take 12 bytes
+     * of each of a refined mesh's hundreds of thousands of samples */
     rl_vec3 display;
-    float h, s, v;
     rl_vec3 diffuse, rest;    /* of the primary layer */
     uint32_t deferred[2];     /* reflection, refraction: index into
-                               * vt_mesh.layers, VT_NONE when empty */
+                               * vt_mesh.layers, or with VT_PLAIN_LAYER
+                               * set into vt_mesh.plain; VT_NONE when empty */
     uint64_t tree_hash;       /* rl_ray_tree_hash of its ray tree */
 } vt_vertex_sample;
 
@@ -87,20 +90,28 @@ typedef struct vt_edge {
                                * face[0] has v[0] -> v[1] counter-clockwise
                                * (it created the edge), face[1] the other
                                * (v[1] -> v[0] when consistently wound);
-                               * sub-edges keep the direction and slots */
-    uint32_t mid;             /* midpoint vertex once split, else VT_NONE */
+                               * sub-edges keep the direction and slots.
+                               * Once the edge is split, a slot may hold the
+                               * face's first child (vt_mesh.drop_parents):
+                               * then only its primary face is read */
     uint32_t child;           /* sub-edge (v[0],mid) once split, else VT_NONE;
-                               * (mid,v[1]) is child + 1 */
-    uint8_t queued;           /* currently in the edge list */
-    uint8_t forced;           /* split by forced refinement */
+                               * (mid,v[1]) is child + 1, so the midpoint is
+                               * the sub-edge's v[1] (vt_edge_mid) */
 } vt_edge;
+/* 20 bytes, four per generated vertex: whether an edge is in the edge
+ * list is a bit of vt_mesh.edge_queued, not a byte here that would pad
+ * the edge to 24. */
 
 typedef struct vt_face {
     uint32_t v[3];            /* counter-clockwise, as the source triangle */
     uint32_t e[3];            /* e[i] joins v[(i+1)%3] and v[(i+2)%3] (opposite v[i]) */
     uint32_t triangle;        /* source scene triangle (its object is
-                               * rl_scene_data.triangle_object's) */
-    uint32_t parent;          /* VT_NONE for a primary face */
+                               * rl_scene_data.triangle_object's); its
+                               * primary face is the face's primary
+                               * ancestor (vt_face_root) */
+    uint32_t seq;             /* creation number since the last reset: the
+                               * draw order (equals the index unless the mesh
+                               * drops split parents, vt_mesh.drop_parents) */
     uint16_t stage;           /* stage that created it (overdraw offset k, Sec. 3.5.1) */
     uint8_t leaf;             /* not split (drawn) */
     uint8_t visible;          /* its primary ancestor passed the ID-buffer test */
@@ -108,12 +119,35 @@ typedef struct vt_face {
                                * for it this frame, else negative */
 } vt_face;
 
+/* A deferred layer without texture (RL_NONE): most reflected and
+ * refracted terms (only textured surfaces seen in a mirror have more), 24
+ * bytes instead of rl_trace_layer's 36; its uv is never read. */
+typedef struct vt_plain_layer {
+    rl_vec3 diffuse, rest;
+} vt_plain_layer;
+#define VT_PLAIN_LAYER 0x80000000u   /* vt_vertex_sample.deferred: in vt_mesh.plain */
+
 typedef struct vt_mesh {
     vt_vertex *verts;  uint32_t num_verts, cap_verts;
     vt_vertex_sample *samples;  uint32_t cap_samples;   /* per vertex, like verts */
     vt_edge *edges;    uint32_t num_edges, cap_edges;
+    uint32_t *edge_queued;    /* bit e: edge e is in the edge list (vt_heap);
+                               * cap_edges bits */
     vt_face *faces;    uint32_t num_faces, cap_faces;
+    uint32_t num_created;     /* faces created since the last reset, primary
+                               * ones included: the next face's seq */
+    /* When set, a split face that is not primary gives its slot to its
+     * first child instead of staying behind as a non-leaf: nothing reads
+     * it again (its edges' face references move to the children, and the
+     * primary ancestor is found through the triangle). About half a refined
+     * mesh's faces are such parents. Unset (the default), every face stays
+     * (vt_draw's progressive overdraw redraws the faces of the last
+     * stages, split or not; the shaft test keeps a verdict per face). */
+    bool drop_parents;
+    uint32_t *tri_face;       /* scene triangle -> its primary face, VT_NONE */
+    uint32_t num_tri_face;
     rl_trace_layer *layers;  uint32_t num_layers, cap_layers;   /* the samples' deferred layers */
+    vt_plain_layer *plain;   uint32_t num_plain, cap_plain;     /* ... those without texture and uv */
     uint32_t num_primary_verts, num_primary_edges, num_primary_faces;
 } vt_mesh;
 
@@ -133,6 +167,23 @@ void vt_mesh_free(vt_mesh *m);
  * unsampled): the start of a new camera frame. Keeps the allocations. */
 void vt_mesh_reset(vt_mesh *m);
 
+/* The primary face that face f descends from (f itself when primary);
+ * VT_NONE for a face that is not of the mesh's triangles (vt_part_import). */
+static inline uint32_t vt_face_root(const vt_mesh *m, uint32_t f)
+{
+    if (f < m->num_primary_faces)
+        return f;
+    uint32_t t = m->faces[f].triangle;
+    return t < m->num_tri_face ? m->tri_face[t] : VT_NONE;
+}
+
+/* The faces for which pick(user, face) holds, in creation order (vt_face.seq),
+ * into *list (grown as needed, capacity *cap); their number in *count.
+ * The order is the one faces had when every split parent stayed: children
+ * after all faces created before them. RL_ERR_OUT_OF_MEMORY. */
+rl_status vt_mesh_pick_in_order(const vt_mesh *m, bool (*pick)(const void *user, const vt_face *f),
+                                const void *user, uint32_t **list, size_t *cap, size_t *count);
+
 /* Bytes the mesh's elements take (counts times sizes, without the arrays'
  * spare room). */
 uint64_t vt_mesh_bytes(const vt_mesh *m);
@@ -148,8 +199,29 @@ rl_status vt_mesh_reserve(vt_mesh *m, uint32_t verts, uint32_t edges, uint32_t f
 rl_status vt_mesh_set_sample(vt_mesh *m, uint32_t v, const vt_vertex_sample *s,
                              const rl_trace_layer layers[RL_TRACE_LAYER_COUNT]);
 /* The layers of vertex v's sample as vt_mesh_set_sample got them, but for
- * the primary layer's texture (RL_NONE) and uv (0), which are not kept. */
+ * the primary layer's texture (RL_NONE) and uv (0), and the uv (0) of a
+ * deferred layer without texture, which are not kept. */
 void vt_mesh_sample_layers(const vt_mesh *m, uint32_t v, rl_trace_layer out[RL_TRACE_LAYER_COUNT]);
+
+/* The midpoint vertex of edge e once split, else VT_NONE. */
+static inline uint32_t vt_edge_mid(const vt_mesh *m, uint32_t e)
+{
+    uint32_t c = m->edges[e].child;
+    return c != VT_NONE ? m->edges[c].v[1] : VT_NONE;
+}
+static inline bool vt_edge_is_split(const vt_edge *e)
+{
+    return e->child != VT_NONE;
+}
+static inline bool vt_edge_queued(const vt_mesh *m, uint32_t e)
+{
+    return (m->edge_queued[e >> 5] >> (e & 31)) & 1u;
+}
+static inline void vt_edge_set_queued(vt_mesh *m, uint32_t e, bool queued)
+{
+    uint32_t bit = 1u << (e & 31);
+    m->edge_queued[e >> 5] = queued ? m->edge_queued[e >> 5] | bit : m->edge_queued[e >> 5] & ~bit;
+}
 
 uint64_t vt_vertex_key_primary(uint32_t object, uint32_t index);
 /* Symmetric in a and b: the midpoint of an edge has the same key whichever
@@ -162,8 +234,9 @@ uint64_t vt_vertex_key_mid(uint64_t a, uint64_t b);
  * adjacent face, key vt_vertex_key_mid, stage as given, state UNSAMPLED.
  * Each adjacent leaf face (a, b, c) with the edge (a, b) opposite c becomes
  * two leaf children (a, v', c) and (v', b, c), joined by a new edge (v', c);
- * the parent stops being a leaf; the children inherit its visible flag and
- * get the given stage. Edge e gets mid and child set. The faces' old edges
+ * the parent stops being a leaf, or, with drop_parents and when it is not
+ * primary, the first child takes its slot; the children inherit its visible
+ * flag and triangle, get the given stage and the next two seq numbers. Edge e gets its child set (vt_edge_mid is v'). The faces' old edges
  * get their face references moved to the children. Returns the new vertex
  * index, or VT_NONE when out of memory (the mesh is unchanged then) or when
  * e is already split (returns its mid then, no change).
@@ -207,7 +280,7 @@ typedef struct vt_criteria {
 /* Parses "rgb", "hsv", "tree", "tree+rgb", "tree+hsv" (also "rgb+tree",
  * "hsv+tree", and "rgb+hsv"); false for anything else. */
 bool vt_criteria_parse(const char *text, unsigned *bits);
-/* Fills display, h, s and v of a sample from its flat colour. */
+/* Fills the display values of a sample from its flat colour. */
 void vt_criteria_prepare(vt_vertex_sample *sample);
 /* The criteria that fire for the samples a and b (prepared), as
  * vt_criterion_bits; 0 = interpolation along the edge is acceptable.

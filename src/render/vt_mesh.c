@@ -84,8 +84,22 @@ static rl_status reserve(vt_mesh *m, uint32_t verts, uint32_t edges, uint32_t fa
     if (st == RL_OK)
         st = grow((void **)&m->samples, &m->cap_samples, m->num_verts + verts, sizeof *m->samples,
                   "vertices");
-    if (st == RL_OK)
+    if (st == RL_OK) {
+        uint32_t old_cap = m->cap_edges;
         st = grow((void **)&m->edges, &m->cap_edges, m->num_edges + edges, sizeof *m->edges, "edges");
+        if (st == RL_OK && m->cap_edges != old_cap) {
+            /* The queued bits follow the edges' capacity (a multiple of 256,
+             * so of 32); new words start clear. */
+            uint32_t words = m->cap_edges / 32, old_words = old_cap / 32;
+            uint32_t *q = rl_realloc_array(m->edge_queued, words, sizeof *q);
+            if (!q) {
+                m->cap_edges = old_cap;   /* the edges keep their new room unused */
+                return RL_ERR_OUT_OF_MEMORY;
+            }
+            memset(q + old_words, 0, (size_t)(words - old_words) * sizeof *q);
+            m->edge_queued = q;
+        }
+    }
     if (st == RL_OK)
         st = grow((void **)&m->faces, &m->cap_faces, m->num_faces + faces, sizeof *m->faces, "faces");
     return st;
@@ -100,7 +114,59 @@ uint64_t vt_mesh_bytes(const vt_mesh *m)
 {
     return (uint64_t)m->num_verts * (sizeof *m->verts + sizeof *m->samples) +
            (uint64_t)m->num_edges * sizeof *m->edges + (uint64_t)m->num_faces * sizeof *m->faces +
-           (uint64_t)m->num_layers * sizeof *m->layers;
+           (uint64_t)m->num_layers * sizeof *m->layers + (uint64_t)m->num_plain * sizeof *m->plain +
+           ((uint64_t)m->num_edges + 7) / 8;
+}
+
+rl_status vt_mesh_pick_in_order(const vt_mesh *m, bool (*pick)(const void *user, const vt_face *f),
+                                const void *user, uint32_t **list, size_t *cap, size_t *count)
+{
+    *count = 0;
+    size_t n = 0;
+    for (uint32_t f = 0; f < m->num_faces; ++f)
+        n += pick(user, &m->faces[f]);
+    if (!n)
+        return RL_OK;
+    if (!rl_reserve((void **)list, cap, n, sizeof **list, 1024))
+        return RL_ERR_OUT_OF_MEMORY;
+    uint32_t *out = *list;
+    if (m->num_created == m->num_faces) {
+        /* No slot was reused: seq is the index. */
+        for (uint32_t f = 0; f < m->num_faces; ++f)
+            if (pick(user, &m->faces[f]))
+                out[(*count)++] = f;
+        return RL_OK;
+    }
+    /* A face's place is the number of picked faces created before it: a
+     * bit per seq and a running count per 64 of them (a fraction of a
+     * list indexed by seq, which would be twice the faces drawn). */
+    size_t words = ((size_t)m->num_created + 63) / 64;
+    uint64_t *bits = rl_calloc(words, sizeof *bits);
+    uint32_t *before = rl_realloc_array(NULL, words, sizeof *before);
+    if (!bits || !before) {
+        free(bits);
+        free(before);
+        return RL_ERR_OUT_OF_MEMORY;
+    }
+    for (uint32_t f = 0; f < m->num_faces; ++f)
+        if (pick(user, &m->faces[f]))
+            bits[m->faces[f].seq >> 6] |= 1ull << (m->faces[f].seq & 63);
+    uint32_t sum = 0;
+    for (size_t w = 0; w < words; ++w) {
+        before[w] = sum;
+        sum += (uint32_t)__builtin_popcountll(bits[w]);
+    }
+    for (uint32_t f = 0; f < m->num_faces; ++f) {
+        uint32_t q = m->faces[f].seq;
+        if (!((bits[q >> 6] >> (q & 63)) & 1u))
+            continue;
+        uint64_t below = bits[q >> 6] & ((1ull << (q & 63)) - 1u);
+        out[before[q >> 6] + (uint32_t)__builtin_popcountll(below)] = f;
+    }
+    free(bits);
+    free(before);
+    *count = n;
+    return RL_OK;
 }
 
 /* ------------------------------------------------------------- samples -- */
@@ -115,14 +181,31 @@ static bool layer_empty(const rl_trace_layer *L)
     return memcmp(L, &no_layer, sizeof no_layer) == 0;
 }
 
+/* A layer without texture: its uv is never read (rl_trace_layer_color,
+ * vt_draw's lookups, the rasterizer's layers sample only a texture), so it
+ * is not kept; it comes back as 0. */
+static bool layer_plain(const rl_trace_layer *L)
+{
+    return L->texture == RL_NONE;
+}
+
 rl_status vt_mesh_set_sample(vt_mesh *m, uint32_t v, const vt_vertex_sample *s,
                              const rl_trace_layer layers[RL_TRACE_LAYER_COUNT])
 {
     const rl_trace_layer *deferred[2] = { &layers[RL_TRACE_LAYER_REFLECTION], &layers[RL_TRACE_LAYER_REFRACTION] };
-    uint32_t need = !layer_empty(deferred[0]) + !layer_empty(deferred[1]);
-    if (need > VT_MESH_MAX_ELEMENTS - m->num_layers)
+    uint32_t need = 0, need_plain = 0;
+    for (int k = 0; k < 2; ++k)
+        if (!layer_empty(deferred[k])) {
+            if (layer_plain(deferred[k]))
+                ++need_plain;
+            else
+                ++need;
+        }
+    if (need > VT_MESH_MAX_ELEMENTS - m->num_layers || need_plain > VT_MESH_MAX_ELEMENTS - m->num_plain)
         return rl_error(RL_ERR_LIMIT, "vt mesh: more than 2^31 deferred layers");
     rl_status st = grow((void **)&m->layers, &m->cap_layers, m->num_layers + need, sizeof *m->layers, "layers");
+    if (st == RL_OK)
+        st = grow((void **)&m->plain, &m->cap_plain, m->num_plain + need_plain, sizeof *m->plain, "layers");
     if (st != RL_OK)
         return st;
     vt_vertex_sample *out = &m->samples[v];
@@ -131,7 +214,12 @@ rl_status vt_mesh_set_sample(vt_mesh *m, uint32_t v, const vt_vertex_sample *s,
     out->rest = layers[RL_TRACE_LAYER_PRIMARY].rest;
     for (int k = 0; k < 2; ++k) {
         out->deferred[k] = VT_NONE;
-        if (!layer_empty(deferred[k])) {
+        if (layer_empty(deferred[k]))
+            continue;
+        if (layer_plain(deferred[k])) {
+            out->deferred[k] = VT_PLAIN_LAYER | m->num_plain;
+            m->plain[m->num_plain++] = (vt_plain_layer){ deferred[k]->diffuse, deferred[k]->rest };
+        } else {
             out->deferred[k] = m->num_layers;
             m->layers[m->num_layers++] = *deferred[k];
         }
@@ -139,12 +227,23 @@ rl_status vt_mesh_set_sample(vt_mesh *m, uint32_t v, const vt_vertex_sample *s,
     return RL_OK;
 }
 
+static rl_trace_layer unpack_layer(const vt_mesh *m, uint32_t index)
+{
+    if (index == VT_NONE)
+        return no_layer;
+    if (index & VT_PLAIN_LAYER) {
+        const vt_plain_layer *p = &m->plain[index & ~VT_PLAIN_LAYER];
+        return (rl_trace_layer){ p->diffuse, p->rest, RL_NONE, { 0.0f, 0.0f } };
+    }
+    return m->layers[index];
+}
+
 void vt_mesh_sample_layers(const vt_mesh *m, uint32_t v, rl_trace_layer out[RL_TRACE_LAYER_COUNT])
 {
     const vt_vertex_sample *s = &m->samples[v];
     out[RL_TRACE_LAYER_PRIMARY] = (rl_trace_layer){ s->diffuse, s->rest, RL_NONE, { 0.0f, 0.0f } };
-    out[RL_TRACE_LAYER_REFLECTION] = s->deferred[0] != VT_NONE ? m->layers[s->deferred[0]] : no_layer;
-    out[RL_TRACE_LAYER_REFRACTION] = s->deferred[1] != VT_NONE ? m->layers[s->deferred[1]] : no_layer;
+    out[RL_TRACE_LAYER_REFLECTION] = unpack_layer(m, s->deferred[0]);
+    out[RL_TRACE_LAYER_REFRACTION] = unpack_layer(m, s->deferred[1]);
 }
 
 /* ------------------------------------------------------------- building -- */
@@ -238,8 +337,8 @@ static uint32_t new_edge(vt_mesh *m, uint32_t a, uint32_t b, uint32_t face)
     e->v[1] = b;
     e->face[0] = face;
     e->face[1] = VT_NONE;
-    e->mid = VT_NONE;
     e->child = VT_NONE;
+    vt_edge_set_queued(m, ei, false);
     return ei;
 }
 
@@ -310,8 +409,9 @@ static rl_status build_object(vt_mesh *m, const rl_scene_data *d, uint32_t o, bu
         memset(f, 0, sizeof *f);
         memcpy(f->v, fv, sizeof fv);
         f->triangle = t;
-        f->parent = VT_NONE;
+        f->seq = fi;
         f->leaf = 1;
+        m->tri_face[t] = fi;
         f->height = -1.0f;
         for (int i = 0; i < 3; ++i)
             f->e[i] = pair_edge(m, s, edge_size - 1, fv[(i + 1) % 3], fv[(i + 2) % 3], fi);
@@ -332,6 +432,12 @@ rl_status vt_mesh_build(vt_mesh *m, const rl_scene_data *d, const uint8_t *objec
         if (d->objects[o].num_triangles > max_triangles)
             max_triangles = d->objects[o].num_triangles;
     }
+    m->tri_face = rl_realloc_array(NULL, d->num_triangles ? d->num_triangles : 1, sizeof *m->tri_face);
+    if (!m->tri_face)
+        return RL_ERR_OUT_OF_MEMORY;
+    m->num_tri_face = d->num_triangles;
+    for (uint32_t t = 0; t < d->num_triangles; ++t)
+        m->tri_face[t] = VT_NONE;
     if (max_triangles == 0)
         return RL_OK;
     uint64_t corners = 3ull * max_triangles;
@@ -357,6 +463,7 @@ rl_status vt_mesh_build(vt_mesh *m, const rl_scene_data *d, const uint8_t *objec
     m->num_primary_verts = m->num_verts;
     m->num_primary_edges = m->num_edges;
     m->num_primary_faces = m->num_faces;
+    m->num_created = m->num_faces;
     return RL_OK;
 }
 
@@ -367,25 +474,27 @@ void vt_mesh_free(vt_mesh *m)
     free(m->verts);
     free(m->samples);
     free(m->edges);
+    free(m->edge_queued);
     free(m->faces);
     free(m->layers);
+    free(m->plain);
+    free(m->tri_face);
     memset(m, 0, sizeof *m);
 }
 
 void vt_mesh_reset(vt_mesh *m)
 {
     /* Splits moved the primary edges' face references down to descendants;
-     * walking the parent chain finds the primary face again without storing
-     * a copy of the original adjacency. */
+     * a descendant's triangle names its primary face, so the original
+     * adjacency needs no copy. (Primary faces never give their slot away,
+     * so their corners and edges are still the built ones.) */
     for (uint32_t i = 0; i < m->num_primary_edges; ++i) {
         vt_edge *e = &m->edges[i];
         for (int s = 0; s < 2; ++s)
-            while (e->face[s] != VT_NONE && e->face[s] >= m->num_primary_faces)
-                e->face[s] = m->faces[e->face[s]].parent;
-        e->mid = VT_NONE;
+            if (e->face[s] != VT_NONE)
+                e->face[s] = vt_face_root(m, e->face[s]);
         e->child = VT_NONE;
-        e->queued = 0;
-        e->forced = 0;
+        vt_edge_set_queued(m, i, false);
     }
     for (uint32_t i = 0; i < m->num_primary_faces; ++i) {
         m->faces[i].leaf = 1;
@@ -399,7 +508,9 @@ void vt_mesh_reset(vt_mesh *m)
     m->num_verts = m->num_primary_verts;
     m->num_edges = m->num_primary_edges;
     m->num_faces = m->num_primary_faces;
+    m->num_created = m->num_primary_faces;
     m->num_layers = 0;
+    m->num_plain = 0;
 }
 
 /* ------------------------------------------------------------ splitting -- */
@@ -412,17 +523,16 @@ static void replace_face(vt_edge *e, uint32_t from, uint32_t to)
         e->face[1] = to;
 }
 
-static uint32_t add_face(vt_mesh *m, const vt_face *parent, uint32_t parent_index, uint32_t a,
-                         uint32_t b, uint32_t c, uint32_t ea, uint32_t eb, uint32_t ec,
-                         uint16_t stage)
+/* A child of parent into slot fi (a new one, or the parent's own). */
+static uint32_t add_face(vt_mesh *m, const vt_face *parent, uint32_t fi, uint32_t a, uint32_t b,
+                         uint32_t c, uint32_t ea, uint32_t eb, uint32_t ec, uint16_t stage)
 {
-    uint32_t fi = m->num_faces++;
     vt_face *f = &m->faces[fi];
     memset(f, 0, sizeof *f);
     f->v[0] = a; f->v[1] = b; f->v[2] = c;
     f->e[0] = ea; f->e[1] = eb; f->e[2] = ec;
     f->triangle = parent->triangle;
-    f->parent = parent_index;
+    f->seq = m->num_created++;
     f->stage = stage;
     f->leaf = 1;
     f->visible = parent->visible;
@@ -437,8 +547,8 @@ uint32_t vt_mesh_split(vt_mesh *m, uint32_t e, uint16_t stage, uint32_t new_edge
     *num_new_faces = 0;
     if (e >= m->num_edges)
         return VT_NONE;
-    if (m->edges[e].mid != VT_NONE)
-        return m->edges[e].mid;
+    if (vt_edge_is_split(&m->edges[e]))
+        return vt_edge_mid(m, e);
     const vt_edge old = m->edges[e];
     int sides = 0;
     for (int s = 0; s < 2; ++s)
@@ -466,8 +576,7 @@ uint32_t vt_mesh_split(vt_mesh *m, uint32_t e, uint16_t stage, uint32_t new_edge
     uint32_t sub[2];
     sub[0] = new_edge(m, old.v[0], mid, VT_NONE);
     sub[1] = new_edge(m, mid, old.v[1], VT_NONE);
-    m->edges[e].mid = mid;
-    m->edges[e].child = sub[0];           /* sub[1] is sub[0] + 1 */
+    m->edges[e].child = sub[0];           /* sub[1] is sub[0] + 1; mid is sub[0].v[1] */
     new_edges[(*num_new_edges)++] = sub[0];
     new_edges[(*num_new_edges)++] = sub[1];
 
@@ -489,9 +598,12 @@ uint32_t vt_mesh_split(vt_mesh *m, uint32_t e, uint16_t stage, uint32_t new_edge
         uint32_t sub_b = sub_a == sub[0] ? sub[1] : sub[0];
         /* (a, v', c): e[0] = (v', c), e[1] = (c, a), e[2] = (a, v');
          * (v', b, c): e[0] = (b, c), e[1] = (c, v'), e[2] = (v', b). */
-        uint32_t f1 = add_face(m, &parent, fi, a, mid, c, inner, e_ca, sub_a, stage);
-        uint32_t f2 = add_face(m, &parent, fi, mid, b, c, e_bc, inner, sub_b, stage);
-        m->faces[fi].leaf = 0;
+        /* A primary parent stays: vt_mesh_reset starts from it again. */
+        const bool reuse = m->drop_parents && fi >= m->num_primary_faces;
+        uint32_t f1 = add_face(m, &parent, reuse ? fi : m->num_faces++, a, mid, c, inner, e_ca, sub_a, stage);
+        uint32_t f2 = add_face(m, &parent, m->num_faces++, mid, b, c, e_bc, inner, sub_b, stage);
+        if (!reuse)
+            m->faces[fi].leaf = 0;
         m->edges[inner].face[0] = f1;
         m->edges[inner].face[1] = f2;
         m->edges[sub_a].face[s] = f1;

@@ -95,10 +95,16 @@ rl_status vt_part_write(const vt_mesh *m, const rl_scene_data *d, const uint8_t 
     const uint32_t vbytes = vertex_bytes(version);
     *out = NULL;
     *size = 0;
-    /* A leaf belongs to the package of its primary ancestor; a child comes
-     * after its parent in the face array, so one pass finds every root. */
+    /* A leaf belongs to the package of its primary ancestor. A package's
+     * mesh keeps its split parents (vt_refine), so the index order is the
+     * creation order. */
     uint32_t *root = rl_realloc_array(NULL, m->num_faces ? m->num_faces : 1, sizeof *root);
     uint32_t *remap = rl_realloc_array(NULL, m->num_verts ? m->num_verts : 1, sizeof *remap);
+    if (m->num_created != m->num_faces) {
+        free(root);
+        free(remap);
+        return rl_error(RL_ERR_INTERNAL, "vt: a package's mesh dropped its split faces");
+    }
     if (!root || !remap) {
         free(root);
         free(remap);
@@ -109,8 +115,8 @@ rl_status vt_part_write(const vt_mesh *m, const rl_scene_data *d, const uint8_t 
     uint32_t nv = 0, nf = 0;
     for (uint32_t f = 0; f < m->num_faces; ++f) {
         const vt_face *face = &m->faces[f];
-        root[f] = f < m->num_primary_faces ? f : root[face->parent];
-        if (!face->leaf || mine[root[f]] != 1)
+        root[f] = vt_face_root(m, f);
+        if (!face->leaf || root[f] == VT_NONE || mine[root[f]] != 1)
             continue;
         bool sampled = true;
         for (int k = 0; k < 3; ++k)
@@ -161,7 +167,7 @@ rl_status vt_part_write(const vt_mesh *m, const rl_scene_data *d, const uint8_t 
     }
     for (uint32_t f = 0; f < m->num_faces; ++f) {
         const vt_face *face = &m->faces[f];
-        if (!face->leaf || mine[root[f]] != 1)
+        if (!face->leaf || root[f] == VT_NONE || mine[root[f]] != 1)
             continue;
         uint32_t idx[3] = { remap[face->v[0]], remap[face->v[1]], remap[face->v[2]] };
         if (idx[0] == VT_NONE || idx[1] == VT_NONE || idx[2] == VT_NONE)
@@ -285,7 +291,7 @@ rl_status vt_part_import(vt_mesh *m, const rl_scene_data *d, const void *part, s
             face->e[k] = VT_NONE;
         }
         face->triangle = tri;
-        face->parent = VT_NONE;
+        face->seq = m->num_created++;
         face->stage = stage[0];
         face->leaf = 1;
         face->visible = 1;

@@ -45,8 +45,15 @@ static double now_ms(void)
 
 /* ------------------------------------------------------------ pre-pass -- */
 
-rl_status vt_prepass(vt_run *run, rl_image *depth_ids)
+rl_status vt_prepass(vt_run *run, rl_image *depth_image, uint32_t *triangle_ids)
 {
+    /* The target with the triangle IDs and no object IDs (a NULL layer is
+     * not written, rl_raster_target_for). */
+    rl_image target = *depth_image;
+    target.layers |= RL_LAYER_ID;
+    target.object_id = NULL;
+    target.triangle_id = triangle_ids;
+    rl_image *depth_ids = &target;
     const vt_settings *set = run->set;
     vt_mesh *m = run->mesh;
     rl_image frame;
@@ -144,9 +151,7 @@ static bool edge_in_package(const vt_run *run, const vt_edge *ed)
         return true;
     const vt_mesh *m = run->mesh;
     for (int k = 0; k < 2; ++k) {
-        uint32_t f = ed->face[k];
-        while (f != VT_NONE && f >= m->num_primary_faces)
-            f = m->faces[f].parent;
+        uint32_t f = ed->face[k] != VT_NONE ? vt_face_root(m, ed->face[k]) : VT_NONE;
         if (f != VT_NONE && run->seed[f])
             return true;
     }
@@ -166,7 +171,7 @@ static void consider_edge(refine_ctx *ctx, uint32_t e, bool primary)
     vt_edge *ed = &m->edges[e];
     const vt_vertex *a = &m->verts[ed->v[0]], *b = &m->verts[ed->v[1]];
     const float length = vt_edge_length(&run->view, a, b);
-    if (!(length > set->min_edge) || ed->mid != VT_NONE || ed->queued ||
+    if (!(length > set->min_edge) || vt_edge_is_split(ed) || vt_edge_queued(m, e) ||
         (!primary && !edge_in_package(run, ed)))
         return;
     if (!primary && set->z_test && !a->visible && !b->visible) {
@@ -184,7 +189,7 @@ static void consider_edge(refine_ctx *ctx, uint32_t e, bool primary)
         run->failed = true;
         return;
     }
-    m->edges[e].queued = 1;
+    vt_edge_set_queued(m, e, true);
 }
 
 /* Forced refinement (Sec. 3.3.2, Fig. 3.10): in each new sub-face the side
@@ -201,7 +206,7 @@ static void check_forced(refine_ctx *ctx, uint32_t f, uint32_t mid)
         return;
     uint32_t base = face->e[slot];
     const vt_edge *be = &m->edges[base];
-    if (be->mid != VT_NONE)
+    if (vt_edge_is_split(be))
         return;
     if (!(vt_face_xi(m, f, slot) > run->set->eps_z) || !(vt_face_height(m, f) > FLAT_HEIGHT_PX))
         return;
@@ -255,7 +260,7 @@ static void run_forced(refine_ctx *ctx, uint16_t stage)
         uint32_t e = ctx->forced[--ctx->forced_count];
         vt_mesh *m = run->mesh;
         vt_edge *ed = &m->edges[e];
-        if (ed->mid != VT_NONE || !edge_in_package(run, ed))
+        if (vt_edge_is_split(ed) || !edge_in_package(run, ed))
             continue;
         const vt_vertex *a = &m->verts[ed->v[0]], *b = &m->verts[ed->v[1]];
         if (!(vt_edge_length(&run->view, a, b) > set->min_edge))
@@ -264,7 +269,6 @@ static void run_forced(refine_ctx *ctx, uint16_t stage)
         if ((set->z_test && !a->visible && !b->visible) ||
             (set->clip_test && !vt_edge_in_viewport(&run->view, a, b)))
             continue;
-        m->edges[e].forced = 1;
         split_edge(ctx, e, VT_REASON_FORCED, stage);
     }
     ctx->forced_count = 0;
@@ -343,14 +347,14 @@ static void run_stage(refine_ctx *ctx, uint16_t stage)
             run->failed = true;
             return;
         }
-        m->edges[e].queued = 0;
+        vt_edge_set_queued(m, e, false);
         ctx->batch[ctx->batch_count++] = e;
     }
     for (uint32_t i = 0; i < ctx->batch_count && !run->failed; ++i) {
         if (!budget_left(run))
             break;
         vt_edge *ed = &m->edges[ctx->batch[i]];
-        if (ed->mid != VT_NONE)
+        if (vt_edge_is_split(ed))
             continue;                       /* split meanwhile by forced refinement */
         const vt_vertex *a = &m->verts[ed->v[0]], *b = &m->verts[ed->v[1]];
         if (a->state != VT_SAMPLED || b->state != VT_SAMPLED)
@@ -559,6 +563,14 @@ rl_status vt_refine(vt_run *run)
     refine_ctx ctx;
     memset(&ctx, 0, sizeof ctx);
     ctx.run = run;
+    /* A whole frame drawn once at its end reads no split face again: the
+     * first child takes a split face's slot (about half of the faces of a
+     * refined mesh). The progressive overdraw redraws the faces of the last
+     * stages, split or not (vt_draw), the shaft test keeps a verdict per
+     * face slot, and a package's result is written in index order
+     * (vt_part_write): those keep every face. */
+    run->mesh->drop_parents = !run->seed && run->set->shaft_cull == VT_SHAFT_OFF &&
+                              !(run->update && run->set->progressive == VT_PROG_OVERDRAW);
     double t0 = now_ms();
     if (run->set->shaft_cull != VT_SHAFT_OFF) {
         rl_status st = vt_shaft_index_build(&ctx.shafts, run->data);

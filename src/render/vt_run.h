@@ -267,9 +267,10 @@ void vt_run_free_blocks(vt_run *run);
 /* The ID-buffer pre-pass (Sec. 3.4.1, Fig. 3.12, 3.17): draws the
  * rasterized half of the frame (vt_draw_base), then the VT objects into a
  * copy of its depth with IDs, flags the visible primary faces, projects the
- * primary vertices, z-tests them. depth_ids is a scratch image with depth
- * and IDs. */
-rl_status vt_prepass(vt_run *run, rl_image *depth_ids);
+ * primary vertices, z-tests them. depth_ids is a scratch image with depth;
+ * triangle_ids (width*height) takes the triangle IDs, which are read only
+ * here (no object IDs are written: the triangle names the face). */
+rl_status vt_prepass(vt_run *run, rl_image *depth_ids, uint32_t *triangle_ids);
 /* Projects and z-tests the primary vertices against the pre-pass' depth
  * (the second half of vt_prepass; a package of a distributed frame redoes
  * it after vt_mesh_reset, from the kept pre-pass). */
