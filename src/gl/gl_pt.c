@@ -79,6 +79,7 @@ typedef struct uniforms {
         num_textures, eps, background, shadow, diffuse, specular, ls_start, ls_offset;
     GLint sm_size, sm_bias, sm_slope, sm_pcf, sm_frame;
     GLint env, env_nee, env_slot, env_map, env_size, env_rot, env_sum, env_off;
+    GLint ggx_ms;
     GLint count, structure, any;
 } uniforms;
 
@@ -207,6 +208,7 @@ static void locate(GLuint p, uniforms *u)
     U(env_rot, "u_env_rot");
     U(env_sum, "u_env_sum");
     U(env_off, "u_env_off");
+    U(ggx_ms, "u_ggx_ms");
     U(count, "u_count");
     U(structure, "u_structure");
     U(any, "u_any");
@@ -224,10 +226,10 @@ static GLuint compute_program(const char *body, bool linespace, const char *what
              "#define STRUCT_LS_CAND %d\n#define STRUCT_LS_PNMT %d\n#define STRUCT_LS_PREILLUM %d\n"
              "#define STRUCT_SHADOWMAP %d\n"
              "#define LIGHT_POINT %d\n#define LIGHT_SPOT %d\n#define LIGHT_DIRECTIONAL %d\n#define LIGHT_QUAD %d\n"
-             "#define INF uintBitsToFloat(0x7f800000u)\n",
+             "#define INF uintBitsToFloat(0x7f800000u)\n#define GGX_NODES %d\n",
              LOCAL, RL_BVH_MAX_DEPTH, (int)RL_GL_PT_GRID, (int)RL_GL_PT_LS_CANDIDATES, (int)RL_GL_PT_LS_PNMT,
              (int)RL_GL_PT_LS_PREILLUM, (int)RL_GL_PT_SHADOWMAP, (int)RL_LIGHT_POINT, (int)RL_LIGHT_SPOT,
-             (int)RL_LIGHT_DIRECTIONAL, (int)RL_LIGHT_QUAD);
+             (int)RL_LIGHT_DIRECTIONAL, (int)RL_LIGHT_QUAD, RL_GL_PT_GGX_NODES);
     if (!body) {
         /* the shadow maps' depth pass: common's declarations, and for the
          * fragment stage the texture lookup of the masks */
@@ -257,21 +259,32 @@ static rl_status check_block(uint64_t bytes, GLint64 max_block, const char *what
 
 /* Materials and lights as gl_pt_shaders.c reads them: what does not depend
  * on the point lit (a spot's cosines, a directional light's direction) is
- * computed here with the C functions of scene/light_eval.c. */
-static rl_status upload_materials_lights(rl_gl_pt *pt, const rl_gl_pt_lights *lt)
+ * computed here with the C functions of scene/light_eval.c. The materials'
+ * buffer starts with GGX's energy-compensation tables (ggx_ms, or zeros):
+ * a storage block of their own would be the path program's 17th with the
+ * Line Space (llvmpipe allows 16), a texture unit another llvmpipe variant
+ * key entry. */
+#define GGX_TABLE_FLOATS (RL_GL_PT_GGX_NODES * RL_GL_PT_GGX_NODES + RL_GL_PT_GGX_NODES)
+static rl_status upload_materials_lights(rl_gl_pt *pt, const rl_gl_pt_lights *lt, const float *ggx_ms)
 {
     const rl_scene_data *d = pt->data;
     typedef struct {
         float diffuse[4], specular[4], emission[4], extra[4];
         uint32_t tex[4];
+        float pbr[4];
     } material;
-    material *mats = rl_calloc(d->num_materials ? d->num_materials : 1, sizeof *mats);
+    _Static_assert(GGX_TABLE_FLOATS * sizeof(float) % 16 == 0, "std430 aligns the materials to 16 bytes");
+    const size_t head = GGX_TABLE_FLOATS * sizeof(float);
+    unsigned char *block = rl_calloc(1, head + sizeof(material) * (d->num_materials ? d->num_materials : 1));
     rl_gl_light *lights = rl_calloc(d->num_lights ? d->num_lights : 1, sizeof *lights);
-    if (!mats || !lights) {
-        free(mats);
+    if (!block || !lights) {
+        free(block);
         free(lights);
         return RL_ERR_OUT_OF_MEMORY;
     }
+    if (ggx_ms)
+        memcpy(block, ggx_ms, head);
+    material *mats = (material *)(void *)(block + head);
     for (uint32_t i = 0; i < d->num_materials; ++i) {
         const rl_material *m = &d->materials[i];
         put4(mats[i].diffuse, m->diffuse, m->reflectivity);
@@ -285,6 +298,10 @@ static rl_status upload_materials_lights(rl_gl_pt *pt, const rl_gl_pt_lights *lt
         mats[i].tex[1] = valid_texture(d, m->normal_texture);
         mats[i].tex[2] = rl_material_mask(d, i);
         mats[i].tex[3] = RL_NONE;
+        /* issue 37's GGX BRDF (pathtrace_ggx.c): roughness, metallic */
+        mats[i].pbr[0] = m->roughness;
+        mats[i].pbr[1] = m->metallic;
+        mats[i].pbr[2] = m->bsdf == RL_BSDF_GGX ? 1.0f : 0.0f;
     }
     for (uint32_t i = 0; i < d->num_lights; ++i) {
         const rl_light *L = &d->lights[i];
@@ -315,9 +332,9 @@ static rl_status upload_materials_lights(rl_gl_pt *pt, const rl_gl_pt_lights *lt
         }
         put4(o->power, power, pmf);
     }
-    pt->buf[B_MATERIALS] = rl_gl_make_buffer(mats, sizeof *mats * d->num_materials, 0);
+    pt->buf[B_MATERIALS] = rl_gl_make_buffer(block, head + sizeof *mats * d->num_materials, 0);
     pt->buf[B_LIGHTS] = rl_gl_make_buffer(lights, sizeof *lights * d->num_lights, 0);
-    free(mats);
+    free(block);
     free(lights);
     return RL_OK;
 }
@@ -529,7 +546,7 @@ rl_status rl_gl_pt_create(const rl_scene *scene, const rl_gl_pt_desc *desc, rl_g
     if (st == RL_OK) {
         locate(pt->path_prog, &pt->pu);
         locate(pt->rays_prog, &pt->ru);
-        st = upload_materials_lights(pt, &desc->lights);
+        st = upload_materials_lights(pt, &desc->lights, desc->ggx_ms);
     }
     if (st == RL_OK)
         st = rl_gl_upload_textures(pt->data, max_block, "gl-pt", &pt->buf[B_TEX_INFO], &pt->buf[B_TEXELS]);
@@ -721,6 +738,7 @@ static rl_status render_frame(rl_gl_pt *pt, const rl_gl_pt_frame *f, float *rgba
     glProgramUniform1ui(p, u->vertex_slots, slots + (pt->have_env ? 1u : 0u));
     glProgramUniform1i(p, u->env, pt->have_env);
     glProgramUniform1i(p, u->env_nee, pt->have_env && f->env_nee);
+    glProgramUniform1i(p, u->ggx_ms, f->ggx_ms);
     glProgramUniform2i(p, u->env_map, pt->env_map[0], pt->env_map[1]);
     glProgramUniform2i(p, u->env_size, pt->env_size[0], pt->env_size[1]);
     glProgramUniform3i(p, u->env_off, pt->env_off[0], pt->env_off[1], pt->env_off[2]);

@@ -58,7 +58,13 @@ typedef struct rl_gl_pt_desc {
     int threads;                   /* BVH and grid build threads (0: all) */
     float eps;                     /* ray origin offset (pt's) */
     rl_gl_pt_lights lights;
+    /* The tables of GGX's energy compensation (issue 37; pathtrace_ggx.c,
+     * Kulla & Conty 2017) as pt builds them: E(mu) at RL_GL_PT_GGX_NODES
+     * roughness x RL_GL_PT_GGX_NODES mu nodes, row-major, then E_avg per
+     * roughness node. NULL: zeros (a scene without GGX never reads them). */
+    const float *ggx_ms;
 } rl_gl_pt_desc;
+#define RL_GL_PT_GGX_NODES 32
 
 /* One frame's settings; the names are pt's options (pathtrace.c). */
 typedef struct rl_gl_pt_frame {
@@ -77,6 +83,9 @@ typedef struct rl_gl_pt_frame {
      * also samples it by its distribution (pt's env_nee: the distribution
      * has weight and shadow rays are traced, not looked up in shadow maps). */
     bool env_nee;
+    /* GGX materials (rl_material.bsdf) with pt's energy compensation
+     * (option ggx_ms); the tables come with the desc */
+    bool ggx_ms;
     /* Sec. 8.5: this frame traces only the pixels whose x + y has the
      * parity of the frames since the reset (pathtrace.c active()) */
     bool checkerboard;

@@ -17,7 +17,7 @@
  * rr_depth, rng, mis, seed, shadow, diffuse, specular, primary,
  * checkerboard, accumulate, filter, filter_fade, atrous_*, grid_res, ls_n,
  * ls_k, ls_dynamic, ls_origin, light_samples, background, env_sampling,
- * threads, shadowmap_size), device (rl_gl.h) and ls_build. Values pt has and gl-pt
+ * ggx_ms, threads, shadowmap_size), device (rl_gl.h) and ls_build. Values pt has and gl-pt
  * has not ported are refused with an option error naming what is ported:
  * shadow=embree, diffuse=embree; pt's ls_file and adaptive* are not in the
  * table.
@@ -52,7 +52,9 @@
  * tracer as plain arrays (rl_gl_pt_set_environment); the shader looks it up
  * and samples it as pt does, at pt's slot with pt's MIS weights. Schlick's
  * Fresnel on mirrors and dielectrics is the shader's too (pt's
- * rl_pt_specular_event); GGX materials are refused (gl_pt_check_scene).
+ * rl_pt_specular_event), and so is the GGX BRDF (pathtrace_ggx.c) with
+ * its energy compensation (ggx_ms): the shader reads pt's own tables,
+ * handed to the tracer as plain floats (rl_gl_pt_desc.ggx_ms).
  *
  * Depth and ID layers, where the image has them, come from that G-buffer,
  * as pt writes them. */
@@ -129,6 +131,9 @@ static const rl_option_info gl_pt_options[] = {
     { "env_sampling", RL_OPT_ENUM, "importance",
       "light samples of a scene environment (issue 37): importance (by its radiance x sin(theta)), uniform "
       "(by solid angle) or bsdf (none: BSDF rays alone find it)", 0, 0, rl_pt_env_sampling_choices },
+    { "ggx_ms", RL_OPT_BOOL, "true",
+      "GGX energy compensation (Kulla & Conty 2017, pt's tables): the light single scattering loses returns as "
+      "a diffuse-like lobe; false: single scattering alone", 0, 0, NULL },
     { "threads", RL_OPT_INT, "0", "CPU threads of the structure builds (0 = all)", 0, 1024, NULL },
     { "device", RL_OPT_STRING, "",
       "EGL device: auto, surfaceless or a device number; empty: $RL_EGL_DEVICE, else auto", 0, 0, NULL },
@@ -209,10 +214,21 @@ static rl_status ensure_gpu(gl_pt_state *s, const rl_scene *scene, const char *d
     if (strlen(device) >= sizeof s->device)
         return rl_error(RL_ERR_INVALID_ARG, "gl-pt: device \"%.40s...\" is too long", device);
     const pt_lights *l = &s->b.lights;
+    /* pt's energy-compensation tables, built (once per process) only for
+     * a scene with a GGX material */
+    _Static_assert(RL_GL_PT_GGX_NODES == RL_PT_GGX_MS_NODES, "gl-pt reads pt's GGX tables as they are");
+    static float ggx_tables[RL_PT_GGX_MS_NODES * RL_PT_GGX_MS_NODES + RL_PT_GGX_MS_NODES];
+    const rl_scene_data *d = rl_scene_get_data(scene);
+    bool ggx = false;
+    for (uint32_t i = 0; d && i < d->num_materials; ++i)
+        ggx = ggx || d->materials[i].bsdf == RL_BSDF_GGX;
+    if (ggx)
+        rl_pt_ggx_ms_tables(ggx_tables, ggx_tables + RL_PT_GGX_MS_NODES * RL_PT_GGX_MS_NODES);
     rl_gl_pt_desc desc = {
         .device = device, .threads = threads, .eps = s->b.eps,
         .lights = { .count = l->count, .source = l->source, .cdf = l->cdf, .light_pmf = l->light_pmf,
                     .light_hittable = l->light_hittable, .tri_pmf = l->tri_pmf, .tri_cover = s->b.tri_cover },
+        .ggx_ms = ggx ? ggx_tables : NULL,
     };
     rl_timer timer;
     rl_timer_start(&timer);
@@ -357,20 +373,6 @@ static rl_status ensure_environment(gl_pt_state *s, const rl_scene_data *d, bool
     return RL_OK;
 }
 
-/* Issue 37's GGX BRDF lives in pt's C code only: refuse it by name rather
- * than render it as Phong (Schlick's Fresnel is ported). */
-static rl_status gl_pt_check_scene(const rl_scene *scene, const rl_scene_data *d)
-{
-    (void)scene;
-    for (uint32_t i = 0; i < d->num_materials; ++i) {
-        const rl_material *m = &d->materials[i];
-        if (m->bsdf != RL_BSDF_PHONG)
-            return rl_error(RL_ERR_UNSUPPORTED, "gl-pt: material '%s' uses GGX, not ported to GL yet (use pt)",
-                            m->name);
-    }
-    return RL_OK;
-}
-
 /* primary=raster (Sec. 8.1): the triangle IDs of the scene drawn by a GL
  * drawer, unlit, into s->ids, as rl_gbuffer_raster draws them with the
  * software rasterizer; every frame, as the thesis' extra render pass. The
@@ -494,9 +496,6 @@ static rl_status gl_pt_render(rl_renderer *r, void *state, const rl_scene *scene
     const rl_scene_data *d = rl_scene_get_data(scene);
     if (!d)
         return RL_ERR_NOT_COMMITTED;
-    rl_status refused = gl_pt_check_scene(scene, d);
-    if (refused != RL_OK)
-        return refused;
     const int threads = (int)rl_renderer_opt_int(r, "threads");
     /* What pt prepares for the GPU's estimator: offsets, covers, light
      * table (the GPU builds its own structures). */
@@ -598,6 +597,7 @@ static rl_status gl_pt_render(rl_renderer *r, void *state, const rl_scene *scene
         .env_nee = d->environment && s->b.env.sampled && env_sampling != PT_ENV_BSDF &&
                    shadow != RL_PT_BACKEND_SHADOWMAP,
         .reset_states = states,
+        .ggx_ms = rl_renderer_opt_bool(r, "ggx_ms"),
     };
     const bool raster = rl_renderer_opt_enum(r, "primary") == 1;
     const char *device = rl_renderer_opt_string(r, "device");

@@ -369,6 +369,12 @@ rl_vec3 rl_pt_ggx_sample_vndf(rl_vec3 wo, float alpha, float u1, float u2);
  * the quadrature of cells x cells visible normals that builds them. */
 float rl_pt_ggx_ms_albedo(float roughness, float mu);
 float rl_pt_ggx_ms_average(float roughness);
+/* The tables themselves, for gl-pt's shader (gl_pathtrace.c uploads them
+ * rather than building its own): E at RL_PT_GGX_MS_NODES roughness nodes
+ * (rows, r = i / (nodes - 1)) x as many mu nodes (mu = (j / (nodes - 1))^2),
+ * row-major into e; E_avg per roughness node into e_avg. */
+#define RL_PT_GGX_MS_NODES 32
+void rl_pt_ggx_ms_tables(float *e, float *e_avg);
 double rl_pt_ggx_albedo_quadrature(float alpha, float mu, int cells);
 
 /* The material's BRDF, Phong or GGX by rl_material.bsdf: what pt and bdpt
