@@ -364,6 +364,12 @@ const char *const rl_gl_pt_glsl_path = GLSL(
     uniform bool u_checker;            /* checkerboard (Sec. 8.5): only the pixels whose */
     uniform uint u_parity;             /* x + y has this parity */
     uniform bool u_raster;             /* primary=raster: paths start from u_ids' triangles */
+    /* adaptive sampling (pathtrace.c adaptive_tile): per pixel the samples
+     * held and this round's share; dispatch u_round_k traces the pixels
+     * whose share exceeds it, as sample number held + u_round_k */
+    layout(rg32ui, binding = 2) uniform uimage2D u_adapt;
+    uniform bool u_adaptive;
+    uniform uint u_round_k;
     layout(binding = 6) uniform usampler2D u_ids;
     /* pt's ray counts by rl_ray_type (rl_render_stats.rays) */
     layout(binding = 0, offset = 0) uniform atomic_uint c_primary;
@@ -950,11 +956,10 @@ const char *const rl_gl_pt_glsl_path = GLSL(
         return pdf;
     }
 
-    bool ggx_sample(Surf s, float u_lobe, float u1, float u2, out vec3 wi, out vec3 weight)
+    bool ggx_sample(Surf s, Ggx g, float u_lobe, float u1, float u2, out vec3 wi, out vec3 weight)
     {
         wi = vec3(0.0);
         weight = vec3(0.0);
-        Ggx g = ggx_setup(s);
         if (g.p_spec < 0.0 || !(g.wo.z > 0.0))
             return false;
         vec3 local;
@@ -979,30 +984,28 @@ const char *const rl_gl_pt_glsl_path = GLSL(
     }
 
     /* rl_pt_bsdf_eval / _pdf / _sample_pdf: Phong or GGX by the material,
-     * a runtime branch (one program for both) */
+     * a runtime branch (one program for both). Every call is about the
+     * path's current vertex, whose GGX lobe trace_path sets up once
+     * (g_lobe): pt sets it up per call, with the same result; one setup
+     * instead of one per call site also keeps the program small, which
+     * llvmpipe compiles in proportion to its inlined size. */
+    Ggx g_lobe;
     bool is_ggx(Surf s) { return materials[s.mat].pbr.z > 0.0; }
 
     vec3 brdf_eval(Surf s, vec3 wi)
     {
-        if (is_ggx(s)) {
-            Ggx g = ggx_setup(s);
-            return ggx_eval_local(g, ggx_local(g, wi));
-        }
-        return phong_eval(s, wi);
+        return is_ggx(s) ? ggx_eval_local(g_lobe, ggx_local(g_lobe, wi)) : phong_eval(s, wi);
     }
 
     float brdf_pdf(Surf s, vec3 wi)
     {
-        if (is_ggx(s)) {
-            Ggx g = ggx_setup(s);
-            return ggx_pdf_local(g, ggx_local(g, wi));
-        }
-        return phong_pdf(s, wi);
+        return is_ggx(s) ? ggx_pdf_local(g_lobe, ggx_local(g_lobe, wi)) : phong_pdf(s, wi);
     }
 
     bool brdf_sample(Surf s, float u_lobe, float u1, float u2, out vec3 wi, out vec3 weight)
     {
-        return is_ggx(s) ? ggx_sample(s, u_lobe, u1, u2, wi, weight) : phong_sample(s, u_lobe, u1, u2, wi, weight);
+        return is_ggx(s) ? ggx_sample(s, g_lobe, u_lobe, u1, u2, wi, weight)
+                         : phong_sample(s, u_lobe, u1, u2, wi, weight);
     }
 
     /* --------------------------------------------------------- lights -- */
@@ -1453,6 +1456,8 @@ const char *const rl_gl_pt_glsl_path = GLSL(
         for (int depth = 0;; ++depth) {
             uint base = SLOT_FIRST_VERTEX + uint(depth) * u_vertex_slots;
             Material m = materials[s.mat];
+            if (m.pbr.z > 0.0)
+                g_lobe = ggx_setup(s);
             vec3 e = u_mis ? emitted_mis(s, after_brdf, prev, prev_pdf) : emitted(s, after_brdf);
             radiance += T * e;
 
@@ -1562,6 +1567,12 @@ const char *const rl_gl_pt_glsl_path = GLSL(
         if (u_checker && cls != u_parity)
             return;
         uint held = u_held[cls];
+        if (u_adaptive) {
+            uvec2 a = imageLoad(u_adapt, px).xy;
+            if (u_round_k >= a.y)
+                return;
+            held = a.x + u_round_k;
+        }
         g_state = imageLoad(u_rng_state, px);
         g_index = held;
         g_slot = 0u;
@@ -1599,7 +1610,202 @@ const char *const rl_gl_pt_glsl_path = GLSL(
         /* Sec. 6.5, eq. 8: C_{s+1} = s/(s+1) C_s + 1/(s+1) C_trace */
         float n = float(held);
         vec4 c = held == 0u ? vec4(0.0) : imageLoad(u_accum, px);
-        imageStore(u_accum, px, vec4(c.rgb * (n / (n + 1.0)) + L * (1.0 / (n + 1.0)), 1.0));
+        /* adaptive: alpha the mean squared luminance, as pt's sum2 */
+        float a = 1.0;
+        if (u_adaptive) {
+            float l = 0.2126 * L.x + 0.7152 * L.y + 0.0722 * L.z;
+            a = c.a * (n / (n + 1.0)) + l * l * (1.0 / (n + 1.0));
+        }
+        imageStore(u_accum, px, vec4(c.rgb * (n / (n + 1.0)) + L * (1.0 / (n + 1.0)), a));
+    }
+);
+
+/* Adaptive sampling's passes (pathtrace.c pixel_errors, adaptive_shares),
+ * one program of 64 threads per work group, by u_mode:
+ *   0 errors: per pixel the relative error of the mean e = sqrt(s^2 / n) /
+ *     (mean + 0.05) of the luminance (-1 under two samples), from the
+ *     accumulation's running means of L and of l^2;
+ *   1 smooth: e averaged over the 3 x 3 neighbours that have one (infinite
+ *     where none has), and the pixels below the threshold counted;
+ *   2 shares: ONE work group: the water-filling t_i = min(cap, lambda e_i)
+ *     with sum t_i = budget (lambda by 50 bisection steps when the cap
+ *     binds), rounded by the running sum in pixel order, as pt; the sum
+ *     runs in units of 1/1024 sample held exactly in doubles, so that each
+ *     thread's contiguous chunk can start from an exact prefix;
+ *   3 commit: samples held += share. */
+const char *const rl_gl_pt_glsl_adapt = GLSL(
+    layout(local_size_x = 64) in;
+    /* image unit 3 and storage 14-15: none of the path program's, so that
+     * the passes and the path dispatches need no rebinding */
+    layout(rgba32f, binding = 3) uniform readonly image2D u_accum;
+    layout(rg32ui, binding = 2) uniform uimage2D u_adapt;
+    layout(std430, binding = 14) buffer Errors { float err[]; };   /* raw, then smoothed */
+    layout(std430, binding = 15) buffer Totals {
+        uint max_share;
+        uint converged;
+        uint pad0;
+        uint pad1;
+        double given;
+    };
+    uniform int u_mode;
+    uniform ivec2 u_size;
+    uniform float u_thr;
+    uniform double u_budget;
+    uniform double u_num_active;
+
+    shared double sh_sum[64];
+    shared float sh_hi[64];
+    shared float sh_lo[64];
+    shared uint sh_n[64];
+    shared uint sh_max;
+
+    const float INF_E = uintBitsToFloat(0x7f800000u);
+
+    /* wants_samples: not converged, and an error above zero */
+    bool wants(float e) { return !isinf(e) && !isnan(e) && e >= u_thr && e > 0.0; }
+
+    void shares()
+    {
+        uint t = gl_LocalInvocationID.x;
+        uint n = uint(u_size.x) * uint(u_size.y);
+        uint chunk = (n + 63u) / 64u;
+        uint b = min(n, t * chunk), end = min(n, b + chunk);
+        double total = 0.0;
+        float e_max = 0.0, e_min = INF_E;
+        uint positive = 0u;
+        for (uint i = b; i < end; ++i) {
+            float e = err[n + i];
+            if (!wants(e))
+                continue;
+            total += double(e);
+            e_max = max(e_max, e);
+            e_min = min(e_min, e);
+            ++positive;
+        }
+        sh_sum[t] = total;
+        sh_hi[t] = e_max;
+        sh_lo[t] = e_min;
+        sh_n[t] = positive;
+        if (t == 0u)
+            sh_max = 0u;
+        barrier();
+        double T = 0.0;
+        float E_max = 0.0, E_min = INF_E;
+        uint P = 0u;
+        for (uint k = 0u; k < 64u; ++k) {
+            T += sh_sum[k];
+            E_max = max(E_max, sh_hi[k]);
+            E_min = min(E_min, sh_lo[k]);
+            P += sh_n[k];
+        }
+        barrier();
+        double cap = 8.0 * u_budget / u_num_active;
+        bool none = P == 0u || !(T > 0.0);
+        /* all: every pixel that wants samples takes the cap */
+        bool all = !none && double(P) * cap <= u_budget;
+        double lambda = none ? 0.0 : u_budget / T;
+        if (!none && !all && lambda * double(E_max) > cap) {
+            double lo = lambda, hi = cap / double(E_min);
+            for (int it = 0; it < 50; ++it) {
+                double mid = 0.5 * (lo + hi), part = 0.0;
+                for (uint i = b; i < end; ++i) {
+                    float e = err[n + i];
+                    if (wants(e))
+                        part += min(cap, mid * double(e));
+                }
+                sh_sum[t] = part;
+                barrier();
+                double got = 0.0;
+                for (uint k = 0u; k < 64u; ++k)
+                    got += sh_sum[k];
+                barrier();
+                if (got < u_budget)
+                    lo = mid;
+                else
+                    hi = mid;
+            }
+            lambda = hi;
+        }
+        /* the chunk's sum in 1/1024 samples (integers: exact in double) */
+        double q_sum = 0.0;
+        for (uint i = b; i < end && !none; ++i) {
+            float e = err[n + i];
+            if (wants(e))
+                q_sum += floor((all ? cap : min(cap, lambda * double(e))) * 1024.0 + 0.5);
+        }
+        sh_sum[t] = q_sum;
+        barrier();
+        double run = 0.0, all_q = 0.0;
+        for (uint k = 0u; k < 64u; ++k) {
+            if (k < t)
+                run += sh_sum[k];
+            all_q += sh_sum[k];
+        }
+        double prev = floor(run / 1024.0 + 0.5);
+        uint most = 0u;
+        for (uint i = b; i < end; ++i) {
+            ivec2 px = ivec2(int(i % uint(u_size.x)), int(i / uint(u_size.x)));
+            uvec2 a = imageLoad(u_adapt, px).xy;
+            uint share = 0u;
+            float e = err[n + i];
+            if (!none && wants(e)) {
+                run += floor((all ? cap : min(cap, lambda * double(e))) * 1024.0 + 0.5);
+                double upto = floor(run / 1024.0 + 0.5);
+                share = uint(upto - prev);
+                prev = upto;
+            }
+            imageStore(u_adapt, px, uvec4(a.x, share, 0u, 0u));
+            most = max(most, share);
+        }
+        atomicMax(sh_max, most);
+        barrier();
+        if (t == 0u) {
+            max_share = sh_max;
+            given = none ? 0.0 : floor(all_q / 1024.0 + 0.5);
+        }
+    }
+
+    void main()
+    {
+        if (u_mode == 2) {
+            shares();
+            return;
+        }
+        /* rows of work groups beyond 65535 (the least dispatch size GL allows) */
+        uint i = gl_GlobalInvocationID.x + gl_GlobalInvocationID.y * gl_NumWorkGroups.x * 64u;
+        uint n = uint(u_size.x) * uint(u_size.y);
+        if (i >= n)
+            return;
+        ivec2 px = ivec2(int(i % uint(u_size.x)), int(i / uint(u_size.x)));
+        uvec2 a = imageLoad(u_adapt, px).xy;
+        if (u_mode == 0) {
+            if (a.x < 2u) {
+                err[i] = -1.0;
+                return;
+            }
+            vec4 c = imageLoad(u_accum, px);
+            double cnt = double(a.x);
+            double mean = 0.2126 * double(c.x) + 0.7152 * double(c.y) + 0.0722 * double(c.z);
+            double var = (double(c.w) - mean * mean) * cnt / (cnt - 1.0);
+            err[i] = float(sqrt(max(var, 0.0) / cnt) / (abs(mean) + 0.05));
+        } else if (u_mode == 1) {
+            double sum = 0.0;
+            int k = 0;
+            for (int y = max(px.y - 1, 0); y <= px.y + 1 && y < u_size.y; ++y)
+                for (int x = max(px.x - 1, 0); x <= px.x + 1 && x < u_size.x; ++x) {
+                    float e = err[uint(y) * uint(u_size.x) + uint(x)];
+                    if (e >= 0.0) {
+                        sum += double(e);
+                        ++k;
+                    }
+                }
+            float sm = k > 0 ? float(sum / double(k)) : INF_E;
+            err[n + i] = sm;
+            if (sm < u_thr)
+                atomicAdd(converged, 1u);
+        } else {
+            imageStore(u_adapt, px, uvec4(a.x + a.y, 0u, 0u, 0u));
+        }
     }
 );
 

@@ -396,4 +396,9 @@ bool rl_pt_bsdf_needs_lobe(const rl_material *m);
  * multiplies the throughput; *refracted tells the ray type. */
 void rl_pt_specular_event(const pt_surface *s, float u_event, rl_vec3 *dir, rl_vec3 *weight, bool *refracted);
 
+/* gl-pt's per-pixel sample counts after an adaptive frame (gl_pathtrace.c,
+ * rl_gl_pt_sample_counts; width x height, row 0 the top row): what
+ * rl_pt_sample_counts gives for pt. */
+rl_status rl_gl_pt_renderer_sample_counts(const rl_renderer *r, uint32_t *counts);
+
 #endif
