@@ -79,6 +79,7 @@ typedef struct uniforms {
         num_textures, eps, background, shadow, diffuse, specular, ls_start, ls_offset;
     GLint sm_size, sm_bias, sm_slope, sm_pcf, sm_frame;
     GLint env, env_nee, env_slot, env_map, env_size, env_rot, env_sum, env_off;
+    GLint ggx_ms, adaptive, round_k;
     GLint count, structure, any;
 } uniforms;
 
@@ -115,6 +116,16 @@ struct rl_gl_pt {
     uint64_t frames;              /* since the reset */
     /* primary=raster: the raster pass's triangle per pixel (r32ui) */
     GLuint tex_ids;
+    /* adaptive sampling: per pixel the samples held and the round's share
+     * (rg32ui, image unit 2), the passes' program (made on first use), its
+     * errors (2 floats per pixel) and totals; the samples of all pixels
+     * together, and those of the uniform start (equal in every pixel) */
+    GLuint tex_adapt, adapt_prog, adapt_err, adapt_tot;
+    GLint a_mode, a_size, a_thr, a_budget, a_num_active;
+    size_t adapt_err_pixels;
+    uint64_t counted;
+    uint32_t start_count;
+    bool adapt_counts;            /* tex_adapt's counts are this accumulation's */
     /* the ray counters (atomic_uint, one per rl_ray_type) */
     GLuint counters;
     /* the cube shadow maps (rl_gl_pt_set_shadowmaps): the depth pass's
@@ -207,6 +218,9 @@ static void locate(GLuint p, uniforms *u)
     U(env_rot, "u_env_rot");
     U(env_sum, "u_env_sum");
     U(env_off, "u_env_off");
+    U(ggx_ms, "u_ggx_ms");
+    U(adaptive, "u_adaptive");
+    U(round_k, "u_round_k");
     U(count, "u_count");
     U(structure, "u_structure");
     U(any, "u_any");
@@ -224,10 +238,10 @@ static GLuint compute_program(const char *body, bool linespace, const char *what
              "#define STRUCT_LS_CAND %d\n#define STRUCT_LS_PNMT %d\n#define STRUCT_LS_PREILLUM %d\n"
              "#define STRUCT_SHADOWMAP %d\n"
              "#define LIGHT_POINT %d\n#define LIGHT_SPOT %d\n#define LIGHT_DIRECTIONAL %d\n#define LIGHT_QUAD %d\n"
-             "#define INF uintBitsToFloat(0x7f800000u)\n",
+             "#define INF uintBitsToFloat(0x7f800000u)\n#define GGX_NODES %d\n",
              LOCAL, RL_BVH_MAX_DEPTH, (int)RL_GL_PT_GRID, (int)RL_GL_PT_LS_CANDIDATES, (int)RL_GL_PT_LS_PNMT,
              (int)RL_GL_PT_LS_PREILLUM, (int)RL_GL_PT_SHADOWMAP, (int)RL_LIGHT_POINT, (int)RL_LIGHT_SPOT,
-             (int)RL_LIGHT_DIRECTIONAL, (int)RL_LIGHT_QUAD);
+             (int)RL_LIGHT_DIRECTIONAL, (int)RL_LIGHT_QUAD, RL_GL_PT_GGX_NODES);
     if (!body) {
         /* the shadow maps' depth pass: common's declarations, and for the
          * fragment stage the texture lookup of the masks */
@@ -257,21 +271,32 @@ static rl_status check_block(uint64_t bytes, GLint64 max_block, const char *what
 
 /* Materials and lights as gl_pt_shaders.c reads them: what does not depend
  * on the point lit (a spot's cosines, a directional light's direction) is
- * computed here with the C functions of scene/light_eval.c. */
-static rl_status upload_materials_lights(rl_gl_pt *pt, const rl_gl_pt_lights *lt)
+ * computed here with the C functions of scene/light_eval.c. The materials'
+ * buffer starts with GGX's energy-compensation tables (ggx_ms, or zeros):
+ * a storage block of their own would be the path program's 17th with the
+ * Line Space (llvmpipe allows 16), a texture unit another llvmpipe variant
+ * key entry. */
+#define GGX_TABLE_FLOATS (RL_GL_PT_GGX_NODES * RL_GL_PT_GGX_NODES + RL_GL_PT_GGX_NODES)
+static rl_status upload_materials_lights(rl_gl_pt *pt, const rl_gl_pt_lights *lt, const float *ggx_ms)
 {
     const rl_scene_data *d = pt->data;
     typedef struct {
         float diffuse[4], specular[4], emission[4], extra[4];
         uint32_t tex[4];
+        float pbr[4];
     } material;
-    material *mats = rl_calloc(d->num_materials ? d->num_materials : 1, sizeof *mats);
+    _Static_assert(GGX_TABLE_FLOATS * sizeof(float) % 16 == 0, "std430 aligns the materials to 16 bytes");
+    const size_t head = GGX_TABLE_FLOATS * sizeof(float);
+    unsigned char *block = rl_calloc(1, head + sizeof(material) * (d->num_materials ? d->num_materials : 1));
     rl_gl_light *lights = rl_calloc(d->num_lights ? d->num_lights : 1, sizeof *lights);
-    if (!mats || !lights) {
-        free(mats);
+    if (!block || !lights) {
+        free(block);
         free(lights);
         return RL_ERR_OUT_OF_MEMORY;
     }
+    if (ggx_ms)
+        memcpy(block, ggx_ms, head);
+    material *mats = (material *)(void *)(block + head);
     for (uint32_t i = 0; i < d->num_materials; ++i) {
         const rl_material *m = &d->materials[i];
         put4(mats[i].diffuse, m->diffuse, m->reflectivity);
@@ -285,6 +310,10 @@ static rl_status upload_materials_lights(rl_gl_pt *pt, const rl_gl_pt_lights *lt
         mats[i].tex[1] = valid_texture(d, m->normal_texture);
         mats[i].tex[2] = rl_material_mask(d, i);
         mats[i].tex[3] = RL_NONE;
+        /* issue 37's GGX BRDF (pathtrace_ggx.c): roughness, metallic */
+        mats[i].pbr[0] = m->roughness;
+        mats[i].pbr[1] = m->metallic;
+        mats[i].pbr[2] = m->bsdf == RL_BSDF_GGX ? 1.0f : 0.0f;
     }
     for (uint32_t i = 0; i < d->num_lights; ++i) {
         const rl_light *L = &d->lights[i];
@@ -315,9 +344,9 @@ static rl_status upload_materials_lights(rl_gl_pt *pt, const rl_gl_pt_lights *lt
         }
         put4(o->power, power, pmf);
     }
-    pt->buf[B_MATERIALS] = rl_gl_make_buffer(mats, sizeof *mats * d->num_materials, 0);
+    pt->buf[B_MATERIALS] = rl_gl_make_buffer(block, head + sizeof *mats * d->num_materials, 0);
     pt->buf[B_LIGHTS] = rl_gl_make_buffer(lights, sizeof *lights * d->num_lights, 0);
-    free(mats);
+    free(block);
     free(lights);
     return RL_OK;
 }
@@ -529,7 +558,7 @@ rl_status rl_gl_pt_create(const rl_scene *scene, const rl_gl_pt_desc *desc, rl_g
     if (st == RL_OK) {
         locate(pt->path_prog, &pt->pu);
         locate(pt->rays_prog, &pt->ru);
-        st = upload_materials_lights(pt, &desc->lights);
+        st = upload_materials_lights(pt, &desc->lights, desc->ggx_ms);
     }
     if (st == RL_OK)
         st = rl_gl_upload_textures(pt->data, max_block, "gl-pt", &pt->buf[B_TEX_INFO], &pt->buf[B_TEXELS]);
@@ -590,6 +619,7 @@ static rl_status reset_images(rl_gl_pt *pt, int w, int h, const uint32_t *states
             glDeleteTextures(1, &pt->tex_accum);
             glDeleteTextures(1, &pt->tex_rng);
             glDeleteTextures(1, &pt->tex_ids);
+            glDeleteTextures(1, &pt->tex_adapt);
         }
         const int aw = unpowered(w, max_size), ah = unpowered(h, max_size);
         glCreateTextures(GL_TEXTURE_2D, 1, &pt->tex_accum);
@@ -604,14 +634,22 @@ static rl_status reset_images(rl_gl_pt *pt, int w, int h, const uint32_t *states
          * and every texelFetch reads 0 */
         glTextureParameteri(pt->tex_ids, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
         glTextureParameteri(pt->tex_ids, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+        /* bound always, for the same reason */
+        glCreateTextures(GL_TEXTURE_2D, 1, &pt->tex_adapt);
+        glTextureStorage2D(pt->tex_adapt, 1, GL_RG32UI, aw, ah);
         pt->width = w;
         pt->height = h;
     }
     glTextureSubImage2D(pt->tex_rng, 0, 0, 0, w, h, GL_RGBA_INTEGER, GL_UNSIGNED_INT, states);
     const float zero[4] = { 0.0f, 0.0f, 0.0f, 0.0f };
     glClearTexImage(pt->tex_accum, 0, GL_RGBA, GL_FLOAT, zero);
+    const GLuint none[4] = { 0, 0, 0, 0 };
+    glClearTexImage(pt->tex_adapt, 0, GL_RG_INTEGER, GL_UNSIGNED_INT, none);
     pt->held[0] = pt->held[1] = 0;
     pt->frames = 0;
+    pt->counted = 0;
+    pt->start_count = 0;
+    pt->adapt_counts = false;
     return RL_OK;
 }
 
@@ -638,7 +676,147 @@ static uint64_t rays_bound(const rl_gl_pt_frame *f, uint32_t num_lights)
     return (uint64_t)f->cam.width * (uint64_t)f->cam.height * (1u + ((uint64_t)f->max_depth + 1u) * per_vertex);
 }
 
-static rl_status render_frame(rl_gl_pt *pt, const rl_gl_pt_frame *f, float *rgba, uint64_t rays[RL_GL_PT_RAY_TYPES])
+/* The dispatches of one round: dispatch k traces sample k of every pixel
+ * with more than k to trace (all of them without adaptive sampling, where
+ * held numbers the samples). The counters are read only when the next
+ * dispatch could wrap them. */
+static void dispatch_samples(rl_gl_pt *pt, uint32_t count, const GLuint held_base[2], GLuint gx, GLuint gy,
+                             uint64_t bound, uint64_t *pending, uint64_t rays[RL_GL_PT_RAY_TYPES])
+{
+    const GLuint p = pt->path_prog;
+    for (uint32_t k = 0; k < count; ++k) {
+        if (*pending > 0 && *pending + bound > UINT32_MAX) {
+            drain_counters(pt, rays);
+            *pending = 0;
+        }
+        /* One sample per dispatch: the accumulation of eq. 8 reads what the
+         * previous sample wrote. Each class of pixels numbers its own
+         * samples (checkerboard traces one class per frame). */
+        const GLuint held[2] = { held_base[0] + k, held_base[1] + k };
+        glProgramUniform1uiv(p, pt->pu.held, 2, held);
+        glProgramUniform1ui(p, pt->pu.round_k, k);
+        glDispatchCompute(gx, gy, 1);
+        glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT);
+        *pending += bound;
+    }
+}
+
+/* Adaptive sampling's program and buffers for w x h pixels. */
+static rl_status adapt_prepare(rl_gl_pt *pt, size_t pixels)
+{
+    if (!pt->adapt_prog) {
+        const char *const parts[] = { rl_gl_pt_glsl_header, rl_gl_pt_glsl_adapt };
+        GLuint s = rl_gl_compile(GL_COMPUTE_SHADER, parts, 2, "gl-pt adaptive");
+        GLuint p = s ? rl_gl_link(s, 0, "gl-pt adaptive") : 0;
+        if (!p)
+            return RL_ERR_INTERNAL;
+        pt->adapt_prog = p;
+        pt->a_mode = glGetUniformLocation(p, "u_mode");
+        pt->a_size = glGetUniformLocation(p, "u_size");
+        pt->a_thr = glGetUniformLocation(p, "u_thr");
+        pt->a_budget = glGetUniformLocation(p, "u_budget");
+        pt->a_num_active = glGetUniformLocation(p, "u_num_active");
+        pt->adapt_tot = rl_gl_make_buffer(NULL, 32, GL_DYNAMIC_STORAGE_BIT);
+    }
+    if (pt->adapt_err_pixels != pixels) {
+        if (pt->adapt_err)
+            glDeleteBuffers(1, &pt->adapt_err);
+        pt->adapt_err = rl_gl_make_buffer(NULL, 2 * sizeof(float) * pixels, 0);
+        pt->adapt_err_pixels = pixels;
+    }
+    return RL_OK;
+}
+
+/* One of the passes (gl_pt_shaders.c rl_gl_pt_glsl_adapt, u_mode). */
+enum { ADAPT_ERRORS = 0, ADAPT_SMOOTH, ADAPT_SHARES, ADAPT_COMMIT };
+static void adapt_pass(rl_gl_pt *pt, int mode, int w, int h, float thr, double budget)
+{
+    const GLuint p = pt->adapt_prog;
+    glUseProgram(p);
+    glBindImageTexture(3, pt->tex_accum, 0, GL_FALSE, 0, GL_READ_ONLY, GL_RGBA32F);
+    glBindImageTexture(2, pt->tex_adapt, 0, GL_FALSE, 0, GL_READ_WRITE, GL_RG32UI);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 14, pt->adapt_err);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 15, pt->adapt_tot);
+    glProgramUniform1i(p, pt->a_mode, mode);
+    glProgramUniform2i(p, pt->a_size, w, h);
+    glProgramUniform1f(p, pt->a_thr, thr);
+    glProgramUniform1d(p, pt->a_budget, budget);
+    glProgramUniform1d(p, pt->a_num_active, (double)w * (double)h);
+    const uint64_t groups = ((uint64_t)w * (uint64_t)h + 63u) / 64u;
+    if (mode == ADAPT_SHARES) {
+        glDispatchCompute(1, 1, 1);
+    } else {
+        const GLuint gx = groups < 65535u ? (GLuint)groups : 65535u;
+        glDispatchCompute(gx, (GLuint)((groups + gx - 1) / gx), 1);
+    }
+    glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_SHADER_IMAGE_ACCESS_BARRIER_BIT);
+}
+
+/* pathtrace.c adaptive_passes on the GPU: the uniform start up to
+ * adaptive_min_spp (equal in every pixel, so a clear sets its shares),
+ * then rounds by error, each at most doubling the mean count, until the
+ * frame's spp x pixels are spent or nothing wants more. The shares come
+ * from the GPU passes; the CPU reads back three numbers per round. */
+static rl_status adaptive_frame(rl_gl_pt *pt, const rl_gl_pt_frame *f, GLuint gx, GLuint gy, uint64_t bound,
+                                uint64_t rays[RL_GL_PT_RAY_TYPES], uint64_t *samples, uint64_t *converged)
+{
+    const int w = f->cam.width, h = f->cam.height;
+    const uint64_t n = (uint64_t)w * (uint64_t)h;
+    rl_status st = adapt_prepare(pt, (size_t)n);
+    if (st != RL_OK)
+        return st;
+    const uint32_t min_spp = (uint32_t)f->adaptive_min_spp, spp = (uint32_t)f->spp;
+    const uint64_t budget = (uint64_t)spp * n;
+    uint64_t spent = 0, pending = 0;
+    const GLuint zero_held[2] = { 0, 0 };
+    if (pt->start_count < min_spp) {
+        const uint32_t need = min_spp - pt->start_count, share = need < spp ? need : spp;
+        const GLuint v[4] = { pt->start_count, share, 0, 0 };
+        glClearTexImage(pt->tex_adapt, 0, GL_RG_INTEGER, GL_UNSIGNED_INT, v);
+        glMemoryBarrier(GL_TEXTURE_UPDATE_BARRIER_BIT | GL_SHADER_IMAGE_ACCESS_BARRIER_BIT);
+        glUseProgram(pt->path_prog);
+        dispatch_samples(pt, share, zero_held, gx, gy, bound, &pending, rays);
+        adapt_pass(pt, ADAPT_COMMIT, w, h, f->adaptive_threshold, 0.0);
+        pt->start_count += share;
+        spent = (uint64_t)share * n;
+        pt->counted += spent;
+    }
+    uint64_t remaining = budget - spent;
+    struct {
+        GLuint max_share, converged, pad[2];
+        double given;
+    } tot;
+    *converged = 0;
+    while (remaining > 0) {
+        const uint64_t mean = pt->counted / n;
+        uint64_t round = n * (mean > 1 ? mean : 1);
+        round = round < remaining ? round : remaining;
+        memset(&tot, 0, sizeof tot);
+        glNamedBufferSubData(pt->adapt_tot, 0, sizeof tot, &tot);
+        adapt_pass(pt, ADAPT_ERRORS, w, h, f->adaptive_threshold, 0.0);
+        adapt_pass(pt, ADAPT_SMOOTH, w, h, f->adaptive_threshold, 0.0);
+        adapt_pass(pt, ADAPT_SHARES, w, h, f->adaptive_threshold, (double)round);
+        glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);
+        glGetNamedBufferSubData(pt->adapt_tot, 0, sizeof tot, &tot);
+        *converged = tot.converged;
+        const uint64_t given = (uint64_t)tot.given;
+        if (given == 0)
+            break;
+        glUseProgram(pt->path_prog);
+        dispatch_samples(pt, tot.max_share, zero_held, gx, gy, bound, &pending, rays);
+        adapt_pass(pt, ADAPT_COMMIT, w, h, f->adaptive_threshold, 0.0);
+        spent += given;
+        pt->counted += given;
+        remaining -= round;
+    }
+    glUseProgram(pt->path_prog);
+    pt->adapt_counts = true;
+    *samples = spent;
+    return RL_OK;
+}
+
+static rl_status render_frame(rl_gl_pt *pt, const rl_gl_pt_frame *f, float *rgba, uint64_t rays[RL_GL_PT_RAY_TYPES],
+                              uint64_t *samples, uint64_t *converged)
 {
     const rl_scene_data *d = pt->data;
     const int w = f->cam.width, h = f->cam.height;
@@ -666,6 +844,7 @@ static rl_status render_frame(rl_gl_pt *pt, const rl_gl_pt_frame *f, float *rgba
     bind_scene(pt, p, u);
     glBindImageTexture(0, pt->tex_accum, 0, GL_FALSE, 0, GL_READ_WRITE, GL_RGBA32F);
     glBindImageTexture(1, pt->tex_rng, 0, GL_FALSE, 0, GL_READ_WRITE, GL_RGBA32UI);
+    glBindImageTexture(2, pt->tex_adapt, 0, GL_FALSE, 0, GL_READ_WRITE, GL_RG32UI);
     const rl_camera_frame *c = &f->cam;
     glProgramUniform2i(p, u->size, w, h);
     glProgramUniform3f(p, u->eye, c->eye.x, c->eye.y, c->eye.z);
@@ -721,6 +900,7 @@ static rl_status render_frame(rl_gl_pt *pt, const rl_gl_pt_frame *f, float *rgba
     glProgramUniform1ui(p, u->vertex_slots, slots + (pt->have_env ? 1u : 0u));
     glProgramUniform1i(p, u->env, pt->have_env);
     glProgramUniform1i(p, u->env_nee, pt->have_env && f->env_nee);
+    glProgramUniform1i(p, u->ggx_ms, f->ggx_ms);
     glProgramUniform2i(p, u->env_map, pt->env_map[0], pt->env_map[1]);
     glProgramUniform2i(p, u->env_size, pt->env_size[0], pt->env_size[1]);
     glProgramUniform3i(p, u->env_off, pt->env_off[0], pt->env_off[1], pt->env_off[2]);
@@ -741,27 +921,26 @@ static rl_status render_frame(rl_gl_pt *pt, const rl_gl_pt_frame *f, float *rgba
         rl_gl_ls_set_uniforms(pt->ls, p);
     }
     const GLuint gx = (GLuint)(w + LOCAL - 1) / LOCAL, gy = (GLuint)(h + LOCAL - 1) / LOCAL;
-    /* the counters are read only when the next dispatch could wrap them */
     const uint64_t bound = rays_bound(f, d->num_lights);
-    uint64_t pending = 0;
-    for (int k = 0; k < f->spp; ++k) {
-        if (pending > 0 && pending + bound > UINT32_MAX) {
-            drain_counters(pt, rays);
-            pending = 0;
-        }
-        /* One sample per dispatch: the accumulation of eq. 8 reads what the
-         * previous sample wrote. Each class of pixels numbers its own
-         * samples (checkerboard traces one class per frame). */
-        const GLuint held[2] = { (GLuint)(pt->held[0] + (uint64_t)k), (GLuint)(pt->held[1] + (uint64_t)k) };
-        glProgramUniform1uiv(p, u->held, 2, held);
-        glDispatchCompute(gx, gy, 1);
-        glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT);
-        pending += bound;
+    glProgramUniform1i(p, u->adaptive, f->adaptive);
+    *converged = 0;
+    if (f->adaptive) {
+        st = adaptive_frame(pt, f, gx, gy, bound, rays, samples, converged);
+        if (st != RL_OK)
+            return st;
+        drain_counters(pt, rays);
+        /* the mean samples per pixel (the filters' noise scale) */
+        pt->held[0] = pt->held[1] = pt->counted / ((uint64_t)w * (uint64_t)h);
+    } else {
+        uint64_t pending = 0;
+        const GLuint held[2] = { (GLuint)pt->held[0], (GLuint)pt->held[1] };
+        dispatch_samples(pt, (uint32_t)f->spp, held, gx, gy, bound, &pending, rays);
+        drain_counters(pt, rays);
+        for (int c = 0; c < 2; ++c)
+            if (!f->checkerboard || (uint32_t)c == parity)
+                pt->held[c] += (uint64_t)f->spp;
+        *samples = 0;
     }
-    drain_counters(pt, rays);
-    for (int c = 0; c < 2; ++c)
-        if (!f->checkerboard || (uint32_t)c == parity)
-            pt->held[c] += (uint64_t)f->spp;
     pt->frames++;
     if (rgba) {
         glMemoryBarrier(GL_TEXTURE_UPDATE_BARRIER_BIT);
@@ -786,10 +965,13 @@ rl_status rl_gl_pt_render(rl_gl_pt *pt, const rl_gl_pt_frame *frame, float *rgba
     const uint64_t most = frame->reset_states ? 0 : (pt->held[0] > pt->held[1] ? pt->held[0] : pt->held[1]);
     if (most + (uint64_t)frame->spp > UINT32_MAX)
         return rl_error(RL_ERR_LIMIT, "gl-pt: more than 2^32 samples per pixel in one accumulation");
-    uint64_t rays[RL_GL_PT_RAY_TYPES] = { 0 };
+    if (frame->adaptive && (frame->checkerboard || frame->adaptive_min_spp < 2 || !(frame->adaptive_threshold >= 0.0f)))
+        return rl_error(RL_ERR_INVALID_ARG, "rl_gl_pt_render: adaptive sampling needs adaptive_min_spp >= 2, a "
+                        "threshold >= 0 and no checkerboard");
+    uint64_t rays[RL_GL_PT_RAY_TYPES] = { 0 }, samples = 0, converged = 0;
     rl_status st = rl_gl_context_make_current(pt->ctx);
     if (st == RL_OK)
-        st = render_frame(pt, frame, rgba, rays);
+        st = render_frame(pt, frame, rgba, rays, &samples, &converged);
     if (st != RL_OK && frame->reset_states) {
         pt->held[0] = pt->held[1] = 0;
         pt->frames = 0;
@@ -798,7 +980,33 @@ rl_status rl_gl_pt_render(rl_gl_pt *pt, const rl_gl_pt_frame *frame, float *rgba
         memcpy(res->held, pt->held, sizeof res->held);
         res->frames = pt->frames;
         memcpy(res->rays, rays, sizeof res->rays);
+        res->samples = samples;
+        res->converged = converged;
     }
+    rl_gl_context_done(pt->ctx);
+    return st;
+}
+
+rl_status rl_gl_pt_sample_counts(rl_gl_pt *pt, uint32_t *counts)
+{
+    if (!pt || !counts || !pt->adapt_counts)
+        return rl_error(RL_ERR_INVALID_ARG, "rl_gl_pt_sample_counts: needs a tracer after an adaptive frame");
+    rl_status st = rl_gl_context_make_current(pt->ctx);
+    if (st != RL_OK)
+        return st;
+    const size_t n = (size_t)pt->width * (size_t)pt->height;
+    uint32_t *both = rl_alloc(2 * n * sizeof *both);
+    if (!both) {
+        rl_gl_context_done(pt->ctx);
+        return RL_ERR_OUT_OF_MEMORY;
+    }
+    glMemoryBarrier(GL_TEXTURE_UPDATE_BARRIER_BIT);
+    glGetTextureSubImage(pt->tex_adapt, 0, 0, 0, 0, pt->width, pt->height, 1, GL_RG_INTEGER, GL_UNSIGNED_INT,
+                         (GLsizei)(2 * n * sizeof *both), both);
+    for (size_t i = 0; i < n; ++i)
+        counts[i] = both[2 * i];
+    free(both);
+    st = rl_gl_check("rl_gl_pt_sample_counts");
     rl_gl_context_done(pt->ctx);
     return st;
 }
@@ -1148,6 +1356,13 @@ rl_status rl_gl_pt_render(rl_gl_pt *pt, const rl_gl_pt_frame *frame, float *rgba
     (void)rgba;
     if (res)
         memset(res, 0, sizeof *res);
+    return rl_error(RL_ERR_UNSUPPORTED, "gl: built without OpenGL");
+}
+
+rl_status rl_gl_pt_sample_counts(rl_gl_pt *pt, uint32_t *counts)
+{
+    (void)pt;
+    (void)counts;
     return rl_error(RL_ERR_UNSUPPORTED, "gl: built without OpenGL");
 }
 

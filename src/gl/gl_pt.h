@@ -58,7 +58,13 @@ typedef struct rl_gl_pt_desc {
     int threads;                   /* BVH and grid build threads (0: all) */
     float eps;                     /* ray origin offset (pt's) */
     rl_gl_pt_lights lights;
+    /* The tables of GGX's energy compensation (issue 37; pathtrace_ggx.c,
+     * Kulla & Conty 2017) as pt builds them: E(mu) at RL_GL_PT_GGX_NODES
+     * roughness x RL_GL_PT_GGX_NODES mu nodes, row-major, then E_avg per
+     * roughness node. NULL: zeros (a scene without GGX never reads them). */
+    const float *ggx_ms;
 } rl_gl_pt_desc;
+#define RL_GL_PT_GGX_NODES 32
 
 /* One frame's settings; the names are pt's options (pathtrace.c). */
 typedef struct rl_gl_pt_frame {
@@ -77,6 +83,16 @@ typedef struct rl_gl_pt_frame {
      * also samples it by its distribution (pt's env_nee: the distribution
      * has weight and shadow rays are traced, not looked up in shadow maps). */
     bool env_nee;
+    /* GGX materials (rl_material.bsdf) with pt's energy compensation
+     * (option ggx_ms); the tables come with the desc */
+    bool ggx_ms;
+    /* Per-pixel adaptive sampling (pt's adaptive=on, pathtrace.c): the
+     * frame's spp x pixels paths go out by each pixel's estimated relative
+     * error, after a uniform start of adaptive_min_spp; pixels below
+     * adaptive_threshold get none. Not with checkerboard. */
+    bool adaptive;
+    float adaptive_threshold;
+    int adaptive_min_spp;
     /* Sec. 8.5: this frame traces only the pixels whose x + y has the
      * parity of the frames since the reset (pathtrace.c active()) */
     bool checkerboard;
@@ -115,9 +131,11 @@ const rl_gl_info *rl_gl_pt_info(const rl_gl_pt *pt);
 #define RL_GL_PT_RAY_TYPES 5
 
 typedef struct rl_gl_pt_result {
-    uint64_t held[2];
+    uint64_t held[2];              /* adaptive: both the mean samples per pixel, rounded down */
     uint64_t frames;
     uint64_t rays[RL_GL_PT_RAY_TYPES];
+    uint64_t samples;              /* adaptive: paths traced in this frame (else 0) */
+    uint64_t converged;            /* adaptive: pixels below the threshold at the last round */
 } rl_gl_pt_result;
 
 /* Traces frame->spp samples per pixel (of the frame's checkerboard half)
@@ -126,6 +144,11 @@ typedef struct rl_gl_pt_result {
  * without reset_states on the first frame or a size change. res may be
  * NULL. */
 rl_status rl_gl_pt_render(rl_gl_pt *pt, const rl_gl_pt_frame *frame, float *rgba, rl_gl_pt_result *res);
+
+/* The samples every pixel of the accumulation holds (width x height, row 0
+ * the top row), kept per pixel only by adaptive frames: RL_ERR_INVALID_ARG
+ * before one. */
+rl_status rl_gl_pt_sample_counts(rl_gl_pt *pt, uint32_t *counts);
 
 /* The Line Space the LS structures walk, replacing the tracer's: uploaded
  * from ls (committed, its origin rule as set) when ls is non-NULL, else
@@ -188,6 +211,8 @@ extern const char *const rl_gl_pt_glsl_common;
 extern const char *const rl_gl_pt_glsl_common2;
 extern const char *const rl_gl_pt_glsl_path;
 extern const char *const rl_gl_pt_glsl_rays;
+/* adaptive sampling's passes (errors, shares): after the header alone */
+extern const char *const rl_gl_pt_glsl_adapt;
 /* the shadow maps' depth pass: after header, defines and common */
 extern const char *const rl_gl_pt_glsl_shadow_vs;
 /* after header, defines, common and rl_gl_glsl_tex_sample */

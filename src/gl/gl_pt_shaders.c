@@ -17,6 +17,8 @@
  *   grid_query        accel/grid.c: a 3-D DDA (Amanatides & Woo 1987) over
  *                     the cells' offsets and triangle lists (Sec. 5.4)
  *   surface_*, phong_ pathtrace_path.c, pathtrace_bsdf.c
+ *   ggx_*, brdf_*     pathtrace_ggx.c: GGX with visible-normal sampling and
+ *                     the energy compensation from pt's tables (issue 37)
  *   direct_light*     Shade (Sec. 6.4.2, 6.3), with MIS (pathtrace_path.c)
  *   env_*             scene/environment.c (lookup) and pathtrace_env.c
  *                     (sampling by pt's own CDFs, density), environment_light
@@ -41,13 +43,20 @@ const char *const rl_gl_pt_glsl_common = GLSL(
     const uint NONE = 0xffffffffu;
     const float PI = 3.14159265358979323846;
 
-    struct Material { vec4 diffuse; vec4 specular; vec4 emission; vec4 extra; uvec4 tex; };
+    /* pbr: GGX's roughness, metallic, and 1 for bsdf = ggx (issue 37) */
+    struct Material { vec4 diffuse; vec4 specular; vec4 emission; vec4 extra; uvec4 tex; vec4 pbr; };
     struct Light { vec4 pos; vec4 power; vec4 dir; vec4 extra; };
     struct TexInfo { uint offset; int width; int height; int pad; };
     struct Node { vec4 lo; vec4 hi; };
     struct Hit { float t; float u; float v; uint tri; };
 
-    layout(std430, binding = 0) readonly buffer Materials { Material materials[]; };
+    /* ggx_e: GGX's energy-compensation tables as pt builds them
+     * (pathtrace_ggx.c ms_build): E [roughness node][mu node], then E_avg
+     * per roughness node; zeros in scenes without GGX */
+    layout(std430, binding = 0) readonly buffer Materials {
+        float ggx_e[GGX_NODES * GGX_NODES + GGX_NODES];
+        Material materials[];
+    };
     layout(std430, binding = 1) readonly buffer Lights { Light lights[]; };
     layout(std430, binding = 2) readonly buffer TexInfos { TexInfo tex_info[]; };
     /* Read-only arrays as buffer textures (texture units 0-3; the path
@@ -334,6 +343,7 @@ const char *const rl_gl_pt_glsl_path = GLSL(
     layout(binding = 8) uniform samplerBuffer u_env_data;     /* r32f */
     uniform bool u_env;                /* escaping rays see it, not u_background */
     uniform bool u_env_nee;            /* BRDF vertices sample it (pt's env_nee) */
+    uniform bool u_ggx_ms;             /* GGX energy compensation (pt's ggx_ms) */
     uniform uint u_env_slot;           /* its 2D sample's slot in a vertex's block */
     uniform ivec2 u_env_map;           /* the map's texels (1 x 1: constant) */
     uniform ivec2 u_env_size;          /* the distribution's grid */
@@ -354,6 +364,12 @@ const char *const rl_gl_pt_glsl_path = GLSL(
     uniform bool u_checker;            /* checkerboard (Sec. 8.5): only the pixels whose */
     uniform uint u_parity;             /* x + y has this parity */
     uniform bool u_raster;             /* primary=raster: paths start from u_ids' triangles */
+    /* adaptive sampling (pathtrace.c adaptive_tile): per pixel the samples
+     * held and this round's share; dispatch u_round_k traces the pixels
+     * whose share exceeds it, as sample number held + u_round_k */
+    layout(rg32ui, binding = 2) uniform uimage2D u_adapt;
+    uniform bool u_adaptive;
+    uniform uint u_round_k;
     layout(binding = 6) uniform usampler2D u_ids;
     /* pt's ray counts by rl_ray_type (rl_render_stats.rays) */
     layout(binding = 0, offset = 0) uniform atomic_uint c_primary;
@@ -677,6 +693,12 @@ const char *const rl_gl_pt_glsl_path = GLSL(
 
     /* ----------------------------------------------------------- BSDF -- */
     float mean3(vec3 c) { return (c.x + c.y + c.z) * (1.0 / 3.0); }
+    /* Schlick 1994's (1 - cos)^5 (pathtrace_ggx.c schlick_weight) */
+    float schlick_weight(float c)
+    {
+        float k = 1.0 - clamp(c, 0.0, 1.0), k2 = k * k;
+        return k2 * k2 * k;
+    }
     vec3 mirror_dir(Surf s) { return s.ns * (2.0 * dot(s.ns, s.v)) - s.v; }
     float lobe(vec3 r, vec3 wi, float n)
     {
@@ -752,6 +774,238 @@ const char *const rl_gl_pt_glsl_path = GLSL(
         wi = dir;
         weight = phong_eval(s, dir) * (cos_theta / pdf);
         return true;
+    }
+
+    /* ------------------------------------------------------------ GGX -- */
+    /* pathtrace_ggx.c line for line (issue 37, Sec. 13.4 outlook): f =
+     * f_d + F D G2 / (4 |wi.n| |wo.n|), D the GGX distribution with alpha
+     * = max(roughness^2, 1e-3), G2 Smith's height-correlated term, F
+     * Schlick's with F0 between the ior's and k_d by metallic, f_d the
+     * coated diffuse lobe; the specular lobe sampled by its visible
+     * normals (Heitz 2018), the diffuse one by the cosine, one-sample MIS
+     * over the two; u_ggx_ms adds Kulla & Conty's multiple-scattering lobe
+     * from pt's own tables (ggx_e). */
+    float ggx_alpha(float roughness) { return max(roughness * roughness, 1e-3); }
+
+    float ggx_d(float alpha, float cos_m)
+    {
+        if (!(cos_m > 0.0))
+            return 0.0;
+        float a2 = alpha * alpha, c2 = cos_m * cos_m;
+        float k = (a2 - 1.0) * c2 + 1.0;
+        return a2 / (PI * k * k);
+    }
+
+    float ggx_lambda(float alpha, float c)
+    {
+        if (!(c > 0.0))
+            return INF;
+        float tan2 = max(0.0, 1.0 - c * c) / (c * c);
+        return 0.5 * (sqrt(1.0 + alpha * alpha * tan2) - 1.0);
+    }
+
+    float ggx_g1(float alpha, float c) { return 1.0 / (1.0 + ggx_lambda(alpha, c)); }
+    float ggx_g2(float alpha, float ci, float co)
+    {
+        return 1.0 / (1.0 + ggx_lambda(alpha, ci) + ggx_lambda(alpha, co));
+    }
+
+    /* rl_pt_ggx_sample_vndf (Heitz 2018, Sec. 3-4) */
+    vec3 ggx_sample_vndf(vec3 wo, float alpha, float u1, float u2)
+    {
+        vec3 vh = normalize(vec3(alpha * wo.x, alpha * wo.y, wo.z));
+        float len2 = vh.x * vh.x + vh.y * vh.y;
+        vec3 t1 = len2 > 0.0 ? vec3(-vh.y, vh.x, 0.0) * (1.0 / sqrt(len2)) : vec3(1.0, 0.0, 0.0);
+        vec3 t2 = cross(vh, t1);
+        float r = sqrt(u1), phi = 2.0 * PI * u2;
+        float p1 = r * cos(phi), p2 = r * sin(phi);
+        float blend = 0.5 * (1.0 + vh.z);
+        p2 = (1.0 - blend) * sqrt(max(0.0, 1.0 - p1 * p1)) + blend * p2;
+        float p3 = sqrt(max(0.0, 1.0 - p1 * p1 - p2 * p2));
+        vec3 nh = t1 * p1 + t2 * p2 + vh * p3;
+        return normalize(vec3(alpha * nh.x, alpha * nh.y, max(1e-7, nh.z)));
+    }
+
+    /* ms_row, ms_mu, rl_pt_ggx_ms_albedo, rl_pt_ggx_ms_average: the
+     * tables' bilinear lookup (mu nodes at (j / (nodes - 1))^2) */
+    int ms_row(float roughness, out float t)
+    {
+        float x = (roughness > 0.0 ? min(roughness, 1.0) : 0.0) * float(GGX_NODES - 1);
+        int i = int(x);
+        if (i > GGX_NODES - 2)
+            i = GGX_NODES - 2;
+        t = x - float(i);
+        return i;
+    }
+
+    float ms_mu(int j)
+    {
+        float x = float(j) / float(GGX_NODES - 1);
+        return x * x;
+    }
+
+    float ggx_ms_albedo(float roughness, float mu)
+    {
+        float t;
+        int i = ms_row(roughness, t);
+        mu = mu > 0.0 ? min(mu, 1.0) : 0.0;
+        int j = int(sqrt(mu) * float(GGX_NODES - 1));
+        if (j > GGX_NODES - 2)
+            j = GGX_NODES - 2;
+        float a = ms_mu(j), b = ms_mu(j + 1);
+        float v = clamp((mu - a) / (b - a), 0.0, 1.0);
+        int r0 = i * GGX_NODES + j, r1 = r0 + GGX_NODES;
+        float e0 = ggx_e[r0] + (ggx_e[r0 + 1] - ggx_e[r0]) * v;
+        float e1 = ggx_e[r1] + (ggx_e[r1 + 1] - ggx_e[r1]) * v;
+        return e0 + (e1 - e0) * t;
+    }
+
+    float ggx_ms_average(float roughness)
+    {
+        float t;
+        int i = ms_row(roughness, t);
+        const int avg = GGX_NODES * GGX_NODES;
+        return ggx_e[avg + i] + (ggx_e[avg + i + 1] - ggx_e[avg + i]) * t;
+    }
+
+    vec3 schlick3(vec3 f0, float c) { return f0 + (vec3(1.0) - f0) * schlick_weight(c); }
+
+    /* ggx_lobe / ggx_setup: the lobes at the outgoing direction, in the
+     * frame of rl_onb_from_normal(ns) */
+    struct Ggx {
+        vec3 t, b, n, wo;
+        float alpha;
+        vec3 f0;
+        float f0d;
+        vec3 diffuse;
+        float p_spec;              /* < 0: black */
+        vec3 ms;                   /* f_ms(wi) = ms (1 - E(wi.z)); zero without it */
+        float roughness;
+    };
+
+    Ggx ggx_setup(Surf s)
+    {
+        Material m = materials[s.mat];
+        Ggx g;
+        vec3 n = s.ns;
+        float sg = n.z < 0.0 || (n.z == 0.0 && floatBitsToUint(n.z) != 0u) ? -1.0 : 1.0;
+        float k = -1.0 / (sg + n.z);
+        float b = n.x * n.y * k;
+        g.t = vec3(1.0 + sg * n.x * n.x * k, sg * b, -sg * n.x);
+        g.b = vec3(b, sg + n.y * n.y * k, -n.y);
+        g.n = n;
+        g.wo = vec3(dot(s.v, g.t), dot(s.v, g.b), dot(s.v, g.n));
+        g.alpha = ggx_alpha(m.pbr.x);
+        float r0 = (m.extra.y - 1.0) / (m.extra.y + 1.0);
+        g.f0d = r0 * r0;
+        float metal = clamp(m.pbr.y, 0.0, 1.0);
+        g.f0 = vec3(g.f0d) * (1.0 - metal) + s.kd * metal;
+        g.diffuse = s.kd * (1.0 - metal);
+        float w_spec = mean3(schlick3(g.f0, g.wo.z));
+        float w_diff = mean3(g.diffuse) * (1.0 - (g.f0d + (1.0 - g.f0d) * schlick_weight(g.wo.z)));
+        g.roughness = m.pbr.x;
+        g.ms = vec3(0.0);
+        if (u_ggx_ms) {
+            float e_avg = ggx_ms_average(m.pbr.x);
+            float e_o = ggx_ms_albedo(m.pbr.x, g.wo.z);
+            if (1.0 - e_avg > 1e-4 && e_o < 1.0) {
+                vec3 f_avg = g.f0 + (vec3(1.0) - g.f0) * (1.0 / 21.0);
+                vec3 f_ms = f_avg * f_avg * vec3(e_avg);
+                f_ms *= vec3(1.0 / (1.0 - f_avg.x * (1.0 - e_avg)), 1.0 / (1.0 - f_avg.y * (1.0 - e_avg)),
+                             1.0 / (1.0 - f_avg.z * (1.0 - e_avg)));
+                g.ms = f_ms * ((1.0 - e_o) / (PI * (1.0 - e_avg)));
+                w_diff += PI * mean3(g.ms);
+            }
+        }
+        g.p_spec = w_spec + w_diff > 0.0 ? w_spec / (w_spec + w_diff) : -1.0;
+        return g;
+    }
+
+    vec3 ggx_local(Ggx g, vec3 w) { return vec3(dot(w, g.t), dot(w, g.b), dot(w, g.n)); }
+
+    vec3 ggx_eval_local(Ggx g, vec3 wi)
+    {
+        float ci = wi.z, co = g.wo.z;
+        if (!(ci > 0.0) || !(co > 0.0))
+            return vec3(0.0);
+        float fd0 = g.f0d;
+        float coat = (1.0 - (fd0 + (1.0 - fd0) * schlick_weight(ci))) * (1.0 - (fd0 + (1.0 - fd0) * schlick_weight(co)));
+        vec3 f = g.diffuse * (coat / PI);
+        if (max_comp(g.ms) > 0.0)
+            f += g.ms * max(0.0, 1.0 - ggx_ms_albedo(g.roughness, ci));
+        vec3 h = wi + g.wo;
+        if (!(dot(h, h) > 0.0))
+            return f;
+        h = normalize(h);
+        float spec = ggx_d(g.alpha, h.z) * ggx_g2(g.alpha, ci, co) / (4.0 * ci * co);
+        return f + schlick3(g.f0, dot(wi, h)) * spec;
+    }
+
+    float ggx_pdf_local(Ggx g, vec3 wi)
+    {
+        float ci = wi.z, co = g.wo.z;
+        if (g.p_spec < 0.0 || !(ci > 0.0) || !(co > 0.0))
+            return 0.0;
+        float pdf = (1.0 - g.p_spec) * ci / PI;
+        vec3 h = wi + g.wo;
+        if (g.p_spec > 0.0 && dot(h, h) > 0.0) {
+            h = normalize(h);
+            /* Heitz 2018, eq. 17 with the reflection's Jacobian */
+            pdf += g.p_spec * ggx_g1(g.alpha, co) * ggx_d(g.alpha, h.z) / (4.0 * co);
+        }
+        return pdf;
+    }
+
+    bool ggx_sample(Surf s, Ggx g, float u_lobe, float u1, float u2, out vec3 wi, out vec3 weight)
+    {
+        wi = vec3(0.0);
+        weight = vec3(0.0);
+        if (g.p_spec < 0.0 || !(g.wo.z > 0.0))
+            return false;
+        vec3 local;
+        if (u_lobe < g.p_spec) {
+            vec3 m = ggx_sample_vndf(g.wo, g.alpha, u1, u2);
+            local = m * (2.0 * dot(g.wo, m)) - g.wo;
+        } else {
+            float r = sqrt(u1), phi = 2.0 * PI * u2;
+            local = vec3(r * cos(phi), r * sin(phi), sqrt(max(0.0, 1.0 - u1)));
+        }
+        if (!(local.z > 0.0))
+            return false;          /* below the horizon: single scattering loses it */
+        vec3 dir = normalize(g.t * local.x + g.b * local.y + g.n * local.z);
+        if (dot(s.ng, dir) <= 0.0)
+            return false;
+        float pdf = ggx_pdf_local(g, local);
+        if (!(pdf > 0.0) || isinf(pdf))
+            return false;
+        wi = dir;
+        weight = ggx_eval_local(g, local) * (local.z / pdf);
+        return true;
+    }
+
+    /* rl_pt_bsdf_eval / _pdf / _sample_pdf: Phong or GGX by the material,
+     * a runtime branch (one program for both). Every call is about the
+     * path's current vertex, whose GGX lobe trace_path sets up once
+     * (g_lobe): pt sets it up per call, with the same result; one setup
+     * instead of one per call site also keeps the program small, which
+     * llvmpipe compiles in proportion to its inlined size. */
+    Ggx g_lobe;
+    bool is_ggx(Surf s) { return materials[s.mat].pbr.z > 0.0; }
+
+    vec3 brdf_eval(Surf s, vec3 wi)
+    {
+        return is_ggx(s) ? ggx_eval_local(g_lobe, ggx_local(g_lobe, wi)) : phong_eval(s, wi);
+    }
+
+    float brdf_pdf(Surf s, vec3 wi)
+    {
+        return is_ggx(s) ? ggx_pdf_local(g_lobe, ggx_local(g_lobe, wi)) : phong_pdf(s, wi);
+    }
+
+    bool brdf_sample(Surf s, float u_lobe, float u1, float u2, out vec3 wi, out vec3 weight)
+    {
+        return is_ggx(s) ? ggx_sample(s, g_lobe, u_lobe, u1, u2, wi, weight)
+                         : phong_sample(s, u_lobe, u1, u2, wi, weight);
     }
 
     /* --------------------------------------------------------- lights -- */
@@ -940,7 +1194,7 @@ const char *const rl_gl_pt_glsl_path = GLSL(
                     float cos_e = -dot(nq, l), cos_r = dot(s.ns, l);
                     if (cos_e <= 0.0 || cos_r <= 0.0 || !visible(s, l, dist, uint(i), j))
                         continue;
-                    sum += phong_eval(s, l) * (le * (cos_e * cos_r / d2));
+                    sum += brdf_eval(s, l) * (le * (cos_e * cos_r / d2));
                 }
                 continue;
             }
@@ -953,7 +1207,7 @@ const char *const rl_gl_pt_glsl_path = GLSL(
             float cos_r = dot(s.ns, l);
             if (cos_r <= 0.0 || !visible(s, l, dist, uint(i), j))
                 continue;
-            sum += phong_eval(s, l) * (E * cos_r);
+            sum += brdf_eval(s, l) * (E * cos_r);
         }
         return sum;
     }
@@ -966,7 +1220,7 @@ const char *const rl_gl_pt_glsl_path = GLSL(
         return 1.0 / (1.0 + r * r);
     }
 
-    float bsdf_pdf(Surf s, vec3 wi) { return dot(s.ng, wi) > 0.0 ? phong_pdf(s, wi) : 0.0; }
+    float bsdf_pdf(Surf s, vec3 wi) { return dot(s.ng, wi) > 0.0 ? brdf_pdf(s, wi) : 0.0; }
 
     float triangle_area(uint tri, out vec3 n)
     {
@@ -1024,7 +1278,7 @@ const char *const rl_gl_pt_glsl_path = GLSL(
                     float cos_r = dot(s.ns, l);
                     if (cos_r <= 0.0 || !visible(s, l, dist, src, j))
                         continue;
-                    sum += phong_eval(s, l) * (E * (cos_r / (pmf * float(n))));
+                    sum += brdf_eval(s, l) * (E * (cos_r / (pmf * float(n))));
                     continue;
                 }
                 n_e = cross(L.dir.xyz, L.extra.xyz);
@@ -1057,7 +1311,7 @@ const char *const rl_gl_pt_glsl_path = GLSL(
                 continue;
             float p_light = pmf * d2 / (area * cos_e);
             float w = bsdf_follows && hittable ? power_heuristic(float(n) * p_light, bsdf_pdf(s, l)) : 1.0;
-            sum += phong_eval(s, l) * (le * (w * cos_r / (p_light * float(n))));
+            sum += brdf_eval(s, l) * (le * (w * cos_r / (p_light * float(n))));
         }
         return sum;
     }
@@ -1077,7 +1331,7 @@ const char *const rl_gl_pt_glsl_path = GLSL(
         if (cos_r <= 0.0 || !visible(s, l, INF, 0u, vec2(0.0)))
             return vec3(0.0);
         float w = bsdf_follows ? power_heuristic(p_env, bsdf_pdf(s, l)) : 1.0;
-        return phong_eval(s, l) * (env_radiance(l) * (w * cos_r / p_env));
+        return brdf_eval(s, l) * (env_radiance(l) * (w * cos_r / p_env));
     }
 
     /* escaped: a ray that left the scene; after a BRDF bounce with density
@@ -1169,11 +1423,6 @@ const char *const rl_gl_pt_glsl_path = GLSL(
     }
 
     /* -------------------------------------------------------- Fresnel -- */
-    float schlick_weight(float c)
-    {
-        float k = 1.0 - clamp(c, 0.0, 1.0), k2 = k * k;
-        return k2 * k2 * k;
-    }
 
     /* scene/material.c rl_fresnel_schlick: eta = n_t / n_i; from the
      * denser side with the angle on the rarer one (reciprocal), 1 past
@@ -1207,6 +1456,8 @@ const char *const rl_gl_pt_glsl_path = GLSL(
         for (int depth = 0;; ++depth) {
             uint base = SLOT_FIRST_VERTEX + uint(depth) * u_vertex_slots;
             Material m = materials[s.mat];
+            if (m.pbr.z > 0.0)
+                g_lobe = ggx_setup(s);
             vec3 e = u_mis ? emitted_mis(s, after_brdf, prev, prev_pdf) : emitted(s, after_brdf);
             radiance += T * e;
 
@@ -1253,16 +1504,17 @@ const char *const rl_gl_pt_glsl_path = GLSL(
                 if (last)
                     break;
                 seek(base + SLOT_LOBE);
-                float u0 = gen || max_comp(m.specular.rgb) > 0.0 ? sample_1d() : 0.0;
+                /* rl_pt_bsdf_needs_lobe: GGX picks a lobe, Phong where it has k_s */
+                float u0 = gen || m.pbr.z > 0.0 || max_comp(m.specular.rgb) > 0.0 ? sample_1d() : 0.0;
                 seek(base + SLOT_BSDF);
                 vec2 u12 = sample_2d();
                 vec3 w;
-                if (!phong_sample(s, u0, u12.x, u12.y, dir, w))
+                if (!brdf_sample(s, u0, u12.x, u12.y, dir, w))
                     break;
                 T *= w;
                 diffuse_ray = true;
                 after_brdf = true;
-                prev_pdf = u_mis || u_env_nee ? phong_pdf(s, dir) : 0.0;
+                prev_pdf = u_mis || u_env_nee ? brdf_pdf(s, dir) : 0.0;
             }
             prev = s.p;
 
@@ -1315,6 +1567,12 @@ const char *const rl_gl_pt_glsl_path = GLSL(
         if (u_checker && cls != u_parity)
             return;
         uint held = u_held[cls];
+        if (u_adaptive) {
+            uvec2 a = imageLoad(u_adapt, px).xy;
+            if (u_round_k >= a.y)
+                return;
+            held = a.x + u_round_k;
+        }
         g_state = imageLoad(u_rng_state, px);
         g_index = held;
         g_slot = 0u;
@@ -1352,7 +1610,202 @@ const char *const rl_gl_pt_glsl_path = GLSL(
         /* Sec. 6.5, eq. 8: C_{s+1} = s/(s+1) C_s + 1/(s+1) C_trace */
         float n = float(held);
         vec4 c = held == 0u ? vec4(0.0) : imageLoad(u_accum, px);
-        imageStore(u_accum, px, vec4(c.rgb * (n / (n + 1.0)) + L * (1.0 / (n + 1.0)), 1.0));
+        /* adaptive: alpha the mean squared luminance, as pt's sum2 */
+        float a = 1.0;
+        if (u_adaptive) {
+            float l = 0.2126 * L.x + 0.7152 * L.y + 0.0722 * L.z;
+            a = c.a * (n / (n + 1.0)) + l * l * (1.0 / (n + 1.0));
+        }
+        imageStore(u_accum, px, vec4(c.rgb * (n / (n + 1.0)) + L * (1.0 / (n + 1.0)), a));
+    }
+);
+
+/* Adaptive sampling's passes (pathtrace.c pixel_errors, adaptive_shares),
+ * one program of 64 threads per work group, by u_mode:
+ *   0 errors: per pixel the relative error of the mean e = sqrt(s^2 / n) /
+ *     (mean + 0.05) of the luminance (-1 under two samples), from the
+ *     accumulation's running means of L and of l^2;
+ *   1 smooth: e averaged over the 3 x 3 neighbours that have one (infinite
+ *     where none has), and the pixels below the threshold counted;
+ *   2 shares: ONE work group: the water-filling t_i = min(cap, lambda e_i)
+ *     with sum t_i = budget (lambda by 50 bisection steps when the cap
+ *     binds), rounded by the running sum in pixel order, as pt; the sum
+ *     runs in units of 1/1024 sample held exactly in doubles, so that each
+ *     thread's contiguous chunk can start from an exact prefix;
+ *   3 commit: samples held += share. */
+const char *const rl_gl_pt_glsl_adapt = GLSL(
+    layout(local_size_x = 64) in;
+    /* image unit 3 and storage 14-15: none of the path program's, so that
+     * the passes and the path dispatches need no rebinding */
+    layout(rgba32f, binding = 3) uniform readonly image2D u_accum;
+    layout(rg32ui, binding = 2) uniform uimage2D u_adapt;
+    layout(std430, binding = 14) buffer Errors { float err[]; };   /* raw, then smoothed */
+    layout(std430, binding = 15) buffer Totals {
+        uint max_share;
+        uint converged;
+        uint pad0;
+        uint pad1;
+        double given;
+    };
+    uniform int u_mode;
+    uniform ivec2 u_size;
+    uniform float u_thr;
+    uniform double u_budget;
+    uniform double u_num_active;
+
+    shared double sh_sum[64];
+    shared float sh_hi[64];
+    shared float sh_lo[64];
+    shared uint sh_n[64];
+    shared uint sh_max;
+
+    const float INF_E = uintBitsToFloat(0x7f800000u);
+
+    /* wants_samples: not converged, and an error above zero */
+    bool wants(float e) { return !isinf(e) && !isnan(e) && e >= u_thr && e > 0.0; }
+
+    void shares()
+    {
+        uint t = gl_LocalInvocationID.x;
+        uint n = uint(u_size.x) * uint(u_size.y);
+        uint chunk = (n + 63u) / 64u;
+        uint b = min(n, t * chunk), end = min(n, b + chunk);
+        double total = 0.0;
+        float e_max = 0.0, e_min = INF_E;
+        uint positive = 0u;
+        for (uint i = b; i < end; ++i) {
+            float e = err[n + i];
+            if (!wants(e))
+                continue;
+            total += double(e);
+            e_max = max(e_max, e);
+            e_min = min(e_min, e);
+            ++positive;
+        }
+        sh_sum[t] = total;
+        sh_hi[t] = e_max;
+        sh_lo[t] = e_min;
+        sh_n[t] = positive;
+        if (t == 0u)
+            sh_max = 0u;
+        barrier();
+        double T = 0.0;
+        float E_max = 0.0, E_min = INF_E;
+        uint P = 0u;
+        for (uint k = 0u; k < 64u; ++k) {
+            T += sh_sum[k];
+            E_max = max(E_max, sh_hi[k]);
+            E_min = min(E_min, sh_lo[k]);
+            P += sh_n[k];
+        }
+        barrier();
+        double cap = 8.0 * u_budget / u_num_active;
+        bool none = P == 0u || !(T > 0.0);
+        /* all: every pixel that wants samples takes the cap */
+        bool all = !none && double(P) * cap <= u_budget;
+        double lambda = none ? 0.0 : u_budget / T;
+        if (!none && !all && lambda * double(E_max) > cap) {
+            double lo = lambda, hi = cap / double(E_min);
+            for (int it = 0; it < 50; ++it) {
+                double mid = 0.5 * (lo + hi), part = 0.0;
+                for (uint i = b; i < end; ++i) {
+                    float e = err[n + i];
+                    if (wants(e))
+                        part += min(cap, mid * double(e));
+                }
+                sh_sum[t] = part;
+                barrier();
+                double got = 0.0;
+                for (uint k = 0u; k < 64u; ++k)
+                    got += sh_sum[k];
+                barrier();
+                if (got < u_budget)
+                    lo = mid;
+                else
+                    hi = mid;
+            }
+            lambda = hi;
+        }
+        /* the chunk's sum in 1/1024 samples (integers: exact in double) */
+        double q_sum = 0.0;
+        for (uint i = b; i < end && !none; ++i) {
+            float e = err[n + i];
+            if (wants(e))
+                q_sum += floor((all ? cap : min(cap, lambda * double(e))) * 1024.0 + 0.5);
+        }
+        sh_sum[t] = q_sum;
+        barrier();
+        double run = 0.0, all_q = 0.0;
+        for (uint k = 0u; k < 64u; ++k) {
+            if (k < t)
+                run += sh_sum[k];
+            all_q += sh_sum[k];
+        }
+        double prev = floor(run / 1024.0 + 0.5);
+        uint most = 0u;
+        for (uint i = b; i < end; ++i) {
+            ivec2 px = ivec2(int(i % uint(u_size.x)), int(i / uint(u_size.x)));
+            uvec2 a = imageLoad(u_adapt, px).xy;
+            uint share = 0u;
+            float e = err[n + i];
+            if (!none && wants(e)) {
+                run += floor((all ? cap : min(cap, lambda * double(e))) * 1024.0 + 0.5);
+                double upto = floor(run / 1024.0 + 0.5);
+                share = uint(upto - prev);
+                prev = upto;
+            }
+            imageStore(u_adapt, px, uvec4(a.x, share, 0u, 0u));
+            most = max(most, share);
+        }
+        atomicMax(sh_max, most);
+        barrier();
+        if (t == 0u) {
+            max_share = sh_max;
+            given = none ? 0.0 : floor(all_q / 1024.0 + 0.5);
+        }
+    }
+
+    void main()
+    {
+        if (u_mode == 2) {
+            shares();
+            return;
+        }
+        /* rows of work groups beyond 65535 (the least dispatch size GL allows) */
+        uint i = gl_GlobalInvocationID.x + gl_GlobalInvocationID.y * gl_NumWorkGroups.x * 64u;
+        uint n = uint(u_size.x) * uint(u_size.y);
+        if (i >= n)
+            return;
+        ivec2 px = ivec2(int(i % uint(u_size.x)), int(i / uint(u_size.x)));
+        uvec2 a = imageLoad(u_adapt, px).xy;
+        if (u_mode == 0) {
+            if (a.x < 2u) {
+                err[i] = -1.0;
+                return;
+            }
+            vec4 c = imageLoad(u_accum, px);
+            double cnt = double(a.x);
+            double mean = 0.2126 * double(c.x) + 0.7152 * double(c.y) + 0.0722 * double(c.z);
+            double var = (double(c.w) - mean * mean) * cnt / (cnt - 1.0);
+            err[i] = float(sqrt(max(var, 0.0) / cnt) / (abs(mean) + 0.05));
+        } else if (u_mode == 1) {
+            double sum = 0.0;
+            int k = 0;
+            for (int y = max(px.y - 1, 0); y <= px.y + 1 && y < u_size.y; ++y)
+                for (int x = max(px.x - 1, 0); x <= px.x + 1 && x < u_size.x; ++x) {
+                    float e = err[uint(y) * uint(u_size.x) + uint(x)];
+                    if (e >= 0.0) {
+                        sum += double(e);
+                        ++k;
+                    }
+                }
+            float sm = k > 0 ? float(sum / double(k)) : INF_E;
+            err[n + i] = sm;
+            if (sm < u_thr)
+                atomicAdd(converged, 1u);
+        } else {
+            imageStore(u_adapt, px, uvec4(a.x + a.y, 0u, 0u, 0u));
+        }
     }
 );
 

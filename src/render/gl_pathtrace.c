@@ -17,10 +17,15 @@
  * rr_depth, rng, mis, seed, shadow, diffuse, specular, primary,
  * checkerboard, accumulate, filter, filter_fade, atrous_*, grid_res, ls_n,
  * ls_k, ls_dynamic, ls_origin, light_samples, background, env_sampling,
- * threads, shadowmap_size), device (rl_gl.h) and ls_build. Values pt has and gl-pt
+ * ggx_ms, adaptive, adaptive_threshold, adaptive_min_spp, threads,
+ * shadowmap_size), device (rl_gl.h) and ls_build. Values pt has and gl-pt
  * has not ported are refused with an option error naming what is ported:
- * shadow=embree, diffuse=embree; pt's ls_file and adaptive* are not in the
- * table.
+ * shadow=embree, diffuse=embree; pt's ls_file is not in the table, and
+ * adaptive=on with checkerboard is refused at render time.
+ *
+ * Adaptive sampling (adaptive=on): pt's algorithm (pathtrace.c
+ * adaptive_passes) with the per-pixel counts, the squared luminance, the
+ * errors and the shares on the GPU (gl_pt.c adaptive_frame).
  *
  * shadow=shadowmap (Sec. 8.6): pt's cube shadow maps (raster/shadowmap.c,
  * the same size, bias and jitter) drawn by GL, depth-only passes per light
@@ -52,7 +57,9 @@
  * tracer as plain arrays (rl_gl_pt_set_environment); the shader looks it up
  * and samples it as pt does, at pt's slot with pt's MIS weights. Schlick's
  * Fresnel on mirrors and dielectrics is the shader's too (pt's
- * rl_pt_specular_event); GGX materials are refused (gl_pt_check_scene).
+ * rl_pt_specular_event), and so is the GGX BRDF (pathtrace_ggx.c) with
+ * its energy compensation (ggx_ms): the shader reads pt's own tables,
+ * handed to the tracer as plain floats (rl_gl_pt_desc.ggx_ms).
  *
  * Depth and ID layers, where the image has them, come from that G-buffer,
  * as pt writes them. */
@@ -75,6 +82,7 @@ _Static_assert(RL_GL_PT_RAY_TYPES == RL_RAY_TYPE_COUNT, "gl-pt counts rays in rl
  * that a value pt knows gets "not ported" rather than "unknown" where
  * gl-pt lacks it (gl_pt_check). */
 static const char *const ls_build_choices[] = { "cpu", "gpu", NULL };
+static const char *const adaptive_choices[] = { "off", "on", NULL };
 
 static const rl_option_info gl_pt_options[] = {
     { "spp", RL_OPT_INT, "1", "paths per pixel and frame (one compute dispatch each)", 1, 65536, NULL },
@@ -109,6 +117,14 @@ static const rl_option_info gl_pt_options[] = {
       "noise filter on the accumulated image (Sec. 8.2): pt's, on the CPU after the read-back", 0, 0,
       rl_pt_filter_choices },
     RL_PT_FILTER_PARAM_OPTIONS,
+    /* pt's (pathtrace.c), the same meaning and defaults */
+    { "adaptive", RL_OPT_ENUM, "off",
+      "per-pixel adaptive sampling: a frame's paths go where the estimated relative error is largest (errors and "
+      "shares computed on the GPU)", 0, 0, adaptive_choices },
+    { "adaptive_threshold", RL_OPT_FLOAT, "0.01",
+      "adaptive: relative error of a pixel's mean below which it gets no more samples", 0, 1e9, NULL },
+    { "adaptive_min_spp", RL_OPT_INT, "8", "adaptive: samples every pixel gets before the error decides",
+      2, 65536, NULL },
     { "grid_res", RL_OPT_INT, "0", "voxels per axis of the grid and the Line Space (0 = grid heuristic)", 0, 1024,
       NULL },
     { "ls_n", RL_OPT_INT, "5", "Line Space patches per voxel face side (Sec. 9.2: 5)", 1, RL_LS_MAX_N, NULL },
@@ -129,6 +145,9 @@ static const rl_option_info gl_pt_options[] = {
     { "env_sampling", RL_OPT_ENUM, "importance",
       "light samples of a scene environment (issue 37): importance (by its radiance x sin(theta)), uniform "
       "(by solid angle) or bsdf (none: BSDF rays alone find it)", 0, 0, rl_pt_env_sampling_choices },
+    { "ggx_ms", RL_OPT_BOOL, "true",
+      "GGX energy compensation (Kulla & Conty 2017, pt's tables): the light single scattering loses returns as "
+      "a diffuse-like lobe; false: single scattering alone", 0, 0, NULL },
     { "threads", RL_OPT_INT, "0", "CPU threads of the structure builds (0 = all)", 0, 1024, NULL },
     { "device", RL_OPT_STRING, "",
       "EGL device: auto, surfaceless or a device number; empty: $RL_EGL_DEVICE, else auto", 0, 0, NULL },
@@ -209,10 +228,21 @@ static rl_status ensure_gpu(gl_pt_state *s, const rl_scene *scene, const char *d
     if (strlen(device) >= sizeof s->device)
         return rl_error(RL_ERR_INVALID_ARG, "gl-pt: device \"%.40s...\" is too long", device);
     const pt_lights *l = &s->b.lights;
+    /* pt's energy-compensation tables, built (once per process) only for
+     * a scene with a GGX material */
+    _Static_assert(RL_GL_PT_GGX_NODES == RL_PT_GGX_MS_NODES, "gl-pt reads pt's GGX tables as they are");
+    static float ggx_tables[RL_PT_GGX_MS_NODES * RL_PT_GGX_MS_NODES + RL_PT_GGX_MS_NODES];
+    const rl_scene_data *d = rl_scene_get_data(scene);
+    bool ggx = false;
+    for (uint32_t i = 0; d && i < d->num_materials; ++i)
+        ggx = ggx || d->materials[i].bsdf == RL_BSDF_GGX;
+    if (ggx)
+        rl_pt_ggx_ms_tables(ggx_tables, ggx_tables + RL_PT_GGX_MS_NODES * RL_PT_GGX_MS_NODES);
     rl_gl_pt_desc desc = {
         .device = device, .threads = threads, .eps = s->b.eps,
         .lights = { .count = l->count, .source = l->source, .cdf = l->cdf, .light_pmf = l->light_pmf,
                     .light_hittable = l->light_hittable, .tri_pmf = l->tri_pmf, .tri_cover = s->b.tri_cover },
+        .ggx_ms = ggx ? ggx_tables : NULL,
     };
     rl_timer timer;
     rl_timer_start(&timer);
@@ -357,20 +387,6 @@ static rl_status ensure_environment(gl_pt_state *s, const rl_scene_data *d, bool
     return RL_OK;
 }
 
-/* Issue 37's GGX BRDF lives in pt's C code only: refuse it by name rather
- * than render it as Phong (Schlick's Fresnel is ported). */
-static rl_status gl_pt_check_scene(const rl_scene *scene, const rl_scene_data *d)
-{
-    (void)scene;
-    for (uint32_t i = 0; i < d->num_materials; ++i) {
-        const rl_material *m = &d->materials[i];
-        if (m->bsdf != RL_BSDF_PHONG)
-            return rl_error(RL_ERR_UNSUPPORTED, "gl-pt: material '%s' uses GGX, not ported to GL yet (use pt)",
-                            m->name);
-    }
-    return RL_OK;
-}
-
 /* primary=raster (Sec. 8.1): the triangle IDs of the scene drawn by a GL
  * drawer, unlit, into s->ids, as rl_gbuffer_raster draws them with the
  * software rasterizer; every frame, as the thesis' extra render pass. The
@@ -494,9 +510,6 @@ static rl_status gl_pt_render(rl_renderer *r, void *state, const rl_scene *scene
     const rl_scene_data *d = rl_scene_get_data(scene);
     if (!d)
         return RL_ERR_NOT_COMMITTED;
-    rl_status refused = gl_pt_check_scene(scene, d);
-    if (refused != RL_OK)
-        return refused;
     const int threads = (int)rl_renderer_opt_int(r, "threads");
     /* What pt prepares for the GPU's estimator: offsets, covers, light
      * table (the GPU builds its own structures). */
@@ -598,6 +611,10 @@ static rl_status gl_pt_render(rl_renderer *r, void *state, const rl_scene *scene
         .env_nee = d->environment && s->b.env.sampled && env_sampling != PT_ENV_BSDF &&
                    shadow != RL_PT_BACKEND_SHADOWMAP,
         .reset_states = states,
+        .ggx_ms = rl_renderer_opt_bool(r, "ggx_ms"),
+        .adaptive = rl_renderer_opt_enum(r, "adaptive") == 1,
+        .adaptive_threshold = (float)rl_renderer_opt_float(r, "adaptive_threshold"),
+        .adaptive_min_spp = (int)rl_renderer_opt_int(r, "adaptive_min_spp"),
     };
     const bool raster = rl_renderer_opt_enum(r, "primary") == 1;
     const char *device = rl_renderer_opt_string(r, "device");
@@ -611,6 +628,11 @@ static rl_status gl_pt_render(rl_renderer *r, void *state, const rl_scene *scene
         f.raster_ids = s->ids->triangle_id;
     }
     f.checkerboard = rl_renderer_opt_bool(r, "checkerboard");
+    if (f.adaptive && f.checkerboard) {
+        free(states);
+        s->force_reset = true;
+        return rl_error(RL_ERR_UNSUPPORTED, "gl-pt: adaptive=on with checkerboard is not ported to GL (pt has it)");
+    }
     rl_gl_pt_result res;
     st = rl_gl_pt_render(s->gpu, &f, s->rgba, &res);
     free(states);
@@ -651,7 +673,7 @@ static rl_status gl_pt_render(rl_renderer *r, void *state, const rl_scene *scene
         memcpy(image->triangle_id, s->gbuf->triangle, n * sizeof *image->triangle_id);
     }
     stats->pixels_written = n;
-    stats->samples = traced * (uint64_t)f.spp;
+    stats->samples = f.adaptive ? res.samples : traced * (uint64_t)f.spp;
     for (int k = 0; k < RL_RAY_TYPE_COUNT; ++k)
         stats->rays[k] = res.rays[k];
     stats->device = s->info[0] ? s->info : NULL;
@@ -662,6 +684,16 @@ static rl_status gl_pt_render(rl_renderer *r, void *state, const rl_scene *scene
     return RL_OK;
 }
 
+rl_status rl_gl_pt_renderer_sample_counts(const rl_renderer *r, uint32_t *counts)
+{
+    if (!r || strcmp(rl_renderer_name(r), "gl-pt") != 0)
+        return rl_error(RL_ERR_INVALID_ARG, "rl_gl_pt_renderer_sample_counts: needs a \"gl-pt\" renderer");
+    gl_pt_state *s = rl_renderer_state(r);
+    if (!s || !s->gpu)
+        return rl_error(RL_ERR_INVALID_ARG, "rl_gl_pt_renderer_sample_counts: no frame rendered");
+    return rl_gl_pt_sample_counts(s->gpu, counts);
+}
+
 const rl_renderer_class rl_gl_pt_renderer_class = {
     .info = { .name = "gl-pt",
               .description = "pt on OpenGL 4.5 compute shaders (headless EGL): the same estimator, BVH, grid "
@@ -670,7 +702,9 @@ const rl_renderer_class rl_gl_pt_renderer_class = {
               .progressive = true, .default_time_s = 10.0,
               /* the read-back mean, the states, the G-buffer, and with
                * primary=raster the ID pass's target (colour, depth, IDs) */
-              .frame_bytes_per_pixel = 4 * sizeof(float) + 16 + 16 + RL_GBUFFER_BYTES_PER_PIXEL + 16 + 4 + 8 },
+              .frame_bytes_per_pixel = 4 * sizeof(float) + 16 + 16 + RL_GBUFFER_BYTES_PER_PIXEL + 16 + 4 + 8 +
+                                       /* adaptive: counts and shares, two errors */
+                                       8 + 8 },
     .options = gl_pt_options,
     .num_options = NUM_OPTIONS,
     .state_size = sizeof(gl_pt_state),

@@ -113,7 +113,7 @@ rl_vec3 rl_pt_ggx_sample_vndf(rl_vec3 wo, float alpha, float u1, float u2)
  * visible-normal sampling (its weight G2 / G1 is in [0, 1] and smooth but
  * for the horizon). The errors against 512^2 cells and between nodes:
  * tests/render/test_pathtrace_bsdf.c. */
-#define MS_NODES 32
+#define MS_NODES RL_PT_GGX_MS_NODES
 #define MS_QUAD 32
 #define MS_MU_MIN 1e-3f          /* node mu = 0: G1 and G2 vanish at the horizon, their ratio does not */
 
@@ -195,6 +195,16 @@ float rl_pt_ggx_ms_albedo(float roughness, float mu)
     float e0 = ms_e[i][j] + (ms_e[i][j + 1] - ms_e[i][j]) * v;
     float e1 = ms_e[i + 1][j] + (ms_e[i + 1][j + 1] - ms_e[i + 1][j]) * v;
     return e0 + (e1 - e0) * t;
+}
+
+void rl_pt_ggx_ms_tables(float *e, float *e_avg)
+{
+    pthread_once(&ms_once, ms_build);
+    for (int i = 0; i < MS_NODES; ++i) {
+        for (int j = 0; j < MS_NODES; ++j)
+            e[i * MS_NODES + j] = ms_e[i][j];
+        e_avg[i] = ms_eavg[i];
+    }
 }
 
 float rl_pt_ggx_ms_average(float roughness)

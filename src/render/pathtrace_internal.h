@@ -369,6 +369,12 @@ rl_vec3 rl_pt_ggx_sample_vndf(rl_vec3 wo, float alpha, float u1, float u2);
  * the quadrature of cells x cells visible normals that builds them. */
 float rl_pt_ggx_ms_albedo(float roughness, float mu);
 float rl_pt_ggx_ms_average(float roughness);
+/* The tables themselves, for gl-pt's shader (gl_pathtrace.c uploads them
+ * rather than building its own): E at RL_PT_GGX_MS_NODES roughness nodes
+ * (rows, r = i / (nodes - 1)) x as many mu nodes (mu = (j / (nodes - 1))^2),
+ * row-major into e; E_avg per roughness node into e_avg. */
+#define RL_PT_GGX_MS_NODES 32
+void rl_pt_ggx_ms_tables(float *e, float *e_avg);
 double rl_pt_ggx_albedo_quadrature(float alpha, float mu, int cells);
 
 /* The material's BRDF, Phong or GGX by rl_material.bsdf: what pt and bdpt
@@ -389,5 +395,10 @@ bool rl_pt_bsdf_needs_lobe(const rl_material *m);
  * with F0 = k_s; within k_t, reflection with probability F). *weight
  * multiplies the throughput; *refracted tells the ray type. */
 void rl_pt_specular_event(const pt_surface *s, float u_event, rl_vec3 *dir, rl_vec3 *weight, bool *refracted);
+
+/* gl-pt's per-pixel sample counts after an adaptive frame (gl_pathtrace.c,
+ * rl_gl_pt_sample_counts; width x height, row 0 the top row): what
+ * rl_pt_sample_counts gives for pt. */
+rl_status rl_gl_pt_renderer_sample_counts(const rl_renderer *r, uint32_t *counts);
 
 #endif
