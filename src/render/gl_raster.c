@@ -21,6 +21,7 @@
 
 #include "core/error.h"
 #include "render/culling.h"
+#include "gl/gl_frame.h"
 #include "render/renderer.h"
 #include "rl/rl_drawer.h"
 #include "rl/rl_gl.h"
@@ -42,6 +43,7 @@ static const rl_option_info gl_raster_options[] = {
 
 typedef struct gl_raster_state {
     rl_drawer *drawer;
+    bool texture_out;             /* rl_renderer_set_gl_output */
     char device[64];              /* the device option the drawer was made on */
     char info[528];               /* rl_render_stats.device: the three strings of rl_gl_info */
 } gl_raster_state;
@@ -87,6 +89,8 @@ static rl_status gl_raster_render(rl_renderer *r, void *state, const rl_scene *s
         rl_timer_start(&timer);
         if (st == RL_OK)
             st = rl_gl_drawer_create(scene, &desc, device, &s->drawer);
+        if (st == RL_OK)
+            st = rl_gl_drawer_set_texture_output(s->drawer, s->texture_out);
         stats->prep_ms = rl_timer_ms(&timer);
         if (st == RL_OK) {
             snprintf(s->device, sizeof s->device, "%s", device);
@@ -103,6 +107,20 @@ static rl_status gl_raster_render(rl_renderer *r, void *state, const rl_scene *s
     return st;
 }
 
+static void gl_raster_gl_output(void *state, bool on)
+{
+    gl_raster_state *s = state;
+    s->texture_out = on;
+    if (s->drawer)
+        rl_gl_drawer_set_texture_output(s->drawer, on);
+}
+
+static bool gl_raster_take_gl_frame(void *state, rl_gl_frame *out)
+{
+    gl_raster_state *s = state;
+    return s->drawer && rl_gl_drawer_take_frame(s->drawer, out);
+}
+
 const rl_renderer_class rl_gl_raster_renderer_class = {
     .info = { .name = "gl-raster",
               .description = "raster on OpenGL 4.5 (headless EGL): the same local Phong shading, IDs and depth",
@@ -114,4 +132,6 @@ const rl_renderer_class rl_gl_raster_renderer_class = {
     .release = gl_raster_release,
     .check = NULL,
     .available = gl_raster_available,
+    .gl_output = gl_raster_gl_output,
+    .take_gl_frame = gl_raster_take_gl_frame,
 };
