@@ -13,6 +13,7 @@
  * (view_gl_read). Where any step fails the caller keeps the readback path. */
 #include "view.h"
 
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -26,7 +27,7 @@
 struct view_gl {
     SDL_Window *win;
     SDL_GLContext ctx;
-    GLuint prog, vao, overlay, frame;
+    GLuint prog, vao, overlay, frame, lut;
     GLint u_size, u_view, u_use_frame;
     int width, height;            /* of the image, the overlay and (when set) the frame */
     bool have_frame;
@@ -46,17 +47,17 @@ static const char fs_src[] =
     "#version 130\n"
     "uniform sampler2D u_frame;\n"
     "uniform sampler2D u_overlay;\n"
+    "uniform sampler2D u_lut;\n"
     "uniform ivec2 u_size;\n"
     "uniform vec4 u_view;\n"
     "uniform bool u_use_frame;\n"
     "out vec4 o_color;\n"
-    /* cmd_view.c to_byte(): the nearest of 4097 steps, then sRGB */
+    /* cmd_view.c to_byte(): the nearest of 4097 steps, its sRGB byte from
+     * the same table (u_lut), so that both paths give the same bytes */
     "float to_byte(float c) {\n"
     "    if (!(c > 0.0)) return 0.0;\n"
     "    if (c >= 1.0) return 255.0;\n"
-    "    float l = floor(c * 4096.0 + 0.5) / 4096.0;\n"
-    "    float s = l <= 0.0031308 ? 12.92 * l : 1.055 * pow(l, 1.0 / 2.4) - 0.055;\n"
-    "    return floor(s * 255.0 + 0.5);\n"
+    "    return floor(texelFetch(u_lut, ivec2(int(c * 4096.0 + 0.5), 0), 0).r * 255.0 + 0.5);\n"
     "}\n"
     "void main() {\n"
     "    vec2 p = (gl_FragCoord.xy - u_view.xy) / u_view.zw;\n"
@@ -114,6 +115,7 @@ static bool make_program(view_gl *g, char *why, size_t n)
     glUseProgram(g->prog);
     glUniform1i(glGetUniformLocation(g->prog, "u_frame"), 0);
     glUniform1i(glGetUniformLocation(g->prog, "u_overlay"), 1);
+    glUniform1i(glGetUniformLocation(g->prog, "u_lut"), 2);
     g->u_size = glGetUniformLocation(g->prog, "u_size");
     g->u_view = glGetUniformLocation(g->prog, "u_view");
     g->u_use_frame = glGetUniformLocation(g->prog, "u_use_frame");
@@ -166,12 +168,22 @@ view_gl *view_gl_open(void *window, char *why, size_t n)
     if (ok) {
         glGenTextures(1, &g->overlay);
         glGenTextures(1, &g->frame);
-        GLuint tex[2] = { g->overlay, g->frame };
-        for (int i = 0; i < 2; i++) {
+        glGenTextures(1, &g->lut);
+        GLuint tex[3] = { g->overlay, g->frame, g->lut };
+        for (int i = 0; i < 3; i++) {
             glBindTexture(GL_TEXTURE_2D, tex[i]);
             glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
             glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
         }
+        /* cmd_view.c init_lut()'s table, on texture unit 2 for good */
+        uint8_t lut[4097];
+        for (int i = 0; i <= 4096; i++)
+            lut[i] = (uint8_t)lrintf(rl_linear_to_srgb((float)i / 4096.0f) * 255.0f);
+        glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
+        glTexImage2D(GL_TEXTURE_2D, 0, GL_R8, 4097, 1, 0, GL_RED, GL_UNSIGNED_BYTE, lut);
+        glActiveTexture(GL_TEXTURE2);
+        glBindTexture(GL_TEXTURE_2D, g->lut);
+        glActiveTexture(GL_TEXTURE0);
         /* Frames come as fast as they come: no wait for the vertical blank. */
         SDL_GL_SetSwapInterval(0);
         ok = glGetError() == GL_NO_ERROR;
@@ -194,6 +206,7 @@ void view_gl_close(view_gl *g)
         glDeleteVertexArrays(1, &g->vao);
         glDeleteTextures(1, &g->overlay);
         glDeleteTextures(1, &g->frame);
+        glDeleteTextures(1, &g->lut);
     }
     /* Only while no library context exists (after every GL renderer is
      * released): else it says so and nothing changes. */

@@ -83,6 +83,8 @@ typedef struct gl_drawer {
     /* Texture output (gl_frame.h): the last frame's colour, not yet taken. */
     bool texture_out;
     rl_gl_frame out;
+    bool clear_set;               /* texture output: the target's colour is clear_color */
+    float clear_color[4];
     /* The frame. */
     rl_image *target;
     rl_mat4 view_proj;
@@ -502,7 +504,9 @@ static rl_status gl_begin(void *impl, rl_image *target, const rl_mat4 *view, con
     set_camera(g, g->batch_prog, &g->batch_u, view, proj, eye);
 
     const int w = target->width, h = target->height;
-    if ((target->layers & RL_LAYER_COLOR) && target->color)
+    if (g->texture_out && g->clear_set)
+        glClearTexImage(g->tex_color, 0, GL_RGBA, GL_FLOAT, g->clear_color);
+    else if ((target->layers & RL_LAYER_COLOR) && target->color)
         glTextureSubImage2D(g->tex_color, 0, 0, 0, w, h, GL_RGBA, GL_FLOAT, target->color);
     else
         glClearTexImage(g->tex_color, 0, GL_RGBA, GL_FLOAT, NULL);
@@ -938,15 +942,17 @@ static rl_status gl_end(void *impl)
     rl_image *t = g->target;
     const size_t n = (size_t)t->width * (size_t)t->height;
     if (g->texture_out && (t->layers & RL_LAYER_COLOR) && t->color) {
-        /* The colour stays on the GPU (gl_frame.h): a copy the caller owns,
-         * so that the next frame may draw while the caller shows this one. */
+        /* The colour stays on the GPU (gl_frame.h): the frame's colour
+         * attachment itself goes to the caller, and a new one takes its
+         * place, so that the next frame may draw while the caller shows
+         * this one, with no copy. */
         drop_frame(g);
-        glCreateTextures(GL_TEXTURE_2D, 1, &g->out.texture);
-        glTextureStorage2D(g->out.texture, 1, GL_RGBA32F, t->width, t->height);
+        g->out.texture = g->tex_color;
         glTextureParameteri(g->out.texture, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
         glTextureParameteri(g->out.texture, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
-        glCopyImageSubData(g->tex_color, GL_TEXTURE_2D, 0, 0, 0, 0, g->out.texture, GL_TEXTURE_2D, 0, 0, 0, 0,
-                           t->width, t->height, 1);
+        glCreateTextures(GL_TEXTURE_2D, 1, &g->tex_color);
+        glTextureStorage2D(g->tex_color, 1, GL_RGBA32F, t->width, t->height);
+        glNamedFramebufferTexture(g->fbo, GL_COLOR_ATTACHMENT0, g->tex_color, 0);
         g->out.width = t->width;
         g->out.height = t->height;
         g->out.fence = glFenceSync(GL_SYNC_GPU_COMMANDS_COMPLETE, 0);
@@ -1047,6 +1053,16 @@ rl_status rl_gl_drawer_set_texture_output(rl_drawer *d, bool on)
     return RL_OK;
 }
 
+void rl_gl_drawer_set_clear(rl_drawer *d, const float *rgba)
+{
+    gl_drawer *g = rl_drawer_impl(d, &gl_ops);
+    if (!g)
+        return;
+    g->clear_set = rgba != NULL;
+    if (rgba)
+        memcpy(g->clear_color, rgba, sizeof g->clear_color);
+}
+
 bool rl_gl_drawer_take_frame(rl_drawer *d, rl_gl_frame *out)
 {
     gl_drawer *g = rl_drawer_impl(d, &gl_ops);
@@ -1075,6 +1091,12 @@ rl_status rl_gl_drawer_set_texture_output(rl_drawer *d, bool on)
     (void)d;
     (void)on;
     return rl_error(RL_ERR_UNSUPPORTED, "gl: texture output needs a GL drawer");
+}
+
+void rl_gl_drawer_set_clear(rl_drawer *d, const float *rgba)
+{
+    (void)d;
+    (void)rgba;
 }
 
 bool rl_gl_drawer_take_frame(rl_drawer *d, rl_gl_frame *out)

@@ -76,9 +76,17 @@ static rl_status gl_raster_render(rl_renderer *r, void *state, const rl_scene *s
     /* The drawer needs a depth layer; borrowed as raster does, and the
      * target cleared before the frame begins (the GL drawer uploads it). */
     rl_cull_target target;
-    rl_status st = rl_cull_target_begin(image, rl_renderer_opt_color(r, "background"), &target);
+    const rl_vec3 bg = rl_renderer_opt_color(r, "background");
+    /* With texture output the colour never visits the CPU: the GL drawer
+     * clears it to the background itself (rl_gl_drawer_set_clear), so the
+     * image's colour is neither filled nor uploaded. */
+    rl_image view = *image;
+    if (s->texture_out)
+        view.color = NULL;
+    rl_status st = rl_cull_target_begin(&view, bg, &target);
     if (st != RL_OK)
         return st;
+    target.image.color = image->color;
     desc.flags |= target.flags;
     if (!rl_drawer_fits(s->drawer, scene, &desc) || strcmp(s->device, device) != 0) {
         rl_drawer_release(s->drawer);
@@ -99,6 +107,9 @@ static rl_status gl_raster_render(rl_renderer *r, void *state, const rl_scene *s
                 snprintf(s->info, sizeof s->info, "%s | %s | %s", info.vendor, info.renderer, info.version);
         }
     }
+    const float clear[4] = { bg.x, bg.y, bg.z, 1.0f };
+    if (st == RL_OK)
+        rl_gl_drawer_set_clear(s->drawer, s->texture_out ? clear : NULL);
     if (st == RL_OK)
         st = rl_cull_draw_all(r, s->drawer, &target, cam, d->bounds, stats);
     rl_cull_target_end(&target);
