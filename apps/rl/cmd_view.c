@@ -220,6 +220,10 @@ typedef struct worker {
     rl_image *ref_img;
     bool want_ref;
     bool glshare;                  /* the shared path: GL renderers hand over textures */
+    /* The shared path's GL renderers that Tab left, kept for the next
+     * switch to them: a released one's GL objects would stay in the
+     * window's share group until the window closes (docs/viewer.md). */
+    rl_renderer *parked[4];
 } worker;
 
 /* *img at w x h with layers: kept when it has that size, else replaced
@@ -597,14 +601,39 @@ static void apply_cmd(worker *w, const view_cmd *c)
     shared *sh = w->sh;
     char why[512] = "";
     if (c->kind == CMD_ALGO) {
-        rl_renderer *r = make_renderer(w, c->text, why, sizeof why);
+        rl_renderer *r = NULL;
+        for (size_t i = 0; i < sizeof w->parked / sizeof w->parked[0] && !r; i++)
+            if (w->parked[i] && strcmp(rl_renderer_name(w->parked[i]), c->text) == 0) {
+                /* as new: its defaults, then --set, and no frame-to-frame state */
+                r = w->parked[i];
+                w->parked[i] = NULL;
+                size_t n = 0;
+                const rl_option_info *opts = rl_renderer_options(r, &n);
+                for (size_t k = 0; k < n; k++)
+                    rl_renderer_set(r, opts[k].key, opts[k].default_value);
+                apply_sets(r, w->args, false);
+                rl_renderer_reset(r);
+                rl_clear_error();
+            }
+        if (!r)
+            r = make_renderer(w, c->text, why, sizeof why);
         if (!r) {
             if (c->line)
                 set_fatal(sh, RL_CLI_FAIL, "%s:%d: algo %s: %s", w->args->script, c->line, c->text, why);
             set_status(sh, "%s: %s", c->text, why);
             return;
         }
-        rl_renderer_release(w->r);
+        /* A GL renderer of the shared path (one that takes texture output) is
+         * parked, not released; a full park releases its oldest. */
+        rl_renderer *old = w->r;
+        if (w->glshare && rl_renderer_set_gl_output(old, true) == RL_OK) {
+            rl_renderer_release(w->parked[0]);
+            memmove(w->parked, w->parked + 1, sizeof w->parked - sizeof w->parked[0]);
+            w->parked[sizeof w->parked / sizeof w->parked[0] - 1] = old;
+            old = NULL;
+        }
+        rl_clear_error();
+        rl_renderer_release(old);
         w->r = r;
         w->have_last = false;
         w->step_sel = 0;
@@ -2651,6 +2680,10 @@ static void close_viewer(viewer *v)
     rl_renderer_release(v->wk.r);
     rl_renderer_release(v->wk.ref);
     v->wk.r = v->wk.ref = NULL;
+    for (size_t i = 0; i < sizeof v->wk.parked / sizeof v->wk.parked[0]; i++) {
+        rl_renderer_release(v->wk.parked[i]);
+        v->wk.parked[i] = NULL;
+    }
     if (v->gl) {
         /* the textures still on their way, in the share group */
         view_gl_delete(v->gl, &v->sh.front_tex);
