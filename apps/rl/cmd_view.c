@@ -2298,15 +2298,15 @@ static int open_window(viewer *v)
     if (!chosen && !env_set("DISPLAY") && !env_set("WAYLAND_DISPLAY"))
         return cli_fail(RL_CLI_FAIL, "view: cannot open a window: no display (DISPLAY and WAYLAND_DISPLAY are "
                                      "unset; a script runs under xvfb-run or SDL_VIDEODRIVER=offscreen)");
-    /* The image is made on the CPU; the window only scales it. SDL's
+    /* The readback path: the image is made on the CPU (or read back from a
+     * GL renderer's context) and the window only scales it. SDL's
      * software path does that without loading an OpenGL driver (under Xvfb
      * that is Mesa, which SDL_Quit unloads with blocks still held, a leak
-     * the sanitizer build cannot attribute). The GL renderers' images come
-     * back from the library's own context as rl_images as well (a context
-     * shared with the window is not possible through the API:
-     * docs/viewer.md), so for them only the upload and scaling go to SDL's
-     * OpenGL renderer (--display gl), which SDL replaces by its software
-     * one where it cannot make a context. auto does so only where the GL
+     * the sanitizer build cannot attribute). Where the shared path (below)
+     * is not taken, a GL renderer's read-back images may have their upload
+     * and scaling done by SDL's OpenGL renderer (--display gl), which SDL
+     * replaces by its software one where it cannot make a context. auto
+     * does so only where the GL
      * backend has a hardware device: on llvmpipe the GL upload is the CPU's
      * too and measured twice the software path's time (docs/viewer.md).
      * The environment's SDL_RENDER_DRIVER and SDL_FRAMEBUFFER_ACCELERATION
