@@ -61,9 +61,11 @@ static const char view_help[] =
     "                      per pixel; default 4096\n"
     "  --ref-spp N         samples per pixel of the pt reference that X compares\n"
     "                      the path tracers with; default 256\n"
-    "  --display MODE      how the image reaches the window: software (SDL's\n"
-    "                      software renderer), gl (SDL's OpenGL renderer) or auto\n"
-    "                      (default: gl for the GL renderers, else software)\n"
+    "  --display MODE      how the image reaches the window: shared (the window's\n"
+    "                      EGL context shared with the GL renderers: their frames\n"
+    "                      stay on the GPU), software (SDL's software renderer),\n"
+    "                      gl (SDL's OpenGL renderer) or auto (default: shared for\n"
+    "                      a GL renderer, else software; falls back to software)\n"
     "\n"
     "model files (the same as SCENE:cameras=off,lights=add,...; see rl scenes):\n"
     CLI_MODEL_FLAGS_HELP
@@ -124,7 +126,7 @@ typedef struct shot_at {
 
 typedef struct view_args {
     const char *scene, *algo, *camera, *script, *record_dir, *shot_dir, *path_out, *stats_out;
-    const char *display;       /* --display: auto, software or gl */
+    const char *display;       /* --display: auto, shared, software or gl */
     bool has_size;             /* --size WxH; without it (or with --size window) the image follows the window */
     int width, height;
     const char **sets;
@@ -182,7 +184,14 @@ typedef struct shared {
     int ref_levels;
     int fatal;                     /* exit code of a failure that ends a scripted run */
     char fatal_msg[512];
-    /* the published image */
+    /* the published image; with the shared path (front_gpu) its colour is
+     * front_tex, a texture of the window's share group, not front->color */
+    bool front_gpu;
+    rl_gl_frame front_tex;
+    /* textures published but never taken (a newer frame came first), for
+     * the main thread to delete: only it has a context of the share group */
+    rl_gl_frame trash[16];
+    int num_trash;
     rl_image *front;
     uint64_t front_seq;
     bool front_final;
@@ -210,6 +219,11 @@ typedef struct worker {
     rl_renderer *ref;              /* the reference renderer of X, kept for the next X */
     rl_image *ref_img;
     bool want_ref;
+    bool glshare;                  /* the shared path: GL renderers hand over textures */
+    /* The shared path's GL renderers that Tab left, kept for the next
+     * switch to them: a released one's GL objects would stay in the
+     * window's share group until the window closes (docs/viewer.md). */
+    rl_renderer *parked[4];
 } worker;
 
 /* *img at w x h with layers: kept when it has that size, else replaced
@@ -234,10 +248,28 @@ static bool on_progress(void *user, double done)
     return SDL_AtomicGet(&w->sh->gen) == w->running_gen;
 }
 
-static void publish(worker *w, const rl_image *img, const rl_render_stats *stats, bool final)
+/* A texture that will never be shown, to the main thread for deletion
+ * (with the lock held); one that finds the bin full is left to the share
+ * group's end. */
+static void discard_tex(shared *sh, rl_gl_frame *t)
+{
+    if (t->texture && sh->num_trash < (int)(sizeof sh->trash / sizeof sh->trash[0]))
+        sh->trash[sh->num_trash++] = *t;
+    *t = (rl_gl_frame){ 0 };
+}
+
+/* img's layers and, with tex (the shared path), its colour as a texture
+ * instead of img->color. */
+static void publish(worker *w, const rl_image *img, const rl_render_stats *stats, bool final, rl_gl_frame *tex)
 {
     shared *sh = w->sh;
     SDL_LockMutex(sh->lock);
+    discard_tex(sh, &sh->front_tex);
+    sh->front_gpu = tex != NULL;
+    if (tex) {
+        sh->front_tex = *tex;
+        *tex = (rl_gl_frame){ 0 };
+    }
     /* The window's size may have changed the image's (--size window). */
     if (fit_image(&sh->front, img->width, img->height, VIEW_LAYERS) != RL_OK) {
         snprintf(sh->status, sizeof sh->status, "out of memory for a %dx%d image", img->width, img->height);
@@ -246,7 +278,8 @@ static void publish(worker *w, const rl_image *img, const rl_render_stats *stats
         return;
     }
     size_t n = (size_t)img->width * (size_t)img->height;
-    memcpy(sh->front->color, img->color, n * sizeof *img->color);
+    if (!sh->front_gpu)
+        memcpy(sh->front->color, img->color, n * sizeof *img->color);
     /* An intermediate image without these layers must not show the last
      * frame's depth and IDs under its colour. */
     for (size_t i = 0; i < n; i++) {
@@ -271,7 +304,7 @@ static bool on_vt_update(void *user, const rl_image *image, uint32_t stage, bool
     (void)stage;
     worker *w = user;
     if (!final)
-        publish(w, image, NULL, false);
+        publish(w, image, NULL, false, NULL);
     return SDL_AtomicGet(&w->sh->gen) == w->running_gen;
 }
 
@@ -355,6 +388,11 @@ static rl_renderer *make_renderer(const worker *w, const char *name, char *why, 
         rl_renderer_release(r);
         return NULL;
     }
+    /* The shared path: a GL renderer's frames stay textures (the CPU
+     * renderers have none and say so, which is no error here). */
+    if (w->glshare)
+        rl_renderer_set_gl_output(r, true);
+    rl_clear_error();
     return r;
 }
 
@@ -563,14 +601,39 @@ static void apply_cmd(worker *w, const view_cmd *c)
     shared *sh = w->sh;
     char why[512] = "";
     if (c->kind == CMD_ALGO) {
-        rl_renderer *r = make_renderer(w, c->text, why, sizeof why);
+        rl_renderer *r = NULL;
+        for (size_t i = 0; i < sizeof w->parked / sizeof w->parked[0] && !r; i++)
+            if (w->parked[i] && strcmp(rl_renderer_name(w->parked[i]), c->text) == 0) {
+                /* as new: its defaults, then --set, and no frame-to-frame state */
+                r = w->parked[i];
+                w->parked[i] = NULL;
+                size_t n = 0;
+                const rl_option_info *opts = rl_renderer_options(r, &n);
+                for (size_t k = 0; k < n; k++)
+                    rl_renderer_set(r, opts[k].key, opts[k].default_value);
+                apply_sets(r, w->args, false);
+                rl_renderer_reset(r);
+                rl_clear_error();
+            }
+        if (!r)
+            r = make_renderer(w, c->text, why, sizeof why);
         if (!r) {
             if (c->line)
                 set_fatal(sh, RL_CLI_FAIL, "%s:%d: algo %s: %s", w->args->script, c->line, c->text, why);
             set_status(sh, "%s: %s", c->text, why);
             return;
         }
-        rl_renderer_release(w->r);
+        /* A GL renderer of the shared path (one that takes texture output) is
+         * parked, not released; a full park releases its oldest. */
+        rl_renderer *old = w->r;
+        if (w->glshare && rl_renderer_set_gl_output(old, true) == RL_OK) {
+            rl_renderer_release(w->parked[0]);
+            memmove(w->parked, w->parked + 1, sizeof w->parked - sizeof w->parked[0]);
+            w->parked[sizeof w->parked / sizeof w->parked[0] - 1] = old;
+            old = NULL;
+        }
+        rl_clear_error();
+        rl_renderer_release(old);
         w->r = r;
         w->have_last = false;
         w->step_sel = 0;
@@ -761,6 +824,11 @@ static int worker_main(void *user)
         rl_render_stats stats = { 0 };
         rl_clear_error();
         rl_status st = fit_image(&w->back, cam.width, cam.height, VIEW_LAYERS);
+        /* X compares w->back's colour: that frame is read back. */
+        bool texture = w->glshare && !w->want_ref && rl_renderer_set_gl_output(w->r, true) == RL_OK;
+        if (w->glshare && !texture)
+            rl_renderer_set_gl_output(w->r, false);
+        rl_clear_error();
         if (st == RL_OK)
             st = rl_renderer_render(w->r, w->scene, &cam, w->back, &stats);
         if (st == RL_OK) {
@@ -768,7 +836,12 @@ static int worker_main(void *user)
             SDL_LockMutex(sh->lock);
             sh->worker_spp += (double)stats.samples / pixels;
             SDL_UnlockMutex(sh->lock);
-            publish(w, w->back, &stats, true);
+            rl_gl_frame tex = { 0 };
+            /* A frame the renderer finished on the CPU (gl-pt's filter) has
+             * no texture and is in w->back. */
+            texture = texture && rl_renderer_take_gl_frame(w->r, &tex) == RL_OK;
+            rl_clear_error();
+            publish(w, w->back, &stats, true, texture ? &tex : NULL);
             if (w->want_ref) {
                 w->want_ref = false;
                 compare_reference(w, &cam);
@@ -869,6 +942,7 @@ typedef struct algo_stat {
     double first_image_ms, first_final_ms, prep_ms;
     double display_s;           /* taking and drawing its new images, summed */
     long long displayed;
+    long long shared_frames;    /* of displayed: shown from a GL texture (the shared path) */
     /* From a restart (camera, renderer or option change) to its first
      * image on screen, an intermediate one included, summed. */
     double latency_s;
@@ -902,7 +976,15 @@ typedef struct viewer {
     SDL_Thread *thread;
     SDL_Window *win;
     SDL_Renderer *ren;
-    char display[32];           /* SDL's renderer: software or opengl */
+    char display[32];           /* SDL's renderer: software or opengl; or gl-shared */
+    /* The shared path (--display shared or auto with a GL renderer): the
+     * window's EGL context shared with the library (view_gl.c); NULL on the
+     * readback path, with the reason it was not taken in path_why. */
+    view_gl *gl;
+    char path_why[256];
+    bool shown_gpu;             /* the shown frame's colour is the texture of v->gl */
+    bool shown_cpu;             /* v->shown->color holds the shown frame's colour */
+    int px_rows, tex_rows;      /* rows of v->pixels / of the overlay texture that may not be transparent */
     SDL_Texture *tex;
     uint32_t *pixels;
     rl_image *shown;            /* the displayed frame, without the overlay */
@@ -1037,6 +1119,8 @@ static bool worker_idle(viewer *v)
 /* ---- output ---- */
 
 static void draw(viewer *v);
+static bool draw_ex(viewer *v, uint32_t *capture);
+static bool ensure_shown_color(viewer *v);
 static bool menu_click(viewer *v, int x, int y, int button);
 
 static rl_status write_shot_json(const viewer *v, const char *png, const char *path)
@@ -1110,6 +1194,11 @@ static bool write_screenshot(viewer *v, const char *png)
     const char *tmp = NULL, *what = png;
     rl_clear_error();
     rl_status st = rl_output_batch_create(&batch);
+    if (st == RL_OK && !ensure_shown_color(v)) {
+        rl_output_batch_release(batch);
+        cli_fail(RL_CLI_FAIL, "%s: the frame cannot be read back from the window's context", png);
+        return false;
+    }
     if (st == RL_OK && (st = rl_output_batch_add(batch, png, &tmp)) == RL_OK)
         st = rl_image_write(v->shown, tmp);
     if (st == RL_OK && (st = rl_output_batch_add(batch, what = json, &tmp)) == RL_OK)
@@ -1129,20 +1218,27 @@ static bool write_screenshot(viewer *v, const char *png)
  * the PNG writer encodes to the same bytes. */
 static bool write_capture(viewer *v, const char *png)
 {
-    draw(v);      /* a key of the script (help, stats) may have changed the overlay */
     rl_image *img = NULL;
     rl_clear_error();
+    uint32_t *px = malloc((size_t)v->shown->width * (size_t)v->shown->height * sizeof *px);
+    /* a key of the script (help, stats) may have changed the overlay */
+    if (!px || !draw_ex(v, px)) {
+        free(px);
+        cli_fail(RL_CLI_FAIL, "%s: cannot read the window's pixels", png);
+        return false;
+    }
     rl_status st = rl_image_create(v->shown->width, v->shown->height, RL_LAYER_COLOR, &img);
     if (st == RL_OK) {
         float lin[256];
         for (int i = 0; i < 256; i++)
             lin[i] = rl_srgb_to_linear((float)i / 255.0f);
         for (size_t i = 0; i < (size_t)img->width * (size_t)img->height; i++) {
-            uint32_t p = v->pixels[i];
+            uint32_t p = px[i];
             img->color[i] = (rl_vec4){ lin[p >> 16 & 255], lin[p >> 8 & 255], lin[p & 255], 1.0f };
         }
         st = rl_image_write(img, png);
     }
+    free(px);
     rl_image_release(img);
     if (st != RL_OK) {
         cli_fail_status(RL_CLI_FAIL, st, png);
@@ -1544,7 +1640,17 @@ static bool handle_events(viewer *v)
         }
         case SDL_MOUSEBUTTONDOWN:
             if (!v->scripted && (e.button.button == SDL_BUTTON_LEFT || e.button.button == SDL_BUTTON_RIGHT))
-                v->mouse_taken = menu_click(v, e.button.x, e.button.y, e.button.button == SDL_BUTTON_RIGHT);
+            {
+                int x = e.button.x, y = e.button.y;
+                if (v->gl) {
+                    /* SDL maps the mouse to the image only for its renderers */
+                    int vx, vy, vw, vh;
+                    view_gl_viewport(v->gl, &vx, &vy, &vw, &vh);
+                    x = vw > 0 ? (x - vx) * v->shown->width / vw : -1;
+                    y = vh > 0 ? (y - vy) * v->shown->height / vh : -1;
+                }
+                v->mouse_taken = menu_click(v, x, y, e.button.button == SDL_BUTTON_RIGHT);
+            }
             break;
         case SDL_MOUSEBUTTONUP:
             v->mouse_taken = false;
@@ -1566,7 +1672,10 @@ static bool handle_events(viewer *v)
              * run does not depend on when the X server answers. */
             if (!v->scripted && e.window.event == SDL_WINDOWEVENT_SIZE_CHANGED) {
                 int w = 0, h = 0;
-                if (SDL_GetRendererOutputSize(v->ren, &w, &h) == 0)
+                if (v->gl) {
+                    view_gl_drawable_size(v->gl, &w, &h);
+                    window_resized(v, w, h);
+                } else if (SDL_GetRendererOutputSize(v->ren, &w, &h) == 0)
                     window_resized(v, w, h);
             }
             break;
@@ -1599,7 +1708,7 @@ static uint8_t to_byte(float c)
  * size (the window was resized) replaces them. */
 static bool fit_shown(viewer *v, int w, int h)
 {
-    if (v->shown && v->shown->width == w && v->shown->height == h && v->tex)
+    if (v->shown && v->shown->width == w && v->shown->height == h && (v->tex || v->gl))
         return true;
     rl_clear_error();
     size_t n = (size_t)w * (size_t)h;
@@ -1607,9 +1716,12 @@ static bool fit_shown(viewer *v, int w, int h)
     rl_vec4 *layer = malloc(n * sizeof *layer);
     rl_image *img = NULL;
     SDL_Texture *tex = NULL;
-    if (px && layer && rl_image_create(w, h, VIEW_LAYERS, &img) == RL_OK)
-        tex = SDL_CreateTexture(v->ren, SDL_PIXELFORMAT_ARGB8888, SDL_TEXTUREACCESS_STREAMING, w, h);
-    if (!tex) {
+    bool ok = px && layer && rl_image_create(w, h, VIEW_LAYERS, &img) == RL_OK;
+    if (ok && v->gl)
+        ok = view_gl_resize(v->gl, w, h);
+    else if (ok)
+        ok = (tex = SDL_CreateTexture(v->ren, SDL_PIXELFORMAT_ARGB8888, SDL_TEXTUREACCESS_STREAMING, w, h)) != NULL;
+    if (!ok) {
         free(px);
         free(layer);
         rl_image_release(img);
@@ -1626,6 +1738,12 @@ static bool fit_shown(viewer *v, int w, int h)
     v->layer_px = layer;
     v->shown = img;
     v->tex = tex;
+    v->px_rows = v->tex_rows = h;
+    v->shown_gpu = v->shown_cpu = false;
+    if (v->gl) {
+        view_gl_drop_frame(v->gl);
+        return true;
+    }
     /* Letterboxed scaling keeps the image's aspect ratio in any window; an
      * image that follows the window is drawn 1:1 (unless capped). */
     SDL_RenderSetLogicalSize(v->ren, w, h);
@@ -1636,7 +1754,13 @@ static bool fit_shown(viewer *v, int w, int h)
 static bool take_frame(viewer *v)
 {
     shared *sh = &v->sh;
+    rl_gl_frame trash[sizeof sh->trash / sizeof sh->trash[0]];
+    rl_gl_frame tex = { 0 };
+    bool gpu = false, want_change = false;
     SDL_LockMutex(sh->lock);
+    int num_trash = sh->num_trash;
+    memcpy(trash, sh->trash, (size_t)num_trash * sizeof *trash);
+    sh->num_trash = 0;
     bool fresh = sh->front_seq != v->shown_seq;
     if (fresh && !fit_shown(v, sh->front->width, sh->front->height)) {
         fresh = false;
@@ -1647,8 +1771,14 @@ static bool take_frame(viewer *v)
     double change = -1.0;
     if (fresh) {
         size_t n = (size_t)sh->front->width * (size_t)sh->front->height;
-        if (sh->front_final && !sh->front_moved && is_progressive(sh->front_algo) &&
-            strcmp(sh->front_algo, v->shown_algo) == 0) {
+        want_change = sh->front_final && !sh->front_moved && is_progressive(sh->front_algo) &&
+                      strcmp(sh->front_algo, v->shown_algo) == 0;
+        gpu = sh->front_gpu && sh->front_tex.texture;
+        if (gpu) {
+            /* The colour is a texture, now the main thread's (below). */
+            tex = sh->front_tex;
+            sh->front_tex = (rl_gl_frame){ 0 };
+        } else if (want_change && (!v->gl || v->shown_cpu)) {
             double sum = 0.0;
             for (size_t i = 0; i < n; i++) {
                 rl_vec4 a = sh->front->color[i], b = v->shown->color[i];
@@ -1657,7 +1787,8 @@ static bool take_frame(viewer *v)
             }
             change = sum / (3.0 * (double)n);
         }
-        memcpy(v->shown->color, sh->front->color, n * sizeof *v->shown->color);
+        if (!gpu)
+            memcpy(v->shown->color, sh->front->color, n * sizeof *v->shown->color);
         memcpy(v->shown->depth, sh->front->depth, n * sizeof *v->shown->depth);
         memcpy(v->shown->object_id, sh->front->object_id, n * sizeof *v->shown->object_id);
         v->shown_seq = sh->front_seq;
@@ -1670,9 +1801,44 @@ static bool take_frame(viewer *v)
         v->shown_request_s = sh->front_request_s;
     }
     SDL_UnlockMutex(sh->lock);
+    for (int i = 0; i < num_trash && v->gl; i++)
+        view_gl_delete(v->gl, &trash[i]);
     if (!fresh)
         return false;
     algo_stat *s = stat_of(v, v->shown_algo);
+    if (v->gl && gpu) {
+        bool had_cpu = v->shown_cpu;
+        view_gl_adopt(v->gl, &tex);
+        v->shown_gpu = true;
+        v->shown_cpu = false;
+        /* Read back only where the CPU needs the colour: --record, and an
+         * accumulating renderer until its image is stable (the settle
+         * measurement compares consecutive frames). */
+        bool settled = s && s->settled && !v->shown_moved && want_change;
+        if (v->a->record_dir || (is_progressive(v->shown_algo) && !settled)) {
+            size_t n = (size_t)v->shown->width * (size_t)v->shown->height;
+            if (view_gl_read(v->gl, v->layer_px)) {
+                if (want_change && had_cpu) {
+                    double sum = 0.0;
+                    for (size_t i = 0; i < n; i++) {
+                        rl_vec4 a = v->layer_px[i], b = v->shown->color[i];
+                        sum += abs(to_byte(a.x) - to_byte(b.x)) + abs(to_byte(a.y) - to_byte(b.y)) +
+                               abs(to_byte(a.z) - to_byte(b.z));
+                    }
+                    change = sum / (3.0 * (double)n);
+                }
+                memcpy(v->shown->color, v->layer_px, n * sizeof *v->shown->color);
+                v->shown_cpu = true;
+            }
+        }
+    } else {
+        v->shown_gpu = false;
+        v->shown_cpu = true;
+        if (v->gl)
+            view_gl_drop_frame(v->gl);
+    }
+    if (s && v->shown_gpu)
+        s->shared_frames++;
     double now = rl_time_s();
     if (s && !s->have_first) {
         s->have_first = true;
@@ -1846,44 +2012,83 @@ static bool menu_click(viewer *v, int x, int y, int button)
     return false;
 }
 
-static void draw(viewer *v)
+/* The shown frame's colour in v->shown->color: read back from the window's
+ * texture on the shared path, where it is not there yet. */
+static bool ensure_shown_color(viewer *v)
+{
+    if (v->gl && v->shown_gpu && !v->shown_cpu)
+        v->shown_cpu = view_gl_read(v->gl, v->shown->color);
+    return !v->gl || v->shown_cpu;
+}
+
+/* The stats overlay's lines. */
+static void stats_text(viewer *v, char *text, size_t size)
 {
     int w = v->shown->width, h = v->shown->height;
-    const rl_vec4 *src = v->shown->color;
-    if (v->layer != CLI_LAYER_COLOR && cli_layer_picture(v->shown, v->layer, v->layer_px))
-        src = v->layer_px;
-    for (size_t i = 0; i < (size_t)w * (size_t)h; i++) {
-        rl_vec4 c = src[i];
-        v->pixels[i] = 0xff000000u | (uint32_t)to_byte(c.x) << 16 | (uint32_t)to_byte(c.y) << 8 | to_byte(c.z);
-    }
+    const rl_render_stats *s = &v->shown_stats;
+    char status[256];
+    SDL_LockMutex(v->sh.lock);
+    snprintf(status, sizeof status, "%s", v->sh.status);
+    SDL_UnlockMutex(v->sh.lock);
+    int n = snprintf(text, size, "%s %dx%d %.1f fps, frame %.1f ms%s\n", v->shown_algo, w, h, current_fps(v),
+                     s->time_ms - s->prep_ms, v->shown_final ? "" : " (refining)");
+    uint64_t rays = 0;
+    for (int t = 0; t < RL_RAY_TYPE_COUNT; t++)
+        rays += s->rays[t];
+    if (rays && n < (int)size)
+        n += snprintf(text + n, size - (size_t)n, "rays %llu: prim %llu shadow %llu refl %llu refr %llu "
+                      "diff %llu\n", (unsigned long long)rays, (unsigned long long)s->rays[RL_RAY_PRIMARY],
+                      (unsigned long long)s->rays[RL_RAY_SHADOW], (unsigned long long)s->rays[RL_RAY_REFLECTION],
+                      (unsigned long long)s->rays[RL_RAY_REFRACTION], (unsigned long long)s->rays[RL_RAY_DIFFUSE]);
+    if (n < (int)size)
+        n += snprintf(text + n, size - (size_t)n, "tris %llu points %llu queries %llu spp %.0f\n",
+                      (unsigned long long)s->triangles_rasterized, (unsigned long long)s->points_drawn,
+                      (unsigned long long)s->occlusion_queries, v->shown_spp);
+    if (n < (int)size && (v->recording || v->playing))
+        n += snprintf(text + n, size - (size_t)n, "%s%s\n", v->recording ? "[rec] " : "",
+                      v->playing ? "[play]" : "");
+    if (n < (int)size && status[0])
+        snprintf(text + n, size - (size_t)n, "%s\n", status);
+}
+
+/* The window's pixels: the frame in sRGB bytes with the overlay. On the
+ * shared path a GPU frame's colour is the texture's, encoded by the
+ * window's shader (view_gl.c), and v->pixels holds only the overlay over a
+ * transparent ground, of which only the rows the text covers are refilled
+ * and uploaded. capture (may be NULL) gets the picture at the image's
+ * size, ARGB8888: on the shared path as the window's shader draws it. */
+static bool draw_ex(viewer *v, uint32_t *capture)
+{
+    int w = v->shown->width, h = v->shown->height;
     int scale = text_scale(v);
-    if (v->stats) {
-        const rl_render_stats *s = &v->shown_stats;
-        char text[1024], status[256];
-        SDL_LockMutex(v->sh.lock);
-        snprintf(status, sizeof status, "%s", v->sh.status);
-        SDL_UnlockMutex(v->sh.lock);
-        int n = snprintf(text, sizeof text, "%s %dx%d %.1f fps, frame %.1f ms%s\n", v->shown_algo, w, h,
-                         current_fps(v), s->time_ms - s->prep_ms, v->shown_final ? "" : " (refining)");
-        uint64_t rays = 0;
-        for (int t = 0; t < RL_RAY_TYPE_COUNT; t++)
-            rays += s->rays[t];
-        if (rays && n < (int)sizeof text)
-            n += snprintf(text + n, sizeof text - (size_t)n, "rays %llu: prim %llu shadow %llu refl %llu refr %llu "
-                          "diff %llu\n", (unsigned long long)rays, (unsigned long long)s->rays[RL_RAY_PRIMARY],
-                          (unsigned long long)s->rays[RL_RAY_SHADOW], (unsigned long long)s->rays[RL_RAY_REFLECTION],
-                          (unsigned long long)s->rays[RL_RAY_REFRACTION], (unsigned long long)s->rays[RL_RAY_DIFFUSE]);
-        if (n < (int)sizeof text)
-            n += snprintf(text + n, sizeof text - (size_t)n, "tris %llu points %llu queries %llu spp %.0f\n",
-                          (unsigned long long)s->triangles_rasterized, (unsigned long long)s->points_drawn,
-                          (unsigned long long)s->occlusion_queries, v->shown_spp);
-        if (n < (int)sizeof text && (v->recording || v->playing))
-            n += snprintf(text + n, sizeof text - (size_t)n, "%s%s\n", v->recording ? "[rec] " : "",
-                          v->playing ? "[play]" : "");
-        if (n < (int)sizeof text && status[0])
-            snprintf(text + n, sizeof text - (size_t)n, "%s\n", status);
-        view_draw_text(v->pixels, w, h, 3 * scale, 3 * scale, scale, text, 0xffffff40u);
+    char text[1024] = "";
+    if (v->stats)
+        stats_text(v, text, sizeof text);
+    bool over_gpu = v->gl && v->shown_gpu && v->layer == CLI_LAYER_COLOR;
+    int rows = h;
+    if (over_gpu) {
+        int lines = 0;
+        for (const char *p = text; *p; p++)
+            lines += *p == '\n';
+        /* view_draw_text's box: from a scale above the text, 9 a line */
+        rows = v->menu || v->help ? h : lines ? (3 + lines * VIEW_FONT_LINE) * scale : 0;
+        rows = rows < h ? rows : h;
+        int fill = rows > v->tex_rows ? rows : v->tex_rows;
+        fill = fill > v->px_rows ? fill : v->px_rows;
+        for (size_t i = 0; i < (size_t)fill * (size_t)w; i++)
+            v->pixels[i] = 0x00fcfcfcu;     /* transparent: view_gl.c */
+    } else {
+        ensure_shown_color(v);
+        const rl_vec4 *src = v->shown->color;
+        if (v->layer != CLI_LAYER_COLOR && cli_layer_picture(v->shown, v->layer, v->layer_px))
+            src = v->layer_px;
+        for (size_t i = 0; i < (size_t)w * (size_t)h; i++) {
+            rl_vec4 c = src[i];
+            v->pixels[i] = 0xff000000u | (uint32_t)to_byte(c.x) << 16 | (uint32_t)to_byte(c.y) << 8 | to_byte(c.z);
+        }
     }
+    if (v->stats)
+        view_draw_text(v->pixels, w, h, 3 * scale, 3 * scale, scale, text, 0xffffff40u);
     if (v->menu) {
         menu_layout(v);
         for (int i = 0; i < v->num_menu_items; i++)
@@ -1892,10 +2097,23 @@ static void draw(viewer *v)
     }
     if (v->help)
         view_draw_text(v->pixels, w, h, 3 * scale, h / 3, scale, view_keys_help, 0xffffffffu);
+    if (v->gl) {
+        view_gl_present(v->gl, v->pixels, over_gpu && v->tex_rows > rows ? v->tex_rows : rows, over_gpu);
+        v->tex_rows = v->px_rows = rows;
+        return !capture || view_gl_capture(v->gl, v->pixels, 0, over_gpu, capture);
+    }
     SDL_UpdateTexture(v->tex, NULL, v->pixels, w * (int)sizeof *v->pixels);
     SDL_RenderClear(v->ren);
     SDL_RenderCopy(v->ren, v->tex, NULL, NULL);
     SDL_RenderPresent(v->ren);
+    if (capture)
+        memcpy(capture, v->pixels, (size_t)w * (size_t)h * sizeof *capture);
+    return true;
+}
+
+static void draw(viewer *v)
+{
+    draw_ex(v, NULL);
 }
 
 /* After a frame is on screen: --record and --screenshot-at. */
@@ -1906,7 +2124,7 @@ static bool after_frame(viewer *v)
         char path[4096];
         snprintf(path, sizeof path, "%s/frame_%06lld.png", v->a->record_dir, v->record_counter++);
         rl_clear_error();
-        rl_status st = rl_image_write(v->shown, path);
+        rl_status st = ensure_shown_color(v) ? rl_image_write(v->shown, path) : RL_ERR_INTERNAL;
         if (st != RL_OK) {
             cli_fail_status(RL_CLI_FAIL, st, path);
             return false;
@@ -1940,8 +2158,9 @@ static int parse_args(int argc, char **argv, view_args *a)
         else if (VALUE("--path-out")) a->path_out = v;
         else if (VALUE("--stats-out")) a->stats_out = v;
         else if (VALUE("--display")) {
-            if (m > 0 && strcmp(v, "auto") != 0 && strcmp(v, "software") != 0 && strcmp(v, "gl") != 0)
-                return cli_fail(RL_CLI_USAGE, "--display: expected auto, software or gl, got '%s'", v);
+            if (m > 0 && strcmp(v, "auto") != 0 && strcmp(v, "software") != 0 && strcmp(v, "gl") != 0 &&
+                strcmp(v, "shared") != 0)
+                return cli_fail(RL_CLI_USAGE, "--display: expected auto, shared, software or gl, got '%s'", v);
             a->display = v;
         }
         else if (VALUE("--size")) {
@@ -2079,25 +2298,41 @@ static int open_window(viewer *v)
     if (!chosen && !env_set("DISPLAY") && !env_set("WAYLAND_DISPLAY"))
         return cli_fail(RL_CLI_FAIL, "view: cannot open a window: no display (DISPLAY and WAYLAND_DISPLAY are "
                                      "unset; a script runs under xvfb-run or SDL_VIDEODRIVER=offscreen)");
-    /* The image is made on the CPU; the window only scales it. SDL's
+    /* The readback path: the image is made on the CPU (or read back from a
+     * GL renderer's context) and the window only scales it. SDL's
      * software path does that without loading an OpenGL driver (under Xvfb
      * that is Mesa, which SDL_Quit unloads with blocks still held, a leak
-     * the sanitizer build cannot attribute). The GL renderers' images come
-     * back from the library's own context as rl_images as well (a context
-     * shared with the window is not possible through the API:
-     * docs/viewer.md), so for them only the upload and scaling go to SDL's
-     * OpenGL renderer (--display gl), which SDL replaces by its software
-     * one where it cannot make a context. auto does so only where the GL
+     * the sanitizer build cannot attribute). Where the shared path (below)
+     * is not taken, a GL renderer's read-back images may have their upload
+     * and scaling done by SDL's OpenGL renderer (--display gl), which SDL
+     * replaces by its software one where it cannot make a context. auto
+     * does so only where the GL
      * backend has a hardware device: on llvmpipe the GL upload is the CPU's
      * too and measured twice the software path's time (docs/viewer.md).
      * The environment's SDL_RENDER_DRIVER and SDL_FRAMEBUFFER_ACCELERATION
      * still override. */
     bool gl = strcmp(v->a->display, "gl") == 0;
+    /* The shared path (docs/viewer.md): the window's context is EGL and
+     * the library's contexts share with it, so that a GL renderer's frame
+     * is drawn from its texture without the trip through the CPU. Tried
+     * for --display shared, and by auto for a GL renderer; where it fails
+     * the readback path below is taken and the status line says why. */
+    bool gl_algo = strncmp(v->a->algo, "gl-", 3) == 0;
+    bool want_share = strcmp(v->a->display, "shared") == 0 || (strcmp(v->a->display, "auto") == 0 && gl_algo);
     rl_gl_info gi;
-    if (strcmp(v->a->display, "auto") == 0 && strncmp(v->a->algo, "gl-", 3) == 0 &&
-        rl_gl_info_get(NULL, &gi) == RL_OK)
+    if (strcmp(v->a->display, "auto") == 0 && gl_algo && rl_gl_info_get(NULL, &gi) == RL_OK)
         gl = !strstr(gi.renderer, "llvmpipe") && !strstr(gi.renderer, "softpipe") && !strstr(gi.renderer, "swrast");
     rl_clear_error();
+#ifdef SDL_HINT_VIDEO_X11_FORCE_EGL
+    if (want_share)
+        SDL_SetHint(SDL_HINT_VIDEO_X11_FORCE_EGL, "1");
+#else
+    if (want_share) {
+        snprintf(v->path_why, sizeof v->path_why, "SDL %d.%d.%d has no SDL_HINT_VIDEO_X11_FORCE_EGL", SDL_MAJOR_VERSION,
+                 SDL_MINOR_VERSION, SDL_PATCHLEVEL);
+        want_share = false;
+    }
+#endif
     SDL_SetHint(SDL_HINT_RENDER_DRIVER, gl ? "opengl" : "software");
     if (!gl)
         SDL_SetHint(SDL_HINT_FRAMEBUFFER_ACCELERATION, "0");
@@ -2117,20 +2352,42 @@ static int open_window(viewer *v)
         ww /= 2;
         wh /= 2;
     }
-    v->win = SDL_CreateWindow(title, SDL_WINDOWPOS_UNDEFINED, SDL_WINDOWPOS_UNDEFINED, ww < 16 ? 16 : ww,
-                              wh < 16 ? 16 : wh, SDL_WINDOW_RESIZABLE);
-    if (!v->win)
-        return cli_fail(RL_CLI_FAIL, "view: cannot open a window: %s", SDL_GetError());
-    v->ren = SDL_CreateRenderer(v->win, -1, 0);
-    if (!v->ren)
-        return cli_fail(RL_CLI_FAIL, "view: cannot draw into the window: %s", SDL_GetError());
-    SDL_RendererInfo info;
-    snprintf(v->display, sizeof v->display, "%s", SDL_GetRendererInfo(v->ren, &info) == 0 ? info.name : "?");
-    cli_debug("view: SDL renderer %s", v->display);
-    if (gl && strcmp(v->display, "opengl") != 0)
+    if (want_share) {
+        v->win = SDL_CreateWindow(title, SDL_WINDOWPOS_UNDEFINED, SDL_WINDOWPOS_UNDEFINED, ww < 16 ? 16 : ww,
+                                  wh < 16 ? 16 : wh, SDL_WINDOW_RESIZABLE | SDL_WINDOW_OPENGL);
+        if (!v->win)
+            snprintf(v->path_why, sizeof v->path_why, "no OpenGL window: %s", SDL_GetError());
+        else if (!(v->gl = view_gl_open(v->win, v->path_why, sizeof v->path_why))) {
+            SDL_DestroyWindow(v->win);
+            v->win = NULL;
+        }
+        if (!v->gl)
+            cli_debug("view: the shared path failed (%s); the readback path", v->path_why);
+    }
+    if (!v->gl) {
+        v->win = SDL_CreateWindow(title, SDL_WINDOWPOS_UNDEFINED, SDL_WINDOWPOS_UNDEFINED, ww < 16 ? 16 : ww,
+                                  wh < 16 ? 16 : wh, SDL_WINDOW_RESIZABLE);
+        if (!v->win)
+            return cli_fail(RL_CLI_FAIL, "view: cannot open a window: %s", SDL_GetError());
+        v->ren = SDL_CreateRenderer(v->win, -1, 0);
+        if (!v->ren)
+            return cli_fail(RL_CLI_FAIL, "view: cannot draw into the window: %s", SDL_GetError());
+        SDL_RendererInfo info;
+        snprintf(v->display, sizeof v->display, "%s", SDL_GetRendererInfo(v->ren, &info) == 0 ? info.name : "?");
+    } else {
+        snprintf(v->display, sizeof v->display, "gl-shared");
+        v->wk.glshare = true;
+    }
+    cli_debug("view: display %s", v->display);
+    if (gl && !v->gl && strcmp(v->display, "opengl") != 0)
         snprintf(v->sh.status, sizeof v->sh.status, "--display gl: SDL made no OpenGL renderer; %s", v->display);
+    if (want_share || v->path_why[0])
+        snprintf(v->sh.status, sizeof v->sh.status, v->gl ? "display: shared GL context, frames stay on the GPU"
+                 : "display: readback, no shared GL context: %.180s", v->path_why);
     int ow = ww, oh = wh;
-    if (v->follow_window && SDL_GetRendererOutputSize(v->ren, &ow, &oh) == 0) {
+    bool have_size = v->gl ? (view_gl_drawable_size(v->gl, &ow, &oh), true)
+                           : SDL_GetRendererOutputSize(v->ren, &ow, &oh) == 0;
+    if (v->follow_window && have_size) {
         window_image_size(ow, oh, &v->width, &v->height);
         v->nav.cam.width = v->width;
         v->nav.cam.height = v->height;
@@ -2365,6 +2622,12 @@ static int write_stats_out(const viewer *v, double wall_s)
     cJSON_AddNumberToObject(obj, "height", v->height);
     cJSON_AddBoolToObject(obj, "scripted", v->scripted);
     cJSON_AddStringToObject(obj, "display", v->display);
+    /* how a GL renderer's frame reaches the window: "shared" (its texture,
+     * in the window's share group) or "readback" (through the CPU), and
+     * why the shared path was not taken where it was tried */
+    cJSON_AddStringToObject(obj, "display_path", v->gl ? "shared" : "readback");
+    if (v->path_why[0])
+        cJSON_AddStringToObject(obj, "display_fallback", v->path_why);
     cJSON_AddNumberToObject(obj, "wall_s", wall_s);
     for (int i = 0; i < v->num_stats; i++) {
         const algo_stat *s = &v->stats_by_algo[i];
@@ -2381,6 +2644,7 @@ static int write_stats_out(const viewer *v, double wall_s)
         cJSON_AddNumberToObject(e, "first_final_ms", s->first_final_ms);
         cJSON_AddNumberToObject(e, "first_prep_ms", s->prep_ms);
         cJSON_AddNumberToObject(e, "display_ms", s->displayed ? s->display_s * 1e3 / (double)s->displayed : 0.0);
+        cJSON_AddNumberToObject(e, "shared_frames", (double)s->shared_frames);
         cJSON_AddNumberToObject(e, "latency_ms", s->latency_n ? s->latency_s * 1e3 / (double)s->latency_n : 0.0);
         /* After the last restart: null where the run ended before the
          * image was stable (last_change says how far it was). */
@@ -2415,6 +2679,19 @@ static void close_viewer(viewer *v)
     }
     rl_renderer_release(v->wk.r);
     rl_renderer_release(v->wk.ref);
+    v->wk.r = v->wk.ref = NULL;
+    for (size_t i = 0; i < sizeof v->wk.parked / sizeof v->wk.parked[0]; i++) {
+        rl_renderer_release(v->wk.parked[i]);
+        v->wk.parked[i] = NULL;
+    }
+    if (v->gl) {
+        /* the textures still on their way, in the share group */
+        view_gl_delete(v->gl, &v->sh.front_tex);
+        for (int i = 0; i < v->sh.num_trash; i++)
+            view_gl_delete(v->gl, &v->sh.trash[i]);
+        view_gl_close(v->gl);
+        v->gl = NULL;
+    }
     rl_image_release(v->wk.ref_img);
     rl_image_release(v->wk.back);
     rl_image_release(v->sh.front);

@@ -95,6 +95,36 @@ typedef struct view_script {
 int view_script_load(const char *path, view_script *out);
 void view_script_free(view_script *s);
 
+/* view_gl.c: the window's EGL context shared with the GL backend, with
+ * SDL2 and the GL backend (stubs that fail otherwise). open takes the
+ * SDL_Window (made with SDL_WINDOW_OPENGL under
+ * SDL_HINT_VIDEO_X11_FORCE_EGL) and hands its context to rl_gl_share_with;
+ * NULL with the reason. The rest runs on the thread that opened it. */
+typedef struct view_gl view_gl;
+view_gl *view_gl_open(void *window, char *why, size_t n);
+void view_gl_close(view_gl *g);
+/* The image's (and the overlay's) size. */
+bool view_gl_resize(view_gl *g, int w, int h);
+/* A frame texture of the library, now shown (its fence waited on by the
+ * GPU, the last one deleted), or deleted unseen. */
+void view_gl_adopt(view_gl *g, const rl_gl_frame *f);
+void view_gl_delete(view_gl *g, const rl_gl_frame *f);
+/* The shown frame is no longer the image (a CPU frame replaced it). */
+void view_gl_drop_frame(view_gl *g);
+/* The shown frame's linear colour into dst (width x height); false when
+ * there is none. */
+bool view_gl_read(view_gl *g, rl_vec4 *dst);
+/* Draws the frame (use_frame) under the overlay (ARGB8888 as draw() makes
+ * it: alpha 255 text, else transparent or shaded, view_gl.c), uploading
+ * its first rows rows, and swaps. */
+void view_gl_present(view_gl *g, const uint32_t *overlay, int rows, bool use_frame);
+/* The same picture at the image's size into out (ARGB8888, top row
+ * first), for a script's capture: what the shader draws, not a CPU copy. */
+bool view_gl_capture(view_gl *g, const uint32_t *overlay, int rows, bool use_frame, uint32_t *out);
+/* Where the image lies in the drawable, and the drawable's size. */
+void view_gl_viewport(const view_gl *g, int *x, int *y, int *w, int *h);
+void view_gl_drawable_size(const view_gl *g, int *w, int *h);
+
 /* cmd_view.c with SDL2, or the message that it is missing. */
 int view_run(int argc, char **argv);
 

@@ -58,6 +58,53 @@ RL_API rl_status rl_gl_info_get(const char *device, rl_gl_info *out);
 RL_API rl_status rl_gl_drawer_create(const rl_scene *scene, const rl_drawer_desc *desc, const char *device,
                                      rl_drawer **out);
 
+/* Sharing with the caller's context (docs/gl.md, "Sharing with a window").
+ *
+ * By default the backend's contexts live on a display of their own and
+ * share nothing, so a GL renderer's frame reaches a caller only as an
+ * rl_image read back to the CPU. rl_gl_share_with hands the backend an
+ * initialised EGLDisplay and an OpenGL EGLContext of that display (a
+ * window's: SDL with SDL_HINT_VIDEO_X11_FORCE_EGL, GLFW's EGL context),
+ * passed as void * so that this header needs no EGL headers. From then on
+ * every context the backend makes is an OpenGL 4.5 core context on that
+ * display in that context's share group, whatever device the renderers
+ * name, and a GL renderer can hand its frame over as a texture
+ * (rl_renderer_set_gl_output, rl_render.h). EGL shares objects only
+ * between contexts of one display, hence the display.
+ *
+ * Call it before the first GL renderer renders: RL_ERR_INVALID_ARG while
+ * any context of the backend exists. It tries a context sharing with the
+ * given one and fails with RL_ERR_UNSUPPORTED and EGL's error where there
+ * is none (another API, a display without EGL_KHR_no_config_context or
+ * EGL_KHR_surfaceless_context, a driver that refuses); sharing then stays
+ * as it was. The calling thread's current context is left as it was.
+ * rl_gl_share_with(NULL, NULL) stops sharing (again only while no context
+ * exists). The caller keeps the display and context alive and current
+ * wherever it likes until every GL renderer is released: the backend
+ * never terminates the display. While sharing, the backend's contexts are
+ * made current on the thread that renders and let go afterwards, the
+ * thread's own context (the window's) current again.
+ *
+ * Objects of a backend context are shared with the caller's group: they
+ * outlive the backend context until the caller's is destroyed, except the
+ * frame textures (rl_renderer_take_gl_frame), which change owner. */
+RL_API rl_status rl_gl_share_with(void *egl_display, void *egl_context);
+
+/* A GL renderer's frame handed over as a texture (rl_renderer_take_gl_frame). */
+typedef struct rl_gl_frame {
+    /* A GL_TEXTURE_2D of internal format GL_RGBA32F, width x height, the
+     * frame's linear colour exactly as the read-back rl_image would hold it
+     * (alpha 1), row 0 the image's top row (texture coordinate t = 0 at the
+     * top). Owned by the caller, who deletes it with glDeleteTextures in a
+     * context of the share group. */
+    uint32_t texture;
+    int width, height;
+    /* A GLsync made after the last write to texture and flushed: the caller
+     * waits on it (glWaitSync, or glClientWaitSync) in its context before
+     * it samples texture, then deletes it (glDeleteSync). */
+    void *fence;
+} rl_gl_frame;
+
 /* Line Space generation on the GPU (Schröder 2017, Sec. 7; docs/gl.md,
  * "Line Space on GL"), for benchmarks: builds the candidate lists of
  * rl_linespace_create(grid, desc) with compute shaders in a context of its

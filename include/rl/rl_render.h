@@ -19,6 +19,7 @@
 
 #include "rl/rl_camera.h"
 #include "rl/rl_common.h"
+#include "rl/rl_gl.h"
 #include "rl/rl_image.h"
 #include "rl/rl_options.h"
 #include "rl/rl_scene.h"
@@ -175,6 +176,29 @@ RL_API void rl_renderer_set_progress(rl_renderer *r, rl_progress_fn fn, void *us
  * be NULL; otherwise it is overwritten. */
 RL_API rl_status rl_renderer_render(rl_renderer *r, const rl_scene *scene, const rl_camera *cam,
                                     rl_image *image, rl_render_stats *stats);
+
+/* GL renderers' frames as textures (docs/gl.md, "Sharing with a window").
+ *
+ * rl_renderer_set_gl_output(r, true), after rl_gl_share_with (rl_gl.h),
+ * keeps r's frames on the GPU: a successful render copies the frame's
+ * colour into a new texture of the caller's share group with a fence and
+ * does not write the image's colour layer (the other layers are written
+ * as before; the colour layer may be cleared to the background on the way).
+ * rl_renderer_take_gl_frame then hands that texture over (rl_gl_frame: the
+ * caller owns it, waits on the fence before sampling and deletes both).
+ * A frame the renderer finishes on the CPU writes the image as without
+ * texture output and offers no texture: gl-pt with a filter, or on the
+ * first frame of a checkerboard accumulation (half its pixels are filled
+ * in from their neighbours). A texture not taken is deleted by the next
+ * frame or the release. false turns it off (the default): frames are read
+ * back into the image, as always.
+ *
+ * RL_ERR_UNSUPPORTED for a renderer without GL frames (every CPU renderer)
+ * and, for true, where the GL backend does not share with the caller;
+ * RL_ERR_NOT_FOUND from take where no texture waits (output off, taken,
+ * the frame went to the image, or the render failed). */
+RL_API rl_status rl_renderer_set_gl_output(rl_renderer *r, bool texture);
+RL_API rl_status rl_renderer_take_gl_frame(rl_renderer *r, rl_gl_frame *out);
 
 /* A renderer class written outside the library (rl_renderer_register).
  * The built-ins are described the same way inside src/render/. */

@@ -42,6 +42,13 @@ struct rl_gl_context {
     EGLDisplay dpy;
     EGLContext ctx;
     const rl_gl_info *info;
+    /* What was current on the thread before make_current, restored by
+     * done: with rl_gl_share_with the calling thread may hold the caller's
+     * context (a viewer's window), which a frame must not take away. */
+    EGLDisplay prev_dpy;
+    EGLSurface prev_draw, prev_read;
+    EGLContext prev_ctx;
+    bool have_prev;
 };
 
 /* One entry per device name asked for: whether it works, its display
@@ -59,6 +66,18 @@ static pthread_mutex_t lock = PTHREAD_MUTEX_INITIALIZER;
 static device_entry devices[MAX_DEVICES];
 static int num_devices;
 
+/* rl_gl_share_with: the caller's display and context. While on, every
+ * context is made on that display in the caller's share group, whatever
+ * device was asked for, and the entry stands for all devices. */
+static struct {
+    bool on;
+    EGLContext ctx;
+    device_entry entry;
+} share;
+/* Contexts made and not yet released (rl_gl_share_with refuses to switch
+ * while any lives: they would sit in two share groups at once). */
+static int live_contexts;
+
 static bool has_word(const char *list, const char *word)
 {
     size_t n = strlen(word);
@@ -68,7 +87,7 @@ static bool has_word(const char *list, const char *word)
     return false;
 }
 
-static EGLContext make_context(EGLDisplay dpy)
+static EGLContext make_context(EGLDisplay dpy, EGLContext share_with)
 {
     static const EGLint attribs[] = {
         EGL_CONTEXT_MAJOR_VERSION, 4, EGL_CONTEXT_MINOR_VERSION, 5,
@@ -76,7 +95,7 @@ static EGLContext make_context(EGLDisplay dpy)
     };
     if (!eglBindAPI(EGL_OPENGL_API))
         return EGL_NO_CONTEXT;
-    return eglCreateContext(dpy, EGL_NO_CONFIG_KHR, EGL_NO_CONTEXT, attribs);
+    return eglCreateContext(dpy, EGL_NO_CONFIG_KHR, share_with, attribs);
 }
 
 /* Initialises dpy and proves it with a 4.5 core context, whose strings go
@@ -99,7 +118,7 @@ static bool try_display(EGLDisplay dpy, const char *label, device_entry *e)
         eglTerminate(dpy);
         return false;
     }
-    EGLContext ctx = make_context(dpy);
+    EGLContext ctx = make_context(dpy, EGL_NO_CONTEXT);
     if (ctx == EGL_NO_CONTEXT || !eglMakeCurrent(dpy, EGL_NO_SURFACE, EGL_NO_SURFACE, ctx)) {
         snprintf(e->why, sizeof e->why, "%s: no OpenGL 4.5 core context (EGL error 0x%x)", label,
                  (unsigned)eglGetError());
@@ -209,6 +228,8 @@ static const device_entry *find_device(const char *device, device_entry *scratch
     const char *name = resolve_device(device);
     const device_entry *found = NULL;
     pthread_mutex_lock(&lock);
+    if (share.on)
+        found = &share.entry;
     for (int i = 0; i < num_devices && !found; ++i)
         if (strcmp(devices[i].name, name) == 0)
             found = &devices[i];
@@ -261,9 +282,15 @@ rl_status rl_gl_context_create(const char *device, rl_gl_context **out)
     rl_gl_context *c = rl_calloc(1, sizeof *c);
     if (!c)
         return RL_ERR_OUT_OF_MEMORY;
+    pthread_mutex_lock(&lock);
+    /* e is the share entry exactly while sharing is on (find_device). */
+    EGLContext share_with = share.on && e == &share.entry ? share.ctx : EGL_NO_CONTEXT;
     c->dpy = e->dpy;
     c->info = &e->info;
-    c->ctx = make_context(e->dpy);
+    c->ctx = make_context(e->dpy, share_with);
+    if (c->ctx != EGL_NO_CONTEXT)
+        live_contexts++;
+    pthread_mutex_unlock(&lock);
     if (c->ctx == EGL_NO_CONTEXT) {
         free(c);
         return rl_error(RL_ERR_UNSUPPORTED, "OpenGL unavailable: %s: eglCreateContext failed (EGL error 0x%x)",
@@ -271,8 +298,7 @@ rl_status rl_gl_context_create(const char *device, rl_gl_context **out)
     }
     rl_status st = rl_gl_context_make_current(c);
     if (st != RL_OK) {
-        eglDestroyContext(c->dpy, c->ctx);
-        free(c);
+        rl_gl_context_release(c);
         return st;
     }
     *out = c;
@@ -281,18 +307,30 @@ rl_status rl_gl_context_create(const char *device, rl_gl_context **out)
 
 rl_status rl_gl_context_make_current(rl_gl_context *c)
 {
-    if (eglGetCurrentContext() == c->ctx)
+    EGLContext cur = eglGetCurrentContext();
+    if (cur == c->ctx)
         return RL_OK;
+    EGLDisplay prev_dpy = eglGetCurrentDisplay();
+    EGLSurface prev_draw = eglGetCurrentSurface(EGL_DRAW), prev_read = eglGetCurrentSurface(EGL_READ);
     if (!eglBindAPI(EGL_OPENGL_API) || !eglMakeCurrent(c->dpy, EGL_NO_SURFACE, EGL_NO_SURFACE, c->ctx))
         return rl_error(RL_ERR_INTERNAL, "gl: eglMakeCurrent failed (EGL error 0x%x): is the drawer in use on "
                         "another thread?", (unsigned)eglGetError());
+    c->have_prev = cur != EGL_NO_CONTEXT;
+    c->prev_dpy = prev_dpy;
+    c->prev_draw = prev_draw;
+    c->prev_read = prev_read;
+    c->prev_ctx = cur;
     return RL_OK;
 }
 
 void rl_gl_context_done(rl_gl_context *c)
 {
-    if (c && eglGetCurrentContext() == c->ctx)
+    if (!c || eglGetCurrentContext() != c->ctx)
+        return;
+    /* The caller's own context (a window's, rl_gl_share_with) comes back. */
+    if (!c->have_prev || !eglMakeCurrent(c->prev_dpy, c->prev_draw, c->prev_read, c->prev_ctx))
         eglMakeCurrent(c->dpy, EGL_NO_SURFACE, EGL_NO_SURFACE, EGL_NO_CONTEXT);
+    c->have_prev = false;
 }
 
 const rl_gl_info *rl_gl_context_info(const rl_gl_context *c) { return c->info; }
@@ -301,10 +339,90 @@ void rl_gl_context_release(rl_gl_context *c)
 {
     if (!c)
         return;
-    if (eglGetCurrentContext() == c->ctx)
-        eglMakeCurrent(c->dpy, EGL_NO_SURFACE, EGL_NO_SURFACE, EGL_NO_CONTEXT);
-    eglDestroyContext(c->dpy, c->ctx);
+    rl_gl_context_done(c);
+    if (c->ctx != EGL_NO_CONTEXT) {
+        eglDestroyContext(c->dpy, c->ctx);
+        pthread_mutex_lock(&lock);
+        live_contexts--;
+        pthread_mutex_unlock(&lock);
+    }
     free(c);
+}
+
+bool rl_gl_share_active(void)
+{
+    pthread_mutex_lock(&lock);
+    bool on = share.on;
+    pthread_mutex_unlock(&lock);
+    return on;
+}
+
+rl_status rl_gl_share_with(void *egl_display, void *egl_context)
+{
+    if (!egl_display != !egl_context)
+        return rl_error(RL_ERR_INVALID_ARG, "rl_gl_share_with: the display and the context go together (both "
+                        "NULL to stop sharing)");
+    pthread_mutex_lock(&lock);
+    if (live_contexts > 0) {
+        int n = live_contexts;
+        pthread_mutex_unlock(&lock);
+        return rl_error(RL_ERR_INVALID_ARG, "rl_gl_share_with: %d GL context%s of the library exist%s already; "
+                        "call it before the first GL renderer renders", n, n == 1 ? "" : "s", n == 1 ? "s" : "");
+    }
+    if (!egl_display) {
+        share.on = false;
+        pthread_mutex_unlock(&lock);
+        return RL_OK;
+    }
+    device_entry e = { .name = "shared" };
+    EGLDisplay dpy = (EGLDisplay)egl_display;
+    rl_status st = RL_OK;
+    const char *ext = epoxy_has_egl() ? eglQueryString(dpy, EGL_EXTENSIONS) : NULL;
+    if (!ext)
+        st = rl_error(RL_ERR_UNSUPPORTED, "rl_gl_share_with: not an initialised EGL display (EGL error 0x%x)",
+                      epoxy_has_egl() ? (unsigned)eglGetError() : 0u);
+    else if (!has_word(ext, "EGL_KHR_no_config_context") && !has_word(ext, "EGL_MESA_configless_context"))
+        st = rl_error(RL_ERR_UNSUPPORTED, "rl_gl_share_with: the display has no EGL_KHR_no_config_context");
+    else if (!has_word(ext, "EGL_KHR_surfaceless_context"))
+        st = rl_error(RL_ERR_UNSUPPORTED, "rl_gl_share_with: the display has no EGL_KHR_surfaceless_context");
+    if (st == RL_OK) {
+        /* A probe context in the caller's share group: EGL refuses one
+         * whose share context is of another display or API. The caller's
+         * binding on this thread comes back afterwards. */
+        EGLDisplay prev_dpy = eglGetCurrentDisplay();
+        EGLSurface prev_draw = eglGetCurrentSurface(EGL_DRAW), prev_read = eglGetCurrentSurface(EGL_READ);
+        EGLContext prev_ctx = eglGetCurrentContext();
+        EGLenum prev_api = eglQueryAPI();
+        EGLContext probe = make_context(dpy, (EGLContext)egl_context);
+        if (probe == EGL_NO_CONTEXT || !eglMakeCurrent(dpy, EGL_NO_SURFACE, EGL_NO_SURFACE, probe)) {
+            st = rl_error(RL_ERR_UNSUPPORTED, "rl_gl_share_with: no OpenGL 4.5 core context sharing with the "
+                          "given one (EGL error 0x%x)", (unsigned)eglGetError());
+        } else {
+            const char *vendor = (const char *)glGetString(GL_VENDOR);
+            const char *renderer = (const char *)glGetString(GL_RENDERER);
+            const char *version = (const char *)glGetString(GL_VERSION);
+            copy_text(e.info.vendor, sizeof e.info.vendor, vendor ? vendor : "?");
+            copy_text(e.info.renderer, sizeof e.info.renderer, renderer ? renderer : "?");
+            copy_text(e.info.version, sizeof e.info.version, version ? version : "?");
+            copy_text(e.info.device, sizeof e.info.device, "shared");
+        }
+        if (prev_ctx != EGL_NO_CONTEXT)
+            eglMakeCurrent(prev_dpy, prev_draw, prev_read, prev_ctx);
+        else
+            eglMakeCurrent(dpy, EGL_NO_SURFACE, EGL_NO_SURFACE, EGL_NO_CONTEXT);
+        if (probe != EGL_NO_CONTEXT)
+            eglDestroyContext(dpy, probe);
+        eglBindAPI(prev_api);
+    }
+    if (st == RL_OK) {
+        e.ok = true;
+        e.dpy = dpy;
+        share.entry = e;
+        share.ctx = (EGLContext)egl_context;
+        share.on = true;
+    }
+    pthread_mutex_unlock(&lock);
+    return st;
 }
 
 #else /* !RL_HAVE_GL */
@@ -348,5 +466,14 @@ const rl_gl_info *rl_gl_context_info(const rl_gl_context *ctx)
 }
 
 void rl_gl_context_release(rl_gl_context *ctx) { (void)ctx; }
+
+bool rl_gl_share_active(void) { return false; }
+
+rl_status rl_gl_share_with(void *egl_display, void *egl_context)
+{
+    if (!egl_display && !egl_context)
+        return RL_OK;
+    return rl_error(RL_ERR_UNSUPPORTED, "rl_gl_share_with: " NO_GL);
+}
 
 #endif

@@ -39,6 +39,7 @@
 
 #ifdef RL_HAVE_GL
 
+#include "gl/gl_frame.h"
 #include "gl/gl_shaders.h"
 
 /* Uniform locations of one program (-1: not used by it). */
@@ -79,6 +80,11 @@ typedef struct gl_drawer {
     /* The framebuffer, remade when the target's size changes. */
     GLuint fbo, tex_color, tex_depth, tex_object, tex_triangle, depth_buffer, tex_depth_in;
     int fb_width, fb_height;
+    /* Texture output (gl_frame.h): the last frame's colour, not yet taken. */
+    bool texture_out;
+    rl_gl_frame out;
+    bool clear_set;               /* texture output: the target's colour is clear_color */
+    float clear_color[4];
     /* The frame. */
     rl_image *target;
     rl_mat4 view_proj;
@@ -99,11 +105,27 @@ static void free_framebuffer(gl_drawer *g)
     g->fb_width = g->fb_height = 0;
 }
 
+/* Deletes the frame texture nobody took (the context current). */
+static void drop_frame(gl_drawer *g)
+{
+    if (g->out.fence)
+        glDeleteSync((GLsync)g->out.fence);
+    if (g->out.texture)
+        glDeleteTextures(1, &g->out.texture);
+    g->out = (rl_gl_frame){ 0 };
+}
+
 static void gl_release(void *impl)
 {
     gl_drawer *g = impl;
     if (!g)
         return;
+    /* A frame texture lives in the caller's share group, which outlives
+     * this context: deleted here, unlike the context's other objects. */
+    if ((g->out.texture || g->out.fence) && rl_gl_context_make_current(g->ctx) == RL_OK) {
+        drop_frame(g);
+        rl_gl_context_done(g->ctx);
+    }
     /* The context's objects go with it; they are not deleted one by one. */
     rl_gl_context_release(g->ctx);
     free(g->pool);
@@ -471,6 +493,8 @@ static rl_status gl_begin(void *impl, rl_image *target, const rl_mat4 *view, con
     if (st != RL_OK)
         return settle(g, st);
     g->target = target;
+    /* An untaken texture of an earlier frame must not pass for this one's. */
+    drop_frame(g);
     g->counts_used = 0;           /* of a frame that failed */
     g->view_proj = rl_mat4_mul(proj, view);
     g->affine = proj->m[3][0] == 0.0f && proj->m[3][1] == 0.0f && proj->m[3][2] == 0.0f && proj->m[3][3] == 1.0f;
@@ -480,7 +504,9 @@ static rl_status gl_begin(void *impl, rl_image *target, const rl_mat4 *view, con
     set_camera(g, g->batch_prog, &g->batch_u, view, proj, eye);
 
     const int w = target->width, h = target->height;
-    if ((target->layers & RL_LAYER_COLOR) && target->color)
+    if (g->texture_out && g->clear_set)
+        glClearTexImage(g->tex_color, 0, GL_RGBA, GL_FLOAT, g->clear_color);
+    else if ((target->layers & RL_LAYER_COLOR) && target->color)
         glTextureSubImage2D(g->tex_color, 0, 0, 0, w, h, GL_RGBA, GL_FLOAT, target->color);
     else
         glClearTexImage(g->tex_color, 0, GL_RGBA, GL_FLOAT, NULL);
@@ -915,8 +941,26 @@ static rl_status gl_end(void *impl)
     read_counts(g);
     rl_image *t = g->target;
     const size_t n = (size_t)t->width * (size_t)t->height;
-    if ((t->layers & RL_LAYER_COLOR) && t->color)
+    if (g->texture_out && (t->layers & RL_LAYER_COLOR) && t->color) {
+        /* The colour stays on the GPU (gl_frame.h): the frame's colour
+         * attachment itself goes to the caller, and a new one takes its
+         * place, so that the next frame may draw while the caller shows
+         * this one, with no copy. */
+        drop_frame(g);
+        g->out.texture = g->tex_color;
+        glTextureParameteri(g->out.texture, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
+        glTextureParameteri(g->out.texture, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+        glCreateTextures(GL_TEXTURE_2D, 1, &g->tex_color);
+        glTextureStorage2D(g->tex_color, 1, GL_RGBA32F, t->width, t->height);
+        glNamedFramebufferTexture(g->fbo, GL_COLOR_ATTACHMENT0, g->tex_color, 0);
+        g->out.width = t->width;
+        g->out.height = t->height;
+        g->out.fence = glFenceSync(GL_SYNC_GPU_COMMANDS_COMPLETE, 0);
+        /* Another context waits on the fence only once it has reached the GPU. */
+        glFlush();
+    } else if ((t->layers & RL_LAYER_COLOR) && t->color) {
         glGetTextureImage(g->tex_color, 0, GL_RGBA, GL_FLOAT, (GLsizei)(n * sizeof(rl_vec4)), t->color);
+    }
     glGetTextureImage(g->tex_depth, 0, GL_RED, GL_FLOAT, (GLsizei)(n * sizeof(float)), t->depth);
     if ((t->layers & RL_LAYER_ID) && t->object_id)
         glGetTextureImage(g->tex_object, 0, GL_RED_INTEGER, GL_UNSIGNED_INT, (GLsizei)(n * sizeof(uint32_t)),
@@ -1000,6 +1044,35 @@ rl_status rl_gl_drawer_create(const rl_scene *scene, const rl_drawer_desc *desc,
     return rl_drawer_make(&gl_ops, g, scene, desc, out);
 }
 
+rl_status rl_gl_drawer_set_texture_output(rl_drawer *d, bool on)
+{
+    gl_drawer *g = rl_drawer_impl(d, &gl_ops);
+    if (!g)
+        return rl_error(RL_ERR_UNSUPPORTED, "gl: texture output needs a GL drawer");
+    g->texture_out = on;
+    return RL_OK;
+}
+
+void rl_gl_drawer_set_clear(rl_drawer *d, const float *rgba)
+{
+    gl_drawer *g = rl_drawer_impl(d, &gl_ops);
+    if (!g)
+        return;
+    g->clear_set = rgba != NULL;
+    if (rgba)
+        memcpy(g->clear_color, rgba, sizeof g->clear_color);
+}
+
+bool rl_gl_drawer_take_frame(rl_drawer *d, rl_gl_frame *out)
+{
+    gl_drawer *g = rl_drawer_impl(d, &gl_ops);
+    if (!g || !g->out.texture)
+        return false;
+    *out = g->out;
+    g->out = (rl_gl_frame){ 0 };
+    return true;
+}
+
 #else /* !RL_HAVE_GL */
 
 rl_status rl_gl_drawer_create(const rl_scene *scene, const rl_drawer_desc *desc, const char *device,
@@ -1011,6 +1084,26 @@ rl_status rl_gl_drawer_create(const rl_scene *scene, const rl_drawer_desc *desc,
         *out = NULL;
     rl_gl_context *ctx = NULL;
     return rl_gl_context_create(device, &ctx);
+}
+
+rl_status rl_gl_drawer_set_texture_output(rl_drawer *d, bool on)
+{
+    (void)d;
+    (void)on;
+    return rl_error(RL_ERR_UNSUPPORTED, "gl: texture output needs a GL drawer");
+}
+
+void rl_gl_drawer_set_clear(rl_drawer *d, const float *rgba)
+{
+    (void)d;
+    (void)rgba;
+}
+
+bool rl_gl_drawer_take_frame(rl_drawer *d, rl_gl_frame *out)
+{
+    (void)d;
+    (void)out;
+    return false;
 }
 
 #endif

@@ -126,6 +126,10 @@ struct rl_gl_pt {
     uint64_t counted;
     uint32_t start_count;
     bool adapt_counts;            /* tex_adapt's counts are this accumulation's */
+    /* texture output (rl_gl_pt_set_texture_output): the last frame's mean,
+     * not yet taken */
+    bool texture_out;
+    rl_gl_frame out;
     /* the ray counters (atomic_uint, one per rl_ray_type) */
     GLuint counters;
     /* the cube shadow maps (rl_gl_pt_set_shadowmaps): the depth pass's
@@ -520,12 +524,17 @@ static GLuint no_maps(void)
     return b;
 }
 
+static void drop_frame(rl_gl_pt *pt);
+
 void rl_gl_pt_release(rl_gl_pt *pt)
 {
     if (!pt)
         return;
-    if (pt->ls && rl_gl_context_make_current(pt->ctx) == RL_OK) {
+    if ((pt->ls || pt->out.texture || pt->out.fence) && rl_gl_context_make_current(pt->ctx) == RL_OK) {
         rl_gl_ls_release(pt->ls);
+        /* in the caller's share group (rl_gl_share_with) it would outlive
+         * the context */
+        drop_frame(pt);
         rl_gl_context_done(pt->ctx);
     }
     rl_gl_context_release(pt->ctx);   /* its objects go with it */
@@ -815,6 +824,16 @@ static rl_status adaptive_frame(rl_gl_pt *pt, const rl_gl_pt_frame *f, GLuint gx
     return RL_OK;
 }
 
+/* Deletes the frame texture nobody took (the context current). */
+static void drop_frame(rl_gl_pt *pt)
+{
+    if (pt->out.fence)
+        glDeleteSync((GLsync)pt->out.fence);
+    if (pt->out.texture)
+        glDeleteTextures(1, &pt->out.texture);
+    pt->out = (rl_gl_frame){ 0 };
+}
+
 static rl_status render_frame(rl_gl_pt *pt, const rl_gl_pt_frame *f, float *rgba, uint64_t rays[RL_GL_PT_RAY_TYPES],
                               uint64_t *samples, uint64_t *converged)
 {
@@ -946,6 +965,21 @@ static rl_status render_frame(rl_gl_pt *pt, const rl_gl_pt_frame *f, float *rgba
         glMemoryBarrier(GL_TEXTURE_UPDATE_BARRIER_BIT);
         glGetTextureSubImage(pt->tex_accum, 0, 0, 0, 0, w, h, 1, GL_RGBA, GL_FLOAT,
                              (GLsizei)((size_t)w * (size_t)h * 4 * sizeof(float)), rgba);
+    } else if (pt->texture_out) {
+        /* The mean stays on the GPU: a copy of the image's part of the
+         * accumulation (which may be larger) for the caller, and a fence. */
+        drop_frame(pt);
+        glMemoryBarrier(GL_TEXTURE_UPDATE_BARRIER_BIT);
+        glCreateTextures(GL_TEXTURE_2D, 1, &pt->out.texture);
+        glTextureStorage2D(pt->out.texture, 1, GL_RGBA32F, w, h);
+        glTextureParameteri(pt->out.texture, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
+        glTextureParameteri(pt->out.texture, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+        glCopyImageSubData(pt->tex_accum, GL_TEXTURE_2D, 0, 0, 0, 0, pt->out.texture, GL_TEXTURE_2D, 0, 0, 0, 0, w,
+                           h, 1);
+        pt->out.width = w;
+        pt->out.height = h;
+        pt->out.fence = glFenceSync(GL_SYNC_GPU_COMMANDS_COMPLETE, 0);
+        glFlush();
     } else {
         glFinish();
     }
@@ -970,8 +1004,11 @@ rl_status rl_gl_pt_render(rl_gl_pt *pt, const rl_gl_pt_frame *frame, float *rgba
                         "threshold >= 0 and no checkerboard");
     uint64_t rays[RL_GL_PT_RAY_TYPES] = { 0 }, samples = 0, converged = 0;
     rl_status st = rl_gl_context_make_current(pt->ctx);
-    if (st == RL_OK)
+    if (st == RL_OK) {
+        /* an untaken texture of an earlier frame must not pass for this one's */
+        drop_frame(pt);
         st = render_frame(pt, frame, rgba, rays, &samples, &converged);
+    }
     if (st != RL_OK && frame->reset_states) {
         pt->held[0] = pt->held[1] = 0;
         pt->frames = 0;
@@ -1009,6 +1046,20 @@ rl_status rl_gl_pt_sample_counts(rl_gl_pt *pt, uint32_t *counts)
     st = rl_gl_check("rl_gl_pt_sample_counts");
     rl_gl_context_done(pt->ctx);
     return st;
+}
+
+void rl_gl_pt_set_texture_output(rl_gl_pt *pt, bool on)
+{
+    pt->texture_out = on;
+}
+
+bool rl_gl_pt_take_frame(rl_gl_pt *pt, rl_gl_frame *out)
+{
+    if (!pt->out.texture)
+        return false;
+    *out = pt->out;
+    pt->out = (rl_gl_frame){ 0 };
+    return true;
 }
 
 rl_status rl_gl_pt_set_linespace(rl_gl_pt *pt, const rl_linespace *ls, const rl_accel *grid,
@@ -1347,6 +1398,19 @@ const rl_gl_info *rl_gl_pt_info(const rl_gl_pt *pt)
 {
     (void)pt;
     return NULL;
+}
+
+void rl_gl_pt_set_texture_output(rl_gl_pt *pt, bool on)
+{
+    (void)pt;
+    (void)on;
+}
+
+bool rl_gl_pt_take_frame(rl_gl_pt *pt, rl_gl_frame *out)
+{
+    (void)pt;
+    (void)out;
+    return false;
 }
 
 rl_status rl_gl_pt_render(rl_gl_pt *pt, const rl_gl_pt_frame *frame, float *rgba, rl_gl_pt_result *res)

@@ -144,6 +144,12 @@ typedef struct rl_gl_pt_result {
  * without reset_states on the first frame or a size change. res may be
  * NULL. */
 rl_status rl_gl_pt_render(rl_gl_pt *pt, const rl_gl_pt_frame *frame, float *rgba, rl_gl_pt_result *res);
+/* Texture output (gl_frame.h): a render with rgba NULL copies the mean of
+ * the image's w x h into a new texture with a fence (rl_gl.h, rl_gl_frame)
+ * instead of only finishing; take hands it over (false: none waiting). An
+ * untaken one is deleted by the next such render or the release. */
+void rl_gl_pt_set_texture_output(rl_gl_pt *pt, bool on);
+bool rl_gl_pt_take_frame(rl_gl_pt *pt, rl_gl_frame *out);
 
 /* The samples every pixel of the accumulation holds (width x height, row 0
  * the top row), kept per pixel only by adaptive frames: RL_ERR_INVALID_ARG

@@ -29,6 +29,11 @@ struct rl_drawer {
 
 enum { SLOT_FREE, SLOT_OPEN, SLOT_KEPT };
 
+void *rl_drawer_impl(const rl_drawer *d, const rl_drawer_ops *ops)
+{
+    return d && d->ops == ops ? d->impl : NULL;
+}
+
 rl_status rl_drawer_make(const rl_drawer_ops *ops, void *impl, const rl_scene *scene, const rl_drawer_desc *desc,
                          rl_drawer **out)
 {

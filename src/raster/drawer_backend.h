@@ -31,4 +31,8 @@ typedef struct rl_drawer_ops {
 rl_status rl_drawer_make(const rl_drawer_ops *ops, void *impl, const rl_scene *scene, const rl_drawer_desc *desc,
                          rl_drawer **out);
 
+/* The impl of d when d was made with ops, else NULL: for calls that only one
+ * backend offers (the GL drawer's frame texture, src/gl/gl_frame.h). */
+void *rl_drawer_impl(const rl_drawer *d, const rl_drawer_ops *ops);
+
 #endif

@@ -176,6 +176,7 @@ typedef struct gl_pt_state {
     rl_drawer *drawer;
     char drawer_device[64];
     rl_image *ids;
+    bool texture_out;             /* rl_renderer_set_gl_output */
 } gl_pt_state;
 
 static void gl_pt_release(void *state)
@@ -633,8 +634,16 @@ static rl_status gl_pt_render(rl_renderer *r, void *state, const rl_scene *scene
         s->force_reset = true;
         return rl_error(RL_ERR_UNSUPPORTED, "gl-pt: adaptive=on with checkerboard is not ported to GL (pt has it)");
     }
+    pt_settings fs;
+    filter_settings(r, &fs);
+    /* Texture output (rl_renderer_set_gl_output) where the GPU's mean is
+     * the image: not with a filter (CPU, on the read-back image) nor on a
+     * checkerboard accumulation's first frame, whose untraced half
+     * resolve() fills in from the neighbours. */
+    const bool texture = s->texture_out && fs.filter == RL_FILTER_NONE && !(f.checkerboard && reset);
+    rl_gl_pt_set_texture_output(s->gpu, texture);
     rl_gl_pt_result res;
-    st = rl_gl_pt_render(s->gpu, &f, s->rgba, &res);
+    st = rl_gl_pt_render(s->gpu, &f, texture ? NULL : s->rgba, &res);
     free(states);
     if (st != RL_OK) {
         s->force_reset = true;
@@ -643,14 +652,13 @@ static rl_status gl_pt_render(rl_renderer *r, void *state, const rl_scene *scene
     s->valid = true;
     s->force_reset = false;
     s->frames++;
-    resolve(s->rgba, res.held, cam->width, cam->height, image);
+    if (!texture)
+        resolve(s->rgba, res.held, cam->width, cam->height, image);
 
     /* pathtrace.c active(): x + y + frame even holds for the larger half
      * when both sides are odd */
     const uint64_t even = (cam->width & cam->height & 1) ? (n + 1) / 2 : n / 2;
     const uint64_t traced = !f.checkerboard ? n : (res.frames - 1) % 2 == 0 ? even : n - even;
-    pt_settings fs;
-    filter_settings(r, &fs);
     bool layers = ((image->layers & RL_LAYER_DEPTH) && image->depth) ||
                   ((image->layers & RL_LAYER_ID) && image->object_id && image->triangle_id);
     if (layers || fs.filter != RL_FILTER_NONE) {
@@ -694,6 +702,18 @@ rl_status rl_gl_pt_renderer_sample_counts(const rl_renderer *r, uint32_t *counts
     return rl_gl_pt_sample_counts(s->gpu, counts);
 }
 
+static void gl_pt_gl_output(void *state, bool on)
+{
+    gl_pt_state *s = state;
+    s->texture_out = on;
+}
+
+static bool gl_pt_take_gl_frame(void *state, rl_gl_frame *out)
+{
+    gl_pt_state *s = state;
+    return s->gpu && rl_gl_pt_take_frame(s->gpu, out);
+}
+
 const rl_renderer_class rl_gl_pt_renderer_class = {
     .info = { .name = "gl-pt",
               .description = "pt on OpenGL 4.5 compute shaders (headless EGL): the same estimator, BVH, grid "
@@ -713,4 +733,6 @@ const rl_renderer_class rl_gl_pt_renderer_class = {
     .check = gl_pt_check,
     .reset = gl_pt_reset_state,
     .available = gl_pt_available,
+    .gl_output = gl_pt_gl_output,
+    .take_gl_frame = gl_pt_take_gl_frame,
 };

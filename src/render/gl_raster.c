@@ -21,6 +21,7 @@
 
 #include "core/error.h"
 #include "render/culling.h"
+#include "gl/gl_frame.h"
 #include "render/renderer.h"
 #include "rl/rl_drawer.h"
 #include "rl/rl_gl.h"
@@ -42,6 +43,7 @@ static const rl_option_info gl_raster_options[] = {
 
 typedef struct gl_raster_state {
     rl_drawer *drawer;
+    bool texture_out;             /* rl_renderer_set_gl_output */
     char device[64];              /* the device option the drawer was made on */
     char info[528];               /* rl_render_stats.device: the three strings of rl_gl_info */
 } gl_raster_state;
@@ -74,9 +76,17 @@ static rl_status gl_raster_render(rl_renderer *r, void *state, const rl_scene *s
     /* The drawer needs a depth layer; borrowed as raster does, and the
      * target cleared before the frame begins (the GL drawer uploads it). */
     rl_cull_target target;
-    rl_status st = rl_cull_target_begin(image, rl_renderer_opt_color(r, "background"), &target);
+    const rl_vec3 bg = rl_renderer_opt_color(r, "background");
+    /* With texture output the colour never visits the CPU: the GL drawer
+     * clears it to the background itself (rl_gl_drawer_set_clear), so the
+     * image's colour is neither filled nor uploaded. */
+    rl_image view = *image;
+    if (s->texture_out)
+        view.color = NULL;
+    rl_status st = rl_cull_target_begin(&view, bg, &target);
     if (st != RL_OK)
         return st;
+    target.image.color = image->color;
     desc.flags |= target.flags;
     if (!rl_drawer_fits(s->drawer, scene, &desc) || strcmp(s->device, device) != 0) {
         rl_drawer_release(s->drawer);
@@ -87,6 +97,8 @@ static rl_status gl_raster_render(rl_renderer *r, void *state, const rl_scene *s
         rl_timer_start(&timer);
         if (st == RL_OK)
             st = rl_gl_drawer_create(scene, &desc, device, &s->drawer);
+        if (st == RL_OK)
+            st = rl_gl_drawer_set_texture_output(s->drawer, s->texture_out);
         stats->prep_ms = rl_timer_ms(&timer);
         if (st == RL_OK) {
             snprintf(s->device, sizeof s->device, "%s", device);
@@ -95,12 +107,29 @@ static rl_status gl_raster_render(rl_renderer *r, void *state, const rl_scene *s
                 snprintf(s->info, sizeof s->info, "%s | %s | %s", info.vendor, info.renderer, info.version);
         }
     }
+    const float clear[4] = { bg.x, bg.y, bg.z, 1.0f };
+    if (st == RL_OK)
+        rl_gl_drawer_set_clear(s->drawer, s->texture_out ? clear : NULL);
     if (st == RL_OK)
         st = rl_cull_draw_all(r, s->drawer, &target, cam, d->bounds, stats);
     rl_cull_target_end(&target);
     if (st == RL_OK)
         stats->device = s->info[0] ? s->info : NULL;
     return st;
+}
+
+static void gl_raster_gl_output(void *state, bool on)
+{
+    gl_raster_state *s = state;
+    s->texture_out = on;
+    if (s->drawer)
+        rl_gl_drawer_set_texture_output(s->drawer, on);
+}
+
+static bool gl_raster_take_gl_frame(void *state, rl_gl_frame *out)
+{
+    gl_raster_state *s = state;
+    return s->drawer && rl_gl_drawer_take_frame(s->drawer, out);
 }
 
 const rl_renderer_class rl_gl_raster_renderer_class = {
@@ -114,4 +143,6 @@ const rl_renderer_class rl_gl_raster_renderer_class = {
     .release = gl_raster_release,
     .check = NULL,
     .available = gl_raster_available,
+    .gl_output = gl_raster_gl_output,
+    .take_gl_frame = gl_raster_take_gl_frame,
 };

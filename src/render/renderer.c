@@ -16,6 +16,7 @@
 #include "core/error.h"
 #include "core/options.h"
 #include "core/threads.h"
+#include "gl/gl_context.h"
 #include "rl/rl_timer.h"
 
 struct rl_renderer {
@@ -269,6 +270,33 @@ rl_status rl_renderer_set(rl_renderer *r, const char *key, const char *value)
         return RL_OK;
     snprintf(clamped, sizeof clamped, "%d", most);
     return rl_option_store_set(&r->options, "threads", clamped, r->cls->info.name, r->cls->check);
+}
+
+rl_status rl_renderer_set_gl_output(rl_renderer *r, bool texture)
+{
+    if (!r)
+        return rl_error(RL_ERR_INVALID_ARG, "rl_renderer_set_gl_output: NULL renderer");
+    if (!r->cls->gl_output)
+        return rl_error(RL_ERR_UNSUPPORTED, "%s: no GL frame texture (only the GL renderers have one)",
+                        r->cls->info.name);
+    if (texture && !rl_gl_share_active())
+        return rl_error(RL_ERR_UNSUPPORTED, "%s: a GL frame texture needs a context shared with the caller's "
+                        "(rl_gl_share_with)", r->cls->info.name);
+    r->cls->gl_output(r->state, texture);
+    return RL_OK;
+}
+
+rl_status rl_renderer_take_gl_frame(rl_renderer *r, rl_gl_frame *out)
+{
+    if (!r || !out)
+        return rl_error(RL_ERR_INVALID_ARG, "rl_renderer_take_gl_frame: NULL argument");
+    if (!r->cls->take_gl_frame)
+        return rl_error(RL_ERR_UNSUPPORTED, "%s: no GL frame texture (only the GL renderers have one)",
+                        r->cls->info.name);
+    if (!r->cls->take_gl_frame(r->state, out))
+        return rl_error(RL_ERR_NOT_FOUND, "%s: no GL frame waiting (texture output off, taken already, or the "
+                        "last frame went to the image)", r->cls->info.name);
+    return RL_OK;
 }
 
 void rl_renderer_reset(rl_renderer *r)

@@ -42,6 +42,12 @@ typedef struct rl_renderer_class {
      * samples are the frame's samples over all its regions. */
     rl_status (*finish_regions)(rl_renderer *r, void *state, const rl_scene *scene, const rl_camera *cam,
                                 rl_image *image, uint64_t samples);
+    /* Optional, GL renderers (rl_renderer_set_gl_output): texture output
+     * on or off, and the last frame's texture handed over (false: the
+     * last render wrote the image instead, or it was taken). NULL: the
+     * renderer's frames exist only as rl_images. */
+    void (*gl_output)(void *state, bool on);
+    bool (*take_gl_frame)(void *state, rl_gl_frame *out);
 } rl_renderer_class;
 
 /* At most this many input slots per class. */
