@@ -48,6 +48,7 @@ typedef struct pt_settings {
     bool sobol;                    /* rng=sobol, else the GPU generator rng */
     rl_rng_gpu_kind rng;
     uint64_t seed;
+    uint32_t sample_offset;        /* rng=sobol: Sobol index of an accumulation's first sample */
     rl_pt_backend shadow, diffuse;
     rl_pt_backend specular;        /* mirror and refraction rays (option specular) */
     pt_primary primary;
