@@ -105,7 +105,11 @@ static const char bench_pt_help[] =
     "  --spp-max N       samples accumulated per variant in the error section; default 64\n"
     "  --conv-size N     convergence: image side; default 512 (quick: 64)\n"
     "  --conv-ref-spp N  convergence: reference samples, rendered once and cached\n"
-    "                    beside --out; default 4096 (quick: 64); 16384 on a big machine\n"
+    "                    beside --out; default 4096 (quick: 64); 16384 on a big machine;\n"
+    "                    progress is saved beside it (.part) and a rerun continues it\n"
+    "  --conv-ref-budget S  convergence: stop rendering the reference after S seconds\n"
+    "                    (wall clock, at a chunk's end), save it and exit 1; rerun the\n"
+    "                    same command to go on; default 0 = no limit\n"
     "  --conv-spp-max N  convergence: the longest curves' samples; default 1024 (quick: 16)\n"
     "  --conv-configs L  convergence: only these configurations (defaults, thesis,\n"
     "                    mis=off, rng=hybrid, rr=false, light_samples=2, light_samples=4,\n"
@@ -180,6 +184,7 @@ typedef struct bpt_args {
     long long builds;              /* generation: fastest of this many builds */
     long long fixed_k;             /* generation: fixed lists of k for the cost of dynamic ones */
     long long conv_size, conv_ref_spp, conv_spp_max;
+    double conv_ref_budget;        /* seconds of reference rendering per run; 0 = no limit */
     const char *conv_configs;
     bool has_conv_size, has_conv_ref_spp, has_conv_spp_max;
     bool has_size, has_err_size, has_ref_spp, has_spp_max, has_builds, has_fixed_k, quick, small_pages;
@@ -1641,7 +1646,8 @@ static rl_status sec_convergence(void *ctx, cJSON *sec)
     bpt *b = ctx;
     bench_pt_conv_args ca = { .size = (int)b->a->conv_size, .ref_spp = b->a->conv_ref_spp,
                               .spp_max = b->a->conv_spp_max, .threads = b->threads, .out_path = b->out_path,
-                              .configs = b->a->conv_configs };
+                              .configs = b->a->conv_configs, .ref_budget_s = b->a->conv_ref_budget,
+                              .reason = b->reason, .reason_size = sizeof b->reason };
     return bench_pt_convergence(&ca, sec);
 }
 
@@ -1672,6 +1678,7 @@ static int parse_args(int argc, char **argv, bpt_args *a)
         RL_BENCH_COUNT("--conv-ref-spp", 1 << 20, &a->conv_ref_spp, &a->has_conv_ref_spp),
         RL_BENCH_COUNT("--conv-spp-max", 1 << 20, &a->conv_spp_max, &a->has_conv_spp_max),
         RL_BENCH_STRING("--conv-configs", &a->conv_configs),
+        RL_BENCH_REAL("--conv-ref-budget", 0.0, 1e9, &a->conv_ref_budget, NULL),
         RL_BENCH_COUNT("--threads", 1024, &a->threads, NULL),
         RL_BENCH_SECTIONS(section_names, SEC_COUNT, &a->sections),
         RL_BENCH_OUT(&a->out),
@@ -1733,6 +1740,7 @@ static cJSON *params_json(const bpt *b)
     cJSON_AddNumberToObject(o, "conv_size", (double)a->conv_size);
     cJSON_AddNumberToObject(o, "conv_ref_spp", (double)a->conv_ref_spp);
     cJSON_AddNumberToObject(o, "conv_spp_max", (double)a->conv_spp_max);
+    cJSON_AddNumberToObject(o, "conv_ref_budget_s", a->conv_ref_budget);
     cJSON_AddStringToObject(o, "sampling",
                             "all sections but convergence: rng=hybrid, mis=off, light_samples=1, rr_depth=2 "
                             "(the thesis; pt's defaults before issue 37)");

@@ -21,7 +21,10 @@
  * variance of their mean, and the halves are independent), and that is
  * subtracted from each measured MSE, so the figures estimate the RMSE
  * against the converged image. The reference is cached next to the JSON
- * record (pt-convergence-ref-SIZE-SPP.bin) and reused when it matches.
+ * record (pt-convergence-ref-SIZE-SPP.bin) and reused when it matches;
+ * while it is rendered its progress is saved beside it (.bin.part), so an
+ * interrupted run or one stopped by --conv-ref-budget continues where it
+ * ended when the same command runs again (render_reference).
  *
  * Time: per configuration the accumulation runs in frames that end at the
  * checkpoints 4, 8, ..., --conv-spp-max spp; each checkpoint records the
@@ -178,32 +181,6 @@ static rl_status make_renderer(const bench_pt_conv_args *a, const char *const *o
     return st;
 }
 
-/* Renders spp samples into rgb (3 floats per pixel), in frames of the
- * largest power of two up to 64 that divides spp: the frame size is set
- * once, since changing any option restarts the accumulation. */
-static rl_status render_spp(rl_renderer *r, const rl_scene *scene, const rl_camera *cam, long long spp,
-                            rl_image *img, float *rgb)
-{
-    int frame = 64;
-    while (spp % frame != 0)
-        frame /= 2;
-    char text[24];
-    snprintf(text, sizeof text, "%d", frame);
-    rl_status st = rl_renderer_set(r, "spp", text);
-    for (long long done = 0; st == RL_OK && done < spp; done += frame) {
-        rl_render_stats s;
-        st = rl_renderer_render(r, scene, cam, img, &s);
-        note("reference: %lld / %lld spp", done + frame, spp);
-    }
-    size_t n = (size_t)cam->width * cam->height;
-    for (size_t i = 0; st == RL_OK && i < n; ++i) {
-        rgb[3 * i + 0] = img->color[i].x;
-        rgb[3 * i + 1] = img->color[i].y;
-        rgb[3 * i + 2] = img->color[i].z;
-    }
-    return st;
-}
-
 static bool load_reference(const char *path, int size, long long spp, float *halves, size_t n)
 {
     FILE *f = fopen(path, "rb");
@@ -221,14 +198,14 @@ static bool load_reference(const char *path, int size, long long spp, float *hal
     return ok;
 }
 
-static void save_reference(const char *path, int size, long long spp, const float *halves, size_t n)
+static bool save_reference(const char *path, int size, long long spp, const float *halves, size_t n)
 {
     char tmp[4400];
     snprintf(tmp, sizeof tmp, "%s.tmp", path);
     FILE *f = fopen(tmp, "wb");
     if (!f) {
         note("cannot write the reference cache %s: %s", tmp, strerror(errno));
-        return;
+        return false;
     }
     int32_t hdr[2] = { size, size };
     int64_t s = spp;
@@ -238,39 +215,191 @@ static void save_reference(const char *path, int size, long long spp, const floa
     if (!ok || rename(tmp, path) != 0) {
         note("cannot write the reference cache %s", path);
         remove(tmp);
+        return false;
     }
+    return true;
+}
+
+/* The reference in progress (issue 37: 16384 spp at 512^2 take about 26
+ * minutes of two quiet cores, too long for one sitting on a shared
+ * machine). Each half is rendered in chunks of REF_CHUNK_MAX spp (or the
+ * largest power of two below that divides the half), each chunk a new
+ * accumulation whose Sobol points start where the last one ended
+ * (sample_offset), so the chunks of a half are the points 0 .. spp/2 - 1
+ * of one long render. The chunks' means are summed in double, chunk by
+ * chunk in the same order however the work is sliced, so a reference made
+ * in several runs is bit for bit the one made at once. The sums and their
+ * spp are saved to CACHE.part (tmp + rename) every REF_SAVE_S seconds, at
+ * the end of each half and when the budget stops the run. */
+#define REF_PART_MAGIC "RLPTREFP"
+#define REF_CHUNK_MAX 16
+#define REF_SAVE_S 120.0
+
+typedef struct ref_progress {
+    int32_t size, chunk;
+    int64_t spp;                  /* the whole reference: two halves of spp / 2 */
+    int64_t done[2];              /* samples summed per half */
+    double *sums;                 /* 6 per pixel: half A's RGB sums, then half B's */
+} ref_progress;
+
+static bool load_progress(const char *path, ref_progress *p, size_t n)
+{
+    FILE *f = fopen(path, "rb");
+    if (!f)
+        return false;
+    char magic[8];
+    int32_t hdr[2];
+    int64_t spp, done[2];
+    bool ok = fread(magic, 1, 8, f) == 8 && memcmp(magic, REF_PART_MAGIC, 8) == 0 &&
+              fread(hdr, sizeof hdr, 1, f) == 1 && fread(&spp, sizeof spp, 1, f) == 1 &&
+              fread(done, sizeof done, 1, f) == 1 && hdr[0] == p->size && hdr[1] == p->chunk && spp == p->spp;
+    for (int h = 0; ok && h < 2; ++h)
+        ok = done[h] >= 0 && done[h] <= p->spp / 2 && done[h] % p->chunk == 0;
+    ok = ok && fread(p->sums, sizeof *p->sums, 6 * n, f) == 6 * n && fgetc(f) == EOF;
+    fclose(f);
+    for (size_t i = 0; ok && i < 6 * n; ++i)
+        ok = isfinite(p->sums[i]);
+    if (ok) {
+        p->done[0] = done[0];
+        p->done[1] = done[1];
+    }
+    return ok;
+}
+
+static bool save_progress(const char *path, const ref_progress *p, size_t n)
+{
+    char tmp[4400];
+    if ((size_t)snprintf(tmp, sizeof tmp, "%s.tmp", path) >= sizeof tmp)
+        return false;
+    FILE *f = fopen(tmp, "wb");
+    if (!f) {
+        note("cannot write the reference progress %s: %s", tmp, strerror(errno));
+        return false;
+    }
+    int32_t hdr[2] = { p->size, p->chunk };
+    bool ok = fwrite(REF_PART_MAGIC, 1, 8, f) == 8 && fwrite(hdr, sizeof hdr, 1, f) == 1 &&
+              fwrite(&p->spp, sizeof p->spp, 1, f) == 1 && fwrite(p->done, sizeof p->done, 1, f) == 1 &&
+              fwrite(p->sums, sizeof *p->sums, 6 * n, f) == 6 * n;
+    ok = fclose(f) == 0 && ok;
+    if (!ok || rename(tmp, path) != 0) {
+        note("cannot write the reference progress %s", path);
+        remove(tmp);
+        return false;
+    }
+    return true;
+}
+
+/* Renders the chunks of the reference still missing in p, until done or
+ * until budget_s seconds (0: none) have passed at a chunk's end; *stopped
+ * tells whether the budget stopped it. */
+static rl_status render_reference(const bench_pt_conv_args *a, const rl_scene *scene, const rl_camera *cam,
+                                  ref_progress *p, const char *part, bool *stopped)
+{
+    size_t n = (size_t)cam->width * cam->height;
+    const char *seeds[2] = { REF_SEED_A, REF_SEED_B };
+    int64_t half = p->spp / 2, total0 = p->done[0] + p->done[1];
+    rl_image *img = NULL;
+    rl_status st = rl_image_create(cam->width, cam->height, RL_LAYER_COLOR, &img);
+    rl_timer run, since_save;
+    rl_timer_start(&run);
+    rl_timer_start(&since_save);
+    char chunk[24];
+    snprintf(chunk, sizeof chunk, "%d", (int)p->chunk);
+    *stopped = false;
+    for (int h = 0; h < 2 && st == RL_OK && !*stopped; ++h) {
+        if (p->done[h] >= half)
+            continue;
+        rl_renderer *r = NULL;
+        if ((st = make_renderer(a, opts_defaults, seeds[h], &r)) == RL_OK)
+            st = rl_renderer_set(r, "spp", chunk);
+        double *sum = p->sums + 3 * n * (size_t)h;
+        while (st == RL_OK && p->done[h] < half) {
+            char offset[24];
+            snprintf(offset, sizeof offset, "%lld", (long long)p->done[h]);
+            /* A new option value starts a new accumulation at that point. */
+            if ((st = rl_renderer_set(r, "sample_offset", offset)) != RL_OK)
+                break;
+            rl_render_stats s;
+            if ((st = rl_renderer_render(r, scene, cam, img, &s)) != RL_OK)
+                break;
+            for (size_t i = 0; i < n; ++i) {
+                sum[3 * i + 0] += (double)img->color[i].x * p->chunk;
+                sum[3 * i + 1] += (double)img->color[i].y * p->chunk;
+                sum[3 * i + 2] += (double)img->color[i].z * p->chunk;
+            }
+            p->done[h] += p->chunk;
+            double secs = rl_timer_ms(&run) / 1e3;
+            int64_t total = p->done[0] + p->done[1], now = total - total0;
+            note("reference: half %c %lld / %lld spp, %lld / %lld in all; %.0f s this run, about %.0f s left",
+                 'A' + h, (long long)p->done[h], (long long)half, (long long)total, (long long)(2 * half), secs,
+                 secs / (double)now * (double)(2 * half - total));
+            bool over = a->ref_budget_s > 0.0 && secs >= a->ref_budget_s && total < 2 * half;
+            if (over || p->done[h] == half || rl_timer_ms(&since_save) >= REF_SAVE_S * 1e3) {
+                save_progress(part, p, n);
+                rl_timer_start(&since_save);
+            }
+            if (over) {
+                *stopped = true;
+                break;
+            }
+        }
+        rl_renderer_release(r);
+    }
+    rl_image_release(img);
+    return st;
 }
 
 /* The reference halves (A then B, 3 floats per pixel each), from the
- * cache or rendered; *ref_ms their render time (0 when loaded). */
+ * cache, or rendered (continuing CACHE.part when there is one); *ref_ms
+ * this run's render time (0 when loaded). RL_ERR_CANCELLED with a->reason
+ * set when --conv-ref-budget stopped it before the end. */
 static rl_status reference(const bench_pt_conv_args *a, const rl_scene *scene, const rl_camera *cam,
-                           float *halves, bool *cached, double *ref_ms, char *cache, size_t cache_size)
+                           float *halves, bool *cached, double *ref_ms, char *cache, size_t cache_size,
+                           long long *resumed_spp)
 {
     size_t n = (size_t)cam->width * cam->height;
     const char *slash = strrchr(a->out_path, '/');
     int dir_len = slash ? (int)(slash - a->out_path) + 1 : 0;
     snprintf(cache, cache_size, "%.*spt-convergence-ref-%d-%lld.bin", dir_len, a->out_path, a->size, a->ref_spp);
     *ref_ms = 0.0;
+    *resumed_spp = 0;
     *cached = load_reference(cache, a->size, a->ref_spp, halves, n);
     if (*cached) {
         note("reference loaded from %s", cache);
         return RL_OK;
     }
-    rl_image *img = NULL;
-    rl_status st = rl_image_create(cam->width, cam->height, RL_LAYER_COLOR, &img);
+    char part[4400];
+    snprintf(part, sizeof part, "%s.part", cache);
+    ref_progress p = { .size = a->size, .spp = a->ref_spp, .chunk = REF_CHUNK_MAX };
+    while ((a->ref_spp / 2) % p.chunk != 0)
+        p.chunk /= 2;
+    p.sums = calloc(6 * n, sizeof *p.sums);
+    if (!p.sums)
+        return RL_ERR_OUT_OF_MEMORY;
+    if (load_progress(part, &p, n)) {
+        *resumed_spp = (long long)(p.done[0] + p.done[1]);
+        note("reference: continuing %s at %lld / %lld spp", part, *resumed_spp, a->ref_spp / 2 * 2);
+    } else {
+        memset(p.sums, 0, 6 * n * sizeof *p.sums);
+    }
     rl_timer t;
     rl_timer_start(&t);
-    const char *seeds[2] = { REF_SEED_A, REF_SEED_B };
-    for (int h = 0; h < 2 && st == RL_OK; ++h) {
-        rl_renderer *r = NULL;
-        if ((st = make_renderer(a, opts_defaults, seeds[h], &r)) == RL_OK)
-            st = render_spp(r, scene, cam, a->ref_spp / 2, img, halves + 3 * n * (size_t)h);
-        rl_renderer_release(r);
-    }
-    rl_image_release(img);
+    bool stopped = false;
+    rl_status st = render_reference(a, scene, cam, &p, part, &stopped);
     *ref_ms = rl_timer_ms(&t);
-    if (st == RL_OK)
-        save_reference(cache, a->size, a->ref_spp, halves, n);
+    if (st == RL_OK && stopped) {
+        if (a->reason)
+            snprintf(a->reason, a->reason_size,
+                 "reference incomplete after --conv-ref-budget: %lld / %lld spp saved to %s; rerun the same "
+                 "command to continue", (long long)(p.done[0] + p.done[1]), a->ref_spp / 2 * 2, part);
+        st = RL_ERR_CANCELLED;
+    } else if (st == RL_OK) {
+        for (size_t i = 0; i < 6 * n; ++i)
+            halves[i] = (float)(p.sums[i] / (double)(a->ref_spp / 2));
+        if (save_reference(cache, a->size, a->ref_spp, halves, n))
+            remove(part);
+    }
+    free(p.sums);
     return st;
 }
 
@@ -468,8 +597,9 @@ rl_status bench_pt_convergence(const bench_pt_conv_args *a, cJSON *sec)
     bool cached = false;
     double ref_ms = 0.0;
     char cache[4300];
+    long long resumed = 0;
     if (st == RL_OK)
-        st = reference(a, scene, &cam, halves, &cached, &ref_ms, cache, sizeof cache);
+        st = reference(a, scene, &cam, halves, &cached, &ref_ms, cache, sizeof cache, &resumed);
     double ref_mse = 0.0, ref_mean[3] = { 0.0, 0.0, 0.0 };
     if (st == RL_OK) {
         for (size_t i = 0; i < 3 * n; ++i) {
@@ -503,6 +633,7 @@ rl_status bench_pt_convergence(const bench_pt_conv_args *a, cJSON *sec)
             cJSON_AddStringToObject(r, "renderer", "pt at its defaults, two halves with seeds " REF_SEED_A
                                                    " and " REF_SEED_B);
             cJSON_AddBoolToObject(r, "cached", cached);
+            cJSON_AddNumberToObject(r, "resumed_at_spp", (double)resumed);
             cJSON_AddStringToObject(r, "cache_file", cache);
             bench_add_num(r, "render_ms", ref_ms);
             bench_add_num(r, "own_rmse", sqrt(ref_mse));

@@ -174,6 +174,10 @@ static const rl_option_info pt_options[] = {
       "on: lights chosen by power, light and BSDF samples weighted by the power heuristic (Veach 1997); off: "
       "the thesis' next-event estimation of every light", 0, 0, rl_pt_mis_choices },
     { "seed", RL_OPT_INT, "0", "seed of the per-pixel generator states", 0, 9007199254740991.0, NULL },
+    { "sample_offset", RL_OPT_INT, "0",
+      "rng=sobol: number of the first Sobol point of an accumulation, so that renders of consecutive sample "
+      "ranges together are one longer render (a resumable reference; other rng: must be 0)", 0, 2147483647.0,
+      NULL },
     { "shadow", RL_OPT_ENUM, "bvh", "shadow test: exact accelerator, Line Space payload or shadow maps",
       0, 0, rl_pt_shadow_choices },
     { "diffuse", RL_OPT_ENUM, "bvh", "secondary rays: exact accelerator or Line Space payload",
@@ -338,6 +342,7 @@ static void read_settings(const rl_renderer *r, pt_settings *set)
     set->rng = set->sobol ? RL_RNG_GPU_HYBRID : (rl_rng_gpu_kind)(rng - 1);
     set->mis = rl_renderer_opt_enum(r, "mis") == 1;
     set->seed = (uint64_t)rl_renderer_opt_int(r, "seed");
+    set->sample_offset = (uint32_t)rl_renderer_opt_int(r, "sample_offset");
     set->shadow = (rl_pt_backend)rl_renderer_opt_enum(r, "shadow");
     int diffuse = rl_renderer_opt_enum(r, "diffuse");
     set->diffuse = diffuse <= RL_PT_BACKEND_LS_PNMT ? (rl_pt_backend)diffuse
@@ -483,7 +488,7 @@ static void tile_bounds(const frame *f, int64_t t, int *x0, int *y0, int *x1, in
 static void pixel_sampler(const frame *f, size_t i, uint32_t pass, pt_sampler *sp)
 {
     if (f->set->sobol)
-        rl_pt_sampler_init(sp, NULL, rl_pt_pixel_seed(f->set->seed, i), f->s->count[i] + pass);
+        rl_pt_sampler_init(sp, NULL, rl_pt_pixel_seed(f->set->seed, i), f->set->sample_offset + f->s->count[i] + pass);
     else
         rl_pt_sampler_init(sp, &f->s->rng[i], 0, 0);
 }
@@ -882,7 +887,7 @@ static void adaptive_tile(const frame *f, int64_t t, pt_counters *c)
         for (int x = x0; x < x1; ++x) {
             size_t i = (size_t)y * f->width + x;
             for (uint32_t k = 0; k < s->share[i]; ++k) {
-                rl_vec3 L = pixel_sample(f, x, y, s->count[i] + k, c);
+                rl_vec3 L = pixel_sample(f, x, y, f->set->sample_offset + s->count[i] + k, c);
                 if (!rl_vfinite(L))       /* as path_tile: counted, not added */
                     continue;
                 s->accum[3 * i + 0] += L.x;
@@ -1149,6 +1154,11 @@ static rl_status pt_render(rl_renderer *r, void *state, const rl_scene *scene, c
     bool part = region.x0 > 0 || region.y0 > 0 || region.x1 < cam->width || region.y1 < cam->height;
     /* A distributed frame filters its assembled image (pt_finish_regions). */
     bool filter_here = set.filter != RL_FILTER_NONE && !(part && rl_renderer_whole_passes_deferred(r));
+    /* The per-pixel generators (Sec. 5.3) draw a varying number of values
+     * per sample, so they cannot skip ahead to sample n as Sobol points do. */
+    if (set.sample_offset != 0 && !set.sobol)
+        return rl_error(RL_ERR_INVALID_ARG, "pt: sample_offset=%u needs rng=sobol (the per-pixel generators "
+                        "cannot skip ahead)", set.sample_offset);
     if (part) {
         if (filter_here)
             return rl_error(RL_ERR_UNSUPPORTED, "pt: filter=%s filters the whole image; a region (rl --dist) "

@@ -48,6 +48,7 @@ typedef struct pt_settings {
     bool sobol;                    /* rng=sobol, else the GPU generator rng */
     rl_rng_gpu_kind rng;
     uint64_t seed;
+    uint32_t sample_offset;        /* rng=sobol: Sobol index of an accumulation's first sample */
     rl_pt_backend shadow, diffuse;
     rl_pt_backend specular;        /* mirror and refraction rays (option specular) */
     pt_primary primary;
@@ -320,9 +321,10 @@ void rl_pt_surface_finish(const rl_scene_data *d, uint32_t tri, rl_vec3 p, rl_ve
  * no triangle. */
 bool rl_pt_surface_at_hit(const rl_scene_data *d, const rl_hit *hit, rl_vec3 o, rl_vec3 dir, pt_surface *s);
 
-/* Radiance arriving along the camera path whose first vertex is s
+/* Radiance arriving along the camera path whose first vertex is *first
+ * (overwritten: it is one of the two vertex buffers the path swaps)
  * (Sec. 6.4: Trace, Shade, Phong sampling, until max_depth or roulette). */
-rl_vec3 rl_pt_trace_path(const pt_ctx *ctx, const pt_surface *first, pt_sampler *sampler, pt_counters *c);
+rl_vec3 rl_pt_trace_path(const pt_ctx *ctx, pt_surface *first, pt_sampler *sampler, pt_counters *c);
 
 /* Closest surface along ray through backend `backend` (exact kinds, Line
  * Space candidates, PNMT), counted as `type`. False on a miss. */

@@ -22,7 +22,8 @@ expect_in "$TMP/err" "rl: error: "
 
 expect_exit 0 "$RL" bench pt --help
 for o in --size --error-size --ref-spp --spp-max --max-memory --builds --fixed-k --small-pages --only --out \
-         --quick generation accumulation convergence --conv-size --conv-ref-spp --conv-spp-max bdpt; do
+         --quick generation accumulation convergence --conv-size --conv-ref-spp --conv-spp-max --conv-ref-budget \
+         bdpt; do
     expect_in "$TMP/out" "$o"
 done
 
@@ -192,6 +193,42 @@ expect_exit 0 "$RL" bench pt --only convergence --quick --conv-size 16 --conv-re
     --out "$TMP/conv/c2.json"
 python3 -c 'import json,sys; assert json.load(open(sys.argv[1]))["convergence"]["reference"]["cached"] is True' \
     "$TMP/conv/c2.json" || fail "the cached reference was not reused"
+
+# A resumable reference: --conv-ref-budget stops after a chunk (16 spp per
+# half here) with exit 1 and the progress saved in .part; reruns of the same
+# command continue it, and the finished reference is byte for byte the one
+# made at once (64 spp: four chunks, so four slices). A damaged .part is
+# ignored: the reference starts over.
+mkdir -p "$TMP/conv/once" "$TMP/conv/sliced"
+expect_exit 0 "$RL" bench pt --only convergence --quick --conv-size 16 --conv-ref-spp 64 --conv-spp-max 4 \
+    --conv-configs defaults --out "$TMP/conv/once/c.json"
+sliced() {
+    "$RL" bench pt --only convergence --quick --conv-size 16 --conv-ref-spp 64 --conv-spp-max 4 \
+        --conv-configs defaults --conv-ref-budget 0.000001 --out "$TMP/conv/sliced/c.json"
+}
+expect_error 1 "reference incomplete after --conv-ref-budget: 16 / 64 spp" sliced
+[ -s "$TMP/conv/sliced/pt-convergence-ref-16-64.bin.part" ] || fail "no .part after the first slice"
+[ -e "$TMP/conv/sliced/pt-convergence-ref-16-64.bin" ] && fail "a slice wrote the finished reference"
+python3 -c 'import json,sys; c = json.load(open(sys.argv[1]))["convergence"]
+assert c["status"] == "failed" and "rerun the same command" in c["reason"], c' "$TMP/conv/sliced/c.json" ||
+    fail "the sliced record does not say why it stopped"
+expect_error 1 "32 / 64 spp" sliced
+expect_error 1 "48 / 64 spp" sliced
+expect_in "$TMP/err" "continuing"
+expect_exit 0 sliced
+[ -e "$TMP/conv/sliced/pt-convergence-ref-16-64.bin.part" ] && fail "the .part outlived the finished reference"
+cmp -s "$TMP/conv/once/pt-convergence-ref-16-64.bin" "$TMP/conv/sliced/pt-convergence-ref-16-64.bin" ||
+    fail "the reference made in four slices differs from the one made at once"
+python3 -c 'import json,sys; r = json.load(open(sys.argv[1]))["convergence"]["reference"]
+assert r["cached"] is False and r["resumed_at_spp"] == 48, r' "$TMP/conv/sliced/c.json" ||
+    fail "the last slice's record"
+mkdir -p "$TMP/conv/bad"
+head -c 100 "$TMP/conv/once/pt-convergence-ref-16-64.bin" >"$TMP/conv/bad/pt-convergence-ref-16-64.bin.part"
+expect_exit 0 "$RL" bench pt --only convergence --quick --conv-size 16 --conv-ref-spp 64 --conv-spp-max 4 \
+    --conv-configs defaults --out "$TMP/conv/bad/c.json"
+cmp -s "$TMP/conv/once/pt-convergence-ref-16-64.bin" "$TMP/conv/bad/pt-convergence-ref-16-64.bin" ||
+    fail "a damaged .part changed the reference"
+expect_usage_error "$RL" bench pt --only convergence --conv-ref-budget -1 --out "$TMP/c.json"
 
 # bdpt (issue 37): pt and bdpt at equal CPU time on both scenes; behind the
 # shade bdpt's error is the lower one

@@ -464,6 +464,41 @@ static void test_accumulation_converges_and_reset_repeats(void **state)
     rl_scene_release(s);
 }
 
+/* sample_offset: two renders of Sobol points 0-3 and 4-7 are one render of
+ * points 0-7 (their mean equals it but for the float rounding of each
+ * image), which is what lets `rl bench pt` resume a reference; the
+ * per-pixel generators cannot skip ahead and refuse an offset. */
+static void test_sample_offset_splits_one_render_into_two(void **state)
+{
+    (void)state;
+    rl_camera cam;
+    rl_scene *s = fx_cornell(&cam, 16);
+    rl_image *whole = fx_render("pt", s, &cam, RL_LAYER_COLOR, (const char *const[]){ "spp", "8", NULL }, NULL);
+    rl_image *a = fx_render("pt", s, &cam, RL_LAYER_COLOR, (const char *const[]){ "spp", "4", NULL }, NULL);
+    rl_image *b = fx_render("pt", s, &cam, RL_LAYER_COLOR,
+                            (const char *const[]){ "spp", "4", "sample_offset", "4", NULL }, NULL);
+    bool differ = false;
+    for (size_t i = 0; i < 16 * 16; ++i) {
+        const float *w = &whole->color[i].x, *pa = &a->color[i].x, *pb = &b->color[i].x;
+        for (int k = 0; k < 3; ++k) {
+            float mean = 0.5f * (pa[k] + pb[k]);
+            assert_true(fabsf(mean - w[k]) <= 1e-5f * fmaxf(1.0f, fabsf(w[k])));
+            differ = differ || pa[k] != pb[k];
+        }
+    }
+    assert_true(differ);
+    rl_renderer *r = fx_make("pt", (const char *const[]){ "rng", "lcg", "sample_offset", "4", NULL });
+    assert_int_equal(rl_renderer_prepare_inputs(r, s), RL_OK);
+    rl_clear_error();
+    assert_int_equal(rl_renderer_render(r, s, &cam, whole, NULL), RL_ERR_INVALID_ARG);
+    assert_non_null(strstr(rl_last_error(), "sample_offset"));
+    rl_renderer_release(r);
+    rl_image_release(whole);
+    rl_image_release(a);
+    rl_image_release(b);
+    rl_scene_release(s);
+}
+
 /* Sec. 8.5: half the pixels per frame; the first frame fills the rest from
  * the neighbours, the second completes the image. */
 static void test_checkerboard_renders_half_and_fills_the_first_frame(void **state)
@@ -639,6 +674,7 @@ int main(void)
         cmocka_unit_test(test_exact_backends_give_the_same_image),
         cmocka_unit_test(test_image_does_not_depend_on_the_thread_count),
         cmocka_unit_test(test_accumulation_converges_and_reset_repeats),
+        cmocka_unit_test(test_sample_offset_splits_one_render_into_two),
         cmocka_unit_test(test_checkerboard_renders_half_and_fills_the_first_frame),
         cmocka_unit_test(test_raster_primary_agrees_with_traced_primary),
         cmocka_unit_test(test_every_rng_renders_the_same_expectation),
