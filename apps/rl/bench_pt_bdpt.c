@@ -225,9 +225,9 @@ rl_status bench_pt_bdpt(const bench_pt_bdpt_args *a, cJSON *sec)
 
 rl_status bench_pt_hybrid(const bench_pt_bdpt_args *a, cJSON *sec)
 {
-    int size = a->quick ? 32 : 64;
-    long long ref_spp = a->quick ? 64 : 512;
-    double budget_s = a->quick ? 1.0 : 10.0;
+    int size = a->quick ? 32 : 48;
+    long long ref_spp = a->quick ? 64 : 1024;
+    double budget_s = a->quick ? 1.0 : 5.0;
     note("hybrid: gl-pt without and with light paths (Sec. 8.4) at equal CPU time (%.1f s per thread, the GL "
          "driver's threads included) on cornell, %dx%d, reference bdpt %lld spp", budget_s, size, size, ref_spp);
     cJSON_AddStringToObject(sec, "error", "RMSE of linear RGB clamped to [0,1], all pixels and channels, against "

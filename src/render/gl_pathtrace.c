@@ -525,15 +525,17 @@ typedef struct lv_params {
 static double sq(double x) { return x * x; }
 
 /* The strategy count of s' = j (j >= 1) on path y: 0 where a delta vertex
- * ends the joining edge y_{j-1} y_j. */
-static double lv_nu(const lv_params *p, const bd_vertex *y, int j)
+ * ends the joining edge y_{j-1} y_j. y_j as the stored vertex (end) is
+ * joined by its BRDF part whatever event its walk chose next, so its own
+ * flag does not count there. */
+static double lv_nu(const lv_params *p, const bd_vertex *y, int j, bool end)
 {
-    if (y[j].delta || (j >= 2 && y[j - 1].delta))
+    if ((!end && y[j].delta) || (j >= 2 && y[j - 1].delta))
         return 0.0;
     return j == 1 ? p->nu1 : 1.0;
 }
 
-/* The record of vertex y_i (i >= 1, not delta) into out
+/* The record of vertex y_i (i >= 1) into out
  * (RL_GL_PT_LV_FLOATS floats; layout in gl_pt.h). */
 static void lv_record(const lv_params *p, const bd_vertex *y, int i, float *out)
 {
@@ -548,7 +550,7 @@ static void lv_record(const lv_params *p, const bd_vertex *y, int i, float *out)
         if (j == 0) {
             rb = q * nu0 * nu0;
         } else {
-            ra = q * (sq(lv_nu(p, y, j)) + ra);
+            ra = q * (sq(lv_nu(p, y, j, false)) + ra);
             rb = q * rb;
         }
     }
@@ -558,8 +560,8 @@ static void lv_record(const lv_params *p, const bd_vertex *y, int i, float *out)
     double d2 = rl_length2(e);
     double cosp = rl_length2(y[i - 1].ng) > 0.0f ? fabs(rl_dot(y[i - 1].ng, e)) / sqrt(d2) : 1.0;
     double g2 = sq(cosp / d2) / sq(pli * plp);
-    double l1 = sq(lv_nu(p, y, i)) / sq(pli);
-    double l2a = i == 1 ? 0.0 : g2 * (sq(lv_nu(p, y, i - 1)) + ra);
+    double l1 = sq(lv_nu(p, y, i, true)) / sq(pli);
+    double l2a = i == 1 ? 0.0 : g2 * (sq(lv_nu(p, y, i - 1, false)) + ra);
     double l2b = i == 1 ? g2 * nu0 * nu0 : g2 * rb;
     const pt_surface *s = &v->s;
     float k = rl_maxf(0.0f, 1.0f - s->m->reflectivity - s->m->transmissivity);
@@ -622,7 +624,7 @@ static rl_status lv_trace(const lv_params *p, uint64_t frame, uint32_t n, int th
                 uint32_t c = 0;
                 for (int i = 1; i < nv; ++i) {
                     const bd_vertex *v = &sc.light[i];
-                    if (v->kind != BD_V_SURFACE || v->delta || !rl_vfinite(v->beta) ||
+                    if (v->kind != BD_V_SURFACE || !rl_vfinite(v->beta) ||
                         !(rl_vmax_comp(v->beta) > 0.0f))
                         continue;
                     lv_record(p, sc.light, i, l->data + ((size_t)j * (size_t)per + c) * RL_GL_PT_LV_FLOATS);
