@@ -111,7 +111,7 @@ static inline void fx_add_room(rl_scene *s)
     fx_room_quad(s, green, rl_v3(1, 0, -1), rl_v3(0, 0, 2), rl_v3(0, 2, 0));    /* right */
 }
 
-/* The room lit only through a shade (bdpt's and gl-pt light_paths' tests): a small quad lamp facing the ceiling
+/* The room lit only through a shade (bdpt's test): a small quad lamp facing the ceiling
  * inside an open-topped box, so every path from the camera reaches the
  * lamp by a bounce off the ceiling; next-event estimation at the surfaces
  * the camera sees is always shadowed. */
