@@ -30,6 +30,8 @@
  *                 improvement switched off (bench_pt_conv.c)
  *   bdpt          issue 37: pt against bdpt at equal CPU time on the Cornell
  *                 box lit directly and through a shade (bench_pt_bdpt.c)
+ *   hybrid        Sec. 8.4: gl-pt without and with the CPU's light paths at
+ *                 equal CPU time on the same scenes (bench_pt_bdpt.c)
  *
  * Every section but convergence measures the thesis' configuration, so
  * make_pt sets the thesis' sampling options explicitly (rng=hybrid,
@@ -61,6 +63,7 @@
 #include <string.h>
 #include <unistd.h>
 
+#include "rl/rl_gl.h"
 #include "rl/rl_linespace.h"
 #include "rl/rl_metrics.h"
 
@@ -97,6 +100,11 @@ static const char bench_pt_help[] =
     "  bdpt          pt against bdpt at equal CPU time (5 s per thread; quick 0.5)\n"
     "                on cornell:variant=bitterli and variant=shade, 96x96 (quick\n"
     "                32x32): RMSE against a 512-spp bdpt reference, channel means\n"
+    "  hybrid        gl-pt without and with light_paths=1024 (Sec. 8.4; overlapped\n"
+    "                and not) at equal CPU time (5 s per thread; quick 1) on the\n"
+    "                same scenes, 48x48 (quick 32x32), reference bdpt 1024 spp\n"
+    "                (quick 64): fps, RMSE, channel means;\n"
+    "                skipped without a GL 4.5 context\n"
     "\n"
     "options:\n"
     "  --size WxH        frame sections; default 1280x720 (the thesis)\n"
@@ -131,10 +139,10 @@ static const char bench_pt_help[] =
     "  rl bench pt --only generation,shadow\n";
 
 enum { SEC_GENERATION, SEC_SCENES, SEC_DIFFUSE, SEC_SHADOW, SEC_ERROR, SEC_SPECULAR, SEC_ACCUMULATION,
-       SEC_CONVERGENCE, SEC_BDPT, SEC_COUNT };
+       SEC_CONVERGENCE, SEC_BDPT, SEC_HYBRID, SEC_COUNT };
 static const char *const section_names[SEC_COUNT] = { "generation", "scenes",       "diffuse",
                                                       "shadow",     "error",        "specular",
-                                                      "accumulation", "convergence", "bdpt" };
+                                                      "accumulation", "convergence", "bdpt", "hybrid" };
 
 /* Schröder 2017, Table 1: generation times in ms on a GeForce GTX 1080. */
 static const struct gen_row {
@@ -1658,6 +1666,19 @@ static rl_status sec_bdpt(void *ctx, cJSON *sec)
     return bench_pt_bdpt(&ba, sec);
 }
 
+static rl_status sec_hybrid(void *ctx, cJSON *sec)
+{
+    bpt *b = ctx;
+    char why[256];
+    if (!rl_gl_available(NULL, why, sizeof why)) {
+        printf("hybrid: skipped, no OpenGL 4.5 context (%s)\n", why);
+        cJSON_AddStringToObject(sec, "skipped", why);
+        return RL_OK;
+    }
+    bench_pt_bdpt_args ba = { .threads = b->threads, .quick = b->a->quick };
+    return bench_pt_hybrid(&ba, sec);
+}
+
 /* ------------------------------------------------------- the command -- */
 
 /* Returns RL_CLI_OK, an exit code, or RL_BENCH_HELP_SHOWN. */
@@ -1812,7 +1833,8 @@ int bench_pt(int argc, char **argv)
     cJSON_AddItemToObject(root, "thesis", thesis_json());
     static const bench_section_fn fns[SEC_COUNT] = { sec_generation, sec_scenes,       sec_diffuse,
                                                         sec_shadow,     sec_error,        sec_specular,
-                                                        sec_accumulation, sec_convergence, sec_bdpt };
+                                                        sec_accumulation, sec_convergence, sec_bdpt,
+                                                        sec_hybrid };
     b.out_path = out;
     printf("rl bench pt: Line Space path tracing (Schroeder 2017), %d threads\n", b.threads);
     rc = bench_run_sections("pt", root, section_names, fns, SEC_COUNT, a.sections, &b,

@@ -31,7 +31,25 @@
 
 static const char *const scenes[] = { "variant=bitterli", "variant=shade" };
 #define NUM_SCENES (sizeof scenes / sizeof scenes[0])
-static const char *const algos[] = { "pt", "bdpt" };
+/* A run: a renderer and its options ({key, value, ..., NULL}). */
+typedef struct bd_config {
+    const char *label, *algo;
+    const char *const *opts;
+} bd_config;
+
+static const bd_config bdpt_configs[] = { { "pt", "pt", NULL }, { "bdpt", "bdpt", NULL } };
+
+/* --only hybrid (Schröder 2017 Sec. 8.4): gl-pt with and without the CPU's
+ * light paths; light_overlap=false traces them before each frame instead
+ * of beside it, so its extra time over the overlapped run is the CPU work
+ * the overlap hides. */
+static const char *const hy_paths[] = { "light_paths", "1024", NULL };
+static const char *const hy_sync[] = { "light_paths", "1024", "light_overlap", "false", NULL };
+static const bd_config hybrid_configs[] = {
+    { "gl-pt", "gl-pt", NULL },
+    { "gl-pt light_paths=1024", "gl-pt", hy_paths },
+    { "gl-pt light_paths=1024 light_overlap=false", "gl-pt", hy_sync },
+};
 
 static float disp(float v)
 {
@@ -72,7 +90,7 @@ static void add_means(cJSON *o, const char *key, const double m[3])
 }
 
 static rl_status run_scene(const bench_pt_bdpt_args *a, const char *params, int size, long long ref_spp,
-                           double budget_s, cJSON *out)
+                           double budget_s, const bd_config *configs, int num_configs, cJSON *out)
 {
     rl_scene *scene = NULL;
     rl_status st = rl_scene_create_builtin("cornell", params, &scene);
@@ -127,13 +145,17 @@ static rl_status run_scene(const bench_pt_bdpt_args *a, const char *params, int 
         add_means(out, "reference_means", ref_means);
     }
     cJSON *runs = st == RL_OK ? cJSON_AddArrayToObject(out, "runs") : NULL;
-    double rmse_of[2] = { 0.0, 0.0 };
-    for (int k = 0; k < 2 && st == RL_OK; ++k) {
+    double rmse_of[8] = { 0.0 };
+    for (int k = 0; k < num_configs && k < 8 && st == RL_OK; ++k) {
+        const bd_config *c = &configs[k];
         rl_renderer *r = NULL;
         rl_render_stats s;
-        /* Warm-up under another seed (builds the BVH and the light table),
-         * then the seed change restarts the accumulation. */
-        st = make(algos[k], a->threads, "9", 1, &r);
+        /* Warm-up under another seed (builds the BVH and the light table;
+         * gl-pt: the context and its shaders), then the seed change
+         * restarts the accumulation. */
+        st = make(c->algo, a->threads, "9", 1, &r);
+        for (int i = 0; st == RL_OK && c->opts && c->opts[i]; i += 2)
+            st = rl_renderer_set(r, c->opts[i], c->opts[i + 1]);
         if (st == RL_OK) st = rl_renderer_render(r, scene, &cam, img, &s);
         if (st == RL_OK) st = rl_renderer_set(r, "seed", "1");
         bench_budget_run run = { 0 };
@@ -153,20 +175,23 @@ static rl_status run_scene(const bench_pt_bdpt_args *a, const char *params, int 
         }
         rmse_of[k] = rmse;
         cJSON *o = cJSON_CreateObject();
-        cJSON_AddStringToObject(o, "algo", algos[k]);
+        cJSON_AddStringToObject(o, "algo", c->label);
         bench_add_num(o, "spp", (double)spp);
         bench_add_num(o, "wall_ms", wall);
         bench_add_num(o, "cpu_ms", cpu);
+        bench_add_num(o, "fps", spp > 0 && wall > 0.0 ? 1e3 * (double)spp / wall : 0.0);
         bench_add_num(o, "rmse", rmse);
         add_means(o, "means", m);
         cJSON_AddItemToArray(runs, o);
         printf("%-18s %-5s %6lld spp %8.1f s cpu/thr %8.1f s wall  RMSE %.5f  means %.4f %.4f %.4f "
-               "(ref %.4f %.4f %.4f)\n", params, algos[k], spp, cpu / 1e3 / a->threads, wall / 1e3, rmse, m[0],
+               "(ref %.4f %.4f %.4f)\n", params, c->label, spp, cpu / 1e3 / a->threads, wall / 1e3, rmse, m[0],
                m[1], m[2], ref_means[0], ref_means[1], ref_means[2]);
         fflush(stdout);
     }
-    if (st == RL_OK)
+    if (st == RL_OK && num_configs == 2)
         bench_add_num(out, "rmse_ratio_pt_over_bdpt", bench_ratio(rmse_of[0], rmse_of[1]));
+    if (st == RL_OK && num_configs == 3)
+        bench_add_num(out, "rmse_ratio_off_over_light_paths", bench_ratio(rmse_of[0], rmse_of[1]));
     rl_image_release(img);
     free(ref);
     free(half);
@@ -193,7 +218,31 @@ rl_status bench_pt_bdpt(const bench_pt_bdpt_args *a, cJSON *sec)
     for (size_t i = 0; i < NUM_SCENES && st == RL_OK; ++i) {
         cJSON *o = cJSON_CreateObject();
         cJSON_AddItemToArray(list, o);
-        st = run_scene(a, scenes[i], size, ref_spp, budget_s, o);
+        st = run_scene(a, scenes[i], size, ref_spp, budget_s, bdpt_configs, 2, o);
+    }
+    return st;
+}
+
+rl_status bench_pt_hybrid(const bench_pt_bdpt_args *a, cJSON *sec)
+{
+    int size = a->quick ? 32 : 48;
+    long long ref_spp = a->quick ? 64 : 1024;
+    double budget_s = a->quick ? 1.0 : 5.0;
+    note("hybrid: gl-pt without and with light paths (Sec. 8.4) at equal CPU time (%.1f s per thread, the GL "
+         "driver's threads included) on cornell, %dx%d, reference bdpt %lld spp", budget_s, size, size, ref_spp);
+    cJSON_AddStringToObject(sec, "error", "RMSE of linear RGB clamped to [0,1], all pixels and channels, against "
+                                          "a bdpt reference in two halves, its own MSE subtracted");
+    cJSON_AddStringToObject(sec, "time", "frames of 1 spp after a warm-up frame until process CPU time / threads "
+                                         "reaches budget_s; fps = frames / wall");
+    bench_add_num(sec, "size", size);
+    bench_add_num(sec, "budget_s", budget_s);
+    bench_add_num(sec, "threads", a->threads);
+    cJSON *list = cJSON_AddArrayToObject(sec, "scenes");
+    rl_status st = RL_OK;
+    for (size_t i = 0; i < NUM_SCENES && st == RL_OK; ++i) {
+        cJSON *o = cJSON_CreateObject();
+        cJSON_AddItemToArray(list, o);
+        st = run_scene(a, scenes[i], size, ref_spp, budget_s, hybrid_configs, 3, o);
     }
     return st;
 }

@@ -16,5 +16,8 @@ typedef struct bench_pt_bdpt_args {
 
 /* Fills sec; RL_OK or the failing status. */
 rl_status bench_pt_bdpt(const bench_pt_bdpt_args *a, struct cJSON *sec);
+/* --only hybrid: gl-pt without and with light paths (light_paths=1024,
+ * overlapped and not) at equal CPU time on the same scenes. */
+rl_status bench_pt_hybrid(const bench_pt_bdpt_args *a, struct cJSON *sec);
 
 #endif

@@ -80,6 +80,7 @@ typedef struct uniforms {
     GLint sm_size, sm_bias, sm_slope, sm_pcf, sm_frame;
     GLint env, env_nee, env_slot, env_map, env_size, env_rot, env_sum, env_off;
     GLint ggx_ms, adaptive, round_k;
+    GLint lvc, lv_paths, lv_base, lv_connect, lv_slot, lv_nu1;
     GLint count, structure, any;
 } uniforms;
 
@@ -88,6 +89,7 @@ typedef struct uniforms {
 #define SM_CASTERS 14              /* the casters list's storage binding (B_RAYS's: the pass is
                                     * no ray set's) */
 #define ENV_UNIT 8                 /* the path program's texture unit of the environment */
+#define LV_UNIT 9                  /* the path program's texture unit of the light vertices */
 
 struct rl_gl_pt {
     rl_gl_context *ctx;
@@ -148,6 +150,11 @@ struct rl_gl_pt {
     int env_map[2], env_size[2], env_off[3];
     float env_rot;
     double env_sum;
+    /* hybrid light paths (rl_gl_pt_set_light_vertices): the paths'
+     * offsets (as float bits, 4 a texel) then the vertices in one rgba32f
+     * buffer texture (a 12-byte one without) */
+    GLuint lv_buf, lv_tex;
+    uint32_t lv_paths, lv_base;
 };
 
 static void replace_buffer(rl_gl_pt *pt, int slot, const void *data, size_t bytes, GLbitfield flags)
@@ -225,6 +232,12 @@ static void locate(GLuint p, uniforms *u)
     U(ggx_ms, "u_ggx_ms");
     U(adaptive, "u_adaptive");
     U(round_k, "u_round_k");
+    U(lvc, "u_lvc");
+    U(lv_paths, "u_lv_paths");
+    U(lv_base, "u_lv_base");
+    U(lv_connect, "u_lv_connect");
+    U(lv_slot, "u_lv_slot");
+    U(lv_nu1, "u_lv_nu1");
     U(count, "u_count");
     U(structure, "u_structure");
     U(any, "u_any");
@@ -584,6 +597,9 @@ rl_status rl_gl_pt_create(const rl_scene *scene, const rl_gl_pt_desc *desc, rl_g
         pt->env_buf = no_maps();
         glCreateTextures(GL_TEXTURE_BUFFER, 1, &pt->env_tex);
         glTextureBuffer(pt->env_tex, GL_R32F, pt->env_buf);
+        pt->lv_buf = no_maps();
+        glCreateTextures(GL_TEXTURE_BUFFER, 1, &pt->lv_tex);
+        glTextureBuffer(pt->lv_tex, GL_RGBA32F, pt->lv_buf);
         st = rl_gl_check("rl_gl_pt_create");
     }
     if (st != RL_OK) {
@@ -681,7 +697,8 @@ static void drain_counters(rl_gl_pt *pt, uint64_t rays[RL_GL_PT_RAY_TYPES])
 static uint64_t rays_bound(const rl_gl_pt_frame *f, uint32_t num_lights)
 {
     uint64_t per_vertex = (uint64_t)f->light_samples * (f->mis ? 1u : (num_lights ? num_lights : 1u)) + 1u +
-                          (f->env_nee ? 1u : 0u);
+                          (f->env_nee ? 1u : 0u) +
+                          (uint64_t)(f->light_connect > 0 ? f->light_connect : 0) * ((uint64_t)f->max_depth + 1u);
     return (uint64_t)f->cam.width * (uint64_t)f->cam.height * (1u + ((uint64_t)f->max_depth + 1u) * per_vertex);
 }
 
@@ -884,6 +901,7 @@ static rl_status render_frame(rl_gl_pt *pt, const rl_gl_pt_frame *f, float *rgba
     glBindTextureUnit(6, pt->tex_ids);
     glBindTextureUnit(SM_UNIT, pt->sm_tex);
     glBindTextureUnit(ENV_UNIT, pt->env_tex);
+    glBindTextureUnit(LV_UNIT, pt->lv_tex);
     if (pt->have_sm) {
         glProgramUniform1i(p, u->sm_size, pt->sm_desc.size);
         glProgramUniform1f(p, u->sm_bias, pt->sm_desc.bias);
@@ -916,7 +934,17 @@ static rl_status render_frame(rl_gl_pt *pt, const rl_gl_pt_frame *f, float *rgba
     /* the environment's sample: one slot after the lights', in scenes
      * that have one (pathtrace.c) */
     glProgramUniform1ui(p, u->env_slot, slots);
-    glProgramUniform1ui(p, u->vertex_slots, slots + (pt->have_env ? 1u : 0u));
+    slots += pt->have_env ? 1u : 0u;
+    /* hybrid light paths: one slot per drawn light path, after the rest
+     * (none without, so that the other slots keep their places) */
+    const bool lvc = f->light_connect > 0 && pt->lv_paths > 0;
+    glProgramUniform1i(p, u->lvc, lvc);
+    glProgramUniform1ui(p, u->lv_slot, slots);
+    glProgramUniform1ui(p, u->lv_paths, pt->lv_paths);
+    glProgramUniform1ui(p, u->lv_base, pt->lv_base);
+    glProgramUniform1i(p, u->lv_connect, f->light_connect);
+    glProgramUniform1f(p, u->lv_nu1, f->light_nu1);
+    glProgramUniform1ui(p, u->vertex_slots, slots + (lvc ? (uint32_t)f->light_connect : 0u));
     glProgramUniform1i(p, u->env, pt->have_env);
     glProgramUniform1i(p, u->env_nee, pt->have_env && f->env_nee);
     glProgramUniform1i(p, u->ggx_ms, f->ggx_ms);
@@ -1301,6 +1329,56 @@ static rl_status upload_environment(rl_gl_pt *pt, const rl_gl_pt_env *e)
     return rl_gl_check("rl_gl_pt_set_environment");
 }
 
+rl_status rl_gl_pt_set_light_vertices(rl_gl_pt *pt, const rl_gl_pt_light_vertices *lv)
+{
+    if (!pt || !lv || (lv->paths > 0 && (!lv->offsets || (lv->offsets[lv->paths] > 0 && !lv->data))))
+        return rl_error(RL_ERR_INVALID_ARG, "rl_gl_pt_set_light_vertices: NULL argument");
+    const uint32_t n = lv->paths;
+    for (uint32_t j = 0; j < n; ++j)
+        if (lv->offsets[j] > lv->offsets[j + 1] || (j == 0 && lv->offsets[0] != 0))
+            return rl_error(RL_ERR_INVALID_ARG, "rl_gl_pt_set_light_vertices: offsets not from 0 upwards");
+    const size_t count = n ? lv->offsets[n] : 0;
+    const size_t base = n ? ((size_t)n + 1 + 3) / 4 : 0;    /* texels of offsets */
+    size_t texels = base + count * (RL_GL_PT_LV_FLOATS / 4);
+    if (n > 0 && ((texels * 16) & (texels * 16 - 1)) == 0)
+        ++texels;                  /* off a power of two: one variant (no_maps) */
+    GLint max_texels = 0;
+    rl_status st = rl_gl_context_make_current(pt->ctx);
+    if (st != RL_OK)
+        return st;
+    glGetIntegerv(GL_MAX_TEXTURE_BUFFER_SIZE, &max_texels);
+    if (texels > (size_t)max_texels || texels > (size_t)INT32_MAX) {
+        rl_gl_context_done(pt->ctx);
+        return rl_error(RL_ERR_LIMIT, "gl-pt: %zu light vertices of %u paths exceed this GL's buffer texture size "
+                        "of %d texels", count, n, (int)max_texels);
+    }
+    GLuint b = 0;
+    if (n > 0) {
+        float *data = rl_calloc(texels, 4 * sizeof *data);
+        if (!data) {
+            rl_gl_context_done(pt->ctx);
+            return RL_ERR_OUT_OF_MEMORY;
+        }
+        memcpy(data, lv->offsets, ((size_t)n + 1) * sizeof *lv->offsets);
+        if (count)
+            memcpy(data + 4 * base, lv->data, count * RL_GL_PT_LV_FLOATS * sizeof *data);
+        b = rl_gl_make_buffer(data, texels * 4 * sizeof *data, 0);
+        free(data);
+    } else {
+        b = no_maps();
+    }
+    glDeleteTextures(1, &pt->lv_tex);
+    glDeleteBuffers(1, &pt->lv_buf);
+    pt->lv_buf = b;
+    glCreateTextures(GL_TEXTURE_BUFFER, 1, &pt->lv_tex);
+    glTextureBuffer(pt->lv_tex, GL_RGBA32F, pt->lv_buf);
+    pt->lv_paths = n;
+    pt->lv_base = (uint32_t)base;
+    st = rl_gl_check("rl_gl_pt_set_light_vertices");
+    rl_gl_context_done(pt->ctx);
+    return st;
+}
+
 rl_status rl_gl_pt_set_environment(rl_gl_pt *pt, const rl_gl_pt_env *env)
 {
     if (!pt)
@@ -1444,6 +1522,13 @@ rl_status rl_gl_pt_set_shadowmaps(rl_gl_pt *pt, const rl_shadowmap_desc *desc)
 {
     (void)pt;
     (void)desc;
+    return rl_error(RL_ERR_UNSUPPORTED, "gl: built without OpenGL");
+}
+
+rl_status rl_gl_pt_set_light_vertices(rl_gl_pt *pt, const rl_gl_pt_light_vertices *lv)
+{
+    (void)pt;
+    (void)lv;
     return rl_error(RL_ERR_UNSUPPORTED, "gl: built without OpenGL");
 }
 

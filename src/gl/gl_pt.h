@@ -105,6 +105,14 @@ typedef struct rl_gl_pt_frame {
      * from these per-pixel states (4 words each, row 0 the top row: the
      * generator state, or for sobol the scramble seed in the first). */
     const uint32_t *reset_states;
+    /* Hybrid light paths (Schröder 2017 Sec. 8.4; rl_gl_pt_set_light_vertices):
+     * 0 off (the shader as without them); else every BRDF vertex of a camera
+     * path joins all vertices of this many light paths drawn from the
+     * uploaded set, and the emitter hits and light samples take the MIS
+     * weights that count these strategies (gl_pt_shaders.c, "light
+     * vertices"). Needs mis, mis_hits and tri_lights, no environment. */
+    int light_connect;
+    float light_nu1;               /* light_samples / light_connect (the NEE strategy's count ratio) */
 } rl_gl_pt_frame;
 
 /* A tracer of scene (committed). RL_ERR_UNSUPPORTED where no GL 4.5
@@ -175,6 +183,22 @@ rl_status rl_gl_pt_set_linespace(rl_gl_pt *pt, const rl_linespace *ls, const rl_
  * RL_ERR_LIMIT where the maps exceed the GL's buffer texture size. Until
  * one succeeds, a frame with shadow = SHADOWMAP is RL_ERR_INVALID_ARG. */
 rl_status rl_gl_pt_set_shadowmaps(rl_gl_pt *pt, const rl_shadowmap_desc *desc);
+
+/* Hybrid light paths (Schröder 2017 Sec. 8.4): the light vertices that
+ * the CPU traced for the next frames, in RL_GL_PT_LV_FLOATS floats each
+ * (gl_pathtrace.c fills them; gl_pt_shaders.c reads them: position and
+ * material, geometric normal, shading normal, direction to the previous
+ * vertex, throughput and index on its path, diffuse colour, each with the
+ * MIS quantities in the fourth float), grouped by path: path j holds
+ * vertices [offsets[j], offsets[j + 1]). paths = 0 removes them. */
+#define RL_GL_PT_LV_FLOATS 24
+typedef struct rl_gl_pt_light_vertices {
+    uint32_t paths;
+    const uint32_t *offsets;       /* paths + 1, offsets[0] = 0, non-decreasing */
+    const float *data;             /* offsets[paths] vertices */
+} rl_gl_pt_light_vertices;
+
+rl_status rl_gl_pt_set_light_vertices(rl_gl_pt *pt, const rl_gl_pt_light_vertices *lv);
 
 /* The scene's environment (issue 37; pt's pathtrace_env.c,
  * scene/environment.c) as plain arrays the caller keeps: the radiance of

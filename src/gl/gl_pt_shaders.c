@@ -395,6 +395,16 @@ const char *const rl_gl_pt_glsl_path = GLSL(
     uniform int u_specular;
     uniform float u_ls_start;
     uniform float u_ls_offset;
+    /* Hybrid light paths (rl_gl_pt_set_light_vertices, Sec. 8.4): the
+     * paths' offsets (float bits, 4 a texel) from texel 0, the vertices (6
+     * texels each) from u_lv_base. Always bound, as the maps. */
+    layout(binding = 9) uniform samplerBuffer u_light_vertices;   /* rgba32f */
+    uniform bool u_lvc;                /* the light-vertex strategies are on */
+    uniform uint u_lv_paths;           /* light paths in the set (N) */
+    uniform uint u_lv_base;
+    uniform int u_lv_connect;          /* paths drawn per camera vertex (M) */
+    uniform uint u_lv_slot;            /* their slots in a vertex's block */
+    uniform float u_lv_nu1;            /* light_samples / M */
 
     /* -------------------------------------------------------- sampler -- */
     const uint SLOT_PIXEL = 0u, SLOT_FIRST_VERTEX = 1u;
@@ -1232,6 +1242,222 @@ const char *const rl_gl_pt_glsl_path = GLSL(
         return 0.5 * len;
     }
 
+
+    /* ------------------------------------------------ light vertices -- */
+    /* Hybrid light paths (Schröder 2017 Sec. 8.4): the CPU traces light
+     * subpaths (bdpt's, bd_light_subpath) and hands their surface vertices
+     * y_1, y_2, ... to this shader; every BRDF vertex of a camera path joins
+     * all vertices of u_lv_connect (= M) paths drawn uniformly from the N
+     * of the set, each join divided by M: the light-vertex-cache estimator
+     * of Davidovic et al. 2014 with whole paths drawn, so the expectation
+     * over the draw is bdpt's connection term with one light subpath and no
+     * bias from the draw.
+     *
+     * MIS (power heuristic, Veach 1997 Sec. 9.2 with sample counts): a path
+     * x_0 (on a light) .. x_k (the camera's first hit), k <= max_depth + 1,
+     * is made by the strategies s' = 0 .. k (s' vertices from the light):
+     * s' = 0 a BRDF ray hits the emitter (1 sample, possible only when
+     * k <= max_depth and the light is hittable), s' = 1 next-event
+     * estimation (light_samples = a samples), s' >= 2 a join of light
+     * vertex x_{s'-1} with camera vertex x_{s'} (M samples); s' = k + 1
+     * (light tracing to the pinhole) is not done. With the counts
+     * relative to M, nu_0 = 1/M, nu_1 = a/M, nu_{>=2} = 1 (0 where a
+     * delta vertex ends the joining edge), and p_i the area densities, the
+     * weight of the strategy s that made the path is
+     *   w_s = nu_s^2 p_s^2 / sum_s' nu_s'^2 p_s'^2,
+     * and these sum to one over the strategies by construction, whatever
+     * the densities are, as long as every strategy computes the same ratios
+     * p_{j+1} / p_j = pL(x_j) / pE(x_j) (pL: density of x_j made from the
+     * light side, pE: from the camera side). Both sides follow bdpt's
+     * conventions (bdpt_path.c): densities made by a delta vertex are 1,
+     * the BRDF's density carries the event's share 1 - k_r - k_t. The sums
+     * run recursively (after Georgiev 2012, "Implementing vertex connection
+     * and merging", in area densities):
+     *   light side  R_j = (pE_j / pL_j)^2 (nu_j^2 + R_{j-1}): the CPU
+     *     stores per vertex y_i the parts that do not depend on the camera
+     *     vertex it joins (L1 = nu_i^2 / pL_i^2; L2 = (cos_{i-1} /
+     *     d_{i-1,i}^2)^2 (nu_{i-1}^2 + R_{i-2}) / (pL_i pL_{i-1})^2, split
+     *     into the part without and the part with s' = 0 so the latter can
+     *     be dropped where the path is longer than a BRDF ray can find),
+     *     and the join finishes R_i = pE_i^2 (L1 + revW^2 L2) with the two
+     *     densities it makes (pE_i from the camera vertex's BRDF, and
+     *     pE_{i-1} = revW cos / d^2 from y_i's BRDF turned to the camera);
+     *   camera side C_m = (pL_m / pE_m)^2 (nu_{m+1}^2 + C_{m+1}) = pL_m^2
+     *     A_m: lv_cam_a below, the previous vertex's A in g_ca; C at the
+     *     first hit is 0 (no light tracing).
+     * A join (s >= 2) weighs 1 / (1 + R_{s-1} + C_s); next-event
+     * estimation 1 / (1 + (pE_0 / (a pL_0))^2 + C_1 / nu_1^2); an emitter
+     * hit 1 / (1 + M^2 (pL_0 / pE_0)^2 (nu_1^2 + C_1)). Refused in
+     * gl_pathtrace.c: environments, point, spot and directional lights
+     * (delta light vertices), payload backends and shadow maps. */
+    float g_ca;                        /* A of the previous camera vertex */
+    float g_cpe;                       /* pE of the current vertex */
+    float g_ccos;                      /* |cos| at the previous vertex towards it */
+    float g_cd2;                       /* squared distance between them */
+    bool g_cok;                        /* the previous vertex joins (a BRDF vertex, not the pinhole) */
+    float g_cdir;                      /* the density the next hit is made with (1: delta) */
+
+    /* bdpt_path.c seen_from: s seen from unit w */
+    Surf turned(Surf s, vec3 w)
+    {
+        Surf r = s;
+        r.v = w;
+        if (dot(r.ng, w) < 0.0) {
+            r.ng = -r.ng;
+            r.front = !r.front;
+        }
+        if (dot(r.ns, w) < 0.0)
+            r.ns = -r.ns;
+        return r;
+    }
+
+    /* bdpt_path.c bsdf_pdf: the BRDF's density with the event's share */
+    float lv_pdf(Surf s, vec3 wi)
+    {
+        Material m = materials[s.mat];
+        float k = max(0.0, 1.0 - m.diffuse.w - m.extra.x);
+        return k > 0.0 && dot(s.ng, wi) > 0.0 ? k * phong_pdf(s, wi) : 0.0;
+    }
+
+    /* A_m of camera vertex s leaving towards wi (delta: a specular event):
+     * C_m = pL_m^2 A_m */
+    float lv_cam_a(Surf s, vec3 wi, bool delta)
+    {
+        float inv = 1.0 / (g_cpe * g_cpe);
+        float a = !delta && g_cok ? inv : 0.0;
+        if (g_ca > 0.0) {
+            float pl = delta ? 1.0 : lv_pdf(turned(s, wi), s.v) * g_ccos / g_cd2;
+            a += pl * pl * g_ca * inv;
+        }
+        return a;
+    }
+
+    /* the state of the first hit: nothing before it joins */
+    void lv_start()
+    {
+        g_ca = 0.0;
+        g_cpe = 1.0;
+        g_ccos = 1.0;
+        g_cd2 = 1.0;
+        g_cok = false;
+        g_cdir = 1.0;
+    }
+
+    /* leaving s towards dir (density pdf_dir; delta: a specular event) */
+    void lv_leave(Surf s, vec3 dir, bool delta)
+    {
+        g_ca = lv_cam_a(s, dir, delta);
+        g_cok = !delta;
+        g_ccos = abs(dot(s.ng, dir));
+        g_cdir = delta ? -1.0 : lv_pdf(s, dir);
+    }
+
+    /* arriving at s from the previous vertex at prev */
+    void lv_arrive(Surf s, vec3 prev)
+    {
+        vec3 d = s.p - prev;
+        g_cd2 = dot(d, d);
+        g_cpe = g_cdir < 0.0 ? 1.0 : g_cdir * abs(dot(s.ng, d)) / (sqrt(g_cd2) * g_cd2);
+    }
+
+    /* the weight of an emitter hit at s (x_0) after the camera's previous
+     * vertex; pmf / area the light table's density of the point, two_sided
+     * a triangle light (emission density |cos| / 2 pi, else cos / pi) */
+    float lv_hit_weight(Surf s, float pmf, float area, bool two_sided)
+    {
+        if (!(g_ca > 0.0) && !g_cok)
+            return 1.0;
+        float cos0 = abs(dot(s.ng, s.v));
+        float pl0 = pmf / area;
+        float pl1 = cos0 / (two_sided ? 2.0 * PI : PI) * g_ccos / g_cd2;
+        float nu1 = g_cok ? u_lv_nu1 : 0.0;
+        float r = pl0 / g_cpe * float(u_lv_connect);
+        float sum = r * r * (nu1 * nu1 + pl1 * pl1 * g_ca);
+        return isinf(sum) || isnan(sum) ? 0.0 : 1.0 / (1.0 + sum);
+    }
+
+    /* the weight of a light sample at camera vertex s towards unit l:
+     * light point at squared distance d2, cos_e there, the table's pmf /
+     * area, bsdf_follows && hittable: a BRDF ray could have found it */
+    float lv_nee_weight(Surf s, vec3 l, float d2, float cos_e, float pmf, float area, bool two_sided, bool hit)
+    {
+        float pl0 = pmf / area;
+        float pe0 = lv_pdf(s, l) * cos_e / d2;
+        float sum = 0.0;
+        if (hit) {
+            float r = pe0 / (pl0 * float(u_light_samples));
+            sum += r * r;
+        }
+        float pl1 = cos_e / (two_sided ? 2.0 * PI : PI) * abs(dot(s.ng, l)) / d2;
+        sum += pl1 * pl1 * lv_cam_a(s, l, false) / (u_lv_nu1 * u_lv_nu1);
+        return isinf(sum) || isnan(sum) ? 0.0 : 1.0 / (1.0 + sum);
+    }
+
+    vec4 lv_texel(uint i) { return texelFetch(u_light_vertices, int(i)); }
+    uint lv_offset(uint j) { return floatBitsToUint(lv_texel(j >> 2)[j & 3u]); }
+
+    /* The joins of camera vertex s at depth: all vertices of M light
+     * paths drawn from the set, each over M. */
+    vec3 light_vertices(Surf s, uint base, int depth)
+    {
+        vec3 sum = vec3(0.0);
+        for (int c = 0; c < u_lv_connect; ++c) {
+            seek(base + u_lv_slot + uint(c));
+            float u = sample_1d();
+            uint j = min(uint(u * float(u_lv_paths)), u_lv_paths - 1u);
+            uint first = lv_offset(j), end = lv_offset(j + 1u);
+            for (uint i = first; i < end; ++i) {
+                uint t = u_lv_base + 6u * i;
+                vec4 t0 = lv_texel(t), t1 = lv_texel(t + 1u), t2 = lv_texel(t + 2u);
+                vec4 t3 = lv_texel(t + 3u), t4 = lv_texel(t + 4u), t5 = lv_texel(t + 5u);
+                int index = int(t4.w);
+                /* pt's longest path: the light vertex's index and the
+                 * camera depth add up to at most max_depth */
+                if (index + depth > u_max_depth)
+                    break;
+                Surf y;
+                y.p = t0.xyz;
+                y.mat = floatBitsToUint(t0.w);
+                y.ng = t1.xyz;
+                y.ns = t2.xyz;
+                y.v = t3.xyz;
+                y.kd = t5.rgb;
+                y.front = true;
+                y.uv = vec2(0.0);
+                y.tri = NONE;
+                vec3 to = y.p - s.p;
+                float d2 = dot(to, to);
+                if (!(d2 > 0.0))
+                    continue;
+                vec3 wo = to * inversesqrt(d2);
+                float cos_c = dot(s.ns, wo);
+                if (cos_c <= 0.0 || dot(s.ng, wo) <= 0.0 || dot(y.ns, -wo) <= 0.0 || dot(y.ng, -wo) <= 0.0)
+                    continue;
+                float cos_y = dot(y.ng, -wo);
+                vec3 c = phong_eval(s, wo) * phong_eval(y, -wo) * t4.rgb * (cos_c * cos_y / d2);
+                if (!(max_comp(c) > 0.0))
+                    continue;
+                /* the shadow ray to y lifted off its surface by eps */
+                vec3 target = y.p + y.ng * u_eps;
+                vec3 tt = target - s.p;
+                float dist = length(tt);
+                if (!(dist > 0.0) || !visible(s, tt / dist, dist, 0u, vec2(0.0)))
+                    continue;
+                float pe_i = lv_pdf(s, wo) * cos_y / d2;
+                float rev = lv_pdf(turned(y, -wo), y.v);
+                float l2 = t2.w + (index + 1 + depth <= u_max_depth ? t3.w : 0.0);
+                float w_light = pe_i * pe_i * (t1.w + rev * rev * l2);
+                float pl_s = lv_pdf(y, -wo) * abs(dot(s.ng, wo)) / d2;
+                float w_cam = pl_s * pl_s * lv_cam_a(s, wo, false);
+                float sw = w_light + w_cam;
+                if (isinf(sw) || isnan(sw))
+                    continue;
+                sum += c * (1.0 / ((1.0 + sw) * float(u_lv_connect)));
+            }
+        }
+        return sum;
+    }
+
     /* rl_pt_lights_pick: the last k with cdf[k] <= u */
     uint pick_light(float u)
     {
@@ -1310,7 +1536,8 @@ const char *const rl_gl_pt_glsl_path = GLSL(
             if (cos_e <= 0.0 || cos_r <= 0.0 || !visible(s, l, dist, src, j))
                 continue;
             float p_light = pmf * d2 / (area * cos_e);
-            float w = bsdf_follows && hittable ? power_heuristic(float(n) * p_light, bsdf_pdf(s, l)) : 1.0;
+            float w = u_lvc ? lv_nee_weight(s, l, d2, cos_e, pmf, area, !is_light, bsdf_follows && hittable)
+                    : bsdf_follows && hittable ? power_heuristic(float(n) * p_light, bsdf_pdf(s, l)) : 1.0;
             sum += brdf_eval(s, l) * (le * (w * cos_r / (p_light * float(n))));
         }
         return sum;
@@ -1422,6 +1649,38 @@ const char *const rl_gl_pt_glsl_path = GLSL(
         return e * power_heuristic(pdf_bsdf, float(u_light_samples) * p_light);
     }
 
+    /* With light vertices: the emitter hit weighed against next-event
+     * estimation and the joins (lv_hit_weight). A quad light that no mesh
+     * covers fully keeps pt's rule (its mesh emits only to rays that did
+     * not leave a BRDF: no other strategy makes those paths), and so does
+     * a hit that no join or light sample could have made (the camera's
+     * first hit, or mirror chains from it): the material's emission. */
+    vec3 emitted_lvc(Surf s, bool after_brdf)
+    {
+        vec3 e = materials[s.mat].emission.rgb;
+        if (!(max_comp(e) > 0.0))
+            return vec3(0.0);
+        if (!after_brdf && !(g_ca > 0.0))
+            return emitted(s, false);
+        uint cover = tri_cover(s.tri);
+        if (cover == NONE) {
+            float pmf = tri_pmf(s.tri);
+            vec3 n_unused;
+            float area = triangle_area(s.tri, n_unused);
+            if (!(pmf > 0.0) || !(area > 0.0))
+                return e;
+            return e * lv_hit_weight(s, pmf, area, true);
+        }
+        Light L = lights[cover];
+        if (!(L.extra.w > 0.0))
+            return emitted(s, after_brdf);
+        vec3 nq = cross(L.dir.xyz, L.extra.xyz);
+        float area = length(nq);
+        if (!(dot(s.v, nq) > 0.0) || !(area > 0.0) || !(L.power.w > 0.0))
+            return vec3(0.0);
+        return L.power.rgb * lv_hit_weight(s, L.power.w, area, false);
+    }
+
     /* -------------------------------------------------------- Fresnel -- */
 
     /* scene/material.c rl_fresnel_schlick: eta = n_t / n_i; from the
@@ -1453,12 +1712,15 @@ const char *const rl_gl_pt_glsl_path = GLSL(
         vec3 prev = s.p;
         float prev_pdf = 0.0;
         bool gen = u_rng != 0;
+        if (u_lvc)
+            lv_start();
         for (int depth = 0;; ++depth) {
             uint base = SLOT_FIRST_VERTEX + uint(depth) * u_vertex_slots;
             Material m = materials[s.mat];
             if (m.pbr.z > 0.0)
                 g_lobe = ggx_setup(s);
-            vec3 e = u_mis ? emitted_mis(s, after_brdf, prev, prev_pdf) : emitted(s, after_brdf);
+            vec3 e = u_lvc ? emitted_lvc(s, after_brdf)
+                           : u_mis ? emitted_mis(s, after_brdf, prev, prev_pdf) : emitted(s, after_brdf);
             radiance += T * e;
 
             float k_r = m.diffuse.w, k_t = m.extra.x;
@@ -1496,6 +1758,8 @@ const char *const rl_gl_pt_glsl_path = GLSL(
                     }
                 }
                 after_brdf = false;
+                if (u_lvc)
+                    lv_leave(s, dir, true);
             } else {
                 bool last = depth >= u_max_depth;
                 radiance += T * (u_mis ? direct_light_mis(s, base, !last) : direct_light(s, base));
@@ -1503,6 +1767,8 @@ const char *const rl_gl_pt_glsl_path = GLSL(
                     radiance += T * environment_light(s, base, !last);
                 if (last)
                     break;
+                if (u_lvc)
+                    radiance += T * light_vertices(s, base, depth);
                 seek(base + SLOT_LOBE);
                 /* rl_pt_bsdf_needs_lobe: GGX picks a lobe, Phong where it has k_s */
                 float u0 = gen || m.pbr.z > 0.0 || max_comp(m.specular.rgb) > 0.0 ? sample_1d() : 0.0;
@@ -1515,6 +1781,8 @@ const char *const rl_gl_pt_glsl_path = GLSL(
                 diffuse_ray = true;
                 after_brdf = true;
                 prev_pdf = u_mis || u_env_nee ? brdf_pdf(s, dir) : 0.0;
+                if (u_lvc)
+                    lv_leave(s, dir, false);
             }
             prev = s.p;
 
@@ -1552,6 +1820,8 @@ const char *const rl_gl_pt_glsl_path = GLSL(
                 radiance += T * escaped(dir, after_brdf, prev_pdf);
                 break;
             }
+            if (u_lvc)
+                lv_arrive(next, s.p);
             s = next;
         }
         return radiance;

@@ -42,6 +42,35 @@ typedef struct bd_ctx {
     float film_area;               /* image plane at distance 1 */
 } bd_ctx;
 
+typedef enum bd_light_kind {
+    BD_LIGHT_NONE = 0, BD_LIGHT_QUAD, BD_LIGHT_TRI, BD_LIGHT_POINT, BD_LIGHT_DIRECTIONAL, BD_LIGHT_ENV
+} bd_light_kind;
+
+/* An emitter at a point: what emits, how strongly, and how a light subpath
+ * would have sampled it. */
+typedef struct bd_light {
+    bd_light_kind kind;
+    const rl_light *L;             /* point, spot, directional */
+    rl_vec3 n;                     /* quad: emitting side; triangle: its normal */
+    rl_vec3 le;                    /* area radiance; environment: its radiance along dir */
+    rl_vec3 dir;                   /* environment: unit direction from the scene towards it */
+    float pdf_pos;                 /* pmf / area, or the pmf of a delta position; environment:
+                                    * env_pick p_env(dir), in solid angle */
+    bool hittable;                 /* a camera ray can find it (s = 0 possible) */
+} bd_light;
+
+typedef enum bd_vkind { BD_V_CAMERA = 0, BD_V_LIGHT, BD_V_SURFACE } bd_vkind;
+
+typedef struct bd_vertex {
+    bd_vkind kind;
+    rl_vec3 p, ng;                 /* ng: geometric normal (surface: facing s.v); light: n */
+    pt_surface s;
+    bd_light light;                /* light vertex, or the emitter a surface is */
+    rl_vec3 beta;                  /* path throughput up to this vertex */
+    float pdf_fwd, pdf_rev;        /* area densities from its own side and from the other */
+    bool delta;                    /* scattered by a mirror / refraction event */
+} bd_vertex;
+
 /* One light-tracing contribution to a pixel's sum. */
 typedef struct bd_splat {
     uint32_t pixel;
@@ -70,5 +99,15 @@ void bd_scratch_release(bd_scratch *sc);
  * the pixel they land in. rng: the sample's own generator. */
 rl_vec3 bd_sample(const bd_ctx *ctx, bd_scratch *sc, rl_rng *rng, int x, int y, bd_splats *splats,
                   uint64_t *rays);
+
+/* The light subpath y_0 .. y_{n-1} (n returned, at most max_vertices): y_0
+ * a point on a light chosen by power (the light table, or the environment
+ * with ctx->env_pick), then a random walk carrying importance; each vertex
+ * with its throughput and its area densities pdf_fwd (from the light
+ * side) and pdf_rev (from the next vertex, set once that is sampled; 1
+ * where a delta vertex makes it). bdpt joins these to its camera subpath;
+ * gl-pt's light_paths (gl_pathtrace.c, Schröder 2017 Sec. 8.4) hands them
+ * to the GPU. */
+int bd_light_subpath(const bd_ctx *ctx, rl_rng *rng, bd_vertex *y, int max_vertices, uint64_t *rays);
 
 #endif

@@ -71,35 +71,6 @@
 
 #define SHADOW_T_SHRINK 1e-4f
 
-typedef enum bd_light_kind {
-    BD_LIGHT_NONE = 0, BD_LIGHT_QUAD, BD_LIGHT_TRI, BD_LIGHT_POINT, BD_LIGHT_DIRECTIONAL, BD_LIGHT_ENV
-} bd_light_kind;
-
-/* An emitter at a point: what emits, how strongly, and how a light subpath
- * would have sampled it. */
-typedef struct bd_light {
-    bd_light_kind kind;
-    const rl_light *L;             /* point, spot, directional */
-    rl_vec3 n;                     /* quad: emitting side; triangle: its normal */
-    rl_vec3 le;                    /* area radiance; environment: its radiance along dir */
-    rl_vec3 dir;                   /* environment: unit direction from the scene towards it */
-    float pdf_pos;                 /* pmf / area, or the pmf of a delta position; environment:
-                                    * env_pick p_env(dir), in solid angle */
-    bool hittable;                 /* a camera ray can find it (s = 0 possible) */
-} bd_light;
-
-typedef enum bd_vkind { BD_V_CAMERA = 0, BD_V_LIGHT, BD_V_SURFACE } bd_vkind;
-
-typedef struct bd_vertex {
-    bd_vkind kind;
-    rl_vec3 p, ng;                 /* ng: geometric normal (surface: facing s.v); light: n */
-    pt_surface s;
-    bd_light light;                /* light vertex, or the emitter a surface is */
-    rl_vec3 beta;                  /* path throughput up to this vertex */
-    float pdf_fwd, pdf_rev;        /* area densities from its own side and from the other */
-    bool delta;                    /* scattered by a mirror / refraction event */
-} bd_vertex;
-
 rl_status bd_scratch_init(bd_scratch *sc, int max_depth)
 {
     size_t n = (size_t)max_depth + 4;
@@ -497,8 +468,9 @@ static int walk(const bd_ctx *ctx, rl_rng *rng, rl_ray ray, rl_vec3 beta, float 
     return n;
 }
 
-/* The light subpath: y_0 on a light chosen by power, then the walk. */
-static int light_subpath(const bd_ctx *ctx, rl_rng *rng, bd_vertex *y, int max_vertices, uint64_t *rays)
+/* The light subpath: y_0 on a light chosen by power, then the walk
+ * (bdpt_internal.h; gl-pt's hybrid light paths trace theirs with it). */
+int bd_light_subpath(const bd_ctx *ctx, rl_rng *rng, bd_vertex *y, int max_vertices, uint64_t *rays)
 {
     float u_pick = rl_rng_float(rng);
     rl_vec2 x = rl_v2(rl_rng_float(rng), rl_rng_float(rng));
@@ -820,7 +792,7 @@ rl_vec3 bd_sample(const bd_ctx *ctx, bd_scratch *sc, rl_rng *rng, int x, int y, 
     bool escaped;
     int nz = walk(ctx, rng, ray, rl_v3s(1.0f), camera_pdf_dir(ctx, ray.d), false, false, z, 1, max_vertices,
                   &escaped, rays);
-    int ny = light_subpath(ctx, rng, yv, max_vertices - 1, rays);
+    int ny = bd_light_subpath(ctx, rng, yv, max_vertices - 1, rays);
 
     rl_vec3 L = rl_v3s(0.0f);
     if (escaped && wanted(ctx, 0, nz + 1)) {

@@ -67,9 +67,13 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include <math.h>
+#include <omp.h>
+
 #include "core/error.h"
 #include "core/params.h"
 #include "gl/gl_pt.h"
+#include "render/bdpt_internal.h"
 #include "render/pathtrace_internal.h"
 #include "render/renderer.h"
 #include "rl/rl_drawer.h"
@@ -148,11 +152,35 @@ static const rl_option_info gl_pt_options[] = {
     { "ggx_ms", RL_OPT_BOOL, "true",
       "GGX energy compensation (Kulla & Conty 2017, pt's tables): the light single scattering loses returns as "
       "a diffuse-like lobe; false: single scattering alone", 0, 0, NULL },
-    { "threads", RL_OPT_INT, "0", "CPU threads of the structure builds (0 = all)", 0, 1024, NULL },
+    { "light_paths", RL_OPT_INT, "0",
+      "hybrid light paths (Sec. 8.4): light subpaths the CPU traces per frame (bdpt's) for the shader to join "
+      "to its camera vertices, weighted by MIS; 0: off", 0, 1048576, NULL },
+    { "light_connect", RL_OPT_INT, "1", "light paths drawn per camera vertex, all their vertices joined", 1, 64,
+      NULL },
+    { "light_overlap", RL_OPT_BOOL, "true",
+      "trace the next frame's light paths on a CPU thread while the GPU renders this one (false: before it)", 0, 0,
+      NULL },
+    { "threads", RL_OPT_INT, "0", "CPU threads of the structure builds and of light paths traced before a frame "
+      "(0 = all)", 0, 1024, NULL },
     { "device", RL_OPT_STRING, "",
       "EGL device: auto, surfaceless or a device number; empty: $RL_EGL_DEVICE, else auto", 0, 0, NULL },
 };
 #define NUM_OPTIONS (sizeof gl_pt_options / sizeof gl_pt_options[0])
+
+/* One frame's light vertices (rl_gl_pt_light_vertices), for frame index
+ * `frame` of the accumulation. */
+typedef struct lv_set {
+    bool ready;
+    uint64_t frame;
+    uint32_t paths;
+    uint32_t *offsets;             /* paths + 1 */
+    float *data;                   /* RL_GL_PT_LV_FLOATS per vertex */
+    size_t cap;                    /* vertices data holds */
+    uint32_t *count;               /* per path, while tracing */
+    double ms;                     /* CPU time of the trace */
+    uint64_t rays;
+    rl_status st;
+} lv_set;
 
 typedef struct gl_pt_state {
     pt_backends b;                /* the light set, offsets; a CPU BVH for depth and ID layers */
@@ -177,11 +205,24 @@ typedef struct gl_pt_state {
     char drawer_device[64];
     rl_image *ids;
     bool texture_out;             /* rl_renderer_set_gl_output */
+    /* light_paths: this frame's and the next frame's light vertices */
+    lv_set lv[2];
+    double lv_trace_ms;           /* CPU time of the last frame's traces (tests, bench) */
 } gl_pt_state;
+
+static void lv_set_free(lv_set *l)
+{
+    free(l->offsets);
+    free(l->data);
+    free(l->count);
+    memset(l, 0, sizeof *l);
+}
 
 static void gl_pt_release(void *state)
 {
     gl_pt_state *s = state;
+    lv_set_free(&s->lv[0]);
+    lv_set_free(&s->lv[1]);
     rl_gl_pt_release(s->gpu);
     rl_pt_backends_release(&s->b);
     rl_gbuffer_release(s->gbuf);
@@ -232,7 +273,7 @@ static rl_status ensure_gpu(gl_pt_state *s, const rl_scene *scene, const char *d
     /* pt's energy-compensation tables, built (once per process) only for
      * a scene with a GGX material */
     _Static_assert(RL_GL_PT_GGX_NODES == RL_PT_GGX_MS_NODES, "gl-pt reads pt's GGX tables as they are");
-    static float ggx_tables[RL_PT_GGX_MS_NODES * RL_PT_GGX_MS_NODES + RL_PT_GGX_MS_NODES];
+    float ggx_tables[RL_PT_GGX_MS_NODES * RL_PT_GGX_MS_NODES + RL_PT_GGX_MS_NODES];
     const rl_scene_data *d = rl_scene_get_data(scene);
     bool ggx = false;
     for (uint32_t i = 0; d && i < d->num_materials; ++i)
@@ -459,6 +500,207 @@ static void resolve(const float *rgba, const uint64_t held[2], int w, int h, rl_
     }
 }
 
+/* A CPU BVH (for the G-buffer and the light paths), kept with the
+ * scene's data. */
+static rl_status ensure_cpu_bvh(gl_pt_state *s, const rl_scene *scene, int threads, rl_render_stats *stats)
+{
+    if (s->b.exact[RL_ACCEL_BVH])
+        return RL_OK;
+    rl_timer timer;
+    rl_timer_start(&timer);
+    rl_status st = rl_accel_create(scene, &(rl_accel_desc){ .kind = RL_ACCEL_BVH, .threads = threads },
+                                   &s->b.exact[RL_ACCEL_BVH]);
+    if (st == RL_OK)
+        st = rl_accel_commit(s->b.exact[RL_ACCEL_BVH]);
+    if (st != RL_OK) {
+        rl_accel_release(s->b.exact[RL_ACCEL_BVH]);
+        s->b.exact[RL_ACCEL_BVH] = NULL;
+        return st;
+    }
+    stats->prep_ms += rl_timer_ms(&timer);
+    return RL_OK;
+}
+
+/* ------------------------------------------------------------------------
+ * Hybrid light paths (Schröder 2017 Sec. 8.4): per frame a CPU thread
+ * traces light_paths light subpaths with bdpt's tracer (bd_light_subpath)
+ * and stores their surface vertices with the MIS quantities the shader's
+ * joins need (gl_pt_shaders.c, "light vertices", has the derivation);
+ * frame k's paths depend only on (seed, k), path j's generator on j, so
+ * the set is the same whatever the threads. */
+
+/* The counts relative to light_connect (M) of the strategies s' = 0
+ * (emitter hit; 1 sample, hittable lights only), s' = 1 (light_samples
+ * light samples) and s' >= 2 (joins, M): nu. */
+typedef struct lv_params {
+    const bd_ctx *ctx;
+    uint64_t seed;
+    int max_depth;
+    float nu0, nu1;                /* 1 / M (before the hittable test), light_samples / M */
+} lv_params;
+
+static double sq(double x) { return x * x; }
+
+/* The strategy count of s' = j (j >= 1) on path y: 0 where a delta vertex
+ * ends the joining edge y_{j-1} y_j. y_j as the stored vertex (end) is
+ * joined by its BRDF part whatever event its walk chose next, so its own
+ * flag does not count there. */
+static double lv_nu(const lv_params *p, const bd_vertex *y, int j, bool end)
+{
+    if ((!end && y[j].delta) || (j >= 2 && y[j - 1].delta))
+        return 0.0;
+    return j == 1 ? p->nu1 : 1.0;
+}
+
+/* The record of vertex y_i (i >= 1) into out
+ * (RL_GL_PT_LV_FLOATS floats; layout in gl_pt.h). */
+static void lv_record(const lv_params *p, const bd_vertex *y, int i, float *out)
+{
+    const rl_scene_data *d = p->ctx->data;
+    const bd_vertex *v = &y[i];
+    const double nu0 = y[0].light.hittable ? p->nu0 : 0.0;
+    /* R_j = (pE_j / pL_j)^2 (nu_j^2 + R_{j-1}) up to j = i - 2, the part
+     * with s' = 0 (rb) apart */
+    double ra = 0.0, rb = 0.0;
+    for (int j = 0; j <= i - 2; ++j) {
+        double pl = y[j].pdf_fwd > 0.0f ? y[j].pdf_fwd : 1.0, q = sq(y[j].pdf_rev / pl);
+        if (j == 0) {
+            rb = q * nu0 * nu0;
+        } else {
+            ra = q * (sq(lv_nu(p, y, j, false)) + ra);
+            rb = q * rb;
+        }
+    }
+    const double pli = v->pdf_fwd > 0.0f ? v->pdf_fwd : 1.0;
+    const double plp = y[i - 1].pdf_fwd > 0.0f ? y[i - 1].pdf_fwd : 1.0;
+    rl_vec3 e = rl_sub(v->p, y[i - 1].p);
+    double d2 = rl_length2(e);
+    double cosp = rl_length2(y[i - 1].ng) > 0.0f ? fabs(rl_dot(y[i - 1].ng, e)) / sqrt(d2) : 1.0;
+    double g2 = sq(cosp / d2) / sq(pli * plp);
+    double l1 = sq(lv_nu(p, y, i, true)) / sq(pli);
+    double l2a = i == 1 ? 0.0 : g2 * (sq(lv_nu(p, y, i - 1, false)) + ra);
+    double l2b = i == 1 ? g2 * nu0 * nu0 : g2 * rb;
+    const pt_surface *s = &v->s;
+    float k = rl_maxf(0.0f, 1.0f - s->m->reflectivity - s->m->transmissivity);
+    float vng = fabsf(rl_dot(s->v, s->ng));
+    /* the adjoint BRDF's shading-normal factor |v.ns| / |v.ng| (Veach 1997
+     * Sec. 5.3; bdpt's connect_inner) and the event's share in the
+     * throughput: the shader then needs only f |wo.ng| */
+    float scale = vng > 0.0f ? k * fabsf(rl_dot(s->v, s->ns)) / vng : 0.0f;
+    rl_vec3 beta = rl_scale(v->beta, scale);
+    uint32_t mat = (uint32_t)(s->m - d->materials);
+    float mat_bits;
+    memcpy(&mat_bits, &mat, sizeof mat_bits);
+    const float rec[RL_GL_PT_LV_FLOATS] = {
+        s->p.x, s->p.y, s->p.z, mat_bits,
+        s->ng.x, s->ng.y, s->ng.z, (float)l1,
+        s->ns.x, s->ns.y, s->ns.z, (float)l2a,
+        s->v.x, s->v.y, s->v.z, (float)l2b,
+        beta.x, beta.y, beta.z, (float)i,
+        s->kd.x, s->kd.y, s->kd.z, 0.0f,
+    };
+    memcpy(out, rec, sizeof rec);
+}
+
+/* Frame `frame`'s n light paths into l, with `threads` threads. */
+static rl_status lv_trace(const lv_params *p, uint64_t frame, uint32_t n, int threads, lv_set *l)
+{
+    rl_timer timer;
+    rl_timer_start(&timer);
+    const int per = p->max_depth > 0 ? p->max_depth : 1;   /* stored vertices of a path: y_1 .. y_max_depth */
+    const size_t cap = (size_t)n * (size_t)per;
+    l->ready = false;
+    if (l->paths != n || l->cap < cap) {
+        free(l->offsets);
+        free(l->data);
+        free(l->count);
+        l->offsets = rl_calloc((size_t)n + 1, sizeof *l->offsets);
+        l->count = rl_calloc(n, sizeof *l->count);
+        l->data = rl_calloc(cap, RL_GL_PT_LV_FLOATS * sizeof *l->data);
+        l->cap = cap;
+        l->paths = n;
+        if (!l->offsets || !l->count || !l->data) {
+            lv_set_free(l);
+            return l->st = RL_ERR_OUT_OF_MEMORY;
+        }
+    }
+    const uint64_t key = rl_hash64(p->seed * 0x9e3779b97f4a7c15ull + 0x6c76ull + frame);
+    uint64_t rays = 0;
+    int failed = 0;
+#pragma omp parallel num_threads(threads) reduction(+ : rays) reduction(| : failed)
+    {
+        bd_scratch sc;
+        if (bd_scratch_init(&sc, p->max_depth) != RL_OK) {
+            failed = 1;
+        } else {
+#pragma omp for schedule(dynamic, 64)
+            for (int64_t j = 0; j < (int64_t)n; ++j) {
+                rl_rng rng;
+                rl_rng_seed(&rng, key, (uint64_t)j);
+                int nv = bd_light_subpath(p->ctx, &rng, sc.light, p->max_depth + 1, &rays);
+                uint32_t c = 0;
+                for (int i = 1; i < nv; ++i) {
+                    const bd_vertex *v = &sc.light[i];
+                    if (v->kind != BD_V_SURFACE || !rl_vfinite(v->beta) ||
+                        !(rl_vmax_comp(v->beta) > 0.0f))
+                        continue;
+                    lv_record(p, sc.light, i, l->data + ((size_t)j * (size_t)per + c) * RL_GL_PT_LV_FLOATS);
+                    ++c;
+                }
+                l->count[j] = c;
+            }
+            bd_scratch_release(&sc);
+        }
+    }
+    if (failed)
+        return l->st = RL_ERR_OUT_OF_MEMORY;
+    /* packed in path order */
+    uint32_t at = 0;
+    for (uint32_t j = 0; j < n; ++j) {
+        l->offsets[j] = at;
+        if (l->count[j] && at != j * (uint32_t)per)
+            memmove(l->data + (size_t)at * RL_GL_PT_LV_FLOATS, l->data + (size_t)j * per * RL_GL_PT_LV_FLOATS,
+                    (size_t)l->count[j] * RL_GL_PT_LV_FLOATS * sizeof *l->data);
+        at += l->count[j];
+    }
+    l->offsets[n] = at;
+    l->frame = frame;
+    l->rays = rays;
+    l->ms = rl_timer_ms(&timer);
+    l->ready = true;
+    return l->st = RL_OK;
+}
+
+/* What light_paths cannot do is refused by name. */
+static rl_status lv_check(const rl_renderer *r, const rl_scene_data *d)
+{
+    if (rl_renderer_opt_enum(r, "mis") != 1)
+        return rl_error(RL_ERR_INVALID_ARG, "gl-pt: light_paths needs mis=on (its weights extend pt's MIS)");
+    static const char *const keys[2] = { "shadow", "diffuse" };
+    for (int k = 0; k < 2; ++k) {
+        rl_pt_backend b = (rl_pt_backend)rl_renderer_opt_enum(r, keys[k]);
+        if (b != RL_PT_BACKEND_BVH && b != RL_PT_BACKEND_GRID && b != RL_PT_BACKEND_LS_CANDIDATES)
+            return rl_error(RL_ERR_INVALID_ARG, "gl-pt: light_paths needs exact rays (%s=bvh, grid or "
+                            "ls-candidates), not %s=%s", keys[k], keys[k], rl_renderer_opt_string(r, keys[k]));
+    }
+    if (d->environment)
+        return rl_error(RL_ERR_UNSUPPORTED, "gl-pt: light_paths does not start light paths at a scene "
+                        "environment (bdpt does; use light_paths=0 or bdpt)");
+    /* The joins evaluate the Phong BRDF at both ends (lv_pdf, phong_eval in
+     * the shader); GGX at a light vertex is not ported there yet. */
+    for (uint32_t i = 0; i < d->num_materials; ++i)
+        if (d->materials[i].bsdf == RL_BSDF_GGX)
+            return rl_error(RL_ERR_UNSUPPORTED, "gl-pt: light_paths does not join GGX materials yet (material %u; "
+                            "use light_paths=0, or bdpt)", i);
+    if (rl_renderer_opt_enum(r, "adaptive") == 1)
+        return rl_error(RL_ERR_UNSUPPORTED, "gl-pt: light_paths with adaptive=on is not supported (one of the two)");
+    for (uint32_t i = 0; i < d->num_lights; ++i)
+        if (d->lights[i].type != RL_LIGHT_QUAD)
+            return rl_error(RL_ERR_UNSUPPORTED, "gl-pt: light_paths does not support point, spot or directional "
+                            "lights (light %u: delta light vertices; bdpt does)", i);
+    return RL_OK;
+}
+
 /* The G-buffer pt would have for this frame: with primary=raster made from
  * the GL pass's IDs (every frame, as pt rasterizes its own every frame),
  * else traced at the pixel centres through a CPU BVH once per
@@ -477,21 +719,9 @@ static rl_status frame_gbuffer(gl_pt_state *s, const rl_scene *scene, const rl_c
     }
     if (s->gbuf_traced)
         return RL_OK;
-    if (!s->b.exact[RL_ACCEL_BVH]) {
-        /* a CPU BVH only for the G-buffer, kept with the scene's data */
-        rl_timer timer;
-        rl_timer_start(&timer);
-        st = rl_accel_create(scene, &(rl_accel_desc){ .kind = RL_ACCEL_BVH, .threads = threads },
-                             &s->b.exact[RL_ACCEL_BVH]);
-        if (st == RL_OK)
-            st = rl_accel_commit(s->b.exact[RL_ACCEL_BVH]);
-        if (st != RL_OK) {
-            rl_accel_release(s->b.exact[RL_ACCEL_BVH]);
-            s->b.exact[RL_ACCEL_BVH] = NULL;
-            return st;
-        }
-        stats->prep_ms += rl_timer_ms(&timer);
-    }
+    st = ensure_cpu_bvh(s, scene, threads, stats);
+    if (st != RL_OK)
+        return st;
     st = rl_gbuffer_trace(s->gbuf, s->b.exact[RL_ACCEL_BVH], cam);
     s->gbuf_traced = st == RL_OK;
     return st;
@@ -642,8 +872,76 @@ static rl_status gl_pt_render(rl_renderer *r, void *state, const rl_scene *scene
      * resolve() fills in from the neighbours. */
     const bool texture = s->texture_out && fs.filter == RL_FILTER_NONE && !(f.checkerboard && reset);
     rl_gl_pt_set_texture_output(s->gpu, texture);
+
+    /* light_paths (Sec. 8.4): this frame's light vertices (traced during
+     * the previous frame, else now), and the next frame's traced on a CPU
+     * thread while the GPU renders this one */
+    const uint32_t light_paths = (uint32_t)rl_renderer_opt_int(r, "light_paths");
+    const int cpu_threads = threads > 0 ? threads : omp_get_max_threads();
+    bd_ctx lctx;
+    lv_params lp;
+    lv_set *next = NULL;
+    s->lv_trace_ms = 0.0;
+    if (reset)
+        s->lv[0].ready = s->lv[1].ready = false;
+    if (light_paths > 0) {
+        st = lv_check(r, d);
+        if (st == RL_OK)
+            st = ensure_cpu_bvh(s, scene, threads, stats);
+        const int connect = (int)rl_renderer_opt_int(r, "light_connect");
+        memset(&lctx, 0, sizeof lctx);
+        lctx.data = d;
+        lctx.b = &s->b;
+        lctx.max_depth = f.max_depth;
+        lctx.rr_depth = f.rr_depth;
+        lctx.rr = f.rr;
+        lctx.mis = BD_MIS_POWER;
+        lctx.only_s = lctx.only_t = -1;
+        lctx.light_share = 1.0f;   /* no environment (lv_check) */
+        lp = (lv_params){ .ctx = &lctx, .seed = (uint64_t)rl_renderer_opt_int(r, "seed"), .max_depth = f.max_depth,
+                          .nu0 = 1.0f / (float)connect, .nu1 = (float)f.light_samples / (float)connect };
+        const uint64_t k = s->frames;
+        int cur = s->lv[0].ready && s->lv[0].frame == k ? 0 : s->lv[1].ready && s->lv[1].frame == k ? 1 : -1;
+        if (st == RL_OK && cur < 0) {
+            cur = 0;
+            st = lv_trace(&lp, k, light_paths, cpu_threads, &s->lv[0]);
+            s->lv_trace_ms += s->lv[0].ms;
+        }
+        if (st == RL_OK) {
+            const rl_gl_pt_light_vertices lv = { .paths = light_paths, .offsets = s->lv[cur].offsets,
+                                                 .data = s->lv[cur].data };
+            st = rl_gl_pt_set_light_vertices(s->gpu, &lv);
+        }
+        if (st != RL_OK) {
+            free(states);
+            s->force_reset = true;
+            return st;
+        }
+        f.light_connect = connect;
+        f.light_nu1 = lp.nu1;
+        if (accumulate)
+            next = &s->lv[1 - cur];
+    }
     rl_gl_pt_result res;
-    st = rl_gl_pt_render(s->gpu, &f, texture ? NULL : s->rgba, &res);
+    rl_status next_st = RL_OK;
+    if (next && rl_renderer_opt_bool(r, "light_overlap")) {
+        /* the GL context is current on the calling thread: thread 0 */
+#pragma omp parallel num_threads(2)
+        {
+            if (omp_get_thread_num() == 0)
+                st = rl_gl_pt_render(s->gpu, &f, texture ? NULL : s->rgba, &res);
+            if (omp_get_thread_num() == 1 || omp_get_num_threads() == 1)
+                next_st = lv_trace(&lp, s->frames + 1, light_paths, 1, next);
+        }
+    } else {
+        st = rl_gl_pt_render(s->gpu, &f, texture ? NULL : s->rgba, &res);
+        if (next && st == RL_OK)
+            next_st = lv_trace(&lp, s->frames + 1, light_paths, cpu_threads, next);
+    }
+    if (next)
+        s->lv_trace_ms += next->ms;
+    if (st == RL_OK)
+        st = next_st;
     free(states);
     if (st != RL_OK) {
         s->force_reset = true;

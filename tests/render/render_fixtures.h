@@ -74,6 +74,72 @@ static inline rl_scene *fx_cornell(rl_camera *cam, int size)
     return s;
 }
 
+/* Two triangles spanning corner p and edges u, v (normal along u x v). */
+static inline void fx_room_quad(rl_scene *s, uint32_t mat, rl_vec3 p, rl_vec3 u, rl_vec3 v)
+{
+    rl_vec3 pos[4] = { p, rl_add(p, u), rl_add(rl_add(p, u), v), rl_add(p, v) };
+    uint32_t idx[6] = { 0, 1, 2, 0, 2, 3 };
+    rl_mesh_desc md = { .name = "quad", .num_vertices = 4, .positions = pos, .num_triangles = 2, .indices = idx,
+                        .material = mat };
+    uint32_t mesh, node;
+    assert_int_equal(rl_scene_add_mesh(s, &md, &mesh), RL_OK);
+    assert_int_equal(rl_scene_add_node(s, RL_NODE_ROOT, "quad", NULL, &node), RL_OK);
+    assert_int_equal(rl_scene_node_set_mesh(s, node, mesh), RL_OK);
+}
+
+static inline uint32_t fx_room_material(rl_scene *s, rl_vec3 kd, rl_vec3 emission)
+{
+    rl_material m = rl_material_default();
+    m.diffuse = kd;
+    m.emission = emission;
+    uint32_t id;
+    assert_int_equal(rl_scene_add_material(s, &m, &id), RL_OK);
+    return id;
+}
+
+/* The closed room [-1,1] x [0,2] x [-1,1] with coloured side walls. */
+static inline void fx_add_room(rl_scene *s)
+{
+    uint32_t white = fx_room_material(s, rl_v3s(0.75f), rl_v3s(0.0f));
+    uint32_t red = fx_room_material(s, rl_v3(0.7f, 0.1f, 0.1f), rl_v3s(0.0f));
+    uint32_t green = fx_room_material(s, rl_v3(0.1f, 0.6f, 0.1f), rl_v3s(0.0f));
+    fx_room_quad(s, white, rl_v3(-1, 0, -1), rl_v3(0, 0, 2), rl_v3(2, 0, 0));   /* floor */
+    fx_room_quad(s, white, rl_v3(-1, 2, -1), rl_v3(2, 0, 0), rl_v3(0, 0, 2));   /* ceiling */
+    fx_room_quad(s, white, rl_v3(-1, 0, -1), rl_v3(2, 0, 0), rl_v3(0, 2, 0));   /* back */
+    fx_room_quad(s, white, rl_v3(-1, 0, 1), rl_v3(0, 2, 0), rl_v3(2, 0, 0));    /* front */
+    fx_room_quad(s, red, rl_v3(-1, 0, -1), rl_v3(0, 2, 0), rl_v3(0, 0, 2));     /* left */
+    fx_room_quad(s, green, rl_v3(1, 0, -1), rl_v3(0, 0, 2), rl_v3(0, 2, 0));    /* right */
+}
+
+/* The room lit only through a shade (bdpt's test): a small quad lamp facing the ceiling
+ * inside an open-topped box, so every path from the camera reaches the
+ * lamp by a bounce off the ceiling; next-event estimation at the surfaces
+ * the camera sees is always shadowed. */
+static inline rl_scene *fx_shade_room(rl_camera *cam, int size)
+{
+    rl_scene *s = NULL;
+    assert_int_equal(rl_scene_create(&s), RL_OK);
+    fx_add_room(s);
+    uint32_t shade = fx_room_material(s, rl_v3s(0.5f), rl_v3s(0.0f));
+    float L = 40.0f, a = 0.1f, y = 0.5f, h = 0.25f;
+    uint32_t lamp = fx_room_material(s, rl_v3s(0.0f), rl_v3s(L));
+    fx_room_quad(s, lamp, rl_v3(-a, y, -a), rl_v3(0, 0, 2 * a), rl_v3(2 * a, 0, 0));
+    float b = a + 0.02f;
+    /* four sides from below the lamp to above it, and a bottom */
+    fx_room_quad(s, shade, rl_v3(-b, y - 0.05f, -b), rl_v3(2 * b, 0, 0), rl_v3(0, h, 0));
+    fx_room_quad(s, shade, rl_v3(-b, y - 0.05f, b), rl_v3(0, h, 0), rl_v3(2 * b, 0, 0));
+    fx_room_quad(s, shade, rl_v3(-b, y - 0.05f, -b), rl_v3(0, h, 0), rl_v3(0, 0, 2 * b));
+    fx_room_quad(s, shade, rl_v3(b, y - 0.05f, -b), rl_v3(0, 0, 2 * b), rl_v3(0, h, 0));
+    fx_room_quad(s, shade, rl_v3(-b, y - 0.05f, -b), rl_v3(0, 0, 2 * b), rl_v3(2 * b, 0, 0));
+    rl_light q = { .type = RL_LIGHT_QUAD, .color = rl_v3s(1.0f), .intensity = L, .position = rl_v3(-a, y, -a),
+                   .edge_u = rl_v3(0, 0, 2 * a), .edge_v = rl_v3(2 * a, 0, 0) };   /* u x v = +y */
+    assert_int_equal(rl_scene_add_light(s, &q), RL_OK);
+    assert_int_equal(rl_scene_commit(s), RL_OK);
+    *cam = (rl_camera){ .eye = rl_v3(0.0f, 0.6f, 0.95f), .target = rl_v3(0.0f, 0.9f, -1.0f), .fov_deg = 70.0f,
+                        .width = size, .height = size };
+    return s;
+}
+
 static inline void fx_add_box(rl_scene *s, uint32_t mat, rl_vec3 lo, rl_vec3 hi, uint32_t subdiv)
 {
     /* A box whose faces are split into subdiv x subdiv quads, so that it
