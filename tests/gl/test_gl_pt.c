@@ -1360,6 +1360,12 @@ int main(void)
         cmocka_unit_test(test_gl_pt_ray_counts_match_pts),
         cmocka_unit_test(test_gl_pt_filters_are_pts),
         cmocka_unit_test(test_gl_pt_shadow_maps_are_pts),
+    };
+    /* Part 2: the environment, GGX and adaptive sampling, which compile
+     * path-program variants of their own on llvmpipe (minutes each with a
+     * cold shader cache); ctest runs the two parts side by side
+     * (RL_TEST_PART, tests/CMakeLists.txt), all of them without it. */
+    const struct CMUnitTest tests2[] = {
         cmocka_unit_test(test_gl_pt_environment_is_pts),
         cmocka_unit_test(test_gl_pt_constant_environment_furnace),
         cmocka_unit_test(test_gl_pt_environment_seen_directly_is_exact),
@@ -1370,5 +1376,11 @@ int main(void)
         cmocka_unit_test(test_gl_pt_refuses_what_is_not_ported),
         cmocka_unit_test(test_gl_pt_unopenable_device_is_reported_unavailable),
     };
-    return cmocka_run_group_tests(tests, find_gl, NULL);
+    const char *part = getenv("RL_TEST_PART");
+    int failed = 0;
+    if (!part || strcmp(part, "2") != 0)
+        failed += cmocka_run_group_tests_name("gl-pt part 1", tests, find_gl, NULL);
+    if (!part || strcmp(part, "1") != 0)
+        failed += cmocka_run_group_tests_name("gl-pt part 2", tests2, find_gl, NULL);
+    return failed;
 }
