@@ -690,8 +690,8 @@ static rl_status lv_check(const rl_renderer *r, const rl_scene_data *d)
      * the shader); GGX at a light vertex is not ported there yet. */
     for (uint32_t i = 0; i < d->num_materials; ++i)
         if (d->materials[i].bsdf == RL_BSDF_GGX)
-            return rl_error(RL_ERR_UNSUPPORTED, "gl-pt: light_paths does not join GGX materials yet (material %u; "
-                            "use light_paths=0, or bdpt)", i);
+            return rl_error(RL_ERR_UNSUPPORTED, "gl-pt: light_paths does not join GGX materials yet (material "
+                            "'%s'; use light_paths=0, or bdpt)", d->materials[i].name);
     if (rl_renderer_opt_enum(r, "adaptive") == 1)
         return rl_error(RL_ERR_UNSUPPORTED, "gl-pt: light_paths with adaptive=on is not supported (one of the two)");
     for (uint32_t i = 0; i < d->num_lights; ++i)
