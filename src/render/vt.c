@@ -123,6 +123,10 @@ static const rl_option_info vt_options[] = {
     { "tree_depth", RL_OPT_INT, "0",
       "ray-tree criterion: compare the rays down to this recursion depth and the feelers of their hits "
       "(0 = the whole tree)", 0, 64, NULL },
+    { "deferred_split", RL_OPT_BOOL, "false",
+      "the criteria also see the deferred reflected and transmitted textures, looked up at the vertices "
+      "(ours, against the distortion of Fig. 5.8; false: the thesis, Sec. 3.5.3, refines on untextured "
+      "radiance)", 0, 0, NULL },
     { "textures", RL_OPT_ENUM, "multitexture",
       "deferred textures: multitexture (eq. 3.20, one pass), multipass (eq. 3.22), sampled (no deferral)",
       0, 0, texture_choices },
@@ -452,6 +456,7 @@ static void read_settings(rl_renderer *r, vt_settings *set)
     set->presort = rl_renderer_opt_bool(r, "presort");
     set->tree_shadow = rl_renderer_opt_enum(r, "tree_shadow");
     set->tree_depth = (int)rl_renderer_opt_int(r, "tree_depth");
+    set->deferred_split = rl_renderer_opt_bool(r, "deferred_split");
 }
 
 /* What the cached feelers depend on besides the scene. */

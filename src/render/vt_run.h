@@ -59,6 +59,8 @@ typedef struct vt_settings {
                                * feeler nodes the ray-tree criterion compares */
     int tree_depth;           /* the ray tree compared down to this
                                * recursion depth; 0 = all of it */
+    bool deferred_split;      /* the criteria see the deferred reflected and
+                               * transmitted textures (vt_sample.c) */
 } vt_settings;
 
 /* Intersection hints (Sec. 3.3.1, 6.2.2): which triangles a refined

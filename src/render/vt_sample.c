@@ -221,6 +221,31 @@ static int thread_index(void)
 
 /* The work unit of Ch. 4: a set of vertices in, their samples out, nothing
  * shared. A master-worker (MPI) version would send exactly this. */
+/* Option deferred_split: the colour the criteria compare with the deferred
+ * reflected and transmitted textures (Sec. 3.5.3) looked up at the vertex,
+ * the primary texture still white. The thesis keeps every texture out of
+ * the criteria (Sec. 3.5.3, Fig. 5.2e-f), so a reflected texture is drawn
+ * from texture coordinates interpolated over faces that nothing refined;
+ * through a curved mirror they are far from linear, and the texture comes
+ * out distorted (Fig. 5.8, left open in Sec. 5.1.2). Seeing the texels, the
+ * criteria split where a reflected texture changes between two vertices, so
+ * its edges are placed by samples, not by the interpolation. The primary
+ * texture needs no samples: its coordinates are the face's own and exact.
+ * Textures modulate k_d only, so a layer's textured radiance is its flat
+ * one plus diffuse * (texel - 1). */
+static rl_vec3 with_deferred_texels(const rl_scene_data *d, const rl_trace_sample *s)
+{
+    rl_vec3 c = s->flat;
+    for (int l = RL_TRACE_LAYER_REFLECTION; l <= RL_TRACE_LAYER_REFRACTION; ++l) {
+        const rl_trace_layer *L = &s->layers[l];
+        if (L->texture >= d->num_textures || !d->textures[L->texture])
+            continue;
+        rl_vec4 t = rl_texture_sample(d->textures[L->texture], L->uv);
+        c = rl_add(c, rl_mul(L->diffuse, rl_v3(t.x - 1.0f, t.y - 1.0f, t.z - 1.0f)));
+    }
+    return c;
+}
+
 static void sample_block(vt_run *run, vt_block *b)
 {
     double t0 = (rl_time_s() * 1000.0);
@@ -258,6 +283,8 @@ static void sample_block(vt_run *run, vt_block *b)
         vt_vertex_sample *out = &b->out[i];
         /* Without deferred textures the criteria see them too. */
         out->flat = run->set->textures == VT_TEX_SAMPLED ? s.color : s.flat;
+        if (run->set->deferred_split && run->set->textures != VT_TEX_SAMPLED)
+            out->flat = with_deferred_texels(run->data, &s);
         memcpy(b->layers[i], s.layers, sizeof b->layers[i]);
         out->tree_hash = run->want_tree ? vt_tree_hash(&tree, run->set->tree_shadow, run->set->tree_depth) : 0;
         vt_criteria_prepare(out);
