@@ -68,6 +68,10 @@ def quality_ok(q):
         assert q[part]["rmse"] is None or 0.0 <= q[part]["rmse"] <= 1.0, q
     # The table's VT objects are in view: the VT pixels are measured.
     assert q["vt_pixels"]["pixels"] > 0 and q["vt_pixels"]["ssim"] is not None, q
+    # ownVT: the same pixels, in the frame with the rest taken from Whitted.
+    o = q["vt_pixels_own"]
+    assert o["pixels"] == q["vt_pixels"]["pixels"] and o["ssim"] is not None and ssim_ok(o["ssim"]), q
+    assert o["rmse"] is not None and 0.0 <= o["rmse"] <= 1.0, q
 
 for name in ("criteria", "resolution", "quality", "threads", "visibility", "modes", "forced", "preview",
              "reduction", "overdraw", "equalrays", "deferred", "animation", "scenario"):
