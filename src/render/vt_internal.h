@@ -69,7 +69,9 @@ typedef struct vt_vertex {
  * empty, in the mesh's layer pool (vt_mesh_set_sample). */
 typedef struct vt_vertex_sample {
     rl_vec3 flat;             /* radiance with deferred textures white; with
-                               * textures=sampled the textured radiance */
+                               * textures=sampled the textured radiance;
+                               * with deferred_split the reflected and
+                               * transmitted textures applied (vt_sample.c) */
     /* flat as the criteria see it (vt_criteria_prepare): display values,
      * computed once by the thread that sampled the vertex instead of once
      * per edge test on the refining thread (three powf per end). Their HSV

@@ -219,8 +219,6 @@ static int thread_index(void)
 #endif
 }
 
-/* The work unit of Ch. 4: a set of vertices in, their samples out, nothing
- * shared. A master-worker (MPI) version would send exactly this. */
 /* Option deferred_split: the colour the criteria compare with the deferred
  * reflected and transmitted textures (Sec. 3.5.3) looked up at the vertex,
  * the primary texture still white. The thesis keeps every texture out of
@@ -246,6 +244,8 @@ static rl_vec3 with_deferred_texels(const rl_scene_data *d, const rl_trace_sampl
     return c;
 }
 
+/* The work unit of Ch. 4: a set of vertices in, their samples out, nothing
+ * shared. A master-worker (MPI) version would send exactly this. */
 static void sample_block(vt_run *run, vt_block *b)
 {
     double t0 = (rl_time_s() * 1000.0);
