@@ -304,6 +304,27 @@ PY
 run_ok "${MPI2[@]}" "$RL" --dist render table --algo vt --size 64x48 --set balance=precompute \
     --set dist_postpass=on --out "$TMP/vtppp.png"
 cmp -s "$TMP/vt1.png" "$TMP/vtppp.png" || fail "vt: dist_postpass: precompute on 2 ranks differs from one process"
+# The post-pass overlapped with the packages still out (dist_overlap):
+# with a slow worker (RL_DIST_DELAY=RANK:MS holds each of its parts back)
+# the master starts the replay while that worker's parts are out, takes
+# them as they come and traces what is not in yet; the image must stay
+# the one-process image whichever rank is slow, and with the overlap off
+# (the post-pass after the last part).
+for slow in 1 2; do
+    run_ok env RL_DIST_DELAY=$slow:700 "${MPI[@]}" "$RL" --dist "${VT[@]}" --set dist_postpass=on \
+        --set dist_overlap=1 --out "$TMP/vtov$slow.png" --stats-json "$TMP/vtov$slow.json"
+    cmp -s "$TMP/vt1.png" "$TMP/vtov$slow.png" || fail "vt: dist_overlap: rank $slow slow changed the image"
+    expect_in "$TMP/out" "^dist: post-pass: .*; overlapped, the image [0-9.]* ms after the last part"
+    python3 - "$TMP/vtov$slow.json" <<'PY' || fail "vt: dist_overlap: the dist record: $(head -c 600 "$TMP/vtov$slow.json")"
+import json, sys
+p = json.load(open(sys.argv[1]))["dist"]["postpass"]
+assert p["overlapped"] and p["early_ms"] > 0 and p["tail_ms"] >= 0 and p["traced"] > 0, p
+PY
+done
+run_ok env RL_DIST_DELAY=1:300 "${MPI[@]}" "$RL" --dist "${VT[@]}" --set dist_postpass=on --set dist_overlap=0 \
+    --out "$TMP/vtov0.png"
+cmp -s "$TMP/vt1.png" "$TMP/vtov0.png" || fail "vt: dist_overlap=0: the image differs from one process"
+expect_in "$TMP/out" "^dist: post-pass: .*; not overlapped, the image [0-9.]* ms after the last part"
 
 # reconstruct=gl: the workers refine on the CPU as always and the master
 # draws the parts with the GL drawer (Ullmann Sec. 3.5 on the GPU). The
