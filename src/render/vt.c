@@ -161,10 +161,10 @@ static const rl_option_info vt_options[] = {
       "rl --dist: the master's post-pass (Sec. 6.1.3): it replays one process' refinement over the packages' "
       "samples and traces what differs at package borders, so the image is the one-process image; the parts "
       "carry every sample (20 bytes more a vertex)", 0, 0, NULL },
-    { "dist_overlap", RL_OPT_FLOAT, "0.125",
+    { "dist_overlap", RL_OPT_FLOAT, "0",
       "rl --dist with dist_postpass: the master, with no package left to refine, starts the post-pass once at "
       "most this share of the visible faces is still out; it takes their samples as their parts come and traces "
-      "what is not in yet (the same samples: the same image); 0: after the last part", 0, 1, NULL },
+      "what is not in yet (the same samples: the same image, more rays); 0: after the last part", 0, 1, NULL },
     RL_TRACER_OPTION_ROWS,
 };
 
@@ -1235,7 +1235,10 @@ static bool postpass_progress_fn(void *user, double done)
  * missing vertices come one forced chain at a time (each stage's splits
  * decide the next), so a second round would be a round trip per stage,
  * for 0.5-10 % of a frame's samples spread over its stages
- * (docs/distributed.md, "The post-pass"). */
+ * (docs/distributed.md, "The post-pass"). Overlapped (dist_overlap,
+ * rl_vt_postpass_add), the replay starts before the last part: s->pp_map
+ * then grows between stages, and a vertex whose part is not in yet is
+ * traced here like one no part has, to the same sample. */
 static rl_status draw_postpass(rl_renderer *r, vt_state *s, const rl_scene *scene, const rl_camera *cam,
                                vt_run *run)
 {
