@@ -321,6 +321,16 @@ p = json.load(open(sys.argv[1]))["dist"]["postpass"]
 assert p["overlapped"] and p["early_ms"] > 0 and p["tail_ms"] >= 0 and p["traced"] > 0, p
 PY
 done
+# A worker killed after its first package while rank 1 is slow: the
+# replay starts with both their packages out, traces what never comes,
+# and the master collects the rest once the lost worker's timeout ends.
+"${RECOVER[@]}" RL_DIST_FAULT=2:1 RL_DIST_DELAY=1:500 timeout 60 mpirun --oversubscribe -np 3 "$RL" --dist "${VT[@]}" \
+    --set dist_postpass=on --set dist_overlap=1 --out "$TMP/vtov-lost.png" >"$TMP/out" 2>"$TMP/err"
+rc=$?
+[ "$rc" -eq 0 ] || fail "vt: dist_overlap with a lost worker: exit $rc: $(grep -v '^\[' "$TMP/err" | head -c 600)"
+cmp -s "$TMP/vt1.png" "$TMP/vtov-lost.png" || fail "vt: dist_overlap: a lost worker changed the image"
+expect_in "$TMP/out" "^dist: 1 worker lost"
+expect_in "$TMP/out" "^dist: post-pass: .*; overlapped"
 run_ok env RL_DIST_DELAY=1:300 "${MPI[@]}" "$RL" --dist "${VT[@]}" --set dist_postpass=on --set dist_overlap=0 \
     --out "$TMP/vtov0.png"
 cmp -s "$TMP/vt1.png" "$TMP/vtov0.png" || fail "vt: dist_overlap=0: the image differs from one process"
