@@ -385,6 +385,9 @@ PY
 expect_exit 2 "$RL" bench dist --vt-postpass maybe
 grep -q "^rl: error: bench dist: --vt-postpass: expected off, on or off,on" "$TMP/err" ||
     fail "bench dist --vt-postpass maybe: $(cat "$TMP/err")"
+expect_exit 2 "$RL" bench dist --vt-overlap 2
+grep -q "^rl: error: bench dist: --vt-overlap: expected a share from 0 to 1, got '2'" "$TMP/err" ||
+    fail "bench dist --vt-overlap 2: $(cat "$TMP/err")"
 expect_exit 2 "$RL" bench dist --ranks 0,2
 grep -q "^rl: error: bench dist: --ranks: expected" "$TMP/err" || fail "bench dist --ranks 0: $(cat "$TMP/err")"
 
