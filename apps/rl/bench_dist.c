@@ -58,6 +58,7 @@ static const char bench_dist_help[] =
     "  --size WxH         tiles: image size; default 640x480\n"
     "  --vt-size WxH      vt: image size; default 320x240\n"
     "  --vt-postpass L    vt: the option dist_postpass, each of off,on; default off,on\n"
+    "  --vt-overlap S     vt: the option dist_overlap of the post-pass runs, 0..1; default 0\n"
     "  --spp N            tiles: pt's samples per pixel; default 4\n"
     "  --eval-scene S     sampling: scene; default city:blocks=2\n"
     "  --samples N        sampling: samples of the visibility property; default 64\n"
@@ -81,7 +82,7 @@ static const char *const section_names[SEC_COUNT] = { "tiles", "sampling", "vt" 
 #define CHILD_TIMEOUT_S 900.0
 
 typedef struct bd_args {
-    const char *scenes, *eval_scene, *mpirun, *out, *vt_postpass;
+    const char *scenes, *eval_scene, *mpirun, *out, *vt_postpass, *vt_overlap;
     int ranks[MAX_RANKS], num_ranks;
     long long threads, spp, samples, repeats;
     int width, height, vt_width, vt_height;
@@ -474,8 +475,8 @@ static void vt_after(bd_ctx *c, int ranks, cJSON *entry, void *user)
         printf("  %-28s %3d ranks: SSIM %.5f on %s against one rank%s", "", ranks, m.ssim,
                q->mask ? "the VT pixels" : "all pixels", same ? ", identical" : "");
         if (pp)
-            printf("; post-pass %.0f traced, %.0f from the parts, %.1f ms", num(pp, "traced"), num(pp, "reused"),
-                   num(pp, "time_ms"));
+            printf("; post-pass %.0f traced, %.0f from the parts, %.1f ms, the image %.1f ms after the last part",
+                   num(pp, "traced"), num(pp, "reused"), num(pp, "time_ms"), num(pp, "tail_ms"));
         printf("\n");
     }
     rl_image_release(img);
@@ -509,11 +510,13 @@ static rl_status sec_vt(void *ctx, cJSON *sec)
             const bool post = k % 2 == 1;
             if (!strstr(a->vt_postpass, post ? "on" : "off"))
                 continue;
-            char balance[48], postpass[48];
+            char balance[48], postpass[48], overlap[64];
             snprintf(balance, sizeof balance, "balance=%s", balances[k / 2]);
             snprintf(postpass, sizeof postpass, "dist_postpass=%s", post ? "on" : "off");
+            snprintf(overlap, sizeof overlap, "dist_overlap=%s", a->vt_overlap);
             const char *cmd[] = { "render", scene, "--algo", "vt", "--size", size, "--set", threads, "--set", balance,
-                                  "--set", postpass, "--out", png, "--stats-json", json, "-q", NULL };
+                                  "--set", postpass, "--set", overlap, "--out", png, "--stats-json", json, "-q",
+                                  NULL };
             char label[128];
             snprintf(label, sizeof label, "vt %s %s%s", scene, balances[k / 2], post ? " post-pass" : "");
             note("vt: %s", label);
@@ -522,6 +525,8 @@ static rl_status sec_vt(void *ctx, cJSON *sec)
             cJSON_AddStringToObject(w, "algorithm", "vt");
             cJSON_AddStringToObject(w, "balance", balances[k / 2]);
             cJSON_AddStringToObject(w, "dist_postpass", post ? "on" : "off");
+            if (post)
+                cJSON_AddNumberToObject(w, "dist_overlap", strtod(a->vt_overlap, NULL));
             cJSON_AddStringToObject(w, "size", size);
             cJSON_AddNumberToObject(w, "vt_pixels", (double)q.mask_pixels);
             cJSON *runs = cJSON_AddArrayToObject(w, "ranks");
@@ -554,6 +559,7 @@ static int parse_args(int argc, char **argv, bd_args *a)
         RL_BENCH_SIZE("--size", &a->width, &a->height, &a->has_size),
         RL_BENCH_SIZE("--vt-size", &a->vt_width, &a->vt_height, &a->has_vt_size),
         RL_BENCH_STRING("--vt-postpass", &a->vt_postpass),
+        RL_BENCH_STRING("--vt-overlap", &a->vt_overlap),
         RL_BENCH_COUNT("--spp", 1 << 20, &a->spp, &a->has_spp),
         RL_BENCH_STRING("--eval-scene", &a->eval_scene),
         RL_BENCH_COUNT("--samples", 1 << 24, &a->samples, &a->has_samples),
@@ -591,6 +597,13 @@ static int parse_args(int argc, char **argv, bd_args *a)
                             a->vt_postpass);
         p += n + (p[n] == ',');
     }
+    if (!a->vt_overlap)
+        a->vt_overlap = "0";
+    char *end = NULL;
+    double overlap = strtod(a->vt_overlap, &end);
+    if (end == a->vt_overlap || *end || !(overlap >= 0.0 && overlap <= 1.0))
+        return cli_fail(RL_CLI_USAGE, "bench dist: --vt-overlap: expected a share from 0 to 1, got '%s'",
+                        a->vt_overlap);
     if (!a->has_spp)
         a->spp = a->quick ? 1 : 4;
     if (!a->eval_scene)

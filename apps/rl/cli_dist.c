@@ -143,6 +143,9 @@ cJSON *cli_dist_json(void)
             cJSON_AddNumberToObject(pp, "reused", (double)last.postpass_reused);
             cJSON_AddNumberToObject(pp, "traced", (double)last.postpass_traced);
             cJSON_AddNumberToObject(pp, "time_ms", last.postpass_ms);
+            cJSON_AddBoolToObject(pp, "overlapped", last.postpass_overlapped);
+            cJSON_AddNumberToObject(pp, "early_ms", last.postpass_early_ms);
+            cJSON_AddNumberToObject(pp, "tail_ms", last.postpass_tail_ms);
         }
     }
     cJSON *ranks = cJSON_AddArrayToObject(o, "per_rank");
@@ -175,9 +178,10 @@ void cli_print_dist_summary(FILE *out)
         fprintf(out, "dist: %llu result%s of an older camera dropped\n", (unsigned long long)last.dropped,
                 last.dropped == 1 ? "" : "s");
     if (last.postpass)
-        fprintf(out, "dist: post-pass: %llu samples from the parts, %llu traced on the master, %.1f ms\n",
-                (unsigned long long)last.postpass_reused, (unsigned long long)last.postpass_traced,
-                last.postpass_ms);
+        fprintf(out, "dist: post-pass: %llu samples from the parts, %llu traced on the master, %.1f ms; %s, the "
+                "image %.1f ms after the last part\n", (unsigned long long)last.postpass_reused,
+                (unsigned long long)last.postpass_traced, last.postpass_ms,
+                last.postpass_overlapped ? "overlapped" : "not overlapped", last.postpass_tail_ms);
     for (int k = 0; k < last.ranks; k++) {
         const rl_dist_rank_stats *p = &last.per_rank[k];
         double idle = last.time_ms > 0.0 ? 100.0 * (1.0 - p->busy_ms / last.time_ms) : 0.0;

@@ -74,6 +74,13 @@ typedef struct rl_dist_stats {
     bool postpass;
     uint64_t postpass_reused, postpass_traced;
     double postpass_ms;
+    /* ... overlapped with the packages still out (option dist_overlap):
+     * whether it started before the last part came, the time it ran
+     * before the last part came, and the master's time from the last part
+     * (or the master's own last package) to the finished image: what the
+     * overlap shortens. */
+    bool postpass_overlapped;
+    double postpass_early_ms, postpass_tail_ms;
     /* Per rank, rank 0 (the master, which renders bands between its
      * messages) first; NULL when the frame ran in one process. Owned by
      * the rl_dist, valid until its next frame or release. */

@@ -150,6 +150,25 @@ RL_API rl_status rl_vt_estimate_costs(rl_renderer *r, const rl_scene *scene, con
 RL_API rl_status rl_vt_draw_parts(rl_renderer *r, const rl_scene *scene, const rl_camera *cam, rl_image *image,
                                   const void *const *parts, const size_t *sizes, size_t count,
                                   rl_render_stats *stats);
+/* The post-pass overlapped with the packages still out (option
+ * dist_postpass; Ullmann 2003, Sec. 6.1.3; docs/distributed.md, "The
+ * post-pass overlapped"): the master adds every part as it comes
+ * (rl_vt_postpass_add: checked as rl_vt_part_check, its samples taken
+ * into r's map; the part must stay valid until rl_vt_postpass_draw
+ * returns) and may start rl_vt_postpass_draw before all are in. The
+ * replay takes a vertex's sample from the parts added so far and traces
+ * it when none has it, which gives the same sample, so the image is the
+ * one-process image whichever parts came when. Between its refinement
+ * stages it calls r's progress callback, from which the caller may add
+ * the parts that came meanwhile. rl_vt_postpass_draw draws as
+ * rl_vt_draw_parts does with dist_postpass and forgets the added parts;
+ * rl_vt_postpass_clear forgets them without drawing (a frame that
+ * failed). rl_vt_draw_parts with dist_postpass is clear, add every part,
+ * draw. */
+RL_API rl_status rl_vt_postpass_add(rl_renderer *r, const void *part, size_t size);
+RL_API rl_status rl_vt_postpass_draw(rl_renderer *r, const rl_scene *scene, const rl_camera *cam, rl_image *image,
+                                     rl_render_stats *stats);
+RL_API void rl_vt_postpass_clear(rl_renderer *r);
 /* Checks a part without a scene (magic, version, counts against its size,
  * checksum, vertex indices): RL_OK with its vertex and face counts, or
  * RL_ERR_PARSE saying what is wrong. vertices and faces may be NULL. */

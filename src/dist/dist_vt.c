@@ -151,6 +151,19 @@ static bool stale_point(const rl_dist *d, uint64_t tasks)
     return e && sscanf(e, "%d:%llu", &rank, &after) == 2 && rank == d->rank && tasks == after;
 }
 
+/* Test hook of the overlapped post-pass (docs/distributed.md):
+ * RL_DIST_DELAY=RANK:MS makes rank RANK wait MS ms before it sends each
+ * package's result, as a slow worker would, so that the master's
+ * post-pass starts while its parts are still out and takes them late.
+ * The image must not change. */
+static double delay_ms(const rl_dist *d)
+{
+    const char *e = getenv("RL_DIST_DELAY");
+    int rank = -1;
+    double ms = 0.0;
+    return e && sscanf(e, "%d:%lf", &rank, &ms) == 2 && rank == d->rank && ms > 0.0 ? ms : 0.0;
+}
+
 /* A worker's frame: packages until DONE, whose status it returns. */
 static rl_status vt_work(rl_dist *d, rl_renderer *r, const rl_scene *scene, const rl_camera *cam,
                          rl_image *image, uint64_t camera)
@@ -272,6 +285,9 @@ static rl_status vt_work(rl_dist *d, rl_renderer *r, const rl_scene *scene, cons
                 break;
             }
         }
+        const double delay = delay_ms(d);
+        for (const double t0 = rl_time_s(); delay > 0.0 && (rl_time_s() - t0) * 1000.0 < delay;)
+            rl_dist_pause();
         st = out_post(o, &res, part, part_size);
         free(part);
         if (st != RL_OK) {
@@ -313,6 +329,12 @@ typedef struct vt_lead_ctx {
     vt_worker *ws;
     uint64_t camera;
     int remaining;
+    /* The overlapped post-pass (option dist_overlap): every part goes into
+     * r's sample map as it comes (rl_vt_postpass_add), so that a replay
+     * started before the last part takes it when it is in. */
+    rl_renderer *r;
+    bool feed;
+    double last_part_s;          /* when the last part came (or the master's own was done) */
 } vt_lead_ctx;
 
 static rl_status add_package(vt_lead_ctx *c, uint32_t first, uint32_t count, int owner)
@@ -471,7 +493,10 @@ static rl_status take_answer(vt_lead_ctx *c, int w, unsigned char *buf, size_t s
         free(buf);                   /* a lost worker's late answer: redone meanwhile */
         return RL_OK;
     }
-    rl_status st = rl_vt_part_check(buf + sizeof res, size - sizeof res, NULL, NULL);
+    /* Fed to the post-pass' map at once (which checks it as
+     * rl_vt_part_check does), or checked now and used at the end. */
+    rl_status st = c->feed ? rl_vt_postpass_add(c->r, buf + sizeof res, size - sizeof res)
+                           : rl_vt_part_check(buf + sizeof res, size - sizeof res, NULL, NULL);
     if (st != RL_OK) {
         free(buf);
         snprintf(failure, n, "rank %d: package %d: %s", w, res.package, rl_last_error());
@@ -483,6 +508,7 @@ static rl_status take_answer(vt_lead_ctx *c, int w, unsigned char *buf, size_t s
     pk->state = 2;
     pk->rank = w;
     --c->remaining;
+    c->last_part_s = rl_time_s();
     c->d->per_rank[w].tasks++;
     c->d->per_rank[w].pixels += res.faces;
     c->d->per_rank[w].busy_ms += res.busy_ms;
@@ -605,6 +631,11 @@ static bool package_progress(void *user, double done)
     if (p->serve && main_thread && p->code == MPI_SUCCESS && p->st == RL_OK) {
         int arrived = 0, completed = 0;
         p->code = take_parts(p->serve, &p->st, p->failure, sizeof p->failure, &completed);
+        if (completed) {
+            p->done = 0.0;
+            for (size_t i = 0; i < p->serve->num_pkg; ++i)
+                p->done += p->serve->pkg[i].state == 2 ? p->serve->pkg[i].count : 0;
+        }
         if (p->code == MPI_SUCCESS)
             p->code = take_headers(p->serve, &arrived);
         if (p->code == MPI_SUCCESS && p->st == RL_OK && arrived && (p->st = hand_out(p->serve)) != RL_OK)
@@ -625,8 +656,33 @@ static bool calibrated(const vt_lead_ctx *c, size_t calibration)
     return true;
 }
 
+/* The share of the visible faces whose packages are not in yet. */
+static double share_out(const vt_lead_ctx *c, uint32_t n)
+{
+    uint64_t out = 0;
+    for (size_t i = 0; i < c->num_pkg; ++i)
+        out += c->pkg[i].state != 2 ? c->pkg[i].count : 0;
+    return n ? (double)out / n : 0.0;
+}
+
 /* The master's frame. A worker silent past the timeout with packages in
- * hand is taken for lost: they go to whoever is free, it gets no more. */
+ * hand is taken for lost: they go to whoever is free, it gets no more.
+ *
+ * The overlapped post-pass (dist_postpass with dist_overlap > 0; Ullmann
+ * 2003, Sec. 6.1.3; docs/distributed.md, "The post-pass overlapped"): the
+ * replay of one process' refinement runs stage by stage over the whole
+ * frame (its stages are octaves of the frame's longest edge, and the
+ * order of splits decides the mesh), so it cannot be cut into the
+ * packages' regions, and its first stage needs every package's primary
+ * vertices: waiting for the parts a stage needs would start it after the
+ * last one. Instead, once the master has no package of its own left and
+ * at most the share dist_overlap of the faces is out, it starts the
+ * replay with the parts in so far, takes every part that comes meanwhile
+ * into the replay's map (between stages, package_progress) and traces a
+ * vertex whose part is not in yet: a sample depends only on its vertex,
+ * so it is the sample the part brings, and the image is the one-process
+ * image whenever the parts come. What the master traces twice is bounded
+ * by the faces still out when it starts. */
 static rl_status vt_lead(rl_dist *d, rl_renderer *r, const rl_scene *scene, const rl_camera *cam,
                          rl_image *image, uint64_t camera, rl_render_stats *stats, rl_dist_stats *ds)
 {
@@ -663,6 +719,15 @@ static rl_status vt_lead(rl_dist *d, rl_renderer *r, const rl_scene *scene, cons
         return RL_ERR_OUT_OF_MEMORY;         /* the CLI aborts the job */
     }
     faces = own_faces;
+    const bool postpass = rl_renderer_opt_bool(r, "dist_postpass");
+    const double overlap = postpass ? rl_renderer_opt_float(r, "dist_overlap") : 0.0;
+    c.r = r;
+    c.feed = postpass && overlap > 0.0;
+    c.last_part_s = rl_time_s();
+    if (postpass)
+        rl_vt_postpass_clear(r);     /* nothing of an earlier frame */
+    bool replayed = false;
+    double replay_start = 0.0, replay_end = 0.0;
     for (int w = 0; w < d->size; ++w)
         for (int k = 0; k < SLOTS; ++k)
             c.ws[w].out[k] = -1;
@@ -726,7 +791,10 @@ static rl_status vt_lead(rl_dist *d, rl_renderer *r, const rl_scene *scene, cons
         for (int w = 1; w < d->size; ++w)
             if (!c.ws[w].lost)
                 outstanding += c.ws[w].pending + c.ws[w].receiving;
-        if (st == RL_OK ? c.remaining == 0 && rest_count == 0 : outstanding == 0)
+        /* After an overlapped post-pass the image is drawn: the packages
+         * still out are only collected (their workers wait for that). */
+        if (st == RL_OK ? (c.remaining == 0 && rest_count == 0) || (replayed && outstanding == 0)
+                        : outstanding == 0)
             break;
         if (vp.cancelled && st == RL_OK) {
             st = RL_ERR_CANCELLED;           /* no more packages out; drain the rest */
@@ -755,7 +823,7 @@ static rl_status vt_lead(rl_dist *d, rl_renderer *r, const rl_scene *scene, cons
             if (st != RL_OK)
                 snprintf(failure, sizeof failure, "%s", rl_last_error());
         }
-        if (st == RL_OK && (st = hand_out(&c)) != RL_OK)
+        if (st == RL_OK && !replayed && (st = hand_out(&c)) != RL_OK)
             snprintf(failure, sizeof failure, "%s", rl_last_error());
         int arrived = 0;
         if ((code = take_headers(&c, &arrived)) != MPI_SUCCESS)
@@ -763,7 +831,7 @@ static rl_status vt_lead(rl_dist *d, rl_renderer *r, const rl_scene *scene, cons
         if (arrived)
             continue;
         /* Nothing to answer: refine a package here. */
-        int p = st == RL_OK ? next_for(&c, 0) : -1;
+        int p = st == RL_OK && !replayed ? next_for(&c, 0) : -1;
         if (p >= 0) {
             package *pk = &c.pkg[p];
             rl_render_stats ps = { 0 };
@@ -793,6 +861,11 @@ static rl_status vt_lead(rl_dist *d, rl_renderer *r, const rl_scene *scene, cons
             pk->rank = 0;
             pk->part_offset = 0;
             --c.remaining;
+            c.last_part_s = rl_time_s();
+            if (c.feed && (st = rl_vt_postpass_add(r, pk->part, pk->part_size)) != RL_OK) {
+                snprintf(failure, sizeof failure, "%s", rl_last_error());
+                continue;
+            }
             ++d->per_rank[0].tasks;
             d->per_rank[0].pixels += pk->count;
             c.cost_done[0] += pk->cost;
@@ -802,6 +875,30 @@ static rl_status vt_lead(rl_dist *d, rl_renderer *r, const rl_scene *scene, cons
             vp.done += pk->count;
             package_progress(&vp, 0.0);
             rl_dist_fault_point(d);
+            continue;
+        }
+        /* Nothing of its own left: the post-pass, overlapped with the
+         * packages still out once few are (above). */
+        if (p < 0 && c.feed && !replayed && st == RL_OK && rest_count == 0 && share_out(&c, n) <= overlap) {
+            vp.current = 0.0;
+            vp.serve = &c;
+            replay_start = rl_time_s();
+            rl_status rs = rl_vt_postpass_draw(r, scene, cam, image, stats);
+            replay_end = rl_time_s();
+            vp.serve = NULL;
+            replayed = true;
+            if (vp.code != MPI_SUCCESS) {
+                code = vp.code;
+                break;
+            }
+            if (vp.st != RL_OK && st == RL_OK) {
+                st = vp.st;
+                snprintf(failure, sizeof failure, "%s", vp.failure);
+            }
+            if (rs != RL_OK && st == RL_OK) {
+                st = rs;
+                snprintf(failure, sizeof failure, "%s", rl_last_error());
+            }
             continue;
         }
         /* Waiting: a worker silent past the timeout is lost. */
@@ -873,19 +970,33 @@ static rl_status vt_lead(rl_dist *d, rl_renderer *r, const rl_scene *scene, cons
         }
         rl_timer tm;
         rl_timer_start(&tm);
-        if (st == RL_OK && (st = rl_vt_draw_parts(r, scene, cam, image, parts, sizes, c.num_pkg, stats)) != RL_OK)
+        /* Drawn already by the overlapped post-pass; else now, from the
+         * parts fed to the post-pass' map as they came, or from all. */
+        if (st == RL_OK && !replayed &&
+            (st = c.feed ? rl_vt_postpass_draw(r, scene, cam, image, stats)
+                         : rl_vt_draw_parts(r, scene, cam, image, parts, sizes, c.num_pkg, stats)) != RL_OK)
             snprintf(failure, sizeof failure, "%s", rl_last_error());
+        const double image_s = replayed ? replay_end : rl_time_s();
         rl_vt_stats vs;
-        if (st == RL_OK && rl_renderer_opt_bool(r, "dist_postpass") && rl_vt_get_stats(r, &vs) == RL_OK) {
+        if (st == RL_OK && postpass && rl_vt_get_stats(r, &vs) == RL_OK) {
             ds->postpass = true;
             ds->postpass_reused = vs.postpass_reused;
             ds->postpass_traced = vs.postpass_traced;
             ds->postpass_ms = vs.time_refine_ms + vs.time_sampling_ms;
+            ds->postpass_overlapped = replayed && replay_start < c.last_part_s;
+            const double early = replayed ? (replay_end < c.last_part_s ? replay_end : c.last_part_s) - replay_start
+                                          : 0.0;
+            ds->postpass_early_ms = early > 0.0 ? 1000.0 * early : 0.0;
+            ds->postpass_tail_ms = image_s > c.last_part_s ? 1000.0 * (image_s - c.last_part_s) : 0.0;
         }
+        if (replayed)
+            d->per_rank[0].busy_ms += 1000.0 * (replay_end - replay_start);
         d->per_rank[0].busy_ms += rl_timer_ms(&tm) + estimate_ms;
         free(parts);
         free(sizes);
     }
+    if (postpass)
+        rl_vt_postpass_clear(r);     /* its map points into the parts */
     for (size_t i = 0; i < c.num_pkg; ++i)
         free(c.pkg[i].part);
     free(c.pkg);

@@ -165,6 +165,10 @@ static const rl_option_info vt_options[] = {
       "rl --dist: the master's post-pass (Sec. 6.1.3): it replays one process' refinement over the packages' "
       "samples and traces what differs at package borders, so the image is the one-process image; the parts "
       "carry every sample (20 bytes more a vertex)", 0, 0, NULL },
+    { "dist_overlap", RL_OPT_FLOAT, "0",
+      "rl --dist with dist_postpass: the master, with no package left to refine, starts the post-pass once at "
+      "most this share of the visible faces is still out; it takes their samples as their parts come and traces "
+      "what is not in yet (the same samples: the same image, more rays); 0: after the last part", 0, 1, NULL },
     RL_TRACER_OPTION_ROWS,
 };
 
@@ -223,6 +227,10 @@ typedef struct vt_state {
     uint32_t *prep_list;      /* the visible ones, ascending */
     size_t prep_count;
     uint8_t *package;         /* per primary face: in the package being refined */
+    /* the master's post-pass (dist_postpass): the samples of the parts
+     * added so far (rl_vt_postpass_add), by vertex key; it points into
+     * the caller's parts and is emptied after every post-pass drawing */
+    vt_part_samples pp_map;
 } vt_state;
 
 /* Temporal coherence (Sec. 3.4.5) is the only state a frame leaves for the
@@ -258,6 +266,7 @@ static void vt_release(void *state)
     free(s->prep_visible);
     free(s->prep_list);
     free(s->package);
+    vt_part_samples_free(&s->pp_map);
 }
 
 /* The kept rasterizer, pre-pass image and scratch depth (for an image
@@ -1231,17 +1240,16 @@ static bool postpass_progress_fn(void *user, double done)
  * missing vertices come one forced chain at a time (each stage's splits
  * decide the next), so a second round would be a round trip per stage,
  * for 0.5-10 % of a frame's samples spread over its stages
- * (docs/distributed.md, "The post-pass"). */
+ * (docs/distributed.md, "The post-pass"). Overlapped (dist_overlap,
+ * rl_vt_postpass_add), the replay starts before the last part: s->pp_map
+ * then grows between stages, and a vertex whose part is not in yet is
+ * traced here like one no part has, to the same sample. */
 static rl_status draw_postpass(rl_renderer *r, vt_state *s, const rl_scene *scene, const rl_camera *cam,
-                               vt_run *run, const void *const *parts, const size_t *sizes, size_t count)
+                               vt_run *run)
 {
     rl_timer t;
     rl_timer_start(&t);
     rl_status st = dist_prepass(r, s, scene, cam, run);
-    vt_part_samples given;
-    memset(&given, 0, sizeof given);
-    if (st == RL_OK)
-        st = vt_part_samples_build(&given, parts, sizes, count);
     vt_mesh *m = &s->mesh;
     if (st == RL_OK) {
         /* As vt_prepass leaves the mesh: the ID test's faces visible. */
@@ -1253,7 +1261,10 @@ static rl_status draw_postpass(rl_renderer *r, vt_state *s, const rl_scene *scen
             run->stats.visible_primary_faces += s->prep_visible[f];
         }
         vt_project_primary(run, s->depth_ids);
-        run->given = &given;
+        /* The map may grow while the replay runs: the caller's progress
+         * callback, called after every stage, may add parts that came
+         * meanwhile (rl_vt_postpass_add; the overlapped post-pass). */
+        run->given = &s->pp_map;
         postpass_progress pp;
         rl_renderer_get_progress(r, &pp.fn, &pp.user);
         rl_renderer_set_progress(r, postpass_progress_fn, &pp);
@@ -1261,7 +1272,6 @@ static rl_status draw_postpass(rl_renderer *r, vt_state *s, const rl_scene *scen
         rl_renderer_set_progress(r, pp.fn, pp.user);
         run->given = NULL;
     }
-    vt_part_samples_free(&given);
     run->stats.time_visibility_ms = rl_timer_ms(&t) - run->stats.time_refine_ms - run->stats.time_sampling_ms;
     if (st == RL_OK)
         st = vt_draw_base(run);
@@ -1283,6 +1293,70 @@ static rl_status draw_postpass(rl_renderer *r, vt_state *s, const rl_scene *scen
     return st;
 }
 
+/* The post-pass' frame over the samples in s->pp_map, which it empties
+ * at its end (the map points into the caller's parts). */
+static rl_status postpass_frame(rl_renderer *r, vt_state *s, const rl_scene *scene, const rl_camera *cam,
+                                rl_image *image, rl_render_stats *stats)
+{
+    vt_settings set;
+    rl_camera c;
+    rl_tracer *tracer;
+    vt_run run;
+    rl_status st = dist_begin(r, s, scene, cam, image, &set, &c, &tracer, &run);
+    /* Only the master draws, so only it needs the GL drawer of
+     * reconstruct = gl: the workers' pre-pass and refinement are the CPU's
+     * in either mode, as in one process. */
+    rl_drawer *gl = NULL;
+    if (st == RL_OK && (st = gl_drawer_for(r, s, scene, &set, image, &gl)) == RL_OK)
+        run.drawer = gl;
+    if (st == RL_OK)
+        st = draw_postpass(r, s, scene, &c, &run);
+    if (st == RL_OK) {
+        run.stats.mesh_bytes = vt_mesh_bytes(&s->mesh);
+        s->stats = run.stats;
+        s->have_frame = true;
+        if (stats) {
+            for (int k = 0; k < RL_RAY_TYPE_COUNT; ++k)
+                stats->rays[k] += run.rays[k];
+            stats->samples += run.stats.vertices_sampled;
+            stats->triangles_rasterized += run.counters.triangles_drawn;
+            stats->pixels_written += run.counters.pixels_written;
+        }
+    }
+    dist_end(&run, tracer);
+    vt_part_samples_free(&s->pp_map);
+    return st;
+}
+
+rl_status rl_vt_postpass_add(rl_renderer *r, const void *part, size_t size)
+{
+    vt_state *s = vt_of(r, "rl_vt_postpass_add");
+    if (!s)
+        return RL_ERR_INVALID_ARG;
+    uint32_t nv, nf;
+    rl_status st = vt_part_check(part, size, &nv, &nf);
+    if (st != RL_OK)
+        return st;
+    return vt_part_samples_add(&s->pp_map, part, size);
+}
+
+void rl_vt_postpass_clear(rl_renderer *r)
+{
+    vt_state *s = r && strcmp(rl_renderer_name(r), "vt") == 0 ? rl_renderer_state(r) : NULL;
+    if (s)
+        vt_part_samples_free(&s->pp_map);
+}
+
+rl_status rl_vt_postpass_draw(rl_renderer *r, const rl_scene *scene, const rl_camera *cam, rl_image *image,
+                              rl_render_stats *stats)
+{
+    vt_state *s = vt_of(r, "rl_vt_postpass_draw");
+    if (!s || !scene || !cam || !image)
+        return rl_error(RL_ERR_INVALID_ARG, "rl_vt_postpass_draw: needs a \"vt\" renderer, scene, camera and "
+                        "image");
+    return postpass_frame(r, s, scene, cam, image, stats);
+}
+
 rl_status rl_vt_draw_parts(rl_renderer *r, const rl_scene *scene, const rl_camera *cam, rl_image *image,
                            const void *const *parts, const size_t *sizes, size_t count, rl_render_stats *stats)
 {
@@ -1301,6 +1375,19 @@ rl_status rl_vt_draw_parts(rl_renderer *r, const rl_scene *scene, const rl_camer
             return rl_error(st, "rl_vt_draw_parts: part %zu: %s", i, why);
         }
     }
+    if (rl_renderer_opt_bool(r, "dist_postpass")) {
+        /* The post-pass over exactly these parts (the overlapped one adds
+         * them as they come, rl_vt_postpass_add). */
+        vt_part_samples_free(&s->pp_map);
+        for (size_t i = 0; i < count; ++i) {
+            rl_status st = vt_part_samples_add(&s->pp_map, parts[i], sizes[i]);
+            if (st != RL_OK) {
+                vt_part_samples_free(&s->pp_map);
+                return st;
+            }
+        }
+        return postpass_frame(r, s, scene, cam, image, stats);
+    }
     vt_settings set;
     rl_camera c;
     rl_tracer *tracer;
@@ -1312,23 +1399,6 @@ rl_status rl_vt_draw_parts(rl_renderer *r, const rl_scene *scene, const rl_camer
     rl_drawer *gl = NULL;
     if (st == RL_OK && (st = gl_drawer_for(r, s, scene, &set, image, &gl)) == RL_OK)
         run.drawer = gl;
-    if (st == RL_OK && rl_renderer_opt_bool(r, "dist_postpass")) {
-        st = draw_postpass(r, s, scene, &c, &run, parts, sizes, count);
-        if (st == RL_OK) {
-            run.stats.mesh_bytes = vt_mesh_bytes(&s->mesh);
-            s->stats = run.stats;
-            s->have_frame = true;
-            if (stats) {
-                for (int k = 0; k < RL_RAY_TYPE_COUNT; ++k)
-                    stats->rays[k] += run.rays[k];
-                stats->samples += run.stats.vertices_sampled;
-                stats->triangles_rasterized += run.counters.triangles_drawn;
-                stats->pixels_written += run.counters.pixels_written;
-            }
-        }
-        dist_end(&run, tracer);
-        return st;
-    }
     /* The parts' faces go after the primary ones. */
     for (size_t i = 0; st == RL_OK && i < count; ++i)
         if ((st = vt_part_import(&s->mesh, run.data, parts[i], sizes[i])) != RL_OK) {

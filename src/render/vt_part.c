@@ -191,22 +191,45 @@ rl_status vt_part_write(const vt_mesh *m, const rl_scene_data *d, const uint8_t 
     return RL_OK;
 }
 
-rl_status vt_part_check(const void *part, size_t size, uint32_t *num_verts, uint32_t *num_faces)
+/* The header of a part: its fields, read once for vt_part_check and the
+ * post-pass' map (vt_part_samples_add). */
+typedef struct part_header {
+    uint32_t version, num_verts, num_faces;
+    uint64_t payload, sum;
+} part_header;
+
+/* The header's fields after its size, magic and version checks (the
+ * payload is vt_part_check's). */
+static rl_status read_header(const void *part, size_t size, part_header *h)
 {
-    *num_verts = *num_faces = 0;
+    memset(h, 0, sizeof *h);
     if (!part || size < HEADER_BYTES)
         return rl_error(RL_ERR_PARSE, "vt part: %zu bytes, shorter than its %u-byte header", size, HEADER_BYTES);
     const unsigned char *p = part;
     if (memcmp(p, PART_MAGIC, 4) != 0)
         return rl_error(RL_ERR_PARSE, "vt part: not a Vertex Tracing part (no \"" PART_MAGIC "\")");
     uint32_t head[3];
-    uint64_t payload, sum;
     p = get(p + 4, head, sizeof head);
-    p = get(p, &payload, 8);
-    get(p, &sum, 8);
-    if (head[0] != PART_VERSION && head[0] != PART_VERSION_SAMPLES)
-        return rl_error(RL_ERR_PARSE, "vt part: version %u (this build reads %u and %u)", head[0], PART_VERSION,
+    p = get(p, &h->payload, 8);
+    get(p, &h->sum, 8);
+    h->version = head[0];
+    h->num_verts = head[1];
+    h->num_faces = head[2];
+    if (h->version != PART_VERSION && h->version != PART_VERSION_SAMPLES)
+        return rl_error(RL_ERR_PARSE, "vt part: version %u (this build reads %u and %u)", h->version, PART_VERSION,
                         PART_VERSION_SAMPLES);
+    return RL_OK;
+}
+
+rl_status vt_part_check(const void *part, size_t size, uint32_t *num_verts, uint32_t *num_faces)
+{
+    *num_verts = *num_faces = 0;
+    part_header h;
+    rl_status st = read_header(part, size, &h);
+    if (st != RL_OK)
+        return st;
+    const uint32_t head[3] = { h.version, h.num_verts, h.num_faces };
+    const uint64_t payload = h.payload, sum = h.sum;
     const uint32_t vbytes = vertex_bytes(head[0]);
     /* Counts below 2^32 keep the products far from overflowing 64 bits. */
     uint64_t want = (uint64_t)head[1] * vbytes + (uint64_t)head[2] * FACE_BYTES;
@@ -238,8 +261,10 @@ rl_status vt_part_import(vt_mesh *m, const rl_scene_data *d, const void *part, s
         return st;
     if ((st = vt_mesh_reserve(m, nv, 0, nf)) != RL_OK)
         return st;
-    uint32_t version;
-    memcpy(&version, (const unsigned char *)part + 4, 4);
+    part_header h;
+    if ((st = read_header(part, size, &h)) != RL_OK)
+        return st;
+    const uint32_t version = h.version;
     const unsigned char *p = (const unsigned char *)part + HEADER_BYTES;
     const uint32_t first = m->num_verts;
     for (uint32_t v = 0; v < nv; ++v) {
@@ -304,57 +329,68 @@ rl_status vt_part_import(vt_mesh *m, const rl_scene_data *d, const void *part, s
 
 /* ------------------------------------------- the post-pass' samples -- */
 
-rl_status vt_part_samples_build(vt_part_samples *ps, const void *const *parts, const size_t *sizes, size_t count)
+/* Moves the map's entries into a table of cap slots (a power of two). */
+static rl_status samples_rehash(vt_part_samples *ps, size_t cap)
 {
-    memset(ps, 0, sizeof *ps);
-    uint64_t total = 0;
-    for (size_t i = 0; i < count; ++i) {
-        uint32_t version, nv;
-        if (!parts[i] || sizes[i] < HEADER_BYTES)
+    uint64_t *keys = rl_calloc(cap, sizeof *keys);
+    const unsigned char **rec = rl_realloc_array(NULL, cap, sizeof *rec);
+    if (!keys || !rec) {
+        free(keys);
+        free(rec);
+        return rl_error(RL_ERR_OUT_OF_MEMORY, "vt: the post-pass' map of %zu samples", cap / 2);
+    }
+    for (size_t i = 0; i < ps->cap; ++i) {
+        if (!ps->keys[i])
             continue;
-        memcpy(&version, (const unsigned char *)parts[i] + 4, 4);
-        memcpy(&nv, (const unsigned char *)parts[i] + 8, 4);
-        if (version == PART_VERSION_SAMPLES)
-            total += nv;
+        size_t k = (size_t)(rl_hash64(ps->keys[i]) & (uint64_t)(cap - 1));
+        while (keys[k])
+            k = (k + 1) & (cap - 1);
+        keys[k] = ps->keys[i];
+        rec[k] = ps->rec[i];
     }
-    if (!total)
-        return RL_OK;           /* no part carries samples: the post-pass traces */
-    /* Load factor <= 1/2: every vertex the frame's refinement makes is
-     * looked up once, most of them found. */
-    size_t cap = 64;
-    while (cap < 2 * total)
-        cap *= 2;
-    ps->keys = rl_calloc(cap, sizeof *ps->keys);
-    ps->rec = rl_realloc_array(NULL, cap, sizeof *ps->rec);
-    if (!ps->keys || !ps->rec) {
-        vt_part_samples_free(ps);
-        return rl_error(RL_ERR_OUT_OF_MEMORY, "vt: the post-pass' map of %llu samples", (unsigned long long)total);
-    }
+    free(ps->keys);
+    free(ps->rec);
+    ps->keys = keys;
+    ps->rec = rec;
     ps->cap = cap;
+    return RL_OK;
+}
+
+rl_status vt_part_samples_add(vt_part_samples *ps, const void *part, size_t size)
+{
+    part_header h;
+    rl_status st = read_header(part, size, &h);
+    if (st != RL_OK)
+        return st;
+    if (h.version != PART_VERSION_SAMPLES || !h.num_verts)
+        return RL_OK;           /* no samples: the post-pass traces what it needs */
+    /* Load factor <= 1/2: every vertex the frame's refinement makes is
+     * looked up once, most of them found. The table doubles as parts come
+     * (a part at a time while the replay runs, rl_vt_postpass_add). */
+    const uint64_t need = 2 * ((uint64_t)ps->count + h.num_verts);
+    if (need > ps->cap) {
+        size_t cap = ps->cap ? ps->cap : 64;
+        while (cap < need)
+            cap *= 2;
+        if ((st = samples_rehash(ps, cap)) != RL_OK)
+            return st;
+    }
+    const size_t cap = ps->cap;
     const uint32_t vbytes = vertex_bytes(PART_VERSION_SAMPLES);
-    for (size_t i = 0; i < count; ++i) {
-        uint32_t version, nv;
-        if (!parts[i] || sizes[i] < HEADER_BYTES)
-            continue;
-        memcpy(&version, (const unsigned char *)parts[i] + 4, 4);
-        memcpy(&nv, (const unsigned char *)parts[i] + 8, 4);
-        if (version != PART_VERSION_SAMPLES)
-            continue;
-        const unsigned char *body = (const unsigned char *)parts[i] + HEADER_BYTES;
-        for (uint32_t v = 0; v < nv; ++v) {
-            const unsigned char *rec = body + (size_t)v * vbytes;
-            uint64_t key;
-            memcpy(&key, rec + VERTEX_BYTES, 8);
-            key = vt_key_nonzero(key);
-            size_t k = (size_t)(rl_hash64(key) & (uint64_t)(cap - 1));
-            while (ps->keys[k] && ps->keys[k] != key)
-                k = (k + 1) & (cap - 1);
-            if (ps->keys[k])
-                continue;     /* a border vertex both sides sampled: the same sample */
-            ps->keys[k] = key;
-            ps->rec[k] = rec;
-            ps->count++;
-        }
+    const unsigned char *body = (const unsigned char *)part + HEADER_BYTES;
+    for (uint32_t v = 0; v < h.num_verts; ++v) {
+        const unsigned char *rec = body + (size_t)v * vbytes;
+        uint64_t key;
+        memcpy(&key, rec + VERTEX_BYTES, 8);
+        key = vt_key_nonzero(key);
+        size_t k = (size_t)(rl_hash64(key) & (uint64_t)(cap - 1));
+        while (ps->keys[k] && ps->keys[k] != key)
+            k = (k + 1) & (cap - 1);
+        if (ps->keys[k])
+            continue;     /* a border vertex both sides sampled: the same sample */
+        ps->keys[k] = key;
+        ps->rec[k] = rec;
+        ps->count++;
     }
     return RL_OK;
 }

@@ -33,9 +33,12 @@ typedef struct vt_part_samples {
     size_t cap, count;
 } vt_part_samples;
 
-/* Builds the map over the parts' version-2 vertices (version-1 parts add
- * nothing); the parts must have passed vt_part_check. */
-rl_status vt_part_samples_build(vt_part_samples *ps, const void *const *parts, const size_t *sizes, size_t count);
+/* Adds the samples of a checked part to the map (a version-1 part adds
+ * nothing); the part must outlive the map's use. Parts may come one by
+ * one, also while a replay reads the map (between its stages: the
+ * overlapped post-pass, rl_vt_postpass_add). A vertex two parts carry
+ * keeps the first part's record (the same sample, vt_sample.c). */
+rl_status vt_part_samples_add(vt_part_samples *ps, const void *part, size_t size);
 /* Stores the parts' sample of vertex v of m (its key, position and
  * triangle must all match) and returns true; false when no part has it
  * (the caller traces it), or, with *failed set, when out of memory. */

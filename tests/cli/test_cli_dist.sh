@@ -304,6 +304,37 @@ PY
 run_ok "${MPI2[@]}" "$RL" --dist render table --algo vt --size 64x48 --set balance=precompute \
     --set dist_postpass=on --out "$TMP/vtppp.png"
 cmp -s "$TMP/vt1.png" "$TMP/vtppp.png" || fail "vt: dist_postpass: precompute on 2 ranks differs from one process"
+# The post-pass overlapped with the packages still out (dist_overlap):
+# with a slow worker (RL_DIST_DELAY=RANK:MS holds each of its parts back)
+# the master starts the replay while that worker's parts are out, takes
+# them as they come and traces what is not in yet; the image must stay
+# the one-process image whichever rank is slow, and with the overlap off
+# (the post-pass after the last part).
+for slow in 1 2; do
+    run_ok env RL_DIST_DELAY=$slow:700 "${MPI[@]}" "$RL" --dist "${VT[@]}" --set dist_postpass=on \
+        --set dist_overlap=1 --out "$TMP/vtov$slow.png" --stats-json "$TMP/vtov$slow.json"
+    cmp -s "$TMP/vt1.png" "$TMP/vtov$slow.png" || fail "vt: dist_overlap: rank $slow slow changed the image"
+    expect_in "$TMP/out" "^dist: post-pass: .*; overlapped, the image [0-9.]* ms after the last part"
+    python3 - "$TMP/vtov$slow.json" <<'PY' || fail "vt: dist_overlap: the dist record: $(head -c 600 "$TMP/vtov$slow.json")"
+import json, sys
+p = json.load(open(sys.argv[1]))["dist"]["postpass"]
+assert p["overlapped"] and p["early_ms"] > 0 and p["tail_ms"] >= 0 and p["traced"] > 0, p
+PY
+done
+# A worker killed after its first package while rank 1 is slow: the
+# replay starts with both their packages out, traces what never comes,
+# and the master collects the rest once the lost worker's timeout ends.
+"${RECOVER[@]}" RL_DIST_FAULT=2:1 RL_DIST_DELAY=1:500 timeout 60 mpirun --oversubscribe -np 3 "$RL" --dist "${VT[@]}" \
+    --set dist_postpass=on --set dist_overlap=1 --out "$TMP/vtov-lost.png" >"$TMP/out" 2>"$TMP/err"
+rc=$?
+[ "$rc" -eq 0 ] || fail "vt: dist_overlap with a lost worker: exit $rc: $(grep -v '^\[' "$TMP/err" | head -c 600)"
+cmp -s "$TMP/vt1.png" "$TMP/vtov-lost.png" || fail "vt: dist_overlap: a lost worker changed the image"
+expect_in "$TMP/out" "^dist: 1 worker lost"
+expect_in "$TMP/out" "^dist: post-pass: .*; overlapped"
+run_ok env RL_DIST_DELAY=1:300 "${MPI[@]}" "$RL" --dist "${VT[@]}" --set dist_postpass=on --set dist_overlap=0 \
+    --out "$TMP/vtov0.png"
+cmp -s "$TMP/vt1.png" "$TMP/vtov0.png" || fail "vt: dist_overlap=0: the image differs from one process"
+expect_in "$TMP/out" "^dist: post-pass: .*; not overlapped, the image [0-9.]* ms after the last part"
 
 # reconstruct=gl: the workers refine on the CPU as always and the master
 # draws the parts with the GL drawer (Ullmann Sec. 3.5 on the GPU). The
@@ -354,6 +385,9 @@ PY
 expect_exit 2 "$RL" bench dist --vt-postpass maybe
 grep -q "^rl: error: bench dist: --vt-postpass: expected off, on or off,on" "$TMP/err" ||
     fail "bench dist --vt-postpass maybe: $(cat "$TMP/err")"
+expect_exit 2 "$RL" bench dist --vt-overlap 2
+grep -q "^rl: error: bench dist: --vt-overlap: expected a share from 0 to 1, got '2'" "$TMP/err" ||
+    fail "bench dist --vt-overlap 2: $(cat "$TMP/err")"
 expect_exit 2 "$RL" bench dist --ranks 0,2
 grep -q "^rl: error: bench dist: --ranks: expected" "$TMP/err" || fail "bench dist --ranks 0: $(cat "$TMP/err")"
 

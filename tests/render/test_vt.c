@@ -1544,6 +1544,139 @@ static void postpass_matches_one_process(void **state)
     rl_scene_release(s);
 }
 
+/* The overlapped post-pass (rl_vt_postpass_add / rl_vt_postpass_draw,
+ * option dist_overlap): the master starts the replay before every part is
+ * in and adds the others as they come, between its stages. Whatever came
+ * when, the image is the one-process image bit for bit: parts added
+ * during the replay in reverse order (one per stage), half of them never,
+ * none at all, all of them in a shuffled order beforehand. A vertex whose
+ * part was not in yet is traced, so those runs trace more than the one
+ * with every part in; every sample one process traced is counted once. */
+typedef struct late_parts {
+    rl_renderer *r;
+    void **parts;
+    size_t *sizes;
+    size_t next, end;            /* parts[next..end) still to come, from end - 1 down */
+    int calls;
+} late_parts;
+
+static bool add_late_part(void *user, double done)
+{
+    (void)done;
+    late_parts *l = user;
+    ++l->calls;
+    if (l->end > l->next) {
+        --l->end;
+        assert_int_equal(rl_vt_postpass_add(l->r, l->parts[l->end], l->sizes[l->end]), RL_OK);
+    }
+    return true;
+}
+
+static void postpass_overlapped_parts(void **state)
+{
+    (void)state;
+    rl_camera cam;
+    rl_scene *s = table_scene(&cam);
+    rl_renderer *r = make_vt(NULL);
+    rl_image *ref = fx_render_with(r, s, &cam, FX_ALL_LAYERS, NULL);
+    rl_vt_stats one;
+    assert_int_equal(rl_vt_get_stats(r, &one), RL_OK);
+    assert_int_equal(rl_renderer_set(r, "dist_postpass", "on"), RL_OK);
+    rl_image *img = NULL;
+    assert_int_equal(rl_image_create(cam.width, cam.height, FX_ALL_LAYERS, &img), RL_OK);
+    const uint32_t *faces;
+    size_t count;
+    assert_int_equal(rl_vt_prepare(r, s, &cam, img, &faces, &count), RL_OK);
+    uint32_t *list = malloc(count * sizeof *list);
+    assert_non_null(list);
+    memcpy(list, faces, count * sizeof *list);
+    enum { N = 8 };
+    void *parts[N];
+    size_t sizes[N], first = 0;
+    for (size_t i = 0; i < N; ++i) {
+        size_t take = i + 1 == N ? count - first : count / N;
+        assert_int_equal(rl_vt_refine_faces(r, s, &cam, img, list + first, take, &parts[i], &sizes[i], NULL),
+                         RL_OK);
+        first += take;
+    }
+    /* Every part in before the replay: the reference of the counts. */
+    assert_int_equal(rl_vt_draw_parts(r, s, &cam, img, (const void *const *)parts, sizes, N, NULL), RL_OK);
+    fx_assert_images_identical(img, ref);
+    rl_vt_stats all;
+    assert_int_equal(rl_vt_get_stats(r, &all), RL_OK);
+    /* in_before parts first (in the order of order[]), then the rest one
+     * per stage from the last down (late), or never. */
+    static const size_t shuffled[N] = { 5, 2, 7, 0, 3, 6, 1, 4 };
+    const struct {
+        size_t in_before;
+        bool late;
+        const char *what;
+    } runs[] = { { 3, true, "3 in, 5 during the replay" }, { 4, false, "4 in, 4 never" },
+                 { 0, false, "none" }, { N, false, "all, shuffled" }, { 0, true, "none in, all during" } };
+    for (size_t k = 0; k < sizeof runs / sizeof runs[0]; ++k) {
+        rl_vt_postpass_clear(r);
+        for (size_t i = 0; i < runs[k].in_before; ++i)
+            assert_int_equal(rl_vt_postpass_add(r, parts[shuffled[i]], sizes[shuffled[i]]), RL_OK);
+        /* the late ones: parts not yet added, by their order in shuffled[] */
+        void *rest[N];
+        size_t rest_sizes[N], nrest = 0;
+        for (size_t i = runs[k].in_before; i < N; ++i) {
+            rest[nrest] = parts[shuffled[i]];
+            rest_sizes[nrest++] = sizes[shuffled[i]];
+        }
+        late_parts late = { .r = r, .parts = rest, .sizes = rest_sizes, .next = 0, .end = runs[k].late ? nrest : 0 };
+        rl_renderer_set_progress(r, add_late_part, &late);
+        rl_image *out = NULL;
+        assert_int_equal(rl_image_create(cam.width, cam.height, FX_ALL_LAYERS, &out), RL_OK);
+        assert_int_equal(rl_vt_postpass_draw(r, s, &cam, out, NULL), RL_OK);
+        rl_renderer_set_progress(r, NULL, NULL);
+        rl_vt_stats st;
+        assert_int_equal(rl_vt_get_stats(r, &st), RL_OK);
+        if (getenv("VT_DEBUG"))
+            print_message("vt overlapped post-pass, %s: %llu from the parts, %llu traced (all in: %llu), %d "
+                          "stages called back\n", runs[k].what, (unsigned long long)st.postpass_reused,
+                          (unsigned long long)st.postpass_traced, (unsigned long long)all.postpass_traced,
+                          late.calls);
+        fx_assert_images_identical(out, ref);
+        assert_int_equal(st.postpass_reused + st.postpass_traced, one.vertices_sampled);
+        assert_int_equal(st.vertices_generated, one.vertices_generated);
+        if (runs[k].in_before == N)
+            assert_int_equal(st.postpass_traced, all.postpass_traced);
+        else if (runs[k].in_before == 0 && !runs[k].late)
+            assert_int_equal(st.postpass_traced, one.vertices_sampled);
+        else
+            assert_true(st.postpass_traced > all.postpass_traced && st.postpass_reused > 0);
+        if (runs[k].late)
+            assert_true(late.end == 0 && late.calls > (int)nrest);   /* all came during the replay */
+        rl_image_release(out);
+    }
+    /* Bad input: a damaged part is refused and adds nothing; only "vt"
+     * renderers have the post-pass. */
+    rl_vt_postpass_clear(r);
+    unsigned char *bad = malloc(sizes[0]);
+    assert_non_null(bad);
+    memcpy(bad, parts[0], sizes[0]);
+    bad[sizes[0] - 1] ^= 0x40;
+    rl_clear_error();
+    assert_int_equal(rl_vt_postpass_add(r, bad, sizes[0]), RL_ERR_PARSE);
+    assert_non_null(strstr(rl_last_error(), "checksum"));
+    assert_int_equal(rl_vt_postpass_add(r, bad, 7), RL_ERR_PARSE);
+    assert_int_equal(rl_vt_postpass_add(r, NULL, 0), RL_ERR_PARSE);
+    rl_renderer *w = fx_make("whitted", NULL);
+    assert_int_equal(rl_vt_postpass_add(w, parts[0], sizes[0]), RL_ERR_INVALID_ARG);
+    assert_int_equal(rl_vt_postpass_draw(w, s, &cam, img, NULL), RL_ERR_INVALID_ARG);
+    rl_vt_postpass_clear(w);             /* nothing to forget, no harm */
+    rl_renderer_release(w);
+    free(bad);
+    for (size_t i = 0; i < N; ++i)
+        free(parts[i]);
+    free(list);
+    rl_image_release(img);
+    rl_image_release(ref);
+    rl_renderer_release(r);
+    rl_scene_release(s);
+}
+
 /* A part is checked before the master draws it: a truncated part, counts
  * that do not fit its size, a damaged byte, a foreign buffer and a face
  * naming a vertex the part lacks are clean RL_ERR_PARSE errors, and
@@ -1681,6 +1814,7 @@ int main(void)
         cmocka_unit_test(bad_options),
         cmocka_unit_test(packages_match_one_process),
         cmocka_unit_test(postpass_matches_one_process),
+        cmocka_unit_test(postpass_overlapped_parts),
         cmocka_unit_test(cost_estimate),
         cmocka_unit_test(part_round_trip_and_bad_parts),
     };
