@@ -86,7 +86,6 @@ _Static_assert(RL_GL_PT_RAY_TYPES == RL_RAY_TYPE_COUNT, "gl-pt counts rays in rl
  * that a value pt knows gets "not ported" rather than "unknown" where
  * gl-pt lacks it (gl_pt_check). */
 static const char *const ls_build_choices[] = { "cpu", "gpu", NULL };
-static const char *const adaptive_choices[] = { "off", "on", NULL };
 
 static const rl_option_info gl_pt_options[] = {
     { "spp", RL_OPT_INT, "1", "paths per pixel and frame (one compute dispatch each)", 1, 65536, NULL },
@@ -122,13 +121,7 @@ static const rl_option_info gl_pt_options[] = {
       rl_pt_filter_choices },
     RL_PT_FILTER_PARAM_OPTIONS,
     /* pt's (pathtrace.c), the same meaning and defaults */
-    { "adaptive", RL_OPT_ENUM, "off",
-      "per-pixel adaptive sampling: a frame's paths go where the estimated relative error is largest (errors and "
-      "shares computed on the GPU)", 0, 0, adaptive_choices },
-    { "adaptive_threshold", RL_OPT_FLOAT, "0.01",
-      "adaptive: relative error of a pixel's mean below which it gets no more samples", 0, 1e9, NULL },
-    { "adaptive_min_spp", RL_OPT_INT, "8", "adaptive: samples every pixel gets before the error decides",
-      2, 65536, NULL },
+    RL_PT_ADAPTIVE_OPTIONS(" (errors and shares computed on the GPU)"),
     { "grid_res", RL_OPT_INT, "0", "voxels per axis of the grid and the Line Space (0 = grid heuristic)", 0, 1024,
       NULL },
     { "ls_n", RL_OPT_INT, "5", "Line Space patches per voxel face side (Sec. 9.2: 5)", 1, RL_LS_MAX_N, NULL },

@@ -156,7 +156,7 @@ const char *const rl_pt_ls_origin_choices[] = { "offset", "exact", NULL };
 const char *const rl_pt_primary_choices[] = { "trace", "raster", NULL };
 /* Order = rl_filter_kind. */
 const char *const rl_pt_filter_choices[] = { "none", "gauss", "bilateral", "aniso", "kuwahara", "atrous", NULL };
-static const char *const adaptive_choices[] = { "off", "on", NULL };
+const char *const rl_pt_adaptive_choices[] = { "off", "on", NULL };
 
 static const rl_option_info pt_options[] = {
     { "spp", RL_OPT_INT, "1", "paths per pixel and frame", 1, 65536, NULL },
@@ -192,13 +192,7 @@ static const rl_option_info pt_options[] = {
     { "accumulate", RL_OPT_BOOL, "true", "progressive accumulation across frames (Sec. 6.5, eq. 8)", 0, 0, NULL },
     { "filter", RL_OPT_ENUM, "none", "noise filter on the accumulated image (Sec. 8.2)", 0, 0, rl_pt_filter_choices },
     RL_PT_FILTER_PARAM_OPTIONS,
-    { "adaptive", RL_OPT_ENUM, "off",
-      "per-pixel adaptive sampling: a frame's paths go where the estimated relative error is largest",
-      0, 0, adaptive_choices },
-    { "adaptive_threshold", RL_OPT_FLOAT, "0.01",
-      "adaptive: relative error of a pixel's mean below which it gets no more samples", 0, 1e9, NULL },
-    { "adaptive_min_spp", RL_OPT_INT, "8", "adaptive: samples every pixel gets before the error decides",
-      2, 65536, NULL },
+    RL_PT_ADAPTIVE_OPTIONS(""),
     { "grid_res", RL_OPT_INT, "0", "voxels per axis of the grid and the Line Space (0 = grid heuristic)",
       0, 1024, NULL },
     { "ls_n", RL_OPT_INT, "5", "Line Space patches per voxel face side (Sec. 9.2: 5)", 1, RL_LS_MAX_N, NULL },
