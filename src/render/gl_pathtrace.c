@@ -122,15 +122,7 @@ static const rl_option_info gl_pt_options[] = {
     RL_PT_FILTER_PARAM_OPTIONS,
     /* pt's (pathtrace.c), the same meaning and defaults */
     RL_PT_ADAPTIVE_OPTIONS(" (errors and shares computed on the GPU)"),
-    { "grid_res", RL_OPT_INT, "0", "voxels per axis of the grid and the Line Space (0 = grid heuristic)", 0, 1024,
-      NULL },
-    { "ls_n", RL_OPT_INT, "5", "Line Space patches per voxel face side (Sec. 9.2: 5)", 1, RL_LS_MAX_N, NULL },
-    { "ls_k", RL_OPT_INT, "8", "Line Space fixed candidate slots per shaft (even; ls_dynamic=false only)", 2,
-      RL_LS_MAX_K, NULL },
-    { "ls_origin", RL_OPT_ENUM, "offset",
-      "PNMT/preillum rays: offset (start one voxel diagonal away, Sec. 12.1) or exact (start at the "
-      "surface; the start voxel's triangles answer PNMT rays exactly)", 0, 0, rl_pt_ls_origin_choices },
-    { "ls_dynamic", RL_OPT_BOOL, "true", "exact per-shaft candidate lists (prefix sums, Sec. 7.1.1)", 0, 0, NULL },
+    RL_PT_LINE_SPACE_OPTIONS,
     { "ls_build", RL_OPT_ENUM, "cpu",
       "where the Line Space is built: cpu (pt's build, uploaded) or gpu (compute shaders; ls-candidates only)",
       0, 0, ls_build_choices },

@@ -98,6 +98,19 @@ extern const char *const rl_pt_rng_choices[], *const rl_pt_mis_choices[], *const
     { "atrous_sigma_x", RL_OPT_FLOAT, "0",                                                                         \
       "a-trous position sigma in world units; 0 = 2^atrous_iterations pixel footprints", 0, 1e9, NULL }
 void rl_pt_read_filter_settings(const rl_renderer *r, pt_settings *set);
+/* The rows of the grid's and the per-voxel Line Space's options (Schröder
+ * 2017, Sec. 7.1-7.4, 9.2, 12.1) that pt and gl-pt share: the same names,
+ * defaults, ranges and help, in this order. */
+#define RL_PT_LINE_SPACE_OPTIONS                                                                                   \
+    { "grid_res", RL_OPT_INT, "0", "voxels per axis of the grid and the Line Space (0 = grid heuristic)",          \
+      0, 1024, NULL },                                                                                             \
+    { "ls_n", RL_OPT_INT, "5", "Line Space patches per voxel face side (Sec. 9.2: 5)", 1, RL_LS_MAX_N, NULL },     \
+    { "ls_k", RL_OPT_INT, "8", "Line Space fixed candidate slots per shaft (even; ls_dynamic=false only)", 2,      \
+      RL_LS_MAX_K, NULL },                                                                                         \
+    { "ls_origin", RL_OPT_ENUM, "offset",                                                                          \
+      "PNMT/preillum rays: offset (start one voxel diagonal away, Sec. 12.1) or exact (start at the "              \
+      "surface; the start voxel's triangles answer PNMT rays exactly)", 0, 0, rl_pt_ls_origin_choices },         \
+    { "ls_dynamic", RL_OPT_BOOL, "true", "exact per-shaft candidate lists (prefix sums, Sec. 7.1.1)", 0, 0, NULL }
 /* The rows of adaptive sampling's options (issue 37; pathtrace.c, "Adaptive
  * sampling"), the same names, defaults and ranges in pt and gl-pt; where is
  * a string literal appended to the help of "adaptive" (gl-pt: where its
