@@ -18,10 +18,12 @@ cd "$(dirname "${BASH_SOURCE[0]}")/.." || exit 1
 OUT=${1:-bench/results/view-$(date -u +%Y%m%d).json}
 RL=${2:-build/rl}
 [ -x "$RL" ] || { echo "view.sh: no $RL (make build)"; exit 1; }
+# shellcheck source=bench/view_common.sh
+. bench/view_common.sh
 TMP=$(mktemp -d)
 trap 'rm -rf "$TMP"' EXIT
 if command -v xvfb-run >/dev/null 2>&1; then
-    run_view() { xvfb-run -a -s "-screen 0 1920x1080x24" "$RL" view "$@"; }
+    run_view() { "${VIEW_XVFB[@]}" "$RL" view "$@"; }
 else
     run_view() { SDL_VIDEODRIVER=offscreen "$RL" view "$@"; }
 fi
@@ -48,7 +50,7 @@ RUNS=(
 # after 5 minutes (bench/README.md).
 i=0
 for run in "${RUNS[@]}"; do
-    [[ -n "${VIEW_RUNS:-}" && ! "$run" =~ $VIEW_RUNS ]] && continue
+    view_selected "$run" "${VIEW_RUNS:-}" || continue
     read -r scene size algo sets <<<"$run"
     i=$((i + 1))
     t0=$(date +%s.%N)
@@ -71,14 +73,5 @@ PY
     fi
     echo "   ($(python3 -c "print(round($(date +%s.%N) - $t0, 1))") s wall, load $(cut -d' ' -f1-3 /proc/loadavg))"
 done
-python3 - "$OUT" "$TMP" <<'PY'
-import glob, json, os, sys
-out, tmp = sys.argv[1], sys.argv[2]
-runs = [json.load(open(f)) for f in sorted(glob.glob(tmp + "/run*.json"), key=lambda f: int(f.split("run")[-1][:-5]))]
-json.dump({"benchmark": "rl view (bench/view.sh, bench/view_stop.txt)",
-           "machine": os.environ.get("RL_MACHINE", "(set RL_MACHINE to name it)"),
-           "note": "scripted runs under Xvfb on a shared machine (other agents' builds and tests running): "
-                   "times are upper bounds; see bench/README.md, rl view",
-           "runs": runs}, open(out, "w"), indent=1)
-print("view.sh: wrote", out, "(%d runs)" % len(runs))
-PY
+view_write_record "$OUT" "$TMP" view.sh "rl view (bench/view.sh, bench/view_stop.txt)" \
+    "scripted runs under Xvfb on a shared machine (other agents' builds and tests running): times are upper bounds; see bench/README.md, rl view"

@@ -18,6 +18,8 @@ REPS=${REPS:-2}
 PT_REPS=${PT_REPS:-1}
 [ -x "$RL" ] || { echo "view_glshare.sh: no $RL (make build)"; exit 1; }
 command -v xvfb-run >/dev/null 2>&1 || { echo "view_glshare.sh: needs xvfb-run"; exit 1; }
+# shellcheck source=bench/view_common.sh
+. bench/view_common.sh
 TMP=$(mktemp -d)
 trap 'rm -rf "$TMP"' EXIT
 RUNS=(
@@ -28,21 +30,13 @@ RUNS=(
 )
 # The record so far (rewritten after every pair, so that a stopped run keeps it).
 write_out() {
-python3 - "$OUT" "$TMP" <<'PY'
-import glob, json, os, sys
-out, tmp = sys.argv[1], sys.argv[2]
-runs = [json.load(open(f)) for f in sorted(glob.glob(tmp + "/run*.json"), key=lambda f: int(f.split("run")[-1][:-5]))]
-json.dump({"benchmark": "rl view shared path vs readback (bench/view_glshare.sh, bench/view_stop.txt; gl-pt bench/view_short.txt)",
-           "machine": os.environ.get("RL_MACHINE", "(set RL_MACHINE to name it)"),
-           "note": "scripted runs under Xvfb on Mesa llvmpipe, shared and readback interleaved, on a machine "
-                   "shared with other builds: compare runs of one pair; see bench/README.md",
-           "runs": runs}, open(out, "w"), indent=1)
-print("view_glshare.sh: wrote", out, "(%d runs)" % len(runs), flush=True)
-PY
+    view_write_record "$OUT" "$TMP" view_glshare.sh \
+        "rl view shared path vs readback (bench/view_glshare.sh, bench/view_stop.txt; gl-pt bench/view_short.txt)" \
+        "scripted runs under Xvfb on Mesa llvmpipe, shared and readback interleaved, on a machine shared with other builds: compare runs of one pair; see bench/README.md"
 }
 i=0
 for run in "${RUNS[@]}"; do
-    [[ -n "${GLSHARE_RUNS:-}" && ! "$run" =~ $GLSHARE_RUNS ]] && continue
+    view_selected "$run" "${GLSHARE_RUNS:-}" || continue
     read -r scene size algo <<<"$run"
     script=bench/view_stop.txt
     reps=$REPS
@@ -50,7 +44,7 @@ for run in "${RUNS[@]}"; do
     for rep in $(seq "$reps"); do
         for display in shared software; do
             i=$((i + 1))
-            /usr/bin/time -f "%U %S %e" -o "$TMP/time$i" xvfb-run -a -s "-screen 0 1920x1080x24" "$RL" view "$scene" \
+            /usr/bin/time -f "%U %S %e" -o "$TMP/time$i" "${VIEW_XVFB[@]}" "$RL" view "$scene" \
                 --algo "$algo" --size "$size" --display "$display" --script "$script" \
                 --stats-out "$TMP/run$i.json" >"$TMP/run$i.log" 2>&1 || { echo "$run $display: failed: $(tail -1 "$TMP/run$i.log")"; continue; }
             python3 - "$TMP/run$i.json" "$TMP/time$i" "$run" "$display" "$rep" <<'PY'

@@ -51,6 +51,20 @@ static const bd_config hybrid_configs[] = {
     { "gl-pt light_paths=1024 light_overlap=false", "gl-pt", hy_sync },
 };
 
+/* A section: its sizes (quick, full), what its note says, its configs and
+ * the JSON key of configs[0]'s RMSE over configs[1]'s. */
+typedef struct bd_section {
+    int size[2];
+    long long ref_spp[2];
+    double budget_s[2];
+    const char *what;         /* the note's opening: "<section>: <renderers>" */
+    const char *cpu_extra;    /* appended inside the note's "(s per thread...)" */
+    const char *time_note;    /* the section's "time" entry */
+    const bd_config *configs;
+    int num_configs;
+    const char *ratio_key;
+} bd_section;
+
 static float disp(float v)
 {
     return v < 0.0f ? 0.0f : (v < 1.0f ? v : 1.0f);
@@ -90,8 +104,10 @@ static void add_means(cJSON *o, const char *key, const double m[3])
 }
 
 static rl_status run_scene(const bench_pt_bdpt_args *a, const char *params, int size, long long ref_spp,
-                           double budget_s, const bd_config *configs, int num_configs, cJSON *out)
+                           double budget_s, const bd_section *sect, cJSON *out)
 {
+    const bd_config *configs = sect->configs;
+    const int num_configs = sect->num_configs;
     rl_scene *scene = NULL;
     rl_status st = rl_scene_create_builtin("cornell", params, &scene);
     rl_camera cam;
@@ -188,10 +204,8 @@ static rl_status run_scene(const bench_pt_bdpt_args *a, const char *params, int 
                m[1], m[2], ref_means[0], ref_means[1], ref_means[2]);
         fflush(stdout);
     }
-    if (st == RL_OK && num_configs == 2)
-        bench_add_num(out, "rmse_ratio_pt_over_bdpt", bench_ratio(rmse_of[0], rmse_of[1]));
-    if (st == RL_OK && num_configs == 3)
-        bench_add_num(out, "rmse_ratio_off_over_light_paths", bench_ratio(rmse_of[0], rmse_of[1]));
+    if (st == RL_OK)
+        bench_add_num(out, sect->ratio_key, bench_ratio(rmse_of[0], rmse_of[1]));
     rl_image_release(img);
     free(ref);
     free(half);
@@ -199,17 +213,17 @@ static rl_status run_scene(const bench_pt_bdpt_args *a, const char *params, int 
     return st;
 }
 
-rl_status bench_pt_bdpt(const bench_pt_bdpt_args *a, cJSON *sec)
+/* One section: the note, its settings, then every scene with its configs. */
+static rl_status run_section(const bench_pt_bdpt_args *a, const bd_section *sect, cJSON *sec)
 {
-    int size = a->quick ? 32 : 96;
-    long long ref_spp = a->quick ? 64 : 512;
-    double budget_s = a->quick ? 0.5 : 5.0;
-    note("bdpt: pt and bdpt at equal CPU time (%.1f s per thread) on cornell, %dx%d, reference bdpt %lld spp",
-         budget_s, size, size, ref_spp);
+    int size = sect->size[!a->quick];
+    long long ref_spp = sect->ref_spp[!a->quick];
+    double budget_s = sect->budget_s[!a->quick];
+    note("%s at equal CPU time (%.1f s per thread%s) on cornell, %dx%d, reference bdpt %lld spp", sect->what,
+         budget_s, sect->cpu_extra, size, size, ref_spp);
     cJSON_AddStringToObject(sec, "error", "RMSE of linear RGB clamped to [0,1], all pixels and channels, against "
                                           "a bdpt reference in two halves, its own MSE subtracted");
-    cJSON_AddStringToObject(sec, "time", "frames of 1 spp after a warm-up frame until process CPU time / threads "
-                                         "reaches budget_s");
+    cJSON_AddStringToObject(sec, "time", sect->time_note);
     bench_add_num(sec, "size", size);
     bench_add_num(sec, "budget_s", budget_s);
     bench_add_num(sec, "threads", a->threads);
@@ -218,31 +232,30 @@ rl_status bench_pt_bdpt(const bench_pt_bdpt_args *a, cJSON *sec)
     for (size_t i = 0; i < NUM_SCENES && st == RL_OK; ++i) {
         cJSON *o = cJSON_CreateObject();
         cJSON_AddItemToArray(list, o);
-        st = run_scene(a, scenes[i], size, ref_spp, budget_s, bdpt_configs, 2, o);
+        st = run_scene(a, scenes[i], size, ref_spp, budget_s, sect, o);
     }
     return st;
 }
 
+#define TIME_NOTE "frames of 1 spp after a warm-up frame until process CPU time / threads reaches budget_s"
+
+rl_status bench_pt_bdpt(const bench_pt_bdpt_args *a, cJSON *sec)
+{
+    static const bd_section bdpt = {
+        .size = { 32, 96 }, .ref_spp = { 64, 512 }, .budget_s = { 0.5, 5.0 },
+        .what = "bdpt: pt and bdpt", .cpu_extra = "", .time_note = TIME_NOTE,
+        .configs = bdpt_configs, .num_configs = 2, .ratio_key = "rmse_ratio_pt_over_bdpt",
+    };
+    return run_section(a, &bdpt, sec);
+}
+
 rl_status bench_pt_hybrid(const bench_pt_bdpt_args *a, cJSON *sec)
 {
-    int size = a->quick ? 32 : 48;
-    long long ref_spp = a->quick ? 64 : 1024;
-    double budget_s = a->quick ? 1.0 : 5.0;
-    note("hybrid: gl-pt without and with light paths (Sec. 8.4) at equal CPU time (%.1f s per thread, the GL "
-         "driver's threads included) on cornell, %dx%d, reference bdpt %lld spp", budget_s, size, size, ref_spp);
-    cJSON_AddStringToObject(sec, "error", "RMSE of linear RGB clamped to [0,1], all pixels and channels, against "
-                                          "a bdpt reference in two halves, its own MSE subtracted");
-    cJSON_AddStringToObject(sec, "time", "frames of 1 spp after a warm-up frame until process CPU time / threads "
-                                         "reaches budget_s; fps = frames / wall");
-    bench_add_num(sec, "size", size);
-    bench_add_num(sec, "budget_s", budget_s);
-    bench_add_num(sec, "threads", a->threads);
-    cJSON *list = cJSON_AddArrayToObject(sec, "scenes");
-    rl_status st = RL_OK;
-    for (size_t i = 0; i < NUM_SCENES && st == RL_OK; ++i) {
-        cJSON *o = cJSON_CreateObject();
-        cJSON_AddItemToArray(list, o);
-        st = run_scene(a, scenes[i], size, ref_spp, budget_s, hybrid_configs, 3, o);
-    }
-    return st;
+    static const bd_section hybrid = {
+        .size = { 32, 48 }, .ref_spp = { 64, 1024 }, .budget_s = { 1.0, 5.0 },
+        .what = "hybrid: gl-pt without and with light paths (Sec. 8.4)",
+        .cpu_extra = ", the GL driver's threads included", .time_note = TIME_NOTE "; fps = frames / wall",
+        .configs = hybrid_configs, .num_configs = 3, .ratio_key = "rmse_ratio_off_over_light_paths",
+    };
+    return run_section(a, &hybrid, sec);
 }

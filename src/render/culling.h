@@ -86,6 +86,18 @@ rl_status rl_octree_cache_get(rl_octree_cache *c, const rl_scene *scene, const r
                               bool *rebuilt);
 void rl_octree_cache_release(rl_octree_cache *c);
 
+/* raster's first rows, which gl-raster repeats (the same drawing on GL):
+ * the shading (rl_cull_shading_choices, in rl_raster_shading's order), back
+ * faces, the ambient term and the background. */
+#define RL_RASTER_OPTIONS                                                                               \
+    { "shading", RL_OPT_ENUM, "textured",                                                               \
+      "flat: per triangle; gouraud: per vertex; textured: gouraud times the diffuse texture",           \
+      0, 0, rl_cull_shading_choices },                                                                  \
+    { "cull", RL_OPT_BOOL, "false", "drop back faces (counter-clockwise = front)", 0, 0, NULL },        \
+    { "ambient", RL_OPT_FLOAT, "0.05", "ambient light, multiplied by k_d", 0, 1, NULL },                \
+    { "background", RL_OPT_COLOR, "0,0,0", "colour where nothing is hit: \"r,g,b\" or one grey value",   \
+      0, 0, NULL }
+
 /* The option rows every culling renderer shares with raster (its mesh
  * drawing), first in its table; rl_cull_frame_begin() reads them. */
 extern const char *const rl_cull_shading_choices[];

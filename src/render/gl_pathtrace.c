@@ -86,7 +86,6 @@ _Static_assert(RL_GL_PT_RAY_TYPES == RL_RAY_TYPE_COUNT, "gl-pt counts rays in rl
  * that a value pt knows gets "not ported" rather than "unknown" where
  * gl-pt lacks it (gl_pt_check). */
 static const char *const ls_build_choices[] = { "cpu", "gpu", NULL };
-static const char *const adaptive_choices[] = { "off", "on", NULL };
 
 static const rl_option_info gl_pt_options[] = {
     { "spp", RL_OPT_INT, "1", "paths per pixel and frame (one compute dispatch each)", 1, 65536, NULL },
@@ -122,22 +121,8 @@ static const rl_option_info gl_pt_options[] = {
       rl_pt_filter_choices },
     RL_PT_FILTER_PARAM_OPTIONS,
     /* pt's (pathtrace.c), the same meaning and defaults */
-    { "adaptive", RL_OPT_ENUM, "off",
-      "per-pixel adaptive sampling: a frame's paths go where the estimated relative error is largest (errors and "
-      "shares computed on the GPU)", 0, 0, adaptive_choices },
-    { "adaptive_threshold", RL_OPT_FLOAT, "0.01",
-      "adaptive: relative error of a pixel's mean below which it gets no more samples", 0, 1e9, NULL },
-    { "adaptive_min_spp", RL_OPT_INT, "8", "adaptive: samples every pixel gets before the error decides",
-      2, 65536, NULL },
-    { "grid_res", RL_OPT_INT, "0", "voxels per axis of the grid and the Line Space (0 = grid heuristic)", 0, 1024,
-      NULL },
-    { "ls_n", RL_OPT_INT, "5", "Line Space patches per voxel face side (Sec. 9.2: 5)", 1, RL_LS_MAX_N, NULL },
-    { "ls_k", RL_OPT_INT, "8", "Line Space fixed candidate slots per shaft (even; ls_dynamic=false only)", 2,
-      RL_LS_MAX_K, NULL },
-    { "ls_origin", RL_OPT_ENUM, "offset",
-      "PNMT/preillum rays: offset (start one voxel diagonal away, Sec. 12.1) or exact (start at the "
-      "surface; the start voxel's triangles answer PNMT rays exactly)", 0, 0, rl_pt_ls_origin_choices },
-    { "ls_dynamic", RL_OPT_BOOL, "true", "exact per-shaft candidate lists (prefix sums, Sec. 7.1.1)", 0, 0, NULL },
+    RL_PT_ADAPTIVE_OPTIONS(" (errors and shares computed on the GPU)"),
+    RL_PT_LINE_SPACE_OPTIONS,
     { "ls_build", RL_OPT_ENUM, "cpu",
       "where the Line Space is built: cpu (pt's build, uploaded) or gpu (compute shaders; ls-candidates only)",
       0, 0, ls_build_choices },

@@ -156,7 +156,7 @@ const char *const rl_pt_ls_origin_choices[] = { "offset", "exact", NULL };
 const char *const rl_pt_primary_choices[] = { "trace", "raster", NULL };
 /* Order = rl_filter_kind. */
 const char *const rl_pt_filter_choices[] = { "none", "gauss", "bilateral", "aniso", "kuwahara", "atrous", NULL };
-static const char *const adaptive_choices[] = { "off", "on", NULL };
+const char *const rl_pt_adaptive_choices[] = { "off", "on", NULL };
 
 static const rl_option_info pt_options[] = {
     { "spp", RL_OPT_INT, "1", "paths per pixel and frame", 1, 65536, NULL },
@@ -192,22 +192,8 @@ static const rl_option_info pt_options[] = {
     { "accumulate", RL_OPT_BOOL, "true", "progressive accumulation across frames (Sec. 6.5, eq. 8)", 0, 0, NULL },
     { "filter", RL_OPT_ENUM, "none", "noise filter on the accumulated image (Sec. 8.2)", 0, 0, rl_pt_filter_choices },
     RL_PT_FILTER_PARAM_OPTIONS,
-    { "adaptive", RL_OPT_ENUM, "off",
-      "per-pixel adaptive sampling: a frame's paths go where the estimated relative error is largest",
-      0, 0, adaptive_choices },
-    { "adaptive_threshold", RL_OPT_FLOAT, "0.01",
-      "adaptive: relative error of a pixel's mean below which it gets no more samples", 0, 1e9, NULL },
-    { "adaptive_min_spp", RL_OPT_INT, "8", "adaptive: samples every pixel gets before the error decides",
-      2, 65536, NULL },
-    { "grid_res", RL_OPT_INT, "0", "voxels per axis of the grid and the Line Space (0 = grid heuristic)",
-      0, 1024, NULL },
-    { "ls_n", RL_OPT_INT, "5", "Line Space patches per voxel face side (Sec. 9.2: 5)", 1, RL_LS_MAX_N, NULL },
-    { "ls_k", RL_OPT_INT, "8", "Line Space fixed candidate slots per shaft (even; ls_dynamic=false only)", 2,
-      RL_LS_MAX_K, NULL },
-    { "ls_origin", RL_OPT_ENUM, "offset",
-      "PNMT/preillum rays: offset (start one voxel diagonal away, Sec. 12.1) or exact (start at the "
-      "surface; the start voxel's triangles answer PNMT rays exactly)", 0, 0, rl_pt_ls_origin_choices },
-    { "ls_dynamic", RL_OPT_BOOL, "true", "exact per-shaft candidate lists (prefix sums, Sec. 7.1.1)", 0, 0, NULL },
+    RL_PT_ADAPTIVE_OPTIONS(""),
+    RL_PT_LINE_SPACE_OPTIONS,
     { "ls_file", RL_OPT_STRING, "",
       "Line Space cache (Sec. 13.3): loaded if the file exists (it must match the scene, grid and "
       "ls_* options), else built and saved there; empty = build in memory only", 0, 0, NULL },

@@ -20,9 +20,9 @@
 
 #include "core/error.h"
 #include "render/pathtrace_internal.h"
+#include "render/trace_internal.h"
 #include "rl/rl_timer.h"
 
-#define EPS_SCALE 1e-5f           /* ray origin offset, as trace.c */
 
 const char *rl_pt_backend_name(rl_pt_backend backend)
 {
@@ -177,15 +177,6 @@ static rl_status sm_build(const rl_scene *scene, int size, rl_shadowmap **out, d
     return RL_OK;
 }
 
-static float scene_scale(rl_aabb b)
-{
-    if (rl_aabb_is_empty(b) || !rl_vfinite(b.min) || !rl_vfinite(b.max))
-        return 1.0f;
-    float coord = rl_maxf(rl_vmax_comp(rl_vmax(b.min, rl_neg(b.min))), rl_vmax_comp(rl_vmax(b.max, rl_neg(b.max))));
-    float s = rl_maxf(coord, rl_length(rl_aabb_extent(b)));
-    return s > 0.0f ? s : 1.0f;
-}
-
 uint32_t rl_pt_cover_point(const rl_scene_data *d, rl_vec3 p, float tol)
 {
     for (uint32_t i = 0; i < d->num_lights; ++i) {
@@ -308,7 +299,7 @@ rl_status rl_pt_backends_prepare_scene(pt_backends *b, const rl_scene *scene)
         rl_pt_backends_release(b);
         b->scene_uid = uid;
         b->data = d;
-        b->eps = EPS_SCALE * scene_scale(d->bounds);
+        b->eps = rl_trace_origin_eps(d->bounds);   /* as whitted's */
         if ((st = build_cover(b, d)) != RL_OK || (st = rl_pt_lights_build(b, d)) != RL_OK ||
             (st = rl_pt_env_build(&b->env, d->environment, false)) != RL_OK) {
             rl_pt_backends_release(b);    /* the next frame starts over */

@@ -86,7 +86,7 @@ extern const char *const rl_pt_filter_choices[];
 /* The other choice lists gl-pt shares with pt (orders: pathtrace.c). */
 extern const char *const rl_pt_rng_choices[], *const rl_pt_mis_choices[], *const rl_pt_shadow_choices[],
     *const rl_pt_diffuse_choices[], *const rl_pt_specular_choices[], *const rl_pt_primary_choices[],
-    *const rl_pt_ls_origin_choices[], *const rl_pt_env_sampling_choices[];
+    *const rl_pt_ls_origin_choices[], *const rl_pt_env_sampling_choices[], *const rl_pt_adaptive_choices[];
 #define RL_PT_FILTER_PARAM_OPTIONS                                                                                 \
     { "filter_fade", RL_OPT_FLOAT, "16",                                                                           \
       "filter weight 1/(1 + spp/filter_fade) with spp the samples so far; 0 = never fade", 0, 1e9, NULL },         \
@@ -98,6 +98,31 @@ extern const char *const rl_pt_rng_choices[], *const rl_pt_mis_choices[], *const
     { "atrous_sigma_x", RL_OPT_FLOAT, "0",                                                                         \
       "a-trous position sigma in world units; 0 = 2^atrous_iterations pixel footprints", 0, 1e9, NULL }
 void rl_pt_read_filter_settings(const rl_renderer *r, pt_settings *set);
+/* The rows of the grid's and the per-voxel Line Space's options (Schröder
+ * 2017, Sec. 7.1-7.4, 9.2, 12.1) that pt and gl-pt share: the same names,
+ * defaults, ranges and help, in this order. */
+#define RL_PT_LINE_SPACE_OPTIONS                                                                                   \
+    { "grid_res", RL_OPT_INT, "0", "voxels per axis of the grid and the Line Space (0 = grid heuristic)",          \
+      0, 1024, NULL },                                                                                             \
+    { "ls_n", RL_OPT_INT, "5", "Line Space patches per voxel face side (Sec. 9.2: 5)", 1, RL_LS_MAX_N, NULL },     \
+    { "ls_k", RL_OPT_INT, "8", "Line Space fixed candidate slots per shaft (even; ls_dynamic=false only)", 2,      \
+      RL_LS_MAX_K, NULL },                                                                                         \
+    { "ls_origin", RL_OPT_ENUM, "offset",                                                                          \
+      "PNMT/preillum rays: offset (start one voxel diagonal away, Sec. 12.1) or exact (start at the "              \
+      "surface; the start voxel's triangles answer PNMT rays exactly)", 0, 0, rl_pt_ls_origin_choices },         \
+    { "ls_dynamic", RL_OPT_BOOL, "true", "exact per-shaft candidate lists (prefix sums, Sec. 7.1.1)", 0, 0, NULL }
+/* The rows of adaptive sampling's options (issue 37; pathtrace.c, "Adaptive
+ * sampling"), the same names, defaults and ranges in pt and gl-pt; where is
+ * a string literal appended to the help of "adaptive" (gl-pt: where its
+ * errors and shares are computed), "" for none. */
+#define RL_PT_ADAPTIVE_OPTIONS(where)                                                                              \
+    { "adaptive", RL_OPT_ENUM, "off",                                                                              \
+      "per-pixel adaptive sampling: a frame's paths go where the estimated relative error is largest" where,       \
+      0, 0, rl_pt_adaptive_choices },                                                                              \
+    { "adaptive_threshold", RL_OPT_FLOAT, "0.01",                                                                  \
+      "adaptive: relative error of a pixel's mean below which it gets no more samples", 0, 1e9, NULL },            \
+    { "adaptive_min_spp", RL_OPT_INT, "8", "adaptive: samples every pixel gets before the error decides",          \
+      2, 65536, NULL }
 
 /* The path length a scene asks for when max_depth is -1, for pt, gl-pt and
  * bdpt alike: the thesis' "max_path_length" root attribute (Sec. 9.3; the

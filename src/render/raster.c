@@ -21,17 +21,8 @@
 #include "render/renderer.h"
 #include "rl/rl_raster.h"
 
-/* Option order = rl_raster_shading order. */
-static const char *const shading_choices[] = { "flat", "gouraud", "textured", NULL };
-
 static const rl_option_info raster_options[] = {
-    { "shading", RL_OPT_ENUM, "textured",
-      "flat: per triangle; gouraud: per vertex; textured: gouraud times the diffuse texture",
-      0, 0, shading_choices },
-    { "cull", RL_OPT_BOOL, "false", "drop back faces (counter-clockwise = front)", 0, 0, NULL },
-    { "ambient", RL_OPT_FLOAT, "0.05", "ambient light, multiplied by k_d", 0, 1, NULL },
-    { "background", RL_OPT_COLOR, "0,0,0", "colour where nothing is hit: \"r,g,b\" or one grey value",
-      0, 0, NULL },
+    RL_RASTER_OPTIONS,
     { "threads", RL_OPT_INT, "0", "OpenMP threads for lighting and rasterization (0 = all)", 0, 1024, NULL },
 };
 

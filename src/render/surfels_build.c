@@ -107,16 +107,6 @@ typedef struct build {
     rl_surfel_timing timing;
 } build;
 
-static int thread_count(int threads)
-{
-#ifdef _OPENMP
-    return threads > 0 ? threads : omp_get_max_threads();
-#else
-    (void)threads;
-    return 1;
-#endif
-}
-
 static int thread_id(void)
 {
 #ifdef _OPENMP
@@ -668,7 +658,7 @@ rl_status rl_surfels_build(const rl_scene *scene, const uint32_t *objects, uint3
         return rl_error(RL_ERR_NOT_COMMITTED, "rl_surfels_build: scene is not committed");
     if (objects && num_objects == 0)
         return rl_error(RL_ERR_INVALID_ARG, "rl_surfels_build: an empty object list (NULL means all)");
-    b.threads = thread_count(b.p.threads);
+    b.threads = rl_surfel_thread_count(b.p.threads);
     const rl_drawer_desc atlas_desc = RL_SURFEL_ATLAS_DRAWER_DESC;
     if (b.p.atlas_drawer && !rl_drawer_fits(b.p.atlas_drawer, scene, &atlas_desc))
         return rl_error(RL_ERR_INVALID_ARG, "rl_surfels_build: the atlas drawer was not made for this "

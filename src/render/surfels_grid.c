@@ -21,7 +21,7 @@
 
 #define GRID_MAX_CELLS_PER_SIDE (1 << 20)
 
-static int thread_count(int threads)
+int rl_surfel_thread_count(int threads)
 {
 #ifdef _OPENMP
     return threads > 0 ? threads : omp_get_max_threads();
@@ -221,7 +221,7 @@ rl_status rl_surfels_prefix_spacing(const rl_surfel *s, uint32_t m, int threads,
     if (st == RL_OK) {
         for (uint32_t i = 0; i < m; ++i)
             rl_surfel_grid_insert(&g, p, i);
-#pragma omp parallel for schedule(dynamic, 256) num_threads(thread_count(threads))
+#pragma omp parallel for schedule(dynamic, 256) num_threads(rl_surfel_thread_count(threads))
         for (int64_t i = 0; i < (int64_t)m; ++i) {
             uint32_t j;
             float d2;

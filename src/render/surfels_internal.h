@@ -44,6 +44,9 @@ uint32_t rl_surfel_grid_knn(const rl_surfel_grid *g, const rl_vec3 *points, rl_v
 /* Squared distance from p to the nearest inserted point (INFINITY if none). */
 float rl_surfel_grid_nearest2(const rl_surfel_grid *g, const rl_vec3 *points, rl_vec3 p);
 void rl_surfel_grid_free(rl_surfel_grid *g);
+/* The threads of a parallel region for a threads option: as asked where
+ * > 0, else OpenMP's default; 1 in a build without OpenMP. */
+int rl_surfel_thread_count(int threads);
 
 
 /* Sec. 6.2: what a frame draws of an octree node with `count` surfels

@@ -101,6 +101,11 @@ static float scene_scale(rl_aabb b)
     return s > 0.0f ? s : 1.0f;
 }
 
+float rl_trace_origin_eps(rl_aabb bounds)
+{
+    return EPS_SCALE * scene_scale(bounds);
+}
+
 rl_status rl_tracer_create(const rl_accel *accel, const rl_tracer_desc *desc, rl_tracer **out)
 {
     if (!accel || !out)
@@ -144,7 +149,7 @@ rl_status rl_tracer_create(const rl_accel *accel, const rl_tracer_desc *desc, rl
     rl_accel_get_stats(accel, &st);
     t->hints = st.kind != RL_ACCEL_EMBREE;
     t->seed = d.seed;
-    t->eps = EPS_SCALE * scene_scale(data->bounds);
+    t->eps = rl_trace_origin_eps(data->bounds);
     *out = t;
     return RL_OK;
 }

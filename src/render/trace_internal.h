@@ -15,6 +15,11 @@
  * not name the occluder (documented in rl_trace.h). */
 #define RL_TRACE_OCCLUDER_UNKNOWN (RL_ID_NONE - 1u)
 
+/* The offset of a secondary ray's origin along the geometric normal in a
+ * scene with these bounds: 1e-5 times the scene's size (trace.c, header;
+ * pt's backends use the same, pathtrace_backend.c). */
+float rl_trace_origin_eps(rl_aabb bounds);
+
 struct rl_tracer {
     const rl_accel *accel;
     const rl_scene_data *data;

@@ -24,18 +24,6 @@
 
 #include "gl_fixtures.h"
 
-/* A quad facing the camera at distance dist along its view, half side half. */
-static void view_quad(const rl_camera *cam, float dist, float half, rl_vec3 pos[4])
-{
-    rl_vec3 fwd = rl_normalize(rl_sub(cam->target, cam->eye));
-    rl_vec3 right = rl_normalize(rl_cross(fwd, cam->up));
-    rl_vec3 up = rl_cross(right, fwd);
-    rl_vec3 c = rl_add(cam->eye, rl_scale(fwd, dist));
-    for (int k = 0; k < 4; ++k)
-        pos[k] = rl_add(c, rl_add(rl_scale(right, k == 1 || k == 2 ? half : -half),
-                                  rl_scale(up, k >= 2 ? half : -half)));
-}
-
 /* Queries on one drawer: a quad behind the Cornell box's back wall issued
  * before the box is drawn, and again after; both read after the second
  * issue. Each answers for the depth buffer of its issue: visible, then
@@ -44,7 +32,7 @@ static void check_async_queries(rl_drawer *dr, const rl_scene *s, const rl_camer
 {
     const float dist = rl_length(rl_sub(cam->target, cam->eye));
     rl_vec3 quad[4];
-    view_quad(cam, 1.9f * dist, 0.1f * dist, quad);
+    fx_view_quad(cam, 1.9f * dist, 0.1f * dist, quad);
     const uint32_t idx[6] = { 0, 1, 2, 0, 2, 3 };
     rl_raster_batch q = { .num_vertices = 4, .positions = quad, .num_triangles = 2, .indices = idx };
     rl_image *img = NULL;
@@ -95,7 +83,7 @@ static void check_kept_queries(rl_drawer *dr, const rl_scene *s, const rl_camera
 {
     const float dist = rl_length(rl_sub(cam->target, cam->eye));
     rl_vec3 quad[4];
-    view_quad(cam, 1.9f * dist, 0.1f * dist, quad);
+    fx_view_quad(cam, 1.9f * dist, 0.1f * dist, quad);
     const uint32_t idx[6] = { 0, 1, 2, 0, 2, 3 };
     rl_raster_batch q = { .num_vertices = 4, .positions = quad, .num_triangles = 2, .indices = idx };
     rl_image *img = NULL;

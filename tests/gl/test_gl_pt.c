@@ -105,44 +105,6 @@ static rl_scene *mask_normal_scene(rl_camera *cam)
     return s;
 }
 
-/* Per channel: the RMSE of a - b and the difference of the image means. */
-static void difference(const rl_image *a, const rl_image *b, double rmse[3], double mean_diff[3])
-{
-    const size_t n = (size_t)a->width * (size_t)a->height;
-    for (int c = 0; c < 3; ++c) {
-        double sq = 0.0, sum = 0.0;
-        for (size_t i = 0; i < n; ++i) {
-            const float *pa = &a->color[i].x, *pb = &b->color[i].x;
-            double d = (double)pa[c] - pb[c];
-            sq += d * d;
-            sum += d;
-        }
-        rmse[c] = sqrt(sq / (double)n);
-        mean_diff[c] = sum / (double)n;
-    }
-}
-
-static double rmse_all(const double rmse[3])
-{
-    return sqrt((rmse[0] * rmse[0] + rmse[1] * rmse[1] + rmse[2] * rmse[2]) / 3.0);
-}
-
-/* The means agree within 3 sigma of the mean of n independent pixel
- * differences, sigma^2 = their variance / n, estimated by RMSE^2 (pixels
- * have independent generator states or scrambles in both tracers). */
-static void assert_means_agree(const char *what, const rl_image *gl, const rl_image *ref)
-{
-    double rmse[3], md[3];
-    difference(gl, ref, rmse, md);
-    const double n = (double)gl->width * gl->height;
-    for (int c = 0; c < 3; ++c) {
-        double sigma = rmse[c] / sqrt(n);
-        print_message("%s: channel %d mean difference %+.5f, sigma %.5f (%.2f sigma)\n", what, c, md[c], sigma,
-                      sigma > 0.0 ? fabs(md[c]) / sigma : 0.0);
-        assert_true(fabs(md[c]) <= 3.0 * sigma + 1e-6);
-    }
-}
-
 static rl_image *render(const char *algo, const rl_scene *s, const rl_camera *cam, const char *const *opts)
 {
     rl_render_stats st = { 0 };
@@ -165,8 +127,8 @@ static void test_gl_pt_converges_to_pt_on_cornell(void **state)
     for (int k = 0; k < 3; ++k) {
         rl_image *gl = render("gl-pt", s, &cam, (const char *const[]){ "spp", spps[k], "rng", "hybrid", NULL });
         double rmse[3], md[3];
-        difference(gl, ref, rmse, md);
-        e[k] = rmse_all(rmse);
+        fx_difference(gl, ref, rmse, md);
+        e[k] = fx_rmse_all(rmse);
         print_message("cornell gl-pt %s spp: RMSE to pt at %s spp %.5f\n", spps[k], REF_SPP, e[k]);
         rl_image_release(last);
         last = gl;
@@ -174,7 +136,7 @@ static void test_gl_pt_converges_to_pt_on_cornell(void **state)
     print_message("ratios %.2f %.2f (1/sqrt(spp): 1.95, 1.84)\n", e[0] / e[1], e[1] / e[2]);
     assert_true(e[0] / e[1] > 1.4 && e[0] / e[1] < 3.0);
     assert_true(e[1] / e[2] > 1.4 && e[1] / e[2] < 3.0);
-    assert_means_agree("cornell hybrid 64 spp", last, ref);
+    fx_assert_means_agree("cornell hybrid 64 spp", last, ref);
     rl_image_release(last);
     rl_image_release(ref);
     rl_scene_release(s);
@@ -203,7 +165,7 @@ static void test_gl_pt_means_agree_with_pt(void **state)
                               (const char *const[]){ "spp", "64", cases[i].opt, cases[i].value, NULL });
         char what[96];
         snprintf(what, sizeof what, "%s %s=%s 64 spp", cases[i].scene, cases[i].opt, cases[i].value);
-        assert_means_agree(what, gl, ref);
+        fx_assert_means_agree(what, gl, ref);
         rl_image_release(gl);
         rl_image_release(ref);
         rl_scene_release(s);
@@ -516,8 +478,8 @@ static void test_gl_pt_primary_raster_converges_to_pt(void **state)
     for (int k = 0; k < 3; ++k) {
         rl_image *gl = render("gl-pt", s, &cam, (const char *const[]){ "spp", spps[k], "primary", "raster", NULL });
         double rmse[3], md[3];
-        difference(gl, ref, rmse, md);
-        e[k] = rmse_all(rmse);
+        fx_difference(gl, ref, rmse, md);
+        e[k] = fx_rmse_all(rmse);
         print_message("cornell gl-pt primary=raster %s spp: RMSE to pt primary=raster at %s spp %.5f\n", spps[k],
                       REF_SPP, e[k]);
         rl_image_release(last);
@@ -526,7 +488,7 @@ static void test_gl_pt_primary_raster_converges_to_pt(void **state)
     print_message("ratios %.2f %.2f\n", e[0] / e[1], e[1] / e[2]);
     assert_true(e[0] / e[1] > 1.4);
     assert_true(e[1] / e[2] > 1.4);
-    assert_means_agree("cornell primary=raster 64 spp", last, ref);
+    fx_assert_means_agree("cornell primary=raster 64 spp", last, ref);
     rl_image_release(last);
     rl_image_release(ref);
     rl_scene_release(s);
@@ -727,9 +689,9 @@ static void test_gl_pt_shadow_maps_are_pts(void **state)
                                                                  NULL });
     rl_image *exact = render("pt", s, &cam, (const char *const[]){ "spp", REF_SPP, "seed", "3", NULL });
     rl_image *gl = render("gl-pt", s, &cam, (const char *const[]){ "spp", "64", "shadow", "shadowmap", NULL });
-    assert_means_agree("cornell shadow=shadowmap 64 spp", gl, ref);
+    fx_assert_means_agree("cornell shadow=shadowmap 64 spp", gl, ref);
     double rmse[3], md[3];
-    difference(gl, exact, rmse, md);
+    fx_difference(gl, exact, rmse, md);
     for (int c = 0; c < 3; ++c) {
         double mean = 0.0;
         for (size_t i = 0; i < (size_t)SIZE * SIZE; ++i)
@@ -883,7 +845,7 @@ static void test_gl_pt_environment_is_pts(void **state)
         snprintf(what, sizeof what, "%s environment%s, env_sampling=%s mis=%s 64 spp",
                  cases[k].map ? "map" : "constant", cases[k].fresnel ? ", Schlick glass and chrome" : "",
                  cases[k].sampling, cases[k].mis);
-        assert_means_agree(what, gl, ref);
+        fx_assert_means_agree(what, gl, ref);
         rl_image_release(gl);
         rl_image_release(ref);
         /* pt's numbers: pt's pixels */
@@ -1059,7 +1021,7 @@ static void test_gl_pt_ggx_is_pts(void **state)
         rl_image *gl = render("gl-pt", s, &cam, (const char *const[]){ "spp", "64", "ggx_ms", ms[k], NULL });
         char what[96];
         snprintf(what, sizeof what, "GGX gold and plastic under the sky map, ggx_ms=%s 64 spp", ms[k]);
-        assert_means_agree(what, gl, ref);
+        fx_assert_means_agree(what, gl, ref);
         rl_image_release(gl);
         rl_image_release(ref);
         rl_image *cpu = render("pt", s, &cam, (const char *const[]){ "spp", "4", "rng", "hybrid", "seed", "5",
@@ -1248,14 +1210,14 @@ static void test_gl_pt_adaptive_spends_where_the_error_is(void **state)
     assert_true(total <= 64 * n);
     assert_true(sky > 50 && ball > 50);
     double rmse_a[3], rmse_b[3], md[3];
-    difference(a, ref, rmse_a, md);
-    difference(b, ref, rmse_b, md);
+    fx_difference(a, ref, rmse_a, md);
+    fx_difference(b, ref, rmse_b, md);
     print_message("adaptive: %llu samples (uniform %zu), sky pixels %.1f spp, sphere pixels %.1f spp; RMSE to pt "
                   "1024 spp: adaptive %.5f, uniform %.5f\n", (unsigned long long)total, 64 * n,
-                  (double)sky_samples / (double)sky, (double)ball_samples / (double)ball, rmse_all(rmse_a),
-                  rmse_all(rmse_b));
+                  (double)sky_samples / (double)sky, (double)ball_samples / (double)ball, fx_rmse_all(rmse_a),
+                  fx_rmse_all(rmse_b));
     assert_true((double)ball_samples / (double)ball > 64.0);
-    assert_true(rmse_all(rmse_a) <= rmse_all(rmse_b));
+    assert_true(fx_rmse_all(rmse_a) <= fx_rmse_all(rmse_b));
     free(counts);
     rl_image_release(a);
     rl_image_release(b);
@@ -1279,10 +1241,10 @@ static void test_gl_pt_adaptive_spends_where_the_error_is(void **state)
         spent += st.samples;
     }
     b = render_frames(off, s, &cam, 4, NULL);
-    difference(a, ref, rmse_a, md);
-    difference(b, ref, rmse_b, md);
+    fx_difference(a, ref, rmse_a, md);
+    fx_difference(b, ref, rmse_b, md);
     print_message("cornell 32 x 32: adaptive %.1f spp RMSE %.5f, uniform 64 spp RMSE %.5f (to pt at 1024 spp)\n",
-                  (double)spent / (double)(cam.width * cam.height), rmse_all(rmse_a), rmse_all(rmse_b));
+                  (double)spent / (double)(cam.width * cam.height), fx_rmse_all(rmse_a), fx_rmse_all(rmse_b));
     rl_image_release(a);
     rl_image_release(b);
     rl_image_release(ref);

@@ -49,43 +49,12 @@ static rl_image *render_frames(const char *algo, const rl_scene *s, const rl_cam
     return img;
 }
 
-/* Per channel: the RMSE of a - b and the difference of the image means. */
-static void difference(const rl_image *a, const rl_image *b, double rmse[3], double mean_diff[3])
-{
-    const size_t n = (size_t)a->width * (size_t)a->height;
-    for (int c = 0; c < 3; ++c) {
-        double sq = 0.0, sum = 0.0;
-        for (size_t i = 0; i < n; ++i) {
-            const float *pa = &a->color[i].x, *pb = &b->color[i].x;
-            double d = (double)pa[c] - pb[c];
-            sq += d * d;
-            sum += d;
-        }
-        rmse[c] = sqrt(sq / (double)n);
-        mean_diff[c] = sum / (double)n;
-    }
-}
-
-static double rmse_all(const rl_image *a, const rl_image *b)
+/* The RMSE of a - b over the three channels. */
+static double rmse_to(const rl_image *a, const rl_image *b)
 {
     double r[3], m[3];
-    difference(a, b, r, m);
-    return sqrt((r[0] * r[0] + r[1] * r[1] + r[2] * r[2]) / 3.0);
-}
-
-/* The means agree within 3 sigma of the mean of n independent pixel
- * differences (sigma^2 = their variance / n, estimated by RMSE^2). */
-static void assert_means_agree(const char *what, const rl_image *img, const rl_image *ref)
-{
-    double rmse[3], md[3];
-    difference(img, ref, rmse, md);
-    const double n = (double)img->width * img->height;
-    for (int c = 0; c < 3; ++c) {
-        double sigma = rmse[c] / sqrt(n);
-        print_message("%s: channel %d mean difference %+.5f, sigma %.5f (%.2f sigma)\n", what, c, md[c], sigma,
-                      sigma > 0.0 ? fabs(md[c]) / sigma : 0.0);
-        assert_true(fabs(md[c]) <= 3.0 * sigma + 1e-6);
-    }
+    fx_difference(a, b, r, m);
+    return fx_rmse_all(r);
 }
 
 /* Cornell box (16 x 16): gl-pt with light paths against pt at 1024 spp. */
@@ -99,7 +68,7 @@ static void test_hybrid_cornell_means_are_pts(void **state)
     rl_image *ref = render_frames("pt", s, &cam, ref_opts, 1);
     const char *opts[] = { "spp", "16", "light_paths", "256", "light_connect", "2", NULL };
     rl_image *img = render_frames("gl-pt", s, &cam, opts, 4);
-    assert_means_agree("cornell gl-pt light_paths=256 64 spp vs pt", img, ref);
+    fx_assert_means_agree("cornell gl-pt light_paths=256 64 spp vs pt", img, ref);
     rl_image_release(img);
     rl_image_release(ref);
     rl_scene_release(s);
@@ -121,10 +90,10 @@ static void test_hybrid_shade_room_is_unbiased_and_less_noisy(void **state)
     const char *on[] = { "spp", "4", "light_paths", "256", NULL };
     rl_image *a = render_frames("gl-pt", s, &cam, off, 16);
     rl_image *b = render_frames("gl-pt", s, &cam, on, 16);
-    double e_off = rmse_all(a, ref), e_on = rmse_all(b, ref);
+    double e_off = rmse_to(a, ref), e_on = rmse_to(b, ref);
     print_message("shade room 64 spp: RMSE to pt at 4096 spp: light_paths=0 %.5f, light_paths=256 %.5f (%.2fx)\n",
                   e_off, e_on, e_off / e_on);
-    assert_means_agree("shade room gl-pt light_paths=256 64 spp vs pt", b, ref);
+    fx_assert_means_agree("shade room gl-pt light_paths=256 64 spp vs pt", b, ref);
     assert_true(e_on < 0.85 * e_off);
     rl_image_release(a);
     rl_image_release(b);

@@ -180,19 +180,6 @@ static void test_gl_drawer_honours_the_draw_flags(void **state)
     rl_scene_release(s);
 }
 
-/* A quad facing the camera at distance dist along its view, half side
- * half, as the two triangles of a query batch. */
-static void view_quad(const rl_camera *cam, float dist, float half, rl_vec3 pos[4])
-{
-    rl_vec3 fwd = rl_normalize(rl_sub(cam->target, cam->eye));
-    rl_vec3 right = rl_normalize(rl_cross(fwd, cam->up));
-    rl_vec3 up = rl_cross(right, fwd);
-    rl_vec3 c = rl_add(cam->eye, rl_scale(fwd, dist));
-    for (int k = 0; k < 4; ++k)
-        pos[k] = rl_add(c, rl_add(rl_scale(right, k == 1 || k == 2 ? half : -half),
-                                  rl_scale(up, k >= 2 ? half : -half)));
-}
-
 /* Occlusion queries and points, the two other things culling and
  * level-of-detail renderers ask of a drawer, against the software one. */
 static void test_gl_drawer_queries_and_points(void **state)
@@ -214,8 +201,8 @@ static void test_gl_drawer_queries_and_points(void **state)
     rl_vec3 near_quad[4], far_quad[4];
     /* Inside the box's opening (the clip range starts at the box), and
      * just behind its back wall. */
-    view_quad(&cam, 1.06f * dist, 0.06f * dist, near_quad);
-    view_quad(&cam, 1.9f * dist, 0.1f * dist, far_quad);
+    fx_view_quad(&cam, 1.06f * dist, 0.06f * dist, near_quad);
+    fx_view_quad(&cam, 1.9f * dist, 0.1f * dist, far_quad);
     for (int b = 0; b < 2; ++b) {
         rl_image_clear(img[b]);
         assert_int_equal(rl_drawer_begin_camera(dr[b], img[b], &cam, rl_scene_get_data(s)->bounds), RL_OK);
