@@ -30,6 +30,18 @@
 
 #define VT_NONE 0xFFFFFFFFu
 
+/* The refinement's large growing arrays (the mesh's, the edge list, the
+ * per-vertex feelers) in mappings of their own where the system has mremap
+ * (Linux), through realloc elsewhere: growth moves pages instead of copying
+ * them and leaves no freed block behind in the heap (why: vt_mesh.c).
+ * vt_array_resize: p of old_bytes (the size it was made with; p NULL: a new
+ * one) to new_bytes, contents kept up to the smaller size, new room zero on
+ * Linux and undefined elsewhere; NULL when out of memory, p unchanged.
+ * vt_array_free: p made with bytes; NULL is ignored. Never mixed with
+ * malloc/free. */
+void *vt_array_resize(void *p, size_t old_bytes, size_t new_bytes);
+void vt_array_free(void *p, size_t bytes);
+
 /* ---------------------------------------------------------------- mesh -- */
 
 enum vt_vertex_state {
@@ -132,7 +144,9 @@ typedef struct vt_mesh {
     vt_vertex_sample *samples;  uint32_t cap_samples;   /* per vertex, like verts */
     vt_edge *edges;    uint32_t num_edges, cap_edges;
     uint32_t *edge_queued;    /* bit e: edge e is in the edge list (vt_heap);
-                               * cap_edges bits */
+                               * cap_queued words, at least cap_edges bits
+                               * once a reserve succeeded */
+    uint32_t cap_queued;
     vt_face *faces;    uint32_t num_faces, cap_faces;
     uint32_t num_created;     /* faces created since the last reset, primary
                                * ones included: the next face's seq */
@@ -166,6 +180,16 @@ void vt_mesh_free(vt_mesh *m);
  * state (edges unsplit and unqueued, faces leaf and invisible, vertices
  * unsampled): the start of a new camera frame. Keeps the allocations. */
 void vt_mesh_reset(vt_mesh *m);
+
+/* Gives back the edges the refinement made, keeping the primary ones (and
+ * the arrays' room for them): once a frame's refinement is over nothing
+ * reads them (the draw reads faces, vertices and samples, rl_vt_get_mesh
+ * vertices and leaves, the feeler map vertices), and vt_mesh_reset keeps
+ * only the primary edges. A refined mesh has four edges per generated
+ * vertex, a quarter of its bytes. Afterwards the refined faces' e[] name
+ * edges that are gone: only the draw, vt_mesh_pick_in_order and
+ * vt_mesh_reset may follow, no split. num_edges is num_primary_edges then. */
+void vt_mesh_drop_refined_edges(vt_mesh *m);
 
 /* The primary face that face f descends from (f itself when primary);
  * VT_NONE for a face that is not of the mesh's triangles (vt_part_import). */
