@@ -1108,15 +1108,15 @@ static double edge_cost(const vt_run *run, const vt_mesh *m, const vt_edge *ed, 
     const vt_vertex_sample *sa = &m->samples[ed->v[0]], *sb = &m->samples[ed->v[1]];
     const unsigned bits = run->set->criteria.bits;
     double delta;
-    if ((bits & VT_CRIT_TREE) && sa->tree_hash != sb->tree_hash) {
+    if ((bits & VT_CRIT_TREE) && vt_sample_tree(sa) != vt_sample_tree(sb)) {
         delta = 1.0;
     } else if (bits & VT_CRIT_RGB || !(bits & VT_CRIT_HSV)) {
-        delta = (fabsf(sa->display.x - sb->display.x) + fabsf(sa->display.y - sb->display.y) +
-                 fabsf(sa->display.z - sb->display.z)) / 3.0;
+        rl_vec3 da = vt_sample_display(sa), db = vt_sample_display(sb);
+        delta = (fabsf(da.x - db.x) + fabsf(da.y - db.y) + fabsf(da.z - db.z)) / 3.0;
     } else {
         float ha, sat_a, va, hb, sat_b, vb;
-        vt_rgb_to_hsv(sa->display, &ha, &sat_a, &va);
-        vt_rgb_to_hsv(sb->display, &hb, &sat_b, &vb);
+        vt_rgb_to_hsv(vt_sample_display(sa), &ha, &sat_a, &va);
+        vt_rgb_to_hsv(vt_sample_display(sb), &hb, &sat_b, &vb);
         float dh = fabsf(ha - hb);
         dh = dh > 0.5f ? 1.0f - dh : dh;
         delta = (2.0 * dh + fabsf(sat_a - sat_b) + fabsf(va - vb)) / 3.0;  /* hue circle: 0.5 at most */

@@ -73,7 +73,7 @@ typedef struct vt_vertex {
 } vt_vertex;
 
 /* The sample of a vertex, valid once its state is VT_SAMPLED: what the
- * criteria compare (display, h/s/v, tree_hash) and what the reconstruction
+ * criteria compare (flat, tree_hash) and what the reconstruction
  * draws. A refined mesh holds hundreds of thousands of them, so only what
  * is read later is kept: of the primary layer its diffuse and rest terms
  * (its texture and uv are the face's and the vertex's, Sec. 3.5.3), and
@@ -82,19 +82,30 @@ typedef struct vt_vertex {
 typedef struct vt_vertex_sample {
     rl_vec3 flat;             /* radiance with deferred textures white; with
                                * textures=sampled the textured radiance */
-    /* flat as the criteria see it (vt_criteria_prepare): display values,
-     * computed once by the thread that sampled the vertex instead of once
-     * per edge test on the refining thread (three powf per end). Their HSV
-     * is not kept: it costs the HSV criterion a few compares and one
-     * division per end and test (vt_rgb_to_hsv), and would take 12 bytes
-     * of each of a refined mesh's hundreds of thousands of samples */
-    rl_vec3 display;
+    /* Neither flat's display values nor their HSV are kept: the criteria
+     * compute them per test (vt_sample_display, vt_rgb_to_hsv; three powf
+     * per end), the same numbers as stored ones. 12 bytes of each of a
+     * refined mesh's hundreds of thousands of samples, at the frame's peak
+     * (the end of the refinement), cost more than the powf (2026-12-06,
+     * bench/README.md "Memory at the defaults, third pass"). */
     rl_vec3 diffuse, rest;    /* of the primary layer */
     uint32_t deferred[2];     /* reflection, refraction: index into
                                * vt_mesh.layers, or with VT_PLAIN_LAYER
                                * set into vt_mesh.plain; VT_NONE when empty */
-    uint64_t tree_hash;       /* rl_ray_tree_hash of its ray tree */
+    uint32_t tree_hash[2];    /* rl_ray_tree_hash of its ray tree, low word
+                               * first (vt_sample_tree): as a uint64_t it
+                               * would pad the 52-byte sample to 56 */
 } vt_vertex_sample;
+
+static inline uint64_t vt_sample_tree(const vt_vertex_sample *s)
+{
+    return (uint64_t)s->tree_hash[1] << 32 | s->tree_hash[0];
+}
+static inline void vt_sample_set_tree(vt_vertex_sample *s, uint64_t hash)
+{
+    s->tree_hash[0] = (uint32_t)hash;
+    s->tree_hash[1] = (uint32_t)(hash >> 32);
+}
 
 typedef struct vt_edge {
     uint32_t v[2];            /* end vertices */
@@ -304,9 +315,10 @@ typedef struct vt_criteria {
 /* Parses "rgb", "hsv", "tree", "tree+rgb", "tree+hsv" (also "rgb+tree",
  * "hsv+tree", and "rgb+hsv"); false for anything else. */
 bool vt_criteria_parse(const char *text, unsigned *bits);
-/* Fills the display values of a sample from its flat colour. */
-void vt_criteria_prepare(vt_vertex_sample *sample);
-/* The criteria that fire for the samples a and b (prepared), as
+/* The display values of a sample's flat colour (vt_display per channel):
+ * what the colour criteria compare. */
+rl_vec3 vt_sample_display(const vt_vertex_sample *sample);
+/* The criteria that fire for the samples a and b, as
  * vt_criterion_bits; 0 = interpolation along the edge is acceptable.
  * Colours compared are the vertices' flat colours (deferred textures left
  * out, Sec. 3.5.3). HSV: hue is ignored when either saturation is below

@@ -290,8 +290,7 @@ static void sample_block(vt_run *run, vt_block *b)
         /* Without deferred textures the criteria see them too. */
         out->flat = run->set->textures == VT_TEX_SAMPLED ? s.color : s.flat;
         memcpy(b->layers[i], s.layers, sizeof b->layers[i]);
-        out->tree_hash = run->want_tree ? vt_tree_hash(&tree, run->set->tree_shadow, run->set->tree_depth) : 0;
-        vt_criteria_prepare(out);
+        vt_sample_set_tree(out, run->want_tree ? vt_tree_hash(&tree, run->set->tree_shadow, run->set->tree_depth) : 0);
         for (int k = 0; k < RL_RAY_TYPE_COUNT; ++k) {
             b->rays[i][k] = s.rays[k];
             tally->rays += s.rays[k];
