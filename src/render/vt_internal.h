@@ -31,12 +31,13 @@
 #define VT_NONE 0xFFFFFFFFu
 
 /* The refinement's large growing arrays (the mesh's, the edge list, the
- * per-vertex feelers) in mappings of their own where the system has mremap
- * (Linux), through realloc elsewhere: growth moves pages instead of copying
- * them and leaves no freed block behind in the heap (why: vt_mesh.c).
- * vt_array_resize: p of old_bytes (the size it was made with; p NULL: a new
- * one) to new_bytes, contents kept up to the smaller size, new room zero on
- * Linux and undefined elsewhere; NULL when out of memory, p unchanged.
+ * frame's per-vertex feelers and hints and its pools) in mappings of their
+ * own where the system has mremap (Linux), through realloc elsewhere and
+ * under AddressSanitizer: growth moves pages instead of copying them and
+ * leaves no freed block behind in the heap (why: vt_mesh.c).
+ * vt_array_resize: p of old_bytes (the size it was made or last resized
+ * with; p NULL: a new one) to new_bytes, contents kept up to the smaller
+ * size, new room undefined; NULL when out of memory, p unchanged.
  * vt_array_free: p made with bytes; NULL is ignored. Never mixed with
  * malloc/free. */
 void *vt_array_resize(void *p, size_t old_bytes, size_t new_bytes);

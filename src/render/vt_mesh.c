@@ -69,8 +69,18 @@ uint64_t vt_vertex_key_mid(uint64_t a, uint64_t b)
  * resident until reused or trimmed. On table at 1024^2 (defaults) that
  * was 12 MB of the frame's peak, which is at the end of the refinement
  * (an RSS trace every 20 ms: 193.8 MB through malloc, 182.0 MB with
- * MALLOC_MMAP_THRESHOLD_=131072). Elsewhere the arrays use realloc. */
-#if defined(__linux__) && defined(MREMAP_MAYMOVE)
+ * MALLOC_MMAP_THRESHOLD_=131072). Elsewhere, and under AddressSanitizer,
+ * the arrays use realloc. */
+#if defined(__SANITIZE_ADDRESS__)
+#define VT_UNDER_ASAN 1
+#elif defined(__has_feature)
+#if __has_feature(address_sanitizer)
+#define VT_UNDER_ASAN 1
+#endif
+#endif
+/* Not under AddressSanitizer: it checks heap blocks, not mappings, and the
+ * sanitizer builds are there to check these arrays. */
+#if defined(__linux__) && defined(MREMAP_MAYMOVE) && !defined(VT_UNDER_ASAN)
 #define VT_MAPPED_ARRAYS 1
 static size_t mapped_size(size_t bytes)
 {
