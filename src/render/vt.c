@@ -506,8 +506,7 @@ static void keep_mesh(vt_state *s, vt_run *run)
     free(s->reason);
     s->reason = run->reason;
     s->num_reason = run->reason ? run->per_vertex_cap : 0;
-    run->reason = NULL;
-    run->per_vertex_cap = 0;
+    run->reason = NULL;       /* per_vertex_cap stays: it sizes the feelers */
 }
 
 /* Copies the refined mesh out for rl_vt_get_mesh. */
@@ -606,6 +605,7 @@ static void setup_run(vt_run *run, rl_renderer *r, vt_state *s, const rl_scene_d
     run->object_raster = s->object_raster;
     run->tri_face = s->mesh.tri_face;
     run->want_tree = (set->criteria.bits & VT_CRIT_TREE) != 0;
+    run->feeler_pool.mapped = run->hint_pool.mapped = true;
     run->cache = set->coherence && s->feelers.count ? &s->feelers : NULL;
     run->renderer = r;
     run->update = s->update;
@@ -747,6 +747,11 @@ static rl_status run_frame(vt_run *run, vt_state *s, const vt_settings *set, rl_
         s->depth_ids = NULL;
         run->view.depth = NULL;
         vt_heap_free(run->heap);
+        /* The refined edges too (a quarter of the mesh, 29 MB at the
+         * defaults at 1024^2): the draw and the feeler map read vertices,
+         * samples and faces only, and the next frame starts from the
+         * primary edges (vt_mesh_reset). */
+        vt_mesh_drop_refined_edges(run->mesh);
         give_back_freed();
     }
     if (st == RL_OK) {
@@ -764,10 +769,8 @@ static rl_status run_frame(vt_run *run, vt_state *s, const vt_settings *set, rl_
     if (st == RL_OK)
         keep_mesh(s, run);
     vt_run_free_blocks(run);
-    free(run->reason);
-    free(run->feelers);
+    vt_run_free_vertex_arrays(run);
     vt_feeler_pool_free(&run->feeler_pool);
-    free(run->hints);
     vt_feeler_pool_free(&run->hint_pool);
     free(run->sorting);
     return st;
@@ -881,10 +884,8 @@ rl_status rl_vt_set_update_callback(rl_renderer *r, rl_vt_update_fn fn, void *us
 static void dist_end(vt_run *run, rl_tracer *tracer)
 {
     vt_run_free_blocks(run);
-    free(run->reason);
-    free(run->feelers);
+    vt_run_free_vertex_arrays(run);
     vt_feeler_pool_free(&run->feeler_pool);
-    free(run->hints);
     vt_feeler_pool_free(&run->hint_pool);
     free(run->sorting);
     rl_tracer_release(tracer);
@@ -1121,15 +1122,15 @@ static double edge_cost(const vt_run *run, const vt_mesh *m, const vt_edge *ed, 
     const vt_vertex_sample *sa = &m->samples[ed->v[0]], *sb = &m->samples[ed->v[1]];
     const unsigned bits = run->set->criteria.bits;
     double delta;
-    if ((bits & VT_CRIT_TREE) && sa->tree_hash != sb->tree_hash) {
+    if ((bits & VT_CRIT_TREE) && vt_sample_tree(sa) != vt_sample_tree(sb)) {
         delta = 1.0;
     } else if (bits & VT_CRIT_RGB || !(bits & VT_CRIT_HSV)) {
-        delta = (fabsf(sa->display.x - sb->display.x) + fabsf(sa->display.y - sb->display.y) +
-                 fabsf(sa->display.z - sb->display.z)) / 3.0;
+        rl_vec3 da = vt_sample_display(sa), db = vt_sample_display(sb);
+        delta = (fabsf(da.x - db.x) + fabsf(da.y - db.y) + fabsf(da.z - db.z)) / 3.0;
     } else {
         float ha, sat_a, va, hb, sat_b, vb;
-        vt_rgb_to_hsv(sa->display, &ha, &sat_a, &va);
-        vt_rgb_to_hsv(sb->display, &hb, &sat_b, &vb);
+        vt_rgb_to_hsv(vt_sample_display(sa), &ha, &sat_a, &va);
+        vt_rgb_to_hsv(vt_sample_display(sb), &hb, &sat_b, &vb);
         float dh = fabsf(ha - hb);
         dh = dh > 0.5f ? 1.0f - dh : dh;
         delta = (2.0 * dh + fabsf(sat_a - sat_b) + fabsf(va - vb)) / 3.0;  /* hue circle: 0.5 at most */

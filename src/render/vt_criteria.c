@@ -82,11 +82,11 @@ static rl_vec3 display_of(rl_vec3 c)
     return rl_v3(vt_display(c.x), vt_display(c.y), vt_display(c.z));
 }
 
-void vt_criteria_prepare(vt_vertex_sample *sample)
+rl_vec3 vt_sample_display(const vt_vertex_sample *sample)
 {
     /* Sec. 3.5.3: deferred textures are applied by the rasterizer, so only
      * the untextured ("flat") radiance decides where to sample. */
-    sample->display = display_of(sample->flat);
+    return display_of(sample->flat);
 }
 
 uint64_t vt_tree_hash(const rl_ray_tree *tree, int shadow, int depth)
@@ -118,7 +118,13 @@ uint64_t vt_tree_hash(const rl_ray_tree *tree, int shadow, int depth)
 unsigned vt_criteria_test(const vt_criteria *c, const vt_vertex_sample *a, const vt_vertex_sample *b)
 {
     unsigned fired = 0;
-    rl_vec3 da = a->display, db = b->display;
+    /* Display values per test, not stored (vt_vertex_sample), and only
+     * for the colour criteria: the tree criterion alone needs none. */
+    rl_vec3 da = rl_v3s(0.0f), db = rl_v3s(0.0f);
+    if (c->bits & (VT_CRIT_RGB | VT_CRIT_HSV)) {
+        da = vt_sample_display(a);
+        db = vt_sample_display(b);
+    }
     if (c->bits & VT_CRIT_RGB) {
         /* eq. 3.11: L1 norm of the difference */
         float l1 = fabsf(da.x - db.x) + fabsf(da.y - db.y) + fabsf(da.z - db.z);
@@ -126,8 +132,6 @@ unsigned vt_criteria_test(const vt_criteria *c, const vt_vertex_sample *a, const
             fired |= VT_CRIT_RGB;
     }
     if (c->bits & VT_CRIT_HSV) {
-        /* From the display values each time: the same numbers as stored
-         * ones, without their room in every sample. */
         float ha, sa, va, hb, sb, vb;
         vt_rgb_to_hsv(da, &ha, &sa, &va);
         vt_rgb_to_hsv(db, &hb, &sb, &vb);
@@ -142,7 +146,7 @@ unsigned vt_criteria_test(const vt_criteria *c, const vt_vertex_sample *a, const
         if (hue_fires || fabsf(sa - sb) > c->eps_s || fabsf(va - vb) > c->eps_v)
             fired |= VT_CRIT_HSV;
     }
-    if ((c->bits & VT_CRIT_TREE) && a->tree_hash != b->tree_hash)
+    if ((c->bits & VT_CRIT_TREE) && vt_sample_tree(a) != vt_sample_tree(b))
         fired |= VT_CRIT_TREE;
     return fired;
 }

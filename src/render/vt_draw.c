@@ -462,7 +462,7 @@ void vt_draw_overlay(vt_run *run)
             const vt_vertex *x = &m->verts[v];
             if (x->state != VT_SAMPLED || !(x->cw > 0.0f))
                 continue;
-            uint8_t r = v < run->per_vertex_cap ? run->reason[v] : 0;
+            uint8_t r = run->reason && v < run->per_vertex_cap ? run->reason[v] : 0;
             rl_vec4 c = (r & (VT_REASON_TREE | VT_REASON_SHAFT)) ? rl_v4(1.0f, 0.1f, 0.1f, 1.0f)
                       : (r & (VT_REASON_RGB | VT_REASON_HSV | VT_REASON_NONLINEAR)) ? rl_v4(1.0f, 0.9f, 0.1f, 1.0f)
                       : (r & VT_REASON_FORCED) ? rl_v4(0.2f, 0.5f, 1.0f, 1.0f)

@@ -27,7 +27,7 @@ rl_status vt_heap_push(vt_heap *h, uint32_t edge, float length)
         if (h->cap >= VT_HEAP_MAX_ITEMS)
             return rl_error(RL_ERR_LIMIT, "vt edge list: more than 2^31 edges");
         uint32_t cap = h->cap ? 2 * h->cap : 1024;
-        vt_heap_item *items = rl_realloc_array(h->items, cap, sizeof *items);
+        vt_heap_item *items = vt_array_resize(h->items, (size_t)h->cap * sizeof *items, (size_t)cap * sizeof *items);
         if (!items)
             return RL_ERR_OUT_OF_MEMORY;
         h->items = items;
@@ -94,7 +94,7 @@ void vt_heap_free(vt_heap *h)
 {
     if (!h)
         return;
-    free(h->items);
+    vt_array_free(h->items, (size_t)h->cap * sizeof *h->items);
     h->items = NULL;
     h->count = h->cap = 0;
 }

@@ -30,6 +30,19 @@
 
 #define VT_NONE 0xFFFFFFFFu
 
+/* The refinement's large growing arrays (the mesh's, the edge list, the
+ * frame's per-vertex feelers and hints and its pools) in mappings of their
+ * own where the system has mremap (Linux), through realloc elsewhere and
+ * under AddressSanitizer: growth moves pages instead of copying them and
+ * leaves no freed block behind in the heap (why: vt_mesh.c).
+ * vt_array_resize: p of old_bytes (the size it was made or last resized
+ * with; p NULL: a new one) to new_bytes, contents kept up to the smaller
+ * size, new room undefined; NULL when out of memory, p unchanged.
+ * vt_array_free: p made with bytes; NULL is ignored. Never mixed with
+ * malloc/free. */
+void *vt_array_resize(void *p, size_t old_bytes, size_t new_bytes);
+void vt_array_free(void *p, size_t bytes);
+
 /* ---------------------------------------------------------------- mesh -- */
 
 enum vt_vertex_state {
@@ -61,7 +74,7 @@ typedef struct vt_vertex {
 } vt_vertex;
 
 /* The sample of a vertex, valid once its state is VT_SAMPLED: what the
- * criteria compare (display, h/s/v, tree_hash) and what the reconstruction
+ * criteria compare (flat, tree_hash) and what the reconstruction
  * draws. A refined mesh holds hundreds of thousands of them, so only what
  * is read later is kept: of the primary layer its diffuse and rest terms
  * (its texture and uv are the face's and the vertex's, Sec. 3.5.3), and
@@ -72,19 +85,30 @@ typedef struct vt_vertex_sample {
                                * textures=sampled the textured radiance;
                                * with deferred_split the reflected and
                                * transmitted textures applied (vt_sample.c) */
-    /* flat as the criteria see it (vt_criteria_prepare): display values,
-     * computed once by the thread that sampled the vertex instead of once
-     * per edge test on the refining thread (three powf per end). Their HSV
-     * is not kept: it costs the HSV criterion a few compares and one
-     * division per end and test (vt_rgb_to_hsv), and would take 12 bytes
-     * of each of a refined mesh's hundreds of thousands of samples */
-    rl_vec3 display;
+    /* Neither flat's display values nor their HSV are kept: the criteria
+     * compute them per test (vt_sample_display, vt_rgb_to_hsv; three powf
+     * per end), the same numbers as stored ones. 12 bytes of each of a
+     * refined mesh's hundreds of thousands of samples, at the frame's peak
+     * (the end of the refinement), cost more than the powf (2026-12-06,
+     * bench/README.md "Memory at the defaults, third pass"). */
     rl_vec3 diffuse, rest;    /* of the primary layer */
     uint32_t deferred[2];     /* reflection, refraction: index into
                                * vt_mesh.layers, or with VT_PLAIN_LAYER
                                * set into vt_mesh.plain; VT_NONE when empty */
-    uint64_t tree_hash;       /* rl_ray_tree_hash of its ray tree */
+    uint32_t tree_hash[2];    /* rl_ray_tree_hash of its ray tree, low word
+                               * first (vt_sample_tree): as a uint64_t it
+                               * would pad the 52-byte sample to 56 */
 } vt_vertex_sample;
+
+static inline uint64_t vt_sample_tree(const vt_vertex_sample *s)
+{
+    return (uint64_t)s->tree_hash[1] << 32 | s->tree_hash[0];
+}
+static inline void vt_sample_set_tree(vt_vertex_sample *s, uint64_t hash)
+{
+    s->tree_hash[0] = (uint32_t)hash;
+    s->tree_hash[1] = (uint32_t)(hash >> 32);
+}
 
 typedef struct vt_edge {
     uint32_t v[2];            /* end vertices */
@@ -134,7 +158,9 @@ typedef struct vt_mesh {
     vt_vertex_sample *samples;  uint32_t cap_samples;   /* per vertex, like verts */
     vt_edge *edges;    uint32_t num_edges, cap_edges;
     uint32_t *edge_queued;    /* bit e: edge e is in the edge list (vt_heap);
-                               * cap_edges bits */
+                               * cap_queued words, at least cap_edges bits
+                               * once a reserve succeeded */
+    uint32_t cap_queued;
     vt_face *faces;    uint32_t num_faces, cap_faces;
     uint32_t num_created;     /* faces created since the last reset, primary
                                * ones included: the next face's seq */
@@ -168,6 +194,16 @@ void vt_mesh_free(vt_mesh *m);
  * state (edges unsplit and unqueued, faces leaf and invisible, vertices
  * unsampled): the start of a new camera frame. Keeps the allocations. */
 void vt_mesh_reset(vt_mesh *m);
+
+/* Gives back the edges the refinement made, keeping the primary ones (and
+ * the arrays' room for them): once a frame's refinement is over nothing
+ * reads them (the draw reads faces, vertices and samples, rl_vt_get_mesh
+ * vertices and leaves, the feeler map vertices), and vt_mesh_reset keeps
+ * only the primary edges. A refined mesh has four edges per generated
+ * vertex, a quarter of its bytes. Afterwards the refined faces' e[] name
+ * edges that are gone: only the draw, vt_mesh_pick_in_order and
+ * vt_mesh_reset may follow, no split. num_edges is num_primary_edges then. */
+void vt_mesh_drop_refined_edges(vt_mesh *m);
 
 /* The primary face that face f descends from (f itself when primary);
  * VT_NONE for a face that is not of the mesh's triangles (vt_part_import). */
@@ -282,9 +318,10 @@ typedef struct vt_criteria {
 /* Parses "rgb", "hsv", "tree", "tree+rgb", "tree+hsv" (also "rgb+tree",
  * "hsv+tree", and "rgb+hsv"); false for anything else. */
 bool vt_criteria_parse(const char *text, unsigned *bits);
-/* Fills the display values of a sample from its flat colour. */
-void vt_criteria_prepare(vt_vertex_sample *sample);
-/* The criteria that fire for the samples a and b (prepared), as
+/* The display values of a sample's flat colour (vt_display per channel):
+ * what the colour criteria compare. */
+rl_vec3 vt_sample_display(const vt_vertex_sample *sample);
+/* The criteria that fire for the samples a and b, as
  * vt_criterion_bits; 0 = interpolation along the edge is acceptable.
  * Colours compared are the vertices' flat colours (deferred textures left
  * out, Sec. 3.5.3). HSV: hue is ignored when either saturation is below

@@ -16,9 +16,15 @@
  * Building is O(n): vertices are welded and edges paired through open
  * addressing hash tables, one object at a time (nothing is shared across
  * objects, so the tables only need to hold one object). */
+#define _GNU_SOURCE            /* mremap */
 #include <math.h>
+#include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
+#if defined(__linux__)
+#include <sys/mman.h>
+#include <unistd.h>
+#endif
 
 #include "core/error.h"
 #include "render/vt_internal.h"
@@ -52,6 +58,74 @@ uint64_t vt_vertex_key_mid(uint64_t a, uint64_t b)
     return mix64(lo ^ mix64(hi + 0x632be59bd9b4e019ull));
 }
 
+/* The mesh's growing arrays (vertices, samples, edges, their queued bits,
+ * faces, deferred layers) live in mappings of their own where the system
+ * has mremap (Linux): growing one moves its pages without copying them,
+ * and shrinking one (vt_mesh_drop_refined_edges) gives the pages back at
+ * once. Through malloc, glibc serves an array below its mmap threshold
+ * from the heap, and that threshold rises to the largest mapped block
+ * freed so far (up to 32 MB; the BVH build frees several): a doubling
+ * there copies the array and leaves the old block behind as free heap,
+ * resident until reused or trimmed. On table at 1024^2 (defaults) that
+ * was 12 MB of the frame's peak, which is at the end of the refinement
+ * (an RSS trace every 20 ms: 193.8 MB through malloc, 182.0 MB with
+ * MALLOC_MMAP_THRESHOLD_=131072). Elsewhere, and under AddressSanitizer,
+ * the arrays use realloc. */
+#if defined(__SANITIZE_ADDRESS__)
+#define VT_UNDER_ASAN 1
+#elif defined(__has_feature)
+#if __has_feature(address_sanitizer)
+#define VT_UNDER_ASAN 1
+#endif
+#endif
+/* Not under AddressSanitizer: it checks heap blocks, not mappings, and the
+ * sanitizer builds are there to check these arrays. */
+#if defined(__linux__) && defined(MREMAP_MAYMOVE) && !defined(VT_UNDER_ASAN)
+#define VT_MAPPED_ARRAYS 1
+static size_t mapped_size(size_t bytes)
+{
+    size_t page = (size_t)sysconf(_SC_PAGESIZE);
+    if (page == 0 || page == (size_t)-1)
+        page = 4096;
+    if (bytes == 0)
+        return page;
+    return bytes > SIZE_MAX - (page - 1) ? 0 : (bytes + page - 1) / page * page;
+}
+#endif
+
+void *vt_array_resize(void *p, size_t old_bytes, size_t new_bytes)
+{
+#if VT_MAPPED_ARRAYS
+    size_t to = mapped_size(new_bytes);
+    if (!to)
+        return NULL;
+    if (!p) {
+        void *q = mmap(NULL, to, PROT_READ | PROT_WRITE, MAP_PRIVATE | MAP_ANONYMOUS, -1, 0);
+        return q == MAP_FAILED ? NULL : q;
+    }
+    size_t from = mapped_size(old_bytes);
+    if (from == to)
+        return p;
+    void *q = mremap(p, from, to, MREMAP_MAYMOVE);
+    return q == MAP_FAILED ? NULL : q;
+#else
+    (void)old_bytes;
+    return realloc(p, new_bytes ? new_bytes : 1);
+#endif
+}
+
+void vt_array_free(void *p, size_t bytes)
+{
+    if (!p)
+        return;
+#if VT_MAPPED_ARRAYS
+    munmap(p, mapped_size(bytes));
+#else
+    (void)bytes;
+    free(p);
+#endif
+}
+
 /* Grows an array of item_size elements to hold at least need of them. */
 static rl_status grow(void **array, uint32_t *cap, uint32_t need, size_t item_size,
                       const char *what)
@@ -65,9 +139,12 @@ static rl_status grow(void **array, uint32_t *cap, uint32_t need, size_t item_si
         n *= 2;
     if (n > VT_MESH_MAX_ELEMENTS)
         n = VT_MESH_MAX_ELEMENTS;
-    void *p = rl_realloc_array(*array, (size_t)n, item_size);
+    if ((size_t)n > SIZE_MAX / item_size)
+        return rl_error(RL_ERR_OUT_OF_MEMORY, "vt mesh: %llu %s overflow the address space",
+                        (unsigned long long)n, what);
+    void *p = vt_array_resize(*array, (size_t)*cap * item_size, (size_t)n * item_size);
     if (!p)
-        return RL_ERR_OUT_OF_MEMORY;
+        return rl_error(RL_ERR_OUT_OF_MEMORY, "vt mesh: out of memory for %llu %s", (unsigned long long)n, what);
     *array = p;
     *cap = (uint32_t)n;
     return RL_OK;
@@ -84,21 +161,20 @@ static rl_status reserve(vt_mesh *m, uint32_t verts, uint32_t edges, uint32_t fa
     if (st == RL_OK)
         st = grow((void **)&m->samples, &m->cap_samples, m->num_verts + verts, sizeof *m->samples,
                   "vertices");
-    if (st == RL_OK) {
-        uint32_t old_cap = m->cap_edges;
+    if (st == RL_OK)
         st = grow((void **)&m->edges, &m->cap_edges, m->num_edges + edges, sizeof *m->edges, "edges");
-        if (st == RL_OK && m->cap_edges != old_cap) {
-            /* The queued bits follow the edges' capacity (a multiple of 256,
-             * so of 32); new words start clear. */
-            uint32_t words = m->cap_edges / 32, old_words = old_cap / 32;
-            uint32_t *q = rl_realloc_array(m->edge_queued, words, sizeof *q);
-            if (!q) {
-                m->cap_edges = old_cap;   /* the edges keep their new room unused */
-                return RL_ERR_OUT_OF_MEMORY;
-            }
-            memset(q + old_words, 0, (size_t)(words - old_words) * sizeof *q);
-            m->edge_queued = q;
-        }
+    if (st == RL_OK && m->cap_queued < m->cap_edges / 32) {
+        /* The queued bits follow the edges' capacity (a multiple of 256,
+         * so of 32); new words start clear. On failure the edges keep
+         * their new room and the bits follow at the next reserve: no split
+         * happens before one succeeds. */
+        uint32_t words = m->cap_edges / 32, old_words = m->cap_queued;
+        uint32_t *q = vt_array_resize(m->edge_queued, (size_t)old_words * sizeof *q, (size_t)words * sizeof *q);
+        if (!q)
+            return rl_error(RL_ERR_OUT_OF_MEMORY, "vt mesh: out of memory for %u edges' bits", m->cap_edges);
+        memset(q + old_words, 0, (size_t)(words - old_words) * sizeof *q);
+        m->edge_queued = q;
+        m->cap_queued = words;
     }
     if (st == RL_OK)
         st = grow((void **)&m->faces, &m->cap_faces, m->num_faces + faces, sizeof *m->faces, "faces");
@@ -471,15 +547,43 @@ void vt_mesh_free(vt_mesh *m)
 {
     if (!m)
         return;
-    free(m->verts);
-    free(m->samples);
-    free(m->edges);
-    free(m->edge_queued);
-    free(m->faces);
-    free(m->layers);
-    free(m->plain);
+    vt_array_free(m->verts, (size_t)m->cap_verts * sizeof *m->verts);
+    vt_array_free(m->samples, (size_t)m->cap_samples * sizeof *m->samples);
+    vt_array_free(m->edges, (size_t)m->cap_edges * sizeof *m->edges);
+    vt_array_free(m->edge_queued, (size_t)m->cap_queued * sizeof *m->edge_queued);
+    vt_array_free(m->faces, (size_t)m->cap_faces * sizeof *m->faces);
+    vt_array_free(m->layers, (size_t)m->cap_layers * sizeof *m->layers);
+    vt_array_free(m->plain, (size_t)m->cap_plain * sizeof *m->plain);
     free(m->tri_face);
     memset(m, 0, sizeof *m);
+}
+
+void vt_mesh_drop_refined_edges(vt_mesh *m)
+{
+    /* Room rounded up to 256 as grow() keeps it, so that the queued bits
+     * stay whole words and the next frame grows from here as from a build. */
+    uint64_t cap = ((uint64_t)m->num_primary_edges + 255u) / 256u * 256u;
+    if (cap < 256u)
+        cap = 256u;
+    m->num_edges = m->num_primary_edges;
+    if (cap >= m->cap_edges)
+        return;
+    /* Shrinking keeps the first cap elements (the primary ones) and gives
+     * the rest back; should it fail, the larger array stays, which is only
+     * memory. */
+    vt_edge *e = vt_array_resize(m->edges, (size_t)m->cap_edges * sizeof *m->edges, (size_t)cap * sizeof *m->edges);
+    if (e) {
+        m->edges = e;
+        m->cap_edges = (uint32_t)cap;
+    }
+    uint32_t words = m->cap_edges / 32;
+    if (m->cap_queued > words) {
+        uint32_t *q = vt_array_resize(m->edge_queued, (size_t)m->cap_queued * sizeof *q, (size_t)words * sizeof *q);
+        if (q) {
+            m->edge_queued = q;
+            m->cap_queued = words;
+        }
+    }
 }
 
 void vt_mesh_reset(vt_mesh *m)

@@ -162,7 +162,8 @@ rl_status vt_part_write(const vt_mesh *m, const rl_scene_data *d, const uint8_t 
         if (all_samples) {
             p = put(p, &x->key, 8);
             p = put(p, &x->triangle, 4);
-            put(p, &m->samples[v].tree_hash, 8);
+            uint64_t tree = vt_sample_tree(&m->samples[v]);
+            put(p, &tree, 8);
         }
     }
     for (uint32_t f = 0; f < m->num_faces; ++f) {
@@ -430,10 +431,9 @@ bool vt_part_samples_take(const vt_part_samples *ps, vt_mesh *m, uint32_t v, boo
         p = get(p, &layers[l].texture, 4);
         p = get_vec2(p, &layers[l].uv);
     }
-    memcpy(&s.tree_hash, p + 12, 8);
-    /* As the sampling thread does (vt_sample.c): the criteria's view of
-     * the colour is computed from flat, so it is the tracer's bit for bit. */
-    vt_criteria_prepare(&s);
+    uint64_t tree;
+    memcpy(&tree, p + 12, 8);
+    vt_sample_set_tree(&s, tree);
     if (vt_mesh_set_sample(m, v, &s, layers) != RL_OK) {
         *failed = true;
         return false;

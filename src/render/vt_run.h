@@ -83,6 +83,9 @@ typedef struct vt_feelers_packed {
 typedef struct vt_feeler_pool {
     uint32_t *occluder;
     size_t count, cap;
+    /* The array is vt_array_resize's (a frame's pools, which grow to
+     * megabytes), not malloc's (the blocks' small ones) */
+    bool mapped;
 } vt_feeler_pool;
 
 /* Appends the occluders of f to pool and describes them in *out; false
@@ -264,6 +267,9 @@ double vt_sample_busy_ms(const vt_run *run);
 /* Makes room for per-vertex arrays up to mesh->num_verts. */
 rl_status vt_run_reserve(vt_run *run);
 void vt_run_free_blocks(vt_run *run);
+/* Frees the per-vertex arrays (reason, feelers, hints; vt_array_resize's
+ * for the last two, sized by per_vertex_cap). */
+void vt_run_free_vertex_arrays(vt_run *run);
 
 /* vt_refine.c ------------------------------------------------------------ */
 /* The ID-buffer pre-pass (Sec. 3.4.1, Fig. 3.12, 3.17): draws the

@@ -37,11 +37,28 @@ static size_t slot_of(uint64_t key, size_t cap)
     return (size_t)(rl_hash64(key) & (uint64_t)(cap - 1));
 }
 
+/* Room for count words in pool. */
+static bool pool_reserve(vt_feeler_pool *pool, size_t count)
+{
+    if (count > UINT32_MAX)
+        return false;
+    if (!pool->mapped)
+        return rl_reserve((void **)&pool->occluder, &pool->cap, count, sizeof *pool->occluder, 256);
+    if (count <= pool->cap)
+        return true;
+    size_t cap = rl_grow_capacity(pool->cap, count, 1024);
+    uint32_t *p = vt_array_resize(pool->occluder, pool->cap * sizeof *p, cap * sizeof *p);
+    if (!p)
+        return false;
+    pool->occluder = p;
+    pool->cap = cap;
+    return true;
+}
+
 bool vt_feelers_pack(const rl_trace_feelers *f, vt_feeler_pool *pool, vt_feelers_packed *out)
 {
     uint32_t n = f->count < RL_TRACE_FEELER_CACHE_MAX ? f->count : RL_TRACE_FEELER_CACHE_MAX;
-    if (pool->count + n > UINT32_MAX || !rl_reserve((void **)&pool->occluder, &pool->cap, pool->count + n,
-                                                    sizeof *pool->occluder, 256))
+    if (!pool_reserve(pool, pool->count + n))
         return false;
     *out = (vt_feelers_packed){ (uint32_t)pool->count, (uint8_t)n, f->front, f->complete };
     if (n)                    /* an empty pool has no array yet */
@@ -79,8 +96,7 @@ static bool hints_pack(const rl_trace_hints *h, vt_feeler_pool *pool, vt_feelers
         code[words++] = h->triangle[i];
         code[words++] = 1;
     }
-    if (pool->count + words > UINT32_MAX || !rl_reserve((void **)&pool->occluder, &pool->cap, pool->count + words,
-                                                        sizeof *pool->occluder, 256))
+    if (!pool_reserve(pool, pool->count + words))
         return false;
     *out = (vt_feelers_packed){ (uint32_t)pool->count, (uint8_t)words, 0, 1 };
     if (words)
@@ -104,8 +120,13 @@ static bool hints_equal(const vt_feelers_packed *a, const vt_feelers_packed *b, 
 
 void vt_feeler_pool_free(vt_feeler_pool *pool)
 {
-    free(pool->occluder);
+    if (pool->mapped)
+        vt_array_free(pool->occluder, pool->cap * sizeof *pool->occluder);
+    else
+        free(pool->occluder);
+    bool mapped = pool->mapped;
     memset(pool, 0, sizeof *pool);
+    pool->mapped = mapped;    /* it stays the kind of pool it was */
 }
 
 const vt_feelers_packed *vt_feeler_map_find(const vt_feeler_map *m, uint64_t key)
@@ -191,13 +212,13 @@ rl_status vt_run_reserve(vt_run *run)
         return RL_ERR_OUT_OF_MEMORY;
     run->reason = reason;
     if (run->set->coherence) {
-        vt_feelers_packed *f = rl_realloc_array(run->feelers, cap, sizeof *f);
+        vt_feelers_packed *f = vt_array_resize(run->feelers, (size_t)run->per_vertex_cap * sizeof *f, (size_t)cap * sizeof *f);
         if (!f)
             return RL_ERR_OUT_OF_MEMORY;
         run->feelers = f;
     }
     if (run->set->hint != VT_HINT_OFF) {
-        vt_feelers_packed *h = rl_realloc_array(run->hints, cap, sizeof *h);
+        vt_feelers_packed *h = vt_array_resize(run->hints, (size_t)run->per_vertex_cap * sizeof *h, (size_t)cap * sizeof *h);
         if (!h)
             return RL_ERR_OUT_OF_MEMORY;
         run->hints = h;
@@ -207,6 +228,16 @@ rl_status vt_run_reserve(vt_run *run)
     memset(run->reason + run->per_vertex_cap, 0, cap - run->per_vertex_cap);
     run->per_vertex_cap = cap;
     return RL_OK;
+}
+
+void vt_run_free_vertex_arrays(vt_run *run)
+{
+    free(run->reason);
+    vt_array_free(run->feelers, (size_t)run->per_vertex_cap * sizeof *run->feelers);
+    vt_array_free(run->hints, (size_t)run->per_vertex_cap * sizeof *run->hints);
+    run->reason = NULL;
+    run->feelers = run->hints = NULL;
+    run->per_vertex_cap = 0;
 }
 
 static int thread_index(void)
@@ -286,8 +317,7 @@ static void sample_block(vt_run *run, vt_block *b)
         if (run->set->deferred_split && run->set->textures != VT_TEX_SAMPLED)
             out->flat = with_deferred_texels(run->data, &s);
         memcpy(b->layers[i], s.layers, sizeof b->layers[i]);
-        out->tree_hash = run->want_tree ? vt_tree_hash(&tree, run->set->tree_shadow, run->set->tree_depth) : 0;
-        vt_criteria_prepare(out);
+        vt_sample_set_tree(out, run->want_tree ? vt_tree_hash(&tree, run->set->tree_shadow, run->set->tree_depth) : 0);
         for (int k = 0; k < RL_RAY_TYPE_COUNT; ++k) {
             b->rays[i][k] = s.rays[k];
             tally->rays += s.rays[k];
@@ -413,9 +443,11 @@ static void add_to_block(vt_run *run, uint32_t v, uint32_t pa, uint32_t pb)
         run->filling = NULL;
         spawn(run, b);
         /* Enough to keep the other threads busy while the primary thread
-         * refines on; more would only hold results back. */
+         * refines on; more would only hold results back, and every block
+         * pending is 9 KB of the frame's peak, which is at the end of the
+         * refinement (256 blocks, the least until 2026-12-06: 2.3 MB). */
         uint32_t most = 16u * (uint32_t)run->set->threads;
-        if (run->num_pending >= (most > 256 ? most : 256))
+        if (run->num_pending >= (most > 64 ? most : 64))
             collect(run);
     }
 }

@@ -846,6 +846,58 @@ static void test_reset_restores_the_primary_mesh(void **state)
     toy_free(&t);
 }
 
+/* vt_mesh_drop_refined_edges (run at the end of a large frame's
+ * refinement): the refined edges go, their room with them, the faces and
+ * vertices stay as they were, and a reset and the next frame's splits give
+ * what a mesh that never dropped its edges gives, edge for edge (the
+ * arrays grow again from the smaller room, with the queued bits clear). */
+static void test_dropped_edges_keep_faces_and_the_next_frame(void **state)
+{
+    (void)state;
+    toy t;
+    toy_grid(&t, 12);
+    uint8_t mask[1] = { 1 };
+    vt_mesh kept = { 0 }, m = { 0 };
+    assert_int_equal(vt_mesh_build(&kept, toy_data(&t), mask), RL_OK);
+    assert_int_equal(vt_mesh_build(&m, toy_data(&t), mask), RL_OK);
+    for (int round = 0; round < 3; ++round) {
+        vt_mesh *both[2] = { &kept, &m };
+        for (int k = 0; k < 2; ++k) {
+            for (uint32_t e = 0; e < both[k]->num_edges; ++e)
+                vt_edge_set_queued(both[k], e, (e + (uint32_t)round) % 3 == 0);
+            random_splits(both[k], 3000, 0x5eed + (uint64_t)round, false, 1000);
+        }
+        assert_int_equal(m.num_edges, kept.num_edges);
+        assert_true(m.num_edges > 4 * m.num_primary_edges);
+        uint32_t cap = m.cap_edges;
+        vt_face *faces = malloc((size_t)m.num_faces * sizeof *faces);
+        vt_vertex *verts = malloc((size_t)m.num_verts * sizeof *verts);
+        assert_non_null(faces);
+        assert_non_null(verts);
+        memcpy(faces, m.faces, (size_t)m.num_faces * sizeof *faces);
+        memcpy(verts, m.verts, (size_t)m.num_verts * sizeof *verts);
+        vt_mesh_drop_refined_edges(&m);
+        assert_int_equal(m.num_edges, m.num_primary_edges);
+        assert_true(m.cap_edges < cap);
+        assert_true(m.cap_edges >= m.num_primary_edges && m.cap_edges % 256 == 0);
+        assert_true(m.cap_queued * 32 >= m.cap_edges);
+        assert_memory_equal(m.faces, faces, (size_t)m.num_faces * sizeof *faces);
+        assert_memory_equal(m.verts, verts, (size_t)m.num_verts * sizeof *verts);
+        free(faces);
+        free(verts);
+        vt_mesh_reset(&m);
+        vt_mesh_reset(&kept);
+        assert_int_equal(m.num_edges, kept.num_edges);
+        assert_memory_equal(m.edges, kept.edges, (size_t)m.num_edges * sizeof *m.edges);
+        for (uint32_t e = 0; e < m.num_edges; ++e)
+            assert_int_equal(vt_edge_queued(&m, e), 0);
+        check_mesh(&m, false);
+    }
+    vt_mesh_free(&m);
+    vt_mesh_free(&kept);
+    toy_free(&t);
+}
+
 static int cmp_u64(const void *a, const void *b)
 {
     uint64_t x = *(const uint64_t *)a, y = *(const uint64_t *)b;
@@ -879,7 +931,7 @@ static void test_samples_keep_only_deferred_layers_that_are_not_empty(void **sta
         vt_vertex_sample s;
         memset(&s, 0, sizeof s);
         s.flat = rl_v3((float)v, 1, 2);
-        s.tree_hash = 1000 + v;
+        vt_sample_set_tree(&s, 1000 + v);
         assert_int_equal(vt_mesh_set_sample(&m, v, &s, in[v]), RL_OK);
     }
     /* untextured ones (1's reflection, 2's -0 reflection) in the plain pool */
@@ -907,7 +959,7 @@ static void test_samples_keep_only_deferred_layers_that_are_not_empty(void **sta
                 want.uv = rl_v2(0, 0);
             assert_memory_equal(&out[l], &want, sizeof want);
         }
-        assert_true(m.samples[v].flat.x == (float)v && m.samples[v].tree_hash == 1000 + v);
+        assert_true(m.samples[v].flat.x == (float)v && vt_sample_tree(&m.samples[v]) == 1000 + v);
     }
     vt_mesh_reset(&m);
     assert_int_equal(m.num_layers, 0);
@@ -989,6 +1041,7 @@ int main(void)
         cmocka_unit_test(test_random_splits_on_committed_sphere),
         cmocka_unit_test(test_dropped_parents_keep_the_leaves_and_their_order),
         cmocka_unit_test(test_reset_restores_the_primary_mesh),
+        cmocka_unit_test(test_dropped_edges_keep_faces_and_the_next_frame),
         cmocka_unit_test(test_samples_keep_only_deferred_layers_that_are_not_empty),
         cmocka_unit_test(test_keys_are_distinct_and_mid_is_symmetric),
         cmocka_unit_test(test_xi_and_height_of_a_face),
