@@ -103,6 +103,22 @@ rl_status rl_bvh_widen(rl_bvh *bvh);
 rl_status rl_bvh_build_wide(const rl_scene_data *data, const rl_accel_desc *desc, rl_bvh *bvh,
                             rl_accel_stats *stats);
 
+/* How the builder works, not what it builds: every setting gives the same
+ * tree, bit for bit (test_bvh checks this against the plain settings).
+ * rl_bvh_build and rl_bvh_build_wide use the defaults (NULL below); the
+ * tests set them to reach each path on small scenes. */
+typedef struct rl_bvh_tuning {
+    uint32_t small_max;       /* nodes of up to this many triangles bin only their
+                               * occupied bins (bins <= 64); 0: never */
+    uint32_t par_bin_min;     /* nodes of at least this many triangles bin in
+                               * chunks on all build threads; 0: never */
+    uint32_t parallel_min;    /* builds of fewer triangles run on one thread */
+} rl_bvh_tuning;
+rl_status rl_bvh_build_tuned(const rl_scene_data *data, const rl_accel_desc *desc, const rl_bvh_tuning *tuning,
+                             rl_bvh *bvh, rl_accel_stats *stats);
+rl_status rl_bvh_build_wide_tuned(const rl_scene_data *data, const rl_accel_desc *desc,
+                                  const rl_bvh_tuning *tuning, rl_bvh *bvh, rl_accel_stats *stats);
+
 /* Between bvh_build.c and bvh_wide.c: where the collapse reads a leaf's
  * triangles, tris[first..] or else the scene triangles
  * ids[first * id_stride], ids[(first + 1) * id_stride], ... of data. */
