@@ -644,19 +644,22 @@ typedef struct tree {
     prim *prims;
     rl_bvh_node *sparse;
     uint32_t num_slots, num_nodes, num_blocks;
+    bool own_prims;          /* false: prims lie in the caller's memory */
 } tree;
 
 static void tree_free(tree *t)
 {
-    free(t->prims);
+    if (t->own_prims)
+        free(t->prims);
     free(t->sparse);
     memset(t, 0, sizeof *t);
 }
 
 static const rl_bvh_tuning default_tuning = { SMALL_MAX, PAR_BIN_MIN, PARALLEL_MIN };
 
+/* room: memory for the N triangle records, or NULL to allocate them. */
 static rl_status build_tree(const rl_scene_data *data, const rl_accel_desc *desc, const rl_bvh_tuning *tuning,
-                            int threads, tree *out)
+                            int threads, void *room, tree *out)
 {
     uint32_t N = data->num_triangles;
     if (N == 0)
@@ -677,11 +680,12 @@ static rl_status build_tree(const rl_scene_data *data, const rl_accel_desc *desc
     /* 2N - 1 nodes at most, plus each thread's last chunk, partly unused;
      * only the slots handed out are ever touched. */
     size_t capacity = (size_t)2 * N - 1 + (size_t)threads * SLOT_CHUNK;
-    prim *prims = rl_big_array(N, sizeof *prims, false);
+    prim *prims = room ? room : rl_big_array(N, sizeof *prims, false);
     rl_bvh_node *sparse = rl_big_array(capacity, sizeof *sparse, false);
     cursor *cursors = rl_calloc((size_t)threads, sizeof *cursors);
     if (!prims || !sparse || !cursors) {
-        free(prims);
+        if (!room)
+            free(prims);
         free(sparse);
         free(cursors);
         return RL_ERR_OUT_OF_MEMORY;
@@ -725,7 +729,8 @@ static rl_status build_tree(const rl_scene_data *data, const rl_accel_desc *desc
     if (!atomic_load(&b.cancelled) && b.progress && !b.progress(b.user, 1.0))
         atomic_store(&b.cancelled, true);
     if (atomic_load(&b.cancelled)) {
-        free(prims);
+        if (!room)
+            free(prims);
         free(sparse);
         free(cursors);
         return rl_error(RL_ERR_CANCELLED, "accel bvh: build cancelled");
@@ -736,7 +741,7 @@ static rl_status build_tree(const rl_scene_data *data, const rl_accel_desc *desc
         blocks += cursors[t].blocks;
     }
     free(cursors);
-    *out = (tree){ prims, sparse, (uint32_t)atomic_load(&b.next_slot), 1 + 2 * pairs, blocks };
+    *out = (tree){ prims, sparse, (uint32_t)atomic_load(&b.next_slot), 1 + 2 * pairs, blocks, !room };
     return RL_OK;
 }
 
@@ -760,7 +765,7 @@ rl_status rl_bvh_build_tuned(const rl_scene_data *data, const rl_accel_desc *des
         tuning = &default_tuning;
     int threads = build_threads(desc, tuning, data->num_triangles);
     tree t;
-    rl_status st = build_tree(data, desc, tuning, threads, &t);
+    rl_status st = build_tree(data, desc, tuning, threads, NULL, &t);
     if (st)
         return st;
     uint32_t N = data->num_triangles;
@@ -812,8 +817,9 @@ static rl_status finish_wide(const rl_scene_data *data, tree *t, rl_bvh_block *b
         return st ? st : RL_ERR_OUT_OF_MEMORY;
     for (uint32_t i = 0; i < N; ++i)
         ids[i] = t->prims[i].id;
-    free(t->prims);
-    t->prims = NULL;
+    if (t->own_prims)
+        free(t->prims);
+    t->prims = NULL;   /* from here on, blocks may overwrite them */
     rl_bvh_leaf_source src = { .ids = ids, .id_stride = 1, .data = data };
     st = rl_bvh_collapse(t->sparse, t->num_slots, t->num_blocks, &src, blocks, bvh);
     free(ids);
@@ -832,26 +838,39 @@ rl_status rl_bvh_build_wide_tuned(const rl_scene_data *data, const rl_accel_desc
     if (!tuning)
         tuning = &default_tuning;
     int threads = build_threads(desc, tuning, data->num_triangles);
+    /* The leaf blocks are the largest array written (city: 107 MB), and on
+     * this VM a page's first touch costs about as much as the work done in
+     * it (bench/README.md, "BVH build time"). A leaf holds at least one
+     * triangle, so there are at most N blocks: the blocks' array is
+     * allocated for N (address space only; untouched pages cost nothing)
+     * before the build, and the build's triangle records (32 of the 160
+     * bytes per triangle) lie at its start. Their pages are then touched
+     * already when the blocks overwrite them, after the collapse has taken
+     * the IDs out (finish_wide). What follows the build is serial, so a
+     * second thread faults the rest of the blocks' pages in meanwhile
+     * (rl_big_prefault), and the serial writer finds them present.
+     * Without the room for N blocks the records get their own array. */
+    uint32_t N = data->num_triangles;
+    rl_bvh_block *room = N > 0 ? rl_bvh_alloc_blocks(N) : NULL;
     tree t;
-    rl_status st = build_tree(data, desc, tuning, threads, &t);
-    if (st)
+    rl_status st = build_tree(data, desc, tuning, threads, room, &t);
+    if (st) {
+        free(room);
         return st;
-    /* The leaf blocks are the largest array written (city: 107 MB). What
-     * follows the build is serial, so a second thread faults the blocks'
-     * pages in meanwhile (rl_big_prefault), and the serial writer finds
-     * them present. */
-    rl_bvh_block *blocks = rl_bvh_alloc_blocks(t.num_blocks);
+    }
+    rl_bvh_block *blocks = room ? room : rl_bvh_alloc_blocks(t.num_blocks);
     if (!blocks) {
         tree_free(&t);
         return rl_error(RL_ERR_OUT_OF_MEMORY, "accel bvh: out of memory for %u leaf blocks", (unsigned)t.num_blocks);
     }
-    if (threads > 1) {
+    size_t touched = room ? (size_t)N * sizeof(prim) : 0, bytes = (size_t)t.num_blocks * sizeof *blocks;
+    if (threads > 1 && bytes > touched) {
 #pragma omp parallel sections num_threads(2)
         {
 #pragma omp section
             st = finish_wide(data, &t, blocks, bvh, stats);
 #pragma omp section
-            rl_big_prefault(blocks, (size_t)t.num_blocks * sizeof *blocks);
+            rl_big_prefault((char *)blocks + touched, bytes - touched);
         }
     } else {
         st = finish_wide(data, &t, blocks, bvh, stats);
