@@ -99,7 +99,9 @@ rl_status rl_bvh_widen(rl_bvh *bvh);
  * the collapse reads the builder's own node array and packs the blocks
  * straight from the scene, which saves writing (and first touching) about
  * 100 MB on city. stats as rl_bvh_build's, memory_bytes that of the wide
- * nodes and the blocks. */
+ * nodes and the blocks. bvh->blocks is allocated with room for N blocks
+ * (the bound; the build's triangle records use its first pages, which the
+ * blocks then reuse): address space only beyond num_blocks. */
 rl_status rl_bvh_build_wide(const rl_scene_data *data, const rl_accel_desc *desc, rl_bvh *bvh,
                             rl_accel_stats *stats);
 

@@ -34,8 +34,11 @@
  * into separate box and centroid arrays, whose gathers slowed the binning,
  * 38 % of the build's CPU time on city); one pass bins all three axes; the children's centroid
  * boxes come from the partition; RL_ACCEL_BVH makes neither the
- * depth-first binary array nor the triangle copies. Every step keeps the
- * tree bit for bit. */
+ * depth-first binary array nor the triangle copies. Second pass
+ * (bench/README.md "BVH build time, second pass"): nodes of up to SMALL_MAX triangles bin only
+ * their occupied bins, the top levels bin in chunks on all threads, and
+ * the triangle records lie in the blocks' array (build_wide), whose
+ * pages they touch first. Every step keeps the tree bit for bit. */
 #include <math.h>
 #include <stdatomic.h>
 #include <stdlib.h>
@@ -66,7 +69,10 @@
  * (nearly all of it libgomp's spin loop), cornell-teapot 70k 39-64 vs
  * 62-120, 2CylinderEngine.glb 110k 113-168 vs 160-196, city 1.38M
  * 1,781-1,824 vs 1,603-1,709. On an idle machine the crossover is likely
- * lower. The tree does not depend on the thread count. */
+ * lower. Rechecked with the top levels binned on both threads (load
+ * 24-28, 6 interleaved builds each, wall ms medians, one vs two threads):
+ * cornell-teapot 70k 190 vs 217, 2CylinderEngine.glb 289 vs 366, so the
+ * threshold stays. The tree does not depend on the thread count. */
 #define PARALLEL_MIN 262144u
 /* Nodes of up to SMALL_MAX triangles (with K <= 64 bins) bin without
  * clearing all 3K bins and without scanning them for the occupied ones:
