@@ -99,9 +99,27 @@ rl_status rl_bvh_widen(rl_bvh *bvh);
  * the collapse reads the builder's own node array and packs the blocks
  * straight from the scene, which saves writing (and first touching) about
  * 100 MB on city. stats as rl_bvh_build's, memory_bytes that of the wide
- * nodes and the blocks. */
+ * nodes and the blocks. bvh->blocks is allocated with room for N blocks
+ * (the bound; the build's triangle records use its first pages, which the
+ * blocks then reuse): address space only beyond num_blocks. */
 rl_status rl_bvh_build_wide(const rl_scene_data *data, const rl_accel_desc *desc, rl_bvh *bvh,
                             rl_accel_stats *stats);
+
+/* How the builder works, not what it builds: every setting gives the same
+ * tree, bit for bit (test_bvh checks this against the plain settings).
+ * rl_bvh_build and rl_bvh_build_wide use the defaults (NULL below); the
+ * tests set them to reach each path on small scenes. */
+typedef struct rl_bvh_tuning {
+    uint32_t small_max;       /* nodes of up to this many triangles bin only their
+                               * occupied bins (bins <= 64); 0: never */
+    uint32_t par_bin_min;     /* nodes of at least this many triangles bin in
+                               * chunks on all build threads; 0: never */
+    uint32_t parallel_min;    /* builds of fewer triangles run on one thread */
+} rl_bvh_tuning;
+rl_status rl_bvh_build_tuned(const rl_scene_data *data, const rl_accel_desc *desc, const rl_bvh_tuning *tuning,
+                             rl_bvh *bvh, rl_accel_stats *stats);
+rl_status rl_bvh_build_wide_tuned(const rl_scene_data *data, const rl_accel_desc *desc,
+                                  const rl_bvh_tuning *tuning, rl_bvh *bvh, rl_accel_stats *stats);
 
 /* Between bvh_build.c and bvh_wide.c: where the collapse reads a leaf's
  * triangles, tris[first..] or else the scene triangles

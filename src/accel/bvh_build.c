@@ -34,8 +34,11 @@
  * into separate box and centroid arrays, whose gathers slowed the binning,
  * 38 % of the build's CPU time on city); one pass bins all three axes; the children's centroid
  * boxes come from the partition; RL_ACCEL_BVH makes neither the
- * depth-first binary array nor the triangle copies. Every step keeps the
- * tree bit for bit. */
+ * depth-first binary array nor the triangle copies. Second pass
+ * (bench/README.md "BVH build time, second pass"): nodes of up to SMALL_MAX triangles bin only
+ * their occupied bins, the top levels bin in chunks on all threads, and
+ * the triangle records lie in the blocks' array (build_wide), whose
+ * pages they touch first. Every step keeps the tree bit for bit. */
 #include <math.h>
 #include <stdatomic.h>
 #include <stdlib.h>
@@ -66,8 +69,27 @@
  * (nearly all of it libgomp's spin loop), cornell-teapot 70k 39-64 vs
  * 62-120, 2CylinderEngine.glb 110k 113-168 vs 160-196, city 1.38M
  * 1,781-1,824 vs 1,603-1,709. On an idle machine the crossover is likely
- * lower. The tree does not depend on the thread count. */
+ * lower. Rechecked with the top levels binned on both threads (load
+ * 24-28, 6 interleaved builds each, wall ms medians, one vs two threads):
+ * cornell-teapot 70k 190 vs 217, 2CylinderEngine.glb 289 vs 366, so the
+ * threshold stays. The tree does not depend on the thread count. */
 #define PARALLEL_MIN 262144u
+/* Nodes of up to SMALL_MAX triangles (with K <= 64 bins) bin without
+ * clearing all 3K bins and without scanning them for the occupied ones:
+ * a first pass computes the bin indices and a bit mask of the occupied
+ * bins per axis, only those bins are cleared, and the sweep walks the
+ * mask's bits. The bins, hence costs, plane and child boxes, are those
+ * of the full binning bit for bit (the same min, max and counts in the
+ * same order). Most nodes of a tree with leaves of 2 are this small, and
+ * for them clearing and scanning 3K bins cost more than the binning. */
+#define SMALL_MAX 32
+/* Nodes of at least this many triangles (the top levels) bin in chunks on
+ * all build threads, merged afterwards (min, max and counts are exact, so
+ * the bins are those of one pass): otherwise the root's binning, over all
+ * triangles, and the next levels' run on one thread while the other waits
+ * for the first subtree task. */
+#define PAR_BIN_MIN 65536u
+#define PAR_BIN_CHUNKS 8
 
 /* One triangle's box, 32 bytes, read as two 4-float vectors: the build
  * sorts these in place instead of an index array into separate box and
@@ -97,6 +119,8 @@ typedef struct builder {
     cursor *cursors;             /* one per thread */
     uint32_t num_tris;
     int bins, leaf_size;
+    int threads;
+    uint32_t small_max, par_bin_min;
     rl_progress_fn progress;
     void *user;
     atomic_bool cancelled;
@@ -259,6 +283,39 @@ static inline void bin_prim(bin_set *bs, const prim *p, v4 vmin, v4 vk1, int K)
     }
 }
 
+/* into = min/max/sum of into and from, per bin. min and max keep the later
+ * operand of equals (a < b ? a : b), which matters for +0 and -0 only: a
+ * fold over a sequence keeps the last of its equal extremes, so merging
+ * consecutive parts in order gives the bins of one pass, bit for bit. */
+static void bins_merge(bin_set *into, const bin_set *from, int K)
+{
+    for (int a = 0; a < 3; ++a)
+        for (int k = 0; k < K; ++k) {
+            into->lo[a][k] = v4_min(into->lo[a][k], from->lo[a][k]);
+            into->hi[a][k] = v4_max(into->hi[a][k], from->hi[a][k]);
+            into->count[a][k] += from->count[a][k];
+        }
+}
+
+/* Bins [lo, hi) into even (offsets from `from` even) and odd, both cleared
+ * first: the alternation of bin_range below. */
+static void bin_pairs(const builder *b, uint32_t from, uint32_t lo, uint32_t hi, v4 vmin, v4 vk1, bin_set *even,
+                      bin_set *odd)
+{
+    int K = b->bins;
+    bins_clear(even, K);
+    bins_clear(odd, K);
+    uint32_t i = lo;
+    if (i < hi && ((i - from) & 1u))
+        bin_prim(odd, &b->prims[i++], vmin, vk1, K);
+    for (; i + 1 < hi; i += 2) {
+        bin_prim(even, &b->prims[i], vmin, vk1, K);
+        bin_prim(odd, &b->prims[i + 1], vmin, vk1, K);
+    }
+    if (i < hi)
+        bin_prim(even, &b->prims[i], vmin, vk1, K);
+}
+
 /* One pass over the range bins every triangle on all three axes at once
  * (the same bin index per axis as bin_of: k1·(c - cmin), truncated). Long
  * ranges alternate between two bin sets, merged at the end (min, max and
@@ -270,26 +327,150 @@ static void bin_range(const builder *b, uint32_t begin, uint32_t end, const floa
 {
     int K = b->bins;
     v4 vmin = v4_make(cmin[0], cmin[1], cmin[2]), vk1 = v4_make(k1[0], k1[1], k1[2]);
-    bins_clear(bs, K);
     if (end - begin < 256) {
+        bins_clear(bs, K);
         for (uint32_t i = begin; i < end; ++i)
             bin_prim(bs, &b->prims[i], vmin, vk1, K);
         return;
     }
-    bins_clear(spare, K);
-    uint32_t i = begin;
-    for (; i + 1 < end; i += 2) {
-        bin_prim(bs, &b->prims[i], vmin, vk1, K);
-        bin_prim(spare, &b->prims[i + 1], vmin, vk1, K);
+    bin_pairs(b, begin, begin, end, vmin, vk1, bs, spare);
+    bins_merge(bs, spare, K);
+}
+
+/* bin_range over PAR_BIN_CHUNKS chunks as OpenMP tasks (any thread of the
+ * team takes any chunk; the one waiting runs chunks itself). Each chunk
+ * keeps bin_range's two alternating sets apart; the even sets are merged
+ * in chunk order, the odd ones too, then odd into even, as bin_range does:
+ * the bins of one pass bit for bit (bins_merge), whatever the schedule.
+ * Without memory for the chunks' bins it is bin_range. */
+static void bin_range_parallel(const builder *b, uint32_t begin, uint32_t end, const float cmin[3],
+                               const float k1[3], bin_set *bs, bin_set *spare)
+{
+    bin_set *parts = malloc(2 * PAR_BIN_CHUNKS * sizeof *parts);
+    if (!parts) {
+        bin_range(b, begin, end, cmin, k1, bs, spare);
+        return;
     }
-    if (i < end)
-        bin_prim(bs, &b->prims[i], vmin, vk1, K);
-    for (int a = 0; a < 3; ++a)
-        for (int k = 0; k < K; ++k) {
-            bs->lo[a][k] = v4_min(bs->lo[a][k], spare->lo[a][k]);
-            bs->hi[a][k] = v4_max(bs->hi[a][k], spare->hi[a][k]);
-            bs->count[a][k] += spare->count[a][k];
+    v4 vmin = v4_make(cmin[0], cmin[1], cmin[2]), vk1 = v4_make(k1[0], k1[1], k1[2]);
+    uint32_t n = end - begin;
+    for (int c = 0; c < PAR_BIN_CHUNKS; ++c) {
+        uint32_t lo = begin + (uint32_t)((uint64_t)n * (uint64_t)c / PAR_BIN_CHUNKS);
+        uint32_t hi = begin + (uint32_t)((uint64_t)n * (uint64_t)(c + 1) / PAR_BIN_CHUNKS);
+#pragma omp task firstprivate(b, begin, lo, hi, c, vmin, vk1, parts)
+        bin_pairs(b, begin, lo, hi, vmin, vk1, &parts[2 * c], &parts[2 * c + 1]);
+    }
+#pragma omp taskwait
+    for (int c = 1; c < PAR_BIN_CHUNKS; ++c) {
+        bins_merge(&parts[0], &parts[2 * c], b->bins);
+        bins_merge(&parts[1], &parts[2 * c + 1], b->bins);
+    }
+    bins_merge(&parts[0], &parts[1], b->bins);
+    memcpy(bs, &parts[0], sizeof *bs);
+    free(parts);
+}
+
+/* The SAH cost term A·N of a box given as two vectors: rl_aabb_area of
+ * the same box, so the costs are bit for bit those of before. */
+static inline float v4_area(v4 lo, v4 hi)
+{
+    return rl_aabb_area(v4_box(lo, hi));
+}
+
+/* Keeps the cheaper of a candidate plane (strict: the first of equal
+ * costs wins, deterministically, in the order axis 0..2, planes left to
+ * right, as the sweep over the bins visits them). */
+static inline void consider(split *best, int axis, int bin, float cost, v4 llo, v4 lhi, v4 rlo, v4 rhi,
+                            float cmin, float k1)
+{
+    if (cost < best->cost)
+        *best = (split){ axis, bin, cost, v4_box(llo, lhi), v4_box(rlo, rhi), cmin, k1 };
+}
+
+/* The SAH sweep over one axis's occupied bins used[0..m) (ascending):
+ * planes between two of them with only empty bins in between all split
+ * alike, at the same cost, and the strict comparison keeps the first of
+ * them, the one right after the left bin, so only that one is evaluated
+ * (bit for bit the choice of a sweep over all K - 1 planes; deep nodes of
+ * a few triangles fill only a few of the K bins). Suffix boxes from the
+ * right, then the planes from the left; the boxes stay vectors (union =
+ * min/max, exact). */
+static void sweep_axis(split *best, int axis, const v4 *blo, const v4 *bhi, const uint32_t *bcnt, const int *used,
+                       int m, float cmin, float k1)
+{
+    v4 rlo[MAX_BINS], rhi[MAX_BINS];
+    uint32_t right_n[MAX_BINS];
+    v4 alo = v4_set1(INFINITY), ahi = v4_set1(-INFINITY);
+    uint32_t cnt = 0;
+    for (int u = m - 1; u > 0; --u) {
+        int k = used[u];
+        alo = v4_min(alo, blo[k]);
+        ahi = v4_max(ahi, bhi[k]);
+        cnt += bcnt[k];
+        rlo[u] = alo;
+        rhi[u] = ahi;
+        right_n[u] = cnt;
+    }
+    alo = v4_set1(INFINITY);
+    ahi = v4_set1(-INFINITY);
+    cnt = 0;
+    for (int u = 1; u < m; ++u) {   /* plane right after bin used[u - 1] */
+        int k = used[u - 1];
+        alo = v4_min(alo, blo[k]);
+        ahi = v4_max(ahi, bhi[k]);
+        cnt += bcnt[k];
+        float cost = v4_area(alo, ahi) * (float)cnt + v4_area(rlo[u], rhi[u]) * (float)right_n[u];
+        consider(best, axis, k + 1, cost, alo, ahi, rlo[u], rhi[u], cmin, k1);
+    }
+}
+
+
+static split find_split_small(const builder *b, uint32_t begin, uint32_t end, const float cmin[3],
+                              const float k1[3], const bool live[3])
+{
+    split best = { .axis = -1, .cost = INFINITY };
+    int K = b->bins;
+    uint32_t n = end - begin;
+    v4 lo[SMALL_MAX], hi[SMALL_MAX];
+    uint8_t key[SMALL_MAX][3];
+    uint64_t mask[3] = { 0, 0, 0 };
+    v4 blo[3][64], bhi[3][64];
+    uint32_t bcnt[3][64];
+    v4 vmin = v4_make(cmin[0], cmin[1], cmin[2]), vk1 = v4_make(k1[0], k1[1], k1[2]);
+    for (uint32_t i = 0; i < n; ++i) {
+        const prim *p = &b->prims[begin + i];
+        lo[i] = prim_lo(p);
+        hi[i] = prim_hi(p);
+        int32_t k[4];   /* bin_prim's index, computed the same way */
+        v4_trunc(v4_mul(vk1, v4_sub(v4_mul(v4_add(lo[i], hi[i]), v4_set1(0.5f)), vmin)), k);
+        for (int a = 0; a < 3; ++a) {
+            int j = clamp_bin(k[a], K);
+            key[i][a] = (uint8_t)j;
+            mask[a] |= (uint64_t)1 << j;
         }
+    }
+    for (int a = 0; a < 3; ++a)
+        for (uint64_t m = mask[a]; m; m &= m - 1) {
+            int j = __builtin_ctzll(m);
+            blo[a][j] = v4_set1(INFINITY);
+            bhi[a][j] = v4_set1(-INFINITY);
+            bcnt[a][j] = 0;
+        }
+    for (uint32_t i = 0; i < n; ++i)
+        for (int a = 0; a < 3; ++a) {
+            int j = key[i][a];
+            blo[a][j] = v4_min(blo[a][j], lo[i]);
+            bhi[a][j] = v4_max(bhi[a][j], hi[i]);
+            bcnt[a][j]++;
+        }
+    for (int axis = 0; axis < 3; ++axis) {
+        if (!live[axis])
+            continue;
+        int used[SMALL_MAX], m = 0;
+        for (uint64_t bits = mask[axis]; bits; bits &= bits - 1)
+            used[m++] = __builtin_ctzll(bits);
+        sweep_axis(&best, axis, blo[axis], bhi[axis], bcnt[axis], used, m, cmin[axis], k1[axis]);
+    }
+    return best;
 }
 
 static split find_split(const builder *b, uint32_t begin, uint32_t end, rl_aabb cb)
@@ -307,44 +488,22 @@ static split find_split(const builder *b, uint32_t begin, uint32_t end, rl_aabb 
     }
     if (!any)
         return best;
+    if (end - begin <= b->small_max && K <= 64)
+        return find_split_small(b, begin, end, cmin, k1, live);
     bin_set bs, spare;
-    bin_range(b, begin, end, cmin, k1, &bs, &spare);
+    if (b->threads > 1 && b->par_bin_min > 0 && end - begin >= b->par_bin_min)
+        bin_range_parallel(b, begin, end, cmin, k1, &bs, &spare);
+    else
+        bin_range(b, begin, end, cmin, k1, &bs, &spare);
     for (int axis = 0; axis < 3; ++axis) {
         if (!live[axis])
             continue;
-        /* The sweep visits the non-empty bins only: planes between two
-         * of them with only empty bins in between all split alike, at the
-         * same cost, and the strict comparison below would keep the first
-         * of them, the one right after the left bin, so that is the plane
-         * taken (bit for bit the choice of a sweep over all K - 1 planes;
-         * deep nodes of a few triangles fill only a few of the K bins). */
         int used[MAX_BINS], m = 0;
-        for (int k = 0; k < K; ++k)
-            if (bs.count[axis][k] > 0)
-                used[m++] = k;
-        /* Sweep from the right storing suffix boxes, then from the left. */
-        rl_aabb right_box[MAX_BINS];
-        uint32_t right_n[MAX_BINS];
-        rl_aabb acc = rl_aabb_empty();
-        uint32_t n = 0;
-        for (int u = m - 1; u > 0; --u) {
-            int k = used[u];
-            acc = rl_aabb_union(acc, v4_box(bs.lo[axis][k], bs.hi[axis][k]));
-            n += bs.count[axis][k];
-            right_box[u] = acc;
-            right_n[u] = n;
+        for (int k = 0; k < K; ++k) {
+            used[m] = k;
+            m += bs.count[axis][k] > 0;
         }
-        acc = rl_aabb_empty();
-        n = 0;
-        for (int u = 1; u < m; ++u) {   /* plane right after bin used[u - 1] */
-            int k = used[u - 1];
-            acc = rl_aabb_union(acc, v4_box(bs.lo[axis][k], bs.hi[axis][k]));
-            n += bs.count[axis][k];
-            float cost = rl_aabb_area(acc) * (float)n + rl_aabb_area(right_box[u]) * (float)right_n[u];
-            if (cost < best.cost) {   /* strict: the first of equals wins, deterministically */
-                best = (split){ axis, k + 1, cost, acc, right_box[u], cmin[axis], k1[axis] };
-            }
-        }
+        sweep_axis(&best, axis, bs.lo[axis], bs.hi[axis], bs.count[axis], used, m, cmin[axis], k1[axis]);
     }
     return best;
 }
@@ -491,16 +650,22 @@ typedef struct tree {
     prim *prims;
     rl_bvh_node *sparse;
     uint32_t num_slots, num_nodes, num_blocks;
+    bool own_prims;          /* false: prims lie in the caller's memory */
 } tree;
 
 static void tree_free(tree *t)
 {
-    free(t->prims);
+    if (t->own_prims)
+        free(t->prims);
     free(t->sparse);
     memset(t, 0, sizeof *t);
 }
 
-static rl_status build_tree(const rl_scene_data *data, const rl_accel_desc *desc, int threads, tree *out)
+static const rl_bvh_tuning default_tuning = { SMALL_MAX, PAR_BIN_MIN, PARALLEL_MIN };
+
+/* room: memory for the N triangle records, or NULL to allocate them. */
+static rl_status build_tree(const rl_scene_data *data, const rl_accel_desc *desc, const rl_bvh_tuning *tuning,
+                            int threads, void *room, tree *out)
 {
     uint32_t N = data->num_triangles;
     if (N == 0)
@@ -509,6 +674,9 @@ static rl_status build_tree(const rl_scene_data *data, const rl_accel_desc *desc
         .num_tris = N,
         .bins = desc->bvh_bins > 0 ? desc->bvh_bins : 16,
         .leaf_size = desc->bvh_leaf_size > 0 ? desc->bvh_leaf_size : DEFAULT_LEAF,
+        .threads = threads,
+        .small_max = tuning->small_max < SMALL_MAX ? tuning->small_max : SMALL_MAX,
+        .par_bin_min = tuning->par_bin_min,
         .progress = desc->progress,
         .user = desc->user,
     };
@@ -518,11 +686,12 @@ static rl_status build_tree(const rl_scene_data *data, const rl_accel_desc *desc
     /* 2N - 1 nodes at most, plus each thread's last chunk, partly unused;
      * only the slots handed out are ever touched. */
     size_t capacity = (size_t)2 * N - 1 + (size_t)threads * SLOT_CHUNK;
-    prim *prims = rl_big_array(N, sizeof *prims, false);
+    prim *prims = room ? room : rl_big_array(N, sizeof *prims, false);
     rl_bvh_node *sparse = rl_big_array(capacity, sizeof *sparse, false);
     cursor *cursors = rl_calloc((size_t)threads, sizeof *cursors);
     if (!prims || !sparse || !cursors) {
-        free(prims);
+        if (!room)
+            free(prims);
         free(sparse);
         free(cursors);
         return RL_ERR_OUT_OF_MEMORY;
@@ -566,7 +735,8 @@ static rl_status build_tree(const rl_scene_data *data, const rl_accel_desc *desc
     if (!atomic_load(&b.cancelled) && b.progress && !b.progress(b.user, 1.0))
         atomic_store(&b.cancelled, true);
     if (atomic_load(&b.cancelled)) {
-        free(prims);
+        if (!room)
+            free(prims);
         free(sparse);
         free(cursors);
         return rl_error(RL_ERR_CANCELLED, "accel bvh: build cancelled");
@@ -577,13 +747,13 @@ static rl_status build_tree(const rl_scene_data *data, const rl_accel_desc *desc
         blocks += cursors[t].blocks;
     }
     free(cursors);
-    *out = (tree){ prims, sparse, (uint32_t)atomic_load(&b.next_slot), 1 + 2 * pairs, blocks };
+    *out = (tree){ prims, sparse, (uint32_t)atomic_load(&b.next_slot), 1 + 2 * pairs, blocks, !room };
     return RL_OK;
 }
 
-static int build_threads(const rl_accel_desc *desc, uint32_t num_tris)
+static int build_threads(const rl_accel_desc *desc, const rl_bvh_tuning *tuning, uint32_t num_tris)
 {
-    if (num_tris < PARALLEL_MIN)
+    if (num_tris < tuning->parallel_min)
         return 1;
     return desc->threads > 0 ? desc->threads : omp_get_max_threads();
 }
@@ -591,9 +761,17 @@ static int build_threads(const rl_accel_desc *desc, uint32_t num_tris)
 rl_status rl_bvh_build(const rl_scene_data *data, const rl_accel_desc *desc, rl_bvh *bvh,
                        rl_accel_stats *stats)
 {
-    int threads = build_threads(desc, data->num_triangles);
+    return rl_bvh_build_tuned(data, desc, NULL, bvh, stats);
+}
+
+rl_status rl_bvh_build_tuned(const rl_scene_data *data, const rl_accel_desc *desc, const rl_bvh_tuning *tuning,
+                             rl_bvh *bvh, rl_accel_stats *stats)
+{
+    if (!tuning)
+        tuning = &default_tuning;
+    int threads = build_threads(desc, tuning, data->num_triangles);
     tree t;
-    rl_status st = build_tree(data, desc, threads, &t);
+    rl_status st = build_tree(data, desc, tuning, threads, NULL, &t);
     if (st)
         return st;
     uint32_t N = data->num_triangles;
@@ -645,8 +823,9 @@ static rl_status finish_wide(const rl_scene_data *data, tree *t, rl_bvh_block *b
         return st ? st : RL_ERR_OUT_OF_MEMORY;
     for (uint32_t i = 0; i < N; ++i)
         ids[i] = t->prims[i].id;
-    free(t->prims);
-    t->prims = NULL;
+    if (t->own_prims)
+        free(t->prims);
+    t->prims = NULL;   /* from here on, blocks may overwrite them */
     rl_bvh_leaf_source src = { .ids = ids, .id_stride = 1, .data = data };
     st = rl_bvh_collapse(t->sparse, t->num_slots, t->num_blocks, &src, blocks, bvh);
     free(ids);
@@ -656,27 +835,48 @@ static rl_status finish_wide(const rl_scene_data *data, tree *t, rl_bvh_block *b
 rl_status rl_bvh_build_wide(const rl_scene_data *data, const rl_accel_desc *desc, rl_bvh *bvh,
                             rl_accel_stats *stats)
 {
-    int threads = build_threads(desc, data->num_triangles);
+    return rl_bvh_build_wide_tuned(data, desc, NULL, bvh, stats);
+}
+
+rl_status rl_bvh_build_wide_tuned(const rl_scene_data *data, const rl_accel_desc *desc,
+                                  const rl_bvh_tuning *tuning, rl_bvh *bvh, rl_accel_stats *stats)
+{
+    if (!tuning)
+        tuning = &default_tuning;
+    int threads = build_threads(desc, tuning, data->num_triangles);
+    /* The leaf blocks are the largest array written (city: 107 MB), and on
+     * this VM a page's first touch costs about as much as the work done in
+     * it (bench/README.md, "BVH build time"). A leaf holds at least one
+     * triangle, so there are at most N blocks: the blocks' array is
+     * allocated for N (address space only; untouched pages cost nothing)
+     * before the build, and the build's triangle records (32 of the 160
+     * bytes per triangle) lie at its start. Their pages are then touched
+     * already when the blocks overwrite them, after the collapse has taken
+     * the IDs out (finish_wide). What follows the build is serial, so a
+     * second thread faults the rest of the blocks' pages in meanwhile
+     * (rl_big_prefault), and the serial writer finds them present.
+     * Without the room for N blocks the records get their own array. */
+    uint32_t N = data->num_triangles;
+    rl_bvh_block *room = N > 0 ? rl_bvh_alloc_blocks(N) : NULL;
     tree t;
-    rl_status st = build_tree(data, desc, threads, &t);
-    if (st)
+    rl_status st = build_tree(data, desc, tuning, threads, room, &t);
+    if (st) {
+        free(room);
         return st;
-    /* The leaf blocks are the largest array written (city: 107 MB). What
-     * follows the build is serial, so a second thread faults the blocks'
-     * pages in meanwhile (rl_big_prefault), and the serial writer finds
-     * them present. */
-    rl_bvh_block *blocks = rl_bvh_alloc_blocks(t.num_blocks);
+    }
+    rl_bvh_block *blocks = room ? room : rl_bvh_alloc_blocks(t.num_blocks);
     if (!blocks) {
         tree_free(&t);
         return rl_error(RL_ERR_OUT_OF_MEMORY, "accel bvh: out of memory for %u leaf blocks", (unsigned)t.num_blocks);
     }
-    if (threads > 1) {
+    size_t touched = room ? (size_t)N * sizeof(prim) : 0, bytes = (size_t)t.num_blocks * sizeof *blocks;
+    if (threads > 1 && bytes > touched) {
 #pragma omp parallel sections num_threads(2)
         {
 #pragma omp section
             st = finish_wide(data, &t, blocks, bvh, stats);
 #pragma omp section
-            rl_big_prefault(blocks, (size_t)t.num_blocks * sizeof *blocks);
+            rl_big_prefault((char *)blocks + touched, bytes - touched);
         }
     } else {
         st = finish_wide(data, &t, blocks, bvh, stats);

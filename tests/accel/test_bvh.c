@@ -191,8 +191,11 @@ static void test_bvh_build_is_identical_with_one_and_two_threads(void **state)
     const rl_scene_data *d = rl_scene_get_data(s);
     rl_bvh t1 = { 0 }, t2 = { 0 };
     rl_accel_stats s1 = { 0 }, s2 = { 0 };
+    /* 20k triangles build on one thread by default (PARALLEL_MIN): the
+     * forced tuning makes the second build use two. */
+    const rl_bvh_tuning two = { .small_max = 32, .par_bin_min = 4096, .parallel_min = 0 };
     assert_int_equal(rl_bvh_build(d, &(rl_accel_desc){ .threads = 1 }, &t1, &s1), RL_OK);
-    assert_int_equal(rl_bvh_build(d, &(rl_accel_desc){ .threads = 2 }, &t2, &s2), RL_OK);
+    assert_int_equal(rl_bvh_build_tuned(d, &(rl_accel_desc){ .threads = 2 }, &two, &t2, &s2), RL_OK);
     assert_int_equal(t1.num_nodes, t2.num_nodes);
     assert_int_equal(t1.num_tris, t2.num_tris);
     assert_int_equal(s1.leaves, s2.leaves);
@@ -417,33 +420,86 @@ static void test_bvh_breaks_ties_by_lowest_triangle_id(void **state)
  * with one thread and two, on SAH splits, on the median fallback (stacked
  * copies of one triangle: all centroids coincide) and on leaf-size and bin
  * settings off the defaults. */
+/* The plain builder: every node binned over all K bins, in one pass,
+ * on one thread. The tuned paths (bvh.h's rl_bvh_tuning) must give its
+ * tree bit for bit. */
+static const rl_bvh_tuning plain_tuning = { .small_max = 0, .par_bin_min = 0, .parallel_min = UINT32_MAX };
+/* Every path on every size: the small-node path, chunked binning down to
+ * ranges of 512 and two threads however small the scene. */
+static const rl_bvh_tuning forced_tuning = { .small_max = 32, .par_bin_min = 512, .parallel_min = 0 };
+
 static void assert_build_wide_matches(const rl_scene_data *d, rl_accel_desc desc)
 {
     rl_bvh ref = { 0 };
     rl_accel_stats ref_st = { 0 };
-    assert_int_equal(rl_bvh_build(d, &desc, &ref, &ref_st), RL_OK);
+    assert_int_equal(rl_bvh_build_tuned(d, &desc, &plain_tuning, &ref, &ref_st), RL_OK);
     assert_int_equal(rl_bvh_widen(&ref), RL_OK);
-    for (int threads = 1; threads <= 2; ++threads) {
-        desc.threads = threads;
-        rl_bvh w = { 0 };
-        rl_accel_stats st = { 0 };
-        assert_int_equal(rl_bvh_build_wide(d, &desc, &w, &st), RL_OK);
-        assert_null(w.nodes);
-        assert_null(w.tris);
-        assert_int_equal(w.num_tris, d->num_triangles);
-        assert_int_equal(w.num_wide, ref.num_wide);
-        assert_int_equal(w.num_blocks, ref.num_blocks);
-        assert_memory_equal(w.wide, ref.wide, (size_t)w.num_wide * sizeof *w.wide);
-        assert_memory_equal(w.blocks, ref.blocks, (size_t)w.num_blocks * sizeof *w.blocks);
-        assert_int_equal(st.nodes, ref_st.nodes);
-        assert_int_equal(st.leaves, ref_st.leaves);
-        assert_int_equal(st.max_depth, ref_st.max_depth);
-        assert_true(st.sah_cost == ref_st.sah_cost);
-        assert_int_equal(st.memory_bytes,
-                         (size_t)w.num_wide * sizeof *w.wide + (size_t)w.num_blocks * sizeof *w.blocks);
-        rl_bvh_free(&w);
-    }
+    const rl_bvh_tuning *tunings[] = { NULL, &forced_tuning };
+    for (int threads = 1; threads <= 2; ++threads)
+        for (size_t ti = 0; ti < sizeof tunings / sizeof tunings[0]; ++ti) {
+            desc.threads = threads;
+            rl_bvh w = { 0 };
+            rl_accel_stats st = { 0 };
+            assert_int_equal(rl_bvh_build_wide_tuned(d, &desc, tunings[ti], &w, &st), RL_OK);
+            assert_null(w.nodes);
+            assert_null(w.tris);
+            assert_int_equal(w.num_tris, d->num_triangles);
+            assert_int_equal(w.num_wide, ref.num_wide);
+            assert_int_equal(w.num_blocks, ref.num_blocks);
+            assert_memory_equal(w.wide, ref.wide, (size_t)w.num_wide * sizeof *w.wide);
+            assert_memory_equal(w.blocks, ref.blocks, (size_t)w.num_blocks * sizeof *w.blocks);
+            assert_int_equal(st.nodes, ref_st.nodes);
+            assert_int_equal(st.leaves, ref_st.leaves);
+            assert_int_equal(st.max_depth, ref_st.max_depth);
+            assert_true(st.sah_cost == ref_st.sah_cost);
+            assert_int_equal(st.memory_bytes,
+                             (size_t)w.num_wide * sizeof *w.wide + (size_t)w.num_blocks * sizeof *w.blocks);
+            rl_bvh_free(&w);
+            /* The binary path too (nodes and triangles in leaf order). */
+            rl_bvh bin = { 0 };
+            assert_int_equal(rl_bvh_build_tuned(d, &desc, tunings[ti], &bin, &st), RL_OK);
+            assert_int_equal(bin.num_nodes, ref.num_nodes);
+            assert_memory_equal(bin.nodes, ref.nodes, (size_t)bin.num_nodes * sizeof *bin.nodes);
+            assert_memory_equal(bin.tris, ref.tris, (size_t)bin.num_tris * sizeof *bin.tris);
+            rl_bvh_free(&bin);
+        }
     rl_bvh_free(&ref);
+}
+
+/* Triangles whose boxes start at +0 and at -0 alternately, in the same
+ * bins: min and max keep one of two equal operands, so the sign of a zero
+ * in a node's box depends on the order in which the bins are merged; the
+ * chunked binning must merge as the one pass does (bvh_build.c,
+ * bins_merge). */
+static void test_bvh_build_keeps_signed_zeros(void **state)
+{
+    (void)state;
+    enum { TRIS = 3000 };
+    rl_vec3 *pos = malloc(3 * TRIS * sizeof *pos);
+    uint32_t *idx = malloc(3 * TRIS * sizeof *idx);
+    assert_true(pos && idx);
+    for (uint32_t i = 0; i < TRIS; ++i) {
+        float z0 = (i % 3 == 1) ? -0.0f : 0.0f, x0 = (i % 2) ? -0.0f : 0.0f;
+        float y = 0.01f * (float)(i % 97), z = 0.02f * (float)(i / 97);
+        pos[3 * i] = rl_v3(x0, y, z0 + z);
+        pos[3 * i + 1] = rl_v3(x0 + 0.5f, y, z + 0.01f);
+        pos[3 * i + 2] = rl_v3(x0, y + 0.005f, z + 0.01f);
+        for (int k = 0; k < 3; ++k)
+            idx[3 * i + (uint32_t)k] = 3 * i + (uint32_t)k;
+    }
+    rl_scene *s = mesh_scene(pos, 3 * TRIS, idx, TRIS);
+    /* The scene's commit folds its transform in, which turns -0 into +0;
+     * the builder gets the positions as given here instead. */
+    rl_scene_data data = *rl_scene_get_data(s);
+    assert_int_equal(data.num_triangles, TRIS);
+    assert_int_equal(data.num_vertices, 3 * TRIS);
+    data.positions = pos;
+    const rl_scene_data *d = &data;
+    assert_build_wide_matches(d, (rl_accel_desc){ 0 });
+    assert_build_wide_matches(d, (rl_accel_desc){ .bvh_bins = 4 });
+    rl_scene_release(s);
+    free(pos);
+    free(idx);
 }
 
 static void test_bvh_build_wide_equals_build_then_widen(void **state)
@@ -678,6 +734,7 @@ int main(void)
         cmocka_unit_test(test_bvh_build_is_identical_with_one_and_two_threads),
         cmocka_unit_test(test_bvh_structure_is_consistent_and_stats_are_sane),
         cmocka_unit_test(test_bvh_build_wide_equals_build_then_widen),
+        cmocka_unit_test(test_bvh_build_keeps_signed_zeros),
         cmocka_unit_test(test_bvh_breaks_ties_by_lowest_triangle_id),
         cmocka_unit_test(test_rays_at_shared_edges_and_vertices_never_escape),
         cmocka_unit_test(test_bvh_agrees_with_brute_force_at_vertices_and_edges),
