@@ -88,6 +88,16 @@ typedef struct uniforms {
 #define SM_UNIT 7                  /* the path program's texture unit of the maps */
 #define SM_CASTERS 14              /* the casters list's storage binding (B_RAYS's: the pass is
                                     * no ray set's) */
+/* The path program's compile-time variants (docs/gl.md, "Path-program
+ * variants"): llvmpipe compiles the program in proportion to its inlined
+ * size, so the parts a frame cannot reach are left out by the GLSL
+ * preprocessor's HAS_* (gl_pt_shaders.c) rather than skipped by a uniform:
+ * GGX (no material of the scene is GGX), the light-vertex joins of Sec.
+ * 8.4 (no light paths this frame) and the environment (none set). A left
+ * out part is one whose uniform would be false, so every variant computes
+ * what the full program computes. */
+enum { V_GGX = 1, V_LIGHT_VERTICES = 2, V_ENV = 4, PATH_VARIANTS = 8 };
+
 #define ENV_UNIT 8                 /* the path program's texture unit of the environment */
 #define LV_UNIT 9                  /* the path program's texture unit of the light vertices */
 
@@ -99,8 +109,13 @@ struct rl_gl_pt {
     uint32_t table_count;
     uint32_t num_nodes;
     bool masks;
+    /* the path program of this frame's variant (use_variant) and its
+     * uniforms; the variants made so far, by PATH_VARIANT bits */
     GLuint path_prog, rays_prog;
     uniforms pu, ru;
+    GLuint variant_prog[PATH_VARIANTS];
+    uniforms variant_u[PATH_VARIANTS];
+    bool has_ggx;                 /* a material of the scene is GGX */
     GLuint buf[B_COUNT];
     GLuint tex[T_COUNT];
     /* the grid, built on first use */
@@ -247,7 +262,7 @@ static void locate(GLuint p, uniforms *u)
 /* The path program includes the Line Space walk (its defines first, right
  * after #version); the ray-set program has no use for it. body NULL: the
  * shadow maps' depth pass, a vertex and a fragment stage. */
-static GLuint compute_program(const char *body, bool linespace, const char *what)
+static GLuint compute_program(const char *body, bool linespace, unsigned variant, const char *what)
 {
     char defines[640];
     snprintf(defines, sizeof defines,
@@ -271,10 +286,16 @@ static GLuint compute_program(const char *body, bool linespace, const char *what
             glDeleteShader(v);
         return f ? rl_gl_link(v, f, what) : 0;
     }
-    const char *const parts[] = { rl_gl_pt_glsl_header, linespace ? rl_gl_linespace_glsl() : "", defines,
+    /* the path program's variant (V_*); the other programs have no use
+     * for it and keep their texts */
+    char has[96] = "";
+    if (linespace)
+        snprintf(has, sizeof has, "#define HAS_GGX %d\n#define HAS_LIGHT_VERTICES %d\n#define HAS_ENV %d\n",
+                 (variant & V_GGX) != 0, (variant & V_LIGHT_VERTICES) != 0, (variant & V_ENV) != 0);
+    const char *const parts[] = { rl_gl_pt_glsl_header, linespace ? rl_gl_linespace_glsl() : "", defines, has,
                                   rl_gl_pt_glsl_common, rl_gl_glsl_tex_sample, rl_gl_pt_glsl_common2,
                                   rl_gl_glsl_light_delta, body };
-    GLuint s = rl_gl_compile(GL_COMPUTE_SHADER, parts, 8, what);
+    GLuint s = rl_gl_compile(GL_COMPUTE_SHADER, parts, 9, what);
     return s ? rl_gl_link(s, 0, what) : 0;
 }
 
@@ -573,12 +594,14 @@ rl_status rl_gl_pt_create(const rl_scene *scene, const rl_gl_pt_desc *desc, rl_g
     GLint64 max_block = 0;
     if (st == RL_OK) {
         glGetInteger64v(GL_MAX_SHADER_STORAGE_BLOCK_SIZE, &max_block);
-        pt->path_prog = compute_program(rl_gl_pt_glsl_path, true, "gl-pt path");
-        pt->rays_prog = pt->path_prog ? compute_program(rl_gl_pt_glsl_rays, false, "gl-pt rays") : 0;
+        /* the path program is made by the first frame, in the variant it
+         * needs (use_variant) */
+        pt->rays_prog = compute_program(rl_gl_pt_glsl_rays, false, 0, "gl-pt rays");
         st = pt->rays_prog ? RL_OK : RL_ERR_INTERNAL;
     }
     if (st == RL_OK) {
-        locate(pt->path_prog, &pt->pu);
+        for (uint32_t i = 0; i < d->num_materials; ++i)
+            pt->has_ggx = pt->has_ggx || d->materials[i].bsdf == RL_BSDF_GGX;
         locate(pt->rays_prog, &pt->ru);
         st = upload_materials_lights(pt, &desc->lights, desc->ggx_ms);
     }
@@ -851,6 +874,23 @@ static void drop_frame(rl_gl_pt *pt)
     pt->out = (rl_gl_frame){ 0 };
 }
 
+/* The path program of variant v (V_*), made on its first use: a scene
+ * without GGX, a frame without light paths and a tracer without an
+ * environment compile the smaller program. */
+static rl_status use_variant(rl_gl_pt *pt, unsigned v)
+{
+    if (!pt->variant_prog[v]) {
+        GLuint p = compute_program(rl_gl_pt_glsl_path, true, v, "gl-pt path");
+        if (!p)
+            return RL_ERR_INTERNAL;
+        pt->variant_prog[v] = p;
+        locate(p, &pt->variant_u[v]);
+    }
+    pt->path_prog = pt->variant_prog[v];
+    pt->pu = pt->variant_u[v];
+    return RL_OK;
+}
+
 static rl_status render_frame(rl_gl_pt *pt, const rl_gl_pt_frame *f, float *rgba, uint64_t rays[RL_GL_PT_RAY_TYPES],
                               uint64_t *samples, uint64_t *converged)
 {
@@ -872,6 +912,9 @@ static rl_status render_frame(rl_gl_pt *pt, const rl_gl_pt_frame *f, float *rgba
                           "holding its payload (rl_gl_pt_set_linespace)");
     if (st == RL_OK && f->shadow == RL_GL_PT_SHADOWMAP && !pt->have_sm)
         st = rl_error(RL_ERR_INVALID_ARG, "rl_gl_pt_render: shadow maps not made (rl_gl_pt_set_shadowmaps)");
+    const bool lvc = f->light_connect > 0 && pt->lv_paths > 0;
+    if (st == RL_OK)
+        st = use_variant(pt, (pt->has_ggx ? V_GGX : 0u) | (lvc ? V_LIGHT_VERTICES : 0u) | (pt->have_env ? V_ENV : 0u));
     if (st != RL_OK)
         return st;
     const GLuint p = pt->path_prog;
@@ -937,7 +980,6 @@ static rl_status render_frame(rl_gl_pt *pt, const rl_gl_pt_frame *f, float *rgba
     slots += pt->have_env ? 1u : 0u;
     /* hybrid light paths: one slot per drawn light path, after the rest
      * (none without, so that the other slots keep their places) */
-    const bool lvc = f->light_connect > 0 && pt->lv_paths > 0;
     glProgramUniform1i(p, u->lvc, lvc);
     glProgramUniform1ui(p, u->lv_slot, slots);
     glProgramUniform1ui(p, u->lv_paths, pt->lv_paths);
@@ -1119,7 +1161,7 @@ static rl_status shadow_program(rl_gl_pt *pt)
 {
     if (pt->sm_prog)
         return RL_OK;
-    GLuint p = compute_program(NULL, false, "gl-pt shadow maps");
+    GLuint p = compute_program(NULL, false, 0, "gl-pt shadow maps");
     if (!p)
         return RL_ERR_INTERNAL;
     pt->sm_prog = p;

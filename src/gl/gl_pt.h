@@ -118,7 +118,11 @@ typedef struct rl_gl_pt_frame {
 /* A tracer of scene (committed). RL_ERR_UNSUPPORTED where no GL 4.5
  * context can be made (with the reason), RL_ERR_LIMIT where the scene's
  * arrays exceed the GL's storage block size, RL_ERR_INTERNAL for a GL or
- * shader error. desc's arrays are copied. */
+ * shader error. desc's arrays are copied. The path program is compiled
+ * by the first frame that needs it, in one of its compile-time variants
+ * (with or without GGX, the light-vertex joins, the environment: gl_pt.c
+ * V_*), so rl_gl_pt_render can also fail with RL_ERR_INTERNAL for a
+ * shader error. */
 rl_status rl_gl_pt_create(const rl_scene *scene, const rl_gl_pt_desc *desc, rl_gl_pt **out);
 void rl_gl_pt_release(rl_gl_pt *pt);      /* NULL is a no-op */
 const rl_gl_info *rl_gl_pt_info(const rl_gl_pt *pt);
@@ -221,9 +225,9 @@ typedef struct rl_gl_pt_env {
 /* Gives the tracer env (copied), or with NULL takes its environment away
  * (escaping rays then see the frame's background). RL_ERR_INVALID_ARG for
  * inconsistent sizes, RL_ERR_LIMIT past the GL's buffer texture size. The
- * arrays live in one r32f buffer texture; without an environment a
- * 12-byte one is bound, so llvmpipe compiles one variant of the path
- * program for both (see no_maps in gl_pt.c). */
+ * arrays live in one r32f buffer texture (without an environment a
+ * 12-byte one is bound, see no_maps in gl_pt.c); frames with and without
+ * an environment use the path program's variants with and without it. */
 rl_status rl_gl_pt_set_environment(rl_gl_pt *pt, const rl_gl_pt_env *env);
 
 /* Traces n rays through structure on the GPU (closest hit, or with any the

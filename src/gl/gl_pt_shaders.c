@@ -405,6 +405,13 @@ const char *const rl_gl_pt_glsl_path = GLSL(
     uniform int u_lv_connect;          /* paths drawn per camera vertex (M) */
     uniform uint u_lv_slot;            /* their slots in a vertex's block */
     uniform float u_lv_nu1;            /* light_samples / M */
+    /* The program's variant (gl_pt.c V_*): HAS_GGX, HAS_LIGHT_VERTICES and
+     * HAS_ENV 0 leave the GGX lobes, the light-vertex joins and the
+     * environment out of the program, as the uniform false would skip
+     * them (llvmpipe's compile time grows with the inlined program). */
+    bool lvc_on() { return HAS_LIGHT_VERTICES != 0 && u_lvc; }
+    bool env_on() { return HAS_ENV != 0 && u_env; }
+    bool env_nee_on() { return HAS_ENV != 0 && u_env_nee; }
 
     /* -------------------------------------------------------- sampler -- */
     const uint SLOT_PIXEL = 0u, SLOT_FIRST_VERTEX = 1u;
@@ -1000,7 +1007,7 @@ const char *const rl_gl_pt_glsl_path = GLSL(
      * instead of one per call site also keeps the program small, which
      * llvmpipe compiles in proportion to its inlined size. */
     Ggx g_lobe;
-    bool is_ggx(Surf s) { return materials[s.mat].pbr.z > 0.0; }
+    bool is_ggx(Surf s) { return HAS_GGX != 0 && materials[s.mat].pbr.z > 0.0; }
 
     vec3 brdf_eval(Surf s, vec3 wi)
     {
@@ -1536,7 +1543,7 @@ const char *const rl_gl_pt_glsl_path = GLSL(
             if (cos_e <= 0.0 || cos_r <= 0.0 || !visible(s, l, dist, src, j))
                 continue;
             float p_light = pmf * d2 / (area * cos_e);
-            float w = u_lvc ? lv_nee_weight(s, l, d2, cos_e, pmf, area, !is_light, bsdf_follows && hittable)
+            float w = lvc_on() ? lv_nee_weight(s, l, d2, cos_e, pmf, area, !is_light, bsdf_follows && hittable)
                     : bsdf_follows && hittable ? power_heuristic(float(n) * p_light, bsdf_pdf(s, l)) : 1.0;
             sum += brdf_eval(s, l) * (le * (w * cos_r / (p_light * float(n))));
         }
@@ -1566,10 +1573,10 @@ const char *const rl_gl_pt_glsl_path = GLSL(
      * samples also reach it */
     vec3 escaped(vec3 dir, bool after_brdf, float pdf_bsdf)
     {
-        if (!u_env)
+        if (!env_on())
             return u_background;
         vec3 L = env_radiance(dir);
-        if (!u_env_nee || !after_brdf)
+        if (!env_nee_on() || !after_brdf)
             return L;
         return L * power_heuristic(pdf_bsdf, env_pdf(dir));
     }
@@ -1712,14 +1719,14 @@ const char *const rl_gl_pt_glsl_path = GLSL(
         vec3 prev = s.p;
         float prev_pdf = 0.0;
         bool gen = u_rng != 0;
-        if (u_lvc)
+        if (lvc_on())
             lv_start();
         for (int depth = 0;; ++depth) {
             uint base = SLOT_FIRST_VERTEX + uint(depth) * u_vertex_slots;
             Material m = materials[s.mat];
-            if (m.pbr.z > 0.0)
+            if (HAS_GGX != 0 && m.pbr.z > 0.0)
                 g_lobe = ggx_setup(s);
-            vec3 e = u_lvc ? emitted_lvc(s, after_brdf)
+            vec3 e = lvc_on() ? emitted_lvc(s, after_brdf)
                            : u_mis ? emitted_mis(s, after_brdf, prev, prev_pdf) : emitted(s, after_brdf);
             radiance += T * e;
 
@@ -1758,16 +1765,16 @@ const char *const rl_gl_pt_glsl_path = GLSL(
                     }
                 }
                 after_brdf = false;
-                if (u_lvc)
+                if (lvc_on())
                     lv_leave(s, dir, true);
             } else {
                 bool last = depth >= u_max_depth;
                 radiance += T * (u_mis ? direct_light_mis(s, base, !last) : direct_light(s, base));
-                if (u_env_nee)
+                if (env_nee_on())
                     radiance += T * environment_light(s, base, !last);
                 if (last)
                     break;
-                if (u_lvc)
+                if (lvc_on())
                     radiance += T * light_vertices(s, base, depth);
                 seek(base + SLOT_LOBE);
                 /* rl_pt_bsdf_needs_lobe: GGX picks a lobe, Phong where it has k_s */
@@ -1780,8 +1787,8 @@ const char *const rl_gl_pt_glsl_path = GLSL(
                 T *= w;
                 diffuse_ray = true;
                 after_brdf = true;
-                prev_pdf = u_mis || u_env_nee ? brdf_pdf(s, dir) : 0.0;
-                if (u_lvc)
+                prev_pdf = u_mis || env_nee_on() ? brdf_pdf(s, dir) : 0.0;
+                if (lvc_on())
                     lv_leave(s, dir, false);
             }
             prev = s.p;
@@ -1820,7 +1827,7 @@ const char *const rl_gl_pt_glsl_path = GLSL(
                 radiance += T * escaped(dir, after_brdf, prev_pdf);
                 break;
             }
-            if (u_lvc)
+            if (lvc_on())
                 lv_arrive(next, s.p);
             s = next;
         }
@@ -1852,7 +1859,7 @@ const char *const rl_gl_pt_glsl_path = GLSL(
         float cx = (2.0 * (float(px.x) + 0.5) / float(u_size.x) - 1.0) * u_tan_half_fov * u_aspect;
         float cy = (1.0 - 2.0 * (float(px.y) + 0.5) / float(u_size.y)) * u_tan_half_fov;
         vec3 centre = normalize(u_cam_u * cx + u_cam_v * cy - u_cam_w);
-        vec3 L = u_env ? env_radiance(centre) : u_background;
+        vec3 L = env_on() ? env_radiance(centre) : u_background;
         if (u_raster) {
             /* the G-buffer's pixel centre: no jitter, no number drawn */
             uint tri = texelFetch(u_ids, px, 0).x;

@@ -677,8 +677,14 @@ static rl_status lv_check(const rl_renderer *r, const rl_scene_data *d)
         if (d->materials[i].bsdf == RL_BSDF_GGX)
             return rl_error(RL_ERR_UNSUPPORTED, "gl-pt: light_paths does not join GGX materials yet (material "
                             "'%s'; use light_paths=0, or bdpt)", d->materials[i].name);
-    if (rl_renderer_opt_enum(r, "adaptive") == 1)
-        return rl_error(RL_ERR_UNSUPPORTED, "gl-pt: light_paths with adaptive=on is not supported (one of the two)");
+    /* adaptive=on needs nothing of its own: each of a pixel's samples is a
+     * camera path that joins paths drawn uniformly from the frame's set,
+     * and the MIS weights count the strategies of one camera path (its
+     * BRDF hit, light_samples light samples, light_connect joins), never
+     * the pixel's samples, since no strategy splats to the image (light
+     * tracing to the pinhole, bdpt's t = 1, is not done). So the samples
+     * adaptive sampling gives a pixel each estimate its value unbiased,
+     * however many it gets; all rounds of a frame join that frame's set. */
     for (uint32_t i = 0; i < d->num_lights; ++i)
         if (d->lights[i].type != RL_LIGHT_QUAD)
             return rl_error(RL_ERR_UNSUPPORTED, "gl-pt: light_paths does not support point, spot or directional "

@@ -6,9 +6,10 @@
  * shade room's error against a converged reference at equal samples, give
  * the same image for 1 and 2 CPU threads and with and without the overlap
  * of CPU and GPU, leave the image exactly as it was with light_paths=0,
- * and refuse what they do not support. Tiny images on llvmpipe; one path
- * program (the light-vertex strategies are a uniform's branch); without a
- * GL 4.5 context the cases skip. */
+ * stay unbiased with adaptive=on, and refuse what they do not support.
+ * Tiny images on llvmpipe; two path-program variants (gl_pt.c V_*: with
+ * the light-vertex joins, and without them for light_paths=0; a refusal
+ * compiles none); without a GL 4.5 context the cases skip. */
 #include <math.h>
 #include <setjmp.h>
 #include <stdarg.h>
@@ -19,6 +20,7 @@
 #include <string.h>
 #include <cmocka.h>
 
+#include "render/pathtrace_internal.h"
 #include "render/render_fixtures.h"
 #include "rl/rl_render.h"
 
@@ -57,7 +59,11 @@ static double rmse_to(const rl_image *a, const rl_image *b)
     return fx_rmse_all(r);
 }
 
-/* Cornell box (16 x 16): gl-pt with light paths against pt at 1024 spp. */
+/* Cornell box (16 x 16): gl-pt with light paths against pt at 1024 spp,
+ * uniform and with adaptive=on (per-pixel counts from 8 to many: the
+ * joins' weights count one camera path's strategies, so each sample stays
+ * unbiased). The same renderer renders both (adaptive=on starts a new
+ * accumulation on the same tracer), so the case compiles one path program. */
 static void test_hybrid_cornell_means_are_pts(void **state)
 {
     (void)state;
@@ -67,9 +73,32 @@ static void test_hybrid_cornell_means_are_pts(void **state)
     const char *ref_opts[] = { "spp", "1024", "seed", "7", NULL };
     rl_image *ref = render_frames("pt", s, &cam, ref_opts, 1);
     const char *opts[] = { "spp", "16", "light_paths", "256", "light_connect", "2", NULL };
-    rl_image *img = render_frames("gl-pt", s, &cam, opts, 4);
+    rl_renderer *r = fx_make("gl-pt", opts);
+    rl_image *img = NULL;
+    for (int k = 0; k < 4; ++k) {
+        rl_image_release(img);
+        img = fx_render_with(r, s, &cam, RL_LAYER_COLOR, NULL);
+    }
     fx_assert_means_agree("cornell gl-pt light_paths=256 64 spp vs pt", img, ref);
+    assert_int_equal(rl_renderer_set(r, "adaptive", "on"), RL_OK);
+    assert_int_equal(rl_renderer_set(r, "adaptive_threshold", "0.001"), RL_OK);
+    rl_render_stats stats = { 0 };
+    for (int k = 0; k < 4; ++k) {
+        rl_image_release(img);
+        img = fx_render_with(r, s, &cam, RL_LAYER_COLOR, &stats);
+    }
+    uint32_t counts[16 * 16];
+    assert_int_equal(rl_gl_pt_renderer_sample_counts(r, counts), RL_OK);
+    uint32_t lo = UINT32_MAX, hi = 0;
+    for (int i = 0; i < 16 * 16; ++i) {
+        lo = counts[i] < lo ? counts[i] : lo;
+        hi = counts[i] > hi ? counts[i] : hi;
+    }
+    print_message("adaptive with light paths: %u to %u samples per pixel\n", lo, hi);
+    assert_true(lo >= 8 && hi > lo);
+    fx_assert_means_agree("cornell gl-pt light_paths=256 adaptive=on 64 spp vs pt", img, ref);
     rl_image_release(img);
+    rl_renderer_release(r);
     rl_image_release(ref);
     rl_scene_release(s);
 }
@@ -182,8 +211,6 @@ static void test_hybrid_refuses_what_it_does_not_support(void **state)
     expect_render_error(s, &cam, maps, RL_ERR_INVALID_ARG, "exact rays");
     const char *pnmt[] = { "light_paths", "16", "diffuse", "ls-pnmt", NULL };
     expect_render_error(s, &cam, pnmt, RL_ERR_INVALID_ARG, "exact rays");
-    const char *adaptive[] = { "light_paths", "16", "adaptive", "on", NULL };
-    expect_render_error(s, &cam, adaptive, RL_ERR_UNSUPPORTED, "adaptive=on");
     rl_scene_release(s);
     /* a point light: delta light vertices */
     s = NULL;
