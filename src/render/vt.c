@@ -1294,6 +1294,20 @@ static rl_status draw_postpass(rl_renderer *r, vt_state *s, const rl_scene *scen
     return st;
 }
 
+/* dist_begin for the master's drawing of a distributed frame (the
+ * post-pass or the parts' faces). Only the master draws, so only it needs
+ * the GL drawer of reconstruct = gl: the workers' pre-pass and refinement
+ * are the CPU's in either mode, as in one process. */
+static rl_status master_begin(rl_renderer *r, vt_state *s, const rl_scene *scene, const rl_camera *cam,
+                              rl_image *image, vt_settings *set, rl_camera *c, rl_tracer **tracer, vt_run *run)
+{
+    rl_status st = dist_begin(r, s, scene, cam, image, set, c, tracer, run);
+    rl_drawer *gl = NULL;
+    if (st == RL_OK && (st = gl_drawer_for(r, s, scene, set, image, &gl)) == RL_OK)
+        run->drawer = gl;
+    return st;
+}
+
 /* The post-pass' frame over the samples in s->pp_map, which it empties
  * at its end (the map points into the caller's parts). */
 static rl_status postpass_frame(rl_renderer *r, vt_state *s, const rl_scene *scene, const rl_camera *cam,
@@ -1303,13 +1317,7 @@ static rl_status postpass_frame(rl_renderer *r, vt_state *s, const rl_scene *sce
     rl_camera c;
     rl_tracer *tracer;
     vt_run run;
-    rl_status st = dist_begin(r, s, scene, cam, image, &set, &c, &tracer, &run);
-    /* Only the master draws, so only it needs the GL drawer of
-     * reconstruct = gl: the workers' pre-pass and refinement are the CPU's
-     * in either mode, as in one process. */
-    rl_drawer *gl = NULL;
-    if (st == RL_OK && (st = gl_drawer_for(r, s, scene, &set, image, &gl)) == RL_OK)
-        run.drawer = gl;
+    rl_status st = master_begin(r, s, scene, cam, image, &set, &c, &tracer, &run);
     if (st == RL_OK)
         st = draw_postpass(r, s, scene, &c, &run);
     if (st == RL_OK) {
@@ -1393,13 +1401,7 @@ rl_status rl_vt_draw_parts(rl_renderer *r, const rl_scene *scene, const rl_camer
     rl_camera c;
     rl_tracer *tracer;
     vt_run run;
-    rl_status st = dist_begin(r, s, scene, cam, image, &set, &c, &tracer, &run);
-    /* Only the master draws, so only it needs the GL drawer of
-     * reconstruct = gl: the workers' pre-pass and refinement are the CPU's
-     * in either mode, as in one process. */
-    rl_drawer *gl = NULL;
-    if (st == RL_OK && (st = gl_drawer_for(r, s, scene, &set, image, &gl)) == RL_OK)
-        run.drawer = gl;
+    rl_status st = master_begin(r, s, scene, cam, image, &set, &c, &tracer, &run);
     /* The parts' faces go after the primary ones. */
     for (size_t i = 0; st == RL_OK && i < count; ++i)
         if ((st = vt_part_import(&s->mesh, run.data, parts[i], sizes[i])) != RL_OK) {
