@@ -51,7 +51,6 @@ if ! command -v xvfb-run >/dev/null 2>&1; then
     echo "test_cli_view: skipped: xvfb-run is missing (Debian: xvfb xauth)"
     exit 77
 fi
-xvfb() { xvfb-run -a -s "-screen 0 640x480x24" "$@"; }
 
 # ssim_ok A B: the SSIM of two PNGs is at least 0.99.
 ssim_ok() {

@@ -30,7 +30,6 @@ if ! available_algos | grep -qx gl-raster || ! available_algos | grep -qx gl-pt;
     echo "test_cli_view_glshare: skipped: no GL 4.5 context here (rl algos marks the GL renderers unavailable)"
     exit 77
 fi
-xvfb() { xvfb-run -a -s "-screen 0 640x480x24" "$@"; }
 
 # json_get FILE EXPR: a Python expression over the JSON object d.
 json_get() { python3 -c "import json,sys; d=json.load(open(sys.argv[1])); print($2)" "$1"; }
