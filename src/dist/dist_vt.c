@@ -647,6 +647,19 @@ static bool package_progress(void *user, double done)
     return !p->cancelled;
 }
 
+/* What the serving inside package_progress left after a refinement or the
+ * post-pass: its first status becomes the frame's if that has none yet;
+ * the return is its MPI failure (MPI_SUCCESS if none), which ends the
+ * master's loop. */
+static int serve_result(const vt_progress *vp, rl_status *st, char *failure, size_t size)
+{
+    if (vp->code == MPI_SUCCESS && vp->st != RL_OK && *st == RL_OK) {
+        *st = vp->st;
+        snprintf(failure, size, "%s", vp->failure);
+    }
+    return vp->code;
+}
+
 /* Whether the calibration packages (the first size ones) are all back. */
 static bool calibrated(const vt_lead_ctx *c, size_t calibration)
 {
@@ -845,14 +858,8 @@ static rl_status vt_lead(rl_dist *d, rl_renderer *r, const rl_scene *scene, cons
             vp.current = 0.0;
             vp.serve = NULL;
             d->per_rank[0].busy_ms += rl_timer_ms(&tm);
-            if (vp.code != MPI_SUCCESS) {
-                code = vp.code;
+            if ((code = serve_result(&vp, &st, failure, sizeof failure)) != MPI_SUCCESS)
                 break;
-            }
-            if (vp.st != RL_OK && st == RL_OK) {
-                st = vp.st;
-                snprintf(failure, sizeof failure, "%s", vp.failure);
-            }
             if (st != RL_OK) {
                 snprintf(failure, sizeof failure, "%s", rl_last_error());
                 continue;
@@ -887,14 +894,8 @@ static rl_status vt_lead(rl_dist *d, rl_renderer *r, const rl_scene *scene, cons
             replay_end = rl_time_s();
             vp.serve = NULL;
             replayed = true;
-            if (vp.code != MPI_SUCCESS) {
-                code = vp.code;
+            if ((code = serve_result(&vp, &st, failure, sizeof failure)) != MPI_SUCCESS)
                 break;
-            }
-            if (vp.st != RL_OK && st == RL_OK) {
-                st = vp.st;
-                snprintf(failure, sizeof failure, "%s", vp.failure);
-            }
             if (rs != RL_OK && st == RL_OK) {
                 st = rs;
                 snprintf(failure, sizeof failure, "%s", rl_last_error());

@@ -88,6 +88,26 @@ static const unsigned char *get_vec2(const unsigned char *p, rl_vec2 *v)
     return p;
 }
 
+/* The start of a vertex record, the same in both part formats: position,
+ * uv, flat radiance and the trace layers, into a cleared sample; the
+ * pointer past them. The import and the post-pass' sample map both read
+ * it. */
+static const unsigned char *get_vertex_sample(const unsigned char *p, rl_vec3 *pos, rl_vec2 *uv,
+                                              vt_vertex_sample *s, rl_trace_layer layers[RL_TRACE_LAYER_COUNT])
+{
+    memset(s, 0, sizeof *s);
+    p = get_vec3(p, pos);
+    p = get_vec2(p, uv);
+    p = get_vec3(p, &s->flat);
+    for (int l = 0; l < RL_TRACE_LAYER_COUNT; ++l) {
+        p = get_vec3(p, &layers[l].diffuse);
+        p = get_vec3(p, &layers[l].rest);
+        p = get(p, &layers[l].texture, 4);
+        p = get_vec2(p, &layers[l].uv);
+    }
+    return p;
+}
+
 rl_status vt_part_write(const vt_mesh *m, const rl_scene_data *d, const uint8_t *mine, bool all_samples, void **out,
                         size_t *size)
 {
@@ -273,16 +293,7 @@ rl_status vt_part_import(vt_mesh *m, const rl_scene_data *d, const void *part, s
         vt_vertex_sample s;
         rl_trace_layer layers[RL_TRACE_LAYER_COUNT];
         memset(x, 0, sizeof *x);
-        memset(&s, 0, sizeof s);
-        p = get_vec3(p, &x->p);
-        p = get_vec2(p, &x->uv);
-        p = get_vec3(p, &s.flat);
-        for (int l = 0; l < RL_TRACE_LAYER_COUNT; ++l) {
-            p = get_vec3(p, &layers[l].diffuse);
-            p = get_vec3(p, &layers[l].rest);
-            p = get(p, &layers[l].texture, 4);
-            p = get_vec2(p, &layers[l].uv);
-        }
+        p = get_vertex_sample(p, &x->p, &x->uv, &s, layers);
         if (version == PART_VERSION_SAMPLES)
             p += VERTEX_EXTRA_BYTES;  /* the post-pass' identity; drawing needs none */
         /* Before any face names it: a failure leaves the mesh as it was
@@ -419,18 +430,9 @@ bool vt_part_samples_take(const vt_part_samples *ps, vt_mesh *m, uint32_t v, boo
         return false;
     vt_vertex_sample s;
     rl_trace_layer layers[RL_TRACE_LAYER_COUNT];
-    memset(&s, 0, sizeof s);
     rl_vec3 skip3;
     rl_vec2 skip2;
-    p = get_vec3(p, &skip3);
-    p = get_vec2(p, &skip2);
-    p = get_vec3(p, &s.flat);
-    for (int l = 0; l < RL_TRACE_LAYER_COUNT; ++l) {
-        p = get_vec3(p, &layers[l].diffuse);
-        p = get_vec3(p, &layers[l].rest);
-        p = get(p, &layers[l].texture, 4);
-        p = get_vec2(p, &layers[l].uv);
-    }
+    p = get_vertex_sample(p, &skip3, &skip2, &s, layers);
     uint64_t tree;
     memcpy(&tree, p + 12, 8);
     vt_sample_set_tree(&s, tree);
