@@ -35,7 +35,9 @@ build-fuzz:
 # keeps what it finds (tests/fuzz/corpus/<kind>); crashes go to
 # tests/fuzz/crashes/<kind>-* as regression inputs. A harness that crashes
 # does not stop the others; the target fails at the end if any did.
-# Leaks are not checked for meshes, where Assimp leaks.
+# Leaks are not checked for meshes, where Assimp leaks. Each input passes
+# through a file in /dev/shm (RL_FUZZ_TMPDIR to choose another folder;
+# tests/fuzz/fuzz_temp.h says why).
 FUZZ_FLAGS = -max_total_time=$(FUZZ_SECONDS) -max_len=4096 -timeout=30 -rss_limit_mb=4096 -print_final_stats=1
 fuzz: build-fuzz
 	@mkdir -p tests/fuzz/crashes

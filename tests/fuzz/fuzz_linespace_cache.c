@@ -12,12 +12,9 @@
  * (linespace_io.c's own rl_ls_file_hash, so the two cannot drift apart).
  * A loaded Line Space answers a few rays: a file that passed the checks must be safe to query. Any
  * status is fine; crashes, leaks and sanitizer reports are not. */
-#define _POSIX_C_SOURCE 200809L
-#include <stdint.h>
-#include <stdio.h>
-#include <stdlib.h>
+#include "fuzz_temp.h"
+
 #include <string.h>
-#include <unistd.h>
 
 #include "rl/rl_accel.h"
 #include "rl/rl_linespace.h"
@@ -67,13 +64,11 @@ int LLVMFuzzerInitialize(int *argc, char ***argv)
     return 0;
 }
 
-static void load(const char *path, const uint8_t *data, size_t size)
+static void load(const uint8_t *data, size_t size)
 {
-    FILE *f = fopen(path, "wb");
-    if (!f)
+    char path[512];
+    if (!fuzz_temp_write(path, sizeof path, "rlls", data, size))
         return;
-    fwrite(data, 1, size, f);
-    fclose(f);
     rl_linespace *ls = NULL;
     if (rl_linespace_load(grid, path, &ls) == RL_OK) {
         rl_linespace_stats s;
@@ -97,13 +92,12 @@ static void load(const char *path, const uint8_t *data, size_t size)
         rl_linespace_release(ls);
     }
     rl_clear_error();
+    fuzz_temp_done(path);
 }
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
 {
-    char path[64];
-    snprintf(path, sizeof path, "/tmp/rl_fuzz_%ld.rlls", (long)getpid());
-    load(path, data, size);
+    load(data, size);
     if (size >= 16) {
         uint8_t *fixed = malloc(size);
         if (!fixed)
@@ -111,7 +105,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
         memcpy(fixed, data, size);
         uint64_t sum = rl_ls_file_hash(0, fixed, size - 8);
         memcpy(fixed + size - 8, &sum, 8);
-        load(path, fixed, size);
+        load(fixed, size);
         free(fixed);
     }
     return 0;

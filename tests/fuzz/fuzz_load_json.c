@@ -8,13 +8,10 @@
  * fuzz FUZZ_SECONDS=N` a longer one that keeps what it finds.
  *
  * The loader reads a file, so each input is written to a per-process
- * temporary file first. "file" and "texture" keys may name real files;
- * run it in a scratch directory. Any status is fine; crashes, leaks and
- * sanitizer reports are not. */
-#define _POSIX_C_SOURCE 200809L
-#include <stdint.h>
-#include <stdio.h>
-#include <unistd.h>
+ * temporary file first (fuzz_temp.h: a tmpfs where there is one). "file"
+ * and "texture" keys may name real files; run it in a scratch directory.
+ * Any status is fine; crashes, leaks and sanitizer reports are not. */
+#include "fuzz_temp.h"
 
 #include "rl/rl_scene.h"
 
@@ -22,16 +19,13 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size);
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
 {
-    char path[64];
-    snprintf(path, sizeof path, "/tmp/rl_fuzz_%ld.json", (long)getpid());
-    FILE *f = fopen(path, "wb");
-    if (!f)
+    char path[512];
+    if (!fuzz_temp_write(path, sizeof path, "json", data, size))
         return 0;
-    fwrite(data, 1, size, f);
-    fclose(f);
     rl_scene *scene = NULL;
     if (rl_scene_load_json(path, &scene) == RL_OK)
         rl_scene_release(scene);
     rl_clear_error();
+    fuzz_temp_done(path);
     return 0;
 }

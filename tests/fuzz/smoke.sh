@@ -10,7 +10,7 @@ shift 4
 rm -rf "$work"
 mkdir -p "$work/corpus" "$work/artifacts"
 cp "$seeds"/* "$work/corpus/"
-cd "$work"   # the harnesses write their temporary files to /tmp, run here
+cd "$work"   # the harnesses write their temporary files to /dev/shm or /tmp (fuzz_temp.h), run here
 # Inputs that once crashed this harness (regressions/<kind>-*, <kind> the
 # seed folder's name), fixed since, run first, once each.
 shopt -s nullglob
