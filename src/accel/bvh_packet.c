@@ -10,8 +10,11 @@
  * their entry distances, so that a pop drops the lanes whose closest hit is
  * already nearer. Before the exact test, an interval test over the
  * packet's origins and 1/d rejects the children no lane can hit, all 8 at
- * once. An entry with few lanes left tests the children lane by lane
- * (visit_lanes). The hybrid of Benthin, Wald, Woop, Ernst, Mark 2012
+ * once, and proves which children every lane hits: those skip the per-lane
+ * test (frustum_children; on a coherent packet most of the children it
+ * keeps). An entry with few lanes left tests the children lane by lane
+ * (visit_lanes). The setup transposes the 8 rays into SIMD registers.
+ * The hybrid of Benthin, Wald, Woop, Ernst, Mark 2012
  * ("Combining Single and Packet-Ray Tracing for Arbitrary Ray
  * Distributions on the Intel MIC Architecture", Sec. 4: such lanes finish
  * the subtree as single rays) is here too but off by measurement
@@ -26,7 +29,11 @@
  * depend on the order in which triangles are met; the lane's box test is
  * rl_bvh_box_n's operations (the near plane chosen per lane by its direction's
  * sign, the same 2^-15 slack), so no box is culled that the single ray
- * would enter with the same t_max. The caller (accel.c) hands over valid
+ * would enter with the same t_max, and visiting more boxes than the single
+ * ray (the frustum's sure children carry a lower bound as their entry
+ * distance, so pops keep lanes longer) only adds triangle tests: the
+ * single ray's closest hit is brute force's (test_bvh), so no further
+ * triangle beats it. The caller (accel.c) hands over valid
  * rays with t_min >= 0 only, so the slack takes the scaled form. Rays of
  * mixed direction signs are correct too, merely slower: accel.c sends only
  * lanes of one octant. */
@@ -58,7 +65,12 @@
 #define SINGLE_BELOW RL_BVH_PACKET_SINGLE_BELOW
 /* 1: children that the frustum proves every lane hits skip the per-lane
  * box test (frustum_children); 0: every child the frustum keeps is tested
- * lane by lane (the state before 2026-12-06's second pass). */
+ * lane by lane (the state before 2026-12-06's second pass). Measured on
+ * 2026-12-06 (rl bench rays --size 512x384, city and Wuson, CPU-time ratios
+ * to Embree's packets, two interleaved runs at load 15-22, both with the
+ * AVX-512 pairs that bench/README.md lists as dropped): 1 gave city
+ * primary 0.78-0.84x, Wuson primary 1.03-1.04x; 0 gave 0.75x and
+ * 0.91-0.96x (shadow rays alike within the noise). */
 #ifndef RL_BVH_PACKET_SURE
 #define RL_BVH_PACKET_SURE 1
 #endif
@@ -211,8 +223,10 @@ static inline __m256 lanes_vector(unsigned mask);
 /* packet_setup with the lanes in SIMD registers: the 8 rays (32
  * bytes each) transposed into o, t_min, d, t_max; signs, octant, the
  * first lane's axis permutation and the lanes that share it, and the
- * frustum's ranges by vector compares and reductions. The same values,
- * bit for bit (moves, compares, min/max and the same divisions); a coherent
+ * frustum's ranges by vector compares and reductions. The same values
+ * (moves, compares, min/max and the same divisions; a range end may
+ * differ from the scalar loop's in the sign of a zero, which only
+ * compares); a coherent
  * packet's setup is a good part of its cost where most packets miss
  * (Wuson: 94 % of the primary rays). */
 static void packet_setup(packet *p, const rl_ray *rays, unsigned active)
