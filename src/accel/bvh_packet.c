@@ -10,8 +10,11 @@
  * their entry distances, so that a pop drops the lanes whose closest hit is
  * already nearer. Before the exact test, an interval test over the
  * packet's origins and 1/d rejects the children no lane can hit, all 8 at
- * once. An entry with few lanes left tests the children lane by lane
- * (visit_lanes). The hybrid of Benthin, Wald, Woop, Ernst, Mark 2012
+ * once, and proves which children every lane hits: those skip the per-lane
+ * test (frustum_children; on a coherent packet most of the children it
+ * keeps). An entry with few lanes left tests the children lane by lane
+ * (visit_lanes). The setup transposes the 8 rays into SIMD registers.
+ * The hybrid of Benthin, Wald, Woop, Ernst, Mark 2012
  * ("Combining Single and Packet-Ray Tracing for Arbitrary Ray
  * Distributions on the Intel MIC Architecture", Sec. 4: such lanes finish
  * the subtree as single rays) is here too but off by measurement
@@ -26,11 +29,16 @@
  * depend on the order in which triangles are met; the lane's box test is
  * rl_bvh_box_n's operations (the near plane chosen per lane by its direction's
  * sign, the same 2^-15 slack), so no box is culled that the single ray
- * would enter with the same t_max. The caller (accel.c) hands over valid
+ * would enter with the same t_max, and visiting more boxes than the single
+ * ray (the frustum's sure children carry a lower bound as their entry
+ * distance, so pops keep lanes longer) only adds triangle tests: the
+ * single ray's closest hit is brute force's (test_bvh), so no further
+ * triangle beats it. The caller (accel.c) hands over valid
  * rays with t_min >= 0 only, so the slack takes the scaled form. Rays of
  * mixed direction signs are correct too, merely slower: accel.c sends only
  * lanes of one octant. */
 #include <math.h>
+#include <stddef.h>
 #include <stdint.h>
 #include <string.h>
 
@@ -55,6 +63,17 @@
 #define RL_BVH_PACKET_SINGLE_BELOW 0
 #endif
 #define SINGLE_BELOW RL_BVH_PACKET_SINGLE_BELOW
+/* 1: children that the frustum proves every lane hits skip the per-lane
+ * box test (frustum_children); 0: every child the frustum keeps is tested
+ * lane by lane (the state before 2026-12-06's second pass). Measured on
+ * 2026-12-06 (rl bench rays --size 512x384, city and Wuson, CPU-time ratios
+ * to Embree's packets, two interleaved runs at load 15-22, both with the
+ * AVX-512 pairs that bench/README.md lists as dropped): 1 gave city
+ * primary 0.78-0.84x, Wuson primary 1.03-1.04x; 0 gave 0.75x and
+ * 0.91-0.96x (shadow rays alike within the noise). */
+#ifndef RL_BVH_PACKET_SURE
+#define RL_BVH_PACKET_SURE 1
+#endif
 
 _Static_assert(LANES == 8, "the packet masks and AVX code assume 8 lanes");
 
@@ -65,6 +84,7 @@ typedef struct packet {
     /* The packet's frustum (one octant, finite 1/d only): the range of
      * origins and of 1/d over the active lanes per axis. */
     bool frustum;
+    bool shared_origin;          /* o_lo == o_hi: a camera's or a point's rays */
     float o_lo[3], o_hi[3], inv_lo[3], inv_hi[3];
     float t_min[LANES];
     float t[LANES];              /* closest hit so far, or t_max (any hit) */
@@ -105,6 +125,7 @@ static inline int popcount8(unsigned m)
 /* The lanes' constants in SIMD layout. Divisions are IEEE exact whether
  * vector or scalar, so inv, sx, sy, sz equal rl_bvh_ray_pre_setup's and
  * rl_ray_watertight_setup's bit for bit. */
+#if !defined(__AVX2__)
 static void packet_setup(packet *p, const rl_ray *rays, unsigned active)
 {
     float d[3][LANES];
@@ -182,10 +203,104 @@ static void packet_setup(packet *p, const rl_ray *rays, unsigned active)
             p->inv_hi[a] = inv > p->inv_hi[a] ? inv : p->inv_hi[a];
         }
     }
+    p->shared_origin = p->o_lo[0] == p->o_hi[0] && p->o_lo[1] == p->o_hi[1] && p->o_lo[2] == p->o_hi[2];
     memcpy(p->wo[0], p->o[p->kx], sizeof p->wo[0]);
     memcpy(p->wo[1], p->o[p->ky], sizeof p->wo[1]);
     memcpy(p->wo[2], p->o[p->kz], sizeof p->wo[2]);
 }
+
+#endif
+
+#if defined(__AVX2__)
+_Static_assert(sizeof(rl_ray) == 8 * sizeof(float) && offsetof(rl_ray, t_min) == 3 * sizeof(float) &&
+                   offsetof(rl_ray, d) == 4 * sizeof(float) && offsetof(rl_ray, t_max) == 7 * sizeof(float),
+               "packet_setup reads a ray as 8 floats: o, t_min, d, t_max");
+
+static inline __m256 all_min8(__m256 v);
+static inline __m256 all_max8(__m256 v);
+static inline __m256 lanes_vector(unsigned mask);
+
+/* packet_setup with the lanes in SIMD registers: the 8 rays (32
+ * bytes each) transposed into o, t_min, d, t_max; signs, octant, the
+ * first lane's axis permutation and the lanes that share it, and the
+ * frustum's ranges by vector compares and reductions. The same values
+ * (moves, compares, min/max and the same divisions; a range end may
+ * differ from the scalar loop's in the sign of a zero, which only
+ * compares); a coherent
+ * packet's setup is a good part of its cost where most packets miss
+ * (Wuson: 94 % of the primary rays). */
+static void packet_setup(packet *p, const rl_ray *rays, unsigned active)
+{
+    /* Inactive lanes (possibly uninitialised) are not read: o 0, t_min 0,
+     * d 1, t_max -1, as the scalar setup's harmless values. */
+    const __m256 dflt = _mm256_setr_ps(0.0f, 0.0f, 0.0f, 0.0f, 1.0f, 1.0f, 1.0f, -1.0f);
+    __m256 r[LANES];
+    for (int l = 0; l < LANES; ++l)
+        r[l] = (active >> l) & 1u ? _mm256_loadu_ps((const float *)(const void *)&rays[l]) : dflt;
+    __m256 t0 = _mm256_unpacklo_ps(r[0], r[1]), t1 = _mm256_unpackhi_ps(r[0], r[1]);
+    __m256 t2 = _mm256_unpacklo_ps(r[2], r[3]), t3 = _mm256_unpackhi_ps(r[2], r[3]);
+    __m256 t4 = _mm256_unpacklo_ps(r[4], r[5]), t5 = _mm256_unpackhi_ps(r[4], r[5]);
+    __m256 t6 = _mm256_unpacklo_ps(r[6], r[7]), t7 = _mm256_unpackhi_ps(r[6], r[7]);
+    __m256 q0 = _mm256_shuffle_ps(t0, t2, 0x44), q1 = _mm256_shuffle_ps(t0, t2, 0xee);
+    __m256 q2 = _mm256_shuffle_ps(t1, t3, 0x44), q3 = _mm256_shuffle_ps(t1, t3, 0xee);
+    __m256 q4 = _mm256_shuffle_ps(t4, t6, 0x44), q5 = _mm256_shuffle_ps(t4, t6, 0xee);
+    __m256 q6 = _mm256_shuffle_ps(t5, t7, 0x44), q7 = _mm256_shuffle_ps(t5, t7, 0xee);
+    const __m256 o[3] = { _mm256_permute2f128_ps(q0, q4, 0x20), _mm256_permute2f128_ps(q1, q5, 0x20),
+                          _mm256_permute2f128_ps(q2, q6, 0x20) };
+    const __m256 t_min = _mm256_permute2f128_ps(q3, q7, 0x20);
+    const __m256 d[3] = { _mm256_permute2f128_ps(q0, q4, 0x31), _mm256_permute2f128_ps(q1, q5, 0x31),
+                          _mm256_permute2f128_ps(q2, q6, 0x31) };
+    const __m256 t_max = _mm256_permute2f128_ps(q3, q7, 0x31);
+    const __m256 one = _mm256_set1_ps(1.0f), inf = _mm256_set1_ps(INFINITY), ninf = _mm256_set1_ps(-INFINITY);
+    const __m256 abs_mask = _mm256_castsi256_ps(_mm256_set1_epi32(0x7fffffff));
+    const __m256 in = lanes_vector(active);
+    p->rays = rays;
+    p->ready = 0;
+    _mm256_storeu_ps(p->t_min, t_min);
+    _mm256_storeu_ps(p->t, t_max);
+    _mm256_storeu_ps(p->t_test, t_max);
+    bool finite = true;
+    __m256 inv[3];
+    for (int a = 0; a < 3; ++a) {
+        _mm256_storeu_ps(p->o[a], o[a]);
+        _mm256_storeu_si256((__m256i *)(void *)p->neg[a], _mm256_srai_epi32(_mm256_castps_si256(d[a]), 31));
+        unsigned sign = (unsigned)_mm256_movemask_ps(d[a]) & active;
+        p->octant[a] = sign == 0 ? 0 : (sign == active ? 1 : -1);
+        inv[a] = _mm256_div_ps(one, d[a]);
+        _mm256_storeu_ps(p->inv[a], inv[a]);
+        finite = finite && ((unsigned)_mm256_movemask_ps(_mm256_cmp_ps(_mm256_and_ps(inv[a], abs_mask), inf,
+                                                                       _CMP_LT_OQ)) & active) == active;
+        p->o_lo[a] = _mm256_cvtss_f32(all_min8(_mm256_blendv_ps(inf, o[a], in)));
+        p->o_hi[a] = _mm256_cvtss_f32(all_max8(_mm256_blendv_ps(ninf, o[a], in)));
+        p->inv_lo[a] = _mm256_cvtss_f32(all_min8(_mm256_blendv_ps(inf, inv[a], in)));
+        p->inv_hi[a] = _mm256_cvtss_f32(all_max8(_mm256_blendv_ps(ninf, inv[a], in)));
+    }
+    /* The first lane's permutation (rl_watertight_axes), and the lanes
+     * with the same one: the same largest |d| component (the scalar
+     * test's comparisons) and the same sign test on it. */
+    int first = rl_bvh_lowest_bit(active);
+    rl_watertight_axes(rays[first].d, &p->kx, &p->ky, &p->kz);
+    const __m256 ax = _mm256_and_ps(d[0], abs_mask), ay = _mm256_and_ps(d[1], abs_mask),
+                 az = _mm256_and_ps(d[2], abs_mask);
+    unsigned xy = (unsigned)_mm256_movemask_ps(_mm256_cmp_ps(ax, ay, _CMP_GT_OQ));
+    unsigned xz = (unsigned)_mm256_movemask_ps(_mm256_cmp_ps(ax, az, _CMP_GT_OQ));
+    unsigned yz = (unsigned)_mm256_movemask_ps(_mm256_cmp_ps(ay, az, _CMP_GT_OQ));
+    unsigned z0 = xy & xz, z1 = ~xy & yz, z2 = ~(z0 | z1);
+    unsigned same_z = p->kz == 0 ? z0 : (p->kz == 1 ? z1 : z2);
+    unsigned below = (unsigned)_mm256_movemask_ps(_mm256_cmp_ps(d[p->kz], _mm256_setzero_ps(), _CMP_LT_OQ));
+    unsigned first_below = (below >> first) & 1u ? 0xffu : 0u;
+    p->same_k = active & same_z & ~(below ^ first_below);
+    const __m256 dz = d[p->kz];
+    _mm256_storeu_ps(p->sx, _mm256_div_ps(d[p->kx], dz));
+    _mm256_storeu_ps(p->sy, _mm256_div_ps(d[p->ky], dz));
+    _mm256_storeu_ps(p->sz, _mm256_div_ps(one, dz));
+    p->frustum = finite && p->octant[0] >= 0 && p->octant[1] >= 0 && p->octant[2] >= 0;
+    p->shared_origin = p->o_lo[0] == p->o_hi[0] && p->o_lo[1] == p->o_hi[1] && p->o_lo[2] == p->o_hi[2];
+    _mm256_storeu_ps(p->wo[0], o[p->kx]);
+    _mm256_storeu_ps(p->wo[1], o[p->ky]);
+    _mm256_storeu_ps(p->wo[2], o[p->kz]);
+}
+#endif
 
 /* Makes lane l's single-ray constants (once). */
 static inline void lane_ready(packet *p, int l)
@@ -306,6 +421,24 @@ static inline unsigned fallback_lanes(packet *p, const rl_bvh_block *b, int j, u
     return hit;
 }
 
+/* The closest-hit bookkeeping of one triangle's hit lanes (the tie rule as
+ * leaf_closest_k): a lane takes the hit if it is nearer, or as near with a
+ * lower ID. */
+static inline void take_hits(packet *p, rl_bvh_closest *c, unsigned hit, const float *th, const float *u,
+                             const float *v, uint32_t id)
+{
+    for (; hit; hit &= hit - 1) {
+        int l = rl_bvh_lowest_bit(hit);
+        if (!(th[l] < c[l].t_test))
+            continue;
+        if (th[l] < c[l].t || id < c[l].id) {
+            c[l] = (rl_bvh_closest){ th[l], rl_bvh_next_up(th[l]), u[l], v[l], id };
+            p->t[l] = th[l];
+            p->t_test[l] = c[l].t_test;
+        }
+    }
+}
+
 /* Closest hits of a leaf for the lanes of mask (all in same_k), one
  * triangle against all lanes at a time; the tie rule as leaf_closest_k. */
 static void leaf_packet_closest(const rl_bvh *bvh, uint32_t ref, uint32_t count, packet *p, unsigned mask,
@@ -319,16 +452,7 @@ static void leaf_packet_closest(const rl_bvh *bvh, uint32_t ref, uint32_t count,
         tri_of(b, j, p, P);
         unsigned hit = tri_lanes(p, P[0], P[1], P[2], mask, p->t_test, th, u, v, &fallback);
         hit |= fallback_lanes(p, b, j, fallback, p->t_test, th, u, v);
-        for (; hit; hit &= hit - 1) {
-            int l = rl_bvh_lowest_bit(hit);
-            if (!(th[l] < c[l].t_test))
-                continue;
-            if (th[l] < c[l].t || b->id[j] < c[l].id) {
-                c[l] = (rl_bvh_closest){ th[l], rl_bvh_next_up(th[l]), u[l], v[l], b->id[j] };
-                p->t[l] = th[l];
-                p->t_test[l] = c[l].t_test;
-            }
-        }
+        take_hits(p, c, hit, th, u, v, b->id[j]);
     }
 }
 
@@ -415,43 +539,120 @@ static inline unsigned child_lanes(const rl_bvh_wide_node *n, int i, const packe
 }
 
 #if defined(__AVX__) && RL_BVH_WIDTH == 8
-/* A quick reject of the children that no lane of the packet can hit, all
- * children at once (Wald 2001's packets share a frustum; here its
- * interval form): per axis the lanes' slab distance (b - o)·(1/d) lies
- * between the least and the greatest product of the interval ends, b -
- * o_hi .. b - o_lo and inv_lo .. inv_hi. Rounding is monotone, so those
- * products, rounded, also bound every lane's rounded distance: a child
- * rejected here fails child_lanes' test on every lane (lo >= LO and hi <=
- * HI per lane), and the exact result does not change. */
-static inline unsigned frustum_children(const rl_bvh_wide_node *n, const packet *p, unsigned mask)
+/* All ones in the lanes of mask. */
+static inline __m256 lanes_vector(unsigned mask)
 {
-    float t_lo = INFINITY, t_hi = -INFINITY;
-    for (unsigned m = mask; m; m &= m - 1) {
-        int l = rl_bvh_lowest_bit(m);
-        t_lo = p->t_min[l] < t_lo ? p->t_min[l] : t_lo;
-        t_hi = p->t[l] > t_hi ? p->t[l] : t_hi;
-    }
-    __m256 LO = _mm256_set1_ps(t_lo), HI = _mm256_set1_ps(t_hi);
+#if defined(__AVX2__)
+    const __m256i bits = _mm256_setr_epi32(1, 2, 4, 8, 16, 32, 64, 128);
+    return _mm256_castsi256_ps(_mm256_cmpeq_epi32(_mm256_and_si256(_mm256_set1_epi32((int)mask), bits), bits));
+#else
+    int32_t m[LANES];
+    for (int l = 0; l < LANES; ++l)
+        m[l] = (mask >> l) & 1u ? -1 : 0;
+    return _mm256_castsi256_ps(_mm256_loadu_si256((const __m256i *)(const void *)m));
+#endif
+}
+
+/* v's least / greatest lane in every lane. */
+static inline __m256 all_min8(__m256 v)
+{
+    v = _mm256_min_ps(v, _mm256_permute2f128_ps(v, v, 1));
+    v = _mm256_min_ps(v, _mm256_permute_ps(v, 0x4e));
+    return _mm256_min_ps(v, _mm256_permute_ps(v, 0xb1));
+}
+
+static inline __m256 all_max8(__m256 v)
+{
+    v = _mm256_max_ps(v, _mm256_permute2f128_ps(v, v, 1));
+    v = _mm256_max_ps(v, _mm256_permute_ps(v, 0x4e));
+    return _mm256_max_ps(v, _mm256_permute_ps(v, 0xb1));
+}
+
+/* The packet's frustum against all children at once (Wald 2001's packets
+ * share a frustum; here its interval form): per axis the lanes' slab
+ * distance (b - o)·(1/d) lies between the least and the greatest product
+ * of the interval ends, b - o_hi .. b - o_lo and inv_lo .. inv_hi (one
+ * product each when the lanes share their origin). Rounding is monotone,
+ * so those products, rounded, also bound every lane's rounded distance.
+ * Returns the children that some lane may hit: the others fail
+ * child_lanes' test on every lane (lo >= LO and hi <= HI per lane), so
+ * the exact result does not change. *all: the children that every lane of
+ * mask hits for sure (each lane's lo <= LO_in and hi >= HI_in, and LO_in,
+ * HI_in pass the slack test, so the lane's own pass it too): child_lanes
+ * would return all of mask, and is skipped. lo: per child a lower bound of
+ * every lane's entry distance, the distance such a child's entry gets
+ * (a pop then keeps a lane at least as long as with its exact distance,
+ * which visits more, never less: the closest hit does not depend on the
+ * order or on extra visits, see the top). */
+static inline unsigned frustum_children(const rl_bvh_wide_node *n, const packet *p, unsigned mask, unsigned *all,
+                                        float lo[LANES])
+{
+    const __m256 in = lanes_vector(mask);
+    const __m256 inf = _mm256_set1_ps(INFINITY), ninf = _mm256_set1_ps(-INFINITY);
+    const __m256 t_min = _mm256_loadu_ps(p->t_min), t = _mm256_loadu_ps(p->t);
+    /* Outer bounds (some lane): the least t_min, the greatest t; inner
+     * bounds (every lane): the greatest t_min, the least t. */
+    __m256 LO = all_min8(_mm256_blendv_ps(inf, t_min, in)), HI = all_max8(_mm256_blendv_ps(ninf, t, in));
+    __m256 LO_in = all_max8(_mm256_blendv_ps(ninf, t_min, in)), HI_in = all_min8(_mm256_blendv_ps(inf, t, in));
     for (int a = 0; a < 3; ++a) {
         const __m256 bn = _mm256_loadu_ps(p->octant[a] ? n->bmax[a] : n->bmin[a]);
         const __m256 bf = _mm256_loadu_ps(p->octant[a] ? n->bmin[a] : n->bmax[a]);
         const __m256 olo = _mm256_set1_ps(p->o_lo[a]), ohi = _mm256_set1_ps(p->o_hi[a]);
         const __m256 i0 = _mm256_set1_ps(p->inv_lo[a]), i1 = _mm256_set1_ps(p->inv_hi[a]);
-        __m256 d0 = _mm256_sub_ps(bn, ohi), d1 = _mm256_sub_ps(bn, olo);
-        __m256 near = _mm256_min_ps(_mm256_min_ps(_mm256_mul_ps(d0, i0), _mm256_mul_ps(d0, i1)),
-                                    _mm256_min_ps(_mm256_mul_ps(d1, i0), _mm256_mul_ps(d1, i1)));
-        __m256 e0 = _mm256_sub_ps(bf, ohi), e1 = _mm256_sub_ps(bf, olo);
-        __m256 far = _mm256_max_ps(_mm256_max_ps(_mm256_mul_ps(e0, i0), _mm256_mul_ps(e0, i1)),
-                                   _mm256_max_ps(_mm256_mul_ps(e1, i0), _mm256_mul_ps(e1, i1)));
-        LO = _mm256_max_ps(near, LO);
-        HI = _mm256_min_ps(far, HI);
+        __m256 near_lo, near_hi, far_lo, far_hi;
+        if (p->shared_origin) {
+            const __m256 d = _mm256_sub_ps(bn, olo), e = _mm256_sub_ps(bf, olo);
+            const __m256 n0 = _mm256_mul_ps(d, i0), n1 = _mm256_mul_ps(d, i1);
+            const __m256 f0 = _mm256_mul_ps(e, i0), f1 = _mm256_mul_ps(e, i1);
+            near_lo = _mm256_min_ps(n0, n1);
+            near_hi = _mm256_max_ps(n0, n1);
+            far_lo = _mm256_min_ps(f0, f1);
+            far_hi = _mm256_max_ps(f0, f1);
+        } else {
+            const __m256 d0 = _mm256_sub_ps(bn, ohi), d1 = _mm256_sub_ps(bn, olo);
+            const __m256 e0 = _mm256_sub_ps(bf, ohi), e1 = _mm256_sub_ps(bf, olo);
+            const __m256 n00 = _mm256_mul_ps(d0, i0), n01 = _mm256_mul_ps(d0, i1);
+            const __m256 n10 = _mm256_mul_ps(d1, i0), n11 = _mm256_mul_ps(d1, i1);
+            const __m256 f00 = _mm256_mul_ps(e0, i0), f01 = _mm256_mul_ps(e0, i1);
+            const __m256 f10 = _mm256_mul_ps(e1, i0), f11 = _mm256_mul_ps(e1, i1);
+            near_lo = _mm256_min_ps(_mm256_min_ps(n00, n01), _mm256_min_ps(n10, n11));
+            near_hi = _mm256_max_ps(_mm256_max_ps(n00, n01), _mm256_max_ps(n10, n11));
+            far_lo = _mm256_min_ps(_mm256_min_ps(f00, f01), _mm256_min_ps(f10, f11));
+            far_hi = _mm256_max_ps(_mm256_max_ps(f00, f01), _mm256_max_ps(f10, f11));
+        }
+        LO = _mm256_max_ps(near_lo, LO);
+        HI = _mm256_min_ps(far_hi, HI);
+        LO_in = _mm256_max_ps(near_hi, LO_in);
+        HI_in = _mm256_min_ps(far_lo, HI_in);
     }
-    /* NaN (never expected: finite 1/d, finite origins) keeps the child. */
-    __m256 miss = _mm256_cmp_ps(_mm256_mul_ps(LO, _mm256_set1_ps(SLACK_LO)),
-                                _mm256_mul_ps(HI, _mm256_set1_ps(SLACK_HI)), _CMP_GT_OQ);
+    _mm256_storeu_ps(lo, LO);
+    const __m256 slo = _mm256_set1_ps(SLACK_LO), shi = _mm256_set1_ps(SLACK_HI);
+    /* NaN (never expected: finite 1/d, finite origins) keeps the child for
+     * the exact test, and makes no child sure. */
+    __m256 miss = _mm256_cmp_ps(_mm256_mul_ps(LO, slo), _mm256_mul_ps(HI, shi), _CMP_GT_OQ);
+    __m256 sure = _mm256_cmp_ps(_mm256_mul_ps(LO_in, slo), _mm256_mul_ps(HI_in, shi), _CMP_LE_OQ);
+    *all = RL_BVH_PACKET_SURE ? (unsigned)_mm256_movemask_ps(sure) : 0u;
     return ~(unsigned)_mm256_movemask_ps(miss) & 0xffu;
 }
 #endif
+
+/* Appends child i of n as hit[*k] (its dist already there) and inserts it
+ * into order, descending by key. */
+static inline void add_child(const rl_bvh *bvh, const rl_bvh_wide_node *n, int i, unsigned lanes, float least,
+                             pentry *hit, float *key, int *order, int *k)
+{
+    hit[*k].ref = n->child[i];
+    hit[*k].count = n->count[i];
+    hit[*k].mask = lanes;
+    rl_bvh_prefetch(bvh, hit[*k].ref, hit[*k].count);
+    key[*k] = least;
+    int j = (*k)++;
+    while (j > 0 && key[order[j - 1]] < least) {
+        order[j] = order[j - 1];
+        --j;
+    }
+    order[j] = *k - 1;
+}
 
 /* The children of n that some lane of mask hits: pushed farthest first (by
  * their least entry distance), the nearest returned in *next; false when
@@ -464,31 +665,32 @@ static bool visit_packet(const rl_bvh *bvh, const rl_bvh_wide_node *n, const pac
     int order[RL_BVH_WIDTH];
     int k = 0;
     /* Used slots: unused ones have inverted bounds. */
+#if defined(__AVX__) && RL_BVH_WIDTH == 8
+    unsigned used = (unsigned)_mm256_movemask_ps(
+        _mm256_cmp_ps(_mm256_loadu_ps(n->bmin[0]), _mm256_loadu_ps(n->bmax[0]), _CMP_LE_OQ));
+    if (p->frustum) {
+        float lo[LANES];
+        unsigned all = 0;
+        used &= frustum_children(n, p, mask, &all, lo);
+        /* Every lane hits these (frustum_children): no per-lane test. */
+        for (all &= used; all; all &= all - 1) {
+            int i = rl_bvh_lowest_bit(all);
+            used &= ~(1u << i);
+            _mm256_storeu_ps(hit[k].dist, _mm256_set1_ps(lo[i]));
+            add_child(bvh, n, i, mask, lo[i], hit, key, order, &k);
+        }
+    }
+#else
     unsigned used = 0;
     for (int i = 0; i < RL_BVH_WIDTH; ++i)
         used |= (n->bmin[0][i] <= n->bmax[0][i]) ? 1u << i : 0u;
-#if defined(__AVX__) && RL_BVH_WIDTH == 8
-    if (p->frustum)
-        used &= frustum_children(n, p, mask);
 #endif
     for (; used; used &= used - 1) {
         int i = rl_bvh_lowest_bit(used);
         float least = 0.0f;
         unsigned lanes = child_lanes(n, i, p, mask, hit[k].dist, &least);
-        if (!lanes)
-            continue;
-        hit[k].ref = n->child[i];
-        hit[k].count = n->count[i];
-        hit[k].mask = lanes;
-        rl_bvh_prefetch(bvh, hit[k].ref, hit[k].count);
-        key[k] = least;
-        /* Insertion into the order, descending by key. */
-        int j = k++;
-        while (j > 0 && key[order[j - 1]] < least) {
-            order[j] = order[j - 1];
-            --j;
-        }
-        order[j] = k - 1;
+        if (lanes)
+            add_child(bvh, n, i, lanes, least, hit, key, order, &k);
     }
     if (!k)
         return false;

@@ -247,6 +247,102 @@ static void test_packet_kernel_equals_single_rays_on_random_packets(void **state
     rl_scene_release(s);
 }
 
+/* Narrow packets, the frustum's domain (frustum_children: its reject and
+ * its shortcut for the children that every lane surely hits decide most
+ * nodes): one shared origin or origins within a small box, directions in
+ * a cone of random width (1e-6 to 0.1 rad) around a triangle's vertex or
+ * centroid (so lanes run along edges and graze the boxes' faces, the flat
+ * boxes of walls included), random active masks, per-lane t_min and
+ * t_max; each lane against the single-ray traversal, bit for bit. */
+static void assert_narrow_packets_equal_single_rays(const char *scene, const char *params, uint64_t seed)
+{
+    rl_scene *s = builtin(scene, params);
+    const rl_scene_data *d = rl_scene_get_data(s);
+    rl_bvh bvh = { 0 };
+    rl_accel_stats st = { 0 };
+    assert_int_equal(rl_bvh_build(d, &(rl_accel_desc){ .threads = 1 }, &bvh, &st), RL_OK);
+    assert_int_equal(rl_bvh_widen(&bvh), RL_OK);
+    rl_rng rng;
+    rl_rng_seed(&rng, seed, 7);
+    float extent = rl_vmax_comp(rl_aabb_extent(d->bounds));
+    int hits = 0, blocked = 0, lanes = 0;
+    for (int packet = 0; packet < 3000; ++packet) {
+        uint32_t tri = (uint32_t)(rl_rng_float(&rng) * (float)d->num_triangles) % d->num_triangles;
+        rl_vec3 v[3];
+        for (int k = 0; k < 3; ++k)
+            v[k] = d->positions[d->indices[3 * (size_t)tri + (size_t)k]];
+        int corner = (int)(rl_rng_float(&rng) * 4.0f);
+        rl_vec3 target = corner < 3 ? v[corner] : rl_scale(rl_add(rl_add(v[0], v[1]), v[2]), 1.0f / 3.0f);
+        float z = 2.0f * rl_rng_float(&rng) - 1.0f, phi = 2.0f * RL_PI * rl_rng_float(&rng);
+        float r = sqrtf(fmaxf(0.0f, 1.0f - z * z));
+        float dist = extent * (0.02f + 1.5f * rl_rng_float(&rng));
+        rl_vec3 eye = rl_add(target, rl_scale(rl_v3(r * cosf(phi), r * sinf(phi), z), dist));
+        float cone = powf(10.0f, -1.0f - 5.0f * rl_rng_float(&rng)) * dist;
+        float spread = packet % 3 == 0 ? 0.0f : cone * rl_rng_float(&rng);
+        rl_ray rays[RL_BVH_PACKET], single[RL_BVH_PACKET];
+        rl_hit hit[RL_BVH_PACKET];
+        unsigned active = 0;
+        for (int l = 0; l < RL_BVH_PACKET; ++l) {
+            rl_vec3 o = rl_add(eye, rl_v3(spread * (rl_rng_float(&rng) - 0.5f), spread * (rl_rng_float(&rng) - 0.5f),
+                                          spread * (rl_rng_float(&rng) - 0.5f)));
+            rl_vec3 at = l == 0 ? target
+                                : rl_add(target, rl_v3(cone * (rl_rng_float(&rng) - 0.5f), cone * (rl_rng_float(&rng) - 0.5f),
+                                                       cone * (rl_rng_float(&rng) - 0.5f)));
+            rl_vec3 dir = rl_sub(at, o);
+            rays[l] = (rl_ray){ .o = o, .t_min = 0.0f, .d = rl_scale(dir, 1.0f / rl_length(dir)), .t_max = INFINITY };
+            if (rl_rng_float(&rng) < 0.3f)
+                rays[l].t_max = dist * 2.0f * rl_rng_float(&rng);
+            if (rl_rng_float(&rng) < 0.2f)
+                rays[l].t_min = rays[l].t_max * 0.5f * rl_rng_float(&rng);
+            if (rl_rng_float(&rng) < 0.9f)
+                active |= 1u << l;
+            single[l] = rays[l];
+            hit[l] = (rl_hit){ .object = RL_ID_NONE };
+        }
+        unsigned found = rl_bvh_packet_intersect(&bvh, rays, hit, active);
+        unsigned occ = rl_bvh_packet_occluded(&bvh, single, active);
+        assert_int_equal(found & ~active, 0);
+        assert_int_equal(occ & ~active, 0);
+        for (int l = 0; l < RL_BVH_PACKET; ++l) {
+            if (!(active & (1u << l)))
+                continue;
+            ++lanes;
+            rl_ray q = single[l];
+            rl_hit h = { .object = RL_ID_NONE };
+            bool got = rl_bvh_wide_intersect(&bvh, &q, &h);
+            if (got != (bool)((found >> l) & 1u) ||
+                (got && (hit[l].triangle != h.triangle || !same_float(hit[l].t, h.t) || !same_float(hit[l].u, h.u) ||
+                         !same_float(hit[l].v, h.v) || !same_float(rays[l].t_max, q.t_max))))
+                fail_msg("%s packet %d lane %d: packet %d triangle %u t %.9g, single %d triangle %u t %.9g", scene,
+                         packet, l, (int)((found >> l) & 1u), hit[l].triangle, (double)hit[l].t, got, h.triangle,
+                         (double)h.t);
+            hits += got;
+            bool o = rl_bvh_wide_occluded(&bvh, &single[l]);
+            if (o != (bool)((occ >> l) & 1u))
+                fail_msg("%s packet %d lane %d: packet occluded %d, single %d", scene, packet, l,
+                         (int)((occ >> l) & 1u), o);
+            blocked += o;
+        }
+    }
+    print_message("%s: %d narrow-packet lanes, %d hits, %d blocked\n", scene, lanes, hits, blocked);
+    assert_true(hits > lanes / 4 && hits < lanes);
+    assert_true(blocked > lanes / 4 && blocked < lanes);
+    rl_bvh_free(&bvh);
+    rl_scene_release(s);
+}
+
+static void test_narrow_packets_equal_single_rays_cornell(void **state)
+{
+    (void)state;
+    assert_narrow_packets_equal_single_rays("cornell", NULL, 21);
+}
+
+static void test_narrow_packets_equal_single_rays_teapot(void **state)
+{
+    (void)state;
+    assert_narrow_packets_equal_single_rays("cornell-teapot", "triangles=2000", 22);
+}
+
 /* A 16x16 quad grid at z = 0 and its exact copy (coplanar: every hit is a
  * tie at equal t), rays aimed at its vertices and edge midpoints from
  * above: the lowest triangle ID must win in both paths. */
@@ -378,6 +474,8 @@ int main(void)
         cmocka_unit_test(test_coherent_batches_equal_single_rays_teapot),
         cmocka_unit_test(test_coherent_batches_equal_single_rays_city),
         cmocka_unit_test(test_packet_kernel_equals_single_rays_on_random_packets),
+        cmocka_unit_test(test_narrow_packets_equal_single_rays_cornell),
+        cmocka_unit_test(test_narrow_packets_equal_single_rays_teapot),
         cmocka_unit_test(test_ties_on_shared_edges_go_to_the_lowest_id),
         cmocka_unit_test(test_batches_skip_alpha_mask_holes_as_single_rays_do),
     };
