@@ -140,6 +140,26 @@ typedef struct refine_ctx {
     uint8_t *face_shaft;  uint32_t face_shaft_cap;
 } refine_ctx;
 
+/* Room for need edges in the stage's batch, as vt_array_resize's: a stage
+ * at min_edge 1 holds hundreds of thousands, and a realloc'd batch left each
+ * smaller copy behind in the heap, resident to the frame's peak. */
+static bool batch_reserve(refine_ctx *ctx, uint32_t need)
+{
+    if (need <= ctx->batch_cap)
+        return true;
+    uint64_t cap = ctx->batch_cap ? ctx->batch_cap : 1024;
+    while (cap < need)
+        cap *= 2;
+    if (cap > UINT32_MAX)
+        return false;
+    uint32_t *p = vt_array_resize(ctx->batch, (size_t)ctx->batch_cap * sizeof *p, (size_t)cap * sizeof *p);
+    if (!p)
+        return false;
+    ctx->batch = p;
+    ctx->batch_cap = (uint32_t)cap;
+    return true;
+}
+
 /* A package of a distributed frame (run->seed) refines its own faces: an
  * edge is its business when a face on either side descends from one of
  * them (or, with dist_postpass, from a face hidden in the ID test). Splits of border edges reach into the neighbours, whose insides
@@ -343,13 +363,19 @@ static void run_stage(refine_ctx *ctx, uint16_t stage)
     uint32_t e;
     float length;
     while (vt_heap_top(run->heap) >= band && vt_heap_pop(run->heap, &e, &length)) {
-        if (!rl_reserve_u32((void **)&ctx->batch, &ctx->batch_cap, (uint64_t)ctx->batch_count + 1, sizeof *ctx->batch, 1024)) {
+        if (!batch_reserve(ctx, ctx->batch_count + 1)) {
             run->failed = true;
             return;
         }
         vt_edge_set_queued(m, e, false);
         ctx->batch[ctx->batch_count++] = e;
     }
+    /* The stage's edges moved from the list to the batch: the list's room
+     * goes back now. Its touched pages otherwise stayed resident to the
+     * end of the refinement, where the frame peaks with the whole mesh
+     * (2.2 MB of that peak on table at 1024^2 with deferred_split, an RSS
+     * trace; bench/README.md, "Memory, fourth pass"). */
+    vt_heap_shrink(run->heap);
     for (uint32_t i = 0; i < ctx->batch_count && !run->failed; ++i) {
         if (!budget_left(run))
             break;
@@ -581,7 +607,7 @@ rl_status vt_refine(vt_run *run)
 #pragma omp single
     refine_all(&ctx);
     double wall = now_ms() - t0;
-    free(ctx.batch);
+    vt_array_free(ctx.batch, (size_t)ctx.batch_cap * sizeof *ctx.batch);
     free(ctx.forced);
     free(ctx.face_shaft);
     vt_shaft_index_free(&ctx.shafts);

@@ -981,6 +981,45 @@ static void progressive_updates(void **state)
     rl_scene_release(s);
 }
 
+/* A frame expected to refine far and drawn without an update callback gives
+ * its rasterizer back during the refinement and, for an image without a
+ * depth layer, its scratch depth too; the rasterized half is drawn again
+ * before the final draw (run_frame, bench/README.md "Memory, fourth pass").
+ * A renderer's first frame takes that path; after a small frame the next
+ * keeps both, and so does a frame with an update callback, whose draws need
+ * them meanwhile. All three must give the same pixels, and the first two
+ * the same counters: the second draw of the rasterized half is not counted
+ * (the callback's preview draw is, so its counters differ). */
+static void given_back_buffers_change_nothing(void **state)
+{
+    (void)state;
+    rl_scene *s = floor_scene(true);
+    rl_camera cam = look(rl_v3(0.0f, 5.0f, 3.0f), rl_v3(0.0f, 0.0f, 0.0f), 96);
+    const char *opts[] = { "criteria", "tree", NULL };
+    rl_renderer *plain = make_vt(opts), *kept = make_vt(opts);
+    updates u = { 0, 0, 0, 0 };
+    assert_int_equal(rl_vt_set_update_callback(kept, on_update, &u), RL_OK);
+    const size_t n = (size_t)cam.width * (size_t)cam.height;
+    rl_render_stats first, next, with_callback;
+    rl_image *given = fx_render_with(plain, s, &cam, RL_LAYER_COLOR, &first);
+    rl_image *small = fx_render_with(plain, s, &cam, RL_LAYER_COLOR, &next);
+    rl_image *updated = fx_render_with(kept, s, &cam, RL_LAYER_COLOR, &with_callback);
+    assert_null(given->depth);
+    assert_int_equal(u.finals, 1);
+    assert_memory_equal(given->color, small->color, n * sizeof *given->color);
+    assert_memory_equal(given->color, updated->color, n * sizeof *given->color);
+    assert_true(first.triangles_rasterized > 0 && first.samples > 0);
+    assert_int_equal(first.triangles_rasterized, next.triangles_rasterized);
+    assert_int_equal(first.pixels_written, next.pixels_written);
+    assert_int_equal(first.samples, next.samples);
+    rl_image_release(given);
+    rl_image_release(small);
+    rl_image_release(updated);
+    rl_renderer_release(plain);
+    rl_renderer_release(kept);
+    rl_scene_release(s);
+}
+
 /* A camera that sees nothing renders the background and traces nothing. */
 static void nothing_in_view(void **state)
 {
@@ -1806,6 +1845,7 @@ int main(void)
         cmocka_unit_test(deterministic_and_coherent),
         cmocka_unit_test(kept_buffers_follow_size_threads_and_layers),
         cmocka_unit_test(progressive_updates),
+        cmocka_unit_test(given_back_buffers_change_nothing),
         cmocka_unit_test(deferred_textures_keep_the_texture),
         cmocka_unit_test(overdraw_offset_lets_children_win),
         cmocka_unit_test(nothing_in_view),
