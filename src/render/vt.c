@@ -72,6 +72,7 @@ static const char *const nonlinear_choices[] = { "off", "extremum", "interval", 
 static const char *const shaft_choices[] = { "off", "shadow", "all", NULL };
 static const char *const hint_choices[] = { "off", "agree", "parents", NULL };   /* VT_HINT_* */
 static const char *const tree_shadow_choices[] = { "blocked", "visible", "occluder", "none", NULL };   /* VT_TREE_SHADOW_* */
+static const char *const pixel_split_choices[] = { "off", "inside", "both", NULL };   /* VT_PIXEL_SPLIT_* */
 enum { RECONSTRUCT_SOFTWARE, RECONSTRUCT_GL };
 
 static const rl_option_info vt_options[] = {
@@ -127,6 +128,13 @@ static const rl_option_info vt_options[] = {
       "the criteria also see the deferred reflected and transmitted textures, looked up at the vertices "
       "(ours, against the distortion of Fig. 5.8; false: the thesis, Sec. 3.5.3, refines on untextured "
       "radiance)", 0, 0, NULL },
+    { "pixel_split", RL_OPT_ENUM, "off",
+      "ours, against Gouraud ramps over the last face at a discontinuity (Sec. 3.5): an edge at or below "
+      "min_edge whose ends a criterion tells apart is still split, down to pixel_floor, where one of its faces "
+      "holds a pixel centre (inside) or pixel centres on both sides of the split (both); off: the thesis, "
+      "nothing below min_edge", 0, 0, pixel_split_choices },
+    { "pixel_floor", RL_OPT_FLOAT, "0.25", "pixel_split: edges this short or shorter are not split (px)",
+      0.05, 1e6, NULL },
     { "textures", RL_OPT_ENUM, "multitexture",
       "deferred textures: multitexture (eq. 3.20, one pass), multipass (eq. 3.22), sampled (no deferral)",
       0, 0, texture_choices },
@@ -466,6 +474,8 @@ static void read_settings(rl_renderer *r, vt_settings *set)
     set->tree_shadow = rl_renderer_opt_enum(r, "tree_shadow");
     set->tree_depth = (int)rl_renderer_opt_int(r, "tree_depth");
     set->deferred_split = rl_renderer_opt_bool(r, "deferred_split");
+    set->pixel_split = rl_renderer_opt_enum(r, "pixel_split");
+    set->pixel_floor = (float)rl_renderer_opt_float(r, "pixel_floor");
 }
 
 /* What the cached feelers depend on besides the scene. */
