@@ -296,6 +296,7 @@ static cJSON *vt_stats_json(const rl_vt_stats *s)
         { "vertices_merged", s->vertices_merged },
         { "splits_nonlinear", s->splits_nonlinear },
         { "splits_shaft", s->splits_shaft },
+        { "splits_pixel", s->splits_pixel },
         { "shaft_faces_tested", s->shaft_faces_tested },
         { "hint_tests", s->hint_tests },
         { "hint_hits", s->hint_hits },

@@ -68,6 +68,9 @@ typedef struct rl_vt_stats {
      * sample a part carried, and vertices it traced itself: the places
      * where the merged packages differ from one process. */
     uint64_t postpass_reused, postpass_traced;
+    /* option pixel_split: edges at or below min_edge split because a
+     * criterion fired and a pixel centre shows the split */
+    uint64_t splits_pixel;
 } rl_vt_stats;
 
 /* Statistics of the last frame rendered by r. RL_ERR_INVALID_ARG when r is

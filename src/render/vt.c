@@ -72,6 +72,7 @@ static const char *const nonlinear_choices[] = { "off", "extremum", "interval", 
 static const char *const shaft_choices[] = { "off", "shadow", "all", NULL };
 static const char *const hint_choices[] = { "off", "agree", "parents", NULL };   /* VT_HINT_* */
 static const char *const tree_shadow_choices[] = { "blocked", "visible", "occluder", "none", NULL };   /* VT_TREE_SHADOW_* */
+static const char *const pixel_split_choices[] = { "off", "inside", "both", NULL };   /* VT_PIXEL_SPLIT_* */
 enum { RECONSTRUCT_SOFTWARE, RECONSTRUCT_GL };
 
 static const rl_option_info vt_options[] = {
@@ -127,6 +128,13 @@ static const rl_option_info vt_options[] = {
       "the criteria also see the deferred reflected and transmitted textures, looked up at the vertices "
       "(ours, against the distortion of Fig. 5.8; false: the thesis, Sec. 3.5.3, refines on untextured "
       "radiance)", 0, 0, NULL },
+    { "pixel_split", RL_OPT_ENUM, "off",
+      "ours, against Gouraud ramps over the last face at a discontinuity (Sec. 3.5): an edge at or below "
+      "min_edge whose ends a criterion tells apart is still split, down to pixel_floor, where one of its faces "
+      "holds a pixel centre (inside) or pixel centres on both sides of the split (both); off: the thesis, "
+      "nothing below min_edge", 0, 0, pixel_split_choices },
+    { "pixel_floor", RL_OPT_FLOAT, "0.25", "pixel_split: edges this short or shorter are not split (px)",
+      0.05, 1e6, NULL },
     { "textures", RL_OPT_ENUM, "multitexture",
       "deferred textures: multitexture (eq. 3.20, one pass), multipass (eq. 3.22), sampled (no deferral)",
       0, 0, texture_choices },
@@ -466,6 +474,8 @@ static void read_settings(rl_renderer *r, vt_settings *set)
     set->tree_shadow = rl_renderer_opt_enum(r, "tree_shadow");
     set->tree_depth = (int)rl_renderer_opt_int(r, "tree_depth");
     set->deferred_split = rl_renderer_opt_bool(r, "deferred_split");
+    set->pixel_split = rl_renderer_opt_enum(r, "pixel_split");
+    set->pixel_floor = (float)rl_renderer_opt_float(r, "pixel_floor");
 }
 
 /* What the cached feelers depend on besides the scene. */
@@ -726,6 +736,33 @@ static rl_status run_frame(vt_run *run, vt_state *s, const vt_settings *set, rl_
     double t0 = rl_time_s() * 1000.0;
     if (st == RL_OK)
         st = run_prepass(s, run);
+    /* The rasterizer is not used again until the final draw unless an
+     * update callback draws meanwhile. Its scratch (set-up triangles of
+     * the pre-pass' largest draw, their bins, clip-space vertices) and the
+     * scene drawer's freed buffers would stay resident through a long
+     * refinement, to its end, where such a frame peaks with the whole mesh;
+     * a frame expected to refine far (as the pre-pass image, s->small_frames)
+     * gives them back and makes a rasterizer anew for the final draw
+     * (bench/README.md, "Memory, fourth pass"). */
+    const bool drop_raster = st == RL_OK && !s->small_frames && !run->update;
+    /* So does the frame's depth where the image has none (the scratch
+     * depth, 4 MB at 1024^2): it holds the rasterized half's depth, which
+     * only the final draw reads again. That half (Fig. 3.17) is drawn again
+     * before the final draw instead, the same pixels (the draw is
+     * deterministic), its counters not counted twice: a few tens of ms of a
+     * frame that samples for seconds. */
+    const bool drop_base = drop_raster && !run->drawer && s->scratch_depth &&
+                           (!(image->layers & RL_LAYER_DEPTH) || !image->depth);
+    if (drop_raster) {
+        rl_raster_release(s->ras);
+        s->ras = run->ras = NULL;
+        if (drop_base) {
+            free(s->scratch_depth);
+            s->scratch_depth = run->scratch_depth = NULL;
+            s->scratch_pixels = 0;
+        }
+        give_back_freed();
+    }
     /* The rasterized half drawn inside the pre-pass counts as drawing. */
     run->stats.time_visibility_ms = rl_time_s() * 1000.0 - t0 - run->stats.time_draw_ms;
     if (st == RL_OK)
@@ -753,6 +790,22 @@ static rl_status run_frame(vt_run *run, vt_state *s, const vt_settings *set, rl_
          * primary edges (vt_mesh_reset). */
         vt_mesh_drop_refined_edges(run->mesh);
         give_back_freed();
+    }
+    if (st == RL_OK && !s->ras) {
+        st = rl_raster_create(&(rl_raster_desc){ .threads = set->threads }, &s->ras);
+        run->ras = s->ras;
+    }
+    if (st == RL_OK && drop_base) {
+        const size_t n = (size_t)image->width * (size_t)image->height;
+        if (!(s->scratch_depth = rl_realloc_array(NULL, n, sizeof *s->scratch_depth))) {
+            st = rl_error(RL_ERR_OUT_OF_MEMORY, "vt: depth of %dx%d pixels", image->width, image->height);
+        } else {
+            s->scratch_pixels = n;
+            run->scratch_depth = s->scratch_depth;
+            const rl_raster_counters counted = run->counters;
+            st = vt_draw_base(run);
+            run->counters = counted;
+        }
     }
     if (st == RL_OK) {
         double td = rl_time_s() * 1000.0;

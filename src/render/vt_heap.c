@@ -85,6 +85,25 @@ float vt_heap_top(const vt_heap *h)
     return h->count ? h->items[0].length : -INFINITY;
 }
 
+void vt_heap_shrink(vt_heap *h)
+{
+    /* Growth doubles from 1024, so the room stays 1024 times a power of
+     * two; the smallest such room with half of it free is kept. The items
+     * are the same in the same places: the pops do not change. */
+    if (h->count > VT_HEAP_MAX_ITEMS / 2)
+        return;
+    uint32_t cap = 1024;
+    while (cap < h->count || cap - h->count < cap / 2)
+        cap *= 2;
+    if (cap >= h->cap || h->cap - cap < 4096)
+        return;
+    vt_heap_item *items = vt_array_resize(h->items, (size_t)h->cap * sizeof *items, (size_t)cap * sizeof *items);
+    if (!items)
+        return;                   /* the larger room stays: only memory */
+    h->items = items;
+    h->cap = cap;
+}
+
 void vt_heap_clear(vt_heap *h)
 {
     h->count = 0;

@@ -400,6 +400,14 @@ rl_status vt_heap_push(vt_heap *h, uint32_t edge, float length);
 bool vt_heap_pop(vt_heap *h, uint32_t *edge, float *length);
 /* Length of the top element; -INFINITY when empty. */
 float vt_heap_top(const vt_heap *h);
+/* Gives back the room of an edge list that emptied: down to the smallest
+ * room (1024 times a power of two) at most half full, when that frees
+ * 32 KB or more. The items and their order stay. Through
+ * vt_array_resize, shrinking returns the pages at once. The refinement
+ * calls it once a stage has taken its edges off the list: the pages of
+ * the list's longest moment otherwise stay resident to the refinement's
+ * end, where the frame peaks (bench/README.md, "Memory, fourth pass"). */
+void vt_heap_shrink(vt_heap *h);
 void vt_heap_clear(vt_heap *h);
 void vt_heap_free(vt_heap *h);
 

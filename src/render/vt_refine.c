@@ -140,6 +140,26 @@ typedef struct refine_ctx {
     uint8_t *face_shaft;  uint32_t face_shaft_cap;
 } refine_ctx;
 
+/* Room for need edges in the stage's batch, as vt_array_resize's: a stage
+ * at min_edge 1 holds hundreds of thousands, and a realloc'd batch left each
+ * smaller copy behind in the heap, resident to the frame's peak. */
+static bool batch_reserve(refine_ctx *ctx, uint32_t need)
+{
+    if (need <= ctx->batch_cap)
+        return true;
+    uint64_t cap = ctx->batch_cap ? ctx->batch_cap : 1024;
+    while (cap < need)
+        cap *= 2;
+    if (cap > UINT32_MAX)
+        return false;
+    uint32_t *p = vt_array_resize(ctx->batch, (size_t)ctx->batch_cap * sizeof *p, (size_t)cap * sizeof *p);
+    if (!p)
+        return false;
+    ctx->batch = p;
+    ctx->batch_cap = (uint32_t)cap;
+    return true;
+}
+
 /* A package of a distributed frame (run->seed) refines its own faces: an
  * edge is its business when a face on either side descends from one of
  * them (or, with dist_postpass, from a face hidden in the ID test). Splits of border edges reach into the neighbours, whose insides
@@ -171,7 +191,11 @@ static void consider_edge(refine_ctx *ctx, uint32_t e, bool primary)
     vt_edge *ed = &m->edges[e];
     const vt_vertex *a = &m->verts[ed->v[0]], *b = &m->verts[ed->v[1]];
     const float length = vt_edge_length(&run->view, a, b);
-    if (!(length > set->min_edge) || vt_edge_is_split(ed) || vt_edge_queued(m, e) ||
+    /* pixel_split: shorter edges enter too, and are split only where a
+     * criterion fires and a pixel shows it (run_stage) */
+    const float shortest = set->pixel_split != VT_PIXEL_SPLIT_OFF && set->pixel_floor < set->min_edge
+                               ? set->pixel_floor : set->min_edge;
+    if (!(length > shortest) || vt_edge_is_split(ed) || vt_edge_queued(m, e) ||
         (!primary && !edge_in_package(run, ed)))
         return;
     if (!primary && set->z_test && !a->visible && !b->visible) {
@@ -333,6 +357,83 @@ static uint8_t correctness_reason(refine_ctx *ctx, const vt_edge *ed)
     return 0;
 }
 
+/* Option pixel_split (ours). At min_edge the refinement stops, and an edge
+ * whose ends still differ is drawn as a Gouraud ramp (Sec. 3.5) over its
+ * faces, where the ray tracer's pixels step: on the cup of table:variant=cup
+ * these ribbons along every discontinuity are most of the VT pixels' own
+ * error (docs/vertex-tracing.md, "where the SSIM on the cup is lost"). A
+ * split changes the image only where a pixel centre lies in a face it
+ * splits (the rasterizer samples at pixel centres), and it places the step
+ * between two pixels only where centres lie on both sides of the new inner
+ * edge (midpoint to the opposite corner). Whether face f of edge ed, cut
+ * that way, holds such centres; faces spanning more than 64 centres' box
+ * count as holding them, faces behind the eye too. */
+#define PIXEL_SPLIT_MAX_CENTRES 64
+static bool split_shows(const vt_run *run, uint32_t f, const vt_edge *ed)
+{
+    if (f == VT_NONE)
+        return false;
+    const vt_mesh *m = run->mesh;
+    const vt_face *face = &m->faces[f];
+    const vt_vertex *p[3];
+    uint32_t c = VT_NONE;
+    for (int k = 0; k < 3; ++k) {
+        p[k] = &m->verts[face->v[k]];
+        if (!(p[k]->cw > 0.0f))
+            return true;
+        if (face->v[k] != ed->v[0] && face->v[k] != ed->v[1])
+            c = face->v[k];
+    }
+    if (c == VT_NONE)
+        return false;
+    double x0 = p[0]->sx, x1 = p[0]->sx, y0 = p[0]->sy, y1 = p[0]->sy;
+    for (int k = 1; k < 3; ++k) {
+        x0 = p[k]->sx < x0 ? p[k]->sx : x0;
+        x1 = p[k]->sx > x1 ? p[k]->sx : x1;
+        y0 = p[k]->sy < y0 ? p[k]->sy : y0;
+        y1 = p[k]->sy > y1 ? p[k]->sy : y1;
+    }
+    /* pixel centres (i + 0.5, j + 0.5) in the box and on the screen */
+    long i0 = (long)ceil(x0 - 0.5), i1 = (long)floor(x1 - 0.5);
+    long j0 = (long)ceil(y0 - 0.5), j1 = (long)floor(y1 - 0.5);
+    i0 = i0 < 0 ? 0 : i0;
+    j0 = j0 < 0 ? 0 : j0;
+    i1 = i1 > run->view.width - 1 ? run->view.width - 1 : i1;
+    j1 = j1 > run->view.height - 1 ? run->view.height - 1 : j1;
+    if (i1 < i0 || j1 < j0)
+        return false;
+    if ((i1 - i0 + 1) * (j1 - j0 + 1) > PIXEL_SPLIT_MAX_CENTRES)
+        return true;
+    double area = ((double)p[1]->sx - p[0]->sx) * ((double)p[2]->sy - p[0]->sy) -
+                  ((double)p[1]->sy - p[0]->sy) * ((double)p[2]->sx - p[0]->sx);
+    if (area == 0.0)
+        return false;
+    const double sign = area > 0.0 ? 1.0 : -1.0;
+    const vt_vertex *a = &m->verts[ed->v[0]], *b = &m->verts[ed->v[1]], *cv = &m->verts[c];
+    const double mx = 0.5 * ((double)a->sx + b->sx), my = 0.5 * ((double)a->sy + b->sy);
+    bool before = false, after = false;
+    for (long j = j0; j <= j1; ++j)
+        for (long i = i0; i <= i1; ++i) {
+            const double qx = (double)i + 0.5, qy = (double)j + 0.5;
+            bool inside = true;
+            for (int k = 0; k < 3 && inside; ++k) {
+                const vt_vertex *u = p[k], *w = p[(k + 1) % 3];
+                double e = ((double)w->sx - u->sx) * (qy - u->sy) - ((double)w->sy - u->sy) * (qx - u->sx);
+                inside = e * sign >= 0.0;
+            }
+            if (!inside)
+                continue;
+            if (run->set->pixel_split == VT_PIXEL_SPLIT_INSIDE)
+                return true;
+            double side = ((double)cv->sx - mx) * (qy - my) - ((double)cv->sy - my) * (qx - mx);
+            before |= side > 0.0;
+            after |= side < 0.0;
+            if (before && after)
+                return true;
+        }
+    return false;
+}
+
 /* One stage: the edges of the top octave, tested longest first. */
 static void run_stage(refine_ctx *ctx, uint16_t stage)
 {
@@ -343,13 +444,19 @@ static void run_stage(refine_ctx *ctx, uint16_t stage)
     uint32_t e;
     float length;
     while (vt_heap_top(run->heap) >= band && vt_heap_pop(run->heap, &e, &length)) {
-        if (!rl_reserve_u32((void **)&ctx->batch, &ctx->batch_cap, (uint64_t)ctx->batch_count + 1, sizeof *ctx->batch, 1024)) {
+        if (!batch_reserve(ctx, ctx->batch_count + 1)) {
             run->failed = true;
             return;
         }
         vt_edge_set_queued(m, e, false);
         ctx->batch[ctx->batch_count++] = e;
     }
+    /* The stage's edges moved from the list to the batch: the list's room
+     * goes back now. Its touched pages otherwise stayed resident to the
+     * end of the refinement, where the frame peaks with the whole mesh
+     * (2.2 MB of that peak on table at 1024^2 with deferred_split, an RSS
+     * trace; bench/README.md, "Memory, fourth pass"). */
+    vt_heap_shrink(run->heap);
     for (uint32_t i = 0; i < ctx->batch_count && !run->failed; ++i) {
         if (!budget_left(run))
             break;
@@ -363,7 +470,12 @@ static void run_stage(refine_ctx *ctx, uint16_t stage)
             continue;
         unsigned bits = vt_criteria_test(&run->set->criteria, &m->samples[ed->v[0]], &m->samples[ed->v[1]]);
         run->stats.edges_tested++;
-        if (!bits) {
+        if (run->set->pixel_split != VT_PIXEL_SPLIT_OFF && !(vt_edge_length(&run->view, a, b) > run->set->min_edge)) {
+            /* below min_edge (pixel_split): a criterion, and a pixel to show it */
+            if (!bits || !(split_shows(run, ed->face[0], ed) || split_shows(run, ed->face[1], ed)))
+                continue;
+            run->stats.splits_pixel++;
+        } else if (!bits) {
             uint8_t why = correctness_reason(ctx, ed);
             if (why && !run->failed)
                 split_edge(ctx, ctx->batch[i], why, stage);
@@ -581,7 +693,7 @@ rl_status vt_refine(vt_run *run)
 #pragma omp single
     refine_all(&ctx);
     double wall = now_ms() - t0;
-    free(ctx.batch);
+    vt_array_free(ctx.batch, (size_t)ctx.batch_cap * sizeof *ctx.batch);
     free(ctx.forced);
     free(ctx.face_shaft);
     vt_shaft_index_free(&ctx.shafts);

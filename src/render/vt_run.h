@@ -61,7 +61,16 @@ typedef struct vt_settings {
                                * recursion depth; 0 = all of it */
     bool deferred_split;      /* the criteria see the deferred reflected and
                                * transmitted textures (vt_sample.c) */
+    int pixel_split;          /* VT_PIXEL_SPLIT_*: criterion splits below
+                               * min_edge where a pixel centre shows them */
+    float pixel_floor;        /* px: ... down to this edge length */
 } vt_settings;
+
+/* Option pixel_split (vt_refine.c): an edge at or below min_edge whose ends
+ * a criterion tells apart is still split, down to pixel_floor, when one of
+ * its faces holds a pixel centre (INSIDE), or pixel centres on both sides of
+ * the split (BOTH). */
+enum { VT_PIXEL_SPLIT_OFF = 0, VT_PIXEL_SPLIT_INSIDE, VT_PIXEL_SPLIT_BOTH };
 
 /* Intersection hints (Sec. 3.3.1, 6.2.2): which triangles a refined
  * vertex's rays test first. agree: those of its two parent vertices when

@@ -127,12 +127,65 @@ static void test_agrees_with_sorted_reference(void **state)
     free(ref);
 }
 
+/* vt_heap_shrink gives back the room of a list that emptied (the
+ * refinement calls it after each stage's pops) and keeps its items and
+ * their pop order; a list still more than half full, or one whose spare
+ * room is small, keeps its room. */
+static void test_shrink_keeps_the_order(void **state)
+{
+    (void)state;
+    enum { N = 200000, KEEP = 3000 };
+    vt_heap h = { 0 }, ref = { 0 };
+    uint64_t seed = 0x2545f4914f6cdd1dull;
+    for (int i = 0; i < N; ++i) {
+        float len = (float)(rng_next(&seed) % 4096) * 0.125f;
+        uint32_t edge = (uint32_t)(rng_next(&seed) % 50000);
+        assert_int_equal(vt_heap_push(&h, edge, len), RL_OK);
+        assert_int_equal(vt_heap_push(&ref, edge, len), RL_OK);
+    }
+    uint32_t full = h.cap;
+    assert_true(full >= N);
+    vt_heap_shrink(&h);               /* full: nothing to give back */
+    assert_int_equal(h.cap, full);
+    for (int i = 0; i < N - KEEP; ++i) {
+        uint32_t a, b;
+        assert_true(vt_heap_pop(&h, &a, NULL) && vt_heap_pop(&ref, &b, NULL));
+        assert_int_equal(a, b);
+    }
+    vt_heap_shrink(&h);
+    /* the smallest 1024 * 2^k at least twice the items */
+    assert_int_equal(h.cap, 8192);
+    assert_int_equal(h.count, KEEP);
+    vt_heap_shrink(&h);               /* already small */
+    assert_int_equal(h.cap, 8192);
+    /* it grows again from there */
+    for (int i = 0; i < 20000; ++i) {
+        float len = (float)(rng_next(&seed) % 4096) * 0.125f;
+        uint32_t edge = (uint32_t)(rng_next(&seed) % 50000);
+        assert_int_equal(vt_heap_push(&h, edge, len), RL_OK);
+        assert_int_equal(vt_heap_push(&ref, edge, len), RL_OK);
+    }
+    uint32_t a, b;
+    float la, lb;
+    while (vt_heap_pop(&ref, &b, &lb)) {
+        assert_true(vt_heap_pop(&h, &a, &la));
+        assert_int_equal(a, b);
+        assert_float_equal(la, lb, 0.0f);
+    }
+    assert_false(vt_heap_pop(&h, NULL, NULL));
+    vt_heap_shrink(&h);               /* empty: back to the first room */
+    assert_int_equal(h.cap, 1024);
+    vt_heap_free(&h);
+    vt_heap_free(&ref);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_empty_heap),
         cmocka_unit_test(test_longest_first_ties_by_index),
         cmocka_unit_test(test_agrees_with_sorted_reference),
+        cmocka_unit_test(test_shrink_keeps_the_order),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
