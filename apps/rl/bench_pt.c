@@ -122,7 +122,10 @@ static const char bench_pt_help[] =
     "  --conv-configs L  convergence: only these configurations (defaults, thesis,\n"
     "                    mis=off, rng=hybrid, rr=false, light_samples=2, light_samples=4,\n"
     "                    adaptive=on, quad_sampling=solid_angle, atrous,\n"
-    "                    adaptive+atrous)\n"
+    "                    adaptive+atrous; none: only --conv-set's)\n"
+    "  --conv-set KV     convergence: one more configuration, \"custom\", to\n"
+    "                    --conv-spp-max with pt's options KEY=VALUE,KEY=VALUE,... (an\n"
+    "                    A/B of a setting against the same cached reference)\n"
     "  --max-memory GB   skip Line Spaces estimated to need more; default 60% of RAM\n"
     "  --builds N        generation: the fastest of N builds per row; default 3 (quick: 1)\n"
     "  --fixed-k K       generation: also build fixed lists of K (even; default 8), for\n"
@@ -194,6 +197,7 @@ typedef struct bpt_args {
     long long conv_size, conv_ref_spp, conv_spp_max;
     double conv_ref_budget;        /* seconds of reference rendering per run; 0 = no limit */
     const char *conv_configs;
+    const char *conv_set;
     bool has_conv_size, has_conv_ref_spp, has_conv_spp_max;
     bool has_size, has_err_size, has_ref_spp, has_spp_max, has_builds, has_fixed_k, quick, small_pages;
     unsigned sections;
@@ -1654,7 +1658,8 @@ static rl_status sec_convergence(void *ctx, cJSON *sec)
     bpt *b = ctx;
     bench_pt_conv_args ca = { .size = (int)b->a->conv_size, .ref_spp = b->a->conv_ref_spp,
                               .spp_max = b->a->conv_spp_max, .threads = b->threads, .out_path = b->out_path,
-                              .configs = b->a->conv_configs, .ref_budget_s = b->a->conv_ref_budget,
+                              .configs = b->a->conv_configs, .custom = b->a->conv_set,
+                              .ref_budget_s = b->a->conv_ref_budget,
                               .reason = b->reason, .reason_size = sizeof b->reason };
     return bench_pt_convergence(&ca, sec);
 }
@@ -1699,6 +1704,7 @@ static int parse_args(int argc, char **argv, bpt_args *a)
         RL_BENCH_COUNT("--conv-ref-spp", 1 << 20, &a->conv_ref_spp, &a->has_conv_ref_spp),
         RL_BENCH_COUNT("--conv-spp-max", 1 << 20, &a->conv_spp_max, &a->has_conv_spp_max),
         RL_BENCH_STRING("--conv-configs", &a->conv_configs),
+        RL_BENCH_STRING("--conv-set", &a->conv_set),
         RL_BENCH_REAL("--conv-ref-budget", 0.0, 1e9, &a->conv_ref_budget, NULL),
         RL_BENCH_COUNT("--threads", 1024, &a->threads, NULL),
         RL_BENCH_SECTIONS(section_names, SEC_COUNT, &a->sections),

@@ -114,6 +114,47 @@ static bool wanted(const char *list, const conv_config *c)
     return false;
 }
 
+/* The configuration of --conv-set "key=value,...": its label "custom
+ * (key=value,...)" and the options split in place. */
+#define MAX_CUSTOM_OPTS 16
+typedef struct custom_config {
+    char label[528], buf[512];
+    const char *opts[2 * MAX_CUSTOM_OPTS + 1];
+    conv_config config;
+} custom_config;
+
+static rl_status bad_set(const char *kv, const char *why)
+{
+    note("--conv-set %s: %s", kv, why);
+    return RL_ERR_INVALID_ARG;
+}
+
+static rl_status parse_custom(const char *kv, custom_config *c)
+{
+    if (strlen(kv) >= sizeof c->buf)
+        return bad_set(kv, "too long");
+    snprintf(c->label, sizeof c->label, "custom (%s)", kv);
+    strcpy(c->buf, kv);
+    size_t k = 0;
+    for (char *p = c->buf; *p;) {
+        char *end = p + strcspn(p, ",");
+        bool last = *end == '\0';
+        *end = '\0';
+        char *eq = strchr(p, '=');
+        if (!eq || eq == p)
+            return bad_set(kv, "expected KEY=VALUE,...");
+        if (k == 2 * MAX_CUSTOM_OPTS)
+            return bad_set(kv, "more than 16 options");
+        *eq = '\0';
+        c->opts[k++] = p;
+        c->opts[k++] = eq + 1;
+        p = last ? end : end + 1;
+    }
+    c->opts[k] = NULL;
+    c->config = (conv_config){ c->label, c->opts, true };
+    return RL_OK;
+}
+
 typedef struct checkpoint {
     long long spp;
     double wall_ms, cpu_ms, rmse;
@@ -589,15 +630,24 @@ rl_status bench_pt_convergence(const bench_pt_conv_args *a, cJSON *sec)
     size_t n = (size_t)a->size * a->size;
     float *halves = malloc(6 * n * sizeof *halves), *ref = malloc(3 * n * sizeof *ref);
     float *rgb = malloc(3 * n * sizeof *rgb);
-    checkpoint *pts = malloc(NUM_CONFIGS * MAX_CHECKPOINTS * sizeof *pts);
-    int nums[NUM_CONFIGS] = { 0 };
-    double means[NUM_CONFIGS][3];
+    checkpoint *pts = malloc((NUM_CONFIGS + 1) * MAX_CHECKPOINTS * sizeof *pts);
+    int nums[NUM_CONFIGS + 1] = { 0 };
+    double means[NUM_CONFIGS + 1][3];
     if (!halves || !ref || !rgb || !pts)
         st = RL_ERR_OUT_OF_MEMORY;
     bool cached = false;
     double ref_ms = 0.0;
     char cache[4300];
     long long resumed = 0;
+    /* --conv-set is checked before the reference is rendered: a typo
+     * should not cost the reference's minutes. */
+    custom_config cu;
+    bool has_custom = a->custom && *a->custom;
+    if (st == RL_OK && has_custom && (st = parse_custom(a->custom, &cu)) == RL_OK) {
+        rl_renderer *probe = NULL;
+        st = make_renderer(a, cu.opts, "7", &probe);
+        rl_renderer_release(probe);
+    }
     if (st == RL_OK)
         st = reference(a, scene, &cam, halves, &cached, &ref_ms, cache, sizeof cache, &resumed);
     double ref_mse = 0.0, ref_mean[3] = { 0.0, 0.0, 0.0 };
@@ -622,6 +672,14 @@ rl_status bench_pt_convergence(const bench_pt_conv_args *a, cJSON *sec)
         st = run_config(a, &configs[c], scene, &cam, ref, ref_mse, p, &nums[c], rgb, means[c]);
         if (st == RL_OK)
             st = report_config(a, &configs[c], p, nums[c], arr);
+    }
+    /* --conv-set: one configuration of the caller's options, to spp_max,
+     * against the same reference (an A/B of a setting). */
+    if (st == RL_OK && has_custom) {
+        checkpoint *p = pts + NUM_CONFIGS * MAX_CHECKPOINTS;
+        st = run_config(a, &cu.config, scene, &cam, ref, ref_mse, p, &nums[NUM_CONFIGS], rgb, means[NUM_CONFIGS]);
+        if (st == RL_OK)
+            st = report_config(a, &cu.config, p, nums[NUM_CONFIGS], arr);
     }
     if (st == RL_OK) {
         cJSON_AddStringToObject(sec, "scene", CONV_SCENE);

@@ -17,6 +17,8 @@ typedef struct bench_pt_conv_args {
     int threads;
     const char *out_path;          /* the JSON record; the reference cache goes beside it */
     const char *configs;           /* comma-separated labels to run; NULL = all */
+    const char *custom;            /* --conv-set: "key=value,..." of one more configuration
+                                    * run to spp_max ("custom"); NULL or "" = none */
     double ref_budget_s;           /* wall seconds of reference rendering in this run; 0 = no limit */
     char *reason;                  /* why the section stopped (budget spent), reason_size bytes */
     size_t reason_size;

@@ -22,7 +22,7 @@ expect_in "$TMP/err" "rl: error: "
 
 expect_exit 0 "$RL" bench pt --help
 for o in --size --error-size --ref-spp --spp-max --max-memory --builds --fixed-k --small-pages --only --out \
-         --quick generation accumulation convergence --conv-size --conv-ref-spp --conv-spp-max --conv-ref-budget \
+         --quick generation accumulation convergence --conv-size --conv-ref-spp --conv-spp-max --conv-ref-budget --conv-set \
          bdpt; do
     expect_in "$TMP/out" "$o"
 done
@@ -193,6 +193,28 @@ expect_exit 0 "$RL" bench pt --only convergence --quick --conv-size 16 --conv-re
     --out "$TMP/conv/c2.json"
 python3 -c 'import json,sys; assert json.load(open(sys.argv[1]))["convergence"]["reference"]["cached"] is True' \
     "$TMP/conv/c2.json" || fail "the cached reference was not reused"
+# --conv-set: one more configuration, pt's options as given, to --conv-spp-max
+# against the cached reference ("none" runs it alone); a malformed list or
+# an unknown option fails before any rendering.
+expect_exit 0 "$RL" bench pt --only convergence --quick --conv-size 16 --conv-ref-spp 32 --conv-spp-max 8 \
+    --conv-configs none --conv-set rr_depth=6,light_samples=2 --out "$TMP/conv/c3.json"
+python3 - "$TMP/conv/c3.json" <<'PY' || fail "c3.json (--conv-set) is wrong"
+import json, sys
+c = json.load(open(sys.argv[1]))["convergence"]
+assert c["reference"]["cached"] is True, c["reference"]
+(x,) = c["configurations"]
+assert x["label"] == "custom (rr_depth=6,light_samples=2)", x["label"]
+assert x["options"] == {"rr_depth": "6", "light_samples": "2"}, x["options"]
+assert [p["spp"] for p in x["points"]] == [4, 8] and all(0 < p["rmse"] < 1 for p in x["points"]), x
+PY
+mkdir -p "$TMP/conv/bad"
+expect_exit 1 "$RL" bench pt --only convergence --quick --conv-size 16 --conv-ref-spp 32 --conv-spp-max 8 \
+    --conv-set rr_depth --out "$TMP/conv/bad/c.json"
+expect_in "$TMP/err" "expected KEY=VALUE"
+expect_exit 1 "$RL" bench pt --only convergence --quick --conv-size 16 --conv-ref-spp 32 --conv-spp-max 8 \
+    --conv-set no_such_option=1 --out "$TMP/conv/bad/c.json"
+expect_in "$TMP/err" "no_such_option"
+[ ! -e "$TMP/conv/bad/pt-convergence-ref-16-32.bin" ] || fail "a bad --conv-set rendered the reference"
 
 # A resumable reference: --conv-ref-budget stops after a chunk (16 spp per
 # half here) with exit 1 and the progress saved in .part; reruns of the same
