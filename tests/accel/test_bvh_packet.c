@@ -175,6 +175,38 @@ static void test_coherent_batches_equal_single_rays_city(void **state)
     assert_coherent_batches_equal_single_rays("city", "blocks=1,detail=0");
 }
 
+/* One packet's results (found, occluded) against the single-ray traversal
+ * of each active lane, bit for bit: hit or not, triangle, t, u, v and the
+ * lane's t_max (a miss leaves it alone); counts lanes, hits and blocked
+ * lanes for the callers' plausibility bounds. */
+static void check_packet_lanes(const rl_bvh *bvh, const char *what, int packet, rl_ray *rays,
+                               const rl_ray *single, rl_hit *hit, unsigned active, int *lanes, int *hits,
+                               int *blocked)
+{
+    unsigned found = rl_bvh_packet_intersect(bvh, rays, hit, active);
+    unsigned occ = rl_bvh_packet_occluded(bvh, single, active);
+    assert_int_equal(found & ~active, 0);
+    assert_int_equal(occ & ~active, 0);
+    for (int l = 0; l < RL_BVH_PACKET; ++l) {
+        if (!(active & (1u << l)))
+            continue;
+        ++*lanes;
+        rl_ray q = single[l];
+        rl_hit h = { .object = RL_ID_NONE };
+        bool got = rl_bvh_wide_intersect(bvh, &q, &h);
+        if (got != (bool)((found >> l) & 1u) || !same_float(rays[l].t_max, q.t_max) ||
+            (got && (hit[l].triangle != h.triangle || !same_float(hit[l].t, h.t) || !same_float(hit[l].u, h.u) ||
+                     !same_float(hit[l].v, h.v))))
+            fail_msg("%s packet %d lane %d: packet %d triangle %u t %.9g, single %d triangle %u t %.9g", what, packet,
+                     l, (int)((found >> l) & 1u), hit[l].triangle, (double)hit[l].t, got, h.triangle, (double)h.t);
+        *hits += got;
+        bool o = rl_bvh_wide_occluded(bvh, &single[l]);
+        if (o != (bool)((occ >> l) & 1u))
+            fail_msg("%s packet %d lane %d: packet occluded %d, single %d", what, packet, l, (int)((occ >> l) & 1u), o);
+        *blocked += o;
+    }
+}
+
 /* The kernel itself on packets of random rays of mixed octants (accel.c
  * would not send these, the traversal must still be exact), random active
  * masks and per-lane t_min, t_max. */
@@ -217,29 +249,7 @@ static void test_packet_kernel_equals_single_rays_on_random_packets(void **state
             single[l] = rays[l];
             hit[l] = (rl_hit){ .object = RL_ID_NONE };
         }
-        unsigned found = rl_bvh_packet_intersect(&bvh, rays, hit, active);
-        unsigned occ = rl_bvh_packet_occluded(&bvh, single, active);
-        assert_int_equal(found & ~active, 0);
-        for (int l = 0; l < RL_BVH_PACKET; ++l) {
-            if (!(active & (1u << l)))
-                continue;
-            ++lanes;
-            rl_ray r = single[l];
-            rl_hit h = { .object = RL_ID_NONE };
-            bool got = rl_bvh_wide_intersect(&bvh, &r, &h);
-            assert_int_equal(got, (found >> l) & 1u);
-            if (got) {
-                ++hits;
-                assert_int_equal(hit[l].triangle, h.triangle);
-                assert_true(same_float(hit[l].t, h.t) && same_float(hit[l].u, h.u) && same_float(hit[l].v, h.v));
-                assert_true(same_float(rays[l].t_max, r.t_max));
-            } else {
-                assert_true(same_float(rays[l].t_max, single[l].t_max));
-            }
-            bool o = rl_bvh_wide_occluded(&bvh, &single[l]);
-            assert_int_equal(o, (occ >> l) & 1u);
-            blocked += o;
-        }
+        check_packet_lanes(&bvh, "random", packet, rays, single, hit, active, &lanes, &hits, &blocked);
     }
     assert_true(hits > lanes / 10 && hits < lanes);
     assert_true(blocked > lanes / 10 && blocked < lanes);
@@ -299,30 +309,7 @@ static void assert_narrow_packets_equal_single_rays(const char *scene, const cha
             single[l] = rays[l];
             hit[l] = (rl_hit){ .object = RL_ID_NONE };
         }
-        unsigned found = rl_bvh_packet_intersect(&bvh, rays, hit, active);
-        unsigned occ = rl_bvh_packet_occluded(&bvh, single, active);
-        assert_int_equal(found & ~active, 0);
-        assert_int_equal(occ & ~active, 0);
-        for (int l = 0; l < RL_BVH_PACKET; ++l) {
-            if (!(active & (1u << l)))
-                continue;
-            ++lanes;
-            rl_ray q = single[l];
-            rl_hit h = { .object = RL_ID_NONE };
-            bool got = rl_bvh_wide_intersect(&bvh, &q, &h);
-            if (got != (bool)((found >> l) & 1u) ||
-                (got && (hit[l].triangle != h.triangle || !same_float(hit[l].t, h.t) || !same_float(hit[l].u, h.u) ||
-                         !same_float(hit[l].v, h.v) || !same_float(rays[l].t_max, q.t_max))))
-                fail_msg("%s packet %d lane %d: packet %d triangle %u t %.9g, single %d triangle %u t %.9g", scene,
-                         packet, l, (int)((found >> l) & 1u), hit[l].triangle, (double)hit[l].t, got, h.triangle,
-                         (double)h.t);
-            hits += got;
-            bool o = rl_bvh_wide_occluded(&bvh, &single[l]);
-            if (o != (bool)((occ >> l) & 1u))
-                fail_msg("%s packet %d lane %d: packet occluded %d, single %d", scene, packet, l,
-                         (int)((occ >> l) & 1u), o);
-            blocked += o;
-        }
+        check_packet_lanes(&bvh, scene, packet, rays, single, hit, active, &lanes, &hits, &blocked);
     }
     print_message("%s: %d narrow-packet lanes, %d hits, %d blocked\n", scene, lanes, hits, blocked);
     assert_true(hits > lanes / 4 && hits < lanes);

@@ -744,16 +744,23 @@ static void tree_readings_counts(void **state)
  * texture (no reflection) it changes nothing. */
 static double vt_pixel_ssim(const rl_image *test, const rl_image *ref, const rl_scene *s);
 
+/* table:variant=cup at 384^2 and Whitted's image of it without shadows
+ * (max_depth 4): the set-up of the reflected-texture tests below. */
+static rl_image *cup_without_shadows(rl_scene **cup, rl_camera *cam)
+{
+    assert_int_equal(rl_scene_create_builtin("table", "variant=cup", cup), RL_OK);
+    assert_int_equal(rl_scene_get_camera(*cup, NULL, cam), RL_OK);
+    cam->width = cam->height = 384;
+    const char *const wopts[] = { "shadows", "false", "max_depth", "4", NULL };
+    return fx_render("whitted", *cup, cam, FX_ALL_LAYERS, wopts, NULL);
+}
+
 static void deferred_split_places_reflected_texture(void **state)
 {
     (void)state;
     rl_scene *cup = NULL;
-    assert_int_equal(rl_scene_create_builtin("table", "variant=cup", &cup), RL_OK);
     rl_camera cam;
-    assert_int_equal(rl_scene_get_camera(cup, NULL, &cam), RL_OK);
-    cam.width = cam.height = 384;
-    const char *const wopts[] = { "shadows", "false", "max_depth", "4", NULL };
-    rl_image *ref = fx_render("whitted", cup, &cam, FX_ALL_LAYERS, wopts, NULL);
+    rl_image *ref = cup_without_shadows(&cup, &cam);
     enum { DEFAULT, OFF, ON, N };
     static const char *const split[N] = { NULL, "false", "true" };
     double ssim[N];
@@ -802,12 +809,8 @@ static void pixel_split_sharpens_steps(void **state)
 {
     (void)state;
     rl_scene *cup = NULL;
-    assert_int_equal(rl_scene_create_builtin("table", "variant=cup", &cup), RL_OK);
     rl_camera cam;
-    assert_int_equal(rl_scene_get_camera(cup, NULL, &cam), RL_OK);
-    cam.width = cam.height = 384;
-    const char *const wopts[] = { "shadows", "false", "max_depth", "4", NULL };
-    rl_image *ref = fx_render("whitted", cup, &cam, FX_ALL_LAYERS, wopts, NULL);
+    rl_image *ref = cup_without_shadows(&cup, &cam);
     enum { DEFAULT, OFF, INSIDE, BOTH, N };
     static const char *const mode[N] = { NULL, "off", "inside", "both" };
     double ssim[N];
