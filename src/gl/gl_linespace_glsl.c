@@ -378,7 +378,12 @@ static const char *const walk_glsl =
         return u_ls_origin_exact && all(greaterThanEqual(start, u_ls_min)) && all(lessThanEqual(start, u_ls_max));
     }
 
-    bool rl_ls_intersect(vec3 o, vec3 d, float t_min, float t_max, out uint tri, out float t, out float u,
+    /* The candidate lists' walk (linespace_query.c): the closest hit, or
+     * with any the first hit in (t_min, t_max), the any-hit query of
+     * shadow rays (that hit is the first the closest-hit walk accepts, so
+     * both answer the same rays alike). One function for both, so that a
+     * program with one ray site holds one copy of the walk. */
+    bool rl_ls_cand_walk(vec3 o, vec3 d, float t_min, float t_max, bool any, out uint tri, out float t, out float u,
                          out float v)
     {
         tri = RL_LS_NONE;
@@ -413,6 +418,8 @@ static const char *const walk_glsl =
                             t = th;
                             u = uh;
                             v = vh;
+                            if (any)
+                                return true;
                             limit = rl_ls_next_up(th);
                         }
                     }
@@ -425,35 +432,17 @@ static const char *const walk_glsl =
         return tri != RL_LS_NONE;
     }
 
+    bool rl_ls_intersect(vec3 o, vec3 d, float t_min, float t_max, out uint tri, out float t, out float u,
+                         out float v)
+    {
+        return rl_ls_cand_walk(o, d, t_min, t_max, false, tri, t, u, v);
+    }
+
     bool rl_ls_occluded(vec3 o, vec3 d, float t_min, float t_max)
     {
-        RlLsDda it;
-        dvec3 lo, ld, linv;
-        if (!rl_ls_walk_begin(o, d, t_min, t_max, it, lo, ld, linv))
-            return false;
-        RlLsWt w = rl_ls_wt_setup(o, d);
-        uint cell;
-        float t0, t1;
-        while (rl_ls_dda_next(it, cell, t0, t1)) {
-            uint block = rl_ls_voxel_slot[cell];
-            if (block == RL_LS_NONE)
-                continue;
-            bool fwd;
-            uint rank = 0u;
-            uint shaft = rl_ls_shaft_of_ray(it.cur, lo, ld, linv, fwd);
-            if (shaft != RL_LS_NONE && !rl_ls_occupied(block, shaft, rank))
-                continue;
-            uint first, count;
-            bool from_cells;
-            rl_ls_list(cell, shaft, rank, first, count, from_cells);
-            for (uint j = 0u; j < count; ++j) {
-                uint id = from_cells ? rl_ls_cells[first + j] : rl_ls_cand[first + j];
-                float th, uh, vh;
-                if (id != RL_LS_NONE && rl_ls_wt_hit(w, id, t_min, t_max, th, uh, vh))
-                    return true;
-            }
-        }
-        return false;
+        uint tri;
+        float t, u, v;
+        return rl_ls_cand_walk(o, d, t_min, t_max, true, tri, t, u, v);
     }
     /* ---- PNMT (Sec. 7.4; linespace_query.c pnmt_walk) ---- */
 

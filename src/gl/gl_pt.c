@@ -96,7 +96,14 @@ typedef struct uniforms {
  * 8.4 (no light paths this frame) and the environment (none set). A left
  * out part is one whose uniform would be false, so every variant computes
  * what the full program computes. */
-enum { V_GGX = 1, V_LIGHT_VERTICES = 2, V_ENV = 4, PATH_VARIANTS = 8 };
+enum { V_GGX = 1, V_LIGHT_VERTICES = 2, V_ENV = 4, V_STRUCTURE_SHIFT = 3, PATH_VARIANTS = 16 };
+/* The structures too: the variant holds the traversals of the frame's
+ * shadow, diffuse and specular structures (STRUCTS, a bit per
+ * rl_gl_pt_structure) and no other, so that a BVH frame does not compile
+ * the grid's walk, the three Line Space walks and the shadow-map lookup
+ * it never takes (docs/gl.md, "One ray site"). The other programs have all
+ * bits, and the path program always the BVH's (its camera rays). */
+#define ALL_STRUCTURES ((1u << RL_GL_PT_STRUCTURE_COUNT) - 1u)
 
 #define ENV_UNIT 8                 /* the path program's texture unit of the environment */
 #define LV_UNIT 9                  /* the path program's texture unit of the light vertices */
@@ -110,11 +117,14 @@ struct rl_gl_pt {
     uint32_t num_nodes;
     bool masks;
     /* the path program of this frame's variant (use_variant) and its
-     * uniforms; the variants made so far, by PATH_VARIANT bits */
+     * uniforms; the variants made so far (up to PATH_VARIANTS), with their
+     * keys (V_* bits and the structures') */
     GLuint path_prog, rays_prog;
     uniforms pu, ru;
     GLuint variant_prog[PATH_VARIANTS];
+    unsigned variant_key[PATH_VARIANTS];
     uniforms variant_u[PATH_VARIANTS];
+    unsigned variants_made;       /* the next slot to fill is variants_made % PATH_VARIANTS */
     bool has_ggx;                 /* a material of the scene is GGX */
     GLuint buf[B_COUNT];
     GLuint tex[T_COUNT];
@@ -266,12 +276,12 @@ static GLuint compute_program(const char *body, bool linespace, unsigned variant
 {
     char defines[640];
     snprintf(defines, sizeof defines,
-             "#define LOCAL_SIZE %d\n#define BVH_STACK %d\n#define STRUCT_GRID %d\n"
+             "#define LOCAL_SIZE %d\n#define BVH_STACK %d\n#define STRUCT_BVH %d\n#define STRUCT_GRID %d\n"
              "#define STRUCT_LS_CAND %d\n#define STRUCT_LS_PNMT %d\n#define STRUCT_LS_PREILLUM %d\n"
              "#define STRUCT_SHADOWMAP %d\n"
              "#define LIGHT_POINT %d\n#define LIGHT_SPOT %d\n#define LIGHT_DIRECTIONAL %d\n#define LIGHT_QUAD %d\n"
              "#define INF uintBitsToFloat(0x7f800000u)\n#define GGX_NODES %d\n",
-             LOCAL, RL_BVH_MAX_DEPTH, (int)RL_GL_PT_GRID, (int)RL_GL_PT_LS_CANDIDATES, (int)RL_GL_PT_LS_PNMT,
+             LOCAL, RL_BVH_MAX_DEPTH, (int)RL_GL_PT_BVH, (int)RL_GL_PT_GRID, (int)RL_GL_PT_LS_CANDIDATES, (int)RL_GL_PT_LS_PNMT,
              (int)RL_GL_PT_LS_PREILLUM, (int)RL_GL_PT_SHADOWMAP, (int)RL_LIGHT_POINT, (int)RL_LIGHT_SPOT,
              (int)RL_LIGHT_DIRECTIONAL, (int)RL_LIGHT_QUAD, RL_GL_PT_GGX_NODES);
     if (!body) {
@@ -288,10 +298,14 @@ static GLuint compute_program(const char *body, bool linespace, unsigned variant
     }
     /* the path program's variant (V_*); the other programs have no use
      * for it and keep their texts */
-    char has[96] = "";
+    char has[128];
     if (linespace)
-        snprintf(has, sizeof has, "#define HAS_GGX %d\n#define HAS_LIGHT_VERTICES %d\n#define HAS_ENV %d\n",
-                 (variant & V_GGX) != 0, (variant & V_LIGHT_VERTICES) != 0, (variant & V_ENV) != 0);
+        snprintf(has, sizeof has,
+                 "#define HAS_GGX %d\n#define HAS_LIGHT_VERTICES %d\n#define HAS_ENV %d\n#define STRUCTS %uu\n",
+                 (variant & V_GGX) != 0, (variant & V_LIGHT_VERTICES) != 0, (variant & V_ENV) != 0,
+                 variant >> V_STRUCTURE_SHIFT);
+    else
+        snprintf(has, sizeof has, "#define STRUCTS %uu\n", ALL_STRUCTURES);
     const char *const parts[] = { rl_gl_pt_glsl_header, linespace ? rl_gl_linespace_glsl() : "", defines, has,
                                   rl_gl_pt_glsl_common, rl_gl_glsl_tex_sample, rl_gl_pt_glsl_common2,
                                   rl_gl_glsl_light_delta, body };
@@ -879,15 +893,25 @@ static void drop_frame(rl_gl_pt *pt)
  * environment compile the smaller program. */
 static rl_status use_variant(rl_gl_pt *pt, unsigned v)
 {
-    if (!pt->variant_prog[v]) {
+    int slot = -1;
+    for (int i = 0; i < PATH_VARIANTS && slot < 0; ++i)
+        if (pt->variant_prog[i] && pt->variant_key[i] == v)
+            slot = i;
+    if (slot < 0) {
         GLuint p = compute_program(rl_gl_pt_glsl_path, true, v, "gl-pt path");
         if (!p)
             return RL_ERR_INTERNAL;
-        pt->variant_prog[v] = p;
-        locate(p, &pt->variant_u[v]);
+        /* a tracer that meets more variants than it keeps (rl view
+         * stepping through the structures) makes the oldest again */
+        slot = (int)(pt->variants_made++ % PATH_VARIANTS);
+        if (pt->variant_prog[slot])
+            glDeleteProgram(pt->variant_prog[slot]);
+        pt->variant_prog[slot] = p;
+        pt->variant_key[slot] = v;
+        locate(p, &pt->variant_u[slot]);
     }
-    pt->path_prog = pt->variant_prog[v];
-    pt->pu = pt->variant_u[v];
+    pt->path_prog = pt->variant_prog[slot];
+    pt->pu = pt->variant_u[slot];
     return RL_OK;
 }
 
@@ -914,7 +938,9 @@ static rl_status render_frame(rl_gl_pt *pt, const rl_gl_pt_frame *f, float *rgba
         st = rl_error(RL_ERR_INVALID_ARG, "rl_gl_pt_render: shadow maps not made (rl_gl_pt_set_shadowmaps)");
     const bool lvc = f->light_connect > 0 && pt->lv_paths > 0;
     if (st == RL_OK)
-        st = use_variant(pt, (pt->has_ggx ? V_GGX : 0u) | (lvc ? V_LIGHT_VERTICES : 0u) | (pt->have_env ? V_ENV : 0u));
+        st = use_variant(pt, (pt->has_ggx ? V_GGX : 0u) | (lvc ? V_LIGHT_VERTICES : 0u) | (pt->have_env ? V_ENV : 0u) |
+                                 ((1u << RL_GL_PT_BVH) | (1u << f->shadow) | (1u << f->diffuse) | (1u << f->specular))
+                                     << V_STRUCTURE_SHIFT);
     if (st != RL_OK)
         return st;
     const GLuint p = pt->path_prog;

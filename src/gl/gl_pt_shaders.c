@@ -19,13 +19,19 @@
  *   surface_*, phong_ pathtrace_path.c, pathtrace_bsdf.c
  *   ggx_*, brdf_*     pathtrace_ggx.c: GGX with visible-normal sampling and
  *                     the energy compensation from pt's tables (issue 37)
- *   direct_light*     Shade (Sec. 6.4.2, 6.3), with MIS (pathtrace_path.c)
+ *   shadow_setup      pathtrace_path.c visible(): a shadow ray for ray_query
+ *   ray_query         the one traversal call of the path program (any-hit
+ *                     or closest-hit through any structure)
  *   env_*             scene/environment.c (lookup) and pathtrace_env.c
- *                     (sampling by pt's own CDFs, density), environment_light
- *                     and escaped of pathtrace_path.c (issue 37)
+ *                     (sampling by pt's own CDFs, density) and escaped of
+ *                     pathtrace_path.c (issue 37)
  *   fresnel_schlick   scene/material.c rl_fresnel_schlick, and the specular
  *                     event of pathtrace_ggx.c rl_pt_specular_event (issue 37)
- *   trace_path        rl_pt_trace_path (Sec. 6.4)
+ *   trace_path        rl_pt_trace_path (Sec. 6.4): one ray per iteration of
+ *                     one loop, the camera ray, the shadow rays of Shade
+ *                     (Sec. 6.4.2, 6.3: pathtrace_path.c direct_light,
+ *                     direct_light_mis, environment_light; the light-vertex
+ *                     joins of Sec. 8.4) and the bounces, one ray_query()
  *   main (path)       one sample of every pixel: jittered camera ray
  *                     through the BVH (primary=trace), the path, eq. 8 of
  *                     Sec. 6.5 into the rgba32f accumulation image
@@ -308,9 +314,16 @@ const char *const rl_gl_pt_glsl_common2 = GLSL(
         return h.tri != NONE;
     }
 
+    /* Whether the program holds structure k's traversal (gl_pt.c: the
+     * path program's variant has those of its frame's structures only,
+     * the other programs all): a test of a constant, which the compiler
+     * folds, so the walks of the others are not in the program. The BVH
+     * is always in (the camera rays take it). */
+    bool may_use(int k) { return (STRUCTS & (1u << uint(k))) != 0u; }
+
     bool query(int structure, vec3 o, vec3 d, float t_min, float t_max, bool any_hit, out Hit h)
     {
-        if (structure == STRUCT_GRID)
+        if (may_use(STRUCT_GRID) && structure == STRUCT_GRID)
             return grid_query(o, d, t_min, t_max, any_hit, h);
         return bvh_query(o, d, t_min, t_max, any_hit, h);
     }
@@ -663,26 +676,47 @@ const char *const rl_gl_pt_glsl_path = GLSL(
         return true;
     }
 
-    /* rl_pt_closest: the first surface along a secondary ray */
-    bool closest(int structure, vec3 o, vec3 dir, out Surf s)
+    /* ------------------------------------------------------- ray site -- */
+    /* The one traversal call of the path program: every ray of a path
+     * (the camera's, the shadow rays, the bounces) through structure,
+     * any: a shadow ray, answered by the first hit in (t_min, t_max); else
+     * the closest hit, in h for the BVH, the grid and the candidate lists,
+     * for the PNMT records in h.tri (NONE) and rec_* (position, normal,
+     * uv, material), for the pre-illuminated colours in rec_p. Mesa
+     * inlines every GLSL function at each of its calls, so every call of a
+     * traversal was another copy of each walk it may take, and llvmpipe's
+     * compile time grows with the inlined program: trace_path makes its
+     * rays one at a time in one loop and calls this once (docs/gl.md,
+     * "One ray site"). */
+    bool ray_query(int structure, vec3 o, vec3 d, float t_min, float t_max, bool any, out Hit h, out vec3 rec_p,
+                   out vec3 rec_n, out vec2 rec_uv, out uint rec_mat)
     {
-        Hit h;
-        if (structure == STRUCT_LS_CAND) {
-            if (!rl_ls_intersect(o, dir, 0.0, INF, h.tri, h.t, h.u, h.v))
-                return false;
-        } else if (structure == STRUCT_LS_PNMT) {
-            float t, t0 = max(0.0, u_ls_start);
-            uint tri, mat;
-            vec3 p, n;
-            vec2 uv;
-            if (!rl_ls_pnmt_intersect(o, dir, t0, INF, t, tri, p, n, uv, mat))
-                return false;
+        h = Hit(t_max, 0.0, 0.0, NONE);
+        rec_p = vec3(0.0);
+        rec_n = vec3(0.0);
+        rec_uv = vec2(0.0);
+        rec_mat = 0u;
+        if (may_use(STRUCT_LS_CAND) && structure == STRUCT_LS_CAND)
+            return rl_ls_cand_walk(o, d, t_min, t_max, any, h.tri, h.t, h.u, h.v);
+        if (may_use(STRUCT_LS_PNMT) && structure == STRUCT_LS_PNMT)
+            return rl_ls_pnmt_walk(o, d, t_min, t_max, !any, h.t, h.tri, rec_p, rec_n, rec_uv, rec_mat);
+        if (may_use(STRUCT_LS_PREILLUM) && structure == STRUCT_LS_PREILLUM)
+            return rl_ls_preillum_walk(o, d, t_min, t_max, !any, rec_p, h.t);
+        return query(structure, o, d, t_min, t_max, any, h);
+    }
+
+    /* rl_pt_closest: the surface a closest-hit query of ray_query found
+     * along the secondary ray from o along dir (false: none to shade) */
+    bool surface_of_hit(int structure, vec3 o, vec3 dir, Hit h, vec3 p, vec3 n, vec2 uv, uint mat, out Surf s)
+    {
+        if (may_use(STRUCT_LS_PNMT) && structure == STRUCT_LS_PNMT) {
+            uint tri = h.tri;
             if (tri != NONE) {
                 /* the start voxel's exact hit (ls_origin=exact), as
                  * rl_ls_surface_at makes it a record: the walk's own
                  * triangle test again for the barycentrics */
-                float u, v;
-                if (!rl_ls_wt_hit(rl_ls_wt_setup(o, dir), tri, t0, INF, t, u, v))
+                float t, u, v;
+                if (!rl_ls_wt_hit(rl_ls_wt_setup(o, dir), tri, max(0.0, u_ls_start), INF, t, u, v))
                     return false;
                 float w = 1.0 - u - v;
                 vec3 q0 = vec3(rl_ls_tri_v[9u * tri], rl_ls_tri_v[9u * tri + 1u], rl_ls_tri_v[9u * tri + 2u]);
@@ -701,8 +735,6 @@ const char *const rl_gl_pt_glsl_path = GLSL(
                 mat = T.w;
             }
             return surface_of_record(p, n, uv, mat, -normalize(dir), s);
-        } else if (!query(structure, o, dir, 0.0, INF, false, h)) {
-            return false;
         }
         s = surface_at(h, dir);
         return true;
@@ -1063,15 +1095,19 @@ const char *const rl_gl_pt_glsl_path = GLSL(
     }
 
     /* pathtrace_path.c visible(): the shadow ray aimed at the light point
-     * from the offset origin, stopped 1e-4 short of it; with shadow maps
-     * light's maps looked up with the jitter j (no ray, none counted). */
-    bool visible(Surf s, vec3 l, float dist, uint light, vec2 j)
+     * from the offset origin, stopped 1e-4 short of it, as the ray of
+     * ray_query (o, d, t_min, t_max through u_shadow); -1: trace it, else
+     * the answer without a ray: 1 blocked, 0 not (the shadow maps, looked
+     * up for light with the jitter j: no ray, none counted). */
+    int shadow_setup(Surf s, vec3 l, float dist, uint light, vec2 j, out vec3 o, out vec3 d, out float t_min,
+                     out float t_max)
     {
-        if (u_shadow == STRUCT_SHADOWMAP)
-            return shadowmap_visible(light, s.p, s.ng, j);
-        vec3 o = offset_origin(s, l);
-        vec3 d = l;
-        float t_max = INF;
+        o = offset_origin(s, l);
+        d = l;
+        t_min = 0.0;
+        t_max = INF;
+        if (may_use(STRUCT_SHADOWMAP) && u_shadow == STRUCT_SHADOWMAP)
+            return shadowmap_visible(light, s.p, s.ng, j) ? 0 : 1;
         if (!isinf(dist)) {
             vec3 to = (s.p + l * dist) - o;
             float len = length(to);
@@ -1080,20 +1116,16 @@ const char *const rl_gl_pt_glsl_path = GLSL(
             t_max = len * (1.0 - 1e-4);
         }
         atomicCounterIncrement(c_shadow);
-        if (u_shadow == STRUCT_LS_CAND)
-            return !rl_ls_occluded(o, d, 0.0, t_max);
-        if (u_shadow == STRUCT_LS_PNMT || u_shadow == STRUCT_LS_PREILLUM) {
+        if ((may_use(STRUCT_LS_PNMT) && u_shadow == STRUCT_LS_PNMT) ||
+            (may_use(STRUCT_LS_PREILLUM) && u_shadow == STRUCT_LS_PREILLUM)) {
             /* pt's voxel offsets: at the light's end always, at the
              * surface's with ls_origin=offset */
-            float t_min = max(0.0, u_ls_start);
+            t_min = max(0.0, u_ls_start);
             t_max -= u_ls_offset;
             if (!(t_min < t_max))
-                return true;
-            return !(u_shadow == STRUCT_LS_PNMT ? rl_ls_pnmt_occluded(o, d, t_min, t_max)
-                                                : rl_ls_preillum_occluded(o, d, t_min, t_max));
+                return 0;
         }
-        Hit h;
-        return !query(u_shadow, o, d, 0.0, t_max, true, h);
+        return -1;
     }
 
     /* ---------------------------------------------------- environment -- */
@@ -1177,56 +1209,6 @@ const char *const rl_gl_pt_glsl_path = GLSL(
         dir = d;
         pdf = p;
         return true;
-    }
-
-    /* direct_light (mis=off): every light, light_samples points per quad */
-    vec3 direct_light(Surf s, uint base)
-    {
-        bool jitter = u_shadow == STRUCT_SHADOWMAP;
-        vec3 sum = vec3(0.0);
-        for (int i = 0; i < u_num_lights; ++i) {
-            Light L = lights[i];
-            uint light_base = base + SLOTS_VERTEX + SLOTS_LIGHT * uint(i) * uint(u_light_samples);
-            if (int(L.pos.w) == LIGHT_QUAD) {
-                vec3 nq = cross(L.dir.xyz, L.extra.xyz);
-                float area = length(nq);
-                if (!(area > 0.0))
-                    continue;
-                nq *= 1.0 / area;
-                int n = u_light_samples;
-                vec3 le = L.power.rgb * (area / float(n));
-                for (int k = 0; k < n; ++k) {
-                    /* both numbers drawn before any test, as pt draws them */
-                    seek(light_base + SLOTS_LIGHT * uint(k) + SLOT_LIGHT_POINT);
-                    vec2 x = sample_2d();
-                    seek(light_base + SLOTS_LIGHT * uint(k) + SLOT_LIGHT_JITTER);
-                    vec2 j = jitter ? sample_2d() : vec2(0.0);
-                    vec3 q = L.pos.xyz + (L.dir.xyz * x.x + L.extra.xyz * x.y);
-                    vec3 to = q - s.p;
-                    float d2 = dot(to, to);
-                    if (!(d2 > 0.0))
-                        continue;
-                    float dist = sqrt(d2);
-                    vec3 l = to * (1.0 / dist);
-                    float cos_e = -dot(nq, l), cos_r = dot(s.ns, l);
-                    if (cos_e <= 0.0 || cos_r <= 0.0 || !visible(s, l, dist, uint(i), j))
-                        continue;
-                    sum += brdf_eval(s, l) * (le * (cos_e * cos_r / d2));
-                }
-                continue;
-            }
-            seek(light_base + SLOT_LIGHT_JITTER);
-            vec2 j = jitter ? sample_2d() : vec2(0.0);
-            vec3 E, l;
-            float dist;
-            if (!light_delta(L, s.p, E, l, dist))
-                continue;
-            float cos_r = dot(s.ns, l);
-            if (cos_r <= 0.0 || !visible(s, l, dist, uint(i), j))
-                continue;
-            sum += brdf_eval(s, l) * (E * cos_r);
-        }
-        return sum;
     }
 
     float power_heuristic(float a, float b)
@@ -1403,68 +1385,6 @@ const char *const rl_gl_pt_glsl_path = GLSL(
     vec4 lv_texel(uint i) { return texelFetch(u_light_vertices, int(i)); }
     uint lv_offset(uint j) { return floatBitsToUint(lv_texel(j >> 2)[j & 3u]); }
 
-    /* The joins of camera vertex s at depth: all vertices of M light
-     * paths drawn from the set, each over M. */
-    vec3 light_vertices(Surf s, uint base, int depth)
-    {
-        vec3 sum = vec3(0.0);
-        for (int c = 0; c < u_lv_connect; ++c) {
-            seek(base + u_lv_slot + uint(c));
-            float u = sample_1d();
-            uint j = min(uint(u * float(u_lv_paths)), u_lv_paths - 1u);
-            uint first = lv_offset(j), end = lv_offset(j + 1u);
-            for (uint i = first; i < end; ++i) {
-                uint t = u_lv_base + 6u * i;
-                vec4 t0 = lv_texel(t), t1 = lv_texel(t + 1u), t2 = lv_texel(t + 2u);
-                vec4 t3 = lv_texel(t + 3u), t4 = lv_texel(t + 4u), t5 = lv_texel(t + 5u);
-                int index = int(t4.w);
-                /* pt's longest path: the light vertex's index and the
-                 * camera depth add up to at most max_depth */
-                if (index + depth > u_max_depth)
-                    break;
-                Surf y;
-                y.p = t0.xyz;
-                y.mat = floatBitsToUint(t0.w);
-                y.ng = t1.xyz;
-                y.ns = t2.xyz;
-                y.v = t3.xyz;
-                y.kd = t5.rgb;
-                y.front = true;
-                y.uv = vec2(0.0);
-                y.tri = NONE;
-                vec3 to = y.p - s.p;
-                float d2 = dot(to, to);
-                if (!(d2 > 0.0))
-                    continue;
-                vec3 wo = to * inversesqrt(d2);
-                float cos_c = dot(s.ns, wo);
-                if (cos_c <= 0.0 || dot(s.ng, wo) <= 0.0 || dot(y.ns, -wo) <= 0.0 || dot(y.ng, -wo) <= 0.0)
-                    continue;
-                float cos_y = dot(y.ng, -wo);
-                vec3 c = phong_eval(s, wo) * phong_eval(y, -wo) * t4.rgb * (cos_c * cos_y / d2);
-                if (!(max_comp(c) > 0.0))
-                    continue;
-                /* the shadow ray to y lifted off its surface by eps */
-                vec3 target = y.p + y.ng * u_eps;
-                vec3 tt = target - s.p;
-                float dist = length(tt);
-                if (!(dist > 0.0) || !visible(s, tt / dist, dist, 0u, vec2(0.0)))
-                    continue;
-                float pe_i = lv_pdf(s, wo) * cos_y / d2;
-                float rev = lv_pdf(turned(y, -wo), y.v);
-                float l2 = t2.w + (index + 1 + depth <= u_max_depth ? t3.w : 0.0);
-                float w_light = pe_i * pe_i * (t1.w + rev * rev * l2);
-                float pl_s = lv_pdf(y, -wo) * abs(dot(s.ng, wo)) / d2;
-                float w_cam = pl_s * pl_s * lv_cam_a(s, wo, false);
-                float sw = w_light + w_cam;
-                if (isinf(sw) || isnan(sw))
-                    continue;
-                sum += c * (1.0 / ((1.0 + sw) * float(u_lv_connect)));
-            }
-        }
-        return sum;
-    }
-
     /* rl_pt_lights_pick: the last k with cdf[k] <= u */
     uint pick_light(float u)
     {
@@ -1477,95 +1397,6 @@ const char *const rl_gl_pt_glsl_path = GLSL(
                 hi = mid;
         }
         return lo;
-    }
-
-    /* direct_light_mis */
-    vec3 direct_light_mis(Surf s, uint base, bool bsdf_follows)
-    {
-        if (u_table_count == 0u)
-            return vec3(0.0);
-        bool jitter = u_shadow == STRUCT_SHADOWMAP;
-        int n = u_light_samples;
-        vec3 sum = vec3(0.0);
-        for (int k = 0; k < n; ++k) {
-            uint slot = base + SLOTS_VERTEX + SLOTS_LIGHT * uint(k);
-            seek(slot + SLOT_LIGHT_PICK);
-            float u_pick = u_table_count > 1u ? sample_1d() : 0.0;
-            seek(slot + SLOT_LIGHT_POINT);
-            vec2 x = sample_2d();
-            seek(slot + SLOT_LIGHT_JITTER);
-            vec2 j = jitter ? sample_2d() : vec2(0.0);
-            uint src = table_source(pick_light(u_pick));
-            vec3 q, n_e, le;
-            float area, pmf;
-            bool hittable;
-            bool is_light = src < uint(u_num_lights);
-            if (is_light) {
-                Light L = lights[src];
-                pmf = L.power.w;
-                if (int(L.pos.w) != LIGHT_QUAD) {
-                    vec3 E, l;
-                    float dist;
-                    if (!light_delta(L, s.p, E, l, dist))
-                        continue;
-                    float cos_r = dot(s.ns, l);
-                    if (cos_r <= 0.0 || !visible(s, l, dist, src, j))
-                        continue;
-                    sum += brdf_eval(s, l) * (E * (cos_r / (pmf * float(n))));
-                    continue;
-                }
-                n_e = cross(L.dir.xyz, L.extra.xyz);
-                area = length(n_e);
-                n_e *= 1.0 / area;
-                q = L.pos.xyz + (L.dir.xyz * x.x + L.extra.xyz * x.y);
-                le = L.power.rgb;
-                hittable = u_mis_hits && L.extra.w > 0.0;
-            } else {
-                if (!u_tri_lights)
-                    continue;
-                uint t = src - uint(u_num_lights);
-                uvec4 T = triangles[t];
-                pmf = tri_pmf(t);
-                area = triangle_area(t, n_e);
-                float r = sqrt(x.x), b1 = x.y * r, b0 = 1.0 - r;
-                q = position(T.x) * b0 + position(T.y) * b1 + position(T.z) * (1.0 - b0 - b1);
-                le = materials[T.w].emission.rgb;
-                hittable = true;
-            }
-            vec3 to = q - s.p;
-            float d2 = dot(to, to);
-            if (!(d2 > 0.0))
-                continue;
-            float dist = sqrt(d2);
-            vec3 l = to * (1.0 / dist);
-            float cos_e = is_light ? -dot(n_e, l) : abs(dot(n_e, l));
-            float cos_r = dot(s.ns, l);
-            if (cos_e <= 0.0 || cos_r <= 0.0 || !visible(s, l, dist, src, j))
-                continue;
-            float p_light = pmf * d2 / (area * cos_e);
-            float w = lvc_on() ? lv_nee_weight(s, l, d2, cos_e, pmf, area, !is_light, bsdf_follows && hittable)
-                    : bsdf_follows && hittable ? power_heuristic(float(n) * p_light, bsdf_pdf(s, l)) : 1.0;
-            sum += brdf_eval(s, l) * (le * (w * cos_r / (p_light * float(n))));
-        }
-        return sum;
-    }
-
-    /* environment_light: one direction from the environment's
-     * distribution, the power heuristic against the BSDF sample that
-     * follows */
-    vec3 environment_light(Surf s, uint base, bool bsdf_follows)
-    {
-        seek(base + u_env_slot);
-        vec2 x = sample_2d();
-        vec3 l;
-        float p_env;
-        if (!env_sample(x.x, x.y, l, p_env))
-            return vec3(0.0);
-        float cos_r = dot(s.ns, l);
-        if (cos_r <= 0.0 || !visible(s, l, INF, 0u, vec2(0.0)))
-            return vec3(0.0);
-        float w = bsdf_follows ? power_heuristic(p_env, bsdf_pdf(s, l)) : 1.0;
-        return brdf_eval(s, l) * (env_radiance(l) * (w * cos_r / p_env));
     }
 
     /* escaped: a ray that left the scene; after a BRDF bounce with density
@@ -1711,8 +1542,23 @@ const char *const rl_gl_pt_glsl_path = GLSL(
     }
 
     /* ----------------------------------------------------------- path -- */
-    vec3 trace_path(Surf first)
+    /* rl_pt_trace_path (Sec. 6.4): the path from the camera ray (eye,
+     * cam_dir), or with raster from the G-buffer's surface first; a camera
+     * ray that leaves the scene brings miss. One ray per iteration of one
+     * loop, all through the one ray_query() call: the camera ray, then per
+     * vertex its shadow rays in pt's order (stage SHADOW: the lights,
+     * every light's samples with mis=off as pathtrace_path.c direct_light,
+     * the light table's light_samples picks with mis as direct_light_mis;
+     * the environment's sample, environment_light; the joins with the
+     * light vertices, light_vertices, not at the last vertex), each sum
+     * apart as pt adds them, then the ray the path goes on along (stage
+     * BOUNCE). A shadow ray that pt drops before its test is dropped here
+     * before the query too (same rays, same counts); an unblocked one
+     * brings C * (a / b) times the BRDF towards l (lights, environment:
+     * pt's products in pt's grouping) or C over a join's MIS sum (a). */
+    vec3 trace_path(bool raster, Surf first, vec3 eye, vec3 cam_dir, vec3 miss)
     {
+        const int VERTEX = 0, SHADOW = 1, PREPARE = 2, BOUNCE = 3;
         vec3 radiance = vec3(0.0), T = vec3(1.0);
         Surf s = first;
         bool after_brdf = false;
@@ -1721,115 +1567,415 @@ const char *const rl_gl_pt_glsl_path = GLSL(
         bool gen = u_rng != 0;
         if (lvc_on())
             lv_start();
-        for (int depth = 0;; ++depth) {
-            uint base = SLOT_FIRST_VERTEX + uint(depth) * u_vertex_slots;
-            Material m = materials[s.mat];
-            if (HAS_GGX != 0 && m.pbr.z > 0.0)
-                g_lobe = ggx_setup(s);
-            vec3 e = lvc_on() ? emitted_lvc(s, after_brdf)
-                           : u_mis ? emitted_mis(s, after_brdf, prev, prev_pdf) : emitted(s, after_brdf);
-            radiance += T * e;
+        int depth = 0;
+        /* without raster the camera ray (through the BVH) comes first */
+        bool camera = !raster;
+        int stage = raster ? VERTEX : BOUNCE;
+        int structure = STRUCT_BVH;
+        vec3 dir = cam_dir, origin = eye;
+        float origin_t = 0.0;
+        bool diffuse_ray = false, refracted = false, last = false;
+        uint base = 0u;
+        Material m;
+        /* the shadow rays: 0 the lights, 1 the environment, 2 the joins,
+         * 3 done; the lights' light i (mis=off) and sample k, the joins'
+         * light paths drawn so far and the vertices of the last one left */
+        int phase = 0, i = 0, k = 0, path = 0;
+        uint vi = 0u, vend = 0u;
+        vec3 direct = vec3(0.0), env = vec3(0.0), joins = vec3(0.0);
+        bool jitter = u_shadow == STRUCT_SHADOWMAP;
+        int n = u_light_samples;
+        while (true) {
+            if (stage == VERTEX) {
+                base = SLOT_FIRST_VERTEX + uint(depth) * u_vertex_slots;
+                m = materials[s.mat];
+                if (HAS_GGX != 0 && m.pbr.z > 0.0)
+                    g_lobe = ggx_setup(s);
+                vec3 e = lvc_on() ? emitted_lvc(s, after_brdf)
+                               : u_mis ? emitted_mis(s, after_brdf, prev, prev_pdf) : emitted(s, after_brdf);
+                radiance += T * e;
 
-            float k_r = m.diffuse.w, k_t = m.extra.x;
-            seek(base + SLOT_EVENT);
-            float u_event = gen || k_r + k_t > 0.0 ? sample_1d() : 1.0;
-            vec3 dir;
-            bool diffuse_ray, refracted = false;
-            if (u_event < k_r + k_t) {
-                if (depth >= u_max_depth)
-                    break;
-                /* rl_pt_specular_event: with Schlick's Fresnel (extra.w) a
-                 * mirror reflects F with F0 = k_s, and within k_t the
-                 * event reflects with probability F (weight 1) */
-                vec3 d = -s.v;
-                diffuse_ray = false;
-                dir = d - s.ns * (2.0 * dot(d, s.ns));
-                bool schlick = m.extra.w > 0.0;
-                bool fresnel_mirror = false;
-                if (u_event < k_r && schlick) {
-                    T *= m.specular.rgb + (vec3(1.0) - m.specular.rgb) * schlick_weight(dot(s.ns, s.v));
-                } else if (u_event >= k_r && schlick) {
-                    float ior = m.extra.y >= 1.0 ? m.extra.y : 1.0;
-                    float F = fresnel_schlick(dot(s.ns, s.v), s.front ? ior : 1.0 / ior);
-                    float u = k_t > 0.0 ? (u_event - k_r) / k_t : 0.0;
-                    fresnel_mirror = u < F;
+                float k_r = m.diffuse.w, k_t = m.extra.x;
+                seek(base + SLOT_EVENT);
+                float u_event = gen || k_r + k_t > 0.0 ? sample_1d() : 1.0;
+                refracted = false;
+                if (u_event < k_r + k_t) {
+                    if (depth >= u_max_depth)
+                        break;
+                    /* rl_pt_specular_event: with Schlick's Fresnel (extra.w) a
+                     * mirror reflects F with F0 = k_s, and within k_t the
+                     * event reflects with probability F (weight 1) */
+                    vec3 d = -s.v;
+                    diffuse_ray = false;
+                    dir = d - s.ns * (2.0 * dot(d, s.ns));
+                    bool schlick = m.extra.w > 0.0;
+                    bool fresnel_mirror = false;
+                    if (u_event < k_r && schlick) {
+                        T *= m.specular.rgb + (vec3(1.0) - m.specular.rgb) * schlick_weight(dot(s.ns, s.v));
+                    } else if (u_event >= k_r && schlick) {
+                        float ior = m.extra.y >= 1.0 ? m.extra.y : 1.0;
+                        float F = fresnel_schlick(dot(s.ns, s.v), s.front ? ior : 1.0 / ior);
+                        float u = k_t > 0.0 ? (u_event - k_r) / k_t : 0.0;
+                        fresnel_mirror = u < F;
+                    }
+                    if (u_event >= k_r && !fresnel_mirror) {
+                        float ior = m.extra.y >= 1.0 ? m.extra.y : 1.0;
+                        float eta = s.front ? 1.0 / ior : ior;
+                        float cos_i = -dot(d, s.ns);
+                        float kk = 1.0 - eta * eta * (1.0 - cos_i * cos_i);
+                        if (kk >= 0.0) {
+                            dir = normalize(d * eta + s.ns * (eta * cos_i - sqrt(kk)));
+                            refracted = true;
+                        }
+                    }
+                    after_brdf = false;
+                    if (lvc_on())
+                        lv_leave(s, dir, true);
+                    stage = PREPARE;
+                } else {
+                    last = depth >= u_max_depth;
+                    direct = vec3(0.0);
+                    env = vec3(0.0);
+                    joins = vec3(0.0);
+                    phase = u_mis && u_table_count == 0u ? 1 : 0;
+                    i = 0;
+                    k = 0;
+                    path = 0;
+                    vi = 0u;
+                    vend = 0u;
+                    stage = SHADOW;
                 }
-                if (u_event >= k_r && !fresnel_mirror) {
-                    float ior = m.extra.y >= 1.0 ? m.extra.y : 1.0;
-                    float eta = s.front ? 1.0 / ior : ior;
-                    float cos_i = -dot(d, s.ns);
-                    float k = 1.0 - eta * eta * (1.0 - cos_i * cos_i);
-                    if (k >= 0.0) {
-                        dir = normalize(d * eta + s.ns * (eta * cos_i - sqrt(k)));
-                        refracted = true;
+            }
+
+            /* the next shadow ray: towards l, dist long (INF: unbounded),
+             * with the jitter j of its light's shadow maps */
+            int kind = phase;
+            vec3 l = vec3(0.0), C = vec3(0.0);
+            float dist = INF, a = 1.0, b = 1.0;
+            uint light = 0u;
+            vec2 j = vec2(0.0);
+            /* lights with mis, area kind: weighed after the test, as pt */
+            bool weigh = false;
+            float d2 = 0.0, cos_e = 0.0, cos_r = 0.0, pmf = 0.0, area = 0.0;
+            bool two_sided = false, hittable = false;
+            if (stage == SHADOW) {
+                if (phase == 0 && !u_mis) {
+                    if (i >= u_num_lights) {
+                        phase = 1;
+                        continue;
+                    }
+                    Light L = lights[i];
+                    uint light_base = base + SLOTS_VERTEX + SLOTS_LIGHT * uint(i) * uint(n);
+                    light = uint(i);
+                    if (int(L.pos.w) == LIGHT_QUAD) {
+                        vec3 nq = cross(L.dir.xyz, L.extra.xyz);
+                        area = length(nq);
+                        if (!(area > 0.0) || k >= n) {
+                            ++i;
+                            k = 0;
+                            continue;
+                        }
+                        nq *= 1.0 / area;
+                        C = L.power.rgb * (area / float(n));
+                        /* both numbers drawn before any test, as pt draws them */
+                        seek(light_base + SLOTS_LIGHT * uint(k) + SLOT_LIGHT_POINT);
+                        vec2 x = sample_2d();
+                        seek(light_base + SLOTS_LIGHT * uint(k) + SLOT_LIGHT_JITTER);
+                        j = jitter ? sample_2d() : vec2(0.0);
+                        ++k;
+                        vec3 q = L.pos.xyz + (L.dir.xyz * x.x + L.extra.xyz * x.y);
+                        vec3 to = q - s.p;
+                        d2 = dot(to, to);
+                        if (!(d2 > 0.0))
+                            continue;
+                        dist = sqrt(d2);
+                        l = to * (1.0 / dist);
+                        cos_e = -dot(nq, l);
+                        cos_r = dot(s.ns, l);
+                        if (cos_e <= 0.0 || cos_r <= 0.0)
+                            continue;
+                        a = cos_e * cos_r;
+                        b = d2;
+                    } else {
+                        ++i;
+                        k = 0;
+                        seek(light_base + SLOT_LIGHT_JITTER);
+                        j = jitter ? sample_2d() : vec2(0.0);
+                        if (!light_delta(L, s.p, C, l, dist))
+                            continue;
+                        cos_r = dot(s.ns, l);
+                        if (cos_r <= 0.0)
+                            continue;
+                        /* pt's E cos_r: a / 1 is a exactly */
+                        a = cos_r;
+                    }
+                } else if (phase == 0) {
+                    if (k >= n) {
+                        phase = 1;
+                        continue;
+                    }
+                    uint slot = base + SLOTS_VERTEX + SLOTS_LIGHT * uint(k);
+                    ++k;
+                    seek(slot + SLOT_LIGHT_PICK);
+                    float u_pick = u_table_count > 1u ? sample_1d() : 0.0;
+                    seek(slot + SLOT_LIGHT_POINT);
+                    vec2 x = sample_2d();
+                    seek(slot + SLOT_LIGHT_JITTER);
+                    j = jitter ? sample_2d() : vec2(0.0);
+                    uint src = table_source(pick_light(u_pick));
+                    light = src;
+                    vec3 q, n_e;
+                    bool is_light = src < uint(u_num_lights);
+                    if (is_light) {
+                        Light L = lights[src];
+                        pmf = L.power.w;
+                        if (int(L.pos.w) != LIGHT_QUAD) {
+                            if (!light_delta(L, s.p, C, l, dist))
+                                continue;
+                            cos_r = dot(s.ns, l);
+                            if (cos_r <= 0.0)
+                                continue;
+                            a = cos_r;
+                            b = pmf * float(n);
+                        } else {
+                            n_e = cross(L.dir.xyz, L.extra.xyz);
+                            area = length(n_e);
+                            n_e *= 1.0 / area;
+                            q = L.pos.xyz + (L.dir.xyz * x.x + L.extra.xyz * x.y);
+                            C = L.power.rgb;
+                            hittable = u_mis_hits && L.extra.w > 0.0;
+                            weigh = true;
+                        }
+                    } else {
+                        if (!u_tri_lights)
+                            continue;
+                        uint t = src - uint(u_num_lights);
+                        uvec4 Tv = triangles[t];
+                        pmf = tri_pmf(t);
+                        area = triangle_area(t, n_e);
+                        float r = sqrt(x.x), b1 = x.y * r, b0 = 1.0 - r;
+                        q = position(Tv.x) * b0 + position(Tv.y) * b1 + position(Tv.z) * (1.0 - b0 - b1);
+                        C = materials[Tv.w].emission.rgb;
+                        hittable = true;
+                        two_sided = true;
+                        weigh = true;
+                    }
+                    if (weigh) {
+                        vec3 to = q - s.p;
+                        d2 = dot(to, to);
+                        if (!(d2 > 0.0))
+                            continue;
+                        dist = sqrt(d2);
+                        l = to * (1.0 / dist);
+                        cos_e = is_light ? -dot(n_e, l) : abs(dot(n_e, l));
+                        cos_r = dot(s.ns, l);
+                        if (cos_e <= 0.0 || cos_r <= 0.0)
+                            continue;
+                    }
+                } else if (phase == 1) {
+                    phase = 2;
+                    if (!env_nee_on())
+                        continue;
+                    seek(base + u_env_slot);
+                    vec2 x = sample_2d();
+                    if (!env_sample(x.x, x.y, l, b))
+                        continue;
+                    cos_r = dot(s.ns, l);
+                    if (cos_r <= 0.0)
+                        continue;
+                } else if (phase == 2) {
+                    if (last || !lvc_on()) {
+                        phase = 3;
+                    } else if (vi >= vend) {
+                        if (path >= u_lv_connect) {
+                            phase = 3;
+                        } else {
+                            seek(base + u_lv_slot + uint(path));
+                            ++path;
+                            float u = sample_1d();
+                            uint jp = min(uint(u * float(u_lv_paths)), u_lv_paths - 1u);
+                            vi = lv_offset(jp);
+                            vend = lv_offset(jp + 1u);
+                            continue;
+                        }
+                    } else {
+                        uint t = u_lv_base + 6u * vi;
+                        ++vi;
+                        vec4 t0 = lv_texel(t), t1 = lv_texel(t + 1u), t2 = lv_texel(t + 2u);
+                        vec4 t3 = lv_texel(t + 3u), t4 = lv_texel(t + 4u), t5 = lv_texel(t + 5u);
+                        int index = int(t4.w);
+                        /* pt's longest path: the light vertex's index and the
+                         * camera depth add up to at most max_depth */
+                        if (index + depth > u_max_depth) {
+                            vi = vend;
+                            continue;
+                        }
+                        Surf y;
+                        y.p = t0.xyz;
+                        y.mat = floatBitsToUint(t0.w);
+                        y.ng = t1.xyz;
+                        y.ns = t2.xyz;
+                        y.v = t3.xyz;
+                        y.kd = t5.rgb;
+                        y.front = true;
+                        y.uv = vec2(0.0);
+                        y.tri = NONE;
+                        vec3 to = y.p - s.p;
+                        d2 = dot(to, to);
+                        if (!(d2 > 0.0))
+                            continue;
+                        vec3 wo = to * inversesqrt(d2);
+                        float cos_c = dot(s.ns, wo);
+                        if (cos_c <= 0.0 || dot(s.ng, wo) <= 0.0 || dot(y.ns, -wo) <= 0.0 || dot(y.ng, -wo) <= 0.0)
+                            continue;
+                        float cos_y = dot(y.ng, -wo);
+                        C = phong_eval(s, wo) * phong_eval(y, -wo) * t4.rgb * (cos_c * cos_y / d2);
+                        if (!(max_comp(C) > 0.0))
+                            continue;
+                        /* the shadow ray to y lifted off its surface by eps */
+                        vec3 target = y.p + y.ng * u_eps;
+                        vec3 tt = target - s.p;
+                        dist = length(tt);
+                        if (!(dist > 0.0))
+                            continue;
+                        l = tt / dist;
+                        /* the MIS weight's sum (tested after the shadow ray, as pt) */
+                        float pe_i = lv_pdf(s, wo) * cos_y / d2;
+                        float rev = lv_pdf(turned(y, -wo), y.v);
+                        float l2 = t2.w + (index + 1 + depth <= u_max_depth ? t3.w : 0.0);
+                        float w_light = pe_i * pe_i * (t1.w + rev * rev * l2);
+                        float pl_s = lv_pdf(y, -wo) * abs(dot(s.ng, wo)) / d2;
+                        float w_cam = pl_s * pl_s * lv_cam_a(s, wo, false);
+                        a = w_light + w_cam;
                     }
                 }
-                after_brdf = false;
-                if (lvc_on())
-                    lv_leave(s, dir, true);
-            } else {
-                bool last = depth >= u_max_depth;
-                radiance += T * (u_mis ? direct_light_mis(s, base, !last) : direct_light(s, base));
-                if (env_nee_on())
-                    radiance += T * environment_light(s, base, !last);
-                if (last)
-                    break;
-                if (lvc_on())
-                    radiance += T * light_vertices(s, base, depth);
-                seek(base + SLOT_LOBE);
-                /* rl_pt_bsdf_needs_lobe: GGX picks a lobe, Phong where it has k_s */
-                float u0 = gen || m.pbr.z > 0.0 || max_comp(m.specular.rgb) > 0.0 ? sample_1d() : 0.0;
-                seek(base + SLOT_BSDF);
-                vec2 u12 = sample_2d();
-                vec3 w;
-                if (!brdf_sample(s, u0, u12.x, u12.y, dir, w))
-                    break;
-                T *= w;
-                diffuse_ray = true;
-                after_brdf = true;
-                prev_pdf = u_mis || env_nee_on() ? brdf_pdf(s, dir) : 0.0;
-                if (lvc_on())
-                    lv_leave(s, dir, false);
+                if (phase == 3) {
+                    /* the vertex's shadow rays are done: pt's sums, then
+                     * the BRDF sample the path goes on with */
+                    radiance += T * direct;
+                    if (env_nee_on())
+                        radiance += T * env;
+                    if (last)
+                        break;
+                    if (lvc_on())
+                        radiance += T * joins;
+                    seek(base + SLOT_LOBE);
+                    /* rl_pt_bsdf_needs_lobe: GGX picks a lobe, Phong where it has k_s */
+                    float u0 = gen || m.pbr.z > 0.0 || max_comp(m.specular.rgb) > 0.0 ? sample_1d() : 0.0;
+                    seek(base + SLOT_BSDF);
+                    vec2 u12 = sample_2d();
+                    vec3 w;
+                    if (!brdf_sample(s, u0, u12.x, u12.y, dir, w))
+                        break;
+                    T *= w;
+                    diffuse_ray = true;
+                    after_brdf = true;
+                    prev_pdf = u_mis || env_nee_on() ? brdf_pdf(s, dir) : 0.0;
+                    if (lvc_on())
+                        lv_leave(s, dir, false);
+                    stage = PREPARE;
+                }
             }
-            prev = s.p;
 
-            if (u_rr && depth >= u_rr_depth) {
-                float q = min(1.0, max_comp(T));
-                seek(base + SLOT_RR);
-                float xi = sample_1d();
-                if (!(xi < q))
+            if (stage == PREPARE) {
+                prev = s.p;
+                if (u_rr && depth >= u_rr_depth) {
+                    float q = min(1.0, max_comp(T));
+                    seek(base + SLOT_RR);
+                    float xi = sample_1d();
+                    if (!(xi < q))
+                        break;
+                    T *= 1.0 / q;
+                }
+                if (!(max_comp(T) > 0.0))
                     break;
-                T *= 1.0 / q;
+                /* Sec. 11.2, 12.3: mirror and refraction rays may take another
+                 * structure than the diffuse bounces */
+                structure = diffuse_ray ? u_diffuse : u_specular;
+                origin = offset_origin(s, dir);
+                if (diffuse_ray)
+                    atomicCounterIncrement(c_diffuse);
+                else if (refracted)
+                    atomicCounterIncrement(c_refraction);
+                else
+                    atomicCounterIncrement(c_reflection);
+                /* the payload walks start at pt's voxel offset */
+                origin_t = (may_use(STRUCT_LS_PNMT) && structure == STRUCT_LS_PNMT) ||
+                           (may_use(STRUCT_LS_PREILLUM) && structure == STRUCT_LS_PREILLUM) ? max(0.0, u_ls_start)
+                                                                                          : 0.0;
+                stage = BOUNCE;
             }
-            if (!(max_comp(T) > 0.0))
-                break;
 
-            /* Sec. 11.2, 12.3: mirror and refraction rays may take another
-             * structure than the diffuse bounces */
-            int structure = diffuse_ray ? u_diffuse : u_specular;
-            vec3 o = offset_origin(s, dir);
-            if (diffuse_ray)
-                atomicCounterIncrement(c_diffuse);
-            else if (refracted)
-                atomicCounterIncrement(c_refraction);
-            else
-                atomicCounterIncrement(c_reflection);
-            if (structure == STRUCT_LS_PREILLUM) {
+            /* the ray: a shadow ray of u_shadow, or the bounce (the camera
+             * ray first) */
+            bool shadow = stage == SHADOW;
+            int rs = structure;
+            vec3 ro = origin, rd = dir;
+            float t_min = origin_t, t_max = INF;
+            int known = -1;
+            if (shadow) {
+                rs = u_shadow;
+                known = shadow_setup(s, l, dist, light, j, ro, rd, t_min, t_max);
+            }
+            Hit h;
+            vec3 rec_p = vec3(0.0), rec_n = vec3(0.0);
+            vec2 rec_uv = vec2(0.0);
+            uint rec_mat = 0u;
+            bool hit = known < 0 ? ray_query(rs, ro, rd, t_min, t_max, shadow, h, rec_p, rec_n, rec_uv, rec_mat)
+                                 : known == 1;
+
+            if (shadow) {
+                if (hit)
+                    continue;
+                if (kind == 2) {
+                    if (!(isinf(a) || isnan(a)))
+                        joins += C * (1.0 / ((1.0 + a) * float(u_lv_connect)));
+                    continue;
+                }
+                if (weigh) {
+                    float p_light = pmf * d2 / (area * cos_e);
+                    float w = lvc_on() ? lv_nee_weight(s, l, d2, cos_e, pmf, area, two_sided, !last && hittable)
+                            : !last && hittable ? power_heuristic(float(n) * p_light, bsdf_pdf(s, l)) : 1.0;
+                    a = w * cos_r;
+                    b = p_light * float(n);
+                } else if (kind == 1) {
+                    float w = !last ? power_heuristic(b, bsdf_pdf(s, l)) : 1.0;
+                    C = env_radiance(l);
+                    a = w * cos_r;
+                }
+                vec3 f = brdf_eval(s, l) * (C * (a / b));
+                if (kind == 0)
+                    direct += f;
+                else
+                    env += f;
+                continue;
+            }
+            if (camera && !hit)
+                return miss;
+            /* (the camera ray's structure is the BVH) */
+            if (may_use(STRUCT_LS_PREILLUM) && structure == STRUCT_LS_PREILLUM) {
                 /* the stored direct light ends the path (Sec. 7.4) */
-                vec3 col;
-                float t;
-                radiance += T * (rl_ls_preillum(o, dir, max(0.0, u_ls_start), INF, col, t) ? col
-                                                                                  : escaped(dir, after_brdf, prev_pdf));
+                radiance += T * (hit ? rec_p : escaped(dir, after_brdf, prev_pdf));
                 break;
             }
             Surf next;
-            if (!closest(structure, o, dir, next)) {
+            if (!hit || !surface_of_hit(structure, origin, dir, h, rec_p, rec_n, rec_uv, rec_mat, next)) {
                 radiance += T * escaped(dir, after_brdf, prev_pdf);
                 break;
+            }
+            if (camera) {
+                /* the first hit: the path starts */
+                camera = false;
+                s = next;
+                prev = s.p;
+                stage = VERTEX;
+                continue;
             }
             if (lvc_on())
                 lv_arrive(next, s.p);
             s = next;
+            ++depth;
+            stage = VERTEX;
         }
         return radiance;
     }
@@ -1860,24 +2006,27 @@ const char *const rl_gl_pt_glsl_path = GLSL(
         float cy = (1.0 - 2.0 * (float(px.y) + 0.5) / float(u_size.y)) * u_tan_half_fov;
         vec3 centre = normalize(u_cam_u * cx + u_cam_v * cy - u_cam_w);
         vec3 L = env_on() ? env_radiance(centre) : u_background;
+        /* one call of trace_path for both kinds of first hit: Mesa inlines
+         * a function at every call, and two calls were two copies of the
+         * whole path program (docs/gl.md, "One ray site") */
+        Surf first;
+        bool go = true;
+        vec3 dir = centre;
         if (u_raster) {
             /* the G-buffer's pixel centre: no jitter, no number drawn */
             uint tri = texelFetch(u_ids, px, 0).x;
-            Surf first;
-            if (tri < uint(triangles.length()) && surface_of_pixel(tri, u_eye, centre, first))
-                L = trace_path(first);
+            go = tri < uint(triangles.length()) && surface_of_pixel(tri, u_eye, centre, first);
         } else {
             seek(SLOT_PIXEL);
             vec2 j = sample_2d();
             /* rl_camera_frame_ray: image plane at distance 1, rows downwards */
             float sx = (2.0 * (float(px.x) + j.x) / float(u_size.x) - 1.0) * u_tan_half_fov * u_aspect;
             float sy = (1.0 - 2.0 * (float(px.y) + j.y) / float(u_size.y)) * u_tan_half_fov;
-            vec3 dir = normalize(u_cam_u * sx + u_cam_v * sy - u_cam_w);
-            Hit h;
+            dir = normalize(u_cam_u * sx + u_cam_v * sy - u_cam_w);
             atomicCounterIncrement(c_primary);
-            if (bvh_query(u_eye, dir, 0.0, INF, false, h))
-                L = trace_path(surface_at(h, dir));
         }
+        if (go)
+            L = trace_path(u_raster, first, u_eye, dir, L);
         /* A NaN or infinity would poison the pixel's mean for good; it
          * counts as black, as pt counts the sample but adds nothing. */
         if (!finite3(L))
