@@ -1300,12 +1300,31 @@ const char *const rl_gl_pt_glsl_path = GLSL(
         return r;
     }
 
-    /* bdpt_path.c bsdf_pdf: the BRDF's density with the event's share */
+    /* bdpt_path.c bsdf_pdf: the BRDF's density with the event's share, at
+     * the path's current vertex s (Phong or GGX; GGX's lobe is g_lobe,
+     * set up for s) */
     float lv_pdf(Surf s, vec3 wi)
     {
         Material m = materials[s.mat];
         float k = max(0.0, 1.0 - m.diffuse.w - m.extra.x);
-        return k > 0.0 && dot(s.ng, wi) > 0.0 ? k * phong_pdf(s, wi) : 0.0;
+        return k > 0.0 && dot(s.ng, wi) > 0.0 ? k * brdf_pdf(s, wi) : 0.0;
+    }
+
+    /* lv_pdf at another surface than the current vertex (a light vertex,
+     * or a vertex seen from its other direction: turned): GGX's lobe
+     * depends on s.v (Sec. 13.4; pathtrace_ggx.c), so it is set up here
+     * for s. Only the GGX variant has that code (is_ggx). */
+    float lv_pdf_at(Surf s, vec3 wi)
+    {
+        Material m = materials[s.mat];
+        float k = max(0.0, 1.0 - m.diffuse.w - m.extra.x);
+        if (!(k > 0.0 && dot(s.ng, wi) > 0.0))
+            return 0.0;
+        if (is_ggx(s)) {
+            Ggx g = ggx_setup(s);
+            return k * ggx_pdf_local(g, ggx_local(g, wi));
+        }
+        return k * phong_pdf(s, wi);
     }
 
     /* A_m of camera vertex s leaving towards wi (delta: a specular event):
@@ -1315,7 +1334,7 @@ const char *const rl_gl_pt_glsl_path = GLSL(
         float inv = 1.0 / (g_cpe * g_cpe);
         float a = !delta && g_cok ? inv : 0.0;
         if (g_ca > 0.0) {
-            float pl = delta ? 1.0 : lv_pdf(turned(s, wi), s.v) * g_ccos / g_cd2;
+            float pl = delta ? 1.0 : lv_pdf_at(turned(s, wi), s.v) * g_ccos / g_cd2;
             a += pl * pl * g_ca * inv;
         }
         return a;
@@ -1829,7 +1848,16 @@ const char *const rl_gl_pt_glsl_path = GLSL(
                         if (cos_c <= 0.0 || dot(s.ng, wo) <= 0.0 || dot(y.ns, -wo) <= 0.0 || dot(y.ng, -wo) <= 0.0)
                             continue;
                         float cos_y = dot(y.ng, -wo);
-                        C = phong_eval(s, wo) * phong_eval(y, -wo) * t4.rgb * (cos_c * cos_y / d2);
+                        /* the BRDFs at both ends (Phong or GGX; y's GGX lobe
+                         * at y.v, the camera vertex's is g_lobe) */
+                        vec3 f_y;
+                        if (is_ggx(y)) {
+                            Ggx gy = ggx_setup(y);
+                            f_y = ggx_eval_local(gy, ggx_local(gy, -wo));
+                        } else {
+                            f_y = phong_eval(y, -wo);
+                        }
+                        C = brdf_eval(s, wo) * f_y * t4.rgb * (cos_c * cos_y / d2);
                         if (!(max_comp(C) > 0.0))
                             continue;
                         /* the shadow ray to y lifted off its surface by eps */
@@ -1841,10 +1869,10 @@ const char *const rl_gl_pt_glsl_path = GLSL(
                         l = tt / dist;
                         /* the MIS weight's sum (tested after the shadow ray, as pt) */
                         float pe_i = lv_pdf(s, wo) * cos_y / d2;
-                        float rev = lv_pdf(turned(y, -wo), y.v);
+                        float rev = lv_pdf_at(turned(y, -wo), y.v);
                         float l2 = t2.w + (index + 1 + depth <= u_max_depth ? t3.w : 0.0);
                         float w_light = pe_i * pe_i * (t1.w + rev * rev * l2);
-                        float pl_s = lv_pdf(y, -wo) * abs(dot(s.ng, wo)) / d2;
+                        float pl_s = lv_pdf_at(y, -wo) * abs(dot(s.ng, wo)) / d2;
                         float w_cam = pl_s * pl_s * lv_cam_a(s, wo, false);
                         a = w_light + w_cam;
                     }

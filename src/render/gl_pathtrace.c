@@ -671,12 +671,11 @@ static rl_status lv_check(const rl_renderer *r, const rl_scene_data *d)
     if (d->environment)
         return rl_error(RL_ERR_UNSUPPORTED, "gl-pt: light_paths does not start light paths at a scene "
                         "environment (bdpt does; use light_paths=0 or bdpt)");
-    /* The joins evaluate the Phong BRDF at both ends (lv_pdf, phong_eval in
-     * the shader); GGX at a light vertex is not ported there yet. */
-    for (uint32_t i = 0; i < d->num_materials; ++i)
-        if (d->materials[i].bsdf == RL_BSDF_GGX)
-            return rl_error(RL_ERR_UNSUPPORTED, "gl-pt: light_paths does not join GGX materials yet (material "
-                            "'%s'; use light_paths=0, or bdpt)", d->materials[i].name);
+    /* GGX needs nothing of its own (Sec. 13.4): a light vertex's record
+     * holds what its lobe is set up from (position, normals, the direction
+     * it was reached from, kd, the material), so the shader's joins
+     * evaluate GGX's BRDF and densities at both ends (lv_pdf_at), and
+     * bd_light_subpath's densities in the record are already GGX's. */
     /* adaptive=on needs nothing of its own: each of a pixel's samples is a
      * camera path that joins paths drawn uniformly from the frame's set,
      * and the MIS weights count the strategies of one camera path (its
@@ -888,6 +887,7 @@ static rl_status gl_pt_render(rl_renderer *r, void *state, const rl_scene *scene
         lctx.rr = f.rr;
         lctx.mis = BD_MIS_POWER;
         lctx.only_s = lctx.only_t = -1;
+        lctx.ggx_ms = f.ggx_ms;    /* the light paths scatter at GGX as the shader evaluates it */
         lctx.light_share = 1.0f;   /* no environment (lv_check) */
         lp = (lv_params){ .ctx = &lctx, .seed = (uint64_t)rl_renderer_opt_int(r, "seed"), .max_depth = f.max_depth,
                           .nu0 = 1.0f / (float)connect, .nu1 = (float)f.light_samples / (float)connect };
