@@ -23,16 +23,10 @@ static inline bool above(vt_heap_item x, vt_heap_item y)
 
 rl_status vt_heap_push(vt_heap *h, uint32_t edge, float length)
 {
-    if (h->count == h->cap) {
-        if (h->cap >= VT_HEAP_MAX_ITEMS)
-            return rl_error(RL_ERR_LIMIT, "vt edge list: more than 2^31 edges");
-        uint32_t cap = h->cap ? 2 * h->cap : 1024;
-        vt_heap_item *items = vt_array_resize(h->items, (size_t)h->cap * sizeof *items, (size_t)cap * sizeof *items);
-        if (!items)
-            return RL_ERR_OUT_OF_MEMORY;
-        h->items = items;
-        h->cap = cap;
-    }
+    rl_status st = vt_array_reserve((void **)&h->items, &h->cap, (uint64_t)h->count + 1, sizeof *h->items, 1024,
+                                    VT_HEAP_MAX_ITEMS, "vt edge list");
+    if (st != RL_OK)
+        return st;
     /* A NaN length would break the ordering for every other edge. */
     if (isnan(length))
         length = -INFINITY;

@@ -42,6 +42,13 @@
  * malloc/free. */
 void *vt_array_resize(void *p, size_t old_bytes, size_t new_bytes);
 void vt_array_free(void *p, size_t bytes);
+/* Room for need items of item_size in *array (vt_array_resize's, *cap
+ * items), doubled from *cap, or from first when empty, and capped at
+ * max_items: one growth rule for the mesh, the edge list and the batches.
+ * RL_ERR_LIMIT when need is above max_items, else RL_ERR_OUT_OF_MEMORY; the
+ * error names `what`, and *array and *cap stay as they were. */
+rl_status vt_array_reserve(void **array, uint32_t *cap, uint64_t need, size_t item_size, uint32_t first,
+                           uint32_t max_items, const char *what);
 
 /* ---------------------------------------------------------------- mesh -- */
 

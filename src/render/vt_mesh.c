@@ -126,28 +126,34 @@ void vt_array_free(void *p, size_t bytes)
 #endif
 }
 
-/* Grows an array of item_size elements to hold at least need of them. */
-static rl_status grow(void **array, uint32_t *cap, uint32_t need, size_t item_size,
-                      const char *what)
+rl_status vt_array_reserve(void **array, uint32_t *cap, uint64_t need, size_t item_size, uint32_t first,
+                           uint32_t max_items, const char *what)
 {
     if (need <= *cap)
         return RL_OK;
-    if (need > VT_MESH_MAX_ELEMENTS)
-        return rl_error(RL_ERR_LIMIT, "vt mesh: more than 2^31 %s", what);
-    uint64_t n = *cap ? *cap : 256;
+    if (need > max_items)
+        return rl_error(RL_ERR_LIMIT, "%s: more than %u", what, max_items);
+    uint64_t n = *cap ? *cap : first;
     while (n < need)
         n *= 2;
-    if (n > VT_MESH_MAX_ELEMENTS)
-        n = VT_MESH_MAX_ELEMENTS;
+    if (n > max_items)
+        n = max_items;
     if ((size_t)n > SIZE_MAX / item_size)
-        return rl_error(RL_ERR_OUT_OF_MEMORY, "vt mesh: %llu %s overflow the address space",
-                        (unsigned long long)n, what);
+        return rl_error(RL_ERR_OUT_OF_MEMORY, "%s: %llu overflow the address space", what,
+                        (unsigned long long)n);
     void *p = vt_array_resize(*array, (size_t)*cap * item_size, (size_t)n * item_size);
     if (!p)
-        return rl_error(RL_ERR_OUT_OF_MEMORY, "vt mesh: out of memory for %llu %s", (unsigned long long)n, what);
+        return rl_error(RL_ERR_OUT_OF_MEMORY, "%s: out of memory for %llu", what, (unsigned long long)n);
     *array = p;
     *cap = (uint32_t)n;
     return RL_OK;
+}
+
+/* The mesh's arrays grow from 256 elements (a multiple of 32: the queued
+ * bits below stay whole words). */
+static rl_status grow(void **array, uint32_t *cap, uint32_t need, size_t item_size, const char *what)
+{
+    return vt_array_reserve(array, cap, need, item_size, 256, VT_MESH_MAX_ELEMENTS, what);
 }
 
 static rl_status reserve(vt_mesh *m, uint32_t verts, uint32_t edges, uint32_t faces)
@@ -157,12 +163,12 @@ static rl_status reserve(vt_mesh *m, uint32_t verts, uint32_t edges, uint32_t fa
         faces > VT_MESH_MAX_ELEMENTS - m->num_faces)
         return rl_error(RL_ERR_LIMIT, "vt mesh: more than 2^31 elements");
     rl_status st = grow((void **)&m->verts, &m->cap_verts, m->num_verts + verts, sizeof *m->verts,
-                        "vertices");
+                        "vt mesh vertices");
     if (st == RL_OK)
         st = grow((void **)&m->samples, &m->cap_samples, m->num_verts + verts, sizeof *m->samples,
-                  "vertices");
+                  "vt mesh vertices");
     if (st == RL_OK)
-        st = grow((void **)&m->edges, &m->cap_edges, m->num_edges + edges, sizeof *m->edges, "edges");
+        st = grow((void **)&m->edges, &m->cap_edges, m->num_edges + edges, sizeof *m->edges, "vt mesh edges");
     if (st == RL_OK && m->cap_queued < m->cap_edges / 32) {
         /* The queued bits follow the edges' capacity (a multiple of 256,
          * so of 32); new words start clear. On failure the edges keep
@@ -177,7 +183,7 @@ static rl_status reserve(vt_mesh *m, uint32_t verts, uint32_t edges, uint32_t fa
         m->cap_queued = words;
     }
     if (st == RL_OK)
-        st = grow((void **)&m->faces, &m->cap_faces, m->num_faces + faces, sizeof *m->faces, "faces");
+        st = grow((void **)&m->faces, &m->cap_faces, m->num_faces + faces, sizeof *m->faces, "vt mesh faces");
     return st;
 }
 
@@ -279,9 +285,9 @@ rl_status vt_mesh_set_sample(vt_mesh *m, uint32_t v, const vt_vertex_sample *s,
         }
     if (need > VT_MESH_MAX_ELEMENTS - m->num_layers || need_plain > VT_MESH_MAX_ELEMENTS - m->num_plain)
         return rl_error(RL_ERR_LIMIT, "vt mesh: more than 2^31 deferred layers");
-    rl_status st = grow((void **)&m->layers, &m->cap_layers, m->num_layers + need, sizeof *m->layers, "layers");
+    rl_status st = grow((void **)&m->layers, &m->cap_layers, m->num_layers + need, sizeof *m->layers, "vt mesh layers");
     if (st == RL_OK)
-        st = grow((void **)&m->plain, &m->cap_plain, m->num_plain + need_plain, sizeof *m->plain, "layers");
+        st = grow((void **)&m->plain, &m->cap_plain, m->num_plain + need_plain, sizeof *m->plain, "vt mesh layers");
     if (st != RL_OK)
         return st;
     vt_vertex_sample *out = &m->samples[v];

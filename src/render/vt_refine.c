@@ -145,19 +145,8 @@ typedef struct refine_ctx {
  * smaller copy behind in the heap, resident to the frame's peak. */
 static bool batch_reserve(refine_ctx *ctx, uint32_t need)
 {
-    if (need <= ctx->batch_cap)
-        return true;
-    uint64_t cap = ctx->batch_cap ? ctx->batch_cap : 1024;
-    while (cap < need)
-        cap *= 2;
-    if (cap > UINT32_MAX)
-        return false;
-    uint32_t *p = vt_array_resize(ctx->batch, (size_t)ctx->batch_cap * sizeof *p, (size_t)cap * sizeof *p);
-    if (!p)
-        return false;
-    ctx->batch = p;
-    ctx->batch_cap = (uint32_t)cap;
-    return true;
+    return vt_array_reserve((void **)&ctx->batch, &ctx->batch_cap, need, sizeof *ctx->batch, 1024, UINT32_MAX,
+                            "vt refinement batch") == RL_OK;
 }
 
 /* A package of a distributed frame (run->seed) refines its own faces: an

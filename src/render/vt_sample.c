@@ -204,9 +204,9 @@ rl_status vt_run_reserve(vt_run *run)
     uint32_t need = run->mesh->num_verts;
     if (need <= run->per_vertex_cap)
         return RL_OK;
-    uint32_t cap = run->per_vertex_cap ? run->per_vertex_cap : 1024;
-    while (cap < need)
-        cap = cap > UINT32_MAX / 2 ? need : cap * 2;
+    /* Three arrays under one capacity: rl_reserve's doubling, kept in 32 bits. */
+    size_t grown = rl_grow_capacity(run->per_vertex_cap, need, 1024);
+    uint32_t cap = grown > UINT32_MAX ? need : (uint32_t)grown;
     uint8_t *reason = rl_realloc_array(run->reason, cap, sizeof *reason);
     if (!reason)
         return RL_ERR_OUT_OF_MEMORY;
