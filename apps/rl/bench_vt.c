@@ -564,6 +564,41 @@ static rl_status table_section(bvt *b, cJSON *sec, bool with_ref, ref_frame **re
     return RL_OK;
 }
 
+/* What most table sections share: the reference and the section's scene
+ * and size (table_section), the "runs" array, the table camera at --size,
+ * an image and, with with_renderer, a vt renderer. table_end releases them
+ * (whatever table_begin got to) and passes st on. */
+typedef struct table_run {
+    ref_frame *ref;
+    char size[32];
+    cJSON *rows;
+    rl_camera cam;
+    rl_image *img;
+    rl_renderer *r;
+} table_run;
+
+static rl_status table_begin(bvt *b, cJSON *sec, bool with_ref, bool with_renderer, table_run *tr)
+{
+    *tr = (table_run){ 0 };
+    rl_status st = table_section(b, sec, with_ref, &tr->ref, tr->size);
+    if (st != RL_OK)
+        return st;
+    tr->rows = cJSON_AddArrayToObject(sec, "runs");
+    tr->cam = sized(&b->table_cam, b->a->width, b->a->height);
+    if (with_renderer)
+        st = make_renderer("vt", b->threads, &tr->r);
+    if (st == RL_OK)
+        st = rl_image_create(b->a->width, b->a->height, RL_LAYER_COLOR, &tr->img);
+    return st;
+}
+
+static rl_status table_end(table_run *tr, rl_status st)
+{
+    rl_image_release(tr->img);
+    rl_renderer_release(tr->r);
+    return st;
+}
+
 static void nan_metrics(rl_image_metrics *m)
 {
     *m = (rl_image_metrics){ .rmse = NAN, .psnr = NAN, .ssim = NAN, .max_abs = NAN };
@@ -592,30 +627,33 @@ static rl_status compare(const rl_image *img, const rl_image *ref, const uint8_t
     return st;
 }
 
+/* The fields of every VT run row: vertices, rays, time (and its ratio to
+ * Whitted's), quality and the renderer's statistics. */
+static void add_run_fields(cJSON *row, const timed_frame *t, const quality *q, double whitted_ms)
+{
+    cJSON_AddNumberToObject(row, "vertices_sampled", (double)t->vt.vertices_sampled);
+    cJSON_AddNumberToObject(row, "vertices_generated", (double)t->vt.vertices_generated);
+    cJSON_AddItemToObject(row, "rays", rays_json(&t->stats));
+    add_num(row, "time_ms", t->stats.time_ms);
+    add_num(row, "time_ratio_to_whitted", ratio(t->stats.time_ms, whitted_ms));
+    cJSON_AddItemToObject(row, "quality", quality_json(q));
+    cJSON_AddItemToObject(row, "vt_stats", vt_stats_json(&t->vt));
+}
+
 /* ---------------------------------------------------------- criteria -- */
 
 /* Fig. 5.5/5.6: the same frame refined by each criterion. */
 static rl_status sec_criteria(void *ctx, cJSON *sec)
 {
     bvt *b = ctx;
-    int w = b->a->width, h = b->a->height;
-    ref_frame *ref = NULL;
-    char size[32];
-    rl_status st = table_section(b, sec, true, &ref, size);
+    table_run tr;
+    rl_status st = table_begin(b, sec, true, true, &tr);
     if (st != RL_OK)
-        return st;
-    cJSON *rows = cJSON_AddArrayToObject(sec, "runs");
-
-    rl_renderer *r = NULL;
-    rl_image *img = NULL;
-    rl_camera cam = sized(&b->table_cam, w, h);
-    st = make_renderer("vt", b->threads, &r);
-    if (st == RL_OK)
-        st = rl_image_create(w, h, RL_LAYER_COLOR, &img);
+        return table_end(&tr, st);
 
     printf("\ncriteria (Fig. 5.5/5.6): %s %s, whitted %.1f ms, %llu rays, %llu VT pixels\n",
-           table_spec(b), size, ref->stats.time_ms, (unsigned long long)rays_total(&ref->stats),
-           (unsigned long long)ref->mask_pixels);
+           table_spec(b), tr.size, tr.ref->stats.time_ms, (unsigned long long)rays_total(&tr.ref->stats),
+           (unsigned long long)tr.ref->mask_pixels);
     printf("%-9s %9s %9s %9s %8s %8s %8s %7s %8s %10s %9s  %6s %7s %6s  %6s %7s  %6s\n", "criteria",
            "sampled", "generated", "thesis", "rgb", "hsv", "tree", "forced", "faces", "rays",
            "ms", "ssimVT", "rmseVT", "psnrVT", "ssim", "rmse", "ownVT");
@@ -626,20 +664,19 @@ static rl_status sec_criteria(void *ctx, cJSON *sec)
         const uint32_t *faces;
         size_t num_verts = 0, num_faces = 0;
         rl_clear_error();
-        st = rl_renderer_set(r, "criteria", criteria[c].name);
+        st = rl_renderer_set(tr.r, "criteria", criteria[c].name);
         if (st == RL_OK)
-            st = render_timed(r, b->table, &cam, img, b->runs, &t);
+            st = render_timed(tr.r, b->table, &tr.cam, tr.img, b->runs, &t);
         if (st == RL_OK)
-            st = rl_vt_get_mesh(r, &verts, &num_verts, &faces, &num_faces);
+            st = rl_vt_get_mesh(tr.r, &verts, &num_verts, &faces, &num_faces);
         if (st == RL_OK)
-            st = compare(img, ref->image, ref->mask, ref->mask_pixels, &q);
+            st = compare(tr.img, tr.ref->image, tr.ref->mask, tr.ref->mask_pixels, &q);
         if (st != RL_OK)
             break;
         cJSON *row = cJSON_CreateObject();
-        cJSON_AddItemToArray(rows, row);
+        cJSON_AddItemToArray(tr.rows, row);
         cJSON_AddStringToObject(row, "criteria", criteria[c].name);
-        cJSON_AddNumberToObject(row, "vertices_sampled", (double)t.vt.vertices_sampled);
-        cJSON_AddNumberToObject(row, "vertices_generated", (double)t.vt.vertices_generated);
+        add_run_fields(row, &t, &q, tr.ref->stats.time_ms);
         cJSON_AddNumberToObject(row, "thesis_vertices_generated", criteria[c].thesis_generated);
         cJSON *splits = cJSON_AddObjectToObject(row, "splits");
         cJSON_AddNumberToObject(splits, "rgb", (double)t.vt.splits_rgb);
@@ -648,11 +685,6 @@ static rl_status sec_criteria(void *ctx, cJSON *sec)
         cJSON_AddNumberToObject(splits, "forced", (double)t.vt.splits_forced);
         cJSON_AddNumberToObject(row, "faces", (double)num_faces);
         cJSON_AddNumberToObject(row, "mesh_vertices", (double)num_verts);
-        cJSON_AddItemToObject(row, "rays", rays_json(&t.stats));
-        add_num(row, "time_ms", t.stats.time_ms);
-        add_num(row, "time_ratio_to_whitted", ratio(t.stats.time_ms, ref->stats.time_ms));
-        cJSON_AddItemToObject(row, "quality", quality_json(&q));
-        cJSON_AddItemToObject(row, "vt_stats", vt_stats_json(&t.vt));
         printf("%-9s %9llu %9llu %9.0f %8llu %8llu %8llu %7llu %8zu %10llu %9.1f  %6.3f %7.4f "
                "%6.2f  %6.3f %7.4f  %6.3f\n",
                criteria[c].name, (unsigned long long)t.vt.vertices_sampled,
@@ -663,12 +695,10 @@ static rl_status sec_criteria(void *ctx, cJSON *sec)
                q.vt_px.rmse, q.vt_px.psnr, q.full.ssim, q.full.rmse, q.vt_own.ssim);
         fflush(stdout);
         note("criteria %s %s: %.1f ms, %llu vertices generated, SSIM %.3f (VT pixels)",
-             criteria[c].name, size, t.stats.time_ms, (unsigned long long)t.vt.vertices_generated,
+             criteria[c].name, tr.size, t.stats.time_ms, (unsigned long long)t.vt.vertices_generated,
              q.vt_px.ssim);
     }
-    rl_image_release(img);
-    rl_renderer_release(r);
-    return st;
+    return table_end(&tr, st);
 }
 
 /* -------------------------------------------------------- resolution -- */
@@ -1016,40 +1046,31 @@ static rl_status sec_visibility(void *ctx, cJSON *sec)
         { "ID", "true", "false", "false" },
         { "none", "false", "false", "false" },
     };
-    int w = b->a->width, h = b->a->height;
-    ref_frame *ref = NULL;
-    char size[32];
-    rl_status st = table_section(b, sec, false, &ref, size);
+    table_run tr;
+    rl_status st = table_begin(b, sec, false, true, &tr);
     if (st != RL_OK)
-        return st;
-    cJSON *rows = cJSON_AddArrayToObject(sec, "runs");
-    rl_renderer *r = NULL;
-    rl_image *img = NULL;
-    rl_camera cam = sized(&b->table_cam, w, h);
-    st = make_renderer("vt", b->threads, &r);
-    if (st == RL_OK)
-        st = rl_image_create(w, h, RL_LAYER_COLOR, &img);
+        return table_end(&tr, st);
     printf("\nvisibility tests (Fig. 5.13): %s %s, ID buffer, Z buffer, viewport clipping\n",
-           table_spec(b), size);
+           table_spec(b), tr.size);
     printf("%-7s %9s %9s %9s %9s %9s %10s  %6s\n", "tests", "VT ms", "sampled", "vis.faces",
            "culled Z", "culled C", "rays", "ssimVT");
     for (size_t i = 0; st == RL_OK && i < sizeof configs / sizeof configs[0]; i++) {
         timed_frame t;
         quality q;
         rl_clear_error();
-        st = rl_renderer_set(r, "id_test", configs[i].id);
+        st = rl_renderer_set(tr.r, "id_test", configs[i].id);
         if (st == RL_OK)
-            st = rl_renderer_set(r, "z_test", configs[i].z);
+            st = rl_renderer_set(tr.r, "z_test", configs[i].z);
         if (st == RL_OK)
-            st = rl_renderer_set(r, "clip_test", configs[i].clip);
+            st = rl_renderer_set(tr.r, "clip_test", configs[i].clip);
         if (st == RL_OK)
-            st = render_timed(r, b->table, &cam, img, b->runs, &t);
+            st = render_timed(tr.r, b->table, &tr.cam, tr.img, b->runs, &t);
         if (st == RL_OK)
-            st = compare(img, ref->image, ref->mask, ref->mask_pixels, &q);
+            st = compare(tr.img, tr.ref->image, tr.ref->mask, tr.ref->mask_pixels, &q);
         if (st != RL_OK)
             break;
         cJSON *row = cJSON_CreateObject();
-        cJSON_AddItemToArray(rows, row);
+        cJSON_AddItemToArray(tr.rows, row);
         cJSON_AddStringToObject(row, "tests", configs[i].name);
         cJSON_AddBoolToObject(row, "id_test", configs[i].id[0] == 't');
         cJSON_AddBoolToObject(row, "z_test", configs[i].z[0] == 't');
@@ -1068,12 +1089,10 @@ static rl_status sec_visibility(void *ctx, cJSON *sec)
                (unsigned long long)t.vt.edges_culled_viewport,
                (unsigned long long)rays_total(&t.stats), q.vt_px.ssim);
         fflush(stdout);
-        note("visibility %s %s: %.1f ms, %llu vertices sampled", configs[i].name, size,
+        note("visibility %s %s: %.1f ms, %llu vertices sampled", configs[i].name, tr.size,
              t.stats.time_ms, (unsigned long long)t.vt.vertices_sampled);
     }
-    rl_image_release(img);
-    rl_renderer_release(r);
-    return st;
+    return table_end(&tr, st);
 }
 
 /* ------------------------------------------------------------- modes -- */
@@ -1162,21 +1181,12 @@ static rl_status sec_forced(void *ctx, cJSON *sec)
         const char *criteria;
         double min_edge;
     } settings[] = { { "tree+hsv", 1 }, { "hsv", 14 } };
-    int w = b->a->width, h = b->a->height;
-    ref_frame *ref = NULL;
-    char size[32];
-    rl_status st = table_section(b, sec, true, &ref, size);
+    table_run tr;
+    rl_status st = table_begin(b, sec, true, true, &tr);
     if (st != RL_OK)
-        return st;
-    cJSON *rows = cJSON_AddArrayToObject(sec, "runs");
-    rl_renderer *r = NULL;
-    rl_image *img = NULL;
-    rl_camera cam = sized(&b->table_cam, w, h);
-    st = make_renderer("vt", b->threads, &r);
-    if (st == RL_OK)
-        st = rl_image_create(w, h, RL_LAYER_COLOR, &img);
-    printf("\nforced refinement (Fig. 5.3): %s %s, whitted %.1f ms\n", table_spec(b), size,
-           ref->stats.time_ms);
+        return table_end(&tr, st);
+    printf("\nforced refinement (Fig. 5.3): %s %s, whitted %.1f ms\n", table_spec(b), tr.size,
+           tr.ref->stats.time_ms);
     printf("%-9s %8s %6s %9s %9s %7s %10s %9s  %6s %7s\n", "criteria", "min_edge", "forced", "sampled",
            "generated", "splits", "rays", "VT ms", "ssimVT", "rmseVT");
     for (size_t i = 0; st == RL_OK && i < sizeof settings / sizeof settings[0]; i++) {
@@ -1184,43 +1194,35 @@ static rl_status sec_forced(void *ctx, cJSON *sec)
             timed_frame t;
             quality q;
             rl_clear_error();
-            st = rl_renderer_set(r, "criteria", settings[i].criteria);
+            st = rl_renderer_set(tr.r, "criteria", settings[i].criteria);
             if (st == RL_OK)
-                st = set_int(r, "min_edge", settings[i].min_edge);
+                st = set_int(tr.r, "min_edge", settings[i].min_edge);
             if (st == RL_OK)
-                st = rl_renderer_set(r, "forced", on ? "true" : "false");
+                st = rl_renderer_set(tr.r, "forced", on ? "true" : "false");
             if (st == RL_OK)
-                st = render_timed(r, b->table, &cam, img, b->runs, &t);
+                st = render_timed(tr.r, b->table, &tr.cam, tr.img, b->runs, &t);
             if (st == RL_OK)
-                st = compare(img, ref->image, ref->mask, ref->mask_pixels, &q);
+                st = compare(tr.img, tr.ref->image, tr.ref->mask, tr.ref->mask_pixels, &q);
             if (st != RL_OK)
                 break;
             cJSON *row = cJSON_CreateObject();
-            cJSON_AddItemToArray(rows, row);
+            cJSON_AddItemToArray(tr.rows, row);
             cJSON_AddStringToObject(row, "criteria", settings[i].criteria);
             cJSON_AddNumberToObject(row, "min_edge", settings[i].min_edge);
             cJSON_AddBoolToObject(row, "forced", on);
-            cJSON_AddNumberToObject(row, "vertices_sampled", (double)t.vt.vertices_sampled);
-            cJSON_AddNumberToObject(row, "vertices_generated", (double)t.vt.vertices_generated);
             cJSON_AddNumberToObject(row, "splits_forced", (double)t.vt.splits_forced);
-            cJSON_AddItemToObject(row, "rays", rays_json(&t.stats));
-            add_num(row, "time_ms", t.stats.time_ms);
-            add_num(row, "time_ratio_to_whitted", ratio(t.stats.time_ms, ref->stats.time_ms));
-            cJSON_AddItemToObject(row, "quality", quality_json(&q));
-            cJSON_AddItemToObject(row, "vt_stats", vt_stats_json(&t.vt));
+            add_run_fields(row, &t, &q, tr.ref->stats.time_ms);
             printf("%-9s %8g %6s %9llu %9llu %7llu %10llu %9.1f  %6.3f %7.4f\n", settings[i].criteria,
                    settings[i].min_edge, on ? "on" : "off", (unsigned long long)t.vt.vertices_sampled,
                    (unsigned long long)t.vt.vertices_generated, (unsigned long long)t.vt.splits_forced,
                    (unsigned long long)rays_total(&t.stats), t.stats.time_ms, q.vt_px.ssim, q.vt_px.rmse);
             fflush(stdout);
             note("forced %s %s/%g %s: %.1f ms, %llu vertices generated, SSIM %.3f (VT pixels)",
-                 on ? "on" : "off", settings[i].criteria, settings[i].min_edge, size, t.stats.time_ms,
+                 on ? "on" : "off", settings[i].criteria, settings[i].min_edge, tr.size, t.stats.time_ms,
                  (unsigned long long)t.vt.vertices_generated, q.vt_px.ssim);
         }
     }
-    rl_image_release(img);
-    rl_renderer_release(r);
-    return st;
+    return table_end(&tr, st);
 }
 
 /* ----------------------------------------------------------- preview -- */
@@ -1412,16 +1414,10 @@ static rl_status correctness_row(bvt *b, const char *label, const rl_scene *scen
     cJSON_AddStringToObject(row, "scene", label);
     cJSON_AddStringToObject(row, "setting", correctness_settings[k].name);
     cJSON_AddStringToObject(row, "option", correctness_runs[i].name);
-    cJSON_AddNumberToObject(row, "vertices_sampled", (double)t.vt.vertices_sampled);
-    cJSON_AddNumberToObject(row, "vertices_generated", (double)t.vt.vertices_generated);
     cJSON_AddNumberToObject(row, "splits_nonlinear", (double)t.vt.splits_nonlinear);
     cJSON_AddNumberToObject(row, "splits_shaft", (double)t.vt.splits_shaft);
-    cJSON_AddItemToObject(row, "rays", rays_json(&t.stats));
-    add_num(row, "time_ms", t.stats.time_ms);
     add_num(row, "time_refine_ms", t.vt.time_refine_ms);
-    add_num(row, "time_ratio_to_whitted", ratio(t.stats.time_ms, ref_ms));
-    cJSON_AddItemToObject(row, "quality", quality_json(&q));
-    cJSON_AddItemToObject(row, "vt_stats", vt_stats_json(&t.vt));
+    add_run_fields(row, &t, &q, ref_ms);
     printf("%-9s %-10s %-20s %9llu %9llu %8llu %8llu %10llu %9.1f %8.1f %6.3f  %6.3f %7.4f\n", label,
            correctness_settings[k].name, correctness_runs[i].name, (unsigned long long)t.vt.vertices_sampled,
            (unsigned long long)t.vt.vertices_generated, (unsigned long long)t.vt.splits_nonlinear,
@@ -1597,17 +1593,11 @@ static rl_status sec_reduction(void *ctx, cJSON *sec)
 {
     bvt *b = ctx;
     static const double merges[] = { 0.0, 0.5, 1.0, 2.0 };
-    int w = b->a->width, h = b->a->height;
-    ref_frame *ref = NULL;
-    char size[32];
-    rl_status st = table_section(b, sec, true, &ref, size);
+    table_run tr;
+    rl_status st = table_begin(b, sec, true, false, &tr);
     if (st != RL_OK)
-        return st;
-    cJSON *rows = cJSON_AddArrayToObject(sec, "runs");
-    rl_camera cam = sized(&b->table_cam, w, h);
-    rl_image *img = NULL;
-    st = rl_image_create(w, h, RL_LAYER_COLOR, &img);
-    printf("\nsample reduction (Sec. 6.2.1): %s %s, whitted %.1f ms\n", table_spec(b), size, ref->stats.time_ms);
+        return table_end(&tr, st);
+    printf("\nsample reduction (Sec. 6.2.1): %s %s, whitted %.1f ms\n", table_spec(b), tr.size, tr.ref->stats.time_ms);
     printf("%-8s %-8s %9s %9s %9s %9s  %6s %7s\n", "merge_px", "frame", "sampled", "merged", "VT ms", "preview",
            "ssimVT", "rmseVT");
     for (size_t i = 0; st == RL_OK && i < sizeof merges / sizeof merges[0]; i++) {
@@ -1621,35 +1611,29 @@ static rl_status sec_reduction(void *ctx, cJSON *sec)
             if (st == RL_OK && preview)
                 st = rl_vt_set_update_callback(r, stop_at_preview, NULL);
             if (st == RL_OK)
-                st = render_timed(r, b->table, &cam, img, b->runs, &t);
+                st = render_timed(r, b->table, &tr.cam, tr.img, b->runs, &t);
             rl_renderer_release(r);
             if (st == RL_OK)
-                st = compare(img, ref->image, ref->mask, ref->mask_pixels, &q);
+                st = compare(tr.img, tr.ref->image, tr.ref->mask, tr.ref->mask_pixels, &q);
             if (st != RL_OK)
                 break;
             cJSON *row = cJSON_CreateObject();
-            cJSON_AddItemToArray(rows, row);
+            cJSON_AddItemToArray(tr.rows, row);
             cJSON_AddNumberToObject(row, "merge_px", merges[i]);
             cJSON_AddStringToObject(row, "frame", preview ? "preview" : "full");
-            cJSON_AddNumberToObject(row, "vertices_sampled", (double)t.vt.vertices_sampled);
             cJSON_AddNumberToObject(row, "vertices_merged", (double)t.vt.vertices_merged);
-            cJSON_AddItemToObject(row, "rays", rays_json(&t.stats));
-            add_num(row, "time_ms", t.stats.time_ms);
             add_num(row, "preview_ms", t.vt.time_preview_ms);
-            add_num(row, "time_ratio_to_whitted", ratio(t.stats.time_ms, ref->stats.time_ms));
-            cJSON_AddItemToObject(row, "quality", quality_json(&q));
-            cJSON_AddItemToObject(row, "vt_stats", vt_stats_json(&t.vt));
+            add_run_fields(row, &t, &q, tr.ref->stats.time_ms);
             printf("%-8g %-8s %9llu %9llu %9.1f %9.1f  %6.3f %7.4f\n", merges[i], preview ? "preview" : "full",
                    (unsigned long long)t.vt.vertices_sampled, (unsigned long long)t.vt.vertices_merged,
                    t.stats.time_ms, t.vt.time_preview_ms, q.vt_px.ssim, q.vt_px.rmse);
             fflush(stdout);
             note("merge_px %g %s %s: %llu sampled, %llu merged, %.1f ms, SSIM %.3f (VT pixels)", merges[i],
-                 preview ? "preview" : "full", size, (unsigned long long)t.vt.vertices_sampled,
+                 preview ? "preview" : "full", tr.size, (unsigned long long)t.vt.vertices_sampled,
                  (unsigned long long)t.vt.vertices_merged, t.stats.time_ms, q.vt_px.ssim);
         }
     }
-    rl_image_release(img);
-    return st;
+    return table_end(&tr, st);
 }
 
 /* -------------------------------------------------------------- hint -- */
