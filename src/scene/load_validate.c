@@ -26,6 +26,8 @@
 
 #define PLY_MAX_ELEMENTS 16
 #define PLY_MAX_PROPERTIES 64
+/* A PLY header keyword, name, type or count: longer ones are refused. */
+#define PLY_WORD 64
 
 /* A mesh file is a regular file of at most this size: a path to a device
  * (a symlink to /dev/zero) or an endless pipe would be read until memory
@@ -148,7 +150,7 @@ typedef struct ply_property {
 } ply_property;
 
 typedef struct ply_element {
-    char name[32];
+    char name[PLY_WORD];
     unsigned long long count;
     ply_property props[PLY_MAX_PROPERTIES];
     int num_props;
@@ -176,21 +178,63 @@ static int type_size(const char *t)
     return 0;
 }
 
-/* Reads the next header line into line (NUL-terminated, without '\r'). */
-static bool next_line(const char *data, size_t size, size_t *pos, char *line, size_t cap)
+/* Reads the next header line into line (NUL-terminated, without '\r').
+ * *ctrl: it holds a control byte other than '\t' and '\r', a NUL too
+ * (which would end the string early and hide the rest of the line from
+ * every check); *cut: it was longer than cap - 1 bytes and is cut short. */
+static bool next_line(const char *data, size_t size, size_t *pos, char *line, size_t cap, bool *ctrl,
+                      bool *cut)
 {
+    *ctrl = *cut = false;
     if (*pos >= size)
         return false;
     size_t n = 0;
     while (*pos < size && data[*pos] != '\n') {
-        if (data[*pos] != '\r' && n + 1 < cap)
-            line[n++] = data[*pos];
+        unsigned char c = (unsigned char)data[*pos];
+        if (c < 0x20 && c != '\t' && c != '\r')
+            *ctrl = true;
+        if (c != '\r') {
+            if (n + 1 < cap)
+                line[n++] = (char)c;
+            else
+                *cut = true;
+        }
         ++*pos;
     }
     if (*pos < size)
         ++*pos;   /* the '\n' */
     line[n] = '\0';
     return true;
+}
+
+/* Splits line into at most max words separated by spaces or tabs, as
+ * Assimp's header reader does; the rest of the line is ignored. *long_word:
+ * a word has PLY_WORD bytes or more (sscanf's "%31s" cut such a word in two
+ * and read its tail as the next word, so the header checked was not the
+ * one Assimp reads: a fuzzed element name of 97 digits became a count of 0
+ * here and 3 there). */
+static int split_words(const char *line, char words[][PLY_WORD], int max, bool *long_word)
+{
+    int n = 0;
+    *long_word = false;
+    for (const char *p = line; *p && n < max;) {
+        while (*p == ' ' || *p == '\t')
+            ++p;
+        if (!*p)
+            break;
+        const char *w = p;
+        while (*p && *p != ' ' && *p != '\t')
+            ++p;
+        size_t len = (size_t)(p - w);
+        if (len >= PLY_WORD) {
+            *long_word = true;
+            len = PLY_WORD - 1;
+        }
+        memcpy(words[n], w, len);
+        words[n][len] = '\0';
+        ++n;
+    }
+    return n;
 }
 
 static unsigned long long read_uint(const unsigned char *p, int size, bool big_endian)
@@ -258,22 +302,31 @@ static rl_status check_ply(const char *path, const char *data, size_t size)
 {
     char line[512];
     size_t pos = 0;
-    if (!next_line(data, size, &pos, line, sizeof line) || strcmp(line, "ply") != 0)
+    bool ctrl, cut;
+    if (!next_line(data, size, &pos, line, sizeof line, &ctrl, &cut) || strcmp(line, "ply") != 0 || ctrl)
         return rl_error(RL_ERR_PARSE, "%s: not a PLY file (first line is not \"ply\")", path);
 
     ply_element elems[PLY_MAX_ELEMENTS];
     int num_elems = 0, format = -1;   /* 0 ascii, 1 little, 2 big endian */
     for (;;) {
-        if (!next_line(data, size, &pos, line, sizeof line))
+        if (!next_line(data, size, &pos, line, sizeof line, &ctrl, &cut))
             return rl_error(RL_ERR_PARSE, "%s: PLY header has no end_header", path);
         /* Assimp's PLY reader can loop forever on odd header bytes. */
-        for (const char *ch = line; *ch; ++ch)
-            if ((unsigned char)*ch < 0x20 && *ch != '\t')
-                return rl_error(RL_ERR_PARSE, "%s: control byte in the PLY header", path);
-        char word[32] = "", a[32] = "", b[32] = "", c[32] = "", d[32] = "";
-        int words = sscanf(line, "%31s %31s %31s %31s %31s", word, a, b, c, d);
+        if (ctrl)
+            return rl_error(RL_ERR_PARSE, "%s: control byte in the PLY header", path);
+        char w[5][PLY_WORD] = { "" };
+        bool long_word;
+        int words = split_words(line, w, 5, &long_word);
         if (words < 1)
             continue;
+        const char *word = w[0], *a = w[1], *b = w[2], *c = w[3], *d = w[4];
+        /* Free text may be long; what is parsed must be read whole. */
+        bool text = strcmp(word, "comment") == 0 || strcmp(word, "obj_info") == 0;
+        if (!text && (long_word || cut))
+            return long_word ? rl_error(RL_ERR_PARSE, "%s: PLY header line \"%.40s...\" has a word of %d bytes "
+                                        "or more", path, line, PLY_WORD)
+                             : rl_error(RL_ERR_PARSE, "%s: PLY header line \"%.40s...\" is longer than %zu bytes",
+                                        path, line, sizeof line - 1);
         if (strcmp(word, "end_header") == 0) {
             if (words != 1)
                 return rl_error(RL_ERR_PARSE, "%s: junk after PLY end_header", path);
@@ -316,7 +369,7 @@ static rl_status check_ply(const char *path, const char *data, size_t size)
             if (p->size == 0 || (list && p->count_size == 0))
                 return rl_error(RL_ERR_PARSE, "%s: unknown PLY property type in \"%s\"", path,
                                 line);
-        } else if (strcmp(word, "comment") != 0 && strcmp(word, "obj_info") != 0) {
+        } else if (!text) {
             /* Real exporters write free text without "comment" (Blender 2.4x:
              * "Created by Blender3D ..."); Assimp skips such lines, so do we. */
             rl_warn("%s: ignoring unknown PLY header line \"%s\"", path, line);
@@ -425,11 +478,12 @@ static rl_status check_off(const char *path, const char *data, size_t size)
 {
     char line[4096];
     size_t pos = 0;
+    bool ctrl, cut;   /* not checked: Assimp's OFF reader reads numbers only */
     long long counts[3] = { -1, -1, -1 };
     int have = 0;
     bool header = false;
     /* The header word, then the three counts (on its line or the next). */
-    while (have < 3 && next_line(data, size, &pos, line, sizeof line)) {
+    while (have < 3 && next_line(data, size, &pos, line, sizeof line, &ctrl, &cut)) {
         char *p = line;
         if (off_blank(p))
             continue;
@@ -463,13 +517,13 @@ static rl_status check_off(const char *path, const char *data, size_t size)
         return rl_error(RL_ERR_PARSE, "%s: OFF declares %lld vertices and %lld faces, more than its %zu bytes after "
                         "the header can hold", path, counts[0], counts[1], size - pos);
     for (long long v = 0; v < counts[0];) {
-        if (!next_line(data, size, &pos, line, sizeof line))
+        if (!next_line(data, size, &pos, line, sizeof line, &ctrl, &cut))
             return RL_OK;   /* short: Assimp reports it */
         if (!off_blank(line))
             ++v;
     }
     for (long long f = 0; f < counts[1];) {
-        if (!next_line(data, size, &pos, line, sizeof line))
+        if (!next_line(data, size, &pos, line, sizeof line, &ctrl, &cut))
             return RL_OK;
         if (off_blank(line))
             continue;

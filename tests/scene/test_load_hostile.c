@@ -1,7 +1,8 @@
 /* test_load_hostile.c: small model files that made Assimp hang or allocate
  * gigabytes (issue 34), refused by our pre-checks (load_validate.c) before
  * Assimp reads them: PLY element counts the file cannot hold (ASCII and
- * binary), GLB chunk lengths beyond the file, OFF indices past the
+ * binary), PLY headers that Assimp reads otherwise than a word-cutting
+ * parser would, GLB chunk lengths beyond the file, OFF indices past the
  * vertices, node hierarchies Assimp recurses through without bound (glTF
  * and Collada: cycles, depth, instancing blow-ups; load_validate_graph.c),
  * and paths that are not regular files. Each must fail with a clear error, quickly. */
@@ -83,6 +84,48 @@ static void test_ply_counts_beyond_the_file_are_refused(void **state)
                         "property float y\nproperty float z\nend_header\n0 0 0\n";
     expect_refused(write_bytes("short.ply", ascii, strlen(ascii), path, sizeof path), RL_ERR_PARSE,
                    "PLY body ends after 1 of 10 \"vertex\" elements");
+}
+
+/* The header is read as Assimp reads it, word by word (fuzz_load_mesh
+ * found a 323-byte PLY for which Assimp allocated 6 GB): an element name of
+ * 97 bytes was cut into 31-byte words by the old sscanf, so its tail became
+ * a count of 0 where Assimp read 3, and a NUL byte ended a header line
+ * before the control-byte check saw the rest. */
+static void test_ply_header_is_read_whole(void **state)
+{
+    (void)state;
+    char path[1200];
+    static const char nul[] = "ply\nformat ascii 1.0\nelement vertex 3\nproperty float\0\0\0\3 x\n"
+                              "property float y\nproperty float z\nend_header\n0 0 0\n1 0 0\n0 1 0\n";
+    expect_refused(write_bytes("nul.ply", nul, sizeof nul - 1, path, sizeof path), RL_ERR_PARSE,
+                   "control byte in the PLY header");
+    char header[1024];
+    char name[98];
+    memset(name, '0', 97);
+    name[97] = '\0';
+    snprintf(header, sizeof header, "ply\nformat ascii 1.0\nelement %s 3\nproperty float x\nend_header\n0\n1\n2\n",
+             name);
+    expect_refused(write_bytes("long_name.ply", header, strlen(header), path, sizeof path), RL_ERR_PARSE,
+                   "has a word of 64 bytes or more");
+    char spaces[600];
+    memset(spaces, ' ', 599);
+    spaces[599] = '\0';
+    snprintf(header, sizeof header, "ply\nformat ascii 1.0\nelement vertex 3%s\nproperty float x\nend_header\n",
+             spaces);
+    expect_refused(write_bytes("long_line.ply", header, strlen(header), path, sizeof path), RL_ERR_PARSE,
+                   "is longer than 511 bytes");
+    /* Long free text and a 40-byte property name (cut in two before) load. */
+    snprintf(header, sizeof header,
+             "ply\nformat ascii 1.0\ncomment %s a long comment\nelement vertex 3\nproperty float x\n"
+             "property float y\nproperty float z\nproperty float confidence_of_the_scanner_at_this_point\n"
+             "element face 1\nproperty list uchar int vertex_indices\nend_header\n"
+             "0 0 0 1\n1 0 0 1\n0 1 0 1\n3 0 1 2\n",
+             spaces);
+    rl_scene *s = NULL;
+    assert_int_equal(rl_scene_load(write_bytes("good.ply", header, strlen(header), path, sizeof path), NULL, &s),
+                     RL_OK);
+    assert_int_equal(rl_scene_get_data(s)->num_triangles, 1);
+    rl_scene_release(s);
 }
 
 static void put32(unsigned char *p, uint32_t v)
@@ -300,6 +343,7 @@ int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_ply_counts_beyond_the_file_are_refused),
+        cmocka_unit_test(test_ply_header_is_read_whole),
         cmocka_unit_test(test_glb_lengths_beyond_the_file_are_refused),
         cmocka_unit_test(test_off_indices_out_of_range_are_refused),
         cmocka_unit_test(test_texture_pixel_limit_applies_before_decoding),
