@@ -482,19 +482,26 @@ static rl_status check_off(const char *path, const char *data, size_t size)
     long long counts[3] = { -1, -1, -1 };
     int have = 0;
     bool header = false;
-    /* The header word, then the three counts (on its line or the next). */
-    while (have < 3 && next_line(data, size, &pos, line, sizeof line, &ctrl, &cut)) {
+    /* The header word, then the counts (on its line or the next): vertices
+     * and faces, the ones Assimp reads, and the edges where they stand on
+     * the same line. A missing edge count does not stop the check (fuzzed:
+     * "OFF\n4 333...3 ???" named 10^62 faces, and Assimp, reading only two
+     * counts, asked for 22 GB). */
+    while (have < 2 && next_line(data, size, &pos, line, sizeof line, &ctrl, &cut)) {
         char *p = line;
         if (off_blank(p))
             continue;
         if (!header) {
-            char word[16] = "";
-            int n = 0;
-            if (sscanf(p, "%15s%n", word, &n) != 1 || strlen(word) < 3 ||
-                strcmp(word + strlen(word) - 3, "OFF") != 0)
+            /* The whole first word (a "%15s" would cut a longer one and
+             * read its tail as the counts). */
+            while (*p == ' ' || *p == '\t')
+                ++p;
+            char *w = p;
+            while (*p && *p != ' ' && *p != '\t')
+                ++p;
+            if (p - w < 3 || memcmp(p - 3, "OFF", 3) != 0)
                 return RL_OK;   /* not the text form we know: Assimp decides */
             header = true;
-            p += n;
         }
         for (char *end; have < 3; p = end) {
             long long v = strtoll(p, &end, 10);
@@ -503,7 +510,7 @@ static rl_status check_off(const char *path, const char *data, size_t size)
             counts[have++] = v;
         }
     }
-    if (have < 3 || counts[0] < 0 || counts[1] < 0)
+    if (have < 2 || counts[0] < 0 || counts[1] < 0)
         return RL_OK;
     /* Assimp sizes its arrays by the declared counts before it reads a
      * line, so a few bytes declaring 10^12 faces ask for gigabytes (found

@@ -180,6 +180,14 @@ static void test_off_indices_out_of_range_are_refused(void **state)
     const char *huge = "\004OFF\n4 1111111111111111111111111111111111111112 0\n0 0 0\n1 0 10 1\n1 1 0\n0 1 0\n3 0 2\n";
     expect_refused(write_bytes("huge.off", huge, strlen(huge), path, sizeof path), RL_ERR_PARSE,
                    "more than its 33 bytes after the header can hold");
+    /* fuzz_load_mesh: no edge count after a face count of 10^62 (Assimp
+     * reads two counts and asked for 22 GB). */
+    const char *no_edges = "OFF\n4 333333333333333333333333333333333333333333333333333333333333333???\n";
+    expect_refused(write_bytes("no_edges.off", no_edges, strlen(no_edges), path, sizeof path), RL_ERR_PARSE,
+                   "OFF declares 4 vertices and 9223372036854775807 faces");
+    const char *counts_below = "OFF\n3\n1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 9\n";
+    expect_refused(write_bytes("counts_below.off", counts_below, strlen(counts_below), path, sizeof path),
+                   RL_ERR_PARSE, "OFF face 0 uses vertex 9 of 3");
     const char *many = "OFF\n3 40 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n";
     expect_refused(write_bytes("many.off", many, strlen(many), path, sizeof path), RL_ERR_PARSE,
                    "OFF declares 3 vertices and 40 faces");
