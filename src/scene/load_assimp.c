@@ -855,8 +855,10 @@ rl_status rl_assimp_import(rl_scene *scene, const char *path, uint32_t parent,
         return rl_error(RL_ERR_PARSE, "%s: %s", path, why);
     }
     if (!ai->mRootNode || (ai->mFlags & AI_SCENE_FLAGS_INCOMPLETE)) {
+        bool meshless = ai->mNumMeshes == 0;
         aiReleaseImport(ai);
-        return rl_error(RL_ERR_PARSE, "%s: incomplete scene", path);
+        return rl_error(RL_ERR_PARSE, "%s: incomplete scene%s", path,
+                        meshless ? " (no meshes: cameras, lights or animation only, or a reader that gave up)" : "");
     }
     rl_status st = check_scene(path, ai);
     if (st == RL_OK)

@@ -6,7 +6,8 @@
  * an OBJ made the error line print part of /etc/passwd. So a quoted
  * excerpt is kept only when it occurs in the named file (within its first
  * SEARCH_BYTES), and then cut to EXCERPT_CHARS with non-printable bytes
- * escaped; anything else quoted is replaced by a note. */
+ * escaped; the named path itself is kept (escaped); anything else quoted
+ * is replaced by a note. */
 #define _GNU_SOURCE
 #include <stdio.h>
 #include <stdlib.h>
@@ -79,7 +80,14 @@ void rl_load_safe_message(const char *path, const char *msg, char *out, size_t s
             continue;
         }
         size_t n = (size_t)(close - p - 1);
-        if (file_contains(path, p + 1, n)) {
+        if (n == strlen(path) && memcmp(p + 1, path, n) == 0) {
+            /* The path the user named (Assimp quotes it when no reader
+             * takes the file): theirs, not the file's text. */
+            put(&s, "\"", 1);
+            for (size_t i = 0; i < n; ++i)
+                put_byte(&s, (unsigned char)path[i]);
+            put(&s, "\"", 1);
+        } else if (file_contains(path, p + 1, n)) {
             put(&s, "\"", 1);
             for (size_t i = 0; i < n && i < EXCERPT_CHARS; ++i)
                 put_byte(&s, (unsigned char)p[1 + i]);

@@ -145,6 +145,9 @@ printf 'root:x:0:0:root:/root:/bin/bash\nnewmtl x\nd secret-hash-in-etc\n' >"$TM
 printf 'mtllib ../../etc/passwd\nv 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl root\nf 1 2 3\n' >"$TMP/a/b/m.obj"
 expect_bounded_error 1 "m.obj" "$RL" render "$TMP/a/b/m.obj" --size 32x24 --out "$OUT"
 ! grep -q 'secret\|root:' "$TMP/err" || fail "the error quotes the referenced file: $(cat "$TMP/err")"
+# The path the user named is shown where Assimp quotes it (no reader).
+printf 'not a model\n' >"$TMP/model.unknownformat"
+expect_bounded_error 1 "No suitable reader found .*\"$TMP/model.unknownformat\"" "$RL" render "$TMP/model.unknownformat" --size 32x24 --out "$OUT"
 printf 'v 0 0 0\nv 1 0 0\nv 0 1 0\nvn abcdefghijklmnopqrstuvwxyzabcdefghijklmnopqrstuvwxyz 1 1\nf 1 2 3\n' >"$TMP/long.obj"
 expect_bounded_error 1 '"abcdefghijklmnopqrstuvwxyzabcdefghijklmn\.\.\."' "$RL" render "$TMP/long.obj" --size 32x24 --out "$OUT"
 
