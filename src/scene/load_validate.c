@@ -479,38 +479,52 @@ static rl_status check_off(const char *path, const char *data, size_t size)
     char line[4096];
     size_t pos = 0;
     bool ctrl, cut;   /* not checked: Assimp's OFF reader reads numbers only */
-    long long counts[3] = { -1, -1, -1 };
-    int have = 0;
+    long long nums[4] = { -1, -1, -1, -1 };
+    int have = 0, need = 2;
     bool header = false;
     /* The header word, then the counts (on its line or the next): vertices
      * and faces, the ones Assimp reads, and the edges where they stand on
      * the same line. A missing edge count does not stop the check (fuzzed:
      * "OFF\n4 333...3 ???" named 10^62 faces, and Assimp, reading only two
      * counts, asked for 22 GB). */
-    while (have < 2 && next_line(data, size, &pos, line, sizeof line, &ctrl, &cut)) {
+    while (have < need && next_line(data, size, &pos, line, sizeof line, &ctrl, &cut)) {
         char *p = line;
         if (off_blank(p))
             continue;
         if (!header) {
-            /* The whole first word (a "%15s" would cut a longer one and
-             * read its tail as the counts). */
+            /* The header word as Assimp's OFF reader reads it: optional
+             * "ST", "C", "N", "4" and "n" (texture coordinates, colours,
+             * normals, homogeneous points, a dimension count first), then
+             * "OFF", and the counts may follow it without a space (fuzzed:
+             * "OFF444...4" made Assimp ask for 5.7 GB of vertices). */
             while (*p == ' ' || *p == '\t')
                 ++p;
-            char *w = p;
-            while (*p && *p != ' ' && *p != '\t')
+            if (p[0] == 'S' && p[1] == 'T')
+                p += 2;
+            if (*p == 'C')
                 ++p;
-            if (p - w < 3 || memcmp(p - 3, "OFF", 3) != 0)
+            if (*p == 'N')
+                ++p;
+            if (*p == '4')
+                ++p;
+            if (*p == 'n') {
+                ++p;
+                need = 3;   /* the dimension, then the counts */
+            }
+            if (strncmp(p, "OFF", 3) != 0)
                 return RL_OK;   /* not the text form we know: Assimp decides */
+            p += 3;
             header = true;
         }
-        for (char *end; have < 3; p = end) {
+        for (char *end; have < need + 1; p = end) {
             long long v = strtoll(p, &end, 10);
             if (end == p)
                 break;
-            counts[have++] = v;
+            nums[have++] = v;
         }
     }
-    if (have < 2 || counts[0] < 0 || counts[1] < 0)
+    long long counts[2] = { nums[need - 2], nums[need - 1] };
+    if (have < need || counts[0] < 0 || counts[1] < 0)
         return RL_OK;
     /* Assimp sizes its arrays by the declared counts before it reads a
      * line, so a few bytes declaring 10^12 faces ask for gigabytes (found

@@ -177,7 +177,7 @@ static void test_off_indices_out_of_range_are_refused(void **state)
     /* Counts the file cannot hold: Assimp would size its arrays by them
      * first (fuzz_load_mesh found 53 GB asked for by a 90-byte file whose
      * face count overflows any integer). */
-    const char *huge = "\004OFF\n4 1111111111111111111111111111111111111112 0\n0 0 0\n1 0 10 1\n1 1 0\n0 1 0\n3 0 2\n";
+    const char *huge = "OFF\n4 1111111111111111111111111111111111111112 0\n0 0 0\n1 0 10 1\n1 1 0\n0 1 0\n3 0 2\n";
     expect_refused(write_bytes("huge.off", huge, strlen(huge), path, sizeof path), RL_ERR_PARSE,
                    "more than its 33 bytes after the header can hold");
     /* fuzz_load_mesh: no edge count after a face count of 10^62 (Assimp
@@ -185,6 +185,15 @@ static void test_off_indices_out_of_range_are_refused(void **state)
     const char *no_edges = "OFF\n4 333333333333333333333333333333333333333333333333333333333333333???\n";
     expect_refused(write_bytes("no_edges.off", no_edges, strlen(no_edges), path, sizeof path), RL_ERR_PARSE,
                    "OFF declares 4 vertices and 9223372036854775807 faces");
+    /* fuzz_load_mesh: counts right after the header word, no space
+     * (Assimp read 33 fours as the vertex count and asked for 5.7 GB). */
+    const char *glued = "OFF444444444444444444444444444444444\n4 0\n0";
+    expect_refused(write_bytes("glued.off", glued, strlen(glued), path, sizeof path), RL_ERR_PARSE,
+                   "OFF declares 9223372036854775807 vertices and 4 faces");
+    /* Geomview's prefixes, the dimension count of "nOFF" before the counts. */
+    const char *dimension = "CnOFF\n3\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 9\n";
+    expect_refused(write_bytes("dimension.off", dimension, strlen(dimension), path, sizeof path), RL_ERR_PARSE,
+                   "OFF face 0 uses vertex 9 of 3");
     const char *counts_below = "OFF\n3\n1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 9\n";
     expect_refused(write_bytes("counts_below.off", counts_below, strlen(counts_below), path, sizeof path),
                    RL_ERR_PARSE, "OFF face 0 uses vertex 9 of 3");
