@@ -98,6 +98,7 @@ void rl_pt_surface_finish(const rl_scene_data *d, uint32_t tri, rl_vec3 p, rl_ve
     s->kd = textured_kd(d, s->m, uv);
     s->tri = tri;
     s->ggx_ms = false;             /* the renderer's option: set where the path uses s */
+    s->lambert = rl_pt_surface_lambert(s);
 }
 
 bool rl_pt_surface_at_hit(const rl_scene_data *d, const rl_hit *hit, rl_vec3 o, rl_vec3 dir, pt_surface *s)
@@ -138,6 +139,7 @@ static bool surface_of_record(const rl_scene_data *d, const rl_ls_surface *r, rl
     s->kd = textured_kd(d, s->m, r->uv);
     s->tri = RL_ID_NONE;
     s->ggx_ms = false;
+    s->lambert = rl_pt_surface_lambert(s);
     return true;
 }
 
@@ -270,7 +272,7 @@ static rl_vec3 direct_light(const pt_ctx *ctx, const pt_surface *s, pt_sampler *
                 float cos_e = -rl_dot(nq, l), cos_r = rl_dot(s->ns, l);
                 if (cos_e <= 0.0f || cos_r <= 0.0f || !visible(ctx, s, l, dist, i, j.x, j.y, c))
                     continue;
-                rl_vec3 f = rl_pt_bsdf_eval(s, l);
+                rl_vec3 f = rl_pt_bsdf_f(s, l);
                 sum = rl_add(sum, rl_mul(f, rl_scale(le, cos_e * cos_r / d2)));   /* eq. 7 */
             }
             continue;
@@ -284,7 +286,7 @@ static rl_vec3 direct_light(const pt_ctx *ctx, const pt_surface *s, pt_sampler *
         float cos_r = rl_dot(s->ns, l);
         if (cos_r <= 0.0f || !visible(ctx, s, l, dist, i, j.x, j.y, c))
             continue;
-        sum = rl_add(sum, rl_mul(rl_pt_bsdf_eval(s, l), rl_scale(E, cos_r)));
+        sum = rl_add(sum, rl_mul(rl_pt_bsdf_f(s, l), rl_scale(E, cos_r)));
     }
     return sum;
 }
@@ -305,7 +307,7 @@ static float power_heuristic(float a, float b)
  * rl_pt_bsdf_sample refuses directions. */
 static float bsdf_pdf(const pt_surface *s, rl_vec3 wi)
 {
-    return rl_dot(s->ng, wi) > 0.0f ? rl_pt_bsdf_pdf(s, wi) : 0.0f;
+    return rl_dot(s->ng, wi) > 0.0f ? rl_pt_bsdf_density(s, wi) : 0.0f;
 }
 
 /* Next-event estimation with mis=on: light_samples lights chosen by power
@@ -346,7 +348,7 @@ static rl_vec3 direct_light_mis(const pt_ctx *ctx, const pt_surface *s, pt_sampl
                 float cos_r = rl_dot(s->ns, l);
                 if (cos_r <= 0.0f || !visible(ctx, s, l, dist, src, j.x, j.y, c))
                     continue;
-                sum = rl_add(sum, rl_mul(rl_pt_bsdf_eval(s, l), rl_scale(E, cos_r / (pmf * (float)n))));
+                sum = rl_add(sum, rl_mul(rl_pt_bsdf_f(s, l), rl_scale(E, cos_r / (pmf * (float)n))));
                 continue;
             }
             n_e = rl_cross(L->edge_u, L->edge_v);
@@ -388,7 +390,7 @@ static rl_vec3 direct_light_mis(const pt_ctx *ctx, const pt_surface *s, pt_sampl
             continue;
         float p_light = p_sa > 0.0f ? p_sa : pmf * d2 / (area * cos_e);   /* solid angle at s */
         float w = bsdf_follows && hittable ? power_heuristic((float)n * p_light, bsdf_pdf(s, l)) : 1.0f;
-        rl_vec3 f = rl_pt_bsdf_eval(s, l);
+        rl_vec3 f = rl_pt_bsdf_f(s, l);
         sum = rl_add(sum, rl_mul(f, rl_scale(le, w * cos_r / (p_light * (float)n))));
     }
     return sum;
@@ -411,7 +413,7 @@ static rl_vec3 environment_light(const pt_ctx *ctx, const pt_surface *s, pt_samp
         return rl_v3s(0.0f);
     float w = bsdf_follows ? power_heuristic(p_env, bsdf_pdf(s, l)) : 1.0f;
     rl_vec3 L = rl_environment_radiance(ctx->env, l);
-    return rl_mul(rl_pt_bsdf_eval(s, l), rl_scale(L, w * cos_r / p_env));
+    return rl_mul(rl_pt_bsdf_f(s, l), rl_scale(L, w * cos_r / p_env));
 }
 
 rl_vec3 rl_pt_escape_radiance(const pt_ctx *ctx, rl_vec3 dir)
@@ -535,7 +537,7 @@ rl_vec3 rl_pt_trace_path(const pt_ctx *ctx, pt_surface *first, pt_sampler *sp, p
             if (last)
                 break;
             rl_pt_sampler_seek(sp, base + PT_SLOT_LOBE);
-            float u0 = sp->rng || rl_pt_bsdf_needs_lobe(s->m) ? rl_pt_sample_1d(sp) : 0.0f;
+            float u0 = sp->rng || (!s->lambert && rl_pt_bsdf_needs_lobe(s->m)) ? rl_pt_sample_1d(sp) : 0.0f;
             rl_pt_sampler_seek(sp, base + PT_SLOT_BSDF);
             rl_vec2 u12 = rl_pt_sample_2d(sp);
             rl_vec3 w;
