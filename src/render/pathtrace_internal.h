@@ -336,7 +336,7 @@ typedef struct pt_surface {
     rl_vec3 v;                /* unit direction back along the incoming ray */
     bool front;               /* the unflipped geometric normal faced the ray */
     rl_vec3 kd;               /* k_d times the diffuse texture */
-    rl_vec2 uv;
+    rl_vec2 uv;               /* at exact hits only where a texture reads it, else 0 */
     const rl_material *m;
     uint32_t tri;
     bool ggx_ms;              /* GGX with Kulla-Conty energy compensation (option ggx_ms) */

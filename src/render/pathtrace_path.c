@@ -85,7 +85,12 @@ void rl_pt_surface_finish(const rl_scene_data *d, uint32_t tri, rl_vec3 p, rl_ve
     const uint32_t *idx = &d->indices[3 * (size_t)tri];
     rl_vec3 p0 = d->positions[idx[0]], p1 = d->positions[idx[1]], p2 = d->positions[idx[2]];
     rl_vec3 ng = rl_normalize(rl_cross(rl_sub(p1, p0), rl_sub(p2, p0)));
-    ns = rl_normalize(rl_shading_normal(d, tri, ns, uv));
+    const rl_material *m = &d->materials[d->triangle_material[tri]];
+    /* rl_shading_normal returns ns untouched, bit for bit, without a normal
+     * map: the test here saves the call at most hits. */
+    if (m->normal_texture < d->num_textures)
+        ns = rl_shading_normal(d, tri, ns, uv);
+    ns = rl_normalize(ns);
     if (!(rl_length2(ns) > 0.0f) || !rl_vfinite(ns))
         ns = ng;
     s->p = p;
@@ -93,9 +98,9 @@ void rl_pt_surface_finish(const rl_scene_data *d, uint32_t tri, rl_vec3 p, rl_ve
     s->front = rl_dot(ng, v) > 0.0f;
     s->ng = s->front ? ng : rl_neg(ng);
     s->ns = rl_dot(ns, v) < 0.0f ? rl_neg(ns) : ns;
-    s->m = &d->materials[d->triangle_material[tri]];
+    s->m = m;
     s->uv = uv;
-    s->kd = textured_kd(d, s->m, uv);
+    s->kd = textured_kd(d, m, uv);
     s->tri = tri;
     s->ggx_ms = false;             /* the renderer's option: set where the path uses s */
     s->lambert = rl_pt_surface_lambert(s);
@@ -114,8 +119,15 @@ bool rl_pt_surface_at_hit(const rl_scene_data *d, const rl_hit *hit, rl_vec3 o, 
                        rl_scale(d->positions[idx[2]], v));
     rl_vec3 ns = rl_add(rl_add(rl_scale(d->normals[idx[0]], w), rl_scale(d->normals[idx[1]], u)),
                         rl_scale(d->normals[idx[2]], v));
-    rl_vec2 t0 = d->uvs[idx[0]], t1 = d->uvs[idx[1]], t2 = d->uvs[idx[2]];
-    rl_vec2 uv = rl_v2(w * t0.x + u * t1.x + v * t2.x, w * t0.y + u * t1.y + v * t2.y);
+    /* The texture coordinates only where a texture reads them (a diffuse
+     * or a normal map): three more vertex loads and six products at every
+     * hit otherwise. */
+    rl_vec2 uv = rl_v2(0.0f, 0.0f);
+    const rl_material *m = &d->materials[d->triangle_material[hit->triangle]];
+    if (m->diffuse_texture < d->num_textures || m->normal_texture < d->num_textures) {
+        rl_vec2 t0 = d->uvs[idx[0]], t1 = d->uvs[idx[1]], t2 = d->uvs[idx[2]];
+        uv = rl_v2(w * t0.x + u * t1.x + v * t2.x, w * t0.y + u * t1.y + v * t2.y);
+    }
     rl_pt_surface_finish(d, hit->triangle, p, ns, uv, rl_neg(rl_normalize(dir)), s);
     return true;
 }
