@@ -139,6 +139,11 @@ typedef struct pt_lights {
     float *cdf;                    /* count + 1 running sums, cdf[count] = 1 */
     float *light_pmf;              /* per scene light: its probability */
     bool *light_hittable;          /* per scene light: a quad whose covering mesh a ray can hit */
+    /* Per scene light: |edge_u x edge_v| (a quad's area) and that cross
+     * product over it (its unit front normal), as next-event estimation
+     * computed them at every vertex before. */
+    float *light_area;
+    rl_vec3 *light_normal;
     float *tri_pmf;                /* per triangle: the probability of an uncovered emitter, else 0 */
     rl_vec3 centre;                /* bounding sphere of the scene (directional lights) */
     float radius;

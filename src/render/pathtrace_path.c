@@ -363,9 +363,8 @@ static rl_vec3 direct_light_mis(const pt_ctx *ctx, const pt_surface *s, pt_sampl
                 sum = rl_add(sum, rl_mul(rl_pt_bsdf_f(s, l), rl_scale(E, cos_r / (pmf * (float)n))));
                 continue;
             }
-            n_e = rl_cross(L->edge_u, L->edge_v);
-            area = rl_length(n_e);
-            n_e = rl_scale(n_e, 1.0f / area);
+            n_e = lt->light_normal[src];
+            area = lt->light_area[src];
             pt_sph_rect rect;
             if (ctx->quad_solid_angle && rl_pt_sph_rect_init(&rect, L, s->p)) {
                 q = rl_pt_sph_rect_sample(&rect, x.x, x.y);
