@@ -469,7 +469,9 @@ static rl_vec3 emitted_mis(const pt_ctx *ctx, const pt_surface *s, bool after_br
     if (!after_brdf || !ctx->mis_hits)
         return emitted(ctx, s, after_brdf);
     rl_vec3 e = s->m->emission;
-    if (!(rl_vmax_comp(e) > 0.0f) || s->tri == RL_ID_NONE)
+    if (!(rl_vmax_comp(e) > 0.0f))
+        return rl_v3s(0.0f);       /* what emitted() returns for it, without the call */
+    if (s->tri == RL_ID_NONE)
         return emitted(ctx, s, after_brdf);
     const pt_backends *b = ctx->b;
     const pt_lights *lt = &b->lights;
