@@ -85,9 +85,36 @@ bool rl_pt_phong_sample(const pt_surface *s, float u_lobe, float u1, float u2, r
     return rl_pt_phong_sample_pdf(s, u_lobe, u1, u2, wi, weight, NULL);
 }
 
+bool rl_pt_surface_lambert(const pt_surface *s)
+{
+    float wd = mean3(s->kd);
+    return s->m->bsdf != RL_BSDF_GGX && !(rl_vmax_comp(s->m->specular) > 0.0f) && wd > 0.0f && isfinite(wd);
+}
+
+/* rl_pt_phong_sample_pdf on a Lambertian surface: the diffuse lobe is
+ * chosen whatever u_lobe (P_d = 1), the pdf is 1 * cos / pi and f = k_d / pi,
+ * written so that every float is the general path's. */
+static bool lambert_sample(const pt_surface *s, float u1, float u2, rl_vec3 *wi, rl_vec3 *weight, float *pdf_out)
+{
+    rl_vec3 dir = around(s->ns, sqrtf(1.0f - u1), 2.0f * RL_PI * u2);
+    float cos_theta = rl_dot(s->ns, dir);
+    if (cos_theta <= 0.0f || rl_dot(s->ng, dir) <= 0.0f)
+        return false;
+    float pdf = cos_theta / RL_PI;
+    if (!(pdf > 0.0f))
+        return false;
+    *wi = dir;
+    *weight = rl_scale(rl_scale(s->kd, 1.0f / RL_PI), cos_theta / pdf);
+    if (pdf_out)
+        *pdf_out = pdf;
+    return true;
+}
+
 bool rl_pt_phong_sample_pdf(const pt_surface *s, float u_lobe, float u1, float u2, rl_vec3 *wi, rl_vec3 *weight,
                             float *pdf_out)
 {
+    if (s->lambert)
+        return lambert_sample(s, u1, u2, wi, weight, pdf_out);
     float pd = diffuse_probability(s);
     if (pd < 0.0f)
         return false;

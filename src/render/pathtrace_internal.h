@@ -139,6 +139,11 @@ typedef struct pt_lights {
     float *cdf;                    /* count + 1 running sums, cdf[count] = 1 */
     float *light_pmf;              /* per scene light: its probability */
     bool *light_hittable;          /* per scene light: a quad whose covering mesh a ray can hit */
+    /* Per scene light: |edge_u x edge_v| (a quad's area) and that cross
+     * product over it (its unit front normal), as next-event estimation
+     * computed them at every vertex before. */
+    float *light_area;
+    rl_vec3 *light_normal;
     float *tri_pmf;                /* per triangle: the probability of an uncovered emitter, else 0 */
     rl_vec3 centre;                /* bounding sphere of the scene (directional lights) */
     float radius;
@@ -311,8 +316,12 @@ enum {
 void rl_pt_sampler_init(pt_sampler *s, rl_rng_gpu *rng, uint32_t pixel_seed, uint32_t index);
 /* A pixel's scramble seed from the option seed and the pixel's number. */
 uint32_t rl_pt_pixel_seed(uint64_t seed, uint64_t pixel);
-/* Moves to a slot (ignored by the GPU generators, which run in order). */
-void rl_pt_sampler_seek(pt_sampler *s, uint32_t slot);
+/* Moves to a slot (ignored by the GPU generators, which run in order).
+ * Inline: a path makes several seeks per vertex, each one store. */
+static inline void rl_pt_sampler_seek(pt_sampler *s, uint32_t slot)
+{
+    s->slot = slot;
+}
 float rl_pt_sample_1d(pt_sampler *s);
 rl_vec2 rl_pt_sample_2d(pt_sampler *s);
 /* Nested uniform scrambling of x read as a binary fraction (MSB first);
@@ -332,10 +341,15 @@ typedef struct pt_surface {
     rl_vec3 v;                /* unit direction back along the incoming ray */
     bool front;               /* the unflipped geometric normal faced the ray */
     rl_vec3 kd;               /* k_d times the diffuse texture */
-    rl_vec2 uv;
+    rl_vec2 uv;               /* at exact hits only where a texture reads it, else 0 */
     const rl_material *m;
     uint32_t tri;
     bool ggx_ms;              /* GGX with Kulla-Conty energy compensation (option ggx_ms) */
+    /* Phong with k_s = 0 and a finite mean(k_d) > 0: f = k_d / pi, the
+     * cosine lobe alone. Set with the surface (rl_pt_surface_lambert); a
+     * surface built by hand leaves it false and takes the general path,
+     * which gives the same numbers, bit for bit, only slower. */
+    bool lambert;
 } pt_surface;
 
 /* Surface on triangle tri at p with raw shading normal ns and texture
@@ -416,6 +430,28 @@ bool rl_pt_bsdf_sample_pdf(const pt_surface *s, float u_lobe, float u1, float u2
 float rl_pt_bsdf_pdf(const pt_surface *s, rl_vec3 wi);
 /* Whether sampling m's BRDF uses the lobe number (more than one lobe). */
 bool rl_pt_bsdf_needs_lobe(const rl_material *m);
+/* Whether s's BRDF is Lambertian (pt_surface.lambert): the Phong model
+ * with no specular lobe and a diffuse reflectance whose mean is finite and
+ * positive, so that the lobe choice's probability of the diffuse lobe,
+ * mean(k_d) / (mean(k_d) + 0), is exactly 1. */
+bool rl_pt_surface_lambert(const pt_surface *s);
+
+/* The fast path of a Lambertian vertex (issue 37, the cost of a sample):
+ * the values of rl_pt_bsdf_eval and rl_pt_bsdf_pdf, bit for bit, without
+ * the call, the GGX dispatch, the specular test and the lobe mixture
+ * (Phong's f = k_d / pi + 0 and pdf = 1 * cos / pi). */
+static inline rl_vec3 rl_pt_bsdf_f(const pt_surface *s, rl_vec3 wi)
+{
+    return s->lambert ? rl_scale(s->kd, 1.0f / RL_PI) : rl_pt_bsdf_eval(s, wi);
+}
+static inline float rl_pt_bsdf_density(const pt_surface *s, rl_vec3 wi)
+{
+    if (!s->lambert)
+        return rl_pt_bsdf_pdf(s, wi);
+    float cos_theta = rl_dot(s->ns, wi);
+    return cos_theta > 0.0f ? cos_theta / RL_PI : 0.0f;
+}
+
 /* The specular event chosen by u_event < k_r + k_t: the mirror (k_r) or
  * the refraction (k_t; total internal reflection mirrors), with Schlick's
  * Fresnel when the material asks for it (the mirror's weight becomes F

@@ -67,6 +67,8 @@ void rl_pt_lights_release(pt_lights *l)
     free(l->cdf);
     free(l->light_pmf);
     free(l->light_hittable);
+    free(l->light_area);
+    free(l->light_normal);
     free(l->tri_pmf);
     memset(l, 0, sizeof *l);
 }
@@ -82,8 +84,11 @@ rl_status rl_pt_lights_build(pt_backends *b, const rl_scene_data *d)
     l->cdf = rl_calloc(entries + 1, sizeof *l->cdf);
     l->light_pmf = rl_calloc(d->num_lights ? d->num_lights : 1, sizeof *l->light_pmf);
     l->light_hittable = rl_calloc(d->num_lights ? d->num_lights : 1, sizeof *l->light_hittable);
+    l->light_area = rl_calloc(d->num_lights ? d->num_lights : 1, sizeof *l->light_area);
+    l->light_normal = rl_calloc(d->num_lights ? d->num_lights : 1, sizeof *l->light_normal);
     l->tri_pmf = rl_calloc(d->num_triangles ? d->num_triangles : 1, sizeof *l->tri_pmf);
-    if (!power || !covered || !l->source || !l->cdf || !l->light_pmf || !l->light_hittable || !l->tri_pmf) {
+    if (!power || !covered || !l->source || !l->cdf || !l->light_pmf || !l->light_hittable || !l->light_area ||
+        !l->light_normal || !l->tri_pmf) {
         free(power);
         free(covered);
         rl_pt_lights_release(l);
@@ -121,7 +126,10 @@ rl_status rl_pt_lights_build(pt_backends *b, const rl_scene_data *d)
     }
     for (uint32_t i = 0; i < d->num_lights; ++i) {
         const rl_light *L = &d->lights[i];
-        float area = rl_length(rl_cross(L->edge_u, L->edge_v));
+        rl_vec3 n_e = rl_cross(L->edge_u, L->edge_v);
+        float area = rl_length(n_e);
+        l->light_area[i] = area;
+        l->light_normal[i] = rl_scale(n_e, 1.0f / area);
         l->light_hittable[i] = L->type == RL_LIGHT_QUAD && area > 0.0f &&
                                fabs(covered[i] - area) <= HITTABLE_AREA_TOL * area;
     }

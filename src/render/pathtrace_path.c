@@ -85,7 +85,12 @@ void rl_pt_surface_finish(const rl_scene_data *d, uint32_t tri, rl_vec3 p, rl_ve
     const uint32_t *idx = &d->indices[3 * (size_t)tri];
     rl_vec3 p0 = d->positions[idx[0]], p1 = d->positions[idx[1]], p2 = d->positions[idx[2]];
     rl_vec3 ng = rl_normalize(rl_cross(rl_sub(p1, p0), rl_sub(p2, p0)));
-    ns = rl_normalize(rl_shading_normal(d, tri, ns, uv));
+    const rl_material *m = &d->materials[d->triangle_material[tri]];
+    /* rl_shading_normal returns ns untouched, bit for bit, without a normal
+     * map: the test here saves the call at most hits. */
+    if (m->normal_texture < d->num_textures)
+        ns = rl_shading_normal(d, tri, ns, uv);
+    ns = rl_normalize(ns);
     if (!(rl_length2(ns) > 0.0f) || !rl_vfinite(ns))
         ns = ng;
     s->p = p;
@@ -93,11 +98,12 @@ void rl_pt_surface_finish(const rl_scene_data *d, uint32_t tri, rl_vec3 p, rl_ve
     s->front = rl_dot(ng, v) > 0.0f;
     s->ng = s->front ? ng : rl_neg(ng);
     s->ns = rl_dot(ns, v) < 0.0f ? rl_neg(ns) : ns;
-    s->m = &d->materials[d->triangle_material[tri]];
+    s->m = m;
     s->uv = uv;
-    s->kd = textured_kd(d, s->m, uv);
+    s->kd = textured_kd(d, m, uv);
     s->tri = tri;
     s->ggx_ms = false;             /* the renderer's option: set where the path uses s */
+    s->lambert = rl_pt_surface_lambert(s);
 }
 
 bool rl_pt_surface_at_hit(const rl_scene_data *d, const rl_hit *hit, rl_vec3 o, rl_vec3 dir, pt_surface *s)
@@ -113,8 +119,15 @@ bool rl_pt_surface_at_hit(const rl_scene_data *d, const rl_hit *hit, rl_vec3 o, 
                        rl_scale(d->positions[idx[2]], v));
     rl_vec3 ns = rl_add(rl_add(rl_scale(d->normals[idx[0]], w), rl_scale(d->normals[idx[1]], u)),
                         rl_scale(d->normals[idx[2]], v));
-    rl_vec2 t0 = d->uvs[idx[0]], t1 = d->uvs[idx[1]], t2 = d->uvs[idx[2]];
-    rl_vec2 uv = rl_v2(w * t0.x + u * t1.x + v * t2.x, w * t0.y + u * t1.y + v * t2.y);
+    /* The texture coordinates only where a texture reads them (a diffuse
+     * or a normal map): three more vertex loads and six products at every
+     * hit otherwise. */
+    rl_vec2 uv = rl_v2(0.0f, 0.0f);
+    const rl_material *m = &d->materials[d->triangle_material[hit->triangle]];
+    if (m->diffuse_texture < d->num_textures || m->normal_texture < d->num_textures) {
+        rl_vec2 t0 = d->uvs[idx[0]], t1 = d->uvs[idx[1]], t2 = d->uvs[idx[2]];
+        uv = rl_v2(w * t0.x + u * t1.x + v * t2.x, w * t0.y + u * t1.y + v * t2.y);
+    }
     rl_pt_surface_finish(d, hit->triangle, p, ns, uv, rl_neg(rl_normalize(dir)), s);
     return true;
 }
@@ -138,6 +151,7 @@ static bool surface_of_record(const rl_scene_data *d, const rl_ls_surface *r, rl
     s->kd = textured_kd(d, s->m, r->uv);
     s->tri = RL_ID_NONE;
     s->ggx_ms = false;
+    s->lambert = rl_pt_surface_lambert(s);
     return true;
 }
 
@@ -270,7 +284,7 @@ static rl_vec3 direct_light(const pt_ctx *ctx, const pt_surface *s, pt_sampler *
                 float cos_e = -rl_dot(nq, l), cos_r = rl_dot(s->ns, l);
                 if (cos_e <= 0.0f || cos_r <= 0.0f || !visible(ctx, s, l, dist, i, j.x, j.y, c))
                     continue;
-                rl_vec3 f = rl_pt_bsdf_eval(s, l);
+                rl_vec3 f = rl_pt_bsdf_f(s, l);
                 sum = rl_add(sum, rl_mul(f, rl_scale(le, cos_e * cos_r / d2)));   /* eq. 7 */
             }
             continue;
@@ -284,7 +298,7 @@ static rl_vec3 direct_light(const pt_ctx *ctx, const pt_surface *s, pt_sampler *
         float cos_r = rl_dot(s->ns, l);
         if (cos_r <= 0.0f || !visible(ctx, s, l, dist, i, j.x, j.y, c))
             continue;
-        sum = rl_add(sum, rl_mul(rl_pt_bsdf_eval(s, l), rl_scale(E, cos_r)));
+        sum = rl_add(sum, rl_mul(rl_pt_bsdf_f(s, l), rl_scale(E, cos_r)));
     }
     return sum;
 }
@@ -305,7 +319,7 @@ static float power_heuristic(float a, float b)
  * rl_pt_bsdf_sample refuses directions. */
 static float bsdf_pdf(const pt_surface *s, rl_vec3 wi)
 {
-    return rl_dot(s->ng, wi) > 0.0f ? rl_pt_bsdf_pdf(s, wi) : 0.0f;
+    return rl_dot(s->ng, wi) > 0.0f ? rl_pt_bsdf_density(s, wi) : 0.0f;
 }
 
 /* Next-event estimation with mis=on: light_samples lights chosen by power
@@ -346,12 +360,11 @@ static rl_vec3 direct_light_mis(const pt_ctx *ctx, const pt_surface *s, pt_sampl
                 float cos_r = rl_dot(s->ns, l);
                 if (cos_r <= 0.0f || !visible(ctx, s, l, dist, src, j.x, j.y, c))
                     continue;
-                sum = rl_add(sum, rl_mul(rl_pt_bsdf_eval(s, l), rl_scale(E, cos_r / (pmf * (float)n))));
+                sum = rl_add(sum, rl_mul(rl_pt_bsdf_f(s, l), rl_scale(E, cos_r / (pmf * (float)n))));
                 continue;
             }
-            n_e = rl_cross(L->edge_u, L->edge_v);
-            area = rl_length(n_e);
-            n_e = rl_scale(n_e, 1.0f / area);
+            n_e = lt->light_normal[src];
+            area = lt->light_area[src];
             pt_sph_rect rect;
             if (ctx->quad_solid_angle && rl_pt_sph_rect_init(&rect, L, s->p)) {
                 q = rl_pt_sph_rect_sample(&rect, x.x, x.y);
@@ -388,7 +401,7 @@ static rl_vec3 direct_light_mis(const pt_ctx *ctx, const pt_surface *s, pt_sampl
             continue;
         float p_light = p_sa > 0.0f ? p_sa : pmf * d2 / (area * cos_e);   /* solid angle at s */
         float w = bsdf_follows && hittable ? power_heuristic((float)n * p_light, bsdf_pdf(s, l)) : 1.0f;
-        rl_vec3 f = rl_pt_bsdf_eval(s, l);
+        rl_vec3 f = rl_pt_bsdf_f(s, l);
         sum = rl_add(sum, rl_mul(f, rl_scale(le, w * cos_r / (p_light * (float)n))));
     }
     return sum;
@@ -411,7 +424,7 @@ static rl_vec3 environment_light(const pt_ctx *ctx, const pt_surface *s, pt_samp
         return rl_v3s(0.0f);
     float w = bsdf_follows ? power_heuristic(p_env, bsdf_pdf(s, l)) : 1.0f;
     rl_vec3 L = rl_environment_radiance(ctx->env, l);
-    return rl_mul(rl_pt_bsdf_eval(s, l), rl_scale(L, w * cos_r / p_env));
+    return rl_mul(rl_pt_bsdf_f(s, l), rl_scale(L, w * cos_r / p_env));
 }
 
 rl_vec3 rl_pt_escape_radiance(const pt_ctx *ctx, rl_vec3 dir)
@@ -456,7 +469,9 @@ static rl_vec3 emitted_mis(const pt_ctx *ctx, const pt_surface *s, bool after_br
     if (!after_brdf || !ctx->mis_hits)
         return emitted(ctx, s, after_brdf);
     rl_vec3 e = s->m->emission;
-    if (!(rl_vmax_comp(e) > 0.0f) || s->tri == RL_ID_NONE)
+    if (!(rl_vmax_comp(e) > 0.0f))
+        return rl_v3s(0.0f);       /* what emitted() returns for it, without the call */
+    if (s->tri == RL_ID_NONE)
         return emitted(ctx, s, after_brdf);
     const pt_backends *b = ctx->b;
     const pt_lights *lt = &b->lights;
@@ -535,7 +550,7 @@ rl_vec3 rl_pt_trace_path(const pt_ctx *ctx, pt_surface *first, pt_sampler *sp, p
             if (last)
                 break;
             rl_pt_sampler_seek(sp, base + PT_SLOT_LOBE);
-            float u0 = sp->rng || rl_pt_bsdf_needs_lobe(s->m) ? rl_pt_sample_1d(sp) : 0.0f;
+            float u0 = sp->rng || (!s->lambert && rl_pt_bsdf_needs_lobe(s->m)) ? rl_pt_sample_1d(sp) : 0.0f;
             rl_pt_sampler_seek(sp, base + PT_SLOT_BSDF);
             rl_vec2 u12 = rl_pt_sample_2d(sp);
             rl_vec3 w;

@@ -97,9 +97,33 @@ void rl_pt_sampler_init(pt_sampler *s, rl_rng_gpu *rng, uint32_t pixel_seed, uin
     s->slot = 0;
 }
 
+/* rl_hash64 (core/rng.c, one splitmix64 step) written out here, so that
+ * the compiler inlines it into every draw: the library's copy is an
+ * exported call, and a draw is only about a hundred operations. The same
+ * function, bit for bit (tested against rl_hash64). */
+static inline uint64_t hash64(uint64_t x)
+{
+    x += 0x9e3779b97f4a7c15ull;
+    x = (x ^ (x >> 30)) * 0xbf58476d1ce4e5b9ull;
+    x = (x ^ (x >> 27)) * 0x94d049bb133111ebull;
+    return x ^ (x >> 31);
+}
+
 uint32_t rl_pt_pixel_seed(uint64_t seed, uint64_t pixel)
 {
-    return (uint32_t)(rl_hash64(rl_hash64(seed) ^ (pixel * 0x9e3779b97f4a7c15ull)) >> 32);
+    return (uint32_t)(hash64(hash64(seed) ^ (pixel * 0x9e3779b97f4a7c15ull)) >> 32);
+}
+
+/* Both halves of a 64-bit word bit-reversed in place: one reversal for the
+ * two coordinates of a 2D draw instead of one each (a reversal is a chain
+ * of 13 integer operations; x86 has no instruction for it). Reversing the
+ * 64 bits swaps the halves, so the caller packs them the other way round. */
+static uint64_t reverse_bits64(uint64_t x)
+{
+    x = __builtin_bswap64(x);
+    x = ((x & 0x0f0f0f0f0f0f0f0full) << 4) | ((x >> 4) & 0x0f0f0f0f0f0f0f0full);
+    x = ((x & 0x3333333333333333ull) << 2) | ((x >> 2) & 0x3333333333333333ull);
+    return ((x & 0x5555555555555555ull) << 1) | ((x >> 1) & 0x5555555555555555ull);
 }
 
 /* The seeds of a slot (index shuffle, x, y) from one 64-bit hash: the
@@ -107,7 +131,7 @@ uint32_t rl_pt_pixel_seed(uint64_t seed, uint64_t pixel)
  * distinct well-mixed words. */
 static void slot_seeds(const pt_sampler *s, uint32_t slot, uint32_t seed[3])
 {
-    uint64_t h = rl_hash64(((uint64_t)s->pixel_seed << 32) | slot);
+    uint64_t h = hash64(((uint64_t)s->pixel_seed << 32) | slot);
     seed[0] = (uint32_t)h;
     seed[1] = (uint32_t)(h >> 32);
     seed[2] = (uint32_t)((h * 0xd1342543de82ef95ull) >> 32) ^ seed[0];
@@ -132,8 +156,9 @@ rl_vec2 rl_pt_sample_2d(pt_sampler *s)
      * cancelled against the ones before them. */
     uint32_t d0 = scramble_reversed(s->index_reversed, seed[0]);
     uint32_t i = reverse_bits(d0);
-    return rl_v2(to_unit(reverse_bits(scramble_reversed(i, seed[1]))),
-                 to_unit(reverse_bits(scramble_reversed(sobol_dim1_reversed(i), seed[2]))));
+    uint64_t xy = reverse_bits64((uint64_t)scramble_reversed(sobol_dim1_reversed(i), seed[2]) << 32 |
+                                 scramble_reversed(i, seed[1]));
+    return rl_v2(to_unit((uint32_t)(xy >> 32)), to_unit((uint32_t)xy));
 }
 
 float rl_pt_sample_1d(pt_sampler *s)
@@ -145,9 +170,4 @@ float rl_pt_sample_1d(pt_sampler *s)
     /* sobol_dim0(owen(index)) = reverse(owen(index)): one reversal less. */
     uint32_t d0 = scramble_reversed(s->index_reversed, seed[0]);
     return to_unit(rl_pt_owen_scramble(d0, seed[1]));
-}
-
-void rl_pt_sampler_seek(pt_sampler *s, uint32_t slot)
-{
-    s->slot = slot;
 }

@@ -197,6 +197,56 @@ static void test_lambertian_weight_is_kd_and_black_is_refused(void **state)
     assert_true(rl_pt_phong_pdf(&b, rl_v3(0, 0, 1)) == 0.0f);
 }
 
+/* The Lambertian fast path (pt_surface.lambert, issue 37's cost of a
+ * sample) returns what the general Phong path returns, bit for bit:
+ * directions, weights, the pdf handed to MIS, f and the pdf of a light
+ * sample's direction; and only Lambertian surfaces take it. */
+static void test_lambert_fast_path_equals_the_general_path_bit_for_bit(void **state)
+{
+    (void)state;
+    rl_rng r;
+    rl_rng_seed(&r, 11, 5);
+    int sampled = 0;
+    for (int k = 0; k < 20000; ++k) {
+        rl_material m = { .diffuse = { rl_rng_float(&r), rl_rng_float(&r), rl_rng_float(&r) } };
+        rl_vec3 ns = rl_normalize(rl_v3(rl_rng_float(&r) - 0.5f, rl_rng_float(&r) - 0.5f, 1.0f));
+        rl_vec3 ng = rl_normalize(rl_v3(0.3f * (rl_rng_float(&r) - 0.5f), 0.3f * (rl_rng_float(&r) - 0.5f), 1.0f));
+        rl_vec3 v = rl_normalize(rl_v3(rl_rng_float(&r) - 0.5f, rl_rng_float(&r) - 0.5f, rl_rng_float(&r)));
+        pt_surface slow = { .ng = ng, .ns = ns, .v = v, .front = true, .kd = m.diffuse, .m = &m, .tri = 0 };
+        pt_surface fast = slow;
+        fast.lambert = true;
+        assert_true(rl_pt_surface_lambert(&slow));
+        /* u_lobe up to the largest float below 1: P_d is exactly 1. */
+        float u0 = k % 7 == 0 ? 0.99999994f : rl_rng_float(&r), u1 = rl_rng_float(&r), u2 = rl_rng_float(&r);
+        rl_vec3 wi_s = rl_v3s(0.0f), w_s = rl_v3s(0.0f), wi_f = rl_v3s(1.0f), w_f = rl_v3s(1.0f);
+        float pdf_s = -1.0f, pdf_f = -2.0f;
+        bool ok_s = rl_pt_bsdf_sample_pdf(&slow, u0, u1, u2, &wi_s, &w_s, &pdf_s);
+        bool ok_f = rl_pt_bsdf_sample_pdf(&fast, u0, u1, u2, &wi_f, &w_f, &pdf_f);
+        assert_true(ok_s == ok_f);
+        if (ok_s) {
+            ++sampled;
+            assert_memory_equal(&wi_s, &wi_f, sizeof wi_s);
+            assert_memory_equal(&w_s, &w_f, sizeof w_s);
+            assert_memory_equal(&pdf_s, &pdf_f, sizeof pdf_s);
+        }
+        rl_vec3 l = rl_normalize(rl_v3(rl_rng_float(&r) - 0.5f, rl_rng_float(&r) - 0.5f, rl_rng_float(&r) - 0.2f));
+        rl_vec3 f_s = rl_pt_bsdf_eval(&slow, l), f_f = rl_pt_bsdf_f(&fast, l);
+        float p_s = rl_pt_bsdf_pdf(&slow, l), p_f = rl_pt_bsdf_density(&fast, l);
+        assert_memory_equal(&f_s, &f_f, sizeof f_s);
+        assert_memory_equal(&p_s, &p_f, sizeof p_s);
+    }
+    assert_true(sampled > 15000);
+    /* Not Lambertian: a specular lobe, GGX, black, or a reflectance whose
+     * mean is not finite. */
+    rl_material spec = thesis_mat, ggx = { .diffuse = { 0.5f, 0.5f, 0.5f }, .bsdf = RL_BSDF_GGX, .roughness = 0.5f };
+    rl_material black = { 0 }, huge = { .diffuse = { INFINITY, 0.5f, 0.5f } };
+    const rl_material *not_lambert[] = { &spec, &ggx, &black, &huge };
+    for (int k = 0; k < 4; ++k) {
+        pt_surface s = surface(not_lambert[k], 20.0f);
+        assert_false(rl_pt_surface_lambert(&s));
+    }
+}
+
 /* ------------------------------------------------ Schlick and GGX (issue 37) */
 
 static void test_schlick_fresnel_has_its_limits_and_is_reciprocal(void **state)
@@ -552,6 +602,7 @@ int main(void)
         cmocka_unit_test(test_phong_samples_follow_the_reported_pdf_for_the_thesis_material),
         cmocka_unit_test(test_phong_samples_follow_the_reported_pdf_for_a_glossy_material),
         cmocka_unit_test(test_lambertian_weight_is_kd_and_black_is_refused),
+        cmocka_unit_test(test_lambert_fast_path_equals_the_general_path_bit_for_bit),
         cmocka_unit_test(test_schlick_fresnel_has_its_limits_and_is_reciprocal),
         cmocka_unit_test(test_specular_event_splits_by_fresnel_and_conserves_energy),
         cmocka_unit_test(test_ggx_is_reciprocal),

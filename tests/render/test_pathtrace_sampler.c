@@ -209,6 +209,8 @@ static void test_draws_match_the_straightforward_evaluation(void **state)
     (void)state;
     for (uint32_t pixel = 0; pixel < 4; ++pixel) {
         uint32_t seed = rl_pt_pixel_seed(9, pixel * 1237u);
+        /* The sampler's own copy of the hash is rl_hash64's. */
+        assert_int_equal(seed, (uint32_t)(rl_hash64(rl_hash64(9) ^ (pixel * 1237ull * 0x9e3779b97f4a7c15ull)) >> 32));
         for (uint32_t index = 0; index < 300; index += 7) {
             for (uint32_t slot = 0; slot < 40; ++slot) {
                 /* The slot's three scramble seeds, the shuffled index, and
