@@ -43,6 +43,12 @@ typedef struct rl_accel_desc {                      /* zero = default */
     int threads;              /* build threads; 0 -> all */
     int bvh_leaf_size;        /* max triangles per leaf; 0 -> 2 */
     int bvh_bins;             /* SAH bins per axis; 0 -> 16 */
+    int bvh_block_cost;       /* 1: the SAH counts a leaf's SoA blocks of 4 triangles
+                               * (ceil(n/4)) instead of its triangles, leaves of up to
+                               * 8: about half the memory, a faster build on large
+                               * scenes, diffuse rays faster on some meshes, slower on
+                               * others (bench/README.md, "Diffuse rays against
+                               * Embree"); 0 (default): per triangle */
     float grid_lambda;        /* grid density λ: cells per axis ≈ λ·∛N scaled to
                                * the box's aspect; 0 -> 2 */
     int grid_res[3];          /* explicit cells per axis; 0 -> from grid_lambda */

@@ -94,6 +94,8 @@ static rl_status check_desc(const rl_accel_desc *d)
         return rl_error(RL_ERR_INVALID_ARG, "accel: bvh_leaf_size %d not in 0..64", d->bvh_leaf_size);
     if (d->bvh_bins != 0 && (d->bvh_bins < 2 || d->bvh_bins > 256))
         return rl_error(RL_ERR_INVALID_ARG, "accel: bvh_bins %d not 0 or in 2..256", d->bvh_bins);
+    if (d->bvh_block_cost != 0 && d->bvh_block_cost != 1)
+        return rl_error(RL_ERR_INVALID_ARG, "accel: bvh_block_cost %d not 0 or 1", d->bvh_block_cost);
     if (!isfinite(d->grid_lambda) || d->grid_lambda < 0.0f)
         return rl_error(RL_ERR_INVALID_ARG, "accel: grid_lambda %g must be finite and >= 0",
                         (double)d->grid_lambda);

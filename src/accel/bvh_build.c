@@ -12,10 +12,21 @@
  * incoherent rays (rl bench rays, diffuse; cornell-teapot 70k and city).
  * With the SIMD leaf test (4 triangles per block, bvh_wide_traverse.c),
  * costing leaves per block and default leaf sizes 3-4 were tried: Wuson
- * gained a little, city lost (shadow -10 %), so the costs stay per triangle.
+ * gained a little, city lost (shadow -10 %), so the costs stay per triangle
+ * by default. desc bvh_block_cost = 1 counts blocks instead, as Embree's
+ * builder does: the cost of n triangles is C_isect·ceil(n/4), in the sweep
+ * and in the leaf test, and leaves hold up to BLOCK_MAX_LEAF triangles
+ * (two blocks). Measured on 2026-12-06 (bench/README.md, "Diffuse rays
+ * against Embree", interleaved, CPU-time ratios to Embree): memory 104 ->
+ * 58 B/triangle on city, build 1.52x -> 0.79x Embree's, diffuse rays
+ * spider.obj 0.81x -> 0.91x, teapots.DAE 0.90x -> 0.98x, but city 0.75x
+ * -> 0.73x and cornell 1.46x -> 1.14x (larger leaves are hit more often,
+ * and the chain of node fetches, where the time goes, is not shorter), so
+ * it is not the default.
  * Termination: N <= desc bvh_leaf_size (default 2) is always a leaf; larger
  * nodes become a leaf when the best split does not beat the leaf cost
- * C_isect·N, up to RL_BVH_MAX_LEAF triangles (so a leaf may exceed
+ * C_isect·N (C_isect·ceil(N/4) with block costs), up to RL_BVH_MAX_LEAF
+ * triangles (BLOCK_MAX_LEAF with block costs; so a leaf may exceed
  * bvh_leaf_size when the SAH says so). Beyond that, when all centroids
  * coincide (no bins), or deeper than RL_BVH_SAH_MAX_DEPTH, we split at the
  * object median.
@@ -56,6 +67,7 @@
 #define C_TRAV 0.5f
 #define DEFAULT_LEAF 2
 #define C_ISECT 1.0f
+#define BLOCK_MAX_LEAF 8
 #define TASK_MIN 4096u
 #define MAX_BINS 256
 /* Node pairs are handed out to each thread in chunks of this many slots
@@ -119,6 +131,8 @@ typedef struct builder {
     cursor *cursors;             /* one per thread */
     uint32_t num_tris;
     int bins, leaf_size;
+    bool block_cost;             /* desc bvh_block_cost: leaves cost per SoA block */
+    uint32_t max_leaf;           /* largest leaf the SAH may choose */
     int threads;
     uint32_t small_max, par_bin_min;
     rl_progress_fn progress;
@@ -386,6 +400,13 @@ static inline void consider(split *best, int axis, int bin, float cost, v4 llo, 
         *best = (split){ axis, bin, cost, v4_box(llo, lhi), v4_box(rlo, rhi), cmin, k1 };
 }
 
+/* The SAH's intersection count of n triangles: n, or with block costs the
+ * blocks of RL_BVH_LANES they fill (a block costs one SIMD test). */
+static inline float isect_units(uint32_t n, bool block_cost)
+{
+    return block_cost ? (float)((n + RL_BVH_LANES - 1) / RL_BVH_LANES) : (float)n;
+}
+
 /* The SAH sweep over one axis's occupied bins used[0..m) (ascending):
  * planes between two of them with only empty bins in between all split
  * alike, at the same cost, and the strict comparison keeps the first of
@@ -395,7 +416,7 @@ static inline void consider(split *best, int axis, int bin, float cost, v4 llo, 
  * right, then the planes from the left; the boxes stay vectors (union =
  * min/max, exact). */
 static void sweep_axis(split *best, int axis, const v4 *blo, const v4 *bhi, const uint32_t *bcnt, const int *used,
-                       int m, float cmin, float k1)
+                       int m, float cmin, float k1, bool block_cost)
 {
     v4 rlo[MAX_BINS], rhi[MAX_BINS];
     uint32_t right_n[MAX_BINS];
@@ -418,7 +439,8 @@ static void sweep_axis(split *best, int axis, const v4 *blo, const v4 *bhi, cons
         alo = v4_min(alo, blo[k]);
         ahi = v4_max(ahi, bhi[k]);
         cnt += bcnt[k];
-        float cost = v4_area(alo, ahi) * (float)cnt + v4_area(rlo[u], rhi[u]) * (float)right_n[u];
+        float cost = v4_area(alo, ahi) * isect_units(cnt, block_cost) +
+                     v4_area(rlo[u], rhi[u]) * isect_units(right_n[u], block_cost);
         consider(best, axis, k + 1, cost, alo, ahi, rlo[u], rhi[u], cmin, k1);
     }
 }
@@ -468,7 +490,7 @@ static split find_split_small(const builder *b, uint32_t begin, uint32_t end, co
         int used[SMALL_MAX], m = 0;
         for (uint64_t bits = mask[axis]; bits; bits &= bits - 1)
             used[m++] = __builtin_ctzll(bits);
-        sweep_axis(&best, axis, blo[axis], bhi[axis], bcnt[axis], used, m, cmin[axis], k1[axis]);
+        sweep_axis(&best, axis, blo[axis], bhi[axis], bcnt[axis], used, m, cmin[axis], k1[axis], b->block_cost);
     }
     return best;
 }
@@ -503,7 +525,8 @@ static split find_split(const builder *b, uint32_t begin, uint32_t end, rl_aabb 
             used[m] = k;
             m += bs.count[axis][k] > 0;
         }
-        sweep_axis(&best, axis, bs.lo[axis], bs.hi[axis], bs.count[axis], used, m, cmin[axis], k1[axis]);
+        sweep_axis(&best, axis, bs.lo[axis], bs.hi[axis], bs.count[axis], used, m, cmin[axis], k1[axis],
+                   b->block_cost);
     }
     return best;
 }
@@ -538,9 +561,10 @@ static void build_node(builder *b, uint32_t slot, uint32_t begin, uint32_t end, 
     split s = { .axis = -1 };
     if (depth < RL_BVH_SAH_MAX_DEPTH)
         s = find_split(b, begin, end, cb);
-    if (n <= RL_BVH_MAX_LEAF) {
+    if (n <= b->max_leaf) {
         float area = rl_aabb_area(bounds);
-        bool pays = s.axis >= 0 && (area > 0.0f ? C_TRAV + C_ISECT * s.cost / area < C_ISECT * (float)n : true);
+        bool pays = s.axis >= 0 &&
+                    (area > 0.0f ? C_TRAV + C_ISECT * s.cost / area < C_ISECT * isect_units(n, b->block_cost) : true);
         if (!pays) {
             make_leaf(b, slot, begin, n, bounds);
             return;
@@ -674,6 +698,8 @@ static rl_status build_tree(const rl_scene_data *data, const rl_accel_desc *desc
         .num_tris = N,
         .bins = desc->bvh_bins > 0 ? desc->bvh_bins : 16,
         .leaf_size = desc->bvh_leaf_size > 0 ? desc->bvh_leaf_size : DEFAULT_LEAF,
+        .block_cost = desc->bvh_block_cost == 1,
+        .max_leaf = desc->bvh_block_cost == 1 ? BLOCK_MAX_LEAF : RL_BVH_MAX_LEAF,
         .threads = threads,
         .small_max = tuning->small_max < SMALL_MAX ? tuning->small_max : SMALL_MAX,
         .par_bin_min = tuning->par_bin_min,

@@ -99,6 +99,7 @@ static void test_create_rejects_bad_descs_and_leaves_out_null(void **state)
         { .threads = -1 },
         { .bvh_leaf_size = -1 }, { .bvh_leaf_size = 65 },
         { .bvh_bins = 1 }, { .bvh_bins = 257 }, { .bvh_bins = -3 },
+        { .bvh_block_cost = -1 }, { .bvh_block_cost = 2 },
         { .grid_lambda = -1.0f }, { .grid_lambda = NAN }, { .grid_lambda = INFINITY },
         { .grid_res = { 4097, 0, 0 } }, { .grid_res = { 0, -1, 0 } },
         { .kind = RL_ACCEL_KIND_COUNT }, { .kind = (rl_accel_kind)-1 },
@@ -113,6 +114,7 @@ static void test_create_rejects_bad_descs_and_leaves_out_null(void **state)
     rl_accel_desc good[] = {
         { .bvh_leaf_size = 64, .bvh_bins = 256, .grid_res = { 4096, 1, 1 } },
         { .bvh_leaf_size = 1, .bvh_bins = 2, .threads = 1, .grid_lambda = 0.5f },
+        { .bvh_block_cost = 1 },
         { 0 },
     };
     for (size_t i = 0; i < sizeof good / sizeof good[0]; ++i) {

@@ -380,6 +380,57 @@ static rl_scene *mesh_scene(const rl_vec3 *pos, uint32_t nv, const uint32_t *idx
     return s;
 }
 
+/* bvh_block_cost = 1 (leaves costed per SoA block, up to 8 triangles):
+ * the same hits as brute force and as the default tree, bit for bit; its
+ * leaves stay within 8 triangles (leaf size 2: the SAH's choice) and fill
+ * their blocks better than the default tree's, so it needs fewer blocks
+ * and less memory. */
+static void test_bvh_block_cost_is_exact_and_fills_blocks(void **state)
+{
+    (void)state;
+    const char *scenes[][2] = { { "cornell-teapot", "triangles=2000" }, { "city", "blocks=1,detail=0" } };
+    for (size_t k = 0; k < sizeof scenes / sizeof scenes[0]; ++k) {
+        uint32_t brute_rays = 2000;
+#ifdef NDEBUG
+        brute_rays = 100000;
+#endif
+        rl_scene *s = builtin(scenes[k][0], scenes[k][1]);
+        const rl_scene_data *d = rl_scene_get_data(s);
+        rl_accel *brute = make_accel(s, (rl_accel_desc){ .kind = RL_ACCEL_BRUTE });
+        rl_accel *plain = make_accel(s, (rl_accel_desc){ .kind = RL_ACCEL_BVH });
+        rl_accel *blocks = make_accel(s, (rl_accel_desc){ .kind = RL_ACCEL_BVH, .bvh_block_cost = 1 });
+        assert_accels_agree(s, brute, blocks, brute_rays, 5);
+        assert_accels_agree(s, plain, blocks, 100000, 6);
+        rl_accel_stats ps, bs;
+        rl_accel_get_stats(plain, &ps);
+        rl_accel_get_stats(blocks, &bs);
+        assert_true(bs.memory_bytes < ps.memory_bytes);
+        assert_true(bs.leaves < ps.leaves);
+        rl_accel_release(blocks);
+        rl_accel_release(plain);
+        rl_accel_release(brute);
+        /* The widened trees: every leaf within 8 triangles, fewer blocks. */
+        rl_bvh pb = { 0 }, bb = { 0 };
+        rl_accel_stats st;
+        assert_int_equal(rl_bvh_build_wide(d, &(rl_accel_desc){ 0 }, &pb, &st), RL_OK);
+        assert_int_equal(rl_bvh_build_wide(d, &(rl_accel_desc){ .bvh_block_cost = 1 }, &bb, &st), RL_OK);
+        uint32_t max_count = 0, tris = 0;
+        for (uint32_t i = 0; i < bb.num_wide; ++i)
+            for (int c = 0; c < RL_BVH_WIDTH; ++c) {
+                max_count = bb.wide[i].count[c] > max_count ? bb.wide[i].count[c] : max_count;
+                tris += bb.wide[i].count[c];
+            }
+        assert_int_equal(tris, d->num_triangles);
+        assert_true(max_count > 2 && max_count <= 8);
+        assert_true(bb.num_blocks < pb.num_blocks);
+        print_message("%s: blocks %u -> %u, leaves %u -> %u, largest leaf %u\n", scenes[k][0], pb.num_blocks,
+                      bb.num_blocks, ps.leaves, bs.leaves, max_count);
+        rl_bvh_free(&pb);
+        rl_bvh_free(&bb);
+        rl_scene_release(s);
+    }
+}
+
 /* Tie rule: 200 copies of one triangle (all centroids equal, so the builder
  * falls back to median splits) -- every kind must report the lowest ID. */
 static void test_bvh_breaks_ties_by_lowest_triangle_id(void **state)
@@ -507,11 +558,13 @@ static void test_bvh_build_wide_equals_build_then_widen(void **state)
     (void)state;
     rl_scene *teapot = builtin("cornell-teapot", "triangles=20000");
     assert_build_wide_matches(rl_scene_get_data(teapot), (rl_accel_desc){ 0 });
+    assert_build_wide_matches(rl_scene_get_data(teapot), (rl_accel_desc){ .bvh_block_cost = 1 });
     assert_build_wide_matches(rl_scene_get_data(teapot), (rl_accel_desc){ .bvh_leaf_size = 1, .bvh_bins = 4 });
     assert_build_wide_matches(rl_scene_get_data(teapot), (rl_accel_desc){ .bvh_leaf_size = 8, .bvh_bins = 256 });
     rl_scene_release(teapot);
     rl_scene *city = builtin("city", "blocks=1,detail=0");
     assert_build_wide_matches(rl_scene_get_data(city), (rl_accel_desc){ 0 });
+    assert_build_wide_matches(rl_scene_get_data(city), (rl_accel_desc){ .bvh_block_cost = 1 });
     rl_scene_release(city);
     /* 5,000 copies of one triangle plus a ramp of small ones: the copies
      * reach the median fallback over a range bigger than a task's. */
@@ -735,6 +788,7 @@ int main(void)
         cmocka_unit_test(test_bvh_structure_is_consistent_and_stats_are_sane),
         cmocka_unit_test(test_bvh_build_wide_equals_build_then_widen),
         cmocka_unit_test(test_bvh_build_keeps_signed_zeros),
+        cmocka_unit_test(test_bvh_block_cost_is_exact_and_fills_blocks),
         cmocka_unit_test(test_bvh_breaks_ties_by_lowest_triangle_id),
         cmocka_unit_test(test_rays_at_shared_edges_and_vertices_never_escape),
         cmocka_unit_test(test_bvh_agrees_with_brute_force_at_vertices_and_edges),
