@@ -564,18 +564,22 @@ static rl_status check_off(const char *path, const char *data, size_t size)
     return RL_OK;
 }
 
-/* Assimp picks its reader by content when the extension's reader declines,
- * so a PLY body in a ".gltf" file still reaches the PLY reader: sniff the
- * magic as well as the extension. */
+/* Assimp picks its reader by content when the extension's reader declines
+ * (its glTF reader declines what does not parse as glTF), and its PLY
+ * reader then takes any file that starts with "ply" in any case, whatever
+ * follows; so a PLY body in a ".gltf" file still reaches the PLY reader:
+ * sniff those three bytes as well as the extension. (fuzz_load_mesh: "ply"
+ * followed by 0xff or NUL bytes instead of the line's end, named .gltf,
+ * made the PLY reader run forever.) */
 static bool starts_like_ply(const char *path)
 {
-    char head[5] = "";
+    char head[3] = "";
     FILE *f = fopen(path, "rb");
     if (!f)
         return false;
-    size_t n = fread(head, 1, 4, f);
+    size_t n = fread(head, 1, 3, f);
     fclose(f);
-    return n == 4 && memcmp(head, "ply", 3) == 0 && (head[3] == '\n' || head[3] == '\r');
+    return n == 3 && (head[0] | 0x20) == 'p' && (head[1] | 0x20) == 'l' && (head[2] | 0x20) == 'y';
 }
 
 static uint32_t le32(const unsigned char *p)

@@ -7,7 +7,7 @@
 # Run as: bash test_cli_hostile_import.sh <rl-binary> <scratch-dir>
 set -u
 . "$(dirname "${BASH_SOURCE[0]}")/lib.bash"
-FINDINGS="$(dirname "${BASH_SOURCE[0]}")/../fuzz/findings"
+REGRESSIONS="$(dirname "${BASH_SOURCE[0]}")/../fuzz/regressions"
 
 # bounded SECONDS MIB TEXT CMD...: exit 1, one error line containing TEXT,
 # at most SECONDS of wall-clock time and MIB of peak resident memory over
@@ -87,10 +87,18 @@ for name, n in (("big.obj", 100000), ("strip.obj", 5000)):
         f.writelines("v %d %d %d\n" % (i % 97, (i // 97) % 89, (i * 7) % 13) for i in range(n))
         f.writelines("f %d %d %d\n" % (i, i + 1, i + 2) for i in range(1, n - 1))
 PY
-# The fuzzer's PLY body that Assimp reads forever (byte 0 picks the
-# harness's extension: .gltf; Assimp sniffs the PLY magic).
-tail -c +2 "$FINDINGS/mesh-assimp-ply-hang.bin" >"$TMP/hang.gltf"
-printf '{ "objects": [ { "file": "hang.gltf" } ] }\n' >"$TMP/uses_hang.json"
+# One OBJ face of 32,000 corners: Assimp's triangulation takes about 10 s.
+python3 - "$TMP/slow.obj" <<'PY'
+import math, sys
+n = 32000
+with open(sys.argv[1], "w") as f:
+    f.writelines("v %.6f %.6f 0\n" % (math.cos(2 * math.pi * i / n), math.sin(2 * math.pi * i / n)) for i in range(n))
+    f.write("f " + " ".join(str(i + 1) for i in range(n)) + "\n")
+PY
+printf '{ "objects": [ { "file": "slow.obj" } ] }\n' >"$TMP/uses_slow.json"
+# The fuzzer's PLY body named .gltf that Assimp's PLY reader, picked by
+# content, read forever: refused now by the PLY pre-check.
+tail -c +2 "$REGRESSIONS/mesh-ply-magic-junk-hang.bin" >"$TMP/hang.gltf"
 
 # Refused by our pre-checks before Assimp runs.
 bounded 10 "$MIB" "self.dae: <node id=\"a\"> instances itself" "$RL" info "$TMP/self.dae"
@@ -101,16 +109,17 @@ bounded 10 "$MIB" "chain.gltf: node hierarchy deeper than 1024 levels" "$RL" inf
 bounded 10 "$MIB" "cycle.gltf: node 0 is its own ancestor" "$RL" info "$TMP/cycle.gltf"
 bounded 10 "$MIB" "endless.ply: .*4000000000" "$RL" info "$TMP/endless.ply"
 bounded 10 "$MIB" "endless_bin.ply: .*4000000000" "$RL" info "$TMP/endless_bin.ply"
+bounded 10 "$MIB" "hang.gltf: not a PLY file" "$RL" info "$TMP/hang.gltf"
 bounded 10 "$MIB" "bomb.glb: GLB chunk 1 claims 2100000000 bytes" "$RL" render "$TMP/bomb.glb" --size 32x24 --out "$TMP/x.png"
 
 # Past the pre-checks: the importer's child crashes, hangs, or runs out of
 # memory, and rl reports it.
 bounded 10 "$MIB" "nested.gltf: the importer crashed (" "$RL" info "$TMP/nested.gltf"
-# (The hang spins, so the CPU-time limit, set to the timeout, may end it
+# (The import spins, so the CPU-time limit, set to the timeout, may end it
 # first on an idle machine: either message is right.)
-bounded 10 "$MIB" "hang.gltf: the importer ran out of .*time (2 s)" "$RL" --import-timeout 2 info "$TMP/hang.gltf"
+bounded 10 "$MIB" "slow.obj: the importer ran out of .*time (2 s)" "$RL" --import-timeout 2 info "$TMP/slow.obj"
 # The same through a JSON scene's "file", with the flag after the command.
-bounded 10 "$MIB" "hang.gltf: the importer ran out of .*time (1 s)" "$RL" render "$TMP/uses_hang.json" --size 32x24 --out "$TMP/x.png" --import-timeout=1
+bounded 10 "$MIB" "slow.obj: the importer ran out of .*time (1 s)" "$RL" render "$TMP/uses_slow.json" --size 32x24 --out "$TMP/x.png" --import-timeout=1
 [ ! -e "$TMP/x.png" ] || fail "a failed import still wrote x.png"
 if [ "$ASAN" = 0 ]; then
     bounded 20 "$MIB" "big.obj: the importer exceeded its memory limit (64 MiB)" "$RL" --import-memory 64 info "$TMP/big.obj"
