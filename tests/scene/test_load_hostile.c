@@ -168,38 +168,32 @@ static void test_off_indices_out_of_range_are_refused(void **state)
 {
     (void)state;
     char path[1200];
-    const char *bad = "OFF\n# a comment\n3 1 0\n0 0 0\n1 0 0\n\n0 1 0\n3 0 1 7\n";
-    expect_refused(write_bytes("bad.off", bad, strlen(bad), path, sizeof path), RL_ERR_PARSE,
-                   "OFF face 0 uses vertex 7 of 3");
-    const char *negative = "OFF 3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 -1 2\n";
-    expect_refused(write_bytes("negative.off", negative, strlen(negative), path, sizeof path),
-                   RL_ERR_PARSE, "uses vertex -1 of 3");
-    /* Counts the file cannot hold: Assimp would size its arrays by them
-     * first (fuzz_load_mesh found 53 GB asked for by a 90-byte file whose
-     * face count overflows any integer). */
-    const char *huge = "OFF\n4 1111111111111111111111111111111111111112 0\n0 0 0\n1 0 10 1\n1 1 0\n0 1 0\n3 0 2\n";
-    expect_refused(write_bytes("huge.off", huge, strlen(huge), path, sizeof path), RL_ERR_PARSE,
-                   "more than its 33 bytes after the header can hold");
-    /* fuzz_load_mesh: no edge count after a face count of 10^62 (Assimp
-     * reads two counts and asked for 22 GB). */
-    const char *no_edges = "OFF\n4 333333333333333333333333333333333333333333333333333333333333333???\n";
-    expect_refused(write_bytes("no_edges.off", no_edges, strlen(no_edges), path, sizeof path), RL_ERR_PARSE,
-                   "OFF declares 4 vertices and 9223372036854775807 faces");
-    /* fuzz_load_mesh: counts right after the header word, no space
-     * (Assimp read 33 fours as the vertex count and asked for 5.7 GB). */
-    const char *glued = "OFF444444444444444444444444444444444\n4 0\n0";
-    expect_refused(write_bytes("glued.off", glued, strlen(glued), path, sizeof path), RL_ERR_PARSE,
-                   "OFF declares 9223372036854775807 vertices and 4 faces");
-    /* Geomview's prefixes, the dimension count of "nOFF" before the counts. */
-    const char *dimension = "CnOFF\n3\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 9\n";
-    expect_refused(write_bytes("dimension.off", dimension, strlen(dimension), path, sizeof path), RL_ERR_PARSE,
-                   "OFF face 0 uses vertex 9 of 3");
-    const char *counts_below = "OFF\n3\n1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 9\n";
-    expect_refused(write_bytes("counts_below.off", counts_below, strlen(counts_below), path, sizeof path),
-                   RL_ERR_PARSE, "OFF face 0 uses vertex 9 of 3");
-    const char *many = "OFF\n3 40 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n";
-    expect_refused(write_bytes("many.off", many, strlen(many), path, sizeof path), RL_ERR_PARSE,
-                   "OFF declares 3 vertices and 40 faces");
+    static const struct {
+        const char *name, *text, *want;
+    } refused[] = {
+        { "bad.off", "OFF\n# a comment\n3 1 0\n0 0 0\n1 0 0\n\n0 1 0\n3 0 1 7\n", "OFF face 0 uses vertex 7 of 3" },
+        { "negative.off", "OFF 3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 -1 2\n", "uses vertex -1 of 3" },
+        /* Counts the file cannot hold: Assimp would size its arrays by
+         * them first (fuzz_load_mesh found 53 GB asked for by a 90-byte
+         * file whose face count overflows any integer). */
+        { "huge.off", "OFF\n4 1111111111111111111111111111111111111112 0\n0 0 0\n1 0 10 1\n1 1 0\n0 1 0\n3 0 2\n",
+          "more than its 33 bytes after the header can hold" },
+        /* fuzz_load_mesh: no edge count after a face count of 10^62
+         * (Assimp reads two counts and asked for 22 GB). */
+        { "no_edges.off", "OFF\n4 333333333333333333333333333333333333333333333333333333333333333???\n",
+          "OFF declares 4 vertices and 9223372036854775807 faces" },
+        /* fuzz_load_mesh: counts right after the header word, no space
+         * (Assimp read 33 fours as the vertex count and asked for 5.7 GB). */
+        { "glued.off", "OFF444444444444444444444444444444444\n4 0\n0",
+          "OFF declares 9223372036854775807 vertices and 4 faces" },
+        /* Geomview's prefixes; "nOFF" has a dimension count before the counts. */
+        { "dimension.off", "CnOFF\n3\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 9\n", "OFF face 0 uses vertex 9 of 3" },
+        { "counts_below.off", "OFF\n3\n1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 9\n", "OFF face 0 uses vertex 9 of 3" },
+        { "many.off", "OFF\n3 40 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n", "OFF declares 3 vertices and 40 faces" },
+    };
+    for (size_t i = 0; i < sizeof refused / sizeof refused[0]; ++i)
+        expect_refused(write_bytes(refused[i].name, refused[i].text, strlen(refused[i].text), path, sizeof path),
+                       RL_ERR_PARSE, refused[i].want);
     const char *good = "OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2";   /* no end after the last line */
     rl_scene *s = NULL;
     assert_int_equal(rl_scene_load(write_bytes("good.off", good, strlen(good), path, sizeof path), NULL, &s),
