@@ -511,9 +511,12 @@ static rl_status check_off(const char *path, const char *data, size_t size)
                 ++p;
                 need = 3;   /* the dimension, then the counts */
             }
-            if (strncmp(p, "OFF", 3) != 0)
+            if (strncmp(p, "OFF", 3) == 0)
+                p += 3;
+            else if (!(*p >= '0' && *p <= '9') && *p != '+')
                 return RL_OK;   /* not the text form we know: Assimp decides */
-            p += 3;
+            /* else no header word: Assimp then reads the counts straight
+             * away (fuzzed: a line of 98 digits asked for 28 GB). */
             header = true;
         }
         for (char *end; have < need + 1; p = end) {

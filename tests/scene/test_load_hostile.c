@@ -186,6 +186,10 @@ static void test_off_indices_out_of_range_are_refused(void **state)
          * (Assimp read 33 fours as the vertex count and asked for 5.7 GB). */
         { "glued.off", "OFF444444444444444444444444444444444\n4 0\n0",
           "OFF declares 9223372036854775807 vertices and 4 faces" },
+        /* fuzz_load_mesh: no header word at all; Assimp reads the counts
+         * from the first line (it asked for 28 GB). */
+        { "headless.off", "\t\t22222222222222222222222222222222222222\t\t1\n",
+          "OFF declares 9223372036854775807 vertices and 1 faces" },
         /* Geomview's prefixes; "nOFF" has a dimension count before the counts. */
         { "dimension.off", "CnOFF\n3\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 9\n", "OFF face 0 uses vertex 9 of 3" },
         { "counts_below.off", "OFF\n3\n1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 9\n", "OFF face 0 uses vertex 9 of 3" },
