@@ -7,6 +7,7 @@
  * random integer generation in an interval"), which has no modulo bias.
  * Jump-ahead is Brown 1994, "Random number generation with arbitrary
  * strides". */
+#include "core/hash.h"
 #include "rl/rl_rng.h"
 
 #define PCG_MULT 6364136223846793005ULL
@@ -84,10 +85,5 @@ void rl_rng_advance(rl_rng *rng, uint64_t delta)
 
 uint64_t rl_hash64(uint64_t x)
 {
-    /* One splitmix64 step (Steele, Lea & Flood 2014): the golden-ratio
-     * increment keeps hash(0) != 0, then the finaliser gives full avalanche. */
-    x += 0x9e3779b97f4a7c15ULL;
-    x = (x ^ (x >> 30)) * 0xbf58476d1ce4e5b9ULL;
-    x = (x ^ (x >> 27)) * 0x94d049bb133111ebULL;
-    return x ^ (x >> 31);
+    return rl_splitmix64(x);
 }

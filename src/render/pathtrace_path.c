@@ -258,11 +258,10 @@ static rl_vec3 direct_light(const pt_ctx *ctx, const pt_surface *s, pt_sampler *
         const rl_light *L = &d->lights[i];
         uint32_t light_base = base + PT_SLOTS_VERTEX + PT_SLOTS_LIGHT * i * (uint32_t)ctx->light_samples;
         if (L->type == RL_LIGHT_QUAD) {
-            rl_vec3 nq = rl_cross(L->edge_u, L->edge_v);
-            float area = rl_length(nq);
+            float area = ctx->b->lights.light_area[i];
             if (!(area > 0.0f))
                 continue;
-            nq = rl_scale(nq, 1.0f / area);
+            rl_vec3 nq = ctx->b->lights.light_normal[i];
             int n = ctx->light_samples;
             rl_vec3 le = rl_scale(L->color, L->intensity * area / (float)n);
             for (int k = 0; k < n; ++k) {
@@ -489,7 +488,7 @@ static rl_vec3 emitted_mis(const pt_ctx *ctx, const pt_surface *s, bool after_br
             return rl_v3s(0.0f);    /* its back, or a quad only NEE reaches */
         e = rl_scale(L->color, L->intensity);
         pmf = lt->light_pmf[cover];
-        area = rl_length(nq);
+        area = lt->light_area[cover];
         /* The density light sampling had at prev: by solid angle where
          * pathtrace_quad.c samples this quad from there. */
         pt_sph_rect rect;

@@ -25,6 +25,7 @@
  * upwards), multiplying by an odd constant, and x ^= x * (even constant).
  * The constants are ours; the stratification this guarantees is tested in
  * tests/render/test_pathtrace_sampler.c. */
+#include "core/hash.h"   /* rl_splitmix64: rl_hash64 inlined into every draw */
 #include "render/pathtrace_internal.h"
 
 #define TO_UNIT_24 (1.0f / 16777216.0f)   /* 2^-24: 24 bits fill a float's mantissa */
@@ -97,21 +98,9 @@ void rl_pt_sampler_init(pt_sampler *s, rl_rng_gpu *rng, uint32_t pixel_seed, uin
     s->slot = 0;
 }
 
-/* rl_hash64 (core/rng.c, one splitmix64 step) written out here, so that
- * the compiler inlines it into every draw: the library's copy is an
- * exported call, and a draw is only about a hundred operations. The same
- * function, bit for bit (tested against rl_hash64). */
-static inline uint64_t hash64(uint64_t x)
-{
-    x += 0x9e3779b97f4a7c15ull;
-    x = (x ^ (x >> 30)) * 0xbf58476d1ce4e5b9ull;
-    x = (x ^ (x >> 27)) * 0x94d049bb133111ebull;
-    return x ^ (x >> 31);
-}
-
 uint32_t rl_pt_pixel_seed(uint64_t seed, uint64_t pixel)
 {
-    return (uint32_t)(hash64(hash64(seed) ^ (pixel * 0x9e3779b97f4a7c15ull)) >> 32);
+    return (uint32_t)(rl_splitmix64(rl_splitmix64(seed) ^ (pixel * 0x9e3779b97f4a7c15ull)) >> 32);
 }
 
 /* Both halves of a 64-bit word bit-reversed in place: one reversal for the
@@ -131,7 +120,7 @@ static uint64_t reverse_bits64(uint64_t x)
  * distinct well-mixed words. */
 static void slot_seeds(const pt_sampler *s, uint32_t slot, uint32_t seed[3])
 {
-    uint64_t h = hash64(((uint64_t)s->pixel_seed << 32) | slot);
+    uint64_t h = rl_splitmix64(((uint64_t)s->pixel_seed << 32) | slot);
     seed[0] = (uint32_t)h;
     seed[1] = (uint32_t)(h >> 32);
     seed[2] = (uint32_t)((h * 0xd1342543de82ef95ull) >> 32) ^ seed[0];
